@@ -1,0 +1,28 @@
+"""Named errors. Every error says which rule was broken, by which value, and where the rule comes from."""
+
+from __future__ import annotations
+
+
+class Supi3Error(Exception):
+    """Base class of every error supi3 raises on purpose."""
+
+
+class ConfigurationError(Supi3Error, ValueError):
+    """A pin-strap combination the manual does not allow.
+
+    Attributes
+    ----------
+    pins:
+        The pins concerned, as the manual names them (``"C[4..0]"``, ``"MFP[15..12]"``, ...).
+    value:
+        The value given, as a bit string MSB first, or a short description.
+    rule:
+        The table or section that rules the combination out.
+    """
+
+    def __init__(self, pins: str, value: str, rule: str, detail: str) -> None:
+        self.pins = pins
+        self.value = value
+        self.rule = rule
+        self.detail = detail
+        super().__init__(f"{pins} = {value}: {detail} ({rule})")
