@@ -393,7 +393,8 @@ SPI_MASTER_MFP: Final[tuple[PinFunction, ...]] = (
 
 UP_MOTOROLA_MFP: Final[tuple[PinFunction, ...]] = (
     PinFunction(0, "SAS_INIT", Direction.IN, "Initialization of the serial interface (active high)"),
-    PinFunction(1, "I/O", Direction.OUT, "I/O access (polling) bit (corresponds to bit D7 in the interrupt event register (rel. addr. 14)"),  # noqa: E501
+    PinFunction(1, "I/O", Direction.OUT,
+                "I/O access (polling) bit (corresponds to bit D7 in the interrupt event register (rel. addr. 14)"),
     PinFunction(2, "C/D", Direction.OUT, "Command/Data status: next byte is a command (0) or data (1)"),
     PinFunction(3, "/IRQ", Direction.OUT, "Interrupt Request"),
     PinFunction(4, "SCLK", Direction.IN, "Clock input (1.5 MHz maximum at 500 kbps, 6 MHz maximum at 2 Mbps)"),
@@ -405,7 +406,8 @@ UP_MOTOROLA_MFP: Final[tuple[PinFunction, ...]] = (
 
 UP_INTEL_MFP: Final[tuple[PinFunction, ...]] = (
     PinFunction(0, "SAS_INIT", Direction.IN, "Initialization of the serial interface (active high)"),
-    PinFunction(1, "I/O", Direction.OUT, "I/O access (polling) bit (corresponds to bit D7 in the interrupt event register)"),  # noqa: E501
+    PinFunction(1, "I/O", Direction.OUT,
+                "I/O access (polling) bit (corresponds to bit D7 in the interrupt event register)"),
     PinFunction(2, "C/D", Direction.OUT, "Command/Data status: next byte is a command (1) or data (0)"),
     PinFunction(3, "/IRQ", Direction.OUT, "Interrupt Request"),
     PinFunction(4, "SCLK", Direction.IN, "Clock input (1.5 MHz maximum at 500 kbps, 6 MHz maximum at 2 Mbps)"),
@@ -417,7 +419,8 @@ UP_INTEL_MFP: Final[tuple[PinFunction, ...]] = (
 the chip can leave it an input after every hardware reset until the mode is known (3.4.3)."""
 
 BUS_TERMINAL_MFP: Final[tuple[PinFunction, ...]] = (
-    PinFunction(8, "FO3", Direction.OUT, 'Initialization diagnostics, optical fiber interface in "READY" bus status or MAU warning in "RUN" bus status.'),  # noqa: E501
+    PinFunction(8, "FO3", Direction.OUT, "Initialization diagnostics, optical fiber interface in "
+                '"READY" bus status or MAU warning in "RUN" bus status.'),
     PinFunction(9, "DO3_CU", Direction.OUT, "Branch data output (copper)"),
     PinFunction(10, "DI3", Direction.IN, "Branch data input"),
     PinFunction(11, "LBST", Direction.IN, "Alarm input for local bus connector"),

@@ -1,0 +1,161 @@
+"""Timing calculator: bit periods, the CPU access time of 3.4.14, the I/O access window, the manual's timing
+tables evaluated for a bit rate, and the optical length formula of 1.6.1 with the resolution of Table 1-5."""
+
+from __future__ import annotations
+
+import ast
+import operator
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from supi3 import tables
+from supi3.errors import Supi3Error
+
+
+class TimingError(Supi3Error, ValueError):
+    """A timing question the manual cannot answer (unknown bit rate, negative byte count, ...)."""
+
+
+def bit_period_s(bit_rate: int) -> float:
+    """t_Bit_IBS: 2 µs at 500 kbit/s, 0.5 µs at 2 Mbit/s (Table 1-7 bit rates only)."""
+    if bit_rate not in tables.BIT_RATES:
+        raise TimingError(f"bit rate {bit_rate} bit/s is not one of Table 1-7's {tables.BIT_RATES}")
+    return 1.0 / bit_rate
+
+
+def cpu_access_time_s(network_bytes: int, bit_rate: int) -> float:
+    """Worst-case time the CPU has after a valid-data-cycle interrupt: T = 13 * (5 + n) * t_Bit (3.4.14).
+
+    ``network_bytes`` is n, the number of data bytes in the entire network. The manual's example, one 2-word
+    device at 500 kbit/s, gives 234 µs.
+    """
+    if network_bytes < 0:
+        raise TimingError(f"network byte count must be >= 0, not {network_bytes}")
+    return (tables.CPU_ACCESS_TELEGRAM_BITS * (tables.CPU_ACCESS_OVERHEAD_BYTES + network_bytes)
+            * bit_period_s(bit_rate))
+
+
+def io_access_window_s(bit_rate: int) -> float:
+    """Time the data registers may be accessed after the I/O access bit falls: 30 bit periods (3.4.14)."""
+    return tables.IO_ACCESS_WINDOW_BITS * bit_period_s(bit_rate)
+
+
+# ------------------------------------------------------------------------------------------------------------
+# The manual's timing expressions ("0.5 * t_Bit_IBS", "2 * TCLK + 10 ns", "667 ns | 167 ns")
+# ------------------------------------------------------------------------------------------------------------
+
+_OPS: dict[type, Callable[[float, float], float]] = {
+    ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
+}
+
+
+def _eval(node: ast.AST, names: dict[str, float]) -> float:
+    if isinstance(node, ast.Expression):
+        return _eval(node.body, names)
+    if isinstance(node, ast.Constant) and isinstance(node.value, int | float):
+        return float(node.value)
+    if isinstance(node, ast.Name) and node.id in names:
+        return names[node.id]
+    if isinstance(node, ast.BinOp) and type(node.op) in _OPS:
+        return _OPS[type(node.op)](_eval(node.left, names), _eval(node.right, names))
+    raise TimingError(f"cannot evaluate {ast.dump(node)} in a timing expression")
+
+
+def evaluate(expression: str, bit_rate: int, n_bytes: int = 1, t0_s: float | None = None) -> float:
+    """Evaluate one of the manual's timing expressions in seconds for a bit rate.
+
+    Names: ``t_Bit_IBS`` (bit period), ``TCLK`` (t_Bit_IBS / 16, Table 3-7), ``t0`` (the table's clock period,
+    passed in ``t0_s``), ``n`` (bytes, Table 3-4 t8), ``ns`` (1e-9). ``"a | b"`` gives ``a`` at 500 kbit/s and
+    ``b`` at 2 Mbit/s.
+    """
+    if "|" in expression:
+        low, high = expression.split("|")
+        expression = low if bit_rate == tables.BIT_RATES[0] else high
+    t_bit = bit_period_s(bit_rate)
+    names = {"t_Bit_IBS": t_bit, "TCLK": t_bit / 16, "n": float(n_bytes), "ns": 1e-9}
+    if t0_s is not None:
+        names["t0"] = t0_s
+    # "100 ns" is the manual's notation for 100 * ns.
+    source = expression.strip().replace(" ns", " * ns")
+    return _eval(ast.parse(source, mode="eval"), names)
+
+
+@dataclass(frozen=True)
+class EvaluatedTiming:
+    """A timing parameter with its limits in seconds (``None`` where the table gives no limit)."""
+
+    symbol: str
+    explanation: str
+    minimum_s: float | None
+    maximum_s: float | None
+
+
+TIMING_TABLES: dict[str, tuple[tables.TimingParameter, ...]] = {
+    "3-4": tables.SPI_MASTER_TIMING,
+    "3-7": tables.UP_INTERFACE_TIMING,
+    "3-15": tables.REGISTER_EXPANSION_TIMING,
+}
+
+
+def timing_table(table: str, bit_rate: int, n_bytes: int = 2) -> list[EvaluatedTiming]:
+    """Evaluate every row of Table 3-4, 3-7 or 3-15 for a bit rate (``n_bytes`` for Table 3-4's t8)."""
+    if table not in TIMING_TABLES:
+        raise TimingError(f"no timing table {table!r}; choose from {sorted(TIMING_TABLES)}")
+    result: list[EvaluatedTiming] = []
+    t0: float | None = None
+    for row in TIMING_TABLES[table]:
+        low = evaluate(row.minimum, bit_rate, n_bytes, t0) if row.minimum else None
+        high = evaluate(row.maximum, bit_rate, n_bytes, t0) if row.maximum else None
+        if row.symbol == "t0":
+            t0 = low
+        result.append(EvaluatedTiming(row.symbol, row.explanation, low, high))
+    return result
+
+
+# ------------------------------------------------------------------------------------------------------------
+# Optical path length (1.6.1, Table 1-5)
+# ------------------------------------------------------------------------------------------------------------
+
+
+def optical_length_m(timer_count: int, bit_rate: int) -> float:
+    """Forward-and-return fibre length from the runtime timer: L = n / (f * t) (1.6.1).
+
+    f is the timer clock, 16 times the bit rate (8 MHz at 500 kbit/s), t = 5 ns/m.
+    """
+    if timer_count < 0:
+        raise TimingError(f"timer count must be >= 0, not {timer_count}")
+    bit_period_s(bit_rate)
+    f = tables.LENGTH_TIMER_CLOCKS_PER_BIT * bit_rate
+    return timer_count / (f * tables.LIGHT_RUNTIME_S_PER_M)
+
+
+def optical_range(length_m: float, bit_rate: int) -> tables.OpticalLengthRange:
+    """The Table 1-5 row that applies to a one-way path length at a bit rate."""
+    bit_period_s(bit_rate)
+    rows = [r for r in tables.OPTICAL_LENGTH_RANGES if r.bit_rate == bit_rate]
+    for row in rows:
+        if row.min_m <= length_m < row.max_m:
+            return row
+    raise TimingError(f"{length_m} m is outside Table 1-5's 0 m to 20 km")
+
+
+def report(network_bytes: int, bit_rate: int) -> dict[str, object]:
+    """Everything ``supi3 timing`` prints, as data (times in µs)."""
+    t_bit = bit_period_s(bit_rate)
+    resolution = optical_length_m(1, bit_rate)
+    near = optical_range(0, bit_rate)
+    return {
+        "bit_rate": bit_rate,
+        "t_bit_us": t_bit * 1e6,
+        "network_bytes": network_bytes,
+        "cpu_access_time_us": round(cpu_access_time_s(network_bytes, bit_rate) * 1e6, 6),
+        "cpu_access_formula": "T = 13 * (5 + n) * t_Bit (manual 3.4.14)",
+        "io_access_window_us": round(io_access_window_s(bit_rate) * 1e6, 6),
+        "io_access_window_formula": "30 * t_Bit (manual 3.4.14, Figure 3-22)",
+        "optical_formula": "L = n / (f * t), f = 16 * bit rate, t = 5 ns/m (manual 1.6.1)",
+        "optical_m_per_count": resolution,
+        "optical_resolution_m": {"typical": near.resolution_m[0] if near.resolution_m else None,
+                                 "worst": near.resolution_m[1] if near.resolution_m else None},
+        "optical_value_range": list(near.values),
+        "optical_long_value": 63,
+    }
