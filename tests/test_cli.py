@@ -87,3 +87,25 @@ def test_console_script_entry_point() -> None:
     bad = subprocess.run([sys.executable, "-m", "supi3.cli", "decode", "--c", "x"], capture_output=True,
                          text=True, check=False)
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1
+
+
+def test_demo(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = _run(capsys, "demo")
+    assert code == 0
+    assert "RB, 8 IN/8 OUT" in out and "Interrupt event (IRQ_EVT)" in out
+    assert len([line for line in out.splitlines() if line[:2].strip().isdigit()]) == 16
+
+
+@pytest.mark.parametrize(("fmt", "marker"), [("md", "#"), ("rdl", "addrmap"), ("h", "#define SUPI3_"),
+                                             ("json", "{")])
+def test_regmap_formats_to_stdout(capsys: pytest.CaptureFixture[str], fmt: str, marker: str) -> None:
+    code, out, _ = _run(capsys, "regmap", "--format", fmt)
+    assert code == 0 and marker in out
+
+
+def test_regmap_html_to_directory(capsys: pytest.CaptureFixture[str], tmp_path: object) -> None:
+    from pathlib import Path
+
+    out_dir = Path(str(tmp_path)) / "html"
+    code, out, _ = _run(capsys, "regmap", "--format", "html", "-o", str(out_dir))
+    assert code == 0 and (out_dir / "index.html").exists() and str(out_dir) in out

@@ -121,15 +121,28 @@ def _parse_bit_rate(text: str) -> int:
         raise timing.TimingError(f"bit rate {text!r}: choose 500k or 2M (Table 1-7)") from None
 
 
+def regmap_summary() -> str:
+    """One line per address of the register map: what a write and a read reach, and how."""
+    from supi3.regmap import REGISTER_MAP, Direction
+
+    rows = []
+    for address in REGISTER_MAP.addresses:
+        cells: list[object] = [address]
+        for direction in (Direction.WRITE, Direction.READ):
+            port = REGISTER_MAP.port(address, direction)
+            name = port.register.name if port.register else ""
+            cells += [f"{port.title} ({name})" if name else port.title, port.access.value]
+        rows.append(cells)
+    return _format_rows(("Addr", "Write", "Access", "Read", "Access"), rows)
+
+
 def cmd_demo(_args: argparse.Namespace) -> None:
     """Decode the default device and summarise the register map."""
-    from supi3.regmap import summary
-
     config = decode(**DEMO_STRAPS)
     print("supi3 demo: the default device (C[4..0] = 10000, CLK_CONF = 01, pins left open)\n")
     print(describe(config))
     print("\nRegister map of the serial µP interface (Table 3-10):\n")
-    print(summary())
+    print(regmap_summary())
 
 
 def build_parser() -> argparse.ArgumentParser:
