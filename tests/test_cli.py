@@ -66,6 +66,16 @@ def test_errors_are_one_line_with_status_2(capsys: pytest.CaptureFixture[str], a
     assert "Traceback" not in err
 
 
+@pytest.mark.parametrize("argv", [["decode"], ["decode", "--c", "10000", "--bogus"], ["frobnicate"],
+                                  ["regmap", "--format", "pdf"], []])
+def test_usage_errors_are_one_line(capsys: pytest.CaptureFixture[str], argv: list[str]) -> None:
+    with pytest.raises(SystemExit) as info:
+        main(argv)
+    _, err = capsys.readouterr()
+    assert info.value.code == 2
+    assert err.count("\n") == 1 and "error:" in err
+
+
 def test_timing_json_manual_example(capsys: pytest.CaptureFixture[str]) -> None:
     code, out, _ = _run(capsys, "timing", "--json")
     data = json.loads(out)

@@ -10,6 +10,7 @@ import json
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import NoReturn
 
 from supi3 import tables, timing
 from supi3.config import DeviceConfig, Interface, Variant, decode, mode_rows
@@ -145,9 +146,16 @@ def cmd_demo(_args: argparse.Namespace) -> None:
     print(regmap_summary())
 
 
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose usage errors are one line, like every other supi3 error."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``supi3`` command."""
-    parser = argparse.ArgumentParser(prog="supi3", description=__doc__)
+    parser = _Parser(prog="supi3", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("demo", help="run the demo on built-in defaults")
