@@ -115,7 +115,10 @@ def _rdl_field(register: Register, field: Field) -> list[str]:
     props = [f"sw = {sw};", f"hw = {'w' if sw == 'r' else 'r'};"]
     if access is Access.RC and sw == "r":
         props.append("onread = rclr;")
-    desc = " ".join([_field_text(field), *(_field_text(o) for o in register.fields if o.overlays == field.name)])
+    overlays = [
+        f"Bits {_bits(o)} are also {o.name}: {_field_text(o)}" for o in register.fields if o.overlays == field.name
+    ]
+    desc = " ".join([_field_text(field), *overlays])
     encode = f" encode = {register.name}_{field.name}_e;" if field.values else ""
     return [
         "        field {",
@@ -215,7 +218,8 @@ def to_html(outdir: Path) -> Path:
     from peakrdl_html import HTMLExporter
 
     outdir.mkdir(parents=True, exist_ok=True)
-    HTMLExporter().export(compile_systemrdl(to_systemrdl()), str(outdir), title=TITLE)
+    exporter = HTMLExporter(generate_source_links=False)
+    exporter.export(compile_systemrdl(to_systemrdl()), str(outdir), title=TITLE)
     return outdir / "index.html"
 
 
