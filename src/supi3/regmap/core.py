@@ -185,7 +185,7 @@ class Layout:
                 raise RegisterMapError(f"{self.name}: field {f.name} overlaps another field")
             taken |= f.mask
         for f in self.fields:
-            if f.overlays is not None and not self.field(f.overlays).mask & f.mask == f.mask:
+            if f.overlays is not None and (self.field(f.overlays).mask & f.mask) != f.mask:
                 raise RegisterMapError(f"{self.name}: field {f.name} is not inside {f.overlays}")
 
     @property
