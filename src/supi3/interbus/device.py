@@ -1,0 +1,220 @@
+"""The transaction-level device interface of the ring, and a plain register device.
+
+A device is one segment of the distributed shift register (docs/interbus.md, "Ring"). At transaction level the
+ring does the shifting, the per-line checks and the timing; a device only parallel-loads its register at the
+start of a cycle and is told at the end whether the cycle was latched. The SUPI 3 model implements
+:class:`Device` too.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+from supi3.interbus import wire
+from supi3.interbus.errors import InterbusError
+from supi3.interbus.wire import Cycle
+from supi3.tables import WATCHDOG_TIMEOUTS_S
+
+
+class Device(Protocol):
+    """What the ring needs from a device (docs/interbus.md, "Device protocol").
+
+    Every call carries ``now``, the bus time in seconds, so a device can run its layer-2 watchdog
+    (Table 3-13) without a clock of its own. Calls for one cycle come in this order: :meth:`load`, then
+    :attr:`attention`, then exactly one of :meth:`latch` or :meth:`discard`.
+    """
+
+    @property
+    def attention(self) -> bool:
+        """The device has a new management flag (PF or WD) and wants the master to run an ID cycle.
+
+        ORed into the CNTR word's ATTN flag as the check sequence passes (assumption A7).
+        """
+        ...
+
+    def load(self, cycle: Cycle, now: float) -> bytes:
+        """Parallel-load the shift register at the start of a cycle and return its contents in line order.
+
+        ID cycle: the 16-bit ID register (``wire.word_bytes(wire.id_register(...))``). Data cycle: the IN data,
+        ``wire.data_bytes(length_code)`` bytes, byte 0 (the most significant, manual 3.4.8) first. The length of
+        the returned bytes is the register's length for this cycle.
+        """
+        ...
+
+    def latch(self, cycle: Cycle, received: bytes, now: float) -> None:
+        """The cycle passed every check and the master sent the latch telegrams: take over ``received``.
+
+        ``received`` is what the register holds at the end of the data sequence: the OUT data in a data cycle,
+        the command word (``wire.decode_command(wire.word_from_bytes(received))``) in an ID cycle.
+        """
+        ...
+
+    def discard(self, cycle: Cycle, local_error: bool, now: float) -> None:
+        """The cycle ended without a latch for this device ("invalid data cycle", Table 3-13).
+
+        ``local_error`` is ``True`` when this device's own check of its incoming line failed; the device then
+        sets the TE management bit of its ID register (assumption A8).
+        """
+        ...
+
+    def reset(self, now: float) -> None:
+        """The device detected an INTERBUS reset (reset pattern, or a silent line for ``IDLE_TIMEOUT_S``)."""
+        ...
+
+    def poll(self, now: float) -> None:
+        """Bus time has advanced to ``now`` without a cycle reaching this device."""
+        ...
+
+
+class Layer2Watchdog:
+    """The layer-2 watchdog of Table 3-13: set by the master, resets process data when no valid data cycle
+    arrives within the set time (50 ms, 200 ms, 1000 ms or off; off after power-up and INTERBUS reset)."""
+
+    def __init__(self) -> None:
+        self.timeout_s: float | None = None
+        self._since = 0.0
+        self._armed = False
+
+    def configure(self, code: int, now: float) -> None:
+        """Apply a command word's watchdog code (an index into ``WATCHDOG_TIMEOUTS_S``)."""
+        self.timeout_s = WATCHDOG_TIMEOUTS_S[code]
+        self.kick(now)
+
+    def off(self) -> None:
+        """Switch the watchdog off (INTERBUS reset)."""
+        self.timeout_s = None
+        self._armed = False
+
+    def kick(self, now: float) -> None:
+        """A valid data cycle ended at ``now``."""
+        self._since = now
+        self._armed = self.timeout_s is not None
+
+    def expired(self, now: float) -> bool:
+        """``True`` once when the set time has passed since the last valid data cycle."""
+        if self._armed and self.timeout_s is not None and now - self._since > self.timeout_s:
+            self._armed = False
+            return True
+        return False
+
+
+class PlainDevice:
+    """A plain INTERBUS register device: an ID code, a length code, IN and OUT data registers.
+
+    Stands for devices that are not SUPI 3 based. Implements :class:`Device`.
+
+    Parameters
+    ----------
+    id_code:
+        ID code, 0..255 (Table A-3; any value is accepted).
+    length_code:
+        Length code (Table 3-11); reserved codes are refused.
+
+    Attributes
+    ----------
+    inputs:
+        IN data the device sends in the next data cycle (set with :meth:`set_inputs`).
+    outputs:
+        OUT data latched from the last valid data cycle.
+    mod_ack_pulses:
+        /ModAck pulses so far: one per Quit Peripheral Error (0714h) received (3.6.2).
+    valid_cycles, invalid_cycles, id_cycles, resets, watchdog_resets:
+        Event counters, the interrupt sources of Table 3-13.
+    last_reset_s:
+        Bus time of the last INTERBUS reset, ``None`` before one.
+    """
+
+    def __init__(self, id_code: int, length_code: int) -> None:
+        wire.id_register(id_code, length_code)
+        self.id_code = id_code
+        self.length_code = length_code
+        self.size = wire.data_bytes(length_code)
+        self.inputs = bytes(self.size)
+        self.outputs = bytes(self.size)
+        self.watchdog = Layer2Watchdog()
+        self.stat_err = False
+        self.mod_ack_pulses = 0
+        self.valid_cycles = 0
+        self.invalid_cycles = 0
+        self.id_cycles = 0
+        self.resets = 0
+        self.watchdog_resets = 0
+        self.last_reset_s: float | None = None
+        self._pf = False
+        self._wd = False
+        self._te = False
+        self._attention = False
+
+    def __repr__(self) -> str:
+        return f"PlainDevice(id_code={self.id_code:#04x}, length_code={self.length_code:#04x})"
+
+    @property
+    def attention(self) -> bool:
+        """See :attr:`Device.attention`."""
+        return self._attention
+
+    def set_inputs(self, data: bytes) -> None:
+        """Set the IN data for the next data cycles."""
+        if len(data) != self.size:
+            raise InterbusError("Table 3-11", data, f"IN data of this device is {self.size} bytes")
+        self.inputs = bytes(data)
+
+    def set_peripheral_fault(self, active: bool) -> None:
+        """Drive the /StatErr input (3.6.2): ``True`` is an I/O error; it latches the PF management bit."""
+        self.stat_err = active
+        if active and not self._pf:
+            self._pf = True
+            self._attention = True
+
+    def management(self) -> int:
+        """The management bits 15..13 of the ID register (assumption A8)."""
+        return (self._pf << wire.MGMT_PF_BIT) | (self._wd << wire.MGMT_WD_BIT) | (self._te << wire.MGMT_TE_BIT)
+
+    def _tick(self, now: float) -> None:
+        if self.watchdog.expired(now):
+            self.inputs = self.outputs = bytes(self.size)
+            self._wd = True
+            self._attention = True
+            self.watchdog_resets += 1
+
+    def load(self, cycle: Cycle, now: float) -> bytes:
+        """See :meth:`Device.load`."""
+        self._tick(now)
+        if cycle is Cycle.ID:
+            return wire.word_bytes(wire.id_register(self.id_code, self.length_code, self.management()))
+        return self.inputs
+
+    def latch(self, cycle: Cycle, received: bytes, now: float) -> None:
+        """See :meth:`Device.latch`."""
+        if cycle is Cycle.DATA:
+            self.outputs = received
+            self.watchdog.kick(now)
+            self.valid_cycles += 1
+            return
+        self.id_cycles += 1
+        command = wire.decode_command(wire.word_from_bytes(received))
+        if command.watchdog_code is not None:
+            self.watchdog.configure(command.watchdog_code, now)
+        if command.quit_peripheral_error:
+            self.mod_ack_pulses += 1
+            self._pf = self.stat_err
+        self._wd = self._te = self._attention = False
+
+    def discard(self, cycle: Cycle, local_error: bool, now: float) -> None:
+        """See :meth:`Device.discard`."""
+        self._tick(now)
+        self._te = self._te or local_error
+        self.invalid_cycles += cycle is Cycle.DATA
+
+    def reset(self, now: float) -> None:
+        """See :meth:`Device.reset`: IN and OUT data registers cleared, watchdog off (Table 3-13)."""
+        self.inputs = self.outputs = bytes(self.size)
+        self.watchdog.off()
+        self._wd = self._te = False
+        self._attention = self._pf
+        self.resets += 1
+        self.last_reset_s = now
+
+    def poll(self, now: float) -> None:
+        """See :meth:`Device.poll`."""
+        self._tick(now)

@@ -1,0 +1,443 @@
+"""An INTERBUS master at transaction level: reset, ID cycles, data cycles, configuration, diagnostics.
+
+The master builds the summation frame, reads the ring's configuration in ID cycles, exchanges process data in
+data cycles, checks loopback word, CRC and CNTR, latches a cycle only when all checks pass, locates errors, and
+offers the services the manual names: Alarm Stop (1303h), Control_Device_Function / Quit Peripheral Error
+(0714h), and the messages 0BB1h (peripheral fault) and 0C6Bh (watchdog). See docs/interbus.md, "Master".
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+from typing import Final
+
+from supi3.interbus import wire
+from supi3.interbus.errors import InterbusError
+from supi3.interbus.ring import ErrorKind, Ring, Transfer
+from supi3.interbus.wire import Cycle
+from supi3.tables import ID_CODES, LENGTH_CODE_BY_VALUE, UP_NOT_READY_ID_CODES, WATCHDOG_TIMEOUTS_S, IdCode
+
+# Firmware service and message codes named in the manual (3.4.14 Table 3-13, 3.6.2, Table 2-8).
+ALARM_STOP: Final = 0x1303
+CONTROL_DEVICE_FUNCTION: Final = 0x0714
+MSG_PERIPHERAL_FAULT: Final = 0x0BB1
+MSG_WATCHDOG: Final = 0x0C6B
+
+
+class InterfaceType(Enum):
+    """Where a device sits, derived from its ID code's group in Table A-3."""
+
+    REMOTE_BUS = "remote bus"
+    LOCAL_BUS = "local bus"
+    BUS_TERMINAL = "bus terminal"
+    UNKNOWN = "unknown"
+    """An ID code Table A-3 does not list; counted like a remote bus device (assumption A17)."""
+
+
+_ID_ROWS: Final[dict[int, IdCode]] = {row.code: row for row in ID_CODES}
+
+
+def interface_type(id_code: int) -> InterfaceType:
+    """The interface type of an ID code: the group its Table A-3 row belongs to."""
+    row = _ID_ROWS.get(id_code)
+    if row is None:
+        return InterfaceType.UNKNOWN
+    if row.group.startswith("Bus terminal"):
+        return InterfaceType.BUS_TERMINAL
+    if row.group.startswith("Local bus"):
+        return InterfaceType.LOCAL_BUS
+    return InterfaceType.REMOTE_BUS
+
+
+@dataclass(frozen=True)
+class ConfigEntry:
+    """One device of the configuration table read in an ID cycle.
+
+    Attributes
+    ----------
+    ring_position:
+        1..N, position 1 next to the master.
+    segment, position:
+        The device number ``segment.position``: a remote bus device or bus terminal opens a new segment at
+        position 0, local bus devices follow at 1, 2, ... (assumption A17).
+    id_code, length_code:
+        ID register bits 7..0 and 12..8.
+    data_bits, data_bytes:
+        Data length of the length code (Table 3-11) and the bytes it occupies on the line (assumption A15).
+    interface:
+        Derived from the ID code (Table A-3).
+    id_row:
+        The Table A-3 row of the ID code, if listed.
+    not_ready:
+        The ID code is a µP_Not_Ready code (3.4.1): the device's processor has not configured it yet.
+    """
+
+    ring_position: int
+    segment: int
+    position: int
+    id_code: int
+    length_code: int
+    data_bits: int
+    data_bytes: int
+    interface: InterfaceType
+    id_row: IdCode | None
+    not_ready: bool
+
+    @property
+    def number(self) -> str:
+        """The device number as a G4 master prints it, ``"segment.position"``."""
+        return f"{self.segment}.{self.position}"
+
+
+@dataclass(frozen=True)
+class Diagnostic:
+    """One error or message reported by the master.
+
+    Attributes
+    ----------
+    kind:
+        What happened.
+    location:
+        Ring position *k* whose incoming line (or whose device) is at fault, N + 1 for the return line into
+        the master; ``None`` if the master could not locate it.
+    device:
+        ``segment.position`` of the device at ``location``, if it is in the configuration.
+    code:
+        The firmware message code where the manual gives one (0BB1h, 0C6Bh).
+    detail:
+        Human-readable details.
+    """
+
+    kind: ErrorKind
+    location: int | None
+    device: str | None
+    code: int | None
+    detail: str
+
+
+@dataclass(frozen=True)
+class CycleResult:
+    """Outcome of one cycle: its type, whether it was latched, and the diagnostics it produced."""
+
+    cycle: Cycle
+    ok: bool
+    diagnostics: tuple[Diagnostic, ...]
+
+
+class Master:
+    """INTERBUS master model (docs/interbus.md, "Master").
+
+    Parameters
+    ----------
+    ring:
+        The ring the master drives.
+    locate:
+        After a failed cycle, locate the error with a diagnostic ID cycle and, if that fails too, a segment
+        search (ID cycles with the ring closed after ring position *j*).
+
+    Attributes
+    ----------
+    config:
+        The configuration table read in the last discovery ID cycle, ``None`` before one.
+    diagnostics:
+        Every diagnostic reported so far, oldest first.
+    """
+
+    def __init__(self, ring: Ring, locate: bool = True) -> None:
+        self.ring = ring
+        self.locate = locate
+        self.config: tuple[ConfigEntry, ...] | None = None
+        self.diagnostics: list[Diagnostic] = []
+        self._out = bytearray(wire.LOOPBACK_BYTES_ON_LINE)
+        self._in = b""
+        self._in_slices: list[slice] = []
+        self._out_slices: list[slice] = []
+        self._watchdog_code: int | None = None
+        self._watchdog_pending = False
+        self._quit: set[int] = set()
+        self._attention = False
+        self._pf_active: set[int] = set()
+
+    # -- services ------------------------------------------------------------------------------------------------
+
+    def alarm_stop(self) -> None:
+        """Alarm Stop (1303h): INTERBUS reset of the whole ring, outputs and inputs reset, configuration
+        forgotten; the next cycle is a discovery ID cycle. A watchdog setting is sent again afterwards."""
+        self.ring.reset()
+        self._set_config(None)
+        self._quit.clear()
+        self._attention = False
+        self._pf_active.clear()
+        self._watchdog_pending = self._watchdog_code is not None
+
+    def start(self) -> CycleResult:
+        """Alarm Stop, then a discovery ID cycle: the usual start-up."""
+        self.alarm_stop()
+        return self.id_cycle()
+
+    def set_watchdog(self, timeout_s: float | None) -> None:
+        """Set every device's layer-2 watchdog (Table 3-13: 0.05, 0.2, 1.0 s or ``None`` for off).
+
+        Sent in the command words of the next ID cycle (assumption A9).
+        """
+        if timeout_s not in WATCHDOG_TIMEOUTS_S:
+            raise InterbusError("Table 3-13", timeout_s, f"watchdog time must be one of {WATCHDOG_TIMEOUTS_S}")
+        self._watchdog_code = WATCHDOG_TIMEOUTS_S.index(timeout_s)
+        self._watchdog_pending = True
+
+    def quit_peripheral_error(self, position: int | str) -> None:
+        """Control_Device_Function 0714h, "Quit Peripheral Error" (3.6.2): acknowledge a device's peripheral
+        fault; the device's /ModAck output pulses. Sent in the device's command word of the next ID cycle."""
+        self._quit.add(self.entry(position).ring_position)
+
+    # -- process data --------------------------------------------------------------------------------------------
+
+    def entry(self, position: int | str) -> ConfigEntry:
+        """The configuration entry of a ring position (int, 1..N) or a device number (``"segment.position"``)."""
+        config = self._require_config()
+        if isinstance(position, int):
+            if 1 <= position <= len(config):
+                return config[position - 1]
+        else:
+            for entry in config:
+                if entry.number == position:
+                    return entry
+        raise InterbusError("docs/interbus.md, Master", position, "no such device in the configuration")
+
+    def set_outputs(self, position: int | str, data: bytes) -> None:
+        """Set the OUT data sent to a device from the next data cycle on."""
+        entry = self.entry(position)
+        if len(data) != entry.data_bytes:
+            raise InterbusError("Table 3-11", data, f"device {entry.number} takes {entry.data_bytes} bytes")
+        self._out[self._out_slices[entry.ring_position - 1]] = data
+
+    def outputs(self, position: int | str) -> bytes:
+        """The OUT data currently set for a device."""
+        return bytes(self._out[self._out_slices[self.entry(position).ring_position - 1]])
+
+    def inputs(self, position: int | str) -> bytes:
+        """The IN data of a device from the last valid data cycle (zeros before one)."""
+        return self._in[self._in_slices[self.entry(position).ring_position - 1]]
+
+    # -- cycles --------------------------------------------------------------------------------------------------
+
+    def cycle(self) -> CycleResult:
+        """Run the next cycle a master would: an ID cycle when there is no configuration, a command to send
+        or a device asking for attention, else a data cycle."""
+        if self.config is None or self._attention or self._watchdog_pending or self._quit:
+            return self.id_cycle()
+        return self.data_cycle()
+
+    def data_cycle(self) -> CycleResult:
+        """One data cycle: send the OUT data, receive the IN data, latch if every check passes."""
+        self._require_config()
+        data_len = len(self._out) - wire.LOOPBACK_BYTES
+        transfer = self.ring.transfer(Cycle.DATA, bytes(self._out))
+        problem = self._check(transfer, data_len)
+        self.ring.finish(transfer, problem is None)
+        if problem is not None:
+            return self._failed(Cycle.DATA, problem)
+        assert transfer.returned is not None
+        self._in = transfer.returned[:data_len]
+        self._attention = self._attention or transfer.flags.attention
+        return CycleResult(Cycle.DATA, True, ())
+
+    def id_cycle(self) -> CycleResult:
+        """One ID cycle: a discovery cycle without a configuration (the loopback word is searched for), else
+        a cycle over the known ring that also carries the command words."""
+        if self.config is None:
+            return self._discovery()
+        config = self.config
+        words = [self._command(entry.ring_position) for entry in reversed(config)]
+        data = wire.LOOPBACK_BYTES_ON_LINE + b"".join(wire.word_bytes(w) for w in words)
+        transfer = self.ring.transfer(Cycle.ID, data)
+        problem = self._check(transfer, 2 * len(config))
+        registers: list[int] = []
+        if problem is None:
+            assert transfer.returned is not None
+            registers = _id_registers(transfer.returned, len(config))
+            problem = _compare(config, registers)
+        self.ring.finish(transfer, problem is None)
+        if problem is not None:
+            if problem.kind is ErrorKind.CONFIGURATION:
+                self._set_config(None)
+            return self._failed(Cycle.ID, problem)
+        self._watchdog_pending = False
+        self._quit.clear()
+        return CycleResult(Cycle.ID, True, self._messages(registers))
+
+    # -- internals -----------------------------------------------------------------------------------------------
+
+    def _require_config(self) -> tuple[ConfigEntry, ...]:
+        if self.config is None:
+            raise InterbusError("docs/interbus.md, Master", None, "no configuration: run an ID cycle first")
+        return self.config
+
+    def _command(self, ring_position: int) -> int:
+        code = self._watchdog_code if self._watchdog_pending else None
+        return wire.command_word(code, ring_position in self._quit)
+
+    def _set_config(self, config: tuple[ConfigEntry, ...] | None) -> None:
+        self.config = config
+        entries = config or ()
+        total = sum(e.data_bytes for e in entries)
+        self._out = bytearray(wire.LOOPBACK_BYTES_ON_LINE + bytes(total))
+        self._in = bytes(total)
+        self._in_slices, self._out_slices = [], []
+        after = total
+        for entry in entries:
+            after -= entry.data_bytes
+            self._in_slices.append(slice(after, after + entry.data_bytes))
+            start = wire.LOOPBACK_BYTES + after
+            self._out_slices.append(slice(start, start + entry.data_bytes))
+
+    def _discovery(self) -> CycleResult:
+        filler = bytes([wire.DISCOVERY_FILLER]) * (2 * wire.MAX_DEVICES)
+        transfer = self.ring.transfer(Cycle.ID, wire.LOOPBACK_BYTES_ON_LINE + filler)
+        problem = self._check(transfer, None)
+        config: tuple[ConfigEntry, ...] | None = None
+        registers: list[int] = []
+        if problem is None:
+            assert transfer.returned is not None
+            devices = _find_loopback(transfer.returned) // 2
+            registers = _id_registers(transfer.returned, devices)
+            config, problem = _configuration(registers)
+        self.ring.finish(transfer, problem is None)
+        if problem is not None:
+            return self._failed(Cycle.ID, problem)
+        self._set_config(config)
+        return CycleResult(Cycle.ID, True, self._messages(registers))
+
+    def _check(self, transfer: Transfer, loopback_at: int | None) -> Diagnostic | None:
+        """The master's checks of a returned frame; ``loopback_at=None`` searches for the loopback word."""
+        n = transfer.devices
+        if transfer.returned is None:
+            return Diagnostic(ErrorKind.DEAD_LINE, None, None, None, "no telegram came back")
+        if transfer.receiver_error is not None:
+            return Diagnostic(transfer.receiver_error, n + 1, None, None, "error on the return line")
+        if transfer.flags.error:
+            return Diagnostic(ErrorKind.TRANSMISSION, None, None, None, "CNTR came back with ERR set")
+        returned = transfer.returned
+        if loopback_at is None:
+            if _find_loopback(returned) < 0:
+                return Diagnostic(ErrorKind.LOOPBACK, None, None, None, "loopback word did not come back")
+        elif returned[loopback_at : loopback_at + wire.LOOPBACK_BYTES] != wire.LOOPBACK_BYTES_ON_LINE:
+            return Diagnostic(ErrorKind.LOOPBACK, None, None, None,
+                              f"loopback word not at byte {loopback_at} of the returned data")  # fmt: skip
+        return None
+
+    def _failed(self, cycle: Cycle, problem: Diagnostic) -> CycleResult:
+        if problem.location is None and self.locate and self.config is not None:
+            location, how = self._locate()
+            problem = Diagnostic(problem.kind, location, None, None, f"{problem.detail}; {how}")
+        located = self._with_device(problem)
+        self.diagnostics.append(located)
+        return CycleResult(cycle, False, (located,))
+
+    def _with_device(self, d: Diagnostic) -> Diagnostic:
+        config = self.config or ()
+        device = config[d.location - 1].number if d.location is not None and d.location <= len(config) else None
+        return Diagnostic(d.kind, d.location, device, d.code, d.detail)
+
+    def _locate(self) -> tuple[int | None, str]:
+        """Locate the error of a failed cycle: read the TE bits in an ID cycle, else search segment by segment."""
+        config = self._require_config()
+        n = len(config)
+        data = wire.LOOPBACK_BYTES_ON_LINE + bytes(2 * n)
+        transfer = self.ring.transfer(Cycle.ID, data)
+        registers: list[int] = []
+        problem = self._check(transfer, 2 * n)
+        if problem is None:
+            assert transfer.returned is not None
+            registers = _id_registers(transfer.returned, n)
+            problem = _compare(config, registers)
+        self.ring.finish(transfer, problem is None)
+        if problem is None:
+            self._messages(registers)
+            te = [k for k, word in enumerate(registers, 1) if (word >> wire.MGMT_TE_BIT) & 1]
+            if te:
+                return te[0], "TE bit read in a diagnostic ID cycle"
+            return None, "not reproducible: the diagnostic ID cycle passed and no device reports TE"
+        low, high = 1, n
+        while low < high:
+            middle = (low + high) // 2
+            if self._probe(middle):
+                low = middle + 1
+            else:
+                high = middle
+        return low, "segment search: the ring fails when closed after this position" + (
+            " (or the return line)" if low == n else ""
+        )
+
+    def _probe(self, devices: int) -> bool:
+        """An ID cycle with the ring closed after ring position ``devices``; ``True`` if it passes."""
+        config = self._require_config()
+        transfer = self.ring.transfer(Cycle.ID, wire.LOOPBACK_BYTES_ON_LINE + bytes(2 * devices), devices)
+        problem = self._check(transfer, 2 * devices)
+        if problem is None:
+            assert transfer.returned is not None
+            problem = _compare(config[:devices], _id_registers(transfer.returned, devices))
+        self.ring.finish(transfer, problem is None)
+        return problem is None
+
+    def _messages(self, registers: list[int]) -> tuple[Diagnostic, ...]:
+        """Report the management bits of a latched ID cycle: PF as 0BB1h (once per fault), WD as 0C6Bh."""
+        found: list[Diagnostic] = []
+        for k, word in enumerate(registers, 1):
+            if (word >> wire.MGMT_PF_BIT) & 1:
+                if k not in self._pf_active:
+                    self._pf_active.add(k)
+                    found.append(Diagnostic(ErrorKind.PERIPHERAL_FAULT, k, None, MSG_PERIPHERAL_FAULT,
+                                            "I/O device error indication (/StatErr)"))  # fmt: skip
+            else:
+                self._pf_active.discard(k)
+            if (word >> wire.MGMT_WD_BIT) & 1:
+                found.append(Diagnostic(ErrorKind.WATCHDOG, k, None, MSG_WATCHDOG,
+                                        "layer-2 watchdog reset the process data"))  # fmt: skip
+        self._attention = False
+        located = tuple(self._with_device(d) for d in found)
+        self.diagnostics.extend(located)
+        return located
+
+
+def _find_loopback(returned: bytes) -> int:
+    """Offset of the first word-aligned loopback word in ``returned``, -1 if there is none."""
+    for at in range(0, len(returned) - 1, 2):
+        if returned[at : at + 2] == wire.LOOPBACK_BYTES_ON_LINE:
+            return at
+    return -1
+
+
+def _id_registers(returned: bytes, devices: int) -> list[int]:
+    """The ID registers in ring order: device N's register comes back first."""
+    return [wire.word_from_bytes(returned[2 * (devices - k) : 2 * (devices - k) + 2]) for k in range(1, devices + 1)]
+
+
+def _configuration(registers: list[int]) -> tuple[tuple[ConfigEntry, ...] | None, Diagnostic | None]:
+    """Build the configuration table from ID registers in ring order."""
+    entries: list[ConfigEntry] = []
+    segment, position = 0, 0
+    for k, word in enumerate(registers, 1):
+        id_code, length_code = word & 0xFF, (word >> 8) & 0x1F
+        bits = LENGTH_CODE_BY_VALUE[length_code].bits
+        if bits is None:
+            return None, Diagnostic(ErrorKind.CONFIGURATION, k, None, None,
+                                    f"reserved length code {length_code:05b}b (Table 3-11)")  # fmt: skip
+        interface = interface_type(id_code)
+        if interface is InterfaceType.LOCAL_BUS:
+            position += 1
+        else:
+            segment, position = segment + 1, 0
+        entries.append(ConfigEntry(k, segment, position, id_code, length_code, bits, wire.data_bytes(length_code),
+                                   interface, _ID_ROWS.get(id_code), id_code in UP_NOT_READY_ID_CODES))  # fmt: skip
+    return tuple(entries), None
+
+
+def _compare(config: tuple[ConfigEntry, ...], registers: list[int]) -> Diagnostic | None:
+    """The first device whose ID code or length code differs from the configuration."""
+    for entry, word in zip(config, registers, strict=True):
+        if (word & 0xFF, (word >> 8) & 0x1F) != (entry.id_code, entry.length_code):
+            return Diagnostic(ErrorKind.CONFIGURATION, entry.ring_position, None, None,
+                              f"ID register {word:04X}h differs from the configuration")  # fmt: skip
+    return None

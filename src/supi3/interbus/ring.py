@@ -1,0 +1,410 @@
+"""The INTERBUS ring at transaction level: a distributed shift register of devices, with fault injection.
+
+The ring carries one frame per cycle from the master through every device and back (docs/interbus.md,
+"Ring"). Each device's register is spliced into the stream as the frame passes: what leaves device *k* is its
+register followed by what entered it, cut to the frame's length, and what stays in the register is the tail of
+what entered. Every line is checked by its receiver (telegrams, sequence, CRC, CNTR).
+
+Speed: on a line without an injected fault the receiver's check passes by construction (the stream received is
+the stream sent), so the ring neither materialises the stream nor computes the CRC there; it hands each device
+its slice of the master's frame. Lines with a fault, and every line when ``record=True``, go through the full
+path, which computes the CRC actually sent and the CRC of what was actually received.
+
+Lines are numbered like the devices: line *k* (1..N) enters ring position *k*, line N + 1 is the return line
+into the master.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from enum import Enum
+
+from supi3.interbus import wire
+from supi3.interbus.device import Device
+from supi3.interbus.errors import InterbusError, TelegramError
+from supi3.interbus.wire import Cycle, Frame
+
+
+class ErrorKind(Enum):
+    """What went wrong, as found by a receiver on the ring or by the master (docs/interbus.md, "Errors")."""
+
+    TELEGRAM = "telegram"
+    """Start, type or stop bit wrong."""
+    SEQUENCE = "sequence"
+    """Select or control bit wrong for its place in the cycle."""
+    CRC = "crc"
+    """The CRC of the data sequence received differs from the CRC word received."""
+    CNTR = "cntr"
+    """The CNTR word received is not a legal code."""
+    TRANSMISSION = "transmission"
+    """The CNTR word came back with ERR set: a device found one of the errors above on its incoming line."""
+    LOOPBACK = "loopback"
+    """The loopback word is missing or not where the configuration puts it."""
+    DEAD_LINE = "dead line"
+    """No telegram came back."""
+    CONFIGURATION = "configuration"
+    """The ID cycle found another configuration than expected, or a reserved length code."""
+    PERIPHERAL_FAULT = "peripheral fault"
+    """A device reports /StatErr (message 0BB1h, 3.6.2)."""
+    WATCHDOG = "watchdog"
+    """A device's layer-2 watchdog reset its process data (message 0C6Bh, Table 3-13)."""
+
+
+# ----------------------------------------------------------------------------------------------------------------
+# Fault injection
+# ----------------------------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class BitFlip:
+    """Invert bit period ``bit`` of the frame (0 = first start bit; see ``wire.locate_bit``) on line ``segment``.
+
+    ``cycles`` is how many cycles the fault hits (``None``: every cycle).
+    """
+
+    segment: int
+    bit: int
+    cycles: int | None = 1
+
+
+@dataclass(frozen=True)
+class Truncate:
+    """Only the first ``keep`` data-sequence telegrams reach the end of line ``segment``; the check follows."""
+
+    segment: int
+    keep: int
+    cycles: int | None = 1
+
+
+@dataclass(frozen=True)
+class CorruptLoopback:
+    """The loopback word on line ``segment`` is ``value``, with a CRC that matches (a fault in the sender)."""
+
+    segment: int
+    value: int
+    cycles: int | None = 1
+
+
+@dataclass(frozen=True)
+class DeadLine:
+    """Line ``segment`` carries nothing at all (broken cable); permanent unless ``cycles`` is given."""
+
+    segment: int
+    cycles: int | None = None
+
+
+Fault = BitFlip | Truncate | CorruptLoopback | DeadLine
+
+
+@dataclass
+class _Active:
+    fault: Fault
+    remaining: int | None
+
+
+# ----------------------------------------------------------------------------------------------------------------
+# Transfer
+# ----------------------------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SegmentTrace:
+    """One line of one cycle, recorded when the ring is built with ``record=True``.
+
+    ``sent`` is the frame the line's sender put on it, ``received`` what its receiver got (``None`` on a dead
+    line), ``error`` the receiver's verdict.
+    """
+
+    segment: int
+    sent: Frame
+    received: Frame | None
+    error: ErrorKind | None
+
+
+@dataclass
+class Transfer:
+    """The data and check sequences of one cycle, shifted through the ring, before the master's verdict.
+
+    Attributes
+    ----------
+    cycle:
+        ID or data cycle.
+    sent:
+        The data sequence the master sent.
+    devices:
+        Devices in the (possibly closed) ring for this cycle.
+    returned:
+        The data sequence that came back to the master, ``None`` if nothing came back.
+    flags:
+        The CNTR flags that came back (an illegal word reads as attention and error).
+    receiver_error:
+        The master's own check of its incoming line.
+    """
+
+    cycle: Cycle
+    sent: bytes
+    devices: int
+    returned: bytes | None
+    flags: wire.CntrFlags
+    receiver_error: ErrorKind | None
+    pending: list[tuple[Device, bytes, bool, bool]] = field(repr=False)
+    """Per reached device: (device, register contents at the end of the data sequence, may latch, local error)."""
+    reached: int = 0
+
+
+@dataclass
+class _Line:
+    """A materialised frame on one line: stream, CRC word (None: matches the stream) and CNTR word."""
+
+    stream: bytes
+    crc: int | None
+    cntr: int
+
+    def frame(self, cycle: Cycle) -> Frame:
+        return Frame(cycle, self.stream, wire.crc16(self.stream) if self.crc is None else self.crc, self.cntr)
+
+
+class Ring:
+    """A master's ring of devices, at transaction level (docs/interbus.md, "Ring").
+
+    Parameters
+    ----------
+    devices:
+        The devices in ring order: ring position 1 is next to the master.
+    bit_rate:
+        500 000 or 2 000 000 bit/s (Table 1-7).
+    record:
+        Keep a :class:`SegmentTrace` of every line of the last cycle in :attr:`trace` (slow; for tests).
+
+    Attributes
+    ----------
+    now:
+        Bus time in seconds.
+    """
+
+    def __init__(self, devices: Sequence[Device], bit_rate: int = 500_000, record: bool = False) -> None:
+        self.devices: list[Device] = list(devices)
+        self.bit_rate = wire.check_bit_rate(bit_rate)
+        self.record = record
+        self.trace: list[SegmentTrace] = []
+        self.now = 0.0
+        self._faults: list[_Active] = []
+        self._silent_since: dict[int, float] = {}
+        self._silent_reset: set[int] = set()
+
+    # -- faults --------------------------------------------------------------------------------------------------
+
+    def inject(self, fault: Fault) -> None:
+        """Add a fault. Lines are 1..N + 1 (N + 1: the return line into the master)."""
+        if not 1 <= fault.segment <= len(self.devices) + 1:
+            raise InterbusError("docs/interbus.md, Fault injection", fault.segment,
+                                f"line must be in 1..{len(self.devices) + 1}")  # fmt: skip
+        if fault.cycles is not None and fault.cycles < 1:
+            raise InterbusError("docs/interbus.md, Fault injection", fault.cycles, "cycles must be >= 1 or None")
+        self._faults.append(_Active(fault, fault.cycles))
+
+    def clear_faults(self) -> None:
+        """Remove every injected fault."""
+        self._faults.clear()
+
+    def _faults_on(self, segments: int) -> dict[int, list[Fault]]:
+        hits: dict[int, list[Fault]] = {}
+        for active in self._faults:
+            if active.fault.segment <= segments:
+                hits.setdefault(active.fault.segment, []).append(active.fault)
+                if active.remaining is not None:
+                    active.remaining -= 1
+        self._faults = [a for a in self._faults if a.remaining is None or a.remaining > 0]
+        return hits
+
+    def _first_dead(self) -> int | None:
+        dead = [a.fault.segment for a in self._faults if isinstance(a.fault, DeadLine)]
+        return min(dead) if dead else None
+
+    # -- one line ------------------------------------------------------------------------------------------------
+
+    def _receive(self, cycle: Cycle, line: _Line, faults: list[Fault], lbw_at: int) -> tuple[_Line, ErrorKind | None]:
+        """What the receiver at the end of a faulted (or recorded) line gets, and its verdict."""
+        stream = line.stream
+        crc = wire.crc16(stream) if line.crc is None else line.crc
+        cntr = line.cntr
+        error: ErrorKind | None = None
+        for fault in faults:
+            if isinstance(fault, CorruptLoopback) and lbw_at + wire.LOOPBACK_BYTES <= len(stream):
+                stream = stream[:lbw_at] + wire.word_bytes(fault.value) + stream[lbw_at + wire.LOOPBACK_BYTES :]
+                crc = wire.crc16(stream)
+        for fault in faults:
+            if isinstance(fault, Truncate):
+                stream = stream[: max(fault.keep, 0)]
+        for fault in faults:
+            if not isinstance(fault, BitFlip) or fault.bit >= wire.frame_bits(len(stream)):
+                continue
+            frame = Frame(cycle, stream, crc, cntr)
+            where = wire.locate_bit(frame, fault.bit)
+            try:
+                telegram = wire.decode_telegram(where.word ^ (1 << where.offset), wire.DATA_TELEGRAM_BITS)
+            except TelegramError:
+                error = error or ErrorKind.TELEGRAM
+                continue
+            in_check = where.telegram >= len(stream)
+            if telegram.cycle is not cycle or telegram.check != in_check:
+                error = error or ErrorKind.SEQUENCE
+                continue
+            assert telegram.data is not None
+            if not in_check:
+                stream = stream[: where.telegram] + bytes([telegram.data]) + stream[where.telegram + 1 :]
+                continue
+            check = bytearray(frame.check_bytes())
+            check[where.telegram - len(stream)] = telegram.data
+            words = {n: wire.word_from_bytes(bytes(check[2 * i : 2 * i + 2]))
+                     for i, n in enumerate(wire.CHECK_SEQUENCE_WORDS)}  # fmt: skip
+            crc, cntr = words["crc"], words["cntr"]
+        if error is None and wire.crc16(stream) != crc:
+            error = ErrorKind.CRC
+        if error is None and wire.decode_cntr(cntr) is None:
+            error = ErrorKind.CNTR
+        return _Line(stream, crc, cntr), error
+
+    # -- a cycle -------------------------------------------------------------------------------------------------
+
+    def transfer(self, cycle: Cycle, data: bytes, close_after: int | None = None) -> Transfer:
+        """Shift one frame (data sequence ``data``, CRC and a clear CNTR) through the ring.
+
+        Parameters
+        ----------
+        cycle:
+            ID or data cycle.
+        data:
+            The master's data sequence: loopback word, then device data (docs/interbus.md, "Frame").
+        close_after:
+            Close the ring after this ring position (the master's segment search); ``None``: the whole ring.
+
+        Returns
+        -------
+        Transfer
+            Hand it to :meth:`finish` with the master's verdict.
+        """
+        n_all = len(self.devices)
+        n = n_all if close_after is None else close_after
+        if not 0 <= n <= n_all:
+            raise InterbusError("docs/interbus.md, Segment search", close_after, f"must be in 0..{n_all}")
+        segments = n + 1 if n == n_all else n
+        faults = self._faults_on(segments) if self._faults else {}
+        dead = min((s for s, fs in faults.items() if any(isinstance(f, DeadLine) for f in fs)), default=None)
+        self.trace = []
+        record = self.record
+        now = self.now
+        base = bytes(data)
+        size = len(base)
+        consumed = 0
+        shifted = 0
+        ins: list[bytes] = []
+        crc: int | None = None
+        attention = False
+        error = False
+        pending: list[tuple[Device, bytes, bool, bool]] = []
+        devices = self.devices[: n if dead is None else min(n, dead - 1)]
+        for index, device in enumerate(devices):
+            segment = index + 1
+            local = False
+            if record or segment in faults:
+                stream = (b"".join(reversed(ins)) + base)[:size]
+                sent = _Line(stream, crc, wire.cntr_word(attention, error))
+                line, kind = self._receive(cycle, sent, faults.get(segment, []), shifted)
+                if record:
+                    self.trace.append(SegmentTrace(segment, sent.frame(cycle), line.frame(cycle), kind))
+                base, size, consumed, ins, crc = line.stream, len(line.stream), 0, [], None
+                cntr, bad = wire.forward_cntr(line.cntr, kind is not None, False)
+                local = kind is not None or bad
+                flags = wire.decode_cntr(line.cntr)
+                error_in = flags is None or flags.error
+                attention, error = wire.decode_cntr(cntr) or (True, True)
+            else:
+                error_in = error
+            register = device.load(cycle, now)
+            attention = attention or device.attention
+            width = len(register)
+            end = size - consumed
+            if end - width >= 0:
+                received = base[end - width : end]
+                ins.append(register)
+                consumed += width
+            else:
+                joined = register + (b"".join(reversed(ins)) + base)[:size]
+                received = joined[size:]
+                base, consumed, ins = joined[:size], 0, []
+            shifted += width
+            pending.append((device, received, not (local or error_in), local))
+        returned: bytes | None = None
+        receiver_error: ErrorKind | None = None
+        flags_back = wire.CntrFlags(attention, error)
+        if dead is None or dead > segments:
+            stream = (b"".join(reversed(ins)) + base)[:size]
+            sent = _Line(stream, crc, wire.cntr_word(attention, error))
+            last = n + 1
+            if record or (n == n_all and last in faults):
+                line, receiver_error = self._receive(cycle, sent, faults.get(last, []), shifted)
+                if record:
+                    self.trace.append(SegmentTrace(last, sent.frame(cycle), line.frame(cycle), receiver_error))
+                flags_back = wire.decode_cntr(line.cntr) or wire.CntrFlags(True, True)
+                sent = line
+            returned = sent.stream
+        elif record:
+            silent = _Line((b"".join(reversed(ins)) + base)[:size], crc, wire.cntr_word(attention, error))
+            self.trace.append(SegmentTrace(dead, silent.frame(cycle), None, None))
+        return Transfer(cycle, bytes(data), n, returned, flags_back, receiver_error, pending, len(devices))
+
+    def finish(self, transfer: Transfer, latch: bool) -> None:
+        """End a cycle with the master's verdict: the latch telegrams (``latch``) or idle telegrams.
+
+        Advances bus time by ``wire.cycle_bits``; a device latches only if its own check passed, no error was
+        flagged upstream of it, and the master latches.
+        """
+        bits = wire.cycle_bits(len(transfer.sent) - wire.LOOPBACK_BYTES, transfer.devices)
+        start = self.now
+        end = start + bits / self.bit_rate
+        cycle = transfer.cycle
+        for device, received, eligible, local in transfer.pending:
+            if latch and eligible:
+                device.latch(cycle, received, end)
+            else:
+                device.discard(cycle, local, end)
+        if self._silent_since:
+            for index in range(transfer.reached):
+                self._silent_since.pop(index, None)
+                self._silent_reset.discard(index)
+        self._go_silent(range(transfer.reached, len(self.devices)), start, end)
+        self.now = end
+
+    def _go_silent(self, indices: range, start: float, end: float) -> None:
+        """Devices at ``indices`` heard nothing from ``start`` to ``end``: poll them, reset after the timeout."""
+        for index in indices:
+            since = self._silent_since.setdefault(index, start)
+            device = self.devices[index]
+            if index not in self._silent_reset and end - since >= wire.IDLE_TIMEOUT_S:
+                device.reset(since + wire.IDLE_TIMEOUT_S)
+                self._silent_reset.add(index)
+            device.poll(end)
+
+    def reset(self) -> None:
+        """An INTERBUS reset (the master's Alarm Stop, 1303h): reset pattern, then idle (assumption A12)."""
+        dead = self._first_dead()
+        reached = len(self.devices) if dead is None else min(len(self.devices), dead - 1)
+        end = self.now + wire.reset_bits(len(self.devices)) / self.bit_rate
+        for device in self.devices[:reached]:
+            device.reset(end)
+        self._go_silent(range(reached, len(self.devices)), self.now, end)
+        self.now = end
+
+    def idle(self, seconds: float) -> None:
+        """The master sends only idle status telegrams for ``seconds`` (no cycles)."""
+        if seconds < 0:
+            raise InterbusError("docs/interbus.md, Idle", seconds, "idle time must be >= 0")
+        dead = self._first_dead()
+        reached = len(self.devices) if dead is None else min(len(self.devices), dead - 1)
+        end = self.now + seconds
+        for device in self.devices[:reached]:
+            device.poll(end)
+        self._go_silent(range(reached, len(self.devices)), self.now, end)
+        self.now = end

@@ -1,0 +1,685 @@
+"""The INTERBUS wire format, bit-exact: telegrams, summation frame, CRC, CNTR, timing and line levels.
+
+Everything here follows ``docs/interbus.md``. The manual (IBS SUPI 3 OPC UM E, rev. 05) does not describe
+layer 2; every constant the project had to decide sits in the "Assumed constants" section below and nowhere
+else, each listed with its evidence in ``docs/assumptions/interbus.md``. Changing one is a one-line change.
+
+Conventions
+-----------
+* A *level sequence* is one line level (0 or 1) per bit period, in the order the bits go on the line.
+* A telegram is held as an ``int`` whose bit *i* is the *i*-th bit period of the telegram on the line.
+* A *stream* is the ``bytes`` of the data sequence (loopback word and device data) as it passes one line.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from enum import Enum
+from typing import Final, NamedTuple
+
+import numpy as np
+import numpy.typing as npt
+
+from supi3.interbus.errors import InterbusError, TelegramError
+from supi3.tables import BIT_RATES, CLOCK_HZ, LENGTH_CODE_BY_VALUE, WATCHDOG_TIMEOUTS_S
+
+# ================================================================================================================
+# Assumed constants. Evidence and alternatives: docs/assumptions/interbus.md (A1..A16).
+# ================================================================================================================
+
+# A1 Line levels (NRZ, RS-485 idle = mark).
+IDLE_LEVEL: Final = 1
+START_LEVEL: Final = 0
+STOP_LEVEL: Final = 1
+
+# A2 Telegram layout: positions (bit periods from the start bit) of the added bits, shared by data and status
+# telegrams; the 8 data bits of a data telegram follow the control bit; the stop bit is always last.
+POS_START: Final = 0
+POS_TYPE: Final = 1
+POS_SELECT: Final = 2
+POS_CONTROL: Final = 3
+POS_DATA: Final = 4
+DATA_LSB_FIRST: Final = True
+
+# A3 Meaning of the added bits: the level that stands for "data telegram", "ID cycle", "check sequence / latch".
+TYPE_DATA_LEVEL: Final = 1
+SELECT_ID_LEVEL: Final = 1
+CONTROL_CHECK_LEVEL: Final = 1
+
+# A4 16-bit words (loopback word, ID register, command word, CRC, CNTR) go low byte first.
+WORD_LOW_BYTE_FIRST: Final = True
+
+# A5 Loopback word. Its length-code field (bits 12..8 if read as an ID register) is 11010b, reserved in Table 3-11,
+# so no conforming device can shift out a word equal to it during an ID cycle.
+LOOPBACK_WORD: Final = 0x5A3C
+
+# A6 Frame check: CRC-16 over the data bytes of the data sequence (Rocksoft model parameters; this set is the
+# catalogued CRC-16/IBM-SDLC, alias X-25, check value 0x906E).
+CRC_POLY: Final = 0x1021
+CRC_INIT: Final = 0xFFFF
+CRC_REFIN: Final = True
+CRC_REFOUT: Final = True
+CRC_XOROUT: Final = 0xFFFF
+
+# A7 CNTR word: two complement-coded flags, everything else zero.
+CNTR_ATTN_BIT: Final = 0
+CNTR_NATTN_BIT: Final = 1
+CNTR_NERR_BIT: Final = 14
+CNTR_ERR_BIT: Final = 15
+
+# A8 ID register management bits (IN direction of the ID cycle).
+MGMT_PF_BIT: Final = 13  # peripheral fault (/StatErr) latched, message 0BB1h
+MGMT_WD_BIT: Final = 14  # layer-2 watchdog has reset the process data, message 0C6Bh
+MGMT_TE_BIT: Final = 15  # a transmission error was detected on this device's incoming line
+
+# A9 Command word (OUT direction of the ID cycle, one per device).
+CMD_WD_CODE_SHIFT: Final = 0  # 2 bits: index into WATCHDOG_TIMEOUTS_S (50 ms, 200 ms, 1000 ms, off)
+CMD_WD_SET_BIT: Final = 2  # apply the watchdog code
+CMD_QUIT_BIT: Final = 3  # Quit Peripheral Error (0714h): clear the PF latch, pulse /ModAck
+
+# A10 Each device repeats the line with this delay; it may look this many bits minus one ahead (mid-bit sampling).
+REPEATER_DELAY_BITS: Final = 3
+
+# A11 Cycle end: idle status telegrams the master adds after the ring delay, then the latch status telegrams.
+TURNAROUND_STATUS_TELEGRAMS: Final = 1
+LATCH_STATUS_TELEGRAMS: Final = 2
+
+# A12 INTERBUS reset: the line held at START_LEVEL. Detected after RESET_DETECT_BITS such bit periods (longer
+# than any run inside legal traffic), sent for RESET_HOLD_BITS, ended by RESET_END_STATUS_TELEGRAMS idle ones.
+RESET_DETECT_BITS: Final = 16
+RESET_HOLD_BITS: Final = 64
+RESET_END_STATUS_TELEGRAMS: Final = 4
+
+# A13 A device that receives no telegram for this long takes it as an INTERBUS reset.
+IDLE_TIMEOUT_S: Final = 0.020
+
+# A14 Ring size limit [public source], and the filler byte of a discovery ID cycle.
+MAX_DEVICES: Final = 512
+DISCOVERY_FILLER: Final = 0x00
+
+# A15 Devices occupy whole bytes on the line: ceil(bits / 8) bytes for the length code's data length.
+# A16 Check sequence: CRC word, then CNTR word.
+CHECK_SEQUENCE_WORDS: Final = ("crc", "cntr")
+
+# ================================================================================================================
+# Derived constants
+# ================================================================================================================
+
+DATA_TELEGRAM_BITS: Final = POS_DATA + 8 + 1
+STATUS_TELEGRAM_BITS: Final = POS_DATA + 1
+LOOPBACK_BYTES: Final = 2
+CHECK_TELEGRAMS: Final = 2 * len(CHECK_SEQUENCE_WORDS)
+FRAME_OVERHEAD_TELEGRAMS: Final = LOOPBACK_BYTES + CHECK_TELEGRAMS
+"""Loopback word plus check sequence: the 6 of Beckhoff's 13 x (6 + N) (docs/interbus.md, "Cycle timing")."""
+
+MGMT_MASK: Final = (1 << MGMT_PF_BIT) | (1 << MGMT_WD_BIT) | (1 << MGMT_TE_BIT)
+
+_DATA_STOP: Final = DATA_TELEGRAM_BITS - 1
+_STATUS_STOP: Final = STATUS_TELEGRAM_BITS - 1
+_DATA_SHIFTS: Final = tuple(POS_DATA + (i if DATA_LSB_FIRST else 7 - i) for i in range(8))
+
+
+def _other(level: int) -> int:
+    return 1 - level
+
+
+# ================================================================================================================
+# Cycles and telegrams
+# ================================================================================================================
+
+
+class Cycle(Enum):
+    """The two INTERBUS cycle types, told apart by the select bit (docs/interbus.md, "Cycles")."""
+
+    ID = "id"
+    DATA = "data"
+
+    @property
+    def select_level(self) -> int:
+        """Line level of the select bit in this cycle's telegrams."""
+        return SELECT_ID_LEVEL if self is Cycle.ID else _other(SELECT_ID_LEVEL)
+
+
+class Telegram(NamedTuple):
+    """One received telegram.
+
+    ``data`` is the byte of a data telegram and ``None`` for a status telegram. ``check`` is the control bit:
+    the check sequence for a data telegram, a latch telegram for a status telegram.
+    """
+
+    cycle: Cycle
+    check: bool
+    data: int | None
+
+
+class LineReset(NamedTuple):
+    """An INTERBUS reset seen on the line: ``bit`` is where the low level began."""
+
+    bit: int
+
+
+def _header(type_level: int, cycle: Cycle, check: bool) -> int:
+    control = CONTROL_CHECK_LEVEL if check else _other(CONTROL_CHECK_LEVEL)
+    return (
+        (START_LEVEL << POS_START)
+        | (type_level << POS_TYPE)
+        | (cycle.select_level << POS_SELECT)
+        | (control << POS_CONTROL)
+    )
+
+
+def _data_field(byte: int) -> int:
+    return sum(((byte >> i) & 1) << shift for i, shift in enumerate(_DATA_SHIFTS))
+
+
+_DATA_FIELDS: Final = tuple(_data_field(b) for b in range(256))
+
+
+def data_telegram(byte: int, cycle: Cycle, check: bool) -> int:
+    """Encode one data telegram (13 bit periods, docs/interbus.md "Telegrams").
+
+    Parameters
+    ----------
+    byte:
+        The data byte, 0..255.
+    cycle:
+        ID or data cycle (the select bit).
+    check:
+        ``True`` in the check sequence, ``False`` in the data sequence (the control bit).
+
+    Returns
+    -------
+    int
+        Bit *i* is the level of bit period *i* of the telegram.
+    """
+    if not 0 <= byte <= 0xFF:
+        raise InterbusError("docs/interbus.md, Telegrams", byte, "a data telegram carries one byte, 0..255")
+    return _header(TYPE_DATA_LEVEL, cycle, check) | _DATA_FIELDS[byte] | (STOP_LEVEL << _DATA_STOP)
+
+
+def status_telegram(cycle: Cycle, check: bool) -> int:
+    """Encode one status telegram (5 bit periods): idle (``check=False``) or latch (``check=True``)."""
+    return _header(_other(TYPE_DATA_LEVEL), cycle, check) | (STOP_LEVEL << _STATUS_STOP)
+
+
+def _bit(word: int, position: int) -> int:
+    return (word >> position) & 1
+
+
+def decode_telegram(word: int, length: int, at: int = 0) -> Telegram:
+    """Decode one telegram of ``length`` (13 or 5) bit periods held as an int (bit *i* = bit period *i*).
+
+    Raises
+    ------
+    TelegramError
+        Wrong start or stop level, or a type bit that does not match ``length``. ``at`` is the index of the
+        telegram's first bit period in the sequence being received, used in the error.
+    """
+    rule = "docs/interbus.md, Telegrams"
+    if _bit(word, POS_START) != START_LEVEL:
+        raise TelegramError(rule, _bit(word, POS_START), "start bit at the wrong level", at + POS_START)
+    is_data = _bit(word, POS_TYPE) == TYPE_DATA_LEVEL
+    if is_data != (length == DATA_TELEGRAM_BITS):
+        raise TelegramError(rule, _bit(word, POS_TYPE), f"type bit does not match a {length}-bit telegram",
+                            at + POS_TYPE)  # fmt: skip
+    stop = length - 1
+    if _bit(word, stop) != STOP_LEVEL:
+        raise TelegramError(rule, _bit(word, stop), "stop bit at the wrong level", at + stop)
+    cycle = Cycle.ID if _bit(word, POS_SELECT) == SELECT_ID_LEVEL else Cycle.DATA
+    check = _bit(word, POS_CONTROL) == CONTROL_CHECK_LEVEL
+    data = sum(_bit(word, shift) << i for i, shift in enumerate(_DATA_SHIFTS)) if is_data else None
+    return Telegram(cycle, check, data)
+
+
+# ================================================================================================================
+# Words
+# ================================================================================================================
+
+
+def word_bytes(word: int) -> bytes:
+    """The two bytes of a 16-bit word in line order (assumption A4)."""
+    if not 0 <= word <= 0xFFFF:
+        raise InterbusError("docs/interbus.md, Words", word, "a word is 16 bits")
+    return word.to_bytes(2, "little" if WORD_LOW_BYTE_FIRST else "big")
+
+
+def word_from_bytes(data: bytes) -> int:
+    """Inverse of :func:`word_bytes`."""
+    if len(data) != 2:
+        raise InterbusError("docs/interbus.md, Words", data, "a word is two bytes")
+    return int.from_bytes(data, "little" if WORD_LOW_BYTE_FIRST else "big")
+
+
+LOOPBACK_BYTES_ON_LINE: Final = word_bytes(LOOPBACK_WORD)
+
+
+def data_bytes(length_code: int) -> int:
+    """Bytes a device with this length code occupies on the line (Table 3-11, assumption A15).
+
+    Raises
+    ------
+    InterbusError
+        The code is outside 0..31 or reserved in Table 3-11.
+    """
+    row = LENGTH_CODE_BY_VALUE.get(length_code)
+    if row is None or row.bits is None:
+        raise InterbusError("Table 3-11", length_code, "length code is reserved or not a 5-bit code")
+    return math.ceil(row.bits / 8)
+
+
+def id_register(id_code: int, length_code: int, management: int = 0) -> int:
+    """Compose the 16-bit ID register: ID code bits 7..0, length code bits 12..8, management bits 15..13.
+
+    ``management`` holds the bits at their register positions (``MGMT_*_BIT``).
+    """
+    if not 0 <= id_code <= 0xFF:
+        raise InterbusError("Table A-3", id_code, "an ID code is 8 bits")
+    if not 0 <= length_code <= 0x1F:
+        raise InterbusError("Table 3-11", length_code, "a length code is 5 bits")
+    if management & ~MGMT_MASK:
+        raise InterbusError("docs/interbus.md, ID register", management, "only bits 15..13 are management bits")
+    return management | (length_code << 8) | id_code
+
+
+def command_word(watchdog_code: int | None = None, quit_peripheral_error: bool = False) -> int:
+    """Compose the 16-bit command word the master shifts into a device in an ID cycle (assumption A9).
+
+    Parameters
+    ----------
+    watchdog_code:
+        Index into ``WATCHDOG_TIMEOUTS_S`` (Table 3-13: 50 ms, 200 ms, 1000 ms, off), or ``None`` to leave the
+        device's setting alone.
+    quit_peripheral_error:
+        Quit Peripheral Error (0714h, manual 3.6.2): the device clears its PF latch and pulses /ModAck.
+    """
+    word = 0
+    if watchdog_code is not None:
+        if not 0 <= watchdog_code < len(WATCHDOG_TIMEOUTS_S):
+            raise InterbusError("Table 3-13", watchdog_code, "watchdog code must index WATCHDOG_TIMEOUTS_S")
+        word |= (watchdog_code << CMD_WD_CODE_SHIFT) | (1 << CMD_WD_SET_BIT)
+    if quit_peripheral_error:
+        word |= 1 << CMD_QUIT_BIT
+    return word
+
+
+class Command(NamedTuple):
+    """A decoded command word: the watchdog code to apply (``None``: leave it) and the quit request."""
+
+    watchdog_code: int | None
+    quit_peripheral_error: bool
+
+
+def decode_command(word: int) -> Command:
+    """Inverse of :func:`command_word`; bits without a meaning are ignored."""
+    code = (word >> CMD_WD_CODE_SHIFT) & 0b11 if _bit(word, CMD_WD_SET_BIT) else None
+    return Command(code, bool(_bit(word, CMD_QUIT_BIT)))
+
+
+# ================================================================================================================
+# CRC
+# ================================================================================================================
+
+
+def _reflect(value: int, width: int) -> int:
+    return int(f"{value:0{width}b}"[::-1], 2)
+
+
+def crc_update_bit(crc: int, bit: int) -> int:
+    """One step of the bit-serial CRC register (the hardware form): shift in one message bit.
+
+    The register is kept in normal (MSB-first) form; :func:`crc16` feeds bits in the order given by
+    ``CRC_REFIN`` and applies ``CRC_REFOUT`` and ``CRC_XOROUT`` at the end.
+    """
+    feedback = ((crc >> 15) & 1) ^ bit
+    crc = (crc << 1) & 0xFFFF
+    return crc ^ CRC_POLY if feedback else crc
+
+
+def _table_entry(byte: int) -> int:
+    crc = 0
+    for i in range(7, -1, -1):
+        crc = crc_update_bit(crc, (byte >> i) & 1)
+    return crc
+
+
+_CRC_TABLE: Final = tuple(_table_entry(b) for b in range(256))
+_BYTE_ORDER_TABLE: Final = tuple(_reflect(b, 8) if CRC_REFIN else b for b in range(256))
+
+
+def crc16(data: bytes, init: int = CRC_INIT) -> int:
+    """CRC-16 of ``data`` with the parameters of assumption A6 (table-driven, built from :func:`crc_update_bit`).
+
+    Examples
+    --------
+    >>> hex(crc16(b"123456789"))
+    '0x906e'
+    """
+    crc = init
+    table = _CRC_TABLE
+    order = _BYTE_ORDER_TABLE
+    for byte in data:
+        crc = ((crc << 8) & 0xFFFF) ^ table[(crc >> 8) ^ order[byte]]
+    if CRC_REFOUT:
+        crc = _reflect(crc, 16)
+    return crc ^ CRC_XOROUT
+
+
+# ================================================================================================================
+# CNTR
+# ================================================================================================================
+
+
+class CntrFlags(NamedTuple):
+    """The two flags of a legal CNTR word: ``attention`` (some device wants an ID cycle) and ``error``."""
+
+    attention: bool
+    error: bool
+
+
+def cntr_word(attention: bool, error: bool) -> int:
+    """Encode a legal CNTR word (assumption A7): each flag next to its complement, all other bits zero."""
+    return (
+        (attention << CNTR_ATTN_BIT)
+        | ((not attention) << CNTR_NATTN_BIT)
+        | (error << CNTR_ERR_BIT)
+        | ((not error) << CNTR_NERR_BIT)
+    )
+
+
+CNTR_CLEAR: Final = cntr_word(False, False)
+"""The CNTR word the master sends."""
+
+_CNTR_LEGAL: Final = {cntr_word(a, e): CntrFlags(a, e) for a in (False, True) for e in (False, True)}
+
+
+def decode_cntr(word: int) -> CntrFlags | None:
+    """The flags of a CNTR word, or ``None`` if the word is not one of the four legal codes."""
+    return _CNTR_LEGAL.get(word)
+
+
+def forward_cntr(word: int, local_error: bool, attention: bool) -> tuple[int, bool]:
+    """What a device sends on for a received CNTR word (docs/interbus.md, "Check sequence").
+
+    Parameters
+    ----------
+    word:
+        The CNTR word received.
+    local_error:
+        The device's own check of its incoming line failed (telegram, sequence or CRC).
+    attention:
+        The device has a new management flag (PF or WD) for the master.
+
+    Returns
+    -------
+    tuple[int, bool]
+        The CNTR word sent on (always legal) and whether the received word was illegal (corrupted). An illegal
+        word counts as a local error and sets the attention flag conservatively. The rule is causal for a
+        repeater with ``REPEATER_DELAY_BITS`` of delay: the ERR pair is last on the line, so the device has seen
+        the whole word, and the stop bit after it, before it sends the pair.
+    """
+    flags = decode_cntr(word)
+    bad = flags is None
+    attn_in, err_in = (True, False) if flags is None else flags
+    return cntr_word(attn_in or attention, err_in or local_error or bad), bad
+
+
+# ================================================================================================================
+# Frame
+# ================================================================================================================
+
+
+@dataclass(frozen=True)
+class Frame:
+    """One summation frame as it passes one line: the data sequence and the check sequence.
+
+    Attributes
+    ----------
+    cycle:
+        ID or data cycle.
+    data:
+        The data sequence's bytes in line order (loopback word and device data, docs/interbus.md "Frame").
+    crc:
+        The CRC word of the check sequence.
+    cntr:
+        The CNTR word of the check sequence.
+    """
+
+    cycle: Cycle
+    data: bytes
+    crc: int
+    cntr: int
+
+    @classmethod
+    def build(cls, cycle: Cycle, data: bytes, cntr: int = CNTR_CLEAR) -> Frame:
+        """A frame whose CRC matches its data."""
+        return cls(cycle, bytes(data), crc16(data), cntr)
+
+    def check_bytes(self) -> bytes:
+        """The check sequence's bytes in line order."""
+        words = {"crc": self.crc, "cntr": self.cntr}
+        return b"".join(word_bytes(words[name]) for name in CHECK_SEQUENCE_WORDS)
+
+    def telegrams(self) -> list[int]:
+        """The frame's data telegrams in line order (data sequence, then check sequence)."""
+        return [data_telegram(b, self.cycle, False) for b in self.data] + [
+            data_telegram(b, self.cycle, True) for b in self.check_bytes()
+        ]
+
+    def bit_count(self) -> int:
+        """Bit periods the frame occupies on the line."""
+        return frame_bits(len(self.data))
+
+
+def frame_bits(data_len: int) -> int:
+    """Bit periods of a frame whose data sequence has ``data_len`` bytes."""
+    return DATA_TELEGRAM_BITS * (data_len + CHECK_TELEGRAMS)
+
+
+class BitLocation(NamedTuple):
+    """Where a bit of a frame sits: telegram index, bit period inside the telegram, and the telegram's word."""
+
+    telegram: int
+    offset: int
+    word: int
+
+
+def locate_bit(frame: Frame, bit: int) -> BitLocation:
+    """The telegram holding bit period ``bit`` of ``frame`` (0 = the first start bit)."""
+    if not 0 <= bit < frame.bit_count():
+        raise InterbusError("docs/interbus.md, Frame", bit, f"bit index outside a {frame.bit_count()}-bit frame")
+    index, offset = divmod(bit, DATA_TELEGRAM_BITS)
+    n = len(frame.data)
+    if index < n:
+        word = data_telegram(frame.data[index], frame.cycle, False)
+    else:
+        word = data_telegram(frame.check_bytes()[index - n], frame.cycle, True)
+    return BitLocation(index, offset, word)
+
+
+def frame_from_telegrams(telegrams: Iterable[Telegram | LineReset]) -> Frame:
+    """Assemble the first frame in a received telegram sequence.
+
+    Leading status telegrams are skipped; the frame is the run of data telegrams with the control bit clear,
+    followed by ``CHECK_TELEGRAMS`` data telegrams with it set, all of one cycle type.
+
+    Raises
+    ------
+    InterbusError
+        A reset, a status telegram or a change of cycle type inside the frame, or a short check sequence.
+    """
+    rule = "docs/interbus.md, Frame"
+    data = bytearray()
+    check = bytearray()
+    cycle: Cycle | None = None
+    for t in telegrams:
+        if isinstance(t, LineReset):
+            raise InterbusError(rule, t, "INTERBUS reset inside a frame")
+        if t.data is None:
+            if cycle is None:
+                continue
+            raise InterbusError(rule, t, "status telegram inside a frame")
+        if cycle is None:
+            cycle = t.cycle
+        if t.cycle is not cycle:
+            raise InterbusError(rule, t, "cycle type changes inside a frame")
+        if not t.check:
+            if check:
+                raise InterbusError(rule, t, "data sequence telegram after the check sequence began")
+            data.append(t.data)
+            continue
+        check.append(t.data)
+        if len(check) == CHECK_TELEGRAMS:
+            words = {
+                name: word_from_bytes(bytes(check[2 * i : 2 * i + 2])) for i, name in enumerate(CHECK_SEQUENCE_WORDS)
+            }
+            return Frame(cycle, bytes(data), words["crc"], words["cntr"])
+    raise InterbusError(rule, len(check), "frame ends before its check sequence is complete")
+
+
+# ================================================================================================================
+# Cycle timing
+# ================================================================================================================
+
+
+def ring_delay_status_telegrams(devices: int) -> int:
+    """Idle status telegrams the master sends while the check sequence travels the ring (assumption A10, A11)."""
+    return math.ceil(devices * REPEATER_DELAY_BITS / STATUS_TELEGRAM_BITS) + TURNAROUND_STATUS_TELEGRAMS
+
+
+def cycle_bits(data_bytes: int, devices: int) -> int:
+    """Bit periods of one cycle (docs/interbus.md, "Cycle timing").
+
+    Parameters
+    ----------
+    data_bytes:
+        Bytes of device data in the data sequence (all devices' registers; ``2 * devices`` in an ID cycle).
+    devices:
+        Devices in the ring.
+
+    Returns
+    -------
+    int
+        13 x (6 + data_bytes) for the frame, then the status telegrams of the ring delay, the master's
+        turnaround and the latch: compare Beckhoff's (13 x (6 + N) + 1.5 x M) x T_bit.
+    """
+    if data_bytes < 0 or devices < 0:
+        raise InterbusError("docs/interbus.md, Cycle timing", (data_bytes, devices), "counts must be >= 0")
+    status = ring_delay_status_telegrams(devices) + LATCH_STATUS_TELEGRAMS
+    return frame_bits(LOOPBACK_BYTES + data_bytes) + STATUS_TELEGRAM_BITS * status
+
+
+def reset_bits(devices: int) -> int:
+    """Bit periods of an INTERBUS reset sequence, including the ring delay of its end (assumption A12)."""
+    return RESET_HOLD_BITS + STATUS_TELEGRAM_BITS * (RESET_END_STATUS_TELEGRAMS + ring_delay_status_telegrams(devices))
+
+
+def check_bit_rate(bit_rate: int) -> int:
+    """Return ``bit_rate`` if Table 1-7 lists it (500 kbit/s, 2 Mbit/s), else raise :class:`InterbusError`."""
+    if bit_rate not in BIT_RATES:
+        raise InterbusError("Table 1-7", bit_rate, f"bit rate must be one of {BIT_RATES}")
+    return bit_rate
+
+
+def clocks_per_bit(bit_rate: int) -> int:
+    """32 MHz clock periods per bit (1.7.1): 64 at 500 kbit/s, 16 at 2 Mbit/s."""
+    return CLOCK_HZ // check_bit_rate(bit_rate)
+
+
+# ================================================================================================================
+# Line levels (the bit/pin-level view)
+# ================================================================================================================
+
+LevelArray = npt.NDArray[np.uint8]
+
+
+def telegram_levels(words: Sequence[int], length: int) -> LevelArray:
+    """Levels of telegrams of one length, concatenated."""
+    packed = np.asarray(words, dtype=np.uint32)[:, None]
+    return ((packed >> np.arange(length, dtype=np.uint32)) & 1).astype(np.uint8).ravel()
+
+
+def frame_levels(frame: Frame) -> LevelArray:
+    """Level sequence of a frame (data sequence and check sequence)."""
+    return telegram_levels(frame.telegrams(), DATA_TELEGRAM_BITS)
+
+
+def status_levels(cycle: Cycle, check: bool, count: int) -> LevelArray:
+    """Level sequence of ``count`` identical status telegrams."""
+    return telegram_levels([status_telegram(cycle, check)] * count, STATUS_TELEGRAM_BITS)
+
+
+def cycle_levels(frame: Frame, devices: int, latch: bool) -> LevelArray:
+    """Everything the master sends in one cycle: the frame, the idle status telegrams of the ring delay and
+    turnaround, then the latch status telegrams (``latch``) or as many idle ones (a failed cycle).
+
+    Its length is :func:`cycle_bits` for the frame's data bytes and ``devices``.
+    """
+    return np.concatenate(
+        [
+            frame_levels(frame),
+            status_levels(frame.cycle, False, ring_delay_status_telegrams(devices)),
+            status_levels(frame.cycle, latch, LATCH_STATUS_TELEGRAMS),
+        ]
+    )
+
+
+def reset_levels(devices: int) -> LevelArray:
+    """Level sequence of an INTERBUS reset (Alarm Stop): the line held low, then idle status telegrams."""
+    low = np.full(RESET_HOLD_BITS, START_LEVEL, dtype=np.uint8)
+    end = RESET_END_STATUS_TELEGRAMS + ring_delay_status_telegrams(devices)
+    return np.concatenate([low, status_levels(Cycle.DATA, False, end)])
+
+
+def parse_levels(levels: Sequence[int] | LevelArray) -> list[Telegram | LineReset]:
+    """Receive a level sequence: the reference receiver of docs/interbus.md, "Receiver".
+
+    Idle levels between telegrams are skipped. A start level that lasts ``RESET_DETECT_BITS`` bit periods is an
+    INTERBUS reset; the reset lasts until the line returns to the idle level. An unfinished telegram at the end
+    of the sequence is ignored.
+
+    Raises
+    ------
+    TelegramError
+        Wrong stop level or a type bit that does not match the telegram's length.
+    """
+    line = [int(v) for v in levels]
+    out: list[Telegram | LineReset] = []
+    i = 0
+    n = len(line)
+    while i < n:
+        if line[i] == IDLE_LEVEL:
+            i += 1
+            continue
+        run = i
+        while run < n and line[run] == START_LEVEL and run - i < RESET_DETECT_BITS:
+            run += 1
+        if run - i >= RESET_DETECT_BITS:
+            out.append(LineReset(i))
+            while i < n and line[i] == START_LEVEL:
+                i += 1
+            continue
+        if i + POS_TYPE >= n:
+            break
+        length = DATA_TELEGRAM_BITS if line[i + POS_TYPE] == TYPE_DATA_LEVEL else STATUS_TELEGRAM_BITS
+        if i + length > n:
+            break
+        word = sum(level << k for k, level in enumerate(line[i : i + length]))
+        out.append(decode_telegram(word, length, at=i))
+        i += length
+    return out
+
+
+def levels_to_samples(levels: Sequence[int] | LevelArray, bit_rate: int) -> LevelArray:
+    """Expand one level per bit period to one sample per 32 MHz clock period (pin level, 1.7.1)."""
+    return np.repeat(np.asarray(levels, dtype=np.uint8), clocks_per_bit(bit_rate))
+
+
+def samples_to_levels(samples: Sequence[int] | LevelArray, bit_rate: int, phase: int | None = None) -> LevelArray:
+    """Sample a 32 MHz pin trace once per bit period, at ``phase`` clocks into each bit (default: mid-bit)."""
+    cpb = clocks_per_bit(bit_rate)
+    at = cpb // 2 if phase is None else phase
+    if not 0 <= at < cpb:
+        raise InterbusError("docs/interbus.md, Line", phase, f"sampling phase must be in 0..{cpb - 1}")
+    return np.asarray(samples, dtype=np.uint8)[at::cpb]
