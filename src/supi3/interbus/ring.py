@@ -19,6 +19,9 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from enum import Enum
+from itertools import accumulate
+from operator import attrgetter, sub
+from typing import NamedTuple
 
 from supi3.interbus import wire
 from supi3.interbus.device import Device
@@ -108,6 +111,38 @@ class _Active:
 # ----------------------------------------------------------------------------------------------------------------
 
 
+_ATTENTION = attrgetter("attention")
+
+
+class _Run(NamedTuple):
+    """Consecutive reached devices: their register contents at the end of the data sequence, whether they may
+    latch (own check passed, no error flagged upstream) and whether their own check failed."""
+
+    devices: list[Device]
+    received: list[bytes]
+    eligible: bool
+    local_error: bool
+
+
+def _shift(registers: list[bytes], stream: bytes) -> tuple[list[bytes], bytes, int]:
+    """Shift ``stream`` through consecutive registers: what each register holds afterwards, what leaves the
+    last one, and the registers' total width. A register emits its contents, then what entered it; the stream
+    keeps its length."""
+    size = len(stream)
+    widths = list(map(len, registers))
+    total = sum(widths)
+    if total <= size:
+        ends = accumulate(widths, sub, initial=size)
+        received = [stream[end - width : end] for end, width in zip(ends, widths, strict=False)]
+        return received, b"".join(reversed(registers)) + stream[: size - total], total
+    received = []
+    for register in registers:
+        joined = register + stream
+        received.append(joined[size:])
+        stream = joined[:size]
+    return received, stream, total
+
+
 @dataclass(frozen=True)
 class SegmentTrace:
     """One line of one cycle, recorded when the ring is built with ``record=True``.
@@ -148,8 +183,8 @@ class Transfer:
     returned: bytes | None
     flags: wire.CntrFlags
     receiver_error: ErrorKind | None
-    pending: list[tuple[Device, bytes, bool, bool]] = field(repr=False)
-    """Per reached device: (device, register contents at the end of the data sequence, may latch, local error)."""
+    runs: list[_Run] = field(repr=False)
+    """The reached devices, in ring order, in runs that share a verdict."""
     reached: int = 0
 
 
@@ -295,52 +330,49 @@ class Ring:
         self.trace = []
         record = self.record
         now = self.now
-        base = bytes(data)
-        size = len(base)
-        consumed = 0
+        stream = bytes(data)
         shifted = 0
-        ins: list[bytes] = []
         crc: int | None = None
         attention = False
         error = False
-        pending: list[tuple[Device, bytes, bool, bool]] = []
+        runs: list[_Run] = []
         devices = self.devices[: n if dead is None else min(n, dead - 1)]
-        for index, device in enumerate(devices):
-            segment = index + 1
-            local = False
-            if record or segment in faults:
-                stream = (b"".join(reversed(ins)) + base)[:size]
-                sent = _Line(stream, crc, wire.cntr_word(attention, error))
-                line, kind = self._receive(cycle, sent, faults.get(segment, []), shifted)
-                if record:
-                    self.trace.append(SegmentTrace(segment, sent.frame(cycle), line.frame(cycle), kind))
-                base, size, consumed, ins, crc = line.stream, len(line.stream), 0, [], None
-                cntr, bad = wire.forward_cntr(line.cntr, kind is not None, False)
-                local = kind is not None or bad
-                flags = wire.decode_cntr(line.cntr)
-                error_in = flags is None or flags.error
-                attention, error = wire.decode_cntr(cntr) or (True, True)
-            else:
-                error_in = error
+        slow = range(len(devices)) if record else sorted(s - 1 for s in faults if s <= len(devices))
+        index = 0
+        for stop in [*slow, len(devices)]:
+            if index < stop:
+                # Unfaulted lines: every receiver gets what its sender sent; no materialising, no CRC.
+                run = devices[index:stop]
+                registers = [device.load(cycle, now) for device in run]
+                attention = attention or any(map(_ATTENTION, run))
+                received, stream, width = _shift(registers, stream)
+                runs.append(_Run(run, received, not error, False))
+                shifted += width
+                crc = None
+                index = stop
+            if stop == len(devices):
+                break
+            segment = stop + 1
+            sent = _Line(stream, crc, wire.cntr_word(attention, error))
+            line, kind = self._receive(cycle, sent, faults.get(segment, []), shifted)
+            if record:
+                self.trace.append(SegmentTrace(segment, sent.frame(cycle), line.frame(cycle), kind))
+            cntr, bad = wire.forward_cntr(line.cntr, kind is not None, False)
+            flags_in = wire.decode_cntr(line.cntr)
+            local = kind is not None or bad
+            device = devices[stop]
             register = device.load(cycle, now)
+            attention, error = wire.decode_cntr(cntr) or (True, True)
             attention = attention or device.attention
-            width = len(register)
-            end = size - consumed
-            if end - width >= 0:
-                received = base[end - width : end]
-                ins.append(register)
-                consumed += width
-            else:
-                joined = register + (b"".join(reversed(ins)) + base)[:size]
-                received = joined[size:]
-                base, consumed, ins = joined[:size], 0, []
+            received, stream, width = _shift([register], line.stream)
+            runs.append(_Run([device], received, not (local or flags_in is None or flags_in.error), local))
             shifted += width
-            pending.append((device, received, not (local or error_in), local))
+            crc = None
+            index = stop + 1
         returned: bytes | None = None
         receiver_error: ErrorKind | None = None
         flags_back = wire.CntrFlags(attention, error)
         if dead is None or dead > segments:
-            stream = (b"".join(reversed(ins)) + base)[:size]
             sent = _Line(stream, crc, wire.cntr_word(attention, error))
             last = n + 1
             if record or (n == n_all and last in faults):
@@ -351,9 +383,9 @@ class Ring:
                 sent = line
             returned = sent.stream
         elif record:
-            silent = _Line((b"".join(reversed(ins)) + base)[:size], crc, wire.cntr_word(attention, error))
+            silent = _Line(stream, crc, wire.cntr_word(attention, error))
             self.trace.append(SegmentTrace(dead, silent.frame(cycle), None, None))
-        return Transfer(cycle, bytes(data), n, returned, flags_back, receiver_error, pending, len(devices))
+        return Transfer(cycle, bytes(data), n, returned, flags_back, receiver_error, runs, len(devices))
 
     def finish(self, transfer: Transfer, latch: bool) -> None:
         """End a cycle with the master's verdict: the latch telegrams (``latch``) or idle telegrams.
@@ -365,11 +397,13 @@ class Ring:
         start = self.now
         end = start + bits / self.bit_rate
         cycle = transfer.cycle
-        for device, received, eligible, local in transfer.pending:
-            if latch and eligible:
-                device.latch(cycle, received, end)
+        for run in transfer.runs:
+            if latch and run.eligible:
+                for device, received in zip(run.devices, run.received, strict=True):
+                    device.latch(cycle, received, end)
             else:
-                device.discard(cycle, local, end)
+                for device in run.devices:
+                    device.discard(cycle, run.local_error, end)
         if self._silent_since:
             for index in range(transfer.reached):
                 self._silent_since.pop(index, None)
