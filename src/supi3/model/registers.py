@@ -1,0 +1,443 @@
+"""The µP-visible register file of the SUPI 3 OPC in the serial µP interface mode ("Init-µP").
+
+Ref: IBS SUPI 3 OPC UM E rev. 05, 3.4.1, 3.4.3, 3.4.7 - 3.4.14, Tables 3-10 to 3-13. Access semantics, reset
+values and reset classes come from :data:`supi3.regmap.REGISTER_MAP`; this module only gives them behaviour.
+
+Two sides use a :class:`RegisterFile`:
+
+* the serial µP interface (:mod:`supi3.spi.upif`) through :meth:`RegisterFile.cpu_read` and
+  :meth:`RegisterFile.cpu_write`, one call per data byte;
+* the INTERBUS slave core through the methods listed under "Core interface" in ``docs/upif.md``
+  (:meth:`~RegisterFile.latch`, :meth:`~RegisterFile.event`, :meth:`~RegisterFile.bus_id_register`, ...).
+
+Rule violations (reconfiguration during bus operation, inconsistent data access, and the interface's protocol
+and timing rules) go to one :class:`ViolationLog` per chip: strict mode raises the named error, lenient mode
+records it. In both modes the operation itself is carried out as the chip would.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Final
+
+from supi3.config import DeviceConfig, MfpKind
+from supi3.errors import Supi3Error
+from supi3.regmap import (
+    INTERRUPT_SOURCES,
+    REGISTER_MAP,
+    Access,
+    Direction,
+    RegisterMapError,
+    Reset,
+    SetConfig,
+    decode_set,
+)
+from supi3.regmap.registers import IN_BYTES, IO_ACCESS_BIT, OUT_BYTES
+
+__all__ = [
+    "InconsistentDataError",
+    "InterfaceViolationError",
+    "ReconfigurationError",
+    "RegisterFile",
+    "RegisterFileError",
+    "SetRegisterError",
+    "ViolationLog",
+]
+
+_DATA_REGISTERS: Final[frozenset[str]] = frozenset(r.name for r in IN_BYTES + OUT_BYTES)
+"""The INTERBUS data registers (3.4.8), the only ones the latch phase touches (3.4.14)."""
+_OPTICAL_REGISTERS: Final[frozenset[str]] = frozenset({"LENGTH_OUT", "LENGTH_BRANCH", "POWER_IN", "POWER_OUT_BRANCH"})
+_SOURCE_BITS: Final[dict[str, int]] = {s.name: s.bit for s in INTERRUPT_SOURCES}
+_PCP_ERASED: Final[tuple[str, ...]] = ("IN0", "IN1")
+"""IN bytes erased after their transfer in a PCP device (/PCP = 0, 3.4.11)."""
+
+
+class RegisterFileError(Supi3Error, ValueError):
+    """A call that breaks the register file's API contract (a bad byte, an unknown source or register)."""
+
+
+class InterfaceViolationError(Supi3Error):
+    """A rule of the serial µP interface broken by the application or the master (strict mode raises it).
+
+    Attributes
+    ----------
+    rule:
+        Where the rule comes from: a manual section, table or timing parameter ("3.4.11", "Table 3-7 t1").
+    detail:
+        What happened.
+    """
+
+    def __init__(self, rule: str, detail: str) -> None:
+        self.rule = rule
+        self.detail = detail
+        super().__init__(f"{detail} ({rule})")
+
+
+class ReconfigurationError(InterfaceViolationError):
+    """SET or ID written while the INTERBUS is running (3.4.3 note, 3.4.11: only during initialization)."""
+
+
+class SetRegisterError(InterfaceViolationError):
+    """SET written with a length code that Tables 3-11/3-12 reserve; the configuration is not applied."""
+
+
+class InconsistentDataError(InterfaceViolationError):
+    """A data-register access overlapped the latch phase: the data may be inconsistent (3.4.14)."""
+
+
+class ViolationLog:
+    """The violations one chip has seen, in order; strict mode raises each one.
+
+    Parameters
+    ----------
+    strict:
+        ``True``: :meth:`report` raises the violation (after the operation that caused it completed, see
+        :meth:`deferred`). ``False``: it is only recorded in :attr:`records`.
+    """
+
+    def __init__(self, strict: bool) -> None:
+        self.strict = strict
+        self.records: list[InterfaceViolationError] = []
+        self._depth = 0
+        self._pending: list[InterfaceViolationError] = []
+
+    def report(self, violation: InterfaceViolationError) -> None:
+        """Record ``violation``; in strict mode raise it, or (inside :meth:`deferred`) at the end of the block."""
+        self.records.append(violation)
+        if not self.strict:
+            return
+        if self._depth:
+            self._pending.append(violation)
+        else:
+            raise violation
+
+    @contextmanager
+    def deferred(self) -> Iterator[None]:
+        """Hold strict-mode raises until the block ends, so that one operation (a byte, a clock cycle) completes
+        and leaves the model consistent; then raise the first violation reported inside it."""
+        self._depth += 1
+        try:
+            yield
+        finally:
+            self._depth -= 1
+        if self._depth == 0 and self._pending:
+            first = self._pending[0]
+            self._pending.clear()
+            raise first
+
+
+class RegisterFile:
+    """The registers of Table 3-10 with their access semantics, resets and interrupt logic.
+
+    Parameters
+    ----------
+    config:
+        The pin-strap configuration; its MFP mode must be Init-µP. ``config.id_code`` is the µP_Not_Ready code the
+        master sees until software writes SET (3.4.1, 3.4.3).
+    strict:
+        Raise violations (``True``) or only record them in :attr:`violations` (``False``).
+
+    Raises
+    ------
+    RegisterFileError
+        If ``config`` is not a µP interface mode.
+    """
+
+    def __init__(self, config: DeviceConfig, *, strict: bool = True) -> None:
+        if config.mfp_mode.kind is not MfpKind.INIT_UP:
+            raise RegisterFileError(f"{config.function!r} is not a serial µP interface mode (Tables 2-4 to 2-7)")
+        self.config = config
+        self.violations = ViolationLog(strict)
+        self._values: dict[str, int] = {r.name: r.reset for r in REGISTER_MAP.registers}
+        self._set: SetConfig | None = None
+        self._bus_running = False
+        self._latch_phase = False
+        self._io_access = False
+        self.power_up_reset()
+
+    # --------------------------------------------------------------------------------------------------------
+    # Resets (3.4.3, 3.4.7)
+    # --------------------------------------------------------------------------------------------------------
+
+    def _reset(self, reset: Reset) -> None:
+        for register in REGISTER_MAP.cleared_by(reset):
+            self._values[register.name] = register.reset
+
+    def power_up_reset(self) -> None:
+        """Power-up (hardware) reset: every register 0, not configured, bus stopped, no latch phase (3.4.7)."""
+        self._reset(Reset.POWER_UP)
+        self._set = None
+        self._bus_running = False
+        self._latch_phase = False
+        self._io_access = False
+
+    def interbus_reset(self) -> None:
+        """INTERBUS reset (or layer-2 watchdog reset): clear IN and OUT data, raise the INTERBUS reset event.
+
+        Ref: 3.4.7, Table 3-13. Configuration (SET, ID) and every other register are kept.
+        """
+        self._reset(Reset.INTERBUS)
+        self.event("IB_RESET")
+
+    def sas_init(self) -> None:
+        """SAS_INIT: the registers keep their values, SET and ID included (3.4.3)."""
+        self._reset(Reset.SAS_INIT)
+
+    # --------------------------------------------------------------------------------------------------------
+    # µP side: one call per data byte (3.4.4, Table 3-10)
+    # --------------------------------------------------------------------------------------------------------
+
+    def cpu_read(self, address: int) -> int:
+        """A µP read data access to ``address``: the byte the chip sends, with the access's side effects.
+
+        Reading 14 returns the events plus the live I/O access bit D7, then clears the events it returned and
+        releases /IRQ (3.4.14). Reading 6 returns 00h. A data register read during the latch phase reports
+        :class:`InconsistentDataError`.
+
+        Raises
+        ------
+        RegisterFileError
+            For addresses 4, 5 and 15, whose accesses the interface handles itself (3.4.4, 3.4.6).
+        """
+        port = REGISTER_MAP.port(self._address(address), Direction.READ)
+        if port.access is Access.RESERVED_ZERO:
+            return 0
+        if port.register is None:
+            raise RegisterFileError(f"address {address} has no read register ({port.access.meaning})")
+        self._check_consistency(port.register.name, "read")
+        value = self._values[port.register.name]
+        if port.access is Access.RC:
+            self._values[port.register.name] = value & ~port.clear_on_read_mask
+            value |= int(self._io_access) << IO_ACCESS_BIT
+        return value
+
+    def cpu_write(self, address: int, value: int) -> None:
+        """A µP write data access: store ``value`` (reserved bits read back 0), or nothing for 6 and 8-11.
+
+        Writing SET applies the configuration (:meth:`bus_id_register`, :meth:`data_bits`); writing SET or ID
+        while the bus runs reports :class:`ReconfigurationError` (3.4.3, 3.4.11); a SET value with a reserved
+        length code reports :class:`SetRegisterError` and is stored but not applied.
+
+        Raises
+        ------
+        RegisterFileError
+            For addresses 4, 5 and 15, or if ``value`` is not a byte.
+        """
+        port = REGISTER_MAP.port(self._address(address), Direction.WRITE)
+        if not 0 <= value <= 0xFF:
+            raise RegisterFileError(f"data byte must be 0..255, not {value!r}")
+        if port.access is Access.NO_EFFECT:
+            return
+        register = port.register
+        if register is None:
+            raise RegisterFileError(f"address {address} has no write register ({port.access.meaning})")
+        self._check_consistency(register.name, "write")
+        if register.name in ("SET", "ID") and self._bus_running:
+            self.violations.report(
+                ReconfigurationError("3.4.3, 3.4.11", f"{register.name} written with {value:02X}h during bus operation")
+            )
+        self._values[register.name] = value & register.mask
+        if register.name == "SET":
+            self._apply_set(value & register.mask)
+
+    def _apply_set(self, value: int) -> None:
+        try:
+            decoded = decode_set(value)
+        except RegisterMapError as error:
+            self.violations.report(SetRegisterError("Table 3-12", f"{error}; configuration not applied"))
+            return
+        if decoded.length.bits is None:
+            self.violations.report(
+                SetRegisterError("Table 3-11", f"SET {value:02X}h: length code {decoded.length.code} is reserved; "
+                                 "configuration not applied")
+            )
+            return
+        self._set = decoded
+
+    @staticmethod
+    def _address(address: int) -> int:
+        if isinstance(address, bool) or not isinstance(address, int) or not 0 <= address <= 15:
+            raise RegisterFileError(f"address must be 0..15, not {address!r}")
+        return address
+
+    def _check_consistency(self, register: str, what: str) -> None:
+        if self._latch_phase and register in _DATA_REGISTERS:
+            self.violations.report(
+                InconsistentDataError("3.4.14", f"inconsistent data: {register} {what} during the latch phase")
+            )
+
+    # --------------------------------------------------------------------------------------------------------
+    # Core interface: configuration seen by the master
+    # --------------------------------------------------------------------------------------------------------
+
+    @property
+    def configured(self) -> bool:
+        """Software has written a valid SET value since power-up (3.4.3)."""
+        return self._set is not None
+
+    def bus_id_register(self) -> int:
+        """Bits 12..0 of the ID register the master reads in an ID cycle; the core adds bits 15..13.
+
+        Bits 7..0 are the ID code, bits 12..8 the length code (ID12..ID8, Table 3-11). Before SET is written:
+        the straps' µP_Not_Ready code with length code 00000 (3.4.1). After: the ID register (address 12) and
+        the length code of SET, the abbreviated code decoded by Table 3-12 (3.4.11).
+        """
+        if self._set is None:
+            return (self.config.length_code << 8) | self.config.id_code
+        return (int(self._set.length.code, 2) << 8) | self._values["ID"]
+
+    def data_bits(self) -> int:
+        """Data length in bits per direction: 0 until SET is written (3.4.1), then SET's length (Table 3-11)."""
+        if self._set is None:
+            return 0
+        bits = self._set.length.bits
+        assert bits is not None  # _apply_set never applies a reserved length code
+        return bits
+
+    def data_bytes(self) -> int:
+        """The data length rounded up to whole bytes: how many of addresses 0.. take part in a data cycle."""
+        return (self.data_bits() + 7) // 8
+
+    @property
+    def internal_data_path(self) -> bool:
+        """``False`` with ExtReg = 1: the internal data registers are not in the data path (3.4.8, 3.4.11)."""
+        return self._set is None or not self._set.extreg
+
+    @property
+    def pcp_device(self) -> bool:
+        """/PCP = 0 without ExtReg: IN bytes 0 and 1 are erased after their transfer (3.4.11)."""
+        return self._set is not None and not self._set.extreg and not self._set.pcp_n
+
+    # --------------------------------------------------------------------------------------------------------
+    # Core interface: data cycles, interrupts, management channel, optical registers
+    # --------------------------------------------------------------------------------------------------------
+
+    def set_bus_running(self, running: bool) -> None:
+        """The core reports whether INTERBUS is in operation; SET/ID writes while it is are violations (3.4.3)."""
+        self._bus_running = running
+
+    @property
+    def bus_running(self) -> bool:
+        """What the core last reported with :meth:`set_bus_running`."""
+        return self._bus_running
+
+    def set_latch_phase(self, active: bool) -> None:
+        """The core marks the latch phase of a data cycle; data-register accesses inside it are reported as
+        inconsistent data (3.4.14)."""
+        self._latch_phase = active
+
+    @property
+    def latch_phase(self) -> bool:
+        """What the core last reported with :meth:`set_latch_phase`."""
+        return self._latch_phase
+
+    def set_io_access(self, busy: bool) -> None:
+        """Set the I/O access (polling) bit: D7 of read 14 and the MFP1 level; 1 = no access now (Fig. 3-22)."""
+        self._io_access = busy
+
+    @property
+    def io_access(self) -> bool:
+        """The I/O access bit as last set by the core."""
+        return self._io_access
+
+    def _in_registers(self) -> tuple[str, ...]:
+        if not self.internal_data_path:
+            raise RegisterFileError("ExtReg = 1: the internal data registers are not in the data path (3.4.8)")
+        return tuple(r.name for r in IN_BYTES[: self.data_bytes()])
+
+    def in_bytes(self) -> bytes:
+        """The IN bytes the next data cycle sends, byte 0 (address 0) the most significant (3.4.8); no effect.
+
+        ``data_bytes()`` bytes; for 2-bit and nibble lengths the data are the low bits of byte 0.
+
+        Raises
+        ------
+        RegisterFileError
+            With ExtReg = 1 (the data come from the external registers).
+        """
+        return bytes(self._values[name] for name in self._in_registers())
+
+    def latch(self, out: bytes) -> bytes:
+        """The latch phase of a valid data cycle: return the IN bytes sent, store ``out`` in OUT0.., and in a
+        PCP device erase the transferred ones of IN bytes 0 and 1 (3.4.11, 3.4.14).
+
+        Parameters
+        ----------
+        out:
+            The OUT data of the cycle, ``data_bytes()`` bytes, byte 0 the most significant.
+
+        Raises
+        ------
+        RegisterFileError
+            If ``out`` has the wrong length, or with ExtReg = 1.
+        """
+        names = self._in_registers()
+        if len(out) != len(names):
+            raise RegisterFileError(
+                f"latch needs {len(names)} OUT bytes for {self.data_bits()} data bits, got {len(out)}"
+            )
+        sent = self.in_bytes()
+        for register, value in zip(OUT_BYTES, out, strict=False):
+            self._values[register.name] = value
+        if self.pcp_device:
+            for name in set(_PCP_ERASED) & set(names):
+                self._values[name] = 0
+        return sent
+
+    def event(self, source: str) -> None:
+        """An interrupt event of ``source`` (a name of :data:`supi3.regmap.INTERRUPT_SOURCES`, Table 3-13).
+
+        The event bit is set only if the source is enabled in IRQ_EN; /IRQ is low while any event bit is set
+        (3.4.14). Works whatever the data length, even 0.
+
+        Raises
+        ------
+        RegisterFileError
+            If ``source`` is not a source name.
+        """
+        if source not in _SOURCE_BITS:
+            raise RegisterFileError(f"no interrupt source {source!r}; sources: {sorted(_SOURCE_BITS)}")
+        mask = 1 << _SOURCE_BITS[source]
+        if self._values["IRQ_EN"] & mask:
+            self._values["IRQ_EVT"] |= mask
+
+    @property
+    def irq_n(self) -> int:
+        """The /IRQ level (MFP3): 0 while an event is pending, else 1 (3.4.14)."""
+        return 0 if self._values["IRQ_EVT"] else 1
+
+    def processor_command(self, value: int) -> None:
+        """The master's management message: store it in PCMD (read 7) and raise the PCMD event (3.4.9)."""
+        if not 0 <= value <= 0xFF:
+            raise RegisterFileError(f"processor command must be a byte, not {value!r}")
+        self._values["PCMD"] = value
+        self.event("PCMD")
+
+    @property
+    def processor_alarm(self) -> int:
+        """The processor alarm register (write 7), for the master to read (3.4.9)."""
+        return self._values["ALARM"]
+
+    def set_optical(self, register: str, value: int) -> None:
+        """Set one of the optical read registers 8-11 (3.4.12, 3.4.13) from the optical block.
+
+        Raises
+        ------
+        RegisterFileError
+            If ``register`` is not LENGTH_OUT, LENGTH_BRANCH, POWER_IN or POWER_OUT_BRANCH, or ``value`` sets a
+            reserved bit.
+        """
+        if register not in _OPTICAL_REGISTERS:
+            raise RegisterFileError(f"{register!r} is not an optical register: {sorted(_OPTICAL_REGISTERS)}")
+        layout = REGISTER_MAP.register(register)
+        if not 0 <= value <= 0xFF or value & ~layout.mask:
+            raise RegisterFileError(f"{register} = {value!r} sets bits outside {layout.mask:02X}h")
+        self._values[register] = value
+
+    def value(self, register: str) -> int:
+        """The stored value of ``register`` (a :data:`REGISTER_MAP` name), without side effects (for tests and
+        the core; IRQ_EVT without the live D7)."""
+        if register not in self._values:
+            raise RegisterFileError(f"no register {register!r}; registers: {sorted(self._values)}")
+        return self._values[register]
