@@ -80,3 +80,15 @@ def test_report() -> None:
     r = timing.report(4, 500_000)
     assert r["cpu_access_time_us"] == 234.0 and r["io_access_window_us"] == 60.0
     assert r["optical_resolution_m"] == {"typical": 24, "worst": 48}
+
+
+def test_data_cycle_time_follows_the_wire_format() -> None:
+    from supi3.interbus import wire
+
+    t = timing.data_cycle_time_s(4, 1, 500_000)
+    assert t == pytest.approx(wire.cycle_bits(4, 1) * 2e-6)
+    # At least the frame of 13 x (6 + n) bit periods (Beckhoff's formula, docs/interbus.md).
+    assert t >= 13 * (6 + 4) * 2e-6
+    assert timing.data_cycle_time_s(8, 2, 2_000_000) > timing.data_cycle_time_s(4, 1, 2_000_000)
+    with pytest.raises(timing.TimingError, match="devices >= 1"):
+        timing.data_cycle_time_s(4, 0, 500_000)

@@ -85,9 +85,9 @@ def cmd_regmap(args: argparse.Namespace) -> None:
 
 
 def cmd_timing(args: argparse.Namespace) -> None:
-    """CPU access time, I/O access window, cycle time, optical length; optionally a timing table."""
+    """Data cycle time, CPU access time, I/O access window, optical length; optionally a timing table."""
     bit_rate = _parse_bit_rate(args.bit_rate)
-    data = timing.report(args.bytes, bit_rate)
+    data = timing.report(args.bytes, bit_rate, args.devices)
     if args.optical_count is not None:
         length = timing.optical_length_m(args.optical_count, bit_rate)
         data["optical_count"] = args.optical_count
@@ -185,6 +185,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("timing", help="CPU access time, I/O access window, cycle time, optical length")
     p.add_argument("--bit-rate", default="500k", help="500k or 2M")
     p.add_argument("--bytes", type=int, default=4, help="data bytes in the whole network (default 4)")
+    p.add_argument("--devices", type=int, default=1, help="devices in the ring (default 1)")
     p.add_argument("--optical-count", type=int, metavar="N", help="length timer result n (1.6.1)")
     p.add_argument("--table", choices=sorted(timing.TIMING_TABLES), help="also evaluate a timing table")
     p.add_argument("--json", action="store_true")

@@ -139,7 +139,17 @@ def optical_range(length_m: float, bit_rate: int) -> tables.OpticalLengthRange:
     raise TimingError(f"{length_m} m is outside Table 1-5's 0 m to 20 km")
 
 
-def report(network_bytes: int, bit_rate: int) -> dict[str, object]:
+def data_cycle_time_s(network_bytes: int, devices: int, bit_rate: int) -> float:
+    """Duration of one INTERBUS data cycle on the wire: frame, ring delay, turnaround and latch
+    (``supi3.interbus.wire.cycle_bits``, docs/interbus.md "Cycle timing")."""
+    from supi3.interbus import wire
+
+    if network_bytes < 0 or devices < 1:
+        raise TimingError(f"need network bytes >= 0 and devices >= 1, not {network_bytes} and {devices}")
+    return wire.cycle_bits(network_bytes, devices) * bit_period_s(bit_rate)
+
+
+def report(network_bytes: int, bit_rate: int, devices: int = 1) -> dict[str, object]:
     """Everything ``supi3 timing`` prints, as data (times in µs)."""
     t_bit = bit_period_s(bit_rate)
     resolution = optical_length_m(1, bit_rate)
@@ -148,6 +158,10 @@ def report(network_bytes: int, bit_rate: int) -> dict[str, object]:
         "bit_rate": bit_rate,
         "t_bit_us": t_bit * 1e6,
         "network_bytes": network_bytes,
+        "devices": devices,
+        "data_cycle_time_us": round(data_cycle_time_s(network_bytes, devices, bit_rate) * 1e6, 6),
+        "data_cycle_formula": "13 * (6 + n) bit periods of frame, then status telegrams for the ring delay, "
+        "turnaround and latch (docs/interbus.md)",
         "cpu_access_time_us": round(cpu_access_time_s(network_bytes, bit_rate) * 1e6, 6),
         "cpu_access_formula": "T = 13 * (5 + n) * t_Bit (manual 3.4.14)",
         "io_access_window_us": round(io_access_window_s(bit_rate) * 1e6, 6),
