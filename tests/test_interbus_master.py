@@ -12,6 +12,8 @@ from supi3.interbus import wire
 from supi3.interbus.device import PlainDevice
 from supi3.interbus.errors import InterbusError
 from supi3.interbus.master import (
+    ALARM_STOP,
+    CONTROL_DEVICE_FUNCTION,
     MSG_PERIPHERAL_FAULT,
     MSG_WATCHDOG,
     InterfaceType,
@@ -308,6 +310,7 @@ def test_peripheral_fault_reports_0bb1h_and_quit_pulses_modack() -> None:
     assert device.mod_ack_pulses == 1
     assert device.management() == 0
     assert [d.code for d in master.diagnostics] == [MSG_PERIPHERAL_FAULT]
+    assert master.services == [ALARM_STOP, CONTROL_DEVICE_FUNCTION]
 
 
 def test_alarm_stop_clears_process_data() -> None:

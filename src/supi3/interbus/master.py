@@ -142,6 +142,8 @@ class Master:
         The configuration table read in the last discovery ID cycle, ``None`` before one.
     diagnostics:
         Every diagnostic reported so far, oldest first.
+    services:
+        The firmware service codes called so far (``ALARM_STOP``, ``CONTROL_DEVICE_FUNCTION``), oldest first.
     """
 
     def __init__(self, ring: Ring, locate: bool = True) -> None:
@@ -149,6 +151,7 @@ class Master:
         self.locate = locate
         self.config: tuple[ConfigEntry, ...] | None = None
         self.diagnostics: list[Diagnostic] = []
+        self.services: list[int] = []
         self._out = bytearray(wire.LOOPBACK_BYTES_ON_LINE)
         self._in = b""
         self._in_slices: list[slice] = []
@@ -164,6 +167,7 @@ class Master:
     def alarm_stop(self) -> None:
         """Alarm Stop (1303h): INTERBUS reset of the whole ring, outputs and inputs reset, configuration
         forgotten; the next cycle is a discovery ID cycle. A watchdog setting is sent again afterwards."""
+        self.services.append(ALARM_STOP)
         self.ring.reset()
         self._set_config(None)
         self._quit.clear()
@@ -190,6 +194,7 @@ class Master:
         """Control_Device_Function 0714h, "Quit Peripheral Error" (3.6.2): acknowledge a device's peripheral
         fault; the device's /ModAck output pulses. Sent in the device's command word of the next ID cycle."""
         self._quit.add(self.entry(position).ring_position)
+        self.services.append(CONTROL_DEVICE_FUNCTION)
 
     # -- process data --------------------------------------------------------------------------------------------
 
