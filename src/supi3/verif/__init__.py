@@ -1,0 +1,39 @@
+"""Verification kit: the pin-level model protocol and the lockstep harness comparing a model with RTL.
+
+See ``docs/verification.md``. The cocotb coroutine lives in :mod:`supi3.verif.cocotb_lockstep` (imported only inside
+a simulator), the example design and model in :mod:`supi3.verif.example`.
+"""
+
+from supi3.verif.errors import (
+    LockstepError,
+    LockstepMismatchError,
+    PinSpecError,
+    SimulationError,
+    SimulatorUnavailableError,
+)
+from supi3.verif.layout import Layout, Stimulus, first_mismatch, model_trace, stimulus_array
+from supi3.verif.lockstep import Lockstep, react, run_lockstep, run_lockstep_batch
+from supi3.verif.pinmodel import EventLog, Pin, PinModel, recent_events
+from supi3.verif.report import LockstepResult
+
+__all__ = [
+    "EventLog",
+    "Layout",
+    "Lockstep",
+    "LockstepError",
+    "LockstepMismatchError",
+    "LockstepResult",
+    "Pin",
+    "PinModel",
+    "PinSpecError",
+    "SimulationError",
+    "SimulatorUnavailableError",
+    "Stimulus",
+    "first_mismatch",
+    "model_trace",
+    "react",
+    "recent_events",
+    "run_lockstep",
+    "run_lockstep_batch",
+    "stimulus_array",
+]

@@ -1,0 +1,92 @@
+"""The per-cycle lockstep loop as a cocotb coroutine, for the harness's own testbench and for other cocotb tests.
+
+Runs inside the simulator process. The DUT is the packed top-level (:class:`~supi3.verif.rtl.LockstepTop`): ports
+``clk``, ``rst``, input words ``lsi<n>`` and output words ``lso<n>``.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+from cocotb.clock import Clock
+from cocotb.triggers import FallingEdge, ReadOnly
+
+from supi3.verif.layout import WORD, Layout, Trace
+from supi3.verif.pinmodel import PinModel, recent_events
+from supi3.verif.report import MismatchRecord, Outcome
+from supi3.verif.vcd import CYCLE_NS
+
+__all__ = ["lockstep"]
+
+
+async def lockstep(dut: Any, model: PinModel, stimulus: Trace, *, reset_cycles: int = 1, window: int = 64) -> Outcome:
+    """Clock the DUT and the model together and compare every output signal on every cycle.
+
+    Timing per cycle ``n`` (see :mod:`supi3.verif.pinmodel`): at the falling clock edge the inputs of cycle ``n`` are
+    written to the DUT and given to the model's ``step``; once the DUT has settled (``ReadOnly``) its outputs are
+    compared with the model's; the next rising edge updates both. Before cycle 0 the ``sync`` reset is held for
+    ``reset_cycles`` rising edges with all inputs at 0, and the model is reset.
+
+    Parameters
+    ----------
+    dut:
+        The cocotb handle of the packed top-level.
+    model:
+        A fresh model.
+    stimulus:
+        Input values ``(cycles, inputs)`` in the model's input order.
+    reset_cycles:
+        Rising edges with reset asserted before cycle 0.
+    window:
+        Cycles of history kept for the mismatch waveform.
+
+    Returns
+    -------
+    Outcome
+        Cycles compared, time taken, and the first mismatch if there was one (the loop stops there).
+    """
+    layout = Layout.of(model)
+    in_port = dut.lsi if layout.in_words else None
+    out_port = dut.lso
+    falling = FallingEdge(dut.clk)
+    settled = ReadOnly()
+
+    dut.rst.value = 1
+    if in_port is not None:
+        in_port.value = 0
+    Clock(dut.clk, CYCLE_NS, unit="ns").start(start_high=False)
+    for _ in range(reset_cycles):
+        await falling
+    model.reset()
+
+    step = model.step
+    names = layout.input_names
+    output_values = layout.output_values
+    matches = layout.matches
+    history = [0] * window
+    packed_inputs = [
+        sum(word << (WORD * index) for index, word in enumerate(row)) for row in layout.input_words(stimulus).tolist()
+    ]
+    start = time.perf_counter()
+    for cycle, (row, packed) in enumerate(zip(stimulus.tolist(), packed_inputs, strict=True)):
+        if cycle:
+            await falling
+        else:
+            dut.rst.value = 0
+        if in_port is not None:
+            in_port.value = packed
+        expected = output_values(step(dict(zip(names, row, strict=True))))
+        await settled
+        actual = out_port.value.to_unsigned()
+        history[cycle % window] = actual
+        if not matches(expected, actual):
+            seconds = time.perf_counter() - start
+            signal = layout.first_difference(expected, layout.unpack_outputs(actual))
+            assert signal is not None, "matches() and first_difference() agree"
+            first = max(0, cycle + 1 - window)
+            record = MismatchRecord(
+                cycle, signal, recent_events(model), [history[k % window] for k in range(first, cycle + 1)]
+            )
+            return Outcome(cycle + 1, seconds, record)
+    return Outcome(stimulus.shape[0], time.perf_counter() - start)

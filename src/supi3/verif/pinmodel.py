@@ -1,0 +1,157 @@
+"""The synchronous pin-level model protocol that the lockstep harness compares against RTL.
+
+Convention
+----------
+A pin model is a synchronous machine clocked at the chip clock. Cycle ``n`` is the time between rising clock edge
+``n`` and rising clock edge ``n + 1``; cycle 0 is the first cycle after reset. During every cycle:
+
+1. the input pins take the values given for cycle ``n`` (they are stable for the whole cycle);
+2. the output pins are observed, after the inputs have settled: an output may depend on the state (registered
+   outputs, or combinational logic from state) and, combinationally, on the inputs of the same cycle;
+3. the rising edge at the end of the cycle updates the state from the state and the inputs of cycle ``n``.
+
+:meth:`PinModel.step` does all three for one cycle: it takes the inputs of cycle ``n``, returns the outputs seen
+during cycle ``n`` and leaves the model in the state of cycle ``n + 1``. An Amaranth design whose ``sync`` domain
+follows the same clock matches it exactly, whatever mix of registered and combinational outputs it has.
+
+Reset: :meth:`PinModel.reset` puts the model in the state that the design has after its ``sync`` domain reset; the
+harness asserts that reset before cycle 0 and does not compare outputs while it is asserted.
+
+Tri-state outputs: an output :class:`Pin` with ``tristate=True`` named ``d`` has a second, one-bit output ``d_oe``
+(its output enable). ``d_oe`` is compared on every cycle; ``d`` only on cycles where ``d_oe`` is 1, so a model may
+return any value for a pin it does not drive.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Protocol, runtime_checkable
+
+from supi3.verif.errors import PinSpecError
+
+__all__ = ["EventLog", "Pin", "PinModel", "compared_signals", "recent_events"]
+
+OE_SUFFIX = "_oe"
+"""Suffix of the output-enable signal of a tri-state output pin."""
+
+
+@dataclass(frozen=True)
+class Pin:
+    """One pin of a pin model: a name, a width in bits, and (outputs only) whether it has an output enable.
+
+    Parameters
+    ----------
+    name:
+        A Python identifier; the design exposes the pin as an attribute of the same name.
+    width:
+        Bits, 1 to 64.
+    tristate:
+        Output pins only: the pin has an output enable named ``<name>_oe`` (one bit), and its value is compared only
+        while the enable is 1.
+    """
+
+    name: str
+    width: int = 1
+    tristate: bool = False
+
+    def __post_init__(self) -> None:
+        if not self.name.isidentifier():
+            raise PinSpecError(f"pin name must be a Python identifier, not {self.name!r}")
+        if isinstance(self.width, bool) or not isinstance(self.width, int) or not 1 <= self.width <= 64:
+            raise PinSpecError(f"pin {self.name!r}: width must be an integer from 1 to 64, not {self.width!r}")
+
+    @property
+    def mask(self) -> int:
+        """All ones over the pin's width."""
+        return (1 << self.width) - 1
+
+
+@runtime_checkable
+class PinModel(Protocol):
+    """What the harness needs from a cycle-accurate Python model (see the module docstring for the timing).
+
+    Attributes
+    ----------
+    inputs:
+        The input pins, in a fixed order (the column order of array stimulus).
+    outputs:
+        The output pins, in the order they are compared within a cycle.
+    """
+
+    inputs: Sequence[Pin]
+    outputs: Sequence[Pin]
+
+    def reset(self) -> None:
+        """Return to the state right after reset; the next :meth:`step` is cycle 0."""
+
+    def step(self, inputs: Mapping[str, int]) -> Mapping[str, int]:
+        """Run one clock cycle.
+
+        Parameters
+        ----------
+        inputs:
+            A value for every input pin, for this cycle.
+
+        Returns
+        -------
+        Mapping[str, int]
+            A value for every output pin observed during this cycle, and ``<name>_oe`` for every tri-state pin.
+        """
+        ...
+
+
+class EventLog:
+    """A bounded log of a model's recent bus events, for mismatch reports.
+
+    A model keeps one and returns :meth:`recent` from a ``recent_events()`` method; the harness prints those lines
+    when the RTL disagrees with the model. Events are formatted only when read, so logging costs little per cycle.
+
+    Parameters
+    ----------
+    depth:
+        How many events to keep; older ones are dropped.
+    """
+
+    def __init__(self, depth: int = 32) -> None:
+        if depth < 1:
+            raise PinSpecError(f"event log depth must be a positive integer, not {depth!r}")
+        self._events: deque[tuple[int, str, tuple[object, ...]]] = deque(maxlen=depth)
+
+    def add(self, cycle: int, message: str, *args: object) -> None:
+        """Record that ``message.format(*args)`` happened at ``cycle``."""
+        self._events.append((cycle, message, args))
+
+    def clear(self) -> None:
+        """Forget every event (call from the model's ``reset``)."""
+        self._events.clear()
+
+    def recent(self) -> list[str]:
+        """The kept events, oldest first, as ``"cycle <n>: <message>"``."""
+        return [f"cycle {cycle}: {message.format(*args)}" for cycle, message, args in self._events]
+
+    def __len__(self) -> int:
+        return len(self._events)
+
+
+def recent_events(model: object) -> list[str]:
+    """The model's recent bus events, oldest first, or an empty list when it keeps none.
+
+    A model opts in by defining ``recent_events() -> Sequence[str]``.
+    """
+    method = getattr(model, "recent_events", None)
+    return [str(event) for event in method()] if callable(method) else []
+
+
+def compared_signals(outputs: Sequence[Pin]) -> list[tuple[str, int, str | None]]:
+    """The output signals in comparison order: ``(name, width, enable)`` with ``enable`` the name of the output
+    enable that gates the comparison, or ``None``. A tri-state pin's enable comes right before its value."""
+    signals: list[tuple[str, int, str | None]] = []
+    for pin in outputs:
+        if pin.tristate:
+            signals.append((pin.name + OE_SUFFIX, 1, None))
+            signals.append((pin.name, pin.width, pin.name + OE_SUFFIX))
+        else:
+            signals.append((pin.name, pin.width, None))
+    return signals

