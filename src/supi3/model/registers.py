@@ -116,15 +116,16 @@ class ViolationLog:
     def deferred(self) -> Iterator[None]:
         """Hold strict-mode raises until the block ends, so that one operation (a byte, a clock cycle) completes
         and leaves the model consistent; then raise the first violation reported inside it."""
+        pending: list[InterfaceViolationError] = []
         self._depth += 1
         try:
             yield
         finally:
             self._depth -= 1
-        if self._depth == 0 and self._pending:
-            first = self._pending[0]
-            self._pending.clear()
-            raise first
+            if self._depth == 0:
+                pending, self._pending = self._pending, []
+        if pending:
+            raise pending[0]
 
 
 class RegisterFile:

@@ -1,0 +1,320 @@
+"""The serial µP interface at pin level: a synchronous machine clocked at the 32 MHz chip clock.
+
+Ref: IBS SUPI 3 OPC UM E rev. 05, 3.4.1 - 3.4.3, Tables 3-5 to 3-7. This is the reference the Amaranth RTL of the
+interface matches pin for pin. The protocol itself is :class:`supi3.spi.upif.UpifProtocol`; this module adds
+the input synchronisers, the shift registers, the output pipeline and the timing checks of Table 3-7 around it.
+The cycle-exact behaviour is specified in ``docs/upif.md`` ("Pin level"); in short, for cycle ``n``:
+
+1. :meth:`SlavePins.tick` takes the input pins of cycle ``n`` (stable for the whole cycle) and returns the
+   outputs seen during cycle ``n``; they depend on the state only (no combinational path from an input);
+2. the clock edge ending cycle ``n`` updates the state from the state and the inputs of cycle ``n``.
+
+Every input passes a 2-flop synchroniser (``s1``, ``s2``); edges are detected between ``s2`` and a third flop
+``s3``. Outputs are the state decoded, delayed by ``output_delay`` = 2 * (clocks per TCLK) - 2 cycles, so that an
+output changes 2 TCLK (to 2 TCLK + 1 clock) after the input edge that caused it, as Table 3-7's t3, t6, t7 and t9
+require.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Callable, Mapping
+from dataclasses import asdict, dataclass, fields
+from typing import Final
+
+from supi3 import tables
+from supi3.model.registers import InterfaceViolationError, RegisterFile
+from supi3.spi.upif import Mode, UpifProtocol, UpifUsageError
+from supi3.timing import timing_table
+
+__all__ = ["INPUT_PINS", "OUTPUT_PINS", "PinsIn", "PinsOut", "SlavePins", "TimingViolationError"]
+
+TCLK_PER_BIT: Final[int] = 16
+"""TCLK = t_Bit_IBS / 16 (Table 3-7)."""
+_EPSILON_S: Final[float] = 1e-12
+"""Tolerance of the timing comparisons (the table's limits are floats)."""
+
+
+class TimingViolationError(InterfaceViolationError):
+    """A Table 3-7 timing requirement on the µP's signals was not met.
+
+    Attributes
+    ----------
+    parameter:
+        The Table 3-7 symbol (``"t1"``, ``"t_SAS_INIT"``, ...).
+    measured_s:
+        The measured time in seconds, or ``None`` when the signal changed inside a forbidden window (t11).
+    required_s:
+        The minimum the table requires.
+    cycle:
+        The chip-clock cycle at which the violation was seen.
+    """
+
+    def __init__(self, parameter: str, explanation: str, measured_s: float | None, required_s: float,
+                 cycle: int) -> None:
+        self.parameter = parameter
+        self.measured_s = measured_s
+        self.required_s = required_s
+        self.cycle = cycle
+        measured = "inside the forbidden window" if measured_s is None else f"measured {measured_s * 1e9:.2f} ns"
+        super().__init__(f"Table 3-7 {parameter}",
+                         f"{parameter} ({explanation}): {measured}, required >= {required_s * 1e9:.2f} ns "
+                         f"at cycle {cycle}")
+
+
+@dataclass(frozen=True)
+class PinsIn:
+    """The input pins of one cycle (Tables 3-5, 3-6), each 0 or 1. The defaults are the idle levels."""
+
+    sas_init: int = 0
+    """MFP0, SAS_INIT (active high)."""
+    sclk: int = 1
+    """MFP4, SCLK; idles high (UP-5)."""
+    ss_n: int = 1
+    """MFP5, /SS."""
+    mfp6: int = 0
+    """MFP6 as seen from outside: SerIN (Motorola) or the µP's level on Ser_IN/OUT (Intel). While the chip drives
+    MFP6 (``mfp6_oe``), the chip reads its own output instead."""
+    mfp7: int = 1
+    """MFP7 as an input: S/R in Intel mode (Table 3-9); not used in Motorola mode (there it is SerOUT)."""
+
+
+@dataclass(frozen=True)
+class PinsOut:
+    """The output pins of one cycle, each with its output enable (``*_oe``, 1 = driven)."""
+
+    io: int
+    """MFP1, the I/O access bit (D7 of read 14)."""
+    io_oe: int
+    c_d: int
+    """MFP2, C/D: 0 = command (or initialization) byte next, 1 = data byte next."""
+    c_d_oe: int
+    irq_n: int
+    """MFP3, /IRQ."""
+    irq_n_oe: int
+    mfp6: int
+    """MFP6, Ser_IN/OUT driven by the chip (Intel mode, S/R = 0)."""
+    mfp6_oe: int
+    mfp7: int
+    """MFP7, SerOUT (Motorola mode)."""
+    mfp7_oe: int
+
+
+INPUT_PINS: Final[tuple[str, ...]] = tuple(f.name for f in fields(PinsIn))
+"""Input pin names, in :class:`PinsIn` order (the lockstep harness's column order)."""
+OUTPUT_PINS: Final[tuple[str, ...]] = tuple(f.name for f in fields(PinsOut))
+"""Output signal names, enables included, in :class:`PinsOut` order."""
+
+
+@dataclass
+class _Sync:
+    """A 2-flop synchroniser plus the edge-detect flop: s1 <= pin, s2 <= s1, s3 <= s2 at every clock edge."""
+
+    s1: int
+    s2: int
+    s3: int
+
+    @property
+    def rose(self) -> bool:
+        return self.s2 == 1 and self.s3 == 0
+
+    @property
+    def fell(self) -> bool:
+        return self.s2 == 0 and self.s3 == 1
+
+    def clock(self, pin: int) -> None:
+        self.s1, self.s2, self.s3 = pin, self.s1, self.s2
+
+
+class _TimingChecker:
+    """Table 3-7 requirements on the µP's signals, checked on the raw pins at chip-clock resolution."""
+
+    def __init__(self, bit_rate: int, clock_hz: int, report: Callable[[InterfaceViolationError], None]) -> None:
+        self._limits = {t.symbol: t for t in timing_table("3-7", bit_rate)}
+        self._clock_hz = clock_hz
+        self._report = report
+        self.reset()
+
+    def reset(self) -> None:
+        self._pins = PinsIn()
+        self._c_d: int | None = None
+        self._last_c_d: int | None = None
+        self._ss_fall: int | None = None
+        self._first_sclk_fall: int | None = None
+        self._last_rise: int | None = None
+        self._last_data: int | None = None
+        self._sas_rise: int | None = None
+
+    def _require(self, symbol: str, cycle: int, since: int | None) -> None:
+        """Report ``symbol`` if less than its minimum elapsed from cycle ``since`` to ``cycle``."""
+        if since is None:
+            return
+        limit = self._limits[symbol]
+        assert limit.minimum_s is not None
+        measured = (cycle - since) / self._clock_hz
+        if measured + _EPSILON_S < limit.minimum_s:
+            self._report(TimingViolationError(symbol, limit.explanation, measured, limit.minimum_s, cycle))
+
+    def check(self, cycle: int, pins: PinsIn, out: PinsOut, intel: bool) -> None:
+        """Check the inputs of ``cycle`` against those of the cycle before; ``out`` are the outputs of ``cycle``."""
+        prev, self._pins = self._pins, pins
+        if self._c_d is not None and out.c_d != self._c_d:
+            self._last_c_d = cycle
+        self._c_d = out.c_d
+        if prev.ss_n and not pins.ss_n:
+            self._require("t8", cycle, self._last_c_d)
+            self._ss_fall, self._first_sclk_fall, self._last_rise = cycle, None, None
+        selected = not pins.ss_n
+        if pins.mfp6 != prev.mfp6 and not out.mfp6_oe:
+            if selected:
+                self._require("t5", cycle, self._last_rise)
+            self._last_data = cycle
+        if selected and prev.sclk and not pins.sclk and self._first_sclk_fall is None:
+            self._first_sclk_fall = cycle
+            self._require("t1", cycle, self._ss_fall)
+        if selected and pins.sclk and not prev.sclk:
+            self._require("t0", cycle, self._last_rise)
+            if not out.mfp6_oe:
+                self._require("t4", cycle, self._last_data)
+            self._last_rise = cycle
+        if intel and selected and not prev.ss_n and pins.mfp7 != prev.mfp7:
+            limit = self._limits["t11"]
+            assert limit.minimum_s is not None
+            self._report(TimingViolationError("t11", limit.explanation + " (S/R changed while /SS low)", None,
+                                              limit.minimum_s, cycle))
+        if pins.ss_n and not prev.ss_n:
+            self._require("t2", cycle, self._last_rise)
+        if pins.sas_init and not prev.sas_init:
+            self._sas_rise = cycle
+        if prev.sas_init and not pins.sas_init:
+            self._require("t_SAS_INIT", cycle, self._sas_rise)
+
+
+class SlavePins:
+    """The serial µP interface pins of the SUPI 3 OPC as a synchronous machine at the chip clock.
+
+    Parameters
+    ----------
+    registers:
+        The chip's register file (its configuration gives the bit rate, its violation log strict or lenient).
+    clock_hz:
+        The chip clock (Table 1-6: 32 MHz); it must be a whole multiple of TCLK = 16 * bit rate.
+
+    Notes
+    -----
+    The model starts in the state after a power-up reset (:meth:`reset`). Timing violations of the µP's signals
+    (Table 3-7) and protocol violations are reported to ``registers.violations``; in strict mode the first one
+    is raised at the end of the :meth:`tick` in which it was seen, after the state was updated.
+    """
+
+    def __init__(self, registers: RegisterFile, *, clock_hz: int = tables.CLOCK_HZ) -> None:
+        bit_rate = registers.config.bit_rate
+        if clock_hz % (TCLK_PER_BIT * bit_rate):
+            raise UpifUsageError(f"clock {clock_hz} Hz is not a multiple of TCLK = {TCLK_PER_BIT} * {bit_rate} Hz")
+        self.protocol = UpifProtocol(registers)
+        self.clocks_per_tclk = clock_hz // (TCLK_PER_BIT * bit_rate)
+        """Chip clocks per TCLK: 4 at 500 kbit/s, 1 at 2 Mbit/s."""
+        self.output_delay = 2 * self.clocks_per_tclk - 2
+        """Output pipeline stages after the decoded state (UP-14): 6 at 500 kbit/s, 0 at 2 Mbit/s."""
+        self.clock_hz = clock_hz
+        self._checker = _TimingChecker(bit_rate, clock_hz, registers.violations.report)
+        self.reset()
+
+    @property
+    def registers(self) -> RegisterFile:
+        """The register file behind the interface."""
+        return self.protocol.registers
+
+    def reset(self) -> None:
+        """Power-up reset: registers, protocol, synchronisers (to the idle levels), shift registers, pipeline."""
+        self.protocol.power_up_reset()
+        self.cycle = 0
+        """The number of the next cycle (0 right after reset)."""
+        idle = PinsIn()
+        self._ss = _Sync(idle.ss_n, idle.ss_n, idle.ss_n)
+        self._sclk = _Sync(idle.sclk, idle.sclk, idle.sclk)
+        self._sas = _Sync(idle.sas_init, idle.sas_init, idle.sas_init)
+        self._data = _Sync(idle.mfp6, idle.mfp6, idle.mfp6)
+        self._s_r = _Sync(idle.mfp7, idle.mfp7, idle.mfp7)
+        self._clear_frame()
+        self._checker.reset()
+        self._pipeline: deque[PinsOut] = deque([self._decode()] * (self.output_delay + 1))
+
+    def _clear_frame(self) -> None:
+        self._bits = 0
+        self._rx = 0
+        self._tx: int | None = None
+
+    def tick(self, pins: PinsIn) -> PinsOut:
+        """Run one chip-clock cycle: return the outputs of this cycle, then clock the state with ``pins``.
+
+        Raises
+        ------
+        TimingViolationError, ProtocolViolationError, ReconfigurationError, InconsistentDataError
+            In strict mode, after the cycle completed.
+        """
+        out = self._pipeline[0]
+        with self.registers.violations.deferred():
+            self._checker.check(self.cycle, pins, out, self.protocol.mode is Mode.INTEL)
+            self._edge(pins, out)
+            self._pipeline.popleft()
+            self._pipeline.append(self._decode())
+            self.cycle += 1
+        return out
+
+    def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
+        """:meth:`tick` with pins by name (the lockstep harness's ``PinModel.step``; names in
+        :data:`INPUT_PINS` and :data:`OUTPUT_PINS`)."""
+        return asdict(self.tick(PinsIn(**inputs)))
+
+    def _edge(self, pins: PinsIn, out: PinsOut) -> None:
+        """The clock edge ending this cycle: act on the edges the synchronised signals show, then clock the
+        synchronisers. Order within one edge: SAS_INIT, /SS falling, SCLK rising, /SS rising."""
+        protocol = self.protocol
+        if self._sas.s2:
+            protocol.sas_init()
+            self._clear_frame()
+        else:
+            if self._ss.fell:
+                self._clear_frame()
+                self._tx = protocol.begin(bool(self._s_r.s2))
+            if protocol.in_frame and not self._ss.s2 and self._sclk.rose:
+                self._shift_in(self._data.s2)
+            if protocol.in_frame and self._ss.rose:
+                if self._bits == 8:
+                    protocol.end(self._rx)
+                else:
+                    protocol.abort(self._bits)
+                self._clear_frame()
+        pad = out.mfp6 if out.mfp6_oe else pins.mfp6
+        for sync, pin in ((self._ss, pins.ss_n), (self._sclk, pins.sclk), (self._sas, pins.sas_init),
+                          (self._data, pad), (self._s_r, pins.mfp7)):
+            sync.clock(pin)
+
+    def _shift_in(self, bit: int) -> None:
+        """One SCLK rising edge: take ``bit`` into the receive register in the mode's bit order (UP-6)."""
+        if self._bits < 8:
+            if self.protocol.lsb_first:
+                self._rx |= bit << self._bits
+            else:
+                self._rx = (self._rx << 1) | bit
+        self._bits += 1
+
+    def _decode(self) -> PinsOut:
+        """The outputs as a function of the state (before the output pipeline)."""
+        protocol = self.protocol
+        registers = protocol.registers
+        drive = protocol.in_frame and self._tx is not None
+        bit = 0
+        if self._tx is not None:
+            index = min(self._bits, 7)
+            bit = (self._tx >> (index if protocol.lsb_first else 7 - index)) & 1
+        intel = drive and protocol.mode is Mode.INTEL
+        motorola = drive and protocol.mode is Mode.MOTOROLA
+        return PinsOut(
+            io=int(registers.io_access), io_oe=1,
+            c_d=protocol.c_d, c_d_oe=1,
+            irq_n=registers.irq_n, irq_n_oe=1,
+            mfp6=bit if intel else 0, mfp6_oe=int(intel),
+            mfp7=bit if motorola else 0, mfp7_oe=int(motorola),
+        )
