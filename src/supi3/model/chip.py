@@ -1,0 +1,297 @@
+"""The SUPI 3 chip's INTERBUS slave behaviour, shared by both model fidelities.
+
+:class:`Supi3` is the transaction-level chip: it implements :class:`supi3.interbus.device.Device`, so a
+:class:`~supi3.interbus.ring.Ring` shifts whole frames through it. The cycle-accurate pin-level model drives the
+very same object at the exact clock of each bus event, so both fidelities share one behaviour; only the pin level
+adds the line receiver, the repeater and the pins' timing.
+
+Time inside the chip is counted in periods of the 32 MHz clock (1.7.1); the transaction-level interface takes
+bus time in seconds and converts.
+
+What the chip does on each bus event (docs/interbus.md, docs/assumptions/model.md):
+
+* **load** (a frame begins): the register is parallel-loaded: the ID register in an ID cycle; the IN data in a
+  data cycle, sampled from the MFP inputs in binary I/O modes (Tables 3-1, 3-2) or taken from IN bytes 0..3 in
+  the µP modes (3.4.8).
+* **latch** (the master's latch telegrams after a good check): OUT data is taken over (MFP outputs in binary I/O
+  modes, OUT bytes in µP modes), the valid-data-cycle event is raised and the layer-2 watchdog restarted; in an ID
+  cycle the command word is applied (watchdog setting, Quit Peripheral Error) and the ID-cycle event raised.
+* **discard** (no latch): nothing latched changes; the invalid-data-cycle event is raised (Table 3-13).
+* **reset** (INTERBUS reset): IN and OUT data registers and MFP outputs are cleared, the watchdog is switched off,
+  the INTERBUS-reset event is raised (3.4.7, Table 3-13).
+* /StatErr low for the filter time (200 ms, 3.6.2) latches the peripheral fault (PF) that the master reports as
+  0BB1h; the watchdog's expiry resets process data and latches WD (0C6Bh). Quit Peripheral Error (0714h) pulses
+  /ModAck.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from typing import Final
+
+from supi3 import tables
+from supi3.config import DeviceConfig, MfpKind, decode
+from supi3.errors import Supi3Error
+from supi3.interbus import wire
+from supi3.interbus.wire import Cycle
+from supi3.model.registers import RegisterFile
+
+CLOCK_HZ: Final = tables.CLOCK_HZ
+
+STATERR_FILTER_CLOCKS: Final = round(tables.STATERR_FILTER_S * CLOCK_HZ)
+"""/StatErr must stay low this many clocks (200 ms, 3.6.2) before the peripheral fault is latched."""
+
+MODACK_PULSE_CLOCKS: Final = round(tables.RESREG_PULSE_NS * 1e-9 * CLOCK_HZ)
+"""/ModAck pulse on Quit Peripheral Error: the manual gives no width; the chip's other single pulse (375 ns,
+Table 3-13) is used (docs/assumptions/model.md M3)."""
+
+RESREG_PULSE_CLOCKS: Final = round(tables.RESREG_PULSE_NS * 1e-9 * CLOCK_HZ)
+"""/ResReg pulse on a layer-2 watchdog reset of process data: 375 ns (Table 3-13)."""
+
+WATCHDOG_CLOCKS: Final[tuple[int | None, ...]] = tuple(
+    None if t is None else round(t * CLOCK_HZ) for t in tables.WATCHDOG_TIMEOUTS_S
+)
+"""Layer-2 watchdog times in clocks, indexed by the command word's watchdog code (Table 3-13)."""
+
+
+class ChipError(Supi3Error, ValueError):
+    """A request the chip model cannot carry out (wrong data width, pin value out of range, ...)."""
+
+
+def clocks(now: float) -> int:
+    """Bus time in seconds as a count of 32 MHz clock periods."""
+    return round(now * CLOCK_HZ)
+
+
+class Supi3:
+    """One SUPI 3 OPC (or LS) chip on an INTERBUS ring, at transaction level.
+
+    Parameters
+    ----------
+    config:
+        The pin-strap configuration (:func:`supi3.config.decode`); ``None`` for the demo device (C[4..0] = 10000).
+    strict:
+        µP modes: raise interface rule violations (``True``) or record them (``False``), see
+        :class:`~supi3.model.registers.RegisterFile`.
+
+    Attributes
+    ----------
+    registers:
+        The µP-visible register file in Init-µP modes, else ``None``.
+    events:
+        How often each interrupt source of Table 3-13 fired (``"VALID"``, ``"INVALID"``, ``"ID_CYCLE"``,
+        ``"IB_RESET"``, ``"PCP_RX"``, ``"PCP_TX"``), plus ``"WATCHDOG"`` and ``"MODACK"``.
+    """
+
+    def __init__(self, config: DeviceConfig | None = None, *, strict: bool = True) -> None:
+        self.config = config if config is not None else decode("10000")
+        kind = self.config.mfp_mode.kind
+        self.registers = RegisterFile(self.config, strict=strict) if kind is MfpKind.INIT_UP else None
+        pins = self.config.mfp_pins
+        binary = kind is MfpKind.BINARY_IO
+        self._in_map = tuple((int(p.signal[2:]), p.pin) for p in pins if binary and p.signal.startswith("In"))
+        self._out_map = tuple((int(p.signal[3:]), p.pin) for p in pins if binary and p.signal.startswith("Out"))
+        self.events: Counter[str] = Counter()
+        self.mfp_in = 0
+        self._stat_err = False
+        self.power_up()
+
+    # --------------------------------------------------------------------------------------------------------
+    # Power-up and pins
+    # --------------------------------------------------------------------------------------------------------
+
+    def power_up(self) -> None:
+        """Power-up reset (1.7.2): every register 0, watchdog off, no fault latched (3.4.7)."""
+        if self.registers is not None:
+            self.registers.power_up_reset()
+        self.in_word = 0
+        self.out_word = 0
+        self.pf = False
+        self.wd = False
+        self.te = False
+        self.attention = False
+        self.bus_active = False
+        self.watchdog_code: int | None = None
+        self._deadline: int | None = None
+        self._stat_low_since: int | None = 0 if self._stat_err else None
+        self.mod_ack_until = 0
+        self.resreg_until = 0
+
+    def set_mfp_inputs(self, levels: int) -> None:
+        """Drive the MFP[15..0] input pins (binary I/O modes sample them when a data cycle begins)."""
+        if not 0 <= levels <= 0xFFFF:
+            raise ChipError(f"MFP levels are 16 bits, not {levels!r}")
+        self.mfp_in = levels
+
+    @property
+    def mfp_outputs(self) -> int:
+        """The levels the chip drives on its MFP output pins (binary I/O modes, Tables 3-1 and 3-2)."""
+        return sum(((self.out_word >> bit) & 1) << pin for bit, pin in self._out_map)
+
+    def set_stat_err(self, active: bool, now: float) -> None:
+        """Drive /StatErr (3.6.2): ``True`` pulls it low (an I/O error); the fault latches after the filter time."""
+        self._set_stat_err(active, clocks(now))
+
+    def _set_stat_err(self, active: bool, clk: int) -> None:
+        self._advance(clk)
+        if active and not self._stat_err:
+            self._stat_low_since = clk
+        elif not active:
+            self._stat_low_since = None
+        self._stat_err = active
+
+    @property
+    def module_error(self) -> bool:
+        """/StatErr has been low for the whole filter time (3.6.2)."""
+        return self._stat_low_since is not None and self._filtered
+
+    # --------------------------------------------------------------------------------------------------------
+    # What the master sees
+    # --------------------------------------------------------------------------------------------------------
+
+    def _id_and_length(self) -> int:
+        if self.registers is not None:
+            return self.registers.bus_id_register()
+        return (self.config.length_code << 8) | self.config.id_code
+
+    def management(self) -> int:
+        """Management bits 15..13 of the ID register: PF, WD, TE (docs/interbus.md, assumption A8)."""
+        return (self.pf << wire.MGMT_PF_BIT) | (self.wd << wire.MGMT_WD_BIT) | (self.te << wire.MGMT_TE_BIT)
+
+    def id_register(self) -> int:
+        """The 16-bit ID register shifted out in an ID cycle."""
+        return self.management() | self._id_and_length()
+
+    def data_bytes(self) -> int:
+        """Bytes the chip occupies on the line in a data cycle (Table 3-11, assumption A15)."""
+        return wire.data_bytes((self._id_and_length() >> 8) & 0x1F)
+
+    def _sample_inputs(self) -> int:
+        if self._in_map:
+            return sum(((self.mfp_in >> pin) & 1) << bit for bit, pin in self._in_map)
+        return self.in_word
+
+    def set_inputs(self, word: int) -> None:
+        """IN data for SPI master and bus terminal modes, whose data path is not modelled at pin level yet."""
+        if not 0 <= word < 1 << (8 * self.data_bytes()):
+            raise ChipError(f"IN data {word!r} does not fit in {self.data_bytes()} bytes")
+        self.in_word = word
+
+    # --------------------------------------------------------------------------------------------------------
+    # Time
+    # --------------------------------------------------------------------------------------------------------
+
+    @property
+    def _filtered(self) -> bool:
+        return self._stat_low_since is not None and self._now - self._stat_low_since >= STATERR_FILTER_CLOCKS
+
+    def _advance(self, clk: int) -> None:
+        """Bring time-driven state up to clock ``clk``: the /StatErr filter and the layer-2 watchdog."""
+        self._now = clk
+        if self._filtered and not self.pf:
+            self.pf = True
+            self.attention = True
+        if self._deadline is not None and clk >= self._deadline:
+            self._deadline = None
+            self._clear_process_data()
+            self.wd = True
+            self.attention = True
+            self.resreg_until = clk + RESREG_PULSE_CLOCKS
+            self.events["WATCHDOG"] += 1
+            self._event("IB_RESET")
+
+    def _clear_process_data(self) -> None:
+        self.in_word = 0
+        self.out_word = 0
+        if self.registers is not None:
+            self.registers.interbus_reset()
+
+    def _event(self, source: str) -> None:
+        self.events[source] += 1
+        if self.registers is not None:
+            self.registers.event(source)
+
+    # --------------------------------------------------------------------------------------------------------
+    # The ring's Device protocol (supi3.interbus.device.Device), in clocks
+    # --------------------------------------------------------------------------------------------------------
+
+    def load_at(self, cycle: Cycle, clk: int) -> bytes:
+        """A frame begins: the register's parallel load, in line order."""
+        self._advance(clk)
+        if cycle is Cycle.ID:
+            return wire.word_bytes(self.id_register())
+        n = self.data_bytes()
+        if self.registers is not None:
+            return self.registers.in_bytes() if n else b""
+        return self._sample_inputs().to_bytes(n, "big")
+
+    def latch_at(self, cycle: Cycle, received: bytes, clk: int) -> None:
+        """The master latched the cycle: take over ``received`` (OUT data or the command word)."""
+        self._advance(clk)
+        if cycle is Cycle.DATA:
+            if self.registers is not None:
+                if received:
+                    self.registers.latch(received)
+                self.registers.set_bus_running(True)
+            else:
+                self.out_word = int.from_bytes(received, "big")
+            self.bus_active = True
+            timeout = WATCHDOG_CLOCKS[self.watchdog_code] if self.watchdog_code is not None else None
+            self._deadline = None if timeout is None else clk + timeout
+            self._event("VALID")
+            self._event("PCP_RX")
+        else:
+            command = wire.decode_command(wire.word_from_bytes(received))
+            if command.watchdog_code is not None:
+                self.watchdog_code = command.watchdog_code
+                timeout = WATCHDOG_CLOCKS[command.watchdog_code]
+                self._deadline = None if timeout is None else clk + timeout
+            if command.quit_peripheral_error:
+                self.pf = self.module_error
+                self.mod_ack_until = clk + MODACK_PULSE_CLOCKS
+                self.events["MODACK"] += 1
+            self.wd = self.te = self.attention = False
+            self._event("ID_CYCLE")
+        self._event("PCP_TX")
+
+    def discard_at(self, cycle: Cycle, local_error: bool, clk: int) -> None:
+        """The cycle ended without a latch: nothing latched changes (Table 3-13, invalid data cycle)."""
+        self._advance(clk)
+        self.te = self.te or local_error
+        if cycle is Cycle.DATA:
+            self._event("INVALID")
+
+    def reset_at(self, clk: int) -> None:
+        """INTERBUS reset (3.4.7, Table 3-13)."""
+        self._advance(clk)
+        self._clear_process_data()
+        self.watchdog_code = None
+        self._deadline = None
+        self.wd = self.te = False
+        self.attention = self.pf
+        self.bus_active = False
+        self.events["IB_RESET"] += 1
+        if self.registers is not None:
+            self.registers.set_bus_running(False)
+
+    # Device protocol in bus seconds -------------------------------------------------------------------------
+
+    def load(self, cycle: Cycle, now: float) -> bytes:
+        """See :meth:`supi3.interbus.device.Device.load`."""
+        return self.load_at(cycle, clocks(now))
+
+    def latch(self, cycle: Cycle, received: bytes, now: float) -> None:
+        """See :meth:`supi3.interbus.device.Device.latch`."""
+        self.latch_at(cycle, received, clocks(now))
+
+    def discard(self, cycle: Cycle, local_error: bool, now: float) -> None:
+        """See :meth:`supi3.interbus.device.Device.discard`."""
+        self.discard_at(cycle, local_error, clocks(now))
+
+    def reset(self, now: float) -> None:
+        """See :meth:`supi3.interbus.device.Device.reset`."""
+        self.reset_at(clocks(now))
+
+    def poll(self, now: float) -> None:
+        """See :meth:`supi3.interbus.device.Device.poll`."""
+        self._advance(clocks(now))
