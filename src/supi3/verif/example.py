@@ -67,8 +67,8 @@ class ShiftCounter(Elaboratable):  # type: ignore[misc]  # amaranth is untyped f
 class ShiftCounterModel:
     """The example's cycle-accurate pin model, following :class:`~supi3.verif.pinmodel.PinModel`."""
 
-    inputs = (Pin("en"), Pin("load"), Pin("din", 8), Pin("sin"), Pin("rd"))
-    outputs = (
+    inputs: tuple[Pin, ...] = (Pin("en"), Pin("load"), Pin("din", 8), Pin("sin"), Pin("rd"))
+    outputs: tuple[Pin, ...] = (
         Pin("count", 8),
         Pin("sr", 16),
         Pin("acc", ACC_BITS),

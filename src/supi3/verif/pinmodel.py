@@ -25,13 +25,13 @@ return any value for a pin it does not drive.
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
 from supi3.verif.errors import PinSpecError
 
-__all__ = ["EventLog", "Pin", "PinModel", "compared_signals", "recent_events"]
+__all__ = ["EventLog", "ModelFactory", "Pin", "PinModel", "compared_signals", "recent_events"]
 
 OE_SUFFIX = "_oe"
 """Suffix of the output-enable signal of a tri-state output pin."""
@@ -72,16 +72,18 @@ class Pin:
 class PinModel(Protocol):
     """What the harness needs from a cycle-accurate Python model (see the module docstring for the timing).
 
-    Attributes
-    ----------
-    inputs:
-        The input pins, in a fixed order (the column order of array stimulus).
-    outputs:
-        The output pins, in the order they are compared within a cycle.
+    ``inputs`` and ``outputs`` may be plain class attributes (tuples of :class:`Pin`).
     """
 
-    inputs: Sequence[Pin]
-    outputs: Sequence[Pin]
+    @property
+    def inputs(self) -> Sequence[Pin]:
+        """The input pins, in a fixed order (the column order of array stimulus)."""
+        ...
+
+    @property
+    def outputs(self) -> Sequence[Pin]:
+        """The output pins, in the order they are compared within a cycle."""
+        ...
 
     def reset(self) -> None:
         """Return to the state right after reset; the next :meth:`step` is cycle 0."""
@@ -100,6 +102,10 @@ class PinModel(Protocol):
             A value for every output pin observed during this cycle, and ``<name>_oe`` for every tri-state pin.
         """
         ...
+
+
+ModelFactory = Callable[[], PinModel]
+"""Returns a fresh model."""
 
 
 class EventLog:

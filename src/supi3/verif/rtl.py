@@ -26,7 +26,10 @@ from amaranth.hdl import ClockDomain, Elaboratable, Module, Signal, Value
 from supi3.verif.errors import PinSpecError, SimulatorUnavailableError
 from supi3.verif.layout import WORD, Layout
 
-__all__ = ["TOP", "LockstepTop", "build_slot", "ensure_toolchain", "to_verilog"]
+__all__ = ["TOP", "DesignFactory", "LockstepTop", "build_slot", "ensure_toolchain", "to_verilog"]
+
+DesignFactory = Callable[[], Elaboratable]
+"""Returns a fresh design exposing the model's pins as attributes."""
 
 TOP = "lockstep_top"
 """Module name of the packed top-level in the generated Verilog."""
