@@ -14,7 +14,7 @@ from typing import Final
 
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusError
-from supi3.interbus.ring import ErrorKind, Ring, Transfer
+from supi3.interbus.ring import Bus, ErrorKind, Transfer
 from supi3.interbus.wire import Cycle
 from supi3.tables import ID_CODES, LENGTH_CODE_BY_VALUE, UP_NOT_READY_ID_CODES, WATCHDOG_TIMEOUTS_S, IdCode
 
@@ -135,6 +135,8 @@ class Master:
     locate:
         After a failed cycle, locate the error with a diagnostic ID cycle and, if that fails too, a segment
         search (ID cycles with the ring closed after ring position *j*).
+    max_devices:
+        Ring size the discovery ID cycle allows for (its filler is two bytes per device, assumption A14).
 
     Attributes
     ----------
@@ -146,9 +148,12 @@ class Master:
         The firmware service codes called so far (``ALARM_STOP``, ``CONTROL_DEVICE_FUNCTION``), oldest first.
     """
 
-    def __init__(self, ring: Ring, locate: bool = True) -> None:
+    def __init__(self, ring: Bus, locate: bool = True, max_devices: int = wire.MAX_DEVICES) -> None:
+        if not 1 <= max_devices <= wire.MAX_DEVICES:
+            raise InterbusError("docs/interbus.md, Master", max_devices, f"must be in 1..{wire.MAX_DEVICES}")
         self.ring = ring
         self.locate = locate
+        self.max_devices = max_devices
         self.config: tuple[ConfigEntry, ...] | None = None
         self.diagnostics: list[Diagnostic] = []
         self.services: list[int] = []
@@ -298,7 +303,7 @@ class Master:
             self._out_slices.append(slice(start, start + entry.data_bytes))
 
     def _discovery(self) -> CycleResult:
-        filler = bytes([wire.DISCOVERY_FILLER]) * (2 * wire.MAX_DEVICES)
+        filler = bytes([wire.DISCOVERY_FILLER]) * (2 * self.max_devices)
         transfer = self.ring.transfer(Cycle.ID, wire.LOOPBACK_BYTES_ON_LINE + filler)
         problem = self._check(transfer, None)
         config: tuple[ConfigEntry, ...] | None = None

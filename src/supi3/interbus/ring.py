@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from enum import Enum
 from itertools import accumulate
 from operator import attrgetter, sub
-from typing import NamedTuple
+from typing import NamedTuple, Protocol
 
 from supi3.interbus import wire
 from supi3.interbus.device import Device
@@ -198,6 +198,32 @@ class _Line:
 
     def frame(self, cycle: Cycle) -> Frame:
         return Frame(cycle, self.stream, wire.crc16(self.stream) if self.crc is None else self.crc, self.cntr)
+
+
+class Bus(Protocol):
+    """What a :class:`~supi3.interbus.master.Master` drives: the transaction-level :class:`Ring`, or the
+    pin-level ring of cycle-accurate chips (:class:`supi3.model.pinring.PinRing`)."""
+
+    @property
+    def now(self) -> float:
+        """Bus time in seconds."""
+        ...
+
+    def transfer(self, cycle: Cycle, data: bytes, close_after: int | None = None) -> Transfer:
+        """Send one frame's data and check sequences and the ring delay; return what came back."""
+        ...
+
+    def finish(self, transfer: Transfer, latch: bool) -> None:
+        """End the cycle with the latch telegrams (``latch``) or idle ones."""
+        ...
+
+    def reset(self) -> None:
+        """INTERBUS reset (Alarm Stop)."""
+        ...
+
+    def idle(self, seconds: float) -> None:
+        """Only idle status telegrams for ``seconds``."""
+        ...
 
 
 class Ring:

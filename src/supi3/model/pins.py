@@ -210,6 +210,10 @@ class Supi3Pins:
             "resu_drive": int(self._stretch > 0),
         }
 
+    def forward_level(self) -> int:
+        """The forward line output (``do2``) of the current cycle; it depends on state only."""
+        return self._do2(self.cycle)
+
     def _do2(self, c: int) -> int:
         level = wire.IDLE_LEVEL
         for start, bit in self._tx:

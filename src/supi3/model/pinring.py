@@ -1,0 +1,185 @@
+"""A ring of cycle-accurate chips driven at line level, one 32 MHz clock at a time.
+
+:class:`PinRing` offers the interface of the transaction-level :class:`~supi3.interbus.ring.Ring` (the
+:class:`~supi3.interbus.ring.Bus` protocol), so the same :class:`~supi3.interbus.master.Master` runs a scenario
+on either fidelity. Here every bit of every telegram really travels: the master's line levels
+(``wire.cycle_levels`` split into frame, ring delay and verdict) are expanded to 32 MHz samples, clocked through
+each chip's :class:`~supi3.model.pins.Supi3Pins` (forward line ``do1 -> do2``, return line ``di2 -> di1``), and
+the return line is received by a UART-style receiver that resynchronises on every start edge.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+from supi3.interbus import wire
+from supi3.interbus.errors import InterbusError, TelegramError
+from supi3.interbus.ring import ErrorKind, Transfer
+from supi3.interbus.wire import Cycle, Frame, LineReset, Telegram
+from supi3.model.pins import Supi3Pins
+from supi3.tables import CLOCK_HZ
+
+
+def receive(samples: npt.NDArray[np.uint8], start: int, cpb: int) -> tuple[list[Telegram | LineReset], int, bool]:
+    """Receive the telegrams in a 32 MHz sample trace from index ``start``.
+
+    Returns the telegrams, the index to continue from (before any unfinished telegram) and whether a telegram
+    error was seen (the erroneous telegram is skipped).
+    """
+    out: list[Telegram | LineReset] = []
+    error = False
+    n = len(samples)
+    i = start
+    while i < n:
+        lows = np.flatnonzero(samples[i:] == wire.START_LEVEL)
+        if not lows.size:
+            return out, n, error
+        t0 = i + int(lows[0])
+        highs = np.flatnonzero(samples[t0:] != wire.START_LEVEL)
+        run = int(highs[0]) if highs.size else n - t0
+        if run >= wire.RESET_DETECT_BITS * cpb:
+            if not highs.size:
+                return out, t0, error
+            out.append(LineReset(t0 // cpb))
+            i = t0 + run
+            continue
+        mid = t0 + cpb // 2
+        if mid + wire.POS_TYPE * cpb >= n:
+            return out, t0, error
+        is_data = samples[mid + wire.POS_TYPE * cpb] == wire.TYPE_DATA_LEVEL
+        length = wire.DATA_TELEGRAM_BITS if is_data else wire.STATUS_TELEGRAM_BITS
+        last = mid + (length - 1) * cpb
+        if last >= n:
+            return out, t0, error
+        word = sum(int(level) << k for k, level in enumerate(samples[mid : last + 1 : cpb]))
+        try:
+            out.append(wire.decode_telegram(word, length))
+        except TelegramError:
+            error = True
+        i = last + 1
+    return out, n, error
+
+
+class PinRing:
+    """INTERBUS master line -> chip 1 -> ... -> chip N -> return line, at pin level.
+
+    Parameters
+    ----------
+    chips:
+        The pin-level chips in ring order (position 1 first). All must run at the same bit rate.
+
+    Attributes
+    ----------
+    devices:
+        The chips.
+    cycle:
+        32 MHz clock cycles so far.
+    returned:
+        The return line's samples so far.
+    """
+
+    def __init__(self, chips: Sequence[Supi3Pins]) -> None:
+        if not chips:
+            raise InterbusError("docs/interbus.md, Ring", 0, "a ring needs at least one device")
+        rates = {chip.config.bit_rate for chip in chips}
+        if len(rates) != 1:
+            raise InterbusError("Table 1-7", sorted(rates), "every device of a ring runs at one bit rate")
+        self.devices = list(chips)
+        self.bit_rate = rates.pop()
+        self.cpb = wire.clocks_per_bit(self.bit_rate)
+        self.cycle = 0
+        self.returned = np.zeros(0, dtype=np.uint8)
+        self._rx = 0
+        self._inputs = [
+            {"di2": 0, "rbst_ext": 0, "mfp_in": 0, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 1} for _ in chips
+        ]
+
+    @property
+    def now(self) -> float:
+        """Bus time in seconds."""
+        return self.cycle / CLOCK_HZ
+
+    def set_input(self, position: int, pin: str, value: int) -> None:
+        """Drive an input pin of the chip at ring ``position`` (1..N) other than its line inputs."""
+        if pin in ("do1", "di2") or pin not in self._inputs[position - 1]:
+            raise InterbusError("docs/model.md", pin, "not an application input pin of the chip")
+        self._inputs[position - 1][pin] = value
+
+    def run_levels(self, levels: npt.NDArray[np.uint8]) -> None:
+        """Send master line levels (one per bit period) through the ring."""
+        self.run_samples(wire.levels_to_samples(levels, self.bit_rate))
+
+    def run_samples(self, samples: npt.NDArray[np.uint8]) -> None:
+        """Clock the ring once per sample of the master's forward line."""
+        chips = self.devices
+        inputs = self._inputs
+        n = len(chips)
+        back = np.empty(len(samples), dtype=np.uint8)
+        for t, level in enumerate(samples.tolist()):
+            forward = [level] + [chip.forward_level() for chip in chips[:-1]]
+            di2 = 0
+            for k in range(n - 1, -1, -1):
+                pins = inputs[k]
+                pins["do1"] = forward[k]
+                pins["di2"] = di2
+                di2 = chips[k].step(pins)["di1"]
+            back[t] = di2
+        self.cycle += len(samples)
+        self.returned = np.concatenate([self.returned, back])
+
+    def _received(self) -> tuple[list[Telegram | LineReset], bool]:
+        telegrams, self._rx, error = receive(self.returned, self._rx, self.cpb)
+        return telegrams, error
+
+    # -- the Bus protocol ------------------------------------------------------------------------------------------
+
+    def transfer(self, cycle: Cycle, data: bytes, close_after: int | None = None) -> Transfer:
+        """Send a frame and the ring delay; receive what came back (see :class:`~supi3.interbus.ring.Bus`)."""
+        if close_after is not None:
+            raise InterbusError("docs/interbus.md, Segment search", close_after,
+                                "the pin-level ring does not close early; use Master(locate=False)")
+        n = len(self.devices)
+        frame = Frame.build(cycle, data)
+        delay = wire.ring_delay_status_telegrams(n)
+        self.run_levels(np.concatenate([wire.frame_levels(frame), wire.status_levels(cycle, False, delay)]))
+        telegrams, error = self._received()
+        receiver_error: ErrorKind | None = ErrorKind.TELEGRAM if error else None
+        returned: bytes | None = None
+        flags = wire.CntrFlags(True, True)
+        frames = [t for t in telegrams if isinstance(t, Telegram) and t.data is not None]
+        if frames:
+            try:
+                back = wire.frame_from_telegrams(frames)
+            except InterbusError:
+                receiver_error = receiver_error or ErrorKind.SEQUENCE
+            else:
+                returned = back.data
+                decoded = wire.decode_cntr(back.cntr)
+                if decoded is None:
+                    receiver_error = receiver_error or ErrorKind.CNTR
+                else:
+                    flags = decoded
+                if wire.crc16(back.data) != back.crc:
+                    receiver_error = receiver_error or ErrorKind.CRC
+        return Transfer(cycle, bytes(data), n, returned, flags, receiver_error, [], n)
+
+    def finish(self, transfer: Transfer, latch: bool) -> None:
+        """Send the verdict: the latch telegrams, or idle ones."""
+        self.run_levels(wire.status_levels(transfer.cycle, latch, wire.LATCH_STATUS_TELEGRAMS))
+        self._received()
+
+    def reset(self) -> None:
+        """INTERBUS reset: the line held low, then idle status telegrams (``wire.reset_levels``)."""
+        self.run_levels(wire.reset_levels(len(self.devices)))
+        self._received()
+
+    def idle(self, seconds: float) -> None:
+        """Idle status telegrams for ``seconds``."""
+        if seconds < 0:
+            raise InterbusError("docs/interbus.md, Idle", seconds, "idle time must be >= 0")
+        count = round(seconds * self.bit_rate / wire.STATUS_TELEGRAM_BITS)
+        self.run_levels(wire.status_levels(Cycle.DATA, False, count))
+        self._received()
