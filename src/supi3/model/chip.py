@@ -112,6 +112,7 @@ class Supi3:
         self.attention = False
         self.bus_active = False
         self.watchdog_code: int | None = None
+        self._now = 0
         self._deadline: int | None = None
         self._stat_low_since: int | None = 0 if self._stat_err else None
         self.mod_ack_until = 0
@@ -184,6 +185,13 @@ class Supi3:
     @property
     def _filtered(self) -> bool:
         return self._stat_low_since is not None and self._now - self._stat_low_since >= STATERR_FILTER_CLOCKS
+
+    def next_event(self) -> int | None:
+        """The next clock at which time alone changes the chip (filter expiry, watchdog), ``None`` if none."""
+        times = [] if self._deadline is None else [self._deadline]
+        if self._stat_low_since is not None and not self.pf:
+            times.append(self._stat_low_since + STATERR_FILTER_CLOCKS)
+        return min(times, default=None)
 
     def _advance(self, clk: int) -> None:
         """Bring time-driven state up to clock ``clk``: the /StatErr filter and the layer-2 watchdog."""

@@ -113,22 +113,26 @@ class PinRing:
         self.run_samples(wire.levels_to_samples(levels, self.bit_rate))
 
     def run_samples(self, samples: npt.NDArray[np.uint8]) -> None:
-        """Clock the ring once per sample of the master's forward line."""
-        chips = self.devices
-        inputs = self._inputs
-        n = len(chips)
-        back = np.empty(len(samples), dtype=np.uint8)
-        for t, level in enumerate(samples.tolist()):
-            forward = [level] + [chip.forward_level() for chip in chips[:-1]]
-            di2 = 0
-            for k in range(n - 1, -1, -1):
-                pins = inputs[k]
-                pins["do1"] = forward[k]
-                pins["di2"] = di2
-                di2 = chips[k].step(pins)["di1"]
-            back[t] = di2
-        self.cycle += len(samples)
-        self.returned = np.concatenate([self.returned, back])
+        """Clock the ring once per sample of the master's forward line.
+
+        Every chip runs the whole trace forward (``do1`` from its upstream neighbour's ``do2``), then the
+        return line is assembled from the last chip back to the first (:meth:`Supi3Pins.return_line`).
+        """
+        n = len(samples)
+        forward = np.asarray(samples, dtype=np.int64)
+        placeholder = np.zeros(n, dtype=np.int64)
+        sent = []
+        for chip, pins in zip(self.devices, self._inputs, strict=True):
+            traces = {name: np.full(n, value, dtype=np.int64) for name, value in pins.items()}
+            traces["do1"] = forward
+            traces["di2"] = placeholder
+            forward = chip.run_forward(traces)["do2"]
+            sent.append(forward)
+        back = placeholder
+        for chip, do2 in zip(reversed(self.devices), reversed(sent), strict=True):
+            back = chip.return_line(back, do2)
+        self.cycle += n
+        self.returned = np.concatenate([self.returned, back.astype(np.uint8)])
 
     def _received(self) -> tuple[list[Telegram | LineReset], bool]:
         telegrams, self._rx, error = receive(self.returned, self._rx, self.cpb)
@@ -174,6 +178,12 @@ class PinRing:
     def reset(self) -> None:
         """INTERBUS reset: the line held low, then idle status telegrams (``wire.reset_levels``)."""
         self.run_levels(wire.reset_levels(len(self.devices)))
+        self._received()
+
+    def settle(self) -> None:
+        """Idle status telegrams for the ring delay, so the last telegrams sent reach every chip."""
+        delay = wire.ring_delay_status_telegrams(len(self.devices))
+        self.run_levels(wire.status_levels(Cycle.DATA, False, delay))
         self._received()
 
     def idle(self, seconds: float) -> None:

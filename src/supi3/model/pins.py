@@ -35,13 +35,16 @@ pin                   dir  meaning
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Final
+from typing import Final, NamedTuple
+
+import numpy as np
+import numpy.typing as npt
 
 from supi3.config import DeviceConfig
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
-from supi3.tables import CLOCK_HZ, RESET_MIN_S, Direction
+from supi3.tables import CLOCK_HZ, RESET_MIN_S
 from supi3.verif.pinmodel import EventLog, Pin
 
 # ----------------------------------------------------------------------------------------------------------------
@@ -71,8 +74,30 @@ def _crc_word(register: int) -> int:
     return word ^ wire.CRC_XOROUT
 
 
+Trace = npt.NDArray[np.int64]
+
+
+class Synced(NamedTuple):
+    """The input pins as the logic sees them, after the synchroniser."""
+
+    do1: int
+    di2: int
+    rbst_ext: int
+    mfp_in: int
+    stat_err_n: int
+    resu_n: int
+    vmon_ok: int
+
+
+_INPUT_NAMES: Final = Synced._fields
+_IDLE_INPUTS: Final = Synced(wire.IDLE_LEVEL, 0, 0, 0, 1, 1, 1)
+"""What the synchroniser holds after reset: the levels of a quiet board (idle line, no fault, power good)."""
+
+_NEVER: Final = 1 << 62
+
+
 class Supi3Pins:
-    """The SUPI 3 chip core at pin level, one 32 MHz clock per :meth:`step`.
+    """The SUPI 3 chip core at pin level, one 32 MHz clock per :meth:`step`, or many per :meth:`run`.
 
     Parameters
     ----------
@@ -87,6 +112,14 @@ class Supi3Pins:
         The transaction-level chip this pin model drives; inspect its registers and events in tests.
     cycle:
         Clock cycles since reset.
+
+    Notes
+    -----
+    The state holds absolute cycle numbers (when the current telegram began, when the line went low, when the
+    reset stretch ends, ...) instead of counters, so that cycles in which nothing happens can be skipped:
+    :meth:`run` visits only the cycles where an input changes or an internal event is due, and renders the
+    output traces between them. :meth:`step` and :meth:`run` share every line of the per-cycle logic
+    (:meth:`_tick`) and agree cycle for cycle (tested).
     """
 
     inputs: Sequence[Pin] = (
@@ -104,10 +137,10 @@ class Supi3Pins:
         self.cpb = wire.clocks_per_bit(config.bit_rate)
         self.mfp_oe = config.mfp_output_mask
         self.log = EventLog()
-        self._out_pins = tuple(p.pin for p in config.mfp_pins if p.direction is Direction.OUT)
         self._complete_diag = config.diagnostics is not None and config.diagnostics.diag_conf == 0
         self._pin_rbst = config.rf_mode is not None and config.rf_mode.rf == "10"
         self._forward_delay = wire.REPEATER_DELAY_BITS * self.cpb - SYNC_STAGES
+        self._reset_run = wire.RESET_DETECT_BITS * self.cpb
         self.reset()
 
     # ------------------------------------------------------------------------------------------------------------
@@ -118,30 +151,38 @@ class Supi3Pins:
         """The state right after the ``sync`` reset: power-up reset in progress (it lasts the reset stretch)."""
         self.cycle = 0
         self.log.clear()
-        self._sync: dict[str, list[int]] = {
-            "do1": [wire.IDLE_LEVEL] * SYNC_STAGES, "di2": [0] * SYNC_STAGES, "rbst_ext": [0] * SYNC_STAGES,
-            "mfp_in": [0] * SYNC_STAGES, "stat_err_n": [1] * SYNC_STAGES, "resu_n": [1] * SYNC_STAGES,
-            "vmon_ok": [1] * SYNC_STAGES,
-        }  # fmt: skip
-        self._stretch = RESET_STRETCH_CLOCKS
-        self._power_up()
+        self._pipe: list[Synced] = [_IDLE_INPUTS] * SYNC_STAGES
+        self._holding = False
+        self._recording = False
+        self._power_ups: list[tuple[int, int]] = []
+        self._tx = []
+        self._power_up(RESET_STRETCH_CLOCKS)
 
-    def _power_up(self) -> None:
+    def _power_up(self, run_from: int) -> None:
+        """Power-up reset; the logic runs again from cycle ``run_from`` (after the reset stretch, M2)."""
+        if self._recording:
+            self._power_ups.append((self.cycle, run_from))
         self.chip.power_up()
         self.chip.mfp_in = 0
+        self._run_from = run_from
         self._stat_active = False
+        self._next_present = False
         # receiver
         self._rx_busy = False
-        self._phase = 0
+        self._t0 = 0
         self._bit = 0
-        self._length = 0
+        self._length = wire.DATA_TELEGRAM_BITS
         self._word = 0
-        self._low_run = 0
+        self._low_since: int | None = None
+        self._last_start = run_from - 1
         self._in_reset = False
         self._reset_end_count = 0
-        self._silent = 0
-        # transmitter: (first cycle, level) of the bits being sent, oldest first
-        self._tx: list[tuple[int, int]] = []
+        # transmitter: (first cycle, level) of every bit sent, oldest first; a power-up drops the bits not yet
+        # begun and idles the line from the next cycle
+        now = self.cycle
+        self._tx: list[tuple[int, int]] = [
+            *(entry for entry in self._tx if entry[0] <= now), (now + 1, wire.IDLE_LEVEL)
+        ]
         # frame engine
         self._state = "idle"  # idle | data | check | wait
         self._cycle = Cycle.DATA
@@ -155,123 +196,137 @@ class Supi3Pins:
         self._err_in = False
         self._latches = 0
         self._attn = 0
-        self._next_present = False
 
     # ------------------------------------------------------------------------------------------------------------
-    # One clock
+    # One clock: step()
     # ------------------------------------------------------------------------------------------------------------
 
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
         """Run one clock cycle (see :mod:`supi3.verif.pinmodel`)."""
-        sync = self._sync
-        s = {name: stages[-1] for name, stages in sync.items()}
-        outputs = self._outputs(inputs)
-        # rising edge
-        for name, stages in sync.items():
-            stages.pop()
-            stages.insert(0, int(inputs[name]))
-        if not s["vmon_ok"] or not s["resu_n"]:
-            if self._stretch == 0:
-                self.log.add(self.cycle, "power-up reset")
-            self._stretch = RESET_STRETCH_CLOCKS
-            self._power_up()
-        elif self._stretch:
-            self._stretch -= 1
-            if self._stretch == 0:
-                self.log.add(self.cycle, "reset released")
-        else:
-            self._clock(s)
-        self.cycle += 1
-        return outputs
-
-    def _outputs(self, inputs: Mapping[str, int]) -> dict[str, int]:
-        chip = self.chip
         c = self.cycle
-        do2 = self._do2(c)
-        bus_active = chip.bus_active
-        if chip.pf:
-            ib_diag = 1 - ((c >> (IB_DIAG_DIVIDER_BITS["fast"] - 1)) & 1)
-        elif not bus_active:
-            ib_diag = 1 - ((c >> (IB_DIAG_DIVIDER_BITS["slow"] - 1)) & 1)
-        else:
-            ib_diag = 1
-        return {
-            "do2": do2,
-            # The return line passes straight through when a device follows; the last device loops back (M5).
-            "di1": int(inputs["di2"]) if self._next_present else do2,
-            "mfp_out": chip.mfp_outputs,
-            "mfp_oe": self.mfp_oe,
-            "mod_ack_n": int(c >= chip.mod_ack_until),
-            "res_reg_n": int(c >= chip.resreg_until),
-            "diag1": int(bus_active) if self._complete_diag else 0,
-            "diag2": 0,
-            "ib_diag": ib_diag,
-            "dclk_out": int(c % self.cpb < self.cpb // 2),
-            "resu_drive": int(self._stretch > 0),
-        }
+        synced = self._pipe[-1]
+        outputs = self.output_values(c, int(inputs["di2"]))
+        self._pipe = [Synced(*(int(inputs[name]) for name in _INPUT_NAMES)), *self._pipe[:-1]]
+        if c >= self._run_from or self._holding or not (synced.resu_n and synced.vmon_ok):
+            self._tick(c, synced)
+            if c >= self._run_from:
+                self._next_present = bool(synced.rbst_ext) if self._pin_rbst else self._next_present or bool(
+                    synced.di2
+                )
+        if len(self._tx) > 8:
+            del self._tx[:-8]
+        self.cycle = c + 1
+        return outputs
 
     def forward_level(self) -> int:
         """The forward line output (``do2``) of the current cycle; it depends on state only."""
         return self._do2(self.cycle)
 
-    def _do2(self, c: int) -> int:
-        level = wire.IDLE_LEVEL
-        for start, bit in self._tx:
-            if start <= c < start + self.cpb:
-                level = bit
-        return level
-
-    # ------------------------------------------------------------------------------------------------------------
-    # Synchronous logic
-    # ------------------------------------------------------------------------------------------------------------
-
-    def _clock(self, s: Mapping[str, int]) -> None:
-        c = self.cycle
+    def output_values(self, c: int, di2: int) -> dict[str, int]:
+        """Every output pin during cycle ``c`` (``c`` >= the current cycle; ``di2`` is that cycle's input)."""
         chip = self.chip
-        chip.mfp_in = s["mfp_in"]
-        stat = not s["stat_err_n"]
+        do2 = self._do2(c)
+        return {
+            "do2": do2,
+            # The return line passes straight through when a device follows; the last device loops back (M5).
+            "di1": di2 if self._next_present else do2,
+            "mfp_out": chip.mfp_outputs,
+            "mfp_oe": self.mfp_oe,
+            "mod_ack_n": int(c >= chip.mod_ack_until),
+            "res_reg_n": int(c >= chip.resreg_until),
+            "diag1": int(chip.bus_active) if self._complete_diag else 0,
+            "diag2": 0,
+            "ib_diag": self._ib_diag(c),
+            "dclk_out": int(c % self.cpb < self.cpb // 2),
+            "resu_drive": int(c < self._run_from),
+        }
+
+    def _ib_diag(self, c: int) -> int:
+        """Table 3-18: flashing fast on a peripheral fault, slowly while the bus is not active, else steady."""
+        if self.chip.pf:
+            return 1 - ((c >> (IB_DIAG_DIVIDER_BITS["fast"] - 1)) & 1)
+        if not self.chip.bus_active:
+            return 1 - ((c >> (IB_DIAG_DIVIDER_BITS["slow"] - 1)) & 1)
+        return 1
+
+    def _do2(self, c: int) -> int:
+        """The repeater's output: the last bit whose bit period covers ``c``, else the idle level."""
+        cpb = self.cpb
+        for start, bit in reversed(self._tx):
+            if start <= c:
+                return bit if c < start + cpb else wire.IDLE_LEVEL
+        return wire.IDLE_LEVEL
+
+    # ------------------------------------------------------------------------------------------------------------
+    # The per-cycle logic, shared by step() and run()
+    # ------------------------------------------------------------------------------------------------------------
+
+    def _tick(self, c: int, s: Synced) -> None:
+        """The rising edge at the end of cycle ``c``, with the synchronised inputs ``s`` of that cycle."""
+        if not (s.resu_n and s.vmon_ok):
+            if not self._holding:
+                self.log.add(c, "power-up reset")
+            self._holding = True
+            self._power_up(_NEVER)
+            return
+        if self._holding:
+            self._holding = False
+            self._power_up(c + RESET_STRETCH_CLOCKS)
+            return
+        if c < self._run_from:
+            return
+        chip = self.chip
+        chip.mfp_in = s.mfp_in
+        stat = not s.stat_err_n
         if stat != self._stat_active:
             self._stat_active = stat
             chip._set_stat_err(stat, c)
-        chip._advance(c)
-        if self._pin_rbst:
-            self._next_present = bool(s["rbst_ext"])
-        elif s["di2"]:
-            self._next_present = True
-        if len(self._tx) > 4:
-            del self._tx[:-4]
-        self._receive(s["do1"], c)
+        due = chip.next_event()
+        if due is not None and c >= due:
+            chip._advance(c)
+        self._receive(s.do1, c)
+
+    def _next_due(self, c: int, line: int) -> int:
+        """The next cycle after ``c`` at which the logic acts with unchanged inputs."""
+        if c < self._run_from:
+            return self._run_from
+        due = [self._last_start + IDLE_TIMEOUT_CLOCKS]
+        if self._rx_busy:
+            due.append(self._t0 + self.cpb // 2 + self._bit * self.cpb)
+        elif line == wire.START_LEVEL:
+            due.append(c + 1)
+        if self._low_since is not None and c < self._low_since + self._reset_run - 1:
+            due.append(self._low_since + self._reset_run - 1)
+        chip_due = self.chip.next_event()
+        if chip_due is not None:
+            due.append(max(chip_due, c + 1))
+        return min(d for d in due if d > c) if any(d > c for d in due) else _NEVER
 
     def _receive(self, line: int, c: int) -> None:
-        cpb = self.cpb
         # INTERBUS reset: the start level held for RESET_DETECT_BITS bit periods (docs/interbus.md).
         if line == wire.START_LEVEL:
-            self._low_run += 1
-            if self._low_run == wire.RESET_DETECT_BITS * cpb:
+            if self._low_since is None:
+                self._low_since = c
+            if c - self._low_since + 1 == self._reset_run:
                 self._enter_reset(c)
         else:
-            self._low_run = 0
-        self._silent += 1
-        if self._silent == IDLE_TIMEOUT_CLOCKS:
+            self._low_since = None
+        if c - self._last_start == IDLE_TIMEOUT_CLOCKS:
             self.log.add(c, "idle timeout: INTERBUS reset")
             self._abandon_frame(c)
             self.chip.reset_at(c)
         if not self._rx_busy:
-            if line != wire.START_LEVEL:
-                return
-            self._rx_busy = True
-            self._phase = 0
-            self._bit = 0
-            self._word = 0
-            self._length = wire.DATA_TELEGRAM_BITS
-            self._silent = 0
-        elif self._phase == cpb - 1:
-            self._phase = 0
-            self._bit += 1
-        else:
-            self._phase += 1
-        if self._phase == cpb // 2:
+            if line == wire.START_LEVEL:
+                self._rx_busy = True
+                self._t0 = c
+                self._bit = 0
+                self._word = 0
+                self._length = wire.DATA_TELEGRAM_BITS
+                self._last_start = c
+            return
+        if c == self._t0 + self.cpb // 2 + self._bit * self.cpb:
             self._sample(line, c)
+            self._bit += 1
 
     def _enter_reset(self, c: int) -> None:
         self.log.add(c, "INTERBUS reset detected")
@@ -428,3 +483,164 @@ class Supi3Pins:
         self._state = "idle"
         self._latches = 0
 
+
+    # ------------------------------------------------------------------------------------------------------------
+    # Many clocks: run()
+    # ------------------------------------------------------------------------------------------------------------
+
+    def _snapshot(self) -> tuple[int, ...]:
+        chip = self.chip
+        return (chip.mfp_outputs, int(chip.bus_active) if self._complete_diag else 0, int(chip.pf),
+                int(chip.bus_active), chip.mod_ack_until, chip.resreg_until, self._run_from)  # fmt: skip
+
+    def run(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]]) -> dict[str, Trace]:
+        """Run as many clock cycles as the input traces are long; return every output pin's trace.
+
+        The same cycles as calling :meth:`step` once per cycle, with the same results, but only the cycles in
+        which something happens are visited (see the class notes).
+
+        Parameters
+        ----------
+        inputs:
+            One equally long trace per input pin.
+        """
+        traces = self.run_forward(inputs)
+        traces["di1"] = self.return_line(np.asarray(inputs["di2"], dtype=np.int64), traces["do2"])
+        return traces
+
+    def _synced_traces(self, raw: Mapping[str, Trace], n: int) -> dict[str, Trace]:
+        """What the synchroniser delivers in each of the next ``n`` cycles, and the pipeline left after them."""
+        synced = {}
+        for name in _INPUT_NAMES:
+            held = [getattr(stage, name) for stage in reversed(self._pipe)]
+            synced[name] = np.concatenate([np.asarray(held, dtype=np.int64), raw[name]])[: n + SYNC_STAGES]
+        return synced
+
+    def run_forward(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]]) -> dict[str, Trace]:
+        """:meth:`run` without ``di1``: the chip's logic does not depend on DI2 beyond the return line's
+        pass-through, so a ring runs every chip forward first and then the return line backwards
+        (:meth:`return_line`). The ``di2`` trace given here is not used."""
+        raw = {name: np.asarray(inputs[name], dtype=np.int64) for name in _INPUT_NAMES}
+        n = len(raw["do1"])
+        if any(len(trace) != n for trace in raw.values()):
+            raise ValueError("every input trace must have the same length")
+        c0 = self.cycle
+        self._return_start = (c0, self._next_present, self._run_from,
+                              [stage.di2 for stage in reversed(self._pipe)])
+        self._power_ups = []
+        self._recording = True
+        full = self._synced_traces(raw, n)
+        synced = {name: trace[:n] for name, trace in full.items()}
+        change = np.zeros(n, dtype=bool)
+        change[0] = n > 0
+        for name in ("do1", "rbst_ext", "stat_err_n", "resu_n", "vmon_ok"):
+            trace = synced[name]
+            change[1:] |= trace[1:] != trace[:-1]
+        input_events = np.flatnonzero(change).tolist()
+        columns = [synced[name].tolist() for name in _INPUT_NAMES]
+        snaps = [(0, self._snapshot())]
+        k = 0
+        due = self._next_due(c0 - 1, columns[0][0]) if n else _NEVER
+        while True:
+            next_input = input_events[k] if k < len(input_events) else n
+            t = min(next_input, due - c0)
+            if t >= n:
+                break
+            if t == next_input:
+                k += 1
+            c = c0 + t
+            s = Synced(*(column[t] for column in columns))
+            self.cycle = c
+            if c >= self._run_from or self._holding or not (s.resu_n and s.vmon_ok):
+                self._tick(c, s)
+            snaps.append((t + 1, self._snapshot()))
+            due = self._next_due(c, s.do1)
+        self._recording = False
+        self.cycle = c0 + n
+        self._pipe = [Synced(*(int(full[name][n + SYNC_STAGES - 1 - i]) for name in _INPUT_NAMES))
+                      for i in range(SYNC_STAGES)] if n >= SYNC_STAGES else self._shifted_pipe(raw, n)
+        self._synced_run = synced
+        traces = self._render(c0, n, snaps, self._tx)
+        if len(self._tx) > 8:
+            del self._tx[:-8]
+        return traces
+
+    def _shifted_pipe(self, raw: Mapping[str, Trace], n: int) -> list[Synced]:
+        pipe = list(self._pipe)
+        for t in range(n):
+            pipe = [Synced(*(int(raw[name][t]) for name in _INPUT_NAMES)), *pipe[:-1]]
+        return pipe
+
+    def _render(self, c0: int, n: int, snaps: list[tuple[int, tuple[int, ...]]], tx: list[tuple[int, int]]
+                ) -> dict[str, Trace]:
+        cycles = np.arange(c0, c0 + n, dtype=np.int64)
+        out = {name: np.zeros(n, dtype=np.int64) for name in ("mfp_out", "diag1", "mod_ack_n", "res_reg_n",
+                                                               "ib_diag", "resu_drive")}
+        bounds = [t for t, _ in snaps] + [n]
+        for (t, snap), end in zip(snaps, bounds[1:], strict=True):
+            if end <= t:
+                continue
+            mfp_out, diag1, pf, bus_active, mod_ack_until, resreg_until, run_from = snap
+            seg = cycles[t:end]
+            out["mfp_out"][t:end] = mfp_out
+            out["diag1"][t:end] = diag1
+            out["mod_ack_n"][t:end] = seg >= mod_ack_until
+            out["res_reg_n"][t:end] = seg >= resreg_until
+            out["resu_drive"][t:end] = seg < run_from
+            if pf:
+                out["ib_diag"][t:end] = 1 - ((seg >> (IB_DIAG_DIVIDER_BITS["fast"] - 1)) & 1)
+            elif not bus_active:
+                out["ib_diag"][t:end] = 1 - ((seg >> (IB_DIAG_DIVIDER_BITS["slow"] - 1)) & 1)
+            else:
+                out["ib_diag"][t:end] = 1
+        do2 = np.full(n, wire.IDLE_LEVEL, dtype=np.int64)
+        cpb = self.cpb
+        for start, bit in tx:
+            lo, hi = max(start, c0) - c0, min(start + cpb, c0 + n) - c0
+            if hi > lo:
+                do2[lo:hi] = bit
+            elif start >= c0 + n:
+                break
+        out["do2"] = do2
+        out["mfp_oe"] = np.full(n, self.mfp_oe, dtype=np.int64)
+        out["diag2"] = np.zeros(n, dtype=np.int64)
+        out["dclk_out"] = (cycles % cpb < cpb // 2).astype(np.int64)
+        return out
+
+    def return_line(self, di2: Trace, do2: Trace) -> Trace:
+        """``di1`` over the last :meth:`run_forward`, given that run's DI2 trace: the return line passes DI2
+        through once a following device is recognised, else loops ``do2`` back (M5).
+
+        Recognition is updated at every clock edge where the logic runs, as in :meth:`step`: with RF = 10 it is
+        the synchronised RBST_EXT, otherwise it latches the first high level seen on DI2; power-up clears it.
+        """
+        c0, value, run_from, held_di2 = self._return_start
+        n = len(do2)
+        if self._pin_rbst:
+            seen = self._synced_run["rbst_ext"]
+        else:
+            seen = np.concatenate([np.asarray(held_di2, dtype=np.int64), di2])[:n]
+            # The synchroniser now holds the real DI2, not the placeholder the forward run saw.
+            tail = np.concatenate([np.asarray(held_di2, dtype=np.int64), di2])[-SYNC_STAGES:][::-1]
+            self._pipe = [stage._replace(di2=int(v)) for stage, v in zip(self._pipe, tail, strict=True)]
+        state = np.empty(n + 1, dtype=bool)  # state[t]: what the outputs of cycle c0 + t see
+        state[0] = value
+        t = 0
+        for at, new_run_from in [*self._power_ups, (c0 + n, run_from)]:
+            end = at - c0
+            if end > t:
+                active = np.arange(c0 + t, c0 + end) >= run_from
+                level = seen[t:end] != 0
+                if self._pin_rbst:
+                    values = np.where(active, level, value)
+                else:
+                    values = np.logical_or.accumulate(level & active) | value
+                state[t + 1 : end + 1] = values
+                value = bool(values[-1])
+            if end < n:
+                value = False
+                run_from = new_run_from
+                state[end + 1] = False
+                t = end + 1
+        self._next_present = value
+        return np.where(state[:n], di2, do2).astype(np.int64)
