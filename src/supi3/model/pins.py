@@ -155,7 +155,7 @@ class Supi3Pins:
         self._holding = False
         self._recording = False
         self._power_ups: list[tuple[int, int]] = []
-        self._tx = []
+        self._tx: list[tuple[int, int]] = []
         self._power_up(RESET_STRETCH_CLOCKS)
 
     def _power_up(self, run_from: int) -> None:
@@ -180,7 +180,7 @@ class Supi3Pins:
         # transmitter: (first cycle, level) of every bit sent, oldest first; a power-up drops the bits not yet
         # begun and idles the line from the next cycle
         now = self.cycle
-        self._tx: list[tuple[int, int]] = [
+        self._tx = [
             *(entry for entry in self._tx if entry[0] <= now), (now + 1, wire.IDLE_LEVEL)
         ]
         # frame engine
