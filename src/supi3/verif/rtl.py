@@ -35,7 +35,7 @@ TOP = "lockstep_top"
 """Module name of the packed top-level in the generated Verilog."""
 
 
-class LockstepTop(Elaboratable):  # type: ignore[misc]  # amaranth is untyped for mypy
+class LockstepTop(Elaboratable):
     """The design with its pins packed into 32-bit words.
 
     Parameters
