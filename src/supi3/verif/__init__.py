@@ -12,9 +12,21 @@ from supi3.verif.errors import (
     SimulatorUnavailableError,
 )
 from supi3.verif.layout import Layout, Stimulus, first_mismatch, model_trace, stimulus_array
-from supi3.verif.lockstep import Lockstep, react, run_lockstep, run_lockstep_batch
 from supi3.verif.pinmodel import EventLog, Pin, PinModel, recent_events
 from supi3.verif.report import LockstepResult
+
+_HEAVY = {"Lockstep", "react", "run_lockstep", "run_lockstep_batch"}
+"""Names from :mod:`supi3.verif.lockstep`, which needs Amaranth (the ``rtl`` extra): imported on first use, so
+that the models, which use only the pin protocol, run on the base install."""
+
+
+def __getattr__(name: str) -> object:
+    if name in _HEAVY:
+        from supi3.verif import lockstep
+
+        return getattr(lockstep, name)
+    raise AttributeError(f"module 'supi3.verif' has no attribute {name!r}")
+
 
 __all__ = [
     "EventLog",
