@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -58,6 +59,8 @@ def test_decode_text(capsys: pytest.CaptureFixture[str]) -> None:
     ["decode", "--c", "10000", "--clk-conf", "00"],
     ["timing", "--bit-rate", "1M"],
     ["timing", "--bytes", "-1"],
+    ["demo", "--cycles", "0"],
+    ["demo", "--bit-rate", "9600"],
 ])
 def test_errors_are_one_line_with_status_2(capsys: pytest.CaptureFixture[str], argv: list[str]) -> None:
     code, out, err = _run(capsys, *argv)
@@ -100,10 +103,20 @@ def test_console_script_entry_point() -> None:
 
 
 def test_demo(capsys: pytest.CaptureFixture[str]) -> None:
-    code, out, _ = _run(capsys, "demo")
+    code, out, _ = _run(capsys, "demo", "--cycles", "2")
     assert code == 0
-    assert "RB, 8 IN/8 OUT" in out and "Interrupt event (IRQ_EVT)" in out
-    assert len([line for line in out.splitlines() if line[:2].strip().isdigit()]) == 16
+    assert "Configuration table" in out and "Interrupt event (IRQ_EVT)" in out
+    assert out.count("(ok,") == 2
+    assert "03h" in out and "BFh" in out and "32h" in out
+
+
+def test_demo_writes_a_vcd(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    vcd = tmp_path / "demo.vcd"
+    code, out, _ = _run(capsys, "demo", "--cycles", "2", "--bit-rate", "2M", "--vcd", str(vcd))
+    assert code == 0 and f"wrote {vcd}" in out and out.count("(ok,") == 4
+    text = vcd.read_text(encoding="ascii")
+    assert "$scope module dev1 $end" in text and "$scope module dev3 $end" in text
+    assert "$timescale 1 ps $end" in text and "mfp_out" in text
 
 
 @pytest.mark.parametrize(("fmt", "marker"), [("md", "#"), ("rdl", "addrmap"), ("h", "#define SUPI3_"),
@@ -113,9 +126,7 @@ def test_regmap_formats_to_stdout(capsys: pytest.CaptureFixture[str], fmt: str, 
     assert code == 0 and marker in out
 
 
-def test_regmap_html_to_directory(capsys: pytest.CaptureFixture[str], tmp_path: object) -> None:
-    from pathlib import Path
-
-    out_dir = Path(str(tmp_path)) / "html"
+def test_regmap_html_to_directory(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    out_dir = tmp_path / "html"
     code, out, _ = _run(capsys, "regmap", "--format", "html", "-o", str(out_dir))
     assert code == 0 and (out_dir / "index.html").exists() and str(out_dir) in out

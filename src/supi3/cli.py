@@ -16,9 +16,6 @@ from supi3 import tables, timing
 from supi3.config import DeviceConfig, Interface, Variant, decode, mode_rows
 from supi3.errors import Supi3Error
 
-DEMO_STRAPS = {"c": "10000"}
-"""The demo device: a remote bus device, 8 IN/8 OUT binary I/O (Table 2-6, first row), 500 kbit/s."""
-
 
 def _print_json(data: object) -> None:
     print(json.dumps(data, indent=2, ensure_ascii=False))
@@ -137,12 +134,16 @@ def regmap_summary() -> str:
     return _format_rows(("Addr", "Write", "Access", "Read", "Access"), rows)
 
 
-def cmd_demo(_args: argparse.Namespace) -> None:
-    """Decode the default device and summarise the register map."""
-    config = decode(**DEMO_STRAPS)
-    print("supi3 demo: the default device (C[4..0] = 10000, CLK_CONF = 01, pins left open)\n")
-    print(describe(config))
-    print("\nRegister map of the serial µP interface (Table 3-10):\n")
+def cmd_demo(args: argparse.Namespace) -> None:
+    """A master and a small ring, live; optionally the pin-level run as a VCD."""
+    from supi3 import demo
+
+    clk_conf = {500_000: "01", 2_000_000: "11"}[_parse_bit_rate(args.bit_rate)]
+    if args.cycles < 1:
+        raise timing.TimingError(f"--cycles must be at least 1, not {args.cycles}")
+    for line in demo.run(args.cycles, Path(args.vcd) if args.vcd else None, clk_conf):
+        print(line)
+    print("\nRegister map of the serial µP interface (Table 3-10; `supi3 regmap` for all formats):\n")
     print(regmap_summary())
 
 
@@ -158,7 +159,10 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="supi3", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
 
-    p = sub.add_parser("demo", help="run the demo on built-in defaults")
+    p = sub.add_parser("demo", help="a master and a small ring, live (built-in defaults)")
+    p.add_argument("--cycles", type=int, default=4, help="data cycles to run (default 4)")
+    p.add_argument("--vcd", metavar="PATH", help="also run the SUPI 3 chips at pin level and write a VCD")
+    p.add_argument("--bit-rate", default="500k", help="500k or 2M")
     p.set_defaults(func=cmd_demo)
 
     p = sub.add_parser("modes", help="list the operating modes (Tables 2-4 to 2-7)")

@@ -70,6 +70,8 @@ class PinRing:
     ----------
     chips:
         The pin-level chips in ring order (position 1 first). All must run at the same bit rate.
+    record:
+        Keep every pin trace of every chip (for :meth:`recorded` and VCD files).
 
     Attributes
     ----------
@@ -81,7 +83,7 @@ class PinRing:
         The return line's samples so far.
     """
 
-    def __init__(self, chips: Sequence[Supi3Pins]) -> None:
+    def __init__(self, chips: Sequence[Supi3Pins], record: bool = False) -> None:
         if not chips:
             raise InterbusError("docs/interbus.md, Ring", 0, "a ring needs at least one device")
         rates = {chip.config.bit_rate for chip in chips}
@@ -93,6 +95,8 @@ class PinRing:
         self.cycle = 0
         self.returned = np.zeros(0, dtype=np.uint8)
         self._rx = 0
+        self.record = record
+        self._chunks: list[list[dict[str, npt.NDArray[np.int64]]]] = []
         self._inputs = [
             {"di2": 0, "rbst_ext": 0, "mfp_in": 0, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 1} for _ in chips
         ]
@@ -122,17 +126,35 @@ class PinRing:
         forward = np.asarray(samples, dtype=np.int64)
         placeholder = np.zeros(n, dtype=np.int64)
         sent = []
+        chunk = []
         for chip, pins in zip(self.devices, self._inputs, strict=True):
             traces = {name: np.full(n, value, dtype=np.int64) for name, value in pins.items()}
             traces["do1"] = forward
             traces["di2"] = placeholder
-            forward = chip.run_forward(traces)["do2"]
+            outputs = chip.run_forward(traces)
+            forward = outputs["do2"]
             sent.append(forward)
+            chunk.append({**traces, **outputs})
         back = placeholder
-        for chip, do2 in zip(reversed(self.devices), reversed(sent), strict=True):
-            back = chip.return_line(back, do2)
+        for k in range(len(self.devices) - 1, -1, -1):
+            chunk[k]["di2"] = back
+            back = self.devices[k].return_line(back, sent[k])
+            chunk[k]["di1"] = back
+        if self.record:
+            self._chunks.append(chunk)
         self.cycle += n
         self.returned = np.concatenate([self.returned, back.astype(np.uint8)])
+
+    def recorded(self) -> list[dict[str, npt.NDArray[np.int64]]]:
+        """Every pin trace of every chip since the ring was made (``record=True``), chips in ring order."""
+        if not self.record:
+            raise InterbusError("docs/model.md", "record=False", "this ring does not record its pins")
+        if not self._chunks:
+            return [{} for _ in self.devices]
+        return [
+            {name: np.concatenate([chunk[k][name] for chunk in self._chunks]) for name in self._chunks[0][k]}
+            for k in range(len(self.devices))
+        ]
 
     def _received(self) -> tuple[list[Telegram | LineReset], bool]:
         telegrams, self._rx, error = receive(self.returned, self._rx, self.cpb)

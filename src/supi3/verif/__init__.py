@@ -4,6 +4,8 @@ See ``docs/verification.md``. The cocotb coroutine lives in :mod:`supi3.verif.co
 a simulator), the example design and model in :mod:`supi3.verif.example`.
 """
 
+from typing import TYPE_CHECKING
+
 from supi3.verif.errors import (
     LockstepError,
     LockstepMismatchError,
@@ -14,6 +16,9 @@ from supi3.verif.errors import (
 from supi3.verif.layout import Layout, Stimulus, first_mismatch, model_trace, stimulus_array
 from supi3.verif.pinmodel import EventLog, Pin, PinModel, recent_events
 from supi3.verif.report import LockstepResult
+
+if TYPE_CHECKING:
+    from supi3.verif.lockstep import Lockstep, react, run_lockstep, run_lockstep_batch
 
 _HEAVY = {"Lockstep", "react", "run_lockstep", "run_lockstep_batch"}
 """Names from :mod:`supi3.verif.lockstep`, which needs Amaranth (the ``rtl`` extra): imported on first use, so
