@@ -162,6 +162,9 @@ class Supi3Pins:
         """Power-up reset; the logic runs again from cycle ``run_from`` (after the reset stretch, M2)."""
         if self._recording:
             self._power_ups.append((self.cycle, run_from))
+        # /StatErr is sampled afresh after a power-up (_stat_active below): the chip forgets the level it had, so
+        # its filter restarts at the first running clock instead of counting from clock 0.
+        self.chip._stat_err = False
         self.chip.power_up()
         self.chip.mfp_in = 0
         self._run_from = run_from
