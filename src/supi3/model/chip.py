@@ -37,6 +37,8 @@ from supi3.interbus.wire import Cycle
 from supi3.model.registers import RegisterFile
 
 CLOCK_HZ: Final = tables.CLOCK_HZ
+_NEVER: Final = 1 << 62
+_DATA: Final = Cycle.DATA  # enum attribute lookups cost ~0.1 µs on the hot path
 
 STATERR_FILTER_CLOCKS: Final = round(tables.STATERR_FILTER_S * CLOCK_HZ)
 """/StatErr must stay low this many clocks (200 ms, 3.6.2) before the peripheral fault is latched."""
@@ -91,9 +93,13 @@ class Supi3:
         binary = kind is MfpKind.BINARY_IO
         self._in_map = tuple((int(p.signal[2:]), p.pin) for p in pins if binary and p.signal.startswith("In"))
         self._out_map = tuple((int(p.signal[3:]), p.pin) for p in pins if binary and p.signal.startswith("Out"))
-        self.events: Counter[str] = Counter()
+        self._events: Counter[str] = Counter()
+        self._fast_valid = 0  # valid data cycles taken by the fast path of latch(), merged into events
         self.mfp_in = 0
         self._stat_err = False
+        # Pin-strapped modes have a fixed data length; the µP modes ask the register file every time.
+        self._fixed_bytes = None if self.registers is not None else wire.data_bytes(self.config.length_code)
+        self._loaded = (-1, b"")  # (MFP levels, IN bytes) of the last data-cycle load
         self.power_up()
 
     # --------------------------------------------------------------------------------------------------------
@@ -105,7 +111,7 @@ class Supi3:
         if self.registers is not None:
             self.registers.power_up_reset()
         self.in_word = 0
-        self.out_word = 0
+        self._out = b""
         self.pf = False
         self.wd = False
         self.te = False
@@ -117,6 +123,18 @@ class Supi3:
         self._stat_low_since: int | None = 0 if self._stat_err else None
         self.mod_ack_until = 0
         self.resreg_until = 0
+        self._reschedule()
+
+    @property
+    def events(self) -> Counter[str]:
+        """How often each interrupt source of Table 3-13 fired, plus ``"WATCHDOG"`` and ``"MODACK"``."""
+        fast = self._fast_valid
+        return self._events + Counter({"VALID": fast, "PCP_RX": fast, "PCP_TX": fast})
+
+    @property
+    def out_word(self) -> int:
+        """The OUT data of the last valid data cycle (binary I/O, SPI master and bus terminal modes)."""
+        return int.from_bytes(self._out, "big")
 
     def set_mfp_inputs(self, levels: int) -> None:
         """Drive the MFP[15..0] input pins (binary I/O modes sample them when a data cycle begins)."""
@@ -140,6 +158,7 @@ class Supi3:
         elif not active:
             self._stat_low_since = None
         self._stat_err = active
+        self._reschedule()
 
     @property
     def module_error(self) -> bool:
@@ -165,6 +184,8 @@ class Supi3:
 
     def data_bytes(self) -> int:
         """Bytes the chip occupies on the line in a data cycle (Table 3-11, assumption A15)."""
+        if self._fixed_bytes is not None:
+            return self._fixed_bytes
         return wire.data_bytes((self._id_and_length() >> 8) & 0x1F)
 
     def _sample_inputs(self) -> int:
@@ -188,14 +209,22 @@ class Supi3:
 
     def next_event(self) -> int | None:
         """The next clock at which time alone changes the chip (filter expiry, watchdog), ``None`` if none."""
-        times = [] if self._deadline is None else [self._deadline]
+        return None if self._due == _NEVER else self._due
+
+    def _reschedule(self) -> None:
+        due = _NEVER if self._deadline is None else self._deadline
         if self._stat_low_since is not None and not self.pf:
-            times.append(self._stat_low_since + STATERR_FILTER_CLOCKS)
-        return min(times, default=None)
+            due = min(due, self._stat_low_since + STATERR_FILTER_CLOCKS)
+        self._due = due
+        self._due_s = due / CLOCK_HZ
 
     def _advance(self, clk: int) -> None:
         """Bring time-driven state up to clock ``clk``: the /StatErr filter and the layer-2 watchdog."""
         self._now = clk
+        if clk >= self._due:
+            self._expire(clk)
+
+    def _expire(self, clk: int) -> None:
         if self._filtered and not self.pf:
             self.pf = True
             self.attention = True
@@ -205,17 +234,18 @@ class Supi3:
             self.wd = True
             self.attention = True
             self.resreg_until = clk + RESREG_PULSE_CLOCKS
-            self.events["WATCHDOG"] += 1
+            self._events["WATCHDOG"] += 1
             self._event("IB_RESET")
+        self._reschedule()
 
     def _clear_process_data(self) -> None:
         self.in_word = 0
-        self.out_word = 0
+        self._out = b""
         if self.registers is not None:
             self.registers.interbus_reset()
 
     def _event(self, source: str) -> None:
-        self.events[source] += 1
+        self._events[source] += 1
         if self.registers is not None:
             self.registers.event(source)
 
@@ -225,27 +255,40 @@ class Supi3:
 
     def load_at(self, cycle: Cycle, clk: int) -> bytes:
         """A frame begins: the register's parallel load, in line order."""
-        self._advance(clk)
+        self._now = clk
+        if clk >= self._due:
+            self._expire(clk)
         if cycle is Cycle.ID:
             return wire.word_bytes(self.id_register())
-        n = self.data_bytes()
         if self.registers is not None:
-            return self.registers.in_bytes() if n else b""
-        return self._sample_inputs().to_bytes(n, "big")
+            return self.registers.in_bytes() if self.data_bytes() else b""
+        if not self._in_map:
+            return self.in_word.to_bytes(self.data_bytes(), "big")
+        levels, loaded = self._loaded
+        if levels != self.mfp_in:
+            loaded = self._sample_inputs().to_bytes(self.data_bytes(), "big")
+            self._loaded = (self.mfp_in, loaded)
+        return loaded
 
     def latch_at(self, cycle: Cycle, received: bytes, clk: int) -> None:
         """The master latched the cycle: take over ``received`` (OUT data or the command word)."""
-        self._advance(clk)
+        self._now = clk
+        if clk >= self._due:
+            self._expire(clk)
+        events = self._events
         if cycle is Cycle.DATA:
-            if self.registers is not None:
-                if received:
-                    self.registers.latch(received)
-                self.registers.set_bus_running(True)
-            else:
-                self.out_word = int.from_bytes(received, "big")
             self.bus_active = True
-            timeout = WATCHDOG_CLOCKS[self.watchdog_code] if self.watchdog_code is not None else None
-            self._deadline = None if timeout is None else clk + timeout
+            if self.watchdog_code is not None:
+                timeout = WATCHDOG_CLOCKS[self.watchdog_code]
+                self._deadline = None if timeout is None else clk + timeout
+                self._reschedule()
+            if self.registers is None:
+                self._out = received
+                self._fast_valid += 1
+                return
+            if received:
+                self.registers.latch(received)
+            self.registers.set_bus_running(True)
             self._event("VALID")
             self._event("PCP_RX")
         else:
@@ -254,10 +297,12 @@ class Supi3:
                 self.watchdog_code = command.watchdog_code
                 timeout = WATCHDOG_CLOCKS[command.watchdog_code]
                 self._deadline = None if timeout is None else clk + timeout
+                self._reschedule()
             if command.quit_peripheral_error:
                 self.pf = self.module_error
                 self.mod_ack_until = clk + MODACK_PULSE_CLOCKS
-                self.events["MODACK"] += 1
+                events["MODACK"] += 1
+                self._reschedule()
             self.wd = self.te = self.attention = False
             self._event("ID_CYCLE")
         self._event("PCP_TX")
@@ -275,10 +320,11 @@ class Supi3:
         self._clear_process_data()
         self.watchdog_code = None
         self._deadline = None
+        self._reschedule()
         self.wd = self.te = False
         self.attention = self.pf
         self.bus_active = False
-        self.events["IB_RESET"] += 1
+        self._events["IB_RESET"] += 1
         if self.registers is not None:
             self.registers.set_bus_running(False)
 
@@ -286,11 +332,18 @@ class Supi3:
 
     def load(self, cycle: Cycle, now: float) -> bytes:
         """See :meth:`supi3.interbus.device.Device.load`."""
-        return self.load_at(cycle, clocks(now))
+        if cycle is _DATA and now < self._due_s and self.mfp_in == self._loaded[0]:
+            return self._loaded[1]  # nothing due, MFP inputs as last sampled: the same IN bytes
+        return self.load_at(cycle, round(now * CLOCK_HZ))
 
     def latch(self, cycle: Cycle, received: bytes, now: float) -> None:
         """See :meth:`supi3.interbus.device.Device.latch`."""
-        self.latch_at(cycle, received, clocks(now))
+        if cycle is _DATA and now < self._due_s and self.registers is None and self.watchdog_code is None:
+            self.bus_active = True  # the latch_at() path for a pin-strapped mode without watchdog
+            self._out = received
+            self._fast_valid += 1
+            return
+        self.latch_at(cycle, received, round(now * CLOCK_HZ))
 
     def discard(self, cycle: Cycle, local_error: bool, now: float) -> None:
         """See :meth:`supi3.interbus.device.Device.discard`."""
