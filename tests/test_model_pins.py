@@ -235,3 +235,36 @@ def test_resu_low_holds_the_chip_in_reset() -> None:
     drive = np.flatnonzero(trace["resu_drive"])
     # The chip pulls /ResU low while the reset lasts and for the 4 µs stretch after it (1.7.2).
     assert drive.max() == 900 + SYNC_STAGES + RESET_STRETCH_CLOCKS - 1
+
+
+def test_voltage_monitor_hysteresis() -> None:
+    from supi3.model.chip import VoltageMonitor
+
+    monitor = VoltageMonitor()
+    ramp = [0.0, 3.0, 4.4, 4.6, 4.2, 3.95, 3.85, 4.4, 4.51, 5.0]
+    assert [monitor.sense(v) for v in ramp] == [False, False, False, True, True, True, False, False, True, True]
+
+
+def test_io_access_bit_covers_check_sequence_and_latch_phase(monkeypatch: pytest.MonkeyPatch) -> None:
+    config = decode("10000", clk_conf=FAST)
+    model = Supi3Pins(config)
+    seen: list[tuple[str, bool, int]] = []
+    original_io, original_latch = model.chip.set_io_access, model.chip.set_latch_phase
+
+    def io(busy: bool) -> None:
+        seen.append(("io", busy, model.cycle))
+        original_io(busy)
+
+    def latch(on: bool) -> None:
+        seen.append(("latch", on, model.cycle))
+        original_latch(on)
+
+    monkeypatch.setattr(model.chip, "set_io_access", io)
+    monkeypatch.setattr(model.chip, "set_latch_phase", latch)
+    model.run(_inputs(wire.levels_to_samples(_traffic(b"\x42"), config.bit_rate).astype(np.int64)))
+    assert [(kind, on) for kind, on, _ in seen] == [("io", True), ("latch", True), ("latch", False), ("io", False)]
+    cpb = wire.clocks_per_bit(config.bit_rate)
+    io_set, latch_start = seen[0][2], seen[1][2]
+    # 3.4.14: once the bit reads 0 the registers may be accessed for 30 bit periods before the latch phase.
+    assert latch_start - io_set >= 30 * cpb
+    assert not model.chip.io_access and model.chip.out_word == 0x42

@@ -123,6 +123,8 @@ class Supi3:
         self._stat_low_since: int | None = 0 if self._stat_err else None
         self.mod_ack_until = 0
         self.resreg_until = 0
+        self.io_access = False
+        self.latch_phase = False
         self._reschedule()
 
     @property
@@ -135,6 +137,21 @@ class Supi3:
     def out_word(self) -> int:
         """The OUT data of the last valid data cycle (binary I/O, SPI master and bus terminal modes)."""
         return int.from_bytes(self._out, "big")
+
+    def set_io_access(self, busy: bool) -> None:
+        """The I/O access (polling) bit (3.4.14, Fig. 3-22): 1 from the start of a data cycle's check sequence to
+        the end of its latch phase, so a 0 leaves at least the check sequence (52 bit periods, more than the
+        manual's 30) before data move; in µP modes it is D7 of the interrupt event register and MFP1."""
+        self.io_access = busy
+        if self.registers is not None:
+            self.registers.set_io_access(busy)
+
+    def set_latch_phase(self, active: bool) -> None:
+        """The latch phase (3.4.14): from the first latch telegram to the latch; µP accesses to the data
+        registers inside it are reported as inconsistent data."""
+        self.latch_phase = active
+        if self.registers is not None:
+            self.registers.set_latch_phase(active)
 
     def set_mfp_inputs(self, levels: int) -> None:
         """Drive the MFP[15..0] input pins (binary I/O modes sample them when a data cycle begins)."""
@@ -356,3 +373,25 @@ class Supi3:
     def poll(self, now: float) -> None:
         """See :meth:`supi3.interbus.device.Device.poll`."""
         self._advance(clocks(now))
+
+
+class VoltageMonitor:
+    """The reset unit's voltage monitor (1.7.2): its output goes high above 4.5 V and low below 3.9 V, and keeps
+    its level in between (hysteresis). Its output is the pin-level model's ``vmon_ok`` input.
+
+    Attributes
+    ----------
+    ok:
+        The output level; low at power-up.
+    """
+
+    def __init__(self) -> None:
+        self.ok = False
+
+    def sense(self, vcc: float) -> bool:
+        """Apply the supply voltage ``vcc`` (volts) and return the output."""
+        if vcc > tables.VOLTAGE_MONITOR_HIGH_V:
+            self.ok = True
+        elif vcc < tables.VOLTAGE_MONITOR_LOW_V:
+            self.ok = False
+        return self.ok

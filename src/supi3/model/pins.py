@@ -335,6 +335,7 @@ class Supi3Pins:
         self.log.add(c, "INTERBUS reset detected")
         self._in_reset = True
         self._reset_end_count = 0
+        self._end_phases()
         self._state = "idle"
         self._latches = 0
         self.chip.reset_at(c)
@@ -343,9 +344,15 @@ class Supi3Pins:
         """A frame that was not latched ends: invalid cycle (Table 3-13)."""
         if self._state != "idle":
             self.log.add(c, f"{self._cycle.value} cycle discarded")
+            self._end_phases()
             self.chip.discard_at(self._cycle, self._local_error, c)
         self._state = "idle"
         self._latches = 0
+
+    def _end_phases(self) -> None:
+        if self.chip.io_access:
+            self.chip.set_latch_phase(False)
+            self.chip.set_io_access(False)
 
     def _sample(self, level: int, c: int) -> None:
         k = self._bit
@@ -377,6 +384,8 @@ class Supi3Pins:
                     self._state = "check"
                     self._check_index = 0
                     self._check_rx = 0
+                    if self._cycle is Cycle.DATA:
+                        self.chip.set_io_access(True)
                 elif self._state == "check":
                     self._check_index += 1
                 if self._state != "check" or self._check_index >= _CHECK_WORDS:
@@ -473,6 +482,8 @@ class Supi3Pins:
             self._error(c, "status telegram inside a frame")
         elif self._state == "wait":
             self._latches = self._latches + 1 if latch else 0
+            if self._latches == 1 and self.chip.io_access:
+                self.chip.set_latch_phase(True)
             if self._latches == wire.LATCH_STATUS_TELEGRAMS:
                 self._finish(c)
 
@@ -483,6 +494,7 @@ class Supi3Pins:
         received = self._register.to_bytes(self._width // 8, "little")
         self.log.add(c, f"{self._cycle.value} cycle latched: {received.hex()}")
         self.chip.latch_at(self._cycle, received, c)
+        self._end_phases()
         self._state = "idle"
         self._latches = 0
 
