@@ -1,0 +1,119 @@
+"""The whole chip at pin level: firmware configures a µP-mode chip through the serial interface on the MFP pins,
+the master reads the configured ID register and exchanges data through IN/OUT bytes, all clock by clock."""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+
+from supi3.config import decode
+from supi3.interbus import wire
+from supi3.interbus.wire import Cycle, Frame
+from supi3.model.top import Supi3Chip
+from supi3.regmap import encode_command
+
+HALF = 8  # SCLK half period in clocks at 2 Mbit/s: 4 MHz, below the 6 MHz maximum (Table 3-7)
+SCLK, SS_N, MOSI, MFP7 = 1 << 4, 1 << 5, 1 << 6, 1 << 7
+IDLE_MFP = SCLK | SS_N | MFP7  # SCLK idles high (mode 3), /SS high, MFP7 (an input until the mode is known) high
+
+
+class Bench:
+    """Drives the chip's pins: the INTERBUS line on do1 and a software SPI master (Motorola) on MFP[7..0]."""
+
+    def __init__(self) -> None:
+        self.chip = Supi3Chip(decode("10011", "1110", clk_conf="11"))  # RB, Init-µP, 2 Mbit/s
+        self.line: list[int] = []
+        self.returned: list[int] = []
+        self.irq_n: list[int] = []
+        self.idle(300)
+
+    def tick(self, mfp: int, do1: int = 1) -> dict[str, int]:
+        out = self.chip.step({"do1": do1, "di2": 0, "rbst_ext": 0, "mfp_in": mfp, "stat_err_n": 1, "resu_n": 1,
+                              "vmon_ok": 1})
+        self.returned.append(out["di1"])
+        self.irq_n.append((out["mfp_out"] >> 3) & 1)
+        return out
+
+    def idle(self, cycles: int) -> None:
+        for _ in range(cycles):
+            self.tick(IDLE_MFP)
+
+    def spi(self, mosi: int) -> int:
+        """One byte, MSB first; returns what the chip sent on MFP7 (SerOUT)."""
+        mfp = IDLE_MFP & ~SS_N
+        for _ in range(HALF):
+            self.tick(mfp)
+        miso = 0
+        for i in range(8):
+            bit = MOSI if (mosi >> (7 - i)) & 1 else 0
+            for _ in range(HALF):
+                out = self.tick((mfp & ~SCLK & ~MOSI) | bit)
+            miso = (miso << 1) | ((out["mfp_out"] >> 7) & 1)
+            for _ in range(HALF):
+                self.tick(mfp | bit)
+        for _ in range(HALF):
+            self.tick(mfp)
+        for _ in range(2 * HALF):
+            self.tick(IDLE_MFP)
+        return miso
+
+    def write(self, address: int, value: int) -> None:
+        self.spi(encode_command(address, wr=True))
+        self.spi(value)
+
+    def read(self, address: int) -> int:
+        self.spi(encode_command(address, rd=True))
+        return self.spi(0)
+
+    def send(self, levels: npt.NDArray[np.uint8]) -> None:
+        """Master line levels, with the µP idle."""
+        for level in wire.levels_to_samples(levels, 2_000_000).tolist():
+            self.tick(IDLE_MFP, int(level))
+
+
+def _frames(samples: list[int]) -> list[Frame]:
+    received = wire.parse_levels(wire.samples_to_levels(np.array(samples, dtype=np.uint8), 2_000_000))
+    telegrams = [t for t in received if isinstance(t, wire.Telegram)]  # the reset pattern carries no frame
+    frames = []
+    while any(t.data is not None for t in telegrams):
+        frame = wire.frame_from_telegrams(telegrams)
+        frames.append(frame)
+        first = next(i for i, t in enumerate(telegrams) if t.data is not None)
+        telegrams = telegrams[first + len(frame.data) + wire.CHECK_TELEGRAMS :]
+    return frames
+
+
+def test_firmware_configures_the_chip_and_exchanges_data_at_pin_level() -> None:
+    bench = Bench()
+    assert bench.spi(0x00) == 0  # initialization byte: Motorola (Table 3-8)
+    bench.write(13, 0x82)  # 3.4.5: SET = 82h, I/O device with 1 byte
+    bench.write(12, 0x01)  # ID code 01h, digital output device
+    bench.write(14, 0x10)  # enable the valid-data-cycle interrupt (3.4.14)
+    assert bench.read(13) == 0x82 and bench.read(12) == 0x01
+    idle = wire.status_levels(Cycle.DATA, False, 8)
+    lw = wire.LOOPBACK_BYTES_ON_LINE
+    start = len(bench.returned)
+    bench.send(np.concatenate([
+        idle, wire.reset_levels(1), idle,
+        wire.cycle_levels(Frame.build(Cycle.ID, lw + wire.word_bytes(wire.command_word())), 1, True), idle,
+    ]))  # fmt: skip
+    # The INTERBUS reset cleared the IN bytes (3.4.7): firmware writes them after the ID cycle (Table 3-13).
+    bench.write(0, 0x77)
+    bench.send(np.concatenate([wire.cycle_levels(Frame.build(Cycle.DATA, lw + b"\x99"), 1, True), idle]))
+    frames = _frames(bench.returned[start + 3 * 16 :])  # the repeater delays the return line by 3 bit periods
+    assert frames[0].data == wire.word_bytes(0x0901) + lw  # ID register: ID 01h, length code 01001 (1 byte)
+    assert frames[1].data == b"\x77" + lw  # IN byte 0 went to the master
+    assert bench.irq_n[-1] == 0  # /IRQ on MFP3: valid data cycle
+    assert bench.read(14) & 0x10
+    assert bench.irq_n[-1] == 1  # reading the event register releases /IRQ
+    assert bench.read(0) == 0x99  # OUT byte 0 from the master
+
+
+def test_chip_without_up_interface_is_the_core() -> None:
+    chip = Supi3Chip(decode("10000", clk_conf="11"))
+    assert chip.upif is None
+    traces = chip.run({"do1": np.ones(50, dtype=np.int64), "di2": np.zeros(50, dtype=np.int64),
+                       "rbst_ext": np.zeros(50, dtype=np.int64), "mfp_in": np.zeros(50, dtype=np.int64),
+                       "stat_err_n": np.ones(50, dtype=np.int64), "resu_n": np.ones(50, dtype=np.int64),
+                       "vmon_ok": np.ones(50, dtype=np.int64)})
+    assert traces["resu_drive"].all()
