@@ -163,3 +163,32 @@ def test_corrupted_cycles_never_change_outputs(modes: list[tables.ModeRow], faul
         # Nothing is lost: a failed cycle leaves every output as the last valid cycle set it (Table 3-13).
         assert [chip.mfp_outputs for chip in chips] == before
         assert all(chip.events["INVALID"] > n for chip, n in zip(chips, invalid, strict=True))
+
+
+def test_management_channel_processor_command_and_alarm() -> None:
+    chip = Supi3(decode("10011", "1110"))  # RB, Init-µP
+    assert chip.registers is not None
+    chip.registers.cpu_write(13, 0x82)
+    chip.registers.cpu_write(12, 0x01)
+    _, master = _ring(chip)
+    chip.registers.cpu_write(14, 0x40)  # enable the processor command interrupt (D6)
+    master.processor_command(1, 0xC3)
+    assert master.cycle().cycle is wire.Cycle.ID  # pending management traffic makes the next cycle an ID cycle
+    assert chip.registers.cpu_read(7) == 0xC3  # 3.4.9: the master's message in the processor command register
+    assert chip.registers.irq_n == 0 and chip.registers.cpu_read(14) & 0x40
+    chip.registers.cpu_write(7, 0x5A)  # the processor alarm for the master
+    master.request_processor_alarm("1.0")
+    assert master.cycle().ok and 1 not in master.processor_alarms
+    assert master.cycle().ok and master.processor_alarms[1] == 0x5A
+    # The alarm took the ID code's place once; the configuration is still the same afterwards.
+    assert master.cycle().cycle is wire.Cycle.DATA and master.entry(1).id_code == 0x01
+    assert master.id_cycle().ok
+
+
+def test_command_word_round_trip() -> None:
+    for pcmd in (None, 0x00, 0xA5):
+        for alarm in (False, True):
+            word = wire.command_word(1, True, pcmd, alarm)
+            assert wire.decode_command(word) == wire.Command(1, True, pcmd, alarm)
+    with pytest.raises(wire.InterbusError, match="one byte"):
+        wire.command_word(processor_command=0x100)

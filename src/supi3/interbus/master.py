@@ -8,6 +8,7 @@ offers the services the manual names: Alarm Stop (1303h), Control_Device_Functio
 
 from __future__ import annotations
 
+from collections.abc import Collection
 from dataclasses import dataclass
 from enum import Enum
 from typing import Final
@@ -166,6 +167,11 @@ class Master:
         self._quit: set[int] = set()
         self._attention = False
         self._pf_active: set[int] = set()
+        self._pcmd: dict[int, int] = {}
+        self._alarm_request: set[int] = set()
+        self._alarm_expected: set[int] = set()
+        self.processor_alarms: dict[int, int] = {}
+        """Ring position -> the last processor alarm byte read from it (management channel, 3.4.9)."""
 
     # -- services ------------------------------------------------------------------------------------------------
 
@@ -178,6 +184,9 @@ class Master:
         self._quit.clear()
         self._attention = False
         self._pf_active.clear()
+        self._pcmd.clear()
+        self._alarm_request.clear()
+        self._alarm_expected.clear()
         self._watchdog_pending = self._watchdog_code is not None
 
     def start(self) -> CycleResult:
@@ -200,6 +209,18 @@ class Master:
         fault; the device's /ModAck output pulses. Sent in the device's command word of the next ID cycle."""
         self._quit.add(self.entry(position).ring_position)
         self.services.append(CONTROL_DEVICE_FUNCTION)
+
+    def processor_command(self, position: int | str, value: int) -> None:
+        """Send a byte to a device's processor command register (management channel, 3.4.9): it arrives with
+        the next ID cycle and raises the device's processor command interrupt (assumption A18)."""
+        if not 0 <= value <= 0xFF:
+            raise InterbusError("manual 3.4.9", value, "a processor command is one byte")
+        self._pcmd[self.entry(position).ring_position] = value
+
+    def request_processor_alarm(self, position: int | str) -> None:
+        """Read a device's processor alarm register (management channel, 3.4.9): the request goes out with the
+        next ID cycle and the value comes back in the one after, into :attr:`processor_alarms` (A18)."""
+        self._alarm_request.add(self.entry(position).ring_position)
 
     # -- process data --------------------------------------------------------------------------------------------
 
@@ -235,7 +256,8 @@ class Master:
     def cycle(self) -> CycleResult:
         """Run the next cycle a master would: an ID cycle when there is no configuration, a command to send
         or a device asking for attention, else a data cycle."""
-        if self.config is None or self._attention or self._watchdog_pending or self._quit:
+        pending = self._pcmd or self._alarm_request or self._alarm_expected
+        if self.config is None or self._attention or self._watchdog_pending or self._quit or pending:
             return self.id_cycle()
         return self.data_cycle()
 
@@ -267,7 +289,7 @@ class Master:
         if problem is None:
             assert transfer.returned is not None
             registers = _id_registers(transfer.returned, len(config))
-            problem = _compare(config, registers)
+            problem = _compare(config, registers, self._alarm_expected)
         self.ring.finish(transfer, problem is None)
         if problem is not None:
             if problem.kind is ErrorKind.CONFIGURATION:
@@ -275,6 +297,8 @@ class Master:
             return self._failed(Cycle.ID, problem)
         self._watchdog_pending = False
         self._quit.clear()
+        self._pcmd.clear()
+        self._take_alarms(registers, sent=True)
         return CycleResult(Cycle.ID, True, self._messages(registers))
 
     # -- internals -----------------------------------------------------------------------------------------------
@@ -286,7 +310,8 @@ class Master:
 
     def _command(self, ring_position: int) -> int:
         code = self._watchdog_code if self._watchdog_pending else None
-        return wire.command_word(code, ring_position in self._quit)
+        return wire.command_word(code, ring_position in self._quit, self._pcmd.get(ring_position),
+                                 ring_position in self._alarm_request)
 
     def _set_config(self, config: tuple[ConfigEntry, ...] | None) -> None:
         self.config = config
@@ -361,9 +386,10 @@ class Master:
         if problem is None:
             assert transfer.returned is not None
             registers = _id_registers(transfer.returned, n)
-            problem = _compare(config, registers)
+            problem = _compare(config, registers, self._alarm_expected)
         self.ring.finish(transfer, problem is None)
         if problem is None:
+            self._take_alarms(registers, sent=False)
             self._messages(registers)
             te = [k for k, word in enumerate(registers, 1) if (word >> wire.MGMT_TE_BIT) & 1]
             if te:
@@ -387,9 +413,23 @@ class Master:
         problem = self._check(transfer, 2 * devices)
         if problem is None:
             assert transfer.returned is not None
-            problem = _compare(config[:devices], _id_registers(transfer.returned, devices))
+            registers = _id_registers(transfer.returned, devices)
+            problem = _compare(config[:devices], registers, self._alarm_expected)
         self.ring.finish(transfer, problem is None)
+        if problem is None:
+            self._take_alarms(registers, sent=False)
         return problem is None
+
+    def _take_alarms(self, registers: list[int], sent: bool) -> None:
+        """After a latched ID cycle: the devices asked in the previous one sent their processor alarm in place
+        of the ID code; the requests this one carried (``sent``) are answered in the next (A18)."""
+        for position in self._alarm_expected:
+            if position <= len(registers):
+                self.processor_alarms[position] = registers[position - 1] & 0xFF
+        answered = range(1, len(registers) + 1)
+        self._alarm_expected = set(self._alarm_request) if sent else self._alarm_expected.difference(answered)
+        if sent:
+            self._alarm_request.clear()
 
     def _messages(self, registers: list[int]) -> tuple[Diagnostic, ...]:
         """Report the management bits of a latched ID cycle: PF as 0BB1h (once per fault), WD as 0C6Bh."""
@@ -444,10 +484,12 @@ def _configuration(registers: list[int]) -> tuple[tuple[ConfigEntry, ...] | None
     return tuple(entries), None
 
 
-def _compare(config: tuple[ConfigEntry, ...], registers: list[int]) -> Diagnostic | None:
-    """The first device whose ID code or length code differs from the configuration."""
+def _compare(config: tuple[ConfigEntry, ...], registers: list[int], alarms: Collection[int]) -> Diagnostic | None:
+    """The first device whose ID code or length code differs from the configuration; devices in ``alarms``
+    send their processor alarm in place of the ID code (A18), so only their length code is compared."""
     for entry, word in zip(config, registers, strict=True):
-        if (word & 0xFF, (word >> 8) & 0x1F) != (entry.id_code, entry.length_code):
+        id_code = entry.id_code if entry.ring_position in alarms else word & 0xFF
+        if (id_code, (word >> 8) & 0x1F) != (entry.id_code, entry.length_code):
             return Diagnostic(ErrorKind.CONFIGURATION, entry.ring_position, None, None,
                               f"ID register {word:04X}h differs from the configuration")  # fmt: skip
     return None

@@ -79,6 +79,13 @@ CMD_WD_CODE_SHIFT: Final = 0  # 2 bits: index into WATCHDOG_TIMEOUTS_S (50 ms, 2
 CMD_WD_SET_BIT: Final = 2  # apply the watchdog code
 CMD_QUIT_BIT: Final = 3  # Quit Peripheral Error (0714h): clear the PF latch, pulse /ModAck
 
+# A18 Management channel (manual 3.4.9) in the command word: a processor command byte for the device's processor
+# command register, and the request to send the processor alarm register in the next ID cycle, in place of the
+# ID code (bits 7..0 of the ID register).
+CMD_PCMD_BIT: Final = 4  # bits 15..8 carry a processor command byte
+CMD_ALARM_BIT: Final = 5  # send the processor alarm in the next ID cycle
+CMD_PCMD_SHIFT: Final = 8
+
 # A10 Each device repeats the line with this delay; it may look this many bits minus one ahead (mid-bit sampling).
 REPEATER_DELAY_BITS: Final = 3
 
@@ -283,8 +290,9 @@ def id_register(id_code: int, length_code: int, management: int = 0) -> int:
     return management | (length_code << 8) | id_code
 
 
-def command_word(watchdog_code: int | None = None, quit_peripheral_error: bool = False) -> int:
-    """Compose the 16-bit command word the master shifts into a device in an ID cycle (assumption A9).
+def command_word(watchdog_code: int | None = None, quit_peripheral_error: bool = False,
+                 processor_command: int | None = None, alarm_request: bool = False) -> int:
+    """Compose the 16-bit command word the master shifts into a device in an ID cycle (assumptions A9, A18).
 
     Parameters
     ----------
@@ -293,8 +301,18 @@ def command_word(watchdog_code: int | None = None, quit_peripheral_error: bool =
         device's setting alone.
     quit_peripheral_error:
         Quit Peripheral Error (0714h, manual 3.6.2): the device clears its PF latch and pulses /ModAck.
+    processor_command:
+        A byte for the device's processor command register (management channel, 3.4.9), or ``None``.
+    alarm_request:
+        Ask the device to send its processor alarm register in the next ID cycle (3.4.9).
     """
     word = 0
+    if processor_command is not None:
+        if not 0 <= processor_command <= 0xFF:
+            raise InterbusError("manual 3.4.9", processor_command, "a processor command is one byte")
+        word |= (processor_command << CMD_PCMD_SHIFT) | (1 << CMD_PCMD_BIT)
+    if alarm_request:
+        word |= 1 << CMD_ALARM_BIT
     if watchdog_code is not None:
         if not 0 <= watchdog_code < len(WATCHDOG_TIMEOUTS_S):
             raise InterbusError("Table 3-13", watchdog_code, "watchdog code must index WATCHDOG_TIMEOUTS_S")
@@ -305,16 +323,20 @@ def command_word(watchdog_code: int | None = None, quit_peripheral_error: bool =
 
 
 class Command(NamedTuple):
-    """A decoded command word: the watchdog code to apply (``None``: leave it) and the quit request."""
+    """A decoded command word: the watchdog code to apply (``None``: leave it), the quit request, a processor
+    command byte (``None``: none) and the processor alarm request."""
 
     watchdog_code: int | None
     quit_peripheral_error: bool
+    processor_command: int | None = None
+    alarm_request: bool = False
 
 
 def decode_command(word: int) -> Command:
     """Inverse of :func:`command_word`; bits without a meaning are ignored."""
     code = (word >> CMD_WD_CODE_SHIFT) & 0b11 if _bit(word, CMD_WD_SET_BIT) else None
-    return Command(code, bool(_bit(word, CMD_QUIT_BIT)))
+    pcmd = (word >> CMD_PCMD_SHIFT) & 0xFF if _bit(word, CMD_PCMD_BIT) else None
+    return Command(code, bool(_bit(word, CMD_QUIT_BIT)), pcmd, bool(_bit(word, CMD_ALARM_BIT)))
 
 
 # ================================================================================================================

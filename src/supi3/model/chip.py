@@ -125,6 +125,7 @@ class Supi3:
         self.resreg_until = 0
         self.io_access = False
         self.latch_phase = False
+        self._send_alarm = False
         self._reschedule()
 
     @property
@@ -188,7 +189,10 @@ class Supi3:
 
     def _id_and_length(self) -> int:
         if self.registers is not None:
-            return self.registers.bus_id_register()
+            word = self.registers.bus_id_register()
+            if self._send_alarm:  # the master asked for the processor alarm (3.4.9, docs/interbus.md A18)
+                word = (word & ~0xFF) | self.registers.processor_alarm
+            return word
         return (self.config.length_code << 8) | self.config.id_code
 
     def management(self) -> int:
@@ -320,6 +324,10 @@ class Supi3:
                 self.mod_ack_until = clk + MODACK_PULSE_CLOCKS
                 events["MODACK"] += 1
                 self._reschedule()
+            if self.registers is not None:
+                if command.processor_command is not None:
+                    self.registers.processor_command(command.processor_command)
+                self._send_alarm = command.alarm_request
             self.wd = self.te = self.attention = False
             self._event("ID_CYCLE")
         self._event("PCP_TX")
@@ -338,6 +346,7 @@ class Supi3:
         self.watchdog_code = None
         self._deadline = None
         self._reschedule()
+        self._send_alarm = False
         self.wd = self.te = False
         self.attention = self.pf
         self.bus_active = False
