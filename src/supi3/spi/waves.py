@@ -1,0 +1,616 @@
+"""Timing diagrams of the serial µP interface drawn from model traces.
+
+A software µP (:class:`SoftMaster`) drives :class:`~supi3.spi.slave_pins.SlavePins` pin by pin at the chip clock,
+within Table 3-7 (IBS SUPI 3 OPC UM E rev. 05, 3.4.2): SCLK idles high, the µP changes its data on falling edges
+and both sides sample on rising edges (UP-5), one byte per /SS low period (UP-7). Every pin of every cycle is
+recorded in a :class:`Trace`, which can be
+
+* written as a VCD (:func:`write_vcd`),
+* decoded back into bytes from the pins alone (:func:`decode_bytes`),
+* turned into WaveJSON sampled once per half SCLK period (:func:`to_wavejson`) and rendered as SVG with the
+  ``wavedrom`` package (:func:`render_svg`).
+
+:data:`FIGURES` redraws the manual's Figures 3-4, 3-5 and 3-9 to 3-12 (missing from the text copy) from such
+traces; ``python -m supi3.spi.waves --out docs/figures`` writes them (see ``docs/figures.md``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Final
+
+import wavedrom  # type: ignore[import-untyped]
+from vcd import VCDWriter
+
+from supi3 import tables
+from supi3.config import decode
+from supi3.model.registers import RegisterFile
+from supi3.model.vcd import CLOCK_PS
+from supi3.regmap import REGISTER_MAP, encode_command
+from supi3.spi.slave_pins import INPUT_PINS, OUTPUT_PINS, PinsIn, PinsOut, SlavePins
+from supi3.spi.upif import BLOCK_ADDRESS, Mode, UpifUsageError
+from supi3.timing import timing_table
+
+__all__ = [
+    "FIGURES",
+    "DecodedByte",
+    "Figure",
+    "MasterTiming",
+    "SoftMaster",
+    "Trace",
+    "decode_bytes",
+    "main",
+    "render_svg",
+    "to_wavejson",
+    "write_figures",
+    "write_vcd",
+]
+
+_EPSILON: Final[float] = 1e-6
+"""Tolerance (in clock cycles) when rounding Table 3-7's times up to whole chip clocks."""
+
+
+# ------------------------------------------------------------------------------------------------------------
+# The software µP
+# ------------------------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class MasterTiming:
+    """How a software µP places its edges, in chip-clock cycles.
+
+    A byte is: /SS high for ``gap`` cycles (S/R takes its new level in the first of them), /SS low, ``lead``
+    cycles later the first SCLK fall, eight SCLK periods of ``low`` + ``high`` cycles (the µP changes its data
+    at each fall), except that after the eighth rise SCLK stays high and /SS rises ``trail`` cycles later.
+    """
+
+    low: int
+    """SCLK low phase: the µP's data setup before the rising edge (t4)."""
+    high: int
+    """SCLK high phase: the µP's data hold after the rising edge (t5)."""
+    lead: int
+    """/SS fall to the first SCLK fall: t1, and t7 (the chip's first bit valid) before the first rise."""
+    trail: int
+    """Last SCLK rise to /SS rise: t2."""
+    gap: int
+    """/SS high between bytes: t6 (maximum, C/D settles) plus t8 (C/D stable before /SS falls)."""
+
+    @property
+    def period(self) -> int:
+        """The SCLK period in chip clocks (t0)."""
+        return self.low + self.high
+
+    @classmethod
+    def fastest(cls, bit_rate: int, *, sclk_hz: float | None = None,
+                clock_hz: int = tables.CLOCK_HZ) -> MasterTiming:
+        """The shortest timing within Table 3-7 at ``bit_rate``, at ``sclk_hz`` (default: the table's maximum,
+        t0) rounded down to a whole number of chip clocks per period.
+
+        Raises
+        ------
+        UpifUsageError
+            If ``sclk_hz`` is faster than t0 allows.
+        """
+        limits = {t.symbol: t for t in timing_table("3-7", bit_rate)}
+
+        def cycles(seconds: float) -> int:
+            return math.ceil(seconds * clock_hz - _EPSILON)
+
+        def minimum(symbol: str) -> float:
+            value = limits[symbol].minimum_s
+            assert value is not None
+            return value
+
+        def maximum(symbol: str) -> float:
+            value = limits[symbol].maximum_s
+            assert value is not None
+            return value
+
+        shortest = cycles(minimum("t0"))
+        period = shortest if sclk_hz is None else cycles(1 / sclk_hz)
+        if period < shortest:
+            raise UpifUsageError(f"SCLK {sclk_hz} Hz is faster than t0 = {minimum('t0') * 1e9:.0f} ns allows "
+                                 f"at {bit_rate} bit/s (Table 3-7)")
+        low = max(period - period // 2, cycles(minimum("t4")))
+        high = max(period - low, cycles(minimum("t5")))
+        return cls(low=low, high=high, lead=max(cycles(minimum("t1")), cycles(maximum("t7")) - low),
+                   trail=cycles(minimum("t2")), gap=cycles(maximum("t6") + minimum("t8")))
+
+    def aligned(self) -> MasterTiming:
+        """The same timing with ``lead``, ``trail`` and ``gap`` rounded up to whole half periods, so that every
+        edge of the µP falls on the grid that :func:`to_wavejson` samples (needs ``low == high``)."""
+        if self.low != self.high:
+            raise UpifUsageError(f"aligned timing needs a symmetric SCLK, not low {self.low} / high {self.high}")
+        half = self.low
+        return replace(self, lead=-(-self.lead // half) * half, trail=-(-self.trail // half) * half,
+                       gap=-(-self.gap // half) * half)
+
+
+@dataclass
+class Trace:
+    """Every pin of a stretch of consecutive chip-clock cycles, as a software µP and the chip drove them."""
+
+    mode: Mode
+    """The µP's interface type: the bit order on the wire (the initialization byte reads the same both ways)."""
+    timing: MasterTiming
+    clock_hz: int
+    bit_rate: int
+    first_cycle: int = 0
+    """The chip cycle of the first recorded cycle."""
+    inputs: list[PinsIn] = field(default_factory=list)
+    outputs: list[PinsOut] = field(default_factory=list)
+    mosi_oe: list[int] = field(default_factory=list)
+    """1 while the µP drives MFP6 (always in Motorola mode; in Intel mode while /SS is low and S/R = 1)."""
+
+    def __len__(self) -> int:
+        return len(self.inputs)
+
+    def window(self, start: int, stop: int | None = None) -> Trace:
+        """The cycles ``start`` to ``stop`` (indices into this trace) as a trace of their own."""
+        return replace(self, first_cycle=self.first_cycle + start, inputs=self.inputs[start:stop],
+                       outputs=self.outputs[start:stop], mosi_oe=self.mosi_oe[start:stop])
+
+    def mfp6_line(self, k: int) -> str:
+        """The level on MFP6 in cycle ``k``: ``"0"``/``"1"``, ``"z"`` if nobody drives, ``"x"`` if both do."""
+        chip, mosi = self.outputs[k].mfp6_oe, self.mosi_oe[k]
+        if chip and mosi:
+            return "x"
+        if chip:
+            return str(self.outputs[k].mfp6)
+        return str(self.inputs[k].mfp6) if mosi else "z"
+
+    def mfp7_line(self, k: int) -> str:
+        """The level on MFP7 in cycle ``k``: the chip's SerOUT (Motorola) or the µP's S/R (Intel)."""
+        if self.outputs[k].mfp7_oe:
+            return str(self.outputs[k].mfp7)
+        return str(self.inputs[k].mfp7) if self.mode is Mode.INTEL else "z"
+
+
+class SoftMaster:
+    """A software µP on the pins of :class:`SlavePins`, one chip clock at a time.
+
+    Parameters
+    ----------
+    chip:
+        The pin-level model it drives.
+    mode:
+        The µP's interface type (bit order: Intel LSB first, Motorola MSB first; UP-6).
+    timing:
+        Edge placement; default :meth:`MasterTiming.fastest` at the chip's bit rate.
+    record:
+        Keep every cycle's pins for :meth:`trace` (off for benchmarks).
+    """
+
+    def __init__(self, chip: SlavePins, mode: Mode, timing: MasterTiming | None = None, *,
+                 record: bool = True) -> None:
+        bit_rate = chip.registers.config.bit_rate
+        self.chip = chip
+        self.mode = mode
+        self.timing = timing or MasterTiming.fastest(bit_rate, clock_hz=chip.clock_hz)
+        self._pins = PinsIn()
+        self._mosi_oe = int(mode is Mode.MOTOROLA)
+        self._trace: Trace | None = (
+            Trace(mode, self.timing, chip.clock_hz, bit_rate, first_cycle=chip.cycle) if record else None
+        )
+
+    @property
+    def cycle(self) -> int:
+        """The chip cycle the next :meth:`run` starts with."""
+        return self.chip.cycle
+
+    def run(self, cycles: int, **changes: int) -> PinsOut:
+        """Apply ``changes`` (pin names of :class:`PinsIn`) and hold the pins for ``cycles`` >= 1 cycles; return
+        the outputs of the first of them (what the µP sees right at its edge)."""
+        self._pins = replace(self._pins, **changes)
+        outputs = [self.chip.tick(self._pins) for _ in range(cycles)]
+        if self._trace is not None:
+            self._trace.inputs.extend([self._pins] * cycles)
+            self._trace.outputs.extend(outputs)
+            self._trace.mosi_oe.extend([self._mosi_oe] * cycles)
+        return outputs[0]
+
+    def deselect(self, *, s_r: bool | None = None) -> None:
+        """/SS high (it rises now if it was low) for the gap between bytes; in Intel mode S/R takes ``s_r`` in
+        the same cycle (t10, t11) and the µP releases Ser_IN/OUT."""
+        self._mosi_oe = int(self.mode is Mode.MOTOROLA)
+        level = self._pins.mfp7 if s_r is None or self.mode is Mode.MOTOROLA else int(s_r)
+        self.run(self.timing.gap, ss_n=1, mfp7=level)
+
+    def byte(self, mosi: int = 0, *, s_r: bool = True) -> int | None:
+        """One byte: :meth:`deselect` (the gap), /SS low, 8 SCLK periods, SCLK high until /SS may rise.
+
+        /SS rises, and the chip processes the byte, at the start of the next byte's gap or of :meth:`deselect`.
+
+        Parameters
+        ----------
+        mosi:
+            The byte the µP shifts out: on SerIN in Motorola mode, on Ser_IN/OUT in Intel mode with ``s_r``.
+        s_r:
+            Intel mode: the S/R level (Table 3-9; ``False``: the µP receives and leaves Ser_IN/OUT to the chip).
+
+        Returns
+        -------
+        int | None
+            The byte the µP sampled from the chip at the rising edges (SerOUT, or Ser_IN/OUT with S/R = 0),
+            ``None`` if the chip did not drive at all eight.
+        """
+        t = self.timing
+        intel = self.mode is Mode.INTEL
+        sends = not intel or s_r
+        self.deselect(s_r=s_r)
+        self._mosi_oe = int(sends)
+        self.run(t.lead, ss_n=0)
+        received: int | None = 0
+        for i in range(8):
+            shift = i if self.mode.lsb_first else 7 - i
+            self.run(t.low, sclk=0, mfp6=(mosi >> shift) & 1 if sends else self._pins.mfp6)
+            out = self.run(1, sclk=1)
+            driven, bit = (out.mfp6_oe, out.mfp6) if intel else (out.mfp7_oe, out.mfp7)
+            received = received | bit << shift if driven and received is not None else None
+            rest = t.high if i < 7 else t.trail
+            if rest > 1:
+                self.run(rest - 1)
+        return received
+
+    def trace(self) -> Trace:
+        """Everything recorded since the master was made."""
+        if self._trace is None:
+            raise UpifUsageError("this master was made with record=False")
+        return self._trace
+
+
+# ------------------------------------------------------------------------------------------------------------
+# Reading a trace
+# ------------------------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class DecodedByte:
+    """One /SS low period of a trace, read from the pins alone."""
+
+    start: int
+    """Index of the first cycle with /SS low."""
+    stop: int
+    """Index of the cycle in which /SS rose."""
+    c_d: int
+    """C/D when /SS fell: what the chip expected (0 command or initialization byte, 1 data; UP-2)."""
+    s_r: int | None
+    """S/R when /SS fell (Intel mode), else ``None``."""
+    edges: int
+    """Rising SCLK edges while /SS was low (8 in a valid frame)."""
+    to_chip: int | None
+    """The byte on SerIN (Ser_IN/OUT driven by the µP) at the first eight rising edges, ``None`` if not driven."""
+    from_chip: int | None
+    """The byte the chip drove on SerOUT (Ser_IN/OUT) at those edges, ``None`` if it did not drive at all."""
+
+
+def _assemble(bits: Sequence[int | None], lsb_first: bool) -> int | None:
+    if len(bits) < 8 or None in bits[:8]:
+        return None
+    value = 0
+    for i, bit in enumerate(bits[:8]):
+        assert bit is not None
+        value |= bit << (i if lsb_first else 7 - i)
+    return value
+
+
+def decode_bytes(trace: Trace) -> list[DecodedByte]:
+    """Every complete /SS low period of ``trace`` (a /SS fall and the following rise), sampled at the rising
+    SCLK edges as the µP and the chip sample them (UP-5, UP-6)."""
+    intel = trace.mode is Mode.INTEL
+    found: list[DecodedByte] = []
+    start: int | None = None
+    rises: list[int] = []
+    for k in range(1, len(trace)):
+        prev, pins = trace.inputs[k - 1], trace.inputs[k]
+        if prev.ss_n and not pins.ss_n:
+            start, rises = k, []
+        elif start is not None and not pins.ss_n and pins.sclk and not prev.sclk:
+            rises.append(k)
+        elif start is not None and pins.ss_n and not prev.ss_n:
+            to_chip: list[int | None] = []
+            from_chip: list[int | None] = []
+            for r in rises:
+                out = trace.outputs[r]
+                chip_oe, chip_bit = (out.mfp6_oe, out.mfp6) if intel else (out.mfp7_oe, out.mfp7)
+                to_chip.append(trace.inputs[r].mfp6 if trace.mosi_oe[r] and not out.mfp6_oe else None)
+                from_chip.append(chip_bit if chip_oe else None)
+            found.append(DecodedByte(
+                start=start, stop=k, c_d=trace.outputs[start].c_d,
+                s_r=trace.inputs[start].mfp7 if intel else None, edges=len(rises),
+                to_chip=_assemble(to_chip, trace.mode.lsb_first),
+                from_chip=_assemble(from_chip, trace.mode.lsb_first),
+            ))
+            start = None
+    return found
+
+
+# ------------------------------------------------------------------------------------------------------------
+# VCD
+# ------------------------------------------------------------------------------------------------------------
+
+
+def write_vcd(trace: Trace, path: Path) -> Path:
+    """Write every pin of ``trace`` to ``path`` as a VCD (time step one 32 MHz clock, only changes written).
+
+    Scopes: ``upif.up`` the µP's pins (:data:`~supi3.spi.slave_pins.INPUT_PINS` plus ``mosi_oe``), ``upif.chip``
+    the chip's outputs and enables (:data:`~supi3.spi.slave_pins.OUTPUT_PINS`), ``upif.line`` the resolved
+    levels of MFP6 and MFP7 (``z`` undriven, ``x`` driven by both).
+    """
+    probes: list[tuple[str, str, Callable[[int], int | str]]] = [
+        *(("upif.up", name, lambda k, name=name: int(getattr(trace.inputs[k], name))) for name in INPUT_PINS),
+        ("upif.up", "mosi_oe", lambda k: trace.mosi_oe[k]),
+        *(("upif.chip", name, lambda k, name=name: int(getattr(trace.outputs[k], name))) for name in OUTPUT_PINS),
+        ("upif.line", "mfp6", trace.mfp6_line),
+        ("upif.line", "mfp7", trace.mfp7_line),
+    ]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with path.open("w", encoding="ascii") as stream, VCDWriter(stream, timescale="1 ps", date="") as writer:
+        variables = [(writer.register_var(scope, name, "wire", size=1, init=probe(0)), probe)
+                     for scope, name, probe in probes]
+        last = [probe(0) for _, probe in variables]
+        for k in range(1, len(trace)):
+            for i, (var, probe) in enumerate(variables):
+                value = probe(k)
+                if value != last[i]:
+                    writer.change(var, k * CLOCK_PS, value)
+                    last[i] = value
+    return path
+
+
+# ------------------------------------------------------------------------------------------------------------
+# WaveJSON and SVG
+# ------------------------------------------------------------------------------------------------------------
+
+
+def _lanes(trace: Trace) -> list[tuple[str, Callable[[int], str]]]:
+    ss_sclk: list[tuple[str, Callable[[int], str]]] = [
+        ("/SS (MFP5)", lambda k: str(trace.inputs[k].ss_n)),
+        ("SCLK (MFP4)", lambda k: str(trace.inputs[k].sclk)),
+    ]
+    c_d: tuple[str, Callable[[int], str]] = ("C/D (MFP2)", lambda k: str(trace.outputs[k].c_d))
+    if trace.mode is Mode.INTEL:
+        return [*ss_sclk, ("S/R (MFP7)", trace.mfp7_line), ("Ser_IN/OUT (MFP6)", trace.mfp6_line), c_d]
+    return [*ss_sclk, ("SerIN (MFP6)", trace.mfp6_line), ("SerOUT (MFP7)", trace.mfp7_line), c_d]
+
+
+def _wave(keys: Sequence[object], data_key: Callable[[object], bool]) -> str:
+    """WaveJSON wave string of one lane: a key per column, ``.`` where it repeats, ``=`` for a data segment."""
+    chars: list[str] = []
+    previous: object = None
+    for key in keys:
+        if key == previous:
+            chars.append(".")
+        else:
+            chars.append("=" if data_key(key) else str(key))
+        previous = key
+    return "".join(chars)
+
+
+def to_wavejson(trace: Trace, title: str, *, step: int | None = None) -> dict[str, object]:
+    """The WaveJSON of ``trace``: one column per ``step`` cycles (default half an SCLK period), each showing
+    the pins in the first cycle of its window, plus two lanes with the bytes :func:`decode_bytes` reads.
+
+    With :meth:`MasterTiming.aligned` every edge of the µP starts a column; the chip's outputs (2 TCLK + 1
+    clock after their cause, UP-14) then show one column after it as long as that is less than ``step``.
+    """
+    step = step or trace.timing.low
+    columns = range(0, len(trace), step)
+    signal: list[object] = []
+    for name, level in _lanes(trace):
+        signal.append({"name": name, "wave": _wave([level(k) for k in columns], lambda _: False)})
+    frames = decode_bytes(trace)
+    for name, attribute in (("µP → chip", "to_chip"), ("chip → µP", "from_chip")):
+        keys: list[object] = []
+        for k in columns:
+            hit = next((i for i, f in enumerate(frames) if f.start <= k < f.stop and getattr(f, attribute) is not None),
+                       None)
+            keys.append("z" if hit is None else hit)
+        labels = [f"{getattr(frames[i], attribute):02X}h" for i in dict.fromkeys(keys) if isinstance(i, int)]
+        signal.append({"name": name, "wave": _wave(keys, lambda key: isinstance(key, int)), "data": labels})
+    t = trace.timing
+    sclk_mhz = trace.clock_hz / t.period / 1e6
+    foot = (f"SUPI 3 model trace ({trace.mode.name.capitalize()}, {trace.bit_rate // 1000} kbit/s, SCLK "
+            f"{sclk_mhz:.2f} MHz); one column = {step} chip clocks = {step * 1e9 / trace.clock_hz:.2f} ns")
+    return {"signal": signal, "head": {"text": title}, "foot": {"text": foot}}
+
+
+def render_svg(wavejson: dict[str, object]) -> str:
+    """Render WaveJSON to SVG text with the ``wavedrom`` package."""
+    return str(wavedrom.render(json.dumps(wavejson)).tostring())
+
+
+# ------------------------------------------------------------------------------------------------------------
+# The manual's figures, redrawn from model traces
+# ------------------------------------------------------------------------------------------------------------
+
+FIGURE_STRAPS: Final[tuple[str, str]] = ("10011", "1110")
+"""C4..0 and MFP15..12 of the figures' chip: remote bus device, Init-µP, 500 kbit/s (``docs/upif.md``)."""
+SET_1_BYTE: Final[int] = 0x82
+"""The SET value of Fig. 3-10: an I/O device with one byte (``decode_set(0x82)``, Table 3-12)."""
+SET_3_BYTES: Final[int] = 0x84
+"""SET for the 24-bit output device of Fig. 3-12 (``decode_set(0x84)``: 3 bytes)."""
+ID_DIGITAL_OUTPUT: Final[int] = 0x01
+"""The ID code of Fig. 3-11: digital output device."""
+BLOCK_OUT_DATA: Final[bytes] = b"\x14\x56\x78"
+"""The OUT data read in Fig. 3-12."""
+EXAMPLE_OUT: Final[int] = 0xC3
+"""OUT0 and IN0 data of the one-byte figures 3-4 and 3-5 (any byte; not the manual's)."""
+EXAMPLE_IN: Final[int] = 0x5A
+
+_SET = REGISTER_MAP.register("SET").address
+_ID = REGISTER_MAP.register("ID").address
+_DATA0 = REGISTER_MAP.register("IN0").address
+
+
+@dataclass(frozen=True)
+class Figure:
+    """One of the manual's serial-interface figures and the scenario that redraws it."""
+
+    name: str
+    """File stem under ``docs/figures``."""
+    manual: str
+    """The manual's figure number and caption."""
+    description: str
+    """What the redrawn figure shows."""
+    build: Callable[[], Trace]
+    """Runs the scenario on a fresh chip and returns the trace of the bytes the figure shows."""
+
+
+class _Scenario:
+    """A fresh chip at :data:`FIGURE_STRAPS` and a µP with aligned fastest timing; bytes before :meth:`show`
+    set the chip up, bytes after it are the figure."""
+
+    def __init__(self, mode: Mode) -> None:
+        chip = SlavePins(RegisterFile(decode(*FIGURE_STRAPS)))
+        timing = MasterTiming.fastest(chip.registers.config.bit_rate, clock_hz=chip.clock_hz).aligned()
+        self.master = SoftMaster(chip, mode, timing)
+        self.start = 0
+
+    def show(self) -> None:
+        """The figure starts here: once the chip's outputs settled after the set-up bytes, with one idle gap."""
+        self.master.deselect()
+        self.start = len(self.master.trace())
+        self.master.deselect()
+
+    def trace(self) -> Trace:
+        """The figure's cycles, ending one idle gap after C/D settled after its last byte."""
+        self.master.deselect()
+        self.master.deselect()
+        return self.master.trace().window(self.start)
+
+
+def _intel_configured(set_value: int) -> _Scenario:
+    """Intel initialization and a SET write (Figs. 3-9, 3-10) as the set-up."""
+    scenario = _Scenario(Mode.INTEL)
+    m = scenario.master
+    m.byte(Mode.INTEL.init_byte)
+    m.byte(encode_command(_SET, wr=True))
+    m.byte(set_value)
+    m.deselect()
+    return scenario
+
+
+def _figure_3_4() -> Trace:
+    scenario = _Scenario(Mode.MOTOROLA)
+    m = scenario.master
+    m.byte(Mode.MOTOROLA.init_byte)
+    m.byte(encode_command(_SET, wr=True))
+    m.byte(SET_1_BYTE)
+    m.deselect()
+    m.chip.registers.latch(bytes([EXAMPLE_OUT]))
+    m.byte(encode_command(_DATA0, rd=True, wr=True))
+    scenario.show()
+    m.byte(EXAMPLE_IN)
+    return scenario.trace()
+
+
+def _figure_3_5() -> Trace:
+    scenario = _intel_configured(SET_1_BYTE)
+    m = scenario.master
+    m.chip.registers.latch(bytes([EXAMPLE_OUT]))
+    m.byte(encode_command(_DATA0, rd=True))
+    scenario.show()
+    m.byte(s_r=False)
+    return scenario.trace()
+
+
+def _figure_3_9() -> Trace:
+    scenario = _Scenario(Mode.INTEL)
+    scenario.show()
+    scenario.master.byte(Mode.INTEL.init_byte)
+    return scenario.trace()
+
+
+def _figure_3_10() -> Trace:
+    scenario = _Scenario(Mode.INTEL)
+    m = scenario.master
+    m.byte(Mode.INTEL.init_byte)
+    scenario.show()
+    m.byte(encode_command(_SET, wr=True))
+    m.byte(SET_1_BYTE)
+    return scenario.trace()
+
+
+def _figure_3_11() -> Trace:
+    scenario = _intel_configured(SET_1_BYTE)
+    scenario.show()
+    scenario.master.byte(encode_command(_ID, wr=True))
+    scenario.master.byte(ID_DIGITAL_OUTPUT)
+    return scenario.trace()
+
+
+def _figure_3_12() -> Trace:
+    scenario = _intel_configured(SET_3_BYTES)
+    m = scenario.master
+    m.chip.registers.latch(BLOCK_OUT_DATA)
+    scenario.show()
+    m.byte(encode_command(BLOCK_ADDRESS, rd=True))
+    for _ in BLOCK_OUT_DATA:
+        m.byte(s_r=False)
+    return scenario.trace()
+
+
+FIGURES: Final[tuple[Figure, ...]] = (
+    Figure("fig3-4", "Figure 3-4 Timing of the synchronous serial interface (Motorola)",
+           "One full-duplex data byte (command C0h before it): SerIN carries 5Ah MSB first into IN0 while SerOUT "
+           "drives OUT0 = C3h; SerOUT is tri-state while /SS is high; C/D returns from data to command.",
+           _figure_3_4),
+    Figure("fig3-5", "Figure 3-5 Timing of the synchronous serial interface (Intel)",
+           "One read data byte (command 80h before it): S/R = 0, the chip drives Ser_IN/OUT with OUT0 = C3h LSB "
+           "first, released when /SS rises; C/D returns from data to command.",
+           _figure_3_5),
+    Figure("fig3-9", "Figure 3-9 Initialization byte timing (81hex)",
+           "The Intel initialization byte 81h after power-up: C/D shows command before and after it (the "
+           "first-initialization signature of 3.4.3).",
+           _figure_3_9),
+    Figure("fig3-10", "Figure 3-10 Timing access to the SET register (address and data)",
+           "Command 4Dh (write address 13), C/D goes to data, then 82h (I/O device, one byte), C/D back to command.",
+           _figure_3_10),
+    Figure("fig3-11", "Figure 3-11 Timing access to the ID code register (address and data)",
+           "Command 4Ch (write address 12), then the ID code 01h (digital output device).",
+           _figure_3_11),
+    Figure("fig3-12", "Figure 3-12 Command and data access during block transfer",
+           "Intel block transfer on a 24-bit output device: command 8Fh (S/R = 1), then three reads (S/R = 0) of "
+           "OUT bytes 14h 56h 78h; C/D stays data until the last byte.",
+           _figure_3_12),
+)
+"""The redrawn figures, in the manual's order."""
+
+
+def write_figures(out: Path, *, vcd: bool = False) -> list[Path]:
+    """Write ``<name>.json`` (WaveJSON) and ``<name>.svg`` for every figure of :data:`FIGURES` into ``out``, and
+    ``<name>.vcd`` too if ``vcd``; return the paths written."""
+    out.mkdir(parents=True, exist_ok=True)
+    written: list[Path] = []
+    for figure in FIGURES:
+        trace = figure.build()
+        wavejson = to_wavejson(trace, f"{figure.manual} (redrawn from the model)")
+        json_path = out / f"{figure.name}.json"
+        json_path.write_text(json.dumps(wavejson, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
+        svg_path = out / f"{figure.name}.svg"
+        svg_path.write_text(render_svg(wavejson) + "\n", encoding="utf-8")
+        written += [json_path, svg_path]
+        if vcd:
+            written.append(write_vcd(trace, out / f"{figure.name}.vcd"))
+    return written
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    """``python -m supi3.spi.waves --out docs/figures [--vcd]``."""
+    parser = argparse.ArgumentParser(description="Redraw the manual's serial µP interface figures from model "
+                                     "traces (WaveJSON, SVG, optionally VCD).")
+    parser.add_argument("--out", type=Path, default=Path("docs/figures"), help="output directory")
+    parser.add_argument("--vcd", action="store_true", help="also write a VCD per figure")
+    args = parser.parse_args(argv)
+    for path in write_figures(args.out, vcd=args.vcd):
+        print(path)
+
+
+if __name__ == "__main__":
+    main()
