@@ -203,16 +203,16 @@ class SoftMaster:
         """The chip cycle the next :meth:`run` starts with."""
         return self.chip.cycle
 
-    def run(self, cycles: int, **changes: int) -> PinsOut:
-        """Apply ``changes`` (pin names of :class:`PinsIn`) and hold the pins for ``cycles`` >= 1 cycles; return
-        the outputs of the first of them (what the µP sees right at its edge)."""
+    def run(self, cycles: int, **changes: int) -> list[PinsOut]:
+        """Apply ``changes`` (pin names of :class:`PinsIn`) and hold the pins for ``cycles`` cycles; return the
+        outputs of those cycles (the first is what the µP sees right at its edge)."""
         self._pins = replace(self._pins, **changes)
         outputs = [self.chip.tick(self._pins) for _ in range(cycles)]
         if self._trace is not None:
             self._trace.inputs.extend([self._pins] * cycles)
             self._trace.outputs.extend(outputs)
             self._trace.mosi_oe.extend([self._mosi_oe] * cycles)
-        return outputs[0]
+        return outputs
 
     def deselect(self, *, s_r: bool | None = None) -> None:
         """/SS high (it rises now if it was low) for the gap between bytes; in Intel mode S/R takes ``s_r`` in
@@ -249,12 +249,10 @@ class SoftMaster:
         for i in range(8):
             shift = i if self.mode.lsb_first else 7 - i
             self.run(t.low, sclk=0, mfp6=(mosi >> shift) & 1 if sends else self._pins.mfp6)
-            out = self.run(1, sclk=1)
+            [out] = self.run(1, sclk=1)
             driven, bit = (out.mfp6_oe, out.mfp6) if intel else (out.mfp7_oe, out.mfp7)
             received = received | bit << shift if driven and received is not None else None
-            rest = t.high if i < 7 else t.trail
-            if rest > 1:
-                self.run(rest - 1)
+            self.run((t.high if i < 7 else t.trail) - 1)
         return received
 
     def trace(self) -> Trace:
