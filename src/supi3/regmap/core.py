@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from enum import StrEnum
+from functools import cached_property
 from typing import Final
 
 from supi3.errors import Supi3Error
@@ -127,12 +128,12 @@ class Field:
                     f"field {self.name}: value {enumerator.name} = {enumerator.value} needs more than {self.width} bits"
                 )
 
-    @property
+    @cached_property
     def msb(self) -> int:
         """Position of the most significant bit."""
         return self.lsb + self.width - 1
 
-    @property
+    @cached_property
     def mask(self) -> int:
         """The field's bits in position."""
         return ((1 << self.width) - 1) << self.lsb
@@ -188,12 +189,12 @@ class Layout:
             if f.overlays is not None and (self.field(f.overlays).mask & f.mask) != f.mask:
                 raise RegisterMapError(f"{self.name}: field {f.name} is not inside {f.overlays}")
 
-    @property
+    @cached_property
     def base_fields(self) -> tuple[Field, ...]:
         """The fields that partition the byte (every field that overlays no other)."""
         return tuple(f for f in self.fields if f.overlays is None)
 
-    @property
+    @cached_property
     def mask(self) -> int:
         """The bits that carry a field; the others are reserved (write 0, read 0)."""
         result = 0

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from functools import cache
 from typing import Final
 
 from supi3.regmap.core import (
@@ -366,6 +367,7 @@ class Command:
         return REGISTER_MAP.port(self.address, Direction.WRITE).access is Access.BLOCK_TRANSFER
 
 
+@cache  # a pure function of 64 possible arguments, on the µP interface's hot path
 def encode_command(address: int, *, rd: bool = False, wr: bool = False) -> int:
     """Build a command byte: ``encode_command(13, wr=True) == 0x4D`` (Fig. 3-10).
 
@@ -377,6 +379,7 @@ def encode_command(address: int, *, rd: bool = False, wr: bool = False) -> int:
     return COMMAND_BYTE.encode(RD=int(rd), WR=int(wr), A=address)
 
 
+@cache  # a pure function of a byte, on the µP interface's hot path
 def decode_command(byte: int) -> Command:
     """Split a command byte into RD, WR and the address A3..0 (3.4.4).
 
