@@ -145,6 +145,7 @@ class Supi3Core(wiring.Component):
                     ]
         cycle = Signal(max(*IB_DIAG_DIVIDER_BITS.values(), *(_width(e.clocks_per_bit) for e in clocks)))
         m.d.sync += cycle.eq(cycle + 1)
+
         def clock(entry: ClockEntry) -> list[Value]:
             cpb_bits = entry.clocks_per_bit.bit_length() - 1
             if entry.clocks_per_bit != 1 << cpb_bits:
@@ -171,8 +172,7 @@ class Supi3Core(wiring.Component):
         synced: dict[str, Value] = {}
         for pin, idle in zip(Supi3Pins.inputs, _IDLE_INPUTS, strict=True):
             stages = [Signal(pin.width, init=idle, name=f"{pin.name}_s{k}") for k in range(SYNC_STAGES)]
-            m.d.sync += [stages[0].eq(getattr(self, pin.name)),
-                         *(b.eq(a) for a, b in pairwise(stages))]
+            m.d.sync += [stages[0].eq(getattr(self, pin.name)), *(b.eq(a) for a, b in pairwise(stages))]
             synced[pin.name] = stages[-1]
         power_fail = ~(synced["resu_n"] & synced["vmon_ok"])
         holding = Signal()
@@ -185,8 +185,17 @@ class Supi3Core(wiring.Component):
             m.d.sync += stretch.eq(stretch - 1)
         running = ~power_fail & ~holding & (stretch == 0)
 
-        engine = _Engine(tables, id_register=id_register, data_bytes=data_bytes, io_map=io_map, cpb=cpb,
-                         reset_run=reset_run, tx_init=tx_init, rbst_by_pin=rbst_by_pin, synced=synced)
+        engine = _Engine(
+            tables,
+            id_register=id_register,
+            data_bytes=data_bytes,
+            io_map=io_map,
+            cpb=cpb,
+            reset_run=reset_run,
+            tx_init=tx_init,
+            rbst_by_pin=rbst_by_pin,
+            synced=synced,
+        )
         m.submodules.engine = ResetInserter(power_fail)(EnableInserter(running)(engine))
 
         pf, bus_active = engine.pf, engine.bus_active
@@ -216,8 +225,19 @@ class _Engine(Elaboratable):
     follows the model's order within one clock, later assignments winning as later Python assignments do.
     """
 
-    def __init__(self, tables: CoreTables, *, id_register: Value, data_bytes: Value, io_map: Value, cpb: Value,
-                 reset_run: Value, tx_init: Value, rbst_by_pin: Value, synced: dict[str, Value]) -> None:
+    def __init__(
+        self,
+        tables: CoreTables,
+        *,
+        id_register: Value,
+        data_bytes: Value,
+        io_map: Value,
+        cpb: Value,
+        reset_run: Value,
+        tx_init: Value,
+        rbst_by_pin: Value,
+        synced: dict[str, Value],
+    ) -> None:
         self.tables = tables
         self.id_register = id_register
         self.data_bytes = data_bytes
@@ -314,8 +334,15 @@ class _Engine(Elaboratable):
 
         def chip_reset() -> list[Value]:
             """chip.reset_at: process data cleared, watchdog off, WD and TE cleared (3.4.7, Table 3-13)."""
-            return [mfp_out.eq(0), wd_code.eq(_WD_OFF), wd_active.eq(0), wd.eq(0), te.eq(0),
-                    attention.eq(pf_now), bus_active.eq(0)]
+            return [
+                mfp_out.eq(0),
+                wd_code.eq(_WD_OFF),
+                wd_active.eq(0),
+                wd.eq(0),
+                te.eq(0),
+                attention.eq(pf_now),
+                bus_active.eq(0),
+            ]
 
         with m.If(enter_reset):
             sync += [in_reset.eq(1), reset_end.eq(0), state.eq(_State.IDLE), latches.eq(0), *chip_reset()]
@@ -365,12 +392,16 @@ class _Engine(Elaboratable):
         crc_bad = Signal()
         cntr_bad = Signal()
         err_bit = Signal()
-        pairs = [tuple(sorted(p)) for p in ((wire.CNTR_ATTN_BIT, wire.CNTR_NATTN_BIT),
-                                            (wire.CNTR_NERR_BIT, wire.CNTR_ERR_BIT))]
+        pairs = [
+            tuple(sorted(p))
+            for p in ((wire.CNTR_ATTN_BIT, wire.CNTR_NATTN_BIT), (wire.CNTR_NERR_BIT, wire.CNTR_ERR_BIT))
+        ]
         firsts = [Signal(name=f"cntr_pair{k}") for k in range(len(pairs))]
         paired = {b for p in pairs for b in p}
-        if (wire.CNTR_NERR_BIT, wire.CNTR_ERR_BIT) != (WORD_BITS - 2, WORD_BITS - 1) or wire.CNTR_ATTN_BIT > \
-                wire.CNTR_NATTN_BIT:
+        if (wire.CNTR_NERR_BIT, wire.CNTR_ERR_BIT) != (
+            WORD_BITS - 2,
+            WORD_BITS - 1,
+        ) or wire.CNTR_ATTN_BIT > wire.CNTR_NATTN_BIT:
             raise ValueError("the model settles the ERR pair as the last two CNTR bits, after ATTN and /ATTN")
 
         register_bytes = Mux(id_cycle, WORD_BITS // 8, self.data_bytes)
@@ -389,8 +420,12 @@ class _Engine(Elaboratable):
 
         te_now = te | ((state != _State.IDLE) & local_error)
         id_word = Signal(WORD_BITS)
-        comb += id_word.eq(self.id_register | (pf_now << wire.MGMT_PF_BIT) | (wd_now << wire.MGMT_WD_BIT)
-                           | (te_now << wire.MGMT_TE_BIT))
+        comb += id_word.eq(
+            self.id_register
+            | (pf_now << wire.MGMT_PF_BIT)
+            | (wd_now << wire.MGMT_WD_BIT)
+            | (te_now << wire.MGMT_TE_BIT)
+        )
         in_word = Signal(reg_bits)
         mfp_s = s["mfp_in"]
         with m.Switch(self.io_map):
@@ -404,9 +439,17 @@ class _Engine(Elaboratable):
             cycle_id = select == wire.SELECT_ID_LEVEL
             check = line == wire.CONTROL_CHECK_LEVEL
             with m.If(~check & (state != _State.DATA)):
-                sync += [*abandon(), state.eq(_State.DATA), id_cycle.eq(cycle_id),
-                         register.eq(Mux(cycle_id, id_word, in_word)), crc_rx.eq(wire.CRC_INIT),
-                         crc_tx.eq(wire.CRC_INIT), local_error.eq(0), err_in.eq(0), latches.eq(0)]
+                sync += [
+                    *abandon(),
+                    state.eq(_State.DATA),
+                    id_cycle.eq(cycle_id),
+                    register.eq(Mux(cycle_id, id_word, in_word)),
+                    crc_rx.eq(wire.CRC_INIT),
+                    crc_tx.eq(wire.CRC_INIT),
+                    local_error.eq(0),
+                    err_in.eq(0),
+                    latches.eq(0),
+                ]
             with m.Elif(cycle_id != id_cycle):
                 sync += error()
             with m.If(check):
@@ -414,8 +457,7 @@ class _Engine(Elaboratable):
                     sync += [state.eq(_State.CHECK), index.eq(0), crc_bad.eq(0), cntr_bad.eq(0)]
                 with m.Elif(state == _State.CHECK):
                     sync += index.eq(index + 1)
-                with m.If(~((state == _State.DATA) | ((state == _State.CHECK)
-                                                       & (index + 1 < wire.CHECK_TELEGRAMS)))):
+                with m.If(~((state == _State.DATA) | ((state == _State.CHECK) & (index + 1 < wire.CHECK_TELEGRAMS)))):
                     sync += error()
         with m.Elif(frame_bit & data_field & (state == _State.DATA)):
             comb += out.eq(shift_out)
@@ -460,8 +502,10 @@ class _Engine(Elaboratable):
         with m.If(sample):
             sync += [countdown[0].eq(self.tx_init), level[0].eq(out)]
             for k in range(1, slots):
-                sync += [countdown[k].eq(Mux(countdown[k - 1] != 0, countdown[k - 1] - 1, 0)),
-                         level[k].eq(level[k - 1])]
+                sync += [
+                    countdown[k].eq(Mux(countdown[k - 1] != 0, countdown[k - 1] - 1, 0)),
+                    level[k].eq(level[k - 1]),
+                ]
         do2 = Const(wire.IDLE_LEVEL)
         for r, v in reversed(list(zip(countdown, level, strict=True))):
             do2 = Mux(r <= self.cpb, Mux(r != 0, v, wire.IDLE_LEVEL), do2)
@@ -475,8 +519,13 @@ class _Engine(Elaboratable):
             with m.If((state == _State.CHECK) & (index == wire.CHECK_TELEGRAMS - 1) & data_now & ~in_reset_now):
                 error_now = local_error | stop_bad | crc_bad | cntr_bad
                 err = error_now | cntr_bad | err_bit
-                sync += [local_error.eq(error_now), err_in.eq(cntr_bad | err_bit), state.eq(_State.WAIT),
-                         level[1].eq(err), level[2].eq(~err)]
+                sync += [
+                    local_error.eq(error_now),
+                    err_in.eq(cntr_bad | err_bit),
+                    state.eq(_State.WAIT),
+                    level[1].eq(err),
+                    level[2].eq(~err),
+                ]
             with m.If(~stop_bad & ~data_now):
                 with m.If(in_reset_now):
                     sync += reset_end.eq(reset_end + 1)
@@ -504,8 +553,9 @@ class _Engine(Elaboratable):
                             with m.Switch(self.io_map):
                                 for k, (_, out_bits) in enumerate(tables.io_maps):
                                     with m.Case(k):
-                                        sync += mfp_out.eq(Cat(*(register[b] if b is not None else Const(0)
-                                                                 for b in out_bits)))
+                                        sync += mfp_out.eq(
+                                            Cat(*(register[b] if b is not None else Const(0) for b in out_bits))
+                                        )
         return m
 
 
