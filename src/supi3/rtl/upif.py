@@ -1,0 +1,430 @@
+"""The serial µP interface of the SUPI 3 OPC in Amaranth: SPI slave / Intel synchronous serial and register file.
+
+Ref: IBS SUPI 3 OPC UM E rev. 05, 3.4 to 3.4.14, Tables 3-5 to 3-13; ``docs/upif.md`` ("Pin level: cycle-exact
+specification" and "RTL"). The block matches :class:`supi3.spi.block_pins.UpifBlockPins` (that is,
+:class:`~supi3.spi.slave_pins.SlavePins`, :class:`~supi3.spi.upif.UpifProtocol` and
+:class:`~supi3.model.registers.RegisterFile`) on every port on every 32 MHz clock. Its ports are the model's:
+the µP pins, the straps (bit rate, µP_Not_Ready code) and the register file's core interface.
+
+Nothing is typed in: register addresses, access kinds, masks, reset values and reset classes come from
+:data:`supi3.regmap.REGISTER_MAP`; the SET decoding is tabulated from :func:`supi3.regmap.decode_set`; the output
+delay per bit rate and the outputs after reset are read off the model (:func:`supi3.spi.block_pins.block_model`).
+
+One clock edge does what the model does between two ticks, in the same order (UP-13, UP-14, ``docs/upif.md``):
+
+1. the core's inputs update the registers (latch, processor command, events, optical registers, INTERBUS reset);
+2. the µP pins act on the synchronised edges: SAS_INIT, /SS falling (``begin``: the byte to send, reads and their
+   side effects), SCLK rising (shift in), /SS rising (``end``: the received byte, writes);
+3. the outputs are decoded from the new state and delayed by the bit rate's output pipeline.
+
+``power_up`` resets everything at the edge, like the ``sync`` reset.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from functools import cache
+from typing import Final
+
+from amaranth.back import verilog as amaranth_verilog
+from amaranth.hdl import Array, Cat, Const, Elaboratable, Module, Mux, ResetInserter, Signal, Value
+from amaranth.lib import enum, wiring
+from amaranth.lib.wiring import In, Out
+
+from supi3.regmap import (
+    COMMAND_BYTE,
+    INTERRUPT_SOURCES,
+    REGISTER_MAP,
+    Access,
+    Direction,
+    RegisterMapError,
+    Reset,
+    decode_set,
+)
+from supi3.regmap.core import BYTE_BITS, BYTE_MASK
+from supi3.regmap.registers import IN_BYTES, IO_ACCESS_BIT, OUT_BYTES
+from supi3.spi.block_pins import DATA_BYTES, OPTICAL_REGISTERS, UpifBlockPins, block_model
+from supi3.spi.slave_pins import PinsIn, PinsOut
+from supi3.spi.upif import C_D_COMMAND, C_D_DATA, Mode, Phase
+from supi3.tables import BIT_RATES, LENGTH_CODE_BY_VALUE
+from supi3.verif.pinmodel import OE_SUFFIX
+
+__all__ = ["UpifBlock", "UpifTables", "upif_tables", "verilog"]
+
+_SET = REGISTER_MAP.register("SET")
+_LENGTH_CODE = _SET.field("LENGTH_CODE")
+_EXTREG = _SET.field("EXTREG")
+_PCP_N = _SET.field("PCP_N")
+_RD = COMMAND_BYTE.field("RD")
+_WR = COMMAND_BYTE.field("WR")
+_ADDRESS = COMMAND_BYTE.field("A")
+_READ_PORTS: Final = {a: REGISTER_MAP.port(a, Direction.READ) for a in REGISTER_MAP.addresses}
+_WRITE_PORTS: Final = {a: REGISTER_MAP.port(a, Direction.WRITE) for a in REGISTER_MAP.addresses}
+_BLOCK_ADDRESSES: Final = tuple(a for a, port in _WRITE_PORTS.items() if port.access is Access.BLOCK_TRANSFER)
+"""A3..0 that start a block transfer (3.4.6: 15)."""
+_IRQ_EVT = REGISTER_MAP.register("IRQ_EVT")
+_IRQ_EN = REGISTER_MAP.register("IRQ_EN")
+_SOURCE_BIT: Final[dict[str, int]] = {source.name: source.bit for source in INTERRUPT_SOURCES}
+_PCP_ERASED: Final[tuple[int, ...]] = (0, 1)
+"""IN bytes erased after their transfer in a PCP device (3.4.11; ``RegisterFile.latch``)."""
+_BIT_COUNT_LIMIT: Final[int] = BYTE_BITS + 1
+"""The SCLK edge counter saturates here: the model only asks for 8, below 8, and more than 8 (3.4.2, UP-7)."""
+
+Phase_ = enum.Enum("Phase_", {phase.name: index for index, phase in enumerate(Phase)})  # type: ignore[misc]
+"""The protocol phases of :class:`~supi3.spi.upif.Phase` as an Amaranth enumeration."""
+
+
+@dataclass(frozen=True)
+class UpifTables:
+    """What the RTL reads off the model and the register map at elaboration.
+
+    Attributes
+    ----------
+    output_delay:
+        Output pipeline stages per bit rate, in :data:`~supi3.tables.BIT_RATES` order (UP-14).
+    reset_outputs:
+        The pin outputs after a power-up reset (the pipeline's initial contents).
+    set_codes:
+        For each applicable (ExtReg, ID12..8 field) of a SET value: the complete length code applied; SET values
+        missing here (reserved codes) are stored but not applied (Tables 3-11, 3-12; UP-20).
+    internal_bytes:
+        For each length code applicable with ExtReg = 0: the data bytes of the internal data path (3.4.8).
+    """
+
+    output_delay: tuple[int, ...]
+    reset_outputs: PinsOut
+    set_codes: dict[tuple[int, int], int]
+    internal_bytes: dict[int, int]
+
+
+@cache
+def upif_tables() -> UpifTables:
+    """The elaboration tables (see :class:`UpifTables`)."""
+    models = [block_model(rate) for rate in BIT_RATES]
+    reset_outputs = models[0].tick(PinsIn())
+    set_codes: dict[tuple[int, int], int] = {}
+    for extreg in range(1 << _EXTREG.width):
+        for low in range(1 << _LENGTH_CODE.width):
+            try:
+                config = decode_set(_SET.encode(EXTREG=extreg, LENGTH_CODE=low))
+            except RegisterMapError:
+                continue
+            if config.length.bits is not None:
+                set_codes[(extreg, low)] = int(config.length.code, 2)
+    internal_bytes = {}
+    for (extreg, _), code in set_codes.items():
+        bits = LENGTH_CODE_BY_VALUE[code].bits
+        if not extreg and bits is not None:
+            internal_bytes[code] = (bits + BYTE_BITS - 1) // BYTE_BITS
+    return UpifTables(tuple(model.output_delay for model in models), reset_outputs, set_codes, internal_bytes)
+
+
+class _Sync:
+    """A 2-flop synchroniser plus the edge-detect flop, reset to the pin's idle level (UP-13)."""
+
+    def __init__(self, m: Module, name: str, pin: Value, idle: int) -> None:
+        self.s1 = Signal(name=f"{name}_s1", init=idle)
+        self.s2 = Signal(name=f"{name}_s2", init=idle)
+        self.s3 = Signal(name=f"{name}_s3", init=idle)
+        m.d.sync += [self.s1.eq(pin), self.s2.eq(self.s1), self.s3.eq(self.s2)]
+
+    @property
+    def rose(self) -> Value:
+        return self.s2 & ~self.s3
+
+    @property
+    def fell(self) -> Value:
+        return ~self.s2 & self.s3
+
+
+class UpifBlock(wiring.Component):
+    """The serial µP interface block with the ports of :class:`~supi3.spi.block_pins.UpifBlockPins`.
+
+    Every input pin of the model is an ``In`` port of the same name and width; every output an ``Out`` port, a
+    tri-state output with its ``<name>_oe``. The straps (``rate``, ``np_id``, ``np_length``) must be static.
+    """
+
+    def __init__(self) -> None:
+        members: dict[str, object] = {pin.name: In(pin.width) for pin in UpifBlockPins.inputs}
+        for pin in UpifBlockPins.outputs:
+            members[pin.name] = Out(pin.width)
+            if pin.tristate:
+                members[pin.name + OE_SUFFIX] = Out(1)
+        super().__init__(members)
+
+    def elaborate(self, _platform: object) -> Elaboratable:
+        m = Module()
+        _Builder(m, self, upif_tables()).build()
+        top = Module()
+        top.submodules.upif = ResetInserter({"sync": self.power_up})(m)
+        return top
+
+
+class _Builder:
+    """The logic of one :class:`UpifBlock`, section by section (the module docstring's steps)."""
+
+    def __init__(self, m: Module, block: UpifBlock, tables: UpifTables) -> None:
+        self.m = m
+        self.b = block
+        self.tables = tables
+        self.regs = {r.name: Signal(BYTE_BITS, name=r.name.lower(), init=r.reset) for r in REGISTER_MAP.registers}
+        """The registers as stored (at the start of the cycle)."""
+        self.core = {name: Signal(BYTE_BITS, name=f"{name.lower()}_core") for name in self.regs}
+        """The registers after the core's inputs of this edge: what a read at this edge sees."""
+        self.io = Signal()
+        self.configured, self.cfg_extreg, self.cfg_pcp_n = Signal(), Signal(), Signal()
+        self.cfg_code = Signal(_LENGTH_CODE.width)
+        self.n_bytes = Signal(range(DATA_BYTES + 1))
+        """Data bytes of the internal data path: 0 before SET and with ExtReg = 1 (``data_bytes()`` gated by
+        ``internal_data_path``)."""
+        self.pcp_device = Signal()
+        # Protocol (UpifProtocol) and frame (SlavePins) state.
+        self.phase = Signal(Phase_, init=Phase_.INIT)
+        self.motorola, self.intel = Signal(), Signal()
+        self.cmd_rd, self.cmd_wr = Signal(), Signal()
+        self.cmd_addr = Signal(_ADDRESS.width)
+        self.last_rx = Signal(BYTE_BITS)
+        self.blk_addr = Signal(range(DATA_BYTES))
+        self.blk_rd, self.blk_wr, self.blk_then_wr = Signal(), Signal(), Signal()
+        self.in_frame, self.frame_s_r, self.tx_valid = Signal(), Signal(), Signal()
+        self.tx, self.rx = Signal(BYTE_BITS), Signal(BYTE_BITS)
+        self.bits = Signal(range(_BIT_COUNT_LIMIT + 1))
+
+    def build(self) -> None:
+        self.configuration()
+        self.core_inputs()
+        self.pins()
+        self.outputs()
+
+    # Configuration seen by the core (RegisterFile.bus_id_register, internal_data_path, pcp_device) ---------------
+
+    def configuration(self) -> None:
+        m, b, regs = self.m, self.b, self.regs
+        with m.If(self.configured & ~self.cfg_extreg), m.Switch(self.cfg_code):
+            for code, count in self.tables.internal_bytes.items():
+                with m.Case(code):
+                    m.d.comb += self.n_bytes.eq(count)
+        m.d.comb += [
+            self.pcp_device.eq(self.configured & ~self.cfg_extreg & ~self.cfg_pcp_n),
+            b.in_data.eq(Cat(*(regs[r.name] for r in IN_BYTES))),
+            b.bus_id.eq(Mux(self.configured, Cat(regs["ID"], self.cfg_code), Cat(b.np_id, b.np_length))),
+            b.ext_reg.eq(self.configured & self.cfg_extreg),
+            b.pcp.eq(self.pcp_device),
+            b.alarm.eq(regs["ALARM"]),
+        ]
+
+    # 1. Core inputs, in the wrapper's order: latch, processor command, events, optical, INTERBUS reset -----------
+
+    def core_inputs(self) -> None:
+        m, b, regs, core = self.m, self.b, self.regs, self.core
+        m.d.comb += [core[name].eq(value) for name, value in regs.items()]
+        with m.If(b.latch):
+            for k, register in enumerate(OUT_BYTES):
+                with m.If(k < self.n_bytes):
+                    m.d.comb += core[register.name].eq(b.latch_out.word_select(k, BYTE_BITS))
+            with m.If(self.pcp_device):
+                for k in _PCP_ERASED:
+                    with m.If(k < self.n_bytes):
+                        m.d.comb += core[IN_BYTES[k].name].eq(0)
+        with m.If(b.pcmd_we):
+            m.d.comb += core["PCMD"].eq(b.pcmd)
+        raised = b.events | (b.pcmd_we << _SOURCE_BIT["PCMD"]) | (b.ib_reset << _SOURCE_BIT["IB_RESET"])
+        m.d.comb += core[_IRQ_EVT.name].eq(regs[_IRQ_EVT.name] | (raised & regs[_IRQ_EN.name]))
+        for k, name in enumerate(OPTICAL_REGISTERS):
+            with m.If(b.optical_we[k]):
+                mask = REGISTER_MAP.register(name).mask
+                m.d.comb += core[name].eq(b.optical.word_select(k, BYTE_BITS) & mask)
+        with m.If(b.ib_reset):
+            m.d.comb += [core[r.name].eq(r.reset) for r in REGISTER_MAP.cleared_by(Reset.INTERBUS)]
+        m.d.sync += [regs[name].eq(value) for name, value in core.items()]
+        m.d.sync += self.io.eq(b.io_access)
+
+    # 2. The µP pins: SAS_INIT, /SS falling, SCLK rising, /SS rising (SlavePins._edge) ---------------------------
+
+    def pins(self) -> None:
+        m, b = self.m, self.b
+        idle = PinsIn()
+        ss = _Sync(m, "ss", b.ss_n, idle.ss_n)
+        sclk = _Sync(m, "sclk", b.sclk, idle.sclk)
+        sas = _Sync(m, "sas", b.sas_init, idle.sas_init)
+        data = _Sync(m, "data", Mux(b.mfp6_oe, b.mfp6, b.mfp6_in), idle.mfp6)
+        s_r = _Sync(m, "s_r", b.mfp7_in, idle.mfp7)
+        with m.If(sas.s2):
+            m.d.sync += [self.phase.eq(Phase_.INIT), self.motorola.eq(0), self.intel.eq(0), self.last_rx.eq(0)]
+            self.clear_frame()
+        with m.Else():
+            with m.If(ss.fell):
+                self.begin(s_r.s2)
+            with m.If((self.in_frame | ss.fell) & ~ss.s2 & sclk.rose):
+                self.shift_in(Mux(ss.fell, 0, self.bits), Mux(ss.fell, 0, self.rx), data.s2)
+            with m.If(self.in_frame & ss.rose):
+                self.clear_frame()
+                with m.If(self.bits == BYTE_BITS):
+                    self.end()
+
+    def clear_frame(self) -> None:
+        self.m.d.sync += [self.in_frame.eq(0), self.tx_valid.eq(0), self.bits.eq(0), self.rx.eq(0)]
+
+    def shift_in(self, count: Value, rx: Value, bit: Value) -> None:
+        """One SCLK rising edge (``SlavePins._shift_in``): Intel LSB first, else MSB first (UP-6)."""
+        m = self.m
+        with m.If(count < BYTE_BITS):
+            with m.If(self.intel):
+                m.d.sync += self.rx.eq(rx | (bit << count)[:BYTE_BITS])
+            with m.Else():
+                m.d.sync += self.rx.eq(Cat(bit, rx[:-1]))
+            m.d.sync += self.bits.eq(count + 1)
+        with m.Else():
+            m.d.sync += self.bits.eq(_BIT_COUNT_LIMIT)
+
+    def begin(self, s_r: Value) -> None:
+        """/SS fell (``UpifProtocol.begin``): the byte to send and the read's side effect (UP-8, UP-9, UP-18)."""
+        m, core = self.m, self.core
+        drives = self.motorola | (self.intel & ~s_r)
+        m.d.sync += [
+            self.in_frame.eq(1),
+            self.frame_s_r.eq(s_r),
+            self.tx_valid.eq(drives),
+            self.bits.eq(0),
+            self.rx.eq(0),
+            self.tx.eq(self.last_rx),
+        ]
+        reads, address = Signal(), Signal(_ADDRESS.width)
+        with m.Switch(self.phase):
+            with m.Case(Phase_.BLOCK):
+                m.d.comb += [reads.eq(self.blk_rd), address.eq(self.blk_addr)]
+            with m.Case(Phase_.DATA):
+                readable = Signal()
+                with m.Switch(self.cmd_addr):
+                    for a, port in _READ_PORTS.items():
+                        if port.access is not Access.RESERVED_IGNORED:
+                            with m.Case(a):
+                                m.d.comb += readable.eq(1)
+                m.d.comb += [reads.eq(self.cmd_rd & readable), address.eq(self.cmd_addr)]
+        with m.If(reads), m.Switch(address):
+            for a, port in _READ_PORTS.items():
+                register = port.register
+                if port.access is Access.RESERVED_ZERO:
+                    with m.Case(a):
+                        m.d.sync += self.tx.eq(0)
+                elif register is not None:
+                    with m.Case(a):
+                        value = core[register.name]
+                        if port.access is Access.RC:
+                            m.d.sync += self.tx.eq(value | (self.b.io_access << IO_ACCESS_BIT))
+                            with m.If(drives):
+                                m.d.sync += self.regs[register.name].eq(value & ~port.clear_on_read_mask & BYTE_MASK)
+                        else:
+                            m.d.sync += self.tx.eq(value)
+
+    def end(self) -> None:
+        """/SS rose after 8 bits (``UpifProtocol.end``): process the received byte ``rx``."""
+        m, rx = self.m, self.rx
+        with m.Switch(self.phase):
+            with m.Case(Phase_.INIT):
+                m.d.sync += self.phase.eq(Phase_.DISABLED)
+                for mode, flag in ((Mode.MOTOROLA, self.motorola), (Mode.INTEL, self.intel)):
+                    with m.If(rx == mode.init_byte):
+                        m.d.sync += [flag.eq(1), self.phase.eq(Phase_.COMMAND)]
+            with m.Case(Phase_.COMMAND), m.If(self.motorola | self.frame_s_r):
+                # An Intel command byte needs S/R = 1 (Table 3-9); the received byte is kept either way.
+                self.command(rx[_RD.lsb], rx[_WR.lsb], rx[_ADDRESS.lsb : _ADDRESS.lsb + _ADDRESS.width])
+            with m.Case(Phase_.DATA):
+                self.data()
+            with m.Case(Phase_.BLOCK):
+                self.block()
+        with m.If(self.phase != Phase_.DISABLED):
+            m.d.sync += self.last_rx.eq(rx)
+
+    def command(self, rd: Value, wr: Value, address: Value) -> None:
+        """A command byte (3.4.4): a data byte follows, or address 15 starts a block transfer (3.4.6, UP-10/11)."""
+        m = self.m
+        m.d.sync += [self.cmd_rd.eq(rd), self.cmd_wr.eq(wr), self.cmd_addr.eq(address), self.phase.eq(Phase_.DATA)]
+        with m.If(address.matches(*_BLOCK_ADDRESSES)):
+            m.d.sync += [self.phase.eq(Phase_.BLOCK), self.blk_addr.eq(0)]
+            with m.If((self.n_bytes == 0) | (self.intel & ~rd & ~wr)):
+                m.d.sync += self.phase.eq(Phase_.COMMAND)
+            with m.If(self.motorola):
+                m.d.sync += [self.blk_rd.eq(1), self.blk_wr.eq(1), self.blk_then_wr.eq(0)]
+            with m.Else():
+                m.d.sync += [self.blk_rd.eq(rd), self.blk_wr.eq(~rd), self.blk_then_wr.eq(rd & wr)]
+
+    def data(self) -> None:
+        """The data byte of a command (3.4.4): a write where RD/WR and S/R allow it (UP-9); 4 and 5 ignored."""
+        m, s_r = self.m, self.frame_s_r
+        m.d.sync += self.phase.eq(Phase_.COMMAND)
+        refused = self.intel & (self.cmd_rd != self.cmd_wr) & (self.cmd_rd == s_r)
+        with m.If(self.cmd_wr & (self.motorola | s_r) & ~refused):
+            self.cpu_write(self.cmd_addr, self.rx)
+
+    def block(self) -> None:
+        """One byte of a block transfer: write IN k in a write slot; then the next slot (UP-11)."""
+        m = self.m
+        refused = self.intel & (self.blk_rd == self.frame_s_r)
+        with m.If(self.blk_wr & ~refused):
+            self.cpu_write(self.blk_addr, self.rx)
+        with m.If(self.blk_addr == self.n_bytes - 1):
+            with m.If(self.blk_then_wr):
+                m.d.sync += [self.blk_addr.eq(0), self.blk_rd.eq(0), self.blk_wr.eq(1), self.blk_then_wr.eq(0)]
+            with m.Else():
+                m.d.sync += self.phase.eq(Phase_.COMMAND)
+        with m.Else():
+            m.d.sync += self.blk_addr.eq(self.blk_addr + 1)
+
+    def cpu_write(self, address: Value, value: Value) -> None:
+        """``RegisterFile.cpu_write``: store the byte's register bits; SET also applies a valid configuration."""
+        m = self.m
+        with m.Switch(Cat(address, Const(0, _ADDRESS.width - len(address)))):
+            for a, port in _WRITE_PORTS.items():
+                register = port.register
+                if port.access is Access.W and register is not None:
+                    with m.Case(a):
+                        m.d.sync += self.regs[register.name].eq(value & register.mask)
+                        if register is _SET:
+                            self.apply_set(value)
+
+    def apply_set(self, value: Value) -> None:
+        """A SET value with an applicable length code configures the device (Tables 3-11, 3-12; UP-20)."""
+        m = self.m
+        key = Cat(value[_LENGTH_CODE.lsb : _LENGTH_CODE.lsb + _LENGTH_CODE.width], value[_EXTREG.lsb])
+        with m.Switch(key):
+            for (extreg, low), code in self.tables.set_codes.items():
+                with m.Case(low | extreg << _LENGTH_CODE.width):
+                    m.d.sync += [
+                        self.configured.eq(1),
+                        self.cfg_extreg.eq(extreg),
+                        self.cfg_code.eq(code),
+                        self.cfg_pcp_n.eq(value[_PCP_N.lsb]),
+                    ]
+
+    # 3. Outputs: the state decoded (SlavePins._decode), then the bit rate's pipeline (UP-14) ---------------------
+
+    def outputs(self) -> None:
+        m, b = self.m, self.b
+        index = Mux(self.bits > BYTE_BITS - 1, BYTE_BITS - 1, self.bits)
+        bit = Mux(self.intel, self.tx, self.tx[::-1]).bit_select(index, 1)
+        drive = self.in_frame & self.tx_valid
+        phase = self.phase
+        decoded: dict[str, Value] = {
+            "io": self.io, "io_oe": Const(1),
+            "c_d": Mux(phase.matches(Phase_.INIT, Phase_.COMMAND), C_D_COMMAND, C_D_DATA), "c_d_oe": Const(1),
+            "irq_n": self.regs[_IRQ_EVT.name] == 0, "irq_n_oe": Const(1),
+            "mfp6": bit & drive & self.intel, "mfp6_oe": drive & self.intel,
+            "mfp7": bit & drive & self.motorola, "mfp7_oe": drive & self.motorola,
+        }  # fmt: skip
+        reset = asdict(self.tables.reset_outputs)
+        delays = self.tables.output_delay
+        for name, value in decoded.items():
+            taps: list[Value] = [value]
+            for stage in range(max(delays)):
+                delayed = Signal(name=f"{name}_d{stage + 1}", init=reset[name])
+                m.d.sync += delayed.eq(taps[-1])
+                taps.append(delayed)
+            m.d.comb += getattr(b, name).eq(Array(taps[delay] for delay in delays)[b.rate])
+
+
+def verilog() -> str:
+    """The Verilog of :class:`UpifBlock` (module ``supi3_upif``), ports named like the model's pins."""
+    block = UpifBlock()
+    text: str = amaranth_verilog.convert(block, name="supi3_upif", emit_src=False)
+    return text
