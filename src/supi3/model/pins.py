@@ -90,7 +90,7 @@ class Synced(NamedTuple):
 
 
 _INPUT_NAMES: Final = Synced._fields
-_IDLE_INPUTS: Final = Synced(wire.IDLE_LEVEL, 0, 0, 0, 1, 1, 1)
+IDLE_INPUTS: Final = Synced(wire.IDLE_LEVEL, 0, 0, 0, 1, 1, 1)
 """What the synchroniser holds after reset: the levels of a quiet board (idle line, no fault, power good)."""
 
 _NEVER: Final = 1 << 62
@@ -137,10 +137,14 @@ class Supi3Pins:
         self.cpb = wire.clocks_per_bit(config.bit_rate)
         self.mfp_oe = config.mfp_output_mask
         self.log = EventLog()
-        self._complete_diag = config.diagnostics is not None and config.diagnostics.diag_conf == 0
-        self._pin_rbst = config.rf_mode is not None and config.rf_mode.rf == "10"
-        self._forward_delay = wire.REPEATER_DELAY_BITS * self.cpb - SYNC_STAGES
-        self._reset_run = wire.RESET_DETECT_BITS * self.cpb
+        self.complete_diagnostics = config.diagnostics is not None and config.diagnostics.diag_conf == 0
+        """DIAG1 shows BA (DIAG_CONF = 0, Table 3-16)."""
+        self.rbst_by_pin = config.rf_mode is not None and config.rf_mode.rf == "10"
+        """A following device is told by RBST_EXT (RF = 10, Table 2-2), not recognised on DI2 (M5)."""
+        self.forward_delay = wire.REPEATER_DELAY_BITS * self.cpb - SYNC_STAGES
+        """Clocks from a bit's mid-bit sample to its first clock on DO2, plus cpb/2 (M8)."""
+        self.reset_run = wire.RESET_DETECT_BITS * self.cpb
+        """Clocks of start level that make an INTERBUS reset (M11)."""
         self.reset()
 
     # ------------------------------------------------------------------------------------------------------------
@@ -151,7 +155,7 @@ class Supi3Pins:
         """The state right after the ``sync`` reset: power-up reset in progress (it lasts the reset stretch)."""
         self.cycle = 0
         self.log.clear()
-        self._pipe: list[Synced] = [_IDLE_INPUTS] * SYNC_STAGES
+        self._pipe: list[Synced] = [IDLE_INPUTS] * SYNC_STAGES
         self._holding = False
         self._recording = False
         self._power_ups: list[tuple[int, int]] = []
@@ -213,7 +217,7 @@ class Supi3Pins:
         if c >= self._run_from or self._holding or not (synced.resu_n and synced.vmon_ok):
             self._tick(c, synced)
             if c >= self._run_from:
-                self._next_present = bool(synced.rbst_ext) if self._pin_rbst else self._next_present or bool(
+                self._next_present = bool(synced.rbst_ext) if self.rbst_by_pin else self._next_present or bool(
                     synced.di2
                 )
         if len(self._tx) > 8:
@@ -237,7 +241,7 @@ class Supi3Pins:
             "mfp_oe": self.mfp_oe,
             "mod_ack_n": int(c >= chip.mod_ack_until),
             "res_reg_n": int(c >= chip.resreg_until),
-            "diag1": int(chip.bus_active) if self._complete_diag else 0,
+            "diag1": int(chip.bus_active) if self.complete_diagnostics else 0,
             "diag2": 0,
             "ib_diag": self._ib_diag(c),
             "dclk_out": int(c % self.cpb < self.cpb // 2),
@@ -298,8 +302,8 @@ class Supi3Pins:
             due.append(self._t0 + self.cpb // 2 + self._bit * self.cpb)
         elif line == wire.START_LEVEL:
             due.append(c + 1)
-        if self._low_since is not None and c < self._low_since + self._reset_run - 1:
-            due.append(self._low_since + self._reset_run - 1)
+        if self._low_since is not None and c < self._low_since + self.reset_run - 1:
+            due.append(self._low_since + self.reset_run - 1)
         chip_due = self.chip.next_event()
         if chip_due is not None:
             due.append(max(chip_due, c + 1))
@@ -310,7 +314,7 @@ class Supi3Pins:
         if line == wire.START_LEVEL:
             if self._low_since is None:
                 self._low_since = c
-            if c - self._low_since + 1 == self._reset_run:
+            if c - self._low_since + 1 == self.reset_run:
                 self._enter_reset(c)
         else:
             self._low_since = None
@@ -364,7 +368,7 @@ class Supi3Pins:
         if not self._in_reset and self._length == wire.DATA_TELEGRAM_BITS:
             out = self._data_telegram_bit(k, level, c)
         # The repeater sends this bit REPEATER_DELAY_BITS after it began on the line (docs/interbus.md).
-        self._tx.append((c - self.cpb // 2 + self._forward_delay, out))
+        self._tx.append((c - self.cpb // 2 + self.forward_delay, out))
         if k == self._length - 1:
             self._rx_busy = False
             self._telegram_end(level, c)
@@ -505,7 +509,7 @@ class Supi3Pins:
 
     def _snapshot(self) -> tuple[int, ...]:
         chip = self.chip
-        return (chip.mfp_outputs, int(chip.bus_active) if self._complete_diag else 0, int(chip.pf),
+        return (chip.mfp_outputs, int(chip.bus_active) if self.complete_diagnostics else 0, int(chip.pf),
                 int(chip.bus_active), chip.mod_ack_until, chip.resreg_until, self._run_from)  # fmt: skip
 
     def run(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]]) -> dict[str, Trace]:
@@ -631,7 +635,7 @@ class Supi3Pins:
         """
         c0, value, run_from, held_di2 = self._return_start
         n = len(do2)
-        if self._pin_rbst:
+        if self.rbst_by_pin:
             seen = self._synced_run["rbst_ext"]
         else:
             seen = np.concatenate([np.asarray(held_di2, dtype=np.int64), di2])[:n]
@@ -646,7 +650,7 @@ class Supi3Pins:
             if end > t:
                 active = np.arange(c0 + t, c0 + end) >= run_from
                 level = seen[t:end] != 0
-                if self._pin_rbst:
+                if self.rbst_by_pin:
                     values = np.where(active, level, value)
                 else:
                     values = np.logical_or.accumulate(level & active) | value

@@ -34,8 +34,8 @@ from supi3.config import Variant
 from supi3.interbus import wire
 from supi3.model.chip import MODACK_PULSE_CLOCKS, RESREG_PULSE_CLOCKS, STATERR_FILTER_CLOCKS, WATCHDOG_CLOCKS
 from supi3.model.pins import (
-    _IDLE_INPUTS,
     IB_DIAG_DIVIDER_BITS,
+    IDLE_INPUTS,
     IDLE_TIMEOUT_CLOCKS,
     RESET_STRETCH_CLOCKS,
     SYNC_STAGES,
@@ -170,7 +170,7 @@ class Supi3Core(wiring.Component):
 
         # Synchronisers (M1) and the power-up reset with its stretch (1.7.2, M2) -------------------------------------
         synced: dict[str, Value] = {}
-        for pin, idle in zip(Supi3Pins.inputs, _IDLE_INPUTS, strict=True):
+        for pin, idle in zip(Supi3Pins.inputs, IDLE_INPUTS, strict=True):
             stages = [Signal(pin.width, init=idle, name=f"{pin.name}_s{k}") for k in range(SYNC_STAGES)]
             m.d.sync += [stages[0].eq(getattr(self, pin.name)), *(b.eq(a) for a, b in pairwise(stages))]
             synced[pin.name] = stages[-1]

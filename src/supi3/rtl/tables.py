@@ -157,14 +157,14 @@ def core_tables(variant: Variant | str = Variant.OPC) -> CoreTables:
     clocks = []
     for value, config in _values(CLK_CONF_BITS, lambda b: decode(first.c, first.mfp, clk_conf=b, variant=variant)):
         pins = Supi3Pins(config)
-        clocks.append(ClockEntry(value, pins.cpb, pins._forward_delay, pins._reset_run))
+        clocks.append(ClockEntry(value, pins.cpb, pins.forward_delay, pins.reset_run))
     if variant is Variant.LS:  # no RF and DIAG_CONF pins (Table 1-4): the model's defaults for the LS
         ls = Supi3Pins(decode(first.c, first.mfp, variant=variant))
-        rbst = tuple(range(1 << RF_BITS)) if ls._pin_rbst else ()
-        complete = tuple(range(1 << DIAG_CONF_BITS)) if ls._complete_diag else ()
+        rbst = tuple(range(1 << RF_BITS)) if ls.rbst_by_pin else ()
+        complete = tuple(range(1 << DIAG_CONF_BITS)) if ls.complete_diagnostics else ()
     else:
         rf = _values(RF_BITS, lambda b: decode(first.c, first.mfp, rf=b, variant=variant))
         diag = _values(DIAG_CONF_BITS, lambda b: decode(first.c, first.mfp, diag_conf=b, variant=variant))
-        rbst = tuple(value for value, config in rf if Supi3Pins(config)._pin_rbst)
-        complete = tuple(value for value, config in diag if Supi3Pins(config)._complete_diag)
+        rbst = tuple(value for value, config in rf if Supi3Pins(config).rbst_by_pin)
+        complete = tuple(value for value, config in diag if Supi3Pins(config).complete_diagnostics)
     return CoreTables(variant, modes, tuple(clocks), rbst, complete)
