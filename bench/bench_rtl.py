@@ -29,6 +29,7 @@ from supi3.model.pins import Supi3Pins
 from supi3.rtl.core import Supi3Core, verilog
 from supi3.rtl.harness import StrapPins, strap_stimulus
 from supi3.tables import CLOCK_HZ
+from supi3.verif import Lockstep
 from supi3.verif.amaranth_sim import run_amaranth_sim
 
 TARGET_GE = 15_000
@@ -115,17 +116,27 @@ def speed(data_cycles: int, amaranth_cycles: int) -> None:
     result = run_amaranth_sim(
         functools.partial(Supi3Core, "opc"), functools.partial(StrapPins, "opc"), stimulus, max_cycles=amaranth_cycles
     )
+    amaranth_rate = result.cycles / result.seconds
     print(f"{'model step()':<40} {n:>9} cycles {n / step_s:>12,.0f} cycles/s")
     print(f"{'model run()':<40} {n:>9} cycles {n / run_s:>12,.0f} cycles/s")
-    print(
-        f"{'Amaranth simulator, lockstep with model':<40} {result.cycles:>9} cycles "
-        f"{result.cycles / result.seconds:>12,.0f} cycles/s"
-    )
+    print(f"{'Amaranth simulator, lockstep with model':<40} {result.cycles:>9} cycles {amaranth_rate:>12,.0f} cycles/s")
+    print(f"model run() / Amaranth simulator: {n / run_s / amaranth_rate:.0f}x (target >= 20x); "
+          f"step(): {n / step_s / amaranth_rate:.0f}x")
+    with tempfile.TemporaryDirectory() as name:
+        lockstep = Lockstep(functools.partial(Supi3Core, "opc"), functools.partial(StrapPins, "opc"),
+                            build_dir=Path(name))
+        lockstep.prepare()
+        per_cycle = lockstep.run(stimulus[: min(n, 30_000)])
+        batch = lockstep.run_batch(stimulus)
+    print(f"{'lockstep per cycle (cocotb + Verilator)':<40} {per_cycle.cycles:>9} cycles {per_cycle.rate:>12,.0f} "
+          "cycles/s (target >= 50k)")
+    print(f"{'lockstep batch (Verilator + numpy)':<40} {batch.cycles:>9} cycles {batch.rate:>12,.0f} "
+          "cycles/s (target >= 1M)")
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--data-cycles", type=int, default=20, help="data cycles in the speed workload")
+    parser.add_argument("--data-cycles", type=int, default=200, help="data cycles in the speed workload")
     parser.add_argument("--amaranth", type=int, default=20_000, help="cycles on Amaranth's simulator")
     parser.add_argument("--no-synthesis", action="store_true", help="skip gate counts and Fmax")
     args = parser.parse_args()

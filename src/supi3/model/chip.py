@@ -100,6 +100,7 @@ class Supi3:
         # Pin-strapped modes have a fixed data length; the µP modes ask the register file every time.
         self._fixed_bytes = None if self.registers is not None else wire.data_bytes(self.config.length_code)
         self._loaded = (-1, b"")  # (MFP levels, IN bytes) of the last data-cycle load
+        self._shown: tuple[bytes | None, int] = (None, 0)  # (OUT bytes, MFP levels) last driven
         self.power_up()
 
     # --------------------------------------------------------------------------------------------------------
@@ -163,7 +164,11 @@ class Supi3:
     @property
     def mfp_outputs(self) -> int:
         """The levels the chip drives on its MFP output pins (binary I/O modes, Tables 3-1 and 3-2)."""
-        return sum(((self.out_word >> bit) & 1) << pin for bit, pin in self._out_map)
+        out = self._out
+        if out is not self._shown[0]:  # recomputed only when new OUT data were latched
+            word = int.from_bytes(out, "big")
+            self._shown = (out, sum(((word >> bit) & 1) << pin for bit, pin in self._out_map))
+        return self._shown[1]
 
     def set_stat_err(self, active: bool, now: float) -> None:
         """Drive /StatErr (3.6.2): ``True`` pulls it low (an I/O error); the fault latches after the filter time."""

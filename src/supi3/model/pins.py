@@ -297,17 +297,20 @@ class Supi3Pins:
         """The next cycle after ``c`` at which the logic acts with unchanged inputs."""
         if c < self._run_from:
             return self._run_from
-        due = [self._last_start + IDLE_TIMEOUT_CLOCKS]
+        due = self._last_start + IDLE_TIMEOUT_CLOCKS
+        if due <= c:
+            due = _NEVER
         if self._rx_busy:
-            due.append(self._t0 + self.cpb // 2 + self._bit * self.cpb)
+            due = min(due, self._t0 + self.cpb // 2 + self._bit * self.cpb)
         elif line == wire.START_LEVEL:
-            due.append(c + 1)
-        if self._low_since is not None and c < self._low_since + self.reset_run - 1:
-            due.append(self._low_since + self.reset_run - 1)
+            due = c + 1
+        low = self._low_since
+        if low is not None and c < low + self.reset_run - 1:
+            due = min(due, low + self.reset_run - 1)
         chip_due = self.chip.next_event()
         if chip_due is not None:
-            due.append(max(chip_due, c + 1))
-        return min(d for d in due if d > c) if any(d > c for d in due) else _NEVER
+            due = min(due, max(chip_due, c + 1))
+        return due
 
     def _receive(self, line: int, c: int) -> None:
         # INTERBUS reset: the start level held for RESET_DETECT_BITS bit periods (docs/interbus.md).
@@ -593,33 +596,34 @@ class Supi3Pins:
     def _render(self, c0: int, n: int, snaps: list[tuple[int, tuple[int, ...]]], tx: list[tuple[int, int]]
                 ) -> dict[str, Trace]:
         cycles = np.arange(c0, c0 + n, dtype=np.int64)
-        out = {name: np.zeros(n, dtype=np.int64) for name in ("mfp_out", "diag1", "mod_ack_n", "res_reg_n",
-                                                               "ib_diag", "resu_drive")}
-        bounds = [t for t, _ in snaps] + [n]
-        for (t, snap), end in zip(snaps, bounds[1:], strict=True):
-            if end <= t:
-                continue
-            mfp_out, diag1, pf, bus_active, mod_ack_until, resreg_until, run_from = snap
-            seg = cycles[t:end]
-            out["mfp_out"][t:end] = mfp_out
-            out["diag1"][t:end] = diag1
-            out["mod_ack_n"][t:end] = seg >= mod_ack_until
-            out["res_reg_n"][t:end] = seg >= resreg_until
-            out["resu_drive"][t:end] = seg < run_from
-            if pf:
-                out["ib_diag"][t:end] = 1 - ((seg >> (IB_DIAG_DIVIDER_BITS["fast"] - 1)) & 1)
-            elif not bus_active:
-                out["ib_diag"][t:end] = 1 - ((seg >> (IB_DIAG_DIVIDER_BITS["slow"] - 1)) & 1)
-            else:
-                out["ib_diag"][t:end] = 1
+        # The snapshot taken after each visited cycle holds until the next one: repeat each over its cycles.
+        starts = np.array([t for t, _ in snaps], dtype=np.int64)
+        lengths = np.diff(np.append(starts, n)).clip(min=0)
+        held = np.repeat(np.array([snap for _, snap in snaps], dtype=np.int64), lengths, axis=0)
+        mfp_out, diag1, pf, bus_active, mod_ack_until, resreg_until, run_from = held.T
+        fast = 1 - ((cycles >> (IB_DIAG_DIVIDER_BITS["fast"] - 1)) & 1)
+        slow = 1 - ((cycles >> (IB_DIAG_DIVIDER_BITS["slow"] - 1)) & 1)
+        out = {
+            "mfp_out": mfp_out,
+            "diag1": diag1,
+            "mod_ack_n": (cycles >= mod_ack_until).astype(np.int64),
+            "res_reg_n": (cycles >= resreg_until).astype(np.int64),
+            "resu_drive": (cycles < run_from).astype(np.int64),
+            "ib_diag": np.where(pf != 0, fast, np.where(bus_active != 0, 1, slow)),
+        }
         do2 = np.full(n, wire.IDLE_LEVEL, dtype=np.int64)
         cpb = self.cpb
-        for start, bit in tx:
-            lo, hi = max(start, c0) - c0, min(start + cpb, c0 + n) - c0
-            if hi > lo:
-                do2[lo:hi] = bit
-            elif start >= c0 + n:
-                break
+        if tx:
+            # Each bit lasts cpb clocks or until the next bit begins (starts are in order): as _do2() reads it.
+            starts = np.array([start for start, _ in tx], dtype=np.int64)
+            bits = np.array([bit for _, bit in tx], dtype=np.int64)
+            ends = np.minimum(starts + cpb, np.append(starts[1:], _NEVER))
+            lo = np.clip(starts - c0, 0, n)
+            lengths = np.clip(ends - c0, 0, n) - lo
+            lengths[lengths < 0] = 0
+            first = np.cumsum(lengths) - lengths
+            where = np.repeat(lo - first, lengths) + np.arange(int(lengths.sum()))
+            do2[where] = np.repeat(bits, lengths)
         out["do2"] = do2
         out["mfp_oe"] = np.full(n, self.mfp_oe, dtype=np.int64)
         out["diag2"] = np.zeros(n, dtype=np.int64)

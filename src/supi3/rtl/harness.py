@@ -111,6 +111,19 @@ class StrapPins:
             raise PinSpecError(f"cycle {self.pins.cycle}: the straps changed ({self._straps} -> {straps})")
         return self.pins.step(inputs)
 
+    def run(self, inputs: Mapping[str, npt.NDArray[np.integer]]) -> dict[str, npt.NDArray[np.int64]]:
+        """Whole traces at once (:meth:`Supi3Pins.run`, event-driven); the straps must be constant."""
+        first = {name: int(np.asarray(trace)[0]) for name, trace in inputs.items()}
+        for name in _STRAP_NAMES:
+            if np.any(np.asarray(inputs[name]) != first[name]):
+                raise PinSpecError(f"the straps must not change during a run ({name})")
+        if self.pins is None:
+            self.pins = Supi3Pins(self.config_for(first))
+            self._straps = tuple(first[name] for name in _STRAP_NAMES)
+        elif tuple(first[name] for name in _STRAP_NAMES) != self._straps:
+            raise PinSpecError(f"cycle {self.pins.cycle}: the straps changed")
+        return self.pins.run({pin.name: np.asarray(inputs[pin.name]) for pin in Supi3Pins.inputs})
+
     def recent_events(self) -> list[str]:
         """The model's last bus events, for mismatch reports."""
         return self.pins.log.recent() if self.pins is not None else []
