@@ -73,7 +73,7 @@ async def exchange(master: SpiMaster, mosi: int) -> int:
 @cocotb.test()
 async def spi_master_reads_and_writes_registers(dut: Any) -> None:
     """Init 00h, SET = 82h and ID = 01h (3.4.5) read back; an enabled VALID event read from IRQ_EVT."""
-    cocotb.start_soon(Clock(dut.clk, 1e9 / CLOCK_HZ, unit="ns").start())
+    Clock(dut.clk, 1e9 / CLOCK_HZ, unit="ns").start()
     for name, value in strap_values(BIT_RATES[0], NOT_READY_ID).items():
         getattr(dut, name).value = value
     for name in ("power_up", "ib_reset", "events", "io_access", "latch", "latch_out", "pcmd_we", "pcmd",

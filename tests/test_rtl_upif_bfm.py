@@ -17,7 +17,8 @@ TOP = "supi3_upif"
 def test_spi_master_bfm(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     if importlib.util.find_spec("cocotbext.spi") is None:
         pytest.skip("cocotbext-spi is not installed (the rtl extra)")
-    from cocotb_tools.runner import get_results, get_runner
+    from cocotb_tools.check_results import get_results
+    from cocotb_tools.runner import get_runner
 
     ensure_toolchain("verilator")
     source = tmp_path / f"{TOP}.v"

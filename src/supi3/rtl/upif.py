@@ -70,7 +70,7 @@ _PCP_ERASED: Final[tuple[int, ...]] = (0, 1)
 _BIT_COUNT_LIMIT: Final[int] = BYTE_BITS + 1
 """The SCLK edge counter saturates here: the model only asks for 8, below 8, and more than 8 (3.4.2, UP-7)."""
 
-Phase_ = enum.Enum("Phase_", {phase.name: index for index, phase in enumerate(Phase)})  # type: ignore[misc]
+Phase_ = enum.Enum("Phase_", {phase.name: index for index, phase in enumerate(Phase)})
 """The protocol phases of :class:`~supi3.spi.upif.Phase` as an Amaranth enumeration."""
 
 

@@ -190,14 +190,14 @@ class UpifBlockPins:
             "pcp": int(registers.pcp_device),
             "alarm": registers.processor_alarm,
         }
-        serial = PinsIn(**{name: int(inputs[_PAD_INPUTS.get(name, name)]) for name in INPUT_PINS})
+        serial = PinsIn(*(int(inputs[pin.name]) for pin in SERIAL_INPUTS))
         if inputs["power_up"]:
             out = pins.tick(serial)
             pins.reset()
         else:
             self._core(registers, inputs)
             out = pins.tick(serial)
-        outputs.update(dataclasses.asdict(out))
+        outputs.update(vars(out))
         return outputs
 
     @staticmethod
