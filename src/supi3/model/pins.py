@@ -96,6 +96,12 @@ IDLE_INPUTS: Final = Synced(wire.IDLE_LEVEL, 0, 0, 0, 1, 1, 1)
 _NEVER: Final = 1 << 62
 
 
+def _integers(trace: Sequence[int] | npt.NDArray[np.generic]) -> npt.NDArray[np.integer]:
+    """An input trace as an integer array, without a copy when it already is one."""
+    array = np.asarray(trace)
+    return array if np.issubdtype(array.dtype, np.integer) else array.astype(np.int64)
+
+
 class Supi3Pins:
     """The SUPI 3 chip core at pin level, one 32 MHz clock per :meth:`step`, or many per :meth:`run`.
 
@@ -534,15 +540,15 @@ class Supi3Pins:
         """What the synchroniser delivers in each of the next ``n`` cycles, and the pipeline left after them."""
         synced = {}
         for name in _INPUT_NAMES:
-            held = [getattr(stage, name) for stage in reversed(self._pipe)]
-            synced[name] = np.concatenate([np.asarray(held, dtype=np.int64), raw[name]])[: n + SYNC_STAGES]
+            held = np.asarray([getattr(stage, name) for stage in reversed(self._pipe)], dtype=raw[name].dtype)
+            synced[name] = np.concatenate([held, raw[name]])[: n + SYNC_STAGES]
         return synced
 
     def run_forward(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]]) -> dict[str, Trace]:
         """:meth:`run` without ``di1``: the chip's logic does not depend on DI2 beyond the return line's
         pass-through, so a ring runs every chip forward first and then the return line backwards
         (:meth:`return_line`). The ``di2`` trace given here is not used."""
-        raw = {name: np.asarray(inputs[name], dtype=np.int64) for name in _INPUT_NAMES}
+        raw = {name: _integers(inputs[name]) for name in _INPUT_NAMES}
         n = len(raw["do1"])
         if any(len(trace) != n for trace in raw.values()):
             raise ValueError("every input trace must have the same length")
@@ -559,10 +565,10 @@ class Supi3Pins:
             trace = synced[name]
             change[1:] |= trace[1:] != trace[:-1]
         input_events = np.flatnonzero(change).tolist()
-        columns = [synced[name].tolist() for name in _INPUT_NAMES]
+        columns = [synced[name] for name in _INPUT_NAMES]
         snaps = [(0, self._snapshot())]
         k = 0
-        due = self._next_due(c0 - 1, columns[0][0]) if n else _NEVER
+        due = self._next_due(c0 - 1, int(columns[0][0])) if n else _NEVER
         while True:
             next_input = input_events[k] if k < len(input_events) else n
             t = min(next_input, due - c0)
@@ -571,7 +577,7 @@ class Supi3Pins:
             if t == next_input:
                 k += 1
             c = c0 + t
-            s = Synced(*(column[t] for column in columns))
+            s = Synced(*(int(column[t]) for column in columns))
             self.cycle = c
             if c >= self._run_from or self._holding or not (s.resu_n and s.vmon_ok):
                 self._tick(c, s)

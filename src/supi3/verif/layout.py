@@ -238,7 +238,7 @@ def model_trace(model: PinModel, stimulus: Trace, layout: Layout) -> Trace:
     names = layout.input_names
     bulk = getattr(model, "run", None)
     if callable(bulk):
-        columns = bulk({name: stimulus[:, index].astype(np.int64) for index, name in enumerate(names)})
+        columns = bulk({name: stimulus[:, index] for index, name in enumerate(names)})
         trace = np.zeros((len(stimulus), len(layout.out_fields)), dtype=np.uint64)
         for index, field in enumerate(layout.out_fields):
             trace[:, index] = np.asarray(columns[field.name], dtype=np.uint64)
@@ -247,10 +247,12 @@ def model_trace(model: PinModel, stimulus: Trace, layout: Layout) -> Trace:
         values = layout.output_values
         rows = [values(step(dict(zip(names, row, strict=True)))) for row in stimulus.tolist()]
         trace = np.array(rows, dtype=np.uint64).reshape(len(rows), len(layout.out_fields))
-    for index, field in enumerate(layout.out_fields):
-        if trace.size and int(trace[:, index].max()) > field.mask:
-            cycle = int(np.argmax(trace[:, index] > np.uint64(field.mask)))
-            raise PinSpecError(f"cycle {cycle}: model output {field.name!r} does not fit in {field.width} bits")
+    masks = np.array([field.mask for field in layout.out_fields], dtype=np.uint64)
+    if trace.size and (trace > masks).any():
+        index = int(np.argmax((trace > masks).any(axis=0)))
+        field = layout.out_fields[index]
+        cycle = int(np.argmax(trace[:, index] > np.uint64(field.mask)))
+        raise PinSpecError(f"cycle {cycle}: model output {field.name!r} does not fit in {field.width} bits")
     return trace
 
 

@@ -19,6 +19,7 @@ import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from typing import NoReturn
 
 from amaranth.back import verilog
 from amaranth.hdl import ClockDomain, Elaboratable, Module, Signal, Value
@@ -59,13 +60,19 @@ class LockstepTop(Elaboratable):
         port = getattr(self.design, name, None)
         kind = type(self.design).__name__
         if port is None:
-            raise PinSpecError(f"design {kind} has no attribute {name!r} for the model's pin of that name")
+            self._reject(f"design {kind} has no attribute {name!r} for the model's pin of that name")
         if assignable and not isinstance(port, Signal):
-            raise PinSpecError(f"design {kind}: input {name!r} must be a Signal, not {port!r}")
+            self._reject(f"design {kind}: input {name!r} must be a Signal, not {port!r}")
         if not isinstance(port, Value) or len(port) != width:
             shape = len(port) if isinstance(port, Value) else type(port).__name__
-            raise PinSpecError(f"design {kind}: {name!r} must be a {width}-bit value like the model's pin, not {shape}")
+            self._reject(f"design {kind}: {name!r} must be a {width}-bit value like the model's pin, not {shape}")
         return port
+
+    def _reject(self, message: str) -> NoReturn:
+        # A rejected design is not Amaranth's "created but never used": silence that warning for both objects.
+        self._MustUse__silence = True
+        self.design._MustUse__silence = True
+        raise PinSpecError(message)
 
     @property
     def ports(self) -> list[Signal]:
