@@ -536,7 +536,8 @@ class Supi3Pins:
         traces["di1"] = self.return_line(np.asarray(inputs["di2"], dtype=np.int64), traces["do2"])
         return traces
 
-    def _synced_traces(self, raw: Mapping[str, Trace], n: int) -> dict[str, Trace]:
+    def _synced_traces(self, raw: Mapping[str, npt.NDArray[np.integer]], n: int
+                       ) -> dict[str, npt.NDArray[np.integer]]:
         """What the synchroniser delivers in each of the next ``n`` cycles, and the pipeline left after them."""
         synced = {}
         for name in _INPUT_NAMES:
@@ -593,7 +594,7 @@ class Supi3Pins:
             del self._tx[:-8]
         return traces
 
-    def _shifted_pipe(self, raw: Mapping[str, Trace], n: int) -> list[Synced]:
+    def _shifted_pipe(self, raw: Mapping[str, npt.NDArray[np.integer]], n: int) -> list[Synced]:
         pipe = list(self._pipe)
         for t in range(n):
             pipe = [Synced(*(int(raw[name][t]) for name in _INPUT_NAMES)), *pipe[:-1]]
