@@ -11,6 +11,7 @@ from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
 from supi3.model.top import Supi3Chip
 from supi3.regmap import encode_command
+from supi3.spi.upif import Phase
 
 HALF = 8  # SCLK half period in clocks at 2 Mbit/s: 4 MHz, below the 6 MHz maximum (Table 3-7)
 SCLK, SS_N, MOSI, MFP7 = 1 << 4, 1 << 5, 1 << 6, 1 << 7
@@ -117,3 +118,16 @@ def test_chip_without_up_interface_is_the_core() -> None:
                        "stat_err_n": np.ones(50, dtype=np.int64), "resu_n": np.ones(50, dtype=np.int64),
                        "vmon_ok": np.ones(50, dtype=np.int64)})
     assert traces["resu_drive"].all()
+
+
+def test_power_fail_resets_the_up_interface_at_the_edge_it_is_seen() -> None:
+    # The µP interface is reset together with the register file at the first edge of a power-up reset, not one
+    # clock later when resu_drive shows it (the RTL resets the whole block at that edge).
+    bench = Bench()
+    assert bench.spi(0x00) == 0
+    assert bench.chip.upif is not None and bench.chip.upif.protocol.phase is not Phase.INIT
+    inputs = {"do1": 1, "di2": 0, "rbst_ext": 0, "mfp_in": IDLE_MFP, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 0}
+    while not bench.chip.core.holding:
+        out = bench.chip.step(inputs)
+        assert not out["resu_drive"]
+    assert bench.chip.upif.protocol.phase is Phase.INIT

@@ -231,6 +231,11 @@ class Supi3Pins:
         self.cycle = c + 1
         return outputs
 
+    @property
+    def holding(self) -> bool:
+        """A source of the power-up reset (``vmon_ok`` low, /ResU pulled low) was seen at the last clock edge (M2)."""
+        return self._holding
+
     def forward_level(self) -> int:
         """The forward line output (``do2``) of the current cycle; it depends on state only."""
         return self._do2(self.cycle)

@@ -8,12 +8,14 @@ from it, and raises its interrupt events, I/O access bit and latch phase (docs/u
 MFP[7..0] are the µP interface's pins in the Init-µP modes (Tables 3-5 and 3-6): SAS_INIT on MFP0, I/O on
 MFP1, C/D on MFP2, /IRQ on MFP3, SCLK on MFP4, /SS on MFP5, SerIN or Ser_IN/OUT on MFP6, SerOUT or S/R on MFP7.
 MFP[15..8] stay with the core (bus terminal signals in BK modes). While the core is in reset (it drives
-``resu_drive``), the µP interface is held in reset too (docs/model.md M2).
+``resu_drive``, or a power-up reset begins at this clock edge), the µP interface is held in reset too (docs/model.md
+M2).
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from typing import Final
 
 import numpy as np
 import numpy.typing as npt
@@ -21,11 +23,27 @@ import numpy.typing as npt
 from supi3.config import DeviceConfig
 from supi3.model.chip import Supi3
 from supi3.model.pins import Supi3Pins, Trace
-from supi3.spi.slave_pins import PinsIn, SlavePins
-from supi3.verif.pinmodel import Pin
+from supi3.spi.slave_pins import PinsIn, PinsOut, SlavePins
+from supi3.verif.pinmodel import OE_SUFFIX, Pin
 
-UP_PINS = 0x00FF
+UP_INPUTS: Final[dict[str, int]] = {"sas_init": 0, "sclk": 4, "ss_n": 5, "mfp6": 6, "mfp7": 7}
+"""The MFP pin of each input of the µP interface (:class:`PinsIn` field, Tables 3-5 and 3-6)."""
+UP_OUTPUTS: Final[dict[str, int]] = {"io": 1, "c_d": 2, "irq_n": 3, "mfp6": 6, "mfp7": 7}
+"""The MFP pin of each output of the µP interface (:class:`PinsOut` field; its enable is ``<field>_oe``)."""
+UP_PINS: Final = 0x00FF
 """MFP[7..0]: the µP interface's pins in the Init-µP modes."""
+
+
+def up_pin_inputs(mfp: int) -> PinsIn:
+    """The µP interface's inputs from the MFP[15..0] input levels."""
+    return PinsIn(**{name: (mfp >> pin) & 1 for name, pin in UP_INPUTS.items()})
+
+
+def up_pin_outputs(up: PinsOut) -> tuple[int, int]:
+    """The MFP levels (undriven bits 0) and output enables of the µP interface's outputs ``up``."""
+    enables = sum(getattr(up, name + OE_SUFFIX) << pin for name, pin in UP_OUTPUTS.items())
+    levels = sum(getattr(up, name) << pin for name, pin in UP_OUTPUTS.items())
+    return levels & enables, enables
 
 
 class Supi3Chip:
@@ -65,14 +83,11 @@ class Supi3Chip:
         out = self.core.step(inputs)
         if self.upif is None:
             return out
-        mfp = int(inputs["mfp_in"])
-        up = self.upif.tick(PinsIn(sas_init=mfp & 1, sclk=(mfp >> 4) & 1, ss_n=(mfp >> 5) & 1,
-                                   mfp6=(mfp >> 6) & 1, mfp7=(mfp >> 7) & 1))
-        if out["resu_drive"]:
+        up = self.upif.tick(up_pin_inputs(int(inputs["mfp_in"])))
+        if out["resu_drive"] or self.core.holding:
             self.upif.reset()
-        levels = (up.io << 1) | (up.c_d << 2) | (up.irq_n << 3) | (up.mfp6 << 6) | (up.mfp7 << 7)
-        enables = (up.io_oe << 1) | (up.c_d_oe << 2) | (up.irq_n_oe << 3) | (up.mfp6_oe << 6) | (up.mfp7_oe << 7)
-        out["mfp_out"] = (out["mfp_out"] & ~UP_PINS) | (levels & enables)
+        levels, enables = up_pin_outputs(up)
+        out["mfp_out"] = (out["mfp_out"] & ~UP_PINS) | levels
         out["mfp_oe"] = (out["mfp_oe"] & ~UP_PINS) | enables
         return out
 
