@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 from supi3 import tables
 from supi3.config import DeviceConfig, MfpKind, decode
 from supi3.interbus import wire
+from supi3.interbus.errors import InterbusError
 from supi3.interbus.master import Master
 from supi3.interbus.ring import BitFlip, CorruptLoopback, Ring, Truncate
 from supi3.model.chip import STATERR_FILTER_CLOCKS, Supi3
@@ -190,5 +191,5 @@ def test_command_word_round_trip() -> None:
         for alarm in (False, True):
             word = wire.command_word(1, True, pcmd, alarm)
             assert wire.decode_command(word) == wire.Command(1, True, pcmd, alarm)
-    with pytest.raises(wire.InterbusError, match="one byte"):
+    with pytest.raises(InterbusError, match="one byte"):
         wire.command_word(processor_command=0x100)
