@@ -34,6 +34,7 @@ pin                   dir  meaning
 
 from __future__ import annotations
 
+from bisect import bisect_right
 from collections.abc import Mapping, Sequence
 from typing import Final, NamedTuple
 
@@ -571,10 +572,17 @@ class Supi3Pins:
             trace = synced[name]
             change[1:] |= trace[1:] != trace[:-1]
         input_events = np.flatnonzero(change).tolist()
-        columns = [synced[name] for name in _INPUT_NAMES]
+        # The synchronised inputs are piecewise constant: keep their values once per piece, found by bisection.
+        pieces = change.copy()
+        for name in ("mfp_in", "di2"):
+            trace = synced[name]
+            pieces[1:] |= trace[1:] != trace[:-1]
+        starts = np.flatnonzero(pieces)
+        values = [Synced(*row) for row in zip(*(synced[name][starts].tolist() for name in _INPUT_NAMES), strict=True)]
+        starts_list = starts.tolist()
         snaps = [(0, self._snapshot())]
         k = 0
-        due = self._next_due(c0 - 1, int(columns[0][0])) if n else _NEVER
+        due = self._next_due(c0 - 1, values[0].do1) if n else _NEVER
         while True:
             next_input = input_events[k] if k < len(input_events) else n
             t = min(next_input, due - c0)
@@ -583,7 +591,7 @@ class Supi3Pins:
             if t == next_input:
                 k += 1
             c = c0 + t
-            s = Synced(*(int(column[t]) for column in columns))
+            s = values[bisect_right(starts_list, t) - 1]
             self.cycle = c
             if c >= self._run_from or self._holding or not (s.resu_n and s.vmon_ok):
                 self._tick(c, s)
