@@ -16,8 +16,12 @@ Blocks, in the order the model's ``_tick`` runs them within one clock:
 * transmitter: a short queue of (countdown, level) entries that repeats each bit ``REPEATER_DELAY_BITS`` after it
   began on DO1, with the ERR pair of the CNTR word settled at the last stop bit (docs/interbus.md, A7, A10).
 
-µP-mode behaviour (the register file of :mod:`supi3.model.registers`) is a later slice: in SPI master, Init-µP
-and bus terminal modes the core sends IN data 0, which is what the model does before software acts.
+µP modes: built with ``register_file=True`` (:class:`supi3.rtl.chip.Supi3Chip`), the core has the ports of the
+register file's core side (:class:`supi3.rtl.upif.UpifBlock`): in Init-µP modes it takes the IN bytes, the ID
+register and the processor alarm from it and strobes the latch, events, processor command, I/O access bit and
+resets at the clocks the model calls :class:`~supi3.model.registers.RegisterFile`. Without it, and in SPI master and
+bus terminal modes, the core sends IN data 0 and the straps' ID code, which is what the model does before software
+acts.
 """
 
 from __future__ import annotations
@@ -41,6 +45,8 @@ from supi3.model.pins import (
     SYNC_STAGES,
     Supi3Pins,
 )
+from supi3.regmap import INTERRUPT_SOURCES
+from supi3.regmap.core import BYTE_BITS
 from supi3.rtl.tables import (
     C_BITS,
     CLK_CONF_BITS,
@@ -52,13 +58,24 @@ from supi3.rtl.tables import (
     CoreTables,
     core_tables,
 )
+from supi3.rtl.upif import upif_tables
+from supi3.spi.block_pins import CORE_INPUTS, CORE_OUTPUTS, EVENT_BITS, STRAP_INPUTS
 from supi3.verif.pinmodel import Pin
 
-__all__ = ["STRAP_PINS", "Supi3Core", "verilog"]
+__all__ = ["REGISTER_FILE_INPUTS", "REGISTER_FILE_OUTPUTS", "STRAP_PINS", "Supi3Core", "verilog"]
 
 STRAP_PINS: Final = (Pin("c", C_BITS), Pin("rf", RF_BITS), Pin("clk_conf", CLK_CONF_BITS),
                      Pin("diag_conf", DIAG_CONF_BITS))  # fmt: skip
 """The strap input ports, beyond the model's pins (Tables 2-2, 2-4 to 2-7, 1-7, 3-16)."""
+
+REGISTER_FILE_INPUTS: Final = tuple(pin for pin in CORE_OUTPUTS if pin.name in ("in_data", "bus_id", "alarm"))
+"""What the core takes from the register file (:class:`supi3.rtl.upif.UpifBlock`'s outputs of the same names)."""
+REGISTER_FILE_OUTPUTS: Final = (
+    *STRAP_INPUTS,
+    *(pin for pin in CORE_INPUTS
+      if pin.name in ("power_up", "ib_reset", "events", "io_access", "latch", "latch_out", "pcmd_we", "pcmd")),
+)  # fmt: skip
+"""What the core gives the register file (the block's inputs of the same names; the optical ones stay 0)."""
 
 WORD_BITS: Final = 8 * len(wire.word_bytes(0))
 """16-bit words: ID register, command word, CRC, CNTR (docs/interbus.md A4)."""
@@ -68,6 +85,8 @@ _STATUS_TELEGRAM_END: Final = wire.STATUS_TELEGRAM_BITS - 1
 _WD_OFF: Final = WATCHDOG_CLOCKS.index(None)
 """The watchdog code that stands for "off"; also the state after an INTERBUS reset (no code set)."""
 _WD_CODE_BITS: Final = (len(WATCHDOG_CLOCKS) - 1).bit_length()
+_SOURCE_BIT: Final = {source.name: source.bit for source in INTERRUPT_SOURCES}
+"""The ``events`` bit of each interrupt source (Table 3-13)."""
 
 
 def _width(value: int) -> int:
@@ -103,15 +122,19 @@ class Supi3Core(wiring.Component):
     variant:
         ``"opc"`` (TQFP 64) or ``"ls"`` (TQFP 44, Table 1-1). On the LS the ``rf`` and ``diag_conf`` ports exist
         but are ignored (the pins do not, Table 1-4), and only the LS's modes decode (C4 = 1).
+    register_file:
+        Add the ports :data:`REGISTER_FILE_INPUTS` (in) and :data:`REGISTER_FILE_OUTPUTS` and ``init_up`` (out)
+        that join the core to :class:`supi3.rtl.upif.UpifBlock` in Init-µP modes (``init_up`` = 1).
     """
 
-    def __init__(self, variant: Variant | str = Variant.OPC) -> None:
+    def __init__(self, variant: Variant | str = Variant.OPC, *, register_file: bool = False) -> None:
         self.variant = Variant(variant)
         self.tables = core_tables(self.variant)
+        self.register_file = register_file
         members: dict[str, object] = {}
-        for pin in (*Supi3Pins.inputs, *STRAP_PINS):
+        for pin in (*Supi3Pins.inputs, *STRAP_PINS, *(REGISTER_FILE_INPUTS if register_file else ())):
             members[pin.name] = In(pin.width)
-        for pin in Supi3Pins.outputs:
+        for pin in (*Supi3Pins.outputs, *((*REGISTER_FILE_OUTPUTS, Pin("init_up")) if register_file else ())):
             members[pin.name] = Out(pin.width)
         super().__init__(members)
 
@@ -122,8 +145,10 @@ class Supi3Core(wiring.Component):
         tables = self.tables
 
         # Strap decode (Tables 2-4 to 2-7, 1-7, 2-2, 3-16) --------------------------------------------------------
-        id_register = Signal(WORD_BITS)
-        data_bytes = Signal(range(tables.register_bits // 8 + 1))
+        strap_id = Signal(WORD_BITS)
+        strap_bytes = Signal(range(tables.register_bits // 8 + 1))
+        init_up = Signal()
+        rate = Signal(range(max(e.rate for e in tables.clocks) + 1))
         io_map = Signal(range(len(tables.io_maps)))
         clocks = tables.clocks
         cpb = Signal(range(max(e.clocks_per_bit for e in clocks) + 1))
@@ -138,8 +163,9 @@ class Supi3Core(wiring.Component):
             for mode in tables.modes:
                 with m.Case(mode.pattern):
                     m.d.comb += [
-                        id_register.eq(mode.id_register),
-                        data_bytes.eq(mode.data_bytes),
+                        strap_id.eq(mode.id_register),
+                        strap_bytes.eq(mode.data_bytes),
+                        init_up.eq(mode.init_up),
                         io_map.eq(maps.index(mode.io_map)),
                         self.mfp_oe.eq(mode.mfp_oe),
                     ]
@@ -151,6 +177,7 @@ class Supi3Core(wiring.Component):
             if entry.clocks_per_bit != 1 << cpb_bits:
                 raise ValueError(f"DCLK_OUT needs a power-of-two bit period, not {entry.clocks_per_bit}")
             return [
+                rate.eq(entry.rate),
                 cpb.eq(entry.clocks_per_bit),
                 reset_run.eq(entry.reset_run),
                 tx_init.eq(entry.forward_delay + entry.clocks_per_bit // 2 - 1),
@@ -185,10 +212,17 @@ class Supi3Core(wiring.Component):
             m.d.sync += stretch.eq(stretch - 1)
         running = ~power_fail & ~holding & (stretch == 0)
 
+        # Init-µP modes: the ID register, the data length and the IN data from the register file (docs/upif.md)
+        id_register = Signal(WORD_BITS)
+        data_bytes = Signal.like(strap_bytes)
+        up = self.register_file
+        in_data = self.in_data if up else Const(0, tables.register_bits)
         engine = _Engine(
             tables,
             id_register=id_register,
             data_bytes=data_bytes,
+            init_up=init_up if up else Const(0),
+            in_data=in_data,
             io_map=io_map,
             cpb=cpb,
             reset_run=reset_run,
@@ -197,6 +231,30 @@ class Supi3Core(wiring.Component):
             synced=synced,
         )
         m.submodules.engine = ResetInserter(power_fail)(EnableInserter(running)(engine))
+        m.d.comb += [id_register.eq(strap_id), data_bytes.eq(strap_bytes)]
+        if up:
+            up_bytes = Signal.like(strap_bytes)
+            with m.Switch(self.bus_id[BYTE_BITS:]):  # the length code (Table 3-11) as the register file applies it
+                for code, count in upif_tables().internal_bytes.items():
+                    with m.Case(code):
+                        m.d.comb += up_bytes.eq(count)
+            with m.If(init_up):
+                # A18: the processor alarm in place of the ID code when the master asked for it
+                up_id = Mux(engine.send_alarm, self.alarm, self.bus_id[:BYTE_BITS])
+                m.d.comb += [id_register.eq(Cat(up_id, self.bus_id[BYTE_BITS:])), data_bytes.eq(up_bytes)]
+            m.d.comb += [
+                self.init_up.eq(init_up),
+                self.rate.eq(rate),
+                Cat(self.np_id, self.np_length).eq(strap_id),
+                self.power_up.eq(~init_up | power_fail | self.resu_drive),
+                self.ib_reset.eq(running & engine.ib_reset),
+                self.events.eq(Mux(running, engine.events, 0)),
+                self.io_access.eq(Mux(running, engine.io_set | (engine.io & ~engine.io_clear), engine.io)),
+                self.latch.eq(running & engine.latch),
+                self.latch_out.eq(engine.register),
+                self.pcmd_we.eq(running & engine.pcmd_we),
+                self.pcmd.eq(engine.pcmd),
+            ]
 
         pf, bus_active = engine.pf, engine.bus_active
         fast, slow = (IB_DIAG_DIVIDER_BITS[k] - 1 for k in ("fast", "slow"))
@@ -223,6 +281,10 @@ class _Engine(Elaboratable):
     It runs only on the clocks where the model's ``_tick`` runs its logic; :class:`Supi3Core` inserts the enable and
     the power-up reset. The chip registers follow :class:`supi3.model.chip.Supi3`; the order of the statements
     follows the model's order within one clock, later assignments winning as later Python assignments do.
+
+    In Init-µP modes (``init_up``) the IN data come from ``in_data``; the strobes ``latch``, ``pcmd_we``,
+    ``events``, ``ib_reset``, ``io_set`` and ``io_clear`` mark the clocks at which the model calls its register
+    file (:class:`Supi3Core` gates them with the enable).
     """
 
     def __init__(
@@ -231,6 +293,8 @@ class _Engine(Elaboratable):
         *,
         id_register: Value,
         data_bytes: Value,
+        init_up: Value,
+        in_data: Value,
         io_map: Value,
         cpb: Value,
         reset_run: Value,
@@ -241,6 +305,8 @@ class _Engine(Elaboratable):
         self.tables = tables
         self.id_register = id_register
         self.data_bytes = data_bytes
+        self.init_up = init_up
+        self.in_data = in_data
         self.io_map = io_map
         self.cpb = cpb
         self.reset_run = reset_run
@@ -254,6 +320,16 @@ class _Engine(Elaboratable):
         self.res_reg_n = Signal()
         self.pf = Signal()
         self.bus_active = Signal()
+        self.register = Signal(tables.register_bits)
+        self.send_alarm = Signal()
+        self.io = Signal()
+        self.io_set = Signal()
+        self.io_clear = Signal()
+        self.latch = Signal()
+        self.pcmd_we = Signal()
+        self.pcmd = Signal(BYTE_BITS)
+        self.events = Signal(EVENT_BITS)
+        self.ib_reset = Signal()
 
     def elaborate(self, _platform: object) -> Module:
         m = Module()
@@ -306,8 +382,14 @@ class _Engine(Elaboratable):
         wd_now = wd | fire
         attention_now = attention | (filtered & ~pf) | fire
         sync += [pf.eq(pf_now), wd.eq(wd_now), attention.eq(attention_now)]
+        events = self.events
+
+        def event(source: str) -> Value:
+            return events[_SOURCE_BIT[source]].eq(1)
+
         with m.If(fire):  # the watchdog resets process data (Table 3-13)
             sync += [wd_active.eq(0), mfp_out.eq(0), res_reg.eq(RESREG_PULSE_CLOCKS - 1)]
+            comb += [self.ib_reset.eq(1), event("IB_RESET")]
 
         # The following device (Table 2-2, M5)
         with m.If(self.rbst_by_pin):
@@ -342,13 +424,20 @@ class _Engine(Elaboratable):
                 te.eq(0),
                 attention.eq(pf_now),
                 bus_active.eq(0),
+                self.send_alarm.eq(0),
             ]
+
+        discard = Signal()  # a frame ends unlatched (chip.discard_at): the invalid-data-cycle event
+        io = self.io
+        sync += io.eq(self.io_set | (io & ~self.io_clear))
 
         with m.If(enter_reset):
             sync += [in_reset.eq(1), reset_end.eq(0), state.eq(_State.IDLE), latches.eq(0), *chip_reset()]
+            comb += [self.ib_reset.eq(1), self.io_clear.eq(1)]
         with m.If(idle_timeout):
             # A frame abandoned here raises TE, which the INTERBUS reset clears again at once.
             sync += [state.eq(_State.IDLE), latches.eq(0), *chip_reset()]
+            comb += [self.ib_reset.eq(1), self.io_clear.eq(1), discard.eq(state != _State.IDLE)]
         in_reset_now = in_reset | enter_reset
 
         # Receiver: framing and mid-bit sampling ------------------------------------------------------------------
@@ -382,7 +471,8 @@ class _Engine(Elaboratable):
 
         # Frame engine --------------------------------------------------------------------------------------------
         id_cycle = Signal()  # the frame's cycle type: 1 = ID cycle
-        register = Signal(reg_bits)
+        register = self.register
+        frame_bytes = Signal.like(self.data_bytes)  # the register's length, fixed when the frame is loaded
         crc_rx = Signal(WORD_BITS, init=wire.CRC_INIT)
         crc_tx = Signal(WORD_BITS, init=wire.CRC_INIT)
         index = Signal(range(wire.CHECK_TELEGRAMS + 2))
@@ -404,7 +494,7 @@ class _Engine(Elaboratable):
         ) or wire.CNTR_ATTN_BIT > wire.CNTR_NATTN_BIT:
             raise ValueError("the model settles the ERR pair as the last two CNTR bits, after ATTN and /ATTN")
 
-        register_bytes = Mux(id_cycle, WORD_BITS // 8, self.data_bytes)
+        register_bytes = frame_bytes
         shift_out = Mux(register_bytes == 0, line, register[0])
         shifted = Signal(reg_bits)
         for i in range(reg_bits):
@@ -416,6 +506,7 @@ class _Engine(Elaboratable):
 
         def abandon() -> list[Value]:
             """A frame ends unlatched: invalid cycle, TE |= local error (Table 3-13)."""
+            m.d.comb += [discard.eq(state != _State.IDLE), self.io_clear.eq(1)]
             return [state.eq(_State.IDLE), latches.eq(0), te.eq(te | ((state != _State.IDLE) & local_error))]
 
         te_now = te | ((state != _State.IDLE) & local_error)
@@ -432,6 +523,8 @@ class _Engine(Elaboratable):
             for k, (in_pins, _) in enumerate(tables.io_maps):
                 with m.Case(k):
                     comb += in_word.eq(Cat(*(mfp_s[p] if p is not None else Const(0) for p in in_pins)))
+        with m.If(self.init_up):  # the IN bytes, cleared first by a watchdog reset at this clock
+            comb += in_word.eq(Mux(fire, 0, self.in_data))
 
         check_n = Cat(j, index[:2])  # bit of the check sequence, line order
         cntr_b = check_n[:4]
@@ -443,6 +536,7 @@ class _Engine(Elaboratable):
                     *abandon(),
                     state.eq(_State.DATA),
                     id_cycle.eq(cycle_id),
+                    frame_bytes.eq(Mux(cycle_id, WORD_BITS // 8, self.data_bytes)),
                     register.eq(Mux(cycle_id, id_word, in_word)),
                     crc_rx.eq(wire.CRC_INIT),
                     crc_tx.eq(wire.CRC_INIT),
@@ -455,6 +549,7 @@ class _Engine(Elaboratable):
             with m.If(check):
                 with m.If(state == _State.DATA):
                     sync += [state.eq(_State.CHECK), index.eq(0), crc_bad.eq(0), cntr_bad.eq(0)]
+                    comb += self.io_set.eq(~id_cycle)  # the I/O access window of a data cycle (Fig. 3-22)
                 with m.Elif(state == _State.CHECK):
                     sync += index.eq(index + 1)
                 with m.If(~((state == _State.DATA) | ((state == _State.CHECK) & (index + 1 < wire.CHECK_TELEGRAMS)))):
@@ -540,8 +635,15 @@ class _Engine(Elaboratable):
                         sync += abandon()
                     with m.Elif(latched == wire.LATCH_STATUS_TELEGRAMS):  # chip.latch_at
                         sync += [state.eq(_State.IDLE), latches.eq(0)]
+                        comb += [self.io_clear.eq(1), event("PCP_TX")]
                         with m.If(id_cycle):  # the command word (docs/interbus.md A9)
                             command = register[:WORD_BITS]
+                            sync += self.send_alarm.eq(command[wire.CMD_ALARM_BIT])  # A18
+                            comb += [
+                                self.pcmd_we.eq(command[wire.CMD_PCMD_BIT]),
+                                self.pcmd.eq(command[wire.CMD_PCMD_SHIFT :][:BYTE_BITS]),
+                                event("ID_CYCLE"),
+                            ]
                             code = command[wire.CMD_WD_CODE_SHIFT :][:_WD_CODE_BITS]
                             with m.If(command[wire.CMD_WD_SET_BIT]):
                                 sync += [wd_code.eq(code), *arm(code)]
@@ -550,12 +652,14 @@ class _Engine(Elaboratable):
                             sync += [wd.eq(0), te.eq(0), attention.eq(0)]
                         with m.Else():  # OUT data to the MFPs (Tables 3-1, 3-2), watchdog restarted
                             sync += [bus_active.eq(1), *arm(wd_code)]
+                            comb += [self.latch.eq(1), event("VALID"), event("PCP_RX")]
                             with m.Switch(self.io_map):
                                 for k, (_, out_bits) in enumerate(tables.io_maps):
                                     with m.Case(k):
                                         sync += mfp_out.eq(
                                             Cat(*(register[b] if b is not None else Const(0) for b in out_bits))
                                         )
+        comb += events[_SOURCE_BIT["INVALID"]].eq(discard & ~id_cycle)
         return m
 
 

@@ -18,7 +18,7 @@ from supi3.config import DeviceConfig, Straps, Variant, decode, mode_rows
 from supi3.errors import ConfigurationError
 from supi3.interbus.wire import Cycle
 from supi3.model.pins import Supi3Pins
-from supi3.tables import DIAG_CONFIGURATIONS, MODE_ROWS, RF_MODES
+from supi3.tables import BIT_RATES, DIAG_CONFIGURATIONS, MODE_ROWS, RF_MODES
 
 MFP_PINS: Final = next(pin.width for pin in Supi3Pins.inputs if pin.name == "mfp_in")
 """MFP[15..0] (Table 1-4)."""
@@ -58,6 +58,9 @@ class ModeEntry:
         the start of a data cycle, or ``None`` (loaded with 0).
     out_bits:
         For each MFP pin, the shift-register bit it takes at the latch of a data cycle, or ``None`` (driven 0).
+    init_up:
+        An Init-µP mode: the model has a register file, which gives the ID register and the data from the serial
+        µP interface (:mod:`supi3.model.top`); ``id_register`` and ``data_bytes`` are then its µP_Not_Ready values.
     """
 
     pattern: str
@@ -66,6 +69,7 @@ class ModeEntry:
     mfp_oe: int
     in_pins: tuple[int | None, ...]
     out_bits: tuple[int | None, ...]
+    init_up: bool
 
     @property
     def io_map(self) -> tuple[tuple[int | None, ...], tuple[int | None, ...]]:
@@ -78,6 +82,8 @@ class ClockEntry:
     """One usable CLK_CONF[1..0] value (Table 1-7) and the timing the model derives from its bit rate."""
 
     clk_conf: int
+    rate: int
+    """The bit rate's index in :data:`supi3.tables.BIT_RATES`."""
     clocks_per_bit: int
     forward_delay: int
     """Clocks from a bit's first synchronised edge to its repetition on DO2 (docs/interbus.md A10)."""
@@ -130,7 +136,8 @@ def _probe_mode(config: DeviceConfig) -> ModeEntry:
             out_bits[chip.mfp_outputs.bit_length() - 1] = bit
     straps = config.straps()
     pattern = straps.c + (straps.mfp if straps.mfp is not None else "-" * EXPANSION_BITS)
-    return ModeEntry(pattern, id_register, n, pins.mfp_oe, tuple(in_pins), tuple(out_bits))
+    init_up = chip.registers is not None
+    return ModeEntry(pattern, id_register, n, pins.mfp_oe, tuple(in_pins), tuple(out_bits), init_up)
 
 
 def _values(width: int, make: Callable[[str], DeviceConfig]) -> list[tuple[int, DeviceConfig]]:
@@ -157,7 +164,8 @@ def core_tables(variant: Variant | str = Variant.OPC) -> CoreTables:
     clocks = []
     for value, config in _values(CLK_CONF_BITS, lambda b: decode(first.c, first.mfp, clk_conf=b, variant=variant)):
         pins = Supi3Pins(config)
-        clocks.append(ClockEntry(value, pins.cpb, pins.forward_delay, pins.reset_run))
+        rate = BIT_RATES.index(config.bit_rate)
+        clocks.append(ClockEntry(value, rate, pins.cpb, pins.forward_delay, pins.reset_run))
     if variant is Variant.LS:  # no RF and DIAG_CONF pins (Table 1-4): the model's defaults for the LS
         ls = Supi3Pins(decode(first.c, first.mfp, variant=variant))
         rbst = tuple(range(1 << RF_BITS)) if ls.rbst_by_pin else ()
