@@ -4,6 +4,8 @@ The RTL core (:class:`supi3.rtl.core.Supi3Core`) reads its configuration from st
 every operating mode. :class:`StrapPins` gives the model the same ports: it decodes the straps it sees on the first
 clock (:func:`supi3.config.decode`) and from then on is the model of that configuration. Stimulus drives the straps
 as constants (:func:`strap_inputs`), with MFP[15..12] at the configuration expansion where the mode has one.
+:class:`ChipStrapPins` does the same for the whole chip (:class:`supi3.model.top.Supi3Chip`, the model of
+:class:`supi3.rtl.chip.Supi3Chip`).
 """
 
 from __future__ import annotations
@@ -15,12 +17,13 @@ import numpy.typing as npt
 
 from supi3.config import DeviceConfig, Variant, decode, mode_rows
 from supi3.model.pins import Supi3Pins
+from supi3.model.top import Supi3Chip
 from supi3.rtl.core import STRAP_PINS
 from supi3.rtl.tables import EXPANSION_BITS, MFP_PINS
 from supi3.verif.errors import PinSpecError
 from supi3.verif.pinmodel import Pin
 
-__all__ = ["StrapPins", "strap_inputs", "strap_stimulus"]
+__all__ = ["ChipStrapPins", "StrapPins", "strap_inputs", "strap_stimulus"]
 
 _STRAP_NAMES = tuple(pin.name for pin in STRAP_PINS)
 _EXPANSION_SHIFT = MFP_PINS - EXPANSION_BITS
@@ -127,3 +130,62 @@ class StrapPins:
     def recent_events(self) -> list[str]:
         """The model's last bus events, for mismatch reports."""
         return self.pins.log.recent() if self.pins is not None else []
+
+
+class ChipStrapPins:
+    """:class:`~supi3.model.top.Supi3Chip` with the strap ports of the RTL chip (a :class:`PinModel`).
+
+    The µP interface rules are not enforced (``strict=False``): violations are recorded in the register file's
+    ``violations`` and the chip carries on, as the RTL does.
+
+    Parameters
+    ----------
+    variant:
+        The chip variant the straps are decoded for (the RTL's elaboration parameter).
+
+    Raises
+    ------
+    PinSpecError
+        From :meth:`step` and :meth:`run`, when the straps of the first clock select no operating mode, or change.
+    """
+
+    inputs: Sequence[Pin] = StrapPins.inputs
+    outputs: Sequence[Pin] = Supi3Chip.outputs
+
+    def __init__(self, variant: Variant | str = Variant.OPC) -> None:
+        self.straps = StrapPins(variant)
+        self.chip: Supi3Chip | None = None
+        self._straps: tuple[int, ...] = ()
+
+    def reset(self) -> None:
+        """Forget the configuration: the next :meth:`step` decodes the straps again."""
+        self.chip = None
+
+    def _model(self, inputs: Mapping[str, int]) -> Supi3Chip:
+        straps = tuple(int(inputs[name]) for name in _STRAP_NAMES)
+        if self.chip is None:
+            self.chip = Supi3Chip(self.straps.config_for(inputs), strict=False)
+            self._straps = straps
+        elif straps != self._straps:
+            raise PinSpecError(f"cycle {self.chip.core.cycle}: the straps changed ({self._straps} -> {straps})")
+        return self.chip
+
+    def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
+        """One clock of the chip the straps select (see :mod:`supi3.verif.pinmodel`)."""
+        return self._model(inputs).step(inputs)
+
+    def run(self, inputs: Mapping[str, npt.NDArray[np.integer]]) -> dict[str, npt.NDArray[np.int64]]:
+        """Whole traces at once (:meth:`Supi3Chip.run`); the straps must be constant."""
+        first = {name: int(np.asarray(trace)[0]) for name, trace in inputs.items()}
+        for name in _STRAP_NAMES:
+            if np.any(np.asarray(inputs[name]) != first[name]):
+                raise PinSpecError(f"the straps must not change during a run ({name})")
+        return self._model(first).run({pin.name: np.asarray(inputs[pin.name]) for pin in Supi3Pins.inputs})
+
+    def recent_events(self) -> list[str]:
+        """The core's last bus events and the register file's last violations, for mismatch reports."""
+        if self.chip is None:
+            return []
+        registers = self.chip.chip.registers
+        violations = [str(v) for v in registers.violations.records[-8:]] if registers is not None else []
+        return [*self.chip.core.log.recent(), *violations]
