@@ -80,9 +80,9 @@ def fmax(source: Path, yosys: str, nextpnr: str, directory: Path) -> float:
     return float(found[-1])
 
 
-def workload(data_cycles: int) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+def workload(data_cycles: int, clk_conf: str = "11") -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """Reset, ID cycle and ``data_cycles`` data cycles of the 8 IN/8 OUT remote bus mode at 2 Mbit/s."""
-    config = decode("10000", clk_conf="11")
+    config = decode("10000", clk_conf=clk_conf)
     rng = np.random.default_rng(1)
     idle = wire.status_levels(Cycle.DATA, False, 8)
     parts = [
@@ -109,10 +109,10 @@ def workload(data_cycles: int) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     return strap_stimulus(config, np.stack([inputs[k] for k in names], axis=1)), inputs
 
 
-def speed(data_cycles: int, amaranth_cycles: int) -> None:
-    stimulus, inputs = workload(data_cycles)
+def speed(data_cycles: int, amaranth_cycles: int, clk_conf: str) -> None:
+    stimulus, inputs = workload(data_cycles, clk_conf)
     n = stimulus.shape[0]
-    config = decode("10000", clk_conf="11")
+    config = decode("10000", clk_conf=clk_conf)
     names = [pin.name for pin in StrapPins.inputs]
     rows = [dict(zip(names, row, strict=True)) for row in stimulus.tolist()]
     model = StrapPins("opc")
@@ -170,7 +170,9 @@ def main() -> None:
                     f"{part} {variant:<4} {ge:>9,.0f} GE (target < {TARGET_GE:,})   "
                     f"iCE40 HX8K Fmax {mhz:6.1f} MHz (target > {TARGET_MHZ:.0f})"
                 )
-    speed(args.data_cycles, args.amaranth)
+    for clk_conf, rate in (("01", "500 kbit/s"), ("11", "2 Mbit/s")):
+        print(f"speed, one chip (RB 8 IN/8 OUT) at {rate}, {args.data_cycles} data cycles:")
+        speed(args.data_cycles, args.amaranth, clk_conf)
 
 
 if __name__ == "__main__":

