@@ -176,12 +176,12 @@ class Layout:
         """Output words ``(cycles, words)`` unpacked into compared signals ``(cycles, signals)``."""
         columns = np.empty((words.shape[0], len(self.out_fields)), dtype=np.uint64)
         for index, field in enumerate(self.out_fields):
-            column = words[:, field.word].astype(np.uint64)
             if field.width > WORD:
+                column = words[:, field.word].astype(np.uint64)
                 column |= words[:, field.word + 1].astype(np.uint64) << np.uint64(WORD)
-            else:
-                column = (column >> np.uint64(field.shift)) & np.uint64(field.mask)
-            columns[:, index] = column
+                columns[:, index] = column
+            else:  # within one word: shift and mask in 32 bits
+                columns[:, index] = (words[:, field.word] >> np.uint32(field.shift)) & np.uint32(field.mask)
         return columns
 
 
@@ -239,9 +239,7 @@ def model_trace(model: PinModel, stimulus: Trace, layout: Layout) -> Trace:
     bulk = getattr(model, "run", None)
     if callable(bulk):
         columns = bulk({name: stimulus[:, index] for index, name in enumerate(names)})
-        trace = np.zeros((len(stimulus), len(layout.out_fields)), dtype=np.uint64)
-        for index, field in enumerate(layout.out_fields):
-            trace[:, index] = np.asarray(columns[field.name], dtype=np.uint64)
+        trace = np.stack([np.asarray(columns[field.name]) for field in layout.out_fields], axis=1).astype(np.uint64)
     else:
         step = model.step
         values = layout.output_values
@@ -257,15 +255,17 @@ def model_trace(model: PinModel, stimulus: Trace, layout: Layout) -> Trace:
 
 
 def first_mismatch(layout: Layout, expected: Trace, actual: Trace) -> tuple[int, int] | None:
-    """The first ``(cycle, signal index)`` where two output traces differ, gated by output enables, or ``None``."""
-    best: tuple[int, int] | None = None
+    """The first ``(cycle, signal index)`` where two output traces differ, gated by output enables, or ``None``.
+
+    Within the first differing cycle the lowest signal index (comparison order) is reported.
+    """
+    differ = expected != actual
     index_of = {field.name: index for index, field in enumerate(layout.out_fields)}
     for index, field in enumerate(layout.out_fields):
-        differ = expected[:, index] != actual[:, index]
         if field.enable is not None:
-            differ &= expected[:, index_of[field.enable]] != 0
-        if differ.any():
-            cycle = int(np.argmax(differ))
-            if best is None or cycle < best[0]:
-                best = (cycle, index)
-    return best
+            differ[:, index] &= expected[:, index_of[field.enable]] != 0
+    rows = differ.any(axis=1)
+    if not rows.any():
+        return None
+    cycle = int(np.argmax(rows))
+    return cycle, int(np.argmax(differ[cycle]))
