@@ -72,18 +72,6 @@ class Bench:
             self.tick(IDLE_MFP, int(level))
 
 
-def _frames(samples: list[int]) -> list[Frame]:
-    received = wire.parse_levels(wire.samples_to_levels(np.array(samples, dtype=np.uint8), 2_000_000))
-    telegrams = [t for t in received if isinstance(t, wire.Telegram)]  # the reset pattern carries no frame
-    frames = []
-    while any(t.data is not None for t in telegrams):
-        frame = wire.frame_from_telegrams(telegrams)
-        frames.append(frame)
-        first = next(i for i, t in enumerate(telegrams) if t.data is not None)
-        telegrams = telegrams[first + len(frame.data) + wire.CHECK_TELEGRAMS :]
-    return frames
-
-
 def test_firmware_configures_the_chip_and_exchanges_data_at_pin_level() -> None:
     bench = Bench()
     assert bench.spi(0x00) == 0  # initialization byte: Motorola (Table 3-8)
@@ -101,7 +89,8 @@ def test_firmware_configures_the_chip_and_exchanges_data_at_pin_level() -> None:
     # The INTERBUS reset cleared the IN bytes (3.4.7): firmware writes them after the ID cycle (Table 3-13).
     bench.write(0, 0x77)
     bench.send(np.concatenate([wire.cycle_levels(Frame.build(Cycle.DATA, lw + b"\x99"), 1, True), idle]))
-    frames = _frames(bench.returned[start + 3 * 16 :])  # the repeater delays the return line by 3 bit periods
+    returned = np.array(bench.returned[start + 3 * 16 :], dtype=np.uint8)  # the repeater delays by 3 bit periods
+    frames = wire.frames_from_levels(wire.samples_to_levels(returned, 2_000_000))
     assert frames[0].data == wire.word_bytes(0x0901) + lw  # ID register: ID 01h, length code 01001 (1 byte)
     assert frames[1].data == b"\x77" + lw  # IN byte 0 went to the master
     assert bench.irq_n[-1] == 0  # /IRQ on MFP3: valid data cycle

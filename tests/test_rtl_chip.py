@@ -126,18 +126,6 @@ class Firmware:
         self.master.run(cycles)
 
 
-def _frames(samples: list[int], bit_rate: int) -> list[Frame]:
-    received = wire.parse_levels(wire.samples_to_levels(np.array(samples, dtype=np.uint8), bit_rate))
-    telegrams = [t for t in received if isinstance(t, wire.Telegram)]
-    frames = []
-    while any(t.data is not None for t in telegrams):
-        frame = wire.frame_from_telegrams(telegrams)
-        frames.append(frame)
-        first = next(i for i, t in enumerate(telegrams) if t.data is not None)
-        telegrams = telegrams[first + len(frame.data) + wire.CHECK_TELEGRAMS :]
-    return frames
-
-
 def id_frame(command: int) -> npt.NDArray[np.uint8]:
     return wire.cycle_levels(Frame.build(Cycle.ID, LOOPBACK + wire.word_bytes(command)), 1, True)
 
@@ -186,7 +174,7 @@ def test_firmware_configures_the_chip_and_exchanges_data(bench: Lockstep, mode: 
     pins.send(np.concatenate([data_frame(b"\x99"), IDLE]))
     pins.drain(64)
     returned = [out["di1"] for out in pins.outputs[start + 3 * wire.clocks_per_bit(pins.config.bit_rate) :]]
-    frames = _frames(returned, pins.config.bit_rate)
+    frames = wire.frames_from_levels(wire.samples_to_levels(np.array(returned, dtype=np.uint8), pins.config.bit_rate))
     assert frames[0].data == wire.word_bytes(0x0901) + LOOPBACK  # ID 01h, length code 01001 (1 byte)
     assert frames[1].data == b"\x77" + LOOPBACK
     assert pins.outputs[-1]["mfp_out"] >> UP_OUTPUTS["irq_n"] & 1 == 0  # /IRQ: valid data cycle
@@ -215,7 +203,7 @@ def test_management_channel(bench: Lockstep) -> None:
     assert pins.outputs[-1]["mfp_out"] >> UP_OUTPUTS["irq_n"] & 1 == 0
     assert up.read(PCMD_ALARM) == 0xC3
     returned = [out["di1"] for out in pins.outputs[start + 3 * wire.clocks_per_bit(pins.config.bit_rate) :]]
-    frames = _frames(returned, pins.config.bit_rate)
+    frames = wire.frames_from_levels(wire.samples_to_levels(np.array(returned, dtype=np.uint8), pins.config.bit_rate))
     assert frames[-1].data[:2] == wire.word_bytes(0x095A)  # the alarm in place of the ID code (A18)
     replay(bench, pins)
 

@@ -705,3 +705,16 @@ def samples_to_levels(samples: Sequence[int] | LevelArray, bit_rate: int, phase:
     if not 0 <= at < cpb:
         raise InterbusError("docs/interbus.md, Line", phase, f"sampling phase must be in 0..{cpb - 1}")
     return np.asarray(samples, dtype=np.uint8)[at::cpb]
+
+
+def frames_from_levels(levels: Sequence[int] | LevelArray) -> list[Frame]:
+    """Every complete frame in a received level sequence, in order; resets and status telegrams between frames
+    are skipped (a receiving master's or testbench's view of a line)."""
+    telegrams = [t for t in parse_levels(levels) if isinstance(t, Telegram)]
+    frames: list[Frame] = []
+    while any(t.data is not None for t in telegrams):
+        frame = frame_from_telegrams(telegrams)
+        frames.append(frame)
+        first = next(i for i, t in enumerate(telegrams) if t.data is not None)
+        telegrams = telegrams[first + len(frame.data) + CHECK_TELEGRAMS :]
+    return frames
