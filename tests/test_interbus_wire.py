@@ -232,3 +232,11 @@ def test_cycle_bits(data_bytes: int, devices: int) -> None:
     assert rest >= devices * wire.REPEATER_DELAY_BITS + wire.STATUS_TELEGRAM_BITS * wire.LATCH_STATUS_TELEGRAMS
     # The manual's CPU access window after the latch, 13 x (5 + n) bit periods (3.4.14), fits in one cycle.
     assert bits >= 13 * (5 + data_bytes)
+
+
+def test_frames_from_levels_finds_every_frame() -> None:
+    first = wire.Frame.build(wire.Cycle.ID, wire.LOOPBACK_BYTES_ON_LINE + b"\x01\x02")
+    second = wire.Frame.build(wire.Cycle.DATA, wire.LOOPBACK_BYTES_ON_LINE + b"\xa5")
+    idle = wire.status_levels(wire.Cycle.DATA, False, 3)
+    levels = np.concatenate([idle, wire.reset_levels(1), wire.frame_levels(first), idle, wire.frame_levels(second)])
+    assert wire.frames_from_levels(levels) == [first, second]
