@@ -7,10 +7,11 @@ Runs inside the simulator process. The DUT is the packed top-level (:class:`~sup
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from typing import Any
 
 from cocotb.clock import Clock
-from cocotb.triggers import FallingEdge, ReadOnly
+from cocotb.triggers import FallingEdge
 
 from supi3.verif.layout import WORD, Layout, Trace, model_trace
 from supi3.verif.pinmodel import PinModel, recent_events
@@ -24,8 +25,9 @@ async def lockstep(dut: Any, model: PinModel, stimulus: Trace, *, reset_cycles: 
     """Clock the DUT and the model together and compare every output signal on every cycle.
 
     Timing per cycle ``n`` (see :mod:`supi3.verif.pinmodel`): at the falling clock edge the inputs of cycle ``n`` are
-    written to the DUT and given to the model's ``step``; once the DUT has settled (``ReadOnly``) its outputs are
-    compared with the model's; the next rising edge updates both. Before cycle 0 the ``sync`` reset is held for
+    written to the DUT and given to the model's ``step``; the rising edge ending the cycle updates both, and the top
+    level holds the DUT's outputs of cycle ``n`` (``lsq``), which are compared at the next falling edge. One wait
+    per cycle. Before cycle 0 the ``sync`` reset is held for
     ``reset_cycles`` rising edges with all inputs at 0, and the model is reset.
 
     Parameters
@@ -48,9 +50,8 @@ async def lockstep(dut: Any, model: PinModel, stimulus: Trace, *, reset_cycles: 
     """
     layout = Layout.of(model)
     in_port = dut.lsi if layout.in_words else None
-    out_port = dut.lso
+    held_port = dut.lsq
     falling = FallingEdge(dut.clk)
-    settled = ReadOnly()
 
     dut.rst.value = 1
     if in_port is not None:
@@ -71,27 +72,36 @@ async def lockstep(dut: Any, model: PinModel, stimulus: Trace, *, reset_cycles: 
     packed_inputs = [
         sum(word << (WORD * index) for index, word in enumerate(row)) for row in layout.input_words(stimulus).tolist()
     ]
+    rows = stimulus.tolist()
+    cycles = len(rows)
+    expected: Sequence[int] = ()
     start = time.perf_counter()
-    for cycle, (row, packed) in enumerate(zip(stimulus.tolist(), packed_inputs, strict=True)):
+    # One wait per cycle: at the falling edge in cycle n the inputs of cycle n are written; the outputs of cycle n
+    # (settled with those inputs, before the edge ending it) are read from the held word at the next falling edge.
+    for cycle in range(cycles + 1):
         if cycle:
             await falling
+            actual = held_port.value.to_unsigned()
+            previous = cycle - 1
+            history[previous % window] = actual
+            if not matches(expected, actual):
+                seconds = time.perf_counter() - start
+                signal = layout.first_difference(expected, layout.unpack_outputs(actual))
+                assert signal is not None, "matches() and first_difference() agree"
+                first = max(0, previous + 1 - window)
+                if ahead is not None:  # replay up to the mismatch, so the bus events end there
+                    model_trace(model, stimulus[: previous + 1], layout)
+                record = MismatchRecord(
+                    previous, signal, recent_events(model), [history[k % window] for k in range(first, previous + 1)]
+                )
+                return Outcome(previous + 1, seconds, record)
         else:
             dut.rst.value = 0
-        if in_port is not None:
-            in_port.value = packed
-        expected = ahead[cycle] if ahead is not None else output_values(step(dict(zip(names, row, strict=True))))
-        await settled
-        actual = out_port.value.to_unsigned()
-        history[cycle % window] = actual
-        if not matches(expected, actual):
-            seconds = time.perf_counter() - start
-            signal = layout.first_difference(expected, layout.unpack_outputs(actual))
-            assert signal is not None, "matches() and first_difference() agree"
-            first = max(0, cycle + 1 - window)
-            if ahead is not None:  # replay up to the mismatch, so the bus events end there
-                model_trace(model, stimulus[: cycle + 1], layout)
-            record = MismatchRecord(
-                cycle, signal, recent_events(model), [history[k % window] for k in range(first, cycle + 1)]
-            )
-            return Outcome(cycle + 1, seconds, record)
+        if cycle < cycles:
+            if in_port is not None and (cycle == 0 or packed_inputs[cycle] != packed_inputs[cycle - 1]):
+                in_port.value = packed_inputs[cycle]  # a write only when an input changes: most cycles have none
+            if ahead is not None:
+                expected = ahead[cycle]
+            else:
+                expected = output_values(step(dict(zip(names, rows[cycle], strict=True))))
     return Outcome(stimulus.shape[0], time.perf_counter() - start)

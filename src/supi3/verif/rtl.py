@@ -6,7 +6,9 @@ output's enable) and uses the ``sync`` clock domain, which the harness clocks an
 
 :class:`LockstepTop` wraps it so the simulator sees only ``clk``, ``rst``, the input words ``lsi0``, ``lsi1``, ...
 packed into one port ``lsi`` and the output words into one port ``lso`` (word ``n`` at bits ``32n`` to ``32n + 31``;
-see :class:`~supi3.verif.layout.Layout`). ``lsi`` is absent when the model has no inputs.
+see :class:`~supi3.verif.layout.Layout`). ``lsi`` is absent when the model has no inputs. ``lsq`` is ``lso`` as it
+was just before the last rising clock edge: the outputs of the cycle that edge ended, held for the whole next cycle,
+so a testbench can read them without waiting for the design to settle.
 """
 
 from __future__ import annotations
@@ -53,6 +55,7 @@ class LockstepTop(Elaboratable):
         self.domain = ClockDomain("sync")
         self.in_bits = Signal(WORD * layout.in_words, name="lsi")
         self.out_bits = Signal(WORD * layout.out_words, name="lso")
+        self.out_held = Signal(WORD * layout.out_words, name="lsq", reset_less=True)
         self.inputs = {field.name: self._port(field.name, field.width, assignable=True) for field in layout.in_fields}
         self.outputs = {field.name: self._port(field.name, field.width) for field in layout.out_fields}
 
@@ -76,8 +79,10 @@ class LockstepTop(Elaboratable):
 
     @property
     def ports(self) -> list[Signal]:
-        """The top-level ports: clock, reset, input words (if any), output words."""
-        words = [self.in_bits, self.out_bits] if self.layout.in_words else [self.out_bits]
+        """The top-level ports: clock, reset, input words (if any), output words, held output words."""
+        words = [self.out_bits, self.out_held]
+        if self.layout.in_words:
+            words.insert(0, self.in_bits)
         return [self.domain.clk, self.domain.rst, *words]
 
     def elaborate(self, _platform: object) -> Module:
@@ -88,6 +93,7 @@ class LockstepTop(Elaboratable):
             m.d.comb += self.inputs[field.name].eq(self.in_bits[field.offset : field.offset + field.width])
         for field in self.layout.out_fields:
             m.d.comb += self.out_bits[field.offset : field.offset + field.width].eq(self.outputs[field.name])
+        m.d.sync += self.out_held.eq(self.out_bits)
         return m
 
 
