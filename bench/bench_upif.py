@@ -23,7 +23,7 @@ from supi3.regmap import REGISTER_MAP, encode_command
 from supi3.spi.slave_pins import SlavePins
 from supi3.spi.upif import Mode, UpInterface
 from supi3.spi.waves import SET_1_BYTE, SoftMaster
-from supi3.timing import timing_table
+from supi3.timing import limit
 
 CLK_CONF = {500_000: "01", 2_000_000: "11"}  # CLK_CONF[1..0] (Table 1-7)
 BYTES_PER_ACCESS = 2  # command byte + data byte (3.4.4)
@@ -35,17 +35,11 @@ def _registers(bit_rate: int) -> RegisterFile:
 
 def real_byte_s(bit_rate: int) -> float:
     """Shortest time per byte of the real interface at the maximum SCLK (Table 3-7)."""
-    t = {row.symbol: row for row in timing_table("3-7", bit_rate)}
-
     def low(symbol: str) -> float:
-        value = t[symbol].minimum_s
-        assert value is not None
-        return value
+        return limit("3-7", symbol, bit_rate)
 
     def high(symbol: str) -> float:
-        value = t[symbol].maximum_s
-        assert value is not None
-        return value
+        return limit("3-7", symbol, bit_rate, maximum=True)
 
     t0 = low("t0")
     lead = max(low("t1"), high("t7") - t0 / 2)
@@ -111,7 +105,7 @@ def main(argv: list[str] | None = None) -> None:
     for bit_rate in tables.BIT_RATES:
         real_bytes = 1 / real_byte_s(bit_rate)
         real_accesses = real_bytes / BYTES_PER_ACCESS
-        sclk_mhz = 1e-6 / next(t.minimum_s or 0.0 for t in timing_table("3-7", bit_rate) if t.symbol == "t0")
+        sclk_mhz = 1e-6 / limit("3-7", "t0", bit_rate)
         pin_rate, model_byte_s = pin_bytes_per_s(bit_rate, args.bytes, args.repeat)
         print(f"{bit_rate // 1000} kbit/s, SCLK max {sclk_mhz:.2f} MHz: real {real_byte_s(bit_rate) * 1e6:.3f} µs/byte"
               f" = {real_bytes:,.0f} bytes/s = {real_accesses:,.0f} accesses/s")

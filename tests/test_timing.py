@@ -92,3 +92,12 @@ def test_data_cycle_time_follows_the_wire_format() -> None:
     assert timing.data_cycle_time_s(8, 2, 2_000_000) > timing.data_cycle_time_s(4, 1, 2_000_000)
     with pytest.raises(timing.TimingError, match="devices >= 1"):
         timing.data_cycle_time_s(4, 0, 500_000)
+
+
+def test_limit_reads_one_table_value() -> None:
+    assert timing.limit("3-7", "t_SAS_INIT", 500_000) == pytest.approx(250e-9)
+    assert timing.limit("3-7", "t6", 500_000, maximum=True) == pytest.approx(375e-9)
+    with pytest.raises(timing.TimingError, match="no maximum"):
+        timing.limit("3-7", "t1", 500_000, maximum=True)
+    with pytest.raises(timing.TimingError, match="no parameter"):
+        timing.limit("3-7", "t99", 500_000)

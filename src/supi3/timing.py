@@ -112,6 +112,23 @@ def timing_table(table: str, bit_rate: int, n_bytes: int = 2) -> list[EvaluatedT
     return result
 
 
+def limit(table: str, symbol: str, bit_rate: int, *, maximum: bool = False) -> float:
+    """One limit of a timing table for a bit rate, in seconds (the minimum unless ``maximum``).
+
+    Raises
+    ------
+    TimingError
+        If the table has no such symbol, or gives no such limit for it.
+    """
+    for row in timing_table(table, bit_rate):
+        if row.symbol == symbol:
+            value = row.maximum_s if maximum else row.minimum_s
+            if value is None:
+                raise TimingError(f"Table {table} gives no {'maximum' if maximum else 'minimum'} for {symbol}")
+            return value
+    raise TimingError(f"Table {table} has no parameter {symbol!r}")
+
+
 # ------------------------------------------------------------------------------------------------------------
 # Optical path length (1.6.1, Table 1-5)
 # ------------------------------------------------------------------------------------------------------------

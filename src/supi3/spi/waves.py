@@ -34,7 +34,7 @@ from supi3.model.vcd import CLOCK_PS
 from supi3.regmap import REGISTER_MAP, encode_command
 from supi3.spi.slave_pins import INPUT_PINS, OUTPUT_PINS, PinsIn, PinsOut, SlavePins
 from supi3.spi.upif import BLOCK_ADDRESS, Mode, UpifUsageError
-from supi3.timing import timing_table
+from supi3.timing import limit
 
 __all__ = [
     "FIGURES",
@@ -96,20 +96,15 @@ class MasterTiming:
         UpifUsageError
             If ``sclk_hz`` is faster than t0 allows.
         """
-        limits = {t.symbol: t for t in timing_table("3-7", bit_rate)}
 
         def cycles(seconds: float) -> int:
             return math.ceil(seconds * clock_hz - _EPSILON)
 
         def minimum(symbol: str) -> float:
-            value = limits[symbol].minimum_s
-            assert value is not None
-            return value
+            return limit("3-7", symbol, bit_rate)
 
         def maximum(symbol: str) -> float:
-            value = limits[symbol].maximum_s
-            assert value is not None
-            return value
+            return limit("3-7", symbol, bit_rate, maximum=True)
 
         shortest = cycles(minimum("t0"))
         period = shortest if sclk_hz is None else cycles(1 / sclk_hz)
