@@ -97,10 +97,10 @@ IDLE_INPUTS: Final = Synced(wire.IDLE_LEVEL, 0, 0, 0, 1, 1, 1)
 _NEVER: Final = 1 << 62
 
 
-def _integers(trace: Sequence[int] | npt.NDArray[np.generic]) -> npt.NDArray[np.integer]:
-    """An input trace as an integer array, without a copy when it already is one."""
-    array = np.asarray(trace)
-    return array if np.issubdtype(array.dtype, np.integer) else array.astype(np.int64)
+def _integers(trace: Sequence[int] | npt.NDArray[np.generic]) -> npt.NDArray[np.int64]:
+    """An input trace as a contiguous ``int64`` array (the fastest for the event search), without a copy when it
+    already is one."""
+    return np.ascontiguousarray(trace, dtype=np.int64)
 
 
 class Supi3Pins:
@@ -142,6 +142,7 @@ class Supi3Pins:
         self.config = config
         self.chip = chip if chip is not None else Supi3(config)
         self.cpb = wire.clocks_per_bit(config.bit_rate)
+        self._half_bit = self.cpb // 2
         self.mfp_oe = config.mfp_output_mask
         self.log = EventLog()
         self.complete_diagnostics = config.diagnostics is not None and config.diagnostics.diag_conf == 0
@@ -300,28 +301,30 @@ class Supi3Pins:
         if stat != self._stat_active:
             self._stat_active = stat
             chip._set_stat_err(stat, c)
-        due = chip.next_event()
-        if due is not None and c >= due:
+        if c >= chip._due:
             chip._advance(c)
         self._receive(s.do1, c)
 
     def _next_due(self, c: int, line: int) -> int:
         """The next cycle after ``c`` at which the logic acts with unchanged inputs."""
+        # Comparisons rather than min(): this runs once per visited cycle of run().
         if c < self._run_from:
             return self._run_from
+        if not self._rx_busy and line == wire.START_LEVEL:
+            return c + 1  # a start bit: nothing can be due sooner
         due = self._last_start + IDLE_TIMEOUT_CLOCKS
         if due <= c:
             due = _NEVER
         if self._rx_busy:
-            due = min(due, self._t0 + self.cpb // 2 + self._bit * self.cpb)
-        elif line == wire.START_LEVEL:
-            due = c + 1
+            sample = self._t0 + self._half_bit + self._bit * self.cpb
+            if sample < due:
+                due = sample
         low = self._low_since
-        if low is not None and c < low + self.reset_run - 1:
-            due = min(due, low + self.reset_run - 1)
-        chip_due = self.chip.next_event()
-        if chip_due is not None:
-            due = min(due, max(chip_due, c + 1))
+        if low is not None and c < low + self.reset_run - 1 < due:
+            due = low + self.reset_run - 1
+        chip_due = self.chip._due
+        if chip_due < due:
+            due = chip_due if chip_due > c else c + 1
         return due
 
     def _receive(self, line: int, c: int) -> None:
@@ -346,7 +349,7 @@ class Supi3Pins:
                 self._length = wire.DATA_TELEGRAM_BITS
                 self._last_start = c
             return
-        if c == self._t0 + self.cpb // 2 + self._bit * self.cpb:
+        if c == self._t0 + self._half_bit + self._bit * self.cpb:
             self._sample(line, c)
             self._bit += 1
 
@@ -566,37 +569,57 @@ class Supi3Pins:
         self._recording = True
         full = self._synced_traces(raw, n)
         synced = {name: trace[:n] for name, trace in full.items()}
+        line = synced["do1"]
+        line_change = np.ones(n, dtype=bool)
+        line_change[1:] = line[1:] != line[:-1]
         change = np.zeros(n, dtype=bool)
-        change[0] = n > 0
-        for name in ("do1", "rbst_ext", "stat_err_n", "resu_n", "vmon_ok"):
+        change[:1] = True
+        for name in ("stat_err_n", "resu_n", "vmon_ok"):
             trace = synced[name]
             change[1:] |= trace[1:] != trace[:-1]
-        input_events = np.flatnonzero(change).tolist()
+        # Input events: cycles where a synchronised input the logic reads changes. A change of the line (do1) only
+        # matters while the receiver waits for a start bit: in a telegram the receiver acts at its due cycles
+        # (mid-bit samples), and the one thing a line change does there, marking where a run of start level began
+        # for the INTERBUS-reset detector, is restored from the trace at each visited cycle (_restore_low_run).
+        line_events = np.flatnonzero(line_change).tolist()
+        other_events = [*np.flatnonzero(change).tolist(), n]
+        self._run_low = (c0, self._low_since, np.maximum.accumulate(np.where(line_change, np.arange(n), 0)))
         # The synchronised inputs are piecewise constant: keep their values once per piece, found by bisection.
-        pieces = change.copy()
-        for name in ("mfp_in", "di2"):
+        pieces = line_change | change
+        for name in ("mfp_in", "di2", "rbst_ext"):
             trace = synced[name]
             pieces[1:] |= trace[1:] != trace[:-1]
         starts = np.flatnonzero(pieces)
-        values = [Synced(*row) for row in zip(*(synced[name][starts].tolist() for name in _INPUT_NAMES), strict=True)]
+        values = list(map(Synced._make, zip(*(synced[name][starts].tolist() for name in _INPUT_NAMES), strict=True)))
         starts_list = starts.tolist()
         snaps = [(0, self._snapshot())]
-        k = 0
+        k = kl = 0
         due = self._next_due(c0 - 1, values[0].do1) if n else _NEVER
+        t = -1
         while True:
-            next_input = input_events[k] if k < len(input_events) else n
-            t = min(next_input, due - c0)
+            while other_events[k] <= t:
+                k += 1
+            after = min(other_events[k], due - c0)
+            if not self._rx_busy:
+                kl = bisect_right(line_events, t, kl)
+                if kl < len(line_events) and line_events[kl] < after:
+                    after = line_events[kl]
+            t = after
             if t >= n:
                 break
-            if t == next_input:
-                k += 1
             c = c0 + t
             s = values[bisect_right(starts_list, t) - 1]
             self.cycle = c
+            if c >= self._run_from:
+                self._restore_low_run(t, s.do1)
             if c >= self._run_from or self._holding or not (s.resu_n and s.vmon_ok):
                 self._tick(c, s)
-            snaps.append((t + 1, self._snapshot()))
+            snap = self._snapshot()
+            if snap != snaps[-1][1]:
+                snaps.append((t + 1, snap))
             due = self._next_due(c, s.do1)
+        if n and c0 + n - 1 >= self._run_from:
+            self._restore_low_run(n - 1, int(line[n - 1]))
         self._recording = False
         self.cycle = c0 + n
         self._pipe = [Synced(*(int(full[name][n + SYNC_STAGES - 1 - i]) for name in _INPUT_NAMES))
@@ -606,6 +629,17 @@ class Supi3Pins:
         if len(self._tx) > 8:
             del self._tx[:-8]
         return traces
+
+    def _restore_low_run(self, t: int, level: int) -> None:
+        """Set the reset detector's ``_low_since`` as :meth:`_receive` leaves it at run cycle ``t`` (the logic
+        running, the synchronised line at ``level``): where this run of start level began, or ``None``."""
+        if level != wire.START_LEVEL:
+            self._low_since = None
+            return
+        c0, before, starts = self._run_low
+        start = int(starts[t])
+        # A run of start level that began before this run() call continues the one the detector already saw.
+        self._low_since = before if start == 0 and before is not None else max(c0 + start, self._run_from)
 
     def _shifted_pipe(self, raw: Mapping[str, npt.NDArray[np.integer]], n: int) -> list[Synced]:
         pipe = list(self._pipe)
@@ -619,8 +653,10 @@ class Supi3Pins:
         # The snapshot taken after each visited cycle holds until the next one: repeat each over its cycles.
         starts = np.array([t for t, _ in snaps], dtype=np.int64)
         lengths = np.diff(np.append(starts, n)).clip(min=0)
-        held = np.repeat(np.array([snap for _, snap in snaps], dtype=np.int64), lengths, axis=0)
-        mfp_out, diag1, pf, bus_active, mod_ack_until, resreg_until, run_from = held.T
+        table = np.array([snap for _, snap in snaps], dtype=np.int64)
+        mfp_out, diag1, pf, bus_active, mod_ack_until, resreg_until, run_from = (
+            np.repeat(column, lengths) for column in table.T
+        )
         fast = 1 - ((cycles >> (IB_DIAG_DIVIDER_BITS["fast"] - 1)) & 1)
         slow = 1 - ((cycles >> (IB_DIAG_DIVIDER_BITS["slow"] - 1)) & 1)
         out = {
@@ -631,19 +667,21 @@ class Supi3Pins:
             "resu_drive": (cycles < run_from).astype(np.int64),
             "ib_diag": np.where(pf != 0, fast, np.where(bus_active != 0, 1, slow)),
         }
-        do2 = np.full(n, wire.IDLE_LEVEL, dtype=np.int64)
         cpb = self.cpb
         if tx:
-            # Each bit lasts cpb clocks or until the next bit begins (starts are in order): as _do2() reads it.
-            starts = np.array([start for start, _ in tx], dtype=np.int64)
-            bits = np.array([bit for _, bit in tx], dtype=np.int64)
-            ends = np.minimum(starts + cpb, np.append(starts[1:], _NEVER))
-            lo = np.clip(starts - c0, 0, n)
-            lengths = np.clip(ends - c0, 0, n) - lo
-            lengths[lengths < 0] = 0
-            first = np.cumsum(lengths) - lengths
-            where = np.repeat(lo - first, lengths) + np.arange(int(lengths.sum()))
-            do2[where] = np.repeat(bits, lengths)
+            # Each bit lasts cpb clocks or until the next bit begins (starts are in order), as _do2() reads it; the
+            # line idles in the gaps. Runs of (gap, bit) levels, repeated over their lengths, are the trace.
+            sent = np.array(tx, dtype=np.int64)
+            bit_starts, bits = sent[:, 0], sent[:, 1]
+            ends = np.minimum(bit_starts + cpb, np.append(bit_starts[1:], _NEVER))
+            lo = np.clip(bit_starts - c0, 0, n)
+            hi = np.maximum(np.clip(ends - c0, 0, n), lo)
+            gaps = lo - np.append(0, hi[:-1])
+            levels = np.column_stack([np.full(len(bits), wire.IDLE_LEVEL), bits]).ravel()
+            runs = np.column_stack([gaps, hi - lo]).ravel()
+            do2 = np.append(np.repeat(levels, runs), np.full(n - int(hi[-1]), wire.IDLE_LEVEL, dtype=np.int64))
+        else:
+            do2 = np.full(n, wire.IDLE_LEVEL, dtype=np.int64)
         out["do2"] = do2
         out["mfp_oe"] = np.full(n, self.mfp_oe, dtype=np.int64)
         out["diag2"] = np.zeros(n, dtype=np.int64)
