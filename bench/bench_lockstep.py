@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from supi3.verif import Layout, Lockstep, first_mismatch, model_trace
+from supi3.verif import Layout, Lockstep, model_trace
 from supi3.verif.amaranth_sim import run_amaranth_sim
 from supi3.verif.example import ShiftCounter, ShiftCounterModel
 
@@ -84,12 +84,12 @@ def main() -> None:
     executable = bench.batch_executable()
     with tempfile.TemporaryDirectory() as scratch:
         inputs, outputs = Path(scratch) / "in.bin", Path(scratch) / "out.bin"
-        inputs.write_bytes(layout.input_words(big_u64).astype("<u4").tobytes())
+        layout.input_words(big_u64).astype("<u4").tofile(inputs)
         command = [str(executable), str(inputs), str(outputs), str(args.batch), "1"]
         report("batch: RTL replay alone", args.batch, timed(lambda: subprocess.run(command, check=True)))
         words = np.fromfile(outputs, dtype="<u4").reshape(-1, layout.out_words)
-    actual = layout.output_trace(words)
-    report("batch: numpy compare alone", args.batch, timed(lambda: first_mismatch(layout, expected, actual)))
+    packed = layout.output_words(expected)
+    report("batch: numpy compare alone", args.batch, timed(lambda: layout.first_word_mismatch(packed, words)))
 
     result = run_amaranth_sim(ShiftCounter, ShiftCounterModel, stimulus(args.amaranth))
     report("amaranth-sim: lockstep on amaranth.sim", result.cycles, result.seconds)

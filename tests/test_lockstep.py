@@ -122,8 +122,36 @@ def test_words_round_trip(values: list[int]) -> None:
     for index in range(layout.out_words):
         words[0, index] = (packed >> (32 * index)) & 0xFFFF_FFFF
     assert layout.output_trace(words)[0].tolist() == row
+    assert layout.output_words(np.array([row], dtype=np.uint64)).tolist() == words.tolist()
+    assert layout.pack_outputs(row) == words[0].tolist()
     assert layout.unpack_outputs(packed) == tuple(row)
     assert layout.matches(row, packed)
+
+
+@given(st.lists(st.lists(st.integers(0, 2**64 - 1), min_size=5, max_size=5), min_size=1, max_size=4))
+def test_input_words_place_every_field(rows: list[list[int]]) -> None:
+    pins = [Pin("a", 3), Pin("b", 64), Pin("c", 31), Pin("d", 33), Pin("e", 1)]
+    layout = Layout(pins, [Pin("x")])
+    stimulus = np.array([[v & pin.mask for v, pin in zip(row, pins, strict=True)] for row in rows], dtype=np.uint64)
+    words = layout.input_words(stimulus)
+    for row, packed_row in zip(stimulus.tolist(), words.tolist(), strict=True):
+        packed = sum(value << field.offset for value, field in zip(row, layout.in_fields, strict=True))
+        assert packed_row == [(packed >> (32 * index)) & 0xFFFF_FFFF for index in range(layout.in_words)]
+
+
+@settings(max_examples=200)
+@given(st.data())
+def test_word_compare_agrees_with_signal_compare(data: st.DataObject) -> None:
+    layout = Layout([Pin("a")], [Pin("x", 5), Pin("y", 40, tristate=True), Pin("t", 2, tristate=True)])
+    cycles = data.draw(st.integers(1, 6))
+    signal = st.tuples(*(st.integers(0, field.mask) for field in layout.out_fields))
+    expected = np.array(data.draw(st.lists(signal, min_size=cycles, max_size=cycles)), dtype=np.uint64)
+    actual = expected.copy()
+    for cycle, index, value in data.draw(st.lists(st.tuples(st.integers(0, cycles - 1), st.integers(0, 4),
+                                                            st.integers(0, 2**40 - 1)), max_size=4)):
+        actual[cycle, index] = value & layout.out_fields[index].mask
+    found = first_mismatch(layout, expected, actual)
+    assert layout.first_word_mismatch(layout.output_words(expected), layout.output_words(actual)) == found
 
 
 def test_tristate_value_compared_only_while_enabled() -> None:
@@ -266,8 +294,10 @@ def test_batch_agrees_with_per_cycle_on_a_bug(
 
 @pytest.mark.usefixtures("bench")
 def test_model_output_wider_than_its_pin_is_named(build_root: Path) -> None:
-    with pytest.raises(PinSpecError, match="cycle 7: model output 'count' does not fit in 8 bits"):
-        run_lockstep_batch(ShiftCounter, WideOutputModel, random_stimulus(20, seed=4), build_dir=build_root)
+    lockstep = Lockstep(ShiftCounter, WideOutputModel, build_dir=build_root)
+    for run in (lockstep.run_batch, lockstep.run):
+        with pytest.raises(PinSpecError, match="cycle 7: model output 'count' does not fit in 8 bits"):
+            run(random_stimulus(20, seed=4))
 
 
 @pytest.mark.usefixtures("bench")
@@ -312,8 +342,8 @@ def test_batch_finds_the_injected_bug_whenever_it_shows(buggy: Lockstep, scenari
 
 @pytest.mark.usefixtures("bench")
 def test_partial_factories_are_accepted(build_root: Path) -> None:
-    lockstep = Lockstep(functools.partial(ShiftCounter), functools.partial(ShiftCounterModel), build_dir=build_root)
-    assert lockstep.run_batch(random_stimulus(1000, seed=5)).cycles == 1000
+    design, model = functools.partial(ShiftCounter), functools.partial(ShiftCounterModel)
+    assert run_lockstep_batch(design, model, random_stimulus(1000, seed=5), build_dir=build_root).cycles == 1000
 
 
 # Amaranth's simulator --------------------------------------------------------------------------------------------

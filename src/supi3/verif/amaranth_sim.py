@@ -50,9 +50,7 @@ def run_amaranth_sim(
     array = stimulus_array(stimulus, layout.inputs, max_cycles)
     top = LockstepTop(design_factory(), layout)
     names = layout.input_names
-    packed_inputs = [
-        sum(word << (WORD * index) for index, word in enumerate(row)) for row in layout.input_words(array).tolist()
-    ]
+    input_rows = layout.input_words(array)[:, : layout.in_words].tolist()
     history: list[tuple[int, ...]] = []
     found: list[int] = []
 
@@ -61,11 +59,11 @@ def run_amaranth_sim(
         step = model.step
         values = layout.output_values
         matches = layout.matches
-        for cycle, (row, packed) in enumerate(zip(array.tolist(), packed_inputs, strict=True)):
-            if layout.in_words:
-                ctx.set(top.in_bits, packed)
+        for cycle, (row, words) in enumerate(zip(array.tolist(), input_rows, strict=True)):
+            for port, word in zip(top.in_words, words, strict=True):
+                ctx.set(port, word)
             expected = values(step(dict(zip(names, row, strict=True))))
-            actual = ctx.get(top.out_bits)
+            actual = sum(ctx.get(port) << (WORD * index) for index, port in enumerate(top.out_words))
             history.append(layout.unpack_outputs(actual))
             if len(history) > window:
                 del history[0]

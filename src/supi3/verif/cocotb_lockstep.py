@@ -1,34 +1,39 @@
 """The per-cycle lockstep loop as a cocotb coroutine, for the harness's own testbench and for other cocotb tests.
 
-Runs inside the simulator process. The DUT is the packed top-level (:class:`~supi3.verif.rtl.LockstepTop`): ports
-``clk``, ``rst``, input words ``lsi<n>`` and output words ``lso<n>``.
+Runs inside the simulator process. The DUT is the packed top-level with its comparator
+(:class:`~supi3.verif.rtl.LockstepTop` built with a ``window``): ports ``clk``, ``rst``, input words ``lsi<n>``,
+expected output words ``lse<n>``, and the comparator's ``lsx``, ``lsc`` and ``lsw``.
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
 from typing import Any
 
+import numpy as np
 from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge
 
-from supi3.verif.layout import WORD, Layout, Trace, model_trace
+from supi3.verif.errors import PinSpecError
+from supi3.verif.layout import WORD, Layout, Trace, model_columns, model_trace
 from supi3.verif.pinmodel import PinModel, recent_events
 from supi3.verif.report import MismatchRecord, Outcome
 from supi3.verif.vcd import CYCLE_NS
 
-__all__ = ["lockstep"]
+__all__ = ["POLL_CYCLES", "lockstep"]
+
+POLL_CYCLES = 1024
+"""Cycles between two reads of the comparator's mismatch flag: how far the simulation may run past a mismatch."""
 
 
 async def lockstep(dut: Any, model: PinModel, stimulus: Trace, *, reset_cycles: int = 1, window: int = 64) -> Outcome:
-    """Clock the DUT and the model together and compare every output signal on every cycle.
+    """Clock the DUT and the model together; the top's comparator checks every output signal on every cycle.
 
-    Timing per cycle ``n`` (see :mod:`supi3.verif.pinmodel`): at the falling clock edge the inputs of cycle ``n`` are
-    written to the DUT and given to the model's ``step``; the rising edge ending the cycle updates both, and the top
-    level holds the DUT's outputs of cycle ``n`` (``lsq``), which are compared at the next falling edge. One wait
-    per cycle. Before cycle 0 the ``sync`` reset is held for
-    ``reset_cycles`` rising edges with all inputs at 0, and the model is reset.
+    Timing per cycle ``n`` (see :mod:`supi3.verif.pinmodel`): at the falling clock edge the inputs of cycle ``n`` and
+    the model's outputs for cycle ``n`` are written to the DUT (each word only when it changes); the rising edge
+    ending the cycle updates the design and compares its outputs with the expected words. One wait per cycle and
+    no read: the mismatch flag is read every :data:`POLL_CYCLES` cycles and at the end. Before cycle 0 the ``sync``
+    reset is held for ``reset_cycles`` rising edges with all inputs at 0, and the model is reset.
 
     Parameters
     ----------
@@ -41,67 +46,71 @@ async def lockstep(dut: Any, model: PinModel, stimulus: Trace, *, reset_cycles: 
     reset_cycles:
         Rising edges with reset asserted before cycle 0.
     window:
-        Cycles of history kept for the mismatch waveform.
+        The comparator's history: cycles of the RTL's outputs kept for the mismatch waveform (the top's build
+        parameter).
 
     Returns
     -------
     Outcome
-        Cycles compared, time taken, and the first mismatch if there was one (the loop stops there).
+        Cycles compared, time taken, and the first mismatch if there was one (the loop stops soon after it).
     """
     layout = Layout.of(model)
-    in_port = dut.lsi if layout.in_words else None
-    held_port = dut.lsq
+    in_ports = [getattr(dut, f"lsi{index}") for index in range(layout.in_words)]
+    expected_ports = [getattr(dut, f"lse{index}") for index in range(layout.out_words)]
+    flag = dut.lsx
     falling = FallingEdge(dut.clk)
 
     dut.rst.value = 1
-    if in_port is not None:
-        in_port.value = 0
+    for port in (*in_ports, *expected_ports):
+        port.value = 0
     Clock(dut.clk, CYCLE_NS, unit="ns").start(start_high=False)
     for _ in range(reset_cycles):
         await falling
     model.reset()
 
-    step = model.step
-    names = layout.input_names
-    output_values = layout.output_values
-    matches = layout.matches
+    in_words = layout.input_words(stimulus)[:, : len(in_ports)]
     # A model with a bulk run() (an event-driven model) computes every expected output before the simulation
-    # starts, so the per-cycle loop only drives, waits and compares; the stimulus is fixed, so this is the same.
-    ahead = model_trace(model, stimulus, layout).tolist() if callable(getattr(model, "run", None)) else None
-    history = [0] * window
-    packed_inputs = [
-        sum(word << (WORD * index) for index, word in enumerate(row)) for row in layout.input_words(stimulus).tolist()
-    ]
+    # starts, so the per-cycle loop only drives and waits; the stimulus is fixed, so this is the same.
+    ahead = callable(getattr(model, "run", None))
+    if ahead:
+        expected_words = layout.pack_columns(model_columns(model, stimulus, layout))
+        in_words = np.concatenate([in_words, expected_words], axis=1)
+    in_rows = in_words.tolist()
+    step, names, values, pack = model.step, layout.input_names, layout.output_values, layout.pack_outputs
     rows = stimulus.tolist()
     cycles = len(rows)
-    expected: Sequence[int] = ()
+    ports = [*in_ports, *expected_ports]
+    written: list[int | None] = [None] * len(ports)
     start = time.perf_counter()
-    # One wait per cycle: at the falling edge in cycle n the inputs of cycle n are written; the outputs of cycle n
-    # (settled with those inputs, before the edge ending it) are read from the held word at the next falling edge.
-    for cycle in range(cycles + 1):
+    dut.rst.value = 0
+    for cycle in range(cycles):
         if cycle:
             await falling
-            actual = held_port.value.to_unsigned()
-            previous = cycle - 1
-            history[previous % window] = actual
-            if not matches(expected, actual):
-                seconds = time.perf_counter() - start
-                signal = layout.first_difference(expected, layout.unpack_outputs(actual))
-                assert signal is not None, "matches() and first_difference() agree"
-                first = max(0, previous + 1 - window)
-                if ahead is not None:  # replay up to the mismatch, so the bus events end there
-                    model_trace(model, stimulus[: previous + 1], layout)
-                record = MismatchRecord(
-                    previous, signal, recent_events(model), [history[k % window] for k in range(first, previous + 1)]
-                )
-                return Outcome(previous + 1, seconds, record)
+            if not cycle % POLL_CYCLES and flag.value:
+                break
+        if ahead:
+            words = in_rows[cycle]
         else:
-            dut.rst.value = 0
-        if cycle < cycles:
-            if in_port is not None and (cycle == 0 or packed_inputs[cycle] != packed_inputs[cycle - 1]):
-                in_port.value = packed_inputs[cycle]  # a write only when an input changes: most cycles have none
-            if ahead is not None:
-                expected = ahead[cycle]
-            else:
-                expected = output_values(step(dict(zip(names, rows[cycle], strict=True))))
-    return Outcome(stimulus.shape[0], time.perf_counter() - start)
+            try:
+                expected = pack(values(step(dict(zip(names, rows[cycle], strict=True)))))
+            except PinSpecError as error:
+                raise PinSpecError(f"cycle {cycle}: {error}") from None
+            words = in_rows[cycle] + expected
+        if words != written:
+            for index, word in enumerate(words):
+                if word != written[index]:
+                    ports[index].value = word  # a write only when a word changes: most cycles have none
+            written = words
+    await falling  # the edge ending the last cycle written has compared it
+    seconds = time.perf_counter() - start
+    if not flag.value:
+        return Outcome(cycles, seconds)
+    mismatch = int(dut.lsc.value) - 1
+    expected_trace = model_trace(model, stimulus[: mismatch + 1], layout)  # a replay: the events end there too
+    bits = WORD * layout.out_words
+    history = dut.lsw.value.to_unsigned()
+    kept = min(window, mismatch + 1)
+    actual = [(history >> (bits * age)) & ((1 << bits) - 1) for age in reversed(range(kept))]
+    signal = layout.first_difference(expected_trace[-1].tolist(), layout.unpack_outputs(actual[-1]))
+    assert signal is not None, "the comparator and first_difference() agree"
+    return Outcome(mismatch + 1, seconds, MismatchRecord(mismatch, signal, recent_events(model), actual))

@@ -19,7 +19,9 @@ import numpy.typing as npt
 from supi3.verif.errors import PinSpecError
 from supi3.verif.pinmodel import Pin, PinModel, compared_signals
 
-__all__ = ["Field", "Layout", "Stimulus", "Trace", "first_mismatch", "model_trace", "stimulus_array"]
+__all__ = [
+    "Field", "Layout", "Stimulus", "Trace", "first_mismatch", "model_columns", "model_trace", "stimulus_array",
+]  # fmt: skip
 
 Trace: TypeAlias = npt.NDArray[np.uint64]
 """Values per cycle and signal: shape ``(cycles, signals)``."""
@@ -30,6 +32,7 @@ or an iterable (list, generator) of per-cycle dicts; a pin missing from a dict k
 first)."""
 
 WORD = 32
+_WORD_MASK = (1 << WORD) - 1
 
 
 @dataclass(frozen=True)
@@ -164,13 +167,68 @@ class Layout:
 
     def input_words(self, stimulus: Trace) -> npt.NDArray[np.uint32]:
         """Stimulus ``(cycles, inputs)`` packed into ``uint32`` input words ``(cycles, words)``."""
-        packed = np.zeros((stimulus.shape[0], max(self.in_words, 1)), dtype=np.uint32)
+        # One integer matrix product places every field of up to 32 bits (the fields of a word are disjoint and
+        # the stimulus is range-checked, so the sums are exact); a wider field fills its two words alone.
+        weights = np.zeros((len(self.in_fields), max(self.in_words, 1)), dtype=np.uint64)
         for index, field in enumerate(self.in_fields):
-            column = stimulus[:, index]
-            packed[:, field.word] |= ((column & np.uint64(0xFFFF_FFFF)) << np.uint64(field.shift)).astype(np.uint32)
+            if field.width <= WORD:
+                weights[index, field.word] = 1 << field.shift
+        packed = (stimulus.astype(np.uint64, copy=False) @ weights).astype(np.uint32)
+        for index, field in enumerate(self.in_fields):
             if field.width > WORD:
-                packed[:, field.word + 1] = (column >> np.uint64(WORD)).astype(np.uint32)
+                packed[:, field.word] = stimulus[:, index] & np.uint64(_WORD_MASK)
+                packed[:, field.word + 1] = stimulus[:, index] >> np.uint64(WORD)
         return packed
+
+    def output_words(self, trace: Trace) -> npt.NDArray[np.uint32]:
+        """Compared output values ``(cycles, signals)`` packed into ``uint32`` output words ``(cycles, words)``,
+        the inverse of :meth:`output_trace`."""
+        return self.pack_columns(list(np.ascontiguousarray(trace.T)))
+
+    def pack_columns(self, columns: Sequence[npt.NDArray[np.uint64]]) -> npt.NDArray[np.uint32]:
+        """Compared output values, one array per signal (as :func:`model_columns` gives them), packed into
+        ``uint32`` output words ``(cycles, words)``."""
+        return _pack(self.out_fields, self.out_words, columns)
+
+    def first_word_mismatch(
+        self, expected: npt.NDArray[np.uint32], actual: npt.NDArray[np.uint32]
+    ) -> tuple[int, int] | None:
+        """The first ``(cycle, signal index)`` where two traces of output words differ, gated by output enables,
+        or ``None``; the same answer as :func:`first_mismatch` on the unpacked traces."""
+        differ = expected ^ actual
+        for field in self.out_fields:
+            if field.enable is not None:  # a tri-state value counts only while the model enables it
+                enable = self.out_fields[self._out_index[field.enable]]
+                enabled = (expected[:, enable.word] >> np.uint32(enable.shift)) & np.uint32(1)
+                care = np.uint32(field.mask << field.shift) if field.width <= WORD else np.uint32(_WORD_MASK)
+                differ[:, field.word] &= ~care | (enabled * care)
+                if field.width > WORD:
+                    differ[:, field.word + 1] &= ~care | (enabled * care)
+        rows = np.flatnonzero(differ.any(axis=1))
+        if not rows.size:
+            return None
+        cycle = int(rows[0])
+        signal = self.first_difference(self._unpack_words(expected[cycle]), self._unpack_words(actual[cycle]))
+        assert signal is not None, "a differing cycle has a differing signal"
+        return cycle, signal
+
+    def _unpack_words(self, words: npt.NDArray[np.uint32]) -> tuple[int, ...]:
+        return self.unpack_outputs(sum(int(word) << (WORD * index) for index, word in enumerate(words)))
+
+    def pack_outputs(self, values: Sequence[int]) -> list[int]:
+        """One cycle's compared output values (comparison order) as output words.
+
+        Raises
+        ------
+        PinSpecError
+            When a value does not fit its signal.
+        """
+        packed = 0
+        for field, value in zip(self.out_fields, values, strict=True):
+            if value >> field.width:
+                raise PinSpecError(f"model output {field.name!r} does not fit in {field.width} bits")
+            packed |= value << field.offset
+        return [(packed >> (WORD * index)) & _WORD_MASK for index in range(self.out_words)]
 
     def output_trace(self, words: npt.NDArray[np.uint32]) -> Trace:
         """Output words ``(cycles, words)`` unpacked into compared signals ``(cycles, signals)``."""
@@ -184,6 +242,16 @@ class Layout:
                 columns[:, index] = (words[:, field.word] >> np.uint32(field.shift)) & np.uint32(field.mask)
         return columns
 
+
+def _pack(fields: Sequence[Field], words: int, columns: Sequence[npt.NDArray[np.uint64]]) -> npt.NDArray[np.uint32]:
+    """Columns of values (one per field) packed into ``uint32`` words ``(cycles, words)``."""
+    cycles = len(columns[0]) if len(columns) else 0
+    packed = np.zeros((words, cycles), dtype=np.uint32)  # one contiguous row per word while packing
+    for field, column in zip(fields, columns, strict=True):
+        packed[field.word] |= column.astype(np.uint32) << np.uint32(field.shift)
+        if field.width > WORD:
+            packed[field.word + 1] = (column >> np.uint64(WORD)).astype(np.uint32)
+    return packed.T
 
 def stimulus_array(stimulus: Stimulus, inputs: Sequence[Pin], max_cycles: int | None = None) -> Trace:
     """Normalise stimulus to a ``uint64`` array ``(cycles, inputs)``, checking names and value ranges.
@@ -227,31 +295,46 @@ def stimulus_array(stimulus: Stimulus, inputs: Sequence[Pin], max_cycles: int | 
     return result
 
 
-def model_trace(model: PinModel, stimulus: Trace, layout: Layout) -> Trace:
-    """Reset ``model`` and run it over ``stimulus``; the compared outputs per cycle ``(cycles, signals)``.
+def model_columns(model: PinModel, stimulus: Trace, layout: Layout) -> list[npt.NDArray[np.uint64]]:
+    """Reset ``model`` and run it over ``stimulus``; one array per compared output signal, in comparison order.
 
     A model that also offers ``run(inputs: Mapping[str, array]) -> Mapping[str, array]`` (whole traces at once,
     the same cycles as repeated :meth:`~supi3.verif.pinmodel.PinModel.step`) is run that way, which is much
     faster for event-driven models.
+
+    Raises
+    ------
+    PinSpecError
+        When an output value does not fit its signal, naming the first such cycle.
     """
     model.reset()
     names = layout.input_names
     bulk = getattr(model, "run", None)
     if callable(bulk):
-        columns = bulk({name: stimulus[:, index] for index, name in enumerate(names)})
-        trace = np.stack([np.asarray(columns[field.name]) for field in layout.out_fields], axis=1).astype(np.uint64)
+        outputs = bulk({name: stimulus[:, index] for index, name in enumerate(names)})
+        columns = [_unsigned(np.asarray(outputs[field.name])) for field in layout.out_fields]
     else:
         step = model.step
         values = layout.output_values
         rows = [values(step(dict(zip(names, row, strict=True)))) for row in stimulus.tolist()]
-        trace = np.array(rows, dtype=np.uint64).reshape(len(rows), len(layout.out_fields))
-    masks = np.array([field.mask for field in layout.out_fields], dtype=np.uint64)
-    if trace.size and (trace > masks).any():
-        index = int(np.argmax((trace > masks).any(axis=0)))
-        field = layout.out_fields[index]
-        cycle = int(np.argmax(trace[:, index] > np.uint64(field.mask)))
-        raise PinSpecError(f"cycle {cycle}: model output {field.name!r} does not fit in {field.width} bits")
-    return trace
+        columns = list(np.array(rows, dtype=np.uint64).reshape(len(rows), len(layout.out_fields)).T)
+    for field, column in zip(layout.out_fields, columns, strict=True):
+        if column.size and column.max() > field.mask:
+            cycle = int(np.argmax(column > np.uint64(field.mask)))
+            raise PinSpecError(f"cycle {cycle}: model output {field.name!r} does not fit in {field.width} bits")
+    return columns
+
+
+def _unsigned(column: npt.NDArray[np.generic]) -> npt.NDArray[np.uint64]:
+    # A negative value becomes a huge one, which the width check then names.
+    return column.view(np.uint64) if column.dtype == np.int64 else column.astype(np.uint64)
+
+
+def model_trace(model: PinModel, stimulus: Trace, layout: Layout) -> Trace:
+    """Reset ``model`` and run it over ``stimulus``; the compared outputs per cycle ``(cycles, signals)``
+    (see :func:`model_columns`)."""
+    columns = model_columns(model, stimulus, layout)
+    return np.stack(columns, axis=1) if columns else np.zeros((stimulus.shape[0], 0), dtype=np.uint64)
 
 
 def first_mismatch(layout: Layout, expected: Trace, actual: Trace) -> tuple[int, int] | None:

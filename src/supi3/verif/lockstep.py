@@ -15,6 +15,7 @@ against the model first (:func:`react`) to produce it, which is exact up to the 
 
 from __future__ import annotations
 
+import functools
 import pickle
 import shutil
 import subprocess
@@ -30,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from supi3.verif.errors import PinSpecError, SimulationError
-from supi3.verif.layout import Layout, Stimulus, Trace, first_mismatch, model_trace, stimulus_array
+from supi3.verif.layout import Layout, Stimulus, Trace, model_columns, model_trace, stimulus_array
 from supi3.verif.pinmodel import ModelFactory, recent_events
 from supi3.verif.report import LockstepResult, Outcome, raise_mismatch, window_trace
 from supi3.verif.rtl import TOP, DesignFactory, build_slot, ensure_toolchain, to_verilog
@@ -131,25 +132,13 @@ class Job:
     result: Path
 
 
-def _cxx_words(port: str, words: int, array: str, *, drive: bool) -> str:
-    # Verilator's C++ type of a port of 32 * words bits: IData (one word), QData (two), VlWide (more).
-    indent = " " * 12
-    if words == 0:
-        return ""
-    if words == 1:
-        lines = [f"top.{port} = {array}[0];" if drive else f"{array}[0] = top.{port};"]
-    elif words == 2:
-        lines = (
-            [f"top.{port} = (uint64_t){array}[0] | (uint64_t){array}[1] << 32;"]
-            if drive
-            else [f"{array}[0] = (uint32_t)top.{port};", f"{array}[1] = (uint32_t)(top.{port} >> 32);"]
-        )
-    else:
-        lines = [
-            f"top.{port}[{index}] = {array}[{index}];" if drive else f"{array}[{index}] = top.{port}[{index}];"
-            for index in range(words)
-        ]
-    return "\n".join(indent + line for line in lines)
+def _cxx_words(prefix: str, words: int, array: str, *, drive: bool) -> str:
+    # One 32-bit port per word: Verilator's IData.
+    lines = [
+        f"top.{prefix}{index} = {array}[{index}];" if drive else f"{array}[{index}] = top.{prefix}{index};"
+        for index in range(words)
+    ]
+    return "\n".join(" " * 12 + line for line in lines)
 
 
 @contextmanager
@@ -208,7 +197,12 @@ class Lockstep:
         self.window = window
         self.layout = Layout.of(model_factory())
         self.verilog = to_verilog(design_factory, self.layout)
-        """The Verilog of the packed top-level (:class:`~supi3.verif.rtl.LockstepTop`)."""
+        """The Verilog of the packed top-level (:class:`~supi3.verif.rtl.LockstepTop`) that the batch path runs."""
+
+    @functools.cached_property
+    def checked_verilog(self) -> str:
+        """The Verilog of the packed top-level with its comparator, which the per-cycle path runs."""
+        return to_verilog(self.design_factory, self.layout, self.window)
 
     def prepare(self, simulators: Sequence[str] = ("verilator",), *, batch: bool = True) -> None:
         """Build ahead, in parallel: the cocotb build for each of ``simulators`` and, if ``batch``, the batch
@@ -248,10 +242,11 @@ class Lockstep:
 
         ensure_toolchain(simulator)
         runner = get_runner(simulator)
-        with build_slot(self.build_dir, f"cocotb-{simulator}", simulator, self.verilog) as (directory, ready):
+        verilog = self.checked_verilog
+        with build_slot(self.build_dir, f"cocotb-{simulator}", simulator, verilog) as (directory, ready):
             if not ready:
                 source = directory / f"{TOP}.v"
-                source.write_text(self.verilog, encoding="utf-8")
+                source.write_text(verilog, encoding="utf-8")
                 log = directory / "build.log"
                 try:
                     runner.build(
@@ -293,6 +288,9 @@ class Lockstep:
             When ``simulator`` is not installed.
         SimulationError
             When the build or the simulation fails.
+        PinSpecError
+            When the model factory cannot be pickled, or the model breaks a pin rule (an output wider than its
+            pin), naming the cycle.
         """
         try:
             pickle.dumps(self.model_factory)
@@ -327,6 +325,8 @@ class Lockstep:
         if not job.result.exists():
             raise SimulationError(f"the cocotb testbench stopped without an outcome under {simulator}", log)
         outcome: Outcome = pickle.loads(job.result.read_bytes())
+        if outcome.error is not None:
+            raise outcome.error
         record = outcome.mismatch
         if record is not None:
             first = record.cycle + 1 - len(record.actual)
@@ -390,7 +390,7 @@ class Lockstep:
         run_dir = self._run_dir("batch")
         inputs, outputs = run_dir / "inputs.bin", run_dir / "outputs.bin"
         start = time.perf_counter()
-        inputs.write_bytes(self.layout.input_words(array).astype("<u4").tobytes())
+        self.layout.input_words(array).astype("<u4").tofile(inputs)
         log = run_dir / "sim.log"
         with log.open("w", encoding="utf-8") as stream:
             process = subprocess.Popen(
@@ -399,14 +399,14 @@ class Lockstep:
                 stderr=subprocess.STDOUT,
             )
             try:
-                expected = model_trace(self.model_factory(), array, self.layout)
+                columns = model_columns(self.model_factory(), array, self.layout)
+                expected = self.layout.pack_columns(columns)
             finally:
                 status = process.wait()
         if status != 0:
             raise SimulationError(f"the batch harness failed ({status})", log)
-        words = np.fromfile(outputs, dtype="<u4").reshape(-1, self.layout.out_words)
-        actual = self.layout.output_trace(words)
-        found = first_mismatch(self.layout, expected, actual)
+        actual = np.fromfile(outputs, dtype="<u4").reshape(-1, self.layout.out_words)
+        found = self.layout.first_word_mismatch(expected, actual)
         seconds = time.perf_counter() - start
         if found is not None:
             cycle, signal = found
@@ -417,8 +417,8 @@ class Lockstep:
                 cycle,
                 signal,
                 self._events_at(array, cycle),
-                expected[first : cycle + 1],
-                actual[first : cycle + 1],
+                np.stack([column[first : cycle + 1] for column in columns], axis=1),
+                self.layout.output_trace(actual[first : cycle + 1]),
                 self._vcd_dir(run_dir),
                 "batch",
             )

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from supi3.verif.errors import LockstepMismatchError
+from supi3.verif.errors import LockstepMismatchError, PinSpecError
 from supi3.verif.layout import Layout, Trace
 from supi3.verif.vcd import write_window
 
@@ -65,11 +65,13 @@ class MismatchRecord:
 
 @dataclass(frozen=True)
 class Outcome:
-    """What the simulator process hands back: cycles run, comparison time, and the mismatch if any."""
+    """What the simulator process hands back: cycles run, comparison time, the mismatch if any, and the error that
+    stopped the run if one did (a model that broke a pin rule)."""
 
     cycles: int
     seconds: float
     mismatch: MismatchRecord | None = None
+    error: PinSpecError | None = None
 
 
 def raise_mismatch(

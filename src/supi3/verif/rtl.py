@@ -4,11 +4,14 @@ A design is any Amaranth elaboratable that exposes each model pin as an attribut
 the pin's width for an input; any value of the pin's width for an output; ``<pin>_oe``, one bit, for a tri-state
 output's enable) and uses the ``sync`` clock domain, which the harness clocks and resets.
 
-:class:`LockstepTop` wraps it so the simulator sees only ``clk``, ``rst``, the input words ``lsi0``, ``lsi1``, ...
-packed into one port ``lsi`` and the output words into one port ``lso`` (word ``n`` at bits ``32n`` to ``32n + 31``;
-see :class:`~supi3.verif.layout.Layout`). ``lsi`` is absent when the model has no inputs. ``lsq`` is ``lso`` as it
-was just before the last rising clock edge: the outputs of the cycle that edge ended, held for the whole next cycle,
-so a testbench can read them without waiting for the design to settle.
+:class:`LockstepTop` wraps it so the simulator sees only ``clk``, ``rst``, one 32-bit port per input word
+(``lsi0``, ``lsi1``, ...) and one per output word (``lso0``, ``lso1``, ...), packed as
+:class:`~supi3.verif.layout.Layout` says. With a ``window``, the top also compares the outputs itself on every rising
+clock edge, for the per-cycle path: the testbench writes the model's expected output words to ``lse0``, ``lse1``,
+... (only when they change); the first cycle whose outputs differ (tri-state values only while the expected enable
+is 1) sets the sticky flag ``lsx``, stops the cycle counter ``lsc`` (then the mismatching cycle plus one) and freezes
+``lsw``, the outputs of the last ``window`` cycles (newest in the low bits), so the mismatch report has the RTL's own
+values.
 """
 
 from __future__ import annotations
@@ -24,7 +27,7 @@ from pathlib import Path
 from typing import NoReturn
 
 from amaranth.back import verilog
-from amaranth.hdl import ClockDomain, Elaboratable, Module, Signal, Value
+from amaranth.hdl import Cat, ClockDomain, Elaboratable, Module, Signal, Value
 
 from supi3.verif.errors import PinSpecError, SimulatorUnavailableError
 from supi3.verif.layout import WORD, Layout
@@ -39,7 +42,7 @@ TOP = "lockstep_top"
 
 
 class LockstepTop(Elaboratable):
-    """The design with its pins packed into 32-bit words.
+    """The design with its pins packed into 32-bit word ports, and, given a ``window``, the comparator.
 
     Parameters
     ----------
@@ -47,15 +50,21 @@ class LockstepTop(Elaboratable):
         The design under test (see the module docstring for the pins it must expose).
     layout:
         The model's pin layout.
+    window:
+        Cycles of output history kept for a mismatch report; ``None`` for no comparator.
     """
 
-    def __init__(self, design: Elaboratable, layout: Layout) -> None:
+    def __init__(self, design: Elaboratable, layout: Layout, window: int | None = None) -> None:
         self.design = design
         self.layout = layout
+        self.window = window
         self.domain = ClockDomain("sync")
-        self.in_bits = Signal(WORD * layout.in_words, name="lsi")
-        self.out_bits = Signal(WORD * layout.out_words, name="lso")
-        self.out_held = Signal(WORD * layout.out_words, name="lsq", reset_less=True)
+        self.in_words = [Signal(WORD, name=f"lsi{index}") for index in range(layout.in_words)]
+        self.out_words = [Signal(WORD, name=f"lso{index}") for index in range(layout.out_words)]
+        self.expected_words = [Signal(WORD, name=f"lse{index}") for index in range(layout.out_words)]
+        self.mismatch = Signal(name="lsx")
+        self.count = Signal(WORD, name="lsc")
+        self.history = Signal(WORD * layout.out_words * (window or 1), name="lsw")
         self.inputs = {field.name: self._port(field.name, field.width, assignable=True) for field in layout.in_fields}
         self.outputs = {field.name: self._port(field.name, field.width) for field in layout.out_fields}
 
@@ -79,27 +88,44 @@ class LockstepTop(Elaboratable):
 
     @property
     def ports(self) -> list[Signal]:
-        """The top-level ports: clock, reset, input words (if any), output words, held output words."""
-        words = [self.out_bits, self.out_held]
-        if self.layout.in_words:
-            words.insert(0, self.in_bits)
-        return [self.domain.clk, self.domain.rst, *words]
+        """The top-level ports: clock, reset, input words, output words and, with a window, the comparator's."""
+        ports = [self.domain.clk, self.domain.rst, *self.in_words, *self.out_words]
+        if self.window is not None:
+            ports += [*self.expected_words, self.mismatch, self.count, self.history]
+        return ports
 
     def elaborate(self, _platform: object) -> Module:
         m = Module()
         m.domains.sync = self.domain
         m.submodules.dut = self.design
+        in_bits, out_bits = Cat(*self.in_words), Cat(*self.out_words)
         for field in self.layout.in_fields:
-            m.d.comb += self.inputs[field.name].eq(self.in_bits[field.offset : field.offset + field.width])
+            m.d.comb += self.inputs[field.name].eq(in_bits[field.offset : field.offset + field.width])
         for field in self.layout.out_fields:
-            m.d.comb += self.out_bits[field.offset : field.offset + field.width].eq(self.outputs[field.name])
-        m.d.sync += self.out_held.eq(self.out_bits)
+            m.d.comb += out_bits[field.offset : field.offset + field.width].eq(self.outputs[field.name])
+        if self.window is not None:
+            expected = Cat(*self.expected_words)
+            index = {field.name: field for field in self.layout.out_fields}
+            differs = []
+            for field in self.layout.out_fields:
+                bits = slice(field.offset, field.offset + field.width)
+                term = out_bits[bits] != expected[bits]
+                if field.enable is not None:
+                    term &= expected[index[field.enable].offset]
+                differs.append(term)
+            with m.If(~self.mismatch):
+                m.d.sync += [
+                    self.mismatch.eq(Cat(*differs).any()),
+                    self.count.eq(self.count + 1),
+                    self.history.eq(Cat(out_bits, self.history)[: len(self.history)]),
+                ]
         return m
 
 
-def to_verilog(design_factory: Callable[[], Elaboratable], layout: Layout) -> str:
-    """The Verilog of a fresh design from ``design_factory`` inside :class:`LockstepTop` (module :data:`TOP`)."""
-    top = LockstepTop(design_factory(), layout)
+def to_verilog(design_factory: Callable[[], Elaboratable], layout: Layout, window: int | None = None) -> str:
+    """The Verilog of a fresh design from ``design_factory`` inside :class:`LockstepTop` (module :data:`TOP`), with
+    the comparator if ``window`` is given."""
+    top = LockstepTop(design_factory(), layout, window)
     text: str = verilog.convert(top, name=TOP, ports=top.ports, emit_src=False)
     return text
 
