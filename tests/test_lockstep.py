@@ -239,6 +239,7 @@ def test_react_feeds_model_outputs_back() -> None:
 def test_per_cycle_passes_on_a_correct_model(bench: Lockstep) -> None:
     result = bench.run(random_stimulus(CYCLES, seed=1))
     assert (result.cycles, result.path, result.simulator) == (CYCLES, "per-cycle", "verilator")
+    assert bench.run([]).cycles == bench.run_batch([]).cycles == 0
 
 
 def test_per_cycle_catches_an_injected_model_bug(

@@ -101,6 +101,9 @@ class Supi3:
         self._fixed_bytes = None if self.registers is not None else wire.data_bytes(self.config.length_code)
         self._loaded = (-1, b"")  # (MFP levels, IN bytes) of the last data-cycle load
         self._shown: tuple[bytes | None, int] = (None, 0)  # (OUT bytes, MFP levels) last driven
+        self.revision = 0
+        """Counts the changes of what the pins show (OUT data, ``pf``, ``bus_active``, the /ModAck and /ResReg
+        pulses): the pin level records its outputs only when this moves."""
         self.power_up()
 
     # --------------------------------------------------------------------------------------------------------
@@ -109,6 +112,7 @@ class Supi3:
 
     def power_up(self) -> None:
         """Power-up reset (1.7.2): every register 0, watchdog off, no fault latched (3.4.7)."""
+        self.revision += 1
         if self.registers is not None:
             self.registers.power_up_reset()
         self.in_word = 0
@@ -251,6 +255,7 @@ class Supi3:
             self._expire(clk)
 
     def _expire(self, clk: int) -> None:
+        self.revision += 1
         if self._filtered and not self.pf:
             self.pf = True
             self.attention = True
@@ -298,6 +303,7 @@ class Supi3:
 
     def latch_at(self, cycle: Cycle, received: bytes, clk: int) -> None:
         """The master latched the cycle: take over ``received`` (OUT data or the command word)."""
+        self.revision += 1
         self._now = clk
         if clk >= self._due:
             self._expire(clk)
@@ -346,6 +352,7 @@ class Supi3:
 
     def reset_at(self, clk: int) -> None:
         """INTERBUS reset (3.4.7, Table 3-13)."""
+        self.revision += 1
         self._advance(clk)
         self._clear_process_data()
         self.watchdog_code = None
@@ -372,6 +379,7 @@ class Supi3:
         if cycle is _DATA and now < self._due_s and self.registers is None and self.watchdog_code is None:
             self.bus_active = True  # the latch_at() path for a pin-strapped mode without watchdog
             self._out = received
+            self.revision += 1
             self._fast_valid += 1
             return
         self.latch_at(cycle, received, round(now * CLOCK_HZ))

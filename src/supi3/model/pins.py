@@ -36,6 +36,7 @@ from __future__ import annotations
 
 from bisect import bisect_right
 from collections.abc import Mapping, Sequence
+from itertools import chain
 from typing import Final, NamedTuple
 
 import numpy as np
@@ -97,10 +98,10 @@ IDLE_INPUTS: Final = Synced(wire.IDLE_LEVEL, 0, 0, 0, 1, 1, 1)
 _NEVER: Final = 1 << 62
 
 
-def _integers(trace: Sequence[int] | npt.NDArray[np.generic]) -> npt.NDArray[np.int64]:
-    """An input trace as a contiguous ``int64`` array (the fastest for the event search), without a copy when it
-    already is one."""
-    return np.ascontiguousarray(trace, dtype=np.int64)
+def _integers(trace: Sequence[int] | npt.NDArray[np.generic]) -> npt.NDArray[np.integer]:
+    """An input trace as an integer array, without a copy when it already is one."""
+    array = np.asarray(trace)
+    return array if np.issubdtype(array.dtype, np.integer) else array.astype(np.int64)
 
 
 class Supi3Pins:
@@ -223,7 +224,7 @@ class Supi3Pins:
         outputs = self.output_values(c, int(inputs["di2"]))
         self._pipe = [Synced(*(int(inputs[name]) for name in _INPUT_NAMES)), *self._pipe[:-1]]
         if c >= self._run_from or self._holding or not (synced.resu_n and synced.vmon_ok):
-            self._tick(c, synced)
+            self._tick(c, synced, synced.do1)
             if c >= self._run_from:
                 self._next_present = bool(synced.rbst_ext) if self.rbst_by_pin else self._next_present or bool(
                     synced.di2
@@ -281,8 +282,9 @@ class Supi3Pins:
     # The per-cycle logic, shared by step() and run()
     # ------------------------------------------------------------------------------------------------------------
 
-    def _tick(self, c: int, s: Synced) -> None:
-        """The rising edge at the end of cycle ``c``, with the synchronised inputs ``s`` of that cycle."""
+    def _tick(self, c: int, s: Synced, line: int) -> None:
+        """The rising edge at the end of cycle ``c``, with the synchronised inputs ``s`` of that cycle; ``line`` is
+        their ``do1`` (given apart, since :meth:`run` keeps the line as a trace of its own)."""
         if not (s.resu_n and s.vmon_ok):
             if not self._holding:
                 self.log.add(c, "power-up reset")
@@ -303,7 +305,7 @@ class Supi3Pins:
             chip._set_stat_err(stat, c)
         if c >= chip._due:
             chip._advance(c)
-        self._receive(s.do1, c)
+        self._receive(line, c)
 
     def _next_due(self, c: int, line: int) -> int:
         """The next cycle after ``c`` at which the logic acts with unchanged inputs."""
@@ -545,13 +547,13 @@ class Supi3Pins:
         traces["di1"] = self.return_line(np.asarray(inputs["di2"], dtype=np.int64), traces["do2"])
         return traces
 
-    def _synced_traces(self, raw: Mapping[str, npt.NDArray[np.integer]], n: int
-                       ) -> dict[str, npt.NDArray[np.integer]]:
-        """What the synchroniser delivers in each of the next ``n`` cycles, and the pipeline left after them."""
+    def _synced_traces(self, raw: Mapping[str, npt.NDArray[np.integer]]) -> dict[str, npt.NDArray[np.int64]]:
+        """What the synchroniser delivers in each cycle of ``raw``, followed by the pipeline left after them, as
+        contiguous ``int64`` traces (the one copy of the inputs a run makes)."""
         synced = {}
         for name in _INPUT_NAMES:
-            held = np.asarray([getattr(stage, name) for stage in reversed(self._pipe)], dtype=raw[name].dtype)
-            synced[name] = np.concatenate([held, raw[name]])[: n + SYNC_STAGES]
+            held = np.asarray([getattr(stage, name) for stage in reversed(self._pipe)], dtype=np.int64)
+            synced[name] = np.concatenate([held, raw[name]], dtype=np.int64, casting="unsafe")
         return synced
 
     def run_forward(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]]) -> dict[str, Trace]:
@@ -567,7 +569,7 @@ class Supi3Pins:
                               [stage.di2 for stage in reversed(self._pipe)])
         self._power_ups = []
         self._recording = True
-        full = self._synced_traces(raw, n)
+        full = self._synced_traces(raw)
         synced = {name: trace[:n] for name, trace in full.items()}
         line = synced["do1"]
         line_change = np.ones(n, dtype=bool)
@@ -584,17 +586,21 @@ class Supi3Pins:
         line_events = np.flatnonzero(line_change).tolist()
         other_events = [*np.flatnonzero(change).tolist(), n]
         self._run_low = (c0, self._low_since, np.maximum.accumulate(np.where(line_change, np.arange(n), 0)))
-        # The synchronised inputs are piecewise constant: keep their values once per piece, found by bisection.
-        pieces = line_change | change
+        # The other synchronised inputs are piecewise constant: keep their values once per piece, found by
+        # bisection (a piece's do1 is its first cycle's: the line is read from its own trace).
+        pieces = change.copy()
         for name in ("mfp_in", "di2", "rbst_ext"):
             trace = synced[name]
             pieces[1:] |= trace[1:] != trace[:-1]
         starts = np.flatnonzero(pieces)
         values = list(map(Synced._make, zip(*(synced[name][starts].tolist() for name in _INPUT_NAMES), strict=True)))
         starts_list = starts.tolist()
+        # Outputs are recorded after a visited cycle only when they may have changed (Supi3.revision).
+        chip = self.chip
+        shown, run_from = chip.revision, self._run_from
         snaps = [(0, self._snapshot())]
         k = kl = 0
-        due = self._next_due(c0 - 1, values[0].do1) if n else _NEVER
+        due = self._next_due(c0 - 1, int(line[0])) if n else _NEVER
         t = -1
         while True:
             while other_events[k] <= t:
@@ -609,15 +615,16 @@ class Supi3Pins:
                 break
             c = c0 + t
             s = values[bisect_right(starts_list, t) - 1]
+            level = line.item(t)
             self.cycle = c
             if c >= self._run_from:
-                self._restore_low_run(t, s.do1)
+                self._restore_low_run(t, level)
             if c >= self._run_from or self._holding or not (s.resu_n and s.vmon_ok):
-                self._tick(c, s)
-            snap = self._snapshot()
-            if snap != snaps[-1][1]:
-                snaps.append((t + 1, snap))
-            due = self._next_due(c, s.do1)
+                self._tick(c, s, level)
+            if chip.revision != shown or self._run_from != run_from:
+                shown, run_from = chip.revision, self._run_from
+                snaps.append((t + 1, self._snapshot()))
+            due = self._next_due(c, level)
         if n and c0 + n - 1 >= self._run_from:
             self._restore_low_run(n - 1, int(line[n - 1]))
         self._recording = False
@@ -637,7 +644,7 @@ class Supi3Pins:
             self._low_since = None
             return
         c0, before, starts = self._run_low
-        start = int(starts[t])
+        start = starts.item(t)
         # A run of start level that began before this run() call continues the one the detector already saw.
         self._low_since = before if start == 0 and before is not None else max(c0 + start, self._run_from)
 
@@ -671,7 +678,7 @@ class Supi3Pins:
         if tx:
             # Each bit lasts cpb clocks or until the next bit begins (starts are in order), as _do2() reads it; the
             # line idles in the gaps. Runs of (gap, bit) levels, repeated over their lengths, are the trace.
-            sent = np.array(tx, dtype=np.int64)
+            sent = np.fromiter(chain.from_iterable(tx), dtype=np.int64, count=2 * len(tx)).reshape(-1, 2)
             bit_starts, bits = sent[:, 0], sent[:, 1]
             ends = np.minimum(bit_starts + cpb, np.append(bit_starts[1:], _NEVER))
             lo = np.clip(bit_starts - c0, 0, n)

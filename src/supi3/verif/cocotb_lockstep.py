@@ -81,6 +81,8 @@ async def lockstep(dut: Any, model: PinModel, stimulus: Trace, *, reset_cycles: 
     cycles = len(rows)
     ports = [*in_ports, *expected_ports]
     written: list[int | None] = [None] * len(ports)
+    if not cycles:
+        return Outcome(0, 0.0)
     start = time.perf_counter()
     dut.rst.value = 0
     for cycle in range(cycles):
@@ -105,7 +107,7 @@ async def lockstep(dut: Any, model: PinModel, stimulus: Trace, *, reset_cycles: 
     seconds = time.perf_counter() - start
     if not flag.value:
         return Outcome(cycles, seconds)
-    mismatch = int(dut.lsc.value) - 1
+    mismatch = dut.lsc.value.to_unsigned() - 1
     expected_trace = model_trace(model, stimulus[: mismatch + 1], layout)  # a replay: the events end there too
     bits = WORD * layout.out_words
     history = dut.lsw.value.to_unsigned()

@@ -359,16 +359,18 @@ class Lockstep:
         """Build (once) and return the batch harness: Verilator's C++ model of the design with a replay loop."""
         ensure_toolchain("verilator")
         main = self._batch_main()
-        with build_slot(self.build_dir, "batch-verilator", main, self.verilog) as (directory, ready):
+        options = [
+            "--cc", "--exe", "--build", "-j", "2", "--no-timing", "-Wno-fatal", "--top-module", TOP,
+            # -O2 rather than the wheel's -Os: the replay runs beside the model on a 2-core machine
+            "-MAKEFLAGS", "OPT_FAST=-O2 OPT_GLOBAL=-O2",
+        ]  # fmt: skip
+        with build_slot(self.build_dir, "batch-verilator", main, self.verilog, *options) as (directory, ready):
             executable = directory / "Vbatch"
             if not ready:
                 (directory / f"{TOP}.v").write_text(self.verilog, encoding="utf-8")
                 (directory / "main.cpp").write_text(main, encoding="utf-8")
-                command = [
-                    "verilator", "--cc", "--exe", "--build", "-j", "2", "--no-timing", "-Wno-fatal",
-                    "--top-module", TOP, "-Mdir", str(directory), "-o", executable.name,
-                    f"{TOP}.v", "main.cpp",
-                ]  # fmt: skip
+                sources = [f"{TOP}.v", "main.cpp"]
+                command = ["verilator", *options, "-Mdir", str(directory), "-o", executable.name, *sources]
                 log = directory / "build.log"
                 with log.open("w", encoding="utf-8") as stream:
                     status = subprocess.run(
