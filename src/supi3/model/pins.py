@@ -130,6 +130,15 @@ class Supi3Pins:
     (:meth:`_tick`) and agree cycle for cycle (tested).
     """
 
+    # Slots: more than 29 instance attributes in a plain __dict__ slow every attribute access on CPython 3.11.
+    __slots__ = (
+        "_attn", "_bit", "_check_index", "_check_rx", "_crc_rx", "_crc_tx", "_cycle", "_err_in", "_half_bit",
+        "_holding", "_in_reset", "_last_start", "_latches", "_length", "_local_error", "_low_since", "_next_present",
+        "_pipe", "_power_ups", "_recording", "_register", "_reset_end_count", "_return_start", "_run_from", "_run_low",
+        "_rx_busy", "_stat_active", "_state", "_synced_run", "_t0", "_tx", "_width", "_word", "chip",
+        "complete_diagnostics", "config", "cpb", "cycle", "forward_delay", "log", "mfp_oe", "rbst_by_pin", "reset_run",
+    )  # fmt: skip
+
     inputs: Sequence[Pin] = (
         Pin("do1"), Pin("di2"), Pin("rbst_ext"), Pin("mfp_in", 16), Pin("stat_err_n"), Pin("resu_n"),
         Pin("vmon_ok"),
