@@ -253,6 +253,7 @@ def _pack(fields: Sequence[Field], words: int, columns: Sequence[npt.NDArray[np.
             packed[field.word + 1] = (column >> np.uint64(WORD)).astype(np.uint32)
     return packed.T
 
+
 def stimulus_array(stimulus: Stimulus, inputs: Sequence[Pin], max_cycles: int | None = None) -> Trace:
     """Normalise stimulus to a ``uint64`` array ``(cycles, inputs)``, checking names and value ranges.
 
