@@ -257,12 +257,21 @@ def test_per_cycle_catches_an_injected_model_bug(
     assert f"#{cycle * 10}\n" in waveform and f"#{(cycle - 63) * 10}\n" in waveform
 
 
-def test_per_cycle_runs_under_icarus(build_root: Path) -> None:
+def test_per_cycle_runs_under_icarus(
+    build_root: Path, buggy: Lockstep, bug_stimulus: np.ndarray, per_cycle_bug: LockstepMismatchError
+) -> None:
     if shutil.which("iverilog") is None:
         pytest.skip("iverilog not installed (apt-get install iverilog): the Icarus path is optional")
     lockstep = Lockstep(ShiftCounter, ShiftCounterModel, build_dir=build_root)
     result = lockstep.run(random_stimulus(500, seed=2), simulator="icarus")
     assert (result.cycles, result.simulator) == (500, "icarus")
+    with pytest.raises(LockstepMismatchError) as caught:
+        buggy.run(bug_stimulus, simulator="icarus")
+    fields = ("cycle", "pin", "expected", "actual", "events")
+    assert [getattr(caught.value, name) for name in fields] == [getattr(per_cycle_bug, name) for name in fields]
+    errors = (caught.value, per_cycle_bug)
+    waveforms = [error.vcd.read_text().split("$enddefinitions")[1] for error in errors if error.vcd]
+    assert len(waveforms) == 2 and waveforms[0] == waveforms[1]
 
 
 @pytest.mark.usefixtures("bench")

@@ -15,7 +15,7 @@ from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge
 
 from supi3.verif.errors import PinSpecError
-from supi3.verif.layout import WORD, Layout, Trace, model_columns, model_trace
+from supi3.verif.layout import Layout, Trace, model_columns, model_trace
 from supi3.verif.pinmodel import PinModel, recent_events
 from supi3.verif.report import MismatchRecord, Outcome
 from supi3.verif.vcd import CYCLE_NS
@@ -109,10 +109,8 @@ async def lockstep(dut: Any, model: PinModel, stimulus: Trace, *, reset_cycles: 
         return Outcome(cycles, seconds)
     mismatch = dut.lsc.value.to_unsigned() - 1
     expected_trace = model_trace(model, stimulus[: mismatch + 1], layout)  # a replay: the events end there too
-    bits = WORD * layout.out_words
-    history = dut.lsw.value.to_unsigned()
-    kept = min(window, mismatch + 1)
-    actual = [(history >> (bits * age)) & ((1 << bits) - 1) for age in reversed(range(kept))]
+    first = max(0, mismatch + 1 - window)
+    actual = [dut.lsw[cycle % window].value.to_unsigned() for cycle in range(first, mismatch + 1)]
     signal = layout.first_difference(expected_trace[-1].tolist(), layout.unpack_outputs(actual[-1]))
     assert signal is not None, "the comparator and first_difference() agree"
     return Outcome(mismatch + 1, seconds, MismatchRecord(mismatch, signal, recent_events(model), actual))

@@ -10,8 +10,8 @@ output's enable) and uses the ``sync`` clock domain, which the harness clocks an
 clock edge, for the per-cycle path: the testbench writes the model's expected output words to ``lse0``, ``lse1``,
 ... (only when they change); the first cycle whose outputs differ (tri-state values only while the expected enable
 is 1) sets the sticky flag ``lsx``, stops the cycle counter ``lsc`` (then the mismatching cycle plus one) and freezes
-``lsw``, the outputs of the last ``window`` cycles (newest in the low bits), so the mismatch report has the RTL's own
-values.
+the memory ``lsw`` that holds the outputs of the last ``window`` cycles (cycle ``n`` at address ``n % window``), so
+the mismatch report has the RTL's own values.
 """
 
 from __future__ import annotations
@@ -27,7 +27,8 @@ from pathlib import Path
 from typing import NoReturn
 
 from amaranth.back import verilog
-from amaranth.hdl import Cat, ClockDomain, Elaboratable, Module, Signal, Value
+from amaranth.hdl import Cat, ClockDomain, Elaboratable, Module, Mux, Signal, Value
+from amaranth.lib.memory import Memory
 
 from supi3.verif.errors import PinSpecError, SimulatorUnavailableError
 from supi3.verif.layout import WORD, Layout
@@ -64,7 +65,6 @@ class LockstepTop(Elaboratable):
         self.expected_words = [Signal(WORD, name=f"lse{index}") for index in range(layout.out_words)]
         self.mismatch = Signal(name="lsx")
         self.count = Signal(WORD, name="lsc")
-        self.history = Signal(WORD * layout.out_words * (window or 1), name="lsw")
         self.inputs = {field.name: self._port(field.name, field.width, assignable=True) for field in layout.in_fields}
         self.outputs = {field.name: self._port(field.name, field.width) for field in layout.out_fields}
 
@@ -91,7 +91,7 @@ class LockstepTop(Elaboratable):
         """The top-level ports: clock, reset, input words, output words and, with a window, the comparator's."""
         ports = [self.domain.clk, self.domain.rst, *self.in_words, *self.out_words]
         if self.window is not None:
-            ports += [*self.expected_words, self.mismatch, self.count, self.history]
+            ports += [*self.expected_words, self.mismatch, self.count]
         return ports
 
     def elaborate(self, _platform: object) -> Module:
@@ -113,11 +113,17 @@ class LockstepTop(Elaboratable):
                 if field.enable is not None:
                     term &= expected[index[field.enable].offset]
                 differs.append(term)
+            # The history: a memory written at one address per cycle (cycle n at n % window), so a simulator that
+            # evaluates every changed signal (Icarus) moves one word per cycle, not the whole window.
+            m.submodules.lsw = history = Memory(shape=len(out_bits), depth=self.window, init=[])
+            slot = Signal(range(max(self.window, 2)))
+            write = history.write_port()
+            m.d.comb += [write.addr.eq(slot), write.data.eq(out_bits), write.en.eq(~self.mismatch)]
             with m.If(~self.mismatch):
                 m.d.sync += [
                     self.mismatch.eq(Cat(*differs).any()),
                     self.count.eq(self.count + 1),
-                    self.history.eq(Cat(out_bits, self.history)[: len(self.history)]),
+                    slot.eq(Mux(slot == self.window - 1, 0, slot + 1)),
                 ]
         return m
 
