@@ -237,11 +237,9 @@ class Supi3:
     def _filtered(self) -> bool:
         return self._stat_low_since is not None and self._now - self._stat_low_since >= STATERR_FILTER_CLOCKS
 
-    def next_event(self) -> int | None:
-        """The next clock at which time alone changes the chip (filter expiry, watchdog), ``None`` if none."""
-        return None if self._due == _NEVER else self._due
-
     def _reschedule(self) -> None:
+        # _due: the next clock at which time alone changes the chip (filter expiry, watchdog), _NEVER if none; the
+        # pin level (supi3.model.pins) reads it on every cycle it visits.
         due = _NEVER if self._deadline is None else self._deadline
         if self._stat_low_since is not None and not self.pf:
             due = min(due, self._stat_low_since + STATERR_FILTER_CLOCKS)
