@@ -339,17 +339,10 @@ def model_trace(model: PinModel, stimulus: Trace, layout: Layout) -> Trace:
 
 
 def first_mismatch(layout: Layout, expected: Trace, actual: Trace) -> tuple[int, int] | None:
-    """The first ``(cycle, signal index)`` where two output traces differ, gated by output enables, or ``None``.
+    """The first ``(cycle, signal index)`` where two output traces (values within their signals' widths) differ,
+    gated by output enables, or ``None``.
 
-    Within the first differing cycle the lowest signal index (comparison order) is reported.
+    Within the first differing cycle the lowest signal index (comparison order) is reported. The traces are compared
+    as packed words, like the batch path (:meth:`Layout.first_word_mismatch`).
     """
-    differ = expected != actual
-    index_of = {field.name: index for index, field in enumerate(layout.out_fields)}
-    for index, field in enumerate(layout.out_fields):
-        if field.enable is not None:
-            differ[:, index] &= expected[:, index_of[field.enable]] != 0
-    rows = differ.any(axis=1)
-    if not rows.any():
-        return None
-    cycle = int(np.argmax(rows))
-    return cycle, int(np.argmax(differ[cycle]))
+    return layout.first_word_mismatch(layout.output_words(expected), layout.output_words(actual))
