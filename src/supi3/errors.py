@@ -26,3 +26,23 @@ class ConfigurationError(Supi3Error, ValueError):
         self.rule = rule
         self.detail = detail
         super().__init__(f"{pins} = {value}: {detail} ({rule})")
+
+
+class ArgumentError(Supi3Error, TypeError, ValueError):
+    """A public constructor or method was given an argument of the wrong type or out of its range.
+
+    It is both a ``TypeError`` and a ``ValueError``, so code that caught either before still catches it. Raised
+    through :mod:`supi3.checks`, whose messages read "X must be ..., not ...".
+
+    Attributes
+    ----------
+    name:
+        The argument, as the caller named it (``"position"``, ``"data"``, ``"pin 'mfp_in'"``).
+    value:
+        The value given.
+    """
+
+    def __init__(self, name: str, value: object, message: str) -> None:
+        self.name = name
+        self.value = value
+        super().__init__(message)
