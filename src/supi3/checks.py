@@ -23,7 +23,11 @@ _SHOWN = 60
 
 def describe(value: object) -> str:
     """The value as an error message quotes it: its ``repr`` (cut to 60 characters) and, unless obvious, its type."""
-    text = repr(value)
+    if isinstance(value, int) and value.bit_length() > 4 * _SHOWN:
+        # repr() of an integer past 4,300 digits raises; the size is what matters in a message anyway.
+        text = f"{'-' if value < 0 else ''}<{value.bit_length()}-bit integer>"
+    else:
+        text = repr(value)
     if len(text) > _SHOWN:
         text = text[: _SHOWN - 3] + "..."
     if isinstance(value, (bool, int, float, str, bytes)) and type(value) in (bool, int, float, str, bytes):
