@@ -49,7 +49,11 @@ MAX_OPTICAL_COUNT = max(r.values[1] for r in tables.OPTICAL_LENGTH_RANGES)
 """``timing --optical-count`` limit: the length timer's value range, 0 to 63 (Table 1-5)."""
 
 MAX_DEMO_CYCLES = 1000
-"""``demo --cycles`` limit: a demo, not a soak test (the pin-level run keeps every pin of every clock)."""
+"""``demo --cycles`` limit: a demo, not a soak test."""
+
+MAX_VCD_CYCLES = 50
+"""``demo --cycles`` limit with ``--vcd``: the pin-level run keeps every pin of every 32 MHz clock until it writes
+the VCD, about 10 MB of memory a data cycle at 500 kbit/s (1000 cycles took 9 GB)."""
 
 BROKEN_PIPE_STATUS = 128 + 13
 """Exit status when the reader closes the pipe early, as a shell reports a tool killed by SIGPIPE."""
@@ -184,6 +188,8 @@ def output_file(option: str, text: str) -> Path:
     """
     if not text:
         raise CommandLineError(f"{option} must be a file path, not ''")
+    if text.endswith(("/", os.sep)):  # Path() would drop the slash and write a file where a folder was meant
+        raise _cannot(option, text, "ends with a slash: give a file path")
     path = Path(text)
     try:
         if path.is_dir():
@@ -366,6 +372,8 @@ def cmd_demo(args: argparse.Namespace) -> None:
 
     clk_conf = {500_000: "01", 2_000_000: "11"}[_parse_bit_rate(args.bit_rate)]
     cycles = check_int("--cycles", args.cycles, 1, MAX_DEMO_CYCLES, "a demo")
+    if args.vcd is not None:
+        check_int("--cycles", cycles, 1, MAX_VCD_CYCLES, "with --vcd: the pin-level run keeps every clock")
     vcd = None if args.vcd is None else output_file("--vcd", args.vcd)  # before the run, not after it
     for line in demo.run(cycles, vcd, clk_conf):
         print(line)
@@ -399,19 +407,21 @@ class _Parser(argparse.ArgumentParser):
         raise UsageError(f"{self.prog}: error: {message} (see {self.prog} --help)")
 
 
+_DESCRIPTION = ("The IBS SUPI 3 OPC INTERBUS slave chip: operating modes, pin-strap decoding, register map, "
+                "timing, and a demo.")
 _EPILOG = """exit status: 0 done; 2 bad input (one line on stderr); 141 output pipe closed early (quiet);
 130 interrupted; 1 an internal error (a traceback: please report it)"""
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``supi3`` command."""
-    parser = _Parser(prog="supi3", description=__doc__.split("\n\n")[0], epilog=_EPILOG,
+    parser = _Parser(prog="supi3", description=_DESCRIPTION, epilog=_EPILOG,
                      formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("demo", help="a master and a small ring, live (built-in defaults)")
     p.add_argument("--cycles", type=integer, default=4, metavar="N",
-                   help=f"data cycles to run, 1 to {MAX_DEMO_CYCLES} (default 4)")
+                   help=f"data cycles to run, 1 to {MAX_DEMO_CYCLES}, to {MAX_VCD_CYCLES} with --vcd (default 4)")
     p.add_argument("--vcd", metavar="PATH", help="also run the SUPI 3 chips at pin level and write a VCD")
     p.add_argument("--bit-rate", default="500k", help="500k or 2M")
     p.set_defaults(func=cmd_demo)
