@@ -19,6 +19,7 @@ import pytest
 
 from supi3 import cli
 from supi3.cli import main
+from supi3.interbus import wire
 
 DATA = Path(__file__).resolve().parent / "data" / "cli_bad_inputs.toml"
 SRC = Path(__file__).resolve().parents[1] / "src"
@@ -247,3 +248,24 @@ def test_stdout_on_a_full_device() -> None:
                                 env=_env(), check=False, timeout=120)
     assert result.returncode == 2
     assert result.stderr.count(b"\n") == 1 and b"No space left on device" in result.stderr
+
+
+README = Path(__file__).resolve().parents[1] / "README.md"
+
+
+def test_readme_cli_section_matches(capsys: pytest.CaptureFixture[str]) -> None:
+    text = README.read_text(encoding="utf-8")
+    section = text[text.index("## The command line"):text.index("## In Python")]
+    # Every "$ supi3 ..." example prints what the README shows.
+    examples = [line.split("    $ supi3 ", 1)[1] for line in section.splitlines() if line.startswith("    $ supi3 ")]
+    assert examples
+    for example in examples:
+        shown = section.split(f"$ supi3 {example}\n", 1)[1].splitlines()[0].strip()
+        code, out, err = _call(capsys, example.split())
+        assert (out + err).strip() == shown and code == 2
+    # The exit-status table gives the statuses main() returns.
+    for status in (0, 2, cli.BROKEN_PIPE_STATUS, cli.INTERRUPTED_STATUS, 1):
+        assert f"\n| {status} | " in section
+    for limit in (cli.MAX_DEMO_CYCLES, cli.MAX_VCD_CYCLES, cli.MAX_NETWORK_BYTES, wire.MAX_DEVICES,
+                  cli.MAX_OPTICAL_COUNT):
+        assert f" to {limit}" in section
