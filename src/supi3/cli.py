@@ -40,12 +40,11 @@ from supi3.checks import check_int
 from supi3.checks import describe as _shown
 from supi3.config import DeviceConfig, Interface, Variant, decode, mode_rows
 from supi3.errors import Supi3Error
-from supi3.interbus.wire import MAX_DEVICES
 
-MAX_NETWORK_BYTES = MAX_DEVICES * max(lc.bits or 0 for lc in tables.LENGTH_CODES) // 8
+MAX_NETWORK_BYTES = timing.MAX_NETWORK_BYTES
 """``timing --bytes`` limit: 512 devices (the INTERBUS limit) of the longest data length, 32 words (Table 3-11)."""
 
-MAX_OPTICAL_COUNT = max(r.values[1] for r in tables.OPTICAL_LENGTH_RANGES)
+MAX_OPTICAL_COUNT = timing.MAX_OPTICAL_COUNT
 """``timing --optical-count`` limit: the length timer's value range, 0 to 63 (Table 1-5)."""
 
 MAX_DEMO_CYCLES = 1000
@@ -312,8 +311,9 @@ def cmd_regmap(args: argparse.Namespace) -> None:
 def cmd_timing(args: argparse.Namespace) -> None:
     """Data cycle time, CPU access time, I/O access window, optical length; optionally a timing table."""
     bit_rate = _parse_bit_rate(args.bit_rate)
-    n_bytes = check_int("--bytes", args.bytes, 0, MAX_NETWORK_BYTES, f"{MAX_DEVICES} devices of at most 32 words")
-    devices = check_int("--devices", args.devices, 1, MAX_DEVICES, "the INTERBUS limit")
+    n_bytes = check_int("--bytes", args.bytes, 0, MAX_NETWORK_BYTES,
+                        f"{timing.MAX_DEVICES} devices of at most 32 words")
+    devices = check_int("--devices", args.devices, 1, timing.MAX_DEVICES, "the INTERBUS limit")
     if args.optical_count is not None:
         check_int("--optical-count", args.optical_count, 0, MAX_OPTICAL_COUNT, "Table 1-5")
     data = timing.report(n_bytes, bit_rate, devices)
@@ -452,7 +452,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--bytes", type=integer, default=4, metavar="N",
                    help=f"data bytes in the whole network, 0 to {MAX_NETWORK_BYTES} (default 4)")
     p.add_argument("--devices", type=integer, default=1, metavar="N",
-                   help=f"devices in the ring, 1 to {MAX_DEVICES} (default 1)")
+                   help=f"devices in the ring, 1 to {timing.MAX_DEVICES} (default 1)")
     p.add_argument("--optical-count", type=integer, metavar="N",
                    help=f"length timer result n, 0 to {MAX_OPTICAL_COUNT} (1.6.1, Table 1-5)")
     p.add_argument("--table", choices=sorted(timing.TIMING_TABLES), help="also evaluate a timing table")
