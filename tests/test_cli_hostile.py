@@ -102,6 +102,14 @@ def test_html_into_an_existing_empty_folder(capsys: pytest.CaptureFixture[str], 
     assert code == 0 and err == "" and (tmp_path / "index.html").exists()
 
 
+def test_html_without_the_docs_extra(capsys: pytest.CaptureFixture[str], tmp_path: Path,
+                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setitem(sys.modules, "peakrdl_html", None)  # as on `pip install supi3`: import fails
+    code, out, err = _call(capsys, ["regmap", "--format", "html", "-o", str(tmp_path / "site")])
+    assert code == 2 and out == "" and err.count("\n") == 1 and "supi3[docs]" in err
+    assert not (tmp_path / "site").exists()
+
+
 def test_a_failed_path_check_leaves_no_probe_file(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     code, _, _ = _call(capsys, ["demo", "--cycles", "1", "--bit-rate", "9600", "--vcd", str(tmp_path / "x.vcd")])
     assert code == 2 and list(tmp_path.iterdir()) == []

@@ -2,15 +2,16 @@
 
 Every subcommand whose output is data takes ``--json``.
 
-Exit status and what goes to stderr, for every subcommand (:func:`main` does it all, so a new subcommand gets it
-by raising a :class:`~supi3.errors.Supi3Error` for bad input and checking its output paths with
-:func:`output_file` or :func:`output_dir` before it starts working):
+Exit status and what goes to stderr, for every subcommand. :func:`main` does it all, so a new subcommand gets it
+by raising a :class:`~supi3.errors.Supi3Error` for bad input, taking integer options with ``type=integer`` (and
+their limits with :func:`~supi3.checks.check_int`), and checking its output paths with :func:`output_file` or
+:func:`output_dir` before it starts working. ``SystemExit(n)`` from a subcommand becomes its status ``n``.
 
 - 0: done.
 - 2: bad input, one line on stderr and never a traceback: a usage error (unknown option or choice, a value that is
   not a plain decimal integer, an abbreviated option), a value the manual rules out (any ``Supi3Error``), an output
   path that cannot be written (empty, a directory, a missing folder, a name too long; checked before any work), a
-  write that fails (``-o /dev/full``, ``> /dev/full``).
+  write that fails (``-o /dev/full``, ``> /dev/full``), ``regmap --format html`` without the ``docs`` extra.
 - 141 (128 + SIGPIPE): the reader closed the pipe early (``supi3 demo | head``). Nothing on stderr, like a Unix
   tool killed by SIGPIPE; under ``set -o pipefail`` the pipeline fails, as it does for ``seq``.
 - 130: interrupted (Ctrl-C), nothing on stderr.
@@ -295,6 +296,8 @@ def cmd_regmap(args: argparse.Namespace) -> None:
         folder = None if args.output is None else output_dir(option, args.output)
         try:
             render("html", folder)
+        except ModuleNotFoundError as exc:  # a plain install: the exporters are the docs extra
+            raise CommandLineError(f"--format html needs the docs extra, pip install 'supi3[docs]' ({exc})") from None
         except OSError as exc:
             raise _cannot(option, str(folder), exc.strerror or str(exc)) from None
         print(f"wrote {folder}")
