@@ -351,7 +351,7 @@ def _parse_bit_rate(text: str) -> int:
     try:
         return aliases[text.lower()]
     except KeyError:
-        raise timing.TimingError(f"bit rate {text!r}: choose 500k or 2M (Table 1-7)") from None
+        raise timing.TimingError(f"--bit-rate must be 500k or 2M (Table 1-7), not {_shown(text)}") from None
 
 
 def regmap_summary() -> str:
