@@ -161,7 +161,6 @@ def print_json(data: object) -> None:
     print(json_for_stdout(json.dumps(data, indent=2, ensure_ascii=False)))
 
 
-
 def _cannot(option: str, text: str, reason: str) -> CommandLineError:
     return CommandLineError(f"cannot write {_shown(text)} ({option}): {reason}")
 
@@ -256,8 +255,8 @@ def cmd_modes(args: argparse.Namespace) -> None:
     rows = list(mode_rows(args.variant, args.interface))
     if args.json:
         print_json([{"table": f"Table {r.table}", "c": r.c, "mfp": r.mfp, "length_code": r.length_code,
-                      "data_length": _length_text(r.length_code), "id_code": f"{r.id_code:02X}",
-                      "function": r.function} for r in rows])
+                     "data_length": _length_text(r.length_code), "id_code": f"{r.id_code:02X}",
+                     "function": r.function} for r in rows])
         return
     print(_format_rows(
         ("Table", "C[4..0]", "MFP[15..12]", "ID12..8", "Data length", "ID", "Function"),
