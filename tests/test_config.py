@@ -209,7 +209,7 @@ def test_as_dict_keys() -> None:
     assert d["interface"] == "RB" and d["id_code"] == "03" and d["data_bits"] == 4
 
 
-@pytest.mark.parametrize("value", ["1" * 5000, 10**5000])
+@pytest.mark.parametrize("value", ["1" * 5000, 10**5000], ids=["long-string", "huge-int"])
 def test_huge_strap_values_are_quoted_short(value: str | int) -> None:
     with pytest.raises(ConfigurationError) as caught:
         decode(value)
