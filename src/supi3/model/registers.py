@@ -376,8 +376,7 @@ class RegisterFile:
         if self._set is None:
             return 0
         bits = self._set.length.bits
-        assert bits is not None  # _apply_set never applies a reserved length code
-        return bits
+        return 0 if bits is None else bits  # None never: _apply_set never applies a reserved length code
 
     def data_bytes(self) -> int:
         """The data length rounded up to whole bytes: how many of addresses 0.. take part in a data cycle."""
