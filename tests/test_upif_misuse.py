@@ -21,6 +21,7 @@ from supi3.model.chip import Supi3
 from supi3.model.registers import InterfaceViolationError, RegisterFile
 from supi3.regmap import REGISTER_MAP
 from supi3.spi.upif import (
+    ACCESS_END_PHASES,
     C_D_COMMAND,
     InterfaceDisabledError,
     InterruptedCommandError,
@@ -363,9 +364,6 @@ def test_hostile_calls_are_refused_by_name_and_change_nothing(
 
 JUNK = st.one_of(st.none(), st.booleans(), st.floats(allow_nan=True), st.text(max_size=2), st.integers(-300, 300),
                  st.binary(max_size=5))
-ACCESS_PHASES = (Phase.COMMAND, Phase.DISABLED)
-"""Where a register access leaves the interface, raised violation or not (UP-28): the command phase, or disabled
-after a write before initialization (UP-26)."""
 
 
 class InterfaceHistory(RuleBasedStateMachine):
@@ -397,7 +395,7 @@ class InterfaceHistory(RuleBasedStateMachine):
             return
         assert self.strict or not raised
         if access:
-            assert self.up.protocol.phase in ACCESS_PHASES
+            assert self.up.protocol.phase in ACCESS_END_PHASES
 
     @rule(mode=st.sampled_from(Mode))
     def init(self, mode: Mode) -> None:

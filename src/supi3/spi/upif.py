@@ -62,6 +62,19 @@ BLOCK_ADDRESS: Final[int] = 15
 """A3..0 of the command byte that starts a block transfer (3.4.6)."""
 _WORD_BITS: Final[int] = 16
 
+# Firmware API after misuse (docs/assumptions/upif.md UP-25 to UP-28): where the manual is silent, one constant each.
+REFUSED_BEFORE_INIT: Final[frozenset[str]] = frozenset({"read", "exchange", "block transfer"})
+"""UP-25: the register accesses that return data; before initialization the chip drives none (3.4.1, 3.4.3), so
+:class:`UpInterface` refuses them (:class:`NotInitializedError`) and sends nothing."""
+UNINITIALIZED_WRITE: Final[str] = "interface not initialized: {command:02X}h taken as a faulty initialization byte; " \
+    "SAS_INIT needed"
+"""UP-26: a write before initialization goes out as on the real chip, which takes its command byte as a faulty
+initialization byte and disables the interface (3.4.3); this is the violation reported (strict: raised)."""
+INTERRUPTED_INIT: Final[str] = "initialize(): C/D = 1 before the initialization byte, the µP was reset in the middle " \
+    "of a command: {byte:02X}h was taken as {what}{effect}; SAS_INIT before initialize() after a µP reset"
+"""UP-27: :meth:`UpInterface.initialize` on a chip showing data sends the byte anyway (the chip takes it as the
+pending data byte, 3.4.3, 3.4.4) and reports this violation; the initialization is not a first one."""
+
 
 class Mode(StrEnum):
     """Interface type chosen by the initialization byte (Table 3-8)."""
@@ -94,6 +107,12 @@ class Phase(StrEnum):
     """The next byte of a block transfer."""
     DISABLED = "disabled"
     """A faulty initialization byte was received: nothing until power-up reset or SAS_INIT (3.4.3)."""
+
+
+ACCESS_END_PHASES: Final[tuple[Phase, ...]] = (Phase.COMMAND, Phase.DISABLED)
+"""UP-28: where a register access of :class:`UpInterface` (read, write, exchange, block transfer) leaves the
+interface, whether or not it raised a violation: ready for the next command, or disabled after a write before
+initialization (UP-26). The access runs to its end inside one :meth:`ViolationLog.deferred` block."""
 
 
 class UpifUsageError(Supi3Error, ValueError):
@@ -504,9 +523,7 @@ class UpInterface:
         self._byte(mode.init_byte, True)
         effect = f", written to {name}" if name and protocol.phase is Phase.COMMAND else ""
         protocol.registers.violations.report(InterruptedCommandError(
-            "3.4.3", f"initialize(): C/D = 1 before the initialization byte, the µP was reset in the middle of a "
-            f"command: {mode.init_byte:02X}h was taken as {what}{effect}; SAS_INIT before initialize() after a µP "
-            "reset"
+            "3.4.3", INTERRUPTED_INIT.format(byte=mode.init_byte, what=what, effect=effect)
         ))
 
     # --------------------------------------------------------------------------------------------------------
@@ -522,7 +539,7 @@ class UpInterface:
         protocol = self.protocol
         self._check_frame(what)
         phase = protocol.phase
-        if phase is Phase.INIT:
+        if phase is Phase.INIT and what in REFUSED_BEFORE_INIT:
             raise NotInitializedError(what)
         if phase is Phase.DISABLED:
             raise InterfaceDisabledError(what)
@@ -589,10 +606,7 @@ class UpInterface:
         with violations.deferred():
             self._byte(command, True)
             self._byte(value, True)
-            violations.report(UninitializedAccessError(
-                "3.4.3", f"interface not initialized: {command:02X}h taken as a faulty initialization byte; "
-                "SAS_INIT needed"
-            ))
+            violations.report(UninitializedAccessError("3.4.3", UNINITIALIZED_WRITE.format(command=command)))
 
     def exchange(self, address: int, value: int) -> int:
         """Motorola only: read and write ``address`` in one data byte (RD and WR set, 3.4.4).
