@@ -93,7 +93,7 @@ def clocks(now: float) -> int:
     ChipArgumentError
         If ``now`` is not a finite number >= 0.
     """
-    if now.__class__ is not float or not 0.0 <= now < _INF:
+    if type(now) is not float or not 0.0 <= now < _INF:
         now = _checked(check_real, "now", now, 0, limit=TIME_LIMIT)
     return round(now * CLOCK_HZ)
 
@@ -202,7 +202,7 @@ class Supi3:
         """The I/O access (polling) bit (3.4.14, Fig. 3-22): 1 from the start of a data cycle's check sequence to
         the end of its latch phase, so a 0 leaves at least the check sequence (52 bit periods, more than the
         manual's 30) before data move; in µP modes it is D7 of the interrupt event register and MFP1."""
-        if busy.__class__ is not bool:
+        if type(busy) is not bool:
             busy = _checked(check_bool, "busy", busy)
         self.io_access = busy
         if self.registers is not None:
@@ -211,7 +211,7 @@ class Supi3:
     def set_latch_phase(self, active: bool) -> None:
         """The latch phase (3.4.14): from the first latch telegram to the latch; µP accesses to the data
         registers inside it are reported as inconsistent data."""
-        if active.__class__ is not bool:
+        if type(active) is not bool:
             active = _checked(check_bool, "active", active)
         if self.registers is not None:
             self.registers.set_latch_phase(active)
@@ -339,9 +339,9 @@ class Supi3:
 
     def load_at(self, cycle: Cycle, clk: int) -> bytes:
         """A frame begins: the register's parallel load, in line order."""
-        if cycle.__class__ is not Cycle:
+        if type(cycle) is not Cycle:
             cycle = _cycle(cycle)
-        if clk.__class__ is not int or clk < 0:
+        if type(clk) is not int or clk < 0:
             clk = _clock(clk)
         self._now = clk
         if clk >= self._due:
@@ -367,12 +367,12 @@ class Supi3:
             If ``received`` is not bytes of this cycle's length: :meth:`data_bytes` in a data cycle, the two bytes
             of the command word in an ID cycle.
         """
-        if cycle.__class__ is not Cycle:
+        if type(cycle) is not Cycle:
             cycle = _cycle(cycle)
-        if clk.__class__ is not int or clk < 0:
+        if type(clk) is not int or clk < 0:
             clk = _clock(clk)
         length = self.data_bytes() if cycle is _DATA else _WORD_BYTES
-        if received.__class__ is not bytes or len(received) != length:
+        if type(received) is not bytes or len(received) != length:
             what = "the OUT data" if cycle is _DATA else "the command word"
             received = _checked(check_bytes, "received", received, length, f"{what} of the {cycle.value} cycle")
         self.revision += 1
@@ -417,11 +417,11 @@ class Supi3:
 
     def discard_at(self, cycle: Cycle, local_error: bool, clk: int) -> None:
         """The cycle ended without a latch: nothing latched changes (Table 3-13, invalid data cycle)."""
-        if cycle.__class__ is not Cycle:
+        if type(cycle) is not Cycle:
             cycle = _cycle(cycle)
-        if local_error.__class__ is not bool:
+        if type(local_error) is not bool:
             local_error = _checked(check_bool, "local_error", local_error)
-        if clk.__class__ is not int or clk < 0:
+        if type(clk) is not int or clk < 0:
             clk = _clock(clk)
         self._advance(clk)
         self.te = self.te or local_error
@@ -430,7 +430,7 @@ class Supi3:
 
     def reset_at(self, clk: int) -> None:
         """INTERBUS reset (3.4.7, Table 3-13)."""
-        if clk.__class__ is not int or clk < 0:
+        if type(clk) is not int or clk < 0:
             clk = _clock(clk)
         self.revision += 1
         self._advance(clk)
@@ -450,15 +450,15 @@ class Supi3:
 
     def load(self, cycle: Cycle, now: float) -> bytes:
         """See :meth:`supi3.interbus.device.Device.load`."""
-        if cycle is _DATA and now.__class__ is float and 0.0 <= now < self._due_s and self.mfp_in == self._loaded[0]:
+        if cycle is _DATA and type(now) is float and 0.0 <= now < self._due_s and self.mfp_in == self._loaded[0]:
             return self._loaded[1]  # nothing due, MFP inputs as last sampled: the same IN bytes
         return self.load_at(cycle, clocks(now))
 
     def latch(self, cycle: Cycle, received: bytes, now: float) -> None:
         """See :meth:`supi3.interbus.device.Device.latch`."""
         # len(received) == _fixed_bytes also stands for "registers is None" (_fixed_bytes is None in the µP modes)
-        if (cycle is _DATA and now.__class__ is float and 0.0 <= now < self._due_s and self.watchdog_code is None
-                and received.__class__ is bytes and len(received) == self._fixed_bytes):
+        if (cycle is _DATA and type(now) is float and 0.0 <= now < self._due_s and self.watchdog_code is None
+                and type(received) is bytes and len(received) == self._fixed_bytes):
             self.bus_active = True  # the latch_at() path for a pin-strapped mode without watchdog
             self._out = received
             self.revision += 1

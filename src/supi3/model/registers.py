@@ -280,7 +280,7 @@ class RegisterFile:
             If ``address`` is not 0..15, or for addresses 4, 5 and 15, whose accesses the interface handles itself
             (3.4.4, 3.4.6).
         """
-        if address.__class__ is not int or not 0 <= address <= 15:
+        if type(address) is not int or not 0 <= address <= 15:
             address = self._address(address)
         port = REGISTER_MAP.port(address, Direction.READ)
         if port.access is Access.RESERVED_ZERO:
@@ -307,9 +307,9 @@ class RegisterFile:
         RegisterArgumentError
             For an address outside 0..15, addresses 4, 5 and 15, or if ``value`` is not a byte.
         """
-        if address.__class__ is not int or not 0 <= address <= 15:
+        if type(address) is not int or not 0 <= address <= 15:
             address = self._address(address)
-        if value.__class__ is not int or not 0 <= value <= 0xFF:
+        if type(value) is not int or not 0 <= value <= 0xFF:
             value = _checked(check_bits, "data byte", value, 8)
         port = REGISTER_MAP.port(address, Direction.WRITE)
         if port.access is Access.NO_EFFECT:
@@ -398,7 +398,7 @@ class RegisterFile:
 
     def set_bus_running(self, running: bool) -> None:
         """The core reports whether INTERBUS is in operation; SET/ID writes while it is are violations (3.4.3)."""
-        if running.__class__ is not bool:
+        if type(running) is not bool:
             running = _checked(check_bool, "running", running)
         self._bus_running = running
 
@@ -410,7 +410,7 @@ class RegisterFile:
     def set_latch_phase(self, active: bool) -> None:
         """The core marks the latch phase of a data cycle; data-register accesses inside it are reported as
         inconsistent data (3.4.14)."""
-        if active.__class__ is not bool:
+        if type(active) is not bool:
             active = _checked(check_bool, "active", active)
         self._latch_phase = active
 
@@ -421,7 +421,7 @@ class RegisterFile:
 
     def set_io_access(self, busy: bool) -> None:
         """Set the I/O access (polling) bit: D7 of read 14 and the MFP1 level; 1 = no access now (Fig. 3-22)."""
-        if busy.__class__ is not bool:
+        if type(busy) is not bool:
             busy = _checked(check_bool, "busy", busy)
         self._io_access = busy
 
@@ -464,7 +464,7 @@ class RegisterFile:
             With ExtReg = 1.
         """
         names = self._in_registers()
-        if out.__class__ is not bytes or len(out) != len(names):
+        if type(out) is not bytes or len(out) != len(names):
             out = _checked(check_bytes, "out", out, len(names),
                            f"the OUT bytes of the cycle: latch needs {len(names)} OUT bytes for {self.data_bits()} "
                            "data bits, 3.4.8")
@@ -487,7 +487,7 @@ class RegisterFile:
         RegisterArgumentError
             If ``source`` is not a source name.
         """
-        if source.__class__ is not str or source not in _SOURCE_BITS:
+        if type(source) is not str or source not in _SOURCE_BITS:
             raise RegisterArgumentError("source", source, f"source must be one of {sorted(_SOURCE_BITS)} (Table "
                                         f"3-13), not {describe(source)}: no interrupt source {source!r}")
         mask = 1 << _SOURCE_BITS[source]
@@ -519,7 +519,7 @@ class RegisterFile:
             If ``register`` is not LENGTH_OUT, LENGTH_BRANCH, POWER_IN or POWER_OUT_BRANCH, or ``value`` sets a
             reserved bit.
         """
-        if register.__class__ is not str or register not in _OPTICAL_REGISTERS:
+        if type(register) is not str or register not in _OPTICAL_REGISTERS:
             raise RegisterArgumentError("register", register, f"register must be one of {sorted(_OPTICAL_REGISTERS)}, "
                                         f"not {describe(register)}: {register!r} is not an optical register "
                                         "(3.4.12, 3.4.13)")
@@ -534,7 +534,7 @@ class RegisterFile:
     def value(self, register: str) -> int:
         """The stored value of ``register`` (a :data:`REGISTER_MAP` name), without side effects (for tests and
         the core; IRQ_EVT without the live D7)."""
-        if register.__class__ is not str or register not in self._values:
+        if type(register) is not str or register not in self._values:
             raise RegisterArgumentError("register", register, f"register must be a name of REGISTER_MAP "
                                         f"({', '.join(sorted(self._values))}), not {describe(register)}: no register "
                                         f"{register!r}")

@@ -225,7 +225,7 @@ class UpifProtocol:
             (the chip sends on Ser_IN/OUT), else ``None``. Before initialization and when disabled: ``None``.
             The byte is the read register for a read access, else :attr:`last_rx` (UP-8).
         """
-        if s_r.__class__ is not bool:
+        if type(s_r) is not bool:
             s_r = _checked(check_bool, "s_r", s_r)
         if self._frame is not None:
             raise UpifUsageError("begin() inside a frame: call end() or abort() first")
@@ -240,7 +240,7 @@ class UpifProtocol:
     def end(self, rx: int) -> None:
         """/SS rose after 8 bits: process the received byte ``rx`` (in Intel receive frames the byte on the
         line is the chip's own, so ``rx`` equals what :meth:`begin` returned)."""
-        if rx.__class__ is not int or not 0 <= rx <= 0xFF:
+        if type(rx) is not int or not 0 <= rx <= 0xFF:
             rx = _checked(check_bits, "rx", rx, 8, "the received byte")
         frame = self._take_frame()
         if self.phase is Phase.DISABLED:
@@ -446,9 +446,9 @@ class UpInterface:
         ProtocolViolationError, ReconfigurationError, InconsistentDataError, SetRegisterError
             In strict mode, after the byte was processed.
         """
-        if mosi.__class__ is not int or not 0 <= mosi <= 0xFF:
+        if type(mosi) is not int or not 0 <= mosi <= 0xFF:
             mosi = _checked(check_bits, "mosi", mosi, 8, "one byte per frame, 3.4.2")
-        if s_r is not None and s_r.__class__ is not bool:
+        if s_r is not None and type(s_r) is not bool:
             s_r = _checked(check_bool, "s_r", s_r)
         protocol = self.protocol
         if protocol.mode is Mode.INTEL and s_r is None:
@@ -495,7 +495,7 @@ class UpInterface:
         InterruptedCommandError
             In strict mode, after the byte was taken as a data byte (recorded in lenient mode).
         """
-        if mode.__class__ is not Mode:
+        if type(mode) is not Mode:
             mode = _checked(check_instance, "mode", mode, Mode, "Mode.MOTOROLA or Mode.INTEL (Table 3-8)")
         protocol = self.protocol
         self._check_frame("initialize")
@@ -558,7 +558,7 @@ class UpInterface:
         NotInitializedError, InterfaceDisabledError, UpifUsageError
             If the interface cannot start a command now (nothing is sent).
         """
-        if address.__class__ is not int or not 0 <= address < BLOCK_ADDRESS:
+        if type(address) is not int or not 0 <= address < BLOCK_ADDRESS:
             address = _register_address(address)
         protocol = self.protocol
         if protocol.phase is not Phase.COMMAND or protocol._frame is not None:
@@ -585,9 +585,9 @@ class UpInterface:
         InterfaceDisabledError, UpifUsageError
             If the interface cannot start a command now (nothing is sent).
         """
-        if address.__class__ is not int or not 0 <= address < BLOCK_ADDRESS:
+        if type(address) is not int or not 0 <= address < BLOCK_ADDRESS:
             address = _register_address(address)
-        if value.__class__ is not int or not 0 <= value <= 0xFF:
+        if type(value) is not int or not 0 <= value <= 0xFF:
             value = _checked(check_bits, "value", value, 8, "a data byte, 3.4.4")
         protocol = self.protocol
         if protocol.phase is not Phase.COMMAND or protocol._frame is not None:
