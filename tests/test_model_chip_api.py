@@ -267,3 +267,23 @@ def test_register_file_constructor_checks_its_arguments(args: tuple[object, ...]
                                                         message: str) -> None:
     with pytest.raises(RegisterArgumentError, match=message):
         RegisterFile(*args, **kwargs)  # type: ignore[arg-type]
+
+
+def test_every_named_error_pickles_with_its_message_and_attributes() -> None:
+    """Errors cross process boundaries (pytest-xdist, multiprocessing): each of these modules' errors survives."""
+    from supi3.spi import upif
+
+    errors: list[Exception] = [
+        ChipArgumentError("now", math.inf, "now must be a finite number >= 0, not inf"),
+        RegisterArgumentError("address", 16, "address must be an integer from 0 to 15, not 16"),
+        upif.UpifArgumentError("mosi", 256, "mosi must be an integer from 0 to 255, not 256"),
+        upif.NotInitializedError("read"),
+        upif.InterfaceDisabledError("write"),
+        upif.UninitializedAccessError("3.4.3", "interface not initialized: 4Dh taken as a faulty initialization byte"),
+        upif.InterruptedCommandError("3.4.3", "initialize(): C/D = 1"),
+        upif.ProtocolViolationError("3.4.2", "incomplete byte"),
+        InconsistentDataError("3.4.14", "inconsistent data: IN0 write during the latch phase", 7),
+    ]
+    for error in errors:
+        again = pickle.loads(pickle.dumps(error))
+        assert type(again) is type(error) and str(again) == str(error) and vars(again) == vars(error)

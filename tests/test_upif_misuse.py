@@ -195,6 +195,17 @@ def test_initialize_after_a_reset_in_the_middle_of_a_command_is_reported(mode: M
     assert [type(v) for v in lenient.registers.violations.records] == [InterruptedCommandError]
 
 
+def test_initialize_in_the_middle_of_an_intel_read_raises_the_interruption_first() -> None:
+    """The init byte goes out with S/R = 1 where the pending read wants S/R = 0 (Table 3-9, also reported): strict
+    mode raises the interruption, the cause the firmware must fix."""
+    up = chip(Mode.INTEL)
+    up.transfer(0x8E, s_r=True)  # read the event register ... and the µP resets here
+    with pytest.raises(InterruptedCommandError, match=r"81h was taken as the data byte of command 8Eh; SAS_INIT"):
+        up.initialize(Mode.INTEL)
+    assert [type(v) for v in up.registers.violations.records] == [InterruptedCommandError, ProtocolViolationError]
+    assert up.protocol.phase is Phase.COMMAND
+
+
 def test_initialize_in_the_middle_of_a_block_transfer_is_reported() -> None:
     up = chip(Mode.MOTOROLA, strict=False)
     up.transfer(0xCF)

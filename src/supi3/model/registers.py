@@ -64,6 +64,9 @@ class RegisterArgumentError(ArgumentError, RegisterFileError):
     """An argument of a :class:`RegisterFile` method of the wrong type or out of its range ("X must be ..., not
     ..."): an :class:`~supi3.errors.ArgumentError` that code catching :class:`RegisterFileError` still catches."""
 
+    def __reduce__(self) -> tuple[object, ...]:
+        return (type(self), (self.name, self.value, str(self)))
+
 
 _T = TypeVar("_T")
 
@@ -92,6 +95,9 @@ class InterfaceViolationError(Supi3Error):
         self.rule = rule
         self.detail = detail
         super().__init__(f"{detail} ({rule})")
+
+    def __reduce__(self) -> tuple[object, ...]:
+        return (type(self), (self.rule, self.detail))
 
 
 class ReconfigurationError(InterfaceViolationError):

@@ -519,12 +519,14 @@ class UpInterface:
         code = 0 if command is None else encode_command(command.address, rd=command.rd, wr=command.wr)
         what = ("the next byte of a block transfer" if protocol.phase is Phase.BLOCK
                 else f"the data byte of command {code:02X}h")
-        name = _port_name(command) if command is not None and command.wr else ""
-        self._byte(mode.init_byte, True)
-        effect = f", written to {name}" if name and protocol.phase is Phase.COMMAND else ""
+        # Reported before the byte (the deferred block raises after it), so that in strict mode this violation,
+        # not one the byte itself causes (Intel: a read command's data byte with S/R = 1, Table 3-9), is raised.
+        name = _port_name(command) if command is not None and command.wr and protocol.phase is Phase.DATA else ""
+        effect = f", written to {name}" if name else ""
         protocol.registers.violations.report(InterruptedCommandError(
             "3.4.3", INTERRUPTED_INIT.format(byte=mode.init_byte, what=what, effect=effect)
         ))
+        self._byte(mode.init_byte, True)
 
     # --------------------------------------------------------------------------------------------------------
     # Register accesses
@@ -687,6 +689,9 @@ class UpifArgumentError(ArgumentError, UpifUsageError):
     be ..., not ..."): an :class:`~supi3.errors.ArgumentError` that code catching :class:`UpifUsageError` still
     catches. Nothing was sent."""
 
+    def __reduce__(self) -> tuple[object, ...]:
+        return (type(self), (self.name, self.value, str(self)))
+
 
 class NotInitializedError(UpifUsageError):
     """A register access before :meth:`UpInterface.initialize` that the API refuses (nothing sent): it would
@@ -697,6 +702,9 @@ class NotInitializedError(UpifUsageError):
         super().__init__(f"{what}: interface not initialized; call initialize(Mode.MOTOROLA or Mode.INTEL) first "
                          "(3.4.3: the chip expects its initialization byte before any other access); nothing sent")
 
+    def __reduce__(self) -> tuple[object, ...]:
+        return (type(self), (self.what,))
+
 
 class InterfaceDisabledError(UpifUsageError):
     """A call to an interface disabled by a faulty initialization byte (3.4.3): nothing was sent."""
@@ -705,6 +713,9 @@ class InterfaceDisabledError(UpifUsageError):
         self.what = what
         super().__init__(f"{what}: the interface is disabled by a faulty initialization byte: SAS_INIT it (or "
                          "power-up reset), then initialize() (3.4.3); nothing sent")
+
+    def __reduce__(self) -> tuple[object, ...]:
+        return (type(self), (self.what,))
 
 
 class UninitializedAccessError(ProtocolViolationError):
