@@ -287,3 +287,14 @@ def test_every_named_error_pickles_with_its_message_and_attributes() -> None:
     for error in errors:
         again = pickle.loads(pickle.dumps(error))
         assert type(again) is type(error) and str(again) == str(error) and vars(again) == vars(error)
+
+
+def test_violation_log_checks_its_arguments() -> None:
+    from supi3.model.registers import ViolationLog
+
+    with pytest.raises(ArgumentError, match=r"^strict must be True or False, not 1$"):
+        ViolationLog(1)  # type: ignore[arg-type]
+    log = ViolationLog(strict=False)
+    with pytest.raises(RegisterArgumentError, match=r"^violation must be an InterfaceViolationError, not 'late'$"):
+        log.report("late")  # type: ignore[arg-type]
+    assert log.records == []

@@ -153,7 +153,7 @@ class ViolationLog:
     def report(self, violation: InterfaceViolationError) -> None:
         """Record ``violation``; in strict mode raise it, or (inside :meth:`deferred`) at the end of the block."""
         if not isinstance(violation, InterfaceViolationError):
-            raise _checked(check_instance, "violation", violation, InterfaceViolationError)
+            _checked(check_instance, "violation", violation, InterfaceViolationError, "an InterfaceViolationError")
         self.records.append(violation)
         if not self.strict:
             return
