@@ -281,6 +281,7 @@ def test_every_named_error_pickles_with_its_message_and_attributes() -> None:
         upif.InterfaceDisabledError("write"),
         upif.UninitializedAccessError("3.4.3", "interface not initialized: 4Dh taken as a faulty initialization byte"),
         upif.InterruptedCommandError("3.4.3", "initialize(): C/D = 1"),
+        upif.ModeLockedError("3.4.3", "initialize(Mode.INTEL): already initialized in Motorola mode"),
         upif.ProtocolViolationError("3.4.2", "incomplete byte"),
         InconsistentDataError("3.4.14", "inconsistent data: IN0 write during the latch phase", 7),
     ]

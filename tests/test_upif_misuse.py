@@ -26,6 +26,7 @@ from supi3.spi.upif import (
     InterfaceDisabledError,
     InterruptedCommandError,
     Mode,
+    ModeLockedError,
     NotInitializedError,
     Phase,
     ProtocolViolationError,
@@ -218,6 +219,27 @@ def test_initialize_in_the_middle_of_a_block_transfer_is_reported() -> None:
     up.transfer(0)
     up.transfer(0)
     assert up.read(1) == 0
+
+
+@pytest.mark.parametrize("mode", list(Mode))
+def test_initialize_with_the_other_mode_is_reported(mode: Mode) -> None:
+    """3.4.3: "Once this access mode has been set it can only be changed by a hardware reset or SAS_INIT". The
+    chip takes the other mode's byte as a command; the firmware would now talk the wrong protocol."""
+    other = Mode.INTEL if mode is Mode.MOTOROLA else Mode.MOTOROLA
+    up = chip(mode, set_value=0x82)
+    with pytest.raises(ModeLockedError) as raised:
+        up.initialize(other)
+    assert raised.value.detail == (
+        f"initialize(Mode.{other.name}): the interface is already initialized in {mode.name.capitalize()} mode, "
+        f"which only a power-up reset or SAS_INIT changes; {other.init_byte:02X}h was taken as a command")
+    assert up.protocol.mode is mode and up.protocol.phase is Phase.COMMAND
+    assert up.read(13) == 0x82
+    assert up.initialize(mode) is False  # the same mode again: no violation
+    up.sas_init()
+    assert up.initialize(other) is True
+    lenient = chip(mode, strict=False)
+    assert lenient.initialize(other) is False
+    assert [type(v) for v in lenient.registers.violations.records] == [ModeLockedError]
 
 
 def test_disabled_interface_refuses_initialize_without_sending() -> None:

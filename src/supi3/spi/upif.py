@@ -41,6 +41,7 @@ __all__ = [
     "InterfaceDisabledError",
     "InterruptedCommandError",
     "Mode",
+    "ModeLockedError",
     "NotInitializedError",
     "Phase",
     "ProtocolViolationError",
@@ -74,6 +75,10 @@ INTERRUPTED_INIT: Final[str] = "initialize(): C/D = 1 before the initialization 
     "of a command: {byte:02X}h was taken as {what}{effect}; SAS_INIT before initialize() after a µP reset"
 """UP-27: :meth:`UpInterface.initialize` on a chip showing data sends the byte anyway (the chip takes it as the
 pending data byte, 3.4.3, 3.4.4) and reports this violation; the initialization is not a first one."""
+MODE_LOCKED: Final[str] = "initialize({wanted}): the interface is already initialized in {mode} mode, which only a " \
+    "power-up reset or SAS_INIT changes; {byte:02X}h was taken as a command"
+"""UP-29: :meth:`UpInterface.initialize` with the other mode on an initialized chip: the chip keeps its mode and
+takes the byte as a command (3.4.3); this violation is reported, the initialization is not a first one."""
 
 
 class Mode(StrEnum):
@@ -494,6 +499,8 @@ class UpInterface:
             sent.
         InterruptedCommandError
             In strict mode, after the byte was taken as a data byte (recorded in lenient mode).
+        ModeLockedError
+            In strict mode, when an initialized chip was asked for the other mode (recorded in lenient mode, UP-29).
         """
         if type(mode) is not Mode:
             mode = _checked(check_instance, "mode", mode, Mode, "Mode.MOTOROLA or Mode.INTEL (Table 3-8)")
@@ -510,6 +517,10 @@ class UpInterface:
                 return True  # command status twice: a first initialization (3.4.3)
             command = protocol.command  # the byte was taken as command 00h or 81h: complete it
             self._byte(0, command is None or not command.rd)
+            if protocol.mode is not mode and protocol.mode is not None:
+                protocol.registers.violations.report(ModeLockedError("3.4.3", MODE_LOCKED.format(
+                    wanted=f"Mode.{mode.name}", mode=protocol.mode.name.capitalize(), byte=mode.init_byte
+                )))
             return False
 
     def _interrupted(self, mode: Mode) -> None:
@@ -726,6 +737,11 @@ class UninitializedAccessError(ProtocolViolationError):
 class InterruptedCommandError(ProtocolViolationError):
     """:meth:`UpInterface.initialize` on a chip that waited for a data byte (the µP was reset in the middle of a
     command): the initialization byte was taken as that data byte (3.4.3; UP-27)."""
+
+
+class ModeLockedError(ProtocolViolationError):
+    """:meth:`UpInterface.initialize` asked for the other mode on an initialized chip, whose mode only a power-up
+    reset or SAS_INIT changes (3.4.3; UP-29)."""
 
 
 _READ_COMMANDS: Final[tuple[int, ...]] = tuple(encode_command(a, rd=True) for a in range(BLOCK_ADDRESS))
