@@ -21,6 +21,7 @@ from supi3.model.registers import (
     RegisterFile,
     RegisterFileError,
 )
+from supi3.model.top import Supi3Chip
 from supi3.regmap import REGISTER_MAP
 from supi3.spi.slave_pins import SlavePins
 from supi3.spi.upif import Mode, UpInterface
@@ -83,6 +84,49 @@ def test_inconsistent_data_names_the_pin_level_cycle() -> None:
     assert violation.clock is not None and start <= violation.clock <= pins.cycle
     assert violation.time_s == violation.clock / CLOCK_HZ
     assert f"at clock {violation.clock} (t = " in str(violation)
+
+
+def test_inconsistent_data_names_the_whole_chip_cycle() -> None:
+    """The whole chip at pin level (Supi3Chip): with the core's cycle counter as the clock source (the µP interface
+    ticks after the core's step, so the cycle being clocked is ``core.cycle - 1``; Supi3Chip should install this
+    itself, docs/model.md), the violation names the exact clock edge of the read: the /SS fall's first cycle + 2,
+    the second synchroniser flop (UP-13) and the read at /SS falling (UP-18)."""
+    half, sclk, ss_n, mosi, mfp7 = 8, 1 << 4, 1 << 5, 1 << 6, 1 << 7
+    idle = sclk | ss_n | mfp7
+    whole = Supi3Chip(decode("10011", "1110", clk_conf="11"), strict=False)
+    registers = whole.chip.registers
+    assert registers is not None
+    registers.use_clock(lambda: whole.core.cycle - 1)
+
+    def tick(mfp: int) -> None:
+        whole.step({"do1": 1, "di2": 0, "rbst_ext": 0, "mfp_in": mfp, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 1})
+
+    def spi(byte: int) -> int:
+        """One Motorola byte; returns the first cycle with /SS low."""
+        selected = idle & ~ss_n
+        fall = whole.core.cycle
+        for _ in range(half):
+            tick(selected)
+        for i in range(8):
+            bit = mosi if (byte >> (7 - i)) & 1 else 0
+            for _ in range(half):
+                tick((selected & ~sclk & ~mosi) | bit)
+            for _ in range(half):
+                tick(selected | bit)
+        for k in range(3 * half):  # SCLK high until /SS may rise, then the gap
+            tick(idle if k >= half else selected)
+        return fall
+
+    for _ in range(300):
+        tick(idle)
+    for byte in (Mode.MOTOROLA.init_byte, 0x4D, SET_2_WORDS, 0x80):  # initialize, SET, then read OUT0
+        spi(byte)
+    whole.chip.set_latch_phase(True)
+    fall = spi(0)
+    [violation] = registers.violations.records
+    assert isinstance(violation, InconsistentDataError)
+    assert violation.clock == fall + 2
+    assert violation.time_s == (fall + 2) / CLOCK_HZ
 
 
 def test_inconsistent_data_without_a_clock_says_so_and_pickles() -> None:

@@ -1,7 +1,7 @@
 """The firmware interface after misuse (issue #8, parts 3 and 5): wrong arguments, wrong call orders and protocol
 violations, tried as a hostile user would. A refused call sends nothing and changes nothing; a register access
 that completes leaves the interface in a documented state (docs/upif.md "Firmware API after misuse", UP-25 to
-UP-28); nothing ends in a bare builtin error, nor (under ``python -O``) in a silent ``None``."""
+UP-29); nothing ends in a bare builtin error, nor (under ``python -O``) in a silent ``None``."""
 
 from __future__ import annotations
 

@@ -63,7 +63,7 @@ BLOCK_ADDRESS: Final[int] = 15
 """A3..0 of the command byte that starts a block transfer (3.4.6)."""
 _WORD_BITS: Final[int] = 16
 
-# Firmware API after misuse (docs/assumptions/upif.md UP-25 to UP-28): where the manual is silent, one constant each.
+# Firmware API after misuse (docs/assumptions/upif.md UP-25 to UP-29): where the manual is silent, one constant each.
 REFUSED_BEFORE_INIT: Final[frozenset[str]] = frozenset({"read", "exchange", "block transfer"})
 """UP-25: the register accesses that return data; before initialization the chip drives none (3.4.1, 3.4.3), so
 :class:`UpInterface` refuses them (:class:`NotInitializedError`) and sends nothing."""
@@ -390,7 +390,7 @@ class UpInterface:
     access (:meth:`read`, :meth:`write`, :meth:`exchange`, :meth:`block_transfer`) the interface is back in the
     command phase, whether or not a violation was raised, except where the violation says otherwise (a write
     before initialization disables the interface, 3.4.3). See docs/upif.md, "Firmware API after misuse" (UP-25 to
-    UP-28).
+    UP-29).
     """
 
     def __init__(self, registers: RegisterFile | Supi3) -> None:
