@@ -579,9 +579,9 @@ class UpInterface:
         with protocol.registers.violations.deferred():
             self._byte(_READ_COMMANDS[address], True)
             value = protocol.begin(False)
-            if value is None:  # cannot happen after a command byte: the chip drives every read data byte
-                raise UpifUsageError(f"read({address}): the chip drove no data byte")
-            protocol.end(value if protocol.mode is Mode.INTEL else 0)
+            protocol.end(value if value is not None and protocol.mode is Mode.INTEL else 0)
+        if value is None:  # cannot happen after a command byte: the chip drives every read data byte
+            raise UpifUsageError(f"read({address}): the chip drove no data byte")
         return value
 
     def write(self, address: int, value: int) -> None:
