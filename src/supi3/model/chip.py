@@ -67,9 +67,6 @@ class ChipArgumentError(ArgumentError, ChipError):
     """An argument of a :class:`Supi3` method of the wrong type or out of its range ("X must be ..., not ..."): an
     :class:`~supi3.errors.ArgumentError` that code catching :class:`ChipError` still catches."""
 
-    def __reduce__(self) -> tuple[object, ...]:
-        return (type(self), (self.name, self.value, str(self)))
-
 
 _T = TypeVar("_T")
 _INF: Final = math.inf

@@ -64,9 +64,6 @@ class RegisterArgumentError(ArgumentError, RegisterFileError):
     """An argument of a :class:`RegisterFile` method of the wrong type or out of its range ("X must be ..., not
     ..."): an :class:`~supi3.errors.ArgumentError` that code catching :class:`RegisterFileError` still catches."""
 
-    def __reduce__(self) -> tuple[object, ...]:
-        return (type(self), (self.name, self.value, str(self)))
-
 
 _T = TypeVar("_T")
 

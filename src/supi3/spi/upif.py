@@ -700,9 +700,6 @@ class UpifArgumentError(ArgumentError, UpifUsageError):
     be ..., not ..."): an :class:`~supi3.errors.ArgumentError` that code catching :class:`UpifUsageError` still
     catches. Nothing was sent."""
 
-    def __reduce__(self) -> tuple[object, ...]:
-        return (type(self), (self.name, self.value, str(self)))
-
 
 class NotInitializedError(UpifUsageError):
     """A register access before :meth:`UpInterface.initialize` that the API refuses (nothing sent): it would
