@@ -262,8 +262,11 @@ class Supi3Pins:
             "di1": di2 if self._next_present else do2,
             "mfp_out": chip.mfp_outputs,
             "mfp_oe": self.mfp_oe,
-            "mod_ack_n": int(c >= chip.mod_ack_until),
-            "res_reg_n": int(c >= chip.resreg_until),
+            # A pulse the chip starts at clock clk (the edge ending cycle clk) lasts until clk + width in chip
+            # time; the pins show it from cycle clk + 1, so for cycles clk + 1 .. clk + width (M3). Cycle 0 comes
+            # before any edge (the chip's "no pulse" value is 0).
+            "mod_ack_n": int(not 0 < c <= chip.mod_ack_until),
+            "res_reg_n": int(not 0 < c <= chip.resreg_until),
             "diag1": int(chip.bus_active) if self.complete_diagnostics else 0,
             "diag2": 0,
             "ib_diag": self._ib_diag(c),
@@ -678,8 +681,8 @@ class Supi3Pins:
         out = {
             "mfp_out": mfp_out,
             "diag1": diag1,
-            "mod_ack_n": (cycles >= mod_ack_until).astype(np.int64),
-            "res_reg_n": (cycles >= resreg_until).astype(np.int64),
+            "mod_ack_n": ((cycles <= 0) | (cycles > mod_ack_until)).astype(np.int64),  # as output_values()
+            "res_reg_n": ((cycles <= 0) | (cycles > resreg_until)).astype(np.int64),
             "resu_drive": (cycles < run_from).astype(np.int64),
             "ib_diag": np.where(pf != 0, fast, np.where(bus_active != 0, 1, slow)),
         }

@@ -36,7 +36,7 @@ from amaranth.lib.wiring import In, Out
 
 from supi3.config import Variant
 from supi3.interbus import wire
-from supi3.model.chip import MODACK_PULSE_CLOCKS, RESREG_PULSE_CLOCKS, STATERR_FILTER_CLOCKS, WATCHDOG_CLOCKS
+from supi3.model.chip import MODACK_PULSE_CLOCKS, STATERR_FILTER_CLOCKS, WATCHDOG_CLOCKS
 from supi3.model.pins import (
     IB_DIAG_DIVIDER_BITS,
     IDLE_INPUTS,
@@ -60,6 +60,7 @@ from supi3.rtl.tables import (
 )
 from supi3.rtl.upif import upif_tables
 from supi3.spi.block_pins import CORE_INPUTS, CORE_OUTPUTS, EVENT_BITS, STRAP_INPUTS
+from supi3.tables import RESREG_PULSE_CLOCKS
 from supi3.verif.pinmodel import Pin
 
 __all__ = ["REGISTER_FILE_INPUTS", "REGISTER_FILE_OUTPUTS", "STRAP_PINS", "Supi3Core", "verilog"]
@@ -370,8 +371,10 @@ class _Engine(Elaboratable):
             count = Array(Const(max(t or 1, 1) - 1, len(wd_count)) for t in WATCHDOG_CLOCKS)[code]
             return [wd_active.eq(on), wd_count.eq(count)]
 
-        mod_ack = Signal(range(MODACK_PULSE_CLOCKS))
-        res_reg = Signal(range(RESREG_PULSE_CLOCKS))
+        # Pulse counters: loaded with the width at the edge that starts the pulse, the pin low while non-zero, so
+        # low for exactly the width's clocks (Table 3-13: 375 ns = tables.RESREG_PULSE_CLOCKS; /ModAck M3).
+        mod_ack = Signal(range(MODACK_PULSE_CLOCKS + 1))
+        res_reg = Signal(range(RESREG_PULSE_CLOCKS + 1))
         with m.If(mod_ack != 0):
             sync += mod_ack.eq(mod_ack - 1)
         with m.If(res_reg != 0):
@@ -388,7 +391,7 @@ class _Engine(Elaboratable):
             return events[_SOURCE_BIT[source]].eq(1)
 
         with m.If(fire):  # the watchdog resets process data (Table 3-13)
-            sync += [wd_active.eq(0), mfp_out.eq(0), res_reg.eq(RESREG_PULSE_CLOCKS - 1)]
+            sync += [wd_active.eq(0), mfp_out.eq(0), res_reg.eq(RESREG_PULSE_CLOCKS)]
             comb += [self.ib_reset.eq(1), event("IB_RESET")]
 
         # The following device (Table 2-2, M5)
@@ -648,7 +651,7 @@ class _Engine(Elaboratable):
                             with m.If(command[wire.CMD_WD_SET_BIT]):
                                 sync += [wd_code.eq(code), *arm(code)]
                             with m.If(command[wire.CMD_QUIT_BIT]):  # Quit Peripheral Error (3.6.2)
-                                sync += [pf.eq(module_error), mod_ack.eq(MODACK_PULSE_CLOCKS - 1)]
+                                sync += [pf.eq(module_error), mod_ack.eq(MODACK_PULSE_CLOCKS)]
                             sync += [wd.eq(0), te.eq(0), attention.eq(0)]
                         with m.Else():  # OUT data to the MFPs (Tables 3-1, 3-2), watchdog restarted
                             sync += [bus_active.eq(1), *arm(wd_code)]
