@@ -26,6 +26,8 @@ from supi3.verif.pinmodel import Pin
 __all__ = ["ChipStrapPins", "StrapPins", "strap_inputs", "strap_stimulus"]
 
 _STRAP_NAMES = tuple(pin.name for pin in STRAP_PINS)
+_CORE_NAMES = tuple(pin.name for pin in Supi3Pins.inputs)
+"""The model's own pins: its step() takes exactly these (the straps are this wrapper's)."""
 _EXPANSION_SHIFT = MFP_PINS - EXPANSION_BITS
 
 
@@ -112,7 +114,7 @@ class StrapPins:
             self._straps = straps
         elif straps != self._straps:
             raise PinSpecError(f"cycle {self.pins.cycle}: the straps changed ({self._straps} -> {straps})")
-        return self.pins.step(inputs)
+        return self.pins.step({name: inputs[name] for name in _CORE_NAMES})
 
     def run(self, inputs: Mapping[str, npt.NDArray[np.integer]]) -> dict[str, npt.NDArray[np.int64]]:
         """Whole traces at once (:meth:`Supi3Pins.run`, event-driven); the straps must be constant."""
@@ -172,7 +174,7 @@ class ChipStrapPins:
 
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
         """One clock of the chip the straps select (see :mod:`supi3.verif.pinmodel`)."""
-        return self._model(inputs).step(inputs)
+        return self._model(inputs).step({name: inputs[name] for name in _CORE_NAMES})
 
     def run(self, inputs: Mapping[str, npt.NDArray[np.integer]]) -> dict[str, npt.NDArray[np.int64]]:
         """Whole traces at once (:meth:`Supi3Chip.run`); the straps must be constant."""

@@ -21,10 +21,11 @@ import math
 from collections import deque
 from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, fields
-from typing import Final
+from typing import Final, NoReturn
 
 from supi3 import tables
-from supi3.checks import check_choice, check_int, fail
+from supi3.checks import check_bits, check_bool, check_choice, check_instance, check_int, fail
+from supi3.errors import ArgumentError
 from supi3.model.registers import InterfaceViolationError, RegisterFile
 from supi3.spi.upif import Mode, UpifProtocol, UpifUsageError
 from supi3.timing import timing_table
@@ -89,6 +90,11 @@ class PinsIn:
     mfp7: int = 1
     """MFP7 as an input: S/R in Intel mode (Table 3-9); not used in Motorola mode (there it is SerOUT)."""
 
+    def __post_init__(self) -> None:
+        a, b, c, d, e = self.sas_init, self.sclk, self.ss_n, self.mfp6, self.mfp7
+        if not (int is type(a) is type(b) is type(c) is type(d) is type(e) and not (a | b | c | d | e) >> 1):
+            _check_levels(self)
+
 
 @dataclass(frozen=True)
 class PinsOut:
@@ -109,6 +115,19 @@ class PinsOut:
     mfp7: int
     """MFP7, SerOUT (Motorola mode)."""
     mfp7_oe: int
+
+    def __post_init__(self) -> None:
+        values = (self.io, self.io_oe, self.c_d, self.c_d_oe, self.irq_n, self.irq_n_oe, self.mfp6, self.mfp6_oe,
+                  self.mfp7, self.mfp7_oe)  # fmt: skip
+        if not all(type(value) is int and not value >> 1 for value in values):
+            _check_levels(self)
+
+
+def _check_levels(pins: PinsIn | PinsOut) -> None:
+    """Every field of ``pins`` a level, 0 or 1 (numpy integers become ``int``), else a named error."""
+    for item in fields(pins):
+        value = check_bits(f"pin {item.name!r}", getattr(pins, item.name), 1)
+        object.__setattr__(pins, item.name, value)
 
 
 INPUT_PINS: Final[tuple[str, ...]] = tuple(f.name for f in fields(PinsIn))
@@ -213,7 +232,20 @@ class TimingChecker:
             self._violation(symbol, cycle, cycle - since)
 
     def check(self, cycle: int, pins: PinsIn, out: PinsOut, intel: bool) -> None:
-        """Check the inputs of ``cycle`` against those of the cycle before; ``out`` are the outputs of ``cycle``."""
+        """Check the inputs of ``cycle`` against those of the cycle before; ``out`` are the outputs of ``cycle``.
+
+        Raises
+        ------
+        ArgumentError
+            ``cycle`` not an integer >= 0, ``pins`` not a :class:`PinsIn`, ``out`` not a :class:`PinsOut`, ``intel``
+            not a bool; nothing changes.
+        """
+        if not (type(cycle) is int and cycle >= 0 and type(pins) is PinsIn and type(out) is PinsOut
+                and type(intel) is bool):
+            check_int("cycle", cycle, 0)
+            check_instance("pins", pins, PinsIn)
+            check_instance("out", out, PinsOut)
+            check_bool("intel", intel)
         prev, self._pins = self._pins, pins
         fell, rose = prev.ss_n and not pins.ss_n, pins.ss_n and not prev.ss_n
         low = not pins.ss_n
@@ -255,6 +287,18 @@ class TimingChecker:
             self._require("t_SAS_INIT", cycle, self._sas_rise)
 
 
+def _bad_names(inputs: object) -> NoReturn:
+    """Raise the named error for a mapping that does not name exactly :data:`INPUT_PINS`."""
+    if not isinstance(inputs, Mapping):
+        raise fail("inputs", "a mapping of pin name to level", inputs)
+    missing = [name for name in INPUT_PINS if name not in inputs]
+    unknown = [name for name in inputs if name not in INPUT_PINS]
+    problems = [f"without {', '.join(map(repr, missing))}" if missing else "",
+                f"with {', '.join(map(repr, unknown))}, no such pin" if unknown else ""]  # fmt: skip
+    raise ArgumentError("inputs", inputs, f"inputs must name exactly the pins {', '.join(INPUT_PINS)}, not "
+                                          + "; ".join(problem for problem in problems if problem))
+
+
 class SlavePins:
     """The serial µP interface pins of the SUPI 3 OPC as a synchronous machine at the chip clock.
 
@@ -273,6 +317,8 @@ class SlavePins:
     """
 
     def __init__(self, registers: RegisterFile, *, clock_hz: int = tables.CLOCK_HZ) -> None:
+        check_instance("registers", registers, RegisterFile)
+        check_int("clock_hz", clock_hz, 1)
         bit_rate = registers.config.bit_rate
         if clock_hz % (TCLK_PER_BIT * bit_rate):
             raise UpifUsageError(f"clock {clock_hz} Hz is not a multiple of TCLK = {TCLK_PER_BIT} * {bit_rate} Hz")
@@ -315,9 +361,13 @@ class SlavePins:
 
         Raises
         ------
+        ArgumentError
+            ``pins`` is not a :class:`PinsIn` (nothing changes).
         TimingViolationError, ProtocolViolationError, ReconfigurationError, InconsistentDataError
             In strict mode, after the cycle completed.
         """
+        if type(pins) is not PinsIn:
+            check_instance("pins", pins, PinsIn)
         out = self._pipeline[0]
         with self.registers.violations.deferred():
             self._checker.check(self.cycle, pins, out, self.protocol.mode is Mode.INTEL)
@@ -329,7 +379,16 @@ class SlavePins:
 
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
         """:meth:`tick` with pins by name (the lockstep harness's ``PinModel.step``; names in
-        :data:`INPUT_PINS` and :data:`OUTPUT_PINS`)."""
+        :data:`INPUT_PINS` and :data:`OUTPUT_PINS`).
+
+        Raises
+        ------
+        ArgumentError
+            ``inputs`` does not name exactly :data:`INPUT_PINS`, or a level is not 0 or 1 (nothing changes).
+        """
+        if not isinstance(inputs, Mapping) or len(inputs) != len(INPUT_PINS) \
+                or any(name not in inputs for name in INPUT_PINS):
+            _bad_names(inputs)
         return asdict(self.tick(PinsIn(**inputs)))
 
     def _edge(self, pins: PinsIn, out: PinsOut) -> None:
