@@ -28,6 +28,10 @@ from supi3.model.pins import Supi3Pins
 from supi3.model.registers import InterfaceViolationError, RegisterFile
 from supi3.model.top import Supi3Chip, up_pin_inputs, up_pin_outputs
 from supi3.model.vcd import write_vcd
+from supi3.rtl.chip import Supi3Chip as RtlChip
+from supi3.rtl.core import Supi3Core
+from supi3.rtl.harness import ChipStrapPins, StrapPins, strap_inputs, strap_stimulus
+from supi3.rtl.tables import core_tables
 from supi3.spi.block_pins import UpifBlockPins, block_model, strap_values
 from supi3.spi.slave_pins import PinsIn, PinsOut, SlavePins, TimingChecker
 from supi3.verif.errors import PinSpecError
@@ -102,6 +106,29 @@ def _after_run_forward() -> Supi3Pins:
     model = Supi3Pins(BINARY)
     model.run_forward(traces())
     return model
+
+
+def _up_chip() -> Supi3Chip:
+    return Supi3Chip(UP, strict=False)
+
+
+def _slave() -> SlavePins:
+    return SlavePins(RegisterFile(UP, strict=False))
+
+
+STRAPS = {name: value for name, value in strap_inputs(BINARY).items() if name != "mfp_expansion"}
+
+
+def _strap_row(**changes: Any) -> dict[str, Any]:
+    return {**IDLE, **STRAPS, **changes}
+
+
+def _strap_traces(**changes: Any) -> dict[str, Any]:
+    return {**traces(), **{k: np.full(N, v) for k, v in STRAPS.items()}, **changes}
+
+
+def probe_straps(model: StrapPins | ChipStrapPins) -> object:
+    return [model.step(_strap_row(do1=k % 2)) for k in range(4)]
 
 
 def _checker() -> TimingChecker:
@@ -246,13 +273,13 @@ CASES: list[tuple[str, Factory, Call, type[Exception], str, Callable[[Any], obje
      probe_none),
     ("chip-strict", lambda: None, lambda _: Supi3Chip(UP, strict=bad("yes")), ArgumentError,
      "strict must be True or False, not 'yes'", probe_none),
-    ("chip-step-mfp", lambda: Supi3Chip(UP, strict=False), lambda c: c.step(idle_with(mfp_in=1 << 16)), ArgumentError,
+    ("chip-step-mfp", _up_chip, lambda c: c.step(idle_with(mfp_in=1 << 16)), ArgumentError,
      "pin 'mfp_in' must be an integer from 0 to 65535 (16 bits), not 65536", probe_chip),
-    ("chip-step-missing", lambda: Supi3Chip(UP, strict=False), lambda c: c.step(without(IDLE, "do1")), ArgumentError,
+    ("chip-step-missing", _up_chip, lambda c: c.step(without(IDLE, "do1")), ArgumentError,
      "not without 'do1'", probe_chip),
-    ("chip-run-up", lambda: Supi3Chip(UP, strict=False), lambda c: c.run(traces(mfp_in=np.full(N, -1))), ArgumentError,
+    ("chip-run-up", _up_chip, lambda c: c.run(traces(mfp_in=np.full(N, -1))), ArgumentError,
      "pin 'mfp_in' trace[0] must be an integer from 0 to 65535 (16 bits), not -1", probe_chip),
-    ("chip-run-lengths", lambda: Supi3Chip(UP, strict=False), lambda c: c.run(traces(do1=np.ones(3, np.int64))), ArgumentError,
+    ("chip-run-lengths", _up_chip, lambda c: c.run(traces(do1=np.ones(3, np.int64))), ArgumentError,
      "the length of pin 'do1' trace", probe_chip),
     ("chip-run-binary", lambda: Supi3Chip(BINARY), lambda c: c.run(traces(do1=np.full(N, 2))), ArgumentError,
      "pin 'do1' trace[0] must be an integer from 0 to 1 (1 bit), not 2", probe_chip),
@@ -273,15 +300,15 @@ CASES: list[tuple[str, Factory, Call, type[Exception], str, Callable[[Any], obje
      "clock_hz must be an integer >= 1, not 0", probe_none),
     ("slave-clock-float", lambda: None, lambda _: SlavePins(RegisterFile(UP), clock_hz=bad(32e6)), ArgumentError,
      "clock_hz must be an integer >= 1, not 32000000.0", probe_none),
-    ("slave-tick", lambda: SlavePins(RegisterFile(UP, strict=False)), lambda s: s.tick(bad({"sclk": 1})), ArgumentError,
+    ("slave-tick", _slave, lambda s: s.tick(bad({"sclk": 1})), ArgumentError,
      "pins must be a PinsIn", probe_slave),
-    ("slave-step-2", lambda: SlavePins(RegisterFile(UP, strict=False)), lambda s: s.step(
+    ("slave-step-2", _slave, lambda s: s.step(
         {"sas_init": 0, "sclk": 2, "ss_n": 1, "mfp6": 0, "mfp7": 1}), ArgumentError,
      "pin 'sclk' must be an integer from 0 to 1 (1 bit), not 2", probe_slave),
-    ("slave-step-missing", lambda: SlavePins(RegisterFile(UP, strict=False)), lambda s: s.step({"sclk": 1}), ArgumentError,
+    ("slave-step-missing", _slave, lambda s: s.step({"sclk": 1}), ArgumentError,
      "inputs must name exactly the pins sas_init, sclk, ss_n, mfp6, mfp7, not without 'sas_init', 'ss_n'",
      probe_slave),
-    ("slave-step-unknown", lambda: SlavePins(RegisterFile(UP, strict=False)), lambda s: s.step(
+    ("slave-step-unknown", _slave, lambda s: s.step(
         {"sas_init": 0, "sclk": 1, "ss_n": 1, "mfp6": 0, "mfp7": 1, "mfp8": 0}), ArgumentError,
      "with 'mfp8', no such pin", probe_slave),
     ("checker-rate", lambda: None, lambda _: TimingChecker(1_000_000, 32_000_000, print), ArgumentError,
@@ -313,6 +340,37 @@ CASES: list[tuple[str, Factory, Call, type[Exception], str, Callable[[Any], obje
     ("block-step-float", UpifBlockPins, lambda b: b.step(
         {pin.name: 0 for pin in UpifBlockPins.inputs} | {"ss_n": 1.0}), ArgumentError,
      "pin 'ss_n' must be an integer from 0 to 1 (1 bit), not 1.0", probe_block),
+    # rtl: constructors and the lockstep harness's pin models
+    ("core-variant", lambda: None, lambda _: Supi3Core(bad("tqfp")), ArgumentError,
+     "variant must be one of 'opc', 'ls' (Table 1-1), not 'tqfp'", probe_none),
+    ("core-register-file", lambda: None, lambda _: Supi3Core("opc", register_file=bad(1)), ArgumentError,
+     "register_file must be True or False, not 1", probe_none),
+    ("rtl-chip-variant", lambda: None, lambda _: RtlChip(bad(None)), ArgumentError, "variant must be one of",
+     probe_none),
+    ("core-tables-variant", lambda: None, lambda _: core_tables(bad(1)), ArgumentError, "variant must be one of",
+     probe_none),
+    ("strap-pins-variant", lambda: None, lambda _: StrapPins(bad("OPC")), ArgumentError, "variant must be one of",
+     probe_none),
+    ("strap-inputs-config", lambda: None, lambda _: strap_inputs(bad("10000")), ArgumentError,
+     "config must be a DeviceConfig", probe_none),
+    ("strap-stimulus-shape", lambda: None, lambda _: strap_stimulus(BINARY, np.zeros((4, 6), np.int64)),
+     ArgumentError, "stimulus must be a 2-D integer array of (cycles, 7)", probe_none),
+    ("strap-stimulus-level", lambda: None, lambda _: strap_stimulus(BINARY, np.full((4, 7), 2, np.int64)),
+     ArgumentError, "pin 'do1' trace[0] must be an integer from 0 to 1 (1 bit), not 2", probe_none),
+    ("strap-step-missing", StrapPins, lambda m: m.step(without(_strap_row(), "c")), ArgumentError, "without 'c'",
+     probe_straps),
+    ("strap-step-wide", StrapPins, lambda m: m.step(_strap_row(c=32)), ArgumentError,
+     "pin 'c' must be an integer from 0 to 31 (5 bits), not 32", probe_straps),
+    ("strap-step-core", StrapPins, lambda m: m.step(_strap_row(do1=2)), ArgumentError,
+     "pin 'do1' must be an integer from 0 to 1 (1 bit), not 2", probe_straps),
+    ("strap-run-core", StrapPins, lambda m: m.run(_strap_traces(do1=np.full(N, 2))), ArgumentError,
+     "pin 'do1' trace[0] must be an integer from 0 to 1 (1 bit), not 2", probe_straps),
+    ("strap-run-length", StrapPins, lambda m: m.run(_strap_traces(c=np.full(3, 16))), ArgumentError,
+     "len(pin 'c' trace) must be 40", probe_straps),
+    ("chip-strap-step-core", ChipStrapPins, lambda m: m.step(_strap_row(mfp_in=-1)), ArgumentError,
+     "pin 'mfp_in' must be an integer from 0 to 65535 (16 bits), not -1", probe_straps),
+    ("chip-strap-run-float", ChipStrapPins, lambda m: m.run(_strap_traces(rf=np.full(N, 3.0))), ArgumentError,
+     "pin 'rf' trace must be a non-empty 1-D integer sequence", probe_straps),
 ]  # fmt: skip
 
 

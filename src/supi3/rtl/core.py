@@ -34,6 +34,7 @@ from amaranth.hdl import Array, Cat, Const, Elaboratable, EnableInserter, Module
 from amaranth.lib import enum, wiring
 from amaranth.lib.wiring import In, Out
 
+from supi3.checks import check_bool
 from supi3.config import Variant
 from supi3.interbus import wire
 from supi3.model.chip import MODACK_PULSE_CLOCKS, STATERR_FILTER_CLOCKS, WATCHDOG_CLOCKS
@@ -56,6 +57,7 @@ from supi3.rtl.tables import (
     RF_BITS,
     ClockEntry,
     CoreTables,
+    check_variant,
     core_tables,
 )
 from supi3.rtl.upif import upif_tables
@@ -129,9 +131,9 @@ class Supi3Core(wiring.Component):
     """
 
     def __init__(self, variant: Variant | str = Variant.OPC, *, register_file: bool = False) -> None:
-        self.variant = Variant(variant)
+        self.variant = check_variant(variant)
         self.tables = core_tables(self.variant)
-        self.register_file = register_file
+        self.register_file = check_bool("register_file", register_file)
         members: dict[str, object] = {}
         for pin in (*Supi3Pins.inputs, *STRAP_PINS, *(REGISTER_FILE_INPUTS if register_file else ())):
             members[pin.name] = In(pin.width)
