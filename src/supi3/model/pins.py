@@ -100,8 +100,12 @@ IDLE_INPUTS: Final = Synced(wire.IDLE_LEVEL, 0, 0, 0, 1, 1, 1)
 _NEVER: Final = 1 << 62
 
 
-_INPUT_WIDTHS: Final[dict[str, int]] = {name: 16 if name == "mfp_in" else 1 for name in _INPUT_NAMES}
-"""Bits of each input pin (``Supi3Pins.inputs``)."""
+_INPUT_PINS: Final[tuple[Pin, ...]] = (
+    Pin("do1"), Pin("di2"), Pin("rbst_ext"), Pin("mfp_in", 16), Pin("stat_err_n"), Pin("resu_n"), Pin("vmon_ok"),
+)  # fmt: skip
+"""``Supi3Pins.inputs``, in :class:`Synced` order."""
+_INPUT_WIDTHS: Final[dict[str, int]] = {pin.name: pin.width for pin in _INPUT_PINS}
+"""Bits of each input pin."""
 
 
 def check_names(what: str, given: object, names: Sequence[str]) -> Mapping[object, object]:
@@ -185,10 +189,7 @@ class Supi3Pins:
         "complete_diagnostics", "config", "cpb", "cycle", "forward_delay", "log", "mfp_oe", "rbst_by_pin", "reset_run",
     )  # fmt: skip
 
-    inputs: Sequence[Pin] = (
-        Pin("do1"), Pin("di2"), Pin("rbst_ext"), Pin("mfp_in", 16), Pin("stat_err_n"), Pin("resu_n"),
-        Pin("vmon_ok"),
-    )  # fmt: skip
+    inputs: Sequence[Pin] = _INPUT_PINS
     outputs: Sequence[Pin] = (
         Pin("do2"), Pin("di1"), Pin("mfp_out", 16), Pin("mfp_oe", 16), Pin("mod_ack_n"), Pin("res_reg_n"),
         Pin("diag1"), Pin("diag2"), Pin("ib_diag"), Pin("dclk_out"), Pin("resu_drive"),

@@ -117,9 +117,10 @@ class PinsOut:
     mfp7_oe: int
 
     def __post_init__(self) -> None:
-        values = (self.io, self.io_oe, self.c_d, self.c_d_oe, self.irq_n, self.irq_n_oe, self.mfp6, self.mfp6_oe,
-                  self.mfp7, self.mfp7_oe)  # fmt: skip
-        if not all(type(value) is int and not value >> 1 for value in values):
+        a, b, c, d, e = self.io, self.io_oe, self.c_d, self.c_d_oe, self.irq_n
+        f, g, h, i, j = self.irq_n_oe, self.mfp6, self.mfp6_oe, self.mfp7, self.mfp7_oe
+        if not (int is type(a) is type(b) is type(c) is type(d) is type(e) is type(f) is type(g) is type(h)
+                is type(i) is type(j) and not (a | b | c | d | e | f | g | h | i | j) >> 1):
             _check_levels(self)
 
 
@@ -172,8 +173,9 @@ class TimingChecker:
     * t1: /SS fall to the frame's first SCLK fall; t2: the frame's last SCLK rise to the /SS rise (an SCLK rise in
       the cycle /SS rises counts as the frame's);
     * t4 (setup) and t5 (hold): a SerIN change against SCLK rises while /SS is low (not while the chip drives MFP6);
-    * t8: /SS fall at least TCLK after C/D changed, and no C/D change, within t6 after the last /SS rise
-      (:data:`C_D_SETTLES_WITHIN`), after /SS fell again (measured negative);
+    * t8: /SS falls at least TCLK after C/D changed; and C/D must have settled: a C/D change up to t6's maximum
+      after /SS rose (:data:`C_D_SETTLES_WITHIN`) that comes after /SS fell again is reported too, measured
+      negative (the fall came first);
     * t10 and t11 (Intel, S/R on MFP7 may change only while /SS is high or in the cycle of either /SS edge): an S/R
       change while /SS is low before the frame's first SCLK fall is t10 (S/R became valid after /SS fell; measured
       negative), a later one t11 (it changed before /SS rose; measured ``None``);
