@@ -36,6 +36,7 @@ from amaranth.lib.wiring import In, Out
 
 from supi3.checks import check_bool
 from supi3.config import Variant
+from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.model.chip import MODACK_PULSE_CLOCKS, STATERR_FILTER_CLOCKS, WATCHDOG_CLOCKS
 from supi3.model.pins import (
@@ -131,9 +132,13 @@ class Supi3Core(wiring.Component):
     """
 
     def __init__(self, variant: Variant | str = Variant.OPC, *, register_file: bool = False) -> None:
-        self.variant = check_variant(variant)
+        try:
+            self.variant = check_variant(variant)
+            self.register_file = check_bool("register_file", register_file)
+        except ArgumentError:
+            self._MustUse__silence = True  # rejected, never elaborated: no "created but never used" warning
+            raise
         self.tables = core_tables(self.variant)
-        self.register_file = check_bool("register_file", register_file)
         members: dict[str, object] = {}
         for pin in (*Supi3Pins.inputs, *STRAP_PINS, *(REGISTER_FILE_INPUTS if register_file else ())):
             members[pin.name] = In(pin.width)
