@@ -289,6 +289,10 @@ class TimingChecker:
             self._require("t_SAS_INIT", cycle, self._sas_rise)
 
 
+_DECODED: dict[tuple[int, ...], PinsOut] = {}
+"""Every output combination :meth:`SlavePins._decode` has produced (PinsOut field order)."""
+
+
 def _bad_names(inputs: object) -> NoReturn:
     """Raise the named error for a mapping that does not name exactly :data:`INPUT_PINS`."""
     if not isinstance(inputs, Mapping):
@@ -437,10 +441,10 @@ class SlavePins:
             bit = (self._tx >> (index if protocol.lsb_first else 7 - index)) & 1
         intel = drive and protocol.mode is Mode.INTEL
         motorola = drive and protocol.mode is Mode.MOTOROLA
-        return PinsOut(
-            io=int(registers.io_access), io_oe=1,
-            c_d=protocol.c_d, c_d_oe=1,
-            irq_n=registers.irq_n, irq_n_oe=1,
-            mfp6=bit if intel else 0, mfp6_oe=int(intel),
-            mfp7=bit if motorola else 0, mfp7_oe=int(motorola),
-        )
+        # PinsOut is frozen: equal outputs share one checked instance (at most 2**10), built once.
+        key = (int(registers.io_access), 1, protocol.c_d, 1, registers.irq_n, 1, bit if intel else 0, int(intel),
+               bit if motorola else 0, int(motorola))  # fmt: skip
+        out = _DECODED.get(key)
+        if out is None:
+            out = _DECODED[key] = PinsOut(*key)
+        return out
