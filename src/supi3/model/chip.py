@@ -46,11 +46,11 @@ _DATA: Final = Cycle.DATA  # enum attribute lookups cost ~0.1 µs on the hot pat
 STATERR_FILTER_CLOCKS: Final = round(tables.STATERR_FILTER_S * CLOCK_HZ)
 """/StatErr must stay low this many clocks (200 ms, 3.6.2) before the peripheral fault is latched."""
 
-MODACK_PULSE_CLOCKS: Final = round(tables.RESREG_PULSE_NS * 1e-9 * CLOCK_HZ)
+MODACK_PULSE_CLOCKS: Final = tables.RESREG_PULSE_CLOCKS
 """/ModAck pulse on Quit Peripheral Error: the manual gives no width; the chip's other single pulse (375 ns,
 Table 3-13) is used (docs/assumptions/model.md M3)."""
 
-RESREG_PULSE_CLOCKS: Final = round(tables.RESREG_PULSE_NS * 1e-9 * CLOCK_HZ)
+RESREG_PULSE_CLOCKS: Final = tables.RESREG_PULSE_CLOCKS
 """/ResReg pulse on a layer-2 watchdog reset of process data: 375 ns (Table 3-13)."""
 
 WATCHDOG_CLOCKS: Final[tuple[int | None, ...]] = tuple(
