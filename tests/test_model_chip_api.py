@@ -87,16 +87,15 @@ def test_inconsistent_data_names_the_pin_level_cycle() -> None:
 
 
 def test_inconsistent_data_names_the_whole_chip_cycle() -> None:
-    """The whole chip at pin level (Supi3Chip): with the core's cycle counter as the clock source (the µP interface
-    ticks after the core's step, so the cycle being clocked is ``core.cycle - 1``; Supi3Chip should install this
-    itself, docs/model.md), the violation names the exact clock edge of the read: the /SS fall's first cycle + 2,
-    the second synchroniser flop (UP-13) and the read at /SS falling (UP-18)."""
+    """The whole chip at pin level (Supi3Chip installs the core's cycle counter as the clock source; the µP
+    interface ticks after the core's step, so the cycle being clocked is ``core.cycle - 1``): the violation names
+    the exact clock edge of the read: the /SS fall's first cycle + 2, the second synchroniser flop (UP-13) and the
+    read at /SS falling (UP-18)."""
     half, sclk, ss_n, mosi, mfp7 = 8, 1 << 4, 1 << 5, 1 << 6, 1 << 7
     idle = sclk | ss_n | mfp7
     whole = Supi3Chip(decode("10011", "1110", clk_conf="11"), strict=False)
     registers = whole.chip.registers
     assert registers is not None
-    registers.use_clock(lambda: whole.core.cycle - 1)
 
     def tick(mfp: int) -> None:
         whole.step({"do1": 1, "di2": 0, "rbst_ext": 0, "mfp_in": mfp, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 1})

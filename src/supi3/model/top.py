@@ -71,6 +71,9 @@ class Supi3Chip:
         self.core = Supi3Pins(config, Supi3(config, strict=strict))
         registers = self.core.chip.registers
         self.upif = SlavePins(registers) if registers is not None else None
+        if registers is not None:
+            # The µP interface ticks after the core's step, so the cycle it clocks is core.cycle - 1 (UP-19).
+            registers.use_clock(lambda: self.core.cycle - 1)
 
     @property
     def chip(self) -> Supi3:
