@@ -82,7 +82,8 @@ def _wave(keys: Sequence[object], data_key: Callable[[object], bool]) -> str:
 
 def to_wavejson(trace: Trace, title: str, *, step: int | None = None) -> dict[str, object]:
     """The WaveJSON of ``trace``: one column per ``step`` cycles (default half an SCLK period), each showing
-    the pins in the first cycle of its window, plus two lanes with the bytes :func:`decode_bytes` reads.
+    the pins in the first cycle of its window, plus two lanes with the bytes that
+    :func:`~supi3.spi.master.decode_bytes` reads.
 
     With :meth:`MasterTiming.aligned` every edge of the µP starts a column; the chip's outputs (2 TCLK + 1
     clock after their cause, UP-14) then show one column after it as long as that is less than ``step``.

@@ -104,7 +104,8 @@ class MasterTiming:
 
     def aligned(self) -> MasterTiming:
         """The same timing with ``lead``, ``trail`` and ``gap`` rounded up to whole half periods, so that every
-        edge of the µP falls on the grid that :func:`to_wavejson` samples (needs ``low == high``)."""
+        edge of the µP falls on the grid that :func:`~supi3.spi.figures.to_wavejson` samples (needs
+        ``low == high``)."""
         if self.low != self.high:
             raise UpifUsageError(f"aligned timing needs a symmetric SCLK, not low {self.low} / high {self.high}")
         half = self.low
