@@ -434,7 +434,7 @@ class _Parser(argparse.ArgumentParser):
 
 
 _DESCRIPTION = ("The IBS SUPI 3 OPC INTERBUS slave chip: operating modes, pin-strap decoding, register map, "
-                "timing, and a demo.")
+                "timing, a demo, and the manual's serial-interface figures redrawn.")
 _EPILOG = """exit status: 0 done; 2 bad input (one line on stderr); 141 output pipe closed early (quiet);
 130 interrupted; 1 an internal error (a traceback: please report it)"""
 
