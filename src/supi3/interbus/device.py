@@ -9,7 +9,7 @@ start of a cycle and is told at the end whether the cycle was latched. The SUPI 
 from __future__ import annotations
 
 import math
-from typing import Protocol
+from typing import Protocol, runtime_checkable
 
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusError
@@ -17,6 +17,7 @@ from supi3.interbus.wire import Cycle
 from supi3.tables import WATCHDOG_TIMEOUTS_S
 
 
+@runtime_checkable
 class Device(Protocol):
     """What the ring needs from a device (docs/interbus.md, "Device protocol").
 
