@@ -197,6 +197,7 @@ class PlainDevice:
         """See :meth:`Device.latch`."""
         if cycle is _DATA:
             self.outputs = received
+            self._te = False  # A8: a latched cycle clears TE (the error it recorded is over)
             if self.watchdog.timeout_s is not None:
                 self.watchdog.kick(now)
             self.valid_cycles += 1

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from enum import Enum
 from typing import Final
 
-from supi3.checks import check_bool, check_bytes, check_instance, check_int, check_real
+from supi3.checks import check_bool, check_bytes, check_int, check_real, fail
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusError
 from supi3.interbus.ring import Bus, ErrorKind, Transfer
@@ -167,7 +167,8 @@ class Master:
     stopped:
         ``True`` after a configuration error with ``rediscover=False``, until :meth:`start`.
     services:
-        The last ``max_diagnostics`` firmware service codes called (``ALARM_STOP``, ``CONTROL_DEVICE_FUNCTION``), oldest first.
+        The last ``max_diagnostics`` firmware service codes called (``ALARM_STOP``,
+        ``CONTROL_DEVICE_FUNCTION``), oldest first.
     """
 
     def __init__(
@@ -179,7 +180,9 @@ class Master:
         rediscover: bool = REDISCOVER,
         max_diagnostics: int = DIAGNOSTICS_KEPT,
     ) -> None:
-        self.ring = check_instance("ring", ring, Bus, "a Ring or PinRing (the Bus protocol)")
+        if not isinstance(ring, Bus):
+            raise fail("ring", "a Ring or PinRing (the Bus protocol)", ring)
+        self.ring = ring
         self.locate = check_bool("locate", locate)
         self.max_devices = check_int("max_devices", max_devices, 1, wire.MAX_DEVICES, _LIMIT_DEVICES)
         self.rediscover = check_bool("rediscover", rediscover)
@@ -400,7 +403,10 @@ class Master:
         if transfer.returned is None:
             return Diagnostic(ErrorKind.DEAD_LINE, None, None, None, "no telegram came back")
         if transfer.receiver_error is not None:
-            return Diagnostic(transfer.receiver_error, n + 1, None, None, "error on the return line")
+            # Only a ring whose return line N + 1 is one line into the master (the transaction-level Ring) pins a
+            # receiver error there; at pin level the return path runs through every chip, so it is located anew.
+            where = n + 1 if getattr(self.ring, "direct_return_line", False) else None
+            return Diagnostic(transfer.receiver_error, where, None, None, "error on the return line")
         if transfer.flags.error:
             return Diagnostic(ErrorKind.TRANSMISSION, None, None, None, "CNTR came back with ERR set")
         returned = transfer.returned
@@ -426,9 +432,12 @@ class Master:
             self.dropped_diagnostics += excess
 
     def _failed(self, cycle: Cycle, problem: Diagnostic) -> CycleResult:
+        # TE bits are trusted only if a full-ring ID cycle was latched since the previous failed cycle: until then
+        # a device may still hold TE from the earlier error (a data cycle does not clear TE in every device).
+        trusted = not self._recover
         self._recover = True
         if problem.kind is not ErrorKind.CONFIGURATION and problem.location is None and self.locate and self.config:
-            problem = self._locate(problem)
+            problem = self._locate(problem, trusted)
         located = self._with_device(problem)
         if problem.kind is ErrorKind.CONFIGURATION and self.config is not None:
             # A configuration difference: the table is dropped (A19); rebuilt by the next cycle() or by start().
@@ -442,7 +451,7 @@ class Master:
         device = config[d.location - 1].number if d.location is not None and d.location <= len(config) else None
         return Diagnostic(d.kind, d.location, device, d.code, d.detail)
 
-    def _locate(self, problem: Diagnostic) -> Diagnostic:
+    def _locate(self, problem: Diagnostic, trusted: bool) -> Diagnostic:
         """Locate the error of a failed cycle: read the TE bits in a diagnostic ID cycle; if the ring answers
         with another configuration, report that; else search segment by segment (docs/interbus.md)."""
         config = self._require_config()
@@ -460,16 +469,16 @@ class Master:
             self._recover = False
             self._take_alarms(registers, sent=False)
             self._record(self._messages(registers))
-            return _from_te(problem, registers, "diagnostic ID cycle")
+            return _from_te(problem, registers, "diagnostic ID cycle", trusted)
         if check.kind is ErrorKind.CONFIGURATION:
             return _changed(problem, check.location, check.detail)
         if check.kind is ErrorKind.LOOPBACK:
-            found = self._rescan(problem)
+            found = self._rescan(problem, trusted)
             if found is not None:
                 return found
         return self._search(problem)
 
-    def _rescan(self, problem: Diagnostic) -> Diagnostic | None:
+    def _rescan(self, problem: Diagnostic, trusted: bool) -> Diagnostic | None:
         """A discovery-sized ID cycle after the loopback word went missing: if it passes, the ring answers with
         another device count (a configuration error at the first position that differs) or the error has gone
         (the TE bits locate it); ``None`` if it fails too."""
@@ -490,7 +499,7 @@ class Master:
             return _changed(problem, where, f"{len(registers)} devices answer, the table has {len(config)}")
         self._take_alarms(registers, sent=False)
         self._record(self._messages(registers))
-        return _from_te(problem, registers, "discovery-sized ID cycle")
+        return _from_te(problem, registers, "discovery-sized ID cycle", trusted)
 
     def _search(self, problem: Diagnostic) -> Diagnostic:
         """Segment search: the smallest *j* for which the ring, closed after position *j* (*N* + 1: the whole ring
@@ -498,8 +507,7 @@ class Master:
         reported as not located rather than at a wrong position (docs/interbus.md, "Error location")."""
         n = len(self._require_config())
         if not getattr(self.ring, "closes_early", False):
-            return Diagnostic(problem.kind, None, None, None,
-                              f"{problem.detail}; not located: this ring cannot be closed early for a segment search")  # fmt: skip
+            return _not_located(problem, "this ring cannot be closed early for a segment search")
         low, high = 1, n + 1
         while low < high:
             middle = (low + high) // 2
@@ -508,8 +516,7 @@ class Master:
             else:
                 high = middle
         if self._probe(low):
-            return Diagnostic(problem.kind, None, None, None,
-                              f"{problem.detail}; not located: the error went away during the segment search")  # fmt: skip
+            return _not_located(problem, "the error went away during the segment search")
         where = "the return line" if low == n + 1 else f"the ring fails when closed after position {low}"
         return Diagnostic(problem.kind, low, None, None, f"{problem.detail}; segment search: {where}")
 
@@ -560,8 +567,7 @@ class Master:
                 found.append(Diagnostic(ErrorKind.WATCHDOG, k, None, MSG_WATCHDOG,
                                         "layer-2 watchdog reset the process data"))  # fmt: skip
         self._attention = False
-        located = tuple(self._with_device(d) for d in found)
-        return located
+        return tuple(self._with_device(d) for d in found)
 
 
 def _find_loopback(returned: bytes) -> int:
@@ -626,10 +632,20 @@ def _changed(problem: Diagnostic, position: int | None, detail: str) -> Diagnost
                       f"{problem.detail}; configuration changed at ring position {position}: {detail}")  # fmt: skip
 
 
-def _from_te(problem: Diagnostic, registers: list[int], how: str) -> Diagnostic:
-    """Locate ``problem`` by the lowest TE bit in a latched ID cycle, or report it not located."""
+def _from_te(problem: Diagnostic, registers: list[int], how: str, trusted: bool) -> Diagnostic:
+    """Locate ``problem`` by the lowest TE bit in a latched ID cycle, or report it not located; TE bits that may
+    be left from an earlier error (``trusted=False``) locate nothing."""
     te = [k for k, word in enumerate(registers, 1) if (word >> wire.MGMT_TE_BIT) & 1]
+    if te and not trusted:
+        return Diagnostic(problem.kind, None, None, None,
+                          f"{problem.detail}; not located: the {how} passed, and its TE bits may be left from an "
+                          "earlier error (no ID cycle was latched since)")  # fmt: skip
     if te:
         return Diagnostic(problem.kind, te[0], None, None, f"{problem.detail}; TE bit read in a {how}")
     return Diagnostic(problem.kind, None, None, None,
                       f"{problem.detail}; not reproducible: the {how} passed and no device reports TE")  # fmt: skip
+
+
+def _not_located(problem: Diagnostic, why: str) -> Diagnostic:
+    """``problem`` reported as not located, with the reason."""
+    return Diagnostic(problem.kind, None, None, None, f"{problem.detail}; not located: {why}")

@@ -279,6 +279,10 @@ class Ring:
 
     closes_early: Final = True
     """The ring can be closed after any position (``transfer(close_after=...)``), for the segment search."""
+    direct_return_line: Final = True
+    """The return line N + 1 runs from device N straight into the master: an error the master's receiver finds
+    is on that line (at pin level the return path runs through every chip, and :class:`PinRing` has neither
+    attribute)."""
 
     def __init__(self, devices: Sequence[Device], bit_rate: int = 500_000, record: bool = False) -> None:
         if isinstance(devices, (str, bytes)) or not isinstance(devices, Sequence):
@@ -288,7 +292,8 @@ class Ring:
             raise InterbusError("docs/interbus.md, Ring", len(devices),
                                 f"a ring has 1 to {wire.MAX_DEVICES} devices ({_LIMIT_DEVICES})")  # fmt: skip
         for k, device in enumerate(devices, 1):
-            check_instance(f"device at ring position {k}", device, Device, "a Device (load, latch, discard, ...)")
+            if not isinstance(device, Device):
+                raise fail(f"device at ring position {k}", "a Device (load, latch, discard, ...)", device)
         self.devices: list[Device] = list(devices)
         self.record = check_bool("record", record)
         self.trace: list[SegmentTrace] = []
@@ -301,8 +306,8 @@ class Ring:
 
     def inject(self, fault: Fault) -> None:
         """Add a fault. Lines are 1..N + 1 (N + 1: the return line into the master)."""
-        check_instance("fault", fault, (BitFlip, Truncate, CorruptLoopback, DeadLine),  # type: ignore[arg-type]
-                       "a BitFlip, Truncate, CorruptLoopback or DeadLine")  # fmt: skip
+        if not isinstance(fault, (BitFlip, Truncate, CorruptLoopback, DeadLine)):
+            raise fail("fault", "a BitFlip, Truncate, CorruptLoopback or DeadLine", fault)
         if not 1 <= fault.segment <= len(self.devices) + 1:
             raise InterbusError("docs/interbus.md, Fault injection", fault.segment,
                                 f"line must be in 1..{len(self.devices) + 1}")  # fmt: skip
