@@ -511,18 +511,24 @@ class Master:
         low, high = 1, n + 1
         while low < high:
             middle = (low + high) // 2
-            if self._probe(middle):
+            failed = self._probe(middle)
+            if failed is not None and failed.kind is ErrorKind.CONFIGURATION:
+                return _changed(problem, failed.location, failed.detail)
+            if failed is None:
                 low = middle + 1
             else:
                 high = middle
-        if self._probe(low):
+        failed = self._probe(low)
+        if failed is None:
             return _not_located(problem, "the error went away during the segment search")
+        if failed.kind is ErrorKind.CONFIGURATION:
+            return _changed(problem, failed.location, failed.detail)
         where = "the return line" if low == n + 1 else f"the ring fails when closed after position {low}"
         return Diagnostic(problem.kind, low, None, None, f"{problem.detail}; segment search: {where}")
 
-    def _probe(self, closed: int) -> bool:
-        """An ID cycle with the ring closed after ring position ``closed`` (N + 1: the whole ring); ``True`` if it
-        passes. Every probe sends the frame of the diagnostic ID cycle (2 N bytes), so a fault that depends on
+    def _probe(self, closed: int) -> Diagnostic | None:
+        """An ID cycle with the ring closed after ring position ``closed`` (N + 1: the whole ring); ``None`` if it
+        passes, else what failed (a configuration difference: the ring changed under the search). Every probe sends the frame of the diagnostic ID cycle (2 N bytes), so a fault that depends on
         where in the frame it hits acts alike on every probe that crosses its line."""
         config = self._require_config()
         n = len(config)
@@ -539,7 +545,7 @@ class Master:
             self._take_alarms(registers, sent=False)
             if closed > n:
                 self._recover = False
-        return problem is None
+        return problem
 
     def _take_alarms(self, registers: list[int], sent: bool) -> None:
         """After a latched ID cycle: the devices asked in the previous one sent their processor alarm in place

@@ -387,7 +387,9 @@ class Ring:
         data:
             The master's data sequence: loopback word, then device data (docs/interbus.md, "Frame").
         close_after:
-            Close the ring after this ring position (the master's segment search); ``None``: the whole ring.
+            Close the ring after this ring position (the master's segment search), inside that device, without
+            the return line N + 1; a position beyond the ring closes it after its last device. ``None``: the
+            whole ring, with the return line.
 
         Returns
         -------
@@ -398,9 +400,8 @@ class Ring:
         n_all = len(self.devices)
         if n_all > wire.MAX_DEVICES:
             raise InterbusError("docs/interbus.md, Ring", n_all, f"a ring has at most {wire.MAX_DEVICES} devices")
-        n = n_all if close_after is None else check_int("close_after", close_after, 0)
-        if n > n_all:
-            raise InterbusError("docs/interbus.md, Segment search", close_after, f"must be in 0..{n_all}")
+        # A position beyond the ring (the master's table may be older than the ring) closes it at its last device.
+        n = n_all if close_after is None else min(check_int("close_after", close_after, 0), n_all)
         # Closed after a position (even the last), the ring returns inside that device: the return line N + 1
         # is only part of the whole ring (close_after=None), so a fault there is told from one on line N.
         segments = n + 1 if close_after is None else n
