@@ -57,7 +57,7 @@ def healthy(master: Master) -> int:
 def test_up_chip_changing_its_length_is_a_configuration_error_then_rediscovered() -> None:
     chip = Supi3(decode("10011", "1110"), strict=False)  # RB, Init-µP
     assert chip.registers is not None
-    ring, master = started([PlainDevice(0xBF, 1), chip])
+    _, master = started([PlainDevice(0xBF, 1), chip])
     chip.registers.cpu_write(13, 0x82)
     chip.registers.cpu_write(12, 0x01)
     assert master.start().ok and master.cycle().ok

@@ -528,8 +528,9 @@ class Master:
 
     def _probe(self, closed: int) -> Diagnostic | None:
         """An ID cycle with the ring closed after ring position ``closed`` (N + 1: the whole ring); ``None`` if it
-        passes, else what failed (a configuration difference: the ring changed under the search). Every probe sends the frame of the diagnostic ID cycle (2 N bytes), so a fault that depends on
-        where in the frame it hits acts alike on every probe that crosses its line."""
+        passes, else what failed (a configuration difference: the ring changed under the search). Every probe
+        sends the frame of the diagnostic ID cycle (2 N bytes), so a fault that depends on where in the frame it
+        hits acts alike on every probe that crosses its line."""
         config = self._require_config()
         n = len(config)
         devices = min(closed, n)
