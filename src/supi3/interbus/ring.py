@@ -26,7 +26,7 @@ from typing import Final, NamedTuple, Protocol, runtime_checkable
 from supi3.checks import check_bool, check_instance, check_int, check_real, fail
 from supi3.interbus import wire
 from supi3.interbus.device import Device
-from supi3.interbus.errors import InterbusError, TelegramError
+from supi3.interbus.errors import InterbusArgumentError, InterbusError, TelegramError
 from supi3.interbus.wire import Cycle, Frame
 
 
@@ -289,8 +289,8 @@ class Ring:
             raise fail("devices", "a sequence of devices", devices)
         self.bit_rate = wire.check_bit_rate(bit_rate)
         if not 1 <= len(devices) <= wire.MAX_DEVICES:
-            raise InterbusError("docs/interbus.md, Ring", len(devices),
-                                f"a ring has 1 to {wire.MAX_DEVICES} devices ({_LIMIT_DEVICES})")  # fmt: skip
+            raise InterbusArgumentError("devices", devices, f"devices must be 1 to {wire.MAX_DEVICES} devices "
+                                        f"({_LIMIT_DEVICES}), not {len(devices)}", _LIMIT_DEVICES)  # fmt: skip
         for k, device in enumerate(devices, 1):
             if not isinstance(device, Device):
                 raise fail(f"device at ring position {k}", "a Device (load, latch, discard, ...)", device)

@@ -667,10 +667,9 @@ def reset_bits(devices: int) -> int:
 
 def check_bit_rate(bit_rate: int) -> int:
     """Return ``bit_rate`` if Table 1-7 lists it (500 kbit/s, 2 Mbit/s), else raise :class:`InterbusError`."""
-    bit_rate = _int("bit_rate", bit_rate, 1, None, f"Table 1-7: one of {BIT_RATES}")
-    if bit_rate not in BIT_RATES:
-        raise InterbusError("Table 1-7", bit_rate, f"bit rate must be one of {BIT_RATES}")
-    return bit_rate
+    if type(bit_rate) is int and bit_rate in BIT_RATES:
+        return bit_rate
+    return checked(check_choice, "bit_rate", bit_rate, BIT_RATES, limit="Table 1-7")
 
 
 def clocks_per_bit(bit_rate: int) -> int:
