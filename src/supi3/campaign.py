@@ -1,5 +1,5 @@
 """A seeded fault campaign: a master runs a ring through random faults, ring changes and resets, and every cycle
-is checked against what really happened (docs/verification.md, "Fault campaign").
+is checked against what really happened (docs/interbus.md, "Fault campaign").
 
 For each *episode* the campaign injects one event, runs the master for a few cycles, removes the event and lets
 the master recover. It counts
