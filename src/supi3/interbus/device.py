@@ -209,10 +209,12 @@ class PlainDevice:
 
     def load(self, cycle: Cycle, now: float) -> bytes:
         """See :meth:`Device.load`."""
-        if type(now) is not float:
-            now = _now(now)
-        if now > self.watchdog.deadline:
-            self._tick(now)
+        try:
+            if now > self.watchdog.deadline:
+                self._tick(now)
+        except TypeError:
+            _now(now)  # a wrong type: the named error (a right one re-raises the original)
+            raise
         if cycle is _DATA:
             return self.inputs
         _cycle(cycle)
@@ -221,10 +223,10 @@ class PlainDevice:
     def latch(self, cycle: Cycle, received: bytes, now: float) -> None:
         """See :meth:`Device.latch`."""
         if cycle is _DATA:
-            if type(received) is not bytes or len(received) != self.size:
+            if received.__class__ is not bytes:  # the length is the ring's: the register width load() gave it
                 received = checked(check_bytes, "received", received, self.size, limit="Table 3-11")
             self.outputs = received
-            self._te = False  # A8: a latched cycle clears TE (the error it recorded is over)
+            self._te = False  # A21: a latched cycle clears TE (the error it recorded is over)
             if self.watchdog.timeout_s is not None:
                 self.watchdog.kick(now)
             self.valid_cycles += 1
