@@ -101,7 +101,7 @@ HOSTILE: list[tuple[str, Callable[[], object], str]] = [
     ("load('data', 0)", lambda: _device().load("data", 0.0), "cycle"),  # type: ignore[arg-type]
     ("load(DATA, 'now')", lambda: _device().load(Cycle.DATA, "now"), "now"),  # type: ignore[arg-type]
     ("latch(DATA, None, 0)", lambda: _device().latch(Cycle.DATA, None, 0.0), "received"),  # type: ignore[arg-type]
-    ("latch(DATA, bytearray(3), 0)", lambda: _device().latch(Cycle.DATA, bytearray(3), 0.0), "received"),
+    ("latch(DATA, bytearray(3), 0)", lambda: _device().latch(Cycle.DATA, bytearray(3), 0.0), "received"),  # type: ignore[arg-type]
     ("latch(ID, b'', nan)", lambda: _device().latch(Cycle.ID, b"\0\0", math.nan), "now"),
     ("discard(DATA, 1, 0)", lambda: _device().discard(Cycle.DATA, 1, 0.0), "local_error"),  # type: ignore[arg-type]
     ("reset(-1)", lambda: _device().reset(-1.0), "now"),
