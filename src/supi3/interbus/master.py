@@ -301,7 +301,7 @@ class Master:
     def cycle(self) -> CycleResult:
         """Run the next cycle a master would: an ID cycle when there is no configuration, a command to send
         or a device asking for attention, and after a failed cycle until an ID cycle is latched (so that no TE
-        bit outlives the error it belongs to, assumption A8); else a data cycle."""
+        bit outlives the error it belongs to, assumption A21); else a data cycle."""
         if self.stopped:
             raise InterbusError("docs/interbus.md, Configuration changes", "rediscover=False",
                                 "the configuration changed and the master waits for start()")  # fmt: skip
