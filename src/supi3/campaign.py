@@ -11,7 +11,9 @@ the master recover. It counts
   data differ from what the devices sent, or a device that took over data in a cycle that failed;
 - **recoveries / stuck masters**: episodes after which the master latched a data cycle on a table that matches
   the ring within ``RECOVERY_CYCLES`` cycles, and those after which it did not (the campaign then restarts it);
-- **peak memory** (``tracemalloc``) and the memory growth between the end of the warm-up and the end.
+- **peak memory** (``tracemalloc``) and the growth of live memory (after ``gc.collect()``) between the end of
+  the warm-up and the end; ring changes keep the ring size within ``RING_SIZE_SPREAD`` of its start, so a long
+  run's growth is comparable to a short one's.
 
 Two fidelities: the transaction-level :class:`~supi3.interbus.ring.Ring` of
 :class:`~supi3.interbus.device.PlainDevice` (faults on lines: bit flips, truncation, a wrong loopback word, dead
@@ -26,6 +28,7 @@ whose device differs; of a chip losing its supply, the chip's position; of a per
 from __future__ import annotations
 
 import argparse
+import gc
 import json
 import random
 import sys
@@ -65,6 +68,8 @@ HOLD_CYCLES: Final = (1, 3)
 """Cycles an event stays before it is removed (inclusive range); a fault with ``cycles`` set may vanish earlier."""
 PERSISTENT_SHARE: Final = 0.5
 """Share of line faults that stay until removed (``cycles=None``); the others hit 1 to 4 cycles."""
+RING_SIZE_SPREAD: Final = 2
+"""Ring changes keep the size between start / 2 and start x 2 (and within 1..64): a bounded walk."""
 WARM_UP_SHARE: Final = 0.1
 """Share of the cycles run before the memory baseline is taken."""
 
@@ -222,6 +227,7 @@ class _Bench:
 class _RingBench(_Bench):
     def __init__(self, rng: random.Random, devices: int) -> None:
         super().__init__(rng)
+        self.initial = devices
         self.devices = [self.new_device() for _ in range(devices)]
         self.ring = Ring(list(self.devices))
         self.master = Master(self.ring)
@@ -391,9 +397,11 @@ def _ring_event(bench: _RingBench, event: str, result: CampaignResult) -> _Episo
         return _Episode(event, True, fault.segment, ring.clear_faults)
     if event in ("remove", "insert", "length"):
         before = bench.specs()
-        if event == "remove" and n > 1:
+        # The ring size walks within RING_SIZE_SPREAD of its start, so memory can be compared over a long run.
+        low, high = max(1, bench.initial // RING_SIZE_SPREAD), min(64, bench.initial * RING_SIZE_SPREAD)
+        if (event == "remove" and n > low) or (event == "insert" and n >= high):
             del ring.devices[rng.randrange(n)]
-        elif (event == "insert" and n < 64) or event == "remove":
+        elif event in ("insert", "remove") and n < high:
             ring.devices.insert(rng.randint(0, n), bench.new_device())
         else:
             at = rng.randrange(n)
@@ -481,10 +489,12 @@ def run_campaign(config: CampaignConfig, progress: Callable[[CampaignResult], No
                 if episode is not None:
                     episode.diagnostics.extend(last.diagnostics)
                 bench.master.clear_diagnostics()  # read, so the master's memory stays flat
+                bench.master.services.clear()
             return last
 
         while result.cycles < config.cycles:
             if baseline is None and result.cycles >= WARM_UP_SHARE * config.cycles:
+                gc.collect()  # live memory only: cyclic garbage waiting for the collector is not growth
                 baseline = tracemalloc.get_traced_memory()[0]
             run(rng.randint(*HEALTHY_CYCLES), None)
             if result.cycles >= config.cycles:
@@ -515,6 +525,7 @@ def run_campaign(config: CampaignConfig, progress: Callable[[CampaignResult], No
                 bench.master.start()
             if progress is not None:
                 progress(result)
+        gc.collect()
         current, peak = tracemalloc.get_traced_memory()
         result.peak_memory_bytes = peak
         result.memory_growth_bytes = current - (baseline if baseline is not None else current)
