@@ -201,8 +201,9 @@ def test_wrong_loopback_is_never_latched_and_is_located(specs: list[tuple[int, i
     assert not result.ok and snapshot(ring, master) == before
     (diagnostic,) = result.diagnostics
     assert diagnostic.kind is ErrorKind.LOOPBACK
-    # A CRC-consistent fault is found by the segment search; the return line reads as the last position.
-    assert diagnostic.location == min(segment, len(specs))
+    # A CRC-consistent fault is found by the segment search; closing after the last position leaves the return
+    # line out, so a fault there is located at N + 1 (it read as N before issue #8, a wrong position).
+    assert diagnostic.location == segment
 
 
 def test_transient_wrong_loopback_is_reported_unlocated() -> None:
@@ -222,8 +223,11 @@ def test_dead_line_is_never_latched_and_is_located(specs: list[tuple[int, int]],
     assert not result.ok and snapshot(ring, master) == before
     (diagnostic,) = result.diagnostics
     assert diagnostic.kind is ErrorKind.DEAD_LINE
-    assert diagnostic.location == min(segment, len(specs))
-    assert diagnostic.device == master.entry(diagnostic.location).number
+    assert diagnostic.location == segment  # N + 1 (the return line) read as N before issue #8
+    if segment <= len(specs):
+        assert diagnostic.device == master.entry(diagnostic.location).number
+    else:
+        assert diagnostic.device is None
     ring.clear_faults()
     assert master.data_cycle().ok
 

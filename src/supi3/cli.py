@@ -384,6 +384,16 @@ def cmd_demo(args: argparse.Namespace) -> None:
     print(regmap_summary())
 
 
+def cmd_campaign(args: argparse.Namespace) -> None:
+    """A seeded fault campaign at transaction and/or pin level (supi3.campaign); exit status 1 if a goal is missed."""
+    from supi3 import campaign
+
+    results = [campaign.run_campaign(config) for config in campaign.configs_from_args(args)]
+    print(campaign.report(results, args.json))
+    if not all(r.ok for r in results):
+        raise SystemExit(1)
+
+
 FIGURES_DIR = "docs/figures"
 """``figures -o`` default: where the source tree keeps the redrawn figures (``docs/figures.md``)."""
 
@@ -484,6 +494,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--table", choices=sorted(timing.TIMING_TABLES), help="also evaluate a timing table")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_timing)
+
+    p = sub.add_parser("campaign", help="a seeded fault campaign: error locations, latches, recovery, memory")
+    from supi3.campaign import add_arguments
+
+    add_arguments(p)
+    p.set_defaults(func=cmd_campaign)
 
     p = sub.add_parser("figures", help="redraw the manual's serial µP interface figures (needs the docs extra)")
     p.add_argument("-o", "--output", metavar="DIR", default=FIGURES_DIR,

@@ -9,14 +9,16 @@ start of a cycle and is told at the end whether the cycle was latched. The SUPI 
 from __future__ import annotations
 
 import math
-from typing import Protocol
+from typing import Protocol, runtime_checkable
 
+from supi3.checks import check_bool, check_bytes, check_instance, check_int, check_real
 from supi3.interbus import wire
-from supi3.interbus.errors import InterbusError
+from supi3.interbus.errors import InterbusError, checked
 from supi3.interbus.wire import Cycle
 from supi3.tables import WATCHDOG_TIMEOUTS_S
 
 
+@runtime_checkable
 class Device(Protocol):
     """What the ring needs from a device (docs/interbus.md, "Device protocol").
 
@@ -68,6 +70,20 @@ class Device(Protocol):
 
 
 _DATA = Cycle.DATA  # enum member lookups cost ~0.1 µs; the hot path compares with this alias
+_ID = Cycle.ID
+
+
+def _now(now: object) -> float:
+    """A bus time: a finite number >= 0 (the named error otherwise)."""
+    if type(now) is float and 0.0 <= now < math.inf:
+        return now
+    return checked(check_real, "now", now, 0.0)
+
+
+def _cycle(cycle: object) -> Cycle:
+    if cycle is _DATA or cycle is _ID:
+        return cycle
+    return checked(check_instance, "cycle", cycle, Cycle, "Cycle.ID or Cycle.DATA")
 
 
 class Layer2Watchdog:
@@ -88,6 +104,8 @@ class Layer2Watchdog:
 
     def configure(self, code: int, now: float) -> None:
         """Apply a command word's watchdog code (an index into ``WATCHDOG_TIMEOUTS_S``)."""
+        code = checked(check_int, "code", code, 0, len(WATCHDOG_TIMEOUTS_S) - 1, limit="Table 3-13")
+        now = _now(now)
         self.timeout_s = WATCHDOG_TIMEOUTS_S[code]
         self.kick(now)
 
@@ -98,10 +116,12 @@ class Layer2Watchdog:
 
     def kick(self, now: float) -> None:
         """A valid data cycle ended at ``now``."""
+        now = _now(now)
         self.deadline = math.inf if self.timeout_s is None else now + self.timeout_s
 
     def expired(self, now: float) -> bool:
         """``True`` once when the set time has passed since the last valid data cycle."""
+        now = _now(now)
         if now > self.deadline:
             self.deadline = math.inf
             return True
@@ -138,6 +158,7 @@ class PlainDevice:
 
     def __init__(self, id_code: int, length_code: int) -> None:
         wire.id_register(id_code, length_code)
+        wire.data_bytes(length_code)
         self.id_code = id_code
         self.length_code = length_code
         self.size = wire.data_bytes(length_code)
@@ -162,12 +183,14 @@ class PlainDevice:
 
     def set_inputs(self, data: bytes) -> None:
         """Set the IN data for the next data cycles."""
+        data = checked(check_bytes, "data", data)
         if len(data) != self.size:
             raise InterbusError("Table 3-11", data, f"IN data of this device is {self.size} bytes")
         self.inputs = bytes(data)
 
     def set_peripheral_fault(self, active: bool) -> None:
         """Drive the /StatErr input (3.6.2): ``True`` is an I/O error; it latches the PF management bit."""
+        active = checked(check_bool, "active", active)
         self.stat_err = active
         if active and not self._pf:
             self._pf = True
@@ -178,7 +201,7 @@ class PlainDevice:
         return (self._pf << wire.MGMT_PF_BIT) | (self._wd << wire.MGMT_WD_BIT) | (self._te << wire.MGMT_TE_BIT)
 
     def _tick(self, now: float) -> None:
-        if self.watchdog.expired(now):
+        if now > self.watchdog.deadline and self.watchdog.expired(now):
             self.inputs = self.outputs = bytes(self.size)
             self._wd = True
             self.attention = True
@@ -186,20 +209,30 @@ class PlainDevice:
 
     def load(self, cycle: Cycle, now: float) -> bytes:
         """See :meth:`Device.load`."""
-        if now > self.watchdog.deadline:
-            self._tick(now)
+        try:
+            if now > self.watchdog.deadline:
+                self._tick(now)
+        except TypeError:
+            _now(now)  # a wrong type: the named error (a right one re-raises the original)
+            raise
         if cycle is _DATA:
             return self.inputs
+        _cycle(cycle)
         return wire.word_bytes(wire.id_register(self.id_code, self.length_code, self.management()))
 
     def latch(self, cycle: Cycle, received: bytes, now: float) -> None:
         """See :meth:`Device.latch`."""
         if cycle is _DATA:
+            if received.__class__ is not bytes:  # the length is the ring's: the register width load() gave it
+                received = checked(check_bytes, "received", received, self.size, limit="Table 3-11")
             self.outputs = received
+            self._te = False  # A21: a latched cycle clears TE (the error it recorded is over)
             if self.watchdog.timeout_s is not None:
                 self.watchdog.kick(now)
             self.valid_cycles += 1
             return
+        _cycle(cycle)
+        now = _now(now)
         self.id_cycles += 1
         command = wire.decode_command(wire.word_from_bytes(received))
         if command.watchdog_code is not None:
@@ -211,12 +244,18 @@ class PlainDevice:
 
     def discard(self, cycle: Cycle, local_error: bool, now: float) -> None:
         """See :meth:`Device.discard`."""
+        _cycle(cycle)
+        if type(local_error) is not bool:
+            local_error = checked(check_bool, "local_error", local_error)
+        if type(now) is not float:
+            now = _now(now)
         self._tick(now)
         self._te = self._te or local_error
         self.invalid_cycles += cycle is _DATA
 
     def reset(self, now: float) -> None:
         """See :meth:`Device.reset`: IN and OUT data registers cleared, watchdog off (Table 3-13)."""
+        now = _now(now)
         self.inputs = self.outputs = bytes(self.size)
         self.watchdog.off()
         self._wd = self._te = False
@@ -226,4 +265,4 @@ class PlainDevice:
 
     def poll(self, now: float) -> None:
         """See :meth:`Device.poll`."""
-        self._tick(now)
+        self._tick(_now(now))

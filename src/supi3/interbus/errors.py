@@ -2,7 +2,13 @@
 
 from __future__ import annotations
 
-from supi3.errors import Supi3Error
+from collections.abc import Callable
+from typing import ParamSpec, TypeVar
+
+from supi3.errors import ArgumentError, Supi3Error
+
+P = ParamSpec("P")
+R = TypeVar("R")
 
 
 class InterbusError(Supi3Error, ValueError):
@@ -37,3 +43,34 @@ class TelegramError(InterbusError):
     def __init__(self, rule: str, value: object, detail: str, bit: int) -> None:
         self.bit = bit
         super().__init__(rule, value, f"{detail} at bit {bit}")
+
+
+class InterbusArgumentError(ArgumentError, InterbusError):
+    """An argument of the INTERBUS layer out of its type or range: an :class:`~supi3.errors.ArgumentError`
+    ("X must be ..., not ...") that is also an :class:`InterbusError`, so code that caught either still does.
+
+    Attributes
+    ----------
+    name, value:
+        As :class:`~supi3.errors.ArgumentError`.
+    rule, detail:
+        As :class:`InterbusError` (``rule`` is the limit named in the message, ``detail`` the message).
+    """
+
+    def __init__(self, name: str, value: object, message: str, rule: str = "") -> None:
+        self.name = name
+        self.value = value
+        self.rule = rule
+        self.detail = message
+        Exception.__init__(self, message)
+
+
+def checked(check: Callable[P, R], *args: P.args, **kwargs: P.kwargs) -> R:
+    """Run a :mod:`supi3.checks` check; its :class:`~supi3.errors.ArgumentError` becomes an
+    :class:`InterbusArgumentError` (same message)."""
+    try:
+        return check(*args, **kwargs)
+    except InterbusArgumentError:
+        raise
+    except ArgumentError as error:
+        raise InterbusArgumentError(error.name, error.value, str(error), str(kwargs.get("limit", ""))) from None

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from enum import Enum
 from typing import Final
 
+from supi3.checks import check_bool, check_bytes, check_int, check_real, fail
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusError
 from supi3.interbus.ring import Bus, ErrorKind, Transfer
@@ -24,6 +25,15 @@ ALARM_STOP: Final = 0x1303
 CONTROL_DEVICE_FUNCTION: Final = 0x0714
 MSG_PERIPHERAL_FAULT: Final = 0x0BB1
 MSG_WATCHDOG: Final = 0x0C6B
+
+# A19 After a configuration error the master drops its table and, by default, rebuilds it from a discovery ID
+# cycle in the next cycle() (docs/assumptions/interbus.md); Master(rediscover=False) waits for start() instead.
+REDISCOVER: Final = True
+
+# A20 How many diagnostics Master.diagnostics keeps (the oldest are dropped first; Master(max_diagnostics=...)).
+DIAGNOSTICS_KEPT: Final = 1000
+
+_LIMIT_DEVICES: Final = "manual: at most 512 devices in a ring"
 
 
 class InterfaceType(Enum):
@@ -138,25 +148,50 @@ class Master:
         search (ID cycles with the ring closed after ring position *j*).
     max_devices:
         Ring size the discovery ID cycle allows for (its filler is two bytes per device, assumption A14).
+    rediscover:
+        After a configuration error (a device count, ID code or length code that differs from the table), the
+        table is dropped; ``True``: the next :meth:`cycle` rebuilds it with a discovery ID cycle; ``False``:
+        :meth:`cycle` refuses to run until :meth:`start` (assumption A19).
+    max_diagnostics:
+        How many diagnostics :attr:`diagnostics` keeps; older ones are dropped and counted in
+        :attr:`dropped_diagnostics` (assumption A20).
 
     Attributes
     ----------
     config:
         The configuration table read in the last discovery ID cycle, ``None`` before one.
     diagnostics:
-        Every diagnostic reported so far, oldest first.
+        The last ``max_diagnostics`` diagnostics reported, oldest first (:meth:`clear_diagnostics` empties it).
+    dropped_diagnostics:
+        Diagnostics dropped from :attr:`diagnostics` to keep it bounded.
+    stopped:
+        ``True`` after a configuration error with ``rediscover=False``, until :meth:`start`.
     services:
-        The firmware service codes called so far (``ALARM_STOP``, ``CONTROL_DEVICE_FUNCTION``), oldest first.
+        The last ``max_diagnostics`` firmware service codes called (``ALARM_STOP``,
+        ``CONTROL_DEVICE_FUNCTION``), oldest first.
     """
 
-    def __init__(self, ring: Bus, locate: bool = True, max_devices: int = wire.MAX_DEVICES) -> None:
-        if not 1 <= max_devices <= wire.MAX_DEVICES:
-            raise InterbusError("docs/interbus.md, Master", max_devices, f"must be in 1..{wire.MAX_DEVICES}")
+    def __init__(
+        self,
+        ring: Bus,
+        locate: bool = True,
+        max_devices: int = wire.MAX_DEVICES,
+        *,
+        rediscover: bool = REDISCOVER,
+        max_diagnostics: int = DIAGNOSTICS_KEPT,
+    ) -> None:
+        if not isinstance(ring, Bus):
+            raise fail("ring", "a Ring or PinRing (the Bus protocol)", ring)
         self.ring = ring
-        self.locate = locate
-        self.max_devices = max_devices
+        self.locate = check_bool("locate", locate)
+        self.max_devices = check_int("max_devices", max_devices, 1, wire.MAX_DEVICES, _LIMIT_DEVICES)
+        self.rediscover = check_bool("rediscover", rediscover)
+        self.max_diagnostics = check_int("max_diagnostics", max_diagnostics, 0)
         self.config: tuple[ConfigEntry, ...] | None = None
         self.diagnostics: list[Diagnostic] = []
+        self.dropped_diagnostics = 0
+        self.stopped = False
+        self._recover = False
         self.services: list[int] = []
         self._out = bytearray(wire.LOOPBACK_BYTES_ON_LINE)
         self._in = b""
@@ -179,8 +214,12 @@ class Master:
         """Alarm Stop (1303h): INTERBUS reset of the whole ring, outputs and inputs reset, configuration
         forgotten; the next cycle is a discovery ID cycle. A watchdog setting is sent again afterwards."""
         self.services.append(ALARM_STOP)
+        if len(self.services) > self.max_diagnostics:
+            del self.services[: len(self.services) - self.max_diagnostics]
         self.ring.reset()
         self._set_config(None)
+        self.stopped = False
+        self._recover = False
         self._quit.clear()
         self._attention = False
         self._pf_active.clear()
@@ -199,6 +238,8 @@ class Master:
 
         Sent in the command words of the next ID cycle (assumption A9).
         """
+        if timeout_s is not None:
+            check_real("timeout_s", timeout_s, 0.0)
         if timeout_s not in WATCHDOG_TIMEOUTS_S:
             raise InterbusError("Table 3-13", timeout_s, f"watchdog time must be one of {WATCHDOG_TIMEOUTS_S}")
         self._watchdog_code = WATCHDOG_TIMEOUTS_S.index(timeout_s)
@@ -209,12 +250,13 @@ class Master:
         fault; the device's /ModAck output pulses. Sent in the device's command word of the next ID cycle."""
         self._quit.add(self.entry(position).ring_position)
         self.services.append(CONTROL_DEVICE_FUNCTION)
+        if len(self.services) > self.max_diagnostics:
+            del self.services[: len(self.services) - self.max_diagnostics]
 
     def processor_command(self, position: int | str, value: int) -> None:
         """Send a byte to a device's processor command register (management channel, 3.4.9): it arrives with
         the next ID cycle and raises the device's processor command interrupt (assumption A18)."""
-        if not 0 <= value <= 0xFF:
-            raise InterbusError("manual 3.4.9", value, "a processor command is one byte")
+        check_int("value", value, 0, 0xFF, "manual 3.4.9: a processor command is one byte")
         self._pcmd[self.entry(position).ring_position] = value
 
     def request_processor_alarm(self, position: int | str) -> None:
@@ -226,8 +268,10 @@ class Master:
 
     def entry(self, position: int | str) -> ConfigEntry:
         """The configuration entry of a ring position (int, 1..N) or a device number (``"segment.position"``)."""
+        if not isinstance(position, str):
+            check_int("position", position, 1, wire.MAX_DEVICES, _LIMIT_DEVICES)
         config = self._require_config()
-        if isinstance(position, int):
+        if not isinstance(position, str):
             if 1 <= position <= len(config):
                 return config[position - 1]
         else:
@@ -239,6 +283,7 @@ class Master:
     def set_outputs(self, position: int | str, data: bytes) -> None:
         """Set the OUT data sent to a device from the next data cycle on."""
         entry = self.entry(position)
+        check_bytes("data", data)
         if len(data) != entry.data_bytes:
             raise InterbusError("Table 3-11", data, f"device {entry.number} takes {entry.data_bytes} bytes")
         self._out[self._out_slices[entry.ring_position - 1]] = data
@@ -255,8 +300,12 @@ class Master:
 
     def cycle(self) -> CycleResult:
         """Run the next cycle a master would: an ID cycle when there is no configuration, a command to send
-        or a device asking for attention, else a data cycle."""
-        pending = self._pcmd or self._alarm_request or self._alarm_expected
+        or a device asking for attention, and after a failed cycle until an ID cycle is latched (so that no TE
+        bit outlives the error it belongs to, assumption A21); else a data cycle."""
+        if self.stopped:
+            raise InterbusError("docs/interbus.md, Configuration changes", "rediscover=False",
+                                "the configuration changed and the master waits for start()")  # fmt: skip
+        pending = self._pcmd or self._alarm_request or self._alarm_expected or self._recover
         if self.config is None or self._attention or self._watchdog_pending or self._quit or pending:
             return self.id_cycle()
         return self.data_cycle()
@@ -292,14 +341,15 @@ class Master:
             problem = _compare(config, registers, self._alarm_expected)
         self.ring.finish(transfer, problem is None)
         if problem is not None:
-            if problem.kind is ErrorKind.CONFIGURATION:
-                self._set_config(None)
             return self._failed(Cycle.ID, problem)
+        self._recover = False
         self._watchdog_pending = False
         self._quit.clear()
         self._pcmd.clear()
         self._take_alarms(registers, sent=True)
-        return CycleResult(Cycle.ID, True, self._messages(registers))
+        messages = self._messages(registers)
+        self._record(messages)
+        return CycleResult(Cycle.ID, True, messages)
 
     # -- internals -----------------------------------------------------------------------------------------------
 
@@ -342,7 +392,10 @@ class Master:
         if problem is not None:
             return self._failed(Cycle.ID, problem)
         self._set_config(config)
-        return CycleResult(Cycle.ID, True, self._messages(registers))
+        self.stopped = self._recover = False
+        messages = self._messages(registers)
+        self._record(messages)
+        return CycleResult(Cycle.ID, True, messages)
 
     def _check(self, transfer: Transfer, loopback_at: int | None) -> Diagnostic | None:
         """The master's checks of a returned frame; ``loopback_at=None`` searches for the loopback word."""
@@ -350,7 +403,10 @@ class Master:
         if transfer.returned is None:
             return Diagnostic(ErrorKind.DEAD_LINE, None, None, None, "no telegram came back")
         if transfer.receiver_error is not None:
-            return Diagnostic(transfer.receiver_error, n + 1, None, None, "error on the return line")
+            # Only a ring whose return line N + 1 is one line into the master (the transaction-level Ring) pins a
+            # receiver error there; at pin level the return path runs through every chip, so it is located anew.
+            where = n + 1 if getattr(self.ring, "direct_return_line", False) else None
+            return Diagnostic(transfer.receiver_error, where, None, None, "error on the return line")
         if transfer.flags.error:
             return Diagnostic(ErrorKind.TRANSMISSION, None, None, None, "CNTR came back with ERR set")
         returned = transfer.returned
@@ -362,12 +418,32 @@ class Master:
                               f"loopback word not at byte {loopback_at} of the returned data")  # fmt: skip
         return None
 
+    def clear_diagnostics(self) -> None:
+        """Forget every diagnostic kept so far (:attr:`diagnostics` and :attr:`dropped_diagnostics`)."""
+        self.diagnostics.clear()
+        self.dropped_diagnostics = 0
+
+    def _record(self, found: Collection[Diagnostic]) -> None:
+        """Keep ``found`` in :attr:`diagnostics`, dropping the oldest beyond ``max_diagnostics`` (A20)."""
+        self.diagnostics.extend(found)
+        excess = len(self.diagnostics) - self.max_diagnostics
+        if excess > 0:
+            del self.diagnostics[:excess]
+            self.dropped_diagnostics += excess
+
     def _failed(self, cycle: Cycle, problem: Diagnostic) -> CycleResult:
-        if problem.location is None and self.locate and self.config is not None:
-            location, how = self._locate()
-            problem = Diagnostic(problem.kind, location, None, None, f"{problem.detail}; {how}")
+        # TE bits are trusted only if a full-ring ID cycle was latched since the previous failed cycle: until then
+        # a device may still hold TE from the earlier error (a data cycle does not clear TE in every device).
+        trusted = not self._recover
+        self._recover = True
+        if problem.kind is not ErrorKind.CONFIGURATION and problem.location is None and self.locate and self.config:
+            problem = self._locate(problem, trusted)
         located = self._with_device(problem)
-        self.diagnostics.append(located)
+        if problem.kind is ErrorKind.CONFIGURATION and self.config is not None:
+            # A configuration difference: the table is dropped (A19); rebuilt by the next cycle() or by start().
+            self._set_config(None)
+            self.stopped = not self.rediscover
+        self._record((located,))
         return CycleResult(cycle, False, (located,))
 
     def _with_device(self, d: Diagnostic) -> Diagnostic:
@@ -375,41 +451,91 @@ class Master:
         device = config[d.location - 1].number if d.location is not None and d.location <= len(config) else None
         return Diagnostic(d.kind, d.location, device, d.code, d.detail)
 
-    def _locate(self) -> tuple[int | None, str]:
-        """Locate the error of a failed cycle: read the TE bits in an ID cycle, else search segment by segment."""
+    def _locate(self, problem: Diagnostic, trusted: bool) -> Diagnostic:
+        """Locate the error of a failed cycle: read the TE bits in a diagnostic ID cycle; if the ring answers
+        with another configuration, report that; else search segment by segment (docs/interbus.md)."""
         config = self._require_config()
         n = len(config)
         data = wire.LOOPBACK_BYTES_ON_LINE + bytes(2 * n)
         transfer = self.ring.transfer(Cycle.ID, data)
         registers: list[int] = []
-        problem = self._check(transfer, 2 * n)
-        if problem is None:
+        check = self._check(transfer, 2 * n)
+        if check is None:
             assert transfer.returned is not None
             registers = _id_registers(transfer.returned, n)
-            problem = _compare(config, registers, self._alarm_expected)
-        self.ring.finish(transfer, problem is None)
-        if problem is None:
+            check = _compare(config, registers, self._alarm_expected)
+        self.ring.finish(transfer, check is None)
+        if check is None:
+            self._recover = False
             self._take_alarms(registers, sent=False)
-            self._messages(registers)
-            te = [k for k, word in enumerate(registers, 1) if (word >> wire.MGMT_TE_BIT) & 1]
-            if te:
-                return te[0], "TE bit read in a diagnostic ID cycle"
-            return None, "not reproducible: the diagnostic ID cycle passed and no device reports TE"
-        low, high = 1, n
+            self._record(self._messages(registers))
+            return _from_te(problem, registers, "diagnostic ID cycle", trusted)
+        if check.kind is ErrorKind.CONFIGURATION:
+            return _changed(problem, check.location, check.detail)
+        if check.kind is ErrorKind.LOOPBACK:
+            found = self._rescan(problem, trusted)
+            if found is not None:
+                return found
+        return self._search(problem)
+
+    def _rescan(self, problem: Diagnostic, trusted: bool) -> Diagnostic | None:
+        """A discovery-sized ID cycle after the loopback word went missing: if it passes, the ring answers with
+        another device count (a configuration error at the first position that differs) or the error has gone
+        (the TE bits locate it); ``None`` if it fails too."""
+        config = self._require_config()
+        filler = bytes([wire.DISCOVERY_FILLER]) * (2 * self.max_devices)
+        transfer = self.ring.transfer(Cycle.ID, wire.LOOPBACK_BYTES_ON_LINE + filler)
+        check = self._check(transfer, None)
+        registers: list[int] = []
+        if check is None:
+            assert transfer.returned is not None
+            registers = _id_registers(transfer.returned, _find_loopback(transfer.returned) // 2)
+        self.ring.finish(transfer, check is None)
+        if check is not None:
+            return None
+        self._recover = False
+        where = _first_difference(config, registers, self._alarm_expected)
+        if where is not None:
+            return _changed(problem, where, f"{len(registers)} devices answer, the table has {len(config)}")
+        self._take_alarms(registers, sent=False)
+        self._record(self._messages(registers))
+        return _from_te(problem, registers, "discovery-sized ID cycle", trusted)
+
+    def _search(self, problem: Diagnostic) -> Diagnostic:
+        """Segment search: the smallest *j* for which the ring, closed after position *j* (*N* + 1: the whole ring
+        with its return line), fails; then the same probe again, so a fault that went away in between is
+        reported as not located rather than at a wrong position (docs/interbus.md, "Error location")."""
+        n = len(self._require_config())
+        if not getattr(self.ring, "closes_early", False):
+            return _not_located(problem, "this ring cannot be closed early for a segment search")
+        low, high = 1, n + 1
         while low < high:
             middle = (low + high) // 2
-            if self._probe(middle):
+            failed = self._probe(middle)
+            if failed is not None and failed.kind is ErrorKind.CONFIGURATION:
+                return _changed(problem, failed.location, failed.detail)
+            if failed is None:
                 low = middle + 1
             else:
                 high = middle
-        return low, "segment search: the ring fails when closed after this position" + (
-            " (or the return line)" if low == n else ""
-        )
+        failed = self._probe(low)
+        if failed is None:
+            return _not_located(problem, "the error went away during the segment search")
+        if failed.kind is ErrorKind.CONFIGURATION:
+            return _changed(problem, failed.location, failed.detail)
+        where = "the return line" if low == n + 1 else f"the ring fails when closed after position {low}"
+        return Diagnostic(problem.kind, low, None, None, f"{problem.detail}; segment search: {where}")
 
-    def _probe(self, devices: int) -> bool:
-        """An ID cycle with the ring closed after ring position ``devices``; ``True`` if it passes."""
+    def _probe(self, closed: int) -> Diagnostic | None:
+        """An ID cycle with the ring closed after ring position ``closed`` (N + 1: the whole ring); ``None`` if it
+        passes, else what failed (a configuration difference: the ring changed under the search). Every probe
+        sends the frame of the diagnostic ID cycle (2 N bytes), so a fault that depends on where in the frame it
+        hits acts alike on every probe that crosses its line."""
         config = self._require_config()
-        transfer = self.ring.transfer(Cycle.ID, wire.LOOPBACK_BYTES_ON_LINE + bytes(2 * devices), devices)
+        n = len(config)
+        devices = min(closed, n)
+        data = wire.LOOPBACK_BYTES_ON_LINE + bytes(2 * n)
+        transfer = self.ring.transfer(Cycle.ID, data, None if closed > n else closed)
         problem = self._check(transfer, 2 * devices)
         if problem is None:
             assert transfer.returned is not None
@@ -418,7 +544,9 @@ class Master:
         self.ring.finish(transfer, problem is None)
         if problem is None:
             self._take_alarms(registers, sent=False)
-        return problem is None
+            if closed > n:
+                self._recover = False
+        return problem
 
     def _take_alarms(self, registers: list[int], sent: bool) -> None:
         """After a latched ID cycle: the devices asked in the previous one sent their processor alarm in place
@@ -446,9 +574,7 @@ class Master:
                 found.append(Diagnostic(ErrorKind.WATCHDOG, k, None, MSG_WATCHDOG,
                                         "layer-2 watchdog reset the process data"))  # fmt: skip
         self._attention = False
-        located = tuple(self._with_device(d) for d in found)
-        self.diagnostics.extend(located)
-        return located
+        return tuple(self._with_device(d) for d in found)
 
 
 def _find_loopback(returned: bytes) -> int:
@@ -493,3 +619,40 @@ def _compare(config: tuple[ConfigEntry, ...], registers: list[int], alarms: Coll
             return Diagnostic(ErrorKind.CONFIGURATION, entry.ring_position, None, None,
                               f"ID register {word:04X}h differs from the configuration")  # fmt: skip
     return None
+
+
+def _first_difference(config: tuple[ConfigEntry, ...], registers: list[int], alarms: Collection[int]) -> int | None:
+    """The first ring position whose device differs from the table (ID code, length code, or present in one
+    and not the other), ``None`` if the ring answers exactly with the table (A18 alarms compare length only)."""
+    for entry, word in zip(config, registers, strict=False):
+        id_code = entry.id_code if entry.ring_position in alarms else word & 0xFF
+        if (id_code, (word >> 8) & 0x1F) != (entry.id_code, entry.length_code):
+            return entry.ring_position
+    if len(registers) != len(config):
+        return min(len(registers), len(config)) + 1
+    return None
+
+
+def _changed(problem: Diagnostic, position: int | None, detail: str) -> Diagnostic:
+    """The configuration error that explains a failed cycle (docs/interbus.md, "Configuration changes")."""
+    return Diagnostic(ErrorKind.CONFIGURATION, position, None, None,
+                      f"{problem.detail}; configuration changed at ring position {position}: {detail}")  # fmt: skip
+
+
+def _from_te(problem: Diagnostic, registers: list[int], how: str, trusted: bool) -> Diagnostic:
+    """Locate ``problem`` by the lowest TE bit in a latched ID cycle, or report it not located; TE bits that may
+    be left from an earlier error (``trusted=False``) locate nothing."""
+    te = [k for k, word in enumerate(registers, 1) if (word >> wire.MGMT_TE_BIT) & 1]
+    if te and not trusted:
+        return Diagnostic(problem.kind, None, None, None,
+                          f"{problem.detail}; not located: the {how} passed, and its TE bits may be left from an "
+                          "earlier error (no ID cycle was latched since)")  # fmt: skip
+    if te:
+        return Diagnostic(problem.kind, te[0], None, None, f"{problem.detail}; TE bit read in a {how}")
+    return Diagnostic(problem.kind, None, None, None,
+                      f"{problem.detail}; not reproducible: the {how} passed and no device reports TE")  # fmt: skip
+
+
+def _not_located(problem: Diagnostic, why: str) -> Diagnostic:
+    """``problem`` reported as not located, with the reason."""
+    return Diagnostic(problem.kind, None, None, None, f"{problem.detail}; not located: {why}")

@@ -21,11 +21,12 @@ from dataclasses import dataclass, field
 from enum import Enum
 from itertools import accumulate
 from operator import attrgetter, sub
-from typing import NamedTuple, Protocol
+from typing import Final, NamedTuple, Protocol, runtime_checkable
 
+from supi3.checks import check_bool, check_instance, check_int, check_real, fail
 from supi3.interbus import wire
 from supi3.interbus.device import Device
-from supi3.interbus.errors import InterbusError, TelegramError
+from supi3.interbus.errors import InterbusArgumentError, InterbusError, TelegramError
 from supi3.interbus.wire import Cycle, Frame
 
 
@@ -59,6 +60,18 @@ class ErrorKind(Enum):
 # ----------------------------------------------------------------------------------------------------------------
 
 
+_LIMIT_DEVICES: Final = "manual: at most 512 devices in a ring"
+_LIMIT_LINES: Final = "lines 1..N + 1 of a ring of at most 512 devices"
+
+
+def _check_segment(segment: object) -> int:
+    return check_int("segment", segment, 1, wire.MAX_DEVICES + 1, _LIMIT_LINES)
+
+
+def _check_cycles(cycles: object) -> int | None:
+    return None if cycles is None else check_int("cycles", cycles, 1)
+
+
 @dataclass(frozen=True)
 class BitFlip:
     """Invert bit period ``bit`` of the frame (0 = first start bit; see ``wire.locate_bit``) on line ``segment``.
@@ -70,6 +83,11 @@ class BitFlip:
     bit: int
     cycles: int | None = 1
 
+    def __post_init__(self) -> None:
+        _check_segment(self.segment)
+        check_int("bit", self.bit, 0)
+        _check_cycles(self.cycles)
+
 
 @dataclass(frozen=True)
 class Truncate:
@@ -78,6 +96,11 @@ class Truncate:
     segment: int
     keep: int
     cycles: int | None = 1
+
+    def __post_init__(self) -> None:
+        _check_segment(self.segment)
+        check_int("keep", self.keep, 0)
+        _check_cycles(self.cycles)
 
 
 @dataclass(frozen=True)
@@ -88,6 +111,11 @@ class CorruptLoopback:
     value: int
     cycles: int | None = 1
 
+    def __post_init__(self) -> None:
+        _check_segment(self.segment)
+        check_int("value", self.value, 0, 0xFFFF, "the loopback word is 16 bits")
+        _check_cycles(self.cycles)
+
 
 @dataclass(frozen=True)
 class DeadLine:
@@ -95,6 +123,10 @@ class DeadLine:
 
     segment: int
     cycles: int | None = None
+
+    def __post_init__(self) -> None:
+        _check_segment(self.segment)
+        _check_cycles(self.cycles)
 
 
 Fault = BitFlip | Truncate | CorruptLoopback | DeadLine
@@ -200,6 +232,7 @@ class _Line:
         return Frame(cycle, self.stream, wire.crc16(self.stream) if self.crc is None else self.crc, self.cntr)
 
 
+@runtime_checkable
 class Bus(Protocol):
     """What a :class:`~supi3.interbus.master.Master` drives: the transaction-level :class:`Ring`, or the
     pin-level ring of cycle-accurate chips (:class:`supi3.model.pinring.PinRing`)."""
@@ -244,10 +277,25 @@ class Ring:
         Bus time in seconds.
     """
 
+    closes_early: Final = True
+    """The ring can be closed after any position (``transfer(close_after=...)``), for the segment search."""
+    direct_return_line: Final = True
+    """The return line N + 1 runs from device N straight into the master: an error the master's receiver finds
+    is on that line (at pin level the return path runs through every chip, and :class:`PinRing` has neither
+    attribute)."""
+
     def __init__(self, devices: Sequence[Device], bit_rate: int = 500_000, record: bool = False) -> None:
-        self.devices: list[Device] = list(devices)
+        if isinstance(devices, (str, bytes)) or not isinstance(devices, Sequence):
+            raise fail("devices", "a sequence of devices", devices)
         self.bit_rate = wire.check_bit_rate(bit_rate)
-        self.record = record
+        if not 1 <= len(devices) <= wire.MAX_DEVICES:
+            raise InterbusArgumentError("devices", devices, f"devices must be 1 to {wire.MAX_DEVICES} devices "
+                                        f"({_LIMIT_DEVICES}), not {len(devices)}", _LIMIT_DEVICES)  # fmt: skip
+        for k, device in enumerate(devices, 1):
+            if not isinstance(device, Device):
+                raise fail(f"device at ring position {k}", "a Device (load, latch, discard, ...)", device)
+        self.devices: list[Device] = list(devices)
+        self.record = check_bool("record", record)
         self.trace: list[SegmentTrace] = []
         self.now = 0.0
         self._faults: list[_Active] = []
@@ -258,11 +306,11 @@ class Ring:
 
     def inject(self, fault: Fault) -> None:
         """Add a fault. Lines are 1..N + 1 (N + 1: the return line into the master)."""
+        if not isinstance(fault, (BitFlip, Truncate, CorruptLoopback, DeadLine)):
+            raise fail("fault", "a BitFlip, Truncate, CorruptLoopback or DeadLine", fault)
         if not 1 <= fault.segment <= len(self.devices) + 1:
             raise InterbusError("docs/interbus.md, Fault injection", fault.segment,
                                 f"line must be in 1..{len(self.devices) + 1}")  # fmt: skip
-        if fault.cycles is not None and fault.cycles < 1:
-            raise InterbusError("docs/interbus.md, Fault injection", fault.cycles, "cycles must be >= 1 or None")
         self._faults.append(_Active(fault, fault.cycles))
 
     def clear_faults(self) -> None:
@@ -339,18 +387,24 @@ class Ring:
         data:
             The master's data sequence: loopback word, then device data (docs/interbus.md, "Frame").
         close_after:
-            Close the ring after this ring position (the master's segment search); ``None``: the whole ring.
+            Close the ring after this ring position (the master's segment search), inside that device, without
+            the return line N + 1; a position beyond the ring closes it after its last device. ``None``: the
+            whole ring, with the return line.
 
         Returns
         -------
         Transfer
             Hand it to :meth:`finish` with the master's verdict.
         """
+        check_instance("cycle", cycle, Cycle)
         n_all = len(self.devices)
-        n = n_all if close_after is None else close_after
-        if not 0 <= n <= n_all:
-            raise InterbusError("docs/interbus.md, Segment search", close_after, f"must be in 0..{n_all}")
-        segments = n + 1 if n == n_all else n
+        if n_all > wire.MAX_DEVICES:
+            raise InterbusError("docs/interbus.md, Ring", n_all, f"a ring has at most {wire.MAX_DEVICES} devices")
+        # A position beyond the ring (the master's table may be older than the ring) closes it at its last device.
+        n = n_all if close_after is None else min(check_int("close_after", close_after, 0), n_all)
+        # Closed after a position (even the last), the ring returns inside that device: the return line N + 1
+        # is only part of the whole ring (close_after=None), so a fault there is told from one on line N.
+        segments = n + 1 if close_after is None else n
         faults = self._faults_on(segments) if self._faults else {}
         dead = min((s for s, fs in faults.items() if any(isinstance(f, DeadLine) for f in fs)), default=None)
         self.trace = []
@@ -401,7 +455,7 @@ class Ring:
         if dead is None or dead > segments:
             sent = _Line(stream, crc, wire.cntr_word(attention, error))
             last = n + 1
-            if record or (n == n_all and last in faults):
+            if record or last in faults:
                 line, receiver_error = self._receive(cycle, sent, faults.get(last, []), shifted)
                 if record:
                     self.trace.append(SegmentTrace(last, sent.frame(cycle), line.frame(cycle), receiver_error))
@@ -459,8 +513,7 @@ class Ring:
 
     def idle(self, seconds: float) -> None:
         """The master sends only idle status telegrams for ``seconds`` (no cycles)."""
-        if seconds < 0:
-            raise InterbusError("docs/interbus.md, Idle", seconds, "idle time must be >= 0")
+        seconds = check_real("seconds", seconds, 0.0)
         dead = self._first_dead()
         reached = len(self.devices) if dead is None else min(len(self.devices), dead - 1)
         end = self.now + seconds

@@ -17,12 +17,13 @@ import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from enum import Enum
-from typing import Final, NamedTuple
+from typing import Final, NamedTuple, NoReturn
 
 import numpy as np
 import numpy.typing as npt
 
-from supi3.interbus.errors import InterbusError, TelegramError
+from supi3.checks import check_bool, check_bytes, check_choice, check_instance, check_int, fail
+from supi3.interbus.errors import InterbusArgumentError, InterbusError, TelegramError, checked
 from supi3.tables import BIT_RATES, CLOCK_HZ, LENGTH_CODE_BY_VALUE, WATCHDOG_TIMEOUTS_S
 
 # ================================================================================================================
@@ -132,6 +133,44 @@ def _other(level: int) -> int:
     return 1 - level
 
 
+def _int(name: str, value: object, lo: int | None, hi: int | None, limit: str = "") -> int:
+    """``value`` if it is a plain ``int`` in range (the fast case), else the checked value or the named error."""
+    if type(value) is int and (lo is None or value >= lo) and (hi is None or value <= hi):
+        return value
+    return checked(check_int, name, value, lo, hi, limit=limit)
+
+
+def _flag(name: str, value: object) -> bool:
+    return value if type(value) is bool else checked(check_bool, name, value)
+
+
+def _cycle(value: object) -> Cycle:
+    return value if type(value) is Cycle else checked(check_instance, "cycle", value, Cycle, "Cycle.ID or Cycle.DATA")
+
+
+def _data(name: str, value: object) -> bytes:
+    return value if type(value) is bytes else checked(check_bytes, name, value)
+
+
+def _levels(name: str, value: object) -> npt.NDArray[np.uint8]:
+    """A sequence of line levels (0 or 1) as an array; anything else is a named error."""
+    try:
+        array = np.asarray(value)
+    except (TypeError, ValueError):
+        array = np.asarray([None])
+    if array.ndim != 1 or not (array.size == 0 or np.issubdtype(array.dtype, np.integer) or array.dtype == bool):
+        _refuse(name, "a sequence of line levels (0 or 1)", value)
+    if array.size and (array.min() < 0 or array.max() > 1):
+        _refuse(name, "a sequence of line levels (0 or 1)", value)
+    return array.astype(np.uint8)
+
+
+def _refuse(name: str, wanted: str, value: object) -> NoReturn:
+    """Raise the named error for ``value`` ("name must be wanted, not value")."""
+    error = fail(name, wanted, value)
+    raise InterbusArgumentError(error.name, error.value, str(error))
+
+
 # ================================================================================================================
 # Cycles and telegrams
 # ================================================================================================================
@@ -201,14 +240,14 @@ def data_telegram(byte: int, cycle: Cycle, check: bool) -> int:
     int
         Bit *i* is the level of bit period *i* of the telegram.
     """
-    if not 0 <= byte <= 0xFF:
-        raise InterbusError("docs/interbus.md, Telegrams", byte, "a data telegram carries one byte, 0..255")
-    return _header(TYPE_DATA_LEVEL, cycle, check) | _DATA_FIELDS[byte] | (STOP_LEVEL << _DATA_STOP)
+    byte = _int("byte", byte, 0, 0xFF, "docs/interbus.md, Telegrams: a data telegram carries one byte, 0..255")
+    header = _header(TYPE_DATA_LEVEL, _cycle(cycle), _flag("check", check))
+    return header | _DATA_FIELDS[byte] | (STOP_LEVEL << _DATA_STOP)
 
 
 def status_telegram(cycle: Cycle, check: bool) -> int:
     """Encode one status telegram (5 bit periods): idle (``check=False``) or latch (``check=True``)."""
-    return _header(_other(TYPE_DATA_LEVEL), cycle, check) | (STOP_LEVEL << _STATUS_STOP)
+    return _header(_other(TYPE_DATA_LEVEL), _cycle(cycle), _flag("check", check)) | (STOP_LEVEL << _STATUS_STOP)
 
 
 def _bit(word: int, position: int) -> int:
@@ -225,6 +264,11 @@ def decode_telegram(word: int, length: int, at: int = 0) -> Telegram:
         telegram's first bit period in the sequence being received, used in the error.
     """
     rule = "docs/interbus.md, Telegrams"
+    if type(length) is not int or (length != DATA_TELEGRAM_BITS and length != STATUS_TELEGRAM_BITS):
+        length = checked(check_choice, "length", length, (STATUS_TELEGRAM_BITS, DATA_TELEGRAM_BITS),
+                         limit="docs/interbus.md, Telegrams")  # fmt: skip
+    word = _int("word", word, 0, (1 << length) - 1, f"a {length}-bit telegram")
+    at = _int("at", at, 0, None)
     if _bit(word, POS_START) != START_LEVEL:
         raise TelegramError(rule, _bit(word, POS_START), "start bit at the wrong level", at + POS_START)
     is_data = _bit(word, POS_TYPE) == TYPE_DATA_LEVEL
@@ -247,15 +291,14 @@ def decode_telegram(word: int, length: int, at: int = 0) -> Telegram:
 
 def word_bytes(word: int) -> bytes:
     """The two bytes of a 16-bit word in line order (assumption A4)."""
-    if not 0 <= word <= 0xFFFF:
-        raise InterbusError("docs/interbus.md, Words", word, "a word is 16 bits")
+    word = _int("word", word, 0, 0xFFFF, "docs/interbus.md, Words: a word is 16 bits")
     return word.to_bytes(2, "little" if WORD_LOW_BYTE_FIRST else "big")
 
 
 def word_from_bytes(data: bytes) -> int:
     """Inverse of :func:`word_bytes`."""
-    if len(data) != 2:
-        raise InterbusError("docs/interbus.md, Words", data, "a word is two bytes")
+    if type(data) is not bytes or len(data) != 2:
+        data = checked(check_bytes, "data", data, 2, limit="docs/interbus.md, Words: a word is two bytes")
     return int.from_bytes(data, "little" if WORD_LOW_BYTE_FIRST else "big")
 
 
@@ -270,6 +313,7 @@ def data_bytes(length_code: int) -> int:
     InterbusError
         The code is outside 0..31 or reserved in Table 3-11.
     """
+    length_code = _int("length_code", length_code, 0, 0x1F, "Table 3-11: a length code is 5 bits")
     row = LENGTH_CODE_BY_VALUE.get(length_code)
     if row is None or row.bits is None:
         raise InterbusError("Table 3-11", length_code, "length code is reserved or not a 5-bit code")
@@ -281,10 +325,9 @@ def id_register(id_code: int, length_code: int, management: int = 0) -> int:
 
     ``management`` holds the bits at their register positions (``MGMT_*_BIT``).
     """
-    if not 0 <= id_code <= 0xFF:
-        raise InterbusError("Table A-3", id_code, "an ID code is 8 bits")
-    if not 0 <= length_code <= 0x1F:
-        raise InterbusError("Table 3-11", length_code, "a length code is 5 bits")
+    id_code = _int("id_code", id_code, 0, 0xFF, "Table A-3: an ID code is 8 bits")
+    length_code = _int("length_code", length_code, 0, 0x1F, "Table 3-11: a length code is 5 bits")
+    management = _int("management", management, 0, 0xFFFF, "docs/interbus.md, ID register")
     if management & ~MGMT_MASK:
         raise InterbusError("docs/interbus.md, ID register", management, "only bits 15..13 are management bits")
     return management | (length_code << 8) | id_code
@@ -307,15 +350,17 @@ def command_word(watchdog_code: int | None = None, quit_peripheral_error: bool =
         Ask the device to send its processor alarm register in the next ID cycle (3.4.9).
     """
     word = 0
+    quit_peripheral_error = _flag("quit_peripheral_error", quit_peripheral_error)
+    alarm_request = _flag("alarm_request", alarm_request)
     if processor_command is not None:
-        if not 0 <= processor_command <= 0xFF:
-            raise InterbusError("manual 3.4.9", processor_command, "a processor command is one byte")
+        processor_command = _int("processor_command", processor_command, 0, 0xFF,
+                                 "manual 3.4.9: a processor command is one byte")  # fmt: skip
         word |= (processor_command << CMD_PCMD_SHIFT) | (1 << CMD_PCMD_BIT)
     if alarm_request:
         word |= 1 << CMD_ALARM_BIT
     if watchdog_code is not None:
-        if not 0 <= watchdog_code < len(WATCHDOG_TIMEOUTS_S):
-            raise InterbusError("Table 3-13", watchdog_code, "watchdog code must index WATCHDOG_TIMEOUTS_S")
+        watchdog_code = _int("watchdog_code", watchdog_code, 0, len(WATCHDOG_TIMEOUTS_S) - 1,
+                             "Table 3-13: an index into WATCHDOG_TIMEOUTS_S")  # fmt: skip
         word |= (watchdog_code << CMD_WD_CODE_SHIFT) | (1 << CMD_WD_SET_BIT)
     if quit_peripheral_error:
         word |= 1 << CMD_QUIT_BIT
@@ -334,6 +379,7 @@ class Command(NamedTuple):
 
 def decode_command(word: int) -> Command:
     """Inverse of :func:`command_word`; bits without a meaning are ignored."""
+    word = _int("word", word, 0, 0xFFFF, "a command word is 16 bits")
     code = (word >> CMD_WD_CODE_SHIFT) & 0b11 if _bit(word, CMD_WD_SET_BIT) else None
     pcmd = (word >> CMD_PCMD_SHIFT) & 0xFF if _bit(word, CMD_PCMD_BIT) else None
     return Command(code, bool(_bit(word, CMD_QUIT_BIT)), pcmd, bool(_bit(word, CMD_ALARM_BIT)))
@@ -354,6 +400,8 @@ def crc_update_bit(crc: int, bit: int) -> int:
     The register is kept in normal (MSB-first) form; :func:`crc16` feeds bits in the order given by
     ``CRC_REFIN`` and applies ``CRC_REFOUT`` and ``CRC_XOROUT`` at the end.
     """
+    crc = _int("crc", crc, 0, 0xFFFF, "a CRC register is 16 bits")
+    bit = _int("bit", bit, 0, 1)
     feedback = ((crc >> 15) & 1) ^ bit
     crc = (crc << 1) & 0xFFFF
     return crc ^ CRC_POLY if feedback else crc
@@ -378,7 +426,8 @@ def crc16(data: bytes, init: int = CRC_INIT) -> int:
     >>> hex(crc16(b"123456789"))
     '0x906e'
     """
-    crc = init
+    data = _data("data", data)
+    crc = _int("init", init, 0, 0xFFFF, "a CRC register is 16 bits")
     table = _CRC_TABLE
     order = _BYTE_ORDER_TABLE
     for byte in data:
@@ -402,6 +451,7 @@ class CntrFlags(NamedTuple):
 
 def cntr_word(attention: bool, error: bool) -> int:
     """Encode a legal CNTR word (assumption A7): each flag next to its complement, all other bits zero."""
+    attention, error = _flag("attention", attention), _flag("error", error)
     return (
         (attention << CNTR_ATTN_BIT)
         | ((not attention) << CNTR_NATTN_BIT)
@@ -418,6 +468,8 @@ _CNTR_LEGAL: Final = {cntr_word(a, e): CntrFlags(a, e) for a in (False, True) fo
 
 def decode_cntr(word: int) -> CntrFlags | None:
     """The flags of a CNTR word, or ``None`` if the word is not one of the four legal codes."""
+    if type(word) is not int:
+        word = _int("word", word, 0, 0xFFFF, "a CNTR word is 16 bits")
     return _CNTR_LEGAL.get(word)
 
 
@@ -441,7 +493,8 @@ def forward_cntr(word: int, local_error: bool, attention: bool) -> tuple[int, bo
         repeater with ``REPEATER_DELAY_BITS`` of delay: the ERR pair is last on the line, so the device has seen
         the whole word, and the stop bit after it, before it sends the pair.
     """
-    flags = decode_cntr(word)
+    flags = decode_cntr(_int("word", word, 0, 0xFFFF, "a CNTR word is 16 bits"))
+    local_error, attention = _flag("local_error", local_error), _flag("attention", attention)
     bad = flags is None
     attn_in, err_in = (True, False) if flags is None else flags
     return cntr_word(attn_in or attention, err_in or local_error or bad), bad
@@ -476,7 +529,14 @@ class Frame:
     @classmethod
     def build(cls, cycle: Cycle, data: bytes, cntr: int = CNTR_CLEAR) -> Frame:
         """A frame whose CRC matches its data."""
-        return cls(cycle, bytes(data), crc16(data), cntr)
+        data = _data("data", data)
+        return cls(_cycle(cycle), data, crc16(data), _int("cntr", cntr, 0, 0xFFFF, "a CNTR word is 16 bits"))
+
+    def __post_init__(self) -> None:
+        _cycle(self.cycle)
+        _data("data", self.data)
+        _int("crc", self.crc, 0, 0xFFFF, "a CRC word is 16 bits")
+        _int("cntr", self.cntr, 0, 0xFFFF, "a CNTR word is 16 bits")
 
     def check_bytes(self) -> bytes:
         """The check sequence's bytes in line order."""
@@ -496,6 +556,7 @@ class Frame:
 
 def frame_bits(data_len: int) -> int:
     """Bit periods of a frame whose data sequence has ``data_len`` bytes."""
+    data_len = _int("data_len", data_len, 0, None)
     return DATA_TELEGRAM_BITS * (data_len + CHECK_TELEGRAMS)
 
 
@@ -509,6 +570,8 @@ class BitLocation(NamedTuple):
 
 def locate_bit(frame: Frame, bit: int) -> BitLocation:
     """The telegram holding bit period ``bit`` of ``frame`` (0 = the first start bit)."""
+    checked(check_instance, "frame", frame, Frame)
+    bit = _int("bit", bit, 0, None)
     if not 0 <= bit < frame.bit_count():
         raise InterbusError("docs/interbus.md, Frame", bit, f"bit index outside a {frame.bit_count()}-bit frame")
     index, offset = divmod(bit, DATA_TELEGRAM_BITS)
@@ -535,7 +598,11 @@ def frame_from_telegrams(telegrams: Iterable[Telegram | LineReset]) -> Frame:
     data = bytearray()
     check = bytearray()
     cycle: Cycle | None = None
+    if isinstance(telegrams, (str, bytes)) or not isinstance(telegrams, Iterable):
+        _refuse("telegrams", "an iterable of telegrams (Telegram or LineReset)", telegrams)
     for t in telegrams:
+        if not isinstance(t, (Telegram, LineReset)):
+            _refuse("telegram", "a Telegram or LineReset", t)
         if isinstance(t, LineReset):
             raise InterbusError(rule, t, "INTERBUS reset inside a frame")
         if t.data is None:
@@ -567,6 +634,7 @@ def frame_from_telegrams(telegrams: Iterable[Telegram | LineReset]) -> Frame:
 
 def ring_delay_status_telegrams(devices: int) -> int:
     """Idle status telegrams the master sends while the check sequence travels the ring (assumption A10, A11)."""
+    devices = _int("devices", devices, 0, MAX_DEVICES, "manual: at most 512 devices in a ring")
     return math.ceil(devices * REPEATER_DELAY_BITS / STATUS_TELEGRAM_BITS) + TURNAROUND_STATUS_TELEGRAMS
 
 
@@ -586,8 +654,8 @@ def cycle_bits(data_bytes: int, devices: int) -> int:
         13 x (6 + data_bytes) for the frame, then the status telegrams of the ring delay, the master's
         turnaround and the latch: compare Beckhoff's (13 x (6 + N) + 1.5 x M) x T_bit.
     """
-    if data_bytes < 0 or devices < 0:
-        raise InterbusError("docs/interbus.md, Cycle timing", (data_bytes, devices), "counts must be >= 0")
+    data_bytes = _int("data_bytes", data_bytes, 0, None, "docs/interbus.md, Cycle timing")
+    devices = _int("devices", devices, 0, MAX_DEVICES, "manual: at most 512 devices in a ring")
     status = ring_delay_status_telegrams(devices) + LATCH_STATUS_TELEGRAMS
     return frame_bits(LOOPBACK_BYTES + data_bytes) + STATUS_TELEGRAM_BITS * status
 
@@ -599,9 +667,9 @@ def reset_bits(devices: int) -> int:
 
 def check_bit_rate(bit_rate: int) -> int:
     """Return ``bit_rate`` if Table 1-7 lists it (500 kbit/s, 2 Mbit/s), else raise :class:`InterbusError`."""
-    if bit_rate not in BIT_RATES:
-        raise InterbusError("Table 1-7", bit_rate, f"bit rate must be one of {BIT_RATES}")
-    return bit_rate
+    if type(bit_rate) is int and bit_rate in BIT_RATES:
+        return bit_rate
+    return checked(check_choice, "bit_rate", bit_rate, BIT_RATES, limit="Table 1-7")
 
 
 def clocks_per_bit(bit_rate: int) -> int:
@@ -618,17 +686,25 @@ LevelArray = npt.NDArray[np.uint8]
 
 def telegram_levels(words: Sequence[int], length: int) -> LevelArray:
     """Levels of telegrams of one length, concatenated."""
+    length = _int("length", length, 1, 32)
+    given = np.asarray(words) if isinstance(words, Sequence | np.ndarray) and not isinstance(words, str) else None
+    if given is None or given.ndim != 1 or not (given.size == 0 or np.issubdtype(given.dtype, np.integer)) or (
+        given.size and (given.min() < 0 or given.max() >> length)
+    ):
+        _refuse("words", f"a sequence of {length}-bit telegram words", words)
     packed = np.asarray(words, dtype=np.uint32)[:, None]
     return ((packed >> np.arange(length, dtype=np.uint32)) & 1).astype(np.uint8).ravel()
 
 
 def frame_levels(frame: Frame) -> LevelArray:
     """Level sequence of a frame (data sequence and check sequence)."""
+    checked(check_instance, "frame", frame, Frame)
     return telegram_levels(frame.telegrams(), DATA_TELEGRAM_BITS)
 
 
 def status_levels(cycle: Cycle, check: bool, count: int) -> LevelArray:
     """Level sequence of ``count`` identical status telegrams."""
+    count = _int("count", count, 0, None)
     return telegram_levels([status_telegram(cycle, check)] * count, STATUS_TELEGRAM_BITS)
 
 
@@ -638,6 +714,8 @@ def cycle_levels(frame: Frame, devices: int, latch: bool) -> LevelArray:
 
     Its length is :func:`cycle_bits` for the frame's data bytes and ``devices``.
     """
+    checked(check_instance, "frame", frame, Frame)
+    _flag("latch", latch)
     return np.concatenate(
         [
             frame_levels(frame),
@@ -666,7 +744,7 @@ def parse_levels(levels: Sequence[int] | LevelArray) -> list[Telegram | LineRese
     TelegramError
         Wrong stop level or a type bit that does not match the telegram's length.
     """
-    line = [int(v) for v in levels]
+    line = [int(v) for v in _levels("levels", levels)]
     out: list[Telegram | LineReset] = []
     i = 0
     n = len(line)
@@ -695,16 +773,14 @@ def parse_levels(levels: Sequence[int] | LevelArray) -> list[Telegram | LineRese
 
 def levels_to_samples(levels: Sequence[int] | LevelArray, bit_rate: int) -> LevelArray:
     """Expand one level per bit period to one sample per 32 MHz clock period (pin level, 1.7.1)."""
-    return np.repeat(np.asarray(levels, dtype=np.uint8), clocks_per_bit(bit_rate))
+    return np.repeat(_levels("levels", levels), clocks_per_bit(bit_rate))
 
 
 def samples_to_levels(samples: Sequence[int] | LevelArray, bit_rate: int, phase: int | None = None) -> LevelArray:
     """Sample a 32 MHz pin trace once per bit period, at ``phase`` clocks into each bit (default: mid-bit)."""
     cpb = clocks_per_bit(bit_rate)
-    at = cpb // 2 if phase is None else phase
-    if not 0 <= at < cpb:
-        raise InterbusError("docs/interbus.md, Line", phase, f"sampling phase must be in 0..{cpb - 1}")
-    return np.asarray(samples, dtype=np.uint8)[at::cpb]
+    at = cpb // 2 if phase is None else _int("phase", phase, 0, cpb - 1, "docs/interbus.md, Line: within one bit")
+    return _levels("samples", samples)[at::cpb]
 
 
 def frames_from_levels(levels: Sequence[int] | LevelArray) -> list[Frame]:

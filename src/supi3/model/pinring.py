@@ -198,9 +198,14 @@ class PinRing:
 
     def transfer(self, cycle: Cycle, data: bytes, close_after: int | None = None) -> Transfer:
         """Send a frame and the ring delay; receive what came back (see :class:`~supi3.interbus.ring.Bus`)."""
+        from supi3.checks import check_bytes, check_instance  # local: this file's imports belong to another change
+
+        check_instance("cycle", cycle, Cycle)
+        data = check_bytes("data", data)
         if close_after is not None:
+            # The master does not ask (PinRing has no ``closes_early``): it reports such errors as not located.
             raise InterbusError("docs/interbus.md, Segment search", close_after,
-                                "the pin-level ring does not close early; use Master(locate=False)")
+                                "the pin-level ring does not close early")
         n = len(self.devices)
         frame = Frame.build(cycle, data)
         delay = wire.ring_delay_status_telegrams(n)
@@ -228,6 +233,10 @@ class PinRing:
 
     def finish(self, transfer: Transfer, latch: bool) -> None:
         """Send the verdict: the latch telegrams, or idle ones."""
+        from supi3.checks import check_bool, check_instance  # local: see transfer
+
+        check_instance("transfer", transfer, Transfer)
+        check_bool("latch", latch)
         self.run_levels(wire.status_levels(transfer.cycle, latch, wire.LATCH_STATUS_TELEGRAMS))
         self._received()
 
