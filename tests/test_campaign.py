@@ -66,12 +66,12 @@ def test_command_line(capsys: pytest.CaptureFixture[str]) -> None:
     assert cli.main(["campaign", "--fidelity", "ring", "--cycles", "200", "--json"]) == 0
     (data,) = json.loads(capsys.readouterr().out)
     assert data["cycles"] == 200 and data["ok"] and data["located_wrong"] == 0
-    assert campaign.main(["--fidelity", "ring", "--cycles", "100", "--mix", "bitflip=2,reset=1"]) == 0
+    assert cli.main(["campaign", "--fidelity", "ring", "--cycles", "100", "--mix", "bitflip=2,reset=1"]) == 0
     out = capsys.readouterr().out
     for label in ("cycles", "faults injected", "detected", "located right", "located wrong", "not located",
                   "corrupted latches", "recoveries", "stuck masters", "peak memory"):  # fmt: skip
         assert label in out
-    assert campaign.main(["--mix", "nonsense=1"]) == 2
+    assert cli.main(["campaign", "--mix", "nonsense=1"]) == 2
     assert "--mix event must be one of" in capsys.readouterr().err
 
 

@@ -27,11 +27,9 @@ whose device differs; of a chip losing its supply, the chip's position; of a per
 
 from __future__ import annotations
 
-import argparse
 import gc
 import json
 import random
-import sys
 import tracemalloc
 from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, field
@@ -40,7 +38,6 @@ from typing import Final, Literal
 from supi3 import tables
 from supi3.checks import check_choice, check_int, fail
 from supi3.config import DeviceConfig, MfpKind, decode
-from supi3.errors import Supi3Error
 from supi3.interbus import wire
 from supi3.interbus.device import PlainDevice
 from supi3.interbus.master import MSG_PERIPHERAL_FAULT, CycleResult, Diagnostic, Master
@@ -614,56 +611,8 @@ def parse_mix(text: str) -> dict[str, int]:
     return mix
 
 
-def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """The campaign's command-line options."""
-    parser.add_argument("--cycles", type=int, default=2000, help="master cycles at transaction level (default 2000)")
-    parser.add_argument("--pin-cycles", type=int, default=200, help="master cycles at pin level (default 200)")
-    parser.add_argument("--seed", type=int, default=1, help="seed of the campaign (default 1)")
-    parser.add_argument("--devices", type=int, default=8, help="ring size at transaction level (1..64, default 8)")
-    parser.add_argument("--pin-devices", type=int, default=3, help="chips at pin level (1..8, default 3)")
-    parser.add_argument("--fidelity", choices=[*FIDELITIES, "both"], default="both",
-                        help="ring (transaction level), pin (cycle-accurate chips) or both (default)")  # fmt: skip
-    parser.add_argument("--mix", metavar="EVENT=W,...",
-                        help=f"event weights; ring: {', '.join(RING_EVENTS)}; pin: {', '.join(PIN_EVENTS)} "
-                             "(with --fidelity both, events of the other fidelity are ignored)")  # fmt: skip
-    parser.add_argument("--json", action="store_true", help="print the results as JSON")
-
-
-def configs_from_args(args: argparse.Namespace) -> list[CampaignConfig]:
-    """The campaigns the options ask for."""
-    fidelities: list[Fidelity] = ["ring", "pin"] if args.fidelity == "both" else [args.fidelity]
-    mix = parse_mix(args.mix) if args.mix else None
-    unknown = sorted(set(mix or ()) - set(RING_EVENTS) - set(PIN_EVENTS))
-    if unknown:
-        raise fail("--mix event", f"one of {', '.join(RING_EVENTS + PIN_EVENTS)}", unknown[0])
-    configs = []
-    for fidelity in fidelities:
-        own = None
-        if mix is not None:
-            events = RING_EVENTS if fidelity == "ring" else PIN_EVENTS
-            own = {e: w for e, w in mix.items() if e in events or args.fidelity != "both"} or None
-        ring = fidelity == "ring"
-        configs.append(CampaignConfig(args.cycles if ring else args.pin_cycles, args.seed,
-                                      args.devices if ring else args.pin_devices, fidelity, own))  # fmt: skip
-    return configs
-
-
 def report(results: list[CampaignResult], as_json: bool) -> str:
     """Text or JSON report of campaigns."""
     if as_json:
         return json.dumps([r.as_dict() for r in results], indent=2)
     return "\n\n".join(format_result(r) for r in results)
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Run the campaigns of the command line; exit status 0 if every goal is met, 1 if not, 2 on a usage error."""
-    parser = argparse.ArgumentParser(prog="fault_campaign", description=__doc__.split("\n\n")[0])
-    add_arguments(parser)
-    args = parser.parse_args(argv)
-    try:
-        results = [run_campaign(config) for config in configs_from_args(args)]
-    except Supi3Error as exc:
-        print(f"fault_campaign: error: {exc}", file=sys.stderr)
-        return 2
-    print(report(results, args.json))
-    return 0 if all(r.ok for r in results) else 1

@@ -37,8 +37,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, NoReturn, TextIO
 
-from supi3 import tables, timing
-from supi3.checks import check_int
+from supi3 import campaign, tables, timing
+from supi3.checks import check_int, fail
 from supi3.checks import describe as _shown
 from supi3.config import DeviceConfig, Interface, Variant, decode, mode_rows
 from supi3.errors import Supi3Error
@@ -386,12 +386,46 @@ def cmd_demo(args: argparse.Namespace) -> None:
 
 def cmd_campaign(args: argparse.Namespace) -> None:
     """A seeded fault campaign at transaction and/or pin level (supi3.campaign); exit status 1 if a goal is missed."""
-    from supi3 import campaign
-
-    results = [campaign.run_campaign(config) for config in campaign.configs_from_args(args)]
+    results = [campaign.run_campaign(config) for config in _campaign_configs(args)]
     print(campaign.report(results, args.json))
     if not all(r.ok for r in results):
         raise SystemExit(1)
+
+
+def _campaign_arguments(parser: argparse.ArgumentParser) -> None:
+    """The campaign's command-line options."""
+    parser.add_argument("--cycles", type=integer, default=2000,
+                        help="master cycles at transaction level (default 2000)")
+    parser.add_argument("--pin-cycles", type=integer, default=200, help="master cycles at pin level (default 200)")
+    parser.add_argument("--seed", type=integer, default=1, help="seed of the campaign (default 1)")
+    parser.add_argument("--devices", type=integer, default=8, help="ring size at transaction level (1..64, default 8)")
+    parser.add_argument("--pin-devices", type=integer, default=3, help="chips at pin level (1..8, default 3)")
+    parser.add_argument("--fidelity", choices=[*campaign.FIDELITIES, "both"], default="both",
+                        help="ring (transaction level), pin (cycle-accurate chips) or both (default)")  # fmt: skip
+    parser.add_argument("--mix", metavar="EVENT=W,...",
+                        help=f"event weights; ring: {', '.join(campaign.RING_EVENTS)}; "
+                             f"pin: {', '.join(campaign.PIN_EVENTS)} "
+                             "(with --fidelity both, events of the other fidelity are ignored)")  # fmt: skip
+    parser.add_argument("--json", action="store_true", help="print the results as JSON")
+
+
+def _campaign_configs(args: argparse.Namespace) -> list[campaign.CampaignConfig]:
+    """The campaigns the options ask for."""
+    fidelities: list[campaign.Fidelity] = ["ring", "pin"] if args.fidelity == "both" else [args.fidelity]
+    mix = campaign.parse_mix(args.mix) if args.mix else None
+    unknown = sorted(set(mix or ()) - set(campaign.RING_EVENTS) - set(campaign.PIN_EVENTS))
+    if unknown:
+        raise fail("--mix event", f"one of {', '.join(campaign.RING_EVENTS + campaign.PIN_EVENTS)}", unknown[0])
+    configs = []
+    for fidelity in fidelities:
+        own = None
+        if mix is not None:
+            events = campaign.RING_EVENTS if fidelity == "ring" else campaign.PIN_EVENTS
+            own = {e: w for e, w in mix.items() if e in events or args.fidelity != "both"} or None
+        ring = fidelity == "ring"
+        configs.append(campaign.CampaignConfig(args.cycles if ring else args.pin_cycles, args.seed,
+                                      args.devices if ring else args.pin_devices, fidelity, own))  # fmt: skip
+    return configs
 
 
 FIGURES_DIR = "docs/figures"
@@ -496,9 +530,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_timing)
 
     p = sub.add_parser("campaign", help="a seeded fault campaign: error locations, latches, recovery, memory")
-    from supi3.campaign import add_arguments
-
-    add_arguments(p)
+    _campaign_arguments(p)
     p.set_defaults(func=cmd_campaign)
 
     p = sub.add_parser("figures", help="redraw the manual's serial µP interface figures (needs the docs extra)")
