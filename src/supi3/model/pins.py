@@ -219,12 +219,13 @@ class Supi3Pins:
         synced = pipe[-1]
         outputs = self._outputs.values(c, row.di2, self._run_from)
         receiver.pipe = [row, *pipe[:-1]]
+        tx = self._transmitter
         if c >= self._run_from or self._holding or not (synced.resu_n and synced.vmon_ok):
             self._tick(c, synced, synced.do1)
             if c >= self._run_from:
-                tx = self._transmitter
                 tx.next_present = bool(synced.rbst_ext) if tx.rbst_by_pin else tx.next_present or bool(synced.di2)
-        self._transmitter.trim()
+        if len(tx.bits) > 8:  # tested here, not in trim(): one call less per step()
+            tx.trim()
         self.cycle = c + 1
         return outputs
 
