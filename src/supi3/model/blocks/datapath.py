@@ -1,0 +1,70 @@
+"""Data path: the shift register of a frame's data bytes, loaded at the frame's start and latched at its end.
+
+Manual: 3.2 and 3.4.8 (the IN data loaded from the MFP inputs or the µP's data registers, the OUT data taken over),
+3.4.10 (the ID register sent in an ID cycle), 3.4.14 (data taken over only at the latch, after a valid check
+sequence). INTERBUS (``/work/shared/reference/interbus-layer2.md`` "Cycles and frame", ``docs/interbus.md``): each
+device is a shift register in the ring; byte 0 goes out first, each byte LSB first. What is loaded and what a latch
+does to the chip are :class:`supi3.model.chip.Supi3` (``load_at``, ``latch_at``); this block is their timing.
+
+RTL counterpart: the ``datapath`` block of :mod:`supi3.rtl.core` (``DataPath``: the data register, its load and
+its latch).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from supi3.interbus.wire import Cycle
+from supi3.verif.pinmodel import EventLog
+
+if TYPE_CHECKING:
+    from supi3.model.chip import Supi3
+
+
+class DataPath:
+    """The frame's shift register, as wide as the bytes the chip loads for the cycle (line order: bit i of
+    :attr:`register` goes out i-th).
+
+    Parameters
+    ----------
+    chip:
+        The bus behaviour that gives the bytes to send (``load_at``) and takes the bytes received (``latch_at``).
+    log:
+        The core's event log.
+    """
+
+    __slots__ = ("chip", "log", "register", "width")
+
+    def __init__(self, chip: Supi3, log: EventLog) -> None:
+        self.chip = chip
+        self.log = log
+        self.power_up()
+
+    def power_up(self) -> None:
+        """Power-up reset: an empty register."""
+        self.register = 0
+        self.width = 0
+        """Bits in the register: 8 times the bytes loaded."""
+
+    def load(self, cycle: Cycle, c: int) -> None:
+        """A frame of ``cycle`` begins at cycle ``c``: load the chip's bytes for it."""
+        loaded = self.chip.load_at(cycle, c)
+        self.log.add(c, f"{cycle.value} cycle: load {loaded.hex()}")
+        self.width = 8 * len(loaded)
+        # Line order: byte 0 first, each byte LSB first: bit i of the register goes out i-th.
+        self.register = int.from_bytes(loaded, "little")
+
+    def shift(self, level: int) -> int:
+        """One data bit in at ``level``; the bit that goes out in its place (the level itself if nothing was
+        loaded: the chip has no data in this cycle)."""
+        if self.width:
+            out = self.register & 1
+            self.register = (self.register >> 1) | (level << (self.width - 1))
+            return out
+        return level
+
+    def latch(self, cycle: Cycle, c: int) -> None:
+        """The frame of ``cycle`` is latched at cycle ``c``: the chip takes over the bytes received."""
+        received = self.register.to_bytes(self.width // 8, "little")
+        self.log.add(c, f"{cycle.value} cycle latched: {received.hex()}")
+        self.chip.latch_at(cycle, received, c)

@@ -1,0 +1,123 @@
+"""Outputs and diagnostics: the MFP outputs and enables, /ModAck, /ResReg, DIAG1/DIAG2, IB_DIAG, DCLK and /ResU.
+
+Manual: Table 1-4 (the output pins), Tables 3-1 to 3-6 and 2-8 (MFP directions), 3.6.2 (/ModAck), Table 3-13 and
+3.4.14 (the /ResReg pulse on a watchdog reset of process data), Table 3-16 (DIAG1/DIAG2: BA/RD or FO1/FO2 by
+DIAG_CONF), Table 3-18 (the IB_DIAG flashing codes), 1.7.2 (the chip pulling /ResU low during its reset). The
+levels come from :class:`supi3.model.chip.Supi3`; this block gives their timing at the pins. Decisions: M3 (pulses
+seen from the cycle after the edge that starts them), M6 (IB_DIAG divider), ``docs/model.md``.
+
+RTL counterpart: the ``outputs`` block of :mod:`supi3.rtl.core` (``Outputs``: the pulse counters, the IB_DIAG
+divider, the diagnostic outputs).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Final
+
+import numpy as np
+import numpy.typing as npt
+
+from supi3.model.blocks.transmitter import Trace, Transmitter
+
+if TYPE_CHECKING:
+    from supi3.model.chip import Supi3
+
+IB_DIAG_DIVIDER_BITS: Final[dict[str, int]] = {"slow": 26, "fast": 24}
+"""IB_DIAG flashes from a free-running binary divider: 2**26 clocks (0.48 Hz) for "bus not active", 2**24
+(1.9 Hz) for "peripheral fault" (Table 3-18 asks 0.5 Hz and 2 Hz; M6)."""
+
+Snapshot = tuple[int, int, int, int, int, int, int]
+"""What the outputs of a cycle depend on besides the cycle number (see :meth:`Outputs.snapshot`)."""
+
+
+class Outputs:
+    """Every output pin but the INTERBUS lines' levels, from the chip's state and the cycle number.
+
+    Parameters
+    ----------
+    chip:
+        The bus behaviour whose outputs are shown.
+    transmitter:
+        The transmitter (DO2, and whether DI1 passes DI2 through).
+    cpb:
+        Clocks per bit (DCLK).
+    mfp_oe:
+        The MFP output enables of the configuration.
+    complete_diagnostics:
+        DIAG1 shows BA (DIAG_CONF = 0, Table 3-16).
+    """
+
+    __slots__ = ("chip", "complete_diagnostics", "cpb", "mfp_oe", "transmitter")
+
+    def __init__(self, chip: Supi3, transmitter: Transmitter, cpb: int, mfp_oe: int, complete_diagnostics: bool
+                 ) -> None:  # fmt: skip
+        self.chip = chip
+        self.transmitter = transmitter
+        self.cpb = cpb
+        self.mfp_oe = mfp_oe
+        self.complete_diagnostics = complete_diagnostics
+
+    def values(self, c: int, di2: int, run_from: int) -> dict[str, int]:
+        """Every output pin during cycle ``c`` (``di2``: that cycle's input; the logic runs from ``run_from``)."""
+        chip = self.chip
+        tx = self.transmitter
+        do2 = tx.level(c)
+        return {
+            "do2": do2,
+            # The return line passes straight through when a device follows; the last device loops back (M5).
+            "di1": di2 if tx.next_present else do2,
+            "mfp_out": chip.mfp_outputs,
+            "mfp_oe": self.mfp_oe,
+            # A pulse the chip starts at clock clk (the edge ending cycle clk) lasts until clk + width in chip
+            # time; the pins show it from cycle clk + 1, so for cycles clk + 1 .. clk + width (M3). Cycle 0 comes
+            # before any edge (the chip's "no pulse" value is 0).
+            "mod_ack_n": int(not 0 < c <= chip.mod_ack_until),
+            "res_reg_n": int(not 0 < c <= chip.resreg_until),
+            "diag1": int(chip.bus_active) if self.complete_diagnostics else 0,
+            "diag2": 0,
+            "ib_diag": self.ib_diag(c),
+            "dclk_out": int(c % self.cpb < self.cpb // 2),
+            "resu_drive": int(c < run_from),
+        }
+
+    def ib_diag(self, c: int) -> int:
+        """Table 3-18: flashing fast on a peripheral fault, slowly while the bus is not active, else steady."""
+        if self.chip.pf:
+            return 1 - ((c >> (IB_DIAG_DIVIDER_BITS["fast"] - 1)) & 1)
+        if not self.chip.bus_active:
+            return 1 - ((c >> (IB_DIAG_DIVIDER_BITS["slow"] - 1)) & 1)
+        return 1
+
+    def snapshot(self, run_from: int) -> Snapshot:
+        """The outputs' state now, for :meth:`render` (``run_from``: the cycle the logic runs from)."""
+        chip = self.chip
+        return (chip.mfp_outputs, int(chip.bus_active) if self.complete_diagnostics else 0, int(chip.pf),
+                int(chip.bus_active), chip.mod_ack_until, chip.resreg_until, run_from)  # fmt: skip
+
+    def render(self, c0: int, n: int, snaps: list[tuple[int, Snapshot]], do2: Trace) -> dict[str, Trace]:
+        """Every output pin but ``di1`` over cycles ``c0`` to ``c0 + n - 1``, as :meth:`values` gives them: each
+        ``(t, snapshot)`` of ``snaps`` holds from run cycle ``t`` until the next; ``do2`` is the transmitter's."""
+        cycles = np.arange(c0, c0 + n, dtype=np.int64)
+        # The snapshot taken after each visited cycle holds until the next one: repeat each over its cycles.
+        starts = np.array([t for t, _ in snaps], dtype=np.int64)
+        lengths = np.diff(np.append(starts, n)).clip(min=0)
+        table = np.array([snap for _, snap in snaps], dtype=np.int64)
+        mfp_out, diag1, pf, bus_active, mod_ack_until, resreg_until, run_from = (
+            np.repeat(column, lengths) for column in table.T
+        )
+        fast = 1 - ((cycles >> (IB_DIAG_DIVIDER_BITS["fast"] - 1)) & 1)
+        slow = 1 - ((cycles >> (IB_DIAG_DIVIDER_BITS["slow"] - 1)) & 1)
+        cpb = self.cpb
+        out: dict[str, npt.NDArray[np.int64]] = {
+            "mfp_out": mfp_out,
+            "diag1": diag1,
+            "mod_ack_n": ((cycles <= 0) | (cycles > mod_ack_until)).astype(np.int64),  # as values()
+            "res_reg_n": ((cycles <= 0) | (cycles > resreg_until)).astype(np.int64),
+            "resu_drive": (cycles < run_from).astype(np.int64),
+            "ib_diag": np.where(pf != 0, fast, np.where(bus_active != 0, 1, slow)),
+            "do2": do2,
+            "mfp_oe": np.full(n, self.mfp_oe, dtype=np.int64),
+            "diag2": np.zeros(n, dtype=np.int64),
+            "dclk_out": (cycles % cpb < cpb // 2).astype(np.int64),
+        }
+        return out
