@@ -15,7 +15,17 @@ from collections.abc import Sequence
 import numpy as np
 import numpy.typing as npt
 
-from supi3.checks import check_bits, check_bool, check_choice, check_int, check_real, check_trace, fail
+from supi3.checks import (
+    check_bits,
+    check_bool,
+    check_bytes,
+    check_choice,
+    check_instance,
+    check_int,
+    check_real,
+    check_trace,
+    fail,
+)
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusError, TelegramError
 from supi3.interbus.ring import ErrorKind, Transfer
@@ -98,7 +108,10 @@ class PinRing:
     cycle:
         32 MHz clock cycles so far.
     returned:
-        The return line's samples so far.
+        The return line's samples not yet received, from clock cycle :attr:`returned_from` on. What the master has
+        received is dropped, so a long run keeps its memory flat.
+    returned_from:
+        The clock cycle of ``returned[0]``.
     """
 
     def __init__(self, chips: Sequence[Supi3Pins], record: bool = False) -> None:
@@ -118,7 +131,7 @@ class PinRing:
         self.cpb = wire.clocks_per_bit(self.bit_rate)
         self.cycle = 0
         self.returned = np.zeros(0, dtype=np.uint8)
-        self._rx = 0
+        self.returned_from = 0
         self.record = record
         self._chunks: list[list[dict[str, npt.NDArray[np.int64]]]] = []
         self._inputs = [
@@ -191,15 +204,15 @@ class PinRing:
         ]
 
     def _received(self) -> tuple[list[Telegram | LineReset], bool]:
-        telegrams, self._rx, error = receive(self.returned, self._rx, self.cpb)
+        telegrams, rx, error = receive(self.returned, 0, self.cpb)
+        self.returned = self.returned[rx:]
+        self.returned_from += rx
         return telegrams, error
 
     # -- the Bus protocol ------------------------------------------------------------------------------------------
 
     def transfer(self, cycle: Cycle, data: bytes, close_after: int | None = None) -> Transfer:
         """Send a frame and the ring delay; receive what came back (see :class:`~supi3.interbus.ring.Bus`)."""
-        from supi3.checks import check_bytes, check_instance  # local: this file's imports belong to another change
-
         check_instance("cycle", cycle, Cycle)
         data = check_bytes("data", data)
         if close_after is not None:
@@ -233,8 +246,6 @@ class PinRing:
 
     def finish(self, transfer: Transfer, latch: bool) -> None:
         """Send the verdict: the latch telegrams, or idle ones."""
-        from supi3.checks import check_bool, check_instance  # local: see transfer
-
         check_instance("transfer", transfer, Transfer)
         check_bool("latch", latch)
         self.run_levels(wire.status_levels(transfer.cycle, latch, wire.LATCH_STATUS_TELEGRAMS))
