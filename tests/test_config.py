@@ -118,7 +118,6 @@ def test_named_errors(kwargs: dict[str, str], pins: str, rule: str) -> None:
     assert (info.value.pins, info.value.rule) == (pins, rule)
 
 
-@pytest.mark.slow
 @given(
     c=st.one_of(st.integers(-5, 40), st.text(max_size=7), st.booleans(), st.none(), st.floats()),
     mfp=st.one_of(st.none(), st.integers(-2, 20), st.text(max_size=5)),

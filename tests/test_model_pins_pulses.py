@@ -65,7 +65,6 @@ def test_mod_ack_pulse_is_12_clocks(how: str) -> None:
     assert out["res_reg_n"].all()
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize("how", ["run", "step"])
 def test_res_reg_pulse_is_12_clocks(how: str) -> None:
     # Watchdog 50 ms (Table 3-13), one latched data cycle, then idle status telegrams past the deadline: process

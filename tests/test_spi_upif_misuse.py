@@ -499,5 +499,5 @@ class LenientInterfaceHistory(InterfaceHistory):
     strict = False
 
 
-TestInterfaceHistory = pytest.mark.slow(InterfaceHistory.TestCase)
-TestLenientInterfaceHistory = pytest.mark.slow(LenientInterfaceHistory.TestCase)
+TestInterfaceHistory = InterfaceHistory.TestCase
+TestLenientInterfaceHistory = LenientInterfaceHistory.TestCase
