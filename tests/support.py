@@ -8,7 +8,7 @@ so model-only tests may use it without the rtl extra; the RTL helpers import the
 
 Why the software µPs here are not :class:`supi3.spi.upif.UpInterface`: ``UpInterface`` is the firmware API over
 the register file's byte-level protocol engine, with no pins and no clock. The lockstep benches need every input
-pin on every 32 MHz clock, so :class:`Firmware` drives :class:`supi3.spi.waves.SoftMaster` (the library's own
+pin on every 32 MHz clock, so :class:`Firmware` drives :class:`supi3.spi.master.SoftMaster` (the library's own
 Table 3-7 master) on the whole-chip model's MFP pins, and :class:`UpifScript` writes the µP block's port values
 directly, as rows of a stimulus array that also carries the core's one-cycle strobes.
 """
@@ -33,9 +33,9 @@ from supi3.model.registers import RegisterFile
 from supi3.model.top import UP_INPUTS, UP_OUTPUTS, Supi3Chip
 from supi3.regmap import encode_command
 from supi3.spi.block_pins import UpifBlockPins, block_model, strap_values
+from supi3.spi.master import SoftMaster
 from supi3.spi.slave_pins import PinsIn, PinsOut
 from supi3.spi.upif import Mode
-from supi3.spi.waves import SoftMaster
 from supi3.tables import BIT_RATES, CLOCK_HZ
 from supi3.timing import timing_table
 from supi3.verif.pinmodel import OE_SUFFIX
@@ -111,7 +111,7 @@ def table_3_7_minimum(bit_rate: int, symbol: str) -> float:
 class FrameTiming:
     """Where a test's software master places its edges, in chip clocks: SCLK half period ``half`` (t0, t4),
     /SS fall to the first SCLK fall ``lead`` (t1, t7), last rise to /SS rise ``trail`` (t2), /SS high between
-    frames ``gap`` (C/D settled, UP-14, plus t8). Not :class:`supi3.spi.waves.MasterTiming`: these tests keep the
+    frames ``gap`` (C/D settled, UP-14, plus t8). Not :class:`supi3.spi.master.MasterTiming`: these tests keep the
     margins they were written with."""
 
     half: int

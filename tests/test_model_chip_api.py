@@ -23,9 +23,9 @@ from supi3.model.registers import (
 )
 from supi3.model.top import Supi3Chip
 from supi3.regmap import REGISTER_MAP
+from supi3.spi.master import SoftMaster
 from supi3.spi.slave_pins import SlavePins
 from supi3.spi.upif import Mode, UpInterface
-from supi3.spi.waves import SoftMaster
 from supi3.tables import CLOCK_HZ
 
 RB_UP = decode("10011", "1110")  # RB, Init-µP

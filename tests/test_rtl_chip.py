@@ -2,7 +2,7 @@
 
 One Verilator build serves every scenario (the straps are ports). Stimulus is made by running the scenario on the
 model itself: the INTERBUS master's line levels on do1 and a software µP (support.Firmware, over
-supi3.spi.waves.SoftMaster with Table 3-7 timing) on MFP[7..0], which reads the chip's answers off the model. The
+supi3.spi.master.SoftMaster with Table 3-7 timing) on MFP[7..0], which reads the chip's answers off the model. The
 recorded pins are then replayed through the batch lockstep, which is exact up to the first mismatch.
 """
 

@@ -1,4 +1,4 @@
-"""The ``supi3`` command line: operating modes, pin-strap decoding, register map, timing, and the demo.
+"""The ``supi3`` command line: operating modes, pin-strap decoding, register map, timing, the demo, and figures.
 
 Every subcommand whose output is data takes ``--json``.
 
@@ -11,7 +11,8 @@ their limits with :func:`~supi3.checks.check_int`), and checking its output path
 - 2: bad input, one line on stderr and never a traceback: a usage error (unknown option or choice, a value that is
   not a plain decimal integer, an abbreviated option), a value the manual rules out (any ``Supi3Error``), an output
   path that cannot be written (empty, a directory, a missing folder, a name too long; checked before any work), a
-  write that fails (``-o /dev/full``, ``> /dev/full``), ``regmap --format html`` without the ``docs`` extra.
+  write that fails (``-o /dev/full``, ``> /dev/full``), ``regmap --format html`` or ``figures`` without the ``docs``
+  extra.
 - 141 (128 + SIGPIPE): the reader closed the pipe early (``supi3 demo | head``). Nothing on stderr, like a Unix
   tool killed by SIGPIPE; under ``set -o pipefail`` the pipeline fails, as it does for ``seq``.
 - 130: interrupted (Ctrl-C), nothing on stderr.
@@ -383,6 +384,29 @@ def cmd_demo(args: argparse.Namespace) -> None:
     print(regmap_summary())
 
 
+FIGURES_DIR = "docs/figures"
+"""``figures -o`` default: where the source tree keeps the redrawn figures (``docs/figures.md``)."""
+
+
+def cmd_figures(args: argparse.Namespace) -> None:
+    """Redraw the manual's serial µP interface figures from model traces (WaveJSON, SVG, optionally VCD)."""
+    from supi3.spi.figures import write_figures
+
+    option = "-o/--output"
+    folder = output_dir(option, args.output)
+    try:
+        written = write_figures(folder, vcd=args.vcd)
+    except ModuleNotFoundError as exc:  # a plain install: wavedrom is the docs extra; checked before any write
+        if exc.name != "wavedrom":
+            raise
+        raise CommandLineError("figures needs the docs extra, pip install 'supi3[docs]' "
+                               "(the wavedrom package renders the SVG)") from None
+    except OSError as exc:
+        raise _cannot(option, str(folder), exc.strerror or str(exc)) from None
+    for path in written:
+        print(f"wrote {path}")
+
+
 _INTEGER = re.compile(r"[+-]?[0-9]+", re.ASCII)
 _MAX_DIGITS = 4000
 """Longer integers are refused unread: far beyond every limit, and ``int()`` refuses 4300 digits anyway."""
@@ -410,7 +434,7 @@ class _Parser(argparse.ArgumentParser):
 
 
 _DESCRIPTION = ("The IBS SUPI 3 OPC INTERBUS slave chip: operating modes, pin-strap decoding, register map, "
-                "timing, and a demo.")
+                "timing, a demo, and the manual's serial-interface figures redrawn.")
 _EPILOG = """exit status: 0 done; 2 bad input (one line on stderr); 141 output pipe closed early (quiet);
 130 interrupted; 1 an internal error (a traceback: please report it)"""
 
@@ -460,6 +484,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--table", choices=sorted(timing.TIMING_TABLES), help="also evaluate a timing table")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_timing)
+
+    p = sub.add_parser("figures", help="redraw the manual's serial µP interface figures (needs the docs extra)")
+    p.add_argument("-o", "--output", metavar="DIR", default=FIGURES_DIR,
+                   help=f"folder to write WaveJSON and SVG into (default {FIGURES_DIR})")
+    p.add_argument("--vcd", action="store_true", help="also write a VCD per figure")
+    p.set_defaults(func=cmd_figures)
     return parser
 
 
