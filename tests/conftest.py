@@ -1,4 +1,5 @@
-"""Shared test configuration: seeded hypothesis, and the chip manual's text for tables checked against it."""
+"""Shared test configuration: seeded hypothesis, the ``rtl`` marker and its Verilator check, and the chip manual's
+text for tables checked against it. Helpers that test modules import live in support.py (tests/README.md)."""
 
 from __future__ import annotations
 
@@ -7,6 +8,8 @@ from pathlib import Path
 
 import pytest
 from hypothesis import settings
+
+from support import VerilatorBuild, verilator_missing
 
 settings.register_profile("supi3", derandomize=True, deadline=None, print_blob=True)
 settings.load_profile("supi3")
@@ -36,3 +39,34 @@ def manual_text() -> str:
     if not MANUAL.exists():
         pytest.skip(f"chip manual not found at {MANUAL}")
     return MANUAL.read_text(encoding="utf-8").translate(_OCR)
+
+
+# The rtl marker ------------------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="session")
+def verilator_build(tmp_path_factory: pytest.TempPathFactory) -> VerilatorBuild:
+    """Fresh, numbered build directories for Verilator models (``verilator_build("rtl_core")``).
+
+    Every test that needs Verilator requests it, directly or through its bench fixture: that marks the test ``rtl``
+    (:func:`pytest_collection_modifyitems`), and skips it with the reason when Verilator is not installed.
+    """
+    reason = verilator_missing()
+    if reason is not None:
+        pytest.skip(reason)
+    return tmp_path_factory.mktemp
+
+
+@pytest.hookimpl(tryfirst=True)  # before -m deselects by marker
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Mark ``rtl`` every test that uses :func:`verilator_build`, and ``slow`` every ``rtl`` test (a Verilator
+    build alone takes a minute); skip every ``rtl`` test when Verilator is missing, with the reason, rather than fail
+    in its fixture."""
+    reason = verilator_missing()
+    for item in items:
+        if "verilator_build" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.rtl)
+        if item.get_closest_marker("rtl") is not None:
+            item.add_marker(pytest.mark.slow)
+            if reason is not None:
+                item.add_marker(pytest.mark.skip(reason=reason))

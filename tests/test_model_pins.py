@@ -62,6 +62,7 @@ def _step_all(model: Supi3Pins, inputs: dict[str, npt.NDArray[np.int64]]) -> dic
 # ------------------------------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 @settings(max_examples=25, deadline=None)
 @given(
     row=st.sampled_from(BINARY),
@@ -102,6 +103,7 @@ def test_step_and_run_agree_cycle_for_cycle(row: tables.ModeRow, out: bytes, see
     assert stepped.chip.mfp_outputs == bulk.chip.mfp_outputs
 
 
+@pytest.mark.slow
 @settings(max_examples=30, deadline=None)
 @given(
     runs=st.lists(st.tuples(st.integers(0, 1), st.integers(1, 3 * wire.RESET_DETECT_BITS * 16)), max_size=60),

@@ -14,22 +14,13 @@ import pytest
 from supi3 import tables
 from supi3.config import DeviceConfig, decode
 from supi3.interbus import wire
-from supi3.interbus.wire import Cycle, Frame
+from supi3.interbus.wire import Cycle
 from supi3.model.chip import WATCHDOG_CLOCKS
 from supi3.model.pins import Supi3Pins
+from support import IDLE, Columns, frame_levels, pulses
 
-Columns = dict[str, npt.NDArray[np.int64]]
-LOOPBACK = wire.LOOPBACK_BYTES_ON_LINE
-IDLE = wire.status_levels(Cycle.DATA, False, 8)
 WIDTH = 12
 """375 ns at 32 MHz (Table 3-13), counted here independently of the code under test."""
-
-
-def pulses(trace: npt.NDArray[np.int64]) -> list[tuple[int, int]]:
-    """(first cycle, length) of every run of 0 in an active-low pin's trace."""
-    low = np.concatenate([[0], (np.asarray(trace) == 0).astype(np.int8), [0]])
-    edges = np.flatnonzero(np.diff(low))
-    return [(int(a), int(b - a)) for a, b in zip(edges[::2], edges[1::2], strict=True)]
 
 
 def _config() -> DeviceConfig:
@@ -45,7 +36,7 @@ def _columns(config: DeviceConfig, levels: npt.NDArray[np.uint8]) -> Columns:
 
 
 def _cycle(kind: Cycle, device: bytes) -> npt.NDArray[np.uint8]:
-    return np.concatenate([wire.cycle_levels(Frame.build(kind, LOOPBACK + device), 1, True), IDLE])
+    return np.concatenate([frame_levels(kind, device), IDLE])
 
 
 def _bring_up(command: int) -> npt.NDArray[np.uint8]:

