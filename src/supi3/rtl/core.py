@@ -1,4 +1,4 @@
-"""The SUPI 3 chip core in Amaranth: the INTERBUS slave of :class:`supi3.model.pins.Supi3Pins`, pin for pin.
+"""The SUPI 3 chip core in Amaranth: the INTERBUS slave of the model ``model.pins.Supi3Pins``, pin for pin.
 
 The model is the specification; this RTL matches it on every output pin on every 32 MHz clock (``docs/rtl.md``).
 Its ports are the model's pins plus the pin straps C[4..0], RF[1..0], CLK_CONF[1..0] and DIAG_CONF (and MFP[15..12]
@@ -19,9 +19,9 @@ Blocks, in the order the model's ``_tick`` runs them within one clock:
 µP modes: built with ``register_file=True`` (:class:`supi3.rtl.chip.Supi3Chip`), the core has the ports of the
 register file's core side (:class:`supi3.rtl.upif.UpifBlock`): in Init-µP modes it takes the IN bytes, the ID
 register and the processor alarm from it and strobes the latch, events, processor command, I/O access bit and
-resets at the clocks the model calls :class:`~supi3.model.registers.RegisterFile`. Without it, and in SPI master and
-bus terminal modes, the core sends IN data 0 and the straps' ID code, which is what the model does before software
-acts.
+resets at the clocks the model calls its register file (``model.registers.RegisterFile``). Without it, and in SPI
+master and bus terminal modes, the core sends IN data 0 and the straps' ID code, which is what the model does before
+software acts.
 """
 
 from __future__ import annotations
@@ -38,45 +38,44 @@ from supi3.checks import check_bool
 from supi3.config import Variant
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
-from supi3.model.chip import MODACK_PULSE_CLOCKS, STATERR_FILTER_CLOCKS, WATCHDOG_CLOCKS
-from supi3.model.pins import (
+from supi3.pinout import (
+    BLOCK_STRAPS,
+    CORE_IDLE,
+    CORE_INPUTS,
+    CORE_OUTPUTS,
+    EVENT_BITS,
+    EXPANSION_BITS,
+    FROM_REGISTER_FILE,
     IB_DIAG_DIVIDER_BITS,
-    IDLE_INPUTS,
-    IDLE_TIMEOUT_CLOCKS,
-    RESET_STRETCH_CLOCKS,
+    MFP_PINS,
+    STRAP_PINS,
     SYNC_STAGES,
-    Supi3Pins,
+    TO_REGISTER_FILE,
 )
 from supi3.regmap import INTERRUPT_SOURCES
 from supi3.regmap.core import BYTE_BITS
 from supi3.rtl.tables import (
-    C_BITS,
-    CLK_CONF_BITS,
-    DIAG_CONF_BITS,
-    EXPANSION_BITS,
-    MFP_PINS,
-    RF_BITS,
+    IDLE_TIMEOUT_CLOCKS,
+    MODACK_PULSE_CLOCKS,
+    RESET_STRETCH_CLOCKS,
+    RESREG_PULSE_CLOCKS,
+    STATERR_FILTER_CLOCKS,
+    WATCHDOG_CLOCKS,
     ClockEntry,
     CoreTables,
     check_variant,
     core_tables,
 )
 from supi3.rtl.upif import upif_tables
-from supi3.spi.block_pins import CORE_INPUTS, CORE_OUTPUTS, EVENT_BITS, STRAP_INPUTS
-from supi3.tables import RESREG_PULSE_CLOCKS
 from supi3.verif.pinmodel import Pin
 
 __all__ = ["REGISTER_FILE_INPUTS", "REGISTER_FILE_OUTPUTS", "STRAP_PINS", "Supi3Core", "verilog"]
 
-STRAP_PINS: Final = (Pin("c", C_BITS), Pin("rf", RF_BITS), Pin("clk_conf", CLK_CONF_BITS),
-                     Pin("diag_conf", DIAG_CONF_BITS))  # fmt: skip
-"""The strap input ports, beyond the model's pins (Tables 2-2, 2-4 to 2-7, 1-7, 3-16)."""
-
-REGISTER_FILE_INPUTS: Final = tuple(pin for pin in CORE_OUTPUTS if pin.name in ("in_data", "bus_id", "alarm"))
+REGISTER_FILE_INPUTS: Final = tuple(pin for pin in FROM_REGISTER_FILE if pin.name in ("in_data", "bus_id", "alarm"))
 """What the core takes from the register file (:class:`supi3.rtl.upif.UpifBlock`'s outputs of the same names)."""
 REGISTER_FILE_OUTPUTS: Final = (
-    *STRAP_INPUTS,
-    *(pin for pin in CORE_INPUTS
+    *BLOCK_STRAPS,
+    *(pin for pin in TO_REGISTER_FILE
       if pin.name in ("power_up", "ib_reset", "events", "io_access", "latch", "latch_out", "pcmd_we", "pcmd")),
 )  # fmt: skip
 """What the core gives the register file (the block's inputs of the same names; the optical ones stay 0)."""
@@ -119,7 +118,7 @@ def _crc_word(crc: Value) -> Value:
 
 
 class Supi3Core(wiring.Component):
-    """The SUPI 3 chip core with the pins of :class:`~supi3.model.pins.Supi3Pins` and the strap ports.
+    """The SUPI 3 chip core with the pins of :data:`supi3.pinout.CORE_INPUTS` and ``CORE_OUTPUTS`` and the strap ports.
 
     Parameters
     ----------
@@ -140,9 +139,9 @@ class Supi3Core(wiring.Component):
             raise
         self.tables = core_tables(self.variant)
         members: dict[str, object] = {}
-        for pin in (*Supi3Pins.inputs, *STRAP_PINS, *(REGISTER_FILE_INPUTS if register_file else ())):
+        for pin in (*CORE_INPUTS, *STRAP_PINS, *(REGISTER_FILE_INPUTS if register_file else ())):
             members[pin.name] = In(pin.width)
-        for pin in (*Supi3Pins.outputs, *((*REGISTER_FILE_OUTPUTS, Pin("init_up")) if register_file else ())):
+        for pin in (*CORE_OUTPUTS, *((*REGISTER_FILE_OUTPUTS, Pin("init_up")) if register_file else ())):
             members[pin.name] = Out(pin.width)
         super().__init__(members)
 
@@ -205,7 +204,7 @@ class Supi3Core(wiring.Component):
 
         # Synchronisers (M1) and the power-up reset with its stretch (1.7.2, M2) -------------------------------------
         synced: dict[str, Value] = {}
-        for pin, idle in zip(Supi3Pins.inputs, IDLE_INPUTS, strict=True):
+        for pin, idle in zip(CORE_INPUTS, CORE_IDLE, strict=True):
             stages = [Signal(pin.width, init=idle, name=f"{pin.name}_s{k}") for k in range(SYNC_STAGES)]
             m.d.sync += [stages[0].eq(getattr(self, pin.name)), *(b.eq(a) for a, b in pairwise(stages))]
             synced[pin.name] = stages[-1]
@@ -287,7 +286,7 @@ class _Engine(Elaboratable):
     """Everything the model's power-up reset clears: time, receiver, frame engine, chip registers, transmitter.
 
     It runs only on the clocks where the model's ``_tick`` runs its logic; :class:`Supi3Core` inserts the enable and
-    the power-up reset. The chip registers follow :class:`supi3.model.chip.Supi3`; the order of the statements
+    the power-up reset. The chip registers follow the model's ``model.chip.Supi3``; the order of the statements
     follows the model's order within one clock, later assignments winning as later Python assignments do.
 
     In Init-µP modes (``init_up``) the IN data come from ``in_data``; the strobes ``latch``, ``pcmd_we``,
@@ -348,7 +347,7 @@ class _Engine(Elaboratable):
         tables = self.tables
         reg_bits = tables.register_bits
 
-        # Chip registers (supi3.model.chip.Supi3) ------------------------------------------------------------------
+        # Chip registers (model.chip.Supi3) ------------------------------------------------------------------------
         pf, bus_active = self.pf, self.bus_active
         wd, te, attention = Signal(), Signal(), Signal()
         mfp_out = self.mfp_out
