@@ -48,6 +48,7 @@ from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
+from supi3.pinout import CORE_INPUTS, CORE_OUTPUTS
 from supi3.tables import CLOCK_HZ, RESET_MIN_S
 from supi3.verif.pinmodel import EventLog, Pin
 
@@ -100,9 +101,7 @@ IDLE_INPUTS: Final = Synced(wire.IDLE_LEVEL, 0, 0, 0, 1, 1, 1)
 _NEVER: Final = 1 << 62
 
 
-_INPUT_PINS: Final[tuple[Pin, ...]] = (
-    Pin("do1"), Pin("di2"), Pin("rbst_ext"), Pin("mfp_in", 16), Pin("stat_err_n"), Pin("resu_n"), Pin("vmon_ok"),
-)  # fmt: skip
+_INPUT_PINS: Final[tuple[Pin, ...]] = CORE_INPUTS
 """``Supi3Pins.inputs``, in :class:`Synced` order."""
 _INPUT_WIDTHS: Final[dict[str, int]] = {pin.name: pin.width for pin in _INPUT_PINS}
 """Bits of each input pin."""
@@ -190,10 +189,7 @@ class Supi3Pins:
     )  # fmt: skip
 
     inputs: Sequence[Pin] = _INPUT_PINS
-    outputs: Sequence[Pin] = (
-        Pin("do2"), Pin("di1"), Pin("mfp_out", 16), Pin("mfp_oe", 16), Pin("mod_ack_n"), Pin("res_reg_n"),
-        Pin("diag1"), Pin("diag2"), Pin("ib_diag"), Pin("dclk_out"), Pin("resu_drive"),
-    )  # fmt: skip
+    outputs: Sequence[Pin] = CORE_OUTPUTS
 
     def __init__(self, config: DeviceConfig, chip: Supi3 | None = None) -> None:
         check_instance("config", config, DeviceConfig)
