@@ -69,7 +69,23 @@ from supi3.rtl.tables import (
 from supi3.rtl.upif import upif_tables
 from supi3.verif.pinmodel import Pin
 
-__all__ = ["REGISTER_FILE_INPUTS", "REGISTER_FILE_OUTPUTS", "STRAP_PINS", "Supi3Core", "verilog"]
+__all__ = [
+    "LINE",
+    "MANAGEMENT",
+    "REGISTER",
+    "REGISTER_FILE_INPUTS",
+    "REGISTER_FILE_OUTPUTS",
+    "STRAP_PINS",
+    "TRANSMIT",
+    "WORDS",
+    "DataPath",
+    "FrameEngine",
+    "Outputs",
+    "Receiver",
+    "Supi3Core",
+    "Transmitter",
+    "verilog",
+]
 
 REGISTER_FILE_INPUTS: Final = tuple(pin for pin in FROM_REGISTER_FILE if pin.name in ("in_data", "bus_id", "alarm"))
 """What the core takes from the register file (:class:`supi3.rtl.upif.UpifBlock`'s outputs of the same names)."""
