@@ -736,12 +736,13 @@ class Transmitter(wiring.Component):
         self.tables = tables
         clocks = tables.clocks
         countdown = max(e.forward_delay + e.clocks_per_bit // 2 - 1 for e in clocks)
-        super().__init__({
+        members: dict[str, object] = {
             "frame": In(TRANSMIT),
             "cpb": In(range(max(e.clocks_per_bit for e in clocks) + 1)),
             "tx_init": In(range(countdown + 1)),
             "do2": Out(1, init=wire.IDLE_LEVEL),
-        })
+        }
+        super().__init__(members)
 
     def elaborate(self, _platform: object) -> Module:
         m = Module()
