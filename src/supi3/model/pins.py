@@ -52,14 +52,13 @@ from supi3.config import DeviceConfig
 from supi3.interbus import wire
 from supi3.model.blocks.datapath import DataPath
 from supi3.model.blocks.frame import FrameEngine
-from supi3.model.blocks.outputs import IB_DIAG_DIVIDER_BITS, Outputs, Snapshot
+from supi3.model.blocks.outputs import Outputs, Snapshot
 from supi3.model.blocks.receiver import (
     IDLE_INPUTS,
     IDLE_TIMEOUT_CLOCKS,
     INPUT_NAMES,
     INPUT_PINS,
     NEVER,
-    SYNC_STAGES,
     Receiver,
     Synced,
     check_names,
@@ -68,6 +67,7 @@ from supi3.model.blocks.receiver import (
 )
 from supi3.model.blocks.transmitter import Trace, Transmitter
 from supi3.model.chip import Supi3
+from supi3.pinout import CORE_OUTPUTS, IB_DIAG_DIVIDER_BITS, SYNC_STAGES
 from supi3.tables import CLOCK_HZ, RESET_MIN_S
 from supi3.verif.pinmodel import EventLog, Pin
 
@@ -122,10 +122,7 @@ class Supi3Pins:
     )  # fmt: skip
 
     inputs: Sequence[Pin] = INPUT_PINS
-    outputs: Sequence[Pin] = (
-        Pin("do2"), Pin("di1"), Pin("mfp_out", 16), Pin("mfp_oe", 16), Pin("mod_ack_n"), Pin("res_reg_n"),
-        Pin("diag1"), Pin("diag2"), Pin("ib_diag"), Pin("dclk_out"), Pin("resu_drive"),
-    )  # fmt: skip
+    outputs: Sequence[Pin] = CORE_OUTPUTS
 
     def __init__(self, config: DeviceConfig, chip: Supi3 | None = None) -> None:
         check_instance("config", config, DeviceConfig)

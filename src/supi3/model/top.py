@@ -20,6 +20,7 @@ from typing import Final
 import numpy as np
 import numpy.typing as npt
 
+from supi3 import pinout
 from supi3.checks import check_bits, check_bool, check_instance
 from supi3.config import DeviceConfig
 from supi3.model.chip import Supi3
@@ -27,11 +28,11 @@ from supi3.model.pins import Supi3Pins, Trace, input_traces
 from supi3.spi.slave_pins import PinsIn, PinsOut, SlavePins
 from supi3.verif.pinmodel import OE_SUFFIX, Pin
 
-UP_INPUTS: Final[dict[str, int]] = {"sas_init": 0, "sclk": 4, "ss_n": 5, "mfp6": 6, "mfp7": 7}
+UP_INPUTS: Final = pinout.UP_INPUTS
 """The MFP pin of each input of the µP interface (:class:`PinsIn` field, Tables 3-5 and 3-6)."""
-UP_OUTPUTS: Final[dict[str, int]] = {"io": 1, "c_d": 2, "irq_n": 3, "mfp6": 6, "mfp7": 7}
+UP_OUTPUTS: Final = pinout.UP_OUTPUTS
 """The MFP pin of each output of the µP interface (:class:`PinsOut` field; its enable is ``<field>_oe``)."""
-UP_PINS: Final = 0x00FF
+UP_PINS: Final = pinout.UP_PINS
 """MFP[7..0]: the µP interface's pins in the Init-µP modes."""
 
 

@@ -1,15 +1,15 @@
 """The whole SUPI 3 chip in Amaranth: the INTERBUS core and the serial µP interface, pin for pin.
 
-:class:`Supi3Chip` matches :class:`supi3.model.top.Supi3Chip` on every output pin on every 32 MHz clock. It joins
+:class:`Supi3Chip` matches the model ``model.top.Supi3Chip`` on every output pin on every 32 MHz clock. It joins
 :class:`~supi3.rtl.core.Supi3Core` (built with its register-file ports) and :class:`~supi3.rtl.upif.UpifBlock`
-(the µP interface and its register file) the way the model joins :class:`~supi3.model.pins.Supi3Pins` and
-:class:`~supi3.spi.slave_pins.SlavePins` through one :class:`~supi3.model.registers.RegisterFile`:
+(the µP interface and its register file) the way the model joins ``model.pins.Supi3Pins`` and
+``spi.slave_pins.SlavePins`` through one ``model.registers.RegisterFile``:
 
 * the core decodes the straps; in Init-µP modes it takes the ID register (bits 12..0), the data length, the IN
   bytes and the processor alarm from the block and strobes the block's core inputs at the clock edges at which the
   model's core calls the register file; at one edge the core's inputs act before the µP pins, as in the model;
-* the block's µP pins are MFP[7..0] with the model's map (:data:`supi3.model.top.UP_INPUTS`,
-  :data:`~supi3.model.top.UP_OUTPUTS`); MFP[15..8] stay with the core;
+* the block's µP pins are MFP[7..0] with the map of the pin declaration (:data:`supi3.pinout.UP_INPUTS`,
+  :data:`~supi3.pinout.UP_OUTPUTS`); MFP[15..8] stay with the core;
 * the block is held in reset while the core's power-up reset runs (``resu_drive``, or a power failure seen at this
   edge) and in every mode other than Init-µP, where MFP[7..0] are the core's.
 """
@@ -24,20 +24,17 @@ from amaranth.lib.wiring import In, Out
 
 from supi3.config import Variant
 from supi3.errors import ArgumentError
-from supi3.model.pins import Supi3Pins
-from supi3.model.top import UP_INPUTS, UP_OUTPUTS, UP_PINS
-from supi3.rtl.core import REGISTER_FILE_INPUTS, REGISTER_FILE_OUTPUTS, STRAP_PINS, Supi3Core
+from supi3.pinout import CORE_INPUTS, CORE_OUTPUTS, STRAP_PINS, UP_INPUTS, UP_OUTPUTS, UP_PINS, up_input_port
+from supi3.rtl.core import REGISTER_FILE_INPUTS, REGISTER_FILE_OUTPUTS, Supi3Core
 from supi3.rtl.tables import check_variant
 from supi3.rtl.upif import UpifBlock
-from supi3.spi.block_pins import SERIAL_INPUTS
-from supi3.spi.slave_pins import INPUT_PINS
 from supi3.verif.pinmodel import OE_SUFFIX
 
 __all__ = ["Supi3Chip", "rtlil", "verilog"]
 
 
 class Supi3Chip(wiring.Component):
-    """The SUPI 3 chip with the pins of :class:`supi3.model.top.Supi3Chip` and the strap ports of
+    """The SUPI 3 chip with the pins of the model ``model.top.Supi3Chip`` (:mod:`supi3.pinout`) and the strap ports of
     :class:`~supi3.rtl.core.Supi3Core`.
 
     Parameters
@@ -52,24 +49,24 @@ class Supi3Chip(wiring.Component):
         except ArgumentError:
             self._MustUse__silence = True  # rejected, never elaborated: no "created but never used" warning
             raise
-        members: dict[str, object] = {pin.name: In(pin.width) for pin in (*Supi3Pins.inputs, *STRAP_PINS)}
-        members.update({pin.name: Out(pin.width) for pin in Supi3Pins.outputs})
+        members: dict[str, object] = {pin.name: In(pin.width) for pin in (*CORE_INPUTS, *STRAP_PINS)}
+        members.update({pin.name: Out(pin.width) for pin in CORE_OUTPUTS})
         super().__init__(members)
 
     def elaborate(self, _platform: object) -> Module:
         m = Module()
         m.submodules.core = core = Supi3Core(self.variant, register_file=True)
         m.submodules.upif = upif = UpifBlock()
-        for pin in (*Supi3Pins.inputs, *STRAP_PINS):
+        for pin in (*CORE_INPUTS, *STRAP_PINS):
             m.d.comb += getattr(core, pin.name).eq(getattr(self, pin.name))
-        for pin in Supi3Pins.outputs:
+        for pin in CORE_OUTPUTS:
             m.d.comb += getattr(self, pin.name).eq(getattr(core, pin.name))
         for pin in REGISTER_FILE_OUTPUTS:
             m.d.comb += getattr(upif, pin.name).eq(getattr(core, pin.name))
         for pin in REGISTER_FILE_INPUTS:
             m.d.comb += getattr(core, pin.name).eq(getattr(upif, pin.name))
-        for name, port in zip(INPUT_PINS, SERIAL_INPUTS, strict=True):
-            m.d.comb += getattr(upif, port.name).eq(self.mfp_in[UP_INPUTS[name]])
+        for name, bit in UP_INPUTS.items():
+            m.d.comb += getattr(upif, up_input_port(name)).eq(self.mfp_in[bit])
         levels: Value = Const(0, len(self.mfp_out))
         enables: Value = Const(0, len(self.mfp_oe))
         for name, bit in UP_OUTPUTS.items():

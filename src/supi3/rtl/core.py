@@ -1,4 +1,4 @@
-"""The SUPI 3 chip core in Amaranth: the INTERBUS slave of :class:`supi3.model.pins.Supi3Pins`, pin for pin.
+"""The SUPI 3 chip core in Amaranth: the INTERBUS slave of the model ``model.pins.Supi3Pins``, pin for pin.
 
 The model is the specification; this RTL matches it on every output pin on every 32 MHz clock (``docs/rtl.md``).
 Its ports are the model's pins plus the pin straps C[4..0], RF[1..0], CLK_CONF[1..0] and DIAG_CONF (and MFP[15..12]
@@ -19,9 +19,9 @@ Blocks, in the order the model's ``_tick`` runs them within one clock:
 µP modes: built with ``register_file=True`` (:class:`supi3.rtl.chip.Supi3Chip`), the core has the ports of the
 register file's core side (:class:`supi3.rtl.upif.UpifBlock`): in Init-µP modes it takes the IN bytes, the ID
 register and the processor alarm from it and strobes the latch, events, processor command, I/O access bit and
-resets at the clocks the model calls :class:`~supi3.model.registers.RegisterFile`. Without it, and in SPI master and
-bus terminal modes, the core sends IN data 0 and the straps' ID code, which is what the model does before software
-acts.
+resets at the clocks the model calls its register file (``model.registers.RegisterFile``). Without it, and in SPI
+master and bus terminal modes, the core sends IN data 0 and the straps' ID code, which is what the model does before
+software acts.
 """
 
 from __future__ import annotations
@@ -31,52 +31,67 @@ from typing import Final
 
 from amaranth.back import verilog as amaranth_verilog
 from amaranth.hdl import Array, Cat, Const, Elaboratable, EnableInserter, Module, Mux, ResetInserter, Signal, Value
-from amaranth.lib import enum, wiring
+from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
 from supi3.checks import check_bool
 from supi3.config import Variant
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
-from supi3.model.chip import MODACK_PULSE_CLOCKS, STATERR_FILTER_CLOCKS, WATCHDOG_CLOCKS
-from supi3.model.pins import (
+from supi3.pinout import (
+    BLOCK_STRAPS,
+    CORE_IDLE,
+    CORE_INPUTS,
+    CORE_OUTPUTS,
+    EVENT_BITS,
+    EXPANSION_BITS,
+    FROM_REGISTER_FILE,
     IB_DIAG_DIVIDER_BITS,
-    IDLE_INPUTS,
-    IDLE_TIMEOUT_CLOCKS,
-    RESET_STRETCH_CLOCKS,
+    MFP_PINS,
+    STRAP_PINS,
     SYNC_STAGES,
-    Supi3Pins,
+    TO_REGISTER_FILE,
 )
 from supi3.regmap import INTERRUPT_SOURCES
 from supi3.regmap.core import BYTE_BITS
 from supi3.rtl.tables import (
-    C_BITS,
-    CLK_CONF_BITS,
-    DIAG_CONF_BITS,
-    EXPANSION_BITS,
-    MFP_PINS,
-    RF_BITS,
+    IDLE_TIMEOUT_CLOCKS,
+    MODACK_PULSE_CLOCKS,
+    RESET_STRETCH_CLOCKS,
+    RESREG_PULSE_CLOCKS,
+    STATERR_FILTER_CLOCKS,
+    WATCHDOG_CLOCKS,
     ClockEntry,
     CoreTables,
     check_variant,
     core_tables,
 )
 from supi3.rtl.upif import upif_tables
-from supi3.spi.block_pins import CORE_INPUTS, CORE_OUTPUTS, EVENT_BITS, STRAP_INPUTS
-from supi3.tables import RESREG_PULSE_CLOCKS
 from supi3.verif.pinmodel import Pin
 
-__all__ = ["REGISTER_FILE_INPUTS", "REGISTER_FILE_OUTPUTS", "STRAP_PINS", "Supi3Core", "verilog"]
+__all__ = [
+    "LINE",
+    "MANAGEMENT",
+    "REGISTER",
+    "REGISTER_FILE_INPUTS",
+    "REGISTER_FILE_OUTPUTS",
+    "STRAP_PINS",
+    "TRANSMIT",
+    "WORDS",
+    "DataPath",
+    "FrameEngine",
+    "Outputs",
+    "Receiver",
+    "Supi3Core",
+    "Transmitter",
+    "verilog",
+]
 
-STRAP_PINS: Final = (Pin("c", C_BITS), Pin("rf", RF_BITS), Pin("clk_conf", CLK_CONF_BITS),
-                     Pin("diag_conf", DIAG_CONF_BITS))  # fmt: skip
-"""The strap input ports, beyond the model's pins (Tables 2-2, 2-4 to 2-7, 1-7, 3-16)."""
-
-REGISTER_FILE_INPUTS: Final = tuple(pin for pin in CORE_OUTPUTS if pin.name in ("in_data", "bus_id", "alarm"))
+REGISTER_FILE_INPUTS: Final = tuple(pin for pin in FROM_REGISTER_FILE if pin.name in ("in_data", "bus_id", "alarm"))
 """What the core takes from the register file (:class:`supi3.rtl.upif.UpifBlock`'s outputs of the same names)."""
 REGISTER_FILE_OUTPUTS: Final = (
-    *STRAP_INPUTS,
-    *(pin for pin in CORE_INPUTS
+    *BLOCK_STRAPS,
+    *(pin for pin in TO_REGISTER_FILE
       if pin.name in ("power_up", "ib_reset", "events", "io_access", "latch", "latch_out", "pcmd_we", "pcmd")),
 )  # fmt: skip
 """What the core gives the register file (the block's inputs of the same names; the optical ones stay 0)."""
@@ -97,13 +112,45 @@ def _width(value: int) -> int:
     return max(1, value.bit_length())
 
 
-class _State(enum.Enum):
-    """Frame engine states of the model (``_state``)."""
+_POSITION: Final = range(wire.DATA_TELEGRAM_BITS + 1)
+"""The bit counter of a telegram: the position of the next bit (docs/interbus.md, "Telegrams")."""
 
-    IDLE = 0
-    DATA = 1
-    CHECK = 2
-    WAIT = 3
+LINE: Final = wiring.Signature({
+    "level": Out(1), "sample": Out(1), "frame_bit": Out(1), "telegram_end": Out(1), "position": Out(_POSITION),
+    "data_now": Out(1), "in_reset": Out(1), "select": Out(1), "control": Out(1), "bus_reset": Out(1),
+    "idle_timeout": Out(1),
+})  # fmt: skip
+"""Receiver -> frame engine, as the receiver sees it: the synchronised line ``level``; ``sample``, the mid-bit
+sample of a telegram bit; ``frame_bit``, a sample in a data telegram outside an INTERBUS reset; ``telegram_end``, the
+stop bit's sample; ``position``, the sampled bit's place in the telegram; ``data_now``, the telegram is a data
+telegram; ``in_reset``, an INTERBUS reset runs (this clock included); ``select`` and ``control``, the bits received;
+``bus_reset``, an INTERBUS reset begins (A12); ``idle_timeout``, 20 ms without a telegram (A13)."""
+
+REGISTER: Final = wiring.Signature({
+    "load": Out(1), "load_id": Out(1), "shift": Out(1), "level": Out(1), "latch": Out(1), "clear": Out(1),
+    "shift_out": In(1),
+})  # fmt: skip
+"""Frame engine -> data path, as the frame engine sees it: ``load`` the register (the ID register if ``load_id``,
+else the IN data) as a frame begins; ``shift`` in ``level`` (a data bit); ``latch`` OUT data to the MFPs; ``clear``
+the MFP outputs (INTERBUS reset); back comes ``shift_out``, the bit the register sends."""
+
+MANAGEMENT: Final = wiring.Signature({
+    "clear": Out(1), "abandon": Out(1), "frame_error": Out(1), "latch_id": Out(1), "latch_data": Out(1),
+    "attention": In(1),
+})  # fmt: skip
+"""Frame engine -> outputs and diagnostics, as the frame engine sees it: ``clear`` (INTERBUS reset or idle
+time-out: chip.reset_at), ``abandon`` (a frame ends unlatched), ``frame_error`` (a frame runs with a local error:
+TE, Table 3-13), ``latch_id`` (an ID cycle's command word is taken), ``latch_data`` (a data cycle's OUT data are
+taken); back comes ``attention``, the ATTN bit the chip adds to the CNTR word."""
+
+TRANSMIT: Final = wiring.Signature({"push": Out(1), "level": Out(1), "set_err": Out(1), "err": Out(1)})
+"""Frame engine -> transmitter: ``push`` the ``level`` this sample sends; ``set_err`` rewrites the ERR pair of the
+CNTR word with ``err`` at the last stop bit of the check sequence."""
+
+WORDS: Final = wiring.Signature({"command": Out(WORD_BITS), "status": In(WORD_BITS), "watchdog_reset": In(1)})
+"""Data path <-> outputs and diagnostics, as the data path sees it: the ``command`` word in the register (an ID
+cycle's latch); back come the management bits 15..13 of the ID register (``status``: PF, WD, TE) and
+``watchdog_reset``, the layer-2 watchdog firing (process data cleared, Table 3-13)."""
 
 
 def _crc_step(crc: Value, bit: Value) -> Value:
@@ -119,7 +166,7 @@ def _crc_word(crc: Value) -> Value:
 
 
 class Supi3Core(wiring.Component):
-    """The SUPI 3 chip core with the pins of :class:`~supi3.model.pins.Supi3Pins` and the strap ports.
+    """The SUPI 3 chip core with the pins of :data:`supi3.pinout.CORE_INPUTS` and ``CORE_OUTPUTS`` and the strap ports.
 
     Parameters
     ----------
@@ -140,9 +187,9 @@ class Supi3Core(wiring.Component):
             raise
         self.tables = core_tables(self.variant)
         members: dict[str, object] = {}
-        for pin in (*Supi3Pins.inputs, *STRAP_PINS, *(REGISTER_FILE_INPUTS if register_file else ())):
+        for pin in (*CORE_INPUTS, *STRAP_PINS, *(REGISTER_FILE_INPUTS if register_file else ())):
             members[pin.name] = In(pin.width)
-        for pin in (*Supi3Pins.outputs, *((*REGISTER_FILE_OUTPUTS, Pin("init_up")) if register_file else ())):
+        for pin in (*CORE_OUTPUTS, *((*REGISTER_FILE_OUTPUTS, Pin("init_up")) if register_file else ())):
             members[pin.name] = Out(pin.width)
         super().__init__(members)
 
@@ -203,13 +250,17 @@ class Supi3Core(wiring.Component):
             complete_diag.eq(Cat(*(self.diag_conf == v for v in tables.complete_diagnostics)).any()),
         ]
 
-        # Synchronisers (M1) and the power-up reset with its stretch (1.7.2, M2) -------------------------------------
-        synced: dict[str, Value] = {}
-        for pin, idle in zip(Supi3Pins.inputs, IDLE_INPUTS, strict=True):
-            stages = [Signal(pin.width, init=idle, name=f"{pin.name}_s{k}") for k in range(SYNC_STAGES)]
-            m.d.sync += [stages[0].eq(getattr(self, pin.name)), *(b.eq(a) for a, b in pairwise(stages))]
-            synced[pin.name] = stages[-1]
-        power_fail = ~(synced["resu_n"] & synced["vmon_ok"])
+        # The blocks (docs/rtl.md, "Architecture"). Each block's clocked logic runs on the clocks where the model's
+        # _tick runs (``running``) and is cleared by a power failure; the receiver's synchronisers always run, so the
+        # receiver applies the enable and reset to its line receiver itself.
+        m.submodules.receiver = receiver = Receiver(tables)
+        frame = FrameEngine()
+        datapath = DataPath(tables)
+        transmitter = Transmitter(tables)
+        outputs = Outputs(len(cycle))
+
+        # The power-up reset with its stretch (1.7.2, M2), from the synchronised /ResU and voltage monitor ---------
+        power_fail = ~(receiver.resu_n_s & receiver.vmon_ok_s)
         holding = Signal()
         stretch = Signal(range(RESET_STRETCH_CLOCKS + 1), init=RESET_STRETCH_CLOCKS)
         with m.If(power_fail):
@@ -220,26 +271,50 @@ class Supi3Core(wiring.Component):
             m.d.sync += stretch.eq(stretch - 1)
         running = ~power_fail & ~holding & (stretch == 0)
 
+        def gated(block: wiring.Component) -> Elaboratable:
+            gated_block: Elaboratable = ResetInserter(power_fail)(EnableInserter(running)(block))
+            return gated_block
+
+        m.submodules.frame = gated(frame)
+        m.submodules.datapath = gated(datapath)
+        m.submodules.transmitter = gated(transmitter)
+        m.submodules.outputs = gated(outputs)
+
+        # Joins between the blocks: connect() where the interfaces fit ---------------------------------------------
+        wiring.connect(m, receiver=receiver.line, frame=frame.line)
+        wiring.connect(m, frame=frame.register, datapath=datapath.frame)
+        wiring.connect(m, frame=frame.management, outputs=outputs.frame)
+        wiring.connect(m, frame=frame.tx, transmitter=transmitter.frame)
+        wiring.connect(m, datapath=datapath.words, outputs=outputs.words)
+        # ... and plain assignments for pins, straps and the synchronised inputs each block takes a few of.
+        m.d.comb += [getattr(receiver, pin.name).eq(getattr(self, pin.name)) for pin in CORE_INPUTS]
+        m.d.comb += [
+            receiver.run.eq(running),
+            receiver.clear.eq(power_fail),
+            receiver.cpb.eq(cpb),
+            receiver.reset_run.eq(reset_run),
+            transmitter.cpb.eq(cpb),
+            transmitter.tx_init.eq(tx_init),
+            datapath.mfp_in.eq(receiver.mfp_in_s),
+            datapath.io_map.eq(io_map),
+            outputs.stat_err_n_s.eq(receiver.stat_err_n_s),
+            outputs.di2_s.eq(receiver.di2_s),
+            outputs.rbst_ext_s.eq(receiver.rbst_ext_s),
+            outputs.di2.eq(self.di2),
+            outputs.do2.eq(transmitter.do2),
+            outputs.divider.eq(cycle),
+            outputs.rbst_by_pin.eq(rbst_by_pin),
+            outputs.complete_diag.eq(complete_diag),
+        ]
+
         # Init-µP modes: the ID register, the data length and the IN data from the register file (docs/upif.md)
-        id_register = Signal(WORD_BITS)
-        data_bytes = Signal.like(strap_bytes)
         up = self.register_file
-        in_data = self.in_data if up else Const(0, tables.register_bits)
-        engine = _Engine(
-            tables,
-            id_register=id_register,
-            data_bytes=data_bytes,
-            init_up=init_up if up else Const(0),
-            in_data=in_data,
-            io_map=io_map,
-            cpb=cpb,
-            reset_run=reset_run,
-            tx_init=tx_init,
-            rbst_by_pin=rbst_by_pin,
-            synced=synced,
-        )
-        m.submodules.engine = ResetInserter(power_fail)(EnableInserter(running)(engine))
-        m.d.comb += [id_register.eq(strap_id), data_bytes.eq(strap_bytes)]
+        m.d.comb += [
+            datapath.id_register.eq(strap_id),
+            datapath.data_bytes.eq(strap_bytes),
+            datapath.init_up.eq(init_up if up else 0),
+            datapath.in_data.eq(self.in_data if up else 0),
+        ]
         if up:
             up_bytes = Signal.like(strap_bytes)
             with m.Switch(self.bus_id[BYTE_BITS:]):  # the length code (Table 3-11) as the register file applies it
@@ -248,110 +323,482 @@ class Supi3Core(wiring.Component):
                         m.d.comb += up_bytes.eq(count)
             with m.If(init_up):
                 # A18: the processor alarm in place of the ID code when the master asked for it
-                up_id = Mux(engine.send_alarm, self.alarm, self.bus_id[:BYTE_BITS])
-                m.d.comb += [id_register.eq(Cat(up_id, self.bus_id[BYTE_BITS:])), data_bytes.eq(up_bytes)]
+                up_id = Mux(outputs.send_alarm, self.alarm, self.bus_id[:BYTE_BITS])
+                m.d.comb += [
+                    datapath.id_register.eq(Cat(up_id, self.bus_id[BYTE_BITS:])),
+                    datapath.data_bytes.eq(up_bytes),
+                ]
+            command = datapath.words.command
+            events = frame.events | (outputs.words.watchdog_reset << _SOURCE_BIT["IB_RESET"])
+            io_now = Mux(running, frame.io_set | (frame.io & ~frame.io_clear), frame.io)
             m.d.comb += [
                 self.init_up.eq(init_up),
                 self.rate.eq(rate),
                 Cat(self.np_id, self.np_length).eq(strap_id),
                 self.power_up.eq(~init_up | power_fail | self.resu_drive),
-                self.ib_reset.eq(running & engine.ib_reset),
-                self.events.eq(Mux(running, engine.events, 0)),
-                self.io_access.eq(Mux(running, engine.io_set | (engine.io & ~engine.io_clear), engine.io)),
-                self.latch.eq(running & engine.latch),
-                self.latch_out.eq(engine.register),
-                self.pcmd_we.eq(running & engine.pcmd_we),
-                self.pcmd.eq(engine.pcmd),
+                self.ib_reset.eq(running & (frame.management.clear | outputs.words.watchdog_reset)),
+                self.events.eq(Mux(running, events, 0)),
+                self.io_access.eq(io_now),
+                self.latch.eq(running & frame.management.latch_data),
+                self.latch_out.eq(datapath.register),
+                self.pcmd_we.eq(running & frame.management.latch_id & command[wire.CMD_PCMD_BIT]),
+                self.pcmd.eq(Mux(frame.management.latch_id, command[wire.CMD_PCMD_SHIFT :][:BYTE_BITS], 0)),
             ]
 
-        pf, bus_active = engine.pf, engine.bus_active
-        fast, slow = (IB_DIAG_DIVIDER_BITS[k] - 1 for k in ("fast", "slow"))
         m.d.comb += [
-            self.do2.eq(engine.do2),
-            # The return line passes straight through when a device follows; the last device loops back (M5).
-            self.di1.eq(Mux(engine.next_present, self.di2, engine.do2)),
-            self.mfp_out.eq(engine.mfp_out),
-            self.mod_ack_n.eq(engine.mod_ack_n),
-            self.res_reg_n.eq(engine.res_reg_n),
-            self.diag1.eq(complete_diag & bus_active),
-            self.diag2.eq(0),
-            # Table 3-18: fast flashing on a peripheral fault, slow while the bus is not active (M6).
-            self.ib_diag.eq(Mux(pf, ~cycle[fast], Mux(bus_active, 1, ~cycle[slow]))),
+            self.do2.eq(transmitter.do2),
+            self.di1.eq(outputs.di1),
+            self.mfp_out.eq(datapath.mfp_out),
+            self.mod_ack_n.eq(outputs.mod_ack_n),
+            self.res_reg_n.eq(outputs.res_reg_n),
+            self.diag1.eq(outputs.diag1),
+            self.diag2.eq(outputs.diag2),
+            self.ib_diag.eq(outputs.ib_diag),
             self.dclk_out.eq(dclk),
             self.resu_drive.eq(holding | (stretch != 0)),
         ]
         return m
 
 
-class _Engine(Elaboratable):
-    """Everything the model's power-up reset clears: time, receiver, frame engine, chip registers, transmitter.
+class Receiver(wiring.Component):
+    """Synchroniser and line receiver (block ``receiver``; the model's ``receiver`` block).
 
-    It runs only on the clocks where the model's ``_tick`` runs its logic; :class:`Supi3Core` inserts the enable and
-    the power-up reset. The chip registers follow :class:`supi3.model.chip.Supi3`; the order of the statements
-    follows the model's order within one clock, later assignments winning as later Python assignments do.
-
-    In Init-µP modes (``init_up``) the IN data come from ``in_data``; the strobes ``latch``, ``pcmd_we``,
-    ``events``, ``ib_reset``, ``io_set`` and ``io_clear`` mark the clocks at which the model calls its register
-    file (:class:`Supi3Core` gates them with the enable).
+    Every input pin passes :data:`~supi3.pinout.SYNC_STAGES` flip-flops (M1) that always run; the synchronised
+    levels come out as ``<pin>_s``. The line receiver runs while ``run`` is 1 and is cleared by ``clear`` (the core's
+    enable and power-up reset): INTERBUS reset detection (a start-level run of ``reset_run`` clocks, A12) and its end
+    after the status telegrams of Table A12, the 20 ms idle time-out (A13), telegram framing (an ``m.FSM``: between
+    telegrams / in a telegram) and the mid-bit sample at ``cpb // 2`` clocks into every bit. Its view of the line is
+    the :data:`LINE` interface ``line``.
     """
 
-    def __init__(
-        self,
-        tables: CoreTables,
-        *,
-        id_register: Value,
-        data_bytes: Value,
-        init_up: Value,
-        in_data: Value,
-        io_map: Value,
-        cpb: Value,
-        reset_run: Value,
-        tx_init: Value,
-        rbst_by_pin: Value,
-        synced: dict[str, Value],
-    ) -> None:
-        self.tables = tables
-        self.id_register = id_register
-        self.data_bytes = data_bytes
-        self.init_up = init_up
-        self.in_data = in_data
-        self.io_map = io_map
-        self.cpb = cpb
-        self.reset_run = reset_run
-        self.tx_init = tx_init
-        self.rbst_by_pin = rbst_by_pin
-        self.synced = synced
-        self.do2 = Signal(init=wire.IDLE_LEVEL)
-        self.next_present = Signal()
-        self.mfp_out = Signal(MFP_PINS)
-        self.mod_ack_n = Signal()
-        self.res_reg_n = Signal()
-        self.pf = Signal()
-        self.bus_active = Signal()
-        self.register = Signal(tables.register_bits)
-        self.send_alarm = Signal()
-        self.io = Signal()
-        self.io_set = Signal()
-        self.io_clear = Signal()
-        self.latch = Signal()
-        self.pcmd_we = Signal()
-        self.pcmd = Signal(BYTE_BITS)
-        self.events = Signal(EVENT_BITS)
-        self.ib_reset = Signal()
+    def __init__(self, tables: CoreTables) -> None:
+        clocks = tables.clocks
+        members: dict[str, object] = {pin.name: In(pin.width) for pin in CORE_INPUTS}
+        members.update({f"{pin.name}_s": Out(pin.width) for pin in CORE_INPUTS})
+        members.update(
+            run=In(1),
+            clear=In(1),
+            cpb=In(range(max(e.clocks_per_bit for e in clocks) + 1)),
+            reset_run=In(range(max(e.reset_run for e in clocks) + 1)),
+            line=Out(LINE),
+        )
+        super().__init__(members)
+
+    def elaborate(self, _platform: object) -> Module:
+        m = Module()
+        for pin, idle in zip(CORE_INPUTS, CORE_IDLE, strict=True):
+            stages = [Signal(pin.width, init=idle, name=f"{pin.name}_s{k}") for k in range(SYNC_STAGES)]
+            m.d.sync += [stages[0].eq(getattr(self, pin.name)), *(b.eq(a) for a, b in pairwise(stages))]
+            m.d.comb += getattr(self, f"{pin.name}_s").eq(stages[-1])
+        rx = Module()
+        m.submodules.line = ResetInserter(self.clear)(EnableInserter(self.run)(rx))
+        sync, comb = rx.d.sync, rx.d.comb
+        line = self.do1_s
+        out = self.line
+
+        # INTERBUS reset, idle time-out (docs/interbus.md A12, A13)
+        in_reset = Signal()
+        reset_end = Signal(range(wire.RESET_END_STATUS_TELEGRAMS + 1))
+        low_run = Signal.like(self.reset_run)
+        silent = Signal(range(IDLE_TIMEOUT_CLOCKS + 2), init=1)  # clocks since the last telegram start
+        low = line == wire.START_LEVEL
+        enter_reset = low & (low_run + 1 == self.reset_run)
+        idle_timeout = silent == IDLE_TIMEOUT_CLOCKS  # once per silence: the count stops one beyond
+        with rx.If(~low):
+            sync += low_run.eq(0)
+        with rx.Elif(low_run != self.reset_run):
+            sync += low_run.eq(low_run + 1)
+        with rx.If(silent != IDLE_TIMEOUT_CLOCKS + 1):
+            sync += silent.eq(silent + 1)
+        with rx.If(enter_reset):
+            sync += [in_reset.eq(1), reset_end.eq(0)]
+        in_reset_now = in_reset | enter_reset
+
+        # Framing and mid-bit sampling
+        busy = Signal()  # in a telegram (the FSM below)
+        phase = Signal.like(self.cpb)  # clocks since the start bit began, modulo the bit period
+        bit = Signal(_POSITION)
+        select = Signal()
+        control = Signal()
+        is_data = Signal(init=1)
+        sample = busy & (phase == self.cpb // 2)
+        data_now = Mux(bit == wire.POS_TYPE, line == wire.TYPE_DATA_LEVEL, is_data)
+        end = bit == Mux(data_now, _DATA_TELEGRAM_END, _STATUS_TELEGRAM_END)
+        with rx.FSM(name="telegram") as fsm:
+            with rx.State("BETWEEN"), rx.If(low):  # a start bit
+                sync += [phase.eq(1), bit.eq(0), is_data.eq(1), silent.eq(1)]
+                rx.next = "TELEGRAM"
+            with rx.State("TELEGRAM"):
+                sync += phase.eq(Mux(phase == self.cpb - 1, 0, phase + 1))
+                with rx.If(sample & end):
+                    rx.next = "BETWEEN"
+        comb += busy.eq(fsm.ongoing("TELEGRAM"))
+        with rx.If(sample):
+            sync += [bit.eq(bit + 1), is_data.eq(data_now)]
+            with rx.If(bit == wire.POS_SELECT):
+                sync += select.eq(line)
+            with rx.If(bit == wire.POS_CONTROL):
+                sync += control.eq(line)
+
+        # The end of an INTERBUS reset: the status telegrams after it (docs/interbus.md A12)
+        with rx.If(sample & end & (line == wire.STOP_LEVEL) & ~data_now & in_reset_now):
+            sync += reset_end.eq(reset_end + 1)
+            with rx.If(reset_end + 1 == wire.RESET_END_STATUS_TELEGRAMS):
+                sync += in_reset.eq(0)
+
+        comb += [
+            out.level.eq(line),
+            out.sample.eq(sample),
+            out.frame_bit.eq(sample & data_now & ~in_reset_now),
+            out.telegram_end.eq(sample & end),
+            out.position.eq(bit),
+            out.data_now.eq(data_now),
+            out.in_reset.eq(in_reset_now),
+            out.select.eq(select),
+            out.control.eq(control),
+            out.bus_reset.eq(enter_reset),
+            out.idle_timeout.eq(idle_timeout),
+        ]
+        return m
+
+
+class FrameEngine(wiring.Component):
+    """Frame engine (block ``frame``): telegram framing into cycles, CRC and check sequence, latch and discard.
+
+    An ``m.FSM`` with the model's states IDLE, DATA (data field), CHECK (check sequence), WAIT (latch telegrams).
+    Bit-serial CRC-16 of the data received and sent; the received check sequence is compared bit-serially (CRC word,
+    CNTR legality, ERR) instead of stored; the CNTR word is forwarded with the chip's ATTN. It drives the data path
+    through ``register`` (:data:`REGISTER`), the chip registers through ``management`` (:data:`MANAGEMENT`) and the
+    transmitter through ``tx`` (:data:`TRANSMIT`); ``events`` are the frame's interrupt sources at their IRQ_EVT
+    bits, ``io`` the I/O access bit with this clock's ``io_set`` and ``io_clear``. The statements follow the model's
+    order within one clock, later assignments winning as later Python assignments do.
+    """
+
+    def __init__(self) -> None:
+        super().__init__({
+            "line": In(LINE), "register": Out(REGISTER), "management": Out(MANAGEMENT), "tx": Out(TRANSMIT),
+            "events": Out(EVENT_BITS), "io": Out(1), "io_set": Out(1), "io_clear": Out(1),
+        })  # fmt: skip
 
     def elaborate(self, _platform: object) -> Module:
         m = Module()
         sync, comb = m.d.sync, m.d.comb
-        s = self.synced
-        line = s["do1"]
-        stat = ~s["stat_err_n"]
-        tables = self.tables
-        reg_bits = tables.register_bits
+        rx, reg, mg, tx = self.line, self.register, self.management, self.tx
+        line = rx.level
+        events = self.events
 
-        # Chip registers (supi3.model.chip.Supi3) ------------------------------------------------------------------
-        pf, bus_active = self.pf, self.bus_active
-        wd, te, attention = Signal(), Signal(), Signal()
+        def event(source: str) -> Value:
+            return events[_SOURCE_BIT[source]].eq(1)
+
+        # The FSM's state as flags, for the conditions below; the transitions are at the end.
+        idle, in_data, in_check, in_wait = Signal(), Signal(), Signal(), Signal()
+        load, check_start, check_done, latch_done = Signal(), Signal(), Signal(), Signal()
+
+        id_cycle = Signal()  # the frame's cycle type: 1 = ID cycle
+        latches = Signal(range(wire.LATCH_STATUS_TELEGRAMS + 1))
+        crc_rx = Signal(WORD_BITS, init=wire.CRC_INIT)
+        crc_tx = Signal(WORD_BITS, init=wire.CRC_INIT)
+        index = Signal(range(wire.CHECK_TELEGRAMS + 2))
+        local_error = Signal()
+        err_in = Signal()
+        attn = Signal()
+        crc_bad = Signal()
+        cntr_bad = Signal()
+        err_bit = Signal()
+        pairs = [
+            tuple(sorted(p))
+            for p in ((wire.CNTR_ATTN_BIT, wire.CNTR_NATTN_BIT), (wire.CNTR_NERR_BIT, wire.CNTR_ERR_BIT))
+        ]
+        firsts = [Signal(name=f"cntr_pair{k}") for k in range(len(pairs))]
+        paired = {b for p in pairs for b in p}
+        if (wire.CNTR_NERR_BIT, wire.CNTR_ERR_BIT) != (
+            WORD_BITS - 2,
+            WORD_BITS - 1,
+        ) or wire.CNTR_ATTN_BIT > wire.CNTR_NATTN_BIT:
+            raise ValueError("the model settles the ERR pair as the last two CNTR bits, after ATTN and /ATTN")
+
+        discard = Signal()  # a frame ends unlatched (chip.discard_at): the invalid-data-cycle event
+        io = self.io
+        sync += io.eq(self.io_set | (io & ~self.io_clear))
+        comb += [tx.push.eq(rx.sample), tx.level.eq(line), reg.level.eq(line), mg.frame_error.eq(~idle & local_error)]
+
+        # INTERBUS reset and idle time-out: the frame is dropped, the chip reset (chip.reset_at)
+        clear = rx.bus_reset | rx.idle_timeout
+        comb += [mg.clear.eq(clear), reg.clear.eq(clear)]
+        with m.If(clear):
+            sync += latches.eq(0)
+            comb += self.io_clear.eq(1)
+        with m.If(rx.idle_timeout):
+            # A frame abandoned here raises TE, which the INTERBUS reset clears again at once.
+            comb += discard.eq(~idle)
+
+        def error() -> Value:
+            return local_error.eq(1)
+
+        def abandon() -> None:
+            """A frame ends unlatched: invalid cycle, TE |= local error (Table 3-13)."""
+            m.d.comb += [discard.eq(~idle), self.io_clear.eq(1), mg.abandon.eq(1)]
+            m.d.sync += latches.eq(0)
+
+        data_field = (rx.position >= wire.POS_DATA) & (rx.position < wire.POS_DATA + 8)
+        j = (rx.position - wire.POS_DATA)[:3]
+        check_n = Cat(j, index[:2])  # bit of the check sequence, line order
+        cntr_b = check_n[:4]
+        with m.If(rx.frame_bit & (rx.position == wire.POS_CONTROL)):
+            cycle_id = rx.select == wire.SELECT_ID_LEVEL
+            check = line == wire.CONTROL_CHECK_LEVEL
+            with m.If(~check & ~in_data):  # a frame begins: the register's parallel load
+                abandon()
+                comb += [load.eq(1), reg.load.eq(1), reg.load_id.eq(cycle_id)]
+                sync += [
+                    id_cycle.eq(cycle_id),
+                    crc_rx.eq(wire.CRC_INIT),
+                    crc_tx.eq(wire.CRC_INIT),
+                    local_error.eq(0),
+                    err_in.eq(0),
+                    latches.eq(0),
+                ]
+            with m.Elif(cycle_id != id_cycle):
+                sync += error()
+            with m.If(check):
+                with m.If(in_data):
+                    sync += [index.eq(0), crc_bad.eq(0), cntr_bad.eq(0)]
+                    comb += [check_start.eq(1), self.io_set.eq(~id_cycle)]  # the I/O access window (Fig. 3-22)
+                with m.Elif(in_check):
+                    sync += index.eq(index + 1)
+                with m.If(~(in_data | (in_check & (index + 1 < wire.CHECK_TELEGRAMS)))):
+                    sync += error()
+        with m.Elif(rx.frame_bit & data_field & in_data):
+            comb += [tx.level.eq(reg.shift_out), reg.shift.eq(1)]
+            sync += [crc_rx.eq(_crc_step(crc_rx, line)), crc_tx.eq(_crc_step(crc_tx, reg.shift_out))]
+        with m.Elif(rx.frame_bit & data_field & in_check & (index < wire.CHECK_TELEGRAMS)):
+            with m.If(check_n < WORD_BITS):  # own CRC word out, the received one compared
+                comb += tx.level.eq(_crc_word(crc_tx).bit_select(check_n[:4], 1))
+                with m.If(line != _crc_word(crc_rx).bit_select(check_n[:4], 1)):
+                    sync += crc_bad.eq(1)
+            with m.Else():  # CNTR forwarded (wire.forward_cntr); the ERR pair is settled at the last stop bit
+                comb += tx.level.eq(0)
+                with m.Switch(cntr_b):
+                    for b in range(WORD_BITS):
+                        with m.Case(b):
+                            if b == wire.CNTR_ATTN_BIT:
+                                comb += tx.level.eq(line | mg.attention)
+                                sync += attn.eq(line | mg.attention)
+                            elif b == wire.CNTR_NATTN_BIT:
+                                comb += tx.level.eq(~attn)
+                            if b == wire.CNTR_ERR_BIT:
+                                sync += err_bit.eq(line)
+                            for first, (lo, hi) in zip(firsts, pairs, strict=True):
+                                if b == lo:
+                                    sync += first.eq(line)
+                                elif b == hi:
+                                    with m.If(line == first):
+                                        sync += cntr_bad.eq(1)
+                            if b not in paired:
+                                with m.If(line):
+                                    sync += cntr_bad.eq(1)
+
+        # Telegram end: check sequence, latch (docs/interbus.md "Cycle end")
+        stop_bad = line != wire.STOP_LEVEL
+        with m.If(rx.telegram_end):
+            with m.If(stop_bad):
+                sync += error()
+            with m.If(in_check & (index == wire.CHECK_TELEGRAMS - 1) & rx.data_now & ~rx.in_reset):
+                error_now = local_error | stop_bad | crc_bad | cntr_bad
+                err = error_now | cntr_bad | err_bit
+                sync += [local_error.eq(error_now), err_in.eq(cntr_bad | err_bit)]
+                comb += [check_done.eq(1), tx.set_err.eq(1), tx.err.eq(err)]
+            with m.If(~stop_bad & ~rx.data_now & ~rx.in_reset):
+                with m.If(in_data | in_check):
+                    sync += error()
+                with m.Elif(in_wait):
+                    latched = Mux(rx.control == wire.CONTROL_CHECK_LEVEL, latches + 1, 0)
+                    sync += latches.eq(latched)
+                    with m.If((latched == wire.LATCH_STATUS_TELEGRAMS) & (local_error | err_in)):
+                        abandon()
+                        comb += latch_done.eq(1)
+                    with m.Elif(latched == wire.LATCH_STATUS_TELEGRAMS):  # chip.latch_at
+                        sync += latches.eq(0)
+                        comb += [latch_done.eq(1), self.io_clear.eq(1), event("PCP_TX")]
+                        with m.If(id_cycle):  # the command word (docs/interbus.md A9)
+                            comb += [mg.latch_id.eq(1), event("ID_CYCLE")]
+                        with m.Else():  # OUT data to the MFPs (Tables 3-1, 3-2), watchdog restarted
+                            comb += [mg.latch_data.eq(1), reg.latch.eq(1), event("VALID"), event("PCP_RX")]
+        comb += events[_SOURCE_BIT["INVALID"]].eq(discard & ~id_cycle)
+
+        # The states (the model's _state), later transitions winning as later assignments do
+        with m.FSM(name="frame") as fsm:
+            with m.State("IDLE"), m.If(load):
+                m.next = "DATA"
+            with m.State("DATA"):
+                with m.If(clear):
+                    m.next = "IDLE"
+                with m.If(check_start):
+                    m.next = "CHECK"
+            with m.State("CHECK"):
+                with m.If(clear):
+                    m.next = "IDLE"
+                with m.If(load):
+                    m.next = "DATA"
+                with m.If(check_done):
+                    m.next = "WAIT"
+            with m.State("WAIT"):
+                with m.If(clear):
+                    m.next = "IDLE"
+                with m.If(load):
+                    m.next = "DATA"
+                with m.If(latch_done):
+                    m.next = "IDLE"
+        comb += [
+            idle.eq(fsm.ongoing("IDLE")),
+            in_data.eq(fsm.ongoing("DATA")),
+            in_check.eq(fsm.ongoing("CHECK")),
+            in_wait.eq(fsm.ongoing("WAIT")),
+        ]
+        return m
+
+
+class DataPath(wiring.Component):
+    """Shift register, load and latch (block ``datapath``).
+
+    The frame's shift register (width 8 x data bytes, or 16 in an ID cycle; bit 0 goes out first) with its length
+    fixed at the load; the parallel load of the ID register (``id_register`` with the management bits ``status``)
+    or of the IN data (the MFP inputs through the mode's map, or ``in_data`` in Init-µP modes, 0 if the watchdog
+    fires at that clock); the latch of OUT data to the MFP outputs through the mode's map, and their clearing by an
+    INTERBUS reset or the watchdog (Tables 3-1, 3-2, 3-13). Driven by the frame engine through ``frame``
+    (:data:`REGISTER`, flipped); ``words`` (:data:`WORDS`) joins it to the outputs and diagnostics.
+    """
+
+    def __init__(self, tables: CoreTables) -> None:
+        self.tables = tables
+        super().__init__({
+            "frame": In(REGISTER), "words": Out(WORDS),
+            "id_register": In(WORD_BITS), "data_bytes": In(range(tables.register_bits // 8 + 1)), "init_up": In(1),
+            "in_data": In(tables.register_bits), "io_map": In(range(len(tables.io_maps))), "mfp_in": In(MFP_PINS),
+            "register": Out(tables.register_bits), "mfp_out": Out(MFP_PINS),
+        })  # fmt: skip
+
+    def elaborate(self, _platform: object) -> Module:
+        m = Module()
+        sync, comb = m.d.sync, m.d.comb
+        f, words = self.frame, self.words
+        reg_bits = self.tables.register_bits
+        register = self.register
+        frame_bytes = Signal.like(self.data_bytes)  # the register's length, fixed when the frame is loaded
+        comb += [
+            f.shift_out.eq(Mux(frame_bytes == 0, f.level, register[0])),
+            words.command.eq(register[:WORD_BITS]),
+        ]
+        shifted = Signal(reg_bits)
+        for i in range(reg_bits):
+            above = register[i + 1] if i + 1 < reg_bits else register[i]
+            comb += shifted[i].eq(Mux(frame_bytes == (i + 1) // 8, f.level, above) if (i + 1) % 8 == 0 else above)
+
+        id_word = Signal(WORD_BITS)
+        comb += id_word.eq(self.id_register | words.status)
+        in_word = Signal(reg_bits)
+        with m.Switch(self.io_map):
+            for k, (in_pins, _) in enumerate(self.tables.io_maps):
+                with m.Case(k):
+                    comb += in_word.eq(Cat(*(self.mfp_in[p] if p is not None else Const(0) for p in in_pins)))
+        with m.If(self.init_up):  # the IN bytes, cleared first by a watchdog reset at this clock
+            comb += in_word.eq(Mux(words.watchdog_reset, 0, self.in_data))
+
+        with m.If(f.load):
+            sync += [
+                frame_bytes.eq(Mux(f.load_id, WORD_BITS // 8, self.data_bytes)),
+                register.eq(Mux(f.load_id, id_word, in_word)),
+            ]
+        with m.Elif(f.shift & (frame_bytes != 0)):
+            sync += register.eq(shifted)
+
         mfp_out = self.mfp_out
+        with m.If(words.watchdog_reset | f.clear):  # process data cleared (Table 3-13, 3.4.7)
+            sync += mfp_out.eq(0)
+        with m.If(f.latch), m.Switch(self.io_map):
+            for k, (_, out_bits) in enumerate(self.tables.io_maps):
+                with m.Case(k):
+                    sync += mfp_out.eq(Cat(*(register[b] if b is not None else Const(0) for b in out_bits)))
+        return m
+
+
+class Transmitter(wiring.Component):
+    """Transmitter and repeater (block ``transmitter``).
+
+    A short queue of (countdown to the end of the bit period, level) entries, newest first: each sample pushes the
+    level it sends, which goes out on DO2 ``tx_init`` clocks later for one bit period (``cpb``), so every bit is
+    repeated :data:`supi3.interbus.wire.REPEATER_DELAY_BITS` after it began on DO1 (A10); DO2 is the newest begun
+    entry while it lasts. The ERR pair of the CNTR word is rewritten at the last stop bit (``tx``,
+    :data:`TRANSMIT`, flipped).
+    """
+
+    def __init__(self, tables: CoreTables) -> None:
+        self.tables = tables
+        clocks = tables.clocks
+        countdown = max(e.forward_delay + e.clocks_per_bit // 2 - 1 for e in clocks)
+        members: dict[str, object] = {
+            "frame": In(TRANSMIT),
+            "cpb": In(range(max(e.clocks_per_bit for e in clocks) + 1)),
+            "tx_init": In(range(countdown + 1)),
+            "do2": Out(1, init=wire.IDLE_LEVEL),
+        }
+        super().__init__(members)
+
+    def elaborate(self, _platform: object) -> Module:
+        m = Module()
+        sync, comb = m.d.sync, m.d.comb
+        f = self.frame
+        slots = _tx_slots(self.tables)
+        width = len(self.tx_init)
+        countdown = [Signal(width, name=f"tx{k}_count") for k in range(slots)]
+        level = [Signal(name=f"tx{k}_level") for k in range(slots)]
+        for r in countdown:
+            with m.If(r != 0):
+                sync += r.eq(r - 1)
+        with m.If(f.push):
+            sync += [countdown[0].eq(self.tx_init), level[0].eq(f.level)]
+            for k in range(1, slots):
+                sync += [
+                    countdown[k].eq(Mux(countdown[k - 1] != 0, countdown[k - 1] - 1, 0)),
+                    level[k].eq(level[k - 1]),
+                ]
+        with m.If(f.set_err):
+            sync += [level[1].eq(f.err), level[2].eq(~f.err)]
+        do2 = Const(wire.IDLE_LEVEL)
+        for r, v in reversed(list(zip(countdown, level, strict=True))):
+            do2 = Mux(r <= self.cpb, Mux(r != 0, v, wire.IDLE_LEVEL), do2)
+        comb += self.do2.eq(do2)
+        return m
+
+
+class Outputs(wiring.Component):
+    """Outputs and diagnostics (block ``outputs``): the chip registers behind the diagnostic pins.
+
+    The /StatErr filter (200 ms, 3.6.2) and the peripheral fault PF, the layer-2 watchdog (Table 3-13) and WD, TE and
+    the attention bit, "bus active", the processor alarm request (A18); the /ModAck and /ResReg pulse counters
+    (loaded with the width at the edge that starts the pulse, the pin low while non-zero); the following device
+    (Table 2-2, M5) and DI1; DIAG1 (BA with complete diagnostics, Table 3-16) and IB_DIAG flashing from the
+    free-running ``divider`` (Table 3-18, M6). The chip registers follow ``model.chip.Supi3``; the frame engine
+    drives them through ``frame`` (:data:`MANAGEMENT`, flipped), and ``words`` (:data:`WORDS`, flipped) gives the
+    data path the management bits and the watchdog's reset and takes the command word.
+    """
+
+    def __init__(self, divider_bits: int) -> None:
+        super().__init__({
+            "frame": In(MANAGEMENT), "words": In(WORDS),
+            "stat_err_n_s": In(1), "di2_s": In(1), "rbst_ext_s": In(1), "di2": In(1), "do2": In(1),
+            "divider": In(divider_bits), "rbst_by_pin": In(1), "complete_diag": In(1),
+            "send_alarm": Out(1), "di1": Out(1), "mod_ack_n": Out(1), "res_reg_n": Out(1), "diag1": Out(1),
+            "diag2": Out(1), "ib_diag": Out(1),
+        })  # fmt: skip
+
+    def elaborate(self, _platform: object) -> Module:
+        m = Module()
+        sync, comb = m.d.sync, m.d.comb
+        f, words = self.frame, self.words
+        stat = ~self.stat_err_n_s
+        pf, wd, te, attention, bus_active = Signal(), Signal(), Signal(), Signal(), Signal()
+        next_present = Signal()
 
         # The model calls chip._advance at the start of every running clock: the /StatErr filter and the watchdog.
         st_valid = Signal()
@@ -392,42 +839,18 @@ class _Engine(Elaboratable):
         wd_now = wd | fire
         attention_now = attention | (filtered & ~pf) | fire
         sync += [pf.eq(pf_now), wd.eq(wd_now), attention.eq(attention_now)]
-        events = self.events
-
-        def event(source: str) -> Value:
-            return events[_SOURCE_BIT[source]].eq(1)
-
         with m.If(fire):  # the watchdog resets process data (Table 3-13)
-            sync += [wd_active.eq(0), mfp_out.eq(0), res_reg.eq(RESREG_PULSE_CLOCKS)]
-            comb += [self.ib_reset.eq(1), event("IB_RESET")]
+            sync += [wd_active.eq(0), res_reg.eq(RESREG_PULSE_CLOCKS)]
+        comb += words.watchdog_reset.eq(fire)
 
         # The following device (Table 2-2, M5)
         with m.If(self.rbst_by_pin):
-            sync += self.next_present.eq(s["rbst_ext"])
-        with m.Elif(s["di2"]):
-            sync += self.next_present.eq(1)
+            sync += next_present.eq(self.rbst_ext_s)
+        with m.Elif(self.di2_s):
+            sync += next_present.eq(1)
 
-        # Receiver: INTERBUS reset, idle time-out (docs/interbus.md A12, A13) ------------------------------------
-        state = Signal(_State)
-        latches = Signal(range(wire.LATCH_STATUS_TELEGRAMS + 1))
-        in_reset = Signal()
-        reset_end = Signal(range(wire.RESET_END_STATUS_TELEGRAMS + 1))
-        low_run = Signal.like(self.reset_run)
-        silent = Signal(range(IDLE_TIMEOUT_CLOCKS + 2), init=1)  # clocks since the last telegram start
-        low = line == wire.START_LEVEL
-        enter_reset = low & (low_run + 1 == self.reset_run)
-        idle_timeout = silent == IDLE_TIMEOUT_CLOCKS  # once per silence: the count stops one beyond
-        with m.If(~low):
-            sync += low_run.eq(0)
-        with m.Elif(low_run != self.reset_run):
-            sync += low_run.eq(low_run + 1)
-        with m.If(silent != IDLE_TIMEOUT_CLOCKS + 1):
-            sync += silent.eq(silent + 1)
-
-        def chip_reset() -> list[Value]:
-            """chip.reset_at: process data cleared, watchdog off, WD and TE cleared (3.4.7, Table 3-13)."""
-            return [
-                mfp_out.eq(0),
+        with m.If(f.clear):  # chip.reset_at: watchdog off, WD and TE cleared (3.4.7, Table 3-13)
+            sync += [
                 wd_code.eq(_WD_OFF),
                 wd_active.eq(0),
                 wd.eq(0),
@@ -436,240 +859,34 @@ class _Engine(Elaboratable):
                 bus_active.eq(0),
                 self.send_alarm.eq(0),
             ]
-
-        discard = Signal()  # a frame ends unlatched (chip.discard_at): the invalid-data-cycle event
-        io = self.io
-        sync += io.eq(self.io_set | (io & ~self.io_clear))
-
-        with m.If(enter_reset):
-            sync += [in_reset.eq(1), reset_end.eq(0), state.eq(_State.IDLE), latches.eq(0), *chip_reset()]
-            comb += [self.ib_reset.eq(1), self.io_clear.eq(1)]
-        with m.If(idle_timeout):
-            # A frame abandoned here raises TE, which the INTERBUS reset clears again at once.
-            sync += [state.eq(_State.IDLE), latches.eq(0), *chip_reset()]
-            comb += [self.ib_reset.eq(1), self.io_clear.eq(1), discard.eq(state != _State.IDLE)]
-        in_reset_now = in_reset | enter_reset
-
-        # Receiver: framing and mid-bit sampling ------------------------------------------------------------------
-        rx_busy = Signal()
-        phase = Signal.like(self.cpb)  # clocks since the start bit began, modulo the bit period
-        bit = Signal(range(wire.DATA_TELEGRAM_BITS + 1))
-        select = Signal()
-        control = Signal()
-        is_data = Signal(init=1)
-        start = ~rx_busy & low
-        sample = rx_busy & (phase == self.cpb // 2)
-        with m.If(start):
-            sync += [rx_busy.eq(1), phase.eq(1), bit.eq(0), is_data.eq(1), silent.eq(1)]
-        with m.Elif(rx_busy):
-            sync += phase.eq(Mux(phase == self.cpb - 1, 0, phase + 1))
-        data_now = Mux(bit == wire.POS_TYPE, line == wire.TYPE_DATA_LEVEL, is_data)
-        end = bit == Mux(data_now, _DATA_TELEGRAM_END, _STATUS_TELEGRAM_END)
-        frame_bit = sample & data_now & ~in_reset_now
-        data_field = (bit >= wire.POS_DATA) & (bit < wire.POS_DATA + 8)
-        j = (bit - wire.POS_DATA)[:3]
-        out = Signal()  # the level this sample sends on
-        comb += out.eq(line)
-        with m.If(sample):
-            sync += [bit.eq(bit + 1), is_data.eq(data_now)]
-            with m.If(bit == wire.POS_SELECT):
-                sync += select.eq(line)
-            with m.If(bit == wire.POS_CONTROL):
-                sync += control.eq(line)
-            with m.If(end):
-                sync += rx_busy.eq(0)
-
-        # Frame engine --------------------------------------------------------------------------------------------
-        id_cycle = Signal()  # the frame's cycle type: 1 = ID cycle
-        register = self.register
-        frame_bytes = Signal.like(self.data_bytes)  # the register's length, fixed when the frame is loaded
-        crc_rx = Signal(WORD_BITS, init=wire.CRC_INIT)
-        crc_tx = Signal(WORD_BITS, init=wire.CRC_INIT)
-        index = Signal(range(wire.CHECK_TELEGRAMS + 2))
-        local_error = Signal()
-        err_in = Signal()
-        attn = Signal()
-        crc_bad = Signal()
-        cntr_bad = Signal()
-        err_bit = Signal()
-        pairs = [
-            tuple(sorted(p))
-            for p in ((wire.CNTR_ATTN_BIT, wire.CNTR_NATTN_BIT), (wire.CNTR_NERR_BIT, wire.CNTR_ERR_BIT))
+        te_now = te | f.frame_error
+        comb += [
+            words.status.eq((pf_now << wire.MGMT_PF_BIT) | (wd_now << wire.MGMT_WD_BIT) | (te_now << wire.MGMT_TE_BIT)),
+            f.attention.eq(attention_now),
         ]
-        firsts = [Signal(name=f"cntr_pair{k}") for k in range(len(pairs))]
-        paired = {b for p in pairs for b in p}
-        if (wire.CNTR_NERR_BIT, wire.CNTR_ERR_BIT) != (
-            WORD_BITS - 2,
-            WORD_BITS - 1,
-        ) or wire.CNTR_ATTN_BIT > wire.CNTR_NATTN_BIT:
-            raise ValueError("the model settles the ERR pair as the last two CNTR bits, after ATTN and /ATTN")
+        with m.If(f.abandon):  # TE |= local error (Table 3-13)
+            sync += te.eq(te_now)
+        with m.If(f.latch_id):  # the command word (docs/interbus.md A9)
+            command = words.command
+            sync += self.send_alarm.eq(command[wire.CMD_ALARM_BIT])  # A18
+            code = command[wire.CMD_WD_CODE_SHIFT :][:_WD_CODE_BITS]
+            with m.If(command[wire.CMD_WD_SET_BIT]):
+                sync += [wd_code.eq(code), *arm(code)]
+            with m.If(command[wire.CMD_QUIT_BIT]):  # Quit Peripheral Error (3.6.2)
+                sync += [pf.eq(module_error), mod_ack.eq(MODACK_PULSE_CLOCKS)]
+            sync += [wd.eq(0), te.eq(0), attention.eq(0)]
+        with m.If(f.latch_data):  # a valid data cycle: the bus is active, the watchdog restarted
+            sync += [bus_active.eq(1), *arm(wd_code)]
 
-        register_bytes = frame_bytes
-        shift_out = Mux(register_bytes == 0, line, register[0])
-        shifted = Signal(reg_bits)
-        for i in range(reg_bits):
-            above = register[i + 1] if i + 1 < reg_bits else register[i]
-            comb += shifted[i].eq(Mux(register_bytes == (i + 1) // 8, line, above) if (i + 1) % 8 == 0 else above)
-
-        def error() -> Value:
-            return local_error.eq(1)
-
-        def abandon() -> list[Value]:
-            """A frame ends unlatched: invalid cycle, TE |= local error (Table 3-13)."""
-            m.d.comb += [discard.eq(state != _State.IDLE), self.io_clear.eq(1)]
-            return [state.eq(_State.IDLE), latches.eq(0), te.eq(te | ((state != _State.IDLE) & local_error))]
-
-        te_now = te | ((state != _State.IDLE) & local_error)
-        id_word = Signal(WORD_BITS)
-        comb += id_word.eq(
-            self.id_register
-            | (pf_now << wire.MGMT_PF_BIT)
-            | (wd_now << wire.MGMT_WD_BIT)
-            | (te_now << wire.MGMT_TE_BIT)
-        )
-        in_word = Signal(reg_bits)
-        mfp_s = s["mfp_in"]
-        with m.Switch(self.io_map):
-            for k, (in_pins, _) in enumerate(tables.io_maps):
-                with m.Case(k):
-                    comb += in_word.eq(Cat(*(mfp_s[p] if p is not None else Const(0) for p in in_pins)))
-        with m.If(self.init_up):  # the IN bytes, cleared first by a watchdog reset at this clock
-            comb += in_word.eq(Mux(fire, 0, self.in_data))
-
-        check_n = Cat(j, index[:2])  # bit of the check sequence, line order
-        cntr_b = check_n[:4]
-        with m.If(frame_bit & (bit == wire.POS_CONTROL)):
-            cycle_id = select == wire.SELECT_ID_LEVEL
-            check = line == wire.CONTROL_CHECK_LEVEL
-            with m.If(~check & (state != _State.DATA)):
-                sync += [
-                    *abandon(),
-                    state.eq(_State.DATA),
-                    id_cycle.eq(cycle_id),
-                    frame_bytes.eq(Mux(cycle_id, WORD_BITS // 8, self.data_bytes)),
-                    register.eq(Mux(cycle_id, id_word, in_word)),
-                    crc_rx.eq(wire.CRC_INIT),
-                    crc_tx.eq(wire.CRC_INIT),
-                    local_error.eq(0),
-                    err_in.eq(0),
-                    latches.eq(0),
-                ]
-            with m.Elif(cycle_id != id_cycle):
-                sync += error()
-            with m.If(check):
-                with m.If(state == _State.DATA):
-                    sync += [state.eq(_State.CHECK), index.eq(0), crc_bad.eq(0), cntr_bad.eq(0)]
-                    comb += self.io_set.eq(~id_cycle)  # the I/O access window of a data cycle (Fig. 3-22)
-                with m.Elif(state == _State.CHECK):
-                    sync += index.eq(index + 1)
-                with m.If(~((state == _State.DATA) | ((state == _State.CHECK) & (index + 1 < wire.CHECK_TELEGRAMS)))):
-                    sync += error()
-        with m.Elif(frame_bit & data_field & (state == _State.DATA)):
-            comb += out.eq(shift_out)
-            sync += [crc_rx.eq(_crc_step(crc_rx, line)), crc_tx.eq(_crc_step(crc_tx, shift_out))]
-            with m.If(register_bytes != 0):
-                sync += register.eq(shifted)
-        with m.Elif(frame_bit & data_field & (state == _State.CHECK) & (index < wire.CHECK_TELEGRAMS)):
-            with m.If(check_n < WORD_BITS):  # own CRC word out, the received one compared
-                comb += out.eq(_crc_word(crc_tx).bit_select(check_n[:4], 1))
-                with m.If(line != _crc_word(crc_rx).bit_select(check_n[:4], 1)):
-                    sync += crc_bad.eq(1)
-            with m.Else():  # CNTR forwarded (wire.forward_cntr); the ERR pair is settled at the last stop bit
-                comb += out.eq(0)
-                with m.Switch(cntr_b):
-                    for b in range(WORD_BITS):
-                        with m.Case(b):
-                            if b == wire.CNTR_ATTN_BIT:
-                                comb += out.eq(line | attention_now)
-                                sync += attn.eq(line | attention_now)
-                            elif b == wire.CNTR_NATTN_BIT:
-                                comb += out.eq(~attn)
-                            if b == wire.CNTR_ERR_BIT:
-                                sync += err_bit.eq(line)
-                            for first, (lo, hi) in zip(firsts, pairs, strict=True):
-                                if b == lo:
-                                    sync += first.eq(line)
-                                elif b == hi:
-                                    with m.If(line == first):
-                                        sync += cntr_bad.eq(1)
-                            if b not in paired:
-                                with m.If(line):
-                                    sync += cntr_bad.eq(1)
-
-        # Transmitter: (countdown to the end of the bit period, level), newest first -------------------------------
-        slots = _tx_slots(tables)
-        width = len(self.tx_init)
-        countdown = [Signal(width, name=f"tx{k}_count") for k in range(slots)]
-        level = [Signal(name=f"tx{k}_level") for k in range(slots)]
-        for r in countdown:
-            with m.If(r != 0):
-                sync += r.eq(r - 1)
-        with m.If(sample):
-            sync += [countdown[0].eq(self.tx_init), level[0].eq(out)]
-            for k in range(1, slots):
-                sync += [
-                    countdown[k].eq(Mux(countdown[k - 1] != 0, countdown[k - 1] - 1, 0)),
-                    level[k].eq(level[k - 1]),
-                ]
-        do2 = Const(wire.IDLE_LEVEL)
-        for r, v in reversed(list(zip(countdown, level, strict=True))):
-            do2 = Mux(r <= self.cpb, Mux(r != 0, v, wire.IDLE_LEVEL), do2)
-        comb += self.do2.eq(do2)
-
-        # Telegram end: check sequence, INTERBUS reset end, latch (docs/interbus.md "Cycle end") ---------------------
-        stop_bad = line != wire.STOP_LEVEL
-        with m.If(sample & end):
-            with m.If(stop_bad):
-                sync += error()
-            with m.If((state == _State.CHECK) & (index == wire.CHECK_TELEGRAMS - 1) & data_now & ~in_reset_now):
-                error_now = local_error | stop_bad | crc_bad | cntr_bad
-                err = error_now | cntr_bad | err_bit
-                sync += [
-                    local_error.eq(error_now),
-                    err_in.eq(cntr_bad | err_bit),
-                    state.eq(_State.WAIT),
-                    level[1].eq(err),
-                    level[2].eq(~err),
-                ]
-            with m.If(~stop_bad & ~data_now):
-                with m.If(in_reset_now):
-                    sync += reset_end.eq(reset_end + 1)
-                    with m.If(reset_end + 1 == wire.RESET_END_STATUS_TELEGRAMS):
-                        sync += in_reset.eq(0)
-                with m.Elif((state == _State.DATA) | (state == _State.CHECK)):
-                    sync += error()
-                with m.Elif(state == _State.WAIT):
-                    latched = Mux(control == wire.CONTROL_CHECK_LEVEL, latches + 1, 0)
-                    sync += latches.eq(latched)
-                    with m.If((latched == wire.LATCH_STATUS_TELEGRAMS) & (local_error | err_in)):
-                        sync += abandon()
-                    with m.Elif(latched == wire.LATCH_STATUS_TELEGRAMS):  # chip.latch_at
-                        sync += [state.eq(_State.IDLE), latches.eq(0)]
-                        comb += [self.io_clear.eq(1), event("PCP_TX")]
-                        with m.If(id_cycle):  # the command word (docs/interbus.md A9)
-                            command = register[:WORD_BITS]
-                            sync += self.send_alarm.eq(command[wire.CMD_ALARM_BIT])  # A18
-                            comb += [
-                                self.pcmd_we.eq(command[wire.CMD_PCMD_BIT]),
-                                self.pcmd.eq(command[wire.CMD_PCMD_SHIFT :][:BYTE_BITS]),
-                                event("ID_CYCLE"),
-                            ]
-                            code = command[wire.CMD_WD_CODE_SHIFT :][:_WD_CODE_BITS]
-                            with m.If(command[wire.CMD_WD_SET_BIT]):
-                                sync += [wd_code.eq(code), *arm(code)]
-                            with m.If(command[wire.CMD_QUIT_BIT]):  # Quit Peripheral Error (3.6.2)
-                                sync += [pf.eq(module_error), mod_ack.eq(MODACK_PULSE_CLOCKS)]
-                            sync += [wd.eq(0), te.eq(0), attention.eq(0)]
-                        with m.Else():  # OUT data to the MFPs (Tables 3-1, 3-2), watchdog restarted
-                            sync += [bus_active.eq(1), *arm(wd_code)]
-                            comb += [self.latch.eq(1), event("VALID"), event("PCP_RX")]
-                            with m.Switch(self.io_map):
-                                for k, (_, out_bits) in enumerate(tables.io_maps):
-                                    with m.Case(k):
-                                        sync += mfp_out.eq(
-                                            Cat(*(register[b] if b is not None else Const(0) for b in out_bits))
-                                        )
-        comb += events[_SOURCE_BIT["INVALID"]].eq(discard & ~id_cycle)
+        fast, slow = (IB_DIAG_DIVIDER_BITS[k] - 1 for k in ("fast", "slow"))
+        comb += [
+            # The return line passes straight through when a device follows; the last device loops back (M5).
+            self.di1.eq(Mux(next_present, self.di2, self.do2)),
+            self.diag1.eq(self.complete_diag & bus_active),
+            self.diag2.eq(0),
+            # Table 3-18: fast flashing on a peripheral fault, slow while the bus is not active (M6).
+            self.ib_diag.eq(Mux(pf, ~self.divider[fast], Mux(bus_active, 1, ~self.divider[slow]))),
+        ]
         return m
 
 

@@ -1,10 +1,12 @@
-"""The strap decode tables of the RTL core, generated at elaboration from the manual's tables and the model.
+"""The strap decode tables of the RTL core, generated at elaboration from the spec layer alone.
 
-Nothing here is typed in: every mode comes from :data:`supi3.tables.MODE_ROWS` through :func:`supi3.config.decode`,
-and every per-mode quantity the RTL needs is read off the cycle-accurate model built for that configuration
-(:class:`supi3.model.pins.Supi3Pins` and its :class:`~supi3.model.chip.Supi3`). The MFP maps are found by probing the
-model's public bus interface (``load_at``/``latch_at``) one pin and one register bit at a time, so the RTL moves
-exactly the bits the model moves, in the model's line order (docs/interbus.md, "Frame"; Tables 3-1 and 3-2).
+Every mode comes from :data:`supi3.tables.MODE_ROWS` through :func:`supi3.config.decode`, and every per-mode
+quantity the RTL needs is derived from that configuration, the manual's tables (:mod:`supi3.tables`) and the wire
+format (:mod:`supi3.interbus.wire`): ID register, data length, MFP output enables, the MFP in/out maps in line order
+(docs/interbus.md, "Frame"; Tables 3-1 and 3-2), the timing per bit rate (Table 1-7) and the RF/DIAG_CONF flags
+(Tables 2-2, 3-16). Nothing is read off the model: the model (``model.pins.Supi3Pins``) derives the same
+quantities on its own, and ``tests/test_rtl_tables.py`` compares the two derivations for every strap combination
+(the lockstep then compares the two implementations built on them).
 """
 
 from __future__ import annotations
@@ -15,29 +17,62 @@ from functools import cache
 from typing import Final
 
 from supi3.checks import fail
-from supi3.config import DeviceConfig, Straps, Variant, decode, mode_rows
+from supi3.config import DeviceConfig, MfpKind, Variant, decode, mode_rows
 from supi3.errors import ConfigurationError
-from supi3.interbus.wire import Cycle
-from supi3.model.pins import Supi3Pins
-from supi3.tables import BIT_RATES, DIAG_CONFIGURATIONS, MODE_ROWS, RF_MODES
+from supi3.interbus import wire
+from supi3.pinout import C_BITS, CLK_CONF_BITS, DIAG_CONF_BITS, EXPANSION_BITS, MFP_PINS, RF_BITS, SYNC_STAGES
+from supi3.regmap.core import BYTE_BITS
+from supi3.tables import (
+    BIT_RATES,
+    CLOCK_HZ,
+    RESET_MIN_S,
+    RESREG_PULSE_CLOCKS,
+    STATERR_FILTER_S,
+    WATCHDOG_TIMEOUTS_S,
+)
 
-MFP_PINS: Final = next(pin.width for pin in Supi3Pins.inputs if pin.name == "mfp_in")
-"""MFP[15..0] (Table 1-4)."""
+__all__ = [
+    "CLK_CONF_BITS",
+    "C_BITS",
+    "DIAG_CONF_BITS",
+    "EXPANSION_BITS",
+    "IDLE_TIMEOUT_CLOCKS",
+    "MFP_PINS",
+    "MODACK_PULSE_CLOCKS",
+    "RESET_STRETCH_CLOCKS",
+    "RESREG_PULSE_CLOCKS",
+    "RF_BITS",
+    "STATERR_FILTER_CLOCKS",
+    "WATCHDOG_CLOCKS",
+    "ClockEntry",
+    "CoreTables",
+    "ModeEntry",
+    "check_variant",
+    "clock_entry",
+    "complete_diagnostics",
+    "core_tables",
+    "mode_entry",
+    "rbst_by_pin",
+]
 
-C_BITS: Final = len(MODE_ROWS[0].c)
-"""C[4..0] (Tables 2-4 to 2-7)."""
+STATERR_FILTER_CLOCKS: Final = round(STATERR_FILTER_S * CLOCK_HZ)
+"""/StatErr must stay low this many clocks (200 ms, 3.6.2) before the peripheral fault is latched."""
+MODACK_PULSE_CLOCKS: Final = RESREG_PULSE_CLOCKS
+"""/ModAck pulse on Quit Peripheral Error: the manual gives no width; the chip's other single pulse (375 ns,
+Table 3-13) is used (docs/assumptions/model.md M3)."""
+WATCHDOG_CLOCKS: Final[tuple[int | None, ...]] = tuple(
+    None if t is None else round(t * CLOCK_HZ) for t in WATCHDOG_TIMEOUTS_S
+)
+"""Layer-2 watchdog times in clocks, indexed by the command word's watchdog code, ``None`` for off (Table 3-13)."""
+RESET_STRETCH_CLOCKS: Final = round(RESET_MIN_S * CLOCK_HZ)
+"""The internal reset lasts 128 clocks (4 µs, 1.7.2) after its last source went away (M2)."""
+IDLE_TIMEOUT_CLOCKS: Final = round(wire.IDLE_TIMEOUT_S * CLOCK_HZ)
+"""A line without a telegram start for 20 ms is an INTERBUS reset (docs/interbus.md A13), once per silence."""
 
-RF_BITS: Final = len(RF_MODES[0].rf)
-"""RF[1..0] (Table 2-2)."""
-
-CLK_CONF_BITS: Final = len(Straps("").clk_conf)
-"""CLK_CONF[1..0] (Table 1-7)."""
-
-DIAG_CONF_BITS: Final = len(str(DIAG_CONFIGURATIONS[0].diag_conf))
-"""DIAG_CONF (Table 3-16), one pin."""
-
-EXPANSION_BITS: Final = next(len(row.mfp) for row in MODE_ROWS if row.mfp is not None)
-"""MFP[15..12]: the configuration expansion C[8..5] in the modes of Table 3-1 (Tables 2-4 to 2-6)."""
+RBST_EXT_CONTROLLED: Final = "Controlled"
+"""Table 2-2's RBST_EXT column in the row where the pin tells whether a device follows (RF = 10)."""
+DIAG1_BA: Final = "BA"
+"""Table 3-16's DIAG1 column in the row of complete diagnostics (DIAG_CONF = 0): DIAG1 shows BA."""
 
 
 @dataclass(frozen=True)
@@ -61,7 +96,7 @@ class ModeEntry:
         For each MFP pin, the shift-register bit it takes at the latch of a data cycle, or ``None`` (driven 0).
     init_up:
         An Init-µP mode: the model has a register file, which gives the ID register and the data from the serial
-        µP interface (:mod:`supi3.model.top`); ``id_register`` and ``data_bytes`` are then its µP_Not_Ready values.
+        µP interface (``model.top``); ``id_register`` and ``data_bytes`` are then its µP_Not_Ready values.
     """
 
     pattern: str
@@ -119,26 +154,62 @@ def _bits(value: int, width: int) -> str:
     return format(value, f"0{width}b")
 
 
-def _probe_mode(config: DeviceConfig) -> ModeEntry:
-    pins = Supi3Pins(config)
-    chip = pins.chip
-    id_register = chip.id_register()  # fresh chip: management bits 15..13 are 0
-    n = chip.data_bytes()
+def _line_position(word_bit: int, n: int) -> int:
+    """The shift-register position (line order, 0 goes out first) of bit ``word_bit`` of an ``n``-byte data word:
+    byte 0, the most significant, first (docs/interbus.md "Frame", 3.4.8), each byte LSB first or MSB first as
+    :data:`supi3.interbus.wire.DATA_LSB_FIRST` says."""
+    byte, k = divmod(word_bit, 8)
+    return 8 * (n - 1 - byte) + (k if wire.DATA_LSB_FIRST else 7 - k)
+
+
+def _io_bit(signal: str, prefix: str) -> int | None:
+    """The data bit of an MFP signal ``In<k>``/``Out<k>`` (Tables 3-1, 3-2), ``None`` for other signals."""
+    rest = signal[len(prefix) :]
+    return int(rest) if signal.startswith(prefix) and rest.isdigit() else None
+
+
+def mode_entry(config: DeviceConfig) -> ModeEntry:
+    """What the straps of ``config`` set in the core, from the manual's tables alone.
+
+    The ID register is the straps' length and ID code (Table 3-11; in Init-µP modes the µP_Not_Ready code, 3.4.1);
+    the data length is the length code's (:func:`supi3.interbus.wire.data_bytes`); the MFP maps are the
+    ``In<k>``/``Out<k>`` signals of the binary I/O modes (Tables 3-1, 3-2), placed in line order; the output
+    enables are the pins the mode drives (Tables 3-1 to 3-6, 2-8).
+    """
+    n = wire.data_bytes(config.length_code)
+    binary = config.mfp_mode.kind is MfpKind.BINARY_IO
     in_pins: list[int | None] = [None] * (8 * n)
-    for pin in range(MFP_PINS):
-        chip.set_mfp_inputs(1 << pin)
-        register = int.from_bytes(chip.load_at(Cycle.DATA, 0), "little")  # the pin model's register order
-        if register:
-            in_pins[register.bit_length() - 1] = pin
     out_bits: list[int | None] = [None] * MFP_PINS
-    for bit in range(8 * n):
-        chip.latch_at(Cycle.DATA, (1 << bit).to_bytes(n, "little"), 0)
-        if chip.mfp_outputs:
-            out_bits[chip.mfp_outputs.bit_length() - 1] = bit
+    for function in config.mfp_pins if binary else ():
+        if (bit := _io_bit(function.signal, "In")) is not None:
+            in_pins[_line_position(bit, n)] = function.pin
+        elif (bit := _io_bit(function.signal, "Out")) is not None:
+            out_bits[function.pin] = _line_position(bit, n)
     straps = config.straps()
     pattern = straps.c + (straps.mfp if straps.mfp is not None else "-" * EXPANSION_BITS)
-    init_up = chip.registers is not None
-    return ModeEntry(pattern, id_register, n, pins.mfp_oe, tuple(in_pins), tuple(out_bits), init_up)
+    id_register = (config.length_code << BYTE_BITS) | config.id_code
+    init_up = config.mfp_mode.kind is MfpKind.INIT_UP
+    return ModeEntry(pattern, id_register, n, config.mfp_output_mask, tuple(in_pins), tuple(out_bits), init_up)
+
+
+def clock_entry(clk_conf: int, config: DeviceConfig) -> ClockEntry:
+    """The timing of the bit rate ``config`` selects through CLK_CONF = ``clk_conf`` (Table 1-7): the bit period
+    (1.7.1), the repeater delay (docs/interbus.md A10, less the synchroniser's stages, M8) and the reset run
+    (A12, M11)."""
+    cpb = wire.clocks_per_bit(config.bit_rate)
+    forward_delay = wire.REPEATER_DELAY_BITS * cpb - SYNC_STAGES
+    return ClockEntry(clk_conf, BIT_RATES.index(config.bit_rate), cpb, forward_delay, wire.RESET_DETECT_BITS * cpb)
+
+
+def rbst_by_pin(config: DeviceConfig) -> bool:
+    """A following device is told by RBST_EXT (the row of Table 2-2 where RBST_EXT is "Controlled"), not
+    recognised on DI2 (M5)."""
+    return config.rf_mode is not None and config.rf_mode.rbst_ext == RBST_EXT_CONTROLLED
+
+
+def complete_diagnostics(config: DeviceConfig) -> bool:
+    """DIAG1 shows BA: complete diagnostics (Table 3-16)."""
+    return config.diagnostics is not None and config.diagnostics.diag1 == DIAG1_BA
 
 
 def _values(width: int, make: Callable[[str], DeviceConfig]) -> list[tuple[int, DeviceConfig]]:
@@ -173,20 +244,18 @@ def core_tables(variant: Variant | str = Variant.OPC) -> CoreTables:
     """
     variant = check_variant(variant)
     rows = list(mode_rows(variant))
-    modes = tuple(_probe_mode(decode(row.c, row.mfp, variant=variant)) for row in rows)
+    modes = tuple(mode_entry(decode(row.c, row.mfp, variant=variant)) for row in rows)
     first = rows[0]
     clocks = []
     for value, config in _values(CLK_CONF_BITS, lambda b: decode(first.c, first.mfp, clk_conf=b, variant=variant)):
-        pins = Supi3Pins(config)
-        rate = BIT_RATES.index(config.bit_rate)
-        clocks.append(ClockEntry(value, rate, pins.cpb, pins.forward_delay, pins.reset_run))
-    if variant is Variant.LS:  # no RF and DIAG_CONF pins (Table 1-4): the model's defaults for the LS
-        ls = Supi3Pins(decode(first.c, first.mfp, variant=variant))
-        rbst = tuple(range(1 << RF_BITS)) if ls.rbst_by_pin else ()
-        complete = tuple(range(1 << DIAG_CONF_BITS)) if ls.complete_diagnostics else ()
+        clocks.append(clock_entry(value, config))
+    if variant is Variant.LS:  # no RF and DIAG_CONF pins (Table 1-4): what the LS's configuration says
+        ls = decode(first.c, first.mfp, variant=variant)
+        rbst = tuple(range(1 << RF_BITS)) if rbst_by_pin(ls) else ()
+        complete = tuple(range(1 << DIAG_CONF_BITS)) if complete_diagnostics(ls) else ()
     else:
         rf = _values(RF_BITS, lambda b: decode(first.c, first.mfp, rf=b, variant=variant))
         diag = _values(DIAG_CONF_BITS, lambda b: decode(first.c, first.mfp, diag_conf=b, variant=variant))
-        rbst = tuple(value for value, config in rf if Supi3Pins(config).rbst_by_pin)
-        complete = tuple(value for value, config in diag if Supi3Pins(config).complete_diagnostics)
+        rbst = tuple(value for value, config in rf if rbst_by_pin(config))
+        complete = tuple(value for value, config in diag if complete_diagnostics(config))
     return CoreTables(variant, modes, tuple(clocks), rbst, complete)

@@ -1,14 +1,16 @@
 """The serial µP interface of the SUPI 3 OPC in Amaranth: SPI slave / Intel synchronous serial and register file.
 
 Ref: IBS SUPI 3 OPC UM E rev. 05, 3.4 to 3.4.14, Tables 3-5 to 3-13; ``docs/upif.md`` ("Pin level: cycle-exact
-specification" and "RTL"). The block matches :class:`supi3.spi.block_pins.UpifBlockPins` (that is,
-:class:`~supi3.spi.slave_pins.SlavePins`, :class:`~supi3.spi.upif.UpifProtocol` and
-:class:`~supi3.model.registers.RegisterFile`) on every port on every 32 MHz clock. Its ports are the model's:
-the µP pins, the straps (bit rate, µP_Not_Ready code) and the register file's core interface.
+specification" and "RTL"). The block matches the model ``spi.block_pins.UpifBlockPins`` (that is,
+``spi.slave_pins.SlavePins``, ``spi.upif.UpifProtocol`` and ``model.registers.RegisterFile``) on every port on
+every 32 MHz clock. Its ports are declared in :mod:`supi3.pinout` (:data:`~supi3.pinout.UP_BLOCK_INPUTS`,
+:data:`~supi3.pinout.UP_BLOCK_OUTPUTS`), as are the model's: the µP pins, the straps (bit rate, µP_Not_Ready
+code) and the register file's core interface.
 
 Nothing is typed in: register addresses, access kinds, masks, reset values and reset classes come from
 :data:`supi3.regmap.REGISTER_MAP`; the SET decoding is tabulated from :func:`supi3.regmap.decode_set`; the output
-delay per bit rate and the outputs after reset are read off the model (:func:`supi3.spi.block_pins.block_model`).
+delay per bit rate comes from TCLK (Table 3-7, UP-14) and the outputs after reset are the decode of the reset state.
+Nothing is read off the model (``tests/test_rtl_tables.py`` compares).
 
 One clock edge does what the model does between two ticks, in the same order (UP-13, UP-14, ``docs/upif.md``):
 
@@ -22,7 +24,7 @@ One clock edge does what the model does between two ticks, in the same order (UP
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from functools import cache
 from typing import Final
 
@@ -31,8 +33,19 @@ from amaranth.hdl import Array, Cat, Const, Elaboratable, Module, Mux, ResetInse
 from amaranth.lib import enum, wiring
 from amaranth.lib.wiring import In, Out
 
+from supi3 import timing
+from supi3.pinout import (
+    C_D_COMMAND,
+    C_D_DATA,
+    DATA_BYTES,
+    OPTICAL_REGISTERS,
+    UP_BLOCK_INPUTS,
+    UP_BLOCK_OUTPUTS,
+    UP_INPUT_IDLE,
+)
 from supi3.regmap import (
     COMMAND_BYTE,
+    INIT_BYTE,
     INTERRUPT_SOURCES,
     REGISTER_MAP,
     Access,
@@ -43,13 +56,10 @@ from supi3.regmap import (
 )
 from supi3.regmap.core import BYTE_BITS, BYTE_MASK
 from supi3.regmap.registers import IN_BYTES, IO_ACCESS_BIT, OUT_BYTES
-from supi3.spi.block_pins import DATA_BYTES, OPTICAL_REGISTERS, UpifBlockPins, block_model
-from supi3.spi.slave_pins import PinsIn, PinsOut
-from supi3.spi.upif import C_D_COMMAND, C_D_DATA, Mode, Phase
-from supi3.tables import BIT_RATES, LENGTH_CODE_BY_VALUE
+from supi3.tables import BIT_RATES, CLOCK_HZ, LENGTH_CODE_BY_VALUE, UP_INTERFACE_TIMING
 from supi3.verif.pinmodel import OE_SUFFIX
 
-__all__ = ["UpifBlock", "UpifTables", "upif_tables", "verilog"]
+__all__ = ["UpifBlock", "UpifTables", "output_delay", "upif_tables", "verilog"]
 
 _SET = REGISTER_MAP.register("SET")
 _LENGTH_CODE = _SET.field("LENGTH_CODE")
@@ -70,13 +80,49 @@ _PCP_ERASED: Final[tuple[int, ...]] = (0, 1)
 _BIT_COUNT_LIMIT: Final[int] = BYTE_BITS + 1
 """The SCLK edge counter saturates here: the model only asks for 8, below 8, and more than 8 (3.4.2, UP-7)."""
 
-Phase_ = enum.Enum("Phase_", {phase.name: index for index, phase in enumerate(Phase)})
-"""The protocol phases of :class:`~supi3.spi.upif.Phase` as an Amaranth enumeration."""
+_TCLK: Final = next(parameter for parameter in UP_INTERFACE_TIMING if parameter.symbol == "TCLK")
+"""The internal reference clock of the µP interface (Table 3-7: TCLK = t_Bit_IBS / 16)."""
+_INIT_BYTES: Final[dict[str, int]] = {name: INIT_BYTE.constant(name).value for name in ("MOTOROLA", "INTEL")}
+"""The initialization bytes that select Motorola (SPI) and Intel mode (Table 3-8)."""
+
+
+class _Phase(enum.Enum):
+    """What the interface expects next (3.4.3 to 3.4.6)."""
+
+    INIT = 0
+    """The initialization byte (after power-up reset or SAS_INIT)."""
+    COMMAND = 1
+    DATA = 2
+    """The data byte of the last command."""
+    BLOCK = 3
+    """The next byte of a block transfer."""
+    DISABLED = 4
+    """A faulty initialization byte was received: nothing until power-up reset or SAS_INIT (3.4.3)."""
+
+
+def output_delay(bit_rate: int) -> int:
+    """Output pipeline stages at ``bit_rate``: 2 TCLK less 2 clocks (UP-14), TCLK from Table 3-7."""
+    expression = _TCLK.minimum or _TCLK.maximum
+    assert expression is not None  # Table 3-7 gives TCLK as an expression
+    clocks_per_tclk = round(timing.evaluate(expression, bit_rate) * CLOCK_HZ)
+    return 2 * clocks_per_tclk - 2
+
+
+def _reset_outputs() -> dict[str, int]:
+    """The outputs decoded from the power-up state (the output pipeline's initial contents, UP-14): no I/O access,
+    the initialization byte next (C/D = command, UP-2), /IRQ from IRQ_EVT's reset value, no frame: nothing sent."""
+    return {
+        "io": 0, "io_oe": 1,
+        "c_d": C_D_COMMAND, "c_d_oe": 1,
+        "irq_n": int(_IRQ_EVT.reset == 0), "irq_n_oe": 1,
+        "mfp6": 0, "mfp6_oe": 0,
+        "mfp7": 0, "mfp7_oe": 0,
+    }  # fmt: skip
 
 
 @dataclass(frozen=True)
 class UpifTables:
-    """What the RTL reads off the model and the register map at elaboration.
+    """What the RTL derives from the manual's tables and the register map at elaboration.
 
     Attributes
     ----------
@@ -92,7 +138,7 @@ class UpifTables:
     """
 
     output_delay: tuple[int, ...]
-    reset_outputs: PinsOut
+    reset_outputs: dict[str, int]
     set_codes: dict[tuple[int, int], int]
     internal_bytes: dict[int, int]
 
@@ -100,8 +146,6 @@ class UpifTables:
 @cache
 def upif_tables() -> UpifTables:
     """The elaboration tables (see :class:`UpifTables`)."""
-    models = [block_model(rate) for rate in BIT_RATES]
-    reset_outputs = models[0].tick(PinsIn())
     set_codes: dict[tuple[int, int], int] = {}
     for extreg in range(1 << _EXTREG.width):
         for low in range(1 << _LENGTH_CODE.width):
@@ -116,7 +160,7 @@ def upif_tables() -> UpifTables:
         bits = LENGTH_CODE_BY_VALUE[code].bits
         if not extreg and bits is not None:
             internal_bytes[code] = (bits + BYTE_BITS - 1) // BYTE_BITS
-    return UpifTables(tuple(model.output_delay for model in models), reset_outputs, set_codes, internal_bytes)
+    return UpifTables(tuple(output_delay(rate) for rate in BIT_RATES), _reset_outputs(), set_codes, internal_bytes)
 
 
 class _Sync:
@@ -138,15 +182,15 @@ class _Sync:
 
 
 class UpifBlock(wiring.Component):
-    """The serial µP interface block with the ports of :class:`~supi3.spi.block_pins.UpifBlockPins`.
+    """The serial µP interface block with the ports of :data:`supi3.pinout.UP_BLOCK_INPUTS` and ``UP_BLOCK_OUTPUTS``.
 
     Every input pin of the model is an ``In`` port of the same name and width; every output an ``Out`` port, a
     tri-state output with its ``<name>_oe``. The straps (``rate``, ``np_id``, ``np_length``) must be static.
     """
 
     def __init__(self) -> None:
-        members: dict[str, object] = {pin.name: In(pin.width) for pin in UpifBlockPins.inputs}
-        for pin in UpifBlockPins.outputs:
+        members: dict[str, object] = {pin.name: In(pin.width) for pin in UP_BLOCK_INPUTS}
+        for pin in UP_BLOCK_OUTPUTS:
             members[pin.name] = Out(pin.width)
             if pin.tristate:
                 members[pin.name + OE_SUFFIX] = Out(1)
@@ -179,7 +223,7 @@ class _Builder:
         ``internal_data_path``)."""
         self.pcp_device = Signal()
         # Protocol (UpifProtocol) and frame (SlavePins) state.
-        self.phase = Signal(Phase_, init=Phase_.INIT)
+        self.phase = Signal(_Phase, init=_Phase.INIT)
         self.motorola, self.intel = Signal(), Signal()
         self.cmd_rd, self.cmd_wr = Signal(), Signal()
         self.cmd_addr = Signal(_ADDRESS.width)
@@ -243,14 +287,14 @@ class _Builder:
 
     def pins(self) -> None:
         m, b = self.m, self.b
-        idle = PinsIn()
-        ss = _Sync(m, "ss", b.ss_n, idle.ss_n)
-        sclk = _Sync(m, "sclk", b.sclk, idle.sclk)
-        sas = _Sync(m, "sas", b.sas_init, idle.sas_init)
-        data = _Sync(m, "data", Mux(b.mfp6_oe, b.mfp6, b.mfp6_in), idle.mfp6)
-        s_r = _Sync(m, "s_r", b.mfp7_in, idle.mfp7)
+        idle = UP_INPUT_IDLE
+        ss = _Sync(m, "ss", b.ss_n, idle["ss_n"])
+        sclk = _Sync(m, "sclk", b.sclk, idle["sclk"])
+        sas = _Sync(m, "sas", b.sas_init, idle["sas_init"])
+        data = _Sync(m, "data", Mux(b.mfp6_oe, b.mfp6, b.mfp6_in), idle["mfp6"])
+        s_r = _Sync(m, "s_r", b.mfp7_in, idle["mfp7"])
         with m.If(sas.s2):
-            m.d.sync += [self.phase.eq(Phase_.INIT), self.motorola.eq(0), self.intel.eq(0), self.last_rx.eq(0)]
+            m.d.sync += [self.phase.eq(_Phase.INIT), self.motorola.eq(0), self.intel.eq(0), self.last_rx.eq(0)]
             self.clear_frame()
         with m.Else():
             with m.If(ss.fell):
@@ -291,9 +335,9 @@ class _Builder:
         ]
         reads, address = Signal(), Signal(_ADDRESS.width)
         with m.Switch(self.phase):
-            with m.Case(Phase_.BLOCK):
+            with m.Case(_Phase.BLOCK):
                 m.d.comb += [reads.eq(self.blk_rd), address.eq(self.blk_addr)]
-            with m.Case(Phase_.DATA):
+            with m.Case(_Phase.DATA):
                 readable = Signal()
                 with m.Switch(self.cmd_addr):
                     for a, port in _READ_PORTS.items():
@@ -321,29 +365,29 @@ class _Builder:
         """/SS rose after 8 bits (``UpifProtocol.end``): process the received byte ``rx``."""
         m, rx = self.m, self.rx
         with m.Switch(self.phase):
-            with m.Case(Phase_.INIT):
-                m.d.sync += self.phase.eq(Phase_.DISABLED)
-                for mode, flag in ((Mode.MOTOROLA, self.motorola), (Mode.INTEL, self.intel)):
-                    with m.If(rx == mode.init_byte):
-                        m.d.sync += [flag.eq(1), self.phase.eq(Phase_.COMMAND)]
-            with m.Case(Phase_.COMMAND), m.If(self.motorola | self.frame_s_r):
+            with m.Case(_Phase.INIT):
+                m.d.sync += self.phase.eq(_Phase.DISABLED)
+                for mode, flag in (("MOTOROLA", self.motorola), ("INTEL", self.intel)):
+                    with m.If(rx == _INIT_BYTES[mode]):
+                        m.d.sync += [flag.eq(1), self.phase.eq(_Phase.COMMAND)]
+            with m.Case(_Phase.COMMAND), m.If(self.motorola | self.frame_s_r):
                 # An Intel command byte needs S/R = 1 (Table 3-9); the received byte is kept either way.
                 self.command(rx[_RD.lsb], rx[_WR.lsb], rx[_ADDRESS.lsb : _ADDRESS.lsb + _ADDRESS.width])
-            with m.Case(Phase_.DATA):
+            with m.Case(_Phase.DATA):
                 self.data()
-            with m.Case(Phase_.BLOCK):
+            with m.Case(_Phase.BLOCK):
                 self.block()
-        with m.If(self.phase != Phase_.DISABLED):
+        with m.If(self.phase != _Phase.DISABLED):
             m.d.sync += self.last_rx.eq(rx)
 
     def command(self, rd: Value, wr: Value, address: Value) -> None:
         """A command byte (3.4.4): a data byte follows, or address 15 starts a block transfer (3.4.6, UP-10/11)."""
         m = self.m
-        m.d.sync += [self.cmd_rd.eq(rd), self.cmd_wr.eq(wr), self.cmd_addr.eq(address), self.phase.eq(Phase_.DATA)]
+        m.d.sync += [self.cmd_rd.eq(rd), self.cmd_wr.eq(wr), self.cmd_addr.eq(address), self.phase.eq(_Phase.DATA)]
         with m.If(address.matches(*_BLOCK_ADDRESSES)):
-            m.d.sync += [self.phase.eq(Phase_.BLOCK), self.blk_addr.eq(0)]
+            m.d.sync += [self.phase.eq(_Phase.BLOCK), self.blk_addr.eq(0)]
             with m.If((self.n_bytes == 0) | (self.intel & ~rd & ~wr)):
-                m.d.sync += self.phase.eq(Phase_.COMMAND)
+                m.d.sync += self.phase.eq(_Phase.COMMAND)
             with m.If(self.motorola):
                 m.d.sync += [self.blk_rd.eq(1), self.blk_wr.eq(1), self.blk_then_wr.eq(0)]
             with m.Else():
@@ -352,7 +396,7 @@ class _Builder:
     def data(self) -> None:
         """The data byte of a command (3.4.4): a write where RD/WR and S/R allow it (UP-9); 4 and 5 ignored."""
         m, s_r = self.m, self.frame_s_r
-        m.d.sync += self.phase.eq(Phase_.COMMAND)
+        m.d.sync += self.phase.eq(_Phase.COMMAND)
         refused = self.intel & (self.cmd_rd != self.cmd_wr) & (self.cmd_rd == s_r)
         with m.If(self.cmd_wr & (self.motorola | s_r) & ~refused):
             self.cpu_write(self.cmd_addr, self.rx)
@@ -367,7 +411,7 @@ class _Builder:
             with m.If(self.blk_then_wr):
                 m.d.sync += [self.blk_addr.eq(0), self.blk_rd.eq(0), self.blk_wr.eq(1), self.blk_then_wr.eq(0)]
             with m.Else():
-                m.d.sync += self.phase.eq(Phase_.COMMAND)
+                m.d.sync += self.phase.eq(_Phase.COMMAND)
         with m.Else():
             m.d.sync += self.blk_addr.eq(self.blk_addr + 1)
 
@@ -407,12 +451,12 @@ class _Builder:
         phase = self.phase
         decoded: dict[str, Value] = {
             "io": self.io, "io_oe": Const(1),
-            "c_d": Mux(phase.matches(Phase_.INIT, Phase_.COMMAND), C_D_COMMAND, C_D_DATA), "c_d_oe": Const(1),
+            "c_d": Mux(phase.matches(_Phase.INIT, _Phase.COMMAND), C_D_COMMAND, C_D_DATA), "c_d_oe": Const(1),
             "irq_n": self.regs[_IRQ_EVT.name] == 0, "irq_n_oe": Const(1),
             "mfp6": bit & drive & self.intel, "mfp6_oe": drive & self.intel,
             "mfp7": bit & drive & self.motorola, "mfp7_oe": drive & self.motorola,
         }  # fmt: skip
-        reset = asdict(self.tables.reset_outputs)
+        reset = self.tables.reset_outputs
         delays = self.tables.output_delay
         for name, value in decoded.items():
             taps: list[Value] = [value]

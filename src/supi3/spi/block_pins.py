@@ -29,6 +29,7 @@ import dataclasses
 from collections.abc import Mapping, Sequence
 from typing import Final
 
+from supi3 import pinout
 from supi3.checks import check_bits, check_bool
 from supi3.config import MfpKind, Variant, decode, mode_rows
 from supi3.errors import ArgumentError
@@ -79,32 +80,11 @@ SERIAL_OUTPUTS: Final[tuple[Pin, ...]] = tuple(
     Pin(name, tristate=True) for name in OUTPUT_PINS if not name.endswith(OE_SUFFIX)
 )
 """I/O, C/D, /IRQ, MFP6 and MFP7 with their output enables (:class:`PinsOut`; UP-24)."""
-STRAP_INPUTS: Final[tuple[Pin, ...]] = (
-    Pin("rate", max(1, (len(BIT_RATES) - 1).bit_length())),
-    Pin("np_id", BYTE_BITS),
-    Pin("np_length", LENGTH_CODE_BITS),
-)
+STRAP_INPUTS: Final[tuple[Pin, ...]] = pinout.BLOCK_STRAPS
 """The bit rate index (Table 1-7) and the µP_Not_Ready ID / length code of the straps (3.4.1)."""
-CORE_INPUTS: Final[tuple[Pin, ...]] = (
-    Pin("power_up"),
-    Pin("ib_reset"),
-    Pin("events", EVENT_BITS),
-    Pin("io_access"),
-    Pin("latch"),
-    Pin("latch_out", BYTE_BITS * DATA_BYTES),
-    Pin("pcmd_we"),
-    Pin("pcmd", BYTE_BITS),
-    Pin("optical_we", len(OPTICAL_REGISTERS)),
-    Pin("optical", BYTE_BITS * len(OPTICAL_REGISTERS)),
-)
+CORE_INPUTS: Final[tuple[Pin, ...]] = pinout.TO_REGISTER_FILE
 """What the INTERBUS core (and the optical block) give the register file (see the module docstring)."""
-CORE_OUTPUTS: Final[tuple[Pin, ...]] = (
-    Pin("in_data", BYTE_BITS * DATA_BYTES),
-    Pin("bus_id", LENGTH_CODE_BITS + BYTE_BITS),
-    Pin("ext_reg"),
-    Pin("pcp"),
-    Pin("alarm", BYTE_BITS),
-)
+CORE_OUTPUTS: Final[tuple[Pin, ...]] = pinout.FROM_REGISTER_FILE
 """What the register file gives the INTERBUS core (see the module docstring)."""
 
 _BASE_CONFIG: Final = next(

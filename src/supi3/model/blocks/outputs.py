@@ -12,19 +12,16 @@ divider, the diagnostic outputs).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Final
+from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
 
 from supi3.model.blocks.transmitter import Trace, Transmitter
+from supi3.pinout import IB_DIAG_DIVIDER_BITS
 
 if TYPE_CHECKING:
     from supi3.model.chip import Supi3
-
-IB_DIAG_DIVIDER_BITS: Final[dict[str, int]] = {"slow": 26, "fast": 24}
-"""IB_DIAG flashes from a free-running binary divider: 2**26 clocks (0.48 Hz) for "bus not active", 2**24
-(1.9 Hz) for "peripheral fault" (Table 3-18 asks 0.5 Hz and 2 Hz; M6)."""
 
 Snapshot = tuple[int, int, int, int, int, int, int]
 """What the outputs of a cycle depend on besides the cycle number (see :meth:`Outputs.snapshot`)."""

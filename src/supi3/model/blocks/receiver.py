@@ -24,6 +24,7 @@ import numpy.typing as npt
 from supi3.checks import check_bits, check_trace, fail
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
+from supi3.pinout import CORE_IDLE, CORE_INPUTS, SYNC_STAGES
 from supi3.tables import CLOCK_HZ
 from supi3.verif.pinmodel import EventLog, Pin
 
@@ -31,9 +32,6 @@ if TYPE_CHECKING:
     from supi3.model.blocks.frame import FrameEngine
     from supi3.model.blocks.transmitter import Transmitter
     from supi3.model.chip import Supi3
-
-SYNC_STAGES: Final = 2
-"""Every asynchronous input passes two flip-flops before use (M1)."""
 
 IDLE_TIMEOUT_CLOCKS: Final = round(wire.IDLE_TIMEOUT_S * CLOCK_HZ)
 """A line without a telegram start for 20 ms is an INTERBUS reset (docs/interbus.md A13), once per silence."""
@@ -55,13 +53,11 @@ class Synced(NamedTuple):
 
 
 INPUT_NAMES: Final = Synced._fields
-IDLE_INPUTS: Final = Synced(wire.IDLE_LEVEL, 0, 0, 0, 1, 1, 1)
+IDLE_INPUTS: Final = Synced(*CORE_IDLE)
 """What the synchroniser holds after reset: the levels of a quiet board (idle line, no fault, power good)."""
 
-INPUT_PINS: Final[tuple[Pin, ...]] = (
-    Pin("do1"), Pin("di2"), Pin("rbst_ext"), Pin("mfp_in", 16), Pin("stat_err_n"), Pin("resu_n"), Pin("vmon_ok"),
-)  # fmt: skip
-"""``Supi3Pins.inputs``, in :class:`Synced` order."""
+INPUT_PINS: Final[tuple[Pin, ...]] = CORE_INPUTS
+"""``Supi3Pins.inputs``, in :class:`Synced` order (the declaration in :mod:`supi3.pinout`, which the RTL uses too)."""
 _INPUT_WIDTHS: Final[dict[str, int]] = {pin.name: pin.width for pin in INPUT_PINS}
 """Bits of each input pin."""
 

@@ -1,0 +1,192 @@
+"""The SUPI 3's pin declarations: names, widths, directions and idle levels, as data the spec level owns.
+
+The model (:mod:`supi3.model.pins`, :mod:`supi3.model.top`, :mod:`supi3.spi.block_pins`) and the RTL
+(:mod:`supi3.rtl`) both take their port lists from here, so neither derives its interface from the other: the
+lockstep then compares two implementations of one declaration. Nothing here depends on the model or the RTL; the
+widths come from the manual's tables (:mod:`supi3.tables`) and the register map (:mod:`supi3.regmap`).
+
+Three groups:
+
+* the chip core (the INTERBUS slave, Table 1-4): :data:`CORE_INPUTS` with their idle levels :data:`CORE_IDLE`,
+  :data:`CORE_OUTPUTS`, and the strap ports of the RTL, :data:`STRAP_PINS`;
+* the serial µP interface (3.4, Tables 3-5, 3-6): its pins (:data:`UP_INPUT_IDLE`, :data:`UP_OUTPUT_NAMES`) and the
+  MFP each sits on in the Init-µP modes (:data:`UP_INPUTS`, :data:`UP_OUTPUTS`, :data:`UP_PINS`);
+* the join of the two through the register file: the µP block's straps (:data:`BLOCK_STRAPS`), what the core gives
+  the register file (:data:`TO_REGISTER_FILE`) and what it gives back (:data:`FROM_REGISTER_FILE`).
+
+Two cycle-level decisions are visible on the pins and belong to the declaration as well: :data:`SYNC_STAGES` (M1)
+and :data:`IB_DIAG_DIVIDER_BITS` (M6, ``docs/model.md``).
+"""
+
+from __future__ import annotations
+
+from typing import Final
+
+from supi3.interbus import wire
+from supi3.regmap import INTERRUPT_SOURCES, REGISTER_MAP, Access, Direction
+from supi3.regmap.core import BYTE_BITS
+from supi3.regmap.registers import IN_BYTES
+from supi3.tables import BIT_RATES, CLOCK_CONFIGURATIONS, DIAG_CONFIGURATIONS, LENGTH_CODES, MODE_ROWS, RF_MODES
+from supi3.verif.pinmodel import Pin
+
+__all__ = [
+    "BLOCK_STRAPS",
+    "CLK_CONF_BITS",
+    "CORE_IDLE",
+    "CORE_INPUTS",
+    "CORE_OUTPUTS",
+    "C_BITS",
+    "C_D_COMMAND",
+    "C_D_DATA",
+    "DATA_BYTES",
+    "DIAG_CONF_BITS",
+    "EVENT_BITS",
+    "EXPANSION_BITS",
+    "FROM_REGISTER_FILE",
+    "IB_DIAG_DIVIDER_BITS",
+    "LENGTH_CODE_BITS",
+    "MFP_PINS",
+    "OPTICAL_REGISTERS",
+    "RF_BITS",
+    "STRAP_PINS",
+    "SYNC_STAGES",
+    "TO_REGISTER_FILE",
+    "UP_BLOCK_INPUTS",
+    "UP_BLOCK_OUTPUTS",
+    "UP_INPUTS",
+    "UP_INPUT_IDLE",
+    "UP_OUTPUTS",
+    "UP_OUTPUT_NAMES",
+    "UP_PINS",
+    "UP_SERIAL_INPUTS",
+    "UP_SERIAL_OUTPUTS",
+    "up_input_port",
+]
+
+# ----------------------------------------------------------------------------------------------------------------
+# Widths (Table 1-4 and the tables that decode the straps)
+# ----------------------------------------------------------------------------------------------------------------
+
+MFP_PINS: Final = 16
+"""MFP[15..0] (Table 1-4)."""
+C_BITS: Final = len(MODE_ROWS[0].c)
+"""C[4..0] (Tables 2-4 to 2-7)."""
+RF_BITS: Final = len(RF_MODES[0].rf)
+"""RF[1..0] (Table 2-2)."""
+CLK_CONF_BITS: Final = len(CLOCK_CONFIGURATIONS[0].clk_conf1 + CLOCK_CONFIGURATIONS[0].clk_conf0)
+"""CLK_CONF[1..0] (Table 1-7)."""
+DIAG_CONF_BITS: Final = len(str(DIAG_CONFIGURATIONS[0].diag_conf))
+"""DIAG_CONF (Table 3-16), one pin."""
+EXPANSION_BITS: Final = next(len(row.mfp) for row in MODE_ROWS if row.mfp is not None)
+"""MFP[15..12]: the configuration expansion C[8..5] in the modes of Table 3-1 (Tables 2-4 to 2-6)."""
+LENGTH_CODE_BITS: Final = len(LENGTH_CODES[0].code)
+"""ID12..ID8 (Table 3-11)."""
+DATA_BYTES: Final = len(IN_BYTES)
+"""IN0..IN3 and OUT0..OUT3: the internal data registers of the µP modes (3.4.8)."""
+EVENT_BITS: Final = max(source.bit for source in INTERRUPT_SOURCES) + 1
+"""One bit per interrupt source, at its IRQ_EVT position (Table 3-13)."""
+OPTICAL_REGISTERS: Final[tuple[str, ...]] = tuple(
+    port.register.name
+    for address in REGISTER_MAP.addresses
+    for port in (REGISTER_MAP.port(address, Direction.READ),)
+    if port.register is not None and REGISTER_MAP.port(address, Direction.WRITE).access is Access.NO_EFFECT
+)
+"""The read-only registers set by the optical block (reads 8 to 11, 3.4.12, 3.4.13), in address order."""
+
+# ----------------------------------------------------------------------------------------------------------------
+# The chip core (the INTERBUS slave)
+# ----------------------------------------------------------------------------------------------------------------
+
+CORE_INPUTS: Final[tuple[Pin, ...]] = (
+    Pin("do1"), Pin("di2"), Pin("rbst_ext"), Pin("mfp_in", MFP_PINS), Pin("stat_err_n"), Pin("resu_n"),
+    Pin("vmon_ok"),
+)  # fmt: skip
+"""DO1 (forward line in), DI2 (return line in), RBST_EXT, MFP[15..0], /StatErr, /ResU as seen from outside, the
+voltage monitor's output (Table 1-4, 1.7.2, 3.6.2)."""
+CORE_IDLE: Final[tuple[int, ...]] = (wire.IDLE_LEVEL, 0, 0, 0, 1, 1, 1)
+"""The levels of a quiet board, in :data:`CORE_INPUTS` order: idle line, no fault, power good (what the
+synchronisers hold after reset)."""
+CORE_OUTPUTS: Final[tuple[Pin, ...]] = (
+    Pin("do2"), Pin("di1"), Pin("mfp_out", MFP_PINS), Pin("mfp_oe", MFP_PINS), Pin("mod_ack_n"), Pin("res_reg_n"),
+    Pin("diag1"), Pin("diag2"), Pin("ib_diag"), Pin("dclk_out"), Pin("resu_drive"),
+)  # fmt: skip
+"""DO2_CU, DI1_CU, MFP levels and output enables, /ModAck, /ResReg, DIAG1/2, IB_DIAG, DCLK_OUT and the open-drain
+/ResU driver (Table 1-4)."""
+STRAP_PINS: Final[tuple[Pin, ...]] = (
+    Pin("c", C_BITS), Pin("rf", RF_BITS), Pin("clk_conf", CLK_CONF_BITS), Pin("diag_conf", DIAG_CONF_BITS),
+)  # fmt: skip
+"""The strap inputs beyond the core's pins (Tables 2-2, 2-4 to 2-7, 1-7, 3-16); MFP[15..12] are read from
+``mfp_in`` in the configuration-expansion modes (Table 3-1)."""
+
+SYNC_STAGES: Final = 2
+"""Every asynchronous input passes two flip-flops before use (M1)."""
+IB_DIAG_DIVIDER_BITS: Final[dict[str, int]] = {"slow": 26, "fast": 24}
+"""IB_DIAG flashes from a free-running binary divider: 2**26 clocks (0.48 Hz) for "bus not active", 2**24
+(1.9 Hz) for "peripheral fault" (Table 3-18 asks 0.5 Hz and 2 Hz; M6)."""
+
+# ----------------------------------------------------------------------------------------------------------------
+# The serial µP interface (3.4) and its place on the MFPs
+# ----------------------------------------------------------------------------------------------------------------
+
+UP_INPUT_IDLE: Final[dict[str, int]] = {"sas_init": 0, "sclk": 1, "ss_n": 1, "mfp6": 0, "mfp7": 1}
+"""The µP interface's inputs and their idle levels: SAS_INIT, SCLK (idles high, UP-5), /SS, MFP6 (SerIN or
+Ser_IN/OUT), MFP7 (S/R in Intel mode) (Tables 3-5, 3-6, 3-9)."""
+UP_OUTPUT_NAMES: Final[tuple[str, ...]] = ("io", "c_d", "irq_n", "mfp6", "mfp7")
+"""The µP interface's outputs, each with an output enable ``<name>_oe``: I/O, C/D, /IRQ, Ser_IN/OUT, SerOUT."""
+UP_INPUTS: Final[dict[str, int]] = {"sas_init": 0, "sclk": 4, "ss_n": 5, "mfp6": 6, "mfp7": 7}
+"""The MFP pin of each input of the µP interface (Tables 3-5 and 3-6)."""
+UP_OUTPUTS: Final[dict[str, int]] = {"io": 1, "c_d": 2, "irq_n": 3, "mfp6": 6, "mfp7": 7}
+"""The MFP pin of each output of the µP interface (its enable is ``<name>_oe``)."""
+UP_PINS: Final = 0x00FF
+"""MFP[7..0]: the µP interface's pins in the Init-µP modes."""
+C_D_COMMAND: Final = 0
+"""C/D (MFP2) level while the next byte is an initialization or command byte, in both modes (UP-2)."""
+C_D_DATA: Final = 1
+"""C/D level while the next byte is a data byte, and while data transmission is disabled (UP-4)."""
+
+
+def up_input_port(name: str) -> str:
+    """The µP block's input port of µP pin ``name``: pins that are also outputs (MFP6, MFP7) get ``_in``."""
+    return f"{name}_in" if name in UP_OUTPUT_NAMES else name
+
+
+UP_SERIAL_INPUTS: Final[tuple[Pin, ...]] = tuple(Pin(up_input_port(name)) for name in UP_INPUT_IDLE)
+"""The µP block's input ports of SAS_INIT, SCLK, /SS, MFP6 and MFP7 (``mfp6_in``, ``mfp7_in``)."""
+UP_SERIAL_OUTPUTS: Final[tuple[Pin, ...]] = tuple(Pin(name, tristate=True) for name in UP_OUTPUT_NAMES)
+"""The µP block's output ports, each with its enable ``<name>_oe`` (UP-24)."""
+
+# ----------------------------------------------------------------------------------------------------------------
+# The join of core and µP interface through the register file
+# ----------------------------------------------------------------------------------------------------------------
+
+BLOCK_STRAPS: Final[tuple[Pin, ...]] = (
+    Pin("rate", max(1, (len(BIT_RATES) - 1).bit_length())),
+    Pin("np_id", BYTE_BITS),
+    Pin("np_length", LENGTH_CODE_BITS),
+)
+"""The bit rate index (Table 1-7) and the µP_Not_Ready ID / length code of the straps (3.4.1)."""
+TO_REGISTER_FILE: Final[tuple[Pin, ...]] = (
+    Pin("power_up"),
+    Pin("ib_reset"),
+    Pin("events", EVENT_BITS),
+    Pin("io_access"),
+    Pin("latch"),
+    Pin("latch_out", BYTE_BITS * DATA_BYTES),
+    Pin("pcmd_we"),
+    Pin("pcmd", BYTE_BITS),
+    Pin("optical_we", len(OPTICAL_REGISTERS)),
+    Pin("optical", BYTE_BITS * len(OPTICAL_REGISTERS)),
+)
+"""What the INTERBUS core (and the optical block) give the register file."""
+FROM_REGISTER_FILE: Final[tuple[Pin, ...]] = (
+    Pin("in_data", BYTE_BITS * DATA_BYTES),
+    Pin("bus_id", LENGTH_CODE_BITS + BYTE_BITS),
+    Pin("ext_reg"),
+    Pin("pcp"),
+    Pin("alarm", BYTE_BITS),
+)
+"""What the register file gives the INTERBUS core."""
+UP_BLOCK_INPUTS: Final[tuple[Pin, ...]] = (*UP_SERIAL_INPUTS, *BLOCK_STRAPS, *TO_REGISTER_FILE)
+"""The input ports of the µP interface block (the serial pins, the straps, the core's side of the register file)."""
+UP_BLOCK_OUTPUTS: Final[tuple[Pin, ...]] = (*UP_SERIAL_OUTPUTS, *FROM_REGISTER_FILE)
+"""The output ports of the µP interface block."""

@@ -1,0 +1,56 @@
+"""The RTL core's blocks (issue #9 part 5): the seams and names agreed with the model, components joined by signatures.
+
+Behaviour is the lockstep's business (tests/test_rtl_core.py, tests/test_rtl_chip.py); here only the structure.
+"""
+
+from __future__ import annotations
+
+import pytest
+from amaranth.hdl import Fragment
+from amaranth.lib import wiring
+
+from supi3.config import Variant
+from supi3.rtl import core
+from supi3.rtl.core import DataPath, FrameEngine, Outputs, Receiver, Supi3Core, Transmitter
+from supi3.rtl.tables import core_tables
+
+BLOCKS = {"receiver": Receiver, "frame": FrameEngine, "datapath": DataPath, "transmitter": Transmitter,
+          "outputs": Outputs}  # fmt: skip
+"""Block name (the same in supi3.model) -> RTL component."""
+
+
+@pytest.mark.parametrize("variant", list(Variant))
+def test_core_is_the_five_blocks(variant: Variant) -> None:
+    fragment = Fragment.get(Supi3Core(variant), None)
+    assert [name for _, name, _ in fragment.subfragments] == list(BLOCKS)
+
+
+def blocks() -> list[wiring.Component]:
+    """One of each block, elaborated on its own (so none is left unused)."""
+    tables = core_tables()
+    made = [Receiver(tables), FrameEngine(), DataPath(tables), Transmitter(tables), Outputs(26)]
+    for block in made:
+        Fragment.get(block, None)
+    return made
+
+
+def test_blocks_are_components_with_signatures() -> None:
+    for block, cls in zip(blocks(), BLOCKS.values(), strict=True):
+        assert isinstance(block, cls)
+        assert isinstance(block, wiring.Component)
+        assert block.signature.members
+
+
+def test_block_interfaces_fit() -> None:
+    """Every interface between two blocks is one signature, seen from both sides (connect() needs that)."""
+    receiver, frame, datapath, transmitter, outputs = blocks()
+    pairs = [
+        (receiver.signature.members["line"], frame.signature.members["line"], core.LINE),
+        (frame.signature.members["register"], datapath.signature.members["frame"], core.REGISTER),
+        (frame.signature.members["management"], outputs.signature.members["frame"], core.MANAGEMENT),
+        (frame.signature.members["tx"], transmitter.signature.members["frame"], core.TRANSMIT),
+        (datapath.signature.members["words"], outputs.signature.members["words"], core.WORDS),
+    ]
+    for source, sink, signature in pairs:
+        assert source.signature == signature
+        assert sink.signature == signature.flip()
