@@ -1,7 +1,7 @@
 """Benchmark: the serial µP interface models against the real interface at its maximum SCLK.
 
 Transaction level: ``UpInterface.write`` / ``read`` register accesses per second. Pin level: bytes per second of
-a software µP (``supi3.spi.waves.SoftMaster``) driving ``SlavePins`` at the fastest Table 3-7 timing. Each is
+a software µP (``supi3.spi.master.SoftMaster``) driving ``SlavePins`` at the fastest Table 3-7 timing. Each is
 printed as a ratio to the real interface, whose times come from Table 3-7: per byte, /SS fall to first SCLK fall
 max(t1, t7 - t0/2), 7.5 SCLK periods t0 to the last rising edge, t2 to /SS rise, and /SS high for t6 (maximum, C/D
 settles) plus t8 before the next byte; one register access is a command byte and a data byte. Run from the
@@ -20,9 +20,10 @@ from supi3 import tables
 from supi3.config import decode
 from supi3.model.registers import RegisterFile
 from supi3.regmap import REGISTER_MAP, encode_command
+from supi3.spi.figures import SET_1_BYTE
+from supi3.spi.master import SoftMaster
 from supi3.spi.slave_pins import SlavePins
 from supi3.spi.upif import Mode, UpInterface
-from supi3.spi.waves import SET_1_BYTE, SoftMaster
 from supi3.timing import limit
 
 CLK_CONF = {500_000: "01", 2_000_000: "11"}  # CLK_CONF[1..0] (Table 1-7)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -74,3 +75,17 @@ def test_long_values_are_cut() -> None:
     with pytest.raises(ArgumentError) as caught:
         check_int("n", "x" * 500)
     assert len(str(caught.value)) < 120
+
+
+def test_huge_integers_are_described_by_size() -> None:
+    with pytest.raises(ArgumentError, match=r"not <13288-bit integer>"):
+        check_int("n", 10**4000, 0, 9)
+    with pytest.raises(ArgumentError, match=r"not -<"):
+        check_int("n", -(10**5000), 0, 9)
+
+
+def test_argument_error_pickles() -> None:
+    with pytest.raises(ArgumentError) as caught:
+        check_int("n", 1.5, 0, 9)
+    copy = pickle.loads(pickle.dumps(caught.value))
+    assert (type(copy), copy.name, copy.value, str(copy)) == (ArgumentError, "n", 1.5, str(caught.value))

@@ -207,3 +207,10 @@ def test_as_dict_keys() -> None:
     d = decode("10011", "0011").as_dict()
     assert {"interface", "mfp_mode", "id_code", "length_code", "data_bits", "function"} <= set(d)
     assert d["interface"] == "RB" and d["id_code"] == "03" and d["data_bits"] == 4
+
+
+@pytest.mark.parametrize("value", ["1" * 5000, 10**5000], ids=["long-string", "huge-int"])
+def test_huge_strap_values_are_quoted_short(value: str | int) -> None:
+    with pytest.raises(ConfigurationError) as caught:
+        decode(value)
+    assert len(str(caught.value)) < 160

@@ -1,7 +1,7 @@
 """The RTL chip top (supi3.rtl.chip) against the whole-chip model (supi3.model.top), every pin every clock.
 
 One Verilator build serves every scenario (the straps are ports). Stimulus is made by running the scenario on the
-model itself: the INTERBUS master's line levels on do1 and a software µP (supi3.spi.waves.SoftMaster, Table 3-7
+model itself: the INTERBUS master's line levels on do1 and a software µP (supi3.spi.master.SoftMaster, Table 3-7
 timing) on MFP[7..0], which reads the chip's answers off the model. The recorded pins are then replayed through
 the batch lockstep, which is exact up to the first mismatch.
 """
@@ -27,9 +27,9 @@ from supi3.regmap import encode_command
 from supi3.rtl.chip import Supi3Chip as Supi3ChipRtl
 from supi3.rtl.chip import verilog
 from supi3.rtl.harness import ChipStrapPins, strap_stimulus
+from supi3.spi.master import SoftMaster
 from supi3.spi.slave_pins import PinsIn, PinsOut
 from supi3.spi.upif import Mode
-from supi3.spi.waves import SoftMaster
 from supi3.tables import CLOCK_HZ
 from supi3.verif import Lockstep
 from supi3.verif.pinmodel import OE_SUFFIX

@@ -248,8 +248,16 @@ def _chunks(n: int, size: int = 1 << 20) -> Iterator[slice]:
         yield slice(start, min(n, start + size))
 
 
-def long_lockstep(bench: Lockstep, config: DeviceConfig, inputs: Columns, directory: Path) -> None:
-    """Replay ``inputs`` through the batch executable and compare with ``Supi3Pins(config).run``."""
+def pulses(trace: npt.NDArray[np.int64]) -> list[tuple[int, int]]:
+    """(first cycle, length) of every run of 0 in an active-low pin's trace."""
+    low = np.concatenate([[0], (trace == 0).astype(np.int8), [0]])
+    edges = np.flatnonzero(np.diff(low))
+    return [(int(a), int(b - a)) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+
+
+def long_lockstep(bench: Lockstep, config: DeviceConfig, inputs: Columns, directory: Path) -> Columns:
+    """Replay ``inputs`` through the batch executable and compare with ``Supi3Pins(config).run``; return the
+    (matching) model outputs."""
     n = len(inputs["do1"])
     layout = bench.layout
     source, sink = directory / "inputs.bin", directory / "outputs.bin"
@@ -270,6 +278,7 @@ def long_lockstep(bench: Lockstep, config: DeviceConfig, inputs: Columns, direct
             pytest.fail(
                 f"cycle {part.start + cycle}: {name} expected {model[cycle, signal]}, RTL {actual[cycle, signal]}"
             )
+    return expected
 
 
 def test_staterr_filter_and_quit(bench: Lockstep, tmp_path: Path) -> None:
@@ -295,4 +304,15 @@ def test_watchdog_expiry(bench: Lockstep, tmp_path: Path) -> None:
     script = Script(config, np.random.default_rng(8)).bring_up().id_cycle(wire.command_word(0)).data_cycle()
     telegrams = (WATCHDOG_CLOCKS[0] or 0) // (wire.STATUS_TELEGRAM_BITS * wire.clocks_per_bit(config.bit_rate))
     script.line(wire.status_levels(Cycle.DATA, False, telegrams + 100)).id_cycle(wire.command_word())
-    long_lockstep(bench, config, script.columns(), tmp_path)
+    expected = long_lockstep(bench, config, script.columns(), tmp_path)
+    assert [length for _, length in pulses(expected["res_reg_n"])] == [12]  # 375 ns (Table 3-13), RTL alike
+
+
+def test_mod_ack_pulse_width(bench: Lockstep, tmp_path: Path) -> None:
+    # Quit Peripheral Error twice: /ModAck pulses 12 clocks each time (M3: the 375 ns of Table 3-13), RTL alike.
+    config = fast_config("10000")
+    script = Script(config, np.random.default_rng(12)).bring_up()
+    script.id_cycle(wire.command_word(quit_peripheral_error=True)).data_cycle()
+    script.id_cycle(wire.command_word(quit_peripheral_error=True))
+    expected = long_lockstep(bench, config, script.columns(), tmp_path)
+    assert [length for _, length in pulses(expected["mod_ack_n"])] == [12, 12]

@@ -1,4 +1,4 @@
-"""The RTL serial µP interface under cocotb + Verilator, driven by cocotbext-spi's SpiMaster (sim/upif_spi_bfm.py)."""
+"""The RTL serial µP interface under cocotb + Verilator, driven by cocotbext-spi's SpiMaster (sim/rtl_upif.py)."""
 
 from __future__ import annotations
 
@@ -27,7 +27,7 @@ def test_spi_master_bfm(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None
     runner.build(sources=[source], hdl_toplevel=TOP, build_dir=tmp_path, build_args=["-Wno-fatal"],
                  timescale=("1ns", "1ps"), log_file=tmp_path / "build.log")
     monkeypatch.syspath_prepend(str(SIM_DIR))
-    results = runner.test(test_module="upif_spi_bfm", hdl_toplevel=TOP, hdl_toplevel_lang="verilog",
+    results = runner.test(test_module="rtl_upif", hdl_toplevel=TOP, hdl_toplevel_lang="verilog",
                           build_dir=tmp_path, test_dir=tmp_path, results_xml=str(tmp_path / "results.xml"),
                           log_file=tmp_path / "sim.log")
     tests, failed = get_results(Path(results))

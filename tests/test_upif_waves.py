@@ -1,5 +1,6 @@
-"""Timing diagrams from model traces: the checked-in figures are current, each figure's trace carries the manual's
-bytes, the software µP is within Table 3-7 (and minimal where the model can tell), VCD output."""
+"""Timing diagrams from model traces: the checked-in figures are current (regenerated through ``supi3 figures``), each
+figure's trace carries the manual's bytes, the software µP is within Table 3-7 (and minimal where the model can
+tell), VCD output."""
 
 from __future__ import annotations
 
@@ -10,12 +11,14 @@ from pathlib import Path
 import pytest
 from vcd.reader import TokenKind, tokenize
 
+from supi3.cli import main
 from supi3.config import decode
 from supi3.model.registers import RegisterFile
 from supi3.regmap import encode_command
+from supi3.spi.figures import FIGURES, Figure
+from supi3.spi.master import MasterTiming, SoftMaster, decode_bytes, write_vcd
 from supi3.spi.slave_pins import SlavePins, TimingViolationError
 from supi3.spi.upif import C_D_COMMAND, C_D_DATA, Mode, UpifUsageError
-from supi3.spi.waves import FIGURES, Figure, MasterTiming, SoftMaster, decode_bytes, write_figures, write_vcd
 
 FIGURE_DIR = Path(__file__).resolve().parents[1] / "docs" / "figures"
 RATES = {500_000: "01", 2_000_000: "11"}  # CLK_CONF[1..0] (Table 1-7)
@@ -35,7 +38,7 @@ EXPECTED = {
 @pytest.fixture(scope="module")
 def generated(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("figures")
-    write_figures(out, vcd=True)
+    assert main(["figures", "-o", str(out), "--vcd"]) == 0
     return out
 
 
@@ -45,7 +48,7 @@ def test_every_manual_figure_is_redrawn() -> None:
 
 @pytest.mark.parametrize("name", list(EXPECTED))
 def test_checked_in_figures_are_current(generated: Path, name: str) -> None:
-    """Regenerate with ``python -m supi3.spi.waves --out docs/figures`` if this fails."""
+    """Regenerate with ``supi3 figures`` (in the source tree's root) if this fails."""
     checked_in = json.loads((FIGURE_DIR / f"{name}.json").read_text(encoding="utf-8"))
     assert json.loads((generated / f"{name}.json").read_text(encoding="utf-8")) == checked_in
     svg = (FIGURE_DIR / f"{name}.svg").read_text(encoding="utf-8")

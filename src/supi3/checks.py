@@ -12,6 +12,7 @@ from collections.abc import Collection
 from typing import TypeVar
 
 import numpy as np
+import numpy.typing as npt
 
 from supi3.errors import ArgumentError
 
@@ -23,7 +24,11 @@ _SHOWN = 60
 
 def describe(value: object) -> str:
     """The value as an error message quotes it: its ``repr`` (cut to 60 characters) and, unless obvious, its type."""
-    text = repr(value)
+    if isinstance(value, int) and value.bit_length() > 4 * _SHOWN:
+        # repr() of an integer past 4,300 digits raises; the size is what matters in a message anyway.
+        text = f"{'-' if value < 0 else ''}<{value.bit_length()}-bit integer>"
+    else:
+        text = repr(value)
     if len(text) > _SHOWN:
         text = text[: _SHOWN - 3] + "..."
     if isinstance(value, (bool, int, float, str, bytes)) and type(value) in (bool, int, float, str, bytes):
@@ -115,3 +120,31 @@ def check_bool(name: str, value: object) -> bool:
     if isinstance(value, bool | np.bool_):
         return bool(value)
     raise fail(name, "True or False", value)
+
+
+def check_trace(name: str, value: object, width: int) -> npt.NDArray[np.integer]:
+    """``value`` (a sequence or array) as a 1-D integer array of ``width``-bit values, checked in one pass.
+
+    Integer dtypes only (no bool, float, str or object arrays: a level is never cast); the range is checked with a
+    single ``max`` over the data seen as unsigned, so negative values fail too. An empty sequence passes.
+    """
+    mask = (1 << width) - 1
+    wanted = f"a 1-D sequence of integers from 0 to {mask} ({width} bit{'s' if width != 1 else ''})"
+    if isinstance(value, (str, bytes, bytearray)) or not hasattr(value, "__len__"):
+        raise fail(name, wanted, value)
+    try:
+        array = np.asarray(value)
+    except (TypeError, ValueError) as error:
+        raise fail(name, wanted, value) from error
+    if array.ndim != 1:
+        raise fail(name, wanted, value)
+    if not array.size:
+        return np.zeros(0, dtype=np.int64)
+    if array.dtype.kind not in "iu":
+        raise fail(name, wanted, value)
+    unsigned = array.view(np.dtype(f"u{array.dtype.itemsize}")) if array.dtype.kind == "i" else array
+    if int(unsigned.max()) > mask:
+        index = int(np.argmax(unsigned > mask))
+        raise fail(f"{name}[{index}]", f"an integer from 0 to {mask} ({width} bit{'s' if width != 1 else ''})",
+                   array[index].item())
+    return array

@@ -1,24 +1,242 @@
-"""The ``supi3`` command line: operating modes, pin-strap decoding, register map, timing, and the demo.
+"""The ``supi3`` command line: operating modes, pin-strap decoding, register map, timing, the demo, and figures.
 
-Every subcommand whose output is data takes ``--json``. Errors print one line and exit with status 2.
+Every subcommand whose output is data takes ``--json``.
+
+Exit status and what goes to stderr, for every subcommand. :func:`main` does it all, so a new subcommand gets it
+by raising a :class:`~supi3.errors.Supi3Error` for bad input, taking integer options with ``type=integer`` (and
+their limits with :func:`~supi3.checks.check_int`), and checking its output paths with :func:`output_file` or
+:func:`output_dir` before it starts working. ``SystemExit(n)`` from a subcommand becomes its status ``n``.
+
+- 0: done.
+- 2: bad input, one line on stderr and never a traceback: a usage error (unknown option or choice, a value that is
+  not a plain decimal integer, an abbreviated option), a value the manual rules out (any ``Supi3Error``), an output
+  path that cannot be written (empty, a directory, a missing folder, a name too long; checked before any work), a
+  write that fails (``-o /dev/full``, ``> /dev/full``), ``regmap --format html`` or ``figures`` without the ``docs``
+  extra.
+- 141 (128 + SIGPIPE): the reader closed the pipe early (``supi3 demo | head``). Nothing on stderr, like a Unix
+  tool killed by SIGPIPE; under ``set -o pipefail`` the pipeline fails, as it does for ``seq``.
+- 130: interrupted (Ctrl-C), nothing on stderr.
+- 1 with a traceback: a genuine bug (any other exception). It is kept so that it can be reported.
+
+Options are spelt out in full (an abbreviation is an error, so a new option can never change what an old command
+line means); a repeated option takes its last value. Output folders are not created. A character stdout cannot
+encode gets a stand-in (``µ`` becomes ``u`` on an ASCII terminal); JSON stays lossless with ``\\u`` escapes.
 """
 
 from __future__ import annotations
 
 import argparse
+import codecs
+import contextlib
 import json
+import os
+import re
 import sys
+import unicodedata
 from collections.abc import Sequence
 from pathlib import Path
-from typing import NoReturn
+from typing import Any, NoReturn, TextIO
 
 from supi3 import tables, timing
+from supi3.checks import check_int
+from supi3.checks import describe as _shown
 from supi3.config import DeviceConfig, Interface, Variant, decode, mode_rows
 from supi3.errors import Supi3Error
 
+MAX_NETWORK_BYTES = timing.MAX_NETWORK_BYTES
+"""``timing --bytes`` limit: 512 devices (the INTERBUS limit) of the longest data length, 32 words (Table 3-11)."""
 
-def _print_json(data: object) -> None:
-    print(json.dumps(data, indent=2, ensure_ascii=False))
+MAX_OPTICAL_COUNT = timing.MAX_OPTICAL_COUNT
+"""``timing --optical-count`` limit: the length timer's value range, 0 to 63 (Table 1-5)."""
+
+MAX_DEMO_CYCLES = 1000
+"""``demo --cycles`` limit: a demo, not a soak test."""
+
+MAX_VCD_CYCLES = 50
+"""``demo --cycles`` limit with ``--vcd``: the pin-level run keeps every pin of every 32 MHz clock until it writes
+the VCD, about 10 MB of memory a data cycle at 500 kbit/s (1000 cycles took 9 GB)."""
+
+BROKEN_PIPE_STATUS = 128 + 13
+"""Exit status when the reader closes the pipe early, as a shell reports a tool killed by SIGPIPE."""
+
+INTERRUPTED_STATUS = 128 + 2
+"""Exit status after Ctrl-C (SIGINT)."""
+
+
+class CommandLineError(Supi3Error, ValueError):
+    """Bad input the command line finds itself: an output path that cannot be written, a failed write."""
+
+
+class UsageError(CommandLineError):
+    """A command line argparse cannot parse; the message is the whole error line, program name included."""
+
+
+class StdoutError(CommandLineError):
+    """Standard output cannot be written (a full disk, a device error); a closed pipe is not one of these."""
+
+
+# ------------------------------------------------------------------------------------------------------------
+# Output: stand-ins for characters stdout cannot encode, JSON, output paths
+# ------------------------------------------------------------------------------------------------------------
+
+_STAND_INS = {"µ": "u", "μ": "u", "Ω": "Ohm", "°": "deg", "±": "+/-", "×": "x", "–": "-", "—": "-", "…": "...",
+              "‘": "'", "’": "'", "“": '"', "”": '"', "→": "->", "≤": "<=", "≥": ">=", "\u00a0": " "}
+_STAND_IN_ERRORS = "supi3.stand-in"
+
+
+def _stand_in(exc: UnicodeError) -> tuple[str, int]:
+    """Codec error handler: an ASCII stand-in for each character the stream cannot encode (``?`` if none)."""
+    if not isinstance(exc, UnicodeEncodeError):
+        raise exc
+    out = []
+    for char in exc.object[exc.start:exc.end]:
+        stand_in = _STAND_INS.get(char)
+        if stand_in is None:
+            stand_in = unicodedata.normalize("NFKD", char).encode("ascii", "ignore").decode("ascii") or "?"
+        out.append(stand_in)
+    return "".join(out), exc.end
+
+
+codecs.register_error(_STAND_IN_ERRORS, _stand_in)
+
+
+class _Stdout:
+    """What ``sys.stdout`` is while :func:`main` runs: the real stream, with stand-ins for characters it cannot
+    encode and a :class:`StdoutError` for a failed write (a closed pipe stays a ``BrokenPipeError``)."""
+
+    def __init__(self, stream: TextIO) -> None:
+        self.stream = stream
+        self.broken = False
+        """Set by a closed pipe, even if the caller swallows the error (argparse's ``--help`` does)."""
+
+    def write(self, text: str) -> int:
+        try:
+            try:
+                return self.stream.write(text)
+            except UnicodeEncodeError:
+                encoding = self.stream.encoding or "utf-8"
+                return self.stream.write(text.encode(encoding, _STAND_IN_ERRORS).decode(encoding))
+        except BrokenPipeError:
+            self.broken = True
+            raise
+        except OSError as exc:
+            raise StdoutError(f"cannot write to standard output: {exc.strerror or exc}") from exc
+
+    def flush(self) -> None:
+        try:
+            self.stream.flush()
+        except BrokenPipeError:
+            self.broken = True
+            raise
+        except OSError as exc:
+            raise StdoutError(f"cannot write to standard output: {exc.strerror or exc}") from exc
+
+    def __getattr__(self, name: str) -> object:
+        return getattr(self.stream, name)
+
+
+def _fits_stdout(text: str) -> bool:
+    encoding = getattr(sys.stdout, "encoding", None) or "utf-8"
+    try:
+        text.encode(encoding)
+    except (UnicodeEncodeError, LookupError):
+        return False
+    return True
+
+
+def _json_escape(char: str) -> str:
+    if ord(char) < 0x80:
+        return char
+    units = char.encode("utf-16-be", "surrogatepass")
+    return "".join(f"\\u{int.from_bytes(units[i:i + 2], 'big'):04x}" for i in range(0, len(units), 2))
+
+
+def json_for_stdout(text: str) -> str:
+    """JSON text as stdout can take it: unchanged, or with every non-ASCII character as a ``\\u`` escape
+    (outside strings JSON is ASCII, so this is ``ensure_ascii`` applied afterwards, and lossless)."""
+    return text if _fits_stdout(text) else "".join(map(_json_escape, text))
+
+
+def print_json(data: object) -> None:
+    """Print ``data`` as indented JSON, escaped if stdout cannot encode it (:func:`json_for_stdout`)."""
+    print(json_for_stdout(json.dumps(data, indent=2, ensure_ascii=False)))
+
+
+def _cannot(option: str, text: str, reason: str) -> CommandLineError:
+    return CommandLineError(f"cannot write {_shown(text)} ({option}): {reason}")
+
+
+def _check_folder(option: str, text: str, path: Path) -> None:
+    folder = path.parent
+    if not folder.exists():
+        raise _cannot(option, text, f"folder {_shown(str(folder))} does not exist")
+    if not folder.is_dir():
+        raise _cannot(option, text, f"{_shown(str(folder))} is not a directory")
+
+
+def output_file(option: str, text: str) -> Path:
+    """The file path given to ``option``, checked before any work is done.
+
+    It must be non-empty, not a directory, in an existing folder (folders are not created) and creatable there
+    (a probe file is made and removed at once); an existing file must be writable. A device such as ``/dev/full``
+    passes: its failure shows when it is written, through :func:`write_output`.
+
+    Raises
+    ------
+    CommandLineError
+        Saying which path, for which option, and why.
+    """
+    if not text:
+        raise CommandLineError(f"{option} must be a file path, not ''")
+    if text.endswith(("/", os.sep)):  # Path() would drop the slash and write a file where a folder was meant
+        raise _cannot(option, text, "ends with a slash: give a file path")
+    path = Path(text)
+    try:
+        if path.is_dir():
+            raise _cannot(option, text, "is a directory")
+        _check_folder(option, text, path)
+        if path.exists():
+            if not os.access(path, os.W_OK):
+                raise _cannot(option, text, "permission denied")
+        else:
+            try:
+                os.close(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+            except FileExistsError:  # a dangling symbolic link, or made meanwhile: writing will tell
+                pass
+            else:
+                path.unlink()
+    except OSError as exc:
+        raise _cannot(option, text, exc.strerror or str(exc)) from None
+    return path
+
+
+def output_dir(option: str, text: str) -> Path:
+    """The directory path given to ``option``, checked before any work: an existing writable directory, or a new
+    one that can be made in an existing folder (a probe directory is made and removed at once)."""
+    if not text:
+        raise CommandLineError(f"{option} must be a directory path, not ''")
+    path = Path(text)
+    try:
+        if path.exists():
+            if not path.is_dir():
+                raise _cannot(option, text, "exists and is not a directory")
+            if not os.access(path, os.W_OK | os.X_OK):
+                raise _cannot(option, text, "permission denied")
+        else:
+            _check_folder(option, text, path)
+            path.mkdir()
+            path.rmdir()
+    except OSError as exc:
+        raise _cannot(option, text, exc.strerror or str(exc)) from None
+    return path
+
+
+def write_output(option: str, path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` (UTF-8); a failed write is a :class:`CommandLineError`."""
+    try:
+        path.write_text(text, encoding="utf-8")
+    except OSError as exc:
+        raise _cannot(option, str(path), exc.strerror or str(exc)) from None
 
 
 def _format_rows(header: Sequence[str], rows: Sequence[Sequence[object]]) -> str:
@@ -37,9 +255,9 @@ def cmd_modes(args: argparse.Namespace) -> None:
     """Print the operating-mode tables (2-4 to 2-7)."""
     rows = list(mode_rows(args.variant, args.interface))
     if args.json:
-        _print_json([{"table": f"Table {r.table}", "c": r.c, "mfp": r.mfp, "length_code": r.length_code,
-                      "data_length": _length_text(r.length_code), "id_code": f"{r.id_code:02X}",
-                      "function": r.function} for r in rows])
+        print_json([{"table": f"Table {r.table}", "c": r.c, "mfp": r.mfp, "length_code": r.length_code,
+                     "data_length": _length_text(r.length_code), "id_code": f"{r.id_code:02X}",
+                     "function": r.function} for r in rows])
         return
     print(_format_rows(
         ("Table", "C[4..0]", "MFP[15..12]", "ID12..8", "Data length", "ID", "Function"),
@@ -64,7 +282,7 @@ def cmd_decode(args: argparse.Namespace) -> None:
         data = config.as_dict()
         data["mfp_pins"] = [{"pin": p.pin, "signal": p.signal, "direction": p.direction.value}
                             for p in config.mfp_pins]
-        _print_json(data)
+        print_json(data)
     else:
         print(describe(config))
 
@@ -73,18 +291,35 @@ def cmd_regmap(args: argparse.Namespace) -> None:
     """Render the register map."""
     from supi3.regmap import render
 
-    out = Path(args.output) if args.output else None
-    text = render(args.format, out)
+    option = "-o/--output"
+    if args.format == "html":
+        folder = None if args.output is None else output_dir(option, args.output)
+        try:
+            render("html", folder)
+        except ModuleNotFoundError as exc:  # a plain install: the exporters are the docs extra
+            raise CommandLineError(f"--format html needs the docs extra, pip install 'supi3[docs]' ({exc})") from None
+        except OSError as exc:
+            raise _cannot(option, str(folder), exc.strerror or str(exc)) from None
+        print(f"wrote {folder}")
+        return
+    out = None if args.output is None else output_file(option, args.output)
+    text = render(args.format)
     if out is None:
-        sys.stdout.write(text)
+        sys.stdout.write(json_for_stdout(text) if args.format == "json" else text)
     else:
+        write_output(option, out, text)
         print(f"wrote {out}")
 
 
 def cmd_timing(args: argparse.Namespace) -> None:
     """Data cycle time, CPU access time, I/O access window, optical length; optionally a timing table."""
     bit_rate = _parse_bit_rate(args.bit_rate)
-    data = timing.report(args.bytes, bit_rate, args.devices)
+    n_bytes = check_int("--bytes", args.bytes, 0, MAX_NETWORK_BYTES,
+                        f"{timing.MAX_DEVICES} devices of at most 32 words")
+    devices = check_int("--devices", args.devices, 1, timing.MAX_DEVICES, "the INTERBUS limit")
+    if args.optical_count is not None:
+        check_int("--optical-count", args.optical_count, 0, MAX_OPTICAL_COUNT, "Table 1-5")
+    data = timing.report(n_bytes, bit_rate, devices)
     if args.optical_count is not None:
         length = timing.optical_length_m(args.optical_count, bit_rate)
         data["optical_count"] = args.optical_count
@@ -94,10 +329,10 @@ def cmd_timing(args: argparse.Namespace) -> None:
             {"symbol": r.symbol, "explanation": r.explanation,
              "min_ns": None if r.minimum_s is None else round(r.minimum_s * 1e9, 3),
              "max_ns": None if r.maximum_s is None else round(r.maximum_s * 1e9, 3)}
-            for r in timing.timing_table(args.table, bit_rate, args.bytes)
+            for r in timing.timing_table(args.table, bit_rate, n_bytes)
         ]
     if args.json:
-        _print_json(data)
+        print_json(data)
         return
     for key, value in data.items():
         if key != "table":
@@ -116,7 +351,7 @@ def _parse_bit_rate(text: str) -> int:
     try:
         return aliases[text.lower()]
     except KeyError:
-        raise timing.TimingError(f"bit rate {text!r}: choose 500k or 2M (Table 1-7)") from None
+        raise timing.TimingError(f"--bit-rate must be 500k or 2M (Table 1-7), not {_shown(text)}") from None
 
 
 def regmap_summary() -> str:
@@ -139,9 +374,11 @@ def cmd_demo(args: argparse.Namespace) -> None:
     from supi3 import demo
 
     clk_conf = {500_000: "01", 2_000_000: "11"}[_parse_bit_rate(args.bit_rate)]
-    if args.cycles < 1:
-        raise timing.TimingError(f"--cycles must be at least 1, not {args.cycles}")
-    for line in demo.run(args.cycles, Path(args.vcd) if args.vcd else None, clk_conf):
+    cycles = check_int("--cycles", args.cycles, 1, MAX_DEMO_CYCLES, "a demo")
+    if args.vcd is not None:
+        check_int("--cycles", cycles, 1, MAX_VCD_CYCLES, "with --vcd: the pin-level run keeps every clock")
+    vcd = None if args.vcd is None else output_file("--vcd", args.vcd)  # before the run, not after it
+    for line in demo.run(cycles, vcd, clk_conf):
         print(line)
     print("\nRegister map of the serial µP interface (Table 3-10; `supi3 regmap` for all formats):\n")
     print(regmap_summary())
@@ -157,20 +394,70 @@ def cmd_campaign(args: argparse.Namespace) -> None:
         raise SystemExit(1)
 
 
+FIGURES_DIR = "docs/figures"
+"""``figures -o`` default: where the source tree keeps the redrawn figures (``docs/figures.md``)."""
+
+
+def cmd_figures(args: argparse.Namespace) -> None:
+    """Redraw the manual's serial µP interface figures from model traces (WaveJSON, SVG, optionally VCD)."""
+    from supi3.spi.figures import write_figures
+
+    option = "-o/--output"
+    folder = output_dir(option, args.output)
+    try:
+        written = write_figures(folder, vcd=args.vcd)
+    except ModuleNotFoundError as exc:  # a plain install: wavedrom is the docs extra; checked before any write
+        if exc.name != "wavedrom":
+            raise
+        raise CommandLineError("figures needs the docs extra, pip install 'supi3[docs]' "
+                               "(the wavedrom package renders the SVG)") from None
+    except OSError as exc:
+        raise _cannot(option, str(folder), exc.strerror or str(exc)) from None
+    for path in written:
+        print(f"wrote {path}")
+
+
+_INTEGER = re.compile(r"[+-]?[0-9]+", re.ASCII)
+_MAX_DIGITS = 4000
+"""Longer integers are refused unread: far beyond every limit, and ``int()`` refuses 4300 digits anyway."""
+
+
+def integer(text: str) -> int:
+    """An argparse type: a plain decimal integer (ASCII digits, an optional sign; no spaces, ``_``, ``1e3``)."""
+    if not _INTEGER.fullmatch(text):
+        raise argparse.ArgumentTypeError(f"must be an integer in decimal digits, not {_shown(text)}")
+    if len(text) > _MAX_DIGITS:
+        raise argparse.ArgumentTypeError(f"must be an integer of at most {_MAX_DIGITS} digits, not {_shown(text)}")
+    return int(text)
+
+
 class _Parser(argparse.ArgumentParser):
-    """An argument parser whose usage errors are one line, like every other supi3 error."""
+    """An argument parser whose usage errors are one :class:`UsageError` line, like every other supi3 error, and
+    which takes options only spelt out in full."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs.setdefault("allow_abbrev", False)
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str) -> NoReturn:
-        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+        raise UsageError(f"{self.prog}: error: {message} (see {self.prog} --help)")
+
+
+_DESCRIPTION = ("The IBS SUPI 3 OPC INTERBUS slave chip: operating modes, pin-strap decoding, register map, "
+                "timing, a demo, and the manual's serial-interface figures redrawn.")
+_EPILOG = """exit status: 0 done; 2 bad input (one line on stderr); 141 output pipe closed early (quiet);
+130 interrupted; 1 an internal error (a traceback: please report it)"""
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``supi3`` command."""
-    parser = _Parser(prog="supi3", description=__doc__)
+    parser = _Parser(prog="supi3", description=_DESCRIPTION, epilog=_EPILOG,
+                     formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("demo", help="a master and a small ring, live (built-in defaults)")
-    p.add_argument("--cycles", type=int, default=4, help="data cycles to run (default 4)")
+    p.add_argument("--cycles", type=integer, default=4, metavar="N",
+                   help=f"data cycles to run, 1 to {MAX_DEMO_CYCLES}, to {MAX_VCD_CYCLES} with --vcd (default 4)")
     p.add_argument("--vcd", metavar="PATH", help="also run the SUPI 3 chips at pin level and write a VCD")
     p.add_argument("--bit-rate", default="500k", help="500k or 2M")
     p.set_defaults(func=cmd_demo)
@@ -198,9 +485,12 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("timing", help="CPU access time, I/O access window, cycle time, optical length")
     p.add_argument("--bit-rate", default="500k", help="500k or 2M")
-    p.add_argument("--bytes", type=int, default=4, help="data bytes in the whole network (default 4)")
-    p.add_argument("--devices", type=int, default=1, help="devices in the ring (default 1)")
-    p.add_argument("--optical-count", type=int, metavar="N", help="length timer result n (1.6.1)")
+    p.add_argument("--bytes", type=integer, default=4, metavar="N",
+                   help=f"data bytes in the whole network, 0 to {MAX_NETWORK_BYTES} (default 4)")
+    p.add_argument("--devices", type=integer, default=1, metavar="N",
+                   help=f"devices in the ring, 1 to {timing.MAX_DEVICES} (default 1)")
+    p.add_argument("--optical-count", type=integer, metavar="N",
+                   help=f"length timer result n, 0 to {MAX_OPTICAL_COUNT} (1.6.1, Table 1-5)")
     p.add_argument("--table", choices=sorted(timing.TIMING_TABLES), help="also evaluate a timing table")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_timing)
@@ -210,18 +500,85 @@ def build_parser() -> argparse.ArgumentParser:
 
     add_arguments(p)
     p.set_defaults(func=cmd_campaign)
+
+    p = sub.add_parser("figures", help="redraw the manual's serial µP interface figures (needs the docs extra)")
+    p.add_argument("-o", "--output", metavar="DIR", default=FIGURES_DIR,
+                   help=f"folder to write WaveJSON and SVG into (default {FIGURES_DIR})")
+    p.add_argument("--vcd", action="store_true", help="also write a VCD per figure")
+    p.set_defaults(func=cmd_figures)
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``supi3`` command."""
-    args = build_parser().parse_args(argv)
+    """Entry point of the ``supi3`` command: run it and return the exit status (see the module docstring).
+
+    Bad input (a usage error or any :class:`~supi3.errors.Supi3Error`) is one line on stderr and status 2; a
+    closed output pipe is status 141, quietly; Ctrl-C is 130; any other exception is a bug and propagates with its
+    traceback. While it runs, ``sys.stdout`` gives stand-ins for characters it cannot encode.
+    """
+    stream = sys.stdout
+    if stream is not None:
+        sys.stdout = _Stdout(stream)
     try:
-        args.func(args)
+        return _run(argv)
+    finally:
+        sys.stdout = stream
+
+
+def _run(argv: Sequence[str] | None) -> int:
+    try:
+        try:
+            args = build_parser().parse_args(argv)
+            args.func(args)
+        finally:
+            if sys.stdout is not None:
+                sys.stdout.flush()  # a closed pipe or a full disk shows here, not at interpreter exit
+    except SystemExit as exc:  # --help, or argparse's own exit
+        if _pipe_closed():
+            return BROKEN_PIPE_STATUS
+        return exc.code if isinstance(exc.code, int) else 0 if exc.code is None else 1
+    except BrokenPipeError:
+        _silence_stdout()
+        return BROKEN_PIPE_STATUS
+    except KeyboardInterrupt:
+        return INTERRUPTED_STATUS
     except Supi3Error as exc:
-        print(f"supi3: error: {exc}", file=sys.stderr)
+        if isinstance(exc, StdoutError):
+            _silence_stdout()
+        _error_line(str(exc) if isinstance(exc, UsageError) else f"supi3: error: {exc}")
         return 2
-    return 0
+    return BROKEN_PIPE_STATUS if _pipe_closed() else 0
+
+
+def _pipe_closed() -> bool:
+    """Whether a write to stdout met a closed pipe (then stdout is silenced)."""
+    if isinstance(sys.stdout, _Stdout) and sys.stdout.broken:
+        _silence_stdout()
+        return True
+    return False
+
+
+def _one_line(text: str) -> str:
+    """``text`` with every non-printable character (a newline in a value, a surrogate) as an escape."""
+    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in text)
+
+
+def _error_line(text: str) -> None:
+    with contextlib.suppress(OSError, ValueError):  # stderr closed too: the status has to do
+        print(_one_line(text), file=sys.stderr, flush=True)
+
+
+def _silence_stdout() -> None:
+    """Point file descriptor 1 at the null device, so that what is still buffered for a closed pipe or a full disk
+    is dropped at exit instead of raising there (the recipe of Python's ``signal`` documentation)."""
+    stream = sys.stdout.stream if isinstance(sys.stdout, _Stdout) else sys.stdout
+    try:
+        fd = stream.fileno()
+        devnull = os.open(os.devnull, os.O_WRONLY)
+    except (OSError, ValueError, AttributeError):  # not a real file (captured, in-process): nothing to do
+        return
+    os.dup2(devnull, fd)
+    os.close(devnull)
 
 
 if __name__ == "__main__":

@@ -18,6 +18,7 @@ from enum import StrEnum
 from functools import cache
 
 from supi3 import tables
+from supi3.checks import describe
 from supi3.errors import ConfigurationError
 from supi3.tables import Direction, PinFunction
 
@@ -264,14 +265,14 @@ def _bits(name: str, value: str | int | None, width: int) -> str | None:
     if value is None:
         return None
     if isinstance(value, bool) or not isinstance(value, int | str):
-        raise ConfigurationError(name, repr(value), "input format", f"expected {width} bits as a string or int")
+        raise ConfigurationError(name, describe(value), "input format", f"expected {width} bits as a string or int")
     if isinstance(value, int):
         if not 0 <= value < (1 << width):
-            raise ConfigurationError(name, str(value), "input format", f"does not fit in {width} bits")
+            raise ConfigurationError(name, describe(value), "input format", f"does not fit in {width} bits")
         return format(value, f"0{width}b")
     text = value.strip().removeprefix("0b")
     if len(text) != width or set(text) - {"0", "1"}:
-        raise ConfigurationError(name, repr(value), "input format", f"expected exactly {width} binary digits")
+        raise ConfigurationError(name, describe(value), "input format", f"expected exactly {width} binary digits")
     return text
 
 

@@ -12,7 +12,9 @@ from collections.abc import Callable, Iterator, Sequence
 from functools import partial
 from pathlib import Path
 
+from supi3.checks import check_int
 from supi3.config import DeviceConfig, decode
+from supi3.errors import Supi3Error
 from supi3.interbus.device import PlainDevice
 from supi3.interbus.master import Master
 from supi3.interbus.ring import Bus, Ring
@@ -26,6 +28,10 @@ SUPI3_STRAPS: tuple[tuple[str, str | None], ...] = (("10000", None), ("11011", "
 
 PLAIN_DEVICES: tuple[tuple[int, int], ...] = ((0x32, 0b00001), (0x02, 0b01001))
 """A remote bus analog input module (ID 32h, 1 word) and a digital input module (ID 02h, 1 byte), Table A-3."""
+
+
+class DemoError(Supi3Error):
+    """The demo could not finish: its VCD file could not be written."""
 
 
 def _configs(clk_conf: str) -> list[DeviceConfig]:
@@ -66,7 +72,16 @@ def _drive(master: Master, chips: list[Supi3], cycles: int, set_mfp: Sequence[Ca
 
 
 def run(cycles: int = 4, vcd: Path | None = None, clk_conf: str = "01") -> Iterator[str]:
-    """The demo, as lines of text."""
+    """The demo, as lines of text.
+
+    Raises
+    ------
+    ArgumentError
+        If ``cycles`` is not an integer >= 1.
+    DemoError
+        If the VCD file cannot be written (the command line checks the path before the run).
+    """
+    check_int("cycles", cycles, 1)
     configs = _configs(clk_conf)
     chips = [Supi3(c) for c in configs]
     devices: list[Supi3 | PlainDevice] = [*chips, *(PlainDevice(id_code, length) for id_code, length in PLAIN_DEVICES)]
@@ -94,7 +109,10 @@ def _pin_level(configs: list[DeviceConfig], cycles: int, vcd: Path) -> Iterator[
     setters = [partial(ring.set_input, k, "mfp_in") for k in range(1, len(pins) + 1)]
     # The latch telegrams reach the chips further down the ring a few bit periods after the master sent them.
     lines = list(_drive(master, [p.chip for p in pins], cycles, setters, ring.settle))
-    write_vcd(vcd, ring)
+    try:
+        write_vcd(vcd, ring)
+    except OSError as exc:
+        raise DemoError(f"cannot write {str(vcd)!r} (--vcd): {exc.strerror or exc}") from None
     yield f"Pin level, SUPI 3 chips only, {ring.cycle} clocks of 32 MHz:"
     yield from lines
     yield f"wrote {vcd}"

@@ -46,3 +46,7 @@ class ArgumentError(Supi3Error, TypeError, ValueError):
         self.name = name
         self.value = value
         super().__init__(message)
+
+    def __reduce__(self) -> tuple[type[ArgumentError], tuple[str, object, str]]:
+        # Exception pickles as cls(*self.args), and args holds only the message.
+        return type(self), (self.name, self.value, str(self))

@@ -737,6 +737,11 @@ WATCHDOG_TIMEOUTS_S: Final[tuple[float | None, ...]] = (0.050, 0.200, 1.000, Non
 RESREG_PULSE_NS: Final[int] = 375
 """/ResReg single pulse on a watchdog reset of process data (Table 3-13)."""
 
+RESREG_PULSE_CLOCKS: Final[int] = RESREG_PULSE_NS * CLOCK_HZ // 1_000_000_000
+"""The /ResReg pulse in clocks: 375 ns at 32 MHz is exactly 12 (3.4.14, Table 3-13, INTERBUS reset: "A single pulse
+of 375 ns is generated"). The one definition of the width: the models (``supi3.model.chip``) and the RTL
+(``supi3.rtl.core``) use it."""
+
 VOLTAGE_MONITOR_HIGH_V: Final[float] = 4.5
 VOLTAGE_MONITOR_LOW_V: Final[float] = 3.9
 RESET_MIN_S: Final[float] = 4e-6

@@ -9,15 +9,44 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from supi3 import tables
+from supi3.checks import check_instance, check_int
 from supi3.errors import Supi3Error
+from supi3.interbus import wire
 
 
 class TimingError(Supi3Error, ValueError):
     """A timing question the manual cannot answer (unknown bit rate, negative byte count, ...)."""
 
 
+MAX_DEVICES = wire.MAX_DEVICES
+"""Devices in one INTERBUS ring, 512."""
+
+MAX_NETWORK_BYTES = MAX_DEVICES * max(lc.bits or 0 for lc in tables.LENGTH_CODES) // 8
+"""Data bytes in a whole network: 512 devices of the longest data length, 32 words (Table 3-11)."""
+
+MAX_OPTICAL_COUNT = max(r.values[1] for r in tables.OPTICAL_LENGTH_RANGES)
+"""Largest length timer result, 63 (Table 1-5's value range)."""
+
+_MAX_EXPRESSION = 200
+"""Longest timing expression evaluated; the manual's are a few dozen characters."""
+
+
+def _shown(number: int) -> str:
+    """An integer for an error message; a huge one by its size (``str`` refuses more than 4300 digits)."""
+    return str(number) if number.bit_length() <= 64 else f"an integer of {number.bit_length()} bits"
+
+
+def _network_bytes(value: object, name: str = "network byte count") -> int:
+    number = check_int(name, value)
+    if not 0 <= number <= MAX_NETWORK_BYTES:
+        raise TimingError(f"{name} must be >= 0 and <= {MAX_NETWORK_BYTES} ({MAX_DEVICES} devices of 32 words), "
+                          f"not {_shown(number)}")
+    return number
+
+
 def bit_period_s(bit_rate: int) -> float:
     """t_Bit_IBS: 2 µs at 500 kbit/s, 0.5 µs at 2 Mbit/s (Table 1-7 bit rates only)."""
+    check_int("bit_rate", bit_rate)
     if bit_rate not in tables.BIT_RATES:
         raise TimingError(f"bit rate {bit_rate} bit/s is not one of Table 1-7's {tables.BIT_RATES}")
     return 1.0 / bit_rate
@@ -29,8 +58,7 @@ def cpu_access_time_s(network_bytes: int, bit_rate: int) -> float:
     ``network_bytes`` is n, the number of data bytes in the entire network. The manual's example, one 2-word
     device at 500 kbit/s, gives 234 µs.
     """
-    if network_bytes < 0:
-        raise TimingError(f"network byte count must be >= 0, not {network_bytes}")
+    _network_bytes(network_bytes)
     return (tables.CPU_ACCESS_TELEGRAM_BITS * (tables.CPU_ACCESS_OVERHEAD_BYTES + network_bytes)
             * bit_period_s(bit_rate))
 
@@ -68,6 +96,9 @@ def evaluate(expression: str, bit_rate: int, n_bytes: int = 1, t0_s: float | Non
     passed in ``t0_s``), ``n`` (bytes, Table 3-4 t8), ``ns`` (1e-9). ``"a | b"`` gives ``a`` at 500 kbit/s and
     ``b`` at 2 Mbit/s.
     """
+    check_instance("expression", expression, str, "a timing expression (str)")
+    if len(expression) > _MAX_EXPRESSION:
+        raise TimingError(f"timing expression of {len(expression)} characters; at most {_MAX_EXPRESSION}")
     if "|" in expression:
         low, high = expression.split("|")
         expression = low if bit_rate == tables.BIT_RATES[0] else high
@@ -77,7 +108,10 @@ def evaluate(expression: str, bit_rate: int, n_bytes: int = 1, t0_s: float | Non
         names["t0"] = t0_s
     # "100 ns" is the manual's notation for 100 * ns.
     source = expression.strip().replace(" ns", " * ns")
-    return _eval(ast.parse(source, mode="eval"), names)
+    try:
+        return _eval(ast.parse(source, mode="eval"), names)
+    except (SyntaxError, ZeroDivisionError, RecursionError, MemoryError) as exc:
+        raise TimingError(f"cannot evaluate timing expression {expression!r}: {exc}") from None
 
 
 @dataclass(frozen=True)
@@ -101,6 +135,7 @@ def timing_table(table: str, bit_rate: int, n_bytes: int = 2) -> list[EvaluatedT
     """Evaluate every row of Table 3-4, 3-7 or 3-15 for a bit rate (``n_bytes`` for Table 3-4's t8)."""
     if table not in TIMING_TABLES:
         raise TimingError(f"no timing table {table!r}; choose from {sorted(TIMING_TABLES)}")
+    _network_bytes(n_bytes, "n_bytes")
     result: list[EvaluatedTiming] = []
     t0: float | None = None
     for row in TIMING_TABLES[table]:
@@ -139,8 +174,10 @@ def optical_length_m(timer_count: int, bit_rate: int) -> float:
 
     f is the timer clock, 16 times the bit rate (8 MHz at 500 kbit/s), t = 5 ns/m.
     """
-    if timer_count < 0:
-        raise TimingError(f"timer count must be >= 0, not {timer_count}")
+    check_int("timer_count", timer_count)
+    if not 0 <= timer_count <= MAX_OPTICAL_COUNT:
+        raise TimingError(f"timer count must be >= 0 and <= {MAX_OPTICAL_COUNT} (Table 1-5), not "
+                          f"{_shown(timer_count)}")
     bit_period_s(bit_rate)
     f = tables.LENGTH_TIMER_CLOCKS_PER_BIT * bit_rate
     return timer_count / (f * tables.LIGHT_RUNTIME_S_PER_M)
@@ -159,15 +196,17 @@ def optical_range(length_m: float, bit_rate: int) -> tables.OpticalLengthRange:
 def data_cycle_time_s(network_bytes: int, devices: int, bit_rate: int) -> float:
     """Duration of one INTERBUS data cycle on the wire: frame, ring delay, turnaround and latch
     (``supi3.interbus.wire.cycle_bits``, docs/interbus.md "Cycle timing")."""
-    from supi3.interbus import wire
-
-    if network_bytes < 0 or devices < 1:
-        raise TimingError(f"need network bytes >= 0 and devices >= 1, not {network_bytes} and {devices}")
+    _network_bytes(network_bytes)
+    check_int("devices", devices)
+    if not 1 <= devices <= MAX_DEVICES:
+        raise TimingError(f"need devices >= 1 and <= {MAX_DEVICES} (the INTERBUS limit), not "
+                          f"{_shown(devices)}")
     return wire.cycle_bits(network_bytes, devices) * bit_period_s(bit_rate)
 
 
 def report(network_bytes: int, bit_rate: int, devices: int = 1) -> dict[str, object]:
     """Everything ``supi3 timing`` prints, as data (times in µs)."""
+    _network_bytes(network_bytes)
     t_bit = bit_period_s(bit_rate)
     resolution = optical_length_m(1, bit_rate)
     near = optical_range(0, bit_rate)

@@ -26,12 +26,15 @@ What the chip does on each bus event (docs/interbus.md, docs/assumptions/model.m
 
 from __future__ import annotations
 
+import math
 from collections import Counter
-from typing import Final
+from collections.abc import Callable
+from typing import Final, TypeVar
 
 from supi3 import tables
+from supi3.checks import check_bits, check_bool, check_bytes, check_instance, check_int, check_real
 from supi3.config import DeviceConfig, MfpKind, decode
-from supi3.errors import Supi3Error
+from supi3.errors import ArgumentError, Supi3Error
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle
 from supi3.model.registers import RegisterFile
@@ -43,11 +46,11 @@ _DATA: Final = Cycle.DATA  # enum attribute lookups cost ~0.1 µs on the hot pat
 STATERR_FILTER_CLOCKS: Final = round(tables.STATERR_FILTER_S * CLOCK_HZ)
 """/StatErr must stay low this many clocks (200 ms, 3.6.2) before the peripheral fault is latched."""
 
-MODACK_PULSE_CLOCKS: Final = round(tables.RESREG_PULSE_NS * 1e-9 * CLOCK_HZ)
+MODACK_PULSE_CLOCKS: Final = tables.RESREG_PULSE_CLOCKS
 """/ModAck pulse on Quit Peripheral Error: the manual gives no width; the chip's other single pulse (375 ns,
 Table 3-13) is used (docs/assumptions/model.md M3)."""
 
-RESREG_PULSE_CLOCKS: Final = round(tables.RESREG_PULSE_NS * 1e-9 * CLOCK_HZ)
+RESREG_PULSE_CLOCKS: Final = tables.RESREG_PULSE_CLOCKS
 """/ResReg pulse on a layer-2 watchdog reset of process data: 375 ns (Table 3-13)."""
 
 WATCHDOG_CLOCKS: Final[tuple[int | None, ...]] = tuple(
@@ -60,9 +63,50 @@ class ChipError(Supi3Error, ValueError):
     """A request the chip model cannot carry out (wrong data width, pin value out of range, ...)."""
 
 
+class ChipArgumentError(ArgumentError, ChipError):
+    """An argument of a :class:`Supi3` method of the wrong type or out of its range ("X must be ..., not ..."): an
+    :class:`~supi3.errors.ArgumentError` that code catching :class:`ChipError` still catches."""
+
+
+_T = TypeVar("_T")
+_INF: Final = math.inf
+_WORD_BYTES: Final = 2
+"""Bytes of the command word an ID cycle latches (16 bits, docs/interbus.md "Words")."""
+TIME_LIMIT: Final = "bus time in seconds since power-up"
+"""What a transaction-level time argument is: finite and not negative (NaN and infinity have no clock count)."""
+
+
+def _checked(check: Callable[..., _T], *args: object, **kwargs: object) -> _T:
+    """Run a :mod:`supi3.checks` check; its error comes out as a :class:`ChipArgumentError`. Hot paths call this
+    only after a cheap inline test failed, so a valid call never pays for it."""
+    try:
+        return check(*args, **kwargs)
+    except ArgumentError as error:
+        raise ChipArgumentError(error.name, error.value, str(error)) from None
+
+
 def clocks(now: float) -> int:
-    """Bus time in seconds as a count of 32 MHz clock periods."""
+    """Bus time in seconds as a count of 32 MHz clock periods.
+
+    Raises
+    ------
+    ChipArgumentError
+        If ``now`` is not a finite number >= 0.
+    """
+    if type(now) is not float or not 0.0 <= now < _INF:
+        now = _checked(check_real, "now", now, 0, limit=TIME_LIMIT)
     return round(now * CLOCK_HZ)
+
+
+def _clock(clk: object) -> int:
+    """``clk`` checked as a clock count (an ``int`` >= 0)."""
+    return _checked(check_int, "clk", clk, 0, limit="32 MHz clock periods since power-up")
+
+
+def _cycle(cycle: object) -> Cycle:
+    """``cycle`` checked as a :class:`~supi3.interbus.wire.Cycle`."""
+    checked: Cycle = _checked(check_instance, "cycle", cycle, Cycle, "Cycle.ID or Cycle.DATA")
+    return checked
 
 
 class Supi3:
@@ -86,9 +130,14 @@ class Supi3:
     """
 
     def __init__(self, config: DeviceConfig | None = None, *, strict: bool = True) -> None:
+        if config is not None and not isinstance(config, DeviceConfig):
+            _checked(check_instance, "config", config, DeviceConfig, "a DeviceConfig (supi3.config.decode) or None")
+        _checked(check_bool, "strict", strict)
         self.config = config if config is not None else decode("10000")
         kind = self.config.mfp_mode.kind
         self.registers = RegisterFile(self.config, strict=strict) if kind is MfpKind.INIT_UP else None
+        if self.registers is not None:
+            self.registers.use_clock(self._clock)  # violations name the clock of the last bus call (docs/model.md)
         pins = self.config.mfp_pins
         binary = kind is MfpKind.BINARY_IO
         self._in_map = tuple((int(p.signal[2:]), p.pin) for p in pins if binary and p.signal.startswith("In"))
@@ -134,6 +183,10 @@ class Supi3:
         self._send_alarm = False
         self._reschedule()
 
+    def _clock(self) -> int:
+        """The chip's clock count as last told by a bus call (load, latch, discard, reset, poll, /StatErr)."""
+        return self._now
+
     @property
     def events(self) -> Counter[str]:
         """How often each interrupt source of Table 3-13 fired, plus ``"WATCHDOG"`` and ``"MODACK"``."""
@@ -149,6 +202,8 @@ class Supi3:
         """The I/O access (polling) bit (3.4.14, Fig. 3-22): 1 from the start of a data cycle's check sequence to
         the end of its latch phase, so a 0 leaves at least the check sequence (52 bit periods, more than the
         manual's 30) before data move; in µP modes it is D7 of the interrupt event register and MFP1."""
+        if type(busy) is not bool:
+            busy = _checked(check_bool, "busy", busy)
         self.io_access = busy
         if self.registers is not None:
             self.registers.set_io_access(busy)
@@ -156,14 +211,14 @@ class Supi3:
     def set_latch_phase(self, active: bool) -> None:
         """The latch phase (3.4.14): from the first latch telegram to the latch; µP accesses to the data
         registers inside it are reported as inconsistent data."""
+        if type(active) is not bool:
+            active = _checked(check_bool, "active", active)
         if self.registers is not None:
             self.registers.set_latch_phase(active)
 
     def set_mfp_inputs(self, levels: int) -> None:
         """Drive the MFP[15..0] input pins (binary I/O modes sample them when a data cycle begins)."""
-        if not 0 <= levels <= 0xFFFF:
-            raise ChipError(f"MFP levels are 16 bits, not {levels!r}")
-        self.mfp_in = levels
+        self.mfp_in = _checked(check_bits, "levels", levels, 16, "MFP[15..0]")
 
     @property
     def mfp_outputs(self) -> int:
@@ -176,6 +231,7 @@ class Supi3:
 
     def set_stat_err(self, active: bool, now: float) -> None:
         """Drive /StatErr (3.6.2): ``True`` pulls it low (an I/O error); the fault latches after the filter time."""
+        active = _checked(check_bool, "active", active)
         self._set_stat_err(active, clocks(now))
 
     def _set_stat_err(self, active: bool, clk: int) -> None:
@@ -225,9 +281,8 @@ class Supi3:
 
     def set_inputs(self, word: int) -> None:
         """IN data for SPI master and bus terminal modes, whose data path is not modelled at pin level yet."""
-        if not 0 <= word < 1 << (8 * self.data_bytes()):
-            raise ChipError(f"IN data {word!r} does not fit in {self.data_bytes()} bytes")
-        self.in_word = word
+        self.in_word = _checked(check_bits, "word", word, 8 * self.data_bytes(),
+                                f"the IN data of {self.data_bytes()} bytes, Table 3-11")
 
     # --------------------------------------------------------------------------------------------------------
     # Time
@@ -284,6 +339,10 @@ class Supi3:
 
     def load_at(self, cycle: Cycle, clk: int) -> bytes:
         """A frame begins: the register's parallel load, in line order."""
+        if type(cycle) is not Cycle:
+            cycle = _cycle(cycle)
+        if type(clk) is not int or clk < 0:
+            clk = _clock(clk)
         self._now = clk
         if clk >= self._due:
             self._expire(clk)
@@ -300,7 +359,22 @@ class Supi3:
         return loaded
 
     def latch_at(self, cycle: Cycle, received: bytes, clk: int) -> None:
-        """The master latched the cycle: take over ``received`` (OUT data or the command word)."""
+        """The master latched the cycle: take over ``received`` (OUT data or the command word).
+
+        Raises
+        ------
+        ChipArgumentError
+            If ``received`` is not bytes of this cycle's length: :meth:`data_bytes` in a data cycle, the two bytes
+            of the command word in an ID cycle.
+        """
+        if type(cycle) is not Cycle:
+            cycle = _cycle(cycle)
+        if type(clk) is not int or clk < 0:
+            clk = _clock(clk)
+        length = self.data_bytes() if cycle is _DATA else _WORD_BYTES
+        if type(received) is not bytes or len(received) != length:
+            what = "the OUT data" if cycle is _DATA else "the command word"
+            received = _checked(check_bytes, "received", received, length, f"{what} of the {cycle.value} cycle")
         self.revision += 1
         self._now = clk
         if clk >= self._due:
@@ -343,6 +417,12 @@ class Supi3:
 
     def discard_at(self, cycle: Cycle, local_error: bool, clk: int) -> None:
         """The cycle ended without a latch: nothing latched changes (Table 3-13, invalid data cycle)."""
+        if type(cycle) is not Cycle:
+            cycle = _cycle(cycle)
+        if type(local_error) is not bool:
+            local_error = _checked(check_bool, "local_error", local_error)
+        if type(clk) is not int or clk < 0:
+            clk = _clock(clk)
         self._advance(clk)
         self.te = self.te or local_error
         if cycle is Cycle.DATA:
@@ -350,6 +430,8 @@ class Supi3:
 
     def reset_at(self, clk: int) -> None:
         """INTERBUS reset (3.4.7, Table 3-13)."""
+        if type(clk) is not int or clk < 0:
+            clk = _clock(clk)
         self.revision += 1
         self._advance(clk)
         self._clear_process_data()
@@ -368,19 +450,21 @@ class Supi3:
 
     def load(self, cycle: Cycle, now: float) -> bytes:
         """See :meth:`supi3.interbus.device.Device.load`."""
-        if cycle is _DATA and now < self._due_s and self.mfp_in == self._loaded[0]:
+        if cycle is _DATA and type(now) is float and 0.0 <= now < self._due_s and self.mfp_in == self._loaded[0]:
             return self._loaded[1]  # nothing due, MFP inputs as last sampled: the same IN bytes
-        return self.load_at(cycle, round(now * CLOCK_HZ))
+        return self.load_at(cycle, clocks(now))
 
     def latch(self, cycle: Cycle, received: bytes, now: float) -> None:
         """See :meth:`supi3.interbus.device.Device.latch`."""
-        if cycle is _DATA and now < self._due_s and self.registers is None and self.watchdog_code is None:
+        # len(received) == _fixed_bytes also stands for "registers is None" (_fixed_bytes is None in the µP modes)
+        if (cycle is _DATA and type(now) is float and 0.0 <= now < self._due_s and self.watchdog_code is None
+                and type(received) is bytes and len(received) == self._fixed_bytes):
             self.bus_active = True  # the latch_at() path for a pin-strapped mode without watchdog
             self._out = received
             self.revision += 1
             self._fast_valid += 1
             return
-        self.latch_at(cycle, received, round(now * CLOCK_HZ))
+        self.latch_at(cycle, received, clocks(now))
 
     def discard(self, cycle: Cycle, local_error: bool, now: float) -> None:
         """See :meth:`supi3.interbus.device.Device.discard`."""
@@ -410,6 +494,7 @@ class VoltageMonitor:
 
     def sense(self, vcc: float) -> bool:
         """Apply the supply voltage ``vcc`` (volts) and return the output."""
+        vcc = _checked(check_real, "vcc", vcc, limit="the supply voltage in volts")
         if vcc > tables.VOLTAGE_MONITOR_HIGH_V:
             self.ok = True
         elif vcc < tables.VOLTAGE_MONITOR_LOW_V:

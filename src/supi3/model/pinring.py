@@ -15,20 +15,38 @@ from collections.abc import Sequence
 import numpy as np
 import numpy.typing as npt
 
+from supi3.checks import check_bits, check_bool, check_choice, check_int, check_real, check_trace, fail
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusError, TelegramError
 from supi3.interbus.ring import ErrorKind, Transfer
 from supi3.interbus.wire import Cycle, Frame, LineReset, Telegram
 from supi3.model.pins import Supi3Pins
-from supi3.tables import CLOCK_HZ
+from supi3.tables import BIT_RATES, CLOCK_HZ
+
+APPLICATION_INPUTS: dict[str, int] = {
+    pin.name: pin.width for pin in Supi3Pins.inputs if pin.name not in ("do1", "di2")
+}
+"""The input pins :meth:`PinRing.set_input` drives, with their widths (the line inputs are the ring's)."""
 
 
-def receive(samples: npt.NDArray[np.uint8], start: int, cpb: int) -> tuple[list[Telegram | LineReset], int, bool]:
+def receive(samples: npt.NDArray[np.integer], start: int, cpb: int) -> tuple[list[Telegram | LineReset], int, bool]:
     """Receive the telegrams in a 32 MHz sample trace from index ``start``.
 
     Returns the telegrams, the index to continue from (before any unfinished telegram) and whether a telegram
     error was seen (the erroneous telegram is skipped).
+
+    Raises
+    ------
+    ArgumentError
+        ``samples`` is not a 1-D sequence of 0/1 integers, ``start`` not an index into it, or ``cpb`` not a number of
+        clocks per bit (Table 1-7).
     """
+    if not isinstance(samples, np.ndarray):
+        samples = check_trace("samples", samples, 1)
+    start = check_int("start", start, 0, len(samples))
+    # An array is checked from ``start`` on: the return line grows run by run and is received piecewise.
+    check_trace(f"samples[{start}:]", samples[start:], 1)
+    cpb = check_choice("cpb", cpb, sorted({wire.clocks_per_bit(rate) for rate in BIT_RATES}), "Table 1-7")
     out: list[Telegram | LineReset] = []
     error = False
     n = len(samples)
@@ -84,6 +102,12 @@ class PinRing:
     """
 
     def __init__(self, chips: Sequence[Supi3Pins], record: bool = False) -> None:
+        if isinstance(chips, (str, bytes)) or not isinstance(chips, Sequence) \
+                or not all(isinstance(chip, Supi3Pins) for chip in chips):
+            raise fail("chips", "a sequence of Supi3Pins", chips)
+        if len({id(chip) for chip in chips}) != len(chips):
+            raise fail("chips", "distinct Supi3Pins (one object per ring position)", chips)
+        check_bool("record", record)
         if not chips:
             raise InterbusError("docs/interbus.md, Ring", 0, "a ring needs at least one device")
         rates = {chip.config.bit_rate for chip in chips}
@@ -107,14 +131,24 @@ class PinRing:
         return self.cycle / CLOCK_HZ
 
     def set_input(self, position: int, pin: str, value: int) -> None:
-        """Drive an input pin of the chip at ring ``position`` (1..N) other than its line inputs."""
-        if pin in ("do1", "di2") or pin not in self._inputs[position - 1]:
-            raise InterbusError("docs/model.md", pin, "not an application input pin of the chip")
-        self._inputs[position - 1][pin] = value
+        """Drive an input pin of the chip at ring ``position`` (1..N) other than its line inputs.
+
+        Raises
+        ------
+        ArgumentError
+            ``position`` not from 1 to N, ``pin`` not one of :data:`APPLICATION_INPUTS`, or ``value`` not an integer
+            within the pin's width (``mfp_in`` 0 to 0xFFFF, the others 0 or 1); nothing changes.
+        """
+        position = check_int("position", position, 1, len(self.devices))
+        if not isinstance(pin, str) or pin not in APPLICATION_INPUTS:
+            raise fail("pin", f"one of {', '.join(map(repr, APPLICATION_INPUTS))} (the line inputs are the ring's)",
+                       pin, "docs/model.md")
+        self._inputs[position - 1][pin] = check_bits(f"pin {pin!r}", value, APPLICATION_INPUTS[pin])
 
     def run_levels(self, levels: npt.NDArray[np.uint8]) -> None:
-        """Send master line levels (one per bit period) through the ring."""
-        self.run_samples(wire.levels_to_samples(levels, self.bit_rate))
+        """Send master line levels (one per bit period, 0 or 1) through the ring."""
+        checked = check_trace("levels", levels, 1)
+        self.run_samples(wire.levels_to_samples(checked.astype(np.uint8, copy=False), self.bit_rate))
 
     def run_samples(self, samples: npt.NDArray[np.uint8]) -> None:
         """Clock the ring once per sample of the master's forward line.
@@ -122,8 +156,8 @@ class PinRing:
         Every chip runs the whole trace forward (``do1`` from its upstream neighbour's ``do2``), then the
         return line is assembled from the last chip back to the first (:meth:`Supi3Pins.return_line`).
         """
-        n = len(samples)
-        forward = np.asarray(samples, dtype=np.int64)
+        forward = check_trace("samples", samples, 1).astype(np.int64, copy=False)
+        n = len(forward)
         placeholder = np.zeros(n, dtype=np.int64)
         sent = []
         chunk = []
@@ -219,6 +253,7 @@ class PinRing:
 
     def idle(self, seconds: float) -> None:
         """Idle status telegrams for ``seconds``."""
+        check_real("seconds", seconds, finite=True)
         if seconds < 0:
             raise InterbusError("docs/interbus.md, Idle", seconds, "idle time must be >= 0")
         count = round(seconds * self.bit_rate / wire.STATUS_TELEGRAM_BITS)

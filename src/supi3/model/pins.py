@@ -42,7 +42,9 @@ from typing import Final, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from supi3.checks import check_bits, check_instance, check_int, check_trace, fail
 from supi3.config import DeviceConfig
+from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
@@ -98,10 +100,58 @@ IDLE_INPUTS: Final = Synced(wire.IDLE_LEVEL, 0, 0, 0, 1, 1, 1)
 _NEVER: Final = 1 << 62
 
 
-def _integers(trace: Sequence[int] | npt.NDArray[np.generic]) -> npt.NDArray[np.integer]:
-    """An input trace as an integer array, without a copy when it already is one."""
-    array = np.asarray(trace)
-    return array if np.issubdtype(array.dtype, np.integer) else array.astype(np.int64)
+_INPUT_PINS: Final[tuple[Pin, ...]] = (
+    Pin("do1"), Pin("di2"), Pin("rbst_ext"), Pin("mfp_in", 16), Pin("stat_err_n"), Pin("resu_n"), Pin("vmon_ok"),
+)  # fmt: skip
+"""``Supi3Pins.inputs``, in :class:`Synced` order."""
+_INPUT_WIDTHS: Final[dict[str, int]] = {pin.name: pin.width for pin in _INPUT_PINS}
+"""Bits of each input pin."""
+
+
+def check_names(what: str, given: object, names: Sequence[str]) -> Mapping[object, object]:
+    """``given`` if it is a mapping whose keys are exactly ``names`` (any order), else a named error that lists the
+    missing and the unknown names."""
+    if not isinstance(given, Mapping):
+        raise fail(what, "a mapping of pin name to value", given)
+    mapping: Mapping[object, object] = given
+    missing = [name for name in names if name not in mapping]
+    unknown = [name for name in mapping if name not in names]
+    if missing or unknown:
+        problems = [f"without {', '.join(map(repr, missing))}" if missing else "",
+                    f"with {', '.join(map(repr, unknown))}, no such pin" if unknown else ""]  # fmt: skip
+        raise ArgumentError(what, given, f"{what} must name exactly the pins {', '.join(names)}, not "
+                                         + "; ".join(problem for problem in problems if problem))
+    return mapping
+
+
+def input_row(inputs: object) -> Synced:
+    """One cycle's input levels by name, checked: every input pin, each an integer within its pin's width.
+
+    Raises
+    ------
+    ArgumentError
+        With the pin's name and width ("pin 'do1' must be an integer from 0 to 1 (1 bit), not 2").
+    """
+    mapping = check_names("inputs", inputs, _INPUT_NAMES)
+    return Synced(*(check_bits(f"pin {name!r}", mapping[name], _INPUT_WIDTHS[name]) for name in _INPUT_NAMES))
+
+
+def input_traces(inputs: object) -> dict[str, npt.NDArray[np.integer]]:
+    """Input traces by name, checked at once (vectorised): every input pin, each a 1-D integer sequence within its
+    pin's width, all of one length. Integer arrays are not copied.
+
+    Raises
+    ------
+    ArgumentError
+        With the pin's name, width and the first bad index, or the lengths.
+    """
+    mapping = check_names("inputs", inputs, _INPUT_NAMES)
+    traces = {name: check_trace(f"pin {name!r} trace", mapping[name], _INPUT_WIDTHS[name]) for name in _INPUT_NAMES}
+    n = len(traces["do1"])
+    for name, trace in traces.items():
+        if len(trace) != n:
+            raise fail(f"len(pin {name!r} trace)", f"{n}, the length of pin 'do1' trace", len(trace))
+    return traces
 
 
 class Supi3Pins:
@@ -139,16 +189,16 @@ class Supi3Pins:
         "complete_diagnostics", "config", "cpb", "cycle", "forward_delay", "log", "mfp_oe", "rbst_by_pin", "reset_run",
     )  # fmt: skip
 
-    inputs: Sequence[Pin] = (
-        Pin("do1"), Pin("di2"), Pin("rbst_ext"), Pin("mfp_in", 16), Pin("stat_err_n"), Pin("resu_n"),
-        Pin("vmon_ok"),
-    )  # fmt: skip
+    inputs: Sequence[Pin] = _INPUT_PINS
     outputs: Sequence[Pin] = (
         Pin("do2"), Pin("di1"), Pin("mfp_out", 16), Pin("mfp_oe", 16), Pin("mod_ack_n"), Pin("res_reg_n"),
         Pin("diag1"), Pin("diag2"), Pin("ib_diag"), Pin("dclk_out"), Pin("resu_drive"),
     )  # fmt: skip
 
     def __init__(self, config: DeviceConfig, chip: Supi3 | None = None) -> None:
+        check_instance("config", config, DeviceConfig)
+        if chip is not None and (not isinstance(chip, Supi3) or chip.config != config):
+            raise fail("chip", "None or a Supi3 of the same configuration", chip)
         self.config = config
         self.chip = chip if chip is not None else Supi3(config)
         self.cpb = wire.clocks_per_bit(config.bit_rate)
@@ -178,6 +228,7 @@ class Supi3Pins:
         self._recording = False
         self._power_ups: list[tuple[int, int]] = []
         self._tx: list[tuple[int, int]] = []
+        self._return_start: tuple[int, bool, int, list[int]] | None = None
         self._power_up(RESET_STRETCH_CLOCKS)
 
     def _power_up(self, run_from: int) -> None:
@@ -227,11 +278,32 @@ class Supi3Pins:
     # ------------------------------------------------------------------------------------------------------------
 
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
-        """Run one clock cycle (see :mod:`supi3.verif.pinmodel`)."""
+        """Run one clock cycle (see :mod:`supi3.verif.pinmodel`).
+
+        Parameters
+        ----------
+        inputs:
+            The level of every input pin (exactly the names of :attr:`inputs`), each an integer within the pin's
+            width: 0 or 1, ``mfp_in`` 0 to 0xFFFF.
+
+        Raises
+        ------
+        ArgumentError
+            A pin missing or unknown, or a level that is not such an integer (:func:`input_row`); nothing changes.
+        """
+        try:
+            do1, di2, rbst = inputs["do1"], inputs["di2"], inputs["rbst_ext"]
+            mfp, stat, resu, vmon = inputs["mfp_in"], inputs["stat_err_n"], inputs["resu_n"], inputs["vmon_ok"]
+            # The fast path: plain ints within range (one type chain and two shifts), the seven names exactly.
+            fast = (int is type(do1) is type(di2) is type(rbst) is type(mfp) is type(stat) is type(resu) is type(vmon)
+                    and not (do1 | di2 | rbst | stat | resu | vmon) >> 1 and not mfp >> 16 and len(inputs) == 7)
+        except Exception:  # anything a broken mapping raises: input_row() names the problem
+            fast = False
+        row = Synced(do1, di2, rbst, mfp, stat, resu, vmon) if fast else input_row(inputs)
         c = self.cycle
         synced = self._pipe[-1]
-        outputs = self.output_values(c, int(inputs["di2"]))
-        self._pipe = [Synced(*(int(inputs[name]) for name in _INPUT_NAMES)), *self._pipe[:-1]]
+        outputs = self._outputs(c, row.di2)
+        self._pipe = [row, *self._pipe[:-1]]
         if c >= self._run_from or self._holding or not (synced.resu_n and synced.vmon_ok):
             self._tick(c, synced, synced.do1)
             if c >= self._run_from:
@@ -254,6 +326,10 @@ class Supi3Pins:
 
     def output_values(self, c: int, di2: int) -> dict[str, int]:
         """Every output pin during cycle ``c`` (``c`` >= the current cycle; ``di2`` is that cycle's input)."""
+        check_int("c", c, self.cycle)
+        return self._outputs(c, check_bits("pin 'di2'", di2, 1))
+
+    def _outputs(self, c: int, di2: int) -> dict[str, int]:
         chip = self.chip
         do2 = self._do2(c)
         return {
@@ -262,8 +338,11 @@ class Supi3Pins:
             "di1": di2 if self._next_present else do2,
             "mfp_out": chip.mfp_outputs,
             "mfp_oe": self.mfp_oe,
-            "mod_ack_n": int(c >= chip.mod_ack_until),
-            "res_reg_n": int(c >= chip.resreg_until),
+            # A pulse the chip starts at clock clk (the edge ending cycle clk) lasts until clk + width in chip
+            # time; the pins show it from cycle clk + 1, so for cycles clk + 1 .. clk + width (M3). Cycle 0 comes
+            # before any edge (the chip's "no pulse" value is 0).
+            "mod_ack_n": int(not 0 < c <= chip.mod_ack_until),
+            "res_reg_n": int(not 0 < c <= chip.resreg_until),
             "diag1": int(chip.bus_active) if self.complete_diagnostics else 0,
             "diag2": 0,
             "ib_diag": self._ib_diag(c),
@@ -550,10 +629,18 @@ class Supi3Pins:
         Parameters
         ----------
         inputs:
-            One equally long trace per input pin.
+            One equally long trace per input pin (exactly the names of :attr:`inputs`): 1-D integer sequences or
+            arrays within the pin's width.
+
+        Raises
+        ------
+        ArgumentError
+            A pin missing or unknown, a trace not such a sequence, a value out of range (with its index), or traces
+            of different lengths (:func:`input_traces`); nothing changes.
         """
-        traces = self.run_forward(inputs)
-        traces["di1"] = self.return_line(np.asarray(inputs["di2"], dtype=np.int64), traces["do2"])
+        raw = input_traces(inputs)
+        traces = self._run_forward(raw)
+        traces["di1"] = self._return_line(raw["di2"].astype(np.int64, copy=False), traces["do2"])
         return traces
 
     def _synced_traces(self, raw: Mapping[str, npt.NDArray[np.integer]]) -> dict[str, npt.NDArray[np.int64]]:
@@ -568,11 +655,11 @@ class Supi3Pins:
     def run_forward(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]]) -> dict[str, Trace]:
         """:meth:`run` without ``di1``: the chip's logic does not depend on DI2 beyond the return line's
         pass-through, so a ring runs every chip forward first and then the return line backwards
-        (:meth:`return_line`). The ``di2`` trace given here is not used."""
-        raw = {name: _integers(inputs[name]) for name in _INPUT_NAMES}
+        (:meth:`return_line`). The ``di2`` trace given here is checked but not used."""
+        return self._run_forward(input_traces(inputs))
+
+    def _run_forward(self, raw: Mapping[str, npt.NDArray[np.integer]]) -> dict[str, Trace]:
         n = len(raw["do1"])
-        if any(len(trace) != n for trace in raw.values()):
-            raise ValueError("every input trace must have the same length")
         c0 = self.cycle
         self._return_start = (c0, self._next_present, self._run_from,
                               [stage.di2 for stage in reversed(self._pipe)])
@@ -678,8 +765,8 @@ class Supi3Pins:
         out = {
             "mfp_out": mfp_out,
             "diag1": diag1,
-            "mod_ack_n": (cycles >= mod_ack_until).astype(np.int64),
-            "res_reg_n": (cycles >= resreg_until).astype(np.int64),
+            "mod_ack_n": ((cycles <= 0) | (cycles > mod_ack_until)).astype(np.int64),  # as output_values()
+            "res_reg_n": ((cycles <= 0) | (cycles > resreg_until)).astype(np.int64),
             "resu_drive": (cycles < run_from).astype(np.int64),
             "ib_diag": np.where(pf != 0, fast, np.where(bus_active != 0, 1, slow)),
         }
@@ -710,7 +797,23 @@ class Supi3Pins:
 
         Recognition is updated at every clock edge where the logic runs, as in :meth:`step`: with RF = 10 it is
         the synchronised RBST_EXT, otherwise it latches the first high level seen on DI2; power-up clears it.
+
+        Raises
+        ------
+        ArgumentError
+            No :meth:`run_forward` came before, or a trace is not 0/1 integers as long as that run.
         """
+        if self._return_start is None:
+            raise fail("do2", "the do2 trace of the last run_forward()", do2, "none ran since reset")
+        n = len(self._synced_run["do1"])
+        traces = {"di2": check_trace("pin 'di2' trace", di2, 1), "do2": check_trace("pin 'do2' trace", do2, 1)}
+        for name, trace in traces.items():
+            if len(trace) != n:
+                raise fail(f"len(pin {name!r} trace)", f"{n}, the length of the last run_forward()", len(trace))
+        return self._return_line(traces["di2"].astype(np.int64, copy=False), traces["do2"].astype(np.int64, copy=False))
+
+    def _return_line(self, di2: npt.NDArray[np.int64], do2: npt.NDArray[np.int64]) -> Trace:
+        assert self._return_start is not None
         c0, value, run_from, held_di2 = self._return_start
         n = len(do2)
         if self.rbst_by_pin:

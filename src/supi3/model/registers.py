@@ -17,12 +17,14 @@ records it. In both modes the operation itself is carried out as the chip would.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from contextlib import contextmanager
-from typing import Final
+from collections.abc import Callable
+from types import TracebackType
+from typing import Final, Literal, TypeVar
 
+from supi3 import tables
+from supi3.checks import check_bits, check_bool, check_bytes, check_instance, check_int, describe
 from supi3.config import DeviceConfig, MfpKind
-from supi3.errors import Supi3Error
+from supi3.errors import ArgumentError, Supi3Error
 from supi3.regmap import (
     INTERRUPT_SOURCES,
     REGISTER_MAP,
@@ -39,6 +41,7 @@ __all__ = [
     "InconsistentDataError",
     "InterfaceViolationError",
     "ReconfigurationError",
+    "RegisterArgumentError",
     "RegisterFile",
     "RegisterFileError",
     "SetRegisterError",
@@ -57,6 +60,23 @@ class RegisterFileError(Supi3Error, ValueError):
     """A call that breaks the register file's API contract (a bad byte, an unknown source or register)."""
 
 
+class RegisterArgumentError(ArgumentError, RegisterFileError):
+    """An argument of a :class:`RegisterFile` method of the wrong type or out of its range ("X must be ..., not
+    ..."): an :class:`~supi3.errors.ArgumentError` that code catching :class:`RegisterFileError` still catches."""
+
+
+_T = TypeVar("_T")
+
+
+def _checked(check: Callable[..., _T], *args: object, **kwargs: object) -> _T:
+    """Run a :mod:`supi3.checks` check; its error comes out as a :class:`RegisterArgumentError`. The hot paths call
+    this only after a cheap inline test failed, so a valid call never pays for it."""
+    try:
+        return check(*args, **kwargs)
+    except ArgumentError as error:
+        raise RegisterArgumentError(error.name, error.value, str(error)) from None
+
+
 class InterfaceViolationError(Supi3Error):
     """A rule of the serial µP interface broken by the application or the master (strict mode raises it).
 
@@ -73,6 +93,9 @@ class InterfaceViolationError(Supi3Error):
         self.detail = detail
         super().__init__(f"{detail} ({rule})")
 
+    def __reduce__(self) -> tuple[object, ...]:
+        return (type(self), (self.rule, self.detail))
+
 
 class ReconfigurationError(InterfaceViolationError):
     """SET or ID written while the INTERBUS is running (3.4.3 note, 3.4.11: only during initialization)."""
@@ -83,7 +106,28 @@ class SetRegisterError(InterfaceViolationError):
 
 
 class InconsistentDataError(InterfaceViolationError):
-    """A data-register access overlapped the latch phase: the data may be inconsistent (3.4.14)."""
+    """A data-register access overlapped the latch phase: the data may be inconsistent (3.4.14).
+
+    Attributes
+    ----------
+    clock:
+        The chip's 32 MHz clock count at the access (the clock source of :meth:`RegisterFile.use_clock`: the
+        transaction-level chip's bus time, or the pin level's cycle), ``None`` if the register file has none.
+    time_s:
+        The same instant in seconds (``clock / 32 MHz``), ``None`` if unknown.
+    """
+
+    def __init__(self, rule: str, detail: str, clock: int | None = None) -> None:
+        self.clock = clock
+        self.time_s = None if clock is None else clock / tables.CLOCK_HZ
+        self._what = detail
+        when = "at an unknown time (no clock source)" if self.time_s is None else (
+            f"at clock {clock} (t = {self.time_s:.9g} s)"
+        )
+        super().__init__(rule, f"{detail} {when}")
+
+    def __reduce__(self) -> tuple[object, ...]:
+        return (type(self), (self.rule, self._what, self.clock))
 
 
 class ViolationLog:
@@ -97,13 +141,16 @@ class ViolationLog:
     """
 
     def __init__(self, strict: bool) -> None:
-        self.strict = strict
+        self.strict = check_bool("strict", strict)
         self.records: list[InterfaceViolationError] = []
         self._depth = 0
         self._pending: list[InterfaceViolationError] = []
+        self._deferred = _Deferred(self)
 
     def report(self, violation: InterfaceViolationError) -> None:
         """Record ``violation``; in strict mode raise it, or (inside :meth:`deferred`) at the end of the block."""
+        if not isinstance(violation, InterfaceViolationError):
+            _checked(check_instance, "violation", violation, InterfaceViolationError, "an InterfaceViolationError")
         self.records.append(violation)
         if not self.strict:
             return
@@ -112,20 +159,36 @@ class ViolationLog:
         else:
             raise violation
 
-    @contextmanager
-    def deferred(self) -> Iterator[None]:
-        """Hold strict-mode raises until the block ends, so that one operation (a byte, a clock cycle) completes
-        and leaves the model consistent; then raise the first violation reported inside it."""
-        pending: list[InterfaceViolationError] = []
-        self._depth += 1
-        try:
-            yield
-        finally:
-            self._depth -= 1
-            if self._depth == 0:
-                pending, self._pending = self._pending, []
-        if pending:
-            raise pending[0]
+    def deferred(self) -> _Deferred:
+        """A context manager that holds strict-mode raises until the block ends, so that one operation (a byte, a
+        clock cycle, a whole register access) completes and leaves the model consistent; then it raises the first
+        violation reported inside it. Blocks nest: only the outermost one raises. An exception that leaves the
+        block wins over the held violations (they stay in :attr:`records`)."""
+        return self._deferred
+
+
+class _Deferred:
+    """:meth:`ViolationLog.deferred` as a plain class: entering and leaving costs two attribute updates (it runs
+    once per byte and per clock cycle)."""
+
+    __slots__ = ("_log",)
+
+    def __init__(self, log: ViolationLog) -> None:
+        self._log = log
+
+    def __enter__(self) -> None:
+        self._log._depth += 1
+
+    def __exit__(
+        self, kind: type[BaseException] | None, error: BaseException | None, trace: TracebackType | None
+    ) -> Literal[False]:
+        log = self._log
+        log._depth -= 1
+        if log._depth == 0 and log._pending:
+            pending, log._pending = log._pending, []
+            if kind is None:
+                raise pending[0]
+        return False
 
 
 class RegisterFile:
@@ -141,21 +204,39 @@ class RegisterFile:
 
     Raises
     ------
-    RegisterFileError
-        If ``config`` is not a µP interface mode.
+    RegisterArgumentError
+        If ``config`` is not a :class:`~supi3.config.DeviceConfig` of a µP interface mode, or ``strict`` not a
+        ``bool``.
     """
 
     def __init__(self, config: DeviceConfig, *, strict: bool = True) -> None:
+        _checked(check_instance, "config", config, DeviceConfig, "a DeviceConfig (supi3.config.decode)")
         if config.mfp_mode.kind is not MfpKind.INIT_UP:
-            raise RegisterFileError(f"{config.function!r} is not a serial µP interface mode (Tables 2-4 to 2-7)")
+            raise RegisterArgumentError("config", config, f"config must be an Init-µP mode (Tables 2-4 to 2-7), not "
+                                        f"{config.function!r}: that is not a serial µP interface mode")
         self.config = config
-        self.violations = ViolationLog(strict)
+        self.violations = ViolationLog(_checked(check_bool, "strict", strict))
+        self._clock: Callable[[], int] | None = None
         self._values: dict[str, int] = {r.name: r.reset for r in REGISTER_MAP.registers}
         self._set: SetConfig | None = None
         self._bus_running = False
         self._latch_phase = False
         self._io_access = False
         self.power_up_reset()
+
+    def use_clock(self, source: Callable[[], int] | None) -> None:
+        """Tell the register file where the chip's time is: ``source()`` returns the 32 MHz clock count now (the
+        transaction-level :class:`~supi3.model.chip.Supi3` installs its bus time; a pin-level model its cycle).
+        Violations that name an instant (:class:`InconsistentDataError`) carry it; ``None``: time unknown."""
+        if source is not None and not callable(source):
+            raise RegisterArgumentError("source", source, "source must be a callable returning the clock count "
+                                        f"or None, not {source!r}")
+        self._clock = source
+
+    @property
+    def clock(self) -> int | None:
+        """The chip's clock count now, from the source given to :meth:`use_clock`; ``None`` without one."""
+        return None if self._clock is None else self._clock()
 
     # --------------------------------------------------------------------------------------------------------
     # Resets (3.4.3, 3.4.7)
@@ -198,14 +279,18 @@ class RegisterFile:
 
         Raises
         ------
-        RegisterFileError
-            For addresses 4, 5 and 15, whose accesses the interface handles itself (3.4.4, 3.4.6).
+        RegisterArgumentError
+            If ``address`` is not 0..15, or for addresses 4, 5 and 15, whose accesses the interface handles itself
+            (3.4.4, 3.4.6).
         """
-        port = REGISTER_MAP.port(self._address(address), Direction.READ)
+        if type(address) is not int or not 0 <= address <= 15:
+            address = self._address(address)
+        port = REGISTER_MAP.port(address, Direction.READ)
         if port.access is Access.RESERVED_ZERO:
             return 0
         if port.register is None:
-            raise RegisterFileError(f"address {address} has no read register ({port.access.meaning})")
+            raise RegisterArgumentError("address", address, f"address must be a readable register, not {address}: "
+                                        f"address {address} has no read register ({port.access.meaning})")
         self._check_consistency(port.register.name, "read")
         value = self._values[port.register.name]
         if port.access is Access.RC:
@@ -222,17 +307,20 @@ class RegisterFile:
 
         Raises
         ------
-        RegisterFileError
-            For addresses 4, 5 and 15, or if ``value`` is not a byte.
+        RegisterArgumentError
+            For an address outside 0..15, addresses 4, 5 and 15, or if ``value`` is not a byte.
         """
-        port = REGISTER_MAP.port(self._address(address), Direction.WRITE)
-        if not 0 <= value <= 0xFF:
-            raise RegisterFileError(f"data byte must be 0..255, not {value!r}")
+        if type(address) is not int or not 0 <= address <= 15:
+            address = self._address(address)
+        if type(value) is not int or not 0 <= value <= 0xFF:
+            value = _checked(check_bits, "data byte", value, 8)
+        port = REGISTER_MAP.port(address, Direction.WRITE)
         if port.access is Access.NO_EFFECT:
             return
         register = port.register
         if register is None:
-            raise RegisterFileError(f"address {address} has no write register ({port.access.meaning})")
+            raise RegisterArgumentError("address", address, f"address must be a writable register, not {address}: "
+                                        f"address {address} has no write register ({port.access.meaning})")
         self._check_consistency(register.name, "write")
         if register.name in ("SET", "ID") and self._bus_running:
             self.violations.report(
@@ -257,16 +345,14 @@ class RegisterFile:
         self._set = decoded
 
     @staticmethod
-    def _address(address: int) -> int:
-        if isinstance(address, bool) or not isinstance(address, int) or not 0 <= address <= 15:
-            raise RegisterFileError(f"address must be 0..15, not {address!r}")
-        return address
+    def _address(address: object) -> int:
+        return _checked(check_int, "address", address, 0, 15, "A3..0, 3.4.7")
 
     def _check_consistency(self, register: str, what: str) -> None:
         if self._latch_phase and register in _DATA_REGISTERS:
-            self.violations.report(
-                InconsistentDataError("3.4.14", f"inconsistent data: {register} {what} during the latch phase")
-            )
+            self.violations.report(InconsistentDataError(
+                "3.4.14", f"inconsistent data: {register} {what} during the latch phase", self.clock
+            ))
 
     # --------------------------------------------------------------------------------------------------------
     # Core interface: configuration seen by the master
@@ -293,8 +379,7 @@ class RegisterFile:
         if self._set is None:
             return 0
         bits = self._set.length.bits
-        assert bits is not None  # _apply_set never applies a reserved length code
-        return bits
+        return 0 if bits is None else bits  # None never: _apply_set never applies a reserved length code
 
     def data_bytes(self) -> int:
         """The data length rounded up to whole bytes: how many of addresses 0.. take part in a data cycle."""
@@ -316,6 +401,8 @@ class RegisterFile:
 
     def set_bus_running(self, running: bool) -> None:
         """The core reports whether INTERBUS is in operation; SET/ID writes while it is are violations (3.4.3)."""
+        if type(running) is not bool:
+            running = _checked(check_bool, "running", running)
         self._bus_running = running
 
     @property
@@ -326,6 +413,8 @@ class RegisterFile:
     def set_latch_phase(self, active: bool) -> None:
         """The core marks the latch phase of a data cycle; data-register accesses inside it are reported as
         inconsistent data (3.4.14)."""
+        if type(active) is not bool:
+            active = _checked(check_bool, "active", active)
         self._latch_phase = active
 
     @property
@@ -335,6 +424,8 @@ class RegisterFile:
 
     def set_io_access(self, busy: bool) -> None:
         """Set the I/O access (polling) bit: D7 of read 14 and the MFP1 level; 1 = no access now (Fig. 3-22)."""
+        if type(busy) is not bool:
+            busy = _checked(check_bool, "busy", busy)
         self._io_access = busy
 
     @property
@@ -370,14 +461,16 @@ class RegisterFile:
 
         Raises
         ------
+        RegisterArgumentError
+            If ``out`` is not bytes of the configured length.
         RegisterFileError
-            If ``out`` has the wrong length, or with ExtReg = 1.
+            With ExtReg = 1.
         """
         names = self._in_registers()
-        if len(out) != len(names):
-            raise RegisterFileError(
-                f"latch needs {len(names)} OUT bytes for {self.data_bits()} data bits, got {len(out)}"
-            )
+        if type(out) is not bytes or len(out) != len(names):
+            out = _checked(check_bytes, "out", out, len(names),
+                           f"the OUT bytes of the cycle: latch needs {len(names)} OUT bytes for {self.data_bits()} "
+                           "data bits, 3.4.8")
         sent = self.in_bytes()
         for register, value in zip(OUT_BYTES, out, strict=False):
             self._values[register.name] = value
@@ -394,11 +487,12 @@ class RegisterFile:
 
         Raises
         ------
-        RegisterFileError
+        RegisterArgumentError
             If ``source`` is not a source name.
         """
-        if source not in _SOURCE_BITS:
-            raise RegisterFileError(f"no interrupt source {source!r}; sources: {sorted(_SOURCE_BITS)}")
+        if type(source) is not str or source not in _SOURCE_BITS:
+            raise RegisterArgumentError("source", source, f"source must be one of {sorted(_SOURCE_BITS)} (Table "
+                                        f"3-13), not {describe(source)}: no interrupt source {source!r}")
         mask = 1 << _SOURCE_BITS[source]
         if self._values["IRQ_EN"] & mask:
             self._values["IRQ_EVT"] |= mask
@@ -410,8 +504,7 @@ class RegisterFile:
 
     def processor_command(self, value: int) -> None:
         """The master's management message: store it in PCMD (read 7) and raise the PCMD event (3.4.9)."""
-        if not 0 <= value <= 0xFF:
-            raise RegisterFileError(f"processor command must be a byte, not {value!r}")
+        value = _checked(check_bits, "processor command", value, 8, "3.4.9")
         self._values["PCMD"] = value
         self.event("PCMD")
 
@@ -425,20 +518,27 @@ class RegisterFile:
 
         Raises
         ------
-        RegisterFileError
+        RegisterArgumentError
             If ``register`` is not LENGTH_OUT, LENGTH_BRANCH, POWER_IN or POWER_OUT_BRANCH, or ``value`` sets a
             reserved bit.
         """
-        if register not in _OPTICAL_REGISTERS:
-            raise RegisterFileError(f"{register!r} is not an optical register: {sorted(_OPTICAL_REGISTERS)}")
+        if type(register) is not str or register not in _OPTICAL_REGISTERS:
+            raise RegisterArgumentError("register", register, f"register must be one of {sorted(_OPTICAL_REGISTERS)}, "
+                                        f"not {describe(register)}: {register!r} is not an optical register "
+                                        "(3.4.12, 3.4.13)")
         layout = REGISTER_MAP.register(register)
-        if not 0 <= value <= 0xFF or value & ~layout.mask:
-            raise RegisterFileError(f"{register} = {value!r} sets bits outside {layout.mask:02X}h")
+        value = _checked(check_bits, "value", value, 8, "3.4.12, 3.4.13")
+        if value & ~layout.mask:
+            raise RegisterArgumentError("value", value, f"value must set only bits {layout.mask:02X}h of {register} "
+                                        f"(3.4.12, 3.4.13), not {value:02X}h: bits outside {layout.mask:02X}h are "
+                                        "reserved")
         self._values[register] = value
 
     def value(self, register: str) -> int:
         """The stored value of ``register`` (a :data:`REGISTER_MAP` name), without side effects (for tests and
         the core; IRQ_EVT without the live D7)."""
-        if register not in self._values:
-            raise RegisterFileError(f"no register {register!r}; registers: {sorted(self._values)}")
+        if type(register) is not str or register not in self._values:
+            raise RegisterArgumentError("register", register, f"register must be a name of REGISTER_MAP "
+                                        f"({', '.join(sorted(self._values))}), not {describe(register)}: no register "
+                                        f"{register!r}")
         return self._values[register]

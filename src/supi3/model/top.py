@@ -20,9 +20,10 @@ from typing import Final
 import numpy as np
 import numpy.typing as npt
 
+from supi3.checks import check_bits, check_bool, check_instance
 from supi3.config import DeviceConfig
 from supi3.model.chip import Supi3
-from supi3.model.pins import Supi3Pins, Trace
+from supi3.model.pins import Supi3Pins, Trace, input_traces
 from supi3.spi.slave_pins import PinsIn, PinsOut, SlavePins
 from supi3.verif.pinmodel import OE_SUFFIX, Pin
 
@@ -36,11 +37,13 @@ UP_PINS: Final = 0x00FF
 
 def up_pin_inputs(mfp: int) -> PinsIn:
     """The µP interface's inputs from the MFP[15..0] input levels."""
+    mfp = check_bits("mfp", mfp, 16)
     return PinsIn(**{name: (mfp >> pin) & 1 for name, pin in UP_INPUTS.items()})
 
 
 def up_pin_outputs(up: PinsOut) -> tuple[int, int]:
     """The MFP levels (undriven bits 0) and output enables of the µP interface's outputs ``up``."""
+    check_instance("up", up, PinsOut)
     enables = sum(getattr(up, name + OE_SUFFIX) << pin for name, pin in UP_OUTPUTS.items())
     levels = sum(getattr(up, name) << pin for name, pin in UP_OUTPUTS.items())
     return levels & enables, enables
@@ -63,9 +66,14 @@ class Supi3Chip:
     outputs: Sequence[Pin] = Supi3Pins.outputs
 
     def __init__(self, config: DeviceConfig, *, strict: bool = True) -> None:
+        check_instance("config", config, DeviceConfig)
+        check_bool("strict", strict)
         self.core = Supi3Pins(config, Supi3(config, strict=strict))
         registers = self.core.chip.registers
         self.upif = SlavePins(registers) if registers is not None else None
+        if registers is not None:
+            # The µP interface ticks after the core's step, so the cycle it clocks is core.cycle - 1 (UP-19).
+            registers.use_clock(lambda: self.core.cycle - 1)
 
     @property
     def chip(self) -> Supi3:
@@ -79,7 +87,13 @@ class Supi3Chip:
             self.upif.reset()
 
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
-        """Run one clock cycle."""
+        """Run one clock cycle.
+
+        Raises
+        ------
+        ArgumentError
+            As :meth:`Supi3Pins.step`: a pin missing or unknown, or a level out of its pin's width (nothing changes).
+        """
         out = self.core.step(inputs)
         if self.upif is None:
             return out
@@ -93,10 +107,17 @@ class Supi3Chip:
 
     def run(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]]) -> dict[str, Trace]:
         """Whole traces at once: the core's event-driven :meth:`Supi3Pins.run` without a µP interface, else
-        cycle by cycle (the interface and the core meet in the register file at any cycle)."""
+        cycle by cycle (the interface and the core meet in the register file at any cycle).
+
+        Raises
+        ------
+        ArgumentError
+            As :meth:`Supi3Pins.run` (:func:`~supi3.model.pins.input_traces`); nothing changes.
+        """
         if self.upif is None:
             return self.core.run(inputs)
+        traces = input_traces(inputs)  # every trace checked before the first cycle runs
         names = [pin.name for pin in self.inputs]
-        columns = [np.asarray(inputs[name], dtype=np.int64).tolist() for name in names]
+        columns = [traces[name].tolist() for name in names]
         rows = [self.step(dict(zip(names, values, strict=True))) for values in zip(*columns, strict=True)]
         return {pin.name: np.array([row[pin.name] for row in rows], dtype=np.int64) for pin in self.outputs}

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+from os import PathLike
 from pathlib import Path
 
 import numpy as np
 from vcd import VCDWriter
 from vcd.writer import Variable
 
+from supi3.checks import check_instance, fail
 from supi3.model.pinring import PinRing
 from supi3.tables import CLOCK_HZ
 
@@ -20,7 +22,18 @@ def write_vcd(path: Path, ring: PinRing) -> Path:
 
     Scopes are ``dev1`` .. ``devN`` in ring order; ``dev1.do1`` is the master's forward line and ``dev1.di1``
     the return line into the master. Only changes are written, so the file stays small.
+
+    Raises
+    ------
+    ArgumentError
+        ``path`` is not a path (``str`` or ``os.PathLike``), or ``ring`` not a :class:`PinRing`.
+    InterbusError
+        The ring does not record its pins.
     """
+    if not isinstance(path, (str, PathLike)):
+        raise fail("path", "a path (str or os.PathLike)", path)
+    path = Path(path)
+    check_instance("ring", ring, PinRing)
     chips = ring.recorded()
     widths = {pin.name: pin.width for chip in ring.devices for pin in (*chip.inputs, *chip.outputs)}
     path.parent.mkdir(parents=True, exist_ok=True)

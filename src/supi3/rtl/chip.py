@@ -23,9 +23,11 @@ from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
 from supi3.config import Variant
+from supi3.errors import ArgumentError
 from supi3.model.pins import Supi3Pins
 from supi3.model.top import UP_INPUTS, UP_OUTPUTS, UP_PINS
 from supi3.rtl.core import REGISTER_FILE_INPUTS, REGISTER_FILE_OUTPUTS, STRAP_PINS, Supi3Core
+from supi3.rtl.tables import check_variant
 from supi3.rtl.upif import UpifBlock
 from supi3.spi.block_pins import SERIAL_INPUTS
 from supi3.spi.slave_pins import INPUT_PINS
@@ -45,7 +47,11 @@ class Supi3Chip(wiring.Component):
     """
 
     def __init__(self, variant: Variant | str = Variant.OPC) -> None:
-        self.variant = Variant(variant)
+        try:
+            self.variant = check_variant(variant)
+        except ArgumentError:
+            self._MustUse__silence = True  # rejected, never elaborated: no "created but never used" warning
+            raise
         members: dict[str, object] = {pin.name: In(pin.width) for pin in (*Supi3Pins.inputs, *STRAP_PINS)}
         members.update({pin.name: Out(pin.width) for pin in Supi3Pins.outputs})
         super().__init__(members)

@@ -34,9 +34,11 @@ from amaranth.hdl import Array, Cat, Const, Elaboratable, EnableInserter, Module
 from amaranth.lib import enum, wiring
 from amaranth.lib.wiring import In, Out
 
+from supi3.checks import check_bool
 from supi3.config import Variant
+from supi3.errors import ArgumentError
 from supi3.interbus import wire
-from supi3.model.chip import MODACK_PULSE_CLOCKS, RESREG_PULSE_CLOCKS, STATERR_FILTER_CLOCKS, WATCHDOG_CLOCKS
+from supi3.model.chip import MODACK_PULSE_CLOCKS, STATERR_FILTER_CLOCKS, WATCHDOG_CLOCKS
 from supi3.model.pins import (
     IB_DIAG_DIVIDER_BITS,
     IDLE_INPUTS,
@@ -56,10 +58,12 @@ from supi3.rtl.tables import (
     RF_BITS,
     ClockEntry,
     CoreTables,
+    check_variant,
     core_tables,
 )
 from supi3.rtl.upif import upif_tables
 from supi3.spi.block_pins import CORE_INPUTS, CORE_OUTPUTS, EVENT_BITS, STRAP_INPUTS
+from supi3.tables import RESREG_PULSE_CLOCKS
 from supi3.verif.pinmodel import Pin
 
 __all__ = ["REGISTER_FILE_INPUTS", "REGISTER_FILE_OUTPUTS", "STRAP_PINS", "Supi3Core", "verilog"]
@@ -128,9 +132,13 @@ class Supi3Core(wiring.Component):
     """
 
     def __init__(self, variant: Variant | str = Variant.OPC, *, register_file: bool = False) -> None:
-        self.variant = Variant(variant)
+        try:
+            self.variant = check_variant(variant)
+            self.register_file = check_bool("register_file", register_file)
+        except ArgumentError:
+            self._MustUse__silence = True  # rejected, never elaborated: no "created but never used" warning
+            raise
         self.tables = core_tables(self.variant)
-        self.register_file = register_file
         members: dict[str, object] = {}
         for pin in (*Supi3Pins.inputs, *STRAP_PINS, *(REGISTER_FILE_INPUTS if register_file else ())):
             members[pin.name] = In(pin.width)
@@ -370,8 +378,10 @@ class _Engine(Elaboratable):
             count = Array(Const(max(t or 1, 1) - 1, len(wd_count)) for t in WATCHDOG_CLOCKS)[code]
             return [wd_active.eq(on), wd_count.eq(count)]
 
-        mod_ack = Signal(range(MODACK_PULSE_CLOCKS))
-        res_reg = Signal(range(RESREG_PULSE_CLOCKS))
+        # Pulse counters: loaded with the width at the edge that starts the pulse, the pin low while non-zero, so
+        # low for exactly the width's clocks (Table 3-13: 375 ns = tables.RESREG_PULSE_CLOCKS; /ModAck M3).
+        mod_ack = Signal(range(MODACK_PULSE_CLOCKS + 1))
+        res_reg = Signal(range(RESREG_PULSE_CLOCKS + 1))
         with m.If(mod_ack != 0):
             sync += mod_ack.eq(mod_ack - 1)
         with m.If(res_reg != 0):
@@ -388,7 +398,7 @@ class _Engine(Elaboratable):
             return events[_SOURCE_BIT[source]].eq(1)
 
         with m.If(fire):  # the watchdog resets process data (Table 3-13)
-            sync += [wd_active.eq(0), mfp_out.eq(0), res_reg.eq(RESREG_PULSE_CLOCKS - 1)]
+            sync += [wd_active.eq(0), mfp_out.eq(0), res_reg.eq(RESREG_PULSE_CLOCKS)]
             comb += [self.ib_reset.eq(1), event("IB_RESET")]
 
         # The following device (Table 2-2, M5)
@@ -648,7 +658,7 @@ class _Engine(Elaboratable):
                             with m.If(command[wire.CMD_WD_SET_BIT]):
                                 sync += [wd_code.eq(code), *arm(code)]
                             with m.If(command[wire.CMD_QUIT_BIT]):  # Quit Peripheral Error (3.6.2)
-                                sync += [pf.eq(module_error), mod_ack.eq(MODACK_PULSE_CLOCKS - 1)]
+                                sync += [pf.eq(module_error), mod_ack.eq(MODACK_PULSE_CLOCKS)]
                             sync += [wd.eq(0), te.eq(0), attention.eq(0)]
                         with m.Else():  # OUT data to the MFPs (Tables 3-1, 3-2), watchdog restarted
                             sync += [bus_active.eq(1), *arm(wd_code)]

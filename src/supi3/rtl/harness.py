@@ -15,17 +15,21 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import numpy.typing as npt
 
+from supi3.checks import check_bits, check_instance, fail
 from supi3.config import DeviceConfig, Variant, decode, mode_rows
-from supi3.model.pins import Supi3Pins
+from supi3.model.pins import Supi3Pins, check_names, input_row, input_traces
 from supi3.model.top import Supi3Chip
 from supi3.rtl.core import STRAP_PINS
-from supi3.rtl.tables import EXPANSION_BITS, MFP_PINS
+from supi3.rtl.tables import EXPANSION_BITS, MFP_PINS, check_variant
 from supi3.verif.errors import PinSpecError
 from supi3.verif.pinmodel import Pin
 
 __all__ = ["ChipStrapPins", "StrapPins", "strap_inputs", "strap_stimulus"]
 
 _STRAP_NAMES = tuple(pin.name for pin in STRAP_PINS)
+_CORE_NAMES = tuple(pin.name for pin in Supi3Pins.inputs)
+"""The model's own pins: its step() takes exactly these (the straps are this wrapper's)."""
+_ALL_NAMES = (*_CORE_NAMES, *_STRAP_NAMES)
 _EXPANSION_SHIFT = MFP_PINS - EXPANSION_BITS
 
 
@@ -37,6 +41,7 @@ def _open(width: int) -> int:
 def strap_inputs(config: DeviceConfig) -> dict[str, int]:
     """The strap port values that select ``config`` (pins the variant lacks driven as if open), and the MFP[15..12]
     expansion bits as ``"mfp_expansion"`` (0 when the mode has none)."""
+    check_instance("config", config, DeviceConfig)
     straps = config.straps()
     widths = {pin.name: pin.width for pin in STRAP_PINS}
     values = {
@@ -51,15 +56,76 @@ def strap_inputs(config: DeviceConfig) -> dict[str, int]:
 
 def strap_stimulus(config: DeviceConfig, stimulus: npt.NDArray[np.integer]) -> npt.NDArray[np.uint64]:
     """``stimulus`` (``(cycles, model inputs)`` in :attr:`Supi3Pins.inputs` order) with the strap columns appended
-    and MFP[15..12] forced to the configuration expansion where the mode has one."""
+    and MFP[15..12] forced to the configuration expansion where the mode has one.
+
+    Raises
+    ------
+    ArgumentError
+        ``config`` is not a :class:`DeviceConfig`, or ``stimulus`` not a 2-D integer array of that shape whose
+        columns fit their pins' widths.
+    """
     values = strap_inputs(config)
-    array = np.asarray(stimulus, dtype=np.uint64)
+    pins = Supi3Pins.inputs
+    given = np.asarray(stimulus) if isinstance(stimulus, (np.ndarray, list, tuple)) else None
+    if given is None or given.ndim != 2 or given.shape[1] != len(pins) or (given.size and given.dtype.kind not in "iu"):
+        raise fail("stimulus", f"a 2-D integer array of (cycles, {len(pins)}) in Supi3Pins.inputs order", stimulus)
+    input_traces({pin.name: given[:, k] for k, pin in enumerate(pins)})  # every column within its pin's width
+    array = given.astype(np.uint64)
     mfp = [pin.name for pin in Supi3Pins.inputs].index("mfp_in")
     if config.straps().mfp is not None:
         low = np.uint64((1 << _EXPANSION_SHIFT) - 1)
         array[:, mfp] = (array[:, mfp] & low) | np.uint64(values["mfp_expansion"] << _EXPANSION_SHIFT)
     straps = np.tile(np.array([values[name] for name in _STRAP_NAMES], dtype=np.uint64), (array.shape[0], 1))
     return np.concatenate([array, straps], axis=1)
+
+
+_STRAP_WIDTHS = {pin.name: pin.width for pin in STRAP_PINS}
+
+
+def _straps_of(inputs: object) -> dict[str, int]:
+    """The straps and ``mfp_in`` of ``inputs``, checked (named error for a missing or bad value)."""
+    if not isinstance(inputs, Mapping):
+        raise fail("inputs", "a mapping of pin name to value", inputs)
+    widths = {**_STRAP_WIDTHS, "mfp_in": MFP_PINS}
+    missing = [name for name in widths if name not in inputs]
+    if missing:
+        raise fail("inputs", f"a mapping with the pins {', '.join(widths)}", inputs, f"without {missing}")
+    return {name: check_bits(f"pin {name!r}", inputs[name], width) for name, width in widths.items()}
+
+
+def _strap_values(inputs: Mapping[str, int]) -> tuple[int, ...]:
+    """The strap values of one clock; every name of :attr:`StrapPins.inputs` exactly, else a named error."""
+    if not isinstance(inputs, Mapping) or len(inputs) != len(StrapPins.inputs) \
+            or any(name not in inputs for name in _ALL_NAMES):
+        check_names("inputs", inputs, _ALL_NAMES)
+    return tuple(check_bits(f"pin {name!r}", inputs[name], width) for name, width in _STRAP_WIDTHS.items())
+
+
+def _first_row(inputs: object) -> dict[str, int]:
+    """The straps and ``mfp_in`` of the first cycle of whole traces, checked (the model's ``run`` checks the rest)."""
+    mapping = check_names("inputs", inputs, _ALL_NAMES)
+    first = {}
+    for name, width in {**_STRAP_WIDTHS, "mfp_in": MFP_PINS}.items():
+        trace = np.asarray(mapping[name])
+        if trace.ndim != 1 or not trace.size or trace.dtype.kind not in "iu":
+            raise fail(f"pin {name!r} trace", "a non-empty 1-D integer sequence", mapping[name])
+        first[name] = check_bits(f"pin {name!r} trace[0]", trace[0].item(), width)
+    return first
+
+
+def _checked_run(inputs: object) -> tuple[dict[str, int], dict[str, npt.NDArray[np.integer]]]:
+    """Whole traces, checked before anything is built: the first cycle's straps and ``mfp_in``, and the model's traces
+    (:func:`~supi3.model.pins.input_traces`); the straps must be constant."""
+    first = _first_row(inputs)
+    assert isinstance(inputs, Mapping)
+    core = input_traces({name: inputs[name] for name in _CORE_NAMES})
+    for name in _STRAP_NAMES:
+        trace = np.asarray(inputs[name])
+        if len(trace) != len(core["do1"]):
+            raise fail(f"len(pin {name!r} trace)", f"{len(core['do1'])}, the length of pin 'do1' trace", len(trace))
+        if np.any(trace != first[name]):
+            raise PinSpecError(f"the straps must not change during a run ({name})")
+    return first, core
 
 
 class StrapPins:
@@ -80,7 +146,7 @@ class StrapPins:
     outputs: Sequence[Pin] = Supi3Pins.outputs
 
     def __init__(self, variant: Variant | str = Variant.OPC) -> None:
-        self.variant = Variant(variant)
+        self.variant = check_variant(variant)
         self.pins: Supi3Pins | None = None
         self._straps: tuple[int, ...] = ()
 
@@ -89,7 +155,16 @@ class StrapPins:
         self.pins = None
 
     def config_for(self, inputs: Mapping[str, int]) -> DeviceConfig:
-        """The configuration the straps in ``inputs`` select (:func:`supi3.config.decode`)."""
+        """The configuration the straps in ``inputs`` select (:func:`supi3.config.decode`).
+
+        Raises
+        ------
+        ArgumentError
+            A strap or ``mfp_in`` missing, or not an integer within its pin's width.
+        ConfigurationError
+            The straps select no operating mode.
+        """
+        inputs = _straps_of(inputs)
         c = format(int(inputs["c"]), f"0{STRAP_PINS[0].width}b")
         expansion = any(row.mfp is not None for row in mode_rows(self.variant) if row.c == c)
         mfp = format(int(inputs["mfp_in"]) >> _EXPANSION_SHIFT, f"0{EXPANSION_BITS}b") if expansion else None
@@ -105,27 +180,32 @@ class StrapPins:
         )
 
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
-        """One clock of the model of the configuration the straps select (see :mod:`supi3.verif.pinmodel`)."""
-        straps = tuple(int(inputs[name]) for name in _STRAP_NAMES)
+        """One clock of the model of the configuration the straps select (see :mod:`supi3.verif.pinmodel`).
+
+        Raises
+        ------
+        ArgumentError
+            ``inputs`` does not name exactly :attr:`inputs`, or a value is not an integer within its pin's width.
+        """
+        straps = _strap_values(inputs)
+        core = {name: inputs[name] for name in _CORE_NAMES}
         if self.pins is None:
+            input_row(core)  # checked before the model is built: a rejected call changes nothing
             self.pins = Supi3Pins(self.config_for(inputs))
             self._straps = straps
         elif straps != self._straps:
             raise PinSpecError(f"cycle {self.pins.cycle}: the straps changed ({self._straps} -> {straps})")
-        return self.pins.step(inputs)
+        return self.pins.step(core)
 
     def run(self, inputs: Mapping[str, npt.NDArray[np.integer]]) -> dict[str, npt.NDArray[np.int64]]:
         """Whole traces at once (:meth:`Supi3Pins.run`, event-driven); the straps must be constant."""
-        first = {name: int(np.asarray(trace)[0]) for name, trace in inputs.items()}
-        for name in _STRAP_NAMES:
-            if np.any(np.asarray(inputs[name]) != first[name]):
-                raise PinSpecError(f"the straps must not change during a run ({name})")
+        first, core = _checked_run(inputs)
         if self.pins is None:
             self.pins = Supi3Pins(self.config_for(first))
             self._straps = tuple(first[name] for name in _STRAP_NAMES)
         elif tuple(first[name] for name in _STRAP_NAMES) != self._straps:
             raise PinSpecError(f"cycle {self.pins.cycle}: the straps changed")
-        return self.pins.run({pin.name: np.asarray(inputs[pin.name]) for pin in Supi3Pins.inputs})
+        return self.pins.run(core)
 
     def recent_events(self) -> list[str]:
         """The model's last bus events, for mismatch reports."""
@@ -161,8 +241,7 @@ class ChipStrapPins:
         """Forget the configuration: the next :meth:`step` decodes the straps again."""
         self.chip = None
 
-    def _model(self, inputs: Mapping[str, int]) -> Supi3Chip:
-        straps = tuple(int(inputs[name]) for name in _STRAP_NAMES)
+    def _model(self, straps: tuple[int, ...], inputs: Mapping[str, int]) -> Supi3Chip:
         if self.chip is None:
             self.chip = Supi3Chip(self.straps.config_for(inputs), strict=False)
             self._straps = straps
@@ -171,16 +250,23 @@ class ChipStrapPins:
         return self.chip
 
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
-        """One clock of the chip the straps select (see :mod:`supi3.verif.pinmodel`)."""
-        return self._model(inputs).step(inputs)
+        """One clock of the chip the straps select (see :mod:`supi3.verif.pinmodel`).
+
+        Raises
+        ------
+        ArgumentError
+            ``inputs`` does not name exactly :attr:`inputs`, or a value is not an integer within its pin's width.
+        """
+        straps = _strap_values(inputs)
+        core = {name: inputs[name] for name in _CORE_NAMES}
+        if self.chip is None:
+            input_row(core)  # checked before the model is built: a rejected call changes nothing
+        return self._model(straps, inputs).step(core)
 
     def run(self, inputs: Mapping[str, npt.NDArray[np.integer]]) -> dict[str, npt.NDArray[np.int64]]:
         """Whole traces at once (:meth:`Supi3Chip.run`); the straps must be constant."""
-        first = {name: int(np.asarray(trace)[0]) for name, trace in inputs.items()}
-        for name in _STRAP_NAMES:
-            if np.any(np.asarray(inputs[name]) != first[name]):
-                raise PinSpecError(f"the straps must not change during a run ({name})")
-        return self._model(first).run({pin.name: np.asarray(inputs[pin.name]) for pin in Supi3Pins.inputs})
+        first, core = _checked_run(inputs)
+        return self._model(tuple(first[name] for name in _STRAP_NAMES), first).run(core)
 
     def recent_events(self) -> list[str]:
         """The core's last bus events and the register file's last violations, for mismatch reports."""

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from functools import cache
 from typing import Final
 
+from supi3.checks import fail
 from supi3.config import DeviceConfig, Straps, Variant, decode, mode_rows
 from supi3.errors import ConfigurationError
 from supi3.interbus.wire import Cycle
@@ -152,12 +153,25 @@ def _values(width: int, make: Callable[[str], DeviceConfig]) -> list[tuple[int, 
 
 
 @cache
+def check_variant(variant: object) -> Variant:
+    """``variant`` as a :class:`~supi3.config.Variant`: a member or its value, ``"opc"`` or ``"ls"`` (Table 1-1).
+
+    Raises
+    ------
+    ArgumentError
+        Anything else ("variant must be one of 'opc', 'ls' (Table 1-1), not ...").
+    """
+    if isinstance(variant, str) and variant in {member.value for member in Variant}:
+        return Variant(variant)
+    raise fail("variant", f"one of {', '.join(repr(member.value) for member in Variant)}", variant, "Table 1-1")
+
+
 def core_tables(variant: Variant | str = Variant.OPC) -> CoreTables:
     """The strap decode tables of ``variant`` (computed once per variant).
 
     The clock, RF and DIAG_CONF entries are probed on the variant's first mode row; they do not depend on the mode.
     """
-    variant = Variant(variant)
+    variant = check_variant(variant)
     rows = list(mode_rows(variant))
     modes = tuple(_probe_mode(decode(row.c, row.mfp, variant=variant)) for row in rows)
     first = rows[0]

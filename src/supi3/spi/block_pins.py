@@ -29,7 +29,9 @@ import dataclasses
 from collections.abc import Mapping, Sequence
 from typing import Final
 
+from supi3.checks import check_bits, check_bool
 from supi3.config import MfpKind, Variant, decode, mode_rows
+from supi3.errors import ArgumentError
 from supi3.model.registers import RegisterFile
 from supi3.regmap import INTERRUPT_SOURCES, REGISTER_MAP, Access, Direction
 from supi3.regmap.core import BYTE_BITS, BYTE_MASK
@@ -122,15 +124,28 @@ def strap_values(rate: int, np_id: int, np_length: int = 0) -> dict[str, int]:
     ------
     PinSpecError
         If ``rate`` is not a bit rate of Table 1-7.
+    ArgumentError
+        ``np_id`` not a byte, ``np_length`` not a 5-bit length code (Table 3-11).
     """
-    if rate not in BIT_RATES:
+    if isinstance(rate, bool) or rate not in BIT_RATES:
         raise PinSpecError(f"bit rate must be one of {BIT_RATES}, not {rate!r}")
-    return {"rate": BIT_RATES.index(rate), "np_id": np_id, "np_length": np_length}
+    return {"rate": BIT_RATES.index(rate), "np_id": check_bits("np_id", np_id, BYTE_BITS, "3.4.1"),
+            "np_length": check_bits("np_length", np_length, LENGTH_CODE_BITS, "Table 3-11")}
 
 
 def block_model(rate: int, np_id: int = 0, np_length: int = 0, *, strict: bool = False) -> SlavePins:
     """A :class:`SlavePins` in its power-up state for bit rate ``rate`` (bit/s) and the µP_Not_Ready code
-    ``np_id`` / ``np_length`` (3.4.1), the only parts of the configuration the interface sees."""
+    ``np_id`` / ``np_length`` (3.4.1), the only parts of the configuration the interface sees.
+
+    Raises
+    ------
+    PinSpecError
+        ``rate`` is not a bit rate of Table 1-7.
+    ArgumentError
+        ``np_id`` not a byte, ``np_length`` not a 5-bit length code, ``strict`` not a bool.
+    """
+    strap_values(rate, np_id, np_length)
+    check_bool("strict", strict)
     config = dataclasses.replace(_BASE_CONFIG, bit_rate=rate, id_code=np_id, length_code=np_length)
     return SlavePins(RegisterFile(config, strict=strict))
 
@@ -138,6 +153,23 @@ def block_model(rate: int, np_id: int = 0, np_length: int = 0, *, strict: bool =
 def _bytes(value: int, count: int) -> bytes:
     """Bytes 0..count-1 of a port holding byte k in bits 8k + 7 .. 8k."""
     return bytes((value >> (BYTE_BITS * k)) & BYTE_MASK for k in range(count))
+
+
+_WIDTHS: Final[dict[str, int]] = {pin.name: pin.width for pin in (*SERIAL_INPUTS, *STRAP_INPUTS, *CORE_INPUTS)}
+
+
+def _checked(inputs: object) -> dict[str, int]:
+    """The block's inputs by name, each an integer within its port's width, as plain ``int``; else a named error."""
+    if not isinstance(inputs, Mapping):
+        raise ArgumentError("inputs", inputs, f"inputs must be a mapping of pin name to value, not {inputs!r:.60}")
+    missing = [name for name in _WIDTHS if name not in inputs]
+    unknown = [name for name in inputs if name not in _WIDTHS]
+    if missing or unknown:
+        problems = [f"without {', '.join(map(repr, missing))}" if missing else "",
+                    f"with {', '.join(map(repr, unknown))}, no such pin" if unknown else ""]  # fmt: skip
+        raise ArgumentError("inputs", inputs, f"inputs must name exactly the pins {', '.join(_WIDTHS)}, not "
+                                              + "; ".join(problem for problem in problems if problem))
+    return {name: check_bits(f"pin {name!r}", inputs[name], width) for name, width in _WIDTHS.items()}
 
 
 class UpifBlockPins:
@@ -159,7 +191,7 @@ class UpifBlockPins:
     outputs: Sequence[Pin] = (*SERIAL_OUTPUTS, *CORE_OUTPUTS)
 
     def __init__(self, *, strict: bool = False) -> None:
-        self.strict = strict
+        self.strict = check_bool("strict", strict)
         self.pins: SlavePins | None = None
         self._straps: tuple[int, ...] = ()
 
@@ -180,7 +212,17 @@ class UpifBlockPins:
         return self.pins
 
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
-        """One clock (see :mod:`supi3.verif.pinmodel`): the outputs of this cycle, then the edge ending it."""
+        """One clock (see :mod:`supi3.verif.pinmodel`): the outputs of this cycle, then the edge ending it.
+
+        Raises
+        ------
+        ArgumentError
+            ``inputs`` does not name exactly the pins of :attr:`inputs`, or a value is not an integer within its
+            pin's width (nothing changes).
+        PinSpecError
+            The straps select no bit rate, or changed after the first clock.
+        """
+        inputs = _checked(inputs)
         pins = self._build(inputs)
         registers = pins.registers
         outputs = {

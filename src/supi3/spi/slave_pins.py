@@ -17,17 +17,29 @@ require.
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, fields
-from typing import Final
+from typing import Final, NoReturn
 
 from supi3 import tables
+from supi3.checks import check_bits, check_bool, check_choice, check_instance, check_int, fail
+from supi3.errors import ArgumentError
 from supi3.model.registers import InterfaceViolationError, RegisterFile
 from supi3.spi.upif import Mode, UpifProtocol, UpifUsageError
 from supi3.timing import timing_table
 
-__all__ = ["INPUT_PINS", "OUTPUT_PINS", "PinsIn", "PinsOut", "SlavePins", "TimingViolationError"]
+__all__ = [
+    "C_D_SETTLES_WITHIN",
+    "INPUT_PINS",
+    "OUTPUT_PINS",
+    "PinsIn",
+    "PinsOut",
+    "SlavePins",
+    "TimingChecker",
+    "TimingViolationError",
+]
 
 TCLK_PER_BIT: Final[int] = 16
 """TCLK = t_Bit_IBS / 16 (Table 3-7)."""
@@ -78,6 +90,11 @@ class PinsIn:
     mfp7: int = 1
     """MFP7 as an input: S/R in Intel mode (Table 3-9); not used in Motorola mode (there it is SerOUT)."""
 
+    def __post_init__(self) -> None:
+        a, b, c, d, e = self.sas_init, self.sclk, self.ss_n, self.mfp6, self.mfp7
+        if not (int is type(a) is type(b) is type(c) is type(d) is type(e) and not (a | b | c | d | e) >> 1):
+            _check_levels(self)
+
 
 @dataclass(frozen=True)
 class PinsOut:
@@ -98,6 +115,20 @@ class PinsOut:
     mfp7: int
     """MFP7, SerOUT (Motorola mode)."""
     mfp7_oe: int
+
+    def __post_init__(self) -> None:
+        a, b, c, d, e = self.io, self.io_oe, self.c_d, self.c_d_oe, self.irq_n
+        f, g, h, i, j = self.irq_n_oe, self.mfp6, self.mfp6_oe, self.mfp7, self.mfp7_oe
+        if not (int is type(a) is type(b) is type(c) is type(d) is type(e) is type(f) is type(g) is type(h)
+                is type(i) is type(j) and not (a | b | c | d | e | f | g | h | i | j) >> 1):
+            _check_levels(self)
+
+
+def _check_levels(pins: PinsIn | PinsOut) -> None:
+    """Every field of ``pins`` a level, 0 or 1 (numpy integers become ``int``), else a named error."""
+    for item in fields(pins):
+        value = check_bits(f"pin {item.name!r}", getattr(pins, item.name), 1)
+        object.__setattr__(pins, item.name, value)
 
 
 INPUT_PINS: Final[tuple[str, ...]] = tuple(f.name for f in fields(PinsIn))
@@ -126,24 +157,72 @@ class _Sync:
         self.s1, self.s2, self.s3 = pin, self.s1, self.s2
 
 
-class _TimingChecker:
-    """Table 3-7 requirements on the µP's signals, checked on the raw pins at chip-clock resolution."""
+C_D_SETTLES_WITHIN: Final[str] = "t6"
+"""After /SS rises, C/D may still change until the maximum of this Table 3-7 row (3 TCLK); a C/D change in that
+window that comes after /SS fell again is a t8 violation: the µP read a stale C/D (docs/assumptions/model.md M14)."""
+
+
+class TimingChecker:
+    """Table 3-7's limits on the µP's signals, checked on the raw pins at chip-clock resolution.
+
+    Ref: IBS SUPI 3 OPC UM E rev. 05, 3.4.2, Table 3-7. Every row that limits the µP's signals is checked (the rules
+    are in docs/assumptions/model.md M14; measured = clocks / ``clock_hz`` between the first cycles showing the two
+    changes):
+
+    * t0, the SCLK period: rising to rising edge while /SS is low (the chip acts on rising edges only; UP-23);
+    * t1: /SS fall to the frame's first SCLK fall; t2: the frame's last SCLK rise to the /SS rise (an SCLK rise in
+      the cycle /SS rises counts as the frame's);
+    * t4 (setup) and t5 (hold): a SerIN change against SCLK rises while /SS is low (not while the chip drives MFP6);
+    * t8: /SS falls at least TCLK after C/D changed; and C/D must have settled: a C/D change up to t6's maximum
+      after /SS rose (:data:`C_D_SETTLES_WITHIN`) that comes after /SS fell again is reported too, measured
+      negative (the fall came first);
+    * t10 and t11 (Intel, S/R on MFP7 may change only while /SS is high or in the cycle of either /SS edge): an S/R
+      change while /SS is low before the frame's first SCLK fall is t10 (S/R became valid after /SS fell; measured
+      negative), a later one t11 (it changed before /SS rose; measured ``None``);
+    * t_SAS_INIT: the SAS_INIT high pulse width.
+
+    t3, t6, t7 and t9 limit the chip's own outputs (guaranteed by docs/assumptions/upif.md UP-14, tested there).
+
+    Parameters
+    ----------
+    bit_rate:
+        The INTERBUS bit rate (bit/s) the limits are evaluated for.
+    clock_hz:
+        The chip clock, the resolution of the measurement.
+    report:
+        Called with each :class:`TimingViolationError`.
+    """
 
     def __init__(self, bit_rate: int, clock_hz: int, report: Callable[[InterfaceViolationError], None]) -> None:
+        check_choice("bit_rate", bit_rate, tables.BIT_RATES, "Table 1-7")
+        check_int("clock_hz", clock_hz, 1)
+        if not callable(report):
+            raise fail("report", "a callable", report)
         self._limits = {t.symbol: t for t in timing_table("3-7", bit_rate)}
+        settle = self._limits[C_D_SETTLES_WITHIN].maximum_s
+        assert settle is not None
+        self._settle = math.ceil(settle * clock_hz - _EPSILON_S * clock_hz)
         self._clock_hz = clock_hz
         self._report = report
         self.reset()
 
     def reset(self) -> None:
+        """Forget every edge seen (the state after a power-up reset)."""
         self._pins = PinsIn()
         self._c_d: int | None = None
         self._last_c_d: int | None = None
         self._ss_fall: int | None = None
+        self._ss_rise: int | None = None
         self._first_sclk_fall: int | None = None
         self._last_rise: int | None = None
         self._last_data: int | None = None
         self._sas_rise: int | None = None
+
+    def _violation(self, symbol: str, cycle: int, clocks: int | None, note: str = "") -> None:
+        limit = self._limits[symbol]
+        assert limit.minimum_s is not None
+        measured = None if clocks is None else clocks / self._clock_hz
+        self._report(TimingViolationError(symbol, limit.explanation + note, measured, limit.minimum_s, cycle))
 
     def _require(self, symbol: str, cycle: int, since: int | None) -> None:
         """Report ``symbol`` if less than its minimum elapsed from cycle ``since`` to ``cycle``."""
@@ -151,43 +230,79 @@ class _TimingChecker:
             return
         limit = self._limits[symbol]
         assert limit.minimum_s is not None
-        measured = (cycle - since) / self._clock_hz
-        if measured + _EPSILON_S < limit.minimum_s:
-            self._report(TimingViolationError(symbol, limit.explanation, measured, limit.minimum_s, cycle))
+        if (cycle - since) / self._clock_hz + _EPSILON_S < limit.minimum_s:
+            self._violation(symbol, cycle, cycle - since)
 
     def check(self, cycle: int, pins: PinsIn, out: PinsOut, intel: bool) -> None:
-        """Check the inputs of ``cycle`` against those of the cycle before; ``out`` are the outputs of ``cycle``."""
+        """Check the inputs of ``cycle`` against those of the cycle before; ``out`` are the outputs of ``cycle``.
+
+        Raises
+        ------
+        ArgumentError
+            ``cycle`` not an integer >= 0, ``pins`` not a :class:`PinsIn`, ``out`` not a :class:`PinsOut`, ``intel``
+            not a bool; nothing changes.
+        """
+        if not (type(cycle) is int and cycle >= 0 and type(pins) is PinsIn and type(out) is PinsOut
+                and type(intel) is bool):
+            check_int("cycle", cycle, 0)
+            check_instance("pins", pins, PinsIn)
+            check_instance("out", out, PinsOut)
+            check_bool("intel", intel)
         prev, self._pins = self._pins, pins
+        fell, rose = prev.ss_n and not pins.ss_n, pins.ss_n and not prev.ss_n
+        low = not pins.ss_n
+        in_frame = low or rose  # an SCLK edge in the cycle /SS rises still belongs to the frame
         if self._c_d is not None and out.c_d != self._c_d:
             self._last_c_d = cycle
+            stale = self._ss_rise is not None and cycle - self._ss_rise <= self._settle
+            if stale and low and self._ss_fall is not None and self._ss_rise is not None \
+                    and self._ss_rise < self._ss_fall < cycle:
+                self._violation("t8", cycle, self._ss_fall - cycle, " (/SS fell before C/D changed)")
         self._c_d = out.c_d
-        if prev.ss_n and not pins.ss_n:
+        if fell:
             self._require("t8", cycle, self._last_c_d)
             self._ss_fall, self._first_sclk_fall, self._last_rise = cycle, None, None
-        selected = not pins.ss_n
         if pins.mfp6 != prev.mfp6 and not out.mfp6_oe:
-            if selected:
+            if low:
                 self._require("t5", cycle, self._last_rise)
             self._last_data = cycle
-        if selected and prev.sclk and not pins.sclk and self._first_sclk_fall is None:
+        if in_frame and prev.sclk and not pins.sclk and self._first_sclk_fall is None:
             self._first_sclk_fall = cycle
             self._require("t1", cycle, self._ss_fall)
-        if selected and pins.sclk and not prev.sclk:
+        if in_frame and pins.sclk and not prev.sclk:
             self._require("t0", cycle, self._last_rise)
             if not out.mfp6_oe:
                 self._require("t4", cycle, self._last_data)
             self._last_rise = cycle
-        if intel and selected and not prev.ss_n and pins.mfp7 != prev.mfp7:
-            limit = self._limits["t11"]
-            assert limit.minimum_s is not None
-            self._report(TimingViolationError("t11", limit.explanation + " (S/R changed while /SS low)", None,
-                                              limit.minimum_s, cycle))
-        if pins.ss_n and not prev.ss_n:
+        if intel and low and not fell and pins.mfp7 != prev.mfp7:
+            if self._first_sclk_fall is None or self._first_sclk_fall == cycle:
+                since = self._ss_fall if self._ss_fall is not None else cycle
+                self._violation("t10", cycle, since - cycle, " (S/R changed after /SS fell)")
+            else:
+                self._violation("t11", cycle, None, " (S/R changed while /SS low)")
+        if rose:
             self._require("t2", cycle, self._last_rise)
+            self._ss_rise = cycle
         if pins.sas_init and not prev.sas_init:
             self._sas_rise = cycle
         if prev.sas_init and not pins.sas_init:
             self._require("t_SAS_INIT", cycle, self._sas_rise)
+
+
+_DECODED: dict[tuple[int, ...], PinsOut] = {}
+"""Every output combination :meth:`SlavePins._decode` has produced (PinsOut field order)."""
+
+
+def _bad_names(inputs: object) -> NoReturn:
+    """Raise the named error for a mapping that does not name exactly :data:`INPUT_PINS`."""
+    if not isinstance(inputs, Mapping):
+        raise fail("inputs", "a mapping of pin name to level", inputs)
+    missing = [name for name in INPUT_PINS if name not in inputs]
+    unknown = [name for name in inputs if name not in INPUT_PINS]
+    problems = [f"without {', '.join(map(repr, missing))}" if missing else "",
+                f"with {', '.join(map(repr, unknown))}, no such pin" if unknown else ""]  # fmt: skip
+    raise ArgumentError("inputs", inputs, f"inputs must name exactly the pins {', '.join(INPUT_PINS)}, not "
+                                          + "; ".join(problem for problem in problems if problem))
 
 
 class SlavePins:
@@ -208,6 +323,8 @@ class SlavePins:
     """
 
     def __init__(self, registers: RegisterFile, *, clock_hz: int = tables.CLOCK_HZ) -> None:
+        check_instance("registers", registers, RegisterFile)
+        check_int("clock_hz", clock_hz, 1)
         bit_rate = registers.config.bit_rate
         if clock_hz % (TCLK_PER_BIT * bit_rate):
             raise UpifUsageError(f"clock {clock_hz} Hz is not a multiple of TCLK = {TCLK_PER_BIT} * {bit_rate} Hz")
@@ -217,7 +334,7 @@ class SlavePins:
         self.output_delay = 2 * self.clocks_per_tclk - 2
         """Output pipeline stages after the decoded state (UP-14): 6 at 500 kbit/s, 0 at 2 Mbit/s."""
         self.clock_hz = clock_hz
-        self._checker = _TimingChecker(bit_rate, clock_hz, registers.violations.report)
+        self._checker = TimingChecker(bit_rate, clock_hz, registers.violations.report)
         self.reset()
 
     @property
@@ -250,9 +367,13 @@ class SlavePins:
 
         Raises
         ------
+        ArgumentError
+            ``pins`` is not a :class:`PinsIn` (nothing changes).
         TimingViolationError, ProtocolViolationError, ReconfigurationError, InconsistentDataError
             In strict mode, after the cycle completed.
         """
+        if type(pins) is not PinsIn:
+            check_instance("pins", pins, PinsIn)
         out = self._pipeline[0]
         with self.registers.violations.deferred():
             self._checker.check(self.cycle, pins, out, self.protocol.mode is Mode.INTEL)
@@ -264,7 +385,16 @@ class SlavePins:
 
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
         """:meth:`tick` with pins by name (the lockstep harness's ``PinModel.step``; names in
-        :data:`INPUT_PINS` and :data:`OUTPUT_PINS`)."""
+        :data:`INPUT_PINS` and :data:`OUTPUT_PINS`).
+
+        Raises
+        ------
+        ArgumentError
+            ``inputs`` does not name exactly :data:`INPUT_PINS`, or a level is not 0 or 1 (nothing changes).
+        """
+        if not isinstance(inputs, Mapping) or len(inputs) != len(INPUT_PINS) \
+                or any(name not in inputs for name in INPUT_PINS):
+            _bad_names(inputs)
         return asdict(self.tick(PinsIn(**inputs)))
 
     def _edge(self, pins: PinsIn, out: PinsOut) -> None:
@@ -311,10 +441,10 @@ class SlavePins:
             bit = (self._tx >> (index if protocol.lsb_first else 7 - index)) & 1
         intel = drive and protocol.mode is Mode.INTEL
         motorola = drive and protocol.mode is Mode.MOTOROLA
-        return PinsOut(
-            io=int(registers.io_access), io_oe=1,
-            c_d=protocol.c_d, c_d_oe=1,
-            irq_n=registers.irq_n, irq_n_oe=1,
-            mfp6=bit if intel else 0, mfp6_oe=int(intel),
-            mfp7=bit if motorola else 0, mfp7_oe=int(motorola),
-        )
+        # PinsOut is frozen: equal outputs share one checked instance (at most 2**10), built once.
+        key = (int(registers.io_access), 1, protocol.c_d, 1, registers.irq_n, 1, bit if intel else 0, int(intel),
+               bit if motorola else 0, int(motorola))  # fmt: skip
+        out = _DECODED.get(key)
+        if out is None:
+            out = _DECODED[key] = PinsOut(*key)
+        return out

@@ -14,11 +14,15 @@ Every decision is in ``docs/upif.md`` and ``docs/assumptions/upif.md``.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from enum import StrEnum
-from typing import Final
+from typing import Final, TypeVar
 
-from supi3.errors import Supi3Error
+from supi3.checks import check_bits, check_bool, check_bytes, check_instance, check_int, describe
+from supi3.config import DeviceConfig
+from supi3.errors import ArgumentError, Supi3Error
+from supi3.model.chip import Supi3
 from supi3.model.registers import InterfaceViolationError, RegisterFile
 from supi3.regmap import (
     COMMAND_BYTE,
@@ -34,13 +38,21 @@ from supi3.regmap import (
 __all__ = [
     "C_D_COMMAND",
     "C_D_DATA",
+    "InterfaceDisabledError",
+    "InterruptedCommandError",
     "Mode",
+    "ModeLockedError",
+    "NotInitializedError",
     "Phase",
     "ProtocolViolationError",
+    "UninitializedAccessError",
     "UpInterface",
+    "UpifArgumentError",
     "UpifProtocol",
     "UpifUsageError",
 ]
+
+_T = TypeVar("_T")
 
 C_D_COMMAND: Final[int] = 0
 """C/D (MFP2) level while the next byte is an initialization or command byte, in both modes (UP-2)."""
@@ -50,6 +62,23 @@ C_D_DATA: Final[int] = 1
 BLOCK_ADDRESS: Final[int] = 15
 """A3..0 of the command byte that starts a block transfer (3.4.6)."""
 _WORD_BITS: Final[int] = 16
+
+# Firmware API after misuse (docs/assumptions/upif.md UP-25 to UP-29): where the manual is silent, one constant each.
+REFUSED_BEFORE_INIT: Final[frozenset[str]] = frozenset({"read", "exchange", "block transfer"})
+"""UP-25: the register accesses that return data; before initialization the chip drives none (3.4.1, 3.4.3), so
+:class:`UpInterface` refuses them (:class:`NotInitializedError`) and sends nothing."""
+UNINITIALIZED_WRITE: Final[str] = "interface not initialized: {command:02X}h taken as a faulty initialization byte; " \
+    "SAS_INIT needed"
+"""UP-26: a write before initialization goes out as on the real chip, which takes its command byte as a faulty
+initialization byte and disables the interface (3.4.3); this is the violation reported (strict: raised)."""
+INTERRUPTED_INIT: Final[str] = "initialize(): C/D = 1 before the initialization byte, the µP was reset in the middle " \
+    "of a command: {byte:02X}h was taken as {what}{effect}; SAS_INIT before initialize() after a µP reset"
+"""UP-27: :meth:`UpInterface.initialize` on a chip showing data sends the byte anyway (the chip takes it as the
+pending data byte, 3.4.3, 3.4.4) and reports this violation; the initialization is not a first one."""
+MODE_LOCKED: Final[str] = "initialize({wanted}): the interface is already initialized in {mode} mode, which only a " \
+    "power-up reset or SAS_INIT changes; {byte:02X}h was taken as a command"
+"""UP-29: :meth:`UpInterface.initialize` with the other mode on an initialized chip: the chip keeps its mode and
+takes the byte as a command (3.4.3); this violation is reported, the initialization is not a first one."""
 
 
 class Mode(StrEnum):
@@ -83,6 +112,12 @@ class Phase(StrEnum):
     """The next byte of a block transfer."""
     DISABLED = "disabled"
     """A faulty initialization byte was received: nothing until power-up reset or SAS_INIT (3.4.3)."""
+
+
+ACCESS_END_PHASES: Final[tuple[Phase, ...]] = (Phase.COMMAND, Phase.DISABLED)
+"""UP-28: where a register access of :class:`UpInterface` (read, write, exchange, block transfer) leaves the
+interface, whether or not it raised a violation: ready for the next command, or disabled after a write before
+initialization (UP-26). The access runs to its end inside one :meth:`ViolationLog.deferred` block."""
 
 
 class UpifUsageError(Supi3Error, ValueError):
@@ -121,6 +156,8 @@ class UpifProtocol:
     """
 
     def __init__(self, registers: RegisterFile) -> None:
+        if not isinstance(registers, RegisterFile):
+            raise _refused("registers", registers, "")
         self.registers = registers
         self.mode: Mode | None = None
         self.phase = Phase.INIT
@@ -193,6 +230,8 @@ class UpifProtocol:
             (the chip sends on Ser_IN/OUT), else ``None``. Before initialization and when disabled: ``None``.
             The byte is the read register for a read access, else :attr:`last_rx` (UP-8).
         """
+        if type(s_r) is not bool:
+            s_r = _checked(check_bool, "s_r", s_r)
         if self._frame is not None:
             raise UpifUsageError("begin() inside a frame: call end() or abort() first")
         tx: int | None = None
@@ -206,9 +245,9 @@ class UpifProtocol:
     def end(self, rx: int) -> None:
         """/SS rose after 8 bits: process the received byte ``rx`` (in Intel receive frames the byte on the
         line is the chip's own, so ``rx`` equals what :meth:`begin` returned)."""
+        if type(rx) is not int or not 0 <= rx <= 0xFF:
+            rx = _checked(check_bits, "rx", rx, 8, "the received byte")
         frame = self._take_frame()
-        if not 0 <= rx <= 0xFF:
-            raise UpifUsageError(f"received byte must be 0..255, not {rx!r}")
         if self.phase is Phase.DISABLED:
             return  # data transmission is disabled until power-up reset or SAS_INIT (3.4.3)
         if self.phase is Phase.INIT:
@@ -223,6 +262,10 @@ class UpifProtocol:
 
     def abort(self, bits: int) -> None:
         """/SS rose after ``bits`` != 8 SCLK edges: the frame is dropped, the protocol state is unchanged."""
+        bits = _checked(check_int, "bits", bits, 0, limit="SCLK rising edges in the frame")
+        if bits == 8:
+            raise UpifArgumentError("bits", bits, "bits must be the SCLK edge count of an incomplete frame, not 8: a "
+                                    "complete byte ends with end() (3.4.2)")
         self._take_frame()
         detail = "/SS held low across bytes" if bits > 8 else "incomplete byte"
         self._violation("3.4.2", f"{detail}: {bits} SCLK rising edges between /SS edges, frame ignored")
@@ -246,11 +289,11 @@ class UpifProtocol:
         if self.phase is Phase.BLOCK:
             slot = self._slots[0]
             return slot.address if slot.read else None
-        if self.phase is Phase.DATA:
-            assert self.command is not None
-            port = REGISTER_MAP.port(self.command.address, Direction.READ)
-            if self.command.rd and port.access is not Access.RESERVED_IGNORED:
-                return self.command.address
+        command = self.command
+        if self.phase is Phase.DATA and command is not None:  # the DATA phase always has its command
+            port = REGISTER_MAP.port(command.address, Direction.READ)
+            if command.rd and port.access is not Access.RESERVED_IGNORED:
+                return command.address
         return None
 
     def _writes(self, s_r: bool) -> bool:
@@ -281,9 +324,10 @@ class UpifProtocol:
 
     def _end_data(self, rx: int, frame: _Frame) -> None:
         command = self.command
-        assert command is not None
-        port = REGISTER_MAP.port(command.address, Direction.WRITE)
         self.phase = Phase.COMMAND
+        if command is None:  # cannot happen: the DATA phase always has its command
+            return
+        port = REGISTER_MAP.port(command.address, Direction.WRITE)
         if port.access is Access.RESERVED_IGNORED:
             return
         if self.mode is Mode.INTEL and command.rd != command.wr and command.rd == frame.s_r:
@@ -333,15 +377,31 @@ class UpInterface:
     Parameters
     ----------
     registers:
-        The chip's register file (shared with the INTERBUS core).
+        The chip's register file (shared with the INTERBUS core), or the transaction-level chip
+        (:class:`~supi3.model.chip.Supi3`) itself, whose register file is taken; either way the chip must be strapped
+        for an Init-µP mode (Tables 2-4 to 2-7).
 
     Notes
     -----
-    Strict mode (``registers.violations.strict``) raises a violation after the byte that caused it has been
-    processed; lenient mode records it in ``registers.violations.records``.
+    Strict mode (``registers.violations.strict``) raises a violation after the register access (or byte) that
+    caused it has completed; lenient mode records it in ``registers.violations.records``. Every method checks its
+    arguments and the interface's state before the first byte goes out: a refused call (an
+    :class:`UpifArgumentError` or :class:`UpifUsageError`) sends nothing and changes nothing. After a register
+    access (:meth:`read`, :meth:`write`, :meth:`exchange`, :meth:`block_transfer`) the interface is back in the
+    command phase, whether or not a violation was raised, except where the violation says otherwise (a write
+    before initialization disables the interface, 3.4.3). See docs/upif.md, "Firmware API after misuse" (UP-25 to
+    UP-29).
     """
 
-    def __init__(self, registers: RegisterFile) -> None:
+    def __init__(self, registers: RegisterFile | Supi3) -> None:
+        if isinstance(registers, Supi3):
+            chip = registers
+            if chip.registers is None:
+                raise _refused("registers", chip, "the chip's strapped mode has no serial µP interface", chip.config)
+            registers = chip.registers
+        elif not isinstance(registers, RegisterFile):
+            hint = "Supi3.registers is None outside the µP modes" if registers is None else ""
+            raise _refused("registers", registers, hint)
         self.protocol = UpifProtocol(registers)
 
     @property
@@ -362,6 +422,10 @@ class UpInterface:
         """A SAS_INIT pulse: the interface waits for an initialization byte, SET and ID are kept (3.4.3)."""
         self.protocol.sas_init()
 
+    # --------------------------------------------------------------------------------------------------------
+    # One byte
+    # --------------------------------------------------------------------------------------------------------
+
     def transfer(self, mosi: int, *, s_r: bool | None = None) -> int | None:
         """One byte: /SS low, 8 bits, /SS high.
 
@@ -380,23 +444,35 @@ class UpInterface:
 
         Raises
         ------
+        UpifArgumentError
+            If ``mosi`` is not a byte or ``s_r`` not a ``bool`` (or ``None``).
         UpifUsageError
-            If ``mosi`` is not a byte, or ``s_r`` is missing in Intel mode.
+            If ``s_r`` is missing in Intel mode, or a frame was begun on :attr:`protocol` and not ended.
         ProtocolViolationError, ReconfigurationError, InconsistentDataError, SetRegisterError
             In strict mode, after the byte was processed.
         """
-        if isinstance(mosi, bool) or not isinstance(mosi, int) or not 0 <= mosi <= 0xFF:
-            raise UpifUsageError(f"mosi must be a byte 0..255, not {mosi!r}")
-        if self.protocol.mode is Mode.INTEL and s_r is None:
+        if type(mosi) is not int or not 0 <= mosi <= 0xFF:
+            mosi = _checked(check_bits, "mosi", mosi, 8, "one byte per frame, 3.4.2")
+        if s_r is not None and type(s_r) is not bool:
+            s_r = _checked(check_bool, "s_r", s_r)
+        protocol = self.protocol
+        if protocol.mode is Mode.INTEL and s_r is None:
             raise UpifUsageError("Intel mode: give s_r (True = the µP sends, False = it receives; Table 3-9)")
-        with self.registers.violations.deferred():
-            tx = self.protocol.begin(bool(s_r) if s_r is not None else True)
-            line = tx if self.protocol.mode is Mode.INTEL and tx is not None else mosi
-            self.protocol.end(line)
+        if protocol.in_frame:
+            raise UpifUsageError("transfer() inside a frame begun on the protocol: end() or abort() it first")
+        with protocol.registers.violations.deferred():
+            return self._byte(mosi, True if s_r is None else s_r)
+
+    def _byte(self, mosi: int, s_r: bool) -> int | None:
+        """One frame, arguments and state already checked: begin, then end with what is on the data line."""
+        protocol = self.protocol
+        tx = protocol.begin(s_r)
+        protocol.end(tx if tx is not None and protocol.mode is Mode.INTEL else mosi)
         return tx
 
-    def _send(self, byte: int) -> int | None:
-        return self.transfer(byte, s_r=True)
+    # --------------------------------------------------------------------------------------------------------
+    # Initialization
+    # --------------------------------------------------------------------------------------------------------
 
     def initialize(self, mode: Mode) -> bool:
         """Send the initialization byte of ``mode`` and tell whether this was a first initialization.
@@ -405,6 +481,10 @@ class UpInterface:
         byte (3.4.3). A chip that was already initialized took the byte as a command and shows data: a no-op
         data byte completes it (00h is command "no direction, address 0"; 81h reads OUT byte 1).
 
+        A chip that shows data *before* the byte (C/D = 1: the µP was reset in the middle of a command or a block
+        transfer) takes the initialization byte as that command's data byte, as the real chip does: this is
+        reported as :class:`InterruptedCommandError` (UP-27), and the initialization is not a first one.
+
         Returns
         -------
         bool
@@ -412,44 +492,155 @@ class UpInterface:
 
         Raises
         ------
-        UpifUsageError
-            If the interface is disabled by an earlier faulty initialization byte (needs SAS_INIT).
+        UpifArgumentError
+            If ``mode`` is not a :class:`Mode`.
+        InterfaceDisabledError
+            If the interface is disabled by an earlier faulty initialization byte (needs SAS_INIT); nothing is
+            sent.
+        InterruptedCommandError
+            In strict mode, after the byte was taken as a data byte (recorded in lenient mode).
+        ModeLockedError
+            In strict mode, when an initialized chip was asked for the other mode (recorded in lenient mode, UP-29).
         """
-        self._send(mode.init_byte)
-        if self.c_d == C_D_COMMAND:
-            return True
-        if self.protocol.phase is Phase.DATA:
-            assert self.protocol.command is not None
-            self.transfer(0, s_r=not self.protocol.command.rd)
+        if type(mode) is not Mode:
+            mode = _checked(check_instance, "mode", mode, Mode, "Mode.MOTOROLA or Mode.INTEL (Table 3-8)")
+        protocol = self.protocol
+        self._check_frame("initialize")
+        if protocol.phase is Phase.DISABLED:
+            raise InterfaceDisabledError("initialize")
+        with protocol.registers.violations.deferred():
+            if protocol.phase in (Phase.DATA, Phase.BLOCK):
+                self._interrupted(mode)
+                return False
+            self._byte(mode.init_byte, True)
+            if self.c_d == C_D_COMMAND:
+                return True  # command status twice: a first initialization (3.4.3)
+            command = protocol.command  # the byte was taken as command 00h or 81h: complete it
+            self._byte(0, command is None or not command.rd)
+            if protocol.mode is not mode and protocol.mode is not None:
+                protocol.registers.violations.report(ModeLockedError("3.4.3", MODE_LOCKED.format(
+                    wanted=f"Mode.{mode.name}", mode=protocol.mode.name.capitalize(), byte=mode.init_byte
+                )))
             return False
-        raise UpifUsageError("the interface is disabled by a faulty initialization byte: SAS_INIT it (3.4.3)")
 
-    def _expect(self, c_d: int, what: str) -> None:
-        if self.c_d != c_d:
-            raise UpifUsageError(f"{what}: C/D = {self.c_d}, the chip is in phase {self.protocol.phase}")
+    def _interrupted(self, mode: Mode) -> None:
+        """The init byte goes to a chip that waits for a data byte (UP-27): send it as the chip takes it, report."""
+        protocol = self.protocol
+        command = protocol.command
+        code = 0 if command is None else encode_command(command.address, rd=command.rd, wr=command.wr)
+        what = ("the next byte of a block transfer" if protocol.phase is Phase.BLOCK
+                else f"the data byte of command {code:02X}h")
+        # Reported before the byte (the deferred block raises after it), so that in strict mode this violation,
+        # not one the byte itself causes (Intel: a read command's data byte with S/R = 1, Table 3-9), is raised.
+        name = _port_name(command) if command is not None and command.wr and protocol.phase is Phase.DATA else ""
+        effect = f", written to {name}" if name else ""
+        protocol.registers.violations.report(InterruptedCommandError(
+            "3.4.3", INTERRUPTED_INIT.format(byte=mode.init_byte, what=what, effect=effect)
+        ))
+        self._byte(mode.init_byte, True)
+
+    # --------------------------------------------------------------------------------------------------------
+    # Register accesses
+    # --------------------------------------------------------------------------------------------------------
+
+    def _check_frame(self, what: str) -> None:
+        if self.protocol.in_frame:
+            raise UpifUsageError(f"{what}() inside a frame begun on the protocol: end() or abort() it first")
+
+    def _start(self, what: str) -> None:
+        """Refuse a register access the interface cannot start now; nothing has been sent."""
+        protocol = self.protocol
+        self._check_frame(what)
+        phase = protocol.phase
+        if phase is Phase.INIT and what in REFUSED_BEFORE_INIT:
+            raise NotInitializedError(what)
+        if phase is Phase.DISABLED:
+            raise InterfaceDisabledError(what)
+        if phase is not Phase.COMMAND:
+            left = f", {len(protocol._slots)} block byte(s) left (3.4.6)" if phase is Phase.BLOCK else ""
+            raise UpifUsageError(f"{what} needs the command phase: C/D = {self.c_d}, the chip is in phase "
+                                 f"{phase}{left}; finish the command with transfer() or SAS_INIT")
 
     def read(self, address: int) -> int:
-        """Read one register: command byte with RD, then a data byte (3.4.4). Returns the data byte."""
-        self._expect(C_D_COMMAND, "read needs the command phase")
-        self._send(encode_command(address, rd=True))
-        value = self.transfer(0, s_r=False)
-        assert value is not None  # a data byte after a command always drives in Motorola and Intel receive
+        """Read one register: command byte with RD, then a data byte (3.4.4). Returns the data byte.
+
+        Raises
+        ------
+        UpifArgumentError
+            If ``address`` is not 0..14 (15 starts a block transfer: :meth:`block_transfer`).
+        NotInitializedError, InterfaceDisabledError, UpifUsageError
+            If the interface cannot start a command now (nothing is sent).
+        """
+        if type(address) is not int or not 0 <= address < BLOCK_ADDRESS:
+            address = _register_address(address)
+        protocol = self.protocol
+        if protocol.phase is not Phase.COMMAND or protocol._frame is not None:
+            self._start("read")
+        with protocol.registers.violations.deferred():
+            self._byte(_READ_COMMANDS[address], True)
+            value = protocol.begin(False)
+            protocol.end(value if value is not None and protocol.mode is Mode.INTEL else 0)
+        if value is None:  # cannot happen after a command byte: the chip drives every read data byte
+            raise UpifUsageError(f"read({address}): the chip drove no data byte")
         return value
 
     def write(self, address: int, value: int) -> None:
-        """Write one register: command byte with WR, then the data byte (3.4.4)."""
-        self._expect(C_D_COMMAND, "write needs the command phase")
-        self._send(encode_command(address, wr=True))
-        self._send(value)
+        """Write one register: command byte with WR, then the data byte (3.4.4).
+
+        Before :meth:`initialize` the chip takes the command byte as a faulty initialization byte and disables the
+        interface (3.4.3): the bytes go out as on the real chip and :class:`UninitializedAccessError` is reported
+        (raised in strict mode, recorded in lenient mode); the interface then needs SAS_INIT (UP-26).
+
+        Raises
+        ------
+        UpifArgumentError
+            If ``address`` is not 0..14 or ``value`` not a byte.
+        InterfaceDisabledError, UpifUsageError
+            If the interface cannot start a command now (nothing is sent).
+        """
+        if type(address) is not int or not 0 <= address < BLOCK_ADDRESS:
+            address = _register_address(address)
+        if type(value) is not int or not 0 <= value <= 0xFF:
+            value = _checked(check_bits, "value", value, 8, "a data byte, 3.4.4")
+        protocol = self.protocol
+        if protocol.phase is not Phase.COMMAND or protocol._frame is not None:
+            if protocol.phase is Phase.INIT and protocol._frame is None:
+                self._write_uninitialized(_WRITE_COMMANDS[address], value)
+                return
+            self._start("write")
+        with protocol.registers.violations.deferred():
+            protocol.begin(True)
+            protocol.end(_WRITE_COMMANDS[address])
+            protocol.begin(True)
+            protocol.end(value)
+
+    def _write_uninitialized(self, command: int, value: int) -> None:
+        violations = self.protocol.registers.violations
+        with violations.deferred():
+            self._byte(command, True)
+            self._byte(value, True)
+            violations.report(UninitializedAccessError("3.4.3", UNINITIALIZED_WRITE.format(command=command)))
 
     def exchange(self, address: int, value: int) -> int:
-        """Motorola only: read and write ``address`` in one data byte (RD and WR set, 3.4.4)."""
+        """Motorola only: read and write ``address`` in one data byte (RD and WR set, 3.4.4).
+
+        Raises
+        ------
+        UpifArgumentError
+            If ``address`` is not 0..14 or ``value`` not a byte.
+        NotInitializedError, InterfaceDisabledError, UpifUsageError
+            If the interface cannot start a command now, or is in Intel mode (nothing is sent).
+        """
+        address = _register_address(address)
+        value = _checked(check_bits, "value", value, 8, "a data byte, 3.4.4")
+        self._start("exchange")
         if self.protocol.mode is not Mode.MOTOROLA:
             raise UpifUsageError("simultaneous read and write needs Motorola mode (3.4.4)")
-        self._expect(C_D_COMMAND, "exchange needs the command phase")
-        self._send(encode_command(address, rd=True, wr=True))
-        result = self._send(value)
-        assert result is not None
+        with self.registers.violations.deferred():
+            self._byte(encode_command(address, rd=True, wr=True), True)
+            result = self._byte(value, True)
+        if result is None:  # cannot happen: SerOUT drives in every Motorola frame
+            raise UpifUsageError(f"exchange({address}): the chip drove no data byte")
         return result
 
     def block_transfer(self, in_data: bytes, *, read: bool = True, write: bool = True) -> bytes:
@@ -458,7 +649,8 @@ class UpInterface:
         Parameters
         ----------
         in_data:
-            The IN bytes to write, byte 0 first; its length is the configured data length in bytes.
+            The IN bytes to write, byte 0 first; its length must be the chip's block length: the configured data
+            length in bytes, 0 with ExtReg = 1 (UP-10).
         read, write:
             Intel mode only: the RD and WR bits of the command byte, i.e. whether the read phase (OUT bytes) and
             the write phase (IN bytes, ``in_data``) take place (UP-11). Motorola mode exchanges both whatever
@@ -471,25 +663,112 @@ class UpInterface:
 
         Raises
         ------
-        UpifUsageError
-            If the chip's block length differs from ``len(in_data)`` (C/D does not show a command afterwards).
+        UpifArgumentError
+            If ``in_data`` is not bytes of the chip's block length, or ``read``/``write`` not ``bool``.
+        NotInitializedError, InterfaceDisabledError, UpifUsageError
+            If the interface cannot start a command now (nothing is sent).
+        ProtocolViolationError
+            In strict mode, after the whole block, for a data length below one word or ExtReg = 1 (3.4.6).
         """
-        self._expect(C_D_COMMAND, "block transfer needs the command phase")
+        data = _checked(check_bytes, "in_data", in_data)
+        rd = _checked(check_bool, "read", read)
+        wr = _checked(check_bool, "write", write)
+        self._start("block transfer")
+        registers = self.registers
+        count = registers.data_bytes() if registers.internal_data_path else 0
+        if len(data) != count:
+            raise UpifArgumentError("in_data", in_data, f"in_data must be {count} byte{'s' if count != 1 else ''}, "
+                                    f"the block length (the configured data length, 3.4.6), not {describe(in_data)}: "
+                                    f"a block transfer of {len(data)} bytes did not end the block; nothing sent")
         intel = self.protocol.mode is Mode.INTEL
-        rd, wr = (read, write) if intel else (True, True)
-        self._send(encode_command(BLOCK_ADDRESS, rd=rd, wr=wr))
+        if not intel:
+            rd = wr = True
         out = bytearray()
-        if intel:
-            out.extend(self._byte(0, s_r=False) for _ in in_data if rd)
-            for value in in_data if wr else b"":
-                self.transfer(value, s_r=True)
-        else:
-            out.extend(self._byte(value, s_r=True) for value in in_data)
-        self._expect(C_D_COMMAND, f"block transfer of {len(in_data)} bytes did not end the block")
+        with registers.violations.deferred():
+            self._byte(encode_command(BLOCK_ADDRESS, rd=rd, wr=wr), True)
+            if intel:
+                out.extend(self._byte(0, False) or 0 for _ in range(count if rd else 0))
+                for value in data if wr else b"":
+                    self._byte(value, True)
+            else:
+                out.extend(self._byte(value, True) or 0 for value in data)
         return bytes(out)
 
-    def _byte(self, value: int, *, s_r: bool) -> int:
-        self._expect(C_D_DATA, "block transfer ended early")
-        result = self.transfer(value, s_r=s_r)
-        assert result is not None
-        return result
+
+class UpifArgumentError(ArgumentError, UpifUsageError):
+    """An argument of :class:`UpInterface` or :class:`UpifProtocol` of the wrong type or out of its range ("X must
+    be ..., not ..."): an :class:`~supi3.errors.ArgumentError` that code catching :class:`UpifUsageError` still
+    catches. Nothing was sent."""
+
+
+class NotInitializedError(UpifUsageError):
+    """A register access before :meth:`UpInterface.initialize` that the API refuses (nothing sent): it would
+    return data, and the chip drives none before its initialization byte (3.4.1, 3.4.3; UP-25)."""
+
+    def __init__(self, what: str) -> None:
+        self.what = what
+        super().__init__(f"{what}: interface not initialized; call initialize(Mode.MOTOROLA or Mode.INTEL) first "
+                         "(3.4.3: the chip expects its initialization byte before any other access); nothing sent")
+
+    def __reduce__(self) -> tuple[object, ...]:
+        return (type(self), (self.what,))
+
+
+class InterfaceDisabledError(UpifUsageError):
+    """A call to an interface disabled by a faulty initialization byte (3.4.3): nothing was sent."""
+
+    def __init__(self, what: str) -> None:
+        self.what = what
+        super().__init__(f"{what}: the interface is disabled by a faulty initialization byte: SAS_INIT it (or "
+                         "power-up reset), then initialize() (3.4.3); nothing sent")
+
+    def __reduce__(self) -> tuple[object, ...]:
+        return (type(self), (self.what,))
+
+
+class UninitializedAccessError(ProtocolViolationError):
+    """:meth:`UpInterface.write` before initialization: its command byte was taken as a faulty initialization
+    byte and the interface disabled itself (3.4.3; UP-26)."""
+
+
+class InterruptedCommandError(ProtocolViolationError):
+    """:meth:`UpInterface.initialize` on a chip that waited for a data byte (the µP was reset in the middle of a
+    command): the initialization byte was taken as that data byte (3.4.3; UP-27)."""
+
+
+class ModeLockedError(ProtocolViolationError):
+    """:meth:`UpInterface.initialize` asked for the other mode on an initialized chip, whose mode only a power-up
+    reset or SAS_INIT changes (3.4.3; UP-29)."""
+
+
+_READ_COMMANDS: Final[tuple[int, ...]] = tuple(encode_command(a, rd=True) for a in range(BLOCK_ADDRESS))
+_WRITE_COMMANDS: Final[tuple[int, ...]] = tuple(encode_command(a, wr=True) for a in range(BLOCK_ADDRESS))
+
+
+def _checked(check: Callable[..., _T], *args: object, **kwargs: object) -> _T:
+    """Run a :mod:`supi3.checks` check; its error comes out as an :class:`UpifArgumentError`. Hot paths call this
+    only after a cheap inline test failed."""
+    try:
+        return check(*args, **kwargs)
+    except ArgumentError as error:
+        raise UpifArgumentError(error.name, error.value, str(error)) from None
+
+
+def _register_address(address: object) -> int:
+    """``address`` checked as the address of one register access: 0..14 (15 starts a block transfer)."""
+    return _checked(check_int, "address", address, 0, BLOCK_ADDRESS - 1,
+                    "A3..0, 3.4.4; 15 starts a block transfer: use block_transfer(), 3.4.6")
+
+
+def _refused(name: str, value: object, hint: str, config: DeviceConfig | None = None) -> UpifArgumentError:
+    wanted = "the RegisterFile (or Supi3) of a chip strapped for an Init-µP mode (Tables 2-4 to 2-7)"
+    shown = describe(value) if config is None else f"a Supi3 in mode {config.function!r} (Table {config.table})"
+    return UpifArgumentError(name, value, f"{name} must be {wanted}, not {shown}{': ' + hint if hint else ''}")
+
+
+def _port_name(command: Command | None) -> str:
+    """The register a command's write goes to, or ``""``."""
+    if command is None:
+        return ""
+    register = REGISTER_MAP.port(command.address, Direction.WRITE).register
+    return "" if register is None else register.name

@@ -1,7 +1,8 @@
 """Verification kit: the pin-level model protocol and the lockstep harness comparing a model with RTL.
 
 See ``docs/verification.md``. The cocotb coroutine lives in :mod:`supi3.verif.cocotb_lockstep` (imported only inside
-a simulator), the example design and model in :mod:`supi3.verif.example`.
+a simulator), the per-cycle path's cocotb test module in :mod:`supi3.verif.testbenches`, the example design and model
+in :mod:`supi3.verif.example`.
 """
 
 from typing import TYPE_CHECKING

@@ -1,4 +1,5 @@
-"""A small example design and its pin model, used to prove the lockstep harness and to benchmark it.
+"""A small example design and its pin model: the starting point for a design of one's own, and what proves the
+lockstep harness (``tests/test_lockstep.py``, the installed-wheel test) and benchmarks it (``bench/bench_lockstep.py``).
 
 The design has every kind of output the chip has: registered outputs (``count``, ``sr``, ``acc``, a 40-bit one
 wider than a word), a combinational output from state (``zero``), a combinational output from inputs and state
