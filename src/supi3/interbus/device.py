@@ -9,7 +9,8 @@ start of a cycle and is told at the end whether the cycle was latched. The SUPI 
 from __future__ import annotations
 
 import math
-from typing import Protocol, runtime_checkable
+from collections.abc import Callable, Sequence
+from typing import Any, NamedTuple, Protocol, runtime_checkable
 
 from supi3.checks import check_bool, check_bytes, check_instance, check_int, check_real
 from supi3.interbus import wire
@@ -67,6 +68,21 @@ class Device(Protocol):
     def poll(self, now: float) -> None:
         """Bus time has advanced to ``now`` without a cycle reaching this device."""
         ...
+
+
+class DataKernel(NamedTuple):
+    """An optional fast path a device class offers the ring for a data cycle's consecutive devices of that class,
+    as its class attribute ``data_kernel`` (docs/interbus.md, "Ring kernel").
+
+    ``load(devices, now)`` must give what ``([d.load(Cycle.DATA, now) for d in devices], any(d.attention for d in
+    devices))`` gives, and ``latch(devices, received, now)`` must do what ``d.latch(Cycle.DATA, r, now)`` does for
+    each device ``d`` and its ``r``. The ring calls them only with a bus time ``now`` that is a finite ``float``
+    >= 0, and ``received`` items that are ``bytes`` of the widths ``load`` returned; the kernel needs no argument
+    checks of its own. tests/test_interbus_ring_kernel.py holds every kernel to the per-device path.
+    """
+
+    load: Callable[[Sequence[Any], float], tuple[list[bytes], bool]]
+    latch: Callable[[Sequence[Any], Sequence[bytes], float], None]
 
 
 _DATA = Cycle.DATA  # enum member lookups cost ~0.1 µs; the hot path compares with this alias

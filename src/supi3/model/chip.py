@@ -28,14 +28,15 @@ from __future__ import annotations
 
 import math
 from collections import Counter
-from collections.abc import Callable
-from typing import Final, TypeVar
+from collections.abc import Callable, Sequence
+from typing import ClassVar, Final, TypeVar
 
 from supi3 import tables
 from supi3.checks import check_bits, check_bool, check_bytes, check_instance, check_int, check_real
 from supi3.config import DeviceConfig, MfpKind, decode
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.interbus import wire
+from supi3.interbus.device import DataKernel
 from supi3.interbus.wire import Cycle
 from supi3.model.registers import RegisterFile
 
@@ -109,6 +110,52 @@ def _cycle(cycle: object) -> Cycle:
     return checked
 
 
+# ----------------------------------------------------------------------------------------------------------------
+# The ring kernel (docs/interbus.md, "Ring kernel")
+# ----------------------------------------------------------------------------------------------------------------
+# The transaction-level ring's hot path: one call per run of chips in a data cycle instead of two method calls per
+# chip. It reads the chip's flat state directly and takes the shortcut of Supi3.load and Supi3.latch, which every
+# other case goes through in full:
+#   _due_s        the bus time of the next time-driven change (/StatErr filter, watchdog), in seconds; -1.0 in
+#                 the µP modes, whose data path goes through the register file;
+#   _loaded       (MFP levels, IN bytes) of the last data-cycle sample (binary I/O modes; (-1, b"") otherwise);
+#   _fixed_bytes  the data length of a pin-strapped mode (None in the µP modes, which never take the shortcut);
+#   watchdog_code None while the master has set no watchdog (a latch then leaves the schedule alone);
+#   _fast_valid   valid data cycles latched by the shortcut, merged into Supi3.events.
+# Flat shape: Supi3 keeps fewer than 30 instance attributes, because from 30 on CPython 3.11 stops sharing the
+# instance dictionaries' keys and every attribute access here slows (tests/test_model_chip.py guards it).
+# tests/test_interbus_ring_kernel.py holds the kernel to the per-chip path.
+
+
+def _load_data_run(chips: Sequence[Supi3], now: float) -> tuple[list[bytes], bool]:
+    """``[chip.load(Cycle.DATA, now) for chip in chips]`` and whether any chip wants attention afterwards."""
+    registers: list[bytes] = []
+    append = registers.append
+    attention = False
+    for chip in chips:
+        loaded = chip._loaded
+        if now < chip._due_s and chip.mfp_in == loaded[0]:
+            append(loaded[1])
+        else:
+            append(chip.load(_DATA, now))
+        if chip.attention:
+            attention = True
+    return registers, attention
+
+
+def _latch_data_run(chips: Sequence[Supi3], received: Sequence[bytes], now: float) -> None:
+    """``chip.latch(Cycle.DATA, data, now)`` for every chip and its ``data`` (of the width its load gave: a µP
+    mode chip, whose width may change, has ``_due_s`` -1 and never takes the shortcut)."""
+    for chip, data in zip(chips, received, strict=True):
+        if now < chip._due_s and chip.watchdog_code is None:
+            chip.bus_active = True
+            chip._out = data
+            chip.revision += 1
+            chip._fast_valid += 1
+        else:
+            chip.latch(_DATA, data, now)
+
+
 class Supi3:
     """One SUPI 3 OPC (or LS) chip on an INTERBUS ring, at transaction level.
 
@@ -128,6 +175,9 @@ class Supi3:
         How often each interrupt source of Table 3-13 fired (``"VALID"``, ``"INVALID"``, ``"ID_CYCLE"``,
         ``"IB_RESET"``, ``"PCP_RX"``, ``"PCP_TX"``), plus ``"WATCHDOG"`` and ``"MODACK"``.
     """
+
+    data_kernel: ClassVar[DataKernel] = DataKernel(_load_data_run, _latch_data_run)
+    """The ring's fast path for runs of chips in a data cycle (:class:`supi3.interbus.device.DataKernel`)."""
 
     def __init__(self, config: DeviceConfig | None = None, *, strict: bool = True) -> None:
         if config is not None and not isinstance(config, DeviceConfig):
@@ -153,8 +203,7 @@ class Supi3:
         self.revision = 0
         """Counts the changes of what the pins show (OUT data, ``pf``, ``bus_active``, the /ModAck and /ResReg
         pulses): the pin level records its outputs only when this moves."""
-        # Keep fewer than 30 instance attributes: from 30 on, CPython 3.11 stops sharing the instance dictionary's
-        # keys and every attribute access slows (measured: the transaction-level ring then runs ~4 % slower).
+        # Keep fewer than 30 instance attributes (see "The ring kernel" above).
         self.power_up()
 
     # --------------------------------------------------------------------------------------------------------
@@ -299,7 +348,7 @@ class Supi3:
         if self._stat_low_since is not None and not self.pf:
             due = min(due, self._stat_low_since + STATERR_FILTER_CLOCKS)
         self._due = due
-        self._due_s = due / CLOCK_HZ
+        self._due_s = due / CLOCK_HZ if self.registers is None else -1.0  # see "The ring kernel"
 
     def _advance(self, clk: int) -> None:
         """Bring time-driven state up to clock ``clk``: the /StatErr filter and the layer-2 watchdog."""
