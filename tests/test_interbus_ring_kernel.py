@@ -1,8 +1,9 @@
 """The ring's data-cycle kernel (docs/interbus.md, "Ring kernel") against the straightforward path.
 
 A ring built with ``record=True`` runs every line through the full path and every device through its own
-``load``/``latch`` methods; a plain ring hands runs of one class to the class's ``data_kernel``. Both must give
-identical results: master verdicts and diagnostics, IN data, and every device's state (OUT data, latched
+``load``/``latch`` methods; a plain ring hands runs of one class to the class's ``data_kernel``. The reference ring
+is recorded and holds reference devices, whose methods take no shortcut (``Supi3.load_at``/``latch_at``). Both
+must give identical results: master verdicts and diagnostics, IN data, and every device's state (OUT data, latched
 registers, events, management bits), over random rings of SUPI 3 chips (binary I/O and µP modes), plain devices
 and devices without a kernel, with random data, faults, /StatErr, watchdogs, idle time and resets.
 """
@@ -23,7 +24,7 @@ from supi3.interbus.device import DataKernel, PlainDevice
 from supi3.interbus.master import Master
 from supi3.interbus.ring import BitFlip, CorruptLoopback, DeadLine, Ring, Truncate
 from supi3.interbus.wire import Cycle
-from supi3.model.chip import Supi3
+from supi3.model.chip import Supi3, clocks
 
 BINARY = [decode(r.c, r.mfp) for r in tables.MODE_ROWS if decode(r.c, r.mfp).mfp_mode.kind is MfpKind.BINARY_IO]
 MICRO = [decode(r.c, r.mfp) for r in tables.MODE_ROWS if decode(r.c, r.mfp).mfp_mode.kind is MfpKind.INIT_UP]
@@ -33,6 +34,34 @@ class NoKernelDevice(PlainDevice):
     """A plain device whose class offers no kernel: the ring must call its methods one by one."""
 
     data_kernel = None
+
+
+class ReferenceChip(Supi3):
+    """A SUPI 3 chip without the kernel: every load and latch goes the full way."""
+
+    data_kernel = None  # type: ignore[assignment]
+
+    def load(self, cycle: Cycle, now: float) -> bytes:
+        return self.load_at(cycle, clocks(now))
+
+    def latch(self, cycle: Cycle, received: bytes, now: float) -> None:
+        self.latch_at(cycle, received, clocks(now))
+
+
+class ReferencePlain(PlainDevice):
+    """A plain device without the kernel (its methods are the reference)."""
+
+    data_kernel = None
+
+
+def _reference(devices: list[Any]) -> list[Any]:
+    twins = copy.deepcopy(devices)
+    for twin in twins:
+        if type(twin) is Supi3:
+            twin.__class__ = ReferenceChip
+        elif type(twin) is PlainDevice:
+            twin.__class__ = ReferencePlain
+    return twins
 
 
 def _device(kind: str, index: int) -> Any:
@@ -47,8 +76,12 @@ def _device(kind: str, index: int) -> Any:
 
 
 def _state(device: Any) -> dict[str, object]:
-    """What a device shows: its attributes, without caches and objects compared by identity."""
-    state = {k: v for k, v in vars(device).items() if k not in ("registers", "watchdog", "_loaded", "_shown")}
+    """What a device shows: its attributes, without caches and objects compared by identity. The events count
+    merged (the shortcut counts valid cycles apart); the clock of the last bus call left out (the shortcut does not
+    move it, as before the kernel: it is read only in the µP modes, which never take the shortcut, and by the next
+    full bus call after setting it)."""
+    hidden = ("registers", "watchdog", "_loaded", "_shown", "_events", "_fast_valid", "_now")
+    state = {k: v for k, v in vars(device).items() if k not in hidden}
     if isinstance(device, Supi3):
         state["events"] = device.events
         state["mfp_outputs"] = device.mfp_outputs
@@ -130,7 +163,7 @@ def _apply(op: tuple[Any, ...], ring: Ring, master: Master) -> object:
 @given(data=st.data(), kinds=st.lists(KINDS, min_size=1, max_size=12))
 def test_kernel_ring_equals_straightforward_ring(data: st.DataObject, kinds: list[str]) -> None:
     fast_devices = [_device(kind, k) for k, kind in enumerate(kinds)]
-    slow_devices = copy.deepcopy(fast_devices)
+    slow_devices = _reference(fast_devices)
     fast, slow = Ring(fast_devices, bit_rate=2_000_000), Ring(slow_devices, bit_rate=2_000_000, record=True)
     fast_master, slow_master = Master(fast), Master(slow)
     assert fast_master.start() == slow_master.start()
@@ -163,6 +196,8 @@ def test_each_kernel_equals_its_methods(
             continue
         for k, device in enumerate(devices):
             device.load(Cycle.DATA, 0.0)  # the kernel's shortcut needs a data cycle before
+            if k % 2:
+                device.discard(Cycle.DATA, True, 0.0)  # TE set: a latched data cycle clears it (A21)
             if isinstance(device, Supi3):
                 if device.registers is None and k % 3:
                     device.set_mfp_inputs(levels[k])
@@ -173,7 +208,7 @@ def test_each_kernel_equals_its_methods(
                 device.set_peripheral_fault(stat_err and k % 2 == 0)
                 if watchdog is not None:
                     device.latch(Cycle.ID, wire.word_bytes(wire.command_word(watchdog_code=watchdog)), 0.0)
-        twins = copy.deepcopy(devices)
+        twins = _reference(devices)
         kernel = cls.data_kernel
         assert isinstance(kernel, DataKernel)
         registers, attention = kernel.load(devices, now)

@@ -114,8 +114,8 @@ def _cycle(cycle: object) -> Cycle:
 # The ring kernel (docs/interbus.md, "Ring kernel")
 # ----------------------------------------------------------------------------------------------------------------
 # The transaction-level ring's hot path: one call per run of chips in a data cycle instead of two method calls per
-# chip. It reads the chip's flat state directly and takes the shortcut of Supi3.load and Supi3.latch, which every
-# other case goes through in full:
+# chip, and Supi3.load and Supi3.latch take their shortcut through it too. It reads the chip's flat state directly
+# and takes the shortcut where nothing is due; every other case goes through load_at/latch_at in full:
 #   _due_s        the bus time of the next time-driven change (/StatErr filter, watchdog), in seconds; -1.0 in
 #                 the µP modes, whose data path goes through the register file;
 #   _loaded       (MFP levels, IN bytes) of the last data-cycle sample (binary I/O modes; (-1, b"") otherwise);
@@ -137,7 +137,7 @@ def _load_data_run(chips: Sequence[Supi3], now: float) -> tuple[list[bytes], boo
         if now < chip._due_s and chip.mfp_in == loaded[0]:
             append(loaded[1])
         else:
-            append(chip.load(_DATA, now))
+            append(chip.load_at(_DATA, clocks(now)))
         if chip.attention:
             attention = True
     return registers, attention
@@ -153,7 +153,7 @@ def _latch_data_run(chips: Sequence[Supi3], received: Sequence[bytes], now: floa
             chip.revision += 1
             chip._fast_valid += 1
         else:
-            chip.latch(_DATA, data, now)
+            chip.latch_at(_DATA, data, clocks(now))
 
 
 class Supi3:
@@ -499,19 +499,16 @@ class Supi3:
 
     def load(self, cycle: Cycle, now: float) -> bytes:
         """See :meth:`supi3.interbus.device.Device.load`."""
-        if cycle is _DATA and type(now) is float and 0.0 <= now < self._due_s and self.mfp_in == self._loaded[0]:
-            return self._loaded[1]  # nothing due, MFP inputs as last sampled: the same IN bytes
+        if cycle is _DATA and type(now) is float and 0.0 <= now < _INF:
+            return _load_data_run((self,), now)[0][0]  # the ring kernel's shortcut, for one chip
         return self.load_at(cycle, clocks(now))
 
     def latch(self, cycle: Cycle, received: bytes, now: float) -> None:
         """See :meth:`supi3.interbus.device.Device.latch`."""
-        # len(received) == _fixed_bytes also stands for "registers is None" (_fixed_bytes is None in the µP modes)
-        if (cycle is _DATA and type(now) is float and 0.0 <= now < self._due_s and self.watchdog_code is None
-                and type(received) is bytes and len(received) == self._fixed_bytes):
-            self.bus_active = True  # the latch_at() path for a pin-strapped mode without watchdog
-            self._out = received
-            self.revision += 1
-            self._fast_valid += 1
+        # len(received) == _fixed_bytes: the kernel's width (and never in the µP modes, where _fixed_bytes is None)
+        if (cycle is _DATA and type(now) is float and 0.0 <= now < _INF
+                and type(received) is bytes and len(received) == self._fixed_bytes):  # fmt: skip
+            _latch_data_run((self,), (received,), now)  # the ring kernel's shortcut, for one chip
             return
         self.latch_at(cycle, received, clocks(now))
 
