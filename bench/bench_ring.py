@@ -4,12 +4,17 @@ Reports simulated bus time / wall time (target >= 10), for SUPI 3 chips (transac
 mode LB-MR 8 IN/OUT) and, as the baseline in the same process, for plain register devices. Run from the
 repository root:
 
-    python bench/bench_ring.py [--cycles N] [--repeat R] [--bit-rate 2000000]
+    python bench/bench_ring.py [--cycles N] [--repeat R] [--bit-rate 2000000] [--profile TOP]
+
+``--profile TOP`` runs ``--cycles`` more data cycles of each ring under cProfile and prints the TOP entries by own
+time (docs/interbus.md, "Ring kernel", quotes them).
 """
 
 from __future__ import annotations
 
 import argparse
+import cProfile
+import pstats
 import sys
 import time
 
@@ -25,7 +30,7 @@ LENGTH_CODE_1_BYTE = 0b01001  # Table 3-11: "1 byte"
 ID_CODE_DIO = 0xBF  # Table A-3: local bus digital input/output module
 
 
-def _measure(kind: str, cycles: int, repeat: int, bit_rate: int) -> tuple[float, float]:
+def _measure(kind: str, cycles: int, repeat: int, bit_rate: int, profile: int = 0) -> tuple[float, float]:
     """Best-of-``repeat`` (bus time, wall time) of ``cycles`` data cycles on a ring of ``kind`` devices."""
     clk_conf = "01" if bit_rate == 500_000 else "11"
     devices: list[Supi3 | PlainDevice]
@@ -58,6 +63,14 @@ def _measure(kind: str, cycles: int, repeat: int, bit_rate: int) -> tuple[float,
         if wall == 0.0 or run_wall < wall:
             bus, wall = ring.now - bus_start, run_wall
     assert master.inputs(DEVICES) == bytes([0]) and master.inputs(1) == bytes([1])
+    if profile:
+        profiler = cProfile.Profile()
+        profiler.enable()
+        for _ in range(cycles):
+            master.data_cycle()
+        profiler.disable()
+        print(f"{kind}: cProfile of {cycles} data cycles, top {profile} by own time")
+        pstats.Stats(profiler, stream=sys.stdout).sort_stats("tottime").print_stats(profile)
     return bus, wall
 
 
@@ -67,13 +80,14 @@ def main(argv: list[str] | None = None) -> float:
     parser.add_argument("--cycles", type=int, default=2000)
     parser.add_argument("--repeat", type=int, default=3, help="runs; the fastest is reported")
     parser.add_argument("--bit-rate", type=int, default=2_000_000, choices=(500_000, 2_000_000))
+    parser.add_argument("--profile", type=int, default=0, metavar="TOP", help="print cProfile's TOP entries")
     args = parser.parse_args(argv)
     bits = wire.cycle_bits(DEVICES, DEVICES)
     print(f"ring: {DEVICES} devices, {8 * DEVICES} I/O bits, {args.bit_rate} bit/s, {bits} bits per cycle "
           f"({bits / args.bit_rate * 1e3:.3f} ms)")  # fmt: skip
     ratios = {}
     for kind in ("plain", "supi3"):
-        bus, wall = _measure(kind, args.cycles, args.repeat, args.bit_rate)
+        bus, wall = _measure(kind, args.cycles, args.repeat, args.bit_rate, args.profile)
         ratios[kind] = bus / wall
         print(f"{kind:6} {args.cycles} data cycles (best of {args.repeat}): bus time {bus:.3f} s, wall time "
               f"{wall:.3f} s, bus/wall = {ratios[kind]:.1f} (target >= 10)")  # fmt: skip

@@ -9,7 +9,8 @@ start of a cycle and is told at the end whether the cycle was latched. The SUPI 
 from __future__ import annotations
 
 import math
-from typing import Protocol, runtime_checkable
+from collections.abc import Callable, Sequence
+from typing import Any, ClassVar, NamedTuple, Protocol, runtime_checkable
 
 from supi3.checks import check_bool, check_bytes, check_instance, check_int, check_real
 from supi3.interbus import wire
@@ -67,6 +68,21 @@ class Device(Protocol):
     def poll(self, now: float) -> None:
         """Bus time has advanced to ``now`` without a cycle reaching this device."""
         ...
+
+
+class DataKernel(NamedTuple):
+    """An optional fast path a device class offers the ring for a data cycle's consecutive devices of that class,
+    as its class attribute ``data_kernel`` (docs/interbus.md, "Ring kernel").
+
+    ``load(devices, now)`` must give what ``([d.load(Cycle.DATA, now) for d in devices], any(d.attention for d in
+    devices))`` gives, and ``latch(devices, received, now)`` must do what ``d.latch(Cycle.DATA, r, now)`` does for
+    each device ``d`` and its ``r``. The ring calls them only with a bus time ``now`` that is a finite ``float``
+    >= 0, and ``received`` items that are ``bytes`` of the widths ``load`` returned; the kernel needs no argument
+    checks of its own. tests/test_interbus_ring_kernel.py holds every kernel to the per-device path.
+    """
+
+    load: Callable[[Sequence[Any], float], tuple[list[bytes], bool]]
+    latch: Callable[[Sequence[Any], Sequence[bytes], float], None]
 
 
 _DATA = Cycle.DATA  # enum member lookups cost ~0.1 µs; the hot path compares with this alias
@@ -128,6 +144,30 @@ class Layer2Watchdog:
         return False
 
 
+def _load_plain_run(devices: Sequence[PlainDevice], now: float) -> tuple[list[bytes], bool]:
+    """``[d.load(Cycle.DATA, now) for d in devices]`` and whether any device wants attention afterwards."""
+    registers: list[bytes] = []
+    append = registers.append
+    attention = False
+    for device in devices:
+        if now > device.watchdog.deadline:
+            device._tick(now)
+        append(device.inputs)
+        if device.attention:
+            attention = True
+    return registers, attention
+
+
+def _latch_plain_run(devices: Sequence[PlainDevice], received: Sequence[bytes], now: float) -> None:
+    """``d.latch(Cycle.DATA, r, now)`` for every device ``d`` and its ``r``."""
+    for device, data in zip(devices, received, strict=True):
+        device.outputs = data
+        device._te = False
+        if device.watchdog.timeout_s is not None:
+            device.watchdog.kick(now)
+        device.valid_cycles += 1
+
+
 class PlainDevice:
     """A plain INTERBUS register device: an ID code, a length code, IN and OUT data registers.
 
@@ -155,6 +195,9 @@ class PlainDevice:
     last_reset_s:
         Bus time of the last INTERBUS reset, ``None`` before one.
     """
+
+    data_kernel: ClassVar[DataKernel | None] = DataKernel(_load_plain_run, _latch_plain_run)
+    """The ring's fast path for runs of plain devices in a data cycle (:class:`DataKernel`)."""
 
     def __init__(self, id_code: int, length_code: int) -> None:
         wire.id_register(id_code, length_code)

@@ -10,12 +10,17 @@ the stream sent), so the ring neither materialises the stream nor computes the C
 its slice of the master's frame. Lines with a fault, and every line when ``record=True``, go through the full
 path, which computes the CRC actually sent and the CRC of what was actually received.
 
+In a data cycle a run of consecutive devices of one class whose class offers a ``data_kernel``
+(:class:`~supi3.interbus.device.DataKernel`, e.g. the SUPI 3 model) is loaded and latched by one kernel call
+rather than by two method calls per device (docs/interbus.md, "Ring kernel").
+
 Lines are numbered like the devices: line *k* (1..N) enters ring position *k*, line N + 1 is the return line
 into the master.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from enum import Enum
@@ -25,7 +30,7 @@ from typing import Final, NamedTuple, Protocol, runtime_checkable
 
 from supi3.checks import check_bool, check_instance, check_int, check_real, fail
 from supi3.interbus import wire
-from supi3.interbus.device import Device
+from supi3.interbus.device import DataKernel, Device
 from supi3.interbus.errors import InterbusArgumentError, InterbusError, TelegramError
 from supi3.interbus.wire import Cycle, Frame
 
@@ -144,16 +149,35 @@ class _Active:
 
 
 _ATTENTION = attrgetter("attention")
+_ONE_BYTE: Final = [bytes((value,)) for value in range(256)]
+
+
+_Groups = list[tuple[int, int, DataKernel | None]]
+"""A run's devices in groups of one class: (start, stop, the class's data kernel or None)."""
 
 
 class _Run(NamedTuple):
     """Consecutive reached devices: their register contents at the end of the data sequence, whether they may
-    latch (own check passed, no error flagged upstream) and whether their own check failed."""
+    latch (own check passed, no error flagged upstream), whether their own check failed, and their groups for the
+    data kernels (``None``: every device by its own methods)."""
 
     devices: list[Device]
     received: list[bytes]
     eligible: bool
     local_error: bool
+    groups: _Groups | None = None
+
+
+def _group(devices: list[Device]) -> _Groups:
+    """Split ``devices`` into runs of one class, each with its class's data kernel (``None`` if it has none)."""
+    groups: _Groups = []
+    start = 0
+    for k in range(1, len(devices) + 1):
+        if k == len(devices) or type(devices[k]) is not type(devices[start]):
+            kernel = getattr(type(devices[start]), "data_kernel", None)
+            groups.append((start, k, kernel if isinstance(kernel, DataKernel) else None))
+            start = k
+    return groups
 
 
 def _shift(registers: list[bytes], stream: bytes) -> tuple[list[bytes], bytes, int]:
@@ -301,6 +325,11 @@ class Ring:
         self._faults: list[_Active] = []
         self._silent_since: dict[int, float] = {}
         self._silent_reset: set[int] = set()
+        # Caches of the data-cycle hot path, each for the last run it served: the classes of the run's devices and
+        # their groups; the registers loaded and the frame size, the registers joined, and the slices that cut each
+        # device's received bytes.
+        self._layout: tuple[list[type], _Groups] = ([], [])
+        self._cuts: tuple[list[bytes], int, bytes, list[slice] | None, int] = ([], -1, b"", None, 0)
 
     # -- faults --------------------------------------------------------------------------------------------------
 
@@ -375,6 +404,59 @@ class Ring:
             error = ErrorKind.CNTR
         return _Line(stream, crc, cntr), error
 
+    # -- the data-cycle kernel -----------------------------------------------------------------------------------
+
+    def _groups(self, run: list[Device]) -> _Groups:
+        """``_group(run)``, cached for the last run's classes."""
+        types = list(map(type, run))
+        if types != self._layout[0]:
+            self._layout = (types, _group(run))
+        return self._layout[1]
+
+    def _load_run(self, cycle: Cycle, run: list[Device], now: float) -> tuple[list[bytes], bool, _Groups | None]:
+        """Every device's ``load(cycle, now)`` and whether one of them wants attention, through the devices' data
+        kernels where the cycle and time allow; the groups used, ``None`` if none."""
+        if cycle is not Cycle.DATA or type(now) is not float or not 0.0 <= now < math.inf:
+            return [device.load(cycle, now) for device in run], any(map(_ATTENTION, run)), None
+        groups = self._groups(run)
+        if len(groups) == 1 and groups[0][2] is not None:
+            registers, attention = groups[0][2].load(run, now)
+            return registers, attention, groups
+        registers = []
+        attention = False
+        for start, stop, kernel in groups:
+            part = run[start:stop]
+            if kernel is None:
+                registers += [device.load(cycle, now) for device in part]
+                attention = attention or any(map(_ATTENTION, part))
+            else:
+                loaded, wants = kernel.load(part, now)
+                registers += loaded
+                attention = attention or wants
+        return registers, attention, groups
+
+    def _shift(self, registers: list[bytes], stream: bytes) -> tuple[list[bytes], bytes, int]:
+        """``_shift(registers, stream)``, with what depends only on the registers and the frame size cached for
+        the last registers (in a data cycle they are mostly the very same bytes objects as in the one before)."""
+        size = len(stream)
+        last_registers, last_size, head, cuts, total = self._cuts
+        if size != last_size or registers != last_registers:
+            widths = list(map(len, registers))
+            total = sum(widths)
+            if total > size:
+                return _shift(registers, stream)
+            ends = accumulate(widths, sub, initial=size)
+            # None: one byte each, cut in one go (the last bytes of the stream, reversed)
+            cuts = None if widths.count(1) == len(widths) else [
+                slice(end - width, end) for end, width in zip(ends, widths, strict=False)]  # fmt: skip
+            head = b"".join(reversed(registers))
+            self._cuts = (registers, size, head, cuts, total)
+        if cuts is None:
+            received = list(map(_ONE_BYTE.__getitem__, stream[size - total : size][::-1]))
+        else:
+            received = list(map(stream.__getitem__, cuts))
+        return received, head + stream[: size - total], total
+
     # -- a cycle -------------------------------------------------------------------------------------------------
 
     def transfer(self, cycle: Cycle, data: bytes, close_after: int | None = None) -> Transfer:
@@ -423,10 +505,10 @@ class Ring:
             if index < stop:
                 # Unfaulted lines: every receiver gets what its sender sent; no materialising, no CRC.
                 run = devices[index:stop]
-                registers = [device.load(cycle, now) for device in run]
-                attention = attention or any(map(_ATTENTION, run))
-                received, stream, width = _shift(registers, stream)
-                runs.append(_Run(run, received, not error, False))
+                registers, wants, groups = self._load_run(cycle, run, now)
+                attention = attention or wants
+                received, stream, width = self._shift(registers, stream)
+                runs.append(_Run(run, received, not error, False, groups))
                 shifted += width
                 crc = None
                 index = stop
@@ -477,8 +559,12 @@ class Ring:
         start = self.now
         end = start + bits / self.bit_rate
         cycle = transfer.cycle
+        kernels = cycle is Cycle.DATA and type(end) is float and 0.0 <= end < math.inf
         for run in transfer.runs:
             if latch and run.eligible:
+                if kernels and run.groups is not None:
+                    self._latch_run(run, run.groups, end)
+                    continue
                 for device, received in zip(run.devices, run.received, strict=True):
                     device.latch(cycle, received, end)
             else:
@@ -490,6 +576,19 @@ class Ring:
                 self._silent_reset.discard(index)
         self._go_silent(range(transfer.reached, len(self.devices)), start, end)
         self.now = end
+
+    @staticmethod
+    def _latch_run(run: _Run, groups: _Groups, end: float) -> None:
+        """Every device of a data cycle's run latches its received bytes, through the data kernels."""
+        if len(groups) == 1 and groups[0][2] is not None:
+            groups[0][2].latch(run.devices, run.received, end)
+            return
+        for start, stop, kernel in groups:
+            if kernel is not None:
+                kernel.latch(run.devices[start:stop], run.received[start:stop], end)
+                continue
+            for device, received in zip(run.devices[start:stop], run.received[start:stop], strict=True):
+                device.latch(Cycle.DATA, received, end)
 
     def _go_silent(self, indices: range, start: float, end: float) -> None:
         """Devices at ``indices`` heard nothing from ``start`` to ``end``: poll them, reset after the timeout."""

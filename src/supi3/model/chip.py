@@ -28,14 +28,15 @@ from __future__ import annotations
 
 import math
 from collections import Counter
-from collections.abc import Callable
-from typing import Final, TypeVar
+from collections.abc import Callable, Sequence
+from typing import ClassVar, Final, TypeVar
 
 from supi3 import tables
 from supi3.checks import check_bits, check_bool, check_bytes, check_instance, check_int, check_real
 from supi3.config import DeviceConfig, MfpKind, decode
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.interbus import wire
+from supi3.interbus.device import DataKernel
 from supi3.interbus.wire import Cycle
 from supi3.model.registers import RegisterFile
 
@@ -109,6 +110,52 @@ def _cycle(cycle: object) -> Cycle:
     return checked
 
 
+# ----------------------------------------------------------------------------------------------------------------
+# The ring kernel (docs/interbus.md, "Ring kernel")
+# ----------------------------------------------------------------------------------------------------------------
+# The transaction-level ring's hot path: one call per run of chips in a data cycle instead of two method calls per
+# chip, and Supi3.load and Supi3.latch take their shortcut through it too. It reads the chip's flat state directly
+# and takes the shortcut where nothing is due; every other case goes through load_at/latch_at in full:
+#   _due_s        the bus time of the next time-driven change (/StatErr filter, watchdog), in seconds; -1.0 in
+#                 the µP modes, whose data path goes through the register file;
+#   _loaded       (MFP levels, IN bytes) of the last data-cycle sample (binary I/O modes; (-1, b"") otherwise);
+#   _fixed_bytes  the data length of a pin-strapped mode (None in the µP modes, which never take the shortcut);
+#   watchdog_code None while the master has set no watchdog (a latch then leaves the schedule alone);
+#   _fast_valid   valid data cycles latched by the shortcut, merged into Supi3.events.
+# Flat shape: Supi3 keeps fewer than 30 instance attributes, because from 30 on CPython 3.11 stops sharing the
+# instance dictionaries' keys and every attribute access here slows (tests/test_model_chip.py guards it).
+# tests/test_interbus_ring_kernel.py holds the kernel to the per-chip path.
+
+
+def _load_data_run(chips: Sequence[Supi3], now: float) -> tuple[list[bytes], bool]:
+    """``[chip.load(Cycle.DATA, now) for chip in chips]`` and whether any chip wants attention afterwards."""
+    registers: list[bytes] = []
+    append = registers.append
+    attention = False
+    for chip in chips:
+        loaded = chip._loaded
+        if now < chip._due_s and chip.mfp_in == loaded[0]:
+            append(loaded[1])
+        else:
+            append(chip.load_at(_DATA, clocks(now)))
+        if chip.attention:
+            attention = True
+    return registers, attention
+
+
+def _latch_data_run(chips: Sequence[Supi3], received: Sequence[bytes], now: float) -> None:
+    """``chip.latch(Cycle.DATA, data, now)`` for every chip and its ``data`` (of the width its load gave: a µP
+    mode chip, whose width may change, has ``_due_s`` -1 and never takes the shortcut)."""
+    for chip, data in zip(chips, received, strict=True):
+        if now < chip._due_s and chip.watchdog_code is None:
+            chip.bus_active = True
+            chip._out = data
+            chip.revision += 1
+            chip._fast_valid += 1
+        else:
+            chip.latch_at(_DATA, data, clocks(now))
+
+
 class Supi3:
     """One SUPI 3 OPC (or LS) chip on an INTERBUS ring, at transaction level.
 
@@ -128,6 +175,9 @@ class Supi3:
         How often each interrupt source of Table 3-13 fired (``"VALID"``, ``"INVALID"``, ``"ID_CYCLE"``,
         ``"IB_RESET"``, ``"PCP_RX"``, ``"PCP_TX"``), plus ``"WATCHDOG"`` and ``"MODACK"``.
     """
+
+    data_kernel: ClassVar[DataKernel] = DataKernel(_load_data_run, _latch_data_run)
+    """The ring's fast path for runs of chips in a data cycle (:class:`supi3.interbus.device.DataKernel`)."""
 
     def __init__(self, config: DeviceConfig | None = None, *, strict: bool = True) -> None:
         if config is not None and not isinstance(config, DeviceConfig):
@@ -153,8 +203,7 @@ class Supi3:
         self.revision = 0
         """Counts the changes of what the pins show (OUT data, ``pf``, ``bus_active``, the /ModAck and /ResReg
         pulses): the pin level records its outputs only when this moves."""
-        # Keep fewer than 30 instance attributes: from 30 on, CPython 3.11 stops sharing the instance dictionary's
-        # keys and every attribute access slows (measured: the transaction-level ring then runs ~4 % slower).
+        # Keep fewer than 30 instance attributes (see "The ring kernel" above).
         self.power_up()
 
     # --------------------------------------------------------------------------------------------------------
@@ -299,7 +348,7 @@ class Supi3:
         if self._stat_low_since is not None and not self.pf:
             due = min(due, self._stat_low_since + STATERR_FILTER_CLOCKS)
         self._due = due
-        self._due_s = due / CLOCK_HZ
+        self._due_s = due / CLOCK_HZ if self.registers is None else -1.0  # see "The ring kernel"
 
     def _advance(self, clk: int) -> None:
         """Bring time-driven state up to clock ``clk``: the /StatErr filter and the layer-2 watchdog."""
@@ -450,19 +499,16 @@ class Supi3:
 
     def load(self, cycle: Cycle, now: float) -> bytes:
         """See :meth:`supi3.interbus.device.Device.load`."""
-        if cycle is _DATA and type(now) is float and 0.0 <= now < self._due_s and self.mfp_in == self._loaded[0]:
-            return self._loaded[1]  # nothing due, MFP inputs as last sampled: the same IN bytes
+        if cycle is _DATA and type(now) is float and 0.0 <= now < _INF:
+            return _load_data_run((self,), now)[0][0]  # the ring kernel's shortcut, for one chip
         return self.load_at(cycle, clocks(now))
 
     def latch(self, cycle: Cycle, received: bytes, now: float) -> None:
         """See :meth:`supi3.interbus.device.Device.latch`."""
-        # len(received) == _fixed_bytes also stands for "registers is None" (_fixed_bytes is None in the µP modes)
-        if (cycle is _DATA and type(now) is float and 0.0 <= now < self._due_s and self.watchdog_code is None
-                and type(received) is bytes and len(received) == self._fixed_bytes):
-            self.bus_active = True  # the latch_at() path for a pin-strapped mode without watchdog
-            self._out = received
-            self.revision += 1
-            self._fast_valid += 1
+        # len(received) == _fixed_bytes: the kernel's width (and never in the µP modes, where _fixed_bytes is None)
+        if (cycle is _DATA and type(now) is float and 0.0 <= now < _INF
+                and type(received) is bytes and len(received) == self._fixed_bytes):  # fmt: skip
+            _latch_data_run((self,), (received,), now)  # the ring kernel's shortcut, for one chip
             return
         self.latch_at(cycle, received, clocks(now))
 
