@@ -214,3 +214,17 @@ def test_huge_strap_values_are_quoted_short(value: str | int) -> None:
     with pytest.raises(ConfigurationError) as caught:
         decode(value)
     assert len(str(caught.value)) < 160
+
+
+@pytest.mark.parametrize("row", tables.MODE_ROWS, ids=lambda r: f"{r.c}-{r.mfp}")
+def test_io_bits_follow_the_pin_tables(row: tables.ModeRow) -> None:
+    """In<k>/Out<k> of Tables 3-1/3-2 as (bit, pin) pairs: one per signal, each bit once, only in binary I/O modes."""
+    config = decode(row.c, row.mfp)
+    for bits, prefix in ((config.in_bits, "In"), (config.out_bits, "Out")):
+        signals = {p.pin: p.signal for p in config.mfp_pins if p.signal.startswith(prefix)}
+        if config.mfp_mode.kind is not MfpKind.BINARY_IO:
+            assert bits == ()
+            continue
+        assert sorted(pin for _, pin in bits) == sorted(signals)
+        assert all(signals[pin] == f"{prefix}{bit}" for bit, pin in bits)
+        assert len({bit for bit, _ in bits}) == len(bits)

@@ -284,14 +284,14 @@ def _pin_config() -> DeviceConfig:
 
 def _expected_in(config: DeviceConfig, mfp: int) -> bytes:
     """IN data from the MFP input levels (Tables 3-1/3-2: In<k> on pin p is bit k, 3.2)."""
-    word = sum(((mfp >> p.pin) & 1) << int(p.signal[2:]) for p in config.mfp_pins if p.signal.startswith("In"))
+    word = sum(((mfp >> pin) & 1) << bit for bit, pin in config.in_bits)
     return word.to_bytes(config.data_bytes, "big")
 
 
 def _expected_mfp(config: DeviceConfig, out: bytes) -> int:
     """MFP output levels from OUT data (Out<k> on pin p is bit k)."""
     word = int.from_bytes(out, "big")
-    return sum(((word >> int(p.signal[3:])) & 1) << p.pin for p in config.mfp_pins if p.signal.startswith("Out"))
+    return sum(((word >> bit) & 1) << pin for bit, pin in config.out_bits)
 
 
 class _PinBench(_Bench):

@@ -147,6 +147,22 @@ class DeviceConfig:
         return _mfp_pins(self.interface, self.mfp_mode)
 
     @property
+    def in_bits(self) -> tuple[tuple[int, int], ...]:
+        """(data bit k, MFP pin) of every ``In<k>`` of a binary I/O mode (Tables 3-1, 3-2; bit k of the IN word,
+        byte 0 most significant, 3.2); empty in the other modes."""
+        return self._io_bits("In")
+
+    @property
+    def out_bits(self) -> tuple[tuple[int, int], ...]:
+        """(data bit k, MFP pin) of every ``Out<k>`` of a binary I/O mode (Tables 3-1, 3-2); empty otherwise."""
+        return self._io_bits("Out")
+
+    def _io_bits(self, prefix: str) -> tuple[tuple[int, int], ...]:
+        if self.mfp_mode.kind is not MfpKind.BINARY_IO:
+            return ()
+        return tuple((int(p.signal[len(prefix):]), p.pin) for p in self.mfp_pins if p.signal.startswith(prefix))
+
+    @property
     def mfp_output_mask(self) -> int:
         """Bit n set when MFPn is driven by the chip after reset."""
         return sum(1 << p.pin for p in self.mfp_pins if p.direction is Direction.OUT)

@@ -188,10 +188,8 @@ class Supi3:
         self.registers = RegisterFile(self.config, strict=strict) if kind is MfpKind.INIT_UP else None
         if self.registers is not None:
             self.registers.use_clock(self._clock)  # violations name the clock of the last bus call (docs/model.md)
-        pins = self.config.mfp_pins
-        binary = kind is MfpKind.BINARY_IO
-        self._in_map = tuple((int(p.signal[2:]), p.pin) for p in pins if binary and p.signal.startswith("In"))
-        self._out_map = tuple((int(p.signal[3:]), p.pin) for p in pins if binary and p.signal.startswith("Out"))
+        self._in_map = self.config.in_bits
+        self._out_map = self.config.out_bits
         self._events: Counter[str] = Counter()
         self._fast_valid = 0  # valid data cycles taken by the fast path of latch(), merged into events
         self.mfp_in = 0
