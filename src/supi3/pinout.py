@@ -23,11 +23,11 @@ from __future__ import annotations
 from typing import Final
 
 from supi3.interbus import wire
+from supi3.pinlevel import Pin
 from supi3.regmap import INTERRUPT_SOURCES, REGISTER_MAP, Access, Direction
 from supi3.regmap.core import BYTE_BITS
 from supi3.regmap.registers import IN_BYTES
 from supi3.tables import BIT_RATES, CLOCK_CONFIGURATIONS, DIAG_CONFIGURATIONS, LENGTH_CODES, MODE_ROWS, RF_MODES
-from supi3.verif.pinmodel import Pin
 
 __all__ = [
     "BLOCK_STRAPS",

@@ -24,11 +24,11 @@ from amaranth.lib.wiring import In, Out
 
 from supi3.config import Variant
 from supi3.errors import ArgumentError
+from supi3.pinlevel import OE_SUFFIX
 from supi3.pinout import CORE_INPUTS, CORE_OUTPUTS, STRAP_PINS, UP_INPUTS, UP_OUTPUTS, UP_PINS, up_input_port
 from supi3.rtl.core import REGISTER_FILE_INPUTS, REGISTER_FILE_OUTPUTS, Supi3Core
 from supi3.rtl.tables import check_variant
 from supi3.rtl.upif import UpifBlock
-from supi3.verif.pinmodel import OE_SUFFIX
 
 __all__ = ["Supi3Chip", "rtlil", "verilog"]
 

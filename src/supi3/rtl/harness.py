@@ -19,10 +19,9 @@ from supi3.checks import check_bits, check_instance, fail
 from supi3.config import DeviceConfig, Variant, decode, mode_rows
 from supi3.model.pins import Supi3Pins, check_names, input_row, input_traces
 from supi3.model.top import Supi3Chip
+from supi3.pinlevel import Pin, PinSpecError
 from supi3.rtl.core import STRAP_PINS
 from supi3.rtl.tables import EXPANSION_BITS, MFP_PINS, check_variant
-from supi3.verif.errors import PinSpecError
-from supi3.verif.pinmodel import Pin
 
 __all__ = ["ChipStrapPins", "StrapPins", "strap_inputs", "strap_stimulus"]
 
@@ -180,7 +179,7 @@ class StrapPins:
         )
 
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
-        """One clock of the model of the configuration the straps select (see :mod:`supi3.verif.pinmodel`).
+        """One clock of the model of the configuration the straps select (see :mod:`supi3.pinlevel`).
 
         Raises
         ------
@@ -250,7 +249,7 @@ class ChipStrapPins:
         return self.chip
 
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
-        """One clock of the chip the straps select (see :mod:`supi3.verif.pinmodel`).
+        """One clock of the chip the straps select (see :mod:`supi3.pinlevel`).
 
         Raises
         ------

@@ -24,9 +24,9 @@ import numpy.typing as npt
 from supi3.checks import check_bits, check_trace, fail
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
+from supi3.pinlevel import EventLog, Pin
 from supi3.pinout import CORE_IDLE, CORE_INPUTS, SYNC_STAGES
 from supi3.tables import CLOCK_HZ
-from supi3.verif.pinmodel import EventLog, Pin
 
 if TYPE_CHECKING:
     from supi3.model.blocks.frame import FrameEngine
