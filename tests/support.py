@@ -30,7 +30,6 @@ from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
 from supi3.model.pins import Supi3Pins
 from supi3.model.registers import RegisterFile
-from supi3.model.top import UP_INPUTS, UP_OUTPUTS, Supi3Chip
 from supi3.pinlevel import OE_SUFFIX
 from supi3.regmap import encode_command
 from supi3.spi.block_pins import UpifBlockPins, block_model, strap_values
@@ -39,6 +38,7 @@ from supi3.spi.slave_pins import PinsIn, PinsOut
 from supi3.spi.upif import Mode
 from supi3.tables import BIT_RATES, CLOCK_HZ
 from supi3.timing import timing_table
+from supi3.top import UP_INPUTS, UP_OUTPUTS, Supi3Chip
 
 Columns = dict[str, npt.NDArray[np.int64]]
 Levels = npt.NDArray[np.uint8]

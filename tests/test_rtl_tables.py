@@ -18,12 +18,12 @@ from pathlib import Path
 import pytest
 
 from supi3 import pinout
+from supi3 import top as model_top
 from supi3.config import DeviceConfig, Variant, decode
 from supi3.errors import ConfigurationError
 from supi3.interbus.wire import Cycle
 from supi3.model import chip as model_chip
 from supi3.model import pins as model_pins
-from supi3.model import top as model_top
 from supi3.model.pins import Supi3Pins
 from supi3.rtl import tables as rtl_tables
 from supi3.rtl.tables import (

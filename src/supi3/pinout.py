@@ -1,6 +1,6 @@
 """The SUPI 3's pin declarations: names, widths, directions and idle levels, as data the spec level owns.
 
-The model (:mod:`supi3.model.pins`, :mod:`supi3.model.top`, :mod:`supi3.spi.block_pins`) and the RTL
+The model (:mod:`supi3.model.pins`, :mod:`supi3.top`, :mod:`supi3.spi.block_pins`) and the RTL
 (:mod:`supi3.rtl`) both take their port lists from here, so neither derives its interface from the other: the
 lockstep then compares two implementations of one declaration. Nothing here depends on the model or the RTL; the
 widths come from the manual's tables (:mod:`supi3.tables`) and the register map (:mod:`supi3.regmap`).
