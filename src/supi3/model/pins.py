@@ -58,14 +58,13 @@ from supi3.model.blocks.receiver import (
     IDLE_TIMEOUT_CLOCKS,
     INPUT_NAMES,
     INPUT_PINS,
-    NEVER,
     Receiver,
     Synced,
     check_names,
     input_row,
     input_traces,
 )
-from supi3.model.blocks.transmitter import Trace, Transmitter
+from supi3.model.blocks.transmitter import NEVER, Trace, Transmitter
 from supi3.model.chip import Supi3
 from supi3.pinlevel import EventLog, Pin
 from supi3.pinout import CORE_OUTPUTS, IB_DIAG_DIVIDER_BITS, SYNC_STAGES
