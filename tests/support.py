@@ -170,7 +170,7 @@ class CoreScript:
         return {name: np.concatenate([part[name] for part in self.parts]) for name in CORE_INPUTS}
 
     def stimulus(self) -> Trace:
-        from supi3.rtl.harness import strap_stimulus  # Amaranth: only when a bench runs
+        from supi3.verif.straps import strap_stimulus  # Amaranth: only when a bench runs
 
         columns = self.columns()
         return strap_stimulus(self.config, np.stack([columns[name] for name in CORE_INPUTS], axis=1))
@@ -311,7 +311,7 @@ class ChipPins:
             self.step()
 
     def stimulus(self) -> Trace:
-        from supi3.rtl.harness import strap_stimulus  # Amaranth: only when a bench runs
+        from supi3.verif.straps import strap_stimulus  # Amaranth: only when a bench runs
 
         return strap_stimulus(self.config, np.array(self.rows, dtype=np.int64))
 

@@ -30,11 +30,11 @@ from supi3.model.vcd import write_vcd
 from supi3.pinlevel import PinSpecError
 from supi3.rtl.chip import Supi3Chip as RtlChip
 from supi3.rtl.core import Supi3Core
-from supi3.rtl.harness import ChipStrapPins, StrapPins, strap_inputs, strap_stimulus
 from supi3.rtl.tables import core_tables
 from supi3.spi.block_pins import UpifBlockPins, block_model, strap_values
 from supi3.spi.slave_pins import PinsIn, PinsOut, SlavePins, TimingChecker
 from supi3.top import Supi3Chip, up_pin_inputs, up_pin_outputs
+from supi3.verif.straps import ChipStrapPins, StrapPins, strap_inputs, strap_stimulus
 
 BINARY = decode("10000", clk_conf="11")
 UP = decode("10011", "1110", clk_conf="11")

@@ -19,10 +19,10 @@ from supi3.config import decode
 from supi3.interbus import wire
 from supi3.rtl.chip import Supi3Chip as Supi3ChipRtl
 from supi3.rtl.chip import verilog
-from supi3.rtl.harness import ChipStrapPins
 from supi3.spi.upif import Mode
 from supi3.top import UP_OUTPUTS
 from supi3.verif import Lockstep
+from supi3.verif.straps import ChipStrapPins
 from support import IDLE, LOOPBACK, RB_INIT_UP, ChipPins, Firmware, VerilatorBuild, bring_up, data_frame, id_frame
 
 IRQ_EVENTS = 14  # read: interrupt events (clears them); write: interrupt enables (3.4.14)
