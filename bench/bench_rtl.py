@@ -35,10 +35,10 @@ from supi3.interbus.wire import Cycle, Frame
 from supi3.model.pins import Supi3Pins
 from supi3.rtl.chip import Supi3Chip
 from supi3.rtl.core import Supi3Core
-from supi3.rtl.harness import StrapPins, strap_stimulus
 from supi3.tables import CLOCK_HZ
 from supi3.verif import Lockstep
 from supi3.verif.amaranth_sim import run_amaranth_sim
+from supi3.verif.straps import StrapPins, strap_stimulus
 
 TARGET_GE = 15_000
 TARGET_MHZ = CLOCK_HZ / 1e6

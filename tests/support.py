@@ -30,7 +30,7 @@ from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
 from supi3.model.pins import Supi3Pins
 from supi3.model.registers import RegisterFile
-from supi3.model.top import UP_INPUTS, UP_OUTPUTS, Supi3Chip
+from supi3.pinlevel import OE_SUFFIX
 from supi3.regmap import encode_command
 from supi3.spi.block_pins import UpifBlockPins, block_model, strap_values
 from supi3.spi.master import SoftMaster
@@ -38,7 +38,7 @@ from supi3.spi.slave_pins import PinsIn, PinsOut
 from supi3.spi.upif import Mode
 from supi3.tables import BIT_RATES, CLOCK_HZ
 from supi3.timing import timing_table
-from supi3.verif.pinmodel import OE_SUFFIX
+from supi3.top import UP_INPUTS, UP_OUTPUTS, Supi3Chip
 
 Columns = dict[str, npt.NDArray[np.int64]]
 Levels = npt.NDArray[np.uint8]
@@ -170,7 +170,7 @@ class CoreScript:
         return {name: np.concatenate([part[name] for part in self.parts]) for name in CORE_INPUTS}
 
     def stimulus(self) -> Trace:
-        from supi3.rtl.harness import strap_stimulus  # Amaranth: only when a bench runs
+        from supi3.verif.straps import strap_stimulus  # Amaranth: only when a bench runs
 
         columns = self.columns()
         return strap_stimulus(self.config, np.stack([columns[name] for name in CORE_INPUTS], axis=1))
@@ -311,7 +311,7 @@ class ChipPins:
             self.step()
 
     def stimulus(self) -> Trace:
-        from supi3.rtl.harness import strap_stimulus  # Amaranth: only when a bench runs
+        from supi3.verif.straps import strap_stimulus  # Amaranth: only when a bench runs
 
         return strap_stimulus(self.config, np.array(self.rows, dtype=np.int64))
 

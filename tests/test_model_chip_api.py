@@ -21,12 +21,12 @@ from supi3.model.registers import (
     RegisterFile,
     RegisterFileError,
 )
-from supi3.model.top import Supi3Chip
 from supi3.regmap import REGISTER_MAP
 from supi3.spi.master import SoftMaster
 from supi3.spi.slave_pins import SlavePins
 from supi3.spi.upif import Mode, UpInterface
 from supi3.tables import CLOCK_HZ
+from supi3.top import Supi3Chip
 
 RB_UP = decode("10011", "1110")  # RB, Init-µP
 RB_IO = decode("10000")  # RB, 8 IN/8 OUT: one byte each way (the demo device)

@@ -1,6 +1,6 @@
 """Hostile calls at every public entry of the pin-level modules: named errors, never a bare builtin, no state change.
 
-Modules: supi3.model.pins (Supi3Pins), supi3.model.pinring (PinRing, receive), supi3.model.top (Supi3Chip,
+Modules: supi3.model.pins (Supi3Pins), supi3.model.pinring (PinRing, receive), supi3.top (Supi3Chip,
 up_pin_inputs/outputs), supi3.model.vcd (write_vcd), supi3.spi.slave_pins (PinsIn, PinsOut, SlavePins,
 TimingChecker) and supi3.spi.block_pins (strap_values, block_model, UpifBlockPins). Each case makes a fresh object,
 makes the wrong call, and checks the error's class and message ("X must be ..., not ...", with the pin's name and
@@ -26,15 +26,15 @@ from supi3.model.chip import Supi3
 from supi3.model.pinring import PinRing, receive
 from supi3.model.pins import Supi3Pins
 from supi3.model.registers import InterfaceViolationError, RegisterFile
-from supi3.model.top import Supi3Chip, up_pin_inputs, up_pin_outputs
 from supi3.model.vcd import write_vcd
+from supi3.pinlevel import PinSpecError
 from supi3.rtl.chip import Supi3Chip as RtlChip
 from supi3.rtl.core import Supi3Core
-from supi3.rtl.harness import ChipStrapPins, StrapPins, strap_inputs, strap_stimulus
 from supi3.rtl.tables import core_tables
 from supi3.spi.block_pins import UpifBlockPins, block_model, strap_values
 from supi3.spi.slave_pins import PinsIn, PinsOut, SlavePins, TimingChecker
-from supi3.verif.errors import PinSpecError
+from supi3.top import Supi3Chip, up_pin_inputs, up_pin_outputs
+from supi3.verif.straps import ChipStrapPins, StrapPins, strap_inputs, strap_stimulus
 
 BINARY = decode("10000", clk_conf="11")
 UP = decode("10011", "1110", clk_conf="11")

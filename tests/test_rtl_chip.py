@@ -1,4 +1,4 @@
-"""The RTL chip top (supi3.rtl.chip) against the whole-chip model (supi3.model.top), every pin every clock.
+"""The RTL chip top (supi3.rtl.chip) against the whole-chip model (supi3.top), every pin every clock.
 
 One Verilator build serves every scenario (the straps are ports). Stimulus is made by running the scenario on the
 model itself: the INTERBUS master's line levels on do1 and a software µP (support.Firmware, over
@@ -17,12 +17,12 @@ from hypothesis import strategies as st
 
 from supi3.config import decode
 from supi3.interbus import wire
-from supi3.model.top import UP_OUTPUTS
 from supi3.rtl.chip import Supi3Chip as Supi3ChipRtl
 from supi3.rtl.chip import verilog
-from supi3.rtl.harness import ChipStrapPins
 from supi3.spi.upif import Mode
+from supi3.top import UP_OUTPUTS
 from supi3.verif import Lockstep
+from supi3.verif.straps import ChipStrapPins
 from support import IDLE, LOOPBACK, RB_INIT_UP, ChipPins, Firmware, VerilatorBuild, bring_up, data_frame, id_frame
 
 IRQ_EVENTS = 14  # read: interrupt events (clears them); write: interrupt enables (3.4.14)

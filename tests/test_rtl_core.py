@@ -1,7 +1,7 @@
 """The RTL chip core (supi3.rtl.core) against the cycle-accurate model (supi3.model.pins), every pin every clock.
 
 One Verilator build of the core serves every operating mode: the straps are ports, driven as constants by the
-stimulus (supi3.rtl.harness). Short scenarios run on the batch path through the harness; the two long ones (the
+stimulus (supi3.verif.straps). Short scenarios run on the batch path through the harness; the two long ones (the
 200 ms /StatErr filter and the 50 ms watchdog) replay through the same Verilator build against the model's fast
 ``run()``, chunk by chunk. Line stimulus is built with supi3.interbus.wire (docs/interbus.md).
 """
@@ -24,10 +24,10 @@ from supi3.interbus.wire import Cycle, Frame
 from supi3.model.chip import STATERR_FILTER_CLOCKS, WATCHDOG_CLOCKS
 from supi3.model.pins import IB_DIAG_DIVIDER_BITS, Supi3Pins
 from supi3.rtl.core import Supi3Core, verilog
-from supi3.rtl.harness import StrapPins, strap_stimulus
 from supi3.tables import RF_MODES, ModeRow
 from supi3.verif import Lockstep, first_mismatch
 from supi3.verif.amaranth_sim import run_amaranth_sim
+from supi3.verif.straps import StrapPins, strap_stimulus
 from support import CORE_INPUTS, IDLE, LOOPBACK, Columns, CoreScript, VerilatorBuild, pulses, quiet_inputs
 
 OPC_ROWS = list(mode_rows(Variant.OPC))

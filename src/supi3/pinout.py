@@ -1,6 +1,6 @@
 """The SUPI 3's pin declarations: names, widths, directions and idle levels, as data the spec level owns.
 
-The model (:mod:`supi3.model.pins`, :mod:`supi3.model.top`, :mod:`supi3.spi.block_pins`) and the RTL
+The model (:mod:`supi3.model.pins`, :mod:`supi3.top`, :mod:`supi3.spi.block_pins`) and the RTL
 (:mod:`supi3.rtl`) both take their port lists from here, so neither derives its interface from the other: the
 lockstep then compares two implementations of one declaration. Nothing here depends on the model or the RTL; the
 widths come from the manual's tables (:mod:`supi3.tables`) and the register map (:mod:`supi3.regmap`).
@@ -23,11 +23,11 @@ from __future__ import annotations
 from typing import Final
 
 from supi3.interbus import wire
+from supi3.pinlevel import Pin
 from supi3.regmap import INTERRUPT_SOURCES, REGISTER_MAP, Access, Direction
 from supi3.regmap.core import BYTE_BITS
 from supi3.regmap.registers import IN_BYTES
 from supi3.tables import BIT_RATES, CLOCK_CONFIGURATIONS, DIAG_CONFIGURATIONS, LENGTH_CODES, MODE_ROWS, RF_MODES
-from supi3.verif.pinmodel import Pin
 
 __all__ = [
     "BLOCK_STRAPS",

@@ -1,6 +1,6 @@
 """The cycle-accurate pin-level model of the SUPI 3 chip core: the reference the Amaranth RTL matches pin for pin.
 
-A synchronous machine clocked at 32 MHz (1.7.1), following the convention of :mod:`supi3.verif.pinmodel`: each
+A synchronous machine clocked at 32 MHz (1.7.1), following the convention of :mod:`supi3.pinlevel`: each
 call of :meth:`Supi3Pins.step` takes the input pins of one clock cycle, returns the output pins seen during that
 cycle, and moves the state across the rising edge at the end of it. The bus behaviour (what is loaded, latched,
 discarded, reset) is :class:`supi3.model.chip.Supi3`, the same object the transaction-level ring uses; this module
@@ -58,18 +58,17 @@ from supi3.model.blocks.receiver import (
     IDLE_TIMEOUT_CLOCKS,
     INPUT_NAMES,
     INPUT_PINS,
-    NEVER,
     Receiver,
     Synced,
     check_names,
     input_row,
     input_traces,
 )
-from supi3.model.blocks.transmitter import Trace, Transmitter
+from supi3.model.blocks.transmitter import NEVER, Trace, Transmitter
 from supi3.model.chip import Supi3
+from supi3.pinlevel import EventLog, Pin
 from supi3.pinout import CORE_OUTPUTS, IB_DIAG_DIVIDER_BITS, SYNC_STAGES
 from supi3.tables import CLOCK_HZ, RESET_MIN_S
-from supi3.verif.pinmodel import EventLog, Pin
 
 __all__ = [
     "IB_DIAG_DIVIDER_BITS",
@@ -188,7 +187,7 @@ class Supi3Pins:
     # ------------------------------------------------------------------------------------------------------------
 
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
-        """Run one clock cycle (see :mod:`supi3.verif.pinmodel`).
+        """Run one clock cycle (see :mod:`supi3.pinlevel`).
 
         Parameters
         ----------

@@ -1,6 +1,6 @@
 """The whole SUPI 3 chip in Amaranth: the INTERBUS core and the serial µP interface, pin for pin.
 
-:class:`Supi3Chip` matches the model ``model.top.Supi3Chip`` on every output pin on every 32 MHz clock. It joins
+:class:`Supi3Chip` matches the model ``supi3.top.Supi3Chip`` on every output pin on every 32 MHz clock. It joins
 :class:`~supi3.rtl.core.Supi3Core` (built with its register-file ports) and :class:`~supi3.rtl.upif.UpifBlock`
 (the µP interface and its register file) the way the model joins ``model.pins.Supi3Pins`` and
 ``spi.slave_pins.SlavePins`` through one ``model.registers.RegisterFile``:
@@ -24,17 +24,17 @@ from amaranth.lib.wiring import In, Out
 
 from supi3.config import Variant
 from supi3.errors import ArgumentError
+from supi3.pinlevel import OE_SUFFIX
 from supi3.pinout import CORE_INPUTS, CORE_OUTPUTS, STRAP_PINS, UP_INPUTS, UP_OUTPUTS, UP_PINS, up_input_port
 from supi3.rtl.core import REGISTER_FILE_INPUTS, REGISTER_FILE_OUTPUTS, Supi3Core
 from supi3.rtl.tables import check_variant
 from supi3.rtl.upif import UpifBlock
-from supi3.verif.pinmodel import OE_SUFFIX
 
 __all__ = ["Supi3Chip", "rtlil", "verilog"]
 
 
 class Supi3Chip(wiring.Component):
-    """The SUPI 3 chip with the pins of the model ``model.top.Supi3Chip`` (:mod:`supi3.pinout`) and the strap ports of
+    """The SUPI 3 chip with the pins of the model ``supi3.top.Supi3Chip`` (:mod:`supi3.pinout`) and the strap ports of
     :class:`~supi3.rtl.core.Supi3Core`.
 
     Parameters

@@ -38,6 +38,7 @@ from supi3.checks import check_bool
 from supi3.config import Variant
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
+from supi3.pinlevel import Pin
 from supi3.pinout import (
     BLOCK_STRAPS,
     CORE_IDLE,
@@ -67,7 +68,6 @@ from supi3.rtl.tables import (
     core_tables,
 )
 from supi3.rtl.upif import upif_tables
-from supi3.verif.pinmodel import Pin
 
 __all__ = [
     "LINE",

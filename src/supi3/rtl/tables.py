@@ -96,7 +96,7 @@ class ModeEntry:
         For each MFP pin, the shift-register bit it takes at the latch of a data cycle, or ``None`` (driven 0).
     init_up:
         An Init-µP mode: the model has a register file, which gives the ID register and the data from the serial
-        µP interface (``model.top``); ``id_register`` and ``data_bytes`` are then its µP_Not_Ready values.
+        µP interface (``supi3.top``); ``id_register`` and ``data_bytes`` are then its µP_Not_Ready values.
     """
 
     pattern: str

@@ -34,6 +34,7 @@ from amaranth.lib import enum, wiring
 from amaranth.lib.wiring import In, Out
 
 from supi3 import timing
+from supi3.pinlevel import OE_SUFFIX
 from supi3.pinout import (
     C_D_COMMAND,
     C_D_DATA,
@@ -57,7 +58,6 @@ from supi3.regmap import (
 from supi3.regmap.core import BYTE_BITS, BYTE_MASK
 from supi3.regmap.registers import IN_BYTES, IO_ACCESS_BIT, OUT_BYTES
 from supi3.tables import BIT_RATES, CLOCK_HZ, LENGTH_CODE_BY_VALUE, UP_INTERFACE_TIMING
-from supi3.verif.pinmodel import OE_SUFFIX
 
 __all__ = ["UpifBlock", "UpifTables", "output_delay", "upif_tables", "verilog"]
 

@@ -34,13 +34,12 @@ from supi3.checks import check_bits, check_bool
 from supi3.config import MfpKind, Variant, decode, mode_rows
 from supi3.errors import ArgumentError
 from supi3.model.registers import RegisterFile
+from supi3.pinlevel import OE_SUFFIX, Pin, PinSpecError
 from supi3.regmap import INTERRUPT_SOURCES, REGISTER_MAP, Access, Direction
 from supi3.regmap.core import BYTE_BITS, BYTE_MASK
 from supi3.regmap.registers import IN_BYTES
 from supi3.spi.slave_pins import INPUT_PINS, OUTPUT_PINS, PinsIn, SlavePins
 from supi3.tables import BIT_RATES, LENGTH_CODES
-from supi3.verif.errors import PinSpecError
-from supi3.verif.pinmodel import OE_SUFFIX, Pin
 
 __all__ = [
     "CORE_INPUTS",
@@ -192,7 +191,7 @@ class UpifBlockPins:
         return self.pins
 
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
-        """One clock (see :mod:`supi3.verif.pinmodel`): the outputs of this cycle, then the edge ending it.
+        """One clock (see :mod:`supi3.pinlevel`): the outputs of this cycle, then the edge ending it.
 
         Raises
         ------

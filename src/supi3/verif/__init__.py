@@ -1,4 +1,4 @@
-"""Verification kit: the pin-level model protocol and the lockstep harness comparing a model with RTL.
+"""Verification kit: the lockstep harness comparing a pin-level model (:mod:`supi3.pinlevel`) with RTL.
 
 See ``docs/verification.md``. The cocotb coroutine lives in :mod:`supi3.verif.cocotb_lockstep` (imported only inside
 a simulator), the per-cycle path's cocotb test module in :mod:`supi3.verif.testbenches`, the example design and model
@@ -7,15 +7,9 @@ in :mod:`supi3.verif.example`.
 
 from typing import TYPE_CHECKING
 
-from supi3.verif.errors import (
-    LockstepError,
-    LockstepMismatchError,
-    PinSpecError,
-    SimulationError,
-    SimulatorUnavailableError,
-)
+from supi3.pinlevel import EventLog, Pin, PinModel, PinSpecError, recent_events
+from supi3.verif.errors import LockstepError, LockstepMismatchError, SimulationError, SimulatorUnavailableError
 from supi3.verif.layout import Layout, Stimulus, first_mismatch, model_trace, stimulus_array
-from supi3.verif.pinmodel import EventLog, Pin, PinModel, recent_events
 from supi3.verif.report import LockstepResult
 
 if TYPE_CHECKING:

@@ -14,8 +14,8 @@ from typing import Any
 import numpy as np
 from amaranth.sim import Simulator
 
+from supi3.pinlevel import ModelFactory, recent_events
 from supi3.verif.layout import WORD, Layout, Stimulus, model_trace, stimulus_array
-from supi3.verif.pinmodel import ModelFactory, recent_events
 from supi3.verif.report import LockstepResult, raise_mismatch
 from supi3.verif.rtl import DesignFactory, LockstepTop
 

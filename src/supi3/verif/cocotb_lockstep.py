@@ -14,9 +14,8 @@ import numpy as np
 from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, Timer
 
-from supi3.verif.errors import PinSpecError
+from supi3.pinlevel import PinModel, PinSpecError, recent_events
 from supi3.verif.layout import Layout, Trace, model_columns, model_trace
-from supi3.verif.pinmodel import PinModel, recent_events
 from supi3.verif.report import MismatchRecord, Outcome
 from supi3.verif.vcd import CYCLE_NS
 
@@ -29,7 +28,7 @@ POLL_CYCLES = 1024
 async def lockstep(dut: Any, model: PinModel, stimulus: Trace, *, reset_cycles: int = 1, window: int = 64) -> Outcome:
     """Clock the DUT and the model together; the top's comparator checks every output signal on every cycle.
 
-    Timing per cycle ``n`` (see :mod:`supi3.verif.pinmodel`): at the falling clock edge the inputs of cycle ``n`` and
+    Timing per cycle ``n`` (see :mod:`supi3.pinlevel`): at the falling clock edge the inputs of cycle ``n`` and
     the model's outputs for cycle ``n`` are written to the DUT (each word only when it changes); the rising edge
     ending the cycle updates the design and compares its outputs with the expected words. One wait per cycle and
     no read: the mismatch flag is read every :data:`POLL_CYCLES` cycles and at the end. Before cycle 0 the ``sync``

@@ -7,15 +7,11 @@ from pathlib import Path
 
 from supi3.errors import Supi3Error
 
-__all__ = ["LockstepError", "LockstepMismatchError", "PinSpecError", "SimulationError", "SimulatorUnavailableError"]
+__all__ = ["LockstepError", "LockstepMismatchError", "SimulationError", "SimulatorUnavailableError"]
 
 
 class LockstepError(Supi3Error):
     """Base class of the harness's errors."""
-
-
-class PinSpecError(LockstepError, ValueError):
-    """A pin list, a design's ports or a stimulus that do not fit together."""
 
 
 class SimulatorUnavailableError(LockstepError):

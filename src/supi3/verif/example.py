@@ -21,7 +21,7 @@ from collections.abc import Mapping
 
 from amaranth.hdl import Elaboratable, Module, Signal
 
-from supi3.verif.pinmodel import EventLog, Pin
+from supi3.pinlevel import EventLog, Pin
 
 __all__ = ["ShiftCounter", "ShiftCounterModel"]
 
@@ -67,7 +67,7 @@ class ShiftCounter(Elaboratable):
 
 
 class ShiftCounterModel:
-    """The example's cycle-accurate pin model, following :class:`~supi3.verif.pinmodel.PinModel`."""
+    """The example's cycle-accurate pin model, following :class:`~supi3.pinlevel.PinModel`."""
 
     inputs: tuple[Pin, ...] = (Pin("en"), Pin("load"), Pin("din", 8), Pin("sin"), Pin("rd"))
     outputs: tuple[Pin, ...] = (
@@ -92,7 +92,7 @@ class ShiftCounterModel:
         self.events.clear()
 
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
-        """One clock cycle (see :mod:`supi3.verif.pinmodel`)."""
+        """One clock cycle (see :mod:`supi3.pinlevel`)."""
         count = self.count
         sr = self.sr
         acc = self.acc

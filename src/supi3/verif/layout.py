@@ -16,8 +16,7 @@ from typing import TypeAlias
 import numpy as np
 import numpy.typing as npt
 
-from supi3.verif.errors import PinSpecError
-from supi3.verif.pinmodel import Pin, PinModel, compared_signals
+from supi3.pinlevel import Pin, PinModel, PinSpecError, compared_signals
 
 __all__ = [
     "Field", "Layout", "Stimulus", "Trace", "first_mismatch", "model_columns", "model_trace", "stimulus_array",
@@ -104,7 +103,7 @@ class Layout:
     Parameters
     ----------
     inputs, outputs:
-        The model's pins (see :class:`~supi3.verif.pinmodel.PinModel`).
+        The model's pins (see :class:`~supi3.pinlevel.PinModel`).
     """
 
     def __init__(self, inputs: Sequence[Pin], outputs: Sequence[Pin]) -> None:
@@ -300,7 +299,7 @@ def model_columns(model: PinModel, stimulus: Trace, layout: Layout) -> list[npt.
     """Reset ``model`` and run it over ``stimulus``; one array per compared output signal, in comparison order.
 
     A model that also offers ``run(inputs: Mapping[str, array]) -> Mapping[str, array]`` (whole traces at once,
-    the same cycles as repeated :meth:`~supi3.verif.pinmodel.PinModel.step`) is run that way, which is much
+    the same cycles as repeated :meth:`~supi3.pinlevel.PinModel.step`) is run that way, which is much
     faster for event-driven models.
 
     Raises

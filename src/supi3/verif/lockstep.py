@@ -1,6 +1,6 @@
 """Lockstep comparison of a Python pin model with the RTL of an Amaranth design, on every output pin every clock.
 
-Two paths share one pin convention (:mod:`supi3.verif.pinmodel`), one packing (:mod:`supi3.verif.layout`) and one
+Two paths share one pin convention (:mod:`supi3.pinlevel`), one packing (:mod:`supi3.verif.layout`) and one
 mismatch report (:class:`~supi3.verif.errors.LockstepMismatchError` with a VCD of the last cycles):
 
 * per-cycle (:meth:`Lockstep.run`): a cocotb test (:mod:`supi3.verif.testbenches.lockstep_tb`, a module of the
@@ -30,9 +30,9 @@ from pathlib import Path
 
 import numpy as np
 
-from supi3.verif.errors import PinSpecError, SimulationError
+from supi3.pinlevel import ModelFactory, PinSpecError, recent_events
+from supi3.verif.errors import SimulationError
 from supi3.verif.layout import Layout, Stimulus, Trace, model_columns, model_trace, stimulus_array
-from supi3.verif.pinmodel import ModelFactory, recent_events
 from supi3.verif.report import LockstepResult, Outcome, raise_mismatch, window_trace
 from supi3.verif.rtl import TOP, DesignFactory, build_slot, ensure_toolchain, to_verilog
 
@@ -149,7 +149,7 @@ class Lockstep:
     design_factory:
         Returns a fresh Amaranth elaboratable exposing the model's pins as attributes (see :mod:`supi3.verif.rtl`).
     model_factory:
-        Returns a fresh :class:`~supi3.verif.pinmodel.PinModel`. For the per-cycle path it is pickled into the
+        Returns a fresh :class:`~supi3.pinlevel.PinModel`. For the per-cycle path it is pickled into the
         simulator process, so it must be a module-level class or function (or a ``functools.partial`` of one).
     build_dir:
         Root of build and run directories (default ``sim_build/lockstep`` in the working directory). Builds are

@@ -7,7 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from supi3.verif.errors import LockstepMismatchError, PinSpecError
+from supi3.pinlevel import PinSpecError
+from supi3.verif.errors import LockstepMismatchError
 from supi3.verif.layout import Layout, Trace
 from supi3.verif.vcd import write_window
 

@@ -30,7 +30,8 @@ from amaranth.back import verilog
 from amaranth.hdl import Cat, ClockDomain, Elaboratable, Module, Mux, Signal, Value
 from amaranth.lib.memory import Memory
 
-from supi3.verif.errors import PinSpecError, SimulatorUnavailableError
+from supi3.pinlevel import PinSpecError
+from supi3.verif.errors import SimulatorUnavailableError
 from supi3.verif.layout import WORD, Layout
 
 __all__ = ["TOP", "DesignFactory", "LockstepTop", "build_slot", "ensure_toolchain", "to_verilog"]

@@ -15,7 +15,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from supi3.interbus.wire import Cycle
-from supi3.verif.pinmodel import EventLog
+from supi3.pinlevel import EventLog
 
 if TYPE_CHECKING:
     from supi3.model.chip import Supi3

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Final
 
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle
-from supi3.verif.pinmodel import EventLog
+from supi3.pinlevel import EventLog
 
 if TYPE_CHECKING:
     from supi3.model.blocks.datapath import DataPath

@@ -24,9 +24,10 @@ import numpy.typing as npt
 from supi3.checks import check_bits, check_trace, fail
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
+from supi3.model.blocks.transmitter import NEVER
+from supi3.pinlevel import EventLog, Pin
 from supi3.pinout import CORE_IDLE, CORE_INPUTS, SYNC_STAGES
 from supi3.tables import CLOCK_HZ
-from supi3.verif.pinmodel import EventLog, Pin
 
 if TYPE_CHECKING:
     from supi3.model.blocks.frame import FrameEngine
@@ -35,10 +36,6 @@ if TYPE_CHECKING:
 
 IDLE_TIMEOUT_CLOCKS: Final = round(wire.IDLE_TIMEOUT_S * CLOCK_HZ)
 """A line without a telegram start for 20 ms is an INTERBUS reset (docs/interbus.md A13), once per silence."""
-
-NEVER: Final = 1 << 62
-"""A cycle that never comes (no event due)."""
-
 
 class Synced(NamedTuple):
     """The input pins as the logic sees them, after the synchroniser."""

@@ -13,14 +13,17 @@ countdowns, the ERR pair rewrite, the return line switch).
 from __future__ import annotations
 
 from itertools import chain
+from typing import Final
 
 import numpy as np
 import numpy.typing as npt
 
 from supi3.interbus import wire
-from supi3.model.blocks.receiver import NEVER
 
 Trace = npt.NDArray[np.int64]
+
+NEVER: Final = 1 << 62
+"""A cycle that never comes (no event due)."""
 
 
 class Transmitter:

@@ -11,8 +11,8 @@ from typing import Any
 
 import cocotb
 
+from supi3.pinlevel import PinSpecError
 from supi3.verif.cocotb_lockstep import lockstep
-from supi3.verif.errors import PinSpecError
 from supi3.verif.lockstep import JOB_ENV, Job
 from supi3.verif.report import Outcome
 

@@ -1,4 +1,8 @@
-"""The synchronous pin-level model protocol that the lockstep harness compares against RTL.
+"""Pin-level primitives shared by the model, the RTL and the verification kit: :class:`Pin`, :class:`EventLog` and the
+synchronous pin-model protocol (:class:`PinModel`) that the lockstep harness compares against RTL.
+
+It imports nothing of the project but :mod:`supi3.errors`, so that the pin declarations (:mod:`supi3.pinout`), the
+model and the verification kit (:mod:`supi3.verif`) can all stand on it (docs/architecture.md).
 
 Convention
 ----------
@@ -29,9 +33,23 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
-from supi3.verif.errors import PinSpecError
+from supi3.errors import Supi3Error
 
-__all__ = ["EventLog", "ModelFactory", "Pin", "PinModel", "compared_signals", "recent_events"]
+__all__ = [
+    "OE_SUFFIX",
+    "EventLog",
+    "ModelFactory",
+    "Pin",
+    "PinModel",
+    "PinSpecError",
+    "compared_signals",
+    "recent_events",
+]
+
+
+class PinSpecError(Supi3Error, ValueError):
+    """A pin list, a design's ports or a stimulus that do not fit together."""
+
 
 OE_SUFFIX = "_oe"
 """Suffix of the output-enable signal of a tri-state output pin."""

@@ -25,8 +25,8 @@ from supi3.checks import check_bits, check_bool, check_instance
 from supi3.config import DeviceConfig
 from supi3.model.chip import Supi3
 from supi3.model.pins import Supi3Pins, Trace, input_traces
+from supi3.pinlevel import OE_SUFFIX, Pin
 from supi3.spi.slave_pins import PinsIn, PinsOut, SlavePins
-from supi3.verif.pinmodel import OE_SUFFIX, Pin
 
 UP_INPUTS: Final = pinout.UP_INPUTS
 """The MFP pin of each input of the µP interface (:class:`PinsIn` field, Tables 3-5 and 3-6)."""
@@ -52,7 +52,7 @@ def up_pin_outputs(up: PinsOut) -> tuple[int, int]:
 
 class Supi3Chip:
     """One SUPI 3 chip, every pin, one 32 MHz clock per :meth:`step` (the convention of
-    :mod:`supi3.verif.pinmodel`).
+    :mod:`supi3.pinlevel`).
 
     Parameters
     ----------

@@ -4,7 +4,7 @@ The RTL core (:class:`supi3.rtl.core.Supi3Core`) reads its configuration from st
 every operating mode. :class:`StrapPins` gives the model the same ports: it decodes the straps it sees on the first
 clock (:func:`supi3.config.decode`) and from then on is the model of that configuration. Stimulus drives the straps
 as constants (:func:`strap_inputs`), with MFP[15..12] at the configuration expansion where the mode has one.
-:class:`ChipStrapPins` does the same for the whole chip (:class:`supi3.model.top.Supi3Chip`, the model of
+:class:`ChipStrapPins` does the same for the whole chip (:class:`supi3.top.Supi3Chip`, the model of
 :class:`supi3.rtl.chip.Supi3Chip`).
 """
 
@@ -18,11 +18,10 @@ import numpy.typing as npt
 from supi3.checks import check_bits, check_instance, fail
 from supi3.config import DeviceConfig, Variant, decode, mode_rows
 from supi3.model.pins import Supi3Pins, check_names, input_row, input_traces
-from supi3.model.top import Supi3Chip
+from supi3.pinlevel import Pin, PinSpecError
 from supi3.rtl.core import STRAP_PINS
 from supi3.rtl.tables import EXPANSION_BITS, MFP_PINS, check_variant
-from supi3.verif.errors import PinSpecError
-from supi3.verif.pinmodel import Pin
+from supi3.top import Supi3Chip
 
 __all__ = ["ChipStrapPins", "StrapPins", "strap_inputs", "strap_stimulus"]
 
@@ -180,7 +179,7 @@ class StrapPins:
         )
 
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
-        """One clock of the model of the configuration the straps select (see :mod:`supi3.verif.pinmodel`).
+        """One clock of the model of the configuration the straps select (see :mod:`supi3.pinlevel`).
 
         Raises
         ------
@@ -213,7 +212,7 @@ class StrapPins:
 
 
 class ChipStrapPins:
-    """:class:`~supi3.model.top.Supi3Chip` with the strap ports of the RTL chip (a :class:`PinModel`).
+    """:class:`~supi3.top.Supi3Chip` with the strap ports of the RTL chip (a :class:`PinModel`).
 
     The µP interface rules are not enforced (``strict=False``): violations are recorded in the register file's
     ``violations`` and the chip carries on, as the RTL does.
@@ -250,7 +249,7 @@ class ChipStrapPins:
         return self.chip
 
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
-        """One clock of the chip the straps select (see :mod:`supi3.verif.pinmodel`).
+        """One clock of the chip the straps select (see :mod:`supi3.pinlevel`).
 
         Raises
         ------

@@ -9,9 +9,9 @@ import numpy.typing as npt
 from supi3.config import decode
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
-from supi3.model.top import Supi3Chip
 from supi3.regmap import encode_command
 from supi3.spi.upif import Phase
+from supi3.top import Supi3Chip
 
 HALF = 8  # SCLK half period in clocks at 2 Mbit/s: 4 MHz, below the 6 MHz maximum (Table 3-7)
 SCLK, SS_N, MOSI, MFP7 = 1 << 4, 1 << 5, 1 << 6, 1 << 7
