@@ -11,8 +11,9 @@ from hypothesis import strategies as st
 from supi3 import tables
 from supi3.config import MfpKind, decode
 from supi3.interbus import wire
-from supi3.interbus.device import Device, PlainDevice
+from supi3.interbus.device import PlainDevice
 from supi3.interbus.errors import InterbusError
+from supi3.interbus.link import Device
 from supi3.interbus.master import Master
 from supi3.interbus.ring import BitFlip, CorruptLoopback, DeadLine, ErrorKind, Fault, Ring, Truncate
 from supi3.interbus.wire import Cycle

@@ -1,7 +1,8 @@
 """INTERBUS layer 1/2: wire format, transaction-level ring and master (docs/interbus.md)."""
 
-from supi3.interbus.device import Device, Layer2Watchdog, PlainDevice
+from supi3.interbus.device import Layer2Watchdog, PlainDevice
 from supi3.interbus.errors import InterbusError, TelegramError
+from supi3.interbus.link import Device
 from supi3.interbus.master import (
     ALARM_STOP,
     CONTROL_DEVICE_FUNCTION,

@@ -11,7 +11,7 @@ its slice of the master's frame. Lines with a fault, and every line when ``recor
 path, which computes the CRC actually sent and the CRC of what was actually received.
 
 In a data cycle a run of consecutive devices of one class whose class offers a ``data_kernel``
-(:class:`~supi3.interbus.device.DataKernel`, e.g. the SUPI 3 model) is loaded and latched by one kernel call
+(:class:`~supi3.interbus.link.DataKernel`, e.g. the SUPI 3 model) is loaded and latched by one kernel call
 rather than by two method calls per device (docs/interbus.md, "Ring kernel").
 
 Lines are numbered like the devices: line *k* (1..N) enters ring position *k*, line N + 1 is the return line
@@ -30,8 +30,8 @@ from typing import Final, NamedTuple, Protocol, runtime_checkable
 
 from supi3.checks import check_bool, check_instance, check_int, check_real, fail
 from supi3.interbus import wire
-from supi3.interbus.device import DataKernel, Device
 from supi3.interbus.errors import InterbusArgumentError, InterbusError, TelegramError
+from supi3.interbus.link import DataKernel, Device
 from supi3.interbus.wire import Cycle, Frame
 
 

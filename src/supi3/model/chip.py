@@ -1,6 +1,6 @@
 """The SUPI 3 chip's INTERBUS slave behaviour, shared by both model fidelities.
 
-:class:`Supi3` is the transaction-level chip: it implements :class:`supi3.interbus.device.Device`, so a
+:class:`Supi3` is the transaction-level chip: it implements :class:`supi3.interbus.link.Device`, so a
 :class:`~supi3.interbus.ring.Ring` shifts whole frames through it. The cycle-accurate pin-level model drives the
 very same object at the exact clock of each bus event, so both fidelities share one behaviour; only the pin level
 adds the line receiver, the repeater and the pins' timing.
@@ -36,7 +36,7 @@ from supi3.checks import check_bits, check_bool, check_bytes, check_instance, ch
 from supi3.config import DeviceConfig, MfpKind, decode
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.interbus import wire
-from supi3.interbus.device import DataKernel
+from supi3.interbus.link import DataKernel
 from supi3.interbus.wire import Cycle
 from supi3.model.registers import RegisterFile
 
@@ -177,7 +177,7 @@ class Supi3:
     """
 
     data_kernel: ClassVar[DataKernel] = DataKernel(_load_data_run, _latch_data_run)
-    """The ring's fast path for runs of chips in a data cycle (:class:`supi3.interbus.device.DataKernel`)."""
+    """The ring's fast path for runs of chips in a data cycle (:class:`supi3.interbus.link.DataKernel`)."""
 
     def __init__(self, config: DeviceConfig | None = None, *, strict: bool = True) -> None:
         if config is not None and not isinstance(config, DeviceConfig):
@@ -381,7 +381,7 @@ class Supi3:
             self.registers.event(source)
 
     # --------------------------------------------------------------------------------------------------------
-    # The ring's Device protocol (supi3.interbus.device.Device), in clocks
+    # The ring's Device protocol (supi3.interbus.link.Device), in clocks
     # --------------------------------------------------------------------------------------------------------
 
     def load_at(self, cycle: Cycle, clk: int) -> bytes:
@@ -496,13 +496,13 @@ class Supi3:
     # Device protocol in bus seconds -------------------------------------------------------------------------
 
     def load(self, cycle: Cycle, now: float) -> bytes:
-        """See :meth:`supi3.interbus.device.Device.load`."""
+        """See :meth:`supi3.interbus.link.Device.load`."""
         if cycle is _DATA and type(now) is float and 0.0 <= now < _INF:
             return _load_data_run((self,), now)[0][0]  # the ring kernel's shortcut, for one chip
         return self.load_at(cycle, clocks(now))
 
     def latch(self, cycle: Cycle, received: bytes, now: float) -> None:
-        """See :meth:`supi3.interbus.device.Device.latch`."""
+        """See :meth:`supi3.interbus.link.Device.latch`."""
         # len(received) == _fixed_bytes: the kernel's width (and never in the µP modes, where _fixed_bytes is None)
         if (cycle is _DATA and type(now) is float and 0.0 <= now < _INF
                 and type(received) is bytes and len(received) == self._fixed_bytes):  # fmt: skip
@@ -511,15 +511,15 @@ class Supi3:
         self.latch_at(cycle, received, clocks(now))
 
     def discard(self, cycle: Cycle, local_error: bool, now: float) -> None:
-        """See :meth:`supi3.interbus.device.Device.discard`."""
+        """See :meth:`supi3.interbus.link.Device.discard`."""
         self.discard_at(cycle, local_error, clocks(now))
 
     def reset(self, now: float) -> None:
-        """See :meth:`supi3.interbus.device.Device.reset`."""
+        """See :meth:`supi3.interbus.link.Device.reset`."""
         self.reset_at(clocks(now))
 
     def poll(self, now: float) -> None:
-        """See :meth:`supi3.interbus.device.Device.poll`."""
+        """See :meth:`supi3.interbus.link.Device.poll`."""
         self._advance(clocks(now))
 
 
