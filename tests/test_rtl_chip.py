@@ -18,8 +18,7 @@ from hypothesis import strategies as st
 from supi3.config import decode
 from supi3.interbus import wire
 from supi3.model.top import UP_OUTPUTS
-from supi3.rtl.chip import Supi3Chip as Supi3ChipRtl
-from supi3.rtl.chip import verilog
+from supi3.rtl.chip import Supi3ChipRtl, verilog
 from supi3.rtl.harness import ChipStrapPins
 from supi3.spi.upif import Mode
 from supi3.verif import Lockstep

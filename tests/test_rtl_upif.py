@@ -24,10 +24,10 @@ from supi3.rtl.upif import UpifBlock, verilog
 from supi3.spi.block_pins import OPTICAL_REGISTERS, UpifBlockPins
 from supi3.spi.upif import BLOCK_ADDRESS, C_D_COMMAND, Mode
 from supi3.tables import BIT_RATES
-from supi3.verif import Layout, Lockstep, model_trace
+from supi3.verif import Lockstep, WordLayout, model_trace
+from supi3.verif.layout import CycleMatrix
 from support import NOT_READY_ID, UpifScript, VerilatorBuild
 
-Trace = npt.NDArray[np.uint64]
 SLOW, FAST = BIT_RATES
 SOURCE_BIT = {s.name: s.bit for s in INTERRUPT_SOURCES}
 SET = REGISTER_MAP.register("SET")
@@ -38,8 +38,8 @@ WIDTH_MASK = {pin.name: pin.mask for pin in UpifBlockPins.inputs}
 class Outcome:
     """The model's outputs of a script (the RTL's too: the lockstep compared them)."""
 
-    layout: Layout
-    trace: Trace
+    layout: WordLayout
+    trace: CycleMatrix
     script: UpifScript
 
     def __getitem__(self, name: str) -> npt.NDArray[np.uint64]:

@@ -16,7 +16,7 @@ from supi3.config import decode
 from supi3.model.registers import RegisterFile
 from supi3.regmap import encode_command
 from supi3.spi.figures import FIGURES, Figure
-from supi3.spi.master import MasterTiming, SoftMaster, decode_bytes, write_vcd
+from supi3.spi.master import MasterTiming, SoftMaster, decode_bytes, write_spi_vcd
 from supi3.spi.slave_pins import SlavePins, TimingViolationError
 from supi3.spi.upif import C_D_COMMAND, C_D_DATA, Mode, UpifUsageError
 
@@ -78,7 +78,7 @@ def test_wavejson_annotates_the_bytes_and_the_c_d_change(generated: Path) -> Non
 
 def test_vcd_of_a_scenario(tmp_path: Path) -> None:
     trace = FIGURES[-1].build()
-    path = write_vcd(trace, tmp_path / "block.vcd")
+    path = write_spi_vcd(tmp_path / "block.vcd", trace)
     ids: dict[str, str] = {}
     falls = 0
     with path.open("rb") as stream:

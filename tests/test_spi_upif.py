@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from supi3.config import decode
 from supi3.model.registers import RegisterFile
-from supi3.regmap import REGISTER_MAP, Access, Direction, encode_command
+from supi3.regmap import REGISTER_MAP, Access, AccessDirection, encode_command
 from supi3.spi.upif import C_D_COMMAND, C_D_DATA, Mode, Phase, ProtocolViolationError, UpifUsageError, UpInterface
 
 RB_UP = decode("10011", "1110")
@@ -111,7 +111,7 @@ def test_every_address_through_the_interface(mode: Mode, address: int) -> None:
     reference.cpu_write(address, 0x45)
     assert up.read(address) == reference.cpu_read(address)
     assert up.c_d == C_D_COMMAND
-    write = REGISTER_MAP.port(address, Direction.WRITE)
+    write = REGISTER_MAP.port(address, AccessDirection.WRITE)
     if write.access is Access.NO_EFFECT:
         assert up.registers.value("IN0") == 0
 

@@ -356,12 +356,12 @@ def _parse_bit_rate(text: str) -> int:
 
 def regmap_summary() -> str:
     """One line per address of the register map: what a write and a read reach, and how."""
-    from supi3.regmap import REGISTER_MAP, Direction
+    from supi3.regmap import REGISTER_MAP, AccessDirection
 
     rows = []
     for address in REGISTER_MAP.addresses:
         cells: list[object] = [address]
-        for direction in (Direction.WRITE, Direction.READ):
+        for direction in (AccessDirection.WRITE, AccessDirection.READ):
             port = REGISTER_MAP.port(address, direction)
             name = port.register.name if port.register else ""
             cells += [f"{port.title} ({name})" if name else port.title, port.access.value]

@@ -20,7 +20,7 @@ from functools import cache
 from supi3 import tables
 from supi3.checks import describe
 from supi3.errors import ConfigurationError
-from supi3.tables import Direction, PinFunction
+from supi3.tables import PinDirection, PinFunction
 
 
 class Variant(StrEnum):
@@ -149,7 +149,7 @@ class DeviceConfig:
     @property
     def mfp_output_mask(self) -> int:
         """Bit n set when MFPn is driven by the chip after reset."""
-        return sum(1 << p.pin for p in self.mfp_pins if p.direction is Direction.OUT)
+        return sum(1 << p.pin for p in self.mfp_pins if p.direction is PinDirection.OUT)
 
     @property
     def package_pins(self) -> tuple[str, ...]:
@@ -233,7 +233,7 @@ def _up_reset_pins() -> tuple[PinFunction, ...]:
         if mot.signal == intel.signal and mot.direction is intel.direction:
             pins.append(mot)
         else:
-            pins.append(PinFunction(mot.pin, f"{mot.signal} | {intel.signal}", Direction.IN,
+            pins.append(PinFunction(mot.pin, f"{mot.signal} | {intel.signal}", PinDirection.IN,
                                     "input until the initialization byte selects Motorola or Intel (3.4.3)"))
     return tuple(pins)
 
@@ -250,7 +250,7 @@ def _mfp_pins(interface: Interface, mode: MfpMode) -> tuple[PinFunction, ...]:
         pins = pins + tables.BUS_TERMINAL_MFP
     elif not (mode.kind is MfpKind.BINARY_IO and tables.BINARY_IO_TABLE[mode.name] == "3-2"):
         # Configuration expansion: MFP[15..12] carry C[8..5] (Table 3-1 heading, Tables 2-4 to 2-6).
-        pins = pins + tuple(PinFunction(p, f"C{p - 7}", Direction.IN, "configuration expansion")
+        pins = pins + tuple(PinFunction(p, f"C{p - 7}", PinDirection.IN, "configuration expansion")
                             for p in range(12, 16))
     return tuple(sorted(pins, key=lambda p: p.pin))
 

@@ -16,7 +16,7 @@ Blocks, in the order the model's ``_tick`` runs them within one clock:
 * transmitter: a short queue of (countdown, level) entries that repeats each bit ``REPEATER_DELAY_BITS`` after it
   began on DO1, with the ERR pair of the CNTR word settled at the last stop bit (docs/interbus.md, A7, A10).
 
-µP modes: built with ``register_file=True`` (:class:`supi3.rtl.chip.Supi3Chip`), the core has the ports of the
+µP modes: built with ``register_file=True`` (:class:`supi3.rtl.chip.Supi3ChipRtl`), the core has the ports of the
 register file's core side (:class:`supi3.rtl.upif.UpifBlock`): in Init-µP modes it takes the IN bytes, the ID
 register and the processor alarm from it and strobes the latch, events, processor command, I/O access bit and
 resets at the clocks the model calls its register file (``model.registers.RegisterFile``). Without it, and in SPI

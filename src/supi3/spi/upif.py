@@ -29,8 +29,8 @@ from supi3.regmap import (
     INIT_BYTE,
     REGISTER_MAP,
     Access,
-    Command,
-    Direction,
+    AccessDirection,
+    CommandByte,
     decode_command,
     encode_command,
 )
@@ -161,7 +161,7 @@ class UpifProtocol:
         self.registers = registers
         self.mode: Mode | None = None
         self.phase = Phase.INIT
-        self.command: Command | None = None
+        self.command: CommandByte | None = None
         self.last_rx = 0
         """The last complete received byte: what the chip sends back when a byte reads no register (UP-8)."""
         self._slots: tuple[_Slot, ...] = ()
@@ -291,7 +291,7 @@ class UpifProtocol:
             return slot.address if slot.read else None
         command = self.command
         if self.phase is Phase.DATA and command is not None:  # the DATA phase always has its command
-            port = REGISTER_MAP.port(command.address, Direction.READ)
+            port = REGISTER_MAP.port(command.address, AccessDirection.READ)
             if command.rd and port.access is not Access.RESERVED_IGNORED:
                 return command.address
         return None
@@ -327,7 +327,7 @@ class UpifProtocol:
         self.phase = Phase.COMMAND
         if command is None:  # cannot happen: the DATA phase always has its command
             return
-        port = REGISTER_MAP.port(command.address, Direction.WRITE)
+        port = REGISTER_MAP.port(command.address, AccessDirection.WRITE)
         if port.access is Access.RESERVED_IGNORED:
             return
         if self.mode is Mode.INTEL and command.rd != command.wr and command.rd == frame.s_r:
@@ -339,7 +339,7 @@ class UpifProtocol:
         if command.wr and self._writes(frame.s_r):
             self.registers.cpu_write(command.address, rx)
 
-    def _start_block(self, command: Command) -> None:
+    def _start_block(self, command: CommandByte) -> None:
         """Address 15: lay out the block transfer's bytes (3.4.6; UP-10, UP-11)."""
         registers = self.registers
         count = registers.data_bytes()
@@ -766,9 +766,9 @@ def _refused(name: str, value: object, hint: str, config: DeviceConfig | None = 
     return UpifArgumentError(name, value, f"{name} must be {wanted}, not {shown}{': ' + hint if hint else ''}")
 
 
-def _port_name(command: Command | None) -> str:
+def _port_name(command: CommandByte | None) -> str:
     """The register a command's write goes to, or ``""``."""
     if command is None:
         return ""
-    register = REGISTER_MAP.port(command.address, Direction.WRITE).register
+    register = REGISTER_MAP.port(command.address, AccessDirection.WRITE).register
     return "" if register is None else register.name

@@ -14,7 +14,7 @@ from supi3.verif.errors import (
     SimulationError,
     SimulatorUnavailableError,
 )
-from supi3.verif.layout import Layout, Stimulus, first_mismatch, model_trace, stimulus_array
+from supi3.verif.layout import Stimulus, WordLayout, first_mismatch, model_trace, stimulus_array
 from supi3.verif.pinmodel import EventLog, Pin, PinModel, recent_events
 from supi3.verif.report import LockstepResult
 
@@ -36,7 +36,6 @@ def __getattr__(name: str) -> object:
 
 __all__ = [
     "EventLog",
-    "Layout",
     "Lockstep",
     "LockstepError",
     "LockstepMismatchError",
@@ -47,6 +46,7 @@ __all__ = [
     "SimulationError",
     "SimulatorUnavailableError",
     "Stimulus",
+    "WordLayout",
     "first_mismatch",
     "model_trace",
     "react",

@@ -15,7 +15,7 @@ from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, Timer
 
 from supi3.verif.errors import PinSpecError
-from supi3.verif.layout import Layout, Trace, model_columns, model_trace
+from supi3.verif.layout import CycleMatrix, WordLayout, model_columns, model_trace
 from supi3.verif.pinmodel import PinModel, recent_events
 from supi3.verif.report import MismatchRecord, Outcome
 from supi3.verif.vcd import CYCLE_NS
@@ -26,7 +26,9 @@ POLL_CYCLES = 1024
 """Cycles between two reads of the comparator's mismatch flag: how far the simulation may run past a mismatch."""
 
 
-async def lockstep(dut: Any, model: PinModel, stimulus: Trace, *, reset_cycles: int = 1, window: int = 64) -> Outcome:
+async def lockstep(
+    dut: Any, model: PinModel, stimulus: CycleMatrix, *, reset_cycles: int = 1, window: int = 64
+) -> Outcome:
     """Clock the DUT and the model together; the top's comparator checks every output signal on every cycle.
 
     Timing per cycle ``n`` (see :mod:`supi3.verif.pinmodel`): at the falling clock edge the inputs of cycle ``n`` and
@@ -54,7 +56,7 @@ async def lockstep(dut: Any, model: PinModel, stimulus: Trace, *, reset_cycles: 
     Outcome
         Cycles compared, time taken, and the first mismatch if there was one (the loop stops soon after it).
     """
-    layout = Layout.of(model)
+    layout = WordLayout.of(model)
     in_ports = [getattr(dut, f"lsi{index}") for index in range(layout.in_words)]
     expected_ports = [getattr(dut, f"lse{index}") for index in range(layout.out_words)]
     flag = dut.lsx

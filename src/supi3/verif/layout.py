@@ -20,10 +20,17 @@ from supi3.verif.errors import PinSpecError
 from supi3.verif.pinmodel import Pin, PinModel, compared_signals
 
 __all__ = [
-    "Field", "Layout", "Stimulus", "Trace", "first_mismatch", "model_columns", "model_trace", "stimulus_array",
+    "CycleMatrix",
+    "Field",
+    "Stimulus",
+    "WordLayout",
+    "first_mismatch",
+    "model_columns",
+    "model_trace",
+    "stimulus_array",
 ]  # fmt: skip
 
-Trace: TypeAlias = npt.NDArray[np.uint64]
+CycleMatrix: TypeAlias = npt.NDArray[np.uint64]
 """Values per cycle and signal: shape ``(cycles, signals)``."""
 
 Stimulus: TypeAlias = npt.NDArray[np.integer] | Iterable[Mapping[str, int]]
@@ -98,7 +105,7 @@ def _comparator(fields: Sequence[Field], index_of: Mapping[str, int]) -> Callabl
     return namespace["matches"]
 
 
-class Layout:
+class WordLayout:
     """The packing of a model's pins into words.
 
     Parameters
@@ -125,7 +132,7 @@ class Layout:
         self._get_outputs = itemgetter(*[field.name for field in self.out_fields])
 
     @classmethod
-    def of(cls, model: PinModel) -> Layout:
+    def of(cls, model: PinModel) -> WordLayout:
         """The layout of ``model``'s pins."""
         return cls(model.inputs, model.outputs)
 
@@ -165,7 +172,7 @@ class Layout:
                 return index
         return None
 
-    def input_words(self, stimulus: Trace) -> npt.NDArray[np.uint32]:
+    def input_words(self, stimulus: CycleMatrix) -> npt.NDArray[np.uint32]:
         """Stimulus ``(cycles, inputs)`` packed into ``uint32`` input words ``(cycles, words)``."""
         # One integer matrix product places every field of up to 32 bits (the fields of a word are disjoint and
         # the stimulus is range-checked, so the sums are exact); a wider field fills its two words alone.
@@ -180,7 +187,7 @@ class Layout:
                 packed[:, field.word + 1] = stimulus[:, index] >> np.uint64(WORD)
         return packed
 
-    def output_words(self, trace: Trace) -> npt.NDArray[np.uint32]:
+    def output_words(self, trace: CycleMatrix) -> npt.NDArray[np.uint32]:
         """Compared output values ``(cycles, signals)`` packed into ``uint32`` output words ``(cycles, words)``,
         the inverse of :meth:`output_trace`."""
         return self.pack_columns(list(np.ascontiguousarray(trace.T)))
@@ -230,7 +237,7 @@ class Layout:
             packed |= value << field.offset
         return [(packed >> (WORD * index)) & _WORD_MASK for index in range(self.out_words)]
 
-    def output_trace(self, words: npt.NDArray[np.uint32]) -> Trace:
+    def output_trace(self, words: npt.NDArray[np.uint32]) -> CycleMatrix:
         """Output words ``(cycles, words)`` unpacked into compared signals ``(cycles, signals)``."""
         columns = np.empty((words.shape[0], len(self.out_fields)), dtype=np.uint64)
         for index, field in enumerate(self.out_fields):
@@ -254,7 +261,7 @@ def _pack(fields: Sequence[Field], words: int, columns: Sequence[npt.NDArray[np.
     return packed.T
 
 
-def stimulus_array(stimulus: Stimulus, inputs: Sequence[Pin], max_cycles: int | None = None) -> Trace:
+def stimulus_array(stimulus: Stimulus, inputs: Sequence[Pin], max_cycles: int | None = None) -> CycleMatrix:
     """Normalise stimulus to a ``uint64`` array ``(cycles, inputs)``, checking names and value ranges.
 
     Parameters
@@ -296,7 +303,7 @@ def stimulus_array(stimulus: Stimulus, inputs: Sequence[Pin], max_cycles: int | 
     return result
 
 
-def model_columns(model: PinModel, stimulus: Trace, layout: Layout) -> list[npt.NDArray[np.uint64]]:
+def model_columns(model: PinModel, stimulus: CycleMatrix, layout: WordLayout) -> list[npt.NDArray[np.uint64]]:
     """Reset ``model`` and run it over ``stimulus``; one array per compared output signal, in comparison order.
 
     A model that also offers ``run(inputs: Mapping[str, array]) -> Mapping[str, array]`` (whole traces at once,
@@ -331,18 +338,18 @@ def _unsigned(column: npt.NDArray[np.generic]) -> npt.NDArray[np.uint64]:
     return column.view(np.uint64) if column.dtype == np.int64 else column.astype(np.uint64)
 
 
-def model_trace(model: PinModel, stimulus: Trace, layout: Layout) -> Trace:
+def model_trace(model: PinModel, stimulus: CycleMatrix, layout: WordLayout) -> CycleMatrix:
     """Reset ``model`` and run it over ``stimulus``; the compared outputs per cycle ``(cycles, signals)``
     (see :func:`model_columns`)."""
     columns = model_columns(model, stimulus, layout)
     return np.stack(columns, axis=1) if columns else np.zeros((stimulus.shape[0], 0), dtype=np.uint64)
 
 
-def first_mismatch(layout: Layout, expected: Trace, actual: Trace) -> tuple[int, int] | None:
+def first_mismatch(layout: WordLayout, expected: CycleMatrix, actual: CycleMatrix) -> tuple[int, int] | None:
     """The first ``(cycle, signal index)`` where two output traces (values within their signals' widths) differ,
     gated by output enables, or ``None``.
 
     Within the first differing cycle the lowest signal index (comparison order) is reported. The traces are compared
-    as packed words, like the batch path (:meth:`Layout.first_word_mismatch`).
+    as packed words, like the batch path (:meth:`WordLayout.first_word_mismatch`).
     """
     return layout.first_word_mismatch(layout.output_words(expected), layout.output_words(actual))

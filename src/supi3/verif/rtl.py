@@ -6,8 +6,8 @@ output's enable) and uses the ``sync`` clock domain, which the harness clocks an
 
 :class:`LockstepTop` wraps it so the simulator sees only ``clk``, ``rst``, one 32-bit port per input word
 (``lsi0``, ``lsi1``, ...) and one per output word (``lso0``, ``lso1``, ...), packed as
-:class:`~supi3.verif.layout.Layout` says. With a ``window``, the top also compares the outputs itself on every rising
-clock edge, for the per-cycle path: the testbench writes the model's expected output words to ``lse0``, ``lse1``,
+:class:`~supi3.verif.layout.WordLayout` says. With a ``window``, the top also compares the outputs itself on every
+rising clock edge, for the per-cycle path: the testbench writes the model's expected output words to ``lse0``, ``lse1``,
 ... (only when they change); the first cycle whose outputs differ (tri-state values only while the expected enable
 is 1) sets the sticky flag ``lsx``, stops the cycle counter ``lsc`` (then the mismatching cycle plus one) and freezes
 the memory ``lsw`` that holds the outputs of the last ``window`` cycles (cycle ``n`` at address ``n % window``), so
@@ -31,7 +31,7 @@ from amaranth.hdl import Cat, ClockDomain, Elaboratable, Module, Mux, Signal, Va
 from amaranth.lib.memory import Memory
 
 from supi3.verif.errors import PinSpecError, SimulatorUnavailableError
-from supi3.verif.layout import WORD, Layout
+from supi3.verif.layout import WORD, WordLayout
 
 __all__ = ["TOP", "DesignFactory", "LockstepTop", "build_slot", "ensure_toolchain", "to_verilog"]
 
@@ -55,7 +55,7 @@ class LockstepTop(Elaboratable):
         Cycles of output history kept for a mismatch report; ``None`` for no comparator.
     """
 
-    def __init__(self, design: Elaboratable, layout: Layout, window: int | None = None) -> None:
+    def __init__(self, design: Elaboratable, layout: WordLayout, window: int | None = None) -> None:
         self.design = design
         self.layout = layout
         self.window = window
@@ -128,7 +128,7 @@ class LockstepTop(Elaboratable):
         return m
 
 
-def to_verilog(design_factory: Callable[[], Elaboratable], layout: Layout, window: int | None = None) -> str:
+def to_verilog(design_factory: Callable[[], Elaboratable], layout: WordLayout, window: int | None = None) -> str:
     """The Verilog of a fresh design from ``design_factory`` inside :class:`LockstepTop` (module :data:`TOP`), with
     the comparator if ``window`` is given."""
     top = LockstepTop(design_factory(), layout, window)
