@@ -36,7 +36,7 @@ from supi3.model.pins import Supi3Pins
 from supi3.rtl.chip import Supi3ChipRtl
 from supi3.rtl.core import Supi3Core
 from supi3.rtl.harness import StrapPins, strap_stimulus
-from supi3.tables import CLOCK_HZ
+from supi3.tables import BIT_RATES, CLOCK_HZ, clk_conf_for
 from supi3.verif import Lockstep
 from supi3.verif.amaranth_sim import run_amaranth_sim
 
@@ -184,9 +184,10 @@ def main() -> None:
                     f"{part} {variant:<4} {ge:>9,.0f} GE (target < {TARGET_GE:,})   "
                     f"iCE40 HX8K Fmax {mhz:6.1f} MHz (target > {TARGET_MHZ:.0f})"
                 )
-    for clk_conf, rate in (("01", "500 kbit/s"), ("11", "2 Mbit/s")):
+    for bit_rate in BIT_RATES:
+        rate = f"{bit_rate // 1000} kbit/s" if bit_rate < 1_000_000 else f"{bit_rate // 1_000_000} Mbit/s"
         print(f"speed, one chip (RB 8 IN/8 OUT) at {rate}, {args.data_cycles} data cycles:")
-        speed(args.data_cycles, args.amaranth, clk_conf, args.repeat)
+        speed(args.data_cycles, args.amaranth, clk_conf_for(bit_rate), args.repeat)
 
 
 if __name__ == "__main__":

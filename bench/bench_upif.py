@@ -26,12 +26,11 @@ from supi3.spi.slave_pins import SlavePins
 from supi3.spi.upif import Mode, UpInterface
 from supi3.timing import limit
 
-CLK_CONF = {500_000: "01", 2_000_000: "11"}  # CLK_CONF[1..0] (Table 1-7)
 BYTES_PER_ACCESS = 2  # command byte + data byte (3.4.4)
 
 
 def _registers(bit_rate: int) -> RegisterFile:
-    return RegisterFile(decode("10011", "1110", clk_conf=CLK_CONF[bit_rate]))  # RB, Init-µP
+    return RegisterFile(decode("10011", "1110", clk_conf=tables.clk_conf_for(bit_rate)))  # RB, Init-µP
 
 
 def real_byte_s(bit_rate: int) -> float:

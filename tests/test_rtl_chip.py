@@ -21,6 +21,7 @@ from supi3.model.top import UP_OUTPUTS
 from supi3.rtl.chip import Supi3ChipRtl, verilog
 from supi3.rtl.harness import ChipStrapPins
 from supi3.spi.upif import Mode
+from supi3.tables import BIT_RATES, clk_conf_for
 from supi3.verif import Lockstep
 from support import IDLE, LOOPBACK, RB_INIT_UP, ChipPins, Firmware, VerilatorBuild, bring_up, data_frame, id_frame
 
@@ -119,7 +120,7 @@ OPS = st.lists(
 
 
 @settings(max_examples=4, derandomize=True, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(mode=st.sampled_from(list(Mode)), rate=st.sampled_from(["01", "11"]), ops=OPS)
+@given(mode=st.sampled_from(list(Mode)), rate=st.sampled_from([clk_conf_for(r) for r in BIT_RATES]), ops=OPS)
 def test_random_interleavings(bench: Lockstep, mode: Mode, rate: str, ops: list[tuple[str, int, int]]) -> None:
     pins = ChipPins(decode(*RB_INIT_UP, clk_conf=rate))
     up = Firmware(pins, mode)

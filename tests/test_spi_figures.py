@@ -19,9 +19,9 @@ from supi3.spi.figures import FIGURES, Figure
 from supi3.spi.master import MasterTiming, SoftMaster, decode_bytes, write_spi_vcd
 from supi3.spi.slave_pins import SlavePins, TimingViolationError
 from supi3.spi.upif import C_D_COMMAND, C_D_DATA, Mode, UpifUsageError
+from supi3.tables import clk_conf_for
 
 FIGURE_DIR = Path(__file__).resolve().parents[1] / "docs" / "figures"
-RATES = {500_000: "01", 2_000_000: "11"}  # CLK_CONF[1..0] (Table 1-7)
 
 # (to chip, from chip, C/D when /SS fell, S/R) per byte, as the manual's figures and text give them (3.4.5, 3.4.6).
 EXPECTED = {
@@ -92,7 +92,7 @@ def test_vcd_of_a_scenario(tmp_path: Path) -> None:
 
 
 def _chip(bit_rate: int, *, strict: bool = True) -> SlavePins:
-    return SlavePins(RegisterFile(decode("10011", "1110", clk_conf=RATES[bit_rate]), strict=strict))
+    return SlavePins(RegisterFile(decode("10011", "1110", clk_conf=clk_conf_for(bit_rate)), strict=strict))
 
 
 @pytest.mark.parametrize(("bit_rate", "period"), [(500_000, 22), (2_000_000, 6)])

@@ -14,14 +14,14 @@ from supi3.model.registers import RegisterFile
 from supi3.regmap import encode_command
 from supi3.spi.slave_pins import INPUT_PINS, OUTPUT_PINS, PinsIn, PinsOut, SlavePins, TimingViolationError
 from supi3.spi.upif import C_D_COMMAND, C_D_DATA, Mode, Phase, ProtocolViolationError, UpifUsageError, UpInterface
-from supi3.tables import CLOCK_HZ
+from supi3.tables import CLOCK_HZ, clk_conf_for
 from support import FrameTiming, table_3_7_minimum
 
-RATES = {"500k": "01", "2M": "11"}  # CLK_CONF[1..0] (Table 1-7)
+RATES = {"500k": 500_000, "2M": 2_000_000}  # bit rates (Table 1-7)
 
 
 def config(rate: str) -> DeviceConfig:
-    return decode("10011", "1110", clk_conf=RATES[rate])
+    return decode("10011", "1110", clk_conf=clk_conf_for(RATES[rate]))
 
 
 def limit(rate: str, symbol: str) -> float:

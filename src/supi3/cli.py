@@ -373,7 +373,7 @@ def cmd_demo(args: argparse.Namespace) -> None:
     """A master and a small ring, live; optionally the pin-level run as a VCD."""
     from supi3 import demo
 
-    clk_conf = {500_000: "01", 2_000_000: "11"}[_parse_bit_rate(args.bit_rate)]
+    clk_conf = tables.clk_conf_for(_parse_bit_rate(args.bit_rate))
     cycles = check_int("--cycles", args.cycles, 1, MAX_DEMO_CYCLES, "a demo")
     if args.vcd is not None:
         check_int("--cycles", cycles, 1, MAX_VCD_CYCLES, "with --vcd: the pin-level run keeps every clock")

@@ -159,12 +159,11 @@ class DeviceConfig:
     def straps(self) -> Straps:
         """The pin straps that select this configuration (inverse of :func:`decode`)."""
         row = _row_for(self.interface, self.mfp_mode)
-        clk = next(r for r in tables.CLOCK_CONFIGURATIONS if r.bit_rate == self.bit_rate)
         return Straps(
             c=row.c,
             mfp=row.mfp,
             rf=self.rf_mode.rf if self.rf_mode is not None else None,
-            clk_conf=clk.clk_conf1 + clk.clk_conf0,
+            clk_conf=tables.clk_conf_for(self.bit_rate),
             diag_conf=str(self.diagnostics.diag_conf) if self.diagnostics is not None else None,
             variant=self.variant,
         )

@@ -15,6 +15,8 @@ from dataclasses import dataclass
 from enum import StrEnum
 from typing import Final
 
+from supi3.errors import ConfigurationError
+
 # ----------------------------------------------------------------------------------------------------------------
 # Operating modes: Tables 2-4, 2-5, 2-6 and 2-7
 # ----------------------------------------------------------------------------------------------------------------
@@ -575,6 +577,14 @@ CLOCK_CONFIGURATIONS: Final[tuple[ClockConf, ...]] = (
 
 BIT_RATES: Final[tuple[int, ...]] = tuple(row.bit_rate for row in CLOCK_CONFIGURATIONS if row.bit_rate)
 
+
+def clk_conf_for(bit_rate: int) -> str:
+    """CLK_CONF[1..0], MSB first, that selects ``bit_rate`` (Table 1-7): ``"01"`` 500 kbit/s, ``"11"`` 2 Mbit/s."""
+    for row in CLOCK_CONFIGURATIONS:
+        if row.bit_rate == bit_rate:
+            return row.clk_conf1 + row.clk_conf0
+    raise ConfigurationError("CLK_CONF[1..0]", f"{bit_rate} bit/s", "Table 1-7", f"the data rates are {BIT_RATES}")
+
 # ----------------------------------------------------------------------------------------------------------------
 # Bus connector recognition and regulation: Tables 2-2 and 2-9
 # ----------------------------------------------------------------------------------------------------------------
@@ -685,8 +695,11 @@ SPI_MASTER_TIMING: Final[tuple[TimingParameter, ...]] = (
 )
 """Table 3-4: SPI master times (t_Bit_IBS = 2 µs at 500 kbaud, 0.5 µs at 2 Mbaud)."""
 
+TCLK_PER_BIT: Final[int] = 16
+"""TCLK = t_Bit_IBS / 16 (Table 3-7): the µP interface's internal reference clock runs at 16 times the bit rate."""
+
 UP_INTERFACE_TIMING: Final[tuple[TimingParameter, ...]] = (
-    TimingParameter("TCLK", "Internal reference clock period", "1/16 * t_Bit_IBS", None),
+    TimingParameter("TCLK", "Internal reference clock period", f"1/{TCLK_PER_BIT} * t_Bit_IBS", None),
     TimingParameter("t0", "Clock period (1.5 MHz at 500 kbaud, 6 MHz at 2 Mbaud)", "667 ns | 167 ns", None),
     TimingParameter("t1", "Negative edge of /SS before first negative edge of SCLK", "1 * TCLK", None),
     TimingParameter("t2", "Positive edge of /SS after last positive edge of SCLK", "3 * TCLK", None),
