@@ -21,6 +21,7 @@ import cocotb.clock
 from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, Timer
 
+from supi3.config import decode
 from supi3.regmap import INTERRUPT_SOURCES, encode_command
 from supi3.spi.block_pins import strap_values
 from supi3.spi.upif import C_D_COMMAND, C_D_DATA, Mode
@@ -58,7 +59,8 @@ class _Miso:
 
 SCLK_HZ = 1_000_000
 """Below t0's 1.5 MHz at 500 kbit/s (Table 3-7)."""
-NOT_READY_ID = 0x38
+NOT_READY_ID = decode("10011", "1110").id_code
+"""RB, Init-µP (Table 2-6): the µP_Not_Ready code the master sees before SET is written (38h)."""
 VALID = next(s.bit for s in INTERRUPT_SOURCES if s.name == "VALID")
 
 

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
-from supi3.config import DeviceConfig
+from supi3.config import DeviceConfig, decode
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
 from supi3.model.pins import Supi3Pins
@@ -179,8 +179,8 @@ class CoreScript:
 # The µP interface block's stimulus (tests/test_rtl_upif.py) -----------------------------------------------------------
 
 UPIF_INPUTS = [pin.name for pin in UpifBlockPins.inputs]
-NOT_READY_ID = 0x38
-"""RB, Init-µP (Table 2-6): what the master sees before SET is written."""
+NOT_READY_ID = decode("10011", "1110").id_code
+"""RB, Init-µP (Table 2-6): what the master sees before SET is written (38h)."""
 
 
 @dataclass

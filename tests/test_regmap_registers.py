@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from supi3 import tables
+from supi3 import regmap, tables
 from supi3.errors import Supi3Error
 from supi3.regmap import (
     CHECKED_IN,
@@ -152,6 +152,14 @@ def test_manual_command_bytes(byte: int, rd: bool, wr: bool, address: int, block
     command = decode_command(byte)
     assert (command.rd, command.wr, command.address, command.block_transfer) == (rd, wr, address, block)
     assert encode_command(address, rd=rd, wr=wr) == byte
+
+
+def test_every_register_is_a_name_of_the_package() -> None:
+    """``from supi3.regmap import SET`` gives the declared register, as ``SUPI3_SET_ADDR`` names it in C."""
+    for register in REGISTER_MAP.registers:
+        assert getattr(regmap, register.name) is register
+        assert register.name in regmap.__all__
+    assert regmap.BLOCK_ADDRESS == tables.BLOCK_TRANSFER_COMMAND & COMMAND_BYTE.field("A").mask == 15
 
 
 def test_manual_command_targets() -> None:

@@ -19,10 +19,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from supi3.regmap import INTERRUPT_SOURCES, REGISTER_MAP, encode_command
+from supi3.regmap import BLOCK_ADDRESS, INTERRUPT_SOURCES, REGISTER_MAP, encode_command
 from supi3.rtl.upif import UpifBlock, verilog
 from supi3.spi.block_pins import OPTICAL_REGISTERS, UpifBlockPins
-from supi3.spi.upif import BLOCK_ADDRESS, C_D_COMMAND, Mode
+from supi3.spi.upif import C_D_COMMAND, Mode
 from supi3.tables import BIT_RATES
 from supi3.verif import Lockstep, WordLayout, model_trace
 from supi3.verif.layout import CycleMatrix

@@ -9,8 +9,17 @@ from hypothesis import strategies as st
 
 from supi3.config import decode
 from supi3.model.registers import RegisterFile
-from supi3.regmap import REGISTER_MAP, Access, AccessDirection, encode_command
-from supi3.spi.upif import C_D_COMMAND, C_D_DATA, Mode, Phase, ProtocolViolationError, UpifUsageError, UpInterface
+from supi3.regmap import ID, IN0, IRQ_EN, IRQ_EVT, OUT0, REGISTER_MAP, SET, Access, AccessDirection, encode_command
+from supi3.spi.upif import (
+    C_D_COMMAND,
+    C_D_DATA,
+    Mode,
+    Phase,
+    ProtocolViolationError,
+    UpifArgumentError,
+    UpifUsageError,
+    UpInterface,
+)
 
 RB_UP = decode("10011", "1110")
 
@@ -217,6 +226,21 @@ def test_api_contract() -> None:
         intel.exchange(0, 0)
     with pytest.raises(UpifUsageError):
         intel.protocol.end(0)
+
+
+def test_registers_as_addresses() -> None:
+    """read/write/exchange take a register of supi3.regmap as well as its address, if it is reached that way."""
+    up = chip(Mode.MOTOROLA)
+    up.write(SET, 0x82)
+    up.write(ID, 0x01)
+    assert up.read(SET) == up.read(13) == 0x82
+    assert up.exchange(ID, 0x01) == 0x01
+    up.write(IRQ_EN, 0x01)
+    assert up.read(IRQ_EVT) == 0
+    refused = (lambda: up.write(IRQ_EVT, 0), lambda: up.read(IRQ_EN), lambda: up.read(IN0), lambda: up.write(OUT0, 0))
+    for call in refused:
+        with pytest.raises(UpifArgumentError, match=r"is not (written|read) at address"):
+            call()
 
 
 _OPS = st.lists(

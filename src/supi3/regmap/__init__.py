@@ -1,7 +1,8 @@
 """The serial µP interface register map of the SUPI 3 OPC, declared once, and every output generated from it.
 
 Ref: IBS SUPI 3 OPC UM E rev. 05, 3.4.3-3.4.14, Table 3-10. The model, the RTL and the SDK import
-:data:`REGISTER_MAP` (and the layouts and helpers below); the documentation and ``supi3_regs.h`` are rendered
+:data:`REGISTER_MAP` (and the layouts and helpers below; each register is also a name of its own, ``SET``, ``ID``,
+``IRQ_EN``, ... as in ``supi3_regs.h``); the documentation and ``supi3_regs.h`` are rendered
 from it by :func:`render`.
 """
 
@@ -29,10 +30,31 @@ from supi3.regmap.export import (
     write_checked_in,
 )
 from supi3.regmap.registers import (
+    ALARM,
+    BLOCK_ADDRESS,
     COMMAND_BYTE,
+    ID,
+    IN0,
+    IN1,
+    IN2,
+    IN3,
+    IN_BYTES,
     INIT_BYTE,
     INTERRUPT_SOURCES,
+    IRQ_EN,
+    IRQ_EVT,
+    LENGTH_BRANCH,
+    LENGTH_OUT,
+    OUT0,
+    OUT1,
+    OUT2,
+    OUT3,
+    OUT_BYTES,
+    PCMD,
+    POWER_IN,
+    POWER_OUT_BRANCH,
     REGISTER_MAP,
+    SET,
     CommandByte,
     InterruptSource,
     SetConfig,
@@ -42,12 +64,33 @@ from supi3.regmap.registers import (
 )
 
 __all__ = [
+    "ALARM",
+    "BLOCK_ADDRESS",
     "CHECKED_IN",
     "COMMAND_BYTE",
     "FORMATS",
+    "ID",
+    "IN0",
+    "IN1",
+    "IN2",
+    "IN3",
     "INIT_BYTE",
     "INTERRUPT_SOURCES",
+    "IN_BYTES",
+    "IRQ_EN",
+    "IRQ_EVT",
+    "LENGTH_BRANCH",
+    "LENGTH_OUT",
+    "OUT0",
+    "OUT1",
+    "OUT2",
+    "OUT3",
+    "OUT_BYTES",
+    "PCMD",
+    "POWER_IN",
+    "POWER_OUT_BRANCH",
     "REGISTER_MAP",
+    "SET",
     "Access",
     "AccessDirection",
     "ByteLayout",

@@ -184,6 +184,8 @@ IN_BYTES: Final[tuple[Register, ...]] = tuple(
 OUT_BYTES: Final[tuple[Register, ...]] = tuple(
     _data_register(f"OUT{n}", n, AccessDirection.READ, DATA_RESETS, "3.4.8", _DATA_DOC) for n in range(4)
 )
+IN0, IN1, IN2, IN3 = IN_BYTES
+OUT0, OUT1, OUT2, OUT3 = OUT_BYTES
 _MANAGEMENT_DOC: Final[str] = "Management channel (firmware 4.0 or later), reserved for future applications (3.4.9)."
 ALARM: Final[Register] = _data_register("ALARM", 7, AccessDirection.WRITE, OTHER_RESETS, "3.4.9", _MANAGEMENT_DOC)
 PCMD: Final[Register] = _data_register("PCMD", 7, AccessDirection.READ, OTHER_RESETS, "3.4.9", _MANAGEMENT_DOC)
@@ -347,6 +349,11 @@ def _ports() -> tuple[Port, ...]:
 
 REGISTER_MAP: Final[RegisterMap] = RegisterMap(ADDRESS_BITS, _ports(), COMMAND_BYTE, INIT_BYTE)
 """The serial µP interface of the SUPI 3 OPC (Table 3-10): import this, never a copy of it."""
+
+BLOCK_ADDRESS: Final[int] = next(
+    p.address for p in REGISTER_MAP.ports if p.access is Access.BLOCK_TRANSFER and p.direction is AccessDirection.WRITE
+)
+"""The address whose command byte starts a block transfer (15, 3.4.6), as :data:`REGISTER_MAP` declares it."""
 
 # ------------------------------------------------------------------------------------------------------------
 # Decoding the interface bytes and the SET register

@@ -19,10 +19,10 @@ from typing import Final
 
 from supi3.config import decode
 from supi3.model.registers import RegisterFile
-from supi3.regmap import REGISTER_MAP, encode_command
+from supi3.regmap import BLOCK_ADDRESS, REGISTER_MAP, encode_command
 from supi3.spi.master import MasterTiming, SoftMaster, SpiTrace, decode_bytes, write_spi_vcd
 from supi3.spi.slave_pins import SlavePins
-from supi3.spi.upif import BLOCK_ADDRESS, Mode
+from supi3.spi.upif import Mode
 
 __all__ = [
     "FIGURES",
