@@ -1,8 +1,8 @@
 """The per-cycle lockstep loop as a cocotb coroutine, for the harness's own testbench and for other cocotb tests.
 
 Runs inside the simulator process. The DUT is the packed top-level with its comparator
-(:class:`~supi3.verif.rtl.LockstepTop` built with a ``window``): ports ``clk``, ``rst``, input words ``lsi<n>``,
-expected output words ``lse<n>``, and the comparator's ``lsx``, ``lsc`` and ``lsw``.
+(:class:`~supi3.verif.rtl.LockstepTop` built with a ``window``): ports ``clk``, ``rst``, input words ``stim_word<n>``,
+expected output words ``expected_word<n>``, and the comparator's ``mismatch``, ``cycle_count`` and ``history``.
 """
 
 from __future__ import annotations
@@ -57,9 +57,9 @@ async def lockstep(
         Cycles compared, time taken, and the first mismatch if there was one (the loop stops soon after it).
     """
     layout = WordLayout.of(model)
-    in_ports = [getattr(dut, f"lsi{index}") for index in range(layout.in_words)]
-    expected_ports = [getattr(dut, f"lse{index}") for index in range(layout.out_words)]
-    flag = dut.lsx
+    in_ports = [getattr(dut, f"stim_word{index}") for index in range(layout.in_words)]
+    expected_ports = [getattr(dut, f"expected_word{index}") for index in range(layout.out_words)]
+    flag = dut.mismatch
     falling = FallingEdge(dut.clk)
     # After the first falling edge, a timer of one period lands on each next one: the same instants, and cocotb
     # resumes a timer faster than an edge trigger (by 2-15 %, measured).
@@ -112,10 +112,10 @@ async def lockstep(
     seconds = time.perf_counter() - start
     if not flag.value:
         return Outcome(cycles, seconds)
-    mismatch = dut.lsc.value.to_unsigned() - 1
+    mismatch = dut.cycle_count.value.to_unsigned() - 1
     expected_trace = model_trace(model, stimulus[: mismatch + 1], layout)  # a replay: the events end there too
     first = max(0, mismatch + 1 - window)
-    actual = [dut.lsw[cycle % window].value.to_unsigned() for cycle in range(first, mismatch + 1)]
+    actual = [dut.history[cycle % window].value.to_unsigned() for cycle in range(first, mismatch + 1)]
     signal = layout.first_difference(expected_trace[-1].tolist(), layout.unpack_outputs(actual[-1]))
     assert signal is not None, "the comparator and first_difference() agree"
     return Outcome(mismatch + 1, seconds, MismatchRecord(mismatch, signal, recent_events(model), actual))

@@ -337,8 +337,8 @@ class Lockstep:
             top=TOP,
             in_stride=max(self.layout.in_words, 1),
             out_words=self.layout.out_words,
-            drive=_cxx_words("lsi", self.layout.in_words, "i", drive=True),
-            sample=_cxx_words("lso", self.layout.out_words, "o", drive=False),
+            drive=_cxx_words("stim_word", self.layout.in_words, "i", drive=True),
+            sample=_cxx_words("rtl_out_word", self.layout.out_words, "o", drive=False),
         )
 
     def batch_executable(self) -> Path:
