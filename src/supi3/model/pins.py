@@ -265,7 +265,7 @@ class Supi3Pins:
         if stat != self._stat_active:
             self._stat_active = stat
             chip._set_stat_err(stat, c)
-        if c >= chip._due:
+        if c >= chip.due:
             chip._advance(c)
         self._receiver.clock(line, c)
 
