@@ -19,7 +19,7 @@ from collections.abc import Callable
 from supi3 import tables
 from supi3.config import decode
 from supi3.model.registers import RegisterFile
-from supi3.regmap import REGISTER_MAP, encode_command
+from supi3.regmap import IN0, OUT0, REGISTER_MAP, encode_command
 from supi3.spi.figures import SET_1_BYTE
 from supi3.spi.master import SoftMaster
 from supi3.spi.slave_pins import SlavePins
@@ -63,8 +63,8 @@ def transaction_accesses_per_s(accesses: int, repeat: int) -> float:
 
     def run() -> None:
         for k in range(accesses // 2):
-            up.write(0, k & 0xFF)
-            up.read(0)
+            up.write(IN0, k & 0xFF)
+            up.read(OUT0)
 
     return accesses // 2 * 2 / _best(repeat, run)
 
@@ -75,7 +75,7 @@ def pin_bytes_per_s(bit_rate: int, count: int, repeat: int) -> tuple[float, floa
     chip = SlavePins(_registers(bit_rate))
     master = SoftMaster(chip, Mode.MOTOROLA, record=False)
     master.byte(Mode.MOTOROLA.init_byte)
-    command = encode_command(0, wr=True)
+    command = encode_command(IN0.address, wr=True)
     cycles = 0
 
     def run() -> None:

@@ -31,7 +31,7 @@ from supi3.interbus.wire import Cycle, Frame
 from supi3.model.pins import Supi3Pins
 from supi3.model.registers import RegisterFile
 from supi3.model.top import UP_INPUTS, UP_OUTPUTS, Supi3Chip
-from supi3.regmap import encode_command
+from supi3.regmap import Register, encode_command
 from supi3.spi.block_pins import UpifBlockPins, block_model, strap_values
 from supi3.spi.master import SoftMaster
 from supi3.spi.slave_pins import PinsIn, PinsOut
@@ -43,6 +43,13 @@ from supi3.verif.pinmodel import OE_SUFFIX
 
 Columns = dict[str, npt.NDArray[np.int64]]
 Levels = npt.NDArray[np.uint8]
+
+
+def register_address(address: int | Register) -> int:
+    """A register access's address: a number, or a register of :mod:`supi3.regmap` (``SET`` -> 13)."""
+    return address if isinstance(address, int) else address.address
+
+
 VerilatorBuild = Callable[[str], Path]
 """The ``verilator_build`` fixture (tests/conftest.py): a fresh build directory for a name."""
 
@@ -236,11 +243,11 @@ class UpifScript:
         self.mode = mode
         return self
 
-    def write(self, address: int, value: int) -> UpifScript:
-        return self.byte(encode_command(address, wr=True)).byte(value)
+    def write(self, address: int | Register, value: int) -> UpifScript:
+        return self.byte(encode_command(register_address(address), wr=True)).byte(value)
 
-    def read(self, address: int) -> UpifScript:
-        return self.byte(encode_command(address, rd=True)).byte(0, s_r=0)
+    def read(self, address: int | Register) -> UpifScript:
+        return self.byte(encode_command(register_address(address), rd=True)).byte(0, s_r=0)
 
     def sas_init(self, cycles: int = 12) -> UpifScript:
         self.mode = None
@@ -329,13 +336,13 @@ class Firmware:
     def init(self) -> None:
         self.master.byte(self.mode.init_byte)
 
-    def write(self, address: int, value: int) -> None:
-        self.master.byte(encode_command(address, wr=True))
+    def write(self, address: int | Register, value: int) -> None:
+        self.master.byte(encode_command(register_address(address), wr=True))
         self.master.byte(value)
         self.master.deselect()
 
-    def read(self, address: int) -> int | None:
-        self.master.byte(encode_command(address, rd=True))
+    def read(self, address: int | Register) -> int | None:
+        self.master.byte(encode_command(register_address(address), rd=True))
         value = self.master.byte(0, s_r=False)
         self.master.deselect()
         return value

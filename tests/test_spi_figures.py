@@ -14,7 +14,7 @@ from vcd.reader import TokenKind, tokenize
 from supi3.cli import main
 from supi3.config import decode
 from supi3.model.registers import RegisterFile
-from supi3.regmap import encode_command
+from supi3.regmap import IN0, encode_command
 from supi3.spi.figures import FIGURES, Figure
 from supi3.spi.master import MasterTiming, SoftMaster, decode_bytes, write_spi_vcd
 from supi3.spi.slave_pins import SlavePins, TimingViolationError
@@ -106,7 +106,7 @@ def test_fastest_master_is_within_table_3_7(bit_rate: int, period: int) -> None:
         m.byte(encode_command(address, wr=True))
         m.byte(value)
     chip.registers.latch(b"\x3c")
-    m.byte(encode_command(0, rd=True, wr=True))
+    m.byte(encode_command(IN0.address, rd=True, wr=True))
     assert m.byte(0x11) == 0x3C
     m.deselect()
     assert chip.registers.value("IN0") == 0x11 and chip.registers.value("SET") == 0x82
