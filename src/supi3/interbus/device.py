@@ -48,7 +48,7 @@ class Device(Protocol):
         """The cycle passed every check and the master sent the latch telegrams: take over ``received``.
 
         ``received`` is what the register holds at the end of the data sequence: the OUT data in a data cycle,
-        the command word (``wire.decode_command(wire.word_from_bytes(received))``) in an ID cycle.
+        the command word (``wire.decode_command_word(wire.word_from_bytes(received))``) in an ID cycle.
         """
         ...
 
@@ -234,7 +234,7 @@ class PlainDevice:
         _cycle(cycle)
         now = _now(now)
         self.id_cycles += 1
-        command = wire.decode_command(wire.word_from_bytes(received))
+        command = wire.decode_command_word(wire.word_from_bytes(received))
         if command.watchdog_code is not None:
             self.watchdog.configure(command.watchdog_code, now)
         if command.quit_peripheral_error:

@@ -377,7 +377,7 @@ class CommandWord(NamedTuple):
     alarm_request: bool = False
 
 
-def decode_command(word: int) -> CommandWord:
+def decode_command_word(word: int) -> CommandWord:
     """Inverse of :func:`command_word`; bits without a meaning are ignored."""
     word = _int("word", word, 0, 0xFFFF, "a command word is 16 bits")
     code = (word >> CMD_WD_CODE_SHIFT) & 0b11 if _bit(word, CMD_WD_SET_BIT) else None

@@ -396,7 +396,7 @@ class Supi3:
             self._event("VALID")
             self._event("PCP_RX")
         else:
-            command = wire.decode_command(wire.word_from_bytes(received))
+            command = wire.decode_command_word(wire.word_from_bytes(received))
             if command.watchdog_code is not None:
                 self.watchdog_code = command.watchdog_code
                 timeout = WATCHDOG_CLOCKS[command.watchdog_code]

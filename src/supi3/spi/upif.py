@@ -24,6 +24,7 @@ from supi3.config import DeviceConfig
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.model.chip import Supi3
 from supi3.model.registers import InterfaceViolationError, RegisterFile
+from supi3.pinout import C_D_COMMAND, C_D_DATA
 from supi3.regmap import (
     BLOCK_ADDRESS,
     COMMAND_BYTE,
@@ -56,10 +57,6 @@ __all__ = [
 
 _T = TypeVar("_T")
 
-C_D_COMMAND: Final[int] = 0
-"""C/D (MFP2) level while the next byte is an initialization or command byte, in both modes (UP-2)."""
-C_D_DATA: Final[int] = 1
-"""C/D level while the next byte is a data byte, and while data transmission is disabled (UP-4)."""
 
 _WORD_BITS: Final[int] = 16
 

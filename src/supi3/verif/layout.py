@@ -21,8 +21,8 @@ from supi3.verif.pinmodel import Pin, PinModel, compared_signals
 
 __all__ = [
     "CycleMatrix",
-    "Field",
     "Stimulus",
+    "WordField",
     "WordLayout",
     "first_mismatch",
     "model_columns",
@@ -43,7 +43,7 @@ _WORD_MASK = (1 << WORD) - 1
 
 
 @dataclass(frozen=True)
-class Field:
+class WordField:
     """Where one signal sits in the packed words.
 
     Attributes
@@ -77,13 +77,13 @@ class Field:
         return (1 << self.width) - 1
 
 
-def _place(signals: Sequence[tuple[str, int, str | None]]) -> tuple[tuple[Field, ...], int]:
-    fields: list[Field] = []
+def _place(signals: Sequence[tuple[str, int, str | None]]) -> tuple[tuple[WordField, ...], int]:
+    fields: list[WordField] = []
     word, shift = 0, 0
     for name, width, enable in signals:
         if shift and (width > WORD or shift + width > WORD):
             word, shift = word + 1, 0
-        fields.append(Field(name, width, word, shift, enable))
+        fields.append(WordField(name, width, word, shift, enable))
         if width > WORD:
             word, shift = word + 2, 0
         else:
@@ -91,7 +91,7 @@ def _place(signals: Sequence[tuple[str, int, str | None]]) -> tuple[tuple[Field,
     return tuple(fields), word + (1 if shift else 0)
 
 
-def _comparator(fields: Sequence[Field], index_of: Mapping[str, int]) -> Callable[[Sequence[int], int], bool]:
+def _comparator(fields: Sequence[WordField], index_of: Mapping[str, int]) -> Callable[[Sequence[int], int], bool]:
     # The per-cycle path's hot loop: one expression over the layout's constants instead of a loop over fields,
     # about three times faster in CPython. Only integers from the layout enter the generated source.
     terms = []
@@ -250,7 +250,7 @@ class WordLayout:
         return columns
 
 
-def _pack(fields: Sequence[Field], words: int, columns: Sequence[npt.NDArray[np.uint64]]) -> npt.NDArray[np.uint32]:
+def _pack(fields: Sequence[WordField], words: int, columns: Sequence[npt.NDArray[np.uint64]]) -> npt.NDArray[np.uint32]:
     """Columns of values (one per field) packed into ``uint32`` words ``(cycles, words)``."""
     cycles = len(columns[0]) if len(columns) else 0
     packed = np.zeros((words, cycles), dtype=np.uint32)  # one contiguous row per word while packing
