@@ -266,7 +266,7 @@ def cmd_modes(args: argparse.Namespace) -> None:
     ))
 
 
-def describe(config: DeviceConfig) -> str:
+def describe_config(config: DeviceConfig) -> str:
     """A human-readable description of a decoded configuration."""
     d = config.as_dict()
     lines = [f"{key:20} {value}" for key, value in d.items()]
@@ -284,7 +284,7 @@ def cmd_decode(args: argparse.Namespace) -> None:
                             for p in config.mfp_pins]
         print_json(data)
     else:
-        print(describe(config))
+        print(describe_config(config))
 
 
 def cmd_regmap(args: argparse.Namespace) -> None:
@@ -387,7 +387,7 @@ def cmd_demo(args: argparse.Namespace) -> None:
 def cmd_campaign(args: argparse.Namespace) -> None:
     """A seeded fault campaign at transaction and/or pin level (supi3.campaign); exit status 1 if a goal is missed."""
     results = [campaign.run_campaign(config) for config in _campaign_configs(args)]
-    print(campaign.report(results, args.json))
+    print(campaign.campaign_report(results, args.json))
     if not all(r.ok for r in results):
         raise SystemExit(1)
 
