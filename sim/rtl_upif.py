@@ -21,7 +21,8 @@ import cocotb.clock
 from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, Timer
 
-from supi3.regmap import INTERRUPT_SOURCES, encode_command
+from supi3.config import decode
+from supi3.regmap import ID, INTERRUPT_SOURCES, IRQ_EN, IRQ_EVT, SET, encode_command
 from supi3.spi.block_pins import strap_values
 from supi3.spi.upif import C_D_COMMAND, C_D_DATA, Mode
 from supi3.tables import BIT_RATES, CLOCK_HZ
@@ -58,7 +59,8 @@ class _Miso:
 
 SCLK_HZ = 1_000_000
 """Below t0's 1.5 MHz at 500 kbit/s (Table 3-7)."""
-NOT_READY_ID = 0x38
+NOT_READY_ID = decode("10011", "1110").id_code
+"""RB, Init-µP (Table 2-6): the µP_Not_Ready code the master sees before SET is written (38h)."""
 VALID = next(s.bit for s in INTERRUPT_SOURCES if s.name == "VALID")
 
 
@@ -93,26 +95,26 @@ async def spi_master_reads_and_writes_registers(dut: Any) -> None:
 
     await exchange(master, Mode.MOTOROLA.init_byte)
     assert int(dut.c_d.value) == C_D_COMMAND, "first initialization shows the command status twice (3.4.3)"
-    await exchange(master, encode_command(13, wr=True))
+    await exchange(master, encode_command(SET.address, wr=True))
     assert int(dut.c_d.value) == C_D_DATA
     await exchange(master, 0x82)
-    await exchange(master, encode_command(12, wr=True))
+    await exchange(master, encode_command(ID.address, wr=True))
     await exchange(master, 0x01)
     assert int(dut.bus_id.value) == 0x0901
-    assert await exchange(master, encode_command(13, rd=True)) == 0x01, "a command byte echoes (UP-8)"
+    assert await exchange(master, encode_command(SET.address, rd=True)) == 0x01, "a command byte echoes (UP-8)"
     assert await exchange(master, 0) == 0x82
-    await exchange(master, encode_command(12, rd=True))
+    await exchange(master, encode_command(ID.address, rd=True))
     assert await exchange(master, 0) == 0x01
 
-    await exchange(master, encode_command(14, wr=True))
+    await exchange(master, encode_command(IRQ_EN.address, wr=True))
     await exchange(master, 1 << VALID)
     dut.events.value = 1 << VALID
     await ClockCycles(dut.clk, 1)
     dut.events.value = 0
     await ClockCycles(dut.clk, 12)
     assert int(dut.irq_n.value) == 0
-    await exchange(master, encode_command(14, rd=True))
+    await exchange(master, encode_command(IRQ_EVT.address, rd=True))
     assert await exchange(master, 0) == 1 << VALID
     assert int(dut.irq_n.value) == 1
-    await exchange(master, encode_command(14, rd=True))
+    await exchange(master, encode_command(IRQ_EVT.address, rd=True))
     assert await exchange(master, 0) == 0

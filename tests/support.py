@@ -25,13 +25,13 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
-from supi3.config import DeviceConfig
+from supi3.config import DeviceConfig, decode
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
 from supi3.model.pins import Supi3Pins
 from supi3.model.registers import RegisterFile
 from supi3.pinlevel import OE_SUFFIX
-from supi3.regmap import encode_command
+from supi3.regmap import Register, encode_command
 from supi3.spi.block_pins import UpifBlockPins, block_model, strap_values
 from supi3.spi.master import SoftMaster
 from supi3.spi.slave_pins import PinsIn, PinsOut
@@ -39,10 +39,17 @@ from supi3.spi.upif import Mode
 from supi3.tables import BIT_RATES, CLOCK_HZ
 from supi3.timing import timing_table
 from supi3.top import UP_INPUTS, UP_OUTPUTS, Supi3Chip
+from supi3.verif.layout import CycleMatrix
 
 Columns = dict[str, npt.NDArray[np.int64]]
 Levels = npt.NDArray[np.uint8]
-Trace = npt.NDArray[np.uint64]
+
+
+def register_address(address: int | Register) -> int:
+    """A register access's address: a number, or a register of :mod:`supi3.regmap` (``SET`` -> 13)."""
+    return address if isinstance(address, int) else address.address
+
+
 VerilatorBuild = Callable[[str], Path]
 """The ``verilator_build`` fixture (tests/conftest.py): a fresh build directory for a name."""
 
@@ -169,7 +176,7 @@ class CoreScript:
     def columns(self) -> Columns:
         return {name: np.concatenate([part[name] for part in self.parts]) for name in CORE_INPUTS}
 
-    def stimulus(self) -> Trace:
+    def stimulus(self) -> CycleMatrix:
         from supi3.verif.straps import strap_stimulus  # Amaranth: only when a bench runs
 
         columns = self.columns()
@@ -179,8 +186,8 @@ class CoreScript:
 # The µP interface block's stimulus (tests/test_rtl_upif.py) -----------------------------------------------------------
 
 UPIF_INPUTS = [pin.name for pin in UpifBlockPins.inputs]
-NOT_READY_ID = 0x38
-"""RB, Init-µP (Table 2-6): what the master sees before SET is written."""
+NOT_READY_ID = decode("10011", "1110").id_code
+"""RB, Init-µP (Table 2-6): what the master sees before SET is written (38h)."""
 
 
 @dataclass
@@ -236,17 +243,17 @@ class UpifScript:
         self.mode = mode
         return self
 
-    def write(self, address: int, value: int) -> UpifScript:
-        return self.byte(encode_command(address, wr=True)).byte(value)
+    def write(self, address: int | Register, value: int) -> UpifScript:
+        return self.byte(encode_command(register_address(address), wr=True)).byte(value)
 
-    def read(self, address: int) -> UpifScript:
-        return self.byte(encode_command(address, rd=True)).byte(0, s_r=0)
+    def read(self, address: int | Register) -> UpifScript:
+        return self.byte(encode_command(register_address(address), rd=True)).byte(0, s_r=0)
 
     def sas_init(self, cycles: int = 12) -> UpifScript:
         self.mode = None
         return self.run(cycles, sas_init=1).run(self.gap, sas_init=0)
 
-    def stimulus(self) -> Trace:
+    def stimulus(self) -> CycleMatrix:
         array = np.concatenate([np.tile(np.array([pins[name] for name in UPIF_INPUTS], dtype=np.uint64), (n, 1))
                                 for n, pins in self.segments])
         for cycle, pins in self.strobes:
@@ -310,7 +317,7 @@ class ChipPins:
         for _ in range(extra):
             self.step()
 
-    def stimulus(self) -> Trace:
+    def stimulus(self) -> CycleMatrix:
         from supi3.verif.straps import strap_stimulus  # Amaranth: only when a bench runs
 
         return strap_stimulus(self.config, np.array(self.rows, dtype=np.int64))
@@ -329,13 +336,13 @@ class Firmware:
     def init(self) -> None:
         self.master.byte(self.mode.init_byte)
 
-    def write(self, address: int, value: int) -> None:
-        self.master.byte(encode_command(address, wr=True))
+    def write(self, address: int | Register, value: int) -> None:
+        self.master.byte(encode_command(register_address(address), wr=True))
         self.master.byte(value)
         self.master.deselect()
 
-    def read(self, address: int) -> int | None:
-        self.master.byte(encode_command(address, rd=True))
+    def read(self, address: int | Register) -> int | None:
+        self.master.byte(encode_command(register_address(address), rd=True))
         value = self.master.byte(0, s_r=False)
         self.master.deselect()
         return value

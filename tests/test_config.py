@@ -175,7 +175,7 @@ def test_binary_io_pins_follow_tables_3_1_and_3_2(mode: str) -> None:
             assert pins[expected.pin] == expected
         if tables.BINARY_IO_TABLE[mode] == "3-1":
             assert [pins[p].signal for p in range(12, 16)] == ["C5", "C6", "C7", "C8"]
-        outputs = {p.pin for p in tables.BINARY_IO_MFP[mode] if p.direction is tables.Direction.OUT}
+        outputs = {p.pin for p in tables.BINARY_IO_MFP[mode] if p.direction is tables.PinDirection.OUT}
         assert config.mfp_output_mask == sum(1 << p for p in outputs)
 
 
@@ -191,7 +191,7 @@ def test_spi_master_and_up_and_bus_terminal_pins() -> None:
     bk = decode("00000")
     assert bk.interface is Interface.BK_RB and bk.mfp_mode.kind is MfpKind.NONE
     assert bk.mfp_output_mask == sum(1 << p.pin for p in tables.BUS_TERMINAL_MFP
-                                     if p.direction is tables.Direction.OUT)
+                                     if p.direction is tables.PinDirection.OUT)
     bk_up = decode("00100")
     assert bk_up.interface is Interface.BK_LB and bk_up.mfp_mode.kind is MfpKind.INIT_UP
 

@@ -129,7 +129,7 @@ HOSTILE: list[tuple[str, Callable[[], object], str]] = [
     ("command_word(None, 1)", lambda: wire.command_word(None, 1), "quit_peripheral_error"),  # type: ignore[arg-type]
     ("command_word(None, False, 300)", lambda: wire.command_word(None, False, 300), "processor_command"),
     ("command_word(alarm_request=None)", lambda: wire.command_word(alarm_request=None), "alarm_request"),  # type: ignore[arg-type]
-    ("decode_command(-1)", lambda: wire.decode_command(-1), "word"),
+    ("decode_command_word(-1)", lambda: wire.decode_command_word(-1), "word"),
     ("crc_update_bit(0, 2)", lambda: wire.crc_update_bit(0, 2), "bit"),
     ("crc_update_bit(0x10000, 0)", lambda: wire.crc_update_bit(0x10000, 0), "crc"),
     ("crc16('abc')", lambda: wire.crc16("abc"), "data"),  # type: ignore[arg-type]

@@ -83,8 +83,8 @@ def test_loopback_word_cannot_be_an_id_register() -> None:
 def test_command_words_round_trip() -> None:
     for code in [None, *range(len(WATCHDOG_TIMEOUTS_S))]:
         for quit_error in (False, True):
-            command = wire.decode_command(wire.command_word(code, quit_error))
-            assert command == wire.Command(code, quit_error)
+            command = wire.decode_command_word(wire.command_word(code, quit_error))
+            assert command == wire.CommandWord(code, quit_error)
     assert wire.command_word() == 0
 
 

@@ -197,6 +197,6 @@ def test_command_word_round_trip() -> None:
     for pcmd in (None, 0x00, 0xA5):
         for alarm in (False, True):
             word = wire.command_word(1, True, pcmd, alarm)
-            assert wire.decode_command(word) == wire.Command(1, True, pcmd, alarm)
+            assert wire.decode_command_word(word) == wire.CommandWord(1, True, pcmd, alarm)
     with pytest.raises(InterbusError, match="one byte"):
         wire.command_word(processor_command=0x100)

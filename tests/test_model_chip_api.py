@@ -21,7 +21,7 @@ from supi3.model.registers import (
     RegisterFile,
     RegisterFileError,
 )
-from supi3.regmap import REGISTER_MAP
+from supi3.regmap import IN1, OUT0, REGISTER_MAP, SET
 from supi3.spi.master import SoftMaster
 from supi3.spi.slave_pins import SlavePins
 from supi3.spi.upif import Mode, UpInterface
@@ -44,10 +44,10 @@ def test_inconsistent_data_names_the_transaction_level_time() -> None:
     chip = Supi3(RB_UP, strict=False)
     up = UpInterface(chip)
     assert up.initialize(Mode.MOTOROLA)
-    up.write(13, SET_2_WORDS)
+    up.write(SET, SET_2_WORDS)
     chip.poll(0.0123)
     chip.set_latch_phase(True)
-    up.read(0)
+    up.read(OUT0)
     [violation] = chip.registers.violations.records  # type: ignore[union-attr]
     assert isinstance(violation, InconsistentDataError)
     assert violation.clock == clocks(0.0123) == 393_600
@@ -60,7 +60,7 @@ def test_inconsistent_data_names_the_transaction_level_time() -> None:
     strict.load(DATA, 2e-3)
     strict.set_latch_phase(True)
     with pytest.raises(InconsistentDataError, match=r"IN1 write during the latch phase at clock 64000 \(t = 0.002 s\)"):
-        fw.write(1, 7)
+        fw.write(IN1, 7)
     assert fw.registers.value("IN1") == 7  # the access still happened (UP-19)
 
 

@@ -28,7 +28,7 @@ from supi3.model.pins import Supi3Pins
 from supi3.model.registers import InterfaceViolationError, RegisterFile
 from supi3.model.vcd import write_vcd
 from supi3.pinlevel import PinSpecError
-from supi3.rtl.chip import Supi3Chip as RtlChip
+from supi3.rtl.chip import Supi3ChipRtl
 from supi3.rtl.core import Supi3Core
 from supi3.rtl.tables import core_tables
 from supi3.spi.block_pins import UpifBlockPins, block_model, strap_values
@@ -345,7 +345,7 @@ CASES: list[tuple[str, Factory, Call, type[Exception], str, Callable[[Any], obje
      "variant must be one of 'opc', 'ls' (Table 1-1), not 'tqfp'", probe_none),
     ("core-register-file", lambda: None, lambda _: Supi3Core("opc", register_file=bad(1)), ArgumentError,
      "register_file must be True or False, not 1", probe_none),
-    ("rtl-chip-variant", lambda: None, lambda _: RtlChip(bad(None)), ArgumentError, "variant must be one of",
+    ("rtl-chip-variant", lambda: None, lambda _: Supi3ChipRtl(bad(None)), ArgumentError, "variant must be one of",
      probe_none),
     ("core-tables-variant", lambda: None, lambda _: core_tables(bad(1)), ArgumentError, "variant must be one of",
      probe_none),

@@ -13,7 +13,7 @@ from supi3.model.registers import (
     RegisterFileError,
     SetRegisterError,
 )
-from supi3.regmap import INTERRUPT_SOURCES, REGISTER_MAP, Access, Direction, Reset, encode_command
+from supi3.regmap import INTERRUPT_SOURCES, REGISTER_MAP, Access, AccessDirection, Reset, encode_command
 from supi3.tables import UP_NOT_READY_ID_CODES
 
 RB_UP = decode("10011", "1110")  # RB, Init-µP: µP_Not_Ready 38h (Table 2-6)
@@ -81,8 +81,8 @@ def test_reserved_set_codes_are_stored_but_not_applied(value: int) -> None:
 def test_every_address_read_and_write(address: int) -> None:
     """Table 3-10 and RM-9: what a read and a write of each address do."""
     r = regs()
-    write = REGISTER_MAP.port(address, Direction.WRITE)
-    read = REGISTER_MAP.port(address, Direction.READ)
+    write = REGISTER_MAP.port(address, AccessDirection.WRITE)
+    read = REGISTER_MAP.port(address, AccessDirection.READ)
     if write.access in (Access.RESERVED_IGNORED, Access.BLOCK_TRANSFER):
         with pytest.raises(RegisterFileError):
             r.cpu_write(address, 0x55)

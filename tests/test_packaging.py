@@ -67,7 +67,7 @@ else:
 
 from supi3.config import decode
 from supi3.model.registers import RegisterFile
-from supi3.regmap import encode_command
+from supi3.regmap import IN0, SET, encode_command
 from supi3.spi.master import SoftMaster, decode_bytes
 from supi3.spi.slave_pins import SlavePins
 from supi3.spi.upif import Mode
@@ -75,11 +75,11 @@ from supi3.spi.upif import Mode
 chip = SlavePins(RegisterFile(decode("10011", "1110")))
 master = SoftMaster(chip, Mode.MOTOROLA)
 master.byte(Mode.MOTOROLA.init_byte)
-master.byte(encode_command(13, wr=True))
+master.byte(encode_command(SET.address, wr=True))
 master.byte(0x82)
 master.deselect()  # /SS rises: the chip takes the SET byte
 chip.registers.latch(b"\\x3c")
-master.byte(encode_command(0, rd=True, wr=True))
+master.byte(encode_command(IN0.address, rd=True, wr=True))
 received = master.byte(0x11)
 master.deselect()
 

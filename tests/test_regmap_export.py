@@ -9,7 +9,7 @@ from typing import Any
 import pytest
 
 from supi3.errors import Supi3Error
-from supi3.regmap import CHECKED_IN, FORMATS, REGISTER_MAP, Direction, RegisterMapError, render, to_systemrdl
+from supi3.regmap import CHECKED_IN, FORMATS, REGISTER_MAP, AccessDirection, RegisterMapError, render, to_systemrdl
 from supi3.regmap.__main__ import main
 from supi3.regmap.export import compile_systemrdl
 
@@ -28,8 +28,8 @@ def test_systemrdl_compiles_and_agrees_with_the_declaration(rdl_top: Any) -> Non
         node = registers[register.name]
         assert node.raw_address_offset == register.address and node.get_property("regwidth") == 8
         directions = {p.direction for p in REGISTER_MAP.ports if p.register is register}
-        assert node.has_sw_writable == (Direction.WRITE in directions)
-        assert node.has_sw_readable == (Direction.READ in directions)
+        assert node.has_sw_writable == (AccessDirection.WRITE in directions)
+        assert node.has_sw_readable == (AccessDirection.READ in directions)
         fields = {f.inst_name: f for f in node.fields()}
         assert set(fields) == {f.name for f in register.base_fields}
         for field in register.base_fields:

@@ -9,12 +9,12 @@ from pathlib import Path
 
 import pytest
 
-from supi3.regmap import REGISTER_MAP, Layout, to_c_header
+from supi3.regmap import REGISTER_MAP, ByteLayout, to_c_header
 
 C_DIR = Path(__file__).parent / "c"
 
 
-def _layout_checks(layout: Layout) -> list[tuple[str, int]]:
+def _layout_checks(layout: ByteLayout) -> list[tuple[str, int]]:
     checks = []
     for f in layout.fields:
         checks += [(f"SUPI3_{layout.name}_{f.name}_POS", f.lsb), (f"SUPI3_{layout.name}_{f.name}_MSK", f.mask)]

@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from supi3 import tables
+from supi3 import regmap, tables
 from supi3.errors import Supi3Error
 from supi3.regmap import (
     CHECKED_IN,
@@ -17,9 +17,9 @@ from supi3.regmap import (
     INTERRUPT_SOURCES,
     REGISTER_MAP,
     Access,
-    Direction,
+    AccessDirection,
+    ByteLayout,
     Field,
-    Layout,
     Port,
     Register,
     RegisterMap,
@@ -53,14 +53,14 @@ def test_checked_in_file_is_current(fmt: str, path: Path) -> None:
 
 def test_every_address_has_one_write_and_one_read_port() -> None:
     keys = [(p.address, p.direction) for p in REGISTER_MAP.ports]
-    assert sorted(keys) == sorted((a, d) for a in range(16) for d in Direction)
+    assert sorted(keys) == sorted((a, d) for a in range(16) for d in AccessDirection)
     assert list(REGISTER_MAP.addresses) == list(range(16))
 
 
 @pytest.mark.parametrize("row", tables.ADDRESS_MAP, ids=lambda r: str(r.address))
 def test_port_titles_are_table_3_10(row: tables.AddressRow) -> None:
-    assert REGISTER_MAP.port(row.address, Direction.WRITE).title == (row.write or "-")
-    assert REGISTER_MAP.port(row.address, Direction.READ).title == row.read
+    assert REGISTER_MAP.port(row.address, AccessDirection.WRITE).title == (row.write or "-")
+    assert REGISTER_MAP.port(row.address, AccessDirection.READ).title == row.read
 
 
 EXPECTED_ACCESS = {
@@ -79,7 +79,7 @@ EXPECTED_ACCESS = {
 
 @pytest.mark.parametrize("address", range(16))
 def test_access_semantics(address: int) -> None:
-    write, read = (REGISTER_MAP.port(address, d) for d in (Direction.WRITE, Direction.READ))
+    write, read = (REGISTER_MAP.port(address, d) for d in (AccessDirection.WRITE, AccessDirection.READ))
     assert (write.access, read.access) == EXPECTED_ACCESS[address]
     shared = write.register is not None and write.register is read.register
     assert shared == (address in (12, 13)), "only ID and SET read back what was written (3.4.11)"
@@ -106,16 +106,16 @@ def test_register_names_and_lookup() -> None:
         "IRQ_EN",
         "IRQ_EVT",
     ]
-    assert REGISTER_MAP.register("SET") is REGISTER_MAP.port(13, Direction.WRITE).register
+    assert REGISTER_MAP.register("SET") is REGISTER_MAP.port(13, AccessDirection.WRITE).register
     with pytest.raises(RegisterMapError, match="no register 'NOPE'"):
         REGISTER_MAP.register("NOPE")
     with pytest.raises(RegisterMapError, match="outside the 16-byte area"):
-        REGISTER_MAP.port(16, Direction.READ)
+        REGISTER_MAP.port(16, AccessDirection.READ)
 
 
 def test_only_the_event_register_clears_on_read() -> None:
     masks = {(p.address, p.direction): p.clear_on_read_mask for p in REGISTER_MAP.ports if p.clear_on_read_mask}
-    assert masks == {(14, Direction.READ): 0x7F}, "events clear, the live I/O access bit D7 does not"
+    assert masks == {(14, AccessDirection.READ): 0x7F}, "events clear, the live I/O access bit D7 does not"
 
 
 # ------------------------------------------------------------------------------------------------------------
@@ -154,9 +154,18 @@ def test_manual_command_bytes(byte: int, rd: bool, wr: bool, address: int, block
     assert encode_command(address, rd=rd, wr=wr) == byte
 
 
+def test_every_register_is_a_name_of_the_package() -> None:
+    """``from supi3.regmap import SET`` gives the declared register, as ``SUPI3_SET_ADDR`` names it in C."""
+    for register in REGISTER_MAP.registers:
+        assert getattr(regmap, register.name) is register
+        assert register.name in regmap.__all__
+    assert regmap.BLOCK_ADDRESS == tables.BLOCK_TRANSFER_COMMAND & COMMAND_BYTE.field("A").mask == 15
+
+
 def test_manual_command_targets() -> None:
-    assert REGISTER_MAP.port(decode_command(0x4D).address, Direction.WRITE).register is REGISTER_MAP.register("SET")
-    assert REGISTER_MAP.port(decode_command(0x4C).address, Direction.WRITE).register is REGISTER_MAP.register("ID")
+    write = AccessDirection.WRITE
+    assert REGISTER_MAP.port(decode_command(0x4D).address, write).register is REGISTER_MAP.register("SET")
+    assert REGISTER_MAP.port(decode_command(0x4C).address, write).register is REGISTER_MAP.register("ID")
     assert COMMAND_BYTE.constant("BLOCK_TRANSFER").value == tables.BLOCK_TRANSFER_COMMAND == 0xCF
 
 
@@ -247,15 +256,15 @@ def test_declaration_errors_are_supi3_errors() -> None:
     with pytest.raises(RegisterMapError, match="do not fit in a byte"):
         Field("X", 6, 3)
     with pytest.raises(RegisterMapError, match="overlaps"):
-        Layout(name="L", title="t", ref="r", fields=(Field("A", 0, 4), Field("B", 3, 2)))
+        ByteLayout(name="L", title="t", ref="r", fields=(Field("A", 0, 4), Field("B", 3, 2)))
     with pytest.raises(RegisterMapError, match="not inside"):
-        Layout(name="L", title="t", ref="r", fields=(Field("A", 0, 2), Field("B", 1, 2, overlays="A")))
+        ByteLayout(name="L", title="t", ref="r", fields=(Field("A", 0, 2), Field("B", 1, 2, overlays="A")))
     with pytest.raises(RegisterMapError, match="needs more than"):
         Field("X", 0, 1, values=(REGISTER_MAP.register("SET").field("CL").values[-1],))
     register = Register(name="R", title="t", ref="r", address=1, cleared_by=frozenset())
     with pytest.raises(RegisterMapError, match="is at 1, not 2"):
-        Port(2, Direction.READ, Access.R, "t", register)
+        Port(2, AccessDirection.READ, Access.R, "t", register)
     with pytest.raises(RegisterMapError, match="not a write access"):
-        Port(1, Direction.WRITE, Access.RC, "t", register)
+        Port(1, AccessDirection.WRITE, Access.RC, "t", register)
     with pytest.raises(RegisterMapError, match="exactly one write port"):
         RegisterMap(4, REGISTER_MAP.ports[:-1], COMMAND_BYTE, INIT_BYTE)

@@ -11,11 +11,11 @@ from amaranth.lib import wiring
 
 from supi3.config import Variant
 from supi3.rtl import core
-from supi3.rtl.core import DataPath, FrameEngine, Outputs, Receiver, Supi3Core, Transmitter
+from supi3.rtl.core import DataPathRtl, FrameEngineRtl, OutputsRtl, ReceiverRtl, Supi3Core, TransmitterRtl
 from supi3.rtl.tables import core_tables
 
-BLOCKS = {"receiver": Receiver, "frame": FrameEngine, "datapath": DataPath, "transmitter": Transmitter,
-          "outputs": Outputs}  # fmt: skip
+BLOCKS = {"receiver": ReceiverRtl, "frame": FrameEngineRtl, "datapath": DataPathRtl, "transmitter": TransmitterRtl,
+          "outputs": OutputsRtl}  # fmt: skip
 """Block name (the same in supi3.model) -> RTL component."""
 
 
@@ -28,7 +28,7 @@ def test_core_is_the_five_blocks(variant: Variant) -> None:
 def blocks() -> list[wiring.Component]:
     """One of each block, elaborated on its own (so none is left unused)."""
     tables = core_tables()
-    made = [Receiver(tables), FrameEngine(), DataPath(tables), Transmitter(tables), Outputs(26)]
+    made = [ReceiverRtl(tables), FrameEngineRtl(), DataPathRtl(tables), TransmitterRtl(tables), OutputsRtl(26)]
     for block in made:
         Fragment.get(block, None)
     return made

@@ -17,9 +17,10 @@ from hypothesis import strategies as st
 
 from supi3.config import decode
 from supi3.interbus import wire
-from supi3.rtl.chip import Supi3Chip as Supi3ChipRtl
-from supi3.rtl.chip import verilog
+from supi3.regmap import IN0, IN1, OUT0
+from supi3.rtl.chip import Supi3ChipRtl, verilog
 from supi3.spi.upif import Mode
+from supi3.tables import BIT_RATES, clk_conf_for
 from supi3.top import UP_OUTPUTS
 from supi3.verif import Lockstep
 from supi3.verif.straps import ChipStrapPins
@@ -62,7 +63,7 @@ def test_firmware_configures_the_chip_and_exchanges_data(bench: Lockstep, mode: 
     start = pins.cycle
     bring_up(pins)
     pins.drain()
-    up.write(0, 0x77)  # IN byte 0, after the INTERBUS reset cleared it (3.4.7)
+    up.write(IN0, 0x77)  # IN byte 0, after the INTERBUS reset cleared it (3.4.7)
     pins.send(np.concatenate([data_frame(b"\x99"), IDLE]))
     pins.drain(64)
     returned = [out["di1"] for out in pins.outputs[start + 3 * wire.clocks_per_bit(pins.config.bit_rate) :]]
@@ -72,7 +73,7 @@ def test_firmware_configures_the_chip_and_exchanges_data(bench: Lockstep, mode: 
     assert pins.outputs[-1]["mfp_out"] >> UP_OUTPUTS["irq_n"] & 1 == 0  # /IRQ: valid data cycle
     assert (up.read(IRQ_EVENTS) or 0) & 0x10
     assert pins.outputs[-1]["mfp_out"] >> UP_OUTPUTS["irq_n"] & 1 == 1  # released by the read
-    assert up.read(0) == 0x99  # OUT byte 0
+    assert up.read(OUT0) == 0x99  # OUT byte 0
     replay(bench, pins)
 
 
@@ -120,7 +121,7 @@ OPS = st.lists(
 
 
 @settings(max_examples=4, derandomize=True, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(mode=st.sampled_from(list(Mode)), rate=st.sampled_from(["01", "11"]), ops=OPS)
+@given(mode=st.sampled_from(list(Mode)), rate=st.sampled_from([clk_conf_for(r) for r in BIT_RATES]), ops=OPS)
 def test_random_interleavings(bench: Lockstep, mode: Mode, rate: str, ops: list[tuple[str, int, int]]) -> None:
     pins = ChipPins(decode(*RB_INIT_UP, clk_conf=rate))
     up = Firmware(pins, mode)
@@ -150,7 +151,7 @@ def test_power_fail_and_watchdog(bench: Lockstep) -> None:
     up.init()
     up.write(SET, 0x82)
     up.write(IRQ_EVENTS, 0xFF)
-    up.write(0, 0x31)
+    up.write(IN0, 0x31)
     pins.pins["resu_n"] = 0  # /ResU pulled low from outside: both blocks reset
     up.idle(5)
     pins.pins["resu_n"] = 1
@@ -161,8 +162,8 @@ def test_power_fail_and_watchdog(bench: Lockstep) -> None:
     bring_up(pins, wire.command_word(watchdog_code=0))  # 50 ms watchdog
     pins.send(np.concatenate([data_frame(b"\x42"), IDLE]))
     pins.drain()
-    up.write(1, 0x11)
-    assert up.read(0) == 0x42
+    up.write(IN1, 0x11)
+    assert up.read(OUT0) == 0x42
     replay(bench, pins)
 
 

@@ -19,18 +19,33 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from supi3.regmap import INTERRUPT_SOURCES, REGISTER_MAP, encode_command
+from supi3.regmap import (
+    ALARM,
+    BLOCK_ADDRESS,
+    ID,
+    IN0,
+    IN1,
+    INTERRUPT_SOURCES,
+    IRQ_EN,
+    IRQ_EVT,
+    LENGTH_OUT,
+    OUT0,
+    OUT1,
+    PCMD,
+    REGISTER_MAP,
+    SET,
+    encode_command,
+)
 from supi3.rtl.upif import UpifBlock, verilog
 from supi3.spi.block_pins import OPTICAL_REGISTERS, UpifBlockPins
-from supi3.spi.upif import BLOCK_ADDRESS, C_D_COMMAND, Mode
+from supi3.spi.upif import C_D_COMMAND, Mode
 from supi3.tables import BIT_RATES
-from supi3.verif import Layout, Lockstep, model_trace
+from supi3.verif import Lockstep, WordLayout, model_trace
+from supi3.verif.layout import CycleMatrix
 from support import NOT_READY_ID, UpifScript, VerilatorBuild
 
-Trace = npt.NDArray[np.uint64]
 SLOW, FAST = BIT_RATES
 SOURCE_BIT = {s.name: s.bit for s in INTERRUPT_SOURCES}
-SET = REGISTER_MAP.register("SET")
 WIDTH_MASK = {pin.name: pin.mask for pin in UpifBlockPins.inputs}
 
 
@@ -38,8 +53,8 @@ WIDTH_MASK = {pin.name: pin.mask for pin in UpifBlockPins.inputs}
 class Outcome:
     """The model's outputs of a script (the RTL's too: the lockstep compared them)."""
 
-    layout: Layout
-    trace: Trace
+    layout: WordLayout
+    trace: CycleMatrix
     script: UpifScript
 
     def __getitem__(self, name: str) -> npt.NDArray[np.uint64]:
@@ -93,7 +108,7 @@ def test_verilog_has_the_model_ports() -> None:
 @pytest.mark.parametrize("mode", list(Mode))
 def test_initialization_example(bench: Lockstep, mode: Mode, rate: int) -> None:
     # 3.4.5: initialization byte, SET = 82h (4Dh 82h), ID = 01h (4Ch 01h); the master then reads 0901h. Read back.
-    script = UpifScript(rate).init(mode).write(13, 0x82).write(12, 0x01).read(13).read(12)
+    script = UpifScript(rate).init(mode).write(SET, 0x82).write(ID, 0x01).read(SET).read(ID)
     outcome = check(bench, script)
     assert list(outcome.frames())[-3::2] == [0x82, 0x01]
     assert outcome.final("bus_id") == 0x0901
@@ -105,7 +120,7 @@ def test_initialization_example(bench: Lockstep, mode: Mode, rate: int) -> None:
 def test_block_transfer_example_intel(bench: Lockstep, rate: int) -> None:
     # 3.4.6, Fig. 3-12: a 24-bit output device reads its OUT data with 8Fh and three bytes (14h 56h 78h).
     three_bytes = SET.encode(PCP_N=1, CL=SET.field("CL").value("LEN_3_BYTES").value)
-    script = UpifScript(rate).init(Mode.INTEL).write(13, three_bytes).write(12, 0x01)
+    script = UpifScript(rate).init(Mode.INTEL).write(SET, three_bytes).write(ID, 0x01)
     script.run(20).strobe(latch=1, latch_out=int.from_bytes(bytes([0x14, 0x56, 0x78]), "little")).run(20)
     script.byte(encode_command(BLOCK_ADDRESS, rd=True))
     for _ in range(3):
@@ -120,7 +135,7 @@ def test_block_transfer_example_intel(bench: Lockstep, rate: int) -> None:
 def test_block_transfer_motorola_full_duplex(bench: Lockstep, rate: int) -> None:
     # Motorola CFh: OUT k out while IN k comes in, for the configured 2 words; C/D data until the last byte.
     two_words = SET.encode(PCP_N=1, CL=SET.field("CL").value("LEN_2_WORDS").value)
-    script = UpifScript(rate).init(Mode.MOTOROLA).write(13, two_words)
+    script = UpifScript(rate).init(Mode.MOTOROLA).write(SET, two_words)
     script.strobe(latch=1, latch_out=0x44332211).byte(encode_command(BLOCK_ADDRESS, rd=True, wr=True))
     for value in (0xA0, 0xB1, 0xC2, 0xD3):
         script.byte(value)
@@ -134,13 +149,13 @@ def test_block_transfer_motorola_full_duplex(bench: Lockstep, rate: int) -> None
 def test_interrupts_and_core_ports(bench: Lockstep, mode: Mode) -> None:
     # Events latched only when enabled (UP-15), /IRQ low until read 14 clears them (3.4.14), D7 = I/O access; PCP
     # device erases IN0/IN1 at the latch (3.4.11); INTERBUS reset clears IN/OUT and raises its event (Table 3-13).
-    enabled = REGISTER_MAP.register("IRQ_EN").mask & ~(1 << SOURCE_BIT["INVALID"])
+    enabled = IRQ_EN.mask & ~(1 << SOURCE_BIT["INVALID"])
     pcp_word = SET.encode(PCP_N=0, CL=SET.field("CL").value("LEN_1_WORD").value)
-    script = UpifScript(FAST).init(mode).write(14, enabled).write(13, pcp_word).write(0, 0x12).write(1, 0x34)
+    script = UpifScript(FAST).init(mode).write(IRQ_EN, enabled).write(SET, pcp_word).write(IN0, 0x12).write(IN1, 0x34)
     script.strobe(events=(1 << SOURCE_BIT["VALID"]) | (1 << SOURCE_BIT["INVALID"]), latch=1, latch_out=0xBEEF)
     script.strobe(pcmd_we=1, pcmd=0x5A, optical_we=0b0101, optical=0xFF00FF)
-    script.run(10, io_access=1).write(7, 0x77).read(14).read(7).read(8).read(0).read(1)
-    script.strobe(ib_reset=1).run(10).read(14).read(0)
+    script.run(10, io_access=1).write(ALARM, 0x77).read(IRQ_EVT).read(PCMD).read(LENGTH_OUT).read(OUT0).read(OUT1)
+    script.strobe(ib_reset=1).run(10).read(IRQ_EVT).read(OUT0)
     outcome = check(bench, script)
     frames = list(outcome.frames())
     read_bytes = frames[-13:-4:2] + frames[-3::2]
@@ -155,8 +170,8 @@ def test_interrupts_and_core_ports(bench: Lockstep, mode: Mode) -> None:
 def test_straps_and_power_up(bench: Lockstep) -> None:
     # The µP_Not_Ready code comes from the straps until SET is written; power-up clears everything, SAS_INIT keeps
     # SET and ID (3.4.3).
-    script = UpifScript(SLOW).run(4, np_id=0x78, np_length=0).init(Mode.MOTOROLA).write(13, 0x82).write(12, 0x42)
-    script.sas_init().init(Mode.MOTOROLA).read(12).strobe(power_up=1).run(30)
+    script = UpifScript(SLOW).run(4, np_id=0x78, np_length=0).init(Mode.MOTOROLA).write(SET, 0x82).write(ID, 0x42)
+    script.sas_init().init(Mode.MOTOROLA).read(ID).strobe(power_up=1).run(30)
     outcome = check(bench, script)
     assert list(outcome.frames())[-1] == 0x42
     assert outcome["bus_id"][0] == 0x78 and outcome.final("bus_id") == 0x78
@@ -168,8 +183,8 @@ def test_straps_and_power_up(bench: Lockstep) -> None:
 CL_VALUES = [v.value for v in SET.field("CL").values]
 op = st.one_of(
     st.tuples(st.just("write"), st.integers(0, 15), st.integers(0, 255)),
-    st.tuples(st.just("write"), st.just(13), st.sampled_from([SET.encode(PCP_N=p, CL=c) for p in (0, 1)
-                                                              for c in CL_VALUES])),
+    st.tuples(st.just("write"), st.just(SET.address), st.sampled_from([SET.encode(PCP_N=p, CL=c) for p in (0, 1)
+                                                                       for c in CL_VALUES])),
     st.tuples(st.just("read"), st.integers(0, 15), st.just(0)),
     st.tuples(st.just("block"), st.integers(0, 3), st.integers(0, 255)),
     st.tuples(st.just("raw"), st.integers(0, 255), st.integers(0, 1)),
@@ -187,7 +202,7 @@ core = st.tuples(
 
 def random_script(mode: Mode, rate: int, ops: list[tuple[str, int, int]],
                   strobes: list[tuple[float, str, int]]) -> UpifScript:
-    script = UpifScript(rate).init(mode).write(14, REGISTER_MAP.register("IRQ_EN").mask)
+    script = UpifScript(rate).init(mode).write(IRQ_EN, IRQ_EN.mask)
     for kind, a, b in ops:
         if kind == "write":
             script.write(a, b)
@@ -250,7 +265,7 @@ def test_long_random_sequence(bench: Lockstep, mode: Mode, rate: int) -> None:
         ops.append({"write": ("write", a & 15, b), "read": ("read", a & 15, 0), "block": ("block", a & 3, b),
                     "raw": ("raw", a, b & 1), "glitch": ("glitch", a % 11, b % 30 + 1), "sas": ("sas", a % 12 + 1, 0),
                     "idle": ("idle", a + 1, 0)}[str(kind)])
-    ops[::25] = [("write", 13, SET.encode(PCP_N=int(p), CL=int(c))) for p, c in
+    ops[::25] = [("write", SET.address, SET.encode(PCP_N=int(p), CL=int(c))) for p, c in
                  zip(rng.integers(0, 2, 40), rng.choice(CL_VALUES, 40), strict=True)]
     whats = ["events", "latch", "pcmd", "optical", "ib_reset", "io_access", "power_up"]
     strobes = [(float(at), str(what), int(value)) for at, what, value in
@@ -263,12 +278,12 @@ def test_long_random_sequence(bench: Lockstep, mode: Mode, rate: int) -> None:
 def test_ss_glitches_and_noise(bench: Lockstep) -> None:
     # /SS and SCLK pulses shorter than a synchroniser sees, random MFP6/MFP7 noise, SAS_INIT pulses of 1..3 clocks.
     rng = np.random.default_rng(7)
-    script = UpifScript(FAST).init(Mode.MOTOROLA).write(14, 0x7F)
+    script = UpifScript(FAST).init(Mode.MOTOROLA).write(IRQ_EN, 0x7F)
     for _ in range(300):
         script.run(int(rng.integers(1, 4)), ss_n=int(rng.integers(0, 2)), sclk=int(rng.integers(0, 2)),
                    mfp6_in=int(rng.integers(0, 2)), mfp7_in=int(rng.integers(0, 2)),
                    sas_init=int(rng.random() < 0.02))
-    script.run(20, ss_n=1, sclk=1, sas_init=0).init(Mode.INTEL).read(14)
+    script.run(20, ss_n=1, sclk=1, sas_init=0).init(Mode.INTEL).read(IRQ_EVT)
     check(bench, script)
 
 
@@ -276,6 +291,6 @@ def test_ss_glitches_and_noise(bench: Lockstep) -> None:
 
 
 def test_per_cycle_path(bench: Lockstep) -> None:
-    script = UpifScript(FAST).init(Mode.INTEL).write(13, 0x82).strobe(latch=1, latch_out=0x99).read(0).read(13)
+    script = UpifScript(FAST).init(Mode.INTEL).write(SET, 0x82).strobe(latch=1, latch_out=0x99).read(OUT0).read(SET)
     result = bench.run(script.stimulus())
     assert result.cycles == script.cycles

@@ -14,14 +14,14 @@ from vcd.reader import TokenKind, tokenize
 from supi3.cli import main
 from supi3.config import decode
 from supi3.model.registers import RegisterFile
-from supi3.regmap import encode_command
+from supi3.regmap import IN0, encode_command
 from supi3.spi.figures import FIGURES, Figure
-from supi3.spi.master import MasterTiming, SoftMaster, decode_bytes, write_vcd
+from supi3.spi.master import MasterTiming, SoftMaster, decode_bytes, write_spi_vcd
 from supi3.spi.slave_pins import SlavePins, TimingViolationError
 from supi3.spi.upif import C_D_COMMAND, C_D_DATA, Mode, UpifUsageError
+from supi3.tables import clk_conf_for
 
 FIGURE_DIR = Path(__file__).resolve().parents[1] / "docs" / "figures"
-RATES = {500_000: "01", 2_000_000: "11"}  # CLK_CONF[1..0] (Table 1-7)
 
 # (to chip, from chip, C/D when /SS fell, S/R) per byte, as the manual's figures and text give them (3.4.5, 3.4.6).
 EXPECTED = {
@@ -78,7 +78,7 @@ def test_wavejson_annotates_the_bytes_and_the_c_d_change(generated: Path) -> Non
 
 def test_vcd_of_a_scenario(tmp_path: Path) -> None:
     trace = FIGURES[-1].build()
-    path = write_vcd(trace, tmp_path / "block.vcd")
+    path = write_spi_vcd(tmp_path / "block.vcd", trace)
     ids: dict[str, str] = {}
     falls = 0
     with path.open("rb") as stream:
@@ -92,7 +92,7 @@ def test_vcd_of_a_scenario(tmp_path: Path) -> None:
 
 
 def _chip(bit_rate: int, *, strict: bool = True) -> SlavePins:
-    return SlavePins(RegisterFile(decode("10011", "1110", clk_conf=RATES[bit_rate]), strict=strict))
+    return SlavePins(RegisterFile(decode("10011", "1110", clk_conf=clk_conf_for(bit_rate)), strict=strict))
 
 
 @pytest.mark.parametrize(("bit_rate", "period"), [(500_000, 22), (2_000_000, 6)])
@@ -106,7 +106,7 @@ def test_fastest_master_is_within_table_3_7(bit_rate: int, period: int) -> None:
         m.byte(encode_command(address, wr=True))
         m.byte(value)
     chip.registers.latch(b"\x3c")
-    m.byte(encode_command(0, rd=True, wr=True))
+    m.byte(encode_command(IN0.address, rd=True, wr=True))
     assert m.byte(0x11) == 0x3C
     m.deselect()
     assert chip.registers.value("IN0") == 0x11 and chip.registers.value("SET") == 0x82

@@ -11,17 +11,17 @@ from hypothesis import strategies as st
 
 from supi3.config import DeviceConfig, decode
 from supi3.model.registers import RegisterFile
-from supi3.regmap import encode_command
+from supi3.regmap import ID, SET, encode_command
 from supi3.spi.slave_pins import INPUT_PINS, OUTPUT_PINS, PinsIn, PinsOut, SlavePins, TimingViolationError
 from supi3.spi.upif import C_D_COMMAND, C_D_DATA, Mode, Phase, ProtocolViolationError, UpifUsageError, UpInterface
-from supi3.tables import CLOCK_HZ
+from supi3.tables import CLOCK_HZ, clk_conf_for
 from support import FrameTiming, table_3_7_minimum
 
-RATES = {"500k": "01", "2M": "11"}  # CLK_CONF[1..0] (Table 1-7)
+RATES = {"500k": 500_000, "2M": 2_000_000}  # bit rates (Table 1-7)
 
 
 def config(rate: str) -> DeviceConfig:
-    return decode("10011", "1110", clk_conf=RATES[rate])
+    return decode("10011", "1110", clk_conf=clk_conf_for(RATES[rate]))
 
 
 def limit(rate: str, symbol: str) -> float:
@@ -97,7 +97,7 @@ def test_manual_initialization_example_at_pin_level(rate: str) -> None:
         m.byte(data)
         assert m.out.c_d == C_D_COMMAND
     assert m.chip.registers.bus_id_register() == 0x0901
-    m.byte(encode_command(13, rd=True))
+    m.byte(encode_command(SET.address, rd=True))
     assert m.byte(0, s_r=False) == 0x82
 
 
@@ -144,9 +144,9 @@ def test_output_latency_is_two_tclk_plus_one_clock(rate: str) -> None:
     m = pins(rate)
     latency = 2 * m.chip.clocks_per_tclk + 1
     m.byte(0x00)
-    m.byte(encode_command(12, wr=True))
+    m.byte(encode_command(ID.address, wr=True))
     m.byte(0x96)
-    m.byte(encode_command(12, rd=True))
+    m.byte(encode_command(ID.address, rd=True))
     history: list[PinsOut] = []
 
     def record(cycles: int = 1, **changes: int) -> None:

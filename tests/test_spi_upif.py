@@ -9,8 +9,17 @@ from hypothesis import strategies as st
 
 from supi3.config import decode
 from supi3.model.registers import RegisterFile
-from supi3.regmap import REGISTER_MAP, Access, Direction, encode_command
-from supi3.spi.upif import C_D_COMMAND, C_D_DATA, Mode, Phase, ProtocolViolationError, UpifUsageError, UpInterface
+from supi3.regmap import ID, IN0, IN2, IRQ_EN, IRQ_EVT, OUT0, REGISTER_MAP, SET, Access, AccessDirection, encode_command
+from supi3.spi.upif import (
+    C_D_COMMAND,
+    C_D_DATA,
+    Mode,
+    Phase,
+    ProtocolViolationError,
+    UpifArgumentError,
+    UpifUsageError,
+    UpInterface,
+)
 
 RB_UP = decode("10011", "1110")
 
@@ -20,7 +29,7 @@ def chip(mode: Mode | None = None, *, strict: bool = True, set_value: int | None
     if mode is not None:
         assert up.initialize(mode)
     if set_value is not None:
-        up.write(13, set_value)
+        up.write(SET, set_value)
     return up
 
 
@@ -37,17 +46,17 @@ def test_manual_initialization_example_intel() -> None:
         up.transfer(data, s_r=True)
         assert up.c_d == C_D_COMMAND
     assert up.registers.bus_id_register() == 0x0901
-    assert up.read(13) == 0x82
-    assert up.read(12) == 0x01
+    assert up.read(SET) == 0x82
+    assert up.read(ID) == 0x01
 
 
 def test_motorola_initialization_and_full_duplex() -> None:
     up = chip()
     assert up.transfer(0x00) is None
     assert up.protocol.mode is Mode.MOTOROLA
-    up.write(13, 0x85)  # 2 words
+    up.write(SET, 0x85)  # 2 words
     up.registers.latch(b"\x0a\x0b\x0c\x0d")
-    assert up.exchange(2, 0x77) == 0x0C
+    assert up.exchange(IN2, 0x77) == 0x0C
     assert up.registers.value("IN2") == 0x77
 
 
@@ -59,10 +68,10 @@ def test_first_init_signature_after_a_microprocessor_reset(mode: Mode) -> None:
     up.registers.latch(b"\x42")
     assert up.initialize(mode) is False
     assert up.c_d == C_D_COMMAND
-    assert up.read(13) == 0x82
+    assert up.read(SET) == 0x82
     up.sas_init()
     assert up.initialize(mode) is True
-    assert up.read(13) == 0x82  # SAS_INIT keeps SET and ID (3.4.3)
+    assert up.read(SET) == 0x82  # SAS_INIT keeps SET and ID (3.4.3)
 
 
 @pytest.mark.parametrize("bad", [0x01, 0x80, 0xFF, 0x42, 0x7E])
@@ -111,7 +120,7 @@ def test_every_address_through_the_interface(mode: Mode, address: int) -> None:
     reference.cpu_write(address, 0x45)
     assert up.read(address) == reference.cpu_read(address)
     assert up.c_d == C_D_COMMAND
-    write = REGISTER_MAP.port(address, Direction.WRITE)
+    write = REGISTER_MAP.port(address, AccessDirection.WRITE)
     if write.access is Access.NO_EFFECT:
         assert up.registers.value("IN0") == 0
 
@@ -179,15 +188,15 @@ def test_block_transfer_with_external_registers_has_no_data_bytes() -> None:
 
 def test_intel_s_r_against_the_command() -> None:
     up = chip(Mode.INTEL, strict=False)
-    up.transfer(encode_command(12, wr=True), s_r=True)
-    assert up.transfer(0x33, s_r=False) == encode_command(12, wr=True)  # chip drives the echo, no write
+    up.transfer(encode_command(ID.address, wr=True), s_r=True)
+    assert up.transfer(0x33, s_r=False) == encode_command(ID.address, wr=True)  # chip drives the echo, no write
     assert up.registers.value("ID") == 0
-    up.transfer(encode_command(12, rd=True), s_r=True)
+    up.transfer(encode_command(ID.address, rd=True), s_r=True)
     assert up.transfer(0x33, s_r=True) is None
     up.transfer(0x00, s_r=False)  # a command byte the chip sends: ignored
     assert up.c_d == C_D_COMMAND
     assert [v.rule for v in up.registers.violations.records] == ["Table 3-9"] * 3
-    up.transfer(encode_command(12, rd=True, wr=True), s_r=True)  # both bits: S/R decides (3.4.4)
+    up.transfer(encode_command(ID.address, rd=True, wr=True), s_r=True)  # both bits: S/R decides (3.4.4)
     up.transfer(0x21, s_r=True)
     assert up.registers.value("ID") == 0x21
     with pytest.raises(UpifUsageError, match="s_r"):
@@ -217,6 +226,21 @@ def test_api_contract() -> None:
         intel.exchange(0, 0)
     with pytest.raises(UpifUsageError):
         intel.protocol.end(0)
+
+
+def test_registers_as_addresses() -> None:
+    """read/write/exchange take a register of supi3.regmap as well as its address, if it is reached that way."""
+    up = chip(Mode.MOTOROLA)
+    up.write(SET, 0x82)
+    up.write(ID, 0x01)
+    assert up.read(SET) == up.read(13) == 0x82
+    assert up.exchange(ID, 0x01) == 0x01
+    up.write(IRQ_EN, 0x01)
+    assert up.read(IRQ_EVT) == 0
+    refused = (lambda: up.write(IRQ_EVT, 0), lambda: up.read(IRQ_EN), lambda: up.read(IN0), lambda: up.write(OUT0, 0))
+    for call in refused:
+        with pytest.raises(UpifArgumentError, match=r"is not (written|read) at address"):
+            call()
 
 
 _OPS = st.lists(
@@ -254,5 +278,5 @@ def test_resets_at_random_points(ops: list[tuple[str, int, bool]]) -> None:
             assert all(up.registers.value(f"IN{n}") == up.registers.value(f"OUT{n}") == 0 for n in range(4))
     up.sas_init()
     assert up.initialize(Mode.MOTOROLA)
-    up.write(12, 0x5A)
-    assert up.read(12) == 0x5A
+    up.write(ID, 0x5A)
+    assert up.read(ID) == 0x5A

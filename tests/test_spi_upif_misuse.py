@@ -19,7 +19,7 @@ from supi3.config import decode
 from supi3.errors import ArgumentError
 from supi3.model.chip import Supi3
 from supi3.model.registers import InterfaceViolationError, RegisterFile
-from supi3.regmap import REGISTER_MAP
+from supi3.regmap import ID, IN0, IRQ_EVT, OUT0, OUT1, REGISTER_MAP, SET
 from supi3.spi.upif import (
     ACCESS_END_PHASES,
     C_D_COMMAND,
@@ -47,7 +47,7 @@ def chip(mode: Mode | None = None, *, strict: bool = True, set_value: int | None
     if mode is not None:
         assert up.initialize(mode)
         if set_value is not None:
-            up.write(13, set_value)
+            up.write(SET, set_value)
     return up
 
 
@@ -107,25 +107,25 @@ def test_write_before_initialize_is_reported_strict() -> None:
     That is the chip's behaviour and stays; strict mode raises the named violation after the bytes went out."""
     up = chip()
     with pytest.raises(UninitializedAccessError) as raised:
-        up.write(13, 0x82)
+        up.write(SET, 0x82)
     assert str(raised.value) == ("interface not initialized: 4Dh taken as a faulty initialization byte; SAS_INIT "
                                  "needed (3.4.3)")
     assert isinstance(raised.value, ProtocolViolationError)
     assert up.protocol.phase is Phase.DISABLED
     assert up.registers.value("SET") == 0
     with pytest.raises(InterfaceDisabledError, match="SAS_INIT"):
-        up.read(13)
+        up.read(SET)
     with pytest.raises(InterfaceDisabledError, match="SAS_INIT"):
-        up.write(13, 0x82)
+        up.write(SET, 0x82)
     up.sas_init()
     assert up.initialize(Mode.MOTOROLA)
-    up.write(13, 0x82)
-    assert up.read(13) == 0x82
+    up.write(SET, 0x82)
+    assert up.read(SET) == 0x82
 
 
 def test_write_before_initialize_is_recorded_lenient() -> None:
     up = chip(strict=False)
-    up.write(0, 0x12)
+    up.write(IN0, 0x12)
     [violation] = up.registers.violations.records
     assert isinstance(violation, UninitializedAccessError)
     assert violation.detail == "interface not initialized: 40h taken as a faulty initialization byte; SAS_INIT needed"
@@ -147,9 +147,9 @@ def test_bad_value_is_refused_before_the_command_byte() -> None:
         up.write(0, 300)
     assert isinstance(raised.value, ArgumentError) and isinstance(raised.value, UpifUsageError)
     assert state(up) == before
-    up.write(0, 0x12)
+    up.write(IN0, 0x12)
     assert up.registers.value("IN0") == 0x12
-    assert up.read(14) == 0
+    assert up.read(IRQ_EVT) == 0
 
 
 def test_strict_violation_inside_a_block_transfer_leaves_the_command_phase() -> None:
@@ -160,17 +160,17 @@ def test_strict_violation_inside_a_block_transfer_leaves_the_command_phase() -> 
         up.block_transfer(b"\x5a")
     assert up.c_d == C_D_COMMAND and up.protocol.phase is Phase.COMMAND
     assert up.registers.value("IN0") == 0x5A
-    assert up.read(13) == 0x82
+    assert up.read(SET) == 0x82
 
 
 def test_strict_inconsistent_read_completes_the_access() -> None:
     up = chip(Mode.INTEL)
     up.registers.set_latch_phase(True)
     with pytest.raises(InterfaceViolationError, match="latch phase"):
-        up.read(0)
+        up.read(OUT0)
     assert up.protocol.phase is Phase.COMMAND
     up.registers.set_latch_phase(False)
-    assert up.read(0) == 0
+    assert up.read(OUT0) == 0
 
 
 @pytest.mark.parametrize("mode", list(Mode))
@@ -188,8 +188,8 @@ def test_initialize_after_a_reset_in_the_middle_of_a_command_is_reported(mode: M
         "a µP reset")
     assert up.registers.value("SET") == code
     assert up.protocol.phase is Phase.COMMAND and up.protocol.mode is mode
-    up.write(13, 0x82)
-    assert up.read(13) == 0x82
+    up.write(SET, 0x82)
+    assert up.read(SET) == 0x82
     lenient = chip(mode, strict=False, set_value=0x82)
     lenient.transfer(0x4D, s_r=True)
     assert lenient.initialize(mode) is False  # not a first initialization: the chip was not reset
@@ -215,10 +215,10 @@ def test_initialize_in_the_middle_of_a_block_transfer_is_reported() -> None:
     [violation] = up.registers.violations.records
     assert "00h was taken as the next byte of a block transfer" in violation.detail
     with pytest.raises(UpifUsageError, match=r"phase block, 2 block byte\(s\) left"):
-        up.read(0)
+        up.read(OUT0)
     up.transfer(0)
     up.transfer(0)
-    assert up.read(1) == 0
+    assert up.read(OUT1) == 0
 
 
 @pytest.mark.parametrize("mode", list(Mode))
@@ -233,7 +233,7 @@ def test_initialize_with_the_other_mode_is_reported(mode: Mode) -> None:
         f"initialize(Mode.{other.name}): the interface is already initialized in {mode.name.capitalize()} mode, "
         f"which only a power-up reset or SAS_INIT changes; {other.init_byte:02X}h was taken as a command")
     assert up.protocol.mode is mode and up.protocol.phase is Phase.COMMAND
-    assert up.read(13) == 0x82
+    assert up.read(SET) == 0x82
     assert up.initialize(mode) is False  # the same mode again: no violation
     up.sas_init()
     assert up.initialize(other) is True
@@ -491,8 +491,8 @@ class InterfaceHistory(RuleBasedStateMachine):
         up.registers.set_latch_phase(False)
         up.sas_init()
         assert up.initialize(Mode.MOTOROLA)
-        up.write(12, 0x5A)
-        assert up.read(12) == 0x5A
+        up.write(ID, 0x5A)
+        assert up.read(ID) == 0x5A
 
 
 class LenientInterfaceHistory(InterfaceHistory):

@@ -184,14 +184,14 @@ def test_table_3_2_row(mode: str, manual_text: str) -> None:
 
 def test_binary_modes_directions() -> None:
     for mode, pins in tables.BINARY_IO_MFP.items():
-        n_in = sum(p.direction is tables.Direction.IN for p in pins)
-        n_out = sum(p.direction is tables.Direction.OUT for p in pins)
+        n_in = sum(p.direction is tables.PinDirection.IN for p in pins)
+        n_out = sum(p.direction is tables.PinDirection.OUT for p in pins)
         width = int(mode.split()[0])
         assert (n_in, n_out) == (width if "IN" in mode else 0, width if "OUT" in mode else 0)
 
 
 def _check_pin_table(rows: tuple[tables.PinFunction, ...], manual_lines: list[list[str]], label: str) -> None:
-    directions = {"IN": tables.Direction.IN, "OUT": tables.Direction.OUT, "I/O": tables.Direction.INOUT}
+    directions = {"IN": tables.PinDirection.IN, "OUT": tables.PinDirection.OUT, "I/O": tables.PinDirection.INOUT}
     for pin in rows:
         hits = [f for f in manual_lines if len(f) >= 3 and f[0] in (f"{label}{pin.pin}", str(pin.pin))
                 and f[1] == pin.signal]

@@ -9,9 +9,10 @@ import numpy.typing as npt
 from supi3.config import decode
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
-from supi3.regmap import encode_command
+from supi3.regmap import ID, IN0, IRQ_EN, IRQ_EVT, OUT0, SET, Register, encode_command
 from supi3.spi.upif import Phase
 from supi3.top import Supi3Chip
+from support import register_address
 
 HALF = 8  # SCLK half period in clocks at 2 Mbit/s: 4 MHz, below the 6 MHz maximum (Table 3-7)
 SCLK, SS_N, MOSI, MFP7 = 1 << 4, 1 << 5, 1 << 6, 1 << 7
@@ -58,12 +59,12 @@ class Bench:
             self.tick(IDLE_MFP)
         return miso
 
-    def write(self, address: int, value: int) -> None:
-        self.spi(encode_command(address, wr=True))
+    def write(self, address: int | Register, value: int) -> None:
+        self.spi(encode_command(register_address(address), wr=True))
         self.spi(value)
 
-    def read(self, address: int) -> int:
-        self.spi(encode_command(address, rd=True))
+    def read(self, address: int | Register) -> int:
+        self.spi(encode_command(register_address(address), rd=True))
         return self.spi(0)
 
     def send(self, levels: npt.NDArray[np.uint8]) -> None:
@@ -75,10 +76,10 @@ class Bench:
 def test_firmware_configures_the_chip_and_exchanges_data_at_pin_level() -> None:
     bench = Bench()
     assert bench.spi(0x00) == 0  # initialization byte: Motorola (Table 3-8)
-    bench.write(13, 0x82)  # 3.4.5: SET = 82h, I/O device with 1 byte
-    bench.write(12, 0x01)  # ID code 01h, digital output device
-    bench.write(14, 0x10)  # enable the valid-data-cycle interrupt (3.4.14)
-    assert bench.read(13) == 0x82 and bench.read(12) == 0x01
+    bench.write(SET, 0x82)  # 3.4.5: SET = 82h, I/O device with 1 byte
+    bench.write(ID, 0x01)  # ID code 01h, digital output device
+    bench.write(IRQ_EN, 0x10)  # enable the valid-data-cycle interrupt (3.4.14)
+    assert bench.read(SET) == 0x82 and bench.read(ID) == 0x01
     idle = wire.status_levels(Cycle.DATA, False, 8)
     lw = wire.LOOPBACK_BYTES_ON_LINE
     start = len(bench.returned)
@@ -87,16 +88,16 @@ def test_firmware_configures_the_chip_and_exchanges_data_at_pin_level() -> None:
         wire.cycle_levels(Frame.build(Cycle.ID, lw + wire.word_bytes(wire.command_word())), 1, True), idle,
     ]))  # fmt: skip
     # The INTERBUS reset cleared the IN bytes (3.4.7): firmware writes them after the ID cycle (Table 3-13).
-    bench.write(0, 0x77)
+    bench.write(IN0, 0x77)
     bench.send(np.concatenate([wire.cycle_levels(Frame.build(Cycle.DATA, lw + b"\x99"), 1, True), idle]))
     returned = np.array(bench.returned[start + 3 * 16 :], dtype=np.uint8)  # the repeater delays by 3 bit periods
     frames = wire.frames_from_levels(wire.samples_to_levels(returned, 2_000_000))
     assert frames[0].data == wire.word_bytes(0x0901) + lw  # ID register: ID 01h, length code 01001 (1 byte)
     assert frames[1].data == b"\x77" + lw  # IN byte 0 went to the master
     assert bench.irq_n[-1] == 0  # /IRQ on MFP3: valid data cycle
-    assert bench.read(14) & 0x10
+    assert bench.read(IRQ_EVT) & 0x10
     assert bench.irq_n[-1] == 1  # reading the event register releases /IRQ
-    assert bench.read(0) == 0x99  # OUT byte 0 from the master
+    assert bench.read(OUT0) == 0x99  # OUT byte 0 from the master
 
 
 def test_chip_without_up_interface_is_the_core() -> None:

@@ -15,11 +15,11 @@ from hypothesis import strategies as st
 from supi3.errors import Supi3Error
 from supi3.verif import (
     EventLog,
-    Layout,
     Lockstep,
     LockstepMismatchError,
     Pin,
     PinSpecError,
+    WordLayout,
     first_mismatch,
     model_trace,
     react,
@@ -105,7 +105,7 @@ def per_cycle_bug(buggy: Lockstep, bug_stimulus: np.ndarray) -> LockstepMismatch
 
 
 def test_layout_keeps_fields_inside_words() -> None:
-    layout = Layout.of(ShiftCounterModel())
+    layout = WordLayout.of(ShiftCounterModel())
     assert layout.output_names == ["count", "sr", "acc", "zero", "match", "bus_oe", "bus"]
     for field in (*layout.in_fields, *layout.out_fields):
         assert (field.width > 32 and field.shift == 0) or field.shift + field.width <= 32
@@ -116,7 +116,9 @@ def test_layout_keeps_fields_inside_words() -> None:
 
 @given(st.lists(st.integers(0, 2**64 - 1), min_size=7, max_size=7))
 def test_words_round_trip(values: list[int]) -> None:
-    layout = Layout([Pin("a", 3)], [Pin("x", 5), Pin("y", 64), Pin("z", 31), Pin("w", 33), Pin("t", 2, tristate=True)])
+    layout = WordLayout(
+        [Pin("a", 3)], [Pin("x", 5), Pin("y", 64), Pin("z", 31), Pin("w", 33), Pin("t", 2, tristate=True)]
+    )
     row = [value & field.mask for value, field in zip(values, layout.out_fields, strict=False)]
     words = np.zeros((1, layout.out_words), dtype=np.uint32)
     packed = sum(value << field.offset for value, field in zip(row, layout.out_fields, strict=True))
@@ -132,7 +134,7 @@ def test_words_round_trip(values: list[int]) -> None:
 @given(st.lists(st.lists(st.integers(0, 2**64 - 1), min_size=5, max_size=5), min_size=1, max_size=4))
 def test_input_words_place_every_field(rows: list[list[int]]) -> None:
     pins = [Pin("a", 3), Pin("b", 64), Pin("c", 31), Pin("d", 33), Pin("e", 1)]
-    layout = Layout(pins, [Pin("x")])
+    layout = WordLayout(pins, [Pin("x")])
     stimulus = np.array([[v & pin.mask for v, pin in zip(row, pins, strict=True)] for row in rows], dtype=np.uint64)
     words = layout.input_words(stimulus)
     for row, packed_row in zip(stimulus.tolist(), words.tolist(), strict=True):
@@ -143,7 +145,7 @@ def test_input_words_place_every_field(rows: list[list[int]]) -> None:
 @settings(max_examples=200)
 @given(st.data())
 def test_word_compare_agrees_with_signal_compare(data: st.DataObject) -> None:
-    layout = Layout([Pin("a")], [Pin("x", 5), Pin("y", 40, tristate=True), Pin("t", 2, tristate=True)])
+    layout = WordLayout([Pin("a")], [Pin("x", 5), Pin("y", 40, tristate=True), Pin("t", 2, tristate=True)])
     cycles = data.draw(st.integers(1, 6))
     signal = st.tuples(*(st.integers(0, field.mask) for field in layout.out_fields))
     expected = np.array(data.draw(st.lists(signal, min_size=cycles, max_size=cycles)), dtype=np.uint64)
@@ -156,7 +158,7 @@ def test_word_compare_agrees_with_signal_compare(data: st.DataObject) -> None:
 
 
 def test_tristate_value_compared_only_while_enabled() -> None:
-    layout = Layout([], [Pin("d", 8, tristate=True)])
+    layout = WordLayout([], [Pin("d", 8, tristate=True)])
     assert layout.output_names == ["d_oe", "d"]
     disabled, enabled = (0, 0x12), (1, 0x12)
     assert layout.matches(disabled, 0x34 << 1)
@@ -204,9 +206,9 @@ def test_pin_rules() -> None:
     with pytest.raises(PinSpecError, match="identifier"):
         Pin("x y")
     with pytest.raises(PinSpecError, match="unique"):
-        Layout([Pin("a")], [Pin("a")])
+        WordLayout([Pin("a")], [Pin("a")])
     with pytest.raises(PinSpecError, match="only output pins"):
-        Layout([Pin("a", tristate=True)], [Pin("b")])
+        WordLayout([Pin("a", tristate=True)], [Pin("b")])
 
 
 def test_event_log_keeps_the_last_events() -> None:
@@ -230,7 +232,7 @@ def test_react_feeds_model_outputs_back() -> None:
         return {"en": 1, "din": cycle & 0xFF, "rd": int(outputs is not None and outputs["count"] & 1)}
 
     stimulus = react(ShiftCounterModel, agent, 50)
-    trace = model_trace(ShiftCounterModel(), stimulus, Layout.of(ShiftCounterModel()))
+    trace = model_trace(ShiftCounterModel(), stimulus, WordLayout.of(ShiftCounterModel()))
     assert stimulus[1:, 4].tolist() == (trace[:-1, 0] & np.uint64(1)).tolist()
 
 

@@ -611,7 +611,7 @@ def parse_mix(text: str) -> dict[str, int]:
     return mix
 
 
-def report(results: list[CampaignResult], as_json: bool) -> str:
+def campaign_report(results: list[CampaignResult], as_json: bool) -> str:
     """Text or JSON report of campaigns."""
     if as_json:
         return json.dumps([r.as_dict() for r in results], indent=2)

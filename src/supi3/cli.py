@@ -266,7 +266,7 @@ def cmd_modes(args: argparse.Namespace) -> None:
     ))
 
 
-def describe(config: DeviceConfig) -> str:
+def describe_config(config: DeviceConfig) -> str:
     """A human-readable description of a decoded configuration."""
     d = config.as_dict()
     lines = [f"{key:20} {value}" for key, value in d.items()]
@@ -284,7 +284,7 @@ def cmd_decode(args: argparse.Namespace) -> None:
                             for p in config.mfp_pins]
         print_json(data)
     else:
-        print(describe(config))
+        print(describe_config(config))
 
 
 def cmd_regmap(args: argparse.Namespace) -> None:
@@ -356,12 +356,12 @@ def _parse_bit_rate(text: str) -> int:
 
 def regmap_summary() -> str:
     """One line per address of the register map: what a write and a read reach, and how."""
-    from supi3.regmap import REGISTER_MAP, Direction
+    from supi3.regmap import REGISTER_MAP, AccessDirection
 
     rows = []
     for address in REGISTER_MAP.addresses:
         cells: list[object] = [address]
-        for direction in (Direction.WRITE, Direction.READ):
+        for direction in (AccessDirection.WRITE, AccessDirection.READ):
             port = REGISTER_MAP.port(address, direction)
             name = port.register.name if port.register else ""
             cells += [f"{port.title} ({name})" if name else port.title, port.access.value]
@@ -373,7 +373,7 @@ def cmd_demo(args: argparse.Namespace) -> None:
     """A master and a small ring, live; optionally the pin-level run as a VCD."""
     from supi3 import demo
 
-    clk_conf = {500_000: "01", 2_000_000: "11"}[_parse_bit_rate(args.bit_rate)]
+    clk_conf = tables.clk_conf_for(_parse_bit_rate(args.bit_rate))
     cycles = check_int("--cycles", args.cycles, 1, MAX_DEMO_CYCLES, "a demo")
     if args.vcd is not None:
         check_int("--cycles", cycles, 1, MAX_VCD_CYCLES, "with --vcd: the pin-level run keeps every clock")
@@ -387,7 +387,7 @@ def cmd_demo(args: argparse.Namespace) -> None:
 def cmd_campaign(args: argparse.Namespace) -> None:
     """A seeded fault campaign at transaction and/or pin level (supi3.campaign); exit status 1 if a goal is missed."""
     results = [campaign.run_campaign(config) for config in _campaign_configs(args)]
-    print(campaign.report(results, args.json))
+    print(campaign.campaign_report(results, args.json))
     if not all(r.ok for r in results):
         raise SystemExit(1)
 

@@ -20,7 +20,7 @@ from functools import cache
 from supi3 import tables
 from supi3.checks import describe
 from supi3.errors import ConfigurationError
-from supi3.tables import Direction, PinFunction
+from supi3.tables import PinDirection, PinFunction
 
 
 class Variant(StrEnum):
@@ -165,7 +165,7 @@ class DeviceConfig:
     @property
     def mfp_output_mask(self) -> int:
         """Bit n set when MFPn is driven by the chip after reset."""
-        return sum(1 << p.pin for p in self.mfp_pins if p.direction is Direction.OUT)
+        return sum(1 << p.pin for p in self.mfp_pins if p.direction is PinDirection.OUT)
 
     @property
     def package_pins(self) -> tuple[str, ...]:
@@ -175,12 +175,11 @@ class DeviceConfig:
     def straps(self) -> Straps:
         """The pin straps that select this configuration (inverse of :func:`decode`)."""
         row = _row_for(self.interface, self.mfp_mode)
-        clk = next(r for r in tables.CLOCK_CONFIGURATIONS if r.bit_rate == self.bit_rate)
         return Straps(
             c=row.c,
             mfp=row.mfp,
             rf=self.rf_mode.rf if self.rf_mode is not None else None,
-            clk_conf=clk.clk_conf1 + clk.clk_conf0,
+            clk_conf=tables.clk_conf_for(self.bit_rate),
             diag_conf=str(self.diagnostics.diag_conf) if self.diagnostics is not None else None,
             variant=self.variant,
         )
@@ -249,7 +248,7 @@ def _up_reset_pins() -> tuple[PinFunction, ...]:
         if mot.signal == intel.signal and mot.direction is intel.direction:
             pins.append(mot)
         else:
-            pins.append(PinFunction(mot.pin, f"{mot.signal} | {intel.signal}", Direction.IN,
+            pins.append(PinFunction(mot.pin, f"{mot.signal} | {intel.signal}", PinDirection.IN,
                                     "input until the initialization byte selects Motorola or Intel (3.4.3)"))
     return tuple(pins)
 
@@ -266,7 +265,7 @@ def _mfp_pins(interface: Interface, mode: MfpMode) -> tuple[PinFunction, ...]:
         pins = pins + tables.BUS_TERMINAL_MFP
     elif not (mode.kind is MfpKind.BINARY_IO and tables.BINARY_IO_TABLE[mode.name] == "3-2"):
         # Configuration expansion: MFP[15..12] carry C[8..5] (Table 3-1 heading, Tables 2-4 to 2-6).
-        pins = pins + tuple(PinFunction(p, f"C{p - 7}", Direction.IN, "configuration expansion")
+        pins = pins + tuple(PinFunction(p, f"C{p - 7}", PinDirection.IN, "configuration expansion")
                             for p in range(12, 16))
     return tuple(sorted(pins, key=lambda p: p.pin))
 

@@ -24,7 +24,7 @@ from typing import Final
 
 from supi3.interbus import wire
 from supi3.pinlevel import Pin
-from supi3.regmap import INTERRUPT_SOURCES, REGISTER_MAP, Access, Direction
+from supi3.regmap import INTERRUPT_SOURCES, REGISTER_MAP, Access, AccessDirection
 from supi3.regmap.core import BYTE_BITS
 from supi3.regmap.registers import IN_BYTES
 from supi3.tables import BIT_RATES, CLOCK_CONFIGURATIONS, DIAG_CONFIGURATIONS, LENGTH_CODES, MODE_ROWS, RF_MODES
@@ -88,8 +88,8 @@ EVENT_BITS: Final = max(source.bit for source in INTERRUPT_SOURCES) + 1
 OPTICAL_REGISTERS: Final[tuple[str, ...]] = tuple(
     port.register.name
     for address in REGISTER_MAP.addresses
-    for port in (REGISTER_MAP.port(address, Direction.READ),)
-    if port.register is not None and REGISTER_MAP.port(address, Direction.WRITE).access is Access.NO_EFFECT
+    for port in (REGISTER_MAP.port(address, AccessDirection.READ),)
+    if port.register is not None and REGISTER_MAP.port(address, AccessDirection.WRITE).access is Access.NO_EFFECT
 )
 """The read-only registers set by the optical block (reads 8 to 11, 3.4.12, 3.4.13), in address order."""
 

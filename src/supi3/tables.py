@@ -15,6 +15,8 @@ from dataclasses import dataclass
 from enum import StrEnum
 from typing import Final
 
+from supi3.errors import ConfigurationError
+
 # ----------------------------------------------------------------------------------------------------------------
 # Operating modes: Tables 2-4, 2-5, 2-6 and 2-7
 # ----------------------------------------------------------------------------------------------------------------
@@ -332,7 +334,7 @@ UP_NOT_READY_ID_CODES: Final[frozenset[int]] = frozenset(
 # ----------------------------------------------------------------------------------------------------------------
 
 
-class Direction(StrEnum):
+class PinDirection(StrEnum):
     """Direction of a pin seen from the chip."""
 
     IN = "in"
@@ -346,12 +348,12 @@ class PinFunction:
 
     pin: int
     signal: str
-    direction: Direction
+    direction: PinDirection
     meaning: str = ""
 
 
 def _io_pins(first_pin: int, prefix: str, first_bit: int, count: int) -> tuple[PinFunction, ...]:
-    direction = Direction.IN if prefix == "In" else Direction.OUT
+    direction = PinDirection.IN if prefix == "In" else PinDirection.OUT
     return tuple(PinFunction(first_pin + k, f"{prefix}{first_bit + k}", direction) for k in range(count))
 
 
@@ -379,55 +381,55 @@ BINARY_IO_TABLE: Final[dict[str, str]] = {mode: ("3-2" if mode in {"8 IN/8 OUT",
                                           for mode in BINARY_IO_MFP}
 
 SPI_MASTER_MFP: Final[tuple[PinFunction, ...]] = (
-    PinFunction(0, "GND", Direction.IN, "Does not serve any function"),
-    PinFunction(1, "GND", Direction.IN, "Does not serve any function"),
-    PinFunction(2, "GND", Direction.IN, "Does not serve any function"),
-    PinFunction(3, "/Conv", Direction.OUT, "Latch (output)"),
-    PinFunction(4, "SCLK", Direction.OUT, "Clock (output) 1 MHz at 500 kbaud, 4 MHz at 2 Mbaud"),
-    PinFunction(5, "/SS", Direction.OUT, "Slave select (output)"),
-    PinFunction(6, "SerIn", Direction.IN, "Data (input)"),
-    PinFunction(7, "SerOut", Direction.OUT, "Data (output)"),
-    *(PinFunction(pin, "GND", Direction.IN, "Does not serve any function") for pin in range(8, 12)),
+    PinFunction(0, "GND", PinDirection.IN, "Does not serve any function"),
+    PinFunction(1, "GND", PinDirection.IN, "Does not serve any function"),
+    PinFunction(2, "GND", PinDirection.IN, "Does not serve any function"),
+    PinFunction(3, "/Conv", PinDirection.OUT, "Latch (output)"),
+    PinFunction(4, "SCLK", PinDirection.OUT, "Clock (output) 1 MHz at 500 kbaud, 4 MHz at 2 Mbaud"),
+    PinFunction(5, "/SS", PinDirection.OUT, "Slave select (output)"),
+    PinFunction(6, "SerIn", PinDirection.IN, "Data (input)"),
+    PinFunction(7, "SerOut", PinDirection.OUT, "Data (output)"),
+    *(PinFunction(pin, "GND", PinDirection.IN, "Does not serve any function") for pin in range(8, 12)),
 )
 """Table 3-3: MFP pins of the SPI master mode (MFP[15..12] are configuration inputs)."""
 
 UP_MOTOROLA_MFP: Final[tuple[PinFunction, ...]] = (
-    PinFunction(0, "SAS_INIT", Direction.IN, "Initialization of the serial interface (active high)"),
-    PinFunction(1, "I/O", Direction.OUT,
+    PinFunction(0, "SAS_INIT", PinDirection.IN, "Initialization of the serial interface (active high)"),
+    PinFunction(1, "I/O", PinDirection.OUT,
                 "I/O access (polling) bit (corresponds to bit D7 in the interrupt event register (rel. addr. 14)"),
-    PinFunction(2, "C/D", Direction.OUT, "Command/Data status: next byte is a command (0) or data (1)"),
-    PinFunction(3, "/IRQ", Direction.OUT, "Interrupt Request"),
-    PinFunction(4, "SCLK", Direction.IN, "Clock input (1.5 MHz maximum at 500 kbps, 6 MHz maximum at 2 Mbps)"),
-    PinFunction(5, "/SS", Direction.IN, "Slave Select"),
-    PinFunction(6, "SerIN", Direction.IN, "Serial input (MOSI: Master Out Slave In)"),
-    PinFunction(7, "SerOUT", Direction.OUT, "Serial output (MISO: Master In Slave Out)"),
+    PinFunction(2, "C/D", PinDirection.OUT, "Command/Data status: next byte is a command (0) or data (1)"),
+    PinFunction(3, "/IRQ", PinDirection.OUT, "Interrupt Request"),
+    PinFunction(4, "SCLK", PinDirection.IN, "Clock input (1.5 MHz maximum at 500 kbps, 6 MHz maximum at 2 Mbps)"),
+    PinFunction(5, "/SS", PinDirection.IN, "Slave Select"),
+    PinFunction(6, "SerIN", PinDirection.IN, "Serial input (MOSI: Master Out Slave In)"),
+    PinFunction(7, "SerOUT", PinDirection.OUT, "Serial output (MISO: Master In Slave Out)"),
 )
 """Table 3-5: MFP pins of the serial µP interface in SPI (Motorola) mode."""
 
 UP_INTEL_MFP: Final[tuple[PinFunction, ...]] = (
-    PinFunction(0, "SAS_INIT", Direction.IN, "Initialization of the serial interface (active high)"),
-    PinFunction(1, "I/O", Direction.OUT,
+    PinFunction(0, "SAS_INIT", PinDirection.IN, "Initialization of the serial interface (active high)"),
+    PinFunction(1, "I/O", PinDirection.OUT,
                 "I/O access (polling) bit (corresponds to bit D7 in the interrupt event register)"),
-    PinFunction(2, "C/D", Direction.OUT, "Command/Data status: next byte is a command (1) or data (0)"),
-    PinFunction(3, "/IRQ", Direction.OUT, "Interrupt Request"),
-    PinFunction(4, "SCLK", Direction.IN, "Clock input (1.5 MHz maximum at 500 kbps, 6 MHz maximum at 2 Mbps)"),
-    PinFunction(5, "/SS", Direction.IN, "Slave Select"),
-    PinFunction(6, "Ser_IN/OUT", Direction.INOUT, "Bidirectional data line"),
-    PinFunction(7, "S/R", Direction.IN, "Data direction: 1 = the processor sends, 0 = the processor receives"),
+    PinFunction(2, "C/D", PinDirection.OUT, "Command/Data status: next byte is a command (1) or data (0)"),
+    PinFunction(3, "/IRQ", PinDirection.OUT, "Interrupt Request"),
+    PinFunction(4, "SCLK", PinDirection.IN, "Clock input (1.5 MHz maximum at 500 kbps, 6 MHz maximum at 2 Mbps)"),
+    PinFunction(5, "/SS", PinDirection.IN, "Slave Select"),
+    PinFunction(6, "Ser_IN/OUT", PinDirection.INOUT, "Bidirectional data line"),
+    PinFunction(7, "S/R", PinDirection.IN, "Data direction: 1 = the processor sends, 0 = the processor receives"),
 )
 """Table 3-6: MFP pins of the serial µP interface in Intel mode. MFP7 is an input in both modes, which is why
 the chip can leave it an input after every hardware reset until the mode is known (3.4.3)."""
 
 BUS_TERMINAL_MFP: Final[tuple[PinFunction, ...]] = (
-    PinFunction(8, "FO3", Direction.OUT, "Initialization diagnostics, optical fiber interface in "
+    PinFunction(8, "FO3", PinDirection.OUT, "Initialization diagnostics, optical fiber interface in "
                 '"READY" bus status or MAU warning in "RUN" bus status.'),
-    PinFunction(9, "DO3_CU", Direction.OUT, "Branch data output (copper)"),
-    PinFunction(10, "DI3", Direction.IN, "Branch data input"),
-    PinFunction(11, "LBST", Direction.IN, "Alarm input for local bus connector"),
-    PinFunction(12, "CONF", Direction.IN, '"Reconfigure Request" control input'),
-    PinFunction(13, "ERROR", Direction.OUT, '"Error" diagnostic LED'),
-    PinFunction(14, "LBDA", Direction.OUT, '"LD" (Local bus Disabled) diagnostic LED'),
-    PinFunction(15, "ALARM", Direction.OUT, "Alarm output"),
+    PinFunction(9, "DO3_CU", PinDirection.OUT, "Branch data output (copper)"),
+    PinFunction(10, "DI3", PinDirection.IN, "Branch data input"),
+    PinFunction(11, "LBST", PinDirection.IN, "Alarm input for local bus connector"),
+    PinFunction(12, "CONF", PinDirection.IN, '"Reconfigure Request" control input'),
+    PinFunction(13, "ERROR", PinDirection.OUT, '"Error" diagnostic LED'),
+    PinFunction(14, "LBDA", PinDirection.OUT, '"LD" (Local bus Disabled) diagnostic LED'),
+    PinFunction(15, "ALARM", PinDirection.OUT, "Alarm output"),
 )
 """Table 2-8: MFP[15..8] in the bus terminal modes; MFP[7..0] are the µP interface in the Init-µP modes only."""
 
@@ -575,6 +577,14 @@ CLOCK_CONFIGURATIONS: Final[tuple[ClockConf, ...]] = (
 
 BIT_RATES: Final[tuple[int, ...]] = tuple(row.bit_rate for row in CLOCK_CONFIGURATIONS if row.bit_rate)
 
+
+def clk_conf_for(bit_rate: int) -> str:
+    """CLK_CONF[1..0], MSB first, that selects ``bit_rate`` (Table 1-7): ``"01"`` 500 kbit/s, ``"11"`` 2 Mbit/s."""
+    for row in CLOCK_CONFIGURATIONS:
+        if row.bit_rate == bit_rate:
+            return row.clk_conf1 + row.clk_conf0
+    raise ConfigurationError("CLK_CONF[1..0]", f"{bit_rate} bit/s", "Table 1-7", f"the data rates are {BIT_RATES}")
+
 # ----------------------------------------------------------------------------------------------------------------
 # Bus connector recognition and regulation: Tables 2-2 and 2-9
 # ----------------------------------------------------------------------------------------------------------------
@@ -685,8 +695,11 @@ SPI_MASTER_TIMING: Final[tuple[TimingParameter, ...]] = (
 )
 """Table 3-4: SPI master times (t_Bit_IBS = 2 µs at 500 kbaud, 0.5 µs at 2 Mbaud)."""
 
+TCLK_PER_BIT: Final[int] = 16
+"""TCLK = t_Bit_IBS / 16 (Table 3-7): the µP interface's internal reference clock runs at 16 times the bit rate."""
+
 UP_INTERFACE_TIMING: Final[tuple[TimingParameter, ...]] = (
-    TimingParameter("TCLK", "Internal reference clock period", "1/16 * t_Bit_IBS", None),
+    TimingParameter("TCLK", "Internal reference clock period", f"1/{TCLK_PER_BIT} * t_Bit_IBS", None),
     TimingParameter("t0", "Clock period (1.5 MHz at 500 kbaud, 6 MHz at 2 Mbaud)", "667 ns | 167 ns", None),
     TimingParameter("t1", "Negative edge of /SS before first negative edge of SCLK", "1 * TCLK", None),
     TimingParameter("t2", "Positive edge of /SS after last positive edge of SCLK", "3 * TCLK", None),

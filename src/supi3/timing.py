@@ -103,7 +103,7 @@ def evaluate(expression: str, bit_rate: int, n_bytes: int = 1, t0_s: float | Non
         low, high = expression.split("|")
         expression = low if bit_rate == tables.BIT_RATES[0] else high
     t_bit = bit_period_s(bit_rate)
-    names = {"t_Bit_IBS": t_bit, "TCLK": t_bit / 16, "n": float(n_bytes), "ns": 1e-9}
+    names = {"t_Bit_IBS": t_bit, "TCLK": t_bit / tables.TCLK_PER_BIT, "n": float(n_bytes), "ns": 1e-9}
     if t0_s is not None:
         names["t0"] = t0_s
     # "100 ns" is the manual's notation for 100 * ns.

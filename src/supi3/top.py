@@ -24,7 +24,7 @@ from supi3 import pinout
 from supi3.checks import check_bits, check_bool, check_instance
 from supi3.config import DeviceConfig
 from supi3.model.chip import Supi3
-from supi3.model.pins import Supi3Pins, Trace, input_traces
+from supi3.model.pins import PinTrace, Supi3Pins, input_traces
 from supi3.pinlevel import OE_SUFFIX, Pin
 from supi3.spi.slave_pins import PinsIn, PinsOut, SlavePins
 
@@ -106,7 +106,7 @@ class Supi3Chip:
         out["mfp_oe"] = (out["mfp_oe"] & ~UP_PINS) | enables
         return out
 
-    def run(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]]) -> dict[str, Trace]:
+    def run(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]]) -> dict[str, PinTrace]:
         """Whole traces at once: the core's event-driven :meth:`Supi3Pins.run` without a µP interface, else
         cycle by cycle (the interface and the core meet in the register file at any cycle).
 

@@ -205,7 +205,7 @@ class PlainDevice:
         _cycle(cycle)
         now = _now(now)
         self.id_cycles += 1
-        command = wire.decode_command(wire.word_from_bytes(received))
+        command = wire.decode_command_word(wire.word_from_bytes(received))
         if command.watchdog_code is not None:
             self.watchdog.configure(command.watchdog_code, now)
         if command.quit_peripheral_error:

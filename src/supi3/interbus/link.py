@@ -45,7 +45,7 @@ class Device(Protocol):
         """The cycle passed every check and the master sent the latch telegrams: take over ``received``.
 
         ``received`` is what the register holds at the end of the data sequence: the OUT data in a data cycle,
-        the command word (``wire.decode_command(wire.word_from_bytes(received))``) in an ID cycle.
+        the command word (``wire.decode_command_word(wire.word_from_bytes(received))``) in an ID cycle.
         """
         ...
 

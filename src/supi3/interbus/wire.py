@@ -367,7 +367,7 @@ def command_word(watchdog_code: int | None = None, quit_peripheral_error: bool =
     return word
 
 
-class Command(NamedTuple):
+class CommandWord(NamedTuple):
     """A decoded command word: the watchdog code to apply (``None``: leave it), the quit request, a processor
     command byte (``None``: none) and the processor alarm request."""
 
@@ -377,12 +377,12 @@ class Command(NamedTuple):
     alarm_request: bool = False
 
 
-def decode_command(word: int) -> Command:
+def decode_command_word(word: int) -> CommandWord:
     """Inverse of :func:`command_word`; bits without a meaning are ignored."""
     word = _int("word", word, 0, 0xFFFF, "a command word is 16 bits")
     code = (word >> CMD_WD_CODE_SHIFT) & 0b11 if _bit(word, CMD_WD_SET_BIT) else None
     pcmd = (word >> CMD_PCMD_SHIFT) & 0xFF if _bit(word, CMD_PCMD_BIT) else None
-    return Command(code, bool(_bit(word, CMD_QUIT_BIT)), pcmd, bool(_bit(word, CMD_ALARM_BIT)))
+    return CommandWord(code, bool(_bit(word, CMD_QUIT_BIT)), pcmd, bool(_bit(word, CMD_ALARM_BIT)))
 
 
 # ================================================================================================================

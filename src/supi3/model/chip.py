@@ -340,18 +340,18 @@ class Supi3:
         return self._stat_low_since is not None and self._now - self._stat_low_since >= STATERR_FILTER_CLOCKS
 
     def _reschedule(self) -> None:
-        # _due: the next clock at which time alone changes the chip (filter expiry, watchdog), _NEVER if none; the
-        # pin level (supi3.model.pins) reads it on every cycle it visits.
+        # due (public, read-only): the next clock at which time alone changes the chip (filter expiry, watchdog),
+        # _NEVER if none; the pin level (supi3.model.pins and its receiver) reads it on every cycle it visits.
         due = _NEVER if self._deadline is None else self._deadline
         if self._stat_low_since is not None and not self.pf:
             due = min(due, self._stat_low_since + STATERR_FILTER_CLOCKS)
-        self._due = due
+        self.due = due
         self._due_s = due / CLOCK_HZ if self.registers is None else -1.0  # see "The ring kernel"
 
     def _advance(self, clk: int) -> None:
         """Bring time-driven state up to clock ``clk``: the /StatErr filter and the layer-2 watchdog."""
         self._now = clk
-        if clk >= self._due:
+        if clk >= self.due:
             self._expire(clk)
 
     def _expire(self, clk: int) -> None:
@@ -391,7 +391,7 @@ class Supi3:
         if type(clk) is not int or clk < 0:
             clk = _clock(clk)
         self._now = clk
-        if clk >= self._due:
+        if clk >= self.due:
             self._expire(clk)
         if cycle is Cycle.ID:
             return wire.word_bytes(self.id_register())
@@ -424,7 +424,7 @@ class Supi3:
             received = _checked(check_bytes, "received", received, length, f"{what} of the {cycle.value} cycle")
         self.revision += 1
         self._now = clk
-        if clk >= self._due:
+        if clk >= self.due:
             self._expire(clk)
         events = self._events
         if cycle is Cycle.DATA:
@@ -443,7 +443,7 @@ class Supi3:
             self._event("VALID")
             self._event("PCP_RX")
         else:
-            command = wire.decode_command(wire.word_from_bytes(received))
+            command = wire.decode_command_word(wire.word_from_bytes(received))
             if command.watchdog_code is not None:
                 self.watchdog_code = command.watchdog_code
                 timeout = WATCHDOG_CLOCKS[command.watchdog_code]

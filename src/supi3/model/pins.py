@@ -64,7 +64,7 @@ from supi3.model.blocks.receiver import (
     input_row,
     input_traces,
 )
-from supi3.model.blocks.transmitter import NEVER, Trace, Transmitter
+from supi3.model.blocks.transmitter import NEVER, PinTrace, Transmitter
 from supi3.model.chip import Supi3
 from supi3.pinlevel import EventLog, Pin
 from supi3.pinout import CORE_OUTPUTS, IB_DIAG_DIVIDER_BITS, SYNC_STAGES
@@ -76,9 +76,9 @@ __all__ = [
     "IDLE_TIMEOUT_CLOCKS",
     "RESET_STRETCH_CLOCKS",
     "SYNC_STAGES",
+    "PinTrace",
     "Supi3Pins",
     "Synced",
-    "Trace",
     "check_names",
     "input_row",
     "input_traces",
@@ -264,7 +264,7 @@ class Supi3Pins:
         if stat != self._stat_active:
             self._stat_active = stat
             chip._set_stat_err(stat, c)
-        if c >= chip._due:
+        if c >= chip.due:
             chip._advance(c)
         self._receiver.clock(line, c)
 
@@ -272,7 +272,7 @@ class Supi3Pins:
     # Many clocks: run()
     # ------------------------------------------------------------------------------------------------------------
 
-    def run(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]]) -> dict[str, Trace]:
+    def run(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]]) -> dict[str, PinTrace]:
         """Run as many clock cycles as the input traces are long; return every output pin's trace.
 
         The same cycles as calling :meth:`step` once per cycle, with the same results, but only the cycles in
@@ -304,13 +304,13 @@ class Supi3Pins:
             synced[name] = np.concatenate([held, raw[name]], dtype=np.int64, casting="unsafe")
         return synced
 
-    def run_forward(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]]) -> dict[str, Trace]:
+    def run_forward(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]]) -> dict[str, PinTrace]:
         """:meth:`run` without ``di1``: the chip's logic does not depend on DI2 beyond the return line's
         pass-through, so a ring runs every chip forward first and then the return line backwards
         (:meth:`return_line`). The ``di2`` trace given here is checked but not used."""
         return self._run_forward(input_traces(inputs))
 
-    def _run_forward(self, raw: Mapping[str, npt.NDArray[np.integer]]) -> dict[str, Trace]:
+    def _run_forward(self, raw: Mapping[str, npt.NDArray[np.integer]]) -> dict[str, PinTrace]:
         # The run kernel: the event scheduler over the blocks' per-cycle logic. It stays flat on purpose (one loop,
         # locals for what it reads every visit): its cost per visited cycle is the run() rate (bench/bench_model.py).
         n = len(raw["do1"])
@@ -395,7 +395,7 @@ class Supi3Pins:
             pipe = [Synced(*(int(raw[name][t]) for name in INPUT_NAMES)), *pipe[:-1]]
         return pipe
 
-    def return_line(self, di2: Trace, do2: Trace) -> Trace:
+    def return_line(self, di2: PinTrace, do2: PinTrace) -> PinTrace:
         """``di1`` over the last :meth:`run_forward`, given that run's DI2 trace: the return line passes DI2
         through once a following device is recognised, else loops ``do2`` back (M5).
 
@@ -416,7 +416,7 @@ class Supi3Pins:
                 raise fail(f"len(pin {name!r} trace)", f"{n}, the length of the last run_forward()", len(trace))
         return self._return_line(traces["di2"].astype(np.int64, copy=False), traces["do2"].astype(np.int64, copy=False))
 
-    def _return_line(self, di2: npt.NDArray[np.int64], do2: npt.NDArray[np.int64]) -> Trace:
+    def _return_line(self, di2: npt.NDArray[np.int64], do2: npt.NDArray[np.int64]) -> PinTrace:
         assert self._return_start is not None
         c0, value, run_from, held_di2 = self._return_start
         n = len(do2)

@@ -29,7 +29,7 @@ from supi3.regmap import (
     INTERRUPT_SOURCES,
     REGISTER_MAP,
     Access,
-    Direction,
+    AccessDirection,
     RegisterMapError,
     Reset,
     SetConfig,
@@ -285,7 +285,7 @@ class RegisterFile:
         """
         if type(address) is not int or not 0 <= address <= 15:
             address = self._address(address)
-        port = REGISTER_MAP.port(address, Direction.READ)
+        port = REGISTER_MAP.port(address, AccessDirection.READ)
         if port.access is Access.RESERVED_ZERO:
             return 0
         if port.register is None:
@@ -314,7 +314,7 @@ class RegisterFile:
             address = self._address(address)
         if type(value) is not int or not 0 <= value <= 0xFF:
             value = _checked(check_bits, "data byte", value, 8)
-        port = REGISTER_MAP.port(address, Direction.WRITE)
+        port = REGISTER_MAP.port(address, AccessDirection.WRITE)
         if port.access is Access.NO_EFFECT:
             return
         register = port.register

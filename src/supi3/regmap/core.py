@@ -22,7 +22,7 @@ class RegisterMapError(Supi3Error, ValueError):
     """A register-map declaration, look-up, value or export request that breaks a rule of the map."""
 
 
-class Direction(StrEnum):
+class AccessDirection(StrEnum):
     """Direction of the data access that follows a command byte, seen from the microprocessor (3.4.4)."""
 
     WRITE = "write"
@@ -78,7 +78,7 @@ class Reset(StrEnum):
 
 @dataclass(frozen=True)
 class Enumerator:
-    """A named value: of a field (unshifted) or of a whole byte (see :attr:`Layout.constants`)."""
+    """A named value: of a field (unshifted) or of a whole byte (see :attr:`ByteLayout.constants`)."""
 
     name: str
     value: int
@@ -163,7 +163,7 @@ class Field:
 
 
 @dataclass(frozen=True, kw_only=True)
-class Layout:
+class ByteLayout:
     """The bit layout of one byte: a register, or an interface byte such as the command byte.
 
     ``constants`` names whole-byte values (the Intel initialization byte 81h, the block-transfer command CFh).
@@ -237,7 +237,7 @@ class Layout:
 
 
 @dataclass(frozen=True, kw_only=True)
-class Register(Layout):
+class Register(ByteLayout):
     """An addressable register: a layout at an address, its reset value and the resets that restore it."""
 
     address: int
@@ -254,7 +254,7 @@ class Port:
     """
 
     address: int
-    direction: Direction
+    direction: AccessDirection
     access: Access
     title: str
     register: Register | None = None
@@ -266,7 +266,7 @@ class Port:
             raise RegisterMapError(f"{self.register.name} is at {self.register.address}, not {self.address}")
         allowed = (
             {Access.W, Access.NO_EFFECT}
-            if self.direction is Direction.WRITE
+            if self.direction is AccessDirection.WRITE
             else {Access.R, Access.RC, Access.RESERVED_ZERO}
         )
         if self.access not in allowed | {Access.RESERVED_IGNORED, Access.BLOCK_TRANSFER}:
@@ -293,13 +293,13 @@ class RegisterMap:
 
     address_bits: int
     ports: tuple[Port, ...]
-    command_byte: Layout
-    init_byte: Layout
-    _by_key: dict[tuple[int, Direction], Port] = field(init=False, repr=False, compare=False)
+    command_byte: ByteLayout
+    init_byte: ByteLayout
+    _by_key: dict[tuple[int, AccessDirection], Port] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         by_key = {(p.address, p.direction): p for p in self.ports}
-        expected = {(a, d) for a in range(1 << self.address_bits) for d in Direction}
+        expected = {(a, d) for a in range(1 << self.address_bits) for d in AccessDirection}
         if len(by_key) != len(self.ports) or set(by_key) != expected:
             raise RegisterMapError("every address needs exactly one write port and one read port")
         names = [r.name for r in self.registers]
@@ -321,7 +321,7 @@ class RegisterMap:
                 seen.setdefault(p.register.name, p.register)
         return tuple(seen.values())
 
-    def port(self, address: int, direction: Direction) -> Port:
+    def port(self, address: int, direction: AccessDirection) -> Port:
         """Return what a ``direction`` data access to ``address`` does.
 
         Raises

@@ -15,7 +15,17 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any, Final
 
-from supi3.regmap.core import BYTE_BITS, Access, Direction, Field, Layout, Port, Register, RegisterMapError, Reset
+from supi3.regmap.core import (
+    BYTE_BITS,
+    Access,
+    AccessDirection,
+    ByteLayout,
+    Field,
+    Port,
+    Register,
+    RegisterMapError,
+    Reset,
+)
 from supi3.regmap.registers import REGISTER_MAP
 
 GENERATOR: Final[str] = "src/supi3/regmap (python -m supi3.regmap --write-checked-in)"
@@ -43,7 +53,7 @@ def _ports_of(register: Register) -> tuple[Port, ...]:
 def _sw(register: Register) -> str:
     """SystemRDL software access of a register: ``w``, ``r`` or ``rw`` (shared write and read storage)."""
     directions = {p.direction for p in _ports_of(register)}
-    return "rw" if len(directions) == 2 else ("w" if Direction.WRITE in directions else "r")
+    return "rw" if len(directions) == 2 else ("w" if AccessDirection.WRITE in directions else "r")
 
 
 def _field_access(register: Register, field: Field) -> str:
@@ -62,7 +72,7 @@ def _resets(register: Register) -> str:
     return ", ".join(r.value for r in Reset if r in register.cleared_by)
 
 
-def _reserved_ranges(layout: Layout) -> list[str]:
+def _reserved_ranges(layout: ByteLayout) -> list[str]:
     """The reserved bits of a layout as ranges, MSB first: ``["6:1"]`` for the initialization byte."""
     ranges: list[str] = []
     bit = BYTE_BITS - 1
@@ -96,7 +106,7 @@ def _port_summary(port: Port) -> str:
     return f"{port.register.name}: {port.title} ({port.access.value})"
 
 
-def _layouts() -> tuple[Layout, ...]:
+def _layouts() -> tuple[ByteLayout, ...]:
     return (REGISTER_MAP.command_byte, REGISTER_MAP.init_byte)
 
 
@@ -137,8 +147,8 @@ def _rdl_enum(register: Register, field: Field) -> list[str]:
 def _rdl_map_desc() -> str:
     lines = ["Address map (Table 3-10), write | read:", ""]
     lines += [
-        f"- {a}: {_port_summary(REGISTER_MAP.port(a, Direction.WRITE))} | "
-        f"{_port_summary(REGISTER_MAP.port(a, Direction.READ))}"
+        f"- {a}: {_port_summary(REGISTER_MAP.port(a, AccessDirection.WRITE))} | "
+        f"{_port_summary(REGISTER_MAP.port(a, AccessDirection.READ))}"
         for a in REGISTER_MAP.addresses
     ]
     for layout in _layouts():
@@ -241,7 +251,7 @@ def _field_json(field: Field) -> dict[str, Any]:
     }
 
 
-def _layout_json(layout: Layout) -> dict[str, Any]:
+def _layout_json(layout: ByteLayout) -> dict[str, Any]:
     result: dict[str, Any] = {"name": layout.name, "title": layout.title, "ref": layout.ref, "doc": layout.doc}
     if isinstance(layout, Register):
         result |= {"address": layout.address, "reset": layout.reset, "cleared_by": sorted(layout.cleared_by)}
@@ -294,16 +304,16 @@ def _md_port(port: Port) -> str:
     return f"[{port.register.name}](#{port.register.name.lower()}) {port.title} ({port.access.value})"
 
 
-def _reserved_text(layout: Layout) -> str:
+def _reserved_text(layout: ByteLayout) -> str:
     """What to do with reserved bits: write 0 where the byte is written, and they read 0 where it is read."""
-    directions = {p.direction for p in _ports_of(layout)} if isinstance(layout, Register) else {Direction.WRITE}
-    rules = (["write 0"] if Direction.WRITE in directions else []) + (
-        ["reads 0"] if Direction.READ in directions else []
+    directions = {p.direction for p in _ports_of(layout)} if isinstance(layout, Register) else {AccessDirection.WRITE}
+    rules = (["write 0"] if AccessDirection.WRITE in directions else []) + (
+        ["reads 0"] if AccessDirection.READ in directions else []
     )
     return f"Reserved: {', '.join(rules)}."
 
 
-def _md_fields(layout: Layout) -> list[str]:
+def _md_fields(layout: ByteLayout) -> list[str]:
     register = layout if isinstance(layout, Register) else None
     rows = [
         (_bits(f), f.name, *([_field_access(register, f)] if register else []), _field_text(f)) for f in layout.fields
@@ -331,8 +341,8 @@ def to_markdown() -> str:
             (
                 (
                     f"{a} ({a:02X}h)",
-                    _md_port(REGISTER_MAP.port(a, Direction.WRITE)),
-                    _md_port(REGISTER_MAP.port(a, Direction.READ)),
+                    _md_port(REGISTER_MAP.port(a, AccessDirection.WRITE)),
+                    _md_port(REGISTER_MAP.port(a, AccessDirection.READ)),
                 )
                 for a in REGISTER_MAP.addresses
             ),
@@ -392,7 +402,7 @@ def _c_hex(value: int) -> str:
     return f"0x{value:02X}u"
 
 
-def _c_fields(layout: Layout) -> list[_CLine]:
+def _c_fields(layout: ByteLayout) -> list[_CLine]:
     lines: list[_CLine] = []
     for f in layout.fields:
         lines += [
@@ -426,7 +436,7 @@ def to_c_header() -> str:
     registers, the command byte (``SUPI3_CMD_*``, ``SUPI3_CMD_WRITE(addr)``, ...) and the initialization byte
     (``SUPI3_INIT_*``).
     """
-    writes = {a: _port_summary(REGISTER_MAP.port(a, Direction.WRITE)) for a in REGISTER_MAP.addresses}
+    writes = {a: _port_summary(REGISTER_MAP.port(a, AccessDirection.WRITE)) for a in REGISTER_MAP.addresses}
     width = max(len(text) for text in writes.values()) + 2
     lines: list[_CLine] = [
         "/**",
@@ -441,7 +451,7 @@ def to_c_header() -> str:
         " *",
         f" * Addr  {'Write'.ljust(width)}Read",
         *(
-            f" * {a:4}  {writes[a].ljust(width)}{_port_summary(REGISTER_MAP.port(a, Direction.READ))}"
+            f" * {a:4}  {writes[a].ljust(width)}{_port_summary(REGISTER_MAP.port(a, AccessDirection.READ))}"
             for a in REGISTER_MAP.addresses
         ),
         " */",
@@ -452,7 +462,7 @@ def to_c_header() -> str:
         *(
             _c_define("BLOCK_TRANSFER_ADDR", _c_hex(p.address))
             for p in REGISTER_MAP.ports
-            if p.access is Access.BLOCK_TRANSFER and p.direction is Direction.WRITE
+            if p.access is Access.BLOCK_TRANSFER and p.direction is AccessDirection.WRITE
         ),
     ]
     for layout in _layouts():

@@ -14,10 +14,10 @@ from typing import Final
 
 from supi3.regmap.core import (
     Access,
-    Direction,
+    AccessDirection,
+    ByteLayout,
     Enumerator,
     Field,
-    Layout,
     Port,
     Register,
     RegisterMap,
@@ -112,10 +112,10 @@ def _bit(name: str, bit: int, doc: str, values: tuple[Enumerator, ...] = ()) -> 
     return Field(name, bit, 1, doc, values=values)
 
 
-def _title(address: int, direction: Direction) -> str:
+def _title(address: int, direction: AccessDirection) -> str:
     """The manual's name of one cell of Table 3-10, "-" where the table has none."""
     row = ADDRESS_MAP[address]
-    text = row.write if direction is Direction.WRITE else row.read
+    text = row.write if direction is AccessDirection.WRITE else row.read
     return text or "-"
 
 
@@ -124,7 +124,7 @@ def _length_name(text: str) -> str:
     return "LEN_" + re.sub(r"\W+", "_", text.split(" (")[0]).upper()
 
 
-COMMAND_BYTE: Final[Layout] = Layout(
+COMMAND_BYTE: Final[ByteLayout] = ByteLayout(
     name="CMD",
     title="Command byte",
     ref="3.4.4, 3.4.6, Fig. 3-8, Figs. 3-10 to 3-12",
@@ -141,7 +141,7 @@ COMMAND_BYTE: Final[Layout] = Layout(
 )
 """The command byte (3.4.4): not addressable, but firmware builds it for every access."""
 
-INIT_BYTE: Final[Layout] = Layout(
+INIT_BYTE: Final[ByteLayout] = ByteLayout(
     name="INIT",
     title="Initialization byte",
     ref="3.4.3, Table 3-8",
@@ -161,7 +161,7 @@ INIT_BYTE: Final[Layout] = Layout(
 
 
 def _data_register(
-    name: str, address: int, direction: Direction, resets: frozenset[Reset], ref: str, doc: str = ""
+    name: str, address: int, direction: AccessDirection, resets: frozenset[Reset], ref: str, doc: str = ""
 ) -> Register:
     return Register(
         name=name,
@@ -179,14 +179,16 @@ _DATA_DOC: Final[str] = (
 )
 
 IN_BYTES: Final[tuple[Register, ...]] = tuple(
-    _data_register(f"IN{n}", n, Direction.WRITE, DATA_RESETS, "3.4.8", _DATA_DOC) for n in range(4)
+    _data_register(f"IN{n}", n, AccessDirection.WRITE, DATA_RESETS, "3.4.8", _DATA_DOC) for n in range(4)
 )
 OUT_BYTES: Final[tuple[Register, ...]] = tuple(
-    _data_register(f"OUT{n}", n, Direction.READ, DATA_RESETS, "3.4.8", _DATA_DOC) for n in range(4)
+    _data_register(f"OUT{n}", n, AccessDirection.READ, DATA_RESETS, "3.4.8", _DATA_DOC) for n in range(4)
 )
+IN0, IN1, IN2, IN3 = IN_BYTES
+OUT0, OUT1, OUT2, OUT3 = OUT_BYTES
 _MANAGEMENT_DOC: Final[str] = "Management channel (firmware 4.0 or later), reserved for future applications (3.4.9)."
-ALARM: Final[Register] = _data_register("ALARM", 7, Direction.WRITE, OTHER_RESETS, "3.4.9", _MANAGEMENT_DOC)
-PCMD: Final[Register] = _data_register("PCMD", 7, Direction.READ, OTHER_RESETS, "3.4.9", _MANAGEMENT_DOC)
+ALARM: Final[Register] = _data_register("ALARM", 7, AccessDirection.WRITE, OTHER_RESETS, "3.4.9", _MANAGEMENT_DOC)
+PCMD: Final[Register] = _data_register("PCMD", 7, AccessDirection.READ, OTHER_RESETS, "3.4.9", _MANAGEMENT_DOC)
 
 _MEDIUM_VALUES: Final[tuple[Enumerator, ...]] = (
     Enumerator("POLYMER", 0, "Polymer fibre (length resolution 12 m)."),
@@ -201,7 +203,7 @@ _ENABLE_DOC: Final[str] = (
 def _length_register(name: str, address: int) -> Register:
     return Register(
         name=name,
-        title=_title(address, Direction.READ),
+        title=_title(address, AccessDirection.READ),
         ref="3.4.12, Fig. 3-16, Table 1-5",
         address=address,
         cleared_by=OTHER_RESETS,
@@ -218,7 +220,7 @@ LENGTH_BRANCH: Final[Register] = _length_register("LENGTH_BRANCH", 9)
 _LEVEL_DOC: Final[str] = "Transmit power level, 1..15 of 15."
 POWER_IN: Final[Register] = Register(
     name="POWER_IN",
-    title=_title(10, Direction.READ),
+    title=_title(10, AccessDirection.READ),
     ref="3.4.13, Fig. 3-17",
     address=10,
     cleared_by=OTHER_RESETS,
@@ -229,7 +231,7 @@ POWER_IN: Final[Register] = Register(
 )
 POWER_OUT_BRANCH: Final[Register] = Register(
     name="POWER_OUT_BRANCH",
-    title=_title(11, Direction.READ),
+    title=_title(11, AccessDirection.READ),
     ref="3.4.13, Fig. 3-18",
     address=11,
     cleared_by=OTHER_RESETS,
@@ -241,7 +243,7 @@ POWER_OUT_BRANCH: Final[Register] = Register(
 )
 ID: Final[Register] = Register(
     name="ID",
-    title=_title(12, Direction.WRITE),
+    title=_title(12, AccessDirection.WRITE),
     ref="3.4.10, 3.4.3, Table A-3",
     address=12,
     cleared_by=OTHER_RESETS,
@@ -251,7 +253,7 @@ ID: Final[Register] = Register(
 )
 SET: Final[Register] = Register(
     name="SET",
-    title=_title(13, Direction.WRITE),
+    title=_title(13, AccessDirection.WRITE),
     ref="3.4.11, Figs. 3-14 and 3-15, Tables 3-11 and 3-12",
     address=13,
     cleared_by=OTHER_RESETS,
@@ -287,7 +289,7 @@ SET: Final[Register] = Register(
 )
 IRQ_EN: Final[Register] = Register(
     name="IRQ_EN",
-    title=_title(14, Direction.WRITE),
+    title=_title(14, AccessDirection.WRITE),
     ref="3.4.14, Fig. 3-19, Table 3-13",
     address=14,
     cleared_by=OTHER_RESETS,
@@ -296,7 +298,7 @@ IRQ_EN: Final[Register] = Register(
 )
 IRQ_EVT: Final[Register] = Register(
     name="IRQ_EVT",
-    title=_title(14, Direction.READ),
+    title=_title(14, AccessDirection.READ),
     ref="3.4.14, Fig. 3-20, Table 3-13",
     address=14,
     cleared_by=OTHER_RESETS,
@@ -320,12 +322,12 @@ IRQ_EVT: Final[Register] = Register(
 # ------------------------------------------------------------------------------------------------------------
 
 
-def _port(address: int, direction: Direction, access: Access, register: Register | None = None) -> Port:
+def _port(address: int, direction: AccessDirection, access: Access, register: Register | None = None) -> Port:
     return Port(address, direction, access, _title(address, direction), register)
 
 
 def _ports() -> tuple[Port, ...]:
-    w, r = Direction.WRITE, Direction.READ
+    w, r = AccessDirection.WRITE, AccessDirection.READ
     by_address: dict[int, tuple[Port, Port]] = {
         **{n: (_port(n, w, Access.W, IN_BYTES[n]), _port(n, r, Access.R, OUT_BYTES[n])) for n in range(4)},
         **{n: (_port(n, w, Access.RESERVED_IGNORED), _port(n, r, Access.RESERVED_IGNORED)) for n in (4, 5)},
@@ -348,13 +350,18 @@ def _ports() -> tuple[Port, ...]:
 REGISTER_MAP: Final[RegisterMap] = RegisterMap(ADDRESS_BITS, _ports(), COMMAND_BYTE, INIT_BYTE)
 """The serial µP interface of the SUPI 3 OPC (Table 3-10): import this, never a copy of it."""
 
+BLOCK_ADDRESS: Final[int] = next(
+    p.address for p in REGISTER_MAP.ports if p.access is Access.BLOCK_TRANSFER and p.direction is AccessDirection.WRITE
+)
+"""The address whose command byte starts a block transfer (15, 3.4.6), as :data:`REGISTER_MAP` declares it."""
+
 # ------------------------------------------------------------------------------------------------------------
 # Decoding the interface bytes and the SET register
 # ------------------------------------------------------------------------------------------------------------
 
 
 @dataclass(frozen=True)
-class Command:
+class CommandByte:
     """A decoded command byte (3.4.4)."""
 
     rd: bool
@@ -364,7 +371,7 @@ class Command:
     @property
     def block_transfer(self) -> bool:
         """Address 15 starts a block transfer whatever RD and WR say (3.4.6)."""
-        return REGISTER_MAP.port(self.address, Direction.WRITE).access is Access.BLOCK_TRANSFER
+        return REGISTER_MAP.port(self.address, AccessDirection.WRITE).access is Access.BLOCK_TRANSFER
 
 
 @cache  # a pure function of 64 possible arguments, on the µP interface's hot path
@@ -380,7 +387,7 @@ def encode_command(address: int, *, rd: bool = False, wr: bool = False) -> int:
 
 
 @cache  # a pure function of a byte, on the µP interface's hot path
-def decode_command(byte: int) -> Command:
+def decode_command(byte: int) -> CommandByte:
     """Split a command byte into RD, WR and the address A3..0 (3.4.4).
 
     Raises
@@ -391,7 +398,7 @@ def decode_command(byte: int) -> Command:
     fields = COMMAND_BYTE.decode(byte)
     if byte & ~COMMAND_BYTE.mask:
         raise RegisterMapError(f"command byte {byte:02X}h sets reserved bits {byte & ~COMMAND_BYTE.mask:02X}h")
-    return Command(bool(fields["RD"]), bool(fields["WR"]), fields["A"])
+    return CommandByte(bool(fields["RD"]), bool(fields["WR"]), fields["A"])
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,6 @@
 """The whole SUPI 3 chip in Amaranth: the INTERBUS core and the serial µP interface, pin for pin.
 
-:class:`Supi3Chip` matches the model ``supi3.top.Supi3Chip`` on every output pin on every 32 MHz clock. It joins
+:class:`Supi3ChipRtl` matches the model ``supi3.top.Supi3Chip`` on every output pin on every 32 MHz clock. It joins
 :class:`~supi3.rtl.core.Supi3Core` (built with its register-file ports) and :class:`~supi3.rtl.upif.UpifBlock`
 (the µP interface and its register file) the way the model joins ``model.pins.Supi3Pins`` and
 ``spi.slave_pins.SlavePins`` through one ``model.registers.RegisterFile``:
@@ -30,10 +30,10 @@ from supi3.rtl.core import REGISTER_FILE_INPUTS, REGISTER_FILE_OUTPUTS, Supi3Cor
 from supi3.rtl.tables import check_variant
 from supi3.rtl.upif import UpifBlock
 
-__all__ = ["Supi3Chip", "rtlil", "verilog"]
+__all__ = ["Supi3ChipRtl", "rtlil", "verilog"]
 
 
-class Supi3Chip(wiring.Component):
+class Supi3ChipRtl(wiring.Component):
     """The SUPI 3 chip with the pins of the model ``supi3.top.Supi3Chip`` (:mod:`supi3.pinout`) and the strap ports of
     :class:`~supi3.rtl.core.Supi3Core`.
 
@@ -82,12 +82,12 @@ class Supi3Chip(wiring.Component):
 
 
 def verilog(variant: Variant | str = Variant.OPC) -> str:
-    """The Verilog of :class:`Supi3Chip` for ``variant``, top module ``supi3_chip`` (for Verilator)."""
-    text: str = amaranth_verilog.convert(Supi3Chip(variant), name="supi3_chip", emit_src=False)
+    """The Verilog of :class:`Supi3ChipRtl` for ``variant``, top module ``supi3_chip`` (for Verilator)."""
+    text: str = amaranth_verilog.convert(Supi3ChipRtl(variant), name="supi3_chip", emit_src=False)
     return text
 
 
 def rtlil(variant: Variant | str = Variant.OPC) -> str:
-    """The RTLIL of :class:`Supi3Chip` for ``variant``, top module ``supi3_chip`` (for yosys synthesis)."""
-    text: str = amaranth_rtlil.convert(Supi3Chip(variant), name="supi3_chip", emit_src=False)
+    """The RTLIL of :class:`Supi3ChipRtl` for ``variant``, top module ``supi3_chip`` (for yosys synthesis)."""
+    text: str = amaranth_rtlil.convert(Supi3ChipRtl(variant), name="supi3_chip", emit_src=False)
     return text

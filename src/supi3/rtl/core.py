@@ -16,7 +16,7 @@ Blocks, in the order the model's ``_tick`` runs them within one clock:
 * transmitter: a short queue of (countdown, level) entries that repeats each bit ``REPEATER_DELAY_BITS`` after it
   began on DO1, with the ERR pair of the CNTR word settled at the last stop bit (docs/interbus.md, A7, A10).
 
-µP modes: built with ``register_file=True`` (:class:`supi3.rtl.chip.Supi3Chip`), the core has the ports of the
+µP modes: built with ``register_file=True`` (:class:`supi3.rtl.chip.Supi3ChipRtl`), the core has the ports of the
 register file's core side (:class:`supi3.rtl.upif.UpifBlock`): in Init-µP modes it takes the IN bytes, the ID
 register and the processor alarm from it and strobes the latch, events, processor command, I/O access bit and
 resets at the clocks the model calls its register file (``model.registers.RegisterFile``). Without it, and in SPI
@@ -78,12 +78,12 @@ __all__ = [
     "STRAP_PINS",
     "TRANSMIT",
     "WORDS",
-    "DataPath",
-    "FrameEngine",
-    "Outputs",
-    "Receiver",
+    "DataPathRtl",
+    "FrameEngineRtl",
+    "OutputsRtl",
+    "ReceiverRtl",
     "Supi3Core",
-    "Transmitter",
+    "TransmitterRtl",
     "verilog",
 ]
 
@@ -253,11 +253,11 @@ class Supi3Core(wiring.Component):
         # The blocks (docs/rtl.md, "Architecture"). Each block's clocked logic runs on the clocks where the model's
         # _tick runs (``running``) and is cleared by a power failure; the receiver's synchronisers always run, so the
         # receiver applies the enable and reset to its line receiver itself.
-        m.submodules.receiver = receiver = Receiver(tables)
-        frame = FrameEngine()
-        datapath = DataPath(tables)
-        transmitter = Transmitter(tables)
-        outputs = Outputs(len(cycle))
+        m.submodules.receiver = receiver = ReceiverRtl(tables)
+        frame = FrameEngineRtl()
+        datapath = DataPathRtl(tables)
+        transmitter = TransmitterRtl(tables)
+        outputs = OutputsRtl(len(cycle))
 
         # The power-up reset with its stretch (1.7.2, M2), from the synchronised /ResU and voltage monitor ---------
         power_fail = ~(receiver.resu_n_s & receiver.vmon_ok_s)
@@ -360,7 +360,7 @@ class Supi3Core(wiring.Component):
         return m
 
 
-class Receiver(wiring.Component):
+class ReceiverRtl(wiring.Component):
     """Synchroniser and line receiver (block ``receiver``; the model's ``receiver`` block).
 
     Every input pin passes :data:`~supi3.pinout.SYNC_STAGES` flip-flops (M1) that always run; the synchronised
@@ -462,7 +462,7 @@ class Receiver(wiring.Component):
         return m
 
 
-class FrameEngine(wiring.Component):
+class FrameEngineRtl(wiring.Component):
     """Frame engine (block ``frame``): telegram framing into cycles, CRC and check sequence, latch and discard.
 
     An ``m.FSM`` with the model's states IDLE, DATA (data field), CHECK (check sequence), WAIT (latch telegrams).
@@ -658,7 +658,7 @@ class FrameEngine(wiring.Component):
         return m
 
 
-class DataPath(wiring.Component):
+class DataPathRtl(wiring.Component):
     """Shift register, load and latch (block ``datapath``).
 
     The frame's shift register (width 8 x data bytes, or 16 in an ID cycle; bit 0 goes out first) with its length
@@ -722,7 +722,7 @@ class DataPath(wiring.Component):
         return m
 
 
-class Transmitter(wiring.Component):
+class TransmitterRtl(wiring.Component):
     """Transmitter and repeater (block ``transmitter``).
 
     A short queue of (countdown to the end of the bit period, level) entries, newest first: each sample pushes the
@@ -771,7 +771,7 @@ class Transmitter(wiring.Component):
         return m
 
 
-class Outputs(wiring.Component):
+class OutputsRtl(wiring.Component):
     """Outputs and diagnostics (block ``outputs``): the chip registers behind the diagnostic pins.
 
     The /StatErr filter (200 ms, 3.6.2) and the peripheral fault PF, the layer-2 watchdog (Table 3-13) and WD, TE and

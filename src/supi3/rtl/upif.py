@@ -50,7 +50,7 @@ from supi3.regmap import (
     INTERRUPT_SOURCES,
     REGISTER_MAP,
     Access,
-    Direction,
+    AccessDirection,
     RegisterMapError,
     Reset,
     decode_set,
@@ -68,8 +68,8 @@ _PCP_N = _SET.field("PCP_N")
 _RD = COMMAND_BYTE.field("RD")
 _WR = COMMAND_BYTE.field("WR")
 _ADDRESS = COMMAND_BYTE.field("A")
-_READ_PORTS: Final = {a: REGISTER_MAP.port(a, Direction.READ) for a in REGISTER_MAP.addresses}
-_WRITE_PORTS: Final = {a: REGISTER_MAP.port(a, Direction.WRITE) for a in REGISTER_MAP.addresses}
+_READ_PORTS: Final = {a: REGISTER_MAP.port(a, AccessDirection.READ) for a in REGISTER_MAP.addresses}
+_WRITE_PORTS: Final = {a: REGISTER_MAP.port(a, AccessDirection.WRITE) for a in REGISTER_MAP.addresses}
 _BLOCK_ADDRESSES: Final = tuple(a for a, port in _WRITE_PORTS.items() if port.access is Access.BLOCK_TRANSFER)
 """A3..0 that start a block transfer (3.4.6: 15)."""
 _IRQ_EVT = REGISTER_MAP.register("IRQ_EVT")

@@ -35,7 +35,7 @@ from supi3.config import MfpKind, Variant, decode, mode_rows
 from supi3.errors import ArgumentError
 from supi3.model.registers import RegisterFile
 from supi3.pinlevel import OE_SUFFIX, Pin, PinSpecError
-from supi3.regmap import INTERRUPT_SOURCES, REGISTER_MAP, Access, Direction
+from supi3.regmap import INTERRUPT_SOURCES, REGISTER_MAP, Access, AccessDirection
 from supi3.regmap.core import BYTE_BITS, BYTE_MASK
 from supi3.regmap.registers import IN_BYTES
 from supi3.spi.slave_pins import INPUT_PINS, OUTPUT_PINS, PinsIn, SlavePins
@@ -62,9 +62,9 @@ EVENT_BITS: Final[int] = max(source.bit for source in INTERRUPT_SOURCES) + 1
 OPTICAL_REGISTERS: Final[tuple[str, ...]] = tuple(
     port.register.name
     for address in REGISTER_MAP.addresses
-    for port in (REGISTER_MAP.port(address, Direction.READ),)
+    for port in (REGISTER_MAP.port(address, AccessDirection.READ),)
     if port.register is not None
-    and REGISTER_MAP.port(address, Direction.WRITE).access is Access.NO_EFFECT
+    and REGISTER_MAP.port(address, AccessDirection.WRITE).access is Access.NO_EFFECT
 )
 """The read-only registers set by the optical block (reads 8 to 11, 3.4.12, 3.4.13), in address order."""
 LENGTH_CODE_BITS: Final[int] = len(LENGTH_CODES[0].code)

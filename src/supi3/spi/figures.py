@@ -1,7 +1,7 @@
 """The manual's serial µP interface figures, redrawn from traces of the pin-level model.
 
 The text copy of the manual (IBS SUPI 3 OPC UM E rev. 05) lacks Figures 3-4, 3-5 and 3-9 to 3-12. :data:`FIGURES`
-redraws each from a :class:`~supi3.spi.master.Trace` of :class:`~supi3.spi.slave_pins.SlavePins` driven by a
+redraws each from a :class:`~supi3.spi.master.SpiTrace` of :class:`~supi3.spi.slave_pins.SlavePins` driven by a
 :class:`~supi3.spi.master.SoftMaster`: :func:`to_wavejson` turns a trace into WaveJSON sampled once per half SCLK
 period, :func:`render_svg` renders it with the ``wavedrom`` package (the ``docs`` extra, imported only there), and
 :func:`write_figures` writes them all; ``supi3 figures`` runs it (see ``docs/figures.md``).
@@ -19,10 +19,10 @@ from typing import Final
 
 from supi3.config import decode
 from supi3.model.registers import RegisterFile
-from supi3.regmap import REGISTER_MAP, encode_command
-from supi3.spi.master import MasterTiming, SoftMaster, Trace, decode_bytes, write_vcd
+from supi3.regmap import BLOCK_ADDRESS, REGISTER_MAP, encode_command
+from supi3.spi.master import MasterTiming, SoftMaster, SpiTrace, decode_bytes, write_spi_vcd
 from supi3.spi.slave_pins import SlavePins
-from supi3.spi.upif import BLOCK_ADDRESS, Mode
+from supi3.spi.upif import Mode
 
 __all__ = [
     "FIGURES",
@@ -56,7 +56,7 @@ def wavedrom_module() -> ModuleType:
 # ------------------------------------------------------------------------------------------------------------
 
 
-def _lanes(trace: Trace) -> list[tuple[str, Callable[[int], str]]]:
+def _lanes(trace: SpiTrace) -> list[tuple[str, Callable[[int], str]]]:
     ss_sclk: list[tuple[str, Callable[[int], str]]] = [
         ("/SS (MFP5)", lambda k: str(trace.inputs[k].ss_n)),
         ("SCLK (MFP4)", lambda k: str(trace.inputs[k].sclk)),
@@ -80,7 +80,7 @@ def _wave(keys: Sequence[object], data_key: Callable[[object], bool]) -> str:
     return "".join(chars)
 
 
-def to_wavejson(trace: Trace, title: str, *, step: int | None = None) -> dict[str, object]:
+def to_wavejson(trace: SpiTrace, title: str, *, step: int | None = None) -> dict[str, object]:
     """The WaveJSON of ``trace``: one column per ``step`` cycles (default half an SCLK period), each showing
     the pins in the first cycle of its window, plus two lanes with the bytes that
     :func:`~supi3.spi.master.decode_bytes` reads.
@@ -153,7 +153,7 @@ class Figure:
     """The manual's figure number and caption."""
     description: str
     """What the redrawn figure shows."""
-    build: Callable[[], Trace]
+    build: Callable[[], SpiTrace]
     """Runs the scenario on a fresh chip and returns the trace of the bytes the figure shows."""
 
 
@@ -173,7 +173,7 @@ class _Scenario:
         self.start = len(self.master.trace())
         self.master.deselect()
 
-    def trace(self) -> Trace:
+    def trace(self) -> SpiTrace:
         """The figure's cycles, ending one idle gap after C/D settled after its last byte."""
         self.master.deselect()
         self.master.deselect()
@@ -191,7 +191,7 @@ def _intel_configured(set_value: int) -> _Scenario:
     return scenario
 
 
-def _figure_3_4() -> Trace:
+def _figure_3_4() -> SpiTrace:
     scenario = _Scenario(Mode.MOTOROLA)
     m = scenario.master
     m.byte(Mode.MOTOROLA.init_byte)
@@ -205,7 +205,7 @@ def _figure_3_4() -> Trace:
     return scenario.trace()
 
 
-def _figure_3_5() -> Trace:
+def _figure_3_5() -> SpiTrace:
     scenario = _intel_configured(SET_1_BYTE)
     m = scenario.master
     m.chip.registers.latch(bytes([EXAMPLE_OUT]))
@@ -215,14 +215,14 @@ def _figure_3_5() -> Trace:
     return scenario.trace()
 
 
-def _figure_3_9() -> Trace:
+def _figure_3_9() -> SpiTrace:
     scenario = _Scenario(Mode.INTEL)
     scenario.show()
     scenario.master.byte(Mode.INTEL.init_byte)
     return scenario.trace()
 
 
-def _figure_3_10() -> Trace:
+def _figure_3_10() -> SpiTrace:
     scenario = _Scenario(Mode.INTEL)
     m = scenario.master
     m.byte(Mode.INTEL.init_byte)
@@ -232,7 +232,7 @@ def _figure_3_10() -> Trace:
     return scenario.trace()
 
 
-def _figure_3_11() -> Trace:
+def _figure_3_11() -> SpiTrace:
     scenario = _intel_configured(SET_1_BYTE)
     scenario.show()
     scenario.master.byte(encode_command(_ID, wr=True))
@@ -240,7 +240,7 @@ def _figure_3_11() -> Trace:
     return scenario.trace()
 
 
-def _figure_3_12() -> Trace:
+def _figure_3_12() -> SpiTrace:
     scenario = _intel_configured(SET_3_BYTES)
     m = scenario.master
     m.chip.registers.latch(BLOCK_OUT_DATA)
@@ -299,5 +299,5 @@ def write_figures(out: Path, *, vcd: bool = False) -> list[Path]:
         svg_path.write_text(render_svg(wavejson) + "\n", encoding="utf-8")
         written += [json_path, svg_path]
         if vcd:
-            written.append(write_vcd(trace, out / f"{figure.name}.vcd"))
+            written.append(write_spi_vcd(out / f"{figure.name}.vcd", trace))
     return written

@@ -3,10 +3,10 @@
 :class:`SoftMaster` drives :class:`~supi3.spi.slave_pins.SlavePins` (or any model with its ``tick``) pin by pin at
 the chip clock, within Table 3-7 (IBS SUPI 3 OPC UM E rev. 05, 3.4.2): SCLK idles high, the µP changes its data on
 falling edges and both sides sample on rising edges (UP-5), one byte per /SS low period (UP-7); the edges are placed
-by :class:`MasterTiming`. Every pin of every cycle can be recorded in a :class:`Trace`, which can be
+by :class:`MasterTiming`. Every pin of every cycle can be recorded in a :class:`SpiTrace`, which can be
 
 * decoded back into bytes from the pins alone (:func:`decode_bytes`),
-* written as a VCD (:func:`write_vcd`),
+* written as a VCD (:func:`write_spi_vcd`),
 * drawn as a timing diagram (:mod:`supi3.spi.figures`, which needs the ``docs`` extra for SVG).
 
 This module needs only the base install (numpy, pyvcd).
@@ -32,9 +32,9 @@ __all__ = [
     "DecodedByte",
     "MasterTiming",
     "SoftMaster",
-    "Trace",
+    "SpiTrace",
     "decode_bytes",
-    "write_vcd",
+    "write_spi_vcd",
 ]
 
 _EPSILON: Final[float] = 1e-6
@@ -114,7 +114,7 @@ class MasterTiming:
 
 
 @dataclass
-class Trace:
+class SpiTrace:
     """Every pin of a stretch of consecutive chip-clock cycles, as a software µP and the chip drove them."""
 
     mode: Mode
@@ -132,7 +132,7 @@ class Trace:
     def __len__(self) -> int:
         return len(self.inputs)
 
-    def window(self, start: int, stop: int | None = None) -> Trace:
+    def window(self, start: int, stop: int | None = None) -> SpiTrace:
         """The cycles ``start`` to ``stop`` (indices into this trace) as a trace of their own."""
         return replace(self, first_cycle=self.first_cycle + start, inputs=self.inputs[start:stop],
                        outputs=self.outputs[start:stop], mosi_oe=self.mosi_oe[start:stop])
@@ -176,8 +176,8 @@ class SoftMaster:
         self.timing = timing or MasterTiming.fastest(bit_rate, clock_hz=chip.clock_hz)
         self._pins = PinsIn()
         self._mosi_oe = int(mode is Mode.MOTOROLA)
-        self._trace: Trace | None = (
-            Trace(mode, self.timing, chip.clock_hz, bit_rate, first_cycle=chip.cycle) if record else None
+        self._trace: SpiTrace | None = (
+            SpiTrace(mode, self.timing, chip.clock_hz, bit_rate, first_cycle=chip.cycle) if record else None
         )
 
     @property
@@ -237,7 +237,7 @@ class SoftMaster:
             self.run((t.high if i < 7 else t.trail) - 1)
         return received
 
-    def trace(self) -> Trace:
+    def trace(self) -> SpiTrace:
         """Everything recorded since the master was made."""
         if self._trace is None:
             raise UpifUsageError("this master was made with record=False")
@@ -279,7 +279,7 @@ def _assemble(bits: Sequence[int | None], lsb_first: bool) -> int | None:
     return value
 
 
-def decode_bytes(trace: Trace) -> list[DecodedByte]:
+def decode_bytes(trace: SpiTrace) -> list[DecodedByte]:
     """Every complete /SS low period of ``trace`` (a /SS fall and the following rise), sampled at the rising
     SCLK edges as the µP and the chip sample them (UP-5, UP-6)."""
     intel = trace.mode is Mode.INTEL
@@ -315,7 +315,7 @@ def decode_bytes(trace: Trace) -> list[DecodedByte]:
 # ------------------------------------------------------------------------------------------------------------
 
 
-def write_vcd(trace: Trace, path: Path) -> Path:
+def write_spi_vcd(path: Path, trace: SpiTrace) -> Path:
     """Write every pin of ``trace`` to ``path`` as a VCD (time step one 32 MHz clock, only changes written).
 
     Scopes: ``upif.up`` the µP's pins (:data:`~supi3.spi.slave_pins.INPUT_PINS` plus ``mosi_oe``), ``upif.chip``

@@ -41,8 +41,6 @@ __all__ = [
     "TimingViolationError",
 ]
 
-TCLK_PER_BIT: Final[int] = 16
-"""TCLK = t_Bit_IBS / 16 (Table 3-7)."""
 _EPSILON_S: Final[float] = 1e-12
 """Tolerance of the timing comparisons (the table's limits are floats)."""
 
@@ -326,10 +324,12 @@ class SlavePins:
         check_instance("registers", registers, RegisterFile)
         check_int("clock_hz", clock_hz, 1)
         bit_rate = registers.config.bit_rate
-        if clock_hz % (TCLK_PER_BIT * bit_rate):
-            raise UpifUsageError(f"clock {clock_hz} Hz is not a multiple of TCLK = {TCLK_PER_BIT} * {bit_rate} Hz")
+        if clock_hz % (tables.TCLK_PER_BIT * bit_rate):
+            raise UpifUsageError(
+                f"clock {clock_hz} Hz is not a multiple of TCLK = {tables.TCLK_PER_BIT} * {bit_rate} Hz"
+            )
         self.protocol = UpifProtocol(registers)
-        self.clocks_per_tclk = clock_hz // (TCLK_PER_BIT * bit_rate)
+        self.clocks_per_tclk = clock_hz // (tables.TCLK_PER_BIT * bit_rate)
         """Chip clocks per TCLK: 4 at 500 kbit/s, 1 at 2 Mbit/s."""
         self.output_delay = 2 * self.clocks_per_tclk - 2
         """Output pipeline stages after the decoded state (UP-14): 6 at 500 kbit/s, 0 at 2 Mbit/s."""

@@ -24,13 +24,16 @@ from supi3.config import DeviceConfig
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.model.chip import Supi3
 from supi3.model.registers import InterfaceViolationError, RegisterFile
+from supi3.pinout import C_D_COMMAND, C_D_DATA
 from supi3.regmap import (
+    BLOCK_ADDRESS,
     COMMAND_BYTE,
     INIT_BYTE,
     REGISTER_MAP,
     Access,
-    Command,
-    Direction,
+    AccessDirection,
+    CommandByte,
+    Register,
     decode_command,
     encode_command,
 )
@@ -54,13 +57,7 @@ __all__ = [
 
 _T = TypeVar("_T")
 
-C_D_COMMAND: Final[int] = 0
-"""C/D (MFP2) level while the next byte is an initialization or command byte, in both modes (UP-2)."""
-C_D_DATA: Final[int] = 1
-"""C/D level while the next byte is a data byte, and while data transmission is disabled (UP-4)."""
 
-BLOCK_ADDRESS: Final[int] = 15
-"""A3..0 of the command byte that starts a block transfer (3.4.6)."""
 _WORD_BITS: Final[int] = 16
 
 # Firmware API after misuse (docs/assumptions/upif.md UP-25 to UP-29): where the manual is silent, one constant each.
@@ -161,7 +158,7 @@ class UpifProtocol:
         self.registers = registers
         self.mode: Mode | None = None
         self.phase = Phase.INIT
-        self.command: Command | None = None
+        self.command: CommandByte | None = None
         self.last_rx = 0
         """The last complete received byte: what the chip sends back when a byte reads no register (UP-8)."""
         self._slots: tuple[_Slot, ...] = ()
@@ -291,7 +288,7 @@ class UpifProtocol:
             return slot.address if slot.read else None
         command = self.command
         if self.phase is Phase.DATA and command is not None:  # the DATA phase always has its command
-            port = REGISTER_MAP.port(command.address, Direction.READ)
+            port = REGISTER_MAP.port(command.address, AccessDirection.READ)
             if command.rd and port.access is not Access.RESERVED_IGNORED:
                 return command.address
         return None
@@ -327,7 +324,7 @@ class UpifProtocol:
         self.phase = Phase.COMMAND
         if command is None:  # cannot happen: the DATA phase always has its command
             return
-        port = REGISTER_MAP.port(command.address, Direction.WRITE)
+        port = REGISTER_MAP.port(command.address, AccessDirection.WRITE)
         if port.access is Access.RESERVED_IGNORED:
             return
         if self.mode is Mode.INTEL and command.rd != command.wr and command.rd == frame.s_r:
@@ -339,7 +336,7 @@ class UpifProtocol:
         if command.wr and self._writes(frame.s_r):
             self.registers.cpu_write(command.address, rx)
 
-    def _start_block(self, command: Command) -> None:
+    def _start_block(self, command: CommandByte) -> None:
         """Address 15: lay out the block transfer's bytes (3.4.6; UP-10, UP-11)."""
         registers = self.registers
         count = registers.data_bytes()
@@ -561,18 +558,21 @@ class UpInterface:
             raise UpifUsageError(f"{what} needs the command phase: C/D = {self.c_d}, the chip is in phase "
                                  f"{phase}{left}; finish the command with transfer() or SAS_INIT")
 
-    def read(self, address: int) -> int:
+    def read(self, address: int | Register) -> int:
         """Read one register: command byte with RD, then a data byte (3.4.4). Returns the data byte.
+
+        ``address`` is a number or a register of :mod:`supi3.regmap` (``read(IRQ_EVT)``).
 
         Raises
         ------
         UpifArgumentError
-            If ``address`` is not 0..14 (15 starts a block transfer: :meth:`block_transfer`).
+            If ``address`` is not 0..14 (15 starts a block transfer: :meth:`block_transfer`), or a register that
+            is not read there.
         NotInitializedError, InterfaceDisabledError, UpifUsageError
             If the interface cannot start a command now (nothing is sent).
         """
         if type(address) is not int or not 0 <= address < BLOCK_ADDRESS:
-            address = _register_address(address)
+            address = _register_address(address, AccessDirection.READ)
         protocol = self.protocol
         if protocol.phase is not Phase.COMMAND or protocol._frame is not None:
             self._start("read")
@@ -584,8 +584,9 @@ class UpInterface:
             raise UpifUsageError(f"read({address}): the chip drove no data byte")
         return value
 
-    def write(self, address: int, value: int) -> None:
-        """Write one register: command byte with WR, then the data byte (3.4.4).
+    def write(self, address: int | Register, value: int) -> None:
+        """Write one register: command byte with WR, then the data byte (3.4.4). ``address`` is a number or a
+        register of :mod:`supi3.regmap` (``write(SET, 0x82)``).
 
         Before :meth:`initialize` the chip takes the command byte as a faulty initialization byte and disables the
         interface (3.4.3): the bytes go out as on the real chip and :class:`UninitializedAccessError` is reported
@@ -594,12 +595,12 @@ class UpInterface:
         Raises
         ------
         UpifArgumentError
-            If ``address`` is not 0..14 or ``value`` not a byte.
+            If ``address`` is not 0..14 or a register that is not written there, or ``value`` not a byte.
         InterfaceDisabledError, UpifUsageError
             If the interface cannot start a command now (nothing is sent).
         """
         if type(address) is not int or not 0 <= address < BLOCK_ADDRESS:
-            address = _register_address(address)
+            address = _register_address(address, AccessDirection.WRITE)
         if type(value) is not int or not 0 <= value <= 0xFF:
             value = _checked(check_bits, "value", value, 8, "a data byte, 3.4.4")
         protocol = self.protocol
@@ -621,7 +622,7 @@ class UpInterface:
             self._byte(value, True)
             violations.report(UninitializedAccessError("3.4.3", UNINITIALIZED_WRITE.format(command=command)))
 
-    def exchange(self, address: int, value: int) -> int:
+    def exchange(self, address: int | Register, value: int) -> int:
         """Motorola only: read and write ``address`` in one data byte (RD and WR set, 3.4.4).
 
         Raises
@@ -754,8 +755,16 @@ def _checked(check: Callable[..., _T], *args: object, **kwargs: object) -> _T:
         raise UpifArgumentError(error.name, error.value, str(error)) from None
 
 
-def _register_address(address: object) -> int:
-    """``address`` checked as the address of one register access: 0..14 (15 starts a block transfer)."""
+def _register_address(address: object, direction: AccessDirection | None = None) -> int:
+    """``address`` checked as the address of one register access: 0..14 (15 starts a block transfer), or a
+    :class:`~supi3.regmap.Register` that ``direction`` (``None``: either) reaches at its address."""
+    if isinstance(address, Register):
+        directions = tuple(AccessDirection) if direction is None else (direction,)
+        if all(REGISTER_MAP.port(address.address, d).register is not address for d in directions):
+            verb = "reached" if direction is None else "written" if direction is AccessDirection.WRITE else "read"
+            raise UpifArgumentError("address", address, f"address: {address.name} is not {verb} at address "
+                                    f"{address.address} (Table 3-10)")
+        return address.address
     return _checked(check_int, "address", address, 0, BLOCK_ADDRESS - 1,
                     "A3..0, 3.4.4; 15 starts a block transfer: use block_transfer(), 3.4.6")
 
@@ -766,9 +775,9 @@ def _refused(name: str, value: object, hint: str, config: DeviceConfig | None = 
     return UpifArgumentError(name, value, f"{name} must be {wanted}, not {shown}{': ' + hint if hint else ''}")
 
 
-def _port_name(command: Command | None) -> str:
+def _port_name(command: CommandByte | None) -> str:
     """The register a command's write goes to, or ``""``."""
     if command is None:
         return ""
-    register = REGISTER_MAP.port(command.address, Direction.WRITE).register
+    register = REGISTER_MAP.port(command.address, AccessDirection.WRITE).register
     return "" if register is None else register.name

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 from supi3.pinlevel import EventLog, Pin, PinModel, PinSpecError, recent_events
 from supi3.verif.errors import LockstepError, LockstepMismatchError, SimulationError, SimulatorUnavailableError
-from supi3.verif.layout import Layout, Stimulus, first_mismatch, model_trace, stimulus_array
+from supi3.verif.layout import Stimulus, WordLayout, first_mismatch, model_trace, stimulus_array
 from supi3.verif.report import LockstepResult
 
 if TYPE_CHECKING:
@@ -30,7 +30,6 @@ def __getattr__(name: str) -> object:
 
 __all__ = [
     "EventLog",
-    "Layout",
     "Lockstep",
     "LockstepError",
     "LockstepMismatchError",
@@ -41,6 +40,7 @@ __all__ = [
     "SimulationError",
     "SimulatorUnavailableError",
     "Stimulus",
+    "WordLayout",
     "first_mismatch",
     "model_trace",
     "react",

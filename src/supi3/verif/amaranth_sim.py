@@ -15,7 +15,7 @@ import numpy as np
 from amaranth.sim import Simulator
 
 from supi3.pinlevel import ModelFactory, recent_events
-from supi3.verif.layout import WORD, Layout, Stimulus, model_trace, stimulus_array
+from supi3.verif.layout import WORD, Stimulus, WordLayout, model_trace, stimulus_array
 from supi3.verif.report import LockstepResult, raise_mismatch
 from supi3.verif.rtl import DesignFactory, LockstepTop
 
@@ -46,7 +46,7 @@ def run_amaranth_sim(
         On the first differing output.
     """
     model = model_factory()
-    layout = Layout.of(model)
+    layout = WordLayout.of(model)
     array = stimulus_array(stimulus, layout.inputs, max_cycles)
     top = LockstepTop(design_factory(), layout)
     names = layout.input_names

@@ -1,8 +1,8 @@
 """The per-cycle lockstep loop as a cocotb coroutine, for the harness's own testbench and for other cocotb tests.
 
 Runs inside the simulator process. The DUT is the packed top-level with its comparator
-(:class:`~supi3.verif.rtl.LockstepTop` built with a ``window``): ports ``clk``, ``rst``, input words ``lsi<n>``,
-expected output words ``lse<n>``, and the comparator's ``lsx``, ``lsc`` and ``lsw``.
+(:class:`~supi3.verif.rtl.LockstepTop` built with a ``window``): ports ``clk``, ``rst``, input words ``stim_word<n>``,
+expected output words ``expected_word<n>``, and the comparator's ``mismatch``, ``cycle_count`` and ``history``.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, Timer
 
 from supi3.pinlevel import PinModel, PinSpecError, recent_events
-from supi3.verif.layout import Layout, Trace, model_columns, model_trace
+from supi3.verif.layout import CycleMatrix, WordLayout, model_columns, model_trace
 from supi3.verif.report import MismatchRecord, Outcome
 from supi3.verif.vcd import CYCLE_NS
 
@@ -25,7 +25,9 @@ POLL_CYCLES = 1024
 """Cycles between two reads of the comparator's mismatch flag: how far the simulation may run past a mismatch."""
 
 
-async def lockstep(dut: Any, model: PinModel, stimulus: Trace, *, reset_cycles: int = 1, window: int = 64) -> Outcome:
+async def lockstep(
+    dut: Any, model: PinModel, stimulus: CycleMatrix, *, reset_cycles: int = 1, window: int = 64
+) -> Outcome:
     """Clock the DUT and the model together; the top's comparator checks every output signal on every cycle.
 
     Timing per cycle ``n`` (see :mod:`supi3.pinlevel`): at the falling clock edge the inputs of cycle ``n`` and
@@ -53,10 +55,10 @@ async def lockstep(dut: Any, model: PinModel, stimulus: Trace, *, reset_cycles: 
     Outcome
         Cycles compared, time taken, and the first mismatch if there was one (the loop stops soon after it).
     """
-    layout = Layout.of(model)
-    in_ports = [getattr(dut, f"lsi{index}") for index in range(layout.in_words)]
-    expected_ports = [getattr(dut, f"lse{index}") for index in range(layout.out_words)]
-    flag = dut.lsx
+    layout = WordLayout.of(model)
+    in_ports = [getattr(dut, f"stim_word{index}") for index in range(layout.in_words)]
+    expected_ports = [getattr(dut, f"expected_word{index}") for index in range(layout.out_words)]
+    flag = dut.mismatch
     falling = FallingEdge(dut.clk)
     # After the first falling edge, a timer of one period lands on each next one: the same instants, and cocotb
     # resumes a timer faster than an edge trigger (by 2-15 %, measured).
@@ -109,10 +111,10 @@ async def lockstep(dut: Any, model: PinModel, stimulus: Trace, *, reset_cycles: 
     seconds = time.perf_counter() - start
     if not flag.value:
         return Outcome(cycles, seconds)
-    mismatch = dut.lsc.value.to_unsigned() - 1
+    mismatch = dut.cycle_count.value.to_unsigned() - 1
     expected_trace = model_trace(model, stimulus[: mismatch + 1], layout)  # a replay: the events end there too
     first = max(0, mismatch + 1 - window)
-    actual = [dut.lsw[cycle % window].value.to_unsigned() for cycle in range(first, mismatch + 1)]
+    actual = [dut.history[cycle % window].value.to_unsigned() for cycle in range(first, mismatch + 1)]
     signal = layout.first_difference(expected_trace[-1].tolist(), layout.unpack_outputs(actual[-1]))
     assert signal is not None, "the comparator and first_difference() agree"
     return Outcome(mismatch + 1, seconds, MismatchRecord(mismatch, signal, recent_events(model), actual))

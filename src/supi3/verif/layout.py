@@ -19,10 +19,17 @@ import numpy.typing as npt
 from supi3.pinlevel import Pin, PinModel, PinSpecError, compared_signals
 
 __all__ = [
-    "Field", "Layout", "Stimulus", "Trace", "first_mismatch", "model_columns", "model_trace", "stimulus_array",
+    "CycleMatrix",
+    "Stimulus",
+    "WordField",
+    "WordLayout",
+    "first_mismatch",
+    "model_columns",
+    "model_trace",
+    "stimulus_array",
 ]  # fmt: skip
 
-Trace: TypeAlias = npt.NDArray[np.uint64]
+CycleMatrix: TypeAlias = npt.NDArray[np.uint64]
 """Values per cycle and signal: shape ``(cycles, signals)``."""
 
 Stimulus: TypeAlias = npt.NDArray[np.integer] | Iterable[Mapping[str, int]]
@@ -35,7 +42,7 @@ _WORD_MASK = (1 << WORD) - 1
 
 
 @dataclass(frozen=True)
-class Field:
+class WordField:
     """Where one signal sits in the packed words.
 
     Attributes
@@ -69,13 +76,13 @@ class Field:
         return (1 << self.width) - 1
 
 
-def _place(signals: Sequence[tuple[str, int, str | None]]) -> tuple[tuple[Field, ...], int]:
-    fields: list[Field] = []
+def _place(signals: Sequence[tuple[str, int, str | None]]) -> tuple[tuple[WordField, ...], int]:
+    fields: list[WordField] = []
     word, shift = 0, 0
     for name, width, enable in signals:
         if shift and (width > WORD or shift + width > WORD):
             word, shift = word + 1, 0
-        fields.append(Field(name, width, word, shift, enable))
+        fields.append(WordField(name, width, word, shift, enable))
         if width > WORD:
             word, shift = word + 2, 0
         else:
@@ -83,7 +90,7 @@ def _place(signals: Sequence[tuple[str, int, str | None]]) -> tuple[tuple[Field,
     return tuple(fields), word + (1 if shift else 0)
 
 
-def _comparator(fields: Sequence[Field], index_of: Mapping[str, int]) -> Callable[[Sequence[int], int], bool]:
+def _comparator(fields: Sequence[WordField], index_of: Mapping[str, int]) -> Callable[[Sequence[int], int], bool]:
     # The per-cycle path's hot loop: one expression over the layout's constants instead of a loop over fields,
     # about three times faster in CPython. Only integers from the layout enter the generated source.
     terms = []
@@ -97,7 +104,7 @@ def _comparator(fields: Sequence[Field], index_of: Mapping[str, int]) -> Callabl
     return namespace["matches"]
 
 
-class Layout:
+class WordLayout:
     """The packing of a model's pins into words.
 
     Parameters
@@ -124,7 +131,7 @@ class Layout:
         self._get_outputs = itemgetter(*[field.name for field in self.out_fields])
 
     @classmethod
-    def of(cls, model: PinModel) -> Layout:
+    def of(cls, model: PinModel) -> WordLayout:
         """The layout of ``model``'s pins."""
         return cls(model.inputs, model.outputs)
 
@@ -164,7 +171,7 @@ class Layout:
                 return index
         return None
 
-    def input_words(self, stimulus: Trace) -> npt.NDArray[np.uint32]:
+    def input_words(self, stimulus: CycleMatrix) -> npt.NDArray[np.uint32]:
         """Stimulus ``(cycles, inputs)`` packed into ``uint32`` input words ``(cycles, words)``."""
         # One integer matrix product places every field of up to 32 bits (the fields of a word are disjoint and
         # the stimulus is range-checked, so the sums are exact); a wider field fills its two words alone.
@@ -179,7 +186,7 @@ class Layout:
                 packed[:, field.word + 1] = stimulus[:, index] >> np.uint64(WORD)
         return packed
 
-    def output_words(self, trace: Trace) -> npt.NDArray[np.uint32]:
+    def output_words(self, trace: CycleMatrix) -> npt.NDArray[np.uint32]:
         """Compared output values ``(cycles, signals)`` packed into ``uint32`` output words ``(cycles, words)``,
         the inverse of :meth:`output_trace`."""
         return self.pack_columns(list(np.ascontiguousarray(trace.T)))
@@ -229,7 +236,7 @@ class Layout:
             packed |= value << field.offset
         return [(packed >> (WORD * index)) & _WORD_MASK for index in range(self.out_words)]
 
-    def output_trace(self, words: npt.NDArray[np.uint32]) -> Trace:
+    def output_trace(self, words: npt.NDArray[np.uint32]) -> CycleMatrix:
         """Output words ``(cycles, words)`` unpacked into compared signals ``(cycles, signals)``."""
         columns = np.empty((words.shape[0], len(self.out_fields)), dtype=np.uint64)
         for index, field in enumerate(self.out_fields):
@@ -242,7 +249,7 @@ class Layout:
         return columns
 
 
-def _pack(fields: Sequence[Field], words: int, columns: Sequence[npt.NDArray[np.uint64]]) -> npt.NDArray[np.uint32]:
+def _pack(fields: Sequence[WordField], words: int, columns: Sequence[npt.NDArray[np.uint64]]) -> npt.NDArray[np.uint32]:
     """Columns of values (one per field) packed into ``uint32`` words ``(cycles, words)``."""
     cycles = len(columns[0]) if len(columns) else 0
     packed = np.zeros((words, cycles), dtype=np.uint32)  # one contiguous row per word while packing
@@ -253,7 +260,7 @@ def _pack(fields: Sequence[Field], words: int, columns: Sequence[npt.NDArray[np.
     return packed.T
 
 
-def stimulus_array(stimulus: Stimulus, inputs: Sequence[Pin], max_cycles: int | None = None) -> Trace:
+def stimulus_array(stimulus: Stimulus, inputs: Sequence[Pin], max_cycles: int | None = None) -> CycleMatrix:
     """Normalise stimulus to a ``uint64`` array ``(cycles, inputs)``, checking names and value ranges.
 
     Parameters
@@ -295,7 +302,7 @@ def stimulus_array(stimulus: Stimulus, inputs: Sequence[Pin], max_cycles: int | 
     return result
 
 
-def model_columns(model: PinModel, stimulus: Trace, layout: Layout) -> list[npt.NDArray[np.uint64]]:
+def model_columns(model: PinModel, stimulus: CycleMatrix, layout: WordLayout) -> list[npt.NDArray[np.uint64]]:
     """Reset ``model`` and run it over ``stimulus``; one array per compared output signal, in comparison order.
 
     A model that also offers ``run(inputs: Mapping[str, array]) -> Mapping[str, array]`` (whole traces at once,
@@ -330,18 +337,18 @@ def _unsigned(column: npt.NDArray[np.generic]) -> npt.NDArray[np.uint64]:
     return column.view(np.uint64) if column.dtype == np.int64 else column.astype(np.uint64)
 
 
-def model_trace(model: PinModel, stimulus: Trace, layout: Layout) -> Trace:
+def model_trace(model: PinModel, stimulus: CycleMatrix, layout: WordLayout) -> CycleMatrix:
     """Reset ``model`` and run it over ``stimulus``; the compared outputs per cycle ``(cycles, signals)``
     (see :func:`model_columns`)."""
     columns = model_columns(model, stimulus, layout)
     return np.stack(columns, axis=1) if columns else np.zeros((stimulus.shape[0], 0), dtype=np.uint64)
 
 
-def first_mismatch(layout: Layout, expected: Trace, actual: Trace) -> tuple[int, int] | None:
+def first_mismatch(layout: WordLayout, expected: CycleMatrix, actual: CycleMatrix) -> tuple[int, int] | None:
     """The first ``(cycle, signal index)`` where two output traces (values within their signals' widths) differ,
     gated by output enables, or ``None``.
 
     Within the first differing cycle the lowest signal index (comparison order) is reported. The traces are compared
-    as packed words, like the batch path (:meth:`Layout.first_word_mismatch`).
+    as packed words, like the batch path (:meth:`WordLayout.first_word_mismatch`).
     """
     return layout.first_word_mismatch(layout.output_words(expected), layout.output_words(actual))

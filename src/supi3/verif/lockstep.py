@@ -32,7 +32,7 @@ import numpy as np
 
 from supi3.pinlevel import ModelFactory, PinSpecError, recent_events
 from supi3.verif.errors import SimulationError
-from supi3.verif.layout import Layout, Stimulus, Trace, model_columns, model_trace, stimulus_array
+from supi3.verif.layout import CycleMatrix, Stimulus, WordLayout, model_columns, model_trace, stimulus_array
 from supi3.verif.report import LockstepResult, Outcome, raise_mismatch, window_trace
 from supi3.verif.rtl import TOP, DesignFactory, build_slot, ensure_toolchain, to_verilog
 
@@ -126,7 +126,7 @@ class Job:
     """What :meth:`Lockstep.run` hands the cocotb testbench (pickled, path in :data:`JOB_ENV`)."""
 
     model_factory: ModelFactory
-    stimulus: Trace
+    stimulus: CycleMatrix
     reset_cycles: int
     window: int
     result: Path
@@ -182,7 +182,7 @@ class Lockstep:
         self.vcd_on_mismatch = vcd_on_mismatch
         self.reset_cycles = reset_cycles
         self.window = window
-        self.layout = Layout.of(model_factory())
+        self.layout = WordLayout.of(model_factory())
         self.verilog = to_verilog(design_factory, self.layout)
         """The Verilog of the packed top-level (:class:`~supi3.verif.rtl.LockstepTop`) that the batch path runs."""
 
@@ -210,7 +210,7 @@ class Lockstep:
             if executable is not None:
                 executable.result()
 
-    def stimulus(self, stimulus: Stimulus, max_cycles: int | None = None) -> Trace:
+    def stimulus(self, stimulus: Stimulus, max_cycles: int | None = None) -> CycleMatrix:
         """``stimulus`` normalised against the model's inputs (see :func:`~supi3.verif.layout.stimulus_array`)."""
         return stimulus_array(stimulus, self.layout.inputs, max_cycles)
 
@@ -337,8 +337,8 @@ class Lockstep:
             top=TOP,
             in_stride=max(self.layout.in_words, 1),
             out_words=self.layout.out_words,
-            drive=_cxx_words("lsi", self.layout.in_words, "i", drive=True),
-            sample=_cxx_words("lso", self.layout.out_words, "o", drive=False),
+            drive=_cxx_words("stim_word", self.layout.in_words, "i", drive=True),
+            sample=_cxx_words("rtl_out_word", self.layout.out_words, "o", drive=False),
         )
 
     def batch_executable(self) -> Path:
@@ -413,12 +413,12 @@ class Lockstep:
         shutil.rmtree(run_dir, ignore_errors=True)
         return LockstepResult(array.shape[0], seconds, "batch", "verilator")
 
-    def _events_at(self, stimulus: Trace, cycle: int) -> list[str]:
+    def _events_at(self, stimulus: CycleMatrix, cycle: int) -> list[str]:
         model = self.model_factory()
         model_trace(model, stimulus[: cycle + 1], self.layout)
         return recent_events(model)
 
-    def _expected(self, stimulus: Trace, first: int, cycle: int) -> Trace:
+    def _expected(self, stimulus: CycleMatrix, first: int, cycle: int) -> CycleMatrix:
         # The model is deterministic: replaying the stimulus gives the outputs it had in the simulator process.
         return model_trace(self.model_factory(), stimulus[: cycle + 1], self.layout)[first:]
 
@@ -427,7 +427,7 @@ def react(
     model_factory: ModelFactory,
     agent: Callable[[int, Mapping[str, int] | None], Mapping[str, int]],
     cycles: int,
-) -> Trace:
+) -> CycleMatrix:
     """Stimulus from a testbench that reacts to the chip's outputs, run against the model.
 
     ``agent(cycle, outputs)`` returns the inputs of ``cycle`` (a dict; missing pins keep their value) given the
@@ -435,7 +435,7 @@ def react(
     mismatch, since until then the RTL's outputs equal the model's.
     """
     model = model_factory()
-    layout = Layout.of(model)
+    layout = WordLayout.of(model)
     names = {pin.name: index for index, pin in enumerate(layout.inputs)}
     current = [0] * len(layout.inputs)
     rows: list[list[int]] = []

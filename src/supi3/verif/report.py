@@ -9,7 +9,7 @@ import numpy as np
 
 from supi3.pinlevel import PinSpecError
 from supi3.verif.errors import LockstepMismatchError
-from supi3.verif.layout import Layout, Trace
+from supi3.verif.layout import CycleMatrix, WordLayout
 from supi3.verif.vcd import write_window
 
 __all__ = ["LockstepResult", "MismatchRecord", "Outcome", "raise_mismatch", "window_trace"]
@@ -51,11 +51,11 @@ class MismatchRecord:
     cycle:
         Cycle of the mismatch.
     signal:
-        Index of the first differing signal in :attr:`Layout.out_fields`.
+        Index of the first differing signal in :attr:`WordLayout.out_fields`.
     events:
         The model's recent bus events at that cycle.
     actual:
-        The RTL's packed outputs (see :meth:`Layout.unpack_outputs`) of the window's cycles, ending at ``cycle``.
+        The RTL's packed outputs (see :meth:`WordLayout.unpack_outputs`) of the window's cycles, ending at ``cycle``.
     """
 
     cycle: int
@@ -76,13 +76,13 @@ class Outcome:
 
 
 def raise_mismatch(
-    layout: Layout,
-    stimulus: Trace,
+    layout: WordLayout,
+    stimulus: CycleMatrix,
     cycle: int,
     signal: int,
     events: list[str],
-    expected: Trace,
-    actual: Trace,
+    expected: CycleMatrix,
+    actual: CycleMatrix,
     vcd_dir: Path | None,
     path: str,
 ) -> LockstepMismatchError:
@@ -113,6 +113,6 @@ def raise_mismatch(
     )
 
 
-def window_trace(layout: Layout, rows: list[tuple[int, ...]]) -> Trace:
+def window_trace(layout: WordLayout, rows: list[tuple[int, ...]]) -> CycleMatrix:
     """Per-cycle output values of a window as a trace ``(window, signals)``."""
     return np.array(rows, dtype=np.uint64).reshape(len(rows), len(layout.out_fields))

@@ -5,13 +5,13 @@ the pin's width for an input; any value of the pin's width for an output; ``<pin
 output's enable) and uses the ``sync`` clock domain, which the harness clocks and resets.
 
 :class:`LockstepTop` wraps it so the simulator sees only ``clk``, ``rst``, one 32-bit port per input word
-(``lsi0``, ``lsi1``, ...) and one per output word (``lso0``, ``lso1``, ...), packed as
-:class:`~supi3.verif.layout.Layout` says. With a ``window``, the top also compares the outputs itself on every rising
-clock edge, for the per-cycle path: the testbench writes the model's expected output words to ``lse0``, ``lse1``,
-... (only when they change); the first cycle whose outputs differ (tri-state values only while the expected enable
-is 1) sets the sticky flag ``lsx``, stops the cycle counter ``lsc`` (then the mismatching cycle plus one) and freezes
-the memory ``lsw`` that holds the outputs of the last ``window`` cycles (cycle ``n`` at address ``n % window``), so
-the mismatch report has the RTL's own values.
+(``stim_word0``, ``stim_word1``, ...) and one per output word of the RTL (``rtl_out_word0``, ``rtl_out_word1``, ...),
+packed as :class:`~supi3.verif.layout.WordLayout` says. With a ``window``, the top also compares the outputs itself on
+every rising clock edge, for the per-cycle path: the testbench writes the model's expected output words to
+``expected_word0``, ``expected_word1``, ... (only when they change); the first cycle whose outputs differ (tri-state
+values only while the expected enable is 1) sets the sticky flag ``mismatch``, stops the cycle counter
+``cycle_count`` (then the mismatching cycle plus one) and freezes the memory ``history`` that holds the outputs of
+the last ``window`` cycles (cycle ``n`` at address ``n % window``), so the mismatch report has the RTL's own values.
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ from amaranth.lib.memory import Memory
 
 from supi3.pinlevel import PinSpecError
 from supi3.verif.errors import SimulatorUnavailableError
-from supi3.verif.layout import WORD, Layout
+from supi3.verif.layout import WORD, WordLayout
 
 __all__ = ["TOP", "DesignFactory", "LockstepTop", "build_slot", "ensure_toolchain", "to_verilog"]
 
@@ -56,16 +56,16 @@ class LockstepTop(Elaboratable):
         Cycles of output history kept for a mismatch report; ``None`` for no comparator.
     """
 
-    def __init__(self, design: Elaboratable, layout: Layout, window: int | None = None) -> None:
+    def __init__(self, design: Elaboratable, layout: WordLayout, window: int | None = None) -> None:
         self.design = design
         self.layout = layout
         self.window = window
         self.domain = ClockDomain("sync")
-        self.in_words = [Signal(WORD, name=f"lsi{index}") for index in range(layout.in_words)]
-        self.out_words = [Signal(WORD, name=f"lso{index}") for index in range(layout.out_words)]
-        self.expected_words = [Signal(WORD, name=f"lse{index}") for index in range(layout.out_words)]
-        self.mismatch = Signal(name="lsx")
-        self.count = Signal(WORD, name="lsc")
+        self.in_words = [Signal(WORD, name=f"stim_word{index}") for index in range(layout.in_words)]
+        self.out_words = [Signal(WORD, name=f"rtl_out_word{index}") for index in range(layout.out_words)]
+        self.expected_words = [Signal(WORD, name=f"expected_word{index}") for index in range(layout.out_words)]
+        self.mismatch = Signal(name="mismatch")
+        self.cycle_count = Signal(WORD, name="cycle_count")
         self.inputs = {field.name: self._port(field.name, field.width, assignable=True) for field in layout.in_fields}
         self.outputs = {field.name: self._port(field.name, field.width) for field in layout.out_fields}
 
@@ -92,7 +92,7 @@ class LockstepTop(Elaboratable):
         """The top-level ports: clock, reset, input words, output words and, with a window, the comparator's."""
         ports = [self.domain.clk, self.domain.rst, *self.in_words, *self.out_words]
         if self.window is not None:
-            ports += [*self.expected_words, self.mismatch, self.count]
+            ports += [*self.expected_words, self.mismatch, self.cycle_count]
         return ports
 
     def elaborate(self, _platform: object) -> Module:
@@ -116,20 +116,20 @@ class LockstepTop(Elaboratable):
                 differs.append(term)
             # The history: a memory written at one address per cycle (cycle n at n % window), so a simulator that
             # evaluates every changed signal (Icarus) moves one word per cycle, not the whole window.
-            m.submodules.lsw = history = Memory(shape=len(out_bits), depth=self.window, init=[])
+            m.submodules.history = history = Memory(shape=len(out_bits), depth=self.window, init=[])
             slot = Signal(range(max(self.window, 2)))
             write = history.write_port()
             m.d.comb += [write.addr.eq(slot), write.data.eq(out_bits), write.en.eq(~self.mismatch)]
             with m.If(~self.mismatch):
                 m.d.sync += [
                     self.mismatch.eq(Cat(*differs).any()),
-                    self.count.eq(self.count + 1),
+                    self.cycle_count.eq(self.cycle_count + 1),
                     slot.eq(Mux(slot == self.window - 1, 0, slot + 1)),
                 ]
         return m
 
 
-def to_verilog(design_factory: Callable[[], Elaboratable], layout: Layout, window: int | None = None) -> str:
+def to_verilog(design_factory: Callable[[], Elaboratable], layout: WordLayout, window: int | None = None) -> str:
     """The Verilog of a fresh design from ``design_factory`` inside :class:`LockstepTop` (module :data:`TOP`), with
     the comparator if ``window`` is given."""
     top = LockstepTop(design_factory(), layout, window)

@@ -5,7 +5,7 @@ every operating mode. :class:`StrapPins` gives the model the same ports: it deco
 clock (:func:`supi3.config.decode`) and from then on is the model of that configuration. Stimulus drives the straps
 as constants (:func:`strap_inputs`), with MFP[15..12] at the configuration expansion where the mode has one.
 :class:`ChipStrapPins` does the same for the whole chip (:class:`supi3.top.Supi3Chip`, the model of
-:class:`supi3.rtl.chip.Supi3Chip`).
+:class:`supi3.rtl.chip.Supi3ChipRtl`).
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from vcd import VCDWriter
 
-from supi3.verif.layout import Layout, Trace
+from supi3.verif.layout import CycleMatrix, WordLayout
 
 __all__ = ["CYCLE_NS", "write_window"]
 
@@ -15,7 +15,8 @@ CYCLE_NS = 10
 
 
 def write_window(
-    path: Path, layout: Layout, first_cycle: int, inputs: Trace, expected: Trace, actual: Trace, mismatch_cycle: int
+    path: Path, layout: WordLayout, first_cycle: int, inputs: CycleMatrix, expected: CycleMatrix, actual: CycleMatrix,
+    mismatch_cycle: int
 ) -> Path:
     """Write a VCD of a window of cycles.
 

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
-from supi3.model.blocks.transmitter import Trace, Transmitter
+from supi3.model.blocks.transmitter import PinTrace, Transmitter
 from supi3.pinout import IB_DIAG_DIVIDER_BITS
 
 if TYPE_CHECKING:
@@ -91,7 +91,7 @@ class Outputs:
         return (chip.mfp_outputs, int(chip.bus_active) if self.complete_diagnostics else 0, int(chip.pf),
                 int(chip.bus_active), chip.mod_ack_until, chip.resreg_until, run_from)  # fmt: skip
 
-    def render(self, c0: int, n: int, snaps: list[tuple[int, Snapshot]], do2: Trace) -> dict[str, Trace]:
+    def render(self, c0: int, n: int, snaps: list[tuple[int, Snapshot]], do2: PinTrace) -> dict[str, PinTrace]:
         """Every output pin but ``di1`` over cycles ``c0`` to ``c0 + n - 1``, as :meth:`values` gives them: each
         ``(t, snapshot)`` of ``snaps`` holds from run cycle ``t`` until the next; ``do2`` is the transmitter's."""
         cycles = np.arange(c0, c0 + n, dtype=np.int64)

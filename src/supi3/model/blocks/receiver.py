@@ -232,7 +232,7 @@ class Receiver:
         low = self.low_since
         if low is not None and c < low + self.reset_run - 1 < due:
             due = low + self.reset_run - 1
-        chip_due = self.chip._due
+        chip_due = self.chip.due
         if chip_due < due:
             due = chip_due if chip_due > c else c + 1
         return due

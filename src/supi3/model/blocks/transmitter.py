@@ -20,7 +20,7 @@ import numpy.typing as npt
 
 from supi3.interbus import wire
 
-Trace = npt.NDArray[np.int64]
+PinTrace = npt.NDArray[np.int64]
 
 NEVER: Final = 1 << 62
 """A cycle that never comes (no event due)."""
@@ -93,7 +93,7 @@ class Transmitter:
                 return bit if c < start + cpb else wire.IDLE_LEVEL
         return wire.IDLE_LEVEL
 
-    def render(self, c0: int, n: int) -> Trace:
+    def render(self, c0: int, n: int) -> PinTrace:
         """DO2 over cycles ``c0`` to ``c0 + n - 1``, from :attr:`bits` (as :meth:`level` reads it)."""
         tx = self.bits
         if not tx:
@@ -117,7 +117,7 @@ class Transmitter:
         seen: npt.NDArray[np.int64],
         di2: npt.NDArray[np.int64],
         do2: npt.NDArray[np.int64],
-    ) -> Trace:
+    ) -> PinTrace:
         """DI1 over a run of ``len(do2)`` cycles, and :attr:`next_present` after it.
 
         ``start`` is (the run's first cycle, :attr:`next_present` then, the first cycle the logic ran from then);
