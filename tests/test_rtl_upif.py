@@ -19,6 +19,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from supi3.pinout import OPTICAL_REGISTERS
 from supi3.regmap import (
     ALARM,
     BLOCK_ADDRESS,
@@ -37,7 +38,7 @@ from supi3.regmap import (
     encode_command,
 )
 from supi3.rtl.upif import UpifBlock, verilog
-from supi3.spi.block_pins import OPTICAL_REGISTERS, UpifBlockPins
+from supi3.spi.block_pins import UpifBlockPins
 from supi3.spi.upif import C_D_COMMAND, Mode
 from supi3.tables import BIT_RATES
 from supi3.verif import Lockstep, WordLayout, model_trace

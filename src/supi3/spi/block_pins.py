@@ -35,18 +35,16 @@ from supi3.config import MfpKind, Variant, decode, mode_rows
 from supi3.errors import ArgumentError
 from supi3.model.registers import RegisterFile
 from supi3.pinlevel import OE_SUFFIX, Pin, PinSpecError
-from supi3.regmap import INTERRUPT_SOURCES, REGISTER_MAP, Access, AccessDirection
+from supi3.pinout import LENGTH_CODE_BITS, OPTICAL_REGISTERS
+from supi3.regmap import INTERRUPT_SOURCES, REGISTER_MAP
 from supi3.regmap.core import BYTE_BITS, BYTE_MASK
 from supi3.regmap.registers import IN_BYTES
 from supi3.spi.slave_pins import INPUT_PINS, OUTPUT_PINS, PinsIn, SlavePins
-from supi3.tables import BIT_RATES, LENGTH_CODES
+from supi3.tables import BIT_RATES
 
 __all__ = [
     "CORE_INPUTS",
     "CORE_OUTPUTS",
-    "DATA_BYTES",
-    "EVENT_BITS",
-    "OPTICAL_REGISTERS",
     "SERIAL_INPUTS",
     "SERIAL_OUTPUTS",
     "STRAP_INPUTS",
@@ -54,21 +52,6 @@ __all__ = [
     "block_model",
     "strap_values",
 ]
-
-DATA_BYTES: Final[int] = len(IN_BYTES)
-"""IN0..IN3 and OUT0..OUT3: the internal data registers (3.4.8)."""
-EVENT_BITS: Final[int] = max(source.bit for source in INTERRUPT_SOURCES) + 1
-"""Width of the ``events`` port: one bit per interrupt source, at its IRQ_EVT position (Table 3-13)."""
-OPTICAL_REGISTERS: Final[tuple[str, ...]] = tuple(
-    port.register.name
-    for address in REGISTER_MAP.addresses
-    for port in (REGISTER_MAP.port(address, AccessDirection.READ),)
-    if port.register is not None
-    and REGISTER_MAP.port(address, AccessDirection.WRITE).access is Access.NO_EFFECT
-)
-"""The read-only registers set by the optical block (reads 8 to 11, 3.4.12, 3.4.13), in address order."""
-LENGTH_CODE_BITS: Final[int] = len(LENGTH_CODES[0].code)
-"""ID12..ID8 (Table 3-11)."""
 
 _PAD_INPUTS: Final[dict[str, str]] = {"mfp6": "mfp6_in", "mfp7": "mfp7_in"}
 """MFP6 and MFP7 are inputs and outputs of the same name in :class:`SlavePins`; the block's input ports are renamed."""
