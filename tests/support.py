@@ -354,3 +354,12 @@ class Firmware:
 def bring_up(pins: ChipPins, command: int = 0) -> None:
     """Queue idle, an INTERBUS reset, idle, an ID cycle with ``command``, idle."""
     pins.send(np.concatenate([IDLE, wire.reset_levels(1), IDLE, id_frame(command), IDLE]))
+
+
+def fields(obj: object) -> dict[str, object]:
+    """An object's attributes by name, from its ``__slots__`` (of every class) and its ``__dict__``: ``vars()`` for
+    classes that declare their state in slots, as :class:`supi3.model.chip.Supi3` does."""
+    names = [name for cls in type(obj).__mro__ for name in getattr(cls, "__slots__", ())]
+    found = {name: getattr(obj, name) for name in names if hasattr(obj, name)}
+    found.update(getattr(obj, "__dict__", {}))
+    return found

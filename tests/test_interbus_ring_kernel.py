@@ -26,6 +26,7 @@ from supi3.interbus.master import Master
 from supi3.interbus.ring import BitFlip, CorruptLoopback, DeadLine, Ring, Truncate
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3, clocks
+from support import fields
 
 BINARY = [decode(r.c, r.mfp) for r in tables.MODE_ROWS if decode(r.c, r.mfp).mfp_mode.kind is MfpKind.BINARY_IO]
 MICRO = [decode(r.c, r.mfp) for r in tables.MODE_ROWS if decode(r.c, r.mfp).mfp_mode.kind is MfpKind.INIT_UP]
@@ -40,6 +41,7 @@ class NoKernelDevice(PlainDevice):
 class ReferenceChip(Supi3):
     """A SUPI 3 chip without the kernel: every load and latch goes the full way."""
 
+    __slots__ = ()  # Supi3's layout, so that a copy of a chip can become one (_reference)
     data_kernel = None  # type: ignore[assignment]
 
     def load(self, cycle: Cycle, now: float) -> bytes:
@@ -82,7 +84,7 @@ def _state(device: Any) -> dict[str, object]:
     move it, as before the kernel: it is read only in the µP modes, which never take the shortcut, and by the next
     full bus call after setting it)."""
     hidden = ("registers", "watchdog", "_loaded", "_shown", "_events", "_fast_valid", "_now")
-    state = {k: v for k, v in vars(device).items() if k not in hidden}
+    state = {k: v for k, v in fields(device).items() if k not in hidden}
     if isinstance(device, Supi3):
         state["events"] = device.events
         state["mfp_outputs"] = device.mfp_outputs

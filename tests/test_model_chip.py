@@ -36,13 +36,6 @@ def _ring(*chips: Supi3) -> tuple[Ring, Master]:
     return ring, master
 
 
-@pytest.mark.parametrize("kind", list(MfpKind))
-def test_chip_state_stays_in_fast_attributes(kind: MfpKind) -> None:
-    """The transaction-level ring's speed depends on it (see Supi3.__init__): fewer than 30 attributes."""
-    row = next(r for r in tables.MODE_ROWS if decode(r.c, r.mfp).mfp_mode.kind is kind)
-    assert len(vars(Supi3(decode(row.c, row.mfp)))) < 30
-
-
 def test_binary_io_modes_are_44_rows() -> None:
     assert len(BINARY_ROWS) == 44
 

@@ -27,6 +27,7 @@ from supi3.spi.slave_pins import SlavePins
 from supi3.spi.upif import Mode, UpInterface
 from supi3.tables import CLOCK_HZ
 from supi3.top import Supi3Chip
+from support import fields
 
 RB_UP = decode("10011", "1110")  # RB, Init-µP
 RB_IO = decode("10000")  # RB, 8 IN/8 OUT: one byte each way (the demo device)
@@ -148,7 +149,7 @@ def test_inconsistent_data_without_a_clock_says_so_and_pickles() -> None:
 
 def chip_state(chip: Supi3) -> object:
     """Every attribute of the chip (copied) and of its register file."""
-    own = {k: copy.copy(v) for k, v in vars(chip).items() if k != "registers"}
+    own = {k: copy.copy(v) for k, v in fields(chip).items() if k != "registers"}
     return own, None if chip.registers is None else registers_state(chip.registers)
 
 

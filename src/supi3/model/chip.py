@@ -122,8 +122,7 @@ def _cycle(cycle: object) -> Cycle:
 #   _fixed_bytes  the data length of a pin-strapped mode (None in the µP modes, which never take the shortcut);
 #   watchdog_code None while the master has set no watchdog (a latch then leaves the schedule alone);
 #   _fast_valid   valid data cycles latched by the shortcut, merged into Supi3.events.
-# Flat shape: Supi3 keeps fewer than 30 instance attributes, because from 30 on CPython 3.11 stops sharing the
-# instance dictionaries' keys and every attribute access here slows (tests/test_model_chip.py guards it).
+# Supi3 declares its state in __slots__, so these reads are fixed-offset loads whatever the number of attributes.
 # tests/test_interbus_ring_kernel.py holds the kernel to the per-chip path.
 
 
@@ -176,6 +175,14 @@ class Supi3:
         ``"IB_RESET"``, ``"PCP_RX"``, ``"PCP_TX"``), plus ``"WATCHDOG"`` and ``"MODACK"``.
     """
 
+    __slots__ = (
+        "_deadline", "_due_s", "_events", "_fast_valid", "_fixed_bytes", "_in_map", "_loaded", "_now", "_out",
+        "_out_map", "_send_alarm", "_shown", "_stat_err", "_stat_low_since", "attention", "bus_active", "config", "due",
+        "in_word", "io_access", "mfp_in", "mod_ack_until", "pf", "registers", "resreg_until", "revision", "te",
+        "watchdog_code", "wd",
+        "__dict__",  # room beyond the declared state, so that a test can spy on a chip's methods
+    )  # fmt: skip
+
     data_kernel: ClassVar[DataKernel] = DataKernel(_load_data_run, _latch_data_run)
     """The ring's fast path for runs of chips in a data cycle (:class:`supi3.interbus.link.DataKernel`)."""
 
@@ -201,7 +208,6 @@ class Supi3:
         self.revision = 0
         """Counts the changes of what the pins show (OUT data, ``pf``, ``bus_active``, the /ModAck and /ResReg
         pulses): the pin level records its outputs only when this moves."""
-        # Keep fewer than 30 instance attributes (see "The ring kernel" above).
         self.power_up()
 
     # --------------------------------------------------------------------------------------------------------
