@@ -176,11 +176,11 @@ class Supi3:
     """
 
     __slots__ = (
+        "__dict__",  # room beyond the declared state, so that a test can spy on a chip's methods
         "_deadline", "_due_s", "_events", "_fast_valid", "_fixed_bytes", "_in_map", "_loaded", "_now", "_out",
         "_out_map", "_send_alarm", "_shown", "_stat_err", "_stat_low_since", "attention", "bus_active", "config", "due",
         "in_word", "io_access", "mfp_in", "mod_ack_until", "pf", "registers", "resreg_until", "revision", "te",
         "watchdog_code", "wd",
-        "__dict__",  # room beyond the declared state, so that a test can spy on a chip's methods
     )  # fmt: skip
 
     data_kernel: ClassVar[DataKernel] = DataKernel(_load_data_run, _latch_data_run)
