@@ -78,6 +78,11 @@ _PIN_ROW: Final = next(r for r in tables.MODE_ROWS if decode(r.c, r.mfp).mfp_mod
 _PIN_CLK_CONF: Final = "11"  # 2 Mbit/s: 16 clocks per bit keeps the pin level short
 
 
+MAX_DEVICES: Final[dict[Fidelity, int]] = {"ring": 64, "pin": 8}
+"""The largest ring a campaign runs, per fidelity (a pin-level ring of more chips runs too slowly to be useful)."""
+DEVICE_LIMITS: Final[dict[Fidelity, str]] = {"ring": "the campaign's ring sizes", "pin": "pin level: at most 8 chips"}
+
+
 @dataclass(frozen=True)
 class CampaignConfig:
     """What a campaign runs.
@@ -106,8 +111,7 @@ class CampaignConfig:
         check_int("cycles", self.cycles, 1)
         check_int("seed", self.seed)
         check_choice("fidelity", self.fidelity, FIDELITIES)
-        check_int("devices", self.devices, 1, 64 if self.fidelity == "ring" else 8,
-                  "the campaign's ring sizes" if self.fidelity == "ring" else "pin level: at most 8 chips")  # fmt: skip
+        check_int("devices", self.devices, 1, MAX_DEVICES[self.fidelity], DEVICE_LIMITS[self.fidelity])
         if self.mix is not None:
             events = RING_EVENTS if self.fidelity == "ring" else PIN_EVENTS
             if not isinstance(self.mix, Mapping) or not self.mix:
@@ -608,6 +612,8 @@ def parse_mix(text: str) -> dict[str, int]:
         if not sep or not weight.strip().isdigit():
             raise fail("--mix", "EVENT=WEIGHT pairs separated by commas", item)
         mix[event.strip()] = int(weight)
+    if not mix:
+        raise fail("--mix", "EVENT=WEIGHT pairs separated by commas", text)
     return mix
 
 

@@ -411,11 +411,16 @@ def _campaign_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _campaign_configs(args: argparse.Namespace) -> list[campaign.CampaignConfig]:
     """The campaigns the options ask for."""
+    check_int("--cycles", args.cycles, 1)
+    check_int("--pin-cycles", args.pin_cycles, 1)
+    check_int("--devices", args.devices, 1, campaign.MAX_DEVICES["ring"], campaign.DEVICE_LIMITS["ring"])
+    check_int("--pin-devices", args.pin_devices, 1, campaign.MAX_DEVICES["pin"], campaign.DEVICE_LIMITS["pin"])
     fidelities: list[campaign.Fidelity] = ["ring", "pin"] if args.fidelity == "both" else [args.fidelity]
     mix = campaign.parse_mix(args.mix) if args.mix else None
     unknown = sorted(set(mix or ()) - set(campaign.RING_EVENTS) - set(campaign.PIN_EVENTS))
     if unknown:
-        raise fail("--mix event", f"one of {', '.join(campaign.RING_EVENTS + campaign.PIN_EVENTS)}", unknown[0])
+        known = dict.fromkeys(campaign.RING_EVENTS + campaign.PIN_EVENTS)  # "reset" is in both
+        raise fail("--mix event", f"one of {', '.join(known)}", unknown[0])
     configs = []
     for fidelity in fidelities:
         own = None
