@@ -5,7 +5,8 @@ from __future__ import annotations
 import pytest
 
 from supi3 import tables
-from supi3.config import DataDirection, MfpKind, parse_function
+from supi3.config import DataDirection, MfpKind, decode, parse_function
+from supi3.errors import ConfigurationError
 
 HEX = "0123456789ABCDEF"
 
@@ -345,3 +346,13 @@ def test_table_1_5_optical_ranges(manual_lines: list[list[str]]) -> None:
         if row.resolution_m:
             per_count = 1 / (tables.LENGTH_TIMER_CLOCKS_PER_BIT * row.bit_rate * tables.LIGHT_RUNTIME_S_PER_M)
             assert abs(per_count - row.resolution_m[0]) / row.resolution_m[0] < 0.05
+
+
+def test_clk_conf_for_every_data_rate_and_nothing_else() -> None:
+    """Table 1-7 read backwards: each data rate's CLK_CONF[1..0] decodes to it; the reserved row and values that
+    only compare equal to a rate (a float, True) select nothing."""
+    for rate in tables.BIT_RATES:
+        assert decode("10000", clk_conf=tables.clk_conf_for(rate)).bit_rate == rate
+    for bad in (None, 2e6, True, "2M", 1_000_000):
+        with pytest.raises(ConfigurationError, match="Table 1-7"):
+            tables.clk_conf_for(bad)  # type: ignore[arg-type]

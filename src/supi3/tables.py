@@ -581,9 +581,11 @@ BIT_RATES: Final[tuple[int, ...]] = tuple(row.bit_rate for row in CLOCK_CONFIGUR
 def clk_conf_for(bit_rate: int) -> str:
     """CLK_CONF[1..0], MSB first, that selects ``bit_rate`` (Table 1-7): ``"01"`` 500 kbit/s, ``"11"`` 2 Mbit/s."""
     for row in CLOCK_CONFIGURATIONS:
-        if row.bit_rate == bit_rate:
+        # Exact type: the reserved row's None, a float 2e6 or True must not select a row.
+        if row.bit_rate is not None and type(bit_rate) is int and row.bit_rate == bit_rate:
             return row.clk_conf1 + row.clk_conf0
-    raise ConfigurationError("CLK_CONF[1..0]", f"{bit_rate} bit/s", "Table 1-7", f"the data rates are {BIT_RATES}")
+    raise ConfigurationError("CLK_CONF[1..0]", f"{bit_rate!r} bit/s", "Table 1-7", f"the data rates are {BIT_RATES}")
+
 
 # ----------------------------------------------------------------------------------------------------------------
 # Bus connector recognition and regulation: Tables 2-2 and 2-9
