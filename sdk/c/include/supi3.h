@@ -1,0 +1,123 @@
+/**
+ * supi3.h - portable C99 driver for the serial uP interface of the IBS SUPI 3 OPC (INTERBUS slave).
+ *
+ * Manual: IBS SUPI 3 OPC UM E rev. 05, 3.4 to 3.4.14. Decisions: docs/assumptions/upif.md (UP-n),
+ * guide: docs/sdk.md. The API mirrors supi3.spi.upif.UpInterface (initialize, read, write, exchange,
+ * block_transfer). No dynamic memory, no global state: everything lives in a caller-owned supi3_t.
+ *
+ * Transport contract (decision, docs/sdk.md "Porting the transport"):
+ *  - xfer() moves ONE byte as ONE frame: /SS low, 8 SCLK periods, /SS high. The chip needs a /SS edge per
+ *    byte (3.4.2, UP-7), so the callback drives /SS itself; there are no separate select/deselect callbacks.
+ *  - Motorola (SPI): mode 3 (SCLK idles high, sample on the rising edge, UP-5), MSB first. s_r is ignored.
+ *  - Intel (8051 serial mode 0): LSB first on the wire (UP-6); the callback sets the S/R pin to s_r before
+ *    /SS falls: 1 = the uP sends (chip writes), 0 = the chip drives Ser_IN/OUT (Table 3-9, UP-9).
+ *  - Byte values in this API are always the manual's values (bit 7 = RD etc.); bit order is the transport's job.
+ *  - Every callback returns 0 on success, anything else is reported as SUPI3_E_TRANSPORT.
+ */
+#ifndef SUPI3_H
+#define SUPI3_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "supi3_regs.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Error codes: 0 = success, negative = failure. Names follow supi3.spi.upif's exceptions. */
+typedef enum {
+    SUPI3_OK = 0,
+    SUPI3_E_ARG = -1,         /**< bad argument (NULL pointer, address not 0..14, length, mode): nothing sent (UpifArgumentError) */
+    SUPI3_E_NOT_INIT = -2,    /**< supi3_init() or supi3_initialize() not done: nothing sent (NotInitializedError, UP-25) */
+    SUPI3_E_TRANSPORT = -3,   /**< a transport callback failed; state of the chip unknown: SAS_INIT and initialize again */
+    SUPI3_E_NOT_READY = -4,   /**< C/D showed "data" before the init byte: command interrupted or interface disabled (UP-4, UP-27); nothing sent */
+    SUPI3_E_NOT_RESET = -5,   /**< the chip was not reset: it took the init byte as a command (UP-3); pulse SAS_INIT, initialize again */
+    SUPI3_E_UNSUPPORTED = -6  /**< not possible in this mode or without an optional callback (exchange in Intel mode, 3.4.4) */
+} supi3_err_t;
+
+/** Interface mode selected by the initialization byte (3.4.3, Table 3-8). */
+typedef enum {
+    SUPI3_MODE_MOTOROLA = 0, /**< init byte 00h, SPI */
+    SUPI3_MODE_INTEL = 1     /**< init byte 81h, 8051 serial mode 0 with S/R */
+} supi3_mode_t;
+
+/** Largest block transfer: IN0..IN3 / OUT0..OUT3, two words (3.4.6, 3.4.8). */
+#define SUPI3_BLOCK_MAX_BYTES 4u
+/** Highest address a single access may name; 15 is the block transfer (3.4.6, 3.4.7). */
+#define SUPI3_ADDR_MAX 14u
+
+typedef int (*supi3_xfer_fn)(void *user, uint8_t tx, uint8_t *rx, int s_r);
+typedef void (*supi3_delay_us_fn)(void *user, uint32_t us);
+typedef int (*supi3_read_pin_fn)(void *user, int *level);
+typedef int (*supi3_write_pin_fn)(void *user, int level);
+
+/** Board configuration: copied by supi3_init(). Only xfer is required. */
+typedef struct {
+    supi3_xfer_fn xfer;          /**< one byte, one /SS frame (required) */
+    supi3_delay_us_fn delay_us;  /**< busy wait; used for frame_gap_us and the SAS_INIT pulse (optional) */
+    supi3_read_pin_fn read_irq;  /**< /IRQ level, 0 = event pending (optional, supi3_irq_service) */
+    supi3_read_pin_fn read_cd;   /**< C/D level, 0 = command expected (optional, init check UP-3) */
+    supi3_write_pin_fn set_sas_init; /**< drive SAS_INIT, 1 = active (optional, supi3_sas_init) */
+    void *user;                  /**< passed to every callback */
+    uint32_t frame_gap_us;       /**< wait after each frame (t8, Table 3-7); 0 = none */
+} supi3_config_t;
+
+/** Driver context. Treat the fields as private; allocate it anywhere (static, stack). */
+typedef struct {
+    uint32_t magic;
+    supi3_config_t cfg;
+    uint8_t initialized;
+    uint8_t mode;
+} supi3_t;
+
+/** Copy cfg into ctx and reset the driver state (the chip is not touched). */
+int supi3_init(supi3_t *ctx, const supi3_config_t *cfg);
+
+/** Send the initialization byte (3.4.3). With read_cd, check the first-initialization signature (UP-3). */
+int supi3_initialize(supi3_t *ctx, supi3_mode_t mode);
+
+/** Pulse SAS_INIT (>= 1 us, t_SAS_INIT >= 250 ns) with set_sas_init; the driver forgets the mode (3.4.3). */
+int supi3_sas_init(supi3_t *ctx);
+
+/** Read one register (3.4.4): command RD|A, then one data byte. addr 0..14. */
+int supi3_read(supi3_t *ctx, uint8_t addr, uint8_t *value);
+
+/** Write one register (3.4.4): command WR|A, then the data byte. addr 0..14. */
+int supi3_write(supi3_t *ctx, uint8_t addr, uint8_t value);
+
+/** Read and write one address in the same data byte (Motorola only, 3.4.4). */
+int supi3_exchange(supi3_t *ctx, uint8_t addr, uint8_t wr_value, uint8_t *rd_value);
+
+/**
+ * Block transfer at address 15 (3.4.6, UP-10, UP-11); n = the configured data length in bytes, 1..4.
+ * out receives OUT0..OUT(n-1) (read), in supplies IN0..IN(n-1) (write).
+ * Motorola: n full-duplex bytes whatever rd/wr say: in is required (the chip writes it), out may be NULL.
+ * Intel: n reads if rd (out required), then n writes if wr (in required); rd or wr must be set.
+ */
+int supi3_block_transfer(supi3_t *ctx, int rd, int wr, uint8_t *out, const uint8_t *in, size_t n);
+
+/** Write SET, then ID (3.4.5: 4Dh set, 4Ch id), before the bus runs. */
+int supi3_configure(supi3_t *ctx, uint8_t set_value, uint8_t id_value);
+
+/**
+ * Read-clear the interrupt event register (3.4.14, read 14). With read_irq and /IRQ high, *events = 0
+ * and nothing is sent.
+ */
+int supi3_irq_service(supi3_t *ctx, uint8_t *events);
+
+/** Text for an error code ("unknown error" for others). */
+const char *supi3_strerror(int err);
+
+/* Multi-byte values in the manual's significance: byte 0 (address 0) is the MSB (3.4.8). */
+void supi3_put_u16(uint8_t *bytes, uint16_t value);
+uint16_t supi3_get_u16(const uint8_t *bytes);
+void supi3_put_u32(uint8_t *bytes, uint32_t value);
+uint32_t supi3_get_u32(const uint8_t *bytes);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SUPI3_H */

@@ -1,0 +1,312 @@
+/*
+ * supi3.c - portable C99 driver for the IBS SUPI 3 OPC serial uP interface (manual 3.4 to 3.4.14).
+ * See supi3.h for the transport contract and docs/sdk.md for the guide. No dynamic memory, no globals.
+ */
+#include "supi3.h"
+
+#define SUPI3_MAGIC 0x53503343u /* "SP3C": set by supi3_init() */
+
+/* S/R levels for the Intel mode (Table 3-9, UP-9); ignored in Motorola mode. */
+#define SR_CHIP_DRIVES 0
+#define SR_UP_SENDS 1
+
+static int ctx_ok(const supi3_t *ctx)
+{
+    return ctx != NULL && ctx->magic == SUPI3_MAGIC;
+}
+
+/* One frame; waits frame_gap_us afterwards (t8, Table 3-7). */
+static int frame(supi3_t *ctx, uint8_t tx, uint8_t *rx, int s_r)
+{
+    uint8_t dummy = 0u;
+    if (ctx->cfg.xfer(ctx->cfg.user, tx, rx != NULL ? rx : &dummy, s_r) != 0) {
+        ctx->initialized = 0u; /* chip state unknown (a half-done command): SAS_INIT needed */
+        return SUPI3_E_TRANSPORT;
+    }
+    if (ctx->cfg.delay_us != NULL && ctx->cfg.frame_gap_us != 0u) {
+        ctx->cfg.delay_us(ctx->cfg.user, ctx->cfg.frame_gap_us);
+    }
+    return SUPI3_OK;
+}
+
+static int read_cd(supi3_t *ctx, int *level)
+{
+    if (ctx->cfg.read_cd(ctx->cfg.user, level) != 0) {
+        return SUPI3_E_TRANSPORT;
+    }
+    return SUPI3_OK;
+}
+
+/* Common entry check of the register accesses (UP-25: refused before the first byte). */
+static int access_ok(const supi3_t *ctx, uint8_t addr)
+{
+    if (!ctx_ok(ctx)) {
+        return ctx == NULL ? SUPI3_E_ARG : SUPI3_E_NOT_INIT;
+    }
+    if (addr > SUPI3_ADDR_MAX) {
+        return SUPI3_E_ARG; /* 15 is the block transfer (3.4.6): supi3_block_transfer() */
+    }
+    if (!ctx->initialized) {
+        return SUPI3_E_NOT_INIT;
+    }
+    return SUPI3_OK;
+}
+
+int supi3_init(supi3_t *ctx, const supi3_config_t *cfg)
+{
+    if (ctx == NULL || cfg == NULL || cfg->xfer == NULL) {
+        return SUPI3_E_ARG;
+    }
+    ctx->cfg = *cfg;
+    ctx->initialized = 0u;
+    ctx->mode = (uint8_t)SUPI3_MODE_MOTOROLA;
+    ctx->magic = SUPI3_MAGIC;
+    return SUPI3_OK;
+}
+
+int supi3_initialize(supi3_t *ctx, supi3_mode_t mode)
+{
+    uint8_t init_byte;
+    int cd = 0;
+    int err;
+    if (ctx == NULL || (mode != SUPI3_MODE_MOTOROLA && mode != SUPI3_MODE_INTEL)) {
+        return SUPI3_E_ARG;
+    }
+    if (!ctx_ok(ctx)) {
+        return SUPI3_E_NOT_INIT;
+    }
+    init_byte = mode == SUPI3_MODE_INTEL ? (uint8_t)SUPI3_INIT_INTEL : (uint8_t)SUPI3_INIT_MOTOROLA;
+    ctx->initialized = 0u;
+    if (ctx->cfg.read_cd != NULL) {
+        /* C/D = 1 before the init byte: a command waits for its data byte (uP reset mid-command, UP-27) or the
+         * interface is disabled (UP-4). The init byte would be taken as data: send nothing, ask for SAS_INIT. */
+        err = read_cd(ctx, &cd);
+        if (err != SUPI3_OK) {
+            return err;
+        }
+        if (cd != 0) {
+            return SUPI3_E_NOT_READY;
+        }
+    }
+    err = frame(ctx, init_byte, NULL, SR_UP_SENDS);
+    if (err != SUPI3_OK) {
+        return err;
+    }
+    if (ctx->cfg.read_cd != NULL) {
+        err = read_cd(ctx, &cd);
+        if (err != SUPI3_OK) {
+            return err;
+        }
+        if (cd != 0) {
+            /* "Command status twice" missing (3.4.3, UP-3): the chip was initialized already and took the byte
+             * as a command (00h: no direction, address 0; 81h: read OUT1). Complete it with a no-op data
+             * byte so the chip is back in its command phase, then report: the mode cannot be changed now. */
+            err = frame(ctx, 0x00u, NULL, mode == SUPI3_MODE_INTEL ? SR_CHIP_DRIVES : SR_UP_SENDS);
+            return err != SUPI3_OK ? err : SUPI3_E_NOT_RESET;
+        }
+    }
+    ctx->mode = (uint8_t)mode;
+    ctx->initialized = 1u;
+    return SUPI3_OK;
+}
+
+int supi3_sas_init(supi3_t *ctx)
+{
+    if (ctx == NULL) {
+        return SUPI3_E_ARG;
+    }
+    if (!ctx_ok(ctx)) {
+        return SUPI3_E_NOT_INIT;
+    }
+    if (ctx->cfg.set_sas_init == NULL) {
+        return SUPI3_E_UNSUPPORTED;
+    }
+    ctx->initialized = 0u; /* the interface waits for the init byte again; registers are kept (3.4.3) */
+    if (ctx->cfg.set_sas_init(ctx->cfg.user, 1) != 0) {
+        return SUPI3_E_TRANSPORT;
+    }
+    if (ctx->cfg.delay_us != NULL) {
+        ctx->cfg.delay_us(ctx->cfg.user, 1u); /* t_SAS_INIT >= 250 ns */
+    }
+    if (ctx->cfg.set_sas_init(ctx->cfg.user, 0) != 0) {
+        return SUPI3_E_TRANSPORT;
+    }
+    return SUPI3_OK;
+}
+
+int supi3_read(supi3_t *ctx, uint8_t addr, uint8_t *value)
+{
+    int err = access_ok(ctx, addr);
+    if (err == SUPI3_OK && value == NULL) {
+        err = SUPI3_E_ARG;
+    }
+    if (err != SUPI3_OK) {
+        return err;
+    }
+    err = frame(ctx, (uint8_t)SUPI3_CMD_READ(addr), NULL, SR_UP_SENDS);
+    if (err != SUPI3_OK) {
+        return err;
+    }
+    return frame(ctx, 0x00u, value, SR_CHIP_DRIVES);
+}
+
+int supi3_write(supi3_t *ctx, uint8_t addr, uint8_t value)
+{
+    int err = access_ok(ctx, addr);
+    if (err != SUPI3_OK) {
+        return err;
+    }
+    err = frame(ctx, (uint8_t)SUPI3_CMD_WRITE(addr), NULL, SR_UP_SENDS);
+    if (err != SUPI3_OK) {
+        return err;
+    }
+    return frame(ctx, value, NULL, SR_UP_SENDS);
+}
+
+int supi3_exchange(supi3_t *ctx, uint8_t addr, uint8_t wr_value, uint8_t *rd_value)
+{
+    int err = access_ok(ctx, addr);
+    if (err == SUPI3_OK && rd_value == NULL) {
+        err = SUPI3_E_ARG;
+    }
+    if (err != SUPI3_OK) {
+        return err;
+    }
+    if (ctx->mode != (uint8_t)SUPI3_MODE_MOTOROLA) {
+        return SUPI3_E_UNSUPPORTED; /* 3.4.4: simultaneous read and write is impossible in Intel mode */
+    }
+    err = frame(ctx, (uint8_t)SUPI3_CMD_READ_WRITE(addr), NULL, SR_UP_SENDS);
+    if (err != SUPI3_OK) {
+        return err;
+    }
+    return frame(ctx, wr_value, rd_value, SR_UP_SENDS);
+}
+
+int supi3_block_transfer(supi3_t *ctx, int rd, int wr, uint8_t *out, const uint8_t *in, size_t n)
+{
+    uint8_t cmd = (uint8_t)SUPI3_CMD_A(SUPI3_BLOCK_TRANSFER_ADDR);
+    size_t k;
+    int err = access_ok(ctx, 0u);
+    if (err != SUPI3_OK) {
+        return err;
+    }
+    if (n < 1u || n > SUPI3_BLOCK_MAX_BYTES) {
+        return SUPI3_E_ARG;
+    }
+    if (ctx->mode == (uint8_t)SUPI3_MODE_MOTOROLA) {
+        /* UP-11: RD/WR have no meaning, every byte is full duplex and writes IN k. */
+        if (in == NULL || (rd && out == NULL)) {
+            return SUPI3_E_ARG;
+        }
+    } else if ((!rd && !wr) || (rd && out == NULL) || (wr && in == NULL)) {
+        return SUPI3_E_ARG;
+    }
+    if (rd) {
+        cmd = (uint8_t)(cmd | SUPI3_CMD_RD_MSK);
+    }
+    if (wr) {
+        cmd = (uint8_t)(cmd | SUPI3_CMD_WR_MSK);
+    }
+    err = frame(ctx, cmd, NULL, SR_UP_SENDS);
+    if (ctx->mode == (uint8_t)SUPI3_MODE_MOTOROLA) {
+        for (k = 0u; err == SUPI3_OK && k < n; ++k) {
+            err = frame(ctx, in[k], out != NULL ? &out[k] : NULL, SR_UP_SENDS);
+        }
+        return err;
+    }
+    /* Intel (UP-11, Fig. 3-12): first n reads with S/R = 0, then n writes with S/R = 1. */
+    for (k = 0u; err == SUPI3_OK && rd && k < n; ++k) {
+        err = frame(ctx, 0x00u, &out[k], SR_CHIP_DRIVES);
+    }
+    for (k = 0u; err == SUPI3_OK && wr && k < n; ++k) {
+        err = frame(ctx, in[k], NULL, SR_UP_SENDS);
+    }
+    return err;
+}
+
+int supi3_configure(supi3_t *ctx, uint8_t set_value, uint8_t id_value)
+{
+    int err = supi3_write(ctx, (uint8_t)SUPI3_SET_ADDR, set_value);
+    if (err != SUPI3_OK) {
+        return err;
+    }
+    return supi3_write(ctx, (uint8_t)SUPI3_ID_ADDR, id_value);
+}
+
+int supi3_irq_service(supi3_t *ctx, uint8_t *events)
+{
+    int irq_n = 0;
+    int err = access_ok(ctx, (uint8_t)SUPI3_IRQ_EVT_ADDR);
+    if (err == SUPI3_OK && events == NULL) {
+        err = SUPI3_E_ARG;
+    }
+    if (err != SUPI3_OK) {
+        return err;
+    }
+    if (ctx->cfg.read_irq != NULL) {
+        if (ctx->cfg.read_irq(ctx->cfg.user, &irq_n) != 0) {
+            return SUPI3_E_TRANSPORT;
+        }
+        if (irq_n != 0) {
+            *events = 0u;
+            return SUPI3_OK;
+        }
+    }
+    return supi3_read(ctx, (uint8_t)SUPI3_IRQ_EVT_ADDR, events);
+}
+
+const char *supi3_strerror(int err)
+{
+    switch (err) {
+    case SUPI3_OK:
+        return "ok";
+    case SUPI3_E_ARG:
+        return "invalid argument (NULL pointer, address not 0..14, block length not 1..4, mode)";
+    case SUPI3_E_NOT_INIT:
+        return "not initialized: call supi3_init() and supi3_initialize() first";
+    case SUPI3_E_TRANSPORT:
+        return "transport error: chip state unknown, pulse SAS_INIT and initialize again";
+    case SUPI3_E_NOT_READY:
+        return "C/D shows data before the initialization byte: pulse SAS_INIT (3.4.3)";
+    case SUPI3_E_NOT_RESET:
+        return "chip was not reset: initialization byte taken as a command, pulse SAS_INIT (3.4.3)";
+    case SUPI3_E_UNSUPPORTED:
+        return "not supported in this mode or without the optional callback";
+    default:
+        return "unknown error";
+    }
+}
+
+void supi3_put_u16(uint8_t *bytes, uint16_t value)
+{
+    if (bytes != NULL) {
+        bytes[0] = (uint8_t)(value >> 8);
+        bytes[1] = (uint8_t)value;
+    }
+}
+
+uint16_t supi3_get_u16(const uint8_t *bytes)
+{
+    if (bytes == NULL) {
+        return 0u;
+    }
+    return (uint16_t)(((uint16_t)bytes[0] << 8) | bytes[1]);
+}
+
+void supi3_put_u32(uint8_t *bytes, uint32_t value)
+{
+    if (bytes != NULL) {
+        bytes[0] = (uint8_t)(value >> 24);
+        bytes[1] = (uint8_t)(value >> 16);
+        bytes[2] = (uint8_t)(value >> 8);
+        bytes[3] = (uint8_t)value;
+    }
+}
+
+uint32_t supi3_get_u32(const uint8_t *bytes)
+{
+    if (bytes == NULL) {
+        return 0u;
+    }
+    return ((uint32_t)bytes[0] << 24) | ((uint32_t)bytes[1] << 16) | ((uint32_t)bytes[2] << 8) | bytes[3];
+}

@@ -1,0 +1,466 @@
+/*
+ * Unit tests of sdk/c (supi3.c) against a fake chip in C, built and run by tests/test_sdk_c.py.
+ * The fake implements the chip side of the byte protocol (manual 3.4.3 to 3.4.6, docs/upif.md): init byte,
+ * command/data alternation with C/D (UP-2), registers 0..14 with read-clear of 14, block transfer (UP-10,
+ * UP-11), Intel S/R direction (UP-9), and a faulty init byte disabling the interface (UP-4).
+ * Prints "N passed, M failed"; exit status 1 on any failure.
+ */
+#include <stdio.h>
+#include <string.h>
+
+#include "supi3.h"
+
+enum phase { PH_INIT, PH_COMMAND, PH_DATA, PH_BLOCK, PH_DISABLED };
+
+typedef struct {
+    enum phase phase;
+    int intel;
+    uint8_t cmd;
+    uint8_t last_rx;
+    uint8_t in[4], out[4];
+    uint8_t alarm, pcmd, id, set, irq_en, irq_evt;
+    size_t block_len, slot;
+    /* log of what the driver sent */
+    uint8_t tx[64];
+    int sr[64];
+    size_t ntx;
+    int fail_at; /* xfer number that fails, -1 = never */
+    int sas_pulses, sas_level, delays;
+    int irq_pin_reads;
+} fake_t;
+
+static int c_d(const fake_t *f)
+{
+    return f->phase == PH_COMMAND || f->phase == PH_INIT ? 0 : 1;
+}
+
+static uint8_t reg_read(fake_t *f, uint8_t a)
+{
+    uint8_t v;
+    switch (a) {
+    case 0: case 1: case 2: case 3: return f->out[a];
+    case 7: return f->pcmd;
+    case 12: return f->id;
+    case 13: return f->set;
+    case 14:
+        v = f->irq_evt;
+        f->irq_evt = (uint8_t)(f->irq_evt & (uint8_t)~SUPI3_IRQ_EVT_CLEAR_ON_READ_MSK);
+        return v;
+    default: return 0u;
+    }
+}
+
+static void reg_write(fake_t *f, uint8_t a, uint8_t v)
+{
+    switch (a) {
+    case 0: case 1: case 2: case 3: f->in[a] = v; break;
+    case 7: f->alarm = v; break;
+    case 12: f->id = v; break;
+    case 13: f->set = v; break;
+    case 14: f->irq_en = v; break;
+    default: break;
+    }
+}
+
+static size_t set_bytes(uint8_t set)
+{
+    static const size_t bytes[8] = {0u, 1u, 1u, 2u, 3u, 4u, 0u, 0u};
+    return bytes[set & SUPI3_SET_CL_MSK];
+}
+
+/* One frame: what the chip sends is decided first (/SS falling), the received byte processed last (UP-7). */
+static int fake_xfer(void *user, uint8_t tx, uint8_t *rx, int s_r)
+{
+    fake_t *f = (fake_t *)user;
+    uint8_t a = (uint8_t)(f->cmd & SUPI3_CMD_A_MSK);
+    int reads = 0, writes = 0;
+    uint8_t send = f->last_rx;
+    if (f->fail_at >= 0 && (size_t)f->fail_at == f->ntx) {
+        return -1;
+    }
+    if (f->ntx < sizeof f->tx) {
+        f->tx[f->ntx] = tx;
+        f->sr[f->ntx] = s_r;
+    }
+    f->ntx++;
+    if (f->phase == PH_DATA) {
+        reads = (f->cmd & SUPI3_CMD_RD_MSK) && (!f->intel || s_r == 0);
+        writes = (f->cmd & SUPI3_CMD_WR_MSK) && (!f->intel || s_r == 1);
+        if (a == 4u || a == 5u) {
+            reads = writes = 0;
+        }
+        if (reads) {
+            send = reg_read(f, a);
+        }
+    } else if (f->phase == PH_BLOCK) {
+        size_t k = f->intel ? f->slot % f->block_len : f->slot;
+        int reading = f->intel && (f->cmd & SUPI3_CMD_RD_MSK) && f->slot < f->block_len;
+        if (!f->intel || reading) {
+            send = f->out[k];
+        }
+    }
+    *rx = send;
+    switch (f->phase) {
+    case PH_INIT:
+        if (tx == SUPI3_INIT_MOTOROLA || tx == SUPI3_INIT_INTEL) {
+            f->intel = tx == SUPI3_INIT_INTEL;
+            f->phase = PH_COMMAND;
+        } else {
+            f->phase = PH_DISABLED;
+        }
+        break;
+    case PH_COMMAND:
+        f->cmd = tx;
+        if ((tx & SUPI3_CMD_A_MSK) == SUPI3_BLOCK_TRANSFER_ADDR) {
+            size_t phases = f->intel ? (size_t)(((tx & SUPI3_CMD_RD_MSK) != 0) + ((tx & SUPI3_CMD_WR_MSK) != 0)) : 1u;
+            f->block_len = set_bytes(f->set);
+            f->slot = 0u;
+            f->phase = f->block_len * phases > 0u ? PH_BLOCK : PH_COMMAND;
+            f->block_len = f->block_len == 0u ? 1u : f->block_len;
+        } else {
+            f->phase = PH_DATA;
+        }
+        break;
+    case PH_DATA:
+        if (writes) {
+            reg_write(f, a, tx);
+        }
+        f->phase = PH_COMMAND;
+        break;
+    case PH_BLOCK: {
+        size_t phases = f->intel ? (size_t)(((f->cmd & SUPI3_CMD_RD_MSK) != 0) + ((f->cmd & SUPI3_CMD_WR_MSK) != 0)) : 1u;
+        int writing = !f->intel || ((f->cmd & SUPI3_CMD_WR_MSK) && (f->slot >= f->block_len || !(f->cmd & SUPI3_CMD_RD_MSK)));
+        if (writing) {
+            f->in[f->slot % f->block_len] = tx;
+        }
+        if (++f->slot == f->block_len * phases) {
+            f->phase = PH_COMMAND;
+        }
+        break;
+    }
+    case PH_DISABLED:
+        return 0;
+    }
+    f->last_rx = tx;
+    return 0;
+}
+
+static int fake_read_cd(void *user, int *level)
+{
+    *level = c_d((const fake_t *)user);
+    return 0;
+}
+
+static int fake_read_irq(void *user, int *level)
+{
+    fake_t *f = (fake_t *)user;
+    f->irq_pin_reads++;
+    *level = (f->irq_evt & f->irq_en & SUPI3_IRQ_EVT_CLEAR_ON_READ_MSK) ? 0 : 1;
+    return 0;
+}
+
+static int fake_sas(void *user, int level)
+{
+    fake_t *f = (fake_t *)user;
+    if (f->sas_level && !level) {
+        f->sas_pulses++;
+        f->phase = PH_INIT; /* SAS_INIT keeps every register (3.4.3) */
+    }
+    f->sas_level = level;
+    return 0;
+}
+
+static void fake_delay(void *user, uint32_t us)
+{
+    (void)us;
+    ((fake_t *)user)->delays++;
+}
+
+/* ---- tiny test harness ---- */
+static int g_failed, g_checks_failed_in_test;
+#define CHECK(cond)                                                                   \
+    do {                                                                              \
+        if (!(cond)) {                                                                \
+            printf("FAIL %s:%d: %s\n", __FILE__, __LINE__, #cond);                    \
+            g_checks_failed_in_test++;                                                \
+        }                                                                             \
+    } while (0)
+#define CHECK_EQ(a, b)                                                                \
+    do {                                                                              \
+        long va_ = (long)(a), vb_ = (long)(b);                                        \
+        if (va_ != vb_) {                                                             \
+            printf("FAIL %s:%d: %s == %s (%ld != %ld)\n", __FILE__, __LINE__, #a, #b, va_, vb_); \
+            g_checks_failed_in_test++;                                                \
+        }                                                                             \
+    } while (0)
+
+static void fake_reset(fake_t *f)
+{
+    memset(f, 0, sizeof *f);
+    f->fail_at = -1;
+}
+
+static void setup(supi3_t *ctx, fake_t *f, int with_cd)
+{
+    supi3_config_t cfg;
+    fake_reset(f);
+    memset(&cfg, 0, sizeof cfg);
+    cfg.xfer = fake_xfer;
+    cfg.read_cd = with_cd ? fake_read_cd : NULL;
+    cfg.read_irq = fake_read_irq;
+    cfg.set_sas_init = fake_sas;
+    cfg.delay_us = fake_delay;
+    cfg.user = f;
+    memset(ctx, 0xA5, sizeof *ctx); /* garbage, as on a stack */
+    (void)supi3_init(ctx, &cfg);
+}
+
+static void log_is(const fake_t *f, const uint8_t *bytes, size_t n)
+{
+    size_t k;
+    CHECK_EQ(f->ntx, n);
+    for (k = 0u; k < n && k < f->ntx; ++k) {
+        CHECK_EQ(f->tx[k], bytes[k]);
+    }
+}
+
+static void test_motorola_init_and_configure(void)
+{
+    supi3_t ctx; fake_t f; uint8_t v = 0u;
+    static const uint8_t expect[] = {0x00u, 0x4Du, 0x82u, 0x4Cu, 0x01u, 0x8Du, 0x00u};
+    setup(&ctx, &f, 1);
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_OK);
+    CHECK_EQ(supi3_configure(&ctx, SUPI3_SET_PCP_N_MSK | SUPI3_SET_CL_LEN_1_BYTE, 0x01u), SUPI3_OK); /* 3.4.5 */
+    CHECK_EQ(supi3_read(&ctx, SUPI3_SET_ADDR, &v), SUPI3_OK);
+    CHECK_EQ(v, 0x82u);
+    CHECK_EQ(f.id, 0x01u);
+    log_is(&f, expect, sizeof expect);
+    CHECK_EQ(c_d(&f), 0);
+}
+
+static void test_intel_init_sr_levels(void)
+{
+    supi3_t ctx; fake_t f; uint8_t v = 0u;
+    setup(&ctx, &f, 1);
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_INTEL), SUPI3_OK);
+    CHECK_EQ(f.tx[0], SUPI3_INIT_INTEL);
+    CHECK(f.intel);
+    f.pcmd = 0x5Au;
+    CHECK_EQ(supi3_read(&ctx, SUPI3_PCMD_ADDR, &v), SUPI3_OK);
+    CHECK_EQ(v, 0x5Au);
+    CHECK_EQ(f.sr[1], 1); /* command byte: the uP sends */
+    CHECK_EQ(f.sr[2], 0); /* data byte of a read: the chip drives (Table 3-9) */
+    CHECK_EQ(supi3_write(&ctx, SUPI3_ALARM_ADDR, 0x33u), SUPI3_OK);
+    CHECK_EQ(f.alarm, 0x33u);
+    CHECK_EQ(f.sr[4], 1);
+    CHECK_EQ(supi3_exchange(&ctx, 0u, 1u, &v), SUPI3_E_UNSUPPORTED); /* 3.4.4 */
+    CHECK_EQ(f.ntx, 5u);
+}
+
+static void test_not_reset_detected(void)
+{
+    supi3_t ctx; fake_t f; uint8_t v;
+    setup(&ctx, &f, 1);
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_OK);
+    /* the uP restarts; the chip keeps its state: the init byte becomes a command (UP-3) */
+    (void)supi3_init(&ctx, &ctx.cfg);
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_E_NOT_RESET);
+    CHECK_EQ(c_d(&f), 0);    /* the no-op data byte completed the command */
+    CHECK_EQ(f.ntx, 3u);
+    CHECK_EQ(supi3_read(&ctx, 0u, &v), SUPI3_E_NOT_INIT);
+    CHECK_EQ(supi3_sas_init(&ctx), SUPI3_OK);
+    CHECK_EQ(f.sas_pulses, 1);
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_INTEL), SUPI3_OK);
+    CHECK(f.intel);
+}
+
+static void test_interrupted_and_disabled(void)
+{
+    supi3_t ctx; fake_t f; uint8_t v = 0u;
+    setup(&ctx, &f, 1);
+    f.phase = PH_COMMAND; f.cmd = 0x4Du; f.phase = PH_DATA; /* uP reset between 4Dh and its data byte */
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_E_NOT_READY);
+    CHECK_EQ(f.ntx, 0u); /* nothing sent: SET not overwritten */
+    f.phase = PH_DISABLED;
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_E_NOT_READY);
+    CHECK_EQ(supi3_sas_init(&ctx), SUPI3_OK);
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_OK);
+    f.out[2] = 0x42u;
+    CHECK_EQ(supi3_read(&ctx, 2u, &v), SUPI3_OK);
+    CHECK_EQ(v, 0x42u);
+}
+
+static void test_without_read_cd(void)
+{
+    supi3_t ctx; fake_t f;
+    setup(&ctx, &f, 0);
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_OK);
+    CHECK_EQ(f.ntx, 1u);
+}
+
+static void test_argument_checks(void)
+{
+    supi3_t ctx; fake_t f; uint8_t v = 0u, buf[4] = {0};
+    supi3_config_t cfg;
+    memset(&cfg, 0, sizeof cfg);
+    CHECK_EQ(supi3_init(NULL, &cfg), SUPI3_E_ARG);
+    CHECK_EQ(supi3_init(&ctx, NULL), SUPI3_E_ARG);
+    CHECK_EQ(supi3_init(&ctx, &cfg), SUPI3_E_ARG); /* no xfer */
+    CHECK_EQ(supi3_read(NULL, 0u, &v), SUPI3_E_ARG);
+    CHECK_EQ(supi3_write(NULL, 0u, 0u), SUPI3_E_ARG);
+    CHECK_EQ(supi3_initialize(NULL, SUPI3_MODE_MOTOROLA), SUPI3_E_ARG);
+    CHECK_EQ(supi3_irq_service(NULL, &v), SUPI3_E_ARG);
+    CHECK_EQ(supi3_sas_init(NULL), SUPI3_E_ARG);
+    setup(&ctx, &f, 1);
+    CHECK_EQ(supi3_initialize(&ctx, (supi3_mode_t)2), SUPI3_E_ARG);
+    CHECK_EQ(supi3_read(&ctx, 0u, &v), SUPI3_E_NOT_INIT); /* UP-25 */
+    CHECK_EQ(supi3_write(&ctx, 0u, 0u), SUPI3_E_NOT_INIT);
+    CHECK_EQ(supi3_block_transfer(&ctx, 1, 1, buf, buf, 2u), SUPI3_E_NOT_INIT);
+    CHECK_EQ(f.ntx, 0u);
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_OK);
+    CHECK_EQ(supi3_read(&ctx, 15u, &v), SUPI3_E_ARG);
+    CHECK_EQ(supi3_write(&ctx, 15u, 0u), SUPI3_E_ARG);
+    CHECK_EQ(supi3_read(&ctx, 0u, NULL), SUPI3_E_ARG);
+    CHECK_EQ(supi3_exchange(&ctx, 0u, 0u, NULL), SUPI3_E_ARG);
+    CHECK_EQ(supi3_irq_service(&ctx, NULL), SUPI3_E_ARG);
+    CHECK_EQ(supi3_block_transfer(&ctx, 1, 1, buf, buf, 0u), SUPI3_E_ARG);
+    CHECK_EQ(supi3_block_transfer(&ctx, 1, 1, buf, buf, 5u), SUPI3_E_ARG);
+    CHECK_EQ(supi3_block_transfer(&ctx, 1, 1, buf, NULL, 2u), SUPI3_E_ARG); /* Motorola writes IN anyway */
+    CHECK_EQ(supi3_block_transfer(&ctx, 1, 1, NULL, buf, 2u), SUPI3_E_ARG);
+    CHECK_EQ(f.ntx, 1u); /* only the init byte went out */
+    CHECK_EQ(c_d(&f), 0);
+}
+
+static void test_motorola_block_and_exchange(void)
+{
+    supi3_t ctx; fake_t f; uint8_t out[4] = {0}, in[4] = {0x12u, 0x34u, 0x56u, 0x78u}, v = 0u;
+    setup(&ctx, &f, 1);
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_OK);
+    CHECK_EQ(supi3_configure(&ctx, SUPI3_SET_PCP_N_MSK | SUPI3_SET_CL_LEN_2_WORDS, 0x03u), SUPI3_OK);
+    supi3_put_u32(f.out, 0xCAFEBABEu);
+    f.ntx = 0u;
+    CHECK_EQ(supi3_block_transfer(&ctx, 1, 1, out, in, 4u), SUPI3_OK);
+    CHECK_EQ(f.tx[0], SUPI3_CMD_BLOCK_TRANSFER);
+    CHECK_EQ(f.ntx, 5u);
+    CHECK_EQ(supi3_get_u32(out), 0xCAFEBABEu);
+    CHECK(memcmp(f.in, in, 4u) == 0);
+    CHECK_EQ(c_d(&f), 0); /* block complete: command phase */
+    f.out[1] = 0x99u;
+    CHECK_EQ(supi3_exchange(&ctx, 1u, 0x77u, &v), SUPI3_OK);
+    CHECK_EQ(f.tx[5], SUPI3_CMD_READ_WRITE(1u));
+    CHECK_EQ(v, 0x99u);
+    CHECK_EQ(f.in[1], 0x77u);
+}
+
+static void test_intel_block_fig_3_12(void)
+{
+    /* Fig. 3-12: 24-bit output device, 8Fh then three reads with S/R = 0 */
+    supi3_t ctx; fake_t f; uint8_t out[3] = {0}, in[3] = {0xA1u, 0xB2u, 0xC3u};
+    setup(&ctx, &f, 1);
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_INTEL), SUPI3_OK);
+    CHECK_EQ(supi3_configure(&ctx, SUPI3_SET_PCP_N_MSK | SUPI3_SET_CL_LEN_3_BYTES, 0x02u), SUPI3_OK);
+    f.out[0] = 0x14u; f.out[1] = 0x56u; f.out[2] = 0x78u;
+    f.ntx = 0u;
+    CHECK_EQ(supi3_block_transfer(&ctx, 1, 0, out, NULL, 3u), SUPI3_OK);
+    CHECK_EQ(f.tx[0], 0x8Fu);
+    CHECK_EQ(f.ntx, 4u);
+    CHECK_EQ(f.sr[1], 0); CHECK_EQ(f.sr[3], 0);
+    CHECK_EQ(out[0], 0x14u); CHECK_EQ(out[1], 0x56u); CHECK_EQ(out[2], 0x78u);
+    CHECK_EQ(c_d(&f), 0);
+    f.ntx = 0u;
+    CHECK_EQ(supi3_block_transfer(&ctx, 1, 1, out, in, 3u), SUPI3_OK); /* reads, then writes (UP-11) */
+    CHECK_EQ(f.ntx, 7u);
+    CHECK_EQ(f.sr[3], 0); CHECK_EQ(f.sr[4], 1);
+    CHECK(memcmp(f.in, in, 3u) == 0);
+    CHECK_EQ(c_d(&f), 0);
+    CHECK_EQ(supi3_block_transfer(&ctx, 0, 0, out, in, 3u), SUPI3_E_ARG);
+    CHECK_EQ(supi3_block_transfer(&ctx, 0, 1, NULL, NULL, 3u), SUPI3_E_ARG);
+}
+
+static void test_irq_service(void)
+{
+    supi3_t ctx; fake_t f; uint8_t ev = 0xFFu;
+    setup(&ctx, &f, 1);
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_OK);
+    CHECK_EQ(supi3_write(&ctx, SUPI3_IRQ_EN_ADDR, SUPI3_IRQ_EN_VALID_MSK | SUPI3_IRQ_EN_PCMD_MSK), SUPI3_OK);
+    f.ntx = 0u;
+    CHECK_EQ(supi3_irq_service(&ctx, &ev), SUPI3_OK); /* /IRQ high: nothing sent */
+    CHECK_EQ(ev, 0u);
+    CHECK_EQ(f.ntx, 0u);
+    f.irq_evt = SUPI3_IRQ_EVT_VALID_MSK | SUPI3_IRQ_EVT_IO_ACCESS_MSK;
+    CHECK_EQ(supi3_irq_service(&ctx, &ev), SUPI3_OK);
+    CHECK_EQ(ev, SUPI3_IRQ_EVT_VALID_MSK | SUPI3_IRQ_EVT_IO_ACCESS_MSK);
+    CHECK_EQ(f.tx[0], SUPI3_CMD_READ(SUPI3_IRQ_EVT_ADDR));
+    CHECK_EQ(f.irq_evt, SUPI3_IRQ_EVT_IO_ACCESS_MSK); /* read-clear of bits 6..0 (3.4.14) */
+    CHECK_EQ(f.irq_pin_reads, 2);
+}
+
+static void test_transport_error(void)
+{
+    supi3_t ctx; fake_t f; uint8_t v = 0u;
+    setup(&ctx, &f, 1);
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_OK);
+    f.fail_at = 2; /* the data byte of the next read */
+    CHECK_EQ(supi3_read(&ctx, 0u, &v), SUPI3_E_TRANSPORT);
+    CHECK_EQ(supi3_read(&ctx, 0u, &v), SUPI3_E_NOT_INIT); /* state unknown: initialize again */
+    f.fail_at = -1;
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_E_NOT_READY); /* chip waits for data */
+    CHECK_EQ(supi3_sas_init(&ctx), SUPI3_OK);
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_OK);
+}
+
+static void test_helpers_and_strerror(void)
+{
+    uint8_t b[4];
+    supi3_put_u16(b, 0x0901u); /* 3.4.5: the master sees 0901h */
+    CHECK_EQ(b[0], 0x09u); CHECK_EQ(b[1], 0x01u);
+    CHECK_EQ(supi3_get_u16(b), 0x0901u);
+    supi3_put_u32(b, 0x01020304u);
+    CHECK_EQ(b[0], 1); CHECK_EQ(b[3], 4);
+    CHECK_EQ(supi3_get_u32(b), 0x01020304u);
+    CHECK_EQ(supi3_get_u32(NULL), 0u);
+    CHECK(strcmp(supi3_strerror(SUPI3_OK), "ok") == 0);
+    CHECK(strcmp(supi3_strerror(12345), "unknown error") == 0);
+    CHECK(strstr(supi3_strerror(SUPI3_E_NOT_RESET), "SAS_INIT") != NULL);
+    CHECK(strcmp(supi3_strerror(SUPI3_E_ARG), supi3_strerror(SUPI3_E_TRANSPORT)) != 0);
+}
+
+static void test_frame_gap_and_no_globals(void)
+{
+    /* two contexts on two fakes do not interfere; frame_gap_us calls delay_us once per frame */
+    supi3_t a, b; fake_t fa, fb; uint8_t v = 0u;
+    setup(&a, &fa, 1);
+    setup(&b, &fb, 1);
+    a.cfg.frame_gap_us = 2u; /* reconfigure through supi3_init */
+    (void)supi3_init(&a, &a.cfg);
+    CHECK_EQ(supi3_initialize(&a, SUPI3_MODE_MOTOROLA), SUPI3_OK);
+    CHECK_EQ(supi3_initialize(&b, SUPI3_MODE_INTEL), SUPI3_OK);
+    fa.out[0] = 1u; fb.out[0] = 2u;
+    CHECK_EQ(supi3_read(&a, 0u, &v), SUPI3_OK); CHECK_EQ(v, 1u);
+    CHECK_EQ(supi3_read(&b, 0u, &v), SUPI3_OK); CHECK_EQ(v, 2u);
+    CHECK_EQ(fa.delays, 3);
+    CHECK_EQ(fb.delays, 0);
+}
+
+int main(void)
+{
+    static void (*const tests[])(void) = {
+        test_motorola_init_and_configure, test_intel_init_sr_levels, test_not_reset_detected,
+        test_interrupted_and_disabled, test_without_read_cd, test_argument_checks,
+        test_motorola_block_and_exchange, test_intel_block_fig_3_12, test_irq_service,
+        test_transport_error, test_helpers_and_strerror, test_frame_gap_and_no_globals,
+    };
+    size_t k, n = sizeof tests / sizeof tests[0];
+    int passed = 0;
+    for (k = 0u; k < n; ++k) {
+        g_checks_failed_in_test = 0;
+        tests[k]();
+        if (g_checks_failed_in_test == 0) {
+            passed++;
+        } else {
+            g_failed++;
+        }
+    }
+    printf("%d passed, %d failed\n", passed, g_failed);
+    return g_failed == 0 ? 0 : 1;
+}
