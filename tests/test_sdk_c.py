@@ -1,15 +1,20 @@
-"""The portable C99 driver (sdk/c) builds warning-free and passes its unit tests against a fake chip in C."""
+"""The portable C99 driver (src/supi3/sdk/c) builds warning-free and passes its unit tests against a fake chip in C."""
 
 from __future__ import annotations
 
+import shlex
 import shutil
 import subprocess
+import tomllib
 from pathlib import Path
 
 import pytest
 
+from supi3 import sdk
+from supi3.cli import main
+
 ROOT = Path(__file__).parent.parent
-SDK_C = ROOT / "sdk" / "c"
+SDK_C = ROOT / "src" / "supi3" / "sdk" / "c"
 TEST_SOURCE = Path(__file__).parent / "c" / "test_driver.c"
 STRICT = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"]
 SANITIZE = ["-fsanitize=address,undefined", "-fno-omit-frame-pointer", "-fno-sanitize-recover=all"]
@@ -99,3 +104,34 @@ def test_cmake_builds_library_and_test(tmp_path: Path) -> None:
     run = subprocess.run([str(build / "supi3_test_driver")], capture_output=True, text=True, check=False)
     assert run.returncode == 0, run.stdout + run.stderr
     assert run.stdout.strip().endswith(" passed, 0 failed")
+
+
+def test_package_paths_point_at_the_shipped_sources() -> None:
+    assert SDK_C.resolve() == sdk.SDK_DIR
+    assert (sdk.include_dir() / "supi3.h").is_file()
+    assert (sdk.include_dir() / "supi3_regs.h").is_file()
+    assert [p.name for p in sdk.sources()] == ["supi3.c"]
+    assert (sdk.SDK_DIR / "CMakeLists.txt").is_file()
+
+
+def test_cli_flags_build_the_driver(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    gcc = _gcc()
+    printed = []
+    for option in ("--cflags", "--sources"):
+        assert main(["sdk", option]) == 0
+        printed += shlex.split(capsys.readouterr().out)
+    assert main(["sdk", "--includes"]) == 0
+    assert shlex.split(capsys.readouterr().out) == [f"-I{sdk.include_dir()}"]
+    assert main(["sdk", "--dir"]) == 0
+    assert capsys.readouterr().out.strip() == str(sdk.SDK_DIR)
+    result = subprocess.run(
+        [gcc, *printed, "-Werror", "-c", "-o", str(tmp_path / "supi3.o")], capture_output=True, text=True, check=False
+    )
+    assert result.returncode == 0, result.stderr
+
+
+def test_package_data_lists_the_sdk_files() -> None:
+    data = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    patterns = data["tool"]["setuptools"]["package-data"]["supi3"]
+    shipped = {p for pattern in patterns for p in (ROOT / "src" / "supi3").glob(pattern)}
+    assert {p for p in SDK_C.rglob("*") if p.is_file()} <= shipped

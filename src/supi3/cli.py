@@ -1,4 +1,4 @@
-"""The ``supi3`` command line: operating modes, pin-strap decoding, register map, timing, the demo, and figures.
+"""The ``supi3`` command line: operating modes, pin-strap decoding, register map, timing, the demo, figures, the C SDK.
 
 Every subcommand whose output is data takes ``--json``.
 
@@ -31,6 +31,7 @@ import contextlib
 import json
 import os
 import re
+import shlex
 import sys
 import unicodedata
 from collections.abc import Sequence
@@ -456,6 +457,20 @@ def cmd_figures(args: argparse.Namespace) -> None:
         print(f"wrote {path}")
 
 
+def cmd_sdk(args: argparse.Namespace) -> None:
+    """Print where the C firmware SDK is and how to compile it (docs/sdk.md), like ``pybind11 --includes``."""
+    from supi3 import sdk
+
+    if args.includes:
+        print(sdk.includes())
+    elif args.sources:
+        print(" ".join(shlex.quote(str(path)) for path in sdk.sources()))
+    elif args.cflags:
+        print(sdk.cflags())
+    else:
+        print(sdk.SDK_DIR)
+
+
 _INTEGER = re.compile(r"[+-]?[0-9]+", re.ASCII)
 _MAX_DIGITS = 4000
 """Longer integers are refused unread: far beyond every limit, and ``int()`` refuses 4300 digits anyway."""
@@ -543,6 +558,14 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"folder to write WaveJSON and SVG into (default {FIGURES_DIR})")
     p.add_argument("--vcd", action="store_true", help="also write a VCD per figure")
     p.set_defaults(func=cmd_figures)
+
+    p = sub.add_parser("sdk", help="paths and flags of the C firmware SDK (docs/sdk.md)")
+    what = p.add_mutually_exclusive_group(required=True)
+    what.add_argument("--includes", action="store_true", help="the -I flag for supi3.h and supi3_regs.h")
+    what.add_argument("--sources", action="store_true", help="the driver's C sources")
+    what.add_argument("--cflags", action="store_true", help="-std=c99, the warning flags and the -I flag")
+    what.add_argument("--dir", action="store_true", help="the SDK folder (include/, src/, CMakeLists.txt)")
+    p.set_defaults(func=cmd_sdk)
     return parser
 
 

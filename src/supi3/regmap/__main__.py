@@ -9,7 +9,7 @@ from supi3.regmap.export import CHECKED_IN, write_checked_in
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Regenerate ``docs/regmap.md`` and ``sdk/c/include/supi3_regs.h`` under the repository root."""
+    """Regenerate ``docs/regmap.md`` and ``src/supi3/sdk/c/include/supi3_regs.h`` under the repository root."""
     parser = argparse.ArgumentParser(prog="python -m supi3.regmap", description=main.__doc__)
     parser.add_argument(
         "--write-checked-in",

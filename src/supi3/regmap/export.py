@@ -37,7 +37,7 @@ FORMATS: Final[tuple[str, ...]] = ("html", "md", "rdl", "h", "json")
 
 CHECKED_IN: Final[dict[str, Path]] = {
     "md": Path("docs/regmap.md"),
-    "h": Path("sdk/c/include/supi3_regs.h"),
+    "h": Path("src/supi3/sdk/c/include/supi3_regs.h"),
 }
 """Generated files kept in the repository, by format, relative to the repository root."""
 
