@@ -135,3 +135,30 @@ def test_package_data_lists_the_sdk_files() -> None:
     patterns = data["tool"]["setuptools"]["package-data"]["supi3"]
     shipped = {p for pattern in patterns for p in (ROOT / "src" / "supi3").glob(pattern)}
     assert {p for p in SDK_C.rglob("*") if p.is_file()} <= shipped
+
+
+STUBS = """#include "supi3.h"
+static int board_xfer(void *u, uint8_t tx, uint8_t *rx, int s_r) { (void)u; (void)tx; (void)s_r; *rx = 0u; return 0; }
+static void board_delay_us(void *u, uint32_t us) { (void)u; (void)us; }
+static int board_irq(void *u, int *level) { (void)u; *level = 1; return 0; }
+static int board_cd(void *u, int *level) { (void)u; *level = 0; return 0; }
+static int board_sas(void *u, int level) { (void)u; (void)level; return 0; }
+static int hspi1;
+int example(void);
+int example(void)
+{
+"""
+
+
+def test_start_up_example_of_the_guide_compiles(tmp_path: Path) -> None:
+    gcc = _gcc()
+    guide = (ROOT / "docs" / "sdk.md").read_text(encoding="utf-8")
+    section = guide.split("## Start-up and recovery", 1)[1]
+    snippet = section.split("```c\n", 1)[1].split("```", 1)[0]
+    source = tmp_path / "example.c"
+    source.write_text(STUBS + snippet + "    return err;\n}\n", encoding="ascii")
+    result = subprocess.run(
+        [gcc, *STRICT, "-fsyntax-only", f"-I{sdk.include_dir()}", str(source)],
+        capture_output=True, text=True, check=False,
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr

@@ -1,5 +1,5 @@
 /*
- * Compile-time checks of src/supi3/sdk/c/include/supi3_regs.h, built by tests/test_regmap_c.py with
+ * Compile-time checks of src/supi3/sdk/c/include/supi3_regs.h, built by tests/test_regmap_export_c.py with
  * gcc -std=c99 and -std=c11, -Wall -Wextra -Werror -pedantic.
  *
  * supi3_expected.h is generated at test time from the Python declaration (src/supi3/regmap): one
