@@ -377,6 +377,37 @@ static void test_intel_block_fig_3_12(void)
     CHECK_EQ(supi3_block_transfer(&ctx, 0, 1, NULL, NULL, 3u), SUPI3_E_ARG);
 }
 
+static void test_block_length_follows_set(void)
+{
+    supi3_t ctx; fake_t f; uint8_t out[4] = {0}, in[4] = {0};
+    setup(&ctx, &f, 1);
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_OK);
+    CHECK_EQ(supi3_block_transfer(&ctx, 1, 1, out, in, 1u), SUPI3_E_ARG); /* below one word (3.4.6) */
+    f.set = SUPI3_SET_PCP_N_MSK | SUPI3_SET_CL_LEN_3_BYTES; /* set before this uP started */
+    CHECK_EQ(supi3_block_transfer(&ctx, 1, 1, out, in, 3u), SUPI3_OK);    /* SET unknown: 2..4 taken */
+    CHECK_EQ(c_d(&f), 0);
+    f.ntx = 0u;
+    CHECK_EQ(supi3_configure(&ctx, SUPI3_SET_PCP_N_MSK | SUPI3_SET_CL_LEN_1_WORD, 0x01u), SUPI3_OK);
+    f.ntx = 0u;
+    CHECK_EQ(supi3_block_transfer(&ctx, 1, 1, out, in, 3u), SUPI3_E_ARG); /* UP-10: SET says 2 bytes */
+    CHECK_EQ(supi3_block_transfer(&ctx, 1, 1, out, in, 2u), SUPI3_OK);
+    CHECK_EQ(f.ntx, 3u);
+    CHECK_EQ(supi3_write(&ctx, SUPI3_SET_ADDR, SUPI3_SET_PCP_N_MSK | SUPI3_SET_CL_LEN_1_BYTE), SUPI3_OK);
+    CHECK_EQ(supi3_block_transfer(&ctx, 1, 1, out, in, 2u), SUPI3_E_ARG); /* one byte: no block transfer */
+    CHECK_EQ(supi3_write(&ctx, SUPI3_SET_ADDR, SUPI3_SET_EXTREG_MSK | SUPI3_SET_CL_LEN_2_WORDS), SUPI3_OK);
+    CHECK_EQ(supi3_block_transfer(&ctx, 1, 1, out, in, 4u), SUPI3_E_ARG); /* ExtReg = 1 (3.4.8) */
+    f.set = SUPI3_SET_PCP_N_MSK | SUPI3_SET_CL_LEN_2_WORDS;
+    CHECK_EQ(supi3_read(&ctx, SUPI3_SET_ADDR, out), SUPI3_OK); /* a read teaches the driver too */
+    f.ntx = 0u;
+    CHECK_EQ(supi3_block_transfer(&ctx, 1, 1, out, in, 4u), SUPI3_OK);
+    CHECK_EQ(f.ntx, 5u);
+    (void)supi3_init(&ctx, &ctx.cfg); /* a restarted uP does not know SET */
+    CHECK_EQ(supi3_sas_init(&ctx), SUPI3_OK);
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_OK);
+    CHECK_EQ(supi3_block_transfer(&ctx, 1, 1, out, in, 4u), SUPI3_OK);
+    CHECK_EQ(c_d(&f), 0);
+}
+
 static void test_irq_service(void)
 {
     supi3_t ctx; fake_t f; uint8_t ev = 0xFFu;
@@ -447,7 +478,7 @@ int main(void)
     static void (*const tests[])(void) = {
         test_motorola_init_and_configure, test_intel_init_sr_levels, test_not_reset_detected,
         test_interrupted_and_disabled, test_without_read_cd, test_argument_checks,
-        test_motorola_block_and_exchange, test_intel_block_fig_3_12, test_irq_service,
+        test_motorola_block_and_exchange, test_intel_block_fig_3_12, test_block_length_follows_set, test_irq_service,
         test_transport_error, test_helpers_and_strerror, test_frame_gap_and_no_globals,
     };
     size_t k, n = sizeof tests / sizeof tests[0];

@@ -29,7 +29,7 @@ extern "C" {
 /** Error codes: 0 = success, negative = failure. Names follow supi3.spi.upif's exceptions. */
 typedef enum {
     SUPI3_OK = 0,
-    SUPI3_E_ARG = -1,         /**< bad argument (NULL pointer, address not 0..14, length, mode): nothing sent (UpifArgumentError) */
+    SUPI3_E_ARG = -1,         /**< bad argument (NULL pointer, address not 0..14, block length, mode): nothing sent (UpifArgumentError) */
     SUPI3_E_NOT_INIT = -2,    /**< supi3_init() or supi3_initialize() not done: nothing sent (NotInitializedError, UP-25) */
     SUPI3_E_TRANSPORT = -3,   /**< a transport callback failed; state of the chip unknown: SAS_INIT and initialize again */
     SUPI3_E_NOT_READY = -4,   /**< C/D showed "data" before the init byte: command interrupted or interface disabled (UP-4, UP-27); nothing sent */
@@ -43,7 +43,8 @@ typedef enum {
     SUPI3_MODE_INTEL = 1     /**< init byte 81h, 8051 serial mode 0 with S/R */
 } supi3_mode_t;
 
-/** Largest block transfer: IN0..IN3 / OUT0..OUT3, two words (3.4.6, 3.4.8). */
+/** Block transfer lengths: one word to two words, IN0..IN3 / OUT0..OUT3 (3.4.6: "lengths >= 1 word", 3.4.8). */
+#define SUPI3_BLOCK_MIN_BYTES 2u
 #define SUPI3_BLOCK_MAX_BYTES 4u
 /** Highest address a single access may name; 15 is the block transfer (3.4.6, 3.4.7). */
 #define SUPI3_ADDR_MAX 14u
@@ -70,6 +71,8 @@ typedef struct {
     supi3_config_t cfg;
     uint8_t initialized;
     uint8_t mode;
+    uint8_t set_known; /* SET was written or read through this context since supi3_init() */
+    uint8_t set_value;
 } supi3_t;
 
 /** Copy cfg into ctx and reset the driver state (the chip is not touched). */
@@ -91,7 +94,8 @@ int supi3_write(supi3_t *ctx, uint8_t addr, uint8_t value);
 int supi3_exchange(supi3_t *ctx, uint8_t addr, uint8_t wr_value, uint8_t *rd_value);
 
 /**
- * Block transfer at address 15 (3.4.6, UP-10, UP-11); n = the configured data length in bytes, 1..4.
+ * Block transfer at address 15 (3.4.6, UP-10, UP-11); n = the configured data length in bytes, 2..4. Once SET
+ * went through this context (supi3_write, supi3_configure, supi3_read), n must be its length and ExtReg 0.
  * out receives OUT0..OUT(n-1) (read), in supplies IN0..IN(n-1) (write).
  * Motorola: n full-duplex bytes whatever rd/wr say: in is required (the chip writes it), out may be NULL.
  * Intel: n reads if rd (out required), then n writes if wr (in required); rd or wr must be set.

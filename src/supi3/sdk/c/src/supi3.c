@@ -52,6 +52,32 @@ static int access_ok(const supi3_t *ctx, uint8_t addr)
     return SUPI3_OK;
 }
 
+/* Bytes of a SET value with ExtReg = 0 (Table 3-12; block transfers at >= 1 word, 3.4.6); 0 = no block. */
+static size_t block_bytes(uint8_t set)
+{
+    if ((set & SUPI3_SET_EXTREG_MSK) != 0u) {
+        return 0u; /* ExtReg = 1: the registers are not in the data path (3.4.8, UP-10) */
+    }
+    switch (set & SUPI3_SET_CL_MSK) {
+    case SUPI3_SET_CL_LEN_1_WORD:
+        return 2u;
+    case SUPI3_SET_CL_LEN_3_BYTES:
+        return 3u;
+    case SUPI3_SET_CL_LEN_2_WORDS:
+        return 4u;
+    default:
+        return 0u; /* below one word, or reserved */
+    }
+}
+
+static void note_set(supi3_t *ctx, uint8_t addr, uint8_t value, int err)
+{
+    if (addr == (uint8_t)SUPI3_SET_ADDR) {
+        ctx->set_known = (uint8_t)(err == SUPI3_OK);
+        ctx->set_value = value;
+    }
+}
+
 int supi3_init(supi3_t *ctx, const supi3_config_t *cfg)
 {
     if (ctx == NULL || cfg == NULL || cfg->xfer == NULL) {
@@ -60,6 +86,8 @@ int supi3_init(supi3_t *ctx, const supi3_config_t *cfg)
     ctx->cfg = *cfg;
     ctx->initialized = 0u;
     ctx->mode = (uint8_t)SUPI3_MODE_MOTOROLA;
+    ctx->set_known = 0u;
+    ctx->set_value = 0u;
     ctx->magic = SUPI3_MAGIC;
     return SUPI3_OK;
 }
@@ -144,10 +172,11 @@ int supi3_read(supi3_t *ctx, uint8_t addr, uint8_t *value)
         return err;
     }
     err = frame(ctx, (uint8_t)SUPI3_CMD_READ(addr), NULL, SR_UP_SENDS);
-    if (err != SUPI3_OK) {
-        return err;
+    if (err == SUPI3_OK) {
+        err = frame(ctx, 0x00u, value, SR_CHIP_DRIVES);
     }
-    return frame(ctx, 0x00u, value, SR_CHIP_DRIVES);
+    note_set(ctx, addr, err == SUPI3_OK ? *value : 0u, err);
+    return err;
 }
 
 int supi3_write(supi3_t *ctx, uint8_t addr, uint8_t value)
@@ -157,10 +186,11 @@ int supi3_write(supi3_t *ctx, uint8_t addr, uint8_t value)
         return err;
     }
     err = frame(ctx, (uint8_t)SUPI3_CMD_WRITE(addr), NULL, SR_UP_SENDS);
-    if (err != SUPI3_OK) {
-        return err;
+    if (err == SUPI3_OK) {
+        err = frame(ctx, value, NULL, SR_UP_SENDS);
     }
-    return frame(ctx, value, NULL, SR_UP_SENDS);
+    note_set(ctx, addr, value, err);
+    return err;
 }
 
 int supi3_exchange(supi3_t *ctx, uint8_t addr, uint8_t wr_value, uint8_t *rd_value)
@@ -176,10 +206,11 @@ int supi3_exchange(supi3_t *ctx, uint8_t addr, uint8_t wr_value, uint8_t *rd_val
         return SUPI3_E_UNSUPPORTED; /* 3.4.4: simultaneous read and write is impossible in Intel mode */
     }
     err = frame(ctx, (uint8_t)SUPI3_CMD_READ_WRITE(addr), NULL, SR_UP_SENDS);
-    if (err != SUPI3_OK) {
-        return err;
+    if (err == SUPI3_OK) {
+        err = frame(ctx, wr_value, rd_value, SR_UP_SENDS);
     }
-    return frame(ctx, wr_value, rd_value, SR_UP_SENDS);
+    note_set(ctx, addr, wr_value, err);
+    return err;
 }
 
 int supi3_block_transfer(supi3_t *ctx, int rd, int wr, uint8_t *out, const uint8_t *in, size_t n)
@@ -190,8 +221,11 @@ int supi3_block_transfer(supi3_t *ctx, int rd, int wr, uint8_t *out, const uint8
     if (err != SUPI3_OK) {
         return err;
     }
-    if (n < 1u || n > SUPI3_BLOCK_MAX_BYTES) {
+    if (n < SUPI3_BLOCK_MIN_BYTES || n > SUPI3_BLOCK_MAX_BYTES) {
         return SUPI3_E_ARG;
+    }
+    if (ctx->set_known && n != block_bytes(ctx->set_value)) {
+        return SUPI3_E_ARG; /* UP-10: the chip moves exactly the configured length */
     }
     if (ctx->mode == (uint8_t)SUPI3_MODE_MOTOROLA) {
         /* UP-11: RD/WR have no meaning, every byte is full duplex and writes IN k. */
@@ -261,7 +295,7 @@ const char *supi3_strerror(int err)
     case SUPI3_OK:
         return "ok";
     case SUPI3_E_ARG:
-        return "invalid argument (NULL pointer, address not 0..14, block length not 1..4, mode)";
+        return "invalid argument (NULL pointer, address not 0..14, block length not 2..4 or not SET's, mode)";
     case SUPI3_E_NOT_INIT:
         return "not initialized: call supi3_init() and supi3_initialize() first";
     case SUPI3_E_TRANSPORT:
