@@ -162,3 +162,19 @@ def test_start_up_example_of_the_guide_compiles(tmp_path: Path) -> None:
         capture_output=True, text=True, check=False,
     )  # fmt: skip
     assert result.returncode == 0, result.stderr
+
+
+def test_header_is_usable_from_cxx(tmp_path: Path) -> None:
+    gxx = shutil.which("g++")
+    if gxx is None:
+        pytest.skip("g++ not found: the C++ include test needs it")
+    source = tmp_path / "user.cpp"
+    source.write_text(
+        '#include "supi3.h"\nint f();\nint f() { return supi3_init(nullptr, nullptr); }\n', encoding="ascii"
+    )
+    result = subprocess.run(
+        [gxx, "-std=c++11", "-Wall", "-Wextra", "-Werror", "-pedantic", "-fsyntax-only", f"-I{sdk.include_dir()}",
+         str(source)],
+        capture_output=True, text=True, check=False,
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr
