@@ -2,12 +2,12 @@
 
 ``tests/c/fuzz_driver.c`` runs the driver with callbacks whose every received byte, C/D, /IRQ and I/O (MFP1) level
 comes from a script (a used-up script makes the callback fail). Hypothesis writes the scripts and the calls. The
-harness, built with ``-fsanitize=address,undefined`` (in the slow tier also plain, with -O2, and more examples), runs many cases in one
-process (one line in, one line out), and every result is checked against :class:`Reference`, a Python statement of
-what the driver must do (3.4.3 to 3.4.14, docs/sdk.md): return codes, values read, block bytes, events OR-ed while
-polling, optical fields decoded with the Python register map, the u16/u32 helpers, and the bytes and S/R levels it
-sent. The sanitizers abort on the first finding (``-fno-sanitize-recover=all``), which fails the test with their
-report; at the end the process must exit 0 with nothing on stderr.
+harness, built with ``-fsanitize=address,undefined`` (the slow tier adds a plain -O2 build and more examples), runs
+many cases in one process (one line in, one line out), and every result is checked against :class:`Reference`, a
+Python statement of what the driver must do (3.4.3 to 3.4.14, docs/sdk.md): return codes, values read, block
+bytes, events OR-ed while polling, optical fields decoded with the Python register map, the u16/u32 helpers, and
+the bytes and S/R levels it sent. The sanitizers abort on the first finding (``-fno-sanitize-recover=all``), which
+fails the test with their report; at the end the process must exit 0 with nothing on stderr.
 """
 
 from __future__ import annotations
