@@ -660,6 +660,25 @@ def cycle_bits(data_bytes: int, devices: int) -> int:
     return frame_bits(LOOPBACK_BYTES + data_bytes) + STATUS_TELEGRAM_BITS * status
 
 
+class CyclePhases(NamedTuple):
+    """Where the phases of 3.4.14 (Figure 3-22) fall in one cycle, in bit periods from its first bit (the
+    transaction level's reading of the pin-level frame engine; all devices see them at once, A23)."""
+
+    check_bits: int
+    """The check sequence begins (the control bit of its first telegram): a data cycle's I/O access bit turns 1."""
+    latch_bits: int
+    """The first latch status telegram has ended: the latch phase begins (data cycles)."""
+    total_bits: int
+    """The second latch status telegram has ended: data latched, both phases over (:func:`cycle_bits`)."""
+
+
+def cycle_phases(data_bytes: int, devices: int) -> CyclePhases:
+    """The phases of one cycle with ``data_bytes`` bytes of device data and ``devices`` devices (3.4.14)."""
+    total = cycle_bits(data_bytes, devices)
+    check = DATA_TELEGRAM_BITS * (LOOPBACK_BYTES + data_bytes) + POS_CONTROL
+    return CyclePhases(check, total - STATUS_TELEGRAM_BITS * (LATCH_STATUS_TELEGRAMS - 1), total)
+
+
 def reset_bits(devices: int) -> int:
     """Bit periods of an INTERBUS reset sequence, including the ring delay of its end (assumption A12)."""
     return RESET_HOLD_BITS + STATUS_TELEGRAM_BITS * (RESET_END_STATUS_TELEGRAMS + ring_delay_status_telegrams(devices))
