@@ -324,6 +324,20 @@ class Bench:
         self._next_start = end if self.cycle_time_s is None else max(end, start + self.cycle_time_s)
         self.irq_edge()
 
+    # -- the board's other pins -------------------------------------------------------------------------------
+
+    def set_stat_err(self, active: bool) -> None:
+        """The firmware drives /StatErr (3.6.2): ``True`` reports a peripheral fault (the chip latches it after its
+        filter time and tells the master); ``False`` ends it."""
+        self.advance(self.now)
+        self.chip.set_stat_err(active, self.now)
+
+    @property
+    def mod_ack(self) -> int:
+        """/ModAck now: 0 during its pulse after the master's Quit Peripheral Error (3.6.2), else 1."""
+        self.advance(self.now)
+        return 0 if clocks(self.now) < self.chip.mod_ack_until else 1
+
     # -- interrupts --------------------------------------------------------------------------------------------
 
     def irq_edge(self) -> None:
