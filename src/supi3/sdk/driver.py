@@ -205,7 +205,7 @@ class OpticalStatus:
 
 def put_u16(value: int) -> bytes:
     """``value`` as the two data bytes of one word, byte 0 (address 0) the MSB (3.4.8); ``supi3_put_u16``."""
-    return check_int("value", value, 0, 0xFFFF, "a 16-bit word").to_bytes(2, "big")
+    return _checked(check_int, "value", value, 0, 0xFFFF, "a 16-bit word").to_bytes(2, "big")
 
 
 def get_u16(data: bytes) -> int:
@@ -215,7 +215,7 @@ def get_u16(data: bytes) -> int:
 
 def put_u32(value: int) -> bytes:
     """``value`` as data bytes 0..3, byte 0 the MSB (3.4.8); ``supi3_put_u32``."""
-    return check_int("value", value, 0, 0xFFFF_FFFF, "a 32-bit value").to_bytes(4, "big")
+    return _checked(check_int, "value", value, 0, 0xFFFF_FFFF, "a 32-bit value").to_bytes(4, "big")
 
 
 def get_u32(data: bytes) -> int:
@@ -224,7 +224,7 @@ def get_u32(data: bytes) -> int:
 
 
 def _exact(data: object, length: int) -> bytes:
-    raw = check_bytes("data", data)
+    raw = _checked(check_bytes, "data", data)
     if len(raw) != length:
         raise DriverArgumentError("data", data, f"data must be {length} bytes, not {describe(data)}")
     return raw
@@ -342,26 +342,31 @@ def _address(register: object, direction: AccessDirection | None) -> int:
                                   f"{describe(register)}{hint}")  # fmt: skip
     directions = tuple(AccessDirection) if direction is None else (direction,)
     if all(REGISTER_MAP.port(register.address, d).register is not register for d in directions):
-        verb = "read and written" if direction is None else f"{direction.value}"
+        verb = "read and written" if direction is None else "read" if direction is AccessDirection.READ else "written"
         raise DriverArgumentError("register", register, f"register {register.name} cannot be {verb} at address "
                                   f"{register.address} (Table 3-10)")  # fmt: skip
     return register.address
 
 
+def _checked(check: Callable[..., _T], *args: object, **kwargs: object) -> _T:
+    """Run a :mod:`supi3.checks` check; its error comes out as a :class:`DriverArgumentError` (``SUPI3_E_ARG``)."""
+    try:
+        return check(*args, **kwargs)
+    except ArgumentError as error:
+        raise DriverArgumentError(error.name, error.value, str(error)) from None
+
+
 def _byte(name: str, value: object) -> int:
     if type(value) is int and 0 <= value <= 0xFF:
         return value
-    try:
-        return check_int(name, value, 0, 0xFF, "one byte")
-    except ArgumentError as error:
-        raise DriverArgumentError(error.name, error.value, str(error)) from None
+    return _checked(check_int, name, value, 0, 0xFF, "one byte")
 
 
 class _Core:
     """The driver's state and its calls as operation generators; shared by the sync and async drivers."""
 
     def __init__(self, frame_gap_us: float) -> None:
-        self.frame_gap_us = check_real("frame_gap_us", frame_gap_us, 0.0)
+        self.frame_gap_us = _checked(check_real, "frame_gap_us", frame_gap_us, 0.0)
         self.initialized = False
         self.mode = Mode.MOTOROLA
         self.set_value: int | None = None
@@ -449,8 +454,8 @@ class _Core:
         return result
 
     def block_transfer(self, in_data: object, read: object, write: object) -> _Call[bytes]:
-        data = check_bytes("in_data", in_data)
-        rd, wr = check_bool("read", read), check_bool("write", write)
+        data = _checked(check_bytes, "in_data", in_data)
+        rd, wr = _checked(check_bool, "read", read), _checked(check_bool, "write", write)
         n = len(data)
         if not BLOCK_MIN_BYTES <= n <= BLOCK_MAX_BYTES:
             raise DriverArgumentError("in_data", in_data, f"in_data must be {BLOCK_MIN_BYTES} to {BLOCK_MAX_BYTES} "
@@ -505,7 +510,7 @@ class _Core:
         return Irq((yield from self._read(IRQ_EVT.address)) & _EVENT_MASK)
 
     def poll_io_window(self, max_polls: object) -> _Call[Irq]:
-        polls = check_int("max_polls", max_polls, 1, None, "polls of the I/O access bit")
+        polls = _checked(check_int, "max_polls", max_polls, 1, None, "polls of the I/O access bit")
         self._ready()
         return self._poll(polls)
 
