@@ -156,7 +156,7 @@ class BenchTransport(ModelTransport):
         bench = self.bench
         protocol = self.protocol
         bench.advance(bench.now)
-        with self.registers.violations.deferred():
+        with self._deferred:
             driven = protocol.begin(s_r)
             bench.advance(bench.now + bench.byte_s)
             protocol.end(driven if driven is not None and protocol.mode is Mode.INTEL else tx)

@@ -19,7 +19,7 @@ from abc import ABC, abstractmethod
 from collections.abc import Awaitable, Callable, Generator
 from dataclasses import dataclass
 from enum import IntEnum, IntFlag
-from typing import Final, TypeVar
+from typing import Any, Final, TypeVar
 
 from supi3 import tables
 from supi3.checks import check_bool, check_bytes, check_int, check_real, describe
@@ -309,7 +309,7 @@ class AsyncTransport(ABC):
 # Operations a driver call yields to its runner: (kind, argument, argument).
 _XFER, _DELAY, _CD, _IRQ, _IO, _SAS = range(6)
 _Op = tuple[int, int | float, bool]
-_Call = Generator[_Op, int | bool | None, _T]
+_Call = Generator[_Op, Any, _T]  # the runner sends each operation's answer back
 
 _S_R_CHIP_DRIVES: Final[bool] = False
 _S_R_UP_SENDS: Final[bool] = True
@@ -379,12 +379,6 @@ class _Core:
             raise NotInitializedError("driver not initialized: call initialize(Mode.MOTOROLA or Mode.INTEL) first "
                                       "(3.4.3), and again after SAS_INIT or a transport error; nothing sent")
 
-    def _frame(self, tx: int, s_r: bool) -> _Call[int]:
-        rx = yield (_XFER, tx, s_r)
-        if self.frame_gap_us:
-            yield (_DELAY, self.frame_gap_us, False)
-        return int(rx or 0)
-
     def _note_set(self, address: int, value: int) -> None:
         if address == SET.address:
             self.set_value = value
@@ -401,10 +395,10 @@ class _Core:
             raise NotReadyError("C/D shows data before the initialization byte: a command waits for its data byte "
                                 "(µP reset mid-command, UP-27) or the interface is disabled (UP-4); pulse SAS_INIT "
                                 "(3.4.3); nothing sent")  # fmt: skip
-        yield from self._frame(mode.init_byte, _S_R_UP_SENDS)
+        yield (_XFER, mode.init_byte, _S_R_UP_SENDS)
         if cd is not None and (yield (_CD, 0, False)):
             # "Command status twice" missing (3.4.3, UP-3): complete the command the byte became, then report.
-            yield from self._frame(0x00, _S_R_CHIP_DRIVES if mode is Mode.INTEL else _S_R_UP_SENDS)
+            yield (_XFER, 0x00, _S_R_CHIP_DRIVES if mode is Mode.INTEL else _S_R_UP_SENDS)
             raise NotResetError(f"initialize({mode.name}): the chip was not reset and took {mode.init_byte:02X}h "
                                 "as a command (3.4.3, UP-3); pulse SAS_INIT and initialize again")  # fmt: skip
         self.mode = mode
@@ -423,8 +417,8 @@ class _Core:
         return self._read(address)
 
     def _read(self, address: int) -> _Call[int]:
-        yield from self._frame(_READ[address], _S_R_UP_SENDS)
-        value = yield from self._frame(0x00, _S_R_CHIP_DRIVES)
+        yield (_XFER, _READ[address], _S_R_UP_SENDS)
+        value: int = yield (_XFER, 0x00, _S_R_CHIP_DRIVES)
         self._note_set(address, value)
         return value
 
@@ -435,8 +429,8 @@ class _Core:
         return self._write(address, byte)
 
     def _write(self, address: int, value: int) -> _Call[None]:
-        yield from self._frame(_WRITE[address], _S_R_UP_SENDS)
-        yield from self._frame(value, _S_R_UP_SENDS)
+        yield (_XFER, _WRITE[address], _S_R_UP_SENDS)
+        yield (_XFER, value, _S_R_UP_SENDS)
         self._note_set(address, value)
 
     def exchange(self, register: object, value: object) -> _Call[int]:
@@ -448,8 +442,8 @@ class _Core:
         return self._exchange(address, byte)
 
     def _exchange(self, address: int, value: int) -> _Call[int]:
-        yield from self._frame(_EXCHANGE[address], _S_R_UP_SENDS)
-        result = yield from self._frame(value, _S_R_UP_SENDS)
+        yield (_XFER, _EXCHANGE[address], _S_R_UP_SENDS)
+        result: int = yield (_XFER, value, _S_R_UP_SENDS)
         self._note_set(address, value)
         return result
 
@@ -471,16 +465,16 @@ class _Core:
         return self._block(data, rd, wr, intel)
 
     def _block(self, data: bytes, rd: bool, wr: bool, intel: bool) -> _Call[bytes]:
-        yield from self._frame(encode_command(BLOCK_ADDRESS, rd=rd, wr=wr), _S_R_UP_SENDS)
+        yield (_XFER, encode_command(BLOCK_ADDRESS, rd=rd, wr=wr), _S_R_UP_SENDS)
         out = bytearray()
         if not intel:  # UP-11: every byte full duplex, IN k written whatever RD/WR say
             for value in data:
-                out.append((yield from self._frame(value, _S_R_UP_SENDS)))
+                out.append((yield (_XFER, value, _S_R_UP_SENDS)))
             return bytes(out) if rd else b""
         for _ in data if rd else b"":
-            out.append((yield from self._frame(0x00, _S_R_CHIP_DRIVES)))
+            out.append((yield (_XFER, 0x00, _S_R_CHIP_DRIVES)))
         for value in data if wr else b"":
-            yield from self._frame(value, _S_R_UP_SENDS)
+            yield (_XFER, value, _S_R_UP_SENDS)
         return bytes(out)
 
     def configure(self, set_value: object, id_code: object) -> _Call[None]:
@@ -587,6 +581,7 @@ class Supi3Driver(_DriverApi):
     def _run(self, call: _Call[_T]) -> _T:
         transport = self.transport
         core = self._core
+        gap = core.frame_gap_us
         with transport.access():
             answer: int | bool | None = None
             try:
@@ -598,6 +593,8 @@ class Supi3Driver(_DriverApi):
                         except (OSError, TransportError) as error:
                             core.initialized = False
                             raise _transport_error(error) from error
+                        if gap:
+                            transport.delay_us(gap)
                     elif kind == _DELAY:
                         answer = None
                         transport.delay_us(argument)
@@ -690,6 +687,8 @@ class AsyncSupi3Driver(_DriverApi):
                     except (OSError, TransportError) as error:
                         self._core.initialized = False
                         raise _transport_error(error) from error
+                    if self._core.frame_gap_us:
+                        await transport.delay_us(self._core.frame_gap_us)
                 elif kind == _DELAY:
                     answer = None
                     await transport.delay_us(argument)
