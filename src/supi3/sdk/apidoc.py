@@ -16,8 +16,8 @@ from pathlib import Path
 from typing import Final
 
 from supi3.errors import Supi3Error
-from supi3.sdk import include_dir
 from supi3.sdk import driver as py
+from supi3.sdk import include_dir
 
 __all__ = ["ApiDocError", "c_calls", "python_counterpart", "render"]
 
