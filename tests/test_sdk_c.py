@@ -171,7 +171,7 @@ def test_start_up_example_of_the_guide_compiles(tmp_path: Path) -> None:
 
 
 def test_polling_example_of_the_guide_compiles(tmp_path: Path) -> None:
-    _compile_guide_example(tmp_path, "Synchronizing with the bus cycle", "    static supi3_t chip;\n")
+    _compile_guide_example(tmp_path, "Synchronizing with the bus: interrupt or polling", "    static supi3_t chip;\n")
 
 
 def test_header_is_usable_from_cxx(tmp_path: Path) -> None:

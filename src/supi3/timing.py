@@ -9,7 +9,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from supi3 import tables
-from supi3.checks import check_instance, check_int
+from supi3.checks import check_instance, check_int, check_real
 from supi3.errors import Supi3Error
 from supi3.interbus import wire
 
@@ -162,6 +162,29 @@ def limit(table: str, symbol: str, bit_rate: int, *, maximum: bool = False) -> f
                 raise TimingError(f"Table {table} gives no {'maximum' if maximum else 'minimum'} for {symbol}")
             return value
     raise TimingError(f"Table {table} has no parameter {symbol!r}")
+
+
+def upif_byte_s(bit_rate: int, sclk_hz: float | None = None) -> float:
+    """Time one byte of the serial µP interface takes, /SS edge to the next byte's /SS edge (Table 3-7).
+
+    /SS fall to the first SCLK fall max(t1, t7 - t0/2), 7.5 SCLK periods to the last rising edge, t2 to /SS rise,
+    and /SS high for t6 (maximum: C/D has settled) plus t8. ``sclk_hz`` ``None``: the fastest SCLK (t0 minimum).
+
+    Raises
+    ------
+    TimingError
+        If ``sclk_hz`` is faster than Table 3-7 allows at ``bit_rate``.
+    """
+    t0 = limit("3-7", "t0", bit_rate)
+    if sclk_hz is not None:
+        period = 1.0 / check_real("sclk_hz", sclk_hz, 1.0, limit="SCLK frequency in Hz")
+        if period < t0 * (1 - 1e-9):
+            raise TimingError(f"sclk_hz {sclk_hz:g} is faster than Table 3-7 allows at {bit_rate} bit/s "
+                              f"(t0 >= {t0 * 1e9:.0f} ns)")
+        t0 = period
+    lead = max(limit("3-7", "t1", bit_rate), limit("3-7", "t7", bit_rate, maximum=True) - t0 / 2)
+    return lead + 7.5 * t0 + limit("3-7", "t2", bit_rate) + limit("3-7", "t6", bit_rate, maximum=True) + \
+        limit("3-7", "t8", bit_rate)
 
 
 # ------------------------------------------------------------------------------------------------------------

@@ -660,6 +660,29 @@ def cycle_bits(data_bytes: int, devices: int) -> int:
     return frame_bits(LOOPBACK_BYTES + data_bytes) + STATUS_TELEGRAM_BITS * status
 
 
+class CyclePhases(NamedTuple):
+    """Where the phases of 3.4.14 (Figure 3-22) fall in one cycle: the bit periods (counted from the cycle's first
+    bit, 0) whose mid-bit sample (A1) decides them, as the pin-level frame engine does; the transaction level has
+    every device see them at once (docs/assumptions/sdk.md, FW-2)."""
+
+    check_bit: int
+    """The control bit of the first check telegram: a data cycle's I/O access bit turns 1 (busy)."""
+    latch_bit: int
+    """The stop bit of the first latch status telegram: the latch phase begins (data cycles)."""
+    end_bit: int
+    """The stop bit of the second latch status telegram: data latched, both phases over."""
+    total_bits: int
+    """The cycle's length (:func:`cycle_bits`)."""
+
+
+def cycle_phases(data_bytes: int, devices: int) -> CyclePhases:
+    """The phases of one cycle with ``data_bytes`` bytes of device data and ``devices`` devices (3.4.14, A11)."""
+    total = cycle_bits(data_bytes, devices)
+    check = DATA_TELEGRAM_BITS * (LOOPBACK_BYTES + data_bytes) + POS_CONTROL
+    last_stop = total - 1
+    return CyclePhases(check, last_stop - STATUS_TELEGRAM_BITS * (LATCH_STATUS_TELEGRAMS - 1), last_stop, total)
+
+
 def reset_bits(devices: int) -> int:
     """Bit periods of an INTERBUS reset sequence, including the ring delay of its end (assumption A12)."""
     return RESET_HOLD_BITS + STATUS_TELEGRAM_BITS * (RESET_END_STATUS_TELEGRAMS + ring_delay_status_telegrams(devices))

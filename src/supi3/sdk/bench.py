@@ -1,0 +1,441 @@
+"""The firmware test bench: INTERBUS master, ring, SUPI 3 chip and firmware on one clock (transaction level).
+
+Ref: IBS SUPI 3 OPC UM E rev. 05, 3.4.14 (interrupts, I/O access bit, latch phase, Figure 3-22), Table 3-7 (byte
+times); decisions FW-1 to FW-6 in docs/assumptions/sdk.md; guide docs/sdk.md, "Firmware tests".
+
+One clock, :attr:`Bench.now` (seconds), is bus time and firmware time at once:
+
+- every byte the firmware clocks costs its Table 3-7 time at the firmware's SCLK (:func:`supi3.timing.upif_byte_s`),
+  and its ``delay_us`` costs what it says; before each byte's /SS edges the bus catches up with the clock;
+- the master starts a cycle every :attr:`Bench.cycle_time_s` (or back to back); a cycle loads the devices' IN data
+  at its start and latches at its end, and in between, in a data cycle, the I/O access bit turns 1 when the check
+  sequence begins and the latch phase runs over the last latch telegram (:func:`supi3.interbus.wire.cycle_phases`);
+- a falling edge of /IRQ calls the firmware's :meth:`Firmware.isr`, at the next point where the firmware may be
+  interrupted: when it is idle, or when a driver call of its main code has ended (FW-3).
+
+So the interrupt method, the polling method with its 30-bit window and a firmware that touches the data registers
+in the latch phase (``InconsistentDataError``) are all tested at transaction level.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Sequence
+from types import TracebackType
+from typing import Final, Literal, NamedTuple
+
+from supi3 import tables, timing
+from supi3.checks import check_bool, check_instance, check_int, check_real, describe
+from supi3.config import DeviceConfig, decode
+from supi3.errors import Supi3Error
+from supi3.interbus import wire
+from supi3.interbus.link import Device
+from supi3.interbus.master import CycleResult, Master
+from supi3.interbus.ring import Ring, Transfer
+from supi3.interbus.wire import Cycle
+from supi3.model.chip import Supi3, clocks
+from supi3.model.registers import RegisterFile
+from supi3.sdk.driver import DriverArgumentError, Mode, Supi3Driver
+from supi3.sdk.transports import ModelTransport
+
+__all__ = ["DEFAULT_STRAPS", "Bench", "BenchError", "BenchTransport", "CycleTiming", "Firmware", "default_config"]
+
+DEFAULT_STRAPS: Final[tuple[str, str]] = ("10011", "1110")
+"""C[4..0] and MFP[15..12] of the bench's default chip: a remote bus device in the Init-µP mode (Table 2-4)."""
+KEPT: Final[int] = 1000
+"""FW-6: how many cycles :attr:`Bench.results` and :attr:`Bench.timeline` keep (a long run stays bounded)."""
+IDLE_LOOPS_LIMIT: Final[int] = 1000
+"""FW-5: main-loop calls in a row that clock no byte and wait for nothing before the bench calls it stuck."""
+
+
+class CycleTiming(NamedTuple):
+    """When one master cycle ran on the bench clock: its start (first bit), its kind and its phases."""
+
+    start: float
+    cycle: Cycle
+    phases: wire.CyclePhases
+    bit_s: float
+
+    def at(self, bit: int) -> float:
+        """The mid-bit sample of bit period ``bit`` (0 = the cycle's first): when the chip decides on it (A1)."""
+        return self.start + (bit + 0.5) * self.bit_s
+
+    @property
+    def io_busy(self) -> float:
+        """A data cycle's I/O access bit turns 1 (the check sequence begins)."""
+        return self.at(self.phases.check_bit)
+
+    @property
+    def latch(self) -> float:
+        """A data cycle's latch phase begins."""
+        return self.at(self.phases.latch_bit)
+
+    @property
+    def end(self) -> float:
+        """The latch: OUT data and events appear, both phases end."""
+        return self.at(self.phases.end_bit)
+
+
+class BenchError(Supi3Error, RuntimeError):
+    """The bench cannot go on: the firmware is stuck, or the bus has nothing left to do."""
+
+
+def default_config(bit_rate: int = 500_000) -> DeviceConfig:
+    """The default chip: :data:`DEFAULT_STRAPS` at ``bit_rate`` (CLK_CONF of Table 1-7)."""
+    return decode(*DEFAULT_STRAPS, clk_conf=tables.clk_conf_for(wire.check_bit_rate(bit_rate)))
+
+
+class Firmware:
+    """The firmware under test, as the bench calls it. Subclass and override what the firmware has.
+
+    :meth:`setup` runs once at power-up, :meth:`isr` on each falling edge of /IRQ, and :meth:`loop` (if overridden)
+    again and again as the main loop; a firmware without a main loop sleeps until its next interrupt.
+    """
+
+    def setup(self, drv: Supi3Driver) -> None:
+        """Power-up: initialize the interface, configure SET and ID, enable interrupts."""
+        del drv
+
+    def isr(self, drv: Supi3Driver) -> None:
+        """The /IRQ service routine."""
+        del drv
+
+    def loop(self, drv: Supi3Driver) -> None:
+        """One pass of the main loop (polling firmware)."""
+        del drv
+
+
+class _ClockedBus:
+    """The ring as the master sees it, except that the finish of a cycle (the latch) waits for the bench clock
+    to reach the cycle's end; a second transfer in one master call (error location) finishes the first at once."""
+
+    closes_early: Final = True
+    direct_return_line: Final = True
+
+    def __init__(self, ring: Ring) -> None:
+        self.ring = ring
+        self.pending: tuple[Transfer, bool, float] | None = None
+
+    @property
+    def now(self) -> float:
+        return self.ring.now
+
+    def flush(self) -> None:
+        if self.pending is not None:
+            transfer, latch, _ = self.pending
+            self.pending = None
+            self.ring.finish(transfer, latch)
+
+    def transfer(self, cycle: Cycle, data: bytes, close_after: int | None = None) -> Transfer:
+        self.flush()
+        return self.ring.transfer(cycle, data, close_after)
+
+    def finish(self, transfer: Transfer, latch: bool) -> None:
+        self.pending = (transfer, latch, self.ring.now)
+
+    def reset(self) -> None:
+        self.flush()
+        self.ring.reset()
+
+    def idle(self, seconds: float) -> None:
+        self.flush()
+        self.ring.idle(seconds)
+
+
+class BenchTransport(ModelTransport):
+    """:class:`ModelTransport` on the bench clock: each byte and delay advances bus time (FW-1, FW-2)."""
+
+    def __init__(self, bench: Bench, chip: Supi3) -> None:
+        super().__init__(chip)
+        self.bench = bench
+        self._depth = 0
+
+    def xfer(self, tx: int, s_r: bool) -> int:
+        """One frame: the chip decides what it drives at /SS falling, takes the byte at /SS rising (UP-18, UP-19);
+        the bus runs up to each edge."""
+        bench = self.bench
+        protocol = self.protocol
+        bench.advance(bench.now)
+        with self._deferred:
+            driven = protocol.begin(s_r)
+            bench.advance(bench.now + bench.byte_s)
+            protocol.end(driven if driven is not None and protocol.mode is Mode.INTEL else tx)
+        bench.bytes_clocked += 1
+        bench.irq_edge()
+        return driven or 0
+
+    def delay_us(self, us: float) -> None:
+        """Busy wait: the bus runs on."""
+        bench = self.bench
+        bench.advance(bench.now + check_real("us", us, 0.0) * 1e-6)
+
+    def read_cd(self) -> int:
+        """C/D now."""
+        self.bench.advance(self.bench.now)
+        return super().read_cd()
+
+    def read_irq(self) -> int:
+        """/IRQ now."""
+        self.bench.advance(self.bench.now)
+        return super().read_irq()
+
+    def read_io(self) -> int:
+        """The I/O access bit now."""
+        self.bench.advance(self.bench.now)
+        return super().read_io()
+
+    def access(self) -> _Access:
+        """A driver call: violations deferred to its end; an interrupt that came during a call of the main code is
+        taken when it ends (FW-3)."""
+        return _Access(self)
+
+
+class _Access:
+    __slots__ = ("_deferred", "_transport")
+
+    def __init__(self, transport: BenchTransport) -> None:
+        self._transport = transport
+        self._deferred = transport.registers.violations.deferred()
+
+    def __enter__(self) -> None:
+        self._transport._depth += 1
+        self._deferred.__enter__()
+
+    def __exit__(self, kind: type[BaseException] | None, error: BaseException | None,
+                 trace: TracebackType | None) -> Literal[False]:  # fmt: skip
+        transport = self._transport
+        transport._depth -= 1
+        self._deferred.__exit__(kind, error, trace)
+        if kind is None and transport._depth == 0:
+            transport.bench.take_interrupt()
+        return False
+
+
+class Bench:
+    """Master, ring, one SUPI 3 chip in an Init-µP mode and its firmware, on one clock (transaction level).
+
+    Parameters
+    ----------
+    config:
+        The chip's straps (an Init-µP mode); default :func:`default_config` at ``bit_rate``.
+    firmware:
+        What runs on the µP (:class:`Firmware`); ``None``: only the test drives :attr:`driver`.
+    mode:
+        The interface type the firmware uses (Table 3-8); tells the bench the Intel bit order, nothing more.
+    bit_rate:
+        INTERBUS bit rate when ``config`` is not given.
+    others:
+        Further devices in the ring, behind the chip (ring positions 2, 3, ...).
+    sclk_hz:
+        The firmware's SCLK; default the fastest Table 3-7 allows.
+    frame_gap_us:
+        The driver's wait after each frame.
+    cycle_time_s:
+        The master starts a cycle this often (``None``: back to back, the fastest the ring allows).
+    strict:
+        Rule violations of the firmware raise (``True``) or are recorded in ``chip.registers.violations``.
+
+    Attributes
+    ----------
+    chip, ring, master, driver, transport:
+        The parts; tests may use each directly (calls on :attr:`driver` from a test act as the firmware's main code).
+    now:
+        The clock, seconds since power-up.
+    cycles:
+        Master cycles finished (ID and data).
+    interrupts:
+        Calls of :meth:`Firmware.isr`.
+    irq_latency_s:
+        The longest time from a falling edge of /IRQ to its service routine's first byte.
+    results:
+        The master's :class:`CycleResult` of every cycle started, the last :data:`KEPT` (FW-6).
+    timeline:
+        The :class:`CycleTiming` of every cycle started, the last :data:`KEPT`.
+    """
+
+    def __init__(
+        self,
+        config: DeviceConfig | None = None,
+        *,
+        firmware: Firmware | None = None,
+        mode: Mode = Mode.MOTOROLA,
+        bit_rate: int = 500_000,
+        others: Sequence[Device] = (),
+        sclk_hz: float | None = None,
+        frame_gap_us: float = 0.0,
+        cycle_time_s: float | None = None,
+        strict: bool = True,
+    ) -> None:
+        self.config = default_config(bit_rate) if config is None else check_instance("config", config, DeviceConfig)
+        if firmware is not None and not isinstance(firmware, Firmware):
+            raise DriverArgumentError("firmware", firmware, f"firmware must be a supi3.sdk.bench.Firmware, not "
+                                      f"{describe(firmware)}")  # fmt: skip
+        self.firmware = firmware
+        self.mode = check_instance("mode", mode, Mode)
+        self.chip = Supi3(self.config, strict=check_bool("strict", strict))
+        if self.chip.registers is None:
+            raise DriverArgumentError("config", config, f"config must strap an Init-µP mode (Tables 2-4 to 2-7), "
+                                      f"not {self.config.function!r}")  # fmt: skip
+        self.registers: RegisterFile = self.chip.registers
+        self.ring = Ring([self.chip, *others], bit_rate=self.config.bit_rate)
+        self._bus = _ClockedBus(self.ring)
+        self.master = Master(self._bus)
+        self.byte_s = timing.upif_byte_s(self.config.bit_rate, sclk_hz)
+        self.cycle_time_s = None if cycle_time_s is None else check_real("cycle_time_s", cycle_time_s, 0.0)
+        self.transport = BenchTransport(self, self.chip)
+        self.driver = Supi3Driver(self.transport, frame_gap_us=frame_gap_us)
+        self._chips = [d for d in self.ring.devices if isinstance(d, Supi3) and d.registers is not None]
+        self.now = 0.0
+        self.cycles = 0
+        self.bytes_clocked = 0
+        self.interrupts = 0
+        self.irq_latency_s = 0.0
+        self.results: deque[CycleResult] = deque(maxlen=KEPT)
+        self.timeline: deque[CycleTiming] = deque(maxlen=KEPT)
+        self.registers.use_clock(lambda: clocks(self.now))
+        self._bit_s = 1.0 / self.config.bit_rate
+        self._events: list[tuple[float, str]] = []  # this cycle's phase changes, latest first
+        self._next_start = 0.0
+        self._started = False
+        self._irq_level = 1
+        self._irq_fell_at: float | None = None
+        self._in_isr = False
+        self._set_up = False
+
+    # -- the bus side ------------------------------------------------------------------------------------------
+
+    def _next_event(self) -> float:
+        return self._events[-1][0] if self._events else self._next_start
+
+    def advance(self, until: float) -> None:
+        """Run the bus up to time ``until`` and set the clock there (not backwards)."""
+        while self._next_event() <= until:
+            self._step_bus()
+        self.now = max(self.now, until)
+
+    def _step_bus(self) -> None:
+        """The next bus event: a cycle starts, a phase begins, or the cycle ends."""
+        if not self._events:
+            self._start_cycle()
+            return
+        at, what = self._events.pop()
+        self.now = max(self.now, at)
+        if what == "io":
+            for chip in self._chips:
+                chip.set_io_access(True)
+        elif what == "latch":
+            for chip in self._chips:
+                chip.set_latch_phase(True)
+        else:
+            self._bus.flush()
+            for chip in self._chips:
+                chip.set_latch_phase(False)
+                chip.set_io_access(False)
+            self.cycles += 1
+            self.irq_edge()
+
+    def _start_cycle(self) -> None:
+        at = self._next_start
+        self.now = max(self.now, at)
+        if at > self.ring.now:
+            self.ring.idle(at - self.ring.now)
+        result = self.master.cycle() if self._started else self.master.start()
+        self._started = True
+        self.results.append(result)
+        pending = self._bus.pending
+        if pending is None:  # cannot happen: every master cycle ends with a finish
+            raise BenchError("the master ran a cycle without finishing it")
+        transfer, _, start = pending
+        timing = CycleTiming(start, transfer.cycle, wire.cycle_phases(len(transfer.sent) - wire.LOOPBACK_BYTES,
+                                                                      transfer.devices), self._bit_s)
+        self.timeline.append(timing)
+        end = timing.end
+        events = [(end, "end")]
+        if transfer.cycle is Cycle.DATA:
+            events += [(timing.latch, "latch"), (timing.io_busy, "io")]
+        self._events = events
+        self._next_start = end if self.cycle_time_s is None else max(end, start + self.cycle_time_s)
+        self.irq_edge()
+
+    # -- the board's other pins -------------------------------------------------------------------------------
+
+    def set_stat_err(self, active: bool) -> None:
+        """The firmware drives /StatErr (3.6.2): ``True`` reports a peripheral fault (the chip latches it after its
+        filter time and tells the master); ``False`` ends it."""
+        self.advance(self.now)
+        self.chip.set_stat_err(active, self.now)
+
+    @property
+    def mod_ack(self) -> int:
+        """/ModAck now: 0 during its pulse after the master's Quit Peripheral Error (3.6.2), else 1."""
+        self.advance(self.now)
+        return 0 if clocks(self.now) < self.chip.mod_ack_until else 1
+
+    # -- interrupts --------------------------------------------------------------------------------------------
+
+    def irq_edge(self) -> None:
+        """Watch /IRQ for a falling edge (FW-3: edge-triggered, as an MCU's external interrupt)."""
+        level = self.registers.irq_n
+        if level < self._irq_level and self._irq_fell_at is None:
+            self._irq_fell_at = self.now
+        self._irq_level = level
+
+    def take_interrupt(self) -> None:
+        """Call the service routine for a pending falling edge of /IRQ (not nested)."""
+        firmware = self.firmware
+        if self._irq_fell_at is None or self._in_isr or firmware is None or not self._set_up:
+            return
+        self.irq_latency_s = max(self.irq_latency_s, self.now - self._irq_fell_at)
+        self._irq_fell_at = None
+        self._in_isr = True
+        self.interrupts += 1
+        try:
+            firmware.isr(self.driver)
+        finally:
+            self._in_isr = False
+
+    # -- running -----------------------------------------------------------------------------------------------
+
+    def power_up(self) -> None:
+        """Run the firmware's :meth:`Firmware.setup` (once; :meth:`run` does it if needed)."""
+        if not self._set_up:
+            self._set_up = True
+            if self.firmware is not None:
+                self.firmware.setup(self.driver)
+
+    def run(self, cycles: int) -> None:
+        """Run until ``cycles`` more master cycles have finished, the firmware's main loop and service routine
+        running as the clock goes.
+
+        Raises
+        ------
+        BenchError
+            If the firmware's main loop runs :data:`IDLE_LOOPS_LIMIT` times without clocking a byte or waiting.
+        """
+        target = self.cycles + check_int("cycles", cycles, 0)
+        self.power_up()
+        firmware = self.firmware
+        has_loop = firmware is not None and type(firmware).loop is not Firmware.loop
+        idle_loops = 0
+        while self.cycles < target:
+            if self._irq_fell_at is not None:
+                self.take_interrupt()
+            if has_loop and firmware is not None:
+                before = (self.now, self.bytes_clocked)
+                firmware.loop(self.driver)
+                if (self.now, self.bytes_clocked) != before:
+                    idle_loops = 0
+                    continue
+                idle_loops += 1
+                if idle_loops < IDLE_LOOPS_LIMIT:
+                    continue
+                raise BenchError(f"the firmware's main loop ran {IDLE_LOOPS_LIMIT} times without clocking a byte or "
+                                 f"waiting, at t = {self.now:.6f} s (FW-5)")  # fmt: skip
+            self._step_bus()  # sleep until the bus does something
+        self.take_interrupt()  # the last cycle's interrupt, as the firmware would take it
+
+    def run_for(self, seconds: float) -> None:
+        """Run until the clock has moved on by ``seconds`` (at least to the next bus event)."""
+        end = self.now + check_real("seconds", seconds, 0.0)
+        while self.now < end:
+            self.run(1)

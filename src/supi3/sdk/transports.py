@@ -1,0 +1,160 @@
+"""Transports for the Python firmware driver (:mod:`supi3.sdk.driver`): the model, and Linux spidev for hardware.
+
+- :class:`ModelTransport`: the transaction-level chip (``supi3.model.chip.Supi3`` or its register file), one byte
+  through the µP protocol engine per frame, C/D, /IRQ, the I/O bit and SAS_INIT from the model (3.4). No time
+  passes; :class:`supi3.sdk.bench.Bench` adds bus time.
+- :class:`SpidevTransport`: a real chip on a Linux SPI controller (the ``spidev`` module, optional extra
+  ``supi3[hw]``), with the chip's status pins as callables (gpiod, sysfs, ...).
+
+The pin-level whole chip and the RTL in cocotb have transports of their own (:mod:`supi3.sdk.pins`,
+:mod:`supi3.sdk.rtl`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import importlib
+import time
+from collections.abc import Callable
+from typing import Any
+
+from supi3.checks import check_int, describe
+from supi3.model.chip import Supi3
+from supi3.model.registers import RegisterFile
+from supi3.sdk.driver import DriverArgumentError, Mode, Transport
+from supi3.spi.upif import UpInterface
+
+__all__ = ["ModelTransport", "SpidevTransport"]
+
+
+class ModelTransport(Transport):
+    """The transaction-level chip behind the driver: every byte goes through the chip's µP protocol engine.
+
+    Parameters
+    ----------
+    chip:
+        A :class:`~supi3.model.chip.Supi3` strapped for an Init-µP mode, its :class:`RegisterFile`, or an
+        :class:`UpInterface` already made on one.
+
+    Each driver call runs inside the register file's ``violations.deferred()`` block (:meth:`access`): in strict
+    mode a rule the firmware broke is raised when the call has ended, with the chip back in a consistent phase.
+    """
+
+    def __init__(self, chip: Supi3 | RegisterFile | UpInterface) -> None:
+        self.up = chip if isinstance(chip, UpInterface) else UpInterface(chip)
+        self.protocol = self.up.protocol
+        self.registers = self.up.registers
+        self.sas_level = 0
+        self._deferred = self.registers.violations.deferred()
+
+    def xfer(self, tx: int, s_r: bool) -> int:
+        """One frame: /SS falls (the chip decides what it drives, UP-18), /SS rises (it takes the byte on the data
+        line: its own in an Intel receive frame). As :meth:`UpInterface.transfer`, without its argument checks:
+        the driver sends only bytes."""
+        protocol = self.protocol
+        with self._deferred:
+            driven = protocol.begin(s_r)
+            protocol.end(driven if driven is not None and protocol.mode is Mode.INTEL else tx)
+        return driven or 0
+
+    def read_cd(self) -> int:
+        """The protocol's C/D (UP-2)."""
+        return self.protocol.c_d
+
+    def read_irq(self) -> int:
+        """The register file's /IRQ (3.4.14)."""
+        return self.registers.irq_n
+
+    def read_io(self) -> int:
+        """The I/O access bit on MFP1 (3.4.14, Fig. 3-22): 1 = no data register access now."""
+        return int(self.registers.io_access)
+
+    def set_sas_init(self, level: int) -> bool:
+        """SAS_INIT: the interface restarts on the rising edge of the pin (3.4.3); registers are kept."""
+        level = check_int("level", level, 0, 1)
+        if level and not self.sas_level:
+            self.up.sas_init()
+        self.sas_level = level
+        return True
+
+    def access(self) -> contextlib.AbstractContextManager[None]:
+        """Strict-mode violations wait for the end of the driver call (``ViolationLog.deferred``)."""
+        return self.registers.violations.deferred()
+
+
+class SpidevTransport(Transport):
+    """A real SUPI 3 on a Linux SPI controller (``/dev/spidevB.D``), one byte per transfer.
+
+    Parameters
+    ----------
+    bus, device:
+        The spidev numbers.
+    mode:
+        Motorola: SPI mode 3, MSB first (UP-5). Intel: LSB first; then ``set_s_r`` is required.
+    speed_hz:
+        SCLK; at most 1.5 MHz at 500 kbit/s and 6 MHz at 2 Mbit/s (Table 3-7, t0).
+    read_cd, read_irq, read_io, set_sas_init, set_s_r:
+        The board's GPIOs as callables (``None``: not wired): C/D, /IRQ and I/O levels, SAS_INIT and S/R drive.
+    spidev_module:
+        The module providing ``SpiDev`` (default: ``import spidev``); tests pass a stand-in.
+
+    ``spidev`` toggles /SS around each ``xfer`` call, which is the one frame per byte the chip needs (3.4.2, UP-7).
+    An ``OSError`` of the controller reaches the driver as its :class:`~supi3.sdk.driver.TransportError`.
+    """
+
+    def __init__(self, bus: int, device: int, *, mode: Mode = Mode.MOTOROLA, speed_hz: int = 1_000_000,
+                 read_cd: Callable[[], int] | None = None, read_irq: Callable[[], int] | None = None,
+                 read_io: Callable[[], int] | None = None, set_sas_init: Callable[[int], None] | None = None,
+                 set_s_r: Callable[[int], None] | None = None, spidev_module: Any = None) -> None:  # fmt: skip
+        if type(mode) is not Mode:
+            raise DriverArgumentError("mode", mode, f"mode must be Mode.MOTOROLA or Mode.INTEL, not {describe(mode)}")
+        if mode is Mode.INTEL and set_s_r is None:
+            raise DriverArgumentError("set_s_r", set_s_r, "set_s_r must be a callable in Intel mode: the chip reads "
+                                      "the direction from S/R (Table 3-9), not None")  # fmt: skip
+        for name, pin in (("read_cd", read_cd), ("read_irq", read_irq), ("read_io", read_io),
+                          ("set_sas_init", set_sas_init), ("set_s_r", set_s_r)):  # fmt: skip
+            if pin is not None and not callable(pin):
+                raise DriverArgumentError(name, pin, f"{name} must be a callable or None, not {describe(pin)}")
+        module = importlib.import_module("spidev") if spidev_module is None else spidev_module
+        self.spi = module.SpiDev()
+        self.spi.open(check_int("bus", bus, 0), check_int("device", device, 0))
+        self.spi.mode = 0b11
+        self.spi.lsbfirst = mode is Mode.INTEL
+        self.spi.max_speed_hz = check_int("speed_hz", speed_hz, 1)
+        self._pins = (read_cd, read_irq, read_io)
+        self._sas = set_sas_init
+        self._s_r = set_s_r
+
+    def xfer(self, tx: int, s_r: bool) -> int:
+        """One ``spidev.xfer([tx])``, S/R set first in Intel mode."""
+        if self._s_r is not None:
+            self._s_r(int(s_r))
+        [rx] = self.spi.xfer([tx])
+        return int(rx)
+
+    def delay_us(self, us: float) -> None:
+        """Sleep (``time.sleep``; the frame gap and the SAS_INIT pulse are far above its resolution's needs)."""
+        time.sleep(us * 1e-6)
+
+    def read_cd(self) -> int | None:
+        """The C/D GPIO, if wired."""
+        return None if self._pins[0] is None else int(self._pins[0]())
+
+    def read_irq(self) -> int | None:
+        """The /IRQ GPIO, if wired."""
+        return None if self._pins[1] is None else int(self._pins[1]())
+
+    def read_io(self) -> int | None:
+        """The I/O GPIO, if wired."""
+        return None if self._pins[2] is None else int(self._pins[2]())
+
+    def set_sas_init(self, level: int) -> bool:
+        """Drive the SAS_INIT GPIO, if wired."""
+        if self._sas is None:
+            return False
+        self._sas(level)
+        return True
+
+    def close(self) -> None:
+        """Release the spidev device."""
+        self.spi.close()
