@@ -139,10 +139,14 @@ class Reference:
 
     # the driver ---------------------------------------------------------------------------------------------------
 
-    def access_ok(self, addr: int) -> int:
-        if addr > ADDR_MAX:
+    def entry_ok(self, args_ok: bool) -> int:
+        """Value arguments first (SUPI3_E_ARG), then the state; pointer arguments are checked after this."""
+        if not args_ok:
             return E_ARG
         return OK if self.initialized else E_NOT_INIT
+
+    def access_ok(self, addr: int) -> int:
+        return self.entry_ok(addr <= ADDR_MAX)
 
     def note_set(self, addr: int, value: int, rc: int) -> None:
         if addr == SET.address:
@@ -260,8 +264,8 @@ class Reference:
         return self.read(IRQ_EVT.address)
 
     def poll(self, max_polls: int, null: bool) -> tuple[int, int | None]:
-        rc = self.access_ok(IRQ_EVT.address)
-        if rc == OK and (max_polls == 0 or (null and not self.case.with_io)):
+        rc = self.entry_ok(max_polls != 0)
+        if rc == OK and null and not self.case.with_io:
             rc = E_ARG
         if rc != OK:
             return rc, None
@@ -283,9 +287,7 @@ class Reference:
         return E_TIMEOUT, events
 
     def irq_enable(self, mask: int) -> int:
-        rc = self.access_ok(IRQ_EN.address)
-        if rc == OK and mask & ~IRQ_EN.mask:
-            rc = E_ARG  # bit 7 reserved (RM-7)
+        rc = self.entry_ok(not mask & ~IRQ_EN.mask)  # bit 7 reserved (RM-7)
         return rc if rc != OK else self.write(IRQ_EN.address, mask)
 
     def optical(self, null: bool) -> tuple[int, list[int]]:

@@ -483,6 +483,7 @@ static void test_irq_enable(void)
     setup(&ctx, &f, 1);
     CHECK_EQ(supi3_irq_enable(NULL, 0x10u), SUPI3_E_ARG);
     CHECK_EQ(supi3_irq_enable(&ctx, 0x10u), SUPI3_E_NOT_INIT);
+    CHECK_EQ(supi3_irq_enable(&ctx, 0x80u), SUPI3_E_ARG); /* value arguments before the state, as addresses */
     CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_OK);
     CHECK_EQ(supi3_irq_enable(&ctx, SUPI3_IRQ_EN_PCMD_MSK | SUPI3_IRQ_EN_VALID_MSK), SUPI3_OK); /* 3.4.14 step 1 */
     CHECK_EQ(f.irq_en, 0x50u);
@@ -501,6 +502,8 @@ static void test_poll_io_window_by_register(void)
     static const uint8_t expect[] = {0x8Eu, 0x00u, 0x8Eu, 0x00u, 0x8Eu, 0x00u};
     setup(&ctx, &f, 1);
     CHECK_EQ(supi3_poll_io_window(&ctx, 1u, &ev), SUPI3_E_NOT_INIT);
+    CHECK_EQ(supi3_poll_io_window(&ctx, 0u, &ev), SUPI3_E_ARG);
+    CHECK_EQ(supi3_poll_io_window(&ctx, 1u, NULL), SUPI3_E_NOT_INIT); /* pointers after the state */
     CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_OK);
     f.ntx = 0u;
     f.io_scripted = 1; f.io_busy_reads = 2;

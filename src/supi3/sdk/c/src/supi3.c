@@ -43,19 +43,25 @@ static int read_pin(const supi3_t *ctx, supi3_read_pin_fn read, int *level)
     return SUPI3_OK;
 }
 
-/* Common entry check of the register accesses (UP-25: refused before the first byte). */
-static int access_ok(const supi3_t *ctx, uint8_t addr)
+/* Common entry check of the register accesses (UP-25: refused before the first byte): the context, then the
+ * value arguments (args_ok), then the state; pointer arguments are checked after this. */
+static int entry_ok(const supi3_t *ctx, int args_ok)
 {
     if (!ctx_ok(ctx)) {
         return ctx == NULL ? SUPI3_E_ARG : SUPI3_E_NOT_INIT;
     }
-    if (addr > SUPI3_ADDR_MAX) {
-        return SUPI3_E_ARG; /* 15 is the block transfer (3.4.6): supi3_block_transfer() */
+    if (!args_ok) {
+        return SUPI3_E_ARG;
     }
     if (!ctx->initialized) {
         return SUPI3_E_NOT_INIT;
     }
     return SUPI3_OK;
+}
+
+static int access_ok(const supi3_t *ctx, uint8_t addr)
+{
+    return entry_ok(ctx, addr <= SUPI3_ADDR_MAX); /* 15 is the block transfer (3.4.6): supi3_block_transfer() */
 }
 
 /* Bytes of a SET value with ExtReg = 0 (Table 3-12; block transfers at >= 1 word, 3.4.6); 0 = no block. */
@@ -298,10 +304,8 @@ int supi3_irq_service(supi3_t *ctx, uint8_t *events)
 
 int supi3_irq_enable(supi3_t *ctx, uint8_t mask)
 {
-    int err = access_ok(ctx, (uint8_t)SUPI3_IRQ_EN_ADDR);
-    if (err == SUPI3_OK && (mask & (uint8_t)~IRQ_EN_SOURCES) != 0u) {
-        err = SUPI3_E_ARG; /* bit 7 is reserved: the I/O access bit is a status, not a source (RM-7) */
-    }
+    /* bit 7 is reserved: the I/O access bit is a status, not a source (RM-7) */
+    int err = entry_ok(ctx, (mask & (uint8_t)~IRQ_EN_SOURCES) == 0u);
     if (err != SUPI3_OK) {
         return err;
     }
@@ -313,8 +317,8 @@ int supi3_poll_io_window(supi3_t *ctx, uint32_t max_polls, uint8_t *events)
     uint32_t k;
     uint8_t value = 0u;
     int level = 1;
-    int err = access_ok(ctx, (uint8_t)SUPI3_IRQ_EVT_ADDR);
-    if (err == SUPI3_OK && (max_polls == 0u || (events == NULL && ctx->cfg.read_io == NULL))) {
+    int err = entry_ok(ctx, max_polls != 0u);
+    if (err == SUPI3_OK && events == NULL && ctx->cfg.read_io == NULL) {
         err = SUPI3_E_ARG;
     }
     if (err != SUPI3_OK) {
