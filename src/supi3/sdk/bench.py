@@ -179,8 +179,10 @@ class BenchTransport(ModelTransport):
         self.bench.advance(self.bench.now)
         return super().read_irq()
 
-    def read_io(self) -> int:
-        """The I/O access bit now."""
+    def read_io(self) -> int | None:
+        """The I/O access bit now; ``None`` if the bench leaves the pin unwired (:attr:`Bench.io_pin`)."""
+        if not self.bench.io_pin:
+            return None
         self.bench.advance(self.bench.now)
         return super().read_io()
 
@@ -234,6 +236,9 @@ class Bench:
         The master starts a cycle this often (``None``: back to back, the fastest the ring allows).
     strict:
         Rule violations of the firmware raise (``True``) or are recorded in ``chip.registers.violations``.
+    io_pin:
+        The I/O access pin (MFP1) is wired to the firmware; ``False``: the driver polls D7 of IRQ_EVT instead, the
+        manual's polling method (3.4.14), each poll clocking its two bytes.
 
     Attributes
     ----------
@@ -265,6 +270,7 @@ class Bench:
         frame_gap_us: float = 0.0,
         cycle_time_s: float | None = None,
         strict: bool = True,
+        io_pin: bool = True,
     ) -> None:
         self.config = default_config(bit_rate) if config is None else check_instance("config", config, DeviceConfig)
         if firmware is not None and not isinstance(firmware, Firmware):
@@ -281,6 +287,7 @@ class Bench:
         self._bus = _ClockedBus(self.ring)
         self.master = Master(self._bus)
         self.byte_s = timing.upif_byte_s(self.config.bit_rate, sclk_hz)
+        self.io_pin = check_bool("io_pin", io_pin)
         self.cycle_time_s = None if cycle_time_s is None else check_real("cycle_time_s", cycle_time_s, 0.0)
         self.transport = BenchTransport(self, self.chip)
         self.driver = Supi3Driver(self.transport, frame_gap_us=frame_gap_us)
@@ -370,6 +377,13 @@ class Bench:
         """/ModAck now: 0 during its pulse after the master's Quit Peripheral Error (3.6.2), else 1."""
         self.advance(self.now)
         return 0 if clocks(self.now) < self.chip.mod_ack_until else 1
+
+    @property
+    def mod_ack_pulses(self) -> int:
+        """/ModAck pulses so far (3.6.2): what an edge-triggered MCU input wired to /ModAck counts (the pulse is
+        shorter than any firmware poll, M3)."""
+        self.advance(self.now)
+        return self.chip.events["MODACK"]
 
     # -- interrupts --------------------------------------------------------------------------------------------
 

@@ -1,0 +1,44 @@
+"""The management channel: the master sends processor commands, the firmware answers with processor alarms.
+
+Ref: IBS SUPI 3 OPC UM E rev. 05, 3.4.9 (processor command register, read at address 7, with its interrupt; processor
+alarm register, written at address 7, read by the master), 3.4.14 (the PCMD interrupt source); the master's side
+of the channel is assumption A18 (docs/assumptions/interbus.md).
+"""
+
+from __future__ import annotations
+
+from typing import Final
+
+from supi3.sdk.bench import Firmware
+from supi3.sdk.driver import Irq, Mode, Supi3Driver
+from supi3.sdk.examples.digital import DIO_ID, ONE_WORD_IO
+
+__all__ = ["ManagementChannel", "STATUS_REQUEST"]
+
+STATUS_REQUEST: Final = 0x01
+"""This example's command "report your status": answered with :attr:`ManagementChannel.status`."""
+
+
+class ManagementChannel(Firmware):
+    """Answers every processor command with an alarm byte: :attr:`status` for :data:`STATUS_REQUEST`, else the
+    command's one's complement (an echo the master can check). :attr:`commands` keeps the commands received."""
+
+    def __init__(self, mode: Mode = Mode.MOTOROLA, status: int = 0x5A) -> None:
+        self.mode = mode
+        self.status = status
+        self.commands: list[int] = []
+
+    def setup(self, drv: Supi3Driver) -> None:
+        drv.initialize(self.mode)
+        drv.configure(ONE_WORD_IO, DIO_ID)
+        drv.irq_enable(Irq.PCMD)
+
+    def isr(self, drv: Supi3Driver) -> None:
+        if drv.irq_service() & Irq.PCMD:
+            command = drv.processor_command()
+            self.commands.append(command)
+            drv.processor_alarm(self.answer(command))
+
+    def answer(self, command: int) -> int:
+        """The alarm byte for ``command``."""
+        return self.status if command == STATUS_REQUEST else command ^ 0xFF
