@@ -65,7 +65,7 @@ class ModelTransport(Transport):
         """The register file's /IRQ (3.4.14)."""
         return self.registers.irq_n
 
-    def read_io(self) -> int:
+    def read_io(self) -> int | None:
         """The I/O access bit on MFP1 (3.4.14, Fig. 3-22): 1 = no data register access now."""
         return int(self.registers.io_access)
 

@@ -11,7 +11,7 @@ from typing import Final
 from supi3.sdk.bench import Firmware
 from supi3.sdk.driver import Irq, Mode, Supi3Driver, get_u32, put_u32
 
-__all__ = ["AIO_ID", "AnalogIo", "TWO_WORDS_IO"]
+__all__ = ["AIO_ID", "TWO_WORDS_IO", "AnalogIo"]
 
 TWO_WORDS_IO: Final = 0x85
 """SET: /PCP = 1, ExtReg = 0, CL = 101 (2 words) (3.4.5, Table 3-12)."""

@@ -13,7 +13,7 @@ from supi3.sdk.bench import Firmware
 from supi3.sdk.driver import Irq, Mode, Supi3Driver
 from supi3.sdk.examples.digital import DIO_ID, ONE_WORD_IO
 
-__all__ = ["ManagementChannel", "STATUS_REQUEST"]
+__all__ = ["STATUS_REQUEST", "ManagementChannel"]
 
 STATUS_REQUEST: Final = 0x01
 """This example's command "report your status": answered with :attr:`ManagementChannel.status`."""
