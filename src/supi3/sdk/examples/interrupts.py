@@ -19,18 +19,20 @@ __all__ = ["InterruptDriven"]
 class InterruptDriven(Firmware):
     """16/16 process data on VALID, and the bus's state from the other events.
 
-    - VALID: one block transfer; the device sends back the count of valid data cycles it has seen (16 bits), and
-      drives the master's word on its outputs (:attr:`outputs`);
+    - VALID: one block transfer: the terminals' word (:attr:`inputs`) to the master, the master's word to the
+      outputs (:attr:`outputs`);
     - IB_RESET: the master reset the bus: outputs to the safe state 0 (3.4.7);
     - ID_CYCLE: counted (the master configures or diagnoses the ring).
 
     :attr:`events` counts each source taken; :attr:`history` keeps the output words in order.
     """
 
+    DATA_BYTES = 2
     SOURCES = Irq.VALID | Irq.ID_CYCLE | Irq.IB_RESET
 
     def __init__(self, mode: Mode = Mode.MOTOROLA) -> None:
         self.mode = mode
+        self.inputs = 0
         self.outputs = 0
         self.events: Counter[str] = Counter()
         self.history: list[int] = []
@@ -48,5 +50,5 @@ class InterruptDriven(Firmware):
         if events & Irq.IB_RESET:
             self.outputs = 0
         if events & Irq.VALID:
-            self.outputs = get_u16(drv.block_transfer(put_u16(self.events["VALID"] & 0xFFFF)))
+            self.outputs = get_u16(drv.block_transfer(put_u16(self.inputs)))
             self.history.append(self.outputs)
