@@ -12,7 +12,7 @@ Everything here runs inside a cocotb 2.x simulation of :class:`supi3.rtl.chip.Su
   Ser_IN/OUT and S/R in Intel mode, C/D, /IRQ, I/O, SAS_INIT) with the edges of
   :class:`supi3.spi.master.MasterTiming` (Table 3-7): ``AsyncSupi3Driver(RtlTransport(board, mode))``;
 - :class:`BridgedTransport`: any ``AsyncTransport`` as a synchronous :class:`~supi3.sdk.driver.Transport` for code
-  run in a ``cocotb.bridge`` thread (each call is ``cocotb.resume``-d), so the very same synchronous firmware
+  run in a ``cocotb.task.bridge`` thread (each call is ``cocotb.task.resume``-d), so the very same synchronous firmware
   (:mod:`supi3.sdk.examples`) runs on the RTL;
 - :class:`RtlRing`: the INTERBUS line through the RTL chip as the :class:`~supi3.interbus.ring.Bus` of a
   :class:`~supi3.interbus.master.Master` (the line levels of :class:`supi3.model.pinring.PinRing`, driven on ``do1``
@@ -37,6 +37,7 @@ import cocotb
 import numpy as np
 import numpy.typing as npt
 from cocotb.clock import Clock
+from cocotb.task import bridge, resume
 from cocotb.triggers import Edge, Event, FallingEdge, First, Timer
 from cocotb.utils import get_sim_time
 
@@ -258,40 +259,43 @@ class RtlTransport(AsyncTransport):
 
 
 class BridgedTransport(Transport):
-    """An :class:`AsyncTransport` as a synchronous :class:`Transport`, for code run with ``cocotb.bridge``: each
-    call blocks its thread while the simulation runs the awaitable (``cocotb.resume``)."""
+    """An :class:`AsyncTransport` as a synchronous :class:`Transport`, for code run with ``cocotb.task.bridge``: each
+    call blocks its thread while the simulation runs the awaitable (``cocotb.task.resume``)."""
 
     def __init__(self, inner: AsyncTransport) -> None:
-        self.inner = check_instance("inner", inner, AsyncTransport)
+        if not isinstance(inner, AsyncTransport):
+            raise DriverArgumentError("inner", inner, f"inner must be a supi3.sdk.driver.AsyncTransport, not "
+                                      f"{describe(inner)}")  # fmt: skip
+        self.inner = inner
 
     def xfer(self, tx: int, s_r: bool) -> int:
         """As :meth:`AsyncTransport.xfer`, blocking."""
-        return cocotb.resume(self.inner.xfer)(tx, s_r)
+        return resume(self.inner.xfer)(tx, s_r)
 
     def delay_us(self, us: float) -> None:
         """As :meth:`AsyncTransport.delay_us`, blocking."""
-        cocotb.resume(self.inner.delay_us)(us)
+        resume(self.inner.delay_us)(us)
 
     def read_cd(self) -> int | None:
         """As :meth:`AsyncTransport.read_cd`, blocking."""
-        return cocotb.resume(self.inner.read_cd)()
+        return resume(self.inner.read_cd)()
 
     def read_irq(self) -> int | None:
         """As :meth:`AsyncTransport.read_irq`, blocking."""
-        return cocotb.resume(self.inner.read_irq)()
+        return resume(self.inner.read_irq)()
 
     def read_io(self) -> int | None:
         """As :meth:`AsyncTransport.read_io`, blocking."""
-        return cocotb.resume(self.inner.read_io)()
+        return resume(self.inner.read_io)()
 
     def set_sas_init(self, level: int) -> bool:
         """As :meth:`AsyncTransport.set_sas_init`, blocking."""
-        return cocotb.resume(self.inner.set_sas_init)(level)
+        return resume(self.inner.set_sas_init)(level)
 
 
 class RtlRing(PinRing):
     """The INTERBUS line through the RTL chip: :class:`PinRing`'s telegrams, receiver and Bus protocol, with the
-    forward line driven on ``do1`` and the return line read from ``di1``. Call it from a ``cocotb.bridge`` thread
+    forward line driven on ``do1`` and the return line read from ``di1``. Call it from a ``cocotb.task.bridge`` thread
     (the master's calls block while the simulation runs)."""
 
     def __init__(self, board: RtlBoard) -> None:
@@ -303,7 +307,9 @@ class RtlRing(PinRing):
     def run_samples(self, samples: npt.NDArray[np.uint8]) -> None:
         """Drive ``samples`` (one per clock) on ``do1`` and append what ``di1`` returned meanwhile."""
         forward = np.asarray(samples, dtype=np.uint8)
-        returned = cocotb.resume(self._drive)(forward)
+        if not len(forward):
+            return
+        returned = resume(self._drive)(forward)
         self.cycle += len(forward)
         self.returned = np.concatenate([self.returned, returned])
 
@@ -370,28 +376,28 @@ class RtlBench:
         firmware, driver = self.firmware, self.driver
         has_loop = type(firmware).loop is not Firmware.loop
         while not self._stopping.is_set():
-            if cocotb.resume(self.transport.read_irq)() == 0:
+            if resume(self.transport.read_irq)() == 0:
                 self.interrupts += 1
                 firmware.isr(driver)
             elif has_loop:
                 firmware.loop(driver)
             else:
-                cocotb.resume(self.board.irq_low_or)(self._stop)
+                resume(self.board.irq_low_or)(self._stop)
 
     def _scenario(self, scenario: Callable[[], _T]) -> _T:
         try:
             return scenario()
         finally:
             self._stopping.set()
-            cocotb.resume(self._set_stop)()
+            resume(self._set_stop)()
 
     async def _set_stop(self) -> None:
         self._stop.set()
 
     async def call(self, scenario: Callable[[], _T]) -> _T:
         """Run the firmware's setup, then ``scenario()`` with the firmware running; return what it returns."""
-        await cocotb.bridge(self.firmware.setup)(self.driver)
-        running = cocotb.start_soon(cocotb.bridge(self._firmware)())
-        result = await cocotb.bridge(self._scenario)(scenario)
+        await bridge(self.firmware.setup)(self.driver)
+        running = cocotb.start_soon(bridge(self._firmware)())
+        result = await bridge(self._scenario)(scenario)
         await running
         return result
