@@ -19,7 +19,6 @@ import cocotb
 from supi3.sdk import examples
 from supi3.sdk.bench import default_config
 from supi3.sdk.driver import Mode
-from supi3.sdk.examples.history import ProcessDevice
 from supi3.sdk.rtl import RtlBench, RtlBoard
 
 JOB_ENV = "SUPI3_SDK_RTL_JOB"
@@ -43,8 +42,7 @@ async def example_on_rtl(dut: Any) -> None:
     def scenario() -> dict[str, Any]:
         bench.run(START_CYCLES)
         entry = bench.master.entry(1)
-        process: ProcessDevice = device
-        seen = examples.play(bench, process, history)  # type: ignore[arg-type]
+        seen = examples.play(bench, device, history)
         return {"id_code": entry.id_code, "data_bits": entry.data_bits, "seen": seen,
                 "interrupts": bench.interrupts, "frames": bench.transport.frames}  # fmt: skip
 

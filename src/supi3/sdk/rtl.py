@@ -21,9 +21,9 @@ Everything here runs inside a cocotb 2.x simulation of :class:`supi3.rtl.chip.Su
   :class:`supi3.sdk.bench.Bench`; :meth:`RtlBench.call` runs a synchronous scenario while the firmware runs beside
   it, each in its own bridge thread.
 
-Decisions (docs/assumptions/sdk.md, RTL-1 to RTL-3): the firmware's interrupt input is level-sensitive
-(:data:`IRQ_LEVEL_SENSITIVE`) and interrupts are taken between main-loop passes; pins change at falling clock edges
-(:data:`EDGE`).
+Decisions (docs/assumptions/sdk.md): the board's pins change at falling clock edges, a frame's edges are
+:meth:`MasterTiming.fastest` (FW-11); the firmware's interrupt input is level-sensitive and taken between main-loop
+passes (FW-12); :class:`RtlRing` is :class:`PinRing` with the RTL on the line (FW-13).
 """
 
 from __future__ import annotations
@@ -55,8 +55,6 @@ from supi3.verif.straps import strap_inputs
 
 __all__ = [
     "CLOCK_PS",
-    "EDGE",
-    "IRQ_LEVEL_SENSITIVE",
     "BridgedTransport",
     "RtlBench",
     "RtlBoard",
@@ -68,12 +66,6 @@ _T = TypeVar("_T")
 
 CLOCK_PS: Final[int] = round(1e12 / CLOCK_HZ)
 """The chip clock's period in ps (32 MHz: 31 250 ps); simulate with a 1 ps precision."""
-EDGE: Final[str] = "falling"
-"""RTL-1: every pin the board drives changes at a falling clock edge, half a period before the chip's rising edge
-samples it (the convention of :mod:`supi3.pinlevel`)."""
-IRQ_LEVEL_SENSITIVE: Final[bool] = True
-"""RTL-2: the firmware's interrupt input follows the /IRQ level (the chip holds /IRQ low until IRQ_EVT is read,
-3.4.14), taken between main-loop passes; the model bench takes the falling edge at the end of a driver call (FW-3)."""
 _QUIET: Final[dict[str, int]] = {"di2": 0, "rbst_ext": 0, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 1}
 """The board inputs other than the line and the MFPs: last device in the ring, no fault, power good."""
 _RESET_POLL_CLOCKS: Final[int] = 16
@@ -108,7 +100,7 @@ class RtlBoard:
         return int(get_sim_time("ps")) // CLOCK_PS
 
     async def align(self) -> None:
-        """Wait, if need be, for the next falling clock edge (RTL-1)."""
+        """Wait, if need be, for the next falling clock edge, where the board changes its pins (FW-11)."""
         if int(get_sim_time("ps")) % CLOCK_PS != CLOCK_PS // 2:
             await FallingEdge(self.dut.clk)
 
