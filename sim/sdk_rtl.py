@@ -1,6 +1,8 @@
-"""cocotb test: a Python example firmware (supi3.sdk.examples) on the RTL chip, with an INTERBUS master on its line.
+"""cocotb tests: the Python driver and example firmware (supi3.sdk) on the RTL chip.
 
-Ref: guide docs/sdk-firmware-python.md, "The RTL back end". The job (JSON, path in ``SUPI3_SDK_RTL_JOB``) names the
+Ref: guide docs/sdk-firmware-python.md, "The RTL back end"; 3.4.3 to 3.4.5, 3.4.14. ``async_driver_registers``
+drives the chip with the async driver straight from a coroutine. ``example_on_rtl`` runs an example firmware with an
+INTERBUS master on the chip's line: the job (JSON, path in ``SUPI3_SDK_RTL_JOB``) names the
 example, the interface mode, the bit rate, the cycle time and a process data history; the test starts the chip
 (:class:`supi3.sdk.rtl.RtlBoard`), runs the firmware with the master (:class:`supi3.sdk.rtl.RtlBench`), plays the
 history (:func:`supi3.sdk.examples.play`) and writes what it saw as JSON next to the job. Started by
@@ -16,12 +18,15 @@ from typing import Any
 
 import cocotb
 
+from supi3.regmap import ID, IRQ_EVT, SET
 from supi3.sdk import examples
 from supi3.sdk.bench import default_config
-from supi3.sdk.driver import Mode
-from supi3.sdk.rtl import RtlBench, RtlBoard
+from supi3.sdk.driver import AsyncSupi3Driver, Irq, Mode, NotResetError
+from supi3.sdk.examples.digital import DIO_ID, ONE_WORD_IO
+from supi3.sdk.rtl import RtlBench, RtlBoard, RtlTransport
 
 JOB_ENV = "SUPI3_SDK_RTL_JOB"
+MODE_ENV = "SUPI3_SDK_RTL_MODE"
 START_CYCLES = 4
 """Master cycles before the history: Alarm Stop and discovery, the rediscovery, data cycles (as on the model
 bench, tests/test_sdk_examples.py)."""
@@ -48,3 +53,30 @@ async def example_on_rtl(dut: Any) -> None:
 
     result = await bench.call(scenario)
     path.with_suffix(".result.json").write_text(json.dumps(result), encoding="utf-8")
+
+
+@cocotb.test()
+async def async_driver_registers(dut: Any) -> None:
+    """``AsyncSupi3Driver`` over ``RtlTransport``: initialize (C/D checked, 3.4.3), SET and ID written and read back
+    (3.4.5), the events of the power-up read and cleared (3.4.14), the init byte refused as a command once the
+    interface runs (UP-3), SAS_INIT restarts it with the registers kept (3.4.3)."""
+    mode = Mode(os.environ.get(MODE_ENV, Mode.MOTOROLA.value))
+    board = RtlBoard(dut, default_config(500_000))
+    await board.start()
+    transport = RtlTransport(board, mode)
+    drv = AsyncSupi3Driver(transport)
+    await drv.initialize(mode)
+    await drv.configure(ONE_WORD_IO, DIO_ID)
+    assert (await drv.read(SET), await drv.read(ID)) == (ONE_WORD_IO, DIO_ID)
+    await drv.irq_enable(Irq.VALID | Irq.IB_RESET)
+    assert await drv.read(IRQ_EVT) & Irq.VALID == 0  # no data cycle yet
+    assert await drv.irq_service() == Irq(0)  # /IRQ high: nothing sent
+    try:
+        await drv.initialize(mode)
+    except NotResetError:
+        pass
+    else:
+        raise AssertionError("a second initialization byte must be taken as a command (UP-3)")
+    await drv.sas_init()
+    await drv.initialize(mode)
+    assert (await drv.read(SET), await drv.read(ID)) == (ONE_WORD_IO, DIO_ID)  # SAS_INIT keeps the registers

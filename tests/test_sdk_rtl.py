@@ -45,21 +45,30 @@ def chip_build(verilator_build: VerilatorBuild) -> Path:
     return build
 
 
-def on_rtl(build: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, example: str, mode: Mode,
-           bit_rate: int) -> dict[str, object]:  # fmt: skip
+def simulate(build: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, testcase: str, **env: str) -> None:
+    """Run one cocotb test of sim/sdk_rtl.py on the build, with ``env`` set; fail with the log's end if it fails."""
     from cocotb_tools.check_results import get_results
     from cocotb_tools.runner import get_runner
 
+    for name, value in env.items():
+        monkeypatch.setenv(name, value)
+    monkeypatch.syspath_prepend(str(SIM_DIR))
+    log = tmp_path / "sim.log"
+    try:
+        results = get_runner("verilator").test(test_module="sdk_rtl", testcase=testcase, hdl_toplevel=TOP,
+                                               hdl_toplevel_lang="verilog", build_dir=build, test_dir=tmp_path,
+                                               results_xml=str(tmp_path / "results.xml"), log_file=log)  # fmt: skip
+    except SystemExit:  # the runner exits when a test fails
+        results = tmp_path / "results.xml"
+    assert get_results(Path(results)) == (1, 0), log.read_text(encoding="utf-8", errors="replace")[-3000:]
+
+
+def on_rtl(build: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, example: str, mode: Mode,
+           bit_rate: int) -> dict[str, object]:  # fmt: skip
     job = tmp_path / "job.json"
     job.write_text(json.dumps({"example": example, "mode": mode.value, "bit_rate": bit_rate,
                                "cycle_time_s": CYCLE_TIME_S, "history": HISTORY}), encoding="utf-8")  # fmt: skip
-    monkeypatch.setenv("SUPI3_SDK_RTL_JOB", str(job))
-    monkeypatch.syspath_prepend(str(SIM_DIR))
-    log = tmp_path / "sim.log"
-    results = get_runner("verilator").test(test_module="sdk_rtl", hdl_toplevel=TOP, hdl_toplevel_lang="verilog",
-                                           build_dir=build, test_dir=tmp_path,
-                                           results_xml=str(tmp_path / "results.xml"), log_file=log)  # fmt: skip
-    assert get_results(Path(results)) == (1, 0), log.read_text(encoding="utf-8", errors="replace")[-3000:]
+    simulate(build, tmp_path, monkeypatch, "example_on_rtl", SUPI3_SDK_RTL_JOB=str(job))
     result: dict[str, object] = json.loads(job.with_suffix(".result.json").read_text(encoding="utf-8"))
     return result
 
@@ -86,3 +95,11 @@ def test_example_on_rtl_gives_the_model_benchs_process_data(
     assert seen == HISTORY
     assert seen == on_model(example, mode, bit_rate)
     assert result["interrupts"] >= len(HISTORY)  # type: ignore[operator]
+
+
+@pytest.mark.parametrize("mode", list(Mode))
+def test_async_driver_on_rtl_pins(
+    chip_build: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, mode: Mode
+) -> None:
+    """AsyncSupi3Driver over RtlTransport from a coroutine: init, SET/ID, events, UP-3, SAS_INIT (sim/sdk_rtl.py)."""
+    simulate(chip_build, tmp_path, monkeypatch, "async_driver_registers", SUPI3_SDK_RTL_MODE=mode.value)
