@@ -43,10 +43,11 @@ from cocotb.utils import get_sim_time
 
 from supi3.checks import check_instance, check_int, check_real, describe
 from supi3.config import DeviceConfig
+from supi3.interbus import wire
 from supi3.interbus.master import Master
 from supi3.model.pinring import PinRing
 from supi3.model.pins import Supi3Pins
-from supi3.pinout import UP_INPUT_IDLE, UP_INPUTS, UP_OUTPUTS
+from supi3.pinout import EXPANSION_BITS, MFP_PINS, UP_INPUT_IDLE, UP_INPUTS, UP_OUTPUTS
 from supi3.sdk.bench import Firmware
 from supi3.sdk.driver import AsyncTransport, DriverArgumentError, Mode, Supi3Driver, Transport
 from supi3.spi.master import MasterTiming
@@ -69,6 +70,7 @@ CLOCK_PS: Final[int] = round(1e12 / CLOCK_HZ)
 _QUIET: Final[dict[str, int]] = {"di2": 0, "rbst_ext": 0, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 1}
 """The board inputs other than the line and the MFPs: last device in the ring, no fault, power good."""
 _RESET_POLL_CLOCKS: Final[int] = 16
+"""How often :meth:`RtlBoard.start` looks whether the power-up reset has ended."""
 
 
 class RtlBoard:
@@ -86,9 +88,9 @@ class RtlBoard:
         self.dut = dut
         self.config = check_instance("config", config, DeviceConfig)
         straps = strap_inputs(config)
-        self._expansion = straps.pop("mfp_expansion") << 12
+        expansion = straps.pop("mfp_expansion") << (MFP_PINS - EXPANSION_BITS)  # MFP[15..12] (Table 2-4)
         self._straps = straps
-        self.mfp_in = self._expansion | sum(level << UP_INPUTS[name] for name, level in UP_INPUT_IDLE.items())
+        self.mfp_in = expansion | sum(level << UP_INPUTS[name] for name, level in UP_INPUT_IDLE.items())
         self._di1: list[tuple[int, int]] = []  # (first clock index, level) of each change of di1
         self._di1_level = 1
 
@@ -116,7 +118,7 @@ class RtlBoard:
         """Straps and quiet inputs, the clock, one clock of ``rst``, then wait out the chip's power-up reset (the
         µP block is held in reset while ``resu_drive`` is 1) and start recording ``di1``."""
         dut = self.dut
-        for name, value in {**self._straps, **_QUIET, "do1": 1}.items():
+        for name, value in {**self._straps, **_QUIET, "do1": wire.IDLE_LEVEL}.items():
             getattr(dut, name).value = value
         dut.mfp_in.value = self.mfp_in
         dut.rst.value = 1
