@@ -64,7 +64,7 @@ class Recording(ModelTransport):
     def set_sas_init(self, level: int) -> bool:
         return super().set_sas_init(level) if self.sas else False
 
-    def read_io(self) -> int | None:  # type: ignore[override]  # the pin is optional here
+    def read_io(self) -> int | None:  # the pin is optional here
         return super().read_io() if self.io else None
 
     @property
