@@ -19,14 +19,14 @@ Python driver's would; ``/StatErr``, ``/ModAck`` and the peripheral's data are t
 An exception raised in a callback (a strict model's ``InconsistentDataError``, ``ReconfigurationError``, ...) is
 caught there, the callback returns an error to C, and every later callback fails at once without touching the
 bus; when the C entry point returns, that exception is raised again (same object) with a note naming the entry
-point and the access in flight: ``in fw_isr(): command 4Dh (write SET), data byte``.
+point and the access in flight: ``in fw_isr(): command 4Dh (write SET), data byte (sent 85h)``.
 """
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import hashlib
-import importlib.machinery
 import importlib.util
 import io
 import os
@@ -60,6 +60,7 @@ __all__ = [
     "describe_command",
     "example",
     "find_compiler",
+    "toolchain_missing",
 ]
 
 EXAMPLES_DIR: Final[Path] = sdk.SDK_DIR / "examples"
@@ -206,7 +207,8 @@ def _access(command: CommandByte) -> str:
 class NativeLibrary:
     """A built driver + firmware: the cffi module's ``ffi`` and ``lib``, and which entry points the firmware has.
 
-    Made by :func:`build`; one object per built library in a process, so its callbacks are registered once.
+    Made by :func:`build`: each is a private copy of the built module, so the firmware's static variables start
+    at zero (as at power-up) and are not shared with another :class:`CFirmware`.
     """
 
     def __init__(self, module: ModuleType, path: Path) -> None:
@@ -245,7 +247,7 @@ def _uncaught(kind: type[BaseException], error: BaseException, trace: object) ->
     CFirmware.orphans.append(error)
 
 
-_LOADED: dict[Path, NativeLibrary] = {}
+_COPIES: list[Path] = []  # the folder of this process's private copies, made on first use
 
 
 def default_cache_dir() -> Path:
@@ -269,7 +271,8 @@ def _sources(sources: Iterable[str | Path]) -> tuple[Path, ...]:
 
 def build(sources: Iterable[str | Path] = (), *, include_dirs: Iterable[str | Path] = (),
           cache_dir: str | Path | None = None) -> NativeLibrary:  # fmt: skip
-    """Build (or take from the cache) the C driver plus the firmware ``sources`` as one cffi module, and load it.
+    """Build (or take from the cache) the C driver plus the firmware ``sources`` as one cffi module, and load a
+    private copy of it (:class:`NativeLibrary`).
 
     Parameters
     ----------
@@ -303,27 +306,48 @@ def build(sources: Iterable[str | Path] = (), *, include_dirs: Iterable[str | Pa
     name = f"_supi3_native_{digest.hexdigest()[:20]}"
     folder = Path(cache_dir) if cache_dir is not None else default_cache_dir()
     target = folder / f"{name}{sysconfig.get_config_var('EXT_SUFFIX')}"
-    loaded = _LOADED.get(target)
-    if loaded is not None:
-        return loaded
     if not target.is_file():
         folder.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryDirectory(dir=folder, prefix=f"{name}.") as work:
             built = _compile(compiler, name, c_files, includes, Path(work))
             os.replace(built, target)
-    spec = importlib.util.spec_from_file_location(name, target)
+    return NativeLibrary(_load_copy(target, name), target)
+
+
+def _load_copy(target: Path, name: str) -> ModuleType:
+    """Load a private copy of the module: a shared library loaded twice from one path is one image, and the
+    firmware's static variables would be shared by every CFirmware of the process."""
+    if not _COPIES:
+        _COPIES.append(Path(tempfile.mkdtemp(prefix="supi3-native-")))
+        atexit.register(shutil.rmtree, _COPIES[0], True)
+    handle, copy = tempfile.mkstemp(dir=_COPIES[0], prefix=f"{name}.", suffix=target.name[len(name):])
+    os.close(handle)
+    shutil.copyfile(target, copy)
+    spec = importlib.util.spec_from_file_location(name, copy)
     if spec is None or spec.loader is None:  # cannot happen for an extension module path
         raise NativeBuildError(f"cannot load {target}")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    library = _LOADED[target] = NativeLibrary(module, target)
-    return library
+    return module
 
 
 def _cffi() -> Any:
-    import cffi  # type: ignore[import-untyped]  # the sdk extra; no type information
-
+    try:
+        import cffi  # type: ignore[import-untyped]  # the sdk extra; no type information
+    except ImportError as error:
+        raise NativeBuildError("cffi is not installed: C firmware needs the sdk extra (pip install supi3[sdk])") \
+            from error
     return cffi
+
+
+def toolchain_missing() -> str | None:
+    """Why C firmware cannot be built here (no cffi, no C compiler), or ``None`` if it can: a test's skip reason."""
+    try:
+        _cffi()
+        find_compiler()
+    except NativeBuildError as error:
+        return str(error)
+    return None
 
 
 def _compile(compiler: str, name: str, c_files: tuple[Path, ...], includes: tuple[Path, ...], work: Path) -> Path:
@@ -506,7 +530,7 @@ class CFirmware(Firmware):
         command = self._protocol.command if phase in (Phase.DATA, Phase.BLOCK) else None
         if isinstance(command, CommandByte):
             byte = encode_command(command.address, rd=command.rd, wr=command.wr)
-            return f"{describe_command(byte)}, data byte {tx:02X}h"
+            return f"{describe_command(byte)}, data byte (sent {tx:02X}h)"
         return f"byte {tx:02X}h"
 
     def _delay_us(self, us: int) -> None:
