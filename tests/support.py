@@ -33,9 +33,9 @@ from supi3.interbus.wire import Cycle, Frame
 from supi3.model.pins import Supi3Pins
 from supi3.model.registers import RegisterFile
 from supi3.pinlevel import OE_SUFFIX
+from supi3.regmap import Register, encode_command
 from supi3.sdk import native
 from supi3.sdk.native import CFirmware
-from supi3.regmap import Register, encode_command
 from supi3.spi.block_pins import UpifBlockPins, block_model, strap_values
 from supi3.spi.master import SoftMaster
 from supi3.spi.slave_pins import PinsIn, PinsOut

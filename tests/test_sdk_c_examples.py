@@ -10,13 +10,13 @@ from __future__ import annotations
 
 import pytest
 
-from support import TEST_FIRMWARE, c_firmware
-from supi3.interbus.master import ErrorKind
+from supi3.interbus.ring import ErrorKind
 from supi3.model.registers import InconsistentDataError
 from supi3.sdk import native
 from supi3.sdk.bench import Bench
 from supi3.sdk.native import CFirmware
 from supi3.timing import upif_byte_s
+from support import TEST_FIRMWARE, c_firmware
 
 
 def _bench(cache: pytest.Cache, name: str, **options: object) -> tuple[Bench, CFirmware]:

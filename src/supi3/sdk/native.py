@@ -38,7 +38,7 @@ import tempfile
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from types import ModuleType
-from typing import Any, Final
+from typing import Any, ClassVar, Final
 
 from supi3 import sdk
 from supi3.errors import ArgumentError, Supi3Error
@@ -136,6 +136,8 @@ static int fw_entry_points(void)
 }
 """
 _HAS_SETUP, _HAS_ISR, _HAS_LOOP = 1, 2, 4
+Sources = str | Path | Iterable[str | Path]
+"""One ``.c`` file or several."""
 _COMPILERS: Final[tuple[str, ...]] = ("cc", "gcc", "clang")
 
 
@@ -258,7 +260,7 @@ def default_cache_dir() -> Path:
     return Path(base) / "supi3" / "native"
 
 
-def _sources(sources: Iterable[str | Path]) -> tuple[Path, ...]:
+def _sources(sources: Sources) -> tuple[Path, ...]:
     if isinstance(sources, str | Path):
         sources = (sources,)
     paths = []
@@ -269,7 +271,7 @@ def _sources(sources: Iterable[str | Path]) -> tuple[Path, ...]:
     return tuple(paths)
 
 
-def build(sources: Iterable[str | Path] = (), *, include_dirs: Iterable[str | Path] = (),
+def build(sources: Sources = (), *, include_dirs: Iterable[str | Path] = (),
           cache_dir: str | Path | None = None) -> NativeLibrary:  # fmt: skip
     """Build (or take from the cache) the C driver plus the firmware ``sources`` as one cffi module, and load a
     private copy of it (:class:`NativeLibrary`).
@@ -277,7 +279,7 @@ def build(sources: Iterable[str | Path] = (), *, include_dirs: Iterable[str | Pa
     Parameters
     ----------
     sources:
-        The firmware's ``.c`` files (none: the driver alone). ``fw_board.h`` and ``supi3.h`` are on the include
+        The firmware's ``.c`` file or files (none: the driver alone). ``fw_board.h`` and ``supi3.h`` are on the include
         path.
     include_dirs:
         Further include folders of the firmware.
@@ -401,13 +403,15 @@ class CFirmware(Firmware):
     bench runs a main loop only for firmware that has one). :meth:`setup` makes the driver context on the
     transport of the driver the bench passes (any :class:`~supi3.sdk.driver.Transport`; /StatErr and /ModAck
     need the bench's). After an entry point returns, an exception a callback caught is raised again with a note
-    (PEP 678), and a driver error the firmware kept in ``board->error`` raises :class:`CFirmwareError`.
+    (PEP 678), else a driver error the firmware kept in ``board->error`` raises :class:`CFirmwareError`; either
+    way ``board->error`` is set back to 0, so that each failure is raised once.
     """
 
-    orphans: list[BaseException] = []
+    library: NativeLibrary
+    orphans: ClassVar[list[BaseException]] = []
     """Errors cffi caught outside our callbacks' own handlers (never expected); raised by the next entry point."""
 
-    def __new__(cls, sources: Iterable[str | Path], **options: Any) -> CFirmware:
+    def __new__(cls, sources: Sources, **options: Any) -> CFirmware:
         """Pick :class:`_LoopingCFirmware` when the firmware has a main loop."""
         library = build(sources, include_dirs=options.get("include_dirs", ()), cache_dir=options.get("cache_dir"))
         chosen = _LoopingCFirmware if library.has_loop and cls is CFirmware else cls
@@ -415,7 +419,7 @@ class CFirmware(Firmware):
         instance.library = library
         return instance
 
-    def __init__(self, sources: Iterable[str | Path], *, include_dirs: Iterable[str | Path] = (),
+    def __init__(self, sources: Sources, *, include_dirs: Iterable[str | Path] = (),
                  cache_dir: str | Path | None = None, frame_gap_us: int = 0) -> None:  # fmt: skip
         del sources, include_dirs, cache_dir  # used by __new__
         library: NativeLibrary = self.library
@@ -436,10 +440,6 @@ class CFirmware(Firmware):
         config = self._config
         config.xfer = lib.supi3_native_xfer
         config.delay_us = lib.supi3_native_delay_us
-        config.read_irq = lib.supi3_native_read_irq
-        config.read_cd = lib.supi3_native_read_cd
-        config.read_io = lib.supi3_native_read_io
-        config.set_sas_init = lib.supi3_native_set_sas_init
         config.user = self._handle
         config.frame_gap_us = frame_gap_us
         self._entries = {name: getattr(lib, name) for name in ("fw_setup", "fw_isr", "fw_loop")
@@ -462,7 +462,16 @@ class CFirmware(Firmware):
         self.transport = transport
         self._xfer_to = transport.xfer
         self._protocol = transport.protocol if isinstance(transport, ModelTransport) else None
-        err = int(self.library.lib.supi3_init(self.context, self._config))
+        lib, config = self.library.lib, self._config
+        # A pin the transport does not wire is a NULL callback, as supi3.h wants: the driver then works without it.
+        # The status pins are read once to find out; SAS_INIT is not driven for that: wired if the class has it.
+        ffi_null = self.library.ffi.NULL
+        config.read_irq = lib.supi3_native_read_irq if transport.read_irq() is not None else ffi_null
+        config.read_cd = lib.supi3_native_read_cd if transport.read_cd() is not None else ffi_null
+        config.read_io = lib.supi3_native_read_io if transport.read_io() is not None else ffi_null
+        sas_wired = type(transport).set_sas_init is not Transport.set_sas_init
+        config.set_sas_init = lib.supi3_native_set_sas_init if sas_wired else ffi_null
+        err = int(lib.supi3_init(self.context, config))
         if err != 0:  # cannot happen: the config has an xfer
             raise CFirmwareError(f"supi3_init() failed: {self._strerror(err)}")
 
@@ -492,13 +501,13 @@ class CFirmware(Firmware):
         finally:
             self._running = ""
         error = self._error or (self.orphans.pop(0) if self.orphans else None)
+        code, self.board.error = self.board.error, 0  # each failure is raised once
         if error is not None:
             self._error = None
             error.add_note(f"in {entry}(): {self._where or 'outside a driver callback'}")
             raise error
-        if self.board.error != 0:
-            raise CFirmwareError(f"{entry}() reported driver error {self.board.error}: "
-                                 f"{self._strerror(self.board.error)}")  # fmt: skip
+        if code != 0:
+            raise CFirmwareError(f"{entry}() reported driver error {code}: {self._strerror(code)}")
 
     def _strerror(self, err: int) -> str:
         return str(self.library.ffi.string(self.library.lib.supi3_strerror(err)).decode())
