@@ -661,22 +661,26 @@ def cycle_bits(data_bytes: int, devices: int) -> int:
 
 
 class CyclePhases(NamedTuple):
-    """Where the phases of 3.4.14 (Figure 3-22) fall in one cycle, in bit periods from its first bit (the
-    transaction level's reading of the pin-level frame engine; all devices see them at once, A23)."""
+    """Where the phases of 3.4.14 (Figure 3-22) fall in one cycle: the bit periods (counted from the cycle's first
+    bit, 0) whose mid-bit sample (A1) decides them, as the pin-level frame engine does; the transaction level has
+    every device see them at once (docs/assumptions/sdk.md, FW-2)."""
 
-    check_bits: int
-    """The check sequence begins (the control bit of its first telegram): a data cycle's I/O access bit turns 1."""
-    latch_bits: int
-    """The first latch status telegram has ended: the latch phase begins (data cycles)."""
+    check_bit: int
+    """The control bit of the first check telegram: a data cycle's I/O access bit turns 1 (busy)."""
+    latch_bit: int
+    """The stop bit of the first latch status telegram: the latch phase begins (data cycles)."""
+    end_bit: int
+    """The stop bit of the second latch status telegram: data latched, both phases over."""
     total_bits: int
-    """The second latch status telegram has ended: data latched, both phases over (:func:`cycle_bits`)."""
+    """The cycle's length (:func:`cycle_bits`)."""
 
 
 def cycle_phases(data_bytes: int, devices: int) -> CyclePhases:
-    """The phases of one cycle with ``data_bytes`` bytes of device data and ``devices`` devices (3.4.14)."""
+    """The phases of one cycle with ``data_bytes`` bytes of device data and ``devices`` devices (3.4.14, A11)."""
     total = cycle_bits(data_bytes, devices)
     check = DATA_TELEGRAM_BITS * (LOOPBACK_BYTES + data_bytes) + POS_CONTROL
-    return CyclePhases(check, total - STATUS_TELEGRAM_BITS * (LATCH_STATUS_TELEGRAMS - 1), total)
+    last_stop = total - 1
+    return CyclePhases(check, last_stop - STATUS_TELEGRAM_BITS * (LATCH_STATUS_TELEGRAMS - 1), last_stop, total)
 
 
 def reset_bits(devices: int) -> int:

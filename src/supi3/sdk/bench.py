@@ -19,9 +19,10 @@ in the latch phase (``InconsistentDataError``) are all tested at transaction lev
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Sequence
 from types import TracebackType
-from typing import Final, Literal
+from typing import Final, Literal, NamedTuple
 
 from supi3 import tables, timing
 from supi3.checks import check_bool, check_instance, check_int, check_real, describe
@@ -37,12 +38,42 @@ from supi3.model.registers import RegisterFile
 from supi3.sdk.driver import DriverArgumentError, Mode, Supi3Driver
 from supi3.sdk.transports import ModelTransport
 
-__all__ = ["DEFAULT_STRAPS", "Bench", "BenchError", "BenchTransport", "Firmware", "default_config"]
+__all__ = ["DEFAULT_STRAPS", "Bench", "BenchError", "BenchTransport", "CycleTiming", "Firmware", "default_config"]
 
 DEFAULT_STRAPS: Final[tuple[str, str]] = ("10011", "1110")
 """C[4..0] and MFP[15..12] of the bench's default chip: a remote bus device in the Init-µP mode (Table 2-4)."""
+KEPT: Final[int] = 1000
+"""FW-6: how many cycles :attr:`Bench.results` and :attr:`Bench.timeline` keep (a long run stays bounded)."""
 IDLE_LOOPS_LIMIT: Final[int] = 1000
 """FW-5: main-loop calls in a row that clock no byte and wait for nothing before the bench calls it stuck."""
+
+
+class CycleTiming(NamedTuple):
+    """When one master cycle ran on the bench clock: its start (first bit), its kind and its phases."""
+
+    start: float
+    cycle: Cycle
+    phases: wire.CyclePhases
+    bit_s: float
+
+    def at(self, bit: int) -> float:
+        """The mid-bit sample of bit period ``bit`` (0 = the cycle's first): when the chip decides on it (A1)."""
+        return self.start + (bit + 0.5) * self.bit_s
+
+    @property
+    def io_busy(self) -> float:
+        """A data cycle's I/O access bit turns 1 (the check sequence begins)."""
+        return self.at(self.phases.check_bit)
+
+    @property
+    def latch(self) -> float:
+        """A data cycle's latch phase begins."""
+        return self.at(self.phases.latch_bit)
+
+    @property
+    def end(self) -> float:
+        """The latch: OUT data and events appear, both phases end."""
+        return self.at(self.phases.end_bit)
 
 
 class BenchError(Supi3Error, RuntimeError):
@@ -125,7 +156,7 @@ class BenchTransport(ModelTransport):
         bench = self.bench
         protocol = self.protocol
         bench.advance(bench.now)
-        with self.registers.violations.deferred():
+        with self._deferred:
             driven = protocol.begin(s_r)
             bench.advance(bench.now + bench.byte_s)
             protocol.end(driven if driven is not None and protocol.mode is Mode.INTEL else tx)
@@ -217,7 +248,9 @@ class Bench:
     irq_latency_s:
         The longest time from a falling edge of /IRQ to its service routine's first byte.
     results:
-        The master's :class:`CycleResult` of every finished cycle, the last 1000 (FW-6).
+        The master's :class:`CycleResult` of every cycle started, the last :data:`KEPT` (FW-6).
+    timeline:
+        The :class:`CycleTiming` of every cycle started, the last :data:`KEPT`.
     """
 
     def __init__(
@@ -257,7 +290,8 @@ class Bench:
         self.bytes_clocked = 0
         self.interrupts = 0
         self.irq_latency_s = 0.0
-        self.results: list[CycleResult] = []
+        self.results: deque[CycleResult] = deque(maxlen=KEPT)
+        self.timeline: deque[CycleTiming] = deque(maxlen=KEPT)
         self.registers.use_clock(lambda: clocks(self.now))
         self._bit_s = 1.0 / self.config.bit_rate
         self._events: list[tuple[float, str]] = []  # this cycle's phase changes, latest first
@@ -308,18 +342,17 @@ class Bench:
         result = self.master.cycle() if self._started else self.master.start()
         self._started = True
         self.results.append(result)
-        if len(self.results) > 1000:
-            del self.results[:-1000]
         pending = self._bus.pending
         if pending is None:  # cannot happen: every master cycle ends with a finish
             raise BenchError("the master ran a cycle without finishing it")
         transfer, _, start = pending
-        phases = wire.cycle_phases(len(transfer.sent) - wire.LOOPBACK_BYTES, transfer.devices)
-        end = start + phases.total_bits * self._bit_s
+        timing = CycleTiming(start, transfer.cycle, wire.cycle_phases(len(transfer.sent) - wire.LOOPBACK_BYTES,
+                                                                      transfer.devices), self._bit_s)
+        self.timeline.append(timing)
+        end = timing.end
         events = [(end, "end")]
         if transfer.cycle is Cycle.DATA:
-            events += [(start + phases.latch_bits * self._bit_s, "latch"),
-                       (start + phases.check_bits * self._bit_s, "io")]  # fmt: skip
+            events += [(timing.latch, "latch"), (timing.io_busy, "io")]
         self._events = events
         self._next_start = end if self.cycle_time_s is None else max(end, start + self.cycle_time_s)
         self.irq_edge()

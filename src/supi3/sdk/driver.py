@@ -19,7 +19,7 @@ from abc import ABC, abstractmethod
 from collections.abc import Awaitable, Callable, Generator
 from dataclasses import dataclass
 from enum import IntEnum, IntFlag
-from typing import Final, TypeVar
+from typing import Any, Final, TypeVar
 
 from supi3 import tables
 from supi3.checks import check_bool, check_bytes, check_int, check_real, describe
@@ -205,7 +205,7 @@ class OpticalStatus:
 
 def put_u16(value: int) -> bytes:
     """``value`` as the two data bytes of one word, byte 0 (address 0) the MSB (3.4.8); ``supi3_put_u16``."""
-    return check_int("value", value, 0, 0xFFFF, "a 16-bit word").to_bytes(2, "big")
+    return _checked(check_int, "value", value, 0, 0xFFFF, "a 16-bit word").to_bytes(2, "big")
 
 
 def get_u16(data: bytes) -> int:
@@ -215,7 +215,7 @@ def get_u16(data: bytes) -> int:
 
 def put_u32(value: int) -> bytes:
     """``value`` as data bytes 0..3, byte 0 the MSB (3.4.8); ``supi3_put_u32``."""
-    return check_int("value", value, 0, 0xFFFF_FFFF, "a 32-bit value").to_bytes(4, "big")
+    return _checked(check_int, "value", value, 0, 0xFFFF_FFFF, "a 32-bit value").to_bytes(4, "big")
 
 
 def get_u32(data: bytes) -> int:
@@ -224,7 +224,7 @@ def get_u32(data: bytes) -> int:
 
 
 def _exact(data: object, length: int) -> bytes:
-    raw = check_bytes("data", data)
+    raw = _checked(check_bytes, "data", data)
     if len(raw) != length:
         raise DriverArgumentError("data", data, f"data must be {length} bytes, not {describe(data)}")
     return raw
@@ -309,7 +309,7 @@ class AsyncTransport(ABC):
 # Operations a driver call yields to its runner: (kind, argument, argument).
 _XFER, _DELAY, _CD, _IRQ, _IO, _SAS = range(6)
 _Op = tuple[int, int | float, bool]
-_Call = Generator[_Op, int | bool | None, _T]
+_Call = Generator[_Op, Any, _T]  # the runner sends each operation's answer back
 
 _S_R_CHIP_DRIVES: Final[bool] = False
 _S_R_UP_SENDS: Final[bool] = True
@@ -342,26 +342,31 @@ def _address(register: object, direction: AccessDirection | None) -> int:
                                   f"{describe(register)}{hint}")  # fmt: skip
     directions = tuple(AccessDirection) if direction is None else (direction,)
     if all(REGISTER_MAP.port(register.address, d).register is not register for d in directions):
-        verb = "read and written" if direction is None else f"{direction.value}"
+        verb = "read and written" if direction is None else "read" if direction is AccessDirection.READ else "written"
         raise DriverArgumentError("register", register, f"register {register.name} cannot be {verb} at address "
                                   f"{register.address} (Table 3-10)")  # fmt: skip
     return register.address
 
 
+def _checked(check: Callable[..., _T], *args: object, **kwargs: object) -> _T:
+    """Run a :mod:`supi3.checks` check; its error comes out as a :class:`DriverArgumentError` (``SUPI3_E_ARG``)."""
+    try:
+        return check(*args, **kwargs)
+    except ArgumentError as error:
+        raise DriverArgumentError(error.name, error.value, str(error)) from None
+
+
 def _byte(name: str, value: object) -> int:
     if type(value) is int and 0 <= value <= 0xFF:
         return value
-    try:
-        return check_int(name, value, 0, 0xFF, "one byte")
-    except ArgumentError as error:
-        raise DriverArgumentError(error.name, error.value, str(error)) from None
+    return _checked(check_int, name, value, 0, 0xFF, "one byte")
 
 
 class _Core:
     """The driver's state and its calls as operation generators; shared by the sync and async drivers."""
 
     def __init__(self, frame_gap_us: float) -> None:
-        self.frame_gap_us = check_real("frame_gap_us", frame_gap_us, 0.0)
+        self.frame_gap_us = _checked(check_real, "frame_gap_us", frame_gap_us, 0.0)
         self.initialized = False
         self.mode = Mode.MOTOROLA
         self.set_value: int | None = None
@@ -373,12 +378,6 @@ class _Core:
         if not self.initialized:
             raise NotInitializedError("driver not initialized: call initialize(Mode.MOTOROLA or Mode.INTEL) first "
                                       "(3.4.3), and again after SAS_INIT or a transport error; nothing sent")
-
-    def _frame(self, tx: int, s_r: bool) -> _Call[int]:
-        rx = yield (_XFER, tx, s_r)
-        if self.frame_gap_us:
-            yield (_DELAY, self.frame_gap_us, False)
-        return int(rx or 0)
 
     def _note_set(self, address: int, value: int) -> None:
         if address == SET.address:
@@ -396,10 +395,10 @@ class _Core:
             raise NotReadyError("C/D shows data before the initialization byte: a command waits for its data byte "
                                 "(µP reset mid-command, UP-27) or the interface is disabled (UP-4); pulse SAS_INIT "
                                 "(3.4.3); nothing sent")  # fmt: skip
-        yield from self._frame(mode.init_byte, _S_R_UP_SENDS)
+        yield (_XFER, mode.init_byte, _S_R_UP_SENDS)
         if cd is not None and (yield (_CD, 0, False)):
             # "Command status twice" missing (3.4.3, UP-3): complete the command the byte became, then report.
-            yield from self._frame(0x00, _S_R_CHIP_DRIVES if mode is Mode.INTEL else _S_R_UP_SENDS)
+            yield (_XFER, 0x00, _S_R_CHIP_DRIVES if mode is Mode.INTEL else _S_R_UP_SENDS)
             raise NotResetError(f"initialize({mode.name}): the chip was not reset and took {mode.init_byte:02X}h "
                                 "as a command (3.4.3, UP-3); pulse SAS_INIT and initialize again")  # fmt: skip
         self.mode = mode
@@ -418,8 +417,8 @@ class _Core:
         return self._read(address)
 
     def _read(self, address: int) -> _Call[int]:
-        yield from self._frame(_READ[address], _S_R_UP_SENDS)
-        value = yield from self._frame(0x00, _S_R_CHIP_DRIVES)
+        yield (_XFER, _READ[address], _S_R_UP_SENDS)
+        value: int = yield (_XFER, 0x00, _S_R_CHIP_DRIVES)
         self._note_set(address, value)
         return value
 
@@ -430,8 +429,8 @@ class _Core:
         return self._write(address, byte)
 
     def _write(self, address: int, value: int) -> _Call[None]:
-        yield from self._frame(_WRITE[address], _S_R_UP_SENDS)
-        yield from self._frame(value, _S_R_UP_SENDS)
+        yield (_XFER, _WRITE[address], _S_R_UP_SENDS)
+        yield (_XFER, value, _S_R_UP_SENDS)
         self._note_set(address, value)
 
     def exchange(self, register: object, value: object) -> _Call[int]:
@@ -443,14 +442,14 @@ class _Core:
         return self._exchange(address, byte)
 
     def _exchange(self, address: int, value: int) -> _Call[int]:
-        yield from self._frame(_EXCHANGE[address], _S_R_UP_SENDS)
-        result = yield from self._frame(value, _S_R_UP_SENDS)
+        yield (_XFER, _EXCHANGE[address], _S_R_UP_SENDS)
+        result: int = yield (_XFER, value, _S_R_UP_SENDS)
         self._note_set(address, value)
         return result
 
     def block_transfer(self, in_data: object, read: object, write: object) -> _Call[bytes]:
-        data = check_bytes("in_data", in_data)
-        rd, wr = check_bool("read", read), check_bool("write", write)
+        data = _checked(check_bytes, "in_data", in_data)
+        rd, wr = _checked(check_bool, "read", read), _checked(check_bool, "write", write)
         n = len(data)
         if not BLOCK_MIN_BYTES <= n <= BLOCK_MAX_BYTES:
             raise DriverArgumentError("in_data", in_data, f"in_data must be {BLOCK_MIN_BYTES} to {BLOCK_MAX_BYTES} "
@@ -466,16 +465,16 @@ class _Core:
         return self._block(data, rd, wr, intel)
 
     def _block(self, data: bytes, rd: bool, wr: bool, intel: bool) -> _Call[bytes]:
-        yield from self._frame(encode_command(BLOCK_ADDRESS, rd=rd, wr=wr), _S_R_UP_SENDS)
+        yield (_XFER, encode_command(BLOCK_ADDRESS, rd=rd, wr=wr), _S_R_UP_SENDS)
         out = bytearray()
         if not intel:  # UP-11: every byte full duplex, IN k written whatever RD/WR say
             for value in data:
-                out.append((yield from self._frame(value, _S_R_UP_SENDS)))
+                out.append((yield (_XFER, value, _S_R_UP_SENDS)))
             return bytes(out) if rd else b""
         for _ in data if rd else b"":
-            out.append((yield from self._frame(0x00, _S_R_CHIP_DRIVES)))
+            out.append((yield (_XFER, 0x00, _S_R_CHIP_DRIVES)))
         for value in data if wr else b"":
-            yield from self._frame(value, _S_R_UP_SENDS)
+            yield (_XFER, value, _S_R_UP_SENDS)
         return bytes(out)
 
     def configure(self, set_value: object, id_code: object) -> _Call[None]:
@@ -505,7 +504,7 @@ class _Core:
         return Irq((yield from self._read(IRQ_EVT.address)) & _EVENT_MASK)
 
     def poll_io_window(self, max_polls: object) -> _Call[Irq]:
-        polls = check_int("max_polls", max_polls, 1, None, "polls of the I/O access bit")
+        polls = _checked(check_int, "max_polls", max_polls, 1, None, "polls of the I/O access bit")
         self._ready()
         return self._poll(polls)
 
@@ -582,6 +581,7 @@ class Supi3Driver(_DriverApi):
     def _run(self, call: _Call[_T]) -> _T:
         transport = self.transport
         core = self._core
+        gap = core.frame_gap_us
         with transport.access():
             answer: int | bool | None = None
             try:
@@ -593,6 +593,8 @@ class Supi3Driver(_DriverApi):
                         except (OSError, TransportError) as error:
                             core.initialized = False
                             raise _transport_error(error) from error
+                        if gap:
+                            transport.delay_us(gap)
                     elif kind == _DELAY:
                         answer = None
                         transport.delay_us(argument)
@@ -685,6 +687,8 @@ class AsyncSupi3Driver(_DriverApi):
                     except (OSError, TransportError) as error:
                         self._core.initialized = False
                         raise _transport_error(error) from error
+                    if self._core.frame_gap_us:
+                        await transport.delay_us(self._core.frame_gap_us)
                 elif kind == _DELAY:
                     answer = None
                     await transport.delay_us(argument)

@@ -45,10 +45,17 @@ class ModelTransport(Transport):
         self.protocol = self.up.protocol
         self.registers = self.up.registers
         self.sas_level = 0
+        self._deferred = self.registers.violations.deferred()
 
     def xfer(self, tx: int, s_r: bool) -> int:
-        """One frame through :meth:`UpInterface.transfer` (the Intel S/R level is ``s_r``)."""
-        return self.up.transfer(tx, s_r=s_r) or 0
+        """One frame: /SS falls (the chip decides what it drives, UP-18), /SS rises (it takes the byte on the data
+        line: its own in an Intel receive frame). As :meth:`UpInterface.transfer`, without its argument checks:
+        the driver sends only bytes."""
+        protocol = self.protocol
+        with self._deferred:
+            driven = protocol.begin(s_r)
+            protocol.end(driven if driven is not None and protocol.mode is Mode.INTEL else tx)
+        return driven or 0
 
     def read_cd(self) -> int:
         """The protocol's C/D (UP-2)."""

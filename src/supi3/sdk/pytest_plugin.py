@@ -1,0 +1,54 @@
+"""pytest fixtures for firmware tests against the SUPI 3 model (registered as the ``supi3`` pytest plugin).
+
+``pip install supi3`` makes pytest load this module (entry point ``pytest11``), so a firmware team writes::
+
+    from supi3.sdk.bench import Firmware
+
+    @pytest.mark.supi3(bit_rate=2_000_000, firmware=MyFirmware())
+    def test_outputs_follow_the_master(supi3_bench):
+        supi3_bench.run(5)
+        ...
+
+- ``supi3_bench``: a :class:`supi3.sdk.bench.Bench` made from the ``supi3`` marker's keyword arguments (any
+  argument of ``Bench``: ``config``, ``firmware``, ``mode``, ``bit_rate``, ``others``, ``sclk_hz``,
+  ``frame_gap_us``, ``cycle_time_s``, ``strict``); without the marker, the defaults.
+- ``supi3_ring``, ``supi3_master``: that bench's ring and INTERBUS master.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from supi3.interbus.master import Master
+from supi3.interbus.ring import Ring
+from supi3.sdk.bench import Bench
+
+MARKER = "supi3"
+"""The marker whose keyword arguments configure ``supi3_bench``."""
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """Register the ``supi3`` marker (so ``--strict-markers`` accepts it)."""
+    config.addinivalue_line("markers", f"{MARKER}(**options): keyword arguments of supi3.sdk.bench.Bench for the "
+                            "supi3_bench fixture")  # fmt: skip
+
+
+@pytest.fixture
+def supi3_bench(request: pytest.FixtureRequest) -> Bench:
+    """A firmware bench (master, ring, chip and firmware on one clock), configured by the ``supi3`` marker."""
+    marker = request.node.get_closest_marker(MARKER)
+    if marker is not None and marker.args:
+        raise pytest.UsageError(f"@pytest.mark.{MARKER} takes keyword arguments of Bench only, not {marker.args!r}")
+    return Bench(**(marker.kwargs if marker is not None else {}))
+
+
+@pytest.fixture
+def supi3_ring(supi3_bench: Bench) -> Ring:
+    """The bench's transaction-level ring (faults: ``supi3_ring.inject(BitFlip(...))``)."""
+    return supi3_bench.ring
+
+
+@pytest.fixture
+def supi3_master(supi3_bench: Bench) -> Master:
+    """The bench's INTERBUS master."""
+    return supi3_bench.master
