@@ -8,6 +8,8 @@ written while the bus runs fails the test; tests/c/firmware/latch_bug.c shows su
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from supi3.interbus.ring import ErrorKind
@@ -114,7 +116,7 @@ def test_polling_io_exchanges_every_cycle_without_interrupts(cache: pytest.Cache
     _set_inputs(firmware, b"\xca\xfe")
     bench.run(10)
     assert bench.interrupts == 0
-    assert all(r.cycle.name == "DATA" for r in bench.results[-10:])
+    assert all(r.cycle.name == "DATA" for r in list(bench.results)[-10:])
     assert firmware.board.cycles - served == 10  # every data cycle seen and served once
     assert _outputs(firmware, 2) == b"\xbe\xef"
     assert bench.master.inputs(1) == b"\xca\xfe"
@@ -189,3 +191,13 @@ def test_pcmd_alarm_reports_its_data_cycles(cache: pytest.Cache) -> None:
     bench.run(3)
     assert bench.master.processor_alarms == {1: cycles & 0xFF}
     assert cycles > 0
+
+
+def test_the_guides_example_runs_as_written(cache: pytest.Cache, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The first Python block of docs/sdk-firmware-c.md."""
+    if (reason := native.toolchain_missing()) is not None:
+        pytest.skip(reason)
+    guide = (Path(__file__).resolve().parents[1] / "docs" / "sdk-firmware-c.md").read_text(encoding="utf-8")
+    code = guide.split("```python\n", 1)[1].split("```", 1)[0]
+    monkeypatch.setenv(native.CACHE_ENV, str(cache.mkdir("supi3-native")))
+    exec(compile(code, "docs/sdk-firmware-c.md", "exec"), {})
