@@ -116,21 +116,22 @@ def test_fw_setup_is_required(cache: pytest.Cache, tmp_path: Path) -> None:
         _firmware(cache, tmp_path, ISR_ONLY)
 
 
-def test_the_build_is_cached_by_content(tmp_path: Path) -> None:
+def test_the_build_is_cached_by_content(cache: pytest.Cache, tmp_path: Path) -> None:
+    """NC-8: the same sources (wherever they are) are one build; a change is another."""
     if (reason := native.toolchain_missing()) is not None:
         pytest.skip(reason)
-    source = tmp_path / "fw.c"
-    source.write_text(SETUP_ONLY)
-    first = native.build([source], cache_dir=tmp_path / "cache")
-    assert native.build([source], cache_dir=tmp_path / "cache").path == first.path
-    source.write_text(SETUP_ONLY + "\n/* changed */\n")
-    assert native.build([source], cache_dir=tmp_path / "cache").path != first.path
-    assert sorted(p.name for p in (tmp_path / "cache").iterdir()) == sorted({first.path.name, _built(tmp_path)})
-
-
-def _built(tmp_path: Path) -> str:
-    return next(p.name for p in (tmp_path / "cache").iterdir() if p.read_bytes() and "changed" not in p.name
-                and p.stat().st_mtime == max(q.stat().st_mtime for q in (tmp_path / "cache").iterdir()))  # fmt: skip
+    folder = cache.mkdir("supi3-native")
+    first, second = tmp_path / "a" / "fw.c", tmp_path / "b" / "fw.c"
+    for source in (first, second):
+        source.parent.mkdir()
+        source.write_text(SETUP_ONLY)
+    built = native.build(first, cache_dir=folder)
+    assert built.path.parent == folder and built.path.is_file()
+    assert native.build(second, cache_dir=folder).path == built.path
+    (second.parent / "local.h").write_text("/* a header beside the source counts */\n")
+    assert native.build(second, cache_dir=folder).path != built.path
+    first.write_text(SETUP_ONLY + "/* changed */\n")
+    assert native.build(first, cache_dir=folder).path != built.path
 
 
 def test_entry_points_decide_the_firmware_class(cache: pytest.Cache) -> None:
@@ -208,7 +209,7 @@ def test_call_checks_its_entry_point_and_attachment(cache: pytest.Cache, tmp_pat
         firmware.call("fw_loop")
     with pytest.raises(ArgumentError, match=r"transport must be a supi3\.sdk\.driver\.Transport"):
         firmware.attach(object())  # type: ignore[arg-type]
-    with pytest.raises(ArgumentError, match="frame_gap_us must be an int"):
+    with pytest.raises(ArgumentError, match=r"frame_gap_us must be an integer from 0 to"):
         c_firmware(cache, tmp_path / "fw.c", frame_gap_us=-1)
 
 

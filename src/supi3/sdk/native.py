@@ -38,9 +38,10 @@ import tempfile
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from types import ModuleType
-from typing import Any, ClassVar, Final
+from typing import Any, Final
 
 from supi3 import sdk
+from supi3.checks import check_int
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.regmap import REGISTER_MAP, AccessDirection, CommandByte, RegisterMapError, decode_command, encode_command
 from supi3.sdk.bench import BenchTransport, Firmware
@@ -57,6 +58,7 @@ __all__ = [
     "NativeBuildError",
     "NativeLibrary",
     "build",
+    "default_cache_dir",
     "describe_command",
     "example",
     "find_compiler",
@@ -231,7 +233,7 @@ class NativeLibrary:
             def callback(user: Any, *args: Any) -> int | None:
                 return method(from_handle(user), *args)
 
-            ffi.def_extern(name=f"supi3_native_{name}", error=error, onerror=_uncaught)(callback)
+            ffi.def_extern(name=f"supi3_native_{name}", error=error)(callback)
 
         register("xfer", CFirmware._xfer, CALLBACK_FAILED)
         register("delay_us", CFirmware._delay_us, None)
@@ -241,12 +243,6 @@ class NativeLibrary:
         register("set_sas_init", CFirmware._set_sas_init, CALLBACK_FAILED)
         register("set_stat_err", CFirmware._set_stat_err, CALLBACK_FAILED)
         register("mod_ack_seen", CFirmware._mod_ack_seen, CALLBACK_FAILED)
-
-
-def _uncaught(kind: type[BaseException], error: BaseException, trace: object) -> None:
-    """cffi's last resort (the callbacks catch everything themselves): keep the error for the entry point."""
-    del kind, trace
-    CFirmware.orphans.append(error)
 
 
 _COPIES: list[Path] = []  # the folder of this process's private copies, made on first use
@@ -299,12 +295,15 @@ def build(sources: Sources = (), *, include_dirs: Iterable[str | Path] = (),
     includes = (sdk.include_dir(), EXAMPLES_DIR, *(Path(d).resolve() for d in include_dirs))
     compiler = find_compiler()
     c_files = (*sdk.sources(), *firmware)
-    headers = sorted(h for d in includes for h in Path(d).glob("*.h"))
+    # A source's own folder is searched first by #include "...": its headers count too. Folders of the sources
+    # themselves do not (NC-8): the same firmware written to two temporary folders is one build.
+    folders = dict.fromkeys((*includes, *(source.parent for source in firmware)))
+    headers = [h for d in folders for h in sorted(Path(d).glob("*.h"))]
     digest = hashlib.sha256()
     for part in (compiler, sys.version, _cffi().__version__, _CDEF, _GLUE, *STRICT_FLAGS, *map(str, includes)):
         digest.update(part.encode() + b"\0")
     for path in (*c_files, *headers):
-        digest.update(str(path).encode() + b"\0" + path.read_bytes() + b"\0")
+        digest.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
     name = f"_supi3_native_{digest.hexdigest()[:20]}"
     folder = Path(cache_dir) if cache_dir is not None else default_cache_dir()
     target = folder / f"{name}{sysconfig.get_config_var('EXT_SUFFIX')}"
@@ -408,8 +407,6 @@ class CFirmware(Firmware):
     """
 
     library: NativeLibrary
-    orphans: ClassVar[list[BaseException]] = []
-    """Errors cffi caught outside our callbacks' own handlers (never expected); raised by the next entry point."""
 
     def __new__(cls, sources: Sources, **options: Any) -> CFirmware:
         """Pick :class:`_LoopingCFirmware` when the firmware has a main loop."""
@@ -425,9 +422,7 @@ class CFirmware(Firmware):
         library: NativeLibrary = self.library
         if not library.has_setup:
             raise NativeBuildError("the firmware must define fw_setup(supi3_t *, fw_board_t *) (fw_board.h)")
-        if type(frame_gap_us) is not int or not 0 <= frame_gap_us <= 0xFFFF_FFFF:
-            raise ArgumentError("frame_gap_us", frame_gap_us, f"frame_gap_us must be an int of 0 to 2**32 - 1, not "
-                                f"{frame_gap_us!r}")  # fmt: skip
+        frame_gap_us = check_int("frame_gap_us", frame_gap_us, 0, 0xFFFF_FFFF, "supi3_config_t.frame_gap_us")
         ffi, lib = library.ffi, library.lib
         self._handle = ffi.new_handle(self)
         self.context: Any = ffi.new("supi3_t *")
@@ -500,11 +495,11 @@ class CFirmware(Firmware):
             function(self.context, self.board)
         finally:
             self._running = ""
-        error = self._error or (self.orphans.pop(0) if self.orphans else None)
+        error = self._error
         code, self.board.error = self.board.error, 0  # each failure is raised once
         if error is not None:
             self._error = None
-            error.add_note(f"in {entry}(): {self._where or 'outside a driver callback'}")
+            error.add_note(f"in {entry}(): {self._where}")
             raise error
         if code != 0:
             raise CFirmwareError(f"{entry}() reported driver error {code}: {self._strerror(code)}")
@@ -554,11 +549,11 @@ class CFirmware(Firmware):
             return CALLBACK_FAILED
         try:
             value = read()
+            if value is None:
+                return NOT_WIRED
+            level[0] = value
         except BaseException as error:
             return self._fail(error, f"reading {name}")
-        if value is None:
-            return NOT_WIRED
-        level[0] = int(value)
         return 0
 
     def _read_irq(self, level: Any) -> int:
@@ -601,11 +596,11 @@ class CFirmware(Firmware):
         try:
             bench = transport.bench
             bench.advance(bench.now)
+            until = bench.chip.mod_ack_until
+            seen[0] = until != self._mod_ack_seen_until
+            self._mod_ack_seen_until = until
         except BaseException as error:
             return self._fail(error, "reading /ModAck (mod_ack_seen)")
-        until = bench.chip.mod_ack_until
-        seen[0] = int(until != self._mod_ack_seen_until)
-        self._mod_ack_seen_until = until
         return 0
 
     def _transport(self) -> Transport:
