@@ -11,11 +11,15 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from supi3.interbus.ring import ErrorKind
 from supi3.model.registers import InconsistentDataError
+from supi3.regmap import IN0, IN1, OUT0, OUT1
 from supi3.sdk import native
-from supi3.sdk.bench import Bench
+from supi3.sdk.bench import Bench, Firmware
+from supi3.sdk.driver import Irq, Mode, Supi3Driver
 from supi3.sdk.native import CFirmware
 from supi3.timing import upif_byte_s
 from support import TEST_FIRMWARE, c_firmware
@@ -66,6 +70,61 @@ def test_digital_io_moves_16_bits_each_way_end_to_end(cache: pytest.Cache) -> No
         assert bench.master.inputs(1) == in_word.to_bytes(2, "big")
     assert firmware.board.error == 0
     assert firmware.board.cycles == bench.interrupts  # one VALID event per data cycle, each served
+
+
+class DigitalIoTwin(Firmware):
+    """digital_io.c written with the Python driver, call for call."""
+
+    def __init__(self) -> None:
+        self.inputs = b"\x00\x00"
+        self.outputs = b""
+
+    def setup(self, drv: Supi3Driver) -> None:
+        drv.initialize(Mode.MOTOROLA)
+        drv.configure(0x83, 0x03)
+        drv.irq_enable(Irq.VALID)
+
+    def isr(self, drv: Supi3Driver) -> None:
+        if drv.irq_service() & Irq.VALID:
+            self.outputs = bytes([drv.read(OUT0), drv.read(OUT1)])
+            drv.write(IN0, self.inputs[0])
+            drv.write(IN1, self.inputs[1])
+
+
+@pytest.mark.parametrize("bit_rate", [500_000, 2_000_000])
+def test_c_firmware_costs_the_bus_time_of_its_python_twin(cache: pytest.Cache, bit_rate: int) -> None:
+    """The same calls through the C driver and the Python driver: the same bytes at the same bus times, so the
+    same interrupt latency and the same data (FW-1: each byte its Table 3-7 time)."""
+    c_bench, c_firmware_ = _bench(cache, "digital_io", bit_rate=bit_rate)
+    twin = DigitalIoTwin()
+    py_bench = Bench(firmware=twin, bit_rate=bit_rate)
+    for bench in (c_bench, py_bench):
+        bench.run(3)
+        bench.master.set_outputs(1, b"\x3c\xc3")
+    _set_inputs(c_firmware_, b"\x96\x69")
+    twin.inputs = b"\x96\x69"
+    for bench in (c_bench, py_bench):
+        bench.run(30)
+    assert c_bench.bytes_clocked == py_bench.bytes_clocked
+    assert c_bench.now == py_bench.now
+    assert c_bench.irq_latency_s == py_bench.irq_latency_s
+    assert c_bench.interrupts == py_bench.interrupts
+    assert _outputs(c_firmware_, 2) == twin.outputs == b"\x3c\xc3"
+    assert c_bench.master.inputs(1) == py_bench.master.inputs(1) == b"\x96\x69"
+
+
+@settings(max_examples=25)
+@given(values=st.lists(st.integers(0, 0xFFFF_FFFF), min_size=1, max_size=4))
+def test_analog_io_carries_any_32_bit_values(pytestconfig: pytest.Config, values: list[int]) -> None:
+    assert pytestconfig.cache is not None
+    bench, firmware = _bench(pytestconfig.cache, "analog_io")
+    bench.run(3)
+    for value in values:
+        bench.master.set_outputs(1, value.to_bytes(4, "big"))
+        _set_inputs(firmware, value.to_bytes(4, "little"))
+        bench.run(2)
+        assert _outputs(firmware, 4) == value.to_bytes(4, "big")
+        assert bench.master.inputs(1) == value.to_bytes(4, "little")
 
 
 def test_analog_io_moves_32_bits_with_one_block_transfer(cache: pytest.Cache) -> None:
