@@ -342,12 +342,15 @@ def _cffi() -> Any:
 
 
 def toolchain_missing() -> str | None:
-    """Why C firmware cannot be built here (no cffi, no C compiler), or ``None`` if it can: a test's skip reason."""
+    """Why C firmware cannot be built here (no cffi, no setuptools for cffi's compile step, no C compiler), or
+    ``None`` if it can: a test's skip reason."""
     try:
         _cffi()
         find_compiler()
     except NativeBuildError as error:
         return str(error)
+    if importlib.util.find_spec("setuptools") is None:
+        return "setuptools is not installed: cffi compiles C firmware with it (pip install setuptools)"
     return None
 
 
