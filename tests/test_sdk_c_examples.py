@@ -24,10 +24,14 @@ from supi3.sdk.native import CFirmware
 from supi3.timing import upif_byte_s
 from support import TEST_FIRMWARE, c_firmware
 
+MODES = (Mode.MOTOROLA, Mode.INTEL)
+INTEL = {"FW_MODE": "SUPI3_MODE_INTEL"}
+"""The examples' build option for the Intel mode (fw_board.h, Table 3-8)."""
 
-def _bench(cache: pytest.Cache, name: str, **options: object) -> tuple[Bench, CFirmware]:
-    firmware = c_firmware(cache, native.example(name))
-    return Bench(firmware=firmware, **options), firmware  # type: ignore[arg-type]
+
+def _bench(cache: pytest.Cache, name: str, mode: Mode = Mode.MOTOROLA, **options: object) -> tuple[Bench, CFirmware]:
+    firmware = c_firmware(cache, native.example(name), defines=INTEL if mode is Mode.INTEL else None)
+    return Bench(firmware=firmware, mode=mode, **options), firmware  # type: ignore[arg-type]
 
 
 def _set_inputs(firmware: CFirmware, data: bytes) -> None:
@@ -56,9 +60,10 @@ def cache(pytestconfig: pytest.Config) -> pytest.Cache:
 WORDS = (0x0000, 0xFFFF, 0x1234, 0x8001, 0x00FF)
 
 
-def test_digital_io_moves_16_bits_each_way_end_to_end(cache: pytest.Cache) -> None:
+@pytest.mark.parametrize("mode", MODES)
+def test_digital_io_moves_16_bits_each_way_end_to_end(cache: pytest.Cache, mode: Mode) -> None:
     """SET 83h (one word, 3.4.11), ID 03h; OUT0/OUT1 read and IN0/IN1 written in the VALID service routine."""
-    bench, firmware = _bench(cache, "digital_io")
+    bench, firmware = _bench(cache, "digital_io", mode)
     bench.run(3)
     entry = bench.master.config[0] if bench.master.config is not None else None
     assert entry is not None and (entry.id_code, entry.data_bytes) == (0x03, 2)
@@ -75,12 +80,13 @@ def test_digital_io_moves_16_bits_each_way_end_to_end(cache: pytest.Cache) -> No
 class DigitalIoTwin(Firmware):
     """digital_io.c written with the Python driver, call for call."""
 
-    def __init__(self) -> None:
+    def __init__(self, mode: Mode) -> None:
+        self.mode = mode
         self.inputs = b"\x00\x00"
         self.outputs = b""
 
     def setup(self, drv: Supi3Driver) -> None:
-        drv.initialize(Mode.MOTOROLA)
+        drv.initialize(self.mode)
         drv.configure(0x83, 0x03)
         drv.irq_enable(Irq.VALID)
 
@@ -92,12 +98,13 @@ class DigitalIoTwin(Firmware):
 
 
 @pytest.mark.parametrize("bit_rate", [500_000, 2_000_000])
-def test_c_firmware_costs_the_bus_time_of_its_python_twin(cache: pytest.Cache, bit_rate: int) -> None:
+@pytest.mark.parametrize("mode", MODES)
+def test_c_firmware_costs_the_bus_time_of_its_python_twin(cache: pytest.Cache, bit_rate: int, mode: Mode) -> None:
     """The same calls through the C driver and the Python driver: the same bytes at the same bus times, so the
     same interrupt latency and the same data (FW-1: each byte its Table 3-7 time)."""
-    c_bench, c_firmware_ = _bench(cache, "digital_io", bit_rate=bit_rate)
-    twin = DigitalIoTwin()
-    py_bench = Bench(firmware=twin, bit_rate=bit_rate)
+    c_bench, c_firmware_ = _bench(cache, "digital_io", mode, bit_rate=bit_rate)
+    twin = DigitalIoTwin(mode)
+    py_bench = Bench(firmware=twin, bit_rate=bit_rate, mode=mode)
     for bench in (c_bench, py_bench):
         bench.run(3)
         bench.master.set_outputs(1, b"\x3c\xc3")
@@ -127,9 +134,11 @@ def test_analog_io_carries_any_32_bit_values(pytestconfig: pytest.Config, values
         assert bench.master.inputs(1) == value.to_bytes(4, "little")
 
 
-def test_analog_io_moves_32_bits_with_one_block_transfer(cache: pytest.Cache) -> None:
-    """SET 85h (two words), ID 33h; 4-byte block transfer (3.4.6), byte 0 the MSB (3.4.8)."""
-    bench, firmware = _bench(cache, "analog_io")
+@pytest.mark.parametrize(("mode", "block_bytes"), [(Mode.MOTOROLA, 4), (Mode.INTEL, 8)])
+def test_analog_io_moves_32_bits_with_one_block_transfer(cache: pytest.Cache, mode: Mode, block_bytes: int) -> None:
+    """SET 85h (two words), ID 33h; 4-byte block transfer (3.4.6), byte 0 the MSB (3.4.8); Intel: four reads, then
+    four writes (UP-11)."""
+    bench, firmware = _bench(cache, "analog_io", mode)
     bench.run(3)
     entry = bench.master.config[0] if bench.master.config is not None else None
     assert entry is not None and (entry.id_code, entry.data_bytes) == (0x33, 4)
@@ -140,13 +149,14 @@ def test_analog_io_moves_32_bits_with_one_block_transfer(cache: pytest.Cache) ->
         bench.run(2)
         assert _outputs(firmware, 4) == value.to_bytes(4, "big")
         assert bench.master.inputs(1) == (value ^ 0xFFFF_FFFF).to_bytes(4, "big")
-    # per data cycle: /IRQ service (2 bytes) + block transfer (command + 4 bytes): 7 bytes, no single accesses
-    assert bench.bytes_clocked - bytes_before == 7 * 8
+    # per data cycle: /IRQ service (2 bytes) + block transfer (command + its data bytes), no single accesses
+    assert bench.bytes_clocked - bytes_before == (2 + 1 + block_bytes) * 8
 
 
-def test_irq_dispatch_sends_its_inputs_in_the_first_data_cycle(cache: pytest.Cache) -> None:
+@pytest.mark.parametrize("mode", MODES)
+def test_irq_dispatch_sends_its_inputs_in_the_first_data_cycle(cache: pytest.Cache, mode: Mode) -> None:
     """The ID cycle event writes IN before any data cycle (Table 3-13), unlike a VALID-only firmware."""
-    bench, firmware = _bench(cache, "irq_dispatch")
+    bench, firmware = _bench(cache, "irq_dispatch", mode)
     _set_inputs(firmware, b"\x5a\xa5")
     while not any(r.cycle.name == "DATA" and r.ok for r in bench.results):
         bench.run(1)
@@ -166,9 +176,10 @@ def test_digital_io_without_id_cycle_handler_sends_zeros_first(cache: pytest.Cac
     assert bench.master.inputs(1) == b"\x00\x00"
 
 
-def test_polling_io_exchanges_every_cycle_without_interrupts(cache: pytest.Cache) -> None:
+@pytest.mark.parametrize("mode", MODES)
+def test_polling_io_exchanges_every_cycle_without_interrupts(cache: pytest.Cache, mode: Mode) -> None:
     """3.4.14 polling: the 1 -> 0 edge of the I/O access bit, then four accesses inside the 30-bit window."""
-    bench, firmware = _bench(cache, "polling_io")
+    bench, firmware = _bench(cache, "polling_io", mode)
     bench.run(5)  # both runs end at a cycle's end, before the firmware sees that fall
     served = firmware.board.cycles
     bench.master.set_outputs(1, b"\xbe\xef")

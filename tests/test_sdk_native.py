@@ -104,6 +104,11 @@ def test_build_refuses_what_is_not_a_c_file(tmp_path: Path) -> None:
             native.build([bad], cache_dir=tmp_path)  # type: ignore[list-item]
     with pytest.raises(ArgumentError, match=r"name must be an example firmware \(analog_io, "):
         native.example("nope")
+    source = tmp_path / "fw.c"
+    source.write_text(SETUP_ONLY)
+    for defines in ({"1X": "1"}, {"X": 1}, ["X"]):
+        with pytest.raises(ArgumentError, match="defines must"):
+            native.build(source, defines=defines, cache_dir=tmp_path)  # type: ignore[arg-type]
 
 
 def test_warnings_are_errors(cache: pytest.Cache, tmp_path: Path) -> None:

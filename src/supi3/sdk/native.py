@@ -30,12 +30,13 @@ import hashlib
 import importlib.util
 import io
 import os
+import re
 import shutil
 import subprocess
 import sys
 import sysconfig
 import tempfile
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 from types import ModuleType
 from typing import Any, Final
@@ -141,6 +142,7 @@ _HAS_SETUP, _HAS_ISR, _HAS_LOOP = 1, 2, 4
 Sources = str | Path | Iterable[str | Path]
 """One ``.c`` file or several."""
 _COMPILERS: Final[tuple[str, ...]] = ("cc", "gcc", "clang")
+_MACRO: Final = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
 
 class NativeBuildError(Supi3Error, RuntimeError):
@@ -267,7 +269,7 @@ def _sources(sources: Sources) -> tuple[Path, ...]:
     return tuple(paths)
 
 
-def build(sources: Sources = (), *, include_dirs: Iterable[str | Path] = (),
+def build(sources: Sources = (), *, include_dirs: Iterable[str | Path] = (), defines: Mapping[str, str] | None = None,
           cache_dir: str | Path | None = None) -> NativeLibrary:  # fmt: skip
     """Build (or take from the cache) the C driver plus the firmware ``sources`` as one cffi module, and load a
     private copy of it (:class:`NativeLibrary`).
@@ -279,6 +281,8 @@ def build(sources: Sources = (), *, include_dirs: Iterable[str | Path] = (),
         path.
     include_dirs:
         Further include folders of the firmware.
+    defines:
+        Preprocessor macros for every source, ``{"FW_MODE": "SUPI3_MODE_INTEL"}`` is ``-DFW_MODE=SUPI3_MODE_INTEL``.
     cache_dir:
         Where built modules are kept (default :func:`default_cache_dir`); a module is rebuilt when a source, a
         header, a flag or the compiler changes. Builds in parallel processes are safe (each builds in a
@@ -293,6 +297,7 @@ def build(sources: Sources = (), *, include_dirs: Iterable[str | Path] = (),
     """
     firmware = _sources(sources)
     includes = (sdk.include_dir(), EXAMPLES_DIR, *(Path(d).resolve() for d in include_dirs))
+    flags = (*STRICT_FLAGS, *_defines(defines))
     compiler = find_compiler()
     c_files = (*sdk.sources(), *firmware)
     # A source's own folder is searched first by #include "...": its headers count too. Folders of the sources
@@ -300,7 +305,7 @@ def build(sources: Sources = (), *, include_dirs: Iterable[str | Path] = (),
     folders = dict.fromkeys((*includes, *(source.parent for source in firmware)))
     headers = [h for d in folders for h in sorted(Path(d).glob("*.h"))]
     digest = hashlib.sha256()
-    for part in (compiler, sys.version, _cffi().__version__, _CDEF, _GLUE, *STRICT_FLAGS, *map(str, includes)):
+    for part in (compiler, sys.version, _cffi().__version__, _CDEF, _GLUE, *flags, *map(str, includes)):
         digest.update(part.encode() + b"\0")
     for path in (*c_files, *headers):
         digest.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
@@ -310,7 +315,7 @@ def build(sources: Sources = (), *, include_dirs: Iterable[str | Path] = (),
     if not target.is_file():
         folder.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryDirectory(dir=folder, prefix=f"{name}.") as work:
-            built = _compile(compiler, name, c_files, includes, Path(work))
+            built = _compile(compiler, flags, name, (c_files, includes), Path(work))
             os.replace(built, target)
     return NativeLibrary(_load_copy(target, name), target)
 
@@ -354,14 +359,28 @@ def toolchain_missing() -> str | None:
     return None
 
 
-def _compile(compiler: str, name: str, c_files: tuple[Path, ...], includes: tuple[Path, ...], work: Path) -> Path:
+def _defines(defines: Mapping[str, str] | None) -> tuple[str, ...]:
+    if defines is None:
+        return ()
+    if not isinstance(defines, Mapping):
+        raise ArgumentError("defines", defines, f"defines must be a mapping of macro names to values, not {defines!r}")
+    for macro, value in defines.items():
+        if not isinstance(macro, str) or _MACRO.fullmatch(macro) is None or not isinstance(value, str):
+            raise ArgumentError("defines", defines, f"defines must map C identifiers to strings, not {macro!r}: "
+                                f"{value!r}")  # fmt: skip
+    return tuple(f"-D{macro}={value}" for macro, value in sorted(defines.items()))
+
+
+def _compile(compiler: str, flags: tuple[str, ...], name: str, files: tuple[tuple[Path, ...], tuple[Path, ...]],
+             work: Path) -> Path:  # fmt: skip
+    c_files, includes = files
     objects = []
     for k, source in enumerate(c_files):
         obj = work / f"{k}_{source.stem}.o"
-        command = [compiler, *STRICT_FLAGS, "-fPIC", "-c", *(f"-I{d}" for d in includes), str(source), "-o", str(obj)]
+        command = [compiler, *flags, "-fPIC", "-c", *(f"-I{d}" for d in includes), str(source), "-o", str(obj)]
         result = subprocess.run(command, capture_output=True, text=True, check=False)
         if result.returncode != 0:
-            raise NativeBuildError(f"{source.name} does not compile with {' '.join(STRICT_FLAGS)}:\n{result.stderr}")
+            raise NativeBuildError(f"{source.name} does not compile with {' '.join(flags)}:\n{result.stderr}")
         objects.append(str(obj))
     ffi = _cffi().FFI()
     ffi.cdef(_CDEF)
@@ -386,8 +405,8 @@ class CFirmware(Firmware):
     ----------
     sources:
         The firmware's ``.c`` file(s), e.g. ``native.example("digital_io")``; built by :func:`build`.
-    include_dirs, cache_dir:
-        Passed to :func:`build`.
+    include_dirs, defines, cache_dir:
+        Passed to :func:`build`; the examples take ``defines={"FW_MODE": "SUPI3_MODE_INTEL"}`` for the Intel mode.
     frame_gap_us:
         ``supi3_config_t.frame_gap_us`` of the C driver (the bench's ``frame_gap_us`` is the Python driver's).
 
@@ -413,15 +432,17 @@ class CFirmware(Firmware):
 
     def __new__(cls, sources: Sources, **options: Any) -> CFirmware:
         """Pick :class:`_LoopingCFirmware` when the firmware has a main loop."""
-        library = build(sources, include_dirs=options.get("include_dirs", ()), cache_dir=options.get("cache_dir"))
+        library = build(sources, include_dirs=options.get("include_dirs", ()), defines=options.get("defines"),
+                        cache_dir=options.get("cache_dir"))  # fmt: skip
         chosen = _LoopingCFirmware if library.has_loop and cls is CFirmware else cls
         instance: CFirmware = super().__new__(chosen)
         instance.library = library
         return instance
 
     def __init__(self, sources: Sources, *, include_dirs: Iterable[str | Path] = (),
-                 cache_dir: str | Path | None = None, frame_gap_us: int = 0) -> None:  # fmt: skip
-        del sources, include_dirs, cache_dir  # used by __new__
+                 defines: Mapping[str, str] | None = None, cache_dir: str | Path | None = None,
+                 frame_gap_us: int = 0) -> None:  # fmt: skip
+        del sources, include_dirs, defines, cache_dir  # used by __new__
         library: NativeLibrary = self.library
         if not library.has_setup:
             raise NativeBuildError("the firmware must define fw_setup(supi3_t *, fw_board_t *) (fw_board.h)")

@@ -2,8 +2,8 @@
  * analog_io.c - a 32-bit analog input/output remote bus device (ID code 33h "AIO", Table A-3).
  *
  * Two words of process data each way (SET 85h: /PCP = 1, ExtReg = 0, CL = 101, two words, Table 3-12), moved
- * with one block transfer (3.4.6: command 0Fh plus four data bytes, OUT0..OUT3 out and IN0..IN3 in, full duplex
- * in the Motorola mode). Here the two words are two 16-bit channels: the DAC value the master sets arrives in
+ * with one block transfer (3.4.6: command CFh, RD and WR at address 15, then four data bytes: OUT0..OUT3 out and
+ * IN0..IN3 in, full duplex in the Motorola mode; four reads, then four writes in the Intel mode). Here the two words are two 16-bit channels: the DAC value the master sets arrives in
  * OUT0..OUT3, the ADC value goes back in IN0..IN3 (byte 0 the most significant, 3.4.8). The "valid data cycle"
  * interrupt synchronizes the access (3.4.14; the manual advises interrupts for more than one word).
  */
@@ -15,7 +15,7 @@
 
 void fw_setup(supi3_t *chip, fw_board_t *board)
 {
-    if (fw_note(board, supi3_initialize(chip, SUPI3_MODE_MOTOROLA)) != SUPI3_OK ||
+    if (fw_note(board, supi3_initialize(chip, FW_MODE)) != SUPI3_OK ||
         fw_note(board, supi3_configure(chip, AIO_SET, AIO_ID_CODE)) != SUPI3_OK) {
         return;
     }

@@ -15,7 +15,7 @@
 void fw_setup(supi3_t *chip, fw_board_t *board)
 {
     /* 3.4.3: initialization byte first, then SET and ID while the bus does not run yet, then the interrupt. */
-    if (fw_note(board, supi3_initialize(chip, SUPI3_MODE_MOTOROLA)) != SUPI3_OK) {
+    if (fw_note(board, supi3_initialize(chip, FW_MODE)) != SUPI3_OK) {
         return;
     }
     if (fw_note(board, supi3_configure(chip, DIO_SET, DIO_ID_CODE)) != SUPI3_OK) {

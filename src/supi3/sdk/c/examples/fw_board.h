@@ -27,6 +27,12 @@
 extern "C" {
 #endif
 
+/** The interface mode the examples initialize (3.4.3, Table 3-8); build with -DFW_MODE=SUPI3_MODE_INTEL for the
+ *  8051 serial mode 0 (then a board's xfer drives S/R, Table 3-9). */
+#ifndef FW_MODE
+#define FW_MODE SUPI3_MODE_MOTOROLA
+#endif
+
 /** Process data bytes the board holds per direction: the chip's data registers, IN0..IN3 / OUT0..OUT3 (3.4.8). */
 #define FW_DATA_BYTES 4u
 

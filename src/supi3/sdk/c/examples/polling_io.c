@@ -16,7 +16,7 @@
 
 void fw_setup(supi3_t *chip, fw_board_t *board)
 {
-    if (fw_note(board, supi3_initialize(chip, SUPI3_MODE_MOTOROLA)) != SUPI3_OK) {
+    if (fw_note(board, supi3_initialize(chip, FW_MODE)) != SUPI3_OK) {
         return;
     }
     (void)fw_note(board, supi3_configure(chip, DEV_SET, DEV_ID_CODE)); /* no interrupt enabled */
