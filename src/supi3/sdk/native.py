@@ -237,7 +237,10 @@ class NativeLibrary:
 
             ffi.def_extern(name=f"supi3_native_{name}", error=error)(callback)
 
-        register("xfer", CFirmware._xfer, CALLBACK_FAILED)
+        def xfer(user: Any, tx: int, rx: Any, s_r: int) -> int:  # the hot path: no *args
+            return from_handle(user)._xfer(tx, rx, s_r)  # type: ignore[no-any-return]
+
+        ffi.def_extern(name="supi3_native_xfer", error=CALLBACK_FAILED)(xfer)
         register("delay_us", CFirmware._delay_us, None)
         register("read_irq", CFirmware._read_irq, CALLBACK_FAILED)
         register("read_cd", CFirmware._read_cd, CALLBACK_FAILED)
