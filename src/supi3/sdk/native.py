@@ -432,6 +432,7 @@ class CFirmware(Firmware):
     """
 
     library: NativeLibrary
+    _xfer_to: Callable[[int, bool], int]  # the transport's xfer, from attach()
 
     def __new__(cls, sources: Sources, **options: Any) -> CFirmware:
         """Pick :class:`_LoopingCFirmware` when the firmware has a main loop."""
@@ -467,12 +468,10 @@ class CFirmware(Firmware):
         self._entries = {name: getattr(lib, name) for name in ("fw_setup", "fw_isr", "fw_loop")
                          if getattr(library, f"has_{name[3:]}")}  # fmt: skip
         self.transport: Transport | None = None
-        self._xfer_to: Callable[[int, bool], int] = _detached
         self._protocol: Any = None
         self._error: BaseException | None = None
         self._where = ""
         self._mod_ack_seen_until = 0
-        self._running = ""
 
     # -- the entry points --------------------------------------------------------------------------------------
 
@@ -517,11 +516,7 @@ class CFirmware(Firmware):
                                 f"({', '.join(self._entries)}), not {entry!r}")  # fmt: skip
         if self.transport is None:
             raise CFirmwareError(f"{entry}() before setup(): attach the firmware to a transport first")
-        self._running = entry
-        try:
-            function(self.context, self.board)
-        finally:
-            self._running = ""
+        function(self.context, self.board)
         error = self._error
         code, self.board.error = self.board.error, 0  # each failure is raised once
         if error is not None:
@@ -644,8 +639,3 @@ class _LoopingCFirmware(CFirmware):
         """One pass of ``fw_loop``."""
         del drv
         self.call("fw_loop")
-
-
-def _detached(tx: int, s_r: bool) -> int:
-    del tx, s_r
-    raise CFirmwareError("the firmware is not attached to a transport")
