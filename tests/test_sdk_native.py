@@ -7,7 +7,6 @@ tests/test_sdk_c_examples.py.
 from __future__ import annotations
 
 import sys
-import tomllib
 from pathlib import Path
 
 import pytest
@@ -315,13 +314,3 @@ void fw_isr(supi3_t *chip, fw_board_t *board)
         firmware.call("fw_isr")
     assert caught.value.__notes__ == ["in fw_isr(): reading /IRQ (read_irq)"]
 
-
-def test_the_examples_are_package_data() -> None:
-    """pyproject's package-data globs cover every file of the examples folder (they ship in the wheel)."""
-    pyproject = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml").read_text(encoding="utf-8"))
-    globs = pyproject["tool"]["setuptools"]["package-data"]["supi3"]
-    package = native.EXAMPLES_DIR.parents[2]
-    shipped = {path for pattern in globs for path in package.glob(pattern)}
-    examples = set(native.EXAMPLES_DIR.iterdir())
-    assert {p.name for p in examples} >= {"fw_board.h", "digital_io.c", "analog_io.c"}
-    assert examples <= shipped
