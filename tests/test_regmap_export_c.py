@@ -1,4 +1,5 @@
-"""The generated C header compiles cleanly under C99 and C11, and every macro equals the Python declaration."""
+"""The generated C header compiles cleanly under C99 and C11, every macro equals the Python declaration, and every
+macro that rests on a recorded decision names it (docs/assumptions)."""
 
 from __future__ import annotations
 
@@ -9,9 +10,11 @@ from pathlib import Path
 
 import pytest
 
-from supi3.regmap import REGISTER_MAP, ByteLayout, to_c_header
+from supi3.regmap import REGISTER_MAP, ByteLayout, RegisterMapError, to_c_header
+from supi3.regmap.core import Assumption
 
 C_DIR = Path(__file__).parent / "c"
+ASSUMPTIONS_DIR = Path(__file__).parent.parent / "docs" / "assumptions"
 
 
 def _layout_checks(layout: ByteLayout) -> list[tuple[str, int]]:
@@ -91,3 +94,63 @@ def test_a_wrong_expectation_fails_the_build(tmp_path: Path) -> None:
             check=False,
         )
         assert result.returncode != 0, std
+
+
+def _recorded_ids() -> set[str]:
+    """The IDs of docs/assumptions/*.md: the ``## RM-7 ...`` headings."""
+    return {
+        found
+        for path in ASSUMPTIONS_DIR.glob("*.md")
+        for found in re.findall(r"^##\s+([A-Z]+-[0-9]+)\b", path.read_text(encoding="utf-8"), flags=re.MULTILINE)
+    }
+
+
+def _macro_lines() -> dict[str, str]:
+    """Every macro of the header by name (function-like ones with their parameter list), its whole line."""
+    pattern = r"^#define\s+(SUPI3_\w+(?:\(\w+\))?).*$"
+    return {m.group(1): m.group(0) for m in re.finditer(pattern, to_c_header(), re.MULTILINE)}
+
+
+NAMED = re.compile(r"/\* assumptions? ([A-Z]+-[0-9]+(?:, [A-Z]+-[0-9]+)*) \*/")
+LEGEND = re.compile(r"^ \*   ([A-Z]+-[0-9]+): \S", re.MULTILINE)
+
+
+def _named_ids() -> set[str]:
+    """Every assumption ID the header's macros name in their comments."""
+    return {one for group in NAMED.findall(to_c_header()) for one in group.split(", ")}
+
+
+def test_every_assumption_the_header_names_is_recorded() -> None:
+    named = _named_ids()
+    assert {"RM-1", "RM-4", "RM-7", "RM-8"} <= named
+    assert named <= _recorded_ids(), named - _recorded_ids()
+
+
+def test_macros_name_the_assumptions_they_rest_on() -> None:
+    lines = _macro_lines()
+    for layout in (REGISTER_MAP.command_byte, REGISTER_MAP.init_byte, *REGISTER_MAP.registers):
+        for f in layout.fields:
+            for suffix in ("POS", "MSK", *(v.name for v in f.values)):
+                line = lines[f"SUPI3_{layout.name}_{f.name}_{suffix}"]
+                assert ("assumption" in line) == bool(f.assumptions), line
+                assert all(a.id in line for a in f.assumptions), line
+    assert lines["SUPI3_IRQ_EVT_IO_ACCESS_MSK"].endswith("/* assumptions RM-7, RM-8 */")
+    assert lines["SUPI3_IRQ_EVT_CLEAR_ON_READ_MSK"].endswith("/* assumptions RM-7, RM-8 */")
+    assert lines["SUPI3_CMD_BLOCK_TRANSFER"].endswith("/* assumptions RM-1, RM-2 */")
+    assert lines["SUPI3_CMD_READ(addr)"].endswith("/* assumption RM-1 */")
+    assert lines["SUPI3_SET_EXTREG_MSK"].endswith("/* assumption RM-4 */")
+    assert "assumption" not in lines["SUPI3_SET_ADDR"] + lines["SUPI3_IN1_DATA_MSK"] + lines["SUPI3_ADDR_COUNT"]
+
+
+def test_the_opening_comment_lists_each_named_assumption_once_with_its_summary() -> None:
+    opening = to_c_header().split("*/", 1)[0]
+    listed = LEGEND.findall(opening)
+    assert sorted(listed) == sorted(set(listed)) and set(listed) == _named_ids()
+
+
+@pytest.mark.parametrize("bad", ["RM7", "rm-7", "RM-", ""])
+def test_an_assumption_needs_an_id_like_rm_7(bad: str) -> None:
+    with pytest.raises(RegisterMapError, match="assumption id must look like 'RM-7'"):
+        Assumption(bad, "summary")
+    with pytest.raises(RegisterMapError):
+        Assumption("RM-7", "")

@@ -143,6 +143,7 @@ static void board_delay_us(void *u, uint32_t us) { (void)u; (void)us; }
 static int board_irq(void *u, int *level) { (void)u; *level = 1; return 0; }
 static int board_cd(void *u, int *level) { (void)u; *level = 0; return 0; }
 static int board_sas(void *u, int level) { (void)u; (void)level; return 0; }
+static int board_io(void *u, int *level) { (void)u; *level = 0; return 0; }
 static int hspi1;
 int example(void);
 int example(void)
@@ -150,18 +151,27 @@ int example(void)
 """
 
 
-def test_start_up_example_of_the_guide_compiles(tmp_path: Path) -> None:
+def _compile_guide_example(tmp_path: Path, heading: str, prelude: str) -> None:
+    """The first C block under ``heading`` in docs/sdk.md, inside a function after the stubs, compiles strictly."""
     gcc = _gcc()
     guide = (ROOT / "docs" / "sdk.md").read_text(encoding="utf-8")
-    section = guide.split("## Start-up and recovery", 1)[1]
+    section = guide.split(f"## {heading}", 1)[1]
     snippet = section.split("```c\n", 1)[1].split("```", 1)[0]
     source = tmp_path / "example.c"
-    source.write_text(STUBS + snippet + "    return err;\n}\n", encoding="ascii")
+    source.write_text(STUBS + prelude + snippet + "    return err;\n}\n", encoding="ascii")
     result = subprocess.run(
         [gcc, *STRICT, "-fsyntax-only", f"-I{sdk.include_dir()}", str(source)],
         capture_output=True, text=True, check=False,
     )  # fmt: skip
     assert result.returncode == 0, result.stderr
+
+
+def test_start_up_example_of_the_guide_compiles(tmp_path: Path) -> None:
+    _compile_guide_example(tmp_path, "Start-up and recovery", "")
+
+
+def test_polling_example_of_the_guide_compiles(tmp_path: Path) -> None:
+    _compile_guide_example(tmp_path, "Synchronizing with the bus: interrupt or polling", "    static supi3_t chip;\n")
 
 
 def test_header_is_usable_from_cxx(tmp_path: Path) -> None:

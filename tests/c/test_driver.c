@@ -2,7 +2,8 @@
  * Unit tests of sdk/c (supi3.c) against a fake chip in C, built and run by tests/test_sdk_c.py.
  * The fake implements the chip side of the byte protocol (manual 3.4.3 to 3.4.6, docs/upif.md): init byte,
  * command/data alternation with C/D (UP-2), registers 0..14 with read-clear of 14, block transfer (UP-10,
- * UP-11), Intel S/R direction (UP-9), and a faulty init byte disabling the interface (UP-4).
+ * UP-11), Intel S/R direction (UP-9), a faulty init byte disabling the interface (UP-4), the optical read
+ * registers 8..11 (3.4.12, 3.4.13) and the I/O access bit D7 of read 14 and its pin MFP1 (3.4.14, RM-8).
  * Prints "N passed, M failed"; exit status 1 on any failure.
  */
 #include <stdio.h>
@@ -27,6 +28,13 @@ typedef struct {
     int fail_at; /* xfer number that fails, -1 = never */
     int sas_pulses, sas_level, delays;
     int irq_pin_reads;
+    uint8_t optical[4]; /* reads 8..11 */
+    /* I/O access: when io_scripted, D7 of read 14 is 1 for the next io_busy_reads reads, then 0 (RM-8); the
+     * events in evt_after[] arrive one after each read of 14 (new events between polls). */
+    int io_scripted, io_busy_reads;
+    uint8_t evt_after[4];
+    size_t n_evt_after, evt_idx;
+    int io_pin_busy, io_pin_reads, io_pin_fail; /* MFP1: 1 for io_pin_busy reads, then 0 */
 } fake_t;
 
 static int c_d(const fake_t *f)
@@ -40,11 +48,20 @@ static uint8_t reg_read(fake_t *f, uint8_t a)
     switch (a) {
     case 0: case 1: case 2: case 3: return f->out[a];
     case 7: return f->pcmd;
+    case 8: case 9: case 10: case 11: return f->optical[a - 8u];
     case 12: return f->id;
     case 13: return f->set;
     case 14:
+        if (f->io_scripted) {
+            f->irq_evt = (uint8_t)((f->irq_evt & SUPI3_IRQ_EVT_CLEAR_ON_READ_MSK) |
+                                   (f->io_busy_reads > 0 ? SUPI3_IRQ_EVT_IO_ACCESS_MSK : 0u));
+            f->io_busy_reads -= f->io_busy_reads > 0;
+        }
         v = f->irq_evt;
         f->irq_evt = (uint8_t)(f->irq_evt & (uint8_t)~SUPI3_IRQ_EVT_CLEAR_ON_READ_MSK);
+        if (f->evt_idx < f->n_evt_after) {
+            f->irq_evt = (uint8_t)(f->irq_evt | f->evt_after[f->evt_idx++]);
+        }
         return v;
     default: return 0u;
     }
@@ -159,6 +176,18 @@ static int fake_read_irq(void *user, int *level)
     return 0;
 }
 
+static int fake_read_io(void *user, int *level)
+{
+    fake_t *f = (fake_t *)user;
+    if (f->io_pin_fail) {
+        return -1;
+    }
+    f->io_pin_reads++;
+    *level = f->io_pin_busy > 0;
+    f->io_pin_busy -= f->io_pin_busy > 0;
+    return 0;
+}
+
 static int fake_sas(void *user, int level)
 {
     fake_t *f = (fake_t *)user;
@@ -212,6 +241,13 @@ static void setup(supi3_t *ctx, fake_t *f, int with_cd)
     cfg.delay_us = fake_delay;
     cfg.user = f;
     memset(ctx, 0xA5, sizeof *ctx); /* garbage, as on a stack */
+    (void)supi3_init(ctx, &cfg);
+}
+
+static void use_io_pin(supi3_t *ctx)
+{
+    supi3_config_t cfg = ctx->cfg;
+    cfg.read_io = fake_read_io;
     (void)supi3_init(ctx, &cfg);
 }
 
@@ -440,6 +476,137 @@ static void test_transport_error(void)
     CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_OK);
 }
 
+static void test_irq_enable(void)
+{
+    supi3_t ctx; fake_t f;
+    static const uint8_t expect[] = {0x00u, 0x4Eu, 0x50u};
+    setup(&ctx, &f, 1);
+    CHECK_EQ(supi3_irq_enable(NULL, 0x10u), SUPI3_E_ARG);
+    CHECK_EQ(supi3_irq_enable(&ctx, 0x10u), SUPI3_E_NOT_INIT);
+    CHECK_EQ(supi3_irq_enable(&ctx, 0x80u), SUPI3_E_ARG); /* value arguments before the state, as addresses */
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_OK);
+    CHECK_EQ(supi3_irq_enable(&ctx, SUPI3_IRQ_EN_PCMD_MSK | SUPI3_IRQ_EN_VALID_MSK), SUPI3_OK); /* 3.4.14 step 1 */
+    CHECK_EQ(f.irq_en, 0x50u);
+    CHECK_EQ(supi3_irq_enable(&ctx, 0x80u), SUPI3_E_ARG); /* bit 7 reserved (RM-7) */
+    CHECK_EQ(supi3_irq_enable(&ctx, 0xFFu), SUPI3_E_ARG);
+    log_is(&f, expect, sizeof expect);
+    CHECK_EQ(supi3_irq_enable(&ctx, 0x7Fu), SUPI3_OK);
+    CHECK_EQ(f.irq_en, 0x7Fu);
+    CHECK_EQ(supi3_irq_enable(&ctx, 0x00u), SUPI3_OK);
+    CHECK_EQ(f.irq_en, 0x00u);
+}
+
+static void test_poll_io_window_by_register(void)
+{
+    supi3_t ctx; fake_t f; uint8_t ev = 0xFFu;
+    static const uint8_t expect[] = {0x8Eu, 0x00u, 0x8Eu, 0x00u, 0x8Eu, 0x00u};
+    setup(&ctx, &f, 1);
+    CHECK_EQ(supi3_poll_io_window(&ctx, 1u, &ev), SUPI3_E_NOT_INIT);
+    CHECK_EQ(supi3_poll_io_window(&ctx, 0u, &ev), SUPI3_E_ARG);
+    CHECK_EQ(supi3_poll_io_window(&ctx, 1u, NULL), SUPI3_E_NOT_INIT); /* pointers after the state */
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_OK);
+    f.ntx = 0u;
+    f.io_scripted = 1; f.io_busy_reads = 2;
+    f.irq_evt = SUPI3_IRQ_EVT_VALID_MSK;
+    f.evt_after[0] = SUPI3_IRQ_EVT_PCMD_MSK; f.n_evt_after = 1u; /* arrives between the first and second poll */
+    CHECK_EQ(supi3_poll_io_window(&ctx, 3u, &ev), SUPI3_OK); /* D7 = 1, 1, 0 */
+    CHECK_EQ(ev, SUPI3_IRQ_EVT_VALID_MSK | SUPI3_IRQ_EVT_PCMD_MSK); /* no event lost, D7 not in events */
+    CHECK_EQ(f.irq_evt, 0u);
+    log_is(&f, expect, sizeof expect);
+    f.ntx = 0u; f.io_busy_reads = 5; f.irq_evt = SUPI3_IRQ_EVT_IB_RESET_MSK;
+    CHECK_EQ(supi3_poll_io_window(&ctx, 3u, &ev), SUPI3_E_TIMEOUT);
+    CHECK_EQ(ev, SUPI3_IRQ_EVT_IB_RESET_MSK); /* the events read before the timeout are kept */
+    CHECK_EQ(f.ntx, 6u);
+    CHECK_EQ(f.io_busy_reads, 2);
+    f.ntx = 0u;
+    CHECK_EQ(supi3_poll_io_window(&ctx, 0u, &ev), SUPI3_E_ARG);
+    CHECK_EQ(supi3_poll_io_window(&ctx, 1u, NULL), SUPI3_E_ARG); /* without read_io the events are needed */
+    CHECK_EQ(supi3_poll_io_window(NULL, 1u, &ev), SUPI3_E_ARG);
+    CHECK_EQ(f.ntx, 0u);
+    f.fail_at = 1; /* the data byte of the first read */
+    CHECK_EQ(supi3_poll_io_window(&ctx, 3u, &ev), SUPI3_E_TRANSPORT);
+    CHECK_EQ(supi3_poll_io_window(&ctx, 3u, &ev), SUPI3_E_NOT_INIT);
+}
+
+static void test_poll_io_window_by_pin(void)
+{
+    supi3_t ctx; fake_t f; uint8_t ev = 0xFFu;
+    setup(&ctx, &f, 1);
+    use_io_pin(&ctx);
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_INTEL), SUPI3_OK);
+    f.ntx = 0u;
+    f.io_pin_busy = 3;
+    f.irq_evt = SUPI3_IRQ_EVT_VALID_MSK;
+    CHECK_EQ(supi3_poll_io_window(&ctx, 4u, &ev), SUPI3_OK);
+    CHECK_EQ(ev, 0u);
+    CHECK_EQ(f.io_pin_reads, 4);
+    CHECK_EQ(f.ntx, 0u); /* nothing sent: the events stay pending */
+    CHECK_EQ(f.irq_evt, SUPI3_IRQ_EVT_VALID_MSK);
+    f.io_pin_busy = 2;
+    CHECK_EQ(supi3_poll_io_window(&ctx, 2u, NULL), SUPI3_E_TIMEOUT);
+    CHECK_EQ(f.io_pin_reads, 6);
+    CHECK_EQ(supi3_poll_io_window(&ctx, 1u, NULL), SUPI3_OK);
+    CHECK_EQ(supi3_poll_io_window(&ctx, 0u, NULL), SUPI3_E_ARG);
+    f.io_pin_fail = 1;
+    CHECK_EQ(supi3_poll_io_window(&ctx, 1u, &ev), SUPI3_E_TRANSPORT);
+    f.io_pin_fail = 0;
+    CHECK_EQ(supi3_poll_io_window(&ctx, 1u, &ev), SUPI3_OK); /* a pin read leaves the chip as it was */
+    CHECK_EQ(f.ntx, 0u);
+}
+
+static void test_processor_alarm_and_command(void)
+{
+    supi3_t ctx; fake_t f; uint8_t v = 0u;
+    int intel;
+    for (intel = 0; intel <= 1; ++intel) {
+        static const uint8_t expect[] = {0x47u, 0xA5u, 0x87u, 0x00u};
+        setup(&ctx, &f, 1);
+        CHECK_EQ(supi3_processor_alarm(&ctx, 0xA5u), SUPI3_E_NOT_INIT);
+        CHECK_EQ(supi3_processor_command(&ctx, &v), SUPI3_E_NOT_INIT);
+        CHECK_EQ(supi3_initialize(&ctx, intel ? SUPI3_MODE_INTEL : SUPI3_MODE_MOTOROLA), SUPI3_OK);
+        f.ntx = 0u;
+        f.pcmd = 0x3Cu;
+        CHECK_EQ(supi3_processor_alarm(&ctx, 0xA5u), SUPI3_OK);  /* 3.4.9: slave to master */
+        CHECK_EQ(supi3_processor_command(&ctx, &v), SUPI3_OK);   /* 3.4.9: master to slave */
+        CHECK_EQ(f.alarm, 0xA5u);
+        CHECK_EQ(v, 0x3Cu);
+        log_is(&f, expect, sizeof expect);
+        CHECK_EQ(f.sr[3], 0); /* read data byte: the chip drives (Table 3-9) */
+        CHECK_EQ(f.sr[1], 1);
+        CHECK_EQ(supi3_processor_command(&ctx, NULL), SUPI3_E_ARG);
+        CHECK_EQ(supi3_processor_alarm(NULL, 0u), SUPI3_E_ARG);
+        CHECK_EQ(f.ntx, 4u);
+    }
+}
+
+static void test_optical_status(void)
+{
+    supi3_t ctx; fake_t f; supi3_optical_t st;
+    static const uint8_t expect[] = {0x88u, 0x00u, 0x89u, 0x00u, 0x8Au, 0x00u, 0x8Bu, 0x00u};
+    setup(&ctx, &f, 1);
+    memset(&st, 0xEE, sizeof st);
+    CHECK_EQ(supi3_optical_status(&ctx, &st), SUPI3_E_NOT_INIT);
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_OK);
+    f.ntx = 0u;
+    f.optical[0] = 0x80u | 0x40u | 62u; /* enabled, glass, 62 (RM-5) */
+    f.optical[1] = 63u;                 /* not enabled, polymer, 63 = 400 m to 20 km */
+    f.optical[2] = 0x80u | 15u;         /* enabled, level 15 (RM-6) */
+    f.optical[3] = 0x3Cu;               /* branch 3, out 12 */
+    CHECK_EQ(supi3_optical_status(&ctx, &st), SUPI3_OK);
+    log_is(&f, expect, sizeof expect);
+    CHECK_EQ(st.out_length, 62); CHECK_EQ(st.out_medium, 1); CHECK_EQ(st.out_enable, 1);
+    CHECK_EQ(st.branch_length, 63); CHECK_EQ(st.branch_medium, 0); CHECK_EQ(st.branch_enable, 0);
+    CHECK_EQ(st.in_level, 15); CHECK_EQ(st.in_enable, 1);
+    CHECK_EQ(st.out_level, 12); CHECK_EQ(st.branch_level, 3);
+    CHECK_EQ(supi3_optical_status(&ctx, NULL), SUPI3_E_ARG);
+    CHECK_EQ(supi3_optical_status(NULL, &st), SUPI3_E_ARG);
+    CHECK_EQ(f.ntx, 8u);
+    memset(&st, 0xEE, sizeof st);
+    f.fail_at = 13; /* the third register's data byte */
+    CHECK_EQ(supi3_optical_status(&ctx, &st), SUPI3_E_TRANSPORT);
+    CHECK_EQ(st.out_length, 0xEE); /* written only when all four reads went through */
+}
+
 static void test_helpers_and_strerror(void)
 {
     uint8_t b[4];
@@ -454,6 +621,8 @@ static void test_helpers_and_strerror(void)
     CHECK(strcmp(supi3_strerror(12345), "unknown error") == 0);
     CHECK(strstr(supi3_strerror(SUPI3_E_NOT_RESET), "SAS_INIT") != NULL);
     CHECK(strcmp(supi3_strerror(SUPI3_E_ARG), supi3_strerror(SUPI3_E_TRANSPORT)) != 0);
+    CHECK(strstr(supi3_strerror(SUPI3_E_TIMEOUT), "max_polls") != NULL);
+    CHECK_EQ(SUPI3_E_TIMEOUT, -7);
 }
 
 static void test_frame_gap_and_no_globals(void)
@@ -479,7 +648,9 @@ int main(void)
         test_motorola_init_and_configure, test_intel_init_sr_levels, test_not_reset_detected,
         test_interrupted_and_disabled, test_without_read_cd, test_argument_checks,
         test_motorola_block_and_exchange, test_intel_block_fig_3_12, test_block_length_follows_set, test_irq_service,
-        test_transport_error, test_helpers_and_strerror, test_frame_gap_and_no_globals,
+        test_transport_error, test_irq_enable, test_poll_io_window_by_register, test_poll_io_window_by_pin,
+        test_processor_alarm_and_command, test_optical_status, test_helpers_and_strerror,
+        test_frame_gap_and_no_globals,
     };
     size_t k, n = sizeof tests / sizeof tests[0];
     int passed = 0;

@@ -5,6 +5,7 @@ Nothing in this module knows the SUPI 3 OPC; :mod:`supi3.regmap.registers` decla
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from enum import StrEnum
 from functools import cached_property
@@ -76,13 +77,37 @@ class Reset(StrEnum):
     """SAS_INIT: re-initializes the serial interface; every register keeps its value (3.4.3)."""
 
 
+_ASSUMPTION_ID: Final[re.Pattern[str]] = re.compile(r"[A-Z]+-[0-9]+")
+
+
+@dataclass(frozen=True)
+class Assumption:
+    """A reference to a recorded project decision where the manual is silent or ambiguous.
+
+    ``id`` is the entry's heading in ``docs/assumptions/*.md`` (``RM-7``, ``UP-21``); ``summary`` says in a few
+    words what was decided, for generated outputs (the C header names both beside every macro that rests on it).
+    """
+
+    id: str
+    summary: str
+
+    def __post_init__(self) -> None:
+        if not _ASSUMPTION_ID.fullmatch(self.id) or not self.summary:
+            raise RegisterMapError(f"assumption id must look like 'RM-7' and have a summary, not {self.id!r}")
+
+
 @dataclass(frozen=True)
 class Enumerator:
-    """A named value: of a field (unshifted) or of a whole byte (see :attr:`ByteLayout.constants`)."""
+    """A named value: of a field (unshifted) or of a whole byte (see :attr:`ByteLayout.constants`).
+
+    ``assumptions``: the recorded decisions the value rests on beyond those of its field (a whole-byte constant
+    has no field).
+    """
 
     name: str
     value: int
     doc: str
+    assumptions: tuple[Assumption, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -107,6 +132,9 @@ class Field:
         register); ``None`` for an ordinary field.
     values:
         Named field values, unshifted.
+    assumptions:
+        The recorded decisions (docs/assumptions) the field's position and width rest on; empty where the
+        manual gives them.
     """
 
     name: str
@@ -116,6 +144,7 @@ class Field:
     access: Access | None = None
     overlays: str | None = None
     values: tuple[Enumerator, ...] = ()
+    assumptions: tuple[Assumption, ...] = ()
 
     def __post_init__(self) -> None:
         if self.width < 1 or self.lsb < 0 or self.lsb + self.width > BYTE_BITS:

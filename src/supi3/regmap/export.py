@@ -19,6 +19,7 @@ from supi3.regmap.core import (
     BYTE_BITS,
     Access,
     AccessDirection,
+    Assumption,
     ByteLayout,
     Field,
     Port,
@@ -385,17 +386,51 @@ def to_markdown() -> str:
 # C header
 # ----------------------------------------------------------------------------------------------------------------
 
-_CLine = str | tuple[str, str]
-"""A header line: text, or a ``(macro, value)`` pair aligned by :func:`_c_join`."""
+_CLine = str | tuple[str, str, str]
+"""A header line: text, or a ``(macro, value, comment)`` triple aligned by :func:`_c_join` (comment may be "")."""
+
+_C_VALUE_WIDTH: Final[int] = len("0xFFu")
+"""Comments after values up to this wide start in one column."""
 
 
-def _c_define(name: str, value: str, indent: bool = False) -> tuple[str, str]:
-    return ("#define   " if indent else "#define ") + "SUPI3_" + name, value
+def _c_assumptions(assumptions: Iterable[Assumption]) -> str:
+    """The comment naming the recorded decisions a macro rests on: ``/* assumption RM-7 */``; "" for none.
+
+    The header's opening comment lists each one with its summary (:func:`_c_assumption_legend`).
+    """
+    ids = list(dict.fromkeys(a.id for a in assumptions))
+    return f"/* assumption{'s' if len(ids) > 1 else ''} {', '.join(ids)} */" if ids else ""
+
+
+def _all_assumptions() -> list[Assumption]:
+    """Every decision a header macro rests on, once each, by area and number (RM-1 .. RM-8, then UP-n)."""
+    found: list[Assumption] = []
+    for layout in (*_layouts(), *REGISTER_MAP.registers):
+        for f in layout.fields:
+            found += [*f.assumptions, *(a for v in f.values for a in v.assumptions)]
+        found += [a for c in layout.constants for a in c.assumptions]
+    return sorted(set(found), key=lambda a: (a.id.split("-")[0], int(a.id.split("-")[1])))
+
+
+def _c_assumption_legend() -> list[str]:
+    return [f" *   {a.id}: {a.summary}" for a in _all_assumptions()]
+
+
+def _c_define(
+    name: str, value: str, indent: bool = False, assumptions: Iterable[Assumption] = ()
+) -> tuple[str, str, str]:
+    return ("#define   " if indent else "#define ") + "SUPI3_" + name, value, _c_assumptions(assumptions)
+
+
+def _c_line(line: tuple[str, str, str], width: int) -> str:
+    macro, value, comment = line
+    text = macro.ljust(width) + value
+    return f"{macro.ljust(width)}{value.ljust(_C_VALUE_WIDTH)} {comment}" if comment else text
 
 
 def _c_join(lines: list[_CLine]) -> str:
     width = max(len(line[0]) for line in lines if isinstance(line, tuple)) + 1
-    return "\n".join(line if isinstance(line, str) else line[0].ljust(width) + line[1] for line in lines)
+    return "\n".join(line if isinstance(line, str) else _c_line(line, width) for line in lines)
 
 
 def _c_hex(value: int) -> str:
@@ -406,24 +441,31 @@ def _c_fields(layout: ByteLayout) -> list[_CLine]:
     lines: list[_CLine] = []
     for f in layout.fields:
         lines += [
-            _c_define(f"{layout.name}_{f.name}_POS", f"{f.lsb}u", indent=True),
-            _c_define(f"{layout.name}_{f.name}_MSK", _c_hex(f.mask), indent=True),
+            _c_define(f"{layout.name}_{f.name}_POS", f"{f.lsb}u", True, f.assumptions),
+            _c_define(f"{layout.name}_{f.name}_MSK", _c_hex(f.mask), True, f.assumptions),
         ]
         lines += [
-            _c_define(f"{layout.name}_{f.name}_{v.name}", _c_hex(v.value << f.lsb), indent=True) for v in f.values
+            _c_define(f"{layout.name}_{f.name}_{v.name}", _c_hex(v.value << f.lsb), True, f.assumptions + v.assumptions)
+            for v in f.values
         ]
     return lines
 
 
+def _field_assumptions(layout: ByteLayout) -> list[Assumption]:
+    """Every decision a layout's fields rest on, in field order (for macros built from the whole layout)."""
+    return [a for f in layout.fields for a in f.assumptions]
+
+
 def _c_command_macros() -> list[_CLine]:
     cmd = f"SUPI3_{REGISTER_MAP.command_byte.name}"
+    assumed = _field_assumptions(REGISTER_MAP.command_byte)
     return [
         "",
         "/* Command byte for a read, a write, or (Motorola only) a simultaneous read and write of address addr. */",
-        _c_define("CMD_A(addr)", f"(((addr) << {cmd}_A_POS) & {cmd}_A_MSK)"),
-        _c_define("CMD_READ(addr)", f"({cmd}_RD_MSK | {cmd}_A(addr))"),
-        _c_define("CMD_WRITE(addr)", f"({cmd}_WR_MSK | {cmd}_A(addr))"),
-        _c_define("CMD_READ_WRITE(addr)", f"({cmd}_RD_MSK | {cmd}_WR_MSK | {cmd}_A(addr))"),
+        _c_define("CMD_A(addr)", f"(((addr) << {cmd}_A_POS) & {cmd}_A_MSK)", assumptions=assumed),
+        _c_define("CMD_READ(addr)", f"({cmd}_RD_MSK | {cmd}_A(addr))", assumptions=assumed),
+        _c_define("CMD_WRITE(addr)", f"({cmd}_WR_MSK | {cmd}_A(addr))", assumptions=assumed),
+        _c_define("CMD_READ_WRITE(addr)", f"({cmd}_RD_MSK | {cmd}_WR_MSK | {cmd}_A(addr))", assumptions=assumed),
     ]
 
 
@@ -434,7 +476,8 @@ def to_c_header() -> str:
     address each have their own), ``SUPI3_<REG>_<FIELD>_POS``/``_MSK`` indented under their register, field
     values in position as ``SUPI3_<REG>_<FIELD>_<VALUE>``, ``SUPI3_<REG>_CLEAR_ON_READ_MSK`` for read-clear
     registers, the command byte (``SUPI3_CMD_*``, ``SUPI3_CMD_WRITE(addr)``, ...) and the initialization byte
-    (``SUPI3_INIT_*``).
+    (``SUPI3_INIT_*``). A macro whose value rests on recorded decisions (the ``assumptions`` of its field, value or
+    constant) ends in a comment naming them, ``/* assumption RM-7 */``; the opening comment lists their summaries.
     """
     writes = {a: _port_summary(REGISTER_MAP.port(a, AccessDirection.WRITE)) for a in REGISTER_MAP.addresses}
     width = max(len(text) for text in writes.values()) + 2
@@ -443,7 +486,9 @@ def to_c_header() -> str:
         f" * {TITLE}: register addresses, field masks and interface bytes.",
         f" * Generated from {GENERATOR}. Do not edit.",
         f" * Source: {MANUAL}, 3.4.3 to 3.4.14.",
-        " * Layout decisions for the manual's missing figures: docs/assumptions/regmap.md.",
+        " * Layout decisions for the manual's missing figures: docs/assumptions/regmap.md (RM-n; UP-n are in",
+        " * docs/assumptions/upif.md). A macro that rests on one ends in a comment naming it (assumption RM-n):",
+        *_c_assumption_legend(),
         " *",
         " * _ADDR is the address A3..0 for the command byte; where Table 3-10 names a different write and read",
         " * register at one address, each has its own _ADDR. _POS is a field's lowest bit, _MSK its mask in",
@@ -467,10 +512,13 @@ def to_c_header() -> str:
     ]
     for layout in _layouts():
         lines += ["", f"/* {layout.name}: {layout.title} ({layout.ref}). Not addressable. */", *_c_fields(layout)]
-        lines += [_c_define(f"{layout.name}_{c.name}", _c_hex(c.value)) for c in layout.constants]
+        lines += [
+            _c_define(f"{layout.name}_{c.name}", _c_hex(c.value), assumptions=c.assumptions) for c in layout.constants
+        ]
     lines += _c_command_macros()
     for register in REGISTER_MAP.registers:
         ports = ", ".join(f"{p.direction.value} ({p.access.value})" for p in _ports_of(register))
+        assumed = _field_assumptions(register)  # the read-clear mask follows from the field layout
         lines += [
             "",
             f"/* {register.name}: {register.title}. Address {register.address}, {ports}.",
@@ -479,7 +527,7 @@ def to_c_header() -> str:
             _c_define(f"{register.name}_RESET", _c_hex(register.reset)),
         ]
         lines += [
-            _c_define(f"{register.name}_CLEAR_ON_READ_MSK", _c_hex(p.clear_on_read_mask))
+            _c_define(f"{register.name}_CLEAR_ON_READ_MSK", _c_hex(p.clear_on_read_mask), False, assumed)
             for p in _ports_of(register)
             if p.clear_on_read_mask
         ]

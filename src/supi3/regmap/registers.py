@@ -15,6 +15,7 @@ from typing import Final
 from supi3.regmap.core import (
     Access,
     AccessDirection,
+    Assumption,
     ByteLayout,
     Enumerator,
     Field,
@@ -98,6 +99,20 @@ INTERRUPT_SOURCES: Final[tuple[InterruptSource, ...]] = (
 """Table 3-13 in manual order from D5 down to D0, with D4 = valid data cycle fixed by 3.4.14; the processor
 command interrupt of 3.4.9 takes D6, just below the I/O access bit D7."""
 
+# References to the decisions above (and to UP-n of docs/assumptions/upif.md), for every generated output: the C
+# header names them beside each macro that rests on one.
+RM_1: Final[Assumption] = Assumption("RM-1", "command byte RD = bit 7, WR = bit 6, A3..0 = bits 3..0")
+RM_2: Final[Assumption] = Assumption("RM-2", "the command byte with A = 15 itself starts the block transfer")
+RM_3: Final[Assumption] = Assumption("RM-3", "init byte mode bit reflected into bits 7 and 0")
+RM_4: Final[Assumption] = Assumption("RM-4", "SET /PCP = bit 7, ExtReg = bit 6, ID12..8 = bits 4..0, CL = bits 2..0")
+RM_5: Final[Assumption] = Assumption("RM-5", "reads 8/9 LENGTH = bits 5..0, MEDIUM = bit 6, ENABLE = bit 7")
+RM_6: Final[Assumption] = Assumption(
+    "RM-6", "read 10 LEVEL = bits 3..0, ENABLE = bit 7; read 11 OUT_LEVEL = bits 3..0, BRANCH_LEVEL = bits 7..4"
+)
+RM_7: Final[Assumption] = Assumption("RM-7", "interrupt bits D6..D0 = PCMD, INVALID, VALID, ID, RESET, PCP RX, PCP TX")
+RM_8: Final[Assumption] = Assumption("RM-8", "I/O access bit D7 is live and not cleared by reading")
+UP_21: Final[Assumption] = Assumption("UP-21", "sub-byte data lengths use the low bits of byte 0")
+
 DATA_RESETS: Final[frozenset[Reset]] = frozenset({Reset.POWER_UP, Reset.INTERBUS})
 """IN/OUT data registers are cleared by power-up reset and by INTERBUS reset (3.4.7, Table 3-13)."""
 OTHER_RESETS: Final[frozenset[Reset]] = frozenset({Reset.POWER_UP})
@@ -108,8 +123,10 @@ OTHER_RESETS: Final[frozenset[Reset]] = frozenset({Reset.POWER_UP})
 # ------------------------------------------------------------------------------------------------------------
 
 
-def _bit(name: str, bit: int, doc: str, values: tuple[Enumerator, ...] = ()) -> Field:
-    return Field(name, bit, 1, doc, values=values)
+def _bit(
+    name: str, bit: int, doc: str, values: tuple[Enumerator, ...] = (), assumptions: tuple[Assumption, ...] = ()
+) -> Field:
+    return Field(name, bit, 1, doc, values=values, assumptions=assumptions)
 
 
 def _title(address: int, direction: AccessDirection) -> str:
@@ -131,12 +148,30 @@ COMMAND_BYTE: Final[ByteLayout] = ByteLayout(
     doc="First byte of every access: direction of the following data access and its address. With address 15 "
     "it starts a block transfer; RD and WR then have no meaning (3.4.6). Bits 5..4 are reserved (write 0).",
     fields=(
-        _bit("RD", COMMAND_RD_BIT, "The data access reads from the SUPI 3 (Motorola: both bits = full duplex)."),
-        _bit("WR", COMMAND_WR_BIT, "The data access writes to the SUPI 3 (Motorola: both bits = full duplex)."),
-        Field("A", COMMAND_ADDRESS_LSB, ADDRESS_BITS, "Binary address A3..0 of the following data access."),
+        _bit(
+            "RD",
+            COMMAND_RD_BIT,
+            "The data access reads from the SUPI 3 (Motorola: both bits = full duplex).",
+            assumptions=(RM_1,),
+        ),
+        _bit(
+            "WR",
+            COMMAND_WR_BIT,
+            "The data access writes to the SUPI 3 (Motorola: both bits = full duplex).",
+            assumptions=(RM_1,),
+        ),
+        Field(
+            "A",
+            COMMAND_ADDRESS_LSB,
+            ADDRESS_BITS,
+            "Binary address A3..0 of the following data access.",
+            assumptions=(RM_1,),
+        ),
     ),
     constants=(
-        Enumerator("BLOCK_TRANSFER", BLOCK_TRANSFER_COMMAND, "Start a block transfer (3.4.6): RD, WR, A = 15."),
+        Enumerator(
+            "BLOCK_TRANSFER", BLOCK_TRANSFER_COMMAND, "Start a block transfer (3.4.6): RD, WR, A = 15.", (RM_1, RM_2)
+        ),
     ),
 )
 """The command byte (3.4.4): not addressable, but firmware builds it for every access."""
@@ -149,19 +184,25 @@ INIT_BYTE: Final[ByteLayout] = ByteLayout(
     "bit order reads it; any other value is ignored and disables data transmission until power-up reset or "
     "SAS_INIT.",
     fields=tuple(
-        _bit(f"MODE_{end}", bit, "Mode bit: 0 = SPI (Motorola), 1 = Intel.")
+        _bit(f"MODE_{end}", bit, "Mode bit: 0 = SPI (Motorola), 1 = Intel.", assumptions=(RM_3,))
         for end, bit in zip(("MSB", "LSB"), INIT_MODE_BITS, strict=True)
     ),
     constants=(
-        Enumerator("MOTOROLA", INIT_BYTE_MOTOROLA, "SPI interface (Motorola)."),
-        Enumerator("INTEL", INIT_BYTE_INTEL, "Synchronous serial interface (Intel)."),
+        Enumerator("MOTOROLA", INIT_BYTE_MOTOROLA, "SPI interface (Motorola).", (RM_3,)),
+        Enumerator("INTEL", INIT_BYTE_INTEL, "Synchronous serial interface (Intel).", (RM_3,)),
     ),
 )
 """The initialization byte (Table 3-8)."""
 
 
 def _data_register(
-    name: str, address: int, direction: AccessDirection, resets: frozenset[Reset], ref: str, doc: str = ""
+    name: str,
+    address: int,
+    direction: AccessDirection,
+    resets: frozenset[Reset],
+    ref: str,
+    doc: str = "",
+    assumptions: tuple[Assumption, ...] = (),
 ) -> Register:
     return Register(
         name=name,
@@ -170,7 +211,7 @@ def _data_register(
         doc=doc,
         address=address,
         cleared_by=resets,
-        fields=(Field("DATA", 0, 8, "Data byte."),),
+        fields=(Field("DATA", 0, 8, "Data byte.", assumptions=assumptions),),
     )
 
 
@@ -178,11 +219,15 @@ _DATA_DOC: Final[str] = (
     "Address 0 holds the most significant byte, address 3 the least; IN bytes cannot be read back (3.4.8)."
 )
 
+_BYTE_0: Final[dict[int, tuple[Assumption, ...]]] = {0: (UP_21,)}
+"""Byte 0 also carries the data of a 2-bit or nibble length, in its low bits (UP-21)."""
 IN_BYTES: Final[tuple[Register, ...]] = tuple(
-    _data_register(f"IN{n}", n, AccessDirection.WRITE, DATA_RESETS, "3.4.8", _DATA_DOC) for n in range(4)
+    _data_register(f"IN{n}", n, AccessDirection.WRITE, DATA_RESETS, "3.4.8", _DATA_DOC, _BYTE_0.get(n, ()))
+    for n in range(4)
 )
 OUT_BYTES: Final[tuple[Register, ...]] = tuple(
-    _data_register(f"OUT{n}", n, AccessDirection.READ, DATA_RESETS, "3.4.8", _DATA_DOC) for n in range(4)
+    _data_register(f"OUT{n}", n, AccessDirection.READ, DATA_RESETS, "3.4.8", _DATA_DOC, _BYTE_0.get(n, ()))
+    for n in range(4)
 )
 IN0, IN1, IN2, IN3 = IN_BYTES
 OUT0, OUT1, OUT2, OUT3 = OUT_BYTES
@@ -208,9 +253,15 @@ def _length_register(name: str, address: int) -> Register:
         address=address,
         cleared_by=OTHER_RESETS,
         fields=(
-            Field("LENGTH", 0, OPTICAL_LENGTH_WIDTH, "Measured path length: 0..62, 63 = 400 m to 20 km."),
-            _bit("MEDIUM", OPTICAL_MEDIUM_BIT, "Optical medium.", _MEDIUM_VALUES),
-            _bit("ENABLE", OPTICAL_ENABLE_BIT, _ENABLE_DOC),
+            Field(
+                "LENGTH",
+                0,
+                OPTICAL_LENGTH_WIDTH,
+                "Measured path length: 0..62, 63 = 400 m to 20 km.",
+                assumptions=(RM_5,),
+            ),
+            _bit("MEDIUM", OPTICAL_MEDIUM_BIT, "Optical medium.", _MEDIUM_VALUES, (RM_5,)),
+            _bit("ENABLE", OPTICAL_ENABLE_BIT, _ENABLE_DOC, assumptions=(RM_5,)),
         ),
     )
 
@@ -225,8 +276,8 @@ POWER_IN: Final[Register] = Register(
     address=10,
     cleared_by=OTHER_RESETS,
     fields=(
-        Field("LEVEL", 0, POWER_LEVEL_WIDTH, _LEVEL_DOC),
-        _bit("ENABLE", OPTICAL_ENABLE_BIT, _ENABLE_DOC),
+        Field("LEVEL", 0, POWER_LEVEL_WIDTH, _LEVEL_DOC, assumptions=(RM_6,)),
+        _bit("ENABLE", OPTICAL_ENABLE_BIT, _ENABLE_DOC, assumptions=(RM_6,)),
     ),
 )
 POWER_OUT_BRANCH: Final[Register] = Register(
@@ -237,8 +288,8 @@ POWER_OUT_BRANCH: Final[Register] = Register(
     cleared_by=OTHER_RESETS,
     doc="Enable statuses of these interfaces are in LENGTH_OUT and LENGTH_BRANCH.",
     fields=(
-        Field("OUT_LEVEL", POWER_OUT_LSB, POWER_LEVEL_WIDTH, "Outgoing interface: " + _LEVEL_DOC),
-        Field("BRANCH_LEVEL", POWER_BRANCH_LSB, POWER_LEVEL_WIDTH, "Bus branch: " + _LEVEL_DOC),
+        Field("OUT_LEVEL", POWER_OUT_LSB, POWER_LEVEL_WIDTH, "Outgoing interface: " + _LEVEL_DOC, assumptions=(RM_6,)),
+        Field("BRANCH_LEVEL", POWER_BRANCH_LSB, POWER_LEVEL_WIDTH, "Bus branch: " + _LEVEL_DOC, assumptions=(RM_6,)),
     ),
 )
 ID: Final[Register] = Register(
@@ -265,17 +316,20 @@ SET: Final[Register] = Register(
             SET_PCP_N_BIT,
             "/PCP: 1 = I/O device (IN bytes 0, 1 sent every cycle); 0 = PCP device (IN "
             "bytes 0, 1 erased after transfer). No meaning when EXTREG = 1.",
+            assumptions=(RM_4,),
         ),
         _bit(
             "EXTREG",
             SET_EXTREG_BIT,
             "1 = external register expansion, complete length code in LENGTH_CODE; 0 = abbreviated length code in CL.",
+            assumptions=(RM_4,),
         ),
         Field(
             "LENGTH_CODE",
             SET_LENGTH_LSB,
             SET_LENGTH_WIDTH,
             "ID12..8, the complete length code of Table 3-11 (EXTREG = 1).",
+            assumptions=(RM_4,),
         ),
         Field(
             "CL",
@@ -284,6 +338,7 @@ SET: Final[Register] = Register(
             "CL2..0, the abbreviated length code of Table 3-12 (EXTREG = 0); 110 and 111 are reserved.",
             overlays="LENGTH_CODE",
             values=tuple(Enumerator(_length_name(a.text), int(a.cl, 2), a.text) for a in ABBREVIATED_LENGTHS),
+            assumptions=(RM_4,),
         ),
     ),
 )
@@ -294,7 +349,7 @@ IRQ_EN: Final[Register] = Register(
     address=14,
     cleared_by=OTHER_RESETS,
     doc="1 enables the interrupt source of the same bit in IRQ_EVT. Bit 7 is reserved (write 0).",
-    fields=tuple(_bit(s.name, s.bit, s.doc) for s in INTERRUPT_SOURCES),
+    fields=tuple(_bit(s.name, s.bit, s.doc, assumptions=(RM_7,)) for s in INTERRUPT_SOURCES),
 )
 IRQ_EVT: Final[Register] = Register(
     name="IRQ_EVT",
@@ -312,8 +367,9 @@ IRQ_EVT: Final[Register] = Register(
             "I/O access (polling) bit, live and not cleared by reading, also on MFP1: 1 = no access now; 0 = "
             "the data registers may be accessed for the next 30 bit periods (Fig. 3-22).",
             access=Access.R,
+            assumptions=(RM_7, RM_8),
         ),
-        *(_bit(s.name, s.bit, s.doc) for s in INTERRUPT_SOURCES),
+        *(_bit(s.name, s.bit, s.doc, assumptions=(RM_7,)) for s in INTERRUPT_SOURCES),
     ),
 )
 

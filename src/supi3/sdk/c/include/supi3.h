@@ -29,12 +29,13 @@ extern "C" {
 /** Error codes: 0 = success, negative = failure. Names follow supi3.spi.upif's exceptions. */
 typedef enum {
     SUPI3_OK = 0,
-    SUPI3_E_ARG = -1,         /**< bad argument (NULL pointer, address not 0..14, block length, mode): nothing sent (UpifArgumentError) */
+    SUPI3_E_ARG = -1,         /**< bad argument (NULL pointer, address not 0..14, block length, mode, reserved bit, max_polls 0): nothing sent (UpifArgumentError) */
     SUPI3_E_NOT_INIT = -2,    /**< supi3_init() or supi3_initialize() not done: nothing sent (NotInitializedError, UP-25) */
     SUPI3_E_TRANSPORT = -3,   /**< a transport callback failed; state of the chip unknown: SAS_INIT and initialize again */
     SUPI3_E_NOT_READY = -4,   /**< C/D showed "data" before the init byte: command interrupted or interface disabled (UP-4, UP-27); nothing sent */
     SUPI3_E_NOT_RESET = -5,   /**< the chip was not reset: it took the init byte as a command (UP-3); pulse SAS_INIT, initialize again */
-    SUPI3_E_UNSUPPORTED = -6  /**< not possible in this mode or without an optional callback (exchange in Intel mode, 3.4.4) */
+    SUPI3_E_UNSUPPORTED = -6, /**< not possible in this mode or without an optional callback (exchange in Intel mode, 3.4.4) */
+    SUPI3_E_TIMEOUT = -7      /**< the I/O access window did not open within max_polls (supi3_poll_io_window, 3.4.14) */
 } supi3_err_t;
 
 /** Interface mode selected by the initialization byte (3.4.3, Table 3-8). */
@@ -63,6 +64,7 @@ typedef struct {
     supi3_write_pin_fn set_sas_init; /**< drive SAS_INIT, 1 = active (optional, supi3_sas_init) */
     void *user;                  /**< passed to every callback */
     uint32_t frame_gap_us;       /**< wait after each frame (t8, Table 3-7); 0 = none */
+    supi3_read_pin_fn read_io;   /**< I/O access pin MFP1 level, 1 = no access now (optional, supi3_poll_io_window) */
 } supi3_config_t;
 
 /** Driver context. Treat the fields as private; allocate it anywhere (static, stack). */
@@ -110,6 +112,45 @@ int supi3_configure(supi3_t *ctx, uint8_t set_value, uint8_t id_value);
  * and nothing is sent.
  */
 int supi3_irq_service(supi3_t *ctx, uint8_t *events);
+
+/** Write the interrupt enable register (write 14, 3.4.14, Fig. 3-19). Bit 7 is reserved (RM-7): SUPI3_E_ARG. */
+int supi3_irq_enable(supi3_t *ctx, uint8_t mask);
+
+/**
+ * Wait for the I/O access window (3.4.14 "Using the polling bit", Fig. 3-22), at most max_polls polls (>= 1).
+ * With read_io: poll the I/O pin (MFP1) until it reads 0; nothing is sent and *events (may be NULL) = 0.
+ * Without: read register 14 until D7 (I/O access) is 0; *events (required) = D6..D0 of every read OR-ed,
+ * since each read clears them (RM-8: D7 is live and not cleared). *events holds them whatever the result.
+ * SUPI3_OK: the data registers may be accessed for the next 30 bit periods (60 us at 500 kbit/s);
+ * SUPI3_E_TIMEOUT: D7 or the pin stayed 1 for max_polls polls.
+ */
+int supi3_poll_io_window(supi3_t *ctx, uint32_t max_polls, uint8_t *events);
+
+/** Write the processor alarm register (write 7): a management message to the master (3.4.9). */
+int supi3_processor_alarm(supi3_t *ctx, uint8_t value);
+
+/** Read the processor command register (read 7): the master's management message (3.4.9). */
+int supi3_processor_command(supi3_t *ctx, uint8_t *value);
+
+/**
+ * Optical registers 8 to 11 decoded (3.4.12, 3.4.13; layouts RM-5, RM-6): raw field values, no metre conversion.
+ * medium: 0 polymer, 1 glass fibre; enable: 1 = optical initialization detected a regulated device; levels 1..15.
+ */
+typedef struct {
+    uint8_t out_length;    /**< read 8 LENGTH: 0..62, 63 = 400 m to 20 km (Table 1-5) */
+    uint8_t out_medium;    /**< read 8 MEDIUM */
+    uint8_t out_enable;    /**< read 8 ENABLE */
+    uint8_t branch_length; /**< read 9 LENGTH */
+    uint8_t branch_medium; /**< read 9 MEDIUM */
+    uint8_t branch_enable; /**< read 9 ENABLE */
+    uint8_t in_level;      /**< read 10 LEVEL: power level of the incoming interface */
+    uint8_t in_enable;     /**< read 10 ENABLE */
+    uint8_t out_level;     /**< read 11 OUT_LEVEL: power level of the outgoing interface */
+    uint8_t branch_level;  /**< read 11 BRANCH_LEVEL: power level of the bus branch */
+} supi3_optical_t;
+
+/** Read 8, 9, 10 and 11 and decode them into *status (written only when all four reads succeeded). */
+int supi3_optical_status(supi3_t *ctx, supi3_optical_t *status);
 
 /** Text for an error code ("unknown error" for others). */
 const char *supi3_strerror(int err);

@@ -10,6 +10,11 @@
 #define SR_CHIP_DRIVES 0
 #define SR_UP_SENDS 1
 
+/* The interrupt sources of IRQ_EN (3.4.14, Table 3-13); bit 7 is reserved (RM-7). */
+#define IRQ_EN_SOURCES                                                                                    \
+    (SUPI3_IRQ_EN_PCMD_MSK | SUPI3_IRQ_EN_INVALID_MSK | SUPI3_IRQ_EN_VALID_MSK | SUPI3_IRQ_EN_ID_CYCLE_MSK | \
+     SUPI3_IRQ_EN_IB_RESET_MSK | SUPI3_IRQ_EN_PCP_RX_MSK | SUPI3_IRQ_EN_PCP_TX_MSK)
+
 static int ctx_ok(const supi3_t *ctx)
 {
     return ctx != NULL && ctx->magic == SUPI3_MAGIC;
@@ -29,27 +34,34 @@ static int frame(supi3_t *ctx, uint8_t tx, uint8_t *rx, int s_r)
     return SUPI3_OK;
 }
 
-static int read_cd(supi3_t *ctx, int *level)
+/* A pin level through an optional callback (C/D, /IRQ, I/O); reading a pin leaves the chip's state as it was. */
+static int read_pin(const supi3_t *ctx, supi3_read_pin_fn read, int *level)
 {
-    if (ctx->cfg.read_cd(ctx->cfg.user, level) != 0) {
+    if (read(ctx->cfg.user, level) != 0) {
         return SUPI3_E_TRANSPORT;
     }
     return SUPI3_OK;
 }
 
-/* Common entry check of the register accesses (UP-25: refused before the first byte). */
-static int access_ok(const supi3_t *ctx, uint8_t addr)
+/* Common entry check of the register accesses (UP-25: refused before the first byte): the context, then the
+ * value arguments (args_ok), then the state; pointer arguments are checked after this. */
+static int entry_ok(const supi3_t *ctx, int args_ok)
 {
     if (!ctx_ok(ctx)) {
         return ctx == NULL ? SUPI3_E_ARG : SUPI3_E_NOT_INIT;
     }
-    if (addr > SUPI3_ADDR_MAX) {
-        return SUPI3_E_ARG; /* 15 is the block transfer (3.4.6): supi3_block_transfer() */
+    if (!args_ok) {
+        return SUPI3_E_ARG;
     }
     if (!ctx->initialized) {
         return SUPI3_E_NOT_INIT;
     }
     return SUPI3_OK;
+}
+
+static int access_ok(const supi3_t *ctx, uint8_t addr)
+{
+    return entry_ok(ctx, addr <= SUPI3_ADDR_MAX); /* 15 is the block transfer (3.4.6): supi3_block_transfer() */
 }
 
 /* Bytes of a SET value with ExtReg = 0 (Table 3-12; block transfers at >= 1 word, 3.4.6); 0 = no block. */
@@ -108,7 +120,7 @@ int supi3_initialize(supi3_t *ctx, supi3_mode_t mode)
     if (ctx->cfg.read_cd != NULL) {
         /* C/D = 1 before the init byte: a command waits for its data byte (uP reset mid-command, UP-27) or the
          * interface is disabled (UP-4). The init byte would be taken as data: send nothing, ask for SAS_INIT. */
-        err = read_cd(ctx, &cd);
+        err = read_pin(ctx, ctx->cfg.read_cd, &cd);
         if (err != SUPI3_OK) {
             return err;
         }
@@ -121,7 +133,7 @@ int supi3_initialize(supi3_t *ctx, supi3_mode_t mode)
         return err;
     }
     if (ctx->cfg.read_cd != NULL) {
-        err = read_cd(ctx, &cd);
+        err = read_pin(ctx, ctx->cfg.read_cd, &cd);
         if (err != SUPI3_OK) {
             return err;
         }
@@ -278,8 +290,9 @@ int supi3_irq_service(supi3_t *ctx, uint8_t *events)
         return err;
     }
     if (ctx->cfg.read_irq != NULL) {
-        if (ctx->cfg.read_irq(ctx->cfg.user, &irq_n) != 0) {
-            return SUPI3_E_TRANSPORT;
+        err = read_pin(ctx, ctx->cfg.read_irq, &irq_n);
+        if (err != SUPI3_OK) {
+            return err;
         }
         if (irq_n != 0) {
             *events = 0u;
@@ -289,13 +302,104 @@ int supi3_irq_service(supi3_t *ctx, uint8_t *events)
     return supi3_read(ctx, (uint8_t)SUPI3_IRQ_EVT_ADDR, events);
 }
 
+int supi3_irq_enable(supi3_t *ctx, uint8_t mask)
+{
+    /* bit 7 is reserved: the I/O access bit is a status, not a source (RM-7) */
+    int err = entry_ok(ctx, (mask & (uint8_t)~IRQ_EN_SOURCES) == 0u);
+    if (err != SUPI3_OK) {
+        return err;
+    }
+    return supi3_write(ctx, (uint8_t)SUPI3_IRQ_EN_ADDR, mask);
+}
+
+int supi3_poll_io_window(supi3_t *ctx, uint32_t max_polls, uint8_t *events)
+{
+    uint32_t k;
+    uint8_t value = 0u;
+    int level = 1;
+    int err = entry_ok(ctx, max_polls != 0u);
+    if (err == SUPI3_OK && events == NULL && ctx->cfg.read_io == NULL) {
+        err = SUPI3_E_ARG;
+    }
+    if (err != SUPI3_OK) {
+        return err;
+    }
+    if (events != NULL) {
+        *events = 0u;
+    }
+    for (k = 0u; k < max_polls; ++k) {
+        if (ctx->cfg.read_io != NULL) {
+            err = read_pin(ctx, ctx->cfg.read_io, &level); /* MFP1 mirrors D7 (Table 3-5): nothing sent */
+        } else {
+            /* Reading 14 clears D6..D0 (3.4.14): keep every event; D7 is live (RM-8). */
+            err = supi3_read(ctx, (uint8_t)SUPI3_IRQ_EVT_ADDR, &value);
+            if (err == SUPI3_OK) {
+                *events = (uint8_t)(*events | (value & SUPI3_IRQ_EVT_CLEAR_ON_READ_MSK));
+                level = (value & SUPI3_IRQ_EVT_IO_ACCESS_MSK) != 0u;
+            }
+        }
+        if (err != SUPI3_OK) {
+            return err;
+        }
+        if (level == 0) {
+            return SUPI3_OK; /* the window is open: 30 bit periods from now (Fig. 3-22) */
+        }
+    }
+    return SUPI3_E_TIMEOUT;
+}
+
+int supi3_processor_alarm(supi3_t *ctx, uint8_t value)
+{
+    return supi3_write(ctx, (uint8_t)SUPI3_ALARM_ADDR, value);
+}
+
+int supi3_processor_command(supi3_t *ctx, uint8_t *value)
+{
+    return supi3_read(ctx, (uint8_t)SUPI3_PCMD_ADDR, value);
+}
+
+/* A field of a register byte, shifted down. */
+#define FIELD(byte, reg, fld) ((uint8_t)(((byte) & SUPI3_##reg##_##fld##_MSK) >> SUPI3_##reg##_##fld##_POS))
+
+int supi3_optical_status(supi3_t *ctx, supi3_optical_t *status)
+{
+    static const uint8_t addrs[4] = {
+        (uint8_t)SUPI3_LENGTH_OUT_ADDR, (uint8_t)SUPI3_LENGTH_BRANCH_ADDR,
+        (uint8_t)SUPI3_POWER_IN_ADDR, (uint8_t)SUPI3_POWER_OUT_BRANCH_ADDR,
+    };
+    uint8_t raw[4] = {0u, 0u, 0u, 0u};
+    size_t k;
+    int err = access_ok(ctx, addrs[0]);
+    if (err == SUPI3_OK && status == NULL) {
+        err = SUPI3_E_ARG;
+    }
+    for (k = 0u; err == SUPI3_OK && k < 4u; ++k) {
+        err = supi3_read(ctx, addrs[k], &raw[k]);
+    }
+    if (err != SUPI3_OK) {
+        return err;
+    }
+    status->out_length = FIELD(raw[0], LENGTH_OUT, LENGTH);
+    status->out_medium = FIELD(raw[0], LENGTH_OUT, MEDIUM);
+    status->out_enable = FIELD(raw[0], LENGTH_OUT, ENABLE);
+    status->branch_length = FIELD(raw[1], LENGTH_BRANCH, LENGTH);
+    status->branch_medium = FIELD(raw[1], LENGTH_BRANCH, MEDIUM);
+    status->branch_enable = FIELD(raw[1], LENGTH_BRANCH, ENABLE);
+    status->in_level = FIELD(raw[2], POWER_IN, LEVEL);
+    status->in_enable = FIELD(raw[2], POWER_IN, ENABLE);
+    status->out_level = FIELD(raw[3], POWER_OUT_BRANCH, OUT_LEVEL);
+    status->branch_level = FIELD(raw[3], POWER_OUT_BRANCH, BRANCH_LEVEL);
+    return SUPI3_OK;
+}
+
 const char *supi3_strerror(int err)
 {
     switch (err) {
     case SUPI3_OK:
         return "ok";
     case SUPI3_E_ARG:
-        return "invalid argument (NULL pointer, address not 0..14, block length not 2..4 or not SET's, mode)";
+        return "invalid argument (NULL pointer, address not 0..14, block length not 2..4 or not SET's, mode, "
+               "reserved bit, max_polls 0)";
     case SUPI3_E_NOT_INIT:
         return "not initialized: call supi3_init() and supi3_initialize() first";
     case SUPI3_E_TRANSPORT:
@@ -306,6 +410,8 @@ const char *supi3_strerror(int err)
         return "chip was not reset: initialization byte taken as a command, pulse SAS_INIT (3.4.3)";
     case SUPI3_E_UNSUPPORTED:
         return "not supported in this mode or without the optional callback";
+    case SUPI3_E_TIMEOUT:
+        return "timeout: the I/O access window did not open within max_polls (3.4.14)";
     default:
         return "unknown error";
     }
