@@ -21,9 +21,11 @@ from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
+import pytest
 
 from supi3.config import DeviceConfig, decode
 from supi3.interbus import wire
@@ -32,6 +34,8 @@ from supi3.model.pins import Supi3Pins
 from supi3.model.registers import RegisterFile
 from supi3.pinlevel import OE_SUFFIX
 from supi3.regmap import Register, encode_command
+from supi3.sdk import native
+from supi3.sdk.native import CFirmware
 from supi3.spi.block_pins import UpifBlockPins, block_model, strap_values
 from supi3.spi.master import SoftMaster
 from supi3.spi.slave_pins import PinsIn, PinsOut
@@ -363,3 +367,18 @@ def fields(obj: object) -> dict[str, object]:
     found = {name: getattr(obj, name) for name in names if hasattr(obj, name)}
     found.update(getattr(obj, "__dict__", {}))
     return found
+
+
+# C firmware on the bench (supi3.sdk.native) ---------------------------------------------------------------------------
+
+TEST_FIRMWARE = Path(__file__).resolve().parent / "c" / "firmware"
+"""C firmware written for tests (bugs for the model to catch), beside the shipped examples."""
+
+
+def c_firmware(cache: pytest.Cache, source: str | Path, **options: Any) -> CFirmware:
+    """A :class:`~supi3.sdk.native.CFirmware` built into pytest's cache folder (kept between runs, shared by the
+    xdist workers); skips the test when cffi or a C compiler is missing."""
+    reason = native.toolchain_missing()
+    if reason is not None:
+        pytest.skip(reason)
+    return native.CFirmware(source, cache_dir=cache.mkdir("supi3-native"), **options)
