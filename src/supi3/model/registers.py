@@ -458,12 +458,13 @@ class RegisterFile:
             return
         if self._latch_phase and name in _DATA_REGISTERS:
             self._inconsistent(name, "write")
+        again = False
         if name in _CONFIGURATION:
-            self._write_configuration(name, value & _WRITE_MASKS[address])
+            again = self._write_configuration(name, value & _WRITE_MASKS[address])
         else:
             self._values[name] = value & _WRITE_MASKS[address]
         if self._pedantic:
-            self._suspicious_write(address, name, value)
+            self._suspicious_write(address, name, value, again)
 
     def _write_no_register(self, address: int, value: int) -> None:
         port = REGISTER_MAP.port(address, AccessDirection.WRITE)
@@ -475,7 +476,10 @@ class RegisterFile:
             self._suspicious(WRITE_TO_READ_ONLY if reads else WRITE_TO_RESERVED, address, AccessDirection.WRITE, value,
                              "no effect")
 
-    def _write_configuration(self, name: str, value: int) -> None:
+    def _write_configuration(self, name: str, value: int) -> bool:
+        """Write SET or ID; ``True`` if it was configured before and the bus is stopped (UP-36: during bus operation
+        the write is a :class:`ReconfigurationError`)."""
+        again = name in self._configured and not self._bus_running
         if self._bus_running:
             self.violations.report(
                 ReconfigurationError("3.4.3, 3.4.11", f"{name} written with {value:02X}h during bus operation")
@@ -483,6 +487,9 @@ class RegisterFile:
         self._values[name] = value
         if name == "SET":
             self._apply_set(value)
+        if name == "ID" or self._set is not None:  # a SET value that was not applied is no configuration
+            self._configured.add(name)
+        return again
 
     def _apply_set(self, value: int) -> None:
         try:
@@ -554,7 +561,7 @@ class RegisterFile:
                 self._suspicious(OUT_BEFORE_DATA_CYCLE, address, AccessDirection.READ, value,
                                  "no valid data cycle since power-up or INTERBUS reset")
 
-    def _suspicious_write(self, address: int, name: str, value: int) -> None:
+    def _suspicious_write(self, address: int, name: str, value: int, again: bool) -> None:
         write = AccessDirection.WRITE
         reserved = value & ~_WRITE_MASKS[address]
         if reserved:
@@ -563,12 +570,9 @@ class RegisterFile:
         if name in _IN_INDEX:
             if not self._in_data_length(_IN_INDEX[name]):
                 self._suspicious(BEYOND_DATA_LENGTH, address, write, value, self._data_length_text())
-        elif name in _CONFIGURATION:
-            if name in self._configured and not self._bus_running:  # during bus operation: ReconfigurationError
-                self._suspicious(CONFIGURATION_REWRITTEN, address, write, value, "SET and ID are set once, during "
-                                 "initialization, and kept by SAS_INIT")
-            if name == "ID" or self._set is not None:
-                self._configured.add(name)
+        elif again:
+            self._suspicious(CONFIGURATION_REWRITTEN, address, write, value, "SET and ID are set once, during "
+                             "initialization, and kept by SAS_INIT (3.4.3)")
         elif name == "IRQ_EN" and value & _PCP_SOURCES and self._set is not None and not self._set.extreg \
                 and self._set.pcp_n:
             self._suspicious(PCP_INTERRUPT_ON_IO_DEVICE, address, write, value, f"PCP bits {value & _PCP_SOURCES:02X}h"
