@@ -15,8 +15,14 @@ repository root:
 from __future__ import annotations
 
 import argparse
+import ctypes
+import importlib
+import shutil
+import subprocess
+import tempfile
 import time
 from collections.abc import Callable
+from pathlib import Path
 
 from supi3 import tables
 from supi3.config import decode
@@ -95,6 +101,54 @@ def transfer_bytes_per_s(count: int, repeat: int) -> float:
     return count // 4 * 4 / _best(repeat, run)
 
 
+_C_LOOP = """
+#include <stdint.h>
+typedef int (*xfer_fn)(void *user, uint8_t tx, uint8_t *rx, int s_r);
+/* n/4 register accesses byte by byte, as the C driver makes them: write IN0, read OUT0 */
+int run(xfer_fn xfer, void *user, long n) {
+    uint8_t rx;
+    for (long k = 0; k < n / 4; k++) {
+        if (xfer(user, 0x40, &rx, 1) || xfer(user, (uint8_t)k, &rx, 1)) return -1;
+        if (xfer(user, 0x80, &rx, 1) || xfer(user, 0, &rx, 0)) return -1;
+    }
+    return 0;
+}
+"""
+_XFER = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_uint8, ctypes.POINTER(ctypes.c_uint8), ctypes.c_int)
+
+
+def c_callback_bytes_per_s(count: int, repeat: int) -> dict[str, float]:
+    """``transfer()`` bytes per second called back from C, one byte per callback (the ``xfer`` hook of the C
+    driver, src/supi3/sdk/c), through ctypes and, if installed, cffi; empty without a C compiler."""
+    compiler = shutil.which("cc") or shutil.which("gcc")
+    if compiler is None:
+        return {}
+    rates: dict[str, float] = {}
+    with tempfile.TemporaryDirectory() as folder:
+        source, library = Path(folder, "loop.c"), Path(folder, "libloop.so")
+        source.write_text(_C_LOOP, encoding="utf-8")
+        subprocess.run([compiler, "-O2", "-shared", "-fPIC", "-o", str(library), str(source)], check=True)
+        transfer = _configured().transfer
+
+        def xfer(_user: object, tx: int, rx: ctypes._Pointer[ctypes.c_uint8], _s_r: int) -> int:
+            rx[0] = transfer(tx) or 0
+            return 0
+
+        loop = ctypes.CDLL(str(library))
+        hook = _XFER(xfer)
+        rates["ctypes"] = count / _best(repeat, lambda: loop.run(hook, None, ctypes.c_long(count)))
+        try:
+            cffi = importlib.import_module("cffi")  # optional: no dependency of the project, and without stubs
+        except ImportError:
+            return rates
+        ffi = cffi.FFI()
+        ffi.cdef("int run(int (*xfer)(void *, uint8_t, uint8_t *, int), void *user, long n);")
+        cffi_loop = ffi.dlopen(str(library))
+        cffi_hook = ffi.callback("int(void *, uint8_t, uint8_t *, int)", xfer)
+        rates["cffi"] = count / _best(repeat, lambda: cffi_loop.run(cffi_hook, ffi.NULL, count))
+    return rates
+
+
 def pin_bytes_per_s(bit_rate: int, count: int, repeat: int) -> tuple[float, float]:
     """Pin-level bytes per second (wall clock) and the simulated time per byte, for a Motorola µP writing IN0 at
     the fastest Table 3-7 timing."""
@@ -130,7 +184,9 @@ def main(argv: list[str] | None = None) -> None:
     byte_rate = transfer_bytes_per_s(2 * args.accesses, args.repeat)
     print(f"transaction level: {access_rate:,.0f} register accesses/s (UpInterface.write/read, best of "
           f"{args.repeat}); pedantic on: {pedantic_rate:,.0f} = {pedantic_rate / access_rate:.2f} x off")
-    print(f"transfer(): {byte_rate:,.0f} bytes/s (one byte per call, best of {args.repeat})")
+    c_rates = c_callback_bytes_per_s(2 * args.accesses, args.repeat)
+    print(f"transfer(): {byte_rate:,.0f} bytes/s (one byte per call, best of {args.repeat})"
+          + "".join(f"; from C through {name} callbacks: {rate:,.0f} bytes/s" for name, rate in c_rates.items()))
     for bit_rate in tables.BIT_RATES:
         real_bytes = 1 / real_byte_s(bit_rate)
         real_accesses = real_bytes / BYTES_PER_ACCESS
@@ -139,7 +195,8 @@ def main(argv: list[str] | None = None) -> None:
         print(f"{bit_rate // 1000} kbit/s, SCLK max {sclk_mhz:.2f} MHz: real {real_byte_s(bit_rate) * 1e6:.3f} µs/byte"
               f" = {real_bytes:,.0f} bytes/s = {real_accesses:,.0f} accesses/s")
         print(f"  transaction level: {access_rate / real_accesses:.2f} x real time; transfer(): "
-              f"{byte_rate / real_bytes:.2f} x real time")
+              f"{byte_rate / real_bytes:.2f} x real time"
+              + "".join(f"; through {name}: {rate / real_bytes:.2f} x" for name, rate in c_rates.items()))
         print(f"  pin level: {pin_rate:,.0f} bytes/s = {pin_rate / real_bytes:.4f} x real time (software µP at "
               f"{model_byte_s * 1e6:.3f} µs/byte simulated, {round(model_byte_s * tables.CLOCK_HZ)} clocks/byte)")
 

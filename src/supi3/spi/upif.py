@@ -506,10 +506,17 @@ class UpInterface:
             raise UpifUsageError("Intel mode: give s_r (True = the µP sends, False = it receives; Table 3-9)")
         if protocol._frame is not None:
             raise UpifUsageError("transfer() inside a frame begun on the protocol: end() or abort() it first")
-        # _byte() inlined: a firmware model (the C driver through ctypes/cffi) sends every byte through here.
-        with protocol.registers.violations.deferred():
+        # _byte() inside deferred(), both by hand: a firmware model (the C driver through ctypes or cffi) sends every
+        # byte through here, and a with statement and a call cost as much as the byte itself.
+        log = protocol.registers.violations
+        log.hold()
+        try:
             tx = protocol.begin(True if s_r is None else s_r)
             protocol.end(tx if tx is not None and mode is Mode.INTEL else mosi)
+        except BaseException:
+            log.release(failed=True)
+            raise
+        log.release()
         return tx
 
     def _byte(self, mosi: int, s_r: bool) -> int | None:
@@ -630,8 +637,15 @@ class UpInterface:
         protocol = self.protocol
         if protocol.phase is not Phase.COMMAND or protocol._frame is not None:
             self._start("read")
-        with protocol.registers.violations.deferred():
-            return protocol._read_access(address)
+        log = protocol.registers.violations
+        log.hold()  # deferred() by hand, as in transfer()
+        try:
+            value = protocol._read_access(address)
+        except BaseException:
+            log.release(failed=True)
+            raise
+        log.release()
+        return value
 
     def write(self, address: int | Register, value: int) -> None:
         """Write one register: command byte with WR, then the data byte (3.4.4). ``address`` is a number or a
@@ -658,8 +672,14 @@ class UpInterface:
                 self._write_uninitialized(_WRITE_COMMANDS[address], value)
                 return
             self._start("write")
-        with protocol.registers.violations.deferred():
+        log = protocol.registers.violations
+        log.hold()  # deferred() by hand, as in transfer()
+        try:
             protocol._write_access(address, value)
+        except BaseException:
+            log.release(failed=True)
+            raise
+        log.release()
 
     def _write_uninitialized(self, command: int, value: int) -> None:
         violations = self.protocol.registers.violations
