@@ -352,7 +352,7 @@ class UpifProtocol:
                 return
             if not s_r:
                 return  # Intel frames with S/R = 0 write nothing (UP-9)
-        if command.wr:  # every Motorola frame can write (full duplex)
+        if command.wr:  # Motorola frames (full duplex) and Intel frames with S/R = 1 write (UP-9)
             self.registers.cpu_write(address, rx)
 
     # --------------------------------------------------------------------------------------------------------
@@ -364,7 +364,7 @@ class UpifProtocol:
         initialized interface (Motorola: data byte 00h; Intel: S/R = 1, then 0): the effects of the four frame
         calls, without their per-byte bookkeeping, which costs three times as much (bench/bench_upif.py).
         ``tests/test_spi_upif_fast.py`` checks it against the frames for every address, mode and state. Runs
-        inside ``deferred()``."""
+        inside a deferred block (``ViolationLog.hold``)."""
         self.command = _COMMANDS[_READ_COMMANDS[address]]
         if _READS_REGISTER[address]:
             value = self.registers.cpu_read(address)
