@@ -152,6 +152,11 @@ _WRITES_REGISTER: Final[tuple[bool, ...]] = tuple(
     for address in REGISTER_MAP.addresses
 )
 """Per address: a written data byte reaches the register file; ``False`` at 4 and 5 (3.4.4, 3.4.7)."""
+_PLAIN_COMMANDS: Final[tuple[bool, ...]] = tuple(
+    not byte & ~COMMAND_BYTE.mask and _COMMANDS[byte].address != BLOCK_ADDRESS for byte in range(256)
+)
+"""Per byte: a command byte without reserved bits that starts no block transfer, whose frame reads no register and
+reports nothing (UP-8, UP-12): :meth:`UpInterface.transfer` takes it without a frame or a deferred block."""
 
 
 class UpifProtocol:
@@ -356,8 +361,19 @@ class UpifProtocol:
             self.registers.cpu_write(address, rx)
 
     # --------------------------------------------------------------------------------------------------------
-    # Whole register accesses: the fast path of UpInterface.read and write
+    # Fast paths of UpInterface: the same effects as the frames, checked against them by tests/test_spi_upif_fast.py
     # --------------------------------------------------------------------------------------------------------
+
+    def _plain_command(self, rx: int) -> int | None:
+        """A whole frame carrying command byte ``rx`` (one of :data:`_PLAIN_COMMANDS`) in the command phase,
+        Motorola or Intel with S/R = 1: what :meth:`begin` and :meth:`end` do, reading no register and reporting
+        nothing. Returns the byte the chip drove (the echo in Motorola mode, UP-8; nothing in Intel mode). Half of
+        the bytes the C driver sends are command bytes."""
+        tx = self.last_rx if self.mode is Mode.MOTOROLA else None
+        self.command = _COMMANDS[rx]
+        self.phase = Phase.DATA
+        self.last_rx = rx
+        return tx
 
     def _read_access(self, address: int) -> int:
         """A read command byte for ``address`` (0..14) and its data byte, given in the command phase of an
@@ -506,8 +522,11 @@ class UpInterface:
             raise UpifUsageError("Intel mode: give s_r (True = the µP sends, False = it receives; Table 3-9)")
         if protocol._frame is not None:
             raise UpifUsageError("transfer() inside a frame begun on the protocol: end() or abort() it first")
-        # _byte() inside deferred(), both by hand: a firmware model (the C driver through ctypes or cffi) sends every
-        # byte through here, and a with statement and a call cost as much as the byte itself.
+        # A firmware model (the C driver through ctypes or cffi) sends every byte through here: a plain command byte
+        # takes a fast path; any other byte is _byte() inside deferred(), both by hand (a with statement and a
+        # call cost as much as the byte itself).
+        if protocol.phase is Phase.COMMAND and _PLAIN_COMMANDS[mosi] and (s_r or mode is Mode.MOTOROLA):
+            return protocol._plain_command(mosi)
         log = protocol.registers.violations
         log.hold()
         try:
