@@ -652,7 +652,8 @@ class UpInterface:
             If the interface cannot start a command now (nothing is sent).
         """
         if type(address) is not int or not 0 <= address < BLOCK_ADDRESS:
-            address = _register_address(address, AccessDirection.READ)
+            known = _READ_ADDRESSES.get(id(address))
+            address = known if known is not None else _register_address(address, AccessDirection.READ)
         protocol = self.protocol
         if protocol.phase is not Phase.COMMAND or protocol._frame is not None:
             self._start("read")
@@ -682,7 +683,8 @@ class UpInterface:
             If the interface cannot start a command now (nothing is sent).
         """
         if type(address) is not int or not 0 <= address < BLOCK_ADDRESS:
-            address = _register_address(address, AccessDirection.WRITE)
+            known = _WRITE_ADDRESSES.get(id(address))
+            address = known if known is not None else _register_address(address, AccessDirection.WRITE)
         if type(value) is not int or not 0 <= value <= 0xFF:
             value = _checked(check_bits, "value", value, 8, "a data byte, 3.4.4")
         protocol = self.protocol
@@ -835,6 +837,11 @@ _PORT_REGISTERS: Final[dict[AccessDirection, tuple[Register | None, ...]]] = {
 }
 """The register each single access reaches, per direction and address 0..14 (Table 3-10): ``read(IN0)`` checks its
 register by identity here, without hashing the register's layout."""
+_READ_ADDRESSES: Final[dict[int, int]] = {id(r): r.address for r in _PORT_REGISTERS[AccessDirection.READ] if r}
+"""The address of each register a read reaches, by the register's identity: ``read(OUT0)`` in one look-up (the
+registers of :mod:`supi3.regmap` live as long as the program; any other object goes to :func:`_register_address`)."""
+_WRITE_ADDRESSES: Final[dict[int, int]] = {id(r): r.address for r in _PORT_REGISTERS[AccessDirection.WRITE] if r}
+"""As :data:`_READ_ADDRESSES`, for writes: ``write(IN0, ...)``."""
 
 
 def _checked(check: Callable[..., _T], *args: object, **kwargs: object) -> _T:
