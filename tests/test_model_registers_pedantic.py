@@ -115,8 +115,7 @@ def test_reserved_and_read_only_addresses_only_in_a_clean_state(mode: Mode) -> N
 def test_reserved_bits(mode: Mode) -> None:
     """UP-34: FFh sets SET bit 5 and IRQ_EN bit 7 (RM-4, RM-7); every other write register has 8 bits. A PCP
     device, so that the PCP interrupt bits are no suspicion of their own."""
-    registers_before = interface(mode, PCP_2_WORDS).registers
-    assert registers_before.pcp_device
+    assert interface(mode, PCP_2_WORDS).registers.pcp_device
     found = every_access(lambda: interface(mode, PCP_2_WORDS), 0xFF)
     assert found == {**RESERVED_AND_READ_ONLY, (13, W): {"UP-34", "UP-36"}, (14, W): {"UP-34"}}
 
