@@ -61,15 +61,17 @@ class Supi3Chip:
     strict:
         µP interface rule violations (Table 3-7 timing, protocol, reconfiguration, inconsistent data) raise
         (``True``) or are recorded in ``registers.violations`` (``False``).
+    pedantic:
+        Also report suspicious µP accesses (:class:`~supi3.model.chip.Supi3`).
     """
 
     inputs: Sequence[Pin] = Supi3Pins.inputs
     outputs: Sequence[Pin] = Supi3Pins.outputs
 
-    def __init__(self, config: DeviceConfig, *, strict: bool = True) -> None:
+    def __init__(self, config: DeviceConfig, *, strict: bool = True, pedantic: bool = False) -> None:
         check_instance("config", config, DeviceConfig)
         check_bool("strict", strict)
-        self.core = Supi3Pins(config, Supi3(config, strict=strict))
+        self.core = Supi3Pins(config, Supi3(config, strict=strict, pedantic=pedantic))
         registers = self.core.chip.registers
         self.upif = SlavePins(registers) if registers is not None else None
         if registers is not None:

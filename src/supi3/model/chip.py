@@ -165,6 +165,9 @@ class Supi3:
     strict:
         µP modes: raise interface rule violations (``True``) or record them (``False``), see
         :class:`~supi3.model.registers.RegisterFile`.
+    pedantic:
+        µP modes: also report legal but suspicious µP accesses (:class:`~supi3.model.registers.RegisterFile`,
+        UP-30); ignored in the other modes.
 
     Attributes
     ----------
@@ -186,13 +189,16 @@ class Supi3:
     data_kernel: ClassVar[DataKernel] = DataKernel(_load_data_run, _latch_data_run)
     """The ring's fast path for runs of chips in a data cycle (:class:`supi3.interbus.link.DataKernel`)."""
 
-    def __init__(self, config: DeviceConfig | None = None, *, strict: bool = True) -> None:
+    def __init__(self, config: DeviceConfig | None = None, *, strict: bool = True, pedantic: bool = False) -> None:
         if config is not None and not isinstance(config, DeviceConfig):
             _checked(check_instance, "config", config, DeviceConfig, "a DeviceConfig (supi3.config.decode) or None")
         _checked(check_bool, "strict", strict)
+        _checked(check_bool, "pedantic", pedantic)
         self.config = config if config is not None else decode("10000")
         kind = self.config.mfp_mode.kind
-        self.registers = RegisterFile(self.config, strict=strict) if kind is MfpKind.INIT_UP else None
+        self.registers = (
+            RegisterFile(self.config, strict=strict, pedantic=pedantic) if kind is MfpKind.INIT_UP else None
+        )
         if self.registers is not None:
             self.registers.use_clock(self._clock)  # violations name the clock of the last bus call (docs/model.md)
         self._in_map = self.config.in_bits

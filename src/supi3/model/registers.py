@@ -17,7 +17,9 @@ records it. In both modes the operation itself is carried out as the chip would.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
 from types import TracebackType
 from typing import Final, Literal, TypeVar
 
@@ -38,6 +40,7 @@ from supi3.regmap import (
 from supi3.regmap.registers import IN_BYTES, IO_ACCESS_BIT, OUT_BYTES
 
 __all__ = [
+    "SUSPICIOUS_ACCESSES",
     "InconsistentDataError",
     "InterfaceViolationError",
     "ReconfigurationError",
@@ -45,6 +48,8 @@ __all__ = [
     "RegisterFile",
     "RegisterFileError",
     "SetRegisterError",
+    "SuspiciousAccess",
+    "SuspiciousAccessError",
     "ViolationLog",
 ]
 
@@ -54,6 +59,34 @@ _OPTICAL_REGISTERS: Final[frozenset[str]] = frozenset({"LENGTH_OUT", "LENGTH_BRA
 _SOURCE_BITS: Final[dict[str, int]] = {s.name: s.bit for s in INTERRUPT_SOURCES}
 _PCP_ERASED: Final[tuple[str, ...]] = ("IN0", "IN1")
 """IN bytes erased after their transfer in a PCP device (/PCP = 0, 3.4.11)."""
+_CONFIGURATION: Final[frozenset[str]] = frozenset({"SET", "ID"})
+"""Written during initialization only (3.4.3, 3.4.10, 3.4.11)."""
+_PCP_SOURCES: Final[int] = sum(1 << s.bit for s in INTERRUPT_SOURCES if s.name.startswith("PCP_"))
+"""The IRQ_EN bits of the PCP interrupt sources (PCP receive, PCP send; Table 3-13)."""
+_IN_INDEX: Final[dict[str, int]] = {r.name: r.address for r in IN_BYTES}
+_OUT_INDEX: Final[dict[str, int]] = {r.name: r.address for r in OUT_BYTES}
+
+
+def _port_names(direction: AccessDirection) -> tuple[str | None, ...]:
+    ports = (REGISTER_MAP.port(a, direction) for a in REGISTER_MAP.addresses)
+    return tuple(None if port.register is None else port.register.name for port in ports)
+
+
+# The µP side runs once per data byte (millions of times for a firmware model): Table 3-10 flattened into
+# per-address tuples, so that an access is a few index operations instead of port look-ups.
+_READ_NAMES: Final[tuple[str | None, ...]] = _port_names(AccessDirection.READ)
+"""The register a read of each address returns; ``None`` where it reaches none."""
+_WRITE_NAMES: Final[tuple[str | None, ...]] = _port_names(AccessDirection.WRITE)
+"""The register a write of each address stores; ``None`` where it reaches none."""
+_READ_CLEARS: Final[tuple[int, ...]] = tuple(
+    REGISTER_MAP.port(a, AccessDirection.READ).clear_on_read_mask for a in REGISTER_MAP.addresses
+)
+"""The bits a read of each address clears (read-clear ports, 3.4.14); 0 elsewhere."""
+_WRITE_MASKS: Final[tuple[int, ...]] = tuple(
+    0 if (register := REGISTER_MAP.port(a, AccessDirection.WRITE).register) is None else register.mask
+    for a in REGISTER_MAP.addresses
+)
+"""The bits a write of each address stores; the others are reserved (write 0, read back 0)."""
 
 
 class RegisterFileError(Supi3Error, ValueError):
@@ -130,6 +163,74 @@ class InconsistentDataError(InterfaceViolationError):
         return (type(self), (self.rule, self._what, self.clock))
 
 
+@dataclass(frozen=True)
+class SuspiciousAccess:
+    """One kind of legal but suspicious µP access that pedantic mode reports (docs/assumptions/upif.md, UP-30)."""
+
+    decision: str
+    """The decision in docs/assumptions/upif.md: ``"UP-31"``."""
+    ref: str
+    """Where the manual states the rule that makes the access suspicious: the error's ``rule``."""
+    what: str
+    """The kind in a few words: the start of the message."""
+
+
+WRITE_TO_READ_ONLY: Final[SuspiciousAccess] = SuspiciousAccess(
+    "UP-31", "3.4.7, Table 3-10", "write to a read-only address (no write register: no effect)"
+)
+WRITE_TO_RESERVED: Final[SuspiciousAccess] = SuspiciousAccess(
+    "UP-32", "3.4.4, 3.4.7, Table 3-10", "write to a reserved address (the data byte is discarded)"
+)
+READ_OF_RESERVED: Final[SuspiciousAccess] = SuspiciousAccess(
+    "UP-33", "3.4.4, 3.4.7, Table 3-10", "read of an address without a read register (the data byte is not a register)"
+)
+RESERVED_BITS: Final[SuspiciousAccess] = SuspiciousAccess(
+    "UP-34", "3.4.11, 3.4.14, RM-4, RM-7", "write sets reserved bits (stored as 0)"
+)
+BEYOND_DATA_LENGTH: Final[SuspiciousAccess] = SuspiciousAccess(
+    "UP-35", "3.4.8, 3.4.11", "data register outside the configured data length (not exchanged with INTERBUS)"
+)
+CONFIGURATION_REWRITTEN: Final[SuspiciousAccess] = SuspiciousAccess(
+    "UP-36", "3.4.3, 3.4.10, 3.4.11", "configuration register written again after the configuration"
+)
+PCP_INTERRUPT_ON_IO_DEVICE: Final[SuspiciousAccess] = SuspiciousAccess(
+    "UP-37", "3.4.11, Table 3-13", "PCP interrupt enabled on an I/O device (/PCP = 1: no PCP communication)"
+)
+OUT_BEFORE_DATA_CYCLE: Final[SuspiciousAccess] = SuspiciousAccess(
+    "UP-38", "3.4.14, Table 3-13", "OUT data read before the first valid data cycle (reset value, not bus data)"
+)
+SUSPICIOUS_ACCESSES: Final[tuple[SuspiciousAccess, ...]] = (
+    WRITE_TO_READ_ONLY, WRITE_TO_RESERVED, READ_OF_RESERVED, RESERVED_BITS, BEYOND_DATA_LENGTH,
+    CONFIGURATION_REWRITTEN, PCP_INTERRUPT_ON_IO_DEVICE, OUT_BEFORE_DATA_CYCLE,
+)  # fmt: skip
+"""Every kind pedantic mode reports, one row each (UP-31 to UP-38)."""
+
+
+class SuspiciousAccessError(InterfaceViolationError):
+    """A legal but suspicious µP access, reported in pedantic mode only (``RegisterFile(..., pedantic=True)``).
+
+    Attributes
+    ----------
+    kind:
+        Which :data:`SUSPICIOUS_ACCESSES` row, with its decision ID (``kind.decision``, ``"UP-31"``).
+    address, direction, value:
+        The access: relative address, read or write, the data byte read or written.
+    """
+
+    def __init__(
+        self, kind: SuspiciousAccess, address: int, direction: AccessDirection, value: int, detail: str
+    ) -> None:
+        self.kind = kind
+        self.address = address
+        self.direction = direction
+        self.value = value
+        self._what = detail
+        super().__init__(kind.ref, f"pedantic {kind.decision}, {kind.what}: {detail}")
+
+    def __reduce__(self) -> tuple[object, ...]:
+        return (type(self), (self.kind, self.address, self.direction, self.value, self._what))
+
+
 class ViolationLog:
     """The violations one chip has seen, in order; strict mode raises each one.
 
@@ -166,10 +267,32 @@ class ViolationLog:
         block wins over the held violations (they stay in :attr:`records`)."""
         return self._deferred
 
+    def hold(self) -> None:
+        """Enter a :meth:`deferred` block by hand; :meth:`release` leaves it. For the per-byte hot paths, where a
+        ``with`` statement costs more than the byte itself (bench/bench_upif.py)::
+
+            log.hold()
+            try:
+                ...
+            except BaseException:
+                log.release(failed=True)
+                raise
+            log.release()
+        """
+        self._depth += 1
+
+    def release(self, *, failed: bool = False) -> None:
+        """Leave a block entered with :meth:`hold`: the outermost one raises the first violation held in it, unless
+        the block ``failed`` (an exception left it; the violations stay in :attr:`records`)."""
+        self._depth -= 1
+        if self._depth == 0 and self._pending:
+            pending, self._pending = self._pending, []
+            if not failed:
+                raise pending[0]
+
 
 class _Deferred:
-    """:meth:`ViolationLog.deferred` as a plain class: entering and leaving costs two attribute updates (it runs
-    once per byte and per clock cycle)."""
+    """:meth:`ViolationLog.deferred` as a plain class (it runs once per clock cycle of the pin level)."""
 
     __slots__ = ("_log",)
 
@@ -177,17 +300,12 @@ class _Deferred:
         self._log = log
 
     def __enter__(self) -> None:
-        self._log._depth += 1
+        self._log.hold()
 
     def __exit__(
         self, kind: type[BaseException] | None, error: BaseException | None, trace: TracebackType | None
     ) -> Literal[False]:
-        log = self._log
-        log._depth -= 1
-        if log._depth == 0 and log._pending:
-            pending, log._pending = log._pending, []
-            if kind is None:
-                raise pending[0]
+        self._log.release(failed=kind is not None)
         return False
 
 
@@ -201,28 +319,51 @@ class RegisterFile:
         master sees until software writes SET (3.4.1, 3.4.3).
     strict:
         Raise violations (``True``) or only record them in :attr:`violations` (``False``).
+    pedantic:
+        Also report legal but suspicious µP accesses (:data:`SUSPICIOUS_ACCESSES`: a write to a read-only or
+        reserved address, reserved bits set, a data register outside the data length, ...) as
+        :class:`SuspiciousAccessError`, through :attr:`violations` like every other violation (UP-30). Off by
+        default; off, it costs one flag test per access.
 
     Raises
     ------
     RegisterArgumentError
-        If ``config`` is not a :class:`~supi3.config.DeviceConfig` of a µP interface mode, or ``strict`` not a
-        ``bool``.
+        If ``config`` is not a :class:`~supi3.config.DeviceConfig` of a µP interface mode, or ``strict`` or
+        ``pedantic`` not a ``bool``.
     """
 
-    def __init__(self, config: DeviceConfig, *, strict: bool = True) -> None:
+    def __init__(self, config: DeviceConfig, *, strict: bool = True, pedantic: bool = False) -> None:
         _checked(check_instance, "config", config, DeviceConfig, "a DeviceConfig (supi3.config.decode)")
         if config.mfp_mode.kind is not MfpKind.INIT_UP:
             raise RegisterArgumentError("config", config, f"config must be an Init-µP mode (Tables 2-4 to 2-7), not "
                                         f"{config.function!r}: that is not a serial µP interface mode")
         self.config = config
         self.violations = ViolationLog(_checked(check_bool, "strict", strict))
+        self._pedantic = _checked(check_bool, "pedantic", pedantic)
         self._clock: Callable[[], int] | None = None
         self._values: dict[str, int] = {r.name: r.reset for r in REGISTER_MAP.registers}
         self._set: SetConfig | None = None
         self._bus_running = False
         self._latch_phase = False
         self._io_access = False
+        self._out_latched = False
+        self._configured: set[str] = set()
         self.power_up_reset()
+
+    @property
+    def pedantic(self) -> bool:
+        """Suspicious accesses are reported (see the ``pedantic`` parameter; paused by :meth:`pedantic_paused`)."""
+        return self._pedantic
+
+    @contextmanager
+    def pedantic_paused(self) -> Iterator[None]:
+        """A block in which pedantic mode reports nothing: for bytes that a procedure of the manual sends, not the
+        firmware (the no-op data byte completing a re-initialization, 3.4.3; UP-30)."""
+        pedantic, self._pedantic = self._pedantic, False
+        try:
+            yield
+        finally:
+            self._pedantic = pedantic
 
     def use_clock(self, source: Callable[[], int] | None) -> None:
         """Tell the register file where the chip's time is: ``source()`` returns the 32 MHz clock count now (the
@@ -253,6 +394,8 @@ class RegisterFile:
         self._bus_running = False
         self._latch_phase = False
         self._io_access = False
+        self._out_latched = False
+        self._configured.clear()
 
     def interbus_reset(self) -> None:
         """INTERBUS reset (or layer-2 watchdog reset): clear IN and OUT data, raise the INTERBUS reset event.
@@ -260,6 +403,7 @@ class RegisterFile:
         Ref: 3.4.7, Table 3-13. Configuration (SET, ID) and every other register are kept.
         """
         self._reset(Reset.INTERBUS)
+        self._out_latched = False
         self.event("IB_RESET")
 
     def sas_init(self) -> None:
@@ -285,18 +429,29 @@ class RegisterFile:
         """
         if type(address) is not int or not 0 <= address <= 15:
             address = self._address(address)
+        name = _READ_NAMES[address]
+        if name is None:
+            return self._read_no_register(address)
+        if self._latch_phase and name in _DATA_REGISTERS:
+            self._inconsistent(name, "read")
+        values = self._values
+        value = values[name]
+        cleared = _READ_CLEARS[address]
+        if cleared:  # read-clear (RC): the events returned are cleared, the live I/O access bit D7 joins (3.4.14)
+            values[name] = value & ~cleared
+            value |= int(self._io_access) << IO_ACCESS_BIT
+        if self._pedantic:
+            self._suspicious_read(address, name, value)
+        return value
+
+    def _read_no_register(self, address: int) -> int:
         port = REGISTER_MAP.port(address, AccessDirection.READ)
-        if port.access is Access.RESERVED_ZERO:
-            return 0
-        if port.register is None:
+        if port.access is not Access.RESERVED_ZERO:
             raise RegisterArgumentError("address", address, f"address must be a readable register, not {address}: "
                                         f"address {address} has no read register ({port.access.meaning})")
-        self._check_consistency(port.register.name, "read")
-        value = self._values[port.register.name]
-        if port.access is Access.RC:
-            self._values[port.register.name] = value & ~port.clear_on_read_mask
-            value |= int(self._io_access) << IO_ACCESS_BIT
-        return value
+        if self._pedantic:
+            self._suspicious(READ_OF_RESERVED, address, AccessDirection.READ, 0, "00h returned")
+        return 0
 
     def cpu_write(self, address: int, value: int) -> None:
         """A µP write data access: store ``value`` (reserved bits read back 0), or nothing for 6 and 8-11.
@@ -314,21 +469,44 @@ class RegisterFile:
             address = self._address(address)
         if type(value) is not int or not 0 <= value <= 0xFF:
             value = _checked(check_bits, "data byte", value, 8)
-        port = REGISTER_MAP.port(address, AccessDirection.WRITE)
-        if port.access is Access.NO_EFFECT:
+        name = _WRITE_NAMES[address]
+        if name is None:
+            self._write_no_register(address, value)
             return
-        register = port.register
-        if register is None:
+        if self._latch_phase and name in _DATA_REGISTERS:
+            self._inconsistent(name, "write")
+        again = False
+        if name in _CONFIGURATION:
+            again = self._write_configuration(name, value & _WRITE_MASKS[address])
+        else:
+            self._values[name] = value & _WRITE_MASKS[address]
+        if self._pedantic:
+            self._suspicious_write(address, name, value, again)
+
+    def _write_no_register(self, address: int, value: int) -> None:
+        port = REGISTER_MAP.port(address, AccessDirection.WRITE)
+        if port.access is not Access.NO_EFFECT:
             raise RegisterArgumentError("address", address, f"address must be a writable register, not {address}: "
                                         f"address {address} has no write register ({port.access.meaning})")
-        self._check_consistency(register.name, "write")
-        if register.name in ("SET", "ID") and self._bus_running:
+        if self._pedantic:
+            reads = REGISTER_MAP.port(address, AccessDirection.READ).register is not None
+            self._suspicious(WRITE_TO_READ_ONLY if reads else WRITE_TO_RESERVED, address, AccessDirection.WRITE, value,
+                             "no effect")
+
+    def _write_configuration(self, name: str, value: int) -> bool:
+        """Write SET or ID; ``True`` if it was configured before and the bus is stopped (UP-36: during bus operation
+        the write is a :class:`ReconfigurationError`)."""
+        again = name in self._configured and not self._bus_running
+        if self._bus_running:
             self.violations.report(
-                ReconfigurationError("3.4.3, 3.4.11", f"{register.name} written with {value:02X}h during bus operation")
+                ReconfigurationError("3.4.3, 3.4.11", f"{name} written with {value:02X}h during bus operation")
             )
-        self._values[register.name] = value & register.mask
-        if register.name == "SET":
-            self._apply_set(value & register.mask)
+        self._values[name] = value
+        if name == "SET":
+            self._apply_set(value)
+        if name == "ID" or self._set is not None:  # a SET value that was not applied is no configuration
+            self._configured.add(name)
+        return again
 
     def _apply_set(self, value: int) -> None:
         try:
@@ -348,11 +526,85 @@ class RegisterFile:
     def _address(address: object) -> int:
         return _checked(check_int, "address", address, 0, 15, "A3..0, 3.4.7")
 
-    def _check_consistency(self, register: str, what: str) -> None:
-        if self._latch_phase and register in _DATA_REGISTERS:
-            self.violations.report(InconsistentDataError(
-                "3.4.14", f"inconsistent data: {register} {what} during the latch phase", self.clock
-            ))
+    def _inconsistent(self, register: str, what: str) -> None:
+        self.violations.report(InconsistentDataError(
+            "3.4.14", f"inconsistent data: {register} {what} during the latch phase", self.clock
+        ))
+
+    # --------------------------------------------------------------------------------------------------------
+    # Pedantic mode: legal but suspicious accesses (UP-30 to UP-38), reported after the access took effect
+    # --------------------------------------------------------------------------------------------------------
+
+    def ignored_access(self, address: int, direction: AccessDirection, value: int) -> None:
+        """The interface ignored a data access to reserved address 4 or 5 (3.4.4), which never reaches
+        :meth:`cpu_read`/:meth:`cpu_write`: pedantic mode reports it, ``value`` being the byte read back (the
+        command byte) or the byte discarded. Without pedantic mode nothing happens.
+
+        Raises
+        ------
+        RegisterArgumentError
+            If ``address`` is not an address whose ``direction`` access the chip ignores, or ``value`` not a byte.
+        """
+        direction = _checked(check_instance, "direction", direction, AccessDirection, "an AccessDirection")
+        address = self._address(address)
+        value = _checked(check_bits, "value", value, 8)
+        if REGISTER_MAP.port(address, direction).access is not Access.RESERVED_IGNORED:
+            raise RegisterArgumentError("address", address, f"address must be one whose {direction} access the chip "
+                                        f"ignores (4, 5: 3.4.4), not {address}")
+        if self._pedantic:
+            kind = WRITE_TO_RESERVED if direction is AccessDirection.WRITE else READ_OF_RESERVED
+            effect = "discarded" if direction is AccessDirection.WRITE else "the command byte sent back"
+            self._suspicious(kind, address, direction, value, effect)
+
+    def _suspicious(
+        self, kind: SuspiciousAccess, address: int, direction: AccessDirection, value: int, detail: str
+    ) -> None:
+        write = direction is AccessDirection.WRITE
+        register = REGISTER_MAP.port(address, direction).register
+        other = REGISTER_MAP.port(address, AccessDirection.READ if write else AccessDirection.WRITE).register
+        name = register.name if register is not None else "reserved" if other is None else (
+            f"{'read' if write else 'write'}-only, {other.name}"
+        )
+        verb = "written to" if write else "read from"
+        self.violations.report(SuspiciousAccessError(
+            kind, address, direction, value, f"{value:02X}h {verb} address {address} ({name}): {detail}"
+        ))
+
+    def _suspicious_read(self, address: int, name: str, value: int) -> None:
+        if name in _OUT_INDEX:
+            if not self._in_data_length(_OUT_INDEX[name]):
+                self._suspicious(BEYOND_DATA_LENGTH, address, AccessDirection.READ, value, self._data_length_text())
+            elif not self._out_latched:
+                self._suspicious(OUT_BEFORE_DATA_CYCLE, address, AccessDirection.READ, value,
+                                 "no valid data cycle since power-up or INTERBUS reset")
+
+    def _suspicious_write(self, address: int, name: str, value: int, again: bool) -> None:
+        write = AccessDirection.WRITE
+        reserved = value & ~_WRITE_MASKS[address]
+        if reserved:
+            self._suspicious(RESERVED_BITS, address, write, value, f"bits {reserved:02X}h are reserved, stored "
+                             f"{value & _WRITE_MASKS[address]:02X}h")
+        if name in _IN_INDEX:
+            if not self._in_data_length(_IN_INDEX[name]):
+                self._suspicious(BEYOND_DATA_LENGTH, address, write, value, self._data_length_text())
+        elif again:
+            self._suspicious(CONFIGURATION_REWRITTEN, address, write, value, "SET and ID are set once, during "
+                             "initialization, and kept by SAS_INIT (3.4.3)")
+        elif name == "IRQ_EN" and value & _PCP_SOURCES and self._set is not None and not self._set.extreg \
+                and self._set.pcp_n:
+            self._suspicious(PCP_INTERRUPT_ON_IO_DEVICE, address, write, value, f"PCP bits {value & _PCP_SOURCES:02X}h"
+                             f" enabled, SET {self._values['SET']:02X}h configures an I/O device")
+
+    def _in_data_length(self, index: int) -> bool:
+        return self.internal_data_path and index < self.data_bytes()
+
+    def _data_length_text(self) -> str:
+        if not self.internal_data_path:
+            return "ExtReg = 1: the internal data registers are not in the data path"
+        if self._set is None:
+            return "not configured: the data length is 0 until SET is written"
+        return (f"the data length is {self.data_bits()} bits = {self.data_bytes()} byte(s) "
+                f"(SET {self._values['SET']:02X}h)")
 
     # --------------------------------------------------------------------------------------------------------
     # Core interface: configuration seen by the master
@@ -474,6 +726,7 @@ class RegisterFile:
         sent = self.in_bytes()
         for register, value in zip(OUT_BYTES, out, strict=False):
             self._values[register.name] = value
+        self._out_latched = True
         if self.pcp_device:
             for name in set(_PCP_ERASED) & set(names):
                 self._values[name] = 0

@@ -135,12 +135,28 @@ class _Slot:
     write: bool
 
 
-@dataclass(frozen=True)
-class _Frame:
-    """What :meth:`UpifProtocol.begin` decided for the current byte."""
+_Frame = tuple[bool, int | None]
+"""What :meth:`UpifProtocol.begin` decided for the current byte: the S/R level and the byte the chip drives. A plain
+tuple, not a dataclass: one is made per byte, and the C driver's bytes all come through here."""
 
-    s_r: bool
-    tx: int | None
+_COMMANDS: Final[tuple[CommandByte, ...]] = tuple(decode_command(byte & COMMAND_BYTE.mask) for byte in range(256))
+"""Every received command byte decoded, reserved bits 5..4 dropped (UP-12): the per-byte path indexes this table."""
+_READS_REGISTER: Final[tuple[bool, ...]] = tuple(
+    REGISTER_MAP.port(address, AccessDirection.READ).access is not Access.RESERVED_IGNORED
+    for address in REGISTER_MAP.addresses
+)
+"""Per address: a read data byte reaches the register file; ``False`` at 4 and 5, whose data access the chip
+ignores, sending the command byte back (3.4.4, 3.4.7)."""
+_WRITES_REGISTER: Final[tuple[bool, ...]] = tuple(
+    REGISTER_MAP.port(address, AccessDirection.WRITE).access is not Access.RESERVED_IGNORED
+    for address in REGISTER_MAP.addresses
+)
+"""Per address: a written data byte reaches the register file; ``False`` at 4 and 5 (3.4.4, 3.4.7)."""
+_PLAIN_COMMANDS: Final[tuple[bool, ...]] = tuple(
+    not byte & ~COMMAND_BYTE.mask and _COMMANDS[byte].address != BLOCK_ADDRESS for byte in range(256)
+)
+"""Per byte: a command byte without reserved bits that starts no block transfer, whose frame reads no register and
+reports nothing (UP-8, UP-12): :meth:`UpInterface.transfer` takes it without a frame or a deferred block."""
 
 
 class UpifProtocol:
@@ -231,12 +247,26 @@ class UpifProtocol:
             s_r = _checked(check_bool, "s_r", s_r)
         if self._frame is not None:
             raise UpifUsageError("begin() inside a frame: call end() or abort() first")
+        mode = self.mode
         tx: int | None = None
-        drives = self.mode is Mode.MOTOROLA or (self.mode is Mode.INTEL and not s_r)
-        if drives and self.phase is not Phase.DISABLED:
-            address = self._read_address()
-            tx = self.registers.cpu_read(address) if address is not None else self.last_rx
-        self._frame = _Frame(s_r, tx)
+        # The chip drives in every Motorola frame and in Intel frames with S/R = 0, which are read frames (Table
+        # 3-9); what it drives is a read register or the echo of the last byte (UP-8).
+        if mode is Mode.MOTOROLA or (mode is Mode.INTEL and not s_r):
+            phase = self.phase
+            if phase is Phase.DATA:
+                command = self.command
+                if command is not None and command.rd and _READS_REGISTER[command.address]:
+                    tx = self.registers.cpu_read(command.address)
+                else:
+                    tx = self.last_rx
+                    if command is not None and command.rd:
+                        self._ignored(command.address, AccessDirection.READ, tx)
+            elif phase is Phase.BLOCK:
+                slot = self._slots[0]
+                tx = self.registers.cpu_read(slot.address) if slot.read else self.last_rx
+            elif phase is not Phase.DISABLED:
+                tx = self.last_rx
+        self._frame = (s_r, tx)
         return tx
 
     def end(self, rx: int) -> None:
@@ -244,17 +274,21 @@ class UpifProtocol:
         line is the chip's own, so ``rx`` equals what :meth:`begin` returned)."""
         if type(rx) is not int or not 0 <= rx <= 0xFF:
             rx = _checked(check_bits, "rx", rx, 8, "the received byte")
-        frame = self._take_frame()
-        if self.phase is Phase.DISABLED:
-            return  # data transmission is disabled until power-up reset or SAS_INIT (3.4.3)
-        if self.phase is Phase.INIT:
-            self._end_init(rx)
-        elif self.phase is Phase.COMMAND:
+        frame = self._frame
+        if frame is None:
+            raise UpifUsageError("end() or abort() without begin()")
+        self._frame = None
+        phase = self.phase
+        if phase is Phase.DATA:
+            self._end_data(rx, frame[0])
+        elif phase is Phase.COMMAND:
             self._end_command(rx, frame)
-        elif self.phase is Phase.DATA:
-            self._end_data(rx, frame)
+        elif phase is Phase.BLOCK:
+            self._end_block(rx, frame[0])
+        elif phase is Phase.INIT:
+            self._end_init(rx)
         else:
-            self._end_block(rx, frame)
+            return  # DISABLED: data transmission is disabled until power-up reset or SAS_INIT (3.4.3)
         self.last_rx = rx
 
     def abort(self, bits: int) -> None:
@@ -263,39 +297,23 @@ class UpifProtocol:
         if bits == 8:
             raise UpifArgumentError("bits", bits, "bits must be the SCLK edge count of an incomplete frame, not 8: a "
                                     "complete byte ends with end() (3.4.2)")
-        self._take_frame()
-        detail = "/SS held low across bytes" if bits > 8 else "incomplete byte"
-        self._violation("3.4.2", f"{detail}: {bits} SCLK rising edges between /SS edges, frame ignored")
-
-    def _take_frame(self) -> _Frame:
         if self._frame is None:
             raise UpifUsageError("end() or abort() without begin()")
-        frame, self._frame = self._frame, None
-        return frame
+        self._frame = None
+        detail = "/SS held low across bytes" if bits > 8 else "incomplete byte"
+        self._violation("3.4.2", f"{detail}: {bits} SCLK rising edges between /SS edges, frame ignored")
 
     def _violation(self, rule: str, detail: str) -> None:
         self.registers.violations.report(ProtocolViolationError(rule, detail))
 
+    def _ignored(self, address: int, direction: AccessDirection, value: int) -> None:
+        """A data access to reserved address 4 or 5, which the chip ignores (3.4.4): only pedantic mode tells."""
+        if self.registers.pedantic:
+            self.registers.ignored_access(address, direction, value)
+
     # --------------------------------------------------------------------------------------------------------
     # What a frame reads and writes
     # --------------------------------------------------------------------------------------------------------
-
-    def _read_address(self) -> int | None:
-        """The register address a frame in which the chip drives reads, or ``None`` (echo). The chip drives in
-        every Motorola frame and in Intel frames with S/R = 0, which are read frames (Table 3-9)."""
-        if self.phase is Phase.BLOCK:
-            slot = self._slots[0]
-            return slot.address if slot.read else None
-        command = self.command
-        if self.phase is Phase.DATA and command is not None:  # the DATA phase always has its command
-            port = REGISTER_MAP.port(command.address, AccessDirection.READ)
-            if command.rd and port.access is not Access.RESERVED_IGNORED:
-                return command.address
-        return None
-
-    def _writes(self, s_r: bool) -> bool:
-        """Whether a frame can write: every Motorola frame (full duplex), Intel frames with S/R = 1 (UP-9)."""
-        return self.mode is Mode.MOTOROLA or s_r
 
     def _end_init(self, rx: int) -> None:
         for mode in Mode:
@@ -306,35 +324,81 @@ class UpifProtocol:
         self.phase = Phase.DISABLED
 
     def _end_command(self, rx: int, frame: _Frame) -> None:
-        if self.mode is Mode.INTEL and not frame.s_r:
-            self._violation("Table 3-9", f"Intel command byte received with S/R = 0 (the chip sent {frame.tx:02X}h); "
+        s_r, tx = frame
+        if self.mode is Mode.INTEL and not s_r:
+            self._violation("Table 3-9", f"Intel command byte received with S/R = 0 (the chip sent {tx:02X}h); "
                             "frame ignored")
             return
         if rx & ~COMMAND_BYTE.mask:
             self._violation("3.4.4, RM-1", f"command byte {rx:02X}h sets reserved bits; they are ignored")
-        command = decode_command(rx & COMMAND_BYTE.mask)
+        command = _COMMANDS[rx]
         self.command = command
-        if command.block_transfer:
+        if command.address == BLOCK_ADDRESS:
             self._start_block(command)
         else:
             self.phase = Phase.DATA
 
-    def _end_data(self, rx: int, frame: _Frame) -> None:
+    def _end_data(self, rx: int, s_r: bool) -> None:
         command = self.command
         self.phase = Phase.COMMAND
         if command is None:  # cannot happen: the DATA phase always has its command
             return
-        port = REGISTER_MAP.port(command.address, AccessDirection.WRITE)
-        if port.access is Access.RESERVED_IGNORED:
+        address = command.address
+        if not _WRITES_REGISTER[address]:
+            if command.wr and (self.mode is Mode.MOTOROLA or s_r):
+                self._ignored(address, AccessDirection.WRITE, rx)
             return
-        if self.mode is Mode.INTEL and command.rd != command.wr and command.rd == frame.s_r:
-            code = encode_command(command.address, rd=command.rd, wr=command.wr)
-            wanted = "read" if command.rd else "write"
-            self._violation("Table 3-9", f"command {code:02X}h asks for a {wanted} but S/R = {int(frame.s_r)}; "
-                            "data byte ignored")
-            return
-        if command.wr and self._writes(frame.s_r):
-            self.registers.cpu_write(command.address, rx)
+        if self.mode is Mode.INTEL:
+            if command.rd != command.wr and command.rd == s_r:
+                code = encode_command(address, rd=command.rd, wr=command.wr)
+                wanted = "read" if command.rd else "write"
+                self._violation("Table 3-9", f"command {code:02X}h asks for a {wanted} but S/R = {int(s_r)}; "
+                                "data byte ignored")
+                return
+            if not s_r:
+                return  # Intel frames with S/R = 0 write nothing (UP-9)
+        if command.wr:  # Motorola frames (full duplex) and Intel frames with S/R = 1 write (UP-9)
+            self.registers.cpu_write(address, rx)
+
+    # --------------------------------------------------------------------------------------------------------
+    # Fast paths of UpInterface: the same effects as the frames, checked against them by tests/test_spi_upif_fast.py
+    # --------------------------------------------------------------------------------------------------------
+
+    def _plain_command(self, rx: int) -> int | None:
+        """A whole frame carrying command byte ``rx`` (one of :data:`_PLAIN_COMMANDS`) in the command phase,
+        Motorola or Intel with S/R = 1: what :meth:`begin` and :meth:`end` do, reading no register and reporting
+        nothing. Returns the byte the chip drove (the echo in Motorola mode, UP-8; nothing in Intel mode). Half of
+        the bytes the C driver sends are command bytes."""
+        tx = self.last_rx if self.mode is Mode.MOTOROLA else None
+        self.command = _COMMANDS[rx]
+        self.phase = Phase.DATA
+        self.last_rx = rx
+        return tx
+
+    def _read_access(self, address: int) -> int:
+        """A read command byte for ``address`` (0..14) and its data byte, given in the command phase of an
+        initialized interface (Motorola: data byte 00h; Intel: S/R = 1, then 0): the effects of the four frame
+        calls, without their per-byte bookkeeping, which costs three times as much (bench/bench_upif.py).
+        ``tests/test_spi_upif_fast.py`` checks it against the frames for every address, mode and state. Runs
+        inside a deferred block (``ViolationLog.hold``)."""
+        self.command = _COMMANDS[_READ_COMMANDS[address]]
+        if _READS_REGISTER[address]:
+            value = self.registers.cpu_read(address)
+        else:
+            value = _READ_COMMANDS[address]  # the command byte is sent back (3.4.4)
+            self._ignored(address, AccessDirection.READ, value)
+        self.last_rx = value if self.mode is Mode.INTEL else 0
+        return value
+
+    def _write_access(self, address: int, value: int) -> None:
+        """A write command byte for ``address`` (0..14) and the data byte ``value``, in the command phase of an
+        initialized interface: the effects of the four frame calls (see :meth:`_read_access`)."""
+        self.command = _COMMANDS[_WRITE_COMMANDS[address]]
+        self.last_rx = value
+        if _WRITES_REGISTER[address]:
+            self.registers.cpu_write(address, value)
+        else:
+            self._ignored(address, AccessDirection.WRITE, value)
 
     def _start_block(self, command: CommandByte) -> None:
         """Address 15: lay out the block transfer's bytes (3.4.6; UP-10, UP-11)."""
@@ -356,12 +420,12 @@ class UpifProtocol:
         self._slots = slots
         self.phase = Phase.BLOCK if slots else Phase.COMMAND
 
-    def _end_block(self, rx: int, frame: _Frame) -> None:
+    def _end_block(self, rx: int, s_r: bool) -> None:
         slot, self._slots = self._slots[0], self._slots[1:]
-        if self.mode is Mode.INTEL and slot.read == frame.s_r:
+        if self.mode is Mode.INTEL and slot.read == s_r:
             wanted = "read" if slot.read else "write"
             self._violation("3.4.6, Table 3-9", f"block transfer byte {slot.address} is a {wanted} but "
-                            f"S/R = {int(frame.s_r)}; byte ignored")
+                            f"S/R = {int(s_r)}; byte ignored")
         elif slot.write:
             self.registers.cpu_write(slot.address, rx)
         if not self._slots:
@@ -453,12 +517,26 @@ class UpInterface:
         if s_r is not None and type(s_r) is not bool:
             s_r = _checked(check_bool, "s_r", s_r)
         protocol = self.protocol
-        if protocol.mode is Mode.INTEL and s_r is None:
+        mode = protocol.mode
+        if mode is Mode.INTEL and s_r is None:
             raise UpifUsageError("Intel mode: give s_r (True = the µP sends, False = it receives; Table 3-9)")
-        if protocol.in_frame:
+        if protocol._frame is not None:
             raise UpifUsageError("transfer() inside a frame begun on the protocol: end() or abort() it first")
-        with protocol.registers.violations.deferred():
-            return self._byte(mosi, True if s_r is None else s_r)
+        # A firmware model (the C driver through ctypes or cffi) sends every byte through here: a plain command byte
+        # takes a fast path; any other byte is _byte() inside deferred(), both by hand (a with statement and a
+        # call cost as much as the byte itself).
+        if protocol.phase is Phase.COMMAND and _PLAIN_COMMANDS[mosi] and (s_r or mode is Mode.MOTOROLA):
+            return protocol._plain_command(mosi)
+        log = protocol.registers.violations
+        log.hold()
+        try:
+            tx = protocol.begin(True if s_r is None else s_r)
+            protocol.end(tx if tx is not None and mode is Mode.INTEL else mosi)
+        except BaseException:
+            log.release(failed=True)
+            raise
+        log.release()
+        return tx
 
     def _byte(self, mosi: int, s_r: bool) -> int | None:
         """One frame, arguments and state already checked: begin, then end with what is on the data line."""
@@ -505,7 +583,9 @@ class UpInterface:
         self._check_frame("initialize")
         if protocol.phase is Phase.DISABLED:
             raise InterfaceDisabledError("initialize")
-        with protocol.registers.violations.deferred():
+        # The bytes of initialize() are the procedure of 3.4.3; what they do to a chip that was not reset is
+        # reported by UP-27 and UP-29, not as suspicious accesses of the firmware (UP-30).
+        with protocol.registers.violations.deferred(), protocol.registers.pedantic_paused():
             if protocol.phase in (Phase.DATA, Phase.BLOCK):
                 self._interrupted(mode)
                 return False
@@ -572,16 +652,19 @@ class UpInterface:
             If the interface cannot start a command now (nothing is sent).
         """
         if type(address) is not int or not 0 <= address < BLOCK_ADDRESS:
-            address = _register_address(address, AccessDirection.READ)
+            known = _READ_ADDRESSES.get(id(address))
+            address = known if known is not None else _register_address(address, AccessDirection.READ)
         protocol = self.protocol
         if protocol.phase is not Phase.COMMAND or protocol._frame is not None:
             self._start("read")
-        with protocol.registers.violations.deferred():
-            self._byte(_READ_COMMANDS[address], True)
-            value = protocol.begin(False)
-            protocol.end(value if value is not None and protocol.mode is Mode.INTEL else 0)
-        if value is None:  # cannot happen after a command byte: the chip drives every read data byte
-            raise UpifUsageError(f"read({address}): the chip drove no data byte")
+        log = protocol.registers.violations
+        log.hold()  # deferred() by hand, as in transfer()
+        try:
+            value = protocol._read_access(address)
+        except BaseException:
+            log.release(failed=True)
+            raise
+        log.release()
         return value
 
     def write(self, address: int | Register, value: int) -> None:
@@ -600,7 +683,8 @@ class UpInterface:
             If the interface cannot start a command now (nothing is sent).
         """
         if type(address) is not int or not 0 <= address < BLOCK_ADDRESS:
-            address = _register_address(address, AccessDirection.WRITE)
+            known = _WRITE_ADDRESSES.get(id(address))
+            address = known if known is not None else _register_address(address, AccessDirection.WRITE)
         if type(value) is not int or not 0 <= value <= 0xFF:
             value = _checked(check_bits, "value", value, 8, "a data byte, 3.4.4")
         protocol = self.protocol
@@ -609,11 +693,14 @@ class UpInterface:
                 self._write_uninitialized(_WRITE_COMMANDS[address], value)
                 return
             self._start("write")
-        with protocol.registers.violations.deferred():
-            protocol.begin(True)
-            protocol.end(_WRITE_COMMANDS[address])
-            protocol.begin(True)
-            protocol.end(value)
+        log = protocol.registers.violations
+        log.hold()  # deferred() by hand, as in transfer()
+        try:
+            protocol._write_access(address, value)
+        except BaseException:
+            log.release(failed=True)
+            raise
+        log.release()
 
     def _write_uninitialized(self, command: int, value: int) -> None:
         violations = self.protocol.registers.violations
@@ -744,6 +831,17 @@ class ModeLockedError(ProtocolViolationError):
 
 _READ_COMMANDS: Final[tuple[int, ...]] = tuple(encode_command(a, rd=True) for a in range(BLOCK_ADDRESS))
 _WRITE_COMMANDS: Final[tuple[int, ...]] = tuple(encode_command(a, wr=True) for a in range(BLOCK_ADDRESS))
+_PORT_REGISTERS: Final[dict[AccessDirection, tuple[Register | None, ...]]] = {
+    direction: tuple(REGISTER_MAP.port(a, direction).register for a in range(BLOCK_ADDRESS))
+    for direction in AccessDirection
+}
+"""The register each single access reaches, per direction and address 0..14 (Table 3-10): ``read(IN0)`` checks its
+register by identity here, without hashing the register's layout."""
+_READ_ADDRESSES: Final[dict[int, int]] = {id(r): r.address for r in _PORT_REGISTERS[AccessDirection.READ] if r}
+"""The address of each register a read reaches, by the register's identity: ``read(OUT0)`` in one look-up (the
+registers of :mod:`supi3.regmap` live as long as the program; any other object goes to :func:`_register_address`)."""
+_WRITE_ADDRESSES: Final[dict[int, int]] = {id(r): r.address for r in _PORT_REGISTERS[AccessDirection.WRITE] if r}
+"""As :data:`_READ_ADDRESSES`, for writes: ``write(IN0, ...)``."""
 
 
 def _checked(check: Callable[..., _T], *args: object, **kwargs: object) -> _T:
@@ -759,12 +857,13 @@ def _register_address(address: object, direction: AccessDirection | None = None)
     """``address`` checked as the address of one register access: 0..14 (15 starts a block transfer), or a
     :class:`~supi3.regmap.Register` that ``direction`` (``None``: either) reaches at its address."""
     if isinstance(address, Register):
-        directions = tuple(AccessDirection) if direction is None else (direction,)
-        if all(REGISTER_MAP.port(address.address, d).register is not address for d in directions):
-            verb = "reached" if direction is None else "written" if direction is AccessDirection.WRITE else "read"
-            raise UpifArgumentError("address", address, f"address: {address.name} is not {verb} at address "
-                                    f"{address.address} (Table 3-10)")
-        return address.address
+        number = address.address
+        for reached in (direction,) if direction is not None else tuple(AccessDirection):
+            if number < BLOCK_ADDRESS and _PORT_REGISTERS[reached][number] is address:
+                return number
+        verb = "reached" if direction is None else "written" if direction is AccessDirection.WRITE else "read"
+        raise UpifArgumentError("address", address, f"address: {address.name} is not {verb} at address "
+                                f"{address.address} (Table 3-10)")
     return _checked(check_int, "address", address, 0, BLOCK_ADDRESS - 1,
                     "A3..0, 3.4.4; 15 starts a block transfer: use block_transfer(), 3.4.6")
 
