@@ -15,7 +15,7 @@ from supi3.interbus.ring import ErrorKind
 from supi3.interbus.wire import Cycle
 from supi3.model.registers import InconsistentDataError
 from supi3.sdk.bench import Bench, Firmware
-from supi3.sdk.driver import IoWindowTimeoutError, Mode, Supi3Driver
+from supi3.sdk.driver import Mode, Supi3Driver
 from supi3.sdk.examples import (
     AnalogIo,
     DigitalIo,
@@ -80,11 +80,14 @@ def test_polling_device_in_the_io_window(mode: Mode, rate: int, history: list[tu
     assert bench.registers.violations.records == []  # never inside the latch phase
 
 
-def test_polling_the_pin_takes_no_bench_time() -> None:
-    """A bench limitation, on record: a pin read takes no time there, so polling the I/O pin in a loop cannot
-    outlast a cycle's check sequence; the example polls the register (every poll clocks two bytes)."""
-    with pytest.raises(IoWindowTimeoutError):
-        started(PollingIo(), Mode.MOTOROLA, BIT_RATES[0])
+@settings(max_examples=5)
+@given(mode=MODES, rate=RATES, history=st.lists(st.tuples(WORD, WORD), min_size=1, max_size=4))
+def test_polling_device_on_the_io_pin(mode: Mode, rate: int, history: list[tuple[int, int]]) -> None:
+    """The same firmware with MFP1 wired: each pin read costs its time (FW-9), the bus runs on, the window opens."""
+    device = PollingIo(mode)
+    bench = started(device, mode, rate)
+    assert play(bench, device, history) == history
+    assert bench.registers.violations.records == []
 
 
 # A timing bug the model catches ------------------------------------------------------------------------------------

@@ -42,6 +42,8 @@ __all__ = ["DEFAULT_STRAPS", "Bench", "BenchError", "BenchTransport", "CycleTimi
 
 DEFAULT_STRAPS: Final[tuple[str, str]] = ("10011", "1110")
 """C[4..0] and MFP[15..12] of the bench's default chip: a remote bus device in the Init-µP mode (Table 2-4)."""
+PIN_READ_S: Final[float] = 0.25e-6
+"""FW-9: one read of a status pin (C/D, /IRQ, I/O) by the firmware, about 12 CPU clocks of a 48 MHz MCU."""
 KEPT: Final[int] = 1000
 """FW-6: how many cycles :attr:`Bench.results` and :attr:`Bench.timeline` keep (a long run stays bounded)."""
 IDLE_LOOPS_LIMIT: Final[int] = 1000
@@ -170,20 +172,21 @@ class BenchTransport(ModelTransport):
         bench.advance(bench.now + check_real("us", us, 0.0) * 1e-6)
 
     def read_cd(self) -> int:
-        """C/D now."""
-        self.bench.advance(self.bench.now)
+        """C/D, read in :attr:`Bench.pin_read_s` (FW-9)."""
+        self.bench.advance(self.bench.now + self.bench.pin_read_s)
         return super().read_cd()
 
     def read_irq(self) -> int:
-        """/IRQ now."""
-        self.bench.advance(self.bench.now)
+        """/IRQ, read in :attr:`Bench.pin_read_s` (FW-9)."""
+        self.bench.advance(self.bench.now + self.bench.pin_read_s)
         return super().read_irq()
 
     def read_io(self) -> int | None:
-        """The I/O access bit now; ``None`` if the bench leaves the pin unwired (:attr:`Bench.io_pin`)."""
+        """The I/O access bit, read in :attr:`Bench.pin_read_s`; ``None`` if the bench leaves the pin unwired
+        (:attr:`Bench.io_pin`)."""
         if not self.bench.io_pin:
             return None
-        self.bench.advance(self.bench.now)
+        self.bench.advance(self.bench.now + self.bench.pin_read_s)
         return super().read_io()
 
     def access(self) -> _Access:
@@ -239,6 +242,10 @@ class Bench:
     io_pin:
         The I/O access pin (MFP1) is wired to the firmware; ``False``: the driver polls D7 of IRQ_EVT instead, the
         manual's polling method (3.4.14), each poll clocking its two bytes.
+    pin_read_s:
+        What reading one of C/D, /IRQ or I/O costs the firmware (FW-9; default :data:`PIN_READ_S`).
+    pedantic:
+        Report legal but suspicious register accesses too (``SuspiciousAccessError``, UP-30 to UP-38).
 
     Attributes
     ----------
@@ -271,6 +278,8 @@ class Bench:
         cycle_time_s: float | None = None,
         strict: bool = True,
         io_pin: bool = True,
+        pin_read_s: float = PIN_READ_S,
+        pedantic: bool = False,
     ) -> None:
         self.config = default_config(bit_rate) if config is None else check_instance("config", config, DeviceConfig)
         if firmware is not None and not isinstance(firmware, Firmware):
@@ -278,7 +287,7 @@ class Bench:
                                       f"{describe(firmware)}")  # fmt: skip
         self.firmware = firmware
         self.mode = check_instance("mode", mode, Mode)
-        self.chip = Supi3(self.config, strict=check_bool("strict", strict))
+        self.chip = Supi3(self.config, strict=check_bool("strict", strict), pedantic=check_bool("pedantic", pedantic))
         if self.chip.registers is None:
             raise DriverArgumentError("config", config, f"config must strap an Init-µP mode (Tables 2-4 to 2-7), "
                                       f"not {self.config.function!r}")  # fmt: skip
@@ -288,6 +297,7 @@ class Bench:
         self.master = Master(self._bus)
         self.byte_s = timing.upif_byte_s(self.config.bit_rate, sclk_hz)
         self.io_pin = check_bool("io_pin", io_pin)
+        self.pin_read_s = check_real("pin_read_s", pin_read_s, 0.0, 1e-3)
         self.cycle_time_s = None if cycle_time_s is None else check_real("cycle_time_s", cycle_time_s, 0.0)
         self.transport = BenchTransport(self, self.chip)
         self.driver = Supi3Driver(self.transport, frame_gap_us=frame_gap_us)
