@@ -52,7 +52,7 @@ def up_pin_outputs(up: PinsOut) -> tuple[int, int]:
 
 class Supi3Chip:
     """One SUPI 3 chip, every pin, one 32 MHz clock per :meth:`step` (the convention of
-    :mod:`supi3.pinlevel`).
+    :mod:`supi3.pinlevel`), or many per :meth:`run`.
 
     Parameters
     ----------
@@ -63,6 +63,21 @@ class Supi3Chip:
         (``True``) or are recorded in ``registers.violations`` (``False``).
     pedantic:
         Also report suspicious µP accesses (:class:`~supi3.model.chip.Supi3`).
+
+    Attributes
+    ----------
+    core:
+        The INTERBUS core (:class:`~supi3.model.pins.Supi3Pins`).
+    upif:
+        The serial µP interface (:class:`~supi3.spi.slave_pins.SlavePins`) in the Init-µP modes, else ``None``.
+
+    Notes
+    -----
+    :meth:`run` is event-driven in every mode. The core and the µP interface meet only in the register file, and
+    the core changes it only at the clock edges its scheduler visits (:meth:`Supi3Pins.run`, ``before``): before
+    each, the µP interface catches up to that cycle, clock by clock where its pins move
+    (:meth:`SlavePins.tick`) and in one step where they hold (:meth:`SlavePins.hold`). Within one cycle the core
+    clocks first, as in :meth:`step`, so the two agree cycle for cycle (tested).
     """
 
     inputs: Sequence[Pin] = Supi3Pins.inputs
@@ -74,20 +89,49 @@ class Supi3Chip:
         self.core = Supi3Pins(config, Supi3(config, strict=strict, pedantic=pedantic))
         registers = self.core.chip.registers
         self.upif = SlavePins(registers) if registers is not None else None
+        self._up_cycle = 0  # the cycle the µP interface clocks (UP-19: violations name it)
+        self._pins_in: dict[int, PinsIn] = {}
         if registers is not None:
-            # The µP interface ticks after the core's step, so the cycle it clocks is core.cycle - 1 (UP-19).
-            registers.use_clock(lambda: self.core.cycle - 1)
+            registers.use_clock(lambda: self._up_cycle)
+
+    @property
+    def config(self) -> DeviceConfig:
+        """The pin straps."""
+        return self.core.config
 
     @property
     def chip(self) -> Supi3:
         """The bus behaviour (and, in µP modes, ``chip.registers``)."""
         return self.core.chip
 
+    @property
+    def cycle(self) -> int:
+        """Clock cycles since reset."""
+        return self.core.cycle
+
     def reset(self) -> None:
         """The state after the ``sync`` reset."""
         self.core.reset()
         if self.upif is not None:
             self.upif.reset()
+
+    def _up_inputs(self, mfp: int) -> PinsIn:
+        """:func:`up_pin_inputs` of MFP levels, each combination made once."""
+        key = mfp & _UP_INPUT_MASK
+        pins = self._pins_in.get(key)
+        if pins is None:
+            pins = self._pins_in[key] = up_pin_inputs(key)
+        return pins
+
+    def _tick_up(self, upif: SlavePins, pins: PinsIn) -> PinsOut:
+        """One cycle of the µP interface, after the core's clock edge of the same cycle: held in reset with the
+        core (M2)."""
+        self._up_cycle = self.core.cycle - 1
+        out = upif.tick(pins)
+        core = self.core
+        if core.holding or core.cycle - 1 < core.run_from:  # resu_drive during the cycle just run
+            upif.reset()
+        return out
 
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
         """Run one clock cycle.
@@ -98,29 +142,120 @@ class Supi3Chip:
             As :meth:`Supi3Pins.step`: a pin missing or unknown, or a level out of its pin's width (nothing changes).
         """
         out = self.core.step(inputs)
-        if self.upif is None:
+        upif = self.upif
+        if upif is None:
             return out
-        up = self.upif.tick(up_pin_inputs(int(inputs["mfp_in"])))
-        if out["resu_drive"] or self.core.holding:
-            self.upif.reset()
-        levels, enables = up_pin_outputs(up)
+        levels, enables = _up_levels(self._tick_up(upif, self._up_inputs(int(inputs["mfp_in"]))))
         out["mfp_out"] = (out["mfp_out"] & ~UP_PINS) | levels
         out["mfp_oe"] = (out["mfp_oe"] & ~UP_PINS) | enables
         return out
 
     def run(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]]) -> dict[str, PinTrace]:
-        """Whole traces at once: the core's event-driven :meth:`Supi3Pins.run` without a µP interface, else
-        cycle by cycle (the interface and the core meet in the register file at any cycle).
+        """Run as many clock cycles as the input traces are long, event-driven (see the class notes); the same
+        outputs, state and violation records as :meth:`step` once per cycle.
 
         Raises
         ------
         ArgumentError
             As :meth:`Supi3Pins.run` (:func:`~supi3.model.pins.input_traces`); nothing changes.
+        InterfaceViolationError
+            In strict mode, the first violation of the µP interface's rules, once every cycle ran (:meth:`step`
+            raises it at the end of its cycle).
         """
-        if self.upif is None:
-            return self.core.run(inputs)
+        return self._run(inputs, forward_only=False)
+
+    def run_forward(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]]) -> dict[str, PinTrace]:
+        """:meth:`run` without ``di1`` (:meth:`Supi3Pins.run_forward`), for a ring (:class:`~supi3.model.pinring.
+        PinRing`), which then gets ``di1`` from :meth:`return_line`."""
+        return self._run(inputs, forward_only=True)
+
+    def return_line(self, di2: PinTrace, do2: PinTrace) -> PinTrace:
+        """``di1`` over the last :meth:`run_forward` (:meth:`Supi3Pins.return_line`; the µP interface has no part
+        in the return line)."""
+        return self.core.return_line(di2, do2)
+
+    def _run(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]], forward_only: bool
+             ) -> dict[str, PinTrace]:  # fmt: skip
+        upif = self.upif
+        run = self.core.run_forward if forward_only else self.core.run
+        if upif is None:
+            return run(inputs)
         traces = input_traces(inputs)  # every trace checked before the first cycle runs
-        names = [pin.name for pin in self.inputs]
-        columns = [traces[name].tolist() for name in names]
-        rows = [self.step(dict(zip(names, values, strict=True))) for values in zip(*columns, strict=True)]
-        return {pin.name: np.array([row[pin.name] for row in rows], dtype=np.int64) for pin in self.outputs}
+        catch_up = _CatchUp(self, upif, traces["mfp_in"])
+        with upif.registers.violations.deferred():
+            out = run(traces, before=catch_up)
+            catch_up(len(traces["mfp_in"]))
+        levels, enables = catch_up.render()
+        out["mfp_out"] = (out["mfp_out"] & ~UP_PINS) | levels
+        out["mfp_oe"] = (out["mfp_oe"] & ~UP_PINS) | enables
+        return out
+
+
+_UP_INPUT_MASK: Final = sum(1 << pin for pin in UP_INPUTS.values())
+"""The MFP pins the µP interface reads."""
+
+_LEVELS: dict[PinsOut, tuple[int, int]] = {}
+""":func:`up_pin_outputs` of every µP interface output combination seen (at most 2**10)."""
+
+
+def _up_levels(up: PinsOut) -> tuple[int, int]:
+    """:func:`up_pin_outputs`, each combination computed once."""
+    levels = _LEVELS.get(up)
+    if levels is None:
+        levels = _LEVELS[up] = up_pin_outputs(up)
+    return levels
+
+
+class _CatchUp:
+    """The µP interface's side of one :meth:`Supi3Chip.run`: called with a trace index ``stop``, it runs the
+    interface's cycles up to ``stop`` (exclusive), holding where its pins and synchronisers rest, and records its
+    outputs where they change."""
+
+    def __init__(self, chip: Supi3Chip, upif: SlavePins, mfp: npt.NDArray[np.integer]) -> None:
+        self.chip = chip
+        self.upif = upif
+        self.c0 = chip.core.cycle
+        keys = np.asarray(mfp, dtype=np.int64) & _UP_INPUT_MASK
+        self.keys = keys.tolist()
+        # Where the µP interface's pins change, and the end: the pieces in which they hold.
+        self.changes = [*(np.flatnonzero(keys[1:] != keys[:-1]) + 1).tolist(), len(keys)]
+        self.k = 0
+        self.done = 0
+        self.outputs: list[tuple[int, PinsOut]] = []
+
+    def __call__(self, stop: int) -> None:
+        t = self.done
+        if t >= stop:
+            return
+        chip, upif, core, changes, outputs = self.chip, self.upif, self.chip.core, self.changes, self.outputs
+        # The core's state is that after its last clock edge before ``stop``, for every cycle from ``t`` on.
+        in_reset = core.holding or core.run_from > self.c0 + t
+        while t < stop:
+            while changes[self.k] <= t:
+                self.k += 1
+            end = min(changes[self.k], stop)
+            pins = chip._up_inputs(self.keys[t])
+            if not in_reset and upif.settled(pins):
+                chip._up_cycle = self.c0 + t  # for a violation's clock (UP-19)
+                for i, out in upif.hold(pins, end - t):
+                    if not outputs or out is not outputs[-1][1]:
+                        outputs.append((t + i, out))
+                t = end
+                continue
+            # The core has already run its edge of cycle t if any: step the µP interface as step() does.
+            chip._up_cycle = self.c0 + t
+            out = upif.tick(pins)
+            if in_reset or core.run_from > self.c0 + t:
+                upif.reset()
+            if not outputs or out is not outputs[-1][1]:
+                outputs.append((t, out))
+            t += 1
+        self.done = t
+
+    def render(self) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
+        """The µP interface's MFP levels and output enables over the run."""
+        n = len(self.keys)
+        starts = np.array([t for t, _ in self.outputs] + [n], dtype=np.int64)
+        table = np.array([_up_levels(out) for _, out in self.outputs], dtype=np.int64).reshape(-1, 2)
+        lengths = np.diff(starts)
+        return np.repeat(table[:, 0], lengths), np.repeat(table[:, 1], lengths)

@@ -41,7 +41,7 @@ pin                   dir  meaning
 from __future__ import annotations
 
 from bisect import bisect_right
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Final
 
 import numpy as np
@@ -226,6 +226,11 @@ class Supi3Pins:
         return outputs
 
     @property
+    def run_from(self) -> int:
+        """The first cycle the logic runs after the power-up reset's stretch (M2); ``resu_drive`` is 1 before it."""
+        return self._run_from
+
+    @property
     def holding(self) -> bool:
         """A source of the power-up reset (``vmon_ok`` low, /ResU pulled low) was seen at the last clock edge (M2)."""
         return self._holding
@@ -272,7 +277,8 @@ class Supi3Pins:
     # Many clocks: run()
     # ------------------------------------------------------------------------------------------------------------
 
-    def run(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]]) -> dict[str, PinTrace]:
+    def run(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]], *,
+            before: Callable[[int], object] | None = None) -> dict[str, PinTrace]:
         """Run as many clock cycles as the input traces are long; return every output pin's trace.
 
         The same cycles as calling :meth:`step` once per cycle, with the same results, but only the cycles in
@@ -283,6 +289,10 @@ class Supi3Pins:
         inputs:
             One equally long trace per input pin (exactly the names of :attr:`inputs`): 1-D integer sequences or
             arrays within the pin's width.
+        before:
+            Called with the index of each cycle whose clock edge may change the chip, before that edge: between
+            two calls nothing in the chip changes (its register file included), so a model that shares it, the µP
+            interface of :class:`supi3.top.Supi3Chip`, catches up to the index in the call.
 
         Raises
         ------
@@ -291,7 +301,7 @@ class Supi3Pins:
             of different lengths (:func:`input_traces`); nothing changes.
         """
         raw = input_traces(inputs)
-        traces = self._run_forward(raw)
+        traces = self._run_forward(raw, before)
         traces["di1"] = self._return_line(raw["di2"].astype(np.int64, copy=False), traces["do2"])
         return traces
 
@@ -304,13 +314,15 @@ class Supi3Pins:
             synced[name] = np.concatenate([held, raw[name]], dtype=np.int64, casting="unsafe")
         return synced
 
-    def run_forward(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]]) -> dict[str, PinTrace]:
+    def run_forward(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]], *,
+                    before: Callable[[int], object] | None = None) -> dict[str, PinTrace]:
         """:meth:`run` without ``di1``: the chip's logic does not depend on DI2 beyond the return line's
         pass-through, so a ring runs every chip forward first and then the return line backwards
         (:meth:`return_line`). The ``di2`` trace given here is checked but not used."""
-        return self._run_forward(input_traces(inputs))
+        return self._run_forward(input_traces(inputs), before)
 
-    def _run_forward(self, raw: Mapping[str, npt.NDArray[np.integer]]) -> dict[str, PinTrace]:
+    def _run_forward(self, raw: Mapping[str, npt.NDArray[np.integer]],
+                     before: Callable[[int], object] | None) -> dict[str, PinTrace]:
         # The run kernel: the event scheduler over the blocks' per-cycle logic. It stays flat on purpose (one loop,
         # locals for what it reads every visit): its cost per visited cycle is the run() rate (bench/bench_model.py).
         n = len(raw["do1"])
@@ -373,6 +385,8 @@ class Supi3Pins:
             if c >= self._run_from:
                 restore_low_run(t, level, self._run_from)
             if c >= self._run_from or self._holding or not (s.resu_n and s.vmon_ok):
+                if before is not None:
+                    before(t)
                 self._tick(c, s, level)
             if chip.revision != shown or self._run_from != run_from:
                 shown, run_from = chip.revision, self._run_from

@@ -216,6 +216,11 @@ class TimingChecker:
         self._last_data: int | None = None
         self._sas_rise: int | None = None
 
+    @property
+    def last_pins(self) -> PinsIn:
+        """The inputs of the last cycle checked (the idle levels after :meth:`reset`)."""
+        return self._pins
+
     def _violation(self, symbol: str, cycle: int, clocks: int | None, note: str = "") -> None:
         limit = self._limits[symbol]
         assert limit.minimum_s is not None
@@ -382,6 +387,65 @@ class SlavePins:
             self._pipeline.append(self._decode())
             self.cycle += 1
         return out
+
+    def settled(self, pins: PinsIn) -> bool:
+        """Whether holding ``pins`` leaves nothing for the clock edges to do but clock the synchronisers and the
+        output pipeline: SAS_INIT low, the /SS, SCLK, SAS_INIT and MFP7 synchronisers all three stages at their
+        pin's level (no edge pending) and ``pins`` the inputs of the last cycle (see :meth:`hold`).
+
+        Raises
+        ------
+        ArgumentError
+            ``pins`` is not a :class:`PinsIn`.
+        """
+        if type(pins) is not PinsIn:
+            check_instance("pins", pins, PinsIn)
+        ss, sclk, sas, s_r = self._ss, self._sclk, self._sas, self._s_r
+        return (not pins.sas_init and self._checker.last_pins == pins
+                and ss.s1 == ss.s2 == ss.s3 == pins.ss_n and sclk.s1 == sclk.s2 == sclk.s3 == pins.sclk
+                and sas.s1 == sas.s2 == sas.s3 == 0 and s_r.s1 == s_r.s2 == s_r.s3 == pins.mfp7)
+
+    def hold(self, pins: PinsIn, cycles: int) -> list[tuple[int, PinsOut]]:
+        """Run ``cycles`` cycles with ``pins`` held, while the register file does not change: the same as
+        ``cycles`` calls of :meth:`tick` (the same outputs, checks and state), at a cost independent of ``cycles``.
+
+        The event-driven whole chip (:meth:`supi3.top.Supi3Chip.run`) uses it between the cycles where the core
+        changes the register file. ``pins`` must be :meth:`settled`: then no edge is detected, so the state after
+        each clock edge decodes to the same outputs, which leave the pipeline ``output_delay`` + 1 cycles later.
+
+        Returns
+        -------
+        list[tuple[int, PinsOut]]
+            The outputs at each change, as (index of the cycle among the ``cycles``, outputs); the first at 0.
+
+        Raises
+        ------
+        ArgumentError
+            ``pins`` not a :class:`PinsIn` or ``cycles`` not an integer >= 1 (nothing changes).
+        UpifUsageError
+            ``pins`` not :meth:`settled` (nothing changes).
+        TimingViolationError
+            In strict mode, after the cycles completed (C/D settling late while /SS is low, t8).
+        """
+        check_int("cycles", cycles, 1)
+        if not self.settled(pins):
+            raise UpifUsageError("hold() needs settled inputs: the synchronisers still move (SlavePins.settled)")
+        pipeline = self._pipeline
+        line = [*pipeline, self._decode()]  # the outputs of cycles 0, 1, ...; the last one holds from then on
+        changes: list[tuple[int, PinsOut]] = []
+        intel = self.protocol.mode is Mode.INTEL
+        with self.registers.violations.deferred():
+            for i, out in enumerate(line[:cycles]):
+                if not changes or out is not changes[-1][1]:
+                    # The checker acts only where an output changes: elsewhere it sees the same pins and C/D.
+                    self._checker.check(self.cycle + i, pins, out, intel)
+                    changes.append((i, out))
+            for i in range(max(cycles - 3, 0), cycles):  # MFP6's synchroniser takes the pad, driven or not
+                out = line[min(i, len(pipeline))]
+                self._data.clock(out.mfp6 if out.mfp6_oe else pins.mfp6)
+            self._pipeline = deque((line[:-1] + line[-1:] * min(cycles, len(pipeline)))[-len(pipeline):])
+            self.cycle += cycles
+        return changes
 
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
         """:meth:`tick` with pins by name (the lockstep harness's ``PinModel.step``; names in
