@@ -3,6 +3,8 @@ with INTERBUS traffic on the line and a µP on the MFP pins (issue #10; docs/mod
 
 from __future__ import annotations
 
+from itertools import pairwise
+
 import numpy as np
 import numpy.typing as npt
 import pytest
@@ -11,7 +13,6 @@ from hypothesis import strategies as st
 
 from supi3.config import decode
 from supi3.interbus import wire
-from supi3.interbus.wire import Cycle
 from supi3.model.registers import RegisterFile
 from supi3.regmap import ID, IN0, IRQ_EN, IRQ_EVT, OUT0, REGISTER_MAP, SET, encode_command
 from supi3.spi.master import SoftMaster
@@ -40,16 +41,16 @@ def up_script(bit_rate: int, mode: Mode, actions: list[tuple[int, int, int, bool
     for address, value in ((SET, 0x82), (ID, 0x01), (IRQ_EN, 0xFF)):
         master.byte(encode_command(register_address(address), wr=True))
         master.byte(value)
-    registers = [register_address(r) for r in (IN0, OUT0, IRQ_EVT, SET, ID)]
+    targets = [register_address(r) for r in (IN0, OUT0, IRQ_EVT, SET, ID)]
     for gap, kind, value, s_r in actions:
         master.deselect()
         master.run(gap)
-        address = registers[value % len(registers)]
+        target = targets[value % len(targets)]
         if kind == 0:
-            master.byte(encode_command(address, wr=True))
+            master.byte(encode_command(target, wr=True))
             master.byte(value)
         elif kind == 1:
-            master.byte(encode_command(address, rd=True))
+            master.byte(encode_command(target, rd=True))
             master.byte(0, s_r=False)
         elif kind == 2:
             master.byte(value, s_r=s_r)
@@ -93,7 +94,7 @@ def stepped(chip: Supi3Chip, inputs: Traces) -> Traces:
 def in_pieces(chip: Supi3Chip, inputs: Traces, cuts: list[float]) -> Traces:
     n = len(inputs["do1"])
     bounds = [0, *sorted(int(cut * n) for cut in cuts), n]
-    pieces = [chip.run({name: trace[a:b] for name, trace in inputs.items()}) for a, b in zip(bounds, bounds[1:])]
+    pieces = [chip.run({name: trace[a:b] for name, trace in inputs.items()}) for a, b in pairwise(bounds)]
     return {name: np.concatenate([piece[name] for piece in pieces]) for name in pieces[0]}
 
 

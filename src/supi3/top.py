@@ -14,6 +14,7 @@ M2).
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Mapping, Sequence
 from typing import Final
 
@@ -21,12 +22,14 @@ import numpy as np
 import numpy.typing as npt
 
 from supi3 import pinout
-from supi3.checks import check_bits, check_bool, check_instance
+from supi3.checks import check_bits, check_bool, check_instance, check_int, check_trace, fail
 from supi3.config import DeviceConfig
 from supi3.model.chip import Supi3
 from supi3.model.pins import PinTrace, Supi3Pins, input_traces
+from supi3.model.registers import RegisterFile
 from supi3.pinlevel import OE_SUFFIX, Pin
 from supi3.spi.slave_pins import PinsIn, PinsOut, SlavePins
+from supi3.spi.upif import UpifUsageError
 
 UP_INPUTS: Final = pinout.UP_INPUTS
 """The MFP pin of each input of the µP interface (:class:`PinsIn` field, Tables 3-5 and 3-6)."""
@@ -48,6 +51,22 @@ def up_pin_outputs(up: PinsOut) -> tuple[int, int]:
     enables = sum(getattr(up, name + OE_SUFFIX) << pin for name, pin in UP_OUTPUTS.items())
     levels = sum(getattr(up, name) << pin for name, pin in UP_OUTPUTS.items())
     return levels & enables, enables
+
+
+def up_input_levels(pins: PinsIn) -> int:
+    """The MFP levels of the µP interface's inputs ``pins`` (the other MFP bits 0): the inverse of
+    :func:`up_pin_inputs`."""
+    check_instance("pins", pins, PinsIn)
+    return sum(getattr(pins, name) << pin for name, pin in UP_INPUTS.items())
+
+
+def up_outputs_of(mfp_out: int, mfp_oe: int) -> PinsOut:
+    """The µP interface's outputs as the MFP output levels and enables show them (an undriven output reads 0, as
+    :func:`up_pin_outputs` gives it): the inverse of :func:`up_pin_outputs`."""
+    mfp_out, mfp_oe = check_bits("mfp_out", mfp_out, 16), check_bits("mfp_oe", mfp_oe, 16)
+    levels = {name: (mfp_out >> pin) & 1 for name, pin in UP_OUTPUTS.items()}
+    enables = {name + OE_SUFFIX: (mfp_oe >> pin) & 1 for name, pin in UP_OUTPUTS.items()}
+    return PinsOut(**levels, **enables)
 
 
 class Supi3Chip:
@@ -221,7 +240,7 @@ class _CatchUp:
         self.changes = [*(np.flatnonzero(keys[1:] != keys[:-1]) + 1).tolist(), len(keys)]
         self.k = 0
         self.done = 0
-        self.outputs: list[tuple[int, PinsOut]] = []
+        self.outputs: list[tuple[int, PinsOut | None]] = [(0, None)]  # then the output of cycle 0 and each change
 
     def __call__(self, stop: int) -> None:
         t = self.done
@@ -235,19 +254,19 @@ class _CatchUp:
                 self.k += 1
             end = min(changes[self.k], stop)
             pins = chip._up_inputs(self.keys[t])
+            chip._up_cycle = self.c0 + t  # a violation names the cycle (UP-19)
             if not in_reset and upif.settled(pins):
-                chip._up_cycle = self.c0 + t  # for a violation's clock (UP-19)
-                for i, out in upif.hold(pins, end - t):
-                    if not outputs or out is not outputs[-1][1]:
+                held = upif.hold(pins, end - t)
+                for i, out in held:
+                    if out is not outputs[-1][1]:
                         outputs.append((t + i, out))
                 t = end
                 continue
             # The core has already run its edge of cycle t if any: step the µP interface as step() does.
-            chip._up_cycle = self.c0 + t
             out = upif.tick(pins)
             if in_reset or core.run_from > self.c0 + t:
                 upif.reset()
-            if not outputs or out is not outputs[-1][1]:
+            if out is not outputs[-1][1]:
                 outputs.append((t, out))
             t += 1
         self.done = t
@@ -255,7 +274,122 @@ class _CatchUp:
     def render(self) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
         """The µP interface's MFP levels and output enables over the run."""
         n = len(self.keys)
-        starts = np.array([t for t, _ in self.outputs] + [n], dtype=np.int64)
-        table = np.array([_up_levels(out) for _, out in self.outputs], dtype=np.int64).reshape(-1, 2)
+        outputs = self.outputs[1:]
+        starts = np.array([t for t, _ in outputs] + [n], dtype=np.int64)
+        table = np.array([_up_levels(out) for _, out in outputs if out is not None], dtype=np.int64).reshape(-1, 2)
         lengths = np.diff(starts)
         return np.repeat(table[:, 0], lengths), np.repeat(table[:, 1], lengths)
+
+
+QUIET_BOARD: Final[dict[str, int]] = {"do1": 1, "di2": 0, "rbst_ext": 0, "mfp_in": 0, "stat_err_n": 1, "resu_n": 1,
+                                      "vmon_ok": 1}  # fmt: skip
+"""The whole chip's inputs on a quiet board: the INTERBUS forward line idle (high, docs/interbus.md), no device
+following, no /StatErr, /ResU released, power good; MFP pins low."""
+
+
+class ChipPort:
+    """The serial µP interface's pins on the whole chip (:class:`~supi3.top.Supi3Chip` in an Init-µP mode): what
+    :class:`~supi3.spi.master.SoftMaster` drives (``SoftMaster(ChipPort(chip), mode)``).
+
+    The µP's pins go to MFP0 (SAS_INIT), MFP4 (SCLK), MFP5 (/SS), MFP6 (SerIN or Ser_IN/OUT) and MFP7 (S/R in
+    Intel mode), Tables 3-5 and 3-6; every other input pin holds its level in :attr:`inputs` (MFP bits outside
+    MFP[7..0] included), except the forward line ``do1``, which takes the samples queued by :meth:`feed` while there
+    are any. Each :meth:`run` is one event-driven :meth:`Supi3Chip.run`.
+
+    Parameters
+    ----------
+    chip:
+        The whole chip, in an Init-µP mode.
+    inputs:
+        Levels of input pins to hold instead of :data:`QUIET_BOARD`'s (names of ``Supi3Chip.inputs``).
+
+    Attributes
+    ----------
+    inputs:
+        The held levels of every input pin (the µP's MFP bits are taken from the µP instead).
+    last:
+        Every output pin in the last cycle run (empty before the first).
+
+    Raises
+    ------
+    ArgumentError
+        ``chip`` not a :class:`Supi3Chip`, an input name unknown or a level out of its pin's width.
+    UpifUsageError
+        The chip is not in an Init-µP mode (it has no µP interface).
+    """
+
+    def __init__(self, chip: Supi3Chip, **inputs: int) -> None:
+        check_instance("chip", chip, Supi3Chip)
+        if chip.upif is None:
+            raise UpifUsageError(f"the chip's MFP mode {chip.config.mfp_mode.kind.name} has no serial µP interface "
+                                 "(Init-µP modes only, Tables 3-5 and 3-6)")
+        widths = {pin.name: pin.width for pin in Supi3Chip.inputs}
+        for name, level in inputs.items():
+            if name not in widths:
+                raise fail("inputs", f"input pin names of the chip ({', '.join(widths)})", name)
+            inputs[name] = check_bits(f"pin {name!r}", level, widths[name])
+        self.chip = chip
+        self.upif: SlavePins = chip.upif
+        self.inputs = {**QUIET_BOARD, **inputs}
+        self.last: dict[str, int] = {}
+        self._line: deque[int] = deque()
+        self._outputs: dict[tuple[int, int], PinsOut] = {}
+
+    @property
+    def registers(self) -> RegisterFile:
+        """The chip's register file."""
+        return self.upif.registers
+
+    @property
+    def clock_hz(self) -> int:
+        """The chip clock."""
+        return self.upif.clock_hz
+
+    @property
+    def cycle(self) -> int:
+        """The chip's clock cycles since reset."""
+        return self.chip.cycle
+
+    def feed(self, samples: Sequence[int] | npt.NDArray[np.integer]) -> None:
+        """Queue forward-line samples (one per clock, 0 or 1) for ``do1``; they go in while the µP works, then
+        ``do1`` holds ``inputs["do1"]`` again.
+
+        Raises
+        ------
+        ArgumentError
+            ``samples`` not a 1-D sequence of 0/1 integers (nothing is queued).
+        """
+        self._line.extend(check_trace("samples", samples, 1).tolist())
+
+    @property
+    def queued(self) -> int:
+        """Forward-line samples fed and not yet sent."""
+        return len(self._line)
+
+    def run(self, pins: PinsIn, cycles: int) -> list[PinsOut]:
+        """Hold the µP's ``pins`` for ``cycles`` clock cycles; return the µP interface's outputs of each cycle.
+
+        Raises
+        ------
+        ArgumentError
+            ``pins`` not a :class:`PinsIn`, ``cycles`` not an integer >= 0.
+        """
+        check_instance("pins", pins, PinsIn)
+        check_int("cycles", cycles, 0)
+        if not cycles:
+            return []
+        traces = {name: np.full(cycles, level, dtype=np.int64) for name, level in self.inputs.items()}
+        traces["mfp_in"][:] = (self.inputs["mfp_in"] & ~UP_PINS) | up_input_levels(pins)
+        fed = min(cycles, len(self._line))
+        if fed:
+            traces["do1"][:fed] = [self._line.popleft() for _ in range(fed)]
+        out = self.chip.run(traces)
+        self.last = {name: int(trace[-1]) for name, trace in out.items()}
+        cache = self._outputs
+        result = []
+        for key in zip(out["mfp_out"].tolist(), out["mfp_oe"].tolist(), strict=True):
+            up = cache.get(key)
+            if up is None:
+                up = cache[key] = up_outputs_of(*key)
+            result.append(up)
+        return result

@@ -4,13 +4,16 @@
 :class:`~supi3.interbus.ring.Bus` protocol), so the same :class:`~supi3.interbus.master.Master` runs a scenario
 on either fidelity. Here every bit of every telegram really travels: the master's line levels
 (``wire.cycle_levels`` split into frame, ring delay and verdict) are expanded to 32 MHz samples, clocked through
-each chip's :class:`~supi3.model.pins.Supi3Pins` (forward line ``do1 -> do2``, return line ``di2 -> di1``), and
-the return line is received by a UART-style receiver that resynchronises on every start edge.
+each chip (forward line ``do1 -> do2``, return line ``di2 -> di1``), and the return line is received by a UART-style
+receiver that resynchronises on every start edge. A chip is the core alone (:class:`~supi3.model.pins.Supi3Pins`) or
+the whole chip (:class:`~supi3.top.Supi3Chip`: in the Init-µP modes with its serial µP interface on MFP[7..0], whose
+pins :meth:`PinRing.set_input` holds or a software µP drives between runs, :class:`~supi3.spi.master.SoftMaster`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 import numpy.typing as npt
@@ -26,12 +29,37 @@ from supi3.checks import (
     check_trace,
     fail,
 )
+from supi3.config import DeviceConfig
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusError, TelegramError
 from supi3.interbus.ring import ErrorKind, Transfer
 from supi3.interbus.wire import Cycle, Frame, LineReset, Telegram
-from supi3.model.pins import Supi3Pins
+from supi3.model.pins import PinTrace, Supi3Pins
+from supi3.pinlevel import Pin
 from supi3.tables import BIT_RATES, CLOCK_HZ
+
+
+@runtime_checkable
+class PinChip(Protocol):
+    """A chip a :class:`PinRing` holds: :class:`~supi3.model.pins.Supi3Pins` or :class:`~supi3.top.Supi3Chip`. It
+    runs whole traces forward first (its logic does not depend on DI2) and then gives the return line."""
+
+    inputs: Sequence[Pin]
+    outputs: Sequence[Pin]
+
+    @property
+    def config(self) -> DeviceConfig:
+        """The pin straps (the ring reads the bit rate)."""
+
+    @property
+    def cycle(self) -> int:
+        """Clock cycles since reset."""
+
+    def run_forward(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]]) -> dict[str, PinTrace]:
+        """Every output but ``di1`` over the input traces (:meth:`Supi3Pins.run_forward`)."""
+
+    def return_line(self, di2: PinTrace, do2: PinTrace) -> PinTrace:
+        """``di1`` over the last :meth:`run_forward` (:meth:`Supi3Pins.return_line`)."""
 
 APPLICATION_INPUTS: dict[str, int] = {
     pin.name: pin.width for pin in Supi3Pins.inputs if pin.name not in ("do1", "di2")
@@ -97,7 +125,7 @@ class PinRing:
     Parameters
     ----------
     chips:
-        The pin-level chips in ring order (position 1 first). All must run at the same bit rate.
+        The pin-level chips (:data:`PinChip`) in ring order (position 1 first). All must run at the same bit rate.
     record:
         Keep every pin trace of every chip (for :meth:`recorded` and VCD files).
 
@@ -114,12 +142,12 @@ class PinRing:
         The clock cycle of ``returned[0]``.
     """
 
-    def __init__(self, chips: Sequence[Supi3Pins], record: bool = False) -> None:
+    def __init__(self, chips: Sequence[PinChip], record: bool = False) -> None:
         if isinstance(chips, (str, bytes)) or not isinstance(chips, Sequence) \
-                or not all(isinstance(chip, Supi3Pins) for chip in chips):
-            raise fail("chips", "a sequence of Supi3Pins", chips)
+                or not all(isinstance(chip, PinChip) for chip in chips):
+            raise fail("chips", "a sequence of Supi3Pins or Supi3Chip", chips)
         if len({id(chip) for chip in chips}) != len(chips):
-            raise fail("chips", "distinct Supi3Pins (one object per ring position)", chips)
+            raise fail("chips", "distinct Supi3Pins or Supi3Chip objects (one per ring position)", chips)
         check_bool("record", record)
         if not chips:
             raise InterbusError("docs/interbus.md, Ring", 0, "a ring needs at least one device")
@@ -167,7 +195,8 @@ class PinRing:
         """Clock the ring once per sample of the master's forward line.
 
         Every chip runs the whole trace forward (``do1`` from its upstream neighbour's ``do2``), then the
-        return line is assembled from the last chip back to the first (:meth:`Supi3Pins.return_line`).
+        return line is assembled from the last chip back to the first (:meth:`Supi3Pins.return_line`,
+        :meth:`Supi3Chip.return_line`).
         """
         forward = check_trace("samples", samples, 1).astype(np.int64, copy=False)
         n = len(forward)

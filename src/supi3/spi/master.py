@@ -18,11 +18,13 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Final
+from typing import Final, Protocol
 
 from vcd import VCDWriter
 
 from supi3 import tables
+from supi3.checks import check_int
+from supi3.model.registers import RegisterFile
 from supi3.model.vcd import CLOCK_PS
 from supi3.spi.slave_pins import INPUT_PINS, OUTPUT_PINS, PinsIn, PinsOut, SlavePins
 from supi3.spi.upif import Mode, UpifUsageError
@@ -31,6 +33,7 @@ from supi3.timing import limit
 __all__ = [
     "DecodedByte",
     "MasterTiming",
+    "PinPort",
     "SoftMaster",
     "SpiTrace",
     "decode_bytes",
@@ -153,13 +156,34 @@ class SpiTrace:
         return str(self.inputs[k].mfp7) if self.mode is Mode.INTEL else "z"
 
 
+class PinPort(Protocol):
+    """Pins :class:`SoftMaster` drives besides :class:`SlavePins`: the whole chip's, :class:`supi3.top.ChipPort`."""
+
+    @property
+    def registers(self) -> RegisterFile:
+        """The chip's register file."""
+
+    @property
+    def clock_hz(self) -> int:
+        """The chip clock."""
+
+    @property
+    def cycle(self) -> int:
+        """The chip's clock cycles since reset."""
+
+    def run(self, pins: PinsIn, cycles: int) -> list[PinsOut]:
+        """Hold the µP's ``pins`` for ``cycles`` cycles; the µP interface's outputs of each."""
+
+
 class SoftMaster:
-    """A software µP on the pins of :class:`SlavePins`, one chip clock at a time.
+    """A software µP on the pins of :class:`SlavePins` or of the whole chip (:class:`~supi3.top.Supi3Chip`
+    through a :class:`~supi3.top.ChipPort`), one chip clock at a time.
 
     Parameters
     ----------
     chip:
-        The pin-level model it drives.
+        The pin-level model it drives: :class:`SlavePins`, or a :class:`PinPort` such as ``ChipPort(Supi3Chip(...))``
+        (the whole chip's MFP pins; its other input pins held or fed by the port).
     mode:
         The µP's interface type (bit order: Intel LSB first, Motorola MSB first; UP-6).
     timing:
@@ -168,11 +192,13 @@ class SoftMaster:
         Keep every cycle's pins for :meth:`trace` (off for benchmarks).
     """
 
-    def __init__(self, chip: SlavePins, mode: Mode, timing: MasterTiming | None = None, *,
+    def __init__(self, chip: SlavePins | PinPort, mode: Mode, timing: MasterTiming | None = None, *,
                  record: bool = True) -> None:
         bit_rate = chip.registers.config.bit_rate
         self.chip = chip
+        """What the master drives: the interface's pins (:class:`SlavePins` or a :class:`PinPort`)."""
         self.mode = mode
+        self._last: PinsOut | None = None
         self.timing = timing or MasterTiming.fastest(bit_rate, clock_hz=chip.clock_hz)
         self._pins = PinsIn()
         self._mosi_oe = int(mode is Mode.MOTOROLA)
@@ -189,12 +215,60 @@ class SoftMaster:
         """Apply ``changes`` (pin names of :class:`PinsIn`) and hold the pins for ``cycles`` cycles; return the
         outputs of those cycles (the first is what the µP sees right at its edge)."""
         self._pins = replace(self._pins, **changes)
-        outputs = [self.chip.tick(self._pins) for _ in range(cycles)]
+        chip = self.chip
+        outputs = [chip.tick(self._pins) for _ in range(cycles)] if isinstance(chip, SlavePins) \
+            else chip.run(self._pins, cycles)
+        if outputs:
+            self._last = outputs[-1]
         if self._trace is not None:
             self._trace.inputs.extend([self._pins] * cycles)
             self._trace.outputs.extend(outputs)
             self._trace.mosi_oe.extend([self._mosi_oe] * cycles)
         return outputs
+
+    @property
+    def outputs(self) -> PinsOut:
+        """The chip's µP interface outputs in the last cycle run: C/D (MFP2), /IRQ (MFP3), the I/O bit (MFP1) and
+        the serial data outputs, with their enables, as the µP reads them now.
+
+        Raises
+        ------
+        UpifUsageError
+            No cycle ran yet.
+        """
+        if self._last is None:
+            raise UpifUsageError("no cycle ran yet: run() the master first")
+        return self._last
+
+    @property
+    def c_d(self) -> int:
+        """The C/D level (MFP2) in the last cycle: 0 = command or initialization byte next, 1 = data byte."""
+        return self.outputs.c_d
+
+    @property
+    def irq_n(self) -> int:
+        """The /IRQ level (MFP3) in the last cycle: 0 while an interrupt event is pending (3.4.14)."""
+        return self.outputs.irq_n
+
+    @property
+    def io(self) -> int:
+        """The I/O access bit (MFP1) in the last cycle: 1 while the data registers must not be accessed (3.4.14)."""
+        return self.outputs.io
+
+    def pulse_sas_init(self, cycles: int | None = None) -> None:
+        """SAS_INIT (MFP0) high for ``cycles`` clocks, default the shortest Table 3-7 allows (t_SAS_INIT), then low
+        again: the interface expects an initialization byte, the registers keep their values (3.4.3). /SS is
+        high meanwhile (a frame in progress ends).
+
+        Raises
+        ------
+        ArgumentError
+            ``cycles`` not an integer >= 1.
+        """
+        shortest = math.ceil(limit("3-7", "t_SAS_INIT", self.chip.registers.config.bit_rate) * self.chip.clock_hz
+                             - _EPSILON)
+        self.run(shortest if cycles is None else check_int("cycles", cycles, 1), ss_n=1, sas_init=1)
+        self.run(1, sas_init=0)
 
     def deselect(self, *, s_r: bool | None = None) -> None:
         """/SS high (it rises now if it was low) for the gap between bytes; in Intel mode S/R takes ``s_r`` in

@@ -361,6 +361,8 @@ class SlavePins:
         self._clear_frame()
         self._checker.reset()
         self._pipeline: deque[PinsOut] = deque([self._decode()] * (self.output_delay + 1))
+        self._resting: PinsOut | None = None
+        """Set by :meth:`hold` once the pipeline and MFP6's synchroniser settled on these decoded outputs."""
 
     def _clear_frame(self) -> None:
         self._bits = 0
@@ -380,6 +382,7 @@ class SlavePins:
         if type(pins) is not PinsIn:
             check_instance("pins", pins, PinsIn)
         out = self._pipeline[0]
+        self._resting = None
         with self.registers.violations.deferred():
             self._checker.check(self.cycle, pins, out, self.protocol.mode is Mode.INTEL)
             self._edge(pins, out)
@@ -400,6 +403,8 @@ class SlavePins:
         """
         if type(pins) is not PinsIn:
             check_instance("pins", pins, PinsIn)
+        if self._resting is not None and self._checker.last_pins is pins:
+            return True
         ss, sclk, sas, s_r = self._ss, self._sclk, self._sas, self._s_r
         return (not pins.sas_init and self._checker.last_pins == pins
                 and ss.s1 == ss.s2 == ss.s3 == pins.ss_n and sclk.s1 == sclk.s2 == sclk.s3 == pins.sclk
@@ -427,11 +432,18 @@ class SlavePins:
         TimingViolationError
             In strict mode, after the cycles completed (C/D settling late while /SS is low, t8).
         """
-        check_int("cycles", cycles, 1)
+        if type(cycles) is not int or cycles < 1:
+            check_int("cycles", cycles, 1)
+        resting, registers = self._resting, self.protocol.registers
+        if (resting is not None and self._checker.last_pins is pins and registers.io_access == resting.io
+                and registers.irq_n == resting.irq_n):  # the rest of _decode() moves only with tick()
+            self.cycle += cycles  # the pipeline and MFP6's synchroniser already hold what they would take
+            return [(0, resting)]
+        decoded = self._decode()
         if not self.settled(pins):
             raise UpifUsageError("hold() needs settled inputs: the synchronisers still move (SlavePins.settled)")
         pipeline = self._pipeline
-        line = [*pipeline, self._decode()]  # the outputs of cycles 0, 1, ...; the last one holds from then on
+        line = [*pipeline, decoded]  # the outputs of cycles 0, 1, ...; the last one holds from then on
         changes: list[tuple[int, PinsOut]] = []
         intel = self.protocol.mode is Mode.INTEL
         with self.registers.violations.deferred():
@@ -445,6 +457,8 @@ class SlavePins:
                 self._data.clock(out.mfp6 if out.mfp6_oe else pins.mfp6)
             self._pipeline = deque((line[:-1] + line[-1:] * min(cycles, len(pipeline)))[-len(pipeline):])
             self.cycle += cycles
+        # Once every stage shows the decoded outputs, holding on only counts cycles (until tick() or reset()).
+        self._resting = decoded if cycles >= len(pipeline) + 3 else None
         return changes
 
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
