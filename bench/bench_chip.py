@@ -5,7 +5,8 @@ One RB chip in an Init-µP mode (Motorola) is configured by a software µP (init
 IRQ_EN), then receives back-to-back data cycles of 1 data byte from the master while the µP does ``--accesses``
 register accesses (2 bytes each, at the fastest Table 3-7 timing; alternately a write of IN0 and a read of OUT0)
 per data cycle, its pins idle otherwise. The same traces run cycle by cycle (``step``) and as whole traces
-(``run``, event-driven); the outputs are identical (tests/test_top_run.py). Run from the repository root:
+(``run``, event-driven); the outputs are identical (tests/test_top_run.py). For scale, the INTERBUS core alone
+(``Supi3Pins.run``, bench/bench_model.py's kernel) runs the same traces too. Run from the repository root:
 
     python bench/bench_chip.py [--cycles N] [--accesses A] [--repeat R]
 """
@@ -22,7 +23,7 @@ import numpy.typing as npt
 from supi3.config import decode
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
-from supi3.model.pins import RESET_STRETCH_CLOCKS
+from supi3.model.pins import RESET_STRETCH_CLOCKS, Supi3Pins
 from supi3.model.registers import RegisterFile
 from supi3.regmap import ID, IN0, IRQ_EN, OUT0, SET, encode_command
 from supi3.spi.master import SoftMaster
@@ -75,15 +76,16 @@ def workload(bit_rate: int, cycles: int, accesses: int) -> dict[str, npt.NDArray
             "vmon_ok": ones}
 
 
-def measure(bit_rate: int, cycles: int, accesses: int, repeat: int) -> tuple[int, float, float, int]:
-    """(clock cycles, best step() seconds, best run() seconds, valid data cycles seen by the chip)."""
+def measure(bit_rate: int, cycles: int, accesses: int, repeat: int) -> tuple[int, float, float, float, int]:
+    """(clock cycles, best step() seconds, best run() seconds, best run() seconds of the core alone, valid data
+    cycles seen by the chip)."""
     config = decode("10011", "1110", clk_conf=clk_conf_for(bit_rate))
     inputs = workload(bit_rate, cycles, accesses)
     n = len(inputs["do1"])
     names = list(inputs)
     rows = [dict(zip(names, values, strict=True)) for values in zip(*(inputs[k].tolist() for k in names),
                                                                      strict=True)]
-    best_step = best_run = float("inf")
+    best_step = best_run = best_core = float("inf")
     valid = 0
     for _ in range(repeat):
         chip = Supi3Chip(config)
@@ -96,7 +98,11 @@ def measure(bit_rate: int, cycles: int, accesses: int, repeat: int) -> tuple[int
         chip.run(inputs)
         best_run = min(best_run, time.perf_counter() - begin)
         valid = chip.chip.events["VALID"]
-    return n, best_step, best_run, valid
+        core = Supi3Pins(config)
+        begin = time.perf_counter()
+        core.run(inputs)
+        best_core = min(best_core, time.perf_counter() - begin)
+    return n, best_step, best_run, best_core, valid
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -107,10 +113,11 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--repeat", type=int, default=3, help="runs; the fastest is reported")
     args = parser.parse_args(argv)
     for bit_rate in (500_000, 2_000_000):
-        n, step_s, run_s, valid = measure(bit_rate, args.cycles, args.accesses, args.repeat)
+        n, step_s, run_s, core_s, valid = measure(bit_rate, args.cycles, args.accesses, args.repeat)
         print(f"{bit_rate // 1000:>5} kbit/s, {n} clocks, {valid} valid data cycles: step() "
-              f"{n / step_s / 1e3:6.0f} k cycles/s, run() {n / run_s / 1e6:5.2f} M cycles/s, "
-              f"run/step = {step_s / run_s:.1f}")
+              f"{n / step_s / 1e3:4.0f} k cycles/s, run() {n / run_s / 1e6:5.2f} M cycles/s, "
+              f"run/step = {step_s / run_s:5.1f}, core alone run() {n / core_s / 1e6:5.2f} M cycles/s "
+              f"(whole chip / core = {core_s / run_s:.2f})")
     print(f"reproduce: python bench/bench_chip.py --cycles {args.cycles} --accesses {args.accesses} "
           f"--repeat {args.repeat}")
 

@@ -211,6 +211,8 @@ class Supi3Chip:
 
 
 _UP_INPUT_MASK: Final = sum(1 << pin for pin in UP_INPUTS.values())
+_SETTLE_CLOCKS: Final = 3
+"""Clock edges for a pin change to pass the µP interface's synchroniser and edge flop (s1, s2, s3)."""
 """The MFP pins the µP interface reads."""
 
 _LEVELS: dict[PinsOut, tuple[int, int]] = {}
@@ -246,29 +248,34 @@ class _CatchUp:
         t = self.done
         if t >= stop:
             return
-        chip, upif, core, changes, outputs = self.chip, self.upif, self.chip.core, self.changes, self.outputs
-        # The core's state is that after its last clock edge before ``stop``, for every cycle from ``t`` on.
-        in_reset = core.holding or core.run_from > self.c0 + t
+        chip, upif, changes, outputs, c0 = self.chip, self.upif, self.changes, self.outputs, self.c0
+        # The core's state is that after its last clock edge before ``stop``, for every cycle from ``t`` on: the µP
+        # interface is held in reset with the core (M2) while it holds or until its reset stretch ends.
+        core = chip.core
+        holding, run_from = core.holding, core.run_from
         while t < stop:
             while changes[self.k] <= t:
                 self.k += 1
             end = min(changes[self.k], stop)
             pins = chip._up_inputs(self.keys[t])
-            chip._up_cycle = self.c0 + t  # a violation names the cycle (UP-19)
-            if not in_reset and upif.settled(pins):
-                held = upif.hold(pins, end - t)
-                for i, out in held:
+            chip._up_cycle = c0 + t  # a violation names the cycle (UP-19)
+            if not holding and c0 + t >= run_from and upif.settled(pins):
+                for i, out in upif.hold(pins, end - t):
                     if out is not outputs[-1][1]:
                         outputs.append((t + i, out))
                 t = end
                 continue
-            # The core has already run its edge of cycle t if any: step the µP interface as step() does.
-            out = upif.tick(pins)
-            if in_reset or core.run_from > self.c0 + t:
-                upif.reset()
-            if out is not outputs[-1][1]:
-                outputs.append((t, out))
-            t += 1
+            # Clock by clock as step() does (the core has run its edge of each cycle already), until the
+            # synchronisers may have settled on the pins: 3 edges after a change (s1, s2, s3).
+            settle = min(end, t + _SETTLE_CLOCKS)
+            while t < settle:
+                chip._up_cycle = c0 + t
+                out = upif.tick(pins)
+                if holding or c0 + t < run_from:
+                    upif.reset()
+                if out is not outputs[-1][1]:
+                    outputs.append((t, out))
+                t += 1
         self.done = t
 
     def render(self) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
