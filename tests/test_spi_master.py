@@ -15,7 +15,7 @@ from supi3.spi.master import SoftMaster
 from supi3.spi.slave_pins import TimingViolationError
 from supi3.spi.upif import C_D_COMMAND, C_D_DATA, Mode, Phase
 from supi3.tables import BIT_RATES, clk_conf_for
-from supi3.top import ChipPort, Supi3Chip
+from supi3.top import QUIET_BOARD, ChipPort, Supi3Chip, up_input_levels
 from support import IDLE, data_frame, id_frame
 
 VALID_BIT = 0x10  # IRQ_EN/IRQ_EVT bit of the valid-data-cycle event (Table 3-13)
@@ -141,3 +141,32 @@ def test_port_holds_the_other_pins_and_names_bad_ones() -> None:
         ChipPort(chip, resu_n=2)
     with pytest.raises(ValueError, match="no serial µP interface"):
         ChipPort(Supi3Chip(decode("10000", clk_conf="11")))
+
+
+@pytest.mark.parametrize("mode", list(Mode))
+def test_port_feeds_the_line_while_the_up_works_as_step_would(mode: Mode) -> None:
+    # The port steps short holds and runs long ones; either way the chip sees what step() would give it.
+    config = decode("10011", "1110", clk_conf="11")
+    port = ChipPort(Supi3Chip(config, strict=False))
+    master = SoftMaster(port, mode)  # recording: every cycle's µP pins
+    master.run(2 * RESET_STRETCH_CLOCKS)
+    samples = wire.levels_to_samples(np.concatenate([IDLE, wire.reset_levels(1), IDLE, id_frame(wire.command_word()),
+                                                     IDLE, data_frame(b"\x5a"), IDLE]), 2_000_000)
+    port.feed(samples)
+    master.byte(mode.init_byte)
+    write(master, SET, 0x82)
+    write(master, ID, 0x01)
+    master.run(port.queued + 100)
+    assert port.queued == 0
+    reference = Supi3Chip(config, strict=False)
+    pins = master.trace().inputs
+    do1 = [*samples.tolist(), *[1] * (len(pins) - len(samples) - 2 * RESET_STRETCH_CLOCKS)]
+    do1 = [1] * 2 * RESET_STRETCH_CLOCKS + do1
+    for level, up in zip(do1, pins, strict=True):
+        last = reference.step({**QUIET_BOARD, "do1": level, "mfp_in": up_input_levels(up)})
+    assert last == port.last
+    assert port.chip.chip.events == reference.chip.events
+    assert port.registers.value("OUT0") == 0x5A
+    assert reference.upif is not None
+    assert [str(v) for v in port.registers.violations.records] == [
+        str(v) for v in reference.upif.registers.violations.records]  # fmt: skip

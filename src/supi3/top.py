@@ -294,6 +294,11 @@ QUIET_BOARD: Final[dict[str, int]] = {"do1": 1, "di2": 0, "rbst_ext": 0, "mfp_in
 following, no /StatErr, /ResU released, power good; MFP pins low."""
 
 
+STEP_BELOW: Final = 64
+""":meth:`ChipPort.run` steps holds shorter than this cycle by cycle: a :meth:`Supi3Chip.run` call costs about as much
+as this many :meth:`Supi3Chip.step` calls (both give the same outputs)."""
+
+
 class ChipPort:
     """The serial µP interface's pins on the whole chip (:class:`~supi3.top.Supi3Chip` in an Init-µP mode): what
     :class:`~supi3.spi.master.SoftMaster` drives (``SoftMaster(ChipPort(chip), mode)``).
@@ -301,7 +306,8 @@ class ChipPort:
     The µP's pins go to MFP0 (SAS_INIT), MFP4 (SCLK), MFP5 (/SS), MFP6 (SerIN or Ser_IN/OUT) and MFP7 (S/R in
     Intel mode), Tables 3-5 and 3-6; every other input pin holds its level in :attr:`inputs` (MFP bits outside
     MFP[7..0] included), except the forward line ``do1``, which takes the samples queued by :meth:`feed` while there
-    are any. Each :meth:`run` is one event-driven :meth:`Supi3Chip.run`.
+    are any. Each :meth:`run` is one event-driven :meth:`Supi3Chip.run`, or :meth:`Supi3Chip.step` per cycle for a hold
+shorter than :data:`STEP_BELOW` cycles.
 
     Parameters
     ----------
@@ -385,16 +391,26 @@ class ChipPort:
         check_int("cycles", cycles, 0)
         if not cycles:
             return []
-        traces = {name: np.full(cycles, level, dtype=np.int64) for name, level in self.inputs.items()}
-        traces["mfp_in"][:] = (self.inputs["mfp_in"] & ~UP_PINS) | up_input_levels(pins)
-        fed = min(cycles, len(self._line))
-        if fed:
-            traces["do1"][:fed] = [self._line.popleft() for _ in range(fed)]
-        out = self.chip.run(traces)
-        self.last = {name: int(trace[-1]) for name, trace in out.items()}
+        mfp = (self.inputs["mfp_in"] & ~UP_PINS) | up_input_levels(pins)
+        line = [self._line.popleft() for _ in range(min(cycles, len(self._line)))]
+        if cycles < STEP_BELOW:
+            row = {**self.inputs, "mfp_in": mfp}
+            rows = []
+            for t in range(cycles):
+                row["do1"] = line[t] if t < len(line) else self.inputs["do1"]
+                rows.append(self.chip.step(row))
+            self.last = rows[-1]
+            levels = [(out["mfp_out"], out["mfp_oe"]) for out in rows]
+        else:
+            traces = {name: np.full(cycles, level, dtype=np.int64) for name, level in self.inputs.items()}
+            traces["mfp_in"][:] = mfp
+            traces["do1"][: len(line)] = line
+            outs = self.chip.run(traces)
+            self.last = {name: int(trace[-1]) for name, trace in outs.items()}
+            levels = list(zip(outs["mfp_out"].tolist(), outs["mfp_oe"].tolist(), strict=True))
         cache = self._outputs
         result = []
-        for key in zip(out["mfp_out"].tolist(), out["mfp_oe"].tolist(), strict=True):
+        for key in levels:
             up = cache.get(key)
             if up is None:
                 up = cache[key] = up_outputs_of(*key)
