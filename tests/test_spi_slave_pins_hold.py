@@ -13,7 +13,7 @@ from supi3.config import decode
 from supi3.errors import ArgumentError
 from supi3.model.registers import RegisterFile
 from supi3.spi.master import SoftMaster
-from supi3.spi.slave_pins import PinsIn, PinsOut, SlavePins
+from supi3.spi.slave_pins import QUIET_FOREVER, PinsIn, PinsOut, SlavePins
 from supi3.spi.upif import Mode, UpifUsageError
 from supi3.tables import clk_conf_for
 
@@ -56,9 +56,10 @@ def test_hold_is_ticks(bit_rate: int, mode: Mode, values: list[int], noise: list
         pins = interned.setdefault(fresh, fresh)
         expected = [ticked.tick(pins) for _ in range(cycles)]
         got: list[PinsOut] = []
-        while len(got) < cycles:  # tick until settled, then hold the rest in chunks
-            if held.settled(pins):
-                n = min(chunks[(k + len(got)) % len(chunks)], cycles - len(got))
+        while len(got) < cycles:  # hold in chunks where the edges are quiet, tick where one acts
+            quiet = held.quiet(pins)
+            if quiet:
+                n = min(chunks[(k + len(got)) % len(chunks)], cycles - len(got), quiet)
                 got += expand(held.hold(pins, n), n)
             else:
                 got.append(held.tick(pins))
@@ -71,16 +72,20 @@ def test_hold_is_ticks(bit_rate: int, mode: Mode, values: list[int], noise: list
         assert held.tick(pins) == ticked.tick(pins)
 
 
-def test_hold_refuses_what_it_cannot_skip() -> None:
+def test_quiet_counts_the_edges_before_one_acts_and_hold_refuses_more() -> None:
     upif = interface(2_000_000)
-    assert upif.settled(PinsIn())  # after reset: idle levels everywhere
-    moving = PinsIn(ss_n=0)
-    assert not upif.settled(moving)
-    with pytest.raises(UpifUsageError, match="settled"):
-        upif.hold(moving, 5)
+    assert upif.quiet(PinsIn()) == QUIET_FOREVER  # after reset: idle levels everywhere
+    selected = PinsIn(ss_n=0)
+    assert upif.quiet(selected) == 2  # /SS low passes s1 and s2; the third edge sees the fall (s2 != s3)
+    with pytest.raises(UpifUsageError, match=r"SlavePins\.quiet"):
+        upif.hold(selected, 3)
+    assert upif.quiet(PinsIn(sas_init=1)) == 2  # SAS_INIT acts once it reaches s2 (3.4.3)
     with pytest.raises(ArgumentError, match="cycles"):
         upif.hold(PinsIn(), 0)
     with pytest.raises(ArgumentError, match="pins"):
-        upif.settled("idle")  # type: ignore[arg-type]
-    assert not upif.settled(PinsIn(sas_init=1))  # SAS_INIT high acts at every edge (3.4.3)
+        upif.quiet("idle")  # type: ignore[arg-type]
     assert upif.cycle == 0
+    upif.hold(selected, 2)
+    assert upif.quiet(selected) == 0 and not upif.protocol.in_frame
+    upif.tick(selected)
+    assert upif.protocol.in_frame and upif.quiet(selected) == QUIET_FOREVER

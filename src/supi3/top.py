@@ -211,10 +211,6 @@ class Supi3Chip:
 
 
 _UP_INPUT_MASK: Final = sum(1 << pin for pin in UP_INPUTS.values())
-_SETTLE_CLOCKS: Final = 3
-"""Clock edges for a pin change to pass the µP interface's synchroniser and edge flop (s1, s2, s3)."""
-"""The MFP pins the µP interface reads."""
-
 _LEVELS: dict[PinsOut, tuple[int, int]] = {}
 """:func:`up_pin_outputs` of every µP interface output combination seen (at most 2**10)."""
 
@@ -259,23 +255,21 @@ class _CatchUp:
             end = min(changes[self.k], stop)
             pins = chip._up_inputs(self.keys[t])
             chip._up_cycle = c0 + t  # a violation names the cycle (UP-19)
-            if not holding and c0 + t >= run_from and upif.settled(pins):
-                for i, out in upif.hold(pins, end - t):
+            quiet = 0 if holding or c0 + t < run_from else upif.quiet(pins)
+            if quiet:
+                held = min(end - t, quiet)
+                for i, out in upif.hold(pins, held):
                     if out is not outputs[-1][1]:
                         outputs.append((t + i, out))
-                t = end
+                t += held
                 continue
-            # Clock by clock as step() does (the core has run its edge of each cycle already), until the
-            # synchronisers may have settled on the pins: 3 edges after a change (s1, s2, s3).
-            settle = min(end, t + _SETTLE_CLOCKS)
-            while t < settle:
-                chip._up_cycle = c0 + t
-                out = upif.tick(pins)
-                if holding or c0 + t < run_from:
-                    upif.reset()
-                if out is not outputs[-1][1]:
-                    outputs.append((t, out))
-                t += 1
+            # The core has run its edge of cycle t already: the µP interface's edge acts, clock it as step() does.
+            out = upif.tick(pins)
+            if holding or c0 + t < run_from:
+                upif.reset()
+            if out is not outputs[-1][1]:
+                outputs.append((t, out))
+            t += 1
         self.done = t
 
     def render(self) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:

@@ -18,6 +18,7 @@ require.
 from __future__ import annotations
 
 import math
+import sys
 from collections import deque
 from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, fields
@@ -34,6 +35,7 @@ __all__ = [
     "C_D_SETTLES_WITHIN",
     "INPUT_PINS",
     "OUTPUT_PINS",
+    "QUIET_FOREVER",
     "PinsIn",
     "PinsOut",
     "SlavePins",
@@ -153,6 +155,15 @@ class _Sync:
 
     def clock(self, pin: int) -> None:
         self.s1, self.s2, self.s3 = pin, self.s1, self.s2
+
+    def hold(self, pin: int, edges: int) -> None:
+        """``edges`` clock edges with ``pin`` held."""
+        if edges >= 3:
+            self.s1 = self.s2 = self.s3 = pin
+        elif edges == 2:
+            self.s1, self.s2, self.s3 = pin, pin, self.s1
+        elif edges == 1:
+            self.clock(pin)
 
 
 C_D_SETTLES_WITHIN: Final[str] = "t6"
@@ -292,6 +303,9 @@ class TimingChecker:
             self._require("t_SAS_INIT", cycle, self._sas_rise)
 
 
+QUIET_FOREVER: Final[int] = sys.maxsize
+""":meth:`SlavePins.quiet` when no clock edge will act as long as the inputs hold."""
+
 _DECODED: dict[tuple[int, ...], PinsOut] = {}
 """Every output combination :meth:`SlavePins._decode` has produced (PinsOut field order)."""
 
@@ -391,10 +405,11 @@ class SlavePins:
             self.cycle += 1
         return out
 
-    def settled(self, pins: PinsIn) -> bool:
-        """Whether holding ``pins`` leaves nothing for the clock edges to do but clock the synchronisers and the
-        output pipeline: SAS_INIT low, the /SS, SCLK, SAS_INIT and MFP7 synchronisers all three stages at their
-        pin's level (no edge pending) and ``pins`` the inputs of the last cycle (see :meth:`hold`).
+    def quiet(self, pins: PinsIn) -> int:
+        """How many cycles from this one :meth:`hold` may run with ``pins`` held: those whose clock edge detects
+        nothing (no /SS or SCLK edge between the second and third flop of its synchroniser, SAS_INIT's second flop
+        low), :data:`QUIET_FOREVER` once the synchronisers hold ``pins`` and SAS_INIT is low, 0 if this cycle's
+        edge acts (:meth:`tick` it).
 
         Raises
         ------
@@ -404,19 +419,25 @@ class SlavePins:
         if type(pins) is not PinsIn:
             check_instance("pins", pins, PinsIn)
         if self._resting is not None and self._checker.last_pins is pins:
-            return True
-        ss, sclk, sas, s_r = self._ss, self._sclk, self._sas, self._s_r
-        return (not pins.sas_init and self._checker.last_pins == pins
-                and ss.s1 == ss.s2 == ss.s3 == pins.ss_n and sclk.s1 == sclk.s2 == sclk.s3 == pins.sclk
-                and sas.s1 == sas.s2 == sas.s3 == 0 and s_r.s1 == s_r.s2 == s_r.s3 == pins.mfp7)
+            return QUIET_FOREVER
+        ss, sclk, sas = self._ss, self._sclk, self._sas
+        # The edge j cycles from now sees s2 = (s2, s1, pin, pin, ...) and s3 = (s3, s2, s1, pin, ...).
+        for j, (ss2, ss3, sclk2, sclk3, sas2) in enumerate((
+                (ss.s2, ss.s3, sclk.s2, sclk.s3, sas.s2), (ss.s1, ss.s2, sclk.s1, sclk.s2, sas.s1),
+                (pins.ss_n, ss.s1, pins.sclk, sclk.s1, pins.sas_init))):  # fmt: skip
+            if ss2 != ss3 or sclk2 != sclk3 or sas2:
+                return j
+        return QUIET_FOREVER
 
     def hold(self, pins: PinsIn, cycles: int) -> list[tuple[int, PinsOut]]:
         """Run ``cycles`` cycles with ``pins`` held, while the register file does not change: the same as
         ``cycles`` calls of :meth:`tick` (the same outputs, checks and state), at a cost independent of ``cycles``.
 
         The event-driven whole chip (:meth:`supi3.top.Supi3Chip.run`) uses it between the cycles where the core
-        changes the register file. ``pins`` must be :meth:`settled`: then no edge is detected, so the state after
-        each clock edge decodes to the same outputs, which leave the pipeline ``output_delay`` + 1 cycles later.
+        changes the register file. ``cycles`` must not exceed :meth:`quiet`: then no clock edge detects anything,
+        the synchronisers only shift ``pins`` in, and the state after each edge decodes to the same outputs, which
+        leave the pipeline ``output_delay`` + 1 cycles later. The timing checker sees ``pins`` in the first cycle,
+        as :meth:`tick` would, and afterwards only where an output changes (elsewhere it sees the same pins and C/D).
 
         Returns
         -------
@@ -428,20 +449,22 @@ class SlavePins:
         ArgumentError
             ``pins`` not a :class:`PinsIn` or ``cycles`` not an integer >= 1 (nothing changes).
         UpifUsageError
-            ``pins`` not :meth:`settled` (nothing changes).
+            ``cycles`` more than :meth:`quiet` (nothing changes).
         TimingViolationError
-            In strict mode, after the cycles completed (C/D settling late while /SS is low, t8).
+            In strict mode, after the cycles completed.
         """
         if type(cycles) is not int or cycles < 1:
             check_int("cycles", cycles, 1)
         resting, registers = self._resting, self.protocol.registers
         if (resting is not None and self._checker.last_pins is pins and registers.io_access == resting.io
                 and registers.irq_n == resting.irq_n):  # the rest of _decode() moves only with tick()
-            self.cycle += cycles  # the pipeline and MFP6's synchroniser already hold what they would take
+            self.cycle += cycles  # the pipeline and the synchronisers already hold what they would take
             return [(0, resting)]
+        quiet = self.quiet(pins)
+        if cycles > quiet:
+            raise UpifUsageError(f"hold() of {cycles} cycles: the clock edge {quiet} cycles from now acts "
+                                 "(SlavePins.quiet); tick() it")
         decoded = self._decode()
-        if not self.settled(pins):
-            raise UpifUsageError("hold() needs settled inputs: the synchronisers still move (SlavePins.settled)")
         pipeline = self._pipeline
         line = [*pipeline, decoded]  # the outputs of cycles 0, 1, ...; the last one holds from then on
         changes: list[tuple[int, PinsOut]] = []
@@ -449,9 +472,12 @@ class SlavePins:
         with self.registers.violations.deferred():
             for i, out in enumerate(line[:cycles]):
                 if not changes or out is not changes[-1][1]:
-                    # The checker acts only where an output changes: elsewhere it sees the same pins and C/D.
                     self._checker.check(self.cycle + i, pins, out, intel)
                     changes.append((i, out))
+            self._ss.hold(pins.ss_n, cycles)
+            self._sclk.hold(pins.sclk, cycles)
+            self._sas.hold(pins.sas_init, cycles)
+            self._s_r.hold(pins.mfp7, cycles)
             for i in range(max(cycles - 3, 0), cycles):  # MFP6's synchroniser takes the pad, driven or not
                 out = line[min(i, len(pipeline))]
                 self._data.clock(out.mfp6 if out.mfp6_oe else pins.mfp6)
