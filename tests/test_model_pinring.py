@@ -12,20 +12,18 @@ from supi3.model.pinring import PinChip, PinRing
 from supi3.model.pins import RESET_STRETCH_CLOCKS, Supi3Pins
 from supi3.regmap import ID, IN0, IN1, OUT0, OUT1, SET, Register, encode_command
 from supi3.spi.master import SoftMaster
-from supi3.spi.slave_pins import PinsIn
 from supi3.spi.upif import Mode
-from supi3.top import ChipPort, Supi3Chip, up_input_levels
+from supi3.top import UP_REST, ChipPort, Supi3Chip
 
 ONE_BYTE = SET.encode(PCP_N=1, CL=SET.field("CL").value("LEN_1_BYTE").value)  # 82h, as in 3.4.5 (Table 3-12)
 ONE_WORD = SET.encode(PCP_N=1, CL=SET.field("CL").value("LEN_1_WORD").value)
-IDLE_UP = up_input_levels(PinsIn())  # the µP's pins at rest: SCLK and /SS high, MFP7 high (UP-5)
 
 
 class Firmware:
     """One chip's µP on its MFP pins (strict: any Table 3-7 or protocol violation raises)."""
 
     def __init__(self, chip: Supi3Chip, mode: Mode) -> None:
-        self.master = SoftMaster(ChipPort(chip, mfp_in=IDLE_UP), mode, record=False)
+        self.master = SoftMaster(ChipPort(chip, mfp_in=UP_REST), mode, record=False)
         self.master.run(2 * RESET_STRETCH_CLOCKS)
         self.master.byte(mode.init_byte)
 
@@ -51,7 +49,7 @@ def test_master_exchanges_process_data_with_each_chips_firmware(modes: tuple[Mod
         fw.write(ID, id_code)
     ring = PinRing(chips)
     for position in (1, 2):
-        ring.set_input(position, "mfp_in", IDLE_UP)  # the µP rests while the ring runs
+        ring.set_input(position, "mfp_in", UP_REST)  # the µP rests while the ring runs
     master = Master(ring, locate=False, max_devices=4)
     assert master.start().ok
     assert [(master.entry(k).id_code, master.entry(k).data_bytes) for k in (1, 2)] == [(0x01, 1), (0x03, 2)]
@@ -80,7 +78,7 @@ def test_ring_takes_cores_and_whole_chips() -> None:
     fw.write(SET, ONE_BYTE)
     fw.write(ID, 0x01)
     ring = PinRing([core, chip])
-    ring.set_input(2, "mfp_in", IDLE_UP)
+    ring.set_input(2, "mfp_in", UP_REST)
     ring.idle(0.0002)  # the core's power-up reset stretch
     master = Master(ring, locate=False, max_devices=4)
     assert master.start().ok

@@ -19,7 +19,7 @@ from supi3.spi.master import SoftMaster
 from supi3.spi.slave_pins import PinsIn, SlavePins
 from supi3.spi.upif import Mode
 from supi3.tables import clk_conf_for
-from supi3.top import UP_INPUTS, Supi3Chip
+from supi3.top import QUIET_BOARD, UP_INPUTS, UP_PINS, Supi3Chip
 from support import CORE_INPUTS, IDLE, data_frame, id_frame, register_address
 
 Traces = dict[str, npt.NDArray[np.int64]]
@@ -144,3 +144,12 @@ def test_run_agrees_with_step_on_a_firmware_session(mode: Mode) -> None:
         assert np.array_equal(trace, got[name]), name
     assert state(by_run) == state(by_step)
     assert by_run.chip.events["VALID"] == 2
+
+
+def test_empty_run_changes_nothing_and_quiet_board_is_quiet() -> None:
+    chip = Supi3Chip(decode("10011", "1110", clk_conf="11"))
+    empty = chip.run({name: np.zeros(0, dtype=np.int64) for name in CORE_INPUTS})
+    assert all(len(trace) == 0 for trace in empty.values()) and chip.cycle == 0
+    quiet = chip.run({name: np.full(400, level, dtype=np.int64) for name, level in QUIET_BOARD.items()})
+    assert quiet["resu_drive"][-1] == 0 and quiet["mfp_oe"][-1] & UP_PINS == 0b1110  # I/O, C/D, /IRQ driven
+    assert chip.upif is not None and not chip.upif.registers.violations.records

@@ -232,10 +232,12 @@ class _CatchUp:
         self.chip = chip
         self.upif = upif
         self.c0 = chip.core.cycle
+        self.n = len(mfp)
         keys = np.asarray(mfp, dtype=np.int64) & _UP_INPUT_MASK
-        self.keys = keys.tolist()
-        # Where the µP interface's pins change, and the end: the pieces in which they hold.
-        self.changes = [*(np.flatnonzero(keys[1:] != keys[:-1]) + 1).tolist(), len(keys)]
+        # The pieces in which the µP interface's pins hold: where each ends, and its pins.
+        starts = np.flatnonzero(np.diff(keys, prepend=-1))
+        self.ends = [*starts[1:].tolist(), len(keys)]
+        self.pins = [chip._up_inputs(key) for key in keys[starts].tolist()]
         self.k = 0
         self.done = 0
         self.outputs: list[tuple[int, PinsOut | None]] = [(0, None)]  # then the output of cycle 0 and each change
@@ -244,20 +246,20 @@ class _CatchUp:
         t = self.done
         if t >= stop:
             return
-        chip, upif, changes, outputs, c0 = self.chip, self.upif, self.changes, self.outputs, self.c0
+        chip, upif, ends, outputs, c0, k = self.chip, self.upif, self.ends, self.outputs, self.c0, self.k
         # The core's state is that after its last clock edge before ``stop``, for every cycle from ``t`` on: the µP
         # interface is held in reset with the core (M2) while it holds or until its reset stretch ends.
         core = chip.core
         holding, run_from = core.holding, core.run_from
         while t < stop:
-            while changes[self.k] <= t:
-                self.k += 1
-            end = min(changes[self.k], stop)
-            pins = chip._up_inputs(self.keys[t])
+            while ends[k] <= t:
+                k += 1
+            end = ends[k] if ends[k] < stop else stop
+            pins = self.pins[k]
             chip._up_cycle = c0 + t  # a violation names the cycle (UP-19)
             quiet = 0 if holding or c0 + t < run_from else upif.quiet(pins)
             if quiet:
-                held = min(end - t, quiet)
+                held = end - t if end - t < quiet else quiet
                 for i, out in upif.hold(pins, held):
                     if out is not outputs[-1][1]:
                         outputs.append((t + i, out))
@@ -270,11 +272,11 @@ class _CatchUp:
             if out is not outputs[-1][1]:
                 outputs.append((t, out))
             t += 1
-        self.done = t
+        self.done, self.k = t, k
 
     def render(self) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
         """The µP interface's MFP levels and output enables over the run."""
-        n = len(self.keys)
+        n = self.n
         outputs = self.outputs[1:]
         starts = np.array([t for t, _ in outputs] + [n], dtype=np.int64)
         table = np.array([_up_levels(out) for _, out in outputs if out is not None], dtype=np.int64).reshape(-1, 2)
@@ -282,10 +284,14 @@ class _CatchUp:
         return np.repeat(table[:, 0], lengths), np.repeat(table[:, 1], lengths)
 
 
-QUIET_BOARD: Final[dict[str, int]] = {"do1": 1, "di2": 0, "rbst_ext": 0, "mfp_in": 0, "stat_err_n": 1, "resu_n": 1,
-                                      "vmon_ok": 1}  # fmt: skip
+UP_REST: Final = up_input_levels(PinsIn())
+"""MFP[7..0] with the µP's pins at rest: SCLK and /SS high, MFP7 high, SAS_INIT and MFP6 low (:class:`PinsIn`)."""
+
+QUIET_BOARD: Final[dict[str, int]] = {"do1": 1, "di2": 0, "rbst_ext": 0, "mfp_in": UP_REST, "stat_err_n": 1,
+                                      "resu_n": 1, "vmon_ok": 1}  # fmt: skip
 """The whole chip's inputs on a quiet board: the INTERBUS forward line idle (high, docs/interbus.md), no device
-following, no /StatErr, /ResU released, power good; MFP pins low."""
+following, no /StatErr, /ResU released, power good; the µP's pins at rest (:data:`UP_REST`), the other MFP pins
+low."""
 
 
 STEP_BELOW: Final = 64

@@ -7,7 +7,8 @@ on either fidelity. Here every bit of every telegram really travels: the master'
 each chip (forward line ``do1 -> do2``, return line ``di2 -> di1``), and the return line is received by a UART-style
 receiver that resynchronises on every start edge. A chip is the core alone (:class:`~supi3.model.pins.Supi3Pins`) or
 the whole chip (:class:`~supi3.top.Supi3Chip`: in the Init-µP modes with its serial µP interface on MFP[7..0], whose
-pins :meth:`PinRing.set_input` holds or a software µP drives between runs, :class:`~supi3.spi.master.SoftMaster`).
+pins :meth:`PinRing.set_input` holds (``mfp_in`` is 0 by default: give such a chip its µP's pins at rest,
+``supi3.top.UP_REST``) or a software µP drives between runs, :class:`~supi3.spi.master.SoftMaster`).
 """
 
 from __future__ import annotations
