@@ -16,7 +16,7 @@ from supi3.interbus import wire
 from supi3.model.registers import RegisterFile
 from supi3.regmap import ID, IN0, IRQ_EN, IRQ_EVT, OUT0, REGISTER_MAP, SET, encode_command
 from supi3.spi.master import SoftMaster
-from supi3.spi.slave_pins import PinsIn, SlavePins
+from supi3.spi.slave_pins import PinsIn, SlavePins, TimingViolationError
 from supi3.spi.upif import Mode
 from supi3.tables import clk_conf_for
 from supi3.top import QUIET_BOARD, UP_INPUTS, UP_PINS, Supi3Chip
@@ -153,3 +153,21 @@ def test_empty_run_changes_nothing_and_quiet_board_is_quiet() -> None:
     quiet = chip.run({name: np.full(400, level, dtype=np.int64) for name, level in QUIET_BOARD.items()})
     assert quiet["resu_drive"][-1] == 0 and quiet["mfp_oe"][-1] & UP_PINS == 0b1110  # I/O, C/D, /IRQ driven
     assert chip.upif is not None and not chip.upif.registers.violations.records
+
+
+def test_strict_run_raises_the_violation_step_raises_once_every_cycle_ran() -> None:
+    # /SS falls and SCLK falls in the same cycle: t1 (Table 3-7) is violated at that cycle.
+    config = decode("10011", "1110", clk_conf="11")
+    n, at = 600, 400
+    inputs = {name: np.full(n, level, dtype=np.int64) for name, level in QUIET_BOARD.items()}
+    ss_n, sclk = 1 << UP_INPUTS["ss_n"], 1 << UP_INPUTS["sclk"]
+    inputs["mfp_in"][at:] &= ~(ss_n | sclk)
+    by_step, by_run = Supi3Chip(config), Supi3Chip(config)
+    for t in range(at):
+        by_step.step({name: int(trace[t]) for name, trace in inputs.items()})
+    with pytest.raises(TimingViolationError) as stepped_error:
+        by_step.step({name: int(trace[at]) for name, trace in inputs.items()})
+    with pytest.raises(TimingViolationError) as run_error:
+        by_run.run(inputs)
+    assert str(run_error.value) == str(stepped_error.value)  # the same cycle of the interface's clock
+    assert by_run.cycle == n and by_step.cycle == at + 1  # step() stops after its cycle, run() after all
