@@ -359,6 +359,9 @@ def toolchain_missing() -> str | None:
         return str(error)
     if importlib.util.find_spec("setuptools") is None:
         return "setuptools is not installed: cffi compiles C firmware with it (pip install setuptools)"
+    headers = Path(sysconfig.get_paths()["include"]) / "Python.h"
+    if not headers.is_file():
+        return f"the Python headers are missing ({headers}): cffi's glue needs them (apt install python3-dev)"
     return None
 
 
