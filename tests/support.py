@@ -294,6 +294,10 @@ class ChipPins:
     def cycle(self) -> int:
         return len(self.rows)
 
+    def run(self, up: PinsIn, cycles: int) -> list[PinsOut]:
+        """Hold the µP's pins for ``cycles`` cycles (the :class:`~supi3.spi.master.PinPort` of :class:`SoftMaster`)."""
+        return [self.tick(up) for _ in range(cycles)]
+
     def tick(self, up: PinsIn) -> PinsOut:
         mfp = sum(getattr(up, name) << bit for name, bit in UP_INPUTS.items())
         out = self.step(mfp_in=self.upper | mfp)
@@ -333,7 +337,7 @@ class Firmware:
 
     def __init__(self, pins: ChipPins, mode: Mode) -> None:
         self.pins = pins
-        self.master = SoftMaster(pins, mode, record=False)  # type: ignore[arg-type]
+        self.master = SoftMaster(pins, mode, record=False)
         self.mode = mode
         self.master.run(8)
 
