@@ -19,7 +19,21 @@ from hypothesis import strategies as st
 from supi3 import sdk
 from supi3.config import decode
 from supi3.model.registers import ReconfigurationError, RegisterFile
-from supi3.regmap import ALARM, ID, IN0, IN1, IRQ_EN, IRQ_EVT, OUT0, OUT1, PCMD, SET, Register
+from supi3.regmap import (
+    ALARM,
+    ID,
+    IN0,
+    IN1,
+    IRQ_EN,
+    IRQ_EVT,
+    OUT0,
+    OUT1,
+    PCMD,
+    REGISTER_MAP,
+    SET,
+    AccessDirection,
+    Register,
+)
 from supi3.sdk.driver import (
     ERROR_CODES,
     AsyncSupi3Driver,
@@ -496,3 +510,48 @@ def test_registers_are_named_objects() -> None:
     drv, _ = driver()
     assert isinstance(OUT0, Register)
     assert drv.read(IRQ_EVT) & 0x80 == 0
+
+
+# ------------------------------------------------------------------------------------------------------------
+# The model's shortcut for whole accesses has exactly the effect of the frames
+# ------------------------------------------------------------------------------------------------------------
+
+READABLE = [r for r in REGISTER_MAP.registers if any(r is REGISTER_MAP.port(r.address, d).register
+                                                   for d in [AccessDirection.READ])]  # fmt: skip
+WRITABLE = [r for r in REGISTER_MAP.registers if r is REGISTER_MAP.port(r.address, AccessDirection.WRITE).register]
+OPS = st.one_of(
+    st.tuples(st.just("read"), st.sampled_from(READABLE), st.just(0)),
+    st.tuples(st.just("write"), st.sampled_from(WRITABLE), st.integers(0, 255)),
+    st.tuples(st.sampled_from(["sas", "init", "raw", "latch", "running"]), st.just(IN0), st.integers(0, 255)),
+)
+
+
+def apply_op(drv: Supi3Driver, t: ModelTransport, mode: Mode, name: str, register: Register, value: int) -> object:
+    calls: dict[str, Callable[[], object]] = {
+        "read": lambda: drv.read(register), "write": lambda: drv.write(register, value), "sas": drv.sas_init,
+        "init": lambda: drv.initialize(mode),
+        "raw": lambda: t.xfer(value, True),  # a stray byte: the chip may now wait for a data byte
+        "latch": lambda: t.registers.latch(bytes(t.registers.data_bytes())),
+        "running": lambda: t.registers.set_bus_running(bool(value & 1)),
+    }  # fmt: skip
+    return calls[name]()
+
+
+@given(mode=st.sampled_from(list(Mode)), strict=st.booleans(), pedantic=st.booleans(),
+       ops=st.lists(OPS, max_size=25))  # fmt: skip
+def test_the_direct_path_has_the_effect_of_the_frames(mode: Mode, strict: bool, pedantic: bool,
+                                                      ops: list[tuple[str, Register, int]]) -> None:  # fmt: skip
+    fast_t = ModelTransport(RegisterFile(decode("10011", "1110"), strict=strict, pedantic=pedantic))
+    slow_t = Recording(RegisterFile(decode("10011", "1110"), strict=strict, pedantic=pedantic))
+    assert fast_t.direct() is not None and slow_t.direct() is None
+    outcomes: list[list[object]] = [[], []]
+    for k, t in enumerate((fast_t, slow_t)):
+        drv = Supi3Driver(t)
+        for name, register, value in [("init", IN0, 0), *ops]:
+            try:
+                outcomes[k].append(apply_op(drv, t, mode, name, register, value))
+            except Exception as error:
+                outcomes[k].append((type(error), str(error)))
+        outcomes[k] += [t.protocol.phase, t.protocol.c_d, [(type(v), str(v)) for v in t.registers.violations.records],
+                        [t.registers.value(r.name) for r in REGISTER_MAP.registers if r.name != "IRQ_EVT"]]  # fmt: skip
+    assert outcomes[0] == outcomes[1]

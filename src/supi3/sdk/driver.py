@@ -19,7 +19,7 @@ from abc import ABC, abstractmethod
 from collections.abc import Awaitable, Callable, Generator
 from dataclasses import dataclass
 from enum import IntEnum, IntFlag
-from typing import Any, Final, TypeVar
+from typing import Any, Final, Protocol, TypeVar
 
 from supi3 import tables
 from supi3.checks import check_bool, check_bytes, check_int, check_real, describe
@@ -50,6 +50,7 @@ __all__ = [
     "ERROR_CODES",
     "AsyncSupi3Driver",
     "AsyncTransport",
+    "DirectAccess",
     "DriverArgumentError",
     "DriverError",
     "ErrorCode",
@@ -276,6 +277,25 @@ class Transport(ABC):
         the chip is never left between a command and its data byte by an exception."""
         return contextlib.nullcontext()
 
+    def direct(self) -> DirectAccess | None:
+        """A shortcut for whole register accesses that has exactly the effect of their two frames (a model's own
+        read/write), or ``None``. The driver uses it for :meth:`Supi3Driver.read` and :meth:`Supi3Driver.write`
+        when it has no frame gap to keep."""
+        return None
+
+
+class DirectAccess(Protocol):
+    """What :meth:`Transport.direct` returns: one register access at once, while :meth:`ready` says it may."""
+
+    def ready(self) -> bool:
+        """Whether the chip waits for a command byte now (else the driver sends the frames one by one)."""
+
+    def read(self, address: int) -> int:
+        """Command RD|A and one data byte (the chip drives it), as two frames would."""
+
+    def write(self, address: int, value: int) -> None:
+        """Command WR|A and the data byte, as two frames would."""
+
 
 class AsyncTransport(ABC):
     """:class:`Transport` for a simulation that runs on awaits (cocotb): the same callbacks, awaitable."""
@@ -334,18 +354,36 @@ def _block_bytes(set_value: int) -> int:
 _BLOCK_BYTES: Final[tuple[int, ...]] = tuple(_block_bytes(v) for v in range(256))
 
 
+def _reaches(register: Register, direction: AccessDirection | None) -> bool:
+    directions = tuple(AccessDirection) if direction is None else (direction,)
+    return any(REGISTER_MAP.port(register.address, d).register == register for d in directions)
+
+
+_ADDRESSES: Final[dict[tuple[int, AccessDirection | None], tuple[Register, int]]] = {
+    (id(register), direction): (register, register.address)
+    for register in REGISTER_MAP.registers
+    for direction in (*AccessDirection, None)
+    if _reaches(register, direction)
+}
+"""Every (register, direction) an access may name, with its address (Table 3-10); ``None``: either direction. Keyed
+by the register's identity: the register map's objects are the names (hashing a register's fields costs more than
+the access)."""
+
+
 def _address(register: object, direction: AccessDirection | None) -> int:
-    """The address of ``register`` if ``direction`` (``None``: both) reaches it there (Table 3-10)."""
+    """The address of ``register`` if ``direction`` (``None``: either) reaches it there (Table 3-10)."""
+    known = _ADDRESSES.get((id(register), direction))
+    if known is not None and known[0] is register:
+        return known[1]
     if not isinstance(register, Register):
         hint = " (registers are named objects: supi3.regmap.OUT0, IRQ_EVT, ...)" if isinstance(register, int) else ""
         raise DriverArgumentError("register", register, f"register must be a supi3.regmap.Register, not "
                                   f"{describe(register)}{hint}")  # fmt: skip
-    directions = tuple(AccessDirection) if direction is None else (direction,)
-    if all(REGISTER_MAP.port(register.address, d).register is not register for d in directions):
-        verb = "read and written" if direction is None else "read" if direction is AccessDirection.READ else "written"
-        raise DriverArgumentError("register", register, f"register {register.name} cannot be {verb} at address "
-                                  f"{register.address} (Table 3-10)")  # fmt: skip
-    return register.address
+    if _reaches(register, direction):  # an equal copy of a map register (a pickled one, say)
+        return register.address
+    verb = "read and written" if direction is None else "read" if direction is AccessDirection.READ else "written"
+    raise DriverArgumentError("register", register, f"register {register.name} cannot be {verb} at address "
+                              f"{register.address} (Table 3-10)")  # fmt: skip
 
 
 def _checked(check: Callable[..., _T], *args: object, **kwargs: object) -> _T:
@@ -577,6 +615,7 @@ class Supi3Driver(_DriverApi):
                                       f"{describe(transport)}")  # fmt: skip
         self.transport = transport
         self._core = _Core(frame_gap_us)
+        self._direct = transport.direct() if not self._core.frame_gap_us else None
 
     def _run(self, call: _Call[_T]) -> _T:
         transport = self.transport
@@ -617,10 +656,27 @@ class Supi3Driver(_DriverApi):
 
     def read(self, register: Register) -> int:
         """Read one register (3.4.4): ``drv.read(OUT0)``; reading IRQ_EVT clears the events (3.4.14)."""
+        direct = self._direct
+        if direct is not None and direct.ready():
+            core = self._core
+            address = _address(register, AccessDirection.READ)
+            core._ready()
+            value = direct.read(address)
+            core._note_set(address, value)
+            return value
         return self._run(self._core.read(register))
 
     def write(self, register: Register, value: int) -> None:
         """Write one register (3.4.4): ``drv.write(IN0, 0x12)``."""
+        direct = self._direct
+        if direct is not None and direct.ready():
+            core = self._core
+            address = _address(register, AccessDirection.WRITE)
+            byte = _byte("value", value)
+            core._ready()
+            direct.write(address, byte)
+            core._note_set(address, byte)
+            return
         self._run(self._core.write(register, value))
 
     def exchange(self, register: Register, value: int) -> int:

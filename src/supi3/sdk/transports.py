@@ -21,8 +21,8 @@ from typing import Any
 from supi3.checks import check_int, describe
 from supi3.model.chip import Supi3
 from supi3.model.registers import RegisterFile
-from supi3.sdk.driver import DriverArgumentError, Mode, Transport
-from supi3.spi.upif import UpInterface
+from supi3.sdk.driver import DirectAccess, DriverArgumentError, Mode, Transport
+from supi3.spi.upif import Phase, UpInterface
 
 __all__ = ["ModelTransport", "SpidevTransport"]
 
@@ -80,6 +80,27 @@ class ModelTransport(Transport):
     def access(self) -> contextlib.AbstractContextManager[None]:
         """Strict-mode violations wait for the end of the driver call (``ViolationLog.deferred``)."""
         return self.registers.violations.deferred()
+
+    def direct(self) -> DirectAccess | None:
+        """``UpInterface``'s whole-access read and write (the same two frames' effect, tests/test_sdk_driver.py),
+        unless a subclass changes how a frame goes (a bench's clock, a log): then ``None``."""
+        if type(self).xfer is not ModelTransport.xfer or type(self).access is not ModelTransport.access:
+            return None
+        return _Direct(self.up)
+
+
+class _Direct:
+    """:class:`UpInterface` read/write as a driver shortcut, while the protocol waits for a command byte."""
+
+    __slots__ = ("protocol", "read", "write")
+
+    def __init__(self, up: UpInterface) -> None:
+        self.protocol = up.protocol
+        self.read = up.read
+        self.write = up.write
+
+    def ready(self) -> bool:
+        return self.protocol.phase is Phase.COMMAND and not self.protocol.in_frame
 
 
 class SpidevTransport(Transport):
