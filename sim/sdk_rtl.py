@@ -2,11 +2,13 @@
 
 Ref: guide docs/sdk-firmware-python.md, "The RTL back end"; 3.4.3 to 3.4.5, 3.4.14. ``async_driver_registers``
 drives the chip with the async driver straight from a coroutine. ``example_on_rtl`` runs an example firmware with an
-INTERBUS master on the chip's line: the job (JSON, path in ``SUPI3_SDK_RTL_JOB``) names the
-example, the interface mode, the bit rate, the cycle time and a process data history; the test starts the chip
-(:class:`supi3.sdk.rtl.RtlBoard`), runs the firmware with the master (:class:`supi3.sdk.rtl.RtlBench`), plays the
-history (:func:`supi3.sdk.examples.play`) and writes what it saw as JSON next to the job. Started by
-tests/test_sdk_rtl.py, not by hand.
+INTERBUS master on the chip's line: the job (JSON, path in ``SUPI3_SDK_RTL_JOB``) is a list of cases, each naming
+the example, the interface mode, the bit rate, the cycle time, whether the I/O pin is wired and a process data
+history (or, for the management channel, the processor commands); one simulation runs them all, one parametrized
+test per case: each starts the chip (:class:`supi3.sdk.rtl.RtlBoard`), runs the firmware with the master
+(:class:`supi3.sdk.rtl.RtlBench`), plays the history (:func:`supi3.sdk.examples.play`) or sends the commands
+(:func:`supi3.sdk.examples.management.ask`) and writes what it saw as JSON next to the job
+(``job.<case>.result.json``). Started by tests/test_sdk_rtl.py, not by hand.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from supi3.sdk import examples
 from supi3.sdk.bench import default_config
 from supi3.sdk.driver import AsyncSupi3Driver, Irq, Mode, NotResetError
 from supi3.sdk.examples.digital import DIO_ID, ONE_WORD_IO
+from supi3.sdk.examples.management import ask
 from supi3.sdk.rtl import RtlBench, RtlBoard, RtlTransport
 
 JOB_ENV = "SUPI3_SDK_RTL_JOB"
@@ -32,27 +35,38 @@ START_CYCLES = 4
 bench, tests/test_sdk_examples.py)."""
 
 
+def _cases() -> list[int]:
+    """The indices of the job's cases (none without a job: the module is also loaded for the driver test)."""
+    path = os.environ.get(JOB_ENV)
+    return list(range(len(json.loads(Path(path).read_text(encoding="utf-8"))))) if path else []
+
+
 @cocotb.test()
-async def example_on_rtl(dut: Any) -> None:
-    """Play the job's history through its example firmware on the RTL chip."""
+@cocotb.parametrize(case=_cases())
+async def example_on_rtl(dut: Any, case: int) -> None:
+    """Play case ``case`` of the job through its example firmware on the RTL chip, from a fresh power-up (each
+    parametrized test ends with its clock stopped; the next one resets the chip)."""
     path = Path(os.environ[JOB_ENV])
-    job = json.loads(path.read_text(encoding="utf-8"))
+    job = json.loads(path.read_text(encoding="utf-8"))[case]
     mode = Mode(job["mode"])
     board = RtlBoard(dut, default_config(job["bit_rate"]))
     await board.start()
     device = getattr(examples, job["example"])(mode)
-    bench = RtlBench(board, device, mode=mode, cycle_time_s=job["cycle_time_s"])
-    history = [tuple(step) for step in job["history"]]
+    bench = RtlBench(board, device, mode=mode, cycle_time_s=job["cycle_time_s"], io_pin=job["io_pin"])
 
     def scenario() -> dict[str, Any]:
         bench.run(START_CYCLES)
         entry = bench.master.entry(1)
-        seen = examples.play(bench, device, history)
-        return {"id_code": entry.id_code, "data_bits": entry.data_bits, "seen": seen,
-                "interrupts": bench.interrupts, "frames": bench.transport.frames}  # fmt: skip
+        result: dict[str, Any] = {"id_code": entry.id_code, "data_bits": entry.data_bits}
+        if isinstance(device, examples.ManagementChannel):
+            result["seen"] = [ask(bench, command) for command in job["commands"]]
+            result["commands"] = device.commands
+        else:
+            result["seen"] = examples.play(bench, device, [tuple(step) for step in job["history"]])
+        return {**result, "interrupts": bench.interrupts, "frames": bench.transport.frames}
 
     result = await bench.call(scenario)
-    path.with_suffix(".result.json").write_text(json.dumps(result), encoding="utf-8")
+    path.with_suffix(f".{case}.result.json").write_text(json.dumps(result), encoding="utf-8")
 
 
 @cocotb.test()

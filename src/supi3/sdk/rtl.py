@@ -41,14 +41,14 @@ from cocotb.task import bridge, resume
 from cocotb.triggers import Edge, Event, FallingEdge, First, Timer
 from cocotb.utils import get_sim_time
 
-from supi3.checks import check_instance, check_int, check_real, describe
+from supi3.checks import check_bool, check_instance, check_int, check_real, describe
 from supi3.config import DeviceConfig
 from supi3.interbus import wire
 from supi3.interbus.master import Master
 from supi3.model.pinring import PinRing
 from supi3.model.pins import Supi3Pins
 from supi3.pinout import EXPANSION_BITS, MFP_PINS, UP_INPUT_IDLE, UP_INPUTS, UP_OUTPUTS
-from supi3.sdk.bench import Firmware
+from supi3.sdk.bench import PIN_READ_S, Firmware
 from supi3.sdk.driver import AsyncTransport, DriverArgumentError, Mode, Supi3Driver, Transport
 from supi3.spi.master import MasterTiming
 from supi3.tables import CLOCK_HZ
@@ -56,6 +56,7 @@ from supi3.verif.straps import strap_inputs
 
 __all__ = [
     "CLOCK_PS",
+    "PIN_READ_CLOCKS",
     "BridgedTransport",
     "RtlBench",
     "RtlBoard",
@@ -69,6 +70,8 @@ CLOCK_PS: Final[int] = round(1e12 / CLOCK_HZ)
 """The chip clock's period in ps (32 MHz: 31 250 ps); simulate with a 1 ps precision."""
 _QUIET: Final[dict[str, int]] = {"di2": 0, "rbst_ext": 0, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 1}
 """The board inputs other than the line and the MFPs: last device in the ring, no fault, power good."""
+PIN_READ_CLOCKS: Final[int] = math.ceil(PIN_READ_S * CLOCK_HZ)
+"""FW-9 on the RTL: one read of the I/O pin by the firmware costs :data:`supi3.sdk.bench.PIN_READ_S` (8 clocks)."""
 _RESET_POLL_CLOCKS: Final[int] = 16
 """How often :meth:`RtlBoard.start` looks whether the power-up reset has ended."""
 
@@ -115,7 +118,7 @@ class RtlBoard:
     # -- power-up ----------------------------------------------------------------------------------------------
 
     async def start(self) -> None:
-        """Straps and quiet inputs, the clock, one clock of ``rst``, then wait out the chip's power-up reset (the
+        """Straps and quiet inputs, the clock, ``rst`` over a rising edge, then wait out the chip's power-up reset (the
         µP block is held in reset while ``resu_drive`` is 1) and start recording ``di1``."""
         dut = self.dut
         for name, value in {**self._straps, **_QUIET, "do1": wire.IDLE_LEVEL}.items():
@@ -124,6 +127,7 @@ class RtlBoard:
         dut.rst.value = 1
         Clock(dut.clk, CLOCK_PS, unit="ps").start()
         await FallingEdge(dut.clk)
+        await self.clocks(1)  # a rising edge with rst high, whatever level an earlier test's clock stopped at
         dut.rst.value = 0
         await self.clocks(1)
         while int(dut.resu_drive.value):
@@ -192,14 +196,20 @@ class RtlTransport(AsyncTransport):
         MFP7, LSB first) (Tables 3-5, 3-6, 3-9).
     timing:
         Edge placement in chip clocks; default :meth:`MasterTiming.fastest` at the chip's bit rate.
+    io_pin:
+        Whether the I/O access pin (MFP1) is wired to the firmware: if not, :meth:`read_io` returns ``None`` and the
+        driver polls D7 of the interrupt event register, the manual's polling method (3.4.14; FW-9, as
+        ``Bench(io_pin=False)``).
     """
 
-    def __init__(self, board: RtlBoard, mode: Mode = Mode.MOTOROLA, timing: MasterTiming | None = None) -> None:
+    def __init__(self, board: RtlBoard, mode: Mode = Mode.MOTOROLA, timing: MasterTiming | None = None, *,
+                 io_pin: bool = True) -> None:  # fmt: skip
         self.board = check_instance("board", board, RtlBoard)
         if type(mode) is not Mode:
             raise DriverArgumentError("mode", mode, f"mode must be Mode.MOTOROLA or Mode.INTEL, not {describe(mode)}")
         self.mode = mode
         self.timing = timing or MasterTiming.fastest(board.config.bit_rate)
+        self.io_pin = check_bool("io_pin", io_pin)
         self.frames = 0
 
     async def xfer(self, tx: int, s_r: bool) -> int:
@@ -242,7 +252,12 @@ class RtlTransport(AsyncTransport):
         return self.board.up_output("irq_n")
 
     async def read_io(self) -> int | None:
-        """The I/O access pin (MFP1)."""
+        """The I/O access pin (MFP1), read in :data:`PIN_READ_CLOCKS` (so a loop polling it lets the bus run);
+        ``None`` if the pin is not wired (``io_pin``)."""
+        if not self.io_pin:
+            return None
+        await self.board.align()
+        await self.board.clocks(PIN_READ_CLOCKS)
         return self.board.up_output("io")
 
     async def set_sas_init(self, level: int) -> bool:
@@ -335,16 +350,19 @@ class RtlBench:
         The interface type the firmware initializes (the transport's bit order).
     cycle_time_s:
         A master cycle starts this often (the line idles between); ``None``: back to back.
+    io_pin:
+        Whether the firmware reads the I/O access pin (:class:`RtlTransport`); ``False`` for the polling examples,
+        as on the model bench (FW-9).
 
     Call :meth:`call` from the cocotb test: it runs the firmware's setup, then the firmware and the given synchronous
     scenario side by side (bridge threads), and stops the firmware when the scenario returns.
     """
 
     def __init__(self, board: RtlBoard, firmware: Firmware, *, mode: Mode = Mode.MOTOROLA,
-                 cycle_time_s: float | None = None) -> None:  # fmt: skip
+                 cycle_time_s: float | None = None, io_pin: bool = True) -> None:  # fmt: skip
         self.board = check_instance("board", board, RtlBoard)
         self.firmware = check_instance("firmware", firmware, Firmware)
-        self.transport = RtlTransport(board, mode)
+        self.transport = RtlTransport(board, mode, io_pin=io_pin)
         self.driver = Supi3Driver(BridgedTransport(self.transport))
         self.ring = RtlRing(board)
         self.master = Master(self.ring)

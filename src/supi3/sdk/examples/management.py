@@ -12,8 +12,9 @@ from typing import Final
 from supi3.sdk.bench import Firmware
 from supi3.sdk.driver import Irq, Mode, Supi3Driver
 from supi3.sdk.examples.digital import DIO_ID, ONE_WORD_IO
+from supi3.sdk.examples.history import ProcessBench
 
-__all__ = ["STATUS_REQUEST", "ManagementChannel"]
+__all__ = ["STATUS_REQUEST", "ManagementChannel", "ask"]
 
 STATUS_REQUEST: Final = 0x01
 """This example's command "report your status": answered with :attr:`ManagementChannel.status`."""
@@ -42,3 +43,15 @@ class ManagementChannel(Firmware):
     def answer(self, command: int) -> int:
         """The alarm byte for ``command``."""
         return self.status if command == STATUS_REQUEST else command ^ 0xFF
+
+
+def ask(bench: ProcessBench, command: int) -> int | None:
+    """The master sends ``command`` to the device at ring position 1, then asks for its processor alarm: the ID cycle
+    carrying the command and one for the PCMD interrupt to run, then the request and the answer in place of the ID
+    code (A18). The alarm byte the master read (taken out of its ``processor_alarms``), ``None`` if none came; on
+    either bench (:class:`~supi3.sdk.bench.Bench`, :class:`~supi3.sdk.rtl.RtlBench`)."""
+    bench.master.processor_command(1, command)
+    bench.run(2)
+    bench.master.request_processor_alarm(1)
+    bench.run(3)
+    return bench.master.processor_alarms.pop(1, None)
