@@ -28,7 +28,7 @@ from supi3.sdk.examples import (
 from supi3.sdk.examples.analog import AIO_ID
 from supi3.sdk.examples.digital import DIO_ID
 from supi3.sdk.examples.history import SETTLE_CYCLES
-from supi3.sdk.examples.management import STATUS_REQUEST
+from supi3.sdk.examples.management import STATUS_REQUEST, ask
 from supi3.tables import BIT_RATES
 
 MODES = st.sampled_from(list(Mode))
@@ -225,3 +225,12 @@ def test_status_request() -> None:
     bench.master.request_processor_alarm(1)
     bench.run(3)
     assert bench.master.processor_alarms[1] == 0xA5
+
+
+def test_ask_gives_the_answer_once() -> None:
+    """``ask()`` (the RTL tests' management scenario): the alarm byte, taken out of the master's record."""
+    device = ManagementChannel(Mode.INTEL)
+    bench = started(device, Mode.INTEL, BIT_RATES[1])
+    assert [ask(bench, STATUS_REQUEST), ask(bench, 0x3C)] == [device.status, 0xC3]
+    assert bench.master.processor_alarms == {}
+    assert device.commands == [STATUS_REQUEST, 0x3C]
