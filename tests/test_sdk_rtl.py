@@ -136,23 +136,24 @@ def test_example_on_rtl_gives_the_model_benchs_process_data(
     assert result["interrupts"] >= len(HISTORY)
 
 
-def test_analog_polling_and_management_examples_on_rtl(
+def test_analog_polling_and_management_on_rtl(
     chip_build: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """One simulation, 2 Mbit/s, short cycles (CI time), the model bench's results:
 
     - AnalogIo: SET 85h, one 4-byte block transfer per VALID (3.4.6; Intel: four reads, then four writes, Fig. 3-12);
     - PollingIo: no interrupt; the I/O access bit polled as D7 of register 14 (3.4.14, Fig. 3-22; FW-9), the block
-      transfer in the window;
+      transfer in the window; then on the I/O pin (MFP1), each read costing ``PIN_READ_CLOCKS``;
     - ManagementChannel: each processor command read on PCMD (address 7) and answered by a processor alarm the
       master reads in place of the ID code (3.4.9, A18).
     """
-    analog, polling, management = cases = [
+    analog, polling, management, pin = cases = [
         Case(AnalogIo, Mode.INTEL, BIT_RATES[1], LONG_HISTORY, cycle_time_s=FAST_CYCLE_TIME_S),
         Case(PollingIo, Mode.MOTOROLA, BIT_RATES[1], HISTORY[:3], cycle_time_s=FAST_CYCLE_TIME_S, io_pin=False),
         Case(ManagementChannel, Mode.INTEL, BIT_RATES[1], commands=COMMANDS, cycle_time_s=FAST_CYCLE_TIME_S),
+        Case(PollingIo, Mode.INTEL, BIT_RATES[1], HISTORY[-2:], cycle_time_s=FAST_CYCLE_TIME_S),
     ]
-    analog_result, polling_result, management_result = on_rtl(chip_build, tmp_path, monkeypatch, cases)
+    analog_result, polling_result, management_result, pin_result = on_rtl(chip_build, tmp_path, monkeypatch, cases)
     check_process_data(analog, analog_result, (AIO_ID, 32))
     assert analog_result["interrupts"] >= len(LONG_HISTORY)
     check_process_data(polling, polling_result, (DIO_ID, 16))
@@ -161,6 +162,8 @@ def test_analog_polling_and_management_examples_on_rtl(
     assert management_result["commands"] == COMMANDS
     assert management_result["seen"] == [ManagementChannel().answer(command) for command in COMMANDS]
     assert management_result["seen"] == management.on_model()
+    check_process_data(pin, pin_result, (DIO_ID, 16))
+    assert pin_result["interrupts"] == 0
 
 
 @pytest.mark.parametrize("mode", list(Mode))
