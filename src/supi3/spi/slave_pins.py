@@ -395,14 +395,21 @@ class SlavePins:
         """
         if type(pins) is not PinsIn:
             check_instance("pins", pins, PinsIn)
-        out = self._pipeline[0]
+        pipeline = self._pipeline
+        out = pipeline[0]
         self._resting = None
-        with self.registers.violations.deferred():
+        log = self.protocol.registers.violations
+        log.hold()  # a deferred() block without the with statement's cost (it runs once per cycle)
+        try:
             self._checker.check(self.cycle, pins, out, self.protocol.mode is Mode.INTEL)
             self._edge(pins, out)
-            self._pipeline.popleft()
-            self._pipeline.append(self._decode())
+            pipeline.popleft()
+            pipeline.append(self._decode())
             self.cycle += 1
+        except BaseException:
+            log.release(failed=True)
+            raise
+        log.release()
         return out
 
     def quiet(self, pins: PinsIn) -> int:
@@ -505,25 +512,27 @@ class SlavePins:
         """The clock edge ending this cycle: act on the edges the synchronised signals show, then clock the
         synchronisers. Order within one edge: SAS_INIT, /SS falling, SCLK rising, /SS rising."""
         protocol = self.protocol
-        if self._sas.s2:
+        ss, sclk, sas, data, s_r = self._ss, self._sclk, self._sas, self._data, self._s_r
+        if sas.s2:
             protocol.sas_init()
             self._clear_frame()
-        else:
-            if self._ss.fell:
+        elif ss.s2 != ss.s3 or sclk.s2 != sclk.s3:  # else no edge to act on (the common case at pin level)
+            if ss.fell:
                 self._clear_frame()
-                self._tx = protocol.begin(bool(self._s_r.s2))
-            if protocol.in_frame and not self._ss.s2 and self._sclk.rose:
-                self._shift_in(self._data.s2)
-            if protocol.in_frame and self._ss.rose:
+                self._tx = protocol.begin(bool(s_r.s2))
+            if protocol.in_frame and not ss.s2 and sclk.rose:
+                self._shift_in(data.s2)
+            if protocol.in_frame and ss.rose:
                 if self._bits == 8:
                     protocol.end(self._rx)
                 else:
                     protocol.abort(self._bits)
                 self._clear_frame()
-        pad = out.mfp6 if out.mfp6_oe else pins.mfp6
-        for sync, pin in ((self._ss, pins.ss_n), (self._sclk, pins.sclk), (self._sas, pins.sas_init),
-                          (self._data, pad), (self._s_r, pins.mfp7)):
-            sync.clock(pin)
+        ss.clock(pins.ss_n)
+        sclk.clock(pins.sclk)
+        sas.clock(pins.sas_init)
+        data.clock(out.mfp6 if out.mfp6_oe else pins.mfp6)
+        s_r.clock(pins.mfp7)
 
     def _shift_in(self, bit: int) -> None:
         """One SCLK rising edge: take ``bit`` into the receive register in the mode's bit order (UP-6)."""
