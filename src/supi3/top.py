@@ -251,6 +251,12 @@ class _CatchUp:
         # interface is held in reset with the core (M2) while it holds or until its reset stretch ends.
         core = chip.core
         holding, run_from = core.holding, core.run_from
+        # The common call: the interface rests on pins that hold until ``stop`` (ends[k] > t then) and shows the
+        # outputs last recorded (a run's first cycle records its outputs: t > 0).
+        if t and stop <= ends[k] and not holding and c0 + t >= run_from and upif.rests(self.pins[k], stop - t):
+            chip._up_cycle = c0 + t  # as the hold below would leave it
+            self.done = stop
+            return
         while t < stop:
             while ends[k] <= t:
                 k += 1

@@ -462,11 +462,9 @@ class SlavePins:
         """
         if type(cycles) is not int or cycles < 1:
             check_int("cycles", cycles, 1)
-        resting, registers = self._resting, self.protocol.registers
-        if (resting is not None and self._checker.last_pins is pins and registers.io_access == resting.io
-                and registers.irq_n == resting.irq_n):  # the rest of _decode() moves only with tick()
-            self.cycle += cycles  # the pipeline and the synchronisers already hold what they would take
-            return [(0, resting)]
+        if self.rests(pins, cycles):
+            assert self._resting is not None
+            return [(0, self._resting)]
         quiet = self.quiet(pins)
         if cycles > quiet:
             raise UpifUsageError(f"hold() of {cycles} cycles: the clock edge {quiet} cycles from now acts "
@@ -493,6 +491,19 @@ class SlavePins:
         # Once every stage shows the decoded outputs, holding on only counts cycles (until tick() or reset()).
         self._resting = decoded if cycles >= len(pipeline) + 3 else None
         return changes
+
+    def rests(self, pins: PinsIn, cycles: int) -> bool:
+        """:meth:`hold`'s constant-cost case, for callers that hold often (the whole chip's run() between the
+        core's events): if the interface rests on ``pins`` (the ``pins`` object itself was held last, long enough for
+        the pipeline and the synchronisers to take it, and the register file still decodes to the outputs shown),
+        run the ``cycles`` (an integer >= 1, not checked) and return ``True``: the outputs are those shown; else
+        change nothing and return ``False``."""
+        resting, registers = self._resting, self.protocol.registers
+        if (resting is not None and self._checker.last_pins is pins and registers.io_access == resting.io
+                and registers.irq_n == resting.irq_n):  # the rest of _decode() moves only with tick()
+            self.cycle += cycles  # the pipeline and the synchronisers already hold what they would take
+            return True
+        return False
 
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
         """:meth:`tick` with pins by name (the lockstep harness's ``PinModel.step``; names in
