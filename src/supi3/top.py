@@ -211,6 +211,10 @@ class Supi3Chip:
 
 
 _UP_INPUT_MASK: Final = sum(1 << pin for pin in UP_INPUTS.values())
+HOLD_FROM: Final = 4
+""":meth:`Supi3Chip.run` ticks the µP interface (:meth:`SlavePins.tick`) through a stretch of held pins shorter than
+this many cycles instead of holding it (:meth:`SlavePins.hold`): a hold that does not find the interface resting costs
+about as much as this many ticks (bench/bench_chip.py; both give the same outputs and state)."""
 _LEVELS: dict[PinsOut, tuple[int, int]] = {}
 """:func:`up_pin_outputs` of every µP interface output combination seen (at most 2**10)."""
 
@@ -262,21 +266,28 @@ class _CatchUp:
                 k += 1
             end = ends[k] if ends[k] < stop else stop
             pins = self.pins[k]
-            chip._up_cycle = c0 + t  # a violation names the cycle (UP-19)
-            # A short quiet stretch (an edge acts within 3 cycles) costs less ticked than held (bench/bench_chip.py).
-            if not (holding or c0 + t < run_from) and upif.quiet(pins) == QUIET_FOREVER:
-                for i, out in upif.hold(pins, end - t):
-                    if out is not outputs[-1][1]:
-                        outputs.append((t + i, out))
-                t = end
-                continue
-            # The core has run its edge of cycle t already: the µP interface's edge acts, clock it as step() does.
-            out = upif.tick(pins)
-            if holding or c0 + t < run_from:
-                upif.reset()
-            if out is not outputs[-1][1]:
-                outputs.append((t, out))
-            t += 1
+            # Hold where no edge acts as long as the pins hold; a short stretch costs less ticked (bench/bench_chip.py),
+            # and so do the quiet cycles before an edge that acts.
+            ticks = end - t
+            if ticks >= HOLD_FROM:
+                quiet = 0 if holding or c0 + t < run_from else upif.quiet(pins)
+                if quiet == QUIET_FOREVER:
+                    chip._up_cycle = c0 + t  # a violation names the cycle (UP-19)
+                    for i, out in upif.hold(pins, ticks):
+                        if out is not outputs[-1][1]:
+                            outputs.append((t + i, out))
+                    t = end
+                    continue
+                ticks = quiet + 1
+            # The core has run its edge of these cycles already: clock the µP interface's as step() does.
+            for u in range(t, t + ticks):
+                chip._up_cycle = c0 + u
+                out = upif.tick(pins)
+                if holding or c0 + u < run_from:
+                    upif.reset()
+                if out is not outputs[-1][1]:
+                    outputs.append((u, out))
+            t += ticks
         self.done, self.k = t, k
 
     def render(self) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:

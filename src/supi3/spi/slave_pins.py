@@ -137,7 +137,7 @@ OUTPUT_PINS: Final[tuple[str, ...]] = tuple(f.name for f in fields(PinsOut))
 """Output signal names, enables included, in :class:`PinsOut` order."""
 
 
-@dataclass
+@dataclass(slots=True)
 class _Sync:
     """A 2-flop synchroniser plus the edge-detect flop: s1 <= pin, s2 <= s1, s3 <= s2 at every clock edge."""
 
@@ -558,16 +558,17 @@ class SlavePins:
         """The outputs as a function of the state (before the output pipeline)."""
         protocol = self.protocol
         registers = protocol.registers
-        drive = protocol.in_frame and self._tx is not None
-        bit = 0
-        if self._tx is not None:
-            index = min(self._bits, 7)
-            bit = (self._tx >> (index if protocol.lsb_first else 7 - index)) & 1
-        intel = drive and protocol.mode is Mode.INTEL
-        motorola = drive and protocol.mode is Mode.MOTOROLA
+        tx = self._tx
         # PinsOut is frozen: equal outputs share one checked instance (at most 2**10), built once.
-        key = (int(registers.io_access), 1, protocol.c_d, 1, registers.irq_n, 1, bit if intel else 0, int(intel),
-               bit if motorola else 0, int(motorola))  # fmt: skip
+        if tx is None or not protocol.in_frame:  # MFP6 and MFP7 not driven
+            key: tuple[int, ...] = (int(registers.io_access), 1, protocol.c_d, 1, registers.irq_n, 1, 0, 0, 0, 0)
+        else:
+            index = min(self._bits, 7)
+            bit = (tx >> (index if protocol.lsb_first else 7 - index)) & 1
+            intel = protocol.mode is Mode.INTEL
+            motorola = protocol.mode is Mode.MOTOROLA
+            key = (int(registers.io_access), 1, protocol.c_d, 1, registers.irq_n, 1, bit if intel else 0, int(intel),
+                   bit if motorola else 0, int(motorola))  # fmt: skip
         out = _DECODED.get(key)
         if out is None:
             out = _DECODED[key] = PinsOut(*key)
