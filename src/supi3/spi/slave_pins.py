@@ -402,9 +402,14 @@ class SlavePins:
         log.hold()  # a deferred() block without the with statement's cost (it runs once per cycle)
         try:
             self._checker.check(self.cycle, pins, out, self.protocol.mode is Mode.INTEL)
-            self._edge(pins, out)
+            last = pipeline[-1]
+            registers = self.protocol.registers
+            # An edge that acts on nothing leaves the state as last decoded; the core may have moved the register
+            # file's part of it (the same test as rests()).
+            if self._edge(pins, out) or last.io != registers.io_access or last.irq_n != registers.irq_n:
+                last = self._decode()
             pipeline.popleft()
-            pipeline.append(self._decode())
+            pipeline.append(last)
             self.cycle += 1
         except BaseException:
             log.release(failed=True)
@@ -519,15 +524,17 @@ class SlavePins:
             _bad_names(inputs)
         return asdict(self.tick(PinsIn(**inputs)))
 
-    def _edge(self, pins: PinsIn, out: PinsOut) -> None:
+    def _edge(self, pins: PinsIn, out: PinsOut) -> bool:
         """The clock edge ending this cycle: act on the edges the synchronised signals show, then clock the
-        synchronisers. Order within one edge: SAS_INIT, /SS falling, SCLK rising, /SS rising."""
+        synchronisers; ``False`` if it acted on nothing (the state :meth:`_decode` reads did not change). Order
+        within one edge: SAS_INIT, /SS falling, SCLK rising, /SS rising."""
         protocol = self.protocol
         ss, sclk, sas, data, s_r = self._ss, self._sclk, self._sas, self._data, self._s_r
+        acts = bool(sas.s2) or ss.s2 != ss.s3 or sclk.s2 != sclk.s3
         if sas.s2:
             protocol.sas_init()
             self._clear_frame()
-        elif ss.s2 != ss.s3 or sclk.s2 != sclk.s3:  # else no edge to act on (the common case at pin level)
+        elif acts:  # else no edge to act on (the common case at pin level)
             if ss.fell:
                 self._clear_frame()
                 self._tx = protocol.begin(bool(s_r.s2))
@@ -544,6 +551,7 @@ class SlavePins:
         sas.clock(pins.sas_init)
         data.clock(out.mfp6 if out.mfp6_oe else pins.mfp6)
         s_r.clock(pins.mfp7)
+        return acts
 
     def _shift_in(self, bit: int) -> None:
         """One SCLK rising edge: take ``bit`` into the receive register in the mode's bit order (UP-6)."""
