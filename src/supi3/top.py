@@ -95,8 +95,10 @@ class Supi3Chip:
     :meth:`run` is event-driven in every mode. The core and the µP interface meet only in the register file, and
     the core changes it only at the clock edges its scheduler visits (:meth:`Supi3Pins.run`, ``before``): before
     each, the µP interface catches up to that cycle, clock by clock where its pins move
-    (:meth:`SlavePins.tick`) and in one step where they hold (:meth:`SlavePins.hold`). Within one cycle the core
-    clocks first, as in :meth:`step`, so the two agree cycle for cycle (tested).
+    (:meth:`SlavePins.tick`; also through stretches shorter than :data:`HOLD_FROM`) and in one step where they hold
+    (:meth:`SlavePins.hold`); when it already rests on pins that hold past that cycle, the catch-up is one
+    :meth:`SlavePins.rests`. Within one cycle the core clocks first, as in :meth:`step`, so the two agree cycle for
+    cycle (tested).
     """
 
     inputs: Sequence[Pin] = Supi3Pins.inputs
