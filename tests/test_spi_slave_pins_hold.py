@@ -89,3 +89,24 @@ def test_quiet_counts_the_edges_before_one_acts_and_hold_refuses_more() -> None:
     assert upif.quiet(selected) == 0 and not upif.protocol.in_frame
     upif.tick(selected)
     assert upif.protocol.in_frame and upif.quiet(selected) == QUIET_FOREVER
+
+
+@pytest.mark.parametrize("bit_rate", [500_000, 2_000_000])
+def test_rests_counts_cycles_only_while_the_interface_rests_on_those_pins(bit_rate: int) -> None:
+    upif, ticked = interface(bit_rate), interface(bit_rate)
+    idle = PinsIn()
+    assert not upif.rests(idle, 5) and upif.cycle == 0  # nothing held since reset
+    settle = upif.output_delay + 4  # the pipeline (output_delay + 1 stages) and the three synchroniser flops
+    upif.hold(idle, settle)
+    assert upif.rests(idle, 7) and upif.cycle == settle + 7
+    assert not upif.rests(PinsIn(), 1)  # equal pins, but not the object held: not known to rest on it
+    upif.registers.set_io_access(True)  # the core moves the I/O access bit (MFP1, D7 of read 14)
+    assert not upif.rests(idle, 1) and upif.cycle == settle + 7
+    expected = [ticked.tick(idle) for _ in range(settle + 7)]
+    ticked.registers.set_io_access(True)
+    expected += [ticked.tick(idle) for _ in range(settle)]
+    assert expand(upif.hold(idle, settle), settle) == expected[-settle:] and expected[-1].io == 1
+    assert upif.rests(idle, 1) and ticked.tick(idle) == expected[-1]  # resting again, on the new outputs
+    for _ in range(3):
+        assert upif.tick(idle) == ticked.tick(idle)
+    assert upif.cycle == ticked.cycle

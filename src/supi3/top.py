@@ -28,7 +28,7 @@ from supi3.model.chip import Supi3
 from supi3.model.pins import PinTrace, Supi3Pins, input_traces
 from supi3.model.registers import RegisterFile
 from supi3.pinlevel import OE_SUFFIX, Pin
-from supi3.spi.slave_pins import PinsIn, PinsOut, SlavePins
+from supi3.spi.slave_pins import QUIET_FOREVER, PinsIn, PinsOut, SlavePins
 from supi3.spi.upif import UpifUsageError
 
 UP_INPUTS: Final = pinout.UP_INPUTS
@@ -95,8 +95,10 @@ class Supi3Chip:
     :meth:`run` is event-driven in every mode. The core and the µP interface meet only in the register file, and
     the core changes it only at the clock edges its scheduler visits (:meth:`Supi3Pins.run`, ``before``): before
     each, the µP interface catches up to that cycle, clock by clock where its pins move
-    (:meth:`SlavePins.tick`) and in one step where they hold (:meth:`SlavePins.hold`). Within one cycle the core
-    clocks first, as in :meth:`step`, so the two agree cycle for cycle (tested).
+    (:meth:`SlavePins.tick`; also through stretches shorter than :data:`HOLD_FROM`) and in one step where they hold
+    (:meth:`SlavePins.hold`); when it already rests on pins that hold past that cycle, the catch-up is one
+    :meth:`SlavePins.rests`. Within one cycle the core clocks first, as in :meth:`step`, so the two agree cycle for
+    cycle (tested).
     """
 
     inputs: Sequence[Pin] = Supi3Pins.inputs
@@ -211,6 +213,10 @@ class Supi3Chip:
 
 
 _UP_INPUT_MASK: Final = sum(1 << pin for pin in UP_INPUTS.values())
+HOLD_FROM: Final = 4
+""":meth:`Supi3Chip.run` ticks the µP interface (:meth:`SlavePins.tick`) through a stretch of held pins shorter than
+this many cycles instead of holding it (:meth:`SlavePins.hold`): a hold that does not find the interface resting costs
+about as much as this many ticks (bench/bench_chip.py; both give the same outputs and state)."""
 _LEVELS: dict[PinsOut, tuple[int, int]] = {}
 """:func:`up_pin_outputs` of every µP interface output combination seen (at most 2**10)."""
 
@@ -251,27 +257,39 @@ class _CatchUp:
         # interface is held in reset with the core (M2) while it holds or until its reset stretch ends.
         core = chip.core
         holding, run_from = core.holding, core.run_from
+        # The common call: the interface rests on pins that hold until ``stop`` (ends[k] > t then) and shows the
+        # outputs last recorded (a run's first cycle records its outputs: t > 0).
+        if t and stop <= ends[k] and not holding and c0 + t >= run_from and upif.rests(self.pins[k], stop - t):
+            chip._up_cycle = c0 + t  # as the hold below would leave it
+            self.done = stop
+            return
         while t < stop:
             while ends[k] <= t:
                 k += 1
             end = ends[k] if ends[k] < stop else stop
             pins = self.pins[k]
-            chip._up_cycle = c0 + t  # a violation names the cycle (UP-19)
-            quiet = 0 if holding or c0 + t < run_from else upif.quiet(pins)
-            if quiet:
-                held = end - t if end - t < quiet else quiet
-                for i, out in upif.hold(pins, held):
-                    if out is not outputs[-1][1]:
-                        outputs.append((t + i, out))
-                t += held
-                continue
-            # The core has run its edge of cycle t already: the µP interface's edge acts, clock it as step() does.
-            out = upif.tick(pins)
-            if holding or c0 + t < run_from:
-                upif.reset()
-            if out is not outputs[-1][1]:
-                outputs.append((t, out))
-            t += 1
+            # Hold where no edge acts as long as the pins hold; a short stretch costs less ticked (bench/bench_chip.py),
+            # and so do the quiet cycles before an edge that acts.
+            ticks = end - t
+            if ticks >= HOLD_FROM:
+                quiet = 0 if holding or c0 + t < run_from else upif.quiet(pins)
+                if quiet == QUIET_FOREVER:
+                    chip._up_cycle = c0 + t  # a violation names the cycle (UP-19)
+                    for i, out in upif.hold(pins, ticks):
+                        if out is not outputs[-1][1]:
+                            outputs.append((t + i, out))
+                    t = end
+                    continue
+                ticks = quiet + 1
+            # The core has run its edge of these cycles already: clock the µP interface's as step() does.
+            for u in range(t, t + ticks):
+                chip._up_cycle = c0 + u
+                out = upif.tick(pins)
+                if holding or c0 + u < run_from:
+                    upif.reset()
+                if out is not outputs[-1][1]:
+                    outputs.append((u, out))
+            t += ticks
         self.done, self.k = t, k
 
     def render(self) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:

@@ -137,7 +137,7 @@ OUTPUT_PINS: Final[tuple[str, ...]] = tuple(f.name for f in fields(PinsOut))
 """Output signal names, enables included, in :class:`PinsOut` order."""
 
 
-@dataclass
+@dataclass(slots=True)
 class _Sync:
     """A 2-flop synchroniser plus the edge-detect flop: s1 <= pin, s2 <= s1, s3 <= s2 at every clock edge."""
 
@@ -395,14 +395,26 @@ class SlavePins:
         """
         if type(pins) is not PinsIn:
             check_instance("pins", pins, PinsIn)
-        out = self._pipeline[0]
+        pipeline = self._pipeline
+        out = pipeline[0]
         self._resting = None
-        with self.registers.violations.deferred():
+        log = self.protocol.registers.violations
+        log.hold()  # a deferred() block without the with statement's cost (it runs once per cycle)
+        try:
             self._checker.check(self.cycle, pins, out, self.protocol.mode is Mode.INTEL)
-            self._edge(pins, out)
-            self._pipeline.popleft()
-            self._pipeline.append(self._decode())
+            last = pipeline[-1]
+            registers = self.protocol.registers
+            # An edge that acts on nothing leaves the state as last decoded; the core may have moved the register
+            # file's part of it (the same test as rests()).
+            if self._edge(pins, out) or last.io != registers.io_access or last.irq_n != registers.irq_n:
+                last = self._decode()
+            pipeline.popleft()
+            pipeline.append(last)
             self.cycle += 1
+        except BaseException:
+            log.release(failed=True)
+            raise
+        log.release()
         return out
 
     def quiet(self, pins: PinsIn) -> int:
@@ -455,11 +467,9 @@ class SlavePins:
         """
         if type(cycles) is not int or cycles < 1:
             check_int("cycles", cycles, 1)
-        resting, registers = self._resting, self.protocol.registers
-        if (resting is not None and self._checker.last_pins is pins and registers.io_access == resting.io
-                and registers.irq_n == resting.irq_n):  # the rest of _decode() moves only with tick()
-            self.cycle += cycles  # the pipeline and the synchronisers already hold what they would take
-            return [(0, resting)]
+        if self.rests(pins, cycles):
+            assert self._resting is not None
+            return [(0, self._resting)]
         quiet = self.quiet(pins)
         if cycles > quiet:
             raise UpifUsageError(f"hold() of {cycles} cycles: the clock edge {quiet} cycles from now acts "
@@ -487,6 +497,19 @@ class SlavePins:
         self._resting = decoded if cycles >= len(pipeline) + 3 else None
         return changes
 
+    def rests(self, pins: PinsIn, cycles: int) -> bool:
+        """:meth:`hold`'s constant-cost case, for callers that hold often (the whole chip's run() between the
+        core's events): if the interface rests on ``pins`` (the ``pins`` object itself was held last, long enough for
+        the pipeline and the synchronisers to take it, and the register file still decodes to the outputs shown),
+        run the ``cycles`` (an integer >= 1, not checked) and return ``True``: the outputs are those shown; else
+        change nothing and return ``False``."""
+        resting, registers = self._resting, self.protocol.registers
+        if (resting is not None and self._checker.last_pins is pins and registers.io_access == resting.io
+                and registers.irq_n == resting.irq_n):  # the rest of _decode() moves only with tick()
+            self.cycle += cycles  # the pipeline and the synchronisers already hold what they would take
+            return True
+        return False
+
     def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
         """:meth:`tick` with pins by name (the lockstep harness's ``PinModel.step``; names in
         :data:`INPUT_PINS` and :data:`OUTPUT_PINS`).
@@ -501,29 +524,34 @@ class SlavePins:
             _bad_names(inputs)
         return asdict(self.tick(PinsIn(**inputs)))
 
-    def _edge(self, pins: PinsIn, out: PinsOut) -> None:
+    def _edge(self, pins: PinsIn, out: PinsOut) -> bool:
         """The clock edge ending this cycle: act on the edges the synchronised signals show, then clock the
-        synchronisers. Order within one edge: SAS_INIT, /SS falling, SCLK rising, /SS rising."""
+        synchronisers; ``False`` if it acted on nothing (the state :meth:`_decode` reads did not change). Order
+        within one edge: SAS_INIT, /SS falling, SCLK rising, /SS rising."""
         protocol = self.protocol
-        if self._sas.s2:
+        ss, sclk, sas, data, s_r = self._ss, self._sclk, self._sas, self._data, self._s_r
+        acts = bool(sas.s2) or ss.s2 != ss.s3 or sclk.s2 != sclk.s3
+        if sas.s2:
             protocol.sas_init()
             self._clear_frame()
-        else:
-            if self._ss.fell:
+        elif acts:  # else no edge to act on (the common case at pin level)
+            if ss.fell:
                 self._clear_frame()
-                self._tx = protocol.begin(bool(self._s_r.s2))
-            if protocol.in_frame and not self._ss.s2 and self._sclk.rose:
-                self._shift_in(self._data.s2)
-            if protocol.in_frame and self._ss.rose:
+                self._tx = protocol.begin(bool(s_r.s2))
+            if protocol.in_frame and not ss.s2 and sclk.rose:
+                self._shift_in(data.s2)
+            if protocol.in_frame and ss.rose:
                 if self._bits == 8:
                     protocol.end(self._rx)
                 else:
                     protocol.abort(self._bits)
                 self._clear_frame()
-        pad = out.mfp6 if out.mfp6_oe else pins.mfp6
-        for sync, pin in ((self._ss, pins.ss_n), (self._sclk, pins.sclk), (self._sas, pins.sas_init),
-                          (self._data, pad), (self._s_r, pins.mfp7)):
-            sync.clock(pin)
+        ss.clock(pins.ss_n)
+        sclk.clock(pins.sclk)
+        sas.clock(pins.sas_init)
+        data.clock(out.mfp6 if out.mfp6_oe else pins.mfp6)
+        s_r.clock(pins.mfp7)
+        return acts
 
     def _shift_in(self, bit: int) -> None:
         """One SCLK rising edge: take ``bit`` into the receive register in the mode's bit order (UP-6)."""
@@ -538,16 +566,17 @@ class SlavePins:
         """The outputs as a function of the state (before the output pipeline)."""
         protocol = self.protocol
         registers = protocol.registers
-        drive = protocol.in_frame and self._tx is not None
-        bit = 0
-        if self._tx is not None:
-            index = min(self._bits, 7)
-            bit = (self._tx >> (index if protocol.lsb_first else 7 - index)) & 1
-        intel = drive and protocol.mode is Mode.INTEL
-        motorola = drive and protocol.mode is Mode.MOTOROLA
+        tx = self._tx
         # PinsOut is frozen: equal outputs share one checked instance (at most 2**10), built once.
-        key = (int(registers.io_access), 1, protocol.c_d, 1, registers.irq_n, 1, bit if intel else 0, int(intel),
-               bit if motorola else 0, int(motorola))  # fmt: skip
+        if tx is None or not protocol.in_frame:  # MFP6 and MFP7 not driven
+            key: tuple[int, ...] = (int(registers.io_access), 1, protocol.c_d, 1, registers.irq_n, 1, 0, 0, 0, 0)
+        else:
+            index = min(self._bits, 7)
+            bit = (tx >> (index if protocol.lsb_first else 7 - index)) & 1
+            intel = protocol.mode is Mode.INTEL
+            motorola = protocol.mode is Mode.MOTOROLA
+            key = (int(registers.io_access), 1, protocol.c_d, 1, registers.irq_n, 1, bit if intel else 0, int(intel),
+                   bit if motorola else 0, int(motorola))  # fmt: skip
         out = _DECODED.get(key)
         if out is None:
             out = _DECODED[key] = PinsOut(*key)
