@@ -2,11 +2,9 @@
 
 Transaction level: ``UpInterface.write`` / ``read`` register accesses per second (pedantic mode off, and on for its
 cost), and bytes per second of ``UpInterface.transfer`` (one byte per call, as the C driver is served). Pin level:
-bytes per second of
-a software µP (``supi3.spi.master.SoftMaster``) driving ``SlavePins`` at the fastest Table 3-7 timing. Each is
-printed as a ratio to the real interface, whose times come from Table 3-7: per byte, /SS fall to first SCLK fall
-max(t1, t7 - t0/2), 7.5 SCLK periods t0 to the last rising edge, t2 to /SS rise, and /SS high for t6 (maximum, C/D
-settles) plus t8 before the next byte; one register access is a command byte and a data byte. Run from the
+bytes per second of a software µP (``supi3.spi.master.SoftMaster``) driving ``SlavePins`` at the fastest Table 3-7 timing. Each is
+printed as a ratio to the real interface, whose time per byte is ``supi3.timing.upif_byte_s`` (Table 3-7, at the
+fastest SCLK); one register access is a command byte and a data byte. Run from the
 repository root:
 
     python bench/bench_upif.py [--accesses N] [--bytes N] [--repeat R]
@@ -32,7 +30,7 @@ from supi3.spi.figures import SET_1_BYTE
 from supi3.spi.master import SoftMaster
 from supi3.spi.slave_pins import SlavePins
 from supi3.spi.upif import Mode, UpInterface
-from supi3.timing import limit
+from supi3.timing import limit, upif_byte_s
 
 BYTES_PER_ACCESS = 2  # command byte + data byte (3.4.4)
 
@@ -49,19 +47,6 @@ def _configured(*, pedantic: bool = False) -> UpInterface:
     up.write(REGISTER_MAP.register("SET").address, SET_1_BYTE)
     up.registers.latch(b"\x00")
     return up
-
-
-def real_byte_s(bit_rate: int) -> float:
-    """Shortest time per byte of the real interface at the maximum SCLK (Table 3-7)."""
-    def low(symbol: str) -> float:
-        return limit("3-7", symbol, bit_rate)
-
-    def high(symbol: str) -> float:
-        return limit("3-7", symbol, bit_rate, maximum=True)
-
-    t0 = low("t0")
-    lead = max(low("t1"), high("t7") - t0 / 2)
-    return lead + 7.5 * t0 + low("t2") + high("t6") + low("t8")
 
 
 def _best(repeat: int, run: Callable[[], None]) -> float:
@@ -188,11 +173,11 @@ def main(argv: list[str] | None = None) -> None:
     print(f"transfer(): {byte_rate:,.0f} bytes/s (one byte per call, best of {args.repeat})"
           + "".join(f"; from C through {name} callbacks: {rate:,.0f} bytes/s" for name, rate in c_rates.items()))
     for bit_rate in tables.BIT_RATES:
-        real_bytes = 1 / real_byte_s(bit_rate)
+        real_bytes = 1 / upif_byte_s(bit_rate)
         real_accesses = real_bytes / BYTES_PER_ACCESS
         sclk_mhz = 1e-6 / limit("3-7", "t0", bit_rate)
         pin_rate, model_byte_s = pin_bytes_per_s(bit_rate, args.bytes, args.repeat)
-        print(f"{bit_rate // 1000} kbit/s, SCLK max {sclk_mhz:.2f} MHz: real {real_byte_s(bit_rate) * 1e6:.3f} µs/byte"
+        print(f"{bit_rate // 1000} kbit/s, SCLK max {sclk_mhz:.2f} MHz: real {upif_byte_s(bit_rate) * 1e6:.3f} µs/byte"
               f" = {real_bytes:,.0f} bytes/s = {real_accesses:,.0f} accesses/s")
         print(f"  transaction level: {access_rate / real_accesses:.2f} x real time; transfer(): "
               f"{byte_rate / real_bytes:.2f} x real time"

@@ -21,10 +21,8 @@ from dataclasses import dataclass
 from enum import IntEnum, IntFlag
 from typing import Any, Final, Protocol, TypeVar
 
-from supi3 import tables
 from supi3.checks import check_bool, check_bytes, check_int, check_real, describe
 from supi3.errors import ArgumentError, Supi3Error
-from supi3.interbus import wire
 from supi3.regmap import ALARM as ALARM_REGISTER
 from supi3.regmap import (
     BLOCK_ADDRESS,
@@ -40,6 +38,8 @@ from supi3.regmap import (
     SET,
     AccessDirection,
     Register,
+    RegisterMapError,
+    decode_set,
     encode_command,
 )
 from supi3.spi.upif import Mode
@@ -339,16 +339,13 @@ _EXCHANGE: Final[tuple[int, ...]] = tuple(encode_command(a, rd=True, wr=True) fo
 
 
 def _block_bytes(set_value: int) -> int:
-    """Block length of a SET value: its data bytes (Table 3-12) with ExtReg = 0 and at least one word, else 0
-    (3.4.6, UP-10)."""
-    if SET.field("EXTREG").extract(set_value):
-        return 0
-    cl = SET.field("CL").extract(set_value)
-    for row in tables.ABBREVIATED_LENGTHS:
-        if int(row.cl, 2) == cl:
-            count = wire.data_bytes(int(row.length_code, 2))
-            return count if count >= BLOCK_MIN_BYTES else 0
-    return 0  # CL 110, 111: reserved
+    """Block length of a SET value: its data bytes with ExtReg = 0 and at least one word, else 0 (3.4.6, UP-10)."""
+    try:
+        config = decode_set(set_value)
+    except RegisterMapError:
+        return 0  # CL 110, 111: reserved
+    count = 0 if config.extreg or config.length.bits is None else (config.length.bits + 7) // 8
+    return count if count >= BLOCK_MIN_BYTES else 0
 
 
 _BLOCK_BYTES: Final[tuple[int, ...]] = tuple(_block_bytes(v) for v in range(256))
