@@ -26,7 +26,8 @@ from supi3.sdk.transports import ModelTransport
 from supi3.spi.upif import UpInterface
 
 
-def _best(repeat: int, run: Callable[[], None]) -> float:
+def best(repeat: int, run: Callable[[], None]) -> float:
+    """The fastest of ``repeat`` runs, in seconds."""
     best = float("inf")
     for _ in range(repeat):
         start = time.perf_counter()
@@ -50,7 +51,7 @@ def driver_accesses_per_s(accesses: int, repeat: int) -> float:
             drv.write(IN0, k & 0xFF)
             drv.read(OUT0)
 
-    return accesses // 2 * 2 / _best(repeat, run)
+    return accesses // 2 * 2 / best(repeat, run)
 
 
 def upif_accesses_per_s(accesses: int, repeat: int) -> float:
@@ -64,7 +65,7 @@ def upif_accesses_per_s(accesses: int, repeat: int) -> float:
             up.write(IN0, k & 0xFF)
             up.read(OUT0)
 
-    return accesses // 2 * 2 / _best(repeat, run)
+    return accesses // 2 * 2 / best(repeat, run)
 
 
 class Echo(Firmware):
@@ -92,7 +93,7 @@ def firmware_run(cycles: int, bit_rate: int, repeat: int) -> tuple[float, float,
         bench.run(cycles)
         simulated, interrupts = bench.now, bench.interrupts
 
-    return _best(repeat, run), simulated, interrupts
+    return best(repeat, run), simulated, interrupts
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -18,17 +18,15 @@ from __future__ import annotations
 
 import argparse
 import tempfile
-import time
-from collections.abc import Callable
 from pathlib import Path
 
+from bench_sdk import best, driver_accesses_per_s  # the Python driver's figure, measured the same way
 from supi3 import tables, timing
 from supi3.config import decode
 from supi3.model.registers import RegisterFile
-from supi3.regmap import IN0, OUT0, SET
 from supi3.sdk import native
 from supi3.sdk.bench import Bench
-from supi3.sdk.driver import Mode, Supi3Driver
+from supi3.sdk.driver import Supi3Driver
 from supi3.sdk.transports import ModelTransport
 
 PASS_ACCESSES = 1000
@@ -57,15 +55,6 @@ void fw_loop(supi3_t *chip, fw_board_t *board)
 """
 
 
-def _best(repeat: int, run: Callable[[], None]) -> float:
-    best = float("inf")
-    for _ in range(repeat):
-        start = time.perf_counter()
-        run()
-        best = min(best, time.perf_counter() - start)
-    return best
-
-
 def _driver() -> Supi3Driver:
     return Supi3Driver(ModelTransport(RegisterFile(decode("10011", "1110"))))  # RB, Init-µP
 
@@ -82,21 +71,7 @@ def c_accesses_per_s(accesses: int, repeat: int, folder: Path) -> float:
         for _ in range(passes):
             firmware.call("fw_loop")
 
-    return passes * PASS_ACCESSES / _best(repeat, run)
-
-
-def python_accesses_per_s(accesses: int, repeat: int) -> float:
-    """``Supi3Driver`` register accesses per second, the same workload."""
-    drv = _driver()
-    drv.initialize(Mode.MOTOROLA)
-    drv.write(SET, 0x82)
-
-    def run() -> None:
-        for k in range(accesses // 2):
-            drv.write(IN0, k & 0xFF)
-            drv.read(OUT0)
-
-    return accesses // 2 * 2 / _best(repeat, run)
+    return passes * PASS_ACCESSES / best(repeat, run)
 
 
 def firmware_run(cycles: int, bit_rate: int, repeat: int) -> tuple[float, float, int, int]:
@@ -112,7 +87,7 @@ def firmware_run(cycles: int, bit_rate: int, repeat: int) -> tuple[float, float,
         bench.run(cycles)
         simulated, interrupts, served = bench.now, bench.interrupts, firmware.board.cycles
 
-    return _best(repeat, run), simulated, interrupts, served
+    return best(repeat, run), simulated, interrupts, served
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -126,7 +101,7 @@ def main(argv: list[str] | None = None) -> None:
           f"--repeat {args.repeat}")
     with tempfile.TemporaryDirectory() as folder:
         c_rate = c_accesses_per_s(args.accesses, args.repeat, Path(folder))
-    py_rate = python_accesses_per_s(args.accesses, args.repeat)
+    py_rate = driver_accesses_per_s(args.accesses, args.repeat)
     print(f"C driver (cffi) over ModelTransport: {c_rate:,.0f} accesses/s; Python driver: {py_rate:,.0f} "
           f"accesses/s (C/Python {c_rate / py_rate:.2f})")
     for bit_rate in tables.BIT_RATES:

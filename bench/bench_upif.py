@@ -2,10 +2,9 @@
 
 Transaction level: ``UpInterface.write`` / ``read`` register accesses per second (pedantic mode off, and on for its
 cost), and bytes per second of ``UpInterface.transfer`` (one byte per call, as the C driver is served). Pin level:
-bytes per second of a software µP (``supi3.spi.master.SoftMaster``) driving ``SlavePins`` at the fastest Table 3-7 timing. Each is
-printed as a ratio to the real interface, whose time per byte is ``supi3.timing.upif_byte_s`` (Table 3-7, at the
-fastest SCLK); one register access is a command byte and a data byte. Run from the
-repository root:
+bytes per second of a software µP (``supi3.spi.master.SoftMaster``) driving ``SlavePins`` at the fastest Table 3-7
+timing. Each is printed as a ratio to the real interface, whose time per byte is ``supi3.timing.upif_byte_s`` (Table
+3-7, at the fastest SCLK); one register access is a command byte and a data byte. Run from the repository root:
 
     python bench/bench_upif.py [--accesses N] [--bytes N] [--repeat R]
 """
