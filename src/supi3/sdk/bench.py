@@ -156,15 +156,15 @@ class BenchTransport(ModelTransport):
         """One frame: the chip decides what it drives at /SS falling, takes the byte at /SS rising (UP-18, UP-19);
         the bus runs up to each edge."""
         bench = self.bench
-        protocol = self.protocol
         bench.advance(bench.now)
-        with self._deferred:
-            driven = protocol.begin(s_r)
-            bench.advance(bench.now + bench.byte_s)
-            protocol.end(driven if driven is not None and protocol.mode is Mode.INTEL else tx)
+        driven = super().xfer(tx, s_r)
         bench.bytes_clocked += 1
         bench.irq_edge()
-        return driven or 0
+        return driven
+
+    def _during_frame(self) -> None:
+        bench = self.bench
+        bench.advance(bench.now + bench.byte_s)
 
     def delay_us(self, us: float) -> None:
         """Busy wait: the bus runs on."""

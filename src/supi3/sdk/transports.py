@@ -54,8 +54,12 @@ class ModelTransport(Transport):
         protocol = self.protocol
         with self._deferred:
             driven = protocol.begin(s_r)
+            self._during_frame()
             protocol.end(driven if driven is not None and protocol.mode is Mode.INTEL else tx)
         return driven or 0
+
+    def _during_frame(self) -> None:
+        """Between /SS falling and rising: no time passes on the bare model (a bench runs its bus here)."""
 
     def read_cd(self) -> int:
         """The protocol's C/D (UP-2)."""
