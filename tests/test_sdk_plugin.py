@@ -54,11 +54,17 @@ def test_outputs_reach_the_firmware(supi3_bench, supi3_master):
 @pytest.mark.supi3(3)
 def test_positional_marker_arguments_are_refused(supi3_bench):
     pass
+
+
+@pytest.mark.supi3(bitrate=2_000_000)
+def test_unknown_marker_arguments_are_refused(supi3_bench):
+    pass
 '''
 
 
 def test_a_firmware_project_uses_the_fixtures(pytester: pytest.Pytester) -> None:
     pytester.makepyfile(test_firmware=FIRMWARE_TEST)
     result = pytester.runpytest("--strict-markers", "-p", "no:cacheprovider")
-    result.assert_outcomes(passed=1, errors=1)
-    result.stdout.fnmatch_lines(["*keyword arguments of Bench only*"])
+    result.assert_outcomes(passed=1, errors=2)
+    result.stdout.fnmatch_lines(["*keyword arguments of Bench only*not (3,)*",
+                                 "*keyword arguments of Bench only*not bitrate*"])

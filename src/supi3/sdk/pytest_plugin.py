@@ -17,6 +17,8 @@
 
 from __future__ import annotations
 
+import inspect
+
 import pytest
 
 from supi3.interbus.master import Master
@@ -37,9 +39,14 @@ def pytest_configure(config: pytest.Config) -> None:
 def supi3_bench(request: pytest.FixtureRequest) -> Bench:
     """A firmware bench (master, ring, chip and firmware on one clock), configured by the ``supi3`` marker."""
     marker = request.node.get_closest_marker(MARKER)
-    if marker is not None and marker.args:
-        raise pytest.UsageError(f"@pytest.mark.{MARKER} takes keyword arguments of Bench only, not {marker.args!r}")
-    return Bench(**(marker.kwargs if marker is not None else {}))
+    if marker is None:
+        return Bench()
+    unknown = sorted(set(marker.kwargs) - set(inspect.signature(Bench).parameters))
+    if marker.args or unknown:
+        shown = repr(marker.args) if marker.args else ", ".join(unknown)
+        raise pytest.UsageError(f"@pytest.mark.{MARKER} takes keyword arguments of Bench only "
+                                f"({', '.join(inspect.signature(Bench).parameters)}), not {shown}")
+    return Bench(**marker.kwargs)
 
 
 @pytest.fixture
