@@ -21,8 +21,8 @@ from supi3.interbus import wire
 from supi3.interbus.device import PlainDevice
 from supi3.interbus.ring import BitFlip
 from supi3.interbus.wire import Cycle
-from supi3.model.registers import InconsistentDataError
-from supi3.regmap import IRQ_EVT, OUT0
+from supi3.model.registers import InconsistentDataError, ReconfigurationError
+from supi3.regmap import IRQ_EVT, OUT0, SET
 from supi3.sdk.bench import IDLE_LOOPS_LIMIT, Bench, BenchError, CycleTiming, Firmware, default_config
 from supi3.sdk.driver import DriverArgumentError, Irq, Mode, Supi3Driver, get_u16, put_u16
 from supi3.timing import TimingError
@@ -282,3 +282,28 @@ def test_stat_err_and_mod_ack_reach_the_master_and_back() -> None:
     bench.run(4)
     assert bench.chip.events["MODACK"] == 1 and not bench.chip.pf
     assert bench.mod_ack == 1  # the 375 ns pulse is over
+
+
+class Reconfigures(Echo):
+    """Rewrites SET to 2 words in its third service routine, while the bus runs (3.4.11: not permitted)."""
+
+    def isr(self, drv: Supi3Driver) -> None:
+        if len(self.seen) >= 3:  # reconfigured: only serve the interrupt
+            drv.irq_service()
+            return
+        super().isr(drv)
+        if len(self.seen) == 3:
+            drv.write(SET, 0x85)
+
+
+def test_set_rewritten_during_a_frame_latches_nothing_and_the_bus_recovers() -> None:
+    bench = Bench(firmware=Reconfigures())
+    with pytest.raises(ReconfigurationError, match="during bus operation"):
+        bench.run(20)
+    out_before = bench.registers.value("OUT0")
+    invalid = bench.chip.events["INVALID"]
+    bench.run(1)  # the frame that loaded 2 bytes ends in a chip that now has 4: discarded (M15)
+    assert bench.chip.events["INVALID"] == invalid + 1 and bench.registers.value("OUT0") == out_before
+    bench.run(10)  # the master sees the new length and rebuilds its table (A19)
+    config = bench.master.config
+    assert config is not None and config[0].data_bytes == 4

@@ -180,10 +180,10 @@ class Supi3:
 
     __slots__ = (
         "__dict__",  # room beyond the declared state, so that a test can spy on a chip's methods
-        "_deadline", "_due_s", "_events", "_fast_valid", "_fixed_bytes", "_in_map", "_loaded", "_now", "_out",
-        "_out_map", "_send_alarm", "_shown", "_stat_err", "_stat_low_since", "attention", "bus_active", "config", "due",
-        "in_word", "io_access", "mfp_in", "mod_ack_until", "pf", "registers", "resreg_until", "revision", "te",
-        "watchdog_code", "wd",
+        "_deadline", "_due_s", "_events", "_fast_valid", "_fixed_bytes", "_frame_bytes", "_in_map", "_loaded", "_now",
+        "_out", "_out_map", "_send_alarm", "_shown", "_stat_err", "_stat_low_since", "attention", "bus_active",
+        "config", "due", "in_word", "io_access", "mfp_in", "mod_ack_until", "pf", "registers", "resreg_until",
+        "revision", "te", "watchdog_code", "wd",
     )  # fmt: skip
 
     data_kernel: ClassVar[DataKernel] = DataKernel(_load_data_run, _latch_data_run)
@@ -210,6 +210,7 @@ class Supi3:
         # Pin-strapped modes have a fixed data length; the µP modes ask the register file every time.
         self._fixed_bytes = None if self.registers is not None else wire.data_bytes(self.config.length_code)
         self._loaded = (-1, b"")  # (MFP levels, IN bytes) of the last data-cycle load
+        self._frame_bytes = -1  # µP modes: the data bytes the last data-cycle load gave (M15)
         self._shown: tuple[bytes | None, int] = (None, 0)  # (OUT bytes, MFP levels) last driven
         self.revision = 0
         """Counts the changes of what the pins show (OUT data, ``pf``, ``bus_active``, the /ModAck and /ResReg
@@ -408,7 +409,9 @@ class Supi3:
         if cycle is Cycle.ID:
             return wire.word_bytes(self.id_register())
         if self.registers is not None:
-            return self.registers.in_bytes() if self.data_bytes() else b""
+            data = self.registers.in_bytes() if self.data_bytes() else b""
+            self._frame_bytes = len(data)
+            return data
         if not self._in_map:
             return self.in_word.to_bytes(self.data_bytes(), "big")
         levels, loaded = self._loaded
@@ -432,6 +435,11 @@ class Supi3:
             clk = _clock(clk)
         length = self.data_bytes() if cycle is _DATA else _WORD_BYTES
         if type(received) is not bytes or len(received) != length:
+            if cycle is _DATA and type(received) is bytes and len(received) == self._frame_bytes:
+                # SET was rewritten while this frame ran (ReconfigurationError, 3.4.11): the frame's length is
+                # not the chip's any more, so nothing is latched (M15).
+                self.discard_at(cycle, True, clk)
+                return
             what = "the OUT data" if cycle is _DATA else "the command word"
             received = _checked(check_bytes, "received", received, length, f"{what} of the {cycle.value} cycle")
         self.revision += 1
