@@ -1,0 +1,86 @@
+"""Serial register expansion (manual 3.5, Tables 3-14 and 3-15, Figures 3-23 and 3-24): the signals, clock by clock.
+
+The one definition of what the SUPI 3 OPC drives on ClkExR, ToExR, LaOuD, /LaInD and /ResReg when the SET register
+selects external data registers (ExtReg = 1, 3.4.11), and of how bytes sit in the external chain. The pin-level
+model, the RTL, the transaction-level chip and the IBS SRE 1 model derive from it; the Table 3-15 checker measures
+traces on its own. Decisions RX-1 to RX-10 are in ``docs/assumptions/expansion.md``.
+
+* **Data path** (RX-2): in a data cycle every data bit the chip receives leaves on ToExR instead of entering the
+  internal data registers, and the bit the chip sends in its place is the one FromExR shows; the external chain is
+  the chip's shift register (as long as the SET register's complete length code says, Table 3-11).
+* **ClkExR** (RX-3): at the clock edge where the receiver samples data bit ``k`` the chip takes FromExR (through its
+  synchroniser) and puts bit ``k`` on ToExR from the next cycle; ClkExR is high from :func:`clock_high` cycles
+  after that, for half a bit: ToExR is valid 0.25 t0 before the rising edge and 0.75 t0 after it (Table 3-15).
+* **End of a cycle** (RX-4): after a latched data cycle LaOuD is high for 4 t0 (the external registers take the
+  OUT data), then 5 t0 later /LaInD is low for 4 t0 (they load the IN data of the next cycle into the chain); after
+  any other cycle end (ID cycle, discarded data cycle) only /LaInD, at once.
+* **/ResReg** (RX-5): with expansion, low for 4 t0 on an INTERBUS reset and on a watchdog reset of process data.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Final
+
+from supi3.checks import check_bool, check_bytes, check_int
+
+__all__ = [
+    "LAIND_AFTER_LAOUD_T0",
+    "PULSE_T0",
+    "EndPulses",
+    "chain_to_line",
+    "clock_high",
+    "end_pulses",
+    "line_to_chain",
+]
+
+PULSE_T0: Final = 4
+"""LaOuD, /LaInD and /ResReg pulses last 4 t0 = 4 bit periods (Table 3-15 minimums, RX-4, RX-5)."""
+LAIND_AFTER_LAOUD_T0: Final = 5
+"""/LaInD falls 5 t0 after LaOuD fell (Table 3-15 minimum)."""
+
+
+def clock_high(cpb: int) -> tuple[int, int]:
+    """(first, end) offsets of ClkExR's high phase from the first cycle ToExR shows a bit, in clocks: a quarter of
+    a bit to three quarters (RX-3). ``cpb``: clocks per bit (64 or 16)."""
+    check_int("cpb", cpb, 4)
+    return cpb // 4, 3 * cpb // 4
+
+
+@dataclass(frozen=True)
+class EndPulses:
+    """The pulses after a cycle's end, as (first, end) offsets in clocks from the cycle after the end's edge."""
+
+    la_ou_d: tuple[int, int] | None
+    """LaOuD high (only after a latched data cycle)."""
+    la_in_d_n: tuple[int, int]
+    """/LaInD low."""
+
+    @property
+    def length(self) -> int:
+        """Cycles until both pulses are over: the chain holds the next IN data from here."""
+        return self.la_in_d_n[1]
+
+
+def end_pulses(latched_data: bool, cpb: int) -> EndPulses:
+    """The pulses after a cycle ends: a latched data cycle (``latched_data``) or anything else (RX-4)."""
+    check_bool("latched_data", latched_data)
+    check_int("cpb", cpb, 4)
+    width = PULSE_T0 * cpb
+    if not latched_data:
+        return EndPulses(None, (0, width))
+    start = width + LAIND_AFTER_LAOUD_T0 * cpb
+    return EndPulses((0, width), (start, start + width))
+
+
+def line_to_chain(received: bytes) -> bytes:
+    """The external chain after the data cycle, numbered from ToExR (byte 0 next to ToExR) as Figure 3-24 numbers
+    it, from the bytes in the order the chip received them: the first received is furthest from ToExR. The manual's
+    example: received 14h, 56h, 78h gives bytes 0..2 = 78h, 56h, 14h."""
+    return bytes(reversed(check_bytes("received", received)))
+
+
+def chain_to_line(chain: bytes) -> bytes:
+    """The bytes the chain sends, in line order, from the chain numbered from ToExR (the inverse of
+    :func:`line_to_chain`): the byte furthest from ToExR reaches FromExR first."""
+    return bytes(reversed(check_bytes("chain", chain)))

@@ -1,0 +1,205 @@
+"""Serial I/O (SPI master mode, manual 3.3): the chip's access sequence on MFP3..MFP7, clock by clock.
+
+The one definition of what the chip drives in the SPI master modes of Tables 2-4 to 2-6 (pins of Table 3-3, times of
+Table 3-4, Figures 3-1 to 3-3). The pin-level model (:mod:`supi3.model.blocks.serial_io`), the RTL
+(:mod:`supi3.rtl.serial_io`), the transaction-level chip and the figures all derive from these functions; the
+Table 3-4 checker (:mod:`supi3.verif.timing`) does not: it measures traces against the table on its own. The
+decisions where the manual is silent or garbled are SM-1 to SM-10 of ``docs/assumptions/serial-io.md``.
+
+A *sequence* starts on the clock after the edge at which a valid data cycle is latched (SM-2). Offsets below are
+clock cycles from the sequence's first cycle; the pins hold the given levels during that cycle.
+
+* **Frame** (SM-3, SM-4): /SS low for ``9 * n * t0`` (t8, ``n`` bytes: 2 or 4, one /SS over the whole 16 or 32
+  bits); bit ``j`` (MSB first, D15 or D31 first: t11) has a slot of ``t0`` starting ``t0/2 + (j + j // 8) * t0``
+  after /SS fell; SCLK is low in the slot's first half and high in its second (idle low: the first rising edge is
+  ``t0`` after /SS falls, t1; the last is ``t0`` before /SS rises, t2); one slot is left out between bytes (t9 =
+  2 t0 from rising edge to rising edge). SerOut changes at slot starts (t3, t11, t12 = t0/2) and is 0 outside
+  write frames.
+* **Sample** (SM-5): SerIn is taken at each rising SCLK edge: the level it had in the cycle before SCLK rose.
+* **Sequence** (SM-6): input mode: one read frame. Output mode: one write frame, then /Conv low for ``t0`` starting
+  ``t0`` after /SS rose (t6, t7). Input/output mode: read frame, pause of :data:`PAUSE_T0` t0 (t10), write frame,
+  /Conv. The IN word read is taken over on the sequence's last clock edge (the third step of 3.3.1).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Final
+
+from supi3.checks import check_bits, check_choice, check_int
+from supi3.config import DataDirection
+from supi3.interbus import wire
+from supi3.tables import BIT_RATES
+
+__all__ = [
+    "IDLE",
+    "PAUSE_T0",
+    "Levels",
+    "SerialFrame",
+    "SerialSequence",
+    "clear_sequence",
+    "sequence",
+    "t0_clocks",
+]
+
+PAUSE_T0: Final = 51
+"""t10, Read /SS to Write /SS, in t0: Table 3-4 prints "50.5 * t0"; whole t0 keep SCLK's phase (SM-7)."""
+CONV_DELAY_T0: Final = 1
+"""t6: /Conv falls t0 after /SS rose (Table 3-4 minimum)."""
+CONV_WIDTH_T0: Final = 1
+"""t7: /Conv is low for t0 (Table 3-4 minimum)."""
+BYTE_SLOTS: Final = 9
+"""t8 = 9 * n * t0: eight bit slots and one pause slot per byte (t9 = 2 t0 between the bytes' rising edges)."""
+
+
+@dataclass(frozen=True)
+class Levels:
+    """MFP3..MFP7 driven by the chip in one cycle (Table 3-3); SerIn (MFP6) is the chip's input."""
+
+    conv_n: int
+    sclk: int
+    ss_n: int
+    ser_out: int
+
+    def mfp(self) -> int:
+        """The levels as MFP bits: /Conv MFP3, SCLK MFP4, /SS MFP5, SerOut MFP7."""
+        return (self.conv_n << 3) | (self.sclk << 4) | (self.ss_n << 5) | (self.ser_out << 7)
+
+
+IDLE: Final = Levels(conv_n=1, sclk=0, ss_n=1, ser_out=0)
+"""Between sequences, after power-up and during the reset stretch (SM-8)."""
+MFP_MASK: Final = IDLE.mfp() | Levels(0, 1, 0, 1).mfp() | (1 << 3) | (1 << 5)
+"""The MFP bits the serial I/O drives (MFP3, 4, 5, 7)."""
+
+
+def t0_clocks(bit_rate: int) -> int:
+    """t0 = t_Bit_IBS / 2 in 32 MHz clocks (Table 3-4): 32 at 500 kbit/s (1 MHz SCLK), 8 at 2 Mbit/s (4 MHz)."""
+    check_choice("bit_rate", bit_rate, BIT_RATES, limit="Table 1-7")
+    return wire.clocks_per_bit(bit_rate) // 2
+
+
+@dataclass(frozen=True)
+class SerialFrame:
+    """One /SS frame of a sequence: its first cycle (offset), its bit count and whether it writes SerOut."""
+
+    start: int
+    bits: int
+    write: bool
+    t0: int
+
+    @property
+    def length(self) -> int:
+        """Cycles with /SS low: 9 * n * t0 (t8)."""
+        return BYTE_SLOTS * (self.bits // 8) * self.t0
+
+    @property
+    def end(self) -> int:
+        """The first cycle after the frame (/SS high again)."""
+        return self.start + self.length
+
+    def slot(self, j: int) -> int:
+        """The first cycle of bit ``j``'s slot (SCLK low half; SerOut changes here)."""
+        return self.start + self.t0 // 2 + (j + j // 8) * self.t0
+
+    def rising(self, j: int) -> int:
+        """The first SCLK-high cycle of bit ``j`` (its rising edge is at the start of this cycle)."""
+        return self.slot(j) + self.t0 // 2
+
+    def sample(self, j: int) -> int:
+        """The cycle whose SerIn level is bit ``j`` of a read frame: the last before SCLK rises (SM-5)."""
+        return self.rising(j) - 1
+
+
+@dataclass(frozen=True)
+class SerialSequence:
+    """The frames and /Conv pulse of one sequence, and its length in cycles."""
+
+    frames: tuple[SerialFrame, ...]
+    conv: tuple[int, int] | None
+    """(first, end) cycles of the /Conv low pulse, or None (input mode)."""
+    length: int
+    """Cycles of the sequence; the IN word read is taken over on the edge ending cycle ``length - 1``."""
+
+    @property
+    def read(self) -> SerialFrame | None:
+        """The read frame, if any."""
+        return next((f for f in self.frames if not f.write), None)
+
+    @property
+    def write(self) -> SerialFrame | None:
+        """The write frame, if any."""
+        return next((f for f in self.frames if f.write), None)
+
+    def levels(self, k: int, out_word: int) -> Levels:
+        """The pins in cycle ``k`` of the sequence, writing ``out_word`` (IDLE outside ``0 <= k < length``)."""
+        conv = 0 if self.conv is not None and self.conv[0] <= k < self.conv[1] else 1
+        for frame in self.frames:
+            if frame.start <= k < frame.end:
+                j = _bit_at(frame, k)
+                sclk = int(j is not None and frame.rising(j) <= k < frame.slot(j) + frame.t0)
+                out = 0
+                if frame.write and k >= frame.slot(0):
+                    last = j if j is not None else _last_bit_before(frame, k)
+                    out = (out_word >> (frame.bits - 1 - last)) & 1
+                return Levels(conv_n=conv, sclk=sclk, ss_n=0, ser_out=out)
+        return Levels(conv_n=conv, sclk=0, ss_n=1, ser_out=0)
+
+
+def _bit_at(frame: SerialFrame, k: int) -> int | None:
+    """The bit whose slot holds cycle ``k`` of ``frame``, or None (before the first slot or in a pause slot)."""
+    rel = k - frame.start - frame.t0 // 2
+    if rel < 0:
+        return None
+    slot = rel // frame.t0
+    byte, within = divmod(slot, BYTE_SLOTS)
+    return None if within == 8 or 8 * byte + within >= frame.bits else 8 * byte + within
+
+
+def _last_bit_before(frame: SerialFrame, k: int) -> int:
+    rel = k - frame.start - frame.t0 // 2
+    slot = rel // frame.t0
+    byte, within = divmod(slot, BYTE_SLOTS)
+    return min(8 * byte + min(within, 7), frame.bits - 1)
+
+
+def sequence(direction: DataDirection, bits: int, bit_rate: int) -> SerialSequence:
+    """The sequence after a valid data cycle in the SPI master mode ``direction`` with ``bits`` (16 or 32) per
+    transfer at ``bit_rate`` (3.3.1, Figures 3-1 to 3-3)."""
+    check_choice("direction", direction, (DataDirection.IN, DataDirection.OUT, DataDirection.IN_OUT))
+    check_choice("bits", bits, (16, 32), limit="Tables 2-4 to 2-6")
+    t0 = t0_clocks(bit_rate)
+    if direction is DataDirection.IN:
+        frame = SerialFrame(0, bits, False, t0)
+        return SerialSequence((frame,), None, frame.end)
+    read: tuple[SerialFrame, ...] = ()
+    start = 0
+    if direction is DataDirection.IN_OUT:
+        read = (SerialFrame(0, bits, False, t0),)
+        start = read[0].end + PAUSE_T0 * t0
+    return _with_write(read, start, bits, t0)
+
+
+def clear_sequence(direction: DataDirection, bits: int, bit_rate: int) -> SerialSequence | None:
+    """After an INTERBUS reset or a watchdog reset of process data: a write frame of zeros and /Conv in the modes
+    with OUT data, so the peripherals' outputs follow the cleared OUT register (SM-9); None in input mode."""
+    if direction is DataDirection.IN:
+        check_choice("bits", bits, (16, 32), limit="Tables 2-4 to 2-6")
+        t0_clocks(bit_rate)
+        return None
+    check_choice("direction", direction, (DataDirection.OUT, DataDirection.IN_OUT))
+    check_choice("bits", bits, (16, 32), limit="Tables 2-4 to 2-6")
+    return _with_write((), 0, bits, t0_clocks(bit_rate))
+
+
+def _with_write(read: tuple[SerialFrame, ...], start: int, bits: int, t0: int) -> SerialSequence:
+    write = SerialFrame(start, bits, True, t0)
+    conv = write.end + CONV_DELAY_T0 * t0
+    return SerialSequence((*read, write), (conv, conv + CONV_WIDTH_T0 * t0), conv + CONV_WIDTH_T0 * t0)
+
+
+def render(seq: SerialSequence, out_word: int) -> list[Levels]:
+    """Every cycle of ``seq`` writing ``out_word`` (for figures and tests; the model computes cycles on demand)."""
+    bits = seq.frames[0].bits
+    check_bits("out_word", out_word, bits)
+    check_int("length", seq.length, 1)
+    return [seq.levels(k, out_word) for k in range(seq.length)]
