@@ -24,7 +24,7 @@ clock cycles from the sequence's first cycle; the pins hold the given levels dur
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Final
+from typing import Final, Protocol, runtime_checkable
 
 from supi3.checks import check_bits, check_choice, check_int
 from supi3.config import DataDirection
@@ -35,6 +35,7 @@ __all__ = [
     "IDLE",
     "PAUSE_T0",
     "Levels",
+    "SerialDevice",
     "SerialFrame",
     "SerialSequence",
     "clear_sequence",
@@ -70,6 +71,36 @@ IDLE: Final = Levels(conv_n=1, sclk=0, ss_n=1, ser_out=0)
 """Between sequences, after power-up and during the reset stretch (SM-8)."""
 MFP_MASK: Final = IDLE.mfp() | Levels(0, 1, 0, 1).mfp() | (1 << 3) | (1 << 5)
 """The MFP bits the serial I/O drives (MFP3, 4, 5, 7)."""
+
+
+PERIPHERAL_DELAY_CLOCKS: Final = 2
+"""A device's SerIn answers an edge of the chip's pins 2 clocks (62.5 ns) later, within Table 3-4's hold time t5
+(50 ns) and well inside half an SCLK period (SM-10). A device attached to the chip model
+(:meth:`supi3.model.chip.Supi3.attach_serial`) therefore shows, at each sample, its answer to every edge before that
+SCLK rise."""
+
+
+@runtime_checkable
+class SerialDevice(Protocol):
+    """What hangs on the serial I/O bus (3.3.1: shift registers, ADCs, DACs), at either fidelity.
+
+    The transaction level calls :meth:`frame` and :meth:`convert` once per /SS frame and /Conv pulse; the pin level
+    calls :meth:`clock` at every cycle in which the chip's MFP3..MFP7 change. A device is driven at one fidelity.
+    """
+
+    @property
+    def drives_ser_in(self) -> bool:
+        """The device's serial output is wired to the chip's SerIn (at most one device on a bus)."""
+
+    def frame(self, ser_out: int, bits: int) -> int:
+        """One /SS frame of ``bits`` SCLK pulses writing ``ser_out`` MSB first (0 in read frames); returns the bits
+        the device put on SerIn, MSB first (0 if it does not drive SerIn)."""
+
+    def convert(self) -> None:
+        """A /Conv pulse (output mode: the DAC converts, the output register takes the shifted word)."""
+
+    def clock(self, levels: Levels) -> int:
+        """The chip's pins changed to ``levels``; returns the SerIn level the device drives from then on."""
 
 
 def t0_clocks(bit_rate: int) -> int:
