@@ -20,7 +20,7 @@ traces on its own. Decisions RX-1 to RX-10 are in ``docs/assumptions/expansion.m
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Final
+from typing import Final, Protocol, runtime_checkable
 
 from supi3.checks import check_bool, check_bytes, check_int
 
@@ -28,6 +28,8 @@ __all__ = [
     "LAIND_AFTER_LAOUD_T0",
     "PULSE_T0",
     "EndPulses",
+    "ExpansionLevels",
+    "ExternalRegisters",
     "chain_to_line",
     "clock_high",
     "end_pulses",
@@ -84,3 +86,51 @@ def chain_to_line(chain: bytes) -> bytes:
     """The bytes the chain sends, in line order, from the chain numbered from ToExR (the inverse of
     :func:`line_to_chain`): the byte furthest from ToExR reaches FromExR first."""
     return bytes(reversed(check_bytes("chain", chain)))
+
+
+@dataclass(frozen=True)
+class ExpansionLevels:
+    """The chip's register-expansion outputs in one cycle (Table 3-14)."""
+
+    clk_exr: int
+    to_exr: int
+    la_ou_d: int
+    la_in_d_n: int
+    res_reg_n: int
+
+
+IDLE: Final = ExpansionLevels(clk_exr=0, to_exr=0, la_ou_d=0, la_in_d_n=1, res_reg_n=1)
+"""After power-up and without expansion (ExtReg = 0, RX-6, RX-7)."""
+
+
+@runtime_checkable
+class ExternalRegisters(Protocol):
+    """External data registers on the expansion interface (the IBS SRE 1's role, 3.5), at either fidelity.
+
+    The transaction level calls :meth:`chain`, :meth:`shift_cycle`, :meth:`take_outputs`, :meth:`load_inputs` and
+    :meth:`clear` at the bus events; the pin level calls :meth:`clock` at every cycle in which the chip's expansion
+    outputs change. A chain is driven at one fidelity.
+    """
+
+    @property
+    def length(self) -> int:
+        """Bytes in the chain."""
+
+    def chain(self) -> bytes:
+        """The chain's contents in line order: what the next data cycle sends (transaction level)."""
+
+    def shift_cycle(self, received: bytes) -> None:
+        """A whole data cycle shifted through: the chain now holds ``received`` (line order, transaction level)."""
+
+    def take_outputs(self) -> None:
+        """LaOuD: the output registers take the chain."""
+
+    def load_inputs(self) -> None:
+        """/LaInD: the chain takes the input registers."""
+
+    def clear(self) -> None:
+        """/ResReg: output registers and chain cleared."""
+
+    def clock(self, levels: ExpansionLevels) -> int:
+        """The chip's pins changed to ``levels``; returns the FromExR level the chain drives from then on (it
+        answers 2 clocks later, as the serial I/O devices do: ``serial_io.PERIPHERAL_DELAY_CLOCKS``)."""
