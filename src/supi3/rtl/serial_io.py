@@ -1,0 +1,218 @@
+"""Serial I/O (SPI master mode, manual 3.3) in Amaranth: the access sequence on MFP3..MFP7, from counters.
+
+:class:`SerialIoRtl` drives /Conv, SCLK, /SS and SerOut exactly as :func:`supi3.spi.serial_io.sequence` schedules
+them (Tables 3-3, 3-4, Figures 3-1 to 3-3; decisions SM-1 to SM-9 of ``docs/assumptions/serial-io.md``), and reads
+SerIn into the IN word. Nothing is stored as a waveform: a sequence counter ``k`` places the frames and the /Conv
+pulse (their offsets are constants taken from the spec's :class:`~supi3.spi.serial_io.SerialSequence` for every
+direction, width and bit rate at elaboration), and a slot counter (``sub`` within a t0, ``within`` a byte of nine
+slots, ``lead`` for the half t0 before the first slot) gives SCLK, the SerOut shifts and the sample points.
+
+* ``start`` (the core's latch of a valid data cycle) with ``out_word``: a sequence begins on the next cycle (SM-2);
+  while one runs, the word waits (one deep, the newest wins) and its sequence begins on the cycle after the running
+  one ends.
+* ``reset`` (INTERBUS reset or watchdog reset of process data): the running sequence is aborted, a waiting one
+  dropped, the IN word cleared, and the clear sequence of the mode (:func:`~supi3.spi.serial_io.clear_sequence`,
+  none in input mode) begins on the next cycle (SM-9). A ``start`` at the same edge wins (the core applies a latch
+  after the watchdog's clearing).
+* ``ser_in`` is SerIn after the core's synchroniser: bit ``j`` of a read frame is taken at the edge ending cycle
+  ``sample(j) + SYNC_STAGES`` of the frame (SM-5); the IN word read is taken over at the edge ending the sequence's
+  last cycle (SM-6).
+"""
+
+from __future__ import annotations
+
+import itertools
+from typing import Final
+
+from amaranth.hdl import Cat, Module, Mux, Signal, Value
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+import supi3.spi.serial_io as spec
+from supi3.config import DataDirection
+from supi3.pinout import SYNC_STAGES
+from supi3.tables import BIT_RATES, SPI_MASTER_MFP
+
+__all__ = ["DIRECTIONS", "MFP_BITS", "SER_IN_PIN", "WIDTHS", "WORD_BITS", "SerialIoRtl", "schedule"]
+
+DIRECTIONS: Final = (DataDirection.IN, DataDirection.OUT, DataDirection.IN_OUT)
+"""The SPI master directions (SM-1), in the order of the ``direction`` port's values."""
+WIDTHS: Final = (16, 32)
+"""Bits per transfer (Tables 2-4 to 2-6), in the order of the ``wide`` port's values."""
+WORD_BITS: Final = max(WIDTHS)
+"""Width of the OUT and IN word ports (a 16-bit word in the low bits)."""
+_CLEAR: Final = len(DIRECTIONS)
+"""Sequence kinds: a direction's sequence (0..2) or its clear sequence (``_CLEAR`` + direction)."""
+
+
+def _mfp_bit(**level: int) -> int:
+    """The MFP bit of the one pin set in ``level`` (the rest at 0), by :meth:`supi3.spi.serial_io.Levels.mfp`."""
+    levels = spec.Levels(**{"conv_n": 0, "sclk": 0, "ss_n": 0, "ser_out": 0, **level})
+    return levels.mfp().bit_length() - 1
+
+
+MFP_BITS: Final = {name: _mfp_bit(**{name: 1}) for name in ("conv_n", "sclk", "ss_n", "ser_out")}
+"""The MFP bit of each driven level (Table 3-3: /Conv MFP3, SCLK MFP4, /SS MFP5, SerOut MFP7)."""
+SER_IN_PIN: Final = next(function.pin for function in SPI_MASTER_MFP if function.signal == "SerIn")
+"""SerIn's MFP pin (Table 3-3: MFP6)."""
+
+
+def schedule(kind: int, bits: int, bit_rate: int) -> spec.SerialSequence | None:
+    """The spec's sequence of a kind: direction ``DIRECTIONS[kind]``, or that direction's clear sequence for
+    ``kind >= len(DIRECTIONS)`` (None in input mode)."""
+    if kind < _CLEAR:
+        return spec.sequence(DIRECTIONS[kind], bits, bit_rate)
+    return spec.clear_sequence(DIRECTIONS[kind - _CLEAR], bits, bit_rate)
+
+
+def _schedules() -> dict[tuple[int, int, int], spec.SerialSequence | None]:
+    """Every (kind, width index, rate index) with its sequence."""
+    return {
+        (kind, wide, rate): schedule(kind, bits, bit_rate)
+        for kind, (wide, bits), (rate, bit_rate) in itertools.product(
+            range(2 * _CLEAR), enumerate(WIDTHS), enumerate(BIT_RATES)
+        )
+    }
+
+
+class SerialIoRtl(wiring.Component):
+    """The serial I/O block of the SPI master modes (block ``serial_io``).
+
+    Ports: ``start``, ``out_word`` (MSB first: D15 or D31 first, SM-4), ``reset``, ``ser_in`` (synchronised) and the
+    mode (``direction``: index into :data:`DIRECTIONS`; ``wide``: 32 bits; ``rate``: index into
+    :data:`supi3.tables.BIT_RATES`) in; the pin levels ``conv_n``, ``sclk``, ``ss_n``, ``ser_out``, the same as MFP
+    bits (``mfp``, :data:`MFP_BITS`), ``in_word`` and ``busy`` out. The mode must be static (straps).
+    """
+
+    def __init__(self) -> None:
+        self.schedules = _schedules()
+        self.longest = max(seq.length for seq in self.schedules.values() if seq is not None)
+        self.t0s = tuple(spec.t0_clocks(bit_rate) for bit_rate in BIT_RATES)
+        for t0 in self.t0s:
+            if t0 // 2 + SYNC_STAGES - 1 >= t0:
+                raise ValueError(f"a SerIn sample needs SYNC_STAGES < t0/2 + 1, not t0 = {t0}")
+        super().__init__({
+            "start": In(1), "out_word": In(WORD_BITS), "reset": In(1), "ser_in": In(1),
+            "direction": In(range(len(DIRECTIONS))), "wide": In(1), "rate": In(range(len(BIT_RATES))),
+            "conv_n": Out(1, init=spec.IDLE.conv_n), "sclk": Out(1, init=spec.IDLE.sclk),
+            "ss_n": Out(1, init=spec.IDLE.ss_n), "ser_out": Out(1, init=spec.IDLE.ser_out),
+            "mfp": Out(max(MFP_BITS.values()) + 1, init=spec.IDLE.mfp()),
+            "in_word": Out(WORD_BITS), "busy": Out(1),
+        })  # fmt: skip
+
+    def elaborate(self, _platform: object) -> Module:
+        m = Module()
+        sync, comb = m.d.sync, m.d.comb
+        k_range = range(self.longest + 1)
+
+        # The running sequence's constants (from the spec's schedule) ------------------------------------------
+        busy = self.busy
+        kind = Signal(range(2 * _CLEAR))
+        read_on, write_on, conv_on = Signal(), Signal(), Signal()
+        read_start, read_end, write_start, write_end = (Signal(k_range, name=n) for n in ("rs", "re", "ws", "we"))
+        conv_start, conv_end, length = Signal(k_range), Signal(k_range), Signal(k_range)
+        with m.Switch(Cat(kind, self.wide, self.rate)):
+            for (kind_value, wide, rate), seq in self.schedules.items():
+                if seq is None:
+                    continue
+                with m.Case(kind_value | (wide << len(kind)) | (rate << (len(kind) + 1))):
+                    comb += length.eq(seq.length)
+                    for frame, on, first, end in ((seq.read, read_on, read_start, read_end),
+                                                  (seq.write, write_on, write_start, write_end)):  # fmt: skip
+                        if frame is not None:
+                            comb += [on.eq(1), first.eq(frame.start), end.eq(frame.end)]
+                    if seq.conv is not None:
+                        comb += [conv_on.eq(1), conv_start.eq(seq.conv[0]), conv_end.eq(seq.conv[1])]
+        # Sequences a reset starts: the clear sequence of this mode's direction, if it has one.
+        has_clear = Signal()
+        with m.Switch(self.direction):
+            for direction in range(_CLEAR):
+                with m.Case(direction):
+                    comb += has_clear.eq(schedule(_CLEAR + direction, WIDTHS[0], BIT_RATES[0]) is not None)
+        t0 = Signal(range(max(self.t0s) + 1))
+        with m.Switch(self.rate):
+            for rate, value in enumerate(self.t0s):
+                with m.Case(rate):
+                    comb += t0.eq(value)
+
+        # Counters ---------------------------------------------------------------------------------------------
+        k = Signal(k_range)
+        sub = Signal(range(max(self.t0s)))  # clock within a t0, 0 at a slot's first cycle
+        lead = Signal()  # the half t0 between /SS falling and the first slot
+        within = Signal(range(spec.BYTE_SLOTS))  # slot within a byte: bits 0..7, then the pause slot
+        pause = within == spec.BYTE_SLOTS - 1
+        in_read = busy & read_on & (k >= read_start) & (k < read_end)
+        in_write = busy & write_on & (k >= write_start) & (k < write_end)
+        in_frame = in_read | in_write
+        high = sub >= (t0 >> 1)
+        out_shift = Signal(WORD_BITS)
+        in_shift = Signal(WORD_BITS)
+        pending = Signal()
+        pending_word = Signal(WORD_BITS)
+        frame_probe = spec.SerialFrame(0, WIDTHS[0], False, max(self.t0s))
+        sample_after = frame_probe.sample(0) + SYNC_STAGES - frame_probe.rising(0)  # clocks after SCLK rose
+
+        levels = {
+            "conv_n": ~(busy & conv_on & (k >= conv_start) & (k < conv_end)),
+            "sclk": in_frame & ~lead & ~pause & high,
+            "ss_n": ~in_frame,
+            "ser_out": in_write & ~lead & out_shift[-1],
+        }
+        comb += [getattr(self, name).eq(level) for name, level in levels.items()]
+        comb += self.mfp.eq(sum((level << MFP_BITS[name] for name, level in levels.items()), Value.cast(0)))
+
+        def frame_begins() -> list[Value]:
+            """The slot counters as they stand in a frame's first cycle: in the lead half t0."""
+            return [sub.eq(t0 >> 1), lead.eq(1), within.eq(0)]
+
+        last = busy & (k == length - 1)
+        with m.If(busy):
+            sync += k.eq(k + 1)
+            with m.If(sub == t0 - 1):
+                sync += sub.eq(0)
+                with m.If(lead):
+                    sync += lead.eq(0)
+                with m.Else():
+                    sync += within.eq(Mux(pause, 0, within + 1))
+                    with m.If(in_write & (within != spec.BYTE_SLOTS - 2)):  # the next slot carries bit j > 0
+                        sync += out_shift.eq(out_shift << 1)
+            with m.Else():
+                sync += sub.eq(sub + 1)
+            with m.If(in_read & ~lead & ~pause & (sub == (t0 >> 1) + sample_after)):
+                sync += in_shift.eq(Cat(self.ser_in, in_shift[:-1]))
+            with m.If(write_on & (k + 1 == write_start)):
+                sync += frame_begins()
+        with m.If(last):
+            sync += busy.eq(0)
+            with m.If(read_on):
+                sync += self.in_word.eq(in_shift)
+
+        # Start, pending start, reset (SM-2, SM-9) -------------------------------------------------------------
+        free = ~busy | last | self.reset
+        want = self.start | (pending & ~self.reset)
+        go = want & free
+        word = Mux(self.start, self.out_word, pending_word)
+        width_shift = Mux(self.wide, 0, WORD_BITS - WIDTHS[0])
+        with m.If(self.start & ~free):
+            sync += [pending.eq(1), pending_word.eq(self.out_word)]
+        with m.If(self.reset):
+            sync += [
+                busy.eq(has_clear),
+                kind.eq(_CLEAR + self.direction),
+                k.eq(0),
+                out_shift.eq(0),
+                pending.eq(0),
+                self.in_word.eq(0),
+                *frame_begins(),
+            ]
+        with m.If(go):
+            sync += [
+                busy.eq(1),
+                kind.eq(self.direction),
+                k.eq(0),
+                out_shift.eq(word << width_shift),
+                in_shift.eq(0),
+                pending.eq(0),
+                *frame_begins(),
+            ]
+        return m
