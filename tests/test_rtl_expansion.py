@@ -1,0 +1,128 @@
+"""The register expansion block in Amaranth (supi3.rtl.expansion) against the spec's schedule (supi3.expansion).
+
+Manual 3.5 (Tables 3-14, 3-15, Figure 3-23) and RX-1 to RX-7 of docs/assumptions/expansion.md, at both bit rates:
+ToExR and ClkExR per data bit (``clock_high``), the end pulses after a latched data cycle and after any other
+cycle end (``end_pulses``), /ResReg for PULSE_T0 bit periods, FromExR sent in place of the internal register, idle
+pins without ExtReg. On Amaranth's own simulator.
+"""
+
+from __future__ import annotations
+
+import random
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+from amaranth.sim import Simulator
+
+from supi3 import expansion
+from supi3.expansion import IDLE, ExpansionLevels
+from supi3.interbus import wire
+from supi3.rtl.expansion import PIN_NAMES, ExpansionRtl
+from supi3.tables import BIT_RATES
+
+Row = dict[str, int]
+
+
+def simulate(bit_rate: int, rows: Iterator[Row]) -> tuple[list[ExpansionLevels], list[Row]]:
+    """Per cycle: set the inputs of ``rows`` (missing ones 0), read the pins and ``send``/``overrun``/``active``."""
+    dut = ExpansionRtl()
+    levels: list[ExpansionLevels] = []
+    seen: list[Row] = []
+
+    async def bench(ctx: Any) -> None:
+        ctx.set(dut.rate, BIT_RATES.index(bit_rate))
+        for row in rows:
+            for name in ("ext", "load", "load_id", "shift", "level", "ended", "latched", "reset", "from_exr"):
+                ctx.set(getattr(dut, name), row.get(name, 0))
+            levels.append(ExpansionLevels(*(ctx.get(getattr(dut, name)) for name in PIN_NAMES)))
+            seen.append({name: ctx.get(getattr(dut, name)) for name in ("send", "overrun", "active")})
+            await ctx.tick()
+
+    simulator = Simulator(dut)
+    simulator.add_clock(1 / 32e6)
+    simulator.add_testbench(bench)
+    simulator.run()
+    return levels, seen
+
+
+def window(first: int, span: tuple[int, int]) -> range:
+    return range(first + span[0], first + span[1])
+
+
+@pytest.mark.parametrize("bit_rate", BIT_RATES)
+@pytest.mark.parametrize("id_cycle", [False, True])
+def test_data_bits_clock_and_end_pulses(bit_rate: int, id_cycle: bool) -> None:
+    """A cycle of 12 data bits one bit period apart, then its latch: ToExR takes each bit from the cycle after the
+    shift, ClkExR is high clock_high() after that; LaOuD, then /LaInD after a latched data cycle, only /LaInD after
+    an ID cycle; FromExR is what the chip sends. An ID cycle's bits stay inside the chip (RX-2)."""
+    cpb = wire.clocks_per_bit(bit_rate)
+    rng = random.Random(bit_rate)
+    bits = [rng.getrandbits(1) for _ in range(12)]
+    shifts = [5 + cpb * j for j in range(len(bits))]
+    end = shifts[-1] + cpb
+    length = end + expansion.end_pulses(True, cpb).length + 5
+    from_exr = [rng.getrandbits(1) for _ in range(length)]
+    latched = not id_cycle
+
+    def rows() -> Iterator[Row]:
+        for c in range(length):
+            row = {"ext": 1, "from_exr": from_exr[c]}
+            if c == 2:
+                row.update(load=1, load_id=int(id_cycle))
+            if c in shifts:
+                row.update(shift=1, level=bits[shifts.index(c)])
+            if c == end:
+                row.update(ended=1, latched=int(latched))
+            yield row
+
+    levels, seen = simulate(bit_rate, rows())
+    assert [row["send"] for row in seen] == from_exr
+    assert [row["active"] for row in seen][3:] == [int(not id_cycle)] * (length - 3)
+    high = set() if id_cycle else {c for s in shifts for c in window(s + 1, expansion.clock_high(cpb))}
+    pulses = expansion.end_pulses(latched, cpb)
+    ou = set() if pulses.la_ou_d is None else set(window(end + 1, pulses.la_ou_d))
+    low = set(window(end + 1, pulses.la_in_d_n))
+    for c, level in enumerate(levels):
+        done = [b for s, b in zip(shifts, bits, strict=True) if s < c]
+        to_exr = done[-1] if done and not id_cycle else IDLE.to_exr
+        assert level == ExpansionLevels(int(c in high), to_exr, int(c in ou), int(c not in low), 1), c
+    assert not any(row["overrun"] for row in seen)
+
+
+@pytest.mark.parametrize("bit_rate", BIT_RATES)
+def test_res_reg_pulse_and_idle_without_ext(bit_rate: int) -> None:
+    """RX-5: /ResReg low PULSE_T0 bit periods from the cycle after a reset; RX-6: without ExtReg every pin idles
+    whatever happens, and /ResReg is left to the core."""
+    cpb = wire.clocks_per_bit(bit_rate)
+    length = 10 + expansion.PULSE_T0 * cpb + 5
+
+    def rows(ext: int) -> Iterator[Row]:
+        for c in range(length):
+            row = {"ext": ext, "reset": int(c == 3), "load": int(c == 4), "shift": int(c == 6), "level": 1}
+            row.update(ended=int(c == 8), latched=1)
+            yield row
+
+    levels, _ = simulate(bit_rate, rows(0))
+    assert set(levels) == {IDLE}
+    levels, _ = simulate(bit_rate, rows(1))
+    low = window(4, (0, expansion.PULSE_T0 * cpb))
+    assert [level.res_reg_n for level in levels] == [int(c not in low) for c in range(length)]
+
+
+@pytest.mark.parametrize("bit_rate", BIT_RATES)
+def test_overrun_when_a_data_bit_comes_before_the_end_pulses_are_over(bit_rate: int) -> None:
+    """RX-4: a data cycle whose first ClkExR rises while the last cycle's end pulses run is an overrun; the pins
+    follow the schedule regardless."""
+    cpb = wire.clocks_per_bit(bit_rate)
+    pulses = expansion.end_pulses(True, cpb)
+    first, _ = expansion.clock_high(cpb)
+    for gap, overrun in ((pulses.length - first - 2, True), (pulses.length - first, False)):
+
+        def rows(gap: int = gap) -> Iterator[Row]:
+            for c in range(pulses.length + 4 * cpb):
+                yield {"ext": 1, "ended": int(c == 0), "latched": 1, "load": int(c == 1), "shift": int(c == gap)}
+
+        levels, seen = simulate(bit_rate, rows())
+        assert [c for c, row in enumerate(seen) if row["overrun"]] == ([gap + 1 + first] if overrun else [])
+        assert [level.clk_exr for level in levels].index(1) == gap + 1 + first
