@@ -2,8 +2,8 @@
 
 Manual 3.5 (Tables 3-14, 3-15, Figure 3-23) and RX-1 to RX-7 of docs/assumptions/expansion.md, at both bit rates:
 ToExR and ClkExR per data bit (``clock_high``), the end pulses after a latched data cycle and after any other
-cycle end (``end_pulses``), /ResReg for PULSE_T0 bit periods, FromExR sent in place of the internal register, idle
-pins without ExtReg. On Amaranth's own simulator.
+cycle end (``end_pulses``), FromExR sent in place of the internal register, idle pins without ExtReg or without
+data bytes. On Amaranth's own simulator; /ResReg is the core's (tests/test_verif_lockstep_serial.py).
 """
 
 from __future__ import annotations
@@ -25,7 +25,8 @@ Row = dict[str, int]
 
 
 def simulate(bit_rate: int, rows: Iterator[Row]) -> tuple[list[ExpansionLevels], list[Row]]:
-    """Per cycle: set the inputs of ``rows`` (missing ones 0), read the pins and ``send``/``overrun``/``active``."""
+    """Per cycle: set the inputs of ``rows`` (missing ones 0; ``has_data`` 1), read the pins (/ResReg, not this
+    block's, as 1) and ``send``/``overrun``/``active``."""
     dut = ExpansionRtl()
     levels: list[ExpansionLevels] = []
     seen: list[Row] = []
@@ -33,9 +34,11 @@ def simulate(bit_rate: int, rows: Iterator[Row]) -> tuple[list[ExpansionLevels],
     async def bench(ctx: Any) -> None:
         ctx.set(dut.rate, BIT_RATES.index(bit_rate))
         for row in rows:
-            for name in ("ext", "load", "load_id", "shift", "level", "ended", "latched", "reset", "from_exr"):
+            for name in ("ext", "load", "load_id", "shift", "level", "ended", "latched", "from_exr"):
                 ctx.set(getattr(dut, name), row.get(name, 0))
-            levels.append(ExpansionLevels(*(ctx.get(getattr(dut, name)) for name in PIN_NAMES)))
+            ctx.set(dut.has_data, row.get("has_data", 1))
+            pins = {name: ctx.get(getattr(dut, name)) for name in PIN_NAMES}
+            levels.append(ExpansionLevels(**pins, res_reg_n=IDLE.res_reg_n))
             seen.append({name: ctx.get(getattr(dut, name)) for name in ("send", "overrun", "active")})
             await ctx.tick()
 
@@ -86,28 +89,26 @@ def test_data_bits_clock_and_end_pulses(bit_rate: int, id_cycle: bool) -> None:
     for c, level in enumerate(levels):
         done = [b for s, b in zip(shifts, bits, strict=True) if s < c]
         to_exr = done[-1] if done and not id_cycle else IDLE.to_exr
-        assert level == ExpansionLevels(int(c in high), to_exr, int(c in ou), int(c not in low), 1), c
+        assert level == ExpansionLevels(int(c in high), to_exr, int(c in ou), int(c not in low), IDLE.res_reg_n), c
     assert not any(row["overrun"] for row in seen)
 
 
-@pytest.mark.parametrize("bit_rate", BIT_RATES)
-def test_res_reg_pulse_and_idle_without_ext(bit_rate: int) -> None:
-    """RX-5: /ResReg low PULSE_T0 bit periods from the cycle after a reset; RX-6: without ExtReg every pin idles
-    whatever happens, and /ResReg is left to the core."""
+@pytest.mark.parametrize(("ext", "has_data"), [(0, 1), (1, 0)])
+def test_idle_without_ext_or_data(ext: int, has_data: int) -> None:
+    """RX-6: without ExtReg every pin idles whatever the core does; RX-2: a length code without data bytes keeps
+    the data bits inside the chip (no ClkExR, ToExR idle), but a cycle end with ExtReg still pulses (RX-4)."""
+    bit_rate = max(BIT_RATES)
     cpb = wire.clocks_per_bit(bit_rate)
-    length = 10 + expansion.PULSE_T0 * cpb + 5
 
-    def rows(ext: int) -> Iterator[Row]:
-        for c in range(length):
-            row = {"ext": ext, "reset": int(c == 3), "load": int(c == 4), "shift": int(c == 6), "level": 1}
-            row.update(ended=int(c == 8), latched=1)
-            yield row
+    def rows() -> Iterator[Row]:
+        for c in range(40 * cpb):
+            yield {"ext": ext, "has_data": has_data, "load": int(c == 4), "shift": int(c in (6, 6 + cpb)),
+                   "level": 1, "ended": int(c == 3 * cpb), "latched": 1}  # fmt: skip
 
-    levels, _ = simulate(bit_rate, rows(0))
-    assert set(levels) == {IDLE}
-    levels, _ = simulate(bit_rate, rows(1))
-    low = window(4, (0, expansion.PULSE_T0 * cpb))
-    assert [level.res_reg_n for level in levels] == [int(c not in low) for c in range(length)]
+    levels, seen = simulate(bit_rate, rows())
+    assert {level.clk_exr for level in levels} == {level.to_exr for level in levels} == {0}
+    assert not any(row["active"] for row in seen)
+    assert any(level.la_ou_d for level in levels) == bool(ext)
 
 
 @pytest.mark.parametrize("bit_rate", BIT_RATES)

@@ -1,20 +1,21 @@
-"""Serial register expansion (manual 3.5) in Amaranth: ClkExR, ToExR, LaOuD, /LaInD and /ResReg from counters.
+"""Serial register expansion (manual 3.5) in Amaranth: ClkExR, ToExR, LaOuD and /LaInD from counters.
 
 :class:`ExpansionRtl` drives the expansion pins of the SUPI 3 OPC as :mod:`supi3.expansion` schedules them (Tables
 3-14, 3-15, Figures 3-23, 3-24; decisions RX-1 to RX-7 of ``docs/assumptions/expansion.md``). Its constants come
-from :func:`supi3.expansion.clock_high`, :func:`~supi3.expansion.end_pulses` and
-:data:`~supi3.expansion.PULSE_T0` for every bit rate at elaboration.
+from :func:`supi3.expansion.clock_high` and :func:`~supi3.expansion.end_pulses` for every bit rate at
+elaboration. /ResReg (RX-5: ``PULSE_T0`` bit periods on an INTERBUS reset and a watchdog reset with ExtReg = 1) is
+the outputs block's pulse counter, which also times the 375 ns pulse without expansion (``supi3.rtl.core``).
 
 * ``ext`` (the SET register's ExtReg, RX-1) decides, at each frame's ``load``, whether the frame's data bits go
-  through the external chain: a data cycle's (not an ID cycle's) ``shift`` then puts the received ``level`` on
+  through the external chain (``has_data``: the length code gives data bytes): a data cycle's (not an ID cycle's)
+  ``shift`` then puts the received ``level`` on
   ToExR from the next cycle, with ClkExR high ``clock_high(cpb)`` cycles after that (RX-3), and the bit the chip
   sends in its place is ``from_exr`` (FromExR after the core's synchroniser, ``send``; RX-2).
-* ``ended`` (a cycle's latch or discard) starts the end pulses from the next cycle, LaOuD only if ``latched`` (a
-  valid data cycle, RX-4); a newer end restarts them. ``overrun`` is 1 in the cycle a data cycle's first ClkExR
-  rises while they run.
-* ``reset`` (INTERBUS reset or watchdog reset of process data) pulls /ResReg low for ``PULSE_T0`` bit periods from
-  the next cycle (RX-5).
-* With ``ext`` = 0 every pin shows :data:`supi3.expansion.IDLE` (RX-6, RX-7).
+* ``ended`` (a cycle's latch or discard) with ``ext`` starts the end pulses from the next cycle, LaOuD only if
+  ``latched`` (a valid data cycle, RX-4); a newer end restarts them. ``overrun`` is 1 in the cycle a data cycle's
+  first ClkExR rises while they run.
+* Without ``ext`` nothing starts: after power-up every pin shows :data:`supi3.expansion.IDLE` (RX-6, RX-7); what
+  runs when ExtReg is cleared runs to its end, and ToExR keeps its last bit, as in the model.
 """
 
 from __future__ import annotations
@@ -31,15 +32,15 @@ from supi3.tables import BIT_RATES
 
 __all__ = ["PIN_NAMES", "ExpansionRtl"]
 
-PIN_NAMES: Final = ("clk_exr", "to_exr", "la_ou_d", "la_in_d_n", "res_reg_n")
-"""The outputs of :class:`supi3.expansion.ExpansionLevels`, as ports of the same names."""
+PIN_NAMES: Final = ("clk_exr", "to_exr", "la_ou_d", "la_in_d_n")
+"""The outputs of :class:`supi3.expansion.ExpansionLevels` this block drives, as ports of the same names."""
 
 
 class ExpansionRtl(wiring.Component):
     """The register expansion block (block ``expansion``).
 
-    Ports: ``ext``, ``rate`` (index into :data:`supi3.tables.BIT_RATES`), ``load``, ``load_id``, ``shift``,
-    ``level``, ``ended``, ``latched``, ``reset``, ``from_exr`` in; the pins :data:`PIN_NAMES`, ``active`` (this
+    Ports: ``ext``, ``has_data``, ``rate`` (index into :data:`supi3.tables.BIT_RATES`), ``load``, ``load_id``,
+    ``shift``, ``level``, ``ended``, ``latched``, ``from_exr`` in; the pins :data:`PIN_NAMES`, ``active`` (this
     frame's data go through the chain), ``send`` (the bit to send in place of the internal register's) and
     ``overrun`` out.
     """
@@ -47,8 +48,8 @@ class ExpansionRtl(wiring.Component):
     def __init__(self) -> None:
         self.cpbs = tuple(wire.clocks_per_bit(bit_rate) for bit_rate in BIT_RATES)
         members: dict[str, object] = {
-            "ext": In(1), "rate": In(range(len(BIT_RATES))), "load": In(1), "load_id": In(1), "shift": In(1),
-            "level": In(1), "ended": In(1), "latched": In(1), "reset": In(1), "from_exr": In(1),
+            "ext": In(1), "has_data": In(1), "rate": In(range(len(BIT_RATES))), "load": In(1), "load_id": In(1),
+            "shift": In(1), "level": In(1), "ended": In(1), "latched": In(1), "from_exr": In(1),
             "active": Out(1), "send": Out(1), "overrun": Out(1),
         }  # fmt: skip
         members.update({name: Out(1, init=getattr(spec.IDLE, name)) for name in PIN_NAMES})
@@ -58,13 +59,13 @@ class ExpansionRtl(wiring.Component):
         m = Module()
         sync, comb = m.d.sync, m.d.comb
         longest = max(
-            max(spec.end_pulses(True, cpb).length, spec.PULSE_T0 * cpb, spec.clock_high(cpb)[1]) for cpb in self.cpbs
+            max(spec.end_pulses(True, cpb).length, spec.clock_high(cpb)[1]) for cpb in self.cpbs
         )
 
         # The bit rate's constants (Table 3-15) ---------------------------------------------------------------
         count_range = range(longest + 1)
         latched_end = Signal()  # the last cycle end was a valid data cycle's latch: LaOuD, then /LaInD
-        clk_first, clk_end, res_width = Signal(count_range), Signal(count_range), Signal(count_range)
+        clk_first, clk_end = Signal(count_range), Signal(count_range)
         ou_end, in_first, in_end, ends = (Signal(count_range, name=n) for n in ("ou_end", "in_first", "in_end", "ends"))
         with m.Switch(self.rate):
             for rate, cpb in enumerate(self.cpbs):
@@ -73,7 +74,7 @@ class ExpansionRtl(wiring.Component):
                     data, other = spec.end_pulses(True, cpb), spec.end_pulses(False, cpb)
                     if data.la_ou_d is None or data.la_ou_d[0] != 0 or other.la_ou_d is not None:
                         raise ValueError("LaOuD must begin at a latched data cycle's end and only there (RX-4)")
-                    comb += [clk_first.eq(first), clk_end.eq(end), res_width.eq(spec.PULSE_T0 * cpb)]
+                    comb += [clk_first.eq(first), clk_end.eq(end)]
                     comb += [
                         ou_end.eq(data.la_ou_d[1]),
                         in_first.eq(Mux(latched_end, data.la_in_d_n[0], other.la_in_d_n[0])),
@@ -84,7 +85,7 @@ class ExpansionRtl(wiring.Component):
         # Data path through the chain (RX-2, RX-3) ------------------------------------------------------------
         active = self.active
         with m.If(self.load):
-            sync += active.eq(self.ext & ~self.load_id)
+            sync += active.eq(self.ext & self.has_data & ~self.load_id)
         comb += self.send.eq(self.from_exr)
         to_exr = Signal(init=spec.IDLE.to_exr)
         clk_run = Signal()
@@ -108,26 +109,19 @@ class ExpansionRtl(wiring.Component):
             sync += end_count.eq(end_count + 1)
             with m.If(end_count + 1 == ends):
                 sync += end_run.eq(0)
-        with m.If(self.ended):
+        with m.If(self.ext & self.ended):
             sync += [end_run.eq(1), end_count.eq(0), latched_end.eq(self.latched)]
-        res_count = Signal(count_range)
-        with m.If(res_count != 0):
-            sync += res_count.eq(res_count - 1)
-        with m.If(self.reset):
-            sync += res_count.eq(res_width)
         first_rise = Signal()  # the data cycle's first ClkExR clock bit
         with m.If(active & self.shift):
             sync += first_rise.eq(first_bit)
         comb += rises.eq(clk_run & (clk_count == clk_first))
-        comb += self.overrun.eq(self.ext & rises & first_rise & end_run)
+        comb += self.overrun.eq(rises & first_rise & end_run)
 
         levels: dict[str, Value] = {
             "clk_exr": clk_exr,
             "to_exr": to_exr,
             "la_ou_d": end_run & latched_end & (end_count < ou_end),
             "la_in_d_n": ~(end_run & (end_count >= in_first) & (end_count < in_end)),
-            "res_reg_n": res_count == 0,
         }
-        for name, level in levels.items():
-            comb += getattr(self, name).eq(Mux(self.ext, level, getattr(spec.IDLE, name)))
+        comb += [getattr(self, name).eq(level) for name, level in levels.items()]
         return m
