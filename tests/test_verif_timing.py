@@ -538,3 +538,34 @@ def test_hostile_arguments_give_named_errors(call: object, message: str) -> None
     assert callable(call)
     with pytest.raises(ArgumentError, match=message):
         call()
+
+
+def test_conv_inside_a_frame_is_t6_measured_negative() -> None:
+    """TC-6: /Conv falling while /SS is still low is the worst t6, measured to the frame's /SS rise."""
+    rate = 2_000_000
+    wave = SpiWave()
+    wave.idle(3)
+    wave.piece(serial_io.sequence(DataDirection.OUT, 16, rate), 0x0F0F)
+    wave.idle(20)
+    conv, sclk, ss, out = wave.arrays()
+    (offset, frame, _), ((first, end),) = wave.frames[0], wave.convs
+    conv[first:end] = 1
+    conv[offset + 20:offset + 28] = 0
+    found = check_serial_io({"mfp_out": mfp(conv, sclk, ss, out), "other": [5]}, bit_rate=rate, bits=16)
+    assert [(v.symbol, v.clock) for v in found] == [("t6", offset + 20)]
+    assert found[0].measured_s == (offset + 20 - (offset + frame.end)) / CLOCK_HZ < 0
+
+
+def test_la_in_d_falling_while_la_ou_d_is_high_is_t7_measured_negative() -> None:
+    rate = 500_000
+    cpb = wire.clocks_per_bit(rate)
+    ends = expansion.end_pulses(True, cpb)
+    assert ends.la_ou_d is not None
+    pins = {name: np.zeros(20 * cpb, dtype=np.uint8) for name in ("clk_exr", "to_exr", "la_ou_d", "res_reg_n")}
+    pins["res_reg_n"][:] = 1
+    pins["la_ou_d"][10 + ends.la_ou_d[0]:10 + ends.la_ou_d[1]] = 1
+    la_in = np.ones(20 * cpb, dtype=np.uint8)
+    fall = 10 + ends.la_ou_d[1] - 3
+    la_in[fall:fall + expansion.PULSE_T0 * cpb] = 0
+    found = check_expansion({**pins, "la_in_d_n": la_in}, bit_rate=rate)
+    assert [(v.symbol, v.measured_s * CLOCK_HZ) for v in found] == [("t7", -3)]
