@@ -569,3 +569,24 @@ def test_la_in_d_falling_while_la_ou_d_is_high_is_t7_measured_negative() -> None
     la_in[fall:fall + expansion.PULSE_T0 * cpb] = 0
     found = check_expansion({**pins, "la_in_d_n": la_in}, bit_rate=rate)
     assert [(v.symbol, v.measured_s * CLOCK_HZ) for v in found] == [("t7", -3)]
+
+
+@pytest.mark.parametrize("length", [0, 1, 2])
+def test_short_traces_have_nothing_to_measure(length: int) -> None:
+    idle = np.full(length, serial_io.IDLE.mfp(), dtype=np.int64)
+    assert check_serial_io({"mfp_out": idle}, bit_rate=500_000, bits=32, ser_in=[1] * length) == []
+    pins = {name: [1] * length for name in ("clk_exr", "to_exr", "la_ou_d", "la_in_d_n", "res_reg_n")}
+    assert check_expansion(pins, bit_rate=2_000_000, from_exr=[0] * length) == []
+
+
+@pytest.mark.parametrize("latched", [False, True])
+@pytest.mark.parametrize("rate", RATES)
+def test_the_spec_meets_table_3_15(rate: int, latched: bool) -> None:
+    """Data cycles of 0 to 4 bytes as the wire sends them (8 data bits of each 13-bit telegram, 5 bits between
+    bytes), ClkExR from expansion.clock_high, the end pulses from expansion.end_pulses, /ResReg 4 t0: no row of
+    Table 3-15 missed, with a chain answering FromExR exactly at its setup or its hold limit."""
+    cycles = [ExpCycle(bytes(range(0x11, 0x11 + 0x22 * n, 0x22)), (5, 5, 5), latched, bytes(range(n)))
+              for n in range(5)]
+    for setup_exact in (False, True):
+        pins, from_exr = build_expansion(rate, cycles, None, 0, 0, setup_exact)
+        assert check_expansion(pins, bit_rate=rate, from_exr=from_exr) == []

@@ -42,6 +42,7 @@ _EPSILON_S: Final = 1e-12
 """Tolerance of the comparisons (the evaluated limits are floats; 0.25 t0 + 100 ns is not a whole clock)."""
 
 Trace = npt.NDArray[np.integer]
+"""A trace as the checkers hold it (int64 after the argument checks)."""
 
 
 def _mfp_pin(signal: str) -> int:
@@ -236,8 +237,8 @@ def _traces(traces: object, names: Sequence[str], width: int) -> list[Trace]:
         raise fail("traces", f"a mapping with the traces {', '.join(map(repr, names))} (without "
                              f"{', '.join(map(repr, missing))})", traces)
     found = [check_trace(f"traces[{name!r}]", traces[name], width) for name in names]
-    return [_same_length(f"traces[{name!r}]", trace, len(found[0]), names[0]) for name, trace in zip(names, found,
-                                                                                                      strict=True)]
+    return [_same_length(f"traces[{name!r}]", trace, len(found[0]), names[0])
+            for name, trace in zip(names, found, strict=True)]
 
 
 def _same_length(name: str, trace: Trace, length: int, reference: str) -> Trace:
