@@ -100,7 +100,10 @@ class SpiWave:
             self.convs.append((offset + seq.conv[0], offset + seq.conv[1]))
 
     def arrays(self) -> tuple[Array, Array, Array, Array]:
-        return tuple(np.array(x, dtype=np.int64) for x in (self.conv, self.sclk, self.ss, self.out))  # type: ignore[return-value]
+        def array(levels: list[int]) -> Array:
+            return np.array(levels, dtype=np.int64)
+
+        return array(self.conv), array(self.sclk), array(self.ss), array(self.out)
 
 
 def mfp(conv: Array, sclk: Array, ss: Array, out: Array) -> Array:
@@ -203,8 +206,7 @@ def build_spi(rate: int, bits: int, pieces: list[tuple[str, int]], symbol: str |
         wave.piece(serial_io.sequence(direction, bits, rate), word)
     wave.idle(40)
     conv, sclk, ss, out = wave.arrays()
-    frame_of_piece = {k: wave.frames[k] for k in range(len(pieces))}
-    offset, frame, _ = frame_of_piece[target]
+    offset, frame, _ = wave.frames[target]  # one frame per piece
     t0 = frame.t0
     moved = None
     if symbol in ("t0", "t9", "t1"):
@@ -338,7 +340,7 @@ def build_expansion(rate: int, cycles: list[ExpCycle], symbol: str | None, targe
     cpb = wire.clocks_per_bit(rate)
     high = expansion.clock_high(cpb)
     setup, hold = at_least("3-15", rate, "t3"), at_most("3-15", rate, "t4")
-    pulses = [(expansion.end_pulses(c.latched, cpb)) for c in cycles]
+    pulses = [expansion.end_pulses(c.latched, cpb) for c in cycles]
     total = 10 + sum(8 * len(c.data) * cpb + sum(c.gaps) * cpb + cpb + p.length + 5
                      for c, p in zip(cycles, pulses, strict=True))
     total += 8 * cpb
