@@ -5,9 +5,11 @@ and load edges; the bus; the converters' voltages."""
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
+from pathlib import Path
 
 import pytest
 from hypothesis import given, settings
@@ -274,3 +276,11 @@ def test_every_device_is_a_serial_device(kind: Kind) -> None:
     device = kind.make()
     assert isinstance(device, SerialDevice)
     assert device.drives_ser_in == (kind.feed is not None)
+
+
+def test_the_docs_example_runs() -> None:
+    text = (Path(__file__).resolve().parents[1] / "docs" / "peripherals.md").read_text(encoding="utf-8")
+    blocks = re.findall(r"```python\n(.*?)```", text, flags=re.DOTALL)
+    assert blocks
+    for block in blocks:
+        exec(compile(block, "docs/peripherals.md", "exec"), {})

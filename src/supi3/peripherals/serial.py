@@ -4,7 +4,7 @@ them, each a :class:`supi3.spi.serial_io.SerialDevice` at both fidelities.
 3.3.1: "The serial I/O interface ... is designed for direct connection of DACs ... and ADCs ... It is also possible
 to connect shift registers (e.g., 74HCT165 or 74HCT594) with a data length of up to 32 bits." The wiring (Table
 3-3): /Conv MFP3, SCLK MFP4, /SS MFP5, SerIn MFP6, SerOut MFP7. The roles are SM-12 of
-``docs/assumptions/serial-io.md``; the choices of these models are PR-1 to PR-6 of ``docs/peripherals.md``.
+``docs/assumptions/serial-io.md``; the choices of these models are PR-1 to PR-5 and PR-7 of ``docs/peripherals.md``.
 
 At transaction level the chip calls :meth:`frame` once per /SS frame and :meth:`convert` once per /Conv pulse; at
 pin level it calls :meth:`clock` with its MFP3..MFP7 levels at every cycle in which they change, and drives the

@@ -10,7 +10,8 @@ Bit order (Figure 3-24): bytes are numbered from ToExR (byte 0 next to it) and m
 after a data cycle that received 14h, 56h, 78h the chain holds bytes 0..2 = 78h, 56h, 14h
 (:func:`supi3.expansion.line_to_chain`). Inside, the chain is the integer whose big-endian bytes are bytes 0, 1,
 ...: bit 0 is the bit furthest from ToExR (byte ``length - 1``'s LSB, on FromExR), and a ClkExR rise shifts the
-integer right, ToExR entering at the top (byte 0's MSB).
+integer right, ToExR entering at the top (byte 0's MSB). The choices where the manual is silent are PR-6 and PR-7
+of ``docs/peripherals.md``.
 """
 
 from __future__ import annotations
