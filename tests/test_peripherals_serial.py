@@ -252,7 +252,7 @@ def test_bus_fans_out_and_answers_with_its_driver() -> None:
     assert isinstance(bus, SerialDevice) and bus.drives_ser_in and bus.devices == (dac, adc, chain)
     adc.set_input(0x8001)
     seq = sequence(DataDirection.IN_OUT, 16, 500_000)
-    assert pins(bus, seq, 0x4321) == (0x8001, 0)
+    assert pins(bus, seq, 0x4321) == (0x8001, 1)  # /SS high again: the ADC shows its input's MSB (PR-1)
     assert (dac.output, chain.outputs) == (0x4321, 0x21)
     quiet = SerialBus(SpiDac(16), SerialBus(ShiftOut(2)))
     assert not quiet.drives_ser_in

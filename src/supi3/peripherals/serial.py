@@ -57,8 +57,9 @@ def _fell(before: int, after: int) -> bool:
 
 
 class _Source:
-    """Parallel in, serial out on SerIn: the register takes the parallel value when /SS falls, shows its MSB on
-    SerIn and shifts towards it on every SCLK rise while /SS is low, zeros coming in behind (PR-1, PR-2)."""
+    """Parallel in, serial out on SerIn: the register follows the parallel value while /SS is high and holds the
+    one it had when /SS fell, shows its MSB on SerIn and shifts towards it on every SCLK rise while /SS is low,
+    zeros coming in behind (PR-1, PR-2)."""
 
     def __init__(self, width: int) -> None:
         self._width = width
@@ -87,7 +88,7 @@ class _Source:
         """The chip's pins changed to ``levels`` (pin level); returns the SerIn level from then on."""
         check_instance("levels", levels, Levels)
         seen, self._seen = self._seen, levels
-        if _fell(seen.ss_n, levels.ss_n):
+        if seen.ss_n == 1:  # /SS high until this change: loading, and the value at its fall is captured
             self._register = self._parallel
         elif levels.ss_n == 0 and _rose(seen.sclk, levels.sclk):
             self._register = (self._register << 1) & _mask(self._width)
