@@ -105,11 +105,22 @@ def _dac_out(device: SerialDevice) -> int:
     return device.output
 
 
+def _bus_in(device: SerialDevice, value: int) -> None:
+    assert isinstance(device, SerialBus)
+    _set_chain(device.devices[0], value)
+
+
+def _bus_out(device: SerialDevice) -> int:
+    assert isinstance(device, SerialBus)
+    return _chain_out(device.devices[1])
+
+
 KINDS = [
     *(Kind(f"ShiftIn({n})", partial(ShiftIn, n), 8 * n, _set_chain, None) for n in range(1, 5)),
     *(Kind(f"ShiftOut({n})", partial(ShiftOut, n), 8 * n, None, _chain_out) for n in range(1, 5)),
     *(Kind(f"SpiAdc({b})", partial(SpiAdc, b), b, _set_code, None) for b in (16, 32)),
     *(Kind(f"SpiDac({b})", partial(SpiDac, b), b, None, _dac_out) for b in (16, 32)),
+    Kind("SerialBus(ShiftIn(2), ShiftOut(2))", lambda: SerialBus(ShiftIn(2), ShiftOut(2)), 16, _bus_in, _bus_out),
 ]
 
 
@@ -274,7 +285,7 @@ def test_bus_refuses_two_drivers_naming_both() -> None:
 @pytest.mark.parametrize("kind", KINDS, ids=lambda kind: kind.name)
 def test_every_device_is_a_serial_device(kind: Kind) -> None:
     device = kind.make()
-    assert isinstance(device, SerialDevice)
+    assert isinstance(device, SerialDevice)  # the bus too
     assert device.drives_ser_in == (kind.feed is not None)
 
 
