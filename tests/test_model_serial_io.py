@@ -174,9 +174,13 @@ def test_device_is_clocked_by_the_pins_and_answers_on_serin(row: tables.ModeRow)
 def test_device_answer_must_be_a_level() -> None:
     config = _config(SPI_ROWS[0])  # IN/OUT: a read frame
     model = Supi3Pins(config)
-    device = EchoDevice(16)
-    device.clock = lambda _levels: 2  # type: ignore[method-assign]
-    model.chip.attach_serial(device)
+
+    class Floating(EchoDevice):
+        def clock(self, levels: sio.Levels) -> int:
+            super().clock(levels)
+            return 2
+
+    model.chip.attach_serial(Floating(16))
     with pytest.raises(ArgumentError, match=r"SerialDevice.clock\(\) must be"):
         model.run(_inputs(config, _line([b"\x00\x00"])))
 
