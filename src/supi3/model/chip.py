@@ -32,7 +32,7 @@ from collections.abc import Callable, Sequence
 from typing import ClassVar, Final, Protocol, TypeVar
 
 from supi3 import tables
-from supi3.checks import check_bits, check_bool, check_bytes, check_instance, check_int, check_real
+from supi3.checks import check_bits, check_bool, check_bytes, check_instance, check_int, check_real, fail
 from supi3.config import DeviceConfig, MfpKind, decode
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.interbus import wire
@@ -420,8 +420,10 @@ class Supi3:
         if self.spi_sequences is None:
             raise SerialModeError(f"attach_serial needs an SPI master mode (Tables 2-4 to 2-6, manual 3.3), not "
                                   f"{self.config.function!r}")
-        if device is not None and not isinstance(device, SerialDevice):
-            _checked(check_instance, "device", device, SerialDevice, "a SerialDevice (supi3.spi.serial_io) or None")
+        # A class has the protocol's methods too: an instance is wanted.
+        if device is not None and (isinstance(device, type) or not isinstance(device, SerialDevice)):
+            error = fail("device", "a SerialDevice (supi3.spi.serial_io) or None", device)
+            raise ChipArgumentError(error.name, device, str(error))
         self.serial_device = device
         self._reschedule()
 
