@@ -17,6 +17,7 @@ from supi3.interbus.wire import Cycle
 from supi3.model.chip import WATCHDOG_CLOCKS, ChipArgumentError, ChipError, SerialModeError, Supi3
 from supi3.model.pinring import PinRing
 from supi3.model.pins import Supi3Pins
+from supi3.peripherals.serial import SerialBus, ShiftIn, ShiftOut, SpiAdc, SpiDac
 from supi3.spi import serial_io as sio
 from support import EchoDevice
 
@@ -164,3 +165,40 @@ def test_transaction_and_pin_level_agree(rows: list[tables.ModeRow], cycles: lis
         assert masters[0].inputs(k) == masters[1].inputs(k)
     assert [d.record for d in devices[0]] == [d.record for d in devices[1]]
     assert [c.in_word for c in tl_chips] == [p.chip.in_word for p in pin_chips]
+
+
+@pytest.mark.parametrize("row", [r for r in SPI_ROWS if decode(r.c, r.mfp).mfp_mode.direction is DataDirection.IN_OUT],
+                         ids=lambda r: f"{r.c}-{r.mfp}")
+def test_analog_and_digital_io_end_to_end_at_both_fidelities(row: tables.ModeRow) -> None:
+    # A user's device: an ADC and a DAC (or a 74HCT165 and a 74HCT594 chain) behind an IN/OUT chip; values move from
+    # the master to the DAC output and from the ADC input to the master, at transaction and at pin level.
+    config = decode(row.c, row.mfp, clk_conf=FAST)
+    width = config.mfp_mode.width
+    for analog in (True, False):
+        tl, pins = Supi3(config), Supi3Pins(config)
+        ends: list[tuple[SpiAdc | ShiftIn, SpiDac | ShiftOut]] = [
+            (SpiAdc(width), SpiDac(width)) if analog else (ShiftIn(width // 8), ShiftOut(width // 8)) for _ in "ab"
+        ]
+        tl.attach_serial(SerialBus(*ends[0]))
+        pins.chip.attach_serial(SerialBus(*ends[1]))
+        pin_ring = PinRing([pins])
+        pin_ring.idle(0.0002)
+        masters = [Master(Ring([tl], bit_rate=2_000_000), locate=False), Master(pin_ring, locate=False)]
+        for master in masters:
+            assert master.start().ok
+        for value in (0x1234, (1 << width) - 1, 0x8001):
+            for source, _ in ends:
+                if isinstance(source, SpiAdc):
+                    source.set_input(value)
+                else:
+                    source.set_inputs(value)
+            for master in masters:
+                master.set_outputs(1, (value ^ 0xFF).to_bytes(config.data_bytes, "big"))
+                assert master.data_cycle().ok
+            pin_ring.idle(0.0001)
+            for master in masters:
+                assert master.data_cycle().ok  # carries the word read after the cycle before
+                assert master.inputs(1) == value.to_bytes(config.data_bytes, "big")
+            pin_ring.idle(0.0001)
+            for _, sink in ends:
+                assert (sink.output if isinstance(sink, SpiDac) else sink.outputs) == value ^ 0xFF
