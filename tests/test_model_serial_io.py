@@ -272,7 +272,7 @@ def test_interbus_reset_on_the_line_in_the_longest_sequence() -> None:
 # ------------------------------------------------------------------------------------------------------------
 
 
-@settings(max_examples=12, deadline=None)
+@settings(max_examples=10, deadline=None)
 @given(
     row=st.sampled_from(SPI_ROWS),
     outs=st.lists(st.binary(min_size=4, max_size=4), min_size=1, max_size=3),
