@@ -27,6 +27,7 @@ import numpy as np
 import numpy.typing as npt
 import pytest
 
+from supi3 import serial_io as sio
 from supi3.config import DeviceConfig, decode
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
@@ -36,7 +37,6 @@ from supi3.pinlevel import OE_SUFFIX
 from supi3.regmap import Register, encode_command
 from supi3.sdk import native
 from supi3.sdk.native import CFirmware
-from supi3.spi import serial_io as sio
 from supi3.spi.block_pins import UpifBlockPins, block_model, strap_values
 from supi3.spi.master import SoftMaster
 from supi3.spi.slave_pins import PinsIn, PinsOut
@@ -393,7 +393,7 @@ def c_firmware(cache: pytest.Cache, source: str | Path, **options: Any) -> CFirm
 
 
 class EchoDevice:
-    """A fake :class:`supi3.spi.serial_io.SerialDevice` at either fidelity, recording what it saw the same way at
+    """A fake :class:`supi3.serial_io.SerialDevice` at either fidelity, recording what it saw the same way at
     both: ``("frame", SerOut word, bits)`` when /SS rises (or per :meth:`frame`), ``("convert",)`` when /Conv falls
     (or per :meth:`convert`). In every frame it shifts :attr:`value` out on SerIn, MSB first (an input register
     captured at /SS falling); set :attr:`value` between sequences."""

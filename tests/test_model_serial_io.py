@@ -1,5 +1,5 @@
 """Serial I/O (SPI master mode, manual 3.3) at pin level: in every SPI master mode of Tables 2-4 to 2-6 at both bit
-rates the MFP pins follow the spec's sequence (supi3.spi.serial_io) from the cycle after each latch (SM-2), SerIn is
+rates the MFP pins follow the spec's sequence (supi3.serial_io) from the cycle after each latch (SM-2), SerIn is
 read at the sample cycles (SM-5) and loaded by the next data cycle (SM-6), resets run the clear sequence (SM-9), and
 step() and run() agree cycle for cycle."""
 
@@ -14,13 +14,13 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from supi3 import serial_io as sio
 from supi3 import tables
 from supi3.config import DataDirection, DeviceConfig, MfpKind, decode
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
 from supi3.model.pins import RESET_STRETCH_CLOCKS, Supi3Pins
-from supi3.spi import serial_io as sio
 from supi3.verif.timing import check_serial_io
 from support import EchoDevice, quiet_inputs
 

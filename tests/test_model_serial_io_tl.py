@@ -8,6 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from supi3 import serial_io as sio
 from supi3 import tables
 from supi3.config import DataDirection, MfpKind, decode
 from supi3.interbus import wire
@@ -18,7 +19,6 @@ from supi3.model.chip import WATCHDOG_CLOCKS, ChipArgumentError, ChipError, Seri
 from supi3.model.pinring import PinRing
 from supi3.model.pins import Supi3Pins
 from supi3.peripherals.serial import SerialBus, ShiftIn, ShiftOut, SpiAdc, SpiDac
-from supi3.spi import serial_io as sio
 from support import EchoDevice
 
 SPI_ROWS = [r for r in tables.MODE_ROWS if decode(r.c, r.mfp).mfp_mode.kind is MfpKind.SPI_MASTER]
@@ -61,7 +61,7 @@ class _NoConvert:
 @pytest.mark.parametrize("device", [1, "device", object(), EchoDevice, _NoConvert(), [EchoDevice(16)]])
 def test_attach_takes_a_serial_device_or_none(device: object) -> None:
     chip = Supi3(decode(SPI_ROWS[0].c, SPI_ROWS[0].mfp))
-    with pytest.raises(ChipArgumentError, match=r"device must be a SerialDevice \(supi3.spi.serial_io\) or None, "):
+    with pytest.raises(ChipArgumentError, match=r"device must be a SerialDevice \(supi3.serial_io\) or None, "):
         chip.attach_serial(device)  # type: ignore[arg-type]
     assert chip.serial_device is None
 

@@ -39,7 +39,7 @@ from supi3.interbus import wire
 from supi3.interbus.link import DataKernel
 from supi3.interbus.wire import Cycle
 from supi3.model.registers import RegisterFile
-from supi3.spi.serial_io import SerialDevice, SerialSequence, clear_sequence, sequence
+from supi3.serial_io import SerialDevice, SerialSequence, clear_sequence, sequence
 
 CLOCK_HZ: Final = tables.CLOCK_HZ
 _NEVER: Final = 1 << 62
@@ -392,7 +392,7 @@ class Supi3:
         mode = self.config.mfp_mode
         self.spi_sequences: tuple[SerialSequence, SerialSequence | None] | None = None
         """The SPI master modes' sequence after a valid data cycle and clear sequence after a reset (SM-6, SM-9,
-        :mod:`supi3.spi.serial_io`); None in the other modes."""
+        :mod:`supi3.serial_io`); None in the other modes."""
         if mode.kind is MfpKind.SPI_MASTER:
             rate = self.config.bit_rate
             self.spi_sequences = (sequence(mode.direction, mode.width, rate),
@@ -415,14 +415,14 @@ class Supi3:
         SerialModeError
             The chip is not in an SPI master mode (Tables 2-4 to 2-6).
         ChipArgumentError
-            ``device`` is neither a :class:`~supi3.spi.serial_io.SerialDevice` nor None.
+            ``device`` is neither a :class:`~supi3.serial_io.SerialDevice` nor None.
         """
         if self.spi_sequences is None:
             raise SerialModeError(f"attach_serial needs an SPI master mode (Tables 2-4 to 2-6, manual 3.3), not "
                                   f"{self.config.function!r}")
         # A class has the protocol's methods too: an instance is wanted.
         if device is not None and (isinstance(device, type) or not isinstance(device, SerialDevice)):
-            error = fail("device", "a SerialDevice (supi3.spi.serial_io) or None", device)
+            error = fail("device", "a SerialDevice (supi3.serial_io) or None", device)
             raise ChipArgumentError(error.name, device, str(error))
         self.serial_device = device
         self._reschedule()

@@ -2,7 +2,7 @@
 
 Manual: 3.3 (serial I/O, SPI master mode), Table 3-3 (the MFP pins), Table 3-4 (times t0 to t12), Figures 3-1 to 3-3
 (input, output and input/output sequences). What the pins do in each cycle of a sequence is the executable spec
-:mod:`supi3.spi.serial_io` (:func:`~supi3.spi.serial_io.sequence`, :meth:`~supi3.spi.serial_io.SerialSequence.levels`);
+:mod:`supi3.serial_io` (:func:`~supi3.serial_io.sequence`, :meth:`~supi3.serial_io.SerialSequence.levels`);
 this block places the sequences in time and takes SerIn in. Decisions: SM-1 to SM-11 of
 ``docs/assumptions/serial-io.md``:
 
@@ -34,7 +34,7 @@ import numpy as np
 from supi3.checks import check_bits
 from supi3.model.blocks.transmitter import NEVER, PinTrace
 from supi3.pinout import SYNC_STAGES
-from supi3.spi.serial_io import IDLE, Levels, SerialDevice, SerialSequence
+from supi3.serial_io import IDLE, Levels, SerialDevice, SerialSequence
 
 if TYPE_CHECKING:
     from supi3.model.chip import Supi3
@@ -221,7 +221,7 @@ class SerialIo:
 
     def feed(self, upto: int) -> None:
         """Clock the device attached to the chip with every change of the pins up to cycle ``upto``: it answers on
-        SerIn (:meth:`supi3.spi.serial_io.SerialDevice.clock`)."""
+        SerIn (:meth:`supi3.serial_io.SerialDevice.clock`)."""
         cycles = self._cycles
         i = self._feed_i
         n = len(cycles)
