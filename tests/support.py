@@ -27,6 +27,7 @@ import numpy as np
 import numpy.typing as npt
 import pytest
 
+from supi3 import serial_io as sio
 from supi3.config import DeviceConfig, decode
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
@@ -386,3 +387,46 @@ def c_firmware(cache: pytest.Cache, source: str | Path, **options: Any) -> CFirm
     if reason is not None:
         pytest.skip(reason)
     return native.CFirmware(source, cache_dir=cache.mkdir("supi3-native"), **options)
+
+
+# Serial I/O (SPI master mode, 3.3): a fake device on the bus ----------------------------------------------------------
+
+
+class EchoDevice:
+    """A fake :class:`supi3.serial_io.SerialDevice` at either fidelity, recording what it saw the same way at
+    both: ``("frame", SerOut word, bits)`` when /SS rises (or per :meth:`frame`), ``("convert",)`` when /Conv falls
+    (or per :meth:`convert`). In every frame it shifts :attr:`value` out on SerIn, MSB first (an input register
+    captured at /SS falling); set :attr:`value` between sequences."""
+
+    drives_ser_in = True
+
+    def __init__(self, bits: int, value: int = 0) -> None:
+        self.bits = bits
+        self.value = value
+        self.record: list[tuple[object, ...]] = []
+        self._levels = sio.IDLE
+        self._captured = 0
+        self._shifted = 0
+        self._count = 0
+
+    def frame(self, ser_out: int, bits: int) -> int:
+        self.record.append(("frame", ser_out, bits))
+        return self.value
+
+    def convert(self) -> None:
+        self.record.append(("convert",))
+
+    def clock(self, levels: sio.Levels) -> int:
+        before, self._levels = self._levels, levels
+        if before.ss_n and not levels.ss_n:
+            self._captured, self._shifted, self._count = self.value, 0, 0
+        if not levels.ss_n and levels.sclk and not before.sclk:
+            self._shifted = (self._shifted << 1) | levels.ser_out
+            self._count += 1
+        if levels.ss_n and not before.ss_n:
+            self.record.append(("frame", self._shifted, self._count))
+        if before.conv_n and not levels.conv_n:
+            self.record.append(("convert",))
+        if levels.ss_n or self._count >= self.bits:
+            return 0
+        return (self._captured >> (self.bits - 1 - self._count)) & 1

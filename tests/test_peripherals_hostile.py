@@ -11,7 +11,7 @@ import pytest
 from supi3.errors import ArgumentError
 from supi3.expansion import ExpansionLevels
 from supi3.peripherals import SerialBus, ShiftIn, ShiftOut, SpiAdc, SpiDac, Sre1
-from supi3.spi.serial_io import Levels
+from supi3.serial_io import Levels
 
 BAD_COUNTS = [0, 5, -1, True, 2.0, "2", None]
 

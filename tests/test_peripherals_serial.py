@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 
 from supi3.config import DataDirection
 from supi3.peripherals import SerialBus, SerInConflictError, ShiftIn, ShiftOut, SpiAdc, SpiDac
-from supi3.spi.serial_io import IDLE, PERIPHERAL_DELAY_CLOCKS, Levels, SerialDevice, SerialSequence, render, sequence
+from supi3.serial_io import IDLE, PERIPHERAL_DELAY_CLOCKS, Levels, SerialDevice, SerialSequence, render, sequence
 from supi3.tables import BIT_RATES
 
 DIRECTIONS = (DataDirection.IN, DataDirection.OUT, DataDirection.IN_OUT)

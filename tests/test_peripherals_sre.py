@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from supi3.expansion import IDLE, PULSE_T0, ExpansionLevels, ExternalRegisters, clock_high, end_pulses
 from supi3.peripherals import Sre1
-from supi3.spi.serial_io import PERIPHERAL_DELAY_CLOCKS
+from supi3.serial_io import PERIPHERAL_DELAY_CLOCKS
 
 CPBS = (64, 16)
 """Clocks per bit at 500 kbit/s and 2 Mbit/s."""

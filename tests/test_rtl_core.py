@@ -91,6 +91,9 @@ def test_verilog_has_the_model_pins_and_straps(variant: str) -> None:
 
 @pytest.mark.parametrize("row", OPC_ROWS, ids=[f"{row.c}-{row.mfp or 'x'}" for row in OPC_ROWS])
 def test_every_mode(bench: Lockstep, row: ModeRow) -> None:
+    if decode(row.c, row.mfp).mfp_mode.kind is MfpKind.SPI_MASTER:
+        # The model drives the serial I/O pins (3.3); the RTL does from supi3.rtl.serial_io on (issue 11).
+        pytest.importorskip("supi3.rtl.serial_io", reason="the RTL's serial I/O block is not on this branch yet")
     index = OPC_ROWS.index(row)
     c, mfp = row.c, row.mfp
     config = decode(

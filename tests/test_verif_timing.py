@@ -1,7 +1,7 @@
 """The trace timing checkers of :mod:`supi3.verif.timing`: Table 3-4 (SPI master, 3.3.2) and Table 3-15 (serial
 register expansion, 3.5).
 
-The good waveforms are the spec's own: :func:`supi3.spi.serial_io.render` of the sequences and
+The good waveforms are the spec's own: :func:`supi3.serial_io.render` of the sequences and
 :func:`supi3.expansion.clock_high` / :func:`~supi3.expansion.end_pulses`, so a clean check also proves the spec meets
 the tables at both bit rates. Hypothesis strings such pieces together with every gap at its limit (SerIn and FromExR
 changes exactly at their setup or hold limit), and one variant moves a single edge by one clock so that exactly one
@@ -21,11 +21,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from supi3 import expansion
+from supi3 import expansion, serial_io
 from supi3.config import DataDirection
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
-from supi3.spi import serial_io
 from supi3.tables import CLOCK_HZ
 from supi3.timing import EvaluatedTiming, timing_table
 from supi3.verif import TimingViolation, TraceTimingError, check_expansion, check_serial_io, raise_first

@@ -38,12 +38,11 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, NoReturn, TextIO
 
-from supi3 import campaign, tables, timing
+from supi3 import campaign, serial_io, tables, timing
 from supi3.checks import check_int, fail
 from supi3.checks import describe as _shown
 from supi3.config import DeviceConfig, Interface, MfpKind, Variant, decode, mode_rows
 from supi3.errors import Supi3Error
-from supi3.spi import serial_io
 
 MAX_NETWORK_BYTES = timing.MAX_NETWORK_BYTES
 """``timing --bytes`` limit: 512 devices (the INTERBUS limit) of the longest data length, 32 words (Table 3-11)."""

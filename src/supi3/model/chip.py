@@ -29,16 +29,17 @@ from __future__ import annotations
 import math
 from collections import Counter
 from collections.abc import Callable, Sequence
-from typing import ClassVar, Final, TypeVar
+from typing import ClassVar, Final, Protocol, TypeVar
 
 from supi3 import tables
-from supi3.checks import check_bits, check_bool, check_bytes, check_instance, check_int, check_real
+from supi3.checks import check_bits, check_bool, check_bytes, check_instance, check_int, check_real, fail
 from supi3.config import DeviceConfig, MfpKind, decode
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.interbus import wire
 from supi3.interbus.link import DataKernel
 from supi3.interbus.wire import Cycle
 from supi3.model.registers import RegisterFile
+from supi3.serial_io import SerialDevice, SerialSequence, clear_sequence, sequence
 
 CLOCK_HZ: Final = tables.CLOCK_HZ
 _NEVER: Final = 1 << 62
@@ -62,6 +63,11 @@ WATCHDOG_CLOCKS: Final[tuple[int | None, ...]] = tuple(
 
 class ChipError(Supi3Error, ValueError):
     """A request the chip model cannot carry out (wrong data width, pin value out of range, ...)."""
+
+
+class SerialModeError(ChipError):
+    """A serial I/O request the chip's mode does not allow: a device attached outside the SPI master modes of
+    Tables 2-4 to 2-6, or IN data set by hand while a device provides them (manual 3.3)."""
 
 
 class ChipArgumentError(ArgumentError, ChipError):
@@ -155,6 +161,26 @@ def _latch_data_run(chips: Sequence[Supi3], received: Sequence[bytes], now: floa
             chip.latch_at(_DATA, data, clocks(now))
 
 
+class _SerialPins(Protocol):
+    """The pin-level serial I/O block (:class:`supi3.model.blocks.serial_io.SerialIo`) as the chip drives it."""
+
+    def start(self, c: int, word: int) -> None: ...
+    def clear(self, c: int) -> None: ...
+
+
+def _transact(seq: SerialSequence, device: SerialDevice, word: int) -> int | None:
+    """``seq`` on ``device`` at transaction level, writing ``word``: its frames in order, then /Conv; the word read
+    (None without a read frame), checked (SM-11)."""
+    read = None
+    for frame in seq.frames:
+        answer = device.frame(word if frame.write else 0, frame.bits)
+        if not frame.write:
+            read = _checked(check_bits, "SerialDevice.frame()", answer, frame.bits, "the bits read, MSB first")
+    if seq.conv is not None:
+        device.convert()
+    return read
+
+
 class Supi3:
     """One SUPI 3 OPC (or LS) chip on an INTERBUS ring, at transaction level.
 
@@ -181,9 +207,9 @@ class Supi3:
     __slots__ = (
         "__dict__",  # room beyond the declared state, so that a test can spy on a chip's methods
         "_deadline", "_due_s", "_events", "_fast_valid", "_fixed_bytes", "_frame_bytes", "_in_map", "_loaded", "_now",
-        "_out", "_out_map", "_send_alarm", "_shown", "_stat_err", "_stat_low_since", "attention", "bus_active",
-        "config", "due", "in_word", "io_access", "mfp_in", "mod_ack_until", "pf", "registers", "resreg_until",
-        "revision", "te", "watchdog_code", "wd",
+        "_out", "_out_map", "_send_alarm", "_serial_pins", "_shown", "_stat_err", "_stat_low_since", "attention",
+        "bus_active", "config", "due", "in_word", "io_access", "mfp_in", "mod_ack_until", "pf", "registers",
+        "resreg_until", "revision", "serial_device", "spi_sequences", "te", "watchdog_code", "wd",
     )  # fmt: skip
 
     data_kernel: ClassVar[DataKernel] = DataKernel(_load_data_run, _latch_data_run)
@@ -212,6 +238,7 @@ class Supi3:
         self._loaded = (-1, b"")  # (MFP levels, IN bytes) of the last data-cycle load
         self._frame_bytes = -1  # µP modes: the data bytes the last data-cycle load gave (M15)
         self._shown: tuple[bytes | None, int] = (None, 0)  # (OUT bytes, MFP levels) last driven
+        self._init_serial()
         self.revision = 0
         """Counts the changes of what the pins show (OUT data, ``pf``, ``bus_active``, the /ModAck and /ResReg
         pulses): the pin level records its outputs only when this moves."""
@@ -340,9 +367,85 @@ class Supi3:
         return self.in_word
 
     def set_inputs(self, word: int) -> None:
-        """IN data for SPI master and bus terminal modes, whose data path is not modelled at pin level yet."""
+        """IN data for the bus terminal modes, whose data path is not modelled at pin level yet, and for the SPI
+        master modes without a serial device (:meth:`attach_serial`): at transaction level the word is what the
+        next data cycles load; at pin level the next sequence's read frame replaces it with what SerIn gave.
+
+        Raises
+        ------
+        SerialModeError
+            A serial device is attached: it provides the IN data (3.3).
+        ChipArgumentError
+            ``word`` is not an integer of the chip's data length.
+        """
+        if self.serial_device is not None:
+            raise SerialModeError(f"set_inputs is refused while a serial device is attached ({self.serial_device!r}):"
+                                  " the device provides the IN data through the read frame (manual 3.3)")
         self.in_word = _checked(check_bits, "word", word, 8 * self.data_bytes(),
                                 f"the IN data of {self.data_bytes()} bytes, Table 3-11")
+
+    # --------------------------------------------------------------------------------------------------------
+    # Serial I/O (SPI master mode, 3.3; docs/assumptions/serial-io.md)
+    # --------------------------------------------------------------------------------------------------------
+
+    def _init_serial(self) -> None:
+        mode = self.config.mfp_mode
+        self.spi_sequences: tuple[SerialSequence, SerialSequence | None] | None = None
+        """The SPI master modes' sequence after a valid data cycle and clear sequence after a reset (SM-6, SM-9,
+        :mod:`supi3.serial_io`); None in the other modes."""
+        if mode.kind is MfpKind.SPI_MASTER:
+            rate = self.config.bit_rate
+            self.spi_sequences = (sequence(mode.direction, mode.width, rate),
+                                  clear_sequence(mode.direction, mode.width, rate))  # fmt: skip
+        self.serial_device: SerialDevice | None = None
+        """The device on the serial I/O bus (:meth:`attach_serial`), or None."""
+        self._serial_pins: _SerialPins | None = None
+
+    def attach_serial(self, device: SerialDevice | None) -> None:
+        """Attach ``device`` to the serial I/O pins (SPI master modes, 3.3), or detach with None.
+
+        At transaction level each valid data cycle's latch runs the whole sequence on the device at once (read
+        frame, write frame, /Conv, in that order) and the word read is the IN data of the next data cycles; an
+        INTERBUS reset or a watchdog reset writes zeros in the modes with OUT data (SM-9, SM-11). At pin level
+        (:class:`supi3.model.pins.Supi3Pins`) the device is clocked with the pins and answers on SerIn instead of
+        the MFP6 input (SM-5). Attach between sequences; :meth:`set_inputs` is refused while a device is attached.
+
+        Raises
+        ------
+        SerialModeError
+            The chip is not in an SPI master mode (Tables 2-4 to 2-6).
+        ChipArgumentError
+            ``device`` is neither a :class:`~supi3.serial_io.SerialDevice` nor None.
+        """
+        if self.spi_sequences is None:
+            raise SerialModeError(f"attach_serial needs an SPI master mode (Tables 2-4 to 2-6, manual 3.3), not "
+                                  f"{self.config.function!r}")
+        # A class has the protocol's methods too: an instance is wanted.
+        if device is not None and (isinstance(device, type) or not isinstance(device, SerialDevice)):
+            error = fail("device", "a SerialDevice (supi3.serial_io) or None", device)
+            raise ChipArgumentError(error.name, device, str(error))
+        self.serial_device = device
+        self._reschedule()
+
+    def _serial_latched(self, clk: int) -> None:
+        """A valid data cycle latched at ``clk``: its sequence runs (SM-2, SM-11)."""
+        if self._serial_pins is not None:
+            self._serial_pins.start(clk, self.out_word)
+        elif self.serial_device is not None:
+            assert self.spi_sequences is not None
+            read = _transact(self.spi_sequences[0], self.serial_device, self.out_word)
+            if read is not None:
+                self.in_word = read
+
+    def _serial_cleared(self, clk: int) -> None:
+        """Process data cleared at ``clk`` (INTERBUS reset, watchdog): the clear sequence (SM-9)."""
+        if self._serial_pins is not None:
+            self._serial_pins.clear(clk)
+        elif self.serial_device is not None:
+            assert self.spi_sequences is not None
+            clear = self.spi_sequences[1]
+            if clear is not None:
+                _transact(clear, self.serial_device, 0)
 
     # --------------------------------------------------------------------------------------------------------
     # Time
@@ -359,7 +462,8 @@ class Supi3:
         if self._stat_low_since is not None and not self.pf:
             due = min(due, self._stat_low_since + STATERR_FILTER_CLOCKS)
         self.due = due
-        self._due_s = due / CLOCK_HZ if self.registers is None else -1.0  # see "The ring kernel"
+        # See "The ring kernel"; a serial device takes the latch's slow path (the sequence runs there).
+        self._due_s = due / CLOCK_HZ if self.registers is None and self.serial_device is None else -1.0
 
     def _advance(self, clk: int) -> None:
         """Bring time-driven state up to clock ``clk``: the /StatErr filter and the layer-2 watchdog."""
@@ -385,6 +489,8 @@ class Supi3:
     def _clear_process_data(self) -> None:
         self.in_word = 0
         self._out = b""
+        if self.spi_sequences is not None:
+            self._serial_cleared(self._now)
         if self.registers is not None:
             self.registers.interbus_reset()
 
@@ -456,6 +562,8 @@ class Supi3:
             if self.registers is None:
                 self._out = received
                 self._fast_valid += 1
+                if self.spi_sequences is not None:
+                    self._serial_latched(clk)
                 return
             if received:
                 self.registers.latch(received)

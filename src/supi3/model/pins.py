@@ -64,6 +64,7 @@ from supi3.model.blocks.receiver import (
     input_row,
     input_traces,
 )
+from supi3.model.blocks.serial_io import SerialIo
 from supi3.model.blocks.transmitter import NEVER, PinTrace, Transmitter
 from supi3.model.chip import Supi3
 from supi3.pinlevel import EventLog, Pin
@@ -116,8 +117,8 @@ class Supi3Pins:
 
     __slots__ = (
         "_datapath", "_frame", "_holding", "_outputs", "_power_ups", "_receiver", "_recording", "_return_start",
-        "_run_from", "_stat_active", "_synced_run", "_transmitter", "chip", "complete_diagnostics", "config", "cpb",
-        "cycle", "forward_delay", "log", "mfp_oe", "rbst_by_pin", "reset_run",
+        "_run_from", "_serial", "_stat_active", "_synced_run", "_transmitter", "chip", "complete_diagnostics",
+        "config", "cpb", "cycle", "forward_delay", "log", "mfp_oe", "rbst_by_pin", "reset_run",
     )  # fmt: skip
 
     inputs: Sequence[Pin] = INPUT_PINS
@@ -145,7 +146,11 @@ class Supi3Pins:
         self._datapath = DataPath(self.chip, self.log)
         self._frame = FrameEngine(self.chip, self.log, self._datapath, self._transmitter)
         self._receiver = Receiver(self.cpb, self.reset_run, self.chip, self.log, self._frame, self._transmitter)
-        self._outputs = Outputs(self.chip, self._transmitter, self.cpb, self.mfp_oe, self.complete_diagnostics)
+        # Serial I/O in the SPI master modes (3.3): the chip starts its sequences at each latch (Supi3.attach_serial).
+        self._serial = SerialIo(self.chip) if self.chip.spi_sequences is not None else None
+        self.chip._serial_pins = self._serial
+        self._outputs = Outputs(self.chip, self._transmitter, self.cpb, self.mfp_oe, self.complete_diagnostics,
+                                self._serial)
         self.reset()
 
     # ------------------------------------------------------------------------------------------------------------
@@ -158,6 +163,8 @@ class Supi3Pins:
         self.log.clear()
         self._receiver.reset()
         self._transmitter.reset()
+        if self._serial is not None:
+            self._serial.reset()
         self._holding = False
         self._recording = False
         self._power_ups: list[tuple[int, int]] = []
@@ -181,6 +188,8 @@ class Supi3Pins:
         self._transmitter.power_up(self.cycle)
         self._frame.power_up()
         self._datapath.power_up()
+        if self._serial is not None:
+            self._serial.power_up(self.cycle)
 
     # ------------------------------------------------------------------------------------------------------------
     # One clock: step()
@@ -214,6 +223,8 @@ class Supi3Pins:
         pipe = receiver.pipe
         synced = pipe[-1]
         outputs = self._outputs.values(c, row.di2, self._run_from)
+        if self._serial is not None:
+            self._serial.feed(c)
         receiver.pipe = [row, *pipe[:-1]]
         tx = self._transmitter
         if c >= self._run_from or self._holding or not (synced.resu_n and synced.vmon_ok):
@@ -271,6 +282,9 @@ class Supi3Pins:
             chip._set_stat_err(stat, c)
         if c >= chip.due:
             chip._advance(c)
+        serial = self._serial
+        if serial is not None and c >= serial.due:
+            serial.clock(c, s.mfp_in)
         self._receiver.clock(line, c)
 
     # ------------------------------------------------------------------------------------------------------------
@@ -364,8 +378,13 @@ class Supi3Pins:
         shown, run_from = chip.revision, self._run_from
         snaps: list[tuple[int, Snapshot]] = [(0, outputs.snapshot(run_from))]
         next_due, restore_low_run = receiver.next_due, receiver.restore_low_run
+        serial = self._serial
+        if serial is not None:
+            serial.keep_from = c0
         k = kl = 0
         due = next_due(c0 - 1, int(line[0]), self._run_from) if n else NEVER
+        if serial is not None and serial.due < due:
+            due = max(serial.due, c0)
         t = -1
         while True:
             while other_events[k] <= t:
@@ -392,6 +411,8 @@ class Supi3Pins:
                 shown, run_from = chip.revision, self._run_from
                 snaps.append((t + 1, outputs.snapshot(run_from)))
             due = next_due(c, level, self._run_from)
+            if serial is not None and serial.due < due:
+                due = serial.due if serial.due > c else c + 1
         if n and c0 + n - 1 >= self._run_from:
             restore_low_run(n - 1, int(line[n - 1]), self._run_from)
         self._recording = False
@@ -399,8 +420,12 @@ class Supi3Pins:
         receiver.pipe = [Synced(*(int(full[name][n + SYNC_STAGES - 1 - i]) for name in INPUT_NAMES))
                          for i in range(SYNC_STAGES)] if n >= SYNC_STAGES else self._shifted_pipe(raw, n)
         self._synced_run = synced
+        if serial is not None:
+            serial.feed(c0 + n - 1)
         traces = outputs.render(c0, n, snaps, self._transmitter.render(c0, n))
         self._transmitter.trim()
+        if serial is not None:
+            serial.keep_from = NEVER
         return traces
 
     def _shifted_pipe(self, raw: Mapping[str, npt.NDArray[np.integer]], n: int) -> list[Synced]:

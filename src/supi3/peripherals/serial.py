@@ -1,5 +1,5 @@
 """Devices on the serial I/O bus (SPI master mode, manual 3.3.1): shift registers, an ADC, a DAC and the bus joining
-them, each a :class:`supi3.spi.serial_io.SerialDevice` at both fidelities.
+them, each a :class:`supi3.serial_io.SerialDevice` at both fidelities.
 
 3.3.1: "The serial I/O interface ... is designed for direct connection of DACs ... and ADCs ... It is also possible
 to connect shift registers (e.g., 74HCT165 or 74HCT594) with a data length of up to 32 bits." The wiring (Table
@@ -8,8 +8,8 @@ to connect shift registers (e.g., 74HCT165 or 74HCT594) with a data length of up
 
 At transaction level the chip calls :meth:`frame` once per /SS frame and :meth:`convert` once per /Conv pulse; at
 pin level it calls :meth:`clock` with its MFP3..MFP7 levels at every cycle in which they change, and drives the
-returned SerIn level into its own input :data:`~supi3.spi.serial_io.PERIPHERAL_DELAY_CLOCKS` later. A device
-detects edges by comparing with the levels it saw last (:data:`~supi3.spi.serial_io.IDLE` after construction).
+returned SerIn level into its own input :data:`~supi3.serial_io.PERIPHERAL_DELAY_CLOCKS` later. A device
+detects edges by comparing with the levels it saw last (:data:`~supi3.serial_io.IDLE` after construction).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from typing import Final
 
 from supi3.checks import check_bits, check_choice, check_instance, check_int, check_real, fail
 from supi3.errors import ArgumentError
-from supi3.spi.serial_io import IDLE, Levels, SerialDevice
+from supi3.serial_io import IDLE, Levels, SerialDevice
 
 __all__ = [
     "FRAME_BITS",
@@ -301,7 +301,7 @@ class SerInConflictError(ArgumentError):
 class SerialBus:
     """Several devices on one serial I/O bus (3.3.1): each sees every frame, /Conv pulse and pin change; at most one
     drives SerIn (:class:`SerInConflictError` otherwise), and the bus answers with its level (0 without one: SerIn
-    is grounded when unused, 3.3.1). The bus is itself a :class:`~supi3.spi.serial_io.SerialDevice`, so buses nest.
+    is grounded when unused, 3.3.1). The bus is itself a :class:`~supi3.serial_io.SerialDevice`, so buses nest.
     """
 
     def __init__(self, *devices: SerialDevice) -> None:

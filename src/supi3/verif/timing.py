@@ -8,7 +8,7 @@ and explanation, the measured and the required value, the clock and the time. Th
 Table 3-15's rows evaluated by :func:`supi3.timing.timing_table` for the bit rate; nothing here repeats a number.
 
 The checkers measure; they do not compare with the schedules that generate the waveforms
-(:mod:`supi3.spi.serial_io`, :mod:`supi3.expansion`). Sample ``i`` of a trace is the level during clock ``i``; an
+(:mod:`supi3.serial_io`, :mod:`supi3.expansion`). Sample ``i`` of a trace is the level during clock ``i``; an
 edge is at the start of the first clock showing the new level, and a time is the number of clocks between two such
 first clocks divided by the clock frequency. How each row is measured where the manual's text is short is decided
 in ``docs/assumptions/timing-checkers.md`` (TC-1 to TC-9).

@@ -11,6 +11,7 @@ module           class                              block
 ``datapath``     :class:`.datapath.DataPath`        data path: shift register, load and latch
 ``transmitter``  :class:`.transmitter.Transmitter`  transmitter and repeater (DO2, DI1)
 ``outputs``      :class:`.outputs.Outputs`          outputs and diagnostics
+``serial_io``    :class:`.serial_io.SerialIo`       serial I/O (SPI master mode, 3.3)
 ===============  =================================  ======================================================
 
 Import the submodules directly (``supi3.model.blocks.receiver``). The blocks share one clock and one

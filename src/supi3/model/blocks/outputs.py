@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
+from supi3.model.blocks.serial_io import SerialIo
 from supi3.model.blocks.transmitter import PinTrace, Transmitter
 from supi3.pinout import IB_DIAG_DIVIDER_BITS
 
@@ -42,13 +43,16 @@ class Outputs:
         The MFP output enables of the configuration.
     complete_diagnostics:
         DIAG1 shows BA (DIAG_CONF = 0, Table 3-16).
+    serial:
+        The serial I/O block driving MFP3, 4, 5 and 7 in the SPI master modes (3.3), else None.
     """
 
-    __slots__ = ("chip", "complete_diagnostics", "cpb", "mfp_oe", "transmitter")
+    __slots__ = ("chip", "complete_diagnostics", "cpb", "mfp_oe", "serial", "transmitter")
 
-    def __init__(self, chip: Supi3, transmitter: Transmitter, cpb: int, mfp_oe: int, complete_diagnostics: bool
-                 ) -> None:  # fmt: skip
+    def __init__(self, chip: Supi3, transmitter: Transmitter, cpb: int, mfp_oe: int, complete_diagnostics: bool,
+                 serial: SerialIo | None = None) -> None:  # fmt: skip
         self.chip = chip
+        self.serial = serial
         self.transmitter = transmitter
         self.cpb = cpb
         self.mfp_oe = mfp_oe
@@ -63,7 +67,7 @@ class Outputs:
             "do2": do2,
             # The return line passes straight through when a device follows; the last device loops back (M5).
             "di1": di2 if tx.next_present else do2,
-            "mfp_out": chip.mfp_outputs,
+            "mfp_out": chip.mfp_outputs if self.serial is None else self.serial.mfp(c),
             "mfp_oe": self.mfp_oe,
             # A pulse the chip starts at clock clk (the edge ending cycle clk) lasts until clk + width in chip
             # time; the pins show it from cycle clk + 1, so for cycles clk + 1 .. clk + width (M3). Cycle 0 comes
@@ -106,7 +110,7 @@ class Outputs:
         slow = 1 - ((cycles >> (IB_DIAG_DIVIDER_BITS["slow"] - 1)) & 1)
         cpb = self.cpb
         out: dict[str, npt.NDArray[np.int64]] = {
-            "mfp_out": mfp_out,
+            "mfp_out": mfp_out if self.serial is None else self.serial.render(c0, n),
             "diag1": diag1,
             "mod_ack_n": ((cycles <= 0) | (cycles > mod_ack_until)).astype(np.int64),  # as values()
             "res_reg_n": ((cycles <= 0) | (cycles > resreg_until)).astype(np.int64),

@@ -10,13 +10,12 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from supi3 import expansion, tables
+from supi3 import expansion, serial_io, tables
 from supi3.cli import main
 from supi3.config import DataDirection, DeviceConfig, MfpKind, decode, mode_rows
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
-from supi3.spi import serial_io
-from supi3.spi.serial_io import IDLE, Levels, clear_sequence, render, sequence, t0_clocks
+from supi3.serial_io import IDLE, Levels, clear_sequence, render, sequence, t0_clocks
 
 SPI_CONFIGS = [
     decode(row.c, row.mfp, clk_conf=clk)
