@@ -3,13 +3,18 @@ text for tables checked against it. Helpers that test modules import live in sup
 
 from __future__ import annotations
 
+import functools
 import re
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 from hypothesis import settings
 
 from support import VerilatorBuild, verilator_missing
+
+if TYPE_CHECKING:
+    from supi3.verif import Lockstep
 
 settings.register_profile("supi3", derandomize=True, deadline=None, print_blob=True)
 settings.load_profile("supi3")
@@ -55,6 +60,38 @@ def verilator_build(tmp_path_factory: pytest.TempPathFactory) -> VerilatorBuild:
     if reason is not None:
         pytest.skip(reason)
     return tmp_path_factory.mktemp
+
+
+@pytest.fixture(scope="session")
+def core_bench(verilator_build: VerilatorBuild) -> Lockstep:
+    """The OPC core (``supi3.rtl.core``) against ``verif.straps.StrapPins``: one Verilator build per session, with the
+    per-cycle path, for every test module that runs the core (the straps are ports)."""
+    from supi3.rtl.core import Supi3Core  # Amaranth: only when a bench runs
+    from supi3.verif import Lockstep
+    from supi3.verif.straps import StrapPins
+
+    lockstep = Lockstep(
+        functools.partial(Supi3Core, "opc"), functools.partial(StrapPins, "opc"), build_dir=verilator_build("rtl_core")
+    )
+    lockstep.prepare()
+    return lockstep
+
+
+@pytest.fixture(scope="session")
+def chip_bench(verilator_build: VerilatorBuild) -> Lockstep:
+    """The OPC chip (``supi3.rtl.chip``) against ``verif.straps.ChipStrapPins``: one Verilator build per session
+    (batch path) for every test module that runs the whole chip."""
+    from supi3.rtl.chip import Supi3ChipRtl  # Amaranth: only when a bench runs
+    from supi3.verif import Lockstep
+    from supi3.verif.straps import ChipStrapPins
+
+    lockstep = Lockstep(
+        functools.partial(Supi3ChipRtl, "opc"),
+        functools.partial(ChipStrapPins, "opc"),
+        build_dir=verilator_build("rtl_chip"),
+    )
+    lockstep.prepare(simulators=())
+    return lockstep
 
 
 @pytest.hookimpl(tryfirst=True)  # before -m deselects by marker

@@ -8,8 +8,6 @@ recorded pins are then replayed through the batch lockstep, which is exact up to
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -18,13 +16,13 @@ from hypothesis import strategies as st
 from supi3.config import decode
 from supi3.interbus import wire
 from supi3.regmap import IN0, IN1, OUT0
-from supi3.rtl.chip import Supi3ChipRtl, verilog
+from supi3.rtl.chip import verilog
 from supi3.spi.upif import Mode
 from supi3.tables import BIT_RATES, clk_conf_for
 from supi3.top import UP_OUTPUTS
 from supi3.verif import Lockstep
 from supi3.verif.straps import ChipStrapPins
-from support import IDLE, LOOPBACK, RB_INIT_UP, ChipPins, Firmware, VerilatorBuild, bring_up, data_frame, id_frame
+from support import IDLE, LOOPBACK, RB_INIT_UP, ChipPins, Firmware, bring_up, data_frame, id_frame
 
 IRQ_EVENTS = 14  # read: interrupt events (clears them); write: interrupt enables (3.4.14)
 SET, ID = 13, 12  # writes (3.4.5)
@@ -32,14 +30,8 @@ PCMD_ALARM = 7  # read: processor command; write: processor alarm (3.4.9)
 
 
 @pytest.fixture(scope="session")
-def bench(verilator_build: VerilatorBuild) -> Lockstep:
-    lockstep = Lockstep(
-        functools.partial(Supi3ChipRtl, "opc"),
-        functools.partial(ChipStrapPins, "opc"),
-        build_dir=verilator_build("rtl_chip"),
-    )
-    lockstep.prepare(simulators=())
-    return lockstep
+def bench(chip_bench: Lockstep) -> Lockstep:
+    return chip_bench  # tests/conftest.py: one build, shared with tests/test_verif_lockstep_serial.py
 
 
 def replay(bench: Lockstep, pins: ChipPins) -> None:

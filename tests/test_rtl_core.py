@@ -28,7 +28,7 @@ from supi3.tables import RF_MODES, ModeRow
 from supi3.verif import Lockstep, first_mismatch
 from supi3.verif.amaranth_sim import run_amaranth_sim
 from supi3.verif.straps import StrapPins, strap_stimulus
-from support import CORE_INPUTS, IDLE, LOOPBACK, Columns, CoreScript, VerilatorBuild, pulses, quiet_inputs
+from support import CORE_INPUTS, IDLE, LOOPBACK, Columns, CoreScript, pulses, quiet_inputs
 
 OPC_ROWS = list(mode_rows(Variant.OPC))
 BINARY_ROWS = [row for row in OPC_ROWS if decode(row.c, row.mfp).mfp_mode.kind is MfpKind.BINARY_IO]
@@ -40,14 +40,8 @@ def fast_config(c: str = "10000", mfp: str | None = None) -> DeviceConfig:
 
 
 @pytest.fixture(scope="session")
-def bench(verilator_build: VerilatorBuild) -> Lockstep:
-    lockstep = Lockstep(
-        functools.partial(Supi3Core, "opc"),
-        functools.partial(StrapPins, "opc"),
-        build_dir=verilator_build("rtl_core"),
-    )
-    lockstep.prepare()
-    return lockstep
+def bench(core_bench: Lockstep) -> Lockstep:
+    return core_bench  # tests/conftest.py: one build, shared with tests/test_verif_lockstep_serial.py
 
 
 @pytest.fixture(scope="session")
@@ -91,9 +85,6 @@ def test_verilog_has_the_model_pins_and_straps(variant: str) -> None:
 
 @pytest.mark.parametrize("row", OPC_ROWS, ids=[f"{row.c}-{row.mfp or 'x'}" for row in OPC_ROWS])
 def test_every_mode(bench: Lockstep, row: ModeRow) -> None:
-    if decode(row.c, row.mfp).mfp_mode.kind is MfpKind.SPI_MASTER:
-        # The model drives the serial I/O pins (3.3); the RTL does from supi3.rtl.serial_io on (issue 11).
-        pytest.importorskip("supi3.rtl.serial_io", reason="the RTL's serial I/O block is not on this branch yet")
     index = OPC_ROWS.index(row)
     c, mfp = row.c, row.mfp
     config = decode(

@@ -1,4 +1,4 @@
-"""The serial I/O block in Amaranth (supi3.rtl.serial_io) against the spec's schedule (supi3.spi.serial_io).
+"""The serial I/O block in Amaranth (supi3.rtl.serial_io) against the spec's schedule (supi3.serial_io).
 
 Manual 3.3 (Tables 3-3, 3-4, Figures 3-1 to 3-3) and SM-1 to SM-9 of docs/assumptions/serial-io.md: the pins equal
 ``serial_io.render`` cycle for cycle for every direction, width and bit rate; SerIn, read through the core's
@@ -17,11 +17,11 @@ from typing import Any
 import pytest
 from amaranth.sim import Simulator
 
+from supi3 import serial_io
 from supi3.config import DataDirection
 from supi3.pinout import SYNC_STAGES
 from supi3.rtl.serial_io import DIRECTIONS, MFP_BITS, SER_IN_PIN, WIDTHS, SerialIoRtl
-from supi3.spi import serial_io
-from supi3.spi.serial_io import IDLE, Levels
+from supi3.serial_io import IDLE, Levels
 from supi3.tables import BIT_RATES
 
 MODES = [

@@ -14,14 +14,16 @@ Blocks, in the order the model's ``_tick`` runs them within one clock:
 * receiver: INTERBUS reset detection, idle time-out, telegram framing and mid-bit sampling (docs/interbus.md);
 * frame engine: the register's parallel load, shifting, CRC, check sequence and CNTR, latch and discard;
 * transmitter: a short queue of (countdown, level) entries that repeats each bit ``REPEATER_DELAY_BITS`` after it
-  began on DO1, with the ERR pair of the CNTR word settled at the last stop bit (docs/interbus.md, A7, A10).
+  began on DO1, with the ERR pair of the CNTR word settled at the last stop bit (docs/interbus.md, A7, A10);
+* serial I/O (SPI master modes, 3.3, :class:`supi3.rtl.serial_io.SerialIoRtl`): the sequence on MFP3, 4, 5, 7 after
+  each valid data cycle's latch, the clear sequence after a reset, and the IN word read from SerIn (MFP6), which
+  the next data cycle loads.
 
 µP modes: built with ``register_file=True`` (:class:`supi3.rtl.chip.Supi3ChipRtl`), the core has the ports of the
 register file's core side (:class:`supi3.rtl.upif.UpifBlock`): in Init-µP modes it takes the IN bytes, the ID
 register and the processor alarm from it and strobes the latch, events, processor command, I/O access bit and
-resets at the clocks the model calls its register file (``model.registers.RegisterFile``). Without it, and in SPI
-master and bus terminal modes, the core sends IN data 0 and the straps' ID code, which is what the model does before
-software acts.
+resets at the clocks the model calls its register file (``model.registers.RegisterFile``). Without it, and in bus
+terminal modes, the core sends IN data 0 and the straps' ID code, which is what the model does before software acts.
 """
 
 from __future__ import annotations
@@ -55,6 +57,7 @@ from supi3.pinout import (
 )
 from supi3.regmap import INTERRUPT_SOURCES
 from supi3.regmap.core import BYTE_BITS
+from supi3.rtl.serial_io import DIRECTIONS, SER_IN_PIN, WIDTHS, SerialIoRtl
 from supi3.rtl.tables import (
     IDLE_TIMEOUT_CLOCKS,
     MODACK_PULSE_CLOCKS,
@@ -66,6 +69,7 @@ from supi3.rtl.tables import (
     CoreTables,
     check_variant,
     core_tables,
+    line_position,
 )
 from supi3.rtl.upif import upif_tables
 
@@ -203,6 +207,9 @@ class Supi3Core(wiring.Component):
         strap_id = Signal(WORD_BITS)
         strap_bytes = Signal(range(tables.register_bits // 8 + 1))
         init_up = Signal()
+        spi = Signal()  # an SPI master mode (SM-1): the serial I/O block drives MFP3, 4, 5, 7
+        spi_direction = Signal(range(len(DIRECTIONS)))
+        spi_wide = Signal()
         rate = Signal(range(max(e.rate for e in tables.clocks) + 1))
         io_map = Signal(range(len(tables.io_maps)))
         clocks = tables.clocks
@@ -215,8 +222,14 @@ class Supi3Core(wiring.Component):
         complete_diag = Signal()
         maps = tables.io_maps
         with m.Switch(Cat(self.mfp_in[MFP_PINS - EXPANSION_BITS :], self.c)):
-            for mode in tables.modes:
+            for mode, serial in zip(tables.modes, tables.serial, strict=True):
                 with m.Case(mode.pattern):
+                    if serial is not None:
+                        m.d.comb += [
+                            spi.eq(1),
+                            spi_direction.eq(DIRECTIONS.index(serial.direction)),
+                            spi_wide.eq(WIDTHS.index(serial.bits)),
+                        ]
                     m.d.comb += [
                         strap_id.eq(mode.id_register),
                         strap_bytes.eq(mode.data_bytes),
@@ -258,6 +271,7 @@ class Supi3Core(wiring.Component):
         datapath = DataPathRtl(tables)
         transmitter = TransmitterRtl(tables)
         outputs = OutputsRtl(len(cycle))
+        serial_io = SerialIoRtl()
 
         # The power-up reset with its stretch (1.7.2, M2), from the synchronised /ResU and voltage monitor ---------
         power_fail = ~(receiver.resu_n_s & receiver.vmon_ok_s)
@@ -279,6 +293,7 @@ class Supi3Core(wiring.Component):
         m.submodules.datapath = gated(datapath)
         m.submodules.transmitter = gated(transmitter)
         m.submodules.outputs = gated(outputs)
+        m.submodules.serial_io = gated(serial_io)
 
         # Joins between the blocks: connect() where the interfaces fit ---------------------------------------------
         wiring.connect(m, receiver=receiver.line, frame=frame.line)
@@ -307,13 +322,31 @@ class Supi3Core(wiring.Component):
             outputs.complete_diag.eq(complete_diag),
         ]
 
+        # SPI master modes (3.3): the serial I/O block takes the OUT word of a valid data cycle's latch and gives
+        # the IN word the next data cycle loads (SM-2, SM-4, SM-6); resets clear it (SM-9).
+        word_bits = {bits: [datapath.register[line_position(w, bits // 8)] for w in range(bits)] for bits in WIDTHS}
+        out_word = Mux(spi_wide, Cat(*word_bits[WIDTHS[1]]), Cat(*word_bits[WIDTHS[0]]))
+        in_data = Signal(tables.register_bits)
+        for bits in WIDTHS:
+            with m.If(spi_wide == WIDTHS.index(bits)):
+                m.d.comb += [in_data[line_position(w, bits // 8)].eq(serial_io.in_word[w]) for w in range(bits)]
+        m.d.comb += [
+            serial_io.start.eq(spi & frame.management.latch_data),
+            serial_io.out_word.eq(out_word),
+            serial_io.reset.eq(spi & (frame.management.clear | outputs.words.watchdog_reset)),
+            serial_io.ser_in.eq(receiver.mfp_in_s[SER_IN_PIN]),
+            serial_io.direction.eq(spi_direction),
+            serial_io.wide.eq(spi_wide),
+            serial_io.rate.eq(rate),
+        ]
+
         # Init-µP modes: the ID register, the data length and the IN data from the register file (docs/upif.md)
         up = self.register_file
         m.d.comb += [
             datapath.id_register.eq(strap_id),
             datapath.data_bytes.eq(strap_bytes),
-            datapath.init_up.eq(init_up if up else 0),
-            datapath.in_data.eq(self.in_data if up else 0),
+            datapath.external.eq(spi | init_up if up else spi),
+            datapath.in_data.eq(Mux(init_up, self.in_data, in_data) if up else in_data),
         ]
         if up:
             up_bytes = Signal.like(strap_bytes)
@@ -348,7 +381,7 @@ class Supi3Core(wiring.Component):
         m.d.comb += [
             self.do2.eq(transmitter.do2),
             self.di1.eq(outputs.di1),
-            self.mfp_out.eq(datapath.mfp_out),
+            self.mfp_out.eq(datapath.mfp_out | Mux(spi, serial_io.mfp, 0)),
             self.mod_ack_n.eq(outputs.mod_ack_n),
             self.res_reg_n.eq(outputs.res_reg_n),
             self.diag1.eq(outputs.diag1),
@@ -470,14 +503,15 @@ class FrameEngineRtl(wiring.Component):
     CNTR legality, ERR) instead of stored; the CNTR word is forwarded with the chip's ATTN. It drives the data path
     through ``register`` (:data:`REGISTER`), the chip registers through ``management`` (:data:`MANAGEMENT`) and the
     transmitter through ``tx`` (:data:`TRANSMIT`); ``events`` are the frame's interrupt sources at their IRQ_EVT
-    bits, ``io`` the I/O access bit with this clock's ``io_set`` and ``io_clear``. The statements follow the model's
-    order within one clock, later assignments winning as later Python assignments do.
+    bits, ``io`` the I/O access bit with this clock's ``io_set`` and ``io_clear``, ``discard`` a frame ending
+    unlatched (``chip.discard_at``). The statements follow the model's order within one clock, later assignments
+    winning as later Python assignments do.
     """
 
     def __init__(self) -> None:
         super().__init__({
             "line": In(LINE), "register": Out(REGISTER), "management": Out(MANAGEMENT), "tx": Out(TRANSMIT),
-            "events": Out(EVENT_BITS), "io": Out(1), "io_set": Out(1), "io_clear": Out(1),
+            "events": Out(EVENT_BITS), "io": Out(1), "io_set": Out(1), "io_clear": Out(1), "discard": Out(1),
         })  # fmt: skip
 
     def elaborate(self, _platform: object) -> Module:
@@ -517,7 +551,7 @@ class FrameEngineRtl(wiring.Component):
         ) or wire.CNTR_ATTN_BIT > wire.CNTR_NATTN_BIT:
             raise ValueError("the model settles the ERR pair as the last two CNTR bits, after ATTN and /ATTN")
 
-        discard = Signal()  # a frame ends unlatched (chip.discard_at): the invalid-data-cycle event
+        discard = self.discard  # a frame ends unlatched (chip.discard_at): the invalid-data-cycle event
         io = self.io
         sync += io.eq(self.io_set | (io & ~self.io_clear))
         comb += [tx.push.eq(rx.sample), tx.level.eq(line), reg.level.eq(line), mg.frame_error.eq(~idle & local_error)]
@@ -663,9 +697,10 @@ class DataPathRtl(wiring.Component):
 
     The frame's shift register (width 8 x data bytes, or 16 in an ID cycle; bit 0 goes out first) with its length
     fixed at the load; the parallel load of the ID register (``id_register`` with the management bits ``status``)
-    or of the IN data (the MFP inputs through the mode's map, or ``in_data`` in Init-µP modes, 0 if the watchdog
-    fires at that clock); the latch of OUT data to the MFP outputs through the mode's map, and their clearing by an
-    INTERBUS reset or the watchdog (Tables 3-1, 3-2, 3-13). Driven by the frame engine through ``frame``
+    or of the IN data (the MFP inputs through the mode's map, or ``in_data`` with ``external``: the register file's IN
+    bytes in Init-µP modes, the serial I/O's IN word in SPI master modes; 0 if the watchdog fires at that clock);
+    the latch of OUT data to the MFP outputs through the mode's map, and their clearing by an INTERBUS reset or the
+    watchdog (Tables 3-1, 3-2, 3-13). Driven by the frame engine through ``frame``
     (:data:`REGISTER`, flipped); ``words`` (:data:`WORDS`) joins it to the outputs and diagnostics.
     """
 
@@ -673,7 +708,7 @@ class DataPathRtl(wiring.Component):
         self.tables = tables
         super().__init__({
             "frame": In(REGISTER), "words": Out(WORDS),
-            "id_register": In(WORD_BITS), "data_bytes": In(range(tables.register_bits // 8 + 1)), "init_up": In(1),
+            "id_register": In(WORD_BITS), "data_bytes": In(range(tables.register_bits // 8 + 1)), "external": In(1),
             "in_data": In(tables.register_bits), "io_map": In(range(len(tables.io_maps))), "mfp_in": In(MFP_PINS),
             "register": Out(tables.register_bits), "mfp_out": Out(MFP_PINS),
         })  # fmt: skip
@@ -701,7 +736,7 @@ class DataPathRtl(wiring.Component):
             for k, (in_pins, _) in enumerate(self.tables.io_maps):
                 with m.Case(k):
                     comb += in_word.eq(Cat(*(self.mfp_in[p] if p is not None else Const(0) for p in in_pins)))
-        with m.If(self.init_up):  # the IN bytes, cleared first by a watchdog reset at this clock
+        with m.If(self.external):  # the IN bytes or word, cleared first by a watchdog reset at this clock
             comb += in_word.eq(Mux(words.watchdog_reset, 0, self.in_data))
 
         with m.If(f.load):

@@ -1,9 +1,9 @@
 """Serial I/O (SPI master mode, manual 3.3) in Amaranth: the access sequence on MFP3..MFP7, from counters.
 
-:class:`SerialIoRtl` drives /Conv, SCLK, /SS and SerOut exactly as :func:`supi3.spi.serial_io.sequence` schedules
+:class:`SerialIoRtl` drives /Conv, SCLK, /SS and SerOut exactly as :func:`supi3.serial_io.sequence` schedules
 them (Tables 3-3, 3-4, Figures 3-1 to 3-3; decisions SM-1 to SM-9 of ``docs/assumptions/serial-io.md``), and reads
 SerIn into the IN word. Nothing is stored as a waveform: a sequence counter ``k`` places the frames and the /Conv
-pulse (their offsets are constants taken from the spec's :class:`~supi3.spi.serial_io.SerialSequence` for every
+pulse (their offsets are constants taken from the spec's :class:`~supi3.serial_io.SerialSequence` for every
 direction, width and bit rate at elaboration), and a slot counter (``sub`` within a t0, ``within`` a byte of nine
 slots, ``lead`` for the half t0 before the first slot) gives SCLK, the SerOut shifts and the sample points.
 
@@ -11,7 +11,7 @@ slots, ``lead`` for the half t0 before the first slot) gives SCLK, the SerOut sh
   while one runs, the word waits (one deep, the newest wins) and its sequence begins on the cycle after the running
   one ends.
 * ``reset`` (INTERBUS reset or watchdog reset of process data): the running sequence is aborted, a waiting one
-  dropped, the IN word cleared, and the clear sequence of the mode (:func:`~supi3.spi.serial_io.clear_sequence`,
+  dropped, the IN word cleared, and the clear sequence of the mode (:func:`~supi3.serial_io.clear_sequence`,
   none in input mode) begins on the next cycle (SM-9). A ``start`` at the same edge wins (the core applies a latch
   after the watchdog's clearing).
 * ``ser_in`` is SerIn after the core's synchroniser: bit ``j`` of a read frame is taken at the edge ending cycle
@@ -28,7 +28,7 @@ from amaranth.hdl import Cat, Module, Mux, Signal, Value
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
-import supi3.spi.serial_io as spec
+from supi3 import serial_io as spec
 from supi3.config import DataDirection
 from supi3.pinout import SYNC_STAGES
 from supi3.tables import BIT_RATES, SPI_MASTER_MFP
@@ -46,7 +46,7 @@ _CLEAR: Final = len(DIRECTIONS)
 
 
 def _mfp_bit(**level: int) -> int:
-    """The MFP bit of the one pin set in ``level`` (the rest at 0), by :meth:`supi3.spi.serial_io.Levels.mfp`."""
+    """The MFP bit of the one pin set in ``level`` (the rest at 0), by :meth:`supi3.serial_io.Levels.mfp`."""
     levels = spec.Levels(**{"conv_n": 0, "sclk": 0, "ss_n": 0, "ser_out": 0, **level})
     return levels.mfp().bit_length() - 1
 

@@ -17,7 +17,7 @@ from functools import cache
 from typing import Final
 
 from supi3.checks import fail
-from supi3.config import DeviceConfig, MfpKind, Variant, decode, mode_rows
+from supi3.config import DataDirection, DeviceConfig, MfpKind, Variant, decode, mode_rows
 from supi3.errors import ConfigurationError
 from supi3.interbus import wire
 from supi3.pinout import C_BITS, CLK_CONF_BITS, DIAG_CONF_BITS, EXPANSION_BITS, MFP_PINS, RF_BITS, SYNC_STAGES
@@ -47,12 +47,15 @@ __all__ = [
     "ClockEntry",
     "CoreTables",
     "ModeEntry",
+    "SerialMode",
     "check_variant",
     "clock_entry",
     "complete_diagnostics",
     "core_tables",
+    "line_position",
     "mode_entry",
     "rbst_by_pin",
+    "serial_mode",
 ]
 
 STATERR_FILTER_CLOCKS: Final = round(STATERR_FILTER_S * CLOCK_HZ)
@@ -114,6 +117,14 @@ class ModeEntry:
 
 
 @dataclass(frozen=True)
+class SerialMode:
+    """What an SPI master row (Tables 2-4 to 2-6, SM-1) sets in the serial I/O block: direction and bits."""
+
+    direction: DataDirection
+    bits: int
+
+
+@dataclass(frozen=True)
 class ClockEntry:
     """One usable CLK_CONF[1..0] value (Table 1-7) and the timing the model derives from its bit rate."""
 
@@ -133,6 +144,8 @@ class CoreTables:
 
     variant: Variant
     modes: tuple[ModeEntry, ...]
+    serial: tuple[SerialMode | None, ...]
+    """For each mode, the SPI master direction and width, or ``None`` (not an SPI master mode)."""
     clocks: tuple[ClockEntry, ...]
     rbst_by_pin: tuple[int, ...]
     """RF[1..0] values that select bus connector recognition via RBST_EXT (Table 2-2)."""
@@ -154,7 +167,7 @@ def _bits(value: int, width: int) -> str:
     return format(value, f"0{width}b")
 
 
-def _line_position(word_bit: int, n: int) -> int:
+def line_position(word_bit: int, n: int) -> int:
     """The shift-register position (line order, 0 goes out first) of bit ``word_bit`` of an ``n``-byte data word:
     byte 0, the most significant, first (docs/interbus.md "Frame", 3.4.8), each byte LSB first or MSB first as
     :data:`supi3.interbus.wire.DATA_LSB_FIRST` says."""
@@ -182,9 +195,9 @@ def mode_entry(config: DeviceConfig) -> ModeEntry:
     out_bits: list[int | None] = [None] * MFP_PINS
     for function in config.mfp_pins if binary else ():
         if (bit := _io_bit(function.signal, "In")) is not None:
-            in_pins[_line_position(bit, n)] = function.pin
+            in_pins[line_position(bit, n)] = function.pin
         elif (bit := _io_bit(function.signal, "Out")) is not None:
-            out_bits[function.pin] = _line_position(bit, n)
+            out_bits[function.pin] = line_position(bit, n)
     straps = config.straps()
     pattern = straps.c + (straps.mfp if straps.mfp is not None else "-" * EXPANSION_BITS)
     id_register = (config.length_code << BYTE_BITS) | config.id_code
@@ -199,6 +212,12 @@ def clock_entry(clk_conf: int, config: DeviceConfig) -> ClockEntry:
     cpb = wire.clocks_per_bit(config.bit_rate)
     forward_delay = wire.REPEATER_DELAY_BITS * cpb - SYNC_STAGES
     return ClockEntry(clk_conf, BIT_RATES.index(config.bit_rate), cpb, forward_delay, wire.RESET_DETECT_BITS * cpb)
+
+
+def serial_mode(config: DeviceConfig) -> SerialMode | None:
+    """The serial I/O of ``config``'s MFP mode (SM-1: the "SPI" rows), or ``None``."""
+    mode = config.mfp_mode
+    return SerialMode(mode.direction, mode.width) if mode.kind is MfpKind.SPI_MASTER else None
 
 
 def rbst_by_pin(config: DeviceConfig) -> bool:
@@ -244,7 +263,9 @@ def core_tables(variant: Variant | str = Variant.OPC) -> CoreTables:
     """
     variant = check_variant(variant)
     rows = list(mode_rows(variant))
-    modes = tuple(mode_entry(decode(row.c, row.mfp, variant=variant)) for row in rows)
+    configs = [decode(row.c, row.mfp, variant=variant) for row in rows]
+    modes = tuple(mode_entry(config) for config in configs)
+    serial = tuple(serial_mode(config) for config in configs)
     first = rows[0]
     clocks = []
     for value, config in _values(CLK_CONF_BITS, lambda b: decode(first.c, first.mfp, clk_conf=b, variant=variant)):
@@ -258,4 +279,4 @@ def core_tables(variant: Variant | str = Variant.OPC) -> CoreTables:
         diag = _values(DIAG_CONF_BITS, lambda b: decode(first.c, first.mfp, diag_conf=b, variant=variant))
         rbst = tuple(value for value, config in rf if rbst_by_pin(config))
         complete = tuple(value for value, config in diag if complete_diagnostics(config))
-    return CoreTables(variant, modes, tuple(clocks), rbst, complete)
+    return CoreTables(variant, modes, serial, tuple(clocks), rbst, complete)
