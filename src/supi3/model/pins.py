@@ -166,6 +166,7 @@ class Supi3Pins:
         self.log.clear()
         self._receiver.reset()
         self._transmitter.reset()
+        self._expansion.sync_reset()
         self._holding = False
         self._recording = False
         self._power_ups: list[tuple[int, int]] = []

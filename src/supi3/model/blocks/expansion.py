@@ -101,6 +101,10 @@ class Expansion:
         self.chip = chip
         self.cpb = cpb
         self._high = clock_high(cpb)
+        self.sync_reset()
+
+    def sync_reset(self) -> None:
+        """After the ``sync`` reset (cycle 0): idle pins, nothing scheduled, the chain's answers forgotten."""
         self.from_exr = 0
         self._events: list[tuple[int, int, int]] = []
         self._shown_levels = list(IDLE_LEVELS)
