@@ -118,9 +118,14 @@ class Expansion:
 
     def power_up(self, c: int) -> None:
         """Power-up reset in cycle ``c``: pending changes dropped, every pin idle from the next cycle (RX-6)."""
-        self._events = [event for event in self._events if event[0] <= c]  # sorted: the cursors stay valid
-        for signal, level in enumerate(IDLE_LEVELS):
-            insort(self._events, (c + 1, signal, level))
+        events = self._events = [event for event in self._events if event[0] <= c]  # sorted: cursors stay valid
+        levels = list(self._shown_levels)
+        for _, signal, level in events[self._shown :]:
+            levels[signal] = level
+        # Only the pins not idle already: a power-up held for many cycles (vmon_ok low) schedules nothing more.
+        for signal, (now, idle) in enumerate(zip(levels, IDLE_LEVELS, strict=True)):
+            if now != idle:
+                insort(events, (c + 1, signal, idle))
         self._free = 0
         self.first = False
 
@@ -186,6 +191,7 @@ class Expansion:
                 levels[events[k][1]] = events[k][2]
                 k += 1
             self._told = k
+            self._trim()
             return
         answers = self._answers
         while k < len(events) and events[k][0] <= until:
