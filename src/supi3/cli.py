@@ -41,8 +41,9 @@ from typing import Any, NoReturn, TextIO
 from supi3 import campaign, tables, timing
 from supi3.checks import check_int, fail
 from supi3.checks import describe as _shown
-from supi3.config import DeviceConfig, Interface, Variant, decode, mode_rows
+from supi3.config import DeviceConfig, Interface, MfpKind, Variant, decode, mode_rows
 from supi3.errors import Supi3Error
+from supi3.spi import serial_io
 
 MAX_NETWORK_BYTES = timing.MAX_NETWORK_BYTES
 """``timing --bytes`` limit: 512 devices (the INTERBUS limit) of the longest data length, 32 words (Table 3-11)."""
@@ -267,12 +268,37 @@ def cmd_modes(args: argparse.Namespace) -> None:
     ))
 
 
+def serial_io_summary(config: DeviceConfig) -> dict[str, Any] | None:
+    """The SPI master modes' access sequence and peripheral wiring (3.3, Tables 3-3 and 3-4); None in other modes."""
+    mode = config.mfp_mode
+    if mode.kind is not MfpKind.SPI_MASTER:
+        return None
+    seq = serial_io.sequence(mode.direction, mode.width, config.bit_rate)
+    uses = {"in": seq.read is not None, "out": seq.write is not None}
+    return {
+        "sclk_hz": tables.CLOCK_HZ // serial_io.t0_clocks(config.bit_rate),
+        "frame_s": seq.frames[0].length / tables.CLOCK_HZ,
+        "sequence_s": seq.length / tables.CLOCK_HZ,
+        "wiring": [{"pin": f"MFP{w.mfp}", "signal": w.signal,
+                    "connect": "; ".join(text for text, side in ((w.inputs, "in"), (w.outputs, "out"))
+                                         if text and uses[side]) or "-"}
+                   for w in serial_io.WIRING],
+    }  # fmt: skip
+
+
 def describe_config(config: DeviceConfig) -> str:
     """A human-readable description of a decoded configuration."""
     d = config.as_dict()
     lines = [f"{key:20} {value}" for key, value in d.items()]
     pins = ", ".join(f"MFP{p.pin}={p.signal}({p.direction.value})" for p in config.mfp_pins)
     lines.append(f"{'mfp_pins':20} {pins or '-'}")
+    serial = serial_io_summary(config)
+    if serial is not None:
+        lines.append(f"{'serial_io':20} SCLK {serial['sclk_hz'] / 1e6:g} MHz, "
+                     f"/SS frame {serial['frame_s'] * 1e6:g} µs, "
+                     f"sequence after each data cycle {serial['sequence_s'] * 1e6:g} µs (3.3, Table 3-4)")
+        lines.append("peripheral wiring (Table 3-3; MFP0-2 and MFP8-11 to GND):")
+        lines.extend(f"  {w['pin']:6} {w['signal']:7} {w['connect']}" for w in serial["wiring"])
     return "\n".join(lines)
 
 
@@ -283,6 +309,9 @@ def cmd_decode(args: argparse.Namespace) -> None:
         data = config.as_dict()
         data["mfp_pins"] = [{"pin": p.pin, "signal": p.signal, "direction": p.direction.value}
                             for p in config.mfp_pins]
+        serial = serial_io_summary(config)
+        if serial is not None:
+            data["serial_io"] = serial
         print_json(data)
     else:
         print(describe_config(config))

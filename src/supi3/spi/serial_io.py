@@ -34,10 +34,12 @@ from supi3.tables import BIT_RATES
 __all__ = [
     "IDLE",
     "PAUSE_T0",
+    "WIRING",
     "Levels",
     "SerialDevice",
     "SerialFrame",
     "SerialSequence",
+    "Wire",
     "clear_sequence",
     "sequence",
     "t0_clocks",
@@ -69,7 +71,7 @@ class Levels:
 
 IDLE: Final = Levels(conv_n=1, sclk=0, ss_n=1, ser_out=0)
 """Between sequences, after power-up and during the reset stretch (SM-8)."""
-MFP_MASK: Final = IDLE.mfp() | Levels(0, 1, 0, 1).mfp() | (1 << 3) | (1 << 5)
+MFP_MASK: Final = Levels(1, 1, 1, 1).mfp()
 """The MFP bits the serial I/O drives (MFP3, 4, 5, 7)."""
 
 
@@ -101,6 +103,30 @@ class SerialDevice(Protocol):
 
     def clock(self, levels: Levels) -> int:
         """The chip's pins changed to ``levels``; returns the SerIn level the device drives from then on."""
+
+
+@dataclass(frozen=True)
+class Wire:
+    """How one pin of Table 3-3 meets the peripherals the serial I/O is made for (3.3.1: ADCs, DACs, 74HCT165 input
+    and 74HCT594 output shift registers), as the models of :mod:`supi3.peripherals` expect it (SM-12)."""
+
+    mfp: int
+    signal: str
+    inputs: str
+    """What input peripherals (IN data) connect here; empty if none."""
+    outputs: str
+    """What output peripherals (OUT data) connect here; empty if none."""
+
+
+WIRING: Final[tuple[Wire, ...]] = (
+    Wire(3, "/Conv", "", "DAC /LDAC (output takes the word at the fall); 74HCT594 ST_CP (storage at the rise)"),
+    Wire(4, "SCLK", "ADC SCLK; 74HCT165 CP", "DAC SCLK; 74HCT594 SH_CP"),
+    Wire(5, "/SS", "ADC /CS (samples at the fall); 74HCT165 /PL through an inverter (captures at the fall)",
+         "DAC /CS"),
+    Wire(6, "SerIn", "ADC DOUT; 74HCT165 Q7 of the first chip (DS of the last to GND)", ""),
+    Wire(7, "SerOut", "", "DAC DIN; 74HCT594 DS of the first chip"),
+)  # fmt: skip
+"""Peripheral wiring of the SPI master pins (Table 3-3); MFP0-2 and MFP8-11 go to GND (3.3.1 note)."""
 
 
 def t0_clocks(bit_rate: int) -> int:

@@ -1,4 +1,5 @@
-"""Verification kit: the lockstep harness comparing a pin-level model (:mod:`supi3.pinlevel`) with RTL.
+"""Verification kit: the lockstep harness comparing a pin-level model (:mod:`supi3.pinlevel`) with RTL, and the
+timing checkers of Tables 3-4 and 3-15 on pin traces (:mod:`supi3.verif.timing`).
 
 See ``docs/verification.md``. The cocotb coroutine lives in :mod:`supi3.verif.cocotb_lockstep` (imported only inside
 a simulator), the per-cycle path's cocotb test module in :mod:`supi3.verif.testbenches`, the example design and model
@@ -11,6 +12,7 @@ from supi3.pinlevel import EventLog, Pin, PinModel, PinSpecError, recent_events
 from supi3.verif.errors import LockstepError, LockstepMismatchError, SimulationError, SimulatorUnavailableError
 from supi3.verif.layout import Stimulus, WordLayout, first_mismatch, model_trace, stimulus_array
 from supi3.verif.report import LockstepResult
+from supi3.verif.timing import TimingViolation, TraceTimingError, check_expansion, check_serial_io, raise_first
 
 if TYPE_CHECKING:
     from supi3.verif.lockstep import Lockstep, react, run_lockstep, run_lockstep_batch
@@ -40,9 +42,14 @@ __all__ = [
     "SimulationError",
     "SimulatorUnavailableError",
     "Stimulus",
+    "TimingViolation",
+    "TraceTimingError",
     "WordLayout",
+    "check_expansion",
+    "check_serial_io",
     "first_mismatch",
     "model_trace",
+    "raise_first",
     "react",
     "recent_events",
     "run_lockstep",
