@@ -23,11 +23,13 @@ from supi3.model.blocks.expansion import OUTPUT_NAMES
 from supi3.model.chip import Supi3
 from supi3.model.pinring import PinRing
 from supi3.model.pins import RESET_STRETCH_CLOCKS, Supi3Pins
+from supi3.peripherals.sre import Sre1
 from supi3.pinout import CORE_IDLE
 from supi3.regmap import ID, SET, encode_command
 from supi3.spi.master import SoftMaster
 from supi3.spi.upif import Mode
 from supi3.top import UP_REST, ChipPort, Supi3Chip
+from supi3.verif.timing import check_expansion
 from support import FakeChain, pulses
 from test_model_expansion import extreg_set, up_chip
 
@@ -305,3 +307,47 @@ def test_pin_level_and_transaction_level_agree(length: int, bit_rate: int, data:
         results.append(seen)
     assert results[0] == results[1]
 
+
+
+# ------------------------------------------------------------------------------------------------------------
+# With the IBS SRE 1 model (supi3.peripherals.sre) and the Table 3-15 checker (supi3.verif.timing)
+# ------------------------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("bit_rate", tables.BIT_RATES)
+def test_sre1_at_both_fidelities_figure_3_24(bit_rate: int) -> None:
+    results = []
+    for pin_level in (False, True):
+        sre = Sre1(3)
+        sre.set_inputs(b"\x01\x02\x03")
+        ring: Ring | PinRing
+        if pin_level:
+            pins = up_pins(3, bit_rate)
+            pins.chip.attach_expansion(sre)
+            ring, master = pin_master(pins)
+        else:
+            chip = up_chip(3, bit_rate)
+            chip.attach_expansion(sre)
+            ring = Ring([chip])
+            master = Master(ring)
+            assert master.start().ok
+        seen = [exchange(ring, master, bytes([0x14, 0x56, 0x78])), sre.outputs]
+        seen.append(exchange(ring, master, bytes([0x9A, 0xBC, 0xDE])))
+        results.append((*seen, sre.outputs, sre.contents()))
+    assert results[0] == results[1]
+    assert results[0][:2] == (b"\x03\x02\x01", bytes([0x78, 0x56, 0x14]))
+
+
+@pytest.mark.parametrize("bit_rate", tables.BIT_RATES)
+def test_model_pins_meet_table_3_15(bit_rate: int) -> None:
+    """The pin-level model's expansion traces (INTERBUS reset, ID cycle, data cycles, a watchdog-free run) pass
+    the Table 3-15 checker with no violation."""
+    pins = up_pins(6, bit_rate)
+    pins.chip.attach_expansion(Sre1(6))
+    ring, master = pin_master(pins, record=True)
+    for k in range(2):
+        exchange(ring, master, bytes(range(k, k + 6)))
+    ring.idle(2 * GAP_BITS / ring.bit_rate)
+    rec = ring.recorded()[0]
+    assert len(pulses(rec["res_reg_n"])) == 1 and len(pulses(rec["la_in_d_n"])) >= 3
+    assert check_expansion(rec, bit_rate=bit_rate) == []
