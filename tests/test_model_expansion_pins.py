@@ -351,3 +351,25 @@ def test_model_pins_meet_table_3_15(bit_rate: int) -> None:
     rec = ring.recorded()[0]
     assert len(pulses(rec["res_reg_n"])) == 1 and len(pulses(rec["la_in_d_n"])) >= 3
     assert check_expansion(rec, bit_rate=bit_rate) == []
+
+
+@pytest.mark.slow
+def test_watchdog_reset_at_pin_level_pulses_resreg_4_t0_and_clears_the_chain() -> None:
+    """RX-5 at pin level: the layer-2 watchdog's reset of process data (Table 3-13) with ExtReg = 1 pulls /ResReg
+    low for 4 t0 (not 375 ns), and the chain sees it: outputs and chain cleared."""
+    bit_rate = 2_000_000
+    cpb = wire.clocks_per_bit(bit_rate)
+    pins = up_pins(3, bit_rate)
+    sre = Sre1(3)
+    pins.chip.attach_expansion(sre)
+    ring, master = pin_master(pins, record=True)
+    master.set_watchdog(tables.WATCHDOG_TIMEOUTS_S[0])
+    assert master.cycle().cycle is Cycle.ID
+    exchange(ring, master, b"\x11\x22\x33")
+    assert sre.outputs == b"\x33\x22\x11"
+    for _ in range(120):  # 60 ms in short pieces (PinRing's receiver is quadratic in one call's length)
+        ring.idle(tables.WATCHDOG_TIMEOUTS_S[0] / 100)
+    assert pins.chip.events["WATCHDOG"] == 1
+    assert sre.outputs == bytes(3) and sre.contents() == bytes(3)
+    rec = ring.recorded()[0]
+    assert [width for _, width in pulses(rec["res_reg_n"])] == [PULSE_T0 * cpb, PULSE_T0 * cpb]  # reset, watchdog
