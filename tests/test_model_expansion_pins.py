@@ -363,12 +363,14 @@ def test_watchdog_reset_at_pin_level_pulses_resreg_4_t0_and_clears_the_chain() -
     sre = Sre1(3)
     pins.chip.attach_expansion(sre)
     ring, master = pin_master(pins, record=True)
-    master.set_watchdog(tables.WATCHDOG_TIMEOUTS_S[0])
+    timeout = tables.WATCHDOG_TIMEOUTS_S[0]
+    assert timeout is not None
+    master.set_watchdog(timeout)
     assert master.cycle().cycle is Cycle.ID
     exchange(ring, master, b"\x11\x22\x33")
     assert sre.outputs == b"\x33\x22\x11"
     for _ in range(120):  # 60 ms in short pieces (PinRing's receiver is quadratic in one call's length)
-        ring.idle(tables.WATCHDOG_TIMEOUTS_S[0] / 100)
+        ring.idle(timeout / 100)
     assert pins.chip.events["WATCHDOG"] == 1
     assert sre.outputs == bytes(3) and sre.contents() == bytes(3)
     rec = ring.recorded()[0]
