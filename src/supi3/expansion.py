@@ -133,4 +133,4 @@ class ExternalRegisters(Protocol):
 
     def clock(self, levels: ExpansionLevels) -> int:
         """The chip's pins changed to ``levels``; returns the FromExR level the chain drives from then on (it
-        answers 2 clocks later, as the serial I/O devices do: ``serial_io.PERIPHERAL_DELAY_CLOCKS``)."""
+        answers ``supi3.serial_io.PERIPHERAL_DELAY_CLOCKS`` = 2 clocks later, as the serial I/O devices do)."""
