@@ -12,16 +12,17 @@ from amaranth.lib import wiring
 from supi3.config import Variant
 from supi3.rtl import core
 from supi3.rtl.core import DataPathRtl, FrameEngineRtl, OutputsRtl, ReceiverRtl, Supi3Core, TransmitterRtl
+from supi3.rtl.expansion import ExpansionRtl
 from supi3.rtl.serial_io import SerialIoRtl
 from supi3.rtl.tables import core_tables
 
 BLOCKS = {"receiver": ReceiverRtl, "frame": FrameEngineRtl, "datapath": DataPathRtl, "transmitter": TransmitterRtl,
-          "outputs": OutputsRtl, "serial_io": SerialIoRtl}  # fmt: skip
+          "outputs": OutputsRtl, "serial_io": SerialIoRtl, "expansion": ExpansionRtl}  # fmt: skip
 """Block name (the same in supi3.model) -> RTL component."""
 
 
 @pytest.mark.parametrize("variant", list(Variant))
-def test_core_is_the_six_blocks(variant: Variant) -> None:
+def test_core_is_the_seven_blocks(variant: Variant) -> None:
     fragment = Fragment.get(Supi3Core(variant), None)
     assert [name for _, name, _ in fragment.subfragments] == list(BLOCKS)
 
@@ -30,7 +31,7 @@ def blocks() -> list[wiring.Component]:
     """One of each block, elaborated on its own (so none is left unused)."""
     tables = core_tables()
     made = [ReceiverRtl(tables), FrameEngineRtl(), DataPathRtl(tables), TransmitterRtl(tables), OutputsRtl(26),
-            SerialIoRtl()]  # fmt: skip
+            SerialIoRtl(), ExpansionRtl()]  # fmt: skip
     for block in made:
         Fragment.get(block, None)
     return made
@@ -45,7 +46,7 @@ def test_blocks_are_components_with_signatures() -> None:
 
 def test_block_interfaces_fit() -> None:
     """Every interface between two blocks is one signature, seen from both sides (connect() needs that)."""
-    receiver, frame, datapath, transmitter, outputs, _ = blocks()
+    receiver, frame, datapath, transmitter, outputs, *_ = blocks()
     pairs = [
         (receiver.signature.members["line"], frame.signature.members["line"], core.LINE),
         (frame.signature.members["register"], datapath.signature.members["frame"], core.REGISTER),

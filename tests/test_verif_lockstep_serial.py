@@ -1,30 +1,48 @@
-"""Lockstep of the RTL (supi3.rtl.serial_io in the core) against the model: SPI master modes (issue #11).
+"""Lockstep of the RTL (supi3.rtl.serial_io, supi3.rtl.expansion in the core) against the model: SPI master modes
+and the serial register expansion (issue #11).
 
 Manual 3.3: every SPI master mode of Tables 2-4 to 2-6 (16 and 32 bits; IN, OUT, IN/OUT) at both bit
 rates, through an INTERBUS reset, ID and data cycles with random OUT data, with a random SerIn trace on MFP6: MFP3,
 4, 5, 7 (/Conv, SCLK, /SS, SerOut), the IN data sent back on DO2 and every other pin equal on every clock. One
 Verilator build of the core serves every mode (the straps are ports; ``core_bench`` of tests/conftest.py, shared with
 tests/test_rtl_core.py); the batch path compares.
+
+Manual 3.5: the whole chip (supi3.rtl.chip) with firmware writing SET with ExtReg = 1 and external registers of
+several lengths on the expansion pins (supi3.peripherals.sre.Sre1, clocked by the model's pins), on the chip's build
+(``chip_bench``, shared with tests/test_rtl_chip.py).
 """
 
 from __future__ import annotations
 
 from collections import deque
+from dataclasses import fields
 
 import numpy as np
 import pytest
 
 from supi3 import serial_io
 from supi3.config import DataDirection, DeviceConfig, MfpKind, Variant, decode, mode_rows
+from supi3.expansion import IDLE as EXPANSION_IDLE
+from supi3.expansion import ExpansionLevels, chain_to_line, line_to_chain
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle
 from supi3.peripherals.serial import SerialBus, ShiftIn, ShiftOut
+from supi3.peripherals.sre import Sre1
+from supi3.regmap.registers import ID, SET
 from supi3.rtl.serial_io import MFP_BITS, SER_IN_PIN, WIDTHS
+from supi3.spi.upif import Mode
 from supi3.tables import BIT_RATES, clk_conf_for
 from supi3.verif import Lockstep
 from supi3.verif.straps import StrapPins
 from support import (
+    IDLE,
+    LOOPBACK,
+    RB_INIT_UP,
+    ChipPins,
     CoreScript,
+    Firmware,
+    bring_up,
+    data_frame,
 )
 
 SPI_ROWS = [row for row in mode_rows(Variant.OPC) if decode(row.c, row.mfp).mfp_mode.kind is MfpKind.SPI_MASTER]
@@ -114,3 +132,59 @@ def test_every_spi_row_decodes(core_bench: Lockstep) -> None:
             continue
         config = decode(row.c, row.mfp, clk_conf=clk_conf_for(max(BIT_RATES)))
         core_bench.run_batch(with_ser_in(spi_script(config, 100 + k, data_cycles=1), 100 + k))
+
+
+# Serial register expansion (3.5): the whole chip, SET with ExtReg = 1 written by firmware --------------------------
+
+
+class ChainPins(ChipPins):
+    """:class:`support.ChipPins` with external registers on the expansion pins, as on a board: the chain is clocked
+    with the chip's ClkExR, ToExR, LaOuD, /LaInD, /ResReg at every change and drives FromExR
+    ``serial_io.PERIPHERAL_DELAY_CLOCKS`` later (the model's own chain interface is not used: the RTL has only pins)."""
+
+    def __init__(self, config: DeviceConfig, chain: Sre1) -> None:
+        super().__init__(config)
+        self.chain = chain
+        self.seen = EXPANSION_IDLE
+        self.answers = deque([0] * serial_io.PERIPHERAL_DELAY_CLOCKS)
+        self.answer = 0
+
+    def step(self, **pins: int) -> dict[str, int]:
+        out = super().step(from_exr=self.answers.popleft(), **pins)
+        levels = ExpansionLevels(**{field.name: out[field.name] for field in fields(EXPANSION_IDLE)})
+        if levels != self.seen:
+            self.seen = levels
+            self.answer = self.chain.clock(levels)
+        self.answers.append(self.answer)
+        return out
+
+
+@pytest.mark.parametrize(("code", "bit_rate"), [(8, max(BIT_RATES)), (3, max(BIT_RATES)), (21, max(BIT_RATES)),
+                                                (1, min(BIT_RATES))])  # fmt: skip
+def test_register_expansion(chip_bench: Lockstep, code: int, bit_rate: int) -> None:
+    """SET = ExtReg | length code (3.4.11, Table 3-11: 1, 6, 20 bytes at 2 Mbit/s, 2 bytes at 500 kbit/s) with a
+    chain of that length on the expansion pins: after the INTERBUS reset (/ResReg 4 t0) and an ID cycle (/LaInD),
+    two data cycles with random OUT data go through the chain (ToExR, ClkExR) and the chain's inputs come back
+    (FromExR): the master reads them, the chain's outputs take the OUT data (LaOuD)."""
+    n = wire.data_bytes(code)
+    rng = np.random.default_rng(code)
+    chain = Sre1(n)
+    chain.set_inputs(bytes(rng.integers(0, 256, n).tolist()))
+    pins = ChainPins(decode(*RB_INIT_UP, clk_conf=clk_conf_for(bit_rate)), chain)
+    up = Firmware(pins, Mode.MOTOROLA)
+    up.idle(300)
+    up.init()
+    up.write(SET, SET.encode(EXTREG=1, LENGTH_CODE=code))
+    up.write(ID, 0x01)
+    start = pins.cycle
+    bring_up(pins)
+    sent = [bytes(rng.integers(0, 256, n).tolist()) for _ in range(2)]
+    for data in sent:
+        pins.send(np.concatenate([data_frame(data), IDLE]))
+    pins.drain(64)
+    returned = [out["di1"] for out in pins.outputs[start + 3 * wire.clocks_per_bit(bit_rate) :]]
+    frames = wire.frames_from_levels(wire.samples_to_levels(np.array(returned, dtype=np.uint8), bit_rate))
+    assert [frame.data for frame in frames[1:]] == [chain_to_line(chain.inputs) + LOOPBACK] * 2
+    assert chain.outputs == line_to_chain(sent[-1])
+    result = chip_bench.run_batch(pins.stimulus())
+    assert result.cycles == pins.cycle

@@ -17,7 +17,10 @@ Blocks, in the order the model's ``_tick`` runs them within one clock:
   began on DO1, with the ERR pair of the CNTR word settled at the last stop bit (docs/interbus.md, A7, A10);
 * serial I/O (SPI master modes, 3.3, :class:`supi3.rtl.serial_io.SerialIoRtl`): the sequence on MFP3, 4, 5, 7 after
   each valid data cycle's latch, the clear sequence after a reset, and the IN word read from SerIn (MFP6), which
-  the next data cycle loads.
+  the next data cycle loads;
+* register expansion (OPC, SET with ExtReg = 1 from the register file, 3.5, :class:`supi3.rtl.expansion.ExpansionRtl`):
+  a data frame's bits through ToExR/ClkExR and back from FromExR, the end pulses on LaOuD and /LaInD, and /ResReg
+  4 t0 on both resets (the outputs block's counter).
 
 µP modes: built with ``register_file=True`` (:class:`supi3.rtl.chip.Supi3ChipRtl`), the core has the ports of the
 register file's core side (:class:`supi3.rtl.upif.UpifBlock`): in Init-µP modes it takes the IN bytes, the ID
@@ -39,8 +42,9 @@ from amaranth.lib.wiring import In, Out
 from supi3.checks import check_bool
 from supi3.config import Variant
 from supi3.errors import ArgumentError
-from supi3.expansion import IDLE
+from supi3.expansion import PULSE_T0
 from supi3.interbus import wire
+from supi3.interbus.errors import InterbusError
 from supi3.pinlevel import Pin
 from supi3.pinout import (
     BLOCK_STRAPS,
@@ -58,6 +62,8 @@ from supi3.pinout import (
 )
 from supi3.regmap import INTERRUPT_SOURCES
 from supi3.regmap.core import BYTE_BITS
+from supi3.rtl.expansion import PIN_NAMES as EXPANSION_PINS
+from supi3.rtl.expansion import ExpansionRtl
 from supi3.rtl.serial_io import DIRECTIONS, SER_IN_PIN, WIDTHS, SerialIoRtl
 from supi3.rtl.tables import (
     IDLE_TIMEOUT_CLOCKS,
@@ -73,6 +79,7 @@ from supi3.rtl.tables import (
     line_position,
 )
 from supi3.rtl.upif import upif_tables
+from supi3.tables import BIT_RATES
 
 __all__ = [
     "LINE",
@@ -92,7 +99,9 @@ __all__ = [
     "verilog",
 ]
 
-REGISTER_FILE_INPUTS: Final = tuple(pin for pin in FROM_REGISTER_FILE if pin.name in ("in_data", "bus_id", "alarm"))
+REGISTER_FILE_INPUTS: Final = tuple(
+    pin for pin in FROM_REGISTER_FILE if pin.name in ("in_data", "bus_id", "ext_reg", "alarm")
+)
 """What the core takes from the register file (:class:`supi3.rtl.upif.UpifBlock`'s outputs of the same names)."""
 REGISTER_FILE_OUTPUTS: Final = (
     *BLOCK_STRAPS,
@@ -111,6 +120,18 @@ _WD_OFF: Final = WATCHDOG_CLOCKS.index(None)
 _WD_CODE_BITS: Final = (len(WATCHDOG_CLOCKS) - 1).bit_length()
 _SOURCE_BIT: Final = {source.name: source.bit for source in INTERRUPT_SOURCES}
 """The ``events`` bit of each interrupt source (Table 3-13)."""
+
+
+_EXPANSION_PULSE_MAX: Final = PULSE_T0 * max(wire.clocks_per_bit(rate) for rate in BIT_RATES)
+"""The longest /ResReg pulse with the register expansion: 4 t0 at the slowest bit rate (RX-5)."""
+
+
+def _code_bytes(code: int) -> int:
+    """The data bytes of a complete length code (Table 3-11), 0 for reserved codes."""
+    try:
+        return wire.data_bytes(code)
+    except InterbusError:
+        return 0
 
 
 def _width(value: int) -> int:
@@ -273,6 +294,7 @@ class Supi3Core(wiring.Component):
         transmitter = TransmitterRtl(tables)
         outputs = OutputsRtl(len(cycle))
         serial_io = SerialIoRtl()
+        expansion = ExpansionRtl()
 
         # The power-up reset with its stretch (1.7.2, M2), from the synchronised /ResU and voltage monitor ---------
         power_fail = ~(receiver.resu_n_s & receiver.vmon_ok_s)
@@ -295,6 +317,7 @@ class Supi3Core(wiring.Component):
         m.submodules.transmitter = gated(transmitter)
         m.submodules.outputs = gated(outputs)
         m.submodules.serial_io = gated(serial_io)
+        m.submodules.expansion = gated(expansion)
 
         # Joins between the blocks: connect() where the interfaces fit ---------------------------------------------
         wiring.connect(m, receiver=receiver.line, frame=frame.line)
@@ -341,8 +364,39 @@ class Supi3Core(wiring.Component):
             serial_io.rate.eq(rate),
         ]
 
-        # Init-µP modes: the ID register, the data length and the IN data from the register file (docs/upif.md)
+        # The register expansion (3.5, OPC only): with ExtReg = 1 in the SET register (Init-µP modes), a data
+        # frame's bits go out on ToExR and the bits sent come from FromExR (RX-2); every cycle end pulses LaOuD and
+        # /LaInD (RX-4); /ResReg is the outputs block's pulse, 4 t0 on both resets with expansion (RX-5).
         up = self.register_file
+        ext = Signal()
+        has_data = Signal()
+        if up and self.variant is Variant.OPC:
+            m.d.comb += ext.eq(init_up & self.ext_reg)
+            with m.Switch(self.bus_id[BYTE_BITS:]):  # the complete length code (Table 3-11)
+                for code in range(1 << len(self.bus_id[BYTE_BITS:])):
+                    if _code_bytes(code):
+                        with m.Case(code):
+                            m.d.comb += has_data.eq(1)
+        register = frame.register
+        management = frame.management
+        m.d.comb += [
+            expansion.ext.eq(ext),
+            expansion.has_data.eq(has_data),
+            expansion.rate.eq(rate),
+            expansion.load.eq(register.load),
+            expansion.load_id.eq(register.load_id),
+            expansion.shift.eq(register.shift),
+            expansion.level.eq(register.level),
+            expansion.ended.eq(management.latch_data | management.latch_id | frame.discard),
+            expansion.latched.eq(management.latch_data),
+            expansion.from_exr.eq(receiver.from_exr_s),
+            datapath.chain.eq(expansion.active),
+            datapath.chain_bit.eq(expansion.send),
+            outputs.expansion.eq(ext),
+            outputs.expansion_pulse.eq(cpb * PULSE_T0),
+        ]
+
+        # Init-µP modes: the ID register, the data length and the IN data from the register file (docs/upif.md)
         m.d.comb += [
             datapath.id_register.eq(strap_id),
             datapath.data_bytes.eq(strap_bytes),
@@ -390,11 +444,7 @@ class Supi3Core(wiring.Component):
             self.ib_diag.eq(outputs.ib_diag),
             self.dclk_out.eq(dclk),
             self.resu_drive.eq(holding | (stretch != 0)),
-            # The register expansion (3.5) at its idle levels until supi3.rtl.expansion drives it (RX-6).
-            self.clk_exr.eq(IDLE.clk_exr),
-            self.to_exr.eq(IDLE.to_exr),
-            self.la_ou_d.eq(IDLE.la_ou_d),
-            self.la_in_d_n.eq(IDLE.la_in_d_n),
+            *(getattr(self, name).eq(getattr(expansion, name)) for name in EXPANSION_PINS),
         ]
         return m
 
@@ -716,6 +766,7 @@ class DataPathRtl(wiring.Component):
             "frame": In(REGISTER), "words": Out(WORDS),
             "id_register": In(WORD_BITS), "data_bytes": In(range(tables.register_bits // 8 + 1)), "external": In(1),
             "in_data": In(tables.register_bits), "io_map": In(range(len(tables.io_maps))), "mfp_in": In(MFP_PINS),
+            "chain": In(1), "chain_bit": In(1),
             "register": Out(tables.register_bits), "mfp_out": Out(MFP_PINS),
         })  # fmt: skip
 
@@ -727,7 +778,7 @@ class DataPathRtl(wiring.Component):
         register = self.register
         frame_bytes = Signal.like(self.data_bytes)  # the register's length, fixed when the frame is loaded
         comb += [
-            f.shift_out.eq(Mux(frame_bytes == 0, f.level, register[0])),
+            f.shift_out.eq(Mux(self.chain, self.chain_bit, Mux(frame_bytes == 0, f.level, register[0]))),
             words.command.eq(register[:WORD_BITS]),
         ]
         shifted = Signal(reg_bits)
@@ -829,6 +880,7 @@ class OutputsRtl(wiring.Component):
             "frame": In(MANAGEMENT), "words": In(WORDS),
             "stat_err_n_s": In(1), "di2_s": In(1), "rbst_ext_s": In(1), "di2": In(1), "do2": In(1),
             "divider": In(divider_bits), "rbst_by_pin": In(1), "complete_diag": In(1),
+            "expansion": In(1), "expansion_pulse": In(range(_EXPANSION_PULSE_MAX + 1)),
             "send_alarm": Out(1), "di1": Out(1), "mod_ack_n": Out(1), "res_reg_n": Out(1), "diag1": Out(1),
             "diag2": Out(1), "ib_diag": Out(1),
         })  # fmt: skip
@@ -869,7 +921,7 @@ class OutputsRtl(wiring.Component):
         # Pulse counters: loaded with the width at the edge that starts the pulse, the pin low while non-zero, so
         # low for exactly the width's clocks (Table 3-13: 375 ns = tables.RESREG_PULSE_CLOCKS; /ModAck M3).
         mod_ack = Signal(range(MODACK_PULSE_CLOCKS + 1))
-        res_reg = Signal(range(RESREG_PULSE_CLOCKS + 1))
+        res_reg = Signal(range(max(RESREG_PULSE_CLOCKS, _EXPANSION_PULSE_MAX) + 1))
         with m.If(mod_ack != 0):
             sync += mod_ack.eq(mod_ack - 1)
         with m.If(res_reg != 0):
@@ -880,8 +932,10 @@ class OutputsRtl(wiring.Component):
         wd_now = wd | fire
         attention_now = attention | (filtered & ~pf) | fire
         sync += [pf.eq(pf_now), wd.eq(wd_now), attention.eq(attention_now)]
-        with m.If(fire):  # the watchdog resets process data (Table 3-13)
-            sync += [wd_active.eq(0), res_reg.eq(RESREG_PULSE_CLOCKS)]
+        with m.If(fire):  # the watchdog resets process data (Table 3-13); 4 t0 with the register expansion (RX-5)
+            sync += [wd_active.eq(0), res_reg.eq(Mux(self.expansion, self.expansion_pulse, RESREG_PULSE_CLOCKS))]
+        with m.If(f.clear & self.expansion):  # /ResReg on an INTERBUS reset with the register expansion (RX-5)
+            sync += res_reg.eq(self.expansion_pulse)
         comb += words.watchdog_reset.eq(fire)
 
         # The following device (Table 2-2, M5)
