@@ -1,0 +1,350 @@
+"""Every redrawn timing figure of the manual: the serial µP interface's (:mod:`supi3.spi.figures`) and the serial
+I/O's (SPI master mode, 3.3.2: Figures 3-1 to 3-3), written by :func:`write_figures` (``supi3 figures``, see
+``docs/figures.md``).
+
+The serial I/O figures come from pin traces of a :class:`~supi3.model.pins.Supi3Pins` in a 16-bit SPI master mode in
+a :class:`~supi3.model.pinring.PinRing`, started and given one data cycle by a :class:`~supi3.interbus.master.Master`,
+with peripherals of :mod:`supi3.peripherals.serial` attached (:meth:`supi3.model.chip.Supi3.attach_serial`). SerIn is
+an input the chip asks its device for (SM-5): the figure's SerIn is the device's answers to the chip's pin changes,
+kept as the chip clocked it, each on the line :data:`~supi3.serial_io.PERIPHERAL_DELAY_CLOCKS` after its cause
+(SM-10) and checked to give, at the samples, the word the chip read. Every trace drawn is checked against Table 3-4
+(:func:`supi3.verif.timing.check_serial_io`) first: a figure never shows a waveform breaking its table.
+
+This module sits beside :mod:`supi3.spi.figures` (not in it) because it uses the verification kit, which imports
+the whole chip, which imports :mod:`supi3.spi`.
+"""
+
+from __future__ import annotations
+
+import json
+from bisect import bisect_left, bisect_right
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Final
+
+import numpy as np
+import numpy.typing as npt
+
+from supi3 import tables
+from supi3.config import DataDirection, DeviceConfig, MfpKind, decode
+from supi3.errors import Supi3Error
+from supi3.interbus.master import Master
+from supi3.model.pinring import PinRing
+from supi3.model.pins import Supi3Pins
+from supi3.peripherals.serial import SerialBus, ShiftIn, ShiftOut, SpiAdc, SpiDac
+from supi3.serial_io import (
+    IDLE,
+    MFP_MASK,
+    PAUSE_T0,
+    PERIPHERAL_DELAY_CLOCKS,
+    Levels,
+    SerialDevice,
+    SerialSequence,
+    render,
+)
+from supi3.spi.figures import FIGURES, GAP, Figure, render_svg, wave_string, wavedrom_module
+from supi3.spi.master import SpiTrace, write_spi_vcd
+from supi3.tables import CLOCK_HZ, clk_conf_for
+from supi3.verif.timing import check_serial_io, raise_first
+
+__all__ = [
+    "ALL_FIGURES",
+    "SERIAL_IO_FIGURES",
+    "FigureTraceError",
+    "SerialIoTrace",
+    "serial_io_wavejson",
+    "write_figures",
+]
+
+
+# ------------------------------------------------------------------------------------------------------------
+# Serial I/O (SPI master mode, 3.3.2): Figures 3-1 to 3-3, redrawn from pin-level ring traces
+# ------------------------------------------------------------------------------------------------------------
+
+SERIAL_IO_BIT_RATE: Final = 2_000_000
+"""Bit rate of the serial I/O figures: t0 = 250 ns = 8 chip clocks, SCLK 4 MHz (Tables 3-3, 3-4)."""
+SERIAL_IO_C: Final = "10011"
+"""C4..0 of the serial I/O figures' chip: remote bus device (the "RB, SPI 16 ..." rows of Table 2-6)."""
+SERIAL_IO_OUT: Final = b"\x3c\x96"
+"""The OUT data the master sends in the serial I/O figures' data cycle (any word; not the manual's)."""
+SERIAL_IO_IN: Final = 0xA55A
+"""What the input devices hold (ADC code, 74HCT165 inputs) in the serial I/O figures (any word)."""
+POWER_UP_S: Final = 0.0002
+"""Idle line before the master starts: longer than the chip's power-up reset stretch."""
+MARGIN_COLUMNS: Final = 2
+"""Idle columns drawn before /SS falls and after the sequence ends."""
+PAUSE_COLUMNS: Final = 2
+"""Columns of the t10 pause (input/output mode) drawn on each side of its gap."""
+
+Trace = npt.NDArray[np.int64]
+
+
+class FigureTraceError(Supi3Error, AssertionError):
+    """A model trace does not show what its figure draws (the spec's sequence, the SerIn the chip read)."""
+
+
+class _Recorder:
+    """A serial device passing every call to ``device`` that keeps, in call order, the pins of each pin-level
+    :meth:`clock` call and the SerIn level the device answered."""
+
+    def __init__(self, device: SerialDevice) -> None:
+        self.device = device
+        self.answers: list[tuple[Levels, int]] = []
+
+    @property
+    def drives_ser_in(self) -> bool:
+        """As the device."""
+        return self.device.drives_ser_in
+
+    def frame(self, ser_out: int, bits: int) -> int:
+        """The device's frame (transaction level; not used by the figures)."""
+        return self.device.frame(ser_out, bits)
+
+    def convert(self) -> None:
+        """The device's /Conv pulse (transaction level; not used by the figures)."""
+        self.device.convert()
+
+    def clock(self, levels: Levels) -> int:
+        """The device's answer to ``levels``, kept."""
+        answer = self.device.clock(levels)
+        self.answers.append((levels, answer))
+        return answer
+
+
+def _ser_in(mfp_out: Trace, answers: Sequence[tuple[Levels, int]]) -> Trace:
+    """SerIn over a whole trace from the device's answers: the chip clocks its device at every change of its pins
+    (``SerialIo.feed``), so answer ``k`` belongs to the ``k``-th change and is on SerIn
+    :data:`~supi3.serial_io.PERIPHERAL_DELAY_CLOCKS` later (SM-10).
+
+    Raises
+    ------
+    FigureTraceError
+        The answers do not pair with the changes of the trace one to one.
+    """
+    changes = np.flatnonzero(np.diff(mfp_out)) + 1
+    if [levels.mfp() for levels, _ in answers] != [int(mfp_out[c]) for c in changes]:
+        raise FigureTraceError(f"the device saw {len(answers)} pin changes, the trace has {len(changes)} others")
+    starts = np.array([0, *(changes + PERIPHERAL_DELAY_CLOCKS)], dtype=np.int64)
+    values = np.array([0, *(answer for _, answer in answers)], dtype=np.int64)
+    return values[np.searchsorted(starts, np.arange(len(mfp_out)), side="right") - 1]
+
+
+@dataclass(frozen=True)
+class SerialIoTrace:
+    """One SPI master sequence (3.3.2) cut from the pin trace of a chip in a ring, with the SerIn levels its
+    devices drove."""
+
+    config: DeviceConfig
+    sequence: SerialSequence
+    """The sequence of the mode (:func:`supi3.serial_io.sequence`)."""
+    devices: tuple[SerialDevice, ...]
+    """The devices on the bus, after the sequence."""
+    start: int
+    """The chip clock of index 0."""
+    first: int
+    """The index of the sequence's first cycle (the clock after the data cycle's latch, SM-2)."""
+    mfp_out: Trace
+    """MFP3, 4, 5 and 7 as driven (the other MFP bits masked)."""
+    ser_in: Trace
+    """SerIn (MFP6): what the devices drove, 0 or 1."""
+    out_word: int
+    """The OUT word written (the data cycle's OUT data, SM-4)."""
+    in_word: int
+    """The IN word the chip took over at the sequence's end (SM-6); 0 without a read frame."""
+
+    def at(self, k: int) -> int:
+        """The index of cycle ``k`` of the sequence."""
+        return self.first + k
+
+
+def _serial_io_trace(direction: DataDirection, *devices: SerialDevice) -> SerialIoTrace:
+    """A chip in the 16-bit SPI master mode ``direction`` with ``devices`` attached, started by a master and given
+    one data cycle; the trace around the sequence after its latch, checked against Table 3-4 and the spec.
+
+    Raises
+    ------
+    TraceTimingError
+        The chip's trace breaks a row of Table 3-4 (:func:`supi3.verif.timing.check_serial_io`).
+    FigureTraceError
+        The master's cycles fail, or the trace is not the spec's sequence, or SerIn at the samples is not the word
+        the chip read.
+    """
+    config = next(
+        c for c in (decode(r.c, r.mfp, clk_conf=clk_conf_for(SERIAL_IO_BIT_RATE)) for r in tables.MODE_ROWS
+                    if r.c == SERIAL_IO_C)
+        if c.mfp_mode.kind is MfpKind.SPI_MASTER and c.mfp_mode.direction is direction and c.mfp_mode.width == 16
+    )
+    pins = Supi3Pins(config)
+    recorder = _Recorder(SerialBus(*devices))
+    pins.chip.attach_serial(recorder)
+    ring = PinRing([pins], record=True)
+    ring.idle(POWER_UP_S)
+    master = Master(ring, locate=False)
+    started = master.start()
+    master.set_outputs(1, SERIAL_IO_OUT)
+    cycle_from = ring.cycle
+    data = master.data_cycle()
+    if not (started.ok and data.ok):
+        raise FigureTraceError(f"the master's cycles failed: {started}, {data}")
+    assert pins.chip.spi_sequences is not None  # an SPI master mode
+    seq = pins.chip.spi_sequences[0]
+    step = seq.frames[0].t0 // 2
+    ring.idle(2 * seq.length / CLOCK_HZ)  # longer than the sequence and the margin after it
+    traced = ring.recorded()[0]
+    mfp_out = traced["mfp_out"] & MFP_MASK
+    ser_in = _ser_in(mfp_out, recorder.answers)
+    raise_first(check_serial_io({"mfp_out": mfp_out}, bit_rate=config.bit_rate, bits=16, ser_in=ser_in))
+    s = cycle_from + int(np.flatnonzero(mfp_out[cycle_from:] != IDLE.mfp())[0])
+    out_word = int.from_bytes(SERIAL_IO_OUT, "big")
+    expected = np.array([levels.mfp() for levels in render(seq, out_word)], dtype=np.int64)
+    if not np.array_equal(mfp_out[s : s + seq.length], expected):
+        raise FigureTraceError(f"the pins from clock {s} are not the sequence writing {out_word:04X}h")
+    read = seq.read
+    word = 0
+    for j in range(read.bits if read is not None else 0):
+        assert read is not None
+        word = (word << 1) | int(ser_in[s + read.sample(j)])
+    if word != pins.chip.in_word:
+        raise FigureTraceError(f"SerIn at the samples is {word:04X}h, the chip read {pins.chip.in_word:04X}h")
+    c0 = s - MARGIN_COLUMNS * step
+    window = slice(c0, s + seq.length + MARGIN_COLUMNS * step)
+    if window.stop > len(mfp_out):
+        raise FigureTraceError(f"the trace ends at clock {len(mfp_out)}, before the figure's end {window.stop}")
+    return SerialIoTrace(config, seq, devices, c0, s - c0, mfp_out[window], ser_in[window], out_word,
+                         pins.chip.in_word)
+
+
+def _data_lane(name: str, keys: Sequence[object], label: Callable[[int], str]) -> dict[str, object]:
+    """A lane of named segments: an int key per column is a segment (``label(key)``), ``"z"`` none."""
+    labels: list[str] = []
+    previous: object = None
+    for key in keys:
+        if key is GAP:
+            continue
+        if key != previous and isinstance(key, int):
+            labels.append(label(key))
+        previous = key
+    return {"name": name, "wave": wave_string(keys, lambda key: isinstance(key, int)), "data": labels}
+
+
+def serial_io_wavejson(trace: SerialIoTrace, title: str) -> dict[str, object]:
+    """The WaveJSON of a serial I/O sequence: one column per half SCLK period (t0 / 2), each showing the pins in its
+    last clock (for SerIn the one the chip samples before a rising SCLK edge, SM-5), the t10 pause cut to a gap.
+
+    Lanes /SS, SCLK, SerOut, SerIn and /Conv (MFP5, 4, 7, 6, 3); SerIn is drawn in read frames only (``x``
+    elsewhere: not sampled). Below them the bit names D15..D0 (t11: D15 first) of SerOut where the chip drives
+    each and of SerIn up to the sample that takes each.
+    """
+    seq = trace.sequence
+    bits = seq.frames[0].bits
+    step = seq.frames[0].t0 // 2
+    read, write = seq.read, seq.write
+    cut = (range(trace.at(read.end + PAUSE_COLUMNS * step), trace.at(write.start - PAUSE_COLUMNS * step))
+           if read is not None and write is not None else range(0))
+    columns: list[int | None] = []  # each column's last clock (an index), or None for the gap
+    for c in range(step - 1, len(trace.mfp_out), step):
+        if c not in cut:
+            columns.append(c)
+        elif columns[-1] is not None:
+            columns.append(None)
+
+    def keys(key: Callable[[int], object]) -> list[object]:
+        return [GAP if c is None else key(c) for c in columns]
+
+    def lane(name: str, level: Callable[[int], str]) -> dict[str, object]:
+        return {"name": name, "wave": wave_string(keys(level), lambda _: False)}
+
+    def pin(number: int) -> Callable[[int], str]:
+        return lambda c: str((int(trace.mfp_out[c]) >> number) & 1)
+
+    def ser_in(c: int) -> str:
+        return str(int(trace.ser_in[c])) if read is not None and trace.at(read.start) <= c < trace.at(read.end) else "x"
+
+    def name(j: int) -> str:
+        return f"D{bits - 1 - j}"
+
+    ss = lane("/SS (MFP5)", pin(5))
+    edges: list[str] = []
+    if read is not None and write is not None:  # t10 from the read frame's /SS rise to the write frame's /SS fall
+        rise, fall = columns.index(trace.at(read.end) + step - 1), columns.index(trace.at(write.start) + step - 1)
+        ss["node"] = "".join("a" if k == rise else "b" if k == fall else "." for k in range(len(columns)))
+        edges.append(f"a<->b t10 = {PAUSE_T0} t0")
+    signal: list[object] = [ss, lane("SCLK (MFP4)", pin(4)), lane("SerOut (MFP7)", pin(7))]
+    if write is not None:  # bit j from its slot's start to the next slot's (t3, t11, t12)
+        slots = [trace.at(write.slot(j)) for j in range(bits)]
+        signal.append(_data_lane("SerOut bit", keys(
+            lambda c: bisect_right(slots, c) - 1 if slots[0] <= c < trace.at(write.end) else "z"), name))
+    signal.append(lane("SerIn (MFP6)", ser_in))
+    if read is not None:  # bit j after the sample of bit j - 1, up to its own (SM-5)
+        samples = [trace.at(read.sample(j)) for j in range(bits)]
+        signal.append(_data_lane("SerIn bit", keys(
+            lambda c: bisect_left(samples, c) if trace.at(read.start) <= c <= samples[-1] else "z"), name))
+    signal.append(lane("/Conv (MFP3)", pin(3)))
+    config = trace.config
+    t0_ns = 2 * step * 1e9 / CLOCK_HZ
+    words = [f"OUT word {trace.out_word:04X}h" if write is not None else "",
+             f"IN word read {trace.in_word:04X}h" if read is not None else ""]
+    foot = (f"SUPI 3 model trace ({config.function}, {config.bit_rate // 1000} kbit/s, t0 = {t0_ns:.0f} ns, SCLK "
+            f"{1e3 / t0_ns:.0f} MHz; {', '.join(w for w in words if w)}; "
+            f"{', '.join(map(repr, trace.devices))}); one column = {step} chip clocks = {step * 1e9 / CLOCK_HZ:.0f} ns"
+            + ("; gap: most of the t10 pause left out" if cut else ""))
+    wavejson: dict[str, object] = {"signal": signal, "head": {"text": title}, "foot": {"text": foot}}
+    if edges:
+        wavejson["edge"] = edges
+    return wavejson
+
+
+def _adc() -> SpiAdc:
+    adc = SpiAdc(16)
+    adc.set_input(SERIAL_IO_IN)
+    return adc
+
+
+def _shift_in() -> ShiftIn:
+    chain = ShiftIn(2)
+    chain.set_inputs(SERIAL_IO_IN)
+    return chain
+
+
+SERIAL_IO_FIGURES: Final[tuple[Figure[SerialIoTrace], ...]] = (
+    Figure("fig3-1", "Figure 3-1 Serial input mode timing",
+           f"SPI 16 IN with a 16-bit SPI ADC on SerIn: one read frame after a data cycle; the ADC's code "
+           f"{SERIAL_IO_IN:04X}h enters D15 first and is the IN data of the next data cycle.",
+           lambda: _serial_io_trace(DataDirection.IN, _adc()), serial_io_wavejson),
+    Figure("fig3-2", "Figure 3-2 Serial output mode timing",
+           f"SPI 16 OUT with a 16-bit SPI DAC: the data cycle's OUT word {SERIAL_IO_OUT.hex().upper()}h leaves on "
+           f"SerOut D15 first in one write frame; /Conv loads the DAC after /SS rose (t6, t7).",
+           lambda: _serial_io_trace(DataDirection.OUT, SpiDac(16)), serial_io_wavejson),
+    Figure("fig3-3", "Figure 3-3 Input/output mode timing",
+           f"SPI 16 IN/OUT with 74HCT165 and 74HCT594 chains: read frame ({SERIAL_IO_IN:04X}h in), the t10 pause "
+           f"(cut), write frame ({SERIAL_IO_OUT.hex().upper()}h out), /Conv stores the outputs.",
+           lambda: _serial_io_trace(DataDirection.IN_OUT, _shift_in(), ShiftOut(2)), serial_io_wavejson),
+)
+"""The serial I/O figures (3.3.2), in the manual's order."""
+ALL_FIGURES: Final[tuple[Figure[SpiTrace] | Figure[SerialIoTrace], ...]] = (*SERIAL_IO_FIGURES, *FIGURES)
+"""Every redrawn figure, in the manual's order (what :func:`write_figures` writes)."""
+
+
+def write_figures(out: Path, *, vcd: bool = False) -> list[Path]:
+    """Write ``<name>.json`` (WaveJSON) and ``<name>.svg`` for every figure of :data:`FIGURES` into ``out``, and
+    ``<name>.vcd`` too if ``vcd``; return the paths written. ``supi3 figures`` runs it.
+
+    Raises
+    ------
+    ModuleNotFoundError
+        When ``wavedrom`` (the ``docs`` extra) is not installed; checked before anything is written.
+    """
+    wavedrom_module()
+    out.mkdir(parents=True, exist_ok=True)
+    written: list[Path] = []
+    for figure in ALL_FIGURES:
+        trace, wavejson = figure.wavejson()
+        json_path = out / f"{figure.name}.json"
+        json_path.write_text(json.dumps(wavejson, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
+        svg_path = out / f"{figure.name}.svg"
+        svg_path.write_text(render_svg(wavejson) + "\n", encoding="utf-8")
+        written += [json_path, svg_path]
+        if vcd and isinstance(trace, SpiTrace):
+            written.append(write_spi_vcd(out / f"{figure.name}.vcd", trace))
+    return written
