@@ -115,11 +115,15 @@ def test_a_trace_breaking_table_3_4_is_not_drawn(monkeypatch: pytest.MonkeyPatch
 
 
 def test_serin_needs_an_answer_to_every_pin_change() -> None:
-    mfp = np.array([0x28, 0x28, 0x08, 0x18], dtype=np.int64)
-    answers = [(Levels(conv_n=1, sclk=0, ss_n=0, ser_out=0), 1), (Levels(conv_n=1, sclk=1, ss_n=0, ser_out=0), 0)]
-    assert figures._ser_in(mfp, answers).tolist() == [0, 0, 0, 0]  # answers arrive 2 clocks after their change
+    mfp = np.array([0x28, 0x28, 0x08, 0x18, 0x18, 0x18], dtype=np.int64)
+    answers = [(Levels(conv_n=1, sclk=0, ss_n=0, ser_out=0).mfp(), 1), (0x18, 0), (0x18, 0)]
+    # Each answer from 2 clocks after its change (SM-10); a repeated call with unchanged pins is one change.
+    assert figures._answered(mfp, answers, 2).tolist() == [0, 0, 0, 0, 1, 0]
+    assert figures._answered(mfp, [(0x28, 1), *answers], 2).tolist() == [1, 1, 1, 1, 1, 0]  # told when attached
     with pytest.raises(FigureTraceError, match="saw 1 pin changes"):
-        figures._ser_in(mfp, answers[:1])
+        figures._answered(mfp, answers[:1], 2)
+    with pytest.raises(FigureTraceError, match="answered 0, then 1 to unchanged pins 0x18"):
+        figures._answered(mfp, [*answers, (0x18, 1)], 2)
 
 
 def test_figure_title_marks_the_redraw() -> None:

@@ -86,11 +86,11 @@ class FigureTraceError(Supi3Error, AssertionError):
 
 class _Recorder:
     """A serial device passing every call to ``device`` that keeps, in call order, the pins of each pin-level
-    :meth:`clock` call and the SerIn level the device answered."""
+    :meth:`clock` call (as MFP bits) and the SerIn level the device answered."""
 
     def __init__(self, device: SerialDevice) -> None:
         self.device = device
-        self.answers: list[tuple[Levels, int]] = []
+        self.answers: list[tuple[int, int]] = []
 
     @property
     def drives_ser_in(self) -> bool:
@@ -108,26 +108,35 @@ class _Recorder:
     def clock(self, levels: Levels) -> int:
         """The device's answer to ``levels``, kept."""
         answer = self.device.clock(levels)
-        self.answers.append((levels, answer))
+        self.answers.append((levels.mfp(), answer))
         return answer
 
 
-def _ser_in(mfp_out: Trace, answers: Sequence[tuple[Levels, int]]) -> Trace:
-    """SerIn over a whole trace from the device's answers: the chip clocks its device at every change of its pins
-    (``SerialIo.feed``), so answer ``k`` belongs to the ``k``-th change and is on SerIn
-    :data:`~supi3.serial_io.PERIPHERAL_DELAY_CLOCKS` later (SM-10).
+def _answered(pins: Trace, answers: Sequence[tuple[int, int]], delay: int) -> Trace:
+    """An input over a whole trace from the answers of the device driving it: the chip clocks its device with its
+    pins (coded as one integer per cycle in ``pins``) at every change, so the answers, with repeated pins merged, pair
+    one to one with the changes of ``pins`` and each is on the line ``delay`` clocks after its change (SM-10). An
+    answer to the pins before the first change (given when the device was attached) holds from the start, else 0.
 
     Raises
     ------
     FigureTraceError
-        The answers do not pair with the changes of the trace one to one.
+        The answers do not pair with the changes of the trace, or differ for unchanged pins.
     """
-    changes = np.flatnonzero(np.diff(mfp_out)) + 1
-    if [levels.mfp() for levels, _ in answers] != [int(mfp_out[c]) for c in changes]:
-        raise FigureTraceError(f"the device saw {len(answers)} pin changes, the trace has {len(changes)} others")
-    starts = np.array([0, *(changes + PERIPHERAL_DELAY_CLOCKS)], dtype=np.int64)
-    values = np.array([0, *(answer for _, answer in answers)], dtype=np.int64)
-    return values[np.searchsorted(starts, np.arange(len(mfp_out)), side="right") - 1]
+    told: list[tuple[int, int]] = []
+    for code, answer in answers:
+        if told and told[-1][0] == code:
+            if told[-1][1] != answer:
+                raise FigureTraceError(f"the device answered {told[-1][1]}, then {answer} to unchanged pins {code:#x}")
+            continue
+        told.append((code, answer))
+    initial = told.pop(0)[1] if told and told[0][0] == int(pins[0]) else 0
+    changes = np.flatnonzero(np.diff(pins)) + 1
+    if [code for code, _ in told] != [int(pins[c]) for c in changes]:
+        raise FigureTraceError(f"the device saw {len(told)} pin changes, the trace has {len(changes)} others")
+    starts = np.array([0, *(changes + delay)], dtype=np.int64)
+    values = np.array([initial, *(answer for _, answer in told)], dtype=np.int64)
+    return values[np.searchsorted(starts, np.arange(len(pins)), side="right") - 1]
 
 
 @dataclass(frozen=True)
@@ -193,7 +202,7 @@ def _serial_io_trace(direction: DataDirection, *devices: SerialDevice) -> Serial
     ring.idle(2 * seq.length / CLOCK_HZ)  # longer than the sequence and the margin after it
     traced = ring.recorded()[0]
     mfp_out = traced["mfp_out"] & MFP_MASK
-    ser_in = _ser_in(mfp_out, recorder.answers)
+    ser_in = _answered(mfp_out, recorder.answers, PERIPHERAL_DELAY_CLOCKS)
     raise_first(check_serial_io({"mfp_out": mfp_out}, bit_rate=config.bit_rate, bits=16, ser_in=ser_in))
     s = cycle_from + int(np.flatnonzero(mfp_out[cycle_from:] != IDLE.mfp())[0])
     out_word = int.from_bytes(SERIAL_IO_OUT, "big")
