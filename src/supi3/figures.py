@@ -224,17 +224,41 @@ def _serial_io_trace(direction: DataDirection, *devices: SerialDevice) -> Serial
                          pins.chip.in_word)
 
 
-def _data_lane(name: str, keys: Sequence[object], label: Callable[[int], str]) -> dict[str, object]:
-    """A lane of named segments: an int key per column is a segment (``label(key)``), ``"z"`` none."""
+def _columns(length: int, step: int, cut: range) -> list[int | None]:
+    """The last clock of each column of ``step`` clocks over ``length`` clocks; the columns whose last clock is in
+    ``cut`` make one gap (None)."""
+    columns: list[int | None] = []
+    for c in range(step - 1, length, step):
+        if c not in cut:
+            columns.append(c)
+        elif columns[-1] is not None:
+            columns.append(None)
+    return columns
+
+
+def _level_lane(name: str, columns: Sequence[int | None], level: Callable[[int], str]) -> dict[str, object]:
+    """A lane of levels: ``level(c)`` per column (its last clock ``c``), the gap as ``|``."""
+    return {"name": name, "wave": wave_string([GAP if c is None else level(c) for c in columns], lambda _: False)}
+
+
+def _node(columns: Sequence[int | None], marks: dict[int, str]) -> str:
+    """A lane's ``node`` string: ``marks[c]`` at the column whose last clock is ``c``."""
+    return "".join(marks.get(c, ".") if c is not None else "." for c in columns)
+
+
+def _bit_lane(name: str, columns: Sequence[int | None], key: Callable[[int], object],
+              label: Callable[[int], str]) -> dict[str, object]:  # fmt: skip
+    """A lane of named segments: ``key(c)`` per column, an int a segment named ``label(key)``, ``"z"`` none."""
+    keys = [GAP if c is None else key(c) for c in columns]
     labels: list[str] = []
     previous: object = None
-    for key in keys:
-        if key is GAP:
+    for k in keys:
+        if k is GAP:
             continue
-        if key != previous and isinstance(key, int):
-            labels.append(label(key))
-        previous = key
-    return {"name": name, "wave": wave_string(keys, lambda key: isinstance(key, int)), "data": labels}
+        if k != previous and isinstance(k, int):
+            labels.append(label(k))
+        previous = k
+    return {"name": name, "wave": wave_string(keys, lambda k: isinstance(k, int)), "data": labels}
 
 
 def serial_io_wavejson(trace: SerialIoTrace, title: str) -> dict[str, object]:
@@ -251,18 +275,7 @@ def serial_io_wavejson(trace: SerialIoTrace, title: str) -> dict[str, object]:
     read, write = seq.read, seq.write
     cut = (range(trace.at(read.end + PAUSE_COLUMNS * step), trace.at(write.start - PAUSE_COLUMNS * step))
            if read is not None and write is not None else range(0))
-    columns: list[int | None] = []  # each column's last clock (an index), or None for the gap
-    for c in range(step - 1, len(trace.mfp_out), step):
-        if c not in cut:
-            columns.append(c)
-        elif columns[-1] is not None:
-            columns.append(None)
-
-    def keys(key: Callable[[int], object]) -> list[object]:
-        return [GAP if c is None else key(c) for c in columns]
-
-    def lane(name: str, level: Callable[[int], str]) -> dict[str, object]:
-        return {"name": name, "wave": wave_string(keys(level), lambda _: False)}
+    columns = _columns(len(trace.mfp_out), step, cut)
 
     def pin(number: int) -> Callable[[int], str]:
         return lambda c: str((int(trace.mfp_out[c]) >> number) & 1)
@@ -273,23 +286,25 @@ def serial_io_wavejson(trace: SerialIoTrace, title: str) -> dict[str, object]:
     def name(j: int) -> str:
         return f"D{bits - 1 - j}"
 
-    ss = lane("/SS (MFP5)", pin(5))
+    ss = _level_lane("/SS (MFP5)", columns, pin(5))
     edges: list[str] = []
     if read is not None and write is not None:  # t10 from the read frame's /SS rise to the write frame's /SS fall
-        rise, fall = columns.index(trace.at(read.end) + step - 1), columns.index(trace.at(write.start) + step - 1)
-        ss["node"] = "".join("a" if k == rise else "b" if k == fall else "." for k in range(len(columns)))
+        ss["node"] = _node(columns, {trace.at(read.end) + step - 1: "a", trace.at(write.start) + step - 1: "b"})
         edges.append(f"a<->b t10 = {PAUSE_T0} t0")
-    signal: list[object] = [ss, lane("SCLK (MFP4)", pin(4)), lane("SerOut (MFP7)", pin(7))]
+    signal: list[object] = [ss, _level_lane("SCLK (MFP4)", columns, pin(4)),
+                            _level_lane("SerOut (MFP7)", columns, pin(7))]
     if write is not None:  # bit j from its slot's start to the next slot's (t3, t11, t12)
         slots = [trace.at(write.slot(j)) for j in range(bits)]
-        signal.append(_data_lane("SerOut bit", keys(
-            lambda c: bisect_right(slots, c) - 1 if slots[0] <= c < trace.at(write.end) else "z"), name))
-    signal.append(lane("SerIn (MFP6)", ser_in))
+        end = trace.at(write.end)
+        signal.append(_bit_lane("SerOut bit", columns,
+                                lambda c: bisect_right(slots, c) - 1 if slots[0] <= c < end else "z", name))
+    signal.append(_level_lane("SerIn (MFP6)", columns, ser_in))
     if read is not None:  # bit j after the sample of bit j - 1, up to its own (SM-5)
         samples = [trace.at(read.sample(j)) for j in range(bits)]
-        signal.append(_data_lane("SerIn bit", keys(
-            lambda c: bisect_left(samples, c) if trace.at(read.start) <= c <= samples[-1] else "z"), name))
-    signal.append(lane("/Conv (MFP3)", pin(3)))
+        signal.append(_bit_lane("SerIn bit", columns,
+                                lambda c: bisect_left(samples, c) if trace.at(read.start) <= c <= samples[-1] else "z",
+                                name))
+    signal.append(_level_lane("/Conv (MFP3)", columns, pin(3)))
     config = trace.config
     t0_ns = 2 * step * 1e9 / CLOCK_HZ
     words = [f"OUT word {trace.out_word:04X}h" if write is not None else "",
