@@ -73,7 +73,7 @@ def workload(bit_rate: int, cycles: int, accesses: int) -> dict[str, npt.NDArray
     mfp = np.concatenate([mfp, np.full(max(n - len(mfp), 0), mfp[-1], dtype=np.int64)])[:n]
     ones, zeros = np.ones(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
     return {"do1": do1, "di2": zeros, "rbst_ext": zeros, "mfp_in": mfp, "stat_err_n": ones, "resu_n": ones,
-            "vmon_ok": ones}
+            "vmon_ok": ones, "from_exr": 0 * ones}
 
 
 def measure(bit_rate: int, cycles: int, accesses: int, repeat: int) -> tuple[int, float, float, float, int]:

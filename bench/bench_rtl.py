@@ -106,6 +106,7 @@ def workload(data_cycles: int, clk_conf: str = "11") -> tuple[np.ndarray, dict[s
         "stat_err_n": np.ones(n, np.int64),
         "resu_n": np.ones(n, np.int64),
         "vmon_ok": np.ones(n, np.int64),
+        "from_exr": np.zeros(n, np.int64),
     }
     names = [pin.name for pin in Supi3Pins.inputs]
     return strap_stimulus(config, np.stack([inputs[k] for k in names], axis=1)), inputs

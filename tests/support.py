@@ -29,6 +29,8 @@ import pytest
 
 from supi3 import serial_io as sio
 from supi3.config import DeviceConfig, decode
+from supi3.expansion import IDLE as EXPANSION_IDLE
+from supi3.expansion import ExpansionLevels, chain_to_line, line_to_chain
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
 from supi3.model.pins import Supi3Pins
@@ -99,7 +101,8 @@ def quiet_inputs(n: int) -> Columns:
     """``n`` clocks of a quiet board: idle line, no fault, power good, no following device."""
     ones, zeros = np.ones(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
     return {"do1": ones.copy(), "di2": zeros.copy(), "rbst_ext": zeros.copy(), "mfp_in": zeros.copy(),
-            "stat_err_n": ones.copy(), "resu_n": ones.copy(), "vmon_ok": ones.copy()}  # fmt: skip
+            "stat_err_n": ones.copy(), "resu_n": ones.copy(), "vmon_ok": ones.copy(),
+            "from_exr": zeros.copy()}  # fmt: skip
 
 
 def pulses(trace: npt.NDArray[np.int64]) -> list[tuple[int, int]]:
@@ -282,7 +285,7 @@ class ChipPins:
         self.rows: list[list[int]] = []
         self.outputs: list[dict[str, int]] = []
         self.pins = {"do1": wire.IDLE_LEVEL, "di2": 0, "rbst_ext": 0, "mfp_in": 0, "stat_err_n": 1, "resu_n": 1,
-                     "vmon_ok": 1}  # fmt: skip
+                     "vmon_ok": 1, "from_exr": 0}  # fmt: skip
         self.upper = 0  # MFP[15..8] levels
 
     @property
@@ -430,3 +433,53 @@ class EchoDevice:
         if levels.ss_n or self._count >= self.bits:
             return 0
         return (self._captured >> (self.bits - 1 - self._count)) & 1
+class FakeChain:
+    """A minimal :class:`supi3.expansion.ExternalRegisters` (RX-8, the IBS SRE 1's role, not its model): ``length``
+    bytes numbered from ToExR, output registers, input registers the test sets.
+
+    Held as a big-endian integer of the chain (byte 0, next to ToExR, most significant): a ClkExR rise shifts it
+    right with ToExR entering at the top, FromExR is its lowest bit (byte ``length - 1`` bit 0), so the bytes a data
+    cycle shifts in LSB first end as :func:`~supi3.expansion.line_to_chain` numbers them.
+    """
+
+    def __init__(self, length: int, inputs: bytes | None = None) -> None:
+        self.length = length
+        self.inputs = bytes(length) if inputs is None else inputs
+        self.contents = bytes(length)
+        self.outputs = bytes(length)
+        self.levels = EXPANSION_IDLE
+        self.calls: list[str] = []
+
+    def chain(self) -> bytes:
+        return chain_to_line(self.contents)
+
+    def shift_cycle(self, received: bytes) -> None:
+        self.calls.append("shift_cycle")
+        self.contents = line_to_chain(received)
+
+    def take_outputs(self) -> None:
+        self.calls.append("take_outputs")
+        self.outputs = self.contents
+
+    def load_inputs(self) -> None:
+        self.calls.append("load_inputs")
+        self.contents = self.inputs
+
+    def clear(self) -> None:
+        self.calls.append("clear")
+        self.outputs = self.contents = bytes(self.length)
+
+    def clock(self, levels: ExpansionLevels) -> int:
+        before, self.levels = self.levels, levels
+        if not levels.res_reg_n:
+            if before.res_reg_n:
+                self.clear()
+        else:
+            if levels.clk_exr and not before.clk_exr:
+                word = int.from_bytes(self.contents, "big") >> 1 | levels.to_exr << (8 * self.length - 1)
+                self.contents = word.to_bytes(self.length, "big")
+            if levels.la_ou_d and not before.la_ou_d:
+                self.take_outputs()
+            if not levels.la_in_d_n and before.la_in_d_n:
+                self.load_inputs()
+        return self.contents[-1] & 1 if self.length else 0

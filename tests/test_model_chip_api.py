@@ -99,7 +99,8 @@ def test_inconsistent_data_names_the_whole_chip_cycle() -> None:
     assert registers is not None
 
     def tick(mfp: int) -> None:
-        whole.step({"do1": 1, "di2": 0, "rbst_ext": 0, "mfp_in": mfp, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 1})
+        whole.step({"do1": 1, "di2": 0, "rbst_ext": 0, "mfp_in": mfp, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 1,
+                    "from_exr": 0})
 
     def spi(byte: int) -> int:
         """One Motorola byte; returns the first cycle with /SS low."""

@@ -43,7 +43,7 @@ def _traffic(out: bytes, latch: bool = True) -> npt.NDArray[np.uint8]:
 def _inputs(do1: npt.NDArray[np.int64], **pins: npt.NDArray[np.int64] | int) -> dict[str, npt.NDArray[np.int64]]:
     n = len(do1)
     base: dict[str, npt.NDArray[np.int64] | int] = {"di2": 0, "rbst_ext": 0, "mfp_in": 0, "stat_err_n": 1,
-                                                    "resu_n": 1, "vmon_ok": 1}
+                                                    "resu_n": 1, "vmon_ok": 1, "from_exr": 0}
     base.update(pins)
     traces = {name: np.broadcast_to(np.asarray(v, dtype=np.int64), (n,)).copy() for name, v in base.items()}
     traces["do1"] = do1

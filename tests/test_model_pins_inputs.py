@@ -38,7 +38,7 @@ from supi3.verif.straps import ChipStrapPins, StrapPins, strap_inputs, strap_sti
 
 BINARY = decode("10000", clk_conf="11")
 UP = decode("10011", "1110", clk_conf="11")
-IDLE = {"do1": 1, "di2": 0, "rbst_ext": 0, "mfp_in": 0, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 1}
+IDLE = {"do1": 1, "di2": 0, "rbst_ext": 0, "mfp_in": 0, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 1, "from_exr": 0}
 N = 40
 
 
@@ -168,7 +168,7 @@ CASES: list[tuple[str, Factory, Call, type[Exception], str, Callable[[Any], obje
     ("step-staterr-5", lambda: Supi3Pins(BINARY), lambda m: m.step(idle_with(stat_err_n=5)), ArgumentError,
      "pin 'stat_err_n' must be an integer from 0 to 1 (1 bit), not 5", probe_pins),
     ("step-missing", lambda: Supi3Pins(BINARY), lambda m: m.step(without(IDLE, "vmon_ok")), ArgumentError,
-     "inputs must name exactly the pins do1, di2, rbst_ext, mfp_in, stat_err_n, resu_n, vmon_ok, not without "
+     "inputs must name exactly the pins do1, di2, rbst_ext, mfp_in, stat_err_n, resu_n, vmon_ok, from_exr, not without "
      "'vmon_ok'", probe_pins),
     ("step-unknown", lambda: Supi3Pins(BINARY), lambda m: m.step(idle_with(do3=1)), ArgumentError,
      "with 'do3', no such pin", probe_pins),
@@ -234,7 +234,7 @@ CASES: list[tuple[str, Factory, Call, type[Exception], str, Callable[[Any], obje
     ("set-input-bool-pos", _ring, lambda r: r.set_input(True, "mfp_in", 0xAB), ArgumentError,
      "position must be an integer", probe_ring),
     ("set-input-line", _ring, lambda r: r.set_input(1, "do1", 1), ArgumentError,
-     "pin must be one of 'rbst_ext', 'mfp_in', 'stat_err_n', 'resu_n', 'vmon_ok'", probe_ring),
+     "pin must be one of 'rbst_ext', 'mfp_in', 'stat_err_n', 'resu_n', 'vmon_ok', 'from_exr'", probe_ring),
     ("set-input-unknown", _ring, lambda r: r.set_input(1, "mfp", 1), ArgumentError, "pin must be one of", probe_ring),
     ("set-input-pin-int", _ring, lambda r: r.set_input(1, bad(5), 1), ArgumentError, "pin must be one of", probe_ring),
     ("set-input-mfp-neg", _ring, lambda r: r.set_input(1, "mfp_in", -1), ArgumentError,
@@ -354,8 +354,8 @@ CASES: list[tuple[str, Factory, Call, type[Exception], str, Callable[[Any], obje
     ("strap-inputs-config", lambda: None, lambda _: strap_inputs(bad("10000")), ArgumentError,
      "config must be a DeviceConfig", probe_none),
     ("strap-stimulus-shape", lambda: None, lambda _: strap_stimulus(BINARY, np.zeros((4, 6), np.int64)),
-     ArgumentError, "stimulus must be a 2-D integer array of (cycles, 7)", probe_none),
-    ("strap-stimulus-level", lambda: None, lambda _: strap_stimulus(BINARY, np.full((4, 7), 2, np.int64)),
+     ArgumentError, "stimulus must be a 2-D integer array of (cycles, 8)", probe_none),
+    ("strap-stimulus-level", lambda: None, lambda _: strap_stimulus(BINARY, np.full((4, 8), 2, np.int64)),
      ArgumentError, "pin 'do1' trace[0] must be an integer from 0 to 1 (1 bit), not 2", probe_none),
     ("strap-step-missing", StrapPins, lambda m: m.step(without(_strap_row(), "c")), ArgumentError, "without 'c'",
      probe_straps),

@@ -32,7 +32,7 @@ def _columns(config: DeviceConfig, levels: npt.NDArray[np.uint8]) -> Columns:
     n = len(do1)
     ones, zeros = np.ones(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
     return {"do1": do1, "di2": zeros, "rbst_ext": zeros, "mfp_in": zeros, "stat_err_n": ones, "resu_n": ones,
-            "vmon_ok": ones}  # fmt: skip
+            "vmon_ok": ones, "from_exr": 0 * ones}  # fmt: skip
 
 
 def _cycle(kind: Cycle, device: bytes) -> npt.NDArray[np.uint8]:

@@ -31,7 +31,7 @@ class Bench:
 
     def tick(self, mfp: int, do1: int = 1) -> dict[str, int]:
         out = self.chip.step({"do1": do1, "di2": 0, "rbst_ext": 0, "mfp_in": mfp, "stat_err_n": 1, "resu_n": 1,
-                              "vmon_ok": 1})
+                              "vmon_ok": 1, "from_exr": 0})
         self.returned.append(out["di1"])
         self.irq_n.append((out["mfp_out"] >> 3) & 1)
         return out
@@ -106,7 +106,7 @@ def test_chip_without_up_interface_is_the_core() -> None:
     traces = chip.run({"do1": np.ones(50, dtype=np.int64), "di2": np.zeros(50, dtype=np.int64),
                        "rbst_ext": np.zeros(50, dtype=np.int64), "mfp_in": np.zeros(50, dtype=np.int64),
                        "stat_err_n": np.ones(50, dtype=np.int64), "resu_n": np.ones(50, dtype=np.int64),
-                       "vmon_ok": np.ones(50, dtype=np.int64)})
+                       "vmon_ok": np.ones(50, dtype=np.int64), "from_exr": np.zeros(50, dtype=np.int64)})
     assert traces["resu_drive"].all()
 
 
@@ -116,7 +116,8 @@ def test_power_fail_resets_the_up_interface_at_the_edge_it_is_seen() -> None:
     bench = Bench()
     assert bench.spi(0x00) == 0
     assert bench.chip.upif is not None and bench.chip.upif.protocol.phase is not Phase.INIT
-    inputs = {"do1": 1, "di2": 0, "rbst_ext": 0, "mfp_in": IDLE_MFP, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 0}
+    inputs = {"do1": 1, "di2": 0, "rbst_ext": 0, "mfp_in": IDLE_MFP, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 0,
+              "from_exr": 0}
     while not bench.chip.core.holding:
         out = bench.chip.step(inputs)
         assert not out["resu_drive"]

@@ -82,7 +82,7 @@ def chip_inputs(bit_rate: int, mode: Mode, actions: list[tuple[int, int, int, bo
     if power_dip is not None:
         vmon[power_dip % n : power_dip % n + 20] = 0
     return {"do1": do1, "di2": np.zeros(n, dtype=np.int64), "rbst_ext": np.zeros(n, dtype=np.int64), "mfp_in": mfp,
-            "stat_err_n": ones, "resu_n": ones, "vmon_ok": vmon}
+            "stat_err_n": ones, "resu_n": ones, "vmon_ok": vmon, "from_exr": 0 * vmon}
 
 
 def stepped(chip: Supi3Chip, inputs: Traces) -> Traces:

@@ -399,7 +399,8 @@ def regmap_summary() -> str:
 
 
 def cmd_demo(args: argparse.Namespace) -> None:
-    """A master and a small ring, live; optionally the pin-level run as a VCD."""
+    """A master and a small ring, live (with ``--analog``: an SPI ADC and DAC behind a SUPI 3, manual 3.3);
+    optionally the pin-level run as a VCD."""
     from supi3 import demo
 
     clk_conf = tables.clk_conf_for(_parse_bit_rate(args.bit_rate))
@@ -407,10 +408,11 @@ def cmd_demo(args: argparse.Namespace) -> None:
     if args.vcd is not None:
         check_int("--cycles", cycles, 1, MAX_VCD_CYCLES, "with --vcd: the pin-level run keeps every clock")
     vcd = None if args.vcd is None else output_file("--vcd", args.vcd)  # before the run, not after it
-    for line in demo.run(cycles, vcd, clk_conf):
+    for line in (demo.run_analog if args.analog else demo.run)(cycles, vcd, clk_conf):
         print(line)
-    print("\nRegister map of the serial µP interface (Table 3-10; `supi3 regmap` for all formats):\n")
-    print(regmap_summary())
+    if not args.analog:
+        print("\nRegister map of the serial µP interface (Table 3-10; `supi3 regmap` for all formats):\n")
+        print(regmap_summary())
 
 
 def cmd_campaign(args: argparse.Namespace) -> None:
@@ -542,6 +544,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"data cycles to run, 1 to {MAX_DEMO_CYCLES}, to {MAX_VCD_CYCLES} with --vcd (default 4)")
     p.add_argument("--vcd", metavar="PATH", help="also run the SUPI 3 chips at pin level and write a VCD")
     p.add_argument("--bit-rate", default="500k", help="500k or 2M")
+    p.add_argument("--analog", action="store_true",
+                   help="an analog I/O device instead: a SUPI 3 in SPI 16 IN/16 OUT with an SPI ADC and DAC (3.3); "
+                        "with --vcd its SPI pins are checked against Table 3-4")
     p.set_defaults(func=cmd_demo)
 
     p = sub.add_parser("modes", help="list the operating modes (Tables 2-4 to 2-7)")

@@ -4,6 +4,12 @@ The ring holds three SUPI 3 chips in binary I/O modes (Tables 2-4 to 2-6) and tw
 runs Alarm Stop and a discovery ID cycle, prints its configuration table, then runs data cycles: each SUPI 3
 chip's MFP inputs go to the master, and the master's outputs appear on the chips' MFP output pins. With a VCD
 path, the same scenario also runs at pin level (the SUPI 3 chips, clock by clock) and every pin is written out.
+
+``supi3 demo --analog`` (:func:`run_analog`): an analog I/O device built on the SPI master mode (manual 3.3): a
+SUPI 3 OPC strapped for RB, SPI 16 IN/16 OUT (Table 2-6) with a 16-bit SPI DAC and a 16-bit SPI ADC on its serial
+I/O bus, the DAC's output wired back to the ADC's input. The master writes a setpoint ramp; it appears at the DAC
+output and, through the ADC, comes back to the master. With a VCD path the same scenario runs at pin level too, and
+the analog chip's SPI pins are checked against Table 3-4.
 """
 
 from __future__ import annotations
@@ -12,6 +18,7 @@ from collections.abc import Callable, Iterator, Sequence
 from functools import partial
 from pathlib import Path
 
+from supi3 import serial_io
 from supi3.checks import check_int
 from supi3.config import DeviceConfig, decode
 from supi3.errors import Supi3Error
@@ -22,12 +29,29 @@ from supi3.model.chip import Supi3
 from supi3.model.pinring import PinRing
 from supi3.model.pins import Supi3Pins
 from supi3.model.vcd import write_vcd
+from supi3.peripherals.serial import SerialBus, SpiAdc, SpiDac
+from supi3.tables import CLOCK_HZ
+from supi3.verif.timing import check_serial_io
 
 SUPI3_STRAPS: tuple[tuple[str, str | None], ...] = (("10000", None), ("11011", "0011"), ("11110", None))
 """RB 8 IN/8 OUT (Table 2-6), LBD-MR 4 IN/4 OUT and LBD-OR 16 OUT (Table 2-5)."""
 
 PLAIN_DEVICES: tuple[tuple[int, int], ...] = ((0x32, 0b00001), (0x02, 0b01001))
 """A remote bus analog input module (ID 32h, 1 word) and a digital input module (ID 02h, 1 byte), Table A-3."""
+
+
+ANALOG_STRAPS: tuple[tuple[str, str | None], ...] = (("10011", "1000"), ("10000", None))
+"""The SUPI 3 chips of ``--analog``: the analog device, RB SPI 16 IN/16 OUT (Table 2-6, ID 33h: one 16-bit word
+each way, one 16-bit ADC and DAC on one /SS frame each, SM-3), then an RB 8 IN/8 OUT binary I/O chip (Table 2-6)."""
+
+ANALOG_PLAIN_DEVICES: tuple[tuple[int, int], ...] = ((0x02, 0b01001),)
+"""``--analog``: a digital input module (ID 02h, 1 byte, Table A-3) behind the SUPI 3 chips (transaction level)."""
+
+VREF = 5.0
+"""Reference voltage of the ``--analog`` demo's DAC and ADC, in volts."""
+
+RAMP_STEP = 0x2000
+"""The ``--analog`` setpoint ramp: one step a cycle, 0.625 V at :data:`VREF`; the 16-bit word wraps every 8th cycle."""
 
 
 class DemoError(Supi3Error):
@@ -99,6 +123,13 @@ def run(cycles: int = 4, vcd: Path | None = None, clk_conf: str = "01") -> Itera
         yield from _pin_level(configs, cycles, vcd)
 
 
+def _write(vcd: Path, ring: PinRing) -> None:
+    try:
+        write_vcd(vcd, ring)
+    except OSError as exc:
+        raise DemoError(f"cannot write {str(vcd)!r} (--vcd): {exc.strerror or exc}") from None
+
+
 def _pin_level(configs: list[DeviceConfig], cycles: int, vcd: Path) -> Iterator[str]:
     pins = [Supi3Pins(c) for c in configs]
     ring = PinRing(pins, record=True)
@@ -109,10 +140,112 @@ def _pin_level(configs: list[DeviceConfig], cycles: int, vcd: Path) -> Iterator[
     setters = [partial(ring.set_input, k, "mfp_in") for k in range(1, len(pins) + 1)]
     # The latch telegrams reach the chips further down the ring a few bit periods after the master sent them.
     lines = list(_drive(master, [p.chip for p in pins], cycles, setters, ring.settle))
-    try:
-        write_vcd(vcd, ring)
-    except OSError as exc:
-        raise DemoError(f"cannot write {str(vcd)!r} (--vcd): {exc.strerror or exc}") from None
+    _write(vcd, ring)
     yield f"Pin level, SUPI 3 chips only, {ring.cycle} clocks of 32 MHz:"
     yield from lines
+    yield f"wrote {vcd}"
+
+
+# ------------------------------------------------------------------------------------------------------------
+# --analog: an ADC and a DAC behind a SUPI 3 in the SPI master mode (3.3)
+# ------------------------------------------------------------------------------------------------------------
+
+
+def setpoint(cycle: int) -> int:
+    """The master's OUT word in data cycle ``cycle`` (0 first) of ``--analog``: a ramp of :data:`RAMP_STEP`."""
+    return (RAMP_STEP * (cycle + 1)) & 0xFFFF
+
+
+def _analog(master: Master, adc: SpiAdc, dac: SpiDac, cycles: int, after: Callable[[], None]) -> Iterator[str]:
+    """Run data cycles (``after`` each one) on the analog device at ring position 1; yield one line per cycle.
+
+    The analog path is a wire from the DAC's output to the ADC's input: the ADC samples, at the read frame of a
+    cycle's sequence, what the DAC put out since the sequence before (the write frame comes after the read frame,
+    3.3.1), and the master gets that sample in the next data cycle.
+    """
+    level = dac.volts(VREF)
+    for n in range(cycles):
+        master.set_outputs(1, setpoint(n).to_bytes(2, "big"))
+        adc.set_voltage(level, VREF)
+        result = master.data_cycle()
+        after()
+        status = "ok" if result.ok else "FAILED"
+        yield (f"  cycle {n + 1} ({status}, {master.ring.now * 1e3:7.3f} ms)  "
+               f"master OUT {master.outputs(1).hex().upper()}h -> DAC {dac.output:04X}h = {dac.volts(VREF):.3f} V  "
+               f"|  ADC input {level:.3f} V = {adc.code:04X}h  |  master IN {master.inputs(1).hex().upper()}h")
+        level = dac.volts(VREF)
+
+
+def _converters(config: DeviceConfig) -> tuple[SpiAdc, SpiDac, SerialBus]:
+    width = config.mfp_mode.width
+    adc, dac = SpiAdc(width), SpiDac(width)
+    return adc, dac, SerialBus(adc, dac)
+
+
+def run_analog(cycles: int = 4, vcd: Path | None = None, clk_conf: str = "01") -> Iterator[str]:
+    """The ``--analog`` demo, as lines of text: a SUPI 3 in the SPI master mode with an SPI ADC and DAC (3.3).
+
+    The master writes the ramp :func:`setpoint` to the analog chip's OUT word; the chip's sequence after each valid
+    data cycle (read frame, write frame, /Conv, SM-6) shifts it into the DAC, whose output is wired to the ADC's
+    input; the ADC's sample travels to the master in the next data cycle. One line per cycle shows the master's OUT
+    word, the DAC's code and output voltage, the ADC's input and code, and the master's IN word. With ``vcd``, the
+    SUPI 3 chips run the same scenario at pin level, every pin is written out, and the analog chip's MFP pins are
+    checked against Table 3-4 (:func:`supi3.verif.timing.check_serial_io`).
+
+    Raises
+    ------
+    ArgumentError
+        If ``cycles`` is not an integer >= 1.
+    DemoError
+        If the VCD file cannot be written (the command line checks the path before the run).
+    """
+    check_int("cycles", cycles, 1)
+    configs = [decode(c, mfp, clk_conf=clk_conf) for c, mfp in ANALOG_STRAPS]
+    chips = [Supi3(c) for c in configs]
+    adc, dac, bus = _converters(configs[0])
+    chips[0].attach_serial(bus)
+    devices: list[Supi3 | PlainDevice] = [*chips, *(PlainDevice(i, length) for i, length in ANALOG_PLAIN_DEVICES)]
+    ring = Ring(devices, bit_rate=configs[0].bit_rate)
+    master = Master(ring)
+    result = master.start()
+    yield (f"supi3 demo --analog: INTERBUS master and a ring of {len(devices)} devices at "
+           f"{ring.bit_rate // 1000} kbit/s (transaction level)")
+    yield (f"Device 1: {configs[0].interface.value}, {configs[0].mfp_mode.name} (Table 2-6) with a "
+           f"{adc.bits}-bit SPI ADC and a {dac.bits}-bit SPI DAC (vref {VREF:g} V) on its serial I/O bus (3.3); "
+           f"the DAC output is wired to the ADC input")
+    yield f"Alarm Stop (1303h) and discovery ID cycle: {'ok' if result.ok else 'FAILED'}"
+    yield "Configuration table:"
+    yield from (f"  {line}" for line in _table(master))
+    yield ("Data cycles (master OUT -> DAC; DAC output -> ADC input, sampled before the DAC takes the new word "
+           "-> master IN one cycle later), device 1:")
+    yield from _analog(master, adc, dac, cycles, lambda: None)
+    if vcd is not None:
+        yield from _analog_pin_level(configs, cycles, vcd)
+
+
+def _analog_pin_level(configs: list[DeviceConfig], cycles: int, vcd: Path) -> Iterator[str]:
+    pins = [Supi3Pins(c) for c in configs]
+    adc, dac, bus = _converters(configs[0])
+    pins[0].chip.attach_serial(bus)
+    ring = PinRing(pins, record=True)
+    ring.settle()  # power-up reset stretch
+    master = Master(ring, locate=False, max_devices=len(pins))
+    master.start()
+    mode = configs[0].mfp_mode
+    sequence = serial_io.sequence(mode.direction, mode.width, ring.bit_rate)
+
+    def after() -> None:
+        # The latch telegrams reach every chip, then the sequence runs to its end, so the word read travels in
+        # the next data cycle (SM-6; the transaction level runs the sequence at the latch).
+        ring.settle()
+        ring.idle(sequence.length / CLOCK_HZ)
+
+    lines = list(_analog(master, adc, dac, cycles, after))
+    violations = check_serial_io(ring.recorded()[0], bit_rate=ring.bit_rate, bits=mode.width)
+    _write(vcd, ring)
+    yield f"Pin level, SUPI 3 chips only, {ring.cycle} clocks of 32 MHz:"
+    yield from lines
+    count = f"{len(violations) or 'no'} violation{'' if len(violations) == 1 else 's'}"
+    yield f"Table 3-4 on device 1's SPI pins (MFP3..MFP7): {count}"
+    yield from (f"  {violation}" for violation in violations)
     yield f"wrote {vcd}"

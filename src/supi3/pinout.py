@@ -99,19 +99,21 @@ OPTICAL_REGISTERS: Final[tuple[str, ...]] = tuple(
 
 CORE_INPUTS: Final[tuple[Pin, ...]] = (
     Pin("do1"), Pin("di2"), Pin("rbst_ext"), Pin("mfp_in", MFP_PINS), Pin("stat_err_n"), Pin("resu_n"),
-    Pin("vmon_ok"),
+    Pin("vmon_ok"), Pin("from_exr"),
 )  # fmt: skip
 """DO1 (forward line in), DI2 (return line in), RBST_EXT, MFP[15..0], /StatErr, /ResU as seen from outside, the
-voltage monitor's output (Table 1-4, 1.7.2, 3.6.2)."""
-CORE_IDLE: Final[tuple[int, ...]] = (wire.IDLE_LEVEL, 0, 0, 0, 1, 1, 1)
-"""The levels of a quiet board, in :data:`CORE_INPUTS` order: idle line, no fault, power good (what the
-synchronisers hold after reset)."""
+voltage monitor's output, FromExR (Table 1-4, 1.7.2, 3.6.2; FromExR: 3.5, Table 3-14)."""
+CORE_IDLE: Final[tuple[int, ...]] = (wire.IDLE_LEVEL, 0, 0, 0, 1, 1, 1, 0)
+"""The levels of a quiet board, in :data:`CORE_INPUTS` order: idle line, no fault, power good, FromExR grounded
+(nothing attached sends 0 bits, RX-2) (what the synchronisers hold after reset)."""
 CORE_OUTPUTS: Final[tuple[Pin, ...]] = (
     Pin("do2"), Pin("di1"), Pin("mfp_out", MFP_PINS), Pin("mfp_oe", MFP_PINS), Pin("mod_ack_n"), Pin("res_reg_n"),
-    Pin("diag1"), Pin("diag2"), Pin("ib_diag"), Pin("dclk_out"), Pin("resu_drive"),
+    Pin("diag1"), Pin("diag2"), Pin("ib_diag"), Pin("dclk_out"), Pin("resu_drive"), Pin("clk_exr"), Pin("to_exr"),
+    Pin("la_ou_d"), Pin("la_in_d_n"),
 )  # fmt: skip
-"""DO2_CU, DI1_CU, MFP levels and output enables, /ModAck, /ResReg, DIAG1/2, IB_DIAG, DCLK_OUT and the open-drain
-/ResU driver (Table 1-4)."""
+"""DO2_CU, DI1_CU, MFP levels and output enables, /ModAck, /ResReg, DIAG1/2, IB_DIAG, DCLK_OUT, the open-drain
+/ResU driver (Table 1-4) and the register expansion's ClkExR, ToExR, LaOuD, /LaInD (3.5, Table 3-14; idle levels
+:data:`supi3.expansion.IDLE`)."""
 STRAP_PINS: Final[tuple[Pin, ...]] = (
     Pin("c", C_BITS), Pin("rf", RF_BITS), Pin("clk_conf", CLK_CONF_BITS), Pin("diag_conf", DIAG_CONF_BITS),
 )  # fmt: skip

@@ -306,10 +306,10 @@ UP_REST: Final = up_input_levels(PinsIn())
 """MFP[7..0] with the µP's pins at rest: SCLK and /SS high, MFP7 high, SAS_INIT and MFP6 low (:class:`PinsIn`)."""
 
 QUIET_BOARD: Final[dict[str, int]] = {"do1": 1, "di2": 0, "rbst_ext": 0, "mfp_in": UP_REST, "stat_err_n": 1,
-                                      "resu_n": 1, "vmon_ok": 1}  # fmt: skip
+                                      "resu_n": 1, "vmon_ok": 1, "from_exr": 0}  # fmt: skip
 """The whole chip's inputs on a quiet board: the INTERBUS forward line idle (high, docs/interbus.md), no device
-following, no /StatErr, /ResU released, power good; the µP's pins at rest (:data:`UP_REST`), the other MFP pins
-low."""
+following, no /StatErr, /ResU released, power good, FromExR grounded; the µP's pins at rest (:data:`UP_REST`), the
+other MFP pins low."""
 
 
 STEP_BELOW: Final = 64

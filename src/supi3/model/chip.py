@@ -33,8 +33,9 @@ from typing import ClassVar, Final, Protocol, TypeVar
 
 from supi3 import tables
 from supi3.checks import check_bits, check_bool, check_bytes, check_instance, check_int, check_real, fail
-from supi3.config import DeviceConfig, MfpKind, decode
+from supi3.config import DeviceConfig, MfpKind, Variant, decode
 from supi3.errors import ArgumentError, Supi3Error
+from supi3.expansion import PULSE_T0, ExternalRegisters, end_pulses
 from supi3.interbus import wire
 from supi3.interbus.link import DataKernel
 from supi3.interbus.wire import Cycle
@@ -73,6 +74,23 @@ class SerialModeError(ChipError):
 class ChipArgumentError(ArgumentError, ChipError):
     """An argument of a :class:`Supi3` method of the wrong type or out of its range ("X must be ..., not ..."): an
     :class:`~supi3.errors.ArgumentError` that code catching :class:`ChipError` still catches."""
+
+
+class ExpansionDriver(Protocol):
+    """The pin level's register-expansion block (:class:`supi3.model.blocks.expansion.Expansion`): when a chip has
+    one, the cycle ends and resets go to its pins, and the chain is clocked there, not at transaction level."""
+
+    def end(self, clk: int, latched_data: bool) -> None:
+        """The cycle ended at the edge ending cycle ``clk``."""
+
+    def reset(self, clk: int) -> None:
+        """An INTERBUS or watchdog reset at the edge ending cycle ``clk``."""
+
+
+EXPANSION_LEAD_BITS: Final = wire.POS_DATA + 1.25
+"""Bit periods from the start of a frame to its first ClkExR rise, less the half bit from the mid-bit sample of the
+previous cycle's last stop bit (where its end pulses begin) to that bit's end: the transaction level's view of
+RX-4 (``supi3.model.blocks.expansion.lead_clocks``; ``docs/assumptions/expansion.md``)."""
 
 
 _T = TypeVar("_T")
@@ -206,10 +224,11 @@ class Supi3:
 
     __slots__ = (
         "__dict__",  # room beyond the declared state, so that a test can spy on a chip's methods
-        "_deadline", "_due_s", "_events", "_fast_valid", "_fixed_bytes", "_frame_bytes", "_in_map", "_loaded", "_now",
-        "_out", "_out_map", "_send_alarm", "_serial_pins", "_shown", "_stat_err", "_stat_low_since", "attention",
-        "bus_active", "config", "due", "in_word", "io_access", "mfp_in", "mod_ack_until", "pf", "registers",
-        "resreg_until", "revision", "serial_device", "spi_sequences", "te", "watchdog_code", "wd",
+        "_chain", "_cpb", "_deadline", "_due_s", "_events", "_exr_driver", "_exr_free", "_fast_valid", "_fixed_bytes",
+        "_frame_bytes", "_in_map", "_loaded", "_now", "_out", "_out_map", "_send_alarm", "_serial_pins", "_shown",
+        "_stat_err", "_stat_low_since", "attention", "bus_active", "config", "due", "in_word", "io_access", "mfp_in",
+        "mod_ack_until", "pf", "registers", "resreg_until", "revision", "serial_device", "spi_sequences", "te",
+        "watchdog_code", "wd",
     )  # fmt: skip
 
     data_kernel: ClassVar[DataKernel] = DataKernel(_load_data_run, _latch_data_run)
@@ -239,6 +258,9 @@ class Supi3:
         self._frame_bytes = -1  # µP modes: the data bytes the last data-cycle load gave (M15)
         self._shown: tuple[bytes | None, int] = (None, 0)  # (OUT bytes, MFP levels) last driven
         self._init_serial()
+        self._chain: ExternalRegisters | None = None
+        self._exr_driver: ExpansionDriver | None = None
+        self._cpb = wire.clocks_per_bit(self.config.bit_rate)
         self.revision = 0
         """Counts the changes of what the pins show (OUT data, ``pf``, ``bus_active``, the /ModAck and /ResReg
         pulses): the pin level records its outputs only when this moves."""
@@ -268,6 +290,7 @@ class Supi3:
         self.resreg_until = 0
         self.io_access = False
         self._send_alarm = False
+        self._exr_free = 0
         self._reschedule()
 
     def _clock(self) -> int:
@@ -446,6 +469,86 @@ class Supi3:
             clear = self.spi_sequences[1]
             if clear is not None:
                 _transact(clear, self.serial_device, 0)
+    # Serial register expansion (3.5, docs/assumptions/expansion.md)
+    # --------------------------------------------------------------------------------------------------------
+
+    @property
+    def expansion(self) -> bool:
+        """SET selects the external data registers (ExtReg = 1, 3.4.11): data cycles go through the expansion."""
+        return self.registers is not None and not self.registers.internal_data_path
+
+    @property
+    def expansion_chain(self) -> ExternalRegisters | None:
+        """The external registers on the expansion interface (:meth:`attach_expansion`), ``None`` if none."""
+        return self._chain
+
+    def attach_expansion(self, chain: ExternalRegisters | None) -> None:
+        """Wire external data registers (the IBS SRE 1's role) to the expansion interface, ``None`` to remove them.
+
+        They are used while SET has ExtReg = 1 (RX-2): at transaction level a data cycle sends
+        ``chain.chain()`` and its latch calls ``shift_cycle``, ``take_outputs`` and ``load_inputs``; at pin level
+        (:class:`supi3.model.pins.Supi3Pins`) the chain is clocked at every change of the expansion pins. Without
+        a chain a data cycle with ExtReg = 1 sends 0 bits (FromExR grounded).
+
+        Raises
+        ------
+        ChipArgumentError
+            ``chain`` is not an :class:`~supi3.expansion.ExternalRegisters` or ``None``, or the chip has no
+            expansion interface: the SUPI 3 LS (3.5) or a mode other than Init-µP (ExtReg is a SET bit, 3.4.11).
+        """
+        if chain is not None and not isinstance(chain, ExternalRegisters):
+            raise ChipArgumentError("chain", chain, "chain must be an ExternalRegisters (supi3.expansion) or None, "
+                                    f"not {chain!r}")
+        if self.config.variant is Variant.LS:
+            raise ChipArgumentError("chain", chain, "the chip must be a SUPI 3 OPC for the register expansion "
+                                    "(3.5: not possible with the SUPI 3 LS), not a SUPI 3 LS")
+        if self.registers is None:
+            raise ChipArgumentError("chain", chain, "the chip must be in an Init-µP mode for the register expansion "
+                                    f"(ExtReg in SET, 3.4.11), not {self.config.mfp_mode.kind}")
+        self._chain = chain
+
+    def _count(self, event: str) -> None:
+        """Count an event that is no interrupt source (``"EXPANSION_OVERRUN"``)."""
+        self._events[event] += 1
+
+    def _expansion_load(self, clk: int) -> bytes:
+        """A data cycle with ExtReg = 1 begins at ``clk``: what it sends (transaction level: the chain's contents,
+        RX-2), after the overrun check of RX-4; zeros at pin level, where FromExR is shifted bit by bit."""
+        length = self.data_bytes()
+        if self._exr_driver is not None:
+            return bytes(length)
+        if clk < self._exr_free:
+            self._count("EXPANSION_OVERRUN")
+        chain = self._chain
+        if chain is None:
+            return bytes(length)
+        if chain.length != length:
+            raise ChipError(f"the external registers must be as long as SET's data length at transaction level "
+                            f"({length} bytes, Table 3-11), not {chain.length} bytes")
+        return chain.chain()
+
+    def _expansion_end(self, clk: int, latched: bytes | None) -> None:
+        """A cycle ended at ``clk`` with ExtReg = 1: the data cycle's ``latched`` bytes (``None``: ID cycle or
+        discarded) go to the chain, then the end pulses (RX-4)."""
+        if self._exr_driver is not None:
+            self._exr_driver.end(clk, latched is not None)
+            return
+        pulses = end_pulses(latched is not None, self._cpb)
+        self._exr_free = clk + pulses.length - round(EXPANSION_LEAD_BITS * self._cpb)
+        chain = self._chain
+        if chain is not None:
+            if latched is not None:
+                chain.shift_cycle(latched)
+                chain.take_outputs()
+            chain.load_inputs()
+
+    def _expansion_reset(self, clk: int) -> None:
+        """INTERBUS or watchdog reset at ``clk`` with ExtReg = 1: /ResReg low for 4 t0, the chain cleared (RX-5)."""
+        self.resreg_until = clk + PULSE_T0 * self._cpb
+        if self._exr_driver is not None:
+            self._exr_driver.reset(clk)
+        elif self._chain is not None:
+            self._chain.clear()
 
     # --------------------------------------------------------------------------------------------------------
     # Time
@@ -482,6 +585,8 @@ class Supi3:
             self.wd = True
             self.attention = True
             self.resreg_until = clk + RESREG_PULSE_CLOCKS
+            if self.expansion:
+                self._expansion_reset(clk)
             self._events["WATCHDOG"] += 1
             self._event("IB_RESET")
         self._reschedule()
@@ -515,7 +620,10 @@ class Supi3:
         if cycle is Cycle.ID:
             return wire.word_bytes(self.id_register())
         if self.registers is not None:
-            data = self.registers.in_bytes() if self.data_bytes() else b""
+            if self.expansion:
+                data = self._expansion_load(clk)
+            else:
+                data = self.registers.in_bytes() if self.data_bytes() else b""
             self._frame_bytes = len(data)
             return data
         if not self._in_map:
@@ -565,7 +673,9 @@ class Supi3:
                 if self.spi_sequences is not None:
                     self._serial_latched(clk)
                 return
-            if received:
+            if self.expansion:
+                self._expansion_end(clk, received)
+            elif received:
                 self.registers.latch(received)
             self.registers.set_bus_running(True)
             self._event("VALID")
@@ -587,6 +697,8 @@ class Supi3:
                     self.registers.processor_command(command.processor_command)
                 self._send_alarm = command.alarm_request
             self.wd = self.te = self.attention = False
+            if self.expansion:
+                self._expansion_end(clk, None)
             self._event("ID_CYCLE")
         self._event("PCP_TX")
 
@@ -600,6 +712,8 @@ class Supi3:
             clk = _clock(clk)
         self._advance(clk)
         self.te = self.te or local_error
+        if self.expansion:
+            self._expansion_end(clk, None)
         if cycle is Cycle.DATA:
             self._event("INVALID")
 
@@ -610,6 +724,8 @@ class Supi3:
         self.revision += 1
         self._advance(clk)
         self._clear_process_data()
+        if self.expansion:
+            self._expansion_reset(clk)
         self.watchdog_code = None
         self._deadline = None
         self._reschedule()

@@ -164,7 +164,8 @@ class PinRing:
         self.record = record
         self._chunks: list[list[dict[str, npt.NDArray[np.int64]]]] = []
         self._inputs = [
-            {"di2": 0, "rbst_ext": 0, "mfp_in": 0, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 1} for _ in chips
+            {"di2": 0, "rbst_ext": 0, "mfp_in": 0, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 1, "from_exr": 0}
+            for _ in chips
         ]
 
     @property

@@ -25,6 +25,7 @@ pin                   dir  meaning
 ``stat_err_n``        in   /StatErr, module error alarm input, active low (3.6.2)
 ``resu_n``            in   /ResU as seen from outside: 0 while something pulls it low (1.7.2)
 ``vmon_ok``           in   the voltage monitor's output: 1 above 4.5 V, 0 below 3.9 V (1.7.2)
+``from_exr``          in   FromExR, the register expansion's serial input (3.5, Table 3-14; 0 = nothing attached)
 ``do2``               out  INTERBUS forward line out (Table 1-4 DO2_CU)
 ``di1``               out  INTERBUS return line out to the previous device (Table 1-4 DI1_CU)
 ``mfp_out``           out  levels driven on MFP[15..0] (undriven bits 0)
@@ -35,6 +36,10 @@ pin                   dir  meaning
 ``ib_diag``           out  IB_DIAG LED (Table 3-18)
 ``dclk_out``          out  data clock (Table 1-4)
 ``resu_drive``        out  1 while the chip pulls /ResU low (open drain, 1.7.2)
+``clk_exr``           out  ClkExR, the register expansion's shift clock (3.5, Table 3-15)
+``to_exr``            out  ToExR, the data bit shifted into the external registers
+``la_ou_d``           out  LaOuD, the external output registers take the chain (high pulse)
+``la_in_d_n``         out  /LaInD, the chain takes the external input registers (low pulse)
 ====================  ===  =============================================================================
 """
 
@@ -51,6 +56,7 @@ from supi3.checks import check_bits, check_instance, check_int, check_trace, fai
 from supi3.config import DeviceConfig
 from supi3.interbus import wire
 from supi3.model.blocks.datapath import DataPath
+from supi3.model.blocks.expansion import Expansion
 from supi3.model.blocks.frame import FrameEngine
 from supi3.model.blocks.outputs import Outputs, Snapshot
 from supi3.model.blocks.receiver import (
@@ -116,8 +122,9 @@ class Supi3Pins:
     """
 
     __slots__ = (
-        "_datapath", "_frame", "_holding", "_outputs", "_power_ups", "_receiver", "_recording", "_return_start",
-        "_run_from", "_serial", "_stat_active", "_synced_run", "_transmitter", "chip", "complete_diagnostics",
+        "_datapath", "_expansion", "_frame", "_holding", "_outputs", "_power_ups", "_receiver", "_recording",
+        "_return_start", "_run_from", "_serial", "_stat_active", "_synced_run", "_transmitter", "chip",
+        "complete_diagnostics",
         "config", "cpb", "cycle", "forward_delay", "log", "mfp_oe", "rbst_by_pin", "reset_run",
     )  # fmt: skip
 
@@ -143,7 +150,9 @@ class Supi3Pins:
         """Clocks of start level that make an INTERBUS reset (M11)."""
         # The blocks, wired to each other (supi3.model.blocks; the RTL core's blocks of the same names).
         self._transmitter = Transmitter(self.cpb, self.forward_delay, self.rbst_by_pin)
-        self._datapath = DataPath(self.chip, self.log)
+        self._expansion = Expansion(self.chip, self.cpb)
+        self.chip._exr_driver = self._expansion  # cycle ends and resets move the expansion pins (RX-3 to RX-5)
+        self._datapath = DataPath(self.chip, self.log, self._expansion)
         self._frame = FrameEngine(self.chip, self.log, self._datapath, self._transmitter)
         self._receiver = Receiver(self.cpb, self.reset_run, self.chip, self.log, self._frame, self._transmitter)
         # Serial I/O in the SPI master modes (3.3): the chip starts its sequences at each latch (Supi3.attach_serial).
@@ -165,6 +174,7 @@ class Supi3Pins:
         self._transmitter.reset()
         if self._serial is not None:
             self._serial.reset()
+        self._expansion.sync_reset()
         self._holding = False
         self._recording = False
         self._power_ups: list[tuple[int, int]] = []
@@ -190,6 +200,7 @@ class Supi3Pins:
         self._datapath.power_up()
         if self._serial is not None:
             self._serial.power_up(self.cycle)
+        self._expansion.power_up(self.cycle)
 
     # ------------------------------------------------------------------------------------------------------------
     # One clock: step()
@@ -212,12 +223,14 @@ class Supi3Pins:
         try:
             do1, di2, rbst = inputs["do1"], inputs["di2"], inputs["rbst_ext"]
             mfp, stat, resu, vmon = inputs["mfp_in"], inputs["stat_err_n"], inputs["resu_n"], inputs["vmon_ok"]
-            # The fast path: plain ints within range (one type chain and two shifts), the seven names exactly.
+            exr = inputs["from_exr"]
+            # The fast path: plain ints within range (one type chain and two shifts), the eight names exactly.
             fast = (int is type(do1) is type(di2) is type(rbst) is type(mfp) is type(stat) is type(resu) is type(vmon)
-                    and not (do1 | di2 | rbst | stat | resu | vmon) >> 1 and not mfp >> 16 and len(inputs) == 7)
+                    is type(exr) and not (do1 | di2 | rbst | stat | resu | vmon | exr) >> 1 and not mfp >> 16
+                    and len(inputs) == 8)  # fmt: skip
         except Exception:  # anything a broken mapping raises: input_row() names the problem
             fast = False
-        row = Synced(do1, di2, rbst, mfp, stat, resu, vmon) if fast else input_row(inputs)
+        row = Synced(do1, di2, rbst, mfp, stat, resu, vmon, exr) if fast else input_row(inputs)
         c = self.cycle
         receiver = self._receiver
         pipe = receiver.pipe
@@ -225,6 +238,7 @@ class Supi3Pins:
         outputs = self._outputs.values(c, row.di2, self._run_from)
         if self._serial is not None:
             self._serial.feed(c)
+        outputs.update(self._expansion.values(c))
         receiver.pipe = [row, *pipe[:-1]]
         tx = self._transmitter
         if c >= self._run_from or self._holding or not (synced.resu_n and synced.vmon_ok):
@@ -253,7 +267,8 @@ class Supi3Pins:
     def output_values(self, c: int, di2: int) -> dict[str, int]:
         """Every output pin during cycle ``c`` (``c`` >= the current cycle; ``di2`` is that cycle's input)."""
         check_int("c", c, self.cycle)
-        return self._outputs.values(c, check_bits("pin 'di2'", di2, 1), self._run_from)
+        return {**self._outputs.values(c, check_bits("pin 'di2'", di2, 1), self._run_from),
+                **self._expansion.peek(c)}
 
     # ------------------------------------------------------------------------------------------------------------
     # The per-cycle logic, shared by step() and run()
@@ -285,6 +300,7 @@ class Supi3Pins:
         serial = self._serial
         if serial is not None and c >= serial.due:
             serial.clock(c, s.mfp_in)
+        self._expansion.from_exr = s.from_exr
         self._receiver.clock(line, c)
 
     # ------------------------------------------------------------------------------------------------------------
@@ -366,7 +382,7 @@ class Supi3Pins:
         # The other synchronised inputs are piecewise constant: keep their values once per piece, found by
         # bisection (a piece's do1 is its first cycle's: the line is read from its own trace).
         pieces = change.copy()
-        for name in ("mfp_in", "di2", "rbst_ext"):
+        for name in ("mfp_in", "di2", "rbst_ext", "from_exr"):
             trace = synced[name]
             pieces[1:] |= trace[1:] != trace[:-1]
         starts = np.flatnonzero(pieces)
@@ -423,6 +439,7 @@ class Supi3Pins:
         if serial is not None:
             serial.feed(c0 + n - 1)
         traces = outputs.render(c0, n, snaps, self._transmitter.render(c0, n))
+        traces.update(self._expansion.render(c0, n))
         self._transmitter.trim()
         if serial is not None:
             serial.keep_from = NEVER

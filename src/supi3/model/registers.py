@@ -25,7 +25,7 @@ from typing import Final, Literal, TypeVar
 
 from supi3 import tables
 from supi3.checks import check_bits, check_bool, check_bytes, check_instance, check_int, describe
-from supi3.config import DeviceConfig, MfpKind
+from supi3.config import DeviceConfig, MfpKind, Variant
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.regmap import (
     INTERRUPT_SOURCES,
@@ -135,7 +135,8 @@ class ReconfigurationError(InterfaceViolationError):
 
 
 class SetRegisterError(InterfaceViolationError):
-    """SET written with a length code that Tables 3-11/3-12 reserve; the configuration is not applied."""
+    """SET written with a length code that Tables 3-11/3-12 reserve, or with ExtReg = 1 on the SUPI 3 LS (3.5,
+    docs/assumptions/expansion.md RX-1); the configuration is not applied."""
 
 
 class InconsistentDataError(InterfaceViolationError):
@@ -518,6 +519,12 @@ class RegisterFile:
             self.violations.report(
                 SetRegisterError("Table 3-11", f"SET {value:02X}h: length code {decoded.length.code} is reserved; "
                                  "configuration not applied")
+            )
+            return
+        if decoded.extreg and self.config.variant is Variant.LS:
+            self.violations.report(
+                SetRegisterError("3.5", f"SET {value:02X}h: ExtReg = 1 selects the serial register expansion, not "
+                                 "possible with the SUPI 3 LS; configuration not applied")
             )
             return
         self._set = decoded

@@ -37,6 +37,7 @@ from amaranth.lib.wiring import In, Out
 from supi3.checks import check_bool
 from supi3.config import Variant
 from supi3.errors import ArgumentError
+from supi3.expansion import IDLE
 from supi3.interbus import wire
 from supi3.pinlevel import Pin
 from supi3.pinout import (
@@ -356,6 +357,11 @@ class Supi3Core(wiring.Component):
             self.ib_diag.eq(outputs.ib_diag),
             self.dclk_out.eq(dclk),
             self.resu_drive.eq(holding | (stretch != 0)),
+            # The register expansion (3.5) at its idle levels until supi3.rtl.expansion drives it (RX-6).
+            self.clk_exr.eq(IDLE.clk_exr),
+            self.to_exr.eq(IDLE.to_exr),
+            self.la_ou_d.eq(IDLE.la_ou_d),
+            self.la_in_d_n.eq(IDLE.la_in_d_n),
         ]
         return m
 

@@ -151,7 +151,7 @@ class FrameEngine:
             return level
         j = k - wire.POS_DATA
         if self.state == "data":
-            out = self.datapath.shift(level)
+            out = self.datapath.shift(level, c)
             self.crc_rx = wire.crc_update_bit(self.crc_rx, level)
             self.crc_tx = wire.crc_update_bit(self.crc_tx, out)
             return out

@@ -47,6 +47,7 @@ class Synced(NamedTuple):
     stat_err_n: int
     resu_n: int
     vmon_ok: int
+    from_exr: int
 
 
 INPUT_NAMES: Final = Synced._fields
