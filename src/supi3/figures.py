@@ -1,14 +1,17 @@
-"""Every redrawn timing figure of the manual: the serial µP interface's (:mod:`supi3.spi.figures`) and the serial
-I/O's (SPI master mode, 3.3.2: Figures 3-1 to 3-3), written by :func:`write_figures` (``supi3 figures``, see
-``docs/figures.md``).
+"""Every redrawn timing figure of the manual: the serial µP interface's (:mod:`supi3.spi.figures`), the serial I/O's
+(SPI master mode, 3.3.2: Figures 3-1 to 3-3) and the serial register expansion's (3.5: Figure 3-23), written by
+:func:`write_figures` (``supi3 figures``, see ``docs/figures.md``).
 
-The serial I/O figures come from pin traces of a :class:`~supi3.model.pins.Supi3Pins` in a 16-bit SPI master mode in
-a :class:`~supi3.model.pinring.PinRing`, started and given one data cycle by a :class:`~supi3.interbus.master.Master`,
-with peripherals of :mod:`supi3.peripherals.serial` attached (:meth:`supi3.model.chip.Supi3.attach_serial`). SerIn is
-an input the chip asks its device for (SM-5): the figure's SerIn is the device's answers to the chip's pin changes,
-kept as the chip clocked it, each on the line :data:`~supi3.serial_io.PERIPHERAL_DELAY_CLOCKS` after its cause
-(SM-10) and checked to give, at the samples, the word the chip read. Every trace drawn is checked against Table 3-4
-(:func:`supi3.verif.timing.check_serial_io`) first: a figure never shows a waveform breaking its table.
+The serial I/O and expansion figures come from pin traces of a :class:`~supi3.model.pins.Supi3Pins` in a
+:class:`~supi3.model.pinring.PinRing`, started and given one data cycle by a :class:`~supi3.interbus.master.Master`,
+with peripherals attached: :mod:`supi3.peripherals.serial` in a 16-bit SPI master mode
+(:meth:`supi3.model.chip.Supi3.attach_serial`), an IBS SRE 1 chain (:class:`supi3.peripherals.sre.Sre1`) with
+ExtReg = 1 (:meth:`supi3.model.chip.Supi3.attach_expansion`). SerIn and FromExR are inputs the chip asks its device
+for (SM-5, RX-3): the figure's level is the device's answers to the chip's pin changes, kept as the chip clocked it,
+each on the line 2 clocks after its cause (SM-10, ``expansion.CHAIN_DELAY_CLOCKS``) and checked to give, at the
+chip's samples, the data the chip took. Every trace drawn is checked against its table first (Table 3-4:
+:func:`supi3.verif.timing.check_serial_io`, Table 3-15: :func:`~supi3.verif.timing.check_expansion`): a figure
+never shows a waveform breaking its table.
 
 This module sits beside :mod:`supi3.spi.figures` (not in it) because it uses the verification kit, which imports
 the whole chip, which imports :mod:`supi3.spi`.
@@ -29,10 +32,15 @@ import numpy.typing as npt
 from supi3 import tables
 from supi3.config import DataDirection, DeviceConfig, MfpKind, decode
 from supi3.errors import Supi3Error
+from supi3.expansion import CHAIN_DELAY_CLOCKS, ExpansionLevels, ExternalRegisters
 from supi3.interbus.master import Master
+from supi3.interbus.wire import LOOPBACK_BYTES_ON_LINE
 from supi3.model.pinring import PinRing
 from supi3.model.pins import Supi3Pins
 from supi3.peripherals.serial import SerialBus, ShiftIn, ShiftOut, SpiAdc, SpiDac
+from supi3.peripherals.sre import Sre1
+from supi3.pinout import SYNC_STAGES
+from supi3.regmap import ID, SET
 from supi3.serial_io import (
     IDLE,
     MFP_MASK,
@@ -43,16 +51,19 @@ from supi3.serial_io import (
     SerialSequence,
     render,
 )
-from supi3.spi.figures import FIGURES, GAP, Figure, render_svg, wave_string, wavedrom_module
+from supi3.spi.figures import FIGURES, GAP, ID_DIGITAL_OUTPUT, Figure, render_svg, wave_string, wavedrom_module
 from supi3.spi.master import SpiTrace, write_spi_vcd
 from supi3.tables import CLOCK_HZ, clk_conf_for
-from supi3.verif.timing import check_serial_io, raise_first
+from supi3.verif.timing import EXPANSION_PINS, check_expansion, check_serial_io, raise_first
 
 __all__ = [
     "ALL_FIGURES",
+    "EXPANSION_FIGURES",
     "SERIAL_IO_FIGURES",
+    "ExpansionTrace",
     "FigureTraceError",
     "SerialIoTrace",
+    "expansion_wavejson",
     "serial_io_wavejson",
     "write_figures",
 ]
@@ -346,7 +357,225 @@ SERIAL_IO_FIGURES: Final[tuple[Figure[SerialIoTrace], ...]] = (
            lambda: _serial_io_trace(DataDirection.IN_OUT, _shift_in(), ShiftOut(2)), serial_io_wavejson),
 )
 """The serial I/O figures (3.3.2), in the manual's order."""
-ALL_FIGURES: Final[tuple[Figure[SpiTrace] | Figure[SerialIoTrace], ...]] = (*SERIAL_IO_FIGURES, *FIGURES)
+
+
+# ------------------------------------------------------------------------------------------------------------
+# Serial register expansion (3.5): Figure 3-23, redrawn from a pin-level ring trace
+# ------------------------------------------------------------------------------------------------------------
+
+EXPANSION_STRAPS: Final[tuple[str, str]] = ("10011", "1110")
+"""C4..0 and MFP15..12 of the expansion figure's chip: remote bus device, Init-µP (ExtReg is a SET bit, 3.4.11)."""
+EXPANSION_OUT: Final = b"\x14\x56\x78"
+"""The OUT data of the expansion figure's data cycle: the manual's example of Figure 3-24."""
+EXPANSION_IN: Final = b"\xa1\xb2\xc3"
+"""The chain's input registers, bytes 0..2 from ToExR (any)."""
+EXPANSION_GAP_BITS: Final = 10
+"""Idle bits the master leaves before and after the data cycle: more than the 7.75 after a latched data cycle that
+keep its first ClkExR rise after the end pulses before it (RX-4)."""
+SHOWN_BITS: Final = 8
+"""The data cycle's last bits drawn (its last byte)."""
+
+
+def _expansion_code(levels: ExpansionLevels) -> int:
+    """The expansion outputs as one integer: bit ``i`` is pin ``EXPANSION_PINS[i]``."""
+    return sum(getattr(levels, name) << i for i, name in enumerate(EXPANSION_PINS))
+
+
+class _ChainRecorder:
+    """External registers passing every call to ``chain`` that keep, in call order, the pins of each pin-level
+    :meth:`clock` call (:func:`_expansion_code`) and the FromExR level the chain answered."""
+
+    def __init__(self, chain: ExternalRegisters) -> None:
+        self.registers = chain
+        self.answers: list[tuple[int, int]] = []
+
+    @property
+    def length(self) -> int:
+        """As the chain."""
+        return self.registers.length
+
+    def chain(self) -> bytes:
+        """The chain's contents (transaction level; not used by the figures)."""
+        return self.registers.chain()
+
+    def shift_cycle(self, received: bytes) -> None:
+        """A data cycle shifted through (transaction level; not used by the figures)."""
+        self.registers.shift_cycle(received)
+
+    def take_outputs(self) -> None:
+        """LaOuD (transaction level; not used by the figures)."""
+        self.registers.take_outputs()
+
+    def load_inputs(self) -> None:
+        """/LaInD (transaction level; not used by the figures)."""
+        self.registers.load_inputs()
+
+    def clear(self) -> None:
+        """/ResReg (transaction level; not used by the figures)."""
+        self.registers.clear()
+
+    def clock(self, levels: ExpansionLevels) -> int:
+        """The chain's answer to ``levels``, kept."""
+        answer = self.registers.clock(levels)
+        self.answers.append((_expansion_code(levels), answer))
+        return answer
+
+
+@dataclass(frozen=True)
+class ExpansionTrace:
+    """The end of a data cycle with ExtReg = 1 (3.5) cut from the pin trace of a chip in a ring: its last
+    :data:`SHOWN_BITS` data bits and the end pulses, with the FromExR levels the chain drove."""
+
+    config: DeviceConfig
+    chain: Sre1
+    """The external registers, after the cycle."""
+    start: int
+    """The chip clock of index 0."""
+    pins: dict[str, Trace]
+    """ClkExR, ToExR, FromExR (what the chain drove), LaOuD and /LaInD by pin name."""
+    rises: tuple[int, ...]
+    """The indexes of the ClkExR rises of the bits drawn."""
+    samples: tuple[int, ...]
+    """The indexes of the ticks at which the chip takes FromExR for the bits drawn (RX-3)."""
+    cut: range
+    """The indexes left out: from after the last ClkExR pulse to before LaOuD."""
+    pulses: tuple[int, int, int, int]
+    """The indexes of LaOuD's rise and fall and /LaInD's fall and rise."""
+    out_byte: int
+    """The byte on ToExR in the bits drawn (the data cycle's last, LSB first)."""
+    in_byte: int
+    """The byte the chip took from FromExR in the bits drawn (the loopback word's last, shifted through the chain)."""
+
+
+def _edges(trace: Trace, rising: bool) -> Trace:
+    """The indexes where ``trace`` rises (or falls)."""
+    return np.flatnonzero(np.diff(trace) == (1 if rising else -1)) + 1
+
+
+def _expansion_trace() -> ExpansionTrace:
+    """A chip with ExtReg = 1 and an IBS SRE 1 chain of 3 bytes, started by a master and given one data cycle with
+    the manual's OUT data; the trace around the cycle's end, checked against Table 3-15 and the data moved.
+
+    Raises
+    ------
+    TraceTimingError
+        The chip's trace breaks a row of Table 3-15 (:func:`supi3.verif.timing.check_expansion`).
+    FigureTraceError
+        The master's cycles fail, the end pulses overrun, or the bits on ToExR and FromExR are not the data moved.
+    """
+    config = decode(*EXPANSION_STRAPS, clk_conf=clk_conf_for(SERIAL_IO_BIT_RATE))
+    pins = Supi3Pins(config)
+    registers = pins.chip.registers
+    assert registers is not None  # an Init-µP mode
+    code = next(int(lc.code, 2) for lc in tables.LENGTH_CODES if lc.bits == 8 * len(EXPANSION_OUT))
+    registers.cpu_write(SET.address, SET.encode(EXTREG=1, LENGTH_CODE=code))
+    registers.cpu_write(ID.address, ID_DIGITAL_OUTPUT)
+    chain = Sre1(len(EXPANSION_OUT))
+    chain.set_inputs(EXPANSION_IN)
+    recorder = _ChainRecorder(chain)
+    pins.chip.attach_expansion(recorder)
+    ring = PinRing([pins], record=True)
+    ring.idle(POWER_UP_S)
+    master = Master(ring, locate=False)
+    started = master.start()
+    ring.idle(EXPANSION_GAP_BITS / ring.bit_rate)
+    master.set_outputs(1, EXPANSION_OUT)
+    cycle_from = ring.cycle
+    data = master.data_cycle()
+    ring.idle(2 * EXPANSION_GAP_BITS / ring.bit_rate)  # the end pulses last 13 t0 after the latch
+    if not (started.ok and data.ok) or pins.chip.events["EXPANSION_OVERRUN"]:
+        raise FigureTraceError(f"the master's cycles failed or overran: {started}, {data}, {pins.chip.events}")
+    traced = ring.recorded()[0]
+    codes = sum(traced[name] << i for i, name in enumerate(EXPANSION_PINS))
+    assert isinstance(codes, np.ndarray)
+    from_exr = _answered(codes, recorder.answers, CHAIN_DELAY_CLOCKS)
+    raise_first(check_expansion(traced, bit_rate=config.bit_rate, from_exr=from_exr))
+    cpb = ring.cpb
+    rises = _edges(traced["clk_exr"][cycle_from:], True) + cycle_from
+    samples = rises - cpb // 4 - 1  # the tick before ToExR shows the bit (RX-3)
+    # The bits the chip sent on ToExR (the loopback word, then the OUT data) and took from FromExR (the chain's
+    # contents: the IN data the master got, then the loopback word shifted through), LSB first (Figure 3-24; the
+    # tick's FromExR is the pin's level through the synchroniser).
+    sent = np.packbits(traced["to_exr"][rises].astype(np.uint8), bitorder="little").tobytes()
+    taken = np.packbits(from_exr[samples - SYNC_STAGES].astype(np.uint8), bitorder="little").tobytes()
+    if sent != LOOPBACK_BYTES_ON_LINE + EXPANSION_OUT or taken != master.inputs(1) + LOOPBACK_BYTES_ON_LINE:
+        raise FigureTraceError(f"ToExR carried {sent.hex()}, FromExR gave {taken.hex()}")
+    (la_ou_rise,) = _edges(traced["la_ou_d"][cycle_from:], True) + cycle_from
+    (la_ou_fall,) = _edges(traced["la_ou_d"][cycle_from:], False) + cycle_from
+    (la_in_fall,) = _edges(traced["la_in_d_n"][cycle_from:], False) + cycle_from
+    (la_in_rise,) = _edges(traced["la_in_d_n"][cycle_from:], True) + cycle_from
+    step = cpb // 4
+    c0 = int(rises[-SHOWN_BITS]) - cpb // 4 - MARGIN_COLUMNS * step
+    stop = int(la_in_rise) + MARGIN_COLUMNS * step
+    if stop > len(codes):
+        raise FigureTraceError(f"the trace ends at clock {len(codes)}, before the figure's end {stop}")
+    window = {name: traced[name][c0:stop] for name in ("clk_exr", "to_exr", "la_ou_d", "la_in_d_n")}
+    window["from_exr"] = from_exr[c0:stop]
+    cut = range(int(rises[-1]) + 3 * step + MARGIN_COLUMNS * step - c0, int(la_ou_rise) - MARGIN_COLUMNS * step - c0)
+    return ExpansionTrace(
+        config, chain, c0, window, tuple(int(r) - c0 for r in rises[-SHOWN_BITS:]),
+        tuple(int(s) - c0 for s in samples[-SHOWN_BITS:]), cut,
+        (int(la_ou_rise) - c0, int(la_ou_fall) - c0, int(la_in_fall) - c0, int(la_in_rise) - c0),
+        EXPANSION_OUT[-1], taken[-1],
+    )
+
+
+def expansion_wavejson(trace: ExpansionTrace, title: str) -> dict[str, object]:
+    """The WaveJSON of the end of a data cycle with register expansion: one column per quarter ClkExR period (a
+    quarter bit), each showing the pins in its last clock, the time between the last ClkExR pulse and LaOuD cut to
+    a gap.
+
+    Lanes ClkExR, ToExR, FromExR, LaOuD and /LaInD (Table 3-14); under ToExR the names of the bits it carries (the
+    data cycle's last byte, D0 first: LSB first, Figure 3-24) from the first clock it shows each; under FromExR the
+    bits the chip takes, each after the sample of the bit before up to its own (RX-3). Arrows: t6 (LaOuD high), t7
+    (LaOuD fall to /LaInD fall) and t5 (/LaInD low) of Table 3-15.
+    """
+    step = (trace.rises[1] - trace.rises[0]) // 4  # ClkExR's period is a bit (Table 3-15 t0)
+    length = len(trace.pins["clk_exr"])
+    columns = _columns(length, step, trace.cut)
+    shows = [r - step for r in trace.rises]  # ToExR shows bit k a quarter bit before its rise
+    after = trace.rises[-1] + 3 * step
+
+    def name(k: int) -> str:
+        return f"D{k}"
+
+    def pin(signal: str) -> Callable[[int], str]:
+        return lambda c: str(int(trace.pins[signal][c]))
+
+    la_ou_d = _level_lane("LaOuD", columns, pin("la_ou_d"))
+    la_in_d_n = _level_lane("/LaInD", columns, pin("la_in_d_n"))
+    rise, fall, low, high = (edge + step - 1 for edge in trace.pulses)  # the columns each edge starts
+    la_ou_d["node"] = _node(columns, {rise: "a", fall: "b"})
+    la_in_d_n["node"] = _node(columns, {low: "c", high: "d"})
+    signal = [
+        _level_lane("ClkExR", columns, pin("clk_exr")),
+        _level_lane("ToExR", columns, pin("to_exr")),
+        _bit_lane("ToExR bit", columns, lambda c: bisect_right(shows, c) - 1 if shows[0] <= c < after else "z", name),
+        _level_lane("FromExR", columns, pin("from_exr")),
+        _bit_lane("FromExR bit", columns,
+                  lambda c: bisect_left(trace.samples, c) if c <= trace.samples[-1] else "z", name),
+        la_ou_d,
+        la_in_d_n,
+    ]
+    config = trace.config
+    foot = (f"SUPI 3 model trace ({config.function}, {config.bit_rate // 1000} kbit/s, ExtReg = 1, "
+            f"{trace.chain!r}); ToExR {trace.out_byte:02X}h and FromExR {trace.in_byte:02X}h LSB first; one column "
+            f"= {step} chip clocks = {step * 1e9 / CLOCK_HZ:.0f} ns; gap: from the last ClkExR pulse to LaOuD")
+    return {"signal": signal, "edge": ["a<->b t6", "b<->c t7", "c<->d t5"], "head": {"text": title},
+            "foot": {"text": foot}}
+
+
+EXPANSION_FIGURES: Final[tuple[Figure[ExpansionTrace], ...]] = (
+    Figure("fig3-23", "Figure 3-23 Serial register expansion interface timing",
+           "ExtReg = 1 with an IBS SRE 1 chain of 3 bytes: the end of the data cycle carrying 14h 56h 78h (Figure "
+           "3-24's example); its last byte 78h leaves on ToExR LSB first, a ClkExR pulse per bit, while FromExR "
+           "gives the chip the loopback word's last byte 5Ah, back from the chain; after the latch LaOuD (the "
+           "outputs take 78h 56h 14h), then /LaInD (the chain loads the inputs).",
+           _expansion_trace, expansion_wavejson),
+)
+"""The register expansion figure (3.5)."""
+ALL_FIGURES: Final[tuple[Figure[SpiTrace] | Figure[SerialIoTrace] | Figure[ExpansionTrace], ...]] = (
+    *SERIAL_IO_FIGURES, *FIGURES, *EXPANSION_FIGURES)
 """Every redrawn figure, in the manual's order (what :func:`write_figures` writes)."""
 
 
