@@ -73,8 +73,9 @@ __all__ = [
 # Serial I/O (SPI master mode, 3.3.2): Figures 3-1 to 3-3, redrawn from pin-level ring traces
 # ------------------------------------------------------------------------------------------------------------
 
-SERIAL_IO_BIT_RATE: Final = 2_000_000
-"""Bit rate of the serial I/O figures: t0 = 250 ns = 8 chip clocks, SCLK 4 MHz (Tables 3-3, 3-4)."""
+TRACE_BIT_RATE: Final = 2_000_000
+"""Bit rate of the serial I/O and expansion figures: t0 = 250 ns = 8 chip clocks, SCLK 4 MHz (Tables 3-3, 3-4);
+ClkExR 2 MHz (Table 3-15)."""
 SERIAL_IO_C: Final = "10011"
 """C4..0 of the serial I/O figures' chip: remote bus device (the "RB, SPI 16 ..." rows of Table 2-6)."""
 SERIAL_IO_OUT: Final = b"\x3c\x96"
@@ -191,7 +192,7 @@ def _serial_io_trace(direction: DataDirection, *devices: SerialDevice) -> Serial
         the chip read.
     """
     config = next(
-        c for c in (decode(r.c, r.mfp, clk_conf=clk_conf_for(SERIAL_IO_BIT_RATE)) for r in tables.MODE_ROWS
+        c for c in (decode(r.c, r.mfp, clk_conf=clk_conf_for(TRACE_BIT_RATE)) for r in tables.MODE_ROWS
                     if r.c == SERIAL_IO_C)
         if c.mfp_mode.kind is MfpKind.SPI_MASTER and c.mfp_mode.direction is direction and c.mfp_mode.width == 16
     )
@@ -463,7 +464,7 @@ def _expansion_trace() -> ExpansionTrace:
     FigureTraceError
         The master's cycles fail, the end pulses overrun, or the bits on ToExR and FromExR are not the data moved.
     """
-    config = decode(*EXPANSION_STRAPS, clk_conf=clk_conf_for(SERIAL_IO_BIT_RATE))
+    config = decode(*EXPANSION_STRAPS, clk_conf=clk_conf_for(TRACE_BIT_RATE))
     pins = Supi3Pins(config)
     registers = pins.chip.registers
     assert registers is not None  # an Init-µP mode
