@@ -25,7 +25,6 @@ from typing import Final, Protocol, runtime_checkable
 from supi3.checks import check_bool, check_bytes, check_int
 
 __all__ = [
-    "CHAIN_DELAY_CLOCKS",
     "LAIND_AFTER_LAOUD_T0",
     "PULSE_T0",
     "EndPulses",
@@ -39,10 +38,6 @@ __all__ = [
 
 PULSE_T0: Final = 4
 """LaOuD, /LaInD and /ResReg pulses last 4 t0 = 4 bit periods (Table 3-15 minimums, RX-4, RX-5)."""
-CHAIN_DELAY_CLOCKS: Final = 2
-"""External registers drive FromExR 2 clocks after the chip's pins changed, as the serial I/O peripherals answer
-(``supi3.spi.serial_io.PERIPHERAL_DELAY_CLOCKS``, SM-10; the spec layer keeps the two apart, a test holds them
-equal)."""
 LAIND_AFTER_LAOUD_T0: Final = 5
 """/LaInD falls 5 t0 after LaOuD fell (Table 3-15 minimum)."""
 
@@ -138,4 +133,4 @@ class ExternalRegisters(Protocol):
 
     def clock(self, levels: ExpansionLevels) -> int:
         """The chip's pins changed to ``levels``; returns the FromExR level the chain drives from then on (it
-        answers :data:`CHAIN_DELAY_CLOCKS` = 2 clocks later, as the serial I/O devices do)."""
+        answers ``supi3.serial_io.PERIPHERAL_DELAY_CLOCKS`` = 2 clocks later, as the serial I/O devices do)."""

@@ -25,7 +25,6 @@ from typing import TYPE_CHECKING, Final
 import numpy as np
 
 from supi3.expansion import (
-    CHAIN_DELAY_CLOCKS,
     IDLE,
     PULSE_T0,
     ExpansionLevels,
@@ -36,6 +35,7 @@ from supi3.expansion import (
 from supi3.interbus import wire
 from supi3.model.blocks.transmitter import PinTrace
 from supi3.pinout import SYNC_STAGES
+from supi3.serial_io import PERIPHERAL_DELAY_CLOCKS
 
 if TYPE_CHECKING:
     from supi3.model.chip import Supi3
@@ -45,10 +45,10 @@ OUTPUT_NAMES: Final = ("clk_exr", "to_exr", "la_ou_d", "la_in_d_n")
 _CLK, _TO, _LAOU, _LAIN, _RES = range(5)
 IDLE_LEVELS: Final[tuple[int, ...]] = astuple(IDLE)
 """The five levels of :class:`~supi3.expansion.ExpansionLevels` after power-up and with ExtReg = 0 (RX-6)."""
-ANSWER_LAG: Final = CHAIN_DELAY_CLOCKS + SYNC_STAGES
-"""A chain's answer to a change at cycle ``ch`` is on FromExR from ``ch + 2`` (``CHAIN_DELAY_CLOCKS``) and reaches
-the logic through the synchroniser (M1): the tick of cycle ``c`` uses the answer to the last change at or before
-``c - 4``."""
+ANSWER_LAG: Final = PERIPHERAL_DELAY_CLOCKS + SYNC_STAGES
+"""A chain's answer to a change at cycle ``ch`` is on FromExR from ``ch + 2`` (``PERIPHERAL_DELAY_CLOCKS``, SM-10)
+and reaches the logic through the synchroniser (M1): the tick of cycle ``c`` uses the answer to the last change at
+or before ``c - 4``."""
 OVERRUN: Final = "EXPANSION_OVERRUN"
 """The event counted in ``Supi3.events`` when a data cycle's first ClkExR rise comes before the end pulses of the
 previous cycle are over (RX-4)."""
