@@ -79,6 +79,6 @@ def test_bit_names_sit_on_the_bits(drawn: tuple[ExpansionTrace, dict[str, object
 def test_a_trace_breaking_table_3_15_is_not_drawn(monkeypatch: pytest.MonkeyPatch) -> None:
     # A chain answering 10 clocks late: FromExR changes 6 clocks before the next ClkExR rise, less than the setup
     # time 0.25 t0 + 100 ns before it (Table 3-15 t3).
-    monkeypatch.setattr(figures, "CHAIN_DELAY_CLOCKS", 10)
+    monkeypatch.setattr(figures, "PERIPHERAL_DELAY_CLOCKS", 10)
     with pytest.raises(TraceTimingError, match=r"Table 3-15 t3 "):
         FIGURE.wavejson()

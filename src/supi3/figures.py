@@ -8,8 +8,8 @@ with peripherals attached: :mod:`supi3.peripherals.serial` in a 16-bit SPI maste
 (:meth:`supi3.model.chip.Supi3.attach_serial`), an IBS SRE 1 chain (:class:`supi3.peripherals.sre.Sre1`) with
 ExtReg = 1 (:meth:`supi3.model.chip.Supi3.attach_expansion`). SerIn and FromExR are inputs the chip asks its device
 for (SM-5, RX-3): the figure's level is the device's answers to the chip's pin changes, kept as the chip clocked it,
-each on the line 2 clocks after its cause (SM-10, ``expansion.CHAIN_DELAY_CLOCKS``) and checked to give, at the
-chip's samples, the data the chip took. Every trace drawn is checked against its table first (Table 3-4:
+each on the line :data:`~supi3.serial_io.PERIPHERAL_DELAY_CLOCKS` after its cause (SM-10) and checked to give, at
+the chip's samples, the data the chip took. Every trace drawn is checked against its table first (Table 3-4:
 :func:`supi3.verif.timing.check_serial_io`, Table 3-15: :func:`~supi3.verif.timing.check_expansion`): a figure
 never shows a waveform breaking its table.
 
@@ -32,7 +32,7 @@ import numpy.typing as npt
 from supi3 import tables
 from supi3.config import DataDirection, DeviceConfig, MfpKind, decode
 from supi3.errors import Supi3Error
-from supi3.expansion import CHAIN_DELAY_CLOCKS, ExpansionLevels, ExternalRegisters
+from supi3.expansion import ExpansionLevels, ExternalRegisters
 from supi3.interbus.master import Master
 from supi3.interbus.wire import LOOPBACK_BYTES_ON_LINE
 from supi3.model.pinring import PinRing
@@ -489,7 +489,7 @@ def _expansion_trace() -> ExpansionTrace:
     traced = ring.recorded()[0]
     codes = sum(traced[name] << i for i, name in enumerate(EXPANSION_PINS))
     assert isinstance(codes, np.ndarray)
-    from_exr = _answered(codes, recorder.answers, CHAIN_DELAY_CLOCKS)
+    from_exr = _answered(codes, recorder.answers, PERIPHERAL_DELAY_CLOCKS)
     raise_first(check_expansion(traced, bit_rate=config.bit_rate, from_exr=from_exr))
     cpb = ring.cpb
     rises = _edges(traced["clk_exr"][cycle_from:], True) + cycle_from
