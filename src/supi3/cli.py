@@ -469,8 +469,9 @@ FIGURES_DIR = "docs/figures"
 
 
 def cmd_figures(args: argparse.Namespace) -> None:
-    """Redraw the manual's serial µP interface figures from model traces (WaveJSON, SVG, optionally VCD)."""
-    from supi3.spi.figures import write_figures
+    """Redraw the manual's serial I/O, µP interface and register expansion figures from model traces (WaveJSON, SVG,
+    VCD)."""
+    from supi3.figures import write_figures
 
     option = "-o/--output"
     folder = output_dir(option, args.output)
@@ -586,10 +587,11 @@ def build_parser() -> argparse.ArgumentParser:
     _campaign_arguments(p)
     p.set_defaults(func=cmd_campaign)
 
-    p = sub.add_parser("figures", help="redraw the manual's serial µP interface figures (needs the docs extra)")
+    p = sub.add_parser("figures", help="redraw the manual's serial I/O, µP interface and register expansion figures "
+                                       "(needs the docs extra)")
     p.add_argument("-o", "--output", metavar="DIR", default=FIGURES_DIR,
                    help=f"folder to write WaveJSON and SVG into (default {FIGURES_DIR})")
-    p.add_argument("--vcd", action="store_true", help="also write a VCD per figure")
+    p.add_argument("--vcd", action="store_true", help="also write a VCD per µP interface figure")
     p.set_defaults(func=cmd_figures)
 
     p = sub.add_parser("sdk", help="paths and flags of the C firmware SDK (docs/sdk.md)")

@@ -4,7 +4,8 @@ The text copy of the manual (IBS SUPI 3 OPC UM E rev. 05) lacks Figures 3-4, 3-5
 redraws each from a :class:`~supi3.spi.master.SpiTrace` of :class:`~supi3.spi.slave_pins.SlavePins` driven by a
 :class:`~supi3.spi.master.SoftMaster`: :func:`to_wavejson` turns a trace into WaveJSON sampled once per half SCLK
 period, :func:`render_svg` renders it with the ``wavedrom`` package (the ``docs`` extra, imported only there), and
-:func:`write_figures` writes them all; ``supi3 figures`` runs it (see ``docs/figures.md``).
+:func:`supi3.figures.write_figures` writes them with the other redrawn figures; ``supi3 figures`` runs it (see
+``docs/figures.md``).
 """
 
 from __future__ import annotations
@@ -13,24 +14,24 @@ import importlib
 import json
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from types import ModuleType
-from typing import Final
+from typing import Final, Generic, TypeVar
 
 from supi3.config import decode
 from supi3.model.registers import RegisterFile
 from supi3.regmap import BLOCK_ADDRESS, REGISTER_MAP, encode_command
-from supi3.spi.master import MasterTiming, SoftMaster, SpiTrace, decode_bytes, write_spi_vcd
+from supi3.spi.master import MasterTiming, SoftMaster, SpiTrace, decode_bytes
 from supi3.spi.slave_pins import SlavePins
 from supi3.spi.upif import Mode
 
 __all__ = [
     "FIGURES",
+    "GAP",
     "Figure",
     "render_svg",
     "to_wavejson",
+    "wave_string",
     "wavedrom_module",
-    "write_figures",
 ]
 
 DOCS_EXTRA_HINT: Final[str] = "pip install 'supi3[docs]'"
@@ -67,11 +68,19 @@ def _lanes(trace: SpiTrace) -> list[tuple[str, Callable[[int], str]]]:
     return [*ss_sclk, ("SerIN (MFP6)", trace.mfp6_line), ("SerOUT (MFP7)", trace.mfp7_line), c_d]
 
 
-def _wave(keys: Sequence[object], data_key: Callable[[object], bool]) -> str:
-    """WaveJSON wave string of one lane: a key per column, ``.`` where it repeats, ``=`` for a data segment."""
+GAP: Final = object()
+"""A column key of :func:`wave_string` drawn as a gap (``|``): time left out, the lane's level unchanged."""
+
+
+def wave_string(keys: Sequence[object], data_key: Callable[[object], bool]) -> str:
+    """WaveJSON wave string of one lane: a key per column, ``.`` where it repeats, ``=`` for a data segment, ``|``
+    for a :data:`GAP` column."""
     chars: list[str] = []
     previous: object = None
     for key in keys:
+        if key is GAP:
+            chars.append("|")
+            continue
         if key == previous:
             chars.append(".")
         else:
@@ -92,7 +101,7 @@ def to_wavejson(trace: SpiTrace, title: str, *, step: int | None = None) -> dict
     columns = range(0, len(trace), step)
     signal: list[object] = []
     for name, level in _lanes(trace):
-        signal.append({"name": name, "wave": _wave([level(k) for k in columns], lambda _: False)})
+        signal.append({"name": name, "wave": wave_string([level(k) for k in columns], lambda _: False)})
     frames = decode_bytes(trace)
     for name, attribute in (("µP → chip", "to_chip"), ("chip → µP", "from_chip")):
         keys: list[object] = []
@@ -101,7 +110,7 @@ def to_wavejson(trace: SpiTrace, title: str, *, step: int | None = None) -> dict
                        None)
             keys.append("z" if hit is None else hit)
         labels = [f"{getattr(frames[i], attribute):02X}h" for i in dict.fromkeys(keys) if isinstance(i, int)]
-        signal.append({"name": name, "wave": _wave(keys, lambda key: isinstance(key, int)), "data": labels})
+        signal.append({"name": name, "wave": wave_string(keys, lambda key: isinstance(key, int)), "data": labels})
     t = trace.timing
     sclk_mhz = trace.clock_hz / t.period / 1e6
     foot = (f"SUPI 3 model trace ({trace.mode.name.capitalize()}, {trace.bit_rate // 1000} kbit/s, SCLK "
@@ -143,9 +152,12 @@ _ID = REGISTER_MAP.register("ID").address
 _DATA0 = REGISTER_MAP.register("IN0").address
 
 
+T = TypeVar("T")
+
+
 @dataclass(frozen=True)
-class Figure:
-    """One of the manual's serial-interface figures and the scenario that redraws it."""
+class Figure(Generic[T]):
+    """One of the manual's timing figures, the scenario that redraws it and how its trace becomes WaveJSON."""
 
     name: str
     """File stem under ``docs/figures``."""
@@ -153,8 +165,20 @@ class Figure:
     """The manual's figure number and caption."""
     description: str
     """What the redrawn figure shows."""
-    build: Callable[[], SpiTrace]
-    """Runs the scenario on a fresh chip and returns the trace of the bytes the figure shows."""
+    build: Callable[[], T]
+    """Runs the scenario on a fresh chip and returns the trace the figure shows."""
+    draw: Callable[[T, str], dict[str, object]]
+    """The WaveJSON of a trace of :attr:`build`, given the title."""
+
+    @property
+    def title(self) -> str:
+        """The figure's heading: the manual's caption, marked as redrawn."""
+        return f"{self.manual} (redrawn from the model)"
+
+    def wavejson(self) -> tuple[T, dict[str, object]]:
+        """Run the scenario: its trace and the figure's WaveJSON."""
+        trace = self.build()
+        return trace, self.draw(trace, self.title)
 
 
 class _Scenario:
@@ -251,53 +275,29 @@ def _figure_3_12() -> SpiTrace:
     return scenario.trace()
 
 
-FIGURES: Final[tuple[Figure, ...]] = (
+FIGURES: Final[tuple[Figure[SpiTrace], ...]] = (
     Figure("fig3-4", "Figure 3-4 Timing of the synchronous serial interface (Motorola)",
            "One full-duplex data byte (command C0h before it): SerIN carries 5Ah MSB first into IN0 while SerOUT "
            "drives OUT0 = C3h; SerOUT is tri-state while /SS is high; C/D returns from data to command.",
-           _figure_3_4),
+           _figure_3_4, to_wavejson),
     Figure("fig3-5", "Figure 3-5 Timing of the synchronous serial interface (Intel)",
            "One read data byte (command 80h before it): S/R = 0, the chip drives Ser_IN/OUT with OUT0 = C3h LSB "
            "first, released when /SS rises; C/D returns from data to command.",
-           _figure_3_5),
+           _figure_3_5, to_wavejson),
     Figure("fig3-9", "Figure 3-9 Initialization byte timing (81hex)",
            "The Intel initialization byte 81h after power-up: C/D shows command before and after it (the "
            "first-initialization signature of 3.4.3).",
-           _figure_3_9),
+           _figure_3_9, to_wavejson),
     Figure("fig3-10", "Figure 3-10 Timing access to the SET register (address and data)",
            "Command 4Dh (write address 13), C/D goes to data, then 82h (I/O device, one byte), C/D back to command.",
-           _figure_3_10),
+           _figure_3_10, to_wavejson),
     Figure("fig3-11", "Figure 3-11 Timing access to the ID code register (address and data)",
            "Command 4Ch (write address 12), then the ID code 01h (digital output device).",
-           _figure_3_11),
+           _figure_3_11, to_wavejson),
     Figure("fig3-12", "Figure 3-12 Command and data access during block transfer",
            "Intel block transfer on a 24-bit output device: command 8Fh (S/R = 1), then three reads (S/R = 0) of "
            "OUT bytes 14h 56h 78h; C/D stays data until the last byte.",
-           _figure_3_12),
+           _figure_3_12, to_wavejson),
 )
 """The redrawn figures, in the manual's order."""
 
-
-def write_figures(out: Path, *, vcd: bool = False) -> list[Path]:
-    """Write ``<name>.json`` (WaveJSON) and ``<name>.svg`` for every figure of :data:`FIGURES` into ``out``, and
-    ``<name>.vcd`` too if ``vcd``; return the paths written. ``supi3 figures`` runs it.
-
-    Raises
-    ------
-    ModuleNotFoundError
-        When ``wavedrom`` (the ``docs`` extra) is not installed; checked before anything is written.
-    """
-    wavedrom_module()
-    out.mkdir(parents=True, exist_ok=True)
-    written: list[Path] = []
-    for figure in FIGURES:
-        trace = figure.build()
-        wavejson = to_wavejson(trace, f"{figure.manual} (redrawn from the model)")
-        json_path = out / f"{figure.name}.json"
-        json_path.write_text(json.dumps(wavejson, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
-        svg_path = out / f"{figure.name}.svg"
-        svg_path.write_text(render_svg(wavejson) + "\n", encoding="utf-8")
-        written += [json_path, svg_path]
-        if vcd:
-            written.append(write_spi_vcd(out / f"{figure.name}.vcd", trace))
-    return written
