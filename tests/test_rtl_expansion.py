@@ -2,8 +2,9 @@
 
 Manual 3.5 (Tables 3-14, 3-15, Figure 3-23) and RX-1 to RX-7 of docs/assumptions/expansion.md, at both bit rates:
 ToExR and ClkExR per data bit (``clock_high``), the end pulses after a latched data cycle and after any other
-cycle end (``end_pulses``), FromExR sent in place of the internal register, idle pins without ExtReg or without
-data bytes. On Amaranth's own simulator; /ResReg is the core's (tests/test_verif_lockstep_serial.py).
+cycle end (``end_pulses``), Table 3-15 (supi3.verif.timing) on the trace, FromExR sent in place of the internal
+register, idle pins without ExtReg or without data bytes. On Amaranth's own simulator; /ResReg is the core's
+(tests/test_verif_lockstep_serial.py).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import random
 from collections.abc import Iterator
 from typing import Any
 
+import numpy as np
 import pytest
 from amaranth.sim import Simulator
 
@@ -20,6 +22,7 @@ from supi3.expansion import IDLE, ExpansionLevels
 from supi3.interbus import wire
 from supi3.rtl.expansion import PIN_NAMES, ExpansionRtl
 from supi3.tables import BIT_RATES
+from supi3.verif.timing import EXPANSION_PINS, check_expansion
 
 Row = dict[str, int]
 
@@ -91,6 +94,8 @@ def test_data_bits_clock_and_end_pulses(bit_rate: int, id_cycle: bool) -> None:
         to_exr = done[-1] if done and not id_cycle else IDLE.to_exr
         assert level == ExpansionLevels(int(c in high), to_exr, int(c in ou), int(c not in low), IDLE.res_reg_n), c
     assert not any(row["overrun"] for row in seen)
+    traces = {name: np.array([getattr(level, name) for level in levels], dtype=np.int64) for name in EXPANSION_PINS}
+    assert check_expansion(traces, bit_rate=bit_rate) == []  # Table 3-15 on the RTL's trace
 
 
 @pytest.mark.parametrize(("ext", "has_data"), [(0, 1), (1, 0)])

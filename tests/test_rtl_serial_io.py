@@ -1,7 +1,8 @@
 """The serial I/O block in Amaranth (supi3.rtl.serial_io) against the spec's schedule (supi3.serial_io).
 
 Manual 3.3 (Tables 3-3, 3-4, Figures 3-1 to 3-3) and SM-1 to SM-9 of docs/assumptions/serial-io.md: the pins equal
-``serial_io.render`` cycle for cycle for every direction, width and bit rate; SerIn, read through the core's
+``serial_io.render`` cycle for cycle for every direction, width and bit rate and meet Table 3-4
+(supi3.verif.timing); SerIn, read through the core's
 synchroniser (SYNC_STAGES), lands in the IN word at the sample cycles; a reset aborts and runs the clear sequence;
 a start while a sequence runs waits (SM-2). On Amaranth's own simulator (no external tools).
 """
@@ -14,6 +15,7 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
 import pytest
 from amaranth.sim import Simulator
 
@@ -23,6 +25,7 @@ from supi3.pinout import SYNC_STAGES
 from supi3.rtl.serial_io import DIRECTIONS, MFP_BITS, SER_IN_PIN, WIDTHS, SerialIoRtl
 from supi3.serial_io import IDLE, Levels
 from supi3.tables import BIT_RATES
+from supi3.verif.timing import check_serial_io
 
 MODES = [
     pytest.param(*mode, marks=pytest.mark.slow)
@@ -118,6 +121,8 @@ def test_sequence_levels_and_in_word_equal_the_spec(direction: DataDirection, bi
     for first, word in zip(firsts, words, strict=True):
         want[first : first + seq.length] = serial_io.render(seq, word)
     assert run.levels == want
+    mfp = np.array([levels.mfp() for levels in run.levels], dtype=np.int64)
+    assert check_serial_io({"mfp_out": mfp}, bit_rate=bit_rate, bits=bits) == []  # Table 3-4 on the RTL's trace
     if seq.read is None:
         assert set(run.in_words) == {0}
         return
