@@ -1,14 +1,21 @@
 """A pin-level ring of whole chips (supi3.model.pinring.PinRing of supi3.top.Supi3Chip): chips in an Init-µP mode
 configured by their µP through the serial interface (SET and ID written, 3.4.5), an INTERBUS master running ID and
-data cycles over them, process data moving end to end between the master and each chip's µP."""
+data cycles over them, process data moving end to end between the master and each chip's µP. And the line after
+power-up: a chip that leaves its reset stretch (M2, 1.7.2) in the middle of a telegram resynchronises (M7, M16), so
+the master starts the ring after any idle time at either bit rate (Table 1-7)."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
 
 from supi3.config import decode
+from supi3.interbus import wire
 from supi3.interbus.master import Master
-from supi3.model.pinring import PinChip, PinRing
+from supi3.interbus.wire import Cycle, Telegram
+from supi3.model.pinring import PinChip, PinRing, receive
 from supi3.model.pins import RESET_STRETCH_CLOCKS, Supi3Pins
 from supi3.regmap import ID, IN0, IN1, OUT0, OUT1, SET, Register, encode_command
 from supi3.spi.master import SoftMaster
@@ -85,3 +92,62 @@ def test_ring_takes_cores_and_whole_chips() -> None:
     assert [master.entry(k).id_code for k in (1, 2)] == [core_config.id_code, 0x01]
     with pytest.raises(ValueError, match="chips must be a sequence of Supi3Pins or Supi3Chip"):
         PinRing([core, "chip"])  # type: ignore[list-item]
+
+
+CLK_CONF_500K, CLK_CONF_2M = "01", "11"  # Table 1-7: CLK_CONF1..0 for 500 kbit/s and 2 Mbit/s
+IDLE_STATUS = Telegram(Cycle.DATA, False, None)
+
+
+def _idle_ring(clk_conf: str, chips: int, idle_telegrams: int) -> PinRing:
+    """Demo devices (pin-strapped, ID 01h) powered up together, then ``idle_telegrams`` idle status telegrams."""
+    ring = PinRing([Supi3Pins(decode("10000", None, clk_conf=clk_conf)) for _ in range(chips)])
+    ring.idle(idle_telegrams * wire.STATUS_TELEGRAM_BITS / ring.bit_rate)
+    return ring
+
+
+@settings(max_examples=8)
+@given(clk_conf=st.sampled_from([CLK_CONF_500K, CLK_CONF_2M]), chips=st.integers(1, 3),
+       idle_telegrams=st.integers(0, 60), data_cycles=st.integers(1, 3))  # fmt: skip
+@example(clk_conf=CLK_CONF_500K, chips=1, idle_telegrams=6, data_cycles=1)  # 32 bit periods: failed before M16
+@example(clk_conf=CLK_CONF_500K, chips=3, idle_telegrams=20, data_cycles=2)  # 100 bit periods
+def test_master_starts_the_ring_after_any_idle_from_power_up(
+    clk_conf: str, chips: int, idle_telegrams: int, data_cycles: int
+) -> None:
+    ring = _idle_ring(clk_conf, chips, idle_telegrams)
+    master = Master(ring, locate=False, max_devices=4)
+    result = master.start()
+    assert result.ok, result.diagnostics
+    assert [master.entry(k).id_code for k in range(1, chips + 1)] == [ring.devices[0].config.id_code] * chips
+    for _ in range(data_cycles):
+        result = master.data_cycle()
+        assert result.ok, result.diagnostics
+
+
+@pytest.mark.parametrize("clk_conf", [CLK_CONF_500K, CLK_CONF_2M])
+def test_a_chip_leaving_reset_mid_telegram_repeats_the_line_bit_for_bit(clk_conf: str) -> None:
+    """M16: once the chip has read the telegram it woke up in (misframed: at 2 Mbit/s it reads a data telegram and
+    sends its register in place of the data bits, M8), a stop bit read at start level puts its receiver back on the
+    telegram grid, and DO2 is the master's line 3 bit periods later (A10), read mid-bit. Before M16 such a stop bit
+    restarted the receiver in the middle of a bit period, and the repeated line slipped by half a bit period."""
+    ring = PinRing([Supi3Pins(decode("10000", None, clk_conf=clk_conf))], record=True)
+    count = 40
+    ring.run_levels(wire.status_levels(Cycle.DATA, False, count))
+    sent = wire.status_levels(Cycle.DATA, False, count)
+    do2 = ring.recorded()[0]["do2"].astype(np.uint8)
+    first = -(-RESET_STRETCH_CLOCKS // ring.cpb)  # the first bit period the chip sees whole after its reset
+    assert first % wire.STATUS_TELEGRAM_BITS != 0  # it wakes up inside a telegram at both bit rates
+    delay = wire.REPEATER_DELAY_BITS
+    synced = first + wire.DATA_TELEGRAM_BITS  # the misframed telegram is at most a data telegram long
+    for phase in (ring.cpb // 4, ring.cpb // 2, 3 * ring.cpb // 4):  # whole bit periods, not just their middles
+        repeated = wire.samples_to_levels(do2, ring.bit_rate, phase)
+        assert np.array_equal(repeated[synced + delay :], sent[synced : len(sent) - delay]), phase
+
+
+def test_the_rings_receiver_resynchronises_after_a_fragment() -> None:
+    """A telegram's tail (a chip waking up inside it) then idle status telegrams: the stop bit read at start level
+    is taken as the next start bit (M16), so the receiver finds the telegram grid again within two telegrams."""
+    status = wire.status_levels(Cycle.DATA, False, 6)
+    levels = np.concatenate([np.ones(5, dtype=np.uint8), status[2:wire.STATUS_TELEGRAM_BITS], status])
+    cpb = wire.clocks_per_bit(500_000)
+    telegrams, rest, error = receive(wire.levels_to_samples(levels, 500_000), 0, cpb)
+    assert error and telegrams == [IDLE_STATUS] * 5 and rest == len(levels) * cpb

@@ -72,7 +72,8 @@ def receive(samples: npt.NDArray[np.integer], start: int, cpb: int) -> tuple[lis
     """Receive the telegrams in a 32 MHz sample trace from index ``start``.
 
     Returns the telegrams, the index to continue from (before any unfinished telegram) and whether a telegram
-    error was seen (the erroneous telegram is skipped).
+    error was seen (the erroneous telegram is skipped). The receiver resynchronises as the chip's does (M7, M16):
+    on the first start level after a stop bit, or on the period of a stop bit read at start level.
 
     Raises
     ------
@@ -116,7 +117,10 @@ def receive(samples: npt.NDArray[np.integer], start: int, cpb: int) -> tuple[lis
             out.append(wire.decode_telegram(word, length))
         except TelegramError:
             error = True
-        i = last + 1
+            # As the chip's receiver (M16): a stop bit at start level is the next telegram's start bit.
+            i = last - cpb // 2
+        else:
+            i = last + 1
     return out, n, error
 
 

@@ -456,8 +456,8 @@ class ReceiverRtl(wiring.Component):
     levels come out as ``<pin>_s``. The line receiver runs while ``run`` is 1 and is cleared by ``clear`` (the core's
     enable and power-up reset): INTERBUS reset detection (a start-level run of ``reset_run`` clocks, A12) and its end
     after the status telegrams of Table A12, the 20 ms idle time-out (A13), telegram framing (an ``m.FSM``: between
-    telegrams / in a telegram) and the mid-bit sample at ``cpb // 2`` clocks into every bit. Its view of the line is
-    the :data:`LINE` interface ``line``.
+    telegrams / in a telegram; a stop bit at start level starts the next one, M16) and the mid-bit sample at
+    ``cpb // 2`` clocks into every bit. Its view of the line is the :data:`LINE` interface ``line``.
     """
 
     def __init__(self, tables: CoreTables) -> None:
@@ -519,7 +519,7 @@ class ReceiverRtl(wiring.Component):
                 rx.next = "TELEGRAM"
             with rx.State("TELEGRAM"):
                 sync += phase.eq(Mux(phase == self.cpb - 1, 0, phase + 1))
-                with rx.If(sample & end):
+                with rx.If(sample & end & (line == wire.STOP_LEVEL)):
                     rx.next = "BETWEEN"
         comb += busy.eq(fsm.ongoing("TELEGRAM"))
         with rx.If(sample):
@@ -528,6 +528,8 @@ class ReceiverRtl(wiring.Component):
                 sync += select.eq(line)
             with rx.If(bit == wire.POS_CONTROL):
                 sync += control.eq(line)
+            with rx.If(end & (line != wire.STOP_LEVEL)):  # M16: the stop bit's period is the next start bit
+                sync += [bit.eq(1), is_data.eq(1), silent.eq(self.cpb // 2 + 1)]
 
         # The end of an INTERBUS reset: the status telegrams after it (docs/interbus.md A12)
         with rx.If(sample & end & (line == wire.STOP_LEVEL) & ~data_now & in_reset_now):

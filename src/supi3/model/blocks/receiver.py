@@ -4,7 +4,8 @@ Manual: Table 1-4 (the input pins DO1, DI2, RBST_EXT, MFP, /StatErr, /ResU), 1.7
 sampled on), 1.7.2 (/ResU and the voltage monitor as inputs). INTERBUS (``/work/shared/reference/interbus-layer2.md``
 "Telegrams", ``docs/interbus.md``): the start bit, mid-bit sampling, the telegram-type bit that tells a 13-bit data
 telegram from a 5-bit status telegram, the INTERBUS reset (start level held, A12) and the 20 ms idle time-out (A13).
-Decisions: M1 (two synchroniser stages), M11 (reset detection), ``docs/model.md``.
+Decisions: M1 (two synchroniser stages), M7 (framing), M11 (reset detection), M16 (a stop bit at start level starts
+the next telegram), ``docs/model.md``.
 
 RTL counterpart: the ``receiver`` block of :mod:`supi3.rtl.core` (``Receiver``: the synchronisers, the INTERBUS
 reset and idle time-out counters, framing and mid-bit sampling).
@@ -188,16 +189,20 @@ class Receiver:
             self.chip.reset_at(c)
         if not self.busy:
             if line == wire.START_LEVEL:
-                self.busy = True
-                self.t0 = c
-                self.bit = 0
-                self.word = 0
-                self.length = wire.DATA_TELEGRAM_BITS
-                self.last_start = c
+                self._begin(c)
             return
         if c == self.t0 + self.half_bit + self.bit * self.cpb:
             self._sample(line, c)
             self.bit += 1
+
+    def _begin(self, t0: int) -> None:
+        """A telegram whose start bit began at cycle ``t0``; its bit 0 is sampled next."""
+        self.busy = True
+        self.t0 = t0
+        self.bit = 0
+        self.word = 0
+        self.length = wire.DATA_TELEGRAM_BITS
+        self.last_start = t0
 
     def _sample(self, level: int, c: int) -> None:
         """Bit :attr:`bit` of the telegram, sampled mid-bit: to the frame engine, then out on the repeater."""
@@ -212,8 +217,14 @@ class Receiver:
             out = frame.data_telegram_bit(k, level, c, self.word)
         self.transmitter.repeat(c, out)
         if k == self.length - 1:
-            self.busy = False
-            frame.telegram_end(level, c, self.word, self.length)
+            word, length = self.word, self.length
+            if level == wire.STOP_LEVEL:
+                self.busy = False
+            else:
+                # M16: a stop bit at start level is the start bit of the next telegram, on the same bit grid
+                # (its bit 0 counts as sampled: :meth:`clock` steps on to bit 1).
+                self._begin(c - self.half_bit)
+            frame.telegram_end(level, c, word, length)
 
     def next_due(self, c: int, line: int, run_from: int) -> int:
         """The next cycle after ``c`` at which the logic acts with unchanged inputs (the line at ``line``, the logic
