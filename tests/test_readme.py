@@ -13,3 +13,10 @@ def test_readme_python_examples_run() -> None:
     assert blocks
     for block in blocks:
         exec(compile(block, str(README), "exec"), {})
+
+
+def test_tests_readme_names_every_test_file() -> None:
+    """tests/README.md's table maps every test file to the source it tests."""
+    tests = Path(__file__).resolve().parent
+    listed = (tests / "README.md").read_text(encoding="utf-8")
+    assert [p.name for p in sorted(tests.glob("test_*.py")) if f"`{p.name}`" not in listed] == []
