@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from os import PathLike
 from pathlib import Path
 
@@ -10,6 +11,7 @@ from vcd import VCDWriter
 from vcd.writer import Variable
 
 from supi3.checks import check_instance, fail
+from supi3.config import DeviceConfig
 from supi3.model.pinring import PinRing
 from supi3.tables import CLOCK_HZ
 
@@ -17,11 +19,28 @@ CLOCK_PS = 10**12 // CLOCK_HZ
 """One 32 MHz clock period in picoseconds (31250), the VCD time step."""
 
 
+def mfp_signals(config: DeviceConfig) -> list[tuple[int, str]]:
+    """(MFP pin, VCD name) of every MFP the mode uses (Tables 3-1 to 3-6, 2-8): ``mfp4_sclk``, ``mfp5_ss_n`` (a
+    leading "/" becomes ``_n``), ``mfp0_in0``; GND pins are left out."""
+    named = []
+    for p in config.mfp_pins:
+        signal = p.signal.split(" | ")[0]
+        if signal == "GND":
+            continue
+        base = re.sub(r"[^0-9a-z]+", "_", signal.lstrip("/").lower()).strip("_")
+        named.append((p.pin, f"mfp{p.pin}_{base}{'_n' if signal.startswith('/') else ''}"))
+    return named
+
+
 def write_vcd(path: Path, ring: PinRing) -> Path:
     """Write every pin of every chip of ``ring`` (made with ``record=True``) to ``path``.
 
     Scopes are ``dev1`` .. ``devN`` in ring order; ``dev1.do1`` is the master's forward line and ``dev1.di1``
-    the return line into the master. Only changes are written, so the file stays small.
+    the return line into the master. Besides the 16-bit ``mfp_in``/``mfp_out``/``mfp_oe`` vectors, every MFP the
+    mode uses is a 1-bit signal of its own (:func:`mfp_signals`: ``mfp4_sclk``, ``mfp5_ss_n``, ...), at the level
+    on the pin: the chip's output where it drives the pin, else the input given to the model (a device attached
+    with ``Supi3.attach_serial`` answers the chip directly, so SerIn shows the pin, not its answer). Only changes
+    are written, so the file stays small.
 
     Raises
     ------
@@ -39,7 +58,13 @@ def write_vcd(path: Path, ring: PinRing) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     changes: list[tuple[int, int, Variable[int], int]] = []
     with path.open("w", encoding="ascii") as stream, VCDWriter(stream, timescale="1 ps", date="") as writer:
-        for k, traces in enumerate(chips, start=1):
+        for k, (chip, traces) in enumerate(zip(ring.devices, chips, strict=True), start=1):
+            traces = dict(traces)
+            if traces:
+                driven = traces["mfp_oe"]
+                for pin, name in mfp_signals(chip.config):
+                    widths[name] = 1
+                    traces[name] = np.where((driven >> pin) & 1, traces["mfp_out"] >> pin, traces["mfp_in"] >> pin) & 1
             for name, trace in sorted(traces.items()):
                 var = writer.register_var(f"dev{k}", name, "wire", size=widths[name], init=int(trace[0]))
                 at = np.flatnonzero(np.diff(trace)) + 1
