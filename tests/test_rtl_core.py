@@ -243,6 +243,19 @@ def test_watchdog_expiry(bench: Lockstep, tmp_path: Path) -> None:
     assert [length for _, length in pulses(expected["res_reg_n"])] == [12]  # 375 ns (Table 3-13), RTL alike
 
 
+def test_watchdog_expiry_clears_the_serial_outputs(bench: Lockstep, tmp_path: Path) -> None:
+    # SPI master mode (RB, SPI 16 OUT, Table 2-6): the watchdog's reset of process data runs the clear sequence (a
+    # write frame of zeros and /Conv, SM-9) in the RTL as in the model; /SS frames: the INTERBUS reset's clear
+    # sequence, the data cycle's write, the watchdog's clear sequence.
+    config = fast_config("10011", "1001")
+    script = CoreScript(config, np.random.default_rng(9)).bring_up().id_cycle(wire.command_word(0)).data_cycle()
+    telegrams = (WATCHDOG_CLOCKS[0] or 0) // (wire.STATUS_TELEGRAM_BITS * wire.clocks_per_bit(config.bit_rate))
+    script.line(wire.status_levels(Cycle.DATA, False, telegrams + 100))
+    expected = long_lockstep(bench, config, script.columns(), tmp_path)
+    ss_n = (expected["mfp_out"] >> 5) & 1
+    assert np.count_nonzero(np.diff(ss_n) == -1) == 3
+
+
 def test_mod_ack_pulse_width(bench: Lockstep, tmp_path: Path) -> None:
     # Quit Peripheral Error twice: /ModAck pulses 12 clocks each time (M3: the 375 ns of Table 3-13), RTL alike.
     config = fast_config("10000")
