@@ -16,6 +16,7 @@ directly, as rows of a stimulus array that also carries the core's one-cycle str
 from __future__ import annotations
 
 import importlib.util
+import itertools
 import math
 from collections import deque
 from collections.abc import Callable
@@ -95,6 +96,28 @@ def id_frame(command: int) -> Levels:
 def data_frame(device: bytes, *, latch: bool = True) -> Levels:
     """A data cycle carrying ``device``'s OUT bytes."""
     return frame_levels(Cycle.DATA, device, latch=latch)
+
+
+def step_all(model: Supi3Pins, inputs: Columns) -> Columns:
+    """Every output trace of ``model`` stepped once per cycle of ``inputs`` (:meth:`Supi3Pins.step`)."""
+    names = list(inputs)
+    columns = [inputs[name].tolist() for name in names]
+    rows = [model.step(dict(zip(names, values, strict=True))) for values in zip(*columns, strict=True)]
+    return {name: np.array([r[name] for r in rows], dtype=np.int64) for name in rows[0]}
+
+
+def assert_run_matches_step(stepped: Supi3Pins, bulk: Supi3Pins, inputs: Columns, cuts: list[float]) -> Columns:
+    """Step ``stepped`` through ``inputs`` cycle by cycle and :meth:`Supi3Pins.run` ``bulk`` in pieces cut at the
+    fractions ``cuts``: every output trace must be equal, cycle for cycle; returns the stepped traces."""
+    n = len(next(iter(inputs.values())))
+    expected = step_all(stepped, inputs)
+    bounds = sorted({0, n, *(int(n * cut) for cut in cuts)})
+    pieces = [bulk.run({k: v[a:b] for k, v in inputs.items()}) for a, b in itertools.pairwise(bounds)]
+    for name, trace in expected.items():
+        got = np.concatenate([piece[name] for piece in pieces])
+        bad = np.flatnonzero(got != trace)
+        assert not bad.size, f"{name} differs first at cycle {bad[0]}: step {trace[bad[0]]}, run {got[bad[0]]}"
+    return expected
 
 
 def quiet_inputs(n: int) -> Columns:

@@ -4,8 +4,6 @@ clocked by them, and the same results as the transaction level (tests/test_model
 
 from __future__ import annotations
 
-import itertools
-
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -30,7 +28,7 @@ from supi3.spi.master import SoftMaster
 from supi3.spi.upif import Mode
 from supi3.top import UP_REST, ChipPort, Supi3Chip
 from supi3.verif.timing import check_expansion
-from support import FakeChain, pulses
+from support import FakeChain, assert_run_matches_step, pulses
 from test_model_expansion import extreg_set, up_chip
 
 GAP_BITS = 10
@@ -255,27 +253,11 @@ def test_step_and_run_agree_with_expansion(outs: list[bytes], seed: int, chained
     inputs = {pin.name: np.full(n, level, dtype=np.int64) for pin, level in idle}
     inputs["do1"] = do1
     inputs["from_exr"] = np.repeat(rng.integers(0, 2, n // 7 + 1), 7)[:n]
-    names = list(inputs)
-    rows = [dict(zip(names, values, strict=True)) for values in zip(*(inputs[k].tolist() for k in names), strict=True)]
-    expected = {name: np.asarray(trace) for name, trace in _step_all(stepped, rows).items()}
-    bounds = sorted({0, n, *(int(n * cut) for cut in cuts)})
-    pieces = [bulk.run({k: v[a:b] for k, v in inputs.items()}) for a, b in itertools.pairwise(bounds)]
-    for name, trace in expected.items():
-        got = np.concatenate([piece[name] for piece in pieces])
-        bad = np.flatnonzero(got != trace)
-        assert not bad.size, f"{name} differs first at cycle {bad[0]}: step {trace[bad[0]]}, run {got[bad[0]]}"
+    expected = assert_run_matches_step(stepped, bulk, inputs, cuts)
     assert set(OUTPUT_NAMES) <= set(expected)
     assert stepped.chip.events == bulk.chip.events
     assert (chains[0].contents, chains[0].outputs) == (chains[1].contents, chains[1].outputs)
     assert stepped.chip.events["VALID"] >= 1
-
-
-def _step_all(model: Supi3Pins, rows: list[dict[str, int]]) -> dict[str, list[int]]:
-    traces: dict[str, list[int]] = {}
-    for row in rows:
-        for name, value in model.step(row).items():
-            traces.setdefault(name, []).append(value)
-    return traces
 
 
 @settings(max_examples=6, deadline=None)

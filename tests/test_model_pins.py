@@ -3,8 +3,6 @@ level agree on shared scenarios; line timing; resets, corrupted telegrams and si
 
 from __future__ import annotations
 
-import itertools
-
 import numpy as np
 import numpy.typing as npt
 import pytest
@@ -20,6 +18,7 @@ from supi3.interbus.wire import Cycle, Frame
 from supi3.model.chip import Supi3
 from supi3.model.pinring import PinRing
 from supi3.model.pins import IDLE_TIMEOUT_CLOCKS, RESET_STRETCH_CLOCKS, SYNC_STAGES, Supi3Pins
+from support import assert_run_matches_step
 
 FAST = tables.clk_conf_for(2_000_000)  # CLK_CONF: 2 Mbit/s, 16 clocks per bit, keeps pin-level tests short
 BINARY = [r for r in tables.MODE_ROWS if decode(r.c, r.mfp).mfp_mode.kind is MfpKind.BINARY_IO]
@@ -48,13 +47,6 @@ def _inputs(do1: npt.NDArray[np.int64], **pins: npt.NDArray[np.int64] | int) -> 
     traces = {name: np.broadcast_to(np.asarray(v, dtype=np.int64), (n,)).copy() for name, v in base.items()}
     traces["do1"] = do1
     return traces
-
-
-def _step_all(model: Supi3Pins, inputs: dict[str, npt.NDArray[np.int64]]) -> dict[str, npt.NDArray[np.int64]]:
-    names = list(inputs)
-    columns = [inputs[name].tolist() for name in names]
-    rows = [model.step(dict(zip(names, values, strict=True))) for values in zip(*columns, strict=True)]
-    return {name: np.array([r[name] for r in rows], dtype=np.int64) for name in rows[0]}
 
 
 # ------------------------------------------------------------------------------------------------------------
@@ -90,14 +82,7 @@ def test_step_and_run_agree_cycle_for_cycle(row: tables.ModeRow, out: bytes, see
     di2 = np.where(np.arange(n) > 3000, rng.integers(0, 2, n), 0)
     inputs = _inputs(do1, resu_n=resu, stat_err_n=stat, mfp_in=mfp, di2=di2)
     stepped, bulk = Supi3Pins(config), Supi3Pins(config)
-    expected = _step_all(stepped, inputs)
-    half = n // 3
-    first = bulk.run({k: v[:half] for k, v in inputs.items()})
-    second = bulk.run({k: v[half:] for k, v in inputs.items()})
-    for name, trace in expected.items():
-        got = np.concatenate([first[name], second[name]])
-        bad = np.flatnonzero(got != trace)
-        assert not bad.size, f"{name} differs first at cycle {bad[0]}: step {trace[bad[0]]}, run {got[bad[0]]}"
+    assert_run_matches_step(stepped, bulk, inputs, [1 / 3])
     assert stepped.chip.events == bulk.chip.events
     assert stepped.chip.id_register() == bulk.chip.id_register()
     assert stepped.chip.mfp_outputs == bulk.chip.mfp_outputs
@@ -125,13 +110,7 @@ def test_step_and_run_agree_on_any_line(runs: list[tuple[int, int]], cuts: list[
         resu[resu_at : resu_at + 3 * cpb] = 0
     inputs = _inputs(do1, resu_n=resu)
     stepped, bulk = Supi3Pins(config), Supi3Pins(config)
-    expected = _step_all(stepped, inputs)
-    bounds = sorted({0, n, *(int(n * cut) for cut in cuts)})
-    pieces = [bulk.run({k: v[a:b] for k, v in inputs.items()}) for a, b in itertools.pairwise(bounds)]
-    for name, trace in expected.items():
-        got = np.concatenate([piece[name] for piece in pieces])
-        bad = np.flatnonzero(got != trace)
-        assert not bad.size, f"{name} differs first at cycle {bad[0]}: step {trace[bad[0]]}, run {got[bad[0]]}"
+    assert_run_matches_step(stepped, bulk, inputs, cuts)
     assert stepped.chip.events == bulk.chip.events
     assert stepped.log.recent() == bulk.log.recent()
 

@@ -5,7 +5,6 @@ step() and run() agree cycle for cycle."""
 
 from __future__ import annotations
 
-import itertools
 import re
 
 import numpy as np
@@ -22,7 +21,7 @@ from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
 from supi3.model.pins import RESET_STRETCH_CLOCKS, Supi3Pins
 from supi3.verif.timing import check_serial_io
-from support import EchoDevice, quiet_inputs
+from support import EchoDevice, assert_run_matches_step, quiet_inputs
 
 SPI_ROWS = [r for r in tables.MODE_ROWS if decode(r.c, r.mfp).mfp_mode.kind is MfpKind.SPI_MASTER]
 RATES = [tables.clk_conf_for(500_000), tables.clk_conf_for(2_000_000)]
@@ -92,13 +91,6 @@ def _read_word(seq: sio.SerialSequence, start: int, ser_in: Trace) -> int:
     for j in range(frame.bits):
         word = (word << 1) | int((ser_in[start + frame.sample(j)] >> 6) & 1)
     return word
-
-
-def _step_all(model: Supi3Pins, inputs: dict[str, Trace]) -> dict[str, Trace]:
-    names = list(inputs)
-    columns = [inputs[name].tolist() for name in names]
-    rows = [model.step(dict(zip(names, values, strict=True))) for values in zip(*columns, strict=True)]
-    return {name: np.array([r[name] for r in rows], dtype=np.int64) for name in rows[0]}
 
 
 # ------------------------------------------------------------------------------------------------------------
@@ -296,12 +288,6 @@ def test_step_and_run_agree_cycle_for_cycle(row: tables.ModeRow, outs: list[byte
     if device:
         stepped.chip.attach_serial(devices[0])
         bulk.chip.attach_serial(devices[1])
-    expected = _step_all(stepped, inputs)
-    bounds = [0, *sorted(int(f * n) for f in cuts), n]
-    pieces = [bulk.run({k: v[a:b] for k, v in inputs.items()}) for a, b in itertools.pairwise(bounds)]
-    for name, trace in expected.items():
-        got = np.concatenate([piece[name] for piece in pieces])
-        bad = np.flatnonzero(got != trace)
-        assert not bad.size, f"{name} differs first at cycle {bad[0]}: step {trace[bad[0]]}, run {got[bad[0]]}"
+    assert_run_matches_step(stepped, bulk, inputs, cuts)
     assert stepped.chip.in_word == bulk.chip.in_word
     assert devices[0].record == devices[1].record
