@@ -6,9 +6,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 from vcd.reader import TokenKind, tokenize
 
 from supi3.config import decode
+from supi3.errors import ArgumentError
 from supi3.interbus.master import Master
 from supi3.model.pinring import PinRing
 from supi3.model.pins import Supi3Pins
@@ -21,6 +23,8 @@ def test_mfp_signal_names_follow_the_mode_tables() -> None:
     assert mfp_signals(decode("10011", "1110"))[:4] == [  # Init-µP, Motorola/Intel (Tables 3-5, 3-6)
         (0, "mfp0_sas_init"), (1, "mfp1_i_o"), (2, "mfp2_c_d"), (3, "mfp3_irq_n")]
     assert mfp_signals(decode("10000"))[0] == (0, "mfp0_in0")
+    with pytest.raises(ArgumentError, match="config must be a DeviceConfig"):
+        mfp_signals("10000")  # type: ignore[arg-type]
 
 
 def _changes(vcd: Path, scope: str) -> dict[str, list[tuple[int, int]]]:

@@ -132,6 +132,21 @@ def test_wiring_names_the_pins_of_table_3_3() -> None:
     (lambda: expansion.clock_high(2), "cpb"),
     (lambda: expansion.end_pulses(1, 16), "latched_data"),  # type: ignore[arg-type]
     (lambda: expansion.line_to_chain("abc"), "received"),  # type: ignore[arg-type]
+    (lambda: sequence(DataDirection.IN, 16, 500_000).levels("a", 0), "k"),  # type: ignore[arg-type]
+    (lambda: sequence(DataDirection.OUT, 16, 500_000).levels(5, -1), "out_word"),
+    (lambda: sequence(DataDirection.OUT, 16, 500_000).levels(5, 1 << 16), "out_word"),
+    (lambda: sequence(DataDirection.IN, 16, 500_000).frames[0].sample(16), "j"),
+    (lambda: sequence(DataDirection.IN, 16, 500_000).frames[0].slot(-1), "j"),
+    (lambda: serial_io.SerialFrame(-1, 16, True, 8), "start"),
+    (lambda: serial_io.SerialFrame(0, 12, True, 8), "bits"),
+    (lambda: serial_io.SerialFrame(0, 16, 1, 8), "write"),  # type: ignore[arg-type]
+    (lambda: serial_io.SerialFrame(0, 16, True, 7), "t0"),
+    (lambda: serial_io.SerialSequence((), None, 5), "frames"),
+    (lambda: serial_io.SerialSequence(sequence(DataDirection.IN, 16, 500_000).frames, 3, 5), "conv"),  # type: ignore[arg-type]
+    (lambda: serial_io.SerialSequence(sequence(DataDirection.IN, 16, 500_000).frames, None, 0), "length"),
+    (lambda: render("x", 0), "seq"),  # type: ignore[arg-type]
+    (lambda: Levels(2, 0, 0, 0), "Levels.conv_n"),
+    (lambda: expansion.ExpansionLevels(0, 0, 0, 0, "1"), "ExpansionLevels.res_reg_n"),  # type: ignore[arg-type]
 ])  # fmt: skip
 def test_bad_arguments_are_named(call: object, name: str) -> None:
     assert callable(call)

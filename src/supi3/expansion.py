@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from typing import Final, Protocol, runtime_checkable
 
 from supi3.checks import check_bool, check_bytes, check_int
+from supi3.serial_io import check_levels
 
 __all__ = [
     "LAIND_AFTER_LAOUD_T0",
@@ -97,6 +98,9 @@ class ExpansionLevels:
     la_ou_d: int
     la_in_d_n: int
     res_reg_n: int
+
+    def __post_init__(self) -> None:
+        check_levels(self)
 
 
 IDLE: Final = ExpansionLevels(clk_exr=0, to_exr=0, la_ou_d=0, la_in_d_n=1, res_reg_n=1)

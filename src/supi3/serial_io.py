@@ -26,7 +26,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Final, Protocol, runtime_checkable
 
-from supi3.checks import check_bits, check_choice, check_int
+from supi3.checks import check_bits, check_bool, check_choice, check_instance, check_int, fail
 from supi3.config import DataDirection
 from supi3.interbus import wire
 from supi3.tables import BIT_RATES
@@ -64,9 +64,20 @@ class Levels:
     ss_n: int
     ser_out: int
 
+    def __post_init__(self) -> None:
+        check_levels(self)
+
     def mfp(self) -> int:
         """The levels as MFP bits: /Conv MFP3, SCLK MFP4, /SS MFP5, SerOut MFP7."""
         return (self.conv_n << 3) | (self.sclk << 4) | (self.ss_n << 5) | (self.ser_out << 7)
+
+
+def check_levels(levels: object) -> None:
+    """Every field of the dataclass ``levels`` must be a pin level, 0 or 1 (:class:`Levels`, and the register
+    expansion's ``ExpansionLevels``)."""
+    for name, level in vars(levels).items():
+        if type(level) is not int or level >> 1 or level < 0:
+            check_bits(f"{type(levels).__name__}.{name}", level, 1)
 
 
 IDLE: Final = Levels(conv_n=1, sclk=0, ss_n=1, ser_out=0)
@@ -144,6 +155,17 @@ class SerialFrame:
     write: bool
     t0: int
 
+    def __post_init__(self) -> None:
+        check_int("start", self.start, 0)
+        check_choice("bits", self.bits, (16, 32), limit="Tables 2-4 to 2-6")
+        check_bool("write", self.write)
+        check_choice("t0", self.t0, tuple(t0_clocks(rate) for rate in BIT_RATES), limit="Table 3-4: 0.5 t_Bit_IBS")
+
+    def _bit(self, j: int) -> int:
+        if type(j) is not int or not 0 <= j < self.bits:
+            check_int("j", j, 0, self.bits - 1, limit=f"a bit of the {self.bits}-bit frame")
+        return j
+
     @property
     def length(self) -> int:
         """Cycles with /SS low: 9 * n * t0 (t8)."""
@@ -156,6 +178,7 @@ class SerialFrame:
 
     def slot(self, j: int) -> int:
         """The first cycle of bit ``j``'s slot (SCLK low half; SerOut changes here)."""
+        j = self._bit(j)
         return self.start + self.t0 // 2 + (j + j // 8) * self.t0
 
     def rising(self, j: int) -> int:
@@ -177,6 +200,14 @@ class SerialSequence:
     length: int
     """Cycles of the sequence; the IN word read is taken over on the edge ending cycle ``length - 1``."""
 
+    def __post_init__(self) -> None:
+        if type(self.frames) is not tuple or not self.frames or not all(
+                isinstance(frame, SerialFrame) for frame in self.frames):  # fmt: skip
+            raise fail("frames", "a non-empty tuple of SerialFrame", self.frames)
+        if self.conv is not None and (type(self.conv) is not tuple or len(self.conv) != 2):
+            raise fail("conv", "None or the (first, end) cycles of the /Conv pulse", self.conv)
+        check_int("length", self.length, 1)
+
     @property
     def read(self) -> SerialFrame | None:
         """The read frame, if any."""
@@ -189,6 +220,11 @@ class SerialSequence:
 
     def levels(self, k: int, out_word: int) -> Levels:
         """The pins in cycle ``k`` of the sequence, writing ``out_word`` (IDLE outside ``0 <= k < length``)."""
+        if type(k) is not int:
+            check_int("k", k)
+        bits = self.frames[0].bits
+        if type(out_word) is not int or out_word < 0 or out_word >> bits:
+            check_bits("out_word", out_word, bits)
         conv = 0 if self.conv is not None and self.conv[0] <= k < self.conv[1] else 1
         for frame in self.frames:
             if frame.start <= k < frame.end:
@@ -256,7 +292,6 @@ def _with_write(read: tuple[SerialFrame, ...], start: int, bits: int, t0: int) -
 
 def render(seq: SerialSequence, out_word: int) -> list[Levels]:
     """Every cycle of ``seq`` writing ``out_word`` (for figures and tests; the model computes cycles on demand)."""
-    bits = seq.frames[0].bits
-    check_bits("out_word", out_word, bits)
-    check_int("length", seq.length, 1)
+    check_instance("seq", seq, SerialSequence)
+    check_bits("out_word", out_word, seq.frames[0].bits)
     return [seq.levels(k, out_word) for k in range(seq.length)]

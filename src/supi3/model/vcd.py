@@ -22,6 +22,7 @@ CLOCK_PS = 10**12 // CLOCK_HZ
 def mfp_signals(config: DeviceConfig) -> list[tuple[int, str]]:
     """(MFP pin, VCD name) of every MFP the mode uses (Tables 3-1 to 3-6, 2-8): ``mfp4_sclk``, ``mfp5_ss_n`` (a
     leading "/" becomes ``_n``), ``mfp0_in0``; GND pins are left out."""
+    check_instance("config", config, DeviceConfig)
     named = []
     for p in config.mfp_pins:
         signal = p.signal.split(" | ")[0]
