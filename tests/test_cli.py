@@ -54,7 +54,6 @@ def test_decode_text(capsys: pytest.CaptureFixture[str]) -> None:
 @pytest.mark.parametrize("argv", [
     ["decode", "--c", "00101"],
     ["decode", "--c", "01011"],
-    ["decode", "--c", "10000", "--rf", "01"],
     ["decode", "--c", "00000", "--variant", "ls"],
     ["decode", "--c", "10000", "--clk-conf", "00"],
     ["timing", "--bit-rate", "1M"],

@@ -53,9 +53,9 @@ VALID, INVALID = _outcomes()
 def test_whole_input_space_decodes_or_raises_configuration_error() -> None:
     # Any other exception would have escaped _outcomes() and failed collection.
     assert len(VALID) + len(INVALID) == 2 * 32 * 17 * 5 * 4 * 3
-    # OPC: 77 mode rows x CLK_CONF {01, 11} x RF {open, 10, 11, 00} x DIAG_CONF {open, 0, 1};
+    # OPC: 77 mode rows x CLK_CONF {01, 11} x RF {open, 10, 11, 00, 01 (OPT-2)} x DIAG_CONF {open, 0, 1};
     # LS: the 54 rows with C4 = 1 x CLK_CONF {01, 11}, RF and DIAG_CONF absent.
-    assert len(VALID) == 77 * 2 * 4 * 3 + 54 * 2
+    assert len(VALID) == 77 * 2 * 5 * 3 + 54 * 2
 
 
 def test_every_error_names_pins_value_and_rule() -> None:
@@ -102,7 +102,6 @@ def test_every_mode_row_decodes(row: tables.ModeRow) -> None:
         ({"c": "00000", "mfp": "0000"}, "MFP[15..12]", "Table 2-7"),
         ({"c": "10000", "clk_conf": "00"}, "CLK_CONF[1..0]", "Table 1-7"),
         ({"c": "10000", "clk_conf": "10"}, "CLK_CONF[1..0]", "Table 1-7"),
-        ({"c": "10000", "rf": "01"}, "RF[1..0]", "Tables 2-2 and 2-9"),
         ({"c": "10000", "rf": "11", "variant": "ls"}, "RF[1..0]", "Table 1-4; 1.6"),
         ({"c": "10000", "diag_conf": "1", "variant": "ls"}, "DIAG_CONF", "Table 1-4; Table 3-16"),
         ({"c": "00000", "variant": "ls"}, "C4", "Tables 2-4 to 2-6, footnote *; Table 1-4"),

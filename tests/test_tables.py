@@ -296,11 +296,17 @@ def test_table_1_6_clock_timing(manual_lines: list[list[str]]) -> None:
 
 
 def test_table_2_2_and_2_9_rf_modes(manual_lines: list[list[str]]) -> None:
-    for row in tables.RF_MODES:
+    manual_rows = [row for row in tables.RF_MODES if row.rf != "01"]
+    for row in manual_rows:
         assert [*row.rf, row.rbst_ext, row.function] in manual_lines
         lbst = [f for f in manual_lines if f[:2] == list(row.rf) and f[-1].startswith(row.lbst_function)]
         assert lbst, row
-    assert {r.rf for r in tables.RF_MODES} == {"10", "11", "00"}
+    assert {r.rf for r in manual_rows} == {"10", "11", "00"}
+    # RF = 01 is the optical diagnostics mode of 1.6.2 (OPT-2): fibre, no regulation, the LBST function of RF = 00.
+    (diagnostics,) = (row for row in tables.RF_MODES if row.rf == "01")
+    assert "OPT-2" in diagnostics.function and not diagnostics.optical_regulation
+    assert diagnostics.medium == "fiber optic"
+    assert diagnostics.lbst_function == next(r.lbst_function for r in manual_rows if r.rf == "00")
 
 
 def test_tables_3_16_to_3_19_diagnostics(manual_lines: list[list[str]]) -> None:

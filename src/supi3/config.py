@@ -354,11 +354,8 @@ def _decode_rf(rf: str | None, variant: Variant) -> tables.RfMode | None:
                                      "the SUPI 3 LS has no RF pins and no optical regulation")
         return None
     rf = "11" if rf is None else rf  # CIp pull-ups (Table 1-4)
-    for row in tables.RF_MODES:
-        if row.rf == rf:
-            return row
-    raise ConfigurationError("RF[1..0]", rf, "Tables 2-2 and 2-9", "no bus connector recognition mode has this "
-                             "pattern (reserved)")
+    # Every 2-bit pattern has a row: Tables 2-2 and 2-9, and 01 for optical diagnostics (OPT-2).
+    return next(row for row in tables.RF_MODES if row.rf == rf)
 
 
 def _decode_diag(diag_conf: str | None, variant: Variant) -> tables.DiagConf | None:

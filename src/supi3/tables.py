@@ -613,8 +613,14 @@ RF_MODES: Final[tuple[RfMode, ...]] = (
            "fiber optic interface only; bit distortion monitoring",
            "Automatic bus connector recognition: Optical fiber interface, possible to switch on (LBST=1)",
            True, "fiber optic"),
+    RfMode("01", "0", "Optical power diagnostics, fiber optic interface only: fixed transmit power, MAU warning "
+           "when the reserve falls (1.6.2; this row is decision OPT-2)",
+           "Automatic bus connector recognition: Optical fiber interface, possible to switch on (LBST=1)",
+           False, "fiber optic"),
 )  # fmt: skip
-"""Tables 2-2 and 2-9. RF[1..0] = 01 has no row in either table and is reserved."""
+"""Tables 2-2 and 2-9, and RF[1..0] = 01, which neither table lists: the optical power diagnostics mode of 1.6.2
+("alternatively ... operated with optical power diagnostics"), the only mode 1.6 names without a pin pattern and the
+only pattern without a mode (OPT-2, ``docs/assumptions/optical.md``)."""
 
 # ----------------------------------------------------------------------------------------------------------------
 # Diagnostics: Tables 3-16 to 3-19
