@@ -16,12 +16,21 @@ rather than by two method calls per device (docs/interbus.md, "Ring kernel").
 
 Lines are numbered like the devices: line *k* (1..N) enters ring position *k*, line N + 1 is the return line
 into the master.
+
+A ring can be a tree (Figure 1-10, docs/interbus.md "Tree"): a :class:`Branch` is a bus terminal module (BK) with
+the devices of its branch. The data path runs into the BK, through the branch and back to the BK, then on along the
+remote bus, so the ring flattens the tree into :attr:`Ring.devices` in that order, leaving out every branch its BK
+has not in the data path (switched off by the master, closed by the BK itself, not present by LBST); it flattens
+again whenever a BK changes that. In a tree a fault belongs to the physical line it was injected on: it follows
+that line when branches are switched, and sleeps while the line is out of the data path. :class:`ReturnBreak`
+breaks a branch's return line, and behind a break in a branch with device-oriented diagnostics the devices send
+the counter telegram to the BK (2.2.2, ``wire.counter_telegram``).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass, field
 from enum import Enum
 from itertools import accumulate
@@ -58,6 +67,10 @@ class ErrorKind(Enum):
     """A device reports /StatErr (message 0BB1h, 3.6.2)."""
     WATCHDOG = "watchdog"
     """A device's layer-2 watchdog reset its process data (message 0C6Bh, Table 3-13)."""
+    RECONFIGURATION_REQUEST = "reconfiguration request"
+    """A bus terminal module's CONF input rose: a request to reconfigure the bus (2.4, Table 2-8; BK-8)."""
+    BRANCH_CLOSED = "branch closed"
+    """A bus terminal module closed its branch itself (extended BK function, 2.4; BK-3)."""
 
 
 # ----------------------------------------------------------------------------------------------------------------
@@ -134,13 +147,200 @@ class DeadLine:
         _check_cycles(self.cycles)
 
 
-Fault = BitFlip | Truncate | CorruptLoopback | DeadLine
+@dataclass(frozen=True)
+class ReturnBreak:
+    """The return line *into* ring position ``segment`` of a tree carries nothing (docs/interbus.md, "Tree").
+
+    ``segment`` is a bus terminal module (its branch's return line, from the branch's first device in a branch
+    with return, from the last in an LBD-OR branch) or a device of a branch with return lines (REMOTE, LOCAL,
+    LBD_MR) that has a device behind it in the branch (the return line from that device). The ring closed early
+    uses the return line into position *k* only when it is closed behind *k*; permanent unless ``cycles`` is given.
+    """
+
+    segment: int
+    cycles: int | None = None
+
+    def __post_init__(self) -> None:
+        check_int("segment", self.segment, 1, wire.MAX_DEVICES, _LIMIT_DEVICES)
+        _check_cycles(self.cycles)
+
+
+Fault = BitFlip | Truncate | CorruptLoopback | DeadLine | ReturnBreak
 
 
 @dataclass
 class _Active:
     fault: Fault
     remaining: int | None
+    target: object = None
+    """In a tree: the device whose incoming line the fault is on (``None``: the return line into the master)."""
+
+
+# ----------------------------------------------------------------------------------------------------------------
+# Trees: bus terminal modules and their branches (2.4, Figure 1-10)
+# ----------------------------------------------------------------------------------------------------------------
+
+
+class BranchKind(Enum):
+    """What hangs on a bus terminal module (Table 2-7; the local bus kinds of Tables 2-4, 2-5)."""
+
+    REMOTE = "BK-RB"
+    """Remote bus branch (BK-RB): remote bus devices, bus terminal modules among them; return lines."""
+    LOCAL = "BK-LB"
+    """Local bus branch without device-oriented diagnostics (BK-LB, LB-MR devices); return lines."""
+    LBD_MR = "LBD-MR"
+    """Local bus with device-oriented diagnostics, devices with return (BK-LBD; 2.2.2): the counter telegram is
+    incremented on the forward and on the looped return line."""
+    LBD_OR = "LBD-OR"
+    """Local bus with device-oriented diagnostics, devices without return (BK-LBD; loop): forward only."""
+
+    @property
+    def terminal(self) -> str:
+        """The BK interface of Table 2-7 this branch needs."""
+        return "BK-LBD" if self in (BranchKind.LBD_MR, BranchKind.LBD_OR) else self.value
+
+    @property
+    def diagnostics(self) -> bool:
+        """Device-oriented local-bus diagnostics (the counter telegram, 2.2.2)."""
+        return self in (BranchKind.LBD_MR, BranchKind.LBD_OR)
+
+
+@runtime_checkable
+class Terminal(Device, Protocol):
+    """What a ring needs from a bus terminal module (:class:`supi3.model.chip.Supi3` in a BK mode)."""
+
+    @property
+    def terminal_interface(self) -> str | None:
+        """``"BK-RB"``, ``"BK-LB"`` or ``"BK-LBD"`` (Table 2-7); ``None`` for a device that is no BK."""
+        ...
+
+    def branch_enabled(self, connected: bool) -> bool:
+        """Whether the branch is in the data path; ``connected``: a device answers on the branch."""
+        ...
+
+    def branch_returned(self, traffic: bool, count: int | None, start: float, end: float) -> None:
+        """The ring drove the whole branch from ``start`` to ``end``: the master's telegrams came back on the return
+        line (``traffic``), and the count of the counter telegram received there (``None``: none)."""
+        ...
+
+
+@dataclass(frozen=True, eq=False)
+class Branch:
+    """A bus terminal module and the devices of its branch, in data-path order (docs/interbus.md, "Tree").
+
+    Parameters
+    ----------
+    terminal:
+        The BK; its :attr:`Terminal.terminal_interface` must be the one ``kind`` needs (Table 2-7).
+    devices:
+        The branch's devices, first to last; only a remote bus branch may hold further branches.
+    kind:
+        What the branch is.
+    """
+
+    terminal: Terminal
+    devices: tuple[Device | Branch, ...]
+    kind: BranchKind
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.terminal, Terminal) or self.terminal.terminal_interface is None:
+            raise fail("terminal", "a bus terminal module (a Supi3 in a mode of Table 2-7)", self.terminal)
+        check_instance("kind", self.kind, BranchKind)
+        if self.terminal.terminal_interface != self.kind.terminal:
+            wanted = f"terminal must be a {self.kind.terminal} for a {self.kind.value} branch (Table 2-7)"
+            raise InterbusArgumentError("terminal", self.terminal,
+                                        f"{wanted}, not a {self.terminal.terminal_interface}", "Table 2-7")
+        if isinstance(self.devices, (str, bytes)) or not isinstance(self.devices, Sequence):
+            raise fail("devices", "a sequence of devices and branches", self.devices)
+        object.__setattr__(self, "devices", tuple(self.devices))
+        for k, device in enumerate(self.devices, 1):
+            if isinstance(device, Branch):
+                if self.kind is not BranchKind.REMOTE:
+                    raise fail(f"branch device {k}", "a device (only a remote bus branch holds bus terminal "
+                               "modules, 2.4)", device)  # fmt: skip
+            elif not isinstance(device, Device):
+                raise fail(f"branch device {k}", "a Device or a Branch", device)
+
+
+@dataclass(frozen=True)
+class _Span:
+    """An enabled branch in the flattened ring: the BK at index ``at``, its devices (nested ones too) at indices
+    ``at + 1 .. end - 1``; ``own`` are the indices of its own devices in order (not those of nested branches)."""
+
+    branch: Branch
+    at: int
+    end: int
+    own: tuple[int, ...]
+
+
+def _branches(items: Sequence[Device | Branch]) -> list[Branch]:
+    """Every branch of a tree, nested ones too, in data-path order."""
+    found: list[Branch] = []
+    for item in items:
+        if isinstance(item, Branch):
+            found.append(item)
+            found += _branches(item.devices)
+    return found
+
+
+def _devices(items: Sequence[Device | Branch]) -> list[Device]:
+    """Every device of a tree, enabled or not."""
+    found: list[Device] = []
+    for item in items:
+        if isinstance(item, Branch):
+            found.append(item.terminal)
+            found += _devices(item.devices)
+        else:
+            found.append(item)
+    return found
+
+
+def lbd_count(kind: BranchKind, devices: int, forward: Collection[int], back: Collection[int]) -> int | None:
+    """The count the BK of an LBD branch of ``devices`` devices receives on its return line (2.2.2, BK-6).
+
+    ``forward`` are the branch devices (1..m) whose incoming forward line is broken, ``back`` those whose incoming
+    return line is broken (0 = the BK's own return input; 1..m - 1 in LBD-MR: the line from the next device).
+    The first device behind the last break on the data path starts the count, every device after it passes the
+    counter telegram on incremented (``wire.count_on``): LBD-MR devices on the forward and on the looped return
+    line, LBD-OR devices forward only. ``None``: no counter telegram arrives (no break, or the BK's return input is
+    broken).
+    """
+    path = [("f", k) for k in range(1, devices + 1)]
+    if kind is BranchKind.LBD_MR:
+        path += [("r", k) for k in range(devices, 0, -1)]  # ("r", m): the loop inside device m, never broken
+    if 0 in back:
+        return None
+    loop = ("r", devices)
+    broken = [i for i, (way, k) in enumerate(path) if k in (forward if way == "f" else back) and (way, k) != loop]
+    if not broken:
+        return None
+    word: int | None = None
+    for _ in path[max(broken) :]:
+        word = wire.count_on(word)
+    assert word is not None
+    return wire.decode_counter_telegram(word)
+
+
+def lbd_position(kind: BranchKind, devices: int, count: int) -> tuple[int, bool] | None:
+    """Where the break is, from the count a BK read (0: none arrived): ``(k, return_line)``, the branch device
+    *k* (0: the BK) whose incoming forward line (``return_line`` False) or return line is broken; ``None`` if
+    no single break gives this count (or the count saturated). The inverse of :func:`lbd_count` (BK-7)."""
+    check_instance("kind", kind, BranchKind)
+    if not kind.diagnostics:
+        raise InterbusArgumentError("kind", kind, f"kind must be LBD_MR or LBD_OR (2.2.2), not {kind}", "2.2.2")
+    devices = check_int("devices", devices, 0, wire.COUNTER_MAX, "BK-6: counts up to 63")
+    count = check_int("count", count, 0, wire.COUNTER_MAX, "BK-5: a count is 6 bits")
+    if count == 0:
+        return 0, True
+    if count == wire.COUNTER_MAX:
+        return None
+    if kind is BranchKind.LBD_OR:
+        return (devices - count + 1, False) if count <= devices else None
+    if count < devices:
+        return count, True
+    if devices < count <= 2 * devices:
+        return 2 * devices - count + 1, False
+    return None
 
 
 # ----------------------------------------------------------------------------------------------------------------
@@ -242,6 +442,9 @@ class Transfer:
     runs: list[_Run] = field(repr=False)
     """The reached devices, in ring order, in runs that share a verdict."""
     reached: int = 0
+    branches: list[tuple[Terminal, bool, int | None]] = field(default_factory=list, repr=False)
+    """In a tree: each bus terminal module whose whole branch this cycle drove, whether the master's telegrams came
+    back on the branch's return line, and the count of the counter telegram received there."""
 
 
 @dataclass
@@ -289,7 +492,9 @@ class Ring:
     Parameters
     ----------
     devices:
-        The devices in ring order: ring position 1 is next to the master.
+        The devices in ring order: ring position 1 is next to the master. A :class:`Branch` stands for its bus
+        terminal module followed by its branch (a tree, docs/interbus.md "Tree"); :attr:`devices` is then the
+        flattened data path, recomputed when a BK switches its branch (do not edit it in a tree).
     bit_rate:
         500 000 or 2 000 000 bit/s (Table 1-7).
     record:
@@ -308,17 +513,27 @@ class Ring:
     is on that line (at pin level the return path runs through every chip, and :class:`PinRing` has neither
     attribute)."""
 
-    def __init__(self, devices: Sequence[Device], bit_rate: int = 500_000, record: bool = False) -> None:
+    def __init__(self, devices: Sequence[Device | Branch], bit_rate: int = 500_000, record: bool = False) -> None:
         if isinstance(devices, (str, bytes)) or not isinstance(devices, Sequence):
             raise fail("devices", "a sequence of devices", devices)
         self.bit_rate = wire.check_bit_rate(bit_rate)
-        if not 1 <= len(devices) <= wire.MAX_DEVICES:
+        every = _devices(devices) if all(isinstance(d, (Device, Branch)) for d in devices) else list(devices)
+        if not 1 <= len(every) <= wire.MAX_DEVICES:
             raise InterbusArgumentError("devices", devices, f"devices must be 1 to {wire.MAX_DEVICES} devices "
-                                        f"({_LIMIT_DEVICES}), not {len(devices)}", _LIMIT_DEVICES)  # fmt: skip
-        for k, device in enumerate(devices, 1):
+                                        f"({_LIMIT_DEVICES}), not {len(every)}", _LIMIT_DEVICES)  # fmt: skip
+        for k, device in enumerate(every, 1):
             if not isinstance(device, Device):
                 raise fail(f"device at ring position {k}", "a Device (load, latch, discard, ...)", device)
-        self.devices: list[Device] = list(devices)
+        if len({id(d) for d in every}) != len(every):
+            raise InterbusArgumentError("devices", devices, "devices must be distinct objects (one device is one "
+                                        "place in the ring), not the same object twice", "Tree")  # fmt: skip
+        self._tree: list[Device | Branch] = list(devices)
+        self._branches = _branches(self._tree)
+        self._enabled: tuple[bool, ...] = ()
+        self._spans: list[_Span] = []
+        self._index: dict[int, int] = {}
+        self._detached: dict[int, tuple[Device, float | None]] = {}
+        self.devices: list[Device] = [d for d in self._tree if not isinstance(d, Branch)]
         self.record = check_bool("record", record)
         self.trace: list[SegmentTrace] = []
         self.now = 0.0
@@ -330,35 +545,183 @@ class Ring:
         # device's received bytes.
         self._layout: tuple[list[type], _Groups] = ([], [])
         self._cuts: tuple[list[bytes], int, bytes, list[slice] | None, int] = ([], -1, b"", None, 0)
+        self._sync()
+
+    # -- the tree ------------------------------------------------------------------------------------------------
+
+    @property
+    def tree(self) -> bool:
+        """The ring has bus terminal modules with branches (:class:`Branch`)."""
+        return bool(self._branches)
+
+    @property
+    def spans(self) -> list[tuple[int, int, BranchKind]]:
+        """Every branch in the data path now: (ring position of its BK, ring positions its branch occupies (nested
+        ones too), kind)."""
+        return [(span.at + 1, span.end - span.at - 1, span.branch.kind) for span in self._spans]
+
+    def _sync(self) -> None:
+        """Flatten the tree again if a BK changed whether its branch is in the data path."""
+        if not self._branches:
+            return
+        enabled = tuple(b.terminal.branch_enabled(bool(b.devices)) for b in self._branches)
+        if enabled == self._enabled and self._index:
+            return
+        self._enabled = enabled
+        before = {id(self.devices[i]): t for i, t in self._silent_since.items() if i < len(self.devices)}
+        was_reset = {id(self.devices[i]) for i in self._silent_reset if i < len(self.devices)}
+        flat: list[Device] = []
+        spans: list[_Span] = []
+
+        def walk(items: Sequence[Device | Branch]) -> None:
+            for item in items:
+                if not isinstance(item, Branch):
+                    flat.append(item)
+                    continue
+                at = len(flat)
+                flat.append(item.terminal)
+                if item.terminal.branch_enabled(bool(item.devices)):
+                    own = []
+                    for device in item.devices:
+                        own.append(len(flat))
+                        walk((device,))
+                    spans.append(_Span(item, at, len(flat), tuple(own)))
+
+        walk(self._tree)
+        self.devices = flat
+        self._spans = sorted(spans, key=attrgetter("at"))
+        self._index = {id(d): i for i, d in enumerate(flat)}
+        self._silent_since = {self._index[k]: t for k, t in before.items() if k in self._index}
+        self._silent_reset = {self._index[k] for k in was_reset if k in self._index}
+        for device in _devices(self._tree):
+            if id(device) not in self._index:
+                self._detached.setdefault(id(device), (device, None))
+            else:
+                self._detached.pop(id(device), None)
+
+    def _silence_detached(self, start: float, end: float) -> None:
+        """Devices of switched-off branches hear nothing: poll them, reset after the timeout (A13)."""
+        for key, (device, since) in list(self._detached.items()):
+            since = start if since is None else since
+            if since >= 0.0 and end - since >= wire.IDLE_TIMEOUT_S:
+                device.reset(since + wire.IDLE_TIMEOUT_S)
+                since = -1.0  # reset once
+            self._detached[key] = (device, since)
+            device.poll(end)
+
+    def _where(self, active: _Active) -> int | None:
+        """The line a fault is on now (``None``: out of the data path); in a tree the line follows its device."""
+        if not self._branches:
+            return active.fault.segment
+        if active.target is None:
+            return len(self.devices) + 1
+        index = self._index.get(id(active.target))
+        return None if index is None else index + 1
+
+    def _span_of(self, index: int, own: bool) -> _Span | None:
+        """The innermost enabled branch whose BK (``own``) or whose device is at ``index``."""
+        found = None
+        for span in self._spans:
+            if (own and span.at == index) or (not own and span.at < index < span.end):
+                found = span
+        return found
+
+    def _returns(self, returns: list[int], close: int | None) -> tuple[int | None, bool]:
+        """The effect of broken return lines (``returns``: 1-based positions) on a transfer closed after ``close``
+        (``None``: the whole ring): the first line that carries nothing on the way on (or ``None``), and whether
+        nothing comes back from inside a branch the ring is closed in."""
+        dead: int | None = None
+        back_dead = False
+        for position in returns:
+            span = self._span_of(position - 1, True) or self._span_of(position - 1, False)
+            if span is None or not (close is None or close > position):
+                continue
+            if close is None or close > span.end:
+                dead = span.end + 1 if dead is None else min(dead, span.end + 1)
+            else:
+                back_dead = True
+        return dead, back_dead
+
+    def _reports(self, reached: int, close: int | None, dead_lines: list[int],
+                 returns: list[int]) -> list[tuple[Terminal, bool, int | None]]:
+        """What each BK whose whole branch was driven receives on its branch return line (docs/interbus.md,
+        "Counter telegram")."""
+        reports: list[tuple[Terminal, bool, int | None]] = []
+        for span in self._spans:
+            if span.at >= reached or not (close is None or close >= span.end):
+                continue
+            forward = [s for s in dead_lines if span.at + 2 <= s <= span.end]
+            back = [p - 1 for p in returns if span.at <= p - 1 < span.end]
+            count = None
+            if span.branch.kind.diagnostics:
+                own = list(span.own)
+                count = lbd_count(span.branch.kind, len(own), {own.index(s - 1) + 1 for s in forward},
+                                  {0 if i == span.at else own.index(i) + 1 for i in back})  # fmt: skip
+            reports.append((span.branch.terminal, not forward and not back, count))
+        return reports
 
     # -- faults --------------------------------------------------------------------------------------------------
 
     def inject(self, fault: Fault) -> None:
-        """Add a fault. Lines are 1..N + 1 (N + 1: the return line into the master)."""
-        if not isinstance(fault, (BitFlip, Truncate, CorruptLoopback, DeadLine)):
-            raise fail("fault", "a BitFlip, Truncate, CorruptLoopback or DeadLine", fault)
-        if not 1 <= fault.segment <= len(self.devices) + 1:
+        """Add a fault. Lines are 1..N + 1 (N + 1: the return line into the master); a :class:`ReturnBreak` only in
+        a tree, on a return line that exists (docs/interbus.md, "Tree")."""
+        if not isinstance(fault, (BitFlip, Truncate, CorruptLoopback, DeadLine, ReturnBreak)):
+            raise fail("fault", "a BitFlip, Truncate, CorruptLoopback, DeadLine or ReturnBreak", fault)
+        self._sync()
+        n = len(self.devices)
+        if not 1 <= fault.segment <= n + (0 if isinstance(fault, ReturnBreak) else 1):
             raise InterbusError("docs/interbus.md, Fault injection", fault.segment,
-                                f"line must be in 1..{len(self.devices) + 1}")  # fmt: skip
-        self._faults.append(_Active(fault, fault.cycles))
+                                f"line must be in 1..{n + (0 if isinstance(fault, ReturnBreak) else 1)}")  # fmt: skip
+        if isinstance(fault, ReturnBreak):
+            index = fault.segment - 1
+            own = self._span_of(index, True)
+            inner = self._span_of(index, False)
+            has_return = own is not None or (inner is not None and inner.branch.kind is not BranchKind.LBD_OR
+                                             and index < inner.end - 1)  # fmt: skip
+            if not has_return:
+                raise InterbusError("docs/interbus.md, Tree", fault.segment,
+                                    "a return line enters only a BK with its branch on, or a device of a branch with "
+                                    "return lines that has a device behind it")  # fmt: skip
+        target = None if fault.segment > n else self.devices[fault.segment - 1]
+        self._faults.append(_Active(fault, fault.cycles, target))
 
     def clear_faults(self) -> None:
         """Remove every injected fault."""
         self._faults.clear()
 
-    def _faults_on(self, segments: int) -> dict[int, list[Fault]]:
+    def _faults_on(self, segments: int) -> tuple[dict[int, list[Fault]], list[int]]:
+        """The faults on lines 1..``segments`` now, by line, and the positions whose return line is broken; each
+        counts one of its cycles."""
         hits: dict[int, list[Fault]] = {}
+        returns: list[int] = []
         for active in self._faults:
-            if active.fault.segment <= segments:
-                hits.setdefault(active.fault.segment, []).append(active.fault)
-                if active.remaining is not None:
-                    active.remaining -= 1
+            where = self._where(active)
+            if where is None:
+                continue
+            if isinstance(active.fault, ReturnBreak):
+                returns.append(where)
+            elif where <= segments:
+                hits.setdefault(where, []).append(active.fault)
+            else:
+                continue
+            if active.remaining is not None:
+                active.remaining -= 1
         self._faults = [a for a in self._faults if a.remaining is None or a.remaining > 0]
-        return hits
+        return hits, returns
 
     def _first_dead(self) -> int | None:
-        dead = [a.fault.segment for a in self._faults if isinstance(a.fault, DeadLine)]
+        """The first line that carries nothing on the whole ring (broken return lines of branches too)."""
+        dead = [w for a in self._faults if isinstance(a.fault, DeadLine) and (w := self._where(a)) is not None]
+        returns = [w for a in self._faults if isinstance(a.fault, ReturnBreak) and (w := self._where(a)) is not None]
+        first, _ = self._returns(returns, None)
+        dead += [] if first is None else [first]
         return min(dead) if dead else None
+
+    def _idle_reports(self, reached: int) -> list[tuple[Terminal, bool, int | None]]:
+        """``_reports`` for the whole ring without counting a fault's cycles (idle telegrams, no frame)."""
+        dead = [w for a in self._faults if isinstance(a.fault, DeadLine) and (w := self._where(a)) is not None]
+        returns = [w for a in self._faults if isinstance(a.fault, ReturnBreak) and (w := self._where(a)) is not None]
+        return self._reports(reached, None, dead, returns)
 
     # -- one line ------------------------------------------------------------------------------------------------
 
@@ -479,6 +842,7 @@ class Ring:
             Hand it to :meth:`finish` with the master's verdict.
         """
         check_instance("cycle", cycle, Cycle)
+        self._sync()
         n_all = len(self.devices)
         if n_all > wire.MAX_DEVICES:
             raise InterbusError("docs/interbus.md, Ring", n_all, f"a ring has at most {wire.MAX_DEVICES} devices")
@@ -487,8 +851,13 @@ class Ring:
         # Closed after a position (even the last), the ring returns inside that device: the return line N + 1
         # is only part of the whole ring (close_after=None), so a fault there is told from one on line N.
         segments = n + 1 if close_after is None else n
-        faults = self._faults_on(segments) if self._faults else {}
-        dead = min((s for s, fs in faults.items() if any(isinstance(f, DeadLine) for f in fs)), default=None)
+        faults, returns = self._faults_on(segments) if self._faults else ({}, [])
+        dead_lines = [s for s, fs in faults.items() if any(isinstance(f, DeadLine) for f in fs)]
+        dead = min(dead_lines, default=None)
+        back_dead = False
+        if returns:
+            first, back_dead = self._returns(returns, None if close_after is None else n)
+            dead = first if dead is None or (first is not None and first < dead) else dead
         self.trace = []
         record = self.record
         now = self.now
@@ -534,7 +903,7 @@ class Ring:
         returned: bytes | None = None
         receiver_error: ErrorKind | None = None
         flags_back = wire.CntrFlags(attention, error)
-        if dead is None or dead > segments:
+        if (dead is None or dead > segments) and not back_dead:
             sent = _Line(stream, crc, wire.cntr_word(attention, error))
             last = n + 1
             if record or last in faults:
@@ -546,8 +915,10 @@ class Ring:
             returned = sent.stream
         elif record:
             silent = _Line(stream, crc, wire.cntr_word(attention, error))
-            self.trace.append(SegmentTrace(dead, silent.frame(cycle), None, None))
-        return Transfer(cycle, bytes(data), n, returned, flags_back, receiver_error, runs, len(devices))
+            self.trace.append(SegmentTrace(segments if dead is None else dead, silent.frame(cycle), None, None))
+        reports = self._reports(len(devices), None if close_after is None else n, dead_lines, returns) \
+            if self._spans else []
+        return Transfer(cycle, bytes(data), n, returned, flags_back, receiver_error, runs, len(devices), reports)
 
     def finish(self, transfer: Transfer, latch: bool) -> None:
         """End a cycle with the master's verdict: the latch telegrams (``latch``) or idle telegrams.
@@ -576,6 +947,11 @@ class Ring:
                 self._silent_reset.discard(index)
         self._go_silent(range(transfer.reached, len(self.devices)), start, end)
         self.now = end
+        if self._branches:
+            for terminal, traffic, count in transfer.branches:
+                terminal.branch_returned(traffic, count, start, end)
+            self._silence_detached(start, end)
+            self._sync()
 
     @staticmethod
     def _latch_run(run: _Run, groups: _Groups, end: float) -> None:
@@ -602,21 +978,31 @@ class Ring:
 
     def reset(self) -> None:
         """An INTERBUS reset (the master's Alarm Stop, 1303h): reset pattern, then idle (assumption A12)."""
+        self._sync()
         dead = self._first_dead()
         reached = len(self.devices) if dead is None else min(len(self.devices), dead - 1)
         end = self.now + wire.reset_bits(len(self.devices)) / self.bit_rate
         for device in self.devices[:reached]:
             device.reset(end)
         self._go_silent(range(reached, len(self.devices)), self.now, end)
+        if self._branches:
+            self._silence_detached(self.now, end)
         self.now = end
+        self._sync()
 
     def idle(self, seconds: float) -> None:
         """The master sends only idle status telegrams for ``seconds`` (no cycles)."""
         seconds = check_real("seconds", seconds, 0.0)
+        self._sync()
         dead = self._first_dead()
         reached = len(self.devices) if dead is None else min(len(self.devices), dead - 1)
         end = self.now + seconds
         for device in self.devices[:reached]:
             device.poll(end)
         self._go_silent(range(reached, len(self.devices)), self.now, end)
+        if self._branches:
+            for terminal, traffic, count in self._idle_reports(reached):
+                terminal.branch_returned(traffic, count, self.now, end)
+            self._silence_detached(self.now, end)
         self.now = end
+        self._sync()

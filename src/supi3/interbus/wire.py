@@ -87,6 +87,11 @@ CMD_PCMD_BIT: Final = 4  # bits 15..8 carry a processor command byte
 CMD_ALARM_BIT: Final = 5  # send the processor alarm in the next ID cycle
 CMD_PCMD_SHIFT: Final = 8
 
+# BK-4 Branch control in the command word of a bus terminal module (BK, Table 2-7; docs/assumptions/bus-terminal.md):
+# a 2-bit field, 0 = leave the branch alone, 1 = switch it off, 2 = switch it on, 3 = switch it on with the
+# extended BK function (2.4: the BK closes a silent branch by itself). Bits 7..6 had no meaning before.
+CMD_BRANCH_SHIFT: Final = 6
+
 # A10 Each device repeats the line with this delay; it may look this many bits minus one ahead (mid-bit sampling).
 REPEATER_DELAY_BITS: Final = 3
 
@@ -333,8 +338,22 @@ def id_register(id_code: int, length_code: int, management: int = 0) -> int:
     return management | (length_code << 8) | id_code
 
 
+class BranchControl(Enum):
+    """What the master tells a bus terminal module to do with its branch (command word bits 7..6, BK-4)."""
+
+    NONE = 0
+    """Leave the branch as it is."""
+    OFF = 1
+    """Switch the branch off: it leaves the data path."""
+    ON = 2
+    """Switch the branch on, without the extended BK function."""
+    ON_EXTENDED = 3
+    """Switch the branch on and activate the extended BK function (2.4)."""
+
+
 def command_word(watchdog_code: int | None = None, quit_peripheral_error: bool = False,
-                 processor_command: int | None = None, alarm_request: bool = False) -> int:
+                 processor_command: int | None = None, alarm_request: bool = False,
+                 branch: BranchControl = BranchControl.NONE) -> int:
     """Compose the 16-bit command word the master shifts into a device in an ID cycle (assumptions A9, A18).
 
     Parameters
@@ -347,9 +366,14 @@ def command_word(watchdog_code: int | None = None, quit_peripheral_error: bool =
     processor_command:
         A byte for the device's processor command register (management channel, 3.4.9), or ``None``.
     alarm_request:
-        Ask the device to send its processor alarm register in the next ID cycle (3.4.9).
+        Ask the device to send its processor alarm register in the next ID cycle (3.4.9); a bus terminal module
+        without a µP sends its branch status byte (:func:`bk_status`, BK-5).
+    branch:
+        A bus terminal module's branch control (BK-4).
     """
-    word = 0
+    if type(branch) is not BranchControl:
+        branch = checked(check_instance, "branch", branch, BranchControl, "a BranchControl")
+    word = branch.value << CMD_BRANCH_SHIFT
     quit_peripheral_error = _flag("quit_peripheral_error", quit_peripheral_error)
     alarm_request = _flag("alarm_request", alarm_request)
     if processor_command is not None:
@@ -375,6 +399,7 @@ class CommandWord(NamedTuple):
     quit_peripheral_error: bool
     processor_command: int | None = None
     alarm_request: bool = False
+    branch: BranchControl = BranchControl.NONE
 
 
 def decode_command_word(word: int) -> CommandWord:
@@ -382,7 +407,79 @@ def decode_command_word(word: int) -> CommandWord:
     word = _int("word", word, 0, 0xFFFF, "a command word is 16 bits")
     code = (word >> CMD_WD_CODE_SHIFT) & 0b11 if _bit(word, CMD_WD_SET_BIT) else None
     pcmd = (word >> CMD_PCMD_SHIFT) & 0xFF if _bit(word, CMD_PCMD_BIT) else None
-    return CommandWord(code, bool(_bit(word, CMD_QUIT_BIT)), pcmd, bool(_bit(word, CMD_ALARM_BIT)))
+    branch = BranchControl((word >> CMD_BRANCH_SHIFT) & 0b11)
+    return CommandWord(code, bool(_bit(word, CMD_QUIT_BIT)), pcmd, bool(_bit(word, CMD_ALARM_BIT)), branch)
+
+
+# ================================================================================================================
+# Bus terminal modules: the counter telegram of device-oriented local-bus diagnostics and the branch status byte
+# (manual 2.2.2, 2.4; docs/interbus.md "Counter telegram"; docs/assumptions/bus-terminal.md BK-5..BK-7)
+# ================================================================================================================
+
+# BK-6 The counter telegram: a data telegram with select = ID and control = check, sent outside any frame by the
+# first device behind a break in place of idle status telegrams; its byte is the count, COUNTER_MARK in bits 7..6.
+COUNTER_CYCLE: Final = Cycle.ID
+COUNTER_CHECK: Final = True
+COUNTER_MARK: Final = 0b10 << 6
+COUNTER_MAX: Final = 0x3F
+"""The count saturates here (6 bits); a saturated count locates nothing (BK-6)."""
+
+# BK-5 The branch status byte a bus terminal module without a µP sends in place of its ID code when asked (command
+# word bit 5): bit 7 a reconfiguration request (CONF edge) waits, bit 6 the BK closed its branch itself
+# (extended function), bits 5..0 the last count received on the branch return line (0: none).
+BK_STATUS_CONF_BIT: Final = 7
+BK_STATUS_CLOSED_BIT: Final = 6
+
+
+def counter_telegram(count: int) -> int:
+    """Encode the counter telegram carrying ``count`` (1..``COUNTER_MAX``) as a data telegram (BK-6)."""
+    count = _int("count", count, 1, COUNTER_MAX, "BK-6: a counter telegram counts 1..63 devices")
+    return data_telegram(COUNTER_MARK | count, COUNTER_CYCLE, COUNTER_CHECK)
+
+
+def decode_counter_telegram(word: int) -> int | None:
+    """The count of a counter telegram, ``None`` if ``word`` is no counter telegram (BK-6)."""
+    word = _int("word", word, 0, (1 << DATA_TELEGRAM_BITS) - 1, "a data telegram is 13 bit periods")
+    try:
+        telegram = decode_telegram(word, DATA_TELEGRAM_BITS)
+    except TelegramError:
+        return None
+    if telegram.data is None or (telegram.cycle, telegram.check) != (COUNTER_CYCLE, COUNTER_CHECK):
+        return None
+    if telegram.data & ~COUNTER_MAX != COUNTER_MARK or telegram.data & COUNTER_MAX == 0:
+        return None
+    return telegram.data & COUNTER_MAX
+
+
+def count_on(word: int | None) -> int:
+    """What a device behind a break sends on: ``None`` (it receives nothing: it is the first behind the break)
+    starts the count at 1, a counter telegram is passed on incremented, saturating at ``COUNTER_MAX`` (BK-6)."""
+    count = 0 if word is None else decode_counter_telegram(word)
+    if count is None:
+        raise InterbusError("docs/interbus.md, Counter telegram", word, "a device passes on counter telegrams only")
+    return counter_telegram(min(count + 1, COUNTER_MAX))
+
+
+class BkStatus(NamedTuple):
+    """A decoded branch status byte (BK-5)."""
+
+    conf_request: bool
+    closed: bool
+    counter: int
+
+
+def bk_status(conf_request: bool, closed: bool, count: int) -> int:
+    """Compose the branch status byte (BK-5); ``count`` 0..``COUNTER_MAX``, 0 for none received."""
+    conf_request = _flag("conf_request", conf_request)
+    closed = _flag("closed", closed)
+    count = _int("count", count, 0, COUNTER_MAX, "BK-5: the count is 6 bits")
+    return (conf_request << BK_STATUS_CONF_BIT) | (closed << BK_STATUS_CLOSED_BIT) | count
+
+
+def decode_bk_status(byte: int) -> BkStatus:
+    """Inverse of :func:`bk_status`."""
+    byte = _int("byte", byte, 0, 0xFF, "BK-5: the status is one byte")
+    return BkStatus(bool(_bit(byte, BK_STATUS_CONF_BIT)), bool(_bit(byte, BK_STATUS_CLOSED_BIT)), byte & COUNTER_MAX)
 
 
 # ================================================================================================================

@@ -39,6 +39,7 @@ from supi3.expansion import PULSE_T0, ExternalRegisters, end_pulses
 from supi3.interbus import wire
 from supi3.interbus.link import DataKernel
 from supi3.interbus.wire import Cycle
+from supi3.model.blocks.bus_terminal import BusTerminal
 from supi3.model.registers import RegisterFile
 from supi3.serial_io import SerialDevice, SerialSequence, clear_sequence, sequence
 
@@ -291,6 +292,7 @@ class Supi3:
         self.io_access = False
         self._send_alarm = False
         self._exr_free = 0
+        self._init_bus_terminal()
         self._reschedule()
 
     def _clock(self) -> int:
@@ -329,6 +331,7 @@ class Supi3:
     def set_mfp_inputs(self, levels: int) -> None:
         """Drive the MFP[15..0] input pins (binary I/O modes sample them when a data cycle begins)."""
         self.mfp_in = _checked(check_bits, "levels", levels, 16, "MFP[15..0]")
+        self._bus_terminal_inputs()
 
     @property
     def mfp_outputs(self) -> int:
@@ -368,7 +371,7 @@ class Supi3:
             if self._send_alarm:  # the master asked for the processor alarm (3.4.9, docs/interbus.md A18)
                 word = (word & ~0xFF) | self.registers.processor_alarm
             return word
-        return (self.config.length_code << 8) | self.config.id_code
+        return (self.config.length_code << 8) | self._bus_terminal_id_code()
 
     def management(self) -> int:
         """Management bits 15..13 of the ID register: PF, WD, TE (docs/interbus.md, assumption A8)."""
@@ -551,6 +554,84 @@ class Supi3:
             self._chain.clear()
 
     # --------------------------------------------------------------------------------------------------------
+    # Bus terminal module (2.4, Tables 2-7..2-9; supi3.model.blocks.bus_terminal, docs/assumptions/bus-terminal.md)
+    # --------------------------------------------------------------------------------------------------------
+    # In the BK modes the chip owns a BusTerminal (self.bus_terminal, None in every other mode). The hooks in the
+    # methods above are one line each: power_up -> _init_bus_terminal, set_mfp_inputs -> _bus_terminal_inputs,
+    # _id_and_length -> _bus_terminal_id_code, latch_at (ID cycle) -> _bus_terminal_command, reset_at ->
+    # _bus_terminal_reset. The ring (supi3.interbus.ring.Branch) asks terminal_interface, branch_enabled and
+    # reports branch_returned.
+
+    def _init_bus_terminal(self) -> None:
+        """Power-up: a fresh BK state in the BK modes, taking the MFP input levels as they are (no CONF edge)."""
+        interface = self.config.interface
+        self.bus_terminal = BusTerminal(interface.value, self.config.rf_mode.rf if self.config.rf_mode else None) \
+            if interface.is_bus_terminal else None
+        if self.bus_terminal is not None:
+            self.bus_terminal.inputs(self.mfp_in)
+            self.bus_terminal.conf_request = False
+
+    def _bus_terminal_inputs(self) -> None:
+        """MFP inputs changed: LBST and CONF; a CONF rising edge asks for the master's attention (BK-8)."""
+        if self.bus_terminal is not None and self.bus_terminal.inputs(self.mfp_in):
+            self.attention = True
+            self.revision += 1
+
+    def _bus_terminal_id_code(self) -> int:
+        """Bits 7..0 of the ID register outside the µP modes: the ID code, or the branch status byte when the
+        master asked for it in the last ID cycle (BK-5)."""
+        if self._send_alarm and self.bus_terminal is not None:
+            return self.bus_terminal.status()
+        return self.config.id_code
+
+    def _bus_terminal_command(self, command: wire.CommandWord) -> None:
+        """A latched ID cycle's command word: branch control, acknowledgement, status request (BK-4, BK-5, BK-8)."""
+        if self.bus_terminal is not None:
+            self.bus_terminal.command(command.branch, command.quit_peripheral_error)
+            if self.registers is None:
+                self._send_alarm = command.alarm_request
+
+    def _bus_terminal_reset(self) -> bool:
+        """INTERBUS reset (BK-9); ``True`` while a reconfiguration request still waits (it keeps ATTN)."""
+        if self.bus_terminal is None:
+            return False
+        self.bus_terminal.reset()
+        return self.bus_terminal.conf_request
+
+    @property
+    def terminal_interface(self) -> str | None:
+        """``"BK-RB"``, ``"BK-LB"`` or ``"BK-LBD"`` in the BK modes of Table 2-7, else ``None``."""
+        return None if self.bus_terminal is None else self.bus_terminal.interface
+
+    def branch_enabled(self, connected: bool) -> bool:
+        """Whether the branch is in the data path (present by Table 2-9, switched on, not closed by the BK);
+        ``connected``: a device answers on the branch.
+
+        Raises
+        ------
+        ChipError
+            The chip is not in a BK mode (Table 2-7).
+        """
+        return self._terminal().enabled(_checked(check_bool, "connected", connected))
+
+    def branch_returned(self, traffic: bool, count: int | None, start: float, end: float) -> None:
+        """The ring drove the branch from ``start`` to ``end`` (bus seconds): ``traffic`` says whether the master's
+        telegrams came back on the return line, ``count`` is the counter telegram's count received there (``None``:
+        none). The extended function may close the branch; that asks for the master's attention (BK-3)."""
+        if count is not None:
+            _checked(check_int, "count", count, 1, wire.COUNTER_MAX, "BK-6: a counter telegram counts 1..63")
+        terminal = self._terminal()
+        if _checked(terminal.returned, traffic, count, start, end):
+            self.attention = True
+            self.revision += 1
+
+    def _terminal(self) -> BusTerminal:
+        if self.bus_terminal is None:
+            raise ChipError(f"the chip must be in a bus terminal mode (Table 2-7) for a branch, not "
+                            f"{self.config.function!r}")
+        return self.bus_terminal
+
+    # --------------------------------------------------------------------------------------------------------
     # Time
     # --------------------------------------------------------------------------------------------------------
 
@@ -696,6 +777,7 @@ class Supi3:
                 if command.processor_command is not None:
                     self.registers.processor_command(command.processor_command)
                 self._send_alarm = command.alarm_request
+            self._bus_terminal_command(command)
             self.wd = self.te = self.attention = False
             if self.expansion:
                 self._expansion_end(clk, None)
@@ -731,7 +813,7 @@ class Supi3:
         self._reschedule()
         self._send_alarm = False
         self.wd = self.te = False
-        self.attention = self.pf
+        self.attention = self.pf or self._bus_terminal_reset()
         self.bus_active = False
         self._events["IB_RESET"] += 1
         if self.registers is not None:
