@@ -11,14 +11,22 @@ from __future__ import annotations
 from collections.abc import Collection
 from dataclasses import dataclass
 from enum import Enum
+from itertools import takewhile
 from typing import Final
 
 from supi3.checks import check_bool, check_bytes, check_int, check_real, fail
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusError
-from supi3.interbus.ring import Bus, ErrorKind, Transfer
-from supi3.interbus.wire import Cycle
-from supi3.tables import ID_CODES, LENGTH_CODE_BY_VALUE, UP_NOT_READY_ID_CODES, WATCHDOG_TIMEOUTS_S, IdCode
+from supi3.interbus.ring import BranchKind, Bus, ErrorKind, Transfer, lbd_position
+from supi3.interbus.wire import BranchControl, Cycle
+from supi3.tables import (
+    ID_CODES,
+    LENGTH_CODE_BY_VALUE,
+    MODE_ROWS,
+    UP_NOT_READY_ID_CODES,
+    WATCHDOG_TIMEOUTS_S,
+    IdCode,
+)
 
 # Firmware service and message codes named in the manual (3.4.14 Table 3-13, 3.6.2, Table 2-8).
 ALARM_STOP: Final = 0x1303
@@ -34,6 +42,15 @@ REDISCOVER: Final = True
 DIAGNOSTICS_KEPT: Final = 1000
 
 _LIMIT_DEVICES: Final = "manual: at most 512 devices in a ring"
+
+BK_LBD_ID_CODE: Final = next(row.id_code for row in MODE_ROWS if row.function.startswith("BK-LBD"))
+"""04h, the bus terminal module with a local bus branch with device-oriented diagnostics (Table 2-7)."""
+STATUS_TERMINAL_ID_CODES: Final = frozenset(
+    row.id_code for row in MODE_ROWS if row.table == "2-7" and "Init" not in row.function
+)
+"""The BKs without a µP (0Ch, 08h, 04h, Table 2-7): they answer a status request with their branch status (BK-5)."""
+LBD_OR_ID_CODES: Final = frozenset(row.id_code for row in MODE_ROWS if row.function.startswith("LBD-OR"))
+"""The ID codes of LBD-OR devices (Table 2-5): a BK-LBD branch of them has no return lines (BK-7)."""
 
 
 class InterfaceType(Enum):
@@ -125,6 +142,8 @@ class Diagnostic:
     device: str | None
     code: int | None
     detail: str
+    return_line: bool = False
+    """The fault is on the *return* line into ``location`` (an LBD branch's, found by the counter telegram)."""
 
 
 @dataclass(frozen=True)
@@ -207,6 +226,11 @@ class Master:
         self._alarm_expected: set[int] = set()
         self.processor_alarms: dict[int, int] = {}
         """Ring position -> the last processor alarm byte read from it (management channel, 3.4.9)."""
+        self.branch_status: dict[int, wire.BkStatus] = {}
+        """Ring position of a BK without µP -> its last branch status (BK-5), read after each configuration and
+        after ATTN."""
+        self._branch: dict[int, BranchControl] = {}
+        self._reconfigure = False
 
     # -- services ------------------------------------------------------------------------------------------------
 
@@ -226,6 +250,8 @@ class Master:
         self._pcmd.clear()
         self._alarm_request.clear()
         self._alarm_expected.clear()
+        self._branch.clear()
+        self._reconfigure = False
         self._watchdog_pending = self._watchdog_code is not None
 
     def start(self) -> CycleResult:
@@ -263,6 +289,31 @@ class Master:
         """Read a device's processor alarm register (management channel, 3.4.9): the request goes out with the
         next ID cycle and the value comes back in the one after, into :attr:`processor_alarms` (A18)."""
         self._alarm_request.add(self.entry(position).ring_position)
+
+    def switch_branch(self, position: int | str, on: bool, extended: bool = False) -> None:
+        """Switch a bus terminal module's branch off or on (2.4), on with the extended BK function if ``extended``
+        (the BK then closes its branch itself when its return line stays silent, BK-3).
+
+        Sent in the BK's command word of the next ID cycle (BK-4); once latched, the master reads the configuration
+        anew (a discovery ID cycle, no configuration error) and the OUT data start from zeros.
+
+        Raises
+        ------
+        InterbusArgumentError
+            ``on`` or ``extended`` is not a bool.
+        InterbusError
+            No such device, or it is no bus terminal module (Table 2-7), or ``extended`` with ``on`` False.
+        """
+        on = check_bool("on", on)
+        extended = check_bool("extended", extended)
+        entry = self.entry(position)
+        if entry.interface is not InterfaceType.BUS_TERMINAL:
+            raise InterbusError("Table 2-7", position, f"device {entry.number} must be a bus terminal module to "
+                                f"switch a branch, not ID code {entry.id_code:02X}h")  # fmt: skip
+        if extended and not on:
+            raise InterbusError("2.4", extended, "the extended BK function is activated with the branch on")
+        control = BranchControl.OFF if not on else BranchControl.ON_EXTENDED if extended else BranchControl.ON
+        self._branch[entry.ring_position] = control
 
     # -- process data --------------------------------------------------------------------------------------------
 
@@ -305,7 +356,7 @@ class Master:
         if self.stopped:
             raise InterbusError("docs/interbus.md, Configuration changes", "rediscover=False",
                                 "the configuration changed and the master waits for start()")  # fmt: skip
-        pending = self._pcmd or self._alarm_request or self._alarm_expected or self._recover
+        pending = self._pcmd or self._alarm_request or self._alarm_expected or self._recover or self._branch
         if self.config is None or self._attention or self._watchdog_pending or self._quit or pending:
             return self.id_cycle()
         return self.data_cycle()
@@ -330,6 +381,8 @@ class Master:
         if self.config is None:
             return self._discovery()
         config = self.config
+        if self._attention:  # who asked? the BKs tell in their branch status (BK-5)
+            self._alarm_request.update(_terminals(config))
         words = [self._command(entry.ring_position) for entry in reversed(config)]
         data = wire.LOOPBACK_BYTES_ON_LINE + b"".join(wire.word_bytes(w) for w in words)
         transfer = self.ring.transfer(Cycle.ID, data)
@@ -346,9 +399,13 @@ class Master:
         self._watchdog_pending = False
         self._quit.clear()
         self._pcmd.clear()
-        self._take_alarms(registers, sent=True)
-        messages = self._messages(registers)
+        replan = bool(self._branch) or self._reconfigure
+        self._branch.clear()
+        self._reconfigure = False
+        messages = self._take_alarms(registers, sent=True) + self._messages(registers)
         self._record(messages)
+        if replan:  # a branch switched, or a reconfiguration request acknowledged: read the configuration anew
+            self._set_config(None)
         return CycleResult(Cycle.ID, True, messages)
 
     # -- internals -----------------------------------------------------------------------------------------------
@@ -361,7 +418,8 @@ class Master:
     def _command(self, ring_position: int) -> int:
         code = self._watchdog_code if self._watchdog_pending else None
         return wire.command_word(code, ring_position in self._quit, self._pcmd.get(ring_position),
-                                 ring_position in self._alarm_request)
+                                 ring_position in self._alarm_request,
+                                 self._branch.get(ring_position, BranchControl.NONE))  # fmt: skip
 
     def _set_config(self, config: tuple[ConfigEntry, ...] | None) -> None:
         self.config = config
@@ -393,6 +451,8 @@ class Master:
             return self._failed(Cycle.ID, problem)
         self._set_config(config)
         self.stopped = self._recover = False
+        self.branch_status.clear()
+        self._alarm_request.update(_terminals(config or ()))  # read every BK's branch status (BK-5)
         messages = self._messages(registers)
         self._record(messages)
         return CycleResult(Cycle.ID, True, messages)
@@ -449,7 +509,7 @@ class Master:
     def _with_device(self, d: Diagnostic) -> Diagnostic:
         config = self.config or ()
         device = config[d.location - 1].number if d.location is not None and d.location <= len(config) else None
-        return Diagnostic(d.kind, d.location, device, d.code, d.detail)
+        return Diagnostic(d.kind, d.location, device, d.code, d.detail, d.return_line)
 
     def _locate(self, problem: Diagnostic, trusted: bool) -> Diagnostic:
         """Locate the error of a failed cycle: read the TE bits in a diagnostic ID cycle; if the ring answers
@@ -467,8 +527,7 @@ class Master:
         self.ring.finish(transfer, check is None)
         if check is None:
             self._recover = False
-            self._take_alarms(registers, sent=False)
-            self._record(self._messages(registers))
+            self._record(self._take_alarms(registers, sent=False) + self._messages(registers))
             return _from_te(problem, registers, "diagnostic ID cycle", trusted)
         if check.kind is ErrorKind.CONFIGURATION:
             return _changed(problem, check.location, check.detail)
@@ -497,8 +556,7 @@ class Master:
         where = _first_difference(config, registers, self._alarm_expected)
         if where is not None:
             return _changed(problem, where, f"{len(registers)} devices answer, the table has {len(config)}")
-        self._take_alarms(registers, sent=False)
-        self._record(self._messages(registers))
+        self._record(self._take_alarms(registers, sent=False) + self._messages(registers))
         return _from_te(problem, registers, "discovery-sized ID cycle", trusted)
 
     def _search(self, problem: Diagnostic) -> Diagnostic:
@@ -524,9 +582,36 @@ class Master:
         if failed.kind is ErrorKind.CONFIGURATION:
             return _changed(problem, failed.location, failed.detail)
         where = "the return line" if low == n + 1 else f"the ring fails when closed after position {low}"
-        return Diagnostic(problem.kind, low, None, None, f"{problem.detail}; segment search: {where}")
+        problem = Diagnostic(problem.kind, low, None, None, f"{problem.detail}; segment search: {where}")
+        return self._counted(problem, low)
 
-    def _probe(self, closed: int) -> Diagnostic | None:
+    def _counted(self, problem: Diagnostic, low: int) -> Diagnostic:
+        """A failure the segment search put at ``low`` inside a BK-LBD's branch: the BK's count of the counter
+        telegram gives the exact line (2.2.2, BK-7); the search and the count must agree, else not located.
+        Outside such a branch ``problem`` stands as the search found it."""
+        config = self._require_config()
+        for entry in config:
+            at = entry.ring_position
+            branch = list(takewhile(lambda e: e.interface is InterfaceType.LOCAL_BUS, config[at:]))
+            if entry.id_code != BK_LBD_ID_CODE or not at < low <= at + len(branch):
+                continue
+            kind = BranchKind.LBD_OR if all(e.id_code in LBD_OR_ID_CODES for e in branch) else BranchKind.LBD_MR
+            self.branch_status.pop(at, None)
+            if self._probe(at, ask=at) is not None or self._probe(at) is not None or at not in self.branch_status:
+                return _not_located(problem, f"the branch status of BK {entry.number} could not be read")
+            count = self.branch_status[at].counter
+            found = lbd_position(kind, len(branch), count)
+            if found is None or at + found[0] + found[1] != low:
+                return _not_located(problem, f"BK {entry.number} counted {count}, which fits no break the segment "
+                                    f"search allows ({kind.value} branch of {len(branch)} devices)")  # fmt: skip
+            k, back = found
+            line = f"the {'return' if back else 'forward'} line into {'the BK' if k == 0 else f'device {k}'}"
+            return Diagnostic(problem.kind, at + k, None, None,
+                              f"{problem.detail}; device-oriented local-bus diagnostics: BK {entry.number} counted "
+                              f"{count} ({kind.value}): {line}", back)  # fmt: skip
+        return problem
+
+    def _probe(self, closed: int, ask: int | None = None) -> Diagnostic | None:
         """An ID cycle with the ring closed after ring position ``closed`` (N + 1: the whole ring); ``None`` if it
         passes, else what failed (a configuration difference: the ring changed under the search). Every probe
         sends the frame of the diagnostic ID cycle (2 N bytes), so a fault that depends on where in the frame it
@@ -534,7 +619,10 @@ class Master:
         config = self._require_config()
         n = len(config)
         devices = min(closed, n)
-        data = wire.LOOPBACK_BYTES_ON_LINE + bytes(2 * n)
+        words = bytearray(2 * n)
+        if ask is not None:  # a status request to the BK at ``ask`` (BK-5), answered in the next probe
+            words[2 * (n - ask) : 2 * (n - ask) + 2] = wire.word_bytes(wire.command_word(alarm_request=True))
+        data = wire.LOOPBACK_BYTES_ON_LINE + bytes(words)
         transfer = self.ring.transfer(Cycle.ID, data, None if closed > n else closed)
         problem = self._check(transfer, 2 * devices)
         if problem is None:
@@ -543,21 +631,49 @@ class Master:
             problem = _compare(config[:devices], registers, self._alarm_expected)
         self.ring.finish(transfer, problem is None)
         if problem is None:
-            self._take_alarms(registers, sent=False)
+            self._record(self._take_alarms(registers, sent=False))
+            if ask is not None:
+                self._alarm_expected.add(ask)
             if closed > n:
                 self._recover = False
         return problem
 
-    def _take_alarms(self, registers: list[int], sent: bool) -> None:
-        """After a latched ID cycle: the devices asked in the previous one sent their processor alarm in place
-        of the ID code; the requests this one carried (``sent``) are answered in the next (A18)."""
-        for position in self._alarm_expected:
-            if position <= len(registers):
+    def _take_alarms(self, registers: list[int], sent: bool) -> tuple[Diagnostic, ...]:
+        """After a latched ID cycle: the devices asked in the previous one sent their processor alarm (a BK without
+        µP: its branch status, BK-5) in place of the ID code; the requests this one carried (``sent``) are answered
+        in the next (A18). Returns the BKs' reports (reconfiguration requests, branches they closed)."""
+        terminals = _terminals(self.config or ())
+        found: list[Diagnostic] = []
+        for position in sorted(self._alarm_expected):
+            if position > len(registers):
+                continue
+            if position in terminals:
+                found += self._branch_report(position, wire.decode_bk_status(registers[position - 1] & 0xFF))
+            else:
                 self.processor_alarms[position] = registers[position - 1] & 0xFF
         answered = range(1, len(registers) + 1)
         self._alarm_expected = set(self._alarm_request) if sent else self._alarm_expected.difference(answered)
         if sent:
             self._alarm_request.clear()
+        return tuple(self._with_device(d) for d in found)
+
+    def _branch_report(self, position: int, status: wire.BkStatus) -> list[Diagnostic]:
+        """A BK's branch status read: report a reconfiguration request and a branch the BK closed, and acknowledge
+        them in the next ID cycle (0714h, BK-8); a reconfiguration request makes the master read the configuration
+        anew once acknowledged."""
+        self.branch_status[position] = status
+        found: list[Diagnostic] = []
+        if status.conf_request:
+            found.append(Diagnostic(ErrorKind.RECONFIGURATION_REQUEST, position, None, None,
+                                    "CONF rose: reconfiguration request, acknowledged (2.4)"))  # fmt: skip
+            self._reconfigure = True
+        if status.closed:
+            found.append(Diagnostic(ErrorKind.BRANCH_CLOSED, position, None, None,
+                                    "the bus terminal module closed its branch: its return line was silent "
+                                    "(extended BK function, 2.4)"))  # fmt: skip
+        if found:
+            self._quit.add(position)
+        return found
 
     def _messages(self, registers: list[int]) -> tuple[Diagnostic, ...]:
         """Report the management bits of a latched ID cycle: PF as 0BB1h (once per fault), WD as 0C6Bh."""
@@ -575,6 +691,11 @@ class Master:
                                         "layer-2 watchdog reset the process data"))  # fmt: skip
         self._attention = False
         return tuple(self._with_device(d) for d in found)
+
+
+def _terminals(config: tuple[ConfigEntry, ...]) -> set[int]:
+    """Ring positions of the BKs without µP, which answer a status request with their branch status (BK-5)."""
+    return {entry.ring_position for entry in config if entry.id_code in STATUS_TERMINAL_ID_CODES}
 
 
 def _find_loopback(returned: bytes) -> int:

@@ -73,6 +73,8 @@ class BusTerminal:
         The extended BK function is active (the master activated it).
     closed:
         The BK closed its branch itself (extended function), until the master switches the branch on again.
+    closed_report:
+        The BK closed its branch and the master has not acknowledged it yet (status bit 6, BK-5).
     conf_request:
         A reconfiguration request (CONF edge) waits for the master's acknowledgement.
     count:
@@ -89,6 +91,7 @@ class BusTerminal:
         self.switched_on = True
         self.extended = False
         self.closed = False
+        self.closed_report = False
         self.conf_request = False
         self.count = 0
         self.closures = 0
@@ -119,7 +122,7 @@ class BusTerminal:
 
     def status(self) -> int:
         """The branch status byte (BK-5)."""
-        return wire.bk_status(self.conf_request, self.closed, self.count)
+        return wire.bk_status(self.conf_request, self.closed_report, self.count)
 
     def command(self, branch: BranchControl, acknowledge: bool) -> None:
         """Apply a latched command word: the branch control (BK-4) and, with ``acknowledge`` (0714h), the end of a
@@ -132,7 +135,7 @@ class BusTerminal:
             self.extended = branch is BranchControl.ON_EXTENDED
             self._silent_since = None
         if acknowledge:
-            self.conf_request = False
+            self.conf_request = self.closed_report = False
 
     def returned(self, traffic: bool, count: int | None, start: float, end: float) -> bool:
         """The branch was driven from ``start`` to ``end``: whether the master's telegrams came back on its return
@@ -148,7 +151,7 @@ class BusTerminal:
         since = start if self._silent_since is None else self._silent_since
         self._silent_since = since
         if self.extended and not self.closed and end - since >= BRANCH_SILENCE_S:
-            self.closed = True
+            self.closed = self.closed_report = True
             self.closures += 1
             return True
         return False
