@@ -34,6 +34,8 @@ from supi3.expansion import IDLE as EXPANSION_IDLE
 from supi3.expansion import ExpansionLevels, chain_to_line, line_to_chain
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
+from supi3.model.blocks.bus_terminal import LBST_PIN
+from supi3.model.chip import Supi3
 from supi3.model.pins import Supi3Pins
 from supi3.model.registers import RegisterFile
 from supi3.pinlevel import OE_SUFFIX
@@ -506,3 +508,15 @@ class FakeChain:
             if not levels.la_in_d_n and before.la_in_d_n:
                 self.load_inputs()
         return self.contents[-1] & 1 if self.length else 0
+
+
+BK_STRAPS: dict[str, str] = {"BK-RB": "00000", "BK-LB": "00001", "BK-LBD": "00010"}
+"""C[4..0] of the bus terminal modes without µP (Table 2-7)."""
+
+
+def terminal(interface: str, lbst: bool = True) -> Supi3:
+    """A SUPI 3 in the bus terminal mode ``interface`` (Table 2-7) with LBST (MFP11) at ``lbst``: with the default
+    straps (RF = 11, copper) its branch is present when a device is connected and LBST = 1 (Table 2-9, BK-2)."""
+    chip = Supi3(decode(BK_STRAPS[interface]))
+    chip.set_mfp_inputs(int(lbst) << LBST_PIN)
+    return chip
