@@ -11,7 +11,6 @@ from dataclasses import dataclass
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from support import terminal
 
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
@@ -21,6 +20,7 @@ from supi3.interbus.link import Device
 from supi3.interbus.master import Master
 from supi3.interbus.ring import Branch, BranchKind, DeadLine, ReturnBreak, Ring, lbd_count, lbd_position
 from supi3.interbus.wire import Cycle
+from support import terminal
 
 RECOVERY_CYCLES = 12
 """A master on a healthy tree latches data cycles again within this many cycles (a switch or a reconfiguration
@@ -62,19 +62,26 @@ def test_branch_status_byte_round_trips_exhaustively() -> None:
 
 
 @pytest.mark.parametrize(("call", "name"), [
-    (lambda: wire.counter_telegram(0), "count"), (lambda: wire.counter_telegram(64), "count"),
-    (lambda: wire.counter_telegram(True), "count"), (lambda: wire.counter_telegram("3"), "count"),
-    (lambda: wire.decode_counter_telegram(1 << 13), "word"), (lambda: wire.decode_counter_telegram(-1), "word"),
-    (lambda: wire.bk_status(1, False, 0), "conf_request"), (lambda: wire.bk_status(False, None, 0), "closed"),
-    (lambda: wire.bk_status(False, False, 64), "count"), (lambda: wire.decode_bk_status(256), "byte"),
-    (lambda: wire.command_word(branch=2), "branch"),
-    (lambda: lbd_position(BranchKind.LOCAL, 3, 1), "kind"), (lambda: lbd_position("LBD-MR", 3, 1), "kind"),
+    (lambda: wire.counter_telegram(0), "count"),
+    (lambda: wire.counter_telegram(64), "count"),
+    (lambda: wire.counter_telegram(True), "count"),
+    (lambda: wire.counter_telegram("3"), "count"),  # type: ignore[arg-type]
+    (lambda: wire.decode_counter_telegram(1 << 13), "word"),
+    (lambda: wire.decode_counter_telegram(-1), "word"),
+    (lambda: wire.bk_status(1, False, 0), "conf_request"),  # type: ignore[arg-type]
+    (lambda: wire.bk_status(False, None, 0), "closed"),  # type: ignore[arg-type]
+    (lambda: wire.bk_status(False, False, 64), "count"),
+    (lambda: wire.decode_bk_status(256), "byte"),
+    (lambda: wire.command_word(branch=2), "branch"),  # type: ignore[arg-type]
+    (lambda: lbd_position(BranchKind.LOCAL, 3, 1), "kind"),
+    (lambda: lbd_position("LBD-MR", 3, 1), "kind"),  # type: ignore[arg-type]
     (lambda: lbd_position(BranchKind.LBD_MR, -1, 1), "devices"),
     (lambda: lbd_position(BranchKind.LBD_MR, 3, 64), "count"),
-    (lambda: ReturnBreak(0), "segment"), (lambda: ReturnBreak(2, cycles=0), "cycles"),
+    (lambda: ReturnBreak(0), "segment"),
+    (lambda: ReturnBreak(2, cycles=0), "cycles"),
 ])  # fmt: skip
 def test_counter_entries_refuse_wrong_types_and_ranges(call: object, name: str) -> None:
-    with pytest.raises(ArgumentError, match=f"^{name} must be"):
+    with pytest.raises(ArgumentError, match=rf"^{name} must be"):
         call()  # type: ignore[operator]
 
 
@@ -89,7 +96,7 @@ def test_branch_control_round_trips_in_the_command_word() -> None:
 
 def single_breaks(kind: BranchKind, m: int) -> list[tuple[int, bool]]:
     """Every line of an LBD branch of ``m`` devices: (device k, return line), k = 0 for the BK's return input."""
-    back = range(0, m) if kind is BranchKind.LBD_MR else range(0, 1)
+    back = range(m) if kind is BranchKind.LBD_MR else range(1)
     return [(k, False) for k in range(1, m + 1)] + [(k, True) for k in back]
 
 

@@ -6,7 +6,6 @@ from __future__ import annotations
 import itertools
 
 import pytest
-from support import BK_STRAPS, terminal
 
 from supi3.config import decode
 from supi3.errors import ArgumentError
@@ -14,6 +13,7 @@ from supi3.interbus import wire
 from supi3.interbus.wire import BranchControl, Cycle
 from supi3.model.blocks.bus_terminal import BRANCH_SILENCE_S, CONF_PIN, LBST_PIN, BusTerminal, branch_present
 from supi3.model.chip import ChipArgumentError, ChipError, Supi3
+from support import BK_STRAPS, terminal
 
 
 def id_latch(chip: Supi3, now: float, **command: object) -> None:
@@ -136,18 +136,18 @@ def test_a_chip_that_is_no_bk_refuses_branch_calls_by_name() -> None:
     ((True, None, 0.0, float("nan")), "end"),
 ])  # fmt: skip
 def test_branch_returned_refuses_wrong_types_and_ranges(args: tuple[object, ...], name: str) -> None:
-    with pytest.raises(ChipArgumentError, match=f"^{name} must be"):
+    with pytest.raises(ChipArgumentError, match=rf"^{name} must be"):
         terminal("BK-LBD").branch_returned(*args)  # type: ignore[arg-type]
 
 
 def test_branch_enabled_and_block_refuse_wrong_types() -> None:
-    with pytest.raises(ChipArgumentError, match="^connected must be"):
+    with pytest.raises(ChipArgumentError, match=r"^connected must be"):
         terminal("BK-LB").branch_enabled(1)  # type: ignore[arg-type]
-    with pytest.raises(ArgumentError, match="^interface must be"):
+    with pytest.raises(ArgumentError, match=r"^interface must be"):
         BusTerminal("BK-XX", None)
-    with pytest.raises(ArgumentError, match="^rf must be"):
+    with pytest.raises(ArgumentError, match=r"^rf must be"):
         branch_present("12", True, True)
-    with pytest.raises(ArgumentError, match="^lbst must be"):
+    with pytest.raises(ArgumentError, match=r"^lbst must be"):
         branch_present("10", 1, True)  # type: ignore[arg-type]
-    with pytest.raises(ArgumentError, match="^levels must be"):
+    with pytest.raises(ArgumentError, match=r"^levels must be"):
         BusTerminal("BK-LB", None).inputs(1 << 16)

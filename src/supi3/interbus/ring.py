@@ -239,7 +239,7 @@ class Branch:
     """
 
     terminal: Terminal
-    devices: tuple[Device | Branch, ...]
+    devices: Sequence[Device | Branch]
     kind: BranchKind
 
     def __post_init__(self) -> None:
