@@ -219,7 +219,7 @@ def test_master_is_never_stuck_with_extended_bks_breaks_and_switching(data: st.D
 
 def test_branch_refuses_what_is_no_tree() -> None:
     with pytest.raises(ArgumentError, match=r"^terminal must be a bus terminal module"):
-        Branch(Supi3(), [], BranchKind.LOCAL)  # type: ignore[arg-type]
+        Branch(Supi3(), [], BranchKind.LOCAL)
     with pytest.raises(ArgumentError, match=r"^terminal must be a bus terminal module"):
         Branch(PlainDevice(0x08, 0), [], BranchKind.LOCAL)  # type: ignore[arg-type]
     with pytest.raises(ArgumentError, match=r"^terminal must be a BK-LBD for a LBD-MR branch"):
