@@ -158,7 +158,10 @@ def test_conf_edge_is_an_acknowledged_reconfiguration_request() -> None:
     requests = [d for d in master.diagnostics if d.kind is ErrorKind.RECONFIGURATION_REQUEST]
     assert [(d.location, d.device) for d in requests] == [(12, "6.0")]
     assert bks["or"].bus_terminal is not None and not bks["or"].bus_terminal.conf_request
-    assert master.branch_status[12] == wire.BkStatus(False, False, 0)
+    assert not bks["or"].attention and master.branch_status == {}  # the table was read anew: statuses too
+    master.clear_diagnostics()
+    healthy(master, ring)
+    assert master.diagnostics == []  # reported once
 
 
 def test_extended_function_closes_a_broken_branch_and_the_master_says_which() -> None:
@@ -175,6 +178,7 @@ def test_extended_function_closes_a_broken_branch_and_the_master_says_which() ->
         master.cycle()
         if master.config is not None and len(master.config) == 13:
             break
+    healthy(master, ring)  # the first data cycle on the new table brings the BK's ATTN
     healthy(master, ring)
     kinds = [(d.kind, d.location) for d in master.diagnostics]
     assert (ErrorKind.DEAD_LINE, 14) in kinds  # located first by the counter telegram

@@ -48,12 +48,12 @@ def test_conf_positive_edge_requests_reconfiguration_once_until_acknowledged() -
     assert not chip.attention
     chip.set_mfp_inputs((1 << LBST_PIN) | (1 << CONF_PIN))
     assert chip.attention and chip.bus_terminal is not None and chip.bus_terminal.conf_request
-    id_latch(chip, 0.001)  # an ID cycle without acknowledgement clears ATTN, not the request
-    assert not chip.attention and chip.bus_terminal.conf_request
+    id_latch(chip, 0.001)  # an ID cycle without acknowledgement: the request and ATTN stay (BK-5)
+    assert chip.attention and chip.bus_terminal.conf_request
+    id_latch(chip, 0.002, quit_peripheral_error=True)
+    assert not chip.attention and not chip.bus_terminal.conf_request
     chip.set_mfp_inputs((1 << LBST_PIN) | (1 << CONF_PIN))  # high stays high: no new edge
     assert not chip.attention
-    id_latch(chip, 0.002, quit_peripheral_error=True)
-    assert not chip.bus_terminal.conf_request
     chip.set_mfp_inputs(1 << LBST_PIN)  # falling edge: nothing
     assert not chip.attention and not chip.bus_terminal.conf_request
 

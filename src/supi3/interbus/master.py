@@ -227,8 +227,8 @@ class Master:
         self.processor_alarms: dict[int, int] = {}
         """Ring position -> the last processor alarm byte read from it (management channel, 3.4.9)."""
         self.branch_status: dict[int, wire.BkStatus] = {}
-        """Ring position of a BK without µP -> its last branch status (BK-5), read after each configuration and
-        after ATTN."""
+        """Ring position of a BK without µP -> its last branch status (BK-5), read after an ATTN no PF or WD bit
+        explains and by the LBD location (emptied when the configuration is read anew)."""
         self._branch: dict[int, BranchControl] = {}
         self._reconfigure = False
 
@@ -381,8 +381,6 @@ class Master:
         if self.config is None:
             return self._discovery()
         config = self.config
-        if self._attention:  # who asked? the BKs tell in their branch status (BK-5)
-            self._alarm_request.update(_terminals(config))
         words = [self._command(entry.ring_position) for entry in reversed(config)]
         data = wire.LOOPBACK_BYTES_ON_LINE + b"".join(wire.word_bytes(w) for w in words)
         transfer = self.ring.transfer(Cycle.ID, data)
@@ -452,7 +450,6 @@ class Master:
         self._set_config(config)
         self.stopped = self._recover = False
         self.branch_status.clear()
-        self._alarm_request.update(_terminals(config or ()))  # read every BK's branch status (BK-5)
         messages = self._messages(registers)
         self._record(messages)
         return CycleResult(Cycle.ID, True, messages)
@@ -689,6 +686,9 @@ class Master:
             if (word >> wire.MGMT_WD_BIT) & 1:
                 found.append(Diagnostic(ErrorKind.WATCHDOG, k, None, MSG_WATCHDOG,
                                         "layer-2 watchdog reset the process data"))  # fmt: skip
+        if self._attention and not found and self.config is not None:
+            # ATTN that no PF or WD bit explains: a BK has a report; its branch status tells (BK-5)
+            self._alarm_request.update(_terminals(self.config))
         self._attention = False
         return tuple(self._with_device(d) for d in found)
 

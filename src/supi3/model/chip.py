@@ -584,12 +584,17 @@ class Supi3:
             return self.bus_terminal.status()
         return self.config.id_code
 
-    def _bus_terminal_command(self, command: wire.CommandWord) -> None:
-        """A latched ID cycle's command word: branch control, acknowledgement, status request (BK-4, BK-5, BK-8)."""
-        if self.bus_terminal is not None:
-            self.bus_terminal.command(command.branch, command.quit_peripheral_error)
-            if self.registers is None:
-                self._send_alarm = command.alarm_request
+    def _bus_terminal_command(self, command: wire.CommandWord) -> bool:
+        """A latched ID cycle's command word: branch control, acknowledgement, status request (BK-4, BK-5, BK-8).
+        ``True`` while a report (reconfiguration request, branch closed) waits for acknowledgement: the BK keeps
+        ATTN up until then, so an ATTN lost in a failed cycle comes back (BK-5)."""
+        terminal = self.bus_terminal
+        if terminal is None:
+            return False
+        terminal.command(command.branch, command.quit_peripheral_error)
+        if self.registers is None:
+            self._send_alarm = command.alarm_request
+        return terminal.conf_request or terminal.closed_report
 
     def _bus_terminal_reset(self) -> bool:
         """INTERBUS reset (BK-9); ``True`` while a reconfiguration request still waits (it keeps ATTN)."""
@@ -777,8 +782,8 @@ class Supi3:
                 if command.processor_command is not None:
                     self.registers.processor_command(command.processor_command)
                 self._send_alarm = command.alarm_request
-            self._bus_terminal_command(command)
-            self.wd = self.te = self.attention = False
+            self.wd = self.te = False
+            self.attention = self._bus_terminal_command(command)
             if self.expansion:
                 self._expansion_end(clk, None)
             self._event("ID_CYCLE")
