@@ -77,6 +77,12 @@ def test_branch_status_byte_round_trips_exhaustively() -> None:
     (lambda: lbd_position("LBD-MR", 3, 1), "kind"),  # type: ignore[arg-type]
     (lambda: lbd_position(BranchKind.LBD_MR, -1, 1), "devices"),
     (lambda: lbd_position(BranchKind.LBD_MR, 3, 64), "count"),
+    (lambda: lbd_count(BranchKind.REMOTE, 3, set(), set()), "kind"),
+    (lambda: lbd_count(BranchKind.LBD_MR, 3.0, set(), set()), "devices"),  # type: ignore[arg-type]
+    (lambda: lbd_count(BranchKind.LBD_MR, 3, 2, set()), "forward"),  # type: ignore[arg-type]
+    (lambda: lbd_count(BranchKind.LBD_MR, 3, {4}, set()), "forward device"),
+    (lambda: lbd_count(BranchKind.LBD_MR, 3, {0}, set()), "forward device"),
+    (lambda: lbd_count(BranchKind.LBD_OR, 3, set(), {-1}), "back device"),
     (lambda: ReturnBreak(0), "segment"),
     (lambda: ReturnBreak(2, cycles=0), "cycles"),
 ])  # fmt: skip

@@ -151,3 +151,7 @@ def test_branch_enabled_and_block_refuse_wrong_types() -> None:
         branch_present("10", 1, True)  # type: ignore[arg-type]
     with pytest.raises(ArgumentError, match=r"^levels must be"):
         BusTerminal("BK-LB", None).inputs(1 << 16)
+    with pytest.raises(ArgumentError, match=r"^branch must be"):
+        BusTerminal("BK-LB", None).command(2, False)  # type: ignore[arg-type]
+    with pytest.raises(ArgumentError, match=r"^acknowledge must be"):
+        BusTerminal("BK-LB", None).command(BranchControl.ON, 1)  # type: ignore[arg-type]

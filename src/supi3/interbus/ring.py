@@ -295,6 +295,13 @@ def _devices(items: Sequence[Device | Branch]) -> list[Device]:
     return found
 
 
+def _check_lbd(kind: object, devices: object) -> None:
+    """``kind`` an LBD branch kind and ``devices`` a branch size, else the named error."""
+    if not check_instance("kind", kind, BranchKind).diagnostics:
+        raise InterbusArgumentError("kind", kind, f"kind must be LBD_MR or LBD_OR (2.2.2), not {kind}", "2.2.2")
+    check_int("devices", devices, 0, wire.MAX_DEVICES, _LIMIT_DEVICES)
+
+
 def lbd_count(kind: BranchKind, devices: int, forward: Collection[int], back: Collection[int]) -> int | None:
     """The count the BK of an LBD branch of ``devices`` devices receives on its return line (2.2.2, BK-6).
 
@@ -305,6 +312,12 @@ def lbd_count(kind: BranchKind, devices: int, forward: Collection[int], back: Co
     line, LBD-OR devices forward only. ``None``: no counter telegram arrives (no break, or the BK's return input is
     broken).
     """
+    _check_lbd(kind, devices)
+    for name, lines in (("forward", forward), ("back", back)):
+        if isinstance(lines, (str, bytes)) or not isinstance(lines, Collection):
+            raise fail(name, "a collection of branch device numbers", lines)
+        for k in lines:
+            check_int(f"{name} device", k, 0 if name == "back" else 1, devices, "the branch's devices (0: the BK)")
     path = [("f", k) for k in range(1, devices + 1)]
     if kind is BranchKind.LBD_MR:
         path += [("r", k) for k in range(devices, 0, -1)]  # ("r", m): the loop inside device m, never broken
@@ -325,10 +338,7 @@ def lbd_position(kind: BranchKind, devices: int, count: int) -> tuple[int, bool]
     """Where the break is, from the count a BK read (0: none arrived): ``(k, return_line)``, the branch device
     *k* (0: the BK) whose incoming forward line (``return_line`` False) or return line is broken; ``None`` if
     no single break gives this count (or the count saturated). The inverse of :func:`lbd_count` (BK-7)."""
-    check_instance("kind", kind, BranchKind)
-    if not kind.diagnostics:
-        raise InterbusArgumentError("kind", kind, f"kind must be LBD_MR or LBD_OR (2.2.2), not {kind}", "2.2.2")
-    devices = check_int("devices", devices, 0, wire.COUNTER_MAX, "BK-6: counts up to 63")
+    _check_lbd(kind, devices)
     count = check_int("count", count, 0, wire.COUNTER_MAX, "BK-5: a count is 6 bits")
     if count == 0:
         return 0, True
@@ -709,19 +719,18 @@ class Ring:
         self._faults = [a for a in self._faults if a.remaining is None or a.remaining > 0]
         return hits, returns
 
+    def _breaks(self) -> tuple[list[int], list[int]]:
+        """The lines broken now (``DeadLine``) and the positions whose return line is broken, without counting a
+        fault's cycles."""
+        lines = [(a.fault, w) for a in self._faults if (w := self._where(a)) is not None]
+        return ([w for f, w in lines if isinstance(f, DeadLine)], [w for f, w in lines if isinstance(f, ReturnBreak)])
+
     def _first_dead(self) -> int | None:
         """The first line that carries nothing on the whole ring (broken return lines of branches too)."""
-        dead = [w for a in self._faults if isinstance(a.fault, DeadLine) and (w := self._where(a)) is not None]
-        returns = [w for a in self._faults if isinstance(a.fault, ReturnBreak) and (w := self._where(a)) is not None]
+        dead, returns = self._breaks()
         first, _ = self._returns(returns, None)
         dead += [] if first is None else [first]
         return min(dead) if dead else None
-
-    def _idle_reports(self, reached: int) -> list[tuple[Terminal, bool, int | None]]:
-        """``_reports`` for the whole ring without counting a fault's cycles (idle telegrams, no frame)."""
-        dead = [w for a in self._faults if isinstance(a.fault, DeadLine) and (w := self._where(a)) is not None]
-        returns = [w for a in self._faults if isinstance(a.fault, ReturnBreak) and (w := self._where(a)) is not None]
-        return self._reports(reached, None, dead, returns)
 
     # -- one line ------------------------------------------------------------------------------------------------
 
@@ -1001,7 +1010,7 @@ class Ring:
             device.poll(end)
         self._go_silent(range(reached, len(self.devices)), self.now, end)
         if self._branches:
-            for terminal, traffic, count in self._idle_reports(reached):
+            for terminal, traffic, count in self._reports(reached, None, *self._breaks()):
                 terminal.branch_returned(traffic, count, self.now, end)
             self._silence_detached(self.now, end)
         self.now = end

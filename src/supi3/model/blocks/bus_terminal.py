@@ -21,7 +21,7 @@ from __future__ import annotations
 from typing import Final
 
 from supi3 import tables
-from supi3.checks import check_bits, check_bool, check_choice, check_real
+from supi3.checks import check_bits, check_bool, check_choice, check_instance, check_real
 from supi3.interbus import wire
 from supi3.interbus.wire import BranchControl
 
@@ -127,6 +127,8 @@ class BusTerminal:
     def command(self, branch: BranchControl, acknowledge: bool) -> None:
         """Apply a latched command word: the branch control (BK-4) and, with ``acknowledge`` (0714h), the end of a
         reconfiguration request and of the closed flag's report (BK-8)."""
+        check_instance("branch", branch, BranchControl)
+        acknowledge = check_bool("acknowledge", acknowledge)
         if branch is BranchControl.OFF:
             self.switched_on = False
         elif branch in (BranchControl.ON, BranchControl.ON_EXTENDED):
