@@ -851,7 +851,8 @@ class Ring:
             Hand it to :meth:`finish` with the master's verdict.
         """
         check_instance("cycle", cycle, Cycle)
-        self._sync()
+        if self._branches:
+            self._sync()
         n_all = len(self.devices)
         if n_all > wire.MAX_DEVICES:
             raise InterbusError("docs/interbus.md, Ring", n_all, f"a ring has at most {wire.MAX_DEVICES} devices")
@@ -860,13 +861,18 @@ class Ring:
         # Closed after a position (even the last), the ring returns inside that device: the return line N + 1
         # is only part of the whole ring (close_after=None), so a fault there is told from one on line N.
         segments = n + 1 if close_after is None else n
-        faults, returns = self._faults_on(segments) if self._faults else ({}, [])
-        dead_lines = [s for s, fs in faults.items() if any(isinstance(f, DeadLine) for f in fs)]
-        dead = min(dead_lines, default=None)
+        faults: dict[int, list[Fault]] = {}
+        returns: list[int] = []
+        dead_lines: list[int] = []
+        dead: int | None = None
         back_dead = False
-        if returns:
-            first, back_dead = self._returns(returns, None if close_after is None else n)
-            dead = first if dead is None or (first is not None and first < dead) else dead
+        if self._faults:
+            faults, returns = self._faults_on(segments)
+            dead_lines = [s for s, fs in faults.items() if any(isinstance(f, DeadLine) for f in fs)]
+            dead = min(dead_lines, default=None)
+            if returns:
+                first, back_dead = self._returns(returns, None if close_after is None else n)
+                dead = first if dead is None or (first is not None and first < dead) else dead
         self.trace = []
         record = self.record
         now = self.now
