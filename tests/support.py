@@ -506,3 +506,8 @@ class FakeChain:
             if not levels.la_in_d_n and before.la_in_d_n:
                 self.load_inputs()
         return self.contents[-1] & 1 if self.length else 0
+
+
+def bad(value: object) -> Any:
+    """A wrongly typed argument for a hostile-input test, passed through without a type error from mypy."""
+    return value
