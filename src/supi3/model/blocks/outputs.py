@@ -18,17 +18,29 @@ divider, the diagnostic outputs).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
-from supi3.diagnostics import DiagnosticOutputs, ib_diag_level
+from supi3.diagnostics import DiagnosticOutputs
 from supi3.model.blocks.serial_io import SerialIo
 from supi3.model.blocks.transmitter import PinTrace, Transmitter
 
 if TYPE_CHECKING:
     from supi3.model.chip import Supi3
+
+class _View(NamedTuple):
+    """The chip's LEDs at one ``Supi3.revision`` and what they put on the pins (DIAG1, DIAG2, the bus terminal's
+    MFP bits, the IB_DIAG divider's bits or 0 for a steady light)."""
+
+    revision: int
+    leds: DiagnosticOutputs
+    diag1: int
+    diag2: int
+    mfp: int
+    ib_bits: int
+
 
 Snapshot = tuple[int, int, int, int, int, int, int, int]
 """What the outputs of a cycle depend on besides the cycle number (see :meth:`Outputs.snapshot`)."""
@@ -60,16 +72,18 @@ class Outputs:
         self.transmitter = transmitter
         self.cpb = cpb
         self.mfp_oe = mfp_oe
-        self._view: tuple[int, DiagnosticOutputs] | None = None
+        self._view: _View | None = None
 
-    def view(self) -> DiagnosticOutputs:
-        """The chip's LEDs now (:attr:`supi3.model.chip.Supi3.diagnostic_outputs`), computed once per change of
-        what the pins show (``Supi3.revision``)."""
+    def view(self) -> _View:
+        """The chip's LEDs now (:attr:`supi3.model.chip.Supi3.diagnostic_outputs`) and the pin levels they make,
+        computed once per change of what the pins show (``Supi3.revision``): ``step()`` reads them every cycle."""
         chip = self.chip
         cached = self._view
-        if cached is None or cached[0] != chip.revision:
-            cached = self._view = (chip.revision, chip.diagnostic_outputs)
-        return cached[1]
+        if cached is None or cached.revision != chip.revision:
+            leds = chip.diagnostic_outputs
+            cached = self._view = _View(chip.revision, leds, leds.diag1, leds.diag2, leds.mfp,
+                                        leds.ib_diag.divider_bits or 0)  # fmt: skip
+        return cached
 
     def values(self, c: int, di2: int, run_from: int) -> dict[str, int]:
         """Every output pin during cycle ``c`` (``di2``: that cycle's input; the logic runs from ``run_from``)."""
@@ -77,6 +91,7 @@ class Outputs:
         tx = self.transmitter
         do2 = tx.level(c)
         view = self.view()
+        flash = view.ib_bits
         return {
             "do2": do2,
             # The return line passes straight through when a device follows; the last device loops back (M5).
@@ -92,7 +107,7 @@ class Outputs:
             "res_reg_n": int(not (0 < c <= chip.resreg_until or chip.line_silent)),
             "diag1": view.diag1,
             "diag2": view.diag2,
-            "ib_diag": ib_diag_level(view.ib_diag, c),
+            "ib_diag": 1 if not flash else 1 - ((c >> (flash - 1)) & 1),  # ib_diag_level(view.leds.ib_diag, c)
             "dclk_out": int(c % self.cpb < self.cpb // 2),
             "resu_drive": int(c < run_from),
         }
@@ -101,8 +116,8 @@ class Outputs:
         """The outputs' state now, for :meth:`render` (``run_from``: the cycle the logic runs from)."""
         chip = self.chip
         view = self.view()
-        return (chip.mfp_outputs | view.mfp, view.diag1, view.diag2, view.ib_diag.divider_bits or 0,
-                chip.mod_ack_until, chip.resreg_until, int(chip.line_silent), run_from)  # fmt: skip
+        return (chip.mfp_outputs | view.mfp, view.diag1, view.diag2, view.ib_bits, chip.mod_ack_until,
+                chip.resreg_until, int(chip.line_silent), run_from)  # fmt: skip
 
     def render(self, c0: int, n: int, snaps: list[tuple[int, Snapshot]], do2: PinTrace) -> dict[str, PinTrace]:
         """Every output pin but ``di1`` over cycles ``c0`` to ``c0 + n - 1``, as :meth:`values` gives them: each
