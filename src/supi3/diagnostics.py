@@ -36,7 +36,7 @@ from supi3.checks import check_bool, check_instance, check_int, fail
 from supi3.config import DeviceConfig, Interface
 from supi3.optical.regulation import Interface as OpticalInterface
 from supi3.optical.regulation import OpticalStatus, fo_lit
-from supi3.pinout import IB_DIAG_DIVIDER_BITS, MFP_PINS
+from supi3.pinout import IB_DIAG_DIVIDER_BITS
 from supi3.tables import BUS_TERMINAL_MFP, DIAG_CONFIGURATIONS, LIMITED_DIAGNOSTICS
 
 __all__ = [
@@ -226,9 +226,7 @@ def bus_terminal_mfp(bus_terminal: bool, alarm: bool, ld: bool, e: bool, fo3: bo
     if not check_bool("bus_terminal", bus_terminal):
         return 0
     levels = {"alarm": alarm, "ld": ld, "e": e, "fo3": fo3}
-    word = sum(int(check_bool(name, levels[name])) << pin for name, pin in BUS_TERMINAL_PINS.items())
-    assert word < 1 << MFP_PINS
-    return word
+    return sum(int(check_bool(name, levels[name])) << pin for name, pin in BUS_TERMINAL_PINS.items())
 
 
 def diagnostic_outputs(config: DeviceConfig, *, supply_ok: bool, line_heard: bool, bus_active: bool,
