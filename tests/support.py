@@ -520,3 +520,8 @@ def terminal(interface: str, lbst: bool = True) -> Supi3:
     chip = Supi3(decode(BK_STRAPS[interface]))
     chip.set_mfp_inputs(int(lbst) << LBST_PIN)
     return chip
+
+
+def bad(value: object) -> Any:
+    """A wrongly typed argument for a hostile-input test, passed through without a type error from mypy."""
+    return value
