@@ -8,6 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from supi3.config import decode
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.device import PlainDevice
@@ -192,6 +193,23 @@ def test_extended_function_closes_a_broken_branch_and_the_master_says_which() ->
     master.switch_branch("6.0", True)
     healthy(master, ring)
     assert len(ring.devices) == 16
+
+
+def test_a_local_bus_chip_behind_a_break_shows_the_line_interrupt_ahead() -> None:
+    """The ring's silence time-out goes through ``Supi3.line_timeout`` (DG-3): IB_DIAG's 4 Hz cause at transaction
+    level, for a local bus chip in a branch behind a break."""
+    chip = Supi3(decode("01000"))  # LB-MR, 8 IN/8 OUT (Table 2-4)
+    ring = Ring([Branch(terminal("BK-LB"), [PlainDevice(0xBF, 0b01001), chip], BranchKind.LOCAL)])
+    master = Master(ring, max_devices=8)
+    master.start()
+    healthy(master, ring)
+    ring.inject(DeadLine(2))
+    master.cycle()
+    ring.idle(2 * wire.IDLE_TIMEOUT_S)
+    assert chip.line_interrupt and chip.line_silent
+    ring.clear_faults()
+    healthy(master, ring)
+    assert not chip.line_interrupt and not chip.line_silent
 
 
 @settings(max_examples=15)

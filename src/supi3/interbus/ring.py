@@ -390,6 +390,16 @@ def _group(devices: list[Device]) -> _Groups:
     return groups
 
 
+def _timeout(device: Device, now: float) -> None:
+    """A device's incoming line was silent for ``wire.IDLE_TIMEOUT_S`` until ``now`` (A13): its ``line_timeout`` if
+    it has one (the SUPI 3 model: the reset plus DG-3/DG-4, docs/assumptions/diagnostics.md), else ``reset``."""
+    timeout = getattr(device, "line_timeout", None)
+    if callable(timeout):
+        timeout(now)
+    else:
+        device.reset(now)
+
+
 def _shift(registers: list[bytes], stream: bytes) -> tuple[list[bytes], bytes, int]:
     """Shift ``stream`` through consecutive registers: what each register holds afterwards, what leaves the
     last one, and the registers' total width. A register emits its contents, then what entered it; the stream
@@ -614,7 +624,7 @@ class Ring:
         for key, (device, since) in list(self._detached.items()):
             since = start if since is None else since
             if since >= 0.0 and end - since >= wire.IDLE_TIMEOUT_S:
-                device.reset(since + wire.IDLE_TIMEOUT_S)
+                _timeout(device, since + wire.IDLE_TIMEOUT_S)
                 since = -1.0  # reset once
             self._detached[key] = (device, since)
             device.poll(end)
@@ -987,7 +997,7 @@ class Ring:
             since = self._silent_since.setdefault(index, start)
             device = self.devices[index]
             if index not in self._silent_reset and end - since >= wire.IDLE_TIMEOUT_S:
-                device.reset(since + wire.IDLE_TIMEOUT_S)
+                _timeout(device, since + wire.IDLE_TIMEOUT_S)
                 self._silent_reset.add(index)
             device.poll(end)
 
