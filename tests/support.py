@@ -34,7 +34,7 @@ from supi3.expansion import IDLE as EXPANSION_IDLE
 from supi3.expansion import ExpansionLevels, chain_to_line, line_to_chain
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
-from supi3.model.blocks.bus_terminal import LBST_PIN
+from supi3.model.bus_terminal import LBST_PIN
 from supi3.model.chip import Supi3
 from supi3.model.pins import Supi3Pins
 from supi3.model.registers import RegisterFile

@@ -17,7 +17,7 @@ from supi3.interbus.link import Device
 from supi3.interbus.master import Master
 from supi3.interbus.ring import Branch, BranchKind, DeadLine, ErrorKind, ReturnBreak, Ring
 from supi3.interbus.wire import Cycle
-from supi3.model.blocks.bus_terminal import BRANCH_SILENCE_S, CONF_PIN, LBST_PIN
+from supi3.model.bus_terminal import BRANCH_SILENCE_S, CONF_PIN, LBST_PIN
 from supi3.model.chip import Supi3
 from support import terminal
 

@@ -1,5 +1,5 @@
 """The SUPI 3 as a bus terminal module (BK) at transaction level: manual 2.4, Tables 2-7, 2-8, 2-9; the BK state of
-supi3.model.blocks.bus_terminal and its hooks in supi3.model.chip (docs/assumptions/bus-terminal.md BK-1..)."""
+supi3.model.bus_terminal and its hooks in supi3.model.chip (docs/assumptions/bus-terminal.md BK-1..)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from supi3.config import decode
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.wire import BranchControl, Cycle
-from supi3.model.blocks.bus_terminal import BRANCH_SILENCE_S, CONF_PIN, LBST_PIN, BusTerminal, branch_present
+from supi3.model.bus_terminal import BRANCH_SILENCE_S, CONF_PIN, LBST_PIN, BusTerminal, branch_present
 from supi3.model.chip import ChipArgumentError, ChipError, Supi3
 from support import BK_STRAPS, terminal
 

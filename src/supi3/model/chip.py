@@ -40,7 +40,7 @@ from supi3.expansion import PULSE_T0, ExternalRegisters, end_pulses
 from supi3.interbus import wire
 from supi3.interbus.link import DataKernel
 from supi3.interbus.wire import Cycle
-from supi3.model.blocks.bus_terminal import BusTerminal
+from supi3.model.bus_terminal import BusTerminal
 from supi3.model.registers import RegisterFile
 from supi3.serial_io import SerialDevice, SerialSequence, clear_sequence, sequence
 
@@ -615,7 +615,7 @@ class Supi3:
             self._chain.clear()
 
     # --------------------------------------------------------------------------------------------------------
-    # Bus terminal module (2.4, Tables 2-7..2-9; supi3.model.blocks.bus_terminal, docs/assumptions/bus-terminal.md)
+    # Bus terminal module (2.4, Tables 2-7..2-9; supi3.model.bus_terminal, docs/assumptions/bus-terminal.md)
     # --------------------------------------------------------------------------------------------------------
     # In the BK modes the chip owns a BusTerminal (self.bus_terminal, None in every other mode). The hooks in the
     # methods above are one line each: power_up -> _init_bus_terminal, set_mfp_inputs -> _bus_terminal_inputs,
