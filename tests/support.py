@@ -526,7 +526,7 @@ class OpticalScript:
     def idle(self, n: int = 1, **pins: int) -> OpticalScript:
         """``n`` cycles with the static inputs and ``pins``; the other inputs 0."""
         row = dict.fromkeys(OPTICAL_INPUTS, 0) | self.static | pins
-        self.rows.extend(dict(row) for _ in range(n))
+        self.rows.extend([row] * n)  # one dict for the whole stretch: rows are read, never changed
         return self
 
     def reset(self, n: int = 3) -> OpticalScript:
@@ -539,8 +539,12 @@ class OpticalScript:
     def test(self, interface: int, ack1: bool, ack2: bool) -> OpticalScript:
         return self.idle(test_valid=1 << interface, ack1=int(ack1) << interface, ack2=int(ack2) << interface)
 
-    def length(self, interface: int, clocks: int) -> OpticalScript:
-        """A length measurement: ``len_stop`` ``clocks`` cycles after ``len_start`` (``clocks`` >= 1)."""
+    def length(self, interface: int, clocks: int, medium: int | None = None) -> OpticalScript:
+        """A length measurement: ``len_stop`` ``clocks`` cycles after ``len_start`` (``clocks`` >= 1), the
+        transceiver reporting ``medium`` (0 polymer, 1 glass; the static ``medium`` when None) from then on."""
+        if medium is not None:
+            bit = 1 << interface
+            self.static["medium"] = self.static["medium"] & ~bit | (bit if medium else 0)
         self.idle(len_start=1 << interface)
         return self.idle(clocks - 1).idle(len_stop=1 << interface)
 

@@ -85,7 +85,7 @@ def block_mode(value: int) -> OpticalMode:
 
 def _checked(inputs: object) -> Mapping[str, int]:
     """The block's inputs by name, each an integer within its port's width; else a named error."""
-    if not isinstance(inputs, Mapping) or len(inputs) != len(_WIDTHS) or set(inputs) != _NAMES:
+    if not isinstance(inputs, Mapping) or inputs.keys() != _NAMES:
         raise ArgumentError("inputs", inputs, f"inputs must be a mapping of exactly the pins {', '.join(_WIDTHS)} "
                                               f"to integers, not {inputs!r:.80}")
     for name, width in _WIDTHS.items():
@@ -200,7 +200,9 @@ class OpticalBlock:
             txs = tuple(start(mode, bool(v["present"] >> i & 1)) for i in Interface)
             self.log.add(self.cycle, "start in {}: {}", mode.name, [tx.phase.value for tx in txs])
         else:
-            txs = tuple(self._strobes(status[i], i, v) for i in Interface)
+            txs = status.transmitters
+            if v["resp_valid"] or v["test_valid"]:
+                txs = tuple(self._strobes(status[i], i, v) for i in Interface)
             if self.countdown:
                 self.countdown -= 1
                 if not self.countdown:
@@ -208,7 +210,9 @@ class OpticalBlock:
                     self.log.add(self.cycle, "6 ms budget over")
         if txs != status.transmitters:
             status = OpticalStatus((txs[0], txs[1], txs[2]), status.length, status.medium)
-        self.status = self._lengths(status, v, mode, bit_rate)
+        if v["len_start"] or v["len_stop"] or self._timers[0].running or self._timers[1].running:
+            status = self._lengths(status, v, mode, bit_rate)
+        self.status = status
 
     def _strobes(self, tx: Transmitter, i: Interface, v: Mapping[str, int]) -> Transmitter:
         """Interface ``i``'s response, then its test, of this cycle."""
