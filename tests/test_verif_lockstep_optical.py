@@ -105,7 +105,7 @@ def test_lengths_media_and_resets(fast: int) -> None:
 
 @pytest.mark.slow
 def test_six_ms_timeout() -> None:
-    """OPT-5: the budget runs out INIT_TIME_LIMIT_CLOCKS after the start (about 60 s on Amaranth's simulator)."""
+    """OPT-5: the budget runs out INIT_TIME_LIMIT_CLOCKS after the start (minutes on Amaranth's simulator)."""
     script = OpticalScript(REG, present=0b101).reset().response(IN, Response.DETECTED)
     block = lockstep(script.idle(INIT_TIME_LIMIT_CLOCKS + 2))
     assert block.status[BRANCH].phase is Phase.FIXED
