@@ -7,8 +7,8 @@ diagnostics), 1.6.3 (MAU warnings), Table 3-17 (FO LEDs), 3.4.12/3.4.13 (reads 8
 ``online_test``, ``diagnostic_mau``, ``mau_after``, ``fo_lit``, ``registers``) are re-implemented here in gates, one
 function each, with every constant taken from the spec at elaboration (levels, steps, the 6 ms budget in clocks,
 the length timer's clock divider, the LENGTH code's scale per bit rate and medium, the register layout). The edge
-order and the port timing are those of the pin model :class:`supi3.model.blocks.optical.OpticalBlock` (its module
-docstring), which ``tests/test_verif_lockstep_optical.py`` holds this block to, cycle by cycle.
+order and the port timing are those of the pin model ``OpticalBlock`` (``src/supi3/model/blocks/optical.py``, its
+module docstring, OPT-25), which ``tests/test_verif_lockstep_optical.py`` holds this block to, cycle by cycle.
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ from supi3.tables import BIT_RATES
 __all__ = ["LENGTH_COUNT_BITS", "PHASES", "OpticalRtl", "length_shift"]
 
 LENGTH_COUNT_BITS: Final = 14
-"""Width of a length timer, saturating (the model's ``supi3.model.blocks.optical.LENGTH_COUNT_BITS``; OPT-24)."""
+"""Width of a length timer, saturating (the pin model's ``LENGTH_COUNT_BITS``; OPT-24)."""
 PHASES: Final[tuple[Phase, ...]] = tuple(Phase)
 """The encoding of a transmitter's phase register: the index in this tuple."""
 _BYTE: Final = 8
@@ -159,8 +159,8 @@ def _init_timeout(tx: _Tx, due: Value) -> _Tx:
 
 class OpticalRtl(wiring.Component):
     """The optical block (ports: :data:`~supi3.optical.regulation.BLOCK_INPUTS` in,
-    :data:`~supi3.optical.regulation.BLOCK_OUTPUTS` out; the module docstring of
-    :mod:`supi3.model.blocks.optical` defines their timing). ``mode``, ``fast``, ``present`` and ``medium`` are
+    :data:`~supi3.optical.regulation.BLOCK_OUTPUTS` out; the module docstring of the pin model ``OpticalBlock``
+    defines their timing). ``mode``, ``fast``, ``present`` and ``medium`` are
     static while out of reset (straps and the interface recognition)."""
 
     def __init__(self) -> None:
