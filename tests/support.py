@@ -510,6 +510,11 @@ class FakeChain:
         return self.contents[-1] & 1 if self.length else 0
 
 
+def bad(value: object) -> Any:
+    """A wrongly typed argument for a hostile-input test, passed through without a type error from mypy."""
+    return value
+
+
 # The optical block (issue 12): stimulus for supi3.model.blocks.optical and supi3.rtl.optical ----------------------
 
 OPTICAL_INPUTS = [pin.name for pin in BLOCK_INPUTS]

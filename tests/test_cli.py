@@ -127,3 +127,21 @@ def test_regmap_html_to_directory(capsys: pytest.CaptureFixture[str], tmp_path: 
     out_dir = tmp_path / "html"
     code, out, _ = _run(capsys, "regmap", "--format", "html", "-o", str(out_dir))
     assert code == 0 and (out_dir / "index.html").exists() and str(out_dir) in out
+
+
+@pytest.mark.parametrize(("argv", "expected"), [
+    (["--metres", "150"], {"code": 24, "medium": "polymer", "register": "0x18", "one_way_m_from": 150.0}),
+    (["--metres", "150", "--medium", "glass"], {"code": 0, "medium": "glass", "register": "0x40"}),
+    (["--code", "63"], {"one_way_m_from": 393.75, "one_way_m_below": 20_000.0, "beyond_range": True}),
+    (["--register", "0xD8"], {"code": 24, "medium": "glass", "enable": 1, "one_way_m_from": 4800.0}),
+    (["--register", "152"], {"code": 24, "medium": "polymer", "enable": 1}),
+    (["--count", "12"], {"code": 24, "one_way_m_from": 150.0}),  # 500 kbit/s: 12.5 m one way per count
+    (["--count", "48", "--bit-rate", "2M"], {"code": 24}),  # 2 Mbit/s: 3.125 m per count
+])  # fmt: skip
+def test_optical_converts_both_ways(capsys: pytest.CaptureFixture[str], argv: list[str],
+                                    expected: dict[str, object]) -> None:
+    code, out, _ = _run(capsys, "optical", *argv, "--json")
+    data = json.loads(out)
+    assert code == 0 and {k: data[k] for k in expected} == expected
+    code, text, _ = _run(capsys, "optical", *argv)
+    assert code == 0 and f"code             {data['code']}" in text

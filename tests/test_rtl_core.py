@@ -264,3 +264,38 @@ def test_mod_ack_pulse_width(bench: Lockstep, tmp_path: Path) -> None:
     script.id_cycle(wire.command_word(quit_peripheral_error=True))
     expected = long_lockstep(bench, config, script.columns(), tmp_path)
     assert [length for _, length in pulses(expected["mod_ack_n"])] == [12, 12]
+
+
+# Diagnostic outputs (3.6.1, Tables 3-16 to 3-19, 2-8; docs/assumptions/diagnostics.md) --------------------------------
+
+
+@pytest.mark.parametrize("c", ["01000", "11100", "10000", "00000", "00100"])
+@pytest.mark.parametrize("diag_conf", [0, 1])
+def test_diagnostics_by_diag_conf(bench: Lockstep, c: str, diag_conf: int) -> None:
+    # DIAG1/DIAG2 (BA/RD or FO1/FO2), IB_DIAG, /ResReg and a bus terminal module's MFP LEDs in LB, LBD, RB and BK
+    # modes, through a reset pattern in the middle of a frame and a discarded cycle.
+    config = decode(c, clk_conf="11", diag_conf=diag_conf)
+    script = CoreScript(config, np.random.default_rng(21)).bring_up().data_cycle().id_cycle(wire.command_word(1))
+    levels = wire.cycle_levels(Frame.build(Cycle.DATA, LOOPBACK + b"\x5a"), 1, True)
+    script.line(levels[: len(levels) // 2]).line(wire.reset_levels(1)).line(IDLE)
+    bench.run_batch(script.data_cycle(latch=False).data_cycle().stimulus())
+
+
+@pytest.mark.parametrize("c", ["01000", "10000"])
+def test_idle_timeout_diagnostics(bench: Lockstep, tmp_path: Path, c: str) -> None:
+    # DG-3, DG-4: the line falls silent after a latched data cycle: /ResReg low (RC off) from the idle time-out
+    # until the master's reset pattern; in the LB mode IB_DIAG flashes at 4 Hz (low from clock 2**22), in the RB
+    # mode slowly (the time-out's reset: bus not active); RTL alike.
+    config = fast_config(c)
+    script = CoreScript(config, np.random.default_rng(22)).bring_up().data_cycle()
+    start = len(script.columns()["do1"])
+    silence = (1 << IB_DIAG_DIVIDER_BITS["very_fast"]) - start
+    script.line(np.ones(silence // wire.clocks_per_bit(config.bit_rate), dtype=np.uint8))
+    end = len(script.columns()["do1"])
+    expected = long_lockstep(bench, config, script.bring_up().data_cycle().columns(), tmp_path)
+    timeout = np.flatnonzero(expected["res_reg_n"] == 0)
+    assert timeout.size and timeout[0] > start and timeout[-1] >= end  # low over the rest of the silence
+    flash = expected["ib_diag"][timeout[0] : end]
+    half = 1 << (IB_DIAG_DIVIDER_BITS["very_fast"] - 1)
+    assert not flash[half - timeout[0] :].any() if c == "01000" else flash.all()
+    assert expected["ib_diag"][-1] == 1  # the bus active again: steady

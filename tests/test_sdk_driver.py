@@ -19,6 +19,7 @@ from hypothesis import strategies as st
 from supi3 import sdk
 from supi3.config import decode
 from supi3.model.registers import ReconfigurationError, RegisterFile
+from supi3.optical import length
 from supi3.regmap import (
     ALARM,
     ID,
@@ -34,6 +35,7 @@ from supi3.regmap import (
     AccessDirection,
     Register,
 )
+from supi3.sdk import include_dir
 from supi3.sdk.driver import (
     ERROR_CODES,
     AsyncSupi3Driver,
@@ -52,10 +54,13 @@ from supi3.sdk.driver import (
     UnsupportedError,
     get_u16,
     get_u32,
+    optical_length_cm,
+    optical_length_code,
     put_u16,
     put_u32,
 )
 from supi3.sdk.transports import ModelTransport, SpidevTransport
+from support import bad
 
 
 class Recording(ModelTransport):
@@ -555,3 +560,22 @@ def test_the_direct_path_has_the_effect_of_the_frames(mode: Mode, strict: bool, 
         outcomes[k] += [t.protocol.phase, t.protocol.c_d, [(type(v), str(v)) for v in t.registers.violations.records],
                         [t.registers.value(r.name) for r in REGISTER_MAP.registers if r.name != "IRQ_EVT"]]  # fmt: skip
     assert outcomes[0] == outcomes[1]
+
+
+def test_optical_length_conversions_match_the_c_header_and_opt_1() -> None:
+    header = (include_dir() / "supi3.h").read_text(encoding="utf-8")
+    defines = dict(re.findall(r"#define SUPI3_OPTICAL_(\w+) (\d+)u", header))
+    assert int(defines["POLYMER_UNIT_CM"]) == round(length.POLYMER_UNIT_M * 100)
+    assert int(defines["GLASS_UNIT_CM"]) == round(length.GLASS_UNIT_M * 100)
+    assert int(defines["LENGTH_MAX_CODE"]) == length.LENGTH_MAX_CODE
+    assert int(defines["MAX_PATH_CM"]) == round(length.MAX_PATH_M * 100)
+    for medium in (0, 1):
+        for code in range(64):
+            low, high = optical_length_cm(code, medium)
+            assert optical_length_code(low, medium) == code == optical_length_code(high - 1, medium)
+    assert optical_length_code(15_000, 0) == 24 and optical_length_cm(63, 0) == (39_375, 2_000_000)
+    for call in (lambda: optical_length_cm(64, 0), lambda: optical_length_cm(0, 2),
+                 lambda: optical_length_code(2_000_001, 0), lambda: optical_length_code(bad(1.5), 0),
+                 lambda: optical_length_code(0, bad(True))):
+        with pytest.raises(DriverArgumentError):
+            call()

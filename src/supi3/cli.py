@@ -43,6 +43,8 @@ from supi3.checks import check_int, fail
 from supi3.checks import describe as _shown
 from supi3.config import DeviceConfig, Interface, MfpKind, Variant, decode, mode_rows
 from supi3.errors import Supi3Error
+from supi3.optical import length as optical_length
+from supi3.regmap import LENGTH_OUT
 
 MAX_NETWORK_BYTES = timing.MAX_NETWORK_BYTES
 """``timing --bytes`` limit: 512 devices (the INTERBUS limit) of the longest data length, 32 words (Table 3-11)."""
@@ -375,6 +377,54 @@ def cmd_timing(args: argparse.Namespace) -> None:
                              r["max_ns"] if r["max_ns"] is not None else "-", r["explanation"]) for r in table]))
 
 
+_MEDIA = {"polymer": optical_length.Medium.POLYMER, "glass": optical_length.Medium.GLASS}
+_METRES = re.compile(r"[0-9]+(\.[0-9]+)?")
+
+
+def metres(text: str) -> float:
+    """An argparse type: a length in metres in decimal digits (``150``, ``387.5``; no sign, exponent or ``_``)."""
+    if not _METRES.fullmatch(text) or len(text) > _MAX_DIGITS:
+        raise argparse.ArgumentTypeError(f"must be metres in decimal digits (e.g. 150 or 387.5), not {_shown(text)}")
+    return float(text)
+
+
+def register_byte(text: str) -> int:
+    """An argparse type: a register byte, decimal or ``0x`` hex, 0 to 255."""
+    try:
+        value = int(text, 16) if text.lower().startswith("0x") else integer(text)
+    except (ValueError, argparse.ArgumentTypeError):
+        raise argparse.ArgumentTypeError(f"must be a byte, decimal or 0x hex, not {_shown(text)}") from None
+    if not 0 <= value <= 0xFF:
+        raise argparse.ArgumentTypeError(f"must be a byte from 0 to 255, not {_shown(text)}")
+    return value
+
+
+def cmd_optical(args: argparse.Namespace) -> None:
+    """Reads 8 and 9 (LENGTH, MEDIUM, ENABLE) to metres and back, and length timer results to codes (OPT-1)."""
+    medium = _MEDIA[args.medium]
+    if args.register is not None:
+        fields = LENGTH_OUT.decode(args.register)
+        medium = optical_length.Medium(fields["MEDIUM"])
+        code, enable = fields["LENGTH"], fields["ENABLE"]
+    elif args.code is not None:
+        code, enable = check_int("--code", args.code, 0, optical_length.LENGTH_MAX_CODE, "LENGTH, 6 bits"), 0
+    elif args.metres is not None:
+        code, enable = optical_length.length_code(args.metres, medium), 0
+    else:
+        count = check_int("--count", args.count, 0, None, "the length timer result n (1.6.1)")
+        code, enable = optical_length.timer_code(count, _parse_bit_rate(args.bit_rate), medium), 0
+    low, high = optical_length.code_range_m(code, medium)
+    register = LENGTH_OUT.encode(LENGTH=code, MEDIUM=int(medium), ENABLE=enable)
+    data = {"code": code, "medium": medium.name.lower(), "enable": enable, "register": f"0x{register:02X}",
+            "one_way_m_from": low, "one_way_m_below": high,
+            "beyond_range": code == optical_length.LENGTH_MAX_CODE}
+    if args.json:
+        print_json(data)
+        return
+    for key, value in data.items():
+        print(f"{key:16} {value}")
+
+
 def _parse_bit_rate(text: str) -> int:
     aliases = {"500k": 500_000, "500000": 500_000, "2m": 2_000_000, "2000000": 2_000_000}
     try:
@@ -582,6 +632,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--table", choices=sorted(timing.TIMING_TABLES), help="also evaluate a timing table")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_timing)
+
+    p = sub.add_parser("optical", help="optical path length: register reads 8/9 <-> metres and medium (OPT-1)")
+    what = p.add_mutually_exclusive_group(required=True)
+    what.add_argument("--register", type=register_byte, metavar="BYTE",
+                      help="a read 8 or 9 byte (LENGTH, MEDIUM, ENABLE; 3.4.12) to decode")
+    what.add_argument("--code", type=integer, metavar="N", help="a LENGTH code, 0 to 63, to turn into metres")
+    what.add_argument("--metres", type=metres, metavar="M", help="a one-way path length to turn into its code")
+    what.add_argument("--count", type=integer, metavar="N", help="a length timer result n (1.6.1) at --bit-rate")
+    p.add_argument("--medium", choices=sorted(_MEDIA), default="polymer", help="fibre medium (default polymer)")
+    p.add_argument("--bit-rate", default="500k", help="500k or 2M, for --count")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_optical)
 
     p = sub.add_parser("campaign", help="a seeded fault campaign: error locations, latches, recovery, memory")
     _campaign_arguments(p)

@@ -122,9 +122,10 @@ STRAP_PINS: Final[tuple[Pin, ...]] = (
 
 SYNC_STAGES: Final = 2
 """Every asynchronous input passes two flip-flops before use (M1)."""
-IB_DIAG_DIVIDER_BITS: Final[dict[str, int]] = {"slow": 26, "fast": 24}
+IB_DIAG_DIVIDER_BITS: Final[dict[str, int]] = {"slow": 26, "fast": 24, "very_fast": 23}
 """IB_DIAG flashes from a free-running binary divider: 2**26 clocks (0.48 Hz) for "bus not active", 2**24
-(1.9 Hz) for "peripheral fault" (Table 3-18 asks 0.5 Hz and 2 Hz; M6)."""
+(1.9 Hz) for "peripheral fault", 2**23 (3.8 Hz) for "line interrupt ahead on the local bus" (Table 3-18 asks
+0.5 Hz, 2 Hz and 4 Hz; M6, DG-2 of ``docs/assumptions/diagnostics.md``)."""
 
 # ----------------------------------------------------------------------------------------------------------------
 # The serial µP interface (3.4) and its place on the MFPs

@@ -607,6 +607,36 @@ static void test_optical_status(void)
     CHECK_EQ(st.out_length, 0xEE); /* written only when all four reads went through */
 }
 
+static void test_optical_length_conversions(void)
+{
+    /* OPT-1: every code of both media round-trips; 150 m polymer is code 24; limits and NULLs are refused. */
+    uint32_t lo = 7u, hi = 7u, m;
+    uint8_t code = 99u, c, medium;
+    for (medium = 0u; medium <= 1u; ++medium) {
+        for (c = 0u; c <= SUPI3_OPTICAL_LENGTH_MAX_CODE; ++c) {
+            CHECK_EQ(supi3_optical_length_cm(c, medium, &lo, &hi), SUPI3_OK);
+            CHECK(lo < hi);
+            CHECK_EQ(supi3_optical_length_code(lo, medium, &code), SUPI3_OK); CHECK_EQ(code, c);
+            CHECK_EQ(supi3_optical_length_code(hi - 1u, medium, &code), SUPI3_OK); CHECK_EQ(code, c);
+        }
+        CHECK_EQ(hi, SUPI3_OPTICAL_MAX_PATH_CM);
+    }
+    CHECK_EQ(supi3_optical_length_code(15000u, 0u, &code), SUPI3_OK); CHECK_EQ(code, 24u);
+    CHECK_EQ(supi3_optical_length_code(15000u, 1u, &code), SUPI3_OK); CHECK_EQ(code, 0u);
+    CHECK_EQ(supi3_optical_length_cm(63u, 0u, &lo, &hi), SUPI3_OK); CHECK_EQ(lo, 39375u);
+    m = SUPI3_OPTICAL_MAX_PATH_CM;
+    CHECK_EQ(supi3_optical_length_code(m, 1u, &code), SUPI3_OK); CHECK_EQ(code, 63u);
+    code = 99u; lo = hi = 7u;
+    CHECK_EQ(supi3_optical_length_code(m + 1u, 0u, &code), SUPI3_E_ARG);
+    CHECK_EQ(supi3_optical_length_code(0u, 2u, &code), SUPI3_E_ARG);
+    CHECK_EQ(supi3_optical_length_code(0u, 0u, NULL), SUPI3_E_ARG);
+    CHECK_EQ(supi3_optical_length_cm(64u, 0u, &lo, &hi), SUPI3_E_ARG);
+    CHECK_EQ(supi3_optical_length_cm(0u, 2u, &lo, &hi), SUPI3_E_ARG);
+    CHECK_EQ(supi3_optical_length_cm(0u, 0u, NULL, &hi), SUPI3_E_ARG);
+    CHECK_EQ(supi3_optical_length_cm(0u, 0u, &lo, NULL), SUPI3_E_ARG);
+    CHECK_EQ(code, 99u); CHECK_EQ(lo, 7u); CHECK_EQ(hi, 7u);
+}
+
 static void test_helpers_and_strerror(void)
 {
     uint8_t b[4];
@@ -649,7 +679,8 @@ int main(void)
         test_interrupted_and_disabled, test_without_read_cd, test_argument_checks,
         test_motorola_block_and_exchange, test_intel_block_fig_3_12, test_block_length_follows_set, test_irq_service,
         test_transport_error, test_irq_enable, test_poll_io_window_by_register, test_poll_io_window_by_pin,
-        test_processor_alarm_and_command, test_optical_status, test_helpers_and_strerror,
+        test_processor_alarm_and_command, test_optical_status, test_optical_length_conversions,
+        test_helpers_and_strerror,
         test_frame_gap_and_no_globals,
     };
     size_t k, n = sizeof tests / sizeof tests[0];

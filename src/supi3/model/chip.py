@@ -35,6 +35,7 @@ from typing import ClassVar, Final, Protocol, TypeVar
 from supi3 import tables
 from supi3.checks import check_bits, check_bool, check_bytes, check_instance, check_int, check_real, fail
 from supi3.config import DeviceConfig, MfpKind, Variant, decode
+from supi3.diagnostics import DiagnosticOutputs, LedInputs, diagnostic_outputs, watches_line_interrupt
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.expansion import PULSE_T0, ExternalRegisters, end_pulses
 from supi3.interbus import wire
@@ -251,10 +252,9 @@ class Supi3:
         "__dict__",  # room beyond the declared state, so that a test can spy on a chip's methods
         "_chain", "_cpb", "_deadline", "_due_s", "_events", "_exr_driver", "_exr_free", "_fast_valid", "_fixed_bytes",
         "_frame_bytes", "_in_map", "_loaded", "_now", "_optical", "_optical_until", "_out", "_out_map", "_send_alarm",
-        "_serial_pins", "_shown",
-        "_stat_err", "_stat_low_since", "attention", "bus_active", "config", "due", "in_word", "io_access", "mfp_in",
-        "mod_ack_until", "pf", "registers", "resreg_until", "revision", "serial_device", "spi_sequences", "te",
-        "watchdog_code", "wd",
+        "_serial_pins", "_shown", "_stat_err", "_stat_low_since", "_watch_line", "attention", "bus_active", "config",
+        "due", "in_word", "io_access", "led_inputs", "line_interrupt", "line_silent", "mfp_in", "mod_ack_until", "pf",
+        "registers", "resreg_until", "revision", "serial_device", "spi_sequences", "te", "watchdog_code", "wd",
     )  # fmt: skip
 
     data_kernel: ClassVar[DataKernel] = DataKernel(_load_data_run, _latch_data_run)
@@ -287,6 +287,9 @@ class Supi3:
         self._chain: ExternalRegisters | None = None
         self._exr_driver: ExpansionDriver | None = None
         self._cpb = wire.clocks_per_bit(self.config.bit_rate)
+        self._watch_line = watches_line_interrupt(self.config)
+        self.led_inputs = LedInputs()
+        """What the optical block and the bus terminal logic show on the LEDs (:meth:`set_led_inputs`)."""
         self.revision = 0
         """Counts the changes of what the pins show (OUT data, ``pf``, ``bus_active``, the /ModAck and /ResReg
         pulses): the pin level records its outputs only when this moves."""
@@ -317,6 +320,10 @@ class Supi3:
         self.io_access = False
         self._send_alarm = False
         self._exr_free = 0
+        self.line_silent = False
+        """The incoming line fell silent (idle time-out) and was not heard since: RC off, /ResReg low (DG-4)."""
+        self.line_interrupt = False
+        """IB_DIAG's 4 Hz cause: a line interrupt ahead on the local bus (DG-3)."""
         self._optical_power_up()  # optical block (issue 12)
         self._reschedule()
 
@@ -384,6 +391,59 @@ class Supi3:
     def module_error(self) -> bool:
         """/StatErr has been low for the whole filter time (3.6.2)."""
         return self._stat_low_since is not None and self._filtered
+
+    # --------------------------------------------------------------------------------------------------------
+    # Diagnostic outputs (3.6.1, Tables 3-16 to 3-19, 2-8): the LED view, the silent line and the line interrupt
+    # ahead (supi3.diagnostics; docs/assumptions/diagnostics.md DG-1 to DG-8). The pin level's outputs block shows
+    # the same state at the pins (supi3.model.blocks.outputs).
+    # --------------------------------------------------------------------------------------------------------
+
+    @property
+    def diagnostic_outputs(self) -> DiagnosticOutputs:
+        """Every diagnostic LED now (read-only), from the chip's state through :func:`supi3.diagnostics.
+        diagnostic_outputs`: UL, RC, BA, RD, LD, E, ALARM, FO1..FO3, the IB_DIAG pattern, and DIAG1/DIAG2 as
+        DIAG_CONF selects. At transaction level the supply is always good (UL lit): the power-up reset has no
+        duration here (1.7.2 is the pin level's)."""
+        return diagnostic_outputs(self.config, supply_ok=True, line_heard=not self.line_silent,
+                                  bus_active=self.bus_active, peripheral_fault=self.pf,
+                                  line_interrupt=self.line_interrupt, leds=self.led_inputs)  # fmt: skip
+
+    def set_led_inputs(self, leds: LedInputs) -> None:
+        """What the chip's optical block (FO1..FO3) and bus terminal logic (RD, LD, E, ALARM) show from now on
+        (DG-5, DG-7); both fidelities read it (the RTL ties these ports to 0 until those blocks drive them).
+
+        Raises
+        ------
+        ChipArgumentError
+            ``leds`` is not a :class:`~supi3.diagnostics.LedInputs`.
+        """
+        self.led_inputs = _checked(check_instance, "leds", leds, LedInputs)
+        self.revision += 1
+
+    def line_timeout(self, now: float) -> None:
+        """The incoming line was silent for ``wire.IDLE_TIMEOUT_S`` (A13), ending at bus time ``now``: what the
+        line side calls in place of :meth:`reset` for a silent line (:meth:`line_timeout_at`)."""
+        self.line_timeout_at(clocks(now))
+
+    def line_timeout_at(self, clk: int) -> None:
+        """The idle time-out at clock ``clk``: the INTERBUS reset it makes (:meth:`reset_at`); the line counts as
+        silent until it is heard again (RC off, /ResReg low: DG-4), and in the local bus modes a bus that was
+        active raises the line interrupt ahead (IB_DIAG 4 Hz: DG-3). The master's reset pattern, the end of the
+        next cycle that reaches the chip (latch or discard) and a power-up clear both."""
+        if type(clk) is not int or clk < 0:
+            clk = _clock(clk)
+        interrupt = self._watch_line and self.bus_active
+        self.reset_at(clk)
+        self.line_silent = True
+        self.line_interrupt = interrupt
+        self._reschedule()
+
+    def _line_heard(self) -> None:
+        """A cycle ended at the chip, or the master's reset pattern arrived: the line is not silent (DG-3, DG-4)."""
+        if self.line_silent:
+            self.line_silent = self.line_interrupt = False
+            self.revision += 1
+            self._reschedule()
 
     # --------------------------------------------------------------------------------------------------------
     # What the master sees
@@ -728,10 +788,12 @@ class Supi3:
             due = min(due, self._stat_low_since + STATERR_FILTER_CLOCKS)
         due = min(due, self._optical_until)  # optical block: the 6 ms initialization budget (OPT-20)
         self.due = due
-        # See "The ring kernel"; a serial device takes the latch's slow path (the sequence runs there), and so does
-        # a chip held by the optical initialization (OPT-20).
-        fast = self.registers is None and self.serial_device is None and self._optical_until == _NEVER
-        self._due_s = due / CLOCK_HZ if fast else -1.0
+        # See "The ring kernel"; a serial device takes the latch's slow path (the sequence runs there).
+        # A silent line takes the slow path too: the next cycle's end is heard there (_line_heard); and so does a chip
+        # held by the optical initialization (OPT-20).
+        kernel = (self.registers is None and self.serial_device is None and not self.line_silent
+                  and self._optical_until == _NEVER)  # fmt: skip
+        self._due_s = due / CLOCK_HZ if kernel else -1.0
 
     def _advance(self, clk: int) -> None:
         """Bring time-driven state up to clock ``clk``: the /StatErr filter and the layer-2 watchdog."""
@@ -825,6 +887,7 @@ class Supi3:
             received = _checked(check_bytes, "received", received, length, f"{what} of the {cycle.value} cycle")
         self.revision += 1
         self._now = clk
+        self._line_heard()
         if clk >= self.due:
             self._expire(clk)
         if self._optical_until != _NEVER:  # optical block: the core is held in reset, latches nothing (OPT-20)
@@ -880,6 +943,7 @@ class Supi3:
         if type(clk) is not int or clk < 0:
             clk = _clock(clk)
         self._advance(clk)
+        self._line_heard()
         if self._optical_until != _NEVER:  # optical block: the core is held in reset (OPT-20)
             return
         self.te = self.te or local_error
@@ -894,6 +958,7 @@ class Supi3:
             clk = _clock(clk)
         self.revision += 1
         self._advance(clk)
+        self._line_heard()
         self._clear_process_data()
         if self.expansion:
             self._expansion_reset(clk)

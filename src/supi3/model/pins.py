@@ -54,6 +54,7 @@ import numpy.typing as npt
 
 from supi3.checks import check_bits, check_instance, check_int, check_trace, fail
 from supi3.config import DeviceConfig
+from supi3.diagnostics import is_complete
 from supi3.interbus import wire
 from supi3.model.blocks.datapath import DataPath
 from supi3.model.blocks.expansion import Expansion
@@ -140,7 +141,7 @@ class Supi3Pins:
         self.cpb = wire.clocks_per_bit(config.bit_rate)
         self.mfp_oe = config.mfp_output_mask
         self.log = EventLog()
-        self.complete_diagnostics = config.diagnostics is not None and config.diagnostics.diag_conf == 0
+        self.complete_diagnostics = is_complete(config)
         """DIAG1 shows BA (DIAG_CONF = 0, Table 3-16)."""
         self.rbst_by_pin = config.rf_mode is not None and config.rf_mode.rf == "10"
         """A following device is told by RBST_EXT (RF = 10, Table 2-2), not recognised on DI2 (M5)."""
@@ -158,8 +159,7 @@ class Supi3Pins:
         # Serial I/O in the SPI master modes (3.3): the chip starts its sequences at each latch (Supi3.attach_serial).
         self._serial = SerialIo(self.chip) if self.chip.spi_sequences is not None else None
         self.chip._serial_pins = self._serial
-        self._outputs = Outputs(self.chip, self._transmitter, self.cpb, self.mfp_oe, self.complete_diagnostics,
-                                self._serial)
+        self._outputs = Outputs(self.chip, self._transmitter, self.cpb, self.mfp_oe, self._serial)
         self.reset()
 
     # ------------------------------------------------------------------------------------------------------------

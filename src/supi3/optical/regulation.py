@@ -71,9 +71,9 @@ __all__ = [
     "length_timer_enable_every",
     "mau_after",
     "online_test",
+    "probe_power_db",
     "registers",
     "start",
-    "test_power_db",
 ]
 
 MAX_LEVEL: Final = 15
@@ -268,7 +268,7 @@ def diagnostic_mau(mau: bool, ack1: bool, ack2: bool) -> bool:
     return False if ack2 else mau
 
 
-def test_power_db(level: int, test: int) -> float:
+def probe_power_db(level: int, test: int) -> float:
     """Transmit power of test 1 or 2 relative to full power (level 15): level, reserve and one level more for
     test 2 (1.6.2; OPT-4). Test 0 is the normal power of the level."""
     check_int("level", level, MIN_LEVEL, MAX_LEVEL)

@@ -41,6 +41,7 @@ from amaranth.lib.wiring import In, Out
 
 from supi3.checks import check_bool
 from supi3.config import Variant
+from supi3.diagnostics import BUS_TERMINAL_PINS
 from supi3.errors import ArgumentError
 from supi3.expansion import PULSE_T0
 from supi3.interbus import wire
@@ -242,10 +243,13 @@ class Supi3Core(wiring.Component):
         dclk = Signal()
         rbst_by_pin = Signal()
         complete_diag = Signal()
+        local_bus = Signal()  # the mode raises the line interrupt ahead (DG-3)
+        bus_terminal = Signal()  # a bus terminal module: LEDs on MFP15, 14, 13, 8 (Table 2-8)
         maps = tables.io_maps
         with m.Switch(Cat(self.mfp_in[MFP_PINS - EXPANSION_BITS :], self.c)):
-            for mode, serial in zip(tables.modes, tables.serial, strict=True):
+            for mode, serial, (watch, bk) in zip(tables.modes, tables.serial, tables.diagnostics, strict=True):
                 with m.Case(mode.pattern):
+                    m.d.comb += [local_bus.eq(watch), bus_terminal.eq(bk)]
                     if serial is not None:
                         m.d.comb += [
                             spi.eq(1),
@@ -344,6 +348,10 @@ class Supi3Core(wiring.Component):
             outputs.divider.eq(cycle),
             outputs.rbst_by_pin.eq(rbst_by_pin),
             outputs.complete_diag.eq(complete_diag),
+            outputs.local_bus.eq(local_bus),
+            outputs.bus_terminal.eq(bus_terminal),
+            outputs.idle_timeout.eq(receiver.line.idle_timeout),
+            outputs.discard.eq(frame.discard),
         ]
 
         # SPI master modes (3.3): the serial I/O block takes the OUT word of a valid data cycle's latch and gives
@@ -436,7 +444,7 @@ class Supi3Core(wiring.Component):
         m.d.comb += [
             self.do2.eq(transmitter.do2),
             self.di1.eq(outputs.di1),
-            self.mfp_out.eq(datapath.mfp_out | Mux(spi, serial_io.mfp, 0)),
+            self.mfp_out.eq(datapath.mfp_out | Mux(spi, serial_io.mfp, 0) | outputs.mfp_diag),
             self.mod_ack_n.eq(outputs.mod_ack_n),
             self.res_reg_n.eq(outputs.res_reg_n),
             self.diag1.eq(outputs.diag1),
@@ -871,10 +879,15 @@ class OutputsRtl(wiring.Component):
     The /StatErr filter (200 ms, 3.6.2) and the peripheral fault PF, the layer-2 watchdog (Table 3-13) and WD, TE and
     the attention bit, "bus active", the processor alarm request (A18); the /ModAck and /ResReg pulse counters
     (loaded with the width at the edge that starts the pulse, the pin low while non-zero); the following device
-    (Table 2-2, M5) and DI1; DIAG1 (BA with complete diagnostics, Table 3-16) and IB_DIAG flashing from the
-    free-running ``divider`` (Table 3-18, M6). The chip registers follow ``model.chip.Supi3``; the frame engine
-    drives them through ``frame`` (:data:`MANAGEMENT`, flipped), and ``words`` (:data:`WORDS`, flipped) gives the
-    data path the management bits and the watchdog's reset and takes the command word.
+    (Table 2-2, M5) and DI1; the diagnostic outputs of ``supi3.diagnostics`` (3.6.1, DG-1 to DG-8): the silent line
+    and the line interrupt ahead (set by the receiver's ``idle_timeout``, cleared when a cycle ends at the chip or
+    the master's reset pattern comes), DIAG1/DIAG2 (BA/RD or FO1/FO2 by ``complete_diag``, Table 3-16), /ResReg
+    low while the line is silent (RC, DG-4), IB_DIAG flashing from the free-running ``divider`` (Table 3-18, M6,
+    DG-1, DG-2), and a bus terminal module's ALARM, LD, E and FO3 on ``mfp_diag`` (Table 2-8). ``fo`` (the optical
+    block's FO1..FO3), ``rd``, ``ld``, ``e`` and ``alarm`` are ``supi3.diagnostics.LedInputs``: the core ties them
+    to 0 until the blocks that drive them are in. The chip registers follow ``model.chip.Supi3``; the frame engine
+    drives them through ``frame`` (:data:`MANAGEMENT`, flipped) and ``discard``, and ``words`` (:data:`WORDS`,
+    flipped) gives the data path the management bits and the watchdog's reset and takes the command word.
     """
 
     def __init__(self, divider_bits: int) -> None:
@@ -883,8 +896,10 @@ class OutputsRtl(wiring.Component):
             "stat_err_n_s": In(1), "di2_s": In(1), "rbst_ext_s": In(1), "di2": In(1), "do2": In(1),
             "divider": In(divider_bits), "rbst_by_pin": In(1), "complete_diag": In(1),
             "expansion": In(1), "expansion_pulse": In(range(_EXPANSION_PULSE_MAX + 1)),
+            "local_bus": In(1), "bus_terminal": In(1), "idle_timeout": In(1), "discard": In(1),
+            "fo": In(3), "rd": In(1), "ld": In(1), "e": In(1), "alarm": In(1),
             "send_alarm": Out(1), "di1": Out(1), "mod_ack_n": Out(1), "res_reg_n": Out(1), "diag1": Out(1),
-            "diag2": Out(1), "ib_diag": Out(1),
+            "diag2": Out(1), "ib_diag": Out(1), "mfp_diag": Out(MFP_PINS),
         })  # fmt: skip
 
     def elaborate(self, _platform: object) -> Module:
@@ -928,7 +943,9 @@ class OutputsRtl(wiring.Component):
             sync += mod_ack.eq(mod_ack - 1)
         with m.If(res_reg != 0):
             sync += res_reg.eq(res_reg - 1)
-        comb += [self.mod_ack_n.eq(mod_ack == 0), self.res_reg_n.eq(res_reg == 0)]
+        # RC (DG-4): /ResReg is low while the incoming line is silent, too.
+        line_silent, line_interrupt = Signal(), Signal()
+        comb += [self.mod_ack_n.eq(mod_ack == 0), self.res_reg_n.eq((res_reg == 0) & ~line_silent)]
 
         pf_now = pf | filtered
         wd_now = wd | fire
@@ -975,15 +992,30 @@ class OutputsRtl(wiring.Component):
         with m.If(f.latch_data):  # a valid data cycle: the bus is active, the watchdog restarted
             sync += [bus_active.eq(1), *arm(wd_code)]
 
-        fast, slow = (IB_DIAG_DIVIDER_BITS[k] - 1 for k in ("fast", "slow"))
+        # The line is heard (chip._line_heard): a cycle ends at the chip, or the master's reset pattern comes; the
+        # idle time-out (chip.line_timeout_at) comes after the frame it abandons, so it wins (DG-3, DG-4).
+        heard = (f.clear & ~self.idle_timeout) | self.discard | f.latch_id | f.latch_data
+        with m.If(heard):
+            sync += [line_silent.eq(0), line_interrupt.eq(0)]
+        with m.If(self.idle_timeout):
+            sync += [line_silent.eq(1), line_interrupt.eq(self.local_bus & bus_active)]
+
+        very_fast, fast, slow = (IB_DIAG_DIVIDER_BITS[k] - 1 for k in ("very_fast", "fast", "slow"))
+        mfp = Signal(MFP_PINS)
+        for name, pin in BUS_TERMINAL_PINS.items():  # Table 2-8 (DG-6)
+            comb += mfp[pin].eq(self.fo[2] if name == "fo3" else getattr(self, name))
         comb += [
             # The return line passes straight through when a device follows; the last device loops back (M5).
             self.di1.eq(Mux(next_present, self.di2, self.do2)),
-            self.diag1.eq(self.complete_diag & bus_active),
-            self.diag2.eq(0),
-            # Table 3-18: fast flashing on a peripheral fault, slow while the bus is not active (M6).
-            self.ib_diag.eq(Mux(pf, ~self.divider[fast], Mux(bus_active, 1, ~self.divider[slow]))),
-        ]
+            # Table 3-16: BA/RD with complete diagnostics, FO1/FO2 with limited diagnostics.
+            self.diag1.eq(Mux(self.complete_diag, bus_active, self.fo[0])),
+            self.diag2.eq(Mux(self.complete_diag, self.rd, self.fo[1])),
+            # Table 3-18 in the order of DG-1: line interrupt ahead (4 Hz), peripheral fault (2 Hz), bus not active
+            # (0.5 Hz), else steady (M6, DG-2).
+            self.ib_diag.eq(Mux(line_interrupt, ~self.divider[very_fast],
+                                Mux(pf, ~self.divider[fast], Mux(bus_active, 1, ~self.divider[slow])))),
+            self.mfp_diag.eq(Mux(self.bus_terminal, mfp, 0)),
+        ]  # fmt: skip
         return m
 
 

@@ -18,6 +18,7 @@ from typing import Final
 
 from supi3.checks import fail
 from supi3.config import DataDirection, DeviceConfig, MfpKind, Variant, decode, mode_rows
+from supi3.diagnostics import watches_line_interrupt
 from supi3.errors import ConfigurationError
 from supi3.interbus import wire
 from supi3.pinout import C_BITS, CLK_CONF_BITS, DIAG_CONF_BITS, EXPANSION_BITS, MFP_PINS, RF_BITS, SYNC_STAGES
@@ -151,6 +152,9 @@ class CoreTables:
     """RF[1..0] values that select bus connector recognition via RBST_EXT (Table 2-2)."""
     complete_diagnostics: tuple[int, ...]
     """DIAG_CONF values that select complete diagnostics, DIAG1 = BA (Table 3-16)."""
+    diagnostics: tuple[tuple[bool, bool], ...]
+    """For each mode, (it raises the line interrupt ahead, it is a bus terminal module): ``supi3.diagnostics``
+    (DG-3, Table 2-8)."""
 
     @property
     def io_maps(self) -> tuple[tuple[tuple[int | None, ...], tuple[int | None, ...]], ...]:
@@ -279,4 +283,5 @@ def core_tables(variant: Variant | str = Variant.OPC) -> CoreTables:
         diag = _values(DIAG_CONF_BITS, lambda b: decode(first.c, first.mfp, diag_conf=b, variant=variant))
         rbst = tuple(value for value, config in rf if rbst_by_pin(config))
         complete = tuple(value for value, config in diag if complete_diagnostics(config))
-    return CoreTables(variant, modes, serial, tuple(clocks), rbst, complete)
+    diagnostics = tuple((watches_line_interrupt(config), config.interface.is_bus_terminal) for config in configs)
+    return CoreTables(variant, modes, serial, tuple(clocks), rbst, complete, diagnostics)

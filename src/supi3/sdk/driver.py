@@ -23,6 +23,7 @@ from typing import Any, Final, Protocol, TypeVar
 
 from supi3.checks import check_bool, check_bytes, check_int, check_real, describe
 from supi3.errors import ArgumentError, Supi3Error
+from supi3.optical import length as _length
 from supi3.regmap import ALARM as ALARM_REGISTER
 from supi3.regmap import (
     BLOCK_ADDRESS,
@@ -67,6 +68,8 @@ __all__ = [
     "UnsupportedError",
     "get_u16",
     "get_u32",
+    "optical_length_cm",
+    "optical_length_code",
     "put_u16",
     "put_u32",
 ]
@@ -197,6 +200,25 @@ class OpticalStatus:
                                         POWER_IN.decode(raw[2]), POWER_OUT_BRANCH.decode(raw[3]))  # fmt: skip
         return cls(out["LENGTH"], out["MEDIUM"], out["ENABLE"], branch["LENGTH"], branch["MEDIUM"], branch["ENABLE"],
                    power_in["LEVEL"], power_in["ENABLE"], power["OUT_LEVEL"], power["BRANCH_LEVEL"])  # fmt: skip
+
+
+def _medium(value: object) -> _length.Medium:
+    return _length.Medium(_checked(check_int, "medium", value, 0, 1, "MEDIUM: 0 polymer, 1 glass"))
+
+
+def optical_length_cm(code: int, medium: int) -> tuple[int, int]:
+    """The one-way path a LENGTH code stands for, ``(low_cm, high_cm)``, high exclusive (OPT-1); code 63 reaches up
+    to 20 km. ``medium``: 0 polymer, 1 glass. ``supi3_optical_length_cm``."""
+    code = _checked(check_int, "code", code, 0, _length.LENGTH_MAX_CODE, "LENGTH, 6 bits (RM-5)")
+    low, high = _length.code_range_m(code, _medium(medium))
+    return round(low * 100), round(high * 100)
+
+
+def optical_length_code(one_way_cm: int, medium: int) -> int:
+    """The LENGTH code a one-way path of ``one_way_cm`` centimetres reads (truncated to the medium's unit, 63 above
+    the range; OPT-1). ``supi3_optical_length_code``."""
+    cm = _checked(check_int, "one_way_cm", one_way_cm, 0, round(_length.MAX_PATH_M * 100), "20 km (Table 1-5)")
+    return _length.length_code(cm / 100, _medium(medium))
 
 
 # ------------------------------------------------------------------------------------------------------------

@@ -1,10 +1,16 @@
 """Outputs and diagnostics: the MFP outputs and enables, /ModAck, /ResReg, DIAG1/DIAG2, IB_DIAG, DCLK and /ResU.
 
 Manual: Table 1-4 (the output pins), Tables 3-1 to 3-6 and 2-8 (MFP directions), 3.6.2 (/ModAck), Table 3-13 and
-3.4.14 (the /ResReg pulse on a watchdog reset of process data), Table 3-16 (DIAG1/DIAG2: BA/RD or FO1/FO2 by
-DIAG_CONF), Table 3-18 (the IB_DIAG flashing codes), 1.7.2 (the chip pulling /ResU low during its reset). The
-levels come from :class:`supi3.model.chip.Supi3`; this block gives their timing at the pins. Decisions: M3 (pulses
-seen from the cycle after the edge that starts them), M6 (IB_DIAG divider), ``docs/model.md``.
+3.4.14 (the /ResReg pulse on a watchdog reset of process data), 3.6.1 (Tables 3-16 to 3-19: DIAG1/DIAG2 as BA/RD or
+FO1/FO2 by DIAG_CONF, the IB_DIAG flashing codes, RC on /ResReg, UL on /ResU), Table 2-8 (a bus terminal module's
+ALARM, LD, E and FO3 on MFP15, 14, 13 and 8), 1.7.2 (the chip pulling /ResU low during its reset). The levels come
+from :class:`supi3.model.chip.Supi3` (its LED view :attr:`~supi3.model.chip.Supi3.diagnostic_outputs`, built by
+:mod:`supi3.diagnostics`); this block gives their timing at the pins. Decisions: M3 (pulses seen from the cycle
+after the edge that starts them), M6 (IB_DIAG divider), ``docs/model.md``; DG-1 to DG-8,
+``docs/assumptions/diagnostics.md``.
+
+What the optical block (FO1..FO3) and the bus terminal logic (RD, LD, E, ALARM) give this block is the chip's
+:attr:`~supi3.model.chip.Supi3.led_inputs` (:class:`supi3.diagnostics.LedInputs`, all 0 until those blocks set it).
 
 RTL counterpart: the ``outputs`` block of :mod:`supi3.rtl.core` (``Outputs``: the pulse counters, the IB_DIAG
 divider, the diagnostic outputs).
@@ -12,19 +18,31 @@ divider, the diagnostic outputs).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
+from supi3.diagnostics import DiagnosticOutputs
 from supi3.model.blocks.serial_io import SerialIo
 from supi3.model.blocks.transmitter import PinTrace, Transmitter
-from supi3.pinout import IB_DIAG_DIVIDER_BITS
 
 if TYPE_CHECKING:
     from supi3.model.chip import Supi3
 
-Snapshot = tuple[int, int, int, int, int, int, int]
+class _View(NamedTuple):
+    """The chip's LEDs at one ``Supi3.revision`` and what they put on the pins (DIAG1, DIAG2, the bus terminal's
+    MFP bits, the IB_DIAG divider's bits or 0 for a steady light)."""
+
+    revision: int
+    leds: DiagnosticOutputs
+    diag1: int
+    diag2: int
+    mfp: int
+    ib_bits: int
+
+
+Snapshot = tuple[int, int, int, int, int, int, int, int]
 """What the outputs of a cycle depend on besides the cycle number (see :meth:`Outputs.snapshot`)."""
 
 
@@ -41,59 +59,65 @@ class Outputs:
         Clocks per bit (DCLK).
     mfp_oe:
         The MFP output enables of the configuration.
-    complete_diagnostics:
-        DIAG1 shows BA (DIAG_CONF = 0, Table 3-16).
     serial:
         The serial I/O block driving MFP3, 4, 5 and 7 in the SPI master modes (3.3), else None.
     """
 
-    __slots__ = ("chip", "complete_diagnostics", "cpb", "mfp_oe", "serial", "transmitter")
+    __slots__ = ("_view", "chip", "cpb", "mfp_oe", "serial", "transmitter")
 
-    def __init__(self, chip: Supi3, transmitter: Transmitter, cpb: int, mfp_oe: int, complete_diagnostics: bool,
+    def __init__(self, chip: Supi3, transmitter: Transmitter, cpb: int, mfp_oe: int,
                  serial: SerialIo | None = None) -> None:  # fmt: skip
         self.chip = chip
         self.serial = serial
         self.transmitter = transmitter
         self.cpb = cpb
         self.mfp_oe = mfp_oe
-        self.complete_diagnostics = complete_diagnostics
+        self._view: _View | None = None
+
+    def view(self) -> _View:
+        """The chip's LEDs now (:attr:`supi3.model.chip.Supi3.diagnostic_outputs`) and the pin levels they make,
+        computed once per change of what the pins show (``Supi3.revision``): ``step()`` reads them every cycle."""
+        chip = self.chip
+        cached = self._view
+        if cached is None or cached.revision != chip.revision:
+            leds = chip.diagnostic_outputs
+            cached = self._view = _View(chip.revision, leds, leds.diag1, leds.diag2, leds.mfp,
+                                        leds.ib_diag.divider_bits or 0)  # fmt: skip
+        return cached
 
     def values(self, c: int, di2: int, run_from: int) -> dict[str, int]:
         """Every output pin during cycle ``c`` (``di2``: that cycle's input; the logic runs from ``run_from``)."""
         chip = self.chip
         tx = self.transmitter
         do2 = tx.level(c)
+        view = self.view()
+        flash = view.ib_bits
         return {
             "do2": do2,
             # The return line passes straight through when a device follows; the last device loops back (M5).
             "di1": di2 if tx.next_present else do2,
-            "mfp_out": chip.mfp_outputs if self.serial is None else self.serial.mfp(c),
+            # A bus terminal module's LEDs on MFP15, 14, 13, 8 (Table 2-8); 0 on other chips.
+            "mfp_out": (chip.mfp_outputs if self.serial is None else self.serial.mfp(c)) | view.mfp,
             "mfp_oe": self.mfp_oe,
             # A pulse the chip starts at clock clk (the edge ending cycle clk) lasts until clk + width in chip
             # time; the pins show it from cycle clk + 1, so for cycles clk + 1 .. clk + width (M3). Cycle 0 comes
-            # before any edge (the chip's "no pulse" value is 0).
+            # before any edge (the chip's "no pulse" value is 0). /ResReg is low while the line is silent too: RC
+            # off (DG-4).
             "mod_ack_n": int(not 0 < c <= chip.mod_ack_until),
-            "res_reg_n": int(not 0 < c <= chip.resreg_until),
-            "diag1": int(chip.bus_active) if self.complete_diagnostics else 0,
-            "diag2": 0,
-            "ib_diag": self.ib_diag(c),
+            "res_reg_n": int(not (0 < c <= chip.resreg_until or chip.line_silent)),
+            "diag1": view.diag1,
+            "diag2": view.diag2,
+            "ib_diag": 1 if not flash else 1 - ((c >> (flash - 1)) & 1),  # ib_diag_level(view.leds.ib_diag, c)
             "dclk_out": int(c % self.cpb < self.cpb // 2),
             "resu_drive": int(c < run_from),
         }
 
-    def ib_diag(self, c: int) -> int:
-        """Table 3-18: flashing fast on a peripheral fault, slowly while the bus is not active, else steady."""
-        if self.chip.pf:
-            return 1 - ((c >> (IB_DIAG_DIVIDER_BITS["fast"] - 1)) & 1)
-        if not self.chip.bus_active:
-            return 1 - ((c >> (IB_DIAG_DIVIDER_BITS["slow"] - 1)) & 1)
-        return 1
-
     def snapshot(self, run_from: int) -> Snapshot:
         """The outputs' state now, for :meth:`render` (``run_from``: the cycle the logic runs from)."""
         chip = self.chip
-        return (chip.mfp_outputs, int(chip.bus_active) if self.complete_diagnostics else 0, int(chip.pf),
-                int(chip.bus_active), chip.mod_ack_until, chip.resreg_until, run_from)  # fmt: skip
+        view = self.view()
+        return (chip.mfp_outputs | view.mfp, view.diag1, view.diag2, view.ib_bits, chip.mod_ack_until,
+                chip.resreg_until, int(chip.line_silent), run_from)  # fmt: skip
 
     def render(self, c0: int, n: int, snaps: list[tuple[int, Snapshot]], do2: PinTrace) -> dict[str, PinTrace]:
         """Every output pin but ``di1`` over cycles ``c0`` to ``c0 + n - 1``, as :meth:`values` gives them: each
@@ -103,22 +127,22 @@ class Outputs:
         starts = np.array([t for t, _ in snaps], dtype=np.int64)
         lengths = np.diff(np.append(starts, n)).clip(min=0)
         table = np.array([snap for _, snap in snaps], dtype=np.int64)
-        mfp_out, diag1, pf, bus_active, mod_ack_until, resreg_until, run_from = (
+        mfp_out, diag1, diag2, ib_bits, mod_ack_until, resreg_until, silent, run_from = (
             np.repeat(column, lengths) for column in table.T
         )
-        fast = 1 - ((cycles >> (IB_DIAG_DIVIDER_BITS["fast"] - 1)) & 1)
-        slow = 1 - ((cycles >> (IB_DIAG_DIVIDER_BITS["slow"] - 1)) & 1)
+        # ib_diag_level over the run: steady (0 bits) or the inverted top bit of the divider.
+        flash = 1 - ((cycles >> np.maximum(ib_bits - 1, 0)) & 1)
         cpb = self.cpb
         out: dict[str, npt.NDArray[np.int64]] = {
-            "mfp_out": mfp_out if self.serial is None else self.serial.render(c0, n),
+            "mfp_out": mfp_out if self.serial is None else self.serial.render(c0, n) | mfp_out,
             "diag1": diag1,
             "mod_ack_n": ((cycles <= 0) | (cycles > mod_ack_until)).astype(np.int64),  # as values()
-            "res_reg_n": ((cycles <= 0) | (cycles > resreg_until)).astype(np.int64),
+            "res_reg_n": (((cycles <= 0) | (cycles > resreg_until)) & (silent == 0)).astype(np.int64),
             "resu_drive": (cycles < run_from).astype(np.int64),
-            "ib_diag": np.where(pf != 0, fast, np.where(bus_active != 0, 1, slow)),
+            "ib_diag": np.where(ib_bits == 0, 1, flash),
             "do2": do2,
             "mfp_oe": np.full(n, self.mfp_oe, dtype=np.int64),
-            "diag2": np.zeros(n, dtype=np.int64),
+            "diag2": diag2,
             "dclk_out": (cycles % cpb < cpb // 2).astype(np.int64),
         }
         return out

@@ -117,7 +117,7 @@ class Receiver:
     reset_run:
         Clocks of start level that make an INTERBUS reset (M11).
     chip:
-        The bus behaviour, told of an idle time-out (``reset_at``).
+        The bus behaviour, told of an idle time-out (``line_timeout_at``).
     log:
         The core's event log.
     frame:
@@ -186,7 +186,7 @@ class Receiver:
         if c - self.last_start == IDLE_TIMEOUT_CLOCKS:
             self.log.add(c, "idle timeout: INTERBUS reset")
             self.frame.abandon(c)
-            self.chip.reset_at(c)
+            self.chip.line_timeout_at(c)
         if not self.busy:
             if line == wire.START_LEVEL:
                 self._begin(c)

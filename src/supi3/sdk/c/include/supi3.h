@@ -152,6 +152,25 @@ typedef struct {
 /** Read 8, 9, 10 and 11 and decode them into *status (written only when all four reads succeeded). */
 int supi3_optical_status(supi3_t *ctx, supi3_optical_t *status);
 
+/* One-way optical path lengths of reads 8 and 9 in centimetres (OPT-1 of docs/assumptions/optical.md): the LENGTH
+ * code counts units of 6.25 m (MEDIUM 0, polymer) or 200 m (MEDIUM 1, glass); 63 is beyond the range, up to 20 km. */
+#define SUPI3_OPTICAL_POLYMER_UNIT_CM 625u
+#define SUPI3_OPTICAL_GLASS_UNIT_CM 20000u
+#define SUPI3_OPTICAL_LENGTH_MAX_CODE 63u
+#define SUPI3_OPTICAL_MAX_PATH_CM 2000000u
+
+/**
+ * The one-way path a LENGTH code stands for, [*low_cm, *high_cm) in centimetres (OPT-1); code 63 reaches up to
+ * 20 km. medium: 0 polymer, 1 glass. SUPI3_E_ARG: code > 63, medium > 1 or a NULL pointer (nothing written).
+ */
+int supi3_optical_length_cm(uint8_t code, uint8_t medium, uint32_t *low_cm, uint32_t *high_cm);
+
+/**
+ * The LENGTH code a one-way path of one_way_cm centimetres reads (truncated to the medium's unit, 63 above the
+ * range; OPT-1). SUPI3_E_ARG: one_way_cm > 2,000,000 (20 km), medium > 1 or code NULL (nothing written).
+ */
+int supi3_optical_length_code(uint32_t one_way_cm, uint8_t medium, uint8_t *code);
+
 /** Text for an error code ("unknown error" for others). */
 const char *supi3_strerror(int err);
 

@@ -417,6 +417,28 @@ const char *supi3_strerror(int err)
     }
 }
 
+int supi3_optical_length_cm(uint8_t code, uint8_t medium, uint32_t *low_cm, uint32_t *high_cm)
+{
+    uint32_t unit = medium == 0u ? SUPI3_OPTICAL_POLYMER_UNIT_CM : SUPI3_OPTICAL_GLASS_UNIT_CM;
+    if (code > SUPI3_OPTICAL_LENGTH_MAX_CODE || medium > 1u || low_cm == NULL || high_cm == NULL) {
+        return SUPI3_E_ARG;
+    }
+    *low_cm = code * unit;
+    *high_cm = code == SUPI3_OPTICAL_LENGTH_MAX_CODE ? SUPI3_OPTICAL_MAX_PATH_CM : (code + 1u) * unit;
+    return SUPI3_OK;
+}
+
+int supi3_optical_length_code(uint32_t one_way_cm, uint8_t medium, uint8_t *code)
+{
+    uint32_t units;
+    if (one_way_cm > SUPI3_OPTICAL_MAX_PATH_CM || medium > 1u || code == NULL) {
+        return SUPI3_E_ARG;
+    }
+    units = one_way_cm / (medium == 0u ? SUPI3_OPTICAL_POLYMER_UNIT_CM : SUPI3_OPTICAL_GLASS_UNIT_CM);
+    *code = (uint8_t)(units < SUPI3_OPTICAL_LENGTH_MAX_CODE ? units : SUPI3_OPTICAL_LENGTH_MAX_CODE);
+    return SUPI3_OK;
+}
+
 void supi3_put_u16(uint8_t *bytes, uint16_t value)
 {
     if (bytes != NULL) {
