@@ -158,6 +158,18 @@ def test_budget_runs_out_in_chip_time() -> None:
     assert {tx.phase for tx in other.optical.transmitters} == {Phase.FIXED}
 
 
+def test_a_second_start_restarts_the_budget() -> None:
+    """A start while still initializing (no reset between: the line side's choice) counts 6 ms from itself."""
+    chip = up_chip()
+    chip.optical_start(ALL)
+    chip.poll(LIMIT_S / 2)
+    chip.optical_start(ALL)
+    assert chip.due == clocks(LIMIT_S / 2) + INIT_TIME_LIMIT_CLOCKS
+    chip.poll(LIMIT_S)
+    assert chip.optical_holding
+    assert {tx.phase for tx in chip.optical.transmitters} == {Phase.INIT}
+
+
 def test_reset_turns_every_transmitter_off_and_keeps_lengths() -> None:
     """1.6: "regulation is reset for the reset period"; OPT-21: the lengths measured stay."""
     chip = up_chip()

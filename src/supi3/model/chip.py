@@ -630,6 +630,7 @@ class Supi3:
         initializing = any(tx.phase is Phase.INIT for tx in txs)
         self._optical_until = self._now + regulation.INIT_TIME_LIMIT_CLOCKS if initializing else _NEVER
         self._optical_set(status)
+        self._reschedule()  # a new budget even if the status is the same (a start while initializing)
 
     def optical_init_response(self, interface: Interface, response: Response) -> None:
         """One initialization step's response on ``interface`` (:func:`~supi3.optical.regulation.init_response`,
