@@ -8,8 +8,8 @@ and the light that no longer gets through into ring faults the master locates.
 
 * **INTERBUS reset** (:meth:`OpticalRing.reset`, 1.6 "Behavior on a reset"): the chips reset (every transmitter off),
   then initialization runs cable by cable down the ring (1.6.1): the forward fibre first (the upstream chip's
-  outgoing interface), then the downstream chip sees the end of the reset (:meth:`~supi3.model.chip.Supi3.
-  optical_start`) and its incoming interface regulates the return fibre. Each step takes
+  outgoing interface), then the downstream chip sees the end of the reset (``optical_start``) and its incoming
+  interface regulates the return fibre. Each step takes
   :data:`~supi3.optical.regulation.INIT_STEP_BITS` bit periods on the ring's clock; the partner's response is
   "pattern detected" ("Light off") when the test at the reserve arrives, "Light on" when it does not, and none when
   the partner is not regulated (the master, a copper or diagnostics-mode chip). The length timer of each outgoing
