@@ -19,6 +19,7 @@ from hypothesis import strategies as st
 from supi3.config import Variant, decode
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import ChipArgumentError, Supi3, clocks
+from supi3.optical import regulation
 from supi3.optical.length import Medium, timer_code, timer_count
 from supi3.optical.regulation import (
     INIT_MAX_STEPS,
@@ -34,6 +35,7 @@ from supi3.optical.regulation import (
 )
 from supi3.pinout import OPTICAL_REGISTERS
 from supi3.tables import BIT_RATES, CLOCK_HZ, clk_conf_for
+from support import bad
 
 IN, OUT, BRANCH = Interface.IN, Interface.OUT, Interface.BRANCH
 ALL = (True, True, True)
@@ -385,3 +387,19 @@ def test_histories_keep_the_invariants(rf: str, bit_rate: int, history: list[tup
                 assert new.level == MAX_LEVEL
             if old.mau and not new.mau:
                 assert new.level == MAX_LEVEL - 2
+
+
+def test_start_at_a_bus_time_counts_the_budget_from_it() -> None:
+    """OPT-5, OPT-20: the 6 ms budget runs from the time the end of the reset reaches the chip."""
+    chip = up_chip("00")
+    chip.optical_start(ALL, 1.0)
+    chip.poll(1.0 + regulation.INIT_TIME_LIMIT_S * 0.99)
+    assert chip.optical_holding
+    chip.poll(1.0 + regulation.INIT_TIME_LIMIT_S * 1.01)
+    assert not chip.optical_holding
+    assert all(tx.phase is Phase.FIXED for tx in chip.optical.transmitters)
+    before = chip.optical
+    for now in (-1.0, float("nan"), "1.0", True):
+        with pytest.raises(ChipArgumentError):
+            chip.optical_start(ALL, bad(now))
+    assert chip.optical == before

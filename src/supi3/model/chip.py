@@ -670,20 +670,22 @@ class Supi3:
         from :meth:`optical_start` in the chip's time (the last bus call), has not run out."""
         return self._optical_until != _NEVER and self._now < self._optical_until
 
-    def optical_start(self, present: tuple[bool, bool, bool]) -> None:
+    def optical_start(self, present: tuple[bool, bool, bool], now: float | None = None) -> None:
         """The end of the INTERBUS reset (1.6): every interface starts (:func:`~supi3.optical.regulation.start`)
         in the chip's optical mode; ``present`` says which of IN, OUT, BRANCH are in use (automatic interface
-        recognition). The 6 ms budget counts from the chip's time now (call :meth:`poll` first to set it).
+        recognition). The 6 ms budget counts from bus time ``now`` (seconds; ``None``: the chip's last bus call).
 
         Raises
         ------
         ChipArgumentError
-            ``present`` is not a tuple of three bools.
+            ``present`` is not a tuple of three bools, or ``now`` is not a time.
         """
         if not (type(present) is tuple and len(present) == len(Interface)
                 and all(type(p) is bool for p in present)):  # fmt: skip
             raise ChipArgumentError("present", present, "present must be a tuple of 3 bools (IN, OUT, BRANCH in "
                                     f"use), not {present!r:.60}")
+        if now is not None:
+            self.poll(now)
         mode = self.optical_mode
         txs = tuple(regulation.start(mode, p) for p in present)
         status = OpticalStatus((txs[0], txs[1], txs[2]), self._optical.length, self._optical.medium)

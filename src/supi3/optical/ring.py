@@ -85,8 +85,8 @@ class OpticalChip(Device, Protocol):
         """What RF[1..0] selects."""
         ...
 
-    def optical_start(self, present: tuple[bool, bool, bool]) -> None:
-        """The end of the INTERBUS reset reached the chip."""
+    def optical_start(self, present: tuple[bool, bool, bool], now: float | None = None) -> None:
+        """The end of the INTERBUS reset reached the chip at bus time ``now``."""
         ...
 
     def optical_init_response(self, interface: Interface, response: Response) -> None:
@@ -298,9 +298,9 @@ class OpticalRing:
                 if up.optical[Interface.OUT].phase is not Phase.OFF and all(
                         self._state(k, cable, d, t) is not LightState.DARK for d in Direction):
                     up.optical_length(Interface.OUT, cable.timer_count(self.bit_rate), cable.medium)
-            down.poll(t)  # the end of the reset reaches the chip's incoming interface
             next_cable = self.links[k] if k < len(self.links) else None
-            down.optical_start((cable is not None, next_cable is not None, False))
+            # The end of the reset reaches the chip's incoming interface at t.
+            down.optical_start((cable is not None, next_cable is not None, False), t)
             if cable is not None:
                 t = self._init_direction(k, cable, Direction.RETURN, t)
         self.ring.idle(t - self.now)
