@@ -403,3 +403,12 @@ def test_start_at_a_bus_time_counts_the_budget_from_it() -> None:
         with pytest.raises(ChipArgumentError):
             chip.optical_start(ALL, bad(now))
     assert chip.optical == before
+
+
+def test_fo_leds_show_the_optical_block() -> None:
+    """Table 3-17, OPT-8, DG-7: in READY (bus not active) a fallen-back interface lights its FO LED."""
+    chip = up_chip("00")
+    chip.optical_start(ALL, 0.0)
+    chip.optical_init_response(IN, Response.NONE)
+    chip.optical_init_response(OUT, Response.NOT_DETECTED)
+    assert chip.diagnostic_outputs.fo == (True, False, False)

@@ -35,7 +35,7 @@ from typing import ClassVar, Final, Protocol, TypeVar
 from supi3 import tables
 from supi3.checks import check_bits, check_bool, check_bytes, check_instance, check_int, check_real, fail
 from supi3.config import DeviceConfig, MfpKind, Variant, decode
-from supi3.diagnostics import DiagnosticOutputs, LedInputs, diagnostic_outputs, watches_line_interrupt
+from supi3.diagnostics import DiagnosticOutputs, LedInputs, diagnostic_outputs, fo_leds, watches_line_interrupt
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.expansion import PULSE_T0, ExternalRegisters, end_pulses
 from supi3.interbus import wire
@@ -404,13 +404,16 @@ class Supi3:
         diagnostic_outputs`: UL, RC, BA, RD, LD, E, ALARM, FO1..FO3, the IB_DIAG pattern, and DIAG1/DIAG2 as
         DIAG_CONF selects. At transaction level the supply is always good (UL lit): the power-up reset has no
         duration here (1.7.2 is the pin level's)."""
+        # FO1..FO3 come from the optical block (Table 3-17, OPT-8; RUN is the bus active, DG-7).
+        leds = replace(self.led_inputs, fo=fo_leds(self._optical, self.bus_active))
         return diagnostic_outputs(self.config, supply_ok=True, line_heard=not self.line_silent,
                                   bus_active=self.bus_active, peripheral_fault=self.pf,
-                                  line_interrupt=self.line_interrupt, leds=self.led_inputs)  # fmt: skip
+                                  line_interrupt=self.line_interrupt, leds=leds)  # fmt: skip
 
     def set_led_inputs(self, leds: LedInputs) -> None:
-        """What the chip's optical block (FO1..FO3) and bus terminal logic (RD, LD, E, ALARM) show from now on
-        (DG-5, DG-7); both fidelities read it (the RTL ties these ports to 0 until those blocks drive them).
+        """What the chip's bus terminal logic (RD, LD, E, ALARM) shows from now on (DG-5); both fidelities read it
+        (the RTL ties these ports to 0). FO1..FO3 always come from the chip's own optical block
+        (:attr:`optical`, :func:`supi3.diagnostics.fo_leds`), so ``leds.fo`` is not used here.
 
         Raises
         ------
