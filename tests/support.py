@@ -34,10 +34,12 @@ from supi3.expansion import IDLE as EXPANSION_IDLE
 from supi3.expansion import ExpansionLevels, chain_to_line, line_to_chain
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
+from supi3.model.blocks.optical import OpticalBlock
 from supi3.model.bus_terminal import LBST_PIN
 from supi3.model.chip import Supi3
 from supi3.model.pins import Supi3Pins
 from supi3.model.registers import RegisterFile
+from supi3.optical.regulation import BLOCK_INPUTS
 from supi3.pinlevel import OE_SUFFIX
 from supi3.regmap import Register, encode_command
 from supi3.sdk import native
@@ -525,3 +527,48 @@ def terminal(interface: str, lbst: bool = True) -> Supi3:
 def bad(value: object) -> Any:
     """A wrongly typed argument for a hostile-input test, passed through without a type error from mypy."""
     return value
+
+
+# The optical block (issue 12): stimulus for supi3.model.blocks.optical and supi3.rtl.optical ----------------------
+
+OPTICAL_INPUTS = [pin.name for pin in BLOCK_INPUTS]
+
+
+class OpticalScript:
+    """Per-cycle inputs of the optical block (``BLOCK_INPUTS``), built call by call: static straps (``mode``,
+    ``fast``, ``present``, ``medium``, ``run``) on every row, strobes one cycle wide, bit i = interface i."""
+
+    def __init__(self, mode: int, *, fast: int = 0, present: int = 0b111, medium: int = 0, run: int = 0) -> None:
+        self.static = {"mode": mode, "fast": fast, "present": present, "medium": medium, "run": run}
+        self.rows: list[dict[str, int]] = []
+
+    def idle(self, n: int = 1, **pins: int) -> OpticalScript:
+        """``n`` cycles with the static inputs and ``pins``; the other inputs 0."""
+        row = dict.fromkeys(OPTICAL_INPUTS, 0) | self.static | pins
+        self.rows.extend([row] * n)  # one dict for the whole stretch: rows are read, never changed
+        return self
+
+    def reset(self, n: int = 3) -> OpticalScript:
+        """An INTERBUS reset ``n`` cycles long; the block starts at the edge ending the next cycle."""
+        return self.idle(n, ib_reset=1).idle()
+
+    def response(self, interface: int, response: int) -> OpticalScript:
+        return self.idle(resp_valid=1 << interface, resp=response << (2 * interface))
+
+    def test(self, interface: int, ack1: bool, ack2: bool) -> OpticalScript:
+        return self.idle(test_valid=1 << interface, ack1=int(ack1) << interface, ack2=int(ack2) << interface)
+
+    def length(self, interface: int, clocks: int, medium: int | None = None) -> OpticalScript:
+        """A length measurement: ``len_stop`` ``clocks`` cycles after ``len_start`` (``clocks`` >= 1), the
+        transceiver reporting ``medium`` (0 polymer, 1 glass; the static ``medium`` when None) from then on."""
+        if medium is not None:
+            bit = 1 << interface
+            self.static["medium"] = self.static["medium"] & ~bit | (bit if medium else 0)
+        self.idle(len_start=1 << interface)
+        return self.idle(clocks - 1).idle(len_stop=1 << interface)
+
+
+def run_optical(rows: list[dict[str, int]]) -> tuple[OpticalBlock, list[dict[str, int]]]:
+    """The optical block's outputs for every row, and the block after them."""
+    block = OpticalBlock()
+    return block, [block.step(row) for row in rows]

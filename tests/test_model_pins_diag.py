@@ -13,6 +13,7 @@ from supi3.interbus import wire
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import STATERR_FILTER_CLOCKS, ChipArgumentError, Supi3
 from supi3.model.pins import IDLE_TIMEOUT_CLOCKS, Supi3Pins
+from supi3.optical.regulation import Interface, Response
 from support import IDLE, Columns, CoreScript, assert_run_matches_step, quiet_inputs
 
 SILENCE_BITS = round(wire.IDLE_TIMEOUT_S * 2_000_000) + 1000
@@ -171,11 +172,20 @@ def test_line_timeout_step_and_run_agree() -> None:
 def test_led_inputs_reach_the_pins(c: str, diag_conf: int) -> None:
     # Table 3-16: FO1/FO2 on DIAG1/DIAG2 with limited diagnostics, RD on DIAG2 with complete; Table 2-8: a bus
     # terminal module's ALARM, LD, E, FO3 on MFP15, 14, 13, 8 whatever DIAG_CONF (DG-6).
-    cfg = config(c, diag_conf)
+    # FO1..FO3 come from the optical block (OPT-8): FO1 and FO3 lit, in READY by a fallback, in RUN by a MAU warning.
+    cfg = decode(c, clk_conf="11", diag_conf=diag_conf, rf="00")
     pins = Supi3Pins(cfg)
     pins.run(CoreScript(cfg).bring_up().columns())
-    leds = LedInputs(fo=(True, False, True), rd=True, ld=True, e=False, alarm=True)
+    leds = LedInputs(rd=True, ld=True, e=False, alarm=True)
     pins.chip.set_led_inputs(leds)
+
+    def light_fo1_and_fo3(chip: Supi3) -> None:
+        chip.optical_start((True, False, True))
+        response = Response.NOT_DETECTED if chip.bus_active else Response.NONE
+        for interface in (Interface.IN, Interface.BRANCH):
+            chip.optical_init_response(interface, response)
+
+    light_fo1_and_fo3(pins.chip)
     out = pins.run(quiet_inputs(50))
     view = pins.chip.diagnostic_outputs
     agrees(pins, out, view)
@@ -183,8 +193,10 @@ def test_led_inputs_reach_the_pins(c: str, diag_conf: int) -> None:
     assert (stepped["diag1"], stepped["diag2"]) == ((0, 1) if diag_conf == 0 else (1, 0))
     if cfg.interface.is_bus_terminal:
         assert (stepped["mfp_out"] & 0xE100, stepped["mfp_oe"] & 0xE100) == (0xC100, 0xE100)
+    assert view.fo == (True, False, cfg.interface.is_bus_terminal)
     tl = tl_chip(cfg, active=False)
     tl.set_led_inputs(leds)
+    light_fo1_and_fo3(tl)
     assert tl.diagnostic_outputs == view
 
 

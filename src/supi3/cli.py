@@ -52,6 +52,9 @@ MAX_NETWORK_BYTES = timing.MAX_NETWORK_BYTES
 MAX_OPTICAL_COUNT = timing.MAX_OPTICAL_COUNT
 """``timing --optical-count`` limit: the length timer's value range, 0 to 63 (Table 1-5)."""
 
+DEMO_CYCLES = 4
+"""``demo --cycles`` default (``--optical`` runs its whole scenario by default)."""
+
 MAX_DEMO_CYCLES = 1000
 """``demo --cycles`` limit: a demo, not a soak test."""
 
@@ -454,7 +457,18 @@ def cmd_demo(args: argparse.Namespace) -> None:
     from supi3 import demo
 
     clk_conf = tables.clk_conf_for(_parse_bit_rate(args.bit_rate))
-    cycles = check_int("--cycles", args.cycles, 1, MAX_DEMO_CYCLES, "a demo")
+    if args.optical:
+        if args.analog or args.vcd is not None:
+            raise CommandLineError("demo --optical takes neither --analog nor --vcd")
+        cycles = check_int("--cycles", demo.OPTICAL_CYCLES if args.cycles is None else args.cycles, 1,
+                           MAX_DEMO_CYCLES, "a demo")  # fmt: skip
+        plot = None if args.plot is None else output_file("--plot", args.plot)  # before the run, not after it
+        for line in demo.run_optical(cycles, plot, clk_conf):
+            print(line)
+        return
+    if args.plot is not None:
+        raise CommandLineError("--plot is for demo --optical only")
+    cycles = check_int("--cycles", DEMO_CYCLES if args.cycles is None else args.cycles, 1, MAX_DEMO_CYCLES, "a demo")
     if args.vcd is not None:
         check_int("--cycles", cycles, 1, MAX_VCD_CYCLES, "with --vcd: the pin-level run keeps every clock")
     vcd = None if args.vcd is None else output_file("--vcd", args.vcd)  # before the run, not after it
@@ -591,13 +605,19 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("demo", help="a master and a small ring, live (built-in defaults)")
-    p.add_argument("--cycles", type=integer, default=4, metavar="N",
-                   help=f"data cycles to run, 1 to {MAX_DEMO_CYCLES}, to {MAX_VCD_CYCLES} with --vcd (default 4)")
+    p.add_argument("--cycles", type=integer, default=None, metavar="N",
+                   help=f"data cycles to run, 1 to {MAX_DEMO_CYCLES}, to {MAX_VCD_CYCLES} with --vcd (default "
+                        f"{DEMO_CYCLES}; with --optical, the whole scenario)")
     p.add_argument("--vcd", metavar="PATH", help="also run the SUPI 3 chips at pin level and write a VCD")
     p.add_argument("--bit-rate", default="500k", help="500k or 2M")
     p.add_argument("--analog", action="store_true",
                    help="an analog I/O device instead: a SUPI 3 in SPI 16 IN/16 OUT with an SPI ADC and DAC (3.3); "
                         "with --vcd its SPI pins are checked against Table 3-4")
+    p.add_argument("--optical", action="store_true",
+                   help="a ring of SUPI 3 OPC chips joined by fibre instead (1.6): optical initialization, the "
+                        "master's optical diagnostic table, a bent fibre and a pulled connector")
+    p.add_argument("--plot", metavar="PATH",
+                   help="with --optical: write the disturbed path's power levels over time (HTML with SVG)")
     p.set_defaults(func=cmd_demo)
 
     p = sub.add_parser("modes", help="list the operating modes (Tables 2-4 to 2-7)")

@@ -10,6 +10,10 @@ SUPI 3 OPC strapped for RB, SPI 16 IN/16 OUT (Table 2-6) with a 16-bit SPI DAC a
 I/O bus, the DAC's output wired back to the ADC's input. The master writes a setpoint ramp; it appears at the DAC
 output and, through the ADC, comes back to the master. With a VCD path the same scenario runs at pin level too, and
 the analog chip's SPI pins are checked against Table 3-4.
+
+``supi3 demo --optical`` (:func:`run_optical`): a ring of SUPI 3 OPC chips joined by polymer, HCS and glass fibre
+(manual 1.6): optical initialization, the master's optical diagnostic table (Figure 1-10), a bent fibre that online
+regulation compensates, a pulled connector the master locates, and a plot of the disturbed path's power levels.
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ from supi3 import serial_io
 from supi3.checks import check_int
 from supi3.config import DeviceConfig, decode
 from supi3.errors import Supi3Error
+from supi3.interbus import wire
 from supi3.interbus.device import PlainDevice
 from supi3.interbus.master import Master
 from supi3.interbus.ring import Bus, Ring
@@ -29,6 +34,9 @@ from supi3.model.chip import Supi3
 from supi3.model.pinring import PinRing
 from supi3.model.pins import Supi3Pins
 from supi3.model.vcd import write_vcd
+from supi3.optical.link import Bend, Fibre, FibreLink, Pull
+from supi3.optical.regulation import MAX_LEVEL
+from supi3.optical.ring import MauReport, OpticalRing, PathSample, diagnostic_table, format_table
 from supi3.peripherals.serial import SerialBus, SpiAdc, SpiDac
 from supi3.tables import CLOCK_HZ
 from supi3.verif.timing import check_serial_io
@@ -55,7 +63,7 @@ RAMP_STEP = 0x2000
 
 
 class DemoError(Supi3Error):
-    """The demo could not finish: its VCD file could not be written."""
+    """The demo could not finish: its VCD file (or the ``--optical`` plot) could not be written."""
 
 
 def _configs(clk_conf: str) -> list[DeviceConfig]:
@@ -249,3 +257,175 @@ def _analog_pin_level(configs: list[DeviceConfig], cycles: int, vcd: Path) -> It
     yield f"Table 3-4 on device 1's SPI pins (MFP3..MFP7): {count}"
     yield from (f"  {violation}" for violation in violations)
     yield f"wrote {vcd}"
+
+
+# ------------------------------------------------------------------------------------------------------------
+# --optical: a ring of SUPI 3 OPC chips joined by fibre cables (manual 1.6), a bend and a pulled connector
+# ------------------------------------------------------------------------------------------------------------
+
+OPTICAL_CABLES: tuple[tuple[float, Fibre], ...] = (
+    (15.0, Fibre.POLYMER), (45.0, Fibre.POLYMER), (65.0, Fibre.POLYMER), (300.0, Fibre.HCS), (1500.0, Fibre.GLASS),
+    (30.0, Fibre.POLYMER),
+)  # fmt: skip
+"""``--optical``: the cable into each ring position (one-way metres, fibre): from the master, then chip to chip."""
+
+OPTICAL_DISTURBED: int = 3
+"""``--optical``: the cable that is bent and pulled, into ring position 3 (path 2.0<->3.0)."""
+
+OPTICAL_BEND: tuple[int, int, float] = (60, 120, 4.0)
+"""``--optical``: the bend, from data-cycle time 60 for 120 cycle times, 4 dB on both fibres."""
+
+OPTICAL_PULL: tuple[int, int] = (260, 70)
+"""``--optical``: the connector pulled at cycle time 260 and put back after 70 cycle times (longer than the 20 ms
+silent-line timeout at 500 kbit/s, so the chips behind it reset)."""
+
+OPTICAL_CYCLES = 480
+"""``--optical``: data cycles to run by default."""
+
+
+def _optical_cable(cable: FibreLink, k: int, master: Master) -> str:
+    up = "master" if k == 1 else master.entry(k - 1).number
+    return f"{up}->{master.entry(k).number} {cable.length_m:g} m {cable.fibre.value}"
+
+
+def _mau(report: MauReport, master: Master) -> str:
+    name = ("incoming interface (MAUWH)", "outgoing interface (MAUWR)", "branch (MAUWS)")[report.interface]
+    state = "on " if report.on else "off"
+    return f"  {report.time_s * 1e3:8.3f} ms  MAU warning {state} at {master.entry(report.ring_position).number} {name}"
+
+
+def run_optical(cycles: int = OPTICAL_CYCLES, plot: Path | None = None, clk_conf: str = "01") -> Iterator[str]:
+    """The ``--optical`` demo, as lines of text: a ring of six SUPI 3 OPC chips in optical regulation mode (RF = 00,
+    1.6) joined by polymer, HCS and glass cables (:mod:`supi3.optical.link`). After Alarm Stop every cable
+    initializes (1.6.1) and the master prints its optical diagnostic table (Figure 1-10); during the data cycles the
+    cable of path 2.0<->3.0 is bent (online regulation raises the power, the MAU warning comes and goes, 1.6.2,
+    1.6.3) and its connector pulled (the master locates the dead line; after the repair it restarts the bus). With
+    ``plot``, a self-contained HTML page with an SVG plot of the disturbed path's power levels over time.
+
+    Raises
+    ------
+    ArgumentError
+        If ``cycles`` is not an integer >= 1.
+    DemoError
+        If the plot cannot be written (the command line checks the path before the run).
+    """
+    check_int("cycles", cycles, 1)
+    chips = [Supi3(decode("10000", rf="00", clk_conf=clk_conf)) for _ in OPTICAL_CABLES]
+    cables = [FibreLink(metres, fibre) for metres, fibre in OPTICAL_CABLES]
+    ring = OpticalRing(chips, cables)
+    master = Master(ring)
+    result = master.start()
+    yield (f"supi3 demo --optical: INTERBUS master and a ring of {len(chips)} SUPI 3 OPC chips joined by fibre "
+           f"(RF = 00, optical regulation), {ring.bit_rate // 1000} kbit/s (transaction level)")
+    yield "Cables: " + "; ".join(_optical_cable(c, k, master) for k, c in enumerate(cables, 1))
+    yield (f"Alarm Stop (1303h), optical initialization (the cores held until {ring.history[0][0].time_s * 1e3:.3f} "
+           f"ms) and discovery ID cycle: {'ok' if result.ok else 'FAILED'}")
+    yield "Optical diagnostic table (Figure 1-10):"
+    yield from (f"  {line}" for line in format_table(diagnostic_table(ring, master)))
+    tick = wire.cycle_bits(len(chips), len(chips)) / ring.bit_rate
+    t0 = ring.now
+    disturbed = cables[OPTICAL_DISTURBED - 1]
+    path = f"{master.entry(OPTICAL_DISTURBED - 1).number}<->{master.entry(OPTICAL_DISTURBED).number}"
+    bend = Bend(t0 + OPTICAL_BEND[0] * tick, OPTICAL_BEND[1] * tick, OPTICAL_BEND[2])
+    pull = Pull(t0 + OPTICAL_PULL[0] * tick, OPTICAL_PULL[1] * tick)
+    disturbed.add(bend)
+    disturbed.add(pull)
+    yield (f"{cycles} data cycles; path {path} bent by {bend.loss_db:g} dB from {bend.start_s * 1e3:.3f} ms to "
+           f"{(bend.start_s + (bend.duration_s or 0)) * 1e3:.3f} ms, its connector pulled from "
+           f"{pull.start_s * 1e3:.3f} ms to {(pull.start_s + (pull.duration_s or 0)) * 1e3:.3f} ms:")
+    yield from _optical_run(ring, master, cycles)
+    yield f"Optical diagnostic table at {ring.now * 1e3:.3f} ms:"
+    yield from (f"  {line}" for line in format_table(diagnostic_table(ring, master)))
+    if plot is not None:
+        _write_plot(plot, _plot_html(ring.history[OPTICAL_DISTURBED - 1], path, (bend, pull)))
+        yield f"wrote {plot}"
+
+
+def _optical_run(ring: OpticalRing, master: Master, cycles: int) -> Iterator[str]:
+    """Run ``cycles`` data cycles; yield the MAU reports, failed cycles (once per diagnosis) and restarts."""
+    reported = 0
+    last = ""
+    failed = False
+    for n in range(cycles):
+        for k, entry in enumerate(master.config or (), 1):
+            master.set_outputs(k, bytes([(n + k) & 0xFF]) * entry.data_bytes)
+        result = master.cycle()
+        for report in ring.reports[reported:]:
+            yield _mau(report, master)
+        reported = len(ring.reports)
+        if not result.ok:
+            failed = True
+            for d in result.diagnostics:
+                where = f"at {d.device} (line {d.location})" if d.location is not None else "not located"
+                text = f"{d.kind.value} {where}"
+                if text != last:
+                    yield f"  {ring.now * 1e3:8.3f} ms  cycle failed: {text}"
+                    last = text
+        elif failed and not any(ring.dark(k) for k in range(1, len(ring.links) + 1)):
+            failed, last = False, ""
+            back = ring.now
+            restarted = master.start()
+            reported = len(ring.reports)
+            yield (f"  {back * 1e3:8.3f} ms  the ring runs again: Alarm Stop, optical initialization and discovery "
+                   f"ID cycle: {'ok' if restarted.ok else 'FAILED'} at {ring.now * 1e3:.3f} ms")
+
+
+def _write_plot(path: Path, html: str) -> None:
+    try:
+        path.write_text(html, encoding="utf-8")
+    except OSError as exc:
+        raise DemoError(f"cannot write {str(path)!r} (--plot): {exc.strerror or exc}") from None
+
+
+_PLOT_W, _PLOT_H, _PLOT_M = 760, 300, 48
+"""The plot's width and height in pixels and its margin for the axes."""
+
+
+def _plot_html(samples: Sequence[PathSample], path: str, events: tuple[Bend, Pull]) -> str:
+    """A self-contained HTML page with an inline SVG: the power levels of a path's two transmitters over bus time
+    (step lines), the bend and the pulled connector as shaded bands."""
+    t0, t1 = samples[0].time_s, samples[-1].time_s
+    span = max(t1 - t0, 1e-9)
+
+    def x(t: float) -> float:
+        return _PLOT_M + (min(max(t, t0), t1) - t0) / span * (_PLOT_W - 2 * _PLOT_M)
+
+    def y(level: float) -> float:
+        return _PLOT_H - _PLOT_M - level / MAX_LEVEL * (_PLOT_H - 2 * _PLOT_M)
+
+    parts = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{_PLOT_W}" height="{_PLOT_H}" '
+             f'viewBox="0 0 {_PLOT_W} {_PLOT_H}" font-family="sans-serif" font-size="11">']
+    for event, colour, label in ((events[0], "#fde2a8", "bend"), (events[1], "#f4b4b4", "connector pulled")):
+        end = event.start_s + (event.duration_s or span)
+        parts.append(f'<rect x="{x(event.start_s):.1f}" y="{_PLOT_M}" width="{x(end) - x(event.start_s):.1f}" '
+                     f'height="{_PLOT_H - 2 * _PLOT_M}" fill="{colour}"><title>{label}</title></rect>')
+        parts.append(f'<text x="{x(event.start_s) + 3:.1f}" y="{_PLOT_M + 12}">{label}</text>')
+    for tick_level in range(0, MAX_LEVEL + 1, 5):
+        at = y(tick_level)
+        parts.append(f'<line x1="{_PLOT_M}" x2="{_PLOT_W - _PLOT_M}" y1="{at:.1f}" y2="{at:.1f}" stroke="#ddd"/>'
+                     f'<text x="{_PLOT_M - 6}" y="{at + 4:.1f}" text-anchor="end">{tick_level}</text>')
+    for i in range(5):
+        t = t0 + span * i / 4
+        parts.append(f'<text x="{x(t):.1f}" y="{_PLOT_H - _PLOT_M + 16}" text-anchor="middle">{t * 1e3:.1f}</text>')
+    parts.append(f'<text x="{_PLOT_W / 2}" y="{_PLOT_H - 8}" text-anchor="middle">bus time (ms)</text>')
+    parts.append(f'<text x="14" y="{_PLOT_H / 2}" transform="rotate(-90 14 {_PLOT_H / 2})" '
+                 f'text-anchor="middle">power level (of {MAX_LEVEL})</text>')
+    for attr, colour, name in (("forward_level", "#1f5fbf", "forward"), ("return_level", "#d0701a", "return")):
+        points = []
+        previous: int | None = None
+        for s in samples:
+            level: int = getattr(s, attr)
+            if previous is not None:
+                points.append(f"{x(s.time_s):.1f},{y(previous):.1f}")
+            points.append(f"{x(s.time_s):.1f},{y(level):.1f}")
+            previous = level
+        parts.append(f'<polyline fill="none" stroke="{colour}" stroke-width="2" points="{" ".join(points)}">'
+                     f"<title>{name}</title></polyline>")
+    parts.append(f'<text x="{_PLOT_W - _PLOT_M}" y="{_PLOT_M - 22}" text-anchor="end"><tspan fill="#1f5fbf">'
+                 f'forward</tspan> / <tspan fill="#d0701a">return</tspan> transmitter</text>')
+    parts.append("</svg>")
+    title = f"supi3 demo --optical: power levels of path {path}"
+    return (f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8"><title>{title}</title></head>\n<body>'
+            f"<h1>{title}</h1>\n<p>Online regulation (manual 1.6.2): each transmitter's power level over bus time; "
+            f"the bend raises it, the pulled connector interrupts the ring until the master restarts it.</p>\n"
+            + "".join(parts) + "\n</body></html>\n")

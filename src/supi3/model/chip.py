@@ -29,12 +29,13 @@ from __future__ import annotations
 import math
 from collections import Counter
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 from typing import ClassVar, Final, Protocol, TypeVar
 
 from supi3 import tables
 from supi3.checks import check_bits, check_bool, check_bytes, check_instance, check_int, check_real, fail
 from supi3.config import DeviceConfig, MfpKind, Variant, decode
-from supi3.diagnostics import DiagnosticOutputs, LedInputs, diagnostic_outputs, watches_line_interrupt
+from supi3.diagnostics import DiagnosticOutputs, LedInputs, diagnostic_outputs, fo_leds, watches_line_interrupt
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.expansion import PULSE_T0, ExternalRegisters, end_pulses
 from supi3.interbus import wire
@@ -42,6 +43,10 @@ from supi3.interbus.link import DataKernel
 from supi3.interbus.wire import Cycle
 from supi3.model.bus_terminal import BusTerminal
 from supi3.model.registers import RegisterFile
+from supi3.optical import regulation
+from supi3.optical.length import Medium, timer_code
+from supi3.optical.regulation import Interface, OpticalMode, OpticalStatus, Phase, Response
+from supi3.pinout import OPTICAL_REGISTERS
 from supi3.serial_io import SerialDevice, SerialSequence, clear_sequence, sequence
 
 CLOCK_HZ: Final = tables.CLOCK_HZ
@@ -136,6 +141,26 @@ def _cycle(cycle: object) -> Cycle:
     return checked
 
 
+_OPTICAL_MODES: Final[dict[str, OpticalMode]] = {"00": OpticalMode.REGULATION, "01": OpticalMode.DIAGNOSTIC}
+"""RF[1..0] patterns with an optical block at work (Table 2-2, OPT-2); the others are copper (OFF)."""
+
+
+def _interface(interface: object) -> Interface:
+    """``interface`` checked as an optical :class:`~supi3.optical.regulation.Interface`."""
+    checked: Interface = _checked(check_instance, "interface", interface, Interface, "Interface.IN, OUT or BRANCH")
+    return checked
+
+
+def optical_test(tx: regulation.Transmitter, ack1: bool, ack2: bool) -> regulation.Transmitter:
+    """One online test of a transmitter, whatever the mode (1.6.2): online regulation of an
+    :attr:`~Phase.ONLINE` transmitter; in optical diagnostics mode (:attr:`~Phase.DIAGNOSTIC`) the MAU warning of
+    the interface (OPT-22); any other transmitter is returned unchanged. Shared by the chip and the pin-level
+    optical block (:mod:`supi3.model.blocks.optical`)."""
+    if tx.phase is Phase.DIAGNOSTIC:
+        return replace(tx, mau=regulation.diagnostic_mau(tx.mau, ack1, ack2))
+    return regulation.online_test(tx, ack1, ack2)
+
+
 # ----------------------------------------------------------------------------------------------------------------
 # The ring kernel (docs/interbus.md, "Ring kernel")
 # ----------------------------------------------------------------------------------------------------------------
@@ -227,10 +252,10 @@ class Supi3:
     __slots__ = (
         "__dict__",  # room beyond the declared state, so that a test can spy on a chip's methods
         "_chain", "_cpb", "_deadline", "_due_s", "_events", "_exr_driver", "_exr_free", "_fast_valid", "_fixed_bytes",
-        "_frame_bytes", "_in_map", "_loaded", "_now", "_out", "_out_map", "_send_alarm", "_serial_pins", "_shown",
-        "_stat_err", "_stat_low_since", "_watch_line", "attention", "bus_active", "config", "due", "in_word",
-        "io_access", "led_inputs", "line_interrupt", "line_silent", "mfp_in", "mod_ack_until", "pf", "registers",
-        "resreg_until", "revision", "serial_device", "spi_sequences", "te", "watchdog_code", "wd",
+        "_frame_bytes", "_in_map", "_loaded", "_now", "_optical", "_optical_until", "_out", "_out_map", "_send_alarm",
+        "_serial_pins", "_shown", "_stat_err", "_stat_low_since", "_watch_line", "attention", "bus_active", "config",
+        "due", "in_word", "io_access", "led_inputs", "line_interrupt", "line_silent", "mfp_in", "mod_ack_until", "pf",
+        "registers", "resreg_until", "revision", "serial_device", "spi_sequences", "te", "watchdog_code", "wd",
     )  # fmt: skip
 
     data_kernel: ClassVar[DataKernel] = DataKernel(_load_data_run, _latch_data_run)
@@ -301,6 +326,7 @@ class Supi3:
         self.line_interrupt = False
         """IB_DIAG's 4 Hz cause: a line interrupt ahead on the local bus (DG-3)."""
         self._init_bus_terminal()
+        self._optical_power_up()  # optical block (issue 12)
         self._reschedule()
 
     def _clock(self) -> int:
@@ -381,13 +407,16 @@ class Supi3:
         diagnostic_outputs`: UL, RC, BA, RD, LD, E, ALARM, FO1..FO3, the IB_DIAG pattern, and DIAG1/DIAG2 as
         DIAG_CONF selects. At transaction level the supply is always good (UL lit): the power-up reset has no
         duration here (1.7.2 is the pin level's)."""
+        # FO1..FO3 come from the optical block (Table 3-17, OPT-8; RUN is the bus active, DG-7).
+        leds = replace(self.led_inputs, fo=fo_leds(self._optical, self.bus_active))
         return diagnostic_outputs(self.config, supply_ok=True, line_heard=not self.line_silent,
                                   bus_active=self.bus_active, peripheral_fault=self.pf,
-                                  line_interrupt=self.line_interrupt, leds=self.led_inputs)  # fmt: skip
+                                  line_interrupt=self.line_interrupt, leds=leds)  # fmt: skip
 
     def set_led_inputs(self, leds: LedInputs) -> None:
-        """What the chip's optical block (FO1..FO3) and bus terminal logic (RD, LD, E, ALARM) show from now on
-        (DG-5, DG-7); both fidelities read it (the RTL ties these ports to 0 until those blocks drive them).
+        """What the chip's bus terminal logic (RD, LD, E, ALARM) shows from now on (DG-5); both fidelities read it
+        (the RTL ties these ports to 0). FO1..FO3 always come from the chip's own optical block
+        (:attr:`optical`, :func:`supi3.diagnostics.fo_leds`), so ``leds.fo`` is not used here.
 
         Raises
         ------
@@ -698,6 +727,143 @@ class Supi3:
         return self.bus_terminal
 
     # --------------------------------------------------------------------------------------------------------
+    # Optical regulation block (issue 12; manual 1.6, 3.4.12, 3.4.13; OPT-20 onward of docs/assumptions/optical.md)
+    # --------------------------------------------------------------------------------------------------------
+    # State: _optical, the block's OpticalStatus; _optical_until, the clock at which the initialization budget
+    # (INIT_TIME_LIMIT_CLOCKS from optical_start) runs out while a transmitter initializes, _NEVER otherwise. While it
+    # is not _NEVER the core is held in reset (latch_at and discard_at do nothing) and the ring kernel takes the slow
+    # path (_reschedule). Every change goes through a pure transition of supi3.optical.regulation and _optical_set.
+
+    def _optical_power_up(self) -> None:
+        """Power-up: every transmitter off, no length measured."""
+        self._optical_until: int = _NEVER
+        self._optical: OpticalStatus = OpticalStatus()
+        self._optical_publish()
+
+    @property
+    def optical(self) -> OpticalStatus:
+        """The optical block's status now: three transmitters, the lengths of the outgoing interface and branch."""
+        return self._optical
+
+    @property
+    def optical_mode(self) -> OpticalMode:
+        """What RF[1..0] selects (Table 2-2, OPT-2): 00 regulation, 01 optical diagnostics, copper and the LS off."""
+        rf = self.config.rf_mode
+        if rf is None:
+            return OpticalMode.OFF
+        return _OPTICAL_MODES.get(rf.rf, OpticalMode.OFF)
+
+    @property
+    def optical_holding(self) -> bool:
+        """The protocol core is held in reset (1.6): a transmitter still initializes and the 6 ms budget, counted
+        from :meth:`optical_start` in the chip's time (the last bus call), has not run out."""
+        return self._optical_until != _NEVER and self._now < self._optical_until
+
+    def optical_start(self, present: tuple[bool, bool, bool], now: float | None = None) -> None:
+        """The end of the INTERBUS reset (1.6): every interface starts (:func:`~supi3.optical.regulation.start`)
+        in the chip's optical mode; ``present`` says which of IN, OUT, BRANCH are in use (automatic interface
+        recognition). The 6 ms budget counts from bus time ``now`` (seconds; ``None``: the chip's last bus call).
+
+        Raises
+        ------
+        ChipArgumentError
+            ``present`` is not a tuple of three bools, or ``now`` is not a time.
+        """
+        if not (type(present) is tuple and len(present) == len(Interface)
+                and all(type(p) is bool for p in present)):  # fmt: skip
+            raise ChipArgumentError("present", present, "present must be a tuple of 3 bools (IN, OUT, BRANCH in "
+                                    f"use), not {present!r:.60}")
+        if now is not None:
+            self.poll(now)
+        mode = self.optical_mode
+        txs = tuple(regulation.start(mode, p) for p in present)
+        status = OpticalStatus((txs[0], txs[1], txs[2]), self._optical.length, self._optical.medium)
+        initializing = any(tx.phase is Phase.INIT for tx in txs)
+        self._optical_until = self._now + regulation.INIT_TIME_LIMIT_CLOCKS if initializing else _NEVER
+        self._optical_set(status)
+        self._reschedule()  # a new budget even if the status is the same (a start while initializing)
+
+    def optical_init_response(self, interface: Interface, response: Response) -> None:
+        """One initialization step's response on ``interface`` (:func:`~supi3.optical.regulation.init_response`,
+        1.6.1); a transmitter not initializing does not change.
+
+        Raises
+        ------
+        ChipArgumentError
+            ``interface`` is not an :class:`Interface` or ``response`` not a :class:`Response`.
+        """
+        interface = _interface(interface)
+        response = _checked(check_instance, "response", response, Response)
+        self._optical_set(self._optical.with_transmitter(
+            interface, regulation.init_response(self._optical[interface], response)))
+
+    def optical_init_timeout(self) -> None:
+        """The 6 ms budget ran out (1.6.1, OPT-5): transmitters still initializing fall back to maximum power. The
+        chip also does this by itself at the first bus call at or after the budget's end."""
+        self._optical_apply(regulation.init_timeout)
+
+    def optical_length(self, interface: Interface, count: int, medium: Medium) -> None:
+        """The length timer's result ``count`` for the outgoing interface or the branch, at the chip's bit rate
+        (:func:`~supi3.optical.length.timer_code`, 1.6.1, OPT-1); ignored when the optical block is off.
+
+        Raises
+        ------
+        ChipArgumentError
+            ``interface`` is not OUT or BRANCH (the incoming path is not measured, 3.4.12), ``count`` not an int
+            >= 0, or ``medium`` not a :class:`Medium`.
+        """
+        if _interface(interface) is Interface.IN:
+            raise ChipArgumentError("interface", interface, "interface must be Interface.OUT or Interface.BRANCH "
+                                    "(the incoming path is not measured, 3.4.12), not Interface.IN")
+        count = _checked(check_int, "count", count, 0, limit="length timer counts")
+        medium = _checked(check_instance, "medium", medium, Medium)
+        if self.optical_mode is not OpticalMode.OFF:
+            code = timer_code(count, self.config.bit_rate, medium)
+            self._optical_set(self._optical.with_length(interface, code, medium))
+
+    def optical_test(self, interface: Interface, ack1: bool, ack2: bool) -> None:
+        """One online test on ``interface`` (1.6.2): ``ack1`` at the reserve, ``ack2`` one level further. Online
+        regulation (:func:`~supi3.optical.regulation.online_test`) in regulation mode; in optical diagnostics mode
+        the interface's MAU warning (:func:`~supi3.optical.regulation.diagnostic_mau`, OPT-22).
+
+        Raises
+        ------
+        ChipArgumentError
+            ``interface`` is not an :class:`Interface`, ``ack1`` or ``ack2`` not a bool.
+        """
+        interface = _interface(interface)
+        ack1 = _checked(check_bool, "ack1", ack1)
+        ack2 = _checked(check_bool, "ack2", ack2)
+        self._optical_set(self._optical.with_transmitter(
+            interface, optical_test(self._optical[interface], ack1, ack2)))
+
+    def _optical_apply(self, transition: Callable[[regulation.Transmitter], regulation.Transmitter]) -> None:
+        """``transition`` applied to every transmitter."""
+        txs = tuple(transition(tx) for tx in self._optical.transmitters)
+        self._optical_set(OpticalStatus((txs[0], txs[1], txs[2]), self._optical.length, self._optical.medium))
+
+    def _optical_reset(self) -> None:
+        """INTERBUS reset: every transmitter off for the reset period (1.6); the lengths stay (OPT-21)."""
+        self._optical_apply(lambda _tx: regulation.Transmitter())
+
+    def _optical_set(self, status: OpticalStatus) -> None:
+        """Take ``status``; the hold ends once no transmitter initializes; reads 8..11 follow (3.4.12)."""
+        if status == self._optical:
+            return
+        self._optical = status
+        self.revision += 1
+        if not any(tx.phase is Phase.INIT for tx in status.transmitters):
+            self._optical_until = _NEVER
+        self._optical_publish()
+        self._reschedule()
+
+    def _optical_publish(self) -> None:
+        """Reads 8..11 into the register file (µP modes; the other modes have none, 3.4.12, 3.4.13)."""
+        if self.registers is not None:
+            for name, value in zip(OPTICAL_REGISTERS, regulation.registers(self._optical), strict=True):
+                self.registers.set_optical(name, value)
+
+    # --------------------------------------------------------------------------------------------------------
     # Time
     # --------------------------------------------------------------------------------------------------------
 
@@ -711,10 +877,13 @@ class Supi3:
         due = _NEVER if self._deadline is None else self._deadline
         if self._stat_low_since is not None and not self.pf:
             due = min(due, self._stat_low_since + STATERR_FILTER_CLOCKS)
+        due = min(due, self._optical_until)  # optical block: the 6 ms initialization budget (OPT-20)
         self.due = due
         # See "The ring kernel"; a serial device takes the latch's slow path (the sequence runs there).
-        # A silent line takes the slow path too: the next cycle's end is heard there (_line_heard).
-        kernel = self.registers is None and self.serial_device is None and not self.line_silent
+        # A silent line takes the slow path too: the next cycle's end is heard there (_line_heard); and so does a chip
+        # held by the optical initialization (OPT-20).
+        kernel = (self.registers is None and self.serial_device is None and not self.line_silent
+                  and self._optical_until == _NEVER)  # fmt: skip
         self._due_s = due / CLOCK_HZ if kernel else -1.0
 
     def _advance(self, clk: int) -> None:
@@ -725,6 +894,8 @@ class Supi3:
 
     def _expire(self, clk: int) -> None:
         self.revision += 1
+        if clk >= self._optical_until:  # optical block: the initialization budget ran out (OPT-5, OPT-20)
+            self._optical_apply(regulation.init_timeout)
         if self._filtered and not self.pf:
             self.pf = True
             self.attention = True
@@ -810,6 +981,8 @@ class Supi3:
         self._line_heard()
         if clk >= self.due:
             self._expire(clk)
+        if self._optical_until != _NEVER:  # optical block: the core is held in reset, latches nothing (OPT-20)
+            return
         events = self._events
         if cycle is Cycle.DATA:
             self.bus_active = True
@@ -863,6 +1036,8 @@ class Supi3:
             clk = _clock(clk)
         self._advance(clk)
         self._line_heard()
+        if self._optical_until != _NEVER:  # optical block: the core is held in reset (OPT-20)
+            return
         self.te = self.te or local_error
         if self.expansion:
             self._expansion_end(clk, None)
@@ -889,6 +1064,7 @@ class Supi3:
         self._events["IB_RESET"] += 1
         if self.registers is not None:
             self.registers.set_bus_running(False)
+        self._optical_reset()  # optical block: regulation reset for the reset period (1.6)
 
     # Device protocol in bus seconds -------------------------------------------------------------------------
 

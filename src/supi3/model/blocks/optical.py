@@ -1,0 +1,251 @@
+"""The optical regulation block at pin level: a synchronous machine with the ports of
+:data:`~supi3.optical.regulation.BLOCK_INPUTS` and :data:`~supi3.optical.regulation.BLOCK_OUTPUTS`.
+
+Manual 1.6 (behaviour on a reset), 1.6.1 (initialization in at most 6 ms, the length timer), 1.6.2 (online
+regulation, optical diagnostics), 1.6.3 (MAU warnings), Table 3-17 / Table 2-8 (FO1..FO3), 3.4.12/3.4.13 (reads 8 to
+11). Every change of a transmitter is a pure transition of :mod:`supi3.optical.regulation` (the model restates none
+of them); the RTL counterpart :mod:`supi3.rtl.optical` re-implements them in gates and is held to this block cycle
+by cycle (``tests/test_verif_lockstep_optical.py``). Decisions: OPT-20 onward of ``docs/assumptions/optical.md``.
+
+What happens at the clock edge ending a cycle, from that cycle's inputs (:mod:`supi3.pinlevel`), first match wins:
+
+1. ``ib_reset`` high: every transmitter off (OPT-21), the length timers stop, the 6 ms counter stops.
+2. The first cycle with ``ib_reset`` low after it was high (its falling edge): every interface starts
+   (:func:`~supi3.optical.regulation.start` with ``mode`` and ``present``) and the 6 ms counter is loaded with
+   :data:`~supi3.optical.regulation.INIT_TIME_LIMIT_CLOCKS`.
+3. Otherwise, per interface: a response strobe (``resp_valid``) applies
+   :func:`~supi3.optical.regulation.init_response`, then a test strobe (``test_valid``) the online test
+   (:func:`supi3.model.chip.optical_test`: regulation, or the diagnostics mode's MAU warning, OPT-22); then, on the
+   edge where the 6 ms counter runs out, :func:`~supi3.optical.regulation.init_timeout` for every transmitter.
+
+The length timers of the outgoing interface and the branch run at every edge, ib_reset aside: ``len_start`` clears
+and starts one; while it runs, every :func:`~supi3.optical.regulation.length_timer_enable_every`-th edge after the
+start counts one (saturating at :data:`LENGTH_COUNT_BITS` bits); ``len_stop`` stops it after that edge's count and,
+unless the block is off, stores :func:`~supi3.optical.length.timer_code` of the count with the ``medium`` bit
+(OPT-24). A ``len_start`` in the same cycle as a ``len_stop`` restarts it.
+
+Outputs during a cycle come from the state (``fo`` also from ``run``): ``optical`` is
+:func:`~supi3.optical.regulation.registers` of the status, byte k = read 8 + k; ``optical_we`` bit k is set while
+byte k differs from what the previous cycle showed (0 after reset, when every byte is 0); ``mau``, ``fo``
+(:func:`~supi3.optical.regulation.fo_lit`) and ``hold`` (a transmitter is initializing) per interface, bit i =
+:class:`~supi3.optical.regulation.Interface` i. A ``mode`` of 3 is off, a ``resp`` of 3 no response (OPT-23).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Final
+
+from supi3.checks import check_bits
+from supi3.errors import ArgumentError
+from supi3.model.chip import optical_test
+from supi3.optical.length import Medium, timer_code
+from supi3.optical.regulation import (
+    BLOCK_INPUTS,
+    BLOCK_OUTPUTS,
+    INIT_TIME_LIMIT_CLOCKS,
+    Interface,
+    OpticalMode,
+    OpticalStatus,
+    Phase,
+    Response,
+    Transmitter,
+    fo_lit,
+    init_response,
+    init_timeout,
+    length_timer_enable_every,
+    registers,
+    start,
+)
+from supi3.pinlevel import EventLog, Pin
+from supi3.regmap.core import BYTE_BITS
+from supi3.tables import BIT_RATES
+
+__all__ = ["LENGTH_COUNT_BITS", "MEASURED", "RESP_BITS", "OpticalBlock", "block_mode"]
+
+LENGTH_COUNT_BITS: Final = 14
+"""Width of a length timer: 20 km one way at 2 Mbit/s is 12,800 counts (1.6.1, Table 1-5); it saturates (OPT-24)."""
+RESP_BITS: Final = 2
+"""Bits of one interface's ``resp`` (a :class:`~supi3.optical.regulation.Response`)."""
+MEASURED: Final[tuple[Interface, Interface]] = (Interface.OUT, Interface.BRANCH)
+"""The paths with a length timer, in the order of :attr:`OpticalStatus.length` (3.4.12)."""
+
+_WIDTHS: Final[dict[str, int]] = {pin.name: pin.width for pin in BLOCK_INPUTS}
+_NAMES: Final = frozenset(_WIDTHS)
+_STROBES: Final = ("ib_reset", "resp_valid", "test_valid", "len_start", "len_stop")
+"""Inputs that change the state at the edge (besides the counters)."""
+_MODES: Final[dict[int, OpticalMode]] = {mode.value: mode for mode in OpticalMode}
+_RESPONSES: Final[dict[int, Response]] = {response.value: response for response in Response}
+
+
+def block_mode(value: int) -> OpticalMode:
+    """The ``mode`` port's value as an :class:`OpticalMode`; the unused code 3 is off (OPT-23)."""
+    return _MODES.get(value, OpticalMode.OFF)
+
+
+def _checked(inputs: object) -> Mapping[str, int]:
+    """The block's inputs by name, each an integer within its port's width; else a named error."""
+    if not isinstance(inputs, Mapping) or inputs.keys() != _NAMES:
+        raise ArgumentError("inputs", inputs, f"inputs must be a mapping of exactly the pins {', '.join(_WIDTHS)} "
+                                              f"to integers, not {inputs!r:.80}")
+    for name, width in _WIDTHS.items():
+        value = inputs[name]
+        if type(value) is not int or value < 0 or value >> width:  # the cheap test first
+            check_bits(f"pin {name!r}", value, width)
+    return inputs
+
+
+class _Timer:
+    """One length timer: running, the clocks since the last count, the count."""
+
+    __slots__ = ("count", "prescale", "running")
+
+    def __init__(self) -> None:
+        self.running = False
+        self.prescale = 0
+        self.count = 0
+
+
+class OpticalBlock:
+    """The optical block as a pin model (:class:`supi3.pinlevel.PinModel`); see the module docstring.
+
+    Attributes
+    ----------
+    status:
+        The block's :class:`OpticalStatus` (the state of the cycle to come).
+    countdown:
+        Edges until the initialization budget runs out, 0 when it is not running.
+    """
+
+    inputs: Sequence[Pin] = BLOCK_INPUTS
+    outputs: Sequence[Pin] = BLOCK_OUTPUTS
+
+    def __init__(self) -> None:
+        self.log = EventLog()
+        self.reset()
+
+    def reset(self) -> None:
+        """The state after the ``sync`` reset (power-up): every transmitter off, nothing measured, timers idle."""
+        self.status = OpticalStatus()
+        self.countdown = 0
+        self._in_reset = False
+        self._timers = (_Timer(), _Timer())
+        self._outputs_of: OpticalStatus | None = None
+        self._regs = self._shown = registers(self.status)
+        self._optical = self._mau = self._hold = 0
+        self._fo: tuple[int, ...] = (0, 0)
+        self.cycle = 0
+        self.log.clear()
+
+    @property
+    def hold(self) -> bool:
+        """The protocol core is held: a transmitter is initializing (1.6)."""
+        return any(tx.phase is Phase.INIT for tx in self.status.transmitters)
+
+    def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
+        """One clock (see :mod:`supi3.pinlevel`): this cycle's outputs, then the edge ending it.
+
+        Raises
+        ------
+        ArgumentError
+            ``inputs`` does not name exactly the block's input pins, or a value is not an integer within its pin's
+            width (nothing changes).
+        """
+        values = _checked(inputs)
+        status = self.status
+        if status is not self._outputs_of:  # recomputed only when the status changed
+            txs = status.transmitters
+            regs = registers(status)
+            self._regs = regs
+            self._optical = sum(byte << (BYTE_BITS * k) for k, byte in enumerate(regs))
+            self._mau = sum(int(tx.mau) << i for i, tx in enumerate(txs))
+            self._fo = tuple(sum(int(fo_lit(tx, run)) << i for i, tx in enumerate(txs)) for run in (False, True))
+            self._hold = int(any(tx.phase is Phase.INIT for tx in txs))
+            self._outputs_of = status
+        regs = self._regs
+        shown = self._shown
+        outputs = {
+            "optical_we": 0 if regs is shown else sum(1 << k for k in range(len(regs)) if regs[k] != shown[k]),
+            "optical": self._optical,
+            "mau": self._mau,
+            "fo": self._fo[values["run"]],
+            "hold": self._hold,
+        }
+        if self._in_reset or self.countdown or any(values[name] for name in _STROBES) or any(
+                timer.running for timer in self._timers):  # fmt: skip
+            self._edge(values)
+        self._shown = regs
+        self.cycle += 1
+        return outputs
+
+    def _edge(self, v: Mapping[str, int]) -> None:
+        """The clock edge ending the cycle with inputs ``v`` (the order of the module docstring)."""
+        mode = block_mode(v["mode"])
+        bit_rate = BIT_RATES[v["fast"]]
+        status = self.status
+        if v["ib_reset"]:
+            if not self._in_reset:
+                self.log.add(self.cycle, "INTERBUS reset: transmitters off")
+            self._in_reset = True
+            self.countdown = 0
+            for timer in self._timers:
+                timer.running = False
+            off = (Transmitter(), Transmitter(), Transmitter())
+            if status.transmitters != off:
+                self.status = OpticalStatus(off, status.length, status.medium)
+            return
+        if self._in_reset:
+            self._in_reset = False
+            self.countdown = INIT_TIME_LIMIT_CLOCKS
+            txs = tuple(start(mode, bool(v["present"] >> i & 1)) for i in Interface)
+            self.log.add(self.cycle, "start in {}: {}", mode.name, [tx.phase.value for tx in txs])
+        else:
+            txs = status.transmitters
+            if v["resp_valid"] or v["test_valid"]:
+                txs = tuple(self._strobes(status[i], i, v) for i in Interface)
+            if self.countdown:
+                self.countdown -= 1
+                if not self.countdown:
+                    txs = tuple(init_timeout(tx) for tx in txs)
+                    self.log.add(self.cycle, "6 ms budget over")
+        if txs != status.transmitters:
+            status = OpticalStatus((txs[0], txs[1], txs[2]), status.length, status.medium)
+        if v["len_start"] or v["len_stop"] or self._timers[0].running or self._timers[1].running:
+            status = self._lengths(status, v, mode, bit_rate)
+        self.status = status
+
+    def _strobes(self, tx: Transmitter, i: Interface, v: Mapping[str, int]) -> Transmitter:
+        """Interface ``i``'s response, then its test, of this cycle."""
+        if v["resp_valid"] >> i & 1:
+            resp = v["resp"] >> (RESP_BITS * i) & ((1 << RESP_BITS) - 1)
+            response = _RESPONSES.get(resp)
+            if response is not None:
+                tx = init_response(tx, response)
+                self.log.add(self.cycle, "{} response {}: {}", i.name, response.name, tx)
+        if v["test_valid"] >> i & 1:
+            tx = optical_test(tx, bool(v["ack1"] >> i & 1), bool(v["ack2"] >> i & 1))
+            self.log.add(self.cycle, "{} test: {}", i.name, tx)
+        return tx
+
+    def _lengths(self, status: OpticalStatus, v: Mapping[str, int], mode: OpticalMode, bit_rate: int) -> OpticalStatus:
+        """The length timers' edge (see the module docstring)."""
+        every = length_timer_enable_every(bit_rate)
+        for timer, i in zip(self._timers, MEASURED, strict=True):
+            if timer.running:
+                timer.prescale += 1
+                if timer.prescale == every:
+                    timer.prescale = 0
+                    timer.count = min(timer.count + 1, (1 << LENGTH_COUNT_BITS) - 1)
+                if v["len_stop"] >> i & 1:
+                    timer.running = False
+                    if mode is not OpticalMode.OFF:
+                        medium = Medium(v["medium"] >> i & 1)
+                        status = status.with_length(i, timer_code(timer.count, bit_rate, medium), medium)
+                        self.log.add(self.cycle, "{} length: {} counts", i.name, timer.count)
+            if v["len_start"] >> i & 1:
+                timer.running, timer.prescale, timer.count = True, 0, 0
+        return status
+
+    def recent_events(self) -> list[str]:
+        """The block's last events, for mismatch reports."""
+        return self.log.recent()
