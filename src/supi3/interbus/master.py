@@ -33,6 +33,8 @@ ALARM_STOP: Final = 0x1303
 CONTROL_DEVICE_FUNCTION: Final = 0x0714
 MSG_PERIPHERAL_FAULT: Final = 0x0BB1
 MSG_WATCHDOG: Final = 0x0C6B
+MSG_MAU_WARNING: Final = 0x0BD4
+"""OPT-52: the message a MAU warning coming on or going off raises (1.6.3 names none; the code is ours)."""
 
 # A19 After a configuration error the master drops its table and, by default, rebuilds it from a discovery ID
 # cycle in the next cycle() (docs/assumptions/interbus.md); Master(rediscover=False) waits for start() instead.
@@ -144,6 +146,8 @@ class Diagnostic:
     detail: str
     return_line: bool = False
     """The fault is on the *return* line into ``location`` (an LBD branch's, found by the counter telegram)."""
+    mau: tuple[str, bool] | None = None
+    """A MAU warning's name (``"MAUWH"``, ``"MAUWR"``, ``"MAUWS"``) and whether it came on (OPT-52)."""
 
 
 @dataclass(frozen=True)
@@ -231,6 +235,12 @@ class Master:
         explains and by the LBD location (emptied when the configuration is read anew)."""
         self._branch: dict[int, BranchControl] = {}
         self._reconfigure = False
+        self.mau_warnings: dict[int, tuple[bool, bool, bool]] = {}
+        """Ring position -> its MAU warnings (MAUWH, MAUWR, MAUWS) as last read (OPT-52); a device without an entry
+        has none on."""
+        self._optical_request: set[int] = set()
+        self._optical_expected: set[int] = set()
+        self._explain: set[int] = set()
 
     # -- services ------------------------------------------------------------------------------------------------
 
@@ -252,6 +262,7 @@ class Master:
         self._alarm_expected.clear()
         self._branch.clear()
         self._reconfigure = False
+        self._forget_optical(False)
         self._watchdog_pending = self._watchdog_code is not None
 
     def start(self) -> CycleResult:
@@ -356,7 +367,8 @@ class Master:
         if self.stopped:
             raise InterbusError("docs/interbus.md, Configuration changes", "rediscover=False",
                                 "the configuration changed and the master waits for start()")  # fmt: skip
-        pending = self._pcmd or self._alarm_request or self._alarm_expected or self._recover or self._branch
+        pending = self._pcmd or self._alarm_request or self._alarm_expected or self._recover or self._branch \
+            or self._optical_request or self._optical_expected
         if self.config is None or self._attention or self._watchdog_pending or self._quit or pending:
             return self.id_cycle()
         return self.data_cycle()
@@ -381,7 +393,8 @@ class Master:
         if self.config is None:
             return self._discovery()
         config = self.config
-        words = [self._command(entry.ring_position) for entry in reversed(config)]
+        optical = self._optical_request - self._alarm_request - self._pcmd.keys()  # one answer each (OPT-50)
+        words = [self._command(entry.ring_position, entry.ring_position in optical) for entry in reversed(config)]
         data = wire.LOOPBACK_BYTES_ON_LINE + b"".join(wire.word_bytes(w) for w in words)
         transfer = self.ring.transfer(Cycle.ID, data)
         problem = self._check(transfer, 2 * len(config))
@@ -389,7 +402,7 @@ class Master:
         if problem is None:
             assert transfer.returned is not None
             registers = _id_registers(transfer.returned, len(config))
-            problem = _compare(config, registers, self._alarm_expected)
+            problem = _compare(config, registers, self._answering)
         self.ring.finish(transfer, problem is None)
         if problem is not None:
             return self._failed(Cycle.ID, problem)
@@ -400,7 +413,7 @@ class Master:
         replan = bool(self._branch) or self._reconfigure
         self._branch.clear()
         self._reconfigure = False
-        messages = self._take_alarms(registers, sent=True) + self._messages(registers)
+        messages = self._take_alarms(registers, sent=True, optical=optical) + self._messages(registers)
         self._record(messages)
         if replan:  # a branch switched, or a reconfiguration request acknowledged: read the configuration anew
             self._set_config(None)
@@ -413,11 +426,27 @@ class Master:
             raise InterbusError("docs/interbus.md, Master", None, "no configuration: run an ID cycle first")
         return self.config
 
-    def _command(self, ring_position: int) -> int:
+    def _command(self, ring_position: int, optical: bool) -> int:
         code = self._watchdog_code if self._watchdog_pending else None
         return wire.command_word(code, ring_position in self._quit, self._pcmd.get(ring_position),
                                  ring_position in self._alarm_request,
-                                 self._branch.get(ring_position, BranchControl.NONE))  # fmt: skip
+                                 self._branch.get(ring_position, BranchControl.NONE), optical)  # fmt: skip
+
+    @property
+    def _answering(self) -> set[int]:
+        """Ring positions that send an answer in place of their ID code in the next ID cycle (A18, BK-5, OPT-50)."""
+        return self._alarm_expected | self._optical_expected
+
+    def _forget_optical(self, ask_again: bool) -> None:
+        """A new configuration: forget the MAU warnings and requests by ring position; ``ask_again``: ask every
+        device once if a warning was on, since positions may have moved (OPT-52)."""
+        known = any(any(mau) for mau in self.mau_warnings.values())
+        self.mau_warnings.clear()
+        self._optical_request.clear()
+        self._optical_expected.clear()
+        self._explain.clear()
+        if ask_again and known:
+            self._optical_request.update(_optical(self.config or ()))
 
     def _set_config(self, config: tuple[ConfigEntry, ...] | None) -> None:
         self.config = config
@@ -450,6 +479,7 @@ class Master:
         self._set_config(config)
         self.stopped = self._recover = False
         self.branch_status.clear()
+        self._forget_optical(True)
         messages = self._messages(registers)
         self._record(messages)
         return CycleResult(Cycle.ID, True, messages)
@@ -506,7 +536,7 @@ class Master:
     def _with_device(self, d: Diagnostic) -> Diagnostic:
         config = self.config or ()
         device = config[d.location - 1].number if d.location is not None and d.location <= len(config) else None
-        return Diagnostic(d.kind, d.location, device, d.code, d.detail, d.return_line)
+        return Diagnostic(d.kind, d.location, device, d.code, d.detail, d.return_line, d.mau)
 
     def _locate(self, problem: Diagnostic, trusted: bool) -> Diagnostic:
         """Locate the error of a failed cycle: read the TE bits in a diagnostic ID cycle; if the ring answers
@@ -520,7 +550,7 @@ class Master:
         if check is None:
             assert transfer.returned is not None
             registers = _id_registers(transfer.returned, n)
-            check = _compare(config, registers, self._alarm_expected)
+            check = _compare(config, registers, self._answering)
         self.ring.finish(transfer, check is None)
         if check is None:
             self._recover = False
@@ -550,7 +580,7 @@ class Master:
         if check is not None:
             return None
         self._recover = False
-        where = _first_difference(config, registers, self._alarm_expected)
+        where = _first_difference(config, registers, self._answering)
         if where is not None:
             return _changed(problem, where, f"{len(registers)} devices answer, the table has {len(config)}")
         self._record(self._take_alarms(registers, sent=False) + self._messages(registers))
@@ -625,7 +655,7 @@ class Master:
         if problem is None:
             assert transfer.returned is not None
             registers = _id_registers(transfer.returned, devices)
-            problem = _compare(config[:devices], registers, self._alarm_expected)
+            problem = _compare(config[:devices], registers, self._answering)
         self.ring.finish(transfer, problem is None)
         if problem is None:
             self._record(self._take_alarms(registers, sent=False))
@@ -635,12 +665,17 @@ class Master:
                 self._recover = False
         return problem
 
-    def _take_alarms(self, registers: list[int], sent: bool) -> tuple[Diagnostic, ...]:
+    def _take_alarms(self, registers: list[int], sent: bool,
+                     optical: Collection[int] = ()) -> tuple[Diagnostic, ...]:  # fmt: skip
         """After a latched ID cycle: the devices asked in the previous one sent their processor alarm (a BK without
-        µP: its branch status, BK-5) in place of the ID code; the requests this one carried (``sent``) are answered
-        in the next (A18). Returns the BKs' reports (reconfiguration requests, branches they closed)."""
+        µP: its branch status, BK-5) or their optical status (OPT-50) in place of the ID code; the requests this one
+        carried (``sent``; ``optical``: the optical ones) are answered in the next (A18). Returns the BKs' reports
+        (reconfiguration requests, branches they closed) and the MAU warnings that changed."""
         terminals = _terminals(self.config or ())
         found: list[Diagnostic] = []
+        for position in sorted(self._optical_expected):
+            if position <= len(registers):
+                found += self._mau_report(position, registers[position - 1] & 0xFF)
         for position in sorted(self._alarm_expected):
             if position > len(registers):
                 continue
@@ -650,8 +685,10 @@ class Master:
                 self.processor_alarms[position] = registers[position - 1] & 0xFF
         answered = range(1, len(registers) + 1)
         self._alarm_expected = set(self._alarm_request) if sent else self._alarm_expected.difference(answered)
+        self._optical_expected = set(optical) if sent else self._optical_expected.difference(answered)
         if sent:
             self._alarm_request.clear()
+            self._optical_request.difference_update(optical)
         return tuple(self._with_device(d) for d in found)
 
     def _branch_report(self, position: int, status: wire.BkStatus) -> list[Diagnostic]:
@@ -670,7 +707,26 @@ class Master:
                                     "(extended BK function, 2.4)"))  # fmt: skip
         if found:
             self._quit.add(position)
+        elif position in self._explain:  # asked after ATTN, and the branch has no report: the BK's optics (OPT-50)
+            self._optical_request.add(position)
+        self._explain.discard(position)
         return found
+
+    def _mau_report(self, position: int, byte: int) -> list[Diagnostic]:
+        """A device's optical status read: report every MAU warning that came on or went off (OPT-52)."""
+        status = wire.decode_optical_status(byte)
+        if status is None:  # the device does not know the request: it sent its ID code
+            return []
+        before = self.mau_warnings.get(position, (False, False, False))
+        if any(status):
+            self.mau_warnings[position] = status
+        else:
+            self.mau_warnings.pop(position, None)
+        return [Diagnostic(ErrorKind.MAU_WARNING, position, None, MSG_MAU_WARNING,
+                           f"{name} {'on' if on else 'off'}: the transmission reserve of the {where} "
+                           f"{'is critical' if on else 'is back'} (1.6.3)", mau=(name, on))
+                for name, where, on, was in zip(wire.MAU_WARNINGS, _MAU_PLACES, status, before, strict=True)
+                if on != was]  # fmt: skip
 
     def _messages(self, registers: list[int]) -> tuple[Diagnostic, ...]:
         """Report the management bits of a latched ID cycle: PF as 0BB1h (once per fault), WD as 0C6Bh."""
@@ -687,8 +743,12 @@ class Master:
                 found.append(Diagnostic(ErrorKind.WATCHDOG, k, None, MSG_WATCHDOG,
                                         "layer-2 watchdog reset the process data"))  # fmt: skip
         if self._attention and not found and self.config is not None:
-            # ATTN that no PF or WD bit explains: a BK has a report; its branch status tells (BK-5)
-            self._alarm_request.update(_terminals(self.config))
+            # ATTN that no PF or WD bit explains: a BK has a report, its branch status tells (BK-5); or a MAU
+            # warning changed: the optical status of the others tells, a BK's after its branch status (OPT-50)
+            terminals = _terminals(self.config)
+            self._alarm_request.update(terminals)
+            self._explain.update(terminals)
+            self._optical_request.update(_optical(self.config) - terminals)
         self._attention = False
         return tuple(self._with_device(d) for d in found)
 
@@ -696,6 +756,16 @@ class Master:
 def _terminals(config: tuple[ConfigEntry, ...]) -> set[int]:
     """Ring positions of the BKs without µP, which answer a status request with their branch status (BK-5)."""
     return {entry.ring_position for entry in config if entry.id_code in STATUS_TERMINAL_ID_CODES}
+
+
+_MAU_PLACES: Final = ("incoming interface", "outgoing interface", "branch interface")
+"""Where each MAU warning of ``wire.MAU_WARNINGS`` belongs (1.6.3)."""
+
+
+def _optical(config: tuple[ConfigEntry, ...]) -> set[int]:
+    """Ring positions the master may ask for their optical status: those whose ID code cannot be taken for an
+    optical status byte (OPT-51)."""
+    return {entry.ring_position for entry in config if wire.decode_optical_status(entry.id_code) is None}
 
 
 def _find_loopback(returned: bytes) -> int:

@@ -71,6 +71,8 @@ class ErrorKind(Enum):
     """A bus terminal module's CONF input rose: a request to reconfigure the bus (2.4, Table 2-8; BK-8)."""
     BRANCH_CLOSED = "branch closed"
     """A bus terminal module closed its branch itself (extended BK function, 2.4; BK-3)."""
+    MAU_WARNING = "MAU warning"
+    """A device's MAU warning (MAUWH, MAUWR or MAUWS) came on or went off (1.6.3; OPT-50..OPT-53)."""
 
 
 # ----------------------------------------------------------------------------------------------------------------

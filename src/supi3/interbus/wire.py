@@ -92,6 +92,11 @@ CMD_PCMD_SHIFT: Final = 8
 # extended BK function (2.4: the BK closes a silent branch by itself). Bits 7..6 had no meaning before.
 CMD_BRANCH_SHIFT: Final = 6
 
+# OPT-50 Optical status request (MAU warnings, manual 1.6.3; docs/assumptions/optical.md): bit 8 with bit 4 (the
+# processor command) clear asks the device to send its optical status byte in the next ID cycle in place of the ID
+# code. Bits 15..8 had a meaning only with bit 4 set (A18), so the two never go in one command word.
+CMD_OPTICAL_BIT: Final = 8
+
 # A10 Each device repeats the line with this delay; it may look this many bits minus one ahead (mid-bit sampling).
 REPEATER_DELAY_BITS: Final = 3
 
@@ -353,7 +358,7 @@ class BranchControl(Enum):
 
 def command_word(watchdog_code: int | None = None, quit_peripheral_error: bool = False,
                  processor_command: int | None = None, alarm_request: bool = False,
-                 branch: BranchControl = BranchControl.NONE) -> int:
+                 branch: BranchControl = BranchControl.NONE, optical_request: bool = False) -> int:
     """Compose the 16-bit command word the master shifts into a device in an ID cycle (assumptions A9, A18).
 
     Parameters
@@ -370,6 +375,9 @@ def command_word(watchdog_code: int | None = None, quit_peripheral_error: bool =
         without a µP sends its branch status byte (:func:`bk_status`, BK-5).
     branch:
         A bus terminal module's branch control (BK-4).
+    optical_request:
+        Ask the device to send its optical status byte (:func:`optical_status`) in the next ID cycle in place of the
+        ID code (OPT-50); not together with ``processor_command`` (both use bits 15..8) or ``alarm_request``.
     """
     if type(branch) is not BranchControl:
         branch = checked(check_instance, "branch", branch, BranchControl, "a BranchControl")
@@ -382,6 +390,11 @@ def command_word(watchdog_code: int | None = None, quit_peripheral_error: bool =
         word |= (processor_command << CMD_PCMD_SHIFT) | (1 << CMD_PCMD_BIT)
     if alarm_request:
         word |= 1 << CMD_ALARM_BIT
+    if _flag("optical_request", optical_request):
+        if processor_command is not None or alarm_request:
+            raise InterbusError("OPT-50", optical_request, "an optical status request goes without a processor "
+                                "command and without an alarm request (one answer per ID cycle, bits 15..8)")
+        word |= 1 << CMD_OPTICAL_BIT
     if watchdog_code is not None:
         watchdog_code = _int("watchdog_code", watchdog_code, 0, len(WATCHDOG_TIMEOUTS_S) - 1,
                              "Table 3-13: an index into WATCHDOG_TIMEOUTS_S")  # fmt: skip
@@ -400,6 +413,7 @@ class CommandWord(NamedTuple):
     processor_command: int | None = None
     alarm_request: bool = False
     branch: BranchControl = BranchControl.NONE
+    optical_request: bool = False
 
 
 def decode_command_word(word: int) -> CommandWord:
@@ -408,7 +422,37 @@ def decode_command_word(word: int) -> CommandWord:
     code = (word >> CMD_WD_CODE_SHIFT) & 0b11 if _bit(word, CMD_WD_SET_BIT) else None
     pcmd = (word >> CMD_PCMD_SHIFT) & 0xFF if _bit(word, CMD_PCMD_BIT) else None
     branch = BranchControl((word >> CMD_BRANCH_SHIFT) & 0b11)
-    return CommandWord(code, bool(_bit(word, CMD_QUIT_BIT)), pcmd, bool(_bit(word, CMD_ALARM_BIT)), branch)
+    optical = pcmd is None and bool(_bit(word, CMD_OPTICAL_BIT))
+    return CommandWord(code, bool(_bit(word, CMD_QUIT_BIT)), pcmd, bool(_bit(word, CMD_ALARM_BIT)), branch, optical)
+
+
+# ================================================================================================================
+# MAU warnings: the optical status byte (manual 1.6.3; docs/assumptions/optical.md OPT-50..OPT-53)
+# ================================================================================================================
+
+# OPT-51 The optical status byte a device sends in place of its ID code when asked (CMD_OPTICAL_BIT): 10000b in
+# bits 7..3 (80h..87h: no ID code of Table A-3 lies there, so the master tells it from the ID code of a device that
+# does not know the request), bits 2..0 MAUWH, MAUWR, MAUWS.
+OPTICAL_STATUS_MARK: Final = 0b10000 << 3
+MAU_WARNINGS: Final = ("MAUWH", "MAUWR", "MAUWS")
+"""The MAU warnings of 1.6.3 in bit order: incoming interface, outgoing interface, branch."""
+
+
+def optical_status(mau: Sequence[bool]) -> int:
+    """Compose the optical status byte from the three MAU warnings (MAUWH, MAUWR, MAUWS; OPT-51)."""
+    if isinstance(mau, (str, bytes)) or not isinstance(mau, Sequence) or len(mau) != len(MAU_WARNINGS):
+        _refuse("mau", "a sequence of 3 bools (MAUWH, MAUWR, MAUWS)", mau)
+    bits = (_flag(name, on) << i for i, (name, on) in enumerate(zip(MAU_WARNINGS, mau, strict=True)))
+    return OPTICAL_STATUS_MARK | sum(bits)
+
+
+def decode_optical_status(byte: int) -> tuple[bool, bool, bool] | None:
+    """The MAU warnings (MAUWH, MAUWR, MAUWS) of an optical status byte, ``None`` if ``byte`` has not the mark
+    (an ID code: the device does not know the request, OPT-51)."""
+    byte = _int("byte", byte, 0, 0xFF, "OPT-51: the optical status is one byte")
+    if byte & ~0b111 != OPTICAL_STATUS_MARK:
+        return None
+    return bool(byte & 1), bool(byte & 2), bool(byte & 4)
 
 
 # ================================================================================================================

@@ -252,7 +252,8 @@ class Supi3:
     __slots__ = (
         "__dict__",  # room beyond the declared state, so that a test can spy on a chip's methods
         "_chain", "_cpb", "_deadline", "_due_s", "_events", "_exr_driver", "_exr_free", "_fast_valid", "_fixed_bytes",
-        "_frame_bytes", "_in_map", "_loaded", "_now", "_optical", "_optical_until", "_out", "_out_map", "_send_alarm",
+        "_frame_bytes", "_in_map", "_loaded", "_mau_events", "_mau_told", "_now", "_optical", "_optical_until", "_out",
+        "_out_map", "_send_alarm", "_send_optical",
         "_serial_pins", "_shown", "_stat_err", "_stat_low_since", "_watch_line", "attention", "bus_active", "config",
         "due", "in_word", "io_access", "led_inputs", "line_interrupt", "line_silent", "mfp_in", "mod_ack_until", "pf",
         "registers", "resreg_until", "revision", "serial_device", "spi_sequences", "te", "watchdog_code", "wd",
@@ -469,7 +470,7 @@ class Supi3:
 
     def id_register(self) -> int:
         """The 16-bit ID register shifted out in an ID cycle."""
-        return self.management() | self._id_and_length()
+        return self._optical_id(self.management() | self._id_and_length())  # optical status when asked (OPT-50)
 
     def data_bytes(self) -> int:
         """Bytes the chip occupies on the line in a data cycle (Table 3-11, assumption A15)."""
@@ -734,11 +735,38 @@ class Supi3:
     # is not _NEVER the core is held in reset (latch_at and discard_at do nothing) and the ring kernel takes the slow
     # path (_reschedule). Every change goes through a pure transition of supi3.optical.regulation and _optical_set.
 
+    #
+    # MAU warnings to the master (OPT-50..OPT-53): _mau_told are the warnings the master last read, _mau_events which
+    # of them changed since (MAU_WARNING_EVENT, 1.6.3); the chip holds ATTN while an event waits. Asked in an ID
+    # cycle's command word (_send_optical), it sends its optical status byte in the next one in place of the ID
+    # code, each waiting event flipping the bit the master knows, and once that cycle is latched the master knows it.
+
     def _optical_power_up(self) -> None:
-        """Power-up: every transmitter off, no length measured."""
+        """Power-up: every transmitter off, no length measured, no MAU report waiting."""
         self._optical_until: int = _NEVER
         self._optical: OpticalStatus = OpticalStatus()
+        self._mau_told = self._mau_events = (False, False, False)
+        self._send_optical = False
         self._optical_publish()
+
+    def _mau_sent(self) -> tuple[bool, bool, bool]:
+        """The MAU warnings the optical status byte shows: what the master knows, flipped where an event waits."""
+        told, events = self._mau_told, self._mau_events
+        return told[0] ^ events[0], told[1] ^ events[1], told[2] ^ events[2]
+
+    def _optical_id(self, word: int) -> int:
+        """The ID register ``word`` with the optical status byte in place of the ID code when asked (OPT-50)."""
+        return (word & ~0xFF) | wire.optical_status(self._mau_sent()) if self._send_optical else word
+
+    def _optical_command(self, command: wire.CommandWord) -> bool:
+        """A latched ID cycle: the master has the status byte sent in it (if asked); take the next request (OPT-50).
+        ``True`` while a MAU event waits (the chip holds ATTN, OPT-53)."""
+        if self._send_optical:
+            self._mau_told = self._mau_sent()
+            mau = tuple(tx.mau for tx in self._optical.transmitters)
+            self._mau_events = (mau[0] != self._mau_told[0], mau[1] != self._mau_told[1], mau[2] != self._mau_told[2])
+        self._send_optical = command.optical_request and not command.alarm_request
+        return any(self._mau_events)
 
     @property
     def optical(self) -> OpticalStatus:
@@ -843,15 +871,24 @@ class Supi3:
         self._optical_set(OpticalStatus((txs[0], txs[1], txs[2]), self._optical.length, self._optical.medium))
 
     def _optical_reset(self) -> None:
-        """INTERBUS reset: every transmitter off for the reset period (1.6); the lengths stay (OPT-21)."""
+        """INTERBUS reset: every transmitter off for the reset period (1.6); the lengths stay (OPT-21); the master
+        forgets the MAU warnings with its configuration, so does the chip (OPT-53)."""
         self._optical_apply(lambda _tx: regulation.Transmitter())
+        self._mau_told = self._mau_events = (False, False, False)
+        self._send_optical = False
 
     def _optical_set(self, status: OpticalStatus) -> None:
         """Take ``status``; the hold ends once no transmitter initializes; reads 8..11 follow (3.4.12)."""
         if status == self._optical:
             return
+        old = self._optical.transmitters
         self._optical = status
         self.revision += 1
+        events = tuple(e or new.mau != was.mau for e, new, was in zip(self._mau_events, status.transmitters, old,
+                                                                       strict=True))  # fmt: skip
+        if events != self._mau_events:  # a MAU warning came on or went off: an event for the master (OPT-53)
+            self._mau_events = (events[0], events[1], events[2])
+            self.attention = True
         if not any(tx.phase is Phase.INIT for tx in status.transmitters):
             self._optical_until = _NEVER
         self._optical_publish()
@@ -1020,7 +1057,7 @@ class Supi3:
                     self.registers.processor_command(command.processor_command)
                 self._send_alarm = command.alarm_request
             self.wd = self.te = False
-            self.attention = self._bus_terminal_command(command)
+            self.attention = self._bus_terminal_command(command) | self._optical_command(command)  # BK-5, OPT-53
             if self.expansion:
                 self._expansion_end(clk, None)
             self._event("ID_CYCLE")
@@ -1059,12 +1096,12 @@ class Supi3:
         self._reschedule()
         self._send_alarm = False
         self.wd = self.te = False
+        self._optical_reset()  # optical block: regulation reset for the reset period (1.6), MAU reports (OPT-53)
         self.attention = self.pf or self._bus_terminal_reset()
         self.bus_active = False
         self._events["IB_RESET"] += 1
         if self.registers is not None:
             self.registers.set_bus_running(False)
-        self._optical_reset()  # optical block: regulation reset for the reset period (1.6)
 
     # Device protocol in bus seconds -------------------------------------------------------------------------
 
