@@ -178,7 +178,7 @@ def test_arguments_are_checked() -> None:
     chips = _chips(2)
     for args, name in (((chips, [FibreLink(1.0)]), "links"), (([], []), "chips"), ((chips, "ab"), "links"),
                        (([chips[0], 3], [None, None]), "chip at ring position 2"),
-                       ((chips, [None, 3]), "link into ring position 2"),
+                       ((chips, [None, 3]), "link into chip 2"),
                        (([chips[0], Supi3(decode("10000", clk_conf="11"))], [None, None]), "chips")):  # fmt: skip
         with pytest.raises(ArgumentError, match=rf"^{name} must be"):
             OpticalRing(*args)

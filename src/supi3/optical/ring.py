@@ -39,7 +39,7 @@ from supi3.config import DeviceConfig
 from supi3.interbus import wire
 from supi3.interbus.link import Device
 from supi3.interbus.master import Master
-from supi3.interbus.ring import BitFlip, DeadLine, Ring, Transfer
+from supi3.interbus.ring import BitFlip, Branch, BranchKind, DeadLine, ReturnBreak, Ring, Transfer
 from supi3.interbus.wire import Cycle
 from supi3.optical.length import Medium, length_m
 from supi3.optical.link import Direction, FibreLink, LightState
@@ -57,6 +57,7 @@ from supi3.optical.regulation import (
 from supi3.regmap.registers import (
     OPTICAL_LENGTH_WIDTH,
     OPTICAL_MEDIUM_BIT,
+    POWER_BRANCH_LSB,
     POWER_LEVEL_WIDTH,
     POWER_OUT_LSB,
 )
@@ -85,6 +86,11 @@ class OpticalChip(Device, Protocol):
         """What RF[1..0] selects."""
         ...
 
+    @property
+    def terminal_interface(self) -> str | None:
+        """The bus terminal interface of Table 2-7 (``None``: no BK)."""
+        ...
+
     def optical_start(self, present: tuple[bool, bool, bool], now: float | None = None) -> None:
         """The end of the INTERBUS reset reached the chip at bus time ``now``."""
         ...
@@ -100,13 +106,6 @@ class OpticalChip(Device, Protocol):
     def optical_test(self, interface: Interface, ack1: bool, ack2: bool) -> None:
         """One online test's result."""
         ...
-
-_TX: Final = (Interface.OUT, Interface.IN)
-"""The transmitting interface of each :class:`~supi3.optical.link.Direction`: the upstream chip's OUT sends the
-forward fibre, the downstream chip's IN the return fibre."""
-_RX: Final = (Interface.IN, Interface.OUT)
-"""The receiving interface of each direction."""
-
 
 @dataclass(frozen=True)
 class MauReport:
@@ -152,16 +151,53 @@ class PathRow:
                 f"{self.return_level} (of {MAX_LEVEL})", f"{self.length_m:g}m", medium)  # fmt: skip
 
 
+@dataclass(frozen=True, eq=False)
+class _Cable:
+    """Cable *k* (``index`` = *k* - 1 into :attr:`OpticalRing.links`): the upstream chip (``None``: the master)
+    sends the forward fibre from ``interface`` (OUT, or BRANCH for a BK's branch) into the downstream chip's incoming
+    interface. ``kind`` is the branch the downstream chip belongs to (``None``: the remote bus of the master)."""
+
+    index: int
+    upstream: OpticalChip | None
+    interface: Interface
+    downstream: OpticalChip
+    link: FibreLink | None
+    kind: BranchKind | None
+
+
+def _walk(items: Sequence[OpticalChip | Branch], upstream: OpticalChip | None, interface: Interface,
+          kind: BranchKind | None, cables: list[_Cable], links: Sequence[FibreLink | None]) -> None:  # fmt: skip
+    """The cables of a tree in walk order: into every device from the one before it (its BK's branch for the first
+    device of a branch, a BK's outgoing interface for the device after its branch)."""
+    for item in items:
+        device = item.terminal if isinstance(item, Branch) else item
+        if not isinstance(device, OpticalChip):
+            raise fail(f"device {len(cables) + 1}", "a chip with an optical block (a Supi3)", device)
+        if len(cables) >= len(links):
+            raise fail("links", "one FibreLink or None per device of the tree", links)
+        cables.append(_Cable(len(cables), upstream, interface, device, links[len(cables)], kind))
+        if isinstance(item, Branch):
+            _walk(item.devices, device, Interface.BRANCH, item.kind, cables, links)  # type: ignore[arg-type]
+        upstream, interface = device, Interface.OUT
+
+
+def _count(items: Sequence[object]) -> int:
+    return sum(1 + _count(item.devices) if isinstance(item, Branch) else 1 for item in items)
+
+
 class OpticalRing:
-    """A master's ring of SUPI 3 chips joined by fibre cables (a :class:`~supi3.interbus.ring.Bus`).
+    """A master's ring of SUPI 3 chips joined by fibre cables (a :class:`~supi3.interbus.ring.Bus`), possibly a tree.
 
     Parameters
     ----------
     chips:
-        The chips in ring order (ring position 1 next to the master); they share one bit rate.
+        The chips in ring order (ring position 1 next to the master); a :class:`~supi3.interbus.ring.Branch` stands
+        for a bus terminal module and its branch (a tree, docs/interbus.md "Tree"). They share one bit rate.
     links:
-        One per chip: ``links[k - 1]`` is the cable entering ring position *k* (from the master for *k* = 1, which is
-        not a regulated device), ``None`` for copper.
+        One per chip in the tree's walk order (a BK, its branch's devices, then on; in a ring without branches ring
+        order): ``links[k - 1]`` is the cable entering chip *k* (from the master for the first; from its BK's branch
+        interface for a branch's first device, from a BK's outgoing interface for the device after its branch),
+        ``None`` for copper.
     seed:
         Seed of the bit errors on marginal fibres.
     record:
@@ -171,6 +207,8 @@ class OpticalRing:
     ----------
     ring:
         The transaction-level ring underneath; its faults are the fibres' (set before every cycle).
+    chips:
+        Every chip in the tree's walk order (``links[k - 1]`` enters ``chips[k - 1]``).
     reports:
         MAU warning changes, oldest first.
     history:
@@ -182,28 +220,34 @@ class OpticalRing:
     direct_return_line: Final = True
     """See :attr:`supi3.interbus.ring.Ring.direct_return_line`."""
 
-    def __init__(self, chips: Sequence[OpticalChip], links: Sequence[FibreLink | None], *, seed: int = 0,
+    def __init__(self, chips: Sequence[OpticalChip | Branch], links: Sequence[FibreLink | None], *, seed: int = 0,
                  record: bool = False) -> None:  # fmt: skip
         if isinstance(chips, (str, bytes)) or not isinstance(chips, Sequence) or not chips:
-            raise fail("chips", "a non-empty sequence of Supi3 chips", chips)
+            raise fail("chips", "a non-empty sequence of Supi3 chips and branches", chips)
         for k, chip in enumerate(chips, 1):
-            if not isinstance(chip, OpticalChip):
-                raise fail(f"chip at ring position {k}", "a chip with an optical block (a Supi3)", chip)
-        rates = {chip.config.bit_rate for chip in chips}
-        if len(rates) != 1:
-            raise fail("chips", "chips of one bit rate", sorted(rates))
-        if isinstance(links, (str, bytes)) or not isinstance(links, Sequence) or len(links) != len(chips):
-            raise fail("links", f"a sequence of {len(chips)} FibreLink or None (one per chip)", links)
+            if not isinstance(chip, (OpticalChip, Branch)):
+                raise fail(f"chip at ring position {k}", "a chip with an optical block (a Supi3) or a Branch", chip)
+        n = _count(chips)
+        if isinstance(links, (str, bytes)) or not isinstance(links, Sequence) or len(links) != n:
+            raise fail("links", f"a sequence of {n} FibreLink or None (one per chip)", links)
         for k, cable in enumerate(links, 1):
             if cable is not None:
-                check_instance(f"link into ring position {k}", cable, FibreLink, "a FibreLink or None")
-        self.chips: list[OpticalChip] = list(chips)
+                check_instance(f"link into chip {k}", cable, FibreLink, "a FibreLink or None")
+        self._cables: list[_Cable] = []
+        _walk(chips, None, Interface.OUT, None, self._cables, links)
+        self.chips: list[OpticalChip] = [c.downstream for c in self._cables]
+        rates = {chip.config.bit_rate for chip in self.chips}
+        if len(rates) != 1:
+            raise fail("chips", "chips of one bit rate", sorted(rates))
         self.links: list[FibreLink | None] = list(links)
-        self.ring = Ring(self.chips, bit_rate=rates.pop(), record=check_bool("record", record))
+        self.ring = Ring(list(chips), bit_rate=rates.pop(), record=check_bool("record", record))
         self._random = random.Random(check_int("seed", seed))
         self.reports: list[MauReport] = []
         self.history: list[list[PathSample]] = [[] for _ in self.links]
         self._data_cycles = 0
+        self._into = {id(c.downstream): c for c in self._cables}
+        self._out: dict[tuple[int, Interface], _Cable] = {
+            (id(c.upstream), c.interface): c for c in self._cables if c.upstream is not None}
         self._mau = [tuple(tx.mau for tx in chip.optical.transmitters) for chip in self.chips]
 
     # -- the Bus protocol ------------------------------------------------------------------------------------------
@@ -227,8 +271,9 @@ class OpticalRing:
     def finish(self, transfer: Transfer, latch: bool) -> None:
         """See :meth:`supi3.interbus.ring.Ring.finish`; every :data:`~supi3.optical.regulation.REPEAT_CYCLES` data
         cycles over the whole ring, an online test round."""
+        whole = transfer.devices == len(self.ring.devices)
         self.ring.finish(transfer, latch)
-        if transfer.cycle is Cycle.DATA and transfer.devices == len(self.chips):
+        if transfer.cycle is Cycle.DATA and whole:
             self._data_cycles += 1
             if self._data_cycles % REPEAT_CYCLES == 0:
                 self._test_round(transfer.reached)
@@ -248,77 +293,142 @@ class OpticalRing:
 
     # -- parties and physics ---------------------------------------------------------------------------------------
 
-    def _ends(self, k: int) -> tuple[OpticalChip | None, OpticalChip]:
-        """Cable *k*'s upstream chip (``None``: the master) and downstream chip."""
-        return (self.chips[k - 2] if k > 1 else None), self.chips[k - 1]
+    def _positions(self) -> dict[int, int]:
+        """Ring position (1..N) of every chip in the data path now, by ``id``."""
+        return {id(d): k for k, d in enumerate(self.ring.devices, 1)}
 
     def _party(self, k: int, direction: Direction) -> tuple[OpticalChip | None, OpticalChip | None]:
         """The transmitting and the receiving chip of ``direction`` on cable *k* (``None``: the master)."""
-        up, down = self._ends(k)
+        cable = self._cables[k - 1]
+        up, down = cable.upstream, cable.downstream
         return (up, down) if direction is Direction.FORWARD else (down, up)
+
+    def _tx_interface(self, k: int, direction: Direction) -> Interface:
+        """The interface that sends ``direction`` on cable *k*."""
+        return self._cables[k - 1].interface if direction is Direction.FORWARD else Interface.IN
 
     def _level(self, k: int, direction: Direction) -> int:
         """The level the transmitter of ``direction`` on cable *k* sends at (the master's: maximum)."""
         tx, _ = self._party(k, direction)
-        return MAX_LEVEL if tx is None else tx.optical[_TX[direction]].level
+        return MAX_LEVEL if tx is None else tx.optical[self._tx_interface(k, direction)].level
 
     def _state(self, k: int, cable: FibreLink, direction: Direction, t: float) -> LightState:
         return cable.state(direction, self._level(k, direction), t)
 
+    def _line(self, cable: _Cable, direction: Direction, at: dict[int, int]) -> DeadLine | ReturnBreak:
+        """The ring fault of a dark fibre of ``cable`` (OPT-47, OPT-54): the forward fibre is the line into the
+        downstream chip; in a branch with return lines the return fibre is the return line into the upstream chip
+        (a BK's branch return input for the branch's first cable), elsewhere the line into the downstream chip too."""
+        down = at[id(cable.downstream)]
+        if direction is Direction.FORWARD or cable.kind in (None, BranchKind.LBD_OR) or cable.upstream is None:
+            return DeadLine(down)
+        if cable.interface is Interface.OUT and cable.upstream.terminal_interface is not None:
+            return DeadLine(down)  # from a nested BK's outgoing interface: not a return line of the ring model
+        return ReturnBreak(at[id(cable.upstream)])
+
+    def _in_path(self, cable: _Cable, at: dict[int, int]) -> bool:
+        return cable.link is not None and id(cable.downstream) in at and (
+            cable.upstream is None or id(cable.upstream) in at)  # fmt: skip
+
+    def _breaks(self, t: float) -> list[DeadLine | ReturnBreak]:
+        """The ring faults of every dark fibre in the data path at bus time ``t``."""
+        at = self._positions()
+        found: list[DeadLine | ReturnBreak] = []
+        for cable in self._cables:
+            if not self._in_path(cable, at):
+                continue
+            assert cable.link is not None
+            for d in Direction:
+                if self._state(cable.index + 1, cable.link, d, t) is LightState.DARK:
+                    found.append(self._line(cable, d, at))
+        return found
+
     def _faults(self, frame_bits: int) -> None:
-        """The ring's faults from the fibres at the current bus time (OPT-47): a dark cable is a dead line, a
-        marginal one hits a frame of ``frame_bits`` bits with one bit error at its bit-error rate."""
+        """The ring's faults from the fibres at the current bus time (OPT-47): a dark fibre is a dead line (or a
+        branch's broken return line, OPT-54), a marginal cable hits a frame of ``frame_bits`` bits with one bit error
+        at its bit-error rate."""
         self.ring.clear_faults()
         t = self.now
-        for k, cable in enumerate(self.links, 1):
-            if cable is None:
+        breaks = self._breaks(t)
+        for fault in dict.fromkeys(breaks):
+            self.ring.inject(fault)
+        if not frame_bits:
+            return
+        at = self._positions()
+        for cable in self._cables:
+            if not self._in_path(cable, at):
                 continue
-            states = [self._state(k, cable, d, t) for d in Direction]
-            if LightState.DARK in states:
-                self.ring.inject(DeadLine(k))
-            elif frame_bits and LightState.MARGINAL in states:
+            assert cable.link is not None
+            k = cable.index + 1
+            states = [self._state(k, cable.link, d, t) for d in Direction]
+            if LightState.DARK not in states and LightState.MARGINAL in states:
                 clean = 1.0
                 for d in Direction:
-                    clean *= (1 - cable.bit_error_rate(d, self._level(k, d), t)) ** frame_bits
+                    clean *= (1 - cable.link.bit_error_rate(d, self._level(k, d), t)) ** frame_bits
                 if self._random.random() >= clean:
-                    self.ring.inject(BitFlip(k, self._random.randrange(frame_bits)))
+                    self.ring.inject(BitFlip(at[id(cable.downstream)], self._random.randrange(frame_bits)))
 
     # -- initialization (1.6.1) ------------------------------------------------------------------------------------
 
+    def _reach(self) -> int:
+        """How many positions of the data path the reset reaches: those before the first dead line, all of a
+        branch whose return line is broken (the ring's reading, BK-10)."""
+        reach = len(self.ring.devices)
+        spans = self.ring.spans
+        for fault in self._breaks(self.now):
+            if isinstance(fault, DeadLine):
+                reach = min(reach, fault.segment - 1)
+                continue
+            inner = [(bk, size) for bk, size, _ in spans if bk == fault.segment]
+            inner = inner or [(bk, size) for bk, size, _ in spans if bk < fault.segment <= bk + size][-1:]
+            if inner:
+                reach = min(reach, inner[0][0] + inner[0][1])
+        return reach
+
     def _initialize(self) -> None:
-        """Initialization cable by cable after the reset (1.6.1, OPT-46); bus time moves to its end."""
+        """Initialization cable by cable down the data path after the reset (1.6.1, OPT-46); a BK initializes its
+        branch and outgoing interfaces right after its incoming one (OPT-54); bus time moves to its end."""
         t = self.now
-        dead = self._first_dead()
-        for k, cable in enumerate(self.links, 1):
-            if dead is not None and k >= dead:
-                break  # the reset did not get here; these chips wait for the silent-line timeout
-            up, down = self._ends(k)
-            if cable is not None and up is not None:
-                t = self._init_direction(k, cable, Direction.FORWARD, t)
-                if up.optical[Interface.OUT].phase is not Phase.OFF and all(
-                        self._state(k, cable, d, t) is not LightState.DARK for d in Direction):
-                    up.optical_length(Interface.OUT, cable.timer_count(self.bit_rate), cable.medium)
-            next_cable = self.links[k] if k < len(self.links) else None
-            # The end of the reset reaches the chip's incoming interface at t.
-            down.optical_start((cable is not None, next_cable is not None, False), t)
-            if cable is not None:
-                t = self._init_direction(k, cable, Direction.RETURN, t)
+        reach = self._reach()
+        at = self._positions()
+        done: set[int] = set()
+        for down in self.ring.devices[:reach]:
+            cable = self._into[id(down)]
+            if cable.index not in done:
+                t = self._forward(cable, t)
+            chip = cable.downstream
+            out = self._out.get((id(chip), Interface.OUT))
+            branch = self._out.get((id(chip), Interface.BRANCH))
+            present = (cable.link is not None, out is not None and out.link is not None,
+                       branch is not None and branch.link is not None and id(branch.downstream) in at)  # fmt: skip
+            chip.optical_start(present, t)  # the end of the reset reaches the chip's incoming interface at t
+            if cable.link is not None:
+                t = self._init_direction(cable.index + 1, cable.link, Direction.RETURN, t)
+            if chip.terminal_interface is not None:
+                for later in (branch, out):
+                    if later is not None and id(later.downstream) in at and at[id(later.downstream)] <= reach:
+                        t = self._forward(later, t)
+                        done.add(later.index)
         self.ring.idle(t - self.now)
         self._record()
 
-    def _first_dead(self) -> int | None:
-        t = self.now
-        for k, cable in enumerate(self.links, 1):
-            if cable is not None and any(self._state(k, cable, d, t) is LightState.DARK for d in Direction):
-                return k
-        return None
+    def _forward(self, cable: _Cable, t: float) -> float:
+        """Initialize the forward fibre of ``cable`` from ``t`` and measure its length; the time it ends."""
+        up, link, k = cable.upstream, cable.link, cable.index + 1
+        if link is None or up is None:
+            return t
+        t = self._init_direction(k, link, Direction.FORWARD, t)
+        if up.optical[cable.interface].phase is not Phase.OFF and all(
+                self._state(k, link, d, t) is not LightState.DARK for d in Direction):  # fmt: skip
+            up.optical_length(cable.interface, link.timer_count(self.bit_rate), link.medium)
+        return t
 
     def _init_direction(self, k: int, cable: FibreLink, direction: Direction, t: float) -> float:
         """Initialize the transmitter of ``direction`` on cable *k* from bus time ``t``; the time it ends."""
         tx, rx = self._party(k, direction)
         if tx is None:
             return t
-        interface = _TX[direction]
+        interface = self._tx_interface(k, direction)
         step = INIT_STEP_BITS / self.bit_rate
         other = Direction(1 - direction)
         while tx.optical[interface].phase is Phase.INIT:
@@ -345,32 +455,38 @@ class OpticalRing:
         """One online test of every regulated transmitter on the cables the cycle reached; then the MAU reports
         and a sample of every path."""
         t = self.now
-        for k, cable in enumerate(self.links, 1):
-            if cable is None or k > reached:
+        at = self._positions()
+        for c in self._cables:
+            cable = c.link
+            if cable is None or not self._in_path(c, at) or at[id(c.downstream)] > reached:
                 continue
+            k = c.index + 1
             for direction in Direction:
                 tx, rx = self._party(k, direction)
+                sends, hears = self._tx_interface(k, direction), self._tx_interface(k, Direction(1 - direction))
                 level = self._level(k, direction)
                 ack1 = cable.detected(direction, level, 1, t)
                 ack2 = cable.detected(direction, level, 2, t)
                 other = Direction(1 - direction)
-                if tx is not None and tx.optical[_TX[direction]].phase is Phase.ONLINE:
+                if tx is not None and tx.optical[sends].phase is Phase.ONLINE:
                     if self._state(k, cable, other, t) is not LightState.DARK:  # the acknowledgement comes back
-                        tx.optical_test(_TX[direction], ack1, ack2)
-                elif (tx is not None and rx is not None and tx.optical[_TX[direction]].phase is Phase.DIAGNOSTIC
-                      and rx.optical[_RX[direction]].phase is Phase.DIAGNOSTIC):  # fmt: skip
-                    rx.optical_test(_RX[direction], ack1, ack2)  # OPT-7: the receiving interface's warning
+                        tx.optical_test(sends, ack1, ack2)
+                elif (tx is not None and rx is not None and tx.optical[sends].phase is Phase.DIAGNOSTIC
+                      and rx.optical[hears].phase is Phase.DIAGNOSTIC):  # fmt: skip
+                    rx.optical_test(hears, ack1, ack2)  # OPT-7: the receiving interface's warning
         self._record()
 
     def _record(self) -> None:
-        """MAU warning changes into :attr:`reports`; a :class:`PathSample` of every cable into :attr:`history`."""
+        """MAU warning changes into :attr:`reports` (at the chip's ring position; a chip out of the data path is not
+        reported); a :class:`PathSample` of every cable into :attr:`history`."""
         t = self.now
-        for position, chip in enumerate(self.chips, 1):
+        at = self._positions()
+        for index, chip in enumerate(self.chips):
             mau = tuple(tx.mau for tx in chip.optical.transmitters)
             for interface in Interface:
-                if mau[interface] != self._mau[position - 1][interface]:
-                    self.reports.append(MauReport(t, position, interface, mau[interface]))
-            self._mau[position - 1] = mau
+                if mau[interface] != self._mau[index][interface] and id(chip) in at:
+                    self.reports.append(MauReport(t, at[id(chip)], interface, mau[interface]))
+            self._mau[index] = mau
         for k, cable in enumerate(self.links, 1):
             if cable is None:
                 continue
@@ -380,10 +496,15 @@ class OpticalRing:
                 cable.received_dbm(Direction.RETURN, levels[1], 0, t)))
 
     def dark(self, k: int) -> bool:
-        """Cable *k* carries no light now in one of its fibres (the master finds a dead line *k*)."""
+        """Cable *k* carries no light now in one of its fibres (the master finds a dead line where it enters)."""
         k = check_int("k", k, 1, len(self.links))
         cable = self.links[k - 1]
         return cable is not None and any(self._state(k, cable, d, self.now) is LightState.DARK for d in Direction)
+
+    def position(self, k: int) -> int | None:
+        """The ring position cable *k* enters now (``None``: out of the data path)."""
+        k = check_int("k", k, 1, len(self.links))
+        return self._positions().get(id(self._cables[k - 1].downstream))
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -396,8 +517,8 @@ def _quality(ring: OpticalRing, k: int, direction: Direction) -> str:
     if ring.dark(k):
         return "interrupted"
     tx, rx = ring._party(k, direction)
-    sender = tx.optical[_TX[direction]] if tx is not None else None
-    receiver = rx.optical[_RX[direction]] if rx is not None else None
+    sender = tx.optical[ring._tx_interface(k, direction)] if tx is not None else None
+    receiver = rx.optical[ring._tx_interface(k, Direction(1 - direction))] if rx is not None else None
     if sender is None or sender.phase in (Phase.OFF, Phase.FIXED):
         return "unregulated"
     if sender.phase is Phase.INIT:
@@ -417,26 +538,32 @@ def _number(master: Master | None, position: int) -> str:
 
 
 def diagnostic_table(ring: OpticalRing, master: Master | None = None) -> list[PathRow]:
-    """The optical diagnostic table of Figure 1-10: one row per fibre cable between two chips, as the master reads
-    it from registers 8 to 11 of the upstream chip (forward level, length, medium) and register 10 of the downstream
-    chip (return level; 3.4.12, 3.4.13), with each direction's quality from the MAU warnings and enable status.
-    Devices are named by the master's configuration (``"1.0<->2.0"``), by ring position without one."""
+    """The optical diagnostic table of Figure 1-10: one row per fibre cable between two chips in the data path, in
+    ring order, as the master reads it from the upstream chip's registers 8 or 9 (length and medium of its outgoing
+    or branch interface) and 11 (their levels), and register 10 of the downstream chip (return level; 3.4.12,
+    3.4.13), with each direction's quality from the MAU warnings and enable status. Devices are named by the master's
+    configuration (``"1.0<->2.0"``, a BK's branch ``"3.0<->3.1"``), by ring position without one."""
     check_instance("ring", ring, OpticalRing)
     if master is not None:
         check_instance("master", master, Master, "a Master or None")
     rows = []
     level_mask = (1 << POWER_LEVEL_WIDTH) - 1
-    for k in range(2, len(ring.links) + 1):
-        if ring.links[k - 1] is None:
+    at = ring._positions()
+    for cable in sorted(ring._cables, key=lambda c: at.get(id(c.downstream), 0)):
+        up = cable.upstream
+        if up is None or not ring._in_path(cable, at):
             continue
-        up, down = ring.chips[k - 2], ring.chips[k - 1]
-        read8, _, _, read11 = registers(up.optical)
-        read10 = registers(down.optical)[2]
-        medium = Medium(read8 >> OPTICAL_MEDIUM_BIT & 1)
+        k = cable.index + 1
+        branch = cable.interface is Interface.BRANCH
+        read8, read9, _, read11 = registers(up.optical)
+        read10 = registers(cable.downstream.optical)[2]
+        path = read9 if branch else read8
+        medium = Medium(path >> OPTICAL_MEDIUM_BIT & 1)
         rows.append(PathRow(
-            f"{_number(master, k - 1)}<->{_number(master, k)}", _quality(ring, k, Direction.FORWARD),
-            _quality(ring, k, Direction.RETURN), read11 >> POWER_OUT_LSB & level_mask, read10 & level_mask,
-            length_m(read8 & ((1 << OPTICAL_LENGTH_WIDTH) - 1), medium), medium))
+            f"{_number(master, at[id(up)])}<->{_number(master, at[id(cable.downstream)])}",
+            _quality(ring, k, Direction.FORWARD), _quality(ring, k, Direction.RETURN),
+            read11 >> (POWER_BRANCH_LSB if branch else POWER_OUT_LSB) & level_mask, read10 & level_mask,
+            length_m(path & ((1 << OPTICAL_LENGTH_WIDTH) - 1), medium), medium))  # fmt: skip
     return rows
 
 
