@@ -59,6 +59,8 @@ def test_initialization_regulates_the_branch_and_the_table_has_its_rows() -> Non
     assert read9 & ((1 << OPTICAL_LENGTH_WIDTH) - 1) == length.timer_code(
         cable.timer_count(ring.bit_rate), ring.bit_rate, cable.medium)
     rows = diagnostic_table(ring, master)
+    ends = [(0, 1), (1, 2), (2, 3), (3, 4), (4, 5), (5, 6), (3, 7)]  # 4.0's cable comes from the BK
+    assert [ring.ends(k) for k in range(1, len(LENGTHS) + 1)] == ends
     assert [r.path for r in rows] == ["1.0<->2.0", "2.0<->3.0", "3.0<->3.1", "3.1<->3.2", "3.2<->3.3", "3.0<->4.0"]
     branch_row = rows[2]
     level = registers(bk.optical)[3] >> POWER_BRANCH_LSB & ((1 << POWER_LEVEL_WIDTH) - 1)
@@ -76,7 +78,7 @@ def test_a_branch_switched_off_leaves_the_table_and_its_faults_sleep() -> None:
     assert [r.path for r in diagnostic_table(ring, master)] == ["1.0<->2.0", "2.0<->3.0", "3.0<->4.0"]
     for index in range(BK_AT, BK_AT + BRANCH):
         link = ring.links[index]
-        assert link is not None and ring.position(index + 1) is None
+        assert link is not None and ring.ends(index + 1) is None
         link.add(Pull(start_s=ring.now, duration_s=None))
     for _ in range(20):
         assert master.cycle().ok

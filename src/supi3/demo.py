@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Sequence
 from functools import partial
+from html import escape
 from pathlib import Path
 
 from supi3 import serial_io
@@ -28,17 +29,17 @@ from supi3.config import DeviceConfig, decode
 from supi3.errors import Supi3Error
 from supi3.interbus import wire
 from supi3.interbus.device import PlainDevice
-from supi3.interbus.master import Master
-from supi3.interbus.ring import Bus, Ring
+from supi3.interbus.master import Diagnostic, Master
+from supi3.interbus.ring import Branch, BranchKind, Bus, Ring
 from supi3.model.chip import Supi3
 from supi3.model.pinring import PinRing
 from supi3.model.pins import Supi3Pins
 from supi3.model.vcd import write_vcd
 from supi3.optical.link import Bend, Fibre, FibreLink, Pull
 from supi3.optical.regulation import MAX_LEVEL
-from supi3.optical.ring import MauReport, OpticalRing, PathSample, diagnostic_table, format_table
+from supi3.optical.ring import OpticalRing, PathSample, diagnostic_table, format_table
 from supi3.peripherals.serial import SerialBus, SpiAdc, SpiDac
-from supi3.tables import CLOCK_HZ
+from supi3.tables import CLOCK_HZ, MODE_ROWS
 from supi3.verif.timing import check_serial_io
 
 SUPI3_STRAPS: tuple[tuple[str, str | None], ...] = (("10000", None), ("11011", "0011"), ("11110", None))
@@ -264,13 +265,30 @@ def _analog_pin_level(configs: list[DeviceConfig], cycles: int, vcd: Path) -> It
 # ------------------------------------------------------------------------------------------------------------
 
 OPTICAL_CABLES: tuple[tuple[float, Fibre], ...] = (
-    (15.0, Fibre.POLYMER), (45.0, Fibre.POLYMER), (65.0, Fibre.POLYMER), (300.0, Fibre.HCS), (1500.0, Fibre.GLASS),
-    (30.0, Fibre.POLYMER),
+    (15.0, Fibre.POLYMER), (45.0, Fibre.POLYMER), (300.0, Fibre.HCS), (65.0, Fibre.POLYMER), (35.0, Fibre.POLYMER),
+    (25.0, Fibre.POLYMER), (1500.0, Fibre.GLASS), (30.0, Fibre.POLYMER),
 )  # fmt: skip
-"""``--optical``: the cable into each ring position (one-way metres, fibre): from the master, then chip to chip."""
+"""``--optical``: the cable into each device (one-way metres, fibre), in ring order: 1.0 from the master, 2.0, the
+bus terminal module 3.0, its local bus devices 3.1 (from the BK's branch interface) to 3.3, then 4.0 (from the BK's
+outgoing interface) and 5.0."""
 
-OPTICAL_DISTURBED: int = 3
-"""``--optical``: the cable that is bent and pulled, into ring position 3 (path 2.0<->3.0)."""
+BUS_TERMINAL_LBD: str = next(row.c for row in MODE_ROWS if row.function.startswith("BK-LBD"))
+"""C[4..0] of the bus terminal module with a local bus with device-oriented diagnostics (Table 2-7)."""
+
+LBD_MR: str = next(row.c for row in MODE_ROWS if row.function == "LBD-MR, 8 IN/8 OUT")
+"""C[4..0] of a local bus device with device-oriented diagnostics and return line, 8 IN / 8 OUT (Table 2-5)."""
+
+OPTICAL_BK: int = 3
+"""``--optical``: the ring position of the bus terminal module (BK-LBD, Table 2-7)."""
+
+OPTICAL_BRANCH: int = 3
+"""``--optical``: the LBD-MR devices of its local bus (device-oriented diagnostics, 2.2.2)."""
+
+OPTICAL_BENT: int = 4
+"""``--optical``: the cable that is bent, into ring position 4 (the branch path 3.0<->3.1)."""
+
+OPTICAL_PULLED: int = 6
+"""``--optical``: the cable whose connector is pulled, into ring position 6 (the local bus path 3.2<->3.3)."""
 
 OPTICAL_BEND: tuple[int, int, float] = (60, 120, 4.0)
 """``--optical``: the bend, from data-cycle time 60 for 120 cycle times, 4 dB on both fibres."""
@@ -283,24 +301,35 @@ OPTICAL_CYCLES = 480
 """``--optical``: data cycles to run by default."""
 
 
-def _optical_cable(cable: FibreLink, k: int, master: Master) -> str:
-    up = "master" if k == 1 else master.entry(k - 1).number
-    return f"{up}->{master.entry(k).number} {cable.length_m:g} m {cable.fibre.value}"
+def _optical_path(ring: OpticalRing, k: int, master: Master) -> str:
+    ends = ring.ends(k)
+    assert ends is not None
+    up = "master" if ends[0] == 0 else master.entry(ends[0]).number
+    return f"{up}<->{master.entry(ends[1]).number}"
 
 
-def _mau(report: MauReport, master: Master) -> str:
-    name = ("incoming interface (MAUWH)", "outgoing interface (MAUWR)", "branch (MAUWS)")[report.interface]
-    state = "on " if report.on else "off"
-    return f"  {report.time_s * 1e3:8.3f} ms  MAU warning {state} at {master.entry(report.ring_position).number} {name}"
+def _message(d: Diagnostic) -> str:
+    """One of the master's messages as the demo prints it."""
+    if d.mau is not None:
+        name, on = d.mau
+        where = {"MAUWH": "incoming", "MAUWR": "outgoing", "MAUWS": "branch"}[name]
+        return f"MAU warning {'on ' if on else 'off'} at {d.device} {where} interface ({name}, {d.code:04X}h)"
+    if d.location is None:
+        return f"cycle failed: {d.kind.value} not located"
+    text = f"cycle failed: {d.kind.value} at {d.device} (line {d.location})"
+    lbd = d.detail.partition("device-oriented local-bus diagnostics: ")[2]
+    return f"{text}, by the counter telegram: {lbd}" if lbd else text
 
 
 def run_optical(cycles: int = OPTICAL_CYCLES, plot: Path | None = None, clk_conf: str = "01") -> Iterator[str]:
-    """The ``--optical`` demo, as lines of text: a ring of six SUPI 3 OPC chips in optical regulation mode (RF = 00,
-    1.6) joined by polymer, HCS and glass cables (:mod:`supi3.optical.link`). After Alarm Stop every cable
+    """The ``--optical`` demo, as lines of text: a ring of SUPI 3 OPC chips in optical regulation mode (RF = 00, 1.6)
+    joined by polymer, HCS and glass cables (:mod:`supi3.optical.link`), with a bus terminal module (BK-LBD) whose
+    local bus of three LBD-MR devices hangs on its branch interface (2.4, Figure 1-10). After Alarm Stop every cable
     initializes (1.6.1) and the master prints its optical diagnostic table (Figure 1-10); during the data cycles the
-    cable of path 2.0<->3.0 is bent (online regulation raises the power, the MAU warning comes and goes, 1.6.2,
-    1.6.3) and its connector pulled (the master locates the dead line; after the repair it restarts the bus). With
-    ``plot``, a self-contained HTML page with an SVG plot of the disturbed path's power levels over time.
+    branch path 3.0<->3.1 is bent (online regulation raises the power, the MAU warnings come and go and the master
+    reports them, 1.6.2, 1.6.3) and the connector of the local bus path 3.2<->3.3 is pulled (the master locates the
+    break on its exact line by the counter telegram, 2.2.2; after the repair it restarts the bus). With ``plot``, a
+    self-contained HTML page with an SVG plot of the bent path's power levels over time.
 
     Raises
     ------
@@ -310,62 +339,63 @@ def run_optical(cycles: int = OPTICAL_CYCLES, plot: Path | None = None, clk_conf
         If the plot cannot be written (the command line checks the path before the run).
     """
     check_int("cycles", cycles, 1)
-    chips = [Supi3(decode("10000", rf="00", clk_conf=clk_conf)) for _ in OPTICAL_CABLES]
+
+    def chip(straps: str) -> Supi3:
+        return Supi3(decode(straps, rf="00", clk_conf=clk_conf))
+
+    branch = Branch(chip(BUS_TERMINAL_LBD), [chip(LBD_MR) for _ in range(OPTICAL_BRANCH)], BranchKind.LBD_MR)
+    devices = [chip("10000") for _ in range(OPTICAL_BK - 1)] + [branch]
+    devices += [chip("10000") for _ in range(len(OPTICAL_CABLES) - OPTICAL_BK - OPTICAL_BRANCH)]
     cables = [FibreLink(metres, fibre) for metres, fibre in OPTICAL_CABLES]
-    ring = OpticalRing(chips, cables)
+    ring = OpticalRing(devices, cables)
     master = Master(ring)
     result = master.start()
-    yield (f"supi3 demo --optical: INTERBUS master and a ring of {len(chips)} SUPI 3 OPC chips joined by fibre "
-           f"(RF = 00, optical regulation), {ring.bit_rate // 1000} kbit/s (transaction level)")
-    yield "Cables: " + "; ".join(_optical_cable(c, k, master) for k, c in enumerate(cables, 1))
+    yield (f"supi3 demo --optical: INTERBUS master and a ring of {len(ring.chips)} SUPI 3 OPC chips joined by fibre "
+           f"(RF = 00, optical regulation), a bus terminal module ({OPTICAL_BK}.0, BK-LBD) with a local bus of "
+           f"{OPTICAL_BRANCH} LBD-MR devices, {ring.bit_rate // 1000} kbit/s (transaction level)")
+    yield "Cables: " + "; ".join(f"{_optical_path(ring, k, master)} {c.length_m:g} m {c.fibre.value}"
+                                 for k, c in enumerate(cables, 1))  # fmt: skip
     yield (f"Alarm Stop (1303h), optical initialization (the cores held until {ring.history[0][0].time_s * 1e3:.3f} "
            f"ms) and discovery ID cycle: {'ok' if result.ok else 'FAILED'}")
     yield "Optical diagnostic table (Figure 1-10):"
     yield from (f"  {line}" for line in format_table(diagnostic_table(ring, master)))
-    tick = wire.cycle_bits(len(chips), len(chips)) / ring.bit_rate
+    tick = wire.cycle_bits(len(ring.chips), len(ring.chips)) / ring.bit_rate
     t0 = ring.now
-    disturbed = cables[OPTICAL_DISTURBED - 1]
-    path = f"{master.entry(OPTICAL_DISTURBED - 1).number}<->{master.entry(OPTICAL_DISTURBED).number}"
+    bent, pulled = _optical_path(ring, OPTICAL_BENT, master), _optical_path(ring, OPTICAL_PULLED, master)
     bend = Bend(t0 + OPTICAL_BEND[0] * tick, OPTICAL_BEND[1] * tick, OPTICAL_BEND[2])
     pull = Pull(t0 + OPTICAL_PULL[0] * tick, OPTICAL_PULL[1] * tick)
-    disturbed.add(bend)
-    disturbed.add(pull)
-    yield (f"{cycles} data cycles; path {path} bent by {bend.loss_db:g} dB from {bend.start_s * 1e3:.3f} ms to "
-           f"{(bend.start_s + (bend.duration_s or 0)) * 1e3:.3f} ms, its connector pulled from "
-           f"{pull.start_s * 1e3:.3f} ms to {(pull.start_s + (pull.duration_s or 0)) * 1e3:.3f} ms:")
+    cables[OPTICAL_BENT - 1].add(bend)
+    cables[OPTICAL_PULLED - 1].add(pull)
+    yield (f"{cycles} data cycles; path {bent} bent by {bend.loss_db:g} dB from {bend.start_s * 1e3:.3f} ms to "
+           f"{(bend.start_s + (bend.duration_s or 0)) * 1e3:.3f} ms, the connector of path {pulled} pulled from "
+           f"{pull.start_s * 1e3:.3f} ms to {(pull.start_s + (pull.duration_s or 0)) * 1e3:.3f} ms; "
+           "the master's messages:")
     yield from _optical_run(ring, master, cycles)
     yield f"Optical diagnostic table at {ring.now * 1e3:.3f} ms:"
     yield from (f"  {line}" for line in format_table(diagnostic_table(ring, master)))
     if plot is not None:
-        _write_plot(plot, _plot_html(ring.history[OPTICAL_DISTURBED - 1], path, (bend, pull)))
+        _write_plot(plot, _plot_html(ring.history[OPTICAL_BENT - 1], bent, (bend, pull), pulled))
         yield f"wrote {plot}"
 
 
 def _optical_run(ring: OpticalRing, master: Master, cycles: int) -> Iterator[str]:
-    """Run ``cycles`` data cycles; yield the MAU reports, failed cycles (once per diagnosis) and restarts."""
-    reported = 0
+    """Run ``cycles`` data cycles; yield the master's messages (a failure once per diagnosis) and restarts."""
     last = ""
     failed = False
     for n in range(cycles):
         for k, entry in enumerate(master.config or (), 1):
             master.set_outputs(k, bytes([(n + k) & 0xFF]) * entry.data_bytes)
         result = master.cycle()
-        for report in ring.reports[reported:]:
-            yield _mau(report, master)
-        reported = len(ring.reports)
-        if not result.ok:
-            failed = True
-            for d in result.diagnostics:
-                where = f"at {d.device} (line {d.location})" if d.location is not None else "not located"
-                text = f"{d.kind.value} {where}"
-                if text != last:
-                    yield f"  {ring.now * 1e3:8.3f} ms  cycle failed: {text}"
-                    last = text
-        elif failed and not any(ring.dark(k) for k in range(1, len(ring.links) + 1)):
+        failed = failed or not result.ok
+        for d in result.diagnostics:
+            text = _message(d)
+            if text != last or d.mau is not None:
+                yield f"  {ring.now * 1e3:8.3f} ms  {text}"
+            last = text
+        if result.ok and failed and not any(ring.dark(k) for k in range(1, len(ring.links) + 1)):
             failed, last = False, ""
             back = ring.now
             restarted = master.start()
-            reported = len(ring.reports)
             yield (f"  {back * 1e3:8.3f} ms  the ring runs again: Alarm Stop, optical initialization and discovery "
                    f"ID cycle: {'ok' if restarted.ok else 'FAILED'} at {ring.now * 1e3:.3f} ms")
 
@@ -381,11 +411,12 @@ _PLOT_W, _PLOT_H, _PLOT_M = 760, 300, 48
 """The plot's width and height in pixels and its margin for the axes."""
 
 
-def _plot_html(samples: Sequence[PathSample], path: str, events: tuple[Bend, Pull]) -> str:
+def _plot_html(samples: Sequence[PathSample], path: str, events: tuple[Bend, Pull], pulled: str) -> str:
     """A self-contained HTML page with an inline SVG: the power levels of a path's two transmitters over bus time
-    (step lines), the bend and the pulled connector as shaded bands."""
+    (step lines), the bend and the pulled connector (of path ``pulled``) as shaded bands."""
     t0, t1 = samples[0].time_s, samples[-1].time_s
     span = max(t1 - t0, 1e-9)
+    path, pulled = escape(path), escape(pulled)
 
     def x(t: float) -> float:
         return _PLOT_M + (min(max(t, t0), t1) - t0) / span * (_PLOT_W - 2 * _PLOT_M)
@@ -395,7 +426,7 @@ def _plot_html(samples: Sequence[PathSample], path: str, events: tuple[Bend, Pul
 
     parts = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{_PLOT_W}" height="{_PLOT_H}" '
              f'viewBox="0 0 {_PLOT_W} {_PLOT_H}" font-family="sans-serif" font-size="11">']
-    for event, colour, label in ((events[0], "#fde2a8", "bend"), (events[1], "#f4b4b4", "connector pulled")):
+    for event, colour, label in ((events[0], "#fde2a8", "bend"), (events[1], "#f4b4b4", f"{pulled} pulled")):
         end = event.start_s + (event.duration_s or span)
         parts.append(f'<rect x="{x(event.start_s):.1f}" y="{_PLOT_M}" width="{x(end) - x(event.start_s):.1f}" '
                      f'height="{_PLOT_H - 2 * _PLOT_M}" fill="{colour}"><title>{label}</title></rect>')
@@ -427,5 +458,6 @@ def _plot_html(samples: Sequence[PathSample], path: str, events: tuple[Bend, Pul
     title = f"supi3 demo --optical: power levels of path {path}"
     return (f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8"><title>{title}</title></head>\n<body>'
             f"<h1>{title}</h1>\n<p>Online regulation (manual 1.6.2): each transmitter's power level over bus time; "
-            f"the bend raises it, the pulled connector interrupts the ring until the master restarts it.</p>\n"
+            f"the bend raises it, the pulled connector of path {pulled} interrupts the ring until the master "
+            "restarts it.</p>\n"
             + "".join(parts) + "\n</body></html>\n")

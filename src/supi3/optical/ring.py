@@ -501,10 +501,14 @@ class OpticalRing:
         cable = self.links[k - 1]
         return cable is not None and any(self._state(k, cable, d, self.now) is LightState.DARK for d in Direction)
 
-    def position(self, k: int) -> int | None:
-        """The ring position cable *k* enters now (``None``: out of the data path)."""
-        k = check_int("k", k, 1, len(self.links))
-        return self._positions().get(id(self._cables[k - 1].downstream))
+    def ends(self, k: int) -> tuple[int, int] | None:
+        """The ring positions cable *k* joins now: its upstream chip's (0: the master) and its downstream chip's;
+        ``None`` while the cable is out of the data path."""
+        cable = self._cables[check_int("k", k, 1, len(self.links)) - 1]
+        at = self._positions()
+        down = at.get(id(cable.downstream))
+        up = 0 if cable.upstream is None else at.get(id(cable.upstream))
+        return None if down is None or up is None else (up, down)
 
 
 # --------------------------------------------------------------------------------------------------------------------
