@@ -1,7 +1,9 @@
 """The optical fault campaign (issue 12, "Reliability"): random fibre events (bends, drift, pulled connectors and
-reconnects) on a fibre-linked ring over many cycles. Every break is located at the right position; no lost or
-corrupted process data is ever latched; regulation never oscillates (1.6.2, 1.6.3's hysteresis). Seeded (the
-conftest's hypothesis profile); the long run is marked slow, a quick one is not."""
+reconnects) on a fibre-linked ring over many cycles, a plain ring and a tree with a bus terminal module and an LBD
+local bus (2.4, 2.2.2; OPT-54). Every break is located at the right position (the exact line in an LBD branch,
+BK-7); no lost or corrupted process data is ever latched; regulation never oscillates (1.6.2, 1.6.3's hysteresis);
+the master ends up knowing every MAU warning (OPT-52). Seeded (the conftest's hypothesis profile); the long runs are
+marked slow, quick ones are not."""
 
 from __future__ import annotations
 
@@ -16,7 +18,7 @@ from hypothesis import strategies as st
 from supi3.config import decode
 from supi3.interbus import wire
 from supi3.interbus.master import Master
-from supi3.interbus.ring import ErrorKind, Fault, Transfer
+from supi3.interbus.ring import Branch, BranchKind, ErrorKind, Fault, ReturnBreak, Transfer
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
 from supi3.optical.link import Ageing, Bend, Direction, Event, FibreLink, Pull, Temperature
@@ -24,34 +26,69 @@ from supi3.optical.regulation import MAX_LEVEL, Interface
 from supi3.optical.ring import OpticalRing
 
 N = 5
+"""Chips of the plain ring."""
+BK_AT, BRANCH = 3, 3
+"""The tree: two chips, a BK-LBD at ring position 3 with 3 LBD devices (MR or OR), one chip behind: 7 chips."""
+QUIET = 40
+"""Cycles after the last event in which the master learns every MAU warning (OPT-52)."""
 
 
 @dataclass
 class Scenario:
-    """Cable lengths (POF, one per ring position) and events: (cable 1..N, event)."""
+    """The ring (``kind``: ``None`` a plain ring of N chips, else the tree's branch kind), cable lengths (POF, one per
+    chip) and events: (cable 1.., event)."""
 
+    kind: BranchKind | None
     lengths: list[float]
     events: list[tuple[int, Event]]
+
+    @property
+    def chips(self) -> int:
+        return N if self.kind is None else BK_AT + BRANCH + 1
 
 
 def _event(draw: st.DrawFn, tick: float, cycles: int) -> Event:
     start = draw(st.integers(0, cycles)) * tick
     duration = draw(st.integers(1, cycles // 3)) * tick
-    kind = draw(st.sampled_from(["bend", "pull", "ageing"]))
+    kind = draw(st.sampled_from(["bend", "pull", "ageing"]))  # a pull is a cable break and its repair
     if kind == "bend":
         return Bend(start, duration, draw(st.sampled_from([1.0, 2.5, 4.0, 6.0, 9.0, 14.0])),
                     draw(st.sampled_from([None, Direction.FORWARD, Direction.RETURN])))  # fmt: skip
     if kind == "pull":
         return Pull(start, duration)
-    return Ageing(start, draw(st.sampled_from([5.0, 20.0, 60.0])), limit_db=draw(st.sampled_from([1.0, 3.0])))
+    return Ageing(start, draw(st.sampled_from([20.0, 60.0])), limit_db=draw(st.sampled_from([1.0, 3.0])))
 
 
 @st.composite
-def scenarios(draw: st.DrawFn, cycles: int) -> Scenario:
-    tick = wire.cycle_bits(N, N) / 500_000
-    lengths = [float(draw(st.integers(5, 75))) for _ in range(N)]
+def scenarios(draw: st.DrawFn, cycles: int, kinds: tuple[BranchKind | None, ...] = (None,)) -> Scenario:
+    kind = draw(st.sampled_from(kinds))
+    n = N if kind is None else BK_AT + BRANCH + 1
+    tick = wire.cycle_bits(n, n) / 500_000
+    lengths = [float(draw(st.integers(5, 75))) for _ in range(n)]
     count = draw(st.integers(1, 6))
-    return Scenario(lengths, [(draw(st.integers(1, N)), _event(draw, tick, cycles)) for _ in range(count)])
+    return Scenario(kind, lengths, [(draw(st.integers(1, n)), _event(draw, tick, cycles)) for _ in range(count)])
+
+
+def _build(scenario: Scenario, seed: int) -> tuple[OpticalRing, list[Supi3]]:
+    """The ring, and its chips that carry process data, in ring order."""
+    def chip(straps: str = "10000") -> Supi3:
+        return Supi3(decode(straps, rf="00"))
+
+    cables = [FibreLink(m) for m in scenario.lengths]
+    if scenario.kind is None:
+        chips = [chip() for _ in range(N)]
+        return OpticalRing(chips, cables, seed=seed), chips
+    branch = [chip("11000" if scenario.kind is BranchKind.LBD_MR else "11100") for _ in range(BRANCH)]
+    outer = [chip() for _ in range(BK_AT)]
+    tree: list[Supi3 | Branch] = [*outer[:-1], Branch(chip("00010"), branch, scenario.kind), outer[-1]]
+    return OpticalRing(tree, cables, seed=seed), [*outer[:-1], *branch, outer[-1]]
+
+
+def _cable_faults(ring: OpticalRing, kind: BranchKind | None, k: int) -> tuple[int, int, bool]:
+    """Cable *k*'s ends (ring positions) and whether its return fibre is a return line of its own (OPT-54)."""
+    ends = ring.ends(k)
+    assert ends is not None
+    return ends[0], ends[1], kind is BranchKind.LBD_MR and BK_AT < ends[1] <= BK_AT + BRANCH
 
 
 def _boundaries(events: list[Event]) -> list[float]:
@@ -68,9 +105,9 @@ def _boundaries(events: list[Event]) -> list[float]:
 
 def _campaign(scenario: Scenario, cycles: int, seed: int) -> None:
     rng = random.Random(seed)
-    chips = [Supi3(decode("10000", rf="00")) for _ in range(N)]
-    cables = [FibreLink(m) for m in scenario.lengths]
-    ring = OpticalRing(chips, cables, seed=seed)
+    ring, chips = _build(scenario, seed)
+    cables = ring.links
+    positions = [ring.ring.devices.index(chip) + 1 for chip in chips]
     master = Master(ring)
     assert master.start().ok
     t0 = ring.now
@@ -83,8 +120,11 @@ def _campaign(scenario: Scenario, cycles: int, seed: int) -> None:
         else:
             assert isinstance(event, Ageing)
             shifted = Ageing(t0 + event.start_s, event.rate_db_per_s, event.limit_db)
-        cables[k - 1].add(shifted)
-    events = [e for cable in cables for e in cable.events]
+        link = cables[k - 1]
+        assert link is not None
+        link.add(shifted)
+    events = [e for cable in cables if cable is not None for e in cable.events]
+    lines = [_cable_faults(ring, scenario.kind, k) for k in range(1, len(cables) + 1)]
 
     injected: list[Fault] = []  # every fault the fibres put on the ring during a cycle
     pending: list[Fault] = []
@@ -105,12 +145,19 @@ def _campaign(scenario: Scenario, cycles: int, seed: int) -> None:
     ring.ring.transfer = spy_transfer  # type: ignore[method-assign]
     restarts = [t0]
     failed = False
-    latched = [0] * N
-    for _ in range(cycles):
-        sent = [rng.randrange(256) for _ in range(N)]
-        for k in range(1, N + 1 if master.config is not None else 1):  # none after a failed restart
-            master.set_outputs(k, bytes([sent[k - 1]]))
-        inputs = [rng.randrange(256) for _ in range(N)]
+    n = len(chips)
+    latched = [0] * n
+    end = max(_boundaries(events), default=0.0)
+    quiet = 0
+    for cycle in itertools.count():
+        if cycle >= cycles:  # then on until the physics is still and the master has had its quiet cycles
+            quiet = quiet + 1 if ring.now > end and not failed else 0
+            if quiet > QUIET or cycle > 4 * cycles:
+                break
+        sent = [rng.randrange(256) for _ in range(n)]
+        for k, at in enumerate(positions if master.config is not None else []):  # none after a failed restart
+            master.set_outputs(at, bytes([sent[k]]))
+        inputs = [rng.randrange(256) for _ in range(n)]
         for chip, value in zip(chips, inputs, strict=True):
             chip.set_mfp_inputs(value)
         injected.clear()
@@ -118,32 +165,41 @@ def _campaign(scenario: Scenario, cycles: int, seed: int) -> None:
         per_transfer.clear()
         result = master.cycle()
         # -- no lost or corrupted process data is ever latched
-        for k, chip in enumerate(chips, 1):
+        for k, chip in enumerate(chips):
             if result.ok and result.cycle is Cycle.DATA:
-                assert chip.out_word == sent[k - 1]
-                assert master.inputs(k) == bytes([inputs[k - 1]])
+                assert chip.out_word == sent[k]
+                assert master.inputs(positions[k]) == bytes([inputs[k]])
             else:
-                assert chip.out_word in (latched[k - 1], 0)  # unchanged, or cleared by a reset
-            latched[k - 1] = chip.out_word
-        # -- every break is located at the right position
-        segments = {f.segment for f in injected}
+                assert chip.out_word in (latched[k], 0)  # unchanged, or cleared by a reset
+            latched[k] = chip.out_word
+        # -- every break is located at the right position: on a line the fibres broke (a broken return line of a
+        #    branch: by the counter telegram at its position, by the segment search behind it)
+        forward = {f.segment for f in injected if not isinstance(f, ReturnBreak)}
+        back = {f.segment for f in injected if isinstance(f, ReturnBreak)}
         for d in result.diagnostics:
             if d.location is None or d.kind in (ErrorKind.PERIPHERAL_FAULT, ErrorKind.WATCHDOG, ErrorKind.MAU_WARNING):
                 continue
-            assert d.location in segments, (d, injected)
+            assert d.location in (back if d.return_line else forward | {s + 1 for s in back}), (d, injected)
         met = set(per_transfer)
-        if not result.ok and len(met) == 1 and (faults := met.pop()) and all(n == "DeadLine" for n, _ in faults):
-            # the same dead lines all through the cycle and its search: located exactly, at the first
-            assert [d.location for d in result.diagnostics] == [min(k for _, k in faults)], (result, injected)
-            assert result.diagnostics[0].kind is ErrorKind.DEAD_LINE
+        if not result.ok and len(met) == 1 and (faults := met.pop()):
+            # the same breaks of one cable all through the cycle and its search: located exactly (OPT-54, BK-7)
+            for up, down, returns in lines:
+                if faults <= {("DeadLine", down), *([("ReturnBreak", up)] if returns else [])}:
+                    where = (up, True) if ("ReturnBreak", up) in faults else (down, False)
+                    assert [(d.location, d.return_line) for d in result.diagnostics] == [where], (result, faults)
+                    assert result.diagnostics[0].kind is ErrorKind.DEAD_LINE
         if not result.ok:
             failed = True
-        elif failed and not any(ring.dark(k) for k in range(1, N + 1)):
+        elif failed and not any(ring.dark(k) for k in range(1, len(cables) + 1)):
             restarts.append(ring.now)  # repaired: the master restarts the bus (a marginal fibre may fail it)
             failed = not master.start().ok
     # -- regulation never oscillates: each transmitter's level moves one way only between jumps of the physics
     #    (anywhere) and the restarts; a MAU warning comes on at MAX only
-    for k in range(1, N + 1):
+    # -- the master knows every MAU warning on (OPT-52), once the physics is still and the ring runs
+    assert quiet <= QUIET or master.mau_warnings == {
+        k: mau for k, chip in enumerate(ring.ring.devices, 1)
+        if any(mau := tuple(tx.mau for tx in chip.optical.transmitters))}  # type: ignore[attr-defined]
+    for k in range(1, len(cables) + 1):
         cuts = sorted([*_boundaries(events), *restarts, ring.now + 1.0])
         samples = ring.history[k - 1]
         for attr in ("forward_level", "return_level"):
@@ -153,8 +209,12 @@ def _campaign(scenario: Scenario, cycles: int, seed: int) -> None:
                 assert all(s > 0 for s in steps) or all(s < 0 for s in steps), (k, attr, low, levels)
     for report in ring.reports:
         if report.on:
-            k, attr = ((report.ring_position + 1, "forward_level") if report.interface is Interface.OUT
-                       else (report.ring_position, "return_level"))  # fmt: skip
+            if report.interface is Interface.IN:
+                k, attr = next(k for k, (_, down, _) in enumerate(lines, 1) if down == report.ring_position), \
+                    "return_level"
+            else:  # the branch interface feeds the BK's next position, the outgoing interface the one after it
+                sent_to = [k for k, (up, _, _) in enumerate(lines, 1) if up == report.ring_position]
+                k, attr = sent_to[report.interface is Interface.OUT and len(sent_to) > 1], "forward_level"
             sample = next(s for s in ring.history[k - 1] if s.time_s == report.time_s)
             assert getattr(sample, attr) == MAX_LEVEL
 
@@ -170,6 +230,22 @@ def test_campaign_quick(scenario: Scenario, seed: int) -> None:
 @settings(max_examples=40, deadline=None, phases=(Phase.explicit, Phase.generate))
 @given(scenarios(cycles=1500), st.integers(0, 2**16))
 def test_campaign_long(scenario: Scenario, seed: int) -> None:
+    _campaign(scenario, 1500, seed)
+
+
+TREES = (BranchKind.LBD_MR, BranchKind.LBD_OR)
+
+
+@settings(max_examples=4, deadline=None, phases=(Phase.explicit, Phase.generate))
+@given(scenarios(cycles=300, kinds=TREES), st.integers(0, 2**16))
+def test_tree_campaign_quick(scenario: Scenario, seed: int) -> None:
+    _campaign(scenario, 300, seed)
+
+
+@pytest.mark.slow
+@settings(max_examples=40, deadline=None, phases=(Phase.explicit, Phase.generate))
+@given(scenarios(cycles=1500, kinds=TREES), st.integers(0, 2**16))
+def test_tree_campaign_long(scenario: Scenario, seed: int) -> None:
     _campaign(scenario, 1500, seed)
 
 
