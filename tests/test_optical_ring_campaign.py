@@ -163,6 +163,7 @@ def _campaign(scenario: Scenario, cycles: int, seed: int) -> None:
         injected.clear()
         pending.clear()
         per_transfer.clear()
+        configured = master.config is not None  # else the cycle is a discovery, which locates nothing
         result = master.cycle()
         # -- no lost or corrupted process data is ever latched
         for k, chip in enumerate(chips):
@@ -181,7 +182,7 @@ def _campaign(scenario: Scenario, cycles: int, seed: int) -> None:
                 continue
             assert d.location in (back if d.return_line else forward | {s + 1 for s in back}), (d, injected)
         met = set(per_transfer)
-        if not result.ok and len(met) == 1 and (faults := met.pop()):
+        if configured and not result.ok and len(met) == 1 and (faults := met.pop()):
             # the same breaks of one cable all through the cycle and its search: located exactly (OPT-54, BK-7)
             for up, down, returns in lines:
                 if faults <= {("DeadLine", down), *([("ReturnBreak", up)] if returns else [])}:
