@@ -155,3 +155,26 @@ def test_branch_enabled_and_block_refuse_wrong_types() -> None:
         BusTerminal("BK-LB", None).command(2, False)  # type: ignore[arg-type]
     with pytest.raises(ArgumentError, match=r"^acknowledge must be"):
         BusTerminal("BK-LB", None).command(BranchControl.ON, 1)  # type: ignore[arg-type]
+
+
+def test_ld_and_e_leds_follow_the_branch_state() -> None:
+    """Tables 2-8, 3-19 (BK-11): LD lit while the branch is switched off or closed by the BK; E lit while a counter
+    telegram reports a break behind the BK or the BK closed the branch; both also on MFP14/MFP13."""
+
+    def leds(chip: Supi3) -> tuple[bool, bool, int]:
+        view = chip.diagnostic_outputs
+        return view.ld, view.e, view.mfp >> 13 & 0b11
+
+    chip = terminal("BK-LBD")
+    assert leds(chip) == (False, False, 0b00)
+    id_latch(chip, 0.001, branch=BranchControl.OFF)
+    assert leds(chip) == (True, False, 0b10)
+    id_latch(chip, 0.002, branch=BranchControl.ON_EXTENDED)
+    revision = chip.revision
+    chip.branch_returned(True, 4, 0.002, 0.003)  # a break four counts behind
+    assert leds(chip) == (False, True, 0b01) and chip.revision > revision
+    chip.branch_returned(True, None, 0.003, 0.004)
+    assert leds(chip) == (False, False, 0b00)
+    chip.branch_returned(False, None, 0.004, 0.004 + BRANCH_SILENCE_S)  # silent: the BK closes its branch
+    assert leds(chip) == (True, True, 0b11)
+    assert Supi3(decode("10000")).diagnostic_outputs.ld is False  # no BK, no LD

@@ -10,7 +10,7 @@ import pytest
 from supi3.config import DeviceConfig, decode
 from supi3.diagnostics import DiagnosticOutputs, IbDiag, LedInputs, ib_diag_level
 from supi3.interbus import wire
-from supi3.interbus.wire import Cycle
+from supi3.interbus.wire import BranchControl, Cycle
 from supi3.model.chip import STATERR_FILTER_CLOCKS, ChipArgumentError, Supi3
 from supi3.model.pins import IDLE_TIMEOUT_CLOCKS, Supi3Pins
 from supi3.optical.regulation import Interface, Response
@@ -180,6 +180,8 @@ def test_led_inputs_reach_the_pins(c: str, diag_conf: int) -> None:
     pins.chip.set_led_inputs(leds)
 
     def light_fo1_and_fo3(chip: Supi3) -> None:
+        if chip.bus_terminal is not None:  # LD: the master switched the branch off (BK-11)
+            chip.bus_terminal.command(BranchControl.OFF, acknowledge=False)
         chip.optical_start((True, False, True))
         response = Response.NOT_DETECTED if chip.bus_active else Response.NONE
         for interface in (Interface.IN, Interface.BRANCH):

@@ -408,16 +408,21 @@ class Supi3:
         diagnostic_outputs`: UL, RC, BA, RD, LD, E, ALARM, FO1..FO3, the IB_DIAG pattern, and DIAG1/DIAG2 as
         DIAG_CONF selects. At transaction level the supply is always good (UL lit): the power-up reset has no
         duration here (1.7.2 is the pin level's)."""
-        # FO1..FO3 come from the optical block (Table 3-17, OPT-8; RUN is the bus active, DG-7).
+        # FO1..FO3 come from the optical block (Table 3-17, OPT-8; RUN is the bus active, DG-7), LD and E from the
+        # bus terminal: the branch switched off or closed by the BK (LD), a break behind it or closed (E; BK-11).
         leds = replace(self.led_inputs, fo=fo_leds(self._optical, self.bus_active))
+        terminal = self.bus_terminal
+        if terminal is not None:
+            closed = terminal.closed
+            leds = replace(leds, ld=closed or not terminal.switched_on, e=closed or terminal.count > 0)
         return diagnostic_outputs(self.config, supply_ok=True, line_heard=not self.line_silent,
                                   bus_active=self.bus_active, peripheral_fault=self.pf,
                                   line_interrupt=self.line_interrupt, leds=leds)  # fmt: skip
 
     def set_led_inputs(self, leds: LedInputs) -> None:
-        """What the chip's bus terminal logic (RD, LD, E, ALARM) shows from now on (DG-5); both fidelities read it
-        (the RTL ties these ports to 0). FO1..FO3 always come from the chip's own optical block
-        (:attr:`optical`, :func:`supi3.diagnostics.fo_leds`), so ``leds.fo`` is not used here.
+        """What RD and ALARM show from now on (DG-5); both fidelities read it (the RTL ties these ports to 0).
+        FO1..FO3 always come from the chip's own optical block (:attr:`optical`, :func:`supi3.diagnostics.fo_leds`)
+        and, in the bus terminal modes, LD and E from its branch state (BK-11), so those fields are not used here.
 
         Raises
         ------
@@ -717,8 +722,11 @@ class Supi3:
         if count is not None:
             _checked(check_int, "count", count, 1, wire.COUNTER_MAX, "BK-6: a counter telegram counts 1..63")
         terminal = self._terminal()
+        before = terminal.count
         if _checked(terminal.returned, traffic, count, start, end):
             self.attention = True
+            self.revision += 1
+        elif terminal.count != before:  # the E LED follows the count (BK-11)
             self.revision += 1
 
     def _terminal(self) -> BusTerminal:
