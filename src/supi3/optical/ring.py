@@ -22,6 +22,11 @@ and the light that no longer gets through into ring faults the master locates.
   (:attr:`~supi3.optical.link.LightState.DARK`) is a :class:`~supi3.interbus.ring.DeadLine` on its line; a
   marginal one gets bit errors at its bit-error rate (seeded). Cable *k* enters ring position *k*, so its faults are
   on line *k*, where the master's location puts them.
+* **Trees** (OPT-54): the chips may hold :class:`~supi3.interbus.ring.Branch` items; a bus terminal module's branch
+  interface sends the cable into its branch's first device, its outgoing interface the cable into the device after
+  the branch. In a branch with return lines a dark return fibre is the branch's return line into the upstream device
+  (:class:`~supi3.interbus.ring.ReturnBreak`), so the counter telegram of an LBD branch names the exact fibre; cables
+  out of the data path carry no faults and no tests.
 * **Diagnostics**: MAU warning changes are reported (:attr:`OpticalRing.reports`, 1.6.3), every path's levels are
   kept over time (:attr:`OpticalRing.history`), and :func:`diagnostic_table` is the master's optical diagnostic
   table of Figure 1-10, read from registers 8 to 11 (3.4.12, 3.4.13).
