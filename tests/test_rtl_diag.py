@@ -18,7 +18,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from supi3.config import decode
-from supi3.diagnostics import LedInputs, ib_diag_level, is_complete, watches_line_interrupt
+from supi3.diagnostics import LedInputs, diagnostic_outputs, ib_diag_level, is_complete, watches_line_interrupt
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
 from supi3.pinout import IB_DIAG_DIVIDER_BITS
@@ -62,13 +62,16 @@ def run(c: str, diag_conf: int, steps: list[Step]) -> None:
                 chip.discard_at(Cycle.DATA, False, clk)
             if event.startswith("timeout"):
                 chip.line_timeout_at(clk)
-            chip.set_led_inputs(leds)
             await ctx.tick()
             ctx.set(f.latch_data, 0)
             ctx.set(f.clear, 0)
             ctx.set(dut.idle_timeout, 0)
             ctx.set(dut.discard, 0)
-            view = chip.diagnostic_outputs
+            # The block maps its LED inputs as the spec does; the chip's own view takes FO, LD and E from its optical
+            # and bus terminal state (OPT-8, BK-11), so the expected view is the spec's function of the same inputs.
+            view = diagnostic_outputs(config, supply_ok=True, line_heard=not chip.line_silent,
+                                      bus_active=chip.bus_active, peripheral_fault=chip.pf,
+                                      line_interrupt=chip.line_interrupt, leds=leds)  # fmt: skip
             got = (ctx.get(dut.diag1), ctx.get(dut.diag2), ctx.get(dut.ib_diag), ctx.get(dut.res_reg_n),
                    ctx.get(dut.mfp_diag))  # fmt: skip
             want = (view.diag1, view.diag2, ib_diag_level(view.ib_diag, divider), int(view.rc), view.mfp)
