@@ -228,7 +228,7 @@ def test_campaign_quick(scenario: Scenario, seed: int) -> None:
 
 
 @pytest.mark.slow
-@settings(max_examples=40, deadline=None, phases=(Phase.explicit, Phase.generate))
+@settings(max_examples=8, deadline=None, phases=(Phase.explicit, Phase.generate))
 @given(scenarios(cycles=1500), st.integers(0, 2**16))
 def test_campaign_long(scenario: Scenario, seed: int) -> None:
     _campaign(scenario, 1500, seed)
@@ -244,7 +244,7 @@ def test_tree_campaign_quick(scenario: Scenario, seed: int) -> None:
 
 
 @pytest.mark.slow
-@settings(max_examples=40, deadline=None, phases=(Phase.explicit, Phase.generate))
+@settings(max_examples=8, deadline=None, phases=(Phase.explicit, Phase.generate))
 @given(scenarios(cycles=1500, kinds=TREES), st.integers(0, 2**16))
 def test_tree_campaign_long(scenario: Scenario, seed: int) -> None:
     _campaign(scenario, 1500, seed)

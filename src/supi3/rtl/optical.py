@@ -163,7 +163,9 @@ class OpticalRtl(wiring.Component):
     defines their timing). ``mode``, ``fast``, ``present`` and ``medium`` are
     static while out of reset (straps and the interface recognition)."""
 
-    def __init__(self) -> None:
+    def __init__(self, time_limit: int = INIT_TIME_LIMIT_CLOCKS) -> None:
+        self.time_limit = time_limit
+        """The initialization budget in clocks (OPT-5); a test may elaborate a shorter one to reach it quickly."""
         super().__init__({
             **{pin.name: In(pin.width) for pin in BLOCK_INPUTS},
             **{pin.name: Out(pin.width) for pin in BLOCK_OUTPUTS},
@@ -183,7 +185,7 @@ class OpticalRtl(wiring.Component):
         length = [Signal(LENGTH_MAX_CODE.bit_length(), name=f"length_{k}") for k in range(2)]
         medium = [Signal(name=f"medium_{k}") for k in range(2)]
         in_reset = Signal()
-        countdown = Signal(range(INIT_TIME_LIMIT_CLOCKS + 1))
+        countdown = Signal(range(self.time_limit + 1))
 
         def assign(i: int, tx: _Tx) -> None:
             for target, value in zip((phase[i], level[i], steps[i], passes[i], mau[i]), tx.parts(), strict=True):
@@ -223,7 +225,7 @@ class OpticalRtl(wiring.Component):
             for i in Interface:
                 assign(i, _off())
         with m.Elif(in_reset):
-            sync += [in_reset.eq(0), countdown.eq(INIT_TIME_LIMIT_CLOCKS)]
+            sync += [in_reset.eq(0), countdown.eq(self.time_limit)]
             for i in Interface:
                 assign(i, _start(self.mode, self.present[i]))
         with m.Else():

@@ -36,7 +36,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Final
 
-from supi3.checks import check_bits
+from supi3.checks import check_bits, check_int
 from supi3.errors import ArgumentError
 from supi3.model.chip import optical_test
 from supi3.optical.length import Medium, timer_code
@@ -120,7 +120,9 @@ class OpticalBlock:
     inputs: Sequence[Pin] = BLOCK_INPUTS
     outputs: Sequence[Pin] = BLOCK_OUTPUTS
 
-    def __init__(self) -> None:
+    def __init__(self, time_limit: int = INIT_TIME_LIMIT_CLOCKS) -> None:
+        self.time_limit = check_int("time_limit", time_limit, 1, INIT_TIME_LIMIT_CLOCKS,
+                                    "the 6 ms budget in clocks (OPT-5); shorter only to test the timeout quickly")
         self.log = EventLog()
         self.reset()
 
@@ -196,7 +198,7 @@ class OpticalBlock:
             return
         if self._in_reset:
             self._in_reset = False
-            self.countdown = INIT_TIME_LIMIT_CLOCKS
+            self.countdown = self.time_limit
             txs = tuple(start(mode, bool(v["present"] >> i & 1)) for i in Interface)
             self.log.add(self.cycle, "start in {}: {}", mode.name, [tx.phase.value for tx in txs])
         else:
