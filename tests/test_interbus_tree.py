@@ -254,6 +254,15 @@ def test_branch_refuses_what_is_no_tree() -> None:
         Branch(terminal("BK-LB"), [Branch(terminal("BK-LB"), [], BranchKind.LOCAL)], BranchKind.LOCAL)
     with pytest.raises(ArgumentError, match=r"^branch device 2 must be a Device or a Branch"):
         Branch(terminal("BK-RB"), [PlainDevice(0x03, 1), 7], BranchKind.REMOTE)  # type: ignore[list-item]
+    # 2.2: no mixed operation on a local bus; a remote bus branch holds remote bus devices and BKs.
+    lbd_mr, lbd_or, lb_mr = (Supi3(decode(c)) for c in ("11000", "11100", "01000"))
+    with pytest.raises(ArgumentError, match=r"^branch device 2 must be in a LBD-MR mode for a LBD-MR branch, not LBD"):
+        Branch(terminal("BK-LBD"), [lbd_mr, lbd_or], BranchKind.LBD_MR)
+    with pytest.raises(ArgumentError, match=r"^branch device 1 must be in a LB-MR mode for a BK-LB branch, not LBD-MR"):
+        Branch(terminal("BK-LB"), [lbd_mr], BranchKind.LOCAL)
+    with pytest.raises(ArgumentError, match=r"^branch device 1 must be in a RB mode for a BK-RB branch, not LB-MR"):
+        Branch(terminal("BK-RB"), [lb_mr], BranchKind.REMOTE)
+    Branch(terminal("BK-RB"), [Supi3(decode("10000")), terminal("BK-LB")], BranchKind.REMOTE)  # a BK as a device
 
 
 def test_ring_refuses_one_device_twice_and_bad_return_breaks() -> None:

@@ -38,6 +38,7 @@ from operator import attrgetter, sub
 from typing import Final, NamedTuple, Protocol, runtime_checkable
 
 from supi3.checks import check_bool, check_instance, check_int, check_real, fail
+from supi3.config import DeviceConfig
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusArgumentError, InterbusError, TelegramError
 from supi3.interbus.link import DataKernel, Device
@@ -262,6 +263,28 @@ class Branch:
                                "modules, 2.4)", device)  # fmt: skip
             elif not isinstance(device, Device):
                 raise fail(f"branch device {k}", "a Device or a Branch", device)
+            else:
+                self._check_interface(k, device)
+
+    def _check_interface(self, k: int, device: Device) -> None:
+        """A SUPI 3 in the branch must be in the branch's kind of interface: "mixed operation is not permitted" on a
+        local bus (2.2), and a remote bus branch holds remote bus devices and bus terminal modules (2.4)."""
+        config = getattr(device, "config", None)
+        if not isinstance(config, DeviceConfig):
+            return  # another device model: its interface is not known here
+        interface = config.interface
+        wanted = _BRANCH_INTERFACES[self.kind]
+        if interface.value not in wanted and not (self.kind is BranchKind.REMOTE and interface.is_bus_terminal):
+            raise InterbusArgumentError(f"branch device {k}", device, f"branch device {k} must be in a "
+                                        f"{' or '.join(wanted)} mode for a {self.kind.value} branch, not "
+                                        f"{interface.value} (2.2: mixed operation is not permitted)", "2.2, 2.4")
+
+
+_BRANCH_INTERFACES: Final[dict[BranchKind, tuple[str, ...]]] = {
+    BranchKind.REMOTE: ("RB",), BranchKind.LOCAL: ("LB-MR",), BranchKind.LBD_MR: ("LBD-MR",),
+    BranchKind.LBD_OR: ("LBD-OR",),
+}
+"""The interface a SUPI 3 in each kind of branch must have (Tables 2-4 to 2-6; a remote branch also holds BKs)."""
 
 
 @dataclass(frozen=True)
