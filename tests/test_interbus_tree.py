@@ -294,3 +294,40 @@ def test_switch_branch_refuses_wrong_devices_types_and_orders() -> None:
     fresh = Master(Ring([Branch(terminal("BK-LB"), [PlainDevice(0xBF, 1)], BranchKind.LOCAL)]))
     with pytest.raises(InterbusError, match="no configuration"):
         fresh.switch_branch(1, False)  # before the first ID cycle
+
+
+def test_the_master_sets_a_bks_alarm_output() -> None:
+    """Table 2-8 (ALARM on MFP15, set by the master, 0714h; BK-12): sent in the next ID cycle, shown on the LED
+    view and MFP15, off again after an Alarm Stop; only bus terminal modules have it."""
+    _, master, bks = figure_1_10()
+    lb = bks["lb"]
+    assert lb.bus_terminal is not None and not lb.diagnostic_outputs.alarm
+    number = next(e.number for e in master.config or () if e.ring_position == lb_position(master, lb))
+    master.set_alarm_output(number, True)
+    assert master.cycle().cycle is Cycle.ID  # the command goes out at once
+    assert lb.bus_terminal.alarm and lb.diagnostic_outputs.alarm and lb.diagnostic_outputs.mfp >> 15 & 1
+    assert not bks["rb"].diagnostic_outputs.alarm  # only the BK it was meant for
+    assert master.cycle().cycle is Cycle.DATA  # nothing left to send
+    master.set_alarm_output(number, False)
+    master.cycle()
+    assert not lb.diagnostic_outputs.alarm
+    master.set_alarm_output(number, True)
+    master.cycle()
+    assert master.start().ok  # Alarm Stop: the INTERBUS reset switches it off
+    assert not lb.diagnostic_outputs.alarm
+    with pytest.raises(InterbusError, match="must be a bus terminal module to set its ALARM output"):
+        master.set_alarm_output("1.0", True)
+    with pytest.raises(ArgumentError, match=r"^on must be"):
+        master.set_alarm_output(number, 1)
+    assert wire.decode_command_word(wire.command_word(alarm_output=True)).alarm_output is True
+    assert wire.decode_command_word(wire.command_word(alarm_output=False)).alarm_output is False
+    assert wire.decode_command_word(wire.command_word()).alarm_output is None
+    with pytest.raises(InterbusError, match="without a processor command"):
+        wire.command_word(processor_command=1, alarm_output=True)
+
+
+def lb_position(master: Master, chip: Supi3) -> int:
+    """The ring position of ``chip`` (a BK) in the master's configuration."""
+    ring = master.ring
+    assert isinstance(ring, Ring)
+    return ring.devices.index(chip) + 1

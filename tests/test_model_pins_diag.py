@@ -180,8 +180,8 @@ def test_led_inputs_reach_the_pins(c: str, diag_conf: int) -> None:
     pins.chip.set_led_inputs(leds)
 
     def light_fo1_and_fo3(chip: Supi3) -> None:
-        if chip.bus_terminal is not None:  # LD: the master switched the branch off (BK-11)
-            chip.bus_terminal.command(BranchControl.OFF, acknowledge=False)
+        if chip.bus_terminal is not None:  # LD: the master switched the branch off (BK-11); ALARM set (BK-12)
+            chip.bus_terminal.command(BranchControl.OFF, acknowledge=False, alarm=True)
         chip.optical_start((True, False, True))
         response = Response.NOT_DETECTED if chip.bus_active else Response.NONE
         for interface in (Interface.IN, Interface.BRANCH):

@@ -234,6 +234,7 @@ class Master:
         """Ring position of a BK without µP -> its last branch status (BK-5), read after an ATTN no PF or WD bit
         explains and by the LBD location (emptied when the configuration is read anew)."""
         self._branch: dict[int, BranchControl] = {}
+        self._alarm_output: dict[int, bool] = {}
         self._reconfigure = False
         self.mau_warnings: dict[int, tuple[bool, bool, bool]] = {}
         """Ring position -> its MAU warnings (MAUWH, MAUWR, MAUWS) as last read (OPT-52); a device without an entry
@@ -261,6 +262,7 @@ class Master:
         self._alarm_request.clear()
         self._alarm_expected.clear()
         self._branch.clear()
+        self._alarm_output.clear()
         self._reconfigure = False
         self._forget_optical(False)
         self._watchdog_pending = self._watchdog_code is not None
@@ -326,6 +328,24 @@ class Master:
         control = BranchControl.OFF if not on else BranchControl.ON_EXTENDED if extended else BranchControl.ON
         self._branch[entry.ring_position] = control
 
+    def set_alarm_output(self, position: int | str, on: bool) -> None:
+        """Set a bus terminal module's ALARM output (MFP15, Table 2-8: set by the master with 0714h) on or off; sent
+        in its command word of the next ID cycle (BK-12). An Alarm Stop switches it off.
+
+        Raises
+        ------
+        InterbusArgumentError
+            ``on`` is not a bool.
+        InterbusError
+            No such device, or it is no bus terminal module (Table 2-7).
+        """
+        on = check_bool("on", on)
+        entry = self.entry(position)
+        if entry.interface is not InterfaceType.BUS_TERMINAL:
+            raise InterbusError("Table 2-8", position, f"device {entry.number} must be a bus terminal module to "
+                                f"set its ALARM output, not ID code {entry.id_code:02X}h")  # fmt: skip
+        self._alarm_output[entry.ring_position] = on
+
     # -- process data --------------------------------------------------------------------------------------------
 
     def entry(self, position: int | str) -> ConfigEntry:
@@ -368,7 +388,7 @@ class Master:
             raise InterbusError("docs/interbus.md, Configuration changes", "rediscover=False",
                                 "the configuration changed and the master waits for start()")  # fmt: skip
         pending = self._pcmd or self._alarm_request or self._alarm_expected or self._recover or self._branch \
-            or self._optical_request or self._optical_expected
+            or self._optical_request or self._optical_expected or self._alarm_output
         if self.config is None or self._attention or self._watchdog_pending or self._quit or pending:
             return self.id_cycle()
         return self.data_cycle()
@@ -409,6 +429,8 @@ class Master:
         self._recover = False
         self._watchdog_pending = False
         self._quit.clear()
+        for ring_position in self._alarm_output.keys() - self._pcmd.keys():  # sent (BK-12: not with a command)
+            del self._alarm_output[ring_position]
         self._pcmd.clear()
         replan = bool(self._branch) or self._reconfigure
         self._branch.clear()
@@ -428,9 +450,11 @@ class Master:
 
     def _command(self, ring_position: int, optical: bool) -> int:
         code = self._watchdog_code if self._watchdog_pending else None
+        alarm_output = None if ring_position in self._pcmd else self._alarm_output.get(ring_position)
         return wire.command_word(code, ring_position in self._quit, self._pcmd.get(ring_position),
                                  ring_position in self._alarm_request,
-                                 self._branch.get(ring_position, BranchControl.NONE), optical)  # fmt: skip
+                                 self._branch.get(ring_position, BranchControl.NONE), optical,
+                                 alarm_output)  # fmt: skip
 
     @property
     def _answering(self) -> set[int]:
@@ -450,6 +474,7 @@ class Master:
 
     def _set_config(self, config: tuple[ConfigEntry, ...] | None) -> None:
         self.config = config
+        self._alarm_output.clear()  # by ring position, which a new configuration may move (BK-12)
         entries = config or ()
         total = sum(e.data_bytes for e in entries)
         self._out = bytearray(wire.LOOPBACK_BYTES_ON_LINE + bytes(total))

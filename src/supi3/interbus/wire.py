@@ -97,6 +97,11 @@ CMD_BRANCH_SHIFT: Final = 6
 # code. Bits 15..8 had a meaning only with bit 4 set (A18), so the two never go in one command word.
 CMD_OPTICAL_BIT: Final = 8
 
+# BK-12 A bus terminal module's ALARM output (MFP15, Table 2-8: "can be set by the master ... 0714h"): bit 9 with
+# bit 4 (the processor command) clear sets the output to bit 10.
+CMD_ALARM_OUT_SET_BIT: Final = 9
+CMD_ALARM_OUT_BIT: Final = 10
+
 # A10 Each device repeats the line with this delay; it may look this many bits minus one ahead (mid-bit sampling).
 REPEATER_DELAY_BITS: Final = 3
 
@@ -358,7 +363,8 @@ class BranchControl(Enum):
 
 def command_word(watchdog_code: int | None = None, quit_peripheral_error: bool = False,
                  processor_command: int | None = None, alarm_request: bool = False,
-                 branch: BranchControl = BranchControl.NONE, optical_request: bool = False) -> int:
+                 branch: BranchControl = BranchControl.NONE, optical_request: bool = False,
+                 alarm_output: bool | None = None) -> int:
     """Compose the 16-bit command word the master shifts into a device in an ID cycle (assumptions A9, A18).
 
     Parameters
@@ -378,6 +384,9 @@ def command_word(watchdog_code: int | None = None, quit_peripheral_error: bool =
     optical_request:
         Ask the device to send its optical status byte (:func:`optical_status`) in the next ID cycle in place of the
         ID code (OPT-50); not together with ``processor_command`` (both use bits 15..8) or ``alarm_request``.
+    alarm_output:
+        Set a bus terminal module's ALARM output (MFP15, Table 2-8) on or off, ``None`` to leave it (BK-12); not
+        together with ``processor_command`` (bits 15..8).
     """
     if type(branch) is not BranchControl:
         branch = checked(check_instance, "branch", branch, BranchControl, "a BranchControl")
@@ -395,6 +404,12 @@ def command_word(watchdog_code: int | None = None, quit_peripheral_error: bool =
             raise InterbusError("OPT-50", optical_request, "an optical status request goes without a processor "
                                 "command and without an alarm request (one answer per ID cycle, bits 15..8)")
         word |= 1 << CMD_OPTICAL_BIT
+    if alarm_output is not None:
+        alarm_output = _flag("alarm_output", alarm_output)
+        if processor_command is not None:
+            raise InterbusError("BK-12", alarm_output, "the ALARM output is set without a processor command "
+                                "(both use bits 15..8)")
+        word |= 1 << CMD_ALARM_OUT_SET_BIT | int(alarm_output) << CMD_ALARM_OUT_BIT
     if watchdog_code is not None:
         watchdog_code = _int("watchdog_code", watchdog_code, 0, len(WATCHDOG_TIMEOUTS_S) - 1,
                              "Table 3-13: an index into WATCHDOG_TIMEOUTS_S")  # fmt: skip
@@ -414,6 +429,7 @@ class CommandWord(NamedTuple):
     alarm_request: bool = False
     branch: BranchControl = BranchControl.NONE
     optical_request: bool = False
+    alarm_output: bool | None = None
 
 
 def decode_command_word(word: int) -> CommandWord:
@@ -423,7 +439,9 @@ def decode_command_word(word: int) -> CommandWord:
     pcmd = (word >> CMD_PCMD_SHIFT) & 0xFF if _bit(word, CMD_PCMD_BIT) else None
     branch = BranchControl((word >> CMD_BRANCH_SHIFT) & 0b11)
     optical = pcmd is None and bool(_bit(word, CMD_OPTICAL_BIT))
-    return CommandWord(code, bool(_bit(word, CMD_QUIT_BIT)), pcmd, bool(_bit(word, CMD_ALARM_BIT)), branch, optical)
+    alarm_out = bool(_bit(word, CMD_ALARM_OUT_BIT)) if pcmd is None and _bit(word, CMD_ALARM_OUT_SET_BIT) else None
+    return CommandWord(code, bool(_bit(word, CMD_QUIT_BIT)), pcmd, bool(_bit(word, CMD_ALARM_BIT)), branch, optical,
+                       alarm_out)
 
 
 # ================================================================================================================

@@ -77,6 +77,8 @@ class BusTerminal:
         The BK closed its branch and the master has not acknowledged it yet (status bit 6, BK-5).
     conf_request:
         A reconfiguration request (CONF edge) waits for the master's acknowledgement.
+    alarm:
+        The ALARM output (MFP15) the master set (BK-12); off after an INTERBUS reset.
     count:
         The count of the last counter telegram received on the branch return line, 0 if none.
     closures:
@@ -95,6 +97,7 @@ class BusTerminal:
         self.conf_request = False
         self.count = 0
         self.closures = 0
+        self.alarm = False
         self._silent_since: float | None = None
 
     __hash__ = None  # type: ignore[assignment]  # mutable state, compared by value
@@ -124,11 +127,14 @@ class BusTerminal:
         """The branch status byte (BK-5)."""
         return wire.bk_status(self.conf_request, self.closed_report, self.count)
 
-    def command(self, branch: BranchControl, acknowledge: bool) -> None:
-        """Apply a latched command word: the branch control (BK-4) and, with ``acknowledge`` (0714h), the end of a
-        reconfiguration request and of the closed flag's report (BK-8)."""
+    def command(self, branch: BranchControl, acknowledge: bool, alarm: bool | None = None) -> None:
+        """Apply a latched command word: the branch control (BK-4), with ``acknowledge`` (0714h) the end of a
+        reconfiguration request and of the closed flag's report (BK-8), and the ALARM output unless ``alarm`` is
+        ``None`` (BK-12)."""
         check_instance("branch", branch, BranchControl)
         acknowledge = check_bool("acknowledge", acknowledge)
+        if alarm is not None:
+            self.alarm = check_bool("alarm", alarm)
         if branch is BranchControl.OFF:
             self.switched_on = False
         elif branch in (BranchControl.ON, BranchControl.ON_EXTENDED):
@@ -165,4 +171,5 @@ class BusTerminal:
         self.extended = False
         self.closed = False
         self.count = 0
+        self.alarm = False
         self._silent_since = None

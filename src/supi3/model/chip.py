@@ -408,21 +408,23 @@ class Supi3:
         diagnostic_outputs`: UL, RC, BA, RD, LD, E, ALARM, FO1..FO3, the IB_DIAG pattern, and DIAG1/DIAG2 as
         DIAG_CONF selects. At transaction level the supply is always good (UL lit): the power-up reset has no
         duration here (1.7.2 is the pin level's)."""
-        # FO1..FO3 come from the optical block (Table 3-17, OPT-8; RUN is the bus active, DG-7), LD and E from the
-        # bus terminal: the branch switched off or closed by the BK (LD), a break behind it or closed (E; BK-11).
+        # FO1..FO3 come from the optical block (Table 3-17, OPT-8; RUN is the bus active, DG-7), LD, E and ALARM from
+        # the bus terminal: the branch switched off or closed by the BK (LD), a break behind it or closed (E; BK-11),
+        # the master's ALARM (BK-12).
         leds = replace(self.led_inputs, fo=fo_leds(self._optical, self.bus_active))
         terminal = self.bus_terminal
         if terminal is not None:
             closed = terminal.closed
-            leds = replace(leds, ld=closed or not terminal.switched_on, e=closed or terminal.count > 0)
+            leds = replace(leds, ld=closed or not terminal.switched_on, e=closed or terminal.count > 0,
+                           alarm=terminal.alarm)
         return diagnostic_outputs(self.config, supply_ok=True, line_heard=not self.line_silent,
                                   bus_active=self.bus_active, peripheral_fault=self.pf,
                                   line_interrupt=self.line_interrupt, leds=leds)  # fmt: skip
 
     def set_led_inputs(self, leds: LedInputs) -> None:
-        """What RD and ALARM show from now on (DG-5); both fidelities read it (the RTL ties these ports to 0).
-        FO1..FO3 always come from the chip's own optical block (:attr:`optical`, :func:`supi3.diagnostics.fo_leds`)
-        and, in the bus terminal modes, LD and E from its branch state (BK-11), so those fields are not used here.
+        """What RD shows from now on (DG-5); both fidelities read it (the RTL ties these ports to 0). FO1..FO3
+        always come from the chip's own optical block (:attr:`optical`, :func:`supi3.diagnostics.fo_leds`) and, in
+        the bus terminal modes, LD, E and ALARM from its branch state (BK-11, BK-12), so those fields are not used.
 
         Raises
         ------
@@ -687,7 +689,7 @@ class Supi3:
         terminal = self.bus_terminal
         if terminal is None:
             return False
-        terminal.command(command.branch, command.quit_peripheral_error)
+        terminal.command(command.branch, command.quit_peripheral_error, command.alarm_output)
         if self.registers is None:
             self._send_alarm = command.alarm_request
         return terminal.conf_request or terminal.closed_report
