@@ -151,16 +151,6 @@ def _interface(interface: object) -> Interface:
     return checked
 
 
-def optical_test(tx: regulation.Transmitter, ack1: bool, ack2: bool) -> regulation.Transmitter:
-    """One online test of a transmitter, whatever the mode (1.6.2): online regulation of an
-    :attr:`~Phase.ONLINE` transmitter; in optical diagnostics mode (:attr:`~Phase.DIAGNOSTIC`) the MAU warning of
-    the interface (OPT-22); any other transmitter is returned unchanged. Shared by the chip and the pin-level
-    optical block (:mod:`supi3.model.blocks.optical`)."""
-    if tx.phase is Phase.DIAGNOSTIC:
-        return replace(tx, mau=regulation.diagnostic_mau(tx.mau, ack1, ack2))
-    return regulation.online_test(tx, ack1, ack2)
-
-
 # ----------------------------------------------------------------------------------------------------------------
 # The ring kernel (docs/interbus.md, "Ring kernel")
 # ----------------------------------------------------------------------------------------------------------------
@@ -873,7 +863,7 @@ class Supi3:
         ack1 = _checked(check_bool, "ack1", ack1)
         ack2 = _checked(check_bool, "ack2", ack2)
         self._optical_set(self._optical.with_transmitter(
-            interface, optical_test(self._optical[interface], ack1, ack2)))
+            interface, regulation.apply_test(self._optical[interface], ack1, ack2)))
 
     def _optical_apply(self, transition: Callable[[regulation.Transmitter], regulation.Transmitter]) -> None:
         """``transition`` applied to every transmitter."""

@@ -30,6 +30,7 @@ __all__ = [
     "MAX_PATH_M",
     "POLYMER_UNIT_M",
     "Medium",
+    "check_bit_rate",
     "code_range_m",
     "length_code",
     "length_m",
@@ -61,7 +62,8 @@ def _medium(medium: object) -> Medium:
     return check_instance("medium", medium, Medium)
 
 
-def _bit_rate(bit_rate: object) -> int:
+def check_bit_rate(bit_rate: object) -> int:
+    """``bit_rate`` if it is one of Table 1-7's bit rates, else a named error."""
     rate = check_int("bit_rate", bit_rate)
     if rate not in BIT_RATES:
         raise fail("bit_rate", f"one of Table 1-7's {BIT_RATES}", bit_rate)
@@ -96,7 +98,7 @@ def length_m(code: int, medium: Medium) -> float:
 def timer_count(one_way_m: float, bit_rate: int) -> int:
     """The length timer's result n for a one-way path: round trip 2 L t, counted at f = 16 x bit rate (1.6.1, F10)."""
     metres = check_real("one_way_m", one_way_m, 0.0, MAX_PATH_M, limit="Table 1-5: 0 m to 20 km")
-    f = LENGTH_TIMER_CLOCKS_PER_BIT * _bit_rate(bit_rate)
+    f = LENGTH_TIMER_CLOCKS_PER_BIT * check_bit_rate(bit_rate)
     # The small epsilon keeps exact multiples (e.g. 12.5 m at 500 kbit/s) from falling one count short in floats.
     return math.floor(2 * metres * LIGHT_RUNTIME_S_PER_M * f + 1e-9)
 
@@ -104,7 +106,7 @@ def timer_count(one_way_m: float, bit_rate: int) -> int:
 def timer_code(count: int, bit_rate: int, medium: Medium) -> int:
     """The LENGTH code from a timer result n: one-way L / 2 = n / (2 f t), in the medium's unit, 63 above."""
     n = check_int("count", count, 0)
-    f = LENGTH_TIMER_CLOCKS_PER_BIT * _bit_rate(bit_rate)
+    f = LENGTH_TIMER_CLOCKS_PER_BIT * check_bit_rate(bit_rate)
     # units = n / (2 f t u); with f t u a ratio of integers in both media, integer arithmetic keeps it exact.
     clocks_per_unit = round(2 * f * LIGHT_RUNTIME_S_PER_M * unit_m(medium) * 1000)  # in thousandths of a count
     return min(LENGTH_MAX_CODE, (n * 1000) // clocks_per_unit)

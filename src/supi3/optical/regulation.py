@@ -35,7 +35,7 @@ from enum import Enum, IntEnum
 from typing import Final
 
 from supi3.checks import check_bool, check_instance, check_int, fail
-from supi3.optical.length import LENGTH_MAX_CODE, Medium
+from supi3.optical.length import LENGTH_MAX_CODE, Medium, check_bit_rate
 from supi3.pinlevel import Pin
 from supi3.regmap.registers import (
     OPTICAL_ENABLE_BIT,
@@ -43,7 +43,7 @@ from supi3.regmap.registers import (
     POWER_BRANCH_LSB,
     POWER_OUT_LSB,
 )
-from supi3.tables import BIT_RATES, CLOCK_HZ
+from supi3.tables import CLOCK_HZ, LENGTH_TIMER_CLOCKS_PER_BIT
 
 __all__ = [
     "BLOCK_INPUTS",
@@ -64,6 +64,7 @@ __all__ = [
     "Phase",
     "Response",
     "Transmitter",
+    "apply_test",
     "diagnostic_mau",
     "fo_lit",
     "init_response",
@@ -268,6 +269,16 @@ def diagnostic_mau(mau: bool, ack1: bool, ack2: bool) -> bool:
     return False if ack2 else mau
 
 
+def apply_test(tx: Transmitter, ack1: bool, ack2: bool) -> Transmitter:
+    """One online test of a transmitter, whatever the mode (1.6.2; OPT-22): :func:`online_test` for an
+    :attr:`Phase.ONLINE` transmitter, :func:`diagnostic_mau` on the MAU warning of a :attr:`Phase.DIAGNOSTIC` one;
+    any other transmitter is returned unchanged."""
+    tx = _tx(tx)
+    if tx.phase is Phase.DIAGNOSTIC:
+        return replace(tx, mau=diagnostic_mau(tx.mau, ack1, ack2))
+    return online_test(tx, ack1, ack2)
+
+
 def probe_power_db(level: int, test: int) -> float:
     """Transmit power of test 1 or 2 relative to full power (level 15): level, reserve and one level more for
     test 2 (1.6.2; OPT-4). Test 0 is the normal power of the level."""
@@ -362,10 +373,7 @@ def registers(status: OpticalStatus) -> tuple[int, int, int, int]:
 
 def length_timer_enable_every(bit_rate: int) -> int:
     """The length timer counts on every n-th chip clock: f = 16 x bit rate (F10) out of the 32 MHz clock."""
-    rate = check_int("bit_rate", bit_rate)
-    if rate not in BIT_RATES:
-        raise fail("bit_rate", f"one of Table 1-7's {BIT_RATES}", bit_rate)
-    return CLOCK_HZ // (16 * rate)
+    return CLOCK_HZ // (LENGTH_TIMER_CLOCKS_PER_BIT * check_bit_rate(bit_rate))
 
 
 _PER_INTERFACE: Final = len(Interface)

@@ -15,7 +15,7 @@ What happens at the clock edge ending a cycle, from that cycle's inputs (:mod:`s
    :data:`~supi3.optical.regulation.INIT_TIME_LIMIT_CLOCKS`.
 3. Otherwise, per interface: a response strobe (``resp_valid``) applies
    :func:`~supi3.optical.regulation.init_response`, then a test strobe (``test_valid``) the online test
-   (:func:`supi3.model.chip.optical_test`: regulation, or the diagnostics mode's MAU warning, OPT-22); then, on the
+   (:func:`~supi3.optical.regulation.apply_test`: regulation, or the diagnostics MAU warning, OPT-22); then, on the
    edge where the 6 ms counter runs out, :func:`~supi3.optical.regulation.init_timeout` for every transmitter.
 
 The length timers of the outgoing interface and the branch run at every edge, ib_reset aside: ``len_start`` clears
@@ -38,7 +38,6 @@ from typing import Final
 
 from supi3.checks import check_bits, check_int
 from supi3.errors import ArgumentError
-from supi3.model.chip import optical_test
 from supi3.optical.length import Medium, timer_code
 from supi3.optical.regulation import (
     BLOCK_INPUTS,
@@ -50,6 +49,7 @@ from supi3.optical.regulation import (
     Phase,
     Response,
     Transmitter,
+    apply_test,
     fo_lit,
     init_response,
     init_timeout,
@@ -225,7 +225,7 @@ class OpticalBlock:
                 tx = init_response(tx, response)
                 self.log.add(self.cycle, "{} response {}: {}", i.name, response.name, tx)
         if v["test_valid"] >> i & 1:
-            tx = optical_test(tx, bool(v["ack1"] >> i & 1), bool(v["ack2"] >> i & 1))
+            tx = apply_test(tx, bool(v["ack1"] >> i & 1), bool(v["ack2"] >> i & 1))
             self.log.add(self.cycle, "{} test: {}", i.name, tx)
         return tx
 
