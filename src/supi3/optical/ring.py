@@ -59,21 +59,15 @@ from supi3.optical.regulation import (
     Response,
     registers,
 )
-from supi3.regmap.registers import (
-    OPTICAL_LENGTH_WIDTH,
-    OPTICAL_MEDIUM_BIT,
-    POWER_BRANCH_LSB,
-    POWER_LEVEL_WIDTH,
-    POWER_OUT_LSB,
-)
+from supi3.regmap import LENGTH_BRANCH, LENGTH_OUT, POWER_IN, POWER_OUT_BRANCH
 
 __all__ = ["MauReport", "OpticalChip", "OpticalRing", "PathRow", "PathSample", "diagnostic_table", "format_table"]
 
 
 @runtime_checkable
 class OpticalChip(Device, Protocol):
-    """What the ring needs from a chip: the INTERBUS device protocol and the optical block's transaction-level API
-    (issue 12), as :class:`supi3.model.chip.Supi3` offers them. (A protocol rather than the class: the model package
+    """What the ring needs from a chip: the INTERBUS device protocol and the optical block's transaction-level API,
+    as :class:`supi3.model.chip.Supi3` offers them. (A protocol rather than the class: the model package
     imports :mod:`supi3.optical`, so :mod:`supi3.optical` must not import the model package back.)"""
 
     @property
@@ -556,7 +550,6 @@ def diagnostic_table(ring: OpticalRing, master: Master | None = None) -> list[Pa
     if master is not None:
         check_instance("master", master, Master, "a Master or None")
     rows = []
-    level_mask = (1 << POWER_LEVEL_WIDTH) - 1
     at = ring._positions()
     for cable in sorted(ring._cables, key=lambda c: at.get(id(c.downstream), 0)):
         up = cable.upstream
@@ -565,14 +558,15 @@ def diagnostic_table(ring: OpticalRing, master: Master | None = None) -> list[Pa
         k = cable.index + 1
         branch = cable.interface is Interface.BRANCH
         read8, read9, _, read11 = registers(up.optical)
-        read10 = registers(cable.downstream.optical)[2]
-        path = read9 if branch else read8
-        medium = Medium(path >> OPTICAL_MEDIUM_BIT & 1)
+        path = LENGTH_BRANCH.decode(read9) if branch else LENGTH_OUT.decode(read8)
+        levels = POWER_OUT_BRANCH.decode(read11)
+        back = POWER_IN.decode(registers(cable.downstream.optical)[2])
+        medium = Medium(path["MEDIUM"])
         rows.append(PathRow(
             f"{_number(master, at[id(up)])}<->{_number(master, at[id(cable.downstream)])}",
             _quality(ring, k, Direction.FORWARD), _quality(ring, k, Direction.RETURN),
-            read11 >> (POWER_BRANCH_LSB if branch else POWER_OUT_LSB) & level_mask, read10 & level_mask,
-            length_m(path & ((1 << OPTICAL_LENGTH_WIDTH) - 1), medium), medium))  # fmt: skip
+            levels["BRANCH_LEVEL" if branch else "OUT_LEVEL"], back["LEVEL"],
+            length_m(path["LENGTH"], medium), medium))  # fmt: skip
     return rows
 
 
