@@ -317,7 +317,7 @@ class Supi3:
         self.line_interrupt = False
         """IB_DIAG's 4 Hz cause: a line interrupt ahead on the local bus (DG-3)."""
         self._init_bus_terminal()
-        self._optical_power_up()  # optical block (issue 12)
+        self._optical_power_up()  # optical block (1.6)
         self._reschedule()
 
     def _clock(self) -> int:
@@ -728,7 +728,7 @@ class Supi3:
         return self.bus_terminal
 
     # --------------------------------------------------------------------------------------------------------
-    # Optical regulation block (issue 12; manual 1.6, 3.4.12, 3.4.13; OPT-20 onward of docs/assumptions/optical.md)
+    # Optical regulation block (manual 1.6, 3.4.12, 3.4.13; OPT-20 onward of docs/assumptions/optical.md)
     # --------------------------------------------------------------------------------------------------------
     # State: _optical, the block's OpticalStatus; _optical_until, the clock at which the initialization budget
     # (INIT_TIME_LIMIT_CLOCKS from optical_start) runs out while a transmitter initializes, _NEVER otherwise. While it

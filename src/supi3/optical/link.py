@@ -1,9 +1,9 @@
 """The physical fibre link between two SUPI 3 OPC devices: transmitter current, fibre, connectors, receiver, time.
 
 What the optical block of a chip regulates (:mod:`supi3.optical.regulation`) is the light on a duplex fibre cable.
-This module is the analog side that the manual leaves to the transceivers and the cable (issue 12: "the analog parts
-(DAC currents, fibre) stay in the model and feed both sides as stimulus"). Every number here is one named constant
-with its evidence in OPT-40 onward of ``docs/assumptions/optical.md``; the manual gives only the CUR_LIM network
+This module is the analog side that the manual leaves to the transceivers and the cable (DAC currents,
+fibre); it feeds the model and the RTL alike as stimulus. Every number here is one named constant with its evidence
+in OPT-40 onward of ``docs/assumptions/optical.md``; the manual gives only the CUR_LIM network
 (2.1.2, Table 2-3) and the runtime of light (1.6.1); the fibre and transceiver figures are *typical* datasheet values
 for 660 nm polymer/HCS and 850 nm glass transceivers, not the manual's.
 

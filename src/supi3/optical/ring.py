@@ -2,8 +2,8 @@
 
 :class:`OpticalRing` is an INTERBUS :class:`~supi3.interbus.ring.Bus` (a master drives it like any ring): a
 transaction-level :class:`~supi3.interbus.ring.Ring` of :class:`~supi3.model.chip.Supi3` chips whose lines are the
-fibres of :class:`~supi3.optical.link.FibreLink` cables. It is the line side of every chip's optical block (the
-chip TL API of issue 12, OPT-20 onward): it turns the link physics at the current bus time into the block's inputs,
+fibres of :class:`~supi3.optical.link.FibreLink` cables. It is the line side of every chip's optical block (its
+transaction-level API, OPT-20 onward): it turns the link physics at the current bus time into the block's inputs,
 and the light that no longer gets through into ring faults the master locates.
 
 * **INTERBUS reset** (:meth:`OpticalRing.reset`, 1.6 "Behavior on a reset"): the chips reset (every transmitter off),
