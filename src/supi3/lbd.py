@@ -143,6 +143,12 @@ def _refuse(name: str, wanted: str, value: object) -> NoReturn:
 def _check_state(state: object) -> CounterState:
     if type(state) is not CounterState:
         _refuse("state", "a CounterState", state)
+    bit, data, kind, carry, frame, quiet, byte, counted, gen, drop = state
+    if (type(bit) is type(data) is type(carry) is type(frame) is type(quiet) is type(byte) is type(counted)
+            is type(gen) is type(drop) is int and type(kind) in (Kind, int) and 0 <= kind <= Kind.GENERATE
+            and 0 <= bit <= IDLE_BIT and 0 <= gen <= IDLE_BIT and 0 <= quiet <= COUNTER_SILENCE_BITS
+            and not (data | carry | frame | drop) >> 1 and 0 <= byte <= 0xFF and 0 <= counted <= wire.COUNTER_MAX):
+        return state
     for name, limit in _LIMITS.items():
         value = getattr(state, name)
         if not isinstance(value, int) or isinstance(value, bool) or not 0 <= value <= limit:
