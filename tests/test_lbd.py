@@ -25,7 +25,7 @@ from supi3.lbd import (
     counter_step,
     send_countdown,
 )
-from support import bad
+from support import bad, lbd_breaks
 
 S = COUNTER_SILENCE_BITS
 N = wire.DATA_TELEGRAM_BITS
@@ -208,14 +208,6 @@ def traffic(devices: int, cut: int) -> list[int]:
     return [int(v) for v in levels[: lead * wire.STATUS_TELEGRAM_BITS + cut]]
 
 
-def breaks(kind: BranchKind, m: int) -> list[tuple[set[int], set[int], int]]:
-    """Every single break of an LBD branch of ``m`` devices: (forward, back, blocks behind it on the path)."""
-    found = [({k}, set[int](), m - k + 1 + (m if kind is BranchKind.LBD_MR else 0)) for k in range(1, m + 1)]
-    if kind is BranchKind.LBD_MR:
-        found += [(set(), {c}, c) for c in range(1, m)]
-    return found
-
-
 PHANTOM_CUTS = range(1, wire.POS_CONTROL + 1)
 """Cuts inside the first telegram of a frame before its control bit: the idle level fills it to an ID check
 telegram of byte FFh outside a frame, a counter telegram (BK-15)."""
@@ -234,7 +226,7 @@ def test_every_break_gives_the_transaction_levels_count(kind: BranchKind) -> Non
     BK receives only counter telegrams with exactly ``ring.lbd_count``'s count, from the first one on; a cut in the
     first header of a frame sends one saturated count (63, which locates nothing, BK-7) ahead of them."""
     for m in range(1, 5):
-        for forward, back, behind in breaks(kind, m):
+        for forward, back, behind in lbd_breaks(kind, m):
             expected = lbd_count(kind, m, forward, back)
             for cut in (-7, m % 3 + 1, 4, 80):
                 counts = counts_behind(behind, cut)
@@ -257,7 +249,7 @@ def test_a_branch_silent_from_power_up_settles(devices: int) -> None:
 
 @pytest.mark.parametrize(("kind", "m"), [(BranchKind.LBD_OR, 63), (BranchKind.LBD_OR, 64), (BranchKind.LBD_MR, 32)])
 def test_long_branches_saturate_as_the_transaction_level(kind: BranchKind, m: int) -> None:
-    forward, back, behind = breaks(kind, m)[0]
+    forward, back, behind = lbd_breaks(kind, m)[0]
     counts = counts_behind(behind, 40)
     assert len(counts) >= 2 and set(counts) == {lbd_count(kind, m, forward, back)}
 
