@@ -1,5 +1,5 @@
 """The counter telegram on the line, bit period by bit period (supi3.lbd; manual 2.2.2, docs/interbus.md "Counter
-telegram", BK-6, BK-13 to BK-16): exhaustive over every data and status telegram in and out of a frame, silence and
+telegram", BK-6, BK-30 to BK-33): exhaustive over every data and status telegram in and out of a frame, silence and
 the generator, dropped telegrams, the transaction-level rule (wire.count_on) bit for bit, chains of devices behind
 every break against ring.lbd_count (saturation included), and hostile inputs."""
 
@@ -52,7 +52,7 @@ def word_of(sent: Sequence[CounterBit]) -> int:
 
 
 def incremented(byte: int) -> int:
-    """The byte sent for a received counter telegram byte, by arithmetic (BK-14): count + 1 modulo 64, the carry
+    """The byte sent for a received counter telegram byte, by arithmetic (BK-31): count + 1 modulo 64, the carry
     out sets bit 6."""
     count = byte & wire.COUNTER_MAX
     return (byte & 0xC0) | ((count + 1) & wire.COUNTER_MAX) | (0x40 if count == wire.COUNTER_MAX else 0)
@@ -127,7 +127,7 @@ def test_stop_bit_at_start_level_starts_the_next_telegram() -> None:
 
 
 def test_a_silent_line_gets_a_counter_telegram_every_silence_plus_one_bits() -> None:
-    """BK-13: S idle bit periods, then the generated telegram (driven), S - 12 idle, the next one, and so on."""
+    """BK-30: S idle bit periods, then the generated telegram (driven), S - 12 idle, the next one, and so on."""
     _, sent = run([wire.IDLE_LEVEL] * (S + 4 * (S + 1)))
     period = [wire.IDLE_LEVEL] * (S - N + 1)
     gen = bits(GENERATED_TELEGRAM)
@@ -136,7 +136,7 @@ def test_a_silent_line_gets_a_counter_telegram_every_silence_plus_one_bits() -> 
 
 
 def test_longest_idle_run_of_working_traffic_is_below_the_silence() -> None:
-    """BK-13's evidence: back to back, no telegram holds the idle level longer than 12 bit periods."""
+    """BK-30's evidence: back to back, no telegram holds the idle level longer than 12 bit periods."""
     words = [wire.data_telegram(b, c, k) for b, c, k in itertools.product(range(256), Cycle, (False, True))]
     longest = max(max(len(run) for run in format(w >> 1, "b").split("0")) for w in words)
     status = max(len(run) for c, k in itertools.product(Cycle, (False, True))
@@ -210,7 +210,7 @@ def traffic(devices: int, cut: int) -> list[int]:
 
 PHANTOM_CUTS = range(1, wire.POS_CONTROL + 1)
 """Cuts inside the first telegram of a frame before its control bit: the idle level fills it to an ID check
-telegram of byte FFh outside a frame, a counter telegram (BK-15)."""
+telegram of byte FFh outside a frame, a counter telegram (BK-32)."""
 
 
 def counts_behind(devices: int, cut: int) -> list[int]:

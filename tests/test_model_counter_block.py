@@ -1,5 +1,5 @@
 """The counter telegram block at pin level (supi3.model.blocks.counter; manual 2.2.2, docs/interbus.md "Counter
-telegram", BK-13 to BK-16): a repeater with the chip's delay for working traffic (frames, status telegrams, the
+telegram", BK-30 to BK-33): a repeater with the chip's delay for working traffic (frames, status telegrams, the
 INTERBUS reset) at both bit rates, counter telegrams passed on incremented, and chains of blocks behind every break of
 LBD-MR and LBD-OR branches giving ``ring.lbd_count``'s count at the BK (the pin level tied to the transaction
 level); hostile inputs."""

@@ -1,6 +1,6 @@
 """Lockstep of the counter telegram block's RTL (supi3.rtl.counter.CounterRtl) against its pin model
 (supi3.model.blocks.counter.CounterBlock), every output every clock, on Amaranth's simulator
-(supi3.verif.amaranth_sim; manual 2.2.2, docs/interbus.md "Counter telegram", BK-13 to BK-16).
+(supi3.verif.amaranth_sim; manual 2.2.2, docs/interbus.md "Counter telegram", BK-30 to BK-33).
 
 Directed streams at both bit rates (working traffic, counter telegrams of every count byte, the saturated mark,
 silence and the generator, a telegram colliding with it, the INTERBUS reset), each also checked to do what it is

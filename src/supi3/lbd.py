@@ -2,8 +2,8 @@
 silent line (device-oriented local-bus diagnostics, manual 2.2.2).
 
 The telegram's format and the transaction-level rule are :mod:`supi3.interbus.wire` (``counter_telegram``,
-``count_on``, ``count_bit``); the protocol is ``docs/interbus.md`` "Counter telegram", the decisions BK-6, BK-13 to
-BK-16 of ``docs/assumptions/bus-terminal.md``. This module is the line behaviour a chip in an LBD mode (Table 2-5)
+``count_on``, ``count_bit``); the protocol is ``docs/interbus.md`` "Counter telegram", the decisions BK-6, BK-30 to
+BK-33 of ``docs/assumptions/bus-terminal.md``. This module is the line behaviour a chip in an LBD mode (Table 2-5)
 applies once per line direction (forward; and the looped return line in LBD-MR), as a pure transition per bit period
 (:func:`counter_step`) and the clock timing around it (:func:`sample_phase`, :func:`send_countdown`,
 :data:`OUTPUT_SLOTS`) that the pin block :mod:`supi3.model.blocks.counter` and the RTL :mod:`supi3.rtl.counter` share.
@@ -13,18 +13,18 @@ between telegrams restarts the grid, as the chip's receiver, M7). Per sample, :f
 send for that bit period (it goes out ``REPEATER_DELAY_BITS`` after the bit began on the input, A10, M8):
 
 * Any telegram is repeated as received, except a *counter telegram*: a data telegram with select = ID and
-  control = check that does not belong to a frame (BK-15). Normal traffic sends such a telegram only as a check
+  control = check that does not belong to a frame (BK-32). Normal traffic sends such a telegram only as a check
   telegram of an ID cycle, after its data sequence; the block knows the frame from the telegrams themselves: a
   data-sequence telegram opens it, a status telegram or :data:`COUNTER_SILENCE_BITS` idle bit periods close it.
   The decision falls at the control bit (bit 3), before the count (bits 4..9).
 * A counter telegram's count bits are incremented serially (``wire.count_bit``): LSB first, the carry from bit to
-  bit, the carry out of bit 9 sets the saturation mark bit 10 (BK-14).
+  bit, the carry out of bit 9 sets the saturation mark bit 10 (BK-31).
 * After :data:`COUNTER_SILENCE_BITS` idle bit periods, the next idle bit period starts a counter telegram of
   count 1 (``wire.count_on(None)``) that the block sends itself (the generator); every telegram begun, received or
   generated, starts the idle count afresh, so a silent line gets one every ``COUNTER_SILENCE_BITS + 1`` bit
   periods, with ``COUNTER_SILENCE_BITS - 12`` idle ones between (the next device never reaches its own silence).
   A telegram that begins on the line while the generator sends is received (a counter telegram's count is kept)
-  but *dropped*: sent as the idle level, driven, to its end (BK-13).
+  but *dropped*: sent as the idle level, driven, to its end (BK-30).
 """
 
 from __future__ import annotations
@@ -55,7 +55,7 @@ __all__ = [
     "send_countdown",
 ]
 
-# BK-13 A line that stays at the idle level for this many bit periods is silent: the frame is forgotten and the next
+# BK-30 A line that stays at the idle level for this many bit periods is silent: the frame is forgotten and the next
 # bit period starts a generated counter telegram (and so on, one every COUNTER_SILENCE_BITS + 13 bit periods). More
 # than twice the longest idle-level run of working traffic (12, tested), far below the BK's 10 ms branch silence
 # (BK-3) and the 20 ms idle time-out (A13); a power of two.

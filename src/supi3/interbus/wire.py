@@ -481,7 +481,7 @@ def decode_optical_status(byte: int) -> tuple[bool, bool, bool] | None:
 # BK-6 The counter telegram: a data telegram with select = ID and control = check, sent outside any frame by the
 # first device behind a break in place of idle status telegrams; its byte is the count (bits 5..0, LSB first on the
 # line in bit periods 4..9) under a 2-bit mark (bits 7..6): COUNTER_MARK, or COUNTER_SATURATED_MARK once a count
-# went past COUNTER_MAX. Devices increment it serially in flight (count_bit, BK-14), so the mark, which comes after
+# went past COUNTER_MAX. Devices increment it serially in flight (count_bit, BK-31), so the mark, which comes after
 # the count, takes the carry out of the count: a saturated count stays saturated.
 COUNTER_CYCLE: Final = Cycle.ID
 COUNTER_CHECK: Final = True
@@ -512,7 +512,7 @@ def counter_telegram(count: int) -> int:
 
 def counter_count(byte: int) -> int | None:
     """The count a counter telegram's byte stands for: the count under COUNTER_MARK (1..63), ``COUNTER_MAX`` under
-    COUNTER_SATURATED_MARK whatever the count bits; ``None`` for any other byte (BK-6, BK-14)."""
+    COUNTER_SATURATED_MARK whatever the count bits; ``None`` for any other byte (BK-6, BK-31)."""
     byte = _int("byte", byte, 0, 0xFF, "BK-6: a counter telegram carries one byte")
     mark = byte & ~COUNTER_MAX
     if mark == COUNTER_SATURATED_MARK:
@@ -536,7 +536,7 @@ def decode_counter_telegram(word: int) -> int | None:
 
 
 def count_bit(position: int, level: int, carry: int) -> tuple[int, int]:
-    """One bit period of the serial increment a device applies to a counter telegram in flight (BK-14).
+    """One bit period of the serial increment a device applies to a counter telegram in flight (BK-31).
 
     Parameters
     ----------
@@ -571,7 +571,7 @@ _COUNT_ZERO: Final = data_telegram(COUNTER_MARK, COUNTER_CYCLE, COUNTER_CHECK)
 def count_on(word: int | None) -> int:
     """What a device behind a break sends on: ``None`` (it receives nothing: it is the first behind the break)
     starts the count at 1, a counter telegram is passed on incremented bit by bit (:func:`count_bit`): 63 and a
-    saturated count give a saturated count (BK-6, BK-14)."""
+    saturated count give a saturated count (BK-6, BK-31)."""
     if word is not None and decode_counter_telegram(word) is None:
         raise InterbusError("docs/interbus.md, Counter telegram", word, "a device passes on counter telegrams only")
     received = _COUNT_ZERO if word is None else word

@@ -4,7 +4,7 @@ a synchronous machine with the ports of :data:`~supi3.lbd.COUNTER_INPUTS` and
 
 Every decision per bit period is :func:`supi3.lbd.counter_step` (the model restates none); this block
 adds the clock timing the RTL counterpart :mod:`supi3.rtl.counter` shares, and which
-``tests/test_verif_lockstep_counter.py`` holds it to cycle by cycle (docs/interbus.md "Counter telegram", BK-16).
+``tests/test_verif_lockstep_counter.py`` holds it to cycle by cycle (docs/interbus.md "Counter telegram", BK-33).
 
 What happens at the clock edge ending a cycle, from that cycle's inputs (:mod:`supi3.pinlevel`):
 
