@@ -23,6 +23,7 @@ from supi3.lbd import (
     CounterState,
     clocks_per_bit,
     counter_step,
+    sample_phase,
     send_countdown,
 )
 from support import bad, lbd_breaks
@@ -279,6 +280,8 @@ def test_timing_constants() -> None:
     (lambda: counter_step(CounterState(), bad(True)), "level"),
     (lambda: counter_step(CounterState(), bad("1")), "level"),
     (lambda: clocks_per_bit(2), "fast"),
+    (lambda: send_countdown(32), "cpb"),
+    (lambda: sample_phase(bad(16.0)), "cpb"),
     (lambda: clocks_per_bit(bad(None)), "fast"),
     (lambda: wire.count_bit(13, 0, 1), "position"),
     (lambda: wire.count_bit(4, 2, 1), "level"),

@@ -84,8 +84,8 @@ def test_counter_telegrams_pass_incremented(fast: int) -> None:
                                                  (BranchKind.LBD_OR, 3, 1), (BranchKind.LBD_MR, 2, 0)])  # fmt: skip
 def test_every_break_gives_the_transaction_levels_count_at_pin_level(kind: BranchKind, m: int, fast: int) -> None:
     """The master's traffic cut in the middle of a data sequence: the blocks behind the break (forward, and in
-    LBD-MR the looped return line) bring the BK counter telegrams with exactly ``ring.lbd_count``'s count, the
-    first one within COUNTER_SILENCE_BITS + 13 + 3 bits per block after the break."""
+    LBD-MR the looped return line) bring the BK counter telegrams with exactly ``ring.lbd_count``'s count: two
+    within 2 x (COUNTER_SILENCE_BITS + 1) + 3 per block + 20 bit periods of the break."""
     frame = wire.Frame.build(Cycle.ID, wire.LOOPBACK_BYTES_ON_LINE + bytes(range(8)))
     head = np.concatenate([wire.status_levels(Cycle.DATA, False, 3), wire.frame_levels(frame)[:50]])
     for forward, back, behind in lbd_breaks(kind, m):

@@ -37,7 +37,7 @@ from supi3.interbus import wire
 from supi3.interbus.errors import InterbusArgumentError
 from supi3.pinlevel import Pin
 from supi3.pinout import SYNC_STAGES
-from supi3.tables import BIT_RATES, CLOCK_HZ
+from supi3.tables import BIT_RATES
 
 __all__ = [
     "COUNTER_INPUTS",
@@ -56,7 +56,7 @@ __all__ = [
 ]
 
 # BK-30 A line that stays at the idle level for this many bit periods is silent: the frame is forgotten and the next
-# bit period starts a generated counter telegram (and so on, one every COUNTER_SILENCE_BITS + 13 bit periods). More
+# idle bit period starts a generated counter telegram (and so on, one every COUNTER_SILENCE_BITS + 1 bit periods). More
 # than twice the longest idle-level run of working traffic (12, tested), far below the BK's 10 ms branch silence
 # (BK-3) and the 20 ms idle time-out (A13); a power of two.
 COUNTER_SILENCE_BITS: Final = 32
@@ -88,8 +88,6 @@ class Kind(IntEnum):
     """Repeat it; the header so far (bits 0..2) is a counter telegram's and no frame is open."""
     COUNT = 2
     """A counter telegram: increment it (bits 4..10) and keep its count."""
-    GENERATE = 3
-    """Send :data:`GENERATED_TELEGRAM` (the line is silent)."""
 
 
 class CounterState(NamedTuple):
@@ -145,7 +143,7 @@ def _check_state(state: object) -> CounterState:
         _refuse("state", "a CounterState", state)
     bit, data, kind, carry, frame, quiet, byte, counted, gen, drop = state
     if (type(bit) is type(data) is type(carry) is type(frame) is type(quiet) is type(byte) is type(counted)
-            is type(gen) is type(drop) is int and type(kind) in (Kind, int) and 0 <= kind <= Kind.GENERATE
+            is type(gen) is type(drop) is int and type(kind) in (Kind, int) and 0 <= kind <= Kind.COUNT
             and 0 <= bit <= IDLE_BIT and 0 <= gen <= IDLE_BIT and 0 <= quiet <= COUNTER_SILENCE_BITS
             and not (data | carry | frame | drop) >> 1 and 0 <= byte <= 0xFF and 0 <= counted <= wire.COUNTER_MAX):
         return state
@@ -243,13 +241,20 @@ def clocks_per_bit(fast: int) -> int:
     """Clocks per bit period for the ``fast`` input: 16 at 2 Mbit/s, 64 at 500 kbit/s (1.7.1, Table 1-7)."""
     if type(fast) is not int or fast not in (0, 1):
         _refuse("fast", "0 (500 kbit/s) or 1 (2 Mbit/s)", fast)
-    return CLOCK_HZ // max(BIT_RATES) if fast else CLOCK_HZ // min(BIT_RATES)
+    return wire.clocks_per_bit(max(BIT_RATES) if fast else min(BIT_RATES))
+
+
+def _check_cpb(cpb: object) -> int:
+    rates = tuple(wire.clocks_per_bit(rate) for rate in BIT_RATES)
+    if type(cpb) is not int or cpb not in rates:
+        _refuse("cpb", f"clocks per bit at a bit rate of Table 1-7, one of {rates}", cpb)
+    return cpb
 
 
 def sample_phase(cpb: int) -> int:
     """The clock of a bit period (0: the first, where a start level restarts the grid) at which the line is
     sampled: mid-bit (A1, M7)."""
-    return cpb // 2
+    return _check_cpb(cpb) // 2
 
 
 def send_countdown(cpb: int) -> int:
@@ -257,6 +262,7 @@ def send_countdown(cpb: int) -> int:
     (M8): the bit goes out ``REPEATER_DELAY_BITS`` bit periods after it began on the pin, the synchroniser's
     ``SYNC_STAGES`` clocks included, for one bit period. A sample's entry is on the line while its countdown is
     1..``cpb``."""
+    cpb = _check_cpb(cpb)
     return wire.REPEATER_DELAY_BITS * cpb - SYNC_STAGES + sample_phase(cpb) - 1
 
 
@@ -265,7 +271,7 @@ def _slots() -> int:
     least half a bit plus one clock apart: a stop bit sampled mid-bit, a start level on the next clock)."""
     most = 0
     for rate in BIT_RATES:
-        cpb = CLOCK_HZ // rate
+        cpb = wire.clocks_per_bit(rate)
         begins = send_countdown(cpb) - cpb + 1
         most = max(most, (begins - 2) // (sample_phase(cpb) + 1) + 1)
     return most + 1
