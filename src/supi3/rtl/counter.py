@@ -7,8 +7,9 @@ generator and the dropped telegram) is re-implemented here in gates, every const
 elaboration; the clock timing (the bit grid restarted by a start level, the mid-bit sample
 :func:`~supi3.lbd.sample_phase`, the output queue of :data:`~supi3.lbd.OUTPUT_SLOTS`
 countdowns loaded with :func:`~supi3.lbd.send_countdown`, as the core's transmitter, M8) is that of the
-pin model :mod:`supi3.model.blocks.counter` (its module docstring), which ``tests/test_verif_lockstep_counter.py``
-holds this block to, cycle by cycle. Not instantiated in ``Supi3Core`` yet (docs/rtl.md, "Counter telegram block").
+pin model ``CounterBlock`` (``src/supi3/model/blocks/counter.py``, its module docstring), which
+``tests/test_verif_lockstep_counter.py`` holds this block to, cycle by cycle. Not instantiated in ``Supi3Core``
+yet (docs/rtl.md, "Counter telegram block").
 """
 
 from __future__ import annotations
