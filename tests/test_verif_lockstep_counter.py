@@ -114,7 +114,9 @@ telegrams, frames, silences around COUNTER_SILENCE_BITS, INTERBUS resets, glitch
 @given(segments=st.lists(SEGMENT, min_size=6, max_size=14))
 def test_random_line_streams(segments: list[Levels]) -> None:
     """Any mix of telegrams, frames, counter telegrams, silences, INTERBUS resets, glitches and skews: the RTL
-    equals the model on every output, every clock (and ends with the generator's telegrams after a silence)."""
-    line = np.concatenate([*segments, samples(idle(S + 14))])
+    equals the model on every output, every clock (and the generator runs in the final silence)."""
+    line = np.concatenate([*segments, samples(idle(2 * S + 30))])
     outputs = lockstep(line, 1)
-    assert any(o["drive"] for o in outputs[-16 * 14 :])
+    # the generator runs at the latest S + 16 bit periods into the final silence (a telegram may end 13 in), one
+    # telegram every S + 1: the last S + 16 bit periods hold driven bits
+    assert any(o["drive"] for o in outputs[-16 * (S + 16) :])
