@@ -33,6 +33,7 @@ from supi3.config import DeviceConfig, decode
 from supi3.expansion import IDLE as EXPANSION_IDLE
 from supi3.expansion import ExpansionLevels, chain_to_line, line_to_chain
 from supi3.interbus import wire
+from supi3.interbus.ring import BranchKind
 from supi3.interbus.wire import Cycle, Frame
 from supi3.model.blocks.optical import OpticalBlock
 from supi3.model.bus_terminal import LBST_PIN
@@ -572,3 +573,15 @@ def run_optical(rows: list[dict[str, int]]) -> tuple[OpticalBlock, list[dict[str
     """The optical block's outputs for every row, and the block after them."""
     block = OpticalBlock()
     return block, [block.step(row) for row in rows]
+
+
+# The counter telegram (issue 12): the breaks of an LBD branch for supi3.lbd, model.blocks.counter, rtl.counter ------
+
+
+def lbd_breaks(kind: BranchKind, m: int) -> list[tuple[set[int], set[int], int]]:
+    """Every single break of an LBD branch of ``m`` devices as ``ring.lbd_count`` takes it (forward, back), with the
+    blocks behind it on the data path: the forward lines into devices k..m, then in LBD-MR the return lines m..1."""
+    found = [({k}, set[int](), m - k + 1 + (m if kind is BranchKind.LBD_MR else 0)) for k in range(1, m + 1)]
+    if kind is BranchKind.LBD_MR:
+        found += [(set(), {c}, c) for c in range(1, m)]
+    return found

@@ -38,7 +38,9 @@ def test_counter_telegram_round_trips_every_count_and_is_a_data_telegram() -> No
 
 
 def test_counter_telegram_is_told_from_every_other_data_telegram() -> None:
-    counters = {wire.counter_telegram(c) for c in range(1, wire.COUNTER_MAX + 1)}
+    counters = {wire.counter_telegram(c) for c in range(1, wire.COUNTER_MAX + 1)} | {
+        wire.data_telegram(wire.COUNTER_SATURATED_MARK | c, Cycle.ID, True) for c in range(wire.COUNTER_MAX + 1)
+    }  # saturated counts (BK-31)
     for byte, cycle, check in itertools.product(range(256), Cycle, (False, True)):
         word = wire.data_telegram(byte, cycle, check)
         assert (wire.decode_counter_telegram(word) is not None) == (word in counters)

@@ -479,10 +479,14 @@ def decode_optical_status(byte: int) -> tuple[bool, bool, bool] | None:
 # ================================================================================================================
 
 # BK-6 The counter telegram: a data telegram with select = ID and control = check, sent outside any frame by the
-# first device behind a break in place of idle status telegrams; its byte is the count, COUNTER_MARK in bits 7..6.
+# first device behind a break in place of idle status telegrams; its byte is the count (bits 5..0, LSB first on the
+# line in bit periods 4..9) under a 2-bit mark (bits 7..6): COUNTER_MARK, or COUNTER_SATURATED_MARK once a count
+# went past COUNTER_MAX. Devices increment it serially in flight (count_bit, BK-31), so the mark, which comes after
+# the count, takes the carry out of the count: a saturated count stays saturated.
 COUNTER_CYCLE: Final = Cycle.ID
 COUNTER_CHECK: Final = True
 COUNTER_MARK: Final = 0b10 << 6
+COUNTER_SATURATED_MARK: Final = 0b11 << 6
 COUNTER_MAX: Final = 0x3F
 """The count saturates here (6 bits); a saturated count locates nothing (BK-6)."""
 
@@ -493,14 +497,34 @@ BK_STATUS_CONF_BIT: Final = 7
 BK_STATUS_CLOSED_BIT: Final = 6
 
 
+COUNT_FIRST_BIT: Final = POS_DATA
+"""The bit period of a counter telegram's count LSB (data bit 0)."""
+COUNT_BITS: Final = COUNTER_MAX.bit_length()
+SATURATION_BIT: Final = POS_DATA + COUNT_BITS
+"""The bit period of the mark bit (data bit 6) that turns COUNTER_MARK into COUNTER_SATURATED_MARK."""
+
+
 def counter_telegram(count: int) -> int:
     """Encode the counter telegram carrying ``count`` (1..``COUNTER_MAX``) as a data telegram (BK-6)."""
     count = _int("count", count, 1, COUNTER_MAX, "BK-6: a counter telegram counts 1..63 devices")
     return data_telegram(COUNTER_MARK | count, COUNTER_CYCLE, COUNTER_CHECK)
 
 
+def counter_count(byte: int) -> int | None:
+    """The count a counter telegram's byte stands for: the count under COUNTER_MARK (1..63), ``COUNTER_MAX`` under
+    COUNTER_SATURATED_MARK whatever the count bits; ``None`` for any other byte (BK-6, BK-31)."""
+    byte = _int("byte", byte, 0, 0xFF, "BK-6: a counter telegram carries one byte")
+    mark = byte & ~COUNTER_MAX
+    if mark == COUNTER_SATURATED_MARK:
+        return COUNTER_MAX
+    if mark != COUNTER_MARK or byte == COUNTER_MARK:
+        return None
+    return byte & COUNTER_MAX
+
+
 def decode_counter_telegram(word: int) -> int | None:
-    """The count of a counter telegram, ``None`` if ``word`` is no counter telegram (BK-6)."""
+    """The count of a counter telegram (:func:`counter_count` of its byte), ``None`` if ``word`` is no counter
+    telegram (BK-6)."""
     word = _int("word", word, 0, (1 << DATA_TELEGRAM_BITS) - 1, "a data telegram is 13 bit periods")
     try:
         telegram = decode_telegram(word, DATA_TELEGRAM_BITS)
@@ -508,18 +532,54 @@ def decode_counter_telegram(word: int) -> int | None:
         return None
     if telegram.data is None or (telegram.cycle, telegram.check) != (COUNTER_CYCLE, COUNTER_CHECK):
         return None
-    if telegram.data & ~COUNTER_MAX != COUNTER_MARK or telegram.data & COUNTER_MAX == 0:
-        return None
-    return telegram.data & COUNTER_MAX
+    return counter_count(telegram.data)
+
+
+def count_bit(position: int, level: int, carry: int) -> tuple[int, int]:
+    """One bit period of the serial increment a device applies to a counter telegram in flight (BK-31).
+
+    Parameters
+    ----------
+    position:
+        The bit period in the telegram (0..12).
+    level:
+        The level received in it.
+    carry:
+        The carry into it: 1 at the start of the telegram (the increment), then what this function returned.
+
+    Returns
+    -------
+    tuple[int, int]
+        The level to send and the carry into the next bit period. Count bits (``COUNT_FIRST_BIT`` ..) send
+        ``level XOR carry`` and carry on ``carry AND level``; the mark bit at ``SATURATION_BIT`` is sent ORed with
+        the carry out of the count (63 + 1 sets COUNTER_SATURATED_MARK, which stays set); every other bit goes on
+        unchanged. Each sent level depends only on bits received up to it, so a repeater with any delay can apply it.
+    """
+    position = _int("position", position, 0, DATA_TELEGRAM_BITS - 1, "a data telegram is 13 bit periods")
+    level, carry = _int("level", level, 0, 1), _int("carry", carry, 0, 1)
+    if COUNT_FIRST_BIT <= position < SATURATION_BIT:
+        return level ^ carry, carry & level
+    if position == SATURATION_BIT:
+        return level | carry, 0
+    return level, carry
+
+
+_COUNT_ZERO: Final = data_telegram(COUNTER_MARK, COUNTER_CYCLE, COUNTER_CHECK)
+"""What a device behind a break increments in its mind: count 0 (not itself a counter telegram)."""
 
 
 def count_on(word: int | None) -> int:
     """What a device behind a break sends on: ``None`` (it receives nothing: it is the first behind the break)
-    starts the count at 1, a counter telegram is passed on incremented, saturating at ``COUNTER_MAX`` (BK-6)."""
-    count = 0 if word is None else decode_counter_telegram(word)
-    if count is None:
+    starts the count at 1, a counter telegram is passed on incremented bit by bit (:func:`count_bit`): 63 and a
+    saturated count give a saturated count (BK-6, BK-31)."""
+    if word is not None and decode_counter_telegram(word) is None:
         raise InterbusError("docs/interbus.md, Counter telegram", word, "a device passes on counter telegrams only")
-    return counter_telegram(min(count + 1, COUNTER_MAX))
+    received = _COUNT_ZERO if word is None else word
+    sent, carry = 0, 1
+    for position in range(DATA_TELEGRAM_BITS):
+        level, carry = count_bit(position, (received >> position) & 1, carry)
+        sent |= level << position
+    return sent
 
 
 class BkStatus(NamedTuple):

@@ -1,0 +1,172 @@
+"""The counter telegram block in Amaranth: one line direction of a chip in an LBD mode (manual 2.2.2, Table 2-5),
+with the ports of :data:`supi3.lbd.COUNTER_INPUTS` / ``COUNTER_OUTPUTS``.
+
+The bit-period transition :func:`supi3.lbd.counter_step` (receiver framing, recognition at the control
+bit, the serial increment ``wire.count_bit`` with its saturation mark, the frame flag, the silence count, the
+generator and the dropped telegram) is re-implemented here in gates, every constant taken from the spec at
+elaboration; the clock timing (the bit grid restarted by a start level, the mid-bit sample
+:func:`~supi3.lbd.sample_phase`, the output queue of :data:`~supi3.lbd.OUTPUT_SLOTS`
+countdowns loaded with :func:`~supi3.lbd.send_countdown`, as the core's transmitter, M8) is that of the
+pin model ``CounterBlock`` (``src/supi3/model/blocks/counter.py``, its module docstring), which
+``tests/test_verif_lockstep_counter.py`` holds this block to, cycle by cycle. Not instantiated in ``Supi3Core``
+yet (docs/rtl.md, "Counter telegram block").
+"""
+
+from __future__ import annotations
+
+from typing import Final
+
+from amaranth.hdl import Cat, Const, Module, Mux, Signal, Value
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+from supi3.interbus import wire
+from supi3.lbd import (
+    COUNTER_INPUTS,
+    COUNTER_OUTPUTS,
+    COUNTER_SILENCE_BITS,
+    GENERATED_TELEGRAM,
+    IDLE_BIT,
+    OUTPUT_SLOTS,
+    Kind,
+    clocks_per_bit,
+    sample_phase,
+    send_countdown,
+)
+
+__all__ = ["CounterRtl"]
+
+_CPB: Final = (clocks_per_bit(0), clocks_per_bit(1))
+_IDLE_VALUE: Final = wire.IDLE_LEVEL
+"""A queue value (level in bit 0, drive in bit 1) for an idle line the block does not drive."""
+_MARK_SHIFT: Final = wire.COUNT_BITS
+
+
+def _by_rate(fast: Value, values: tuple[int, int]) -> Value:
+    """``values[fast]`` as a gate (500 kbit/s, 2 Mbit/s)."""
+    return Mux(fast, values[1], values[0])
+
+
+class CounterRtl(wiring.Component):
+    """The counter telegram block (ports: :data:`~supi3.lbd.COUNTER_INPUTS` in,
+    :data:`~supi3.lbd.COUNTER_OUTPUTS` out; the pin model ``CounterBlock`` defines their timing).
+    ``fast`` is a strap: change it only while the line is idle."""
+
+    def __init__(self) -> None:
+        super().__init__({
+            **{pin.name: In(pin.width) for pin in COUNTER_INPUTS},
+            **{pin.name: Out(pin.width) for pin in COUNTER_OUTPUTS},
+        })  # fmt: skip
+
+    def elaborate(self, _platform: object) -> Module:
+        m = Module()
+        sync, comb = m.d.sync, m.d.comb
+        line, fast = self.line, self.fast
+        countdown_max = max(send_countdown(cpb) for cpb in _CPB)
+
+        # State ---------------------------------------------------------------------------------------------------
+        phase = Signal(range(max(_CPB)))
+        pending = Signal()
+        bit = Signal(range(IDLE_BIT + 1), init=IDLE_BIT)
+        data = Signal(init=1)
+        kind = Signal(range(len(Kind)), init=Kind.PASS)
+        carry = Signal()
+        frame = Signal()
+        quiet = Signal(range(COUNTER_SILENCE_BITS + 1))
+        byte = Signal(8)
+        counted = Signal(wire.COUNT_BITS)
+        gen = Signal(range(IDLE_BIT + 1), init=IDLE_BIT)
+        drop = Signal()
+        seen = Signal()
+        countdown = [Signal(range(countdown_max + 1), name=f"tx{k}_count") for k in range(OUTPUT_SLOTS)]
+        value = [Signal(2, name=f"tx{k}_value", init=_IDLE_VALUE) for k in range(OUTPUT_SLOTS)]
+
+        # The bit grid and the sample -----------------------------------------------------------------------------
+        cpb = _by_rate(fast, _CPB)
+        idle_rx = bit == IDLE_BIT
+        restart = idle_rx & ~pending & (line == wire.START_LEVEL)
+        ph = Mux(restart, 0, phase)
+        sample = ph == _by_rate(fast, (sample_phase(_CPB[0]), sample_phase(_CPB[1])))
+        sync += phase.eq(Mux(ph >= cpb - 1, 0, ph + 1))
+        with m.If(restart):
+            sync += pending.eq(1)
+        sync += seen.eq(0)
+        for r in countdown:
+            with m.If(r != 0):
+                sync += r.eq(r - 1)
+
+        # The receiver (counter_step's _receive) ------------------------------------------------------------------
+        rx_out, rx_drive, begin, seen_now = Signal(), Signal(), Signal(), Signal()
+        last = Mux(data, bit == wire.DATA_TELEGRAM_BITS - 1, bit == wire.STATUS_TELEGRAM_BITS - 1)
+        counting = (bit >= wire.COUNT_FIRST_BIT) & (bit < wire.SATURATION_BIT)
+        saturating = bit == wire.SATURATION_BIT
+        comb += rx_out.eq(line)
+        mark = byte[_MARK_SHIFT:]
+        saturated = mark == wire.COUNTER_SATURATED_MARK >> _MARK_SHIFT
+        valid = saturated | ((mark == wire.COUNTER_MARK >> _MARK_SHIFT) & (byte[:_MARK_SHIFT] != 0))
+        with m.If(sample):
+            sync += pending.eq(0)
+            with m.If(idle_rx):
+                with m.If(line == wire.START_LEVEL):
+                    comb += begin.eq(1)
+                with m.Else():
+                    sync += quiet.eq(Mux(quiet == COUNTER_SILENCE_BITS, quiet, quiet + 1))
+                    with m.If(quiet + 1 >= COUNTER_SILENCE_BITS):
+                        sync += frame.eq(0)
+            with m.Else():
+                sync += bit.eq(bit + 1)
+                with m.If(bit == wire.POS_TYPE):
+                    sync += data.eq(line == wire.TYPE_DATA_LEVEL)
+                    with m.If(line != wire.TYPE_DATA_LEVEL):
+                        sync += kind.eq(Kind.PASS)
+                with m.Elif(bit == wire.POS_SELECT):
+                    sync += kind.eq(Mux(line == wire.SELECT_ID_LEVEL, kind, Kind.PASS))
+                with m.Elif(bit == wire.POS_CONTROL):
+                    check = line == wire.CONTROL_CHECK_LEVEL
+                    sync += [frame.eq(Mux(data, Mux(check, frame, 1), 0)),
+                             kind.eq(Mux((kind == Kind.MAYBE) & check, Kind.COUNT, Kind.PASS))]  # fmt: skip
+                with m.Elif(kind == Kind.COUNT):
+                    comb += [rx_out.eq(Mux(counting, line ^ carry, Mux(saturating, line | carry, line))),
+                             rx_drive.eq(1)]  # fmt: skip
+                    sync += carry.eq(Mux(counting, carry & line, Mux(saturating, 0, carry)))
+                    with m.If(bit < wire.POS_DATA + 8):
+                        sync += byte.eq(Cat(byte[1:], line))
+                with m.If(last):
+                    with m.If(line != wire.STOP_LEVEL):
+                        comb += begin.eq(1)  # M16
+                    with m.Else():
+                        sync += [bit.eq(IDLE_BIT), drop.eq(0)]
+                        with m.If((kind == Kind.COUNT) & valid):
+                            sync += counted.eq(Mux(saturated, wire.COUNTER_MAX, byte[:_MARK_SHIFT]))
+                            comb += seen_now.eq(1)
+            with m.If(begin):
+                sync += [bit.eq(1), data.eq(1), kind.eq(Mux(frame, Kind.PASS, Kind.MAYBE)), carry.eq(1),
+                         quiet.eq(0), drop.eq((gen != IDLE_BIT) | (drop & ~idle_rx))]  # fmt: skip
+
+            # The generator and what goes out ----------------------------------------------------------------------
+            silent = idle_rx & (line == wire.IDLE_LEVEL) & (quiet == COUNTER_SILENCE_BITS)
+            out, drive = Signal(), Signal()
+            with m.If((gen != IDLE_BIT) | silent):
+                k = Mux(silent, 0, gen)
+                comb += [out.eq(Const(GENERATED_TELEGRAM, wire.DATA_TELEGRAM_BITS).bit_select(k, 1)), drive.eq(1)]
+                sync += gen.eq(k + 1)  # the stop bit's k + 1 is IDLE_BIT
+                with m.If(silent):
+                    sync += quiet.eq(0)
+            with m.Elif(drop & ~idle_rx):
+                comb += [out.eq(wire.IDLE_LEVEL), drive.eq(1)]
+            with m.Else():
+                comb += [out.eq(rx_out), drive.eq(rx_drive)]
+            sync += [seen.eq(seen_now), countdown[0].eq(_by_rate(fast, (send_countdown(_CPB[0]),
+                                                                          send_countdown(_CPB[1])))),
+                     value[0].eq(Cat(out, drive))]  # fmt: skip
+            for k_slot in range(1, OUTPUT_SLOTS):
+                previous = countdown[k_slot - 1]
+                sync += [countdown[k_slot].eq(Mux(previous != 0, previous - 1, 0)),
+                         value[k_slot].eq(value[k_slot - 1])]  # fmt: skip
+
+        # Outputs -------------------------------------------------------------------------------------------------
+        shown: Value = Const(_IDLE_VALUE, 2)
+        for r, v in reversed(list(zip(countdown, value, strict=True))):
+            shown = Mux(r <= cpb, Mux(r != 0, v, _IDLE_VALUE), shown)
+        comb += [self.out.eq(shown[0]), self.drive.eq(shown[1]), self.seen.eq(seen), self.count.eq(counted)]
+        return m
