@@ -368,7 +368,8 @@ class Board:
     # -- running -----------------------------------------------------------------------------------------------
 
     def run(self, cycles: int, *, max_instructions: int = DEFAULT_MAX_INSTRUCTIONS) -> None:
-        """Run the firmware until ``cycles`` more master cycles have finished.
+        """Run the firmware until ``cycles`` more master cycles have finished and it has served the interrupts they
+        raised (as :meth:`Bench.run` takes the last cycle's interrupt).
 
         Raises
         ------
@@ -380,7 +381,7 @@ class Board:
             In strict mode, the first rule the firmware broke, with a note: bus time, PC and function.
         """
         target = self.bench.cycles + check_int("cycles", cycles, 0)
-        self._run(lambda: self.bench.cycles >= target, max_instructions)
+        self._run(lambda: self.bench.cycles >= target and not self.core.in_exception, max_instructions)
 
     def run_for(self, seconds: float, *, max_instructions: int = DEFAULT_MAX_INSTRUCTIONS) -> None:
         """Run the firmware for ``seconds`` of bus time (raises as :meth:`run`)."""
@@ -391,9 +392,11 @@ class Board:
         core = self.core
         limit = core.instructions + check_int("max_instructions", max_instructions, 1)
         self.sync(core.cycles)
-        while not done():
+        while True:
             core.systick.update()
             self._request()
+            if done():
+                return
             if core.instructions >= limit:
                 raise FirmwareStoppedError(core.report(Stop.BUDGET, f"instruction budget of {max_instructions} used up "
                                                   "(an endless loop?)"))  # fmt: skip

@@ -47,30 +47,31 @@ def toolchain_missing() -> str | None:
 
 def build_command(sources: Sequence[str | Path], output: str | Path, *, cpu: str = "cortex_m3",
                   defines: Mapping[str, str] | None = None, include_dirs: Iterable[str | Path] = (),
-                  compiler_rt: bool = False) -> list[str]:  # fmt: skip
+                  compiler_rt: bool = False, port: bool = True) -> list[str]:  # fmt: skip
     """The command line :func:`build` runs (see the module's docstring)."""
     if cpu not in CPUS:
         raise ArgumentError("cpu", cpu, f"cpu must be one of {', '.join(CPUS)}, not {cpu!r}")
     paths = [Path(s) for s in sources]
     for path in paths:
-        if not path.is_file() or path.suffix != ".c":
-            raise ArgumentError("sources", path, f"sources must be paths of existing .c files, not {str(path)!r}")
+        if not path.is_file() or path.suffix not in (".c", ".S"):
+            raise ArgumentError("sources", path, f"sources must be paths of existing .c or .S files, not {str(path)!r}")
     includes = (sdk.include_dir(), sdk.SDK_DIR / "examples", BOARD_DIR, *(Path(d) for d in include_dirs))
     macros = [f"-D{name}={value}" for name, value in sorted((defines or {}).items())]
+    library = (BOARD_DIR / "startup.c", BOARD_DIR / "board.c", *sdk.sources()) if port else ()
     return [sys.executable, "-m", "ziglang", "cc", f"-mcpu={cpu}", *FLAGS, *(["-lcompiler_rt"] if compiler_rt else []),
-            "-T", str(BOARD_DIR / "board.ld"), *macros, *(f"-I{d}" for d in includes),
-            str(BOARD_DIR / "startup.c"), str(BOARD_DIR / "board.c"), *map(str, sdk.sources()), *map(str, paths),
-            "-o", str(output)]  # fmt: skip
+            "-T", str(BOARD_DIR / "board.ld"), *macros, *(f"-I{d}" for d in includes), *map(str, library),
+            *map(str, paths), "-o", str(output)]  # fmt: skip
 
 
 def build(sources: str | Path | Sequence[str | Path], output: str | Path, *, cpu: str = "cortex_m3",
           defines: Mapping[str, str] | None = None, include_dirs: Iterable[str | Path] = (),
-          compiler_rt: bool = False) -> Path:  # fmt: skip
+          compiler_rt: bool = False, port: bool = True) -> Path:  # fmt: skip
     """Build the firmware ``sources`` (the ``fw_setup``/``fw_isr``/``fw_loop`` of ``examples/fw_board.h``) with the
     C driver and the board port into the ELF ``output`` for ``cpu`` (``"cortex_m3"`` or ``"cortex_m0"``).
 
     ``compiler_rt`` links the toolchain's run-time library, for firmware that needs more helpers than
-    ``startup.c`` has (its first build compiles it: about 15 s). Returns ``output``.
+    ``startup.c`` has (its first build compiles it: about 15 s). ``port=False`` links ``sources`` (C or assembly
+    with their own vector table) alone with ``board.ld``: no driver, no board port. Returns ``output``.
 
     Raises
     ------
@@ -82,7 +83,7 @@ def build(sources: str | Path | Sequence[str | Path], output: str | Path, *, cpu
         raise BuildError(missing)
     files = [sources] if isinstance(sources, str | Path) else list(sources)
     command = build_command(files, output, cpu=cpu, defines=defines, include_dirs=include_dirs,
-                            compiler_rt=compiler_rt)  # fmt: skip
+                            compiler_rt=compiler_rt, port=port)  # fmt: skip
     result = subprocess.run(command, capture_output=True, text=True, check=False)
     if result.returncode != 0:
         raise BuildError(f"the firmware does not build for {cpu}:\n{result.stderr}")

@@ -184,7 +184,7 @@ class FirmwareImage:
     segments: tuple[tuple[int, bytes], ...]
     entry: int
     symbols: dict[str, tuple[int, int]]
-    """name -> (address, size); Thumb functions without their bit 0."""
+    """name -> (address, size) of the functions, objects and labels; Thumb functions without their bit 0."""
 
     @classmethod
     def load(cls, path: str | Path) -> FirmwareImage:
@@ -205,7 +205,9 @@ class FirmwareImage:
                 symbols = {} if not isinstance(table, SymbolTableSection) else {
                     sym.name: (int(sym["st_value"]) & ~1 if sym["st_info"]["type"] == "STT_FUNC"
                                else int(sym["st_value"]), int(sym["st_size"]))
-                    for sym in table.iter_symbols() if sym.name and sym["st_info"]["type"] in ("STT_FUNC", "STT_OBJECT")
+                    for sym in table.iter_symbols()
+                    if sym.name and not sym.name.startswith("$") and sym["st_shndx"] != "SHN_UNDEF"
+                    and sym["st_info"]["type"] in ("STT_FUNC", "STT_OBJECT", "STT_NOTYPE")
                 }  # fmt: skip
                 return cls(path, segments, int(elf["e_entry"]), symbols)
         except (OSError, ELFError) as error:
@@ -339,6 +341,7 @@ class CortexM:
         """Called with the exception number after each exception entry (the board measures latency)."""
         self._costs: dict[tuple[int, int], tuple[int, int]] = {}
         self._block = (0, 0)  # address and cycle count at the entry of the block running
+        self._block_end = 0
         self.vtor = 0
         self.systick = SysTick(self)
         self._scs_words: dict[int, int] = {}
@@ -389,6 +392,10 @@ class CortexM:
     def reg(self, name: str) -> int:
         """One register by name (``r0``..``r12``, ``sp``, ``lr``, ``pc``, ``xpsr``, ``primask``, ``control``)."""
         return int(self.uc.reg_read(getattr(arm, f"UC_ARM_REG_{name.upper()}")))
+
+    def set_reg(self, name: str, value: int) -> None:
+        """Write one register by name (as :meth:`reg`), between runs."""
+        self.uc.reg_write(getattr(arm, f"UC_ARM_REG_{name.upper()}"), value)
 
     def registers(self) -> dict[str, int]:
         """R0-R12, SP, LR, PC and xPSR."""
@@ -453,6 +460,11 @@ class CortexM:
         """Make exception ``number`` pending (an external interrupt: ``EXTERNAL + irq``)."""
         self.pending.add(number)
         self.sleeping = False if self._takeable() is not None else self.sleeping
+
+    @property
+    def in_exception(self) -> bool:
+        """An exception is active, or pending and allowed to preempt: the core has interrupt work to do."""
+        return bool(self.active) or self._takeable() is not None
 
     def _takeable(self) -> int | None:
         candidates = [n for n in self.pending if n < EXTERNAL or n in self.enabled]
@@ -531,6 +543,7 @@ class CortexM:
         if cost is None:
             cost = self._costs[key] = block_cost(self.read_bytes(address, size))
         self._block = (address, self.cycles)
+        self._block_end = address + size
         self.instructions += cost[0]
         self.cycles += cost[1]
 
@@ -578,12 +591,11 @@ class CortexM:
         if number is not None:
             what = "a breakpoint (BKPT)" if number == EXCP_BKPT else f"core exception {number}"
             raise FirmwareStoppedError(self.report(Stop.FAULT, f"{what}: not modelled"))
+        if pc == self._block_end and self.read_bytes(pc - 2, 2) in (b"\x30\xbf", b"\x20\xbf"):
+            self.sleeping = True  # the last block ended in WFI or WFE: unicorn halts the core after them
+            return "sleep"
         if self.stop_request or self.cycles >= self.deadline:
             return "run"
-        halfword = struct.unpack("<H", self.read_bytes(pc - 2, 2))[0] if pc - 2 >= self.flash[0] else 0
-        if halfword in (0xBF30, 0xBF20):  # WFI, WFE: unicorn halts the core after them
-            self.sleeping = True
-            return "sleep"
         raise FirmwareStoppedError(self.report(Stop.FAULT, "the core stopped for no known reason"))
 
     def idle_loop(self) -> bool:
@@ -704,7 +716,9 @@ class SysTick:
         self.rvr = 0
         self._start = 0  # cycle at which the counter held _value
         self._value = 0
-        self._flag_checked = 0  # ticks up to which COUNTFLAG was reported
+        self._seen = 0  # zeros since the base that pended the exception (or were passed with TICKINT off)
+        self._flag_zeros = 0  # zeros since the base that COUNTFLAG reported
+        self._flag = False  # a zero before the last rebase that COUNTFLAG has not reported
 
     @property
     def enabled(self) -> bool:
@@ -725,46 +739,48 @@ class SysTick:
         return self.rvr - (ticks - self._value - 1) % (self.rvr + 1)
 
     def _zeros_until(self, ticks: int) -> int:
-        """How many times the counter reached 0 from 1 in the first ``ticks`` ticks."""
-        first = self._value if self._value else self._value + self.rvr + 1
+        """How many times the counter reached 0 from 1 in the first ``ticks`` ticks after the base."""
         if self.rvr == 0 and not self._value:
             return 0
+        first = self._first()
         if ticks < first:
             return 0
         return 1 + ((ticks - first) // (self.rvr + 1) if self.rvr else 0)
 
+    def _first(self) -> int:
+        """Ticks from the base to the first time the counter reaches 0."""
+        return self._value if self._value else self.rvr + 1
+
     def next_event(self) -> int | None:
         """The cycle of the next wrap that pends the SysTick exception (TICKINT), or ``None``."""
-        if not self.enabled or not self.csr & 2:
+        if not self.enabled or not self.csr & 2 or (self.rvr == 0 and (self._seen or not self._value)):
             return None
-        ticks = self._ticks(self.core.cycles)
-        count = self._zeros_until(ticks)
-        first = self._value if self._value else self._value + self.rvr + 1
-        if self.rvr == 0 and count:
-            return None
-        at = first + count * (self.rvr + 1)
+        at = self._first() + self._seen * (self.rvr + 1)
         return self._start + at * self._divider()
 
     def update(self) -> None:
-        """Pend the exception for wraps up to now (TICKINT)."""
-        event = self.next_event()
-        if event is not None and event <= self.core.cycles:
-            self._rebase(self.core.cycles)
-            self.core.pend(SYSTICK)
+        """Pend the exception if the counter reached 0 since the last update (TICKINT)."""
+        zeros = self._zeros_until(self._ticks(self.core.cycles))
+        if zeros > self._seen:
+            self._seen = zeros
+            if self.csr & 2:
+                self.core.pend(SYSTICK)
 
     def _rebase(self, cycles: int) -> None:
         ticks = self._ticks(cycles)
+        zeros = self._zeros_until(ticks)
+        self._flag = self._flag or zeros > self._flag_zeros
         self._value = self._value_after(ticks)
         self._start += ticks * self._divider()
-        self._flag_checked = 0
+        self._seen = self._flag_zeros = 0
 
     def read(self, offset: int) -> int:
         """CSR (COUNTFLAG clears on read), RVR, CVR, CALIB."""
         cycles = self.core.cycles_now()
         if offset == 0x0:
-            ticks = self._ticks(cycles)
-            flag = self._zeros_until(ticks) > self._zeros_until(self._flag_checked)
-            self._flag_checked = ticks
+            zeros = self._zeros_until(self._ticks(cycles))
+            flag = self._flag or zeros > self._flag_zeros
+            self._flag, self._flag_zeros = False, zeros
             return self.csr | (flag << 16)
         if offset == 0x4:
             return self.rvr
@@ -783,4 +799,5 @@ class SysTick:
             self.rvr = value & SYST_MAX
         elif offset == 0x8:
             self._value = 0
+            self._flag = False
         self.core.stop_request = True  # the next wrap may come sooner: the run loop recomputes its deadline

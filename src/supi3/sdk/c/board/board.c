@@ -23,13 +23,17 @@ static volatile uint32_t irq_noted;
 
 #define PIN(n) (1u << (n))
 #define SYST_MAX 0x00FFFFFFu
+/* Table 3-7 at 500 kbit/s (they halve at 2 Mbit/s): t2 min, t6 max, t8 min in ns; CPU clocks for ns, rounded up. */
+#define BOARD_T2_NS 375u
+#define BOARD_T6_MAX_NS 375u
+#define BOARD_T8_NS 125u
+#define BOARD_NS_CYCLES(ns) (((ns) * (BOARD_SYSCLK_HZ / 1000000u) + 999u) / 1000u)
 
-/* Busy wait on the free-running SysTick (a 24-bit down counter at the CPU clock). */
-static void board_delay_us(void *user, uint32_t us)
+/* Busy wait for at least `cycles` CPU clocks on the free-running SysTick (a 24-bit down counter at the CPU clock). */
+static void board_wait_cycles(uint32_t cycles)
 {
-    uint32_t left = us * (BOARD_SYSCLK_HZ / 1000000u);
+    uint32_t left = cycles;
     uint32_t last = SYST_CVR;
-    (void)user;
     while (left != 0u) {
         uint32_t now = SYST_CVR;
         uint32_t passed = (last - now) & SYST_MAX;
@@ -38,7 +42,15 @@ static void board_delay_us(void *user, uint32_t us)
     }
 }
 
-/* One byte, one /SS frame (supi3.h transport contract; RM0008 25.3.5, full-duplex master sequence). */
+static void board_delay_us(void *user, uint32_t us)
+{
+    (void)user;
+    board_wait_cycles(us * (BOARD_SYSCLK_HZ / 1000000u));
+}
+
+/* One byte, one /SS frame (supi3.h transport contract; RM0008 25.3.5, full-duplex master sequence). Table 3-7 at
+ * 500 kbit/s, the slower rate's longer times: /SS rises t2 after the last SCLK edge (BSY falls with it), and stays
+ * high until C/D has settled (t6 max) plus t8 before the next frame may begin. */
 static int board_xfer(void *user, uint8_t tx, uint8_t *rx, int s_r)
 {
     (void)user;
@@ -50,7 +62,9 @@ static int board_xfer(void *user, uint8_t tx, uint8_t *rx, int s_r)
     *rx = (uint8_t)SPI1_DR;
     while ((SPI1_SR & SPI_SR_BSY) != 0u) {
     }
+    board_wait_cycles(BOARD_NS_CYCLES(BOARD_T2_NS));
     GPIOA_BSRR = PIN(BOARD_PIN_SS);
+    board_wait_cycles(BOARD_NS_CYCLES(BOARD_T6_MAX_NS + BOARD_T8_NS));
     return 0;
 }
 

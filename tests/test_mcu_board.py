@@ -1,0 +1,112 @@
+"""Firmware in the loop: the SDK's example firmware as a Cortex-M0 and -M3 binary on the emulated board
+(supi3.mcu.board) against the transaction-level chip, with the INTERBUS master exchanging data.
+
+The binary is built once per module with ziglang (supi3.mcu.build: the C driver, the board port of
+src/supi3/sdk/c/board, the example) and must give the process data the host build gives on the firmware bench
+(tests/test_sdk_c_examples.py). Ref: 3.4.14 (interrupt-driven exchange), Table 3-7 (the frame timing the board
+checks), RM0008 (the board's peripherals).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from supi3.mcu import board as mcu_board
+from supi3.mcu import build as mcu_build
+from supi3.mcu.board import Board
+from supi3.mcu.core import CPUS
+from supi3.model.registers import InterfaceViolationError
+from supi3.sdk import native
+from supi3.sdk.bench import Bench
+from support import c_firmware
+
+pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
+
+WORDS = (0x0000, 0xFFFF, 0x1234, 0x8001, 0x00FF)
+"""As tests/test_sdk_c_examples.py."""
+
+
+@pytest.fixture(scope="module")
+def digital_io(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """The digital 16/16 example built for each core, once per module."""
+    folder = tmp_path_factory.mktemp("mcu")
+    return {cpu: mcu_build.build(native.example("digital_io"), folder / f"digital_io_{cpu}.elf", cpu=cpu)
+            for cpu in CPUS}  # fmt: skip
+
+
+def test_the_board_pins_are_board_h_s() -> None:
+    """The emulator's wiring constants are the board port's (board.h BOARD_PIN_*)."""
+    text = (mcu_build.BOARD_DIR / "board.h").read_text()
+    defined = {name: int(value) for name, value in re.findall(r"#define BOARD_PIN_(\w+) (\d+)u", text)}
+    for name in ("IRQ", "CD", "IO", "SAS_INIT", "SS", "STAT_ERR"):
+        assert getattr(mcu_board, f"PIN_{name}") == defined[name], name
+
+
+@pytest.mark.parametrize("cpu", CPUS)
+def test_digital_io_binary_gives_the_host_builds_process_data(
+    pytestconfig: pytest.Config, digital_io: dict[str, Path], cpu: str
+) -> None:
+    """SET 83h, ID 03h, then OUT0/OUT1 read and IN0/IN1 written in the EXTI0 handler after each VALID event: the
+    master's configuration and the data both ways are those of the same firmware compiled for the host."""
+    board = Board(digital_io[cpu], cpu=cpu)
+    assert board.fw_board is not None
+    fw = board.fw_board
+    board.run(3)
+    config = board.bench.master.config
+    assert config is not None and (config[0].id_code, config[0].data_bytes) == (0x03, 2)
+
+    outputs: list[bytes] = []
+    exchanged = []
+    for out_word, in_word in zip(WORDS, reversed(WORDS), strict=True):
+        board.bench.master.set_outputs(1, out_word.to_bytes(2, "big"))
+        fw.inputs = in_word.to_bytes(2, "big")
+        board.run(2)
+        outputs.append(fw.outputs[:2])
+        exchanged.append(board.bench.master.inputs(1))
+    assert fw.error == 0
+    assert fw.cycles == board.interrupts > 0  # one VALID event per data cycle, each served in the handler
+    assert board.violations == []
+
+    assert pytestconfig.cache is not None
+    host = c_firmware(pytestconfig.cache, native.example("digital_io"))
+    bench = Bench(firmware=host)
+    bench.run(3)
+    host_outputs: list[bytes] = []
+    host_exchanged = []
+    for out_word, in_word in zip(WORDS, reversed(WORDS), strict=True):
+        bench.master.set_outputs(1, out_word.to_bytes(2, "big"))
+        for k, value in enumerate(in_word.to_bytes(2, "big")):
+            host.board.inputs[k] = value
+        bench.run(2)
+        host_outputs.append(bytes(host.board.outputs[0:2]))
+        host_exchanged.append(bench.master.inputs(1))
+    assert outputs == host_outputs == [w.to_bytes(2, "big") for w in WORDS]
+    assert exchanged == host_exchanged == [w.to_bytes(2, "big") for w in reversed(WORDS)]
+
+
+@pytest.mark.parametrize("cpu", CPUS)
+def test_a_sleeping_core_enters_the_handler_in_its_interrupt_latency(digital_io: dict[str, Path], cpu: str) -> None:
+    """The example sleeps in WFI between cycles: from the falling edge of /IRQ to the handler's first instruction
+    is the core's exception entry, 12 cycles on the Cortex-M3 and 16 on the Cortex-M0 at 48 MHz (MCU-2)."""
+    board = Board(digital_io[cpu], cpu=cpu)
+    board.run(6)
+    assert board.interrupts >= 3
+    assert board.irq_latency_s == pytest.approx(CPUS[cpu].entry_cycles / 48e6)
+
+
+def test_a_too_fast_sclk_is_caught_with_the_program_counter(tmp_path: Path) -> None:
+    """BOARD_SPI_BR = 0 (f_PCLK / 2 = 24 MHz) breaks Table 3-7's t0 (667 ns at 500 kbit/s): strict mode stops the
+    run at the first byte, the note names the transport function; non-strict mode records each byte."""
+    elf = mcu_build.build(native.example("digital_io"), tmp_path / "fast.elf", defines={"BOARD_SPI_BR": "0u"})
+    board = Board(elf)
+    with pytest.raises(InterfaceViolationError, match=r"SCLK period 42 ns, shorter than t0 = 667 ns") as caught:
+        board.run(1)
+    assert caught.value.rule == "Table 3-7 t0"
+    assert any("in board_xfer()" in note for note in caught.value.__notes__)
+    lenient = Board(elf, strict=False)
+    lenient.run(3)
+    assert lenient.violations and {v.function for v in lenient.violations} == {"board_xfer"}
+    assert "t0" in str(lenient.violations[0])
