@@ -110,3 +110,15 @@ def test_a_too_fast_sclk_is_caught_with_the_program_counter(tmp_path: Path) -> N
     lenient.run(3)
     assert lenient.violations and {v.function for v in lenient.violations} == {"board_xfer"}
     assert "t0" in str(lenient.violations[0])
+
+
+def test_raising_ss_before_the_byte_is_out_is_an_incomplete_frame(tmp_path: Path) -> None:
+    """tests/mcu/early_ss.c waits for TXE instead of BSY: /SS rises while SPI1 still shifts, the chip drops the
+    frame (3.4.2), and the violation names fw_setup."""
+    elf = mcu_build.build(Path(__file__).parent / "mcu" / "early_ss.c", tmp_path / "early_ss.elf")
+    board = Board(elf)
+    with pytest.raises(InterfaceViolationError, match=r"incomplete byte: [0-7] SCLK rising edges") as caught:
+        board.run(1)
+    assert caught.value.rule == "3.4.2"
+    assert any("in fw_setup()" in note for note in caught.value.__notes__)
+    assert board.protocol.mode is None  # the initialization byte did not count

@@ -182,3 +182,26 @@ def test_the_image_names_its_symbols(exceptions_elf: Path) -> None:
     assert image.function_at(image.address("Irq1_Handler")) == "Irq1_Handler"
     with pytest.raises(ValueError, match="name must be a symbol"):
         image.address("nothing")
+
+
+def test_systick_counts_down_from_its_reload_and_pends_on_each_wrap(exceptions_elf: Path) -> None:
+    """B3.3: a CVR write clears the counter, the next tick loads RVR, the counter reaching 0 sets COUNTFLAG (read
+    clears it) and, with TICKINT, pends SysTick: every RVR + 1 ticks."""
+    core = CortexM(exceptions_elf)
+    systick = core.systick
+    systick.write(0x4, 99)  # RVR
+    systick.write(0x8, 0)  # CVR
+    systick.write(0x0, 0b111)  # ENABLE, TICKINT, CLKSOURCE = core clock
+    start = core.cycles
+    assert systick.next_event() == start + 100
+    for ticks, value in ((1, 99), (50, 50), (99, 1), (100, 0), (101, 99), (200, 0)):
+        core.cycles = start + ticks
+        assert systick.read(0x8) == value, ticks
+    core.cycles = start + 99
+    systick.update()
+    assert 15 not in core.pending and not systick.read(0x0) & (1 << 16)
+    core.cycles = start + 100
+    systick.update()
+    assert 15 in core.pending
+    assert systick.read(0x0) & (1 << 16) and not systick.read(0x0) & (1 << 16)  # COUNTFLAG clears on read
+    assert systick.next_event() == start + 200

@@ -83,9 +83,14 @@ class ViolationAt:
     function: str | None
     error: InterfaceViolationError
 
+    @property
+    def place(self) -> str:
+        """``PC 08000B7Eh in fw_setup(), t = 7.125 µs``."""
+        function = f" in {self.function}()" if self.function else ""
+        return f"PC {self.pc:08X}h{function}, t = {self.time_s * 1e6:.3f} µs"
+
     def __str__(self) -> str:
-        where = f"PC {self.pc:08X}h" + (f" in {self.function}()" if self.function else "")
-        return f"t = {self.time_s * 1e6:.3f} µs, {where}: {self.error}"
+        return f"{self.place}: {self.error}"
 
 
 class _BoardBench(Bench):
@@ -408,10 +413,10 @@ class Board:
             try:
                 state = core.step(max(deadline, core.cycles + 1))
             except InterfaceViolationError as error:
-                pc = core.pc
-                function = core.image.function_at(pc)
-                error.add_note(f"firmware at PC {pc:08X}h{f' in {function}()' if function else ''}, "
-                               f"t = {core.time_s * 1e6:.3f} µs")  # fmt: skip
+                where = next((v for v in reversed(self.violations) if v.error is error), None)
+                if where is None:  # raised by the bus between two accesses: where the core stopped
+                    where = ViolationAt(core.time_s, core.pc, core.image.function_at(core.pc), error)
+                error.add_note(f"firmware at {where.place}")
                 raise
             if state == "run" and core.idle_loop():
                 if core.active:

@@ -47,7 +47,9 @@ __all__ = [
     "FirmwareFaultError",
     "FirmwareImage",
     "FirmwareStoppedError",
+    "Stop",
     "StopReport",
+    "SysTick",
     "block_cost",
 ]
 
@@ -342,6 +344,7 @@ class CortexM:
         self._costs: dict[tuple[int, int], tuple[int, int]] = {}
         self._block = (0, 0)  # address and cycle count at the entry of the block running
         self._block_end = 0
+        self._running = False
         self.vtor = 0
         self.systick = SysTick(self)
         self._scs_words: dict[int, int] = {}
@@ -412,8 +415,10 @@ class CortexM:
         return self.cycles / self.cpu_hz
 
     def cycles_now(self) -> int:
-        """The cycle of the instruction running now, inside a peripheral callback: the block's entry plus the
-        instructions before the program counter (MCU-1)."""
+        """The cycle of the instruction running now: inside a peripheral callback the block's entry plus the
+        instructions before the program counter (MCU-1), between runs :attr:`cycles`."""
+        if not self._running:
+            return self.cycles
         address, start = self._block
         pc = int(self.uc.reg_read(arm.UC_ARM_REG_PC))
         if pc <= address:
@@ -569,10 +574,13 @@ class CortexM:
         self.stop_request = False
         self.interrupt = None
         pc = self.pc
+        self._running = True
         try:
             self.uc.emu_start(pc | 1, 0)
         except UcError as error:
             raise FirmwareFaultError(self._fault(error)) from None
+        finally:
+            self._running = False
         failure = self.error
         if failure is not None:
             self.error = None
