@@ -208,7 +208,7 @@ class Board:
         self.rcc = Rcc()
         self.exti = Exti(self.rcc)
         self.gpio = Gpio(self.rcc, IOPAEN, "GPIOA", self._inputs, self._on_output, PULL_UPS)
-        self.spi = Spi(self.rcc, self.core.cycles_now, self)
+        self.spi = Spi(self.rcc, self.core.cycles_now, self, self.core.cycles_polled)
         core = self.core
         core.mmio(RCC_BASE, PERIPHERAL_SIZE, self.rcc.read, self.rcc.write)
         core.mmio(GPIOA_BASE, PERIPHERAL_SIZE, self.gpio.read, self.gpio.write)

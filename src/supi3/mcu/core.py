@@ -2,7 +2,7 @@
 
 Ref: ARMv7-M Architecture Reference Manual (ARM DDI 0403): B1.5 (exception model: B1.5.6 entry, B1.5.7 stack
 alignment, B1.5.8 return), B3.2 (SCB), B3.3 (SysTick), B3.4 (NVIC); ARMv6-M (ARM DDI 0419) for the Cortex-M0;
-Cortex-M3 Technical Reference Manual (ARM DDI 0337), chapter 18 (instruction timing). Guide:
+Cortex-M3 Technical Reference Manual (ARM DDI 0337): instruction timing, interrupt latency. Guide:
 docs/firmware-in-the-loop.md; decisions MCU-n in docs/assumptions/mcu.md.
 
 unicorn 2 runs Thumb code of an M-profile core but has no NVIC: it neither enters an exception nor returns from one
@@ -101,9 +101,9 @@ class Cpu:
 
 
 CPUS: Final[dict[str, Cpu]] = {
-    # Cortex-M3 TRM 5.5.1: 12 cycles from the interrupt to the handler's first instruction; return 10 (MCU-2).
+    # Cortex-M3: 12 cycles from the interrupt to the handler's first instruction, return 10 (MCU-2).
     "cortex_m3": Cpu("cortex_m3", arm.UC_CPU_ARM_CORTEX_M3, 0x412F_C231, 12, 10, vtor=True),
-    # Cortex-M0 TRM 2.3: 16 cycles interrupt latency; the return taken as long (MCU-2). ARMv6-M: no VTOR.
+    # Cortex-M0: 16 cycles interrupt latency, the return taken as long (MCU-2). ARMv6-M: no VTOR.
     "cortex_m0": Cpu("cortex_m0", arm.UC_CPU_ARM_CORTEX_M0, 0x410C_C200, 16, 16, vtor=False),
 }
 """The cores :class:`CortexM` emulates, by their ``-mcpu`` names."""
@@ -265,7 +265,7 @@ def _cost(first: int, second: int | None) -> tuple[int, bool]:
 def block_cost(code: bytes) -> tuple[int, int]:
     """(instructions, cycles) of the Thumb code ``code`` run straight through (MCU-1): one cycle per instruction,
     one more per single load or store, one per register of LDM/STM/PUSH/POP, two more if the last instruction is
-    a branch (the pipeline refill of a taken branch, Cortex-M3 TRM 18.2)."""
+    a branch (the pipeline refill of a taken branch)."""
     instructions = cycles = 0
     offset = 0
     branch = False
@@ -345,6 +345,7 @@ class CortexM:
         self._block = (0, 0)  # address and cycle count at the entry of the block running
         self._block_end = 0
         self._running = False
+        self._handed = 0  # the latest time a peripheral was given
         self.vtor = 0
         self.systick = SysTick(self)
         self._scs_words: dict[int, int] = {}
@@ -416,18 +417,28 @@ class CortexM:
 
     def cycles_now(self) -> int:
         """The cycle of the instruction running now: inside a peripheral callback the block's entry plus the
-        instructions before the program counter (MCU-1), between runs :attr:`cycles`."""
+        instructions before the program counter (MCU-1), between runs :attr:`cycles`. Never earlier than a time
+        already handed out (:meth:`cycles_polled`)."""
         if not self._running:
             return self.cycles
         address, start = self._block
         pc = int(self.uc.reg_read(arm.UC_ARM_REG_PC))
-        if pc <= address:
-            return start
-        key = (address, pc - address)
-        cost = self._costs.get(key)
-        if cost is None:
-            cost = self._costs[key] = block_cost(self.read_bytes(address, pc - address))
-        return start + cost[1]
+        if pc > address:
+            key = (address, pc - address)
+            cost = self._costs.get(key)
+            if cost is None:
+                cost = self._costs[key] = block_cost(self.read_bytes(address, pc - address))
+            start += cost[1]
+        self._handed = max(self._handed, start)
+        return self._handed
+
+    def cycles_polled(self) -> int:
+        """The time of a status read (a flag the firmware polls): the end of the running block, which costs no
+        register read; later times handed out are never earlier (MCU-1)."""
+        if not self._running:
+            return self.cycles
+        self._handed = max(self._handed, self.cycles)
+        return self._handed
 
     # -- reset and exceptions ----------------------------------------------------------------------------------
 
@@ -783,8 +794,8 @@ class SysTick:
         self._seen = self._flag_zeros = 0
 
     def read(self, offset: int) -> int:
-        """CSR (COUNTFLAG clears on read), RVR, CVR, CALIB."""
-        cycles = self.core.cycles_now()
+        """CSR (COUNTFLAG clears on read), RVR, CVR, CALIB (at the polled time: a busy wait reads it)."""
+        cycles = self.core.cycles_polled()
         if offset == 0x0:
             zeros = self._zeros_until(self._ticks(cycles))
             flag = self._flag or zeros > self._flag_zeros

@@ -248,6 +248,9 @@ class SpiWire(Protocol):
 class Spi:
     """SPI1 as a full-duplex master (RM0008 25.3.3, 25.3.5; timing model MCU-8).
 
+    ``now`` gives the time of a write, ``polled`` that of a status or data read (default ``now``; the board gives
+    the cheaper block-end time, MCU-1).
+
     Writing DR while the shift register is idle starts a transfer at once (TXE stays 1, BSY 1); a second write
     waits in the transmit buffer (TXE 0) and starts when the running byte ends, back to back. A transfer takes 8
     SCLK periods (16 with DFF), a period 2^(BR+1) core clocks (PCLK2 = the core clock, MCU-7); at its end the
@@ -256,9 +259,12 @@ class Spi:
     (25.3.10); /NSS is not wired (SSM = 0 reads it high, MCU-6).
     """
 
-    def __init__(self, rcc: Rcc, now: Callable[[], int], wire: SpiWire) -> None:
+    def __init__(
+        self, rcc: Rcc, now: Callable[[], int], wire: SpiWire, polled: Callable[[], int] | None = None
+    ) -> None:
         self.rcc = rcc
         self.now = now
+        self.polled = now if polled is None else polled
         self.wire = wire
         self.cr1 = 0
         self.cr2 = 0
@@ -298,7 +304,7 @@ class Spi:
 
     def status(self) -> int:
         """SR now (25.5.3)."""
-        self._run(self.now())
+        self._run(self.polled())
         busy = self.shifting is not None or self.tx_buffer is not None
         return ((self.rx_buffer is not None) * SR_RXNE | (self.tx_buffer is None) * SR_TXE
                 | self.modf * SR_MODF | self.ovr * SR_OVR | busy * SR_BSY)  # fmt: skip
@@ -317,7 +323,7 @@ class Spi:
                 self.ovr = self._ovr_seen = False
             return value
         if offset == SPI_DR:
-            self._run(self.now())
+            self._run(self.polled())
             if self.rx_buffer is not None:
                 self.rx_last, self.rx_buffer = self.rx_buffer, None
             self._ovr_seen = self.ovr
