@@ -45,6 +45,38 @@ def test_the_board_pins_are_board_h_s() -> None:
         assert getattr(mcu_board, f"PIN_{name}") == defined[name], name
 
 
+def _binary_exchange(board: Board, words: tuple[bytes, ...]) -> list[tuple[bytes, bytes]]:
+    """Per step: the master's outputs and the device's inputs set, two cycles run; (the firmware's output
+    terminals, the master's inputs) after them."""
+    fw = board.fw_board
+    assert fw is not None
+    n = len(words[0])
+    seen = []
+    for out_data, in_data in zip(words, reversed(words), strict=True):
+        board.bench.master.set_outputs(1, out_data)
+        fw.inputs = in_data
+        board.run(2)
+        seen.append((fw.outputs[:n], board.bench.master.inputs(1)))
+    return seen
+
+
+def _host_exchange(pytestconfig: pytest.Config, name: str, words: tuple[bytes, ...]) -> list[tuple[bytes, bytes]]:
+    """The same steps with the same firmware built for the host, on the firmware bench."""
+    assert pytestconfig.cache is not None
+    host = c_firmware(pytestconfig.cache, native.example(name))
+    bench = Bench(firmware=host)
+    bench.run(3)
+    n = len(words[0])
+    seen = []
+    for out_data, in_data in zip(words, reversed(words), strict=True):
+        bench.master.set_outputs(1, out_data)
+        for k, value in enumerate(in_data):
+            host.board.inputs[k] = value
+        bench.run(2)
+        seen.append((bytes(host.board.outputs[0:n]), bench.master.inputs(1)))
+    return seen
+
+
 @pytest.mark.parametrize("cpu", CPUS)
 def test_digital_io_binary_gives_the_host_builds_process_data(
     pytestconfig: pytest.Config, digital_io: dict[str, Path], cpu: str
@@ -52,39 +84,34 @@ def test_digital_io_binary_gives_the_host_builds_process_data(
     """SET 83h, ID 03h, then OUT0/OUT1 read and IN0/IN1 written in the EXTI0 handler after each VALID event: the
     master's configuration and the data both ways are those of the same firmware compiled for the host."""
     board = Board(digital_io[cpu], cpu=cpu)
-    assert board.fw_board is not None
-    fw = board.fw_board
     board.run(3)
     config = board.bench.master.config
     assert config is not None and (config[0].id_code, config[0].data_bytes) == (0x03, 2)
-
-    outputs: list[bytes] = []
-    exchanged = []
-    for out_word, in_word in zip(WORDS, reversed(WORDS), strict=True):
-        board.bench.master.set_outputs(1, out_word.to_bytes(2, "big"))
-        fw.inputs = in_word.to_bytes(2, "big")
-        board.run(2)
-        outputs.append(fw.outputs[:2])
-        exchanged.append(board.bench.master.inputs(1))
-    assert fw.error == 0
-    assert fw.cycles == board.interrupts > 0  # one VALID event per data cycle, each served in the handler
+    words = tuple(w.to_bytes(2, "big") for w in WORDS)
+    seen = _binary_exchange(board, words)
+    assert seen == _host_exchange(pytestconfig, "digital_io", words)
+    assert seen == list(zip(words, reversed(words), strict=True))
+    assert board.fw_board is not None and board.fw_board.error == 0
+    assert board.fw_board.cycles == board.interrupts > 0  # one VALID event per data cycle, each served
     assert board.violations == []
 
-    assert pytestconfig.cache is not None
-    host = c_firmware(pytestconfig.cache, native.example("digital_io"))
-    bench = Bench(firmware=host)
-    bench.run(3)
-    host_outputs: list[bytes] = []
-    host_exchanged = []
-    for out_word, in_word in zip(WORDS, reversed(WORDS), strict=True):
-        bench.master.set_outputs(1, out_word.to_bytes(2, "big"))
-        for k, value in enumerate(in_word.to_bytes(2, "big")):
-            host.board.inputs[k] = value
-        bench.run(2)
-        host_outputs.append(bytes(host.board.outputs[0:2]))
-        host_exchanged.append(bench.master.inputs(1))
-    assert outputs == host_outputs == [w.to_bytes(2, "big") for w in WORDS]
-    assert exchanged == host_exchanged == [w.to_bytes(2, "big") for w in reversed(WORDS)]
+
+@pytest.mark.parametrize(
+    ("name", "size", "interrupts"),
+    [("polling_io", 2, False), ("analog_io", 4, True), ("irq_dispatch", 2, True), ("pcmd_alarm", 2, True)],
+)
+def test_more_example_binaries_give_the_host_builds_process_data(
+    pytestconfig: pytest.Config, tmp_path: Path, name: str, size: int, interrupts: bool
+) -> None:
+    """The polling example (fw_loop: the main loop polls the I/O pin), the block transfer (analog_io, 3.4.6), the
+    event dispatch and the processor command examples, on the Cortex-M3."""
+    board = Board(mcu_build.build(native.example(name), tmp_path / f"{name}.elf"))
+    board.run(3)
+    words = (bytes(range(1, size + 1)), bytes(range(0xF0, 0xF0 + size)), bytes(size))
+    assert _binary_exchange(board, words) == _host_exchange(pytestconfig, name, words)
+    assert board.fw_board is not None and board.fw_board.error == 0
+    assert (board.interrupts > 0) == interrupts
+    assert board.violations == []
 
 
 @pytest.mark.parametrize("cpu", CPUS)
