@@ -205,3 +205,28 @@ def test_systick_counts_down_from_its_reload_and_pends_on_each_wrap(exceptions_e
     assert 15 in core.pending
     assert systick.read(0x0) & (1 << 16) and not systick.read(0x0) & (1 << 16)  # COUNTFLAG clears on read
     assert systick.next_event() == start + 200
+
+
+def test_primask_holds_an_interrupt_until_cleared(exceptions_elf: Path) -> None:
+    """B1.5.4: PRIMASK = 1 raises the execution priority to 0: IRQ 0 stays pending and the core sleeps on."""
+    core = CortexM(exceptions_elf)
+    _sleep(core)
+    core.set_reg("primask", 1)
+    core.pend(EXTERNAL + 0)
+    assert core.step(core.cycles + 1000) == "sleep"
+    assert core.active == [] and EXTERNAL + 0 in core.pending
+    core.set_reg("primask", 0)
+    core.pend(EXTERNAL + 0)
+    _sleep(core)
+    assert _word(core, "order") == 0x123
+
+
+def test_an_interrupt_in_thread_mode_on_the_process_stack_is_reported(exceptions_elf: Path) -> None:
+    """MCU-3: CONTROL.SPSEL = 1 (thread mode on PSP) is not modelled: the entry stops with a report."""
+    core = CortexM(exceptions_elf)
+    _sleep(core)
+    core.set_reg("psp", 0x2000_4000)
+    core.set_reg("control", 0b10)
+    core.pend(EXTERNAL + 0)
+    with pytest.raises(FirmwareStoppedError, match="process stack"):
+        core.step(core.cycles + 1000)

@@ -232,10 +232,11 @@ class Board:
     def _seconds(self, cycles: int) -> float:
         return cycles / self.core.cpu_hz
 
-    def sync(self, cycles: int) -> None:
-        """Run the bus up to core cycle ``cycles``, then follow /IRQ."""
+    def sync(self, cycles: int, event: int | None = None) -> None:
+        """Run the bus up to core cycle ``cycles``, then follow /IRQ; ``event``: the cycle of the bus event passed
+        on the way, when /IRQ changed if it did."""
         self.bench.advance(self._seconds(cycles))
-        self._follow_irq(cycles)
+        self._follow_irq(cycles, event)
 
     def _now(self) -> int:
         cycles = self.core.cycles_now()
@@ -244,12 +245,12 @@ class Board:
 
     # -- /IRQ, EXTI0 and the NVIC ------------------------------------------------------------------------------
 
-    def _follow_irq(self, cycles: int) -> None:
+    def _follow_irq(self, cycles: int, event: int | None = None) -> None:
         level = self.registers.irq_n
         if level != self._irq_level:
             self._irq_level = level
             if not level and self._irq_fell is None:
-                self._irq_fell = cycles
+                self._irq_fell = cycles if event is None else event
             self.exti.edge(0, PIN_IRQ, level)
         self._request()
 
@@ -405,7 +406,7 @@ class Board:
             if core.instructions >= limit:
                 raise FirmwareStoppedError(core.report(Stop.BUDGET, f"instruction budget of {max_instructions} used up "
                                                   "(an endless loop?)"))  # fmt: skip
-            deadline = math.ceil(self.bench.next_event_s() * core.cpu_hz)
+            deadline = event = math.ceil(self.bench.next_event_s() * core.cpu_hz)
             tick = core.systick.next_event()
             for bound in (tick, end):
                 if bound is not None:
@@ -423,7 +424,7 @@ class Board:
                     raise FirmwareStoppedError(core.report(Stop.HANG, f"endless loop (b .) in the handler of exception "
                                                       f"{core.active[-1]}"))  # fmt: skip
                 core.sleeping = True
-            self.sync(core.cycles)
+            self.sync(core.cycles, event if event <= core.cycles else None)
 
 
 def _reverse(byte: int) -> int:
