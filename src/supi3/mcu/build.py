@@ -7,8 +7,8 @@ and the firmware's sources for a Cortex-M0 or -M3 and links them with ``board/bo
         -std=c99 -Wall -Wextra -pedantic -Werror -Os -g -Wl,--entry=Reset_Handler -T board.ld
         -I<sdk include> -I<sdk examples> -I<board> board/startup.c board/board.c src/supi3.c FIRMWARE.c -o OUT.elf
 
-``supi3 sdk --board-build`` is not there yet; from the shell: ``python -m supi3.mcu.build FIRMWARE.c -o OUT.elf
-[--cpu cortex_m0]`` (guide: docs/firmware-in-the-loop.md).
+From the shell: ``python -m supi3.mcu.build FIRMWARE.c -o OUT.elf [--cpu cortex_m0] [-D NAME=VALUE]`` (guide:
+docs/firmware-in-the-loop.md).
 """
 
 from __future__ import annotations
