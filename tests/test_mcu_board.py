@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pytest
 
+from supi3.interbus.ring import ErrorKind
 from supi3.mcu import board as mcu_board
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import Board
@@ -41,7 +42,7 @@ def test_the_board_pins_are_board_h_s() -> None:
     """The emulator's wiring constants are the board port's (board.h BOARD_PIN_*)."""
     text = (mcu_build.BOARD_DIR / "board.h").read_text()
     defined = {name: int(value) for name, value in re.findall(r"#define BOARD_PIN_(\w+) (\d+)u", text)}
-    for name in ("IRQ", "CD", "IO", "SAS_INIT", "SS", "STAT_ERR"):
+    for name in ("IRQ", "CD", "IO", "SAS_INIT", "SS", "STAT_ERR", "MODACK"):
         assert getattr(mcu_board, f"PIN_{name}") == defined[name], name
 
 
@@ -149,3 +150,30 @@ def test_raising_ss_before_the_byte_is_out_is_an_incomplete_frame(tmp_path: Path
     assert caught.value.rule == "3.4.2"
     assert any("in fw_setup()" in note for note in caught.value.__notes__)
     assert board.protocol.mode is None  # the initialization byte did not count
+
+
+def test_fault_report_binary_trips_until_quit_peripheral_error(tmp_path: Path) -> None:
+    """fault_report.c as a binary, the steps of its host test (tests/test_sdk_c_examples.py): /StatErr (PA8) low
+    for the filter time -> 0BB1h at the master, outputs off until a Quit Peripheral Error after the fault has gone;
+    the /ModAck pulse reaches the firmware through EXTI line 1's pending bit (PB1, 3.6.2)."""
+    board = Board(mcu_build.build(native.example("fault_report"), tmp_path / "fault_report.elf"), cycle_time_s=1e-3)
+    fw, chip, master = board.fw_board, board.bench.chip, board.bench.master
+    assert fw is not None
+    board.run(3)
+    master.set_outputs(1, b"\x81\x18")
+    board.run_for(0.02)
+    assert fw.outputs[:2] == b"\x81\x18"
+    fw.fault = 1
+    board.run_for(0.3)  # > t3 = 200 ms + 31.5 %
+    assert chip.module_error and chip.pf and fw.outputs[:2] == b"\x00\x00"
+    assert sum(d.kind is ErrorKind.PERIPHERAL_FAULT for d in master.diagnostics) == 1
+    master.quit_peripheral_error(1)  # while the fault lasts: nothing changes
+    board.run_for(0.01)
+    assert chip.pf and fw.outputs[:2] == b"\x00\x00"
+    fw.fault = 0
+    board.run_for(0.01)
+    assert not chip.module_error and chip.pf and fw.outputs[:2] == b"\x00\x00"
+    master.quit_peripheral_error(1)
+    board.run_for(0.01)
+    assert not chip.pf and fw.outputs[:2] == b"\x81\x18"
+    assert fw.error == 0 and board.violations == []

@@ -33,7 +33,9 @@ from supi3.mcu.stm32 import (
     EXTI0_IRQ,
     EXTI_BASE,
     GPIOA_BASE,
+    GPIOB_BASE,
     IOPAEN,
+    IOPBEN,
     PERIPHERAL_SIZE,
     RCC_BASE,
     SPI1_BASE,
@@ -51,6 +53,7 @@ __all__ = [
     "PIN_CD",
     "PIN_IO",
     "PIN_IRQ",
+    "PIN_MODACK",
     "PIN_SAS_INIT",
     "PIN_SS",
     "PIN_STAT_ERR",
@@ -66,6 +69,9 @@ PIN_IO: Final[int] = 2
 PIN_SAS_INIT: Final[int] = 3
 PIN_SS: Final[int] = 4
 PIN_STAT_ERR: Final[int] = 8
+PIN_MODACK: Final[int] = 1
+"""On port B: PB1."""
+PORT_B: Final[int] = 1
 PULL_UPS: Final[int] = (1 << PIN_SS) | (1 << PIN_STAT_ERR)
 """MCU-6: /SS and /StatErr have pull-ups on the board: high while the MCU does not drive them."""
 MISO_IDLE: Final[int] = 0xFF
@@ -208,10 +214,12 @@ class Board:
         self.rcc = Rcc()
         self.exti = Exti(self.rcc)
         self.gpio = Gpio(self.rcc, IOPAEN, "GPIOA", self._inputs, self._on_output, PULL_UPS)
+        self.gpio_b = Gpio(self.rcc, IOPBEN, "GPIOB", self._inputs_b, self._on_output_b, 0)
         self.spi = Spi(self.rcc, self.core.cycles_now, self, self.core.cycles_polled)
         core = self.core
         core.mmio(RCC_BASE, PERIPHERAL_SIZE, self.rcc.read, self.rcc.write)
         core.mmio(GPIOA_BASE, PERIPHERAL_SIZE, self.gpio.read, self.gpio.write)
+        core.mmio(GPIOB_BASE, PERIPHERAL_SIZE, self.gpio_b.read, self.gpio_b.write)
         core.mmio(AFIO_BASE, PERIPHERAL_SIZE, self.exti.read_afio, self.exti.write_afio)
         core.mmio(EXTI_BASE, PERIPHERAL_SIZE, self.exti.read, self.exti.write)
         core.mmio(SPI1_BASE, PERIPHERAL_SIZE, self.spi.read, self.spi.write)
@@ -226,6 +234,7 @@ class Board:
         self._sas_rise = 0
         self._irq_level = 1
         self._irq_fell: int | None = None
+        self._mod_acks = 0
 
     # -- time --------------------------------------------------------------------------------------------------
 
@@ -246,6 +255,11 @@ class Board:
     # -- /IRQ, EXTI0 and the NVIC ------------------------------------------------------------------------------
 
     def _follow_irq(self, cycles: int, event: int | None = None) -> None:
+        pulses = self.bench.chip.events["MODACK"]
+        if pulses != self._mod_acks:  # a /ModAck pulse (375 ns, 3.6.2): both edges, the falling one latched
+            self._mod_acks = pulses
+            self.exti.edge(PORT_B, PIN_MODACK, 0)
+            self.exti.edge(PORT_B, PIN_MODACK, 1)
         level = self.registers.irq_n
         if level != self._irq_level:
             self._irq_level = level
@@ -273,6 +287,14 @@ class Board:
         cycles = self._now()
         cd = self.protocol.c_d if cycles >= self._ss_rise + self._cycles(self._limits["t6max"]) else self._cd_before
         return self.registers.irq_n << PIN_IRQ | cd << PIN_CD | int(self.registers.io_access) << PIN_IO
+
+    def _inputs_b(self) -> int:
+        self._now()
+        return self.bench.mod_ack << PIN_MODACK
+
+    def _on_output_b(self, pin: int, level: int) -> None:
+        """Port B drives nothing the chip sees."""
+        del pin, level
 
     def _cycles(self, seconds: float) -> int:
         return math.ceil(seconds * self.core.cpu_hz - 1e-6)

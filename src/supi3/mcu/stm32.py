@@ -21,6 +21,7 @@ __all__ = [
     "EXTI0_IRQ",
     "EXTI_BASE",
     "GPIOA_BASE",
+    "GPIOB_BASE",
     "PERIPHERAL_SIZE",
     "RCC_BASE",
     "SPI1_BASE",
@@ -34,6 +35,7 @@ __all__ = [
 
 RCC_BASE: Final[int] = 0x4002_1000
 GPIOA_BASE: Final[int] = 0x4001_0800
+GPIOB_BASE: Final[int] = 0x4001_0C00
 AFIO_BASE: Final[int] = 0x4001_0000
 EXTI_BASE: Final[int] = 0x4001_0400
 SPI1_BASE: Final[int] = 0x4001_3000
@@ -45,6 +47,7 @@ EXTI0_IRQ: Final[int] = 6
 APB2ENR: Final[int] = 0x18
 AFIOEN: Final[int] = 1 << 0
 IOPAEN: Final[int] = 1 << 2
+IOPBEN: Final[int] = 1 << 3
 SPI1EN: Final[int] = 1 << 12
 
 # SPI (RM0008 25.5.1 to 25.5.3)

@@ -115,16 +115,18 @@ static int board_set_stat_err(void *user, int active)
     return 0;
 }
 
+/* The edge latch fw_board.h asks for: EXTI line 1's pending bit caught the falling edge of /ModAck (3.6.2). */
 static int board_mod_ack_seen(void *user, int *seen)
 {
     (void)user;
-    (void)seen;
-    return SUPI3_E_UNSUPPORTED; /* /ModAck is not wired on this board (yet) */
+    *seen = (EXTI_PR & PIN(BOARD_PIN_MODACK)) != 0u;
+    EXTI_PR = PIN(BOARD_PIN_MODACK);
+    return 0;
 }
 
 static void board_init(void)
 {
-    RCC_APB2ENR |= RCC_APB2ENR_AFIOEN | RCC_APB2ENR_IOPAEN | RCC_APB2ENR_SPI1EN;
+    RCC_APB2ENR |= RCC_APB2ENR_AFIOEN | RCC_APB2ENR_IOPAEN | RCC_APB2ENR_IOPBEN | RCC_APB2ENR_SPI1EN;
     GPIOA_BSRR = PIN(BOARD_PIN_SS) | PIN(BOARD_PIN_STAT_ERR); /* /SS and /StatErr idle high */
     GPIOA_BRR = PIN(BOARD_PIN_SAS_INIT);
     GPIOA_CRL = (GPIO_CFG_INPUT_FLOATING << (4u * BOARD_PIN_IRQ)) | (GPIO_CFG_INPUT_FLOATING << (4u * BOARD_PIN_CD)) |
@@ -139,9 +141,10 @@ static void board_init(void)
     SYST_RVR = SYST_MAX;
     SYST_CVR = 0u;
     SYST_CSR = SYST_CSR_ENABLE | SYST_CSR_CLKSOURCE;
-    AFIO_EXTICR1 = 0u; /* EXTI0 on PA0 */
-    EXTI_FTSR |= PIN(BOARD_PIN_IRQ);
-    EXTI_IMR |= PIN(BOARD_PIN_IRQ);
+    GPIOB_CRL = GPIO_CFG_INPUT_FLOATING << (4u * BOARD_PIN_MODACK);
+    AFIO_EXTICR1 = AFIO_EXTICR_PB << (4u * BOARD_PIN_MODACK); /* EXTI0 on PA0, EXTI1 on PB1 */
+    EXTI_FTSR |= PIN(BOARD_PIN_IRQ) | PIN(BOARD_PIN_MODACK);
+    EXTI_IMR |= PIN(BOARD_PIN_IRQ) | PIN(BOARD_PIN_MODACK); /* EXTI1's NVIC line stays disabled: a latch only */
 }
 
 void EXTI0_IRQHandler(void)

@@ -14,6 +14,7 @@
  *   PA4  -> /SS               output (GPIO, one frame per byte: 3.4.2)
  *   PA5  -> SCLK, PA6 <- SerOUT (MISO), PA7 -> SerIN (MOSI): SPI1, mode 3, MSB first (Motorola, 3.4.2)
  *   PA8  -> /StatErr          output, 0 = peripheral fault (3.6.2)
+ *   PB1  <- /ModAck           input, EXTI line 1 falling edge: PR latches the 375 ns pulse (3.6.2); no interrupt
  */
 #ifndef SUPI3_BOARD_H
 #define SUPI3_BOARD_H
@@ -40,6 +41,7 @@
 #define BOARD_PIN_MISO 6u
 #define BOARD_PIN_MOSI 7u
 #define BOARD_PIN_STAT_ERR 8u
+#define BOARD_PIN_MODACK 1u /* on port B */
 
 #define REG32(address) (*(volatile uint32_t *)(address))
 
@@ -47,6 +49,7 @@
 #define RCC_APB2ENR REG32(0x40021018u)
 #define RCC_APB2ENR_AFIOEN (1u << 0)
 #define RCC_APB2ENR_IOPAEN (1u << 2)
+#define RCC_APB2ENR_IOPBEN (1u << 3)
 #define RCC_APB2ENR_SPI1EN (1u << 12)
 
 /* GPIOA (RM0008 9.2): CRL/CRH 4 bits per pin (MODE[1:0], CNF[1:0]), IDR, ODR, BSRR (set low half), BRR. */
@@ -55,12 +58,14 @@
 #define GPIOA_IDR REG32(0x40010808u)
 #define GPIOA_BSRR REG32(0x40010810u)
 #define GPIOA_BRR REG32(0x40010814u)
+#define GPIOB_CRL REG32(0x40010C00u)
 #define GPIO_CFG_INPUT_FLOATING 0x4u   /* CNF 01, MODE 00 */
 #define GPIO_CFG_OUTPUT_PP_2MHZ 0x2u   /* CNF 00, MODE 10 */
 #define GPIO_CFG_AF_PP_50MHZ 0xBu      /* CNF 10, MODE 11 */
 
-/* AFIO (RM0008 9.4.3): EXTICR1 selects the port of EXTI lines 0..3 (0 = PA). */
+/* AFIO (RM0008 9.4.3): EXTICR1 selects the port of EXTI lines 0..3, 4 bits each (0 = PA, 1 = PB). */
 #define AFIO_EXTICR1 REG32(0x40010008u)
+#define AFIO_EXTICR_PB 1u
 
 /* EXTI (RM0008 10.3): interrupt mask, falling trigger, pending (write 1 to clear). */
 #define EXTI_IMR REG32(0x40010400u)
