@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import struct
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
 from typing import Any, Final
@@ -129,7 +129,6 @@ class Stop(StrEnum):
     FAULT = "fault"
     BUDGET = "budget"
     HANG = "hang"
-    VIOLATION = "violation"
 
 
 @dataclass(frozen=True)
@@ -146,7 +145,6 @@ class StopReport:
     time_s: float
     stacked: dict[str, int] | None = None
     symbol: str | None = None
-    cause: BaseException | None = field(default=None, compare=False)
 
     def __str__(self) -> str:
         where = f"PC {self.pc:08X}h" + (f" ({self.symbol})" if self.symbol else "")
@@ -170,7 +168,7 @@ class FirmwareFaultError(FirmwareError):
 
 
 class FirmwareStoppedError(FirmwareError):
-    """The run's instruction budget ran out, the firmware hung in a handler, or it broke an interface rule."""
+    """The run's instruction budget ran out, the firmware hung in a handler, or it needs what is not modelled."""
 
 
 # ------------------------------------------------------------------------------------------------------------
@@ -645,8 +643,7 @@ class CortexM:
                 frame = None
         return self.report(Stop.FAULT, reason, pc=pc, stacked=frame)
 
-    def report(self, stop: Stop, reason: str, *, pc: int | None = None, stacked: int | None = None,
-               cause: BaseException | None = None) -> StopReport:  # fmt: skip
+    def report(self, stop: Stop, reason: str, *, pc: int | None = None, stacked: int | None = None) -> StopReport:
         """A :class:`StopReport` of the core now; ``stacked``: the address of a stacked frame to include."""
         pc = self.pc if pc is None else pc
         frame = None
@@ -654,7 +651,7 @@ class CortexM:
             words = struct.unpack("<8I", self.read_bytes(stacked, FRAME_WORDS * 4))
             frame = dict(zip(FRAME_NAMES, words, strict=True))
         return StopReport(stop, reason, pc, self.registers(), self.instructions, self.cycles, self.time_s, frame,
-                          self.image.function_at(pc), cause)  # fmt: skip
+                          self.image.function_at(pc))  # fmt: skip
 
     # -- system control space: SysTick, NVIC, SCB (B3.2 to B3.4) -----------------------------------------------
 
