@@ -177,3 +177,22 @@ def test_fault_report_binary_trips_until_quit_peripheral_error(tmp_path: Path) -
     board.run_for(0.01)
     assert not chip.pf and fw.outputs[:2] == b"\x81\x18"
     assert fw.error == 0 and board.violations == []
+
+
+@pytest.mark.parametrize("cpu", CPUS)
+def test_skipping_poll_loops_changes_nothing_but_the_speed(digital_io: dict[str, Path], cpu: str) -> None:
+    """MCU-10: the SPI status polls counted without running them give the same cycles, instructions, bus time,
+    interrupts and data as running each."""
+    outcomes = []
+    for skip in (True, False):
+        board = Board(digital_io[cpu], cpu=cpu)
+        board.core.skip_polls = skip
+        board.run(3)
+        board.bench.master.set_outputs(1, b"\x12\x34")
+        assert board.fw_board is not None
+        board.fw_board.inputs = b"\x56\x78"
+        board.run(4)
+        outcomes.append((board.core.cycles, board.core.instructions, board.bench.now, board.interrupts,
+                         board.irq_latency_s, board.fw_board.outputs, board.bench.master.inputs(1)))  # fmt: skip
+    assert outcomes[0] == outcomes[1]
+    assert outcomes[0][5][:2] == b"\x12\x34" and outcomes[0][6] == b"\x56\x78"

@@ -27,6 +27,7 @@ from supi3.mcu.core import (
     FirmwareStoppedError,
     Stop,
     block_cost,
+    is_poll_loop,
 )
 
 pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
@@ -230,3 +231,20 @@ def test_an_interrupt_in_thread_mode_on_the_process_stack_is_reported(exceptions
     core.pend(EXTERNAL + 0)
     with pytest.raises(FirmwareStoppedError, match="process stack"):
         core.step(core.cycles + 1000)
+
+
+@pytest.mark.parametrize(
+    ("code", "pure"),
+    [
+        ("0168 c907 fcd0", True),  # ldr r1, [r0]; lsls r1, r1, #31; beq .-4: wait for RXNE
+        ("0168 0906 fcd4", True),  # ldr r1, [r0]; lsls r1, r1, #24; bmi: wait while BSY
+        ("0168 0142 fcd0", True),  # ldr r1, [r0]; tst r1, r0; beq
+        ("0068 c007 fcd0", False),  # ldr r0, [r0]: the base is overwritten
+        ("0168 4a1c c907 fbd0", False),  # adds r2, r1, #1: another register written
+        ("0168 c907 fdd0", False),  # the branch does not go back to the block's start
+        ("0168 c907 fce7", False),  # b: not a poll (no exit)
+    ],
+)
+def test_a_pure_poll_loop_is_a_load_tests_and_a_branch_back(code: str, pure: bool) -> None:
+    """MCU-10: only loops that write nothing but the loaded register and the flags are skipped."""
+    assert is_poll_loop(bytes.fromhex(code.replace(" ", "")), 0x0800_0100) is pure

@@ -216,6 +216,7 @@ class Board:
         self.gpio = Gpio(self.rcc, IOPAEN, "GPIOA", self._inputs, self._on_output, PULL_UPS)
         self.gpio_b = Gpio(self.rcc, IOPBEN, "GPIOB", self._inputs_b, self._on_output_b, 0)
         self.spi = Spi(self.rcc, self.core.cycles_now, self, self.core.cycles_polled)
+        self.spi.on_poll = self.core.skip_poll
         core = self.core
         core.mmio(RCC_BASE, PERIPHERAL_SIZE, self.rcc.read, self.rcc.write)
         core.mmio(GPIOA_BASE, PERIPHERAL_SIZE, self.gpio.read, self.gpio.write)
@@ -234,7 +235,7 @@ class Board:
         self._sas_rise = 0
         self._irq_level = 1
         self._irq_fell: int | None = None
-        self._mod_acks = 0
+        self._mod_ack_until = 0
 
     # -- time --------------------------------------------------------------------------------------------------
 
@@ -255,9 +256,9 @@ class Board:
     # -- /IRQ, EXTI0 and the NVIC ------------------------------------------------------------------------------
 
     def _follow_irq(self, cycles: int, event: int | None = None) -> None:
-        pulses = self.bench.chip.events["MODACK"]
-        if pulses != self._mod_acks:  # a /ModAck pulse (375 ns, 3.6.2): both edges, the falling one latched
-            self._mod_acks = pulses
+        pulse = self.bench.chip.mod_ack_until
+        if pulse != self._mod_ack_until:  # a new /ModAck pulse (375 ns, 3.6.2): both edges, the falling one latched
+            self._mod_ack_until = pulse
             self.exti.edge(PORT_B, PIN_MODACK, 0)
             self.exti.edge(PORT_B, PIN_MODACK, 1)
         level = self.registers.irq_n

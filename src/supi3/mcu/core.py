@@ -51,6 +51,7 @@ __all__ = [
     "StopReport",
     "SysTick",
     "block_cost",
+    "is_poll_loop",
 ]
 
 EXCP_EXCEPTION_EXIT: Final[int] = 8
@@ -260,6 +261,29 @@ def _cost(first: int, second: int | None) -> tuple[int, bool]:
     return 1, bool(second & 0x5000) or (first >> 7) & 0b111 != 0b111
 
 
+def is_poll_loop(code: bytes, address: int) -> bool:
+    """The block ``code`` at ``address`` is a pure poll loop (MCU-10): ``LDR Rt, [Rn, #imm]`` (Rt is not Rn), then
+    only shifts of Rt by an immediate (LSLS, LSRS), ``TST Rt, Rm`` or ``CMP Rt, #imm``, and a conditional branch
+    back to ``address``. Its iterations write only Rt and the flags, which the last one writes again."""
+    halfwords = [code[k] | code[k + 1] << 8 for k in range(0, len(code) - 1, 2)]
+    if len(halfwords) < 2 or (halfwords[0] >> 11) != 0b01101:
+        return False
+    rt, rn = halfwords[0] & 7, halfwords[0] >> 3 & 7
+    if rt == rn:
+        return False
+    for middle in halfwords[1:-1]:
+        shift = (middle >> 11) in (0b00000, 0b00001) and middle & 7 == rt and middle >> 3 & 7 == rt
+        test = (middle & 0xFFC0) == 0x4200 and middle & 7 == rt
+        compare = (middle >> 11) == 0b00101 and middle >> 8 & 7 == rt
+        if not (shift or test or compare):
+            return False
+    branch = halfwords[-1]
+    if (branch >> 12) != 0b1101 or (branch >> 9) & 0b111 == 0b111:
+        return False
+    offset = (branch & 0xFF) - (0x100 if branch & 0x80 else 0)
+    return address + 2 * (len(halfwords) - 1) + 4 + 2 * offset == address
+
+
 def block_cost(code: bytes) -> tuple[int, int]:
     """(instructions, cycles) of the Thumb code ``code`` run straight through (MCU-1): one cycle per instruction,
     one more per single load or store, one per register of LDM/STM/PUSH/POP, two more if the last instruction is
@@ -344,6 +368,10 @@ class CortexM:
         self._block_end = 0
         self._running = False
         self._handed = 0  # the latest time a peripheral was given
+        self._skip: tuple[int, int] | None = None  # (poll loop address, cycle its status changes)
+        self._polls: dict[int, bool] = {}
+        self.skip_polls = True
+        """MCU-10: skip the iterations of pure poll loops (the same result, faster); ``False`` runs each."""
         self.vtor = 0
         self.systick = SysTick(self)
         self._scs_words: dict[int, int] = {}
@@ -556,10 +584,40 @@ class CortexM:
         cost = self._costs.get(key)
         if cost is None:
             cost = self._costs[key] = block_cost(self.read_bytes(address, size))
+        skip = self._skip
+        if skip is not None:
+            self._skip = None
+            if skip[0] == address:
+                self._skip_polls(cost, skip[1])
+                if self.cycles >= self.deadline:
+                    uc.emu_stop()
+                    return
         self._block = (address, self.cycles)
         self._block_end = address + size
         self.instructions += cost[0]
         self.cycles += cost[1]
+
+    def _skip_polls(self, cost: tuple[int, int], until: int) -> None:
+        """Count, without running them, the iterations of a poll loop that would start before the deadline and
+        read before ``until`` (MCU-10): each reads at its block's end (:meth:`cycles_polled`)."""
+        instructions, cycles = cost
+        before_deadline = -(-(self.deadline - self.cycles) // cycles)
+        reading_early = -(-(until - cycles - self.cycles) // cycles)
+        skipped = max(0, min(before_deadline, reading_early))
+        self.instructions += skipped * instructions
+        self.cycles += skipped * cycles
+
+    def skip_poll(self, until: int) -> None:
+        """The status register just read keeps its value until cycle ``until``: if the running block is a pure poll
+        loop on it (:func:`is_poll_loop`), its next iterations up to then are counted without running (MCU-10)."""
+        if not self.skip_polls:
+            return
+        address = self._block[0]
+        pure = self._polls.get(address)
+        if pure is None:
+            pure = self._polls[address] = is_poll_loop(self.read_bytes(address, self._block_end - address), address)
+        if pure:
+            self._skip = (address, until)
 
     def _on_interrupt(self, uc: Any, number: int, data: Any) -> None:
         del data

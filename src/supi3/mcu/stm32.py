@@ -128,6 +128,7 @@ class Gpio:
         self.pulled_up = pulled_up
         self.cr = [0x4444_4444, 0x4444_4444]  # reset: every pin a floating input
         self.odr = 0
+        self._mask: int | None = None  # the output pins, from CRL and CRH
         self._levels = self.levels()
 
     def is_output(self, pin: int) -> bool:
@@ -135,7 +136,9 @@ class Gpio:
         return bool(self.cr[pin // 8] >> (4 * (pin % 8)) & 0b11)
 
     def _output_mask(self) -> int:
-        return sum(1 << pin for pin in range(16) if self.is_output(pin))
+        if self._mask is None:
+            self._mask = sum(1 << pin for pin in range(16) if self.is_output(pin))
+        return self._mask
 
     def levels(self) -> int:
         """The levels the port drives: ODR on output pins, the pull-ups elsewhere."""
@@ -168,6 +171,7 @@ class Gpio:
         self.rcc.require(self.enable_bit, self.name)
         if offset in (0x0, 0x4):
             self.cr[offset // 4] = value
+            self._mask = None
         elif offset == 0xC:
             self.odr = value & 0xFFFF
         elif offset == 0x10:
@@ -268,6 +272,8 @@ class Spi:
         self.rcc = rcc
         self.now = now
         self.polled = now if polled is None else polled
+        self.on_poll: Callable[[int], None] = _ignore
+        """Called on a status read while a byte shifts, with the cycle SR changes next (the board's poll skip)."""
         self.wire = wire
         self.cr1 = 0
         self.cr2 = 0
@@ -306,8 +312,10 @@ class Spi:
         self.transfers += 1
 
     def status(self) -> int:
-        """SR now (25.5.3)."""
+        """SR now (25.5.3); while a byte shifts, tells :attr:`on_poll` when SR changes next (its end)."""
         self._run(self.polled())
+        if self.shifting is not None:
+            self.on_poll(self.shifting[2])
         busy = self.shifting is not None or self.tx_buffer is not None
         return ((self.rx_buffer is not None) * SR_RXNE | (self.tx_buffer is None) * SR_TXE
                 | self.modf * SR_MODF | self.ovr * SR_OVR | busy * SR_BSY)  # fmt: skip
@@ -352,3 +360,7 @@ class Spi:
             self.tx_buffer = value & 0xFFFF  # a write with TXE = 0 overwrites the waiting byte
             if self.cr1 & CR1_SPE and self.cr1 & CR1_MSTR and self.shifting is None:
                 self._start(cycles)
+
+
+def _ignore(cycles: int) -> None:
+    del cycles
