@@ -1,0 +1,454 @@
+"""The emulated SUPI 3 board: a Cortex-M core, STM32F10x peripherals and the transaction-level chip on the bench.
+
+Ref: IBS SUPI 3 OPC UM E rev. 05, 3.4.2 (one /SS frame per byte), 3.4.3 (SAS_INIT, C/D), 3.4.14 (/IRQ, the I/O
+access bit), Table 3-7 (t0, t1, t2, t6, t8, t_SAS_INIT), 3.6.2 (/StatErr); the board's wiring is
+``src/supi3/sdk/c/board/board.h``; guide docs/firmware-in-the-loop.md, decisions MCU-n in docs/assumptions/mcu.md.
+
+One clock: the core's cycle count is the bench's time (``bench.now = cycles / cpu_hz``). Before every peripheral
+access the bus runs up to the instruction's cycle (:meth:`Board.sync`), so what the firmware sees on C/D, /IRQ
+and the I/O pin, and what the chip sees on /SS and the SPI lines, happens at the firmware's own time. The run loop
+stops the core at each bus event (a cycle's phases) and at each SysTick wrap, so an edge of /IRQ enters EXTI0's
+handler at the next block boundary after it (MCU-1).
+"""
+
+from __future__ import annotations
+
+import math
+import struct
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Final
+
+from supi3 import timing
+from supi3.checks import check_int, check_real
+from supi3.config import DeviceConfig
+from supi3.interbus.link import Device
+from supi3.mcu.core import EXTERNAL, CortexM, FirmwareImage, FirmwareStoppedError, Stop
+from supi3.mcu.stm32 import (
+    AFIO_BASE,
+    CR1_CPHA,
+    CR1_CPOL,
+    CR1_LSBFIRST,
+    EXTI0_IRQ,
+    EXTI_BASE,
+    GPIOA_BASE,
+    GPIOB_BASE,
+    IOPAEN,
+    IOPBEN,
+    PERIPHERAL_SIZE,
+    RCC_BASE,
+    SPI1_BASE,
+    Exti,
+    Gpio,
+    Rcc,
+    Spi,
+)
+from supi3.model.registers import InterfaceViolationError
+from supi3.pinout import C_D_COMMAND
+from supi3.sdk.bench import Bench
+
+__all__ = [
+    "DEFAULT_MAX_INSTRUCTIONS",
+    "PIN_CD",
+    "PIN_IO",
+    "PIN_IRQ",
+    "PIN_MODACK",
+    "PIN_SAS_INIT",
+    "PIN_SS",
+    "PIN_STAT_ERR",
+    "Board",
+    "FwBoard",
+    "ViolationAt",
+]
+
+# GPIOA pins of board.h (BOARD_PIN_*); tests/test_mcu_board.py checks they agree.
+PIN_IRQ: Final[int] = 0
+PIN_CD: Final[int] = 1
+PIN_IO: Final[int] = 2
+PIN_SAS_INIT: Final[int] = 3
+PIN_SS: Final[int] = 4
+PIN_STAT_ERR: Final[int] = 8
+PIN_MODACK: Final[int] = 1
+"""On port B: PB1."""
+PORT_B: Final[int] = 1
+PULL_UPS: Final[int] = (1 << PIN_SS) | (1 << PIN_STAT_ERR)
+"""MCU-6: /SS and /StatErr have pull-ups on the board: high while the MCU does not drive them."""
+MISO_IDLE: Final[int] = 0xFF
+"""MCU-6: what the SPI receives when the chip drives no SerOUT (pulled up)."""
+DEFAULT_MAX_INSTRUCTIONS: Final[int] = 20_000_000
+"""The instruction budget of one :meth:`Board.run` call unless given."""
+
+
+@dataclass(frozen=True)
+class ViolationAt:
+    """An interface rule the firmware broke: the chip's violation, with the bus time and where the core was."""
+
+    time_s: float
+    pc: int
+    function: str | None
+    error: InterfaceViolationError
+
+    @property
+    def place(self) -> str:
+        """``PC 08000B7Eh in fw_setup(), t = 7.125 µs``."""
+        function = f" in {self.function}()" if self.function else ""
+        return f"PC {self.pc:08X}h{function}, t = {self.time_s * 1e6:.3f} µs"
+
+    def __str__(self) -> str:
+        return f"{self.place}: {self.error}"
+
+
+class _BoardBench(Bench):
+    """The bench, driven by the core's clock: the run loop needs the next bus event to stop the core there."""
+
+    def next_event_s(self) -> float:
+        """The time of the next bus event (a cycle start, phase or end)."""
+        return self._next_event()
+
+
+@dataclass
+class _Frame:
+    fall: int  # cycle of /SS falling
+    driven: int | None  # what the chip drives on SerOUT (UP-18)
+    transfers: list[tuple[int, int, int, int]]  # (tx as the chip sees it, bits, start cycle, period)
+
+
+class FwBoard:
+    """The firmware's ``fw_board_t fw_board`` (examples/fw_board.h) in the emulated RAM: the terminals the host
+    writes (inputs, fault) and what the firmware keeps (outputs, command, cycles, error). Offsets are the
+    structure's layout under the ARM EABI (AAPCS: ``uint32_t`` and ``int`` 4-byte aligned)."""
+
+    INPUTS: Final = 0
+    OUTPUTS: Final = 4
+    FAULT: Final = 8
+    COMMAND: Final = 9
+    CYCLES: Final = 12
+    ERROR: Final = 16
+    SIZE: Final = 36
+
+    def __init__(self, core: CortexM, symbol: str = "fw_board") -> None:
+        self.core = core
+        self.address = core.image.address(symbol)
+
+    @property
+    def inputs(self) -> bytes:
+        """The input terminals (4 bytes, byte 0 the most significant, 3.4.8)."""
+        return self.core.read_bytes(self.address + self.INPUTS, 4)
+
+    @inputs.setter
+    def inputs(self, data: bytes) -> None:
+        self.core.write_bytes(self.address + self.INPUTS, bytes(data).ljust(4, b"\0")[:4])
+
+    @property
+    def outputs(self) -> bytes:
+        """The output terminals (4 bytes)."""
+        return self.core.read_bytes(self.address + self.OUTPUTS, 4)
+
+    @property
+    def fault(self) -> int:
+        """1 = the peripheral has an error."""
+        return self.core.read_bytes(self.address + self.FAULT, 1)[0]
+
+    @fault.setter
+    def fault(self, value: int) -> None:
+        self.core.write_bytes(self.address + self.FAULT, bytes([check_int("fault", value, 0, 1)]))
+
+    @property
+    def command(self) -> int:
+        """The last processor command (3.4.9)."""
+        return self.core.read_bytes(self.address + self.COMMAND, 1)[0]
+
+    @property
+    def cycles(self) -> int:
+        """Data cycles the firmware exchanged."""
+        return int(struct.unpack("<I", self.core.read_bytes(self.address + self.CYCLES, 4))[0])
+
+    @property
+    def error(self) -> int:
+        """The first driver error (supi3_err_t), 0 = none."""
+        return int(struct.unpack("<i", self.core.read_bytes(self.address + self.ERROR, 4))[0])
+
+
+class Board:
+    """The firmware's ELF on an emulated STM32F10x-class board, wired to the chip of a :class:`Bench`.
+
+    Parameters
+    ----------
+    firmware:
+        The ELF (built by :func:`supi3.mcu.build.build` with the SDK's board port, or any firmware for
+        ``board.h``'s wiring and ``board.ld``'s memory map).
+    cpu, cpu_hz:
+        The core (``"cortex_m3"``, ``"cortex_m0"``) and its clock (MCU-1; the board port's ``BOARD_SYSCLK_HZ``
+        must agree: 48 MHz by default).
+    config, bit_rate, others, cycle_time_s, strict, pedantic:
+        The bench's (:class:`supi3.sdk.bench.Bench`): the chip's straps, the ring, the master's cycle, and whether
+        an interface violation raises (strict) or is only recorded in :attr:`violations`.
+
+    Attributes
+    ----------
+    core, bench, spi, gpio, exti, rcc:
+        The parts. ``bench.master`` exchanges the process data; ``bench.chip`` is the chip.
+    fw_board:
+        The firmware's ``fw_board`` (:class:`FwBoard`), if the ELF has that symbol.
+    interrupts:
+        EXTI0 handler entries (/IRQ edges served).
+    irq_latency_s:
+        The longest time from a falling edge of /IRQ to the first instruction of its handler.
+    violations:
+        Every interface violation with its bus time and program counter (strict mode raises the first).
+    """
+
+    def __init__(self, firmware: str | Path | FirmwareImage, *, cpu: str = "cortex_m3", cpu_hz: float = 48e6,
+                 config: DeviceConfig | None = None, bit_rate: int = 500_000, others: Sequence[Device] = (),
+                 cycle_time_s: float | None = None, strict: bool = True, pedantic: bool = False) -> None:  # fmt: skip
+        self.bench = _BoardBench(config, bit_rate=bit_rate, others=others, cycle_time_s=cycle_time_s, strict=strict,
+                                 pedantic=pedantic)  # fmt: skip
+        self.core = CortexM(firmware, cpu=cpu, cpu_hz=cpu_hz)
+        self.registers = self.bench.registers
+        self.protocol = self.bench.transport.protocol
+        bit_rate = self.bench.config.bit_rate
+        self._limits = {symbol: timing.limit("3-7", symbol, bit_rate) for symbol in ("t0", "t1", "t2", "t8")}
+        self._limits["t6max"] = timing.limit("3-7", "t6", bit_rate, maximum=True)
+        self._limits["t_SAS_INIT"] = timing.limit("3-7", "t_SAS_INIT", bit_rate)
+        self.rcc = Rcc()
+        self.exti = Exti(self.rcc)
+        self.gpio = Gpio(self.rcc, IOPAEN, "GPIOA", self._inputs, self._on_output, PULL_UPS)
+        self.gpio_b = Gpio(self.rcc, IOPBEN, "GPIOB", self._inputs_b, self._on_output_b, 0)
+        self.spi = Spi(self.rcc, self.core.cycles_now, self, self.core.cycles_polled)
+        self.spi.on_poll = self.core.skip_poll
+        core = self.core
+        core.mmio(RCC_BASE, PERIPHERAL_SIZE, self.rcc.read, self.rcc.write)
+        core.mmio(GPIOA_BASE, PERIPHERAL_SIZE, self.gpio.read, self.gpio.write)
+        core.mmio(GPIOB_BASE, PERIPHERAL_SIZE, self.gpio_b.read, self.gpio_b.write)
+        core.mmio(AFIO_BASE, PERIPHERAL_SIZE, self.exti.read_afio, self.exti.write_afio)
+        core.mmio(EXTI_BASE, PERIPHERAL_SIZE, self.exti.read, self.exti.write)
+        core.mmio(SPI1_BASE, PERIPHERAL_SIZE, self.spi.read, self.spi.write)
+        core.entered = self._entered
+        self.fw_board = FwBoard(core) if "fw_board" in core.image.symbols else None
+        self.interrupts = 0
+        self.irq_latency_s = 0.0
+        self.violations: list[ViolationAt] = []
+        self._frame: _Frame | None = None
+        self._ss_rise = -(1 << 62)
+        self._cd_before = C_D_COMMAND  # C/D until t6 max after /SS rises (MCU-9)
+        self._sas_rise = 0
+        self._irq_level = 1
+        self._irq_fell: int | None = None
+        self._mod_ack_until = 0
+
+    # -- time --------------------------------------------------------------------------------------------------
+
+    def _seconds(self, cycles: int) -> float:
+        return cycles / self.core.cpu_hz
+
+    def sync(self, cycles: int, event: int | None = None) -> None:
+        """Run the bus up to core cycle ``cycles``, then follow /IRQ; ``event``: the cycle of the bus event passed
+        on the way, when /IRQ changed if it did."""
+        self.bench.advance(self._seconds(cycles))
+        self._follow_irq(cycles, event)
+
+    def _now(self) -> int:
+        cycles = self.core.cycles_now()
+        self.sync(cycles)
+        return cycles
+
+    # -- /IRQ, EXTI0 and the NVIC ------------------------------------------------------------------------------
+
+    def _follow_irq(self, cycles: int, event: int | None = None) -> None:
+        pulse = self.bench.chip.mod_ack_until
+        if pulse != self._mod_ack_until:  # a new /ModAck pulse (375 ns, 3.6.2): both edges, the falling one latched
+            self._mod_ack_until = pulse
+            self.exti.edge(PORT_B, PIN_MODACK, 0)
+            self.exti.edge(PORT_B, PIN_MODACK, 1)
+        level = self.registers.irq_n
+        if level != self._irq_level:
+            self._irq_level = level
+            if not level and self._irq_fell is None:
+                self._irq_fell = cycles if event is None else event
+            self.exti.edge(0, PIN_IRQ, level)
+        self._request()
+
+    def _request(self) -> None:
+        number = EXTERNAL + EXTI0_IRQ
+        if self.exti.requesting(0) and number not in self.core.active and number not in self.core.pending:
+            self.core.pend(number)
+            self.core.stop_request = True
+
+    def _entered(self, number: int) -> None:
+        if number == EXTERNAL + EXTI0_IRQ:
+            self.interrupts += 1
+            if self._irq_fell is not None:
+                self.irq_latency_s = max(self.irq_latency_s, self._seconds(self.core.cycles - self._irq_fell))
+                self._irq_fell = None
+
+    # -- pins --------------------------------------------------------------------------------------------------
+
+    def _inputs(self) -> int:
+        cycles = self._now()
+        cd = self.protocol.c_d if cycles >= self._ss_rise + self._cycles(self._limits["t6max"]) else self._cd_before
+        return self.registers.irq_n << PIN_IRQ | cd << PIN_CD | int(self.registers.io_access) << PIN_IO
+
+    def _inputs_b(self) -> int:
+        self._now()
+        return self.bench.mod_ack << PIN_MODACK
+
+    def _on_output_b(self, pin: int, level: int) -> None:
+        """Port B drives nothing the chip sees."""
+        del pin, level
+
+    def _cycles(self, seconds: float) -> int:
+        return math.ceil(seconds * self.core.cpu_hz - 1e-6)
+
+    def _on_output(self, pin: int, level: int) -> None:
+        cycles = self._now()
+        if pin == PIN_SS:
+            self._ss_edge(level, cycles)
+        elif pin == PIN_SAS_INIT:
+            if level:
+                self._sas_rise = cycles
+            elif cycles - self._sas_rise < self._cycles(self._limits["t_SAS_INIT"]):
+                self._violation("Table 3-7 t_SAS_INIT", f"SAS_INIT pulse of {self._ns(cycles - self._sas_rise)} ns, "
+                                f"shorter than {self._limits['t_SAS_INIT'] * 1e9:.0f} ns")  # fmt: skip
+            self._chip(lambda: self.bench.transport.set_sas_init(level), cycles)
+        elif pin == PIN_STAT_ERR:
+            self._chip(lambda: self.bench.set_stat_err(not level), cycles)
+
+    def _ns(self, cycles: int) -> str:
+        return f"{self._seconds(cycles) * 1e9:.0f}"
+
+    def _ss_edge(self, level: int, cycles: int) -> None:
+        if not level:
+            gap = cycles - self._ss_rise
+            need = self._limits["t6max"] + self._limits["t8"]
+            if gap < self._cycles(need):
+                self._violation("Table 3-7 t8", f"/SS fell {self._ns(gap)} ns after it rose: C/D settles t6 "
+                                f"(max) + t8 = {need * 1e9:.0f} ns after the rise")  # fmt: skip
+            driven: list[int | None] = [None]
+
+            def begin() -> None:
+                driven[0] = self.protocol.begin(True)
+
+            self._chip(begin, cycles)
+            self._frame = _Frame(cycles, driven[0], [])
+            return
+        frame, self._frame = self._frame, None
+        if frame is None:
+            return
+        self._ss_rise = cycles
+        self._cd_before = self.protocol.c_d
+        edges = sum(min(bits, (cycles - start) // period) for _, bits, start, period in frame.transfers)
+        if edges == 8:
+            tx, bits, start, period = frame.transfers[-1]
+            last = start + bits * period
+            if cycles - last < self._cycles(self._limits["t2"]):
+                self._violation("Table 3-7 t2", f"/SS rose {self._ns(cycles - last)} ns after the last SCLK edge, "
+                                f"less than t2 = {self._limits['t2'] * 1e9:.0f} ns")  # fmt: skip
+            self._chip(lambda: self.protocol.end(tx), cycles)
+        else:
+            self._chip(lambda: self.protocol.abort(edges), cycles)
+
+    def spi_byte(self, tx: int, bits: int, start: int, period: int, cr1: int) -> int:
+        """:class:`~supi3.mcu.stm32.SpiWire`: SPI1 starts a transfer; the chip sees it inside its /SS frame."""
+        self.sync(start)
+        period_s = self._seconds(period)
+        if period_s < self._limits["t0"] * (1 - 1e-9):
+            self._violation("Table 3-7 t0", f"SCLK period {period_s * 1e9:.0f} ns, shorter than t0 = "
+                            f"{self._limits['t0'] * 1e9:.0f} ns")  # fmt: skip
+        if cr1 & (CR1_CPOL | CR1_CPHA) != CR1_CPOL | CR1_CPHA:
+            self._violation("3.4.2", f"SPI mode CPOL={cr1 >> 1 & 1}, CPHA={cr1 & 1}: the chip needs mode 3 (SCLK "
+                            "idles high, data taken on the rising edge, UP-5)")  # fmt: skip
+        frame = self._frame
+        if frame is None:
+            self._violation("3.4.2", f"byte {tx:02X}h clocked with /SS high: the chip ignores it")
+            return MISO_IDLE
+        lsb = bool(cr1 & CR1_LSBFIRST)
+        seen = _reverse(tx & 0xFF) if lsb else tx & 0xFF
+        if not frame.transfers and start + period // 2 - frame.fall < self._cycles(self._limits["t1"]):
+            self._violation("Table 3-7 t1", f"first SCLK edge {self._ns(start + period // 2 - frame.fall)} ns after "
+                            f"/SS fell, less than t1 = {self._limits['t1'] * 1e9:.0f} ns")  # fmt: skip
+        frame.transfers.append((seen, bits, start, period))
+        driven = MISO_IDLE if frame.driven is None else frame.driven
+        return _reverse(driven) if lsb else driven
+
+    # -- the chip and its violations ---------------------------------------------------------------------------
+
+    def _chip(self, action: Callable[[], object], cycles: int) -> None:
+        """Do ``action`` on the chip with its violations deferred to its end; note the new ones with the PC."""
+        log = self.registers.violations
+        before = len(log.records)
+        try:
+            with log.deferred():
+                action()
+        finally:
+            self._note(log.records[before:], cycles)
+            self._follow_irq(cycles)
+
+    def _violation(self, rule: str, detail: str) -> None:
+        self._chip(lambda: self.registers.violations.report(InterfaceViolationError(rule, detail)),
+                   self.core.cycles_now())  # fmt: skip
+
+    def _note(self, errors: list[InterfaceViolationError], cycles: int) -> None:
+        pc = self.core.pc
+        for error in errors:
+            function = self.core.image.function_at(pc)
+            self.violations.append(ViolationAt(self._seconds(cycles), pc, function, error))
+
+    # -- running -----------------------------------------------------------------------------------------------
+
+    def run(self, cycles: int, *, max_instructions: int = DEFAULT_MAX_INSTRUCTIONS) -> None:
+        """Run the firmware until ``cycles`` more master cycles have finished and it has served the interrupts they
+        raised (as :meth:`Bench.run` takes the last cycle's interrupt).
+
+        Raises
+        ------
+        FirmwareFaultError
+            The core faulted (report: fault type, PC, stacked registers).
+        FirmwareStoppedError
+            ``max_instructions`` ran out, or the firmware loops on ``b .`` inside a handler.
+        InterfaceViolationError
+            In strict mode, the first rule the firmware broke, with a note: bus time, PC and function.
+        """
+        target = self.bench.cycles + check_int("cycles", cycles, 0)
+        self._run(lambda: self.bench.cycles >= target and not self.core.in_exception, max_instructions)
+
+    def run_for(self, seconds: float, *, max_instructions: int = DEFAULT_MAX_INSTRUCTIONS) -> None:
+        """Run the firmware for ``seconds`` of bus time (raises as :meth:`run`)."""
+        end = self.core.cycles + self._cycles(check_real("seconds", seconds, 0.0))
+        self._run(lambda: self.core.cycles >= end, max_instructions, end)
+
+    def _run(self, done: Callable[[], bool], max_instructions: int, end: int | None = None) -> None:
+        core = self.core
+        limit = core.instructions + check_int("max_instructions", max_instructions, 1)
+        self.sync(core.cycles)
+        while True:
+            core.systick.update()
+            self._request()
+            if done():
+                return
+            if core.instructions >= limit:
+                raise FirmwareStoppedError(core.report(Stop.BUDGET, f"instruction budget of {max_instructions} used up "
+                                                  "(an endless loop?)"))  # fmt: skip
+            deadline = event = math.ceil(self.bench.next_event_s() * core.cpu_hz)
+            tick = core.systick.next_event()
+            for bound in (tick, end):
+                if bound is not None:
+                    deadline = min(deadline, bound)
+            try:
+                state = core.step(max(deadline, core.cycles + 1))
+            except InterfaceViolationError as error:
+                where = next((v for v in reversed(self.violations) if v.error is error), None)
+                if where is None:  # raised by the bus between two accesses: where the core stopped
+                    where = ViolationAt(core.time_s, core.pc, core.image.function_at(core.pc), error)
+                error.add_note(f"firmware at {where.place}")
+                raise
+            if state == "run" and core.idle_loop():
+                if core.active:
+                    raise FirmwareStoppedError(core.report(Stop.HANG, f"endless loop (b .) in the handler of exception "
+                                                      f"{core.active[-1]}"))  # fmt: skip
+                core.sleeping = True
+            self.sync(core.cycles, event if event <= core.cycles else None)
+
+
+def _reverse(byte: int) -> int:
+    return int(f"{byte:08b}"[::-1], 2)

@@ -1,0 +1,112 @@
+"""Build a firmware for the emulated board with the Zig toolchain from PyPI (``ziglang``): one command.
+
+:func:`build` compiles the SDK's C driver (``supi3.c``), the board port (``board/board.c``, ``board/startup.c``)
+and the firmware's sources for a Cortex-M0 or -M3 and links them with ``board/board.ld``:
+
+    python -m ziglang cc -target thumb-freestanding-eabi -mcpu=cortex_m3 -ffreestanding -nostdlib
+        -std=c99 -Wall -Wextra -pedantic -Werror -Os -g -Wl,--entry=Reset_Handler -T board.ld
+        -I<sdk include> -I<sdk examples> -I<board> board/startup.c board/board.c src/supi3.c FIRMWARE.c -o OUT.elf
+
+From the shell: ``python -m supi3.mcu.build FIRMWARE.c -o OUT.elf [--cpu cortex_m0] [-D NAME=VALUE]`` (guide:
+docs/firmware-in-the-loop.md).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import subprocess
+import sys
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import Final
+
+from supi3 import sdk
+from supi3.errors import ArgumentError, Supi3Error
+from supi3.mcu.core import CPUS
+
+__all__ = ["BOARD_DIR", "FLAGS", "BuildError", "build", "build_command", "main", "toolchain_missing"]
+
+BOARD_DIR: Final[Path] = sdk.SDK_DIR / "board"
+"""The board port: ``board.h``, ``board.c``, ``startup.c``, ``board.ld``."""
+FLAGS: Final[tuple[str, ...]] = ("-target", "thumb-freestanding-eabi", "-ffreestanding", "-nostdlib",
+                                 *sdk.CFLAGS, "-Werror", "-Os", "-g", "-Wl,--entry=Reset_Handler")  # fmt: skip
+"""Flags of every firmware build besides ``-mcpu`` and the paths: the SDK's strict C99 flags, no library."""
+
+
+class BuildError(Supi3Error, RuntimeError):
+    """The firmware did not compile or link (the compiler's messages are in the text), or there is no ziglang."""
+
+
+def toolchain_missing() -> str | None:
+    """Why firmware cannot be built here (``ziglang`` not installed), or ``None``: a test's skip reason."""
+    if importlib.util.find_spec("ziglang") is None:
+        return "ziglang is not installed: firmware builds need the firmware extra (pip install supi3[firmware])"
+    return None
+
+
+def build_command(sources: Sequence[str | Path], output: str | Path, *, cpu: str = "cortex_m3",
+                  defines: Mapping[str, str] | None = None, include_dirs: Iterable[str | Path] = (),
+                  compiler_rt: bool = False, port: bool = True) -> list[str]:  # fmt: skip
+    """The command line :func:`build` runs (see the module's docstring)."""
+    if cpu not in CPUS:
+        raise ArgumentError("cpu", cpu, f"cpu must be one of {', '.join(CPUS)}, not {cpu!r}")
+    paths = [Path(s) for s in sources]
+    for path in paths:
+        if not path.is_file() or path.suffix not in (".c", ".S"):
+            raise ArgumentError("sources", path, f"sources must be paths of existing .c or .S files, not {str(path)!r}")
+    includes = (sdk.include_dir(), sdk.SDK_DIR / "examples", BOARD_DIR, *(Path(d) for d in include_dirs))
+    macros = [f"-D{name}={value}" for name, value in sorted((defines or {}).items())]
+    library = (BOARD_DIR / "startup.c", BOARD_DIR / "board.c", *sdk.sources()) if port else ()
+    return [sys.executable, "-m", "ziglang", "cc", f"-mcpu={cpu}", *FLAGS, *(["-lcompiler_rt"] if compiler_rt else []),
+            "-T", str(BOARD_DIR / "board.ld"), *macros, *(f"-I{d}" for d in includes), *map(str, library),
+            *map(str, paths), "-o", str(output)]  # fmt: skip
+
+
+def build(sources: str | Path | Sequence[str | Path], output: str | Path, *, cpu: str = "cortex_m3",
+          defines: Mapping[str, str] | None = None, include_dirs: Iterable[str | Path] = (),
+          compiler_rt: bool = False, port: bool = True) -> Path:  # fmt: skip
+    """Build the firmware ``sources`` (the ``fw_setup``/``fw_isr``/``fw_loop`` of ``examples/fw_board.h``) with the
+    C driver and the board port into the ELF ``output`` for ``cpu`` (``"cortex_m3"`` or ``"cortex_m0"``).
+
+    ``compiler_rt`` links the toolchain's run-time library, for firmware that needs more helpers than
+    ``startup.c`` has (its first build compiles it: about 15 s). ``port=False`` links ``sources`` (C or assembly
+    with their own vector table) alone with ``board.ld``: no driver, no board port. Returns ``output``.
+
+    Raises
+    ------
+    BuildError
+        If ziglang is missing or the sources do not compile under :data:`FLAGS`.
+    """
+    missing = toolchain_missing()
+    if missing is not None:
+        raise BuildError(missing)
+    files = [sources] if isinstance(sources, str | Path) else list(sources)
+    command = build_command(files, output, cpu=cpu, defines=defines, include_dirs=include_dirs,
+                            compiler_rt=compiler_rt, port=port)  # fmt: skip
+    result = subprocess.run(command, capture_output=True, text=True, check=False)
+    if result.returncode != 0:
+        raise BuildError(f"the firmware does not build for {cpu}:\n{result.stderr}")
+    return Path(output)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python -m supi3.mcu.build FIRMWARE.c [...] -o OUT.elf [--cpu cortex_m0] [-D NAME=VALUE]``."""
+    parser = argparse.ArgumentParser(prog="python -m supi3.mcu.build", description=main.__doc__)
+    parser.add_argument("sources", nargs="+", type=Path, help="the firmware's .c files")
+    parser.add_argument("-o", "--output", type=Path, required=True, help="the ELF to write")
+    parser.add_argument("--cpu", choices=sorted(CPUS), default="cortex_m3")
+    parser.add_argument("-D", dest="defines", action="append", default=[], metavar="NAME=VALUE")
+    args = parser.parse_args(argv)
+    defines = dict(d.split("=", 1) if "=" in d else (d, "1") for d in args.defines)
+    try:
+        build(args.sources, args.output, cpu=args.cpu, defines=defines)
+    except (BuildError, ArgumentError) as error:
+        print(error, file=sys.stderr)
+        return 1
+    print(args.output)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

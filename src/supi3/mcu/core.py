@@ -1,0 +1,877 @@
+"""A Cortex-M core on unicorn: memory map, ELF loading, the timing model, exceptions, SysTick and the NVIC.
+
+Ref: ARMv7-M Architecture Reference Manual (ARM DDI 0403): B1.5 (exception model: B1.5.6 entry, B1.5.7 stack
+alignment, B1.5.8 return), B3.2 (SCB), B3.3 (SysTick), B3.4 (NVIC); ARMv6-M (ARM DDI 0419) for the Cortex-M0;
+Cortex-M3 Technical Reference Manual (ARM DDI 0337): instruction timing, interrupt latency. Guide:
+docs/firmware-in-the-loop.md; decisions MCU-n in docs/assumptions/mcu.md.
+
+unicorn 2 runs Thumb code of an M-profile core but has no NVIC: it neither enters an exception nor returns from one
+(a branch to an EXC_RETURN value only raises its internal "exception exit", number :data:`EXCP_EXCEPTION_EXIT`, and
+then loops on a prefetch abort). :class:`CortexM` does both itself, as the architecture says (B1.5.6, B1.5.8).
+
+Timing (MCU-1): every basic block unicorn enters costs its instructions' cycles (:func:`block_cost`: one per
+instruction, one more per single load or store, one per register of a multiple load or store, two more for a
+branch that ends the block, taken as taken), so the clock is exact at block boundaries; a peripheral access is
+placed inside its block by the program counter (:meth:`CortexM.cycles_now`). Emulation only ever stops at a block
+boundary (a block hook refuses the next block), because unicorn restarts an instruction stopped inside a memory
+callback and a peripheral would see its access twice.
+"""
+
+from __future__ import annotations
+
+import struct
+from collections.abc import Callable
+from dataclasses import dataclass
+from enum import StrEnum
+from pathlib import Path
+from typing import Any, Final
+
+import unicorn
+from unicorn import arm_const as arm
+from unicorn import unicorn_const as ucc
+
+from supi3.checks import check_real
+from supi3.errors import ArgumentError, Supi3Error
+
+_UNICORN: Any = unicorn  # typed, but its Uc methods are not annotated
+UcError: type[Exception] = _UNICORN.UcError
+
+__all__ = [
+    "CPUS",
+    "EXC_RETURN_HANDLER",
+    "EXC_RETURN_THREAD_MSP",
+    "EXC_RETURN_THREAD_PSP",
+    "CortexM",
+    "Cpu",
+    "FirmwareError",
+    "FirmwareFaultError",
+    "FirmwareImage",
+    "FirmwareStoppedError",
+    "Stop",
+    "StopReport",
+    "SysTick",
+    "block_cost",
+    "is_poll_loop",
+]
+
+EXCP_EXCEPTION_EXIT: Final[int] = 8
+"""unicorn's interrupt number for a branch to an EXC_RETURN value in handler mode (QEMU's EXCP_EXCEPTION_EXIT)."""
+EXCP_SWI: Final[int] = 2
+EXCP_BKPT: Final[int] = 7
+EXC_RETURN_HANDLER: Final[int] = 0xFFFF_FFF1
+"""Return to handler mode, main stack (B1.5.8, Table B1-8)."""
+EXC_RETURN_THREAD_MSP: Final[int] = 0xFFFF_FFF9
+"""Return to thread mode, main stack."""
+EXC_RETURN_THREAD_PSP: Final[int] = 0xFFFF_FFFD
+"""Return to thread mode, process stack."""
+FRAME_WORDS: Final[int] = 8
+"""The basic stack frame: R0-R3, R12, LR, return address, xPSR (B1.5.6)."""
+XPSR_T: Final[int] = 1 << 24
+XPSR_ALIGN: Final[int] = 1 << 9
+"""Stacked xPSR bit 9: the frame was aligned to 8 bytes by one more word (B1.5.7)."""
+CONTROL_SPSEL: Final[int] = 1 << 1
+
+HARDFAULT: Final[int] = 3
+SVCALL: Final[int] = 11
+PENDSV: Final[int] = 14
+SYSTICK: Final[int] = 15
+EXTERNAL: Final[int] = 16
+"""Exception number of IRQ 0 (B1.5.2)."""
+EXCEPTION_NAMES: Final[dict[int, str]] = {1: "Reset", 2: "NMI", 3: "HardFault", 4: "MemManage", 5: "BusFault",
+                                          6: "UsageFault", 11: "SVCall", 12: "DebugMonitor", 14: "PendSV",
+                                          15: "SysTick"}  # fmt: skip
+
+SCS_BASE: Final[int] = 0xE000_E000
+SCS_SIZE: Final[int] = 0x1000
+SYST_MAX: Final[int] = 0xFF_FFFF
+"""SysTick is a 24-bit down counter (B3.3.1)."""
+IRQ_LINES: Final[int] = 32
+"""External interrupts the NVIC model has (one ISER word)."""
+
+
+@dataclass(frozen=True)
+class Cpu:
+    """A core variant: unicorn's CPU model, CPUID (B3.2.3) and its exception entry and return cycles (MCU-2)."""
+
+    name: str
+    model: int
+    cpuid: int
+    entry_cycles: int
+    return_cycles: int
+    vtor: bool
+
+
+CPUS: Final[dict[str, Cpu]] = {
+    # Cortex-M3: 12 cycles from the interrupt to the handler's first instruction, return 10 (MCU-2).
+    "cortex_m3": Cpu("cortex_m3", arm.UC_CPU_ARM_CORTEX_M3, 0x412F_C231, 12, 10, vtor=True),
+    # Cortex-M0: 16 cycles interrupt latency, the return taken as long (MCU-2). ARMv6-M: no VTOR.
+    "cortex_m0": Cpu("cortex_m0", arm.UC_CPU_ARM_CORTEX_M0, 0x410C_C200, 16, 16, vtor=False),
+}
+"""The cores :class:`CortexM` emulates, by their ``-mcpu`` names."""
+
+_REGS: Final[tuple[tuple[str, int], ...]] = (
+    *((f"r{k}", getattr(arm, f"UC_ARM_REG_R{k}")) for k in range(13)),
+    ("sp", arm.UC_ARM_REG_SP), ("lr", arm.UC_ARM_REG_LR), ("pc", arm.UC_ARM_REG_PC), ("xpsr", arm.UC_ARM_REG_XPSR),
+)  # fmt: skip
+_FRAME_REGS: Final[tuple[int, ...]] = (arm.UC_ARM_REG_R0, arm.UC_ARM_REG_R1, arm.UC_ARM_REG_R2, arm.UC_ARM_REG_R3,
+                                       arm.UC_ARM_REG_R12, arm.UC_ARM_REG_LR)  # fmt: skip
+FRAME_NAMES: Final[tuple[str, ...]] = ("r0", "r1", "r2", "r3", "r12", "lr", "pc", "xpsr")
+"""The stacked frame's words in address order (B1.5.6)."""
+
+
+# ------------------------------------------------------------------------------------------------------------
+# Reports
+# ------------------------------------------------------------------------------------------------------------
+
+
+class Stop(StrEnum):
+    """Why a run of the firmware ended before its goal."""
+
+    FAULT = "fault"
+    BUDGET = "budget"
+    HANG = "hang"
+
+
+@dataclass(frozen=True)
+class StopReport:
+    """What the core looked like when a run ended early: the why, the registers and, for a fault, the frame the
+    core stacked when it took the HardFault (what a debugger shows in the fault handler)."""
+
+    stop: Stop
+    reason: str
+    pc: int
+    registers: dict[str, int]
+    instructions: int
+    cycles: int
+    time_s: float
+    stacked: dict[str, int] | None = None
+    symbol: str | None = None
+
+    def __str__(self) -> str:
+        where = f"PC {self.pc:08X}h" + (f" ({self.symbol})" if self.symbol else "")
+        text = f"{self.stop.value}: {self.reason} at {where}, t = {self.time_s * 1e6:.3f} µs, " \
+               f"{self.instructions} instructions"  # fmt: skip
+        if self.stacked is not None:
+            text += "; stacked " + " ".join(f"{name}={value:08X}h" for name, value in self.stacked.items())
+        return text
+
+
+class FirmwareError(Supi3Error, RuntimeError):
+    """The firmware did not reach the run's goal; :attr:`report` says why and where."""
+
+    def __init__(self, report: StopReport) -> None:
+        self.report = report
+        super().__init__(str(report))
+
+
+class FirmwareFaultError(FirmwareError):
+    """The core faulted (bus error, undefined instruction, bad state): the HardFault frame is in the report."""
+
+
+class FirmwareStoppedError(FirmwareError):
+    """The run's instruction budget ran out, the firmware hung in a handler, or it needs what is not modelled."""
+
+
+# ------------------------------------------------------------------------------------------------------------
+# The firmware image
+# ------------------------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class FirmwareImage:
+    """An ELF firmware: its loadable segments (physical addresses), entry point and symbols (pyelftools)."""
+
+    path: Path
+    segments: tuple[tuple[int, bytes], ...]
+    entry: int
+    symbols: dict[str, tuple[int, int]]
+    """name -> (address, size) of the functions, objects and labels; Thumb functions without their bit 0."""
+
+    @classmethod
+    def load(cls, path: str | Path) -> FirmwareImage:
+        """Read ``path``; raises :class:`ArgumentError` if it is not a 32-bit little-endian ARM ELF."""
+        from elftools.common.exceptions import ELFError
+        from elftools.elf.elffile import ELFFile
+        from elftools.elf.sections import SymbolTableSection
+
+        path = Path(path)
+        try:
+            with path.open("rb") as stream:
+                elf = ELFFile(stream)
+                if elf["e_machine"] != "EM_ARM" or elf.elfclass != 32 or not elf.little_endian:
+                    raise ArgumentError("path", path, f"path must be a 32-bit little-endian ARM ELF, not {path}")
+                segments = tuple((int(seg["p_paddr"]), bytes(seg.data())) for seg in elf.iter_segments()
+                                 if seg["p_type"] == "PT_LOAD" and seg["p_filesz"])  # fmt: skip
+                table = elf.get_section_by_name(".symtab")
+                symbols = {} if not isinstance(table, SymbolTableSection) else {
+                    sym.name: (int(sym["st_value"]) & ~1 if sym["st_info"]["type"] == "STT_FUNC"
+                               else int(sym["st_value"]), int(sym["st_size"]))
+                    for sym in table.iter_symbols()
+                    if sym.name and not sym.name.startswith("$") and sym["st_shndx"] != "SHN_UNDEF"
+                    and sym["st_info"]["type"] in ("STT_FUNC", "STT_OBJECT", "STT_NOTYPE")
+                }  # fmt: skip
+                return cls(path, segments, int(elf["e_entry"]), symbols)
+        except (OSError, ELFError) as error:
+            raise ArgumentError("path", path, f"path must be a readable ELF file, not {path} ({error})") from error
+
+    def address(self, name: str) -> int:
+        """The address of symbol ``name``; :class:`ArgumentError` if the firmware has none."""
+        try:
+            return self.symbols[name][0]
+        except KeyError:
+            raise ArgumentError("name", name, f"name must be a symbol of {self.path.name}, not {name!r}") from None
+
+    def function_at(self, pc: int) -> str | None:
+        """The function whose code holds ``pc``, if the symbol table says."""
+        for name, (address, size) in self.symbols.items():
+            if address <= pc < address + max(size, 1):
+                return name
+        return None
+
+
+# ------------------------------------------------------------------------------------------------------------
+# The timing model (MCU-1)
+# ------------------------------------------------------------------------------------------------------------
+
+
+def _is_32bit(halfword: int) -> bool:
+    return (halfword >> 11) in (0b11101, 0b11110, 0b11111)
+
+
+def _cost(first: int, second: int | None) -> tuple[int, bool]:
+    """Cycles of one instruction (MCU-1), and whether it is a branch."""
+    if second is None:
+        if (first >> 11) == 0b01001 or (first >> 12) in (0b0101, 0b1000, 0b1001) or (first >> 13) == 0b011:
+            return 2, False  # LDR literal, LDR/STR register, immediate, halfword, SP-relative
+        if (first & 0xF600) == 0xB400:  # PUSH / POP
+            pc = (first & 0xFF00) == 0xBD00
+            return 1 + bin(first & 0x1FF).count("1"), pc
+        if (first >> 12) == 0b1100:  # LDM / STM
+            return 1 + bin(first & 0xFF).count("1"), False
+        branch = ((first >> 12) == 0b1101 and (first >> 9) & 0b111 != 0b111) or (first >> 11) == 0b11100 \
+            or (first & 0xFF00) == 0x4700 or (first & 0xF500) == 0xB100  # fmt: skip
+        return 1, branch
+    if (first >> 9) == 0b1111100:  # load / store single (32-bit encodings)
+        return 2, False
+    if (first >> 9) == 0b1110100:  # LDM / STM (32-bit)
+        return 1 + bin(second & 0xDFFF).count("1"), bool(second & 0x8000) and bool(first & 0x10)
+    if (first >> 11) != 0b11110 or not second & 0x8000:
+        return 1, False
+    # B.W and BL (second[12] or second[14] set), B<c>.W unless its condition field is 111x (MSR, MRS, hints)
+    return 1, bool(second & 0x5000) or (first >> 7) & 0b111 != 0b111
+
+
+def is_poll_loop(code: bytes, address: int) -> bool:
+    """The block ``code`` at ``address`` is a pure poll loop (MCU-10): ``LDR Rt, [Rn, #imm]`` (Rt is not Rn), then
+    only shifts of Rt by an immediate (LSLS, LSRS), ``TST Rt, Rm`` or ``CMP Rt, #imm``, and a conditional branch
+    back to ``address``. Its iterations write only Rt and the flags, which the last one writes again."""
+    halfwords = [code[k] | code[k + 1] << 8 for k in range(0, len(code) - 1, 2)]
+    if len(halfwords) < 2 or (halfwords[0] >> 11) != 0b01101:
+        return False
+    rt, rn = halfwords[0] & 7, halfwords[0] >> 3 & 7
+    if rt == rn:
+        return False
+    for middle in halfwords[1:-1]:
+        shift = (middle >> 11) in (0b00000, 0b00001) and middle & 7 == rt and middle >> 3 & 7 == rt
+        test = (middle & 0xFFC0) == 0x4200 and middle & 7 == rt
+        compare = (middle >> 11) == 0b00101 and middle >> 8 & 7 == rt
+        if not (shift or test or compare):
+            return False
+    branch = halfwords[-1]
+    if (branch >> 12) != 0b1101 or (branch >> 9) & 0b111 == 0b111:
+        return False
+    offset = (branch & 0xFF) - (0x100 if branch & 0x80 else 0)
+    return address + 2 * (len(halfwords) - 1) + 4 + 2 * offset == address
+
+
+def block_cost(code: bytes) -> tuple[int, int]:
+    """(instructions, cycles) of the Thumb code ``code`` run straight through (MCU-1): one cycle per instruction,
+    one more per single load or store, one per register of LDM/STM/PUSH/POP, two more if the last instruction is
+    a branch (the pipeline refill of a taken branch)."""
+    instructions = cycles = 0
+    offset = 0
+    branch = False
+    while offset + 1 < len(code):
+        first = code[offset] | code[offset + 1] << 8
+        if _is_32bit(first) and offset + 3 < len(code):
+            second = code[offset + 2] | code[offset + 3] << 8
+            cost, branch = _cost(first, second)
+            offset += 4
+        else:
+            cost, branch = _cost(first, None)
+            offset += 2
+        instructions += 1
+        cycles += cost
+    return instructions, cycles + (2 if branch else 0)
+
+
+# ------------------------------------------------------------------------------------------------------------
+# The core
+# ------------------------------------------------------------------------------------------------------------
+
+ReadFn = Callable[[int, int], int]
+WriteFn = Callable[[int, int, int], None]
+
+
+class CortexM:
+    """A Cortex-M0 or -M3 with flash, RAM, the system control space (SysTick, NVIC, SCB) and the firmware loaded.
+
+    Parameters
+    ----------
+    image:
+        The firmware (:class:`FirmwareImage` or an ELF path).
+    cpu:
+        ``"cortex_m3"`` or ``"cortex_m0"`` (:data:`CPUS`).
+    cpu_hz:
+        The core clock: cycles to seconds.
+    flash, ram:
+        (base, size) of each memory.
+
+    Attributes
+    ----------
+    cycles, instructions:
+        Cycles and instructions since reset (exception entry and return cycles included in :attr:`cycles`).
+    """
+
+    def __init__(self, image: FirmwareImage | str | Path, *, cpu: str = "cortex_m3", cpu_hz: float = 48e6,
+                 flash: tuple[int, int] = (0x0800_0000, 64 * 1024),
+                 ram: tuple[int, int] = (0x2000_0000, 20 * 1024)) -> None:  # fmt: skip
+        self.image = image if isinstance(image, FirmwareImage) else FirmwareImage.load(image)
+        if cpu not in CPUS:
+            raise ArgumentError("cpu", cpu, f"cpu must be one of {', '.join(CPUS)}, not {cpu!r}")
+        self.cpu = CPUS[cpu]
+        self.cpu_hz = check_real("cpu_hz", cpu_hz, 1e3, 1e9, limit="the core clock in Hz")
+        self.uc: Any = _UNICORN.Uc(ucc.UC_ARCH_ARM, ucc.UC_MODE_THUMB | ucc.UC_MODE_MCLASS)
+        self.uc.ctl_set_cpu_model(self.cpu.model)
+        self.flash = flash
+        self.ram = ram
+        for base, size in (flash, ram):
+            self.uc.mem_map(base, size)
+        for address, data in self.image.segments:
+            self.uc.mem_write(address, data)
+        self.cycles = 0
+        self.instructions = 0
+        self.deadline = 0
+        self.sleeping = False
+        self.active: list[int] = []  # active exceptions, outermost first
+        self.pending: set[int] = set()
+        self.enabled: set[int] = set()  # external interrupts enabled in the NVIC (exception numbers)
+        self.priorities: dict[int, int] = {}
+        self.stop_request = False
+        self.error: BaseException | None = None
+        self.exception_exit = False
+        self.interrupt: int | None = None
+        self.entered: Callable[[int], None] = _nothing
+        """Called with the exception number after each exception entry (the board measures latency)."""
+        self._costs: dict[tuple[int, int], tuple[int, int]] = {}
+        self._block = (0, 0)  # address and cycle count at the entry of the block running
+        self._block_end = 0
+        self._running = False
+        self._handed = 0  # the latest time a peripheral was given
+        self._skip: tuple[int, int] | None = None  # (poll loop address, cycle its status changes)
+        self._polls: dict[int, bool] = {}
+        self.skip_polls = True
+        """MCU-10: skip the iterations of pure poll loops (the same result, faster); ``False`` runs each."""
+        self.vtor = 0
+        self.systick = SysTick(self)
+        self._scs_words: dict[int, int] = {}
+        self.mmio(SCS_BASE, SCS_SIZE, self._scs_read, self._scs_write)
+        self.uc.hook_add(ucc.UC_HOOK_BLOCK, self._on_block)
+        self.uc.hook_add(ucc.UC_HOOK_INTR, self._on_interrupt)
+        self.reset()
+
+    # -- memory ------------------------------------------------------------------------------------------------
+
+    def mmio(self, base: int, size: int, read: ReadFn, write: WriteFn) -> None:
+        """Map a peripheral: ``read(offset, size) -> value`` and ``write(offset, size, value)`` run on every
+        access. An exception they raise stops the run at the end of the block (:attr:`error`)."""
+
+        def on_read(uc: Any, offset: int, size: int, data: Any) -> int:
+            del uc, data
+            try:
+                return read(offset, size)
+            except BaseException as error:  # handed to the run loop, raised there
+                self.fail(error)
+                return 0
+
+        def on_write(uc: Any, offset: int, size: int, value: int, data: Any) -> None:
+            del uc, data
+            try:
+                write(offset, size, value)
+            except BaseException as error:  # handed to the run loop, raised there
+                self.fail(error)
+
+        self.uc.mmio_map(base, size, on_read, None, on_write, None)
+
+    def read_bytes(self, address: int, size: int) -> bytes:
+        """Memory as the core sees it (RAM, flash)."""
+        return bytes(self.uc.mem_read(address, size))
+
+    def write_bytes(self, address: int, data: bytes) -> None:
+        """Write memory (RAM) from the host, between runs."""
+        self.uc.mem_write(address, data)
+
+    def fail(self, error: BaseException) -> None:
+        """Stop at the end of the running block and raise ``error`` from :meth:`run` (the first one wins)."""
+        if self.error is None:
+            self.error = error
+        self.stop_request = True
+
+    # -- registers ---------------------------------------------------------------------------------------------
+
+    def reg(self, name: str) -> int:
+        """One register by name (``r0``..``r12``, ``sp``, ``lr``, ``pc``, ``xpsr``, ``primask``, ``control``)."""
+        return int(self.uc.reg_read(getattr(arm, f"UC_ARM_REG_{name.upper()}")))
+
+    def set_reg(self, name: str, value: int) -> None:
+        """Write one register by name (as :meth:`reg`), between runs."""
+        self.uc.reg_write(getattr(arm, f"UC_ARM_REG_{name.upper()}"), value)
+
+    def registers(self) -> dict[str, int]:
+        """R0-R12, SP, LR, PC and xPSR."""
+        return {name: int(self.uc.reg_read(reg)) for name, reg in _REGS}
+
+    @property
+    def pc(self) -> int:
+        """The address of the next instruction."""
+        return int(self.uc.reg_read(arm.UC_ARM_REG_PC))
+
+    @property
+    def time_s(self) -> float:
+        """Core time: cycles / cpu_hz."""
+        return self.cycles / self.cpu_hz
+
+    def cycles_now(self) -> int:
+        """The cycle of the instruction running now: inside a peripheral callback the block's entry plus the
+        instructions before the program counter (MCU-1), between runs :attr:`cycles`. Never earlier than a time
+        already handed out (:meth:`cycles_polled`)."""
+        if not self._running:
+            return self.cycles
+        address, start = self._block
+        pc = int(self.uc.reg_read(arm.UC_ARM_REG_PC))
+        if pc > address:
+            key = (address, pc - address)
+            cost = self._costs.get(key)
+            if cost is None:
+                cost = self._costs[key] = block_cost(self.read_bytes(address, pc - address))
+            start += cost[1]
+        self._handed = max(self._handed, start)
+        return self._handed
+
+    def cycles_polled(self) -> int:
+        """The time of a status read (a flag the firmware polls): the end of the running block, which costs no
+        register read; later times handed out are never earlier (MCU-1)."""
+        if not self._running:
+            return self.cycles
+        self._handed = max(self._handed, self.cycles)
+        return self._handed
+
+    # -- reset and exceptions ----------------------------------------------------------------------------------
+
+    def reset(self) -> None:
+        """Power-on reset (B1.5.5): MSP and PC from the vector table at the flash base, thread mode, privileged."""
+        base = self.flash[0]
+        sp, entry = struct.unpack("<2I", self.read_bytes(base, 8))
+        self.uc.reg_write(arm.UC_ARM_REG_XPSR, XPSR_T)
+        self.uc.reg_write(arm.UC_ARM_REG_MSP, sp)
+        self.uc.reg_write(arm.UC_ARM_REG_SP, sp)
+        self.uc.reg_write(arm.UC_ARM_REG_PC, entry & ~1)
+        self.vtor = base
+        self.active.clear()
+        self.pending.clear()
+
+    def vector(self, number: int) -> int:
+        """Entry ``number`` of the vector table."""
+        return int(struct.unpack("<I", self.read_bytes(self.vtor + 4 * number, 4))[0])
+
+    def priority(self, number: int) -> int:
+        """The priority of exception ``number``: Reset, NMI, HardFault fixed at -3, -2, -1 (B1.5.4)."""
+        if number <= HARDFAULT:
+            return number - 4
+        return self.priorities.get(number, 0)
+
+    def execution_priority(self) -> int:
+        """The running priority: the highest (lowest number) active exception, 0 under PRIMASK (B1.5.4); 256 in
+        thread mode with nothing masked."""
+        running = min((self.priority(n) for n in self.active), default=256)
+        if self.reg("primask") & 1:
+            running = min(running, 0)
+        return running
+
+    def pend(self, number: int) -> None:
+        """Make exception ``number`` pending (an external interrupt: ``EXTERNAL + irq``)."""
+        self.pending.add(number)
+        self.sleeping = False if self._takeable() is not None else self.sleeping
+
+    @property
+    def in_exception(self) -> bool:
+        """An exception is active, or pending and allowed to preempt: the core has interrupt work to do."""
+        return bool(self.active) or self._takeable() is not None
+
+    def _takeable(self) -> int | None:
+        candidates = [n for n in self.pending if n < EXTERNAL or n in self.enabled]
+        if not candidates:
+            return None
+        best = min(candidates, key=lambda n: (self.priority(n), n))
+        return best if self.priority(best) < self.execution_priority() else None
+
+    def enter(self, number: int) -> None:
+        """Exception entry (B1.5.6): stack the basic frame on the current stack, aligned to 8 bytes (B1.5.7), LR
+        = EXC_RETURN, IPSR = ``number``, PC = its vector; costs :attr:`Cpu.entry_cycles`."""
+        uc = self.uc
+        handler_mode = bool(self.active)
+        control = self.reg("control")
+        if control & CONTROL_SPSEL and not handler_mode:
+            raise FirmwareStoppedError(self.report(Stop.FAULT, "exception entry from thread mode on the process stack "
+                                              "(CONTROL.SPSEL = 1) is not modelled (MCU-3)"))  # fmt: skip
+        sp = int(uc.reg_read(arm.UC_ARM_REG_SP))
+        words = [int(uc.reg_read(r)) for r in _FRAME_REGS]
+        xpsr = int(uc.reg_read(arm.UC_ARM_REG_XPSR))
+        aligned = sp & 4
+        frame = (sp - FRAME_WORDS * 4) & ~7
+        words += [self.pc, xpsr | (XPSR_ALIGN if aligned else 0)]
+        try:
+            uc.mem_write(frame, struct.pack("<8I", *words))
+        except UcError as error:
+            raise FirmwareFaultError(self.report(Stop.FAULT, f"stacking error: the frame at {frame:08X}h is not in "
+                                            f"memory ({error})")) from None  # fmt: skip
+        uc.reg_write(arm.UC_ARM_REG_SP, frame)
+        uc.reg_write(arm.UC_ARM_REG_LR, EXC_RETURN_HANDLER if handler_mode else EXC_RETURN_THREAD_MSP)
+        uc.reg_write(arm.UC_ARM_REG_XPSR, XPSR_T | number)
+        target = self.vector(number)
+        uc.reg_write(arm.UC_ARM_REG_PC, target & ~1)
+        self.pending.discard(number)
+        self.active.append(number)
+        self.cycles += self.cpu.entry_cycles
+        self.sleeping = False
+        self.entered(number)
+        if not target & 1:
+            reason = f"vector {number} ({_name(number)}) is {target:08X}h: bit 0 clear, an INVSTATE UsageFault (B1.5.6)"
+            raise FirmwareFaultError(self.report(Stop.FAULT, reason, stacked=frame))
+
+    def exception_return(self, exc_return: int) -> None:
+        """Exception return (B1.5.8): unstack the frame, undo the alignment word, back to the mode EXC_RETURN
+        names; costs :attr:`Cpu.return_cycles`."""
+        uc = self.uc
+        if exc_return not in (EXC_RETURN_HANDLER, EXC_RETURN_THREAD_MSP) or not self.active:
+            raise FirmwareFaultError(self.report(Stop.FAULT, f"exception return with EXC_RETURN {exc_return:08X}h "
+                                            f"{'in' if self.active else 'outside'} a handler: an INVPC "
+                                            "UsageFault or not modelled (MCU-3)"))  # fmt: skip
+        if (exc_return == EXC_RETURN_HANDLER) != (len(self.active) > 1):
+            nesting = f"{len(self.active)} active exception(s)"
+            reason = f"EXC_RETURN {exc_return:08X}h does not match the nesting of {nesting}: INVPC UsageFault (B1.5.8)"
+            raise FirmwareFaultError(self.report(Stop.FAULT, reason))
+        sp = int(uc.reg_read(arm.UC_ARM_REG_SP))
+        words = struct.unpack("<8I", self.read_bytes(sp, FRAME_WORDS * 4))
+        for reg, value in zip(_FRAME_REGS, words[:6], strict=True):
+            uc.reg_write(reg, value)
+        xpsr = words[7]
+        sp += FRAME_WORDS * 4 + (4 if xpsr & XPSR_ALIGN else 0)
+        uc.reg_write(arm.UC_ARM_REG_SP, sp)
+        uc.reg_write(arm.UC_ARM_REG_XPSR, (xpsr & ~XPSR_ALIGN) | XPSR_T)
+        uc.reg_write(arm.UC_ARM_REG_PC, words[6] & ~1)
+        self.active.pop()
+        self.cycles += self.cpu.return_cycles
+
+    # -- running -----------------------------------------------------------------------------------------------
+
+    def _on_block(self, uc: Any, address: int, size: int, data: Any) -> None:
+        del data
+        if self.stop_request or self.cycles >= self.deadline:
+            uc.emu_stop()  # this block does not run: it is the first of the next run
+            return
+        key = (address, size)
+        cost = self._costs.get(key)
+        if cost is None:
+            cost = self._costs[key] = block_cost(self.read_bytes(address, size))
+        skip = self._skip
+        if skip is not None:
+            self._skip = None
+            if skip[0] == address:
+                self._skip_polls(cost, skip[1])
+                if self.cycles >= self.deadline:
+                    uc.emu_stop()
+                    return
+        self._block = (address, self.cycles)
+        self._block_end = address + size
+        self.instructions += cost[0]
+        self.cycles += cost[1]
+
+    def _skip_polls(self, cost: tuple[int, int], until: int) -> None:
+        """Count, without running them, the iterations of a poll loop that would start before the deadline and
+        read before ``until`` (MCU-10): each reads at its block's end (:meth:`cycles_polled`)."""
+        instructions, cycles = cost
+        before_deadline = -(-(self.deadline - self.cycles) // cycles)
+        reading_early = -(-(until - cycles - self.cycles) // cycles)
+        skipped = max(0, min(before_deadline, reading_early))
+        self.instructions += skipped * instructions
+        self.cycles += skipped * cycles
+
+    def skip_poll(self, until: int) -> None:
+        """The status register just read keeps its value until cycle ``until``: if the running block is a pure poll
+        loop on it (:func:`is_poll_loop`), its next iterations up to then are counted without running (MCU-10)."""
+        if not self.skip_polls:
+            return
+        address = self._block[0]
+        pure = self._polls.get(address)
+        if pure is None:
+            pure = self._polls[address] = is_poll_loop(self.read_bytes(address, self._block_end - address), address)
+        if pure:
+            self._skip = (address, until)
+
+    def _on_interrupt(self, uc: Any, number: int, data: Any) -> None:
+        del data
+        self.interrupt = number
+        uc.emu_stop()
+
+    def step(self, deadline: int) -> str:
+        """Run from the current PC until the clock reaches ``deadline`` (cycles; checked at block boundaries), a
+        peripheral asks to stop, or the core sleeps, faults or returns from an exception. Returns ``"run"`` or
+        ``"sleep"``; raises :class:`FirmwareError` for a fault or a breakpoint, or the error a peripheral raised.
+
+        A pending exception that may preempt (B1.5.4) is entered first; a sleeping core (WFI, or ``b .`` in thread
+        mode: MCU-4) only lets the time pass."""
+        self.deadline = deadline
+        number = self._takeable()
+        if number is not None:
+            self.enter(number)
+        if self.sleeping:
+            self.cycles = max(self.cycles, deadline)
+            return "sleep"
+        self.stop_request = False
+        self.interrupt = None
+        pc = self.pc
+        self._running = True
+        try:
+            self.uc.emu_start(pc | 1, 0)
+        except UcError as error:
+            raise FirmwareFaultError(self._fault(error)) from None
+        finally:
+            self._running = False
+        failure = self.error
+        if failure is not None:
+            self.error = None
+            raise failure
+        return self._after_stop()
+
+    def _after_stop(self) -> str:
+        pc = self.pc
+        number = self.interrupt
+        if number == EXCP_EXCEPTION_EXIT:
+            self.exception_return(pc | 1)
+            return "run"
+        if number == EXCP_SWI:
+            self.enter(SVCALL)
+            return "run"
+        if number is not None:
+            what = "a breakpoint (BKPT)" if number == EXCP_BKPT else f"core exception {number}"
+            raise FirmwareStoppedError(self.report(Stop.FAULT, f"{what}: not modelled"))
+        if pc == self._block_end and self.read_bytes(pc - 2, 2) in (b"\x30\xbf", b"\x20\xbf"):
+            self.sleeping = True  # the last block ended in WFI or WFE: unicorn halts the core after them
+            return "sleep"
+        if self.stop_request or self.cycles >= self.deadline:
+            return "run"
+        raise FirmwareStoppedError(self.report(Stop.FAULT, "the core stopped for no known reason"))
+
+    def idle_loop(self) -> bool:
+        """The core sits on ``b .`` (a branch to itself): in thread mode it waits for an interrupt (MCU-4)."""
+        pc = self.pc
+        return bool(self.flash[0] <= pc < self.flash[0] + self.flash[1] - 1 and
+                    self.read_bytes(pc, 2) == b"\xfe\xe7")  # fmt: skip
+
+    def _fault(self, error: Any) -> StopReport:
+        pc = self.pc
+        kinds = {
+            ucc.UC_ERR_READ_UNMAPPED: "precise bus fault: read of unmapped memory",
+            ucc.UC_ERR_WRITE_UNMAPPED: "precise bus fault: write to unmapped memory",
+            ucc.UC_ERR_FETCH_UNMAPPED: "instruction bus fault: fetch from unmapped memory (run-away PC)",
+            ucc.UC_ERR_INSN_INVALID: "usage fault: undefined instruction",
+            ucc.UC_ERR_READ_UNALIGNED: "usage fault: unaligned read",
+            ucc.UC_ERR_WRITE_UNALIGNED: "usage fault: unaligned write",
+            ucc.UC_ERR_FETCH_PROT: "memory fault: execute from a non-executable region",
+            ucc.UC_ERR_WRITE_PROT: "memory fault: write to read-only memory",
+        }
+        reason = kinds.get(error.errno, f"fault ({error})")
+        frame: int | None = None
+        if self.ram[0] + FRAME_WORDS * 4 <= (self.reg("sp") & ~7) <= self.ram[0] + self.ram[1]:
+            try:  # take the HardFault as the core would: the report shows the frame its handler would see
+                self.enter(HARDFAULT)
+                frame = self.reg("sp")
+            except FirmwareError:
+                frame = None
+        return self.report(Stop.FAULT, reason, pc=pc, stacked=frame)
+
+    def report(self, stop: Stop, reason: str, *, pc: int | None = None, stacked: int | None = None) -> StopReport:
+        """A :class:`StopReport` of the core now; ``stacked``: the address of a stacked frame to include."""
+        pc = self.pc if pc is None else pc
+        frame = None
+        if stacked is not None:
+            words = struct.unpack("<8I", self.read_bytes(stacked, FRAME_WORDS * 4))
+            frame = dict(zip(FRAME_NAMES, words, strict=True))
+        return StopReport(stop, reason, pc, self.registers(), self.instructions, self.cycles, self.time_s, frame,
+                          self.image.function_at(pc))  # fmt: skip
+
+    # -- system control space: SysTick, NVIC, SCB (B3.2 to B3.4) -----------------------------------------------
+
+    def _scs_read(self, offset: int, size: int) -> int:
+        if 0x010 <= offset < 0x020:
+            return self.systick.read(offset - 0x010)
+        if 0x100 <= offset < 0x104 or 0x180 <= offset < 0x184:  # ISER0, ICER0
+            return sum(1 << (n - EXTERNAL) for n in self.enabled)
+        if 0x200 <= offset < 0x204 or 0x280 <= offset < 0x284:  # ISPR0, ICPR0
+            return sum(1 << (n - EXTERNAL) for n in self.pending if n >= EXTERNAL)
+        if 0x300 <= offset < 0x304:  # IABR0
+            return sum(1 << (n - EXTERNAL) for n in self.active if n >= EXTERNAL)
+        if 0x400 <= offset < 0x420:  # IPR: one byte per interrupt
+            return self._priority_bytes(EXTERNAL + offset - 0x400, size)
+        if offset == 0xD00:
+            return self.cpu.cpuid
+        if offset == 0xD04:  # ICSR: VECTACTIVE, PENDSTSET
+            return (self.active[-1] if self.active else 0) | ((SYSTICK in self.pending) << 26)
+        if offset == 0xD08:
+            return self.vtor if self.cpu.vtor else 0
+        if 0xD18 <= offset < 0xD24:  # SHPR1..3
+            return self._priority_bytes(4 + offset - 0xD18, size)
+        return self._scs_words.get(offset, 0)
+
+    def _priority_bytes(self, first: int, size: int) -> int:
+        return sum(self.priorities.get(first + k, 0) << (8 * k) for k in range(size))
+
+    def _scs_write(self, offset: int, size: int, value: int) -> None:
+        if 0x010 <= offset < 0x020:
+            self.systick.write(offset - 0x010, value)
+        elif 0x100 <= offset < 0x104:
+            self.enabled |= {EXTERNAL + k for k in range(IRQ_LINES) if value >> k & 1}
+            self.stop_request = True  # a pending interrupt may now be taken
+        elif 0x180 <= offset < 0x184:
+            self.enabled -= {EXTERNAL + k for k in range(IRQ_LINES) if value >> k & 1}
+        elif 0x200 <= offset < 0x204:
+            self.pending |= {EXTERNAL + k for k in range(IRQ_LINES) if value >> k & 1}
+            self.stop_request = True
+        elif 0x280 <= offset < 0x284:
+            self.pending -= {EXTERNAL + k for k in range(IRQ_LINES) if value >> k & 1}
+        elif 0x400 <= offset < 0x420 or 0xD18 <= offset < 0xD24:
+            first = EXTERNAL + offset - 0x400 if offset < 0xD00 else 4 + offset - 0xD18
+            for k in range(size):
+                self.priorities[first + k] = value >> (8 * k) & 0xFF
+        elif offset == 0xD04:
+            if value & (1 << 26):
+                self.pending.add(SYSTICK)
+                self.stop_request = True
+            if value & (1 << 25):
+                self.pending.discard(SYSTICK)
+            if value & (1 << 28):
+                self.pending.add(PENDSV)
+                self.stop_request = True
+        elif offset == 0xD08 and self.cpu.vtor:
+            self.vtor = value & ~0x7F
+        else:
+            self._scs_words[offset] = value
+
+
+def _nothing(number: int) -> None:
+    del number
+
+
+def _name(number: int) -> str:
+    return EXCEPTION_NAMES.get(number, f"IRQ {number - EXTERNAL}")
+
+
+class SysTick:
+    """The SysTick timer (B3.3): a 24-bit down counter at the core clock (CLKSOURCE 1) or the reference clock
+    (CLKSOURCE 0: the core clock / :data:`REFERENCE_DIVIDER`, as the STM32F1's HCLK/8, RM0008 7.2), computed from
+    the core's cycle count when read (MCU-5)."""
+
+    REFERENCE_DIVIDER: Final[int] = 8
+
+    def __init__(self, core: CortexM) -> None:
+        self.core = core
+        self.csr = 0
+        self.rvr = 0
+        self._start = 0  # cycle at which the counter held _value
+        self._value = 0
+        self._seen = 0  # zeros since the base that pended the exception (or were passed with TICKINT off)
+        self._flag_zeros = 0  # zeros since the base that COUNTFLAG reported
+        self._flag = False  # a zero before the last rebase that COUNTFLAG has not reported
+
+    @property
+    def enabled(self) -> bool:
+        """CSR.ENABLE."""
+        return bool(self.csr & 1)
+
+    def _divider(self) -> int:
+        return 1 if self.csr & 4 else self.REFERENCE_DIVIDER
+
+    def _ticks(self, cycles: int) -> int:
+        return (cycles - self._start) // self._divider() if self.enabled else 0
+
+    def _value_after(self, ticks: int) -> int:
+        if ticks <= self._value:
+            return self._value - ticks
+        if self.rvr == 0:
+            return 0
+        return self.rvr - (ticks - self._value - 1) % (self.rvr + 1)
+
+    def _zeros_until(self, ticks: int) -> int:
+        """How many times the counter reached 0 from 1 in the first ``ticks`` ticks after the base."""
+        if self.rvr == 0 and not self._value:
+            return 0
+        first = self._first()
+        if ticks < first:
+            return 0
+        return 1 + ((ticks - first) // (self.rvr + 1) if self.rvr else 0)
+
+    def _first(self) -> int:
+        """Ticks from the base to the first time the counter reaches 0."""
+        return self._value if self._value else self.rvr + 1
+
+    def next_event(self) -> int | None:
+        """The cycle of the next wrap that pends the SysTick exception (TICKINT), or ``None``."""
+        if not self.enabled or not self.csr & 2 or (self.rvr == 0 and (self._seen or not self._value)):
+            return None
+        at = self._first() + self._seen * (self.rvr + 1)
+        return self._start + at * self._divider()
+
+    def update(self) -> None:
+        """Pend the exception if the counter reached 0 since the last update (TICKINT)."""
+        zeros = self._zeros_until(self._ticks(self.core.cycles))
+        if zeros > self._seen:
+            self._seen = zeros
+            if self.csr & 2:
+                self.core.pend(SYSTICK)
+
+    def _rebase(self, cycles: int) -> None:
+        ticks = self._ticks(cycles)
+        zeros = self._zeros_until(ticks)
+        self._flag = self._flag or zeros > self._flag_zeros
+        self._value = self._value_after(ticks)
+        self._start += ticks * self._divider()
+        self._seen = self._flag_zeros = 0
+
+    def read(self, offset: int) -> int:
+        """CSR (COUNTFLAG clears on read), RVR, CVR, CALIB (at the polled time: a busy wait reads it)."""
+        cycles = self.core.cycles_polled()
+        if offset == 0x0:
+            zeros = self._zeros_until(self._ticks(cycles))
+            flag = self._flag or zeros > self._flag_zeros
+            self._flag, self._flag_zeros = False, zeros
+            return self.csr | (flag << 16)
+        if offset == 0x4:
+            return self.rvr
+        if offset == 0x8:
+            return self._value_after(self._ticks(cycles))
+        return 0
+
+    def write(self, offset: int, value: int) -> None:
+        """CSR, RVR, CVR (any write clears the counter and COUNTFLAG)."""
+        cycles = self.core.cycles_now()
+        self._rebase(cycles)
+        self._start = cycles
+        if offset == 0x0:
+            self.csr = value & 0b111
+        elif offset == 0x4:
+            self.rvr = value & SYST_MAX
+        elif offset == 0x8:
+            self._value = 0
+            self._flag = False
+        self.core.stop_request = True  # the next wrap may come sooner: the run loop recomputes its deadline

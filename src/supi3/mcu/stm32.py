@@ -1,0 +1,366 @@
+"""STM32F10x peripherals of the emulated board: RCC clock enables, GPIO, AFIO/EXTI and the SPI master.
+
+Ref: STM32F10x reference manual RM0008: RCC 7.3.7 (APB2ENR), GPIO 9.2 (CRL, CRH, IDR, ODR, BSRR, BRR), AFIO 9.4.3
+(EXTICR1), EXTI 10.3 (IMR, FTSR, RTSR, PR), SPI 25.3.3 (master mode), 25.3.5 (transmit and receive sequence),
+25.3.7 (status flags), 25.3.10 (overrun), 25.5 (registers). Written from the manual's register descriptions; only
+what a SUPI 3 firmware uses is modelled (docs/firmware-in-the-loop.md, MCU-6 to MCU-8 in docs/assumptions/mcu.md).
+
+Each peripheral is a plain object with ``read(offset, size)`` and ``write(offset, size, value)`` for
+:meth:`supi3.mcu.core.CortexM.mmio`; time comes from the core (:meth:`~supi3.mcu.core.CortexM.cycles_now`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Final, Protocol
+
+from supi3.errors import Supi3Error
+
+__all__ = [
+    "AFIO_BASE",
+    "EXTI0_IRQ",
+    "EXTI_BASE",
+    "GPIOA_BASE",
+    "GPIOB_BASE",
+    "PERIPHERAL_SIZE",
+    "RCC_BASE",
+    "SPI1_BASE",
+    "Exti",
+    "Gpio",
+    "PeripheralClockError",
+    "Rcc",
+    "Spi",
+    "SpiWire",
+]
+
+RCC_BASE: Final[int] = 0x4002_1000
+GPIOA_BASE: Final[int] = 0x4001_0800
+GPIOB_BASE: Final[int] = 0x4001_0C00
+AFIO_BASE: Final[int] = 0x4001_0000
+EXTI_BASE: Final[int] = 0x4001_0400
+SPI1_BASE: Final[int] = 0x4001_3000
+PERIPHERAL_SIZE: Final[int] = 0x400
+"""Each peripheral's address block (RM0008 3.3, Table 3)."""
+EXTI0_IRQ: Final[int] = 6
+"""The EXTI line 0 interrupt in the STM32F10x vector table (RM0008 10.1.2, Table 63)."""
+
+APB2ENR: Final[int] = 0x18
+AFIOEN: Final[int] = 1 << 0
+IOPAEN: Final[int] = 1 << 2
+IOPBEN: Final[int] = 1 << 3
+SPI1EN: Final[int] = 1 << 12
+
+# SPI (RM0008 25.5.1 to 25.5.3)
+CR1_CPHA: Final[int] = 1 << 0
+CR1_CPOL: Final[int] = 1 << 1
+CR1_MSTR: Final[int] = 1 << 2
+CR1_BR_SHIFT: Final[int] = 3
+CR1_SPE: Final[int] = 1 << 6
+CR1_LSBFIRST: Final[int] = 1 << 7
+CR1_SSI: Final[int] = 1 << 8
+CR1_SSM: Final[int] = 1 << 9
+CR1_DFF: Final[int] = 1 << 11
+SR_RXNE: Final[int] = 1 << 0
+SR_TXE: Final[int] = 1 << 1
+SR_MODF: Final[int] = 1 << 5
+SR_OVR: Final[int] = 1 << 6
+SR_BSY: Final[int] = 1 << 7
+SPI_CR1, SPI_CR2, SPI_SR, SPI_DR = 0x0, 0x4, 0x8, 0xC
+
+
+class PeripheralClockError(Supi3Error, RuntimeError):
+    """The firmware touched a peripheral whose clock is off (RCC_APB2ENR, RM0008 7.3.7): on the chip the access
+    does nothing, here it stops the run (MCU-7)."""
+
+
+class Rcc:
+    """RCC with the APB2 clock enables only (MCU-7: the clock tree is not modelled, SYSCLK = PCLK2 = the core
+    clock from reset)."""
+
+    def __init__(self) -> None:
+        self.apb2enr = 0
+        self._other: dict[int, int] = {}
+
+    def require(self, bit: int, name: str) -> None:
+        """Raise :class:`PeripheralClockError` unless APB2ENR has ``bit``."""
+        if not self.apb2enr & bit:
+            raise PeripheralClockError(f"{name} accessed while its clock is off (RCC_APB2ENR bit {bit.bit_length() - 1}"
+                                       " = 0, RM0008 7.3.7)")  # fmt: skip
+
+    def read(self, offset: int, size: int) -> int:
+        """APB2ENR, or what was written."""
+        del size
+        return self.apb2enr if offset == APB2ENR else self._other.get(offset, 0)
+
+    def write(self, offset: int, size: int, value: int) -> None:
+        """APB2ENR, or kept."""
+        del size
+        if offset == APB2ENR:
+            self.apb2enr = value
+        else:
+            self._other[offset] = value
+
+
+class Gpio:
+    """One GPIO port (RM0008 9.2): CRL/CRH configure each pin, IDR reads the inputs, ODR/BSRR/BRR drive outputs.
+
+    Parameters
+    ----------
+    rcc, enable_bit, name:
+        The port's clock enable.
+    inputs:
+        The levels on the pins (bit mask) when read: the board's wiring.
+    on_output:
+        Called with (pin, level) when a pin configured as an output changes level.
+
+    A pin is an output when its MODE bits are not 00 (RM0008 9.2.1); a pin that is not an output reads its input
+    level, an output reads back ODR. An output pin not configured as one is not driven (MCU-6: the board's pull-ups
+    keep /SS and /StatErr high).
+    """
+
+    def __init__(self, rcc: Rcc, enable_bit: int, name: str, inputs: Callable[[], int],
+                 on_output: Callable[[int, int], None], pulled_up: int) -> None:  # fmt: skip
+        self.rcc = rcc
+        self.enable_bit = enable_bit
+        self.name = name
+        self.inputs = inputs
+        self.on_output = on_output
+        self.pulled_up = pulled_up
+        self.cr = [0x4444_4444, 0x4444_4444]  # reset: every pin a floating input
+        self.odr = 0
+        self._mask: int | None = None  # the output pins, from CRL and CRH
+        self._levels = self.levels()
+
+    def is_output(self, pin: int) -> bool:
+        """MODE of ``pin`` is not 00 (input)."""
+        return bool(self.cr[pin // 8] >> (4 * (pin % 8)) & 0b11)
+
+    def _output_mask(self) -> int:
+        if self._mask is None:
+            self._mask = sum(1 << pin for pin in range(16) if self.is_output(pin))
+        return self._mask
+
+    def levels(self) -> int:
+        """The levels the port drives: ODR on output pins, the pull-ups elsewhere."""
+        mask = self._output_mask()
+        return (self.odr & mask) | (self.pulled_up & ~mask)
+
+    def _changed(self) -> None:
+        levels = self.levels()
+        changed, self._levels = levels ^ self._levels, levels
+        for pin in range(16):
+            if changed >> pin & 1:
+                self.on_output(pin, levels >> pin & 1)
+
+    def read(self, offset: int, size: int) -> int:
+        """CRL, CRH, IDR, ODR."""
+        del size
+        self.rcc.require(self.enable_bit, self.name)
+        if offset in (0x0, 0x4):
+            return self.cr[offset // 4]
+        if offset == 0x8:
+            mask = self._output_mask()
+            return (self.inputs() & ~mask | self.odr & mask) & 0xFFFF
+        if offset == 0xC:
+            return self.odr
+        return 0
+
+    def write(self, offset: int, size: int, value: int) -> None:
+        """CRL, CRH, ODR, BSRR (set in bits 0..15, reset in 16..31, set wins), BRR."""
+        del size
+        self.rcc.require(self.enable_bit, self.name)
+        if offset in (0x0, 0x4):
+            self.cr[offset // 4] = value
+            self._mask = None
+        elif offset == 0xC:
+            self.odr = value & 0xFFFF
+        elif offset == 0x10:
+            self.odr = (self.odr & ~(value >> 16) | value) & 0xFFFF
+        elif offset == 0x14:
+            self.odr &= ~value & 0xFFFF
+        else:
+            return
+        self._changed()
+
+
+class Exti:
+    """AFIO's EXTICR1 and the EXTI controller for lines 0..3 (RM0008 9.4.3, 10.3): an edge on a selected pin sets
+    PR if its trigger is enabled; a line's interrupt request is PR AND IMR, held until PR is cleared by writing 1.
+    """
+
+    def __init__(self, rcc: Rcc) -> None:
+        self.rcc = rcc
+        self.exticr1 = 0
+        self.imr = 0
+        self.emr = 0
+        self.rtsr = 0
+        self.ftsr = 0
+        self.pr = 0
+
+    def edge(self, port: int, pin: int, level: int) -> None:
+        """Pin ``pin`` of port ``port`` (0 = A) went to ``level``."""
+        if pin >= 4 or (self.exticr1 >> (4 * pin)) & 0xF != port:
+            return
+        trigger = self.rtsr if level else self.ftsr
+        if trigger >> pin & 1:
+            self.pr |= 1 << pin
+
+    def requesting(self, line: int) -> bool:
+        """Line ``line`` asks the NVIC for its interrupt."""
+        return bool(self.pr & self.imr >> line & 1)
+
+    def read_afio(self, offset: int, size: int) -> int:
+        """EXTICR1 (other AFIO registers read 0)."""
+        del size
+        self.rcc.require(AFIOEN, "AFIO")
+        return self.exticr1 if offset == 0x8 else 0
+
+    def write_afio(self, offset: int, size: int, value: int) -> None:
+        """EXTICR1."""
+        del size
+        self.rcc.require(AFIOEN, "AFIO")
+        if offset == 0x8:
+            self.exticr1 = value & 0xFFFF
+
+    def read(self, offset: int, size: int) -> int:
+        """IMR, EMR, RTSR, FTSR, SWIER (0), PR."""
+        del size
+        return {0x0: self.imr, 0x4: self.emr, 0x8: self.rtsr, 0xC: self.ftsr, 0x14: self.pr}.get(offset, 0)
+
+    def write(self, offset: int, size: int, value: int) -> None:
+        """IMR, EMR, RTSR, FTSR, SWIER (sets PR), PR (write 1 to clear)."""
+        del size
+        if offset == 0x0:
+            self.imr = value
+        elif offset == 0x4:
+            self.emr = value
+        elif offset == 0x8:
+            self.rtsr = value
+        elif offset == 0xC:
+            self.ftsr = value
+        elif offset == 0x10:
+            self.pr |= value & self.imr
+        elif offset == 0x14:
+            self.pr &= ~value
+
+
+class SpiWire(Protocol):
+    """The other end of the SPI peripheral's pins: the board."""
+
+    def spi_byte(self, tx: int, bits: int, start: int, period: int, cr1: int) -> int:
+        """A transfer of ``bits`` bits starts at cycle ``start``, one SCLK period every ``period`` cycles, with
+        CR1 ``cr1``: return what MISO shifts in (as the data register will hold it)."""
+
+
+class Spi:
+    """SPI1 as a full-duplex master (RM0008 25.3.3, 25.3.5; timing model MCU-8).
+
+    ``now`` gives the time of a write, ``polled`` that of a status or data read (default ``now``; the board gives
+    the cheaper block-end time, MCU-1).
+
+    Writing DR while the shift register is idle starts a transfer at once (TXE stays 1, BSY 1); a second write
+    waits in the transmit buffer (TXE 0) and starts when the running byte ends, back to back. A transfer takes 8
+    SCLK periods (16 with DFF), a period 2^(BR+1) core clocks (PCLK2 = the core clock, MCU-7); at its end the
+    received byte is in DR (RXNE 1), or lost with OVR if RXNE was still 1 (25.3.10). BSY is 1 from the start of a
+    transfer to the end of the last one. MODF: SSM = 1 with SSI = 0 in master mode clears MSTR and SPE
+    (25.3.10); /NSS is not wired (SSM = 0 reads it high, MCU-6).
+    """
+
+    def __init__(
+        self, rcc: Rcc, now: Callable[[], int], wire: SpiWire, polled: Callable[[], int] | None = None
+    ) -> None:
+        self.rcc = rcc
+        self.now = now
+        self.polled = now if polled is None else polled
+        self.on_poll: Callable[[int], None] = _ignore
+        """Called on a status read while a byte shifts, with the cycle SR changes next (the board's poll skip)."""
+        self.wire = wire
+        self.cr1 = 0
+        self.cr2 = 0
+        self.modf = False
+        self.ovr = False
+        self._ovr_seen = False
+        self.tx_buffer: int | None = None
+        self.rx_buffer: int | None = None
+        self.rx_last = 0
+        self.shifting: tuple[int, int, int] | None = None  # (received byte, start cycle, end cycle)
+        self.transfers = 0
+
+    @property
+    def period(self) -> int:
+        """Core clocks per SCLK period: f_PCLK / 2^(BR+1) (RM0008 25.5.1)."""
+        return 2 << (self.cr1 >> CR1_BR_SHIFT & 0b111)
+
+    def _run(self, cycles: int) -> None:
+        while self.shifting is not None and cycles >= self.shifting[2]:
+            received, _, end = self.shifting
+            self.shifting = None
+            if self.rx_buffer is not None:
+                self.ovr = True  # the new byte is lost (25.3.10)
+            else:
+                self.rx_buffer = received
+            if self.tx_buffer is not None and self.cr1 & CR1_SPE:
+                self._start(end)
+
+    def _start(self, cycles: int) -> None:
+        tx = self.tx_buffer if self.tx_buffer is not None else 0
+        self.tx_buffer = None
+        bits = 16 if self.cr1 & CR1_DFF else 8
+        period = self.period
+        received = self.wire.spi_byte(tx, bits, cycles, period, self.cr1)
+        self.shifting = (received, cycles, cycles + bits * period)
+        self.transfers += 1
+
+    def status(self) -> int:
+        """SR now (25.5.3); while a byte shifts, tells :attr:`on_poll` when SR changes next (its end)."""
+        self._run(self.polled())
+        if self.shifting is not None:
+            self.on_poll(self.shifting[2])
+        busy = self.shifting is not None or self.tx_buffer is not None
+        return ((self.rx_buffer is not None) * SR_RXNE | (self.tx_buffer is None) * SR_TXE
+                | self.modf * SR_MODF | self.ovr * SR_OVR | busy * SR_BSY)  # fmt: skip
+
+    def read(self, offset: int, size: int) -> int:
+        """CR1, CR2, SR, DR (reading DR clears RXNE; reading SR after DR clears OVR, 25.3.10)."""
+        del size
+        self.rcc.require(SPI1EN, "SPI1")
+        if offset == SPI_CR1:
+            return self.cr1
+        if offset == SPI_CR2:
+            return self.cr2
+        if offset == SPI_SR:
+            value = self.status()
+            if self._ovr_seen:
+                self.ovr = self._ovr_seen = False
+            return value
+        if offset == SPI_DR:
+            self._run(self.polled())
+            if self.rx_buffer is not None:
+                self.rx_last, self.rx_buffer = self.rx_buffer, None
+            self._ovr_seen = self.ovr
+            return self.rx_last
+        return 0
+
+    def write(self, offset: int, size: int, value: int) -> None:
+        """CR1 (MODF check on enabling), CR2, DR (into the transmit buffer; starts a transfer if idle)."""
+        del size
+        self.rcc.require(SPI1EN, "SPI1")
+        cycles = self.now()
+        self._run(cycles)
+        if offset == SPI_CR1:
+            self.cr1 = value & 0xFFFF
+            if self.cr1 & CR1_MSTR and self.cr1 & CR1_SSM and not self.cr1 & CR1_SSI:
+                self.modf = True
+                self.cr1 &= ~(CR1_MSTR | CR1_SPE)
+            if self.cr1 & CR1_SPE and self.tx_buffer is not None and self.shifting is None:
+                self._start(cycles)
+        elif offset == SPI_CR2:
+            self.cr2 = value & 0xFF
+        elif offset == SPI_DR:
+            self.tx_buffer = value & 0xFFFF  # a write with TXE = 0 overwrites the waiting byte
+            if self.cr1 & CR1_SPE and self.cr1 & CR1_MSTR and self.shifting is None:
+                self._start(cycles)
+
+
+def _ignore(cycles: int) -> None:
+    del cycles

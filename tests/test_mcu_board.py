@@ -1,0 +1,198 @@
+"""Firmware in the loop: the SDK's example firmware as a Cortex-M0 and -M3 binary on the emulated board
+(supi3.mcu.board) against the transaction-level chip, with the INTERBUS master exchanging data.
+
+The binary is built once per module with ziglang (supi3.mcu.build: the C driver, the board port of
+src/supi3/sdk/c/board, the example) and must give the process data the host build gives on the firmware bench
+(tests/test_sdk_c_examples.py). Ref: 3.4.14 (interrupt-driven exchange), Table 3-7 (the frame timing the board
+checks), RM0008 (the board's peripherals).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from supi3.interbus.ring import ErrorKind
+from supi3.mcu import board as mcu_board
+from supi3.mcu import build as mcu_build
+from supi3.mcu.board import Board
+from supi3.mcu.core import CPUS
+from supi3.model.registers import InterfaceViolationError
+from supi3.sdk import native
+from supi3.sdk.bench import Bench
+from support import c_firmware
+
+pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
+
+WORDS = (0x0000, 0xFFFF, 0x1234, 0x8001, 0x00FF)
+"""As tests/test_sdk_c_examples.py."""
+
+
+@pytest.fixture(scope="module")
+def digital_io(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """The digital 16/16 example built for each core, once per module."""
+    folder = tmp_path_factory.mktemp("mcu")
+    return {cpu: mcu_build.build(native.example("digital_io"), folder / f"digital_io_{cpu}.elf", cpu=cpu)
+            for cpu in CPUS}  # fmt: skip
+
+
+def test_the_board_pins_are_board_h_s() -> None:
+    """The emulator's wiring constants are the board port's (board.h BOARD_PIN_*)."""
+    text = (mcu_build.BOARD_DIR / "board.h").read_text()
+    defined = {name: int(value) for name, value in re.findall(r"#define BOARD_PIN_(\w+) (\d+)u", text)}
+    for name in ("IRQ", "CD", "IO", "SAS_INIT", "SS", "STAT_ERR", "MODACK"):
+        assert getattr(mcu_board, f"PIN_{name}") == defined[name], name
+
+
+def _binary_exchange(board: Board, words: tuple[bytes, ...]) -> list[tuple[bytes, bytes]]:
+    """Per step: the master's outputs and the device's inputs set, two cycles run; (the firmware's output
+    terminals, the master's inputs) after them."""
+    fw = board.fw_board
+    assert fw is not None
+    n = len(words[0])
+    seen = []
+    for out_data, in_data in zip(words, reversed(words), strict=True):
+        board.bench.master.set_outputs(1, out_data)
+        fw.inputs = in_data
+        board.run(2)
+        seen.append((fw.outputs[:n], board.bench.master.inputs(1)))
+    return seen
+
+
+def _host_exchange(pytestconfig: pytest.Config, name: str, words: tuple[bytes, ...]) -> list[tuple[bytes, bytes]]:
+    """The same steps with the same firmware built for the host, on the firmware bench."""
+    assert pytestconfig.cache is not None
+    host = c_firmware(pytestconfig.cache, native.example(name))
+    bench = Bench(firmware=host)
+    bench.run(3)
+    n = len(words[0])
+    seen = []
+    for out_data, in_data in zip(words, reversed(words), strict=True):
+        bench.master.set_outputs(1, out_data)
+        for k, value in enumerate(in_data):
+            host.board.inputs[k] = value
+        bench.run(2)
+        seen.append((bytes(host.board.outputs[0:n]), bench.master.inputs(1)))
+    return seen
+
+
+@pytest.mark.parametrize("cpu", CPUS)
+def test_digital_io_binary_gives_the_host_builds_process_data(
+    pytestconfig: pytest.Config, digital_io: dict[str, Path], cpu: str
+) -> None:
+    """SET 83h, ID 03h, then OUT0/OUT1 read and IN0/IN1 written in the EXTI0 handler after each VALID event: the
+    master's configuration and the data both ways are those of the same firmware compiled for the host."""
+    board = Board(digital_io[cpu], cpu=cpu)
+    board.run(3)
+    config = board.bench.master.config
+    assert config is not None and (config[0].id_code, config[0].data_bytes) == (0x03, 2)
+    words = tuple(w.to_bytes(2, "big") for w in WORDS)
+    seen = _binary_exchange(board, words)
+    assert seen == _host_exchange(pytestconfig, "digital_io", words)
+    assert seen == list(zip(words, reversed(words), strict=True))
+    assert board.fw_board is not None and board.fw_board.error == 0
+    assert board.fw_board.cycles == board.interrupts > 0  # one VALID event per data cycle, each served
+    assert board.violations == []
+
+
+@pytest.mark.parametrize(
+    ("name", "size", "interrupts"),
+    [("polling_io", 2, False), ("analog_io", 4, True), ("irq_dispatch", 2, True), ("pcmd_alarm", 2, True)],
+)
+def test_more_example_binaries_give_the_host_builds_process_data(
+    pytestconfig: pytest.Config, tmp_path: Path, name: str, size: int, interrupts: bool
+) -> None:
+    """The polling example (fw_loop: the main loop polls the I/O pin), the block transfer (analog_io, 3.4.6), the
+    event dispatch and the processor command examples, on the Cortex-M3."""
+    board = Board(mcu_build.build(native.example(name), tmp_path / f"{name}.elf"))
+    board.run(3)
+    words = (bytes(range(1, size + 1)), bytes(range(0xF0, 0xF0 + size)), bytes(size))
+    assert _binary_exchange(board, words) == _host_exchange(pytestconfig, name, words)
+    assert board.fw_board is not None and board.fw_board.error == 0
+    assert (board.interrupts > 0) == interrupts
+    assert board.violations == []
+
+
+@pytest.mark.parametrize("cpu", CPUS)
+def test_a_sleeping_core_enters_the_handler_in_its_interrupt_latency(digital_io: dict[str, Path], cpu: str) -> None:
+    """The example sleeps in WFI between cycles: from the falling edge of /IRQ to the handler's first instruction
+    is the core's exception entry, 12 cycles on the Cortex-M3 and 16 on the Cortex-M0 at 48 MHz (MCU-2)."""
+    board = Board(digital_io[cpu], cpu=cpu)
+    board.run(6)
+    assert board.interrupts >= 3
+    assert board.irq_latency_s == pytest.approx(CPUS[cpu].entry_cycles / 48e6)
+
+
+def test_a_too_fast_sclk_is_caught_with_the_program_counter(tmp_path: Path) -> None:
+    """BOARD_SPI_BR = 0 (f_PCLK / 2 = 24 MHz) breaks Table 3-7's t0 (667 ns at 500 kbit/s): strict mode stops the
+    run at the first byte, the note names the transport function; non-strict mode records each byte."""
+    elf = mcu_build.build(native.example("digital_io"), tmp_path / "fast.elf", defines={"BOARD_SPI_BR": "0u"})
+    board = Board(elf)
+    with pytest.raises(InterfaceViolationError, match=r"SCLK period 42 ns, shorter than t0 = 667 ns") as caught:
+        board.run(1)
+    assert caught.value.rule == "Table 3-7 t0"
+    assert any("in board_xfer()" in note for note in caught.value.__notes__)
+    lenient = Board(elf, strict=False)
+    lenient.run(3)
+    assert lenient.violations and {v.function for v in lenient.violations} == {"board_xfer"}
+    assert "t0" in str(lenient.violations[0])
+
+
+def test_raising_ss_before_the_byte_is_out_is_an_incomplete_frame(tmp_path: Path) -> None:
+    """tests/mcu/early_ss.c waits for TXE instead of BSY: /SS rises while SPI1 still shifts, the chip drops the
+    frame (3.4.2), and the violation names fw_setup."""
+    elf = mcu_build.build(Path(__file__).parent / "mcu" / "early_ss.c", tmp_path / "early_ss.elf")
+    board = Board(elf)
+    with pytest.raises(InterfaceViolationError, match=r"incomplete byte: [0-7] SCLK rising edges") as caught:
+        board.run(1)
+    assert caught.value.rule == "3.4.2"
+    assert any("in fw_setup()" in note for note in caught.value.__notes__)
+    assert board.protocol.mode is None  # the initialization byte did not count
+
+
+def test_fault_report_binary_trips_until_quit_peripheral_error(tmp_path: Path) -> None:
+    """fault_report.c as a binary, the steps of its host test (tests/test_sdk_c_examples.py): /StatErr (PA8) low
+    for the filter time -> 0BB1h at the master, outputs off until a Quit Peripheral Error after the fault has gone;
+    the /ModAck pulse reaches the firmware through EXTI line 1's pending bit (PB1, 3.6.2)."""
+    board = Board(mcu_build.build(native.example("fault_report"), tmp_path / "fault_report.elf"), cycle_time_s=1e-3)
+    fw, chip, master = board.fw_board, board.bench.chip, board.bench.master
+    assert fw is not None
+    board.run(3)
+    master.set_outputs(1, b"\x81\x18")
+    board.run_for(0.02)
+    assert fw.outputs[:2] == b"\x81\x18"
+    fw.fault = 1
+    board.run_for(0.3)  # > t3 = 200 ms + 31.5 %
+    assert chip.module_error and chip.pf and fw.outputs[:2] == b"\x00\x00"
+    assert sum(d.kind is ErrorKind.PERIPHERAL_FAULT for d in master.diagnostics) == 1
+    master.quit_peripheral_error(1)  # while the fault lasts: nothing changes
+    board.run_for(0.01)
+    assert chip.pf and fw.outputs[:2] == b"\x00\x00"
+    fw.fault = 0
+    board.run_for(0.01)
+    assert not chip.module_error and chip.pf and fw.outputs[:2] == b"\x00\x00"
+    master.quit_peripheral_error(1)
+    board.run_for(0.01)
+    assert not chip.pf and fw.outputs[:2] == b"\x81\x18"
+    assert fw.error == 0 and board.violations == []
+
+
+@pytest.mark.parametrize("cpu", CPUS)
+def test_skipping_poll_loops_changes_nothing_but_the_speed(digital_io: dict[str, Path], cpu: str) -> None:
+    """MCU-10: the SPI status polls counted without running them give the same cycles, instructions, bus time,
+    interrupts and data as running each."""
+    outcomes = []
+    for skip in (True, False):
+        board = Board(digital_io[cpu], cpu=cpu)
+        board.core.skip_polls = skip
+        board.run(3)
+        board.bench.master.set_outputs(1, b"\x12\x34")
+        assert board.fw_board is not None
+        board.fw_board.inputs = b"\x56\x78"
+        board.run(4)
+        outcomes.append((board.core.cycles, board.core.instructions, board.bench.now, board.interrupts,
+                         board.irq_latency_s, board.fw_board.outputs, board.bench.master.inputs(1)))  # fmt: skip
+    assert outcomes[0] == outcomes[1]
+    assert outcomes[0][5][:2] == b"\x12\x34" and outcomes[0][6] == b"\x56\x78"

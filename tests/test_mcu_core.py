@@ -1,0 +1,250 @@
+"""The emulated Cortex-M core (supi3.mcu.core): exception entry and return against hand-written assembly, the timing
+model, and the reports of a fault, an endless loop and a hang instead of a hang of the test.
+
+Ref: ARMv7-M ARM B1.5.6 (entry: the 8-word frame R0-R3, R12, LR, return address, xPSR; LR = EXC_RETURN), B1.5.7
+(8-byte stack alignment, stacked xPSR bit 9), B1.5.8 (return); ARMv6-M the same for the Cortex-M0. The programs are
+tests/mcu/exceptions.S (Thumb-1, runs on both cores) and tests/mcu/faults.c (through the SDK's board port).
+"""
+
+from __future__ import annotations
+
+import struct
+from pathlib import Path
+
+import pytest
+
+from supi3.mcu import build as mcu_build
+from supi3.mcu.board import Board
+from supi3.mcu.core import (
+    EXC_RETURN_HANDLER,
+    EXC_RETURN_THREAD_MSP,
+    EXTERNAL,
+    FRAME_NAMES,
+    XPSR_ALIGN,
+    CortexM,
+    FirmwareFaultError,
+    FirmwareImage,
+    FirmwareStoppedError,
+    Stop,
+    block_cost,
+    is_poll_loop,
+)
+
+pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
+
+PROGRAMS = Path(__file__).parent / "mcu"
+CPUS = ("cortex_m0", "cortex_m3")
+
+
+@pytest.fixture(scope="module")
+def exceptions_elf(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """exceptions.S linked with the board's linker script, once per module (Thumb-1: one ELF for both cores)."""
+    out = tmp_path_factory.mktemp("mcu") / "exceptions.elf"
+    return mcu_build.build(PROGRAMS / "exceptions.S", out, cpu="cortex_m0", port=False)
+
+
+@pytest.fixture(scope="module")
+def faults_elf(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return mcu_build.build(PROGRAMS / "faults.c", tmp_path_factory.mktemp("mcu") / "faults.elf")
+
+
+def _sleep(core: CortexM, steps: int = 100) -> None:
+    """Run until the core sleeps (WFI)."""
+    for _ in range(steps):
+        if core.step(core.cycles + 10_000) == "sleep":
+            return
+    raise AssertionError("the program did not reach its WFI")
+
+
+def _word(core: CortexM, name: str, index: int = 0) -> int:
+    return int(struct.unpack("<I", core.read_bytes(core.image.address(name) + 4 * index, 4))[0])
+
+
+@pytest.mark.parametrize("misalign", [0, 4])
+@pytest.mark.parametrize("cpu", CPUS)
+def test_nested_exception_entry_and_return_to_thread_mode(exceptions_elf: Path, cpu: str, misalign: int) -> None:
+    """IRQ 0 from thread mode stacks R0-R3, R12, LR, the return address and xPSR on the main stack and enters with
+    LR = FFFFFFF9h; IRQ 1 (higher priority) preempts it with LR = FFFFFFF1h and the frame of handler mode; both
+    return, and thread mode has its registers and stack pointer back (B1.5.6 to B1.5.8). A stack pointer that is
+    4 mod 8 gets one more word and bit 9 in the stacked xPSR (B1.5.7)."""
+    core = CortexM(exceptions_elf, cpu=cpu)
+    _sleep(core)
+    image = core.image
+    assert core.pc == image.address("resume1")  # WFI done: the return address is the next instruction
+    sp = core.reg("sp") - misalign
+    core.set_reg("sp", sp)
+    before = {name: core.reg(name) for name in ("r0", "r1", "r2", "r3", "r12", "lr", "xpsr")}
+    assert before["r0"] == 0xA0A0_A0A0 and before["r12"] == 0xC0C0_C0C0
+    core.pend(EXTERNAL + 0)
+    _sleep(core)
+    assert _word(core, "order") == 0x123  # IRQ 0 entered, IRQ 1 preempted it, IRQ 0 resumed
+    assert _word(core, "seen0_lr") == EXC_RETURN_THREAD_MSP
+    assert _word(core, "seen1_lr") == EXC_RETURN_HANDLER
+    frame0 = _word(core, "seen0_sp")
+    assert frame0 == (sp - 32) & ~7
+    stacked = dict(zip(FRAME_NAMES, struct.unpack("<8I", core.read_bytes(frame0, 32)), strict=True))
+    assert {name: stacked[name] for name in ("r0", "r1", "r2", "r3", "r12", "lr")} == \
+        {name: before[name] for name in ("r0", "r1", "r2", "r3", "r12", "lr")}  # fmt: skip
+    assert stacked["pc"] == image.address("resume1")
+    assert stacked["xpsr"] == before["xpsr"] | (XPSR_ALIGN if misalign else 0)
+    frame1 = _word(core, "seen1_sp")
+    assert frame1 == frame0 - 32
+    nested = struct.unpack("<8I", core.read_bytes(frame1, 32))
+    assert nested[6] == image.address("irq0_resumed")  # the preempted handler's next instruction
+    assert nested[7] & 0x1FF == EXTERNAL + 0  # its IPSR: exception 16 was running
+    assert nested[5] == EXC_RETURN_THREAD_MSP  # its LR
+    after = struct.unpack("<6I", core.read_bytes(image.address("after"), 24))
+    assert after == (0xA0A0_A0A0, 0xA1A1_A1A1, 0xA2A2_A2A2, 0xA3A3_A3A3, 0xC0C0_C0C0, sp)
+    assert core.active == [] and core.reg("xpsr") & 0x1FF == 0  # thread mode again
+    assert core.pc == image.address("sleep2") + 2
+
+
+@pytest.mark.parametrize("cpu", CPUS)
+def test_exception_entry_and_return_cost_the_cores_cycles(exceptions_elf: Path, cpu: str) -> None:
+    """MCU-2: 12 cycles entry and 10 return on the Cortex-M3, 16 and 16 on the Cortex-M0, around the handler's
+    cycles (Irq1_Handler is one block of 12 instructions ending in BX LR)."""
+    core = CortexM(exceptions_elf, cpu=cpu)
+    _sleep(core)
+    start = core.cycles
+    entries: list[int] = []
+    core.entered = entries.append
+    core.pend(EXTERNAL + 1)
+    assert core.step(start + 10_000) == "run"  # entry, the handler, the exception return
+    assert entries == [EXTERNAL + 1]
+    assert core.active == []
+    handler = block_cost(core.read_bytes(core.image.address("Irq1_Handler"), 2 * 12))
+    assert handler[0] == 12
+    assert core.cycles == start + core.cpu.entry_cycles + handler[1] + core.cpu.return_cycles
+
+
+def test_block_cost_counts_loads_stores_and_a_final_branch() -> None:
+    """MCU-1: 1 cycle per instruction, +1 per single load/store, +N for N registers of PUSH/POP/LDM/STM, +2 for a
+    block-ending branch."""
+    assert block_cost(bytes.fromhex("0120")) == (1, 1)  # movs r0, #1
+    assert block_cost(bytes.fromhex("0868")) == (1, 2)  # ldr r0, [r1]
+    assert block_cost(bytes.fromhex("30b5")) == (1, 4)  # push {r4, r5, lr}
+    assert block_cost(bytes.fromhex("0120fee7")) == (2, 4)  # movs; b .
+    assert block_cost(bytes.fromhex("7047")) == (1, 3)  # bx lr
+    assert block_cost(bytes.fromhex("d1f80800")) == (1, 2)  # ldr.w r0, [r1, #8]
+    assert block_cost(bytes.fromhex("00f002f8")) == (1, 3)  # bl
+    assert block_cost(bytes.fromhex("eff30880")) == (1, 1)  # mrs r0, msp: not a branch
+
+
+def _faulting(faults_elf: Path, scenario: int) -> Board:
+    board = Board(faults_elf)
+    board.run_for(20e-6)  # reset, set-up, the main loop runs
+    board.core.write_bytes(board.core.image.address("scenario"), struct.pack("<I", scenario))
+    return board
+
+
+def test_a_bus_fault_ends_the_run_with_the_hard_fault_frame(faults_elf: Path) -> None:
+    board = _faulting(faults_elf, 1)
+    with pytest.raises(FirmwareFaultError) as caught:
+        board.run_for(20e-6)
+    report = caught.value.report
+    assert report.stop is Stop.FAULT
+    assert "read of unmapped memory" in report.reason
+    assert report.symbol == "fw_loop"
+    assert report.stacked is not None and report.stacked["pc"] == report.pc  # the faulting instruction
+    assert report.stacked["xpsr"] & 0x1FF == 0  # it ran in thread mode
+    assert board.core.active == [3]  # HardFault taken as the core would, then stopped
+    assert "stacked r0=" in str(caught.value)
+
+
+def test_an_undefined_instruction_ends_the_run_with_a_usage_fault(faults_elf: Path) -> None:
+    board = _faulting(faults_elf, 4)
+    with pytest.raises(FirmwareFaultError, match="undefined instruction") as caught:
+        board.run_for(20e-6)
+    assert caught.value.report.symbol == "fw_loop"
+    assert board.core.read_bytes(caught.value.report.pc, 2) == b"\x00\xde"
+
+
+def test_an_endless_loop_ends_when_the_instruction_budget_runs_out(faults_elf: Path) -> None:
+    board = _faulting(faults_elf, 2)
+    with pytest.raises(FirmwareStoppedError, match="instruction budget of 50000") as caught:
+        board.run(1000, max_instructions=50_000)
+    report = caught.value.report
+    assert report.stop is Stop.BUDGET and report.symbol == "fw_loop"
+    assert board.bench.cycles < 1000
+
+
+def test_an_interrupt_without_handler_is_a_hang_in_default_handler(faults_elf: Path) -> None:
+    board = _faulting(faults_elf, 3)
+    with pytest.raises(FirmwareStoppedError, match="endless loop") as caught:
+        board.run(10)
+    report = caught.value.report
+    assert report.stop is Stop.HANG and report.pc == board.core.image.address("Default_Handler")
+    assert board.core.active == [15]  # SysTick
+
+
+def test_the_image_names_its_symbols(exceptions_elf: Path) -> None:
+    image = FirmwareImage.load(exceptions_elf)
+    assert image.entry & ~1 == image.address("Reset_Handler")
+    assert image.function_at(image.address("Irq1_Handler")) == "Irq1_Handler"
+    with pytest.raises(ValueError, match="name must be a symbol"):
+        image.address("nothing")
+
+
+def test_systick_counts_down_from_its_reload_and_pends_on_each_wrap(exceptions_elf: Path) -> None:
+    """B3.3: a CVR write clears the counter, the next tick loads RVR, the counter reaching 0 sets COUNTFLAG (read
+    clears it) and, with TICKINT, pends SysTick: every RVR + 1 ticks."""
+    core = CortexM(exceptions_elf)
+    systick = core.systick
+    systick.write(0x4, 99)  # RVR
+    systick.write(0x8, 0)  # CVR
+    systick.write(0x0, 0b111)  # ENABLE, TICKINT, CLKSOURCE = core clock
+    start = core.cycles
+    assert systick.next_event() == start + 100
+    for ticks, value in ((1, 99), (50, 50), (99, 1), (100, 0), (101, 99), (200, 0)):
+        core.cycles = start + ticks
+        assert systick.read(0x8) == value, ticks
+    core.cycles = start + 99
+    systick.update()
+    assert 15 not in core.pending and not systick.read(0x0) & (1 << 16)
+    core.cycles = start + 100
+    systick.update()
+    assert 15 in core.pending
+    assert systick.read(0x0) & (1 << 16) and not systick.read(0x0) & (1 << 16)  # COUNTFLAG clears on read
+    assert systick.next_event() == start + 200
+
+
+def test_primask_holds_an_interrupt_until_cleared(exceptions_elf: Path) -> None:
+    """B1.5.4: PRIMASK = 1 raises the execution priority to 0: IRQ 0 stays pending and the core sleeps on."""
+    core = CortexM(exceptions_elf)
+    _sleep(core)
+    core.set_reg("primask", 1)
+    core.pend(EXTERNAL + 0)
+    assert core.step(core.cycles + 1000) == "sleep"
+    assert core.active == [] and EXTERNAL + 0 in core.pending
+    core.set_reg("primask", 0)
+    core.pend(EXTERNAL + 0)
+    _sleep(core)
+    assert _word(core, "order") == 0x123
+
+
+def test_an_interrupt_in_thread_mode_on_the_process_stack_is_reported(exceptions_elf: Path) -> None:
+    """MCU-3: CONTROL.SPSEL = 1 (thread mode on PSP) is not modelled: the entry stops with a report."""
+    core = CortexM(exceptions_elf)
+    _sleep(core)
+    core.set_reg("psp", 0x2000_4000)
+    core.set_reg("control", 0b10)
+    core.pend(EXTERNAL + 0)
+    with pytest.raises(FirmwareStoppedError, match="process stack"):
+        core.step(core.cycles + 1000)
+
+
+@pytest.mark.parametrize(
+    ("code", "pure"),
+    [
+        ("0168 c907 fcd0", True),  # ldr r1, [r0]; lsls r1, r1, #31; beq .-4: wait for RXNE
+        ("0168 0906 fcd4", True),  # ldr r1, [r0]; lsls r1, r1, #24; bmi: wait while BSY
+        ("0168 0142 fcd0", True),  # ldr r1, [r0]; tst r1, r0; beq
+        ("0068 c007 fcd0", False),  # ldr r0, [r0]: the base is overwritten
+        ("0168 4a1c c907 fbd0", False),  # adds r2, r1, #1: another register written
+        ("0168 c907 fdd0", False),  # the branch does not go back to the block's start
+        ("0168 c907 fce7", False),  # b: not a poll (no exit)
+    ],
+)
+def test_a_pure_poll_loop_is_a_load_tests_and_a_branch_back(code: str, pure: bool) -> None:
+    """MCU-10: only loops that write nothing but the loaded register and the flags are skipped."""
+    assert is_poll_loop(bytes.fromhex(code.replace(" ", "")), 0x0800_0100) is pure
