@@ -12,6 +12,7 @@ import pytest
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.wire import BranchControl
+from supi3.model.blocks.terminal import TerminalBlock
 from supi3.model.bus_terminal import BusTerminal
 from supi3.tables import CLOCK_HZ
 from supi3.terminal import (
@@ -37,6 +38,7 @@ from supi3.terminal import (
 )
 from support import bad
 
+IDLE = {pin.name: 0 for pin in BLOCK_INPUTS}
 FLAGS = ("conf", "switched_on", "extended", "closed", "closed_report", "conf_request", "alarm")
 COUNTS = (0, 1, wire.COUNTER_MAX)
 STATES = [
@@ -196,6 +198,13 @@ HOSTILE = [
     (lambda: BusTerminal("BK-LB", bad("12")), "rf"),
     (lambda: BusTerminal("BK-LB", None).returned(False, 64, 0.0, 1.0), "count"),
     (lambda: setattr(BusTerminal("BK-LB", None), "conf_request", bad(1)), "conf_request"),
+    (lambda: TerminalBlock(0), "time_limit"),
+    (lambda: TerminalBlock(BRANCH_SILENCE_CLOCKS + 1), "time_limit"),
+    (lambda: TerminalBlock(bad(1.0)), "time_limit"),
+    (lambda: TerminalBlock().step(bad({})), "inputs"),
+    (lambda: TerminalBlock().step(IDLE | {"count": 64}), "pin 'count'"),
+    (lambda: TerminalBlock().step(IDLE | {"mode": bad(True)}), "pin 'mode'"),
+    (lambda: TerminalBlock().step(IDLE | {"extra": 0}), "inputs"),
 ]
 
 
@@ -204,3 +213,12 @@ def test_hostile_inputs_are_named_errors(call: object, name: str) -> None:
     assert callable(call)
     with pytest.raises(ArgumentError, match=rf"^{name} must be"):
         call()
+
+
+def test_a_refused_step_changes_nothing() -> None:
+    block = TerminalBlock(3)
+    block.step(IDLE | {"mode": TerminalMode.LBD, "conf": 1})
+    before = (block.state, block.timer, block.cycle)
+    with pytest.raises(ArgumentError):
+        block.step(IDLE | {"mode": TerminalMode.LBD, "conf": 2})
+    assert (block.state, block.timer, block.cycle) == before
