@@ -3,7 +3,10 @@
 A chip strapped to a BK mode (C[4..0] = 00000..00100, Table 2-7) connects a branch (remote bus or local bus) to the
 remote bus. :class:`BusTerminal` holds what the BK decides about its branch; :class:`supi3.model.chip.Supi3` owns
 one in the BK modes and the transaction-level ring (:class:`supi3.interbus.ring.Ring`) asks it whether the branch
-is in the data path. Decisions where the manual is silent are BK-1.. in docs/assumptions/bus-terminal.md.
+is in the data path. Every change of the branch state is a pure transition of :mod:`supi3.terminal` (the spec,
+shared with the pin-level block and the RTL); this class adds the transaction level's view of time (the silence of
+the return line in bus seconds) and of the inputs (MFP levels). Decisions where the manual is silent are BK-1.. in
+docs/assumptions/bus-terminal.md.
 
 * **CONF** (MFP12, Table 2-8): a positive edge is a reconfiguration request; the BK keeps it, asks for the master's
   attention and clears it when the master acknowledges it (Control_Device_Function 0714h, BK-8).
@@ -18,45 +21,32 @@ is in the data path. Decisions where the manual is silent are BK-1.. in docs/ass
 
 from __future__ import annotations
 
-from typing import Final
+from dataclasses import replace
 
-from supi3 import tables
-from supi3.checks import check_bits, check_bool, check_choice, check_instance, check_real
-from supi3.interbus import wire
+from supi3 import terminal as spec
+from supi3.checks import check_bits, check_bool, check_choice, check_real
 from supi3.interbus.wire import BranchControl
+from supi3.terminal import (
+    BRANCH_SILENCE_S,
+    CONF_PIN,
+    LBST_PIN,
+    TERMINAL_INTERFACES,
+    Terminal,
+    branch_present,
+)
 
-BRANCH_SILENCE_S: Final = 0.010
-"""BK-3: the extended BK function closes a branch whose return line was silent this long: half the 20 ms after which
-a device takes silence for a reset (A13), so the remote bus behind the BK is closed again before it resets."""
-
-CONF_PIN: Final = next(p.pin for p in tables.BUS_TERMINAL_MFP if p.signal == "CONF")
-LBST_PIN: Final = next(p.pin for p in tables.BUS_TERMINAL_MFP if p.signal == "LBST")
-
-TERMINAL_INTERFACES: Final = ("BK-RB", "BK-LB", "BK-LBD")
-"""The interfaces of Table 2-7: remote bus branch, local bus branch, local bus branch with device-oriented
-diagnostics."""
-
-
-def branch_present(rf: str | None, lbst: bool, connected: bool) -> bool:
-    """Whether a BK's branch is present, from the RF straps and LBST (Table 2-9, BK-2).
-
-    RF = 10: LBST alone (an external connector signal, as on the IBS SUPI 3). RF = 11 (copper, automatic
-    recognition): a device answers on the branch (``connected``) and LBST = 1 (LBST = 0 switches the branch
-    interface off). RF = 00 or 01 (fibre, automatic recognition): a device answers, or LBST = 1 switches it on.
-    ``rf`` ``None`` (no RF pins) counts as copper with automatic recognition.
-    """
-    rf = "11" if rf is None else check_choice("rf", rf, ("00", "01", "10", "11"))
-    lbst = check_bool("lbst", lbst)
-    connected = check_bool("connected", connected)
-    if rf == "10":
-        return lbst
-    if rf == "11":
-        return connected and lbst
-    return connected or lbst
+__all__ = [
+    "BRANCH_SILENCE_S",
+    "CONF_PIN",
+    "LBST_PIN",
+    "TERMINAL_INTERFACES",
+    "BusTerminal",
+    "branch_present",
+]
 
 
 class BusTerminal:
-    """A BK's branch state (manual 2.4; docs/assumptions/bus-terminal.md).
+    """A BK's branch state (manual 2.4; docs/assumptions/bus-terminal.md) at transaction level.
 
     Parameters
     ----------
@@ -67,37 +57,23 @@ class BusTerminal:
 
     Attributes
     ----------
-    switched_on:
-        The master's last branch control: on (the default after power-up and reset) or off.
-    extended:
-        The extended BK function is active (the master activated it).
-    closed:
-        The BK closed its branch itself (extended function), until the master switches the branch on again.
-    closed_report:
-        The BK closed its branch and the master has not acknowledged it yet (status bit 6, BK-5).
-    conf_request:
-        A reconfiguration request (CONF edge) waits for the master's acknowledgement.
-    alarm:
-        The ALARM output (MFP15) the master set (BK-12); off after an INTERBUS reset.
-    count:
-        The count of the last counter telegram received on the branch return line, 0 if none.
+    state:
+        The branch state, a :class:`supi3.terminal.Terminal`; its fields are also attributes of this object
+        (read-only but ``conf_request``): ``switched_on``, ``extended``, ``closed``, ``closed_report``,
+        ``conf_request``, ``alarm`` and ``count`` (see there).
+    lbst:
+        The LBST (MFP11) level last seen.
     closures:
         How often the BK closed its branch itself.
     """
 
     def __init__(self, interface: str, rf: str | None) -> None:
         self.interface = check_choice("interface", interface, TERMINAL_INTERFACES)
+        spec.rf_code(rf)
         self.rf = rf
         self.lbst = False
-        self.conf = False
-        self.switched_on = True
-        self.extended = False
-        self.closed = False
-        self.closed_report = False
-        self.conf_request = False
-        self.count = 0
+        self.state = Terminal()
         self.closures = 0
-        self.alarm = False
         self._silent_since: float | None = None
 
     __hash__ = None  # type: ignore[assignment]  # mutable state, compared by value
@@ -108,42 +84,70 @@ class BusTerminal:
     def __repr__(self) -> str:
         return f"BusTerminal({', '.join(f'{k}={v!r}' for k, v in vars(self).items())})"
 
+    @property
+    def switched_on(self) -> bool:
+        """The master's last branch control: on (the default after power-up and reset) or off."""
+        return self.state.switched_on
+
+    @property
+    def extended(self) -> bool:
+        """The extended BK function is active (the master activated it)."""
+        return self.state.extended
+
+    @property
+    def closed(self) -> bool:
+        """The BK closed its branch itself (extended function), until the master switches the branch on again."""
+        return self.state.closed
+
+    @property
+    def closed_report(self) -> bool:
+        """The BK closed its branch and the master has not acknowledged it yet (status bit 6, BK-5)."""
+        return self.state.closed_report
+
+    @property
+    def conf_request(self) -> bool:
+        """A reconfiguration request (CONF edge) waits for the master's acknowledgement."""
+        return self.state.conf_request
+
+    @conf_request.setter
+    def conf_request(self, waiting: bool) -> None:
+        self.state = replace(self.state, conf_request=check_bool("conf_request", waiting))
+
+    @property
+    def alarm(self) -> bool:
+        """The ALARM output (MFP15) the master set (BK-12); off after an INTERBUS reset."""
+        return self.state.alarm
+
+    @property
+    def count(self) -> int:
+        """The count of the last counter telegram received on the branch return line, 0 if none."""
+        return self.state.count
+
     def inputs(self, levels: int) -> bool:
         """The MFP input levels changed to ``levels``: LBST follows MFP11; ``True`` on a CONF (MFP12) rising edge,
         which raises a reconfiguration request."""
         levels = check_bits("levels", levels, 16, "MFP[15..0]")
         conf = bool((levels >> CONF_PIN) & 1)
         self.lbst = bool((levels >> LBST_PIN) & 1)
-        rising = conf and not self.conf
-        self.conf = conf
-        self.conf_request = self.conf_request or rising
+        rising = conf and not self.state.conf
+        self.state = spec.conf_level(self.state, conf)
         return rising
 
     def enabled(self, connected: bool) -> bool:
         """The branch is in the data path: present (Table 2-9), switched on by the master, not closed by the BK."""
-        return branch_present(self.rf, self.lbst, connected) and self.switched_on and not self.closed
+        return spec.enabled(self.state, self.rf, self.lbst, connected)
 
     def status(self) -> int:
         """The branch status byte (BK-5)."""
-        return wire.bk_status(self.conf_request, self.closed_report, self.count)
+        return self.state.status
 
     def command(self, branch: BranchControl, acknowledge: bool, alarm: bool | None = None) -> None:
         """Apply a latched command word: the branch control (BK-4), with ``acknowledge`` (0714h) the end of a
         reconfiguration request and of the closed flag's report (BK-8), and the ALARM output unless ``alarm`` is
         ``None`` (BK-12)."""
-        check_instance("branch", branch, BranchControl)
-        acknowledge = check_bool("acknowledge", acknowledge)
-        if alarm is not None:
-            self.alarm = check_bool("alarm", alarm)
-        if branch is BranchControl.OFF:
-            self.switched_on = False
-        elif branch in (BranchControl.ON, BranchControl.ON_EXTENDED):
-            self.switched_on = True
-            self.closed = False
-            self.extended = branch is BranchControl.ON_EXTENDED
+        self.state = spec.command(self.state, branch, acknowledge, alarm)
+        if spec.restarts_silence(branch):
             self._silent_since = None
-        if acknowledge:
-            self.conf_request = self.closed_report = False
 
     def returned(self, traffic: bool, count: int | None, start: float, end: float) -> bool:
         """The branch was driven from ``start`` to ``end``: whether the master's telegrams came back on its return
@@ -152,14 +156,14 @@ class BusTerminal:
         traffic = check_bool("traffic", traffic)
         start = check_real("start", start, 0.0)
         end = check_real("end", end, start)
-        self.count = 0 if count is None else count
+        self.state = spec.received(self.state, 0 if count is None else count)
         if traffic:
             self._silent_since = None
             return False
         since = start if self._silent_since is None else self._silent_since
         self._silent_since = since
-        if self.extended and not self.closed and end - since >= BRANCH_SILENCE_S:
-            self.closed = self.closed_report = True
+        if spec.watching(self.state) and end - since >= BRANCH_SILENCE_S:
+            self.state = spec.silence(self.state)
             self.closures += 1
             return True
         return False
@@ -167,9 +171,5 @@ class BusTerminal:
     def reset(self) -> None:
         """INTERBUS reset: the branch switched on again (also one the BK closed), the extended function off, the
         count forgotten (BK-9); a waiting reconfiguration request stays until acknowledged."""
-        self.switched_on = True
-        self.extended = False
-        self.closed = False
-        self.count = 0
-        self.alarm = False
+        self.state = spec.reset(self.state)
         self._silent_since = None

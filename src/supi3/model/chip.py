@@ -404,9 +404,8 @@ class Supi3:
         leds = replace(self.led_inputs, fo=fo_leds(self._optical, self.bus_active))
         terminal = self.bus_terminal
         if terminal is not None:
-            closed = terminal.closed
-            leds = replace(leds, ld=closed or not terminal.switched_on, e=closed or terminal.count > 0,
-                           alarm=terminal.alarm)
+            state = terminal.state
+            leds = replace(leds, ld=state.ld, e=state.e, alarm=state.alarm)
         return diagnostic_outputs(self.config, supply_ok=True, line_heard=not self.line_silent,
                                   bus_active=self.bus_active, peripheral_fault=self.pf,
                                   line_interrupt=self.line_interrupt, leds=leds)  # fmt: skip

@@ -77,6 +77,7 @@ from supi3.model.chip import Supi3
 from supi3.pinlevel import EventLog, Pin
 from supi3.pinout import CORE_OUTPUTS, IB_DIAG_DIVIDER_BITS, SYNC_STAGES
 from supi3.tables import CLOCK_HZ, RESET_MIN_S
+from supi3.terminal import CONF_PIN
 
 __all__ = [
     "IB_DIAG_DIVIDER_BITS",
@@ -290,7 +291,13 @@ class Supi3Pins:
         if c < self._run_from:
             return
         chip = self.chip
-        chip.mfp_in = s.mfp_in
+        if chip.bus_terminal is None:
+            chip.mfp_in = s.mfp_in
+        elif c == self._run_from:  # a BK takes CONF as it is at the first running clock: no edge (BK-20)
+            chip.mfp_in = s.mfp_in
+            chip._init_bus_terminal()
+        elif s.mfp_in != chip.mfp_in:  # a BK's CONF edge (reconfiguration request, ATTN; BK-8) and LBST
+            chip.set_mfp_inputs(s.mfp_in)
         stat = not s.stat_err_n
         if stat != self._stat_active:
             self._stat_active = stat
@@ -372,6 +379,9 @@ class Supi3Pins:
         for name in ("stat_err_n", "resu_n", "vmon_ok"):
             trace = synced[name]
             change[1:] |= trace[1:] != trace[:-1]
+        if self.chip.bus_terminal is not None:  # a BK's CONF edges (BK-8)
+            conf = synced["mfp_in"] >> CONF_PIN & 1
+            change[1:] |= conf[1:] != conf[:-1]
         # Input events: cycles where a synchronised input the logic reads changes. A change of the line (do1) only
         # matters while the receiver waits for a start bit: in a telegram the receiver acts at its due cycles
         # (mid-bit samples), and the one thing a line change does there, marking where a run of start level began

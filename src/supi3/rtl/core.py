@@ -79,8 +79,10 @@ from supi3.rtl.tables import (
     core_tables,
     line_position,
 )
+from supi3.rtl.terminal import TerminalRtl
 from supi3.rtl.upif import upif_tables
 from supi3.tables import BIT_RATES
+from supi3.terminal import CONF_PIN, LBST_PIN, TerminalMode
 
 __all__ = [
     "LINE",
@@ -245,11 +247,12 @@ class Supi3Core(wiring.Component):
         complete_diag = Signal()
         local_bus = Signal()  # the mode raises the line interrupt ahead (DG-3)
         bus_terminal = Signal()  # a bus terminal module: LEDs on MFP15, 14, 13, 8 (Table 2-8)
+        terminal_mode = Signal(range(len(TerminalMode)))  # which one (Table 2-7)
         maps = tables.io_maps
         with m.Switch(Cat(self.mfp_in[MFP_PINS - EXPANSION_BITS :], self.c)):
             for mode, serial, (watch, bk) in zip(tables.modes, tables.serial, tables.diagnostics, strict=True):
                 with m.Case(mode.pattern):
-                    m.d.comb += [local_bus.eq(watch), bus_terminal.eq(bk)]
+                    m.d.comb += [local_bus.eq(watch), bus_terminal.eq(bk != TerminalMode.NONE), terminal_mode.eq(bk)]
                     if serial is not None:
                         m.d.comb += [
                             spi.eq(1),
@@ -322,6 +325,31 @@ class Supi3Core(wiring.Component):
         m.submodules.outputs = gated(outputs)
         m.submodules.serial_io = gated(serial_io)
         m.submodules.expansion = gated(expansion)
+
+        # The bus terminal module (2.4, docs/bus-terminal.md): in reset until the core runs, so that it takes CONF as it
+        # is at the first running clock (BK-20). Until the branch's data path (DI3/DO3) is in, no device is seen on
+        # the branch and its return line counts as carrying the master's telegrams: no closure by the extended
+        # function and no count at pin level (the transaction-level ring's branch_returned has them).
+        terminal = TerminalRtl()
+        m.submodules.terminal = ResetInserter(~running)(terminal)
+        command = datapath.words.command
+        m.d.comb += [
+            terminal.ib_reset.eq(frame.management.clear),
+            terminal.mode.eq(terminal_mode),
+            terminal.rf.eq(self.rf),
+            terminal.conf.eq(receiver.mfp_in_s[CONF_PIN]),
+            terminal.lbst.eq(receiver.mfp_in_s[LBST_PIN]),
+            terminal.cmd_valid.eq(frame.management.latch_id),
+            terminal.branch.eq(command[wire.CMD_BRANCH_SHIFT :][: len(terminal.branch)]),
+            terminal.ack.eq(command[wire.CMD_QUIT_BIT]),
+            terminal.alarm_set.eq(command[wire.CMD_ALARM_OUT_SET_BIT] & ~command[wire.CMD_PCMD_BIT]),
+            terminal.alarm_on.eq(command[wire.CMD_ALARM_OUT_BIT]),
+            terminal.ret_valid.eq(1),
+            outputs.ld.eq(terminal.ld),
+            outputs.e.eq(terminal.e),
+            outputs.alarm.eq(terminal.alarm),
+            outputs.bk_attention.eq(terminal.attention),
+        ]
 
         # Joins between the blocks: connect() where the interfaces fit ---------------------------------------------
         wiring.connect(m, receiver=receiver.line, frame=frame.line)
@@ -406,7 +434,9 @@ class Supi3Core(wiring.Component):
 
         # Init-µP modes: the ID register, the data length and the IN data from the register file (docs/upif.md)
         m.d.comb += [
-            datapath.id_register.eq(strap_id),
+            # A BK without µP sends its branch status byte when the master asked for it (BK-5)
+            datapath.id_register.eq(Mux(outputs.send_alarm & bus_terminal & ~init_up,
+                                        Cat(terminal.status, strap_id[BYTE_BITS:]), strap_id)),
             datapath.data_bytes.eq(strap_bytes),
             datapath.external.eq(spi | init_up if up else spi),
             datapath.in_data.eq(Mux(init_up, self.in_data, in_data) if up else in_data),
@@ -885,9 +915,11 @@ class OutputsRtl(wiring.Component):
     low while the line is silent (RC, DG-4), IB_DIAG flashing from the free-running ``divider`` (Table 3-18, M6,
     DG-1, DG-2), and a bus terminal module's ALARM, LD, E and FO3 on ``mfp_diag`` (Table 2-8). ``fo`` (the optical
     block's FO1..FO3), ``rd``, ``ld``, ``e`` and ``alarm`` are ``supi3.diagnostics.LedInputs``: the core ties them
-    to 0 until the blocks that drive them are in. The chip registers follow ``model.chip.Supi3``; the frame engine
-    drives them through ``frame`` (:data:`MANAGEMENT`, flipped) and ``discard``, and ``words`` (:data:`WORDS`,
-    flipped) gives the data path the management bits and the watchdog's reset and takes the command word.
+    to 0 until the blocks that drive them are in (``ld``, ``e``, ``alarm`` come from the bus terminal block);
+    ``bk_attention``, that block's waiting report, joins the attention bit. The chip registers follow
+    ``model.chip.Supi3``; the frame engine drives them through ``frame`` (:data:`MANAGEMENT`, flipped) and
+    ``discard``, and ``words`` (:data:`WORDS`, flipped) gives the data path the management bits and the watchdog's
+    reset and takes the command word.
     """
 
     def __init__(self, divider_bits: int) -> None:
@@ -897,7 +929,7 @@ class OutputsRtl(wiring.Component):
             "divider": In(divider_bits), "rbst_by_pin": In(1), "complete_diag": In(1),
             "expansion": In(1), "expansion_pulse": In(range(_EXPANSION_PULSE_MAX + 1)),
             "local_bus": In(1), "bus_terminal": In(1), "idle_timeout": In(1), "discard": In(1),
-            "fo": In(3), "rd": In(1), "ld": In(1), "e": In(1), "alarm": In(1),
+            "fo": In(3), "rd": In(1), "ld": In(1), "e": In(1), "alarm": In(1), "bk_attention": In(1),
             "send_alarm": Out(1), "di1": Out(1), "mod_ack_n": Out(1), "res_reg_n": Out(1), "diag1": Out(1),
             "diag2": Out(1), "ib_diag": Out(1), "mfp_diag": Out(MFP_PINS),
         })  # fmt: skip
@@ -976,7 +1008,7 @@ class OutputsRtl(wiring.Component):
         te_now = te | f.frame_error
         comb += [
             words.status.eq((pf_now << wire.MGMT_PF_BIT) | (wd_now << wire.MGMT_WD_BIT) | (te_now << wire.MGMT_TE_BIT)),
-            f.attention.eq(attention_now),
+            f.attention.eq(attention_now | self.bk_attention),  # a BK's waiting report (BK-5, BK-8)
         ]
         with m.If(f.abandon):  # TE |= local error (Table 3-13)
             sync += te.eq(te_now)

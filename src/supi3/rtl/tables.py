@@ -31,6 +31,7 @@ from supi3.tables import (
     STATERR_FILTER_S,
     WATCHDOG_TIMEOUTS_S,
 )
+from supi3.terminal import TerminalMode
 
 __all__ = [
     "CLK_CONF_BITS",
@@ -152,9 +153,9 @@ class CoreTables:
     """RF[1..0] values that select bus connector recognition via RBST_EXT (Table 2-2)."""
     complete_diagnostics: tuple[int, ...]
     """DIAG_CONF values that select complete diagnostics, DIAG1 = BA (Table 3-16)."""
-    diagnostics: tuple[tuple[bool, bool], ...]
-    """For each mode, (it raises the line interrupt ahead, it is a bus terminal module): ``supi3.diagnostics``
-    (DG-3, Table 2-8)."""
+    diagnostics: tuple[tuple[bool, TerminalMode], ...]
+    """For each mode, (it raises the line interrupt ahead, its bus terminal interface or NONE): ``supi3.diagnostics``
+    (DG-3), ``supi3.terminal`` (Tables 2-7, 2-8)."""
 
     @property
     def io_maps(self) -> tuple[tuple[tuple[int | None, ...], tuple[int | None, ...]], ...]:
@@ -283,5 +284,5 @@ def core_tables(variant: Variant | str = Variant.OPC) -> CoreTables:
         diag = _values(DIAG_CONF_BITS, lambda b: decode(first.c, first.mfp, diag_conf=b, variant=variant))
         rbst = tuple(value for value, config in rf if rbst_by_pin(config))
         complete = tuple(value for value, config in diag if complete_diagnostics(config))
-    diagnostics = tuple((watches_line_interrupt(config), config.interface.is_bus_terminal) for config in configs)
+    diagnostics = tuple((watches_line_interrupt(config), TerminalMode.of(config.interface.value)) for config in configs)
     return CoreTables(variant, modes, serial, tuple(clocks), rbst, complete, diagnostics)

@@ -1,0 +1,123 @@
+"""The bus terminal module (BK) block in Amaranth: the branch state, CONF edge detection, the command word's branch
+control, the silence timer of the extended function, the status byte and the LEDs, with the ports of
+:data:`supi3.terminal.BLOCK_INPUTS` / ``BLOCK_OUTPUTS``.
+
+Manual 2.4 (Tables 2-7, 2-8, 2-9, "Extended bus terminal module functions"), 2.2.2, Table 3-19. The transitions of
+:mod:`supi3.terminal` (``power_up``, ``conf_level``, ``command``, ``received``, ``silence``, ``reset``, ``enabled``
+and the outputs of ``Terminal``) are re-implemented here in gates, with every constant taken from the spec at
+elaboration (the branch control codes, the status byte's bits, the RF codes of Table 2-9, the silence in clocks).
+The edge order and the port timing are those of the pin model ``TerminalBlock``
+(``src/supi3/model/blocks/terminal.py``, its module docstring, BK-20), which
+``tests/test_verif_lockstep_terminal.py`` holds this block to, cycle by cycle.
+"""
+
+from __future__ import annotations
+
+from amaranth.hdl import Module, Mux, Signal, Value
+from amaranth.lib import wiring
+from amaranth.lib.wiring import In, Out
+
+from supi3.interbus.wire import BK_STATUS_CLOSED_BIT, BK_STATUS_CONF_BIT, COUNTER_MAX, BranchControl
+from supi3.terminal import BLOCK_INPUTS, BLOCK_OUTPUTS, BRANCH_SILENCE_CLOCKS, RF_CODES, TerminalMode
+
+__all__ = ["TerminalRtl"]
+
+
+class TerminalRtl(wiring.Component):
+    """The bus terminal block (see the module docstring).
+
+    Parameters
+    ----------
+    time_limit:
+        The silence after which the extended function closes the branch, in clocks (BK-3); a test may elaborate a
+        shorter one to reach it quickly.
+    """
+
+    def __init__(self, time_limit: int = BRANCH_SILENCE_CLOCKS) -> None:
+        self.time_limit = time_limit
+        super().__init__({
+            **{pin.name: In(pin.width) for pin in BLOCK_INPUTS},
+            **{pin.name: Out(pin.width) for pin in BLOCK_OUTPUTS},
+        })  # fmt: skip
+
+    def _present(self, m: Module) -> Value:
+        """Table 2-9 (BK-2, ``branch_present``): RF = 10 LBST alone, 11 a device answers and LBST, 00/01 either."""
+        present = Signal()
+        with m.Switch(self.rf):
+            for code, rf in enumerate(RF_CODES):
+                with m.Case(code):
+                    if rf == "10":
+                        m.d.comb += present.eq(self.lbst)
+                    elif rf == "11":
+                        m.d.comb += present.eq(self.connected & self.lbst)
+                    else:
+                        m.d.comb += present.eq(self.connected | self.lbst)
+        return present
+
+    def elaborate(self, _platform: object) -> Module:
+        m = Module()
+        sync, comb = m.d.sync, m.d.comb
+
+        # State (Terminal's fields), the power-up flag and the silence timer -------------------------------------
+        conf = Signal()
+        switched_on = Signal(init=1)
+        extended = Signal()
+        closed = Signal()
+        closed_report = Signal()
+        conf_request = Signal()
+        count = Signal(COUNTER_MAX.bit_length())
+        alarm = Signal()
+        fresh = Signal(init=1)
+        timer = Signal(range(max(self.time_limit, 2)))
+
+        # Outputs from the state ---------------------------------------------------------------------------------
+        bk = self.mode != TerminalMode.NONE
+        on = self._present(m) & switched_on & ~closed
+        status = Signal(8)
+        comb += status.eq(count | (closed_report << BK_STATUS_CLOSED_BIT) | (conf_request << BK_STATUS_CONF_BIT))
+        comb += [
+            self.enabled.eq(bk & on),
+            self.status.eq(Mux(bk, status, 0)),
+            self.attention.eq(bk & (conf_request | closed_report)),
+            self.ld.eq(bk & (closed | ~switched_on)),
+            self.e.eq(bk & (closed | (count != 0))),
+            self.alarm.eq(bk & alarm),
+            self.closed.eq(bk & closed),
+        ]
+
+        # The edge -----------------------------------------------------------------------------------------------
+        branch_on = self.branch.matches(BranchControl.ON.value, BranchControl.ON_EXTENDED.value)
+        cmd_off = self.cmd_valid & (self.branch == BranchControl.OFF.value)
+        cmd_on = self.cmd_valid & branch_on
+        counting = extended & on
+        restart = self.ret_valid | cmd_on
+        expired = counting & ~restart & (timer + 1 >= self.time_limit)
+        with m.If(bk):
+            with m.If(fresh):  # power_up: the CONF level, no edge
+                sync += [fresh.eq(0), conf.eq(self.conf)]
+            with m.Else():
+                sync += conf.eq(self.conf)  # conf_level
+                with m.If(self.conf & ~conf):
+                    sync += conf_request.eq(1)
+                with m.If(self.ib_reset):  # reset: all but the CONF level and the request
+                    sync += [switched_on.eq(1), extended.eq(0), closed.eq(0), closed_report.eq(0), count.eq(0),
+                             alarm.eq(0), timer.eq(0)]  # fmt: skip
+                with m.Else():
+                    with m.If(self.cmd_valid):  # command
+                        with m.If(self.alarm_set):
+                            sync += alarm.eq(self.alarm_on)
+                        with m.If(cmd_off):
+                            sync += switched_on.eq(0)
+                        with m.If(cmd_on):
+                            sync += [switched_on.eq(1), closed.eq(0),
+                                     extended.eq(self.branch == BranchControl.ON_EXTENDED.value)]  # fmt: skip
+                        with m.If(self.ack):
+                            sync += [conf_request.eq(0), closed_report.eq(0)]
+                    with m.If(self.cnt_valid):  # received
+                        sync += count.eq(self.count)
+                    with m.Elif(self.ret_valid):
+                        sync += count.eq(0)
+                    with m.If(expired & ~cmd_off):  # silence, on the state after the command (watching)
+                        sync += [closed.eq(1), closed_report.eq(1)]
+                    sync += timer.eq(Mux(counting & ~restart & ~expired, timer + 1, 0))
+        return m
