@@ -12,9 +12,8 @@ from supi3 import tables
 from supi3.config import DeviceConfig, Interface, decode
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle, Frame
-from supi3.model.pinring import receive
 from supi3.model.pins import RESET_STRETCH_CLOCKS, Supi3Pins
-from support import assert_run_matches_step, quiet_inputs
+from support import assert_run_matches_step, counter_counts, counter_levels, quiet_inputs
 
 FAST = tables.clk_conf_for(2_000_000)
 SLOW = tables.clk_conf_for(500_000)
@@ -36,13 +35,6 @@ def _traffic(config: DeviceConfig) -> npt.NDArray[np.uint8]:
         wire.cycle_levels(Frame.build(Cycle.ID, lw + wire.word_bytes(wire.command_word(0))), 1, True), IDLE,
         wire.cycle_levels(Frame.build(Cycle.DATA, lw + bytes(range(config.data_bytes))), 1, True), IDLE,
     ])  # fmt: skip
-
-
-def _counts(trace: npt.NDArray[np.int64], cpb: int) -> list[int | None]:
-    """The count of each data telegram on a line that reads as a counter telegram (ID check, BK-6), else ``None``."""
-    telegrams, _, _ = receive(trace, 0, cpb)
-    return [wire.counter_count(t.data) if t.cycle is Cycle.ID and t.check else None
-            for t in telegrams if isinstance(t, wire.Telegram) and t.data is not None]  # fmt: skip
 
 
 def _line(levels: npt.NDArray[np.uint8], config: DeviceConfig, **pins: int) -> dict[str, npt.NDArray[np.int64]]:
@@ -76,12 +68,12 @@ def test_a_silent_input_gives_count_1_forward_and_count_2_on_the_looped_return_l
     config = _config(interface, clk)
     cpb = wire.clocks_per_bit(config.bit_rate)
     traces = Supi3Pins(config).run(_line(np.ones(200, dtype=np.uint8), config))
-    forward = _counts(traces["do2"], cpb)
+    forward = counter_counts(traces["do2"], cpb)
     assert len(forward) == (200 - RESET_STRETCH_CLOCKS // cpb - 13) // 33 and set(forward) == {1}
     # LBD-MR: both blocks fall silent at once at power-up and race once (docs/interbus.md "Known limits"): the
     # return block's own count 1 comes first.
     looped = [1, *[2] * (len(forward) - 1)] if interface is Interface.LBD_MR else forward
-    assert _counts(traces["di1"], cpb) == looped
+    assert counter_counts(traces["di1"], cpb) == looped
 
 
 @pytest.mark.parametrize("interface", [Interface.LBD_MR, Interface.LBD_OR])
@@ -90,13 +82,10 @@ def test_a_received_counter_telegram_goes_on_incremented(interface: Interface) -
     on incremented, DI1 (looped) once more in LBD-MR; the frame engine sees no frame in them."""
     config = _config(interface)
     cpb = wire.clocks_per_bit(config.bit_rate)
-    telegram = wire.counter_telegram(5)
-    period = np.ones(33, dtype=np.uint8)
-    period[: wire.DATA_TELEGRAM_BITS] = [(telegram >> k) & 1 for k in range(wire.DATA_TELEGRAM_BITS)]
     model = Supi3Pins(config)
-    traces = model.run(_line(np.concatenate([np.ones(20, dtype=np.uint8), np.tile(period, 5)]), config))
-    assert _counts(traces["do2"], cpb) == [6] * 5
-    assert _counts(traces["di1"], cpb) == [7 if interface is Interface.LBD_MR else 6] * 5
+    traces = model.run(_line(np.concatenate([np.ones(20, dtype=np.uint8), np.tile(counter_levels(5, 33), 5)]), config))
+    assert counter_counts(traces["do2"], cpb) == [6] * 5
+    assert counter_counts(traces["di1"], cpb) == [7 if interface is Interface.LBD_MR else 6] * 5
     assert not model.chip.events
 
 
@@ -114,4 +103,4 @@ def test_working_traffic_goes_out_as_the_transmitter_sends_it(interface: Interfa
     start = RESET_STRETCH_CLOCKS + 3 * cpb
     delay = wire.REPEATER_DELAY_BITS * cpb if interface is Interface.LBD_MR else 0
     assert np.array_equal(traces["di1"][start + delay :], traces["do2"][start : len(traces["do2"]) - delay])
-    assert len(_counts(traces["do2"], cpb)) > 10  # the frames went through
+    assert len(counter_counts(traces["do2"], cpb)) > 10  # the frames went through
