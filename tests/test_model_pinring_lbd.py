@@ -51,9 +51,9 @@ def test_every_break_brings_the_master_the_count_of_lbd_count(kind: BranchKind, 
 def test_a_master_runs_cycles_over_lbd_mr_chips() -> None:
     """The return line of an LBD-MR chip is repeated 3 bit periods later (its counter block): the ring delay the
     master allows for counts 2 repeaters per LBD-MR chip, so ID and data cycles come back whole and latch."""
-    chips = [Supi3Pins(_config(interface)) for interface in (Interface.LBD_MR, Interface.LBD_OR, Interface.LBD_MR)]
+    chips = [Supi3Pins(_config(Interface.LBD_MR)) for _ in range(3)]  # 3 repeaters short without M17: no latch
     ring = PinRing(chips)
-    assert ring.repeaters == 5
+    assert ring.repeaters == 6 and PinRing([Supi3Pins(_config(Interface.LBD_OR))]).repeaters == 1
     master = Master(ring, locate=False, max_devices=4)
     assert master.start().ok
     master.set_outputs(2, b"\x5a")
