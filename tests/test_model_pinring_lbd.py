@@ -5,7 +5,6 @@ return lines' repeaters (M17), so a master runs cycles over LBD-MR chips as over
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
 from supi3 import tables
