@@ -599,7 +599,7 @@ def counter_levels(count: int, period: int) -> npt.NDArray[np.uint8]:
     return levels
 
 
-def counter_counts(trace: npt.NDArray[np.int64], cpb: int) -> list[int | None]:
+def counter_counts(trace: npt.NDArray[np.integer], cpb: int) -> list[int | None]:
     """The count of each data telegram on a line (32 MHz samples) that reads as a counter telegram (an ID check
     telegram, BK-6), else ``None``."""
     telegrams, _, _ = receive(trace, 0, cpb)

@@ -25,7 +25,9 @@ telegram's stop bit was sampled; ``count`` is the spec state's ``counted``.
 
 from __future__ import annotations
 
+from bisect import bisect_left
 from collections.abc import Mapping, Sequence
+from functools import lru_cache
 from typing import Final
 
 import numpy as np
@@ -60,6 +62,9 @@ _SAMPLE: Final = tuple(sample_phase(cpb) for cpb in _CPB)
 _COUNTDOWN: Final = tuple(send_countdown(cpb) for cpb in _CPB)
 _IDLE_OUT: Final = wire.IDLE_LEVEL
 """A queue value (level in bit 0, drive in bit 1) for an idle line the block does not drive."""
+_step: Final = lru_cache(maxsize=1 << 14)(counter_step)
+"""``counter_step``, remembered: a line visits few states (plain ints, hashable), and ``run()`` of a chip replays
+its blocks over every bit period (M17)."""
 
 
 class CounterBlock:
@@ -137,7 +142,7 @@ class CounterBlock:
             phase, self.pending = 0, True
         self.seen = 0
         if phase == _SAMPLE[fast]:
-            self.state, sent = counter_step(self.state, line)
+            self.state, sent = _step(self.state, line)
             self.pending = False
             self.seen = sent.seen
             self.queue.append((self.cycle + 1 + _COUNTDOWN[fast], sent.out | sent.drive << 1))
@@ -147,9 +152,14 @@ class CounterBlock:
     def advance(self, line: npt.NDArray[np.int64], c0: int, stop: int, fast: int) -> None:
         """:meth:`clock` for every cycle from :attr:`cycle` to ``stop - 1``, ``line[c - c0]`` being cycle ``c``'s
         input (``fast`` fixed), visiting only the cycles where a start level restarts the grid or the line is
-        sampled: the same state as clocking each cycle. Nothing happens if :attr:`cycle` >= ``stop``."""
+        sampled, and taking the samples of an idle line between telegrams in one go: the same state and line out
+        (:meth:`render`) as clocking each cycle. Nothing happens if :attr:`cycle` >= ``stop``."""
         cpb, half = _CPB[fast], _SAMPLE[fast]
         c = self.cycle
+        if c >= stop:
+            return
+        starts = (np.flatnonzero(line[c - c0 : stop - c0] == wire.START_LEVEL) + c).tolist()
+        k = 0
         while c < stop:
             phase = self.phase
             if phase >= cpb:  # left by a change of ``fast``: one clock brings it back into the bit period
@@ -158,9 +168,14 @@ class CounterBlock:
                 continue
             event = c + (half - phase) % cpb
             if self.state.bit == IDLE_BIT and not self.pending:
-                lows = np.flatnonzero(line[c - c0 : min(event + 1, stop) - c0] == wire.START_LEVEL)
-                if lows.size:
-                    event = c + int(lows[0])
+                k = bisect_left(starts, c, k)
+                restart = starts[k] if k < len(starts) else stop
+                if event < restart:  # samples of the idle line before the next start level (or the end)
+                    self._idle_samples(event, (restart - 1 - event) // cpb + 1, fast)
+                    c = self.cycle
+                    continue
+                if restart < stop:
+                    event = restart
             if event >= stop:
                 event = stop
             if event > c:  # the cycles between: the phase runs on, nothing else changes
@@ -171,6 +186,22 @@ class CounterBlock:
                 return
             self.clock(int(line[event - c0]), fast)
             c = event + 1
+
+    def _idle_samples(self, first: int, count: int, fast: int) -> None:
+        """The samples of an idle line between telegrams at cycles ``first``, ``first + cpb``, ... (``count`` of
+        them), as :meth:`clock` takes them; entries of the idle level not driven are not queued (the line is idle
+        where no entry is, and a sample of the idle line comes a whole bit period after the one before, so its
+        entry cuts none short)."""
+        cpb, countdown = _CPB[fast], 1 + _COUNTDOWN[fast]
+        state, queue, seen = self.state, self.queue, 0
+        for s in range(first, first + count * cpb, cpb):
+            state, sent = _step(state, wire.IDLE_LEVEL)
+            if sent.out != wire.IDLE_LEVEL or sent.drive:
+                queue.append((s + countdown, sent.out | sent.drive << 1))
+            seen = sent.seen
+        self.state, self.seen = state, seen
+        self.cycle = first + (count - 1) * cpb + 1
+        self.phase = _SAMPLE[fast] + 1
 
     def power_up(self, now: int, run_from: int, fast: int) -> None:
         """A chip's power-up reset in cycle ``now`` (``fast`` fixed): the state after reset from the next cycle,
