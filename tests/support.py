@@ -38,6 +38,7 @@ from supi3.interbus.wire import Cycle, Frame
 from supi3.model.blocks.optical import OpticalBlock
 from supi3.model.bus_terminal import LBST_PIN
 from supi3.model.chip import Supi3
+from supi3.model.pinring import receive
 from supi3.model.pins import Supi3Pins
 from supi3.model.registers import RegisterFile
 from supi3.optical.regulation import BLOCK_INPUTS
@@ -585,3 +586,22 @@ def lbd_breaks(kind: BranchKind, m: int) -> list[tuple[set[int], set[int], int]]
     if kind is BranchKind.LBD_MR:
         found += [(set(), {c}, c) for c in range(1, m)]
     return found
+
+
+# The LBD counter telegram on a chip's lines (tests/test_model_pins_lbd.py, tests/test_rtl_core_lbd.py) ----------------
+
+
+def counter_levels(count: int, period: int) -> npt.NDArray[np.uint8]:
+    """A counter telegram of ``count`` (BK-6), then the idle level to ``period`` bit periods."""
+    telegram = wire.counter_telegram(count)
+    levels = np.ones(period, dtype=np.uint8)
+    levels[: wire.DATA_TELEGRAM_BITS] = [(telegram >> k) & 1 for k in range(wire.DATA_TELEGRAM_BITS)]
+    return levels
+
+
+def counter_counts(trace: npt.NDArray[np.integer], cpb: int) -> list[int | None]:
+    """The count of each data telegram on a line (32 MHz samples) that reads as a counter telegram (an ID check
+    telegram, BK-6), else ``None``."""
+    telegrams, _, _ = receive(trace, 0, cpb)
+    return [wire.counter_count(t.data) if t.cycle is Cycle.ID and t.check else None
+            for t in telegrams if isinstance(t, wire.Telegram) and t.data is not None]  # fmt: skip

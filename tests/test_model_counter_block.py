@@ -6,11 +6,14 @@ level); hostile inputs."""
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 
 import numpy as np
 import numpy.typing as npt
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
@@ -111,3 +114,28 @@ def test_hostile_inputs_are_named_and_change_nothing(inputs: object, name: str) 
         block.step(bad(inputs))
     assert caught.value.name == name and str(caught.value).startswith(f"{name} must")
     assert (block.cycle, block.state, block.phase, list(block.queue)) == before
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    runs=st.lists(st.tuples(st.integers(0, 1), st.integers(1, 3 * COUNTER_SILENCE_BITS * 16)), max_size=40),
+    cuts=st.lists(st.floats(0, 1), max_size=5),
+    fast=st.integers(0, 1),
+)
+def test_advance_and_render_agree_with_step(runs: list[tuple[int, int]], cuts: list[float], fast: int) -> None:
+    """What the chip core's run() uses (M17): ``advance`` over any line in pieces, visiting only restarts and
+    samples, then ``render``, gives every clock's ``out`` and ``drive`` and the state that ``step`` gives."""
+    line = np.concatenate([np.full(n, level, dtype=np.int64) for level, n in runs] or [np.ones(1, np.int64)])
+    n = len(line)
+    stepped = CounterBlock()
+    expected = [stepped.step({"line": int(level), "fast": fast}) for level in line]
+    bulk = CounterBlock()
+    bounds = sorted({0, n, *(int(n * cut) for cut in cuts)})
+    pieces = []
+    for a, b in itertools.pairwise(bounds):
+        bulk.advance(line[a:b], a, b, fast)
+        pieces.append(bulk.render(a, b - a, fast))
+    for k, name in enumerate(("out", "drive")):
+        assert np.concatenate([piece[k] for piece in pieces]).tolist() == [o[name] for o in expected]
+    assert (bulk.state, bulk.phase, bulk.pending, bulk.cycle) == (stepped.state, stepped.phase, stepped.pending,
+                                                                  stepped.cycle)

@@ -12,6 +12,7 @@ from amaranth.lib import wiring
 from supi3.config import Variant
 from supi3.rtl import core
 from supi3.rtl.core import DataPathRtl, FrameEngineRtl, OutputsRtl, ReceiverRtl, Supi3Core, TransmitterRtl
+from supi3.rtl.counter import CounterLinesRtl
 from supi3.rtl.expansion import ExpansionRtl
 from supi3.rtl.serial_io import SerialIoRtl
 from supi3.rtl.tables import core_tables
@@ -19,9 +20,9 @@ from supi3.rtl.terminal import TerminalRtl
 
 BLOCKS = {"receiver": ReceiverRtl, "frame": FrameEngineRtl, "datapath": DataPathRtl, "transmitter": TransmitterRtl,
           "outputs": OutputsRtl, "serial_io": SerialIoRtl, "expansion": ExpansionRtl,
-          "terminal": TerminalRtl}  # fmt: skip
-"""Block name (the same in supi3.model; the model's bus terminal block's state is the chip's, supi3.model.bus_terminal)
--> RTL component."""
+          "counter_lines": CounterLinesRtl, "terminal": TerminalRtl}  # fmt: skip
+"""Block name (the same in supi3.model; ``counter_lines``: ``Supi3Pins``'s ``LineCounters``, M17; ``terminal``: its
+state is the model chip's, supi3.model.bus_terminal) -> RTL component."""
 
 
 @pytest.mark.parametrize("variant", list(Variant))
@@ -34,7 +35,7 @@ def blocks() -> list[wiring.Component]:
     """One of each block, elaborated on its own (so none is left unused)."""
     tables = core_tables()
     made = [ReceiverRtl(tables), FrameEngineRtl(), DataPathRtl(tables), TransmitterRtl(tables), OutputsRtl(26),
-            SerialIoRtl(), ExpansionRtl(), TerminalRtl()]  # fmt: skip
+            SerialIoRtl(), ExpansionRtl(), CounterLinesRtl(), TerminalRtl()]  # fmt: skip
     for block in made:
         Fragment.get(block, None)
     return made

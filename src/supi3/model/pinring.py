@@ -30,7 +30,7 @@ from supi3.checks import (
     check_trace,
     fail,
 )
-from supi3.config import DeviceConfig
+from supi3.config import DeviceConfig, Interface
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusError, TelegramError
 from supi3.interbus.ring import ErrorKind, Transfer
@@ -160,6 +160,10 @@ class PinRing:
         if len(rates) != 1:
             raise InterbusError("Table 1-7", sorted(rates), "every device of a ring runs at one bit rate")
         self.devices = list(chips)
+        self.repeaters = len(chips) + sum(chip.config.interface is Interface.LBD_MR for chip in chips)
+        """The repeaters a bit passes round the ring, each ``REPEATER_DELAY_BITS`` (A10): every chip on the forward
+        line, and an LBD-MR chip once more on its return line (its counter block repeats it, M17). The master's
+        ring delay (A11, ``wire.ring_delay_status_telegrams``) counts them."""
         self.bit_rate = rates.pop()
         self.cpb = wire.clocks_per_bit(self.bit_rate)
         self.cycle = 0
@@ -167,6 +171,8 @@ class PinRing:
         self.returned_from = 0
         self.record = record
         self._chunks: list[list[dict[str, npt.NDArray[np.int64]]]] = []
+        self.cuts: set[tuple[int, bool]] = set()
+        """Broken lines, as ``(position, forward)``: see :meth:`cut`."""
         self._inputs = [
             {"di2": 0, "rbst_ext": 0, "mfp_in": 0, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 1, "from_exr": 0}
             for _ in chips
@@ -192,6 +198,21 @@ class PinRing:
                        pin, "docs/model.md")
         self._inputs[position - 1][pin] = check_bits(f"pin {pin!r}", value, APPLICATION_INPUTS[pin])
 
+    def cut(self, position: int, forward: bool) -> None:
+        """Break the line into the chip at ring ``position``: its forward input DO1 (``forward``, 1..N), or its return
+        input DI2 from the chip behind it (1..N - 1). A broken line reads at the idle level (RS-485 fail-safe
+        bias, BK-30): behind it the LBD chips' counter telegrams (2.2.2) bring the master the count of
+        ``ring.lbd_count`` (``forward``, ``back``) for a branch of these chips.
+
+        Raises
+        ------
+        ArgumentError
+            ``forward`` not a bool or ``position`` out of range; nothing changes.
+        """
+        check_bool("forward", forward)
+        position = check_int("position", position, 1, len(self.devices) - (0 if forward else 1))
+        self.cuts.add((position, forward))
+
     def run_levels(self, levels: npt.NDArray[np.uint8]) -> None:
         """Send master line levels (one per bit period, 0 or 1) through the ring."""
         checked = check_trace("levels", levels, 1)
@@ -207,11 +228,12 @@ class PinRing:
         forward = check_trace("samples", samples, 1).astype(np.int64, copy=False)
         n = len(forward)
         placeholder = np.zeros(n, dtype=np.int64)
+        broken = np.full(n, wire.IDLE_LEVEL, dtype=np.int64)
         sent = []
         chunk = []
-        for chip, pins in zip(self.devices, self._inputs, strict=True):
+        for position, (chip, pins) in enumerate(zip(self.devices, self._inputs, strict=True), 1):
             traces = {name: np.full(n, value, dtype=np.int64) for name, value in pins.items()}
-            traces["do1"] = forward
+            traces["do1"] = broken if (position, True) in self.cuts else forward
             traces["di2"] = placeholder
             outputs = chip.run_forward(traces)
             forward = outputs["do2"]
@@ -219,6 +241,8 @@ class PinRing:
             chunk.append({**traces, **outputs})
         back = placeholder
         for k in range(len(self.devices) - 1, -1, -1):
+            if (k + 1, False) in self.cuts:
+                back = broken
             chunk[k]["di2"] = back
             back = self.devices[k].return_line(back, sent[k])
             chunk[k]["di1"] = back
@@ -256,7 +280,7 @@ class PinRing:
                                 "the pin-level ring does not close early")
         n = len(self.devices)
         frame = Frame.build(cycle, data)
-        delay = wire.ring_delay_status_telegrams(n)
+        delay = wire.ring_delay_status_telegrams(self.repeaters)
         self.run_levels(np.concatenate([wire.frame_levels(frame), wire.status_levels(cycle, False, delay)]))
         telegrams, error = self._received()
         receiver_error: ErrorKind | None = ErrorKind.TELEGRAM if error else None
@@ -288,12 +312,12 @@ class PinRing:
 
     def reset(self) -> None:
         """INTERBUS reset: the line held low, then idle status telegrams (``wire.reset_levels``)."""
-        self.run_levels(wire.reset_levels(len(self.devices)))
+        self.run_levels(wire.reset_levels(self.repeaters))
         self._received()
 
     def settle(self) -> None:
         """Idle status telegrams for the ring delay, so the last telegrams sent reach every chip."""
-        delay = wire.ring_delay_status_telegrams(len(self.devices))
+        delay = wire.ring_delay_status_telegrams(self.repeaters)
         self.run_levels(wire.status_levels(Cycle.DATA, False, delay))
         self._received()
 

@@ -56,6 +56,7 @@ from supi3.checks import check_bits, check_instance, check_int, check_trace, fai
 from supi3.config import DeviceConfig
 from supi3.diagnostics import is_complete
 from supi3.interbus import wire
+from supi3.model.blocks.counter import LineCounters
 from supi3.model.blocks.datapath import DataPath
 from supi3.model.blocks.expansion import Expansion
 from supi3.model.blocks.frame import FrameEngine
@@ -124,8 +125,8 @@ class Supi3Pins:
     """
 
     __slots__ = (
-        "_datapath", "_expansion", "_frame", "_holding", "_outputs", "_power_ups", "_receiver", "_recording",
-        "_return_start", "_run_from", "_serial", "_stat_active", "_synced_run", "_transmitter", "chip",
+        "_counters", "_datapath", "_expansion", "_frame", "_holding", "_outputs", "_power_ups", "_receiver",
+        "_recording", "_return_start", "_run_from", "_serial", "_stat_active", "_synced_run", "_transmitter", "chip",
         "complete_diagnostics",
         "config", "cpb", "cycle", "forward_delay", "log", "mfp_oe", "rbst_by_pin", "reset_run",
     )  # fmt: skip
@@ -161,6 +162,8 @@ class Supi3Pins:
         self._serial = SerialIo(self.chip) if self.chip.spi_sequences is not None else None
         self.chip._serial_pins = self._serial
         self._outputs = Outputs(self.chip, self._transmitter, self.cpb, self.mfp_oe, self._serial)
+        # LBD modes (Table 2-5): the counter telegram blocks on DO2 and, in LBD-MR, DI1 (M17).
+        self._counters = LineCounters.of(config)
         self.reset()
 
     # ------------------------------------------------------------------------------------------------------------
@@ -176,6 +179,8 @@ class Supi3Pins:
         if self._serial is not None:
             self._serial.reset()
         self._expansion.sync_reset()
+        if self._counters is not None:
+            self._counters.reset()
         self._holding = False
         self._recording = False
         self._power_ups: list[tuple[int, int]] = []
@@ -202,6 +207,8 @@ class Supi3Pins:
         if self._serial is not None:
             self._serial.power_up(self.cycle)
         self._expansion.power_up(self.cycle)
+        if self._counters is not None and not self._recording:  # a run replays its power-ups (_run_forward)
+            self._counters.power_up(self.cycle, run_from)
 
     # ------------------------------------------------------------------------------------------------------------
     # One clock: step()
@@ -242,6 +249,10 @@ class Supi3Pins:
         outputs.update(self._expansion.values(c))
         receiver.pipe = [row, *pipe[:-1]]
         tx = self._transmitter
+        if self._counters is not None:
+            running = c >= self._run_from and synced.resu_n and synced.vmon_ok
+            source = self._counters.show(c, outputs, row.di2, tx.next_present)
+            self._counters.clock(source, synced.do1 if running else None)
         if c >= self._run_from or self._holding or not (synced.resu_n and synced.vmon_ok):
             self._tick(c, synced, synced.do1)
             if c >= self._run_from:
@@ -263,13 +274,17 @@ class Supi3Pins:
 
     def forward_level(self) -> int:
         """The forward line output (``do2``) of the current cycle; it depends on state only."""
-        return self._transmitter.level(self.cycle)
+        sent = self._transmitter.level(self.cycle)
+        return sent if self._counters is None else self._counters.do2(self.cycle, sent)
 
     def output_values(self, c: int, di2: int) -> dict[str, int]:
         """Every output pin during cycle ``c`` (``c`` >= the current cycle; ``di2`` is that cycle's input)."""
         check_int("c", c, self.cycle)
-        return {**self._outputs.values(c, check_bits("pin 'di2'", di2, 1), self._run_from),
-                **self._expansion.peek(c)}
+        values = {**self._outputs.values(c, check_bits("pin 'di2'", di2, 1), self._run_from),
+                  **self._expansion.peek(c)}
+        if self._counters is not None:
+            self._counters.show(c, values, di2, self._transmitter.next_present)
+        return values
 
     # ------------------------------------------------------------------------------------------------------------
     # The per-cycle logic, shared by step() and run()
@@ -449,6 +464,8 @@ class Supi3Pins:
         if serial is not None:
             serial.feed(c0 + n - 1)
         traces = outputs.render(c0, n, snaps, self._transmitter.render(c0, n))
+        if self._counters is not None:
+            traces["do2"] = self._counters.forward_run(line, c0, self._power_ups, traces["do2"])
         traces.update(self._expansion.render(c0, n))
         self._transmitter.trim()
         if serial is not None:
@@ -495,4 +512,5 @@ class Supi3Pins:
             tail = np.concatenate([np.asarray(held_di2, dtype=np.int64), di2])[-SYNC_STAGES:][::-1]
             receiver = self._receiver
             receiver.pipe = [stage._replace(di2=int(v)) for stage, v in zip(receiver.pipe, tail, strict=True)]
-        return transmitter.return_line((c0, value, run_from), self._power_ups, seen, di2, do2)
+        source = transmitter.return_line((c0, value, run_from), self._power_ups, seen, di2, do2)
+        return source if self._counters is None else self._counters.return_run(source, c0, self._power_ups)

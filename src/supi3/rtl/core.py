@@ -46,6 +46,7 @@ from supi3.errors import ArgumentError
 from supi3.expansion import PULSE_T0
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusError
+from supi3.lbd import clocks_per_bit
 from supi3.pinlevel import Pin
 from supi3.pinout import (
     BLOCK_STRAPS,
@@ -63,6 +64,7 @@ from supi3.pinout import (
 )
 from supi3.regmap import INTERRUPT_SOURCES
 from supi3.regmap.core import BYTE_BITS
+from supi3.rtl.counter import CounterLinesRtl, lbd_lines
 from supi3.rtl.expansion import PIN_NAMES as EXPANSION_PINS
 from supi3.rtl.expansion import ExpansionRtl
 from supi3.rtl.serial_io import DIRECTIONS, SER_IN_PIN, WIDTHS, SerialIoRtl
@@ -325,6 +327,14 @@ class Supi3Core(wiring.Component):
         m.submodules.outputs = gated(outputs)
         m.submodules.serial_io = gated(serial_io)
         m.submodules.expansion = gated(expansion)
+        # LBD modes (Table 2-5): the counter telegram blocks on DO2 and DI1 (docs/rtl.md, "Counter telegram block")
+        m.submodules.counter_lines = lines = CounterLinesRtl()
+        lbd, lbd_mr = lbd_lines(m, Cat(self.mfp_in[MFP_PINS - EXPANSION_BITS :], self.c), self.variant)
+        m.d.comb += [
+            lines.line.eq(receiver.do1_s), lines.fast.eq(cpb == clocks_per_bit(1)), lines.sent.eq(transmitter.do2),
+            lines.source.eq(outputs.di1), lines.forward.eq(lbd), lines.looped.eq(lbd_mr), lines.run.eq(running),
+            lines.clear.eq(power_fail),
+        ]  # fmt: skip
 
         # The bus terminal module (2.4, docs/bus-terminal.md): in reset until the core runs, so that it takes CONF as it
         # is at the first running clock (BK-20). Until the branch's data path (DI3/DO3) is in, no device is seen on
@@ -372,7 +382,7 @@ class Supi3Core(wiring.Component):
             outputs.di2_s.eq(receiver.di2_s),
             outputs.rbst_ext_s.eq(receiver.rbst_ext_s),
             outputs.di2.eq(self.di2),
-            outputs.do2.eq(transmitter.do2),
+            outputs.do2.eq(lines.do2),
             outputs.divider.eq(cycle),
             outputs.rbst_by_pin.eq(rbst_by_pin),
             outputs.complete_diag.eq(complete_diag),
@@ -472,8 +482,8 @@ class Supi3Core(wiring.Component):
             ]
 
         m.d.comb += [
-            self.do2.eq(transmitter.do2),
-            self.di1.eq(outputs.di1),
+            self.do2.eq(lines.do2),
+            self.di1.eq(lines.di1),
             self.mfp_out.eq(datapath.mfp_out | Mux(spi, serial_io.mfp, 0) | outputs.mfp_diag),
             self.mod_ack_n.eq(outputs.mod_ack_n),
             self.res_reg_n.eq(outputs.res_reg_n),

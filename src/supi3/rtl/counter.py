@@ -8,18 +8,20 @@ elaboration; the clock timing (the bit grid restarted by a start level, the mid-
 :func:`~supi3.lbd.sample_phase`, the output queue of :data:`~supi3.lbd.OUTPUT_SLOTS`
 countdowns loaded with :func:`~supi3.lbd.send_countdown`, as the core's transmitter, M8) is that of the
 pin model ``CounterBlock`` (``src/supi3/model/blocks/counter.py``, its module docstring), which
-``tests/test_verif_lockstep_counter.py`` holds this block to, cycle by cycle. Not instantiated in ``Supi3Core``
-yet (docs/rtl.md, "Counter telegram block").
+``tests/test_verif_lockstep_counter.py`` holds this block to, cycle by cycle. :class:`CounterLinesRtl` puts it
+into ``Supi3Core`` (docs/rtl.md, "Counter telegram block").
 """
 
 from __future__ import annotations
 
+from itertools import pairwise
 from typing import Final
 
-from amaranth.hdl import Cat, Const, Module, Mux, Signal, Value
+from amaranth.hdl import Cat, Const, EnableInserter, Module, Mux, ResetInserter, Signal, Value
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
+from supi3.config import Interface, Variant, decode, mode_rows
 from supi3.interbus import wire
 from supi3.lbd import (
     COUNTER_INPUTS,
@@ -33,8 +35,10 @@ from supi3.lbd import (
     sample_phase,
     send_countdown,
 )
+from supi3.pinout import SYNC_STAGES
+from supi3.rtl.tables import core_tables
 
-__all__ = ["CounterRtl"]
+__all__ = ["CounterLinesRtl", "CounterRtl", "lbd_lines"]
 
 _CPB: Final = (clocks_per_bit(0), clocks_per_bit(1))
 _IDLE_VALUE: Final = wire.IDLE_LEVEL
@@ -170,3 +174,49 @@ class CounterRtl(wiring.Component):
             shown = Mux(r <= cpb, Mux(r != 0, v, _IDLE_VALUE), shown)
         comb += [self.out.eq(shown[0]), self.drive.eq(shown[1]), self.seen.eq(seen), self.count.eq(counted)]
         return m
+
+
+class CounterLinesRtl(wiring.Component):
+    """The counter blocks in the chip core (docs/rtl.md "Counter telegram block"; the pin model's
+    ``LineCounters`` in ``src/supi3/model/blocks/counter.py``): one :class:`CounterRtl` on the forward line in the
+    LBD modes (``forward``), one on the return line in LBD-MR (``looped``), each held in reset otherwise.
+
+    Ports: ``line`` the synchronised DO1 (the receiver's), ``fast`` the bit rate (1: 2 Mbit/s), ``sent`` the
+    transmitter's DO2, ``source`` the return line's source (M5: DI2 or the chip's DO2), ``run`` and ``clear`` the
+    core's enable and power-up reset (they gate both blocks; the return line's ``SYNC_STAGES`` synchroniser always
+    runs, M1); out: ``do2`` (the forward block's ``out`` while its ``drive`` is 1, else ``sent``) and ``di1`` (the
+    return block's ``out`` in LBD-MR, else ``source``).
+    """
+
+    def __init__(self) -> None:
+        super().__init__({
+            "line": In(1), "fast": In(1), "sent": In(1), "source": In(1), "forward": In(1), "looped": In(1),
+            "run": In(1), "clear": In(1), "do2": Out(1), "di1": Out(1),
+        })  # fmt: skip
+
+    def elaborate(self, _platform: object) -> Module:
+        m = Module()
+        forward, back = CounterRtl(), CounterRtl()
+        m.submodules.forward = ResetInserter(self.clear | ~self.forward)(EnableInserter(self.run)(forward))
+        m.submodules.back = ResetInserter(self.clear | ~self.looped)(EnableInserter(self.run)(back))
+        stages = [Signal(init=wire.IDLE_LEVEL, name=f"source_s{k}") for k in range(SYNC_STAGES)]
+        m.d.sync += [stages[0].eq(self.source), *(b.eq(a) for a, b in pairwise(stages))]
+        m.d.comb += [
+            forward.line.eq(self.line), forward.fast.eq(self.fast),
+            back.line.eq(stages[-1]), back.fast.eq(self.fast),
+            self.do2.eq(Mux(forward.drive, forward.out, self.sent)),
+            self.di1.eq(Mux(self.looped, back.out, self.source)),
+        ]  # fmt: skip
+        return m
+
+
+def lbd_lines(m: Module, straps: Value, variant: Variant) -> tuple[Signal, Signal]:
+    """Decode the LBD modes of Table 2-5 from ``straps``, the core's C[4..0] and MFP[15..12] (the patterns of
+    ``CoreTables.modes``): (``forward``: an LBD mode, ``looped``: LBD-MR), driven in ``m``."""
+    forward, looped = Signal(), Signal()
+    configs = (decode(row.c, row.mfp, variant=variant) for row in mode_rows(variant))
+    for config, mode in zip(configs, core_tables(variant).modes, strict=True):
+        if config.interface in (Interface.LBD_MR, Interface.LBD_OR):
+            with m.If(straps.matches(mode.pattern)):
+                m.d.comb += [forward.eq(1), looped.eq(config.interface is Interface.LBD_MR)]
+    return forward, looped

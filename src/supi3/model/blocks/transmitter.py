@@ -95,20 +95,7 @@ class Transmitter:
 
     def render(self, c0: int, n: int) -> PinTrace:
         """DO2 over cycles ``c0`` to ``c0 + n - 1``, from :attr:`bits` (as :meth:`level` reads it)."""
-        tx = self.bits
-        if not tx:
-            return np.full(n, wire.IDLE_LEVEL, dtype=np.int64)
-        # Each bit lasts cpb clocks or until the next bit begins (starts are in order); the line idles in the gaps.
-        # Runs of (gap, bit) levels, repeated over their lengths, are the trace.
-        sent = np.fromiter(chain.from_iterable(tx), dtype=np.int64, count=2 * len(tx)).reshape(-1, 2)
-        bit_starts, bits = sent[:, 0], sent[:, 1]
-        ends = np.minimum(bit_starts + self.cpb, np.append(bit_starts[1:], NEVER))
-        lo = np.clip(bit_starts - c0, 0, n)
-        hi = np.maximum(np.clip(ends - c0, 0, n), lo)
-        gaps = lo - np.append(0, hi[:-1])
-        levels = np.column_stack([np.full(len(bits), wire.IDLE_LEVEL), bits]).ravel()
-        runs = np.column_stack([gaps, hi - lo]).ravel()
-        return np.append(np.repeat(levels, runs), np.full(n - int(hi[-1]), wire.IDLE_LEVEL, dtype=np.int64))
+        return render_bits(self.bits, self.cpb, c0, n)
 
     def return_line(
         self,
@@ -149,3 +136,21 @@ class Transmitter:
                 t = end + 1
         self.next_present = value
         return np.where(state[:n], di2, do2).astype(np.int64)
+
+
+def render_bits(bits: list[tuple[int, int]], cpb: int, c0: int, n: int) -> PinTrace:
+    """A line over cycles ``c0`` to ``c0 + n - 1`` from ``(first cycle, value)`` entries in order of their first
+    cycles: each value lasts ``cpb`` clocks or until the next entry begins, the idle level in between
+    (:meth:`Transmitter.level`; the counter block's queue, :mod:`supi3.model.blocks.counter`)."""
+    if not bits:
+        return np.full(n, wire.IDLE_LEVEL, dtype=np.int64)
+    # Runs of (gap, bit) levels, repeated over their lengths, are the trace.
+    sent = np.fromiter(chain.from_iterable(bits), dtype=np.int64, count=2 * len(bits)).reshape(-1, 2)
+    bit_starts, values = sent[:, 0], sent[:, 1]
+    ends = np.minimum(bit_starts + cpb, np.append(bit_starts[1:], NEVER))
+    lo = np.clip(bit_starts - c0, 0, n)
+    hi = np.maximum(np.clip(ends - c0, 0, n), lo)
+    gaps = lo - np.append(0, hi[:-1])
+    levels = np.column_stack([np.full(len(values), wire.IDLE_LEVEL), values]).ravel()
+    runs = np.column_stack([gaps, hi - lo]).ravel()
+    return np.append(np.repeat(levels, runs), np.full(n - int(hi[-1]), wire.IDLE_LEVEL, dtype=np.int64))
