@@ -130,6 +130,11 @@ def test_block_cost_counts_loads_stores_and_a_final_branch() -> None:
     assert block_cost(bytes.fromhex("eff30880")) == (1, 1)  # mrs r0, msp: not a branch
 
 
+def _line_of(path: Path, marker: str) -> int:
+    """The 1-based line of ``path`` holding ``marker`` (the source line a report must name)."""
+    return next(k for k, text in enumerate(path.read_text().splitlines(), 1) if marker in text)
+
+
 def _faulting(faults_elf: Path, scenario: int) -> Board:
     board = Board(faults_elf)
     board.run_for(20e-6)  # reset, set-up, the main loop runs
@@ -149,6 +154,10 @@ def test_a_bus_fault_ends_the_run_with_the_hard_fault_frame(faults_elf: Path) ->
     assert report.stacked["xpsr"] & 0x1FF == 0  # it ran in thread mode
     assert board.core.active == [3]  # HardFault taken as the core would, then stopped
     assert "stacked r0=" in str(caught.value)
+    line = _line_of(PROGRAMS / "faults.c", "REG32(0x30000000u)")
+    assert report.source is not None and (report.source.file, report.source.line) == ("faults.c", line)
+    assert f"(fw_loop) faults.c:{line}" in str(caught.value)
+    assert [frame.function for frame in report.backtrace] == ["fw_loop", "main", "Reset_Handler"]  # .debug_frame
 
 
 def test_an_undefined_instruction_ends_the_run_with_a_usage_fault(faults_elf: Path) -> None:
@@ -165,6 +174,10 @@ def test_an_endless_loop_ends_when_the_instruction_budget_runs_out(faults_elf: P
         board.run(1000, max_instructions=50_000)
     report = caught.value.report
     assert report.stop is Stop.BUDGET and report.symbol == "fw_loop"
+    assert report.source is not None and report.source.file == "faults.c"
+    assert report.source.line in range(
+        _line_of(PROGRAMS / "faults.c", "case 2u"), _line_of(PROGRAMS / "faults.c", "case 3u")
+    )
     assert board.bench.cycles < 1000
 
 

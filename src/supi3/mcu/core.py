@@ -19,10 +19,12 @@ callback and a peripheral would see its access twice.
 
 from __future__ import annotations
 
+import bisect
 import struct
 from collections.abc import Callable
 from dataclasses import dataclass
 from enum import StrEnum
+from functools import cached_property
 from pathlib import Path
 from typing import Any, Final
 
@@ -47,6 +49,8 @@ __all__ = [
     "FirmwareFaultError",
     "FirmwareImage",
     "FirmwareStoppedError",
+    "Frame",
+    "SourceLine",
     "Stop",
     "StopReport",
     "SysTick",
@@ -85,6 +89,8 @@ SCS_BASE: Final[int] = 0xE000_E000
 SCS_SIZE: Final[int] = 0x1000
 SYST_MAX: Final[int] = 0xFF_FFFF
 """SysTick is a 24-bit down counter (B3.3.1)."""
+BACKTRACE_DEPTH: Final[int] = 16
+"""Frames :meth:`CortexM.backtrace` unwinds at most."""
 IRQ_LINES: Final[int] = 32
 """External interrupts the NVIC model has (one ISER word)."""
 
@@ -124,6 +130,37 @@ FRAME_NAMES: Final[tuple[str, ...]] = ("r0", "r1", "r2", "r3", "r12", "lr", "pc"
 # ------------------------------------------------------------------------------------------------------------
 
 
+@dataclass(frozen=True)
+class SourceLine:
+    """A place in the firmware's source, from the ELF's DWARF line program (``.debug_line``)."""
+
+    path: str
+    """The file as the compiler named it (its directory joined)."""
+    line: int
+
+    @property
+    def file(self) -> str:
+        """The file's name without its directory."""
+        return Path(self.path).name
+
+    def __str__(self) -> str:
+        return f"{self.file}:{self.line}"
+
+
+@dataclass(frozen=True)
+class Frame:
+    """One frame of the firmware's call stack: the address running (innermost) or returned to, its function and
+    its source line (for a return address: the line of the call)."""
+
+    pc: int
+    function: str | None
+    source: SourceLine | None
+
+    def __str__(self) -> str:
+        name = f"{self.function}()" if self.function else f"{self.pc:08X}h"
+        return name + (f" {self.source}" if self.source else "")
+
+
 class Stop(StrEnum):
     """Why a run of the firmware ended before its goal."""
 
@@ -146,11 +183,21 @@ class StopReport:
     time_s: float
     stacked: dict[str, int] | None = None
     symbol: str | None = None
+    backtrace: tuple[Frame, ...] = ()
+    """The call stack at :attr:`pc`, innermost first (DWARF call frame information), up to an exception entry."""
+
+    @property
+    def source(self) -> SourceLine | None:
+        """The source line of :attr:`pc`."""
+        return self.backtrace[0].source if self.backtrace else None
 
     def __str__(self) -> str:
         where = f"PC {self.pc:08X}h" + (f" ({self.symbol})" if self.symbol else "")
+        where += f" {self.source}" if self.source else ""
         text = f"{self.stop.value}: {self.reason} at {where}, t = {self.time_s * 1e6:.3f} µs, " \
                f"{self.instructions} instructions"  # fmt: skip
+        if len(self.backtrace) > 1:
+            text += "; called from " + " <- ".join(str(frame) for frame in self.backtrace[1:])
         if self.stacked is not None:
             text += "; stacked " + " ".join(f"{name}={value:08X}h" for name, value in self.stacked.items())
         return text
@@ -227,6 +274,80 @@ class FirmwareImage:
             if address <= pc < address + max(size, 1):
                 return name
         return None
+
+    def line_at(self, pc: int) -> SourceLine | None:
+        """The source line of the instruction at ``pc`` from the DWARF line program, if the ELF has one (built with
+        ``-g``: :func:`supi3.mcu.build.build` does)."""
+        addresses, lines = self._lines
+        k = bisect.bisect_right(addresses, pc) - 1
+        return lines[k] if k >= 0 else None
+
+    def frame_rule(self, pc: int) -> tuple[int, int, dict[int, int]] | None:
+        """How to find the caller of the code at ``pc`` (DWARF ``.debug_frame``): (CFA register, CFA offset,
+        {register: offset from the CFA of its saved copy}); ``None`` where the ELF has no call frame information."""
+        starts, entries = self._frames
+        k = bisect.bisect_right(starts, pc) - 1
+        if k < 0 or pc >= entries[k][0]:
+            return None
+        rows = entries[k][1]
+        row = rows[bisect.bisect_right([r[0] for r in rows], pc) - 1]
+        return row[1], row[2], row[3]
+
+    def _dwarf(self) -> Any:
+        from elftools.elf.elffile import ELFFile
+
+        stream = self.path.open("rb")
+        elf = ELFFile(stream)
+        return stream, elf.get_dwarf_info() if elf.has_dwarf_info() else None
+
+    @cached_property
+    def _lines(self) -> tuple[list[int], list[SourceLine | None]]:
+        """The line table: sorted addresses and the line starting at each (``None``: a sequence ends there)."""
+        rows: list[tuple[int, int, SourceLine | None]] = []
+        stream, dwarf = self._dwarf()
+        with stream:
+            for unit in dwarf.iter_CUs() if dwarf is not None else ():
+                program = dwarf.line_program_for_CU(unit)
+                if program is None:
+                    continue
+                header = program.header
+                v5 = header["version"] >= 5  # DWARF 5 counts files and directories from 0, DWARF 4 from 1
+                top = unit.get_top_DIE().attributes.get("DW_AT_comp_dir")
+                folders = [top.value.decode() if top else ""] * (not v5)
+                folders += [bytes(d).decode() for d in header["include_directory"]]
+                files = [str(Path(folders[f.dir_index]) / bytes(f.name).decode()) for f in header["file_entry"]]
+                for entry in program.get_entries():
+                    state = entry.state
+                    if state is None:
+                        continue
+                    if state.end_sequence or not state.line:
+                        rows.append((state.address, 0, None))
+                    else:
+                        rows.append((state.address, 1, SourceLine(files[state.file - (not v5)], state.line)))
+        rows.sort(key=lambda row: row[:2])
+        return [row[0] for row in rows], [row[2] for row in rows]
+
+    @cached_property
+    def _frames(self) -> tuple[list[int], list[tuple[int, list[tuple[int, int, int, dict[int, int]]]]]]:
+        """The call frame information: sorted function starts and, per function, its end and its rows (address,
+        CFA register, CFA offset, saved registers)."""
+        from elftools.dwarf.callframe import FDE, RegisterRule
+
+        functions: list[tuple[int, int, list[tuple[int, int, int, dict[int, int]]]]] = []
+        stream, dwarf = self._dwarf()
+        with stream:
+            for entry in dwarf.CFI_entries() if dwarf is not None and dwarf.has_CFI() else ():
+                if not isinstance(entry, FDE):
+                    continue
+                start = int(entry["initial_location"])
+                rows = [(int(row["pc"]), int(row["cfa"].reg), int(row["cfa"].offset),
+                         {int(reg): int(rule.arg) for reg, rule in row.items()
+                          if isinstance(reg, int) and rule.type == RegisterRule.OFFSET})
+                        for row in entry.get_decoded().table if row["cfa"].reg is not None]  # fmt: skip
+                if rows:
+                    functions.append((start, start + int(entry["address_range"]), rows))
+        functions.sort(key=lambda f: f[0])
+        return [f[0] for f in functions], [(f[1], f[2]) for f in functions]
 
 
 # ------------------------------------------------------------------------------------------------------------
@@ -692,6 +813,7 @@ class CortexM:
             ucc.UC_ERR_WRITE_PROT: "memory fault: write to read-only memory",
         }
         reason = kinds.get(error.errno, f"fault ({error})")
+        backtrace = self.backtrace()
         frame: int | None = None
         if self.ram[0] + FRAME_WORDS * 4 <= (self.reg("sp") & ~7) <= self.ram[0] + self.ram[1]:
             try:  # take the HardFault as the core would: the report shows the frame its handler would see
@@ -699,17 +821,47 @@ class CortexM:
                 frame = self.reg("sp")
             except FirmwareError:
                 frame = None
-        return self.report(Stop.FAULT, reason, pc=pc, stacked=frame)
+        return self.report(Stop.FAULT, reason, pc=pc, stacked=frame, backtrace=backtrace)
 
-    def report(self, stop: Stop, reason: str, *, pc: int | None = None, stacked: int | None = None) -> StopReport:
-        """A :class:`StopReport` of the core now; ``stacked``: the address of a stacked frame to include."""
+    def report(self, stop: Stop, reason: str, *, pc: int | None = None, stacked: int | None = None,
+               backtrace: tuple[Frame, ...] | None = None) -> StopReport:  # fmt: skip
+        """A :class:`StopReport` of the core now; ``stacked``: the address of a stacked frame to include;
+        ``backtrace``: the call stack if not the core's now (:meth:`backtrace`)."""
         pc = self.pc if pc is None else pc
         frame = None
         if stacked is not None:
             words = struct.unpack("<8I", self.read_bytes(stacked, FRAME_WORDS * 4))
             frame = dict(zip(FRAME_NAMES, words, strict=True))
         return StopReport(stop, reason, pc, self.registers(), self.instructions, self.cycles, self.time_s, frame,
-                          self.image.function_at(pc))  # fmt: skip
+                          self.image.function_at(pc), self.backtrace() if backtrace is None else backtrace)  # fmt: skip
+
+    def backtrace(self, depth: int = BACKTRACE_DEPTH) -> tuple[Frame, ...]:
+        """The call stack now, innermost first: the PC's function and line, then each caller's return address
+        with the line of its call, unwound with the ELF's call frame information (``.debug_frame``) up to
+        ``depth`` frames, a frame without that information, or an exception entry (LR = EXC_RETURN)."""
+        image = self.image
+        pc = self.pc
+        frames = [Frame(pc, image.function_at(pc), image.line_at(pc))]
+        regs = {n: self.reg(f"r{n}") for n in range(13)} | {13: self.reg("sp"), 14: self.reg("lr")}
+        while len(frames) < depth:
+            rule = image.frame_rule(pc)
+            if rule is None or rule[0] not in regs:
+                break
+            cfa = regs[rule[0]] + rule[1]
+            try:
+                saved = {reg: int(struct.unpack("<I", self.read_bytes(cfa + offset, 4))[0])
+                         for reg, offset in rule[2].items()}  # fmt: skip
+            except UcError:
+                break
+            regs |= saved
+            regs[13] = cfa
+            back = regs[14] & ~1
+            if regs[14] >= EXC_RETURN_HANDLER or not self.flash[0] <= back < self.flash[0] + self.flash[1] \
+                    or (back == pc and not saved):  # fmt: skip
+                break
+            pc = back
+            frames.append(Frame(pc, image.function_at(pc - 1), image.line_at(pc - 1)))  # the call's line
+        return tuple(frames)
 
     # -- system control space: SysTick, NVIC, SCB (B3.2 to B3.4) -----------------------------------------------
 
