@@ -97,16 +97,17 @@ def test_digital_io_binary_gives_the_host_builds_process_data(
     assert board.violations == []
 
 
+@pytest.mark.parametrize("cpu", CPUS)
 @pytest.mark.parametrize(
     ("name", "size", "interrupts"),
     [("polling_io", 2, False), ("analog_io", 4, True), ("irq_dispatch", 2, True), ("pcmd_alarm", 2, True)],
 )
 def test_more_example_binaries_give_the_host_builds_process_data(
-    pytestconfig: pytest.Config, tmp_path: Path, name: str, size: int, interrupts: bool
+    pytestconfig: pytest.Config, tmp_path: Path, name: str, size: int, interrupts: bool, cpu: str
 ) -> None:
     """The polling example (fw_loop: the main loop polls the I/O pin), the block transfer (analog_io, 3.4.6), the
-    event dispatch and the processor command examples, on the Cortex-M3."""
-    board = Board(mcu_build.build(native.example(name), tmp_path / f"{name}.elf"))
+    event dispatch and the processor command examples, on both cores."""
+    board = Board(mcu_build.build(native.example(name), tmp_path / f"{name}.elf", cpu=cpu), cpu=cpu)
     board.run(3)
     words = (bytes(range(1, size + 1)), bytes(range(0xF0, 0xF0 + size)), bytes(size))
     assert _binary_exchange(board, words) == _host_exchange(pytestconfig, name, words)
@@ -152,11 +153,13 @@ def test_raising_ss_before_the_byte_is_out_is_an_incomplete_frame(tmp_path: Path
     assert board.protocol.mode is None  # the initialization byte did not count
 
 
-def test_fault_report_binary_trips_until_quit_peripheral_error(tmp_path: Path) -> None:
+@pytest.mark.parametrize("cpu", CPUS)
+def test_fault_report_binary_trips_until_quit_peripheral_error(tmp_path: Path, cpu: str) -> None:
     """fault_report.c as a binary, the steps of its host test (tests/test_sdk_c_examples.py): /StatErr (PA8) low
     for the filter time -> 0BB1h at the master, outputs off until a Quit Peripheral Error after the fault has gone;
     the /ModAck pulse reaches the firmware through EXTI line 1's pending bit (PB1, 3.6.2)."""
-    board = Board(mcu_build.build(native.example("fault_report"), tmp_path / "fault_report.elf"), cycle_time_s=1e-3)
+    elf = mcu_build.build(native.example("fault_report"), tmp_path / "fault_report.elf", cpu=cpu)
+    board = Board(elf, cpu=cpu, cycle_time_s=1e-3)
     fw, chip, master = board.fw_board, board.bench.chip, board.bench.master
     assert fw is not None
     board.run(3)
