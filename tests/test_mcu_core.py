@@ -27,6 +27,7 @@ from supi3.mcu.core import (
     FirmwareStoppedError,
     Stop,
     block_cost,
+    countdown_register,
     is_poll_loop,
 )
 
@@ -261,3 +262,21 @@ def test_an_interrupt_in_thread_mode_on_the_process_stack_is_reported(exceptions
 def test_a_pure_poll_loop_is_a_load_tests_and_a_branch_back(code: str, pure: bool) -> None:
     """MCU-10: only loops that write nothing but the loaded register and the flags are skipped."""
     assert is_poll_loop(bytes.fromhex(code.replace(" ", "")), 0x0800_0100) is pure
+
+
+@pytest.mark.parametrize(
+    ("code", "register"),
+    [
+        ("401e fdd1", 0),  # subs r0, r0, #1; bne .-2 (T1): the board port's wait
+        ("5b1e fdd1", 3),  # subs r3, r3, #1 (T1)
+        ("013f fdd1", 7),  # subs r7, #1 (T2)
+        ("481e fdd1", -1),  # subs r0, r1, #1: counts another register down
+        ("801e fdd1", -1),  # subs r0, r0, #2
+        ("401e fcd1", -1),  # bne elsewhere
+        ("401e fdd0", -1),  # beq
+        ("401e fdd1 00bf", -1),  # more than the two instructions
+    ],
+)
+def test_a_countdown_loop_is_subs_1_and_bne_back(code: str, register: int) -> None:
+    """MCU-11: only SUBS Rd, Rd, #1 and BNE to it are counted without running (they write only Rd and flags)."""
+    assert countdown_register(bytes.fromhex(code.replace(" ", ""))) == register

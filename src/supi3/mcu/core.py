@@ -55,6 +55,7 @@ __all__ = [
     "StopReport",
     "SysTick",
     "block_cost",
+    "countdown_register",
     "is_poll_loop",
 ]
 
@@ -119,6 +120,7 @@ _REGS: Final[tuple[tuple[str, int], ...]] = (
     *((f"r{k}", getattr(arm, f"UC_ARM_REG_R{k}")) for k in range(13)),
     ("sp", arm.UC_ARM_REG_SP), ("lr", arm.UC_ARM_REG_LR), ("pc", arm.UC_ARM_REG_PC), ("xpsr", arm.UC_ARM_REG_XPSR),
 )  # fmt: skip
+_LOW_REGS: Final[tuple[int, ...]] = tuple(getattr(arm, f"UC_ARM_REG_R{k}") for k in range(8))
 _FRAME_REGS: Final[tuple[int, ...]] = (arm.UC_ARM_REG_R0, arm.UC_ARM_REG_R1, arm.UC_ARM_REG_R2, arm.UC_ARM_REG_R3,
                                        arm.UC_ARM_REG_R12, arm.UC_ARM_REG_LR)  # fmt: skip
 FRAME_NAMES: Final[tuple[str, ...]] = ("r0", "r1", "r2", "r3", "r12", "lr", "pc", "xpsr")
@@ -405,6 +407,22 @@ def is_poll_loop(code: bytes, address: int) -> bool:
     return address + 2 * (len(halfwords) - 1) + 4 + 2 * offset == address
 
 
+def countdown_register(code: bytes) -> int:
+    """The register a countdown loop counts down (MCU-11), or -1: the block ``code`` is exactly ``SUBS Rd, Rd,
+    #1`` (a 16-bit encoding, Rd one of R0-R7) and ``BNE`` back to the ``SUBS``. Its iterations
+    write only Rd and the flags, which the last one writes again."""
+    if len(code) != 4:
+        return -1
+    first, branch = code[0] | code[1] << 8, code[2] | code[3] << 8
+    if (first & 0xFFC0) == 0x1E40 and first & 7 == first >> 3 & 7:  # SUBS Rd, Rn, #1 (T1) with Rn = Rd
+        register = first & 7
+    elif (first & 0xF8FF) == 0x3801:  # SUBS Rdn, #1 (T2)
+        register = first >> 8 & 7
+    else:
+        return -1
+    return register if branch == 0xD1FD else -1  # BNE to the SUBS: 4 + 2 * (-3) bytes from the branch
+
+
 def block_cost(code: bytes) -> tuple[int, int]:
     """(instructions, cycles) of the Thumb code ``code`` run straight through (MCU-1): one cycle per instruction,
     one more per single load or store, one per register of LDM/STM/PUSH/POP, two more if the last instruction is
@@ -491,8 +509,10 @@ class CortexM:
         self._handed = 0  # the latest time a peripheral was given
         self._skip: tuple[int, int] | None = None  # (poll loop address, cycle its status changes)
         self._polls: dict[int, bool] = {}
+        self._countdowns: dict[int, int] = {}
         self.skip_polls = True
-        """MCU-10: skip the iterations of pure poll loops (the same result, faster); ``False`` runs each."""
+        """MCU-10, MCU-11: count the iterations of pure poll loops and countdown loops without running them (the
+        same result, faster); ``False`` runs each."""
         self.vtor = 0
         self.systick = SysTick(self)
         self._scs_words: dict[int, int] = {}
@@ -713,6 +733,13 @@ class CortexM:
                 if self.cycles >= self.deadline:
                     uc.emu_stop()
                     return
+        if self.skip_polls:
+            register = self._countdowns.get(address)
+            if register is None:
+                register = self._countdowns[address] = countdown_register(self.read_bytes(address, size))
+            if register >= 0 and self._skip_countdown(register, cost):
+                uc.emu_stop()
+                return
         self._block = (address, self.cycles)
         self._block_end = address + size
         self.instructions += cost[0]
@@ -727,6 +754,18 @@ class CortexM:
         skipped = max(0, min(before_deadline, reading_early))
         self.instructions += skipped * instructions
         self.cycles += skipped * cycles
+
+    def _skip_countdown(self, register: int, cost: tuple[int, int]) -> bool:
+        """Count, without running them, the iterations of a countdown loop on ``register`` that would start before
+        the deadline, all but its last (MCU-11); whether the deadline came first (the block must not run)."""
+        reg = _LOW_REGS[register]
+        left = int(self.uc.reg_read(reg))
+        skipped = max(0, min(left - 1, -(-(self.deadline - self.cycles) // cost[1])))
+        if skipped:
+            self.uc.reg_write(reg, left - skipped)
+            self.instructions += skipped * cost[0]
+            self.cycles += skipped * cost[1]
+        return self.cycles >= self.deadline
 
     def skip_poll(self, until: int) -> None:
         """The status register just read keeps its value until cycle ``until``: if the running block is a pure poll
