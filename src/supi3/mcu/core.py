@@ -502,14 +502,14 @@ class CortexM:
         self.interrupt: int | None = None
         self.entered: Callable[[int], None] = _nothing
         """Called with the exception number after each exception entry (the board measures latency)."""
-        self._costs: dict[tuple[int, int], tuple[int, int]] = {}
+        self._costs: dict[tuple[int, int], tuple[int, int]] = {}  # the cost of a block's first instructions
         self._block = (0, 0)  # address and cycle count at the entry of the block running
         self._block_end = 0
         self._running = False
         self._handed = 0  # the latest time a peripheral was given
         self._skip: tuple[int, int] | None = None  # (poll loop address, cycle its status changes)
         self._polls: dict[int, bool] = {}
-        self._countdowns: dict[int, int] = {}
+        self._blocks: dict[tuple[int, int], tuple[tuple[int, int], int]] = {}  # cost, countdown register (MCU-11)
         self.skip_polls = True
         """MCU-10, MCU-11: count the iterations of pure poll loops and countdown loops without running them (the
         same result, faster); ``False`` runs each."""
@@ -722,9 +722,11 @@ class CortexM:
             uc.emu_stop()  # this block does not run: it is the first of the next run
             return
         key = (address, size)
-        cost = self._costs.get(key)
-        if cost is None:
-            cost = self._costs[key] = block_cost(self.read_bytes(address, size))
+        block = self._blocks.get(key)
+        if block is None:
+            code = self.read_bytes(address, size)
+            block = self._blocks[key] = (block_cost(code), countdown_register(code))
+        cost = block[0]
         skip = self._skip
         if skip is not None:
             self._skip = None
@@ -733,13 +735,9 @@ class CortexM:
                 if self.cycles >= self.deadline:
                     uc.emu_stop()
                     return
-        if self.skip_polls:
-            register = self._countdowns.get(address)
-            if register is None:
-                register = self._countdowns[address] = countdown_register(self.read_bytes(address, size))
-            if register >= 0 and self._skip_countdown(register, cost):
-                uc.emu_stop()
-                return
+        if block[1] >= 0 and self.skip_polls and self._skip_countdown(block[1], cost):
+            uc.emu_stop()
+            return
         self._block = (address, self.cycles)
         self._block_end = address + size
         self.instructions += cost[0]
