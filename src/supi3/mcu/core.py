@@ -525,10 +525,13 @@ class CortexM:
 
     def mmio(self, base: int, size: int, read: ReadFn, write: WriteFn) -> None:
         """Map a peripheral: ``read(offset, size) -> value`` and ``write(offset, size, value)`` run on every
-        access. An exception they raise stops the run at the end of the block (:attr:`error`)."""
+        access. An exception they raise stops the run at the end of the block (:attr:`error`); the block's later
+        accesses reach no peripheral (no follow-on reports of a run that has ended)."""
 
         def on_read(uc: Any, offset: int, size: int, data: Any) -> int:
             del uc, data
+            if self.error is not None:  # the run ends with this block: its later accesses reach no peripheral
+                return 0
             try:
                 return read(offset, size)
             except BaseException as error:  # handed to the run loop, raised there
@@ -537,6 +540,8 @@ class CortexM:
 
         def on_write(uc: Any, offset: int, size: int, value: int, data: Any) -> None:
             del uc, data
+            if self.error is not None:
+                return
             try:
                 write(offset, size, value)
             except BaseException as error:  # handed to the run loop, raised there
