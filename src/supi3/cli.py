@@ -16,6 +16,8 @@ their limits with :func:`~supi3.checks.check_int`), and checking its output path
 - 141 (128 + SIGPIPE): the reader closed the pipe early (``supi3 demo | head``). Nothing on stderr, like a Unix
   tool killed by SIGPIPE; under ``set -o pipefail`` the pipeline fails, as it does for ``seq``.
 - 130: interrupted (Ctrl-C), nothing on stderr.
+- 3 and 4, ``firmware run`` only: the firmware faulted, ran away or used up its budget (3), or broke an interface
+  rule or did not exchange the process data (4); the report is on stdout.
 - 1 with a traceback: a genuine bug (any other exception). It is kept so that it can be reported.
 
 Options are spelt out in full (an abbreviation is an error, so a new option can never change what an old command
@@ -667,7 +669,8 @@ class _Parser(argparse.ArgumentParser):
 _DESCRIPTION = ("The IBS SUPI 3 OPC INTERBUS slave chip: operating modes, pin-strap decoding, register map, "
                 "timing, a demo, and the manual's serial-interface figures redrawn.")
 _EPILOG = """exit status: 0 done; 2 bad input (one line on stderr); 141 output pipe closed early (quiet);
-130 interrupted; 1 an internal error (a traceback: please report it)"""
+130 interrupted; 3 and 4 (firmware run) the firmware stopped or broke a rule; 1 an internal error (a traceback:
+please report it)"""
 
 
 def build_parser() -> argparse.ArgumentParser:

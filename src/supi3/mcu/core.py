@@ -548,6 +548,10 @@ class CortexM:
                 self.fail(error)
 
         self.uc.mmio_map(base, size, on_read, None, on_write, None)
+        # unicorn updates the PC before a load or store only if a memory hook covers its address: without one, a
+        # peripheral callback sees the PC of the block's first instruction, and the access would be timed there
+        # (MCU-1 places it by the PC).
+        self.uc.hook_add(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, _exact_pc, None, base, base + size - 1)
 
     def read_bytes(self, address: int, size: int) -> bytes:
         """Memory as the core sees it (RAM, flash)."""
@@ -961,6 +965,11 @@ class CortexM:
             self.vtor = value & ~0x7F
         else:
             self._scs_words[offset] = value
+
+
+def _exact_pc(uc: Any, access: int, address: int, size: int, value: int, data: Any) -> None:
+    """A memory hook that does nothing: its presence makes unicorn keep the PC exact at each access it covers."""
+    del uc, access, address, size, value, data
 
 
 def _nothing(number: int) -> None:
