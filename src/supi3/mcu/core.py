@@ -12,7 +12,8 @@ then loops on a prefetch abort). :class:`CortexM` does both itself, as the archi
 Timing (MCU-1): every basic block unicorn enters costs its instructions' cycles (:func:`block_cost`: one per
 instruction, one more per single load or store, one per register of a multiple load or store, two more for a
 branch that ends the block, taken as taken), so the clock is exact at block boundaries; a peripheral access is
-placed inside its block by the program counter (:meth:`CortexM.cycles_now`). Emulation only ever stops at a block
+placed inside its block by the program counter (:meth:`CortexM.cycles_now`; unicorn keeps the PC exact at an
+access only under a memory hook, so each peripheral range has an empty one). Emulation only ever stops at a block
 boundary (a block hook refuses the next block), because unicorn restarts an instruction stopped inside a memory
 callback and a peripheral would see its access twice.
 """
