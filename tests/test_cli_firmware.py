@@ -57,11 +57,13 @@ def test_a_good_firmware_runs_clean_with_its_configuration_and_data(
     assert (code, err) == (0, "")
     assert "03h  00001       2  remote bus" in out
     assert "master OUT 81 18 -> firmware outputs 81 18" in out and "firmware inputs 0f f0 -> master IN 0f f0  ok" in out
-    assert "longest /IRQ latency 250 ns (12 core cycles)" in out and "violations  none" in out
+    assert "longest /IRQ latency 250 ns (12 core cycles) of the 182 µs the manual leaves" in out  # 13 * 7 * 2 µs
+    assert "violations  none" in out
     code, out, _ = _call(capsys, ["firmware", "run", str(elves["digital_io"]), "--json", "--devices", "3",
                                   "--cycles", "6"])  # fmt: skip
     data = json.loads(out)
     assert code == 0 and data["process_data"]["ok"] and data["interrupts"] > 0 and data["violations"] == []
+    assert data["access_time_s"] == pytest.approx(13 * (5 + 2 + 2 + 2) * 2e-6)  # three one-word devices
     assert [(d["ring_position"], d["id_code"]) for d in data["configuration"]] == [(1, 0x03), (2, 0x02), (3, 0x02)]
 
 

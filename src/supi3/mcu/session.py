@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Final
 
-from supi3 import tables
+from supi3 import tables, timing
 from supi3.checks import check_int
 from supi3.config import decode
 from supi3.errors import Supi3Error
@@ -55,6 +55,9 @@ class FirmwareRun:
     master_inputs: bytes | None = None
     interrupts: int = 0
     irq_latency_s: float = 0.0
+    access_time_s: float | None = None
+    """T = 13 (5 + n) t_Bit, the time the manual leaves the firmware after /IRQ for n data bytes in the whole ring
+    (3.4.14); ``None`` without a configuration."""
     instructions: int = 0
     core_cycles: int = 0
     bus_time_s: float = 0.0
@@ -88,7 +91,7 @@ class FirmwareRun:
             "process_data": {"master_out": self.sent_out.hex(), "firmware_outputs": _hex(self.firmware_outputs),
                              "firmware_inputs": self.firmware_inputs.hex(), "master_in": _hex(self.master_inputs),
                              "ok": self.data_ok},
-            "interrupts": self.interrupts, "irq_latency_s": self.irq_latency_s,
+            "interrupts": self.interrupts, "irq_latency_s": self.irq_latency_s, "access_time_s": self.access_time_s,
             "instructions": self.instructions, "core_cycles": self.core_cycles, "bus_time_s": self.bus_time_s,
             "wall_s": self.wall_s,
             "violations": [{"time_s": v.time_s, "pc": v.pc, "function": v.function,
@@ -116,7 +119,9 @@ class FirmwareRun:
                   f"  master OUT {_spaced(self.sent_out)} -> firmware outputs {_spaced(self.firmware_outputs)}",
                   f"  firmware inputs {_spaced(self.firmware_inputs)} -> master IN {_spaced(self.master_inputs)}  {ok}",
                   f"interrupts  {self.interrupts} EXTI0 handler entries, longest /IRQ latency "
-                  f"{self.irq_latency_s * 1e9:.0f} ns ({round(self.irq_latency_s * self.cpu_hz)} core cycles)",
+                  f"{self.irq_latency_s * 1e9:.0f} ns ({round(self.irq_latency_s * self.cpu_hz)} core cycles)"
+                  + ("" if self.access_time_s is None else f" of the {self.access_time_s * 1e6:g} µs the manual "
+                     "leaves the firmware after /IRQ (T = 13 (5 + n) t_Bit, 3.4.14)"),
                   f"run         {self.bus_time_s * 1e3:.3f} ms of bus time, {self.instructions} instructions, "
                   f"{self.core_cycles} core cycles, {self.wall_s:.2f} s wall "
                   f"({self.bus_time_s / max(self.wall_s, 1e-9):.3f}x real time)"]  # fmt: skip
@@ -175,6 +180,9 @@ def run_firmware(firmware: str | Path, *, cpu: str = "cortex_m3", cpu_hz: float 
         report.error = str(error)
     report.wall_s = time.perf_counter() - started
     report.config = board.bench.master.config
+    if report.config:
+        network_bytes = sum(entry.data_bytes for entry in report.config)
+        report.access_time_s = timing.cpu_access_time_s(network_bytes, report.bit_rate)
     if report.sent_out and board.fw_board is not None:
         report.firmware_outputs = board.fw_board.outputs[: len(report.sent_out)]
     if report.sent_out:
