@@ -161,6 +161,18 @@ def test_a_bus_fault_ends_the_run_with_the_hard_fault_frame(faults_elf: Path) ->
     assert [frame.function for frame in report.backtrace] == ["fw_loop", "main", "Reset_Handler"]  # .debug_frame
 
 
+def test_a_report_without_the_elf_names_no_line(faults_elf: Path, tmp_path: Path) -> None:
+    """MCU-12: the DWARF tables are read on first use; an ELF gone by then gives a report without lines, not an
+    error of its own."""
+    copy = tmp_path / "gone.elf"
+    copy.write_bytes(faults_elf.read_bytes())
+    board = _faulting(copy, 1)
+    copy.unlink()
+    with pytest.raises(FirmwareFaultError, match="read of unmapped memory") as caught:
+        board.run_for(20e-6)
+    assert caught.value.report.symbol == "fw_loop" and caught.value.report.source is None
+
+
 def test_an_undefined_instruction_ends_the_run_with_a_usage_fault(faults_elf: Path) -> None:
     board = _faulting(faults_elf, 4)
     with pytest.raises(FirmwareFaultError, match="undefined instruction") as caught:

@@ -296,61 +296,77 @@ class FirmwareImage:
         row = rows[bisect.bisect_right([r[0] for r in rows], pc) - 1]
         return row[1], row[2], row[3]
 
-    def _dwarf(self) -> Any:
-        from elftools.elf.elffile import ELFFile
-
-        stream = self.path.open("rb")
-        elf = ELFFile(stream)
-        return stream, elf.get_dwarf_info() if elf.has_dwarf_info() else None
-
     @cached_property
     def _lines(self) -> tuple[list[int], list[SourceLine | None]]:
-        """The line table: sorted addresses and the line starting at each (``None``: a sequence ends there)."""
-        rows: list[tuple[int, int, SourceLine | None]] = []
-        stream, dwarf = self._dwarf()
-        with stream:
-            for unit in dwarf.iter_CUs() if dwarf is not None else ():
-                program = dwarf.line_program_for_CU(unit)
-                if program is None:
-                    continue
-                header = program.header
-                v5 = header["version"] >= 5  # DWARF 5 counts files and directories from 0, DWARF 4 from 1
-                top = unit.get_top_DIE().attributes.get("DW_AT_comp_dir")
-                folders = [top.value.decode() if top else ""] * (not v5)
-                folders += [bytes(d).decode() for d in header["include_directory"]]
-                files = [str(Path(folders[f.dir_index]) / bytes(f.name).decode()) for f in header["file_entry"]]
-                for entry in program.get_entries():
-                    state = entry.state
-                    if state is None:
-                        continue
-                    if state.end_sequence or not state.line:
-                        rows.append((state.address, 0, None))
-                    else:
-                        rows.append((state.address, 1, SourceLine(files[state.file - (not v5)], state.line)))
-        rows.sort(key=lambda row: row[:2])
-        return [row[0] for row in rows], [row[2] for row in rows]
+        return self._debug[0]
 
     @cached_property
-    def _frames(self) -> tuple[list[int], list[tuple[int, list[tuple[int, int, int, dict[int, int]]]]]]:
-        """The call frame information: sorted function starts and, per function, its end and its rows (address,
-        CFA register, CFA offset, saved registers)."""
-        from elftools.dwarf.callframe import FDE, RegisterRule
+    def _frames(self) -> _FrameTable:
+        return self._debug[1]
 
-        functions: list[tuple[int, int, list[tuple[int, int, int, dict[int, int]]]]] = []
-        stream, dwarf = self._dwarf()
-        with stream:
-            for entry in dwarf.CFI_entries() if dwarf is not None and dwarf.has_CFI() else ():
-                if not isinstance(entry, FDE):
-                    continue
-                start = int(entry["initial_location"])
-                rows = [(int(row["pc"]), int(row["cfa"].reg), int(row["cfa"].offset),
-                         {int(reg): int(rule.arg) for reg, rule in row.items()
-                          if isinstance(reg, int) and rule.type == RegisterRule.OFFSET})
-                        for row in entry.get_decoded().table if row["cfa"].reg is not None]  # fmt: skip
-                if rows:
-                    functions.append((start, start + int(entry["address_range"]), rows))
-        functions.sort(key=lambda f: f[0])
-        return [f[0] for f in functions], [(f[1], f[2]) for f in functions]
+    @cached_property
+    def _debug(self) -> tuple[tuple[list[int], list[SourceLine | None]], _FrameTable]:
+        """The line table and the call frame information, read on first use; empty if the ELF has no DWARF or can
+        no longer be read (the reports then name no lines)."""
+        from elftools.common.exceptions import DWARFError, ELFError
+        from elftools.elf.elffile import ELFFile
+
+        try:
+            with self.path.open("rb") as stream:
+                elf = ELFFile(stream)
+                dwarf = elf.get_dwarf_info() if elf.has_dwarf_info() else None
+                return _line_table(dwarf), _frame_table(dwarf)
+        except (OSError, ELFError, DWARFError):
+            return ([], []), ([], [])
+
+
+_FrameRow = tuple[int, int, int, dict[int, int]]
+_FrameTable = tuple[list[int], list[tuple[int, list[_FrameRow]]]]
+
+
+def _line_table(dwarf: Any) -> tuple[list[int], list[SourceLine | None]]:
+    """The line program's rows: sorted addresses and the line starting at each (``None``: a sequence ends there)."""
+    rows: list[tuple[int, int, SourceLine | None]] = []
+    for unit in dwarf.iter_CUs() if dwarf is not None else ():
+        program = dwarf.line_program_for_CU(unit)
+        if program is None:
+            continue
+        header = program.header
+        v5 = header["version"] >= 5  # DWARF 5 counts files and directories from 0, DWARF 4 from 1
+        top = unit.get_top_DIE().attributes.get("DW_AT_comp_dir")
+        folders = [top.value.decode() if top else ""] * (not v5)
+        folders += [bytes(d).decode() for d in header["include_directory"]]
+        files = [str(Path(folders[f.dir_index]) / bytes(f.name).decode()) for f in header["file_entry"]]
+        for entry in program.get_entries():
+            state = entry.state
+            if state is None:
+                continue
+            if state.end_sequence or not state.line:
+                rows.append((state.address, 0, None))
+            else:
+                rows.append((state.address, 1, SourceLine(files[state.file - (not v5)], state.line)))
+    rows.sort(key=lambda row: row[:2])
+    return [row[0] for row in rows], [row[2] for row in rows]
+
+
+def _frame_table(dwarf: Any) -> _FrameTable:
+    """The call frame information: sorted function starts and, per function, its end and its rows (address, CFA
+    register, CFA offset, saved registers)."""
+    from elftools.dwarf.callframe import FDE, RegisterRule
+
+    functions: list[tuple[int, int, list[_FrameRow]]] = []
+    for entry in dwarf.CFI_entries() if dwarf is not None and dwarf.has_CFI() else ():
+        if not isinstance(entry, FDE):
+            continue
+        start = int(entry["initial_location"])
+        rows = [(int(row["pc"]), int(row["cfa"].reg), int(row["cfa"].offset),
+                 {int(reg): int(rule.arg) for reg, rule in row.items()
+                  if isinstance(reg, int) and rule.type == RegisterRule.OFFSET})
+                for row in entry.get_decoded().table if row["cfa"].reg is not None]  # fmt: skip
+        if rows:
+            functions.append((start, start + int(entry["address_range"]), rows))
+    functions.sort(key=lambda f: f[0])
+    return [f[0] for f in functions], [(f[1], f[2]) for f in functions]
 
 
 # ------------------------------------------------------------------------------------------------------------
