@@ -19,7 +19,7 @@ from supi3.mcu import board as mcu_board
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import Board
 from supi3.mcu.core import CPUS
-from supi3.model.registers import InterfaceViolationError
+from supi3.model.registers import InconsistentDataError, InterfaceViolationError
 from supi3.sdk import native
 from supi3.sdk.bench import Bench
 from support import c_firmware
@@ -97,16 +97,17 @@ def test_digital_io_binary_gives_the_host_builds_process_data(
     assert board.violations == []
 
 
+@pytest.mark.parametrize("cpu", CPUS)
 @pytest.mark.parametrize(
     ("name", "size", "interrupts"),
     [("polling_io", 2, False), ("analog_io", 4, True), ("irq_dispatch", 2, True), ("pcmd_alarm", 2, True)],
 )
 def test_more_example_binaries_give_the_host_builds_process_data(
-    pytestconfig: pytest.Config, tmp_path: Path, name: str, size: int, interrupts: bool
+    pytestconfig: pytest.Config, tmp_path: Path, name: str, size: int, interrupts: bool, cpu: str
 ) -> None:
     """The polling example (fw_loop: the main loop polls the I/O pin), the block transfer (analog_io, 3.4.6), the
-    event dispatch and the processor command examples, on the Cortex-M3."""
-    board = Board(mcu_build.build(native.example(name), tmp_path / f"{name}.elf"))
+    event dispatch and the processor command examples, on both cores."""
+    board = Board(mcu_build.build(native.example(name), tmp_path / f"{name}.elf", cpu=cpu), cpu=cpu)
     board.run(3)
     words = (bytes(range(1, size + 1)), bytes(range(0xF0, 0xF0 + size)), bytes(size))
     assert _binary_exchange(board, words) == _host_exchange(pytestconfig, name, words)
@@ -152,11 +153,13 @@ def test_raising_ss_before_the_byte_is_out_is_an_incomplete_frame(tmp_path: Path
     assert board.protocol.mode is None  # the initialization byte did not count
 
 
-def test_fault_report_binary_trips_until_quit_peripheral_error(tmp_path: Path) -> None:
+@pytest.mark.parametrize("cpu", CPUS)
+def test_fault_report_binary_trips_until_quit_peripheral_error(tmp_path: Path, cpu: str) -> None:
     """fault_report.c as a binary, the steps of its host test (tests/test_sdk_c_examples.py): /StatErr (PA8) low
     for the filter time -> 0BB1h at the master, outputs off until a Quit Peripheral Error after the fault has gone;
     the /ModAck pulse reaches the firmware through EXTI line 1's pending bit (PB1, 3.6.2)."""
-    board = Board(mcu_build.build(native.example("fault_report"), tmp_path / "fault_report.elf"), cycle_time_s=1e-3)
+    elf = mcu_build.build(native.example("fault_report"), tmp_path / "fault_report.elf", cpu=cpu)
+    board = Board(elf, cpu=cpu, cycle_time_s=1e-3)
     fw, chip, master = board.fw_board, board.bench.chip, board.bench.master
     assert fw is not None
     board.run(3)
@@ -196,3 +199,44 @@ def test_skipping_poll_loops_changes_nothing_but_the_speed(digital_io: dict[str,
                          board.irq_latency_s, board.fw_board.outputs, board.bench.master.inputs(1)))  # fmt: skip
     assert outcomes[0] == outcomes[1]
     assert outcomes[0][5][:2] == b"\x12\x34" and outcomes[0][6] == b"\x56\x78"
+
+
+def _line_of(path: Path, marker: str) -> int:
+    return next(k for k, text in enumerate(path.read_text().splitlines(), 1) if marker in text)
+
+
+def test_a_data_register_read_in_the_latch_phase_names_the_source_line(tmp_path: Path) -> None:
+    """tests/mcu/latch_bug.c reads OUT0 in its main loop without looking at the I/O access bit (3.4.14): at
+    2 Mbit/s a read soon falls into the latch phase. The chip's InconsistentDataError carries the bus time, the
+    PC in the transport and the call stack from DWARF down to the line marked LATCH-BUG."""
+    source = Path(__file__).parent / "mcu" / "latch_bug.c"
+    line = _line_of(source, "LATCH-BUG */")
+    board = Board(mcu_build.build(source, tmp_path / "latch_bug.elf"), bit_rate=2_000_000)
+    with pytest.raises(InconsistentDataError, match="OUT0 read during the latch phase") as caught:
+        board.run(40)
+    assert caught.value.rule == "3.4.14"
+    note = caught.value.__notes__[-1]
+    assert f"fw_loop() latch_bug.c:{line}" in note and "in board_xfer() board.c:" in note
+    assert len(board.violations) == 1  # the run ends at the first: nothing after it is reported
+    where = board.violations[0]
+    assert where.error is caught.value and where.function == "board_xfer"
+    assert [frame.function for frame in where.backtrace][:4] == ["board_xfer", "frame", "supi3_read", "fw_loop"]
+    assert where.backtrace[3].source is not None and where.backtrace[3].source.line == line
+
+
+def test_digital_io_with_a_3_mhz_sclk_at_2_mbit_s_reaches_the_latch_phase(tmp_path: Path) -> None:
+    """Round 1's finding: SPI1 at f_PCLK / 16 = 3 MHz (BOARD_SPI_BR = 3, the fastest that meets t0 = 333 ns at
+    2 Mbit/s) with back-to-back cycles: the handler's four single accesses (3.4.4) end after the next cycle's latch
+    phase has begun (3.4.14), which the host build (bytes at their Table 3-7 time) does not show. Every report
+    names a data register access of fw_isr in digital_io.c."""
+    elf = mcu_build.build(native.example("digital_io"), tmp_path / "br3.elf", defines={"BOARD_SPI_BR": "3u"})
+    board = Board(elf, bit_rate=2_000_000, strict=False)
+    board.run(8)
+    assert board.violations
+    source = native.example("digital_io")
+    accesses = range(_line_of(source, "SUPI3_OUT0_ADDR"), _line_of(source, "SUPI3_IN1_ADDR") + 1)
+    for where in board.violations:
+        assert isinstance(where.error, InconsistentDataError) and where.error.rule == "3.4.14"
+        isr = next(frame for frame in where.backtrace if frame.function == "fw_isr")
+        assert isr.source is not None and isr.source.file == "digital_io.c" and isr.source.line in accesses
+        assert "during the latch phase" in str(where) and "fw_isr() digital_io.c:" in str(where)

@@ -27,6 +27,7 @@ from supi3.mcu.core import (
     FirmwareStoppedError,
     Stop,
     block_cost,
+    countdown_register,
     is_poll_loop,
 )
 
@@ -130,6 +131,11 @@ def test_block_cost_counts_loads_stores_and_a_final_branch() -> None:
     assert block_cost(bytes.fromhex("eff30880")) == (1, 1)  # mrs r0, msp: not a branch
 
 
+def _line_of(path: Path, marker: str) -> int:
+    """The 1-based line of ``path`` holding ``marker`` (the source line a report must name)."""
+    return next(k for k, text in enumerate(path.read_text().splitlines(), 1) if marker in text)
+
+
 def _faulting(faults_elf: Path, scenario: int) -> Board:
     board = Board(faults_elf)
     board.run_for(20e-6)  # reset, set-up, the main loop runs
@@ -149,6 +155,22 @@ def test_a_bus_fault_ends_the_run_with_the_hard_fault_frame(faults_elf: Path) ->
     assert report.stacked["xpsr"] & 0x1FF == 0  # it ran in thread mode
     assert board.core.active == [3]  # HardFault taken as the core would, then stopped
     assert "stacked r0=" in str(caught.value)
+    line = _line_of(PROGRAMS / "faults.c", "REG32(0x30000000u)")
+    assert report.source is not None and (report.source.file, report.source.line) == ("faults.c", line)
+    assert f"(fw_loop) faults.c:{line}" in str(caught.value)
+    assert [frame.function for frame in report.backtrace] == ["fw_loop", "main", "Reset_Handler"]  # .debug_frame
+
+
+def test_a_report_without_the_elf_names_no_line(faults_elf: Path, tmp_path: Path) -> None:
+    """MCU-12: the DWARF tables are read on first use; an ELF gone by then gives a report without lines, not an
+    error of its own."""
+    copy = tmp_path / "gone.elf"
+    copy.write_bytes(faults_elf.read_bytes())
+    board = _faulting(copy, 1)
+    copy.unlink()
+    with pytest.raises(FirmwareFaultError, match="read of unmapped memory") as caught:
+        board.run_for(20e-6)
+    assert caught.value.report.symbol == "fw_loop" and caught.value.report.source is None
 
 
 def test_an_undefined_instruction_ends_the_run_with_a_usage_fault(faults_elf: Path) -> None:
@@ -165,6 +187,10 @@ def test_an_endless_loop_ends_when_the_instruction_budget_runs_out(faults_elf: P
         board.run(1000, max_instructions=50_000)
     report = caught.value.report
     assert report.stop is Stop.BUDGET and report.symbol == "fw_loop"
+    assert report.source is not None and report.source.file == "faults.c"
+    assert report.source.line in range(
+        _line_of(PROGRAMS / "faults.c", "case 2u"), _line_of(PROGRAMS / "faults.c", "case 3u")
+    )
     assert board.bench.cycles < 1000
 
 
@@ -248,3 +274,21 @@ def test_an_interrupt_in_thread_mode_on_the_process_stack_is_reported(exceptions
 def test_a_pure_poll_loop_is_a_load_tests_and_a_branch_back(code: str, pure: bool) -> None:
     """MCU-10: only loops that write nothing but the loaded register and the flags are skipped."""
     assert is_poll_loop(bytes.fromhex(code.replace(" ", "")), 0x0800_0100) is pure
+
+
+@pytest.mark.parametrize(
+    ("code", "register"),
+    [
+        ("401e fdd1", 0),  # subs r0, r0, #1; bne .-2 (T1): the board port's wait
+        ("5b1e fdd1", 3),  # subs r3, r3, #1 (T1)
+        ("013f fdd1", 7),  # subs r7, #1 (T2)
+        ("481e fdd1", -1),  # subs r0, r1, #1: counts another register down
+        ("801e fdd1", -1),  # subs r0, r0, #2
+        ("401e fcd1", -1),  # bne elsewhere
+        ("401e fdd0", -1),  # beq
+        ("401e fdd1 00bf", -1),  # more than the two instructions
+    ],
+)
+def test_a_countdown_loop_is_subs_1_and_bne_back(code: str, register: int) -> None:
+    """MCU-11: only SUBS Rd, Rd, #1 and BNE to it are counted without running (they write only Rd and flags)."""
+    assert countdown_register(bytes.fromhex(code.replace(" ", ""))) == register

@@ -16,6 +16,8 @@ their limits with :func:`~supi3.checks.check_int`), and checking its output path
 - 141 (128 + SIGPIPE): the reader closed the pipe early (``supi3 demo | head``). Nothing on stderr, like a Unix
   tool killed by SIGPIPE; under ``set -o pipefail`` the pipeline fails, as it does for ``seq``.
 - 130: interrupted (Ctrl-C), nothing on stderr.
+- 3 and 4, ``firmware run`` only: the firmware faulted, ran away or used up its budget (3), or broke an interface
+  rule or did not exchange the process data (4); the report is on stdout.
 - 1 with a traceback: a genuine bug (any other exception). It is kept so that it can be reported.
 
 Options are spelt out in full (an abbreviation is an error, so a new option can never change what an old command
@@ -45,6 +47,7 @@ from supi3.config import DeviceConfig, Interface, MfpKind, Variant, decode, mode
 from supi3.errors import Supi3Error
 from supi3.optical import length as optical_length
 from supi3.regmap import LENGTH_OUT
+from supi3.sdk.bench import DEFAULT_STRAPS
 
 MAX_NETWORK_BYTES = timing.MAX_NETWORK_BYTES
 """``timing --bytes`` limit: 512 devices (the INTERBUS limit) of the longest data length, 32 words (Table 3-11)."""
@@ -566,6 +569,77 @@ def cmd_sdk(args: argparse.Namespace) -> None:
         print(sdk.SDK_DIR)
 
 
+FIRMWARE_STOPPED_STATUS = 3
+"""``firmware run``: the firmware faulted, hung, used up its instruction budget, or the bench could not go on."""
+
+FIRMWARE_FAILED_STATUS = 4
+"""``firmware run``: the run ended, but the firmware broke an interface rule or the process data did not arrive."""
+
+MAX_FIRMWARE_CYCLES = 100_000
+"""``firmware run --cycles`` limit (about 6 s of bus time at 500 kbit/s)."""
+
+
+def _firmware_extra() -> None:
+    """Refuse ``firmware`` without the firmware extra (unicorn, pyelftools, ziglang), one line, before any work."""
+    import importlib.util
+
+    missing = [name for name in ("unicorn", "elftools") if importlib.util.find_spec(name) is None]
+    if missing:
+        raise CommandLineError(f"firmware needs the firmware extra, pip install 'supi3[firmware]' (missing: "
+                               f"{', '.join(missing)})")  # fmt: skip
+
+
+def cmd_firmware_run(args: argparse.Namespace) -> None:
+    """Run a firmware ELF on the emulated board against the chip and report (docs/firmware-in-the-loop.md)."""
+    _firmware_extra()
+    from supi3.mcu.session import run_firmware
+
+    if not Path(args.firmware).is_file():
+        raise CommandLineError(f"FIRMWARE must be an ELF file, not {_shown(args.firmware)} (no such file)")
+    check_int("--cycles", args.cycles, 3, MAX_FIRMWARE_CYCLES)
+    check_int("--cpu-hz", args.cpu_hz, 1_000_000, 1_000_000_000)
+    check_int("--devices", args.devices, 1, 64)
+    check_int("--max-instructions", args.max_instructions, 1000, 10**10)
+    mfp = args.mfp if args.mfp is not None or args.c != DEFAULT_STRAPS[0] else DEFAULT_STRAPS[1]
+    report = run_firmware(args.firmware, cpu=args.cpu, cpu_hz=float(args.cpu_hz), straps=(args.c, mfp),
+                          bit_rate=_parse_bit_rate(args.bit_rate), devices=args.devices, cycles=args.cycles,
+                          out_data=args.out_data, in_data=args.in_data, max_instructions=args.max_instructions)
+    if args.json:
+        print_json(report.as_dict())
+    else:
+        print(report)
+    if report.stop is not None or report.error is not None:
+        raise SystemExit(FIRMWARE_STOPPED_STATUS)
+    if report.failed:
+        raise SystemExit(FIRMWARE_FAILED_STATUS)
+
+
+def cmd_firmware_build(args: argparse.Namespace) -> None:
+    """Build a firmware for the emulated board with the SDK's driver and board port (supi3.mcu.build)."""
+    _firmware_extra()
+    from supi3.mcu.build import build
+
+    out = output_file("-o/--output", args.output)
+    defines = {}
+    for text in args.defines:
+        name, _, value = text.partition("=")
+        if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name, re.ASCII):
+            raise CommandLineError(f"-D must be NAME or NAME=VALUE with a C identifier NAME, not {_shown(text)}")
+        defines[name] = value if _ else "1"
+    print(build(args.sources, out, cpu=args.cpu, defines=defines))
+
+
+def hex_bytes(text: str) -> bytes:
+    """An argparse type: bytes in hex digits, optionally spaced (``1234``, ``12 34``), at most 32 bytes."""
+    try:
+        data = bytes.fromhex(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be bytes in hex digits (e.g. 1234), not {_shown(text)}") from None
+    if not 1 <= len(data) <= 32:
+        raise argparse.ArgumentTypeError(f"must be 1 to 32 bytes, not {len(data)}")
+    return data
+
+
 _INTEGER = re.compile(r"[+-]?[0-9]+", re.ASCII)
 _MAX_DIGITS = 4000
 """Longer integers are refused unread: far beyond every limit, and ``int()`` refuses 4300 digits anyway."""
@@ -595,7 +669,8 @@ class _Parser(argparse.ArgumentParser):
 _DESCRIPTION = ("The IBS SUPI 3 OPC INTERBUS slave chip: operating modes, pin-strap decoding, register map, "
                 "timing, a demo, and the manual's serial-interface figures redrawn.")
 _EPILOG = """exit status: 0 done; 2 bad input (one line on stderr); 141 output pipe closed early (quiet);
-130 interrupted; 1 an internal error (a traceback: please report it)"""
+130 interrupted; 3 and 4 (firmware run) the firmware stopped or broke a rule; 1 an internal error (a traceback:
+please report it)"""
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -683,6 +758,42 @@ def build_parser() -> argparse.ArgumentParser:
     what.add_argument("--cflags", action="store_true", help="-std=c99, the warning flags and the -I flag")
     what.add_argument("--dir", action="store_true", help="the SDK folder (include/, src/, CMakeLists.txt)")
     p.set_defaults(func=cmd_sdk)
+
+    firmware = sub.add_parser("firmware", help="a firmware binary on the emulated board against the chip (needs the "
+                                               "firmware extra; docs/firmware-in-the-loop.md)")  # fmt: skip
+    steps = firmware.add_subparsers(dest="step", required=True)
+    p = steps.add_parser("run", help="run a firmware ELF on the default bench and report",
+                         epilog=f"exit status: 0 clean; {FIRMWARE_STOPPED_STATUS} the firmware faulted, hung or used "
+                                f"up its budget; {FIRMWARE_FAILED_STATUS} an interface violation or process data "
+                                "that did not arrive; 2 bad input")  # fmt: skip
+    p.add_argument("firmware", metavar="FIRMWARE.elf", help="built for the board port (supi3 firmware build)")
+    p.add_argument("--cpu", choices=["cortex_m3", "cortex_m0"], default="cortex_m3")
+    p.add_argument("--cpu-hz", type=integer, default=48_000_000, metavar="HZ",
+                   help="core clock, 1 MHz to 1 GHz (default 48000000, the board port's BOARD_SYSCLK_HZ)")
+    p.add_argument("--c", default=DEFAULT_STRAPS[0], metavar="BITS",
+                   help=f"the chip's C[4..0] straps, an Init-µP mode (default {DEFAULT_STRAPS[0]})")
+    p.add_argument("--mfp", metavar="BITS",
+                   help=f"MFP[15..12], for the modes with configuration expansion (default {DEFAULT_STRAPS[1]} with "
+                        "the default C[4..0], else unset)")  # fmt: skip
+    p.add_argument("--bit-rate", default="500k", help="500k or 2M")
+    p.add_argument("--devices", type=integer, default=1, metavar="N",
+                   help="devices in the ring, the chip first, 1 to 64 (default 1)")
+    p.add_argument("--cycles", type=integer, default=10, metavar="N",
+                   help=f"master cycles in all, 3 to {MAX_FIRMWARE_CYCLES} (default 10)")
+    p.add_argument("--max-instructions", type=integer, default=20_000_000, metavar="N",
+                   help="instruction budget of the power-up and of the exchange (default 20000000)")
+    p.add_argument("--out", dest="out_data", type=hex_bytes, metavar="HEX", help="the master's OUT data")
+    p.add_argument("--in", dest="in_data", type=hex_bytes, metavar="HEX", help="the firmware's input terminals")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_firmware_run)
+
+    p = steps.add_parser("build", help="build a firmware with the SDK's driver and board port (ziglang)")
+    p.add_argument("sources", nargs="+", metavar="SOURCE.c", help="the firmware's .c files")
+    p.add_argument("-o", "--output", required=True, metavar="PATH", help="the ELF to write")
+    p.add_argument("--cpu", choices=["cortex_m3", "cortex_m0"], default="cortex_m3")
+    p.add_argument("-D", dest="defines", action="append", default=[], metavar="NAME=VALUE",
+                   help="a macro, e.g. -D BOARD_SPI_BR=3u")
+    p.set_defaults(func=cmd_firmware_build)
     return parser
 
 

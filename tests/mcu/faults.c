@@ -1,12 +1,17 @@
 /*
  * faults.c - a firmware that goes wrong on request (tests/test_mcu_core.py): the test sets `scenario` while the
  * main loop runs. 1: read of unmapped memory (a precise bus fault), 2: an endless loop, 3: the SysTick interrupt
- * without a handler (Default_Handler loops in handler mode), 4: an undefined instruction.
+ * without a handler (Default_Handler loops in handler mode), 4: an undefined instruction. -DFAULTS_SCENARIO=n starts
+ * with scenario n (tests/test_cli_firmware.py).
  */
 #include "board.h"
 #include "fw_board.h"
 
-volatile uint32_t scenario;
+#ifndef FAULTS_SCENARIO
+#define FAULTS_SCENARIO 0u
+#endif
+
+volatile uint32_t scenario = FAULTS_SCENARIO;
 volatile uint32_t spins;
 
 void fw_setup(supi3_t *chip, fw_board_t *board)

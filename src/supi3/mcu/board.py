@@ -24,7 +24,7 @@ from supi3 import timing
 from supi3.checks import check_int, check_real
 from supi3.config import DeviceConfig
 from supi3.interbus.link import Device
-from supi3.mcu.core import EXTERNAL, CortexM, FirmwareImage, FirmwareStoppedError, Stop
+from supi3.mcu.core import EXTERNAL, CortexM, FirmwareImage, FirmwareStoppedError, Frame, SourceLine, Stop
 from supi3.mcu.stm32 import (
     AFIO_BASE,
     CR1_CPHA,
@@ -88,12 +88,29 @@ class ViolationAt:
     pc: int
     function: str | None
     error: InterfaceViolationError
+    backtrace: tuple[Frame, ...] = ()
+    """The firmware's call stack, innermost first (:meth:`supi3.mcu.core.CortexM.backtrace`)."""
+
+    @property
+    def source(self) -> SourceLine | None:
+        """The source line of :attr:`pc` (DWARF)."""
+        return self.backtrace[0].source if self.backtrace else None
 
     @property
     def place(self) -> str:
-        """``PC 08000B7Eh in fw_setup(), t = 7.125 µs``."""
+        """``PC 08000B7Eh in board_xfer() board.c:95, t = 7.125 µs, called from supi3_read() supi3.c:120 <-
+        fw_isr() digital_io.c:32``."""
         function = f" in {self.function}()" if self.function else ""
-        return f"PC {self.pc:08X}h{function}, t = {self.time_s * 1e6:.3f} µs"
+        source = f" {self.source}" if self.source else ""
+        calls = " <- ".join(str(frame) for frame in self.backtrace[1:])
+        return f"PC {self.pc:08X}h{function}{source}, t = {self.time_s * 1e6:.3f} µs" + \
+            (f", called from {calls}" if calls else "")  # fmt: skip
+
+    @classmethod
+    def now(cls, core: CortexM, time_s: float, error: InterfaceViolationError) -> ViolationAt:
+        """``error`` at the core's PC and call stack now."""
+        pc = core.pc
+        return cls(time_s, pc, core.image.function_at(pc), error, core.backtrace())
 
     def __str__(self) -> str:
         return f"{self.place}: {self.error}"
@@ -389,10 +406,8 @@ class Board:
                    self.core.cycles_now())  # fmt: skip
 
     def _note(self, errors: list[InterfaceViolationError], cycles: int) -> None:
-        pc = self.core.pc
         for error in errors:
-            function = self.core.image.function_at(pc)
-            self.violations.append(ViolationAt(self._seconds(cycles), pc, function, error))
+            self.violations.append(ViolationAt.now(self.core, self._seconds(cycles), error))
 
     # -- running -----------------------------------------------------------------------------------------------
 
@@ -439,7 +454,7 @@ class Board:
             except InterfaceViolationError as error:
                 where = next((v for v in reversed(self.violations) if v.error is error), None)
                 if where is None:  # raised by the bus between two accesses: where the core stopped
-                    where = ViolationAt(core.time_s, core.pc, core.image.function_at(core.pc), error)
+                    where = ViolationAt.now(core, core.time_s, error)
                 error.add_note(f"firmware at {where.place}")
                 raise
             if state == "run" and core.idle_loop():

@@ -7,13 +7,12 @@ and the firmware's sources for a Cortex-M0 or -M3 and links them with ``board/bo
         -std=c99 -Wall -Wextra -pedantic -Werror -Os -g -Wl,--entry=Reset_Handler -T board.ld
         -I<sdk include> -I<sdk examples> -I<board> board/startup.c board/board.c src/supi3.c FIRMWARE.c -o OUT.elf
 
-From the shell: ``python -m supi3.mcu.build FIRMWARE.c -o OUT.elf [--cpu cortex_m0] [-D NAME=VALUE]`` (guide:
+From the shell: ``supi3 firmware build FIRMWARE.c -o OUT.elf [--cpu cortex_m0] [-D NAME=VALUE]`` (guide:
 docs/firmware-in-the-loop.md).
 """
 
 from __future__ import annotations
 
-import argparse
 import importlib.util
 import subprocess
 import sys
@@ -25,7 +24,7 @@ from supi3 import sdk
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.mcu.core import CPUS
 
-__all__ = ["BOARD_DIR", "FLAGS", "BuildError", "build", "build_command", "main", "toolchain_missing"]
+__all__ = ["BOARD_DIR", "FLAGS", "BuildError", "build", "build_command", "toolchain_missing"]
 
 BOARD_DIR: Final[Path] = sdk.SDK_DIR / "board"
 """The board port: ``board.h``, ``board.c``, ``startup.c``, ``board.ld``."""
@@ -88,25 +87,3 @@ def build(sources: str | Path | Sequence[str | Path], output: str | Path, *, cpu
     if result.returncode != 0:
         raise BuildError(f"the firmware does not build for {cpu}:\n{result.stderr}")
     return Path(output)
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m supi3.mcu.build FIRMWARE.c [...] -o OUT.elf [--cpu cortex_m0] [-D NAME=VALUE]``."""
-    parser = argparse.ArgumentParser(prog="python -m supi3.mcu.build", description=main.__doc__)
-    parser.add_argument("sources", nargs="+", type=Path, help="the firmware's .c files")
-    parser.add_argument("-o", "--output", type=Path, required=True, help="the ELF to write")
-    parser.add_argument("--cpu", choices=sorted(CPUS), default="cortex_m3")
-    parser.add_argument("-D", dest="defines", action="append", default=[], metavar="NAME=VALUE")
-    args = parser.parse_args(argv)
-    defines = dict(d.split("=", 1) if "=" in d else (d, "1") for d in args.defines)
-    try:
-        build(args.sources, args.output, cpu=args.cpu, defines=defines)
-    except (BuildError, ArgumentError) as error:
-        print(error, file=sys.stderr)
-        return 1
-    print(args.output)
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -12,17 +12,20 @@ then loops on a prefetch abort). :class:`CortexM` does both itself, as the archi
 Timing (MCU-1): every basic block unicorn enters costs its instructions' cycles (:func:`block_cost`: one per
 instruction, one more per single load or store, one per register of a multiple load or store, two more for a
 branch that ends the block, taken as taken), so the clock is exact at block boundaries; a peripheral access is
-placed inside its block by the program counter (:meth:`CortexM.cycles_now`). Emulation only ever stops at a block
+placed inside its block by the program counter (:meth:`CortexM.cycles_now`; unicorn keeps the PC exact at an
+access only under a memory hook, so each peripheral range has an empty one). Emulation only ever stops at a block
 boundary (a block hook refuses the next block), because unicorn restarts an instruction stopped inside a memory
 callback and a peripheral would see its access twice.
 """
 
 from __future__ import annotations
 
+import bisect
 import struct
 from collections.abc import Callable
 from dataclasses import dataclass
 from enum import StrEnum
+from functools import cached_property
 from pathlib import Path
 from typing import Any, Final
 
@@ -47,10 +50,13 @@ __all__ = [
     "FirmwareFaultError",
     "FirmwareImage",
     "FirmwareStoppedError",
+    "Frame",
+    "SourceLine",
     "Stop",
     "StopReport",
     "SysTick",
     "block_cost",
+    "countdown_register",
     "is_poll_loop",
 ]
 
@@ -85,6 +91,8 @@ SCS_BASE: Final[int] = 0xE000_E000
 SCS_SIZE: Final[int] = 0x1000
 SYST_MAX: Final[int] = 0xFF_FFFF
 """SysTick is a 24-bit down counter (B3.3.1)."""
+BACKTRACE_DEPTH: Final[int] = 16
+"""Frames :meth:`CortexM.backtrace` unwinds at most."""
 IRQ_LINES: Final[int] = 32
 """External interrupts the NVIC model has (one ISER word)."""
 
@@ -113,6 +121,7 @@ _REGS: Final[tuple[tuple[str, int], ...]] = (
     *((f"r{k}", getattr(arm, f"UC_ARM_REG_R{k}")) for k in range(13)),
     ("sp", arm.UC_ARM_REG_SP), ("lr", arm.UC_ARM_REG_LR), ("pc", arm.UC_ARM_REG_PC), ("xpsr", arm.UC_ARM_REG_XPSR),
 )  # fmt: skip
+_LOW_REGS: Final[tuple[int, ...]] = tuple(getattr(arm, f"UC_ARM_REG_R{k}") for k in range(8))
 _FRAME_REGS: Final[tuple[int, ...]] = (arm.UC_ARM_REG_R0, arm.UC_ARM_REG_R1, arm.UC_ARM_REG_R2, arm.UC_ARM_REG_R3,
                                        arm.UC_ARM_REG_R12, arm.UC_ARM_REG_LR)  # fmt: skip
 FRAME_NAMES: Final[tuple[str, ...]] = ("r0", "r1", "r2", "r3", "r12", "lr", "pc", "xpsr")
@@ -122,6 +131,37 @@ FRAME_NAMES: Final[tuple[str, ...]] = ("r0", "r1", "r2", "r3", "r12", "lr", "pc"
 # ------------------------------------------------------------------------------------------------------------
 # Reports
 # ------------------------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SourceLine:
+    """A place in the firmware's source, from the ELF's DWARF line program (``.debug_line``)."""
+
+    path: str
+    """The file as the compiler named it (its directory joined)."""
+    line: int
+
+    @property
+    def file(self) -> str:
+        """The file's name without its directory."""
+        return Path(self.path).name
+
+    def __str__(self) -> str:
+        return f"{self.file}:{self.line}"
+
+
+@dataclass(frozen=True)
+class Frame:
+    """One frame of the firmware's call stack: the address running (innermost) or returned to, its function and
+    its source line (for a return address: the line of the call)."""
+
+    pc: int
+    function: str | None
+    source: SourceLine | None
+
+    def __str__(self) -> str:
+        name = f"{self.function}()" if self.function else f"{self.pc:08X}h"
+        return name + (f" {self.source}" if self.source else "")
 
 
 class Stop(StrEnum):
@@ -146,11 +186,21 @@ class StopReport:
     time_s: float
     stacked: dict[str, int] | None = None
     symbol: str | None = None
+    backtrace: tuple[Frame, ...] = ()
+    """The call stack at :attr:`pc`, innermost first (DWARF call frame information), up to an exception entry."""
+
+    @property
+    def source(self) -> SourceLine | None:
+        """The source line of :attr:`pc`."""
+        return self.backtrace[0].source if self.backtrace else None
 
     def __str__(self) -> str:
         where = f"PC {self.pc:08X}h" + (f" ({self.symbol})" if self.symbol else "")
+        where += f" {self.source}" if self.source else ""
         text = f"{self.stop.value}: {self.reason} at {where}, t = {self.time_s * 1e6:.3f} µs, " \
                f"{self.instructions} instructions"  # fmt: skip
+        if len(self.backtrace) > 1:
+            text += "; called from " + " <- ".join(str(frame) for frame in self.backtrace[1:])
         if self.stacked is not None:
             text += "; stacked " + " ".join(f"{name}={value:08X}h" for name, value in self.stacked.items())
         return text
@@ -228,6 +278,96 @@ class FirmwareImage:
                 return name
         return None
 
+    def line_at(self, pc: int) -> SourceLine | None:
+        """The source line of the instruction at ``pc`` from the DWARF line program, if the ELF has one (built with
+        ``-g``: :func:`supi3.mcu.build.build` does)."""
+        addresses, lines = self._lines
+        k = bisect.bisect_right(addresses, pc) - 1
+        return lines[k] if k >= 0 else None
+
+    def frame_rule(self, pc: int) -> tuple[int, int, dict[int, int]] | None:
+        """How to find the caller of the code at ``pc`` (DWARF ``.debug_frame``): (CFA register, CFA offset,
+        {register: offset from the CFA of its saved copy}); ``None`` where the ELF has no call frame information."""
+        starts, entries = self._frames
+        k = bisect.bisect_right(starts, pc) - 1
+        if k < 0 or pc >= entries[k][0]:
+            return None
+        rows = entries[k][1]
+        row = rows[bisect.bisect_right([r[0] for r in rows], pc) - 1]
+        return row[1], row[2], row[3]
+
+    @cached_property
+    def _lines(self) -> tuple[list[int], list[SourceLine | None]]:
+        return self._debug[0]
+
+    @cached_property
+    def _frames(self) -> _FrameTable:
+        return self._debug[1]
+
+    @cached_property
+    def _debug(self) -> tuple[tuple[list[int], list[SourceLine | None]], _FrameTable]:
+        """The line table and the call frame information, read on first use; empty if the ELF has no DWARF or can
+        no longer be read (the reports then name no lines)."""
+        from elftools.common.exceptions import DWARFError, ELFError
+        from elftools.elf.elffile import ELFFile
+
+        try:
+            with self.path.open("rb") as stream:
+                elf = ELFFile(stream)
+                dwarf = elf.get_dwarf_info() if elf.has_dwarf_info() else None
+                return _line_table(dwarf), _frame_table(dwarf)
+        except (OSError, ELFError, DWARFError):
+            return ([], []), ([], [])
+
+
+_FrameRow = tuple[int, int, int, dict[int, int]]
+_FrameTable = tuple[list[int], list[tuple[int, list[_FrameRow]]]]
+
+
+def _line_table(dwarf: Any) -> tuple[list[int], list[SourceLine | None]]:
+    """The line program's rows: sorted addresses and the line starting at each (``None``: a sequence ends there)."""
+    rows: list[tuple[int, int, SourceLine | None]] = []
+    for unit in dwarf.iter_CUs() if dwarf is not None else ():
+        program = dwarf.line_program_for_CU(unit)
+        if program is None:
+            continue
+        header = program.header
+        v5 = header["version"] >= 5  # DWARF 5 counts files and directories from 0, DWARF 4 from 1
+        top = unit.get_top_DIE().attributes.get("DW_AT_comp_dir")
+        folders = [top.value.decode() if top else ""] * (not v5)
+        folders += [bytes(d).decode() for d in header["include_directory"]]
+        files = [str(Path(folders[f.dir_index]) / bytes(f.name).decode()) for f in header["file_entry"]]
+        for entry in program.get_entries():
+            state = entry.state
+            if state is None:
+                continue
+            if state.end_sequence or not state.line:
+                rows.append((state.address, 0, None))
+            else:
+                rows.append((state.address, 1, SourceLine(files[state.file - (not v5)], state.line)))
+    rows.sort(key=lambda row: row[:2])
+    return [row[0] for row in rows], [row[2] for row in rows]
+
+
+def _frame_table(dwarf: Any) -> _FrameTable:
+    """The call frame information: sorted function starts and, per function, its end and its rows (address, CFA
+    register, CFA offset, saved registers)."""
+    from elftools.dwarf.callframe import FDE, RegisterRule
+
+    functions: list[tuple[int, int, list[_FrameRow]]] = []
+    for entry in dwarf.CFI_entries() if dwarf is not None and dwarf.has_CFI() else ():
+        if not isinstance(entry, FDE):
+            continue
+        start = int(entry["initial_location"])
+        rows = [(int(row["pc"]), int(row["cfa"].reg), int(row["cfa"].offset),
+                 {int(reg): int(rule.arg) for reg, rule in row.items()
+                  if isinstance(reg, int) and rule.type == RegisterRule.OFFSET})
+                for row in entry.get_decoded().table if row["cfa"].reg is not None]  # fmt: skip
+        if rows:
+            functions.append((start, start + int(entry["address_range"]), rows))
+    functions.sort(key=lambda f: f[0])
+    return [f[0] for f in functions], [(f[1], f[2]) for f in functions]
+
 
 # ------------------------------------------------------------------------------------------------------------
 # The timing model (MCU-1)
@@ -282,6 +422,22 @@ def is_poll_loop(code: bytes, address: int) -> bool:
         return False
     offset = (branch & 0xFF) - (0x100 if branch & 0x80 else 0)
     return address + 2 * (len(halfwords) - 1) + 4 + 2 * offset == address
+
+
+def countdown_register(code: bytes) -> int:
+    """The register a countdown loop counts down (MCU-11), or -1: the block ``code`` is exactly ``SUBS Rd, Rd,
+    #1`` (a 16-bit encoding, Rd one of R0-R7) and ``BNE`` back to the ``SUBS``. Its iterations
+    write only Rd and the flags, which the last one writes again."""
+    if len(code) != 4:
+        return -1
+    first, branch = code[0] | code[1] << 8, code[2] | code[3] << 8
+    if (first & 0xFFC0) == 0x1E40 and first & 7 == first >> 3 & 7:  # SUBS Rd, Rn, #1 (T1) with Rn = Rd
+        register = first & 7
+    elif (first & 0xF8FF) == 0x3801:  # SUBS Rdn, #1 (T2)
+        register = first >> 8 & 7
+    else:
+        return -1
+    return register if branch == 0xD1FD else -1  # BNE to the SUBS: 4 + 2 * (-3) bytes from the branch
 
 
 def block_cost(code: bytes) -> tuple[int, int]:
@@ -363,15 +519,17 @@ class CortexM:
         self.interrupt: int | None = None
         self.entered: Callable[[int], None] = _nothing
         """Called with the exception number after each exception entry (the board measures latency)."""
-        self._costs: dict[tuple[int, int], tuple[int, int]] = {}
+        self._costs: dict[tuple[int, int], tuple[int, int]] = {}  # the cost of a block's first instructions
         self._block = (0, 0)  # address and cycle count at the entry of the block running
         self._block_end = 0
         self._running = False
         self._handed = 0  # the latest time a peripheral was given
         self._skip: tuple[int, int] | None = None  # (poll loop address, cycle its status changes)
         self._polls: dict[int, bool] = {}
+        self._blocks: dict[tuple[int, int], tuple[tuple[int, int], int]] = {}  # cost, countdown register (MCU-11)
         self.skip_polls = True
-        """MCU-10: skip the iterations of pure poll loops (the same result, faster); ``False`` runs each."""
+        """MCU-10, MCU-11: count the iterations of pure poll loops and countdown loops without running them (the
+        same result, faster); ``False`` runs each."""
         self.vtor = 0
         self.systick = SysTick(self)
         self._scs_words: dict[int, int] = {}
@@ -384,10 +542,13 @@ class CortexM:
 
     def mmio(self, base: int, size: int, read: ReadFn, write: WriteFn) -> None:
         """Map a peripheral: ``read(offset, size) -> value`` and ``write(offset, size, value)`` run on every
-        access. An exception they raise stops the run at the end of the block (:attr:`error`)."""
+        access. An exception they raise stops the run at the end of the block (:attr:`error`); the block's later
+        accesses reach no peripheral (no follow-on reports of a run that has ended)."""
 
         def on_read(uc: Any, offset: int, size: int, data: Any) -> int:
             del uc, data
+            if self.error is not None:  # the run ends with this block: its later accesses reach no peripheral
+                return 0
             try:
                 return read(offset, size)
             except BaseException as error:  # handed to the run loop, raised there
@@ -396,12 +557,18 @@ class CortexM:
 
         def on_write(uc: Any, offset: int, size: int, value: int, data: Any) -> None:
             del uc, data
+            if self.error is not None:
+                return
             try:
                 write(offset, size, value)
             except BaseException as error:  # handed to the run loop, raised there
                 self.fail(error)
 
         self.uc.mmio_map(base, size, on_read, None, on_write, None)
+        # unicorn updates the PC before a load or store only if a memory hook covers its address: without one, a
+        # peripheral callback sees the PC of the block's first instruction, and the access would be timed there
+        # (MCU-1 places it by the PC).
+        self.uc.hook_add(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, _exact_pc, None, base, base + size - 1)
 
     def read_bytes(self, address: int, size: int) -> bytes:
         """Memory as the core sees it (RAM, flash)."""
@@ -581,9 +748,11 @@ class CortexM:
             uc.emu_stop()  # this block does not run: it is the first of the next run
             return
         key = (address, size)
-        cost = self._costs.get(key)
-        if cost is None:
-            cost = self._costs[key] = block_cost(self.read_bytes(address, size))
+        block = self._blocks.get(key)
+        if block is None:
+            code = self.read_bytes(address, size)
+            block = self._blocks[key] = (block_cost(code), countdown_register(code))
+        cost = block[0]
         skip = self._skip
         if skip is not None:
             self._skip = None
@@ -592,6 +761,9 @@ class CortexM:
                 if self.cycles >= self.deadline:
                     uc.emu_stop()
                     return
+        if block[1] >= 0 and self.skip_polls and self._skip_countdown(block[1], cost):
+            uc.emu_stop()
+            return
         self._block = (address, self.cycles)
         self._block_end = address + size
         self.instructions += cost[0]
@@ -606,6 +778,18 @@ class CortexM:
         skipped = max(0, min(before_deadline, reading_early))
         self.instructions += skipped * instructions
         self.cycles += skipped * cycles
+
+    def _skip_countdown(self, register: int, cost: tuple[int, int]) -> bool:
+        """Count, without running them, the iterations of a countdown loop on ``register`` that would start before
+        the deadline, all but its last (MCU-11); whether the deadline came first (the block must not run)."""
+        reg = _LOW_REGS[register]
+        left = int(self.uc.reg_read(reg))
+        skipped = max(0, min(left - 1, -(-(self.deadline - self.cycles) // cost[1])))
+        if skipped:
+            self.uc.reg_write(reg, left - skipped)
+            self.instructions += skipped * cost[0]
+            self.cycles += skipped * cost[1]
+        return self.cycles >= self.deadline
 
     def skip_poll(self, until: int) -> None:
         """The status register just read keeps its value until cycle ``until``: if the running block is a pure poll
@@ -692,6 +876,7 @@ class CortexM:
             ucc.UC_ERR_WRITE_PROT: "memory fault: write to read-only memory",
         }
         reason = kinds.get(error.errno, f"fault ({error})")
+        backtrace = self.backtrace()
         frame: int | None = None
         if self.ram[0] + FRAME_WORDS * 4 <= (self.reg("sp") & ~7) <= self.ram[0] + self.ram[1]:
             try:  # take the HardFault as the core would: the report shows the frame its handler would see
@@ -699,17 +884,47 @@ class CortexM:
                 frame = self.reg("sp")
             except FirmwareError:
                 frame = None
-        return self.report(Stop.FAULT, reason, pc=pc, stacked=frame)
+        return self.report(Stop.FAULT, reason, pc=pc, stacked=frame, backtrace=backtrace)
 
-    def report(self, stop: Stop, reason: str, *, pc: int | None = None, stacked: int | None = None) -> StopReport:
-        """A :class:`StopReport` of the core now; ``stacked``: the address of a stacked frame to include."""
+    def report(self, stop: Stop, reason: str, *, pc: int | None = None, stacked: int | None = None,
+               backtrace: tuple[Frame, ...] | None = None) -> StopReport:  # fmt: skip
+        """A :class:`StopReport` of the core now; ``stacked``: the address of a stacked frame to include;
+        ``backtrace``: the call stack if not the core's now (:meth:`backtrace`)."""
         pc = self.pc if pc is None else pc
         frame = None
         if stacked is not None:
             words = struct.unpack("<8I", self.read_bytes(stacked, FRAME_WORDS * 4))
             frame = dict(zip(FRAME_NAMES, words, strict=True))
         return StopReport(stop, reason, pc, self.registers(), self.instructions, self.cycles, self.time_s, frame,
-                          self.image.function_at(pc))  # fmt: skip
+                          self.image.function_at(pc), self.backtrace() if backtrace is None else backtrace)  # fmt: skip
+
+    def backtrace(self, depth: int = BACKTRACE_DEPTH) -> tuple[Frame, ...]:
+        """The call stack now, innermost first: the PC's function and line, then each caller's return address
+        with the line of its call, unwound with the ELF's call frame information (``.debug_frame``) up to
+        ``depth`` frames, a frame without that information, or an exception entry (LR = EXC_RETURN)."""
+        image = self.image
+        pc = self.pc
+        frames = [Frame(pc, image.function_at(pc), image.line_at(pc))]
+        regs = {n: self.reg(f"r{n}") for n in range(13)} | {13: self.reg("sp"), 14: self.reg("lr")}
+        while len(frames) < depth:
+            rule = image.frame_rule(pc)
+            if rule is None or rule[0] not in regs:
+                break
+            cfa = regs[rule[0]] + rule[1]
+            try:
+                saved = {reg: int(struct.unpack("<I", self.read_bytes(cfa + offset, 4))[0])
+                         for reg, offset in rule[2].items()}  # fmt: skip
+            except UcError:
+                break
+            regs |= saved
+            regs[13] = cfa
+            back = regs[14] & ~1
+            if regs[14] >= EXC_RETURN_HANDLER or not self.flash[0] <= back < self.flash[0] + self.flash[1] \
+                    or (back == pc and not saved):  # fmt: skip
+                break
+            pc = back
+            frames.append(Frame(pc, image.function_at(pc - 1), image.line_at(pc - 1)))  # the call's line
+        return tuple(frames)
 
     # -- system control space: SysTick, NVIC, SCB (B3.2 to B3.4) -----------------------------------------------
 
@@ -767,6 +982,11 @@ class CortexM:
             self.vtor = value & ~0x7F
         else:
             self._scs_words[offset] = value
+
+
+def _exact_pc(uc: Any, access: int, address: int, size: int, value: int, data: Any) -> None:
+    """A memory hook that does nothing: its presence makes unicorn keep the PC exact at each access it covers."""
+    del uc, access, address, size, value, data
 
 
 def _nothing(number: int) -> None:

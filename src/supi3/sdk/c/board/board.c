@@ -1,6 +1,6 @@
 /*
  * board.c - the SDK's port to the emulated SUPI 3 board (board.h): the C driver's transport on SPI1 and GPIOA,
- * /IRQ on EXTI0, a SysTick busy wait, and main() running the board contract of examples/fw_board.h.
+ * /IRQ on EXTI0, a register-only busy wait, and main() running the board contract of examples/fw_board.h.
  *
  * main() sets the clocks, pins and SPI1 up, calls supi3_init() with the transport, then fw_setup(). A falling edge
  * of /IRQ enters EXTI0_IRQHandler: a firmware without fw_loop gets fw_isr() there (its main loop only sleeps,
@@ -22,24 +22,21 @@ fw_board_t fw_board;
 static volatile uint32_t irq_noted;
 
 #define PIN(n) (1u << (n))
-#define SYST_MAX 0x00FFFFFFu
 /* Table 3-7 at 500 kbit/s (they halve at 2 Mbit/s): t2 min, t6 max, t8 min in ns; CPU clocks for ns, rounded up. */
 #define BOARD_T2_NS 375u
 #define BOARD_T6_MAX_NS 375u
 #define BOARD_T8_NS 125u
 #define BOARD_NS_CYCLES(ns) (((ns) * (BOARD_SYSCLK_HZ / 1000000u) + 999u) / 1000u)
 
-/* Busy wait for at least `cycles` CPU clocks on the free-running SysTick (a 24-bit down counter at the CPU clock). */
+/* Busy wait for at least `cycles` CPU clocks: a countdown loop of two 16-bit instructions (SUBS, BNE) that takes at
+ * least BOARD_SPIN_CYCLES clocks an iteration on either core (Cortex-M3: SUBS 1, a taken branch 2 or more; Cortex-M0:
+ * 1 + 3). Registers only: safe in a handler and in the code it interrupts, SysTick stays the firmware's. The emulator
+ * counts the iterations without running them (MCU-11). */
+#define BOARD_SPIN_CYCLES 3u
 static void board_wait_cycles(uint32_t cycles)
 {
-    uint32_t left = cycles;
-    uint32_t last = SYST_CVR;
-    while (left != 0u) {
-        uint32_t now = SYST_CVR;
-        uint32_t passed = (last - now) & SYST_MAX;
-        last = now;
-        left = passed >= left ? 0u : left - passed;
-    }
+    uint32_t n = cycles / BOARD_SPIN_CYCLES + 1u;
+    __asm__ volatile("1: subs %0, %0, #1\n\tbne 1b" : "+l"(n) : : "cc");
 }
 
 static void board_delay_us(void *user, uint32_t us)
@@ -138,9 +135,6 @@ static void board_init(void)
      * software slave select (SSM, SSI: /SS is the GPIO above). */
     SPI1_CR1 = SPI_CR1_CPHA | SPI_CR1_CPOL | SPI_CR1_MSTR | (BOARD_SPI_BR << SPI_CR1_BR_POS) | SPI_CR1_SSI | SPI_CR1_SSM;
     SPI1_CR1 |= SPI_CR1_SPE;
-    SYST_RVR = SYST_MAX;
-    SYST_CVR = 0u;
-    SYST_CSR = SYST_CSR_ENABLE | SYST_CSR_CLKSOURCE;
     GPIOB_CRL = GPIO_CFG_INPUT_FLOATING << (4u * BOARD_PIN_MODACK);
     AFIO_EXTICR1 = AFIO_EXTICR_PB << (4u * BOARD_PIN_MODACK); /* EXTI0 on PA0, EXTI1 on PB1 */
     EXTI_FTSR |= PIN(BOARD_PIN_IRQ) | PIN(BOARD_PIN_MODACK);

@@ -1,0 +1,111 @@
+"""Benchmark: the firmware's binary on the emulated board (supi3.mcu) against the transaction-level chip.
+
+The issue's case (#13): the digital 16/16 example (``digital_io.c``) built for the Cortex-M3, the core at 48 MHz, the
+ring at 2 Mbit/s with back-to-back cycles, the transaction-level chip. SPI1 runs at f_PCLK / 16 = 3 MHz
+(``BOARD_SPI_BR=3u``), the fastest the board's divider gives within Table 3-7's t0 = 333 ns at 2 Mbit/s (the board
+port's default, 750 kHz, cannot serve a 2 Mbit/s cycle: its handler outlasts the cycle). The run is non-strict: the
+handler's accesses reach the next latch phase (a finding, tests/test_mcu_board.py), which the run counts. Beside it
+the same example at 500 kbit/s with the port's defaults, and the host build of the example on the firmware bench in
+the same process (the baseline: the C driver through cffi, bytes at their Table 3-7 time).
+
+Figures: simulated time / CPU time of the process (``time.process_time``: the machine is shared, wall time swings
+with its load; the issue's goal: >= 1x), emulated instructions per second, and two ratios measured in the same
+process: against the same binary with every poll and countdown loop iteration run (``skip_polls = False``: MCU-10
+and MCU-11 off) and against the host build. Run from the repository root:
+
+    python bench/bench_mcu.py [--cycles N] [--repeat R]
+"""
+
+from __future__ import annotations
+
+import argparse
+import platform
+import tempfile
+import time
+from collections.abc import Callable
+from functools import partial
+from pathlib import Path
+
+from supi3.mcu.board import Board
+from supi3.mcu.build import build
+from supi3.sdk import native
+from supi3.sdk.bench import Bench
+
+POWER_UP = 3
+"""Cycles before the measured ones: set-up, the ID cycle, the first data cycle."""
+
+
+def _cpu_s(run: Callable[[], None], repeat: int) -> float:
+    """The fastest of ``repeat`` runs, in CPU seconds of this process."""
+    fastest = float("inf")
+    for _ in range(repeat):
+        start = time.process_time()
+        run()
+        fastest = min(fastest, time.process_time() - start)
+    return fastest
+
+
+def binary_run(elf: Path, bit_rate: int, cycles: int, repeat: int, skip: bool = True
+               ) -> tuple[float, float, int, int, int]:  # fmt: skip
+    """CPU seconds for ``cycles`` master cycles of ``elf`` after power-up (the fastest of ``repeat``), simulated
+    seconds, instructions, interrupts, violations; ``skip``: MCU-10 and MCU-11 on."""
+    outcome = (0.0, 0, 0, 0)
+    fastest = float("inf")
+    for _ in range(repeat):
+        board = Board(elf, bit_rate=bit_rate, strict=False)
+        board.core.skip_polls = skip
+        board.run(POWER_UP)
+        board.bench.master.set_outputs(1, b"\x12\x34")
+        assert board.fw_board is not None
+        board.fw_board.inputs = b"\xab\xcd"
+        start_s, start_i = board.bench.now, board.core.instructions
+        fastest = min(fastest, _cpu_s(partial(board.run, cycles), 1))
+        outcome = (board.bench.now - start_s, board.core.instructions - start_i, board.interrupts,
+                   len(board.violations))  # fmt: skip
+    return (fastest, *outcome)
+
+
+def host_run(bit_rate: int, cycles: int, repeat: int) -> tuple[float, float]:
+    """CPU and simulated seconds of the same example built for the host, on the firmware bench."""
+    simulated = 0.0
+    firmware = native.CFirmware(native.example("digital_io"))
+    fastest = float("inf")
+    for _ in range(repeat):
+        bench = Bench(firmware=firmware, bit_rate=bit_rate)
+        bench.run(POWER_UP)
+        start = bench.now
+        fastest = min(fastest, _cpu_s(partial(bench.run, cycles), 1))
+        simulated = bench.now - start
+    return fastest, simulated
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Measure and print."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--cycles", type=int, default=500, help="master cycles measured after power-up")
+    parser.add_argument("--repeat", type=int, default=3, help="runs; the fastest is reported")
+    args = parser.parse_args(argv)
+    print(f"reproduce: python bench/bench_mcu.py --cycles {args.cycles} --repeat {args.repeat}")
+    print(f"machine: {platform.processor() or platform.machine()}, Python {platform.python_version()}")
+    with tempfile.TemporaryDirectory() as folder:
+        cases = [("issue case: 2 Mbit/s, SPI1 3 MHz", 2_000_000, {"BOARD_SPI_BR": "3u"}),
+                 ("500 kbit/s, SPI1 750 kHz (the port's default)", 500_000, {})]  # fmt: skip
+        for title, bit_rate, defines in cases:
+            elf = build(native.example("digital_io"), Path(folder) / f"dio_{bit_rate}.elf", defines=defines)
+            cpu, simulated, instructions, interrupts, violations = binary_run(elf, bit_rate, args.cycles,
+                                                                              args.repeat)  # fmt: skip
+            slow_cpu, slow_simulated = binary_run(elf, bit_rate, args.cycles, args.repeat, skip=False)[:2]
+            host_cpu, host_simulated = host_run(bit_rate, args.cycles, args.repeat)
+            speed = simulated / cpu
+            print(
+                f"digital_io.c on the Cortex-M3 at 48 MHz, {title}: {args.cycles} cycles, "
+                f"{simulated * 1e3:.2f} ms simulated in {cpu:.3f} CPU s = {speed:.3f}x real time; "
+                f"{instructions / cpu / 1e6:.2f} M instructions/s; {interrupts} interrupts, {violations} "
+                f"violations; {speed / (slow_simulated / slow_cpu):.2f}x the speed with every loop iteration "
+                f"run; the host build on the bench {host_simulated / host_cpu:.2f}x real time (binary / host "
+                f"{speed / (host_simulated / host_cpu):.3f})"
+            )
+
+
+if __name__ == "__main__":
+    main()
