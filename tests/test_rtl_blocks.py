@@ -13,16 +13,18 @@ from supi3.config import Variant
 from supi3.rtl import core
 from supi3.rtl.core import DataPathRtl, FrameEngineRtl, OutputsRtl, ReceiverRtl, Supi3Core, TransmitterRtl
 from supi3.rtl.expansion import ExpansionRtl
+from supi3.rtl.optical import OpticalRtl
 from supi3.rtl.serial_io import SerialIoRtl
 from supi3.rtl.tables import core_tables
 
 BLOCKS = {"receiver": ReceiverRtl, "frame": FrameEngineRtl, "datapath": DataPathRtl, "transmitter": TransmitterRtl,
-          "outputs": OutputsRtl, "serial_io": SerialIoRtl, "expansion": ExpansionRtl}  # fmt: skip
+          "outputs": OutputsRtl, "serial_io": SerialIoRtl, "expansion": ExpansionRtl,
+          "optical": OpticalRtl}  # fmt: skip
 """Block name (the same in supi3.model) -> RTL component."""
 
 
 @pytest.mark.parametrize("variant", list(Variant))
-def test_core_is_the_seven_blocks(variant: Variant) -> None:
+def test_core_is_the_eight_blocks(variant: Variant) -> None:
     fragment = Fragment.get(Supi3Core(variant), None)
     assert [name for _, name, _ in fragment.subfragments] == list(BLOCKS)
 
@@ -31,7 +33,7 @@ def blocks() -> list[wiring.Component]:
     """One of each block, elaborated on its own (so none is left unused)."""
     tables = core_tables()
     made = [ReceiverRtl(tables), FrameEngineRtl(), DataPathRtl(tables), TransmitterRtl(tables), OutputsRtl(26),
-            SerialIoRtl(), ExpansionRtl()]  # fmt: skip
+            SerialIoRtl(), ExpansionRtl(), OpticalRtl()]  # fmt: skip
     for block in made:
         Fragment.get(block, None)
     return made

@@ -103,6 +103,8 @@ __all__ = [
     "check_names",
     "input_row",
     "input_traces",
+    "split_optical",
+    "split_optical_traces",
 ]
 
 RESET_STRETCH_CLOCKS: Final = round(RESET_MIN_S * CLOCK_HZ)
