@@ -41,7 +41,7 @@ from supi3.model.chip import Supi3
 from supi3.model.pinring import receive
 from supi3.model.pins import Supi3Pins
 from supi3.model.registers import RegisterFile
-from supi3.optical.regulation import BLOCK_INPUTS
+from supi3.optical.regulation import BLOCK_INPUTS, INIT_TIME_LIMIT_CLOCKS, Interface, OpticalMode, Response
 from supi3.pinlevel import OE_SUFFIX
 from supi3.regmap import Register, encode_command
 from supi3.sdk import native
@@ -82,6 +82,8 @@ def verilator_missing() -> str | None:
 
 CORE_INPUTS = [pin.name for pin in Supi3Pins.inputs]
 """The chip core's input pins, in the model's order (the columns of a core or chip stimulus)."""
+OPTICAL_LINES = [pin.name for pin in Supi3Pins.optical_inputs]
+"""The optical block's line side, the core's inputs beside its pins (columns after the straps in a bench stimulus)."""
 LOOPBACK = wire.LOOPBACK_BYTES_ON_LINE
 IDLE = wire.status_levels(Cycle.DATA, False, 8)
 """Eight idle status telegrams on the line."""
@@ -181,16 +183,43 @@ class CoreScript:
     def __init__(self, config: DeviceConfig, rng: np.random.Generator | None = None) -> None:
         self.config = config
         self.rng = rng if rng is not None else np.random.default_rng(0)
-        self.pins = {name: int(value[0]) for name, value in quiet_inputs(1).items()}
+        self.pins = {name: int(value[0]) for name, value in quiet_inputs(1).items()} | dict.fromkeys(OPTICAL_LINES, 0)
         self.parts: list[Columns] = []
 
     def line(self, levels: Levels, **pins: int) -> CoreScript:
+        """``levels`` on the line with the other pins (the optical line side included) at ``pins`` from now on."""
         self.pins.update(pins)
         do1 = wire.levels_to_samples(levels, self.config.bit_rate).astype(np.int64)
         part = {name: np.full(len(do1), value, dtype=np.int64) for name, value in self.pins.items()}
         part["do1"] = do1
         self.parts.append(part)
         return self
+
+    def strobe(self, **pins: int) -> CoreScript:
+        """One clock of an idle line with ``pins`` (optical strobes, :class:`OpticalScript`'s bit layout) on it."""
+        part = {name: np.full(1, value, dtype=np.int64) for name, value in (self.pins | pins).items()}
+        part["do1"][0] = wire.IDLE_LEVEL
+        self.parts.append(part)
+        return self.line(np.ones(2, dtype=np.uint8))
+
+    def response(self, interface: int, response: int) -> CoreScript:
+        """An initialization step's response (:class:`~supi3.optical.regulation.Response`) on ``interface``."""
+        return self.strobe(resp_valid=1 << interface, resp=response << (2 * interface))
+
+    def test(self, interface: int, ack1: bool, ack2: bool) -> CoreScript:
+        """An online test's result on ``interface``."""
+        return self.strobe(test_valid=1 << interface, ack1=int(ack1) << interface, ack2=int(ack2) << interface)
+
+    def length(self, interface: int, clocks: int, medium: int) -> CoreScript:
+        """A length measurement of ``clocks`` clocks from ``len_start`` to ``len_stop``, the medium held at it."""
+        self.pins["medium"] = self.pins["medium"] & ~(1 << interface) | medium << interface
+        self.strobe(len_start=1 << interface)
+        self.parts[-1] = {name: np.full(clocks - 1, trace[0]) for name, trace in self.parts[-1].items()}
+        return self.strobe(len_stop=1 << interface)
+
+    def inputs(self) -> Columns:
+        """Every column: the core's pins and the optical line side."""
+        return {name: np.concatenate([part[name] for part in self.parts]) for name in (*CORE_INPUTS, *OPTICAL_LINES)}
 
     def bring_up(self) -> CoreScript:
         """Idle, an INTERBUS reset, idle."""
@@ -216,8 +245,9 @@ class CoreScript:
     def stimulus(self) -> CycleMatrix:
         from supi3.verif.straps import strap_stimulus  # Amaranth: only when a bench runs
 
-        columns = self.columns()
-        return strap_stimulus(self.config, np.stack([columns[name] for name in CORE_INPUTS], axis=1))
+        columns = self.inputs()
+        return strap_stimulus(self.config, np.stack([columns[name] for name in CORE_INPUTS], axis=1),
+                              np.stack([columns[name] for name in OPTICAL_LINES], axis=1))  # fmt: skip
 
 
 # The µP interface block's stimulus (tests/test_rtl_upif.py) -----------------------------------------------------------
@@ -314,7 +344,7 @@ class ChipPins:
         self.rows: list[list[int]] = []
         self.outputs: list[dict[str, int]] = []
         self.pins = {"do1": wire.IDLE_LEVEL, "di2": 0, "rbst_ext": 0, "mfp_in": 0, "stat_err_n": 1, "resu_n": 1,
-                     "vmon_ok": 1, "from_exr": 0}  # fmt: skip
+                     "vmon_ok": 1, "from_exr": 0, **dict.fromkeys(OPTICAL_LINES, 0)}  # fmt: skip
         self.upper = 0  # MFP[15..8] levels
 
     @property
@@ -343,7 +373,7 @@ class ChipPins:
     def step(self, **pins: int) -> dict[str, int]:
         self.pins.update(pins)
         self.pins["do1"] = self.line.popleft() if self.line else wire.IDLE_LEVEL
-        self.rows.append([self.pins[name] for name in CORE_INPUTS])
+        self.rows.append([self.pins[name] for name in (*CORE_INPUTS, *OPTICAL_LINES)])
         out = self.chip.step(self.pins)
         self.outputs.append(out)
         return out
@@ -361,7 +391,13 @@ class ChipPins:
     def stimulus(self) -> CycleMatrix:
         from supi3.verif.straps import strap_stimulus  # Amaranth: only when a bench runs
 
-        return strap_stimulus(self.config, np.array(self.rows, dtype=np.int64))
+        rows = np.array(self.rows, dtype=np.int64)
+        return strap_stimulus(self.config, rows[:, : len(CORE_INPUTS)], rows[:, len(CORE_INPUTS) :])
+
+    def strobe(self, **optical: int) -> None:
+        """One clock with optical line strobes (the optical block's line side, :class:`OpticalScript`'s layout)."""
+        self.step(**optical)
+        self.pins.update(dict.fromkeys(optical, 0))
 
 
 class Firmware:
@@ -605,3 +641,50 @@ def counter_counts(trace: npt.NDArray[np.integer], cpb: int) -> list[int | None]
     telegrams, _, _ = receive(trace, 0, cpb)
     return [wire.counter_count(t.data) if t.cycle is Cycle.ID and t.check else None
             for t in telegrams if isinstance(t, wire.Telegram) and t.data is not None]  # fmt: skip
+
+
+# The optical block inside the chip core (tests/test_model_pins_optical.py, tests/test_rtl_core_optical.py) --------
+
+OpticalOp = tuple[Any, ...]
+"""One step of an optical scenario at chip level: ``("reset", present)`` an INTERBUS reset with the interfaces in use,
+``("resp", interface, response)``, ``("test", interface, ack1, ack2)``, ``("length", interface, clocks, medium)``,
+``("timeout",)`` the 6 ms budget passing, ``("id", command)`` an ID cycle with a command word."""
+
+
+def optical_ops(mode: OpticalMode) -> list[OpticalOp]:
+    """A scenario through every optical transition the chip core sees in ``mode`` (regulation or diagnostics): an
+    INTERBUS reset with IN and OUT in use, an ID cycle during the hold, the initialization responses ("Light on",
+    "Light off", none), online tests moving the MAU warnings, optical status requests (OPT-50) and the ID cycles
+    that answer them, a length measurement; then a reset with the branch alone, left to the 6 ms time-out."""
+    ask = wire.command_word(optical_request=True)
+    ops: list[OpticalOp] = [("reset", 0b011), ("id", 0)]
+    if mode is OpticalMode.REGULATION:
+        ops += [("resp", Interface.IN, Response.DETECTED), ("resp", Interface.IN, Response.DETECTED),
+                ("resp", Interface.IN, Response.NOT_DETECTED), ("resp", Interface.OUT, Response.NONE)]  # fmt: skip
+    ops += [("id", ask), ("test", Interface.IN, False, True), ("test", Interface.OUT, False, False), ("id", ask),
+            ("id", ask), ("length", Interface.OUT, 160, 1), ("test", Interface.IN, True, True),
+            ("test", Interface.IN, True, True), ("test", Interface.IN, True, True), ("test", Interface.IN, True, True),
+            ("id", ask), ("id", 0), ("reset", 0b100), ("id", 0), ("timeout",), ("id", ask), ("id", 0)]  # fmt: skip
+    return ops
+
+
+def optical_script(config: DeviceConfig, ops: list[OpticalOp]) -> tuple[CoreScript, list[int]]:
+    """The core's stimulus of ``ops`` (:data:`OpticalOp`) and the cycle at which each op's part ends."""
+    script = CoreScript(config)
+    ends = []
+    for kind, *args in ops:
+        if kind == "reset":
+            script.line(IDLE, present=int(args[0])).line(wire.reset_levels(1)).line(IDLE)
+        elif kind == "resp":
+            script.response(int(args[0]), int(args[1])).line(IDLE)
+        elif kind == "test":
+            script.test(int(args[0]), bool(args[1]), bool(args[2])).line(IDLE)
+        elif kind == "length":
+            script.length(int(args[0]), int(args[1]), int(args[2])).line(IDLE)
+        elif kind == "timeout":
+            bits = -(-INIT_TIME_LIMIT_CLOCKS // wire.clocks_per_bit(config.bit_rate))
+            script.line(np.ones(bits, dtype=np.uint8)).line(IDLE)
+        else:
+            script.id_cycle(int(args[0]))
+        ends.append(sum(len(part["do1"]) for part in script.parts))
+    return script, ends

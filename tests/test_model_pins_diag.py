@@ -173,21 +173,26 @@ def test_led_inputs_reach_the_pins(c: str, diag_conf: int) -> None:
     # Table 3-16: FO1/FO2 on DIAG1/DIAG2 with limited diagnostics, RD on DIAG2 with complete; Table 2-8: a bus
     # terminal module's ALARM, LD, E, FO3 on MFP15, 14, 13, 8 whatever DIAG_CONF (DG-6).
     # FO1..FO3 come from the optical block (OPT-8): FO1 and FO3 lit, in READY by a fallback, in RUN by a MAU warning.
+    # At pin level the core's block does it, from its line side (OPT-26); at transaction level the chip's optical API.
     cfg = decode(c, clk_conf="11", diag_conf=diag_conf, rf="00")
     pins = Supi3Pins(cfg)
-    pins.run(CoreScript(cfg).bring_up().columns())
+    script = CoreScript(cfg).line(IDLE, present=0b101).line(wire.reset_levels(1)).line(IDLE)
+    pins.run(script.response(Interface.IN, Response.NONE).response(Interface.BRANCH, Response.NONE).inputs())
     leds = LedInputs(rd=True, ld=True, e=False, alarm=True)
     pins.chip.set_led_inputs(leds)
 
-    def light_fo1_and_fo3(chip: Supi3) -> None:
+    def alarm_and_ld(chip: Supi3) -> None:
         if chip.bus_terminal is not None:  # LD: the master switched the branch off (BK-11); ALARM set (BK-12)
             chip.bus_terminal.command(BranchControl.OFF, acknowledge=False, alarm=True)
+
+    def light_fo1_and_fo3(chip: Supi3) -> None:
+        alarm_and_ld(chip)
         chip.optical_start((True, False, True))
         response = Response.NOT_DETECTED if chip.bus_active else Response.NONE
         for interface in (Interface.IN, Interface.BRANCH):
             chip.optical_init_response(interface, response)
 
-    light_fo1_and_fo3(pins.chip)
+    alarm_and_ld(pins.chip)
     out = pins.run(quiet_inputs(50))
     view = pins.chip.diagnostic_outputs
     agrees(pins, out, view)

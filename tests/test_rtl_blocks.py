@@ -14,13 +14,14 @@ from supi3.rtl import core
 from supi3.rtl.core import DataPathRtl, FrameEngineRtl, OutputsRtl, ReceiverRtl, Supi3Core, TransmitterRtl
 from supi3.rtl.counter import CounterLinesRtl
 from supi3.rtl.expansion import ExpansionRtl
+from supi3.rtl.optical import OpticalRtl
 from supi3.rtl.serial_io import SerialIoRtl
 from supi3.rtl.tables import core_tables
 from supi3.rtl.terminal import TerminalRtl
 
 BLOCKS = {"receiver": ReceiverRtl, "frame": FrameEngineRtl, "datapath": DataPathRtl, "transmitter": TransmitterRtl,
           "outputs": OutputsRtl, "serial_io": SerialIoRtl, "expansion": ExpansionRtl,
-          "counter_lines": CounterLinesRtl, "terminal": TerminalRtl}  # fmt: skip
+          "counter_lines": CounterLinesRtl, "terminal": TerminalRtl, "optical": OpticalRtl}  # fmt: skip
 """Block name (the same in supi3.model; ``counter_lines``: ``Supi3Pins``'s ``LineCounters``, M17; ``terminal``: its
 state is the model chip's, supi3.model.bus_terminal) -> RTL component."""
 
@@ -35,7 +36,7 @@ def blocks() -> list[wiring.Component]:
     """One of each block, elaborated on its own (so none is left unused)."""
     tables = core_tables()
     made = [ReceiverRtl(tables), FrameEngineRtl(), DataPathRtl(tables), TransmitterRtl(tables), OutputsRtl(26),
-            SerialIoRtl(), ExpansionRtl(), CounterLinesRtl(), TerminalRtl()]  # fmt: skip
+            SerialIoRtl(), ExpansionRtl(), CounterLinesRtl(), TerminalRtl(), OpticalRtl()]  # fmt: skip
     for block in made:
         Fragment.get(block, None)
     return made

@@ -2,10 +2,10 @@
 (Supi3.diagnostic_outputs, supi3.diagnostics): manual 3.6.1 (Tables 3-16 to 3-19), Table 2-8, DG-1 to DG-8.
 
 On Amaranth's own simulator, the block alone: random sequences of the frame engine's events (latch, reset pattern,
-discard, idle time-out), of the LED inputs the core ties to 0 until the optical block and the bus terminal logic
-drive them, and of the IB_DIAG divider, applied to the block and to a transaction-level chip alike. The whole core
-runs the same outputs in the lockstep (tests/test_rtl_core.py: ``test_diagnostics_by_diag_conf``,
-``test_idle_timeout_diagnostics``).
+discard, idle time-out), of the LED inputs (in the core FO1..FO3 come from the optical block, the others are tied to 0
+until the bus terminal logic drives them), and of the IB_DIAG divider, applied to the block and to a transaction-level
+chip alike. The whole core runs the same outputs in the lockstep (tests/test_rtl_core.py:
+``test_diagnostics_by_diag_conf``, ``test_idle_timeout_diagnostics``).
 """
 
 from __future__ import annotations
@@ -49,7 +49,7 @@ def run(c: str, diag_conf: int, steps: list[Step]) -> None:
             ctx.set(f.latch_data, int(event == "latch"))
             ctx.set(f.clear, int(event in {"pattern", "timeout", "timeout_discard"}))
             ctx.set(dut.idle_timeout, int(event.startswith("timeout")))
-            ctx.set(dut.discard, int(event in {"discard", "timeout_discard"}))
+            ctx.set(dut.ended, int(event in {"latch", "discard", "timeout_discard"}))  # a cycle ended at the chip
             ctx.set(dut.fo, sum(int(v) << i for i, v in enumerate(leds.fo)))
             for name in ("rd", "ld", "e", "alarm"):
                 ctx.set(getattr(dut, name), int(getattr(leds, name)))
@@ -66,7 +66,7 @@ def run(c: str, diag_conf: int, steps: list[Step]) -> None:
             ctx.set(f.latch_data, 0)
             ctx.set(f.clear, 0)
             ctx.set(dut.idle_timeout, 0)
-            ctx.set(dut.discard, 0)
+            ctx.set(dut.ended, 0)
             # The block maps its LED inputs as the spec does; the chip's own view takes FO, LD and E from its optical
             # and bus terminal state (OPT-8, BK-11), so the expected view is the spec's function of the same inputs.
             view = diagnostic_outputs(config, supply_ok=True, line_heard=not chip.line_silent,

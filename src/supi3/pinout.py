@@ -23,6 +23,7 @@ from __future__ import annotations
 from typing import Final
 
 from supi3.interbus import wire
+from supi3.optical.regulation import BLOCK_INPUTS
 from supi3.pinlevel import Pin
 from supi3.regmap import INTERRUPT_SOURCES, REGISTER_MAP, Access, AccessDirection
 from supi3.regmap.core import BYTE_BITS
@@ -46,6 +47,8 @@ __all__ = [
     "IB_DIAG_DIVIDER_BITS",
     "LENGTH_CODE_BITS",
     "MFP_PINS",
+    "OPTICAL_CORE_DRIVEN",
+    "OPTICAL_LINE_INPUTS",
     "OPTICAL_REGISTERS",
     "RF_BITS",
     "STRAP_PINS",
@@ -119,6 +122,15 @@ STRAP_PINS: Final[tuple[Pin, ...]] = (
 )  # fmt: skip
 """The strap inputs beyond the core's pins (Tables 2-2, 2-4 to 2-7, 1-7, 3-16); MFP[15..12] are read from
 ``mfp_in`` in the configuration-expansion modes (Table 3-1)."""
+
+OPTICAL_CORE_DRIVEN: Final[tuple[str, ...]] = ("ib_reset", "mode", "fast", "run")
+"""The optical block's inputs the core drives (OPT-26): its INTERBUS reset, the mode of RF[1..0], the bit rate, the bus
+active (RUN)."""
+OPTICAL_LINE_INPUTS: Final[tuple[Pin, ...]] = tuple(pin for pin in BLOCK_INPUTS if pin.name not in OPTICAL_CORE_DRIVEN)
+"""The optical block's line side (the fibre transceivers and the regulation's analog part: interfaces in use, medium,
+initialization responses, online test results, length timer start and stop; :data:`supi3.optical.regulation.
+BLOCK_INPUTS`): inputs of the chip core beside :data:`CORE_INPUTS`, taken as they are at each clock (no synchroniser,
+OPT-26); 0 is quiet."""
 
 SYNC_STAGES: Final = 2
 """Every asynchronous input passes two flip-flops before use (M1)."""

@@ -25,7 +25,7 @@ from supi3 import pinout
 from supi3.checks import check_bits, check_bool, check_instance, check_int, check_trace, fail
 from supi3.config import DeviceConfig
 from supi3.model.chip import Supi3
-from supi3.model.pins import PinTrace, Supi3Pins, input_traces
+from supi3.model.pins import PinTrace, Supi3Pins, split_optical_traces
 from supi3.model.registers import RegisterFile
 from supi3.pinlevel import OE_SUFFIX, Pin
 from supi3.spi.slave_pins import QUIET_FOREVER, PinsIn, PinsOut, SlavePins
@@ -201,7 +201,8 @@ class Supi3Chip:
         run = self.core.run_forward if forward_only else self.core.run
         if upif is None:
             return run(inputs)
-        traces = input_traces(inputs)  # every trace checked before the first cycle runs
+        core, optical = split_optical_traces(inputs)  # every trace checked before the first cycle runs
+        traces = {**core, **optical}
         catch_up = _CatchUp(self, upif, traces["mfp_in"])
         with upif.registers.violations.deferred():
             out = run(traces, before=catch_up)

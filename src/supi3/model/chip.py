@@ -242,8 +242,8 @@ class Supi3:
     __slots__ = (
         "__dict__",  # room beyond the declared state, so that a test can spy on a chip's methods
         "_chain", "_cpb", "_deadline", "_due_s", "_events", "_exr_driver", "_exr_free", "_fast_valid", "_fixed_bytes",
-        "_frame_bytes", "_in_map", "_loaded", "_mau_events", "_mau_told", "_now", "_optical", "_optical_until", "_out",
-        "_out_map", "_send_alarm", "_send_optical",
+        "_frame_bytes", "_in_map", "_loaded", "_mau_events", "_mau_told", "_now", "_optical", "_optical_driven",
+        "_optical_held", "_optical_until", "_out", "_out_map", "_send_alarm", "_send_optical",
         "_serial_pins", "_shown", "_stat_err", "_stat_low_since", "_watch_line", "attention", "bus_active", "config",
         "due", "in_word", "io_access", "led_inputs", "line_interrupt", "line_silent", "mfp_in", "mod_ack_until", "pf",
         "registers", "resreg_until", "revision", "serial_device", "spi_sequences", "te", "watchdog_code", "wd",
@@ -278,6 +278,7 @@ class Supi3:
         self._init_serial()
         self._chain: ExternalRegisters | None = None
         self._exr_driver: ExpansionDriver | None = None
+        self._optical_driven = False  # pin level: the optical block makes every transition (_optical_drive, OPT-26)
         self._cpb = wire.clocks_per_bit(self.config.bit_rate)
         self._watch_line = watches_line_interrupt(self.config)
         self.led_inputs = LedInputs()
@@ -743,6 +744,7 @@ class Supi3:
     def _optical_power_up(self) -> None:
         """Power-up: every transmitter off, no length measured, no MAU report waiting."""
         self._optical_until: int = _NEVER
+        self._optical_held = False
         self._optical: OpticalStatus = OpticalStatus()
         self._mau_told = self._mau_events = (False, False, False)
         self._send_optical = False
@@ -784,7 +786,7 @@ class Supi3:
     def optical_holding(self) -> bool:
         """The protocol core is held in reset (1.6): a transmitter still initializes and the 6 ms budget, counted
         from :meth:`optical_start` in the chip's time (the last bus call), has not run out."""
-        return self._optical_until != _NEVER and self._now < self._optical_until
+        return self._optical_held or (self._optical_until != _NEVER and self._now < self._optical_until)
 
     def optical_start(self, present: tuple[bool, bool, bool], now: float | None = None) -> None:
         """The end of the INTERBUS reset (1.6): every interface starts (:func:`~supi3.optical.regulation.start`)
@@ -871,13 +873,16 @@ class Supi3:
 
     def _optical_reset(self) -> None:
         """INTERBUS reset: every transmitter off for the reset period (1.6); the lengths stay (OPT-21); the master
-        forgets the MAU warnings with its configuration, so does the chip (OPT-53)."""
-        self._optical_apply(lambda _tx: regulation.Transmitter())
+        forgets the MAU warnings with its configuration, so does the chip (OPT-53). At pin level the block turns its
+        transmitters off itself (OPT-26)."""
+        if not self._optical_driven:
+            self._optical_apply(lambda _tx: regulation.Transmitter())
         self._mau_told = self._mau_events = (False, False, False)
         self._send_optical = False
 
-    def _optical_set(self, status: OpticalStatus) -> None:
-        """Take ``status``; the hold ends once no transmitter initializes; reads 8..11 follow (3.4.12)."""
+    def _optical_set(self, status: OpticalStatus, report: bool = True) -> None:
+        """Take ``status``; the hold ends once no transmitter initializes; reads 8..11 follow (3.4.12). A MAU
+        change is an event for the master when ``report`` (not in the reset period: OPT-26, OPT-53)."""
         if status == self._optical:
             return
         old = self._optical.transmitters
@@ -885,7 +890,7 @@ class Supi3:
         self.revision += 1
         events = tuple(e or new.mau != was.mau for e, new, was in zip(self._mau_events, status.transmitters, old,
                                                                        strict=True))  # fmt: skip
-        if events != self._mau_events:  # a MAU warning came on or went off: an event for the master (OPT-53)
+        if report and events != self._mau_events:  # a MAU warning came on or went off: an event for the master (OPT-53)
             self._mau_events = (events[0], events[1], events[2])
             self.attention = True
         if not any(tx.phase is Phase.INIT for tx in status.transmitters):
@@ -893,9 +898,19 @@ class Supi3:
         self._optical_publish()
         self._reschedule()
 
+    def _optical_drive(self, status: OpticalStatus, hold: bool, report: bool) -> None:
+        """Pin level (:class:`supi3.model.pins.Supi3Pins`, OPT-26): the optical block's ``status`` and ``hold`` after
+        a clock edge. The block makes every transition; the chip takes its status for the ID path (OPT-50..OPT-53),
+        the FO LEDs and the hold (OPT-20); a MAU change is an event when ``report`` (the block was not in reset).
+        Reads 8..11 reach the register file through the block's ``optical_we`` port, a clock later."""
+        self._optical_held = hold
+        if status is not self._optical:
+            self._optical_set(status, report)
+
     def _optical_publish(self) -> None:
-        """Reads 8..11 into the register file (µP modes; the other modes have none, 3.4.12, 3.4.13)."""
-        if self.registers is not None:
+        """Reads 8..11 into the register file (µP modes; the other modes have none, 3.4.12, 3.4.13); at pin level
+        the block writes them (``optical_we``, OPT-26)."""
+        if self.registers is not None and not self._optical_driven:
             for name, value in zip(OPTICAL_REGISTERS, regulation.registers(self._optical), strict=True):
                 self.registers.set_optical(name, value)
 
@@ -1017,7 +1032,7 @@ class Supi3:
         self._line_heard()
         if clk >= self.due:
             self._expire(clk)
-        if self._optical_until != _NEVER:  # optical block: the core is held in reset, latches nothing (OPT-20)
+        if self._optical_until != _NEVER or self._optical_held:  # optical block: held in reset, no latch (OPT-20)
             return
         events = self._events
         if cycle is Cycle.DATA:
@@ -1072,7 +1087,7 @@ class Supi3:
             clk = _clock(clk)
         self._advance(clk)
         self._line_heard()
-        if self._optical_until != _NEVER:  # optical block: the core is held in reset (OPT-20)
+        if self._optical_until != _NEVER or self._optical_held:  # optical block: the core is held in reset (OPT-20)
             return
         self.te = self.te or local_error
         if self.expansion:

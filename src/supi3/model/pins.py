@@ -26,6 +26,7 @@ pin                   dir  meaning
 ``resu_n``            in   /ResU as seen from outside: 0 while something pulls it low (1.7.2)
 ``vmon_ok``           in   the voltage monitor's output: 1 above 4.5 V, 0 below 3.9 V (1.7.2)
 ``from_exr``          in   FromExR, the register expansion's serial input (3.5, Table 3-14; 0 = nothing attached)
+``present`` ...       in   the optical block's line side, :data:`~supi3.pinout.OPTICAL_LINE_INPUTS` (optional, below)
 ``do2``               out  INTERBUS forward line out (Table 1-4 DO2_CU)
 ``di1``               out  INTERBUS return line out to the previous device (Table 1-4 DI1_CU)
 ``mfp_out``           out  levels driven on MFP[15..0] (undriven bits 0)
@@ -41,6 +42,16 @@ pin                   dir  meaning
 ``la_ou_d``           out  LaOuD, the external output registers take the chain (high pulse)
 ``la_in_d_n``         out  /LaInD, the chain takes the external input registers (low pulse)
 ====================  ===  =============================================================================
+
+The optical regulation block (1.6, 3.4.12, 3.4.13; OPT-26 of ``docs/assumptions/optical.md``): with RF = 00 or 01
+(:attr:`Supi3.optical_mode <supi3.model.chip.Supi3.optical_mode>`) the core owns an
+:class:`~supi3.model.blocks.optical.OpticalBlock` clocked with it. Its line side (:data:`~supi3.pinout.
+OPTICAL_LINE_INPUTS`) may be given with the pins above, to :meth:`Supi3Pins.step` and :meth:`Supi3Pins.run`, all or
+none (none: 0, quiet); its ``ib_reset`` is the core's INTERBUS reset period (the reset on the line, or the idle
+time-out until the line is heard), ``mode`` and ``fast`` come from the straps, ``run`` is the bus active. At each edge
+the block's status goes to the chip (``Supi3._optical_drive``): its ``hold`` holds the protocol core (OPT-20), its FO
+LEDs are the outputs block's, its MAU warnings the optical status byte of the ID path (OPT-50..OPT-53); its
+``optical_we`` writes reads 8..11 into the register file.
 """
 
 from __future__ import annotations
@@ -60,6 +71,7 @@ from supi3.model.blocks.counter import LineCounters
 from supi3.model.blocks.datapath import DataPath
 from supi3.model.blocks.expansion import Expansion
 from supi3.model.blocks.frame import FrameEngine
+from supi3.model.blocks.optical import OpticalBlock
 from supi3.model.blocks.outputs import Outputs, Snapshot
 from supi3.model.blocks.receiver import (
     IDLE_INPUTS,
@@ -75,9 +87,10 @@ from supi3.model.blocks.receiver import (
 from supi3.model.blocks.serial_io import SerialIo
 from supi3.model.blocks.transmitter import NEVER, PinTrace, Transmitter
 from supi3.model.chip import Supi3
+from supi3.optical.regulation import OpticalMode
 from supi3.pinlevel import EventLog, Pin
-from supi3.pinout import CORE_OUTPUTS, IB_DIAG_DIVIDER_BITS, SYNC_STAGES
-from supi3.tables import CLOCK_HZ, RESET_MIN_S
+from supi3.pinout import CORE_OUTPUTS, IB_DIAG_DIVIDER_BITS, OPTICAL_LINE_INPUTS, OPTICAL_REGISTERS, SYNC_STAGES
+from supi3.tables import BIT_RATES, CLOCK_HZ, RESET_MIN_S
 from supi3.terminal import CONF_PIN
 
 __all__ = [
@@ -92,10 +105,47 @@ __all__ = [
     "check_names",
     "input_row",
     "input_traces",
+    "split_optical",
+    "split_optical_traces",
 ]
 
 RESET_STRETCH_CLOCKS: Final = round(RESET_MIN_S * CLOCK_HZ)
 """The internal reset lasts 128 clocks (4 µs, 1.7.2) after its last source went away (M2)."""
+
+_OPTICAL_WIDTHS: Final[dict[str, int]] = {pin.name: pin.width for pin in OPTICAL_LINE_INPUTS}
+_OPTICAL_QUIET: Final[dict[str, int]] = dict.fromkeys(_OPTICAL_WIDTHS, 0)
+_OPTICAL_STROBES: Final = ("resp_valid", "test_valid", "len_start", "len_stop")
+
+
+def split_optical(inputs: object) -> tuple[object, dict[str, int] | None]:
+    """The core's pins of one cycle and, if ``inputs`` names the optical line side too, its levels (checked: each an
+    integer within its pin's width); otherwise ``inputs`` unchanged and ``None``."""
+    if not isinstance(inputs, Mapping) or len(inputs) != len(INPUT_PINS) + len(_OPTICAL_WIDTHS) or any(
+            name not in inputs for name in _OPTICAL_WIDTHS):  # fmt: skip
+        return inputs, None
+    optical = {name: check_bits(f"pin {name!r}", inputs[name], width) for name, width in _OPTICAL_WIDTHS.items()}
+    return {name: value for name, value in inputs.items() if name not in _OPTICAL_WIDTHS}, optical
+
+
+def split_optical_traces(inputs: object) -> tuple[dict[str, npt.NDArray[np.integer]], dict[str, npt.NDArray[np.int64]]]:
+    """:func:`input_traces` of the core's pins, and the optical line side's traces (checked, as long as the others;
+    zeros when ``inputs`` does not name them)."""
+    if isinstance(inputs, Mapping) and any(name in inputs for name in _OPTICAL_WIDTHS):
+        core = input_traces({name: value for name, value in inputs.items() if name not in _OPTICAL_WIDTHS})
+        n = len(core["do1"])
+        optical = {}
+        for name, width in _OPTICAL_WIDTHS.items():
+            if name not in inputs:
+                raise fail("inputs", f"a mapping with every optical line pin ({', '.join(_OPTICAL_WIDTHS)}) or none",
+                           inputs, f"without {name!r}")
+            trace = check_trace(f"pin {name!r} trace", inputs[name], width)
+            if len(trace) != n:
+                raise fail(f"len(pin {name!r} trace)", f"{n}, the length of pin 'do1' trace", len(trace))
+            optical[name] = trace.astype(np.int64, copy=False)
+        return core, optical
+    core = input_traces(inputs)
+    n = len(core["do1"])
+    return core, {name: np.zeros(n, dtype=np.int64) for name in _OPTICAL_WIDTHS}
 
 
 class Supi3Pins:
@@ -125,14 +175,17 @@ class Supi3Pins:
     """
 
     __slots__ = (
-        "_counters", "_datapath", "_expansion", "_frame", "_holding", "_outputs", "_power_ups", "_receiver",
-        "_recording", "_return_start", "_run_from", "_serial", "_stat_active", "_synced_run", "_transmitter", "chip",
+        "_counters", "_datapath", "_expansion", "_frame", "_holding", "_optical", "_optical_at", "_optical_fixed",
+        "_outputs", "_power_ups", "_receiver", "_recording",
+        "_return_start", "_run_from", "_serial", "_stat_active", "_synced_run", "_transmitter", "chip",
         "complete_diagnostics",
         "config", "cpb", "cycle", "forward_delay", "log", "mfp_oe", "rbst_by_pin", "reset_run",
     )  # fmt: skip
 
     inputs: Sequence[Pin] = INPUT_PINS
     outputs: Sequence[Pin] = CORE_OUTPUTS
+    optical_inputs: Sequence[Pin] = OPTICAL_LINE_INPUTS
+    """The optical block's line side, inputs that may be given with :attr:`inputs` (see the module docstring)."""
 
     def __init__(self, config: DeviceConfig, chip: Supi3 | None = None) -> None:
         check_instance("config", config, DeviceConfig)
@@ -164,6 +217,12 @@ class Supi3Pins:
         self._outputs = Outputs(self.chip, self._transmitter, self.cpb, self.mfp_oe, self._serial)
         # LBD modes (Table 2-5): the counter telegram blocks on DO2 and, in LBD-MR, DI1 (M17).
         self._counters = LineCounters.of(config)
+        # The optical block (1.6) with RF = 00 or 01; it makes every optical transition, the chip takes its status.
+        mode = self.chip.optical_mode
+        self._optical = OpticalBlock() if mode is not OpticalMode.OFF else None
+        self.chip._optical_driven = self._optical is not None
+        self._optical_fixed = {"mode": int(mode), "fast": BIT_RATES.index(config.bit_rate)}
+        """The block's inputs from the straps."""
         self.reset()
 
     # ------------------------------------------------------------------------------------------------------------
@@ -209,6 +268,10 @@ class Supi3Pins:
         self._expansion.power_up(self.cycle)
         if self._counters is not None and not self._recording:  # a run replays its power-ups (_run_forward)
             self._counters.power_up(self.cycle, run_from)
+        if self._optical is not None:
+            self._optical.reset()
+        self._optical_at = run_from
+        """The cycle whose edge the optical block takes next (it catches up in one go, OpticalBlock.quiet)."""
 
     # ------------------------------------------------------------------------------------------------------------
     # One clock: step()
@@ -228,6 +291,9 @@ class Supi3Pins:
         ArgumentError
             A pin missing or unknown, or a level that is not such an integer (:func:`input_row`); nothing changes.
         """
+        optical = None
+        if type(inputs) is not dict or len(inputs) != len(INPUT_PINS):
+            inputs, optical = split_optical(inputs)  # type: ignore[assignment]
         try:
             do1, di2, rbst = inputs["do1"], inputs["di2"], inputs["rbst_ext"]
             mfp, stat, resu, vmon = inputs["mfp_in"], inputs["stat_err_n"], inputs["resu_n"], inputs["vmon_ok"]
@@ -254,7 +320,7 @@ class Supi3Pins:
             source = self._counters.show(c, outputs, row.di2, tx.next_present)
             self._counters.clock(source, synced.do1 if running else None)
         if c >= self._run_from or self._holding or not (synced.resu_n and synced.vmon_ok):
-            self._tick(c, synced, synced.do1)
+            self._tick(c, synced, synced.do1, optical or _OPTICAL_QUIET)
             if c >= self._run_from:
                 tx.next_present = bool(synced.rbst_ext) if tx.rbst_by_pin else tx.next_present or bool(synced.di2)
         if len(tx.bits) > 8:  # tested here, not in trim(): one call less per step()
@@ -290,9 +356,10 @@ class Supi3Pins:
     # The per-cycle logic, shared by step() and run()
     # ------------------------------------------------------------------------------------------------------------
 
-    def _tick(self, c: int, s: Synced, line: int) -> None:
+    def _tick(self, c: int, s: Synced, line: int, optical: Mapping[str, int]) -> None:
         """The rising edge at the end of cycle ``c``, with the synchronised inputs ``s`` of that cycle; ``line`` is
-        their ``do1`` (given apart, since :meth:`run` keeps the line as a trace of its own)."""
+        their ``do1`` (given apart, since :meth:`run` keeps the line as a trace of its own); ``optical``: the
+        optical block's line side in that cycle."""
         if not (s.resu_n and s.vmon_ok):
             if not self._holding:
                 self.log.add(c, "power-up reset")
@@ -323,7 +390,41 @@ class Supi3Pins:
         if serial is not None and c >= serial.due:
             serial.clock(c, s.mfp_in)
         self._expansion.from_exr = s.from_exr
+        if self._optical is None:
+            self._receiver.clock(line, c)
+            return
+        resetting = self._frame.in_reset or chip.line_silent
         self._receiver.clock(line, c)
+        self._optical_edge(c, resetting, optical)
+
+    def _optical_edge(self, c: int, resetting: bool, line: Mapping[str, int]) -> None:
+        """The optical block's edge ending cycle ``c`` (after the core's: the core saw the hold of the cycle), with
+        the line side ``line``; ``resetting``: the core's INTERBUS reset period before the core's edge (OPT-26)."""
+        block = self._optical
+        assert block is not None
+        chip = self.chip
+        # ib_reset: the INTERBUS reset period, this cycle included: the reset on the line (from the edge detecting it
+        # to the one ending it) or the idle time-out until the line is heard (the RTL's in_reset | idle_timeout |
+        # line_silent).
+        ib = int(resetting or self._frame.in_reset or chip.line_silent)
+        values = {**line, **self._optical_fixed, "ib_reset": ib, "run": int(chip.bus_active)}
+        if c > self._optical_at:
+            block.quiet(c - self._optical_at, {**values, **_OPTICAL_QUIET, "ib_reset": int(resetting)})
+        shown = block.outputs_now(values["run"])
+        written = shown["optical_we"]
+        if written and chip.registers is not None:  # the register file takes reads 8..11 (TO_REGISTER_FILE ports)
+            for k, name in enumerate(OPTICAL_REGISTERS):
+                if written >> k & 1:
+                    chip.registers.set_optical(name, shown["optical"] >> (8 * k) & 0xFF)
+        block.edge(values)
+        self._optical_at = c + 1
+        chip._optical_drive(block.status, block.hold, not ib)
+
+    def _optical_due(self, c: int) -> int:
+        """The next cycle the optical block needs a visit after the edge ending cycle ``c`` (:meth:`run`)."""
+        assert self._optical is not None
+        due = self._optical.next_change(int(self._frame.in_reset or self.chip.line_silent))
+        return NEVER if due is None else c + 1 + due
 
     # ------------------------------------------------------------------------------------------------------------
     # Many clocks: run()
@@ -352,8 +453,8 @@ class Supi3Pins:
             A pin missing or unknown, a trace not such a sequence, a value out of range (with its index), or traces
             of different lengths (:func:`input_traces`); nothing changes.
         """
-        raw = input_traces(inputs)
-        traces = self._run_forward(raw, before)
+        raw, optical = split_optical_traces(inputs)
+        traces = self._run_forward(raw, optical, before)
         traces["di1"] = self._return_line(raw["di2"].astype(np.int64, copy=False), traces["do2"])
         return traces
 
@@ -371,9 +472,9 @@ class Supi3Pins:
         """:meth:`run` without ``di1``: the chip's logic does not depend on DI2 beyond the return line's
         pass-through, so a ring runs every chip forward first and then the return line backwards
         (:meth:`return_line`). The ``di2`` trace given here is checked but not used."""
-        return self._run_forward(input_traces(inputs), before)
+        return self._run_forward(*split_optical_traces(inputs), before)
 
-    def _run_forward(self, raw: Mapping[str, npt.NDArray[np.integer]],
+    def _run_forward(self, raw: Mapping[str, npt.NDArray[np.integer]], optical: Mapping[str, npt.NDArray[np.int64]],
                      before: Callable[[int], object] | None) -> dict[str, PinTrace]:
         # The run kernel: the event scheduler over the blocks' per-cycle logic. It stays flat on purpose (one loop,
         # locals for what it reads every visit): its cost per visited cycle is the run() rate (bench/bench_model.py).
@@ -397,6 +498,12 @@ class Supi3Pins:
         if self.chip.bus_terminal is not None:  # a BK's CONF edges (BK-8)
             conf = synced["mfp_in"] >> CONF_PIN & 1
             change[1:] |= conf[1:] != conf[:-1]
+        block = self._optical
+        if block is not None:  # the optical block's line side: every strobe and every change of a level
+            for name, trace in optical.items():
+                change[1:] |= trace[1:] != trace[:-1]
+                if name in _OPTICAL_STROBES:
+                    change |= trace != 0
         # Input events: cycles where a synchronised input the logic reads changes. A change of the line (do1) only
         # matters while the receiver waits for a start bit: in a telegram the receiver acts at its due cycles
         # (mid-bit samples), and the one thing a line change does there, marking where a run of start level began
@@ -426,6 +533,8 @@ class Supi3Pins:
         due = next_due(c0 - 1, int(line[0]), self._run_from) if n else NEVER
         if serial is not None and serial.due < due:
             due = max(serial.due, c0)
+        if block is not None and self._optical_at != NEVER:  # a change the block showed before this run
+            due = min(due, max(self._optical_due(self._optical_at - 1), c0))
         t = -1
         while True:
             while other_events[k] <= t:
@@ -447,13 +556,16 @@ class Supi3Pins:
             if c >= self._run_from or self._holding or not (s.resu_n and s.vmon_ok):
                 if before is not None:
                     before(t)
-                self._tick(c, s, level)
+                self._tick(c, s, level, {name: trace.item(t) for name, trace in optical.items()}
+                           if block is not None else _OPTICAL_QUIET)  # fmt: skip
             if chip.revision != shown or self._run_from != run_from:
                 shown, run_from = chip.revision, self._run_from
                 snaps.append((t + 1, outputs.snapshot(run_from)))
             due = next_due(c, level, self._run_from)
             if serial is not None and serial.due < due:
                 due = serial.due if serial.due > c else c + 1
+            if block is not None and c >= self._run_from:
+                due = min(due, self._optical_due(c))
         if n and c0 + n - 1 >= self._run_from:
             restore_low_run(n - 1, int(line[n - 1]), self._run_from)
         self._recording = False

@@ -25,7 +25,16 @@ from amaranth.lib.wiring import In, Out
 from supi3.config import Variant
 from supi3.errors import ArgumentError
 from supi3.pinlevel import OE_SUFFIX
-from supi3.pinout import CORE_INPUTS, CORE_OUTPUTS, STRAP_PINS, UP_INPUTS, UP_OUTPUTS, UP_PINS, up_input_port
+from supi3.pinout import (
+    CORE_INPUTS,
+    CORE_OUTPUTS,
+    OPTICAL_LINE_INPUTS,
+    STRAP_PINS,
+    UP_INPUTS,
+    UP_OUTPUTS,
+    UP_PINS,
+    up_input_port,
+)
 from supi3.rtl.core import REGISTER_FILE_INPUTS, REGISTER_FILE_OUTPUTS, Supi3Core
 from supi3.rtl.tables import check_variant
 from supi3.rtl.upif import UpifBlock
@@ -34,8 +43,8 @@ __all__ = ["Supi3ChipRtl", "rtlil", "verilog"]
 
 
 class Supi3ChipRtl(wiring.Component):
-    """The SUPI 3 chip with the pins of the model ``supi3.top.Supi3Chip`` (:mod:`supi3.pinout`) and the strap ports of
-    :class:`~supi3.rtl.core.Supi3Core`.
+    """The SUPI 3 chip with the pins of the model ``supi3.top.Supi3Chip`` (:mod:`supi3.pinout`), the strap ports of
+    :class:`~supi3.rtl.core.Supi3Core` and its optical block's line side (:data:`~supi3.pinout.OPTICAL_LINE_INPUTS`).
 
     Parameters
     ----------
@@ -49,7 +58,8 @@ class Supi3ChipRtl(wiring.Component):
         except ArgumentError:
             self._MustUse__silence = True  # rejected, never elaborated: no "created but never used" warning
             raise
-        members: dict[str, object] = {pin.name: In(pin.width) for pin in (*CORE_INPUTS, *STRAP_PINS)}
+        inputs = (*CORE_INPUTS, *STRAP_PINS, *OPTICAL_LINE_INPUTS)
+        members: dict[str, object] = {pin.name: In(pin.width) for pin in inputs}
         members.update({pin.name: Out(pin.width) for pin in CORE_OUTPUTS})
         super().__init__(members)
 
@@ -57,7 +67,7 @@ class Supi3ChipRtl(wiring.Component):
         m = Module()
         m.submodules.core = core = Supi3Core(self.variant, register_file=True)
         m.submodules.upif = upif = UpifBlock()
-        for pin in (*CORE_INPUTS, *STRAP_PINS):
+        for pin in (*CORE_INPUTS, *STRAP_PINS, *OPTICAL_LINE_INPUTS):
             m.d.comb += getattr(core, pin.name).eq(getattr(self, pin.name))
         for pin in CORE_OUTPUTS:
             m.d.comb += getattr(self, pin.name).eq(getattr(core, pin.name))

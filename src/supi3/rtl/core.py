@@ -47,6 +47,7 @@ from supi3.expansion import PULSE_T0
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusError
 from supi3.lbd import clocks_per_bit
+from supi3.optical.regulation import OpticalMode
 from supi3.pinlevel import Pin
 from supi3.pinout import (
     BLOCK_STRAPS,
@@ -58,6 +59,7 @@ from supi3.pinout import (
     FROM_REGISTER_FILE,
     IB_DIAG_DIVIDER_BITS,
     MFP_PINS,
+    OPTICAL_LINE_INPUTS,
     STRAP_PINS,
     SYNC_STAGES,
     TO_REGISTER_FILE,
@@ -67,6 +69,7 @@ from supi3.regmap.core import BYTE_BITS
 from supi3.rtl.counter import CounterLinesRtl, lbd_lines
 from supi3.rtl.expansion import PIN_NAMES as EXPANSION_PINS
 from supi3.rtl.expansion import ExpansionRtl
+from supi3.rtl.optical import OpticalRtl
 from supi3.rtl.serial_io import DIRECTIONS, SER_IN_PIN, WIDTHS, SerialIoRtl
 from supi3.rtl.tables import (
     IDLE_TIMEOUT_CLOCKS,
@@ -83,7 +86,7 @@ from supi3.rtl.tables import (
 )
 from supi3.rtl.terminal import TerminalRtl
 from supi3.rtl.upif import upif_tables
-from supi3.tables import BIT_RATES
+from supi3.tables import BIT_RATES, RF_MODES, RfMode
 from supi3.terminal import CONF_PIN, LBST_PIN, TerminalMode
 
 __all__ = [
@@ -111,9 +114,11 @@ REGISTER_FILE_INPUTS: Final = tuple(
 REGISTER_FILE_OUTPUTS: Final = (
     *BLOCK_STRAPS,
     *(pin for pin in TO_REGISTER_FILE
-      if pin.name in ("power_up", "ib_reset", "events", "io_access", "latch", "latch_out", "pcmd_we", "pcmd")),
+      if pin.name in ("power_up", "ib_reset", "events", "io_access", "latch", "latch_out", "pcmd_we", "pcmd",
+                      "optical_we", "optical")),
 )  # fmt: skip
-"""What the core gives the register file (the block's inputs of the same names; the optical ones stay 0)."""
+"""What the core gives the register file (the block's inputs of the same names; reads 8..11 from the optical
+block)."""
 
 WORD_BITS: Final = 8 * len(wire.word_bytes(0))
 """16-bit words: ID register, command word, CRC, CNTR (docs/interbus.md A4)."""
@@ -141,6 +146,18 @@ def _code_bytes(code: int) -> int:
 
 def _width(value: int) -> int:
     return max(1, value.bit_length())
+
+
+def _optical_mode(row: RfMode) -> OpticalMode:
+    """The optical block's mode for a row of Table 2-2 (OPT-2): regulation, diagnostics on fibre without it, else
+    off (copper)."""
+    if row.optical_regulation:
+        return OpticalMode.REGULATION
+    return OpticalMode.DIAGNOSTIC if row.medium == _FIBRE else OpticalMode.OFF
+
+
+_FIBRE: Final = next(row.medium for row in RF_MODES if row.optical_regulation)
+"""Table 2-2's medium of the fibre optic rows."""
 
 
 _POSITION: Final = range(wire.DATA_TELEGRAM_BITS + 1)
@@ -218,7 +235,7 @@ class Supi3Core(wiring.Component):
             raise
         self.tables = core_tables(self.variant)
         members: dict[str, object] = {}
-        for pin in (*CORE_INPUTS, *STRAP_PINS, *(REGISTER_FILE_INPUTS if register_file else ())):
+        for pin in (*CORE_INPUTS, *STRAP_PINS, *OPTICAL_LINE_INPUTS, *(REGISTER_FILE_INPUTS if register_file else ())):
             members[pin.name] = In(pin.width)
         for pin in (*CORE_OUTPUTS, *((*REGISTER_FILE_OUTPUTS, Pin("init_up")) if register_file else ())):
             members[pin.name] = Out(pin.width)
@@ -304,6 +321,7 @@ class Supi3Core(wiring.Component):
         outputs = OutputsRtl(len(cycle))
         serial_io = SerialIoRtl()
         expansion = ExpansionRtl()
+        optical = OpticalRtl()
 
         # The power-up reset with its stretch (1.7.2, M2), from the synchronised /ResU and voltage monitor ---------
         power_fail = ~(receiver.resu_n_s & receiver.vmon_ok_s)
@@ -360,6 +378,7 @@ class Supi3Core(wiring.Component):
             outputs.alarm.eq(terminal.alarm),
             outputs.bk_attention.eq(terminal.attention),
         ]
+        m.submodules.optical = gated(optical)
 
         # Joins between the blocks: connect() where the interfaces fit ---------------------------------------------
         wiring.connect(m, receiver=receiver.line, frame=frame.line)
@@ -389,7 +408,31 @@ class Supi3Core(wiring.Component):
             outputs.local_bus.eq(local_bus),
             outputs.bus_terminal.eq(bus_terminal),
             outputs.idle_timeout.eq(receiver.line.idle_timeout),
-            outputs.discard.eq(frame.discard),
+            outputs.ended.eq(frame.ended),
+        ]
+
+        # The optical block (1.6, OPT-26): RF[1..0] selects its mode (the LS has none); its INTERBUS reset is the
+        # reset period (the reset on the line, or the idle time-out until the line is heard); it holds the protocol
+        # core (OPT-20: no latch, discard, event), lights FO1..FO3, writes reads 8..11 and gives the MAU warnings of
+        # the optical status byte (OPT-50..OPT-53).
+        optical_mode = Signal(range(len(OpticalMode)))
+        if self.variant is Variant.OPC:
+            with m.Switch(self.rf):
+                for row in RF_MODES:
+                    with m.Case(int(row.rf, 2)):
+                        m.d.comb += optical_mode.eq(_optical_mode(row))
+        m.d.comb += [
+            *(getattr(optical, pin.name).eq(getattr(self, pin.name)) for pin in OPTICAL_LINE_INPUTS),
+            optical.ib_reset.eq(receiver.line.in_reset | receiver.line.idle_timeout | outputs.line_silent),
+            optical.mode.eq(optical_mode),
+            optical.fast.eq(rate == BIT_RATES.index(max(BIT_RATES))),
+            optical.run.eq(outputs.bus_active),
+            frame.hold.eq(optical.hold),
+            outputs.fo.eq(optical.fo),  # DG-7
+            outputs.mau.eq(optical.mau),
+            outputs.optical_quiet.eq(optical.ib_reset),
+            datapath.optical_send.eq(outputs.send_optical),
+            datapath.optical_mau.eq(outputs.mau_sent),
         ]
 
         # SPI master modes (3.3): the serial I/O block takes the OUT word of a valid data cycle's latch and gives
@@ -433,7 +476,7 @@ class Supi3Core(wiring.Component):
             expansion.load_id.eq(register.load_id),
             expansion.shift.eq(register.shift),
             expansion.level.eq(register.level),
-            expansion.ended.eq(management.latch_data | management.latch_id | frame.discard),
+            expansion.ended.eq(management.latch_data | management.latch_id | (frame.discard & ~optical.hold)),
             expansion.latched.eq(management.latch_data),
             expansion.from_exr.eq(receiver.from_exr_s),
             datapath.chain.eq(expansion.active),
@@ -479,6 +522,8 @@ class Supi3Core(wiring.Component):
                 self.latch_out.eq(datapath.register),
                 self.pcmd_we.eq(running & frame.management.latch_id & command[wire.CMD_PCMD_BIT]),
                 self.pcmd.eq(Mux(frame.management.latch_id, command[wire.CMD_PCMD_SHIFT :][:BYTE_BITS], 0)),
+                self.optical_we.eq(optical.optical_we),
+                self.optical.eq(optical.optical),
             ]
 
         m.d.comb += [
@@ -618,6 +663,7 @@ class FrameEngineRtl(wiring.Component):
         super().__init__({
             "line": In(LINE), "register": Out(REGISTER), "management": Out(MANAGEMENT), "tx": Out(TRANSMIT),
             "events": Out(EVENT_BITS), "io": Out(1), "io_set": Out(1), "io_clear": Out(1), "discard": Out(1),
+            "hold": In(1), "ended": Out(1),
         })  # fmt: skip
 
     def elaborate(self, _platform: object) -> Module:
@@ -625,7 +671,7 @@ class FrameEngineRtl(wiring.Component):
         sync, comb = m.d.sync, m.d.comb
         rx, reg, mg, tx = self.line, self.register, self.management, self.tx
         line = rx.level
-        events = self.events
+        events = Signal(EVENT_BITS)  # the frame's interrupt sources; none while the optical block holds the core
 
         def event(source: str) -> Value:
             return events[_SOURCE_BIT[source]].eq(1)
@@ -660,7 +706,8 @@ class FrameEngineRtl(wiring.Component):
         discard = self.discard  # a frame ends unlatched (chip.discard_at): the invalid-data-cycle event
         io = self.io
         sync += io.eq(self.io_set | (io & ~self.io_clear))
-        comb += [tx.push.eq(rx.sample), tx.level.eq(line), reg.level.eq(line), mg.frame_error.eq(~idle & local_error)]
+        comb += [tx.push.eq(rx.sample), tx.level.eq(line), reg.level.eq(line),
+                 mg.frame_error.eq(~idle & local_error & ~self.hold)]  # fmt: skip
 
         # INTERBUS reset and idle time-out: the frame is dropped, the chip reset (chip.reset_at)
         clear = rx.bus_reset | rx.idle_timeout
@@ -677,7 +724,7 @@ class FrameEngineRtl(wiring.Component):
 
         def abandon() -> None:
             """A frame ends unlatched: invalid cycle, TE |= local error (Table 3-13)."""
-            m.d.comb += [discard.eq(~idle), self.io_clear.eq(1), mg.abandon.eq(1)]
+            m.d.comb += [discard.eq(~idle), self.io_clear.eq(1), mg.abandon.eq(~self.hold)]
             m.d.sync += latches.eq(0)
 
         data_field = (rx.position >= wire.POS_DATA) & (rx.position < wire.POS_DATA + 8)
@@ -761,10 +808,14 @@ class FrameEngineRtl(wiring.Component):
                         sync += latches.eq(0)
                         comb += [latch_done.eq(1), self.io_clear.eq(1), event("PCP_TX")]
                         with m.If(id_cycle):  # the command word (docs/interbus.md A9)
-                            comb += [mg.latch_id.eq(1), event("ID_CYCLE")]
+                            comb += [mg.latch_id.eq(~self.hold), event("ID_CYCLE")]
                         with m.Else():  # OUT data to the MFPs (Tables 3-1, 3-2), watchdog restarted
-                            comb += [mg.latch_data.eq(1), reg.latch.eq(1), event("VALID"), event("PCP_RX")]
+                            comb += [mg.latch_data.eq(~self.hold), reg.latch.eq(~self.hold), event("VALID"),
+                                     event("PCP_RX")]  # fmt: skip
         comb += events[_SOURCE_BIT["INVALID"]].eq(discard & ~id_cycle)
+        # The optical block's hold (OPT-20): the core behaves as in reset, a cycle's end latches nothing, raises no
+        # event, sets no TE; the line is still heard (``ended``: a cycle ended at the chip, DG-3, DG-4).
+        comb += [self.events.eq(Mux(self.hold, 0, events)), self.ended.eq(discard | latch_done)]
 
         # The states (the model's _state), later transitions winning as later assignments do
         with m.FSM(name="frame") as fsm:
@@ -816,7 +867,7 @@ class DataPathRtl(wiring.Component):
             "frame": In(REGISTER), "words": Out(WORDS),
             "id_register": In(WORD_BITS), "data_bytes": In(range(tables.register_bits // 8 + 1)), "external": In(1),
             "in_data": In(tables.register_bits), "io_map": In(range(len(tables.io_maps))), "mfp_in": In(MFP_PINS),
-            "chain": In(1), "chain_bit": In(1),
+            "chain": In(1), "chain_bit": In(1), "optical_send": In(1), "optical_mau": In(len(wire.MAU_WARNINGS)),
             "register": Out(tables.register_bits), "mfp_out": Out(MFP_PINS),
         })  # fmt: skip
 
@@ -838,6 +889,13 @@ class DataPathRtl(wiring.Component):
 
         id_word = Signal(WORD_BITS)
         comb += id_word.eq(self.id_register | words.status)
+        # The optical status byte in place of the ID code when the master asked (OPT-50, OPT-51: wire.optical_status)
+        none = (False,) * len(wire.MAU_WARNINGS)
+        status = Const(wire.optical_status(none), BYTE_BITS)
+        for i in range(len(none)):
+            status |= Mux(self.optical_mau[i], wire.optical_status(tuple(k == i for k in range(len(none)))), 0)
+        with m.If(self.optical_send):
+            comb += id_word.eq(Cat(status, self.id_register[BYTE_BITS:]) | words.status)
         in_word = Signal(reg_bits)
         with m.Switch(self.io_map):
             for k, (in_pins, _) in enumerate(self.tables.io_maps):
@@ -924,12 +982,13 @@ class OutputsRtl(wiring.Component):
     the master's reset pattern comes), DIAG1/DIAG2 (BA/RD or FO1/FO2 by ``complete_diag``, Table 3-16), /ResReg
     low while the line is silent (RC, DG-4), IB_DIAG flashing from the free-running ``divider`` (Table 3-18, M6,
     DG-1, DG-2), and a bus terminal module's ALARM, LD, E and FO3 on ``mfp_diag`` (Table 2-8). ``fo`` (the optical
-    block's FO1..FO3), ``rd``, ``ld``, ``e`` and ``alarm`` are ``supi3.diagnostics.LedInputs``: the core ties them
-    to 0 until the blocks that drive them are in (``ld``, ``e``, ``alarm`` come from the bus terminal block);
-    ``bk_attention``, that block's waiting report, joins the attention bit. The chip registers follow
-    ``model.chip.Supi3``; the frame engine drives them through ``frame`` (:data:`MANAGEMENT`, flipped) and
-    ``discard``, and ``words`` (:data:`WORDS`, flipped) gives the data path the management bits and the watchdog's
-    reset and takes the command word.
+    block's FO1..FO3), ``rd``, ``ld``, ``e`` and ``alarm`` are ``supi3.diagnostics.LedInputs``: ``fo`` is the optical
+    block's (DG-7), ``ld``, ``e`` and ``alarm`` come from the bus terminal block, ``rd`` is tied to 0 until the logic
+    that drives it is in; ``bk_attention``, the bus terminal block's waiting report, joins the attention bit. The MAU
+    warnings of the optical block (``mau``) make the optical status byte's events and ATTN (``send_optical``,
+    ``mau_sent``; OPT-50..OPT-53). The chip registers follow ``model.chip.Supi3``; the frame engine drives them
+    through ``frame`` (:data:`MANAGEMENT`, flipped) and ``ended``, and ``words`` (:data:`WORDS`, flipped) gives the
+    data path the management bits and the watchdog's reset and takes the command word.
     """
 
     def __init__(self, divider_bits: int) -> None:
@@ -938,10 +997,13 @@ class OutputsRtl(wiring.Component):
             "stat_err_n_s": In(1), "di2_s": In(1), "rbst_ext_s": In(1), "di2": In(1), "do2": In(1),
             "divider": In(divider_bits), "rbst_by_pin": In(1), "complete_diag": In(1),
             "expansion": In(1), "expansion_pulse": In(range(_EXPANSION_PULSE_MAX + 1)),
-            "local_bus": In(1), "bus_terminal": In(1), "idle_timeout": In(1), "discard": In(1),
+            "local_bus": In(1), "bus_terminal": In(1), "idle_timeout": In(1), "ended": In(1),
             "fo": In(3), "rd": In(1), "ld": In(1), "e": In(1), "alarm": In(1), "bk_attention": In(1),
+            "mau": In(len(wire.MAU_WARNINGS)), "optical_quiet": In(1),
             "send_alarm": Out(1), "di1": Out(1), "mod_ack_n": Out(1), "res_reg_n": Out(1), "diag1": Out(1),
             "diag2": Out(1), "ib_diag": Out(1), "mfp_diag": Out(MFP_PINS),
+            "bus_active": Out(1), "line_silent": Out(1), "send_optical": Out(1),
+            "mau_sent": Out(len(wire.MAU_WARNINGS)),
         })  # fmt: skip
 
     def elaborate(self, _platform: object) -> Module:
@@ -949,7 +1011,8 @@ class OutputsRtl(wiring.Component):
         sync, comb = m.d.sync, m.d.comb
         f, words = self.frame, self.words
         stat = ~self.stat_err_n_s
-        pf, wd, te, attention, bus_active = Signal(), Signal(), Signal(), Signal(), Signal()
+        pf, wd, te, attention = Signal(), Signal(), Signal(), Signal()
+        bus_active = self.bus_active
         next_present = Signal()
 
         # The model calls chip._advance at the start of every running clock: the /StatErr filter and the watchdog.
@@ -986,12 +1049,23 @@ class OutputsRtl(wiring.Component):
         with m.If(res_reg != 0):
             sync += res_reg.eq(res_reg - 1)
         # RC (DG-4): /ResReg is low while the incoming line is silent, too.
-        line_silent, line_interrupt = Signal(), Signal()
+        line_silent, line_interrupt = self.line_silent, Signal()
         comb += [self.mod_ack_n.eq(mod_ack == 0), self.res_reg_n.eq((res_reg == 0) & ~line_silent)]
+
+        # MAU warnings to the master (OPT-50..OPT-53; model.chip._optical_set, _optical_command, _optical_reset):
+        # ``told`` what the master last read, ``events`` which changed since; a change of the optical block's ``mau``
+        # at an edge out of its reset period (``optical_quiet``) is an event, seen here from the next clock on.
+        warnings = len(wire.MAU_WARNINGS)
+        told, events, mau_seen, quiet_seen = Signal(warnings), Signal(warnings), Signal(warnings), Signal()
+        send_optical = self.send_optical
+        pending = Mux(quiet_seen, 0, self.mau ^ mau_seen)
+        events_now = events | pending
+        sync += [mau_seen.eq(self.mau), quiet_seen.eq(self.optical_quiet), events.eq(events_now)]
+        comb += self.mau_sent.eq(told ^ events_now)
 
         pf_now = pf | filtered
         wd_now = wd | fire
-        attention_now = attention | (filtered & ~pf) | fire
+        attention_now = attention | (filtered & ~pf) | fire | (pending & ~events).any()
         sync += [pf.eq(pf_now), wd.eq(wd_now), attention.eq(attention_now)]
         with m.If(fire):  # the watchdog resets process data (Table 3-13); 4 t0 with the register expansion (RX-5)
             sync += [wd_active.eq(0), res_reg.eq(Mux(self.expansion, self.expansion_pulse, RESREG_PULSE_CLOCKS))]
@@ -1014,6 +1088,9 @@ class OutputsRtl(wiring.Component):
                 attention.eq(pf_now),
                 bus_active.eq(0),
                 self.send_alarm.eq(0),
+                told.eq(0),
+                events.eq(0),
+                send_optical.eq(0),
             ]
         te_now = te | f.frame_error
         comb += [
@@ -1030,13 +1107,18 @@ class OutputsRtl(wiring.Component):
                 sync += [wd_code.eq(code), *arm(code)]
             with m.If(command[wire.CMD_QUIT_BIT]):  # Quit Peripheral Error (3.6.2)
                 sync += [pf.eq(module_error), mod_ack.eq(MODACK_PULSE_CLOCKS)]
-            sync += [wd.eq(0), te.eq(0), attention.eq(0)]
+            # OPT-50, OPT-53: the status byte sent in this cycle is read; the next request; ATTN while an event waits
+            told_next = Mux(send_optical, told ^ events_now, told)
+            events_next = Mux(send_optical, self.mau ^ told_next, events_now)
+            request = command[wire.CMD_OPTICAL_BIT] & ~command[wire.CMD_PCMD_BIT] & ~command[wire.CMD_ALARM_BIT]
+            sync += [wd.eq(0), te.eq(0), attention.eq(events_next.any()), told.eq(told_next), events.eq(events_next),
+                     send_optical.eq(request)]  # fmt: skip
         with m.If(f.latch_data):  # a valid data cycle: the bus is active, the watchdog restarted
             sync += [bus_active.eq(1), *arm(wd_code)]
 
         # The line is heard (chip._line_heard): a cycle ends at the chip, or the master's reset pattern comes; the
         # idle time-out (chip.line_timeout_at) comes after the frame it abandons, so it wins (DG-3, DG-4).
-        heard = (f.clear & ~self.idle_timeout) | self.discard | f.latch_id | f.latch_data
+        heard = (f.clear & ~self.idle_timeout) | self.ended
         with m.If(heard):
             sync += [line_silent.eq(0), line_interrupt.eq(0)]
         with m.If(self.idle_timeout):

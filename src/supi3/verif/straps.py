@@ -17,7 +17,7 @@ import numpy.typing as npt
 
 from supi3.checks import check_bits, check_instance, fail
 from supi3.config import DeviceConfig, Variant, decode, mode_rows
-from supi3.model.pins import Supi3Pins, check_names, input_row, input_traces
+from supi3.model.pins import Supi3Pins, check_names, input_row, input_traces, split_optical, split_optical_traces
 from supi3.pinlevel import Pin, PinSpecError
 from supi3.rtl.core import STRAP_PINS
 from supi3.rtl.tables import EXPANSION_BITS, MFP_PINS, check_variant
@@ -28,7 +28,17 @@ __all__ = ["ChipStrapPins", "StrapPins", "strap_inputs", "strap_stimulus"]
 _STRAP_NAMES = tuple(pin.name for pin in STRAP_PINS)
 _CORE_NAMES = tuple(pin.name for pin in Supi3Pins.inputs)
 """The model's own pins: its step() takes exactly these (the straps are this wrapper's)."""
-_ALL_NAMES = (*_CORE_NAMES, *_STRAP_NAMES)
+_OPTICAL_NAMES = tuple(pin.name for pin in Supi3Pins.optical_inputs)
+"""The optical block's line side: the model's step() and run() take them with its pins."""
+_ALL_NAMES = (*_CORE_NAMES, *_STRAP_NAMES, *_OPTICAL_NAMES)
+_BOARD_NAMES = (*_CORE_NAMES, *_STRAP_NAMES)
+"""What a caller may give without the optical line side (quiet then, as :class:`Supi3Pins` takes it)."""
+
+
+def _names(inputs: object) -> tuple[str, ...]:
+    """The input names ``inputs`` must have: with the optical line side if it names any of it."""
+    optical = isinstance(inputs, Mapping) and any(name in inputs for name in _OPTICAL_NAMES)
+    return _ALL_NAMES if optical else _BOARD_NAMES
 _EXPANSION_SHIFT = MFP_PINS - EXPANSION_BITS
 
 
@@ -53,9 +63,11 @@ def strap_inputs(config: DeviceConfig) -> dict[str, int]:
     return values
 
 
-def strap_stimulus(config: DeviceConfig, stimulus: npt.NDArray[np.integer]) -> npt.NDArray[np.uint64]:
+def strap_stimulus(config: DeviceConfig, stimulus: npt.NDArray[np.integer],
+                   optical: npt.NDArray[np.integer] | None = None) -> npt.NDArray[np.uint64]:  # fmt: skip
     """``stimulus`` (``(cycles, model inputs)`` in :attr:`Supi3Pins.inputs` order) with the strap columns appended
-    and MFP[15..12] forced to the configuration expansion where the mode has one.
+    and MFP[15..12] forced to the configuration expansion where the mode has one, then the optical block's line side
+    (``optical``: ``(cycles, lines)`` in :attr:`Supi3Pins.optical_inputs` order; zeros, quiet, if ``None``).
 
     Raises
     ------
@@ -75,7 +87,13 @@ def strap_stimulus(config: DeviceConfig, stimulus: npt.NDArray[np.integer]) -> n
         low = np.uint64((1 << _EXPANSION_SHIFT) - 1)
         array[:, mfp] = (array[:, mfp] & low) | np.uint64(values["mfp_expansion"] << _EXPANSION_SHIFT)
     straps = np.tile(np.array([values[name] for name in _STRAP_NAMES], dtype=np.uint64), (array.shape[0], 1))
-    return np.concatenate([array, straps], axis=1)
+    lines = np.zeros((array.shape[0], len(_OPTICAL_NAMES)), dtype=np.uint64)
+    if optical is not None:
+        given_lines = np.asarray(optical)
+        if given_lines.shape != lines.shape or (given_lines.size and given_lines.dtype.kind not in "iu"):
+            raise fail("optical", f"a 2-D integer array of {lines.shape} in Supi3Pins.optical_inputs order", optical)
+        lines = given_lines.astype(np.uint64)
+    return np.concatenate([array, straps, lines], axis=1)
 
 
 _STRAP_WIDTHS = {pin.name: pin.width for pin in STRAP_PINS}
@@ -93,16 +111,17 @@ def _straps_of(inputs: object) -> dict[str, int]:
 
 
 def _strap_values(inputs: Mapping[str, int]) -> tuple[int, ...]:
-    """The strap values of one clock; every name of :attr:`StrapPins.inputs` exactly, else a named error."""
-    if not isinstance(inputs, Mapping) or len(inputs) != len(StrapPins.inputs) \
-            or any(name not in inputs for name in _ALL_NAMES):
-        check_names("inputs", inputs, _ALL_NAMES)
+    """The strap values of one clock; every name of :attr:`StrapPins.inputs` exactly (the optical line side may be
+    left out), else a named error."""
+    if not isinstance(inputs, Mapping) or len(inputs) != len(_names(inputs)) \
+            or any(name not in inputs for name in _names(inputs)):
+        check_names("inputs", inputs, _names(inputs))
     return tuple(check_bits(f"pin {name!r}", inputs[name], width) for name, width in _STRAP_WIDTHS.items())
 
 
 def _first_row(inputs: object) -> dict[str, int]:
     """The straps and ``mfp_in`` of the first cycle of whole traces, checked (the model's ``run`` checks the rest)."""
-    mapping = check_names("inputs", inputs, _ALL_NAMES)
+    mapping = check_names("inputs", inputs, _names(inputs))
     first = {}
     for name, width in {**_STRAP_WIDTHS, "mfp_in": MFP_PINS}.items():
         trace = np.asarray(mapping[name])
@@ -117,7 +136,8 @@ def _checked_run(inputs: object) -> tuple[dict[str, int], dict[str, npt.NDArray[
     (:func:`~supi3.model.pins.input_traces`); the straps must be constant."""
     first = _first_row(inputs)
     assert isinstance(inputs, Mapping)
-    core = input_traces({name: inputs[name] for name in _CORE_NAMES})
+    split = split_optical_traces({name: inputs[name] for name in (*_CORE_NAMES, *_OPTICAL_NAMES) if name in inputs})
+    core = {**split[0], **split[1]}
     for name in _STRAP_NAMES:
         trace = np.asarray(inputs[name])
         if len(trace) != len(core["do1"]):
@@ -141,7 +161,7 @@ class StrapPins:
         From :meth:`step`, when the straps of the first clock select no operating mode, or change later.
     """
 
-    inputs: Sequence[Pin] = (*Supi3Pins.inputs, *STRAP_PINS)
+    inputs: Sequence[Pin] = (*Supi3Pins.inputs, *STRAP_PINS, *Supi3Pins.optical_inputs)
     outputs: Sequence[Pin] = Supi3Pins.outputs
 
     def __init__(self, variant: Variant | str = Variant.OPC) -> None:
@@ -187,9 +207,9 @@ class StrapPins:
             ``inputs`` does not name exactly :attr:`inputs`, or a value is not an integer within its pin's width.
         """
         straps = _strap_values(inputs)
-        core = {name: inputs[name] for name in _CORE_NAMES}
+        core = {name: inputs[name] for name in (*_CORE_NAMES, *_OPTICAL_NAMES) if name in inputs}
         if self.pins is None:
-            input_row(core)  # checked before the model is built: a rejected call changes nothing
+            input_row(split_optical(core)[0])  # checked before the model is built: a rejected call changes nothing
             self.pins = Supi3Pins(self.config_for(inputs))
             self._straps = straps
         elif straps != self._straps:
@@ -257,9 +277,9 @@ class ChipStrapPins:
             ``inputs`` does not name exactly :attr:`inputs`, or a value is not an integer within its pin's width.
         """
         straps = _strap_values(inputs)
-        core = {name: inputs[name] for name in _CORE_NAMES}
+        core = {name: inputs[name] for name in (*_CORE_NAMES, *_OPTICAL_NAMES) if name in inputs}
         if self.chip is None:
-            input_row(core)  # checked before the model is built: a rejected call changes nothing
+            input_row(split_optical(core)[0])  # checked before the model is built: a rejected call changes nothing
         return self._model(straps, inputs).step(core)
 
     def run(self, inputs: Mapping[str, npt.NDArray[np.integer]]) -> dict[str, npt.NDArray[np.int64]]:

@@ -154,6 +154,12 @@ class OpticalBlock:
             width (nothing changes).
         """
         values = _checked(inputs)
+        outputs = self.outputs_now(values["run"])
+        self.edge(values)
+        return outputs
+
+    def outputs_now(self, run: int) -> dict[str, int]:
+        """The outputs during the current cycle (they depend on the state and ``run``, the master in RUN)."""
         status = self.status
         if status is not self._outputs_of:  # recomputed only when the status changed
             txs = status.transmitters
@@ -166,19 +172,52 @@ class OpticalBlock:
             self._outputs_of = status
         regs = self._regs
         shown = self._shown
-        outputs = {
+        return {
             "optical_we": 0 if regs is shown else sum(1 << k for k in range(len(regs)) if regs[k] != shown[k]),
             "optical": self._optical,
             "mau": self._mau,
-            "fo": self._fo[values["run"]],
+            "fo": self._fo[run],
             "hold": self._hold,
         }
+
+    def edge(self, values: Mapping[str, int]) -> None:
+        """The clock edge ending the current cycle, with that cycle's inputs ``values`` (checked by the caller: every
+        input pin, each within its width); :meth:`outputs_now` must have been called in the cycle (it keeps what the
+        cycle showed for ``optical_we``)."""
         if self._in_reset or self.countdown or any(values[name] for name in _STROBES) or any(
                 timer.running for timer in self._timers):  # fmt: skip
             self._edge(values)
-        self._shown = regs
+        self._shown = self._regs
         self.cycle += 1
-        return outputs
+
+    def quiet(self, n: int, values: Mapping[str, int]) -> None:
+        """``n`` clocks (outputs and edges) with the inputs ``values`` held, which must have no strobe but possibly
+        ``ib_reset``: the same state as ``n`` :meth:`step` calls, in one go once only the counters move (the 6 ms
+        counter and the length timers; the event-driven pin level, :meth:`supi3.model.pins.Supi3Pins.run`)."""
+        run = values["run"]
+        while n > 0 and not (self._in_reset == bool(values["ib_reset"]) and not 0 < self.countdown <= n
+                             and self._outputs_of is self.status and self._shown is self._regs):  # fmt: skip
+            self.outputs_now(run)
+            self.edge(values)
+            n -= 1
+        if n <= 0:
+            return
+        if not self._in_reset:  # no edge changes the status: the counters move by n (OPT-24, OPT-25)
+            self.countdown = max(self.countdown - n, 0)
+            every = length_timer_enable_every(BIT_RATES[values["fast"]])
+            for timer in self._timers:
+                if timer.running:
+                    ticks, timer.prescale = divmod(timer.prescale + n, every)
+                    timer.count = min(timer.count + ticks, (1 << LENGTH_COUNT_BITS) - 1)
+        self.cycle += n
+
+    def next_change(self, ib_reset: int) -> int | None:
+        """Edges from the current cycle to the first that changes the status with ``ib_reset`` held and no strobe
+        (the start after an INTERBUS reset, the 6 ms budget's end), or 0 when the current cycle shows a change to the
+        register file (``optical_we``); ``None`` if none does (the event-driven pin level visits these cycles)."""
+        if self._outputs_of is not self.status or self._in_reset != bool(ib_reset):
+            return 0
+        return self.countdown - 1 if self.countdown else None
 
     def _edge(self, v: Mapping[str, int]) -> None:
         """The clock edge ending the cycle with inputs ``v`` (the order of the module docstring)."""
