@@ -54,9 +54,9 @@ CASES: list[tuple[str, Callable[[], object], str]] = [
     ("step mode 4", lambda: TerminalBlock(5).step({**QUIET, "mode": 4}), "pin 'mode'"),
     ("step mode True", lambda: TerminalBlock(5).step({**QUIET, "mode": True}), "pin 'mode'"),
     ("step count 64", lambda: TerminalBlock(5).step({**QUIET, "mode": 1, "count": 64}), "pin 'count'"),
-    ("step lbst None", lambda: TerminalBlock(5).step({**QUIET, "lbst": None}), "pin 'lbst'"),
+    ("step lbst None", lambda: TerminalBlock(5).step({**QUIET, "lbst": bad(None)}), "pin 'lbst'"),
     ("step rf -1", lambda: TerminalBlock(5).step({**QUIET, "rf": -1}), "pin 'rf'"),
-    ("step conf 1.0", lambda: TerminalBlock(5).step({**QUIET, "conf": 1.0}), "pin 'conf'"),
+    ("step conf 1.0", lambda: TerminalBlock(5).step({**QUIET, "conf": bad(1.0)}), "pin 'conf'"),
     ("step a pin missing", lambda: TerminalBlock(5).step({"mode": 1}), "inputs"),
     ("step an extra pin", lambda: TerminalBlock(5).step({**QUIET, "x": 0}), "inputs"),
     ("step None", lambda: TerminalBlock(5).step(bad(None)), "inputs"),
@@ -72,8 +72,8 @@ def test_hostile_arguments_give_named_errors(call: Callable[[], object], name: s
 
 def test_numpy_integers_pass_as_integers() -> None:
     """numpy integers are integers (supi3.checks): accepted wherever an int is, never refused as a wrong type."""
-    assert TerminalBlock(np.int64(5)).time_limit == 5
-    assert bk.rf_of(np.int64(1)) == "01" and bk.received(S, np.int16(3)).count == 3
+    assert TerminalBlock(bad(np.int64(5))).time_limit == 5
+    assert bk.rf_of(bad(np.int64(1))) == "01" and bk.received(S, bad(np.int16(3))).count == 3
 
 
 def test_a_refused_step_changes_nothing() -> None:
