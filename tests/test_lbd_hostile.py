@@ -22,7 +22,7 @@ from supi3.interbus import wire
 from supi3.interbus.master import Master
 from supi3.interbus.wire import Cycle
 from supi3.lbd import CounterState
-from supi3.model.blocks.counter import CounterBlock
+from supi3.model.blocks.counter import CounterBlock, LineCounters
 from supi3.model.pinring import PinRing
 from supi3.model.pins import Supi3Pins
 from support import bad
@@ -54,6 +54,9 @@ CASES: list[tuple[str, Callable[[], object], str]] = [
     ("CounterBlock.step list", lambda: CounterBlock().step(bad([1, 0])), "inputs"),
     ("CounterBlock.step extra", lambda: CounterBlock().step({"line": 1, "fast": 0, "x": 1}), "inputs"),
     ("CounterBlock.step missing", lambda: CounterBlock().step({"line": 1}), "inputs"),
+    *((f"LineCounters({f!r}, False)", lambda f=f: LineCounters(bad(f), False), "fast") for f in [2, -1, True, 1.0]),
+    *((f"LineCounters(0, {v!r})", lambda v=v: LineCounters(0, bad(v)), "looped") for v in [1, None, "yes"]),
+    *((f"LineCounters.of({v!r})", lambda v=v: LineCounters.of(bad(v)), "config") for v in [None, "LBD-MR"]),
 ]
 
 
