@@ -18,7 +18,7 @@ pytest.importorskip("elftools")
 from supi3.cli import main
 from supi3.errors import ArgumentError
 from supi3.mcu import build as mcu_build
-from supi3.mcu.board import Board
+from supi3.mcu.board import Board, FwBoard
 from supi3.mcu.core import CortexM, FirmwareError, FirmwareImage
 from supi3.mcu.session import run_firmware
 from support import bad
@@ -113,6 +113,20 @@ def test_hostile_arguments_give_named_errors(files: Path, call: Callable[[Path],
     with pytest.raises(ArgumentError, match=rf"^{re.escape(name)} must be .*, not ") as caught:
         call(files)
     assert caught.value.name == name
+
+
+@pytest.mark.parametrize(("attribute", "value"), [("inputs", 5), ("inputs", "ab"), ("inputs", None), ("fault", 2),
+                                                 ("fault", True)])  # fmt: skip
+def test_the_firmware_board_refuses_bad_terminals(files: Path, attribute: str, value: object) -> None:
+    """``FwBoard``'s input terminals are bytes (an int was taken as that many zero bytes), the fault flag 0 or 1;
+    nothing is written."""
+    image = FirmwareImage.load(files / "loop.elf")
+    core = CortexM(FirmwareImage(image.path, image.segments, image.entry, {"fw_board": (RAM_TOP - 0x1000, 36)}))
+    board = FwBoard(core)
+    board.inputs = b"\x12\x34\x56\x78"
+    with pytest.raises(ArgumentError, match=rf"^{attribute} must be "):
+        setattr(board, attribute, value)
+    assert (board.inputs, board.fault) == (b"\x12\x34\x56\x78", 0)
 
 
 def test_a_run_after_a_fault_stops_again_with_a_report(files: Path) -> None:
