@@ -84,6 +84,16 @@ CASES: list[Case] = [
       for v in [None, (1, 5), (FLASH, 0), (FLASH,), [FLASH, 0x10000], (FLASH, True), (0xFFFF_F000, 0x2000),
                 (0xE000_0000, 0x10000)]),
     ("CortexM ram over flash", lambda d: CortexM(d / "loop.elf", ram=(FLASH, 0x1000)), "ram"),
+    *((f"CortexM.step({v!r})", lambda d, v=v: CortexM(d / "loop.elf").step(bad(v)), "deadline")
+      for v in ["x", None, -5, 1.5]),
+    *((f"CortexM.reg({v!r})", lambda d, v=v: CortexM(d / "loop.elf").reg(bad(v)), "name")
+      for v in ["xx", None, "r0; x", ""]),
+    *((f"CortexM.set_reg r0 {v!r}", lambda d, v=v: CortexM(d / "loop.elf").set_reg("r0", bad(v)), "value")
+      for v in [-1, 1 << 32, 1.0, None]),
+    ("CortexM.write_bytes str", lambda d: CortexM(d / "loop.elf").write_bytes(RAM_TOP - 4, bad("ab")), "data"),
+    *((f"CortexM.pend({v!r})", lambda d, v=v: CortexM(d / "loop.elf").pend(bad(v)), "number")
+      for v in [999, -1, 0, 1, True]),
+    ("CortexM.backtrace(-1)", lambda d: CortexM(d / "loop.elf").backtrace(-1), "depth"),
     ("Board cycles -1", lambda d: Board(d / "loop.elf").run(-1), "cycles"),
     ("Board cycles 1.5", lambda d: Board(d / "loop.elf").run(bad(1.5)), "cycles"),
     ("Board max_instructions 0", lambda d: Board(d / "loop.elf").run(1, max_instructions=0), "max_instructions"),

@@ -34,7 +34,7 @@ import unicorn
 from unicorn import arm_const as arm
 from unicorn import unicorn_const as ucc
 
-from supi3.checks import check_real, fail
+from supi3.checks import check_bytes, check_int, check_real, fail
 from supi3.errors import ArgumentError, Supi3Error
 
 _UNICORN: Any = unicorn  # typed, but its Uc methods are not annotated
@@ -85,6 +85,8 @@ PENDSV: Final[int] = 14
 SYSTICK: Final[int] = 15
 EXTERNAL: Final[int] = 16
 """Exception number of IRQ 0 (B1.5.2)."""
+MAX_EXCEPTION: Final[int] = 511
+"""ARMv7-M B1.5.2: exception numbers up to 16 + 495 external interrupts (ARMv6-M has fewer; the NVIC ignores more)."""
 EXCEPTION_NAMES: Final[dict[int, str]] = {1: "Reset", 2: "NMI", 3: "HardFault", 4: "MemManage", 5: "BusFault",
                                           6: "UsageFault", 11: "SVCall", 12: "DebugMonitor", 14: "PendSV",
                                           15: "SysTick"}  # fmt: skip
@@ -391,6 +393,14 @@ def _frame_table(dwarf: Any) -> _FrameTable:
 # ------------------------------------------------------------------------------------------------------------
 
 
+def _register(name: object) -> int:
+    """Unicorn's number of the register ``name`` (``r0``, ``sp``, ``primask``, ...); else an ArgumentError."""
+    number = getattr(arm, f"UC_ARM_REG_{name.upper()}", None) if isinstance(name, str) and name.isalnum() else None
+    if not isinstance(number, int):
+        raise fail("name", "a register name (r0..r12, sp, lr, pc, xpsr, msp, psp, primask, control, ...)", name)
+    return number
+
+
 def _check_memories(image: FirmwareImage, flash: object, ram: object) -> None:
     """Refuse memories the emulator cannot map (whole pages within the address space, apart from each other and
     from the system control space) and an image with a segment outside them, by name."""
@@ -609,7 +619,7 @@ class CortexM:
 
     def write_bytes(self, address: int, data: bytes) -> None:
         """Write memory (RAM) from the host, between runs."""
-        self.uc.mem_write(address, data)
+        self.uc.mem_write(address, check_bytes("data", data))
 
     def fail(self, error: BaseException) -> None:
         """Stop at the end of the running block and raise ``error`` from :meth:`run` (the first one wins)."""
@@ -621,11 +631,11 @@ class CortexM:
 
     def reg(self, name: str) -> int:
         """One register by name (``r0``..``r12``, ``sp``, ``lr``, ``pc``, ``xpsr``, ``primask``, ``control``)."""
-        return int(self.uc.reg_read(getattr(arm, f"UC_ARM_REG_{name.upper()}")))
+        return int(self.uc.reg_read(_register(name)))
 
     def set_reg(self, name: str, value: int) -> None:
-        """Write one register by name (as :meth:`reg`), between runs."""
-        self.uc.reg_write(getattr(arm, f"UC_ARM_REG_{name.upper()}"), value)
+        """Write one register by name (as :meth:`reg`) with a 32-bit value, between runs."""
+        self.uc.reg_write(_register(name), check_int("value", value, 0, 0xFFFF_FFFF, "a 32-bit register"))
 
     def registers(self) -> dict[str, int]:
         """R0-R12, SP, LR, PC and xPSR."""
@@ -700,7 +710,7 @@ class CortexM:
 
     def pend(self, number: int) -> None:
         """Make exception ``number`` pending (an external interrupt: ``EXTERNAL + irq``)."""
-        self.pending.add(number)
+        self.pending.add(check_int("number", number, 2, MAX_EXCEPTION, "B1.5.2: NMI (2) up to the last interrupt"))
         self.sleeping = False if self._takeable() is not None else self.sleeping
 
     @property
@@ -848,7 +858,7 @@ class CortexM:
 
         A pending exception that may preempt (B1.5.4) is entered first; a sleeping core (WFI, or ``b .`` in thread
         mode: MCU-4) only lets the time pass."""
-        self.deadline = deadline
+        self.deadline = check_int("deadline", deadline, 0, limit="core cycles")
         number = self._takeable()
         if number is not None:
             self.enter(number)
@@ -935,6 +945,7 @@ class CortexM:
         """The call stack now, innermost first: the PC's function and line, then each caller's return address
         with the line of its call, unwound with the ELF's call frame information (``.debug_frame``) up to
         ``depth`` frames, a frame without that information, or an exception entry (LR = EXC_RETURN)."""
+        check_int("depth", depth, 1)
         image = self.image
         pc = self.pc
         frames = [Frame(pc, image.function_at(pc), image.line_at(pc))]
