@@ -595,7 +595,8 @@ def cmd_firmware_run(args: argparse.Namespace) -> None:
     from supi3.mcu.session import run_firmware
 
     if not Path(args.firmware).is_file():
-        raise CommandLineError(f"FIRMWARE must be an ELF file, not {_shown(args.firmware)} (no such file)")
+        reason = "not a file" if Path(args.firmware).exists() else "no such file"
+        raise CommandLineError(f"FIRMWARE must be an ELF file, not {_shown(args.firmware)} ({reason})")
     check_int("--cycles", args.cycles, 3, MAX_FIRMWARE_CYCLES)
     check_int("--cpu-hz", args.cpu_hz, 1_000_000, 1_000_000_000)
     check_int("--devices", args.devices, 1, 64)
@@ -617,13 +618,13 @@ def cmd_firmware_run(args: argparse.Namespace) -> None:
 def cmd_firmware_build(args: argparse.Namespace) -> None:
     """Build a firmware for the emulated board with the SDK's driver and board port (supi3.mcu.build)."""
     _firmware_extra()
-    from supi3.mcu.build import build
+    from supi3.mcu.build import MACRO_NAME, build
 
     out = output_file("-o/--output", args.output)
     defines = {}
     for text in args.defines:
         name, _, value = text.partition("=")
-        if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name, re.ASCII):
+        if not MACRO_NAME.fullmatch(name):
             raise CommandLineError(f"-D must be NAME or NAME=VALUE with a C identifier NAME, not {_shown(text)}")
         defines[name] = value if _ else "1"
     print(build(args.sources, out, cpu=args.cpu, defines=defines))

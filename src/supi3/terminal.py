@@ -59,6 +59,7 @@ __all__ = [
     "rf_code",
     "rf_of",
     "silence",
+    "silence_limit",
     "watching",
 ]
 
@@ -67,6 +68,13 @@ BRANCH_SILENCE_S: Final = 0.010
 a device takes silence for a reset (A13), so the remote bus behind the BK is closed again before it resets."""
 BRANCH_SILENCE_CLOCKS: Final = round(BRANCH_SILENCE_S * CLOCK_HZ)
 """:data:`BRANCH_SILENCE_S` in chip clocks (320,000 at 32 MHz): the pin-level silence timer's limit."""
+
+
+def silence_limit(time_limit: object) -> int:
+    """The pin-level silence timer's limit ``time_limit`` in clocks, checked: 1 up to :data:`BRANCH_SILENCE_CLOCKS`
+    (BK-3; shorter only so that a test reaches the closure quickly)."""
+    return check_int("time_limit", time_limit, 1, BRANCH_SILENCE_CLOCKS,
+                     "the 10 ms of BK-3 in clocks; shorter only to test the closure quickly")  # fmt: skip
 
 CONF_PIN: Final = next(p.pin for p in tables.BUS_TERMINAL_MFP if p.signal == "CONF")
 """MFP12 (Table 2-8)."""
@@ -97,6 +105,8 @@ class TerminalMode(IntEnum):
     def of(cls, interface: str | None) -> TerminalMode:
         """The mode of a chip interface (``"BK-RB"``, ``"BK-LB"``, ``"BK-LBD"``; anything else, ``None`` included,
         is :attr:`NONE`)."""
+        if interface is not None:
+            check_instance("interface", interface, str, "a chip interface name (a str) or None")
         if interface is None or interface not in TERMINAL_INTERFACES:
             return cls.NONE
         return cls(TERMINAL_INTERFACES.index(interface) + 1)

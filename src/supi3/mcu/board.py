@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Final
 
 from supi3 import timing
-from supi3.checks import check_int, check_real
+from supi3.checks import check_bytes, check_int, check_real
 from supi3.config import DeviceConfig
 from supi3.interbus.link import Device
 from supi3.mcu.core import EXTERNAL, CortexM, FirmwareImage, FirmwareStoppedError, Frame, SourceLine, Stop
@@ -155,7 +155,7 @@ class FwBoard:
 
     @inputs.setter
     def inputs(self, data: bytes) -> None:
-        self.core.write_bytes(self.address + self.INPUTS, bytes(data).ljust(4, b"\0")[:4])
+        self.core.write_bytes(self.address + self.INPUTS, check_bytes("inputs", data).ljust(4, b"\0")[:4])
 
     @property
     def outputs(self) -> bytes:

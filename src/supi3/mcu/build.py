@@ -14,23 +14,28 @@ docs/firmware-in-the-loop.md).
 from __future__ import annotations
 
 import importlib.util
+import re
 import subprocess
 import sys
 from collections.abc import Iterable, Mapping, Sequence
+from os import PathLike
 from pathlib import Path
 from typing import Final
 
 from supi3 import sdk
+from supi3.checks import fail
 from supi3.errors import ArgumentError, Supi3Error
-from supi3.mcu.core import CPUS
+from supi3.mcu.core import check_cpu
 
-__all__ = ["BOARD_DIR", "FLAGS", "BuildError", "build", "build_command", "toolchain_missing"]
+__all__ = ["BOARD_DIR", "FLAGS", "MACRO_NAME", "BuildError", "build", "build_command", "toolchain_missing"]
 
 BOARD_DIR: Final[Path] = sdk.SDK_DIR / "board"
 """The board port: ``board.h``, ``board.c``, ``startup.c``, ``board.ld``."""
 FLAGS: Final[tuple[str, ...]] = ("-target", "thumb-freestanding-eabi", "-ffreestanding", "-nostdlib",
                                  *sdk.CFLAGS, "-Werror", "-Os", "-g", "-Wl,--entry=Reset_Handler")  # fmt: skip
 """Flags of every firmware build besides ``-mcpu`` and the paths: the SDK's strict C99 flags, no library."""
+MACRO_NAME: Final[re.Pattern[str]] = re.compile(r"[A-Za-z_][A-Za-z0-9_]*", re.ASCII)
+"""A macro name of ``defines``: a C identifier."""
 
 
 class BuildError(Supi3Error, RuntimeError):
@@ -48,12 +53,19 @@ def build_command(sources: Sequence[str | Path], output: str | Path, *, cpu: str
                   defines: Mapping[str, str] | None = None, include_dirs: Iterable[str | Path] = (),
                   compiler_rt: bool = False, port: bool = True) -> list[str]:  # fmt: skip
     """The command line :func:`build` runs (see the module's docstring)."""
-    if cpu not in CPUS:
-        raise ArgumentError("cpu", cpu, f"cpu must be one of {', '.join(CPUS)}, not {cpu!r}")
+    check_cpu(cpu)
+    if isinstance(sources, str | bytes) or not isinstance(sources, Sequence) or not sources \
+            or not all(isinstance(s, str | PathLike) for s in sources):  # fmt: skip
+        raise fail("sources", "a non-empty sequence of paths of .c or .S files", sources)
     paths = [Path(s) for s in sources]
     for path in paths:
         if not path.is_file() or path.suffix not in (".c", ".S"):
             raise ArgumentError("sources", path, f"sources must be paths of existing .c or .S files, not {str(path)!r}")
+    for name, value in (defines or {}).items():
+        if not isinstance(name, str) or not MACRO_NAME.fullmatch(name) or not isinstance(value, str):
+            raise fail("defines", "a mapping of C identifiers to str values", {name: value})
+    if isinstance(include_dirs, str | bytes) or not isinstance(include_dirs, Iterable):
+        raise fail("include_dirs", "an iterable of folder paths", include_dirs)
     includes = (sdk.include_dir(), sdk.SDK_DIR / "examples", BOARD_DIR, *(Path(d) for d in include_dirs))
     macros = [f"-D{name}={value}" for name, value in sorted((defines or {}).items())]
     library = (BOARD_DIR / "startup.c", BOARD_DIR / "board.c", *sdk.sources()) if port else ()
@@ -80,7 +92,7 @@ def build(sources: str | Path | Sequence[str | Path], output: str | Path, *, cpu
     missing = toolchain_missing()
     if missing is not None:
         raise BuildError(missing)
-    files = [sources] if isinstance(sources, str | Path) else list(sources)
+    files = [sources] if isinstance(sources, str | PathLike) else sources
     command = build_command(files, output, cpu=cpu, defines=defines, include_dirs=include_dirs,
                             compiler_rt=compiler_rt, port=port)  # fmt: skip
     result = subprocess.run(command, capture_output=True, text=True, check=False)

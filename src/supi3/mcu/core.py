@@ -26,6 +26,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from enum import StrEnum
 from functools import cached_property
+from os import PathLike
 from pathlib import Path
 from typing import Any, Final
 
@@ -33,7 +34,7 @@ import unicorn
 from unicorn import arm_const as arm
 from unicorn import unicorn_const as ucc
 
-from supi3.checks import check_real
+from supi3.checks import check_bytes, check_int, check_real, fail
 from supi3.errors import ArgumentError, Supi3Error
 
 _UNICORN: Any = unicorn  # typed, but its Uc methods are not annotated
@@ -56,6 +57,7 @@ __all__ = [
     "StopReport",
     "SysTick",
     "block_cost",
+    "check_cpu",
     "countdown_register",
     "is_poll_loop",
 ]
@@ -83,12 +85,17 @@ PENDSV: Final[int] = 14
 SYSTICK: Final[int] = 15
 EXTERNAL: Final[int] = 16
 """Exception number of IRQ 0 (B1.5.2)."""
+MAX_EXCEPTION: Final[int] = 511
+"""ARMv7-M B1.5.2: exception numbers up to 16 + 495 external interrupts (ARMv6-M has fewer; the NVIC ignores more)."""
 EXCEPTION_NAMES: Final[dict[int, str]] = {1: "Reset", 2: "NMI", 3: "HardFault", 4: "MemManage", 5: "BusFault",
                                           6: "UsageFault", 11: "SVCall", 12: "DebugMonitor", 14: "PendSV",
                                           15: "SysTick"}  # fmt: skip
 
 SCS_BASE: Final[int] = 0xE000_E000
 SCS_SIZE: Final[int] = 0x1000
+_PAGE: Final[int] = 0x1000
+"""The emulator maps memory in 4 KiB pages: a memory's base and size are multiples of it."""
+_ADDRESS_SPACE: Final[int] = 1 << 32
 SYST_MAX: Final[int] = 0xFF_FFFF
 """SysTick is a 24-bit down counter (B3.3.1)."""
 BACKTRACE_DEPTH: Final[int] = 16
@@ -116,6 +123,14 @@ CPUS: Final[dict[str, Cpu]] = {
     "cortex_m0": Cpu("cortex_m0", arm.UC_CPU_ARM_CORTEX_M0, 0x410C_C200, 16, 16, vtor=False),
 }
 """The cores :class:`CortexM` emulates, by their ``-mcpu`` names."""
+
+
+def check_cpu(cpu: object) -> str:
+    """``cpu`` if it names a core of :data:`CPUS`; else an :class:`ArgumentError`."""
+    if isinstance(cpu, str) and cpu in CPUS:
+        return cpu
+    raise fail("cpu", f"one of {', '.join(CPUS)}", cpu)
+
 
 _REGS: Final[tuple[tuple[str, int], ...]] = (
     *((f"r{k}", getattr(arm, f"UC_ARM_REG_R{k}")) for k in range(13)),
@@ -244,6 +259,8 @@ class FirmwareImage:
         from elftools.elf.elffile import ELFFile
         from elftools.elf.sections import SymbolTableSection
 
+        if not isinstance(path, str | PathLike):
+            raise fail("path", "a path (str or os.PathLike)", path)
         path = Path(path)
         try:
             with path.open("rb") as stream:
@@ -260,6 +277,8 @@ class FirmwareImage:
                     if sym.name and not sym.name.startswith("$") and sym["st_shndx"] != "SHN_UNDEF"
                     and sym["st_info"]["type"] in ("STT_FUNC", "STT_OBJECT", "STT_NOTYPE")
                 }  # fmt: skip
+                if not segments:
+                    raise ArgumentError("path", path, f"path must be an ELF with a loadable segment, not {path}")
                 return cls(path, segments, int(elf["e_entry"]), symbols)
         except (OSError, ELFError) as error:
             raise ArgumentError("path", path, f"path must be a readable ELF file, not {path} ({error})") from error
@@ -372,6 +391,31 @@ def _frame_table(dwarf: Any) -> _FrameTable:
 # ------------------------------------------------------------------------------------------------------------
 # The timing model (MCU-1)
 # ------------------------------------------------------------------------------------------------------------
+
+
+def _register(name: object) -> int:
+    """Unicorn's number of the register ``name`` (``r0``, ``sp``, ``primask``, ...); else an ArgumentError."""
+    number = getattr(arm, f"UC_ARM_REG_{name.upper()}", None) if isinstance(name, str) and name.isalnum() else None
+    if not isinstance(number, int):
+        raise fail("name", "a register name (r0..r12, sp, lr, pc, xpsr, msp, psp, primask, control, ...)", name)
+    return number
+
+
+def _check_memories(image: FirmwareImage, flash: object, ram: object) -> None:
+    """Refuse memories the emulator cannot map (whole pages within the address space, apart from each other and
+    from the system control space) and an image with a segment outside them, by name."""
+    mapped: list[tuple[int, int]] = [(SCS_BASE, SCS_SIZE)]
+    for name, region in (("flash", flash), ("ram", ram)):
+        if not (isinstance(region, tuple) and len(region) == 2
+                and all(type(v) is int and v >= 0 and not v % _PAGE for v in region)
+                and 0 < region[1] <= _ADDRESS_SPACE - region[0]
+                and not any(region[0] < base + size and base < region[0] + region[1] for base, size in mapped)):
+            raise fail(name, f"a (base, size) of whole {_PAGE}-byte pages, apart from the other memories", region)
+        mapped.append(region)
+    for address, data in image.segments:
+        if not any(base <= address and address + len(data) <= base + size for base, size in mapped[1:]):
+            raise fail("image", f"a firmware whose segments lie in flash {flash} or RAM {ram}",
+                       f"a segment at {address:#x}, {len(data)} bytes")
 
 
 def _is_32bit(halfword: int) -> bool:
@@ -493,10 +537,9 @@ class CortexM:
                  flash: tuple[int, int] = (0x0800_0000, 64 * 1024),
                  ram: tuple[int, int] = (0x2000_0000, 20 * 1024)) -> None:  # fmt: skip
         self.image = image if isinstance(image, FirmwareImage) else FirmwareImage.load(image)
-        if cpu not in CPUS:
-            raise ArgumentError("cpu", cpu, f"cpu must be one of {', '.join(CPUS)}, not {cpu!r}")
-        self.cpu = CPUS[cpu]
+        self.cpu = CPUS[check_cpu(cpu)]
         self.cpu_hz = check_real("cpu_hz", cpu_hz, 1e3, 1e9, limit="the core clock in Hz")
+        _check_memories(self.image, flash, ram)
         self.uc: Any = _UNICORN.Uc(ucc.UC_ARCH_ARM, ucc.UC_MODE_THUMB | ucc.UC_MODE_MCLASS)
         self.uc.ctl_set_cpu_model(self.cpu.model)
         self.flash = flash
@@ -576,7 +619,7 @@ class CortexM:
 
     def write_bytes(self, address: int, data: bytes) -> None:
         """Write memory (RAM) from the host, between runs."""
-        self.uc.mem_write(address, data)
+        self.uc.mem_write(address, check_bytes("data", data))
 
     def fail(self, error: BaseException) -> None:
         """Stop at the end of the running block and raise ``error`` from :meth:`run` (the first one wins)."""
@@ -588,11 +631,11 @@ class CortexM:
 
     def reg(self, name: str) -> int:
         """One register by name (``r0``..``r12``, ``sp``, ``lr``, ``pc``, ``xpsr``, ``primask``, ``control``)."""
-        return int(self.uc.reg_read(getattr(arm, f"UC_ARM_REG_{name.upper()}")))
+        return int(self.uc.reg_read(_register(name)))
 
     def set_reg(self, name: str, value: int) -> None:
-        """Write one register by name (as :meth:`reg`), between runs."""
-        self.uc.reg_write(getattr(arm, f"UC_ARM_REG_{name.upper()}"), value)
+        """Write one register by name (as :meth:`reg`) with a 32-bit value, between runs."""
+        self.uc.reg_write(_register(name), check_int("value", value, 0, 0xFFFF_FFFF, "a 32-bit register"))
 
     def registers(self) -> dict[str, int]:
         """R0-R12, SP, LR, PC and xPSR."""
@@ -667,7 +710,7 @@ class CortexM:
 
     def pend(self, number: int) -> None:
         """Make exception ``number`` pending (an external interrupt: ``EXTERNAL + irq``)."""
-        self.pending.add(number)
+        self.pending.add(check_int("number", number, 2, MAX_EXCEPTION, "B1.5.2: NMI (2) up to the last interrupt"))
         self.sleeping = False if self._takeable() is not None else self.sleeping
 
     @property
@@ -815,7 +858,7 @@ class CortexM:
 
         A pending exception that may preempt (B1.5.4) is entered first; a sleeping core (WFI, or ``b .`` in thread
         mode: MCU-4) only lets the time pass."""
-        self.deadline = deadline
+        self.deadline = check_int("deadline", deadline, 0, limit="core cycles")
         number = self._takeable()
         if number is not None:
             self.enter(number)
@@ -902,6 +945,7 @@ class CortexM:
         """The call stack now, innermost first: the PC's function and line, then each caller's return address
         with the line of its call, unwound with the ELF's call frame information (``.debug_frame``) up to
         ``depth`` frames, a frame without that information, or an exception entry (LR = EXC_RETURN)."""
+        check_int("depth", depth, 1)
         image = self.image
         pc = self.pc
         frames = [Frame(pc, image.function_at(pc), image.line_at(pc))]

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Final
 
 from supi3 import tables, timing
-from supi3.checks import check_int
+from supi3.checks import check_bytes, check_int, fail
 from supi3.config import decode
 from supi3.errors import Supi3Error
 from supi3.interbus.device import PlainDevice
@@ -158,6 +158,11 @@ def run_firmware(firmware: str | Path, *, cpu: str = "cortex_m3", cpu_hz: float 
     """
     devices = check_int("devices", devices, 1, 64)
     cycles = check_int("cycles", cycles, POWER_UP_CYCLES, 100_000)
+    max_instructions = check_int("max_instructions", max_instructions, 1)
+    out_data = None if out_data is None else check_bytes("out_data", out_data)
+    in_data = None if in_data is None else check_bytes("in_data", in_data)
+    if not isinstance(straps, tuple) or len(straps) != 2:
+        raise fail("straps", "a pair (C[4..0], MFP[15..12] or None)", straps)
     config = decode(straps[0], straps[1], clk_conf=tables.clk_conf_for(bit_rate))
     others = [PlainDevice(*RING_DEVICE) for _ in range(devices - 1)]
     board = Board(firmware, cpu=cpu, cpu_hz=cpu_hz, config=config, others=others, strict=False)

@@ -210,7 +210,8 @@ class PinRing:
             ``forward`` not a bool or ``position`` out of range; nothing changes.
         """
         check_bool("forward", forward)
-        position = check_int("position", position, 1, len(self.devices) - (0 if forward else 1))
+        position = check_int("position", position, 1, len(self.devices) - (0 if forward else 1),
+                             "a chip of the ring; a return line only from a chip behind it")  # fmt: skip
         self.cuts.add((position, forward))
 
     def run_levels(self, levels: npt.NDArray[np.uint8]) -> None:

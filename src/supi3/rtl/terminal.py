@@ -17,8 +17,9 @@ from amaranth.hdl import Module, Mux, Signal, Value
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
+from supi3.errors import ArgumentError
 from supi3.interbus.wire import BK_STATUS_CLOSED_BIT, BK_STATUS_CONF_BIT, COUNTER_MAX, BranchControl
-from supi3.terminal import BLOCK_INPUTS, BLOCK_OUTPUTS, BRANCH_SILENCE_CLOCKS, RF_CODES, TerminalMode
+from supi3.terminal import BLOCK_INPUTS, BLOCK_OUTPUTS, BRANCH_SILENCE_CLOCKS, RF_CODES, TerminalMode, silence_limit
 
 __all__ = ["TerminalRtl"]
 
@@ -30,11 +31,15 @@ class TerminalRtl(wiring.Component):
     ----------
     time_limit:
         The silence after which the extended function closes the branch, in clocks (BK-3); a test may elaborate a
-        shorter one to reach it quickly.
+        shorter one to reach it quickly (1 up to the default; else :class:`~supi3.errors.ArgumentError`).
     """
 
     def __init__(self, time_limit: int = BRANCH_SILENCE_CLOCKS) -> None:
-        self.time_limit = time_limit
+        try:
+            self.time_limit = silence_limit(time_limit)
+        except ArgumentError:
+            self._MustUse__silence = True  # rejected, never elaborated: no "created but never used" warning
+            raise
         super().__init__({
             **{pin.name: In(pin.width) for pin in BLOCK_INPUTS},
             **{pin.name: Out(pin.width) for pin in BLOCK_OUTPUTS},

@@ -38,7 +38,7 @@ from typing import Final
 import numpy as np
 import numpy.typing as npt
 
-from supi3.checks import check_bits
+from supi3.checks import check_bits, check_bool, check_instance
 from supi3.config import DeviceConfig, Interface
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
@@ -244,20 +244,25 @@ class LineCounters:
         The bit rate strap: 1 at 2 Mbit/s, 0 at 500 kbit/s.
     looped:
         LBD-MR: a block on the return line too.
+
+    Raises
+    ------
+    ArgumentError
+        ``fast`` not 0 or 1, ``looped`` not a bool.
     """
 
     __slots__ = ("back", "fast", "forward", "pipe")
 
     def __init__(self, fast: int, looped: bool) -> None:
-        self.fast = fast
+        self.fast = check_bits("fast", fast, 1)
         self.forward = CounterBlock()
-        self.back = CounterBlock() if looped else None
+        self.back = CounterBlock() if check_bool("looped", looped) else None
         self.reset()
 
     @classmethod
     def of(cls, config: DeviceConfig) -> LineCounters | None:
         """The counter blocks of a chip of ``config``: ``None`` outside the LBD modes (Table 2-5)."""
-        if config.interface not in (Interface.LBD_MR, Interface.LBD_OR):
+        if check_instance("config", config, DeviceConfig).interface not in (Interface.LBD_MR, Interface.LBD_OR):
             return None
         return cls(int(config.bit_rate == max(BIT_RATES)), config.interface is Interface.LBD_MR)
 

@@ -33,7 +33,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Final
 
-from supi3.checks import check_bits, check_int
+from supi3.checks import check_bits
 from supi3.errors import ArgumentError
 from supi3.interbus.wire import BranchControl
 from supi3.pinlevel import EventLog, Pin
@@ -52,6 +52,7 @@ from supi3.terminal import (
     restarts_silence,
     rf_of,
     silence,
+    silence_limit,
 )
 
 __all__ = ["TerminalBlock"]
@@ -94,8 +95,7 @@ class TerminalBlock:
     outputs: Sequence[Pin] = BLOCK_OUTPUTS
 
     def __init__(self, time_limit: int = BRANCH_SILENCE_CLOCKS) -> None:
-        self.time_limit = check_int("time_limit", time_limit, 1, BRANCH_SILENCE_CLOCKS,
-                                    "the 10 ms of BK-3 in clocks; shorter only to test the closure quickly")
+        self.time_limit = silence_limit(time_limit)
         self.log = EventLog()
         self.reset()
 
