@@ -257,23 +257,24 @@ def test_random_intel(bench: Lockstep, rate: int, ops: list[tuple[str, int, int]
 @pytest.mark.parametrize("rate", BIT_RATES)
 @pytest.mark.parametrize("mode", list(Mode))
 def test_long_random_sequence(bench: Lockstep, mode: Mode, rate: int) -> None:
-    # Hundreds of thousands of cycles on the batch path: 1000 random operations and 800 core strobes.
+    # Long runs on the batch path (about 73,000 cycles at 2 Mbit/s, 185,000 at 500 kbit/s): 500 random operations
+    # and 400 core strobes.
     rng = np.random.default_rng([BIT_RATES.index(rate), list(Mode).index(mode)])
     kinds = ["write", "write", "read", "read", "block", "raw", "glitch", "sas", "idle"]
     ops = []
-    for kind in rng.choice(kinds, 1000):
+    for kind in rng.choice(kinds, 500):
         a, b = (int(x) for x in rng.integers(0, 256, 2))
         ops.append({"write": ("write", a & 15, b), "read": ("read", a & 15, 0), "block": ("block", a & 3, b),
                     "raw": ("raw", a, b & 1), "glitch": ("glitch", a % 11, b % 30 + 1), "sas": ("sas", a % 12 + 1, 0),
                     "idle": ("idle", a + 1, 0)}[str(kind)])
     ops[::25] = [("write", SET.address, SET.encode(PCP_N=int(p), CL=int(c))) for p, c in
-                 zip(rng.integers(0, 2, 40), rng.choice(CL_VALUES, 40), strict=True)]
+                 zip(rng.integers(0, 2, 20), rng.choice(CL_VALUES, 20), strict=True)]
     whats = ["events", "latch", "pcmd", "optical", "ib_reset", "io_access", "power_up"]
     strobes = [(float(at), str(what), int(value)) for at, what, value in
-               zip(rng.random(800), rng.choice(whats, 800, p=[0.3, 0.25, 0.1, 0.1, 0.1, 0.14, 0.01]),
-                   rng.integers(0, 2**32, 800), strict=True)]
+               zip(rng.random(400), rng.choice(whats, 400, p=[0.3, 0.25, 0.1, 0.1, 0.1, 0.14, 0.01]),
+                   rng.integers(0, 2**32, 400), strict=True)]
     result = bench.run_batch(random_script(mode, rate, ops, strobes).stimulus())
-    assert result.cycles > 100_000
+    assert result.cycles > 70_000
 
 
 def test_ss_glitches_and_noise(bench: Lockstep) -> None:

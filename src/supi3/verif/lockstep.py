@@ -49,6 +49,12 @@ __all__ = [
 JOB_ENV = "SUPI3_LOCKSTEP_JOB"
 """Environment variable naming the pickled :class:`Job` file for the cocotb testbench."""
 
+PER_CYCLE_VERILATOR_ARGS = ("-Wno-fatal", "-CFLAGS", "-O0")
+"""Verilator options of the per-cycle (cocotb) build. ``-O0`` comes after the makefile's ``-Os`` (``OPT_FAST``) on
+every compile line, so the model's C++ is not optimised: the per-cycle path spends its time in the Python model and
+the VPI calls of every clock, not in the model's C++, and the core's build takes about 30 s instead of about 70 s
+(``docs/verification.md``). The batch path keeps the optimised build: it runs long stimulus in C++ alone."""
+
 TESTBENCH = "supi3.verif.testbenches.lockstep_tb"
 """The cocotb test module of the per-cycle path, which the simulator imports by this dotted name: it is found
 wherever :mod:`supi3` is installed (the runner hands the simulator this process's ``sys.path``), so no file path is
@@ -240,7 +246,7 @@ class Lockstep:
                         sources=[source],
                         hdl_toplevel=TOP,
                         build_dir=directory,
-                        build_args=["-Wno-fatal"] if simulator == "verilator" else [],
+                        build_args=[*PER_CYCLE_VERILATOR_ARGS] if simulator == "verilator" else [],
                         timescale=("1ns", "1ps"),
                         always=True,
                         log_file=log,
