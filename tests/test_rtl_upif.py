@@ -238,7 +238,7 @@ def random_script(mode: Mode, rate: int, ops: list[tuple[str, int, int]],
     return script
 
 
-@settings(max_examples=60)
+@settings(max_examples=30)
 @given(rate=st.sampled_from(BIT_RATES), ops=st.lists(op, min_size=8, max_size=40),
        strobes=st.lists(core, min_size=4, max_size=40))
 def test_random_motorola(bench: Lockstep, rate: int, ops: list[tuple[str, int, int]],
@@ -246,7 +246,7 @@ def test_random_motorola(bench: Lockstep, rate: int, ops: list[tuple[str, int, i
     bench.run_batch(random_script(Mode.MOTOROLA, rate, ops, strobes).stimulus())
 
 
-@settings(max_examples=60)
+@settings(max_examples=30)
 @given(rate=st.sampled_from(BIT_RATES), ops=st.lists(op, min_size=8, max_size=40),
        strobes=st.lists(core, min_size=4, max_size=40))
 def test_random_intel(bench: Lockstep, rate: int, ops: list[tuple[str, int, int]],

@@ -518,7 +518,7 @@ def test_driver_matches_the_reference_on_scripted_chips(harness: Harness, case: 
 
 
 @pytest.mark.slow
-@settings(max_examples=1500)
+@settings(max_examples=1000)
 @given(case=cases())
 def test_driver_matches_the_reference_on_many_scripted_chips(harness: Harness, case: Case) -> None:
     check(harness, case)

@@ -178,8 +178,8 @@ def test_random_strobes(segments: list[tuple[int, int, int, int, list[tuple[obje
 
 
 @pytest.mark.slow
-@settings(max_examples=15)
+@settings(max_examples=8)
 @given(segments=st.lists(SEGMENT, min_size=4, max_size=8))
 def test_random_strobes_more(segments: list[tuple[int, int, int, int, list[tuple[object, ...]]]]) -> None:
-    """:func:`test_random_strobes` on five times as many examples, with longer histories."""
+    """:func:`test_random_strobes` on about three times as many examples, with longer histories."""
     lockstep(random_script(segments))
