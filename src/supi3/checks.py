@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 import numbers
-from collections.abc import Collection
+from collections.abc import Collection, Mapping
 from typing import TypeVar
 
 import numpy as np
@@ -148,3 +148,16 @@ def check_trace(name: str, value: object, width: int) -> npt.NDArray[np.integer]
         raise fail(f"{name}[{index}]", f"an integer from 0 to {mask} ({width} bit{'s' if width != 1 else ''})",
                    array[index].item())
     return array
+
+
+def check_inputs(inputs: object, widths: Mapping[str, int]) -> Mapping[str, int]:
+    """A pin block's inputs: a mapping of exactly the pins of ``widths`` (name -> width) to integers within their
+    widths; else the named error (a block's ``step`` calls it before it changes any state)."""
+    if not isinstance(inputs, Mapping) or inputs.keys() != widths.keys():
+        raise ArgumentError("inputs", inputs, f"inputs must be a mapping of exactly the pins {', '.join(widths)} "
+                                              f"to integers, not {inputs!r:.80}")
+    for name, width in widths.items():
+        value = inputs[name]
+        if type(value) is not int or value < 0 or value >> width:  # the cheap test first
+            check_bits(f"pin {name!r}", value, width)
+    return inputs

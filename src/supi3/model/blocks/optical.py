@@ -36,8 +36,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Final
 
-from supi3.checks import check_bits, check_int
-from supi3.errors import ArgumentError
+from supi3.checks import check_inputs, check_int
 from supi3.optical.length import Medium, timer_code
 from supi3.optical.regulation import (
     BLOCK_INPUTS,
@@ -71,7 +70,6 @@ MEASURED: Final[tuple[Interface, Interface]] = (Interface.OUT, Interface.BRANCH)
 """The paths with a length timer, in the order of :attr:`OpticalStatus.length` (3.4.12)."""
 
 _WIDTHS: Final[dict[str, int]] = {pin.name: pin.width for pin in BLOCK_INPUTS}
-_NAMES: Final = frozenset(_WIDTHS)
 _STROBES: Final = ("ib_reset", "resp_valid", "test_valid", "len_start", "len_stop")
 """Inputs that change the state at the edge (besides the counters)."""
 _MODES: Final[dict[int, OpticalMode]] = {mode.value: mode for mode in OpticalMode}
@@ -82,17 +80,6 @@ def block_mode(value: int) -> OpticalMode:
     """The ``mode`` port's value as an :class:`OpticalMode`; the unused code 3 is off (OPT-23)."""
     return _MODES.get(value, OpticalMode.OFF)
 
-
-def _checked(inputs: object) -> Mapping[str, int]:
-    """The block's inputs by name, each an integer within its port's width; else a named error."""
-    if not isinstance(inputs, Mapping) or inputs.keys() != _NAMES:
-        raise ArgumentError("inputs", inputs, f"inputs must be a mapping of exactly the pins {', '.join(_WIDTHS)} "
-                                              f"to integers, not {inputs!r:.80}")
-    for name, width in _WIDTHS.items():
-        value = inputs[name]
-        if type(value) is not int or value < 0 or value >> width:  # the cheap test first
-            check_bits(f"pin {name!r}", value, width)
-    return inputs
 
 
 class _Timer:
@@ -153,7 +140,7 @@ class OpticalBlock:
             ``inputs`` does not name exactly the block's input pins, or a value is not an integer within its pin's
             width (nothing changes).
         """
-        values = _checked(inputs)
+        values = check_inputs(inputs, _WIDTHS)
         outputs = self.outputs_now(values["run"])
         self.edge(values)
         return outputs

@@ -33,8 +33,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Final
 
-from supi3.checks import check_bits
-from supi3.errors import ArgumentError
+from supi3.checks import check_inputs
 from supi3.interbus.wire import BranchControl
 from supi3.pinlevel import EventLog, Pin
 from supi3.terminal import (
@@ -58,20 +57,8 @@ from supi3.terminal import (
 __all__ = ["TerminalBlock"]
 
 _WIDTHS: Final[dict[str, int]] = {pin.name: pin.width for pin in BLOCK_INPUTS}
-_NAMES: Final = frozenset(_WIDTHS)
 _OFF: Final[dict[str, int]] = {pin.name: 0 for pin in BLOCK_OUTPUTS}
 
-
-def _checked(inputs: object) -> Mapping[str, int]:
-    """The block's inputs by name, each an integer within its port's width; else a named error."""
-    if not isinstance(inputs, Mapping) or inputs.keys() != _NAMES:
-        raise ArgumentError("inputs", inputs, f"inputs must be a mapping of exactly the pins {', '.join(_WIDTHS)} "
-                                              f"to integers, not {inputs!r:.80}")
-    for name, width in _WIDTHS.items():
-        value = inputs[name]
-        if type(value) is not int or value < 0 or value >> width:  # the cheap test first
-            check_bits(f"pin {name!r}", value, width)
-    return inputs
 
 
 class TerminalBlock:
@@ -116,7 +103,7 @@ class TerminalBlock:
             ``inputs`` does not name exactly the block's input pins, or a value is not an integer within its pin's
             width (nothing changes).
         """
-        v = _checked(inputs)
+        v = check_inputs(inputs, _WIDTHS)
         self.cycle += 1
         if v["mode"] == TerminalMode.NONE:
             return dict(_OFF)
