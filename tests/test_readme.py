@@ -20,3 +20,11 @@ def test_tests_readme_names_every_test_file() -> None:
     tests = Path(__file__).resolve().parent
     listed = (tests / "README.md").read_text(encoding="utf-8")
     assert [p.name for p in sorted(tests.glob("test_*.py")) if f"`{p.name}`" not in listed] == []
+
+
+def test_ci_runs_the_readmes_test_command() -> None:
+    """.ci/run calls the quick start's second command (install everything the tests need, run the whole suite)."""
+    commands = re.findall(r"^    (python3 -m venv .*)$", README.read_text(encoding="utf-8"), flags=re.MULTILINE)
+    assert len(commands) == 2, commands
+    ci = (README.parent / ".ci" / "run").read_text(encoding="utf-8")
+    assert commands[1] in ci.splitlines()
