@@ -1,6 +1,7 @@
 """RD, the outgoing interface switched off (DIAG2 with complete diagnostics, manual 3.6.1 Tables 3-16 and 3-19; DG-5),
 and counter telegrams at the frame engine and the idle time-out (LBD modes, 2.2.2, Table 3-18's 4 Hz; BK-36, DG-9), at
-pin level (``Supi3Pins``: ``step()`` and ``run()`` alike, a ``PinRing``) and in the transaction-level LED view."""
+pin level (``Supi3Pins``: ``step()`` and ``run()`` alike, a ``PinRing``) and at transaction level (the LED view, a
+``Ring`` with a break)."""
 
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ from supi3.diagnostics import IbDiag, diag_pins, diagnostic_outputs, is_complete
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.master import Master
+from supi3.interbus.ring import DeadLine, Ring
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import ChipArgumentError, Supi3
 from supi3.model.pinring import PinRing
@@ -160,11 +162,34 @@ def test_only_the_chip_at_the_break_shows_the_line_interrupt() -> None:
         assert int(out["res_reg_n"][-1]) == 0  # RC off: the time-out came (DG-4)
 
 
+BEHIND_A_BREAK = {
+    Interface.LBD_OR: [IbDiag.STEADY, IbDiag.VERY_FAST, IbDiag.SLOW],
+    Interface.LBD_MR: [IbDiag.STEADY, IbDiag.VERY_FAST, IbDiag.SLOW],
+    Interface.LB_MR: [IbDiag.STEADY, IbDiag.VERY_FAST, IbDiag.VERY_FAST],
+}
+"""IB_DIAG of three chips with the forward line into chip 2 broken after the bus ran, 20 ms on (DG-3, DG-9): chip 1 is
+still reached (steady), chip 2's input is silent (4 Hz; in the LBD modes it sends count 1), chip 3 hears chip 2's
+counter telegrams in the LBD modes ("bus not active", 0.5 Hz); LB-MR chips have none, so every chip behind the break
+shows 4 Hz."""
+
+
+@pytest.mark.parametrize("interface", list(BEHIND_A_BREAK))
+def test_a_ring_break_lights_4_hz_directly_behind_it(interface: Interface) -> None:
+    # The transaction-level ring: the chips of the silent stretch behind an LBD chip time out counted (DG-9).
+    config = decode("01000", clk_conf=FAST, diag_conf=0) if interface is Interface.LB_MR else _lbd(interface)
+    chips = [Supi3(config) for _ in range(3)]
+    ring = Ring(chips)
+    master = Master(ring, locate=False, max_devices=4)
+    assert master.start().ok and master.data_cycle().ok
+    ring.inject(DeadLine(2))
+    ring.idle(wire.IDLE_TIMEOUT_S * 1.02)
+    assert [chip.diagnostic_outputs.ib_diag for chip in chips] == BEHIND_A_BREAK[interface]
+
+
 @pytest.mark.slow
 def test_a_pin_ring_break_lights_4_hz_directly_behind_it() -> None:
-    # Three LBD-OR chips, the forward line into chip 2 cut after the bus ran: chip 2 (its input silent, it generates
-    # count 1) shows the line interrupt ahead, chip 3 (it hears chip 2's counter telegrams) shows "bus not active",
-    # chip 1 (still reached) steady light.
+    # The same at pin level (LBD-OR): chip 2 generates count 1 behind the cut, chip 3's idle time-out runs on through
+    # the counter telegrams; TL == pin.
     config = _lbd(Interface.LBD_OR)
     chips = [Supi3Pins(config) for _ in range(3)]
     ring = PinRing(chips)
@@ -172,5 +197,4 @@ def test_a_pin_ring_break_lights_4_hz_directly_behind_it() -> None:
     assert master.start().ok and master.data_cycle().ok
     ring.cut(2, True)
     ring.idle(wire.IDLE_TIMEOUT_S * 1.02)
-    shown = [chip.chip.diagnostic_outputs.ib_diag for chip in chips]
-    assert shown == [IbDiag.STEADY, IbDiag.VERY_FAST, IbDiag.SLOW]
+    assert [chip.chip.diagnostic_outputs.ib_diag for chip in chips] == BEHIND_A_BREAK[Interface.LBD_OR]

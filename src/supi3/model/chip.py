@@ -444,10 +444,11 @@ class Supi3:
         self.led_inputs = _checked(check_instance, "leds", leds, LedInputs)
         self.revision += 1
 
-    def line_timeout(self, now: float) -> None:
+    def line_timeout(self, now: float, counted: bool = False) -> None:
         """The incoming line was silent for ``wire.IDLE_TIMEOUT_S`` (A13), ending at bus time ``now``: what the
-        line side calls in place of :meth:`reset` for a silent line (:meth:`line_timeout_at`)."""
-        self.line_timeout_at(clocks(now))
+        line side calls in place of :meth:`reset` for a silent line (:meth:`line_timeout_at`); ``counted``: counter
+        telegrams came in the silence (DG-9)."""
+        self.line_timeout_at(clocks(now), _checked(check_bool, "counted", counted))
 
     def line_timeout_at(self, clk: int, counted: bool = False) -> None:
         """The idle time-out at clock ``clk``: the INTERBUS reset it makes (:meth:`reset_at`); the line counts as
