@@ -101,9 +101,9 @@ def test_bus_terminal_leds_on_their_mfps() -> None:
 @pytest.mark.parametrize("diag_conf", [0, 1])
 def test_diagnostic_outputs_of_a_chip(c: str, diag_conf: int) -> None:
     config = decode(c, diag_conf=diag_conf)
-    leds = LedInputs(fo=(True, False, True), rd=True, ld=True, e=True, alarm=True)
+    leds = LedInputs(fo=(True, False, True), ld=True, e=True, alarm=True)
     view = diagnostic_outputs(config, supply_ok=True, line_heard=False, bus_active=True, peripheral_fault=True,
-                              line_interrupt=False, leds=leds)  # fmt: skip
+                              line_interrupt=False, following=False, leds=leds)  # fmt: skip
     bk = config.interface.is_bus_terminal
     assert view == DiagnosticOutputs(diag_conf == 0, True, False, True, True, bk, bk, bk, (True, False, bk),
                                      IbDiag.FAST)  # fmt: skip
@@ -123,7 +123,9 @@ def test_diagnostic_outputs_of_a_chip(c: str, diag_conf: int) -> None:
         (lambda: fo_leds(None, True), "status must be a OpticalStatus"),  # type: ignore[arg-type]
         (lambda: is_complete("10000"), "config must be a DeviceConfig"),  # type: ignore[arg-type]
         (lambda: diagnostic_outputs(decode("10000"), supply_ok=True, line_heard=True, bus_active=True,
-                                    peripheral_fault=False, line_interrupt=False, leds=None), "leds must be a"),  # type: ignore[arg-type]
+                                    peripheral_fault=False, line_interrupt=False, following=True,
+                                    leds=None),  # type: ignore[arg-type]
+         "leds must be a"),
     ],
 )  # fmt: skip
 def test_bad_arguments_are_named(call: object, message: str) -> None:

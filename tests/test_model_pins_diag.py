@@ -178,7 +178,7 @@ def test_led_inputs_reach_the_pins(c: str, diag_conf: int) -> None:
     pins = Supi3Pins(cfg)
     script = CoreScript(cfg).line(IDLE, present=0b101).line(wire.reset_levels(1)).line(IDLE)
     pins.run(script.response(Interface.IN, Response.NONE).response(Interface.BRANCH, Response.NONE).inputs())
-    leds = LedInputs(rd=True, ld=True, e=False, alarm=True)
+    leds = LedInputs(ld=True, e=False, alarm=True)
     pins.chip.set_led_inputs(leds)
 
     def alarm_and_ld(chip: Supi3) -> None:

@@ -51,7 +51,7 @@ def run(c: str, diag_conf: int, steps: list[Step]) -> None:
             ctx.set(dut.idle_timeout, int(event.startswith("timeout")))
             ctx.set(dut.ended, int(event in {"latch", "discard", "timeout_discard"}))  # a cycle ended at the chip
             ctx.set(dut.fo, sum(int(v) << i for i, v in enumerate(leds.fo)))
-            for name in ("rd", "ld", "e", "alarm"):
+            for name in ("ld", "e", "alarm"):
                 ctx.set(getattr(dut, name), int(getattr(leds, name)))
             ctx.set(dut.divider, divider)
             if event == "latch":
@@ -71,7 +71,8 @@ def run(c: str, diag_conf: int, steps: list[Step]) -> None:
             # and bus terminal state (OPT-8, BK-11), so the expected view is the spec's function of the same inputs.
             view = diagnostic_outputs(config, supply_ok=True, line_heard=not chip.line_silent,
                                       bus_active=chip.bus_active, peripheral_fault=chip.pf,
-                                      line_interrupt=chip.line_interrupt, leds=leds)  # fmt: skip
+                                      line_interrupt=chip.line_interrupt, following=chip.following,
+                                      leds=leds)  # fmt: skip
             got = (ctx.get(dut.diag1), ctx.get(dut.diag2), ctx.get(dut.ib_diag), ctx.get(dut.res_reg_n),
                    ctx.get(dut.mfp_diag))  # fmt: skip
             want = (view.diag1, view.diag2, ib_diag_level(view.ib_diag, divider), int(view.rc), view.mfp)
@@ -87,7 +88,7 @@ def run(c: str, diag_conf: int, steps: list[Step]) -> None:
 
 
 leds_strategy = st.builds(
-    LedInputs, fo=st.tuples(st.booleans(), st.booleans(), st.booleans()), rd=st.booleans(), ld=st.booleans(),
+    LedInputs, fo=st.tuples(st.booleans(), st.booleans(), st.booleans()), ld=st.booleans(),
     e=st.booleans(), alarm=st.booleans(),
 )  # fmt: skip
 steps_strategy = st.lists(

@@ -17,13 +17,15 @@ re-implements :func:`ib_diag_state` and :func:`diag_pins` in gates) all take the
   master's reset pattern, the next cycle that ends at the chip, or a power-up clear it.
 * **DIAG1/DIAG2** (Table 3-16): :func:`diag_pins` gives BA/RD with complete diagnostics (DIAG_CONF = 0), FO1/FO2 with
   limited diagnostics (DIAG_CONF = 1).
+* **RD** ("Remote bus Disabled", Table 3-19, DG-5): lit while no following device is recognised on the outgoing
+  interface (M5: the chip closes the ring itself, looping DO2 back onto DI1): :func:`remote_bus_disabled`.
 * **RC** on /ResReg (Table 3-19, DG-4): the incoming line is heard; /ResReg is low while it is silent (from the idle
   time-out until the line is heard again) and for the reset pulses of Table 3-13 and RX-5.
 * **Bus terminal modules** (Table 2-8, DG-6): LD on MFP14, E on MFP13, FO3 on MFP8 and ALARM on MFP15, whatever
   DIAG_CONF says (:data:`BUS_TERMINAL_PINS`, :func:`bus_terminal_mfp`).
 
-What the chip's other blocks give the outputs block (the FO LEDs of the optical block, RD, and the bus terminal's LD,
-E and ALARM) is one :class:`LedInputs` value (DG-5, DG-7).
+What the chip's other blocks give the outputs block (the FO LEDs of the optical block and the bus terminal's LD, E
+and ALARM) is one :class:`LedInputs` value (DG-6, DG-7).
 """
 
 from __future__ import annotations
@@ -53,6 +55,7 @@ __all__ = [
     "ib_diag_level",
     "ib_diag_state",
     "is_complete",
+    "remote_bus_disabled",
     "watches_line_interrupt",
 ]
 
@@ -129,6 +132,12 @@ def watches_line_interrupt(config: DeviceConfig) -> bool:
     return check_instance("config", config, DeviceConfig).interface in LINE_INTERRUPT_INTERFACES
 
 
+def remote_bus_disabled(following: bool) -> bool:
+    """RD (Table 3-19, DG-5): the outgoing interface is switched off, i.e. no following device is recognised on it
+    (``following``: M5's recognition, RBST_EXT with RF = 10, else the first high level seen on DI2)."""
+    return not check_bool("following", following)
+
+
 def diag_pins(complete: bool, ba: bool, rd: bool, fo1: bool, fo2: bool) -> tuple[int, int]:
     """DIAG1 and DIAG2 (Table 3-16): BA and RD with complete diagnostics, else FO1 and FO2 (Table 3-17)."""
     if check_bool("complete", complete):
@@ -147,14 +156,12 @@ def fo_leds(status: OpticalStatus, run: bool) -> tuple[bool, bool, bool]:
 
 @dataclass(frozen=True)
 class LedInputs:
-    """What the chip's other blocks give the outputs block: 0 until those blocks drive them (DG-5, DG-7).
+    """What the chip's other blocks give the outputs block: 0 until those blocks drive them (DG-6, DG-7).
 
     Attributes
     ----------
     fo:
         FO1, FO2, FO3 of the optical block (its ``fo`` port, :func:`fo_leds`).
-    rd:
-        The outgoing remote bus interface is switched off (RD, DG-5).
     ld:
         Bus terminal module: the branch is switched off (LD, "Local bus Disabled", Table 2-8).
     e:
@@ -164,7 +171,6 @@ class LedInputs:
     """
 
     fo: tuple[bool, bool, bool] = (False, False, False)
-    rd: bool = False
     ld: bool = False
     e: bool = False
     alarm: bool = False
@@ -172,8 +178,8 @@ class LedInputs:
     def __post_init__(self) -> None:
         if not (isinstance(self.fo, tuple) and len(self.fo) == len(OpticalInterface)):
             raise fail("fo", "a tuple of 3 bool (FO1, FO2, FO3)", self.fo)
-        for name, value in (("fo1", self.fo[0]), ("fo2", self.fo[1]), ("fo3", self.fo[2]), ("rd", self.rd),
-                            ("ld", self.ld), ("e", self.e), ("alarm", self.alarm)):  # fmt: skip
+        for name, value in (("fo1", self.fo[0]), ("fo2", self.fo[1]), ("fo3", self.fo[2]), ("ld", self.ld),
+                            ("e", self.e), ("alarm", self.alarm)):  # fmt: skip
             check_bool(name, value)
 
 
@@ -193,7 +199,7 @@ class DiagnosticOutputs:
     ba: bool
     """BA: bus active (a valid data cycle latched since the last reset)."""
     rd: bool
-    """RD: the outgoing remote bus is switched off (DG-5)."""
+    """RD: the outgoing remote bus is switched off: no following device recognised (DG-5)."""
     ld: bool
     """LD on MFP14: the branch is switched off (bus terminal module)."""
     e: bool
@@ -230,11 +236,13 @@ def bus_terminal_mfp(bus_terminal: bool, alarm: bool, ld: bool, e: bool, fo3: bo
 
 
 def diagnostic_outputs(config: DeviceConfig, *, supply_ok: bool, line_heard: bool, bus_active: bool,
-                       peripheral_fault: bool, line_interrupt: bool, leds: LedInputs) -> DiagnosticOutputs:  # fmt: skip
+                       peripheral_fault: bool, line_interrupt: bool, following: bool,
+                       leds: LedInputs) -> DiagnosticOutputs:  # fmt: skip
     """Every diagnostic LED of a chip of ``config`` from the chip's state (Tables 3-16 to 3-19, 2-8).
 
     ``supply_ok``: /ResU is not held low (UL); ``line_heard``: the incoming line is not silent (RC, DG-4);
     ``bus_active``, ``peripheral_fault``: the chip's BA and PF; ``line_interrupt``: the 4 Hz cause (DG-3);
+    ``following``: a following device is recognised on the outgoing interface (M5; RD is its negation, DG-5);
     ``leds``: what the optical block and the bus terminal logic give (:class:`LedInputs`).
     """
     check_instance("leds", leds, LedInputs)
@@ -244,7 +252,7 @@ def diagnostic_outputs(config: DeviceConfig, *, supply_ok: bool, line_heard: boo
         ul=check_bool("supply_ok", supply_ok),
         rc=check_bool("line_heard", line_heard),
         ba=check_bool("bus_active", bus_active),
-        rd=leds.rd,
+        rd=remote_bus_disabled(following),
         ld=bk and leds.ld,
         e=bk and leds.e,
         alarm=bk and leds.alarm,

@@ -38,7 +38,7 @@ from operator import attrgetter, sub
 from typing import Final, NamedTuple, Protocol, runtime_checkable
 
 from supi3.checks import check_bool, check_instance, check_int, check_real, fail
-from supi3.config import DeviceConfig
+from supi3.config import DeviceConfig, Interface
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusArgumentError, InterbusError, TelegramError
 from supi3.interbus.link import DataKernel, Device
@@ -415,14 +415,22 @@ def _group(devices: list[Device]) -> _Groups:
     return groups
 
 
-def _timeout(device: Device, now: float) -> None:
+def _timeout(device: Device, now: float, counted: bool = False) -> None:
     """A device's incoming line was silent for ``wire.IDLE_TIMEOUT_S`` until ``now`` (A13): its ``line_timeout`` if
-    it has one (the SUPI 3 model: the reset plus DG-3/DG-4, docs/assumptions/diagnostics.md), else ``reset``."""
+    it has one (the SUPI 3 model: the reset plus DG-3/DG-4, docs/assumptions/diagnostics.md), else ``reset``;
+    ``counted``: counter telegrams came in the silence (DG-9), told to a ``line_timeout`` that takes them."""
     timeout = getattr(device, "line_timeout", None)
     if callable(timeout):
-        timeout(now)
+        timeout(now, counted) if counted else timeout(now)
     else:
         device.reset(now)
+
+
+def _sends_counts(device: Device) -> bool:
+    """The device sends counter telegrams behind a break (an LBD chip, Table 2-5, BK-30): every device after it in
+    the silent stretch hears them (DG-9)."""
+    config = getattr(device, "config", None)
+    return isinstance(config, DeviceConfig) and config.interface in (Interface.LBD_MR, Interface.LBD_OR)
 
 
 def _shift(registers: list[bytes], stream: bytes) -> tuple[list[bytes], bytes, int]:
@@ -1017,14 +1025,17 @@ class Ring:
                 device.latch(Cycle.DATA, received, end)
 
     def _go_silent(self, indices: range, start: float, end: float) -> None:
-        """Devices at ``indices`` heard nothing from ``start`` to ``end``: poll them, reset after the timeout."""
+        """Devices at ``indices`` heard nothing from ``start`` to ``end``: poll them, reset after the timeout; those
+        behind an LBD chip of the stretch hear its counter telegrams (DG-9)."""
+        counted = False
         for index in indices:
             since = self._silent_since.setdefault(index, start)
             device = self.devices[index]
             if index not in self._silent_reset and end - since >= wire.IDLE_TIMEOUT_S:
-                _timeout(device, since + wire.IDLE_TIMEOUT_S)
+                _timeout(device, since + wire.IDLE_TIMEOUT_S, counted)
                 self._silent_reset.add(index)
             device.poll(end)
+            counted = counted or _sends_counts(device)
 
     def reset(self) -> None:
         """An INTERBUS reset (the master's Alarm Stop, 1303h): reset pattern, then idle (assumption A12)."""

@@ -245,8 +245,9 @@ class Supi3:
         "_frame_bytes", "_in_map", "_loaded", "_mau_events", "_mau_told", "_now", "_optical", "_optical_driven",
         "_optical_held", "_optical_until", "_out", "_out_map", "_send_alarm", "_send_optical",
         "_serial_pins", "_shown", "_stat_err", "_stat_low_since", "_watch_line", "attention", "bus_active", "config",
-        "due", "in_word", "io_access", "led_inputs", "line_interrupt", "line_silent", "mfp_in", "mod_ack_until", "pf",
-        "registers", "resreg_until", "revision", "serial_device", "spi_sequences", "te", "watchdog_code", "wd",
+        "due", "following", "in_word", "io_access", "led_inputs", "line_interrupt", "line_silent", "mfp_in",
+        "mod_ack_until", "pf", "registers", "resreg_until", "revision", "serial_device", "spi_sequences", "te",
+        "watchdog_code", "wd",
     )  # fmt: skip
 
     data_kernel: ClassVar[DataKernel] = DataKernel(_load_data_run, _latch_data_run)
@@ -283,6 +284,9 @@ class Supi3:
         self._watch_line = watches_line_interrupt(self.config)
         self.led_inputs = LedInputs()
         """What the optical block and the bus terminal logic show on the LEDs (:meth:`set_led_inputs`)."""
+        self.following = False
+        """A following device is recognised on the outgoing interface (M5; RD is off, DG-5): :meth:`set_following`
+        (the pin level's transmitter tells it at every clock edge)."""
         self.revision = 0
         """Counts the changes of what the pins show (OUT data, ``pf``, ``bus_active``, the /ModAck and /ResReg
         pulses): the pin level records its outputs only when this moves."""
@@ -409,10 +413,26 @@ class Supi3:
             leds = replace(leds, ld=state.ld, e=state.e, alarm=state.alarm)
         return diagnostic_outputs(self.config, supply_ok=True, line_heard=not self.line_silent,
                                   bus_active=self.bus_active, peripheral_fault=self.pf,
-                                  line_interrupt=self.line_interrupt, leds=leds)  # fmt: skip
+                                  line_interrupt=self.line_interrupt, following=self.following,
+                                  leds=leds)  # fmt: skip
+
+    def set_following(self, present: bool) -> None:
+        """The line side's recognition of a following device on the outgoing interface (M5): RD is lit while there
+        is none (DG-5). A chip alone has none; a ring's line side tells each chip (the pin level's recognition is
+        the transmitter's, RBST_EXT with RF = 10, else the first high level seen on DI2).
+
+        Raises
+        ------
+        ChipArgumentError
+            ``present`` is not a bool.
+        """
+        present = _checked(check_bool, "present", present)
+        if present != self.following:
+            self.following = present
+            self.revision += 1
 
     def set_led_inputs(self, leds: LedInputs) -> None:
-        """What RD shows from now on (DG-5); both fidelities read it (the RTL ties these ports to 0). FO1..FO3
+        """What the LED inputs show from now on; both fidelities read it (the RTL ties these ports to 0). FO1..FO3
         always come from the chip's own optical block (:attr:`optical`, :func:`supi3.diagnostics.fo_leds`) and, in
         the bus terminal modes, LD, E and ALARM from its branch state (BK-11, BK-12), so those fields are not used.
 
@@ -424,19 +444,21 @@ class Supi3:
         self.led_inputs = _checked(check_instance, "leds", leds, LedInputs)
         self.revision += 1
 
-    def line_timeout(self, now: float) -> None:
+    def line_timeout(self, now: float, counted: bool = False) -> None:
         """The incoming line was silent for ``wire.IDLE_TIMEOUT_S`` (A13), ending at bus time ``now``: what the
-        line side calls in place of :meth:`reset` for a silent line (:meth:`line_timeout_at`)."""
-        self.line_timeout_at(clocks(now))
+        line side calls in place of :meth:`reset` for a silent line (:meth:`line_timeout_at`); ``counted``: counter
+        telegrams came in the silence (DG-9)."""
+        self.line_timeout_at(clocks(now), _checked(check_bool, "counted", counted))
 
-    def line_timeout_at(self, clk: int) -> None:
+    def line_timeout_at(self, clk: int, counted: bool = False) -> None:
         """The idle time-out at clock ``clk``: the INTERBUS reset it makes (:meth:`reset_at`); the line counts as
         silent until it is heard again (RC off, /ResReg low: DG-4), and in the local bus modes a bus that was
-        active raises the line interrupt ahead (IB_DIAG 4 Hz: DG-3). The master's reset pattern, the end of the
-        next cycle that reaches the chip (latch or discard) and a power-up clear both."""
+        active raises the line interrupt ahead (IB_DIAG 4 Hz: DG-3) unless ``counted``: counter telegrams came in
+        the silence, so the break is further ahead (DG-9). The master's reset pattern, the end of the next cycle
+        that reaches the chip (latch or discard) and a power-up clear both."""
         if type(clk) is not int or clk < 0:
             clk = _clock(clk)
-        interrupt = self._watch_line and self.bus_active
+        interrupt = self._watch_line and self.bus_active and not counted
         self.reset_at(clk)
         self.line_silent = True
         self.line_interrupt = interrupt

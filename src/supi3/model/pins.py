@@ -175,8 +175,8 @@ class Supi3Pins:
     """
 
     __slots__ = (
-        "_counters", "_datapath", "_expansion", "_frame", "_holding", "_optical", "_optical_at", "_optical_fixed",
-        "_outputs", "_power_ups", "_receiver", "_recording",
+        "_counters", "_datapath", "_diag2", "_expansion", "_frame", "_holding", "_optical", "_optical_at",
+        "_optical_fixed", "_outputs", "_power_ups", "_receiver", "_recording",
         "_return_start", "_run_from", "_serial", "_stat_active", "_synced_run", "_transmitter", "chip",
         "complete_diagnostics",
         "config", "cpb", "cycle", "forward_delay", "log", "mfp_oe", "rbst_by_pin", "reset_run",
@@ -217,6 +217,7 @@ class Supi3Pins:
         self._outputs = Outputs(self.chip, self._transmitter, self.cpb, self.mfp_oe, self._serial)
         # LBD modes (Table 2-5): the counter telegram blocks on DO2 and, in LBD-MR, DI1 (M17).
         self._counters = LineCounters.of(config)
+        self._frame.counter_telegrams = self._counters is not None  # BK-36: the frame engine takes them as such
         # The optical block (1.6) with RF = 00 or 01; it makes every optical transition, the chip takes its status.
         mode = self.chip.optical_mode
         self._optical = OpticalBlock() if mode is not OpticalMode.OFF else None
@@ -323,6 +324,8 @@ class Supi3Pins:
             self._tick(c, synced, synced.do1, optical or _OPTICAL_QUIET)
             if c >= self._run_from:
                 tx.next_present = bool(synced.rbst_ext) if tx.rbst_by_pin else tx.next_present or bool(synced.di2)
+            if tx.next_present != self.chip.following:  # RD (DG-5): the outputs of the next cycle show it
+                self.chip.set_following(tx.next_present)
         if len(tx.bits) > 8:  # tested here, not in trim(): one call less per step()
             tx.trim()
         self.cycle = c + 1
@@ -576,6 +579,7 @@ class Supi3Pins:
         if serial is not None:
             serial.feed(c0 + n - 1)
         traces = outputs.render(c0, n, snaps, self._transmitter.render(c0, n))
+        self._diag2 = traces["diag2"]  # RD in it waits for the return line (_return_line, DG-5)
         if self._counters is not None:
             traces["do2"] = self._counters.forward_run(line, c0, self._power_ups, traces["do2"])
         traces.update(self._expansion.render(c0, n))
@@ -592,7 +596,9 @@ class Supi3Pins:
 
     def return_line(self, di2: PinTrace, do2: PinTrace) -> PinTrace:
         """``di1`` over the last :meth:`run_forward`, given that run's DI2 trace: the return line passes DI2
-        through once a following device is recognised, else loops ``do2`` back (M5).
+        through once a following device is recognised, else loops ``do2`` back (M5). With complete diagnostics it
+        also completes, in place, the ``diag2`` trace that run returned: RD, lit while no following device is
+        recognised (DG-5).
 
         Recognition is updated at every clock edge where the logic runs, as in :meth:`step`: with RF = 10 it is
         the synchronised RBST_EXT, otherwise it latches the first high level seen on DI2; power-up clears it.
@@ -624,5 +630,7 @@ class Supi3Pins:
             tail = np.concatenate([np.asarray(held_di2, dtype=np.int64), di2])[-SYNC_STAGES:][::-1]
             receiver = self._receiver
             receiver.pipe = [stage._replace(di2=int(v)) for stage, v in zip(receiver.pipe, tail, strict=True)]
-        source = transmitter.return_line((c0, value, run_from), self._power_ups, seen, di2, do2)
+        source, present = transmitter.return_line((c0, value, run_from), self._power_ups, seen, di2, do2)
+        self._outputs.show_following(self._diag2, present)
+        self.chip.set_following(transmitter.next_present)
         return source if self._counters is None else self._counters.return_run(source, c0, self._power_ups)

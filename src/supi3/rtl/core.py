@@ -166,13 +166,15 @@ _POSITION: Final = range(wire.DATA_TELEGRAM_BITS + 1)
 LINE: Final = wiring.Signature({
     "level": Out(1), "sample": Out(1), "frame_bit": Out(1), "telegram_end": Out(1), "position": Out(_POSITION),
     "data_now": Out(1), "in_reset": Out(1), "select": Out(1), "control": Out(1), "bus_reset": Out(1),
-    "idle_timeout": Out(1),
+    "idle_timeout": Out(1), "counted": Out(1), "counter": In(1),
 })  # fmt: skip
 """Receiver -> frame engine, as the receiver sees it: the synchronised line ``level``; ``sample``, the mid-bit
 sample of a telegram bit; ``frame_bit``, a sample in a data telegram outside an INTERBUS reset; ``telegram_end``, the
 stop bit's sample; ``position``, the sampled bit's place in the telegram; ``data_now``, the telegram is a data
 telegram; ``in_reset``, an INTERBUS reset runs (this clock included); ``select`` and ``control``, the bits received;
-``bus_reset``, an INTERBUS reset begins (A12); ``idle_timeout``, 20 ms without a telegram (A13)."""
+``bus_reset``, an INTERBUS reset begins (A12); ``idle_timeout``, 20 ms without a telegram (A13); ``counted``, a
+counter telegram came since the last other telegram (DG-9); back comes ``counter``, the control bit sampled now is a
+counter telegram's (BK-36): the idle time-out runs on through it."""
 
 REGISTER: Final = wiring.Signature({
     "load": Out(1), "load_id": Out(1), "shift": Out(1), "level": Out(1), "latch": Out(1), "clear": Out(1),
@@ -351,7 +353,7 @@ class Supi3Core(wiring.Component):
         m.d.comb += [
             lines.line.eq(receiver.do1_s), lines.fast.eq(cpb == clocks_per_bit(1)), lines.sent.eq(transmitter.do2),
             lines.source.eq(outputs.di1), lines.forward.eq(lbd), lines.looped.eq(lbd_mr), lines.run.eq(running),
-            lines.clear.eq(power_fail),
+            lines.clear.eq(power_fail), frame.lbd.eq(lbd),
         ]  # fmt: skip
 
         # The bus terminal module (2.4, docs/bus-terminal.md): in reset until the core runs, so that it takes CONF as it
@@ -408,6 +410,7 @@ class Supi3Core(wiring.Component):
             outputs.local_bus.eq(local_bus),
             outputs.bus_terminal.eq(bus_terminal),
             outputs.idle_timeout.eq(receiver.line.idle_timeout),
+            outputs.counted.eq(receiver.line.counted),
             outputs.ended.eq(frame.ended),
         ]
 
@@ -582,7 +585,8 @@ class ReceiverRtl(wiring.Component):
         in_reset = Signal()
         reset_end = Signal(range(wire.RESET_END_STATUS_TELEGRAMS + 1))
         low_run = Signal.like(self.reset_run)
-        silent = Signal(range(IDLE_TIMEOUT_CLOCKS + 2), init=1)  # clocks since the last telegram start
+        silent = Signal(range(IDLE_TIMEOUT_CLOCKS + 2), init=1)  # clocks since the last start of no counter telegram
+        counted = Signal()  # a counter telegram since then (DG-9)
         low = line == wire.START_LEVEL
         enter_reset = low & (low_run + 1 == self.reset_run)
         idle_timeout = silent == IDLE_TIMEOUT_CLOCKS  # once per silence: the count stops one beyond
@@ -608,7 +612,7 @@ class ReceiverRtl(wiring.Component):
         end = bit == Mux(data_now, _DATA_TELEGRAM_END, _STATUS_TELEGRAM_END)
         with rx.FSM(name="telegram") as fsm:
             with rx.State("BETWEEN"), rx.If(low):  # a start bit
-                sync += [phase.eq(1), bit.eq(0), is_data.eq(1), silent.eq(1)]
+                sync += [phase.eq(1), bit.eq(0), is_data.eq(1)]
                 rx.next = "TELEGRAM"
             with rx.State("TELEGRAM"):
                 sync += phase.eq(Mux(phase == self.cpb - 1, 0, phase + 1))
@@ -620,9 +624,13 @@ class ReceiverRtl(wiring.Component):
             with rx.If(bit == wire.POS_SELECT):
                 sync += select.eq(line)
             with rx.If(bit == wire.POS_CONTROL):
-                sync += control.eq(line)
+                # The idle time-out restarts from this telegram's start bit (its control bit's sample is cpb // 2 +
+                # 3 cpb clocks after it) unless it is a counter telegram (DG-9, BK-36).
+                sync += [control.eq(line), counted.eq(out.counter)]
+                with rx.If(~out.counter):
+                    sync += silent.eq(self.cpb // 2 + wire.POS_CONTROL * self.cpb + 1)
             with rx.If(end & (line != wire.STOP_LEVEL)):  # M16: the stop bit's period is the next start bit
-                sync += [bit.eq(1), is_data.eq(1), silent.eq(self.cpb // 2 + 1)]
+                sync += [bit.eq(1), is_data.eq(1)]
 
         # The end of an INTERBUS reset: the status telegrams after it (docs/interbus.md A12)
         with rx.If(sample & end & (line == wire.STOP_LEVEL) & ~data_now & in_reset_now):
@@ -642,6 +650,7 @@ class ReceiverRtl(wiring.Component):
             out.control.eq(control),
             out.bus_reset.eq(enter_reset),
             out.idle_timeout.eq(idle_timeout),
+            out.counted.eq(counted),
         ]
         return m
 
@@ -663,7 +672,7 @@ class FrameEngineRtl(wiring.Component):
         super().__init__({
             "line": In(LINE), "register": Out(REGISTER), "management": Out(MANAGEMENT), "tx": Out(TRANSMIT),
             "events": Out(EVENT_BITS), "io": Out(1), "io_set": Out(1), "io_clear": Out(1), "discard": Out(1),
-            "hold": In(1), "ended": Out(1),
+            "hold": In(1), "ended": Out(1), "lbd": In(1),
         })  # fmt: skip
 
     def elaborate(self, _platform: object) -> Module:
@@ -731,9 +740,12 @@ class FrameEngineRtl(wiring.Component):
         j = (rx.position - wire.POS_DATA)[:3]
         check_n = Cat(j, index[:2])  # bit of the check sequence, line order
         cntr_b = check_n[:4]
-        with m.If(rx.frame_bit & (rx.position == wire.POS_CONTROL)):
-            cycle_id = rx.select == wire.SELECT_ID_LEVEL
-            check = line == wire.CONTROL_CHECK_LEVEL
+        control_bit = rx.frame_bit & (rx.position == wire.POS_CONTROL)
+        cycle_id = rx.select == wire.SELECT_ID_LEVEL
+        check = line == wire.CONTROL_CHECK_LEVEL
+        # A counter telegram (LBD modes, BK-36): an ID check telegram while no frame runs; the frame ignores it.
+        comb += rx.counter.eq(control_bit & self.lbd & cycle_id & check & (idle | in_wait | rx.idle_timeout))
+        with m.If(control_bit & ~rx.counter):
             with m.If(~check & ~in_data):  # a frame begins: the register's parallel load
                 abandon()
                 comb += [load.eq(1), reg.load.eq(1), reg.load_id.eq(cycle_id)]
@@ -974,21 +986,22 @@ class TransmitterRtl(wiring.Component):
 class OutputsRtl(wiring.Component):
     """Outputs and diagnostics (block ``outputs``): the chip registers behind the diagnostic pins.
 
-    The /StatErr filter (200 ms, 3.6.2) and the peripheral fault PF, the layer-2 watchdog (Table 3-13) and WD, TE and
-    the attention bit, "bus active", the processor alarm request (A18); the /ModAck and /ResReg pulse counters
+    The /StatErr filter (200 ms, 3.6.2) and the peripheral fault PF, the layer-2 watchdog (Table 3-13) and WD, TE
+    and the attention bit, "bus active", the processor alarm request (A18); the /ModAck and /ResReg pulse counters
     (loaded with the width at the edge that starts the pulse, the pin low while non-zero); the following device
     (Table 2-2, M5) and DI1; the diagnostic outputs of ``supi3.diagnostics`` (3.6.1, DG-1 to DG-8): the silent line
-    and the line interrupt ahead (set by the receiver's ``idle_timeout``, cleared when a cycle ends at the chip or
-    the master's reset pattern comes), DIAG1/DIAG2 (BA/RD or FO1/FO2 by ``complete_diag``, Table 3-16), /ResReg
-    low while the line is silent (RC, DG-4), IB_DIAG flashing from the free-running ``divider`` (Table 3-18, M6,
-    DG-1, DG-2), and a bus terminal module's ALARM, LD, E and FO3 on ``mfp_diag`` (Table 2-8). ``fo`` (the optical
-    block's FO1..FO3), ``rd``, ``ld``, ``e`` and ``alarm`` are ``supi3.diagnostics.LedInputs``: ``fo`` is the optical
-    block's (DG-7), ``ld``, ``e`` and ``alarm`` come from the bus terminal block, ``rd`` is tied to 0 until the logic
-    that drives it is in; ``bk_attention``, the bus terminal block's waiting report, joins the attention bit. The MAU
-    warnings of the optical block (``mau``) make the optical status byte's events and ATTN (``send_optical``,
-    ``mau_sent``; OPT-50..OPT-53). The chip registers follow ``model.chip.Supi3``; the frame engine drives them
-    through ``frame`` (:data:`MANAGEMENT`, flipped) and ``ended``, and ``words`` (:data:`WORDS`, flipped) gives the
-    data path the management bits and the watchdog's reset and takes the command word.
+    and the line interrupt ahead (set by the receiver's ``idle_timeout`` unless ``counted``, DG-9; cleared when a
+    cycle ends at the chip or the master's reset pattern comes), DIAG1/DIAG2 (BA/RD or FO1/FO2 by ``complete_diag``,
+    Table 3-16), /ResReg low while the line is silent (RC, DG-4), IB_DIAG flashing from the free-running ``divider``
+    (Table 3-18, M6, DG-1, DG-2), RD on DIAG2 the following device not recognised (DG-5: the same register that
+    switches DI1), and a bus terminal module's ALARM, LD, E and FO3 on ``mfp_diag`` (Table 2-8). ``fo`` (the optical
+    block's FO1..FO3), ``ld``, ``e`` and ``alarm`` are ``supi3.diagnostics.LedInputs``: ``fo`` is the optical
+    block's (DG-7), ``ld``, ``e`` and ``alarm`` come from the bus terminal block; ``bk_attention``, the bus terminal
+    block's waiting report, joins the attention bit. The MAU warnings of the optical block (``mau``) make the
+    optical status byte's events and ATTN (``send_optical``, ``mau_sent``; OPT-50..OPT-53). The chip registers
+    follow ``model.chip.Supi3``; the frame engine drives them through ``frame`` (:data:`MANAGEMENT`, flipped) and
+    ``ended``, and ``words`` (:data:`WORDS`, flipped) gives the data path the management bits and the watchdog's
+    reset and takes the command word.
     """
 
     def __init__(self, divider_bits: int) -> None:
@@ -997,8 +1010,8 @@ class OutputsRtl(wiring.Component):
             "stat_err_n_s": In(1), "di2_s": In(1), "rbst_ext_s": In(1), "di2": In(1), "do2": In(1),
             "divider": In(divider_bits), "rbst_by_pin": In(1), "complete_diag": In(1),
             "expansion": In(1), "expansion_pulse": In(range(_EXPANSION_PULSE_MAX + 1)),
-            "local_bus": In(1), "bus_terminal": In(1), "idle_timeout": In(1), "ended": In(1),
-            "fo": In(3), "rd": In(1), "ld": In(1), "e": In(1), "alarm": In(1), "bk_attention": In(1),
+            "local_bus": In(1), "bus_terminal": In(1), "idle_timeout": In(1), "counted": In(1), "ended": In(1),
+            "fo": In(3), "ld": In(1), "e": In(1), "alarm": In(1), "bk_attention": In(1),
             "mau": In(len(wire.MAU_WARNINGS)), "optical_quiet": In(1),
             "send_alarm": Out(1), "di1": Out(1), "mod_ack_n": Out(1), "res_reg_n": Out(1), "diag1": Out(1),
             "diag2": Out(1), "ib_diag": Out(1), "mfp_diag": Out(MFP_PINS),
@@ -1122,7 +1135,7 @@ class OutputsRtl(wiring.Component):
         with m.If(heard):
             sync += [line_silent.eq(0), line_interrupt.eq(0)]
         with m.If(self.idle_timeout):
-            sync += [line_silent.eq(1), line_interrupt.eq(self.local_bus & bus_active)]
+            sync += [line_silent.eq(1), line_interrupt.eq(self.local_bus & bus_active & ~self.counted)]  # DG-9
 
         very_fast, fast, slow = (IB_DIAG_DIVIDER_BITS[k] - 1 for k in ("very_fast", "fast", "slow"))
         mfp = Signal(MFP_PINS)
@@ -1133,7 +1146,7 @@ class OutputsRtl(wiring.Component):
             self.di1.eq(Mux(next_present, self.di2, self.do2)),
             # Table 3-16: BA/RD with complete diagnostics, FO1/FO2 with limited diagnostics.
             self.diag1.eq(Mux(self.complete_diag, bus_active, self.fo[0])),
-            self.diag2.eq(Mux(self.complete_diag, self.rd, self.fo[1])),
+            self.diag2.eq(Mux(self.complete_diag, ~next_present, self.fo[1])),  # RD: no following device (DG-5)
             # Table 3-18 in the order of DG-1: line interrupt ahead (4 Hz), peripheral fault (2 Hz), bus not active
             # (0.5 Hz), else steady (M6, DG-2).
             self.ib_diag.eq(Mux(line_interrupt, ~self.divider[very_fast],

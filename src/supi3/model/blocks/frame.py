@@ -11,6 +11,11 @@ decisions are in ``docs/model.md``.
 RTL counterpart: the ``frame`` block of :mod:`supi3.rtl.core` (``FrameEngine``: the frame state, the CRC registers,
 the check sequence and the telegram end).
 
+Counter telegrams (LBD modes, Table 2-5; BK-36 of ``docs/assumptions/bus-terminal.md``): an ID check telegram while
+no frame runs (between frames, or waiting for the latch telegrams) is a counter telegram (:meth:`FrameEngine.
+counter_telegram`, the forward counter block's recognition of BK-32 from the frame engine's own state); it changes no
+frame and is no local error, and the receiver's idle time-out runs on through it (DG-9).
+
 The frame's data bits go through the data path (:class:`~supi3.model.blocks.datapath.DataPath`); the frame engine
 computes both CRCs over what comes in and what goes out.
 """
@@ -60,10 +65,13 @@ class FrameEngine:
     in_reset:
         An INTERBUS reset is in progress (until :data:`~supi3.interbus.wire.RESET_END_STATUS_TELEGRAMS` status
         telegrams): data telegrams are repeated as received.
+    counter_telegrams:
+        The chip is in an LBD mode (Table 2-5): it takes counter telegrams as such (BK-36); set by the core.
     """
 
     __slots__ = (
-        "attn", "check_index", "check_rx", "chip", "crc_rx", "crc_tx", "cycle", "datapath", "err_in", "in_reset",
+        "attn", "check_index", "check_rx", "chip", "counter_telegrams", "crc_rx", "crc_tx", "cycle", "datapath",
+        "err_in", "in_reset",
         "latches", "local_error", "log", "reset_end_count", "state", "transmitter",
     )  # fmt: skip
 
@@ -72,6 +80,7 @@ class FrameEngine:
         self.log = log
         self.datapath = datapath
         self.transmitter = transmitter
+        self.counter_telegrams = False
         self.power_up()
 
     def power_up(self) -> None:
@@ -123,6 +132,14 @@ class FrameEngine:
         if self.chip.io_access:
             self.chip.set_latch_phase(False)
             self.chip.set_io_access(False)
+
+    def counter_telegram(self, word: int) -> bool:
+        """The data telegram whose bits up to its control bit are ``word`` is a counter telegram (BK-36): an LBD
+        mode, select = ID, control = check, and no frame running (between frames or waiting for the latch
+        telegrams). Normal traffic sends ID check telegrams only inside an ID cycle's check sequence (BK-32)."""
+        return (self.counter_telegrams and self.state in ("idle", "wait")
+                and (word >> wire.POS_SELECT) & 1 == wire.SELECT_ID_LEVEL
+                and (word >> wire.POS_CONTROL) & 1 == wire.CONTROL_CHECK_LEVEL)  # fmt: skip
 
     def data_telegram_bit(self, k: int, level: int, c: int, word: int) -> int:
         """Bit ``k`` of a data telegram, received at ``level`` (``word``: the telegram's bits so far): the level to

@@ -9,8 +9,11 @@ from :class:`supi3.model.chip.Supi3` (its LED view :attr:`~supi3.model.chip.Supi
 after the edge that starts them), M6 (IB_DIAG divider), ``docs/model.md``; DG-1 to DG-8,
 ``docs/assumptions/diagnostics.md``.
 
-What the optical block (FO1..FO3) and the bus terminal logic (RD, LD, E, ALARM) give this block is the chip's
+What the optical block (FO1..FO3) and the bus terminal logic (LD, E, ALARM) give this block is the chip's
 :attr:`~supi3.model.chip.Supi3.led_inputs` (:class:`supi3.diagnostics.LedInputs`, all 0 until those blocks set it).
+RD (DIAG2 with complete diagnostics, DG-5) is the transmitter's recognition of a following device (M5), a register
+that changes at clock edges: ``step()`` tells the chip at each edge (:meth:`~supi3.model.chip.Supi3.set_following`);
+``run()`` knows it only once the return line is known and completes DIAG2 then (:meth:`Outputs.show_following`).
 
 RTL counterpart: the ``outputs`` block of :mod:`supi3.rtl.core` (``Outputs``: the pulse counters, the IB_DIAG
 divider, the diagnostic outputs).
@@ -23,7 +26,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from supi3.diagnostics import DiagnosticOutputs
+from supi3.diagnostics import DiagnosticOutputs, is_complete
 from supi3.model.blocks.serial_io import SerialIo
 from supi3.model.blocks.transmitter import PinTrace, Transmitter
 
@@ -63,7 +66,7 @@ class Outputs:
         The serial I/O block driving MFP3, 4, 5 and 7 in the SPI master modes (3.3), else None.
     """
 
-    __slots__ = ("_view", "chip", "cpb", "mfp_oe", "serial", "transmitter")
+    __slots__ = ("_view", "chip", "complete", "cpb", "mfp_oe", "serial", "transmitter")
 
     def __init__(self, chip: Supi3, transmitter: Transmitter, cpb: int, mfp_oe: int,
                  serial: SerialIo | None = None) -> None:  # fmt: skip
@@ -72,6 +75,8 @@ class Outputs:
         self.transmitter = transmitter
         self.cpb = cpb
         self.mfp_oe = mfp_oe
+        self.complete = is_complete(chip.config)
+        """DIAG2 shows RD (DIAG_CONF = 0, Table 3-16)."""
         self._view: _View | None = None
 
     def view(self) -> _View:
@@ -146,3 +151,10 @@ class Outputs:
             "dclk_out": (cycles % cpb < cpb // 2).astype(np.int64),
         }
         return out
+
+    def show_following(self, diag2: PinTrace, present: npt.NDArray[np.bool_]) -> None:
+        """With complete diagnostics, set ``diag2`` (a run's DIAG2 trace, in place) to RD over the run: lit in each
+        cycle whose outputs see no following device recognised (``present``, M5; DG-5). The rest of the run's
+        outputs do not depend on DI2, so :meth:`render` gives them before the return line is known."""
+        if self.complete:
+            diag2[:] = ~present

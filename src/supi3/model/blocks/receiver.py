@@ -3,7 +3,10 @@
 Manual: Table 1-4 (the input pins DO1, DI2, RBST_EXT, MFP, /StatErr, /ResU), 1.7.1 (the 32 MHz clock every input is
 sampled on), 1.7.2 (/ResU and the voltage monitor as inputs). INTERBUS (``/work/shared/reference/interbus-layer2.md``
 "Telegrams", ``docs/interbus.md``): the start bit, mid-bit sampling, the telegram-type bit that tells a 13-bit data
-telegram from a 5-bit status telegram, the INTERBUS reset (start level held, A12) and the 20 ms idle time-out (A13).
+telegram from a 5-bit status telegram, the INTERBUS reset (start level held, A12) and the 20 ms idle time-out (A13),
+which counter telegrams (LBD modes, BK-36) do not restart: it runs from the start of the last other telegram, taken
+at its control bit where the frame engine knows a counter telegram, and a time-out after counter telegrams is no
+line interrupt ahead (DG-9, ``docs/assumptions/diagnostics.md``).
 Decisions: M1 (two synchroniser stages), M7 (framing), M11 (reset detection), M16 (a stop bit at start level starts
 the next telegram), ``docs/model.md``.
 
@@ -133,7 +136,8 @@ class Receiver:
     """
 
     __slots__ = (
-        "bit", "busy", "chip", "cpb", "frame", "half_bit", "last_start", "length", "log", "low_since", "pipe",
+        "bit", "busy", "chip", "counted", "cpb", "frame", "half_bit", "last_start", "length", "log", "low_since",
+        "pipe",
         "reset_run", "run_low", "t0", "transmitter", "word",
     )  # fmt: skip
 
@@ -171,7 +175,10 @@ class Receiver:
         self.low_since: int | None = None
         """The first cycle of the current run of start level on the line, or ``None``."""
         self.last_start = run_from - 1
-        """The cycle the last telegram began (for the idle time-out)."""
+        """The cycle the last telegram that was no counter telegram began (for the idle time-out): taken at its
+        control bit, where a counter telegram is known (DG-9)."""
+        self.counted = False
+        """A counter telegram came since that telegram (DG-9): a time-out now is no line interrupt ahead."""
 
     def clock(self, line: int, c: int) -> None:
         """The rising edge at the end of cycle ``c`` with the synchronised forward line at ``line``."""
@@ -186,7 +193,7 @@ class Receiver:
         if c - self.last_start == IDLE_TIMEOUT_CLOCKS:
             self.log.add(c, "idle timeout: INTERBUS reset")
             self.frame.abandon(c)
-            self.chip.line_timeout_at(c)
+            self.chip.line_timeout_at(c, self.counted)
         if not self.busy:
             if line == wire.START_LEVEL:
                 self._begin(c)
@@ -202,7 +209,6 @@ class Receiver:
         self.bit = 0
         self.word = 0
         self.length = wire.DATA_TELEGRAM_BITS
-        self.last_start = t0
 
     def _sample(self, level: int, c: int) -> None:
         """Bit :attr:`bit` of the telegram, sampled mid-bit: to the frame engine, then out on the repeater."""
@@ -213,7 +219,15 @@ class Receiver:
             self.length = wire.DATA_TELEGRAM_BITS if data else wire.STATUS_TELEGRAM_BITS
         out = level
         frame = self.frame
-        if not frame.in_reset and self.length == wire.DATA_TELEGRAM_BITS:
+        framed = not frame.in_reset and self.length == wire.DATA_TELEGRAM_BITS
+        if k == wire.POS_CONTROL:
+            # The idle time-out restarts from this telegram's start unless it is a counter telegram (DG-9, BK-36).
+            self.counted = framed and frame.counter_telegram(self.word)
+            if self.counted:
+                framed = False  # no frame's telegram: the frame engine does not see its control bit
+            else:
+                self.last_start = self.t0
+        if framed:
             out = frame.data_telegram_bit(k, level, c, self.word)
         self.transmitter.repeat(c, out)
         if k == self.length - 1:

@@ -104,8 +104,9 @@ class Transmitter:
         seen: npt.NDArray[np.int64],
         di2: npt.NDArray[np.int64],
         do2: npt.NDArray[np.int64],
-    ) -> PinTrace:
-        """DI1 over a run of ``len(do2)`` cycles, and :attr:`next_present` after it.
+    ) -> tuple[PinTrace, npt.NDArray[np.bool_]]:
+        """DI1 over a run of ``len(do2)`` cycles, the recognition each cycle's outputs see (RD is its negation,
+        DG-5), and :attr:`next_present` after it.
 
         ``start`` is (the run's first cycle, :attr:`next_present` then, the first cycle the logic ran from then);
         ``power_ups`` the (cycle, logic runs from) of each power-up reset in the run; ``seen`` what recognition
@@ -135,7 +136,7 @@ class Transmitter:
                 state[end + 1] = False
                 t = end + 1
         self.next_present = value
-        return np.where(state[:n], di2, do2).astype(np.int64)
+        return np.where(state[:n], di2, do2).astype(np.int64), state[:n]
 
 
 def render_bits(bits: list[tuple[int, int]], cpb: int, c0: int, n: int) -> PinTrace:
