@@ -578,6 +578,10 @@ FIRMWARE_FAILED_STATUS = 4
 MAX_FIRMWARE_CYCLES = 100_000
 """``firmware run --cycles`` limit (about 6 s of bus time at 500 kbit/s)."""
 
+MAX_PIN_FIRMWARE_CYCLES = MAX_VCD_CYCLES
+"""``firmware run --cycles`` limit with ``--fidelity pin``: every chip clock is a step of the pin-level chip (about
+0.5 s of wall time a cycle at 500 kbit/s), and with ``--vcd`` every pin of every clock is kept, as ``demo --vcd``."""
+
 
 def _firmware_extra() -> None:
     """Refuse ``firmware`` without the firmware extra (unicorn, pyelftools, ziglang), one line, before any work."""
@@ -597,14 +601,26 @@ def cmd_firmware_run(args: argparse.Namespace) -> None:
     if not Path(args.firmware).is_file():
         reason = "not a file" if Path(args.firmware).exists() else "no such file"
         raise CommandLineError(f"FIRMWARE must be an ELF file, not {_shown(args.firmware)} ({reason})")
-    check_int("--cycles", args.cycles, 3, MAX_FIRMWARE_CYCLES)
+    pin = args.fidelity == "pin"
+    if args.vcd is not None and not pin:
+        raise CommandLineError("--vcd needs --fidelity pin (the transaction-level chip has no pins)")
+    if pin and args.devices != 1:
+        raise CommandLineError(f"--devices must be 1 with --fidelity pin (the chip alone in the ring), not "
+                               f"{args.devices}")  # fmt: skip
+    check_int("--cycles", args.cycles, 3, MAX_PIN_FIRMWARE_CYCLES if pin else MAX_FIRMWARE_CYCLES,
+              "with --fidelity pin: every chip clock is stepped" if pin else "")  # fmt: skip
     check_int("--cpu-hz", args.cpu_hz, 1_000_000, 1_000_000_000)
     check_int("--devices", args.devices, 1, 64)
     check_int("--max-instructions", args.max_instructions, 1000, 10**10)
     mfp = args.mfp if args.mfp is not None or args.c != DEFAULT_STRAPS[0] else DEFAULT_STRAPS[1]
-    report = run_firmware(args.firmware, cpu=args.cpu, cpu_hz=float(args.cpu_hz), straps=(args.c, mfp),
-                          bit_rate=_parse_bit_rate(args.bit_rate), devices=args.devices, cycles=args.cycles,
-                          out_data=args.out_data, in_data=args.in_data, max_instructions=args.max_instructions)
+    vcd = None if args.vcd is None else output_file("--vcd", args.vcd)  # before the run, not after it
+    try:
+        report = run_firmware(args.firmware, cpu=args.cpu, cpu_hz=float(args.cpu_hz), straps=(args.c, mfp),
+                              bit_rate=_parse_bit_rate(args.bit_rate), devices=args.devices, cycles=args.cycles,
+                              out_data=args.out_data, in_data=args.in_data, max_instructions=args.max_instructions,
+                              fidelity=args.fidelity, vcd=vcd)  # fmt: skip
+    except OSError as exc:
+        raise CommandLineError(f"cannot write {_shown(str(vcd))} (--vcd): {exc.strerror or exc}") from None
     if args.json:
         print_json(report.as_dict())
     else:
@@ -785,6 +801,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="instruction budget of the power-up and of the exchange (default 20000000)")
     p.add_argument("--out", dest="out_data", type=hex_bytes, metavar="HEX", help="the master's OUT data")
     p.add_argument("--in", dest="in_data", type=hex_bytes, metavar="HEX", help="the firmware's input terminals")
+    p.add_argument("--fidelity", choices=["transaction", "pin"], default="transaction",
+                   help="the chip: transaction level (default), or the pin-level whole chip with SPI1 and the GPIO "
+                        "pins on its MFP pins, Table 3-7 checked by the chip (1 device, up to "
+                        f"{MAX_PIN_FIRMWARE_CYCLES} cycles)")  # fmt: skip
+    p.add_argument("--vcd", metavar="PATH", help="with --fidelity pin: write the chip's pins and the MCU's lines")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_firmware_run)
 
