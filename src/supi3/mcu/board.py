@@ -90,6 +90,9 @@ DEFAULT_MAX_INSTRUCTIONS: Final[int] = 20_000_000
 FIDELITIES: Final[tuple[str, ...]] = ("transaction", "pin")
 """The chip on the board: the transaction-level model (:class:`supi3.sdk.bench.Bench`) or the pin-level whole chip
 (:class:`supi3.top.Supi3Chip` in lockstep with the core, :mod:`supi3.mcu.pins`)."""
+START_WAIT_S: Final[float] = 1e-3
+"""MCU-17: at pin level the master starts (Alarm Stop, ID cycle) once the firmware first sleeps, its set-up done,
+or after this much bus time of idle status telegrams, whichever comes first."""
 SERVE_TELEGRAMS: Final[int] = 64
 """MCU-17: at pin level, after its last master cycle :meth:`Board.run` idles the line up to this many status
 telegrams while the firmware is still in a handler or has an /IRQ edge to serve."""
@@ -652,6 +655,8 @@ class Board:
                     master.cycle()
                 else:
                     ring.settle()  # the power-up reset stretch (as supi3 demo --vcd)
+                    while not core.sleeping and ring.now < START_WAIT_S:
+                        ring.status_telegram()
                     master.start()
                 self._cycles_done += 1
                 if self._cycle_time_s is not None:

@@ -129,7 +129,7 @@ class FirmwareRun:
                      "leaves the firmware after /IRQ (T = 13 (5 + n) t_Bit, 3.4.14)"),
                   f"run         {self.bus_time_s * 1e3:.3f} ms of bus time, {self.instructions} instructions, "
                   f"{self.core_cycles} core cycles, {self.wall_s:.2f} s wall "
-                  f"({self.bus_time_s / max(self.wall_s, 1e-9):.3f}x real time)"]  # fmt: skip
+                  f"({self.bus_time_s / max(self.wall_s, 1e-9):.3g}x real time)"]  # fmt: skip
         lines.append(f"violations  {len(self.violations) or 'none'}")
         lines += [f"  {v.error.rule}: {v.error}\n    at {v.place}" for v in self.violations]
         if self.stop is not None:
