@@ -634,7 +634,7 @@ def cmd_firmware_run(args: argparse.Namespace) -> None:
 def cmd_firmware_build(args: argparse.Namespace) -> None:
     """Build a firmware for the emulated board with the SDK's driver and board port (supi3.mcu.build)."""
     _firmware_extra()
-    from supi3.mcu.build import MACRO_NAME, build
+    from supi3.mcu.build import MACRO_NAME, BuildError, build
 
     out = output_file("-o/--output", args.output)
     defines = {}
@@ -643,7 +643,15 @@ def cmd_firmware_build(args: argparse.Namespace) -> None:
         if not MACRO_NAME.fullmatch(name):
             raise CommandLineError(f"-D must be NAME or NAME=VALUE with a C identifier NAME, not {_shown(text)}")
         defines[name] = value if _ else "1"
-    print(build(args.sources, out, cpu=args.cpu, defines=defines))
+    try:
+        print(build(args.sources, out, cpu=args.cpu, defines=defines))
+    except BuildError as exc:
+        if not exc.output:
+            raise
+        # The compiler's messages as it wrote them, line by line; then the one error line.
+        with contextlib.suppress(OSError, ValueError):
+            sys.stderr.write(exc.output if exc.output.endswith("\n") else exc.output + "\n")
+        raise CommandLineError(f"{exc.summary} (the compiler's messages above)") from None
 
 
 def hex_bytes(text: str) -> bytes:
