@@ -110,7 +110,10 @@ class LockstepRing(PinRing):
         ``on_violation(error, cycle, cause)``: the chip found a violation in clock ``cycle``, caused by the pin
         change of ``cause`` (``None``: no change of the firmware's before it).
     last:
-        Every output pin in the last clock run.
+        The outputs the board reads (:data:`_WATCHED`: the return line, the MFP levels and enables, /ModAck) in the
+        last clock run.
+    irq_n, mod_ack_n:
+        /IRQ (MFP3) and /ModAck in the last clock run.
     """
 
     def __init__(self, chip: Supi3Chip, cpu_hz: float, where: Callable[[], Cause], *, record: bool = False) -> None:
