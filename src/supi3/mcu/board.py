@@ -83,6 +83,9 @@ PIN_MODACK: Final[int] = 1
 PORT_B: Final[int] = 1
 PULL_UPS: Final[int] = (1 << PIN_SS) | (1 << PIN_STAT_ERR)
 """MCU-6: /SS and /StatErr have pull-ups on the board: high while the MCU does not drive them."""
+_CHIP_INPUTS: Final[dict[int, tuple[str, int]]] = {PIN_SS: ("mfp_in", SS_BIT), PIN_SAS_INIT: ("mfp_in", SAS_INIT_BIT),
+                                                   PIN_STAT_ERR: ("stat_err_n", 0)}  # fmt: skip
+"""At pin level, the chip input (pin, bit) each GPIOA output drives: /SS on MFP5, SAS_INIT on MFP0, /StatErr."""
 MISO_IDLE: Final[int] = 0xFF
 """MCU-6: what the SPI receives when the chip drives no SerOUT (pulled up)."""
 DEFAULT_MAX_INSTRUCTIONS: Final[int] = 20_000_000
@@ -447,7 +450,7 @@ class Board:
     def _inputs(self) -> int:
         ring = self._ring
         if ring is not None:
-            ring.sync(ring.clock_of(self.core.cycles_now()))
+            ring.sync_to_core(self.core.cycles_now())
             return ring.irq_n << PIN_IRQ | ring.c_d << PIN_CD | ring.io << PIN_IO
         cycles = self._now()
         cd = self.protocol.c_d if cycles >= self._ss_rise + self._cycles(self._limits["t6max"]) else self._cd_before
@@ -456,7 +459,7 @@ class Board:
     def _inputs_b(self) -> int:
         ring = self._ring
         if ring is not None:
-            ring.sync(ring.clock_of(self.core.cycles_now()))
+            ring.sync_to_core(self.core.cycles_now())
             return ring.mod_ack_n << PIN_MODACK
         self._now()
         return self.bench.mod_ack << PIN_MODACK
@@ -471,9 +474,9 @@ class Board:
     def _on_output(self, pin: int, level: int) -> None:
         ring = self._ring
         if ring is not None:
-            pins = {PIN_SS: ("mfp_in", SS_BIT), PIN_SAS_INIT: ("mfp_in", SAS_INIT_BIT), PIN_STAT_ERR: ("stat_err_n", 0)}
-            if pin in pins:
-                ring.drive(self.core.cycles_now(), *pins[pin], level)
+            wire = _CHIP_INPUTS.get(pin)
+            if wire is not None:
+                ring.drive(self.core.cycles_now(), *wire, level)
             return
         cycles = self._now()
         if pin == PIN_SS:
@@ -600,8 +603,7 @@ class Board:
 
     def _run(self, done: Callable[[], bool], max_instructions: int, end: int | None = None) -> None:
         core = self.core
-        self._budget = check_int("max_instructions", max_instructions, 1)
-        self._limit = core.instructions + self._budget
+        self._set_budget(max_instructions)
         self.sync(core.cycles)
         while True:
             core.systick.update()
@@ -615,6 +617,10 @@ class Board:
                     deadline = min(deadline, bound)
             self._step(deadline)
             self.sync(core.cycles, event if event <= core.cycles else None)
+
+    def _set_budget(self, max_instructions: int) -> None:
+        self._budget = check_int("max_instructions", max_instructions, 1)
+        self._limit = self.core.instructions + self._budget
 
     def _step(self, deadline: int) -> None:
         """One run of the core up to ``deadline`` (at least one block), within the instruction budget."""
@@ -646,8 +652,7 @@ class Board:
 
     def _run_pin(self, done: Callable[[], bool], max_instructions: int) -> None:
         core, ring, master = self.core, self.ring, self._master
-        self._budget = check_int("max_instructions", max_instructions, 1)
-        self._limit = core.instructions + self._budget
+        self._set_budget(max_instructions)
         try:
             while not done():
                 start = ring.now

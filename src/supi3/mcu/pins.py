@@ -237,6 +237,10 @@ class LockstepRing(PinRing):
                 break
         return self.cycle
 
+    def sync_to_core(self, cycles: int) -> int:
+        """:meth:`sync` up to core cycle ``cycles`` (:meth:`clock_of`)."""
+        return self.sync(self.clock_of(cycles))
+
     def _blame(self, error: InterfaceViolationError, start: int) -> None:
         clock = error.cycle if isinstance(error, TimingViolationError) else start
         cause = next((c for at, c in reversed(self._recent) if at <= clock), None)
