@@ -169,3 +169,26 @@ def test_the_board_refuses_what_its_fidelity_has_not(digital_io: Path, tmp_path:
     with pytest.raises(ArgumentError, match=r"devices must be an integer from 1 to 1 \(the chip alone in the ring"):
         run_firmware(digital_io, fidelity="pin", devices=2)
     assert not (tmp_path / "x.vcd").exists()
+
+
+@pytest.mark.parametrize("fidelity", ["transaction", "pin"])
+def test_sas_init_restarts_the_interface_and_keeps_the_registers(tmp_path: Path, fidelity: str) -> None:
+    """tests/mcu/sas_init.c: SAS_INIT (PA3 on MFP0) after SET 83h, then the initialization byte again: the interface
+    runs in Motorola mode again and SET still reads 83h (3.4.3), with no violation; on either fidelity."""
+    elf = mcu_build.build(Path(__file__).parent / "mcu" / "sas_init.c", tmp_path / "sas_init.elf")
+    board = Board(elf, bit_rate=2_000_000, fidelity=fidelity)
+    board.run(1)
+    assert board.fw_board is not None and (board.fw_board.error, board.fw_board.outputs[0]) == (0, 0x83)
+    assert board.protocol.mode is not None and board.violations == []
+
+
+@pytest.mark.parametrize("fidelity", ["transaction", "pin"])
+def test_a_too_short_sas_init_pulse_names_the_line(tmp_path: Path, fidelity: str) -> None:
+    """SAS_SHORT = 1: SAS_INIT high for two stores (about 40 ns) breaks Table 3-7's t_SAS_INIT on either fidelity,
+    reported at the store that ends the pulse (pin level: the chip's own check, clock-exact)."""
+    elf = mcu_build.build(Path(__file__).parent / "mcu" / "sas_init.c", tmp_path / "short.elf",
+                          defines={"SAS_SHORT": "1u"})  # fmt: skip
+    board = Board(elf, bit_rate=2_000_000, fidelity=fidelity, strict=False)
+    board.run(1)
+    rules = [(v.error.rule, v.function, v.source.file if v.source else None) for v in board.violations]
+    assert rules == [("Table 3-7 t_SAS_INIT", "fw_setup", "sas_init.c")]

@@ -33,7 +33,6 @@ from supi3.mcu.stm32 import CR1_CPHA, CR1_CPOL, CR1_LSBFIRST
 from supi3.model.pinring import PinRing
 from supi3.model.registers import InterfaceViolationError
 from supi3.pinout import UP_INPUTS, UP_OUTPUTS
-from supi3.spi.slave_pins import TimingViolationError
 from supi3.tables import CLOCK_HZ
 from supi3.top import QUIET_BOARD, STEP_BELOW, Supi3Chip
 
@@ -242,9 +241,10 @@ class LockstepRing(PinRing):
         return self.sync(self.clock_of(cycles))
 
     def _blame(self, error: InterfaceViolationError, start: int) -> None:
-        clock = error.cycle if isinstance(error, TimingViolationError) else start
-        cause = next((c for at, c in reversed(self._recent) if at <= clock), None)
-        self.on_violation(error, clock, cause)
+        """A violation found while the inputs held from clock ``start``: the pin change there caused it (a piece
+        ends at every change; the chip's µP interface counts its own cycles, so the error's clock is not used)."""
+        cause = next((c for at, c in reversed(self._recent) if at <= start), None)
+        self.on_violation(error, start, cause)
 
     def _clock(self, n: int, until_edge: bool) -> bool:
         """Run ``n`` clocks with the inputs held (but ``do1``); whether it stopped early at an edge."""
