@@ -47,6 +47,7 @@ def test_a_pin_level_run_reports_the_data_and_writes_the_vcd(
     (["--fidelity", "pin", "--devices", "2"], "--devices must be 1 with --fidelity pin"),
     (["--fidelity", "pin", "--cycles", "51"], "--cycles must be an integer from 3 to 50 (with --fidelity pin"),
     (["--fidelity", "gate"], "invalid choice: 'gate'"),
+    (["--mode", "spi"], "invalid choice: 'spi'"),
     (["--fidelity", "pin", "--vcd", "{tmp}/no/x.vcd"], "--vcd"),
 ])  # fmt: skip
 def test_pin_level_options_are_refused_in_one_line(

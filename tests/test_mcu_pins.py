@@ -7,6 +7,7 @@ function and source line, and the VCD of the chip's pins and the MCU's lines.
 from __future__ import annotations
 
 import itertools
+import re
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +15,7 @@ import pytest
 
 from supi3.errors import ArgumentError
 from supi3.interbus.device import PlainDevice
+from supi3.mcu import board as mcu_board
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import Board, BoardError
 from supi3.mcu.core import CPUS
@@ -23,6 +25,7 @@ from supi3.mcu.stm32 import CR1_CPHA, CR1_CPOL, CR1_LSBFIRST
 from supi3.model.registers import InterfaceViolationError
 from supi3.sdk import native
 from supi3.sdk.bench import default_config
+from supi3.spi.upif import Mode
 from supi3.top import Supi3Chip
 
 pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
@@ -82,20 +85,27 @@ def _exchange(board: Board) -> list[tuple[bytes, bytes]]:
 
 
 @pytest.mark.slow
-def test_digital_io_gives_the_same_process_data_on_both_fidelities(digital_io: Path) -> None:
+@pytest.mark.parametrize("mode", list(Mode))
+def test_digital_io_gives_the_same_process_data_on_both_fidelities(
+    digital_io: Path, tmp_path: Path, mode: Mode
+) -> None:
     """A master cycle every 400 µs at 500 kbit/s (the handler's four accesses end before the next cycle begins,
     MCU-17): the pin-level chip, its µP pins driven by SPI1 and the GPIO port in lockstep with the core, gives the
     master's configuration and the process data of the transaction-level run, breaks no Table 3-7 rule, and a
     sleeping core enters the handler the 12 cycles of its exception entry after the falling edge of /IRQ on MFP3
-    (MCU-2, MCU-14)."""
+    (MCU-2, MCU-14). The same on the Intel board (MCU-18: S/R from PB0, Ser_IN/OUT half duplex, LSB first; at pin
+    level the chip checks t10/t11 on S/R too) with the example built for it."""
+    elf = digital_io if mode is Mode.MOTOROLA else mcu_build.build(
+        native.example("digital_io"), tmp_path / "intel.elf", defines={"FW_MODE": "SUPI3_MODE_INTEL"})
     seen = {}
     for fidelity in ("transaction", "pin"):
-        board = Board(digital_io, cycle_time_s=400e-6, fidelity=fidelity)
+        board = Board(elf, cycle_time_s=400e-6, fidelity=fidelity, mode=mode)
         board.run(3)
         config = board.master.config
         assert config is not None and (config[0].id_code, config[0].data_bytes) == (0x03, 2)
         seen[fidelity] = _exchange(board)
         assert board.violations == [] and board.fw_board is not None and board.fw_board.error == 0
+        assert board.protocol.mode is mode
         assert board.irq_latency_s == pytest.approx(CPUS["cortex_m3"].entry_cycles / 48e6)
     assert seen["pin"] == seen["transaction"] == list(zip(WORDS, reversed(WORDS), strict=True))
 
@@ -192,3 +202,9 @@ def test_a_too_short_sas_init_pulse_names_the_line(tmp_path: Path, fidelity: str
     board.run(1)
     rules = [(v.error.rule, v.function, v.source.file if v.source else None) for v in board.violations]
     assert rules == [("Table 3-7 t_SAS_INIT", "fw_setup", "sas_init.c")]
+
+
+def test_the_intel_boards_s_r_pin_is_board_h_s() -> None:
+    """The emulator's S/R wiring (MCU-18) is the board port's: PB0, board.h BOARD_PIN_SR."""
+    text = (mcu_build.BOARD_DIR / "board.h").read_text()
+    assert re.search(rf"#define BOARD_PIN_SR {mcu_board.PIN_SR}u /\* on port B", text)

@@ -597,6 +597,7 @@ def cmd_firmware_run(args: argparse.Namespace) -> None:
     """Run a firmware ELF on the emulated board against the chip and report (docs/firmware-in-the-loop.md)."""
     _firmware_extra()
     from supi3.mcu.session import run_firmware
+    from supi3.spi.upif import Mode
 
     if not Path(args.firmware).is_file():
         reason = "not a file" if Path(args.firmware).exists() else "no such file"
@@ -618,7 +619,7 @@ def cmd_firmware_run(args: argparse.Namespace) -> None:
         report = run_firmware(args.firmware, cpu=args.cpu, cpu_hz=float(args.cpu_hz), straps=(args.c, mfp),
                               bit_rate=_parse_bit_rate(args.bit_rate), devices=args.devices, cycles=args.cycles,
                               out_data=args.out_data, in_data=args.in_data, max_instructions=args.max_instructions,
-                              fidelity=args.fidelity, vcd=vcd)  # fmt: skip
+                              fidelity=args.fidelity, vcd=vcd, mode=Mode(args.mode))  # fmt: skip
     except OSError as exc:
         raise CommandLineError(f"cannot write {_shown(str(vcd))} (--vcd): {exc.strerror or exc}") from None
     if args.json:
@@ -814,6 +815,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "pins on its MFP pins, Table 3-7 checked by the chip (1 device, up to "
                         f"{MAX_PIN_FIRMWARE_CYCLES} cycles)")  # fmt: skip
     p.add_argument("--vcd", metavar="PATH", help="with --fidelity pin: write the chip's pins and the MCU's lines")
+    p.add_argument("--mode", choices=["motorola", "intel"], default="motorola",
+                   help="the board's wiring for the interface the firmware initializes: motorola (SPI, default) or "
+                        "intel (S/R on PB0, Ser_IN/OUT half duplex; build with -D FW_MODE=SUPI3_MODE_INTEL)")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_firmware_run)
 

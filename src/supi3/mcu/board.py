@@ -27,7 +27,7 @@ from supi3.errors import Supi3Error
 from supi3.interbus.link import Device
 from supi3.interbus.master import Master
 from supi3.mcu.core import EXTERNAL, CortexM, FirmwareImage, FirmwareStoppedError, Frame, SourceLine, Stop
-from supi3.mcu.pins import SAS_INIT_BIT, SS_BIT, SYNC_S, Cause, LockstepRing, mcu_lines
+from supi3.mcu.pins import SAS_INIT_BIT, SR_BIT, SS_BIT, SYNC_S, Cause, LockstepRing, mcu_lines
 from supi3.mcu.stm32 import (
     AFIO_BASE,
     CR1_CPHA,
@@ -51,7 +51,7 @@ from supi3.model.registers import InterfaceViolationError
 from supi3.model.vcd import write_vcd
 from supi3.pinout import C_D_COMMAND
 from supi3.sdk.bench import Bench, default_config
-from supi3.spi.upif import UpifProtocol
+from supi3.spi.upif import Mode, UpifProtocol
 from supi3.tables import CLOCK_HZ
 from supi3.top import Supi3Chip
 
@@ -81,6 +81,8 @@ PIN_STAT_ERR: Final[int] = 8
 PIN_MODACK: Final[int] = 1
 """On port B: PB1."""
 PORT_B: Final[int] = 1
+PIN_SR: Final[int] = 0
+"""On port B: PB0, S/R to MFP7 on the Intel board (MCU-18)."""
 PULL_UPS: Final[int] = (1 << PIN_SS) | (1 << PIN_STAT_ERR)
 """MCU-6: /SS and /StatErr have pull-ups on the board: high while the MCU does not drive them."""
 _CHIP_INPUTS: Final[dict[int, tuple[str, int]]] = {PIN_SS: ("mfp_in", SS_BIT), PIN_SAS_INIT: ("mfp_in", SAS_INIT_BIT),
@@ -234,6 +236,10 @@ class Board:
         (``others`` empty, MCU-17).
     record:
         Pin level only: keep every pin for :meth:`write_vcd`.
+    mode:
+        The board's wiring for the interface type the firmware initializes (Table 3-8): ``Mode.MOTOROLA`` (MISO on
+        SerOUT, MFP7) or ``Mode.INTEL`` (MCU-18: MISO on Ser_IN/OUT, MFP6, MOSI on it through a resistor, S/R from
+        PB0 to MFP7; build the firmware with ``-DFW_MODE=SUPI3_MODE_INTEL``).
 
     Attributes
     ----------
@@ -256,8 +262,10 @@ class Board:
     def __init__(self, firmware: str | Path | FirmwareImage, *, cpu: str = "cortex_m3", cpu_hz: float = 48e6,
                  config: DeviceConfig | None = None, bit_rate: int = 500_000, others: Sequence[Device] = (),
                  cycle_time_s: float | None = None, strict: bool = True, pedantic: bool = False,
-                 fidelity: str = "transaction", record: bool = False) -> None:  # fmt: skip
+                 fidelity: str = "transaction", record: bool = False, mode: Mode = Mode.MOTOROLA) -> None:  # fmt: skip
         self.fidelity = check_choice("fidelity", fidelity, FIDELITIES)
+        self.intel = check_instance("mode", mode, Mode) is Mode.INTEL
+        self._s_r = 1  # PB0: S/R, 1 = the µP sends
         check_bool("record", record)
         self.core = CortexM(firmware, cpu=cpu, cpu_hz=cpu_hz)
         self._bench: _BoardBench | None = None
@@ -319,7 +327,7 @@ class Board:
             raise fail("config", "the straps of an Init-µP mode (Tables 2-4 to 2-7)", self.config.function)
         self.registers = chip.chip.registers
         self.protocol = chip.upif.protocol
-        self._ring = ring = LockstepRing(chip, self.core.cpu_hz, self._cause, record=record)
+        self._ring = ring = LockstepRing(chip, self.core.cpu_hz, self._cause, record=record, intel=self.intel)
         ring.runner = self._lockstep
         ring.on_edge = self._pin_edge
         ring.on_violation = self._pin_violation
@@ -373,7 +381,7 @@ class Board:
         ring = self.ring
         if not ring.record:
             raise BoardError("Board.write_vcd needs a board made with record=True")
-        return write_vcd(Path(path), ring, {"mcu": mcu_lines(ring.recorded()[0])})
+        return write_vcd(Path(path), ring, {"mcu": mcu_lines(ring.recorded()[0], intel=self.intel)})
 
     def _cause(self) -> Cause:
         core = self.core
@@ -465,8 +473,15 @@ class Board:
         return self.bench.mod_ack << PIN_MODACK
 
     def _on_output_b(self, pin: int, level: int) -> None:
-        """Port B drives nothing the chip sees."""
-        del pin, level
+        """Port B drives S/R (PB0, MFP7) on the Intel board, nothing the chip sees on the Motorola board."""
+        if not self.intel or pin != PIN_SR:
+            return
+        ring = self._ring
+        if ring is not None:
+            ring.drive(self.core.cycles_now(), "mfp_in", SR_BIT, level)
+        else:
+            self._now()
+            self._s_r = level
 
     def _cycles(self, seconds: float) -> int:
         return math.ceil(seconds * self.core.cpu_hz - 1e-6)
@@ -504,7 +519,7 @@ class Board:
             driven: list[int | None] = [None]
 
             def begin() -> None:
-                driven[0] = self.protocol.begin(True)
+                driven[0] = self.protocol.begin(bool(self._s_r) if self.intel else True)
 
             self._chip(begin, cycles)
             self._frame = _Frame(cycles, driven[0], [])
@@ -521,7 +536,9 @@ class Board:
             if cycles - last < self._cycles(self._limits["t2"]):
                 self._violation("Table 3-7 t2", f"/SS rose {self._ns(cycles - last)} ns after the last SCLK edge, "
                                 f"less than t2 = {self._limits['t2'] * 1e9:.0f} ns")  # fmt: skip
-            self._chip(lambda: self.protocol.end(tx), cycles)
+            # An Intel receive frame: the chip's driver wins on Ser_IN/OUT, it takes its own byte (MCU-18).
+            on_line = frame.driven if self.intel and frame.driven is not None else tx
+            self._chip(lambda: self.protocol.end(on_line), cycles)
         else:
             self._chip(lambda: self.protocol.abort(edges), cycles)
 
@@ -540,13 +557,14 @@ class Board:
             self._violation("3.4.2", f"byte {tx:02X}h clocked with /SS high: the chip ignores it")
             return MISO_IDLE
         lsb = bool(cr1 & CR1_LSBFIRST)
-        seen = _reverse(tx & 0xFF) if lsb else tx & 0xFF
+        reverse = lsb != (self.protocol.mode is Mode.INTEL)  # the chip shifts LSB first in Intel mode (UP-6)
+        seen = _reverse(tx & 0xFF) if reverse else tx & 0xFF
         if not frame.transfers and start + period // 2 - frame.fall < self._cycles(self._limits["t1"]):
             self._violation("Table 3-7 t1", f"first SCLK edge {self._ns(start + period // 2 - frame.fall)} ns after "
                             f"/SS fell, less than t1 = {self._limits['t1'] * 1e9:.0f} ns")  # fmt: skip
         frame.transfers.append((seen, bits, start, period))
         driven = MISO_IDLE if frame.driven is None else frame.driven
-        return _reverse(driven) if lsb else driven
+        return _reverse(driven) if reverse else driven
 
     # -- the chip and its violations ---------------------------------------------------------------------------
 

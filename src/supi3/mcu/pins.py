@@ -51,6 +51,8 @@ SCLK_BIT: Final[int] = UP_INPUTS["sclk"]
 MOSI_BIT: Final[int] = UP_INPUTS["mfp6"]
 SS_BIT: Final[int] = UP_INPUTS["ss_n"]
 SAS_INIT_BIT: Final[int] = UP_INPUTS["sas_init"]
+SR_BIT: Final[int] = UP_INPUTS["mfp7"]
+SER_IN_OUT_BIT: Final[int] = UP_OUTPUTS["mfp6"]
 MCU_LINES: Final[dict[str, tuple[str, int, int | None]]] = {
     "pa0_irq_n": ("mfp_out", IRQ_BIT, 1), "pa1_c_d": ("mfp_out", CD_BIT, 1), "pa2_io": ("mfp_out", IO_BIT, 1),
     "pa3_sas_init": ("mfp_in", SAS_INIT_BIT, None), "pa4_ss_n": ("mfp_in", SS_BIT, None),
@@ -60,6 +62,11 @@ MCU_LINES: Final[dict[str, tuple[str, int, int | None]]] = {
 }  # fmt: skip
 """The MCU's lines of board.h (``BOARD_PIN_*``, SPI1 on PA5 to PA7), each the chip pin it is wired to: (trace, bit,
 the level while the chip drives it not, ``None`` for the MCU's outputs and the chip's plain outputs)."""
+INTEL_LINES: Final[dict[str, tuple[str, int, int | None]]] = {
+    **MCU_LINES, "pa6_miso": ("mfp_out", SER_IN_OUT_BIT, None), "pb0_s_r": ("mfp_in", SR_BIT, None),
+}  # fmt: skip
+"""The Intel board's lines (MCU-18): MISO on Ser_IN/OUT (MFP6: the chip's level while it drives, else MOSI's through
+the resistor), S/R from PB0 to MFP7."""
 _WATCHED: Final[tuple[str, ...]] = ("di1", "mfp_out", "mfp_oe", "mod_ack_n")
 """The outputs the board reads: the return line, the µP interface's pins, /ModAck."""
 RECENT: Final[int] = 256
@@ -97,6 +104,9 @@ class LockstepRing(PinRing):
         The firmware's place now (:class:`Cause`), called at each pin change.
     record:
         Keep every pin trace for :func:`supi3.model.vcd.write_vcd`.
+    intel:
+        The Intel board (MCU-18): SPI1 samples MISO on Ser_IN/OUT (MFP6), MOSI's level where the chip drives it not;
+        else on SerOUT (MFP7), pulled up.
 
     Attributes
     ----------
@@ -115,8 +125,10 @@ class LockstepRing(PinRing):
         /IRQ (MFP3) and /ModAck in the last clock run.
     """
 
-    def __init__(self, chip: Supi3Chip, cpu_hz: float, where: Callable[[], Cause], *, record: bool = False) -> None:
+    def __init__(self, chip: Supi3Chip, cpu_hz: float, where: Callable[[], Cause], *, record: bool = False,
+                 intel: bool = False) -> None:  # fmt: skip
         super().__init__([chip], record)
+        self.miso = SER_IN_OUT_BIT if intel else SEROUT_BIT
         self.chip = chip
         self.cpu_hz = cpu_hz
         self.where = where
@@ -286,7 +298,11 @@ class LockstepRing(PinRing):
         self.last = {name: int(traces[name][-1]) for name in _WATCHED}
         for clock in [c for c in self._samples if start <= c < start + n]:
             k = clock - start
-            level = traces["mfp_out"][k] >> SEROUT_BIT & 1 if traces["mfp_oe"][k] >> SEROUT_BIT & 1 else MISO_PULL_UP
+            bit = self.miso
+            if traces["mfp_oe"][k] >> bit & 1:
+                level = traces["mfp_out"][k] >> bit & 1
+            else:  # Intel: MOSI's level through the resistor; Motorola: the pull-up
+                level = self.inputs["mfp_in"] >> bit & 1 if bit == SER_IN_OUT_BIT else MISO_PULL_UP
             for sample in self._samples.pop(clock):
                 sample.bits[clock] = int(level)
         for name, levels, now in (("irq_n", traces["mfp_out"] >> IRQ_BIT & 1, self.irq_n),
@@ -303,13 +319,15 @@ class LockstepRing(PinRing):
         self.run_levels(wire.status_levels(wire.Cycle.DATA, False, 1))
 
 
-def mcu_lines(traces: dict[str, npt.NDArray[np.int64]]) -> dict[str, npt.NDArray[np.int64]]:
-    """The MCU's lines (:data:`MCU_LINES`) from the recorded pin traces of its chip."""
+def mcu_lines(traces: dict[str, npt.NDArray[np.int64]], *, intel: bool = False) -> dict[str, npt.NDArray[np.int64]]:
+    """The MCU's lines (:data:`MCU_LINES`, the Intel board's :data:`INTEL_LINES`) from the recorded pin traces of
+    its chip."""
     lines = {}
-    for name, (trace, bit, undriven) in MCU_LINES.items():
+    for name, (trace, bit, undriven) in (INTEL_LINES if intel else MCU_LINES).items():
         level = traces[trace] >> bit & 1
-        if undriven is not None:
-            level = np.where(traces["mfp_oe"] >> bit & 1, level, undriven)
+        if trace == "mfp_out":
+            fallback = traces["mfp_in"] >> bit & 1 if undriven is None else undriven
+            level = np.where(traces["mfp_oe"] >> bit & 1, level, fallback)
         lines[name] = level
     return lines
 

@@ -25,6 +25,7 @@ from supi3.interbus.master import ConfigEntry
 from supi3.mcu.board import DEFAULT_MAX_INSTRUCTIONS, FIDELITIES, Board, ViolationAt
 from supi3.mcu.core import FirmwareError, StopReport
 from supi3.sdk.bench import DEFAULT_STRAPS
+from supi3.spi.upif import Mode
 
 __all__ = ["DEFAULT_CYCLES", "POWER_UP_CYCLES", "RING_DEVICE", "FirmwareRun", "run_firmware"]
 
@@ -67,6 +68,8 @@ class FirmwareRun:
     stop: StopReport | None = None
     error: str | None = None
     fidelity: str = "transaction"
+    mode: Mode = Mode.MOTOROLA
+    """The board's wiring: the interface type the firmware initializes (MCU-18)."""
     vcd: Path | None = None
     """The VCD file written (pin level only)."""
 
@@ -103,7 +106,8 @@ class FirmwareRun:
                             "message": str(v.error), "place": v.place} for v in self.violations],
             "stop": None if self.stop is None else {"stop": self.stop.stop.value, "reason": self.stop.reason,
                                                     "pc": self.stop.pc, "text": str(self.stop)},
-            "error": self.error, "fidelity": self.fidelity, "vcd": None if self.vcd is None else str(self.vcd),
+            "error": self.error, "fidelity": self.fidelity,
+            "mode": self.mode.value, "vcd": None if self.vcd is None else str(self.vcd),
         }  # fmt: skip
 
     def __str__(self) -> str:
@@ -111,7 +115,7 @@ class FirmwareRun:
         lines = [f"firmware    {self.firmware.name} on {self.cpu} at {mhz:g} MHz",
                  f"chip        C[4..0] = {self.straps[0]}, MFP[15..12] = {self.straps[1] or '-'}, "
                  f"{self.bit_rate / 1000:g} kbit/s, ring of {self.devices} device(s), {self.cycles} cycles, "
-                 f"{self.fidelity} level",
+                 f"{self.fidelity} level, {self.mode.value} board",
                  "configuration table (the master's ID cycle):"]  # fmt: skip
         if self.config:
             lines.append(f"  {'pos':>3}  {'number':6}  {'ID':>3}  {'length':6}  {'bytes':>5}  interface")
@@ -153,7 +157,7 @@ def run_firmware(firmware: str | Path, *, cpu: str = "cortex_m3", cpu_hz: float 
                  straps: tuple[str, str | None] = DEFAULT_STRAPS, bit_rate: int = 500_000, devices: int = 1,
                  cycles: int = DEFAULT_CYCLES, out_data: bytes | None = None, in_data: bytes | None = None,
                  max_instructions: int = DEFAULT_MAX_INSTRUCTIONS, fidelity: str = "transaction",
-                 vcd: str | Path | None = None) -> FirmwareRun:  # fmt: skip
+                 vcd: str | Path | None = None, mode: Mode = Mode.MOTOROLA) -> FirmwareRun:  # fmt: skip
     """Run ``firmware`` (an ELF for the board port) on the default bench and report (see the module docstring).
 
     ``straps``: C[4..0] and MFP[15..12] (``None``: unset) of the chip (CLK_CONF follows ``bit_rate``);
@@ -163,7 +167,8 @@ def run_firmware(firmware: str | Path, *, cpu: str = "cortex_m3", cpu_hz: float 
     as the chip's data); ``max_instructions``: the budget of each of the two runs (power-up, exchange);
     ``fidelity``: the chip at transaction level or the pin-level whole chip (:data:`~supi3.mcu.board.FIDELITIES`;
     at pin level the chip alone in the ring, ``devices`` 1); ``vcd``: pin level only, the VCD file to write the chip's
-    pins and the MCU's lines to (:meth:`Board.write_vcd`), also when the run stopped.
+    pins and the MCU's lines to (:meth:`Board.write_vcd`), also when the run stopped; ``mode``: the board's wiring
+    for the interface type the firmware initializes (``Board``'s ``mode``, MCU-18).
 
     Bad arguments raise :class:`~supi3.errors.Supi3Error` subclasses; what the firmware does wrong is in the report.
     ``OSError`` if the VCD file cannot be written.
@@ -183,8 +188,9 @@ def run_firmware(firmware: str | Path, *, cpu: str = "cortex_m3", cpu_hz: float 
     config = decode(straps[0], straps[1], clk_conf=tables.clk_conf_for(bit_rate))
     others = [PlainDevice(*RING_DEVICE) for _ in range(devices - 1)]
     board = Board(firmware, cpu=cpu, cpu_hz=cpu_hz, config=config, others=others, strict=False, fidelity=fidelity,
-                  record=vcd is not None)  # fmt: skip
-    report = FirmwareRun(Path(firmware), cpu, cpu_hz, straps, config.bit_rate, devices, cycles, fidelity=fidelity)
+                  record=vcd is not None, mode=mode)  # fmt: skip
+    report = FirmwareRun(Path(firmware), cpu, cpu_hz, straps, config.bit_rate, devices, cycles, fidelity=fidelity,
+                         mode=mode)  # fmt: skip
     master = board.master
     started = time.perf_counter()
     try:
