@@ -578,6 +578,10 @@ FIRMWARE_FAILED_STATUS = 4
 MAX_FIRMWARE_CYCLES = 100_000
 """``firmware run --cycles`` limit (about 6 s of bus time at 500 kbit/s)."""
 
+MAX_PIN_FIRMWARE_CYCLES = MAX_VCD_CYCLES
+"""``firmware run --cycles`` limit with ``--fidelity pin``: every chip clock is a step of the pin-level chip (about
+0.5 s of wall time a cycle at 500 kbit/s), and with ``--vcd`` every pin of every clock is kept, as ``demo --vcd``."""
+
 
 def _firmware_extra() -> None:
     """Refuse ``firmware`` without the firmware extra (unicorn, pyelftools, ziglang), one line, before any work."""
@@ -593,18 +597,31 @@ def cmd_firmware_run(args: argparse.Namespace) -> None:
     """Run a firmware ELF on the emulated board against the chip and report (docs/firmware-in-the-loop.md)."""
     _firmware_extra()
     from supi3.mcu.session import run_firmware
+    from supi3.spi.upif import Mode
 
     if not Path(args.firmware).is_file():
         reason = "not a file" if Path(args.firmware).exists() else "no such file"
         raise CommandLineError(f"FIRMWARE must be an ELF file, not {_shown(args.firmware)} ({reason})")
-    check_int("--cycles", args.cycles, 3, MAX_FIRMWARE_CYCLES)
+    pin = args.fidelity == "pin"
+    if args.vcd is not None and not pin:
+        raise CommandLineError("--vcd needs --fidelity pin (the transaction-level chip has no pins)")
+    if pin and args.devices != 1:
+        raise CommandLineError(f"--devices must be 1 with --fidelity pin (the chip alone in the ring), not "
+                               f"{args.devices}")  # fmt: skip
+    check_int("--cycles", args.cycles, 3, MAX_PIN_FIRMWARE_CYCLES if pin else MAX_FIRMWARE_CYCLES,
+              "with --fidelity pin: every chip clock is stepped" if pin else "")  # fmt: skip
     check_int("--cpu-hz", args.cpu_hz, 1_000_000, 1_000_000_000)
     check_int("--devices", args.devices, 1, 64)
     check_int("--max-instructions", args.max_instructions, 1000, 10**10)
     mfp = args.mfp if args.mfp is not None or args.c != DEFAULT_STRAPS[0] else DEFAULT_STRAPS[1]
-    report = run_firmware(args.firmware, cpu=args.cpu, cpu_hz=float(args.cpu_hz), straps=(args.c, mfp),
-                          bit_rate=_parse_bit_rate(args.bit_rate), devices=args.devices, cycles=args.cycles,
-                          out_data=args.out_data, in_data=args.in_data, max_instructions=args.max_instructions)
+    vcd = None if args.vcd is None else output_file("--vcd", args.vcd)  # before the run, not after it
+    try:
+        report = run_firmware(args.firmware, cpu=args.cpu, cpu_hz=float(args.cpu_hz), straps=(args.c, mfp),
+                              bit_rate=_parse_bit_rate(args.bit_rate), devices=args.devices, cycles=args.cycles,
+                              out_data=args.out_data, in_data=args.in_data, max_instructions=args.max_instructions,
+                              fidelity=args.fidelity, vcd=vcd, mode=Mode(args.mode))  # fmt: skip
+    except OSError as exc:
+        raise CommandLineError(f"cannot write {_shown(str(vcd))} (--vcd): {exc.strerror or exc}") from None
     if args.json:
         print_json(report.as_dict())
     else:
@@ -618,7 +635,7 @@ def cmd_firmware_run(args: argparse.Namespace) -> None:
 def cmd_firmware_build(args: argparse.Namespace) -> None:
     """Build a firmware for the emulated board with the SDK's driver and board port (supi3.mcu.build)."""
     _firmware_extra()
-    from supi3.mcu.build import MACRO_NAME, build
+    from supi3.mcu.build import MACRO_NAME, BuildError, build
 
     out = output_file("-o/--output", args.output)
     defines = {}
@@ -627,7 +644,15 @@ def cmd_firmware_build(args: argparse.Namespace) -> None:
         if not MACRO_NAME.fullmatch(name):
             raise CommandLineError(f"-D must be NAME or NAME=VALUE with a C identifier NAME, not {_shown(text)}")
         defines[name] = value if _ else "1"
-    print(build(args.sources, out, cpu=args.cpu, defines=defines))
+    try:
+        print(build(args.sources, out, cpu=args.cpu, defines=defines))
+    except BuildError as exc:
+        if not exc.output:
+            raise
+        # The compiler's messages as it wrote them, line by line; then the one error line.
+        with contextlib.suppress(OSError, ValueError):
+            sys.stderr.write(exc.output if exc.output.endswith("\n") else exc.output + "\n")
+        raise CommandLineError(f"{exc.summary} (the compiler's messages above)") from None
 
 
 def hex_bytes(text: str) -> bytes:
@@ -785,6 +810,14 @@ def build_parser() -> argparse.ArgumentParser:
                    help="instruction budget of the power-up and of the exchange (default 20000000)")
     p.add_argument("--out", dest="out_data", type=hex_bytes, metavar="HEX", help="the master's OUT data")
     p.add_argument("--in", dest="in_data", type=hex_bytes, metavar="HEX", help="the firmware's input terminals")
+    p.add_argument("--fidelity", choices=["transaction", "pin"], default="transaction",
+                   help="the chip: transaction level (default), or the pin-level whole chip with SPI1 and the GPIO "
+                        "pins on its MFP pins, Table 3-7 checked by the chip (1 device, up to "
+                        f"{MAX_PIN_FIRMWARE_CYCLES} cycles)")  # fmt: skip
+    p.add_argument("--vcd", metavar="PATH", help="with --fidelity pin: write the chip's pins and the MCU's lines")
+    p.add_argument("--mode", choices=["motorola", "intel"], default="motorola",
+                   help="the board's wiring for the interface the firmware initializes: motorola (SPI, default) or "
+                        "intel (S/R on PB0, Ser_IN/OUT half duplex; build with -D FW_MODE=SUPI3_MODE_INTEL)")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_firmware_run)
 

@@ -21,10 +21,13 @@ from pathlib import Path
 from typing import Final
 
 from supi3 import timing
-from supi3.checks import check_bytes, check_int, check_real
+from supi3.checks import check_bool, check_bytes, check_choice, check_instance, check_int, check_real, fail
 from supi3.config import DeviceConfig
+from supi3.errors import Supi3Error
 from supi3.interbus.link import Device
+from supi3.interbus.master import Master
 from supi3.mcu.core import EXTERNAL, CortexM, FirmwareImage, FirmwareStoppedError, Frame, SourceLine, Stop
+from supi3.mcu.pins import SAS_INIT_BIT, SR_BIT, SS_BIT, SYNC_S, Cause, LockstepRing, mcu_lines
 from supi3.mcu.stm32 import (
     AFIO_BASE,
     CR1_CPHA,
@@ -45,11 +48,16 @@ from supi3.mcu.stm32 import (
     Spi,
 )
 from supi3.model.registers import InterfaceViolationError
+from supi3.model.vcd import write_vcd
 from supi3.pinout import C_D_COMMAND
-from supi3.sdk.bench import Bench
+from supi3.sdk.bench import Bench, default_config
+from supi3.spi.upif import Mode, UpifProtocol
+from supi3.tables import CLOCK_HZ
+from supi3.top import Supi3Chip
 
 __all__ = [
     "DEFAULT_MAX_INSTRUCTIONS",
+    "FIDELITIES",
     "PIN_CD",
     "PIN_IO",
     "PIN_IRQ",
@@ -58,6 +66,7 @@ __all__ = [
     "PIN_SS",
     "PIN_STAT_ERR",
     "Board",
+    "BoardError",
     "FwBoard",
     "ViolationAt",
 ]
@@ -72,12 +81,31 @@ PIN_STAT_ERR: Final[int] = 8
 PIN_MODACK: Final[int] = 1
 """On port B: PB1."""
 PORT_B: Final[int] = 1
+PIN_SR: Final[int] = 0
+"""On port B: PB0, S/R to MFP7 on the Intel board (MCU-18)."""
 PULL_UPS: Final[int] = (1 << PIN_SS) | (1 << PIN_STAT_ERR)
 """MCU-6: /SS and /StatErr have pull-ups on the board: high while the MCU does not drive them."""
+_CHIP_INPUTS: Final[dict[int, tuple[str, int]]] = {PIN_SS: ("mfp_in", SS_BIT), PIN_SAS_INIT: ("mfp_in", SAS_INIT_BIT),
+                                                   PIN_STAT_ERR: ("stat_err_n", 0)}  # fmt: skip
+"""At pin level, the chip input (pin, bit) each GPIOA output drives: /SS on MFP5, SAS_INIT on MFP0, /StatErr."""
 MISO_IDLE: Final[int] = 0xFF
 """MCU-6: what the SPI receives when the chip drives no SerOUT (pulled up)."""
 DEFAULT_MAX_INSTRUCTIONS: Final[int] = 20_000_000
 """The instruction budget of one :meth:`Board.run` call unless given."""
+FIDELITIES: Final[tuple[str, ...]] = ("transaction", "pin")
+"""The chip on the board: the transaction-level model (:class:`supi3.sdk.bench.Bench`) or the pin-level whole chip
+(:class:`supi3.top.Supi3Chip` in lockstep with the core, :mod:`supi3.mcu.pins`)."""
+START_WAIT_S: Final[float] = 1e-3
+"""MCU-17: at pin level the master starts (Alarm Stop, ID cycle) once the firmware first sleeps, its set-up done,
+or after this much bus time of idle status telegrams, whichever comes first."""
+SERVE_TELEGRAMS: Final[int] = 64
+"""MCU-17: at pin level, after its last master cycle :meth:`Board.run` idles the line up to this many status
+telegrams while the firmware is still in a handler or has an /IRQ edge to serve."""
+
+
+class BoardError(Supi3Error, RuntimeError):
+    """The board cannot do what was asked at its fidelity (the transaction-level bench at pin level, a VCD at
+    transaction level)."""
 
 
 @dataclass(frozen=True)
@@ -201,11 +229,26 @@ class Board:
     config, bit_rate, others, cycle_time_s, strict, pedantic:
         The bench's (:class:`supi3.sdk.bench.Bench`): the chip's straps, the ring, the master's cycle, and whether
         an interface violation raises (strict) or is only recorded in :attr:`violations`.
+    fidelity:
+        ``"transaction"`` (default): the transaction-level bench, the board checking Table 3-7 on SPI1's transfers;
+        ``"pin"``: the pin-level whole chip in lockstep with the core (:mod:`supi3.mcu.pins`), SPI1 and the GPIO
+        pins driving its MFP pins at chip clocks, Table 3-7 checked by the chip itself; the chip alone in the ring
+        (``others`` empty, MCU-17).
+    record:
+        Pin level only: keep every pin for :meth:`write_vcd`.
+    mode:
+        The board's wiring for the interface type the firmware initializes (Table 3-8): ``Mode.MOTOROLA`` (MISO on
+        SerOUT, MFP7) or ``Mode.INTEL`` (MCU-18: MISO on Ser_IN/OUT, MFP6, MOSI on it through a resistor, S/R from
+        PB0 to MFP7; build the firmware with ``-DFW_MODE=SUPI3_MODE_INTEL``).
 
     Attributes
     ----------
-    core, bench, spi, gpio, exti, rcc:
-        The parts. ``bench.master`` exchanges the process data; ``bench.chip`` is the chip.
+    core, spi, gpio, exti, rcc:
+        The parts. :attr:`master` exchanges the process data.
+    bench:
+        The transaction-level bench (``bench.chip`` is the chip); :class:`BoardError` at pin level.
+    ring, chip:
+        Pin level: the :class:`~supi3.mcu.pins.LockstepRing` and its :class:`~supi3.top.Supi3Chip`.
     fw_board:
         The firmware's ``fw_board`` (:class:`FwBoard`), if the ELF has that symbol.
     interrupts:
@@ -218,13 +261,27 @@ class Board:
 
     def __init__(self, firmware: str | Path | FirmwareImage, *, cpu: str = "cortex_m3", cpu_hz: float = 48e6,
                  config: DeviceConfig | None = None, bit_rate: int = 500_000, others: Sequence[Device] = (),
-                 cycle_time_s: float | None = None, strict: bool = True, pedantic: bool = False) -> None:  # fmt: skip
-        self.bench = _BoardBench(config, bit_rate=bit_rate, others=others, cycle_time_s=cycle_time_s, strict=strict,
-                                 pedantic=pedantic)  # fmt: skip
+                 cycle_time_s: float | None = None, strict: bool = True, pedantic: bool = False,
+                 fidelity: str = "transaction", record: bool = False, mode: Mode = Mode.MOTOROLA) -> None:  # fmt: skip
+        self.fidelity = check_choice("fidelity", fidelity, FIDELITIES)
+        self.intel = check_instance("mode", mode, Mode) is Mode.INTEL
+        self._s_r = 1  # PB0: S/R, 1 = the µP sends
+        check_bool("record", record)
         self.core = CortexM(firmware, cpu=cpu, cpu_hz=cpu_hz)
-        self.registers = self.bench.registers
-        self.protocol = self.bench.transport.protocol
-        bit_rate = self.bench.config.bit_rate
+        self._bench: _BoardBench | None = None
+        self._ring: LockstepRing | None = None
+        self.protocol: UpifProtocol
+        if fidelity == "pin":
+            self._pin_setup(config, bit_rate, others, cycle_time_s, strict, pedantic, record)
+        else:
+            if record:
+                raise fail("record", "False at transaction level (the chip has no pins: fidelity='pin')", record)
+            self._bench = bench = _BoardBench(config, bit_rate=bit_rate, others=others, cycle_time_s=cycle_time_s,
+                                              strict=strict, pedantic=pedantic)  # fmt: skip
+            self.registers = bench.registers
+            self.protocol = bench.transport.protocol
+            self.config = bench.config
+        bit_rate = self.config.bit_rate
         self._limits = {symbol: timing.limit("3-7", symbol, bit_rate) for symbol in ("t0", "t1", "t2", "t8")}
         self._limits["t6max"] = timing.limit("3-7", "t6", bit_rate, maximum=True)
         self._limits["t_SAS_INIT"] = timing.limit("3-7", "t_SAS_INIT", bit_rate)
@@ -232,7 +289,8 @@ class Board:
         self.exti = Exti(self.rcc)
         self.gpio = Gpio(self.rcc, IOPAEN, "GPIOA", self._inputs, self._on_output, PULL_UPS)
         self.gpio_b = Gpio(self.rcc, IOPBEN, "GPIOB", self._inputs_b, self._on_output_b, 0)
-        self.spi = Spi(self.rcc, self.core.cycles_now, self, self.core.cycles_polled)
+        self.spi = Spi(self.rcc, self.core.cycles_now, self if self._ring is None else self._ring,
+                       self.core.cycles_polled)  # fmt: skip
         self.spi.on_poll = self.core.skip_poll
         core = self.core
         core.mmio(RCC_BASE, PERIPHERAL_SIZE, self.rcc.read, self.rcc.write)
@@ -253,6 +311,102 @@ class Board:
         self._irq_level = 1
         self._irq_fell: int | None = None
         self._mod_ack_until = 0
+        self._limit = self._budget = 0
+        self._held: list[tuple[str, int, int]] | None = None  # pin level: edges held while a sleeping core waits
+
+    def _pin_setup(self, config: DeviceConfig | None, bit_rate: int, others: Sequence[Device],
+                   cycle_time_s: float | None, strict: bool, pedantic: bool, record: bool) -> None:  # fmt: skip
+        """The pin-level chip, its ring and master (MCU-14 to MCU-17)."""
+        self.config = default_config(bit_rate) if config is None else check_instance("config", config, DeviceConfig)
+        if others:
+            raise fail("others", "empty at pin level (the chip alone in the ring, MCU-17)", others)
+        self._cycle_time_s = None if cycle_time_s is None else check_real("cycle_time_s", cycle_time_s, 0.0)
+        self.chip = chip = Supi3Chip(self.config, strict=check_bool("strict", strict),
+                                     pedantic=check_bool("pedantic", pedantic))  # fmt: skip
+        if chip.upif is None or chip.chip.registers is None:
+            raise fail("config", "the straps of an Init-µP mode (Tables 2-4 to 2-7)", self.config.function)
+        self.registers = chip.chip.registers
+        self.protocol = chip.upif.protocol
+        self._ring = ring = LockstepRing(chip, self.core.cpu_hz, self._cause, record=record, intel=self.intel)
+        ring.runner = self._lockstep
+        ring.on_edge = self._pin_edge
+        ring.on_violation = self._pin_violation
+        self._master = Master(ring, locate=False, max_devices=1)
+        self._cycles_done = 0
+
+    # -- what both fidelities show -----------------------------------------------------------------------------
+
+    @property
+    def bench(self) -> _BoardBench:
+        """The transaction-level bench (:class:`BoardError` at pin level: use :attr:`master`, :attr:`ring`)."""
+        if self._bench is None:
+            raise BoardError("Board.bench is the transaction-level bench; this board runs the pin-level chip "
+                             "(fidelity='pin'): use board.master, board.ring, board.chip")  # fmt: skip
+        return self._bench
+
+    @property
+    def ring(self) -> LockstepRing:
+        """The pin-level ring (:class:`BoardError` at transaction level)."""
+        if self._ring is None:
+            raise BoardError("Board.ring is the pin-level ring; this board runs the transaction-level chip "
+                             "(fidelity='transaction')")  # fmt: skip
+        return self._ring
+
+    @property
+    def master(self) -> Master:
+        """The INTERBUS master: it exchanges the process data with the chip."""
+        return self.bench.master if self._ring is None else self._master
+
+    @property
+    def cycles(self) -> int:
+        """Master cycles finished (ID and data)."""
+        return self.bench.cycles if self._ring is None else self._cycles_done
+
+    @property
+    def now(self) -> float:
+        """Bus time, seconds since power-up (at pin level: the chip's clocks run)."""
+        return self.bench.now if self._ring is None else self._ring.now
+
+    def write_vcd(self, path: str | Path) -> Path:
+        """Write the chip's pins (scope ``dev1``, :func:`supi3.model.vcd.write_vcd`) and the MCU's lines (scope
+        ``mcu``: the GPIO and SPI1 pins of board.h, named ``pa5_sck`` ...) to the VCD file ``path``.
+
+        Raises
+        ------
+        BoardError
+            The board is not a pin-level one made with ``record=True``.
+        OSError
+            The file cannot be written.
+        """
+        ring = self.ring
+        if not ring.record:
+            raise BoardError("Board.write_vcd needs a board made with record=True")
+        return write_vcd(Path(path), ring, {"mcu": mcu_lines(ring.recorded()[0], intel=self.intel)})
+
+    def _cause(self) -> Cause:
+        core = self.core
+        pc = core.pc
+        return Cause(pc, core.image.function_at(pc), core.backtrace())
+
+    def _pin_edge(self, name: str, level: int, clock: int) -> None:
+        """/IRQ or /ModAck changed in chip clock ``clock`` (held while a sleeping core waits for it)."""
+        if self._held is not None:
+            self._held.append((name, level, clock))
+            return
+        if name == "mod_ack_n":
+            self.exti.edge(PORT_B, PIN_MODACK, level)
+        elif level != self._irq_level:
+            self._irq_level = level
+            if not level and self._irq_fell is None:
+                self._irq_fell = self.ring.core_cycle(clock)
+            self.exti.edge(0, PIN_IRQ, level)
+        self._request()
+
+    def _pin_violation(self, error: InterfaceViolationError, clock: int, cause: Cause | None) -> None:
+        if cause is None:
+            self.violations.append(ViolationAt.now(self.core, clock / CLOCK_HZ, error))
+        else:
+            self.violations.append(ViolationAt(clock / CLOCK_HZ, cause.pc, cause.function, error, cause.backtrace))
 
     # -- time --------------------------------------------------------------------------------------------------
 
@@ -302,22 +456,43 @@ class Board:
     # -- pins --------------------------------------------------------------------------------------------------
 
     def _inputs(self) -> int:
+        ring = self._ring
+        if ring is not None:
+            ring.sync_to_core(self.core.cycles_now())
+            return ring.irq_n << PIN_IRQ | ring.c_d << PIN_CD | ring.io << PIN_IO
         cycles = self._now()
         cd = self.protocol.c_d if cycles >= self._ss_rise + self._cycles(self._limits["t6max"]) else self._cd_before
         return self.registers.irq_n << PIN_IRQ | cd << PIN_CD | int(self.registers.io_access) << PIN_IO
 
     def _inputs_b(self) -> int:
+        ring = self._ring
+        if ring is not None:
+            ring.sync_to_core(self.core.cycles_now())
+            return ring.mod_ack_n << PIN_MODACK
         self._now()
         return self.bench.mod_ack << PIN_MODACK
 
     def _on_output_b(self, pin: int, level: int) -> None:
-        """Port B drives nothing the chip sees."""
-        del pin, level
+        """Port B drives S/R (PB0, MFP7) on the Intel board, nothing the chip sees on the Motorola board."""
+        if not self.intel or pin != PIN_SR:
+            return
+        ring = self._ring
+        if ring is not None:
+            ring.drive(self.core.cycles_now(), "mfp_in", SR_BIT, level)
+        else:
+            self._now()
+            self._s_r = level
 
     def _cycles(self, seconds: float) -> int:
         return math.ceil(seconds * self.core.cpu_hz - 1e-6)
 
     def _on_output(self, pin: int, level: int) -> None:
+        ring = self._ring
+        if ring is not None:
+            wire = _CHIP_INPUTS.get(pin)
+            if wire is not None:
+                ring.drive(self.core.cycles_now(), *wire, level)
+            return
         cycles = self._now()
         if pin == PIN_SS:
             self._ss_edge(level, cycles)
@@ -344,7 +519,7 @@ class Board:
             driven: list[int | None] = [None]
 
             def begin() -> None:
-                driven[0] = self.protocol.begin(True)
+                driven[0] = self.protocol.begin(bool(self._s_r) if self.intel else True)
 
             self._chip(begin, cycles)
             self._frame = _Frame(cycles, driven[0], [])
@@ -361,7 +536,9 @@ class Board:
             if cycles - last < self._cycles(self._limits["t2"]):
                 self._violation("Table 3-7 t2", f"/SS rose {self._ns(cycles - last)} ns after the last SCLK edge, "
                                 f"less than t2 = {self._limits['t2'] * 1e9:.0f} ns")  # fmt: skip
-            self._chip(lambda: self.protocol.end(tx), cycles)
+            # An Intel receive frame: the chip's driver wins on Ser_IN/OUT, it takes its own byte (MCU-18).
+            on_line = frame.driven if self.intel and frame.driven is not None else tx
+            self._chip(lambda: self.protocol.end(on_line), cycles)
         else:
             self._chip(lambda: self.protocol.abort(edges), cycles)
 
@@ -380,13 +557,14 @@ class Board:
             self._violation("3.4.2", f"byte {tx:02X}h clocked with /SS high: the chip ignores it")
             return MISO_IDLE
         lsb = bool(cr1 & CR1_LSBFIRST)
-        seen = _reverse(tx & 0xFF) if lsb else tx & 0xFF
+        reverse = lsb != (self.protocol.mode is Mode.INTEL)  # the chip shifts LSB first in Intel mode (UP-6)
+        seen = _reverse(tx & 0xFF) if reverse else tx & 0xFF
         if not frame.transfers and start + period // 2 - frame.fall < self._cycles(self._limits["t1"]):
             self._violation("Table 3-7 t1", f"first SCLK edge {self._ns(start + period // 2 - frame.fall)} ns after "
                             f"/SS fell, less than t1 = {self._limits['t1'] * 1e9:.0f} ns")  # fmt: skip
         frame.transfers.append((seen, bits, start, period))
         driven = MISO_IDLE if frame.driven is None else frame.driven
-        return _reverse(driven) if lsb else driven
+        return _reverse(driven) if reverse else driven
 
     # -- the chip and its violations ---------------------------------------------------------------------------
 
@@ -413,7 +591,9 @@ class Board:
 
     def run(self, cycles: int, *, max_instructions: int = DEFAULT_MAX_INSTRUCTIONS) -> None:
         """Run the firmware until ``cycles`` more master cycles have finished and it has served the interrupts they
-        raised (as :meth:`Bench.run` takes the last cycle's interrupt).
+        raised (as :meth:`Bench.run` takes the last cycle's interrupt). At pin level the master's cycles run whole,
+        and the run goes on while the firmware is in a handler or has an /IRQ edge to serve, up to
+        :data:`SERVE_TELEGRAMS` status telegrams (MCU-17).
 
         Raises
         ------
@@ -424,45 +604,124 @@ class Board:
         InterfaceViolationError
             In strict mode, the first rule the firmware broke, with a note: bus time, PC and function.
         """
-        target = self.bench.cycles + check_int("cycles", cycles, 0)
+        target = self.cycles + check_int("cycles", cycles, 0)
+        if self._ring is not None:
+            self._run_pin(lambda: self._cycles_done >= target, max_instructions)
+            return
         self._run(lambda: self.bench.cycles >= target and not self.core.in_exception, max_instructions)
 
     def run_for(self, seconds: float, *, max_instructions: int = DEFAULT_MAX_INSTRUCTIONS) -> None:
-        """Run the firmware for ``seconds`` of bus time (raises as :meth:`run`)."""
+        """Run the firmware for ``seconds`` of bus time (raises as :meth:`run`; at pin level to the end of the
+        master cycle running then)."""
         end = self.core.cycles + self._cycles(check_real("seconds", seconds, 0.0))
+        if self._ring is not None:
+            self._run_pin(lambda: self.core.cycles >= end, max_instructions)
+            return
         self._run(lambda: self.core.cycles >= end, max_instructions, end)
 
     def _run(self, done: Callable[[], bool], max_instructions: int, end: int | None = None) -> None:
         core = self.core
-        limit = core.instructions + check_int("max_instructions", max_instructions, 1)
+        self._set_budget(max_instructions)
         self.sync(core.cycles)
         while True:
             core.systick.update()
             self._request()
             if done():
                 return
-            if core.instructions >= limit:
-                raise FirmwareStoppedError(core.report(Stop.BUDGET, f"instruction budget of {max_instructions} used up "
-                                                  "(an endless loop?)"))  # fmt: skip
             deadline = event = math.ceil(self.bench.next_event_s() * core.cpu_hz)
             tick = core.systick.next_event()
             for bound in (tick, end):
                 if bound is not None:
                     deadline = min(deadline, bound)
-            try:
-                state = core.step(max(deadline, core.cycles + 1))
-            except InterfaceViolationError as error:
-                where = next((v for v in reversed(self.violations) if v.error is error), None)
-                if where is None:  # raised by the bus between two accesses: where the core stopped
-                    where = ViolationAt.now(core, core.time_s, error)
-                error.add_note(f"firmware at {where.place}")
-                raise
-            if state == "run" and core.idle_loop():
-                if core.active:
-                    raise FirmwareStoppedError(core.report(Stop.HANG, f"endless loop (b .) in the handler of exception "
-                                                      f"{core.active[-1]}"))  # fmt: skip
-                core.sleeping = True
+            self._step(deadline)
             self.sync(core.cycles, event if event <= core.cycles else None)
+
+    def _set_budget(self, max_instructions: int) -> None:
+        self._budget = check_int("max_instructions", max_instructions, 1)
+        self._limit = self.core.instructions + self._budget
+
+    def _step(self, deadline: int) -> None:
+        """One run of the core up to ``deadline`` (at least one block), within the instruction budget."""
+        core = self.core
+        if core.instructions >= self._limit:
+            raise FirmwareStoppedError(core.report(Stop.BUDGET, f"instruction budget of {self._budget} used up "
+                                                   "(an endless loop?)"))  # fmt: skip
+        try:
+            state = core.step(max(deadline, core.cycles + 1))
+        except InterfaceViolationError as error:
+            self._place(error)
+            raise
+        if state == "run" and core.idle_loop():
+            if core.active:
+                raise FirmwareStoppedError(core.report(Stop.HANG, f"endless loop (b .) in the handler of exception "
+                                                  f"{core.active[-1]}"))  # fmt: skip
+            core.sleeping = True
+
+    def _place(self, error: InterfaceViolationError) -> None:
+        """Note on ``error`` where the firmware broke the rule (once)."""
+        if any(note.startswith("firmware at ") for note in getattr(error, "__notes__", ())):
+            return
+        where = next((v for v in reversed(self.violations) if v.error is error), None)
+        if where is None:  # raised by the bus between two accesses: where the core stopped
+            where = ViolationAt.now(self.core, self.core.time_s, error)
+        error.add_note(f"firmware at {where.place}")
+
+    # -- running at pin level ------------------------------------------------------------------------------------
+
+    def _run_pin(self, done: Callable[[], bool], max_instructions: int) -> None:
+        core, ring, master = self.core, self.ring, self._master
+        self._set_budget(max_instructions)
+        try:
+            while not done():
+                start = ring.now
+                if self._cycles_done:
+                    master.cycle()
+                else:
+                    ring.settle()  # the power-up reset stretch (as supi3 demo --vcd)
+                    while not core.sleeping and ring.now < START_WAIT_S:
+                        ring.status_telegram()
+                    master.start()
+                self._cycles_done += 1
+                if self._cycle_time_s is not None:
+                    ring.idle(max(0.0, start + self._cycle_time_s - ring.now))
+            for _ in range(SERVE_TELEGRAMS):
+                if not core.in_exception and self._irq_fell is None:
+                    break
+                ring.status_telegram()
+        except InterfaceViolationError as error:
+            self._place(error)
+            raise
+
+    def _lockstep(self, clock: int) -> None:
+        """:attr:`LockstepRing.runner`: run the firmware and the chip until the chip has clocked ``clock`` cycles
+        (MCU-14: the chip catches up at each peripheral access and every :data:`~supi3.mcu.pins.SYNC_S`; a sleeping
+        core sleeps until the chip clock where /IRQ or /ModAck changes)."""
+        core, ring = self.core, self.ring
+        end = ring.core_cycle(clock)
+        interval = max(1, self._cycles(SYNC_S))
+        while ring.cycle < clock:
+            if core.cycles >= end:  # the core ran past the chip's target in its last block
+                ring.sync(clock)
+                break
+            core.systick.update()
+            self._request()
+            tick = core.systick.next_event()
+            if core.sleeping:
+                stop = clock if tick is None else min(clock, ring.clock_of(tick))
+                held: list[tuple[str, int, int]] = []
+                self._held = held
+                try:
+                    reached = ring.sync(stop, until_edge=True)
+                finally:
+                    self._held = None
+                wake = ring.core_cycle(reached - 1) if held else (end if stop == clock else tick)
+                self._step(max(core.cycles, wake if wake is not None else end))
+                for edge in held:
+                    self._pin_edge(*edge)
+                continue
+            deadline = min(end, core.cycles + interval, end if tick is None else tick)
+            self._step(deadline)
+            ring.sync(min(clock, ring.clock_of(core.cycles)))
 
 
 def _reverse(byte: int) -> int:

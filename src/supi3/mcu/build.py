@@ -39,7 +39,23 @@ MACRO_NAME: Final[re.Pattern[str]] = re.compile(r"[A-Za-z_][A-Za-z0-9_]*", re.AS
 
 
 class BuildError(Supi3Error, RuntimeError):
-    """The firmware did not compile or link (the compiler's messages are in the text), or there is no ziglang."""
+    """The firmware did not compile or link, or there is no ziglang.
+
+    Attributes
+    ----------
+    summary:
+        What failed, one line.
+    output:
+        The compiler's messages, lines as it wrote them ("" if none); the text of the error is the summary and them.
+    """
+
+    def __init__(self, summary: str, output: str = "") -> None:
+        self.summary = summary
+        self.output = output
+        super().__init__(f"{summary}:\n{output}" if output else summary)
+
+    def __reduce__(self) -> tuple[object, ...]:
+        return (type(self), (self.summary, self.output))
 
 
 def toolchain_missing() -> str | None:
@@ -97,5 +113,5 @@ def build(sources: str | Path | Sequence[str | Path], output: str | Path, *, cpu
                             compiler_rt=compiler_rt, port=port)  # fmt: skip
     result = subprocess.run(command, capture_output=True, text=True, check=False)
     if result.returncode != 0:
-        raise BuildError(f"the firmware does not build for {cpu}:\n{result.stderr}")
+        raise BuildError(f"the firmware does not build for {cpu}", result.stderr)
     return Path(output)

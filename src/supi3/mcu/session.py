@@ -5,7 +5,8 @@ every interface violation is kept), power-up and the ID cycle, then the master's
 terminals set and the remaining cycles run. The report (:class:`FirmwareRun`) holds the master's configuration
 table, the process data both ways, the interrupts and their latency, every violation with its bus time, program
 counter, function and source line, and, if the firmware faulted, hung or used up its budget, the core's report.
-Guide: docs/firmware-in-the-loop.md.
+With ``fidelity="pin"`` the chip is the pin-level whole chip (:mod:`supi3.mcu.pins`), and ``vcd`` writes its pins
+and the MCU's lines. Guide: docs/firmware-in-the-loop.md.
 """
 
 from __future__ import annotations
@@ -16,14 +17,15 @@ from pathlib import Path
 from typing import Final
 
 from supi3 import tables, timing
-from supi3.checks import check_bytes, check_int, fail
+from supi3.checks import check_bytes, check_choice, check_int, fail
 from supi3.config import decode
 from supi3.errors import Supi3Error
 from supi3.interbus.device import PlainDevice
 from supi3.interbus.master import ConfigEntry
-from supi3.mcu.board import DEFAULT_MAX_INSTRUCTIONS, Board, ViolationAt
+from supi3.mcu.board import DEFAULT_MAX_INSTRUCTIONS, FIDELITIES, Board, ViolationAt
 from supi3.mcu.core import FirmwareError, StopReport
 from supi3.sdk.bench import DEFAULT_STRAPS
+from supi3.spi.upif import Mode
 
 __all__ = ["DEFAULT_CYCLES", "POWER_UP_CYCLES", "RING_DEVICE", "FirmwareRun", "run_firmware"]
 
@@ -65,6 +67,11 @@ class FirmwareRun:
     violations: list[ViolationAt] = field(default_factory=list)
     stop: StopReport | None = None
     error: str | None = None
+    fidelity: str = "transaction"
+    mode: Mode = Mode.MOTOROLA
+    """The board's wiring: the interface type the firmware initializes (MCU-18)."""
+    vcd: Path | None = None
+    """The VCD file written (pin level only)."""
 
     @property
     def data_ok(self) -> bool:
@@ -99,14 +106,16 @@ class FirmwareRun:
                             "message": str(v.error), "place": v.place} for v in self.violations],
             "stop": None if self.stop is None else {"stop": self.stop.stop.value, "reason": self.stop.reason,
                                                     "pc": self.stop.pc, "text": str(self.stop)},
-            "error": self.error,
+            "error": self.error, "fidelity": self.fidelity,
+            "mode": self.mode.value, "vcd": None if self.vcd is None else str(self.vcd),
         }  # fmt: skip
 
     def __str__(self) -> str:
         mhz = self.cpu_hz / 1e6
         lines = [f"firmware    {self.firmware.name} on {self.cpu} at {mhz:g} MHz",
                  f"chip        C[4..0] = {self.straps[0]}, MFP[15..12] = {self.straps[1] or '-'}, "
-                 f"{self.bit_rate / 1000:g} kbit/s, ring of {self.devices} device(s), {self.cycles} cycles",
+                 f"{self.bit_rate / 1000:g} kbit/s, ring of {self.devices} device(s), {self.cycles} cycles, "
+                 f"{self.fidelity} level, {self.mode.value} board",
                  "configuration table (the master's ID cycle):"]  # fmt: skip
         if self.config:
             lines.append(f"  {'pos':>3}  {'number':6}  {'ID':>3}  {'length':6}  {'bytes':>5}  interface")
@@ -124,13 +133,15 @@ class FirmwareRun:
                      "leaves the firmware after /IRQ (T = 13 (5 + n) t_Bit, 3.4.14)"),
                   f"run         {self.bus_time_s * 1e3:.3f} ms of bus time, {self.instructions} instructions, "
                   f"{self.core_cycles} core cycles, {self.wall_s:.2f} s wall "
-                  f"({self.bus_time_s / max(self.wall_s, 1e-9):.3f}x real time)"]  # fmt: skip
+                  f"({self.bus_time_s / max(self.wall_s, 1e-9):.3g}x real time)"]  # fmt: skip
         lines.append(f"violations  {len(self.violations) or 'none'}")
         lines += [f"  {v.error.rule}: {v.error}\n    at {v.place}" for v in self.violations]
         if self.stop is not None:
             lines.append(f"STOPPED     {self.stop}")
         if self.error is not None:
             lines.append(f"STOPPED     the bench: {self.error}")
+        if self.vcd is not None:
+            lines.append(f"wrote       {self.vcd}")
         return "\n".join(lines)
 
 
@@ -145,18 +156,29 @@ def _spaced(data: bytes | None) -> str:
 def run_firmware(firmware: str | Path, *, cpu: str = "cortex_m3", cpu_hz: float = 48e6,
                  straps: tuple[str, str | None] = DEFAULT_STRAPS, bit_rate: int = 500_000, devices: int = 1,
                  cycles: int = DEFAULT_CYCLES, out_data: bytes | None = None, in_data: bytes | None = None,
-                 max_instructions: int = DEFAULT_MAX_INSTRUCTIONS) -> FirmwareRun:  # fmt: skip
+                 max_instructions: int = DEFAULT_MAX_INSTRUCTIONS, fidelity: str = "transaction",
+                 vcd: str | Path | None = None, mode: Mode = Mode.MOTOROLA) -> FirmwareRun:  # fmt: skip
     """Run ``firmware`` (an ELF for the board port) on the default bench and report (see the module docstring).
 
     ``straps``: C[4..0] and MFP[15..12] (``None``: unset) of the chip (CLK_CONF follows ``bit_rate``);
     ``devices``: the ring's length, the chip first and :data:`RING_DEVICE` modules behind it; ``cycles``: master
     cycles in all;
     ``out_data``/``in_data``: the master's OUT data and the firmware's input terminals (default: a pattern as long
-    as the chip's data); ``max_instructions``: the budget of each of the two runs (power-up, exchange).
+    as the chip's data); ``max_instructions``: the budget of each of the two runs (power-up, exchange);
+    ``fidelity``: the chip at transaction level or the pin-level whole chip (:data:`~supi3.mcu.board.FIDELITIES`;
+    at pin level the chip alone in the ring, ``devices`` 1); ``vcd``: pin level only, the VCD file to write the chip's
+    pins and the MCU's lines to (:meth:`Board.write_vcd`), also when the run stopped; ``mode``: the board's wiring
+    for the interface type the firmware initializes (``Board``'s ``mode``, MCU-18).
 
     Bad arguments raise :class:`~supi3.errors.Supi3Error` subclasses; what the firmware does wrong is in the report.
+    ``OSError`` if the VCD file cannot be written.
     """
-    devices = check_int("devices", devices, 1, 64)
+    fidelity = check_choice("fidelity", fidelity, FIDELITIES)
+    if vcd is not None and fidelity != "pin":
+        raise fail("vcd", "None at transaction level (a VCD holds pins: fidelity='pin')", vcd)
+    pin = fidelity == "pin"
+    devices = check_int("devices", devices, 1, 1 if pin else 64, "the chip alone in the ring at pin level, MCU-17"
+                        if pin else "")  # fmt: skip
     cycles = check_int("cycles", cycles, POWER_UP_CYCLES, 100_000)
     max_instructions = check_int("max_instructions", max_instructions, 1)
     out_data = None if out_data is None else check_bytes("out_data", out_data)
@@ -165,17 +187,20 @@ def run_firmware(firmware: str | Path, *, cpu: str = "cortex_m3", cpu_hz: float 
         raise fail("straps", "a pair (C[4..0], MFP[15..12] or None)", straps)
     config = decode(straps[0], straps[1], clk_conf=tables.clk_conf_for(bit_rate))
     others = [PlainDevice(*RING_DEVICE) for _ in range(devices - 1)]
-    board = Board(firmware, cpu=cpu, cpu_hz=cpu_hz, config=config, others=others, strict=False)
-    report = FirmwareRun(Path(firmware), cpu, cpu_hz, straps, config.bit_rate, devices, cycles)
+    board = Board(firmware, cpu=cpu, cpu_hz=cpu_hz, config=config, others=others, strict=False, fidelity=fidelity,
+                  record=vcd is not None, mode=mode)  # fmt: skip
+    report = FirmwareRun(Path(firmware), cpu, cpu_hz, straps, config.bit_rate, devices, cycles, fidelity=fidelity,
+                         mode=mode)  # fmt: skip
+    master = board.master
     started = time.perf_counter()
     try:
         board.run(POWER_UP_CYCLES, max_instructions=max_instructions)
-        report.config = board.bench.master.config
+        report.config = master.config
         size = report.config[0].data_bytes if report.config else 0
         report.sent_out = (bytes([0x12, 0x34, 0x56, 0x78] * 8) if out_data is None else out_data)[:size]
         report.firmware_inputs = (bytes([0xAB, 0xCD, 0xEF, 0x01] * 8) if in_data is None else in_data)[:size]
         if size:
-            board.bench.master.set_outputs(1, report.sent_out)
+            master.set_outputs(1, report.sent_out)
             if board.fw_board is not None:
                 board.fw_board.inputs = report.firmware_inputs
         board.run(cycles - POWER_UP_CYCLES, max_instructions=max_instructions)
@@ -184,18 +209,20 @@ def run_firmware(firmware: str | Path, *, cpu: str = "cortex_m3", cpu_hz: float 
     except Supi3Error as error:  # the bench cannot go on (a stuck firmware, a chip refusing the straps' mode)
         report.error = str(error)
     report.wall_s = time.perf_counter() - started
-    report.config = board.bench.master.config
+    report.config = master.config
     if report.config:
         network_bytes = sum(entry.data_bytes for entry in report.config)
         report.access_time_s = timing.cpu_access_time_s(network_bytes, report.bit_rate)
     if report.sent_out and board.fw_board is not None:
         report.firmware_outputs = board.fw_board.outputs[: len(report.sent_out)]
     if report.sent_out:
-        report.master_inputs = board.bench.master.inputs(1)
+        report.master_inputs = master.inputs(1)
     report.interrupts = board.interrupts
     report.irq_latency_s = board.irq_latency_s
     report.instructions = board.core.instructions
     report.core_cycles = board.core.cycles
-    report.bus_time_s = board.bench.now
+    report.bus_time_s = board.now
     report.violations = list(board.violations)
+    if vcd is not None:
+        report.vcd = board.write_vcd(vcd)
     return report

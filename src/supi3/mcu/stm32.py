@@ -247,9 +247,10 @@ class Exti:
 class SpiWire(Protocol):
     """The other end of the SPI peripheral's pins: the board."""
 
-    def spi_byte(self, tx: int, bits: int, start: int, period: int, cr1: int) -> int:
+    def spi_byte(self, tx: int, bits: int, start: int, period: int, cr1: int) -> int | Callable[[], int]:
         """A transfer of ``bits`` bits starts at cycle ``start``, one SCLK period every ``period`` cycles, with
-        CR1 ``cr1``: return what MISO shifts in (as the data register will hold it)."""
+        CR1 ``cr1``: return what MISO shifts in (as the data register will hold it), or what reads it when the
+        transfer has ended (a pin-level chip drives MISO bit by bit)."""
 
 
 class Spi:
@@ -283,7 +284,7 @@ class Spi:
         self.tx_buffer: int | None = None
         self.rx_buffer: int | None = None
         self.rx_last = 0
-        self.shifting: tuple[int, int, int] | None = None  # (received byte, start cycle, end cycle)
+        self.shifting: tuple[int | Callable[[], int], int, int] | None = None  # (received, start cycle, end cycle)
         self.transfers = 0
 
     @property
@@ -298,7 +299,7 @@ class Spi:
             if self.rx_buffer is not None:
                 self.ovr = True  # the new byte is lost (25.3.10)
             else:
-                self.rx_buffer = received
+                self.rx_buffer = received if isinstance(received, int) else received()
             if self.tx_buffer is not None and self.cr1 & CR1_SPE:
                 self._start(end)
 

@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from os import PathLike
 from pathlib import Path
 
 import numpy as np
+import numpy.typing as npt
 from vcd import VCDWriter
 from vcd.writer import Variable
 
@@ -33,8 +35,10 @@ def mfp_signals(config: DeviceConfig) -> list[tuple[int, str]]:
     return named
 
 
-def write_vcd(path: Path, ring: PinRing) -> Path:
-    """Write every pin of every chip of ``ring`` (made with ``record=True``) to ``path``.
+def write_vcd(path: Path, ring: PinRing, scopes: Mapping[str, Mapping[str, npt.NDArray[np.int64]]] | None = None
+              ) -> Path:  # fmt: skip
+    """Write every pin of every chip of ``ring`` (made with ``record=True``) to ``path``, and the 1-bit ``scopes``
+    given (scope name -> signal name -> a level per clock over the whole recording, e.g. a board's own lines).
 
     Scopes are ``dev1`` .. ``devN`` in ring order; ``dev1.do1`` is the master's forward line and ``dev1.di1``
     the return line into the master. Besides the 16-bit ``mfp_in``/``mfp_out``/``mfp_oe`` vectors, every MFP the
@@ -67,10 +71,19 @@ def write_vcd(path: Path, ring: PinRing) -> Path:
                     widths[name] = 1
                     traces[name] = np.where((driven >> pin) & 1, traces["mfp_out"] >> pin, traces["mfp_in"] >> pin) & 1
             for name, trace in sorted(traces.items()):
-                var = writer.register_var(f"dev{k}", name, "wire", size=widths[name], init=int(trace[0]))
-                at = np.flatnonzero(np.diff(trace)) + 1
-                changes.extend((int(t), len(changes), var, int(trace[t])) for t in at)
+                _add(writer, changes, f"dev{k}", name, widths[name], trace)
+        for scope, signals in (scopes or {}).items():
+            for name, trace in sorted(signals.items()):
+                _add(writer, changes, scope, name, 1, trace)
         changes.sort(key=lambda change: (change[0], change[1]))
         for cycle, _, var, value in changes:
             writer.change(var, cycle * CLOCK_PS, value)
     return path
+
+
+def _add(writer: VCDWriter, changes: list[tuple[int, int, Variable[int], int]], scope: str, name: str, size: int,
+         trace: npt.NDArray[np.int64]) -> None:  # fmt: skip
+    """Register ``scope.name`` and queue its changes (clock, order, variable, level)."""
+    var = writer.register_var(scope, name, "wire", size=size, init=int(trace[0]))
+    at = np.flatnonzero(np.diff(trace)) + 1
+    changes.extend((int(t), len(changes), var, int(trace[t])) for t in at)

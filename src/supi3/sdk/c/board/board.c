@@ -51,7 +51,14 @@ static void board_delay_us(void *user, uint32_t us)
 static int board_xfer(void *user, uint8_t tx, uint8_t *rx, int s_r)
 {
     (void)user;
-    (void)s_r; /* Motorola mode only on this board: no S/R pin */
+    if (FW_MODE == SUPI3_MODE_INTEL) { /* S/R before /SS falls (t10); receiving, MOSI sends FFh (MCU-18) */
+        if (s_r != 0) {
+            GPIOB_BSRR = PIN(BOARD_PIN_SR);
+        } else {
+            GPIOB_BRR = PIN(BOARD_PIN_SR);
+            tx = 0xFFu;
+        }
+    }
     GPIOA_BRR = PIN(BOARD_PIN_SS);
     SPI1_DR = tx;
     while ((SPI1_SR & SPI_SR_RXNE) == 0u) {
@@ -133,9 +140,11 @@ static void board_init(void)
     GPIOA_CRH = GPIO_CFG_OUTPUT_PP_2MHZ << (4u * (BOARD_PIN_STAT_ERR - 8u));
     /* Mode 3 (CPOL 1, CPHA 1: SCLK idles high, the chip samples on the rising edge, UP-5), MSB first, master,
      * software slave select (SSM, SSI: /SS is the GPIO above). */
-    SPI1_CR1 = SPI_CR1_CPHA | SPI_CR1_CPOL | SPI_CR1_MSTR | (BOARD_SPI_BR << SPI_CR1_BR_POS) | SPI_CR1_SSI | SPI_CR1_SSM;
+    SPI1_CR1 = SPI_CR1_CPHA | SPI_CR1_CPOL | SPI_CR1_MSTR | (BOARD_SPI_BR << SPI_CR1_BR_POS) | SPI_CR1_SSI | SPI_CR1_SSM |
+               (FW_MODE == SUPI3_MODE_INTEL ? SPI_CR1_LSBFIRST : 0u); /* Intel: LSB first (UP-6) */
     SPI1_CR1 |= SPI_CR1_SPE;
-    GPIOB_CRL = GPIO_CFG_INPUT_FLOATING << (4u * BOARD_PIN_MODACK);
+    GPIOB_BSRR = PIN(BOARD_PIN_SR); /* S/R idles high: the uP sends */
+    GPIOB_CRL = (GPIO_CFG_INPUT_FLOATING << (4u * BOARD_PIN_MODACK)) | (GPIO_CFG_OUTPUT_PP_2MHZ << (4u * BOARD_PIN_SR));
     AFIO_EXTICR1 = AFIO_EXTICR_PB << (4u * BOARD_PIN_MODACK); /* EXTI0 on PA0, EXTI1 on PB1 */
     EXTI_FTSR |= PIN(BOARD_PIN_IRQ) | PIN(BOARD_PIN_MODACK);
     EXTI_IMR |= PIN(BOARD_PIN_IRQ) | PIN(BOARD_PIN_MODACK); /* EXTI1's NVIC line stays disabled: a latch only */

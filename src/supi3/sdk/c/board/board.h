@@ -42,6 +42,7 @@
 #define BOARD_PIN_MOSI 7u
 #define BOARD_PIN_STAT_ERR 8u
 #define BOARD_PIN_MODACK 1u /* on port B */
+#define BOARD_PIN_SR 0u /* on port B: S/R to MFP7, Intel mode only (docs/assumptions/mcu.md MCU-18) */
 
 #define REG32(address) (*(volatile uint32_t *)(address))
 
@@ -59,6 +60,8 @@
 #define GPIOA_BSRR REG32(0x40010810u)
 #define GPIOA_BRR REG32(0x40010814u)
 #define GPIOB_CRL REG32(0x40010C00u)
+#define GPIOB_BSRR REG32(0x40010C10u)
+#define GPIOB_BRR REG32(0x40010C14u)
 #define GPIO_CFG_INPUT_FLOATING 0x4u   /* CNF 01, MODE 00 */
 #define GPIO_CFG_OUTPUT_PP_2MHZ 0x2u   /* CNF 00, MODE 10 */
 #define GPIO_CFG_AF_PP_50MHZ 0xBu      /* CNF 10, MODE 11 */

@@ -1,0 +1,340 @@
+"""The pin-level whole chip on the emulated board: ``Board(..., fidelity="pin")``.
+
+Ref: IBS SUPI 3 OPC UM E rev. 05, 3.4.2 (frames), Table 3-7 (the µP's timing, checked by the chip's own
+:class:`supi3.spi.slave_pins.TimingChecker`), Tables 3-5 and 3-6 (the µP pins on MFP[7..0]), 3.4.14 (/IRQ, I/O);
+RM0008 25.3.3 (the SPI master's clock phase and polarity); decisions MCU-14 to MCU-17 in docs/assumptions/mcu.md.
+
+:class:`LockstepRing` is the :class:`~supi3.model.pinring.PinRing` of one :class:`~supi3.top.Supi3Chip` whose µP
+pins the board drives, clocked in step with the core. The master's calls queue their line samples on ``do1``;
+:attr:`LockstepRing.runner` (the board) then runs the firmware until the chip has clocked them, and the chip runs
+lazily behind the core: up to the core's time at each peripheral access (:meth:`LockstepRing.sync`). GPIO writes and
+SPI1's edges (SCLK, MOSI, from the peripheral's own baud-rate divider) are pin changes at chip clocks
+(:meth:`LockstepRing.drive`, :meth:`LockstepRing.spi_byte`), MISO is sampled from the chip's SerOUT at the SPI's
+sampling edges, and every violation the chip finds is handed on with the firmware's place when it made the edge
+that broke the rule (:class:`Cause`).
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Final
+
+import numpy as np
+import numpy.typing as npt
+
+from supi3.checks import check_trace
+from supi3.interbus import wire
+from supi3.mcu.core import Frame
+from supi3.mcu.stm32 import CR1_CPHA, CR1_CPOL, CR1_LSBFIRST
+from supi3.model.pinring import PinRing
+from supi3.model.registers import InterfaceViolationError
+from supi3.pinout import UP_INPUTS, UP_OUTPUTS
+from supi3.tables import CLOCK_HZ
+from supi3.top import QUIET_BOARD, STEP_BELOW, Supi3Chip
+
+__all__ = ["MCU_LINES", "MISO_PULL_UP", "SYNC_S", "Cause", "LockstepRing", "Sample", "mcu_lines"]
+
+SYNC_S: Final[float] = 1e-6
+"""MCU-14: while the core runs (not asleep), the chip catches up with it at least this often of bus time, so an edge
+of /IRQ (or /ModAck) is taken at most this much after it; a sleeping core wakes at the chip clock of the edge."""
+MISO_PULL_UP: Final[int] = 1
+"""MCU-6: MISO reads high while the chip drives no SerOUT (MFP7)."""
+IRQ_BIT: Final[int] = UP_OUTPUTS["irq_n"]
+CD_BIT: Final[int] = UP_OUTPUTS["c_d"]
+IO_BIT: Final[int] = UP_OUTPUTS["io"]
+SEROUT_BIT: Final[int] = UP_OUTPUTS["mfp7"]
+SCLK_BIT: Final[int] = UP_INPUTS["sclk"]
+MOSI_BIT: Final[int] = UP_INPUTS["mfp6"]
+SS_BIT: Final[int] = UP_INPUTS["ss_n"]
+SAS_INIT_BIT: Final[int] = UP_INPUTS["sas_init"]
+SR_BIT: Final[int] = UP_INPUTS["mfp7"]
+SER_IN_OUT_BIT: Final[int] = UP_OUTPUTS["mfp6"]
+MCU_LINES: Final[dict[str, tuple[str, int, int | None]]] = {
+    "pa0_irq_n": ("mfp_out", IRQ_BIT, 1), "pa1_c_d": ("mfp_out", CD_BIT, 1), "pa2_io": ("mfp_out", IO_BIT, 1),
+    "pa3_sas_init": ("mfp_in", SAS_INIT_BIT, None), "pa4_ss_n": ("mfp_in", SS_BIT, None),
+    "pa5_sck": ("mfp_in", SCLK_BIT, None), "pa6_miso": ("mfp_out", SEROUT_BIT, MISO_PULL_UP),
+    "pa7_mosi": ("mfp_in", MOSI_BIT, None), "pa8_stat_err_n": ("stat_err_n", 0, None),
+    "pb1_mod_ack_n": ("mod_ack_n", 0, None),
+}  # fmt: skip
+"""The MCU's lines of board.h (``BOARD_PIN_*``, SPI1 on PA5 to PA7), each the chip pin it is wired to: (trace, bit,
+the level while the chip drives it not, ``None`` for the MCU's outputs and the chip's plain outputs)."""
+INTEL_LINES: Final[dict[str, tuple[str, int, int | None]]] = {
+    **MCU_LINES, "pa6_miso": ("mfp_out", SER_IN_OUT_BIT, None), "pb0_s_r": ("mfp_in", SR_BIT, None),
+}  # fmt: skip
+"""The Intel board's lines (MCU-18): MISO on Ser_IN/OUT (MFP6: the chip's level while it drives, else MOSI's through
+the resistor), S/R from PB0 to MFP7."""
+_WATCHED: Final[tuple[str, ...]] = ("di1", "mfp_out", "mfp_oe", "mod_ack_n")
+"""The outputs the board reads: the return line, the µP interface's pins, /ModAck."""
+RECENT: Final[int] = 256
+"""Pin changes kept to name the cause of a violation the chip finds later."""
+
+
+@dataclass(frozen=True)
+class Cause:
+    """Where the firmware was when it made a pin change: its program counter, function and call stack."""
+
+    pc: int
+    function: str | None
+    backtrace: tuple[Frame, ...]
+
+
+@dataclass
+class Sample:
+    """MISO of one SPI transfer: the chip clocks at which SPI1 samples it, the bits seen so far."""
+
+    cycles: list[int]
+    lsb_first: bool
+    bits: dict[int, int]
+
+
+class LockstepRing(PinRing):
+    """The master's line through one whole chip whose µP pins the firmware drives, in step with the core.
+
+    Parameters
+    ----------
+    chip:
+        The chip (an Init-µP mode).
+    cpu_hz:
+        The core clock: core cycle ``c`` is bus time ``c / cpu_hz``.
+    where:
+        The firmware's place now (:class:`Cause`), called at each pin change.
+    record:
+        Keep every pin trace for :func:`supi3.model.vcd.write_vcd`.
+    intel:
+        The Intel board (MCU-18): SPI1 samples MISO on Ser_IN/OUT (MFP6), MOSI's level where the chip drives it not;
+        else on SerOUT (MFP7), pulled up.
+
+    Attributes
+    ----------
+    runner:
+        ``runner(k)`` runs the firmware until the chip has clocked ``k`` cycles (set by the board).
+    on_edge:
+        ``on_edge(name, level, cycle)``: /IRQ (``"irq_n"``) or /ModAck (``"mod_ack_n"``) changed in chip clock
+        ``cycle``.
+    on_violation:
+        ``on_violation(error, cycle, cause)``: the chip found a violation in clock ``cycle``, caused by the pin
+        change of ``cause`` (``None``: no change of the firmware's before it).
+    last:
+        The outputs the board reads (:data:`_WATCHED`: the return line, the MFP levels and enables, /ModAck) in the
+        last clock run.
+    irq_n, mod_ack_n:
+        /IRQ (MFP3) and /ModAck in the last clock run.
+    """
+
+    def __init__(self, chip: Supi3Chip, cpu_hz: float, where: Callable[[], Cause], *, record: bool = False,
+                 intel: bool = False) -> None:  # fmt: skip
+        super().__init__([chip], record)
+        self.miso = SER_IN_OUT_BIT if intel else SEROUT_BIT
+        self.chip = chip
+        self.cpu_hz = cpu_hz
+        self.where = where
+        self.runner: Callable[[int], None] = self._catch_up
+        self.on_edge: Callable[[str, int, int], None] = _no_edge
+        self.on_violation: Callable[[InterfaceViolationError, int, Cause | None], None] = _no_violation
+        self.inputs = dict(QUIET_BOARD)
+        self.last: dict[str, int] = {"mfp_out": 0, "mfp_oe": 0, "mod_ack_n": 1}
+        self.irq_n = 1
+        self.mod_ack_n = 1
+        self._line: deque[int] = deque()
+        self._events: list[tuple[int, int, str, int, int, Cause]] = []  # (cycle, order, pin, bit, level, cause)
+        self._order = 0
+        self._recent: deque[tuple[int, Cause]] = deque(maxlen=RECENT)
+        self._samples: dict[int, list[Sample]] = {}
+        self._di1: list[npt.NDArray[np.int64]] = []
+
+    # -- time --------------------------------------------------------------------------------------------------
+
+    def clock_of(self, cycles: int) -> int:
+        """The chip clocks run when the core is at cycle ``cycles``: those that began at or before it (a read then
+        sees the outputs of the clock running; a write acts from the next clock, MCU-15)."""
+        return math.floor(cycles * CLOCK_HZ / self.cpu_hz + 1e-9) + 1
+
+    def core_cycle(self, clock: int) -> int:
+        """The first core cycle at or after the start of chip clock ``clock``."""
+        return math.ceil(clock * self.cpu_hz / CLOCK_HZ - 1e-9)
+
+    # -- the Bus protocol's line ----------------------------------------------------------------------------------
+
+    def run_samples(self, samples: npt.NDArray[np.uint8]) -> None:
+        """Queue ``samples`` on ``do1`` and run the firmware (:attr:`runner`) until the chip has clocked them."""
+        self._line.extend(check_trace("samples", samples, 1).tolist())
+        self.runner(self.cycle + len(self._line))
+        self.returned = np.concatenate([self.returned, *(d.astype(np.uint8) for d in self._di1)])
+        self._di1.clear()
+
+    def _catch_up(self, clock: int) -> None:
+        """The runner until the board sets its own: the chip alone."""
+        self.sync(clock)
+
+    # -- the µP's pins ---------------------------------------------------------------------------------------------
+
+    def drive(self, cycles: int, pin: str, bit: int, level: int, cause: Cause | None = None) -> None:
+        """The board drives input ``pin`` (bit ``bit`` of ``mfp_in``, or a one-bit pin with ``bit`` 0) to ``level``
+        from core cycle ``cycles`` on."""
+        clock = max(self.clock_of(cycles), self.cycle)
+        self._order += 1
+        heapq.heappush(self._events, (clock, self._order, pin, bit, level, self.where() if cause is None else cause))
+
+    def spi_byte(self, tx: int, bits: int, start: int, period: int, cr1: int) -> Callable[[], int]:
+        """:class:`~supi3.mcu.stm32.SpiWire`: SPI1's edges of one transfer as pin changes (RM0008 25.3.3 and MCU-8:
+        SCLK idles at CPOL, bit ``k``'s leading edge half a period after ``start + k * period``, its trailing edge at
+        ``start + (k + 1) * period``; MOSI changes on the leading edge with CPHA = 1, half a period before it with
+        CPHA = 0, MISO is sampled on the other edge); returns what reads the received word once the chip has run past
+        its last sample (MCU-16)."""
+        cause = self.where()
+        lsb = bool(cr1 & CR1_LSBFIRST)
+        cpol, cpha = int(bool(cr1 & CR1_CPOL)), int(bool(cr1 & CR1_CPHA))
+        half = period // 2
+        out = [(tx >> (k if lsb else bits - 1 - k)) & 1 for k in range(bits)]
+        self.drive(start, "mfp_in", SCLK_BIT, cpol, cause)
+        sample_at = []
+        for k in range(bits):
+            lead, trail = start + k * period + half, start + (k + 1) * period
+            self.drive(lead if cpha else lead - half, "mfp_in", MOSI_BIT, out[k], cause)
+            self.drive(lead, "mfp_in", SCLK_BIT, 1 - cpol, cause)
+            self.drive(trail, "mfp_in", SCLK_BIT, cpol, cause)
+            sample_at.append(self.clock_of(trail if cpha else lead) - 1)
+        sample = Sample(sample_at, lsb, {})
+        for clock in sample_at:
+            self._samples.setdefault(clock, []).append(sample)
+        return lambda: self._miso(sample)
+
+    def _miso(self, sample: Sample) -> int:
+        self.sync(sample.cycles[-1] + 1)
+        bits = [sample.bits.get(clock, MISO_PULL_UP) for clock in sample.cycles]
+        n = len(bits)
+        return sum(bit << (k if sample.lsb_first else n - 1 - k) for k, bit in enumerate(bits))
+
+    @property
+    def c_d(self) -> int:
+        """C/D (MFP2) in the last clock run."""
+        return self.last["mfp_out"] >> CD_BIT & 1
+
+    @property
+    def io(self) -> int:
+        """The I/O access bit (MFP1) in the last clock run."""
+        return self.last["mfp_out"] >> IO_BIT & 1
+
+    # -- running the chip -------------------------------------------------------------------------------------------
+
+    def sync(self, clock: int, *, until_edge: bool = False) -> int:
+        """Run the chip until it has clocked ``clock`` cycles (``until_edge``: or until /IRQ or /ModAck changed, clock
+        by clock); return the clocks run so far. The line idles high once the samples queued are used up."""
+        log = self.chip.core.chip.registers
+        assert log is not None
+        violations = log.violations
+        while self.cycle < clock:
+            events = self._events
+            while events and events[0][0] <= self.cycle:
+                at, _, pin, bit, level, cause = heapq.heappop(events)
+                old = self.inputs[pin]
+                self.inputs[pin] = (old & ~(1 << bit)) | (level << bit)
+                if self.inputs[pin] != old:
+                    self._recent.append((at, cause))
+            end = min(clock, events[0][0]) if events else clock
+            before = len(violations.records)
+            start = self.cycle
+            try:
+                with violations.deferred():
+                    edge = self._clock(end - start, until_edge)
+            finally:
+                for error in violations.records[before:]:
+                    self._blame(error, start)
+            if edge:
+                break
+        return self.cycle
+
+    def sync_to_core(self, cycles: int) -> int:
+        """:meth:`sync` up to core cycle ``cycles`` (:meth:`clock_of`)."""
+        return self.sync(self.clock_of(cycles))
+
+    def _blame(self, error: InterfaceViolationError, start: int) -> None:
+        """A violation found while the inputs held from clock ``start``: the pin change there caused it (a piece
+        ends at every change; the chip's µP interface counts its own cycles, so the error's clock is not used)."""
+        cause = next((c for at, c in reversed(self._recent) if at <= start), None)
+        self.on_violation(error, start, cause)
+
+    def _clock(self, n: int, until_edge: bool) -> bool:
+        """Run ``n`` clocks with the inputs held (but ``do1``); whether it stopped early at an edge."""
+        chip, line, idle = self.chip, self._line, self.inputs["do1"]
+        start = self.cycle
+        if n < STEP_BELOW or until_edge:
+            row = dict(self.inputs)
+            do1, outs = [], []
+            edge = False
+            irq_n, mod_ack_n = self.irq_n, self.mod_ack_n
+            for _ in range(n):
+                row["do1"] = level = line.popleft() if line else idle
+                out = chip.step(row)
+                do1.append(level)
+                outs.append(out)
+                if until_edge and ((out["mfp_out"] >> IRQ_BIT & 1) != irq_n or out["mod_ack_n"] != mod_ack_n):
+                    edge = True
+                    break
+            names = outs[0] if self.record else _WATCHED
+            traces = {name: np.array([out[name] for out in outs], dtype=np.int64) for name in names}
+            traces["do1"] = np.array(do1, dtype=np.int64)
+            if self.record:
+                traces.update({name: np.full(len(do1), row[name], dtype=np.int64) for name in row if name != "do1"})
+        else:
+            edge = False
+            traces = {name: np.full(n, level, dtype=np.int64) for name, level in self.inputs.items()}
+            taken = [line.popleft() for _ in range(min(n, len(line)))]
+            traces["do1"][: len(taken)] = taken
+            traces.update(chip.run(traces))
+        self._after(start, traces)
+        return edge
+
+    def _after(self, start: int, traces: dict[str, npt.NDArray[np.int64]]) -> None:
+        n = len(traces["do1"])
+        self.cycle = start + n
+        self._di1.append(traces["di1"])
+        if self.record:
+            self._chunks.append([traces])
+        self.last = {name: int(traces[name][-1]) for name in _WATCHED}
+        for clock in [c for c in self._samples if start <= c < start + n]:
+            k = clock - start
+            bit = self.miso
+            if traces["mfp_oe"][k] >> bit & 1:
+                level = traces["mfp_out"][k] >> bit & 1
+            else:  # Intel: MOSI's level through the resistor; Motorola: the pull-up
+                level = self.inputs["mfp_in"] >> bit & 1 if bit == SER_IN_OUT_BIT else MISO_PULL_UP
+            for sample in self._samples.pop(clock):
+                sample.bits[clock] = int(level)
+        for name, levels, now in (("irq_n", traces["mfp_out"] >> IRQ_BIT & 1, self.irq_n),
+                                  ("mod_ack_n", traces["mod_ack_n"], self.mod_ack_n)):  # fmt: skip
+            if levels[-1] == now and not np.any(levels != now):
+                continue
+            changes = np.flatnonzero(np.diff(levels, prepend=now))
+            for k in changes.tolist():
+                self.on_edge(name, int(levels[k]), start + k)
+            setattr(self, name, int(levels[-1]))
+
+    def status_telegram(self) -> None:
+        """One idle status telegram on the line (the master waiting between its calls)."""
+        self.run_levels(wire.status_levels(wire.Cycle.DATA, False, 1))
+
+
+def mcu_lines(traces: dict[str, npt.NDArray[np.int64]], *, intel: bool = False) -> dict[str, npt.NDArray[np.int64]]:
+    """The MCU's lines (:data:`MCU_LINES`, the Intel board's :data:`INTEL_LINES`) from the recorded pin traces of
+    its chip."""
+    lines = {}
+    for name, (trace, bit, undriven) in (INTEL_LINES if intel else MCU_LINES).items():
+        level = traces[trace] >> bit & 1
+        if trace == "mfp_out":
+            fallback = traces["mfp_in"] >> bit & 1 if undriven is None else undriven
+            level = np.where(traces["mfp_oe"] >> bit & 1, level, fallback)
+        lines[name] = level
+    return lines
+
+
+def _no_edge(name: str, level: int, cycle: int) -> None:
+    del name, level, cycle
+
+
+def _no_violation(error: InterfaceViolationError, cycle: int, cause: Cause | None) -> None:
+    del error, cycle, cause

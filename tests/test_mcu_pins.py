@@ -1,0 +1,210 @@
+"""The pin-level whole chip on the emulated board (supi3.mcu.pins, ``Board(..., fidelity="pin")``): SPI1's edges
+from its baud-rate divider (RM0008 25.3.3, MCU-8, MCU-16), the example firmware's process data on both fidelities,
+Table 3-7 and 3.4.2 violations found by the chip's own checks and reported with the firmware's program counter,
+function and source line, and the VCD of the chip's pins and the MCU's lines.
+"""
+
+from __future__ import annotations
+
+import itertools
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from supi3.errors import ArgumentError
+from supi3.interbus.device import PlainDevice
+from supi3.mcu import board as mcu_board
+from supi3.mcu import build as mcu_build
+from supi3.mcu.board import Board, BoardError
+from supi3.mcu.core import CPUS
+from supi3.mcu.pins import MISO_PULL_UP, Cause, LockstepRing, mcu_lines
+from supi3.mcu.session import run_firmware
+from supi3.mcu.stm32 import CR1_CPHA, CR1_CPOL, CR1_LSBFIRST
+from supi3.model.registers import InterfaceViolationError
+from supi3.sdk import native
+from supi3.sdk.bench import default_config
+from supi3.spi.upif import Mode
+from supi3.top import Supi3Chip
+
+pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
+
+WORDS = tuple(w.to_bytes(2, "big") for w in (0x1234, 0x8001))
+
+
+@pytest.fixture(scope="module")
+def digital_io(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The digital 16/16 example for the Cortex-M3, built once per module."""
+    return mcu_build.build(native.example("digital_io"), tmp_path_factory.mktemp("pins") / "digital_io.elf")
+
+
+def _falls(trace: np.ndarray) -> list[int]:
+    return (np.flatnonzero(np.diff(trace) < 0) + 1).tolist()
+
+
+def _rises(trace: np.ndarray) -> list[int]:
+    return (np.flatnonzero(np.diff(trace) > 0) + 1).tolist()
+
+
+@pytest.mark.parametrize(("cpol", "cpha", "lsb"), list(itertools.product((0, 1), repeat=3)))
+def test_spi1_edges_follow_its_baud_rate_divider(cpol: int, cpha: int, lsb: int) -> None:
+    """One transfer of A6h, 64 core clocks a period (BR = 5 at 48 MHz), from core cycle 960: SCLK's leading edge of
+    bit k half a period after 960 + 64 k, its trailing edge at 960 + 64 (k + 1), each at the chip clock after it
+    (32 MHz: 2/3 of a core clock); MOSI carries bit k from its leading edge (CPHA = 1) or half a period before it;
+    the chip drives no SerOUT while /SS is high, so SPI1 receives the pull-up's FFh (MCU-6)."""
+    ring = LockstepRing(Supi3Chip(default_config()), 48e6, lambda: Cause(0, None, ()), record=True)
+    cr1 = CR1_CPOL * cpol | CR1_CPHA * cpha | CR1_LSBFIRST * lsb
+    received = ring.spi_byte(0xA6, 8, 960, 64, cr1)
+    assert received() == 0xFF * MISO_PULL_UP
+    ring.sync(ring.clock_of(960 + 64 * 9))
+    lines = mcu_lines(ring.recorded()[0])
+    leads = [ring.clock_of(960 + 64 * k + 32) for k in range(8)]
+    trails = [ring.clock_of(960 + 64 * (k + 1)) for k in range(8)]
+    sck = lines["pa5_sck"]
+    if cpol:
+        assert (_falls(sck), _rises(sck)) == (leads, trails)
+    else:  # the board rests SCLK high (UP-5) until SPI1 drives its CPOL at the transfer's start
+        assert (_falls(sck), _rises(sck)) == ([ring.clock_of(960), *trails], leads)
+    sampled = [int(lines["pa7_mosi"][c]) for c in (trails if cpha else leads)]
+    assert sampled == [(0xA6 >> (k if lsb else 7 - k)) & 1 for k in range(8)]
+
+
+def _exchange(board: Board) -> list[tuple[bytes, bytes]]:
+    """Per word: the master's outputs and the firmware's inputs set, two cycles run; (the firmware's outputs, the
+    master's inputs) after them (as tests/test_mcu_board.py)."""
+    fw = board.fw_board
+    assert fw is not None
+    seen = []
+    for out_data, in_data in zip(WORDS, reversed(WORDS), strict=True):
+        board.master.set_outputs(1, out_data)
+        fw.inputs = in_data
+        board.run(2)
+        seen.append((fw.outputs[:2], board.master.inputs(1)))
+    return seen
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("mode", list(Mode))
+def test_digital_io_gives_the_same_process_data_on_both_fidelities(
+    digital_io: Path, tmp_path: Path, mode: Mode
+) -> None:
+    """A master cycle every 400 µs at 500 kbit/s (the handler's four accesses end before the next cycle begins,
+    MCU-17): the pin-level chip, its µP pins driven by SPI1 and the GPIO port in lockstep with the core, gives the
+    master's configuration and the process data of the transaction-level run, breaks no Table 3-7 rule, and a
+    sleeping core enters the handler the 12 cycles of its exception entry after the falling edge of /IRQ on MFP3
+    (MCU-2, MCU-14). The same on the Intel board (MCU-18: S/R from PB0, Ser_IN/OUT half duplex, LSB first; at pin
+    level the chip checks t10/t11 on S/R too) with the example built for it."""
+    elf = digital_io if mode is Mode.MOTOROLA else mcu_build.build(
+        native.example("digital_io"), tmp_path / "intel.elf", defines={"FW_MODE": "SUPI3_MODE_INTEL"})
+    seen = {}
+    for fidelity in ("transaction", "pin"):
+        board = Board(elf, cycle_time_s=400e-6, fidelity=fidelity, mode=mode)
+        board.run(3)
+        config = board.master.config
+        assert config is not None and (config[0].id_code, config[0].data_bytes) == (0x03, 2)
+        seen[fidelity] = _exchange(board)
+        assert board.violations == [] and board.fw_board is not None and board.fw_board.error == 0
+        assert board.protocol.mode is mode
+        assert board.irq_latency_s == pytest.approx(CPUS["cortex_m3"].entry_cycles / 48e6)
+    assert seen["pin"] == seen["transaction"] == list(zip(WORDS, reversed(WORDS), strict=True))
+
+
+def test_a_too_fast_sclk_is_found_by_the_pin_level_chip_with_the_source_line(tmp_path: Path) -> None:
+    """BOARD_SPI_BR = 3: a 16-clock SCLK period (333 ns, at the chip's 32 MHz 11 clocks) is shorter than Table 3-7's
+    t0 = 667 ns at 500 kbit/s: the chip's own timing check finds it at the first byte's second rising edge, and the
+    note names the transport function, its line and the calls (fw_setup, supi3_initialize); non-strict, every byte
+    breaks t0 and nothing else."""
+    elf = mcu_build.build(native.example("digital_io"), tmp_path / "fast.elf", defines={"BOARD_SPI_BR": "3u"})
+    board = Board(elf, fidelity="pin")
+    with pytest.raises(InterfaceViolationError, match=r"measured 343\.75 ns, required >= 667\.00 ns") as caught:
+        board.run(1)
+    assert caught.value.rule == "Table 3-7 t0"
+    notes = caught.value.__notes__
+    assert any("in board_xfer() board.c:" in note and "supi3_initialize()" in note for note in notes), notes
+    lenient = Board(elf, fidelity="pin", strict=False)
+    lenient.run(1)
+    assert lenient.violations and {(v.error.rule, v.function) for v in lenient.violations} == {
+        ("Table 3-7 t0", "board_xfer")}
+    first = lenient.violations[0]
+    assert first.source is not None and first.source.file == "board.c" and 0 < first.time_s < 20e-6
+
+
+def test_raising_ss_before_the_byte_is_out_is_an_incomplete_frame_at_pin_level(tmp_path: Path) -> None:
+    """tests/mcu/early_ss.c waits for TXE instead of BSY: /SS rises on MFP5 before SCLK's first rising edge, the
+    chip's µP interface ignores the frame (3.4.2), and the violation names fw_setup and its line."""
+    elf = mcu_build.build(Path(__file__).parent / "mcu" / "early_ss.c", tmp_path / "early_ss.elf")
+    board = Board(elf, fidelity="pin")
+    with pytest.raises(InterfaceViolationError, match=r"incomplete byte: 0 SCLK rising edges") as caught:
+        board.run(1)
+    assert caught.value.rule == "3.4.2"
+    assert any("in fw_setup() early_ss.c:" in note for note in caught.value.__notes__)
+    assert board.protocol.mode is None  # the initialization byte did not count
+
+
+def test_the_vcd_holds_the_chip_pins_and_the_mcu_lines(digital_io: Path, tmp_path: Path) -> None:
+    """``record=True``: :meth:`Board.write_vcd` writes scope dev1 (the chip's pins) and scope mcu (board.h's lines);
+    each SPI1 transfer is one /SS frame of 8 SCLK periods, the same on the MCU's PA4/PA5 and the chip's MFP5/MFP4."""
+    board = Board(digital_io, bit_rate=2_000_000, fidelity="pin", record=True)
+    board.run(1)
+    path = board.write_vcd(tmp_path / "run.vcd")
+    text = path.read_text()
+    for name in ("$scope module dev1", "$scope module mcu", "pa5_sck", "pa6_miso", "mfp4_sclk", "mfp5_ss_n"):
+        assert name in text
+    chip = board.ring.recorded()[0]
+    lines = mcu_lines(chip)
+    transfers = board.spi.transfers
+    assert transfers > 3
+    assert len(_falls(lines["pa4_ss_n"])) == len(_falls(chip["mfp_in"] >> 5 & 1)) == transfers
+    assert len(_falls(lines["pa5_sck"])) == len(_falls(chip["mfp_in"] >> 4 & 1)) == 8 * transfers
+
+
+def test_the_board_refuses_what_its_fidelity_has_not(digital_io: Path, tmp_path: Path) -> None:
+    """Named errors: an unknown fidelity, other devices or a transaction-level bench at pin level, the pin-level ring,
+    a record or a VCD at transaction level, and the session's VCD or ring without the pin level."""
+    with pytest.raises(ArgumentError, match=r"fidelity must be one of 'transaction', 'pin', not 'gate'"):
+        Board(digital_io, fidelity="gate")
+    with pytest.raises(ArgumentError, match=r"others must be empty at pin level"):
+        Board(digital_io, fidelity="pin", others=[PlainDevice(0x02, 1)])
+    with pytest.raises(ArgumentError, match=r"record must be False at transaction level"):
+        Board(digital_io, record=True)
+    with pytest.raises(BoardError, match=r"Board.bench is the transaction-level bench"):
+        _ = Board(digital_io, fidelity="pin").bench
+    with pytest.raises(BoardError, match=r"Board.write_vcd needs a board made with record=True"):
+        Board(digital_io, fidelity="pin").write_vcd(tmp_path / "x.vcd")
+    with pytest.raises(BoardError, match=r"Board.ring is the pin-level ring"):
+        Board(digital_io).write_vcd(tmp_path / "x.vcd")
+    with pytest.raises(ArgumentError, match=r"vcd must be None at transaction level"):
+        run_firmware(digital_io, vcd=tmp_path / "x.vcd")
+    with pytest.raises(ArgumentError, match=r"devices must be an integer from 1 to 1 \(the chip alone in the ring"):
+        run_firmware(digital_io, fidelity="pin", devices=2)
+    assert not (tmp_path / "x.vcd").exists()
+
+
+@pytest.mark.parametrize("fidelity", ["transaction", "pin"])
+def test_sas_init_restarts_the_interface_and_keeps_the_registers(tmp_path: Path, fidelity: str) -> None:
+    """tests/mcu/sas_init.c: SAS_INIT (PA3 on MFP0) after SET 83h, then the initialization byte again: the interface
+    runs in Motorola mode again and SET still reads 83h (3.4.3), with no violation; on either fidelity."""
+    elf = mcu_build.build(Path(__file__).parent / "mcu" / "sas_init.c", tmp_path / "sas_init.elf")
+    board = Board(elf, bit_rate=2_000_000, fidelity=fidelity)
+    board.run(1)
+    assert board.fw_board is not None and (board.fw_board.error, board.fw_board.outputs[0]) == (0, 0x83)
+    assert board.protocol.mode is not None and board.violations == []
+
+
+@pytest.mark.parametrize("fidelity", ["transaction", "pin"])
+def test_a_too_short_sas_init_pulse_names_the_line(tmp_path: Path, fidelity: str) -> None:
+    """SAS_SHORT = 1: SAS_INIT high for two stores (about 40 ns) breaks Table 3-7's t_SAS_INIT on either fidelity,
+    reported at the store that ends the pulse (pin level: the chip's own check, clock-exact)."""
+    elf = mcu_build.build(Path(__file__).parent / "mcu" / "sas_init.c", tmp_path / "short.elf",
+                          defines={"SAS_SHORT": "1u"})  # fmt: skip
+    board = Board(elf, bit_rate=2_000_000, fidelity=fidelity, strict=False)
+    board.run(1)
+    rules = [(v.error.rule, v.function, v.source.file if v.source else None) for v in board.violations]
+    assert rules == [("Table 3-7 t_SAS_INIT", "fw_setup", "sas_init.c")]
+
+
+def test_the_intel_boards_s_r_pin_is_board_h_s() -> None:
+    """The emulator's S/R wiring (MCU-18) is the board port's: PB0, board.h BOARD_PIN_SR."""
+    text = (mcu_build.BOARD_DIR / "board.h").read_text()
+    assert re.search(rf"#define BOARD_PIN_SR {mcu_board.PIN_SR}u /\* on port B", text)
