@@ -16,11 +16,15 @@ placed inside its block by the program counter (:meth:`CortexM.cycles_now`; unic
 access only under a memory hook, so each peripheral range has an empty one). Emulation only ever stops at a block
 boundary (a block hook refuses the next block), because unicorn restarts an instruction stopped inside a memory
 callback and a peripheral would see its access twice.
+
+Speed (MCU-14): the block hook, the peripheral callbacks and the register reads they need go to unicorn's C library
+through ctypes directly; the binding's wrappers around each call cost as much again as the call.
 """
 
 from __future__ import annotations
 
 import bisect
+import ctypes
 import struct
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -39,6 +43,10 @@ from supi3.errors import ArgumentError, Supi3Error
 
 _UNICORN: Any = unicorn  # typed, but its Uc methods are not annotated
 UcError: type[Exception] = _UNICORN.UcError
+_BINDING: Any = _UNICORN.unicorn_py3.unicorn
+_LIB: Any = _BINDING.uclib
+"""unicorn's C library: the hot callbacks are registered with it directly (MCU-14), without the binding's
+per-call wrappers."""
 
 __all__ = [
     "CPUS",
@@ -542,6 +550,10 @@ class CortexM:
         _check_memories(self.image, flash, ram)
         self.uc: Any = _UNICORN.Uc(ucc.UC_ARCH_ARM, ucc.UC_MODE_THUMB | ucc.UC_MODE_MCLASS)
         self.uc.ctl_set_cpu_model(self.cpu.model)
+        self._handle = self.uc._uch  # the engine, for the direct calls (MCU-14)
+        self._register_value = ctypes.c_uint64()
+        self._register_ref = ctypes.byref(self._register_value)
+        self._callbacks: list[object] = []  # the ctypes callbacks unicorn holds: kept alive with the core
         self.flash = flash
         self.ram = ram
         for base, size in (flash, ram):
@@ -577,7 +589,7 @@ class CortexM:
         self.systick = SysTick(self)
         self._scs_words: dict[int, int] = {}
         self.mmio(SCS_BASE, SCS_SIZE, self._scs_read, self._scs_write)
-        self.uc.hook_add(ucc.UC_HOOK_BLOCK, self._on_block)
+        self._hook(ucc.UC_HOOK_BLOCK, _BINDING.HOOK_CODE_CFUNC(self._on_block))
         self.uc.hook_add(ucc.UC_HOOK_INTR, self._on_interrupt)
         self.reset()
 
@@ -588,8 +600,8 @@ class CortexM:
         access. An exception they raise stops the run at the end of the block (:attr:`error`); the block's later
         accesses reach no peripheral (no follow-on reports of a run that has ended)."""
 
-        def on_read(uc: Any, offset: int, size: int, data: Any) -> int:
-            del uc, data
+        def on_read(handle: int, offset: int, size: int, data: int) -> int:
+            del handle, data
             if self.error is not None:  # the run ends with this block: its later accesses reach no peripheral
                 return 0
             try:
@@ -598,8 +610,8 @@ class CortexM:
                 self.fail(error)
                 return 0
 
-        def on_write(uc: Any, offset: int, size: int, value: int, data: Any) -> None:
-            del uc, data
+        def on_write(handle: int, offset: int, size: int, value: int, data: int) -> None:
+            del handle, data
             if self.error is not None:
                 return
             try:
@@ -607,11 +619,25 @@ class CortexM:
             except BaseException as error:  # handed to the run loop, raised there
                 self.fail(error)
 
-        self.uc.mmio_map(base, size, on_read, None, on_write, None)
+        callbacks = (_BINDING.MMIO_READ_CFUNC(on_read), _BINDING.MMIO_WRITE_CFUNC(on_write))
+        self._callbacks += callbacks
+        self._check(_LIB.uc_mmio_map(self._handle, base, size, callbacks[0], None, callbacks[1], None))
         # unicorn updates the PC before a load or store only if a memory hook covers its address: without one, a
         # peripheral callback sees the PC of the block's first instruction, and the access would be timed there
         # (MCU-1 places it by the PC).
-        self.uc.hook_add(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, _exact_pc, None, base, base + size - 1)
+        self._hook(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, _EXACT_PC, base, base + size - 1)
+
+    def _hook(self, kind: int, callback: object, begin: int = 1, end: int = 0) -> None:
+        """Add a hook with a ctypes callback (MCU-14); ``begin > end``: every address."""
+        self._callbacks.append(callback)
+        handle = _BINDING.uc_hook_h()
+        self._check(_LIB.uc_hook_add(self._handle, ctypes.byref(handle), kind, ctypes.cast(callback, ctypes.c_void_p),
+                                     None, ctypes.c_uint64(begin), ctypes.c_uint64(end)))  # fmt: skip
+
+    @staticmethod
+    def _check(status: int) -> None:
+        if status != ucc.UC_ERR_OK:
+            raise UcError(status)
 
     def read_bytes(self, address: int, size: int) -> bytes:
         """Memory as the core sees it (RAM, flash)."""
@@ -644,7 +670,12 @@ class CortexM:
     @property
     def pc(self) -> int:
         """The address of the next instruction."""
-        return int(self.uc.reg_read(arm.UC_ARM_REG_PC))
+        return self._read(arm.UC_ARM_REG_PC)
+
+    def _read(self, register: int) -> int:
+        """A core register by unicorn's number, read by the C library directly (MCU-14)."""
+        _LIB.uc_reg_read(self._handle, register, self._register_ref)
+        return self._register_value.value
 
     @property
     def time_s(self) -> float:
@@ -658,7 +689,7 @@ class CortexM:
         if not self._running:
             return self.cycles
         address, start = self._block
-        pc = int(self.uc.reg_read(arm.UC_ARM_REG_PC))
+        pc = self._read(arm.UC_ARM_REG_PC)
         if pc > address:
             key = (address, pc - address)
             cost = self._costs.get(key)
@@ -785,32 +816,37 @@ class CortexM:
 
     # -- running -----------------------------------------------------------------------------------------------
 
-    def _on_block(self, uc: Any, address: int, size: int, data: Any) -> None:
+    def _on_block(self, handle: int, address: int, size: int, data: int) -> None:
+        """The block at ``address`` is about to run: refuse it at the deadline or on a stop request, else count its
+        cost (MCU-1) or skip the iterations of a poll or countdown loop (MCU-10, MCU-11)."""
         del data
-        if self.stop_request or self.cycles >= self.deadline:
-            uc.emu_stop()  # this block does not run: it is the first of the next run
-            return
-        key = (address, size)
-        block = self._blocks.get(key)
-        if block is None:
-            code = self.read_bytes(address, size)
-            block = self._blocks[key] = (block_cost(code), countdown_register(code))
-        cost = block[0]
-        skip = self._skip
-        if skip is not None:
-            self._skip = None
-            if skip[0] == address:
-                self._skip_polls(cost, skip[1])
-                if self.cycles >= self.deadline:
-                    uc.emu_stop()
-                    return
-        if block[1] >= 0 and self.skip_polls and self._skip_countdown(block[1], cost):
-            uc.emu_stop()
-            return
-        self._block = (address, self.cycles)
-        self._block_end = address + size
-        self.instructions += cost[0]
-        self.cycles += cost[1]
+        try:
+            if self.stop_request or self.cycles >= self.deadline:
+                _LIB.uc_emu_stop(handle)  # this block does not run: it is the first of the next run
+                return
+            block = self._blocks.get((address, size))
+            if block is None:
+                code = self.read_bytes(address, size)
+                block = self._blocks[address, size] = (block_cost(code), countdown_register(code))
+            cost = block[0]
+            skip = self._skip
+            if skip is not None:
+                self._skip = None
+                if skip[0] == address:
+                    self._skip_polls(cost, skip[1])
+                    if self.cycles >= self.deadline:
+                        _LIB.uc_emu_stop(handle)
+                        return
+            if block[1] >= 0 and self.skip_polls and self._skip_countdown(block[1], cost):
+                _LIB.uc_emu_stop(handle)
+                return
+            self._block = (address, self.cycles)
+            self._block_end = address + size
+            self.instructions += cost[0]
+            self.cycles += cost[1]
+        except BaseException as error:  # handed to the run loop, raised there (an escape would be lost in ctypes)
+            self.fail(error)
+            _LIB.uc_emu_stop(handle)
 
     def _skip_polls(self, cost: tuple[int, int], until: int) -> None:
         """Count, without running them, the iterations of a poll loop that would start before the deadline and
@@ -1028,9 +1064,12 @@ class CortexM:
             self._scs_words[offset] = value
 
 
-def _exact_pc(uc: Any, access: int, address: int, size: int, value: int, data: Any) -> None:
+def _exact_pc(handle: int, access: int, address: int, size: int, value: int, data: int) -> None:
     """A memory hook that does nothing: its presence makes unicorn keep the PC exact at each access it covers."""
-    del uc, access, address, size, value, data
+    del handle, access, address, size, value, data
+
+
+_EXACT_PC: Final = _BINDING.HOOK_MEM_ACCESS_CFUNC(_exact_pc)
 
 
 def _nothing(number: int) -> None:
