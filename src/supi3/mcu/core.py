@@ -627,7 +627,7 @@ class CortexM:
         # (MCU-1 places it by the PC).
         self._hook(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, _EXACT_PC, base, base + size - 1)
 
-    def _hook(self, kind: int, callback: object, begin: int = 1, end: int = 0) -> None:
+    def _hook(self, kind: int, callback: Any, begin: int = 1, end: int = 0) -> None:
         """Add a hook with a ctypes callback (MCU-14); ``begin > end``: every address."""
         self._callbacks.append(callback)
         handle = _BINDING.uc_hook_h()
@@ -657,7 +657,7 @@ class CortexM:
 
     def reg(self, name: str) -> int:
         """One register by name (``r0``..``r12``, ``sp``, ``lr``, ``pc``, ``xpsr``, ``primask``, ``control``)."""
-        return int(self.uc.reg_read(_register(name)))
+        return int(self.uc.reg_read(_register(name)))  # any width: through the binding
 
     def set_reg(self, name: str, value: int) -> None:
         """Write one register by name (as :meth:`reg`) with a 32-bit value, between runs."""
@@ -665,7 +665,7 @@ class CortexM:
 
     def registers(self) -> dict[str, int]:
         """R0-R12, SP, LR, PC and xPSR."""
-        return {name: int(self.uc.reg_read(reg)) for name, reg in _REGS}
+        return {name: self._read(reg) for name, reg in _REGS}
 
     @property
     def pc(self) -> int:
@@ -673,9 +673,14 @@ class CortexM:
         return self._read(arm.UC_ARM_REG_PC)
 
     def _read(self, register: int) -> int:
-        """A core register by unicorn's number, read by the C library directly (MCU-14)."""
+        """A 32-bit core register by unicorn's number, read by the C library directly (MCU-14)."""
         _LIB.uc_reg_read(self._handle, register, self._register_ref)
         return self._register_value.value
+
+    def _write(self, register: int, value: int) -> None:
+        """Write a 32-bit core register by unicorn's number, by the C library directly (MCU-14)."""
+        self._register_value.value = value
+        _LIB.uc_reg_write(self._handle, register, self._register_ref)
 
     @property
     def time_s(self) -> float:
@@ -713,10 +718,10 @@ class CortexM:
         """Power-on reset (B1.5.5): MSP and PC from the vector table at the flash base, thread mode, privileged."""
         base = self.flash[0]
         sp, entry = struct.unpack("<2I", self.read_bytes(base, 8))
-        self.uc.reg_write(arm.UC_ARM_REG_XPSR, XPSR_T)
-        self.uc.reg_write(arm.UC_ARM_REG_MSP, sp)
-        self.uc.reg_write(arm.UC_ARM_REG_SP, sp)
-        self.uc.reg_write(arm.UC_ARM_REG_PC, entry & ~1)
+        self._write(arm.UC_ARM_REG_XPSR, XPSR_T)
+        self._write(arm.UC_ARM_REG_MSP, sp)
+        self._write(arm.UC_ARM_REG_SP, sp)
+        self._write(arm.UC_ARM_REG_PC, entry & ~1)
         self.vtor = base
         self.active.clear()
         self.pending.clear()
@@ -735,7 +740,7 @@ class CortexM:
         """The running priority: the highest (lowest number) active exception, 0 under PRIMASK (B1.5.4); 256 in
         thread mode with nothing masked."""
         running = min((self.priority(n) for n in self.active), default=256)
-        if self.reg("primask") & 1:
+        if self._read(arm.UC_ARM_REG_PRIMASK) & 1:
             running = min(running, 0)
         return running
 
@@ -761,13 +766,13 @@ class CortexM:
         = EXC_RETURN, IPSR = ``number``, PC = its vector; costs :attr:`Cpu.entry_cycles`."""
         uc = self.uc
         handler_mode = bool(self.active)
-        control = self.reg("control")
+        control = self._read(arm.UC_ARM_REG_CONTROL)
         if control & CONTROL_SPSEL and not handler_mode:
             raise FirmwareStoppedError(self.report(Stop.FAULT, "exception entry from thread mode on the process stack "
                                               "(CONTROL.SPSEL = 1) is not modelled (MCU-3)"))  # fmt: skip
-        sp = int(uc.reg_read(arm.UC_ARM_REG_SP))
-        words = [int(uc.reg_read(r)) for r in _FRAME_REGS]
-        xpsr = int(uc.reg_read(arm.UC_ARM_REG_XPSR))
+        sp = self._read(arm.UC_ARM_REG_SP)
+        words = [self._read(r) for r in _FRAME_REGS]
+        xpsr = self._read(arm.UC_ARM_REG_XPSR)
         aligned = sp & 4
         frame = (sp - FRAME_WORDS * 4) & ~7
         words += [self.pc, xpsr | (XPSR_ALIGN if aligned else 0)]
@@ -776,11 +781,11 @@ class CortexM:
         except UcError as error:
             raise FirmwareFaultError(self.report(Stop.FAULT, f"stacking error: the frame at {frame:08X}h is not in "
                                             f"memory ({error})")) from None  # fmt: skip
-        uc.reg_write(arm.UC_ARM_REG_SP, frame)
-        uc.reg_write(arm.UC_ARM_REG_LR, EXC_RETURN_HANDLER if handler_mode else EXC_RETURN_THREAD_MSP)
-        uc.reg_write(arm.UC_ARM_REG_XPSR, XPSR_T | number)
+        self._write(arm.UC_ARM_REG_SP, frame)
+        self._write(arm.UC_ARM_REG_LR, EXC_RETURN_HANDLER if handler_mode else EXC_RETURN_THREAD_MSP)
+        self._write(arm.UC_ARM_REG_XPSR, XPSR_T | number)
         target = self.vector(number)
-        uc.reg_write(arm.UC_ARM_REG_PC, target & ~1)
+        self._write(arm.UC_ARM_REG_PC, target & ~1)
         self.pending.discard(number)
         self.active.append(number)
         self.cycles += self.cpu.entry_cycles
@@ -793,7 +798,6 @@ class CortexM:
     def exception_return(self, exc_return: int) -> None:
         """Exception return (B1.5.8): unstack the frame, undo the alignment word, back to the mode EXC_RETURN
         names; costs :attr:`Cpu.return_cycles`."""
-        uc = self.uc
         if exc_return not in (EXC_RETURN_HANDLER, EXC_RETURN_THREAD_MSP) or not self.active:
             raise FirmwareFaultError(self.report(Stop.FAULT, f"exception return with EXC_RETURN {exc_return:08X}h "
                                             f"{'in' if self.active else 'outside'} a handler: an INVPC "
@@ -802,15 +806,15 @@ class CortexM:
             nesting = f"{len(self.active)} active exception(s)"
             reason = f"EXC_RETURN {exc_return:08X}h does not match the nesting of {nesting}: INVPC UsageFault (B1.5.8)"
             raise FirmwareFaultError(self.report(Stop.FAULT, reason))
-        sp = int(uc.reg_read(arm.UC_ARM_REG_SP))
+        sp = self._read(arm.UC_ARM_REG_SP)
         words = struct.unpack("<8I", self.read_bytes(sp, FRAME_WORDS * 4))
         for reg, value in zip(_FRAME_REGS, words[:6], strict=True):
-            uc.reg_write(reg, value)
+            self._write(reg, value)
         xpsr = words[7]
         sp += FRAME_WORDS * 4 + (4 if xpsr & XPSR_ALIGN else 0)
-        uc.reg_write(arm.UC_ARM_REG_SP, sp)
-        uc.reg_write(arm.UC_ARM_REG_XPSR, (xpsr & ~XPSR_ALIGN) | XPSR_T)
-        uc.reg_write(arm.UC_ARM_REG_PC, words[6] & ~1)
+        self._write(arm.UC_ARM_REG_SP, sp)
+        self._write(arm.UC_ARM_REG_XPSR, (xpsr & ~XPSR_ALIGN) | XPSR_T)
+        self._write(arm.UC_ARM_REG_PC, words[6] & ~1)
         self.active.pop()
         self.cycles += self.cpu.return_cycles
 
@@ -862,10 +866,10 @@ class CortexM:
         """Count, without running them, the iterations of a countdown loop on ``register`` that would start before
         the deadline, all but its last (MCU-11); whether the deadline came first (the block must not run)."""
         reg = _LOW_REGS[register]
-        left = int(self.uc.reg_read(reg))
+        left = self._read(reg)
         skipped = max(0, min(left - 1, -(-(self.deadline - self.cycles) // cost[1])))
         if skipped:
-            self.uc.reg_write(reg, left - skipped)
+            self._write(reg, left - skipped)
             self.instructions += skipped * cost[0]
             self.cycles += skipped * cost[1]
         return self.cycles >= self.deadline
