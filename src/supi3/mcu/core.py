@@ -581,6 +581,7 @@ class CortexM:
         self._handed = 0  # the latest time a peripheral was given
         self._skip: tuple[int, int] | None = None  # (poll loop address, cycle its status changes)
         self._polls: dict[int, bool] = {}
+        self._idle: dict[int, bool] = {}  # address: the instruction there is ``b .``
         self._blocks: dict[tuple[int, int], tuple[tuple[int, int], int]] = {}  # cost, countdown register (MCU-11)
         self.skip_polls = True
         """MCU-10, MCU-11: count the iterations of pure poll loops and countdown loops without running them (the
@@ -943,8 +944,11 @@ class CortexM:
     def idle_loop(self) -> bool:
         """The core sits on ``b .`` (a branch to itself): in thread mode it waits for an interrupt (MCU-4)."""
         pc = self.pc
-        return bool(self.flash[0] <= pc < self.flash[0] + self.flash[1] - 1 and
-                    self.read_bytes(pc, 2) == b"\xfe\xe7")  # fmt: skip
+        idle = self._idle.get(pc)  # the code does not change (as the block costs)
+        if idle is None:
+            idle = self._idle[pc] = bool(self.flash[0] <= pc < self.flash[0] + self.flash[1] - 1 and
+                                         self.read_bytes(pc, 2) == b"\xfe\xe7")  # fmt: skip
+        return idle
 
     def _fault(self, error: Any) -> StopReport:
         pc = self.pc
