@@ -43,10 +43,16 @@ from supi3.errors import ArgumentError, Supi3Error
 
 _UNICORN: Any = unicorn  # typed, but its Uc methods are not annotated
 UcError: type[Exception] = _UNICORN.UcError
-_BINDING: Any = _UNICORN.unicorn_py3.unicorn
-_LIB: Any = _BINDING.uclib
-"""unicorn's C library: the hot callbacks are registered with it directly (MCU-14), without the binding's
-per-call wrappers."""
+_LIB: Any = _UNICORN.unicorn_py3.unicorn.uclib
+"""unicorn's C library as its binding loaded it (with the argument types it declares): the hot callbacks and
+register accesses go to it directly (MCU-14), without the binding's wrappers around each call."""
+# Callback types of unicorn.h (uc_cb_hookcode_t, uc_cb_hookmem_t, uc_cb_mmio_read_t, uc_cb_mmio_write_t).
+_HOOK_CODE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint32, ctypes.c_void_p)
+_HOOK_MEM: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_int, ctypes.c_uint64, ctypes.c_int, ctypes.c_int64,
+                                    ctypes.c_void_p)  # fmt: skip
+_MMIO_READ: Final = ctypes.CFUNCTYPE(ctypes.c_uint64, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint, ctypes.c_void_p)
+_MMIO_WRITE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint, ctypes.c_uint64,
+                                      ctypes.c_void_p)  # fmt: skip
 
 __all__ = [
     "CPUS",
@@ -550,7 +556,7 @@ class CortexM:
         _check_memories(self.image, flash, ram)
         self.uc: Any = _UNICORN.Uc(ucc.UC_ARCH_ARM, ucc.UC_MODE_THUMB | ucc.UC_MODE_MCLASS)
         self.uc.ctl_set_cpu_model(self.cpu.model)
-        self._handle = self.uc._uch  # the engine, for the direct calls (MCU-14)
+        self._handle = self.uc._uch  # the engine (uc_engine *) for the direct calls (MCU-14)
         self._register_value = ctypes.c_uint64()
         self._register_ref = ctypes.byref(self._register_value)
         self._callbacks: list[object] = []  # the ctypes callbacks unicorn holds: kept alive with the core
@@ -590,7 +596,7 @@ class CortexM:
         self.systick = SysTick(self)
         self._scs_words: dict[int, int] = {}
         self.mmio(SCS_BASE, SCS_SIZE, self._scs_read, self._scs_write)
-        self._hook(ucc.UC_HOOK_BLOCK, _BINDING.HOOK_CODE_CFUNC(self._on_block))
+        self._hook(ucc.UC_HOOK_BLOCK, _HOOK_CODE(self._on_block))
         self.uc.hook_add(ucc.UC_HOOK_INTR, self._on_interrupt)
         self.reset()
 
@@ -620,7 +626,7 @@ class CortexM:
             except BaseException as error:  # handed to the run loop, raised there
                 self.fail(error)
 
-        callbacks = (_BINDING.MMIO_READ_CFUNC(on_read), _BINDING.MMIO_WRITE_CFUNC(on_write))
+        callbacks = (_MMIO_READ(on_read), _MMIO_WRITE(on_write))
         self._callbacks += callbacks
         self._check(_LIB.uc_mmio_map(self._handle, base, size, callbacks[0], None, callbacks[1], None))
         # unicorn updates the PC before a load or store only if a memory hook covers its address: without one, a
@@ -631,7 +637,7 @@ class CortexM:
     def _hook(self, kind: int, callback: Any, begin: int = 1, end: int = 0) -> None:
         """Add a hook with a ctypes callback (MCU-14); ``begin > end``: every address."""
         self._callbacks.append(callback)
-        handle = _BINDING.uc_hook_h()
+        handle = ctypes.c_size_t()  # uc_hook
         self._check(_LIB.uc_hook_add(self._handle, ctypes.byref(handle), kind, ctypes.cast(callback, ctypes.c_void_p),
                                      None, ctypes.c_uint64(begin), ctypes.c_uint64(end)))  # fmt: skip
 
@@ -1077,7 +1083,7 @@ def _exact_pc(handle: int, access: int, address: int, size: int, value: int, dat
     del handle, access, address, size, value, data
 
 
-_EXACT_PC: Final = _BINDING.HOOK_MEM_ACCESS_CFUNC(_exact_pc)
+_EXACT_PC: Final = _HOOK_MEM(_exact_pc)
 
 
 def _nothing(number: int) -> None:
