@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 
+from supi3.errors import ArgumentError
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import Board
 from supi3.mcu.core import (
@@ -257,6 +258,28 @@ def test_an_interrupt_in_thread_mode_on_the_process_stack_is_reported(exceptions
     core.pend(EXTERNAL + 0)
     with pytest.raises(FirmwareStoppedError, match="process stack"):
         core.step(core.cycles + 1000)
+
+
+def test_memory_outside_flash_and_ram_is_a_named_error_and_a_fault_when_unstacked(exceptions_elf: Path) -> None:
+    """The host's reads and writes of unmapped memory raise ArgumentError naming the memories; an exception return
+    whose stack pointer leaves RAM is an unstacking fault with a report (B1.5.8), an exception entry whose vector
+    table is not in memory a vector read fault (B1.5.6), not unicorn's own error."""
+    core = CortexM(exceptions_elf)
+    ram_end = core.ram[0] + core.ram[1]
+    for address, size in ((0, 4), (ram_end - 2, 4), (0x4000_0000, 1)):
+        with pytest.raises(ArgumentError, match=f"address must start {size} bytes of mapped memory .*RAM 20000000h"):
+            core.read_bytes(address, size)
+        with pytest.raises(ArgumentError, match="address must start"):
+            core.write_bytes(address, bytes(size))
+    _sleep(core)
+    core.enter(EXTERNAL + 0)
+    core.set_reg("sp", ram_end)
+    with pytest.raises(FirmwareFaultError, match=f"unstacking error: the frame at {ram_end:08X}h is not in memory"):
+        core.exception_return(EXC_RETURN_THREAD_MSP)
+    core = CortexM(exceptions_elf)
+    core.vtor = 0x3000_0000  # as a write of SCB->VTOR would set it
+    with pytest.raises(FirmwareFaultError, match="vector table read error: entry 16 \\(IRQ 0\\) at VTOR 30000000h"):
+        core.enter(EXTERNAL + 0)
 
 
 @pytest.mark.parametrize(

@@ -647,12 +647,24 @@ class CortexM:
             raise UcError(status)
 
     def read_bytes(self, address: int, size: int) -> bytes:
-        """Memory as the core sees it (RAM, flash)."""
-        return bytes(self.uc.mem_read(address, size))
+        """Memory as the core sees it (RAM, flash); an :class:`ArgumentError` if any of it is not mapped."""
+        try:
+            return bytes(self.uc.mem_read(address, size))
+        except UcError:
+            raise self._unmapped(address, size) from None
 
     def write_bytes(self, address: int, data: bytes) -> None:
-        """Write memory (RAM) from the host, between runs."""
-        self.uc.mem_write(address, check_bytes("data", data))
+        """Write memory (RAM) from the host, between runs; an :class:`ArgumentError` if any of it is not mapped."""
+        try:
+            self.uc.mem_write(address, check_bytes("data", data))
+        except UcError:
+            raise self._unmapped(address, len(data)) from None
+
+    def _unmapped(self, address: int, size: int) -> ArgumentError:
+        memories = ", ".join(f"{name} {base:08X}h to {base + length - 1:08X}h"
+                             for name, (base, length) in (("flash", self.flash), ("RAM", self.ram)))  # fmt: skip
+        return ArgumentError("address", address, f"address must start {size} bytes of mapped memory ({memories}), "
+                             f"not {address:#010x}")  # fmt: skip
 
     def fail(self, error: BaseException) -> None:
         """Stop at the end of the running block and raise ``error`` from :meth:`run` (the first one wins)."""
@@ -791,7 +803,11 @@ class CortexM:
         self._write(arm.UC_ARM_REG_SP, frame)
         self._write(arm.UC_ARM_REG_LR, EXC_RETURN_HANDLER if handler_mode else EXC_RETURN_THREAD_MSP)
         self._write(arm.UC_ARM_REG_XPSR, XPSR_T | number)
-        target = self.vector(number)
+        try:
+            target = self.vector(number)
+        except ArgumentError:
+            reason = f"vector table read error: entry {number} ({_name(number)}) at VTOR {self.vtor:08X}h is unmapped"
+            raise FirmwareFaultError(self.report(Stop.FAULT, reason, stacked=frame)) from None
         self._write(arm.UC_ARM_REG_PC, target & ~1)
         self.pending.discard(number)
         self.active.append(number)
@@ -814,7 +830,11 @@ class CortexM:
             reason = f"EXC_RETURN {exc_return:08X}h does not match the nesting of {nesting}: INVPC UsageFault (B1.5.8)"
             raise FirmwareFaultError(self.report(Stop.FAULT, reason))
         sp = self._read(arm.UC_ARM_REG_SP)
-        words = struct.unpack("<8I", self.read_bytes(sp, FRAME_WORDS * 4))
+        try:
+            words = struct.unpack("<8I", self.read_bytes(sp, FRAME_WORDS * 4))
+        except ArgumentError:
+            reason = f"unstacking error: the frame at {sp:08X}h is not in memory (B1.5.8)"
+            raise FirmwareFaultError(self.report(Stop.FAULT, reason)) from None
         for reg, value in zip(_FRAME_REGS, words[:6], strict=True):
             self._write(reg, value)
         xpsr = words[7]
@@ -1008,7 +1028,7 @@ class CortexM:
             try:
                 saved = {reg: int(struct.unpack("<I", self.read_bytes(cfa + offset, 4))[0])
                          for reg, offset in rule[2].items()}  # fmt: skip
-            except UcError:
+            except ArgumentError:
                 break
             regs |= saved
             regs[13] = cfa
