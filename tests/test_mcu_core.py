@@ -156,6 +156,11 @@ def test_a_bus_fault_ends_the_run_with_the_hard_fault_frame(faults_elf: Path) ->
     assert report.stacked["xpsr"] & 0x1FF == 0  # it ran in thread mode
     assert board.core.active == [3]  # HardFault taken as the core would, then stopped
     assert "stacked r0=" in str(caught.value)
+    assert report.fault_status == {"CFSR": 1 << 9, "HFSR": 1 << 30}  # BFSR.PRECISERR, escalated (B3.2.15, B3.2.16)
+    assert str(caught.value).endswith("; CFSR=00000200h HFSR=40000000h")
+    assert board.core._scs_read(0xD28, 4) == 1 << 9  # what the HardFault handler reads
+    board.core._scs_write(0xD28, 4, 1 << 9)  # write 1 to clear
+    assert board.core._scs_read(0xD28, 4) == 0
     line = _line_of(PROGRAMS / "faults.c", "REG32(0x30000000u)")
     assert report.source is not None and (report.source.file, report.source.line) == ("faults.c", line)
     assert f"(fw_loop) faults.c:{line}" in str(caught.value)
@@ -180,6 +185,7 @@ def test_an_undefined_instruction_ends_the_run_with_a_usage_fault(faults_elf: Pa
         board.run_for(20e-6)
     assert caught.value.report.symbol == "fw_loop"
     assert board.core.read_bytes(caught.value.report.pc, 2) == b"\x00\xde"
+    assert caught.value.report.fault_status == {"CFSR": 1 << 16, "HFSR": 1 << 30}  # UFSR.UNDEFINSTR
 
 
 def test_an_endless_loop_ends_when_the_instruction_budget_runs_out(faults_elf: Path) -> None:

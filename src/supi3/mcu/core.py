@@ -116,6 +116,23 @@ BACKTRACE_DEPTH: Final[int] = 16
 """Frames :meth:`CortexM.backtrace` unwinds at most."""
 IRQ_LINES: Final[int] = 32
 """External interrupts the NVIC model has (one ISER word)."""
+CFSR: Final[int] = 0xD28
+"""Configurable Fault Status Register, offset in the SCS (B3.2.15): MMFSR bits 0-7, BFSR 8-15, UFSR 16-31."""
+HFSR: Final[int] = 0xD2C
+"""HardFault Status Register (B3.2.16)."""
+HFSR_FORCED: Final[int] = 1 << 30
+"""A configurable fault escalated to HardFault: its handler is disabled (SHCSR, as from reset; MCU-3)."""
+_FAULTS: Final[dict[int, tuple[str, int]]] = {
+    ucc.UC_ERR_READ_UNMAPPED: ("precise bus fault: read of unmapped memory", 1 << 9),  # BFSR.PRECISERR
+    ucc.UC_ERR_WRITE_UNMAPPED: ("precise bus fault: write to unmapped memory", 1 << 9),
+    ucc.UC_ERR_FETCH_UNMAPPED: ("instruction bus fault: fetch from unmapped memory (run-away PC)", 1 << 8),  # IBUSERR
+    ucc.UC_ERR_INSN_INVALID: ("usage fault: undefined instruction", 1 << 16),  # UFSR.UNDEFINSTR
+    ucc.UC_ERR_READ_UNALIGNED: ("usage fault: unaligned read", 1 << 24),  # UFSR.UNALIGNED
+    ucc.UC_ERR_WRITE_UNALIGNED: ("usage fault: unaligned write", 1 << 24),
+    ucc.UC_ERR_FETCH_PROT: ("memory fault: execute from a non-executable region", 1 << 0),  # MMFSR.IACCVIOL
+    ucc.UC_ERR_WRITE_PROT: ("memory fault: write to read-only memory", 1 << 1),  # MMFSR.DACCVIOL
+}
+"""unicorn's error of a fault: the report's reason and the CFSR bit the core sets (B3.2.15)."""
 
 
 @dataclass(frozen=True)
@@ -128,13 +145,15 @@ class Cpu:
     entry_cycles: int
     return_cycles: int
     vtor: bool
+    fault_status: bool
+    """The core has CFSR and HFSR (ARMv7-M B3.2.15, B3.2.16; ARMv6-M has neither)."""
 
 
 CPUS: Final[dict[str, Cpu]] = {
     # Cortex-M3: 12 cycles from the interrupt to the handler's first instruction, return 10 (MCU-2).
-    "cortex_m3": Cpu("cortex_m3", arm.UC_CPU_ARM_CORTEX_M3, 0x412F_C231, 12, 10, vtor=True),
+    "cortex_m3": Cpu("cortex_m3", arm.UC_CPU_ARM_CORTEX_M3, 0x412F_C231, 12, 10, vtor=True, fault_status=True),
     # Cortex-M0: 16 cycles interrupt latency, the return taken as long (MCU-2). ARMv6-M: no VTOR.
-    "cortex_m0": Cpu("cortex_m0", arm.UC_CPU_ARM_CORTEX_M0, 0x410C_C200, 16, 16, vtor=False),
+    "cortex_m0": Cpu("cortex_m0", arm.UC_CPU_ARM_CORTEX_M0, 0x410C_C200, 16, 16, vtor=False, fault_status=False),
 }
 """The cores :class:`CortexM` emulates, by their ``-mcpu`` names."""
 
@@ -217,6 +236,8 @@ class StopReport:
     symbol: str | None = None
     backtrace: tuple[Frame, ...] = ()
     """The call stack at :attr:`pc`, innermost first (DWARF call frame information), up to an exception entry."""
+    fault_status: dict[str, int] | None = None
+    """For a fault on an ARMv7-M core: CFSR and HFSR as its HardFault handler would read them (B3.2.15, B3.2.16)."""
 
     @property
     def source(self) -> SourceLine | None:
@@ -232,6 +253,8 @@ class StopReport:
             text += "; called from " + " <- ".join(str(frame) for frame in self.backtrace[1:])
         if self.stacked is not None:
             text += "; stacked " + " ".join(f"{name}={value:08X}h" for name, value in self.stacked.items())
+        if self.fault_status is not None:
+            text += "; " + " ".join(f"{name}={value:08X}h" for name, value in self.fault_status.items())
         return text
 
 
@@ -978,17 +1001,12 @@ class CortexM:
 
     def _fault(self, error: Any) -> StopReport:
         pc = self.pc
-        kinds = {
-            ucc.UC_ERR_READ_UNMAPPED: "precise bus fault: read of unmapped memory",
-            ucc.UC_ERR_WRITE_UNMAPPED: "precise bus fault: write to unmapped memory",
-            ucc.UC_ERR_FETCH_UNMAPPED: "instruction bus fault: fetch from unmapped memory (run-away PC)",
-            ucc.UC_ERR_INSN_INVALID: "usage fault: undefined instruction",
-            ucc.UC_ERR_READ_UNALIGNED: "usage fault: unaligned read",
-            ucc.UC_ERR_WRITE_UNALIGNED: "usage fault: unaligned write",
-            ucc.UC_ERR_FETCH_PROT: "memory fault: execute from a non-executable region",
-            ucc.UC_ERR_WRITE_PROT: "memory fault: write to read-only memory",
-        }
-        reason = kinds.get(error.errno, f"fault ({error})")
+        reason, bit = _FAULTS.get(error.errno, (f"fault ({error})", 0))
+        status = None
+        if self.cpu.fault_status and bit:  # the status registers as the fault leaves them (B3.2.15, B3.2.16)
+            words = self._scs_words
+            words[CFSR], words[HFSR] = words.get(CFSR, 0) | bit, words.get(HFSR, 0) | HFSR_FORCED
+            status = {"CFSR": words[CFSR], "HFSR": words[HFSR]}
         backtrace = self.backtrace()
         frame: int | None = None
         if self.ram[0] + FRAME_WORDS * 4 <= (self.reg("sp") & ~7) <= self.ram[0] + self.ram[1]:
@@ -997,19 +1015,21 @@ class CortexM:
                 frame = self.reg("sp")
             except FirmwareError:
                 frame = None
-        return self.report(Stop.FAULT, reason, pc=pc, stacked=frame, backtrace=backtrace)
+        return self.report(Stop.FAULT, reason, pc=pc, stacked=frame, backtrace=backtrace, fault_status=status)
 
     def report(self, stop: Stop, reason: str, *, pc: int | None = None, stacked: int | None = None,
-               backtrace: tuple[Frame, ...] | None = None) -> StopReport:  # fmt: skip
+               backtrace: tuple[Frame, ...] | None = None, fault_status: dict[str, int] | None = None
+               ) -> StopReport:  # fmt: skip
         """A :class:`StopReport` of the core now; ``stacked``: the address of a stacked frame to include;
-        ``backtrace``: the call stack if not the core's now (:meth:`backtrace`)."""
+        ``backtrace``: the call stack if not the core's now (:meth:`backtrace`); ``fault_status``: CFSR and HFSR."""
         pc = self.pc if pc is None else pc
         frame = None
         if stacked is not None:
             words = struct.unpack("<8I", self.read_bytes(stacked, FRAME_WORDS * 4))
             frame = dict(zip(FRAME_NAMES, words, strict=True))
         return StopReport(stop, reason, pc, self.registers(), self.instructions, self.cycles, self.time_s, frame,
-                          self.image.function_at(pc), self.backtrace() if backtrace is None else backtrace)  # fmt: skip
+                          self.image.function_at(pc), self.backtrace() if backtrace is None else backtrace,
+                          fault_status)  # fmt: skip
 
     def backtrace(self, depth: int = BACKTRACE_DEPTH) -> tuple[Frame, ...]:
         """The call stack now, innermost first: the PC's function and line, then each caller's return address
@@ -1094,6 +1114,8 @@ class CortexM:
                 self.stop_request = True
         elif offset == 0xD08 and self.cpu.vtor:
             self.vtor = value & ~0x7F
+        elif offset in (CFSR, HFSR):  # write 1 to clear (B3.2.15, B3.2.16)
+            self._scs_words[offset] = self._scs_words.get(offset, 0) & ~value
         else:
             self._scs_words[offset] = value
 
