@@ -119,6 +119,31 @@ def test_exception_entry_and_return_cost_the_cores_cycles(exceptions_elf: Path, 
     assert core.cycles == start + core.cpu.entry_cycles + handler[1] + core.cpu.return_cycles
 
 
+@pytest.mark.parametrize("cpu", CPUS)
+def test_a_pending_interrupt_at_the_return_is_tail_chained_on_the_same_frame(exceptions_elf: Path, cpu: str) -> None:
+    """MCU-15: IRQ 1 and IRQ 0 pend together in thread mode; IRQ 1 (priority 40h) runs first, and at its return IRQ 0
+    (80h, still above thread mode) starts on the frame IRQ 1 left, with the same EXC_RETURN, after the core's
+    tail-chain cycles instead of a return and an entry; thread mode then gets its registers back (B1.5.8)."""
+    core = CortexM(exceptions_elf, cpu=cpu)
+    _sleep(core)
+    entries: list[int] = []
+    core.entered = entries.append
+    core.pend(EXTERNAL + 1)
+    core.pend(EXTERNAL + 0)
+    start, thread_sp = core.cycles, core.reg("sp")
+    assert core.step(start + 10_000) == "run"  # entry of IRQ 1, its handler, the tail-chain into IRQ 0
+    assert entries == [EXTERNAL + 1, EXTERNAL + 0] and core.active == [EXTERNAL + 0]
+    assert core.pc == core.image.address("Irq0_Handler")
+    frame = core.reg("sp")
+    assert frame == _word(core, "seen1_sp") == (thread_sp - 32) & ~7  # the one frame, not unstacked
+    assert core.reg("lr") == _word(core, "seen1_lr") == EXC_RETURN_THREAD_MSP
+    handler = block_cost(core.read_bytes(core.image.address("Irq1_Handler"), 2 * 12))
+    assert core.cycles == start + core.cpu.entry_cycles + handler[1] + core.cpu.tail_chain_cycles
+    _sleep(core)  # IRQ 0 pends IRQ 1 again, which preempts it; both return to thread mode
+    assert core.active == [] and core.reg("sp") == thread_sp
+    assert [_word(core, "after", k) for k in range(5)] == [0xA0A0A0A0, 0xA1A1A1A1, 0xA2A2A2A2, 0xA3A3A3A3, 0xC0C0C0C0]
+
+
 def test_block_cost_counts_loads_stores_and_a_final_branch() -> None:
     """MCU-1: 1 cycle per instruction, +1 per single load/store, +N for N registers of PUSH/POP/LDM/STM, +2 for a
     block-ending branch."""

@@ -147,13 +147,18 @@ class Cpu:
     vtor: bool
     fault_status: bool
     """The core has CFSR and HFSR (ARMv7-M B3.2.15, B3.2.16; ARMv6-M has neither)."""
+    tail_chain_cycles: int
+    """From an exception return to the next handler's first instruction when a pending exception is taken at once,
+    without unstacking and stacking again (tail-chaining, MCU-15)."""
 
 
 CPUS: Final[dict[str, Cpu]] = {
     # Cortex-M3: 12 cycles from the interrupt to the handler's first instruction, return 10 (MCU-2).
-    "cortex_m3": Cpu("cortex_m3", arm.UC_CPU_ARM_CORTEX_M3, 0x412F_C231, 12, 10, vtor=True, fault_status=True),
+    "cortex_m3": Cpu("cortex_m3", arm.UC_CPU_ARM_CORTEX_M3, 0x412F_C231, 12, 10, vtor=True, fault_status=True,
+                     tail_chain_cycles=6),
     # Cortex-M0: 16 cycles interrupt latency, the return taken as long (MCU-2). ARMv6-M: no VTOR.
-    "cortex_m0": Cpu("cortex_m0", arm.UC_CPU_ARM_CORTEX_M0, 0x410C_C200, 16, 16, vtor=False, fault_status=False),
+    "cortex_m0": Cpu("cortex_m0", arm.UC_CPU_ARM_CORTEX_M0, 0x410C_C200, 16, 16, vtor=False, fault_status=False,
+                     tail_chain_cycles=16),
 }
 """The cores :class:`CortexM` emulates, by their ``-mcpu`` names."""
 
@@ -824,7 +829,13 @@ class CortexM:
             raise FirmwareFaultError(self.report(Stop.FAULT, f"stacking error: the frame at {frame:08X}h is not in "
                                             f"memory ({error})")) from None  # fmt: skip
         self._write(arm.UC_ARM_REG_SP, frame)
-        self._write(arm.UC_ARM_REG_LR, EXC_RETURN_HANDLER if handler_mode else EXC_RETURN_THREAD_MSP)
+        self._take(number, EXC_RETURN_HANDLER if handler_mode else EXC_RETURN_THREAD_MSP, frame, self.cpu.entry_cycles)
+
+    def _take(self, number: int, exc_return: int, frame: int, cycles: int) -> None:
+        """The part of an entry after the stacking (B1.5.6), also a tail-chain's: LR = ``exc_return``, IPSR, PC =
+        the vector of ``number``, which becomes active; costs ``cycles``. ``frame``: the stacked frame, for a
+        report."""
+        self._write(arm.UC_ARM_REG_LR, exc_return)
         self._write(arm.UC_ARM_REG_XPSR, XPSR_T | number)
         try:
             target = self.vector(number)
@@ -834,7 +845,7 @@ class CortexM:
         self._write(arm.UC_ARM_REG_PC, target & ~1)
         self.pending.discard(number)
         self.active.append(number)
-        self.cycles += self.cpu.entry_cycles
+        self.cycles += cycles
         self.sleeping = False
         self.entered(number)
         if not target & 1:
@@ -843,7 +854,9 @@ class CortexM:
 
     def exception_return(self, exc_return: int) -> None:
         """Exception return (B1.5.8): unstack the frame, undo the alignment word, back to the mode EXC_RETURN
-        names; costs :attr:`Cpu.return_cycles`."""
+        names; costs :attr:`Cpu.return_cycles`. A pending exception that may preempt the code returned to is
+        tail-chained instead (MCU-15): its handler starts on the same frame, with the same EXC_RETURN, after
+        :attr:`Cpu.tail_chain_cycles`."""
         if exc_return not in (EXC_RETURN_HANDLER, EXC_RETURN_THREAD_MSP) or not self.active:
             raise FirmwareFaultError(self.report(Stop.FAULT, f"exception return with EXC_RETURN {exc_return:08X}h "
                                             f"{'in' if self.active else 'outside'} a handler: an INVPC "
@@ -853,6 +866,12 @@ class CortexM:
             reason = f"EXC_RETURN {exc_return:08X}h does not match the nesting of {nesting}: INVPC UsageFault (B1.5.8)"
             raise FirmwareFaultError(self.report(Stop.FAULT, reason))
         sp = self._read(arm.UC_ARM_REG_SP)
+        returning = self.active.pop()
+        chained = self._takeable()
+        if chained is not None:
+            self._take(chained, exc_return, sp, self.cpu.tail_chain_cycles)
+            return
+        self.active.append(returning)  # until the frame is back: a fault report shows the handler still active
         try:
             words = struct.unpack("<8I", self.read_bytes(sp, FRAME_WORDS * 4))
         except ArgumentError:
