@@ -19,6 +19,7 @@ from supi3.mcu.board import Board
 from supi3.mcu.core import (
     EXC_RETURN_HANDLER,
     EXC_RETURN_THREAD_MSP,
+    EXC_RETURN_THREAD_PSP,
     EXTERNAL,
     FRAME_NAMES,
     XPSR_ALIGN,
@@ -280,15 +281,32 @@ def test_primask_holds_an_interrupt_until_cleared(exceptions_elf: Path) -> None:
     assert _word(core, "order") == 0x123
 
 
-def test_an_interrupt_in_thread_mode_on_the_process_stack_is_reported(exceptions_elf: Path) -> None:
-    """MCU-3: CONTROL.SPSEL = 1 (thread mode on PSP) is not modelled: the entry stops with a report."""
-    core = CortexM(exceptions_elf)
+@pytest.mark.parametrize("cpu", CPUS)
+def test_an_interrupt_in_thread_mode_on_the_process_stack_stacks_there_and_returns_there(
+    exceptions_elf: Path, cpu: str
+) -> None:
+    """Thread mode on the process stack (CONTROL.SPSEL = 1): the entry stacks the frame on the PSP, the handler runs
+    on the main stack with LR = FFFFFFFDh and SPSEL = 0, and the return unstacks from the PSP and selects it again
+    (B1.5.6, B1.5.8), at the same cycles as on the main stack."""
+    core = CortexM(exceptions_elf, cpu=cpu)
     _sleep(core)
-    core.set_reg("psp", 0x2000_4000)
+    msp, psp = core.reg("msp"), 0x2000_4000
+    core.set_reg("psp", psp)
     core.set_reg("control", 0b10)
-    core.pend(EXTERNAL + 0)
-    with pytest.raises(FirmwareStoppedError, match="process stack"):
-        core.step(core.cycles + 1000)
+    assert core.reg("sp") == psp
+    core.pend(EXTERNAL + 1)
+    start = core.cycles
+    assert core.step(start + 10_000) == "run"  # entry, Irq1_Handler, the exception return
+    assert _word(core, "seen1_lr") == EXC_RETURN_THREAD_PSP
+    assert _word(core, "seen1_sp") == msp  # the handler's stack: the main one, untouched by the frame
+    frame = dict(zip(FRAME_NAMES, struct.unpack("<8I", core.read_bytes(psp - 32, 32)), strict=True))
+    assert [frame[r] for r in ("r0", "r1", "r2", "r3", "r12")] == [0xA0A0A0A0, 0xA1A1A1A1, 0xA2A2A2A2, 0xA3A3A3A3,
+                                                                  0xC0C0C0C0]  # fmt: skip
+    assert frame["pc"] == core.image.address("resume1") == core.pc
+    assert core.active == [] and core.reg("control") == 0b10
+    assert (core.reg("sp"), core.reg("psp"), core.reg("msp")) == (psp, psp, msp)
+    handler = block_cost(core.read_bytes(core.image.address("Irq1_Handler"), 2 * 12))
+    assert core.cycles == start + core.cpu.entry_cycles + handler[1] + core.cpu.return_cycles
 
 
 def test_memory_outside_flash_and_ram_is_a_named_error_and_a_fault_when_unstacked(exceptions_elf: Path) -> None:

@@ -808,15 +808,15 @@ class CortexM:
         best = min(candidates, key=lambda n: (self.priority(n), n))
         return best if self.priority(best) < self.execution_priority() else None
 
-    def enter(self, number: int) -> None:
-        """Exception entry (B1.5.6): stack the basic frame on the current stack, aligned to 8 bytes (B1.5.7), LR
-        = EXC_RETURN, IPSR = ``number``, PC = its vector; costs :attr:`Cpu.entry_cycles`."""
+    def enter(self, number: int) -> int:
+        """Exception entry (B1.5.6): stack the basic frame on the current stack (the process stack in thread mode
+        with CONTROL.SPSEL = 1), aligned to 8 bytes (B1.5.7), LR = EXC_RETURN, CONTROL.SPSEL = 0 (the handler runs
+        on the main stack), IPSR = ``number``, PC = its vector; costs :attr:`Cpu.entry_cycles`. Returns the
+        frame's address."""
         uc = self.uc
         handler_mode = bool(self.active)
         control = self._read(arm.UC_ARM_REG_CONTROL)
-        if control & CONTROL_SPSEL and not handler_mode:
-            raise FirmwareStoppedError(self.report(Stop.FAULT, "exception entry from thread mode on the process stack "
-                                              "(CONTROL.SPSEL = 1) is not modelled (MCU-3)"))  # fmt: skip
+        process = bool(control & CONTROL_SPSEL) and not handler_mode
         sp = self._read(arm.UC_ARM_REG_SP)
         words = [self._read(r) for r in _FRAME_REGS]
         xpsr = self._read(arm.UC_ARM_REG_XPSR)
@@ -829,7 +829,11 @@ class CortexM:
             raise FirmwareFaultError(self.report(Stop.FAULT, f"stacking error: the frame at {frame:08X}h is not in "
                                             f"memory ({error})")) from None  # fmt: skip
         self._write(arm.UC_ARM_REG_SP, frame)
-        self._take(number, EXC_RETURN_HANDLER if handler_mode else EXC_RETURN_THREAD_MSP, frame, self.cpu.entry_cycles)
+        if process:
+            self._write(arm.UC_ARM_REG_CONTROL, control & ~CONTROL_SPSEL)  # unicorn switches SP to the MSP
+        exc_return = EXC_RETURN_HANDLER if handler_mode else EXC_RETURN_THREAD_PSP if process else EXC_RETURN_THREAD_MSP
+        self._take(number, exc_return, frame, self.cpu.entry_cycles)
+        return frame
 
     def _take(self, number: int, exc_return: int, frame: int, cycles: int) -> None:
         """The part of an entry after the stacking (B1.5.6), also a tail-chain's: LR = ``exc_return``, IPSR, PC =
@@ -857,15 +861,15 @@ class CortexM:
         names; costs :attr:`Cpu.return_cycles`. A pending exception that may preempt the code returned to is
         tail-chained instead (MCU-15): its handler starts on the same frame, with the same EXC_RETURN, after
         :attr:`Cpu.tail_chain_cycles`."""
-        if exc_return not in (EXC_RETURN_HANDLER, EXC_RETURN_THREAD_MSP) or not self.active:
+        if exc_return not in (EXC_RETURN_HANDLER, EXC_RETURN_THREAD_MSP, EXC_RETURN_THREAD_PSP) or not self.active:
             raise FirmwareFaultError(self.report(Stop.FAULT, f"exception return with EXC_RETURN {exc_return:08X}h "
                                             f"{'in' if self.active else 'outside'} a handler: an INVPC "
-                                            "UsageFault or not modelled (MCU-3)"))  # fmt: skip
+                                            "UsageFault (B1.5.8)"))  # fmt: skip
         if (exc_return == EXC_RETURN_HANDLER) != (len(self.active) > 1):
             nesting = f"{len(self.active)} active exception(s)"
             reason = f"EXC_RETURN {exc_return:08X}h does not match the nesting of {nesting}: INVPC UsageFault (B1.5.8)"
             raise FirmwareFaultError(self.report(Stop.FAULT, reason))
-        sp = self._read(arm.UC_ARM_REG_SP)
+        sp = self._read(arm.UC_ARM_REG_PSP if exc_return == EXC_RETURN_THREAD_PSP else arm.UC_ARM_REG_SP)
         returning = self.active.pop()
         chained = self._takeable()
         if chained is not None:
@@ -881,8 +885,10 @@ class CortexM:
             self._write(reg, value)
         xpsr = words[7]
         sp += FRAME_WORDS * 4 + (4 if xpsr & XPSR_ALIGN else 0)
+        self._write(arm.UC_ARM_REG_XPSR, (xpsr & ~XPSR_ALIGN) | XPSR_T)  # the mode first: it selects the SP
+        if exc_return == EXC_RETURN_THREAD_PSP:
+            self._write(arm.UC_ARM_REG_CONTROL, self._read(arm.UC_ARM_REG_CONTROL) | CONTROL_SPSEL)
         self._write(arm.UC_ARM_REG_SP, sp)
-        self._write(arm.UC_ARM_REG_XPSR, (xpsr & ~XPSR_ALIGN) | XPSR_T)
         self._write(arm.UC_ARM_REG_PC, words[6] & ~1)
         self.active.pop()
         self.cycles += self.cpu.return_cycles
@@ -1030,8 +1036,7 @@ class CortexM:
         frame: int | None = None
         if self.ram[0] + FRAME_WORDS * 4 <= (self.reg("sp") & ~7) <= self.ram[0] + self.ram[1]:
             try:  # take the HardFault as the core would: the report shows the frame its handler would see
-                self.enter(HARDFAULT)
-                frame = self.reg("sp")
+                frame = self.enter(HARDFAULT)
             except FirmwareError:
                 frame = None
         return self.report(Stop.FAULT, reason, pc=pc, stacked=frame, backtrace=backtrace, fault_status=status)
