@@ -11,15 +11,22 @@ the same process (the baseline: the C driver through cffi, bytes at their Table 
 Figures: simulated time / CPU time of the process (``time.process_time``: the machine is shared, wall time swings
 with its load; the issue's goal: >= 1x), emulated instructions per second, and two ratios measured in the same
 process: against the same binary with every poll and countdown loop iteration run (``skip_polls = False``: MCU-10
-and MCU-11 off) and against the host build. Run from the repository root:
+and MCU-11 off) and against the host build. ``--profile`` also splits the CPU time of one run (cProfile, which
+slows the calls it counts, so the split is a guide, not a measure) by part: unicorn's C code with the ctypes
+transitions into the callbacks, the core's block hook, the rest of the core, the STM32 peripheral models, the board's
+bus synchronisation and checks, and the chip, ring and bench models. Run from the repository root:
 
-    python bench/bench_mcu.py [--cycles N] [--repeat R]
+    python bench/bench_mcu.py [--cycles N] [--repeat R] [--profile]
 """
 
 from __future__ import annotations
 
 import argparse
+import collections
+import cProfile
+import os
 import platform
+import pstats
 import tempfile
 import time
 from collections.abc import Callable
@@ -45,6 +52,17 @@ def _cpu_s(run: Callable[[], None], repeat: int) -> float:
     return fastest
 
 
+def _board(elf: Path, bit_rate: int, skip: bool) -> Board:
+    """The board after power-up, the master's outputs and the firmware's inputs set."""
+    board = Board(elf, bit_rate=bit_rate, strict=False)
+    board.core.skip_polls = skip
+    board.run(POWER_UP)
+    board.bench.master.set_outputs(1, b"\x12\x34")
+    assert board.fw_board is not None
+    board.fw_board.inputs = b"\xab\xcd"
+    return board
+
+
 def binary_run(elf: Path, bit_rate: int, cycles: int, repeat: int, skip: bool = True
                ) -> tuple[float, float, int, int, int]:  # fmt: skip
     """CPU seconds for ``cycles`` master cycles of ``elf`` after power-up (the fastest of ``repeat``), simulated
@@ -52,17 +70,42 @@ def binary_run(elf: Path, bit_rate: int, cycles: int, repeat: int, skip: bool = 
     outcome = (0.0, 0, 0, 0)
     fastest = float("inf")
     for _ in range(repeat):
-        board = Board(elf, bit_rate=bit_rate, strict=False)
-        board.core.skip_polls = skip
-        board.run(POWER_UP)
-        board.bench.master.set_outputs(1, b"\x12\x34")
-        assert board.fw_board is not None
-        board.fw_board.inputs = b"\xab\xcd"
+        board = _board(elf, bit_rate, skip)
         start_s, start_i = board.bench.now, board.core.instructions
         fastest = min(fastest, _cpu_s(partial(board.run, cycles), 1))
         outcome = (board.bench.now - start_s, board.core.instructions - start_i, board.interrupts,
                    len(board.violations))  # fmt: skip
     return (fastest, *outcome)
+
+
+PARTS: tuple[tuple[str, str, frozenset[str] | None], ...] = (
+    ("unicorn: C code, ctypes transitions", "/unicorn/", frozenset({"emu_start"})),
+    ("unicorn's Python binding", "/unicorn/", None),
+    ("core: block hook (MCU-1, -10, -11)", "mcu/core.py", frozenset({"_on_block", "_skip_polls", "_skip_countdown"})),
+    ("core: memory callbacks", "mcu/core.py", frozenset({"on_read", "on_write", "_exact_pc"})),
+    ("core: the rest (run loop, access times, exceptions, registers)", "mcu/core.py", None),
+    ("stm32: peripheral models", "mcu/stm32.py", None),
+    ("board: bus synchronisation, pins, Table 3-7 checks", "mcu/board.py", None),
+    ("chip, ring and bench models (supi3 outside mcu)", "/supi3/", None),
+    ("Python builtins and the rest", "", None),
+)
+"""The parts of ``--profile`` (name, part of the file's path, function names or all): the first that matches a
+function takes its own time."""
+
+
+def profile_split(elf: Path, bit_rate: int, cycles: int) -> list[tuple[str, float]]:
+    """The own CPU time of ``cycles`` master cycles under cProfile, by part (:data:`PARTS`), largest first, as
+    fractions of the whole."""
+    board = _board(elf, bit_rate, skip=True)
+    _ = board.core.image.line_at(0)  # the DWARF tables (for the violations' lines) are read once, before
+    profiler = cProfile.Profile()
+    profiler.runcall(board.run, cycles)
+    split: collections.Counter[str] = collections.Counter()
+    for (path, _line, name), row in pstats.Stats(profiler).stats.items():  # type: ignore[attr-defined]
+        part = next(part for part, where, names in PARTS if where in path and (names is None or name in names))
+        split[part] += row[2]
+    total = sum(split.values())
+    return [(part, seconds / total) for part, seconds in split.most_common()]
 
 
 def host_run(bit_rate: int, cycles: int, repeat: int) -> tuple[float, float]:
@@ -84,9 +127,13 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cycles", type=int, default=500, help="master cycles measured after power-up")
     parser.add_argument("--repeat", type=int, default=3, help="runs; the fastest is reported")
+    parser.add_argument("--profile", action="store_true", help="also split the CPU time by part (cProfile)")
     args = parser.parse_args(argv)
-    print(f"reproduce: python bench/bench_mcu.py --cycles {args.cycles} --repeat {args.repeat}")
-    print(f"machine: {platform.processor() or platform.machine()}, Python {platform.python_version()}")
+    print(f"reproduce: python bench/bench_mcu.py --cycles {args.cycles} --repeat {args.repeat}"
+          + " --profile" * args.profile)  # fmt: skip
+    load = ", ".join(f"{value:.1f}" for value in os.getloadavg())
+    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, load {load}, "
+          f"Python {platform.python_version()}")  # fmt: skip
     with tempfile.TemporaryDirectory() as folder:
         cases = [("issue case: 2 Mbit/s, SPI1 3 MHz", 2_000_000, {"BOARD_SPI_BR": "3u"}),
                  ("500 kbit/s, SPI1 750 kHz (the port's default)", 500_000, {})]  # fmt: skip
@@ -105,6 +152,9 @@ def main(argv: list[str] | None = None) -> None:
                 f"run; the host build on the bench {host_simulated / host_cpu:.2f}x real time (binary / host "
                 f"{speed / (host_simulated / host_cpu):.3f})"
             )
+            if args.profile:
+                for part, share in profile_split(elf, bit_rate, args.cycles):
+                    print(f"    {share * 100:5.1f} %  {part}")
 
 
 if __name__ == "__main__":

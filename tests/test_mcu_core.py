@@ -13,11 +13,13 @@ from pathlib import Path
 
 import pytest
 
+from supi3.errors import ArgumentError
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import Board
 from supi3.mcu.core import (
     EXC_RETURN_HANDLER,
     EXC_RETURN_THREAD_MSP,
+    EXC_RETURN_THREAD_PSP,
     EXTERNAL,
     FRAME_NAMES,
     XPSR_ALIGN,
@@ -118,6 +120,31 @@ def test_exception_entry_and_return_cost_the_cores_cycles(exceptions_elf: Path, 
     assert core.cycles == start + core.cpu.entry_cycles + handler[1] + core.cpu.return_cycles
 
 
+@pytest.mark.parametrize("cpu", CPUS)
+def test_a_pending_interrupt_at_the_return_is_tail_chained_on_the_same_frame(exceptions_elf: Path, cpu: str) -> None:
+    """MCU-20: IRQ 1 and IRQ 0 pend together in thread mode; IRQ 1 (priority 40h) runs first, and at its return IRQ 0
+    (80h, still above thread mode) starts on the frame IRQ 1 left, with the same EXC_RETURN, after the core's
+    tail-chain cycles instead of a return and an entry; thread mode then gets its registers back (B1.5.8)."""
+    core = CortexM(exceptions_elf, cpu=cpu)
+    _sleep(core)
+    entries: list[int] = []
+    core.entered = entries.append
+    core.pend(EXTERNAL + 1)
+    core.pend(EXTERNAL + 0)
+    start, thread_sp = core.cycles, core.reg("sp")
+    assert core.step(start + 10_000) == "run"  # entry of IRQ 1, its handler, the tail-chain into IRQ 0
+    assert entries == [EXTERNAL + 1, EXTERNAL + 0] and core.active == [EXTERNAL + 0]
+    assert core.pc == core.image.address("Irq0_Handler")
+    frame = core.reg("sp")
+    assert frame == _word(core, "seen1_sp") == (thread_sp - 32) & ~7  # the one frame, not unstacked
+    assert core.reg("lr") == _word(core, "seen1_lr") == EXC_RETURN_THREAD_MSP
+    handler = block_cost(core.read_bytes(core.image.address("Irq1_Handler"), 2 * 12))
+    assert core.cycles == start + core.cpu.entry_cycles + handler[1] + core.cpu.tail_chain_cycles
+    _sleep(core)  # IRQ 0 pends IRQ 1 again, which preempts it; both return to thread mode
+    assert core.active == [] and core.reg("sp") == thread_sp
+    assert [_word(core, "after", k) for k in range(5)] == [0xA0A0A0A0, 0xA1A1A1A1, 0xA2A2A2A2, 0xA3A3A3A3, 0xC0C0C0C0]
+
+
 def test_block_cost_counts_loads_stores_and_a_final_branch() -> None:
     """MCU-1: 1 cycle per instruction, +1 per single load/store, +N for N registers of PUSH/POP/LDM/STM, +2 for a
     block-ending branch."""
@@ -155,6 +182,11 @@ def test_a_bus_fault_ends_the_run_with_the_hard_fault_frame(faults_elf: Path) ->
     assert report.stacked["xpsr"] & 0x1FF == 0  # it ran in thread mode
     assert board.core.active == [3]  # HardFault taken as the core would, then stopped
     assert "stacked r0=" in str(caught.value)
+    assert report.fault_status == {"CFSR": 1 << 9, "HFSR": 1 << 30}  # BFSR.PRECISERR, escalated (B3.2.15, B3.2.16)
+    assert str(caught.value).endswith("; CFSR=00000200h HFSR=40000000h")
+    assert board.core._scs_read(0xD28, 4) == 1 << 9  # what the HardFault handler reads
+    board.core._scs_write(0xD28, 4, 1 << 9)  # write 1 to clear
+    assert board.core._scs_read(0xD28, 4) == 0
     line = _line_of(PROGRAMS / "faults.c", "REG32(0x30000000u)")
     assert report.source is not None and (report.source.file, report.source.line) == ("faults.c", line)
     assert f"(fw_loop) faults.c:{line}" in str(caught.value)
@@ -179,6 +211,7 @@ def test_an_undefined_instruction_ends_the_run_with_a_usage_fault(faults_elf: Pa
         board.run_for(20e-6)
     assert caught.value.report.symbol == "fw_loop"
     assert board.core.read_bytes(caught.value.report.pc, 2) == b"\x00\xde"
+    assert caught.value.report.fault_status == {"CFSR": 1 << 16, "HFSR": 1 << 30}  # UFSR.UNDEFINSTR
 
 
 def test_an_endless_loop_ends_when_the_instruction_budget_runs_out(faults_elf: Path) -> None:
@@ -248,15 +281,54 @@ def test_primask_holds_an_interrupt_until_cleared(exceptions_elf: Path) -> None:
     assert _word(core, "order") == 0x123
 
 
-def test_an_interrupt_in_thread_mode_on_the_process_stack_is_reported(exceptions_elf: Path) -> None:
-    """MCU-3: CONTROL.SPSEL = 1 (thread mode on PSP) is not modelled: the entry stops with a report."""
-    core = CortexM(exceptions_elf)
+@pytest.mark.parametrize("cpu", CPUS)
+def test_an_interrupt_in_thread_mode_on_the_process_stack_stacks_there_and_returns_there(
+    exceptions_elf: Path, cpu: str
+) -> None:
+    """Thread mode on the process stack (CONTROL.SPSEL = 1): the entry stacks the frame on the PSP, the handler runs
+    on the main stack with LR = FFFFFFFDh and SPSEL = 0, and the return unstacks from the PSP and selects it again
+    (B1.5.6, B1.5.8), at the same cycles as on the main stack."""
+    core = CortexM(exceptions_elf, cpu=cpu)
     _sleep(core)
-    core.set_reg("psp", 0x2000_4000)
+    msp, psp = core.reg("msp"), 0x2000_4000
+    core.set_reg("psp", psp)
     core.set_reg("control", 0b10)
-    core.pend(EXTERNAL + 0)
-    with pytest.raises(FirmwareStoppedError, match="process stack"):
-        core.step(core.cycles + 1000)
+    assert core.reg("sp") == psp
+    core.pend(EXTERNAL + 1)
+    start = core.cycles
+    assert core.step(start + 10_000) == "run"  # entry, Irq1_Handler, the exception return
+    assert _word(core, "seen1_lr") == EXC_RETURN_THREAD_PSP
+    assert _word(core, "seen1_sp") == msp  # the handler's stack: the main one, untouched by the frame
+    frame = dict(zip(FRAME_NAMES, struct.unpack("<8I", core.read_bytes(psp - 32, 32)), strict=True))
+    assert [frame[r] for r in ("r0", "r1", "r2", "r3", "r12")] == [0xA0A0A0A0, 0xA1A1A1A1, 0xA2A2A2A2, 0xA3A3A3A3,
+                                                                  0xC0C0C0C0]  # fmt: skip
+    assert frame["pc"] == core.image.address("resume1") == core.pc
+    assert core.active == [] and core.reg("control") == 0b10
+    assert (core.reg("sp"), core.reg("psp"), core.reg("msp")) == (psp, psp, msp)
+    handler = block_cost(core.read_bytes(core.image.address("Irq1_Handler"), 2 * 12))
+    assert core.cycles == start + core.cpu.entry_cycles + handler[1] + core.cpu.return_cycles
+
+
+def test_memory_outside_flash_and_ram_is_a_named_error_and_a_fault_when_unstacked(exceptions_elf: Path) -> None:
+    """The host's reads and writes of unmapped memory raise ArgumentError naming the memories; an exception return
+    whose stack pointer leaves RAM is an unstacking fault with a report (B1.5.8), an exception entry whose vector
+    table is not in memory a vector read fault (B1.5.6), not unicorn's own error."""
+    core = CortexM(exceptions_elf)
+    ram_end = core.ram[0] + core.ram[1]
+    for address, size in ((0, 4), (ram_end - 2, 4), (0x4000_0000, 1)):
+        with pytest.raises(ArgumentError, match=f"address must start {size} bytes of mapped memory .*RAM 20000000h"):
+            core.read_bytes(address, size)
+        with pytest.raises(ArgumentError, match="address must start"):
+            core.write_bytes(address, bytes(size))
+    _sleep(core)
+    core.enter(EXTERNAL + 0)
+    core.set_reg("sp", ram_end)
+    with pytest.raises(FirmwareFaultError, match=f"unstacking error: the frame at {ram_end:08X}h is not in memory"):
+        core.exception_return(EXC_RETURN_THREAD_MSP)
+    core = CortexM(exceptions_elf)
+    core.vtor = 0x3000_0000  # as a write of SCB->VTOR would set it
+    with pytest.raises(FirmwareFaultError, match="vector table read error: entry 16 \\(IRQ 0\\) at VTOR 30000000h"):
+        core.enter(EXTERNAL + 0)
 
 
 @pytest.mark.parametrize(

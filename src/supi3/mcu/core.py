@@ -16,11 +16,15 @@ placed inside its block by the program counter (:meth:`CortexM.cycles_now`; unic
 access only under a memory hook, so each peripheral range has an empty one). Emulation only ever stops at a block
 boundary (a block hook refuses the next block), because unicorn restarts an instruction stopped inside a memory
 callback and a peripheral would see its access twice.
+
+Speed (MCU-19): the block hook, the peripheral callbacks and the register reads they need go to unicorn's C library
+through ctypes directly; the binding's wrappers around each call cost as much again as the call.
 """
 
 from __future__ import annotations
 
 import bisect
+import ctypes
 import struct
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -39,6 +43,16 @@ from supi3.errors import ArgumentError, Supi3Error
 
 _UNICORN: Any = unicorn  # typed, but its Uc methods are not annotated
 UcError: type[Exception] = _UNICORN.UcError
+_LIB: Any = _UNICORN.unicorn_py3.unicorn.uclib
+"""unicorn's C library as its binding loaded it (with the argument types it declares): the hot callbacks and
+register accesses go to it directly (MCU-19), without the binding's wrappers around each call."""
+# Callback types of unicorn.h (uc_cb_hookcode_t, uc_cb_hookmem_t, uc_cb_mmio_read_t, uc_cb_mmio_write_t).
+_HOOK_CODE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint32, ctypes.c_void_p)
+_HOOK_MEM: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_int, ctypes.c_uint64, ctypes.c_int, ctypes.c_int64,
+                                    ctypes.c_void_p)  # fmt: skip
+_MMIO_READ: Final = ctypes.CFUNCTYPE(ctypes.c_uint64, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint, ctypes.c_void_p)
+_MMIO_WRITE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint, ctypes.c_uint64,
+                                      ctypes.c_void_p)  # fmt: skip
 
 __all__ = [
     "CPUS",
@@ -102,6 +116,23 @@ BACKTRACE_DEPTH: Final[int] = 16
 """Frames :meth:`CortexM.backtrace` unwinds at most."""
 IRQ_LINES: Final[int] = 32
 """External interrupts the NVIC model has (one ISER word)."""
+CFSR: Final[int] = 0xD28
+"""Configurable Fault Status Register, offset in the SCS (B3.2.15): MMFSR bits 0-7, BFSR 8-15, UFSR 16-31."""
+HFSR: Final[int] = 0xD2C
+"""HardFault Status Register (B3.2.16)."""
+HFSR_FORCED: Final[int] = 1 << 30
+"""A configurable fault escalated to HardFault: its handler is disabled (SHCSR, as from reset; MCU-3)."""
+_FAULTS: Final[dict[int, tuple[str, int]]] = {
+    ucc.UC_ERR_READ_UNMAPPED: ("precise bus fault: read of unmapped memory", 1 << 9),  # BFSR.PRECISERR
+    ucc.UC_ERR_WRITE_UNMAPPED: ("precise bus fault: write to unmapped memory", 1 << 9),
+    ucc.UC_ERR_FETCH_UNMAPPED: ("instruction bus fault: fetch from unmapped memory (run-away PC)", 1 << 8),  # IBUSERR
+    ucc.UC_ERR_INSN_INVALID: ("usage fault: undefined instruction", 1 << 16),  # UFSR.UNDEFINSTR
+    ucc.UC_ERR_READ_UNALIGNED: ("usage fault: unaligned read", 1 << 24),  # UFSR.UNALIGNED
+    ucc.UC_ERR_WRITE_UNALIGNED: ("usage fault: unaligned write", 1 << 24),
+    ucc.UC_ERR_FETCH_PROT: ("memory fault: execute from a non-executable region", 1 << 0),  # MMFSR.IACCVIOL
+    ucc.UC_ERR_WRITE_PROT: ("memory fault: write to read-only memory", 1 << 1),  # MMFSR.DACCVIOL
+}
+"""unicorn's error of a fault: the report's reason and the CFSR bit the core sets (B3.2.15)."""
 
 
 @dataclass(frozen=True)
@@ -114,13 +145,20 @@ class Cpu:
     entry_cycles: int
     return_cycles: int
     vtor: bool
+    fault_status: bool
+    """The core has CFSR and HFSR (ARMv7-M B3.2.15, B3.2.16; ARMv6-M has neither)."""
+    tail_chain_cycles: int
+    """From an exception return to the next handler's first instruction when a pending exception is taken at once,
+    without unstacking and stacking again (tail-chaining, MCU-20)."""
 
 
 CPUS: Final[dict[str, Cpu]] = {
     # Cortex-M3: 12 cycles from the interrupt to the handler's first instruction, return 10 (MCU-2).
-    "cortex_m3": Cpu("cortex_m3", arm.UC_CPU_ARM_CORTEX_M3, 0x412F_C231, 12, 10, vtor=True),
+    "cortex_m3": Cpu("cortex_m3", arm.UC_CPU_ARM_CORTEX_M3, 0x412F_C231, 12, 10, vtor=True, fault_status=True,
+                     tail_chain_cycles=6),
     # Cortex-M0: 16 cycles interrupt latency, the return taken as long (MCU-2). ARMv6-M: no VTOR.
-    "cortex_m0": Cpu("cortex_m0", arm.UC_CPU_ARM_CORTEX_M0, 0x410C_C200, 16, 16, vtor=False),
+    "cortex_m0": Cpu("cortex_m0", arm.UC_CPU_ARM_CORTEX_M0, 0x410C_C200, 16, 16, vtor=False, fault_status=False,
+                     tail_chain_cycles=16),
 }
 """The cores :class:`CortexM` emulates, by their ``-mcpu`` names."""
 
@@ -203,6 +241,8 @@ class StopReport:
     symbol: str | None = None
     backtrace: tuple[Frame, ...] = ()
     """The call stack at :attr:`pc`, innermost first (DWARF call frame information), up to an exception entry."""
+    fault_status: dict[str, int] | None = None
+    """For a fault on an ARMv7-M core: CFSR and HFSR as its HardFault handler would read them (B3.2.15, B3.2.16)."""
 
     @property
     def source(self) -> SourceLine | None:
@@ -218,6 +258,8 @@ class StopReport:
             text += "; called from " + " <- ".join(str(frame) for frame in self.backtrace[1:])
         if self.stacked is not None:
             text += "; stacked " + " ".join(f"{name}={value:08X}h" for name, value in self.stacked.items())
+        if self.fault_status is not None:
+            text += "; " + " ".join(f"{name}={value:08X}h" for name, value in self.fault_status.items())
         return text
 
 
@@ -542,6 +584,10 @@ class CortexM:
         _check_memories(self.image, flash, ram)
         self.uc: Any = _UNICORN.Uc(ucc.UC_ARCH_ARM, ucc.UC_MODE_THUMB | ucc.UC_MODE_MCLASS)
         self.uc.ctl_set_cpu_model(self.cpu.model)
+        self._handle = self.uc._uch  # the engine (uc_engine *) for the direct calls (MCU-19)
+        self._register_value = ctypes.c_uint64()
+        self._register_ref = ctypes.byref(self._register_value)
+        self._callbacks: list[object] = []  # the ctypes callbacks unicorn holds: kept alive with the core
         self.flash = flash
         self.ram = ram
         for base, size in (flash, ram):
@@ -569,6 +615,7 @@ class CortexM:
         self._handed = 0  # the latest time a peripheral was given
         self._skip: tuple[int, int] | None = None  # (poll loop address, cycle its status changes)
         self._polls: dict[int, bool] = {}
+        self._idle: dict[int, bool] = {}  # address: the instruction there is ``b .``
         self._blocks: dict[tuple[int, int], tuple[tuple[int, int], int]] = {}  # cost, countdown register (MCU-11)
         self.skip_polls = True
         """MCU-10, MCU-11: count the iterations of pure poll loops and countdown loops without running them (the
@@ -577,7 +624,7 @@ class CortexM:
         self.systick = SysTick(self)
         self._scs_words: dict[int, int] = {}
         self.mmio(SCS_BASE, SCS_SIZE, self._scs_read, self._scs_write)
-        self.uc.hook_add(ucc.UC_HOOK_BLOCK, self._on_block)
+        self._hook(ucc.UC_HOOK_BLOCK, _HOOK_CODE(self._on_block))
         self.uc.hook_add(ucc.UC_HOOK_INTR, self._on_interrupt)
         self.reset()
 
@@ -588,8 +635,8 @@ class CortexM:
         access. An exception they raise stops the run at the end of the block (:attr:`error`); the block's later
         accesses reach no peripheral (no follow-on reports of a run that has ended)."""
 
-        def on_read(uc: Any, offset: int, size: int, data: Any) -> int:
-            del uc, data
+        def on_read(handle: int, offset: int, size: int, data: int) -> int:
+            del handle, data
             if self.error is not None:  # the run ends with this block: its later accesses reach no peripheral
                 return 0
             try:
@@ -598,8 +645,8 @@ class CortexM:
                 self.fail(error)
                 return 0
 
-        def on_write(uc: Any, offset: int, size: int, value: int, data: Any) -> None:
-            del uc, data
+        def on_write(handle: int, offset: int, size: int, value: int, data: int) -> None:
+            del handle, data
             if self.error is not None:
                 return
             try:
@@ -607,19 +654,45 @@ class CortexM:
             except BaseException as error:  # handed to the run loop, raised there
                 self.fail(error)
 
-        self.uc.mmio_map(base, size, on_read, None, on_write, None)
+        callbacks = (_MMIO_READ(on_read), _MMIO_WRITE(on_write))
+        self._callbacks += callbacks
+        self._check(_LIB.uc_mmio_map(self._handle, base, size, callbacks[0], None, callbacks[1], None))
         # unicorn updates the PC before a load or store only if a memory hook covers its address: without one, a
         # peripheral callback sees the PC of the block's first instruction, and the access would be timed there
         # (MCU-1 places it by the PC).
-        self.uc.hook_add(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, _exact_pc, None, base, base + size - 1)
+        self._hook(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, _EXACT_PC, base, base + size - 1)
+
+    def _hook(self, kind: int, callback: Any, begin: int = 1, end: int = 0) -> None:
+        """Add a hook with a ctypes callback (MCU-19); ``begin > end``: every address."""
+        self._callbacks.append(callback)
+        handle = ctypes.c_size_t()  # uc_hook
+        self._check(_LIB.uc_hook_add(self._handle, ctypes.byref(handle), kind, ctypes.cast(callback, ctypes.c_void_p),
+                                     None, ctypes.c_uint64(begin), ctypes.c_uint64(end)))  # fmt: skip
+
+    @staticmethod
+    def _check(status: int) -> None:
+        if status != ucc.UC_ERR_OK:
+            raise UcError(status)
 
     def read_bytes(self, address: int, size: int) -> bytes:
-        """Memory as the core sees it (RAM, flash)."""
-        return bytes(self.uc.mem_read(address, size))
+        """Memory as the core sees it (RAM, flash); an :class:`ArgumentError` if any of it is not mapped."""
+        try:
+            return bytes(self.uc.mem_read(address, size))
+        except UcError:
+            raise self._unmapped(address, size) from None
 
     def write_bytes(self, address: int, data: bytes) -> None:
-        """Write memory (RAM) from the host, between runs."""
-        self.uc.mem_write(address, check_bytes("data", data))
+        """Write memory (RAM) from the host, between runs; an :class:`ArgumentError` if any of it is not mapped."""
+        try:
+            self.uc.mem_write(address, check_bytes("data", data))
+        except UcError:
+            raise self._unmapped(address, len(data)) from None
+
+    def _unmapped(self, address: int, size: int) -> ArgumentError:
+        memories = ", ".join(f"{name} {base:08X}h to {base + length - 1:08X}h"
+                             for name, (base, length) in (("flash", self.flash), ("RAM", self.ram)))  # fmt: skip
+        return ArgumentError("address", address, f"address must start {size} bytes of mapped memory ({memories}), "
+                             f"not {address:#010x}")  # fmt: skip
 
     def fail(self, error: BaseException) -> None:
         """Stop at the end of the running block and raise ``error`` from :meth:`run` (the first one wins)."""
@@ -631,7 +704,7 @@ class CortexM:
 
     def reg(self, name: str) -> int:
         """One register by name (``r0``..``r12``, ``sp``, ``lr``, ``pc``, ``xpsr``, ``primask``, ``control``)."""
-        return int(self.uc.reg_read(_register(name)))
+        return int(self.uc.reg_read(_register(name)))  # any width: through the binding
 
     def set_reg(self, name: str, value: int) -> None:
         """Write one register by name (as :meth:`reg`) with a 32-bit value, between runs."""
@@ -639,12 +712,22 @@ class CortexM:
 
     def registers(self) -> dict[str, int]:
         """R0-R12, SP, LR, PC and xPSR."""
-        return {name: int(self.uc.reg_read(reg)) for name, reg in _REGS}
+        return {name: self._read(reg) for name, reg in _REGS}
 
     @property
     def pc(self) -> int:
         """The address of the next instruction."""
-        return int(self.uc.reg_read(arm.UC_ARM_REG_PC))
+        return self._read(arm.UC_ARM_REG_PC)
+
+    def _read(self, register: int) -> int:
+        """A 32-bit core register by unicorn's number, read by the C library directly (MCU-19)."""
+        _LIB.uc_reg_read(self._handle, register, self._register_ref)
+        return self._register_value.value
+
+    def _write(self, register: int, value: int) -> None:
+        """Write a 32-bit core register by unicorn's number, by the C library directly (MCU-19)."""
+        self._register_value.value = value
+        _LIB.uc_reg_write(self._handle, register, self._register_ref)
 
     @property
     def time_s(self) -> float:
@@ -658,7 +741,7 @@ class CortexM:
         if not self._running:
             return self.cycles
         address, start = self._block
-        pc = int(self.uc.reg_read(arm.UC_ARM_REG_PC))
+        pc = self._read(arm.UC_ARM_REG_PC)
         if pc > address:
             key = (address, pc - address)
             cost = self._costs.get(key)
@@ -682,10 +765,10 @@ class CortexM:
         """Power-on reset (B1.5.5): MSP and PC from the vector table at the flash base, thread mode, privileged."""
         base = self.flash[0]
         sp, entry = struct.unpack("<2I", self.read_bytes(base, 8))
-        self.uc.reg_write(arm.UC_ARM_REG_XPSR, XPSR_T)
-        self.uc.reg_write(arm.UC_ARM_REG_MSP, sp)
-        self.uc.reg_write(arm.UC_ARM_REG_SP, sp)
-        self.uc.reg_write(arm.UC_ARM_REG_PC, entry & ~1)
+        self._write(arm.UC_ARM_REG_XPSR, XPSR_T)
+        self._write(arm.UC_ARM_REG_MSP, sp)
+        self._write(arm.UC_ARM_REG_SP, sp)
+        self._write(arm.UC_ARM_REG_PC, entry & ~1)
         self.vtor = base
         self.active.clear()
         self.pending.clear()
@@ -704,7 +787,7 @@ class CortexM:
         """The running priority: the highest (lowest number) active exception, 0 under PRIMASK (B1.5.4); 256 in
         thread mode with nothing masked."""
         running = min((self.priority(n) for n in self.active), default=256)
-        if self.reg("primask") & 1:
+        if self._read(arm.UC_ARM_REG_PRIMASK) & 1:
             running = min(running, 0)
         return running
 
@@ -725,18 +808,18 @@ class CortexM:
         best = min(candidates, key=lambda n: (self.priority(n), n))
         return best if self.priority(best) < self.execution_priority() else None
 
-    def enter(self, number: int) -> None:
-        """Exception entry (B1.5.6): stack the basic frame on the current stack, aligned to 8 bytes (B1.5.7), LR
-        = EXC_RETURN, IPSR = ``number``, PC = its vector; costs :attr:`Cpu.entry_cycles`."""
+    def enter(self, number: int) -> int:
+        """Exception entry (B1.5.6): stack the basic frame on the current stack (the process stack in thread mode
+        with CONTROL.SPSEL = 1), aligned to 8 bytes (B1.5.7), LR = EXC_RETURN, CONTROL.SPSEL = 0 (the handler runs
+        on the main stack), IPSR = ``number``, PC = its vector; costs :attr:`Cpu.entry_cycles`. Returns the
+        frame's address."""
         uc = self.uc
         handler_mode = bool(self.active)
-        control = self.reg("control")
-        if control & CONTROL_SPSEL and not handler_mode:
-            raise FirmwareStoppedError(self.report(Stop.FAULT, "exception entry from thread mode on the process stack "
-                                              "(CONTROL.SPSEL = 1) is not modelled (MCU-3)"))  # fmt: skip
-        sp = int(uc.reg_read(arm.UC_ARM_REG_SP))
-        words = [int(uc.reg_read(r)) for r in _FRAME_REGS]
-        xpsr = int(uc.reg_read(arm.UC_ARM_REG_XPSR))
+        control = self._read(arm.UC_ARM_REG_CONTROL)
+        process = bool(control & CONTROL_SPSEL) and not handler_mode
+        sp = self._read(arm.UC_ARM_REG_SP)
+        words = [self._read(r) for r in _FRAME_REGS]
+        xpsr = self._read(arm.UC_ARM_REG_XPSR)
         aligned = sp & 4
         frame = (sp - FRAME_WORDS * 4) & ~7
         words += [self.pc, xpsr | (XPSR_ALIGN if aligned else 0)]
@@ -745,14 +828,28 @@ class CortexM:
         except UcError as error:
             raise FirmwareFaultError(self.report(Stop.FAULT, f"stacking error: the frame at {frame:08X}h is not in "
                                             f"memory ({error})")) from None  # fmt: skip
-        uc.reg_write(arm.UC_ARM_REG_SP, frame)
-        uc.reg_write(arm.UC_ARM_REG_LR, EXC_RETURN_HANDLER if handler_mode else EXC_RETURN_THREAD_MSP)
-        uc.reg_write(arm.UC_ARM_REG_XPSR, XPSR_T | number)
-        target = self.vector(number)
-        uc.reg_write(arm.UC_ARM_REG_PC, target & ~1)
+        self._write(arm.UC_ARM_REG_SP, frame)
+        if process:
+            self._write(arm.UC_ARM_REG_CONTROL, control & ~CONTROL_SPSEL)  # unicorn switches SP to the MSP
+        exc_return = EXC_RETURN_HANDLER if handler_mode else EXC_RETURN_THREAD_PSP if process else EXC_RETURN_THREAD_MSP
+        self._take(number, exc_return, frame, self.cpu.entry_cycles)
+        return frame
+
+    def _take(self, number: int, exc_return: int, frame: int, cycles: int) -> None:
+        """The part of an entry after the stacking (B1.5.6), also a tail-chain's: LR = ``exc_return``, IPSR, PC =
+        the vector of ``number``, which becomes active; costs ``cycles``. ``frame``: the stacked frame, for a
+        report."""
+        self._write(arm.UC_ARM_REG_LR, exc_return)
+        self._write(arm.UC_ARM_REG_XPSR, XPSR_T | number)
+        try:
+            target = self.vector(number)
+        except ArgumentError:
+            reason = f"vector table read error: entry {number} ({_name(number)}) at VTOR {self.vtor:08X}h is unmapped"
+            raise FirmwareFaultError(self.report(Stop.FAULT, reason, stacked=frame)) from None
+        self._write(arm.UC_ARM_REG_PC, target & ~1)
         self.pending.discard(number)
         self.active.append(number)
-        self.cycles += self.cpu.entry_cycles
+        self.cycles += cycles
         self.sleeping = False
         self.entered(number)
         if not target & 1:
@@ -761,56 +858,74 @@ class CortexM:
 
     def exception_return(self, exc_return: int) -> None:
         """Exception return (B1.5.8): unstack the frame, undo the alignment word, back to the mode EXC_RETURN
-        names; costs :attr:`Cpu.return_cycles`."""
-        uc = self.uc
-        if exc_return not in (EXC_RETURN_HANDLER, EXC_RETURN_THREAD_MSP) or not self.active:
+        names; costs :attr:`Cpu.return_cycles`. A pending exception that may preempt the code returned to is
+        tail-chained instead (MCU-20): its handler starts on the same frame, with the same EXC_RETURN, after
+        :attr:`Cpu.tail_chain_cycles`."""
+        if exc_return not in (EXC_RETURN_HANDLER, EXC_RETURN_THREAD_MSP, EXC_RETURN_THREAD_PSP) or not self.active:
             raise FirmwareFaultError(self.report(Stop.FAULT, f"exception return with EXC_RETURN {exc_return:08X}h "
                                             f"{'in' if self.active else 'outside'} a handler: an INVPC "
-                                            "UsageFault or not modelled (MCU-3)"))  # fmt: skip
+                                            "UsageFault (B1.5.8)"))  # fmt: skip
         if (exc_return == EXC_RETURN_HANDLER) != (len(self.active) > 1):
             nesting = f"{len(self.active)} active exception(s)"
             reason = f"EXC_RETURN {exc_return:08X}h does not match the nesting of {nesting}: INVPC UsageFault (B1.5.8)"
             raise FirmwareFaultError(self.report(Stop.FAULT, reason))
-        sp = int(uc.reg_read(arm.UC_ARM_REG_SP))
-        words = struct.unpack("<8I", self.read_bytes(sp, FRAME_WORDS * 4))
+        sp = self._read(arm.UC_ARM_REG_PSP if exc_return == EXC_RETURN_THREAD_PSP else arm.UC_ARM_REG_SP)
+        returning = self.active.pop()
+        chained = self._takeable()
+        if chained is not None:
+            self._take(chained, exc_return, sp, self.cpu.tail_chain_cycles)
+            return
+        self.active.append(returning)  # until the frame is back: a fault report shows the handler still active
+        try:
+            words = struct.unpack("<8I", self.read_bytes(sp, FRAME_WORDS * 4))
+        except ArgumentError:
+            reason = f"unstacking error: the frame at {sp:08X}h is not in memory (B1.5.8)"
+            raise FirmwareFaultError(self.report(Stop.FAULT, reason)) from None
         for reg, value in zip(_FRAME_REGS, words[:6], strict=True):
-            uc.reg_write(reg, value)
+            self._write(reg, value)
         xpsr = words[7]
         sp += FRAME_WORDS * 4 + (4 if xpsr & XPSR_ALIGN else 0)
-        uc.reg_write(arm.UC_ARM_REG_SP, sp)
-        uc.reg_write(arm.UC_ARM_REG_XPSR, (xpsr & ~XPSR_ALIGN) | XPSR_T)
-        uc.reg_write(arm.UC_ARM_REG_PC, words[6] & ~1)
+        self._write(arm.UC_ARM_REG_XPSR, (xpsr & ~XPSR_ALIGN) | XPSR_T)  # the mode first: it selects the SP
+        if exc_return == EXC_RETURN_THREAD_PSP:
+            self._write(arm.UC_ARM_REG_CONTROL, self._read(arm.UC_ARM_REG_CONTROL) | CONTROL_SPSEL)
+        self._write(arm.UC_ARM_REG_SP, sp)
+        self._write(arm.UC_ARM_REG_PC, words[6] & ~1)
         self.active.pop()
         self.cycles += self.cpu.return_cycles
 
     # -- running -----------------------------------------------------------------------------------------------
 
-    def _on_block(self, uc: Any, address: int, size: int, data: Any) -> None:
+    def _on_block(self, handle: int, address: int, size: int, data: int) -> None:
+        """The block at ``address`` is about to run: refuse it at the deadline or on a stop request, else count its
+        cost (MCU-1) or skip the iterations of a poll or countdown loop (MCU-10, MCU-11)."""
         del data
-        if self.stop_request or self.cycles >= self.deadline:
-            uc.emu_stop()  # this block does not run: it is the first of the next run
-            return
-        key = (address, size)
-        block = self._blocks.get(key)
-        if block is None:
-            code = self.read_bytes(address, size)
-            block = self._blocks[key] = (block_cost(code), countdown_register(code))
-        cost = block[0]
-        skip = self._skip
-        if skip is not None:
-            self._skip = None
-            if skip[0] == address:
-                self._skip_polls(cost, skip[1])
-                if self.cycles >= self.deadline:
-                    uc.emu_stop()
-                    return
-        if block[1] >= 0 and self.skip_polls and self._skip_countdown(block[1], cost):
-            uc.emu_stop()
-            return
-        self._block = (address, self.cycles)
-        self._block_end = address + size
-        self.instructions += cost[0]
-        self.cycles += cost[1]
+        try:
+            if self.stop_request or self.cycles >= self.deadline:
+                _LIB.uc_emu_stop(handle)  # this block does not run: it is the first of the next run
+                return
+            block = self._blocks.get((address, size))
+            if block is None:
+                code = self.read_bytes(address, size)
+                block = self._blocks[address, size] = (block_cost(code), countdown_register(code))
+            cost = block[0]
+            skip = self._skip
+            if skip is not None:
+                self._skip = None
+                if skip[0] == address:
+                    self._skip_polls(cost, skip[1])
+                    if self.cycles >= self.deadline:
+                        _LIB.uc_emu_stop(handle)
+                        return
+            if block[1] >= 0 and self.skip_polls and self._skip_countdown(block[1], cost):
+                _LIB.uc_emu_stop(handle)
+                return
+            self._block = (address, self.cycles)
+            self._block_end = address + size
+            self.instructions += cost[0]
+            self.cycles += cost[1]
+        except BaseException as error:  # handed to the run loop, raised there (an escape would be lost in ctypes)
+            self.fail(error)
+            _LIB.uc_emu_stop(handle)
 
     def _skip_polls(self, cost: tuple[int, int], until: int) -> None:
         """Count, without running them, the iterations of a poll loop that would start before the deadline and
@@ -826,10 +941,10 @@ class CortexM:
         """Count, without running them, the iterations of a countdown loop on ``register`` that would start before
         the deadline, all but its last (MCU-11); whether the deadline came first (the block must not run)."""
         reg = _LOW_REGS[register]
-        left = int(self.uc.reg_read(reg))
+        left = self._read(reg)
         skipped = max(0, min(left - 1, -(-(self.deadline - self.cycles) // cost[1])))
         if skipped:
-            self.uc.reg_write(reg, left - skipped)
+            self._write(reg, left - skipped)
             self.instructions += skipped * cost[0]
             self.cycles += skipped * cost[1]
         return self.cycles >= self.deadline
@@ -903,43 +1018,42 @@ class CortexM:
     def idle_loop(self) -> bool:
         """The core sits on ``b .`` (a branch to itself): in thread mode it waits for an interrupt (MCU-4)."""
         pc = self.pc
-        return bool(self.flash[0] <= pc < self.flash[0] + self.flash[1] - 1 and
-                    self.read_bytes(pc, 2) == b"\xfe\xe7")  # fmt: skip
+        idle = self._idle.get(pc)  # the code does not change (as the block costs)
+        if idle is None:
+            idle = self._idle[pc] = bool(self.flash[0] <= pc < self.flash[0] + self.flash[1] - 1 and
+                                         self.read_bytes(pc, 2) == b"\xfe\xe7")  # fmt: skip
+        return idle
 
     def _fault(self, error: Any) -> StopReport:
         pc = self.pc
-        kinds = {
-            ucc.UC_ERR_READ_UNMAPPED: "precise bus fault: read of unmapped memory",
-            ucc.UC_ERR_WRITE_UNMAPPED: "precise bus fault: write to unmapped memory",
-            ucc.UC_ERR_FETCH_UNMAPPED: "instruction bus fault: fetch from unmapped memory (run-away PC)",
-            ucc.UC_ERR_INSN_INVALID: "usage fault: undefined instruction",
-            ucc.UC_ERR_READ_UNALIGNED: "usage fault: unaligned read",
-            ucc.UC_ERR_WRITE_UNALIGNED: "usage fault: unaligned write",
-            ucc.UC_ERR_FETCH_PROT: "memory fault: execute from a non-executable region",
-            ucc.UC_ERR_WRITE_PROT: "memory fault: write to read-only memory",
-        }
-        reason = kinds.get(error.errno, f"fault ({error})")
+        reason, bit = _FAULTS.get(error.errno, (f"fault ({error})", 0))
+        status = None
+        if self.cpu.fault_status and bit:  # the status registers as the fault leaves them (B3.2.15, B3.2.16)
+            words = self._scs_words
+            words[CFSR], words[HFSR] = words.get(CFSR, 0) | bit, words.get(HFSR, 0) | HFSR_FORCED
+            status = {"CFSR": words[CFSR], "HFSR": words[HFSR]}
         backtrace = self.backtrace()
         frame: int | None = None
         if self.ram[0] + FRAME_WORDS * 4 <= (self.reg("sp") & ~7) <= self.ram[0] + self.ram[1]:
             try:  # take the HardFault as the core would: the report shows the frame its handler would see
-                self.enter(HARDFAULT)
-                frame = self.reg("sp")
+                frame = self.enter(HARDFAULT)
             except FirmwareError:
                 frame = None
-        return self.report(Stop.FAULT, reason, pc=pc, stacked=frame, backtrace=backtrace)
+        return self.report(Stop.FAULT, reason, pc=pc, stacked=frame, backtrace=backtrace, fault_status=status)
 
     def report(self, stop: Stop, reason: str, *, pc: int | None = None, stacked: int | None = None,
-               backtrace: tuple[Frame, ...] | None = None) -> StopReport:  # fmt: skip
+               backtrace: tuple[Frame, ...] | None = None, fault_status: dict[str, int] | None = None
+               ) -> StopReport:  # fmt: skip
         """A :class:`StopReport` of the core now; ``stacked``: the address of a stacked frame to include;
-        ``backtrace``: the call stack if not the core's now (:meth:`backtrace`)."""
+        ``backtrace``: the call stack if not the core's now (:meth:`backtrace`); ``fault_status``: CFSR and HFSR."""
         pc = self.pc if pc is None else pc
         frame = None
         if stacked is not None:
             words = struct.unpack("<8I", self.read_bytes(stacked, FRAME_WORDS * 4))
             frame = dict(zip(FRAME_NAMES, words, strict=True))
         return StopReport(stop, reason, pc, self.registers(), self.instructions, self.cycles, self.time_s, frame,
-                          self.image.function_at(pc), self.backtrace() if backtrace is None else backtrace)  # fmt: skip
+                          self.image.function_at(pc), self.backtrace() if backtrace is None else backtrace,
+                          fault_status)  # fmt: skip
 
     def backtrace(self, depth: int = BACKTRACE_DEPTH) -> tuple[Frame, ...]:
         """The call stack now, innermost first: the PC's function and line, then each caller's return address
@@ -958,7 +1072,7 @@ class CortexM:
             try:
                 saved = {reg: int(struct.unpack("<I", self.read_bytes(cfa + offset, 4))[0])
                          for reg, offset in rule[2].items()}  # fmt: skip
-            except UcError:
+            except ArgumentError:
                 break
             regs |= saved
             regs[13] = cfa
@@ -1024,13 +1138,18 @@ class CortexM:
                 self.stop_request = True
         elif offset == 0xD08 and self.cpu.vtor:
             self.vtor = value & ~0x7F
+        elif offset in (CFSR, HFSR):  # write 1 to clear (B3.2.15, B3.2.16)
+            self._scs_words[offset] = self._scs_words.get(offset, 0) & ~value
         else:
             self._scs_words[offset] = value
 
 
-def _exact_pc(uc: Any, access: int, address: int, size: int, value: int, data: Any) -> None:
+def _exact_pc(handle: int, access: int, address: int, size: int, value: int, data: int) -> None:
     """A memory hook that does nothing: its presence makes unicorn keep the PC exact at each access it covers."""
-    del uc, access, address, size, value, data
+    del handle, access, address, size, value, data
+
+
+_EXACT_PC: Final = _HOOK_MEM(_exact_pc)
 
 
 def _nothing(number: int) -> None:

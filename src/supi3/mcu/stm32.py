@@ -148,9 +148,10 @@ class Gpio:
     def _changed(self) -> None:
         levels = self.levels()
         changed, self._levels = levels ^ self._levels, levels
-        for pin in range(16):
-            if changed >> pin & 1:
-                self.on_output(pin, levels >> pin & 1)
+        while changed:  # the changed pins, lowest first
+            pin = (changed & -changed).bit_length() - 1
+            changed &= changed - 1
+            self.on_output(pin, levels >> pin & 1)
 
     def read(self, offset: int, size: int) -> int:
         """CRL, CRH, IDR, ODR."""
