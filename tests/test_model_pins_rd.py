@@ -14,12 +14,12 @@ from supi3.diagnostics import IbDiag, diag_pins, diagnostic_outputs, is_complete
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.master import Master
-from supi3.interbus.ring import DeadLine, Ring
+from supi3.interbus.ring import Branch, BranchKind, DeadLine, Ring
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import ChipArgumentError, Supi3
 from supi3.model.pinring import PinRing
 from supi3.model.pins import IDLE_TIMEOUT_CLOCKS, SYNC_STAGES, Supi3Pins
-from support import Columns, CoreScript, assert_run_matches_step, counter_levels, quiet_inputs
+from support import Columns, CoreScript, assert_run_matches_step, counter_levels, quiet_inputs, terminal
 
 FAST = tables.clk_conf_for(2_000_000)
 PHASE = 300
@@ -106,6 +106,26 @@ def test_a_pin_ring_shows_rd_on_its_last_chip_only() -> None:
     ring.run_levels(wire.status_levels(Cycle.DATA, False, 20))
     assert [chip.chip.following for chip in ring.devices] == [True, True, False]  # type: ignore[attr-defined]
     assert [int(pins["diag2"][-1]) for pins in ring.recorded()] == [0, 0, 1]
+
+
+
+def test_a_ring_tells_each_chip_whether_a_device_follows() -> None:
+    # The transaction-level ring tells its chips what the pin level's DI2 shows (DG-5): RD on the last of the ring
+    # and the last of each branch only; a BK's outgoing remote bus is followed by what comes after its branch, and
+    # switching its branch off changes no wiring.
+    config = decode("10000", diag_conf=0)
+    plain = [Supi3(config) for _ in range(3)]
+    bk, last_bk = terminal("BK-LB"), terminal("BK-LB")
+    b1, b2, b3 = (Supi3(decode("01000", diag_conf=0)) for _ in range(3))
+    ring = Ring([plain[0], Branch(bk, [b1, b2], BranchKind.LOCAL), plain[1], Branch(last_bk, [b3], BranchKind.LOCAL)])
+    expected = {plain[0]: False, bk: False, b1: False, b2: True, plain[1]: False, last_bk: True, b3: True}
+    assert {chip: chip.diagnostic_outputs.rd for chip in expected} == expected
+    Master(ring, locate=False).start()
+    bk.set_mfp_inputs(0)  # LBST = 0: the branch switched off (Table 2-9)
+    ring.idle(0.01)
+    assert {chip: chip.diagnostic_outputs.rd for chip in expected} == expected
+    alone = Ring([plain[2]])
+    assert alone.devices[0].diagnostic_outputs.rd  # type: ignore[attr-defined]
 
 
 # Counter telegrams (BK-36, DG-9) --------------------------------------------------------------------------------------

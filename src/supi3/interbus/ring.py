@@ -426,6 +426,20 @@ def _timeout(device: Device, now: float, counted: bool = False) -> None:
         device.reset(now)
 
 
+def _tell_following(items: Sequence[Device | Branch]) -> None:
+    """Tell every device that takes it (``set_following``, the SUPI 3 model) whether a device follows on its
+    outgoing interface (M5; RD, DG-5): each but the last of the ring and of each branch. A BK's outgoing interface is
+    its remote bus: what follows it there is the item after its :class:`Branch`, not the branch's first device
+    (that one is on DO3). The wiring is physical: a branch switched off keeps it."""
+    for k, item in enumerate(items):
+        device = item.terminal if isinstance(item, Branch) else item
+        tell = getattr(device, "set_following", None)
+        if callable(tell):
+            tell(k + 1 < len(items))
+        if isinstance(item, Branch):
+            _tell_following(item.devices)
+
+
 def _sends_counts(device: Device) -> bool:
     """The device sends counter telegrams behind a break (an LBD chip, Table 2-5, BK-30): every device after it in
     the silent stretch hears them (DG-9)."""
@@ -598,6 +612,7 @@ class Ring:
         # device's received bytes.
         self._layout: tuple[list[type], _Groups] = ([], [])
         self._cuts: tuple[list[bytes], int, bytes, list[slice] | None, int] = ([], -1, b"", None, 0)
+        _tell_following(self._tree)
         self._sync()
 
     # -- the tree ------------------------------------------------------------------------------------------------
