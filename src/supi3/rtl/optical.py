@@ -83,6 +83,21 @@ def _timer_bits() -> int:
                 if all(_shifted((1 << bits) - 1, shift) >= LENGTH_MAX_CODE for shift in shifts))  # fmt: skip
 
 
+def _prescale_bits(bit_rate: int) -> int:
+    """log2 of :func:`~supi3.optical.regulation.length_timer_enable_every`: the timer counts one every that many
+    clocks, so its count is the clocks since the start shifted right by this.
+
+    Raises
+    ------
+    ValueError
+        If the enable period is not a power of two.
+    """
+    every = length_timer_enable_every(bit_rate)
+    if every & (every - 1):
+        raise ValueError(f"the length timer's enable period must be a power of two for the RTL, not {every}")
+    return every.bit_length() - 1
+
+
 @dataclass(frozen=True)
 class _Tx:
     """One transmitter's state (:class:`supi3.optical.regulation.Transmitter`) as signals. ``steps`` is not kept:
@@ -246,34 +261,34 @@ class OpticalRtl(wiring.Component):
         with m.Elif(countdown != 0):
             sync += countdown.eq(countdown - 1)
 
-        # Length timers of the outgoing interface and the branch ----------------------------------------------
-        everies = [length_timer_enable_every(rate) for rate in BIT_RATES]
+        # Length timers of the outgoing interface and the branch: the clocks since the start, of which the count is
+        # the clocks shifted right by log2 of the bit rate's enable period (OPT-24)
+        prescale = [_prescale_bits(rate) for rate in BIT_RATES]
         block_on = (self.mode == OpticalMode.REGULATION) | (self.mode == OpticalMode.DIAGNOSTIC)
-        timer_bits = _timer_bits()
-        saturated = (1 << timer_bits) - 1
+        clock_bits = _timer_bits() + max(prescale)
+        saturated = (1 << clock_bits) - 1
         for k, i in ((_OUT_K, Interface.OUT), (_BRANCH_K, Interface.BRANCH)):
             running = Signal(name=f"timer_running_{k}")
-            prescale = Signal(range(max(everies)), name=f"timer_prescale_{k}")
-            counter = Signal(timer_bits, name=f"timer_count_{k}")
-            tick = Mux(self.fast, prescale == everies[1] - 1, prescale == everies[0] - 1)
-            counted = Mux(tick & (counter != saturated), counter + 1, counter)
+            clocks = Signal(clock_bits, name=f"timer_clocks_{k}", reset_less=True)  # cleared at each start
+            counted = Mux(clocks != saturated, clocks + 1, clocks)
             code = Signal(len(length[k]), name=f"timer_code_{k}")
             with m.Switch(Cat(self.medium[i], self.fast)):
                 for fast, rate in enumerate(BIT_RATES):
                     for medium_bit in (0, 1):
                         with m.Case(medium_bit | fast << 1):
-                            comb += code.eq(self._code(counted, length_shift(rate, Medium(medium_bit))))
+                            shift = length_shift(rate, Medium(medium_bit))
+                            comb += code.eq(self._code(counted[prescale[fast] :], shift))
             with m.If(self.ib_reset):
                 sync += running.eq(0)
             with m.Else():
                 with m.If(running):
-                    sync += [prescale.eq(Mux(tick, 0, prescale + 1)), counter.eq(counted)]
+                    sync += clocks.eq(counted)
                     with m.If(self.len_stop[i]):
                         sync += running.eq(0)
                         with m.If(block_on):
                             comb += [new_length[k].eq(code), new_medium[k].eq(self.medium[i])]
                 with m.If(self.len_start[i]):
-                    sync += [running.eq(1), prescale.eq(0), counter.eq(0)]
+                    sync += [running.eq(1), clocks.eq(0)]
         return m
 
     @staticmethod
