@@ -11,6 +11,8 @@ Run: ``python bench/bench_rtl.py`` (``--help`` for options). Synthesis needs the
   and prints a "+" after the total);
 * Fmax: ``synth_ice40`` and ``nextpnr-ice40 --hx8k`` of the core and the chip, the maximum frequency of the 32 MHz
   ``clk`` (``--no-fmax`` skips it);
+* Verilator build times of the core OPC (``--build-times``): the per-cycle cocotb build and the batch build, wall
+  and the CPU seconds of the build's child processes (a shared machine inflates the wall time, not the CPU time);
 * speed: the model's :meth:`~supi3.model.pins.Supi3Pins.step` and ``run()`` and the Amaranth simulator in lockstep
   with it, on the same data-cycle workload, and both lockstep paths under Verilator (cycles per second; the best of
   ``--repeat`` runs, since the machine is shared).
@@ -22,6 +24,7 @@ import argparse
 import functools
 import itertools
 import re
+import resource
 import shutil
 import subprocess
 import tempfile
@@ -87,6 +90,26 @@ def fmax(source: Path, yosys: str, nextpnr: str, directory: Path) -> float:
     if not found:
         raise RuntimeError(f"nextpnr gave no Fmax:\n{result.stderr[-2000:]}")
     return float(found[-1])
+
+
+def _child_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def build_times(variant: str) -> None:
+    """Print the wall and child-process CPU seconds of the core's per-cycle (cocotb) and batch Verilator builds."""
+    with tempfile.TemporaryDirectory() as name:
+        lockstep = Lockstep(functools.partial(Supi3Core, variant), functools.partial(StrapPins, variant),
+                            build_dir=Path(name))
+        builds: dict[str, Callable[[], object]] = {
+            "per-cycle (cocotb)": lambda: lockstep.prepare(batch=False), "batch": lockstep.batch_executable,
+        }  # fmt: skip
+        for label, build in builds.items():
+            wall, cpu = time.perf_counter(), _child_cpu()
+            build()
+            print(f"Verilator build of the core {variant}, {label}: {time.perf_counter() - wall:.1f} s wall, "
+                  f"{_child_cpu() - cpu:.1f} s CPU", flush=True)
 
 
 def workload(data_cycles: int, clk_conf: str = "11") -> tuple[np.ndarray, dict[str, np.ndarray]]:
@@ -171,8 +194,12 @@ def main() -> None:
     parser.add_argument("--amaranth", type=int, default=20_000, help="cycles on Amaranth's simulator")
     parser.add_argument("--no-synthesis", action="store_true", help="skip gate counts and Fmax")
     parser.add_argument("--no-fmax", action="store_true", help="gate counts only (no place and route)")
+    parser.add_argument("--build-times", action="store_true", help="time the core's Verilator builds, then stop")
     parser.add_argument("--repeat", type=int, default=3, help="runs per speed figure; the best is printed")
     args = parser.parse_args()
+    if args.build_times:
+        build_times("opc")
+        return
     yosys, nextpnr = _tool("yosys"), _tool("nextpnr-ice40")
     if args.no_synthesis:
         pass
