@@ -4,9 +4,11 @@ and reads 8 to 11, with the ports of :data:`supi3.optical.regulation.BLOCK_INPUT
 Manual 1.6 (reset behaviour), 1.6.1 (initialization, length timer), 1.6.2 (online regulation, optical
 diagnostics), 1.6.3 (MAU warnings), Table 3-17 (FO LEDs), 3.4.12/3.4.13 (reads 8 to 11). The transitions of
 :mod:`supi3.optical.regulation` (:func:`~supi3.optical.regulation.start`, ``init_response``, ``init_timeout``,
-``online_test``, ``diagnostic_mau``, ``mau_after``, ``fo_lit``, ``registers``) are re-implemented here in gates, one
-function each, with every constant taken from the spec at elaboration (levels, steps, the 6 ms budget in clocks,
-the length timer's clock divider, the LENGTH code's scale per bit rate and medium, the register layout). The edge
+``online_test``, ``diagnostic_mau``, ``mau_after``, ``fo_lit``, ``registers``) are re-implemented here as
+``If``/``Switch`` statements on each register's value after the edge (``_transitions``; no nested ``Mux`` chains,
+which made the core's Verilog twice as long), with every constant taken from the spec at elaboration (levels,
+steps, the 6 ms budget in clocks, the length timer's clock divider, the LENGTH code's scale per bit rate and medium,
+the register layout). The edge
 order and the port timing are those of the pin model ``OpticalBlock`` (``src/supi3/model/blocks/optical.py``, its
 module docstring, OPT-25), which ``tests/test_verif_lockstep_optical.py`` holds this block to, cycle by cycle.
 """
