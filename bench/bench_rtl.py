@@ -5,9 +5,14 @@ Run: ``python bench/bench_rtl.py`` (``--help`` for options). Synthesis needs the
 
 * gate equivalents: ``synth -flatten; dfflegalize -cell $_DFF_P_ 01; stat -tech cmos`` (CMOS transistors / 4) of
   the core (:class:`~supi3.rtl.core.Supi3Core`) and of the whole chip (:class:`~supi3.rtl.chip.Supi3ChipRtl`) for each
-  variant, read as RTLIL; ``dfflegalize`` turns the flip-flops with synchronous reset or enable into plain ones plus
-  gates, which ``stat -tech cmos`` counts (it leaves the others out and prints a "+" after the total);
-* Fmax: ``synth_ice40`` and ``nextpnr-ice40 --hx8k`` of each, the maximum frequency of the 32 MHz ``clk``;
+  variant, and of the blocks :class:`~supi3.rtl.counter.CounterRtl`, :class:`~supi3.rtl.optical.OpticalRtl` and
+  :class:`~supi3.rtl.terminal.TerminalRtl` alone, read as RTLIL; ``dfflegalize`` turns the flip-flops with
+  synchronous reset or enable into plain ones plus gates, which ``stat -tech cmos`` counts (it leaves the others out
+  and prints a "+" after the total);
+* Fmax: ``synth_ice40`` and ``nextpnr-ice40 --hx8k`` of the core and the chip, the maximum frequency of the 32 MHz
+  ``clk`` (``--no-fmax`` skips it);
+* Verilator build times of the core OPC (``--build-times``): the per-cycle cocotb build and the batch build, wall
+  and the CPU seconds of the build's child processes (a shared machine inflates the wall time, not the CPU time);
 * speed: the model's :meth:`~supi3.model.pins.Supi3Pins.step` and ``run()`` and the Amaranth simulator in lockstep
   with it, on the same data-cycle workload, and both lockstep paths under Verilator (cycles per second; the best of
   ``--repeat`` runs, since the machine is shared).
@@ -19,6 +24,7 @@ import argparse
 import functools
 import itertools
 import re
+import resource
 import shutil
 import subprocess
 import tempfile
@@ -28,6 +34,7 @@ from pathlib import Path
 
 import numpy as np
 from amaranth.back import rtlil
+from amaranth.hdl import Elaboratable
 
 from supi3.config import decode
 from supi3.interbus import wire
@@ -35,6 +42,9 @@ from supi3.interbus.wire import Cycle, Frame
 from supi3.model.pins import Supi3Pins
 from supi3.rtl.chip import Supi3ChipRtl
 from supi3.rtl.core import Supi3Core
+from supi3.rtl.counter import CounterRtl
+from supi3.rtl.optical import OpticalRtl
+from supi3.rtl.terminal import TerminalRtl
 from supi3.tables import BIT_RATES, CLOCK_HZ, clk_conf_for
 from supi3.verif import Lockstep
 from supi3.verif.amaranth_sim import run_amaranth_sim
@@ -80,6 +90,26 @@ def fmax(source: Path, yosys: str, nextpnr: str, directory: Path) -> float:
     if not found:
         raise RuntimeError(f"nextpnr gave no Fmax:\n{result.stderr[-2000:]}")
     return float(found[-1])
+
+
+def _child_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def build_times(variant: str) -> None:
+    """Print the wall and child-process CPU seconds of the core's per-cycle (cocotb) and batch Verilator builds."""
+    with tempfile.TemporaryDirectory() as name:
+        lockstep = Lockstep(functools.partial(Supi3Core, variant), functools.partial(StrapPins, variant),
+                            build_dir=Path(name))
+        builds: dict[str, Callable[[], object]] = {
+            "per-cycle (cocotb)": lambda: lockstep.prepare(batch=False), "batch": lockstep.batch_executable,
+        }  # fmt: skip
+        for label, build in builds.items():
+            wall, cpu = time.perf_counter(), _child_cpu()
+            build()
+            print(f"Verilator build of the core {variant}, {label}: {time.perf_counter() - wall:.1f} s wall, "
+                  f"{_child_cpu() - cpu:.1f} s CPU", flush=True)
 
 
 def workload(data_cycles: int, clk_conf: str = "11") -> tuple[np.ndarray, dict[str, np.ndarray]]:
@@ -163,8 +193,13 @@ def main() -> None:
     parser.add_argument("--data-cycles", type=int, default=200, help="data cycles in the speed workload")
     parser.add_argument("--amaranth", type=int, default=20_000, help="cycles on Amaranth's simulator")
     parser.add_argument("--no-synthesis", action="store_true", help="skip gate counts and Fmax")
+    parser.add_argument("--no-fmax", action="store_true", help="gate counts only (no place and route)")
+    parser.add_argument("--build-times", action="store_true", help="time the core's Verilator builds, then stop")
     parser.add_argument("--repeat", type=int, default=3, help="runs per speed figure; the best is printed")
     args = parser.parse_args()
+    if args.build_times:
+        build_times("opc")
+        return
     yosys, nextpnr = _tool("yosys"), _tool("nextpnr-ice40")
     if args.no_synthesis:
         pass
@@ -173,18 +208,22 @@ def main() -> None:
     else:
         with tempfile.TemporaryDirectory() as name:
             directory = Path(name)
-            designs = {"core": Supi3Core, "chip": Supi3ChipRtl}
-            for (part, design), variant in itertools.product(designs.items(), ("opc", "ls")):
+            designs: dict[str, Callable[[], Elaboratable]] = {
+                **{f"{part}_{variant}": functools.partial(design, variant)
+                   for (part, design), variant in itertools.product(
+                       {"core": Supi3Core, "chip": Supi3ChipRtl}.items(), ("opc", "ls"))},
+                "counter": CounterRtl, "optical": OpticalRtl, "terminal": TerminalRtl,
+            }  # fmt: skip
+            for part, design in designs.items():
                 # RTLIL: yosys cannot read the Verilog of the µP block; one directory per design (stat.txt)
-                (directory / f"{part}_{variant}").mkdir()
-                source = directory / f"{part}_{variant}" / f"supi3_{part}.il"
-                source.write_text(rtlil.convert(design(variant), name=source.stem, emit_src=False), encoding="utf-8")
-                ge = gate_equivalents(source, yosys)
-                mhz = fmax(source, yosys, nextpnr, source.parent)
-                print(
-                    f"{part} {variant:<4} {ge:>9,.0f} GE (target < {TARGET_GE:,})   "
-                    f"iCE40 HX8K Fmax {mhz:6.1f} MHz (target > {TARGET_MHZ:.0f})"
-                )
+                (directory / part).mkdir()
+                source = directory / part / f"supi3_{part}.il"
+                source.write_text(rtlil.convert(design(), name=source.stem, emit_src=False), encoding="utf-8")
+                line = f"{part:<9} {gate_equivalents(source, yosys):>9,.0f} GE (target < {TARGET_GE:,} for the chip)"
+                if not args.no_fmax and part.startswith(("core", "chip")):
+                    mhz = fmax(source, yosys, nextpnr, source.parent)
+                    line += f"   iCE40 HX8K Fmax {mhz:6.1f} MHz (target > {TARGET_MHZ:.0f})"
+                print(line, flush=True)
     for bit_rate in BIT_RATES:
         rate = f"{bit_rate // 1000} kbit/s" if bit_rate < 1_000_000 else f"{bit_rate // 1_000_000} Mbit/s"
         print(f"speed, one chip (RB 8 IN/8 OUT) at {rate}, {args.data_cycles} data cycles:")

@@ -5,8 +5,8 @@ The bit-period transition :func:`supi3.lbd.counter_step` (receiver framing, reco
 bit, the serial increment ``wire.count_bit`` with its saturation mark, the frame flag, the silence count, the
 generator and the dropped telegram) is re-implemented here in gates, every constant taken from the spec at
 elaboration; the clock timing (the bit grid restarted by a start level, the mid-bit sample
-:func:`~supi3.lbd.sample_phase`, the output queue of :data:`~supi3.lbd.OUTPUT_SLOTS`
-countdowns loaded with :func:`~supi3.lbd.send_countdown`, as the core's transmitter, M8) is that of the
+:func:`~supi3.lbd.sample_phase`, and each sample's bit on the line while the model's countdown
+:func:`~supi3.lbd.send_countdown` would be 1..cpb, as the core's transmitter, M8) is that of the
 pin model ``CounterBlock`` (``src/supi3/model/blocks/counter.py``, its module docstring), which
 ``tests/test_verif_lockstep_counter.py`` holds this block to, cycle by cycle. :class:`CounterLinesRtl` puts it
 into ``Supi3Core`` (docs/rtl.md, "Counter telegram block").
@@ -14,6 +14,9 @@ into ``Supi3Core`` (docs/rtl.md, "Counter telegram block").
 
 from __future__ import annotations
 
+import functools
+import operator
+from collections.abc import Callable
 from itertools import pairwise
 from typing import Final
 
@@ -44,11 +47,28 @@ _CPB: Final = (clocks_per_bit(0), clocks_per_bit(1))
 _IDLE_VALUE: Final = wire.IDLE_LEVEL
 """A queue value (level in bit 0, drive in bit 1) for an idle line the block does not drive."""
 _MARK_SHIFT: Final = wire.COUNT_BITS
+_WAITING: Final = OUTPUT_SLOTS - 1
+"""Bits sampled but not yet begun on the line: at most all of the queue's entries but the one being sent."""
+
+
+def _begins(cpb: int) -> int:
+    """Clocks from a sample to the first clock of its bit on the line (its countdown reaches ``cpb``, M8)."""
+    return send_countdown(cpb) - cpb + 1
+
+
+_STAMP_BITS: Final = max(_begins(cpb) for cpb in _CPB).bit_length()
+"""Width of the free-running clock count and of a waiting bit's sample time: the waiting bits' ages (under
+``_begins``) are distinct modulo ``2 ** _STAMP_BITS``."""
 
 
 def _by_rate(fast: Value, values: tuple[int, int]) -> Value:
     """``values[fast]`` as a gate (500 kbit/s, 2 Mbit/s)."""
     return Mux(fast, values[1], values[0])
+
+
+def _at_rate(fast: Value, test: Callable[[int], Value]) -> Value:
+    """``test`` of the clocks per bit at the ``fast`` input's rate, one gate per rate (a constant compare each)."""
+    return Mux(fast, test(_CPB[1]), test(_CPB[0]))
 
 
 class CounterRtl(wiring.Component):
@@ -66,38 +86,53 @@ class CounterRtl(wiring.Component):
         m = Module()
         sync, comb = m.d.sync, m.d.comb
         line, fast = self.line, self.fast
-        countdown_max = max(send_countdown(cpb) for cpb in _CPB)
 
         # State ---------------------------------------------------------------------------------------------------
         phase = Signal(range(max(_CPB)))
         pending = Signal()
         bit = Signal(range(IDLE_BIT + 1), init=IDLE_BIT)
-        data = Signal(init=1)
-        kind = Signal(range(len(Kind)), init=Kind.PASS)
-        carry = Signal()
+        # (the telegram's fields are set at its begin before they are read: no reset)
+        data = Signal(init=1, reset_less=True)
+        kind = Signal(range(len(Kind)), init=Kind.PASS, reset_less=True)
+        carry = Signal(reset_less=True)
         frame = Signal()
         quiet = Signal(range(COUNTER_SILENCE_BITS + 1))
-        byte = Signal(8)
+        byte = Signal(8, reset_less=True)
         counted = Signal(wire.COUNT_BITS)
         gen = Signal(range(IDLE_BIT + 1), init=IDLE_BIT)
         drop = Signal()
         seen = Signal()
-        countdown = [Signal(range(countdown_max + 1), name=f"tx{k}_count") for k in range(OUTPUT_SLOTS)]
-        value = [Signal(2, name=f"tx{k}_value", init=_IDLE_VALUE) for k in range(OUTPUT_SLOTS)]
+        # the output queue: the ``waiting`` bits not yet begun (newest first) with their sample times on a free-running
+        # clock count, and the bit on the line with the clocks it has ``left`` (docs/rtl.md "Counter telegram
+        # block"); ``waiting`` and ``left`` say which of them count, so the rest need no reset
+        now = Signal(_STAMP_BITS, reset_less=True)
+        stamp = [Signal(_STAMP_BITS, name=f"tx{k}_stamp", reset_less=True) for k in range(_WAITING)]
+        value = [Signal(2, name=f"tx{k}_value", reset_less=True) for k in range(_WAITING)]
+        waiting = Signal(range(_WAITING + 1))
+        sent = Signal(2, reset_less=True)
+        left = Signal(range(max(_CPB) + 1))
 
         # The bit grid and the sample -----------------------------------------------------------------------------
         cpb = _by_rate(fast, _CPB)
         idle_rx = bit == IDLE_BIT
         restart = idle_rx & ~pending & (line == wire.START_LEVEL)
         ph = Mux(restart, 0, phase)
-        sample = ph == _by_rate(fast, (sample_phase(_CPB[0]), sample_phase(_CPB[1])))
-        sync += phase.eq(Mux(ph >= cpb - 1, 0, ph + 1))
+        sample = _at_rate(fast, lambda c: ph == sample_phase(c))
+        sync += phase.eq(Mux(_at_rate(fast, lambda c: ph >= c - 1), 0, ph + 1))
         with m.If(restart):
             sync += pending.eq(1)
-        sync += seen.eq(0)
-        for r in countdown:
-            with m.If(r != 0):
-                sync += r.eq(r - 1)
+        sync += [seen.eq(0), now.eq(now + 1)]
+        # the oldest waiting bit begins on the line in the next cycle (``_begins`` clocks after its sample)
+        ahead = [(1 - _begins(c)) % (1 << _STAMP_BITS) for c in _CPB]
+        due = (now + _by_rate(fast, (ahead[0], ahead[1])))[:_STAMP_BITS]
+        head = [(waiting == k + 1) & (stamp[k] == due) for k in range(_WAITING)]
+        begin_now = Cat(*head).any()
+        with m.If(begin_now):
+            sync += [sent.eq(functools.reduce(operator.or_, (Mux(h, v, 0) for h, v in zip(head, value, strict=True)))),
+                     left.eq(cpb)]  # fmt: skip
+        with m.Elif(left != 0):
+            sync += left.eq(left - 1)
+        sync += waiting.eq(waiting - begin_now)
 
         # The receiver (counter_step's _receive) ------------------------------------------------------------------
         rx_out, rx_drive, begin, seen_now = Signal(), Signal(), Signal(), Signal()
@@ -160,18 +195,13 @@ class CounterRtl(wiring.Component):
                 comb += [out.eq(wire.IDLE_LEVEL), drive.eq(1)]
             with m.Else():
                 comb += [out.eq(rx_out), drive.eq(rx_drive)]
-            sync += [seen.eq(seen_now), countdown[0].eq(_by_rate(fast, (send_countdown(_CPB[0]),
-                                                                          send_countdown(_CPB[1])))),
-                     value[0].eq(Cat(out, drive))]  # fmt: skip
-            for k_slot in range(1, OUTPUT_SLOTS):
-                previous = countdown[k_slot - 1]
-                sync += [countdown[k_slot].eq(Mux(previous != 0, previous - 1, 0)),
-                         value[k_slot].eq(value[k_slot - 1])]  # fmt: skip
+            sync += [seen.eq(seen_now), stamp[0].eq(now), value[0].eq(Cat(out, drive)),
+                     waiting.eq(waiting + 1 - begin_now),
+                     *(stamp[k].eq(stamp[k - 1]) for k in range(1, _WAITING)),
+                     *(value[k].eq(value[k - 1]) for k in range(1, _WAITING))]  # fmt: skip
 
         # Outputs -------------------------------------------------------------------------------------------------
-        shown: Value = Const(_IDLE_VALUE, 2)
-        for r, v in reversed(list(zip(countdown, value, strict=True))):
-            shown = Mux(r <= cpb, Mux(r != 0, v, _IDLE_VALUE), shown)
+        shown = Mux(left != 0, sent, _IDLE_VALUE)
         comb += [self.out.eq(shown[0]), self.drive.eq(shown[1]), self.seen.eq(seen), self.count.eq(counted)]
         return m
 

@@ -4,9 +4,11 @@ and reads 8 to 11, with the ports of :data:`supi3.optical.regulation.BLOCK_INPUT
 Manual 1.6 (reset behaviour), 1.6.1 (initialization, length timer), 1.6.2 (online regulation, optical
 diagnostics), 1.6.3 (MAU warnings), Table 3-17 (FO LEDs), 3.4.12/3.4.13 (reads 8 to 11). The transitions of
 :mod:`supi3.optical.regulation` (:func:`~supi3.optical.regulation.start`, ``init_response``, ``init_timeout``,
-``online_test``, ``diagnostic_mau``, ``mau_after``, ``fo_lit``, ``registers``) are re-implemented here in gates, one
-function each, with every constant taken from the spec at elaboration (levels, steps, the 6 ms budget in clocks,
-the length timer's clock divider, the LENGTH code's scale per bit rate and medium, the register layout). The edge
+``online_test``, ``diagnostic_mau``, ``mau_after``, ``fo_lit``, ``registers``) are re-implemented here as
+``If``/``Switch`` statements on each register's value after the edge (``_transitions``; no nested ``Mux`` chains,
+which made the core's Verilog twice as long), with every constant taken from the spec at elaboration (levels,
+steps, the 6 ms budget in clocks, the length timer's clock divider, the LENGTH code's scale per bit rate and medium,
+the register layout). The edge
 order and the port timing are those of the pin model ``OpticalBlock`` (``src/supi3/model/blocks/optical.py``, its
 module docstring, OPT-25), which ``tests/test_verif_lockstep_optical.py`` holds this block to, cycle by cycle.
 """
@@ -74,87 +76,129 @@ def _phase(phase: Phase) -> int:
     return PHASES.index(phase)
 
 
+@functools.cache
+def _timer_bits() -> int:
+    """The narrowest timer that gives every LENGTH code of a :data:`LENGTH_COUNT_BITS`-bit count: its saturated
+    count already reads as :data:`~supi3.optical.length.LENGTH_MAX_CODE` at every bit rate and medium."""
+    shifts = [length_shift(rate, medium) for rate in BIT_RATES for medium in Medium]
+    return next(bits for bits in range(1, LENGTH_COUNT_BITS + 1)
+                if all(_shifted((1 << bits) - 1, shift) >= LENGTH_MAX_CODE for shift in shifts))  # fmt: skip
+
+
+def _prescale_bits(bit_rate: int) -> int:
+    """log2 of :func:`~supi3.optical.regulation.length_timer_enable_every`: the timer counts one every that many
+    clocks, so its count is the clocks since the start shifted right by this.
+
+    Raises
+    ------
+    ValueError
+        If the enable period is not a power of two.
+    """
+    every = length_timer_enable_every(bit_rate)
+    if every & (every - 1):
+        raise ValueError(f"the length timer's enable period must be a power of two for the RTL, not {every}")
+    return every.bit_length() - 1
+
+
 @dataclass(frozen=True)
 class _Tx:
-    """One transmitter's state (:class:`supi3.optical.regulation.Transmitter`) as values."""
+    """One transmitter's state (:class:`supi3.optical.regulation.Transmitter`) as signals. ``steps`` is not kept:
+    an initializing transmitter has lowered its level once per step, so it is ``MAX_LEVEL - level``."""
 
-    phase: Value | int
-    level: Value | int = MAX_LEVEL
-    steps: Value | int = 0
-    passes: Value | int = 0
-    mau: Value | int = 0
+    phase: Signal
+    level: Signal
+    passes: Signal
+    mau: Signal
 
-    def parts(self) -> tuple[Value | int, ...]:
-        return (self.phase, self.level, self.steps, self.passes, self.mau)
+    @staticmethod
+    def signals(name: str, registers: _Tx | None = None) -> _Tx:
+        """Signals of one transmitter (``registers``: the state registers whose width and reset they take)."""
+        if registers is None:
+            return _Tx(Signal(range(len(PHASES)), name=f"phase_{name}", init=_phase(Phase.OFF)),
+                       Signal(range(MAX_LEVEL + 1), name=f"level_{name}", init=MAX_LEVEL),
+                       Signal(range(max(DECREASE_AFTER, 2)), name=f"passes_{name}"),
+                       Signal(name=f"mau_{name}"))  # fmt: skip
+        return _Tx(*(Signal.like(r, name=f"{r.name}_{name}") for r in registers.parts()))
 
-    def where(self, cond: Value, other: _Tx) -> _Tx:
-        """``other`` where ``cond``, else this."""
-        return _Tx(*(Mux(cond, b, a) for a, b in zip(self.parts(), other.parts(), strict=True)))
+    def parts(self) -> tuple[Signal, Signal, Signal, Signal]:
+        return (self.phase, self.level, self.passes, self.mau)
 
-    def with_(self, **parts: Value | int) -> _Tx:
-        values = dict(zip(("phase", "level", "steps", "passes", "mau"), self.parts(), strict=True)) | parts
-        return _Tx(**values)
+    def eq(self, other: _Tx) -> list[Value]:
+        return [a.eq(b) for a, b in zip(self.parts(), other.parts(), strict=True)]
+
+    def set(self, phase: Phase | Value, level: Value | int = MAX_LEVEL, mau: Value | int = 0) -> list[Value]:
+        """A transmitter of ``phase`` at ``level`` with ``mau``, no passes (every transition but a test's)."""
+        code = _phase(phase) if isinstance(phase, Phase) else phase
+        return [self.phase.eq(code), self.level.eq(level), self.passes.eq(0), self.mau.eq(mau)]
 
     def is_(self, phase: Phase) -> Value:
-        return Value.cast(self.phase) == _phase(phase)
+        return self.phase == _phase(phase)
 
 
-def _off() -> _Tx:
-    """:class:`~supi3.optical.regulation.Transmitter` ``()``: off at maximum power."""
-    return _Tx(_phase(Phase.OFF))
-
-
-def _up(level: Value | int) -> Value:
-    """One level up, at most :data:`MAX_LEVEL`."""
-    level = Value.cast(level)
-    return Mux(level == MAX_LEVEL, MAX_LEVEL, level + 1)
-
-
-def _mau_after(mau: Value | int, old: Value | int, new: Value) -> Value:
-    """:func:`~supi3.optical.regulation.mau_after`: on at MAX-1 -> MAX, off at MAX-1 -> MAX-2 (1.6.3)."""
-    from_below = Value.cast(old) == MAX_LEVEL - 1
-    return Mux(from_below & (new == MAX_LEVEL), 1, Mux(from_below & (new == MAX_LEVEL - 2), 0, mau))
-
-
-def _start(mode: Value, present: Value) -> _Tx:
-    """:func:`~supi3.optical.regulation.start` (1.6.1, OPT-2); a mode code of 3 is off (OPT-23)."""
+def _start(mode: Value, present: Value) -> Value:
+    """:func:`~supi3.optical.regulation.start`'s phase (1.6.1, OPT-2); a mode code of 3 is off (OPT-23)."""
     phase = Mux(mode == OpticalMode.REGULATION, _phase(Phase.INIT),
                 Mux(mode == OpticalMode.DIAGNOSTIC, _phase(Phase.DIAGNOSTIC), _phase(Phase.OFF)))  # fmt: skip
-    return _Tx(Mux(present, phase, _phase(Phase.OFF)))
+    return Mux(present, phase, _phase(Phase.OFF))
 
 
-def _init_response(tx: _Tx, valid: Value, resp: Value) -> _Tx:
-    """:func:`~supi3.optical.regulation.init_response` on a strobe; a ``resp`` of 3 is no response (OPT-23)."""
-    level = Value.cast(tx.level)
-    steps = Value.cast(tx.steps) + 1
-    last = steps == INIT_MAX_STEPS
-    lowered = _Tx(Mux(last, _phase(Phase.ONLINE), _phase(Phase.INIT)), level - 1, Mux(last, 0, steps))
-    raised = _up(level)
-    light_on = _Tx(_phase(Phase.ONLINE), raised, mau=(level == MAX_LEVEL) | _mau_after(0, level, raised))
-    fixed = _Tx(_phase(Phase.FIXED))
-    result = fixed.where(resp == Response.DETECTED, lowered).where(resp == Response.NOT_DETECTED, light_on)
-    known = (resp == Response.NONE) | (resp == Response.DETECTED) | (resp == Response.NOT_DETECTED)
-    return tx.where(valid & known & tx.is_(Phase.INIT), result)
+def _transitions(m: Module, tx: _Tx, new: _Tx, strobes: tuple[Value, Value, Value, Value, Value],
+                 timeout: Value) -> None:
+    """``new`` = ``tx`` after this edge's strobes (``resp_valid``, ``resp``, ``test_valid``, ``ack1``, ``ack2`` of
+    the transmitter) in the order of the pin model: a response (3 is none, OPT-23) by
+    :func:`~supi3.optical.regulation.init_response`, a test by :func:`~supi3.optical.regulation.apply_test`
+    (OPT-22), then :func:`~supi3.optical.regulation.init_timeout` when ``timeout``. The MAU hysteresis
+    :func:`~supi3.optical.regulation.mau_after` (1.6.3) is written out where the level moves by one."""
+    comb = m.d.comb
+    resp_valid, resp, test_valid, ack1, ack2 = strobes
+    mid = _Tx.signals("mid", tx)
+    comb += mid.eq(tx)
+    with m.If(resp_valid & tx.is_(Phase.INIT)), m.Switch(resp):
+        with m.Case(Response.NONE):
+            comb += mid.set(Phase.FIXED)
+        with m.Case(Response.NOT_DETECTED):  # one up; MAU at MAX itself or reaching it from MAX - 1
+            comb += mid.set(Phase.ONLINE, Mux(tx.level == MAX_LEVEL, MAX_LEVEL, tx.level + 1),
+                            tx.level >= MAX_LEVEL - 1)  # fmt: skip
+        with m.Case(Response.DETECTED):  # one down; online after the last of INIT_MAX_STEPS steps
+            comb += mid.level.eq(tx.level - 1)
+            with m.If(tx.level == MAX_LEVEL - INIT_MAX_STEPS + 1):
+                comb += mid.phase.eq(_phase(Phase.ONLINE))
+    comb += new.eq(mid)
+    with m.If(test_valid & mid.is_(Phase.ONLINE)):
+        with m.If(~ack1):  # failed: one up, MAU at MAX or reaching it
+            comb += [new.level.eq(Mux(mid.level == MAX_LEVEL, MAX_LEVEL, mid.level + 1)), new.passes.eq(0),
+                     new.mau.eq(mid.mau | (mid.level >= MAX_LEVEL - 1))]  # fmt: skip
+        with m.Elif(~ack2):
+            comb += new.passes.eq(0)
+        with m.Elif(mid.passes + 1 < DECREASE_AFTER):
+            comb += new.passes.eq(mid.passes + 1)
+        with m.Else():  # passed DECREASE_AFTER times: one down, MAU off leaving MAX - 1
+            comb += [new.level.eq(Mux(mid.level == MIN_LEVEL, MIN_LEVEL, mid.level - 1)), new.passes.eq(0),
+                     new.mau.eq(mid.mau & (mid.level != MAX_LEVEL - 1))]  # fmt: skip
+    with m.Elif(test_valid & mid.is_(Phase.DIAGNOSTIC)):  # diagnostic_mau
+        comb += new.mau.eq(~ack1 | (~ack2 & mid.mau))
+    with m.If(timeout & mid.is_(Phase.INIT)):
+        comb += new.set(Phase.FIXED)
 
 
-def _online_test(tx: _Tx, valid: Value, ack1: Value, ack2: Value) -> _Tx:
-    """:func:`~supi3.optical.regulation.online_test` of an online transmitter, or
-    :func:`~supi3.optical.regulation.diagnostic_mau` of one in diagnostics mode, on a strobe (OPT-22)."""
-    level, passes, mau = Value.cast(tx.level), Value.cast(tx.passes), Value.cast(tx.mau)
-    raised = _up(level)
-    lowered = Mux(level == MIN_LEVEL, MIN_LEVEL, level - 1)
-    failed = tx.with_(level=raised, passes=0, mau=mau | (level == MAX_LEVEL) | _mau_after(mau, level, raised))
-    counted = tx.with_(passes=passes + 1)
-    lower = tx.with_(level=lowered, passes=0, mau=_mau_after(mau, level, lowered))
-    passed = counted.where(passes + 1 >= DECREASE_AFTER, lower)
-    online = failed.where(ack1, tx.with_(passes=0).where(ack2, passed))
-    diagnostic = tx.with_(mau=Mux(~ack1, 1, Mux(ack2, 0, mau)))
-    return tx.where(valid & tx.is_(Phase.ONLINE), online).where(valid & tx.is_(Phase.DIAGNOSTIC), diagnostic)
+def _reads(txs: list[_Tx], length: list[Signal], medium: list[Signal]) -> Value:
+    """Reads 8..11 (:func:`~supi3.optical.regulation.registers`, 3.4.12, 3.4.13) of the transmitters ``txs`` and
+    the measured paths' ``length`` and ``medium``, byte k = read 8 + k."""
 
+    def power(tx: _Tx) -> Value:
+        return Mux(tx.is_(Phase.OFF), 0, tx.level)
 
-def _init_timeout(tx: _Tx, due: Value) -> _Tx:
-    """:func:`~supi3.optical.regulation.init_timeout` when ``due`` (OPT-5)."""
-    return tx.where(due & tx.is_(Phase.INIT), _Tx(_phase(Phase.FIXED)))
+    def path(k: int, tx: _Tx) -> Value:
+        return length[k] | (medium[k] << OPTICAL_MEDIUM_BIT) | (tx.is_(Phase.ONLINE) << OPTICAL_ENABLE_BIT)
+
+    tx_in, tx_out, tx_branch = (txs[i] for i in Interface)
+    reads = [
+        path(_OUT_K, tx_out),
+        path(_BRANCH_K, tx_branch),
+        power(tx_in) | (tx_in.is_(Phase.ONLINE) << OPTICAL_ENABLE_BIT),
+        (power(tx_out) << POWER_OUT_LSB) | (power(tx_branch) << POWER_BRANCH_LSB),
+    ]
+    return Cat(*(read.as_unsigned()[:_BYTE] for read in reads))
 
 
 class OpticalRtl(wiring.Component):
@@ -175,98 +219,78 @@ class OpticalRtl(wiring.Component):
         m = Module()
         sync, comb = m.d.sync, m.d.comb
 
-        # State ---------------------------------------------------------------------------------------------------
-        phase = [Signal(range(len(PHASES)), name=f"phase_{i.name}", init=_phase(Phase.OFF)) for i in Interface]
-        level = [Signal(range(MAX_LEVEL + 1), name=f"level_{i.name}", init=MAX_LEVEL) for i in Interface]
-        steps = [Signal(range(INIT_MAX_STEPS + 1), name=f"steps_{i.name}") for i in Interface]
-        passes = [Signal(range(max(DECREASE_AFTER, 2)), name=f"passes_{i.name}") for i in Interface]
-        mau = [Signal(name=f"mau_{i.name}") for i in Interface]
-        state = [_Tx(phase[i], level[i], steps[i], passes[i], mau[i]) for i in Interface]
+        # State (and each register's value after this edge, ``new``) ---------------------------------------------
+        state = [_Tx.signals(i.name) for i in Interface]
+        new = [_Tx.signals("next", tx) for tx in state]
         length = [Signal(LENGTH_MAX_CODE.bit_length(), name=f"length_{k}") for k in range(2)]
         medium = [Signal(name=f"medium_{k}") for k in range(2)]
+        new_length = [Signal.like(r, name=f"{r.name}_next") for r in length]
+        new_medium = [Signal.like(r, name=f"{r.name}_next") for r in medium]
         in_reset = Signal()
         countdown = Signal(range(self.time_limit + 1))
+        changed = Signal(len(self.optical_we))
+        for tx, after in zip(state, new, strict=True):
+            sync += tx.eq(after)
+        sync += [*(r.eq(n) for r, n in zip([*length, *medium], [*new_length, *new_medium], strict=True))]
+        comb += [*(n.eq(r) for r, n in zip([*length, *medium], [*new_length, *new_medium], strict=True))]
 
-        def assign(i: int, tx: _Tx) -> None:
-            for target, value in zip((phase[i], level[i], steps[i], passes[i], mau[i]), tx.parts(), strict=True):
-                m.d.sync += target.eq(value)
-
-        # Outputs from the state ---------------------------------------------------------------------------------
-        def power(i: Interface) -> Value:
-            return Mux(state[i].is_(Phase.OFF), 0, level[i])
-
-        def enable(i: Interface) -> Value:
-            return state[i].is_(Phase.ONLINE)
-
-        def path(k: int, i: Interface) -> Value:
-            return length[k] | (medium[k] << OPTICAL_MEDIUM_BIT) | (enable(i) << OPTICAL_ENABLE_BIT)
-
-        reads = [
-            path(_OUT_K, Interface.OUT),
-            path(_BRANCH_K, Interface.BRANCH),
-            power(Interface.IN) | (enable(Interface.IN) << OPTICAL_ENABLE_BIT),
-            (power(Interface.OUT) << POWER_OUT_LSB) | (power(Interface.BRANCH) << POWER_BRANCH_LSB),
-        ]
-        shown = Signal(len(self.optical))
-        comb += self.optical.eq(Cat(*(read.as_unsigned()[:_BYTE] for read in reads)))
-        sync += shown.eq(self.optical)
-        comb += self.optical_we.eq(Cat(*(self.optical.word_select(k, _BYTE) != shown.word_select(k, _BYTE)
-                                         for k in range(len(reads)))))  # fmt: skip
+        # Outputs from the state: reads 8..11, and a byte written while it differs from the cycle before ----------
+        shown = _reads(state, length, medium)
         comb += [
-            self.mau.eq(Cat(*mau)),
-            self.fo.eq(Cat(*(Mux(self.run, mau[i], state[i].is_(Phase.FIXED)) for i in Interface))),
-            self.hold.eq(Cat(*(state[i].is_(Phase.INIT) for i in Interface)).any()),
+            self.optical.eq(shown),
+            self.optical_we.eq(changed),
+            self.mau.eq(Cat(*(tx.mau for tx in state))),
+            self.fo.eq(Cat(*(Mux(self.run, tx.mau, tx.is_(Phase.FIXED)) for tx in state))),
+            self.hold.eq(Cat(*(tx.is_(Phase.INIT) for tx in state)).any()),
         ]
+        after = _reads(new, new_length, new_medium)
+        sync += changed.eq(Cat(*(after.word_select(k, _BYTE) != shown.word_select(k, _BYTE)
+                                 for k in range(len(changed)))))  # fmt: skip
 
-        # The edge: reset, start, or strobes and the 6 ms counter -----------------------------------------------
+        # The edge: strobes and the 6 ms counter, unless a reset or the start --------------------------------------
         timeout = countdown == 1
+        for i in Interface:
+            strobes = (self.resp_valid[i], self.resp.word_select(i, 2), self.test_valid[i], self.ack1[i], self.ack2[i])
+            _transitions(m, state[i], new[i], strobes, timeout)
         with m.If(self.ib_reset):
             sync += [in_reset.eq(1), countdown.eq(0)]
             for i in Interface:
-                assign(i, _off())
+                comb += new[i].set(Phase.OFF)
         with m.Elif(in_reset):
             sync += [in_reset.eq(0), countdown.eq(self.time_limit)]
             for i in Interface:
-                assign(i, _start(self.mode, self.present[i]))
-        with m.Else():
-            with m.If(countdown != 0):
-                sync += countdown.eq(countdown - 1)
-            for i in Interface:
-                tx = _init_response(state[i], self.resp_valid[i], self.resp.word_select(i, 2))
-                tx = _online_test(tx, self.test_valid[i], self.ack1[i], self.ack2[i])
-                assign(i, _init_timeout(tx, timeout))
+                comb += new[i].set(_start(self.mode, self.present[i]))
+        with m.Elif(countdown != 0):
+            sync += countdown.eq(countdown - 1)
 
-        # Length timers of the outgoing interface and the branch ----------------------------------------------
-        everies = [length_timer_enable_every(rate) for rate in BIT_RATES]
-        every = Mux(self.fast, everies[1], everies[0])
+        # Length timers of the outgoing interface and the branch: the clocks since the start, of which the count is
+        # the clocks shifted right by log2 of the bit rate's enable period (OPT-24)
+        prescale = [_prescale_bits(rate) for rate in BIT_RATES]
         block_on = (self.mode == OpticalMode.REGULATION) | (self.mode == OpticalMode.DIAGNOSTIC)
-        saturated = (1 << LENGTH_COUNT_BITS) - 1
+        clock_bits = _timer_bits() + max(prescale)
+        saturated = (1 << clock_bits) - 1
         for k, i in ((_OUT_K, Interface.OUT), (_BRANCH_K, Interface.BRANCH)):
             running = Signal(name=f"timer_running_{k}")
-            prescale = Signal(range(max(everies)), name=f"timer_prescale_{k}")
-            counter = Signal(LENGTH_COUNT_BITS, name=f"timer_count_{k}")
-            tick = prescale + 1 == every
-            counted = Mux(tick & (counter != saturated), counter + 1, counter)
-            codes = {
-                (fast, medium_bit): self._code(counted, length_shift(rate, Medium(medium_bit)))
-                for fast, rate in enumerate(BIT_RATES) for medium_bit in (0, 1)
-            }  # fmt: skip
+            clocks = Signal(clock_bits, name=f"timer_clocks_{k}", reset_less=True)  # cleared at each start
+            counted = Mux(clocks != saturated, clocks + 1, clocks)
             code = Signal(len(length[k]), name=f"timer_code_{k}")
             with m.Switch(Cat(self.medium[i], self.fast)):
-                for (fast, medium_bit), value in codes.items():
-                    with m.Case(medium_bit | fast << 1):
-                        comb += code.eq(value)
+                for fast, rate in enumerate(BIT_RATES):
+                    for medium_bit in (0, 1):
+                        with m.Case(medium_bit | fast << 1):
+                            shift = length_shift(rate, Medium(medium_bit))
+                            comb += code.eq(self._code(counted[prescale[fast] :], shift))
             with m.If(self.ib_reset):
                 sync += running.eq(0)
             with m.Else():
                 with m.If(running):
-                    sync += [prescale.eq(Mux(tick, 0, prescale + 1)), counter.eq(counted)]
+                    sync += clocks.eq(counted)
                     with m.If(self.len_stop[i]):
                         sync += running.eq(0)
                         with m.If(block_on):
-                            sync += [length[k].eq(code), medium[k].eq(self.medium[i])]
+                            comb += [new_length[k].eq(code), new_medium[k].eq(self.medium[i])]
                 with m.If(self.len_start[i]):
-                    sync += [running.eq(1), prescale.eq(0), counter.eq(0)]
+                    sync += [running.eq(1), clocks.eq(0)]
         return m
 
     @staticmethod
