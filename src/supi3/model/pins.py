@@ -85,6 +85,7 @@ from supi3.model.blocks.receiver import (
     input_traces,
 )
 from supi3.model.blocks.serial_io import SerialIo
+from supi3.model.blocks.terminal import BranchLines
 from supi3.model.blocks.transmitter import NEVER, PinTrace, Transmitter
 from supi3.model.chip import Supi3
 from supi3.optical.regulation import OpticalMode
@@ -175,8 +176,8 @@ class Supi3Pins:
     """
 
     __slots__ = (
-        "_counters", "_datapath", "_expansion", "_frame", "_holding", "_optical", "_optical_at", "_optical_fixed",
-        "_outputs", "_power_ups", "_receiver", "_recording",
+        "_branch", "_counters", "_datapath", "_expansion", "_frame", "_holding", "_optical", "_optical_at",
+        "_optical_fixed", "_outputs", "_power_ups", "_receiver", "_recording",
         "_return_start", "_run_from", "_serial", "_stat_active", "_synced_run", "_transmitter", "chip",
         "complete_diagnostics",
         "config", "cpb", "cycle", "forward_delay", "log", "mfp_oe", "rbst_by_pin", "reset_run",
@@ -217,6 +218,9 @@ class Supi3Pins:
         self._outputs = Outputs(self.chip, self._transmitter, self.cpb, self.mfp_oe, self._serial)
         # LBD modes (Table 2-5): the counter telegram blocks on DO2 and, in LBD-MR, DI1 (M17).
         self._counters = LineCounters.of(config)
+        # BK modes (Table 2-7): the branch's data lines DO3 and DI3 and the switch of DO2 (BK-1, BK-37).
+        rf = config.rf_mode.rf if config.rf_mode is not None else None
+        self._branch = BranchLines(rf) if config.interface.is_bus_terminal else None
         # The optical block (1.6) with RF = 00 or 01; it makes every optical transition, the chip takes its status.
         mode = self.chip.optical_mode
         self._optical = OpticalBlock() if mode is not OpticalMode.OFF else None
@@ -268,6 +272,8 @@ class Supi3Pins:
         self._expansion.power_up(self.cycle)
         if self._counters is not None and not self._recording:  # a run replays its power-ups (_run_forward)
             self._counters.power_up(self.cycle, run_from)
+        if self._branch is not None:  # a run renders its lines afterwards (BranchLines.render)
+            self._branch.power_up()
         if self._optical is not None:
             self._optical.reset()
         self._optical_at = run_from
@@ -319,10 +325,16 @@ class Supi3Pins:
             running = c >= self._run_from and synced.resu_n and synced.vmon_ok
             source = self._counters.show(c, outputs, row.di2, tx.next_present)
             self._counters.clock(source, synced.do1 if running else None)
+        branch = self._branch
+        if branch is not None:
+            assert self.chip.bus_terminal is not None
+            branch.route(outputs, self.chip.bus_terminal.state, synced.mfp_in, tx.next_present)
         if c >= self._run_from or self._holding or not (synced.resu_n and synced.vmon_ok):
             self._tick(c, synced, synced.do1, optical or _OPTICAL_QUIET)
             if c >= self._run_from:
                 tx.next_present = bool(synced.rbst_ext) if tx.rbst_by_pin else tx.next_present or bool(synced.di2)
+                if branch is not None:
+                    branch.clock(synced.mfp_in)
         if len(tx.bits) > 8:  # tested here, not in trim(): one call less per step()
             tx.trim()
         self.cycle = c + 1
@@ -341,7 +353,18 @@ class Supi3Pins:
     def forward_level(self) -> int:
         """The forward line output (``do2``) of the current cycle; it depends on state only."""
         sent = self._transmitter.level(self.cycle)
+        if self._branch is not None:
+            return self._route(self.cycle, {"do2": sent, "di1": 0, "mfp_out": 0})["do2"]
         return sent if self._counters is None else self._counters.do2(self.cycle, sent)
+
+    def _route(self, c: int, values: dict[str, int]) -> dict[str, int]:
+        """``values`` of cycle ``c`` through a BK's branch lines (:class:`BranchLines`): the synchronised inputs of
+        cycle ``c`` are in the synchroniser (the latest one held for the cycles beyond it)."""
+        assert self._branch is not None and self.chip.bus_terminal is not None
+        pipe = self._receiver.pipe
+        synced = pipe[max(len(pipe) - 1 - (c - self.cycle), 0)]
+        self._branch.route(values, self.chip.bus_terminal.state, synced.mfp_in, self._transmitter.next_present)
+        return values
 
     def output_values(self, c: int, di2: int) -> dict[str, int]:
         """Every output pin during cycle ``c`` (``c`` >= the current cycle; ``di2`` is that cycle's input)."""
@@ -350,7 +373,7 @@ class Supi3Pins:
                   **self._expansion.peek(c)}
         if self._counters is not None:
             self._counters.show(c, values, di2, self._transmitter.next_present)
-        return values
+        return values if self._branch is None else self._route(c, values)
 
     # ------------------------------------------------------------------------------------------------------------
     # The per-cycle logic, shared by step() and run()
@@ -485,6 +508,10 @@ class Supi3Pins:
                               [stage.di2 for stage in reversed(receiver.pipe)])
         self._power_ups = []
         self._recording = True
+        branch = self._branch
+        if branch is not None:
+            assert self.chip.bus_terminal is not None
+            branch.begin(c0, self._run_from, self.chip.bus_terminal.state)
         full = self._synced_traces(raw)
         synced = {name: trace[:n] for name, trace in full.items()}
         line = synced["do1"]
@@ -561,6 +588,8 @@ class Supi3Pins:
             if chip.revision != shown or self._run_from != run_from:
                 shown, run_from = chip.revision, self._run_from
                 snaps.append((t + 1, outputs.snapshot(run_from)))
+            if branch is not None:
+                branch.record(t + 1, chip.bus_terminal.state)  # type: ignore[union-attr]  # a BK has one
             due = next_due(c, level, self._run_from)
             if serial is not None and serial.due < due:
                 due = serial.due if serial.due > c else c + 1
@@ -578,6 +607,8 @@ class Supi3Pins:
         traces = outputs.render(c0, n, snaps, self._transmitter.render(c0, n))
         if self._counters is not None:
             traces["do2"] = self._counters.forward_run(line, c0, self._power_ups, traces["do2"])
+        if branch is not None:
+            branch.render(traces, synced["mfp_in"], self._power_ups)
         traces.update(self._expansion.render(c0, n))
         self._transmitter.trim()
         if serial is not None:

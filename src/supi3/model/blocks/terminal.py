@@ -33,15 +33,24 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Final
 
+import numpy as np
+import numpy.typing as npt
+
 from supi3.checks import check_inputs
+from supi3.interbus import wire
 from supi3.interbus.wire import BranchControl
+from supi3.model.blocks.transmitter import recognition
 from supi3.pinlevel import EventLog, Pin
 from supi3.terminal import (
     BLOCK_INPUTS,
     BLOCK_OUTPUTS,
     BRANCH_SILENCE_CLOCKS,
+    DI3_PIN,
+    DO3_PIN,
+    LBST_PIN,
     Terminal,
     TerminalMode,
+    branch_present,
     command,
     conf_level,
     enabled,
@@ -54,7 +63,7 @@ from supi3.terminal import (
     silence_limit,
 )
 
-__all__ = ["TerminalBlock"]
+__all__ = ["BranchLines", "TerminalBlock"]
 
 _WIDTHS: Final[dict[str, int]] = {pin.name: pin.width for pin in BLOCK_INPUTS}
 _OFF: Final[dict[str, int]] = {pin.name: 0 for pin in BLOCK_OUTPUTS}
@@ -150,3 +159,96 @@ class TerminalBlock:
     def recent_events(self) -> list[str]:
         """The block's last events, for mismatch reports."""
         return self.log.recent()
+
+
+class BranchLines:
+    """A BK's branch data lines in the chip core (manual 2.4, Tables 2-7, 2-8, 2-9; BK-1, BK-37): DO3_CU (MFP9),
+    DI3 (MFP10) and the switch of DO2, for ``supi3.model.pins.Supi3Pins`` in the BK modes.
+
+    While the branch is in the data path (:func:`~supi3.terminal.enabled`: present by Table 2-9, switched on, not
+    closed) DO3 carries what the transmitter sends (the DO2 of a chip without branch) and DO2 repeats the
+    synchronised DI3, the branch's return line: the data path runs through the BK, its branch, then on along the
+    remote bus (BK-1's flattened order); the M5 loop-back takes this DO2. Otherwise DO3 idles and DO2 is the
+    transmitter's. ``connected`` (a device answers on the branch, BK-37) latches the first high level of the
+    synchronised DI3 at every clock edge where the core's logic runs (a device's idle return line, as M5 recognises
+    a following device on DI2); a power-up reset clears it.
+
+    Parameters
+    ----------
+    rf:
+        The RF[1..0] straps (Table 2-2), ``None`` without RF pins.
+
+    Attributes
+    ----------
+    connected:
+        A device answered on the branch (for the cycle to come).
+    """
+
+    __slots__ = ("_opens", "_start", "connected", "present")
+
+    def __init__(self, rf: str | None) -> None:
+        self.present = np.array([[branch_present(rf, bool(lbst), bool(connected)) for connected in (0, 1)]
+                                 for lbst in (0, 1)])  # fmt: skip
+        """Table 2-9 by [LBST][connected] (:func:`~supi3.terminal.branch_present`)."""
+        self.connected = False
+        self._start: tuple[int, bool, int] = (0, False, 0)
+        self._opens: list[tuple[int, bool]] = []
+
+    def on(self, state: Terminal, mfp_in: int) -> bool:
+        """The branch is in the data path in a cycle of the synchronised MFP inputs ``mfp_in`` (LBST) and the BK
+        state ``state`` (:func:`~supi3.terminal.enabled`)."""
+        return bool(self.present[mfp_in >> LBST_PIN & 1, int(self.connected)]) and _open(state)
+
+    def route(self, outputs: dict[str, int], state: Terminal, mfp_in: int, next_present: bool) -> None:
+        """Set ``do2``, ``mfp_out`` (DO3) and, when the chip loops back (M5: ``next_present`` false), ``di1`` of a
+        cycle in that cycle's ``outputs`` (``do2`` the transmitter's)."""
+        sent = outputs["do2"]
+        if self.on(state, mfp_in):
+            do2 = outputs["do2"] = mfp_in >> DI3_PIN & 1
+            if not next_present:
+                outputs["di1"] = do2
+            outputs["mfp_out"] |= sent << DO3_PIN
+        else:
+            outputs["mfp_out"] |= wire.IDLE_LEVEL << DO3_PIN
+
+    def clock(self, mfp_in: int) -> None:
+        """A clock edge where the core's logic runs, with the synchronised MFP inputs ``mfp_in``."""
+        self.connected = self.connected or bool(mfp_in >> DI3_PIN & 1)
+
+    def power_up(self) -> None:
+        """The core's power-up reset: no device seen."""
+        self.connected = False
+
+    def begin(self, c0: int, run_from: int, state: Terminal) -> None:
+        """A run of ``Supi3Pins.run`` begins at cycle ``c0`` (the logic runs from ``run_from``, the BK state is
+        ``state``): :meth:`record` follows the state, :meth:`render` draws the lines."""
+        self._start = (c0, self.connected, run_from)
+        self._opens = [(0, _open(state))]
+
+    def record(self, t: int, state: Terminal) -> None:
+        """The BK state from the run's cycle ``t`` on is ``state``."""
+        opened = _open(state)
+        if opened != self._opens[-1][1]:
+            self._opens.append((t, opened))
+
+    def render(self, traces: dict[str, npt.NDArray[np.int64]], mfp_in: npt.NDArray[np.int64],
+               power_ups: Sequence[tuple[int, int]]) -> None:
+        """:meth:`route` over the run begun by :meth:`begin`: ``traces`` the run's outputs (``do2`` the
+        transmitter's), ``mfp_in`` its synchronised MFP inputs, ``power_ups`` its power-up resets (cycle, logic runs
+        from); :attr:`connected` is then the value after the run."""
+        n = len(mfp_in)
+        seen = mfp_in >> DI3_PIN & 1
+        connected = recognition(self._start, power_ups, seen, False)
+        self.connected = bool(connected[-1])
+        starts = [t for t, _ in self._opens]
+        opens = np.repeat([o for _, o in self._opens], np.diff([*starts, n]).clip(min=0))
+        on = self.present[mfp_in >> LBST_PIN & 1, connected[:-1].astype(np.int64)] & opens
+        sent = traces["do2"]
+        traces["mfp_out"] = traces["mfp_out"] | np.where(on, sent, wire.IDLE_LEVEL) << DO3_PIN
+        traces["do2"] = np.where(on, seen, sent)
+
+
+def _open(state: Terminal) -> bool:
+    """The BK keeps its branch open: switched on and not closed by itself (:func:`~supi3.terminal.enabled` without
+    Table 2-9)."""
+    return state.switched_on and not state.closed

@@ -1,0 +1,79 @@
+"""A bus terminal module's branch data lines in the pin-level chip core (supi3.model.pins.Supi3Pins with
+supi3.model.blocks.terminal.BranchLines; manual 2.4, Tables 2-7, 2-8, 2-9; BK-1, BK-2, BK-37): while the branch is
+in the data path DO3 (MFP9) carries what the chip would send on DO2 and DO2 repeats the synchronised DI3 (MFP10);
+otherwise DO3 idles and DO2 is the transmitter's. A device answers on the branch once DI3 was high (BK-37). Held
+against the same scenario without a branch (the chip's logic does not read DI3 beyond this), step() equals run(), and
+the RTL core in lockstep (tests/test_rtl_core_branch.py).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from supi3.config import decode
+from supi3.interbus import wire
+from supi3.interbus.wire import BranchControl
+from supi3.model.pins import Supi3Pins
+from supi3.pinout import SYNC_STAGES
+from supi3.terminal import DI3_PIN, DO3_PIN, LBST_PIN, branch_present
+from support import BK_STRAPS, Columns, CoreScript, assert_run_matches_step
+
+LBST = 1 << LBST_PIN
+LD_PIN = 14  # Table 2-8: LBDA, "local bus disabled"
+BRANCH_DELAY = 37
+"""Clocks a branch of repeaters takes from DO3 back to DI3 in these scenarios (any will do: DI3 is stimulus)."""
+
+
+def scenario(interface: str, rf: str, seed: int) -> tuple[CoreScript, Columns]:
+    """Frames with the branch on, switched off, on again, an INTERBUS reset; the MFP inputs with LBST high but
+    during one data cycle; DI3 silent (0: nothing attached) for the first third, then the forward line delayed by
+    :data:`BRANCH_DELAY` (a branch repeating what it gets). Returns the script and its columns with DI3 in."""
+    config = decode(BK_STRAPS[interface], rf=rf, clk_conf="11")
+    script = CoreScript(config, np.random.default_rng(seed))
+    script.pins["mfp_in"] = LBST
+    script.bring_up().id_cycle(wire.command_word()).data_cycle(mfp_in=LBST)
+    script.id_cycle(wire.command_word(branch=BranchControl.OFF), mfp_in=LBST).data_cycle(mfp_in=LBST)
+    script.id_cycle(wire.command_word(branch=BranchControl.ON), mfp_in=LBST).data_cycle(mfp_in=0)
+    script.data_cycle(mfp_in=LBST).line(wire.reset_levels(1)).line(wire.status_levels(wire.Cycle.DATA, False, 4))
+    script.id_cycle(wire.command_word(), mfp_in=LBST).data_cycle(mfp_in=LBST)
+    columns = script.inputs()
+    n = len(columns["do1"])
+    di3 = np.zeros(n, dtype=np.int64)
+    di3[n // 3 :] = columns["do1"][n // 3 - BRANCH_DELAY : n - BRANCH_DELAY]
+    columns["mfp_in"] = columns["mfp_in"] & ~(1 << DI3_PIN) | di3 << DI3_PIN
+    script.parts = [columns]
+    return script, script.columns()
+
+
+CASES = [("BK-RB", "10", 1), ("BK-LB", "11", 2), ("BK-LBD", "00", 3), ("BK-LB", "01", 4)]
+
+
+def synced(trace: np.ndarray) -> np.ndarray:
+    """What the core's synchroniser gives in each cycle (M1): the input ``SYNC_STAGES`` clocks before, 0 at first."""
+    return np.concatenate([np.zeros(SYNC_STAGES, dtype=np.int64), trace[:-SYNC_STAGES]])
+
+
+@pytest.mark.parametrize(("interface", "rf", "seed"), CASES)
+def test_the_branch_takes_the_data_path(interface: str, rf: str, seed: int) -> None:
+    """Against the same scenario with DI3 silent and LBST low (no branch by Table 2-9): where the branch is in the
+    data path (Table 2-9 with LBST and a device seen on DI3 since the core runs, not switched off: LD dark) DO2 is
+    the synchronised DI3 and DO3 the other run's DO2; elsewhere DO2 is the other run's and DO3 idles. Both happen,
+    and step() equals run()."""
+    _, columns = scenario(interface, rf, seed)
+    silent = {**columns, "mfp_in": columns["mfp_in"] & ~(1 << DI3_PIN | LBST)}  # never present (Table 2-9)
+    pins = Supi3Pins(decode(BK_STRAPS[interface], rf=rf, clk_conf="11"))
+    out = assert_run_matches_step(pins, Supi3Pins(pins.config), columns, [0.3, 0.71])
+    reference = Supi3Pins(pins.config).run(silent)
+    mfp = synced(columns["mfp_in"])
+    di3 = mfp >> DI3_PIN & 1
+    running = out["resu_drive"] == 0  # no power-up reset after the first: the logic runs from its end on
+    seen = np.logical_or.accumulate(di3.astype(bool) & running)
+    connected = np.concatenate([[False], seen[:-1]])
+    table = np.array([[branch_present(rf, bool(lbst), bool(c)) for c in (0, 1)] for lbst in (0, 1)])
+    on = table[mfp >> LBST_PIN & 1, connected.astype(np.int64)] & (out["mfp_out"] >> LD_PIN & 1 == 0)
+    assert on.any() and (~on).any()
+    np.testing.assert_array_equal(out["do2"], np.where(on, di3, reference["do2"]))
+    np.testing.assert_array_equal(out["mfp_out"] >> DO3_PIN & 1, np.where(on, reference["do2"], wire.IDLE_LEVEL))
+    assert np.array_equal(out["mfp_out"] & ~(1 << DO3_PIN), reference["mfp_out"] & ~(1 << DO3_PIN))
+    np.testing.assert_array_equal(out["di1"], out["do2"])  # no following device: the loop-back takes DO2 (M5)

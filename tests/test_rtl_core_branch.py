@@ -1,0 +1,23 @@
+"""A bus terminal module's branch data lines in the RTL core (supi3.rtl.core.Supi3Core; manual 2.4, Tables 2-7,
+2-8, 2-9; BK-1, BK-37): the scenarios of tests/test_model_pins_branch.py (DI3 silent, then repeating the forward
+line; the branch switched off and on; LBST low for a data cycle; an INTERBUS reset) in lockstep with the pin-level
+model, every pin every clock: DO3 on MFP9, DO2 repeating DI3, the loop-back, `connected` from DI3.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from supi3.verif import Lockstep
+from test_model_pins_branch import CASES, scenario
+
+
+@pytest.mark.parametrize(("interface", "rf", "seed"), CASES)
+def test_rtl_core_matches(bench: Lockstep, interface: str, rf: str, seed: int) -> None:
+    script, _ = scenario(interface, rf, seed)
+    bench.run_batch(script.stimulus())
+
+
+@pytest.fixture(scope="session")
+def bench(core_bench: Lockstep) -> Lockstep:
+    return core_bench  # tests/conftest.py: one build, shared with tests/test_rtl_core.py
