@@ -77,3 +77,59 @@ def test_the_branch_takes_the_data_path(interface: str, rf: str, seed: int) -> N
     np.testing.assert_array_equal(out["mfp_out"] >> DO3_PIN & 1, np.where(on, reference["do2"], wire.IDLE_LEVEL))
     assert np.array_equal(out["mfp_out"] & ~(1 << DO3_PIN), reference["mfp_out"] & ~(1 << DO3_PIN))
     np.testing.assert_array_equal(out["di1"], out["do2"])  # no following device: the loop-back takes DO2 (M5)
+
+
+E_PIN = 13  # Table 2-8: ERROR, "error in connected branch" (BK-11)
+COUNT = 5
+COUNTER_GAP_BITS = 20
+"""Idle bit periods after each counter telegram, as behind a break (BK-30: one every 33 bit periods); twice that
+before the first, so that a telegram cut by the break leaves no frame open (BK-32)."""
+
+
+def count_scenario(rf: str, seed: int) -> tuple[CoreScript, list[int]]:
+    """BK-LBD: frames with DI3 repeating the forward line (the master's telegrams back); then status requests while
+    DI3 brings counter telegrams of :data:`COUNT` (a break in the branch, BK-6); then DI3 repeating again. Returns the
+    script (DI3 in) and the cycles where the three stretches begin."""
+    config = decode(BK_STRAPS["BK-LBD"], rf=rf, clk_conf="11")
+    script = CoreScript(config, np.random.default_rng(seed))
+    script.pins["mfp_in"] = LBST
+    script.bring_up().id_cycle(wire.command_word()).data_cycle(mfp_in=LBST)
+    script.id_cycle(wire.command_word(alarm_request=True), mfp_in=LBST).id_cycle(wire.command_word(), mfp_in=LBST)
+    broken = len(script.columns()["do1"])
+    script.id_cycle(wire.command_word(alarm_request=True), mfp_in=LBST).id_cycle(wire.command_word(), mfp_in=LBST)
+    mended = len(script.columns()["do1"])
+    script.data_cycle(mfp_in=LBST).id_cycle(wire.command_word(alarm_request=True), mfp_in=LBST)
+    script.id_cycle(wire.command_word(), mfp_in=LBST)
+    columns = script.inputs()
+    n = len(columns["do1"])
+    di3 = np.ones(n, dtype=np.int64)
+    di3[BRANCH_DELAY:] = columns["do1"][: n - BRANCH_DELAY]
+    levels = np.concatenate([wire.telegram_levels([wire.counter_telegram(COUNT)], wire.DATA_TELEGRAM_BITS),
+                             np.ones(COUNTER_GAP_BITS, dtype=np.uint8)])  # fmt: skip
+    samples = wire.levels_to_samples(levels, config.bit_rate).astype(np.int64)
+    span = mended - broken
+    quiet = wire.levels_to_samples(np.ones(2 * COUNTER_GAP_BITS, dtype=np.uint8), config.bit_rate)  # BK-32's flag
+    di3[broken:mended] = np.concatenate([quiet, np.tile(samples, span // len(samples) + 1)])[:span]
+    columns["mfp_in"] = columns["mfp_in"] & ~(1 << DI3_PIN) | di3 << DI3_PIN
+    script.parts = [columns]
+    return script, [broken, mended]
+
+
+COUNT_CASES = [("00", 5), ("10", 6)]
+
+
+@pytest.mark.parametrize(("rf", "seed"), COUNT_CASES)
+def test_the_bk_counts_on_di3(rf: str, seed: int) -> None:
+    """BK-39, BK-38: the counter block on DI3 gives the BK its count (E lit, the count in the BK state) while the
+    counter telegrams come; the master's telegrams back on DI3 clear it (E dark again); step() equals run()."""
+    script, (broken, mended) = count_scenario(rf, seed)
+    columns = script.columns()
+    pins = Supi3Pins(script.config)
+    out = assert_run_matches_step(pins, Supi3Pins(script.config), columns, [0.4, 0.55, 0.8])
+    e = out["mfp_out"] >> E_PIN & 1
+    assert not e[:broken].any() and e[broken:mended].any() and not e[-1]
+    lit = np.flatnonzero(e)
+    assert lit[-1] - lit[0] + 1 == len(lit) and lit[-1] < mended + 20 * pins.cpb  # one stretch, ended by traffic
+    bulk = Supi3Pins(script.config)
+    bulk.run({name: trace[:mended] for name, trace in columns.items()})
+    assert bulk.chip.bus_terminal is not None and bulk.chip.bus_terminal.count == COUNT

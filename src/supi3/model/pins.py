@@ -64,7 +64,7 @@ import numpy as np
 import numpy.typing as npt
 
 from supi3.checks import check_bits, check_instance, check_int, check_trace, fail
-from supi3.config import DeviceConfig
+from supi3.config import DeviceConfig, Interface
 from supi3.diagnostics import is_complete
 from supi3.interbus import wire
 from supi3.model.blocks.counter import LineCounters
@@ -92,7 +92,7 @@ from supi3.optical.regulation import OpticalMode
 from supi3.pinlevel import EventLog, Pin
 from supi3.pinout import CORE_OUTPUTS, IB_DIAG_DIVIDER_BITS, OPTICAL_LINE_INPUTS, OPTICAL_REGISTERS, SYNC_STAGES
 from supi3.tables import BIT_RATES, CLOCK_HZ, RESET_MIN_S
-from supi3.terminal import CONF_PIN
+from supi3.terminal import CONF_PIN, received
 
 __all__ = [
     "IB_DIAG_DIVIDER_BITS",
@@ -220,7 +220,8 @@ class Supi3Pins:
         self._counters = LineCounters.of(config)
         # BK modes (Table 2-7): the branch's data lines DO3 and DI3 and the switch of DO2 (BK-1, BK-37).
         rf = config.rf_mode.rf if config.rf_mode is not None else None
-        self._branch = BranchLines(rf) if config.interface.is_bus_terminal else None
+        self._branch = BranchLines(rf, self.cpb, config.interface is Interface.BK_LBD) \
+            if config.interface.is_bus_terminal else None  # fmt: skip
         # The optical block (1.6) with RF = 00 or 01; it makes every optical transition, the chip takes its status.
         mode = self.chip.optical_mode
         self._optical = OpticalBlock() if mode is not OpticalMode.OFF else None
@@ -272,8 +273,10 @@ class Supi3Pins:
         self._expansion.power_up(self.cycle)
         if self._counters is not None and not self._recording:  # a run replays its power-ups (_run_forward)
             self._counters.power_up(self.cycle, run_from)
-        if self._branch is not None:  # a run renders its lines afterwards (BranchLines.render)
+        if self._branch is not None:  # a run renders its lines afterwards (BranchLines.render) and plans anew
             self._branch.power_up()
+            if self._recording:
+                self._branch.plan(self.cycle + 1, run_from)
         if self._optical is not None:
             self._optical.reset()
         self._optical_at = run_from
@@ -396,6 +399,7 @@ class Supi3Pins:
         if c < self._run_from:
             return
         chip = self.chip
+        resets = chip._events["IB_RESET"]
         if chip.bus_terminal is None:
             chip.mfp_in = s.mfp_in
         elif c == self._run_from:  # a BK takes CONF as it is at the first running clock: no edge (BK-20)
@@ -415,11 +419,30 @@ class Supi3Pins:
         self._expansion.from_exr = s.from_exr
         if self._optical is None:
             self._receiver.clock(line, c)
-            return
-        resetting = self._frame.in_reset or chip.line_silent
-        self._receiver.clock(line, c)
-        self._optical_edge(c, resetting, optical)
+        else:
+            resetting = self._frame.in_reset or chip.line_silent
+            self._receiver.clock(line, c)
+            self._optical_edge(c, resetting, optical)
+        if self._branch is not None and chip._events["IB_RESET"] == resets:
+            self._branch_edge(c)
 
+    def _branch_edge(self, c: int) -> None:
+        """A BK's edge ending cycle ``c`` after the core's (a command latched there applies first, BK-20): the
+        master's telegram back (count 0) and the counter telegram (its count) of the branch return line (BK-38,
+        BK-39); not in a clock with an INTERBUS reset, where the BK ignores them."""
+        branch, terminal = self._branch, self.chip.bus_terminal
+        assert branch is not None and terminal is not None
+        ret, cnt, count = branch.strobes_at(c) if self._recording else branch.strobes()
+        if not (ret or cnt):
+            return
+        state = terminal.state
+        if ret:
+            state = received(state, 0)
+        if cnt:
+            state = received(state, count)
+        if state is not terminal.state:
+            terminal.state = state
+            self.chip.revision += 1  # the E LED and the status byte (BK-5, BK-11)
     def _optical_edge(self, c: int, resetting: bool, line: Mapping[str, int]) -> None:
         """The optical block's edge ending cycle ``c`` (after the core's: the core saw the hold of the cycle), with
         the line side ``line``; ``resetting``: the core's INTERBUS reset period before the core's edge (OPT-26)."""
@@ -509,10 +532,10 @@ class Supi3Pins:
         self._power_ups = []
         self._recording = True
         branch = self._branch
+        full = self._synced_traces(raw)
         if branch is not None:
             assert self.chip.bus_terminal is not None
-            branch.begin(c0, self._run_from, self.chip.bus_terminal.state)
-        full = self._synced_traces(raw)
+            branch.begin(c0, self._run_from, self.chip.bus_terminal.state, full["mfp_in"][:n])
         synced = {name: trace[:n] for name, trace in full.items()}
         line = synced["do1"]
         line_change = np.ones(n, dtype=bool)
@@ -562,6 +585,8 @@ class Supi3Pins:
             due = max(serial.due, c0)
         if block is not None and self._optical_at != NEVER:  # a change the block showed before this run
             due = min(due, max(self._optical_due(self._optical_at - 1), c0))
+        if branch is not None:
+            due = min(due, c0 + branch.next_strobe(-1))
         t = -1
         while True:
             while other_events[k] <= t:
@@ -595,6 +620,8 @@ class Supi3Pins:
                 due = serial.due if serial.due > c else c + 1
             if block is not None and c >= self._run_from:
                 due = min(due, self._optical_due(c))
+            if branch is not None:
+                due = min(due, c0 + branch.next_strobe(t))
         if n and c0 + n - 1 >= self._run_from:
             restore_low_run(n - 1, int(line[n - 1]), self._run_from)
         self._recording = False

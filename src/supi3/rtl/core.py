@@ -84,7 +84,7 @@ from supi3.rtl.tables import (
     core_tables,
     line_position,
 )
-from supi3.rtl.terminal import TerminalRtl
+from supi3.rtl.terminal import ReturnWatchRtl, TerminalRtl
 from supi3.rtl.upif import upif_tables
 from supi3.tables import BIT_RATES, RF_MODES, RfMode
 from supi3.terminal import CONF_PIN, DI3_PIN, DO3_PIN, LBST_PIN, TerminalMode
@@ -369,6 +369,11 @@ class Supi3Core(wiring.Component):
             m.d.sync += connected.eq(1)
         do2 = Signal(init=wire.IDLE_LEVEL)
         m.d.comb += do2.eq(Mux(terminal.enabled, di3, lines.do2))
+        # The master's telegrams back on DI3 (BK-38) and, in BK-LBD, the counter block on DI3 (BK-39).
+        watch = ReturnWatchRtl(len(cpb))
+        m.submodules.watch = gated(watch)
+        m.d.comb += [watch.line.eq(di3), watch.cpb.eq(cpb), lines.branch_line.eq(di3),
+                     lines.branch.eq(terminal_mode == TerminalMode.LBD)]  # fmt: skip
         command = datapath.words.command
         m.d.comb += [
             terminal.ib_reset.eq(frame.management.clear),
@@ -382,7 +387,9 @@ class Supi3Core(wiring.Component):
             terminal.alarm_set.eq(command[wire.CMD_ALARM_OUT_SET_BIT] & ~command[wire.CMD_PCMD_BIT]),
             terminal.alarm_on.eq(command[wire.CMD_ALARM_OUT_BIT]),
             terminal.connected.eq(connected),
-            terminal.ret_valid.eq(1),
+            terminal.ret_valid.eq(watch.seen),
+            terminal.cnt_valid.eq(lines.seen),
+            terminal.count.eq(lines.count),
             outputs.ld.eq(terminal.ld),
             outputs.e.eq(terminal.e),
             outputs.alarm.eq(terminal.alarm),

@@ -30,6 +30,7 @@ is 0 while ``mode`` is NONE.
 
 from __future__ import annotations
 
+from bisect import bisect_right
 from collections.abc import Mapping, Sequence
 from typing import Final
 
@@ -39,7 +40,9 @@ import numpy.typing as npt
 from supi3.checks import check_inputs
 from supi3.interbus import wire
 from supi3.interbus.wire import BranchControl
-from supi3.model.blocks.transmitter import recognition
+from supi3.lbd import clocks_per_bit
+from supi3.model.blocks.counter import CounterBlock
+from supi3.model.blocks.transmitter import NEVER, recognition
 from supi3.pinlevel import EventLog, Pin
 from supi3.terminal import (
     BLOCK_INPUTS,
@@ -63,7 +66,7 @@ from supi3.terminal import (
     silence_limit,
 )
 
-__all__ = ["BranchLines", "TerminalBlock"]
+__all__ = ["BranchLines", "ReturnWatch", "TerminalBlock"]
 
 _WIDTHS: Final[dict[str, int]] = {pin.name: pin.width for pin in BLOCK_INPUTS}
 _OFF: Final[dict[str, int]] = {pin.name: 0 for pin in BLOCK_OUTPUTS}
@@ -161,6 +164,55 @@ class TerminalBlock:
         return self.log.recent()
 
 
+class ReturnWatch:
+    """The master's telegrams back on a BK's branch return line (BK-38): ``seen`` is 1 in the cycle after the stop
+    bit of a status telegram was sampled at the idle level on the synchronised DI3 (``ret_valid`` of
+    :data:`~supi3.terminal.BLOCK_INPUTS`). Counter telegrams are data telegrams: they never count (BK-3).
+
+    The bit grid is the chip receiver's (M7): between telegrams a start level makes that clock the first of a bit
+    period; the line is sampled mid-bit (``cpb // 2``); a start bit sampled at the idle level is no telegram; the type
+    bit (``wire.POS_TYPE``) gives the length; after the stop bit's sample the watch is between telegrams again. The RTL
+    counterpart is ``supi3.rtl.terminal.ReturnWatchRtl``, clocked and reset as the core's logic.
+
+    Attributes
+    ----------
+    seen:
+        ``ret_valid`` for the cycle to come.
+    """
+
+    __slots__ = ("bit", "data", "phase", "seen")
+
+    def __init__(self) -> None:
+        self.reset()
+
+    def reset(self) -> None:
+        """Between telegrams, nothing seen."""
+        self.bit = -1
+        """The telegram's bit period now, -1 between telegrams."""
+        self.phase = 0
+        self.data = False
+        self.seen = 0
+
+    def clock(self, line: int, cpb: int) -> None:
+        """The clock edge ending a cycle with the synchronised DI3 at ``line``, ``cpb`` clocks per bit."""
+        seen = 0
+        if self.bit < 0 and line == wire.START_LEVEL:
+            self.bit, self.phase = 0, 0
+        if self.bit >= 0:
+            if self.phase == cpb // 2:
+                bit = self.bit
+                self.bit += 1
+                if bit == wire.POS_START and line != wire.START_LEVEL:
+                    self.bit = -1
+                elif bit == wire.POS_TYPE:
+                    self.data = line == wire.TYPE_DATA_LEVEL
+                elif bit == (wire.DATA_TELEGRAM_BITS if self.data else wire.STATUS_TELEGRAM_BITS) - 1:
+                    seen = int(not self.data and line == wire.IDLE_LEVEL)
+                    self.bit = -1
+            self.phase = 0 if self.phase >= cpb - 1 else self.phase + 1
+        self.seen = seen
+
+
 class BranchLines:
     """A BK's branch data lines in the chip core (manual 2.4, Tables 2-7, 2-8, 2-9; BK-1, BK-37): DO3_CU (MFP9),
     DI3 (MFP10) and the switch of DO2, for ``supi3.model.pins.Supi3Pins`` in the BK modes.
@@ -173,26 +225,67 @@ class BranchLines:
     synchronised DI3 at every clock edge where the core's logic runs (a device's idle return line, as M5 recognises
     a following device on DI2); a power-up reset clears it.
 
+    The return line's strobes for the BK (``ret_valid``, ``cnt_valid``/``count`` of
+    :data:`~supi3.terminal.BLOCK_INPUTS`): a :class:`ReturnWatch` on the synchronised DI3 (BK-38) and, in BK-LBD, a
+    :class:`~supi3.model.blocks.counter.CounterBlock` whose ``seen`` and ``count`` give the BK its count (BK-39),
+    clocked where the core's logic runs and cleared by a power-up reset. ``Supi3Pins.step`` clocks them each cycle;
+    over a ``run()`` they are clocked ahead over the run's DI3 (:meth:`plan`, again after each power-up reset), and
+    the run visits the cycles with a strobe (:meth:`next_strobe`).
+
     Parameters
     ----------
     rf:
         The RF[1..0] straps (Table 2-2), ``None`` without RF pins.
+    cpb:
+        Clocks per bit.
+    lbd:
+        BK-LBD: the counter block on DI3.
 
     Attributes
     ----------
     connected:
         A device answered on the branch (for the cycle to come).
+    watch, counter:
+        The blocks on DI3 (``counter`` ``None`` but in BK-LBD).
     """
 
-    __slots__ = ("_opens", "_start", "connected", "present")
+    __slots__ = ("_c0", "_events", "_line", "_opens", "_start", "_strobes", "connected", "counter", "cpb", "fast",
+                 "present", "watch")  # fmt: skip
 
-    def __init__(self, rf: str | None) -> None:
+    def __init__(self, rf: str | None, cpb: int, lbd: bool) -> None:
         self.present = np.array([[branch_present(rf, bool(lbst), bool(connected)) for connected in (0, 1)]
                                  for lbst in (0, 1)])  # fmt: skip
         """Table 2-9 by [LBST][connected] (:func:`~supi3.terminal.branch_present`)."""
+        self.cpb = cpb
+        self.fast = int(cpb == clocks_per_bit(1))
         self.connected = False
+        self.watch = ReturnWatch()
+        self.counter = CounterBlock() if lbd else None
         self._start: tuple[int, bool, int] = (0, False, 0)
         self._opens: list[tuple[int, bool]] = []
+        self._c0 = 0
+        self._line = np.zeros(0, dtype=np.int64)
+        self._strobes = np.zeros((0, 3), dtype=np.int64)
+        self._events: list[int] = []
+
+    def strobes(self) -> tuple[int, int, int]:
+        """``ret_valid``, ``cnt_valid`` and ``count`` in the cycle to come (``Supi3Pins.step``)."""
+        counter = self.counter
+        if counter is None:
+            return self.watch.seen, 0, 0
+        return self.watch.seen, counter.seen, counter.state.counted
+
+    def strobes_at(self, c: int) -> tuple[int, int, int]:
+        """:meth:`strobes` in cycle ``c`` of the run being planned."""
+        ret, cnt, count = self._strobes[c - self._c0].tolist()
+        return ret, cnt, count
+
+    def _clock_blocks(self, di3: int) -> None:
+        self.watch.clock(di3, self.cpb)
+        counter = self.counter
+        if counter is not None:
+            counter.clock(di3, self.fast)
+            counter.queue.clear()  # its line goes nowhere: the BK takes seen and count only
 
     def on(self, state: Terminal, mfp_in: int) -> bool:
         """The branch is in the data path in a cycle of the synchronised MFP inputs ``mfp_in`` (LBST) and the BK
@@ -213,17 +306,44 @@ class BranchLines:
 
     def clock(self, mfp_in: int) -> None:
         """A clock edge where the core's logic runs, with the synchronised MFP inputs ``mfp_in``."""
-        self.connected = self.connected or bool(mfp_in >> DI3_PIN & 1)
+        di3 = mfp_in >> DI3_PIN & 1
+        self.connected = self.connected or bool(di3)
+        self._clock_blocks(di3)
 
     def power_up(self) -> None:
-        """The core's power-up reset: no device seen."""
+        """The core's power-up reset: no device seen, the blocks on DI3 cleared."""
         self.connected = False
+        self.watch.reset()
+        if self.counter is not None:
+            self.counter.reset()
 
-    def begin(self, c0: int, run_from: int, state: Terminal) -> None:
+    def begin(self, c0: int, run_from: int, state: Terminal, mfp_in: npt.NDArray[np.int64]) -> None:
         """A run of ``Supi3Pins.run`` begins at cycle ``c0`` (the logic runs from ``run_from``, the BK state is
-        ``state``): :meth:`record` follows the state, :meth:`render` draws the lines."""
+        ``state``, ``mfp_in`` the run's synchronised MFP inputs): :meth:`record` follows the state, :meth:`render`
+        draws the lines; the blocks on DI3 are planned over the run."""
         self._start = (c0, self.connected, run_from)
         self._opens = [(0, _open(state))]
+        self._c0 = c0
+        self._line = mfp_in >> DI3_PIN & 1
+        self._strobes = np.zeros((len(mfp_in), 3), dtype=np.int64)
+        self.plan(c0, run_from)
+
+    def plan(self, c: int, run_from: int) -> None:
+        """Clock the blocks on DI3 from cycle ``c`` to the run's end where the logic runs (from ``run_from``),
+        keeping their strobes: after :meth:`begin` and after each power-up reset (in cycle ``c - 1``)."""
+        line, strobes, c0 = self._line, self._strobes, self._c0
+        t = min(c - c0, len(line))
+        first = max(t, run_from - c0) if run_from != NEVER else len(line)
+        strobes[t:first] = self.strobes()
+        for k in range(first, len(line)):
+            strobes[k] = self.strobes()
+            self._clock_blocks(int(line[k]))
+        self._events = np.flatnonzero(strobes[:, 0] | strobes[:, 1]).tolist()
+
+    def next_strobe(self, t: int) -> int:
+        """The first cycle of the run after its cycle ``t`` with a strobe for the BK (the run's length if none)."""
+        k = bisect_right(self._events, t)
+        return self._events[k] if k < len(self._events) else len(self._line)
 
     def record(self, t: int, state: Terminal) -> None:
         """The BK state from the run's cycle ``t`` on is ``state``."""
