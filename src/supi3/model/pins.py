@@ -92,7 +92,7 @@ from supi3.optical.regulation import OpticalMode
 from supi3.pinlevel import EventLog, Pin
 from supi3.pinout import CORE_OUTPUTS, IB_DIAG_DIVIDER_BITS, OPTICAL_LINE_INPUTS, OPTICAL_REGISTERS, SYNC_STAGES
 from supi3.tables import BIT_RATES, CLOCK_HZ, RESET_MIN_S
-from supi3.terminal import CONF_PIN, received
+from supi3.terminal import BRANCH_SILENCE_CLOCKS, CONF_PIN
 
 __all__ = [
     "IB_DIAG_DIVIDER_BITS",
@@ -158,6 +158,10 @@ class Supi3Pins:
         The pin-strap configuration (the RTL reads the same straps from its strap ports).
     chip:
         The bus behaviour to drive; a new :class:`~supi3.model.chip.Supi3` for ``config`` by default.
+    branch_silence:
+        In the BK modes, the silence of the branch return line after which the extended function closes the
+        branch, in clocks: 1 up to :data:`~supi3.terminal.BRANCH_SILENCE_CLOCKS` (the default, BK-3, as the RTL
+        core's); shorter only to reach it quickly in tests.
 
     Attributes
     ----------
@@ -188,10 +192,13 @@ class Supi3Pins:
     optical_inputs: Sequence[Pin] = OPTICAL_LINE_INPUTS
     """The optical block's line side, inputs that may be given with :attr:`inputs` (see the module docstring)."""
 
-    def __init__(self, config: DeviceConfig, chip: Supi3 | None = None) -> None:
+    def __init__(self, config: DeviceConfig, chip: Supi3 | None = None, *,
+                 branch_silence: int = BRANCH_SILENCE_CLOCKS) -> None:
         check_instance("config", config, DeviceConfig)
         if chip is not None and (not isinstance(chip, Supi3) or chip.config != config):
             raise fail("chip", "None or a Supi3 of the same configuration", chip)
+        check_int("branch_silence", branch_silence, 1, BRANCH_SILENCE_CLOCKS,
+                  "the 10 ms of BK-3 in clocks; shorter only to test the closure quickly")  # fmt: skip
         self.config = config
         self.chip = chip if chip is not None else Supi3(config)
         self.cpb = wire.clocks_per_bit(config.bit_rate)
@@ -220,7 +227,7 @@ class Supi3Pins:
         self._counters = LineCounters.of(config)
         # BK modes (Table 2-7): the branch's data lines DO3 and DI3 and the switch of DO2 (BK-1, BK-37).
         rf = config.rf_mode.rf if config.rf_mode is not None else None
-        self._branch = BranchLines(rf, self.cpb, config.interface is Interface.BK_LBD) \
+        self._branch = BranchLines(rf, self.cpb, config.interface is Interface.BK_LBD, branch_silence) \
             if config.interface.is_bus_terminal else None  # fmt: skip
         # The optical block (1.6) with RF = 00 or 01; it makes every optical transition, the chip takes its status.
         mode = self.chip.optical_mode
@@ -400,6 +407,9 @@ class Supi3Pins:
             return
         chip = self.chip
         resets = chip._events["IB_RESET"]
+        terminal = chip.bus_terminal
+        if terminal is not None:
+            before, switched_on = terminal.state, terminal.switched_on_commands
         if chip.bus_terminal is None:
             chip.mfp_in = s.mfp_in
         elif c == self._run_from:  # a BK takes CONF as it is at the first running clock: no edge (BK-20)
@@ -423,26 +433,25 @@ class Supi3Pins:
             resetting = self._frame.in_reset or chip.line_silent
             self._receiver.clock(line, c)
             self._optical_edge(c, resetting, optical)
-        if self._branch is not None and chip._events["IB_RESET"] == resets:
-            self._branch_edge(c)
-
-    def _branch_edge(self, c: int) -> None:
-        """A BK's edge ending cycle ``c`` after the core's (a command latched there applies first, BK-20): the
-        master's telegram back (count 0) and the counter telegram (its count) of the branch return line (BK-38,
-        BK-39); not in a clock with an INTERBUS reset, where the BK ignores them."""
-        branch, terminal = self._branch, self.chip.bus_terminal
-        assert branch is not None and terminal is not None
-        ret, cnt, count = branch.strobes_at(c) if self._recording else branch.strobes()
-        if not (ret or cnt):
+        branch = self._branch
+        if branch is None:
             return
-        state = terminal.state
-        if ret:
-            state = received(state, 0)
-        if cnt:
-            state = received(state, count)
+        # The BK's edge after the core's (BK-20's order): a fresh BK (its first running clock) and an INTERBUS reset
+        # take no strobe; else the master's telegram back, the counter telegram, the silence (BK-3, BK-38, BK-39).
+        terminal = chip.bus_terminal
+        assert terminal is not None
+        if c == self._run_from or chip._events["IB_RESET"] != resets:
+            branch.quiet(c, terminal.state, self._recording)
+            return
+        state, closes = branch.edge(c, before, terminal.state, terminal.switched_on_commands != switched_on,
+                                    s.mfp_in, self._recording)  # fmt: skip
         if state is not terminal.state:
             terminal.state = state
-            self.chip.revision += 1  # the E LED and the status byte (BK-5, BK-11)
+            chip.revision += 1  # the E LED, LD and the status byte (BK-5, BK-11)
+        if closes:
+            terminal.closures += 1
+            chip.attention = True
+            self.log.add(c, "the BK closed its silent branch (BK-3)")
     def _optical_edge(self, c: int, resetting: bool, line: Mapping[str, int]) -> None:
         """The optical block's edge ending cycle ``c`` (after the core's: the core saw the hold of the cycle), with
         the line side ``line``; ``resetting``: the core's INTERBUS reset period before the core's edge (OPT-26)."""
@@ -586,7 +595,7 @@ class Supi3Pins:
         if block is not None and self._optical_at != NEVER:  # a change the block showed before this run
             due = min(due, max(self._optical_due(self._optical_at - 1), c0))
         if branch is not None:
-            due = min(due, c0 + branch.next_strobe(-1))
+            due = min(due, c0 + branch.next_event(-1))
         t = -1
         while True:
             while other_events[k] <= t:
@@ -621,7 +630,7 @@ class Supi3Pins:
             if block is not None and c >= self._run_from:
                 due = min(due, self._optical_due(c))
             if branch is not None:
-                due = min(due, c0 + branch.next_strobe(t))
+                due = min(due, c0 + branch.next_event(t))
         if n and c0 + n - 1 >= self._run_from:
             restore_low_run(n - 1, int(line[n - 1]), self._run_from)
         self._recording = False
@@ -635,7 +644,7 @@ class Supi3Pins:
         if self._counters is not None:
             traces["do2"] = self._counters.forward_run(line, c0, self._power_ups, traces["do2"])
         if branch is not None:
-            branch.render(traces, synced["mfp_in"], self._power_ups)
+            branch.render(traces, synced["mfp_in"])
         traces.update(self._expansion.render(c0, n))
         self._transmitter.trim()
         if serial is not None:

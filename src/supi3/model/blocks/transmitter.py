@@ -12,7 +12,6 @@ countdowns, the ERR pair rewrite, the return line switch).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from itertools import chain
 from typing import Final
 
@@ -114,40 +113,29 @@ class Transmitter:
         updated at every clock edge where the logic runs: with RF = 10 it is RBST_EXT, otherwise it latches the
         first high level seen on DI2; power-up clears it.
         """
-        state = recognition(start, power_ups, seen, self.rbst_by_pin)
-        self.next_present = bool(state[-1])
-        return np.where(state[:-1], di2, do2).astype(np.int64)
-
-
-def recognition(start: tuple[int, bool, int], power_ups: Sequence[tuple[int, int]], seen: npt.NDArray[np.int64],
-                by_pin: bool) -> npt.NDArray[np.bool_]:
-    """A recognised device over a run of ``len(seen)`` cycles: element ``t`` what the outputs of the run's cycle
-    ``t`` see, element ``len(seen)`` the value after the run.
-
-    ``start`` is (the run's first cycle, the value then, the first cycle the logic ran from then); ``power_ups`` the
-    (cycle, logic runs from) of each power-up reset in the run; ``seen`` what recognition reads in each cycle. It is
-    updated at every clock edge where the logic runs: ``by_pin``, it is ``seen`` (M5's RBST_EXT), otherwise it
-    latches the first high level of ``seen`` (M5's DI2, BK-37's DI3); power-up clears it.
-    """
-    c0, value, run_from = start
-    n = len(seen)
-    state = np.empty(n + 1, dtype=bool)
-    state[0] = value
-    t = 0
-    for at, new_run_from in [*power_ups, (c0 + n, run_from)]:
-        end = at - c0
-        if end > t:
-            active = np.arange(c0 + t, c0 + end) >= run_from
-            level = seen[t:end] != 0
-            values = np.where(active, level, value) if by_pin else np.logical_or.accumulate(level & active) | value
-            state[t + 1 : end + 1] = values
-            value = bool(values[-1])
-        if end < n:
-            value = False
-            run_from = new_run_from
-            state[end + 1] = False
-            t = end + 1
-    return state
+        c0, value, run_from = start
+        n = len(do2)
+        state = np.empty(n + 1, dtype=bool)  # state[t]: what the outputs of cycle c0 + t see
+        state[0] = value
+        t = 0
+        for at, new_run_from in [*power_ups, (c0 + n, run_from)]:
+            end = at - c0
+            if end > t:
+                active = np.arange(c0 + t, c0 + end) >= run_from
+                level = seen[t:end] != 0
+                if self.rbst_by_pin:
+                    values = np.where(active, level, value)
+                else:
+                    values = np.logical_or.accumulate(level & active) | value
+                state[t + 1 : end + 1] = values
+                value = bool(values[-1])
+            if end < n:
+                value = False
+                run_from = new_run_from
+                state[end + 1] = False
+                t = end + 1
+        self.next_present = value
+        return np.where(state[:n], di2, do2).astype(np.int64)
 
 
 def render_bits(bits: list[tuple[int, int]], cpb: int, c0: int, n: int) -> PinTrace:
