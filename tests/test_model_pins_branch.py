@@ -181,7 +181,10 @@ def test_the_extended_function_closes_a_silent_branch() -> None:
     switching it on reopens it; step() equals run()."""
     script, silent = silence_scenario(4, 7)
     columns = script.columns()
-    make = lambda: Supi3Pins(script.config, branch_silence=SHORT_SILENCE)  # noqa: E731
+
+    def make() -> Supi3Pins:
+        return Supi3Pins(script.config, branch_silence=SHORT_SILENCE)
+
     pins = make()
     out = assert_run_matches_step(pins, make(), columns, [0.35, 0.6, 0.9])
     ld = out["mfp_out"] >> LD_PIN & 1
