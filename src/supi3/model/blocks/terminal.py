@@ -30,7 +30,7 @@ is 0 while ``mode`` is NONE.
 
 from __future__ import annotations
 
-from bisect import bisect_right
+from bisect import bisect_left, bisect_right
 from collections.abc import Mapping, Sequence
 from typing import Final
 
@@ -257,23 +257,8 @@ class BranchLines:
     """
 
     __slots__ = (
-        "_c0",
-        "_connected",
-        "_events",
-        "_lbst",
-        "_line",
-        "_opens",
-        "_strobes",
-        "connected",
-        "counter",
-        "counting",
-        "cpb",
-        "fast",
-        "limit",
-        "present",
-        "timer",
-        "timer_at",
-        "watch",
+        "_c0", "_connected", "_events", "_lbst", "_line", "_opens", "_starts", "_strobes", "connected", "counter",
+        "counting", "cpb", "fast", "limit", "present", "timer", "timer_at", "watch",
     )  # fmt: skip
 
     def __init__(self, rf: str | None, cpb: int, lbd: bool, time_limit: int = BRANCH_SILENCE_CLOCKS) -> None:
@@ -293,6 +278,7 @@ class BranchLines:
         self._opens: list[tuple[int, bool]] = []
         self._c0 = 0
         self._line = np.zeros(0, dtype=np.int64)
+        self._starts: list[int] = []
         self._lbst = np.zeros(0, dtype=np.int64)
         self._connected = np.zeros(0, dtype=np.int64)
         self._strobes = np.zeros((0, 3), dtype=np.int64)
@@ -394,6 +380,7 @@ class BranchLines:
         self._opens = [(0, _open(state))]
         self._c0 = c0
         self._line = mfp_in >> DI3_PIN & 1
+        self._starts = np.flatnonzero(self._line == wire.START_LEVEL).tolist()
         self._lbst = mfp_in >> LBST_PIN & 1
         self._strobes = np.zeros((len(mfp_in), 3), dtype=np.int64)
         self._connected = np.zeros(len(mfp_in), dtype=np.int64)
@@ -412,10 +399,22 @@ class BranchLines:
         first = max(t, run_from - c0) if run_from != NEVER else len(line)
         strobes[t:first] = self.strobes()
         connected[t:first] = self.connected
-        for k in range(first, len(line)):
+        n, k = len(line), first
+        starts = self._starts
+        watch = self.watch
+        while k < n:
+            if self.counter is None and self.connected and watch.bit < 0 and not watch.seen and line[k]:
+                # An idle line between telegrams changes nothing until its next start level: skip to it.
+                s = bisect_left(starts, k)
+                end = starts[s] if s < len(starts) else n
+                strobes[k:end] = 0
+                connected[k:end] = 1
+                k = end
+                continue
             strobes[k] = self.strobes()
             connected[k] = self.connected
             self.clock(int(line[k]) << DI3_PIN)
+            k += 1
         rises = np.flatnonzero(np.diff(connected, prepend=connected[:1]) | np.diff(self._lbst, prepend=self._lbst[:1]))
         self._events = sorted({*np.flatnonzero(strobes[:, 0] | strobes[:, 1]).tolist(), *rises.tolist()})
 
