@@ -84,7 +84,7 @@ from supi3.rtl.tables import (
     core_tables,
     line_position,
 )
-from supi3.rtl.terminal import ReturnWatchRtl, TerminalRtl
+from supi3.rtl.terminal import TerminalRtl
 from supi3.rtl.upif import upif_tables
 from supi3.tables import BIT_RATES, RF_MODES, RfMode
 from supi3.terminal import CONF_PIN, DI3_PIN, DO3_PIN, LBST_PIN, TerminalMode
@@ -358,7 +358,7 @@ class Supi3Core(wiring.Component):
         # is at the first running clock (BK-20). A device answers on the branch once the synchronised DI3 was high
         # where the logic ran (BK-37, as M5 on DI2); a power failure forgets it. While the branch is in the data path
         # DO3 (MFP9) takes the DO2 the core would send and DO2 repeats the synchronised DI3 (BK-1's order: the BK,
-        # its branch, on along the remote bus); else DO3 idles (model: supi3.model.blocks.terminal.BranchLines).
+        # its branch, on along the remote bus); else DO3 idles (the pin model's BranchLines).
         terminal = TerminalRtl()
         m.submodules.terminal = ResetInserter(~running)(terminal)
         di3 = receiver.mfp_in_s[DI3_PIN]
@@ -370,10 +370,7 @@ class Supi3Core(wiring.Component):
         do2 = Signal(init=wire.IDLE_LEVEL)
         m.d.comb += do2.eq(Mux(terminal.enabled, di3, lines.do2))
         # The master's telegrams back on DI3 (BK-38) and, in BK-LBD, the counter block on DI3 (BK-39).
-        watch = ReturnWatchRtl(len(cpb))
-        m.submodules.watch = gated(watch)
-        m.d.comb += [watch.line.eq(di3), watch.cpb.eq(cpb), lines.branch_line.eq(di3),
-                     lines.branch.eq(terminal_mode == TerminalMode.LBD)]  # fmt: skip
+        m.d.comb += [lines.branch_line.eq(di3), lines.branch.eq(terminal_mode == TerminalMode.LBD)]
         command = datapath.words.command
         m.d.comb += [
             terminal.ib_reset.eq(frame.management.clear),
@@ -387,7 +384,7 @@ class Supi3Core(wiring.Component):
             terminal.alarm_set.eq(command[wire.CMD_ALARM_OUT_SET_BIT] & ~command[wire.CMD_PCMD_BIT]),
             terminal.alarm_on.eq(command[wire.CMD_ALARM_OUT_BIT]),
             terminal.connected.eq(connected),
-            terminal.ret_valid.eq(watch.seen),
+            terminal.ret_valid.eq(lines.returned),
             terminal.cnt_valid.eq(lines.seen),
             terminal.count.eq(lines.count),
             outputs.ld.eq(terminal.ld),
