@@ -57,7 +57,6 @@ def synced(trace: np.ndarray) -> np.ndarray:
     return np.concatenate([np.zeros(SYNC_STAGES, dtype=np.int64), trace[:-SYNC_STAGES]])
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize(("interface", "rf", "seed"), CASES[1:3])
 def test_the_branch_takes_the_data_path(interface: str, rf: str, seed: int) -> None:
     """Against the same scenario with DI3 silent and LBST low (no branch by Table 2-9): where the branch is in the
@@ -122,7 +121,6 @@ def count_scenario(rf: str, seed: int) -> tuple[CoreScript, list[int]]:
 COUNT_CASES = [("00", 5), ("10", 6)]
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize(("rf", "seed"), COUNT_CASES[:1])
 def test_the_bk_counts_on_di3(rf: str, seed: int) -> None:
     """BK-39, BK-38: the counter block on DI3 gives the BK its count (E lit, the count in the BK state) while the
@@ -174,7 +172,6 @@ def silence_scenario(limit_frames: int, seed: int) -> tuple[CoreScript, int]:
     return script, silent
 
 
-@pytest.mark.slow
 def test_the_extended_function_closes_a_silent_branch() -> None:
     """BK-3, BK-20, BK-38 at pin level: while the master's telegrams come back the branch stays open; silent for the
     limit, the BK closes it (LD lit, DO2 the transmitter's again, the report and ATTN waiting); the master's command
