@@ -43,6 +43,8 @@ __all__ = [
     "BRANCH_SILENCE_CLOCKS",
     "BRANCH_SILENCE_S",
     "CONF_PIN",
+    "DI3_PIN",
+    "DO3_PIN",
     "LBST_PIN",
     "RF_CODES",
     "TERMINAL_INTERFACES",
@@ -80,6 +82,10 @@ CONF_PIN: Final = next(p.pin for p in tables.BUS_TERMINAL_MFP if p.signal == "CO
 """MFP12 (Table 2-8)."""
 LBST_PIN: Final = next(p.pin for p in tables.BUS_TERMINAL_MFP if p.signal == "LBST")
 """MFP11 (Table 2-8)."""
+DI3_PIN: Final = next(p.pin for p in tables.BUS_TERMINAL_MFP if p.signal == "DI3")
+"""MFP10 (Table 2-8): the branch data input, the return line from the branch."""
+DO3_PIN: Final = next(p.pin for p in tables.BUS_TERMINAL_MFP if p.signal == "DO3_CU")
+"""MFP9 (Table 2-8): the branch data output (copper), the forward line into the branch."""
 
 TERMINAL_INTERFACES: Final = ("BK-RB", "BK-LB", "BK-LBD")
 """The interfaces of Table 2-7: remote bus branch, local bus branch, local bus branch with device-oriented

@@ -65,6 +65,9 @@ class BusTerminal:
         The LBST (MFP11) level last seen.
     closures:
         How often the BK closed its branch itself.
+    switched_on_commands:
+        How many commands switched the branch on (each restarts the silence, BK-3; the pin level's silence timer
+        reads it).
     """
 
     def __init__(self, interface: str, rf: str | None) -> None:
@@ -74,6 +77,7 @@ class BusTerminal:
         self.lbst = False
         self.state = Terminal()
         self.closures = 0
+        self.switched_on_commands = 0
         self._silent_since: float | None = None
 
     __hash__ = None  # type: ignore[assignment]  # mutable state, compared by value
@@ -148,6 +152,7 @@ class BusTerminal:
         self.state = spec.command(self.state, branch, acknowledge, alarm)
         if spec.restarts_silence(branch):
             self._silent_since = None
+            self.switched_on_commands += 1
 
     def returned(self, traffic: bool, count: int | None, start: float, end: float) -> bool:
         """The branch was driven from ``start`` to ``end``: whether the master's telegrams came back on its return

@@ -64,7 +64,7 @@ import numpy as np
 import numpy.typing as npt
 
 from supi3.checks import check_bits, check_instance, check_int, check_trace, fail
-from supi3.config import DeviceConfig
+from supi3.config import DeviceConfig, Interface
 from supi3.diagnostics import is_complete
 from supi3.interbus import wire
 from supi3.model.blocks.counter import LineCounters
@@ -85,13 +85,14 @@ from supi3.model.blocks.receiver import (
     input_traces,
 )
 from supi3.model.blocks.serial_io import SerialIo
+from supi3.model.blocks.terminal import BranchLines
 from supi3.model.blocks.transmitter import NEVER, PinTrace, Transmitter
 from supi3.model.chip import Supi3
 from supi3.optical.regulation import OpticalMode
 from supi3.pinlevel import EventLog, Pin
 from supi3.pinout import CORE_OUTPUTS, IB_DIAG_DIVIDER_BITS, OPTICAL_LINE_INPUTS, OPTICAL_REGISTERS, SYNC_STAGES
 from supi3.tables import BIT_RATES, CLOCK_HZ, RESET_MIN_S
-from supi3.terminal import CONF_PIN
+from supi3.terminal import BRANCH_SILENCE_CLOCKS, CONF_PIN
 
 __all__ = [
     "IB_DIAG_DIVIDER_BITS",
@@ -157,6 +158,10 @@ class Supi3Pins:
         The pin-strap configuration (the RTL reads the same straps from its strap ports).
     chip:
         The bus behaviour to drive; a new :class:`~supi3.model.chip.Supi3` for ``config`` by default.
+    branch_silence:
+        In the BK modes, the silence of the branch return line after which the extended function closes the
+        branch, in clocks: 1 up to :data:`~supi3.terminal.BRANCH_SILENCE_CLOCKS` (the default, BK-3, as the RTL
+        core's); shorter only to reach it quickly in tests.
 
     Attributes
     ----------
@@ -175,7 +180,7 @@ class Supi3Pins:
     """
 
     __slots__ = (
-        "_counters", "_datapath", "_diag2", "_expansion", "_frame", "_holding", "_optical", "_optical_at",
+        "_branch", "_counters", "_datapath", "_diag2", "_expansion", "_frame", "_holding", "_optical", "_optical_at",
         "_optical_fixed", "_outputs", "_power_ups", "_receiver", "_recording",
         "_return_start", "_run_from", "_serial", "_stat_active", "_synced_run", "_transmitter", "chip",
         "complete_diagnostics",
@@ -187,10 +192,13 @@ class Supi3Pins:
     optical_inputs: Sequence[Pin] = OPTICAL_LINE_INPUTS
     """The optical block's line side, inputs that may be given with :attr:`inputs` (see the module docstring)."""
 
-    def __init__(self, config: DeviceConfig, chip: Supi3 | None = None) -> None:
+    def __init__(self, config: DeviceConfig, chip: Supi3 | None = None, *,
+                 branch_silence: int = BRANCH_SILENCE_CLOCKS) -> None:
         check_instance("config", config, DeviceConfig)
         if chip is not None and (not isinstance(chip, Supi3) or chip.config != config):
             raise fail("chip", "None or a Supi3 of the same configuration", chip)
+        check_int("branch_silence", branch_silence, 1, BRANCH_SILENCE_CLOCKS,
+                  "the 10 ms of BK-3 in clocks; shorter only to test the closure quickly")  # fmt: skip
         self.config = config
         self.chip = chip if chip is not None else Supi3(config)
         self.cpb = wire.clocks_per_bit(config.bit_rate)
@@ -218,6 +226,10 @@ class Supi3Pins:
         # LBD modes (Table 2-5): the counter telegram blocks on DO2 and, in LBD-MR, DI1 (M17).
         self._counters = LineCounters.of(config)
         self._frame.counter_telegrams = self._counters is not None  # BK-36: the frame engine takes them as such
+        # BK modes (Table 2-7): the branch's data lines DO3 and DI3 and the switch of DO2 (BK-1, BK-37).
+        rf = config.rf_mode.rf if config.rf_mode is not None else None
+        self._branch = BranchLines(rf, self.cpb, config.interface is Interface.BK_LBD, branch_silence) \
+            if config.interface.is_bus_terminal else None  # fmt: skip
         # The optical block (1.6) with RF = 00 or 01; it makes every optical transition, the chip takes its status.
         mode = self.chip.optical_mode
         self._optical = OpticalBlock() if mode is not OpticalMode.OFF else None
@@ -269,6 +281,10 @@ class Supi3Pins:
         self._expansion.power_up(self.cycle)
         if self._counters is not None and not self._recording:  # a run replays its power-ups (_run_forward)
             self._counters.power_up(self.cycle, run_from)
+        if self._branch is not None:  # a run renders its lines afterwards (BranchLines.render) and plans anew
+            self._branch.power_up()
+            if self._recording:
+                self._branch.plan(self.cycle + 1, run_from)
         if self._optical is not None:
             self._optical.reset()
         self._optical_at = run_from
@@ -320,10 +336,16 @@ class Supi3Pins:
             running = c >= self._run_from and synced.resu_n and synced.vmon_ok
             source = self._counters.show(c, outputs, row.di2, tx.next_present)
             self._counters.clock(source, synced.do1 if running else None)
+        branch = self._branch
+        if branch is not None:
+            assert self.chip.bus_terminal is not None
+            branch.route(outputs, self.chip.bus_terminal.state, synced.mfp_in, tx.next_present)
         if c >= self._run_from or self._holding or not (synced.resu_n and synced.vmon_ok):
             self._tick(c, synced, synced.do1, optical or _OPTICAL_QUIET)
             if c >= self._run_from:
                 tx.next_present = bool(synced.rbst_ext) if tx.rbst_by_pin else tx.next_present or bool(synced.di2)
+                if branch is not None:
+                    branch.clock(synced.mfp_in)
             if tx.next_present != self.chip.following:  # RD (DG-5): the outputs of the next cycle show it
                 self.chip.set_following(tx.next_present)
         if len(tx.bits) > 8:  # tested here, not in trim(): one call less per step()
@@ -344,7 +366,18 @@ class Supi3Pins:
     def forward_level(self) -> int:
         """The forward line output (``do2``) of the current cycle; it depends on state only."""
         sent = self._transmitter.level(self.cycle)
+        if self._branch is not None:
+            return self._route(self.cycle, {"do2": sent, "di1": 0, "mfp_out": 0})["do2"]
         return sent if self._counters is None else self._counters.do2(self.cycle, sent)
+
+    def _route(self, c: int, values: dict[str, int]) -> dict[str, int]:
+        """``values`` of cycle ``c`` through a BK's branch lines (:class:`BranchLines`): the synchronised inputs of
+        cycle ``c`` are in the synchroniser (the latest one held for the cycles beyond it)."""
+        assert self._branch is not None and self.chip.bus_terminal is not None
+        pipe = self._receiver.pipe
+        synced = pipe[max(len(pipe) - 1 - (c - self.cycle), 0)]
+        self._branch.route(values, self.chip.bus_terminal.state, synced.mfp_in, self._transmitter.next_present)
+        return values
 
     def output_values(self, c: int, di2: int) -> dict[str, int]:
         """Every output pin during cycle ``c`` (``c`` >= the current cycle; ``di2`` is that cycle's input)."""
@@ -353,7 +386,7 @@ class Supi3Pins:
                   **self._expansion.peek(c)}
         if self._counters is not None:
             self._counters.show(c, values, di2, self._transmitter.next_present)
-        return values
+        return values if self._branch is None else self._route(c, values)
 
     # ------------------------------------------------------------------------------------------------------------
     # The per-cycle logic, shared by step() and run()
@@ -376,6 +409,10 @@ class Supi3Pins:
         if c < self._run_from:
             return
         chip = self.chip
+        resets = chip._events["IB_RESET"]
+        terminal = chip.bus_terminal
+        if terminal is not None:
+            before, switched_on = terminal.state, terminal.switched_on_commands
         if chip.bus_terminal is None:
             chip.mfp_in = s.mfp_in
         elif c == self._run_from:  # a BK takes CONF as it is at the first running clock: no edge (BK-20)
@@ -395,11 +432,29 @@ class Supi3Pins:
         self._expansion.from_exr = s.from_exr
         if self._optical is None:
             self._receiver.clock(line, c)
+        else:
+            resetting = self._frame.in_reset or chip.line_silent
+            self._receiver.clock(line, c)
+            self._optical_edge(c, resetting, optical)
+        branch = self._branch
+        if branch is None:
             return
-        resetting = self._frame.in_reset or chip.line_silent
-        self._receiver.clock(line, c)
-        self._optical_edge(c, resetting, optical)
-
+        # The BK's edge after the core's (BK-20's order): a fresh BK (its first running clock) and an INTERBUS reset
+        # take no strobe; else the master's telegram back, the counter telegram, the silence (BK-3, BK-38, BK-39).
+        terminal = chip.bus_terminal
+        assert terminal is not None
+        if c == self._run_from or chip._events["IB_RESET"] != resets:
+            branch.quiet(c, terminal.state, self._recording)
+            return
+        state, closes = branch.edge(c, before, terminal.state, terminal.switched_on_commands != switched_on,
+                                    s.mfp_in, self._recording)  # fmt: skip
+        if state is not terminal.state:
+            terminal.state = state
+            chip.revision += 1  # the E LED, LD and the status byte (BK-5, BK-11)
+        if closes:
+            terminal.closures += 1
+            chip.attention = True
+            self.log.add(c, "the BK closed its silent branch (BK-3)")
     def _optical_edge(self, c: int, resetting: bool, line: Mapping[str, int]) -> None:
         """The optical block's edge ending cycle ``c`` (after the core's: the core saw the hold of the cycle), with
         the line side ``line``; ``resetting``: the core's INTERBUS reset period before the core's edge (OPT-26)."""
@@ -488,7 +543,11 @@ class Supi3Pins:
                               [stage.di2 for stage in reversed(receiver.pipe)])
         self._power_ups = []
         self._recording = True
+        branch = self._branch
         full = self._synced_traces(raw)
+        if branch is not None:
+            assert self.chip.bus_terminal is not None
+            branch.begin(c0, self._run_from, self.chip.bus_terminal.state, full["mfp_in"][:n])
         synced = {name: trace[:n] for name, trace in full.items()}
         line = synced["do1"]
         line_change = np.ones(n, dtype=bool)
@@ -538,6 +597,8 @@ class Supi3Pins:
             due = max(serial.due, c0)
         if block is not None and self._optical_at != NEVER:  # a change the block showed before this run
             due = min(due, max(self._optical_due(self._optical_at - 1), c0))
+        if branch is not None:
+            due = min(due, c0 + branch.next_event(-1))
         t = -1
         while True:
             while other_events[k] <= t:
@@ -564,11 +625,15 @@ class Supi3Pins:
             if chip.revision != shown or self._run_from != run_from:
                 shown, run_from = chip.revision, self._run_from
                 snaps.append((t + 1, outputs.snapshot(run_from)))
+            if branch is not None:
+                branch.record(t + 1, chip.bus_terminal.state)  # type: ignore[union-attr]  # a BK has one
             due = next_due(c, level, self._run_from)
             if serial is not None and serial.due < due:
                 due = serial.due if serial.due > c else c + 1
             if block is not None and c >= self._run_from:
                 due = min(due, self._optical_due(c))
+            if branch is not None:
+                due = min(due, c0 + branch.next_event(t))
         if n and c0 + n - 1 >= self._run_from:
             restore_low_run(n - 1, int(line[n - 1]), self._run_from)
         self._recording = False
@@ -582,6 +647,8 @@ class Supi3Pins:
         self._diag2 = traces["diag2"]  # RD in it waits for the return line (_return_line, DG-5)
         if self._counters is not None:
             traces["do2"] = self._counters.forward_run(line, c0, self._power_ups, traces["do2"])
+        if branch is not None:
+            branch.render(traces, synced["mfp_in"])
         traces.update(self._expansion.render(c0, n))
         self._transmitter.trim()
         if serial is not None:

@@ -87,7 +87,7 @@ from supi3.rtl.tables import (
 from supi3.rtl.terminal import TerminalRtl
 from supi3.rtl.upif import upif_tables
 from supi3.tables import BIT_RATES, RF_MODES, RfMode
-from supi3.terminal import CONF_PIN, LBST_PIN, TerminalMode
+from supi3.terminal import CONF_PIN, DI3_PIN, DO3_PIN, LBST_PIN, TerminalMode
 
 __all__ = [
     "LINE",
@@ -357,11 +357,22 @@ class Supi3Core(wiring.Component):
         ]  # fmt: skip
 
         # The bus terminal module (2.4, docs/bus-terminal.md): in reset until the core runs, so that it takes CONF as it
-        # is at the first running clock (BK-20). Until the branch's data path (DI3/DO3) is in, no device is seen on
-        # the branch and its return line counts as carrying the master's telegrams: no closure by the extended
-        # function and no count at pin level (the transaction-level ring's branch_returned has them).
+        # is at the first running clock (BK-20). A device answers on the branch once the synchronised DI3 was high
+        # where the logic ran (BK-37, as M5 on DI2); a power failure forgets it. While the branch is in the data path
+        # DO3 (MFP9) takes the DO2 the core would send and DO2 repeats the synchronised DI3 (BK-1's order: the BK,
+        # its branch, on along the remote bus); else DO3 idles (the pin model's BranchLines).
         terminal = TerminalRtl()
         m.submodules.terminal = ResetInserter(~running)(terminal)
+        di3 = receiver.mfp_in_s[DI3_PIN]
+        connected = Signal()
+        with m.If(power_fail):
+            m.d.sync += connected.eq(0)
+        with m.Elif(running & di3):
+            m.d.sync += connected.eq(1)
+        do2 = Signal(init=wire.IDLE_LEVEL)
+        m.d.comb += do2.eq(Mux(terminal.enabled, di3, lines.do2))
+        # The master's telegrams back on DI3 (BK-38) and, in BK-LBD, the counter block on DI3 (BK-39).
+        m.d.comb += [lines.branch_line.eq(di3), lines.branch.eq(terminal_mode == TerminalMode.LBD)]
         command = datapath.words.command
         m.d.comb += [
             terminal.ib_reset.eq(frame.management.clear),
@@ -374,7 +385,10 @@ class Supi3Core(wiring.Component):
             terminal.ack.eq(command[wire.CMD_QUIT_BIT]),
             terminal.alarm_set.eq(command[wire.CMD_ALARM_OUT_SET_BIT] & ~command[wire.CMD_PCMD_BIT]),
             terminal.alarm_on.eq(command[wire.CMD_ALARM_OUT_BIT]),
-            terminal.ret_valid.eq(1),
+            terminal.connected.eq(connected),
+            terminal.ret_valid.eq(lines.returned),
+            terminal.cnt_valid.eq(lines.seen),
+            terminal.count.eq(lines.count),
             outputs.ld.eq(terminal.ld),
             outputs.e.eq(terminal.e),
             outputs.alarm.eq(terminal.alarm),
@@ -403,7 +417,7 @@ class Supi3Core(wiring.Component):
             outputs.di2_s.eq(receiver.di2_s),
             outputs.rbst_ext_s.eq(receiver.rbst_ext_s),
             outputs.di2.eq(self.di2),
-            outputs.do2.eq(lines.do2),
+            outputs.do2.eq(do2),
             outputs.divider.eq(cycle),
             outputs.rbst_by_pin.eq(rbst_by_pin),
             outputs.complete_diag.eq(complete_diag),
@@ -530,9 +544,10 @@ class Supi3Core(wiring.Component):
             ]
 
         m.d.comb += [
-            self.do2.eq(lines.do2),
+            self.do2.eq(do2),
             self.di1.eq(lines.di1),
-            self.mfp_out.eq(datapath.mfp_out | Mux(spi, serial_io.mfp, 0) | outputs.mfp_diag),
+            self.mfp_out.eq(datapath.mfp_out | Mux(spi, serial_io.mfp, 0) | outputs.mfp_diag
+                            | Mux(bus_terminal, Mux(terminal.enabled, lines.do2, wire.IDLE_LEVEL) << DO3_PIN, 0)),
             self.mod_ack_n.eq(outputs.mod_ack_n),
             self.res_reg_n.eq(outputs.res_reg_n),
             self.diag1.eq(outputs.diag1),

@@ -40,6 +40,7 @@ from supi3.lbd import (
 )
 from supi3.pinout import SYNC_STAGES
 from supi3.rtl.tables import core_tables
+from supi3.rtl.terminal import ReturnWatchRtl
 
 __all__ = ["CounterLinesRtl", "CounterRtl", "lbd_lines"]
 
@@ -209,33 +210,44 @@ class CounterRtl(wiring.Component):
 class CounterLinesRtl(wiring.Component):
     """The counter blocks in the chip core (docs/rtl.md "Counter telegram block"; the pin model's
     ``LineCounters`` in ``src/supi3/model/blocks/counter.py``): one :class:`CounterRtl` on the forward line in the
-    LBD modes (``forward``), one on the return line in LBD-MR (``looped``), each held in reset otherwise.
+    LBD modes (``forward``), one on the return line in LBD-MR (``looped``), each held in reset otherwise; in BK-LBD
+    (``branch``) the forward block takes the branch return line instead (BK-39, the pin model's
+    ``BranchLines.counter``: a BK has no counter block on its forward line, so the two share one block).
 
     Ports: ``line`` the synchronised DO1 (the receiver's), ``fast`` the bit rate (1: 2 Mbit/s), ``sent`` the
     transmitter's DO2, ``source`` the return line's source (M5: DI2 or the chip's DO2), ``run`` and ``clear`` the
     core's enable and power-up reset (they gate both blocks; the return line's ``SYNC_STAGES`` synchroniser always
     runs, M1); out: ``do2`` (the forward block's ``out`` while its ``drive`` is 1, else ``sent``) and ``di1`` (the
-    return block's ``out`` in LBD-MR, else ``source``).
+    return block's ``out`` in LBD-MR, else ``source``); ``branch_line`` the synchronised DI3, out ``seen`` and
+    ``count`` of its block, the BK's counter telegram strobe and count (``cnt_valid``, ``count``), and ``returned``
+    the BK's return watch on it in every mode (``ret_valid``, BK-38: ``supi3.rtl.terminal.ReturnWatchRtl``).
     """
 
     def __init__(self) -> None:
         super().__init__({
             "line": In(1), "fast": In(1), "sent": In(1), "source": In(1), "forward": In(1), "looped": In(1),
-            "run": In(1), "clear": In(1), "do2": Out(1), "di1": Out(1),
+            "run": In(1), "clear": In(1), "do2": Out(1), "di1": Out(1), "branch": In(1), "branch_line": In(1),
+            "seen": Out(1), "count": Out(wire.COUNTER_MAX.bit_length()), "returned": Out(1),
         })  # fmt: skip
 
     def elaborate(self, _platform: object) -> Module:
         m = Module()
         forward, back = CounterRtl(), CounterRtl()
-        m.submodules.forward = ResetInserter(self.clear | ~self.forward)(EnableInserter(self.run)(forward))
         m.submodules.back = ResetInserter(self.clear | ~self.looped)(EnableInserter(self.run)(back))
+        on = self.forward | self.branch
+        watch = ReturnWatchRtl(_CPB[0].bit_length())
+        m.submodules.watch = ResetInserter(self.clear)(EnableInserter(self.run)(watch))
+        m.d.comb += [watch.line.eq(self.branch_line), watch.cpb.eq(Mux(self.fast, _CPB[1], _CPB[0])),
+                     self.returned.eq(watch.seen)]  # fmt: skip
+        m.submodules.forward = ResetInserter(self.clear | ~on)(EnableInserter(self.run)(forward))
         stages = [Signal(init=wire.IDLE_LEVEL, name=f"source_s{k}") for k in range(SYNC_STAGES)]
         m.d.sync += [stages[0].eq(self.source), *(b.eq(a) for a, b in pairwise(stages))]
         m.d.comb += [
-            forward.line.eq(self.line), forward.fast.eq(self.fast),
+            forward.line.eq(Mux(self.branch, self.branch_line, self.line)), forward.fast.eq(self.fast),
             back.line.eq(stages[-1]), back.fast.eq(self.fast),
-            self.do2.eq(Mux(forward.drive, forward.out, self.sent)),
+            self.do2.eq(Mux(forward.drive & self.forward, forward.out, self.sent)),
             self.di1.eq(Mux(self.looped, back.out, self.source)),
+            self.seen.eq(forward.seen), self.count.eq(forward.count),
         ]  # fmt: skip
         return m
 

@@ -18,10 +18,11 @@ from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
 from supi3.errors import ArgumentError
+from supi3.interbus import wire
 from supi3.interbus.wire import BK_STATUS_CLOSED_BIT, BK_STATUS_CONF_BIT, COUNTER_MAX, BranchControl
 from supi3.terminal import BLOCK_INPUTS, BLOCK_OUTPUTS, BRANCH_SILENCE_CLOCKS, RF_CODES, TerminalMode, silence_limit
 
-__all__ = ["TerminalRtl"]
+__all__ = ["ReturnWatchRtl", "TerminalRtl"]
 
 
 class TerminalRtl(wiring.Component):
@@ -125,4 +126,46 @@ class TerminalRtl(wiring.Component):
                     with m.If(expired & ~cmd_off):  # silence, on the state after the command (watching)
                         sync += [closed.eq(1), closed_report.eq(1)]
                     sync += timer.eq(Mux(counting & ~restart & ~expired, timer + 1, 0))
+        return m
+
+
+class ReturnWatchRtl(wiring.Component):
+    """The master's telegrams back on the branch return line (BK-38; the pin model's ``ReturnWatch`` in
+    ``src/supi3/model/blocks/terminal.py``, whose docstring is the behaviour): ``line`` the synchronised DI3, ``cpb``
+    clocks per bit; ``seen`` is 1 in the cycle after a status telegram's stop bit was sampled at the idle level.
+
+    Parameters
+    ----------
+    cpb_width:
+        The width of the ``cpb`` port.
+    """
+
+    def __init__(self, cpb_width: int) -> None:
+        super().__init__({"line": In(1), "cpb": In(cpb_width), "seen": Out(1)})
+
+    def elaborate(self, _platform: object) -> Module:
+        m = Module()
+        sync = m.d.sync
+        busy = Signal()
+        data = Signal()
+        bit = Signal(range(wire.DATA_TELEGRAM_BITS))
+        phase = Signal.like(self.cpb)
+        seen = Signal()
+        start = ~busy & (self.line == wire.START_LEVEL)
+        now = Mux(start, 0, phase)
+        sync += seen.eq(0)
+        with m.If(busy | start):
+            sync += [busy.eq(1), phase.eq(Mux(now >= self.cpb - 1, 0, now + 1))]
+            with m.If(now == self.cpb >> 1):
+                k = Mux(start, 0, bit)
+                sync += bit.eq(k + 1)
+                with m.If(k == wire.POS_START), m.If(self.line != wire.START_LEVEL):
+                    sync += busy.eq(0)
+                with m.Elif(k == wire.POS_TYPE):
+                    sync += data.eq(self.line == wire.TYPE_DATA_LEVEL)
+                with m.Elif(k == Mux(data, wire.DATA_TELEGRAM_BITS - 1, wire.STATUS_TELEGRAM_BITS - 1)):
+                    sync += [seen.eq(~data & (self.line == wire.IDLE_LEVEL)), busy.eq(0)]
+            with m.Elif(start):
+                sync += bit.eq(0)
+        m.d.comb += self.seen.eq(seen)
         return m

@@ -30,18 +30,30 @@ is 0 while ``mode`` is NONE.
 
 from __future__ import annotations
 
+from bisect import bisect_left, bisect_right
 from collections.abc import Mapping, Sequence
 from typing import Final
 
+import numpy as np
+import numpy.typing as npt
+
 from supi3.checks import check_inputs
+from supi3.interbus import wire
 from supi3.interbus.wire import BranchControl
+from supi3.lbd import clocks_per_bit
+from supi3.model.blocks.counter import CounterBlock
+from supi3.model.blocks.transmitter import NEVER
 from supi3.pinlevel import EventLog, Pin
 from supi3.terminal import (
     BLOCK_INPUTS,
     BLOCK_OUTPUTS,
     BRANCH_SILENCE_CLOCKS,
+    DI3_PIN,
+    DO3_PIN,
+    LBST_PIN,
     Terminal,
     TerminalMode,
+    branch_present,
     command,
     conf_level,
     enabled,
@@ -52,9 +64,10 @@ from supi3.terminal import (
     rf_of,
     silence,
     silence_limit,
+    watching,
 )
 
-__all__ = ["TerminalBlock"]
+__all__ = ["BranchLines", "ReturnWatch", "TerminalBlock"]
 
 _WIDTHS: Final[dict[str, int]] = {pin.name: pin.width for pin in BLOCK_INPUTS}
 _OFF: Final[dict[str, int]] = {pin.name: 0 for pin in BLOCK_OUTPUTS}
@@ -150,3 +163,292 @@ class TerminalBlock:
     def recent_events(self) -> list[str]:
         """The block's last events, for mismatch reports."""
         return self.log.recent()
+
+
+class ReturnWatch:
+    """The master's telegrams back on a BK's branch return line (BK-38): ``seen`` is 1 in the cycle after the stop
+    bit of a status telegram was sampled at the idle level on the synchronised DI3 (``ret_valid`` of
+    :data:`~supi3.terminal.BLOCK_INPUTS`). Counter telegrams are data telegrams: they never count (BK-3).
+
+    The bit grid is the chip receiver's (M7): between telegrams a start level makes that clock the first of a bit
+    period; the line is sampled mid-bit (``cpb // 2``); a start bit sampled at the idle level is no telegram; the type
+    bit (``wire.POS_TYPE``) gives the length; after the stop bit's sample the watch is between telegrams again. The RTL
+    counterpart is ``supi3.rtl.terminal.ReturnWatchRtl``, clocked and reset as the core's logic.
+
+    Attributes
+    ----------
+    seen:
+        ``ret_valid`` for the cycle to come.
+    """
+
+    __slots__ = ("bit", "data", "phase", "seen")
+
+    def __init__(self) -> None:
+        self.reset()
+
+    def reset(self) -> None:
+        """Between telegrams, nothing seen."""
+        self.bit = -1
+        """The telegram's bit period now, -1 between telegrams."""
+        self.phase = 0
+        self.data = False
+        self.seen = 0
+
+    def clock(self, line: int, cpb: int) -> None:
+        """The clock edge ending a cycle with the synchronised DI3 at ``line``, ``cpb`` clocks per bit."""
+        seen = 0
+        if self.bit < 0 and line == wire.START_LEVEL:
+            self.bit, self.phase = 0, 0
+        if self.bit >= 0:
+            if self.phase == cpb // 2:
+                bit = self.bit
+                self.bit += 1
+                if bit == wire.POS_START and line != wire.START_LEVEL:
+                    self.bit = -1
+                elif bit == wire.POS_TYPE:
+                    self.data = line == wire.TYPE_DATA_LEVEL
+                elif bit == (wire.DATA_TELEGRAM_BITS if self.data else wire.STATUS_TELEGRAM_BITS) - 1:
+                    seen = int(not self.data and line == wire.IDLE_LEVEL)
+                    self.bit = -1
+            self.phase = 0 if self.phase >= cpb - 1 else self.phase + 1
+        self.seen = seen
+
+
+class BranchLines:
+    """A BK's branch data lines in the chip core (manual 2.4, Tables 2-7, 2-8, 2-9; BK-1, BK-37): DO3_CU (MFP9),
+    DI3 (MFP10) and the switch of DO2, for ``supi3.model.pins.Supi3Pins`` in the BK modes.
+
+    While the branch is in the data path (:func:`~supi3.terminal.enabled`: present by Table 2-9, switched on, not
+    closed) DO3 carries what the transmitter sends (the DO2 of a chip without branch) and DO2 repeats the
+    synchronised DI3, the branch's return line: the data path runs through the BK, its branch, then on along the
+    remote bus (BK-1's flattened order); the M5 loop-back takes this DO2. Otherwise DO3 idles and DO2 is the
+    transmitter's. ``connected`` (a device answers on the branch, BK-37) latches the first high level of the
+    synchronised DI3 at every clock edge where the core's logic runs (a device's idle return line, as M5 recognises
+    a following device on DI2); a power-up reset clears it.
+
+    The return line's strobes for the BK (``ret_valid``, ``cnt_valid``/``count`` of
+    :data:`~supi3.terminal.BLOCK_INPUTS`): a :class:`ReturnWatch` on the synchronised DI3 (BK-38) and, in BK-LBD, a
+    :class:`~supi3.model.blocks.counter.CounterBlock` whose ``seen`` and ``count`` give the BK its count (BK-39),
+    clocked where the core's logic runs and cleared by a power-up reset. The silence timer of the extended function
+    (BK-3, BK-20; :meth:`edge`) is :class:`TerminalBlock`'s. ``Supi3Pins.step`` clocks them each cycle; over a
+    ``run()`` the lines are clocked ahead over the run's DI3 (:meth:`plan`, again after each power-up reset), the run
+    visits the cycles with a strobe, a change of ``connected`` or LBST, or the silence running out
+    (:meth:`next_event`), and the timer catches up over the cycles between.
+
+    Parameters
+    ----------
+    rf:
+        The RF[1..0] straps (Table 2-2), ``None`` without RF pins.
+    cpb:
+        Clocks per bit.
+    lbd:
+        BK-LBD: the counter block on DI3.
+    time_limit:
+        The silence after which the extended function closes the branch, in clocks (BK-3; shorter only in tests).
+
+    Attributes
+    ----------
+    connected:
+        A device answered on the branch (for the cycle to come).
+    watch, counter:
+        The blocks on DI3 (``counter`` ``None`` but in BK-LBD).
+    timer:
+        Edges of silence counted up to cycle :attr:`timer_at` (BK-20).
+    """
+
+    __slots__ = (
+        "_c0", "_connected", "_events", "_lbst", "_line", "_opens", "_starts", "_strobes", "connected", "counter",
+        "counting", "cpb", "fast", "limit", "present", "timer", "timer_at", "watch",
+    )  # fmt: skip
+
+    def __init__(self, rf: str | None, cpb: int, lbd: bool, time_limit: int = BRANCH_SILENCE_CLOCKS) -> None:
+        self.present = np.array([[branch_present(rf, bool(lbst), bool(connected)) for connected in (0, 1)]
+                                 for lbst in (0, 1)])  # fmt: skip
+        """Table 2-9 by [LBST][connected] (:func:`~supi3.terminal.branch_present`)."""
+        self.cpb = cpb
+        self.fast = int(cpb == clocks_per_bit(1))
+        self.limit = silence_limit(time_limit)
+        self.connected = False
+        self.watch = ReturnWatch()
+        self.counter = CounterBlock() if lbd else None
+        self.timer = 0
+        self.timer_at = 0
+        self.counting = False
+        """The timer counts in the cycles from :attr:`timer_at` on (a run's view, until its next visit)."""
+        self._opens: list[tuple[int, bool]] = []
+        self._c0 = 0
+        self._line = np.zeros(0, dtype=np.int64)
+        self._starts: list[int] = []
+        self._lbst = np.zeros(0, dtype=np.int64)
+        self._connected = np.zeros(0, dtype=np.int64)
+        self._strobes = np.zeros((0, 3), dtype=np.int64)
+        self._events: list[int] = []
+
+    # One cycle --------------------------------------------------------------------------------------------------
+
+    def on(self, state: Terminal, lbst: int, connected: bool) -> bool:
+        """The branch is in the data path with the BK state ``state``, the synchronised LBST ``lbst`` and
+        ``connected`` (:func:`~supi3.terminal.enabled`)."""
+        return bool(self.present[lbst, int(connected)]) and _open(state)
+
+    def route(self, outputs: dict[str, int], state: Terminal, mfp_in: int, next_present: bool) -> None:
+        """Set ``do2``, ``mfp_out`` (DO3) and, when the chip loops back (M5: ``next_present`` false), ``di1`` of a
+        cycle in that cycle's ``outputs`` (``do2`` the transmitter's; ``mfp_in`` the synchronised MFP inputs)."""
+        sent = outputs["do2"]
+        if self.on(state, mfp_in >> LBST_PIN & 1, self.connected):
+            do2 = outputs["do2"] = mfp_in >> DI3_PIN & 1
+            if not next_present:
+                outputs["di1"] = do2
+            outputs["mfp_out"] |= sent << DO3_PIN
+        else:
+            outputs["mfp_out"] |= wire.IDLE_LEVEL << DO3_PIN
+
+    def strobes(self) -> tuple[int, int, int]:
+        """``ret_valid``, ``cnt_valid`` and ``count`` in the cycle to come (``Supi3Pins.step``)."""
+        counter = self.counter
+        if counter is None:
+            return self.watch.seen, 0, 0
+        return self.watch.seen, counter.seen, counter.state.counted
+
+    def clock(self, mfp_in: int) -> None:
+        """A clock edge where the core's logic runs, with the synchronised MFP inputs ``mfp_in``."""
+        di3 = mfp_in >> DI3_PIN & 1
+        self.connected = self.connected or bool(di3)
+        self._clock_blocks(di3)
+
+    def _clock_blocks(self, di3: int) -> None:
+        self.watch.clock(di3, self.cpb)
+        counter = self.counter
+        if counter is not None:
+            counter.clock(di3, self.fast)
+            counter.queue.clear()  # its line goes nowhere: the BK takes seen and count only
+
+    def power_up(self) -> None:
+        """The core's power-up reset: no device seen, the blocks on DI3 and the timer cleared."""
+        self.connected = False
+        self.watch.reset()
+        if self.counter is not None:
+            self.counter.reset()
+        self.timer, self.counting = 0, False
+
+    def quiet(self, c: int, state: Terminal, recording: bool) -> None:
+        """The BK's edge ending cycle ``c`` takes no strobe (its first running clock, an INTERBUS reset): the timer
+        starts from 0 (BK-20); ``state`` the BK state after it, ``recording`` in a run."""
+        self.timer, self.timer_at = 0, c + 1
+        self.counting = recording and self._counts(c + 1, state)
+
+    def edge(self, c: int, before: Terminal, after: Terminal, switched_on: bool, mfp_in: int,
+             recording: bool) -> tuple[Terminal, bool]:
+        """The BK's edge ending running cycle ``c`` after the core's (BK-20's order; the chip applied CONF and a
+        command there): ``before`` the state before the edge, ``after`` after the core's, ``switched_on`` a command
+        switched the branch on, ``mfp_in`` the synchronised MFP inputs; ``recording``: in a run (the strobes
+        planned). Returns the state after the master's telegram back, the counter telegram and the silence, and
+        whether the silence closed the branch."""
+        connected = bool(self._connected[c - self._c0]) if recording else self.connected
+        ret, cnt, count = self._strobes[c - self._c0].tolist() if recording else self.strobes()
+        if self.counting:  # the cycles between a run's visits
+            self.timer += c - self.timer_at
+        counting = before.extended and self.on(before, mfp_in >> LBST_PIN & 1, connected)
+        restart = bool(ret) or switched_on
+        expired = counting and not restart and self.timer + 1 >= self.limit
+        state = after
+        if ret:
+            state = received(state, 0)
+        if cnt:
+            state = received(state, count)
+        closes = expired and not (before.switched_on and not after.switched_on) and watching(state)
+        if closes:
+            state = silence(state)
+        self.timer = self.timer + 1 if counting and not restart and not expired else 0
+        self.timer_at = c + 1
+        self.counting = recording and self._counts(c + 1, state)
+        return state, closes
+
+    def _counts(self, c: int, state: Terminal) -> bool:
+        """The timer counts in a run's cycle ``c`` (and those after it until the next visit) with ``state``."""
+        t = c - self._c0
+        if not state.extended or t >= len(self._line):
+            return False
+        return self.on(state, int(self._lbst[t]), bool(self._connected[t]))
+
+    # A run ------------------------------------------------------------------------------------------------------
+
+    def begin(self, c0: int, run_from: int, state: Terminal, mfp_in: npt.NDArray[np.int64]) -> None:
+        """A run of ``Supi3Pins.run`` begins at cycle ``c0`` (the logic runs from ``run_from``, the BK state is
+        ``state``, ``mfp_in`` the run's synchronised MFP inputs): :meth:`record` follows the state, :meth:`render`
+        draws the lines; the lines on DI3 are planned over the run."""
+        self._opens = [(0, _open(state))]
+        self._c0 = c0
+        self._line = mfp_in >> DI3_PIN & 1
+        self._starts = np.flatnonzero(self._line == wire.START_LEVEL).tolist()
+        self._lbst = mfp_in >> LBST_PIN & 1
+        self._strobes = np.zeros((len(mfp_in), 3), dtype=np.int64)
+        self._connected = np.zeros(len(mfp_in), dtype=np.int64)
+        self.plan(c0, run_from)
+        counting = c0 >= run_from and self._counts(c0, state)
+        if counting and not self.counting:  # the timer stood at 0
+            self.timer, self.timer_at = 0, c0
+        self.counting = counting
+
+    def plan(self, c: int, run_from: int) -> None:
+        """Clock the lines on DI3 from cycle ``c`` to the run's end where the logic runs (from ``run_from``),
+        keeping their strobes and ``connected``: after :meth:`begin` and after each power-up reset (in cycle
+        ``c - 1``)."""
+        line, strobes, connected, c0 = self._line, self._strobes, self._connected, self._c0
+        t = min(c - c0, len(line))
+        first = max(t, run_from - c0) if run_from != NEVER else len(line)
+        strobes[t:first] = self.strobes()
+        connected[t:first] = self.connected
+        n, k = len(line), first
+        starts = self._starts
+        watch = self.watch
+        while k < n:
+            if self.counter is None and self.connected and watch.bit < 0 and not watch.seen and line[k]:
+                # An idle line between telegrams changes nothing until its next start level: skip to it.
+                s = bisect_left(starts, k)
+                end = starts[s] if s < len(starts) else n
+                strobes[k:end] = 0
+                connected[k:end] = 1
+                k = end
+                continue
+            strobes[k] = self.strobes()
+            connected[k] = self.connected
+            self.clock(int(line[k]) << DI3_PIN)
+            k += 1
+        rises = np.flatnonzero(np.diff(connected, prepend=connected[:1]) | np.diff(self._lbst, prepend=self._lbst[:1]))
+        self._events = sorted({*np.flatnonzero(strobes[:, 0] | strobes[:, 1]).tolist(), *rises.tolist()})
+
+    def next_event(self, t: int) -> int:
+        """The first cycle of the run after its cycle ``t`` that the BK must see: a strobe, a change of ``connected``
+        or LBST, the silence running out (the run's length if none)."""
+        k = bisect_right(self._events, t)
+        event = self._events[k] if k < len(self._events) else len(self._line)
+        if self.counting:
+            event = min(event, self.timer_at - self._c0 + self.limit - 1 - self.timer)
+        return max(event, t + 1)
+
+    def record(self, t: int, state: Terminal) -> None:
+        """The BK state from the run's cycle ``t`` on is ``state``."""
+        opened = _open(state)
+        if opened != self._opens[-1][1]:
+            self._opens.append((t, opened))
+
+    def render(self, traces: dict[str, npt.NDArray[np.int64]], mfp_in: npt.NDArray[np.int64]) -> None:
+        """:meth:`route` over the run begun by :meth:`begin`: ``traces`` the run's outputs (``do2`` the
+        transmitter's), ``mfp_in`` its synchronised MFP inputs; the timer catches up to the run's end."""
+        n = len(mfp_in)
+        if self.counting:
+            self.timer += self._c0 + n - self.timer_at
+            self.timer_at = self._c0 + n
+        starts = [t for t, _ in self._opens]
+        opens = np.repeat([o for _, o in self._opens], np.diff([*starts, n]).clip(min=0))
+        on = self.present[self._lbst, self._connected] & opens
+        sent = traces["do2"]
+        traces["mfp_out"] = traces["mfp_out"] | np.where(on, sent, wire.IDLE_LEVEL) << DO3_PIN
+        traces["do2"] = np.where(on, self._line, sent)
+
+
+def _open(state: Terminal) -> bool:
+    """The BK keeps its branch open: switched on and not closed by itself (:func:`~supi3.terminal.enabled` without
+    Table 2-9)."""
+    return state.switched_on and not state.closed

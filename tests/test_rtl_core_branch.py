@@ -1,0 +1,44 @@
+"""A bus terminal module's branch data lines in the RTL core (supi3.rtl.core.Supi3Core; manual 2.4, Tables 2-7,
+2-8, 2-9; BK-1, BK-37): the scenarios of tests/test_model_pins_branch.py (DI3 silent, then repeating the forward
+line; the branch switched off and on; LBST low for a data cycle; an INTERBUS reset) in lockstep with the pin-level
+model, every pin every clock: DO3 on MFP9, DO2 repeating DI3, the loop-back, `connected` from DI3; and in BK-LBD
+the count from counter telegrams on DI3, cleared by the master's telegrams back (the status byte, E); the extended
+function closing a branch silent for 10 ms.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from supi3.model.pins import Supi3Pins
+from supi3.terminal import BRANCH_SILENCE_CLOCKS
+from supi3.verif import Lockstep
+from test_model_pins_branch import CASES, COUNT_CASES, LD_PIN, count_scenario, scenario, silence_scenario
+
+
+@pytest.mark.parametrize(("interface", "rf", "seed"), CASES)
+def test_rtl_core_matches(bench: Lockstep, interface: str, rf: str, seed: int) -> None:
+    script, _ = scenario(interface, rf, seed)
+    bench.run_batch(script.stimulus())
+
+
+@pytest.mark.parametrize(("rf", "seed"), COUNT_CASES)
+def test_rtl_core_counts(bench: Lockstep, rf: str, seed: int) -> None:
+    """BK-LBD: the counter block on DI3 and the return watch give the BK its count and clear it (BK-38, BK-39)."""
+    script, _ = count_scenario(rf, seed)
+    bench.run_batch(script.stimulus())
+
+
+@pytest.mark.slow
+def test_rtl_core_closes_a_silent_branch(bench: Lockstep) -> None:
+    """BK-3 with its 10 ms (320,000 clocks): the extended function closes the silent branch in the RTL core at the
+    model's clock (LD, ATTN, the status byte's bit 6), and the master's command reopens it."""
+    script, silent = silence_scenario(BRANCH_SILENCE_CLOCKS // 2000 + 3, 8)
+    bench.run_batch(script.stimulus())
+    out = Supi3Pins(script.config).run(script.columns())
+    assert (out["mfp_out"][silent + BRANCH_SILENCE_CLOCKS + 100 :] >> LD_PIN & 1).any()
+
+
+@pytest.fixture(scope="session")
+def bench(core_bench: Lockstep) -> Lockstep:
+    return core_bench  # tests/conftest.py: one build, shared with tests/test_rtl_core.py
