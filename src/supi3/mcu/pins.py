@@ -229,7 +229,8 @@ class LockstepRing(PinRing):
 
     def sync(self, clock: int, *, until_edge: bool = False) -> int:
         """Run the chip until it has clocked ``clock`` cycles (``until_edge``: or until /IRQ or /ModAck changed, clock
-        by clock); return the clocks run so far. The line idles high once the samples queued are used up."""
+        by clock or, from :data:`LOOK_AHEAD_FROM` clocks, found on a copy of the chip: MCU-21); return the clocks run
+        so far. The line idles high once the samples queued are used up."""
         log = self.chip.core.chip.registers
         assert log is not None
         violations = log.violations
