@@ -240,3 +240,29 @@ def test_digital_io_with_a_3_mhz_sclk_at_2_mbit_s_reaches_the_latch_phase(tmp_pa
         isr = next(frame for frame in where.backtrace if frame.function == "fw_isr")
         assert isr.source is not None and isr.source.file == "digital_io.c" and isr.source.line in accesses
         assert "during the latch phase" in str(where) and "fw_isr() digital_io.c:" in str(where)
+
+
+FINGERPRINTS = {
+    2_000_000: (761_182, 56_211, 33, [(t, "board_xfer") for t in (14_123_958, 14_867_958, 15_611_958)]),
+    500_000: (2_969_198, 110_250, 30, []),
+}
+"""MCU-21: power-up and 30 data cycles of bench/bench_mcu.py's cases, as measured before the round-4 speed work (the
+core's cycles, instructions, EXTI0 entries, each violation's time in ns and function); pinned to the firmware the
+ziglang of the lock builds (a toolchain or board port change re-measures them with ``Board.run``)."""
+
+
+@pytest.mark.parametrize("bit_rate", list(FINGERPRINTS))
+def test_the_bench_cases_keep_their_fingerprint(digital_io: dict[str, Path], tmp_path: Path, bit_rate: int) -> None:
+    """The speed work changes nothing the firmware or the master sees: the same cycles, instructions, interrupts,
+    violations (time, function) and process data as before it, at both bit rates of the bench."""
+    elf = digital_io["cortex_m3"] if bit_rate == 500_000 else mcu_build.build(
+        native.example("digital_io"), tmp_path / "br3.elf", defines={"BOARD_SPI_BR": "3u"})  # fmt: skip
+    board = Board(elf, bit_rate=bit_rate, strict=False)
+    board.run(3)
+    board.bench.master.set_outputs(1, b"\x12\x34")
+    assert board.fw_board is not None
+    board.fw_board.inputs = b"\xab\xcd"
+    board.run(30)
+    violations = [(round(v.time_s * 1e9), v.function) for v in board.violations]
+    assert (board.core.cycles, board.core.instructions, board.interrupts, violations) == FINGERPRINTS[bit_rate]
+    assert (board.fw_board.outputs, board.bench.master.inputs(1)) == (b"\x12\x34\0\0", b"\xab\xcd")

@@ -17,6 +17,7 @@ from supi3.errors import ArgumentError
 from supi3.interbus.device import PlainDevice
 from supi3.mcu import board as mcu_board
 from supi3.mcu import build as mcu_build
+from supi3.mcu import pins as mcu_pins
 from supi3.mcu.board import Board, BoardError
 from supi3.mcu.core import CPUS
 from supi3.mcu.pins import MISO_PULL_UP, Cause, LockstepRing, mcu_lines
@@ -208,3 +209,24 @@ def test_the_intel_boards_s_r_pin_is_board_h_s() -> None:
     """The emulator's S/R wiring (MCU-18) is the board port's: PB0, board.h BOARD_PIN_SR."""
     text = (mcu_build.BOARD_DIR / "board.h").read_text()
     assert re.search(rf"#define BOARD_PIN_SR {mcu_board.PIN_SR}u /\* on port B", text)
+
+
+def _pin_fingerprint(elf: Path) -> tuple[object, ...]:
+    """Power-up and one data cycle at pin level, recorded: the core's cycles, instructions, interrupts and /IRQ
+    latency, the violations (time, PC, rule), the firmware's outputs, the master's inputs, every chip pin."""
+    board = Board(elf, fidelity="pin", strict=False, record=True)
+    board.run(3)
+    assert board.fw_board is not None
+    traces = board.ring.recorded()[0]
+    return (board.core.cycles, board.core.instructions, board.interrupts, board.irq_latency_s,
+            [(v.time_s, v.pc, v.error.rule) for v in board.violations], board.fw_board.outputs,
+            board.master.inputs(1), {name: trace.tolist() for name, trace in traces.items()})  # fmt: skip
+
+
+@pytest.mark.slow
+def test_the_look_ahead_to_an_edge_changes_nothing(digital_io: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """MCU-21: a sleeping core's wait for /IRQ run to the edge in one piece (found on a copy of the chip) gives the
+    same core, violations, process data and chip pins, clock for clock, as the chip stepped clock by clock."""
+    ahead = _pin_fingerprint(digital_io)
+    monkeypatch.setattr(mcu_pins, "LOOK_AHEAD_FROM", 1 << 62)
+    assert _pin_fingerprint(digital_io) == ahead

@@ -18,7 +18,7 @@ import struct
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Final
+from typing import Final, TypeVar
 
 from supi3 import timing
 from supi3.checks import check_bool, check_bytes, check_choice, check_instance, check_int, check_real, fail
@@ -101,6 +101,10 @@ or after this much bus time of idle status telegrams, whichever comes first."""
 SERVE_TELEGRAMS: Final[int] = 64
 """MCU-17: at pin level, after its last master cycle :meth:`Board.run` idles the line up to this many status
 telegrams while the firmware is still in a handler or has an /IRQ edge to serve."""
+
+
+_T = TypeVar("_T")
+_R = TypeVar("_R")
 
 
 class BoardError(Supi3Error, RuntimeError):
@@ -285,6 +289,8 @@ class Board:
         self._limits = {symbol: timing.limit("3-7", symbol, bit_rate) for symbol in ("t0", "t1", "t2", "t8")}
         self._limits["t6max"] = timing.limit("3-7", "t6", bit_rate, maximum=True)
         self._limits["t_SAS_INIT"] = timing.limit("3-7", "t_SAS_INIT", bit_rate)
+        self._least = {symbol: self._cycles(limit) for symbol, limit in self._limits.items()}  # in core cycles
+        self._least["t8"] = self._cycles(self._limits["t6max"] + self._limits["t8"])  # after /SS rises
         self.rcc = Rcc()
         self.exti = Exti(self.rcc)
         self.gpio = Gpio(self.rcc, IOPAEN, "GPIOA", self._inputs, self._on_output, PULL_UPS)
@@ -427,7 +433,9 @@ class Board:
     # -- /IRQ, EXTI0 and the NVIC ------------------------------------------------------------------------------
 
     def _follow_irq(self, cycles: int, event: int | None = None) -> None:
-        pulse = self.bench.chip.mod_ack_until
+        bench = self._bench
+        assert bench is not None
+        pulse = bench.chip.mod_ack_until
         if pulse != self._mod_ack_until:  # a new /ModAck pulse (375 ns, 3.6.2): both edges, the falling one latched
             self._mod_ack_until = pulse
             self.exti.edge(PORT_B, PIN_MODACK, 0)
@@ -461,7 +469,7 @@ class Board:
             ring.sync_to_core(self.core.cycles_now())
             return ring.irq_n << PIN_IRQ | ring.c_d << PIN_CD | ring.io << PIN_IO
         cycles = self._now()
-        cd = self.protocol.c_d if cycles >= self._ss_rise + self._cycles(self._limits["t6max"]) else self._cd_before
+        cd = self.protocol.c_d if cycles >= self._ss_rise + self._least["t6max"] else self._cd_before
         return self.registers.irq_n << PIN_IRQ | cd << PIN_CD | int(self.registers.io_access) << PIN_IO
 
     def _inputs_b(self) -> int:
@@ -499,12 +507,12 @@ class Board:
         elif pin == PIN_SAS_INIT:
             if level:
                 self._sas_rise = cycles
-            elif cycles - self._sas_rise < self._cycles(self._limits["t_SAS_INIT"]):
+            elif cycles - self._sas_rise < self._least["t_SAS_INIT"]:
                 self._violation("Table 3-7 t_SAS_INIT", f"SAS_INIT pulse of {self._ns(cycles - self._sas_rise)} ns, "
                                 f"shorter than {self._limits['t_SAS_INIT'] * 1e9:.0f} ns")  # fmt: skip
-            self._chip(lambda: self.bench.transport.set_sas_init(level), cycles)
+            self._chip(self.bench.transport.set_sas_init, cycles, level)
         elif pin == PIN_STAT_ERR:
-            self._chip(lambda: self.bench.set_stat_err(not level), cycles)
+            self._chip(self.bench.set_stat_err, cycles, not level)
 
     def _ns(self, cycles: int) -> str:
         return f"{self._seconds(cycles) * 1e9:.0f}"
@@ -512,17 +520,12 @@ class Board:
     def _ss_edge(self, level: int, cycles: int) -> None:
         if not level:
             gap = cycles - self._ss_rise
-            need = self._limits["t6max"] + self._limits["t8"]
-            if gap < self._cycles(need):
+            if gap < self._least["t8"]:
+                need = self._limits["t6max"] + self._limits["t8"]
                 self._violation("Table 3-7 t8", f"/SS fell {self._ns(gap)} ns after it rose: C/D settles t6 "
                                 f"(max) + t8 = {need * 1e9:.0f} ns after the rise")  # fmt: skip
-            driven: list[int | None] = [None]
-
-            def begin() -> None:
-                driven[0] = self.protocol.begin(bool(self._s_r) if self.intel else True)
-
-            self._chip(begin, cycles)
-            self._frame = _Frame(cycles, driven[0], [])
+            driven = self._chip(self.protocol.begin, cycles, bool(self._s_r) if self.intel else True)
+            self._frame = _Frame(cycles, driven, [])
             return
         frame, self._frame = self._frame, None
         if frame is None:
@@ -533,14 +536,14 @@ class Board:
         if edges == 8:
             tx, bits, start, period = frame.transfers[-1]
             last = start + bits * period
-            if cycles - last < self._cycles(self._limits["t2"]):
+            if cycles - last < self._least["t2"]:
                 self._violation("Table 3-7 t2", f"/SS rose {self._ns(cycles - last)} ns after the last SCLK edge, "
                                 f"less than t2 = {self._limits['t2'] * 1e9:.0f} ns")  # fmt: skip
             # An Intel receive frame: the chip's driver wins on Ser_IN/OUT, it takes its own byte (MCU-18).
             on_line = frame.driven if self.intel and frame.driven is not None else tx
-            self._chip(lambda: self.protocol.end(on_line), cycles)
+            self._chip(self.protocol.end, cycles, on_line)
         else:
-            self._chip(lambda: self.protocol.abort(edges), cycles)
+            self._chip(self.protocol.abort, cycles, edges)
 
     def spi_byte(self, tx: int, bits: int, start: int, period: int, cr1: int) -> int:
         """:class:`~supi3.mcu.stm32.SpiWire`: SPI1 starts a transfer; the chip sees it inside its /SS frame."""
@@ -559,7 +562,7 @@ class Board:
         lsb = bool(cr1 & CR1_LSBFIRST)
         reverse = lsb != (self.protocol.mode is Mode.INTEL)  # the chip shifts LSB first in Intel mode (UP-6)
         seen = _reverse(tx & 0xFF) if reverse else tx & 0xFF
-        if not frame.transfers and start + period // 2 - frame.fall < self._cycles(self._limits["t1"]):
+        if not frame.transfers and start + period // 2 - frame.fall < self._least["t1"]:
             self._violation("Table 3-7 t1", f"first SCLK edge {self._ns(start + period // 2 - frame.fall)} ns after "
                             f"/SS fell, less than t1 = {self._limits['t1'] * 1e9:.0f} ns")  # fmt: skip
         frame.transfers.append((seen, bits, start, period))
@@ -568,20 +571,21 @@ class Board:
 
     # -- the chip and its violations ---------------------------------------------------------------------------
 
-    def _chip(self, action: Callable[[], object], cycles: int) -> None:
-        """Do ``action`` on the chip with its violations deferred to its end; note the new ones with the PC."""
+    def _chip(self, action: Callable[[_T], _R], cycles: int, argument: _T) -> _R:
+        """``action(argument)`` on the chip with its violations deferred to its end; note the new ones with the PC."""
         log = self.registers.violations
-        before = len(log.records)
+        records = log.records
+        before = len(records)
         try:
             with log.deferred():
-                action()
+                return action(argument)
         finally:
-            self._note(log.records[before:], cycles)
+            if len(records) > before:
+                self._note(records[before:], cycles)
             self._follow_irq(cycles)
 
     def _violation(self, rule: str, detail: str) -> None:
-        self._chip(lambda: self.registers.violations.report(InterfaceViolationError(rule, detail)),
-                   self.core.cycles_now())  # fmt: skip
+        self._chip(self.registers.violations.report, self.core.cycles_now(), InterfaceViolationError(rule, detail))
 
     def _note(self, errors: list[InterfaceViolationError], cycles: int) -> None:
         for error in errors:

@@ -16,7 +16,9 @@ that broke the rule (:class:`Cause`).
 
 from __future__ import annotations
 
+import copy
 import heapq
+import itertools
 import math
 from collections import deque
 from collections.abc import Callable
@@ -69,6 +71,10 @@ INTEL_LINES: Final[dict[str, tuple[str, int, int | None]]] = {
 the resistor), S/R from PB0 to MFP7."""
 _WATCHED: Final[tuple[str, ...]] = ("di1", "mfp_out", "mfp_oe", "mod_ack_n")
 """The outputs the board reads: the return line, the µP interface's pins, /ModAck."""
+LOOK_AHEAD_FROM: Final[int] = 256
+"""MCU-21: a sleeping core's wait for /IRQ or /ModAck of at least this many chip clocks is looked ahead on a copy of
+the chip (:meth:`LockstepRing.sync` with ``until_edge``); a shorter one is stepped clock by clock. The copy costs
+about as much as 60 clock steps, each run of the chip in one piece about as much as :data:`~supi3.top.STEP_BELOW`."""
 RECENT: Final[int] = 256
 """Pin changes kept to name the cause of a violation the chip finds later."""
 
@@ -223,7 +229,8 @@ class LockstepRing(PinRing):
 
     def sync(self, clock: int, *, until_edge: bool = False) -> int:
         """Run the chip until it has clocked ``clock`` cycles (``until_edge``: or until /IRQ or /ModAck changed, clock
-        by clock); return the clocks run so far. The line idles high once the samples queued are used up."""
+        by clock or, from :data:`LOOK_AHEAD_FROM` clocks, found on a copy of the chip: MCU-21); return the clocks run
+        so far. The line idles high once the samples queued are used up."""
         log = self.chip.core.chip.registers
         assert log is not None
         violations = log.violations
@@ -259,13 +266,17 @@ class LockstepRing(PinRing):
         self.on_violation(error, start, cause)
 
     def _clock(self, n: int, until_edge: bool) -> bool:
-        """Run ``n`` clocks with the inputs held (but ``do1``); whether it stopped early at an edge."""
+        """Run ``n`` clocks with the inputs held (but ``do1``); whether it stopped early at an edge. A long wait for
+        an edge (from :data:`LOOK_AHEAD_FROM` clocks) runs to it in one piece (:meth:`_edge_ahead`, MCU-21)."""
         chip, line, idle = self.chip, self._line, self.inputs["do1"]
         start = self.cycle
+        edge = False
+        if until_edge and n >= LOOK_AHEAD_FROM:
+            n, edge = self._edge_ahead(n)
+            until_edge = False
         if n < STEP_BELOW or until_edge:
             row = dict(self.inputs)
             do1, outs = [], []
-            edge = False
             irq_n, mod_ack_n = self.irq_n, self.mod_ack_n
             for _ in range(n):
                 row["do1"] = level = line.popleft() if line else idle
@@ -281,13 +292,29 @@ class LockstepRing(PinRing):
             if self.record:
                 traces.update({name: np.full(len(do1), row[name], dtype=np.int64) for name in row if name != "do1"})
         else:
-            edge = False
-            traces = {name: np.full(n, level, dtype=np.int64) for name, level in self.inputs.items()}
-            taken = [line.popleft() for _ in range(min(n, len(line)))]
-            traces["do1"][: len(taken)] = taken
+            traces = self._held(n, [line.popleft() for _ in range(min(n, len(line)))])
             traces.update(chip.run(traces))
         self._after(start, traces)
         return edge
+
+    def _held(self, n: int, line: list[int]) -> dict[str, npt.NDArray[np.int64]]:
+        """The input traces of ``n`` clocks with the inputs held, ``do1`` from ``line`` then idle."""
+        traces = {name: np.full(n, level, dtype=np.int64) for name, level in self.inputs.items()}
+        traces["do1"][: len(line)] = line
+        return traces
+
+    def _edge_ahead(self, n: int) -> tuple[int, bool]:
+        """MCU-21: of the next ``n`` clocks (the inputs held), those up to and with the first in which /IRQ or
+        /ModAck changes, and whether one does: found on a copy of the chip run through them in one piece
+        (:meth:`Supi3Chip.run` visits only the cycles where something is due; the same outputs as clock by clock),
+        so the chip itself then runs to the edge in one piece too instead of clock by clock."""
+        log = self.chip.core.chip.registers
+        assert log is not None
+        probe = copy.deepcopy(self.chip, {id(log.violations.records): []})  # the copy's findings are not kept
+        out = probe.run(self._held(n, list(itertools.islice(self._line, n))))
+        changed = ((out["mfp_out"] >> IRQ_BIT & 1) != self.irq_n) | (out["mod_ack_n"] != self.mod_ack_n)
+        edges = np.flatnonzero(changed)
+        return (n, False) if not len(edges) else (int(edges[0]) + 1, True)
 
     def _after(self, start: int, traces: dict[str, npt.NDArray[np.int64]]) -> None:
         n = len(traces["do1"])
