@@ -248,7 +248,8 @@ FINGERPRINTS = {
 }
 """MCU-21: power-up and 30 data cycles of bench/bench_mcu.py's cases, as measured before the round-4 speed work (the
 core's cycles, instructions, EXTI0 entries, each violation's time in ns and function); pinned to the firmware the
-ziglang of the lock builds (a toolchain or board port change re-measures them with ``Board.run``)."""
+ziglang pinned in pyproject.toml's firmware extra builds (a toolchain or board port change re-measures them with
+``Board.run``)."""
 
 
 @pytest.mark.parametrize("bit_rate", list(FINGERPRINTS))
