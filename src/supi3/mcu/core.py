@@ -676,6 +676,8 @@ class CortexM:
 
     def read_bytes(self, address: int, size: int) -> bytes:
         """Memory as the core sees it (RAM, flash); an :class:`ArgumentError` if any of it is not mapped."""
+        check_int("address", address, 0, 0xFFFF_FFFF, "the 32-bit address space")
+        check_int("size", size, 0, limit="bytes")
         try:
             return bytes(self.uc.mem_read(address, size))
         except UcError:
@@ -683,6 +685,7 @@ class CortexM:
 
     def write_bytes(self, address: int, data: bytes) -> None:
         """Write memory (RAM) from the host, between runs; an :class:`ArgumentError` if any of it is not mapped."""
+        check_int("address", address, 0, 0xFFFF_FFFF, "the 32-bit address space")
         try:
             self.uc.mem_write(address, check_bytes("data", data))
         except UcError:
@@ -793,7 +796,7 @@ class CortexM:
 
     def pend(self, number: int) -> None:
         """Make exception ``number`` pending (an external interrupt: ``EXTERNAL + irq``)."""
-        self.pending.add(check_int("number", number, 2, MAX_EXCEPTION, "B1.5.2: NMI (2) up to the last interrupt"))
+        self.pending.add(_exception_number(number))
         self.sleeping = False if self._takeable() is not None else self.sleeping
 
     @property
@@ -813,6 +816,7 @@ class CortexM:
         with CONTROL.SPSEL = 1), aligned to 8 bytes (B1.5.7), LR = EXC_RETURN, CONTROL.SPSEL = 0 (the handler runs
         on the main stack), IPSR = ``number``, PC = its vector; costs :attr:`Cpu.entry_cycles`. Returns the
         frame's address."""
+        _exception_number(number)
         uc = self.uc
         handler_mode = bool(self.active)
         control = self._read(arm.UC_ARM_REG_CONTROL)
@@ -1158,6 +1162,11 @@ def _nothing(number: int) -> None:
 
 def _name(number: int) -> str:
     return EXCEPTION_NAMES.get(number, f"IRQ {number - EXTERNAL}")
+
+
+def _exception_number(number: object) -> int:
+    """``number`` checked as an exception that can be pended or entered: NMI (2) up to the last interrupt."""
+    return check_int("number", number, 2, MAX_EXCEPTION, "B1.5.2: NMI (2) up to the last interrupt")
 
 
 class SysTick:
