@@ -633,6 +633,8 @@ class Board:
             for bound in (tick, end):
                 if bound is not None:
                     deadline = min(deadline, bound)
+            if not core.sleeping:  # within the budget: an instruction costs a cycle at least (MCU-1)
+                deadline = min(deadline, core.cycles + self._limit - core.instructions)
             self._step(deadline)
             self.sync(core.cycles, event if event <= core.cycles else None)
 
