@@ -13,20 +13,22 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 from amaranth.hdl import Fragment
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from supi3.config import decode
 from supi3.diagnostics import LedInputs, diagnostic_outputs, remote_bus_disabled
 from supi3.errors import ArgumentError
+from supi3.interbus import wire
 from supi3.interbus.ring import Branch, BranchKind, Ring
+from supi3.interbus.wire import BranchControl
 from supi3.model.blocks.terminal import BranchLines
 from supi3.model.chip import ChipArgumentError, Supi3
 from supi3.model.pins import Supi3Pins
 from supi3.rtl.counter import CounterLinesRtl
 from supi3.rtl.terminal import ReturnWatchRtl
-from supi3.terminal import BRANCH_SILENCE_CLOCKS
-from support import Columns, bad, quiet_inputs, terminal
+from supi3.terminal import BRANCH_SILENCE_CLOCKS, CONF_PIN, DI3_PIN, LBST_PIN, Terminal
+from support import BK_STRAPS, Columns, CoreScript, bad, quiet_inputs, terminal
 
 NOT_BOOLS: list[object] = [0, 1, None, "yes", 1.0, np.int64(1)]
 """Values a bool parameter must refuse: ``0``/``1`` are not a guess at False/True."""
@@ -87,8 +89,9 @@ def test_a_missing_following_is_a_type_error_not_a_default() -> None:
 def test_a_refused_call_changes_nothing() -> None:
     chip = Supi3(_CHIP)
     before = (chip.following, chip.revision, chip.line_silent)
-    for call in (lambda: chip.set_following(1), lambda: chip.line_timeout_at(10, "no"),  # type: ignore[arg-type]
-                 lambda: chip.line_timeout(-1.0), lambda: chip.line_timeout(1.0, None)):  # type: ignore[arg-type]
+    calls: list[Callable[[], None]] = [lambda: chip.set_following(bad(1)), lambda: chip.line_timeout_at(10, bad("no")),
+                                       lambda: chip.line_timeout(-1.0), lambda: chip.line_timeout(1.0, bad(None))]
+    for call in calls:
         with pytest.raises(ChipArgumentError):
             call()
     assert (chip.following, chip.revision, chip.line_silent) == before
@@ -125,9 +128,9 @@ def test_the_ring_lights_rd_on_the_last_of_the_ring_and_of_each_branch(shape: st
         expected.update({d: j == len(devices) - 1 for j, d in enumerate(devices)})
     if not items:
         with pytest.raises(ArgumentError):
-            Ring(items)  # type: ignore[arg-type]
+            Ring(items)
         return
-    Ring(items)  # type: ignore[arg-type]
+    Ring(items)
     assert {chip: chip.diagnostic_outputs.rd for chip in expected} == expected
     assert all(chip.following is not rd for chip, rd in expected.items())
     for chip in expected:  # what the chip's own life does (power-up, resets, time-outs) keeps the wiring
@@ -190,3 +193,87 @@ def test_rd_is_not_following_over_any_history(rf: str, segments: list[tuple[str,
     assert np.array_equal(rd, np.logical_not(recognised[:-1]).astype(np.int64)), (segments,)
     assert bulk.chip.following == stepped.chip.following
     assert bulk.chip.diagnostic_outputs.rd == (not bulk.chip.following)
+
+
+# -- a BK's branch over any history ---------------------------------------------------------------------------------
+
+LBST, CONF = 1 << LBST_PIN, 1 << CONF_PIN
+LD_PIN, E_PIN = 14, 13  # Table 2-8: LBDA ("local bus disabled"), ERROR
+SILENCE = 1500
+"""The branch silence limit in clocks for these histories (BK-3's 10 ms is 320,000; ``branch_silence``)."""
+BRANCH_DELAY = 37
+"""Clocks from DO3 back to DI3 through the branch (any will do: DI3 is stimulus)."""
+
+_BK_EVENT = st.one_of(
+    st.tuples(st.just("command"), st.sampled_from(list(BranchControl)), st.booleans()),
+    st.tuples(st.just("data"), st.integers(1, 3), st.booleans()),
+    st.tuples(st.just("conf"), st.booleans(), st.booleans()),
+)
+"""A latched command (branch control, acknowledge), data cycles with DI3 repeating or silent, CONF set or cleared."""
+
+
+def _bk_history(events: list[tuple[str, object, bool]], seed: int) -> Columns:
+    script = CoreScript(decode(BK_STRAPS["BK-LB"], rf="10", clk_conf="11"), np.random.default_rng(seed))
+    mfp = LBST
+    script.pins["mfp_in"] = mfp
+    script.bring_up()
+    silent: list[tuple[int, int]] = []
+    for kind, value, flag in events:
+        start = len(script.columns()["do1"])
+        if kind == "command":
+            assert isinstance(value, BranchControl)
+            script.id_cycle(wire.command_word(branch=value, quit_peripheral_error=flag), mfp_in=mfp)
+        elif kind == "data":
+            assert isinstance(value, int)
+            for _ in range(value):
+                script.data_cycle(mfp_in=mfp)
+            if flag:
+                silent.append((start, len(script.columns()["do1"])))
+        else:
+            mfp = mfp | CONF if value else mfp & ~CONF
+            script.pins["mfp_in"] = mfp
+            script.strobe(mfp_in=mfp)
+    columns = script.inputs()
+    n = len(columns["do1"])
+    di3 = np.ones(n, dtype=np.int64)
+    di3[BRANCH_DELAY:] = columns["do1"][: n - BRANCH_DELAY]
+    for a, b in silent:
+        di3[a:b] = wire.IDLE_LEVEL
+    columns["mfp_in"] = columns["mfp_in"] & ~(1 << DI3_PIN) | di3 << DI3_PIN
+    return columns
+
+
+@pytest.mark.slow  # about 6 s: every clock stepped
+@settings(max_examples=4)
+@example(events=[("command", BranchControl.ON_EXTENDED, False), ("data", 3, True), ("conf", True, False),
+                 ("command", BranchControl.ON, True)], seed=1, cuts=[0.5])  # closed by the silence, then reopened
+@given(events=st.lists(_BK_EVENT, min_size=1, max_size=6), seed=st.integers(0, 9),
+       cuts=st.lists(st.floats(0.05, 0.95), max_size=2))  # fmt: skip
+def test_the_bk_state_and_its_leds_agree_over_any_history(events: list[tuple[str, object, bool]], seed: int,
+                                                          cuts: list[float]) -> None:  # fmt: skip
+    # Any sequence of branch commands (on, off, on with the extended function, none; acknowledged or not), CONF
+    # edges and DI3 silences (some longer than the short limit: the extended function closes the branch, BK-3):
+    # step() == run() cycle for cycle; in every cycle LD and E on the pins are those of the BK state held after the
+    # previous edge (BK-11), and run() ends in the same state as step().
+    columns = _bk_history(events, seed)
+    config = decode(BK_STRAPS["BK-LB"], rf="10", clk_conf="11")
+    stepped, bulk = Supi3Pins(config, branch_silence=SILENCE), Supi3Pins(config, branch_silence=SILENCE)
+    def state() -> Terminal:  # a power-up makes the chip's BK anew
+        assert stepped.chip.bus_terminal is not None
+        return stepped.chip.bus_terminal.state
+
+    names, n = list(columns), len(columns["do1"])
+    rows, states = [], [state()]
+    for values in zip(*(columns[name].tolist() for name in names), strict=True):
+        rows.append(stepped.step(dict(zip(names, values, strict=True))))
+        states.append(state())
+    bounds = sorted({0, n, *(int(n * cut) for cut in cuts)})
+    pieces = [bulk.run({k: v[a:b] for k, v in columns.items()}) for a, b in itertools.pairwise(bounds)]
+    for name in rows[0]:
+        got = np.concatenate([piece[name] for piece in pieces])
+        want = np.array([row[name] for row in rows])
+        assert np.array_equal(got, want), (name, np.flatnonzero(got != want)[:3], events)
+    mfp_out = np.array([row["mfp_out"] for row in rows])
+    assert np.array_equal(mfp_out >> LD_PIN & 1, [int(s.ld) for s in states[:-1]]), events
+    assert np.array_equal(mfp_out >> E_PIN & 1, [int(s.e) for s in states[:-1]]), events
+    assert bulk.chip.bus_terminal is not None and bulk.chip.bus_terminal.state == state()
