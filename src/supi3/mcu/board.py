@@ -17,6 +17,7 @@ import math
 import struct
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from os import PathLike
 from pathlib import Path
 from typing import Final
 
@@ -374,14 +375,21 @@ class Board:
         Raises
         ------
         BoardError
-            The board is not a pin-level one made with ``record=True``.
+            The board is not a pin-level one made with ``record=True``, or it has not run yet.
+        ArgumentError
+            ``path`` is not a path.
         OSError
             The file cannot be written.
         """
+        if not isinstance(path, str | PathLike):
+            raise fail("path", "a file path (str or os.PathLike)", path)
         ring = self.ring
         if not ring.record:
             raise BoardError("Board.write_vcd needs a board made with record=True")
-        return write_vcd(Path(path), ring, {"mcu": mcu_lines(ring.recorded()[0], intel=self.intel)})
+        traces = ring.recorded()[0]
+        if not traces:
+            raise BoardError("Board.write_vcd has nothing to write: the board has not run yet")
+        return write_vcd(Path(path), ring, {"mcu": mcu_lines(traces, intel=self.intel)})
 
     def _cause(self) -> Cause:
         core = self.core
