@@ -375,7 +375,7 @@ class Board:
         Raises
         ------
         BoardError
-            The board is not a pin-level one made with ``record=True``, or it has not run yet.
+            The board is not a pin-level one made with ``record=True``.
         ArgumentError
             ``path`` is not a path.
         OSError
@@ -386,10 +386,8 @@ class Board:
         ring = self.ring
         if not ring.record:
             raise BoardError("Board.write_vcd needs a board made with record=True")
-        traces = ring.recorded()[0]
-        if not traces:
-            raise BoardError("Board.write_vcd has nothing to write: the board has not run yet")
-        return write_vcd(Path(path), ring, {"mcu": mcu_lines(traces, intel=self.intel)})
+        traces = ring.recorded()[0]  # none yet if the firmware stopped before the chip's first clock: no samples
+        return write_vcd(Path(path), ring, {"mcu": mcu_lines(traces, intel=self.intel)} if traces else None)
 
     def _cause(self) -> Cause:
         core = self.core
@@ -641,8 +639,6 @@ class Board:
             for bound in (tick, end):
                 if bound is not None:
                     deadline = min(deadline, bound)
-            if not core.sleeping:  # within the budget: an instruction costs a cycle at least (MCU-1)
-                deadline = min(deadline, core.cycles + self._limit - core.instructions)
             self._step(deadline)
             self.sync(core.cycles, event if event <= core.cycles else None)
 
@@ -656,6 +652,8 @@ class Board:
         if core.instructions >= self._limit:
             raise FirmwareStoppedError(core.report(Stop.BUDGET, f"instruction budget of {self._budget} used up "
                                                    "(an endless loop?)"))  # fmt: skip
+        if not core.sleeping:  # within the budget: an instruction costs a cycle at least (MCU-1)
+            deadline = min(deadline, core.cycles + self._limit - core.instructions)
         try:
             state = core.step(max(deadline, core.cycles + 1))
         except InterfaceViolationError as error:

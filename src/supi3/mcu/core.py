@@ -677,7 +677,7 @@ class CortexM:
     def read_bytes(self, address: int, size: int) -> bytes:
         """Memory as the core sees it (RAM, flash); an :class:`ArgumentError` if any of it is not mapped."""
         check_int("address", address, 0, 0xFFFF_FFFF, "the 32-bit address space")
-        check_int("size", size, 0, limit="bytes")
+        check_int("size", size, 0, max(self.flash[1], self.ram[1]), "bytes: no more than the larger memory")
         try:
             return bytes(self.uc.mem_read(address, size))
         except UcError:
