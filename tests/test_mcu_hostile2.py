@@ -10,6 +10,7 @@ import re
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 pytest.importorskip("unicorn")
@@ -22,6 +23,7 @@ from supi3.cli import main
 from supi3.errors import ArgumentError
 from supi3.mcu.board import Board, BoardError
 from supi3.mcu.core import CortexM
+from supi3.mcu.pins import mcu_lines
 from supi3.mcu.session import run_firmware
 from supi3.spi.upif import Mode
 from support import bad
@@ -30,6 +32,8 @@ from test_mcu_hostile import FILES, RAM_TOP, firmware
 NOP_LOOP = b"\x00\xbf\xfd\xe7"
 """nop; b.n back to the nop: a runaway the idle-loop rule (MCU-4) does not take for a wait."""
 RAM = 0x2000_0000
+TRACES = ["mfp_in", "mfp_out", "mfp_oe", "mod_ack_n", "stat_err_n"]
+"""The pin traces the MCU's lines come from."""
 
 
 @pytest.fixture(scope="module")
@@ -71,6 +75,9 @@ CASES: list[Case] = [
     ("Board(pin, strict=1)", lambda d: Board(d / "loop.elf", fidelity="pin", strict=bad(1)), "strict"),
     *((f"write_vcd({v!r})", lambda d, v=v: Board(d / "loop.elf", fidelity="pin", record=True).write_vcd(bad(v)),
        "path") for v in [None, 3, b"x.vcd"]),
+    # mcu_lines took what it was given: KeyError 'mfp_out', "'NoneType' object is not subscriptable"
+    *((f"mcu_lines({v!r})", lambda _d, v=v: mcu_lines(bad(v)), "traces") for v in [{}, {"mfp_out": 0}, None, "x"]),
+    ("mcu_lines(intel=1)", lambda _d: mcu_lines({k: np.zeros(2, np.int64) for k in TRACES}, intel=bad(1)), "intel"),
     ("run_firmware(vcd=) at transaction level", lambda d: run_firmware(d / "loop.elf", vcd=d / "x.vcd"), "vcd"),
     ("run_firmware(pin, devices=2)", lambda d: run_firmware(d / "loop.elf", fidelity="pin", devices=2), "devices"),
 ]
