@@ -65,6 +65,9 @@ CASES: list[Case] = [
     # enter(-1) wrote xPSR = T | -1 and left a core that failed later with struct.error
     *((f"enter({v!r})", lambda d, v=v: CortexM(d / "loop.elf").enter(bad(v)), "number")
       for v in [-1, 0, 1, 512, True, "3", 3.0, None]),
+    # exception_return("x") was a ValueError "Unknown format code 'X'"
+    *((f"exception_return({v!r})", lambda d, v=v: CortexM(d / "loop.elf").exception_return(bad(v)), "exc_return")
+      for v in ["x", None, 1.5, -1, 1 << 32, True]),
     *((f"Board({k}={v!r})", lambda d, k=k, v=v: Board(d / "loop.elf", **{k: bad(v)}), k) for k, v in [
         ("fidelity", "PIN"), ("fidelity", None), ("fidelity", "both"), ("mode", "intel"), ("mode", 1),
         ("record", 1), ("record", None)]),

@@ -865,6 +865,8 @@ class CortexM:
         names; costs :attr:`Cpu.return_cycles`. A pending exception that may preempt the code returned to is
         tail-chained instead (MCU-20): its handler starts on the same frame, with the same EXC_RETURN, after
         :attr:`Cpu.tail_chain_cycles`."""
+        if type(exc_return) is not int or not 0 <= exc_return <= 0xFFFF_FFFF:  # the host's call, not the firmware's
+            check_int("exc_return", exc_return, 0, 0xFFFF_FFFF, "a 32-bit EXC_RETURN value (B1.5.8)")
         if exc_return not in (EXC_RETURN_HANDLER, EXC_RETURN_THREAD_MSP, EXC_RETURN_THREAD_PSP) or not self.active:
             raise FirmwareFaultError(self.report(Stop.FAULT, f"exception return with EXC_RETURN {exc_return:08X}h "
                                             f"{'in' if self.active else 'outside'} a handler: an INVPC "
