@@ -168,7 +168,8 @@ def test_bad_firmware_run_options_are_one_line_and_status_2(capsys: pytest.Captu
     ("udf.elf", ["--fidelity", "pin", "--cycles", "3"], 3),
     ("udf.elf", ["--fidelity", "pin", "--cycles", "3", "--mode", "intel", "--vcd", "{d}/udf.vcd"], 3),
     ("nop.elf", ["--fidelity", "pin", "--cycles", "3", "--max-instructions", "1000"], 3),
-    ("loop.elf", ["--fidelity", "pin", "--cycles", "3", "--max-instructions", "1000"], 4),  # b .: a wait (MCU-4)
+    pytest.param("loop.elf", ["--fidelity", "pin", "--cycles", "3", "--max-instructions", "1000"], 4,
+                 marks=pytest.mark.slow),  # b .: a wait (MCU-4), three whole cycles stepped: 1.3 to 2.6 s
 ])  # fmt: skip
 def test_a_stopped_or_failed_firmware_gives_3_or_4_and_its_report(capsys: pytest.CaptureFixture[str], files: Path,
                                                                   name: str, argv: list[str], status: int) -> None:
