@@ -17,6 +17,7 @@ import math
 import struct
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from os import PathLike
 from pathlib import Path
 from typing import Final, TypeVar
 
@@ -381,13 +382,18 @@ class Board:
         ------
         BoardError
             The board is not a pin-level one made with ``record=True``.
+        ArgumentError
+            ``path`` is not a path.
         OSError
             The file cannot be written.
         """
+        if not isinstance(path, str | PathLike):
+            raise fail("path", "a file path (str or os.PathLike)", path)
         ring = self.ring
         if not ring.record:
             raise BoardError("Board.write_vcd needs a board made with record=True")
-        return write_vcd(Path(path), ring, {"mcu": mcu_lines(ring.recorded()[0], intel=self.intel)})
+        traces = ring.recorded()[0]  # none yet if the firmware stopped before the chip's first clock: no samples
+        return write_vcd(Path(path), ring, {"mcu": mcu_lines(traces, intel=self.intel)} if traces else None)
 
     def _cause(self) -> Cause:
         core = self.core
@@ -650,6 +656,8 @@ class Board:
         if core.instructions >= self._limit:
             raise FirmwareStoppedError(core.report(Stop.BUDGET, f"instruction budget of {self._budget} used up "
                                                    "(an endless loop?)"))  # fmt: skip
+        if not core.sleeping:  # within the budget: an instruction costs a cycle at least (MCU-1)
+            deadline = min(deadline, core.cycles + self._limit - core.instructions)
         try:
             state = core.step(max(deadline, core.cycles + 1))
         except InterfaceViolationError as error:

@@ -676,6 +676,8 @@ class CortexM:
 
     def read_bytes(self, address: int, size: int) -> bytes:
         """Memory as the core sees it (RAM, flash); an :class:`ArgumentError` if any of it is not mapped."""
+        check_int("address", address, 0, 0xFFFF_FFFF, "the 32-bit address space")
+        check_int("size", size, 0, max(self.flash[1], self.ram[1]), "bytes: no more than the larger memory")
         try:
             return bytes(self.uc.mem_read(address, size))
         except UcError:
@@ -683,6 +685,7 @@ class CortexM:
 
     def write_bytes(self, address: int, data: bytes) -> None:
         """Write memory (RAM) from the host, between runs; an :class:`ArgumentError` if any of it is not mapped."""
+        check_int("address", address, 0, 0xFFFF_FFFF, "the 32-bit address space")
         try:
             self.uc.mem_write(address, check_bytes("data", data))
         except UcError:
@@ -793,7 +796,7 @@ class CortexM:
 
     def pend(self, number: int) -> None:
         """Make exception ``number`` pending (an external interrupt: ``EXTERNAL + irq``)."""
-        self.pending.add(check_int("number", number, 2, MAX_EXCEPTION, "B1.5.2: NMI (2) up to the last interrupt"))
+        self.pending.add(_exception_number(number))
         self.sleeping = False if self._takeable() is not None else self.sleeping
 
     @property
@@ -813,6 +816,7 @@ class CortexM:
         with CONTROL.SPSEL = 1), aligned to 8 bytes (B1.5.7), LR = EXC_RETURN, CONTROL.SPSEL = 0 (the handler runs
         on the main stack), IPSR = ``number``, PC = its vector; costs :attr:`Cpu.entry_cycles`. Returns the
         frame's address."""
+        _exception_number(number)
         uc = self.uc
         handler_mode = bool(self.active)
         control = self._read(arm.UC_ARM_REG_CONTROL)
@@ -861,6 +865,8 @@ class CortexM:
         names; costs :attr:`Cpu.return_cycles`. A pending exception that may preempt the code returned to is
         tail-chained instead (MCU-20): its handler starts on the same frame, with the same EXC_RETURN, after
         :attr:`Cpu.tail_chain_cycles`."""
+        if type(exc_return) is not int or not 0 <= exc_return <= 0xFFFF_FFFF:  # the host's call, not the firmware's
+            check_int("exc_return", exc_return, 0, 0xFFFF_FFFF, "a 32-bit EXC_RETURN value (B1.5.8)")
         if exc_return not in (EXC_RETURN_HANDLER, EXC_RETURN_THREAD_MSP, EXC_RETURN_THREAD_PSP) or not self.active:
             raise FirmwareFaultError(self.report(Stop.FAULT, f"exception return with EXC_RETURN {exc_return:08X}h "
                                             f"{'in' if self.active else 'outside'} a handler: an INVPC "
@@ -1158,6 +1164,11 @@ def _nothing(number: int) -> None:
 
 def _name(number: int) -> str:
     return EXCEPTION_NAMES.get(number, f"IRQ {number - EXTERNAL}")
+
+
+def _exception_number(number: object) -> int:
+    """``number`` checked as an exception that can be pended or entered: NMI (2) up to the last interrupt."""
+    return check_int("number", number, 2, MAX_EXCEPTION, "B1.5.2: NMI (2) up to the last interrupt")
 
 
 class SysTick:

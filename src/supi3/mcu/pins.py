@@ -21,14 +21,14 @@ import heapq
 import itertools
 import math
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Final
 
 import numpy as np
 import numpy.typing as npt
 
-from supi3.checks import check_trace
+from supi3.checks import check_bool, check_trace, fail
 from supi3.interbus import wire
 from supi3.mcu.core import Frame
 from supi3.mcu.stm32 import CR1_CPHA, CR1_CPOL, CR1_LSBFIRST
@@ -346,11 +346,18 @@ class LockstepRing(PinRing):
         self.run_levels(wire.status_levels(wire.Cycle.DATA, False, 1))
 
 
+_TRACES: Final[frozenset[str]] = frozenset({"mfp_oe", *(trace for trace, _, _ in INTEL_LINES.values())})
+"""The pin traces :func:`mcu_lines` reads (INTEL_LINES holds MCU_LINES' traces)."""
+
+
 def mcu_lines(traces: dict[str, npt.NDArray[np.int64]], *, intel: bool = False) -> dict[str, npt.NDArray[np.int64]]:
     """The MCU's lines (:data:`MCU_LINES`, the Intel board's :data:`INTEL_LINES`) from the recorded pin traces of
     its chip."""
+    if not isinstance(traces, Mapping) or not traces.keys() >= _TRACES:
+        shown = sorted(traces) if isinstance(traces, Mapping) else traces
+        raise fail("traces", f"a chip's recorded pin traces ({', '.join(sorted(_TRACES))} at least)", shown)
     lines = {}
-    for name, (trace, bit, undriven) in (INTEL_LINES if intel else MCU_LINES).items():
+    for name, (trace, bit, undriven) in (INTEL_LINES if check_bool("intel", intel) else MCU_LINES).items():
         level = traces[trace] >> bit & 1
         if trace == "mfp_out":
             fallback = traces["mfp_in"] >> bit & 1 if undriven is None else undriven

@@ -448,7 +448,7 @@ class Supi3:
         """The incoming line was silent for ``wire.IDLE_TIMEOUT_S`` (A13), ending at bus time ``now``: what the
         line side calls in place of :meth:`reset` for a silent line (:meth:`line_timeout_at`); ``counted``: counter
         telegrams came in the silence (DG-9)."""
-        self.line_timeout_at(clocks(now), _checked(check_bool, "counted", counted))
+        self.line_timeout_at(clocks(now), counted)
 
     def line_timeout_at(self, clk: int, counted: bool = False) -> None:
         """The idle time-out at clock ``clk``: the INTERBUS reset it makes (:meth:`reset_at`); the line counts as
@@ -458,6 +458,8 @@ class Supi3:
         that reaches the chip (latch or discard) and a power-up clear both."""
         if type(clk) is not int or clk < 0:
             clk = _clock(clk)
+        if type(counted) is not bool:
+            counted = _checked(check_bool, "counted", counted)
         interrupt = self._watch_line and self.bus_active and not counted
         self.reset_at(clk)
         self.line_silent = True

@@ -13,16 +13,23 @@ The edge order and the port timing are those of the pin model ``TerminalBlock``
 
 from __future__ import annotations
 
+from typing import Final
+
 from amaranth.hdl import Module, Mux, Signal, Value
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
+from supi3.checks import check_int
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.wire import BK_STATUS_CLOSED_BIT, BK_STATUS_CONF_BIT, COUNTER_MAX, BranchControl
+from supi3.lbd import clocks_per_bit
 from supi3.terminal import BLOCK_INPUTS, BLOCK_OUTPUTS, BRANCH_SILENCE_CLOCKS, RF_CODES, TerminalMode, silence_limit
 
 __all__ = ["ReturnWatchRtl", "TerminalRtl"]
+
+_CPB_BITS: Final[int] = clocks_per_bit(0).bit_length()
+"""Bits of a ``cpb`` port: the clocks per bit of 500 kbit/s (64, Table 1-7)."""
 
 
 class TerminalRtl(wiring.Component):
@@ -137,10 +144,15 @@ class ReturnWatchRtl(wiring.Component):
     Parameters
     ----------
     cpb_width:
-        The width of the ``cpb`` port.
+        The width of the ``cpb`` port: :data:`_CPB_BITS` at least, to hold the clocks per bit of 500 kbit/s.
     """
 
     def __init__(self, cpb_width: int) -> None:
+        try:
+            check_int("cpb_width", cpb_width, _CPB_BITS, limit="bits: cpb holds 64 clocks per bit at 500 kbit/s")
+        except ArgumentError:
+            self._MustUse__silence = True  # rejected, never elaborated: no "created but never used" warning
+            raise
         super().__init__({"line": In(1), "cpb": In(cpb_width), "seen": Out(1)})
 
     def elaborate(self, _platform: object) -> Module:

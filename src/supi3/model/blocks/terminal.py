@@ -37,7 +37,7 @@ from typing import Final
 import numpy as np
 import numpy.typing as npt
 
-from supi3.checks import check_inputs
+from supi3.checks import check_bool, check_choice, check_inputs
 from supi3.interbus import wire
 from supi3.interbus.wire import BranchControl
 from supi3.lbd import clocks_per_bit
@@ -71,6 +71,8 @@ __all__ = ["BranchLines", "ReturnWatch", "TerminalBlock"]
 
 _WIDTHS: Final[dict[str, int]] = {pin.name: pin.width for pin in BLOCK_INPUTS}
 _OFF: Final[dict[str, int]] = {pin.name: 0 for pin in BLOCK_OUTPUTS}
+_CPBS: Final[tuple[int, int]] = (clocks_per_bit(0), clocks_per_bit(1))
+"""Clocks per bit at 500 kbit/s and 2 Mbit/s (Table 1-7)."""
 
 
 
@@ -262,6 +264,8 @@ class BranchLines:
     )  # fmt: skip
 
     def __init__(self, rf: str | None, cpb: int, lbd: bool, time_limit: int = BRANCH_SILENCE_CLOCKS) -> None:
+        cpb = check_choice("cpb", cpb, _CPBS, "clocks per bit at 500 kbit/s or 2 Mbit/s")
+        lbd = check_bool("lbd", lbd)
         self.present = np.array([[branch_present(rf, bool(lbst), bool(connected)) for connected in (0, 1)]
                                  for lbst in (0, 1)])  # fmt: skip
         """Table 2-9 by [LBST][connected] (:func:`~supi3.terminal.branch_present`)."""
