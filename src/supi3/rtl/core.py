@@ -903,7 +903,9 @@ class DataPathRtl(wiring.Component):
         sync, comb = m.d.sync, m.d.comb
         f, words = self.frame, self.words
         reg_bits = self.tables.register_bits
-        register = self.register
+        # The shift register: every frame's load sets all of it before it is shifted, latched or read as the
+        # command word (the frame engine, reset with it, loads before it latches), so it needs no reset.
+        register = Signal(reg_bits, reset_less=True)
         frame_bytes = Signal.like(self.data_bytes)  # the register's length, fixed when the frame is loaded
         comb += [
             f.shift_out.eq(Mux(self.chain, self.chain_bit, Mux(frame_bytes == 0, f.level, register[0]))),
@@ -939,6 +941,7 @@ class DataPathRtl(wiring.Component):
         with m.Elif(f.shift & (frame_bytes != 0)):
             sync += register.eq(shifted)
 
+        comb += self.register.eq(register)
         mfp_out = self.mfp_out
         with m.If(words.watchdog_reset | f.clear):  # process data cleared (Table 3-13, 3.4.7)
             sync += mfp_out.eq(0)
@@ -978,7 +981,8 @@ class TransmitterRtl(wiring.Component):
         slots = _tx_slots(self.tables)
         width = len(self.tx_init)
         countdown = [Signal(width, name=f"tx{k}_count") for k in range(slots)]
-        level = [Signal(name=f"tx{k}_level") for k in range(slots)]
+        # a level counts while its countdown runs, and each push sets both: the levels need no reset
+        level = [Signal(name=f"tx{k}_level", reset_less=True) for k in range(slots)]
         for r in countdown:
             with m.If(r != 0):
                 sync += r.eq(r - 1)
