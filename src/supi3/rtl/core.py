@@ -69,6 +69,7 @@ from supi3.regmap.core import BYTE_BITS
 from supi3.rtl.counter import CounterLinesRtl, lbd_lines
 from supi3.rtl.expansion import PIN_NAMES as EXPANSION_PINS
 from supi3.rtl.expansion import ExpansionRtl
+from supi3.rtl.lfsr import Countdown
 from supi3.rtl.optical import OpticalRtl
 from supi3.rtl.serial_io import DIRECTIONS, SER_IN_PIN, WIDTHS, SerialIoRtl
 from supi3.rtl.tables import (
@@ -1048,14 +1049,13 @@ class OutputsRtl(wiring.Component):
         next_present = Signal()
 
         # The model calls chip._advance at the start of every running clock: the /StatErr filter and the watchdog.
+        # The clocks /StatErr has been low, counted down from STATERR_FILTER_CLOCKS - 1 (one clock old at the edge
+        # after it fell) to 0 (filtered) as an LFSR (supi3.rtl.lfsr); it is read only while /StatErr stays low
+        # (``st_valid``), so it may run on after it rose.
         st_valid = Signal()
-        st_count = Signal(range(STATERR_FILTER_CLOCKS + 1))
-        filtered = st_valid & (st_count == STATERR_FILTER_CLOCKS)
+        st_count = Countdown(m, STATERR_FILTER_CLOCKS - 1, load=stat & ~st_valid, clear=Const(0), name="st_count")
+        filtered = st_valid & st_count.idle
         sync += st_valid.eq(stat)
-        with m.If(stat & ~st_valid):
-            sync += st_count.eq(1)  # low since this clock: one clock old at the next
-        with m.Elif(stat & (st_count != STATERR_FILTER_CLOCKS)):
-            sync += st_count.eq(st_count + 1)
         module_error = stat & filtered
 
         timeouts = [t for t in WATCHDOG_CLOCKS if t is not None]

@@ -16,7 +16,7 @@ from typing import Final
 
 from amaranth.hdl import Cat, Module, Signal, Value
 
-__all__ = ["TAPS", "Countdown", "step"]
+__all__ = ["TAPS", "Countdown", "advance", "step"]
 
 TAPS: Final[dict[int, tuple[int, ...]]] = {
     2: (2, 1), 3: (3, 2), 4: (4, 3), 5: (5, 3), 6: (6, 5), 7: (7, 6), 8: (8, 6, 5, 4), 9: (9, 5), 10: (10, 7),
@@ -36,6 +36,27 @@ def step(state: int, width: int) -> int:
     return (state << 1 | feedback) & ((1 << width) - 1)
 
 
+def advance(state: int, width: int, steps: int) -> int:
+    """The state ``steps`` steps after ``state``: the step is linear over GF(2), so its power is found by squaring
+    (the images of the unit vectors), in a few dozen operations for any count."""
+    power = [1 << i for i in range(width)]  # the identity: images of the unit vectors
+    square = [step(1 << i, width) for i in range(width)]  # one step
+
+    def apply(images: list[int], value: int) -> int:
+        result = 0
+        for i in range(width):
+            if value >> i & 1:
+                result ^= images[i]
+        return result
+
+    while steps:
+        if steps & 1:
+            power = [apply(square, image) for image in power]
+        square = [apply(square, image) for image in square]
+        steps >>= 1
+    return apply(power, state)
+
+
 class Countdown:
     """A down counter from ``limit`` (1 to ``2 ** 24 - 1``) as an LFSR, built in ``m``'s ``sync`` domain.
 
@@ -47,9 +68,7 @@ class Countdown:
         if not 1 <= limit < 1 << max(TAPS):
             raise ValueError(f"limit must be from 1 to {(1 << max(TAPS)) - 1}, not {limit}")
         width = max(min(TAPS), limit.bit_length())  # limit < 2 ** width: the states limit..1 are distinct
-        start = 1  # the state limit - 1 steps before 1: 2 ** width - 1 - (limit - 1) steps after it
-        for _ in range((1 << width) - limit):
-            start = step(start, width)
+        start = advance(1, width, (1 << width) - limit)  # limit - 1 steps before 1: 2 ** width - limit after it
         state = Signal(width, name=name)
         feedback = Cat(*(state[tap - 1] for tap in TAPS[width])).xor()
         self.last: Value = state == 1
