@@ -69,7 +69,7 @@ from supi3.regmap.core import BYTE_BITS
 from supi3.rtl.counter import CounterLinesRtl, lbd_lines
 from supi3.rtl.expansion import PIN_NAMES as EXPANSION_PINS
 from supi3.rtl.expansion import ExpansionRtl
-from supi3.rtl.lfsr import Countdown
+from supi3.rtl.lfsr import Countdown, before, next_state
 from supi3.rtl.optical import OpticalRtl
 from supi3.rtl.serial_io import DIRECTIONS, SER_IN_PIN, WIDTHS, SerialIoRtl
 from supi3.rtl.tables import (
@@ -1060,16 +1060,18 @@ class OutputsRtl(wiring.Component):
 
         timeouts = [t for t in WATCHDOG_CLOCKS if t is not None]
         wd_code = Signal(_WD_CODE_BITS, init=_WD_OFF)
+        # The watchdog's clocks to its deadline as an LFSR (supi3.rtl.lfsr) that fires at the state 1: loaded with
+        # the state timeout - 1 steps before it, stepping every clock; read only while ``wd_active`` (no reset).
         wd_active = Signal()
-        wd_count = Signal(range(max(timeouts)))
-        fire = wd_active & (wd_count == 0)
-        with m.If(wd_active):
-            sync += wd_count.eq(wd_count - 1)
+        wd_count = Signal(range(max(timeouts)), reset_less=True)
+        fire = wd_active & (wd_count == 1)
+        sync += wd_count.eq(next_state(wd_count))
 
         def arm(code: Value) -> list[Value]:
             """The deadline for a watchdog code: clk + timeout, or none ("off")."""
             on = Array(Const(int(t is not None), 1) for t in WATCHDOG_CLOCKS)[code]
-            count = Array(Const(max(t or 1, 1) - 1, len(wd_count)) for t in WATCHDOG_CLOCKS)[code]
+            width = len(wd_count)
+            count = Array(Const(before(max(t or 1, 1) - 1, width), width) for t in WATCHDOG_CLOCKS)[code]
             return [wd_active.eq(on), wd_count.eq(count)]
 
         # Pulse counters: loaded with the width at the edge that starts the pulse, the pin low while non-zero, so

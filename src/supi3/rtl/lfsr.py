@@ -6,7 +6,7 @@ decrement needs a carry chain of its width. :class:`Countdown` gives the behavio
 ``c`` that is loaded with ``limit``, counts down while non-zero, and is at ``1`` (``last``) one clock before it
 stops at ``0``; its states are the LFSR's, the idle state ``0`` (the LFSR's fixed point) is the counter's ``0``
 and the state ``1`` is the counter's ``1``, so a counter value ``v`` is the state ``v - 1`` steps before ``1``.
-The feedback taps are the maximal-length ones of Xilinx XAPP052 (Table 3), for every width from 2 to 24;
+The feedback taps are the maximal-length ones of Xilinx XAPP052 (Table 3), for every width from 2 to 25;
 ``tests/test_rtl_lfsr.py`` checks each sequence's period.
 """
 
@@ -16,13 +16,13 @@ from typing import Final
 
 from amaranth.hdl import Cat, Module, Signal, Value
 
-__all__ = ["TAPS", "Countdown", "advance", "step"]
+__all__ = ["TAPS", "Countdown", "advance", "before", "next_state", "step"]
 
 TAPS: Final[dict[int, tuple[int, ...]]] = {
     2: (2, 1), 3: (3, 2), 4: (4, 3), 5: (5, 3), 6: (6, 5), 7: (7, 6), 8: (8, 6, 5, 4), 9: (9, 5), 10: (10, 7),
     11: (11, 9), 12: (12, 6, 4, 1), 13: (13, 4, 3, 1), 14: (14, 5, 3, 1), 15: (15, 14), 16: (16, 15, 13, 4),
     17: (17, 14), 18: (18, 11), 19: (19, 6, 2, 1), 20: (20, 17), 21: (21, 19), 22: (22, 21), 23: (23, 18),
-    24: (24, 23, 22, 17),
+    24: (24, 23, 22, 17), 25: (25, 22),
 }  # fmt: skip
 """Feedback taps (bit numbers from 1) of a maximal-length LFSR of each width: the sequence from any non-zero state
 runs through all ``2 ** width - 1`` non-zero states."""
@@ -57,6 +57,19 @@ def advance(state: int, width: int, steps: int) -> int:
     return apply(power, state)
 
 
+def before(steps: int, width: int) -> int:
+    """The state ``steps`` steps before the state ``1`` (``steps`` below ``2 ** width - 1``): what a counter that
+    ends at ``1`` is loaded with to end ``steps`` clocks later."""
+    if not 0 <= steps < (1 << width) - 1:
+        raise ValueError(f"steps must be from 0 to {(1 << width) - 2}, not {steps}")
+    return advance(1, width, (1 << width) - 1 - steps)
+
+
+def next_state(state: Value) -> Value:
+    """:func:`step` in gates, for a signal whose width has taps."""
+    return Cat(Cat(*(state[tap - 1] for tap in TAPS[len(state)])).xor(), state[:-1])
+
+
 class Countdown:
     """A down counter from ``limit`` (1 to ``2 ** 24 - 1``) as an LFSR, built in ``m``'s ``sync`` domain.
 
@@ -68,9 +81,8 @@ class Countdown:
         if not 1 <= limit < 1 << max(TAPS):
             raise ValueError(f"limit must be from 1 to {(1 << max(TAPS)) - 1}, not {limit}")
         width = max(min(TAPS), limit.bit_length())  # limit < 2 ** width: the states limit..1 are distinct
-        start = advance(1, width, (1 << width) - limit)  # limit - 1 steps before 1: 2 ** width - limit after it
+        start = before(limit - 1, width)
         state = Signal(width, name=name)
-        feedback = Cat(*(state[tap - 1] for tap in TAPS[width])).xor()
         self.last: Value = state == 1
         self.idle: Value = state == 0
         with m.If(clear):
@@ -80,4 +92,4 @@ class Countdown:
         with m.Elif(self.last):
             m.d.sync += state.eq(0)
         with m.Else():  # 0 steps to 0
-            m.d.sync += state.eq(Cat(feedback, state[:-1]))
+            m.d.sync += state.eq(next_state(state))
