@@ -69,6 +69,7 @@ from supi3.regmap.core import BYTE_BITS
 from supi3.rtl.counter import CounterLinesRtl, lbd_lines
 from supi3.rtl.expansion import PIN_NAMES as EXPANSION_PINS
 from supi3.rtl.expansion import ExpansionRtl
+from supi3.rtl.lfsr import Countdown, before, next_state
 from supi3.rtl.optical import OpticalRtl
 from supi3.rtl.serial_io import DIRECTIONS, SER_IN_PIN, WIDTHS, SerialIoRtl
 from supi3.rtl.tables import (
@@ -903,7 +904,9 @@ class DataPathRtl(wiring.Component):
         sync, comb = m.d.sync, m.d.comb
         f, words = self.frame, self.words
         reg_bits = self.tables.register_bits
-        register = self.register
+        # The shift register: every frame's load sets all of it before it is shifted, latched or read as the
+        # command word (the frame engine, reset with it, loads before it latches), so it needs no reset.
+        register = Signal(reg_bits, reset_less=True)
         frame_bytes = Signal.like(self.data_bytes)  # the register's length, fixed when the frame is loaded
         comb += [
             f.shift_out.eq(Mux(self.chain, self.chain_bit, Mux(frame_bytes == 0, f.level, register[0]))),
@@ -939,6 +942,7 @@ class DataPathRtl(wiring.Component):
         with m.Elif(f.shift & (frame_bytes != 0)):
             sync += register.eq(shifted)
 
+        comb += self.register.eq(register)
         mfp_out = self.mfp_out
         with m.If(words.watchdog_reset | f.clear):  # process data cleared (Table 3-13, 3.4.7)
             sync += mfp_out.eq(0)
@@ -978,7 +982,8 @@ class TransmitterRtl(wiring.Component):
         slots = _tx_slots(self.tables)
         width = len(self.tx_init)
         countdown = [Signal(width, name=f"tx{k}_count") for k in range(slots)]
-        level = [Signal(name=f"tx{k}_level") for k in range(slots)]
+        # a level counts while its countdown runs, and each push sets both: the levels need no reset
+        level = [Signal(name=f"tx{k}_level", reset_less=True) for k in range(slots)]
         for r in countdown:
             with m.If(r != 0):
                 sync += r.eq(r - 1)
@@ -1044,28 +1049,29 @@ class OutputsRtl(wiring.Component):
         next_present = Signal()
 
         # The model calls chip._advance at the start of every running clock: the /StatErr filter and the watchdog.
+        # The clocks /StatErr has been low, counted down from STATERR_FILTER_CLOCKS - 1 (one clock old at the edge
+        # after it fell) to 0 (filtered) as an LFSR (supi3.rtl.lfsr); it is read only while /StatErr stays low
+        # (``st_valid``), so it may run on after it rose.
         st_valid = Signal()
-        st_count = Signal(range(STATERR_FILTER_CLOCKS + 1))
-        filtered = st_valid & (st_count == STATERR_FILTER_CLOCKS)
+        st_count = Countdown(m, STATERR_FILTER_CLOCKS - 1, load=stat & ~st_valid, clear=Const(0), name="st_count")
+        filtered = st_valid & st_count.idle
         sync += st_valid.eq(stat)
-        with m.If(stat & ~st_valid):
-            sync += st_count.eq(1)  # low since this clock: one clock old at the next
-        with m.Elif(stat & (st_count != STATERR_FILTER_CLOCKS)):
-            sync += st_count.eq(st_count + 1)
         module_error = stat & filtered
 
         timeouts = [t for t in WATCHDOG_CLOCKS if t is not None]
         wd_code = Signal(_WD_CODE_BITS, init=_WD_OFF)
+        # The watchdog's clocks to its deadline as an LFSR (supi3.rtl.lfsr) that fires at the state 1: loaded with
+        # the state timeout - 1 steps before it, stepping every clock; read only while ``wd_active`` (no reset).
         wd_active = Signal()
-        wd_count = Signal(range(max(timeouts)))
-        fire = wd_active & (wd_count == 0)
-        with m.If(wd_active):
-            sync += wd_count.eq(wd_count - 1)
+        wd_count = Signal(range(max(timeouts)), reset_less=True)
+        fire = wd_active & (wd_count == 1)
+        sync += wd_count.eq(next_state(wd_count))
 
         def arm(code: Value) -> list[Value]:
             """The deadline for a watchdog code: clk + timeout, or none ("off")."""
             on = Array(Const(int(t is not None), 1) for t in WATCHDOG_CLOCKS)[code]
-            count = Array(Const(max(t or 1, 1) - 1, len(wd_count)) for t in WATCHDOG_CLOCKS)[code]
+            width = len(wd_count)
+            count = Array(Const(before(max(t or 1, 1) - 1, width), width) for t in WATCHDOG_CLOCKS)[code]
             return [wd_active.eq(on), wd_count.eq(count)]
 
         # Pulse counters: loaded with the width at the edge that starts the pulse, the pin low while non-zero, so

@@ -39,6 +39,7 @@ from supi3.optical.regulation import (
     length_timer_enable_every,
 )
 from supi3.regmap.registers import OPTICAL_ENABLE_BIT, OPTICAL_MEDIUM_BIT, POWER_BRANCH_LSB, POWER_OUT_LSB
+from supi3.rtl.lfsr import Countdown
 from supi3.tables import BIT_RATES
 
 __all__ = ["LENGTH_COUNT_BITS", "PHASES", "OpticalRtl", "length_shift"]
@@ -227,7 +228,6 @@ class OpticalRtl(wiring.Component):
         new_length = [Signal.like(r, name=f"{r.name}_next") for r in length]
         new_medium = [Signal.like(r, name=f"{r.name}_next") for r in medium]
         in_reset = Signal()
-        countdown = Signal(range(self.time_limit + 1))
         changed = Signal(len(self.optical_we))
         for tx, after in zip(state, new, strict=True):
             sync += tx.eq(after)
@@ -248,20 +248,19 @@ class OpticalRtl(wiring.Component):
                                  for k in range(len(changed)))))  # fmt: skip
 
         # The edge: strobes and the 6 ms counter, unless a reset or the start --------------------------------------
-        timeout = countdown == 1
+        # (the 6 ms counter: loaded with the budget at the start, zero in reset, ``last`` one clock before it ends)
+        countdown = Countdown(m, self.time_limit, load=in_reset, clear=self.ib_reset, name="countdown")
         for i in Interface:
             strobes = (self.resp_valid[i], self.resp.word_select(i, 2), self.test_valid[i], self.ack1[i], self.ack2[i])
-            _transitions(m, state[i], new[i], strobes, timeout)
+            _transitions(m, state[i], new[i], strobes, countdown.last)
         with m.If(self.ib_reset):
-            sync += [in_reset.eq(1), countdown.eq(0)]
+            sync += in_reset.eq(1)
             for i in Interface:
                 comb += new[i].set(Phase.OFF)
         with m.Elif(in_reset):
-            sync += [in_reset.eq(0), countdown.eq(self.time_limit)]
+            sync += in_reset.eq(0)
             for i in Interface:
                 comb += new[i].set(_start(self.mode, self.present[i]))
-        with m.Elif(countdown != 0):
-            sync += countdown.eq(countdown - 1)
 
         # Length timers of the outgoing interface and the branch: the clocks since the start, of which the count is
         # the clocks shifted right by log2 of the bit rate's enable period (OPT-24)

@@ -145,10 +145,12 @@ class SerialIoRtl(wiring.Component):
         in_write = busy & write_on & (k >= write_start) & (k < write_end)
         in_frame = in_read | in_write
         high = sub >= (t0 >> 1)
-        out_shift = Signal(WORD_BITS)
-        in_shift = Signal(WORD_BITS)
+        # the shift registers and the waiting word are written before they are read (every sequence loads
+        # ``out_shift`` and a read sequence clears ``in_shift``; ``pending`` says when the word counts): no reset
+        out_shift = Signal(WORD_BITS, reset_less=True)
+        in_shift = Signal(WORD_BITS, reset_less=True)
         pending = Signal()
-        pending_word = Signal(WORD_BITS)
+        pending_word = Signal(WORD_BITS, reset_less=True)
         frame_probe = spec.SerialFrame(0, WIDTHS[0], False, max(self.t0s))
         sample_after = frame_probe.sample(0) + SYNC_STAGES - frame_probe.rising(0)  # clocks after SCLK rose
 

@@ -24,6 +24,7 @@ from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.wire import BK_STATUS_CLOSED_BIT, BK_STATUS_CONF_BIT, COUNTER_MAX, BranchControl
 from supi3.lbd import clocks_per_bit
+from supi3.rtl.lfsr import TAPS, before, next_state
 from supi3.terminal import BLOCK_INPUTS, BLOCK_OUTPUTS, BRANCH_SILENCE_CLOCKS, RF_CODES, TerminalMode, silence_limit
 
 __all__ = ["ReturnWatchRtl", "TerminalRtl"]
@@ -81,7 +82,11 @@ class TerminalRtl(wiring.Component):
         count = Signal(COUNTER_MAX.bit_length())
         alarm = Signal()
         fresh = Signal(init=1)
-        timer = Signal(range(max(self.time_limit, 2)))
+        # the silence timer counts the clocks since it was restarted as an LFSR (supi3.rtl.lfsr): ``idle`` is its 0,
+        # and it is at the state 1 when the silence ends (time_limit - 1 clocks on)
+        width = max(min(TAPS), self.time_limit.bit_length())
+        idle = before(self.time_limit - 1, width)
+        timer = Signal(width, init=idle)
 
         # Outputs from the state ---------------------------------------------------------------------------------
         bk = self.mode != TerminalMode.NONE
@@ -104,7 +109,7 @@ class TerminalRtl(wiring.Component):
         cmd_on = self.cmd_valid & branch_on
         counting = extended & on
         restart = self.ret_valid | cmd_on
-        expired = counting & ~restart & (timer + 1 >= self.time_limit)
+        expired = counting & ~restart & (timer == 1)
         with m.If(bk):
             with m.If(fresh):  # power_up: the CONF level, no edge
                 sync += [fresh.eq(0), conf.eq(self.conf)]
@@ -114,7 +119,7 @@ class TerminalRtl(wiring.Component):
                     sync += conf_request.eq(1)
                 with m.If(self.ib_reset):  # reset: all but the CONF level and the request
                     sync += [switched_on.eq(1), extended.eq(0), closed.eq(0), closed_report.eq(0), count.eq(0),
-                             alarm.eq(0), timer.eq(0)]  # fmt: skip
+                             alarm.eq(0), timer.eq(idle)]  # fmt: skip
                 with m.Else():
                     with m.If(self.cmd_valid):  # command
                         with m.If(self.alarm_set):
@@ -132,7 +137,7 @@ class TerminalRtl(wiring.Component):
                         sync += count.eq(0)
                     with m.If(expired & ~cmd_off):  # silence, on the state after the command (watching)
                         sync += [closed.eq(1), closed_report.eq(1)]
-                    sync += timer.eq(Mux(counting & ~restart & ~expired, timer + 1, 0))
+                    sync += timer.eq(Mux(counting & ~restart & ~expired, next_state(timer), idle))
         return m
 
 
