@@ -235,7 +235,7 @@ class PinRing:
     def __init__(self, chips: Sequence[PinChip | PinBranch], record: bool = False) -> None:
         if isinstance(chips, (str, bytes)) or not isinstance(chips, Sequence) \
                 or not all(isinstance(chip, (PinChip, PinBranch)) for chip in chips):
-            raise fail("chips", "a sequence of Supi3Pins, Supi3Chip or PinBranch", chips)
+            raise fail("chips", "a sequence of Supi3Pins or Supi3Chip objects and PinBranch trees", chips)
         every = _chips(chips)
         if len({id(chip) for chip in every}) != len(every):
             raise fail("chips", "distinct Supi3Pins or Supi3Chip objects (one per ring position)", chips)
