@@ -81,7 +81,7 @@ def view(master: Master) -> tuple[list[tuple[str, int, int]], list[bytes]]:
             [master.inputs(k) for k in range(1, len(master.config) + 1)])  # fmt: skip
 
 
-CASES = [(BranchKind.REMOTE, 1), (BranchKind.LOCAL, 2), (BranchKind.LBD_MR, 2), (BranchKind.LBD_OR, 2)]
+CASES = [(BranchKind.REMOTE, 1), (BranchKind.LOCAL, 2), (BranchKind.LBD_MR, 1), (BranchKind.LBD_OR, 1)]
 
 
 @pytest.mark.parametrize(("kind", "m"), CASES)
@@ -89,16 +89,17 @@ def test_a_master_sees_the_same_tree_at_both_fidelities(kind: BranchKind, m: int
     """BK-RB, BK-LB, BK-LBD (LBD-MR, LBD-OR): the same configuration (numbers x.0, x.1, ...), ID codes, data
     lengths and process data; OUT data reach the branch's last device at both; switching the branch off removes its
     devices from the configuration at both, switching it on brings them back."""
-    rings: list[Ring | PinRing] = [tl_tree(kind, m), pin_tree(kind, m)]
+    pins = pin_tree(kind, m)
+    rings: list[Ring | PinRing] = [tl_tree(kind, m), pins]
     masters = [Master(ring, locate=False, max_devices=8) for ring in rings]
     views = []
     for master in masters:
         assert master.start().ok
         master.set_outputs(2 + m, b"\xa5")
         healthy(master)
-        healthy(master)
         views.append(view(master))
     assert views[0] == views[1]
+    pins.settle()  # the latch telegrams reach the last chips
     assert [number for number, _, _ in views[0][0]] == ["1.0", "2.0", *(f"2.{k}" for k in range(1, m + 1)), "3.0"] \
         if kind is not BranchKind.REMOTE else ["1.0", "2.0", "3.0", "4.0"]  # fmt: skip
     assert rings[0].devices[1 + m].mfp_outputs == rings[1].devices[1 + m].chip.mfp_outputs != 0  # type: ignore[union-attr]
@@ -135,8 +136,9 @@ SILENCE = 8_000
 their longest master cycle, so a working branch never falls silent that long."""
 
 
+@pytest.mark.slow  # 2 to 4 s each: a master cycles through the silence
 @pytest.mark.parametrize(("kind", "m", "at"), [(BranchKind.LOCAL, 2, 2), (BranchKind.LBD_MR, 2, 2),
-                                               (BranchKind.LBD_OR, 3, 2)])  # fmt: skip
+                                               (BranchKind.LBD_OR, 2, 1)])  # fmt: skip
 def test_the_bk_closes_a_branch_silent_behind_a_cut(kind: BranchKind, m: int, at: int) -> None:
     """BK-3, BK-37..39 through a whole ring: the master's telegrams stop coming back on DI3, the BK closes the
     branch, the master sees the data length change (the branch's devices gone) and the BK's report; in BK-LBD the

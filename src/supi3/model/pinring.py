@@ -14,9 +14,10 @@ A ring can be a tree (docs/interbus.md "Tree"): a :class:`PinBranch` is the pin-
 :class:`~supi3.interbus.ring.Branch`, a bus terminal module (BK) chip with the chips of its branch. The BK sends on
 DO3 (MFP9) into the branch's first chip and takes the branch's return line on DI3 (MFP10): the first chip's DI1, or
 the last chip's DO2 in an LBD-OR branch (BK-37). The BK's outputs depend on DI3, which depends on its DO3 through the
-branch, so a branch is closed by iteration on copies (BK-40): the BK and its branch run on a copy with a guess of
-DI3, the branch's return line is the next guess, until it comes back unchanged; then the chips themselves run once
-with it. An empty branch reads DI3 at the idle level, the pull-up the manual asks for on an unused DI3 (BK-41).
+branch, so a branch is closed by iteration on copies (BK-40): the BK runs on a copy with a guess of DI3, its branch
+on a copy with the BK's DO3 gives the next guess, until the BK's DO3 comes back unchanged; then the chips themselves
+run once with that DI3. An empty branch reads DI3 at the idle level, the pull-up the manual asks for on an unused
+DI3 (BK-41).
 """
 
 from __future__ import annotations
@@ -261,7 +262,7 @@ class PinRing:
         self.returned_from = 0
         self.record = record
         self.trials = 0
-        """Runs of a branch on a copy so far (BK-40), for benches."""
+        """Runs of a branch's chips on copies so far (BK-40), for benches."""
         self._chunks: list[list[dict[str, npt.NDArray[np.int64]]]] = []
         self.cuts: set[tuple[int, bool]] = set()
         """Broken lines, as ``(position, forward)``: see :meth:`cut`."""
@@ -382,35 +383,41 @@ class PinRing:
 
     def _branch(self, branch: PinBranch, position: int, line: npt.NDArray[np.int64],
                 chunk: dict[int, dict[str, npt.NDArray[np.int64]]] | None) -> dict[str, PinTrace]:
-        """Run a BK at ``position`` with ``line`` on DO1 and its branch; the BK's outputs (BK-40). Its DI3 is the
-        fixed point of guess -> (BK, branch) on a copy -> return line, from the idle level: a loop through a branch
-        delays by at least one repeater (3 bit periods, A10) and the BK reads DI3 through its synchroniser, so each
-        trial makes DI3 right for at least the loop's delay further than the guess was, and the first guess that
-        comes back unchanged is the one the chips would see. The chips then run once with it."""
+        """Run a BK at ``position`` with ``line`` on DO1 and its branch; the BK's outputs (BK-40).
+
+        DI3 is the fixed point of guess -> the BK's DO3 -> the branch's return line, from the idle level, found on
+        copies of the chips: a guess ``g`` gives the BK's DO3 ``d = B(g)`` and the branch's return line ``F(d)``, the
+        next guess; once ``B(F(d)) == d`` the branch would return ``F(d)`` again, a fixed point. A loop through a
+        branch delays by at least one repeater (3 bit periods, A10) and the BK reads DI3 through its synchroniser,
+        so each guess is right for at least the loop's delay further than the one before: the iteration ends, at
+        the latest after the run's length over that delay, and its fixed point is the one the chips would see (the
+        line is causal). Usually the BK's DO3 does not depend on DI3 within a run, and two runs of the BK and one of
+        the branch on copies find it. The chips then run once with it."""
         di3 = np.full(len(line), wire.IDLE_LEVEL, dtype=np.int64)  # nothing attached: the pull-up (BK-41)
         if branch.devices:
+            do3 = None
             while True:
-                self.trials += 1
-                _, back = self._close(copy.deepcopy(branch), position, line, di3, None)
-                if np.array_equal(back, di3):
+                outputs = self._run(copy.deepcopy(branch.terminal), position, line, di3, None)
+                sent = (outputs["mfp_out"] >> DO3_PIN & 1).astype(np.int64)
+                if do3 is not None and np.array_equal(sent, do3):
                     break
-                di3 = back
-        outputs, _ = self._close(branch, position, line, di3, chunk)
+                do3 = sent
+                self.trials += 1
+                di3 = self._return(branch.kind, copy.deepcopy(branch.devices), position + 1, do3, None)
+        outputs = self._run(branch.terminal, position, line, di3, chunk)
+        if branch.devices:
+            self._return(branch.kind, branch.devices, position + 1, (outputs["mfp_out"] >> DO3_PIN & 1).astype(
+                np.int64), chunk)  # fmt: skip
         return outputs
 
-    def _close(self, branch: PinBranch, position: int, line: npt.NDArray[np.int64], di3: npt.NDArray[np.int64],
-               chunk: dict[int, dict[str, npt.NDArray[np.int64]]] | None,
-               ) -> tuple[dict[str, PinTrace], npt.NDArray[np.int64]]:
-        """The BK at ``position`` with ``line`` on DO1 and ``di3`` on DI3, then its branch on its DO3: the BK's
-        outputs and the branch's return line (the first chip's DI1; the last chip's DO2 in an LBD-OR branch; idle
-        with nothing attached)."""
-        outputs = self._run(branch.terminal, position, line, di3, chunk)
-        if not branch.devices:
-            return outputs, di3
-        do3 = (outputs["mfp_out"] >> DO3_PIN & 1).astype(np.int64)
-        end, sent = self._forward(branch.devices, position + 1, do3, chunk)
-        back = self._back(sent, np.zeros(len(line), dtype=np.int64), chunk)
-        return outputs, (end if branch.kind is BranchKind.LBD_OR else back).astype(np.int64, copy=False)
+    def _return(self, kind: BranchKind, devices: Sequence[PinChip | PinBranch], first: int,
+                do3: npt.NDArray[np.int64], chunk: dict[int, dict[str, npt.NDArray[np.int64]]] | None,
+                ) -> npt.NDArray[np.int64]:
+        """Run a branch's ``devices`` (the first at ring position ``first``) with ``do3`` from their BK: the branch's
+        return line into the BK's DI3, the first chip's DI1, or the last chip's DO2 in an LBD-OR branch."""
+        end, sent = self._forward(devices, first, do3, chunk)
+        back = self._back(sent, np.zeros(len(do3), dtype=np.int64), chunk)
+        return (end if kind is BranchKind.LBD_OR else back).astype(np.int64, copy=False)
 
     def recorded(self) -> list[dict[str, npt.NDArray[np.int64]]]:
         """Every pin trace of every chip since the ring was made (``record=True``), chips in ring order."""
