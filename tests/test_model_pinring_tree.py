@@ -189,3 +189,66 @@ def test_pin_branches_are_checked_as_branches() -> None:
         with pytest.raises(ArgumentError, match="position"):
             ring.cut(position, False)
     assert wire.IDLE_LEVEL == 1
+
+
+@pytest.mark.parametrize("kind", [BranchKind.LOCAL, BranchKind.LBD_OR])
+def test_the_branch_loop_closes_on_the_chips_own_lines(kind: BranchKind) -> None:
+    """BK-40: in the recording, the branch's first chip takes the BK's DO3 on DO1, and the BK's DI3 is the branch's
+    return line (the first chip's DI1; the last chip's DO2 in an LBD-OR branch) in every clock of the run; the
+    iteration needed at most 2 branch runs on copies per ring run (the BK's DO3 depended on DI3 once: when the
+    branch was first seen)."""
+    m = 2
+    bk = Supi3Pins(_bk(kind))
+    chips = [Supi3Pins(_config(ROWS[kind])) for _ in range(m)]
+    ring = PinRing([Supi3Pins(_config(ROWS[BranchKind.REMOTE])), PinBranch(bk, chips, kind)], record=True)
+    ring.set_input(2, "mfp_in", LBST)
+    master = Master(ring, locate=False, max_devices=4)
+    assert master.start().ok
+    healthy(master)
+    runs = ring.trials
+    pins = ring.recorded()
+    assert (pins[2]["do1"] == pins[1]["mfp_out"] >> DO3_PIN & 1).all()
+    returned = pins[1 + m]["do2"] if kind is BranchKind.LBD_OR else pins[2]["di1"]
+    di3 = pins[1]["mfp_in"] >> 10 & 1
+    assert (di3 == returned).all() and not di3.all()  # the branch's traffic came back on DI3
+    assert master.config is not None and len(master.config) == 2 + m
+    assert runs <= 2 * len(ring._chunks)
+
+
+def nested_tl() -> Ring:
+    """Figure 1-10's nesting, small: RB device, BK-RB (RB device, BK-LB (one LB-MR device)), RB device; the RB device
+    in the remote bus branch reads 5Ah on its MFP inputs."""
+    rb = [Supi3(_config(ROWS[BranchKind.REMOTE])) for _ in range(3)]
+    outer, inner = Supi3(_bk(BranchKind.REMOTE)), Supi3(_bk(BranchKind.LOCAL))
+    for device, value in ((outer, LBST), (rb[1], 0x5A), (inner, LBST)):
+        device.set_mfp_inputs(value)
+    local = Branch(inner, [Supi3(_config(ROWS[BranchKind.LOCAL]))], BranchKind.LOCAL)
+    return Ring([rb[0], Branch(outer, [rb[1], local], BranchKind.REMOTE), rb[2]], bit_rate=2_000_000)
+
+
+def nested_pin() -> PinRing:
+    """The pin-level twin of :func:`nested_tl`."""
+    rb = [Supi3Pins(_config(ROWS[BranchKind.REMOTE])) for _ in range(3)]
+    local = PinBranch(Supi3Pins(_bk(BranchKind.LOCAL)), [Supi3Pins(_config(ROWS[BranchKind.LOCAL]))], BranchKind.LOCAL)
+    ring = PinRing([rb[0], PinBranch(Supi3Pins(_bk(BranchKind.REMOTE)), [rb[1], local], BranchKind.REMOTE), rb[2]])
+    for position, value in ((2, LBST), (3, 0x5A), (4, LBST)):
+        ring.set_input(position, "mfp_in", value)
+    return ring
+
+
+@pytest.mark.slow  # about 2 s
+def test_a_nested_tree_is_the_same_at_both_fidelities() -> None:
+    """A BK-LB inside a remote bus branch (2.4: only a remote bus branch holds BKs): the same configuration and
+    process data; switching the inner branch off removes its device at both."""
+    views = []
+    for ring in (nested_tl(), nested_pin()):
+        master = Master(ring, locate=False, max_devices=8)
+        assert master.start().ok
+        healthy(master)
+        views.append(view(master))
+        master.switch_branch(4, False)
+        healthy(master)
+        views.append(view(master))
+    assert views[0] == views[2] and views[1] == views[3]
+    assert [number for number, _, _ in views[0][0]] == ["1.0", "2.0", "3.0", "4.0", "4.1", "5.0"]
+    assert len(views[1][0]) == 5 and views[0][1][2] != b"\x00"
