@@ -306,8 +306,9 @@ class PinRing:
         check_bool("forward", forward)
         position = check_int("position", position, 1, len(self.devices), "a chip of the ring")
         if not forward and position not in self._return_inputs:
-            raise fail("position", "a chip with a chip behind it on its return input (not the last of the ring or a "
-                       "branch, none in an LBD-OR branch)", position)  # fmt: skip
+            raise fail("position", f"an integer from 1 to {len(self.devices)} (a chip of the ring; a return line only "
+                       "from a chip behind it: not into the last of the ring or of a branch, none in an LBD-OR branch)",
+                       position)  # fmt: skip
         self.cuts.add((position, forward))
 
     def run_levels(self, levels: npt.NDArray[np.uint8]) -> None:
