@@ -104,7 +104,7 @@ def test_a_pin_ring_shows_rd_on_its_last_chip_only() -> None:
     config = decode("10000", clk_conf=FAST, diag_conf=0)
     ring = PinRing([Supi3Pins(config) for _ in range(3)], record=True)
     ring.run_levels(wire.status_levels(Cycle.DATA, False, 20))
-    assert [chip.chip.following for chip in ring.devices] == [True, True, False]  # type: ignore[attr-defined]
+    assert [chip.chip.following for chip in ring.devices] == [True, True, False]
     assert [int(pins["diag2"][-1]) for pins in ring.recorded()] == [0, 0, 1]
 
 

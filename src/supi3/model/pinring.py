@@ -9,11 +9,22 @@ receiver that resynchronises on every start edge. A chip is the core alone (:cla
 the whole chip (:class:`~supi3.top.Supi3Chip`: in the Init-µP modes with its serial µP interface on MFP[7..0], whose
 pins :meth:`PinRing.set_input` holds (``mfp_in`` is 0 by default: give such a chip its µP's pins at rest,
 ``supi3.top.UP_REST``) or a software µP drives between runs, :class:`~supi3.spi.master.SoftMaster`).
+
+A ring can be a tree (docs/interbus.md "Tree"): a :class:`PinBranch` is the pin-level twin of
+:class:`~supi3.interbus.ring.Branch`, a bus terminal module (BK) chip with the chips of its branch. The BK sends on
+DO3 (MFP9) into the branch's first chip and takes the branch's return line on DI3 (MFP10): the first chip's DI1, or
+the last chip's DO2 in an LBD-OR branch (BK-37). The BK's outputs depend on DI3, which depends on its DO3 through the
+branch, so a branch is closed by iteration on copies (BK-40): the BK runs on a copy with a guess of DI3, its branch
+on a copy with the BK's DO3 gives the next guess, until the BK's DO3 comes back unchanged; then the chips themselves
+run once with that DI3. An empty branch reads DI3 at the idle level, the pull-up the manual asks for on an unused
+DI3 (BK-41).
 """
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
 import numpy as np
@@ -33,11 +44,13 @@ from supi3.checks import (
 from supi3.config import DeviceConfig, Interface
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusError, TelegramError
-from supi3.interbus.ring import ErrorKind, Transfer
+from supi3.interbus.ring import Branch, BranchKind, ErrorKind, Transfer
 from supi3.interbus.wire import Cycle, Frame, LineReset, Telegram
+from supi3.model.chip import Supi3
 from supi3.model.pins import PinTrace, Supi3Pins
 from supi3.pinlevel import Pin
 from supi3.tables import BIT_RATES, CLOCK_HZ
+from supi3.terminal import DI3_PIN, DO3_PIN
 
 
 @runtime_checkable
@@ -47,6 +60,10 @@ class PinChip(Protocol):
 
     inputs: Sequence[Pin]
     outputs: Sequence[Pin]
+
+    @property
+    def chip(self) -> Supi3:
+        """The chip's bus behaviour (the transaction-level model it drives)."""
 
     @property
     def config(self) -> DeviceConfig:
@@ -61,6 +78,73 @@ class PinChip(Protocol):
 
     def return_line(self, di2: PinTrace, do2: PinTrace) -> PinTrace:
         """``di1`` over the last :meth:`run_forward` (:meth:`Supi3Pins.return_line`)."""
+
+@dataclass(frozen=True, eq=False)
+class PinBranch:
+    """A bus terminal module chip and the chips of its branch, in data-path order: the pin-level twin of
+    :class:`~supi3.interbus.ring.Branch` (docs/interbus.md, "Tree"), checked by the same rules (Table 2-7, 2.2, 2.4:
+    the BK's interface fits ``kind``, the branch's chips are in ``kind``'s interface, only a remote bus branch holds
+    further branches).
+
+    Parameters
+    ----------
+    terminal:
+        The BK chip (:class:`PinChip` in a mode of Table 2-7).
+    devices:
+        The branch's chips and branches, first to last (none: nothing attached, BK-41).
+    kind:
+        What the branch is.
+    """
+
+    terminal: PinChip
+    devices: Sequence[PinChip | PinBranch]
+    kind: BranchKind
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.terminal, PinChip):
+            raise fail("terminal", "a Supi3Pins or Supi3Chip in a bus terminal mode (Table 2-7)", self.terminal)
+        if isinstance(self.devices, (str, bytes)) or not isinstance(self.devices, Sequence) \
+                or not all(isinstance(device, (PinChip, PinBranch)) for device in self.devices):
+            raise fail("devices", "a sequence of Supi3Pins, Supi3Chip and PinBranch objects", self.devices)
+        object.__setattr__(self, "devices", tuple(self.devices))
+        self.transaction_level()  # Branch's checks, on the chips' bus behaviour
+
+    def transaction_level(self) -> Branch:
+        """The same tree over the chips' transaction-level models (:attr:`PinChip.chip`), as
+        :class:`~supi3.interbus.ring.Branch` checks and describes it."""
+        return Branch(self.terminal.chip, [_transaction_level(device) for device in self.devices], self.kind)
+
+
+def _transaction_level(item: PinChip | PinBranch) -> Supi3 | Branch:
+    return item.transaction_level() if isinstance(item, PinBranch) else item.chip
+
+
+def _chips(items: Sequence[PinChip | PinBranch]) -> list[PinChip]:
+    """Every chip of a tree in physical order: a BK, then its branch's chips (nested branches in place)."""
+    found: list[PinChip] = []
+    for item in items:
+        if isinstance(item, PinBranch):
+            found.append(item.terminal)
+            found += _chips(item.devices)
+        else:
+            found.append(item)
+    return found
+
+
+def _return_inputs(items: Sequence[PinChip | PinBranch], first: int, returns: bool) -> set[int]:
+    """The positions (from ``first`` on, physical order) of the chips of ``items`` whose DI2 a chip drives: all but
+    the last of a sequence with return lines (``returns``), in branches too; none in an LBD-OR branch."""
+    found: set[int] = set()
+    position = first
+    for k, item in enumerate(items):
+        if returns and k + 1 < len(items):
+            found.add(position)
+        if isinstance(item, PinBranch):
+            found |= _return_inputs(item.devices, position + 1, item.kind is not BranchKind.LBD_OR)
+            position += len(_chips(item.devices))
+        position += 1
+    return found
+
 
 APPLICATION_INPUTS: dict[str, int] = {
     pin.name: pin.width for pin in Supi3Pins.inputs if pin.name not in ("do1", "di2")
@@ -130,14 +214,16 @@ class PinRing:
     Parameters
     ----------
     chips:
-        The pin-level chips (:data:`PinChip`) in ring order (position 1 first). All must run at the same bit rate.
+        The pin-level chips (:data:`PinChip`) in ring order (position 1 first), bus terminal modules with their
+        branches as :class:`PinBranch`. All must run at the same bit rate.
     record:
         Keep every pin trace of every chip (for :meth:`recorded` and VCD files).
 
     Attributes
     ----------
     devices:
-        The chips.
+        Every chip in physical order: a BK, then its branch's chips (nested branches in place), then on along the
+        remote bus; ring positions (:meth:`set_input`, :meth:`cut`) number them from 1.
     cycle:
         32 MHz clock cycles so far.
     returned:
@@ -147,35 +233,42 @@ class PinRing:
         The clock cycle of ``returned[0]``.
     """
 
-    def __init__(self, chips: Sequence[PinChip], record: bool = False) -> None:
+    def __init__(self, chips: Sequence[PinChip | PinBranch], record: bool = False) -> None:
         if isinstance(chips, (str, bytes)) or not isinstance(chips, Sequence) \
-                or not all(isinstance(chip, PinChip) for chip in chips):
-            raise fail("chips", "a sequence of Supi3Pins or Supi3Chip", chips)
-        if len({id(chip) for chip in chips}) != len(chips):
+                or not all(isinstance(chip, (PinChip, PinBranch)) for chip in chips):
+            raise fail("chips", "a sequence of Supi3Pins or Supi3Chip objects and PinBranch trees", chips)
+        every = _chips(chips)
+        if len({id(chip) for chip in every}) != len(every):
             raise fail("chips", "distinct Supi3Pins or Supi3Chip objects (one per ring position)", chips)
         check_bool("record", record)
         if not chips:
             raise InterbusError("docs/interbus.md, Ring", 0, "a ring needs at least one device")
-        rates = {chip.config.bit_rate for chip in chips}
+        rates = {chip.config.bit_rate for chip in every}
         if len(rates) != 1:
             raise InterbusError("Table 1-7", sorted(rates), "every device of a ring runs at one bit rate")
-        self.devices = list(chips)
-        self.repeaters = len(chips) + sum(chip.config.interface is Interface.LBD_MR for chip in chips)
+        self.tree: list[PinChip | PinBranch] = list(chips)
+        """The ring's items as given (:class:`PinBranch` for a BK with its branch)."""
+        self.devices = every
+        self.repeaters = len(every) + sum(chip.config.interface is Interface.LBD_MR for chip in every)
         """The repeaters a bit passes round the ring, each ``REPEATER_DELAY_BITS`` (A10): every chip on the forward
         line, and an LBD-MR chip once more on its return line (its counter block repeats it, M17). The master's
-        ring delay (A11, ``wire.ring_delay_status_telegrams``) counts them."""
+        ring delay (A11, ``wire.ring_delay_status_telegrams``) counts them; in a tree every chip of every branch (a
+        BK repeats DI3 without delay, BK-37), the most the data path can hold."""
+        self._return_inputs = _return_inputs(chips, 1, True)
         self.bit_rate = rates.pop()
         self.cpb = wire.clocks_per_bit(self.bit_rate)
         self.cycle = 0
         self.returned = np.zeros(0, dtype=np.uint8)
         self.returned_from = 0
         self.record = record
+        self.trials = 0
+        """Runs of a branch's chips on copies so far (BK-40), for benches."""
         self._chunks: list[list[dict[str, npt.NDArray[np.int64]]]] = []
         self.cuts: set[tuple[int, bool]] = set()
         """Broken lines, as ``(position, forward)``: see :meth:`cut`."""
         self._inputs = [
             {"di2": 0, "rbst_ext": 0, "mfp_in": 0, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 1, "from_exr": 0}
-            for _ in chips
+            for _ in every
         ]
 
     @property
@@ -199,10 +292,11 @@ class PinRing:
         self._inputs[position - 1][pin] = check_bits(f"pin {pin!r}", value, APPLICATION_INPUTS[pin])
 
     def cut(self, position: int, forward: bool) -> None:
-        """Break the line into the chip at ring ``position``: its forward input DO1 (``forward``, 1..N), or its return
-        input DI2 from the chip behind it (1..N - 1). A broken line reads at the idle level (RS-485 fail-safe
-        bias, BK-30): behind it the LBD chips' counter telegrams (2.2.2) bring the master the count of
-        ``ring.lbd_count`` (``forward``, ``back``) for a branch of these chips.
+        """Break the line into the chip at ring ``position``: its forward input DO1 (``forward``, any chip; the first
+        chip of a branch takes its BK's DO3), or its return input DI2 from the chip behind it (a chip that has one:
+        not the last of the ring or of a branch, none in an LBD-OR branch). A broken line reads at the idle level
+        (RS-485 fail-safe bias, BK-30): behind it the LBD chips' counter telegrams (2.2.2) bring the master, or the
+        branch's BK, the count of ``ring.lbd_count`` (``forward``, ``back``) for a branch of these chips.
 
         Raises
         ------
@@ -210,8 +304,11 @@ class PinRing:
             ``forward`` not a bool or ``position`` out of range; nothing changes.
         """
         check_bool("forward", forward)
-        position = check_int("position", position, 1, len(self.devices) - (0 if forward else 1),
-                             "a chip of the ring; a return line only from a chip behind it")  # fmt: skip
+        position = check_int("position", position, 1, len(self.devices), "a chip of the ring")
+        if not forward and position not in self._return_inputs:
+            raise fail("position", f"an integer from 1 to {len(self.devices)} (a chip of the ring; a return line only "
+                       "from a chip behind it: not into the last of the ring or of a branch, none in an LBD-OR branch)",
+                       position)  # fmt: skip
         self.cuts.add((position, forward))
 
     def run_levels(self, levels: npt.NDArray[np.uint8]) -> None:
@@ -222,35 +319,106 @@ class PinRing:
     def run_samples(self, samples: npt.NDArray[np.uint8]) -> None:
         """Clock the ring once per sample of the master's forward line.
 
-        Every chip runs the whole trace forward (``do1`` from its upstream neighbour's ``do2``), then the
-        return line is assembled from the last chip back to the first (:meth:`Supi3Pins.return_line`,
-        :meth:`Supi3Chip.return_line`).
+        Every chip runs the whole trace forward (``do1`` from its upstream neighbour's ``do2``, a branch's first
+        chip's from its BK's DO3), then the return line is assembled from the last chip back to the first
+        (:meth:`Supi3Pins.return_line`, :meth:`Supi3Chip.return_line`); a branch is closed first (BK-40).
         """
         forward = check_trace("samples", samples, 1).astype(np.int64, copy=False)
         n = len(forward)
-        placeholder = np.zeros(n, dtype=np.int64)
-        broken = np.full(n, wire.IDLE_LEVEL, dtype=np.int64)
-        sent = []
-        chunk = []
-        for position, (chip, pins) in enumerate(zip(self.devices, self._inputs, strict=True), 1):
-            traces = {name: np.full(n, value, dtype=np.int64) for name, value in pins.items()}
-            traces["do1"] = broken if (position, True) in self.cuts else forward
-            traces["di2"] = placeholder
-            outputs = chip.run_forward(traces)
-            forward = outputs["do2"]
-            sent.append(forward)
-            chunk.append({**traces, **outputs})
-        back = placeholder
-        for k in range(len(self.devices) - 1, -1, -1):
-            if (k + 1, False) in self.cuts:
-                back = broken
-            chunk[k]["di2"] = back
-            back = self.devices[k].return_line(back, sent[k])
-            chunk[k]["di1"] = back
-        if self.record:
-            self._chunks.append(chunk)
+        chunk: dict[int, dict[str, npt.NDArray[np.int64]]] | None = {} if self.record else None
+        _, sent = self._forward(self.tree, 1, forward, chunk)
+        back = self._back(sent, np.zeros(n, dtype=np.int64), chunk)
+        if chunk is not None:
+            self._chunks.append([chunk[k] for k in range(1, len(self.devices) + 1)])
         self.cycle += n
         self.returned = np.concatenate([self.returned, back.astype(np.uint8)])
+
+    def _forward(self, items: Sequence[PinChip | PinBranch], first: int, line: npt.NDArray[np.int64],
+                 chunk: dict[int, dict[str, npt.NDArray[np.int64]]] | None,
+                 ) -> tuple[npt.NDArray[np.int64], list[tuple[PinChip, int, PinTrace]]]:
+        """Run ``items`` (the first at ring position ``first``) forward on ``line``: what the last sends on, and each
+        item's chip (a branch's BK), position and ``do2`` for :meth:`_back`."""
+        sent = []
+        position = first
+        for item in items:
+            if isinstance(item, PinBranch):
+                chip = item.terminal
+                outputs = self._branch(item, position, line, chunk)
+                size = 1 + len(_chips(item.devices))
+            else:
+                chip, size = item, 1
+                outputs = self._run(chip, position, line, None, chunk)
+            line = outputs["do2"]
+            sent.append((chip, position, line))
+            position += size
+        return line, sent
+
+    def _back(self, sent: list[tuple[PinChip, int, PinTrace]], back: npt.NDArray[np.int64],
+              chunk: dict[int, dict[str, npt.NDArray[np.int64]]] | None) -> npt.NDArray[np.int64]:
+        """The return line through the chips :meth:`_forward` ran, from the last back to the first, ``back`` into the
+        last: what the first sends back."""
+        for chip, position, do2 in reversed(sent):
+            if (position, False) in self.cuts:
+                back = np.full(len(back), wire.IDLE_LEVEL, dtype=np.int64)
+            if chunk is not None:
+                chunk[position]["di2"] = back
+            back = chip.return_line(back, do2)
+            if chunk is not None:
+                chunk[position]["di1"] = back
+        return back
+
+    def _run(self, chip: PinChip, position: int, line: npt.NDArray[np.int64], di3: npt.NDArray[np.int64] | None,
+             chunk: dict[int, dict[str, npt.NDArray[np.int64]]] | None) -> dict[str, PinTrace]:
+        """Run the chip at ``position`` forward with ``line`` on DO1 (broken: idle, BK-30) and, for a BK, ``di3``
+        on DI3."""
+        n = len(line)
+        traces = {name: np.full(n, value, dtype=np.int64) for name, value in self._inputs[position - 1].items()}
+        traces["do1"] = np.full(n, wire.IDLE_LEVEL, dtype=np.int64) if (position, True) in self.cuts else line
+        traces["di2"] = np.zeros(n, dtype=np.int64)  # the return line comes in _back
+        if di3 is not None:
+            traces["mfp_in"] = traces["mfp_in"] & ~(1 << DI3_PIN) | di3 << DI3_PIN
+        outputs = chip.run_forward(traces)
+        if chunk is not None:
+            chunk[position] = {**traces, **outputs}
+        return outputs
+
+    def _branch(self, branch: PinBranch, position: int, line: npt.NDArray[np.int64],
+                chunk: dict[int, dict[str, npt.NDArray[np.int64]]] | None) -> dict[str, PinTrace]:
+        """Run a BK at ``position`` with ``line`` on DO1 and its branch; the BK's outputs (BK-40).
+
+        DI3 is the fixed point of guess -> the BK's DO3 -> the branch's return line, from the idle level, found on
+        copies of the chips: a guess ``g`` gives the BK's DO3 ``d = B(g)`` and the branch's return line ``F(d)``, the
+        next guess; once ``B(F(d)) == d`` the branch would return ``F(d)`` again, a fixed point. A loop through a
+        branch delays by at least one repeater (3 bit periods, A10) and the BK reads DI3 through its synchroniser,
+        so each guess is right for at least the loop's delay further than the one before: the iteration ends, at
+        the latest after the run's length over that delay, and its fixed point is the one the chips would see (the
+        line is causal). Usually the BK's DO3 does not depend on DI3 within a run, and two runs of the BK and one of
+        the branch on copies find it. The chips then run once with it."""
+        di3 = np.full(len(line), wire.IDLE_LEVEL, dtype=np.int64)  # nothing attached: the pull-up (BK-41)
+        if branch.devices:
+            do3 = None
+            while True:
+                outputs = self._run(copy.deepcopy(branch.terminal), position, line, di3, None)
+                sent = (outputs["mfp_out"] >> DO3_PIN & 1).astype(np.int64)
+                if do3 is not None and np.array_equal(sent, do3):
+                    break
+                do3 = sent
+                self.trials += 1
+                di3 = self._return(branch.kind, copy.deepcopy(branch.devices), position + 1, do3, None)
+        outputs = self._run(branch.terminal, position, line, di3, chunk)
+        if branch.devices:
+            self._return(branch.kind, branch.devices, position + 1, (outputs["mfp_out"] >> DO3_PIN & 1).astype(
+                np.int64), chunk)  # fmt: skip
+        return outputs
+
+    def _return(self, kind: BranchKind, devices: Sequence[PinChip | PinBranch], first: int,
+                do3: npt.NDArray[np.int64], chunk: dict[int, dict[str, npt.NDArray[np.int64]]] | None,
+                ) -> npt.NDArray[np.int64]:
+        """Run a branch's ``devices`` (the first at ring position ``first``) with ``do3`` from their BK: the branch's
+        return line into the BK's DI3, the first chip's DI1, or the last chip's DO2 in an LBD-OR branch."""
+        end, sent = self._forward(devices, first, do3, chunk)
+        back = self._back(sent, np.zeros(len(do3), dtype=np.int64), chunk)
+        return (end if kind is BranchKind.LBD_OR else back).astype(np.int64, copy=False)
 
     def recorded(self) -> list[dict[str, npt.NDArray[np.int64]]]:
         """Every pin trace of every chip since the ring was made (``record=True``), chips in ring order."""

@@ -1,0 +1,254 @@
+"""A pin-level ring that is a tree (supi3.model.pinring.PinRing with PinBranch; manual 2.4, Figure 1-10, Tables 2-7 to
+2-9; docs/interbus.md "Tree"; BK-37..BK-41): a master on it gets the same configuration, data length and process data
+as on the transaction-level ring (supi3.interbus.ring.Ring) of the same tree, for every kind of branch; switching the
+branch off and on changes the data length at both; the extended BK function closes a branch silent behind a cut and,
+in BK-LBD, the BK's count locates the cut as ``ring.lbd_count`` says; an empty branch reads DI3 idle (BK-41)."""
+
+from __future__ import annotations
+
+import pytest
+
+from supi3 import tables
+from supi3.config import DeviceConfig, decode
+from supi3.errors import ArgumentError
+from supi3.interbus import wire
+from supi3.interbus.master import Master
+from supi3.interbus.ring import Branch, BranchKind, ErrorKind, Ring, lbd_count
+from supi3.interbus.wire import Cycle
+from supi3.model.chip import Supi3
+from supi3.model.pinring import PinBranch, PinRing
+from supi3.model.pins import Supi3Pins
+from supi3.terminal import DO3_PIN, LBST_PIN
+from support import BK_STRAPS
+
+FAST = tables.clk_conf_for(2_000_000)
+LBST = 1 << LBST_PIN
+ROWS = {BranchKind.REMOTE: "RB, 8 IN/8 OUT", BranchKind.LOCAL: "LB-MR, 8 IN/OUT",
+        BranchKind.LBD_MR: "LBD-MR, 8 IN/8 OUT", BranchKind.LBD_OR: "LBD-OR, 8 IN/8 OUT"}  # fmt: skip
+"""The branch devices' mode of each kind (Tables 2-4 to 2-6); the remote bus devices are RB ones."""
+INPUTS = [0x11, 0x22, 0x33, 0x44, 0x55]
+"""MFP input levels of the positions after the BK's, in order (the process data IN)."""
+RECOVERY = 8
+
+
+def _config(row: str) -> DeviceConfig:
+    found = next(r for r in tables.MODE_ROWS if r.function == row)
+    return decode(found.c, found.mfp, clk_conf=FAST)
+
+
+def _bk(kind: BranchKind, rf: str = "11") -> DeviceConfig:
+    return decode(BK_STRAPS[kind.terminal], rf=rf, clk_conf=FAST)
+
+
+def tl_tree(kind: BranchKind, m: int, lbst: bool = True) -> Ring:
+    """RB device, BK with ``m`` branch devices of ``kind``, RB device; the MFP inputs of :data:`INPUTS`."""
+    bk = Supi3(_bk(kind))
+    bk.set_mfp_inputs(LBST if lbst else 0)
+    chips = [Supi3(_config(ROWS[BranchKind.REMOTE])), *(Supi3(_config(ROWS[kind])) for _ in range(m)),
+             Supi3(_config(ROWS[BranchKind.REMOTE]))]  # fmt: skip
+    for chip, value in zip([chips[0], *chips[1:]], [0x5A, *INPUTS], strict=False):
+        chip.set_mfp_inputs(value)
+    return Ring([chips[0], Branch(bk, chips[1:-1], kind), chips[-1]], bit_rate=2_000_000)
+
+
+def pin_tree(kind: BranchKind, m: int, lbst: bool = True, silence: int | None = None,
+             rf: str = "11") -> PinRing:  # fmt: skip
+    """The pin-level twin of :func:`tl_tree`; ``silence`` shortens the BK's branch silence (BK-3), in clocks."""
+    bk = Supi3Pins(_bk(kind, rf)) if silence is None else Supi3Pins(_bk(kind, rf), branch_silence=silence)
+    chips = [Supi3Pins(_config(ROWS[kind])) for _ in range(m)]
+    ring = PinRing([Supi3Pins(_config(ROWS[BranchKind.REMOTE])), PinBranch(bk, chips, kind),
+                    Supi3Pins(_config(ROWS[BranchKind.REMOTE]))])  # fmt: skip
+    ring.set_input(2, "mfp_in", LBST if lbst else 0)
+    for position, value in zip([1, *range(3, m + 4)], [0x5A, *INPUTS], strict=False):
+        ring.set_input(position, "mfp_in", value)
+    return ring
+
+
+def healthy(master: Master) -> None:
+    """Cycles until a data cycle latches on a table of the ring's data path (a switch garbles the telegram in flight
+    at pin level: the master recovers)."""
+    for _ in range(RECOVERY):
+        result = master.cycle()
+        if result.ok and result.cycle is Cycle.DATA:
+            return
+    raise AssertionError(f"stuck: {master.diagnostics[-3:]}")
+
+
+def view(master: Master) -> tuple[list[tuple[str, int, int]], list[bytes]]:
+    """The master's configuration (number, ID code, data length) and the process data IN of every position."""
+    assert master.config is not None
+    return ([(entry.number, entry.id_code, entry.data_bytes) for entry in master.config],
+            [master.inputs(k) for k in range(1, len(master.config) + 1)])  # fmt: skip
+
+
+CASES = [(BranchKind.REMOTE, 1), (BranchKind.LOCAL, 2), (BranchKind.LBD_MR, 1), (BranchKind.LBD_OR, 1)]
+
+
+@pytest.mark.parametrize(("kind", "m"), CASES)
+def test_a_master_sees_the_same_tree_at_both_fidelities(kind: BranchKind, m: int) -> None:
+    """BK-RB, BK-LB, BK-LBD (LBD-MR, LBD-OR): the same configuration (numbers x.0, x.1, ...), ID codes, data
+    lengths and process data; OUT data reach the branch's last device at both; switching the branch off removes its
+    devices from the configuration at both, switching it on brings them back."""
+    pins = pin_tree(kind, m)
+    rings: list[Ring | PinRing] = [tl_tree(kind, m), pins]
+    masters = [Master(ring, locate=False, max_devices=8) for ring in rings]
+    views = []
+    for master in masters:
+        assert master.start().ok
+        master.set_outputs(2 + m, b"\xa5")
+        healthy(master)
+        views.append(view(master))
+    assert views[0] == views[1]
+    pins.settle()  # the latch telegrams reach the last chips
+    assert [number for number, _, _ in views[0][0]] == ["1.0", "2.0", *(f"2.{k}" for k in range(1, m + 1)), "3.0"] \
+        if kind is not BranchKind.REMOTE else ["1.0", "2.0", "3.0", "4.0"]  # fmt: skip
+    assert rings[0].devices[1 + m].mfp_outputs == rings[1].devices[1 + m].chip.mfp_outputs != 0  # type: ignore[union-attr]
+    for on, size in ((False, 3), (True, 3 + m)):
+        for master in masters:
+            master.switch_branch(2, on)
+            healthy(master)
+            assert master.config is not None and len(master.config) == size
+        assert view(masters[0]) == view(masters[1])
+
+
+def cut_tree(kind: BranchKind, m: int, at: int) -> tuple[PinRing, Master]:
+    """:func:`pin_tree` with a short branch silence, the extended function on, then the forward line into branch
+    device ``at`` cut; the master cycles until it reports the branch closed."""
+    ring = pin_tree(kind, m, silence=SILENCE)
+    master = Master(ring, max_devices=8)
+    assert master.start().ok
+    master.switch_branch(2, True, extended=True)
+    healthy(master)
+    assert master.config is not None and len(master.config) == 3 + m
+    ring.cut(2 + at, True)
+    for _ in range(RECOVERY):
+        result = master.cycle()
+        if any(d.kind is ErrorKind.BRANCH_CLOSED for d in result.diagnostics):
+            break
+    else:
+        raise AssertionError(f"never closed: {master.diagnostics[-3:]}")
+    healthy(master)
+    return ring, master
+
+
+SILENCE = 8_000
+"""The BK's branch silence in these rings, in clocks (0.25 ms; BK-3's 10 ms would take 40 times as long): twice
+their longest master cycle, so a working branch never falls silent that long."""
+
+
+@pytest.mark.slow  # 2 to 4 s each: a master cycles through the silence
+@pytest.mark.parametrize(("kind", "m", "at"), [(BranchKind.LOCAL, 2, 2), (BranchKind.LBD_MR, 2, 2),
+                                               (BranchKind.LBD_OR, 2, 1)])  # fmt: skip
+def test_the_bk_closes_a_branch_silent_behind_a_cut(kind: BranchKind, m: int, at: int) -> None:
+    """BK-3, BK-37..39 through a whole ring: the master's telegrams stop coming back on DI3, the BK closes the
+    branch, the master sees the data length change (the branch's devices gone) and the BK's report; in BK-LBD the
+    count the BK kept locates the cut: ``ring.lbd_count``'s, as the transaction-level BK reports it."""
+    ring, master = cut_tree(kind, m, at)
+    assert master.config is not None and len(master.config) == 3
+    status = master.branch_status[2]
+    bk = ring.devices[1].chip.bus_terminal
+    assert bk is not None and bk.closures == 1
+    expected = lbd_count(kind, m, {at}, set()) if kind.diagnostics else None
+    assert status.counter == (expected or 0) == bk.count
+
+
+@pytest.mark.parametrize("rf", ["10", "11"])
+def test_an_empty_branch_reads_di3_idle(rf: str) -> None:
+    """BK-41: nothing attached, DI3 is pulled up (Table 2-8 notes). With LBST = 0, the manual's wiring of an unused
+    branch interface, the branch is not present (Table 2-9) and the ring runs through the BK as at transaction
+    level; with LBST = 1 the BK routes the data path into the open interface and DO2 idles: nothing comes back."""
+    for lbst in (False, True):
+        bk = Supi3Pins(_bk(BranchKind.LOCAL, rf))
+        ring = PinRing([Supi3Pins(_config(ROWS[BranchKind.REMOTE])), PinBranch(bk, [], BranchKind.LOCAL)], record=True)
+        ring.set_input(2, "mfp_in", LBST if lbst else 0)
+        master = Master(ring, locate=False, max_devices=4)
+        result = master.start()
+        assert result.ok is not lbst
+        if lbst:
+            assert result.diagnostics[0].kind is ErrorKind.DEAD_LINE
+        bk_pins = ring.recorded()[1]
+        assert (bk_pins["mfp_in"] >> 10 & 1).all()  # DI3 (MFP10) idle throughout
+        assert (bk_pins["mfp_out"] >> DO3_PIN & 1)[-1000:].any()
+
+
+def test_pin_branches_are_checked_as_branches() -> None:
+    """PinBranch takes Branch's rules (Table 2-7, 2.2, 2.4) on the chips' bus behaviour; a return line can be cut
+    only where a chip drives it."""
+    rb = Supi3Pins(_config(ROWS[BranchKind.REMOTE]))
+    with pytest.raises(ArgumentError, match="terminal"):
+        PinBranch(rb, [], BranchKind.LOCAL)
+    with pytest.raises(ArgumentError, match="branch device 1"):
+        PinBranch(Supi3Pins(_bk(BranchKind.LOCAL)), [Supi3Pins(_config(ROWS[BranchKind.REMOTE]))], BranchKind.LOCAL)
+    with pytest.raises(ArgumentError, match="devices"):
+        PinBranch(Supi3Pins(_bk(BranchKind.LOCAL)), "ab", BranchKind.LOCAL)  # type: ignore[arg-type]
+    ring = pin_tree(BranchKind.LBD_OR, 2)
+    assert isinstance(ring.tree[1], PinBranch) and isinstance(ring.tree[1].transaction_level(), Branch)
+    ring.cut(1, False)
+    ring.cut(2, False)  # the BK's DI2, from the remote bus device behind it
+    for position in (3, 4, 5):  # LBD-OR chips have no return line; the last remote bus device has none behind it
+        with pytest.raises(ArgumentError, match="position"):
+            ring.cut(position, False)
+    assert wire.IDLE_LEVEL == 1
+
+
+@pytest.mark.parametrize("kind", [BranchKind.LOCAL, BranchKind.LBD_OR])
+def test_the_branch_loop_closes_on_the_chips_own_lines(kind: BranchKind) -> None:
+    """BK-40: in the recording, the branch's first chip takes the BK's DO3 on DO1, and the BK's DI3 is the branch's
+    return line (the first chip's DI1; the last chip's DO2 in an LBD-OR branch) in every clock of the run; the
+    iteration needed at most 2 branch runs on copies per ring run (the BK's DO3 depended on DI3 once: when the
+    branch was first seen)."""
+    m = 2
+    bk = Supi3Pins(_bk(kind))
+    chips = [Supi3Pins(_config(ROWS[kind])) for _ in range(m)]
+    ring = PinRing([Supi3Pins(_config(ROWS[BranchKind.REMOTE])), PinBranch(bk, chips, kind)], record=True)
+    ring.set_input(2, "mfp_in", LBST)
+    master = Master(ring, locate=False, max_devices=4)
+    assert master.start().ok
+    healthy(master)
+    runs = ring.trials
+    pins = ring.recorded()
+    assert (pins[2]["do1"] == pins[1]["mfp_out"] >> DO3_PIN & 1).all()
+    returned = pins[1 + m]["do2"] if kind is BranchKind.LBD_OR else pins[2]["di1"]
+    di3 = pins[1]["mfp_in"] >> 10 & 1
+    assert (di3 == returned).all() and not di3.all()  # the branch's traffic came back on DI3
+    assert master.config is not None and len(master.config) == 2 + m
+    assert runs <= 2 * len(ring._chunks)
+
+
+def nested_tl() -> Ring:
+    """Figure 1-10's nesting, small: RB device, BK-RB (RB device, BK-LB (one LB-MR device)), RB device; the RB device
+    in the remote bus branch reads 5Ah on its MFP inputs."""
+    rb = [Supi3(_config(ROWS[BranchKind.REMOTE])) for _ in range(3)]
+    outer, inner = Supi3(_bk(BranchKind.REMOTE)), Supi3(_bk(BranchKind.LOCAL))
+    for device, value in ((outer, LBST), (rb[1], 0x5A), (inner, LBST)):
+        device.set_mfp_inputs(value)
+    local = Branch(inner, [Supi3(_config(ROWS[BranchKind.LOCAL]))], BranchKind.LOCAL)
+    return Ring([rb[0], Branch(outer, [rb[1], local], BranchKind.REMOTE), rb[2]], bit_rate=2_000_000)
+
+
+def nested_pin() -> PinRing:
+    """The pin-level twin of :func:`nested_tl`."""
+    rb = [Supi3Pins(_config(ROWS[BranchKind.REMOTE])) for _ in range(3)]
+    local = PinBranch(Supi3Pins(_bk(BranchKind.LOCAL)), [Supi3Pins(_config(ROWS[BranchKind.LOCAL]))], BranchKind.LOCAL)
+    ring = PinRing([rb[0], PinBranch(Supi3Pins(_bk(BranchKind.REMOTE)), [rb[1], local], BranchKind.REMOTE), rb[2]])
+    for position, value in ((2, LBST), (3, 0x5A), (4, LBST)):
+        ring.set_input(position, "mfp_in", value)
+    return ring
+
+
+@pytest.mark.slow  # about 2 s
+def test_a_nested_tree_is_the_same_at_both_fidelities() -> None:
+    """A BK-LB inside a remote bus branch (2.4: only a remote bus branch holds BKs): the same configuration and
+    process data; switching the inner branch off removes its device at both."""
+    views = []
+    for ring in (nested_tl(), nested_pin()):
+        master = Master(ring, locate=False, max_devices=8)
+        assert master.start().ok
+        healthy(master)
+        views.append(view(master))
+        master.switch_branch(4, False)
+        healthy(master)
+        views.append(view(master))
+    assert views[0] == views[2] and views[1] == views[3]
+    assert [number for number, _, _ in views[0][0]] == ["1.0", "2.0", "3.0", "4.0", "4.1", "5.0"]
+    assert len(views[1][0]) == 5 and views[0][1][2] != b"\x00"
