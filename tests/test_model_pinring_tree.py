@@ -332,7 +332,8 @@ def test_a_cut_of_the_bks_di3_is_the_transaction_levels_return_break(kind: Branc
     ``ReturnBreak`` at the BK give the master the same view: the cycles fail with nothing coming back until the
     extended function closes the silent branch (BK-3; at pin level after the rings' short silence), then both read
     the same shorter configuration and process data and the same branch status (closed; count 0 in BK-LBD: the BK's
-    own return input, BK-7, as no counter telegram reaches it) and report the closure at the BK."""
+    own return input, BK-7, as no counter telegram reaches it), report the closure at the BK and count the same chips
+    in a transfer (BK-1: the closed branch's are out of the data path)."""
     m = 2
     rings: list[Ring | PinRing] = [tl_tree(kind, m), pin_tree(kind, m, silence=SILENCE)]
     views = []
@@ -355,7 +356,9 @@ def test_a_cut_of_the_bks_di3_is_the_transaction_levels_return_break(kind: Branc
         else:
             raise AssertionError(f"never closed: {master.diagnostics[-3:]}")
         healthy(master)
-        views.append((view(master), master.branch_status[2], closed))
+        counts = counted(ring)
+        healthy(master)
+        views.append((view(master), master.branch_status[2], closed, counts[-1]))  # closed: 3 chips in the path
     assert views[0] == views[1]
     assert len(views[0][0][0]) == 3 and views[0][1].closed and views[0][1].counter == 0
     pins = pin_tree(kind, m)
