@@ -363,8 +363,11 @@ def test_a_cut_of_the_bks_di3_is_the_transaction_levels_return_break(kind: Branc
     assert len(views[0][0][0]) == 3 and views[0][1].closed and views[0][1].counter == 0
     pins = pin_tree(kind, m)
     for position, forward in ((1, False), (2, True)):  # not a BK; DI3 is a return input
-        with pytest.raises(ArgumentError, match="position"):
+        with pytest.raises(ArgumentError, match=r"^position must be the ring position of a BK with a branch \(\[2\]\)"):
             pins.cut(position, forward, branch=True)
+    with pytest.raises(ArgumentError, match=r"^branch must be"):
+        pins.cut(2, False, branch=1)  # type: ignore[arg-type]
+    assert pins.branch_cuts == set() and pins.cuts == set()
 
 
 def test_a_whole_chip_with_a_microprocessor_is_a_bk_in_a_tree() -> None:
