@@ -104,6 +104,9 @@ SERVE_TELEGRAMS: Final[int] = 64
 telegrams while the firmware is still in a handler or has an /IRQ edge to serve."""
 
 
+_EXTI0: Final[int] = EXTERNAL + EXTI0_IRQ
+"""The exception number of EXTI0, /IRQ's line."""
+
 _T = TypeVar("_T")
 _R = TypeVar("_R")
 
@@ -428,7 +431,10 @@ class Board:
     def sync(self, cycles: int, event: int | None = None) -> None:
         """Run the bus up to core cycle ``cycles``, then follow /IRQ; ``event``: the cycle of the bus event passed
         on the way, when /IRQ changed if it did."""
-        self.bench.advance(self._seconds(cycles))
+        bench = self._bench
+        if bench is None:
+            bench = self.bench  # BoardError at pin level
+        bench.advance(cycles / self.core.cpu_hz)
         self._follow_irq(cycles, event)
 
     def _now(self) -> int:
@@ -455,13 +461,14 @@ class Board:
         self._request()
 
     def _request(self) -> None:
-        number = EXTERNAL + EXTI0_IRQ
-        if self.exti.requesting(0) and number not in self.core.active and number not in self.core.pending:
-            self.core.pend(number)
-            self.core.stop_request = True
+        if self.exti.requesting(0):
+            core = self.core
+            if _EXTI0 not in core.active and _EXTI0 not in core.pending:
+                core.pend(_EXTI0)
+                core.stop_request = True
 
     def _entered(self, number: int) -> None:
-        if number == EXTERNAL + EXTI0_IRQ:
+        if number == _EXTI0:
             self.interrupts += 1
             if self._irq_fell is not None:
                 self.irq_latency_s = max(self.irq_latency_s, self._seconds(self.core.cycles - self._irq_fell))
@@ -582,9 +589,15 @@ class Board:
         log = self.registers.violations
         records = log.records
         before = len(records)
+        log.hold()  # log.deferred() without the with statement's cost (the per-byte hot path)
         try:
-            with log.deferred():
-                return action(argument)
+            try:
+                result = action(argument)
+            except BaseException:
+                log.release(failed=True)
+                raise
+            log.release()
+            return result
         finally:
             if len(records) > before:
                 self._note(records[before:], cycles)
