@@ -979,15 +979,15 @@ class Ring:
         receiver_error: ErrorKind | None = None
         flags_back = wire.CntrFlags(attention, error)
         if (dead is None or dead > segments) and not back_dead:
-            sent = _Line(stream, crc, wire.cntr_word(attention, error))
+            returned = stream
             last = n + 1
             if record or last in faults:
+                sent = _Line(stream, crc, wire.cntr_word(attention, error))
                 line, receiver_error = self._receive(cycle, sent, faults.get(last, []), shifted)
                 if record:
                     self.trace.append(SegmentTrace(last, sent.frame(cycle), line.frame(cycle), receiver_error))
                 flags_back = wire.decode_cntr(line.cntr) or wire.CntrFlags(True, True)
-                sent = line
-            returned = sent.stream
+                returned = line.stream
         elif record:
             silent = _Line(stream, crc, wire.cntr_word(attention, error))
             self.trace.append(SegmentTrace(segments if dead is None else dead, silent.frame(cycle), None, None))
@@ -1023,7 +1023,8 @@ class Ring:
             for index in range(transfer.reached):
                 self._silent_since.pop(index, None)
                 self._silent_reset.discard(index)
-        self._go_silent(range(transfer.reached, len(self.devices)), start, end)
+        if transfer.reached < len(self.devices):
+            self._go_silent(range(transfer.reached, len(self.devices)), start, end)
         self.now = end
         if self._branches:
             for terminal, traffic, count in transfer.branches:
