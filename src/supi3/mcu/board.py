@@ -160,7 +160,7 @@ class _BoardBench(Bench):
         return self._next_event()
 
 
-@dataclass
+@dataclass(slots=True)
 class _Frame:
     fall: int  # cycle of /SS falling
     driven: int | None  # what the chip drives on SerOUT (UP-18)
@@ -444,7 +444,10 @@ class Board:
 
     # -- /IRQ, EXTI0 and the NVIC ------------------------------------------------------------------------------
 
-    def _follow_irq(self, cycles: int, event: int | None = None) -> None:
+    def _follow_irq(self, cycles: int, event: int | None = None, *, request: bool = True) -> None:
+        """Pass /IRQ's and /ModAck's edges since the last call to EXTI, then let EXTI0 request its interrupt;
+        ``request=False``: only if an edge was passed (the caller requested since, and nothing else changes EXTI or
+        the NVIC within one peripheral access)."""
         bench = self._bench
         assert bench is not None
         pulse = bench.chip.mod_ack_until
@@ -452,13 +455,16 @@ class Board:
             self._mod_ack_until = pulse
             self.exti.edge(PORT_B, PIN_MODACK, 0)
             self.exti.edge(PORT_B, PIN_MODACK, 1)
+            request = True
         level = self.registers.irq_n
         if level != self._irq_level:
             self._irq_level = level
             if not level and self._irq_fell is None:
                 self._irq_fell = cycles if event is None else event
             self.exti.edge(0, PIN_IRQ, level)
-        self._request()
+            request = True
+        if request:
+            self._request()
 
     def _request(self) -> None:
         if self.exti.requesting(0):
@@ -585,7 +591,8 @@ class Board:
     # -- the chip and its violations ---------------------------------------------------------------------------
 
     def _chip(self, action: Callable[[_T], _R], cycles: int, argument: _T) -> _R:
-        """``action(argument)`` on the chip with its violations deferred to its end; note the new ones with the PC."""
+        """``action(argument)`` on the chip with its violations deferred to its end; note the new ones with the PC.
+        Called within a peripheral access after :meth:`sync`, which let EXTI0 request its interrupt."""
         log = self.registers.violations
         records = log.records
         before = len(records)
@@ -601,7 +608,7 @@ class Board:
         finally:
             if len(records) > before:
                 self._note(records[before:], cycles)
-            self._follow_irq(cycles)
+            self._follow_irq(cycles, request=False)
 
     def _violation(self, rule: str, detail: str) -> None:
         self._chip(self.registers.violations.report, self.core.cycles_now(), InterfaceViolationError(rule, detail))
