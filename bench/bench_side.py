@@ -20,9 +20,11 @@ the same work (instructions, interrupts, violations, process data). Run from the
 from __future__ import annotations
 
 import argparse
+import cProfile
 import gc
 import importlib
 import os
+import pstats
 import sys
 import tempfile
 import time
@@ -66,8 +68,16 @@ def use(tree: Tree) -> None:
     sys.modules.update(tree)
 
 
+COUNT_CALLS = False
+"""``--calls``: run the measured part under cProfile and report its function calls in place of CPU seconds."""
+
+
 def _cpu(run: Callable[[], object]) -> float:
     gc.collect()
+    if COUNT_CALLS:
+        profiler = cProfile.Profile()
+        profiler.runcall(run)
+        return float(pstats.Stats(profiler).total_calls)  # type: ignore[attr-defined]
     start = time.process_time()
     run()
     return time.process_time() - start
@@ -125,13 +135,17 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--against", help="another tree's src folder, measured interleaved with this one")
     parser.add_argument("--rounds", type=int, default=3, help="runs of each case and tree")
     parser.add_argument("--cases", default=",".join(CYCLES), help="comma-separated: " + ", ".join(CYCLES))
+    parser.add_argument("--calls", action="store_true", help="count the function calls of each run (cProfile) in "
+                        "place of its CPU time: a measure the machine's load does not move")  # fmt: skip
     args = parser.parse_args(argv)
+    global COUNT_CALLS
+    COUNT_CALLS = args.calls
     cases = args.cases.split(",")
     unknown = set(cases) - CYCLES.keys()
     if unknown:
         parser.error(f"unknown case(s) {sorted(unknown)}: choose from {list(CYCLES)}")
     print(f"reproduce: python bench/bench_side.py --rounds {args.rounds} --cases {args.cases}"
-          + (f" --against {args.against}" if args.against else ""))  # fmt: skip
+          + (f" --against {args.against}" if args.against else "") + " --calls" * args.calls)  # fmt: skip
     here = str(Path(__file__).resolve().parents[1] / "src")
     trees = {"this": load(here)}
     if args.against:
@@ -160,6 +174,12 @@ def main(argv: list[str] | None = None) -> None:
     print(f"load {load_avg} (1, 5, 15 min) on {os.cpu_count()} CPUs; simulated / CPU time, fastest and slowest run")
     for case in cases:
         parts = []
+        if args.calls:
+            counts = {key: int(results[case, key][0][0]) for key in trees}
+            ratio = f"; after / before {counts['before'] / counts['after']:.2f}x" if args.against else ""
+            print(f"{case:8} {CYCLES[case]} cycles: " + ", ".join(f"{k} {n:,} calls" for k, n in counts.items())
+                  + ratio)  # fmt: skip
+            continue
         for key in trees:
             cpus = sorted(run[0] for run in results[case, key])
             simulated = results[case, key][0][1]
