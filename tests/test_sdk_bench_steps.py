@@ -122,7 +122,7 @@ def test_data_cycle_tables_follow_set(steps: list[tuple[str, int]], running: boo
             registers.sas_init()
         elif action == "ib_reset":
             registers.interbus_reset()
-        elif action == "in" and registers.data_bytes():
+        elif action == "in" and registers.internal_data_path and registers.data_bytes():  # IN0.. of the length
             registers.cpu_write(IN0.address + value % registers.data_bytes(), value)
         registers.set_bus_running(running)
         length_code = registers.bus_id_register() >> 8 & 0x1F
