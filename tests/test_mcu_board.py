@@ -22,12 +22,22 @@ from supi3.mcu.core import CPUS
 from supi3.model.registers import InconsistentDataError, InterfaceViolationError
 from supi3.sdk import native
 from supi3.sdk.bench import Bench
+from supi3.spi.upif import Mode
 from support import c_firmware
 
 pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
 
 WORDS = (0x0000, 0xFFFF, 0x1234, 0x8001, 0x00FF)
 """As tests/test_sdk_c_examples.py."""
+MODES = (Mode.MOTOROLA, Mode.INTEL)
+INTEL = {"FW_MODE": "SUPI3_MODE_INTEL"}
+"""The examples' build for the Intel interface (fw_board.h FW_MODE), on the board and on the host (MCU-18)."""
+
+
+def _example(name: str, folder: Path, cpu: str, mode: Mode) -> Path:
+    """The example ``name`` built for ``cpu`` and the interface ``mode``."""
+    return mcu_build.build(native.example(name), folder / f"{name}_{cpu}_{mode.name}.elf", cpu=cpu,
+                           defines=INTEL if mode is Mode.INTEL else None)  # fmt: skip
 
 
 @pytest.fixture(scope="module")
@@ -61,11 +71,12 @@ def _binary_exchange(board: Board, words: tuple[bytes, ...]) -> list[tuple[bytes
     return seen
 
 
-def _host_exchange(pytestconfig: pytest.Config, name: str, words: tuple[bytes, ...]) -> list[tuple[bytes, bytes]]:
+def _host_exchange(pytestconfig: pytest.Config, name: str, words: tuple[bytes, ...],
+                   mode: Mode = Mode.MOTOROLA) -> list[tuple[bytes, bytes]]:  # fmt: skip
     """The same steps with the same firmware built for the host, on the firmware bench."""
     assert pytestconfig.cache is not None
-    host = c_firmware(pytestconfig.cache, native.example(name))
-    bench = Bench(firmware=host)
+    host = c_firmware(pytestconfig.cache, native.example(name), defines=INTEL if mode is Mode.INTEL else None)
+    bench = Bench(firmware=host, mode=mode)
     bench.run(3)
     n = len(words[0])
     seen = []
@@ -78,40 +89,45 @@ def _host_exchange(pytestconfig: pytest.Config, name: str, words: tuple[bytes, .
     return seen
 
 
+@pytest.mark.parametrize("mode", MODES)
 @pytest.mark.parametrize("cpu", CPUS)
 def test_digital_io_binary_gives_the_host_builds_process_data(
-    pytestconfig: pytest.Config, digital_io: dict[str, Path], cpu: str
+    pytestconfig: pytest.Config, digital_io: dict[str, Path], tmp_path: Path, cpu: str, mode: Mode
 ) -> None:
     """SET 83h, ID 03h, then OUT0/OUT1 read and IN0/IN1 written in the EXTI0 handler after each VALID event: the
-    master's configuration and the data both ways are those of the same firmware compiled for the host."""
-    board = Board(digital_io[cpu], cpu=cpu)
+    master's configuration and the data both ways are those of the same firmware compiled for the host; in either
+    interface mode (the Intel build on the Intel board, MCU-18)."""
+    elf = digital_io[cpu] if mode is Mode.MOTOROLA else _example("digital_io", tmp_path, cpu, mode)
+    board = Board(elf, cpu=cpu, mode=mode)
     board.run(3)
     config = board.bench.master.config
     assert config is not None and (config[0].id_code, config[0].data_bytes) == (0x03, 2)
     words = tuple(w.to_bytes(2, "big") for w in WORDS)
     seen = _binary_exchange(board, words)
-    assert seen == _host_exchange(pytestconfig, "digital_io", words)
+    assert seen == _host_exchange(pytestconfig, "digital_io", words, mode)
     assert seen == list(zip(words, reversed(words), strict=True))
-    assert board.fw_board is not None and board.fw_board.error == 0
+    assert board.fw_board is not None and board.fw_board.error == 0 and board.protocol.mode is mode
     assert board.fw_board.cycles == board.interrupts > 0  # one VALID event per data cycle, each served
     assert board.violations == []
 
 
+@pytest.mark.parametrize("mode", MODES)
 @pytest.mark.parametrize("cpu", CPUS)
 @pytest.mark.parametrize(
     ("name", "size", "interrupts"),
     [("polling_io", 2, False), ("analog_io", 4, True), ("irq_dispatch", 2, True), ("pcmd_alarm", 2, True)],
 )
 def test_more_example_binaries_give_the_host_builds_process_data(
-    pytestconfig: pytest.Config, tmp_path: Path, name: str, size: int, interrupts: bool, cpu: str
+    pytestconfig: pytest.Config, tmp_path: Path, name: str, size: int, interrupts: bool, cpu: str, mode: Mode
 ) -> None:
     """The polling example (fw_loop: the main loop polls the I/O pin), the block transfer (analog_io, 3.4.6), the
-    event dispatch and the processor command examples, on both cores."""
-    board = Board(mcu_build.build(native.example(name), tmp_path / f"{name}.elf", cpu=cpu), cpu=cpu)
+    event dispatch and the processor command examples, on both cores, in either interface mode (MCU-18: the Intel
+    build on the Intel board against the Intel host build)."""
+    board = Board(_example(name, tmp_path, cpu, mode), cpu=cpu, mode=mode)
     board.run(3)
     words = (bytes(range(1, size + 1)), bytes(range(0xF0, 0xF0 + size)), bytes(size))
-    assert _binary_exchange(board, words) == _host_exchange(pytestconfig, name, words)
-    assert board.fw_board is not None and board.fw_board.error == 0
+    assert _binary_exchange(board, words) == _host_exchange(pytestconfig, name, words, mode)
+    assert board.fw_board is not None and board.fw_board.error == 0 and board.protocol.mode is mode
     assert (board.interrupts > 0) == interrupts
     assert board.violations == []
 
@@ -153,13 +169,14 @@ def test_raising_ss_before_the_byte_is_out_is_an_incomplete_frame(tmp_path: Path
     assert board.protocol.mode is None  # the initialization byte did not count
 
 
+@pytest.mark.parametrize("mode", MODES)
 @pytest.mark.parametrize("cpu", CPUS)
-def test_fault_report_binary_trips_until_quit_peripheral_error(tmp_path: Path, cpu: str) -> None:
+def test_fault_report_binary_trips_until_quit_peripheral_error(tmp_path: Path, cpu: str, mode: Mode) -> None:
     """fault_report.c as a binary, the steps of its host test (tests/test_sdk_c_examples.py): /StatErr (PA8) low
     for the filter time -> 0BB1h at the master, outputs off until a Quit Peripheral Error after the fault has gone;
-    the /ModAck pulse reaches the firmware through EXTI line 1's pending bit (PB1, 3.6.2)."""
-    elf = mcu_build.build(native.example("fault_report"), tmp_path / "fault_report.elf", cpu=cpu)
-    board = Board(elf, cpu=cpu, cycle_time_s=1e-3)
+    the /ModAck pulse reaches the firmware through EXTI line 1's pending bit (PB1, 3.6.2); in either interface
+    mode."""
+    board = Board(_example("fault_report", tmp_path, cpu, mode), cpu=cpu, cycle_time_s=1e-3, mode=mode)
     fw, chip, master = board.fw_board, board.bench.chip, board.bench.master
     assert fw is not None
     board.run(3)
@@ -179,7 +196,7 @@ def test_fault_report_binary_trips_until_quit_peripheral_error(tmp_path: Path, c
     master.quit_peripheral_error(1)
     board.run_for(0.01)
     assert not chip.pf and fw.outputs[:2] == b"\x81\x18"
-    assert fw.error == 0 and board.violations == []
+    assert fw.error == 0 and board.violations == [] and board.protocol.mode is mode
 
 
 @pytest.mark.parametrize("cpu", CPUS)

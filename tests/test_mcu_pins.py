@@ -111,6 +111,33 @@ def test_digital_io_gives_the_same_process_data_on_both_fidelities(
     assert seen["pin"] == seen["transaction"] == list(zip(WORDS, reversed(WORDS), strict=True))
 
 
+def test_the_intel_block_transfer_gives_the_same_process_data_on_both_fidelities(tmp_path: Path) -> None:
+    """analog_io (the 4-byte block transfer, 3.4.6) built for the Intel interface on the Intel board (MCU-18): the
+    pin-level chip, S/R from PB0 on MFP7 and Ser_IN/OUT half duplex, gives the process data of the transaction-level
+    run (which is the Intel host build's, tests/test_mcu_board.py), with no Table 3-7 rule broken (t10/t11 on S/R
+    included). A master cycle every 1 ms: the Intel handler clocks more frames than the Motorola one (about 145 µs
+    against 85 µs at 500 kbit/s), and with a cycle every 400 µs it ends after the next data frame began, so the
+    pin-level chip, which loads IN when a frame begins, sends its IN data a cycle later (docs/model.md M10, MCU-17)."""
+    elf = mcu_build.build(native.example("analog_io"), tmp_path / "analog_intel.elf",
+                          defines={"FW_MODE": "SUPI3_MODE_INTEL"})  # fmt: skip
+    words = (bytes(range(1, 5)), bytes(range(0xF0, 0xF4)))
+    seen = {}
+    for fidelity in ("transaction", "pin"):
+        board = Board(elf, cycle_time_s=1e-3, fidelity=fidelity, mode=Mode.INTEL)
+        board.run(3)
+        fw = board.fw_board
+        assert fw is not None
+        steps = []
+        for out_data, in_data in zip(words, reversed(words), strict=True):
+            board.master.set_outputs(1, out_data)
+            fw.inputs = in_data
+            board.run(2)
+            steps.append((fw.outputs, board.master.inputs(1)))
+        seen[fidelity] = steps
+        assert board.violations == [] and fw.error == 0 and board.protocol.mode is Mode.INTEL
+    assert seen["pin"] == seen["transaction"] == list(zip(words, reversed(words), strict=True))
+
+
 def test_a_too_fast_sclk_is_found_by_the_pin_level_chip_with_the_source_line(tmp_path: Path) -> None:
     """BOARD_SPI_BR = 3: a 16-clock SCLK period (333 ns, at the chip's 32 MHz 11 clocks) is shorter than Table 3-7's
     t0 = 667 ns at 500 kbit/s: the chip's own timing check finds it at the first byte's second rising edge, and the
