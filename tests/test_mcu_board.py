@@ -18,12 +18,13 @@ from supi3.interbus.ring import ErrorKind
 from supi3.mcu import board as mcu_board
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import Board
-from supi3.mcu.core import CPUS
+from supi3.mcu.core import CPUS, FirmwareStoppedError, Stop
 from supi3.model.registers import InconsistentDataError, InterfaceViolationError
 from supi3.sdk import native
 from supi3.sdk.bench import Bench
 from supi3.spi.upif import Mode
 from support import c_firmware
+from test_mcu_hostile import FILES
 
 pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
 
@@ -284,3 +285,60 @@ def test_the_bench_cases_keep_their_fingerprint(digital_io: dict[str, Path], tmp
     violations = [(round(v.time_s * 1e9), v.function) for v in board.violations]
     assert (board.core.cycles, board.core.instructions, board.interrupts, violations) == FINGERPRINTS[bit_rate]
     assert (board.fw_board.outputs, board.bench.master.inputs(1)) == (b"\x12\x34\0\0", b"\xab\xcd")
+
+
+
+IDLE_TICK = Path(__file__).parent / "mcu" / "idle_tick.S"
+"""SysTick every 100 µs waking a thread-mode ``b .``: seven instructions to it, five in the handler."""
+
+
+@pytest.fixture(scope="module")
+def idle_tick(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """idle_tick.S (Thumb-1) as it is (``tick``), with SysTick on Default_Handler's ``b .`` (``hang``), and
+    test_mcu_hostile's ``loop.elf`` (``loop``: ``b .`` at the reset vector, nothing else)."""
+    folder = tmp_path_factory.mktemp("idle")
+    (folder / "loop.elf").write_bytes(FILES["loop.elf"])
+    return {"loop": folder / "loop.elf", **{
+        name: mcu_build.build(IDLE_TICK, folder / f"{name}.elf", cpu="cortex_m0", port=False,
+                              defines={"HANG": "1"} if name == "hang" else None) for name in ("tick", "hang")}}
+
+
+FIDELITIES = ["transaction", "pin"]
+
+
+@pytest.mark.parametrize("fidelity", FIDELITIES)
+@pytest.mark.parametrize("budget", [1, 2, 1000, 10**7])
+def test_a_thread_mode_b_dot_is_a_wait_from_its_first_iteration_at_any_budget(
+    idle_tick: dict[str, Path], fidelity: str, budget: int
+) -> None:
+    """MCU-4: the core stops at its first ``b .`` whatever the run's deadline, and sleeps; a sleeping core spends
+    none of the budget. Round 4 ran the loop up to the next bus event or the budget's end at transaction level (334
+    iterations for a budget of 1000), for 1 µs at pin level (16), and a budget of 1 stopped the run: the verdict and
+    the count now are the same at both fidelities and any budget."""
+    board = Board(idle_tick["loop"], fidelity=fidelity)
+    for _ in range(2):
+        board.run(1, max_instructions=budget)
+        assert board.core.sleeping and board.core.instructions == 1 and board.cycles > 0
+
+
+@pytest.mark.parametrize("fidelity", FIDELITIES)
+def test_an_interrupt_returning_to_b_dot_sleeps_at_once(idle_tick: dict[str, Path], fidelity: str) -> None:
+    """Each SysTick wake runs the handler's five instructions; its return to the ``b .`` sleeps without running it:
+    the instructions are the set-up's six, one iteration, and five a wake, at both fidelities."""
+    board = Board(idle_tick["tick"], cpu="cortex_m0", fidelity=fidelity)
+    board.run(1)
+    ticks = int.from_bytes(board.core.read_bytes(board.core.image.address("ticks"), 4), "little")
+    assert ticks == board.core.cycles // 4800 > 0
+    assert board.core.sleeping and board.core.instructions == 6 + 1 + 5 * ticks
+
+
+@pytest.mark.parametrize("fidelity", FIDELITIES)
+def test_b_dot_in_a_handler_is_a_hang_at_its_first_iteration(idle_tick: dict[str, Path], fidelity: str) -> None:
+    """SysTick's vector on Default_Handler (``b .``): the first wake stops the run with a hang report at the loop,
+    after the set-up, its ``b .`` and the handler's one iteration, at both fidelities (MCU-4)."""
+    board = Board(idle_tick["hang"], cpu="cortex_m0", fidelity=fidelity)
+    with pytest.raises(FirmwareStoppedError, match=r"endless loop \(b \.\) in the handler of exception 15") as caught:
+        board.run(1)
+    report = caught.value.report
+    assert (report.stop, report.symbol, report.instructions) == (Stop.HANG, "Default_Handler", 8)
+    assert 4800 < board.core.cycles - CPUS["cortex_m0"].entry_cycles - 3 < 4800 + 20  # the first wrap: its iteration

@@ -653,7 +653,7 @@ class Board:
     def _step(self, deadline: int) -> None:
         """One run of the core up to ``deadline`` (at least one block), within the instruction budget."""
         core = self.core
-        if core.instructions >= self._limit:
+        if core.instructions >= self._limit and not core.sleeping:  # a sleeping core runs no instruction (MCU-4)
             raise FirmwareStoppedError(core.report(Stop.BUDGET, f"instruction budget of {self._budget} used up "
                                                    "(an endless loop?)"))  # fmt: skip
         if not core.sleeping:  # within the budget: an instruction costs a cycle at least (MCU-1)

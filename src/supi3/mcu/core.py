@@ -73,6 +73,7 @@ __all__ = [
     "block_cost",
     "check_cpu",
     "countdown_register",
+    "idle_loops",
     "is_poll_loop",
 ]
 
@@ -109,6 +110,8 @@ SCS_BASE: Final[int] = 0xE000_E000
 SCS_SIZE: Final[int] = 0x1000
 _PAGE: Final[int] = 0x1000
 """The emulator maps memory in 4 KiB pages: a memory's base and size are multiples of it."""
+_IDLE_LOOP: Final[bytes] = b"\xfe\xe7"
+"""``b .``, a branch to itself (B T2 with offset -4: E7FEh), MCU-4."""
 _ADDRESS_SPACE: Final[int] = 1 << 32
 SYST_MAX: Final[int] = 0xFF_FFFF
 """SysTick is a 24-bit down counter (B3.3.1)."""
@@ -510,6 +513,19 @@ def is_poll_loop(code: bytes, address: int) -> bool:
     return address + 2 * (len(halfwords) - 1) + 4 + 2 * offset == address
 
 
+def idle_loops(image: FirmwareImage, flash: tuple[int, int]) -> tuple[int, ...]:
+    """The halfword-aligned addresses in the firmware's flash that hold ``b .`` (FEE7h: a branch to itself), where
+    the core stops at the first iteration (MCU-4); a constant that happens to read so is never run and costs
+    nothing."""
+    base, size = flash
+    found = []
+    for address, data in image.segments:
+        if base <= address < base + size:
+            start = address & 1
+            found += [address + k for k in range(start, len(data) - 1, 2) if data[k:k + 2] == _IDLE_LOOP]
+    return tuple(found)
+
+
 def countdown_register(code: bytes) -> int:
     """The register a countdown loop counts down (MCU-11), or -1: the block ``code`` is exactly ``SUBS Rd, Rd,
     #1`` (a 16-bit encoding, Rd one of R0-R7) and ``BNE`` back to the ``SUBS``. Its iterations
@@ -625,6 +641,9 @@ class CortexM:
         self._scs_words: dict[int, int] = {}
         self.mmio(SCS_BASE, SCS_SIZE, self._scs_read, self._scs_write)
         self._hook(ucc.UC_HOOK_BLOCK, _HOOK_CODE(self._on_block))
+        on_idle_loop = _HOOK_CODE(self._on_idle_loop)
+        for address in idle_loops(self.image, flash):  # MCU-4: the core stops at its first ``b .``
+            self._hook(ucc.UC_HOOK_CODE, on_idle_loop, address, address)
         self.uc.hook_add(ucc.UC_HOOK_INTR, self._on_interrupt)
         self.reset()
 
@@ -933,6 +952,13 @@ class CortexM:
             self.fail(error)
             _LIB.uc_emu_stop(handle)
 
+    def _on_idle_loop(self, handle: int, address: int, size: int, data: int) -> None:
+        """A ``b .`` is about to run (its block counted): stop there, at its first iteration, whatever the deadline;
+        the run loop takes it for a wait in thread mode and a hang in a handler (MCU-4)."""
+        del address, size, data
+        self.stop_request = True
+        _LIB.uc_emu_stop(handle)
+
     def _skip_polls(self, cost: tuple[int, int], until: int) -> None:
         """Count, without running them, the iterations of a poll loop that would start before the deadline and
         read before ``until`` (MCU-10): each reads at its block's end (:meth:`cycles_polled`)."""
@@ -1027,7 +1053,7 @@ class CortexM:
         idle = self._idle.get(pc)  # the code does not change (as the block costs)
         if idle is None:
             idle = self._idle[pc] = bool(self.flash[0] <= pc < self.flash[0] + self.flash[1] - 1 and
-                                         self.read_bytes(pc, 2) == b"\xfe\xe7")  # fmt: skip
+                                         self.read_bytes(pc, 2) == _IDLE_LOOP)  # fmt: skip
         return idle
 
     def _fault(self, error: Any) -> StopReport:
