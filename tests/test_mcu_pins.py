@@ -138,6 +138,43 @@ def test_the_intel_block_transfer_gives_the_same_process_data_on_both_fidelities
     assert seen["pin"] == seen["transaction"] == list(zip(words, reversed(words), strict=True))
 
 
+def test_run_for_gives_the_transaction_levels_cycles_time_and_data(digital_io: Path) -> None:
+    """``run_for`` at pin level (MCU-22): with a master cycle every 400 µs, 1.6 ms and then 0.8 ms of bus time run
+    the cycles that start in them and idle the line to the end, as at transaction level: the same bus time (to
+    half a status telegram, 5 µs at 500 kbit/s; the line's telegrams do not drift from the cycle time's schedule),
+    the same master cycles, EXTI0 handler entries and data cycles of the firmware, and the same process data; a
+    zero time runs nothing. A cycle running past the end ends the call at its end: the pin-level master cannot stop
+    inside a cycle."""
+    seen = {}
+    for fidelity in ("transaction", "pin"):
+        board = Board(digital_io, cycle_time_s=400e-6, fidelity=fidelity)
+        board.run(3)
+        fw = board.fw_board
+        assert fw is not None
+        steps = []
+        for seconds, (out_data, in_data) in zip((1.6e-3, 0.8e-3), zip(WORDS, reversed(WORDS), strict=True), strict=True):
+            board.master.set_outputs(1, out_data)
+            fw.inputs = in_data
+            before = (board.now, board.cycles, board.interrupts, fw.cycles)
+            board.run_for(seconds)
+            assert board.now - before[0] == pytest.approx(seconds, abs=5e-6)
+            steps.append((board.cycles - before[1], board.interrupts - before[2], fw.cycles - before[3],
+                          fw.outputs, board.master.inputs(1)))  # fmt: skip
+        after = (board.now, board.cycles, board.core.instructions)
+        board.run_for(0.0)
+        assert (board.now, board.cycles, board.core.instructions) == after
+        assert board.violations == [] and fw.error == 0
+        seen[fidelity] = steps
+    assert seen["pin"] == seen["transaction"]
+    assert [step[:3] for step in seen["pin"]] == [(4, 4, 4), (2, 2, 2)]
+    assert [step[3:] for step in seen["pin"]] == [(WORDS[0] + bytes(2), WORDS[1]), (WORDS[1] + bytes(2), WORDS[0])]
+    board = Board(digital_io, cycle_time_s=400e-6, fidelity="pin")
+    board.run(3)
+    start = board.now
+    board.run_for(50e-6)  # inside the next cycle: it runs whole (a data cycle of one device: 248 µs)
+    assert (board.cycles, 240e-6 < board.now - start < 260e-6) == (4, True)
+
+
 def test_a_too_fast_sclk_is_found_by_the_pin_level_chip_with_the_source_line(tmp_path: Path) -> None:
     """BOARD_SPI_BR = 3: a 16-clock SCLK period (333 ns, at the chip's 32 MHz 11 clocks) is shorter than Table 3-7's
     t0 = 667 ns at 500 kbit/s: the chip's own timing check finds it at the first byte's second rising edge, and the

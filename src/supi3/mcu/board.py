@@ -25,6 +25,7 @@ from supi3 import timing
 from supi3.checks import check_bool, check_bytes, check_choice, check_instance, check_int, check_real, fail
 from supi3.config import DeviceConfig
 from supi3.errors import Supi3Error
+from supi3.interbus import wire
 from supi3.interbus.link import Device
 from supi3.interbus.master import Master
 from supi3.mcu.core import EXTERNAL, CortexM, FirmwareImage, FirmwareStoppedError, Frame, SourceLine, Stop
@@ -340,6 +341,8 @@ class Board:
         ring.on_violation = self._pin_violation
         self._master = Master(ring, locate=False, max_devices=1)
         self._cycles_done = 0
+        self._next_start = 0.0  # cycle_time_s: the bus time the next master cycle starts
+        self._telegram_s = wire.STATUS_TELEGRAM_BITS / self.config.bit_rate  # the line idles in whole telegrams
 
     # -- what both fidelities show -----------------------------------------------------------------------------
 
@@ -621,12 +624,17 @@ class Board:
         self._run(lambda: self.bench.cycles >= target and not self.core.in_exception, max_instructions)
 
     def run_for(self, seconds: float, *, max_instructions: int = DEFAULT_MAX_INSTRUCTIONS) -> None:
-        """Run the firmware for ``seconds`` of bus time (raises as :meth:`run`; at pin level to the end of the
-        master cycle running then)."""
-        end = self.core.cycles + self._cycles(check_real("seconds", seconds, 0.0))
-        if self._ring is not None:
-            self._run_pin(lambda: self.core.cycles >= end, max_instructions)
+        """Run the firmware for ``seconds`` of bus time (raises as :meth:`run`). At pin level (MCU-22) the master
+        cycles that start before the end run whole, then the line idles up to the end, to the nearest status
+        telegram; a cycle that runs past the end ends the call there, and the rest of a cycle time's idle is left
+        to the next call; the firmware's handler of the last cycle is not waited for (as at transaction level)."""
+        seconds = check_real("seconds", seconds, 0.0)
+        ring = self._ring
+        if ring is not None:
+            end_s = ring.now + seconds
+            self._run_pin(lambda: ring.now > end_s - self._telegram_s / 2, max_instructions, end_s)
             return
+        end = self.core.cycles + self._cycles(seconds)
         self._run(lambda: self.core.cycles >= end, max_instructions, end)
 
     def _run(self, done: Callable[[], bool], max_instructions: int, end: int | None = None) -> None:
@@ -680,11 +688,13 @@ class Board:
 
     # -- running at pin level ------------------------------------------------------------------------------------
 
-    def _run_pin(self, done: Callable[[], bool], max_instructions: int) -> None:
+    def _run_pin(self, done: Callable[[], bool], max_instructions: int, end_s: float | None = None) -> None:
         core, ring, master = self.core, self.ring, self._master
         self._set_budget(max_instructions)
         try:
             while not done():
+                if self._idle_to(end_s):  # the rest of the last cycle's time, left by run_for
+                    continue
                 start = ring.now
                 if self._cycles_done:
                     master.cycle()
@@ -694,8 +704,12 @@ class Board:
                         ring.status_telegram()
                     master.start()
                 self._cycles_done += 1
-                if self._cycle_time_s is not None:
-                    ring.idle(max(0.0, start + self._cycle_time_s - ring.now))
+                if self._cycle_time_s is not None:  # on its schedule: no drift from the line's whole telegrams
+                    on_time = abs(start - self._next_start) < self._telegram_s
+                    self._next_start = (self._next_start if on_time else start) + self._cycle_time_s
+                    self._idle_to(end_s)
+            if end_s is not None:
+                return
             for _ in range(SERVE_TELEGRAMS):
                 if not core.in_exception and self._irq_fell is None:
                     break
@@ -703,6 +717,15 @@ class Board:
         except InterfaceViolationError as error:
             self._place(error)
             raise
+
+    def _idle_to(self, end_s: float | None) -> bool:
+        """Idle status telegrams up to the next cycle's start (``cycle_time_s``), not past ``end_s``; whether any
+        (the line idles in whole telegrams: a wait under half of one is none)."""
+        until = self._next_start if end_s is None else min(self._next_start, end_s)
+        ring = self.ring
+        before = ring.cycle
+        ring.idle(max(0.0, until - ring.now))
+        return ring.cycle != before
 
     def _lockstep(self, clock: int) -> None:
         """:attr:`LockstepRing.runner`: run the firmware and the chip until the chip has clocked ``clock`` cycles
