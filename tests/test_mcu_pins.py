@@ -152,7 +152,8 @@ def test_run_for_gives_the_transaction_levels_cycles_time_and_data(digital_io: P
         fw = board.fw_board
         assert fw is not None
         steps = []
-        for seconds, (out_data, in_data) in zip((1.6e-3, 0.8e-3), zip(WORDS, reversed(WORDS), strict=True), strict=True):
+        words = zip(WORDS, reversed(WORDS), strict=True)
+        for seconds, (out_data, in_data) in zip((1.6e-3, 0.8e-3), words, strict=True):
             board.master.set_outputs(1, out_data)
             fw.inputs = in_data
             before = (board.now, board.cycles, board.interrupts, fw.cycles)
