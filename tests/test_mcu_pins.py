@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from supi3.config import decode
 from supi3.errors import ArgumentError
 from supi3.interbus.device import PlainDevice
 from supi3.mcu import board as mcu_board
@@ -21,12 +22,15 @@ from supi3.mcu import pins as mcu_pins
 from supi3.mcu.board import Board, BoardError
 from supi3.mcu.core import CPUS
 from supi3.mcu.pins import MISO_PULL_UP, Cause, LockstepRing, mcu_lines
-from supi3.mcu.session import run_firmware
+from supi3.mcu.session import RING_DEVICE, RING_DEVICE_STRAPS, run_firmware
 from supi3.mcu.stm32 import CR1_CPHA, CR1_CPOL, CR1_LSBFIRST
+from supi3.model.chip import Supi3
+from supi3.model.pins import Supi3Pins
 from supi3.model.registers import InterfaceViolationError
 from supi3.sdk import native
 from supi3.sdk.bench import default_config
 from supi3.spi.upif import Mode
+from supi3.tables import clk_conf_for
 from supi3.top import Supi3Chip
 
 pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
@@ -176,6 +180,36 @@ def test_run_for_gives_the_transaction_levels_cycles_time_and_data(digital_io: P
     assert (board.cycles, 240e-6 < board.now - start < 260e-6) == (4, True)
 
 
+def test_a_device_behind_the_chip_at_pin_level_gives_the_transaction_levels_ring(
+    digital_io: Path, tmp_path: Path
+) -> None:
+    """MCU-23: a pin-level SUPI 3 strapped RB 16 IN (session.RING_DEVICE_STRAPS: ID 02h, one word) behind the board's
+    chip, each piece of the chip's lockstep run carried on through it and back: the master's configuration table and
+    the process data both ways (the chip's, and the device's inputs at ring position 2) are those of the same ring
+    at transaction level, with no violation; the VCD holds the second chip's pins (scope dev2)."""
+    config = decode(*RING_DEVICE_STRAPS, clk_conf=clk_conf_for(500_000))
+    seen = {}
+    for fidelity in ("transaction", "pin"):
+        behind = Supi3Pins(config) if fidelity == "pin" else Supi3(config)
+        board = Board(digital_io, cycle_time_s=600e-6, fidelity=fidelity, others=[behind],
+                      record=fidelity == "pin")  # fmt: skip
+        board.run(3)
+        assert board.master.config is not None
+        table = [(e.id_code, e.length_code) for e in board.master.config]
+        board.master.set_outputs(1, WORDS[0])
+        assert board.fw_board is not None
+        board.fw_board.inputs = WORDS[1]
+        if isinstance(behind, Supi3):
+            behind.set_mfp_inputs(0xA55A)
+        else:
+            board.ring.set_input(2, "mfp_in", 0xA55A)
+        board.run(2)
+        assert board.violations == []
+        seen[fidelity] = (table, board.fw_board.outputs[:2], board.master.inputs(1), board.master.inputs(2))
+    assert seen["pin"] == seen["transaction"] == ([(0x03, 0b00001), RING_DEVICE], WORDS[0], WORDS[1], b"\xa5\x5a")
+    assert "$scope module dev2" in board.write_vcd(tmp_path / "ring.vcd").read_text()
+
+
 def test_a_too_fast_sclk_is_found_by_the_pin_level_chip_with_the_source_line(tmp_path: Path) -> None:
     """BOARD_SPI_BR = 3: a 16-clock SCLK period (333 ns, at the chip's 32 MHz 11 clocks) is shorter than Table 3-7's
     t0 = 667 ns at 500 kbit/s: the chip's own timing check finds it at the first byte's second rising edge, and the
@@ -230,7 +264,7 @@ def test_the_board_refuses_what_its_fidelity_has_not(digital_io: Path, tmp_path:
     a record or a VCD at transaction level, and the session's VCD or ring without the pin level."""
     with pytest.raises(ArgumentError, match=r"fidelity must be one of 'transaction', 'pin', not 'gate'"):
         Board(digital_io, fidelity="gate")
-    with pytest.raises(ArgumentError, match=r"others must be empty at pin level"):
+    with pytest.raises(ArgumentError, match=r"others must be pin-level chips at pin level \(Supi3Pins"):
         Board(digital_io, fidelity="pin", others=[PlainDevice(0x02, 1)])
     with pytest.raises(ArgumentError, match=r"record must be False at transaction level"):
         Board(digital_io, record=True)
@@ -242,8 +276,8 @@ def test_the_board_refuses_what_its_fidelity_has_not(digital_io: Path, tmp_path:
         Board(digital_io).write_vcd(tmp_path / "x.vcd")
     with pytest.raises(ArgumentError, match=r"vcd must be None at transaction level"):
         run_firmware(digital_io, vcd=tmp_path / "x.vcd")
-    with pytest.raises(ArgumentError, match=r"devices must be an integer from 1 to 1 \(the chip alone in the ring"):
-        run_firmware(digital_io, fidelity="pin", devices=2)
+    with pytest.raises(ArgumentError, match=r"devices must be an integer from 1 to 4 \(at pin level, MCU-23"):
+        run_firmware(digital_io, fidelity="pin", devices=5)
     assert not (tmp_path / "x.vcd").exists()
 
 

@@ -19,7 +19,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
-from typing import Final, TypeVar
+from typing import Final, TypeVar, cast
 
 from supi3 import timing
 from supi3.checks import check_bool, check_bytes, check_choice, check_instance, check_int, check_real, fail
@@ -49,6 +49,7 @@ from supi3.mcu.stm32 import (
     Rcc,
     Spi,
 )
+from supi3.model.pinring import PinBranch, PinChip
 from supi3.model.registers import InterfaceViolationError
 from supi3.model.vcd import write_vcd
 from supi3.pinout import C_D_COMMAND
@@ -238,8 +239,8 @@ class Board:
     fidelity:
         ``"transaction"`` (default): the transaction-level bench, the board checking Table 3-7 on SPI1's transfers;
         ``"pin"``: the pin-level whole chip in lockstep with the core (:mod:`supi3.mcu.pins`), SPI1 and the GPIO
-        pins driving its MFP pins at chip clocks, Table 3-7 checked by the chip itself; the chip alone in the ring
-        (``others`` empty, MCU-17).
+        pins driving its MFP pins at chip clocks, Table 3-7 checked by the chip itself; ``others`` then are pin-level
+        chips behind it (``Supi3Pins`` or ``Supi3Chip`` objects, ``PinBranch`` trees, MCU-23).
     record:
         Pin level only: keep every pin for :meth:`write_vcd`.
     mode:
@@ -266,7 +267,8 @@ class Board:
     """
 
     def __init__(self, firmware: str | Path | FirmwareImage, *, cpu: str = "cortex_m3", cpu_hz: float = 48e6,
-                 config: DeviceConfig | None = None, bit_rate: int = 500_000, others: Sequence[Device] = (),
+                 config: DeviceConfig | None = None, bit_rate: int = 500_000,
+                 others: Sequence[Device | PinChip | PinBranch] = (),
                  cycle_time_s: float | None = None, strict: bool = True, pedantic: bool = False,
                  fidelity: str = "transaction", record: bool = False, mode: Mode = Mode.MOTOROLA) -> None:  # fmt: skip
         self.fidelity = check_choice("fidelity", fidelity, FIDELITIES)
@@ -282,7 +284,8 @@ class Board:
         else:
             if record:
                 raise fail("record", "False at transaction level (the chip has no pins: fidelity='pin')", record)
-            self._bench = bench = _BoardBench(config, bit_rate=bit_rate, others=others, cycle_time_s=cycle_time_s,
+            devices = cast("Sequence[Device]", others)  # the ring names a device that is not one (ArgumentError)
+            self._bench = bench = _BoardBench(config, bit_rate=bit_rate, others=devices, cycle_time_s=cycle_time_s,
                                               strict=strict, pedantic=pedantic)  # fmt: skip
             self.registers = bench.registers
             self.protocol = bench.transport.protocol
@@ -322,12 +325,14 @@ class Board:
         self._limit = self._budget = 0
         self._held: list[tuple[str, int, int]] | None = None  # pin level: edges held while a sleeping core waits
 
-    def _pin_setup(self, config: DeviceConfig | None, bit_rate: int, others: Sequence[Device],
+    def _pin_setup(self, config: DeviceConfig | None, bit_rate: int, others: Sequence[Device | PinChip | PinBranch],
                    cycle_time_s: float | None, strict: bool, pedantic: bool, record: bool) -> None:  # fmt: skip
         """The pin-level chip, its ring and master (MCU-14 to MCU-17)."""
         self.config = default_config(bit_rate) if config is None else check_instance("config", config, DeviceConfig)
-        if others:
-            raise fail("others", "empty at pin level (the chip alone in the ring, MCU-17)", others)
+        if isinstance(others, str | bytes) or not isinstance(others, Sequence) \
+                or not all(isinstance(other, PinChip | PinBranch) for other in others):  # fmt: skip
+            raise fail("others", "pin-level chips at pin level (Supi3Pins or Supi3Chip objects, PinBranch trees: "
+                       "MCU-23)", others)  # fmt: skip
         self._cycle_time_s = None if cycle_time_s is None else check_real("cycle_time_s", cycle_time_s, 0.0)
         self.chip = chip = Supi3Chip(self.config, strict=check_bool("strict", strict),
                                      pedantic=check_bool("pedantic", pedantic))  # fmt: skip
@@ -335,11 +340,13 @@ class Board:
             raise fail("config", "the straps of an Init-µP mode (Tables 2-4 to 2-7)", self.config.function)
         self.registers = chip.chip.registers
         self.protocol = chip.upif.protocol
-        self._ring = ring = LockstepRing(chip, self.core.cpu_hz, self._cause, record=record, intel=self.intel)
+        chips = cast("Sequence[PinChip | PinBranch]", others)  # checked above
+        self._ring = ring = LockstepRing(chip, self.core.cpu_hz, self._cause, record=record, intel=self.intel,
+                                         others=chips)  # fmt: skip
         ring.runner = self._lockstep
         ring.on_edge = self._pin_edge
         ring.on_violation = self._pin_violation
-        self._master = Master(ring, locate=False, max_devices=1)
+        self._master = Master(ring, locate=False, max_devices=len(ring.devices))
         self._cycles_done = 0
         self._next_start = 0.0  # cycle_time_s: the bus time the next master cycle starts
         self._telegram_s = wire.STATUS_TELEGRAM_BITS / self.config.bit_rate  # the line idles in whole telegrams
