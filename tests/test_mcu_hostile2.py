@@ -77,6 +77,9 @@ CASES: list[Case] = [
     ("Board(pin, others=[PlainDevice])",
      lambda d: Board(d / "loop.elf", fidelity="pin", others=bad([PlainDevice(2, 1)])), "others"),
     ("Board(pin, others='ab')", lambda d: Board(d / "loop.elf", fidelity="pin", others=bad("ab")), "others"),
+    *((f"Board({f}, stat_err_filter={v!r})",
+       lambda d, f=f, v=v: Board(d / "loop.elf", fidelity=f, stat_err_filter=bad(v)), "stat_err_filter")
+      for f, v in [("transaction", 32_000), ("pin", 0), ("pin", 6_400_001), ("pin", 1.5), ("pin", "1")]),
     ("Board(pin, cycle_time_s=-1)", lambda d: Board(d / "loop.elf", fidelity="pin", cycle_time_s=-1.0),
      "cycle_time_s"),
     ("Board(pin, strict=1)", lambda d: Board(d / "loop.elf", fidelity="pin", strict=bad(1)), "strict"),

@@ -16,6 +16,7 @@ import pytest
 from supi3.config import decode
 from supi3.errors import ArgumentError
 from supi3.interbus.device import PlainDevice
+from supi3.interbus.ring import ErrorKind
 from supi3.mcu import board as mcu_board
 from supi3.mcu import build as mcu_build
 from supi3.mcu import pins as mcu_pins
@@ -208,6 +209,41 @@ def test_a_device_behind_the_chip_at_pin_level_gives_the_transaction_levels_ring
         seen[fidelity] = (table, board.fw_board.outputs[:2], board.master.inputs(1), board.master.inputs(2))
     assert seen["pin"] == seen["transaction"] == ([(0x03, 0b00001), RING_DEVICE], WORDS[0], WORDS[1], b"\xa5\x5a")
     assert "$scope module dev2" in board.write_vcd(tmp_path / "ring.vcd").read_text()
+
+
+def test_fault_report_trips_and_quits_at_pin_level_with_a_short_stat_err_filter(tmp_path: Path) -> None:
+    """fault_report.c at pin level, the steps of tests/test_mcu_board.py's transaction-level test, with the chip's
+    /StatErr filter shortened from 200 ms to 1 ms (``stat_err_filter``, MCU-24; the filter's logic is the chip's
+    own, only its constant differs): PA8 drives /StatErr, the fault is latched once it has been low for the filter
+    time and not before, 0BB1h reaches the master; the Quit Peripheral Error's /ModAck pulse (375 ns on the chip's
+    pin, 3.6.2) sets EXTI line 1's pending bit, which the firmware reads: while the fault lasts nothing changes,
+    after it went the chip clears PF and the firmware drives its outputs again."""
+    elf = mcu_build.build(native.example("fault_report"), tmp_path / "fault_report.elf")
+    board = Board(elf, fidelity="pin", stat_err_filter=32_000)  # 1 ms at 32 MHz
+    fw, chip, master = board.fw_board, board.chip.chip, board.master
+    assert fw is not None
+    board.run(3)
+    master.set_outputs(1, b"\x81\x18")
+    board.run(3)
+    assert fw.outputs[:2] == b"\x81\x18" and board.ring.inputs["stat_err_n"] == 1
+    fw.fault = 1
+    board.run_for(0.6e-3)  # /StatErr low since the first handler of these cycles: under the filter time
+    assert not chip.module_error and not chip.pf and fw.outputs[:2] == b"\x00\x00"
+    assert board.ring.inputs["stat_err_n"] == 0  # PA8 low on the chip's pin
+    board.run_for(0.9e-3)
+    assert chip.module_error and chip.pf and fw.outputs[:2] == b"\x00\x00"
+    assert [d.kind for d in master.diagnostics] == [ErrorKind.PERIPHERAL_FAULT]
+    acks = chip.events["MODACK"]
+    master.quit_peripheral_error(1)  # while the fault lasts: nothing changes
+    board.run(2)
+    assert chip.events["MODACK"] == acks + 1 and chip.pf and fw.outputs[:2] == b"\x00\x00"
+    fw.fault = 0
+    board.run(2)
+    assert not chip.module_error and chip.pf and fw.outputs[:2] == b"\x00\x00"
+    master.quit_peripheral_error(1)
+    board.run(3)
+    assert not chip.pf and fw.outputs[:2] == b"\x81\x18"
+    assert fw.error == 0 and board.violations == []
 
 
 def test_a_too_fast_sclk_is_found_by_the_pin_level_chip_with_the_source_line(tmp_path: Path) -> None:

@@ -49,6 +49,7 @@ from supi3.mcu.stm32 import (
     Rcc,
     Spi,
 )
+from supi3.model.chip import STATERR_FILTER_CLOCKS
 from supi3.model.pinring import PinBranch, PinChip
 from supi3.model.registers import InterfaceViolationError
 from supi3.model.vcd import write_vcd
@@ -243,6 +244,9 @@ class Board:
         chips behind it (``Supi3Pins`` or ``Supi3Chip`` objects, ``PinBranch`` trees, MCU-23).
     record:
         Pin level only: keep every pin for :meth:`write_vcd`.
+    stat_err_filter:
+        Pin level only: the chip's /StatErr filter in clocks (3.6.2: t3 = 200 ms, the default); shorter only to test
+        a peripheral fault (``fault_report``) in a few milliseconds of bus time (MCU-24).
     mode:
         The board's wiring for the interface type the firmware initializes (Table 3-8): ``Mode.MOTOROLA`` (MISO on
         SerOUT, MFP7) or ``Mode.INTEL`` (MCU-18: MISO on Ser_IN/OUT, MFP6, MOSI on it through a resistor, S/R from
@@ -270,7 +274,8 @@ class Board:
                  config: DeviceConfig | None = None, bit_rate: int = 500_000,
                  others: Sequence[Device | PinChip | PinBranch] = (),
                  cycle_time_s: float | None = None, strict: bool = True, pedantic: bool = False,
-                 fidelity: str = "transaction", record: bool = False, mode: Mode = Mode.MOTOROLA) -> None:  # fmt: skip
+                 fidelity: str = "transaction", record: bool = False, mode: Mode = Mode.MOTOROLA,
+                 stat_err_filter: int = STATERR_FILTER_CLOCKS) -> None:  # fmt: skip
         self.fidelity = check_choice("fidelity", fidelity, FIDELITIES)
         self.intel = check_instance("mode", mode, Mode) is Mode.INTEL
         self._s_r = 1  # PB0: S/R, 1 = the µP sends
@@ -280,10 +285,14 @@ class Board:
         self._ring: LockstepRing | None = None
         self.protocol: UpifProtocol
         if fidelity == "pin":
-            self._pin_setup(config, bit_rate, others, cycle_time_s, strict, pedantic, record)
+            self._pin_setup(config, bit_rate, others, cycle_time_s, strict, pedantic, record, stat_err_filter)
         else:
             if record:
                 raise fail("record", "False at transaction level (the chip has no pins: fidelity='pin')", record)
+            if stat_err_filter != STATERR_FILTER_CLOCKS:
+                raise fail("stat_err_filter", f"{STATERR_FILTER_CLOCKS} (200 ms) at transaction level, which runs it "
+                           "in well under a second (a shorter filter is for the pin level's tests, MCU-24)",
+                           stat_err_filter)  # fmt: skip
             devices = cast("Sequence[Device]", others)  # the ring names a device that is not one (ArgumentError)
             self._bench = bench = _BoardBench(config, bit_rate=bit_rate, others=devices, cycle_time_s=cycle_time_s,
                                               strict=strict, pedantic=pedantic)  # fmt: skip
@@ -326,7 +335,8 @@ class Board:
         self._held: list[tuple[str, int, int]] | None = None  # pin level: edges held while a sleeping core waits
 
     def _pin_setup(self, config: DeviceConfig | None, bit_rate: int, others: Sequence[Device | PinChip | PinBranch],
-                   cycle_time_s: float | None, strict: bool, pedantic: bool, record: bool) -> None:  # fmt: skip
+                   cycle_time_s: float | None, strict: bool, pedantic: bool, record: bool,
+                   stat_err_filter: int) -> None:  # fmt: skip
         """The pin-level chip, its ring and master (MCU-14 to MCU-17)."""
         self.config = default_config(bit_rate) if config is None else check_instance("config", config, DeviceConfig)
         if isinstance(others, str | bytes) or not isinstance(others, Sequence) \
@@ -335,7 +345,7 @@ class Board:
                        "MCU-23)", others)  # fmt: skip
         self._cycle_time_s = None if cycle_time_s is None else check_real("cycle_time_s", cycle_time_s, 0.0)
         self.chip = chip = Supi3Chip(self.config, strict=check_bool("strict", strict),
-                                     pedantic=check_bool("pedantic", pedantic))  # fmt: skip
+                                     pedantic=check_bool("pedantic", pedantic), stat_err_filter=stat_err_filter)
         if chip.upif is None or chip.chip.registers is None:
             raise fail("config", "the straps of an Init-µP mode (Tables 2-4 to 2-7)", self.config.function)
         self.registers = chip.chip.registers
