@@ -83,8 +83,11 @@ EXCP_EXCEPTION_EXIT: Final[int] = 8
 """unicorn's interrupt number for a branch to an EXC_RETURN value in handler mode (QEMU's EXCP_EXCEPTION_EXIT)."""
 EXCP_SWI: Final[int] = 2
 EXCP_PREFETCH_ABORT: Final[int] = 3
-"""unicorn's interrupt number for an instruction fetch from a peripheral's region (QEMU's EXCP_PREFETCH_ABORT): on
-this board the peripheral and system regions, Execute Never in the default memory map (B3.1)."""
+"""unicorn's interrupt number for an instruction fetch it cannot make (QEMU's EXCP_PREFETCH_ABORT): from a peripheral
+callback's region, or from some unmapped addresses (0)."""
+EXECUTE_NEVER: Final[tuple[tuple[int, int], ...]] = ((0x4000_0000, 0x6000_0000), (0xA000_0000, 0x1_0000_0000))
+"""The Execute Never regions of the default memory map (B3.1, Table B3-1: Peripheral, Device, System): a fetch there
+is a MemManage fault (IACCVIOL)."""
 EXCP_BKPT: Final[int] = 7
 EXC_RETURN_HANDLER: Final[int] = 0xFFFF_FFF1
 """Return to handler mode, main stack (B1.5.8, Table B1-8)."""
@@ -1055,9 +1058,11 @@ class CortexM:
         if number == EXCP_SWI:
             self.enter(SVCALL)
             return "run"
-        if number == EXCP_PREFETCH_ABORT:  # B3.1: the peripheral and system regions are Execute Never
-            raise FirmwareFaultError(self._fault_report(f"memory fault: execute from a peripheral region at "
-                                                        f"{pc:08X}h (Execute Never)", IACCVIOL))  # fmt: skip
+        if number == EXCP_PREFETCH_ABORT:
+            if any(low <= pc < high for low, high in EXECUTE_NEVER):
+                raise FirmwareFaultError(self._fault_report(f"memory fault: execute from a peripheral region at "
+                                                            f"{pc:08X}h (Execute Never)", IACCVIOL))  # fmt: skip
+            raise FirmwareFaultError(self._fault_report(*_FAULTS[ucc.UC_ERR_FETCH_UNMAPPED]))
         if number is not None:
             what = "a breakpoint (BKPT)" if number == EXCP_BKPT else f"core exception {number}"
             raise FirmwareStoppedError(self.report(Stop.FAULT, f"{what}: not modelled"))
