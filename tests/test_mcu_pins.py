@@ -181,6 +181,7 @@ def test_run_for_gives_the_transaction_levels_cycles_time_and_data(digital_io: P
     assert (board.cycles, 240e-6 < board.now - start < 260e-6) == (4, True)
 
 
+@pytest.mark.slow  # one device behind the chip: three times the chip's CPU time (MCU-23)
 def test_a_device_behind_the_chip_at_pin_level_gives_the_transaction_levels_ring(
     digital_io: Path, tmp_path: Path
 ) -> None:
