@@ -98,7 +98,8 @@ class Sample:
 
 
 class LockstepRing(PinRing):
-    """The master's line through one whole chip whose µP pins the firmware drives, in step with the core.
+    """The master's line through one whole chip whose µP pins the firmware drives, in step with the core, and on
+    through the pin-level chips behind it (``others``).
 
     Parameters
     ----------
@@ -272,11 +273,11 @@ class LockstepRing(PinRing):
     def _clock(self, n: int, until_edge: bool) -> bool:
         """Run ``n`` clocks with the inputs held (but ``do1``); whether it stopped early at an edge. A long wait for
         an edge (from :data:`LOOK_AHEAD_FROM` clocks) runs to it in one piece (:meth:`_edge_ahead`, MCU-21)."""
+        if len(self.tree) > 1:
+            return self._clock_ring(n, until_edge)
         chip, line, idle = self.chip, self._line, self.inputs["do1"]
         start = self.cycle
         edge = False
-        if len(self.tree) > 1:
-            return self._clock_ring(n, until_edge)
         if until_edge and n >= LOOK_AHEAD_FROM:
             n, edge = self._edge_ahead(n)
             until_edge = False
