@@ -182,19 +182,23 @@ def test_run_for_gives_the_transaction_levels_cycles_time_and_data(digital_io: P
 
 
 @pytest.mark.slow  # one device behind the chip: three times the chip's CPU time (MCU-23)
+@pytest.mark.parametrize("mode", list(Mode))
 def test_a_device_behind_the_chip_at_pin_level_gives_the_transaction_levels_ring(
-    digital_io: Path, tmp_path: Path
+    digital_io: Path, tmp_path: Path, mode: Mode
 ) -> None:
     """MCU-23: a pin-level SUPI 3 strapped RB 16 IN (session.RING_DEVICE_STRAPS: ID 02h, one word) behind the board's
     chip, each piece of the chip's lockstep run carried on through it and back: the master's configuration table and
     the process data both ways (the chip's, and the device's inputs at ring position 2) are those of the same ring
-    at transaction level, with no violation; the VCD holds the second chip's pins (scope dev2)."""
+    at transaction level, with no violation; the VCD holds the second chip's pins (scope dev2). On the Motorola and
+    the Intel board (MCU-18)."""
     config = decode(*RING_DEVICE_STRAPS, clk_conf=clk_conf_for(500_000))
+    elf = digital_io if mode is Mode.MOTOROLA else mcu_build.build(
+        native.example("digital_io"), tmp_path / "intel.elf", defines={"FW_MODE": "SUPI3_MODE_INTEL"})
     seen = {}
     for fidelity in ("transaction", "pin"):
         behind = Supi3Pins(config) if fidelity == "pin" else Supi3(config)
-        board = Board(digital_io, cycle_time_s=600e-6, fidelity=fidelity, others=[behind],
-                      record=fidelity == "pin")  # fmt: skip
+        board = Board(elf, cycle_time_s=600e-6, fidelity=fidelity, others=[behind], record=fidelity == "pin",
+                      mode=mode)  # fmt: skip
         board.run(3)
         assert board.master.config is not None
         table = [(e.id_code, e.length_code) for e in board.master.config]
@@ -206,7 +210,7 @@ def test_a_device_behind_the_chip_at_pin_level_gives_the_transaction_levels_ring
         else:
             board.ring.set_input(2, "mfp_in", 0xA55A)
         board.run(2)
-        assert board.violations == []
+        assert board.violations == [] and board.protocol.mode is mode
         seen[fidelity] = (table, board.fw_board.outputs[:2], board.master.inputs(1), board.master.inputs(2))
     assert seen["pin"] == seen["transaction"] == ([(0x03, 0b00001), RING_DEVICE], WORDS[0], WORDS[1], b"\xa5\x5a")
     assert "$scope module dev2" in board.write_vcd(tmp_path / "ring.vcd").read_text()
