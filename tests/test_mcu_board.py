@@ -13,6 +13,8 @@ import re
 from pathlib import Path
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from supi3.interbus.ring import ErrorKind
 from supi3.mcu import board as mcu_board
@@ -289,7 +291,7 @@ def test_the_bench_cases_keep_their_fingerprint(digital_io: dict[str, Path], tmp
 
 
 IDLE_TICK = Path(__file__).parent / "mcu" / "idle_tick.S"
-"""SysTick every 100 µs waking a thread-mode ``b .``: seven instructions to it, five in the handler."""
+"""SysTick every 100 µs waking a thread-mode ``b .``: nine instructions to it, five in the handler."""
 
 
 @pytest.fixture(scope="module")
@@ -324,12 +326,12 @@ def test_a_thread_mode_b_dot_is_a_wait_from_its_first_iteration_at_any_budget(
 @pytest.mark.parametrize("fidelity", FIDELITIES)
 def test_an_interrupt_returning_to_b_dot_sleeps_at_once(idle_tick: dict[str, Path], fidelity: str) -> None:
     """Each SysTick wake runs the handler's five instructions; its return to the ``b .`` sleeps without running it:
-    the instructions are the set-up's six, one iteration, and five a wake, at both fidelities."""
+    the instructions are the set-up's nine, one iteration, and five a wake, at both fidelities."""
     board = Board(idle_tick["tick"], cpu="cortex_m0", fidelity=fidelity)
     board.run(1)
     ticks = int.from_bytes(board.core.read_bytes(board.core.image.address("ticks"), 4), "little")
     assert ticks == board.core.cycles // 4800 > 0
-    assert board.core.sleeping and board.core.instructions == 6 + 1 + 5 * ticks
+    assert board.core.sleeping and board.core.instructions == 9 + 1 + 5 * ticks
 
 
 @pytest.mark.parametrize("fidelity", FIDELITIES)
@@ -340,5 +342,38 @@ def test_b_dot_in_a_handler_is_a_hang_at_its_first_iteration(idle_tick: dict[str
     with pytest.raises(FirmwareStoppedError, match=r"endless loop \(b \.\) in the handler of exception 15") as caught:
         board.run(1)
     report = caught.value.report
-    assert (report.stop, report.symbol, report.instructions) == (Stop.HANG, "Default_Handler", 8)
+    assert (report.stop, report.symbol, report.instructions) == (Stop.HANG, "Default_Handler", 11)
     assert 4800 < board.core.cycles - CPUS["cortex_m0"].entry_cycles - 3 < 4800 + 20  # the first wrap: its iteration
+
+
+BUDGETS = [1, 7, 100, 2000, 10**6]
+"""Instruction budgets from below the set-up to far above a run's instructions."""
+
+
+@settings(max_examples=20, derandomize=True, deadline=None)
+@given(calls=st.lists(st.tuples(st.booleans(), st.integers(0, 3), st.sampled_from(BUDGETS)), min_size=1, max_size=6))
+def test_any_history_of_runs_keeps_the_wait_out_of_the_budget(idle_tick: dict[str, Path],
+                                                              calls: list[tuple[bool, int, int]]) -> None:  # fmt: skip
+    """MCU-4 over histories: any sequence of ``run(n)`` and ``run_for(n x 100 µs)`` calls, each with its own budget,
+    on the SysTick-woken ``b .``: after each the instructions are the set-up's nine, one iteration and five a wake
+    (the handler is one block: run whole, or not yet entered), never more, the core asleep or about to run the
+    handler; a call ends in a budget stop only if it ran at least its budget."""
+    board = Board(idle_tick["tick"], cpu="cortex_m0")
+    ticks_at = board.core.image.address("ticks")
+    for by_time, amount, budget in calls:
+        before = board.core.instructions
+        stopped: FirmwareStoppedError | None = None
+        try:
+            if by_time:
+                board.run_for(amount * 100e-6, max_instructions=budget)
+            else:
+                board.run(amount, max_instructions=budget)
+        except FirmwareStoppedError as error:
+            stopped = error
+        if stopped is not None:
+            assert stopped.report.stop is Stop.BUDGET and board.core.instructions - before >= budget
+            return
+        ticks = int.from_bytes(board.core.read_bytes(ticks_at, 4), "little")
+        core = board.core
+        if core.instructions:  # (a first run(0) or run_for(0) runs nothing) the handler is one block: whole or not yet
+            assert core.instructions == 9 + 1 + 5 * ticks and (core.sleeping or core.in_exception)
