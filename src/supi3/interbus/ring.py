@@ -598,6 +598,9 @@ class Ring:
         self._branches = _branches(self._tree)
         self._enabled: tuple[bool, ...] = ()
         self._spans: list[_Span] = []
+        self._unanswered: list[int] = []
+        """The ring positions of the BKs whose branch is in the data path with nothing attached (BK-43): their branch
+        return input carries nothing, as a :class:`ReturnBreak` there."""
         self._index: dict[int, int] = {}
         self._detached: dict[int, tuple[Device, float | None]] = {}
         self.devices: list[Device] = [d for d in self._tree if not isinstance(d, Branch)]
@@ -658,6 +661,7 @@ class Ring:
         walk(self._tree)
         self.devices = flat
         self._spans = sorted(spans, key=attrgetter("at"))
+        self._unanswered = [span.at + 1 for span in self._spans if span.end == span.at + 1]
         self._index = {id(d): i for i, d in enumerate(flat)}
         self._silent_since = {self._index[k]: t for k, t in before.items() if k in self._index}
         self._silent_reset = {self._index[k] for k in was_reset if k in self._index}
@@ -758,10 +762,10 @@ class Ring:
         self._faults.clear()
 
     def _faults_on(self, segments: int) -> tuple[dict[int, list[Fault]], list[int]]:
-        """The faults on lines 1..``segments`` now, by line, and the positions whose return line is broken; each
-        counts one of its cycles."""
+        """The faults on lines 1..``segments`` now, by line, and the positions whose return line is broken (a BK with
+        nothing attached in the data path too, BK-43); each fault counts one of its cycles."""
         hits: dict[int, list[Fault]] = {}
-        returns: list[int] = []
+        returns: list[int] = list(self._unanswered)
         for active in self._faults:
             where = self._where(active)
             if where is None:
@@ -778,10 +782,11 @@ class Ring:
         return hits, returns
 
     def _breaks(self) -> tuple[list[int], list[int]]:
-        """The lines broken now (``DeadLine``) and the positions whose return line is broken, without counting a
-        fault's cycles."""
+        """The lines broken now (``DeadLine``) and the positions whose return line is broken (a BK with nothing
+        attached in the data path too, BK-43), without counting a fault's cycles."""
         lines = [(a.fault, w) for a in self._faults if (w := self._where(a)) is not None]
-        return ([w for f, w in lines if isinstance(f, DeadLine)], [w for f, w in lines if isinstance(f, ReturnBreak)])
+        return ([w for f, w in lines if isinstance(f, DeadLine)],
+                [*self._unanswered, *(w for f, w in lines if isinstance(f, ReturnBreak))])  # fmt: skip
 
     def _first_dead(self) -> int | None:
         """The first line that carries nothing on the whole ring (broken return lines of branches too)."""
@@ -924,7 +929,7 @@ class Ring:
         dead_lines: list[int] = []
         dead: int | None = None
         back_dead = False
-        if self._faults:
+        if self._faults or self._unanswered:
             faults, returns = self._faults_on(segments)
             dead_lines = [s for s, fs in faults.items() if any(isinstance(f, DeadLine) for f in fs)]
             dead = min(dead_lines, default=None)
