@@ -295,13 +295,13 @@ BLOCK_INPUTS: Final[tuple[Pin, ...]] = (
 """The bus terminal block's inputs:
 
 ``ib_reset`` the core's INTERBUS reset (:func:`reset` while high); ``mode`` a :class:`TerminalMode` (static, from
-C[4..0]); ``rf`` RF[1..0] (static, :data:`RF_CODES`; 3 on a chip without RF pins); ``conf`` and ``lbst`` the levels
-of MFP12 and MFP11 after the input synchroniser; ``connected`` a device answers on the branch (automatic
-recognition, Table 2-9; in the chip: a status telegram came back on DI3, BK-37); ``cmd_valid`` a latched ID cycle's
-command word, whose fields are ``branch`` (a :class:`~supi3.interbus.wire.BranchControl`, bits 7..6), ``ack`` (the
-quit bit, 0714h), ``alarm_set`` and ``alarm_on`` (bits 9 and 10 without a processor command, BK-12); ``ret_valid`` one of the master's telegrams (frame
-or status telegram) came back on the branch return line; ``cnt_valid``/``count`` a counter telegram came back there
-with that count (BK-6). Strobes are one clock wide."""
+C[4..0]); ``rf`` RF[1..0] (static, :data:`RF_CODES`; 3 on a chip without RF pins); ``conf`` and ``lbst`` the levels of
+MFP12 and MFP11 after the input synchroniser; ``connected`` a device answers on the branch (automatic recognition, Table
+2-9; in the chip: the first start level on DI3, BK-37); ``cmd_valid`` a latched ID cycle's command word, whose fields
+are ``branch`` (a :class:`~supi3.interbus.wire.BranchControl`, bits 7..6), ``ack`` (the quit bit, 0714h), ``alarm_set``
+and ``alarm_on`` (bits 9 and 10 without a processor command, BK-12); ``ret_valid`` one of the master's telegrams (frame
+or status telegram) came back on the branch return line; ``cnt_valid``/``count`` a counter telegram came back there with
+that count (BK-6). Strobes are one clock wide."""
 
 BLOCK_OUTPUTS: Final[tuple[Pin, ...]] = (
     Pin("enabled"), Pin("live"), Pin("status", 8), Pin("attention"), Pin("ld"), Pin("e"), Pin("alarm"), Pin("closed"),

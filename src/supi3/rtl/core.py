@@ -359,10 +359,10 @@ class Supi3Core(wiring.Component):
 
         # The bus terminal module (2.4, docs/bus-terminal.md): in reset until the core runs, so that it takes CONF as it
         # is at the first running clock (BK-20). A device answers on the branch once the synchronised DI3 was at the
-        # start level where the logic ran (BK-37: a pulled-up or broken DI3 never is); a power failure forgets it. While the interface is
-        # live DO3 (MFP9) takes the DO2 the core would send (BK-42), else it idles; while the branch is in the data
-        # path DO2 repeats the synchronised DI3 (BK-1's order: the BK, its branch, on along the remote bus; the pin
-        # model's BranchLines).
+        # start level where the logic ran (BK-37: a pulled-up or broken DI3 never is); a power failure forgets it.
+        # While the interface is live DO3 (MFP9) takes the DO2 the core would send (BK-42), else it idles; while the
+        # branch is in the data path DO2 repeats the synchronised DI3 (BK-1's order: the BK, its branch, on along the
+        # remote bus; the pin model's BranchLines).
         terminal = TerminalRtl()
         m.submodules.terminal = ResetInserter(~running)(terminal)
         di3 = receiver.mfp_in_s[DI3_PIN]

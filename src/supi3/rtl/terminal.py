@@ -3,12 +3,12 @@ control, the silence timer of the extended function, the status byte and the LED
 :data:`supi3.terminal.BLOCK_INPUTS` / ``BLOCK_OUTPUTS``.
 
 Manual 2.4 (Tables 2-7, 2-8, 2-9, "Extended bus terminal module functions"), 2.2.2, Table 3-19. The transitions of
-:mod:`supi3.terminal` (``power_up``, ``conf_level``, ``command``, ``received``, ``silence``, ``reset``, ``enabled``
-and the outputs of ``Terminal``) are re-implemented here in gates (``live`` is ``enabled`` with a device answering), with every constant taken from the spec at
-elaboration (the branch control codes, the status byte's bits, the RF codes of Table 2-9, the silence in clocks).
-The edge order and the port timing are those of the pin model ``TerminalBlock``
-(``src/supi3/model/blocks/terminal.py``, its module docstring, BK-20), which
-``tests/test_verif_lockstep_terminal.py`` holds this block to, cycle by cycle.
+:mod:`supi3.terminal` (``power_up``, ``conf_level``, ``command``, ``received``, ``silence``, ``reset``, ``enabled`` and
+the outputs of ``Terminal``) are re-implemented here in gates (``live`` is ``enabled`` with a device answering), with
+every constant taken from the spec at elaboration (the branch control codes, the status byte's bits, the RF codes of
+Table 2-9, the silence in clocks). The edge order and the port timing are those of the pin model ``TerminalBlock``
+(``src/supi3/model/blocks/terminal.py``, its module docstring, BK-20), which ``tests/test_verif_lockstep_terminal.py``
+holds this block to, cycle by cycle.
 """
 
 from __future__ import annotations

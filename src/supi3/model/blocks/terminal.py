@@ -124,10 +124,12 @@ class TerminalBlock:
         if v["mode"] == TerminalMode.NONE:
             return dict(_OFF)
         state = self.state
-        on = enabled(state, rf_of(v["rf"]), bool(v["lbst"]), bool(v["connected"]))
+        rf, lbst = rf_of(v["rf"]), bool(v["lbst"])
+        on = enabled(state, rf, lbst, bool(v["connected"]))
         outputs = {
-            "enabled": int(on), "live": int(live(state, rf_of(v["rf"]), bool(v["lbst"]))), "status": state.status, "attention": int(state.attention), "ld": int(state.ld),
-            "e": int(state.e), "alarm": int(state.alarm), "closed": int(state.closed),
+            "enabled": int(on), "live": int(live(state, rf, lbst)), "status": state.status,
+            "attention": int(state.attention), "ld": int(state.ld), "e": int(state.e), "alarm": int(state.alarm),
+            "closed": int(state.closed),
         }  # fmt: skip
         self._edge(v, state.extended and on)
         return outputs
