@@ -4,9 +4,9 @@ and power-up resets, the pin-level BK (:class:`~supi3.model.pins.Supi3Pins`) fol
 
 * ``connected`` latches the first start level (0) of the synchronised DI3 at a clock edge where the core's logic
   runs, and a power-up reset clears it (BK-37); a pulled-up DI3 with nothing attached never shows one (BK-41);
-* DO3 (MFP9) idles while the interface is not live (BK-42: the branch open and present by Table 2-9 were a device
-  answering), and DO2 repeats the synchronised DI3 while the branch is in the data path (Table 2-9 with
-  ``connected``).
+* DO3 (MFP9) carries the DO2 of a chip without branch (the same straps, DI3 at rest, LBST low) while the interface is
+  live (BK-42: the branch open and present by Table 2-9 were a device answering) and idles else; DO2 repeats the
+  synchronised DI3 while the branch is in the data path (Table 2-9 with ``connected``) and is that chip's else.
 
 The attached device answers as a following protocol chip does: it returns what DO3 sends, a repeater's delay later;
 detached, DI3 reads the pull-up. run() equals step() on them, and the RTL core runs them in lockstep
@@ -78,6 +78,7 @@ def close_loop(config: DeviceConfig, columns: Columns, device: np.ndarray) -> tu
     pins = Supi3Pins(config)
     n = len(columns["do1"])
     mfp = columns["mfp_in"].copy()
+    alone = Supi3Pins(config).run({**columns, "mfp_in": mfp & ~(1 << LBST_PIN) | 1 << DI3_PIN})["do2"]
     do3 = np.ones(n, dtype=np.int64)
     names = [name for name in columns if name in {pin.name for pin in Supi3Pins.inputs}]
     connected = False
@@ -93,10 +94,10 @@ def close_loop(config: DeviceConfig, columns: Columns, device: np.ndarray) -> tu
         out = pins.step({name: int(columns[name][t]) if name != "mfp_in" else int(mfp[t]) for name in names})
         do3[t] = out["mfp_out"] >> DO3_PIN & 1
         live, on = opened and table[lbst, 1], opened and table[lbst, int(connected)]
-        if not live and do3[t] != wire.IDLE_LEVEL:
-            problems.append(f"{t}: DO3 sends while the interface is not live")
-        if on and out["do2"] != di3:
-            problems.append(f"{t}: DO2 is not DI3 in the data path")
+        if do3[t] != (alone[t] if live else wire.IDLE_LEVEL):
+            problems.append(f"{t}: DO3 {do3[t]}, live {live}")
+        if out["do2"] != (di3 if on else alone[t]):
+            problems.append(f"{t}: DO2 {out['do2']}, in the data path {on}")
         connected = (connected or di3 == wire.START_LEVEL) if pins.run_from <= t else False
         assert pins._branch is not None
         if pins._branch.connected != connected:
