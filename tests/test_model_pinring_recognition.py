@@ -14,7 +14,7 @@ from __future__ import annotations
 import pytest
 
 from supi3.interbus.master import Master
-from supi3.interbus.ring import Branch, BranchKind, ErrorKind, Ring
+from supi3.interbus.ring import Branch, BranchKind, DeadLine, ErrorKind, Ring
 from supi3.model.chip import Supi3
 from supi3.model.pinring import PinBranch, PinRing
 from supi3.model.pins import Supi3Pins
@@ -89,3 +89,17 @@ def test_every_row_of_table_2_9_is_the_same_at_both_fidelities(kind: BranchKind,
             else:
                 assert tl[0][0] and ok and seen is not None and len(seen[0]) == 3 + (m if present else 0)
                 assert leds[1][1:] == (False, False)  # the BK's LD and E dark
+
+
+def test_a_branch_cut_before_the_first_start_is_the_recorded_limit() -> None:
+    """BK-37's limit, pinned down: a BK-LB branch whose forward line into its second device is cut before the master's
+    first start returns the idle level to DI3, so the pin-level BK never recognises it and the ring runs through the
+    BK; the transaction-level ring recognised the populated branch when it was built and reports the break."""
+    pin, _ = pin_ring(BranchKind.LOCAL, "11", True, 2)
+    pin.cut(4, True)
+    tl, _ = tl_ring(BranchKind.LOCAL, "11", True, 2)
+    tl.inject(DeadLine(4))
+    pin_master, tl_master = Master(pin, locate=False, max_devices=8), Master(tl, locate=False, max_devices=8)
+    assert pin_master.start().ok and pin_master.config is not None and len(pin_master.config) == 3
+    result = tl_master.start()
+    assert not result.ok and result.diagnostics[0].kind is ErrorKind.DEAD_LINE
