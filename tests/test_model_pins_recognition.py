@@ -82,7 +82,7 @@ def close_loop(config: DeviceConfig, columns: Columns, device: np.ndarray) -> tu
     do3 = np.ones(n, dtype=np.int64)
     names = [name for name in columns if name in {pin.name for pin in Supi3Pins.inputs}]
     connected = False
-    table = np.array([[branch_present(rf_of(config), bool(lbst), bool(c)) for c in (0, 1)] for lbst in (0, 1)])
+    table = np.array([[branch_present(_rf(config), bool(lbst), bool(c)) for c in (0, 1)] for lbst in (0, 1)])
     problems: list[str] = []
     for t in range(n):
         answer = int(do3[t - ANSWER_DELAY]) if device[t] and t >= ANSWER_DELAY else wire.IDLE_LEVEL
@@ -105,7 +105,7 @@ def close_loop(config: DeviceConfig, columns: Columns, device: np.ndarray) -> tu
     return {**columns, "mfp_in": mfp}, problems
 
 
-def rf_of(config: DeviceConfig) -> str:
+def _rf(config: DeviceConfig) -> str:
     """The RF straps of a chip (Table 2-2)."""
     assert config.rf_mode is not None
     return config.rf_mode.rf
