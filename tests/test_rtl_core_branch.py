@@ -16,7 +16,7 @@ from supi3.terminal import BRANCH_SILENCE_CLOCKS
 from supi3.verif import Lockstep
 from support import CoreScript
 from test_model_pins_branch import CASES, COUNT_CASES, LD_PIN, count_scenario, scenario, silence_scenario
-from test_model_pins_recognition import FIXED, close_loop, history
+from test_model_pins_recognition import FIXED, RANDOM_SEEDS, close_loop, history, random_history
 
 
 @pytest.mark.parametrize(("interface", "rf", "seed"), CASES)
@@ -25,7 +25,7 @@ def test_rtl_core_matches(bench: Lockstep, interface: str, rf: str, seed: int) -
     bench.run_batch(script.stimulus())
 
 
-@pytest.mark.parametrize(("interface", "rf", "ops"), FIXED)
+@pytest.mark.parametrize(("interface", "rf", "ops"), [*FIXED, *map(random_history, RANDOM_SEEDS)])
 def test_rtl_core_recognises_as_the_model(bench: Lockstep, interface: str, rf: str, ops: list[tuple[str, int]]) -> None:
     """BK-37, BK-42: histories of attaching and detaching the branch's device (DI3 its answer or the pull-up), LBST
     changes, INTERBUS and power-up resets: ``connected`` from the first start level on DI3, DO3 while live, DO2 in
