@@ -17,8 +17,9 @@ access only under a memory hook, so each peripheral range has an empty one). Emu
 boundary (a block hook refuses the next block), because unicorn restarts an instruction stopped inside a memory
 callback and a peripheral would see its access twice.
 
-Speed (MCU-19): the block hook, the peripheral callbacks and the register reads they need go to unicorn's C library
-through ctypes directly; the binding's wrappers around each call cost as much again as the call.
+Speed (MCU-19): the peripheral callbacks and the register reads they need go to unicorn's C library through ctypes
+directly; the binding's wrappers around each call cost as much again as the call. The block hook and the empty memory
+hooks are native code (MCU-22, :mod:`supi3.mcu.hook`): a block calls Python only the first time it runs.
 """
 
 from __future__ import annotations
@@ -40,16 +41,14 @@ from unicorn import unicorn_const as ucc
 
 from supi3.checks import check_bytes, check_int, check_real, fail
 from supi3.errors import ArgumentError, Supi3Error
+from supi3.mcu import hook
 
 _UNICORN: Any = unicorn  # typed, but its Uc methods are not annotated
 UcError: type[Exception] = _UNICORN.UcError
 _LIB: Any = _UNICORN.unicorn_py3.unicorn.uclib
 """unicorn's C library as its binding loaded it (with the argument types it declares): the hot callbacks and
 register accesses go to it directly (MCU-19), without the binding's wrappers around each call."""
-# Callback types of unicorn.h (uc_cb_hookcode_t, uc_cb_hookmem_t, uc_cb_mmio_read_t, uc_cb_mmio_write_t).
-_HOOK_CODE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint32, ctypes.c_void_p)
-_HOOK_MEM: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_int, ctypes.c_uint64, ctypes.c_int, ctypes.c_int64,
-                                    ctypes.c_void_p)  # fmt: skip
+# Callback types of unicorn.h (uc_cb_mmio_read_t, uc_cb_mmio_write_t).
 _MMIO_READ: Final = ctypes.CFUNCTYPE(ctypes.c_uint64, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint, ctypes.c_void_p)
 _MMIO_WRITE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint, ctypes.c_uint64,
                                       ctypes.c_void_p)  # fmt: skip
@@ -114,6 +113,9 @@ SYST_MAX: Final[int] = 0xFF_FFFF
 """SysTick is a 24-bit down counter (B3.3.1)."""
 BACKTRACE_DEPTH: Final[int] = 16
 """Frames :meth:`CortexM.backtrace` unwinds at most."""
+BLOCK_CACHE_SLOTS: Final[int] = 1 << 13
+"""Slots of the native block hook's cost cache (MCU-22), one per halfword address modulo their number: 16 KiB of
+code without two blocks sharing a slot (a block that finds its slot taken asks Python again)."""
 IRQ_LINES: Final[int] = 32
 """External interrupts the NVIC model has (one ISER word)."""
 CFSR: Final[int] = 0xD28
@@ -594,9 +596,18 @@ class CortexM:
             self.uc.mem_map(base, size)
         for address, data in self.image.segments:
             self.uc.mem_write(address, data)
-        self.cycles = 0
-        self.instructions = 0
-        self.deadline = 0
+        native = hook.library()
+        self._exact_pc = ctypes.cast(native.supi3_exact_pc, ctypes.c_void_p)
+        self._state = state = hook.State()  # cycles, instructions, deadline, ...: shared with the native hook
+        self._cache = (hook.Block * BLOCK_CACHE_SLOTS)()
+        self._describe_callback = hook.DESCRIBE(self._describe)
+        state.cache = self._cache
+        state.mask = BLOCK_CACHE_SLOTS - 1
+        state.low_registers[:] = _LOW_REGS
+        state.emu_stop = ctypes.cast(_LIB.uc_emu_stop, ctypes.c_void_p)
+        state.reg_read = ctypes.cast(_LIB.uc_reg_read, ctypes.c_void_p)
+        state.reg_write = ctypes.cast(_LIB.uc_reg_write, ctypes.c_void_p)
+        state.describe = self._describe_callback
         self.sleeping = False
         self.active: list[int] = []  # active exceptions, outermost first
         self.pending: set[int] = set()
@@ -609,22 +620,17 @@ class CortexM:
         self.entered: Callable[[int], None] = _nothing
         """Called with the exception number after each exception entry (the board measures latency)."""
         self._costs: dict[tuple[int, int], tuple[int, int]] = {}  # the cost of a block's first instructions
-        self._block = (0, 0)  # address and cycle count at the entry of the block running
-        self._block_end = 0
         self._running = False
         self._handed = 0  # the latest time a peripheral was given
-        self._skip: tuple[int, int] | None = None  # (poll loop address, cycle its status changes)
         self._polls: dict[int, bool] = {}
         self._idle: dict[int, bool] = {}  # address: the instruction there is ``b .``
         self._blocks: dict[tuple[int, int], tuple[tuple[int, int], int]] = {}  # cost, countdown register (MCU-11)
         self.skip_polls = True
-        """MCU-10, MCU-11: count the iterations of pure poll loops and countdown loops without running them (the
-        same result, faster); ``False`` runs each."""
         self.vtor = 0
         self.systick = SysTick(self)
         self._scs_words: dict[int, int] = {}
         self.mmio(SCS_BASE, SCS_SIZE, self._scs_read, self._scs_write)
-        self._hook(ucc.UC_HOOK_BLOCK, _HOOK_CODE(self._on_block))
+        self._hook(ucc.UC_HOOK_BLOCK, ctypes.cast(native.supi3_block_hook, ctypes.c_void_p), data=ctypes.byref(state))
         self.uc.hook_add(ucc.UC_HOOK_INTR, self._on_interrupt)
         self.reset()
 
@@ -660,14 +666,13 @@ class CortexM:
         # unicorn updates the PC before a load or store only if a memory hook covers its address: without one, a
         # peripheral callback sees the PC of the block's first instruction, and the access would be timed there
         # (MCU-1 places it by the PC).
-        self._hook(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, _EXACT_PC, base, base + size - 1)
+        self._hook(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, self._exact_pc, base, base + size - 1)
 
-    def _hook(self, kind: int, callback: Any, begin: int = 1, end: int = 0) -> None:
-        """Add a hook with a ctypes callback (MCU-19); ``begin > end``: every address."""
-        self._callbacks.append(callback)
+    def _hook(self, kind: int, callback: ctypes.c_void_p, begin: int = 1, end: int = 0, data: Any = None) -> None:
+        """Add a hook with a native callback (MCU-19, MCU-22) and its user data; ``begin > end``: every address."""
         handle = ctypes.c_size_t()  # uc_hook
-        self._check(_LIB.uc_hook_add(self._handle, ctypes.byref(handle), kind, ctypes.cast(callback, ctypes.c_void_p),
-                                     None, ctypes.c_uint64(begin), ctypes.c_uint64(end)))  # fmt: skip
+        self._check(_LIB.uc_hook_add(self._handle, ctypes.byref(handle), kind, callback, data, ctypes.c_uint64(begin),
+                                     ctypes.c_uint64(end)))  # fmt: skip
 
     @staticmethod
     def _check(status: int) -> None:
@@ -732,6 +737,54 @@ class CortexM:
         self._register_value.value = value
         _LIB.uc_reg_write(self._handle, register, self._register_ref)
 
+    # -- the clock, shared with the native block hook (MCU-1, MCU-22) ------------------------------------------------
+
+    @property
+    def cycles(self) -> int:
+        """Cycles since reset (exception entry and return cycles included)."""
+        return int(self._state.cycles)
+
+    @cycles.setter
+    def cycles(self, value: int) -> None:
+        self._state.cycles = value
+
+    @property
+    def instructions(self) -> int:
+        """Instructions since reset."""
+        return int(self._state.instructions)
+
+    @instructions.setter
+    def instructions(self, value: int) -> None:
+        self._state.instructions = value
+
+    @property
+    def deadline(self) -> int:
+        """The cycle the running :meth:`step` ends at (checked at block boundaries)."""
+        return int(self._state.deadline)
+
+    @deadline.setter
+    def deadline(self, value: int) -> None:
+        self._state.deadline = value
+
+    @property
+    def stop_request(self) -> bool:
+        """End the run at the next block boundary (a peripheral's change the run loop must see)."""
+        return bool(self._state.stop_request)
+
+    @stop_request.setter
+    def stop_request(self, value: bool) -> None:
+        self._state.stop_request = value
+
+    @property
+    def skip_polls(self) -> bool:
+        """MCU-10, MCU-11: count the iterations of pure poll loops and countdown loops without running them (the
+        same result, faster); ``False`` runs each."""
+        return bool(self._state.skip_polls)
+
+    @skip_polls.setter
+    def skip_polls(self, value: bool) -> None:
+        self._state.skip_polls = value
+
     @property
     def time_s(self) -> float:
         """Core time: cycles / cpu_hz."""
@@ -741,9 +794,10 @@ class CortexM:
         """The cycle of the instruction running now: inside a peripheral callback the block's entry plus the
         instructions before the program counter (MCU-1), between runs :attr:`cycles`. Never earlier than a time
         already handed out (:meth:`cycles_polled`)."""
+        state = self._state
         if not self._running:
-            return self.cycles
-        address, start = self._block
+            return int(state.cycles)
+        address, start = state.block_address, state.block_start
         pc = self._read(arm.UC_ARM_REG_PC)
         if pc > address:
             key = (address, pc - address)
@@ -757,9 +811,11 @@ class CortexM:
     def cycles_polled(self) -> int:
         """The time of a status read (a flag the firmware polls): the end of the running block, which costs no
         register read; later times handed out are never earlier (MCU-1)."""
+        cycles = int(self._state.cycles)
         if not self._running:
-            return self.cycles
-        self._handed = max(self._handed, self.cycles)
+            return cycles
+        if cycles > self._handed:
+            self._handed = cycles
         return self._handed
 
     # -- reset and exceptions ----------------------------------------------------------------------------------
@@ -901,71 +957,34 @@ class CortexM:
 
     # -- running -----------------------------------------------------------------------------------------------
 
-    def _on_block(self, handle: int, address: int, size: int, data: int) -> None:
-        """The block at ``address`` is about to run: refuse it at the deadline or on a stop request, else count its
-        cost (MCU-1) or skip the iterations of a poll or countdown loop (MCU-10, MCU-11)."""
-        del data
+    def _describe(self, address: int, size: int) -> int:
+        """The native block hook met a block not in its cache: its cost (MCU-1) and countdown register (MCU-11)
+        into the cache and :attr:`hook.State.fresh`; 1 (stop the run) if its code cannot be read."""
         try:
-            if self.stop_request or self.cycles >= self.deadline:
-                _LIB.uc_emu_stop(handle)  # this block does not run: it is the first of the next run
-                return
             block = self._blocks.get((address, size))
             if block is None:
                 code = self.read_bytes(address, size)
                 block = self._blocks[address, size] = (block_cost(code), countdown_register(code))
-            cost = block[0]
-            skip = self._skip
-            if skip is not None:
-                self._skip = None
-                if skip[0] == address:
-                    self._skip_polls(cost, skip[1])
-                    if self.cycles >= self.deadline:
-                        _LIB.uc_emu_stop(handle)
-                        return
-            if block[1] >= 0 and self.skip_polls and self._skip_countdown(block[1], cost):
-                _LIB.uc_emu_stop(handle)
-                return
-            self._block = (address, self.cycles)
-            self._block_end = address + size
-            self.instructions += cost[0]
-            self.cycles += cost[1]
+            (instructions, cycles), countdown = block
+            self._state.fresh = self._cache[(address >> 1) & (BLOCK_CACHE_SLOTS - 1)] = \
+                hook.Block(address, size, instructions, cycles, countdown)  # fmt: skip
+            return 0
         except BaseException as error:  # handed to the run loop, raised there (an escape would be lost in ctypes)
             self.fail(error)
-            _LIB.uc_emu_stop(handle)
-
-    def _skip_polls(self, cost: tuple[int, int], until: int) -> None:
-        """Count, without running them, the iterations of a poll loop that would start before the deadline and
-        read before ``until`` (MCU-10): each reads at its block's end (:meth:`cycles_polled`)."""
-        instructions, cycles = cost
-        before_deadline = -(-(self.deadline - self.cycles) // cycles)
-        reading_early = -(-(until - cycles - self.cycles) // cycles)
-        skipped = max(0, min(before_deadline, reading_early))
-        self.instructions += skipped * instructions
-        self.cycles += skipped * cycles
-
-    def _skip_countdown(self, register: int, cost: tuple[int, int]) -> bool:
-        """Count, without running them, the iterations of a countdown loop on ``register`` that would start before
-        the deadline, all but its last (MCU-11); whether the deadline came first (the block must not run)."""
-        reg = _LOW_REGS[register]
-        left = self._read(reg)
-        skipped = max(0, min(left - 1, -(-(self.deadline - self.cycles) // cost[1])))
-        if skipped:
-            self._write(reg, left - skipped)
-            self.instructions += skipped * cost[0]
-            self.cycles += skipped * cost[1]
-        return self.cycles >= self.deadline
+            return 1
 
     def skip_poll(self, until: int) -> None:
         """The status register just read keeps its value until cycle ``until``: if the running block is a pure poll
         loop on it (:func:`is_poll_loop`), its next iterations up to then are counted without running (MCU-10)."""
-        if not self.skip_polls:
+        state = self._state
+        if not state.skip_polls:
             return
-        address = self._block[0]
+        address = state.block_address
         pure = self._polls.get(address)
         if pure is None:
-            pure = self._polls[address] = is_poll_loop(self.read_bytes(address, self._block_end - address), address)
+            pure = self._polls[address] = is_poll_loop(self.read_bytes(address, state.block_end - address), address)
         if pure:
-            self._skip = (address, until)
+            state.skip_address, state.skip_until, state.skip_pending = address, until, 1
 
     def _on_interrupt(self, uc: Any, number: int, data: Any) -> None:
         del data
@@ -1014,7 +1033,7 @@ class CortexM:
         if number is not None:
             what = "a breakpoint (BKPT)" if number == EXCP_BKPT else f"core exception {number}"
             raise FirmwareStoppedError(self.report(Stop.FAULT, f"{what}: not modelled"))
-        if pc == self._block_end and self.read_bytes(pc - 2, 2) in (b"\x30\xbf", b"\x20\xbf"):
+        if pc == self._state.block_end and self.read_bytes(pc - 2, 2) in (b"\x30\xbf", b"\x20\xbf"):
             self.sleeping = True  # the last block ended in WFI or WFE: unicorn halts the core after them
             return "sleep"
         if self.stop_request or self.cycles >= self.deadline:
@@ -1148,14 +1167,6 @@ class CortexM:
             self._scs_words[offset] = self._scs_words.get(offset, 0) & ~value
         else:
             self._scs_words[offset] = value
-
-
-def _exact_pc(handle: int, access: int, address: int, size: int, value: int, data: int) -> None:
-    """A memory hook that does nothing: its presence makes unicorn keep the PC exact at each access it covers."""
-    del handle, access, address, size, value, data
-
-
-_EXACT_PC: Final = _HOOK_MEM(_exact_pc)
 
 
 def _nothing(number: int) -> None:

@@ -1,0 +1,130 @@
+/* The emulated core's block hook and empty memory hook in native code (MCU-22; docs/assumptions/mcu.md).
+ *
+ * Built for the host on first use by supi3.mcu.hook (the Zig toolchain from PyPI) and loaded with ctypes. It links
+ * against nothing: unicorn's functions it calls come as pointers in the shared state, which the Python side
+ * (supi3.mcu.core.CortexM) owns and reads between runs and in its peripheral callbacks.
+ *
+ * The block hook does what MCU-1, MCU-10 and MCU-11 say, to the cycle:
+ *   - refuse the block (uc_emu_stop) on a stop request or at the deadline: it is the first of the next run;
+ *   - otherwise take its cost (instructions, cycles) from a cache filled by Python's block_cost; a block not in the
+ *     cache calls Python's `describe` once, which fills the cache and `fresh`;
+ *   - a poll loop whose status was just read (skip_address) counts its iterations up to the status change or the
+ *     deadline without running them (MCU-10); a countdown block (SUBS Rd, Rd, #1; BNE) counts all but its last
+ *     iteration up to the deadline and writes Rd back (MCU-11);
+ *   - note the block's address, entry cycle and end (a peripheral access is timed inside its block by the PC).
+ */
+#include <stdint.h>
+
+typedef struct {
+    uint32_t address;
+    uint32_t size; /* 0: an empty slot */
+    uint32_t instructions;
+    uint32_t cycles;
+    int32_t countdown; /* the register a countdown loop counts down (0 to 7), or -1 */
+} supi3_block;
+
+typedef int (*uc_emu_stop_fn)(void *uc);
+typedef int (*uc_reg_fn)(void *uc, int regid, void *value);
+typedef int (*describe_fn)(uint64_t address, uint32_t size);
+
+typedef struct {
+    uint64_t cycles;
+    uint64_t instructions;
+    uint64_t deadline;
+    uint64_t block_start;   /* cycle at the entry of the block running */
+    uint64_t block_address;
+    uint64_t block_end;
+    uint64_t skip_until;    /* MCU-10: the cycle the polled status changes */
+    uint64_t skip_address;  /* MCU-10: the poll loop's address */
+    uint32_t skip_pending;  /* a status read asked for a skip at the next block */
+    uint32_t stop_request;
+    uint32_t skip_polls;    /* MCU-10 and MCU-11 on */
+    uint32_t mask;          /* cache slots - 1 (a power of two) */
+    supi3_block *cache;
+    supi3_block fresh;      /* `describe` writes the block's cost here */
+    int32_t low_registers[8]; /* unicorn's numbers of R0..R7 */
+    uc_emu_stop_fn emu_stop;
+    uc_reg_fn reg_read;
+    uc_reg_fn reg_write;
+    describe_fn describe;   /* nonzero: Python failed, stop */
+} supi3_state;
+
+static int64_t ceil_div(int64_t numerator, int64_t denominator) {
+    /* denominator > 0; C division truncates toward zero, which is the ceiling for a negative numerator */
+    return numerator >= 0 ? (numerator + denominator - 1) / denominator : numerator / denominator;
+}
+
+static int64_t at_least_zero(int64_t value) { return value > 0 ? value : 0; }
+
+static int64_t smaller(int64_t a, int64_t b) { return a < b ? a : b; }
+
+static void skip_polls(supi3_state *s, const supi3_block *cost, uint64_t until) {
+    int64_t cycles = cost->cycles;
+    int64_t before_deadline = ceil_div((int64_t)(s->deadline - s->cycles), cycles);
+    int64_t reading_early = ceil_div((int64_t)until - cycles - (int64_t)s->cycles, cycles);
+    int64_t skipped = at_least_zero(smaller(before_deadline, reading_early));
+    s->instructions += (uint64_t)skipped * cost->instructions;
+    s->cycles += (uint64_t)skipped * cost->cycles;
+}
+
+/* Whether the deadline came first: the block must not run. */
+static int skip_countdown(supi3_state *s, void *uc, const supi3_block *cost) {
+    int regid = s->low_registers[cost->countdown];
+    uint64_t left = 0;
+    s->reg_read(uc, regid, &left);
+    left &= 0xFFFFFFFFu;
+    int64_t skipped = at_least_zero(smaller((int64_t)left - 1, ceil_div((int64_t)(s->deadline - s->cycles),
+                                                                       cost->cycles)));
+    if (skipped) {
+        uint64_t value = left - (uint64_t)skipped;
+        s->reg_write(uc, regid, &value);
+        s->instructions += (uint64_t)skipped * cost->instructions;
+        s->cycles += (uint64_t)skipped * cost->cycles;
+    }
+    return s->cycles >= s->deadline;
+}
+
+void supi3_block_hook(void *uc, uint64_t address, uint32_t size, void *data) {
+    supi3_state *s = (supi3_state *)data;
+    if (s->stop_request || s->cycles >= s->deadline) {
+        s->emu_stop(uc); /* this block does not run: it is the first of the next run */
+        return;
+    }
+    const supi3_block *cost = &s->cache[(address >> 1) & s->mask];
+    if (cost->size != size || cost->address != address || size == 0) {
+        if (s->describe(address, size)) {
+            s->emu_stop(uc);
+            return;
+        }
+        cost = &s->fresh;
+    }
+    if (s->skip_pending) {
+        s->skip_pending = 0;
+        if (s->skip_address == address) {
+            skip_polls(s, cost, s->skip_until);
+            if (s->cycles >= s->deadline) {
+                s->emu_stop(uc);
+                return;
+            }
+        }
+    }
+    if (cost->countdown >= 0 && s->skip_polls && skip_countdown(s, uc, cost)) {
+        s->emu_stop(uc);
+        return;
+    }
+    s->block_address = address;
+    s->block_start = s->cycles;
+    s->block_end = address + size;
+    s->instructions += cost->instructions;
+    s->cycles += cost->cycles;
+}
+
+/* A memory hook that does nothing: its presence makes unicorn keep the PC exact at each access it covers (MCU-1). */
+void supi3_exact_pc(void *uc, int type, uint64_t address, int size, int64_t value, void *data) {
+    (void)uc;
+    (void)type;
+    (void)address;
+    (void)size;
+    (void)value;
+    (void)data;
+}

@@ -1,0 +1,122 @@
+"""The core's block hook in native code (MCU-22): ``hook.c`` built for the host with the Zig toolchain from PyPI.
+
+Ref: unicorn.h (uc_cb_hookcode_t, uc_cb_hookmem_t); decisions MCU-1, MCU-10, MCU-11, MCU-22 in
+docs/assumptions/mcu.md. The C source ships with the package; :func:`library` compiles it on first use with
+
+    python -m ziglang cc -shared -fPIC -O2 -target native -mcpu=baseline -nostdlib -std=c99 -Wall -Wextra
+        -pedantic -Werror hook.c -o <cache>/_supi3_mcu_hook_<hash>.so
+
+into the native build cache (:func:`supi3.sdk.native.default_cache_dir`), keyed by the source, the flags, the
+compiler's version and the machine, and loads it with ctypes. Parallel processes (pytest-xdist workers) each build
+into a temporary file of the cache folder and rename it into place: a process sees no file or a whole one. The
+library links against nothing: the unicorn functions it calls are pointers in :class:`State`.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import importlib.metadata
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+from typing import Final
+
+from supi3.errors import Supi3Error
+from supi3.sdk.native import default_cache_dir
+
+__all__ = ["FLAGS", "SOURCE", "Block", "NativeHookError", "State", "library"]
+
+SOURCE: Final[Path] = Path(__file__).with_name("hook.c")
+FLAGS: Final[tuple[str, ...]] = ("-shared", "-fPIC", "-O2", "-target", "native", "-mcpu=baseline", "-nostdlib",
+                                 "-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror")  # fmt: skip
+"""The host build of :data:`SOURCE`: position-independent, no C library, the SDK's strictness."""
+
+DESCRIBE: Final = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_uint64, ctypes.c_uint32)
+"""``describe(address, size)``: Python's cost of a block not in the cache (fills it and :attr:`State.fresh`);
+nonzero stops the run."""
+
+
+class NativeHookError(Supi3Error, RuntimeError):
+    """The native block hook cannot be built or loaded here (no ziglang, or the compiler failed): the emulated core
+    needs it (MCU-22); the firmware extra installs the compiler (``pip install supi3[firmware]``)."""
+
+
+class Block(ctypes.Structure):
+    """A cached block cost (``supi3_block``): the block's address and size (0: empty), its instructions and cycles
+    (MCU-1), the register it counts down or -1 (MCU-11)."""
+
+    _fields_ = (("address", ctypes.c_uint32), ("size", ctypes.c_uint32), ("instructions", ctypes.c_uint32),
+                ("cycles", ctypes.c_uint32), ("countdown", ctypes.c_int32))  # fmt: skip
+
+
+class State(ctypes.Structure):
+    """The state the native hook shares with :class:`supi3.mcu.core.CortexM` (``supi3_state`` of hook.c)."""
+
+    _fields_ = (
+        ("cycles", ctypes.c_uint64),
+        ("instructions", ctypes.c_uint64),
+        ("deadline", ctypes.c_uint64),
+        ("block_start", ctypes.c_uint64),
+        ("block_address", ctypes.c_uint64),
+        ("block_end", ctypes.c_uint64),
+        ("skip_until", ctypes.c_uint64),
+        ("skip_address", ctypes.c_uint64),
+        ("skip_pending", ctypes.c_uint32),
+        ("stop_request", ctypes.c_uint32),
+        ("skip_polls", ctypes.c_uint32),
+        ("mask", ctypes.c_uint32),
+        ("cache", ctypes.POINTER(Block)),
+        ("fresh", Block),
+        ("low_registers", ctypes.c_int32 * 8),
+        ("emu_stop", ctypes.c_void_p),
+        ("reg_read", ctypes.c_void_p),
+        ("reg_write", ctypes.c_void_p),
+        ("describe", DESCRIBE),
+    )
+
+
+_LOADED: list[ctypes.CDLL] = []
+
+
+def _compiler_version() -> str:
+    try:
+        return importlib.metadata.version("ziglang")
+    except importlib.metadata.PackageNotFoundError:
+        raise NativeHookError("ziglang is not installed: the emulated core's block hook is built with it (MCU-22; "
+                              "pip install supi3[firmware])") from None  # fmt: skip
+
+
+def library() -> ctypes.CDLL:
+    """The native hook library, built into the cache on first use; :class:`NativeHookError` if it cannot be."""
+    if _LOADED:
+        return _LOADED[0]
+    source = SOURCE.read_bytes()
+    digest = hashlib.sha256()
+    for part in (source, _compiler_version().encode(), *(flag.encode() for flag in FLAGS),
+                 platform.machine().encode(), sys.platform.encode()):  # fmt: skip
+        digest.update(part + b"\0")
+    folder = default_cache_dir()
+    target = folder / f"_supi3_mcu_hook_{digest.hexdigest()[:20]}.so"
+    if not target.is_file():
+        folder.mkdir(parents=True, exist_ok=True)
+        handle, work = tempfile.mkstemp(dir=folder, prefix=f"{target.stem}.", suffix=".tmp")
+        os.close(handle)
+        try:
+            command = [sys.executable, "-m", "ziglang", "cc", *FLAGS, str(SOURCE), "-o", work]
+            result = subprocess.run(command, capture_output=True, text=True, check=False)
+            if result.returncode != 0:
+                raise NativeHookError(f"the native block hook does not build (MCU-22): {' '.join(command)}\n"
+                                      f"{result.stderr}")  # fmt: skip
+            os.replace(work, target)
+        finally:
+            Path(work).unlink(missing_ok=True)
+    try:
+        loaded = ctypes.CDLL(str(target))
+    except OSError as error:
+        raise NativeHookError(f"the native block hook {target} does not load (MCU-22): {error}") from error
+    _LOADED.append(loaded)
+    return loaded
