@@ -604,6 +604,7 @@ class CortexM:
         state.cache = self._cache
         state.mask = BLOCK_CACHE_SLOTS - 1
         state.low_registers[:] = _LOW_REGS
+        state.pc_register = arm.UC_ARM_REG_PC
         state.emu_stop = ctypes.cast(_LIB.uc_emu_stop, ctypes.c_void_p)
         state.reg_read = ctypes.cast(_LIB.uc_reg_read, ctypes.c_void_p)
         state.reg_write = ctypes.cast(_LIB.uc_reg_write, ctypes.c_void_p)
@@ -665,8 +666,9 @@ class CortexM:
         self._check(_LIB.uc_mmio_map(self._handle, base, size, callbacks[0], None, callbacks[1], None))
         # unicorn updates the PC before a load or store only if a memory hook covers its address: without one, a
         # peripheral callback sees the PC of the block's first instruction, and the access would be timed there
-        # (MCU-1 places it by the PC).
-        self._hook(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, self._exact_pc, base, base + size - 1)
+        # (MCU-1 places it by the PC). The native hook also notes that PC for cycles_now (MCU-22).
+        self._hook(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, self._exact_pc, base, base + size - 1,
+                   ctypes.byref(self._state))  # fmt: skip
 
     def _hook(self, kind: int, callback: ctypes.c_void_p, begin: int = 1, end: int = 0, data: Any = None) -> None:
         """Add a hook with a native callback (MCU-19, MCU-22) and its user data; ``begin > end``: every address."""
@@ -797,8 +799,7 @@ class CortexM:
         state = self._state
         if not self._running:
             return int(state.cycles)
-        address, start = state.block_address, state.block_start
-        pc = self._read(arm.UC_ARM_REG_PC)
+        address, start, pc = state.block_address, state.block_start, state.access_pc
         if pc > address:
             key = (address, pc - address)
             cost = self._costs.get(key)

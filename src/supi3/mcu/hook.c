@@ -42,7 +42,9 @@ typedef struct {
     uint32_t mask;          /* cache slots - 1 (a power of two) */
     supi3_block *cache;
     supi3_block fresh;      /* `describe` writes the block's cost here */
+    uint64_t access_pc;     /* the PC of the latest peripheral access */
     int32_t low_registers[8]; /* unicorn's numbers of R0..R7 */
+    int32_t pc_register;    /* unicorn's number of the PC */
     uc_emu_stop_fn emu_stop;
     uc_reg_fn reg_read;
     uc_reg_fn reg_write;
@@ -119,12 +121,14 @@ void supi3_block_hook(void *uc, uint64_t address, uint32_t size, void *data) {
     s->cycles += cost->cycles;
 }
 
-/* A memory hook that does nothing: its presence makes unicorn keep the PC exact at each access it covers (MCU-1). */
+/* The memory hook of each peripheral range: its presence makes unicorn keep the PC exact at each access it covers
+ * (MCU-1); it notes that PC for the peripheral's callback, which runs next (CortexM.cycles_now). */
 void supi3_exact_pc(void *uc, int type, uint64_t address, int size, int64_t value, void *data) {
-    (void)uc;
+    supi3_state *s = (supi3_state *)data;
     (void)type;
     (void)address;
     (void)size;
     (void)value;
-    (void)data;
+    s->access_pc = 0;
+    s->reg_read(uc, s->pc_register, &s->access_pc);
 }
