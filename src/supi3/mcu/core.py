@@ -48,8 +48,7 @@ UcError: type[Exception] = _UNICORN.UcError
 _LIB: Any = _UNICORN.unicorn_py3.unicorn.uclib
 """unicorn's C library as its binding loaded it (with the argument types it declares): the hot callbacks and
 register accesses go to it directly (MCU-19), without the binding's wrappers around each call."""
-# Callback types of unicorn.h (uc_cb_mmio_read_t, uc_cb_mmio_write_t).
-_MMIO_READ: Final = ctypes.CFUNCTYPE(ctypes.c_uint64, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint, ctypes.c_void_p)
+# Callback type of unicorn.h (uc_cb_mmio_write_t; the read's is hook.MMIO_READ).
 _MMIO_WRITE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint, ctypes.c_uint64,
                                       ctypes.c_void_p)  # fmt: skip
 
@@ -65,6 +64,7 @@ __all__ = [
     "FirmwareImage",
     "FirmwareStoppedError",
     "Frame",
+    "HeldRegister",
     "SourceLine",
     "Stop",
     "StopReport",
@@ -555,6 +555,29 @@ def block_cost(code: bytes) -> tuple[int, int]:
 
 ReadFn = Callable[[int, int], int]
 WriteFn = Callable[[int, int, int], None]
+_FOREVER: Final[int] = (1 << 64) - 1
+
+
+class HeldRegister:
+    """A peripheral's register that the core answers natively while the peripheral holds its value (MCU-22), from
+    :meth:`CortexM.mmio`. A peripheral holds a value only after a read that changed nothing, for as long as its
+    reads would return it and change nothing, and releases it at any other access (its own read or write)."""
+
+    def __init__(self, held: hook.Held) -> None:
+        self._held = held
+
+    def hold(self, offset: int, value: int, until: int | None) -> None:
+        """Reads of ``offset`` return ``value`` while their time (:meth:`CortexM.cycles_polled`) is before cycle
+        ``until`` and tell the poll skip (:meth:`CortexM.skip_poll`, MCU-10) that cycle; ``None``: until
+        :meth:`release`, no poll skip. Any other read goes to the peripheral."""
+        held = self._held
+        held.offset, held.value = offset, value
+        held.until, held.poll = (_FOREVER, 0) if until is None else (until, 1)
+        held.held = 1
+
+    def release(self) -> None:
+        """Every read goes to the peripheral again."""
+        self._held.held = 0
 
 
 class CortexM:
@@ -598,6 +621,7 @@ class CortexM:
             self.uc.mem_write(address, data)
         native = hook.library()
         self._exact_pc = ctypes.cast(native.supi3_exact_pc, ctypes.c_void_p)
+        self._held_read = ctypes.cast(native.supi3_held_read, ctypes.c_void_p)
         self._state = state = hook.State()  # cycles, instructions, deadline, ...: shared with the native hook
         self._cache = (hook.Block * BLOCK_CACHE_SLOTS)()
         self._describe_callback = hook.DESCRIBE(self._describe)
@@ -622,10 +646,10 @@ class CortexM:
         """Called with the exception number after each exception entry (the board measures latency)."""
         self._costs: dict[tuple[int, int], tuple[int, int]] = {}  # the cost of a block's first instructions
         self._running = False
-        self._handed = 0  # the latest time a peripheral was given
-        self._polls: dict[int, bool] = {}
+        self._held: list[hook.Held] = []  # the peripherals' held registers (MCU-22)
         self._idle: dict[int, bool] = {}  # address: the instruction there is ``b .``
-        self._blocks: dict[tuple[int, int], tuple[tuple[int, int], int]] = {}  # cost, countdown register (MCU-11)
+        # (address, size) of a block: its cost, countdown register (MCU-11), whether a pure poll loop (MCU-10)
+        self._blocks: dict[tuple[int, int], tuple[tuple[int, int], int, bool]] = {}
         self.skip_polls = True
         self.vtor = 0
         self.systick = SysTick(self)
@@ -637,10 +661,11 @@ class CortexM:
 
     # -- memory ------------------------------------------------------------------------------------------------
 
-    def mmio(self, base: int, size: int, read: ReadFn, write: WriteFn) -> None:
+    def mmio(self, base: int, size: int, read: ReadFn, write: WriteFn) -> HeldRegister:
         """Map a peripheral: ``read(offset, size) -> value`` and ``write(offset, size, value)`` run on every
-        access. An exception they raise stops the run at the end of the block (:attr:`error`); the block's later
-        accesses reach no peripheral (no follow-on reports of a run that has ended)."""
+        access, but a read of a register the peripheral holds (the :class:`HeldRegister` returned) is answered
+        natively (MCU-22). An exception they raise stops the run at the end of the block (:attr:`error`); the
+        block's later accesses reach no peripheral (no follow-on reports of a run that has ended)."""
 
         def on_read(handle: int, offset: int, size: int, data: int) -> int:
             del handle, data
@@ -661,14 +686,18 @@ class CortexM:
             except BaseException as error:  # handed to the run loop, raised there
                 self.fail(error)
 
-        callbacks = (_MMIO_READ(on_read), _MMIO_WRITE(on_write))
+        callbacks = (hook.MMIO_READ(on_read), _MMIO_WRITE(on_write))
         self._callbacks += callbacks
-        self._check(_LIB.uc_mmio_map(self._handle, base, size, callbacks[0], None, callbacks[1], None))
+        held = hook.Held(ctypes.pointer(self._state), callbacks[0])
+        self._held.append(held)
+        self._check(_LIB.uc_mmio_map(self._handle, base, size, self._held_read, ctypes.byref(held), callbacks[1],
+                                     None))  # fmt: skip
         # unicorn updates the PC before a load or store only if a memory hook covers its address: without one, a
         # peripheral callback sees the PC of the block's first instruction, and the access would be timed there
         # (MCU-1 places it by the PC). The native hook also notes that PC for cycles_now (MCU-22).
         self._hook(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, self._exact_pc, base, base + size - 1,
                    ctypes.byref(self._state))  # fmt: skip
+        return HeldRegister(held)
 
     def _hook(self, kind: int, callback: ctypes.c_void_p, begin: int = 1, end: int = 0, data: Any = None) -> None:
         """Add a hook with a native callback (MCU-19, MCU-22) and its user data; ``begin > end``: every address."""
@@ -709,6 +738,8 @@ class CortexM:
         if self.error is None:
             self.error = error
         self.stop_request = True
+        for held in self._held:  # the peripherals are silent now (mmio): no register is answered natively either
+            held.held = 0
 
     # -- registers ---------------------------------------------------------------------------------------------
 
@@ -806,18 +837,20 @@ class CortexM:
             if cost is None:
                 cost = self._costs[key] = block_cost(self.read_bytes(address, pc - address))
             start += cost[1]
-        self._handed = max(self._handed, start)
-        return self._handed
+        if start > state.handed:
+            state.handed = start
+        return int(state.handed)
 
     def cycles_polled(self) -> int:
         """The time of a status read (a flag the firmware polls): the end of the running block, which costs no
         register read; later times handed out are never earlier (MCU-1)."""
-        cycles = int(self._state.cycles)
+        state = self._state
+        cycles = int(state.cycles)
         if not self._running:
             return cycles
-        if cycles > self._handed:
-            self._handed = cycles
-        return self._handed
+        if cycles > state.handed:
+            state.handed = cycles
+        return int(state.handed)
 
     # -- reset and exceptions ----------------------------------------------------------------------------------
 
@@ -959,16 +992,17 @@ class CortexM:
     # -- running -----------------------------------------------------------------------------------------------
 
     def _describe(self, address: int, size: int) -> int:
-        """The native block hook met a block not in its cache: its cost (MCU-1) and countdown register (MCU-11)
-        into the cache and :attr:`hook.State.fresh`; 1 (stop the run) if its code cannot be read."""
+        """The native block hook met a block not in its cache: its cost (MCU-1), countdown register (MCU-11) and
+        whether it is a pure poll loop (MCU-10) into the cache and :attr:`hook.State.fresh`; 1 (stop the run) if its code cannot be read."""
         try:
             block = self._blocks.get((address, size))
             if block is None:
                 code = self.read_bytes(address, size)
-                block = self._blocks[address, size] = (block_cost(code), countdown_register(code))
-            (instructions, cycles), countdown = block
+                block = self._blocks[address, size] = (block_cost(code), countdown_register(code),
+                                                       is_poll_loop(code, address))  # fmt: skip
+            (instructions, cycles), countdown, poll = block
             self._state.fresh = self._cache[(address >> 1) & (BLOCK_CACHE_SLOTS - 1)] = \
-                hook.Block(address, size, instructions, cycles, countdown)  # fmt: skip
+                hook.Block(address, size, instructions, cycles, countdown, poll)  # fmt: skip
             return 0
         except BaseException as error:  # handed to the run loop, raised there (an escape would be lost in ctypes)
             self.fail(error)
@@ -978,14 +1012,8 @@ class CortexM:
         """The status register just read keeps its value until cycle ``until``: if the running block is a pure poll
         loop on it (:func:`is_poll_loop`), its next iterations up to then are counted without running (MCU-10)."""
         state = self._state
-        if not state.skip_polls:
-            return
-        address = state.block_address
-        pure = self._polls.get(address)
-        if pure is None:
-            pure = self._polls[address] = is_poll_loop(self.read_bytes(address, state.block_end - address), address)
-        if pure:
-            state.skip_address, state.skip_until, state.skip_pending = address, until, 1
+        if state.skip_polls and state.block_poll:  # the native hook's held_read does the same (MCU-22)
+            state.skip_address, state.skip_until, state.skip_pending = state.block_address, until, 1
 
     def _on_interrupt(self, uc: Any, number: int, data: Any) -> None:
         del data

@@ -12,6 +12,9 @@
  *     deadline without running them (MCU-10); a countdown block (SUBS Rd, Rd, #1; BNE) counts all but its last
  *     iteration up to the deadline and writes Rd back (MCU-11);
  *   - note the block's address, entry cycle and end (a peripheral access is timed inside its block by the PC).
+ *
+ * A peripheral's reads go first to supi3_held_read: a register whose value the peripheral holds until a cycle (SPI1's
+ * SR while a byte shifts) is answered here, as the peripheral would answer it; every other read goes to Python.
  */
 #include <stdint.h>
 
@@ -21,11 +24,13 @@ typedef struct {
     uint32_t instructions;
     uint32_t cycles;
     int32_t countdown; /* the register a countdown loop counts down (0 to 7), or -1 */
+    int32_t poll;      /* a pure poll loop (MCU-10) */
 } supi3_block;
 
 typedef int (*uc_emu_stop_fn)(void *uc);
 typedef int (*uc_reg_fn)(void *uc, int regid, void *value);
 typedef int (*describe_fn)(uint64_t address, uint32_t size);
+typedef uint64_t (*mmio_read_fn)(void *uc, uint64_t offset, unsigned size, void *data);
 
 typedef struct {
     uint64_t cycles;
@@ -36,10 +41,12 @@ typedef struct {
     uint64_t block_end;
     uint64_t skip_until;    /* MCU-10: the cycle the polled status changes */
     uint64_t skip_address;  /* MCU-10: the poll loop's address */
+    uint64_t handed;        /* the latest time a peripheral was given (CortexM.cycles_polled) */
     uint32_t skip_pending;  /* a status read asked for a skip at the next block */
     uint32_t stop_request;
     uint32_t skip_polls;    /* MCU-10 and MCU-11 on */
     uint32_t mask;          /* cache slots - 1 (a power of two) */
+    uint32_t block_poll;    /* the block running is a pure poll loop (MCU-10) */
     supi3_block *cache;
     supi3_block fresh;      /* `describe` writes the block's cost here */
     uint64_t access_pc;     /* the PC of the latest peripheral access */
@@ -117,6 +124,7 @@ void supi3_block_hook(void *uc, uint64_t address, uint32_t size, void *data) {
     s->block_address = address;
     s->block_start = s->cycles;
     s->block_end = address + size;
+    s->block_poll = (uint32_t)cost->poll;
     s->instructions += cost->instructions;
     s->cycles += cost->cycles;
 }
@@ -131,4 +139,36 @@ void supi3_exact_pc(void *uc, int type, uint64_t address, int size, int64_t valu
     (void)value;
     s->access_pc = 0;
     s->reg_read(uc, s->pc_register, &s->access_pc);
+}
+
+/* A register value a peripheral holds while the read's time is before `until` (MCU-22). */
+typedef struct {
+    supi3_state *state;
+    mmio_read_fn slow; /* the peripheral's read in Python */
+    uint64_t until;
+    uint32_t offset;
+    uint32_t value;
+    uint32_t held;     /* a value is held */
+    uint32_t poll;     /* a read tells the poll skip (MCU-10) the cycle `until`, the status's change */
+} supi3_held;
+
+/* A peripheral's read callback (uc_cb_mmio_read_t): the held register as CortexM.cycles_polled and
+ * CortexM.skip_poll would do it, or Python's read. A stop request (a failure, or a change the run loop must see)
+ * always goes to Python. */
+uint64_t supi3_held_read(void *uc, uint64_t offset, unsigned size, void *data) {
+    supi3_held *h = (supi3_held *)data;
+    supi3_state *s = h->state;
+    if (h->held && offset == h->offset && !s->stop_request) {
+        uint64_t time = s->handed > s->cycles ? s->handed : s->cycles;
+        if (time < h->until) {
+            s->handed = time;
+            if (h->poll && s->skip_polls && s->block_poll) {
+                s->skip_address = s->block_address;
+                s->skip_until = h->until;
+                s->skip_pending = 1;
+            }
+            return h->value;
+        }
+    }
+    return h->slow(uc, offset, size, 0);
 }

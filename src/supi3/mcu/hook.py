@@ -28,7 +28,7 @@ from typing import Final
 from supi3.errors import Supi3Error
 from supi3.sdk.native import default_cache_dir
 
-__all__ = ["FLAGS", "SOURCE", "Block", "NativeHookError", "State", "library"]
+__all__ = ["DESCRIBE", "FLAGS", "MMIO_READ", "SOURCE", "Block", "Held", "NativeHookError", "State", "library"]
 
 SOURCE: Final[Path] = Path(__file__).with_name("hook.c")
 FLAGS: Final[tuple[str, ...]] = ("-shared", "-fPIC", "-O2", "-target", "native", "-mcpu=baseline", "-nostdlib",
@@ -38,6 +38,8 @@ FLAGS: Final[tuple[str, ...]] = ("-shared", "-fPIC", "-O2", "-target", "native",
 DESCRIBE: Final = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_uint64, ctypes.c_uint32)
 """``describe(address, size)``: Python's cost of a block not in the cache (fills it and :attr:`State.fresh`);
 nonzero stops the run."""
+MMIO_READ: Final = ctypes.CFUNCTYPE(ctypes.c_uint64, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint, ctypes.c_void_p)
+"""unicorn.h's uc_cb_mmio_read_t: a peripheral's read (``handle, offset, size, user data -> value``)."""
 
 
 class NativeHookError(Supi3Error, RuntimeError):
@@ -47,10 +49,10 @@ class NativeHookError(Supi3Error, RuntimeError):
 
 class Block(ctypes.Structure):
     """A cached block cost (``supi3_block``): the block's address and size (0: empty), its instructions and cycles
-    (MCU-1), the register it counts down or -1 (MCU-11)."""
+    (MCU-1), the register it counts down or -1 (MCU-11), whether it is a pure poll loop (MCU-10)."""
 
     _fields_ = (("address", ctypes.c_uint32), ("size", ctypes.c_uint32), ("instructions", ctypes.c_uint32),
-                ("cycles", ctypes.c_uint32), ("countdown", ctypes.c_int32))  # fmt: skip
+                ("cycles", ctypes.c_uint32), ("countdown", ctypes.c_int32), ("poll", ctypes.c_int32))  # fmt: skip
 
 
 class State(ctypes.Structure):
@@ -65,10 +67,12 @@ class State(ctypes.Structure):
         ("block_end", ctypes.c_uint64),
         ("skip_until", ctypes.c_uint64),
         ("skip_address", ctypes.c_uint64),
+        ("handed", ctypes.c_uint64),
         ("skip_pending", ctypes.c_uint32),
         ("stop_request", ctypes.c_uint32),
         ("skip_polls", ctypes.c_uint32),
         ("mask", ctypes.c_uint32),
+        ("block_poll", ctypes.c_uint32),
         ("cache", ctypes.POINTER(Block)),
         ("fresh", Block),
         ("access_pc", ctypes.c_uint64),
@@ -78,6 +82,20 @@ class State(ctypes.Structure):
         ("reg_read", ctypes.c_void_p),
         ("reg_write", ctypes.c_void_p),
         ("describe", DESCRIBE),
+    )
+
+
+class Held(ctypes.Structure):
+    """A register value a peripheral holds until a cycle, answered natively (``supi3_held`` of hook.c)."""
+
+    _fields_ = (
+        ("state", ctypes.POINTER(State)),
+        ("slow", MMIO_READ),
+        ("until", ctypes.c_uint64),
+        ("offset", ctypes.c_uint32),
+        ("value", ctypes.c_uint32),
+        ("held", ctypes.c_uint32),
+        ("poll", ctypes.c_uint32),
     )
 
 
