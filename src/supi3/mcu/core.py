@@ -993,7 +993,8 @@ class CortexM:
 
     def _describe(self, address: int, size: int) -> int:
         """The native block hook met a block not in its cache: its cost (MCU-1), countdown register (MCU-11) and
-        whether it is a pure poll loop (MCU-10) into the cache and :attr:`hook.State.fresh`; 1 (stop the run) if its code cannot be read."""
+        whether it is a pure poll loop (MCU-10) into the cache and :attr:`hook.State.fresh`; 1 (stop the run) if its
+        code cannot be read."""
         try:
             block = self._blocks.get((address, size))
             if block is None:
@@ -1001,7 +1002,7 @@ class CortexM:
                 block = self._blocks[address, size] = (block_cost(code), countdown_register(code),
                                                        is_poll_loop(code, address))  # fmt: skip
             (instructions, cycles), countdown, poll = block
-            self._state.fresh = self._cache[(address >> 1) & (BLOCK_CACHE_SLOTS - 1)] = \
+            self._state.fresh = self._cache[(address >> 1) & (len(self._cache) - 1)] = \
                 hook.Block(address, size, instructions, cycles, countdown, poll)  # fmt: skip
             return 0
         except BaseException as error:  # handed to the run loop, raised there (an escape would be lost in ctypes)
