@@ -648,6 +648,7 @@ class CortexM:
         self._running = False
         self._held: list[hook.Held] = []  # the peripherals' held registers (MCU-22)
         self._idle: dict[int, bool] = {}  # address: the instruction there is ``b .``
+        self._sleeps: dict[int, bool] = {}  # address: the instruction before it is WFI or WFE
         # (address, size) of a block: its cost, countdown register (MCU-11), whether a pure poll loop (MCU-10)
         self._blocks: dict[tuple[int, int], tuple[tuple[int, int], int, bool]] = {}
         self.skip_polls = True
@@ -1063,9 +1064,13 @@ class CortexM:
         if number is not None:
             what = "a breakpoint (BKPT)" if number == EXCP_BKPT else f"core exception {number}"
             raise FirmwareStoppedError(self.report(Stop.FAULT, f"{what}: not modelled"))
-        if pc == self._state.block_end and self.read_bytes(pc - 2, 2) in (b"\x30\xbf", b"\x20\xbf"):
-            self.sleeping = True  # the last block ended in WFI or WFE: unicorn halts the core after them
-            return "sleep"
+        if pc == self._state.block_end:
+            sleeps = self._sleeps.get(pc)  # the code does not change (as the block costs)
+            if sleeps is None:
+                sleeps = self._sleeps[pc] = self.read_bytes(pc - 2, 2) in (b"\x30\xbf", b"\x20\xbf")
+            if sleeps:
+                self.sleeping = True  # the last block ended in WFI or WFE: unicorn halts the core after them
+                return "sleep"
         if self.stop_request or self.cycles >= self.deadline:
             return "run"
         raise FirmwareStoppedError(self.report(Stop.FAULT, "the core stopped for no known reason"))
