@@ -28,7 +28,8 @@ from typing import Final
 from supi3.errors import Supi3Error
 from supi3.sdk.native import default_cache_dir
 
-__all__ = ["DESCRIBE", "FLAGS", "MMIO_READ", "SOURCE", "Block", "Held", "NativeHookError", "State", "library"]
+__all__ = ["DESCRIBE", "FLAGS", "MMIO_READ", "SOURCE", "Block", "Held", "NativeHookError", "State", "cached_path",
+           "library"]
 
 SOURCE: Final[Path] = Path(__file__).with_name("hook.c")
 FLAGS: Final[tuple[str, ...]] = ("-shared", "-fPIC", "-O2", "-target", "native", "-mcpu=baseline", "-nostdlib",
@@ -110,20 +111,29 @@ def _compiler_version() -> str:
                               "pip install supi3[firmware])") from None  # fmt: skip
 
 
-def library() -> ctypes.CDLL:
-    """The native hook library, built into the cache on first use; :class:`NativeHookError` if it cannot be."""
-    if _LOADED:
-        return _LOADED[0]
-    source = SOURCE.read_bytes()
+def cached_path() -> Path:
+    """Where :func:`library` keeps the build: the native build cache, named by the hash of the source, the flags,
+    the compiler's version and the machine; :class:`NativeHookError` if there is no compiler."""
     digest = hashlib.sha256()
-    for part in (source, _compiler_version().encode(), *(flag.encode() for flag in FLAGS),
+    for part in (SOURCE.read_bytes(), _compiler_version().encode(), *(flag.encode() for flag in FLAGS),
                  platform.machine().encode(), sys.platform.encode()):  # fmt: skip
         digest.update(part + b"\0")
-    folder = default_cache_dir()
-    target = folder / f"_supi3_mcu_hook_{digest.hexdigest()[:20]}.so"
+    return default_cache_dir() / f"_supi3_mcu_hook_{digest.hexdigest()[:20]}.so"
+
+
+def library() -> ctypes.CDLL:
+    """The native hook library, built into the cache on first use (:func:`cached_path`), loaded once a process;
+    :class:`NativeHookError` if it cannot be built or loaded."""
+    if _LOADED:
+        return _LOADED[0]
+    target = cached_path()
+    folder = target.parent
     if not target.is_file():
-        folder.mkdir(parents=True, exist_ok=True)
-        handle, work = tempfile.mkstemp(dir=folder, prefix=f"{target.stem}.", suffix=".tmp")
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+            handle, work = tempfile.mkstemp(dir=folder, prefix=f"{target.stem}.", suffix=".tmp")
+        except OSError as error:
+            raise NativeHookError(f"the native block hook cannot be built into {folder} (MCU-22): {error}") from error
         os.close(handle)
         try:
             command = [sys.executable, "-m", "ziglang", "cc", *FLAGS, str(SOURCE), "-o", work]
