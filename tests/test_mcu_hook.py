@@ -39,8 +39,8 @@ def digital_io(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
 class NoHolder:
     """A board whose SPI holds nothing: every status read goes to the model."""
 
-    def hold(self, offset: int, value: int, until: int | None) -> None:
-        del offset, value, until
+    def hold(self, offset: int, value: int, until: int | None, after: int | None) -> None:
+        del offset, value, until, after
 
     def release(self) -> None:
         pass

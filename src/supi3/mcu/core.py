@@ -566,13 +566,15 @@ class HeldRegister:
     def __init__(self, held: hook.Held) -> None:
         self._held = held
 
-    def hold(self, offset: int, value: int, until: int | None) -> None:
+    def hold(self, offset: int, value: int, until: int | None, after: int | None = None) -> None:
         """Reads of ``offset`` return ``value`` while their time (:meth:`CortexM.cycles_polled`) is before cycle
-        ``until`` and tell the poll skip (:meth:`CortexM.skip_poll`, MCU-10) that cycle; ``None``: until
-        :meth:`release`, no poll skip. Any other read goes to the peripheral."""
+        ``until`` and tell the poll skip (:meth:`CortexM.skip_poll`, MCU-10) that cycle (``None``: until
+        :meth:`release`, no poll skip), then ``after`` (``None``: the peripheral answers). Any other read goes to the
+        peripheral."""
         held = self._held
         held.offset, held.value = offset, value
         held.until, held.poll = (_FOREVER, 0) if until is None else (until, 1)
+        held.after, held.has_after = (0, 0) if after is None else (after, 1)
         held.held = 1
 
     def release(self) -> None:

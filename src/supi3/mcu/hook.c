@@ -150,10 +150,13 @@ typedef struct {
     uint32_t value;
     uint32_t held;     /* a value is held */
     uint32_t poll;     /* a read tells the poll skip (MCU-10) the cycle `until`, the status's change */
+    uint32_t after;    /* the value from `until` on, if has_after */
+    uint32_t has_after;
 } supi3_held;
 
 /* A peripheral's read callback (uc_cb_mmio_read_t): the held register as CortexM.cycles_polled and
- * CortexM.skip_poll would do it, or Python's read. A stop request (a failure, or a change the run loop must see)
+ * CortexM.skip_poll would do it (before `until`: the value and the poll skip; from then on: `after`, no skip), or
+ * Python's read. A stop request (a failure, or a change the run loop must see)
  * always goes to Python. */
 uint64_t supi3_held_read(void *uc, uint64_t offset, unsigned size, void *data) {
     supi3_held *h = (supi3_held *)data;
@@ -168,6 +171,10 @@ uint64_t supi3_held_read(void *uc, uint64_t offset, unsigned size, void *data) {
                 s->skip_pending = 1;
             }
             return h->value;
+        }
+        if (h->has_after) {
+            s->handed = time;
+            return h->after;
         }
     }
     return h->slow(uc, offset, size, 0);

@@ -97,6 +97,8 @@ class Held(ctypes.Structure):
         ("value", ctypes.c_uint32),
         ("held", ctypes.c_uint32),
         ("poll", ctypes.c_uint32),
+        ("after", ctypes.c_uint32),
+        ("has_after", ctypes.c_uint32),
     )
 
 

@@ -263,8 +263,9 @@ class ValueHolder(Protocol):
     """Where a peripheral says that a register holds its value (the core answers its reads natively, MCU-22):
     :class:`supi3.mcu.core.HeldRegister`."""
 
-    def hold(self, offset: int, value: int, until: int | None) -> None:
-        """Reads of ``offset`` return ``value`` while their time is before cycle ``until`` (``None``: always)."""
+    def hold(self, offset: int, value: int, until: int | None, after: int | None) -> None:
+        """Reads of ``offset`` return ``value`` while their time is before cycle ``until`` (``None``: always), then
+        ``after`` (``None``: the peripheral answers)."""
 
     def release(self) -> None:
         """Every read goes to the peripheral again."""
@@ -273,8 +274,8 @@ class ValueHolder(Protocol):
 class _NoHolder:
     """No native answers: every read goes to the peripheral."""
 
-    def hold(self, offset: int, value: int, until: int | None) -> None:
-        del offset, value, until
+    def hold(self, offset: int, value: int, until: int | None, after: int | None) -> None:
+        del offset, value, until, after
 
     def release(self) -> None:
         pass
@@ -293,8 +294,9 @@ class Spi:
     transfer to the end of the last one. MODF: SSM = 1 with SSI = 0 in master mode clears MSTR and SPE
     (25.3.10); /NSS is not wired (SSM = 0 reads it high, MCU-6).
 
-    After a read of SR that changed nothing, SR holds its value (:attr:`holder`) until the shifting byte ends or the
-    next access to SPI1 or RCC_APB2ENR: the core answers the reads in between natively (MCU-22).
+    After a read of SR, SR holds its value (:attr:`holder`) until the shifting byte ends, then the value after it if
+    nothing starts then, until the next access to SPI1 or RCC_APB2ENR: the core answers the reads in between
+    natively (MCU-22).
     """
 
     def __init__(
@@ -357,8 +359,18 @@ class Spi:
         if self.shifting is not None:
             self.on_poll(self.shifting[2])
         busy = self.shifting is not None or self.tx_buffer is not None
-        return ((self.rx_buffer is not None) * SR_RXNE | (self.tx_buffer is None) * SR_TXE
-                | self.modf * SR_MODF | self.ovr * SR_OVR | busy * SR_BSY)  # fmt: skip
+        return self._flags(self.rx_buffer is not None, self.ovr, busy)
+
+    def _flags(self, rxne: bool, ovr: bool, busy: bool) -> int:
+        return (rxne * SR_RXNE | (self.tx_buffer is None) * SR_TXE | self.modf * SR_MODF | ovr * SR_OVR
+                | busy * SR_BSY)  # fmt: skip
+
+    def _after(self) -> int | None:
+        """SR once the shifting byte has ended, if nothing starts then (no byte waits) and the byte's end needs no
+        look at the wire (a received value known now): RXNE, OVR if RXNE was still 1 (25.3.10), not busy."""
+        if self.shifting is None or self.tx_buffer is not None or not isinstance(self.shifting[0], int):
+            return None
+        return self._flags(True, self.ovr or self.rx_buffer is not None, False)
 
     def read(self, offset: int, size: int) -> int:
         """CR1, CR2, SR, DR (reading DR clears RXNE; reading SR after DR clears OVR, 25.3.10)."""
@@ -373,9 +385,9 @@ class Spi:
             value = self.status()
             if self._ovr_seen:
                 self.ovr = self._ovr_seen = False
-            else:  # SR now holds until the shifting byte ends (the time a poll may skip to, MCU-10) or an access
-                self._holding = True
-                self.holder.hold(SPI_SR, value, None if self.shifting is None else self.shifting[2])
+            else:  # SR now holds until the shifting byte ends (the time a poll may skip to, MCU-10), then its value
+                self._holding = True  # after the byte if known now, until an access
+                self.holder.hold(SPI_SR, value, None if self.shifting is None else self.shifting[2], self._after())
             return value
         if offset == SPI_DR:
             self._run(self.polled())
