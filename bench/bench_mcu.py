@@ -13,7 +13,7 @@ with its load; the issue's goal: >= 1x), emulated instructions per second, and t
 process: against the same binary with every poll and countdown loop iteration run (``skip_polls = False``: MCU-10
 and MCU-11 off) and against the host build. ``--profile`` also splits the CPU time of one run (cProfile, which
 slows the calls it counts, so the split is a guide, not a measure) by part: unicorn's C code with the native block
-and memory hooks (MCU-22) and the ctypes transitions into the Python callbacks, a block's first costing, the rest of
+and memory hooks (MCU-25) and the ctypes transitions into the Python callbacks, a block's first costing, the rest of
 the core, the STM32 peripheral models, the board's bus synchronisation and checks, and the chip, ring and bench
 models. Run from the repository root:
 
@@ -80,7 +80,7 @@ def binary_run(elf: Path, bit_rate: int, cycles: int, repeat: int, skip: bool = 
 
 
 PARTS: tuple[tuple[str, str, frozenset[str] | None], ...] = (
-    ("unicorn: C code with the native hooks (MCU-22), ctypes transitions", "/unicorn/", frozenset({"emu_start"})),
+    ("unicorn: C code with the native hooks (MCU-25), ctypes transitions", "/unicorn/", frozenset({"emu_start"})),
     ("unicorn's Python binding", "/unicorn/", None),
     ("core: a block's first cost (MCU-1, -10, -11)", "mcu/core.py", frozenset({"_describe"})),
     ("core: memory callbacks", "mcu/core.py", frozenset({"on_read", "on_write"})),

@@ -1,6 +1,6 @@
-"""The core's native block and memory hooks and SPI1's held status (supi3.mcu.hook, hook.c; MCU-22).
+"""The core's native block and memory hooks and SPI1's held status (supi3.mcu.hook, hook.c; MCU-25).
 
-MCU-22: the block hook, the empty memory hooks and the reads of a held register run in C built with the Zig
+MCU-25: the block hook, the empty memory hooks and the reads of a held register run in C built with the Zig
 toolchain; the board does the same work to the cycle as with every block costed and every status read by Python
 (each block's cost asked again: a cache of two slots; no register held), on both cores. The build lands in the
 cache once for parallel processes; no compiler, a source that does not compile and a cached file that does not load
@@ -69,7 +69,7 @@ def _outcome(board: Board, counts: dict[str, int]) -> tuple[object, ...]:
 @pytest.mark.parametrize("cpu", CPUS)
 def test_the_native_shortcuts_change_nothing(digital_io: dict[str, Path], cpu: str,
                                              monkeypatch: pytest.MonkeyPatch) -> None:  # fmt: skip
-    """MCU-22: the cached block costs and the held SR give the same cycles, instructions, registers, bus time,
+    """MCU-25: the cached block costs and the held SR give the same cycles, instructions, registers, bus time,
     interrupts, latency and data as costing every block in Python again (a cache of two slots: nearly every block
     finds its slot taken) and as reading every SR in the model. The shortcuts are taken: fewer blocks reach
     Python, fewer SR reads reach the model."""
@@ -111,7 +111,7 @@ def test_parallel_processes_build_the_hook_once(tmp_path: Path) -> None:
 
 def test_no_compiler_a_broken_source_or_a_broken_build_is_a_named_error(
         digital_io: dict[str, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:  # fmt: skip
-    """MCU-22: the core needs the native hook; without ziglang, with a source that does not compile and with a
+    """MCU-25: the core needs the native hook; without ziglang, with a source that does not compile and with a
     cached file that is no library, building a core raises NativeHookError with the reason, and no file is left."""
     monkeypatch.setenv(CACHE_ENV, str(tmp_path / "cache"))
     monkeypatch.setattr(hook, "_LOADED", [])
@@ -127,14 +127,14 @@ def test_no_compiler_a_broken_source_or_a_broken_build_is_a_named_error(
     broken.write_text("void supi3_block_hook(void) { return 1; }\n")
     with monkeypatch.context() as patch:
         patch.setattr(hook, "SOURCE", broken)
-        with pytest.raises(hook.NativeHookError, match=r"does not build \(MCU-22\).*\n.*error: void function"):
+        with pytest.raises(hook.NativeHookError, match=r"does not build \(MCU-25\).*\n.*error: void function"):
             CortexM(digital_io["cortex_m3"])
     assert list((tmp_path / "cache").iterdir()) == []
     hook.cached_path().write_bytes(b"not a library")
-    with pytest.raises(hook.NativeHookError, match=r"_supi3_mcu_hook_\w+\.so does not load \(MCU-22\)"):
+    with pytest.raises(hook.NativeHookError, match=r"_supi3_mcu_hook_\w+\.so does not load \(MCU-25\)"):
         CortexM(digital_io["cortex_m3"])
     unwritable = tmp_path / "file"
     unwritable.write_text("")
     monkeypatch.setenv(CACHE_ENV, str(unwritable / "cache"))
-    with pytest.raises(hook.NativeHookError, match=r"cannot be built into .*file/cache \(MCU-22\)"):
+    with pytest.raises(hook.NativeHookError, match=r"cannot be built into .*file/cache \(MCU-25\)"):
         CortexM(digital_io["cortex_m3"])

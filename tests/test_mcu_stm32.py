@@ -3,7 +3,7 @@
 SPI: the full-duplex master sequence of 25.3.5 (Figure 240: TXE set again as soon as the byte moves to the shift
 register, RXNE at the end of each byte, BSY over back-to-back bytes), overrun (25.3.10), mode fault (25.3.10), the
 baud-rate divider (25.5.1). GPIO: BSRR/BRR (9.2.5, 9.2.6), outputs only where MODE is not 00 (9.2.1). EXTI: the
-falling trigger, mask and pending bit (10.3). RCC: a peripheral with its clock off (7.3.7). MCU-22: SR held for the
+falling trigger, mask and pending bit (10.3). RCC: a peripheral with its clock off (7.3.7). MCU-25: SR held for the
 core's native reads answers as the model would, over random histories of accesses.
 """
 
@@ -201,7 +201,7 @@ def test_exti_falling_edge_sets_pending_which_asks_while_unmasked() -> None:
 
 
 class Holder:
-    """What the core does with a held register (supi3_held_read in src/supi3/mcu/hook.c, MCU-22), in Python."""
+    """What the core does with a held register (supi3_held_read in src/supi3/mcu/hook.c, MCU-25), in Python."""
 
     def __init__(self, spi: Spi, clock: Clock) -> None:
         self.spi, self.clock = spi, clock
@@ -243,7 +243,7 @@ _STEP = st.one_of(
 @settings(derandomize=True, max_examples=300, deadline=None)
 @given(st.lists(_STEP, min_size=20, max_size=80))
 def test_a_held_status_answers_as_the_model_would(steps: list[tuple[object, ...]]) -> None:
-    """MCU-22: the SPI holds SR after a status read until its byte ends or the next access to SPI1 or RCC_APB2ENR;
+    """MCU-25: the SPI holds SR after a status read until its byte ends or the next access to SPI1 or RCC_APB2ENR;
     a core that answers SR from the hold in between (no call into the model) reads the same values, tells the poll
     skip the same cycles and leaves the model in the same state (once it catches up with the time) as one that
     always asks the model, over random histories of waits, reads, polls, writes, clock switches and faults (a clock

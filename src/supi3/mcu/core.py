@@ -19,7 +19,7 @@ callback and a peripheral would see its access twice.
 
 Speed (MCU-19): the peripheral callbacks and the register reads they need go to unicorn's C library through ctypes
 directly; the binding's wrappers around each call cost as much again as the call. The block hook and the empty memory
-hooks are native code (MCU-22, :mod:`supi3.mcu.hook`): a block calls Python only the first time it runs.
+hooks are native code (MCU-25, :mod:`supi3.mcu.hook`): a block calls Python only the first time it runs.
 """
 
 from __future__ import annotations
@@ -114,7 +114,7 @@ SYST_MAX: Final[int] = 0xFF_FFFF
 BACKTRACE_DEPTH: Final[int] = 16
 """Frames :meth:`CortexM.backtrace` unwinds at most."""
 BLOCK_CACHE_SLOTS: Final[int] = 1 << 13
-"""Slots of the native block hook's cost cache (MCU-22), one per halfword address modulo their number: 16 KiB of
+"""Slots of the native block hook's cost cache (MCU-25), one per halfword address modulo their number: 16 KiB of
 code without two blocks sharing a slot (a block that finds its slot taken asks Python again)."""
 IRQ_LINES: Final[int] = 32
 """External interrupts the NVIC model has (one ISER word)."""
@@ -559,7 +559,7 @@ _FOREVER: Final[int] = (1 << 64) - 1
 
 
 class HeldRegister:
-    """A peripheral's register that the core answers natively while the peripheral holds its value (MCU-22), from
+    """A peripheral's register that the core answers natively while the peripheral holds its value (MCU-25), from
     :meth:`CortexM.mmio`. A peripheral holds a value only after a read that changed nothing, for as long as its
     reads would return it and change nothing, and releases it at any other access (its own read or write)."""
 
@@ -622,7 +622,7 @@ class CortexM:
         for address, data in self.image.segments:
             self.uc.mem_write(address, data)
         native = hook.library()
-        self._exact_pc = ctypes.cast(native.supi3_exact_pc, ctypes.c_void_p)
+        self._exact_pc = native.supi3_exact_pc
         self._held_read = ctypes.cast(native.supi3_held_read, ctypes.c_void_p)
         self._state = state = hook.State()  # cycles, instructions, deadline, ...: shared with the native hook
         self._cache = (hook.Block * BLOCK_CACHE_SLOTS)()
@@ -648,7 +648,7 @@ class CortexM:
         """Called with the exception number after each exception entry (the board measures latency)."""
         self._costs: dict[tuple[int, int], tuple[int, int]] = {}  # the cost of a block's first instructions
         self._running = False
-        self._held: list[hook.Held] = []  # the peripherals' held registers (MCU-22)
+        self._held: list[hook.Held] = []  # the peripherals' held registers (MCU-25)
         self._idle: dict[int, bool] = {}  # address: the instruction there is ``b .``
         self._sleeps: dict[int, bool] = {}  # address: the instruction before it is WFI or WFE
         # (address, size) of a block: its cost, countdown register (MCU-11), whether a pure poll loop (MCU-10)
@@ -658,7 +658,7 @@ class CortexM:
         self.systick = SysTick(self)
         self._scs_words: dict[int, int] = {}
         self.mmio(SCS_BASE, SCS_SIZE, self._scs_read, self._scs_write)
-        self._hook(ucc.UC_HOOK_BLOCK, ctypes.cast(native.supi3_block_hook, ctypes.c_void_p), data=ctypes.byref(state))
+        self._hook(ucc.UC_HOOK_BLOCK, native.supi3_block_hook, data=ctypes.byref(state))
         self.uc.hook_add(ucc.UC_HOOK_INTR, self._on_interrupt)
         self.reset()
 
@@ -667,7 +667,7 @@ class CortexM:
     def mmio(self, base: int, size: int, read: ReadFn, write: WriteFn) -> HeldRegister:
         """Map a peripheral: ``read(offset, size) -> value`` and ``write(offset, size, value)`` run on every
         access, but a read of a register the peripheral holds (the :class:`HeldRegister` returned) is answered
-        natively (MCU-22). An exception they raise stops the run at the end of the block (:attr:`error`); the
+        natively (MCU-25). An exception they raise stops the run at the end of the block (:attr:`error`); the
         block's later accesses reach no peripheral (no follow-on reports of a run that has ended)."""
 
         def on_read(handle: int, offset: int, size: int, data: int) -> int:
@@ -697,16 +697,18 @@ class CortexM:
                                      None))  # fmt: skip
         # unicorn updates the PC before a load or store only if a memory hook covers its address: without one, a
         # peripheral callback sees the PC of the block's first instruction, and the access would be timed there
-        # (MCU-1 places it by the PC). The native hook also notes that PC for cycles_now (MCU-22).
+        # (MCU-1 places it by the PC). The native hook also notes that PC for cycles_now (MCU-25).
         self._hook(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, self._exact_pc, base, base + size - 1,
                    ctypes.byref(self._state))  # fmt: skip
         return HeldRegister(held)
 
-    def _hook(self, kind: int, callback: ctypes.c_void_p, begin: int = 1, end: int = 0, data: Any = None) -> None:
-        """Add a hook with a native callback (MCU-19, MCU-22) and its user data; ``begin > end``: every address."""
+    def _hook(self, kind: int, callback: Any, begin: int = 1, end: int = 0, data: Any = None) -> None:
+        """Add a hook with a ctypes callback or a native function (MCU-19, MCU-25) and its user data; ``begin >
+        end``: every address."""
+        self._callbacks.append(callback)
         handle = ctypes.c_size_t()  # uc_hook
-        self._check(_LIB.uc_hook_add(self._handle, ctypes.byref(handle), kind, callback, data, ctypes.c_uint64(begin),
-                                     ctypes.c_uint64(end)))  # fmt: skip
+        self._check(_LIB.uc_hook_add(self._handle, ctypes.byref(handle), kind, ctypes.cast(callback, ctypes.c_void_p),
+                                     data, ctypes.c_uint64(begin), ctypes.c_uint64(end)))  # fmt: skip
 
     @staticmethod
     def _check(status: int) -> None:
@@ -773,7 +775,7 @@ class CortexM:
         self._register_value.value = value
         _LIB.uc_reg_write(self._handle, register, self._register_ref)
 
-    # -- the clock, shared with the native block hook (MCU-1, MCU-22) ------------------------------------------------
+    # -- the clock, shared with the native block hook (MCU-1, MCU-25) ------------------------------------------------
 
     @property
     def cycles(self) -> int:
@@ -1016,7 +1018,7 @@ class CortexM:
         """The status register just read keeps its value until cycle ``until``: if the running block is a pure poll
         loop on it (:func:`is_poll_loop`), its next iterations up to then are counted without running (MCU-10)."""
         state = self._state
-        if state.skip_polls and state.block_poll:  # the native hook's held_read does the same (MCU-22)
+        if state.skip_polls and state.block_poll:  # the native hook's held_read does the same (MCU-25)
             state.skip_address, state.skip_until, state.skip_pending = state.block_address, until, 1
 
     def _on_interrupt(self, uc: Any, number: int, data: Any) -> None:

@@ -1,4 +1,4 @@
-/* The emulated core's block hook and empty memory hook in native code (MCU-22; docs/assumptions/mcu.md).
+/* The emulated core's block hook and empty memory hook in native code (MCU-25; docs/assumptions/mcu.md).
  *
  * Built for the host on first use by supi3.mcu.hook (the Zig toolchain from PyPI) and loaded with ctypes. It links
  * against nothing: unicorn's functions it calls come as pointers in the shared state, which the Python side
@@ -141,7 +141,7 @@ void supi3_exact_pc(void *uc, int type, uint64_t address, int size, int64_t valu
     s->reg_read(uc, s->pc_register, &s->access_pc);
 }
 
-/* A register value a peripheral holds while the read's time is before `until` (MCU-22). */
+/* A register value a peripheral holds while the read's time is before `until` (MCU-25). */
 typedef struct {
     supi3_state *state;
     mmio_read_fn slow; /* the peripheral's read in Python */

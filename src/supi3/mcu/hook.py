@@ -1,6 +1,6 @@
-"""The core's block hook in native code (MCU-22): ``hook.c`` built for the host with the Zig toolchain from PyPI.
+"""The core's block hook in native code (MCU-25): ``hook.c`` built for the host with the Zig toolchain from PyPI.
 
-Ref: unicorn.h (uc_cb_hookcode_t, uc_cb_hookmem_t); decisions MCU-1, MCU-10, MCU-11, MCU-22 in
+Ref: unicorn.h (uc_cb_hookcode_t, uc_cb_hookmem_t); decisions MCU-1, MCU-10, MCU-11, MCU-25 in
 docs/assumptions/mcu.md. The C source ships with the package; :func:`library` compiles it on first use with
 
     python -m ziglang cc -shared -fPIC -O2 -target native -mcpu=baseline -nostdlib -std=c99 -Wall -Wextra
@@ -45,7 +45,7 @@ MMIO_READ: Final = ctypes.CFUNCTYPE(ctypes.c_uint64, ctypes.c_void_p, ctypes.c_u
 
 class NativeHookError(Supi3Error, RuntimeError):
     """The native block hook cannot be built or loaded here (no ziglang, or the compiler failed): the emulated core
-    needs it (MCU-22); the firmware extra installs the compiler (``pip install supi3[firmware]``)."""
+    needs it (MCU-25); the firmware extra installs the compiler (``pip install supi3[firmware]``)."""
 
 
 class Block(ctypes.Structure):
@@ -109,7 +109,7 @@ def _compiler_version() -> str:
     try:
         return importlib.metadata.version("ziglang")
     except importlib.metadata.PackageNotFoundError:
-        raise NativeHookError("ziglang is not installed: the emulated core's block hook is built with it (MCU-22; "
+        raise NativeHookError("ziglang is not installed: the emulated core's block hook is built with it (MCU-25; "
                               "pip install supi3[firmware])") from None  # fmt: skip
 
 
@@ -135,13 +135,13 @@ def library() -> ctypes.CDLL:
             folder.mkdir(parents=True, exist_ok=True)
             handle, work = tempfile.mkstemp(dir=folder, prefix=f"{target.stem}.", suffix=".tmp")
         except OSError as error:
-            raise NativeHookError(f"the native block hook cannot be built into {folder} (MCU-22): {error}") from error
+            raise NativeHookError(f"the native block hook cannot be built into {folder} (MCU-25): {error}") from error
         os.close(handle)
         try:
             command = [sys.executable, "-m", "ziglang", "cc", *FLAGS, str(SOURCE), "-o", work]
             result = subprocess.run(command, capture_output=True, text=True, check=False)
             if result.returncode != 0:
-                raise NativeHookError(f"the native block hook does not build (MCU-22): {' '.join(command)}\n"
+                raise NativeHookError(f"the native block hook does not build (MCU-25): {' '.join(command)}\n"
                                       f"{result.stderr}")  # fmt: skip
             os.replace(work, target)
         finally:
@@ -149,6 +149,6 @@ def library() -> ctypes.CDLL:
     try:
         loaded = ctypes.CDLL(str(target))
     except OSError as error:
-        raise NativeHookError(f"the native block hook {target} does not load (MCU-22): {error}") from error
+        raise NativeHookError(f"the native block hook {target} does not load (MCU-25): {error}") from error
     _LOADED.append(loaded)
     return loaded

@@ -260,7 +260,7 @@ class SpiWire(Protocol):
 
 
 class ValueHolder(Protocol):
-    """Where a peripheral says that a register holds its value (the core answers its reads natively, MCU-22):
+    """Where a peripheral says that a register holds its value (the core answers its reads natively, MCU-25):
     :class:`supi3.mcu.core.HeldRegister`."""
 
     def hold(self, offset: int, value: int, until: int | None, after: int | None) -> None:
@@ -296,7 +296,7 @@ class Spi:
 
     After a read of SR, SR holds its value (:attr:`holder`) until the shifting byte ends, then the value after it if
     nothing starts then, until the next access to SPI1 or RCC_APB2ENR: the core answers the reads in between
-    natively (MCU-22).
+    natively (MCU-25).
     """
 
     def __init__(
@@ -319,7 +319,7 @@ class Spi:
         self.shifting: tuple[int | Callable[[], int], int, int] | None = None  # (received, start cycle, end cycle)
         self.transfers = 0
         self.holder: ValueHolder = _NoHolder()
-        """Told when SR holds its value (:meth:`supi3.mcu.core.CortexM.mmio`'s register, MCU-22)."""
+        """Told when SR holds its value (:meth:`supi3.mcu.core.CortexM.mmio`'s register, MCU-25)."""
         self._holding = False
         rcc.on_enable_change.append(self._release)
 
