@@ -560,8 +560,8 @@ _FOREVER: Final[int] = (1 << 64) - 1
 
 class HeldRegister:
     """A peripheral's register that the core answers natively while the peripheral holds its value (MCU-25), from
-    :meth:`CortexM.mmio`. A peripheral holds a value only after a read that changed nothing, for as long as its
-    reads would return it and change nothing, and releases it at any other access (its own read or write)."""
+    :meth:`CortexM.mmio`. A peripheral holds a value for as long as its own reads would return it and change nothing
+    but what its next access catches up with (its model runs on the time), and releases it at that access."""
 
     def __init__(self, held: hook.Held) -> None:
         self._held = held
