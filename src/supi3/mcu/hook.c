@@ -109,7 +109,7 @@ void supi3_block_hook(void *uc, uint64_t address, uint32_t size, void *data) {
     }
     if (s->skip_pending) {
         s->skip_pending = 0;
-        if (s->skip_address == address) {
+        if (s->skip_address == address && cost->cycles) { /* the poll loop again (never a block of no code) */
             skip_polls(s, cost, s->skip_until);
             if (s->cycles >= s->deadline) {
                 s->emu_stop(uc);
