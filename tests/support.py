@@ -39,7 +39,7 @@ from supi3.model.blocks.optical import OpticalBlock
 from supi3.model.bus_terminal import LBST_PIN
 from supi3.model.chip import Supi3
 from supi3.model.pinring import receive
-from supi3.model.pins import Supi3Pins
+from supi3.model.pins import IDLE_TIMEOUT_CLOCKS, Supi3Pins
 from supi3.model.registers import RegisterFile
 from supi3.optical.regulation import BLOCK_INPUTS, INIT_TIME_LIMIT_CLOCKS, Interface, OpticalMode, Response
 from supi3.pinlevel import OE_SUFFIX
@@ -633,6 +633,18 @@ def counter_levels(count: int, period: int) -> npt.NDArray[np.uint8]:
     levels = np.ones(period, dtype=np.uint8)
     levels[: wire.DATA_TELEGRAM_BITS] = [(telegram >> k) & 1 for k in range(wire.DATA_TELEGRAM_BITS)]
     return levels
+
+
+def counters_in_reset(config: DeviceConfig, rng: np.random.Generator) -> tuple[CoreScript, int]:
+    """A latched data cycle, the master's line held at start level (an INTERBUS reset, A12), then only counter
+    telegrams (count 4, BK-6) beyond the 20 ms idle time-out (A13): no status telegram ends the reset. With the
+    sample after the hold, where the counter telegrams begin (DG-9: they do not restart the time-out)."""
+    script = CoreScript(config, rng).bring_up().data_cycle()
+    script.line(np.full(wire.RESET_HOLD_BITS, wire.START_LEVEL, dtype=np.uint8))
+    start = len(script.columns()["do1"])
+    periods = IDLE_TIMEOUT_CLOCKS // wire.clocks_per_bit(config.bit_rate) + 100
+    script.line(np.tile(counter_levels(4, 33), periods // 33 + 1))
+    return script, start
 
 
 def counter_counts(trace: npt.NDArray[np.integer], cpb: int) -> list[int | None]:

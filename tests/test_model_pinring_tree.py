@@ -13,13 +13,19 @@ from supi3.config import DeviceConfig, decode
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.master import Master
-from supi3.interbus.ring import Branch, BranchKind, ErrorKind, Ring, lbd_count
+from supi3.interbus.ring import Branch, BranchKind, DeadLine, ErrorKind, ReturnBreak, Ring, Transfer, lbd_count
 from supi3.interbus.wire import Cycle
+from supi3.model.bus_terminal import BRANCH_SILENCE_S
 from supi3.model.chip import Supi3
 from supi3.model.pinring import PinBranch, PinRing
 from supi3.model.pins import Supi3Pins
+from supi3.regmap import ID, IN0, OUT0, SET
+from supi3.spi.upif import Mode
+from supi3.tables import CLOCK_HZ
 from supi3.terminal import DO3_PIN, LBST_PIN
+from supi3.top import UP_REST, Supi3Chip
 from support import BK_STRAPS
+from test_model_pinring import ONE_BYTE, Firmware
 
 FAST = tables.clk_conf_for(2_000_000)
 LBST = 1 << LBST_PIN
@@ -252,3 +258,149 @@ def test_a_nested_tree_is_the_same_at_both_fidelities() -> None:
     assert views[0] == views[2] and views[1] == views[3]
     assert [number for number, _, _ in views[0][0]] == ["1.0", "2.0", "3.0", "4.0", "4.1", "5.0"]
     assert len(views[1][0]) == 5 and views[0][1][2] != b"\x00"
+
+
+def counted(ring: Ring | PinRing) -> list[int]:
+    """Every :class:`Transfer`'s device count from now on, in order (the ring's ``transfer`` wrapped)."""
+    counts: list[int] = []
+    transfer = ring.transfer
+
+    def spy(cycle: Cycle, data: bytes, close_after: int | None = None) -> Transfer:
+        result = transfer(cycle, data, close_after)
+        counts.append(result.devices)
+        return result
+
+    ring.transfer = spy  # type: ignore[method-assign]
+    return counts
+
+
+@pytest.mark.parametrize(("kind", "m"), [(BranchKind.LOCAL, 2), (BranchKind.LBD_OR, 1)])
+def test_a_transfer_counts_the_chips_in_the_data_path(kind: BranchKind, m: int) -> None:
+    """BK-1: ``Transfer.devices`` of a pin-level tree counts the chips in the data path, as the transaction-level
+    ring's does: the BK's branch only while it is in the data path (switched on, off, on again; after an INTERBUS
+    reset), in every healthy cycle of the history."""
+    rings: list[Ring | PinRing] = [tl_tree(kind, m), pin_tree(kind, m)]
+    masters = [Master(ring, locate=False, max_devices=8) for ring in rings]
+    counts = [counted(ring) for ring in rings]
+    for master in masters:
+        assert master.start().ok
+    expected = []
+    for step in ("off", "on", "off", "reset"):
+        for master in masters:
+            if step == "reset":
+                assert master.start().ok
+            else:
+                master.switch_branch(2, step == "on")
+            healthy(master)
+        expected.append(3 if step == "off" else 3 + m)
+        assert counts[0][-1] == counts[1][-1] == expected[-1] == len(rings[0].devices)
+    assert {3, 3 + m} <= set(counts[1])
+
+
+@pytest.mark.parametrize("pins", [False, True])
+def test_a_branch_closed_by_the_bk_needs_the_masters_location_at_both_fidelities(pins: bool) -> None:
+    """Issue 12, item 3: after the BK closes its silent branch (BK-3) the ring is shorter. A master with
+    ``locate=False`` has no diagnostic mechanism to find that out (2.4: the data length change "triggers the
+    diagnostic mechanisms" of the master): its ID cycles over the old table fail with the loopback word out of place
+    at both fidelities, and it stays there. With ``locate=True`` (the rescan of a missing loopback word) both read
+    the shorter configuration and the BK's report: :func:`test_the_bk_closes_a_branch_silent_behind_a_cut` and
+    :func:`test_a_cut_of_the_bks_di3_is_the_transaction_levels_return_break`."""
+    ring = pin_tree(BranchKind.LOCAL, 2, silence=SILENCE) if pins else tl_tree(BranchKind.LOCAL, 2)
+    master = Master(ring, locate=False, max_devices=8)
+    assert master.start().ok
+    master.switch_branch(2, True, extended=True)
+    healthy(master)
+    if isinstance(ring, PinRing):
+        ring.cut(4, True)  # the forward line into the branch's second device
+    else:
+        ring.inject(DeadLine(4))
+    start = ring.now
+    kinds = []
+    while ring.now - start < 2 * (SILENCE / CLOCK_HZ if pins else BRANCH_SILENCE_S):
+        result = master.cycle()
+        assert not result.ok
+        kinds.append(result.diagnostics[0].kind)
+    bk = ring.devices[1]
+    assert not (bk.branch_in_path if isinstance(bk, Supi3Pins) else bk.branch_enabled(True))  # type: ignore[union-attr]
+    assert kinds[-1] is ErrorKind.LOOPBACK
+    assert master.config is not None and len(master.config) == 5  # the old table: never read anew
+
+
+@pytest.mark.parametrize("kind", [BranchKind.LOCAL, BranchKind.LBD_MR, BranchKind.LBD_OR])
+def test_a_cut_of_the_bks_di3_is_the_transaction_levels_return_break(kind: BranchKind) -> None:
+    """BK-10: ``PinRing.cut(bk, False, branch=True)`` (DI3 reads idle, BK-30) and the transaction level's
+    ``ReturnBreak`` at the BK give the master the same view: the cycles fail with nothing coming back until the
+    extended function closes the silent branch (BK-3; at pin level after the rings' short silence), then both read
+    the same shorter configuration and process data and the same branch status (closed; count 0 in BK-LBD: the BK's
+    own return input, BK-7, as no counter telegram reaches it), report the closure at the BK and count the same chips
+    in a transfer (BK-1: the closed branch's are out of the data path)."""
+    m = 2
+    rings: list[Ring | PinRing] = [tl_tree(kind, m), pin_tree(kind, m, silence=SILENCE)]
+    views = []
+    for ring in rings:
+        master = Master(ring, max_devices=8)
+        assert master.start().ok
+        master.switch_branch(2, True, extended=True)
+        healthy(master)
+        if isinstance(ring, Ring):
+            ring.inject(ReturnBreak(2))
+        else:
+            ring.cut(2, False, branch=True)
+        first = master.cycle()
+        assert not first.ok and first.diagnostics[0].kind is ErrorKind.DEAD_LINE
+        for _ in range(400):
+            result = master.cycle()
+            if any(d.kind is ErrorKind.BRANCH_CLOSED for d in result.diagnostics):
+                closed = [(d.location, d.device) for d in result.diagnostics if d.kind is ErrorKind.BRANCH_CLOSED]
+                break
+        else:
+            raise AssertionError(f"never closed: {master.diagnostics[-3:]}")
+        healthy(master)
+        counts = counted(ring)
+        healthy(master)
+        views.append((view(master), master.branch_status[2], closed, counts[-1]))  # closed: 3 chips in the path
+    assert views[0] == views[1]
+    assert len(views[0][0][0]) == 3 and views[0][1].closed and views[0][1].counter == 0
+    pins = pin_tree(kind, m)
+    for position, forward in ((1, False), (2, True)):  # not a BK; DI3 is a return input
+        with pytest.raises(ArgumentError, match=r"^position must be the ring position of a BK with a branch \(\[2\]\)"):
+            pins.cut(position, forward, branch=True)
+    with pytest.raises(ArgumentError, match=r"^branch must be"):
+        pins.cut(2, False, branch=1)  # type: ignore[arg-type]
+    assert pins.branch_cuts == set() and pins.cuts == set()
+
+
+def test_a_whole_chip_with_a_microprocessor_is_a_bk_in_a_tree() -> None:
+    """BK-40 with a :class:`~supi3.top.Supi3Chip` in BK-LB Init-µP (Table 2-7, 04h: ID code and length from its µP
+    over the serial interface, 3.4.5) as the BK: the loop is closed on deep copies of the whole chip, its µP interface
+    included, and the real chip runs last, so the µP configured beforehand and reading and writing between the
+    ring's runs talks to the chip the ring drives: the master reads the µP's ID code and length and the branch
+    behind it, IN data the µP wrote and OUT data reach the µP; switching the branch off and on changes the data length
+    as with a core-only BK; no µP interface violation."""
+    bk = Supi3Chip(decode("00100", rf="11", clk_conf=FAST))
+    firmware = Firmware(bk, Mode.MOTOROLA)
+    firmware.write(SET, ONE_BYTE)
+    firmware.write(ID, 0x08)
+    chips = [Supi3Pins(_config(ROWS[BranchKind.LOCAL])) for _ in range(2)]
+    remote = [Supi3Pins(_config(ROWS[BranchKind.REMOTE])) for _ in range(2)]
+    ring = PinRing([remote[0], PinBranch(bk, chips, BranchKind.LOCAL), remote[1]])
+    ring.set_input(2, "mfp_in", LBST | UP_REST)  # the µP rests while the ring runs
+    for position, value in ((1, 0x5A), (3, 0x11), (4, 0x22), (5, 0x33)):
+        ring.set_input(position, "mfp_in", value)
+    ring.idle(0.0002)  # the cores' power-up reset stretch
+    master = Master(ring, locate=False, max_devices=8)
+    assert master.start().ok
+    ring.settle()
+    firmware.write(IN0, 0xC3)
+    master.set_outputs(2, b"\x77")
+    for _ in range(2):
+        healthy(master)
+    ring.settle()
+    assert view(master) == ([("1.0", 3, 1), ("2.0", 8, 1), ("2.1", 0xBF, 1), ("2.2", 0xBF, 1), ("3.0", 3, 1)],
+                            [b"\x5a", b"\xc3", b"\x11", b"\x22", b"\x33"])  # fmt: skip
+    assert firmware.read(OUT0) == 0x77 and ring.trials > 0
+    for on, size in ((False, 3), (True, 5)):
+        master.switch_branch(2, on)
+        healthy(master)
+        assert master.config is not None and len(master.config) == size
+    assert bk.chip.registers is not None and not bk.chip.registers.violations.records

@@ -19,7 +19,15 @@ from supi3.interbus.wire import Cycle
 from supi3.model.chip import ChipArgumentError, Supi3
 from supi3.model.pinring import PinRing
 from supi3.model.pins import IDLE_TIMEOUT_CLOCKS, SYNC_STAGES, Supi3Pins
-from support import Columns, CoreScript, assert_run_matches_step, counter_levels, quiet_inputs, terminal
+from support import (
+    Columns,
+    CoreScript,
+    assert_run_matches_step,
+    counter_levels,
+    counters_in_reset,
+    quiet_inputs,
+    terminal,
+)
 
 FAST = tables.clk_conf_for(2_000_000)
 PHASE = 300
@@ -180,6 +188,34 @@ def test_only_the_chip_at_the_break_shows_the_line_interrupt() -> None:
         assert chip.line_interrupt is (not counters)
         assert chip.diagnostic_outputs.ib_diag is shown
         assert int(out["res_reg_n"][-1]) == 0  # RC off: the time-out came (DG-4)
+
+
+def test_counter_telegrams_in_an_interbus_reset_do_not_restart_the_idle_timeout() -> None:
+    # DG-9 in an INTERBUS reset: the line held at start level (A12), then only counter telegrams, no status telegram
+    # to end the reset: the 20 ms run from the last telegram start in the held line, the chip times out (RC off) with
+    # no line interrupt ahead (counted). Before, the receiver took a counter telegram in reset for another telegram.
+    config = _lbd(Interface.LBD_OR)
+    script, start = counters_in_reset(config, np.random.default_rng(7))
+    pins = Supi3Pins(config)
+    out = pins.run(script.columns())
+    low = np.flatnonzero(out["res_reg_n"][start:] == 0)
+    assert low.size and low[0] <= IDLE_TIMEOUT_CLOCKS
+    assert pins.chip.line_silent and not pins.chip.line_interrupt and not pins.chip.bus_active
+    assert "idle timeout: INTERBUS reset" in pins.log.recent()[-1]
+
+
+def test_a_ring_reset_with_a_break_times_out_the_chips_behind_it_counted() -> None:
+    # DG-9 at transaction level: an Alarm Stop whose reset pattern stops at a break reaches no chip behind it; those
+    # hear nothing (the chip directly behind: 4 Hz) or the counter telegrams of an LBD chip before them (no line
+    # interrupt), and all of them reset after the 20 ms from the reset's start.
+    chips = [Supi3(_lbd(Interface.LBD_OR)) for _ in range(3)]
+    ring = Ring(chips, bit_rate=2_000_000)
+    master = Master(ring, locate=False, max_devices=4)
+    assert master.start().ok and master.data_cycle().ok
+    ring.inject(DeadLine(2))
+    ring.reset()
+    ring.idle(wire.IDLE_TIMEOUT_S)
+    assert [(chip.line_silent, chip.line_interrupt) for chip in chips] == [(False, False), (True, True), (True, False)]
 
 
 BEHIND_A_BREAK = {

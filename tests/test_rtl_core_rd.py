@@ -20,7 +20,7 @@ from supi3.model.pins import IDLE_TIMEOUT_CLOCKS, Supi3Pins
 from supi3.pinout import IB_DIAG_DIVIDER_BITS
 from supi3.rtl.core import OutputsRtl
 from supi3.verif import Lockstep
-from support import IDLE, LOOPBACK, CoreScript, counter_levels
+from support import IDLE, LOOPBACK, CoreScript, counter_levels, counters_in_reset
 
 FAST = tables.clk_conf_for(2_000_000)
 MODES = {"LB-MR": "01000", "LBD-MR": "11000", "LBD-OR": "11100", "RB": "10000", "BK-RB": "00000"}
@@ -77,6 +77,18 @@ def test_idle_timeout_through_counter_telegrams(bench: Lockstep) -> None:
     low = np.flatnonzero(out["res_reg_n"] == 0)
     assert low.size and start < low[0] < start + IDLE_TIMEOUT_CLOCKS + 64 * cpb
     assert pins.chip.line_silent and not pins.chip.line_interrupt and not pins.chip.bus_active
+    bench.run_batch(script.line(wire.reset_levels(1)).line(IDLE).data_cycle().stimulus())
+
+
+@pytest.mark.slow
+def test_idle_timeout_through_counter_telegrams_in_an_interbus_reset(bench: Lockstep) -> None:
+    # DG-9 in an INTERBUS reset (the line held at start level, then only counter telegrams, no status telegram to end
+    # the reset): the frame engine's ``counter`` takes them there too, so the time-out runs from the held line and
+    # /ResReg goes low at the same clock in RTL and model; then the master's reset pattern and a data cycle.
+    config = decode(MODES["LBD-OR"], clk_conf=tables.clk_conf_for(500_000), diag_conf=0)
+    script, start = counters_in_reset(config, np.random.default_rng(34))
+    out = Supi3Pins(config).run(script.columns())
+    assert np.flatnonzero(out["res_reg_n"][start:] == 0)[0] <= IDLE_TIMEOUT_CLOCKS
     bench.run_batch(script.line(wire.reset_levels(1)).line(IDLE).data_cycle().stimulus())
 
 

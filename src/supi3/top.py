@@ -130,6 +130,11 @@ class Supi3Chip:
         """Clock cycles since reset."""
         return self.core.cycle
 
+    @property
+    def branch_in_path(self) -> bool:
+        """A BK's branch is in the data path in the current cycle (:attr:`Supi3Pins.branch_in_path`)."""
+        return self.core.branch_in_path
+
     def reset(self) -> None:
         """The state after the ``sync`` reset."""
         self.core.reset()

@@ -159,6 +159,10 @@ class CycleResult:
     diagnostics: tuple[Diagnostic, ...]
 
 
+_DATA_LATCHED: Final = CycleResult(Cycle.DATA, True, ())
+"""Every latched data cycle's result (immutable, so one object serves them all)."""
+
+
 class Master:
     """INTERBUS master model (docs/interbus.md, "Master").
 
@@ -405,7 +409,7 @@ class Master:
         assert transfer.returned is not None
         self._in = transfer.returned[:data_len]
         self._attention = self._attention or transfer.flags.attention
-        return CycleResult(Cycle.DATA, True, ())
+        return _DATA_LATCHED
 
     def id_cycle(self) -> CycleResult:
         """One ID cycle: a discovery cycle without a configuration (the loopback word is searched for), else

@@ -612,6 +612,7 @@ class Ring:
         # device's received bytes.
         self._layout: tuple[list[type], _Groups] = ([], [])
         self._cuts: tuple[list[bytes], int, bytes, list[slice] | None, int] = ([], -1, b"", None, 0)
+        self._bits = ((-1, -1), 0)  # (bytes sent, devices) of the last cycle finished, and its wire.cycle_bits
         _tell_following(self._tree)
         self._sync()
 
@@ -908,7 +909,8 @@ class Ring:
         Transfer
             Hand it to :meth:`finish` with the master's verdict.
         """
-        check_instance("cycle", cycle, Cycle)
+        if type(cycle) is not Cycle:
+            check_instance("cycle", cycle, Cycle)
         if self._branches:
             self._sync()
         n_all = len(self.devices)
@@ -941,7 +943,7 @@ class Ring:
         error = False
         runs: list[_Run] = []
         devices = self.devices[: n if dead is None else min(n, dead - 1)]
-        slow = range(len(devices)) if record else sorted(s - 1 for s in faults if s <= len(devices))
+        slow = range(len(devices)) if record else sorted(s - 1 for s in faults if s <= len(devices)) if faults else ()
         index = 0
         for stop in [*slow, len(devices)]:
             if index < stop:
@@ -977,15 +979,15 @@ class Ring:
         receiver_error: ErrorKind | None = None
         flags_back = wire.CntrFlags(attention, error)
         if (dead is None or dead > segments) and not back_dead:
-            sent = _Line(stream, crc, wire.cntr_word(attention, error))
+            returned = stream
             last = n + 1
             if record or last in faults:
+                sent = _Line(stream, crc, wire.cntr_word(attention, error))
                 line, receiver_error = self._receive(cycle, sent, faults.get(last, []), shifted)
                 if record:
                     self.trace.append(SegmentTrace(last, sent.frame(cycle), line.frame(cycle), receiver_error))
                 flags_back = wire.decode_cntr(line.cntr) or wire.CntrFlags(True, True)
-                sent = line
-            returned = sent.stream
+                returned = line.stream
         elif record:
             silent = _Line(stream, crc, wire.cntr_word(attention, error))
             self.trace.append(SegmentTrace(segments if dead is None else dead, silent.frame(cycle), None, None))
@@ -999,7 +1001,10 @@ class Ring:
         Advances bus time by ``wire.cycle_bits``; a device latches only if its own check passed, no error was
         flagged upstream of it, and the master latches.
         """
-        bits = wire.cycle_bits(len(transfer.sent) - wire.LOOPBACK_BYTES, transfer.devices)
+        size = (len(transfer.sent), transfer.devices)
+        if size != self._bits[0]:
+            self._bits = (size, wire.cycle_bits(size[0] - wire.LOOPBACK_BYTES, size[1]))
+        bits = self._bits[1]
         start = self.now
         end = start + bits / self.bit_rate
         cycle = transfer.cycle
@@ -1018,7 +1023,8 @@ class Ring:
             for index in range(transfer.reached):
                 self._silent_since.pop(index, None)
                 self._silent_reset.discard(index)
-        self._go_silent(range(transfer.reached, len(self.devices)), start, end)
+        if transfer.reached < len(self.devices):
+            self._go_silent(range(transfer.reached, len(self.devices)), start, end)
         self.now = end
         if self._branches:
             for terminal, traffic, count in transfer.branches:

@@ -104,6 +104,9 @@ SERVE_TELEGRAMS: Final[int] = 64
 telegrams while the firmware is still in a handler or has an /IRQ edge to serve."""
 
 
+_EXTI0: Final[int] = EXTERNAL + EXTI0_IRQ
+"""The exception number of EXTI0, /IRQ's line."""
+
 _T = TypeVar("_T")
 _R = TypeVar("_R")
 
@@ -157,7 +160,7 @@ class _BoardBench(Bench):
         return self._next_event()
 
 
-@dataclass
+@dataclass(slots=True)
 class _Frame:
     fall: int  # cycle of /SS falling
     driven: int | None  # what the chip drives on SerOUT (UP-18)
@@ -428,7 +431,10 @@ class Board:
     def sync(self, cycles: int, event: int | None = None) -> None:
         """Run the bus up to core cycle ``cycles``, then follow /IRQ; ``event``: the cycle of the bus event passed
         on the way, when /IRQ changed if it did."""
-        self.bench.advance(self._seconds(cycles))
+        bench = self._bench
+        if bench is None:
+            bench = self.bench  # BoardError at pin level
+        bench.advance(cycles / self.core.cpu_hz)
         self._follow_irq(cycles, event)
 
     def _now(self) -> int:
@@ -438,7 +444,10 @@ class Board:
 
     # -- /IRQ, EXTI0 and the NVIC ------------------------------------------------------------------------------
 
-    def _follow_irq(self, cycles: int, event: int | None = None) -> None:
+    def _follow_irq(self, cycles: int, event: int | None = None, *, request: bool = True) -> None:
+        """Pass /IRQ's and /ModAck's edges since the last call to EXTI, then let EXTI0 request its interrupt;
+        ``request=False``: only if an edge was passed (the caller requested since, and nothing else changes EXTI or
+        the NVIC within one peripheral access)."""
         bench = self._bench
         assert bench is not None
         pulse = bench.chip.mod_ack_until
@@ -446,22 +455,26 @@ class Board:
             self._mod_ack_until = pulse
             self.exti.edge(PORT_B, PIN_MODACK, 0)
             self.exti.edge(PORT_B, PIN_MODACK, 1)
+            request = True
         level = self.registers.irq_n
         if level != self._irq_level:
             self._irq_level = level
             if not level and self._irq_fell is None:
                 self._irq_fell = cycles if event is None else event
             self.exti.edge(0, PIN_IRQ, level)
-        self._request()
+            request = True
+        if request:
+            self._request()
 
     def _request(self) -> None:
-        number = EXTERNAL + EXTI0_IRQ
-        if self.exti.requesting(0) and number not in self.core.active and number not in self.core.pending:
-            self.core.pend(number)
-            self.core.stop_request = True
+        if self.exti.requesting(0):
+            core = self.core
+            if _EXTI0 not in core.active and _EXTI0 not in core.pending:
+                core.pend(_EXTI0)
+                core.stop_request = True
 
     def _entered(self, number: int) -> None:
-        if number == EXTERNAL + EXTI0_IRQ:
+        if number == _EXTI0:
             self.interrupts += 1
             if self._irq_fell is not None:
                 self.irq_latency_s = max(self.irq_latency_s, self._seconds(self.core.cycles - self._irq_fell))
@@ -578,17 +591,24 @@ class Board:
     # -- the chip and its violations ---------------------------------------------------------------------------
 
     def _chip(self, action: Callable[[_T], _R], cycles: int, argument: _T) -> _R:
-        """``action(argument)`` on the chip with its violations deferred to its end; note the new ones with the PC."""
+        """``action(argument)`` on the chip with its violations deferred to its end; note the new ones with the PC.
+        Called within a peripheral access after :meth:`sync`, which let EXTI0 request its interrupt."""
         log = self.registers.violations
         records = log.records
         before = len(records)
+        log.hold()  # log.deferred() without the with statement's cost (the per-byte hot path)
         try:
-            with log.deferred():
-                return action(argument)
+            try:
+                result = action(argument)
+            except BaseException:
+                log.release(failed=True)
+                raise
+            log.release()
+            return result
         finally:
             if len(records) > before:
                 self._note(records[before:], cycles)
-            self._follow_irq(cycles)
+            self._follow_irq(cycles, request=False)
 
     def _violation(self, rule: str, detail: str) -> None:
         self._chip(self.registers.violations.report, self.core.cycles_now(), InterfaceViolationError(rule, detail))

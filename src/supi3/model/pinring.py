@@ -73,6 +73,10 @@ class PinChip(Protocol):
     def cycle(self) -> int:
         """Clock cycles since reset."""
 
+    @property
+    def branch_in_path(self) -> bool:
+        """A BK's branch is in the data path now (:attr:`Supi3Pins.branch_in_path`); ``False`` for other chips."""
+
     def run_forward(self, inputs: Mapping[str, Sequence[int] | npt.NDArray[np.generic]]) -> dict[str, PinTrace]:
         """Every output but ``di1`` over the input traces (:meth:`Supi3Pins.run_forward`)."""
 
@@ -128,6 +132,26 @@ def _chips(items: Sequence[PinChip | PinBranch]) -> list[PinChip]:
             found += _chips(item.devices)
         else:
             found.append(item)
+    return found
+
+
+def _in_path(items: Sequence[PinChip | PinBranch]) -> int:
+    """The chips of a tree in the data path now: every chip, but a branch's only while its BK has the branch in the
+    data path (BK-1's flattened data path, as ``Ring.devices`` counts it)."""
+    return sum(1 + (_in_path(item.devices) if item.terminal.branch_in_path else 0) if isinstance(item, PinBranch)
+               else 1 for item in items)  # fmt: skip
+
+
+def _terminal_positions(items: Sequence[PinChip | PinBranch], first: int) -> set[int]:
+    """The positions (from ``first`` on, physical order) of the BKs of :class:`PinBranch` items, nested ones too."""
+    found: set[int] = set()
+    position = first
+    for item in items:
+        if isinstance(item, PinBranch):
+            found.add(position)
+            found |= _terminal_positions(item.devices, position + 1)
+            position += len(_chips(item.devices))
+        position += 1
     return found
 
 
@@ -266,6 +290,9 @@ class PinRing:
         self._chunks: list[list[dict[str, npt.NDArray[np.int64]]]] = []
         self.cuts: set[tuple[int, bool]] = set()
         """Broken lines, as ``(position, forward)``: see :meth:`cut`."""
+        self.branch_cuts: set[int] = set()
+        """Positions of BKs whose branch return input DI3 is broken: see :meth:`cut`."""
+        self._terminals = _terminal_positions(chips, 1)
         self._inputs = [
             {"di2": 0, "rbst_ext": 0, "mfp_in": 0, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 1, "from_exr": 0}
             for _ in every
@@ -291,20 +318,30 @@ class PinRing:
                        pin, "docs/model.md")
         self._inputs[position - 1][pin] = check_bits(f"pin {pin!r}", value, APPLICATION_INPUTS[pin])
 
-    def cut(self, position: int, forward: bool) -> None:
+    def cut(self, position: int, forward: bool, *, branch: bool = False) -> None:
         """Break the line into the chip at ring ``position``: its forward input DO1 (``forward``, any chip; the first
         chip of a branch takes its BK's DO3), or its return input DI2 from the chip behind it (a chip that has one:
-        not the last of the ring or of a branch, none in an LBD-OR branch). A broken line reads at the idle level
-        (RS-485 fail-safe bias, BK-30): behind it the LBD chips' counter telegrams (2.2.2) bring the master, or the
-        branch's BK, the count of ``ring.lbd_count`` (``forward``, ``back``) for a branch of these chips.
+        not the last of the ring or of a branch, none in an LBD-OR branch), or with ``branch`` (``forward`` false) a
+        BK's branch return input DI3 (MFP10), the line ``ring.ReturnBreak`` breaks at a BK (BK-10). A broken line
+        reads at the idle level (RS-485 fail-safe bias, BK-30): behind it the LBD chips' counter telegrams (2.2.2)
+        bring the master, or the branch's BK, the count of ``ring.lbd_count`` (``forward``, ``back``) for a branch of
+        these chips.
 
         Raises
         ------
         ArgumentError
-            ``forward`` not a bool or ``position`` out of range; nothing changes.
+            ``forward`` or ``branch`` not a bool, ``position`` out of range, or ``branch`` with ``forward`` or at a
+            chip that is not a BK with a branch (:class:`PinBranch`); nothing changes.
         """
         check_bool("forward", forward)
+        check_bool("branch", branch)
         position = check_int("position", position, 1, len(self.devices), "a chip of the ring")
+        if branch:
+            if forward or position not in self._terminals:
+                raise fail("position", f"the ring position of a BK with a branch ({sorted(self._terminals)}), with "
+                           "forward=False (branch=True breaks the BK's DI3)", (position, forward))  # fmt: skip
+            self.branch_cuts.add(position)
+            return
         if not forward and position not in self._return_inputs:
             raise fail("position", f"an integer from 1 to {len(self.devices)} (a chip of the ring; a return line only "
                        "from a chip behind it: not into the last of the ring or of a branch, none in an LBD-OR branch)",
@@ -394,8 +431,9 @@ class PinRing:
         the latest after the run's length over that delay, and its fixed point is the one the chips would see (the
         line is causal). Usually the BK's DO3 does not depend on DI3 within a run, and two runs of the BK and one of
         the branch on copies find it. The chips then run once with it."""
-        di3 = np.full(len(line), wire.IDLE_LEVEL, dtype=np.int64)  # nothing attached: the pull-up (BK-41)
-        if branch.devices:
+        # Nothing attached: the pull-up (BK-41); DI3 broken: the idle level too (BK-30).
+        di3 = np.full(len(line), wire.IDLE_LEVEL, dtype=np.int64)
+        if branch.devices and position not in self.branch_cuts:
             do3 = None
             while True:
                 outputs = self._run(copy.deepcopy(branch.terminal), position, line, di3, None)
@@ -447,7 +485,7 @@ class PinRing:
             # The master does not ask (PinRing has no ``closes_early``): it reports such errors as not located.
             raise InterbusError("docs/interbus.md, Segment search", close_after,
                                 "the pin-level ring does not close early")
-        n = len(self.devices)
+        n = _in_path(self.tree)
         frame = Frame.build(cycle, data)
         delay = wire.ring_delay_status_telegrams(self.repeaters)
         self.run_levels(np.concatenate([wire.frame_levels(frame), wire.status_levels(cycle, False, delay)]))

@@ -92,7 +92,7 @@ from supi3.optical.regulation import OpticalMode
 from supi3.pinlevel import EventLog, Pin
 from supi3.pinout import CORE_OUTPUTS, IB_DIAG_DIVIDER_BITS, OPTICAL_LINE_INPUTS, OPTICAL_REGISTERS, SYNC_STAGES
 from supi3.tables import BIT_RATES, CLOCK_HZ, RESET_MIN_S
-from supi3.terminal import BRANCH_SILENCE_CLOCKS, CONF_PIN
+from supi3.terminal import BRANCH_SILENCE_CLOCKS, CONF_PIN, LBST_PIN
 
 __all__ = [
     "IB_DIAG_DIVIDER_BITS",
@@ -362,6 +362,17 @@ class Supi3Pins:
     def holding(self) -> bool:
         """A source of the power-up reset (``vmon_ok`` low, /ResU pulled low) was seen at the last clock edge (M2)."""
         return self._holding
+
+    @property
+    def branch_in_path(self) -> bool:
+        """A BK's branch is in the data path in the current cycle (BK-37: present by Table 2-9 with the synchronised
+        LBST and ``connected``, switched on, not closed; :meth:`BranchLines.on`); ``False`` in the other modes."""
+        branch = self._branch
+        if branch is None:
+            return False
+        assert self.chip.bus_terminal is not None
+        return branch.on(self.chip.bus_terminal.state, self._receiver.pipe[-1].mfp_in >> LBST_PIN & 1,
+                         branch.connected)  # fmt: skip
 
     def forward_level(self) -> int:
         """The forward line output (``do2``) of the current cycle; it depends on state only."""

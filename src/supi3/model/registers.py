@@ -65,6 +65,7 @@ _PCP_SOURCES: Final[int] = sum(1 << s.bit for s in INTERRUPT_SOURCES if s.name.s
 """The IRQ_EN bits of the PCP interrupt sources (PCP receive, PCP send; Table 3-13)."""
 _IN_INDEX: Final[dict[str, int]] = {r.name: r.address for r in IN_BYTES}
 _OUT_INDEX: Final[dict[str, int]] = {r.name: r.address for r in OUT_BYTES}
+_OUT_NAMES: Final[tuple[str, ...]] = tuple(r.name for r in OUT_BYTES)
 
 
 def _port_names(direction: AccessDirection) -> tuple[str | None, ...]:
@@ -344,6 +345,9 @@ class RegisterFile:
         self._clock: Callable[[], int] | None = None
         self._values: dict[str, int] = {r.name: r.reset for r in REGISTER_MAP.registers}
         self._set: SetConfig | None = None
+        self._in_names: tuple[str, ...] = ()  # derived from _set by _configure: the IN registers of a data cycle
+        self._erased: tuple[str, ...] = ()  # and those a PCP device erases after their transfer (3.4.11)
+        self._length_code = 0  # and SET's length code (Table 3-12) as a number
         self._bus_running = False
         self._latch_phase = False
         self._io_access = False
@@ -391,7 +395,7 @@ class RegisterFile:
     def power_up_reset(self) -> None:
         """Power-up (hardware) reset: every register 0, not configured, bus stopped, no latch phase (3.4.7)."""
         self._reset(Reset.POWER_UP)
-        self._set = None
+        self._configure(None)
         self._bus_running = False
         self._latch_phase = False
         self._io_access = False
@@ -527,7 +531,14 @@ class RegisterFile:
                                  "possible with the SUPI 3 LS; configuration not applied")
             )
             return
+        self._configure(decoded)
+
+    def _configure(self, decoded: SetConfig | None) -> None:
+        """Take ``decoded`` as the configuration (``None``: none), with the tables a data cycle reads from it."""
         self._set = decoded
+        self._length_code = 0 if decoded is None else int(decoded.length.code, 2)
+        self._in_names = tuple(r.name for r in IN_BYTES[: self.data_bytes()]) if self.internal_data_path else ()
+        self._erased = tuple(name for name in _PCP_ERASED if name in self._in_names) if self.pcp_device else ()
 
     @staticmethod
     def _address(address: object) -> int:
@@ -631,7 +642,7 @@ class RegisterFile:
         """
         if self._set is None:
             return (self.config.length_code << 8) | self.config.id_code
-        return (int(self._set.length.code, 2) << 8) | self._values["ID"]
+        return (self._length_code << 8) | self._values["ID"]
 
     def data_bits(self) -> int:
         """Data length in bits per direction: 0 until SET is written (3.4.1), then SET's length (Table 3-11)."""
@@ -695,7 +706,7 @@ class RegisterFile:
     def _in_registers(self) -> tuple[str, ...]:
         if not self.internal_data_path:
             raise RegisterFileError("ExtReg = 1: the internal data registers are not in the data path (3.4.8)")
-        return tuple(r.name for r in IN_BYTES[: self.data_bytes()])
+        return self._in_names
 
     def in_bytes(self) -> bytes:
         """The IN bytes the next data cycle sends, byte 0 (address 0) the most significant (3.4.8); no effect.
@@ -707,7 +718,8 @@ class RegisterFile:
         RegisterFileError
             With ExtReg = 1 (the data come from the external registers).
         """
-        return bytes(self._values[name] for name in self._in_registers())
+        values = self._values
+        return bytes([values[name] for name in self._in_registers()])
 
     def latch(self, out: bytes) -> bytes:
         """The latch phase of a valid data cycle: return the IN bytes sent, store ``out`` in OUT0.., and in a
@@ -730,13 +742,12 @@ class RegisterFile:
             out = _checked(check_bytes, "out", out, len(names),
                            f"the OUT bytes of the cycle: latch needs {len(names)} OUT bytes for {self.data_bits()} "
                            "data bits, 3.4.8")
-        sent = self.in_bytes()
-        for register, value in zip(OUT_BYTES, out, strict=False):
-            self._values[register.name] = value
+        values = self._values
+        sent = bytes([values[name] for name in names])
+        values.update(zip(_OUT_NAMES, out, strict=False))
         self._out_latched = True
-        if self.pcp_device:
-            for name in set(_PCP_ERASED) & set(names):
-                self._values[name] = 0
+        for name in self._erased:
+            values[name] = 0
         return sent
 
     def event(self, source: str) -> None:

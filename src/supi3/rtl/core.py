@@ -759,8 +759,10 @@ class FrameEngineRtl(wiring.Component):
         control_bit = rx.frame_bit & (rx.position == wire.POS_CONTROL)
         cycle_id = rx.select == wire.SELECT_ID_LEVEL
         check = line == wire.CONTROL_CHECK_LEVEL
-        # A counter telegram (LBD modes, BK-36): an ID check telegram while no frame runs; the frame ignores it.
-        comb += rx.counter.eq(control_bit & self.lbd & cycle_id & check & (idle | in_wait | rx.idle_timeout))
+        # A counter telegram (LBD modes, BK-36): an ID check telegram while no frame runs; the frame ignores it. In an
+        # INTERBUS reset too (the frame idles; DG-9: it does not restart the idle time-out there either).
+        counter_bit = rx.sample & rx.data_now & (rx.position == wire.POS_CONTROL)
+        comb += rx.counter.eq(counter_bit & self.lbd & cycle_id & check & (idle | in_wait | rx.idle_timeout))
         with m.If(control_bit & ~rx.counter):
             with m.If(~check & ~in_data):  # a frame begins: the register's parallel load
                 abandon()

@@ -313,6 +313,8 @@ class Bench:
         self._bit_s = 1.0 / self.config.bit_rate
         self._events: list[tuple[float, str]] = []  # this cycle's phase changes, latest first
         self._next_start = 0.0
+        self._next_at = 0.0  # the time of the next bus event: the last of _events, else _next_start
+        self._phases = ((-1, -1), wire.CyclePhases(0, 0, 0, 0))  # (data bytes, devices) of the last cycle, its phases
         self._started = False
         self._irq_level = 1
         self._irq_fell_at: float | None = None
@@ -322,20 +324,25 @@ class Bench:
     # -- the bus side ------------------------------------------------------------------------------------------
 
     def _next_event(self) -> float:
-        return self._events[-1][0] if self._events else self._next_start
+        return self._next_at
 
     def advance(self, until: float) -> None:
         """Run the bus up to time ``until`` and set the clock there (not backwards)."""
-        while self._next_event() <= until:
+        # Most calls (a byte, a pin read, the board's synchronisation at each peripheral access) find no bus event
+        # due: one comparison with the next event's time, kept by _step_bus and _start_cycle.
+        while self._next_at <= until:
             self._step_bus()
-        self.now = max(self.now, until)
+        if until > self.now:
+            self.now = until
 
     def _step_bus(self) -> None:
         """The next bus event: a cycle starts, a phase begins, or the cycle ends."""
         if not self._events:
             self._start_cycle()
             return
-        at, what = self._events.pop()
+        events = self._events
+        at, what = events.pop()
+        self._next_at = events[-1][0] if events else self._next_start
         self.now = max(self.now, at)
         if what == "io":
             for chip in self._chips:
@@ -363,8 +370,10 @@ class Bench:
         if pending is None:  # cannot happen: every master cycle ends with a finish
             raise BenchError("the master ran a cycle without finishing it")
         transfer, _, start = pending
-        timing = CycleTiming(start, transfer.cycle, wire.cycle_phases(len(transfer.sent) - wire.LOOPBACK_BYTES,
-                                                                      transfer.devices), self._bit_s)
+        size = (len(transfer.sent) - wire.LOOPBACK_BYTES, transfer.devices)
+        if size != self._phases[0]:
+            self._phases = (size, wire.cycle_phases(*size))
+        timing = CycleTiming(start, transfer.cycle, self._phases[1], self._bit_s)
         self.timeline.append(timing)
         end = timing.end
         events = [(end, "end")]
@@ -372,6 +381,7 @@ class Bench:
             events += [(timing.latch, "latch"), (timing.io_busy, "io")]
         self._events = events
         self._next_start = end if self.cycle_time_s is None else max(end, start + self.cycle_time_s)
+        self._next_at = events[-1][0]
         self.irq_edge()
 
     # -- the board's other pins -------------------------------------------------------------------------------

@@ -45,17 +45,23 @@ class ModelTransport(Transport):
         self.protocol = self.up.protocol
         self.registers = self.up.registers
         self.sas_level = 0
-        self._deferred = self.registers.violations.deferred()
+        self._log = self.registers.violations
 
     def xfer(self, tx: int, s_r: bool) -> int:
         """One frame: /SS falls (the chip decides what it drives, UP-18), /SS rises (it takes the byte on the data
         line: its own in an Intel receive frame). As :meth:`UpInterface.transfer`, without its argument checks:
         the driver sends only bytes."""
         protocol = self.protocol
-        with self._deferred:
+        log = self._log
+        log.hold()  # a deferred() block without the with statement's cost (the per-byte hot path)
+        try:
             driven = protocol.begin(s_r)
             self._during_frame()
             protocol.end(driven if driven is not None and protocol.mode is Mode.INTEL else tx)
+        except BaseException:
+            log.release(failed=True)
+            raise
+        log.release()
         return driven or 0
 
     def _during_frame(self) -> None:

@@ -221,8 +221,9 @@ class Receiver:
         frame = self.frame
         framed = not frame.in_reset and self.length == wire.DATA_TELEGRAM_BITS
         if k == wire.POS_CONTROL:
-            # The idle time-out restarts from this telegram's start unless it is a counter telegram (DG-9, BK-36).
-            self.counted = framed and frame.counter_telegram(self.word)
+            # The idle time-out restarts from this telegram's start unless it is a counter telegram (DG-9, BK-36),
+            # in an INTERBUS reset too (the frame engine idles there: no frame takes it either way).
+            self.counted = self.length == wire.DATA_TELEGRAM_BITS and frame.counter_telegram(self.word)
             if self.counted:
                 framed = False  # no frame's telegram: the frame engine does not see its control bit
             else:
