@@ -42,9 +42,28 @@ def test_a_pin_level_run_reports_the_data_and_writes_the_vcd(
     assert "$scope module dev1" in text and "$scope module mcu" in text and "pa7_mosi" in text
 
 
+@pytest.mark.slow
+def test_devices_behind_the_chip_at_pin_level_are_the_transaction_levels(
+    capsys: pytest.CaptureFixture[str], elf: Path
+) -> None:
+    """``--devices 2`` at pin level (MCU-23): the device behind the chip is a pin-level SUPI 3 strapped RB 16 IN, so
+    the report's configuration table and process data are those of the transaction-level run with its plain
+    device of the same ID code and length (02h, one word)."""
+    reports = []
+    for fidelity in ("transaction", "pin"):
+        code = main(["firmware", "run", str(elf), "--fidelity", fidelity, "--devices", "2", "--cycles", "6", "--out",
+                     "8118", "--in", "0ff0", "--json"])  # fmt: skip
+        out, err = capsys.readouterr()
+        assert (code, err) == (0, "")
+        reports.append(json.loads(out))
+    for key in ("configuration", "process_data", "violations"):
+        assert reports[0][key] == reports[1][key], key
+    assert [(e["id_code"], e["data_bytes"]) for e in reports[1]["configuration"]] == [(3, 2), (2, 2)]
+
+
 @pytest.mark.parametrize(("argv", "expect"), [
     (["--vcd", "{tmp}/x.vcd"], "--vcd needs --fidelity pin (the transaction-level chip has no pins)"),
-    (["--fidelity", "pin", "--devices", "2"], "--devices must be 1 with --fidelity pin"),
+    (["--fidelity", "pin", "--devices", "5"], "--devices must be an integer from 1 to 4 (with --fidelity pin"),
     (["--fidelity", "pin", "--cycles", "51"], "--cycles must be an integer from 3 to 50 (with --fidelity pin"),
     (["--fidelity", "gate"], "invalid choice: 'gate'"),
     (["--mode", "spi"], "invalid choice: 'spi'"),

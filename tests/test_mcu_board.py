@@ -13,21 +13,34 @@ import re
 from pathlib import Path
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from supi3.interbus.ring import ErrorKind
 from supi3.mcu import board as mcu_board
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import Board
-from supi3.mcu.core import CPUS
+from supi3.mcu.core import CPUS, FirmwareStoppedError, Stop
 from supi3.model.registers import InconsistentDataError, InterfaceViolationError
 from supi3.sdk import native
 from supi3.sdk.bench import Bench
+from supi3.spi.upif import Mode
 from support import c_firmware
+from test_mcu_hostile import FILES
 
 pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
 
 WORDS = (0x0000, 0xFFFF, 0x1234, 0x8001, 0x00FF)
 """As tests/test_sdk_c_examples.py."""
+MODES = (Mode.MOTOROLA, Mode.INTEL)
+INTEL = {"FW_MODE": "SUPI3_MODE_INTEL"}
+"""The examples' build for the Intel interface (fw_board.h FW_MODE), on the board and on the host (MCU-18)."""
+
+
+def _example(name: str, folder: Path, cpu: str, mode: Mode) -> Path:
+    """The example ``name`` built for ``cpu`` and the interface ``mode``."""
+    return mcu_build.build(native.example(name), folder / f"{name}_{cpu}_{mode.name}.elf", cpu=cpu,
+                           defines=INTEL if mode is Mode.INTEL else None)  # fmt: skip
 
 
 @pytest.fixture(scope="module")
@@ -61,11 +74,12 @@ def _binary_exchange(board: Board, words: tuple[bytes, ...]) -> list[tuple[bytes
     return seen
 
 
-def _host_exchange(pytestconfig: pytest.Config, name: str, words: tuple[bytes, ...]) -> list[tuple[bytes, bytes]]:
+def _host_exchange(pytestconfig: pytest.Config, name: str, words: tuple[bytes, ...],
+                   mode: Mode = Mode.MOTOROLA) -> list[tuple[bytes, bytes]]:  # fmt: skip
     """The same steps with the same firmware built for the host, on the firmware bench."""
     assert pytestconfig.cache is not None
-    host = c_firmware(pytestconfig.cache, native.example(name))
-    bench = Bench(firmware=host)
+    host = c_firmware(pytestconfig.cache, native.example(name), defines=INTEL if mode is Mode.INTEL else None)
+    bench = Bench(firmware=host, mode=mode)
     bench.run(3)
     n = len(words[0])
     seen = []
@@ -78,40 +92,45 @@ def _host_exchange(pytestconfig: pytest.Config, name: str, words: tuple[bytes, .
     return seen
 
 
+@pytest.mark.parametrize("mode", MODES)
 @pytest.mark.parametrize("cpu", CPUS)
 def test_digital_io_binary_gives_the_host_builds_process_data(
-    pytestconfig: pytest.Config, digital_io: dict[str, Path], cpu: str
+    pytestconfig: pytest.Config, digital_io: dict[str, Path], tmp_path: Path, cpu: str, mode: Mode
 ) -> None:
     """SET 83h, ID 03h, then OUT0/OUT1 read and IN0/IN1 written in the EXTI0 handler after each VALID event: the
-    master's configuration and the data both ways are those of the same firmware compiled for the host."""
-    board = Board(digital_io[cpu], cpu=cpu)
+    master's configuration and the data both ways are those of the same firmware compiled for the host; in either
+    interface mode (the Intel build on the Intel board, MCU-18)."""
+    elf = digital_io[cpu] if mode is Mode.MOTOROLA else _example("digital_io", tmp_path, cpu, mode)
+    board = Board(elf, cpu=cpu, mode=mode)
     board.run(3)
     config = board.bench.master.config
     assert config is not None and (config[0].id_code, config[0].data_bytes) == (0x03, 2)
     words = tuple(w.to_bytes(2, "big") for w in WORDS)
     seen = _binary_exchange(board, words)
-    assert seen == _host_exchange(pytestconfig, "digital_io", words)
+    assert seen == _host_exchange(pytestconfig, "digital_io", words, mode)
     assert seen == list(zip(words, reversed(words), strict=True))
-    assert board.fw_board is not None and board.fw_board.error == 0
+    assert board.fw_board is not None and board.fw_board.error == 0 and board.protocol.mode is mode
     assert board.fw_board.cycles == board.interrupts > 0  # one VALID event per data cycle, each served
     assert board.violations == []
 
 
+@pytest.mark.parametrize("mode", MODES)
 @pytest.mark.parametrize("cpu", CPUS)
 @pytest.mark.parametrize(
     ("name", "size", "interrupts"),
     [("polling_io", 2, False), ("analog_io", 4, True), ("irq_dispatch", 2, True), ("pcmd_alarm", 2, True)],
 )
 def test_more_example_binaries_give_the_host_builds_process_data(
-    pytestconfig: pytest.Config, tmp_path: Path, name: str, size: int, interrupts: bool, cpu: str
+    pytestconfig: pytest.Config, tmp_path: Path, name: str, size: int, interrupts: bool, cpu: str, mode: Mode
 ) -> None:
     """The polling example (fw_loop: the main loop polls the I/O pin), the block transfer (analog_io, 3.4.6), the
-    event dispatch and the processor command examples, on both cores."""
-    board = Board(mcu_build.build(native.example(name), tmp_path / f"{name}.elf", cpu=cpu), cpu=cpu)
+    event dispatch and the processor command examples, on both cores, in either interface mode (MCU-18: the Intel
+    build on the Intel board against the Intel host build)."""
+    board = Board(_example(name, tmp_path, cpu, mode), cpu=cpu, mode=mode)
     board.run(3)
     words = (bytes(range(1, size + 1)), bytes(range(0xF0, 0xF0 + size)), bytes(size))
-    assert _binary_exchange(board, words) == _host_exchange(pytestconfig, name, words)
-    assert board.fw_board is not None and board.fw_board.error == 0
+    assert _binary_exchange(board, words) == _host_exchange(pytestconfig, name, words, mode)
+    assert board.fw_board is not None and board.fw_board.error == 0 and board.protocol.mode is mode
     assert (board.interrupts > 0) == interrupts
     assert board.violations == []
 
@@ -153,13 +172,14 @@ def test_raising_ss_before_the_byte_is_out_is_an_incomplete_frame(tmp_path: Path
     assert board.protocol.mode is None  # the initialization byte did not count
 
 
+@pytest.mark.parametrize("mode", MODES)
 @pytest.mark.parametrize("cpu", CPUS)
-def test_fault_report_binary_trips_until_quit_peripheral_error(tmp_path: Path, cpu: str) -> None:
+def test_fault_report_binary_trips_until_quit_peripheral_error(tmp_path: Path, cpu: str, mode: Mode) -> None:
     """fault_report.c as a binary, the steps of its host test (tests/test_sdk_c_examples.py): /StatErr (PA8) low
     for the filter time -> 0BB1h at the master, outputs off until a Quit Peripheral Error after the fault has gone;
-    the /ModAck pulse reaches the firmware through EXTI line 1's pending bit (PB1, 3.6.2)."""
-    elf = mcu_build.build(native.example("fault_report"), tmp_path / "fault_report.elf", cpu=cpu)
-    board = Board(elf, cpu=cpu, cycle_time_s=1e-3)
+    the /ModAck pulse reaches the firmware through EXTI line 1's pending bit (PB1, 3.6.2); in either interface
+    mode."""
+    board = Board(_example("fault_report", tmp_path, cpu, mode), cpu=cpu, cycle_time_s=1e-3, mode=mode)
     fw, chip, master = board.fw_board, board.bench.chip, board.bench.master
     assert fw is not None
     board.run(3)
@@ -179,7 +199,7 @@ def test_fault_report_binary_trips_until_quit_peripheral_error(tmp_path: Path, c
     master.quit_peripheral_error(1)
     board.run_for(0.01)
     assert not chip.pf and fw.outputs[:2] == b"\x81\x18"
-    assert fw.error == 0 and board.violations == []
+    assert fw.error == 0 and board.violations == [] and board.protocol.mode is mode
 
 
 @pytest.mark.parametrize("cpu", CPUS)
@@ -267,3 +287,93 @@ def test_the_bench_cases_keep_their_fingerprint(digital_io: dict[str, Path], tmp
     violations = [(round(v.time_s * 1e9), v.function) for v in board.violations]
     assert (board.core.cycles, board.core.instructions, board.interrupts, violations) == FINGERPRINTS[bit_rate]
     assert (board.fw_board.outputs, board.bench.master.inputs(1)) == (b"\x12\x34\0\0", b"\xab\xcd")
+
+
+
+IDLE_TICK = Path(__file__).parent / "mcu" / "idle_tick.S"
+"""SysTick every 100 µs waking a thread-mode ``b .``: nine instructions to it, five in the handler."""
+
+
+@pytest.fixture(scope="module")
+def idle_tick(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """idle_tick.S (Thumb-1) as it is (``tick``), with SysTick on Default_Handler's ``b .`` (``hang``), and
+    test_mcu_hostile's ``loop.elf`` (``loop``: ``b .`` at the reset vector, nothing else)."""
+    folder = tmp_path_factory.mktemp("idle")
+    (folder / "loop.elf").write_bytes(FILES["loop.elf"])
+    return {"loop": folder / "loop.elf", **{
+        name: mcu_build.build(IDLE_TICK, folder / f"{name}.elf", cpu="cortex_m0", port=False,
+                              defines={"HANG": "1"} if name == "hang" else None) for name in ("tick", "hang")}}
+
+
+FIDELITIES = ["transaction", "pin"]
+
+
+@pytest.mark.parametrize("fidelity", FIDELITIES)
+@pytest.mark.parametrize("budget", [1, 2, 1000, 10**7])
+def test_a_thread_mode_b_dot_is_a_wait_from_its_first_iteration_at_any_budget(
+    idle_tick: dict[str, Path], fidelity: str, budget: int
+) -> None:
+    """MCU-4: the core stops at its first ``b .`` whatever the run's deadline, and sleeps; a sleeping core spends
+    none of the budget. Round 4 ran the loop up to the next bus event or the budget's end at transaction level (334
+    iterations for a budget of 1000), for 1 µs at pin level (16), and a budget of 1 stopped the run: the verdict and
+    the count now are the same at both fidelities and any budget."""
+    board = Board(idle_tick["loop"], fidelity=fidelity)
+    for _ in range(2):
+        board.run(1, max_instructions=budget)
+        assert board.core.sleeping and board.core.instructions == 1 and board.cycles > 0
+
+
+@pytest.mark.parametrize("fidelity", FIDELITIES)
+def test_an_interrupt_returning_to_b_dot_sleeps_at_once(idle_tick: dict[str, Path], fidelity: str) -> None:
+    """Each SysTick wake runs the handler's five instructions; its return to the ``b .`` sleeps without running it:
+    the instructions are the set-up's nine, one iteration, and five a wake, at both fidelities."""
+    board = Board(idle_tick["tick"], cpu="cortex_m0", fidelity=fidelity)
+    board.run(1)
+    ticks = int.from_bytes(board.core.read_bytes(board.core.image.address("ticks"), 4), "little")
+    assert ticks == board.core.cycles // 4800 > 0
+    assert board.core.sleeping and board.core.instructions == 9 + 1 + 5 * ticks
+
+
+@pytest.mark.parametrize("fidelity", FIDELITIES)
+def test_b_dot_in_a_handler_is_a_hang_at_its_first_iteration(idle_tick: dict[str, Path], fidelity: str) -> None:
+    """SysTick's vector on Default_Handler (``b .``): the first wake stops the run with a hang report at the loop,
+    after the set-up, its ``b .`` and the handler's one iteration, at both fidelities (MCU-4)."""
+    board = Board(idle_tick["hang"], cpu="cortex_m0", fidelity=fidelity)
+    with pytest.raises(FirmwareStoppedError, match=r"endless loop \(b \.\) in the handler of exception 15") as caught:
+        board.run(1)
+    report = caught.value.report
+    assert (report.stop, report.symbol, report.instructions) == (Stop.HANG, "Default_Handler", 11)
+    assert 4800 < board.core.cycles - CPUS["cortex_m0"].entry_cycles - 3 < 4800 + 20  # the first wrap: its iteration
+
+
+BUDGETS = [1, 7, 100, 2000, 10**6]
+"""Instruction budgets from below the set-up to far above a run's instructions."""
+
+
+@settings(max_examples=20, derandomize=True, deadline=None)
+@given(calls=st.lists(st.tuples(st.booleans(), st.integers(0, 3), st.sampled_from(BUDGETS)), min_size=1, max_size=6))
+def test_any_history_of_runs_keeps_the_wait_out_of_the_budget(idle_tick: dict[str, Path],
+                                                              calls: list[tuple[bool, int, int]]) -> None:  # fmt: skip
+    """MCU-4 over histories: any sequence of ``run(n)`` and ``run_for(n x 100 µs)`` calls, each with its own budget,
+    on the SysTick-woken ``b .``: after each the instructions are the set-up's nine, one iteration and five a wake
+    (the handler is one block: run whole, or not yet entered), never more, the core asleep or about to run the
+    handler; a call ends in a budget stop only if it ran at least its budget."""
+    board = Board(idle_tick["tick"], cpu="cortex_m0")
+    ticks_at = board.core.image.address("ticks")
+    for by_time, amount, budget in calls:
+        before = board.core.instructions
+        stopped: FirmwareStoppedError | None = None
+        try:
+            if by_time:
+                board.run_for(amount * 100e-6, max_instructions=budget)
+            else:
+                board.run(amount, max_instructions=budget)
+        except FirmwareStoppedError as error:
+            stopped = error
+        if stopped is not None:
+            assert stopped.report.stop is Stop.BUDGET and board.core.instructions - before >= budget
+            return
+        ticks = int.from_bytes(board.core.read_bytes(ticks_at, 4), "little")
+        core = board.core
+        if core.instructions:  # (a first run(0) or run_for(0) runs nothing) the handler is one block: whole or not yet
+            assert core.instructions == 9 + 1 + 5 * ticks and (core.sleeping or core.in_exception)

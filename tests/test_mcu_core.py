@@ -12,6 +12,7 @@ import struct
 from pathlib import Path
 
 import pytest
+from unicorn import unicorn_const as ucc
 
 from supi3.errors import ArgumentError
 from supi3.mcu import build as mcu_build
@@ -182,15 +183,59 @@ def test_a_bus_fault_ends_the_run_with_the_hard_fault_frame(faults_elf: Path) ->
     assert report.stacked["xpsr"] & 0x1FF == 0  # it ran in thread mode
     assert board.core.active == [3]  # HardFault taken as the core would, then stopped
     assert "stacked r0=" in str(caught.value)
-    assert report.fault_status == {"CFSR": 1 << 9, "HFSR": 1 << 30}  # BFSR.PRECISERR, escalated (B3.2.15, B3.2.16)
-    assert str(caught.value).endswith("; CFSR=00000200h HFSR=40000000h")
-    assert board.core._scs_read(0xD28, 4) == 1 << 9  # what the HardFault handler reads
-    board.core._scs_write(0xD28, 4, 1 << 9)  # write 1 to clear
+    # BFSR.PRECISERR and BFARVALID, BFAR the address, escalated (B3.2.15, B3.2.16, B3.2.18)
+    assert report.fault_status == {"CFSR": 1 << 9 | 1 << 15, "HFSR": 1 << 30, "BFAR": 0x3000_0000}
+    assert str(caught.value).endswith("; CFSR=00008200h HFSR=40000000h BFAR=30000000h")
+    assert board.core._scs_read(0xD28, 4) == 1 << 9 | 1 << 15  # what the HardFault handler reads
+    board.core._scs_write(0xD28, 4, 1 << 9 | 1 << 15)  # write 1 to clear
     assert board.core._scs_read(0xD28, 4) == 0
     line = _line_of(PROGRAMS / "faults.c", "REG32(0x30000000u)")
     assert report.source is not None and (report.source.file, report.source.line) == ("faults.c", line)
     assert f"(fw_loop) faults.c:{line}" in str(caught.value)
     assert [frame.function for frame in report.backtrace] == ["fw_loop", "main", "Reset_Handler"]  # .debug_frame
+
+
+FAULT_ADDRESSES = {
+    1: ("precise bus fault: read of unmapped memory", 1 << 9 | 1 << 15, {"BFAR": 0x3000_0004}),
+    2: ("precise bus fault: write to unmapped memory", 1 << 9 | 1 << 15, {"BFAR": 0x6000_0010}),
+    3: ("instruction bus fault: fetch from unmapped memory", 1 << 8, {}),
+    4: ("memory fault: execute from a peripheral region at 40010800h (Execute Never)", 1 << 0, {}),
+    5: ("memory fault: write to read-only memory", 1 << 1 | 1 << 7, {"MMFAR": 0x0800_0100}),
+}
+"""tests/mcu/fault_address.S's scenarios: the reason, CFSR (B3.2.15: PRECISERR 9 and BFARVALID 15, IBUSERR 8,
+IACCVIOL 0, DACCVIOL 1 and MMARVALID 7) and the address registers loaded."""
+
+
+@pytest.mark.parametrize("cpu", CPUS)
+@pytest.mark.parametrize("scenario", list(FAULT_ADDRESSES))
+def test_a_data_fault_loads_bfar_or_mmfar_with_its_valid_bit(tmp_path: Path, scenario: int, cpu: str) -> None:
+    """MCU-3: a precise data bus fault loads BFAR with the address and sets BFARVALID (B3.2.18), a data access
+    violation MMFAR and MMARVALID (B3.2.17); an instruction fetch fault (IBUSERR, IACCVIOL: a fetch from a peripheral
+    region, Execute Never in the default memory map, B3.1) loads neither. The report shows them after CFSR and HFSR,
+    and the HardFault handler would read them in the SCS; the Cortex-M0 (ARMv6-M) has none of these registers. The
+    board maps flash writable and has no MPU, so scenario 5 makes flash read-only through unicorn first: no firmware
+    on this board can raise a DACCVIOL."""
+    elf = mcu_build.build(PROGRAMS / "fault_address.S", tmp_path / "fa.elf", cpu="cortex_m0", port=False,
+                          defines={"SCENARIO": str(scenario)})  # fmt: skip
+    board = Board(elf, cpu=cpu)
+    if scenario == 5:
+        board.core.uc.mem_protect(*board.core.flash, ucc.UC_PROT_READ | ucc.UC_PROT_EXEC)
+    with pytest.raises(FirmwareFaultError) as caught:
+        board.run(1)
+    reason, cfsr, loaded = FAULT_ADDRESSES[scenario]
+    report = caught.value.report
+    assert reason in report.reason and board.core.active == [3]
+    assert report.stacked is not None and report.stacked["r0"] == 5
+    if cpu == "cortex_m0":
+        assert report.fault_status is None
+        return
+    assert report.fault_status == {"CFSR": cfsr, "HFSR": 1 << 30, **loaded}
+    assert str(caught.value).endswith(" ".join(f"{name}={value:08X}h" for name, value in report.fault_status.items()))
+    for name, offset in (("MMFAR", 0xD34), ("BFAR", 0xD38)):
+        if name in loaded:
+            assert board.core._scs_read(offset, 4) == loaded[name]
+    if scenario < 3:
+        assert report.pc == board.core.image.address("faulting")  # precise: the faulting load or store
 
 
 def test_a_report_without_the_elf_names_no_line(faults_elf: Path, tmp_path: Path) -> None:

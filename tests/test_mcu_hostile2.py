@@ -21,6 +21,7 @@ from hypothesis import strategies as st
 
 from supi3.cli import main
 from supi3.errors import ArgumentError
+from supi3.interbus.device import PlainDevice
 from supi3.mcu.board import Board, BoardError
 from supi3.mcu.core import CortexM
 from supi3.mcu.pins import mcu_lines
@@ -73,6 +74,12 @@ CASES: list[Case] = [
         ("record", 1), ("record", None)]),
     ("Board(record=True) at transaction level", lambda d: Board(d / "loop.elf", record=True), "record"),
     ("Board(pin, others=[x])", lambda d: Board(d / "loop.elf", fidelity="pin", others=bad([object()])), "others"),
+    ("Board(pin, others=[PlainDevice])",
+     lambda d: Board(d / "loop.elf", fidelity="pin", others=bad([PlainDevice(2, 1)])), "others"),
+    ("Board(pin, others='ab')", lambda d: Board(d / "loop.elf", fidelity="pin", others=bad("ab")), "others"),
+    *((f"Board({f}, stat_err_filter={v!r})",
+       lambda d, f=f, v=v: Board(d / "loop.elf", fidelity=f, stat_err_filter=bad(v)), "stat_err_filter")
+      for f, v in [("transaction", 32_000), ("pin", 0), ("pin", 6_400_001), ("pin", 1.5), ("pin", "1")]),
     ("Board(pin, cycle_time_s=-1)", lambda d: Board(d / "loop.elf", fidelity="pin", cycle_time_s=-1.0),
      "cycle_time_s"),
     ("Board(pin, strict=1)", lambda d: Board(d / "loop.elf", fidelity="pin", strict=bad(1)), "strict"),
@@ -82,7 +89,7 @@ CASES: list[Case] = [
     *((f"mcu_lines({v!r})", lambda _d, v=v: mcu_lines(bad(v)), "traces") for v in [{}, {"mfp_out": 0}, None, "x"]),
     ("mcu_lines(intel=1)", lambda _d: mcu_lines({k: np.zeros(2, np.int64) for k in TRACES}, intel=bad(1)), "intel"),
     ("run_firmware(vcd=) at transaction level", lambda d: run_firmware(d / "loop.elf", vcd=d / "x.vcd"), "vcd"),
-    ("run_firmware(pin, devices=2)", lambda d: run_firmware(d / "loop.elf", fidelity="pin", devices=2), "devices"),
+    ("run_firmware(pin, devices=5)", lambda d: run_firmware(d / "loop.elf", fidelity="pin", devices=5), "devices"),
 ]
 
 
@@ -139,8 +146,8 @@ def test_the_budget_ends_a_runaway_with_a_report(files: Path, budget: int, fidel
 # -- supi3 firmware run ---------------------------------------------------------------------------------------------
 
 CLI_BAD: list[tuple[list[str], str]] = [
-    (["--fidelity", "pin", "--devices", "2"], "--devices must be 1 with --fidelity pin"),
-    (["--fidelity", "pin", "--devices", "0"], "--devices must be 1 with --fidelity pin"),
+    (["--fidelity", "pin", "--devices", "5"], "--devices must be an integer from 1 to 4 (with --fidelity pin"),
+    (["--fidelity", "pin", "--devices", "0"], "--devices must be an integer from 1 to 4 (with --fidelity pin"),
     (["--fidelity", "pin", "--cycles", "2"], "--cycles must be an integer from 3 to 50"),
     (["--fidelity", "pin", "--cycles", "51"], "--cycles must be an integer from 3 to 50"),
     (["--fidelity", "PIN"], "argument --fidelity: invalid choice"),

@@ -13,20 +13,25 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from supi3.config import decode
 from supi3.errors import ArgumentError
 from supi3.interbus.device import PlainDevice
+from supi3.interbus.ring import ErrorKind
 from supi3.mcu import board as mcu_board
 from supi3.mcu import build as mcu_build
 from supi3.mcu import pins as mcu_pins
 from supi3.mcu.board import Board, BoardError
 from supi3.mcu.core import CPUS
 from supi3.mcu.pins import MISO_PULL_UP, Cause, LockstepRing, mcu_lines
-from supi3.mcu.session import run_firmware
+from supi3.mcu.session import RING_DEVICE, RING_DEVICE_STRAPS, run_firmware
 from supi3.mcu.stm32 import CR1_CPHA, CR1_CPOL, CR1_LSBFIRST
+from supi3.model.chip import Supi3
+from supi3.model.pins import Supi3Pins
 from supi3.model.registers import InterfaceViolationError
 from supi3.sdk import native
 from supi3.sdk.bench import default_config
 from supi3.spi.upif import Mode
+from supi3.tables import clk_conf_for
 from supi3.top import Supi3Chip
 
 pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
@@ -111,6 +116,141 @@ def test_digital_io_gives_the_same_process_data_on_both_fidelities(
     assert seen["pin"] == seen["transaction"] == list(zip(WORDS, reversed(WORDS), strict=True))
 
 
+def test_the_intel_block_transfer_gives_the_same_process_data_on_both_fidelities(tmp_path: Path) -> None:
+    """analog_io (the 4-byte block transfer, 3.4.6) built for the Intel interface on the Intel board (MCU-18): the
+    pin-level chip, S/R from PB0 on MFP7 and Ser_IN/OUT half duplex, gives the process data of the transaction-level
+    run (which is the Intel host build's, tests/test_mcu_board.py), with no Table 3-7 rule broken (t10/t11 on S/R
+    included). A master cycle every 1 ms: the Intel handler clocks more frames than the Motorola one (about 145 µs
+    against 85 µs at 500 kbit/s), and with a cycle every 400 µs it ends after the next data frame began, so the
+    pin-level chip, which loads IN when a frame begins, sends its IN data a cycle later (docs/model.md M10, MCU-17)."""
+    elf = mcu_build.build(native.example("analog_io"), tmp_path / "analog_intel.elf",
+                          defines={"FW_MODE": "SUPI3_MODE_INTEL"})  # fmt: skip
+    words = (bytes(range(1, 5)), bytes(range(0xF0, 0xF4)))
+    seen = {}
+    for fidelity in ("transaction", "pin"):
+        board = Board(elf, cycle_time_s=1e-3, fidelity=fidelity, mode=Mode.INTEL)
+        board.run(3)
+        fw = board.fw_board
+        assert fw is not None
+        steps = []
+        for out_data, in_data in zip(words, reversed(words), strict=True):
+            board.master.set_outputs(1, out_data)
+            fw.inputs = in_data
+            board.run(2)
+            steps.append((fw.outputs, board.master.inputs(1)))
+        seen[fidelity] = steps
+        assert board.violations == [] and fw.error == 0 and board.protocol.mode is Mode.INTEL
+    assert seen["pin"] == seen["transaction"] == list(zip(words, reversed(words), strict=True))
+
+
+def test_run_for_gives_the_transaction_levels_cycles_time_and_data(digital_io: Path) -> None:
+    """``run_for`` at pin level (MCU-22): with a master cycle every 400 µs, 1.6 ms and then 0.8 ms of bus time run
+    the cycles that start in them and idle the line to the end, as at transaction level: the same bus time (to
+    half a status telegram, 5 µs at 500 kbit/s; the line's telegrams do not drift from the cycle time's schedule),
+    the same master cycles, EXTI0 handler entries and data cycles of the firmware, and the same process data; a
+    zero time runs nothing. A cycle running past the end ends the call at its end: the pin-level master cannot stop
+    inside a cycle."""
+    seen = {}
+    for fidelity in ("transaction", "pin"):
+        board = Board(digital_io, cycle_time_s=400e-6, fidelity=fidelity)
+        board.run(3)
+        fw = board.fw_board
+        assert fw is not None
+        steps = []
+        words = zip(WORDS, reversed(WORDS), strict=True)
+        for seconds, (out_data, in_data) in zip((1.6e-3, 0.8e-3), words, strict=True):
+            board.master.set_outputs(1, out_data)
+            fw.inputs = in_data
+            before = (board.now, board.cycles, board.interrupts, fw.cycles)
+            board.run_for(seconds)
+            assert board.now - before[0] == pytest.approx(seconds, abs=5e-6)
+            steps.append((board.cycles - before[1], board.interrupts - before[2], fw.cycles - before[3],
+                          fw.outputs, board.master.inputs(1)))  # fmt: skip
+        after = (board.now, board.cycles, board.core.instructions)
+        board.run_for(0.0)
+        assert (board.now, board.cycles, board.core.instructions) == after
+        assert board.violations == [] and fw.error == 0
+        seen[fidelity] = steps
+    assert seen["pin"] == seen["transaction"]
+    assert [step[:3] for step in seen["pin"]] == [(4, 4, 4), (2, 2, 2)]
+    assert [step[3:] for step in seen["pin"]] == [(WORDS[0] + bytes(2), WORDS[1]), (WORDS[1] + bytes(2), WORDS[0])]
+    board = Board(digital_io, cycle_time_s=400e-6, fidelity="pin")
+    board.run(3)
+    start = board.now
+    board.run_for(50e-6)  # inside the next cycle: it runs whole (a data cycle of one device: 248 µs)
+    assert (board.cycles, 240e-6 < board.now - start < 260e-6) == (4, True)
+
+
+@pytest.mark.slow  # one device behind the chip: three times the chip's CPU time (MCU-23)
+@pytest.mark.parametrize("mode", list(Mode))
+def test_a_device_behind_the_chip_at_pin_level_gives_the_transaction_levels_ring(
+    digital_io: Path, tmp_path: Path, mode: Mode
+) -> None:
+    """MCU-23: a pin-level SUPI 3 strapped RB 16 IN (session.RING_DEVICE_STRAPS: ID 02h, one word) behind the board's
+    chip, each piece of the chip's lockstep run carried on through it and back: the master's configuration table and
+    the process data both ways (the chip's, and the device's inputs at ring position 2) are those of the same ring
+    at transaction level, with no violation; the VCD holds the second chip's pins (scope dev2). On the Motorola and
+    the Intel board (MCU-18)."""
+    config = decode(*RING_DEVICE_STRAPS, clk_conf=clk_conf_for(500_000))
+    elf = digital_io if mode is Mode.MOTOROLA else mcu_build.build(
+        native.example("digital_io"), tmp_path / "intel.elf", defines={"FW_MODE": "SUPI3_MODE_INTEL"})
+    seen = {}
+    for fidelity in ("transaction", "pin"):
+        behind = Supi3Pins(config) if fidelity == "pin" else Supi3(config)
+        board = Board(elf, cycle_time_s=600e-6, fidelity=fidelity, others=[behind], record=fidelity == "pin",
+                      mode=mode)  # fmt: skip
+        board.run(3)
+        assert board.master.config is not None
+        table = [(e.id_code, e.length_code) for e in board.master.config]
+        board.master.set_outputs(1, WORDS[0])
+        assert board.fw_board is not None
+        board.fw_board.inputs = WORDS[1]
+        if isinstance(behind, Supi3):
+            behind.set_mfp_inputs(0xA55A)
+        else:
+            board.ring.set_input(2, "mfp_in", 0xA55A)
+        board.run(2)
+        assert board.violations == [] and board.protocol.mode is mode
+        seen[fidelity] = (table, board.fw_board.outputs[:2], board.master.inputs(1), board.master.inputs(2))
+    assert seen["pin"] == seen["transaction"] == ([(0x03, 0b00001), RING_DEVICE], WORDS[0], WORDS[1], b"\xa5\x5a")
+    assert "$scope module dev2" in board.write_vcd(tmp_path / "ring.vcd").read_text()
+
+
+def test_fault_report_trips_and_quits_at_pin_level_with_a_short_stat_err_filter(tmp_path: Path) -> None:
+    """fault_report.c at pin level, the steps of tests/test_mcu_board.py's transaction-level test, with the chip's
+    /StatErr filter shortened from 200 ms to 1 ms (``stat_err_filter``, MCU-24; the filter's logic is the chip's
+    own, only its constant differs): PA8 drives /StatErr, the fault is latched once it has been low for the filter
+    time and not before, 0BB1h reaches the master; the Quit Peripheral Error's /ModAck pulse (375 ns on the chip's
+    pin, 3.6.2) sets EXTI line 1's pending bit, which the firmware reads: while the fault lasts nothing changes,
+    after it went the chip clears PF and the firmware drives its outputs again."""
+    elf = mcu_build.build(native.example("fault_report"), tmp_path / "fault_report.elf")
+    board = Board(elf, fidelity="pin", stat_err_filter=32_000)  # 1 ms at 32 MHz
+    fw, chip, master = board.fw_board, board.chip.chip, board.master
+    assert fw is not None
+    board.run(3)
+    master.set_outputs(1, b"\x81\x18")
+    board.run(3)
+    assert fw.outputs[:2] == b"\x81\x18" and board.ring.inputs["stat_err_n"] == 1
+    fw.fault = 1
+    board.run_for(0.6e-3)  # /StatErr low since the first handler of these cycles: under the filter time
+    assert not chip.module_error and not chip.pf and fw.outputs[:2] == b"\x00\x00"
+    assert board.ring.inputs["stat_err_n"] == 0  # PA8 low on the chip's pin
+    board.run_for(0.9e-3)
+    assert chip.module_error and chip.pf and fw.outputs[:2] == b"\x00\x00"
+    assert [d.kind for d in master.diagnostics] == [ErrorKind.PERIPHERAL_FAULT]
+    acks = chip.events["MODACK"]
+    master.quit_peripheral_error(1)  # while the fault lasts: nothing changes
+    board.run(2)
+    assert chip.events["MODACK"] == acks + 1 and chip.pf and fw.outputs[:2] == b"\x00\x00"
+    fw.fault = 0
+    board.run(2)
+    assert not chip.module_error and chip.pf and fw.outputs[:2] == b"\x00\x00"
+    master.quit_peripheral_error(1)
+    board.run(3)
+    assert not chip.pf and fw.outputs[:2] == b"\x81\x18"
+    assert fw.error == 0 and board.violations == []
+
+
 def test_a_too_fast_sclk_is_found_by_the_pin_level_chip_with_the_source_line(tmp_path: Path) -> None:
     """BOARD_SPI_BR = 3: a 16-clock SCLK period (333 ns, at the chip's 32 MHz 11 clocks) is shorter than Table 3-7's
     t0 = 667 ns at 500 kbit/s: the chip's own timing check finds it at the first byte's second rising edge, and the
@@ -165,7 +305,7 @@ def test_the_board_refuses_what_its_fidelity_has_not(digital_io: Path, tmp_path:
     a record or a VCD at transaction level, and the session's VCD or ring without the pin level."""
     with pytest.raises(ArgumentError, match=r"fidelity must be one of 'transaction', 'pin', not 'gate'"):
         Board(digital_io, fidelity="gate")
-    with pytest.raises(ArgumentError, match=r"others must be empty at pin level"):
+    with pytest.raises(ArgumentError, match=r"others must be pin-level chips at pin level \(Supi3Pins"):
         Board(digital_io, fidelity="pin", others=[PlainDevice(0x02, 1)])
     with pytest.raises(ArgumentError, match=r"record must be False at transaction level"):
         Board(digital_io, record=True)
@@ -177,8 +317,8 @@ def test_the_board_refuses_what_its_fidelity_has_not(digital_io: Path, tmp_path:
         Board(digital_io).write_vcd(tmp_path / "x.vcd")
     with pytest.raises(ArgumentError, match=r"vcd must be None at transaction level"):
         run_firmware(digital_io, vcd=tmp_path / "x.vcd")
-    with pytest.raises(ArgumentError, match=r"devices must be an integer from 1 to 1 \(the chip alone in the ring"):
-        run_firmware(digital_io, fidelity="pin", devices=2)
+    with pytest.raises(ArgumentError, match=r"devices must be an integer from 1 to 4 \(at pin level, MCU-23"):
+        run_firmware(digital_io, fidelity="pin", devices=5)
     assert not (tmp_path / "x.vcd").exists()
 
 

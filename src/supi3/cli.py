@@ -596,7 +596,7 @@ def _firmware_extra() -> None:
 def cmd_firmware_run(args: argparse.Namespace) -> None:
     """Run a firmware ELF on the emulated board against the chip and report (docs/firmware-in-the-loop.md)."""
     _firmware_extra()
-    from supi3.mcu.session import run_firmware
+    from supi3.mcu.session import MAX_PIN_DEVICES, run_firmware
     from supi3.spi.upif import Mode
 
     if not Path(args.firmware).is_file():
@@ -605,13 +605,11 @@ def cmd_firmware_run(args: argparse.Namespace) -> None:
     pin = args.fidelity == "pin"
     if args.vcd is not None and not pin:
         raise CommandLineError("--vcd needs --fidelity pin (the transaction-level chip has no pins)")
-    if pin and args.devices != 1:
-        raise CommandLineError(f"--devices must be 1 with --fidelity pin (the chip alone in the ring), not "
-                               f"{args.devices}")  # fmt: skip
     check_int("--cycles", args.cycles, 3, MAX_PIN_FIRMWARE_CYCLES if pin else MAX_FIRMWARE_CYCLES,
               "with --fidelity pin: every chip clock is stepped" if pin else "")  # fmt: skip
     check_int("--cpu-hz", args.cpu_hz, 1_000_000, 1_000_000_000)
-    check_int("--devices", args.devices, 1, 64)
+    check_int("--devices", args.devices, 1, MAX_PIN_DEVICES if pin else 64,
+              "with --fidelity pin: each further chip is stepped with it" if pin else "")  # fmt: skip
     check_int("--max-instructions", args.max_instructions, 1000, 10**10)
     mfp = args.mfp if args.mfp is not None or args.c != DEFAULT_STRAPS[0] else DEFAULT_STRAPS[1]
     vcd = None if args.vcd is None else output_file("--vcd", args.vcd)  # before the run, not after it
@@ -803,7 +801,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "the default C[4..0], else unset)")  # fmt: skip
     p.add_argument("--bit-rate", default="500k", help="500k or 2M")
     p.add_argument("--devices", type=integer, default=1, metavar="N",
-                   help="devices in the ring, the chip first, 1 to 64 (default 1)")
+                   help="devices in the ring, the chip first, 1 to 64, fewer with --fidelity pin (default 1)")
     p.add_argument("--cycles", type=integer, default=10, metavar="N",
                    help=f"master cycles in all, 3 to {MAX_FIRMWARE_CYCLES} (default 10)")
     p.add_argument("--max-instructions", type=integer, default=20_000_000, metavar="N",

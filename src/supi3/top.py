@@ -24,7 +24,7 @@ import numpy.typing as npt
 from supi3 import pinout
 from supi3.checks import check_bits, check_bool, check_instance, check_int, check_trace, fail
 from supi3.config import DeviceConfig
-from supi3.model.chip import Supi3
+from supi3.model.chip import STATERR_FILTER_CLOCKS, Supi3
 from supi3.model.pins import PinTrace, Supi3Pins, split_optical_traces
 from supi3.model.registers import RegisterFile
 from supi3.pinlevel import OE_SUFFIX, Pin
@@ -82,6 +82,8 @@ class Supi3Chip:
         (``True``) or are recorded in ``registers.violations`` (``False``).
     pedantic:
         Also report suspicious µP accesses (:class:`~supi3.model.chip.Supi3`).
+    stat_err_filter:
+        The /StatErr filter in clocks (:class:`~supi3.model.chip.Supi3`: 200 ms by default, shorter only in tests).
 
     Attributes
     ----------
@@ -104,10 +106,11 @@ class Supi3Chip:
     inputs: Sequence[Pin] = Supi3Pins.inputs
     outputs: Sequence[Pin] = Supi3Pins.outputs
 
-    def __init__(self, config: DeviceConfig, *, strict: bool = True, pedantic: bool = False) -> None:
+    def __init__(self, config: DeviceConfig, *, strict: bool = True, pedantic: bool = False,
+                 stat_err_filter: int = STATERR_FILTER_CLOCKS) -> None:  # fmt: skip
         check_instance("config", config, DeviceConfig)
         check_bool("strict", strict)
-        self.core = Supi3Pins(config, Supi3(config, strict=strict, pedantic=pedantic))
+        self.core = Supi3Pins(config, Supi3(config, strict=strict, pedantic=pedantic, stat_err_filter=stat_err_filter))
         registers = self.core.chip.registers
         self.upif = SlavePins(registers) if registers is not None else None
         self._up_cycle = 0  # the cycle the µP interface clocks (UP-19: violations name it)

@@ -19,12 +19,13 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
-from typing import Final, TypeVar
+from typing import Final, TypeVar, cast
 
 from supi3 import timing
 from supi3.checks import check_bool, check_bytes, check_choice, check_instance, check_int, check_real, fail
 from supi3.config import DeviceConfig
 from supi3.errors import Supi3Error
+from supi3.interbus import wire
 from supi3.interbus.link import Device
 from supi3.interbus.master import Master
 from supi3.mcu.core import EXTERNAL, CortexM, FirmwareImage, FirmwareStoppedError, Frame, SourceLine, Stop
@@ -48,6 +49,8 @@ from supi3.mcu.stm32 import (
     Rcc,
     Spi,
 )
+from supi3.model.chip import STATERR_FILTER_CLOCKS
+from supi3.model.pinring import PinBranch, PinChip
 from supi3.model.registers import InterfaceViolationError
 from supi3.model.vcd import write_vcd
 from supi3.pinout import C_D_COMMAND
@@ -240,10 +243,13 @@ class Board:
     fidelity:
         ``"transaction"`` (default): the transaction-level bench, the board checking Table 3-7 on SPI1's transfers;
         ``"pin"``: the pin-level whole chip in lockstep with the core (:mod:`supi3.mcu.pins`), SPI1 and the GPIO
-        pins driving its MFP pins at chip clocks, Table 3-7 checked by the chip itself; the chip alone in the ring
-        (``others`` empty, MCU-17).
+        pins driving its MFP pins at chip clocks, Table 3-7 checked by the chip itself; ``others`` then are pin-level
+        chips behind it (``Supi3Pins`` or ``Supi3Chip`` objects, ``PinBranch`` trees, MCU-23).
     record:
         Pin level only: keep every pin for :meth:`write_vcd`.
+    stat_err_filter:
+        Pin level only: the chip's /StatErr filter in clocks (3.6.2: t3 = 200 ms, the default); shorter only to test
+        a peripheral fault (``fault_report``) in a few milliseconds of bus time (MCU-24).
     mode:
         The board's wiring for the interface type the firmware initializes (Table 3-8): ``Mode.MOTOROLA`` (MISO on
         SerOUT, MFP7) or ``Mode.INTEL`` (MCU-18: MISO on Ser_IN/OUT, MFP6, MOSI on it through a resistor, S/R from
@@ -268,9 +274,11 @@ class Board:
     """
 
     def __init__(self, firmware: str | Path | FirmwareImage, *, cpu: str = "cortex_m3", cpu_hz: float = 48e6,
-                 config: DeviceConfig | None = None, bit_rate: int = 500_000, others: Sequence[Device] = (),
+                 config: DeviceConfig | None = None, bit_rate: int = 500_000,
+                 others: Sequence[Device | PinChip | PinBranch] = (),
                  cycle_time_s: float | None = None, strict: bool = True, pedantic: bool = False,
-                 fidelity: str = "transaction", record: bool = False, mode: Mode = Mode.MOTOROLA) -> None:  # fmt: skip
+                 fidelity: str = "transaction", record: bool = False, mode: Mode = Mode.MOTOROLA,
+                 stat_err_filter: int = STATERR_FILTER_CLOCKS) -> None:  # fmt: skip
         self.fidelity = check_choice("fidelity", fidelity, FIDELITIES)
         self.intel = check_instance("mode", mode, Mode) is Mode.INTEL
         self._s_r = 1  # PB0: S/R, 1 = the µP sends
@@ -280,11 +288,16 @@ class Board:
         self._ring: LockstepRing | None = None
         self.protocol: UpifProtocol
         if fidelity == "pin":
-            self._pin_setup(config, bit_rate, others, cycle_time_s, strict, pedantic, record)
+            self._pin_setup(config, bit_rate, others, cycle_time_s, strict, pedantic, record, stat_err_filter)
         else:
             if record:
                 raise fail("record", "False at transaction level (the chip has no pins: fidelity='pin')", record)
-            self._bench = bench = _BoardBench(config, bit_rate=bit_rate, others=others, cycle_time_s=cycle_time_s,
+            if stat_err_filter != STATERR_FILTER_CLOCKS:
+                raise fail("stat_err_filter", f"{STATERR_FILTER_CLOCKS} (200 ms) at transaction level, which runs it "
+                           "in well under a second (a shorter filter is for the pin level's tests, MCU-24)",
+                           stat_err_filter)  # fmt: skip
+            devices = cast("Sequence[Device]", others)  # the ring names a device that is not one (ArgumentError)
+            self._bench = bench = _BoardBench(config, bit_rate=bit_rate, others=devices, cycle_time_s=cycle_time_s,
                                               strict=strict, pedantic=pedantic)  # fmt: skip
             self.registers = bench.registers
             self.protocol = bench.transport.protocol
@@ -324,25 +337,32 @@ class Board:
         self._limit = self._budget = 0
         self._held: list[tuple[str, int, int]] | None = None  # pin level: edges held while a sleeping core waits
 
-    def _pin_setup(self, config: DeviceConfig | None, bit_rate: int, others: Sequence[Device],
-                   cycle_time_s: float | None, strict: bool, pedantic: bool, record: bool) -> None:  # fmt: skip
+    def _pin_setup(self, config: DeviceConfig | None, bit_rate: int, others: Sequence[Device | PinChip | PinBranch],
+                   cycle_time_s: float | None, strict: bool, pedantic: bool, record: bool,
+                   stat_err_filter: int) -> None:  # fmt: skip
         """The pin-level chip, its ring and master (MCU-14 to MCU-17)."""
         self.config = default_config(bit_rate) if config is None else check_instance("config", config, DeviceConfig)
-        if others:
-            raise fail("others", "empty at pin level (the chip alone in the ring, MCU-17)", others)
+        if isinstance(others, str | bytes) or not isinstance(others, Sequence) \
+                or not all(isinstance(other, PinChip | PinBranch) for other in others):  # fmt: skip
+            raise fail("others", "pin-level chips at pin level (Supi3Pins or Supi3Chip objects, PinBranch trees: "
+                       "MCU-23)", others)  # fmt: skip
         self._cycle_time_s = None if cycle_time_s is None else check_real("cycle_time_s", cycle_time_s, 0.0)
         self.chip = chip = Supi3Chip(self.config, strict=check_bool("strict", strict),
-                                     pedantic=check_bool("pedantic", pedantic))  # fmt: skip
+                                     pedantic=check_bool("pedantic", pedantic), stat_err_filter=stat_err_filter)
         if chip.upif is None or chip.chip.registers is None:
             raise fail("config", "the straps of an Init-µP mode (Tables 2-4 to 2-7)", self.config.function)
         self.registers = chip.chip.registers
         self.protocol = chip.upif.protocol
-        self._ring = ring = LockstepRing(chip, self.core.cpu_hz, self._cause, record=record, intel=self.intel)
+        chips = cast("Sequence[PinChip | PinBranch]", others)  # checked above
+        self._ring = ring = LockstepRing(chip, self.core.cpu_hz, self._cause, record=record, intel=self.intel,
+                                         others=chips)  # fmt: skip
         ring.runner = self._lockstep
         ring.on_edge = self._pin_edge
         ring.on_violation = self._pin_violation
-        self._master = Master(ring, locate=False, max_devices=1)
+        self._master = Master(ring, locate=False, max_devices=len(ring.devices))
         self._cycles_done = 0
+        self._next_start = 0.0  # cycle_time_s: the bus time the next master cycle starts
+        self._telegram_s = wire.STATUS_TELEGRAM_BITS / self.config.bit_rate  # the line idles in whole telegrams
 
     # -- what both fidelities show -----------------------------------------------------------------------------
 
@@ -641,12 +661,17 @@ class Board:
         self._run(lambda: self.bench.cycles >= target and not self.core.in_exception, max_instructions)
 
     def run_for(self, seconds: float, *, max_instructions: int = DEFAULT_MAX_INSTRUCTIONS) -> None:
-        """Run the firmware for ``seconds`` of bus time (raises as :meth:`run`; at pin level to the end of the
-        master cycle running then)."""
-        end = self.core.cycles + self._cycles(check_real("seconds", seconds, 0.0))
-        if self._ring is not None:
-            self._run_pin(lambda: self.core.cycles >= end, max_instructions)
+        """Run the firmware for ``seconds`` of bus time (raises as :meth:`run`). At pin level (MCU-22) the master
+        cycles that start before the end run whole, then the line idles up to the end, to the nearest status
+        telegram; a cycle that runs past the end ends the call there, and the rest of a cycle time's idle is left
+        to the next call; the firmware's handler of the last cycle is not waited for (as at transaction level)."""
+        seconds = check_real("seconds", seconds, 0.0)
+        ring = self._ring
+        if ring is not None:
+            end_s = ring.now + seconds
+            self._run_pin(lambda: ring.now > end_s - self._telegram_s / 2, max_instructions, end_s)
             return
+        end = self.core.cycles + self._cycles(seconds)
         self._run(lambda: self.core.cycles >= end, max_instructions, end)
 
     def _run(self, done: Callable[[], bool], max_instructions: int, end: int | None = None) -> None:
@@ -673,7 +698,7 @@ class Board:
     def _step(self, deadline: int) -> None:
         """One run of the core up to ``deadline`` (at least one block), within the instruction budget."""
         core = self.core
-        if core.instructions >= self._limit:
+        if core.instructions >= self._limit and not core.sleeping:  # a sleeping core runs no instruction (MCU-4)
             raise FirmwareStoppedError(core.report(Stop.BUDGET, f"instruction budget of {self._budget} used up "
                                                    "(an endless loop?)"))  # fmt: skip
         if not core.sleeping:  # within the budget: an instruction costs a cycle at least (MCU-1)
@@ -700,11 +725,13 @@ class Board:
 
     # -- running at pin level ------------------------------------------------------------------------------------
 
-    def _run_pin(self, done: Callable[[], bool], max_instructions: int) -> None:
+    def _run_pin(self, done: Callable[[], bool], max_instructions: int, end_s: float | None = None) -> None:
         core, ring, master = self.core, self.ring, self._master
         self._set_budget(max_instructions)
         try:
             while not done():
+                if self._idle_to(end_s):  # the rest of the last cycle's time, left by run_for
+                    continue
                 start = ring.now
                 if self._cycles_done:
                     master.cycle()
@@ -714,8 +741,12 @@ class Board:
                         ring.status_telegram()
                     master.start()
                 self._cycles_done += 1
-                if self._cycle_time_s is not None:
-                    ring.idle(max(0.0, start + self._cycle_time_s - ring.now))
+                if self._cycle_time_s is not None:  # on its schedule: no drift from the line's whole telegrams
+                    on_time = abs(start - self._next_start) < self._telegram_s
+                    self._next_start = (self._next_start if on_time else start) + self._cycle_time_s
+                    self._idle_to(end_s)
+            if end_s is not None:
+                return
             for _ in range(SERVE_TELEGRAMS):
                 if not core.in_exception and self._irq_fell is None:
                     break
@@ -723,6 +754,15 @@ class Board:
         except InterfaceViolationError as error:
             self._place(error)
             raise
+
+    def _idle_to(self, end_s: float | None) -> bool:
+        """Idle status telegrams up to the next cycle's start (``cycle_time_s``), not past ``end_s``; whether any
+        (the line idles in whole telegrams: a wait under half of one is none)."""
+        until = self._next_start if end_s is None else min(self._next_start, end_s)
+        ring = self.ring
+        before = ring.cycle
+        ring.idle(max(0.0, until - ring.now))
+        return ring.cycle != before
 
     def _lockstep(self, clock: int) -> None:
         """:attr:`LockstepRing.runner`: run the firmware and the chip until the chip has clocked ``clock`` cycles

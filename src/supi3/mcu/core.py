@@ -48,7 +48,10 @@ UcError: type[Exception] = _UNICORN.UcError
 _LIB: Any = _UNICORN.unicorn_py3.unicorn.uclib
 """unicorn's C library as its binding loaded it (with the argument types it declares): the hot callbacks and
 register accesses go to it directly (MCU-19), without the binding's wrappers around each call."""
-# Callback type of unicorn.h (uc_cb_mmio_write_t; the read's is hook.MMIO_READ).
+# Callback types of unicorn.h (uc_cb_hookcode_t, uc_cb_eventmem_t, uc_cb_mmio_write_t; mmio reads: hook.MMIO_READ).
+_HOOK_CODE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint32, ctypes.c_void_p)
+_HOOK_MEM_INVALID: Final = ctypes.CFUNCTYPE(ctypes.c_bool, ctypes.c_void_p, ctypes.c_int, ctypes.c_uint64, ctypes.c_int,
+                                            ctypes.c_int64, ctypes.c_void_p)  # fmt: skip
 _MMIO_WRITE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint, ctypes.c_uint64,
                                       ctypes.c_void_p)  # fmt: skip
 
@@ -72,12 +75,19 @@ __all__ = [
     "block_cost",
     "check_cpu",
     "countdown_register",
+    "idle_loops",
     "is_poll_loop",
 ]
 
 EXCP_EXCEPTION_EXIT: Final[int] = 8
 """unicorn's interrupt number for a branch to an EXC_RETURN value in handler mode (QEMU's EXCP_EXCEPTION_EXIT)."""
 EXCP_SWI: Final[int] = 2
+EXCP_PREFETCH_ABORT: Final[int] = 3
+"""unicorn's interrupt number for an instruction fetch it cannot make (QEMU's EXCP_PREFETCH_ABORT): from a peripheral
+callback's region, or from some unmapped addresses (0)."""
+EXECUTE_NEVER: Final[tuple[tuple[int, int], ...]] = ((0x4000_0000, 0x6000_0000), (0xA000_0000, 0x1_0000_0000))
+"""The Execute Never regions of the default memory map (B3.1, Table B3-1: Peripheral, Device, System): a fetch there
+is a MemManage fault (IACCVIOL)."""
 EXCP_BKPT: Final[int] = 7
 EXC_RETURN_HANDLER: Final[int] = 0xFFFF_FFF1
 """Return to handler mode, main stack (B1.5.8, Table B1-8)."""
@@ -108,6 +118,8 @@ SCS_BASE: Final[int] = 0xE000_E000
 SCS_SIZE: Final[int] = 0x1000
 _PAGE: Final[int] = 0x1000
 """The emulator maps memory in 4 KiB pages: a memory's base and size are multiples of it."""
+_IDLE_LOOP: Final[bytes] = b"\xfe\xe7"
+"""``b .``, a branch to itself (B T2 with offset -4: E7FEh), MCU-4."""
 _ADDRESS_SPACE: Final[int] = 1 << 32
 SYST_MAX: Final[int] = 0xFF_FFFF
 """SysTick is a 24-bit down counter (B3.3.1)."""
@@ -124,15 +136,26 @@ HFSR: Final[int] = 0xD2C
 """HardFault Status Register (B3.2.16)."""
 HFSR_FORCED: Final[int] = 1 << 30
 """A configurable fault escalated to HardFault: its handler is disabled (SHCSR, as from reset; MCU-3)."""
+MMFAR: Final[int] = 0xD34
+"""MemManage Fault Address Register, offset in the SCS (B3.2.17): the data address of a DACCVIOL."""
+BFAR: Final[int] = 0xD38
+"""BusFault Address Register (B3.2.18): the data address of a precise bus fault."""
+PRECISERR: Final[int] = 1 << 9
+DACCVIOL: Final[int] = 1 << 1
+IACCVIOL: Final[int] = 1 << 0
+_FAULT_ADDRESS: Final[dict[int, tuple[str, int, int]]] = {PRECISERR: ("BFAR", BFAR, 1 << 15),  # BFSR.BFARVALID
+                                                          DACCVIOL: ("MMFAR", MMFAR, 1 << 7)}  # MMFSR.MMARVALID
+"""The faults that load an address register (B3.2.15): the CFSR bit, the register's name, offset and valid bit. An
+instruction fetch fault (IBUSERR, IACCVIOL) loads none."""
 _FAULTS: Final[dict[int, tuple[str, int]]] = {
-    ucc.UC_ERR_READ_UNMAPPED: ("precise bus fault: read of unmapped memory", 1 << 9),  # BFSR.PRECISERR
-    ucc.UC_ERR_WRITE_UNMAPPED: ("precise bus fault: write to unmapped memory", 1 << 9),
+    ucc.UC_ERR_READ_UNMAPPED: ("precise bus fault: read of unmapped memory", PRECISERR),  # BFSR.PRECISERR
+    ucc.UC_ERR_WRITE_UNMAPPED: ("precise bus fault: write to unmapped memory", PRECISERR),
     ucc.UC_ERR_FETCH_UNMAPPED: ("instruction bus fault: fetch from unmapped memory (run-away PC)", 1 << 8),  # IBUSERR
     ucc.UC_ERR_INSN_INVALID: ("usage fault: undefined instruction", 1 << 16),  # UFSR.UNDEFINSTR
     ucc.UC_ERR_READ_UNALIGNED: ("usage fault: unaligned read", 1 << 24),  # UFSR.UNALIGNED
     ucc.UC_ERR_WRITE_UNALIGNED: ("usage fault: unaligned write", 1 << 24),
-    ucc.UC_ERR_FETCH_PROT: ("memory fault: execute from a non-executable region", 1 << 0),  # MMFSR.IACCVIOL
-    ucc.UC_ERR_WRITE_PROT: ("memory fault: write to read-only memory", 1 << 1),  # MMFSR.DACCVIOL
+    ucc.UC_ERR_FETCH_PROT: ("memory fault: execute from a non-executable region", IACCVIOL),  # MMFSR.IACCVIOL
+    ucc.UC_ERR_WRITE_PROT: ("memory fault: write to read-only memory", DACCVIOL),  # MMFSR.DACCVIOL
 }
 """unicorn's error of a fault: the report's reason and the CFSR bit the core sets (B3.2.15)."""
 
@@ -512,6 +535,19 @@ def is_poll_loop(code: bytes, address: int) -> bool:
     return address + 2 * (len(halfwords) - 1) + 4 + 2 * offset == address
 
 
+def idle_loops(image: FirmwareImage, flash: tuple[int, int]) -> tuple[int, ...]:
+    """The halfword-aligned addresses in the firmware's flash that hold ``b .`` (FEE7h: a branch to itself), where
+    the core stops at the first iteration (MCU-4); a constant that happens to read so is never run and costs
+    nothing."""
+    base, size = flash
+    found = []
+    for address, data in image.segments:
+        if base <= address < base + size:
+            start = address & 1
+            found += [address + k for k in range(start, len(data) - 1, 2) if data[k:k + 2] == _IDLE_LOOP]
+    return tuple(found)
+
+
 def countdown_register(code: bytes) -> int:
     """The register a countdown loop counts down (MCU-11), or -1: the block ``code`` is exactly ``SUBS Rd, Rd,
     #1`` (a 16-bit encoding, Rd one of R0-R7) and ``BNE`` back to the ``SUBS``. Its iterations
@@ -659,7 +695,12 @@ class CortexM:
         self._scs_words: dict[int, int] = {}
         self.mmio(SCS_BASE, SCS_SIZE, self._scs_read, self._scs_write)
         self._hook(ucc.UC_HOOK_BLOCK, native.supi3_block_hook, data=ctypes.byref(state))
+        on_idle_loop = _HOOK_CODE(self._on_idle_loop)
+        for address in idle_loops(self.image, flash):  # MCU-4: the core stops at its first ``b .``
+            self._hook(ucc.UC_HOOK_CODE, on_idle_loop, address, address)
         self.uc.hook_add(ucc.UC_HOOK_INTR, self._on_interrupt)
+        self._fault_address: int | None = None  # the address of the last unmapped or protected access (BFAR, MMFAR)
+        self._hook(ucc.UC_HOOK_MEM_INVALID, _HOOK_MEM_INVALID(self._on_invalid_access))
         self.reset()
 
     # -- memory ------------------------------------------------------------------------------------------------
@@ -1014,6 +1055,13 @@ class CortexM:
             self.fail(error)
             return 1
 
+    def _on_idle_loop(self, handle: int, address: int, size: int, data: int) -> None:
+        """A ``b .`` is about to run (its block counted): stop there, at its first iteration, whatever the deadline;
+        the run loop takes it for a wait in thread mode and a hang in a handler (MCU-4)."""
+        del address, size, data
+        self.stop_request = True
+        _LIB.uc_emu_stop(handle)
+
     def skip_poll(self, until: int) -> None:
         """The status register just read keeps its value until cycle ``until``: if the running block is a pure poll
         loop on it (:func:`is_poll_loop`), its next iterations up to then are counted without running (MCU-10)."""
@@ -1065,6 +1113,11 @@ class CortexM:
         if number == EXCP_SWI:
             self.enter(SVCALL)
             return "run"
+        if number == EXCP_PREFETCH_ABORT:
+            if any(low <= pc < high for low, high in EXECUTE_NEVER):
+                raise FirmwareFaultError(self._fault_report(f"memory fault: execute from a peripheral region at "
+                                                            f"{pc:08X}h (Execute Never)", IACCVIOL))  # fmt: skip
+            raise FirmwareFaultError(self._fault_report(*_FAULTS[ucc.UC_ERR_FETCH_UNMAPPED]))
         if number is not None:
             what = "a breakpoint (BKPT)" if number == EXCP_BKPT else f"core exception {number}"
             raise FirmwareStoppedError(self.report(Stop.FAULT, f"{what}: not modelled"))
@@ -1085,17 +1138,35 @@ class CortexM:
         idle = self._idle.get(pc)  # the code does not change (as the block costs)
         if idle is None:
             idle = self._idle[pc] = bool(self.flash[0] <= pc < self.flash[0] + self.flash[1] - 1 and
-                                         self.read_bytes(pc, 2) == b"\xfe\xe7")  # fmt: skip
+                                         self.read_bytes(pc, 2) == _IDLE_LOOP)  # fmt: skip
         return idle
 
+    def _on_invalid_access(self, handle: int, access: int, address: int, size: int, value: int, data: int) -> bool:
+        """An access to unmapped or protected memory is about to fault: note its address (BFAR, MMFAR); unicorn then
+        stops with the error (``False``: not handled)."""
+        del handle, access, size, value, data
+        self._fault_address = address
+        return False
+
     def _fault(self, error: Any) -> StopReport:
-        pc = self.pc
         reason, bit = _FAULTS.get(error.errno, (f"fault ({error})", 0))
+        return self._fault_report(reason, bit)
+
+    def _fault_report(self, reason: str, bit: int) -> StopReport:
+        """The report of a core fault (``bit``: its CFSR bit, 0 if none), the HardFault entry taken (MCU-3)."""
+        pc = self.pc
+        address, self._fault_address = self._fault_address, None
         status = None
-        if self.cpu.fault_status and bit:  # the status registers as the fault leaves them (B3.2.15, B3.2.16)
+        if self.cpu.fault_status and bit:  # the status registers as the fault leaves them (B3.2.15 to B3.2.18)
             words = self._scs_words
+            loaded = _FAULT_ADDRESS.get(bit)
+            if loaded is not None and address is not None:
+                words[loaded[1]] = address
+                bit |= loaded[2]
             words[CFSR], words[HFSR] = words.get(CFSR, 0) | bit, words.get(HFSR, 0) | HFSR_FORCED
             status = {"CFSR": words[CFSR], "HFSR": words[HFSR]}
+            if loaded is not None and address is not None:
+                status[loaded[0]] = address
         backtrace = self.backtrace()
         frame: int | None = None
         if self.ram[0] + FRAME_WORDS * 4 <= (self.reg("sp") & ~7) <= self.ram[0] + self.ram[1]:

@@ -21,7 +21,7 @@ import heapq
 import itertools
 import math
 from collections import deque
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Final
 
@@ -32,7 +32,7 @@ from supi3.checks import check_bool, check_trace, fail
 from supi3.interbus import wire
 from supi3.mcu.core import Frame
 from supi3.mcu.stm32 import CR1_CPHA, CR1_CPOL, CR1_LSBFIRST
-from supi3.model.pinring import PinRing
+from supi3.model.pinring import PinBranch, PinChip, PinRing
 from supi3.model.registers import InterfaceViolationError
 from supi3.pinout import UP_INPUTS, UP_OUTPUTS
 from supi3.tables import CLOCK_HZ
@@ -98,7 +98,8 @@ class Sample:
 
 
 class LockstepRing(PinRing):
-    """The master's line through one whole chip whose µP pins the firmware drives, in step with the core.
+    """The master's line through one whole chip whose µP pins the firmware drives, in step with the core, and on
+    through the pin-level chips behind it (``others``).
 
     Parameters
     ----------
@@ -113,6 +114,10 @@ class LockstepRing(PinRing):
     intel:
         The Intel board (MCU-18): SPI1 samples MISO on Ser_IN/OUT (MFP6), MOSI's level where the chip drives it not;
         else on SerOUT (MFP7), pulled up.
+    others:
+        Further pin-level chips behind the chip, ring positions 2, 3, ... (as :class:`PinRing` takes them:
+        :class:`~supi3.model.pins.Supi3Pins` or :class:`~supi3.top.Supi3Chip` objects and :class:`PinBranch` trees);
+        each piece of the chip's run then runs them as :class:`PinRing` runs a ring (MCU-23).
 
     Attributes
     ----------
@@ -132,8 +137,8 @@ class LockstepRing(PinRing):
     """
 
     def __init__(self, chip: Supi3Chip, cpu_hz: float, where: Callable[[], Cause], *, record: bool = False,
-                 intel: bool = False) -> None:  # fmt: skip
-        super().__init__([chip], record)
+                 intel: bool = False, others: Sequence[PinChip | PinBranch] = ()) -> None:  # fmt: skip
+        super().__init__([chip, *others], record)
         self.miso = SER_IN_OUT_BIT if intel else SEROUT_BIT
         self.chip = chip
         self.cpu_hz = cpu_hz
@@ -268,6 +273,8 @@ class LockstepRing(PinRing):
     def _clock(self, n: int, until_edge: bool) -> bool:
         """Run ``n`` clocks with the inputs held (but ``do1``); whether it stopped early at an edge. A long wait for
         an edge (from :data:`LOOK_AHEAD_FROM` clocks) runs to it in one piece (:meth:`_edge_ahead`, MCU-21)."""
+        if len(self.tree) > 1:
+            return self._clock_ring(n, until_edge)
         chip, line, idle = self.chip, self._line, self.inputs["do1"]
         start = self.cycle
         edge = False
@@ -297,6 +304,24 @@ class LockstepRing(PinRing):
         self._after(start, traces)
         return edge
 
+    def _clock_ring(self, n: int, until_edge: bool) -> bool:
+        """:meth:`_clock` with devices behind the chip (MCU-23): the piece runs as :class:`PinRing` runs a ring, the
+        chip forward (its logic does not depend on DI2), the devices behind it on its DO2, then the return line from
+        the last back to the chip's DI1; a wait for an edge is found on a copy of the chip first, whatever its
+        length (:meth:`_edge_ahead`), since the piece cannot stop inside."""
+        start, line = self.cycle, self._line
+        edge = False
+        if until_edge:
+            n, edge = self._edge_ahead(n)
+        traces = self._held(n, [line.popleft() for _ in range(min(n, len(line)))])
+        traces.update(self.chip.run_forward(traces))
+        chunk: dict[int, dict[str, npt.NDArray[np.int64]]] | None = {} if self.record else None
+        _, sent = self._forward(self.tree[1:], 2, traces["do2"], chunk)
+        traces["di2"] = self._back(sent, np.zeros(n, dtype=np.int64), chunk)
+        traces["di1"] = self.chip.return_line(traces["di2"], traces["do2"])
+        self._after(start, traces, None if chunk is None else [chunk[k] for k in range(2, len(self.devices) + 1)])
+        return edge
+
     def _held(self, n: int, line: list[int]) -> dict[str, npt.NDArray[np.int64]]:
         """The input traces of ``n`` clocks with the inputs held, ``do1`` from ``line`` then idle."""
         traces = {name: np.full(n, level, dtype=np.int64) for name, level in self.inputs.items()}
@@ -316,12 +341,14 @@ class LockstepRing(PinRing):
         edges = np.flatnonzero(changed)
         return (n, False) if not len(edges) else (int(edges[0]) + 1, True)
 
-    def _after(self, start: int, traces: dict[str, npt.NDArray[np.int64]]) -> None:
+    def _after(self, start: int, traces: dict[str, npt.NDArray[np.int64]],
+               behind: list[dict[str, npt.NDArray[np.int64]]] | None = None) -> None:  # fmt: skip
+        """The chip ran ``traces`` from clock ``start`` (``behind``: the pins of the devices behind it, recorded)."""
         n = len(traces["do1"])
         self.cycle = start + n
         self._di1.append(traces["di1"])
         if self.record:
-            self._chunks.append([traces])
+            self._chunks.append([traces, *(behind or ())])
         self.last = {name: int(traces[name][-1]) for name in _WATCHED}
         for clock in [c for c in self._samples if start <= c < start + n]:
             k = clock - start

@@ -21,13 +21,16 @@ from supi3.checks import check_bytes, check_choice, check_int, fail
 from supi3.config import decode
 from supi3.errors import Supi3Error
 from supi3.interbus.device import PlainDevice
+from supi3.interbus.link import Device
 from supi3.interbus.master import ConfigEntry
 from supi3.mcu.board import DEFAULT_MAX_INSTRUCTIONS, FIDELITIES, Board, ViolationAt
 from supi3.mcu.core import FirmwareError, StopReport
+from supi3.model.pins import Supi3Pins
 from supi3.sdk.bench import DEFAULT_STRAPS
 from supi3.spi.upif import Mode
 
-__all__ = ["DEFAULT_CYCLES", "POWER_UP_CYCLES", "RING_DEVICE", "FirmwareRun", "run_firmware"]
+__all__ = ["DEFAULT_CYCLES", "MAX_PIN_DEVICES", "POWER_UP_CYCLES", "RING_DEVICE", "RING_DEVICE_STRAPS", "FirmwareRun",
+           "run_firmware"]
 
 DEFAULT_CYCLES: Final[int] = 10
 """Master cycles a run has unless told (ID cycles included)."""
@@ -36,6 +39,12 @@ POWER_UP_CYCLES: Final[int] = 3
 RING_DEVICE: Final[tuple[int, int]] = (0x02, 0b00001)
 """ID code and length code of each further device in the ring, behind the chip: a plain digital output module of
 one word (Table A-3, Table 3-11)."""
+RING_DEVICE_STRAPS: Final[tuple[str, str | None]] = ("10001", None)
+"""MCU-23: at pin level each further device is a pin-level SUPI 3 (:class:`~supi3.model.pins.Supi3Pins`) strapped RB,
+16 IN (Table 2-6): the ID code and length code of :data:`RING_DEVICE`, so the master sees the same ring."""
+MAX_PIN_DEVICES: Final[int] = 4
+"""MCU-23: the longest ring at pin level (the chip and three devices behind it): each further chip runs every piece
+of the board's chip, so each costs about as much CPU time again."""
 
 
 @dataclass
@@ -166,7 +175,8 @@ def run_firmware(firmware: str | Path, *, cpu: str = "cortex_m3", cpu_hz: float 
     ``out_data``/``in_data``: the master's OUT data and the firmware's input terminals (default: a pattern as long
     as the chip's data); ``max_instructions``: the budget of each of the two runs (power-up, exchange);
     ``fidelity``: the chip at transaction level or the pin-level whole chip (:data:`~supi3.mcu.board.FIDELITIES`;
-    at pin level the chip alone in the ring, ``devices`` 1); ``vcd``: pin level only, the VCD file to write the chip's
+    at pin level the devices behind it are pin-level chips strapped :data:`RING_DEVICE_STRAPS`, ``devices`` up to
+    :data:`MAX_PIN_DEVICES`); ``vcd``: pin level only, the VCD file to write the chip's
     pins and the MCU's lines to (:meth:`Board.write_vcd`), also when the run stopped; ``mode``: the board's wiring
     for the interface type the firmware initializes (``Board``'s ``mode``, MCU-18).
 
@@ -177,16 +187,18 @@ def run_firmware(firmware: str | Path, *, cpu: str = "cortex_m3", cpu_hz: float 
     if vcd is not None and fidelity != "pin":
         raise fail("vcd", "None at transaction level (a VCD holds pins: fidelity='pin')", vcd)
     pin = fidelity == "pin"
-    devices = check_int("devices", devices, 1, 1 if pin else 64, "the chip alone in the ring at pin level, MCU-17"
-                        if pin else "")  # fmt: skip
+    devices = check_int("devices", devices, 1, MAX_PIN_DEVICES if pin else 64, "at pin level, MCU-23" if pin else "")
     cycles = check_int("cycles", cycles, POWER_UP_CYCLES, 100_000)
     max_instructions = check_int("max_instructions", max_instructions, 1)
     out_data = None if out_data is None else check_bytes("out_data", out_data)
     in_data = None if in_data is None else check_bytes("in_data", in_data)
     if not isinstance(straps, tuple) or len(straps) != 2:
         raise fail("straps", "a pair (C[4..0], MFP[15..12] or None)", straps)
-    config = decode(straps[0], straps[1], clk_conf=tables.clk_conf_for(bit_rate))
-    others = [PlainDevice(*RING_DEVICE) for _ in range(devices - 1)]
+    clk_conf = tables.clk_conf_for(bit_rate)
+    config = decode(straps[0], straps[1], clk_conf=clk_conf)
+    others: list[Device | Supi3Pins] = [
+        Supi3Pins(decode(*RING_DEVICE_STRAPS, clk_conf=clk_conf)) if pin else PlainDevice(*RING_DEVICE)
+        for _ in range(devices - 1)]  # fmt: skip
     board = Board(firmware, cpu=cpu, cpu_hz=cpu_hz, config=config, others=others, strict=False, fidelity=fidelity,
                   record=vcd is not None, mode=mode)  # fmt: skip
     report = FirmwareRun(Path(firmware), cpu, cpu_hz, straps, config.bit_rate, devices, cycles, fidelity=fidelity,

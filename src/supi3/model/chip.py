@@ -229,6 +229,10 @@ class Supi3:
     pedantic:
         µP modes: also report legal but suspicious µP accesses (:class:`~supi3.model.registers.RegisterFile`,
         UP-30); ignored in the other modes.
+    stat_err_filter:
+        The /StatErr input filter (3.6.2: t3 = 200 ms) in clocks: 1 up to :data:`STATERR_FILTER_CLOCKS` (the default);
+        shorter only to reach a peripheral fault quickly in tests at pin level (MCU-24), as ``Supi3Pins``'s
+        ``branch_silence``.
 
     Attributes
     ----------
@@ -244,7 +248,8 @@ class Supi3:
         "_chain", "_cpb", "_deadline", "_due_s", "_events", "_exr_driver", "_exr_free", "_fast_valid", "_fixed_bytes",
         "_frame_bytes", "_in_map", "_loaded", "_mau_events", "_mau_told", "_now", "_optical", "_optical_driven",
         "_optical_held", "_optical_until", "_out", "_out_map", "_send_alarm", "_send_optical",
-        "_serial_pins", "_shown", "_stat_err", "_stat_low_since", "_watch_line", "attention", "bus_active", "config",
+        "_serial_pins", "_shown", "_stat_err", "_stat_filter", "_stat_low_since", "_watch_line", "attention",
+        "bus_active", "config",
         "due", "following", "in_word", "io_access", "led_inputs", "line_interrupt", "line_silent", "mfp_in",
         "mod_ack_until", "pf", "registers", "resreg_until", "revision", "serial_device", "spi_sequences", "te",
         "watchdog_code", "wd",
@@ -253,11 +258,14 @@ class Supi3:
     data_kernel: ClassVar[DataKernel] = DataKernel(_load_data_run, _latch_data_run)
     """The ring's fast path for runs of chips in a data cycle (:class:`supi3.interbus.link.DataKernel`)."""
 
-    def __init__(self, config: DeviceConfig | None = None, *, strict: bool = True, pedantic: bool = False) -> None:
+    def __init__(self, config: DeviceConfig | None = None, *, strict: bool = True, pedantic: bool = False,
+                 stat_err_filter: int = STATERR_FILTER_CLOCKS) -> None:  # fmt: skip
         if config is not None and not isinstance(config, DeviceConfig):
             _checked(check_instance, "config", config, DeviceConfig, "a DeviceConfig (supi3.config.decode) or None")
         _checked(check_bool, "strict", strict)
         _checked(check_bool, "pedantic", pedantic)
+        self._stat_filter = _checked(check_int, "stat_err_filter", stat_err_filter, 1, STATERR_FILTER_CLOCKS,
+                                     "the 200 ms of 3.6.2 in clocks; shorter only to test a fault quickly")  # fmt: skip
         self.config = config if config is not None else decode("10000")
         kind = self.config.mfp_mode.kind
         self.registers = (
@@ -944,14 +952,14 @@ class Supi3:
 
     @property
     def _filtered(self) -> bool:
-        return self._stat_low_since is not None and self._now - self._stat_low_since >= STATERR_FILTER_CLOCKS
+        return self._stat_low_since is not None and self._now - self._stat_low_since >= self._stat_filter
 
     def _reschedule(self) -> None:
         # due (public, read-only): the next clock at which time alone changes the chip (filter expiry, watchdog),
         # _NEVER if none; the pin level (supi3.model.pins and its receiver) reads it on every cycle it visits.
         due = _NEVER if self._deadline is None else self._deadline
         if self._stat_low_since is not None and not self.pf:
-            due = min(due, self._stat_low_since + STATERR_FILTER_CLOCKS)
+            due = min(due, self._stat_low_since + self._stat_filter)
         due = min(due, self._optical_until)  # optical block: the 6 ms initialization budget (OPT-20)
         self.due = due
         # See "The ring kernel"; a serial device takes the latch's slow path (the sequence runs there).
