@@ -595,9 +595,10 @@ _FOREVER: Final[int] = (1 << 64) - 1
 
 
 class HeldRegister:
-    """A peripheral's register that the core answers natively while the peripheral holds its value (MCU-25), from
-    :meth:`CortexM.mmio`. A peripheral holds a value for as long as its own reads would return it and change nothing
-    but what its next access catches up with (its model runs on the time), and releases it at that access."""
+    """A peripheral's register that the core answers natively while the peripheral holds its value (MCU-25), and a
+    read the peripheral offers from a cycle on (MCU-26), from :meth:`CortexM.mmio`. A peripheral holds a value (or
+    offers a read) for as long as its own reads would return it and change nothing but what its next access catches
+    up with (its model runs on the time), and releases it at that access."""
 
     def __init__(self, held: hook.Held) -> None:
         self._held = held
@@ -616,6 +617,23 @@ class HeldRegister:
     def release(self) -> None:
         """Every read goes to the peripheral again."""
         self._held.held = 0
+
+    def offer(self, offset: int, value: int, start: int, then: int) -> None:
+        """MCU-26: the first read of ``offset`` at a time (:meth:`CortexM.cycles_polled`) from cycle ``start`` on
+        returns ``value``, once, and from then on the held register reads ``then`` (as long as it is held)."""
+        held = self._held
+        held.once_offset, held.once_value, held.once_from, held.once_then = offset, value, start, then
+        held.taken, held.once = 0, 1
+
+    def withdraw(self) -> int | None:
+        """No more offered read; the time of the one taken since :meth:`offer`, if one was (the peripheral catches
+        up with it)."""
+        held = self._held
+        held.once = 0
+        if not held.taken:
+            return None
+        held.taken = 0
+        return int(held.once_at)
 
 
 class CortexM:
@@ -785,7 +803,7 @@ class CortexM:
             self.error = error
         self.stop_request = True
         for held in self._held:  # the peripherals are silent now (mmio): no register is answered natively either
-            held.held = 0
+            held.held = held.once = 0
 
     # -- registers ---------------------------------------------------------------------------------------------
 
