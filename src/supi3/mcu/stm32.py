@@ -29,8 +29,8 @@ __all__ = [
     "Gpio",
     "PeripheralClockError",
     "Rcc",
-    "Spi",
     "ReadOffer",
+    "Spi",
     "SpiWire",
     "ValueHolder",
 ]
