@@ -109,8 +109,6 @@ telegrams while the firmware is still in a handler or has an /IRQ edge to serve.
 
 _EXTI0: Final[int] = EXTERNAL + EXTI0_IRQ
 """The exception number of EXTI0, /IRQ's line."""
-_NEVER: Final[int] = (1 << 64) - 1
-"""A core cycle never reached (the native hook's 64-bit clock)."""
 
 _T = TypeVar("_T")
 _R = TypeVar("_R")
@@ -568,7 +566,6 @@ class Board:
                                 f"(max) + t8 = {need * 1e9:.0f} ns after the rise")  # fmt: skip
             driven = self._chip(self.protocol.begin, cycles, bool(self._s_r) if self.intel else True)
             self._frame = _Frame(cycles, driven, [])
-            self._arm_byte(cycles, driven)
             return
         frame, self._frame = self._frame, None
         if frame is None:
@@ -592,7 +589,7 @@ class Board:
         """:class:`~supi3.mcu.stm32.SpiWire`: SPI1 starts a transfer; the chip sees it inside its /SS frame."""
         self.sync(start)
         period_s = self._seconds(period)
-        if not self._fast_enough(period):
+        if period_s < self._limits["t0"] * (1 - 1e-9):
             self._violation("Table 3-7 t0", f"SCLK period {period_s * 1e9:.0f} ns, shorter than t0 = "
                             f"{self._limits['t0'] * 1e9:.0f} ns")  # fmt: skip
         if cr1 & (CR1_CPOL | CR1_CPHA) != CR1_CPOL | CR1_CPHA:
@@ -602,50 +599,15 @@ class Board:
         if frame is None:
             self._violation("3.4.2", f"byte {tx:02X}h clocked with /SS high: the chip ignores it")
             return MISO_IDLE
-        reverse = self._reversed(cr1)
+        lsb = bool(cr1 & CR1_LSBFIRST)
+        reverse = lsb != (self.protocol.mode is Mode.INTEL)  # the chip shifts LSB first in Intel mode (UP-6)
         seen = _reverse(tx & 0xFF) if reverse else tx & 0xFF
         if not frame.transfers and start + period // 2 - frame.fall < self._least["t1"]:
             self._violation("Table 3-7 t1", f"first SCLK edge {self._ns(start + period // 2 - frame.fall)} ns after "
                             f"/SS fell, less than t1 = {self._limits['t1'] * 1e9:.0f} ns")  # fmt: skip
         frame.transfers.append((seen, bits, start, period))
-        return self._miso(frame.driven, reverse)
-
-    def _fast_enough(self, period: int) -> bool:
-        """An SCLK period of ``period`` core cycles is no shorter than Table 3-7's t0."""
-        return self._seconds(period) >= self._limits["t0"] * (1 - 1e-9)
-
-    def _reversed(self, cr1: int) -> bool:
-        """SPI1 and the chip shift in opposite bit orders (the chip shifts LSB first in Intel mode, UP-6)."""
-        return bool(cr1 & CR1_LSBFIRST) != (self.protocol.mode is Mode.INTEL)
-
-    @staticmethod
-    def _miso(driven: int | None, reverse: bool) -> int:
-        """What SPI1 receives of the byte the chip drives on SerOUT (pulled up when it drives none, MCU-6)."""
-        driven = MISO_IDLE if driven is None else driven
+        driven = MISO_IDLE if frame.driven is None else frame.driven
         return _reverse(driven) if reverse else driven
-
-    def _arm_byte(self, fall: int, driven: int | None) -> None:
-        """MCU-27: /SS just fell at ``fall`` and the chip drives ``driven``: SPI1's first byte of the frame costs
-        no check (mode 3, t0, and t1 once it starts late enough) and no bus event while it starts before the next
-        one is due (a sync up to then runs nothing, and /IRQ was followed just now): SPI1 may let the core take that
-        write of DR natively (:meth:`Spi.arm_byte`); :meth:`spi_byte` runs at its next call into the peripherals."""
-        spi = self.spi
-        cr1 = spi.cr1
-        period = spi.period
-        if cr1 & (CR1_CPOL | CR1_CPHA) != CR1_CPOL | CR1_CPHA or not self._fast_enough(period):
-            return
-        next_s = self.bench.next_event_s()
-        hz = self.core.cpu_hz
-        if math.isfinite(next_s):
-            quiet = math.ceil(next_s * hz)  # the first cycle whose sync runs the event: sync's own division
-            while quiet > 0 and (quiet - 1) / hz >= next_s:
-                quiet -= 1
-            while quiet / hz < next_s:
-                quiet += 1
-        else:
-            quiet = _NEVER
-        spi.arm_byte(fall + self._least["t1"] - period // 2, min(quiet, _NEVER), self._miso(driven,
-                     self._reversed(cr1)))  # fmt: skip
 
     # -- the chip and its violations ---------------------------------------------------------------------------
 

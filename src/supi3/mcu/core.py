@@ -48,10 +48,12 @@ UcError: type[Exception] = _UNICORN.UcError
 _LIB: Any = _UNICORN.unicorn_py3.unicorn.uclib
 """unicorn's C library as its binding loaded it (with the argument types it declares): the hot callbacks and
 register accesses go to it directly (MCU-19), without the binding's wrappers around each call."""
-# Callback types of unicorn.h (uc_cb_hookcode_t, uc_cb_eventmem_t; mmio: hook.MMIO_READ, hook.MMIO_WRITE).
+# Callback types of unicorn.h (uc_cb_hookcode_t, uc_cb_eventmem_t, uc_cb_mmio_write_t; mmio reads: hook.MMIO_READ).
 _HOOK_CODE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint32, ctypes.c_void_p)
 _HOOK_MEM_INVALID: Final = ctypes.CFUNCTYPE(ctypes.c_bool, ctypes.c_void_p, ctypes.c_int, ctypes.c_uint64, ctypes.c_int,
                                             ctypes.c_int64, ctypes.c_void_p)  # fmt: skip
+_MMIO_WRITE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint, ctypes.c_uint64,
+                                      ctypes.c_void_p)  # fmt: skip
 
 __all__ = [
     "CPUS",
@@ -123,9 +125,6 @@ SYST_MAX: Final[int] = 0xFF_FFFF
 """SysTick is a 24-bit down counter (B3.3.1)."""
 BACKTRACE_DEPTH: Final[int] = 16
 """Frames :meth:`CortexM.backtrace` unwinds at most."""
-PREFIX_SLOTS: Final[int] = 1 << 10
-"""MCU-27: the native write callback's table of the cycles before an access's PC in its block (direct-mapped by the
-PC's halfword address; a missing entry sends the write to Python, which fills it)."""
 BLOCK_CACHE_SLOTS: Final[int] = 1 << 13
 """Slots of the native block hook's cost cache (MCU-25), one per halfword address modulo their number: 16 KiB of
 code without two blocks sharing a slot (a block that finds its slot taken asks Python again)."""
@@ -601,9 +600,8 @@ class HeldRegister:
     offers a read) for as long as its own reads would return it and change nothing but what its next access catches
     up with (its model runs on the time), and releases it at that access."""
 
-    def __init__(self, held: hook.Held, deferred: list[Callable[[], None]]) -> None:
+    def __init__(self, held: hook.Held) -> None:
         self._held = held
-        self._deferred = deferred
 
     def hold(self, offset: int, value: int, until: int | None, after: int | None = None) -> None:
         """Reads of ``offset`` return ``value`` while their time (:meth:`CortexM.cycles_polled`) is before cycle
@@ -636,30 +634,6 @@ class HeldRegister:
             return None
         held.taken = 0
         return int(held.once_at)
-
-    def arm_write(self, offset: int, start: int, end: int, length: int, hold: tuple[int, int, int],
-                  offer: tuple[int, int, int], catch_up: Callable[[], None]) -> None:  # fmt: skip
-        """MCU-27: the next write of ``offset`` at a time (:meth:`CortexM.cycles_now`) from cycle ``start`` to
-        before ``end`` is taken natively: from its time on, the register ``hold[0]`` reads ``hold[1]`` until
-        ``length`` cycles later (telling a poll loop that cycle), then ``hold[2]`` (:meth:`hold`), and the read of
-        ``offer[0]`` from then on is offered: value ``offer[1]``, then ``offer[2]`` (:meth:`offer`). The core calls
-        ``catch_up`` before any other peripheral call and after the run: the peripheral then takes the write
-        (:meth:`disarm_write`)."""
-        held = self._held
-        held.offset, held.value, held.after, held.poll, held.has_after = hold[0], hold[1], hold[2], 1, 1
-        held.once_offset, held.once_value, held.once_then = offer
-        held.write_offset, held.write_from, held.write_until, held.write_length = offset, start, end, length
-        held.written, held.write_armed = 0, 1
-        self._deferred.append(catch_up)
-
-    def disarm_write(self) -> tuple[int, int] | None:
-        """No more armed write; the value and time of the one taken, if one was."""
-        held = self._held
-        held.write_armed = 0
-        if not held.written:
-            return None
-        held.written = 0
-        return int(held.write_value), int(held.write_at)
 
 
 class CortexM:
@@ -715,11 +689,6 @@ class CortexM:
         state.reg_read = ctypes.cast(_LIB.uc_reg_read, ctypes.c_void_p)
         state.reg_write = ctypes.cast(_LIB.uc_reg_write, ctypes.c_void_p)
         state.describe = self._describe_callback
-        self._prefix = (hook.Prefix * PREFIX_SLOTS)()
-        state.prefix = self._prefix
-        state.prefix_mask = PREFIX_SLOTS - 1
-        self._held_write = ctypes.cast(native.supi3_held_write, ctypes.c_void_p)
-        self._deferred: list[Callable[[], None]] = []  # a peripheral's catch-up with a write taken natively (MCU-27)
         self.sleeping = False
         self.active: list[int] = []  # active exceptions, outermost first
         self.pending: set[int] = set()
@@ -765,8 +734,6 @@ class CortexM:
             if self.error is not None:  # the run ends with this block: its later accesses reach no peripheral
                 return 0
             try:
-                if self._deferred:
-                    self.catch_up()
                 return read(offset, size)
             except BaseException as error:  # handed to the run loop, raised there
                 self.fail(error)
@@ -777,32 +744,22 @@ class CortexM:
             if self.error is not None:
                 return
             try:
-                if self._deferred:
-                    self.catch_up()
                 write(offset, size, value)
             except BaseException as error:  # handed to the run loop, raised there
                 self.fail(error)
 
-        callbacks = (hook.MMIO_READ(on_read), hook.MMIO_WRITE(on_write))
+        callbacks = (hook.MMIO_READ(on_read), _MMIO_WRITE(on_write))
         self._callbacks += callbacks
         held = hook.Held(ctypes.pointer(self._state), callbacks[0])
-        held.slow_write = callbacks[1]
         self._held.append(held)
-        self._check(_LIB.uc_mmio_map(self._handle, base, size, self._held_read, ctypes.byref(held), self._held_write,
-                                     ctypes.byref(held)))  # fmt: skip
+        self._check(_LIB.uc_mmio_map(self._handle, base, size, self._held_read, ctypes.byref(held), callbacks[1],
+                                     None))  # fmt: skip
         # unicorn updates the PC before a load or store only if a memory hook covers its address: without one, a
         # peripheral callback sees the PC of the block's first instruction, and the access would be timed there
         # (MCU-1 places it by the PC). The native hook also notes that PC for cycles_now (MCU-25).
         self._hook(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, self._exact_pc, base, base + size - 1,
                    ctypes.byref(self._state))  # fmt: skip
-        return HeldRegister(held, self._deferred)
-
-    def catch_up(self) -> None:
-        """Let each peripheral that armed a native write (MCU-27) take it, if the core took it: before any other
-        peripheral call and after each run, so the peripherals see their accesses in time order."""
-        deferred = self._deferred
-        while deferred:
-            deferred.pop(0)()
+        return HeldRegister(held)
 
     def _hook(self, kind: int, callback: Any, begin: int = 1, end: int = 0, data: Any = None) -> None:
         """Add a hook with a ctypes callback or a native function (MCU-19, MCU-25) and its user data; ``begin >
@@ -846,7 +803,7 @@ class CortexM:
             self.error = error
         self.stop_request = True
         for held in self._held:  # the peripherals are silent now (mmio): no register is answered natively either
-            held.held = held.once = held.write_armed = 0
+            held.held = held.once = 0
 
     # -- registers ---------------------------------------------------------------------------------------------
 
@@ -944,9 +901,6 @@ class CortexM:
             if cost is None:
                 cost = self._costs[key] = block_cost(self.read_bytes(address, pc - address))
             start += cost[1]
-            slot = self._prefix[(pc >> 1) & (PREFIX_SLOTS - 1)]
-            if slot.pc != pc or slot.block != address:  # for the native write callback (MCU-27)
-                slot.block, slot.pc, slot.cycles = address, pc, cost[1]
         if start > state.handed:
             state.handed = start
         return int(state.handed)
@@ -1162,8 +1116,6 @@ class CortexM:
             raise FirmwareFaultError(self._fault(error)) from None
         finally:
             self._running = False
-            if self._deferred:  # a write the core took natively in the run's last accesses (MCU-27)
-                self.catch_up()
         failure = self.error
         if failure is not None:
             self.error = None

@@ -32,14 +32,6 @@ typedef int (*uc_emu_stop_fn)(void *uc);
 typedef int (*uc_reg_fn)(void *uc, int regid, void *value);
 typedef int (*describe_fn)(uint64_t address, uint32_t size);
 typedef uint64_t (*mmio_read_fn)(void *uc, uint64_t offset, unsigned size, void *data);
-typedef void (*mmio_write_fn)(void *uc, uint64_t offset, unsigned size, uint64_t value, void *data);
-
-/* The cycles of a block's instructions before an access's PC (CortexM.cycles_now fills it, MCU-27). */
-typedef struct {
-    uint64_t block;
-    uint64_t pc;
-    uint64_t cycles;
-} supi3_prefix;
 
 typedef struct {
     uint64_t cycles;
@@ -65,8 +57,6 @@ typedef struct {
     uc_reg_fn reg_read;
     uc_reg_fn reg_write;
     describe_fn describe;   /* nonzero: Python failed, stop */
-    supi3_prefix *prefix;   /* MCU-27: direct-mapped by the access's PC */
-    uint32_t prefix_mask;
 } supi3_state;
 
 static int64_t ceil_div(int64_t numerator, int64_t denominator) {
@@ -170,15 +160,6 @@ typedef struct {
     uint32_t once;      /* offered, not yet taken */
     uint32_t taken;     /* taken: the held register reads once_then from now on */
     uint32_t once_then;
-    mmio_write_fn slow_write; /* the peripheral's write in Python */
-    uint64_t write_from;      /* MCU-27: a write of write_offset at a time in [write_from, write_until) is taken */
-    uint64_t write_until;
-    uint64_t write_at;        /* its time, once taken */
-    uint32_t write_offset;
-    uint32_t write_armed;
-    uint32_t written;
-    uint32_t write_value;
-    uint32_t write_length;    /* from the write: the register held until, and the offered read from, this later */
 } supi3_held;
 
 /* A peripheral's read callback (uc_cb_mmio_read_t): the offered register's one read from `once_from` on (MCU-26);
@@ -219,40 +200,4 @@ uint64_t supi3_held_read(void *uc, uint64_t offset, unsigned size, void *data) {
         }
     }
     return h->slow(uc, offset, size, 0);
-}
-
-/* A peripheral's write callback (uc_cb_mmio_write_t): the armed write (MCU-27) taken at the access's time as
- * CortexM.cycles_now gives it (the block's entry plus the cycles before the PC, known once Python has timed that PC;
- * never earlier than a time handed out) if that time is in [write_from, write_until): noted for the peripheral,
- * which catches up with it at its next call, and the register held and the read offered from then on (the values the
- * peripheral set when it armed the write). Every other write goes to Python. */
-void supi3_held_write(void *uc, uint64_t offset, unsigned size, uint64_t value, void *data) {
-    supi3_held *h = (supi3_held *)data;
-    supi3_state *s = h->state;
-    if (h->write_armed && offset == h->write_offset && !s->stop_request) {
-        uint64_t time = s->block_start;
-        int known = 1;
-        if (s->access_pc > s->block_address) {
-            const supi3_prefix *p = &s->prefix[(s->access_pc >> 1) & s->prefix_mask];
-            known = p->block == s->block_address && p->pc == s->access_pc;
-            time += p->cycles;
-        }
-        if (time < s->handed) {
-            time = s->handed;
-        }
-        if (known && time >= h->write_from && time < h->write_until) {
-            s->handed = time;
-            h->write_armed = 0;
-            h->written = 1;
-            h->write_at = time;
-            h->write_value = (uint32_t)value;
-            h->until = time + h->write_length;
-            h->held = 1;
-            h->once_from = h->until;
-            h->taken = 0;
-            h->once = 1;
-            return;
-        }
-    }
-    h->slow_write(uc, offset, size, value, 0);
 }

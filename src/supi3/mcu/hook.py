@@ -28,8 +28,8 @@ from typing import Final
 from supi3.errors import Supi3Error
 from supi3.sdk.native import default_cache_dir
 
-__all__ = ["DESCRIBE", "FLAGS", "MMIO_READ", "MMIO_WRITE", "SOURCE", "Block", "Held", "NativeHookError", "Prefix",
-           "State", "cached_path", "library"]
+__all__ = ["DESCRIBE", "FLAGS", "MMIO_READ", "SOURCE", "Block", "Held", "NativeHookError", "State", "cached_path",
+           "library"]
 
 SOURCE: Final[Path] = Path(__file__).with_name("hook.c")
 FLAGS: Final[tuple[str, ...]] = ("-shared", "-fPIC", "-O2", "-target", "native", "-mcpu=baseline", "-nostdlib",
@@ -41,9 +41,6 @@ DESCRIBE: Final = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_uint64, ctypes.c_uint3
 nonzero stops the run."""
 MMIO_READ: Final = ctypes.CFUNCTYPE(ctypes.c_uint64, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint, ctypes.c_void_p)
 """unicorn.h's uc_cb_mmio_read_t: a peripheral's read (``handle, offset, size, user data -> value``)."""
-MMIO_WRITE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint, ctypes.c_uint64,
-                                     ctypes.c_void_p)  # fmt: skip
-"""unicorn.h's uc_cb_mmio_write_t: a peripheral's write (``handle, offset, size, value, user data``)."""
 
 
 class NativeHookError(Supi3Error, RuntimeError):
@@ -57,12 +54,6 @@ class Block(ctypes.Structure):
 
     _fields_ = (("address", ctypes.c_uint32), ("size", ctypes.c_uint32), ("instructions", ctypes.c_uint32),
                 ("cycles", ctypes.c_uint32), ("countdown", ctypes.c_int32), ("poll", ctypes.c_int32))  # fmt: skip
-
-
-class Prefix(ctypes.Structure):
-    """The cycles of a block's instructions before an access's PC (``supi3_prefix``, MCU-27)."""
-
-    _fields_ = (("block", ctypes.c_uint64), ("pc", ctypes.c_uint64), ("cycles", ctypes.c_uint64))
 
 
 class State(ctypes.Structure):
@@ -92,8 +83,6 @@ class State(ctypes.Structure):
         ("reg_read", ctypes.c_void_p),
         ("reg_write", ctypes.c_void_p),
         ("describe", DESCRIBE),
-        ("prefix", ctypes.POINTER(Prefix)),
-        ("prefix_mask", ctypes.c_uint32),
     )
 
 
@@ -118,15 +107,6 @@ class Held(ctypes.Structure):
         ("once", ctypes.c_uint32),
         ("taken", ctypes.c_uint32),
         ("once_then", ctypes.c_uint32),
-        ("slow_write", MMIO_WRITE),
-        ("write_from", ctypes.c_uint64),
-        ("write_until", ctypes.c_uint64),
-        ("write_at", ctypes.c_uint64),
-        ("write_offset", ctypes.c_uint32),
-        ("write_armed", ctypes.c_uint32),
-        ("written", ctypes.c_uint32),
-        ("write_value", ctypes.c_uint32),
-        ("write_length", ctypes.c_uint32),
     )
 
 

@@ -283,16 +283,6 @@ class ReadOffer(Protocol):
     def withdraw(self) -> int | None:
         """No more offered read; the time of the one taken, if one was."""
 
-    def arm_write(self, offset: int, start: int, end: int, length: int, hold: tuple[int, int, int],
-                  offer: tuple[int, int, int], catch_up: Callable[[], None]) -> None:  # fmt: skip
-        """MCU-27: the next write of ``offset`` at a time in [``start``, ``end``) is taken natively; from it on the
-        register ``hold[0]`` holds ``hold[1]`` for ``length`` cycles, then ``hold[2]``, and the read of ``offer[0]``
-        is offered from then on (``offer[1]``, then ``offer[2]``); ``catch_up`` is called before the next call into
-        the peripherals."""
-
-    def disarm_write(self) -> tuple[int, int] | None:
-        """No more armed write; the value and time of the one taken, if one was."""
-
 
 class _NoHolder:
     """No native answers: every read goes to the peripheral."""
@@ -307,13 +297,6 @@ class _NoHolder:
         del offset, value, start, then
 
     def withdraw(self) -> int | None:
-        return None
-
-    def arm_write(self, offset: int, start: int, end: int, length: int, hold: tuple[int, int, int],
-                  offer: tuple[int, int, int], catch_up: Callable[[], None]) -> None:  # fmt: skip
-        del offset, start, end, length, hold, offer, catch_up
-
-    def disarm_write(self) -> tuple[int, int] | None:
         return None
 
 
@@ -361,40 +344,9 @@ class Spi:
         self.offer: ReadOffer = _NoHolder()
         """Told when the read of DR after the shifting byte is known (the same register of the core, MCU-26)."""
         self._holding = False
-        self._armed = False
         rcc.on_enable_change.append(self._release)
 
-    def arm_byte(self, start: int, end: int, received: int) -> None:
-        """MCU-27: the wire (the board) knows what the next byte written to DR receives (``received``) and that a
-        start of it at a cycle in [``start``, ``end``) costs it nothing but the byte (no check fails, no bus event
-        is due). If SPI1 is idle, enabled as master for 8-bit bytes, its receive buffer empty and no overrun flagged,
-        a write of DR in that window is taken by the core natively: SR and DR then read as the model would (MCU-25,
-        MCU-26), and the model takes the write (:meth:`_catch_up`) before the next call into the peripherals."""
-        self._release()
-        cr1 = self.cr1
-        if cr1 & (CR1_SPE | CR1_MSTR | CR1_DFF) != CR1_SPE | CR1_MSTR or self.shifting is not None \
-                or self.tx_buffer is not None or self.rx_buffer is not None or self.ovr or self._ovr_seen \
-                or not self.rcc.apb2enr & SPI1EN:  # fmt: skip
-            return
-        self._armed = True
-        sr = (SPI_SR, self._flags(False, False, True), self._flags(True, False, False))  # shifting, then RXNE
-        self.offer.arm_write(SPI_DR, start, end, 8 * self.period, sr, (SPI_DR, received, self._flags(False, False,
-                             False)), self._catch_up)  # fmt: skip
-
-    def _catch_up(self) -> None:
-        """Take the write of DR the core took natively (MCU-27), at its time: the byte starts, SR is held."""
-        if not self._armed:
-            return
-        self._armed = False
-        written = self.offer.disarm_write()
-        if written is not None:
-            value, cycles = written
-            self.tx_buffer = value & 0xFFFF
-            self._start(cycles)
-            self._holding = True  # the core holds SR and offers DR's read, as _hold would have told it
-
     def _release(self) -> None:
-        self._catch_up()
         if self._holding:
             self._holding = False
             self.holder.release()
