@@ -221,6 +221,15 @@ class Terminal(Device, Protocol):
         """Whether the branch is in the data path; ``connected``: a device answers on the branch."""
         ...
 
+    @property
+    def branch_recognised(self) -> bool:
+        """A device on the branch has answered since the BK's power-up (BK-37, BK-47)."""
+        ...
+
+    def recognise_branch(self) -> None:
+        """A device answered on the branch (BK-47): recognised until the BK's power-up reset."""
+        ...
+
     def branch_returned(self, traffic: bool, count: int | None, start: float, end: float) -> None:
         """The ring drove the whole branch from ``start`` to ``end``: the master's telegrams came back on the return
         line (``traffic``), and the count of the counter telegram received there (``None``: none)."""
@@ -598,6 +607,9 @@ class Ring:
         self._branches = _branches(self._tree)
         self._enabled: tuple[bool, ...] = ()
         self._spans: list[_Span] = []
+        self._settled = False
+        """A BK's branch is in the data path by its recognition (BK-47) once the ring ran (a reset, a cycle, idle);
+        before, as if every populated branch answered, so that faults are injected on the whole tree's lines."""
         self._unanswered: list[int] = []
         """The ring positions of the BKs whose branch is in the data path with nothing attached (BK-43): their branch
         return input carries nothing, as a :class:`ReturnBreak` there."""
@@ -636,8 +648,9 @@ class Ring:
         """Flatten the tree again if a BK changed whether its branch is in the data path."""
         if not self._branches:
             return
-        # A device answers on a populated branch (BK-37); one present without (by LBST) breaks at its BK (BK-43).
-        enabled = tuple(b.terminal.branch_enabled(bool(b.devices)) for b in self._branches)
+        # A device answered on a recognised branch (BK-37, BK-47); one present without (by LBST) breaks at its BK
+        # (BK-43).
+        enabled = tuple(b.terminal.branch_enabled(self._answered(b)) for b in self._branches)
         if enabled == self._enabled and self._index:
             return
         self._enabled = enabled
@@ -653,7 +666,7 @@ class Ring:
                     continue
                 at = len(flat)
                 flat.append(item.terminal)
-                if item.terminal.branch_enabled(bool(item.devices)):
+                if item.terminal.branch_enabled(self._answered(item)):
                     own = []
                     for device in item.devices:
                         own.append(len(flat))
@@ -672,6 +685,51 @@ class Ring:
                 self._detached.setdefault(id(device), (device, None))
             else:
                 self._detached.pop(id(device), None)
+
+    def _answered(self, branch: Branch) -> bool:
+        """``connected`` of ``branch``'s BK: its recognition (BK-47), before the ring ran whether it is populated."""
+        return branch.terminal.branch_recognised if self._settled else bool(branch.devices)
+
+    def _recognise(self) -> None:
+        """The ring runs (a reset, a cycle, idle telegrams): every BK whose branch device answers now recognises its
+        branch (BK-47), then the tree flattens again. A branch with return lines (BK-RB, BK-LB) answers when its BK
+        is reached, its interface is live (BK-42) and the loop from DO3 through the branch back to DI3 is whole; an
+        LBD branch when its BK's return input is whole (its devices send counter telegrams on their own, BK-30)."""
+        self._settled = True
+        while True:
+            self._sync()
+            waiting = [b for b in self._branches if b.devices and not b.terminal.branch_recognised]
+            if not waiting:
+                return
+            broken = {id(a.target) for a in self._faults if isinstance(a.fault, (DeadLine, ReturnBreak))}
+            back = {id(a.target) for a in self._faults if isinstance(a.fault, ReturnBreak)}
+            dead = self._first_dead()
+            found = False
+            for branch in waiting:
+                at = self._index.get(id(branch.terminal))
+                reached = at is not None and (dead is None or dead > at + 1) and branch.terminal.branch_enabled(True)
+                if (branch.kind.diagnostics or reached) and self._loop_whole(branch, broken, back):
+                    branch.terminal.recognise_branch()
+                    found = True
+            if not found:
+                return
+
+    def _loop_whole(self, branch: Branch, broken: set[int], back: set[int]) -> bool:
+        """Something sent into ``branch`` comes back to its BK's DI3 (BK-47): its BK's return input is not broken
+        (``back``: the devices whose return input is), and in a branch with return lines no line of the loop is
+        (``broken``: the devices whose forward or return input is), nor the loop of a nested branch in the data path
+        (its BK repeats its DI3 on DO2, BK-37). An LBD branch's devices send counter telegrams behind a break
+        (BK-30)."""
+        if not branch.devices or id(branch.terminal) in back:
+            return False
+        for item in branch.devices:
+            device = item.terminal if isinstance(item, Branch) else item
+            if not branch.kind.diagnostics and id(device) in broken:
+                return False
+            if isinstance(item, Branch) and item.terminal.branch_enabled(self._answered(item)) \
+                    and not self._loop_whole(item, broken, back):
+                return False
+        return True
 
     def _silence_detached(self, start: float, end: float) -> None:
         """Devices of switched-off branches hear nothing: poll them, reset after the timeout (A13)."""
@@ -918,7 +976,7 @@ class Ring:
         if type(cycle) is not Cycle:
             check_instance("cycle", cycle, Cycle)
         if self._branches:
-            self._sync()
+            self._sync() if self._settled else self._recognise()
         n_all = len(self.devices)
         if n_all > wire.MAX_DEVICES:
             raise InterbusError("docs/interbus.md, Ring", n_all, f"a ring has at most {wire.MAX_DEVICES} devices")
@@ -1036,7 +1094,7 @@ class Ring:
             for terminal, traffic, count in transfer.branches:
                 terminal.branch_returned(traffic, count, start, end)
             self._silence_detached(start, end)
-            self._sync()
+            self._recognise()
 
     @staticmethod
     def _latch_run(run: _Run, groups: _Groups, end: float) -> None:
@@ -1065,8 +1123,9 @@ class Ring:
             counted = counted or _sends_counts(device)
 
     def reset(self) -> None:
-        """An INTERBUS reset (the master's Alarm Stop, 1303h): reset pattern, then idle (assumption A12)."""
-        self._sync()
+        """An INTERBUS reset (the master's Alarm Stop, 1303h): reset pattern, then idle (assumption A12). A branch is
+        recognised in the reset's hold, before its devices reset (BK-37, BK-47)."""
+        self._recognise()
         dead = self._first_dead()
         reached = len(self.devices) if dead is None else min(len(self.devices), dead - 1)
         end = self.now + wire.reset_bits(len(self.devices)) / self.bit_rate
@@ -1081,7 +1140,7 @@ class Ring:
     def idle(self, seconds: float) -> None:
         """The master sends only idle status telegrams for ``seconds`` (no cycles)."""
         seconds = check_real("seconds", seconds, 0.0)
-        self._sync()
+        self._recognise()
         dead = self._first_dead()
         reached = len(self.devices) if dead is None else min(len(self.devices), dead - 1)
         end = self.now + seconds
