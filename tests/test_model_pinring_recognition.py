@@ -6,7 +6,9 @@ ring (:class:`~supi3.interbus.ring.Ring` with :class:`~supi3.interbus.ring.Branc
 thing: whether the start succeeds and the diagnostics it reports, the configuration (numbers, ID codes, data
 lengths), the process data IN, and every chip's RD, LD and E LEDs. A branch present by LBST with nothing attached
 breaks the ring at both (BK-43); an empty branch that needs a device's answer (RF = 11, or fibre with LBST = 0) is
-not present and the ring runs through the BK.
+not present and the ring runs through the BK. The transaction-level BK recognises its branch by the pin level's rule
+(BK-47): a break of the branch's loop before the master's first start and after it, in every branch kind, and any
+history of breaks, repairs, starts, cycles and branch commands give the same at both fidelities.
 """
 
 from __future__ import annotations
@@ -61,13 +63,14 @@ Step = tuple[bool, list[object], View | None, Leds]
 
 
 def history(ring: Ring | PinRing, chips: list[Supi3],
-            change: tuple[Callable[[], bool], int] | None = None) -> list[Step]:
+            change: tuple[Callable[[], bool], int] | None = None, cycles: int = CYCLES) -> list[Step]:
     """Start a master on ``ring`` and cycle it: per step, whether it latched, the diagnostics' kinds, the master's
     view (configuration and process data IN, ``None`` without a configuration) and every chip's RD, LD and E (DG-5,
-    BK-11); ``change`` (a callable, step) is called before that step and its result is added to the step's kinds."""
+    BK-11), for ``cycles`` cycles; ``change`` (a callable, step) is called before that step and its result is added
+    to the step's kinds."""
     master = Master(ring, locate=False, max_devices=8)
     steps: list[Step] = []
-    for k in range(CYCLES + 1):
+    for k in range(cycles + 1):
         extra: list[object] = []
         if change is not None and change[1] == k:
             extra.append(change[0]())
@@ -134,8 +137,8 @@ def read_lbd_break(step: Step, kind: BranchKind) -> Step:
 
 def cut_history(kind: BranchKind, rf: str, lbst: bool, cut: Cut, at: int) -> tuple[list[Step], list[Step]]:
     """:func:`history` of the transaction-level and the pin-level tree (two branch devices) with ``cut`` made before
-    step ``at`` (0: before the master's first start); after each step the BK's recognition (``branch_recognised``,
-    ``branch_connected``) must agree."""
+    step ``at`` (0: before the master's first start), up to two cycles after it; after each step the BK's recognition
+    (``branch_recognised``, ``branch_connected``) must agree."""
     fault, (position, forward, branch) = cut
     tl, tl_chips = tl_ring(kind, rf, lbst, 2)
     pin, pin_chips = pin_ring(kind, rf, lbst, 2)
@@ -148,11 +151,11 @@ def cut_history(kind: BranchKind, rf: str, lbst: bool, cut: Cut, at: int) -> tup
         pin.cut(position, forward, branch=branch)
         return connected(pin)
 
-    return history(tl, tl_chips, (tl_cut, at)), history(pin, pin_chips, (pin_cut, at))
+    return history(tl, tl_chips, (tl_cut, at), at + 2), history(pin, pin_chips, (pin_cut, at), at + 2)
 
 
 @pytest.mark.parametrize("kind", [*KINDS, BranchKind.LBD_OR])
-@pytest.mark.parametrize(("rf", "lbst"), [("11", True), ("00", False)])
+@pytest.mark.parametrize(("rf", "lbst"), [("11", True), pytest.param("00", False, marks=pytest.mark.slow)])
 def test_a_branch_cut_before_or_after_the_first_start_is_the_same_at_both_fidelities(
         kind: BranchKind, rf: str, lbst: bool) -> None:
     """BK-37, BK-47, every branch kind, the rows of Table 2-9 that need a device's answer (copper RF = 11 with
@@ -210,3 +213,18 @@ def test_the_recognition_follows_any_history_the_same_at_both_fidelities(
             tl.inject(fault)
             pin.cut(position, forward, branch=branch)
         assert tl_chips[1].branch_recognised == connected(pin), (name, index)
+
+
+def test_the_recognition_stays_through_resets_and_breaks_until_the_power_up() -> None:
+    """BK-47 (BK-37's clearing rule): recognised at the master's start, a BK-LB branch stays recognised through a
+    break, INTERBUS resets and the branch switched off; the BK's power-up reset forgets it, and with the loop broken
+    the next start leaves the branch out (the ring runs through the BK)."""
+    ring, chips = tl_ring(BranchKind.LOCAL, "11", True, 2)
+    master = Master(ring, locate=False, max_devices=8)
+    assert not chips[1].branch_recognised
+    assert master.start().ok and chips[1].branch_recognised and master.config is not None and len(master.config) == 5
+    ring.inject(DeadLine(4))
+    assert not master.start().ok and chips[1].branch_recognised
+    chips[1].power_up()
+    assert not chips[1].branch_recognised
+    assert master.start().ok and not chips[1].branch_recognised and len(master.config) == 3

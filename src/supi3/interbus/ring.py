@@ -20,11 +20,11 @@ into the master.
 A ring can be a tree (Figure 1-10, docs/interbus.md "Tree"): a :class:`Branch` is a bus terminal module (BK) with the
 devices of its branch. The data path runs into the BK, through the branch and back to the BK, then on along the remote
 bus, so the ring flattens the tree into :attr:`Ring.devices` in that order, leaving out every branch its BK has not in
-the data path (switched off by the master, closed by the BK itself, not present by LBST); it flattens again whenever a
-BK changes that. In a tree a fault belongs to the physical line it was injected on: it follows that line when branches
-are switched, and sleeps while the line is out of the data path. :class:`ReturnBreak` breaks a branch's return line (a
-branch in the data path with nothing attached is broken so at its BK, BK-43), and behind a break in a branch with
-device-oriented diagnostics the devices send the counter telegram to the BK (2.2.2, ``wire.counter_telegram``).
+the data path (switched off by the master, closed by the BK itself, not present by Table 2-9: a BK recognises its
+branch once a device answered, BK-47); it flattens again whenever a BK changes that. In a tree a fault belongs to the
+physical line it was injected on: it follows that line when branches are switched, and sleeps while the line is out
+of the data path. :class:`ReturnBreak` breaks a branch's return line (a branch in the data path with nothing attached
+is broken so at its BK, BK-43), and behind a break in a branch with device-oriented diagnostics the devices send the counter telegram to the BK (2.2.2, ``wire.counter_telegram``).
 """
 
 from __future__ import annotations
