@@ -24,7 +24,8 @@ the data path (switched off by the master, closed by the BK itself, not present 
 branch once a device answered, BK-47); it flattens again whenever a BK changes that. In a tree a fault belongs to the
 physical line it was injected on: it follows that line when branches are switched, and sleeps while the line is out
 of the data path. :class:`ReturnBreak` breaks a branch's return line (a branch in the data path with nothing attached
-is broken so at its BK, BK-43), and behind a break in a branch with device-oriented diagnostics the devices send the counter telegram to the BK (2.2.2, ``wire.counter_telegram``).
+is broken so at its BK, BK-43), and behind a break in a branch with device-oriented diagnostics the devices send the
+counter telegram to the BK (2.2.2, ``wire.counter_telegram``).
 """
 
 from __future__ import annotations
