@@ -25,7 +25,7 @@ from supi3.model.chip import Supi3
 from supi3.model.pinring import PinBranch, PinRing
 from supi3.model.pins import Supi3Pins
 from supi3.terminal import RF_CODES, branch_present
-from test_model_pinring_tree import INPUTS, LBST, ROWS, _bk, _config, view
+from test_model_pinring_tree import INPUTS, LBST, ROWS, _bk, _config, nested_pin, nested_tl, view
 
 KINDS = [BranchKind.REMOTE, BranchKind.LOCAL, BranchKind.LBD_MR]
 """BK-RB, BK-LB and BK-LBD (Table 2-7)."""
@@ -228,3 +228,34 @@ def test_the_recognition_stays_through_resets_and_breaks_until_the_power_up() ->
     chips[1].power_up()
     assert not chips[1].branch_recognised
     assert master.start().ok and not chips[1].branch_recognised and len(master.config) == 3
+
+
+@pytest.mark.parametrize("at", [0, 1])
+def test_a_nested_branch_cut_is_the_same_at_both_fidelities(at: int) -> None:
+    """BK-47 in Figure 1-10's nesting (RB device, BK-RB (RB device, BK-LB (LB-MR device)), RB device): a break of the
+    inner branch's loop before the first start leaves the inner branch out and the outer one in (the inner BK, not in
+    the data path, sends its own stream on DO2); a break of the outer branch's forward line leaves both out (the inner
+    BK hears nothing); after the start both are recognised and the master finds the break. The same steps and both
+    BKs' recognition at both fidelities."""
+    cases: list[Cut] = [(DeadLine(5), (5, True, False)), (ReturnBreak(4), (4, False, True)),
+                        (DeadLine(3), (3, True, False))]  # fmt: skip
+    for fault, (position, forward, branch) in cases:
+        tl, pin = nested_tl(), nested_pin()
+        tl_chips = [chip for chip in tl.devices if isinstance(chip, Supi3)]
+        pin_chips = [pins.chip for pins in pin.devices]
+
+        def tl_cut(ring: Ring = tl, made: Fault = fault) -> bool:
+            ring.inject(made)
+            return False
+
+        def pin_cut(ring: PinRing = pin, cut: tuple[int, bool, bool] = (position, forward, branch)) -> bool:
+            ring.cut(cut[0], cut[1], branch=cut[2])
+            return False
+
+        steps = history(tl, tl_chips, (tl_cut, at), at + 1), history(pin, pin_chips, (pin_cut, at), at + 1)
+        assert steps[0] == steps[1], (fault, at)
+        bks = [pin.devices[k] for k in (1, 3)]
+        assert all(isinstance(bk, Supi3Pins) for bk in bks)
+        recognised = [tl_chips[k].branch_recognised for k in (1, 3)]
+        assert recognised == [bk.branch_connected for bk in bks if isinstance(bk, Supi3Pins)], (fault, at)
+        assert recognised == ([True, True] if at else [False, False] if position == 3 else [True, False]), fault

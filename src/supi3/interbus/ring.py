@@ -178,6 +178,9 @@ class _Active:
     remaining: int | None
     target: object = None
     """In a tree: the device whose incoming line the fault is on (``None``: the return line into the master)."""
+    branch: bool = False
+    """A :class:`ReturnBreak` at a BK with its branch on: its branch return input, out of the data path (asleep) while
+    that branch is (BK-47)."""
 
 
 # ----------------------------------------------------------------------------------------------------------------
@@ -702,33 +705,33 @@ class Ring:
             waiting = [b for b in self._branches if b.devices and not b.terminal.branch_recognised]
             if not waiting:
                 return
-            broken = {id(a.target) for a in self._faults if isinstance(a.fault, (DeadLine, ReturnBreak))}
-            back = {id(a.target) for a in self._faults if isinstance(a.fault, ReturnBreak)}
+            forward = {id(a.target) for a in self._faults if isinstance(a.fault, DeadLine)}
+            back = {(id(a.target), a.branch) for a in self._faults if isinstance(a.fault, ReturnBreak)}
             dead = self._first_dead()
             found = False
             for branch in waiting:
                 at = self._index.get(id(branch.terminal))
                 reached = at is not None and (dead is None or dead > at + 1) and branch.terminal.branch_enabled(True)
-                if (branch.kind.diagnostics or reached) and self._loop_whole(branch, broken, back):
+                if (branch.kind.diagnostics or reached) and self._loop_whole(branch, forward, back):
                     branch.terminal.recognise_branch()
                     found = True
             if not found:
                 return
 
-    def _loop_whole(self, branch: Branch, broken: set[int], back: set[int]) -> bool:
+    def _loop_whole(self, branch: Branch, forward: set[int], back: set[tuple[int, bool]]) -> bool:
         """Something sent into ``branch`` comes back to its BK's DI3 (BK-47): its BK's return input is not broken
-        (``back``: the devices whose return input is), and in a branch with return lines no line of the loop is
-        (``broken``: the devices whose forward or return input is), nor the loop of a nested branch in the data path
-        (its BK repeats its DI3 on DO2, BK-37). An LBD branch's devices send counter telegrams behind a break
-        (BK-30)."""
-        if not branch.devices or id(branch.terminal) in back:
+        (``back``: the devices whose return input is, with whether it is a BK's branch return input), and in a branch
+        with return lines no line of the loop is (``forward``: the devices whose forward input is), nor the loop of a
+        nested branch in the data path (its BK repeats its DI3 on DO2, BK-37). An LBD branch's devices send counter
+        telegrams behind a break (BK-30)."""
+        if not branch.devices or (id(branch.terminal), True) in back:
             return False
         for item in branch.devices:
             device = item.terminal if isinstance(item, Branch) else item
-            if not branch.kind.diagnostics and id(device) in broken:
+            if not branch.kind.diagnostics and (id(device) in forward or (id(device), False) in back):
                 return False
             if isinstance(item, Branch) and item.terminal.branch_enabled(self._answered(item)) \
-                    and not self._loop_whole(item, broken, back):
+                    and not self._loop_whole(item, forward, back):
                 return False
         return True
 
@@ -749,7 +752,9 @@ class Ring:
         if active.target is None:
             return len(self.devices) + 1
         index = self._index.get(id(active.target))
-        return None if index is None else index + 1
+        if index is None or (active.branch and self._span_of(index, True) is None):
+            return None
+        return index + 1
 
     def _span_of(self, index: int, own: bool) -> _Span | None:
         """The innermost enabled branch whose BK (``own``) or whose device is at ``index``."""
@@ -816,7 +821,8 @@ class Ring:
                                     "a return line enters only a BK with its branch on, or a device of a branch with "
                                     "return lines that has a device behind it")  # fmt: skip
         target = None if fault.segment > n else self.devices[fault.segment - 1]
-        self._faults.append(_Active(fault, fault.cycles, target))
+        branch = isinstance(fault, ReturnBreak) and self._span_of(fault.segment - 1, True) is not None
+        self._faults.append(_Active(fault, fault.cycles, target, branch))
 
     def clear_faults(self) -> None:
         """Remove every injected fault."""
