@@ -187,7 +187,8 @@ loop (an index into :func:`cuts`), every break repaired, the branch switched off
 
 @settings(max_examples=12, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
 @given(kind=st.sampled_from([*KINDS, BranchKind.LBD_OR]),
-       row=st.sampled_from([("11", True), ("00", False), ("10", False)]), ops=st.lists(OPS, min_size=1, max_size=7))
+       row=st.sampled_from([("11", True), ("00", False), ("10", False), ("10", True)]),
+       ops=st.lists(OPS, min_size=1, max_size=7))
 def test_the_recognition_follows_any_history_the_same_at_both_fidelities(
         kind: BranchKind, row: tuple[str, bool], ops: list[Op]) -> None:
     """BK-37, BK-47: breaks, repairs, starts (INTERBUS resets), cycles and branch commands in any order leave the
