@@ -6,7 +6,8 @@ and power-up resets, the pin-level BK (:class:`~supi3.model.pins.Supi3Pins`) fol
   runs, and a power-up reset clears it (BK-37); a pulled-up DI3 with nothing attached never shows one (BK-41);
 * DO3 (MFP9) carries the DO2 of a chip without branch (the same straps, DI3 at rest, LBST low) while the interface is
   live (BK-42: the branch open and present by Table 2-9 were a device answering) and idles else; DO2 repeats the
-  synchronised DI3 while the branch is in the data path (Table 2-9 with ``connected``) and is that chip's else.
+  synchronised DI3 while the branch is in the data path (Table 2-9 with ``connected``) and is that chip's else;
+  each line switches between telegrams, within ``SWITCH_WINDOW`` of a change and idle meanwhile (BK-47).
 
 The attached device answers as a following protocol chip does: it returns what DO3 sends, a repeater's delay later;
 detached, DI3 reads the pull-up. run() equals step() on them, and the RTL core runs them in lockstep
@@ -26,7 +27,7 @@ from supi3.interbus import wire
 from supi3.interbus.wire import Cycle
 from supi3.model.pins import Supi3Pins
 from supi3.pinout import SYNC_STAGES
-from supi3.terminal import DI3_PIN, DO3_PIN, LBST_PIN, RF_CODES, TERMINAL_INTERFACES, branch_present
+from supi3.terminal import BRANCH_DRAIN_BITS, DI3_PIN, DO3_PIN, LBST_PIN, RF_CODES, TERMINAL_INTERFACES, branch_present
 from support import BK_STRAPS, Columns, CoreScript, assert_run_matches_step
 
 ANSWER_DELAY = 3 * 16 + 5
@@ -72,6 +73,42 @@ def history(interface: str, rf: str, ops: Sequence[Op]) -> tuple[DeviceConfig, C
     return config, columns, device
 
 
+SWITCH_WINDOW = 2 * wire.DATA_TELEGRAM_BITS + BRANCH_DRAIN_BITS + 2
+"""Bit periods after a change of the BK state within which a branch line has switched (BK-47): up to a telegram to
+leave the old line (DI3 once drained), up to a telegram to take the new one."""
+
+
+def settled(change: np.ndarray, cpb: int, sent: np.ndarray | None = None) -> np.ndarray:
+    """The cycles at least :data:`SWITCH_WINDOW` bit periods after the last change of the boolean trace ``change``
+    and after the end of an INTERBUS reset (a start level held, A12) on ``sent``: a line waits for the end of it."""
+    moved = np.zeros(len(change), dtype=bool)
+    moved[1:] = change[1:] != change[:-1]
+    if sent is not None:
+        low = sent == wire.START_LEVEL
+        ends = np.flatnonzero(low[:-1] & ~low[1:]) + 1
+        began = np.maximum.accumulate(np.where(low & ~np.concatenate([[False], low[:-1]]), np.arange(len(low)), 0))
+        moved[ends[ends - began[ends - 1] > wire.RESET_DETECT_BITS * cpb]] = True
+        moved |= low & (np.arange(len(low)) - began > wire.RESET_DETECT_BITS * cpb)
+    last = np.maximum.accumulate(np.where(moved, np.arange(len(change)), -SWITCH_WINDOW * cpb))
+    return np.arange(len(change)) - last >= SWITCH_WINDOW * cpb
+
+
+def line_problems(do2: np.ndarray, do3: np.ndarray, alone: np.ndarray, di3: np.ndarray, live: np.ndarray,
+                  on: np.ndarray, cpb: int) -> list[str]:
+    """BK-42, BK-47 on a BK's lines: DO3 is ``alone`` (the DO2 of a chip without branch) where the interface is
+    ``live``, else idle; DO2 is the synchronised ``di3`` where the branch is ``on`` (in the data path), else
+    ``alone``; exactly so from :data:`SWITCH_WINDOW` after a change, and within it one of the two or idle (the lines
+    switch between telegrams)."""
+    problems = []
+    for name, line, want, sources in (("DO3", do3, np.where(live, alone, wire.IDLE_LEVEL), [alone]),
+                                      ("DO2", do2, np.where(on, di3, alone), [di3, alone])):
+        steady = settled(live if name == "DO3" else on, cpb, alone)
+        wrong = np.flatnonzero(steady & (line != want)).tolist()
+        stray = np.flatnonzero((line != wire.IDLE_LEVEL) & ~np.logical_or.reduce([line == s for s in sources]))
+        problems += [f"{t}: {name} {line[t]}, want {want[t]}" for t in [*wrong[:3], *stray[:3].tolist()]]
+    return problems
+
+
 def close_loop(config: DeviceConfig, columns: Columns, device: np.ndarray) -> tuple[Columns, list[str]]:
     """Step a BK through ``columns`` with DI3 from the attached device (DO3 ``ANSWER_DELAY`` clocks before) or the
     pull-up, checking the reading every clock; the columns with DI3 filled in, and the rule violations found."""
@@ -80,6 +117,10 @@ def close_loop(config: DeviceConfig, columns: Columns, device: np.ndarray) -> tu
     mfp = columns["mfp_in"].copy()
     alone = Supi3Pins(config).run({**columns, "mfp_in": mfp & ~(1 << LBST_PIN) | 1 << DI3_PIN})["do2"]
     do3 = np.ones(n, dtype=np.int64)
+    do2 = np.ones(n, dtype=np.int64)
+    live = np.zeros(n, dtype=bool)
+    on = np.zeros(n, dtype=bool)
+    di3s = np.ones(n, dtype=np.int64)
     names = [name for name in columns if name in {pin.name for pin in Supi3Pins.inputs}]
     connected = False
     table = np.array([[branch_present(_rf(config), bool(lbst), bool(c)) for c in (0, 1)] for lbst in (0, 1)])
@@ -92,16 +133,13 @@ def close_loop(config: DeviceConfig, columns: Columns, device: np.ndarray) -> tu
         terminal = pins.chip.bus_terminal
         opened = terminal is not None and terminal.state.switched_on and not terminal.state.closed
         out = pins.step({name: int(columns[name][t]) if name != "mfp_in" else int(mfp[t]) for name in names})
-        do3[t] = out["mfp_out"] >> DO3_PIN & 1
-        live, on = opened and table[lbst, 1], opened and table[lbst, int(connected)]
-        if do3[t] != (alone[t] if live else wire.IDLE_LEVEL):
-            problems.append(f"{t}: DO3 {do3[t]}, live {live}")
-        if out["do2"] != (di3 if on else alone[t]):
-            problems.append(f"{t}: DO2 {out['do2']}, in the data path {on}")
+        do3[t], do2[t], di3s[t] = out["mfp_out"] >> DO3_PIN & 1, out["do2"], di3
+        live[t], on[t] = opened and table[lbst, 1], opened and table[lbst, int(connected)]
         connected = (connected or di3 == wire.START_LEVEL) if pins.run_from <= t else False
         assert pins._branch is not None
         if pins._branch.connected != connected:
             problems.append(f"{t}: connected {pins._branch.connected}, the reading says {connected}")
+    problems += line_problems(do2, do3, alone, di3s, live, on, pins.cpb)
     return {**columns, "mfp_in": mfp}, problems
 
 
