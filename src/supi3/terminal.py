@@ -50,6 +50,7 @@ __all__ = [
     "LBST_PIN",
     "RF_CODES",
     "TERMINAL_INTERFACES",
+    "LineSource",
     "Terminal",
     "TerminalMode",
     "branch_present",
@@ -77,6 +78,15 @@ BRANCH_DRAIN_BITS: Final = wire.STATUS_TELEGRAM_BITS
 """BK-47: a BK leaving its branch's return line (DO2 no longer repeating DI3) waits until DI3 has been between
 telegrams at the idle level for this many bit periods (a status telegram's length: the master fills every gap with
 status telegrams, so the branch has drained what it held)."""
+
+
+class LineSource(IntEnum):
+    """What a BK's DO2 carries (BK-47): the transmitter's line, the synchronised DI3 (the branch in the data path), or
+    the idle level while it switches between the two."""
+
+    SENT = 0
+    DI3 = 1
+    IDLE = 2
 
 
 def silence_limit(time_limit: object) -> int:

@@ -53,6 +53,7 @@ from supi3.terminal import (
     DI3_PIN,
     DO3_PIN,
     LBST_PIN,
+    LineSource,
     Terminal,
     TerminalMode,
     branch_present,
@@ -306,9 +307,9 @@ class BranchLines:
     """
 
     __slots__ = (
-        "_busy", "_c0", "_connected", "_events", "_initial", "_lbst", "_line", "_opens", "_restarts", "_running", "_starts",
-        "_strobes", "connected", "counter", "counting", "cpb", "drain", "drained", "fast", "limit", "present", "sel2",
-        "sel3", "timer", "timer_at", "tx", "watch",
+        "_busy", "_c0", "_connected", "_events", "_initial", "_lbst", "_line", "_opens", "_restarts", "_running",
+        "_starts", "_strobes", "connected", "counter", "counting", "cpb", "drain", "drained", "fast", "limit",
+        "present", "sel2", "sel3", "timer", "timer_at", "tx", "watch",
     )  # fmt: skip
 
     def __init__(self, rf: str | None, cpb: int, lbd: bool, time_limit: int = BRANCH_SILENCE_CLOCKS) -> None:
@@ -330,7 +331,7 @@ class BranchLines:
         self.sel3 = False
         """DO3 carries the transmitter's line (else it idles), BK-47."""
         self.sel2 = _SENT
-        """What DO2 carries: :data:`_SENT`, :data:`_DI3` or :data:`_IDLE` (BK-47)."""
+        """What DO2 carries, a :class:`~supi3.terminal.LineSource` (BK-47)."""
         self.drained = 0
         """Clocks before this one that DI3 spent between telegrams at the idle level, at most :attr:`drain`."""
         self.timer = 0
@@ -607,8 +608,7 @@ class BranchLines:
         self.drained = drained(m)
 
 
-_SENT, _DI3, _IDLE = 0, 1, 2
-"""What a BK's DO2 carries (BK-47): the transmitter's line, the synchronised DI3, the idle level."""
+_SENT, _DI3, _IDLE = (int(source) for source in LineSource)
 
 
 def _open(state: Terminal) -> bool:
