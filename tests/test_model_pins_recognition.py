@@ -24,7 +24,7 @@ from hypothesis import strategies as st
 
 from supi3.config import DeviceConfig, decode
 from supi3.interbus import wire
-from supi3.interbus.wire import Cycle
+from supi3.interbus.wire import BranchControl, Cycle
 from supi3.model.pins import Supi3Pins
 from supi3.pinout import SYNC_STAGES
 from supi3.terminal import BRANCH_DRAIN_BITS, DI3_PIN, DO3_PIN, LBST_PIN, RF_CODES, TERMINAL_INTERFACES, branch_present
@@ -40,9 +40,10 @@ OPS = st.one_of(
     st.tuples(st.sampled_from(["attach", "detach", "reset", "power"]), st.just(0)),
     st.tuples(st.just("lbst"), st.integers(0, 1)),
     st.tuples(st.just("idle"), st.integers(1, 12)),
+    st.tuples(st.just("switch"), st.sampled_from([control.value for control in BranchControl][1:])),
 )  # fmt: skip
 """One step of a history: attach or detach the branch's device, an INTERBUS reset, a power-up reset, LBST to a level,
-or idle status telegrams."""
+idle status telegrams, or a latched ID cycle whose command word switches the branch (BK-4: off, on, on extended)."""
 
 
 def history(interface: str, rf: str, ops: Sequence[Op]) -> tuple[DeviceConfig, Columns, np.ndarray]:
@@ -62,6 +63,8 @@ def history(interface: str, rf: str, ops: Sequence[Op]) -> tuple[DeviceConfig, C
             script.pins["mfp_in"] = value << LBST_PIN
         elif op == "reset":
             script.line(wire.reset_levels(1))
+        elif op == "switch":
+            script.id_cycle(wire.command_word(branch=BranchControl(value)))
         elif op == "power":
             script.line(np.ones(POWER_DOWN_BITS, dtype=np.uint8), resu_n=0).line(np.ones(1, np.uint8), resu_n=1)
         script.line(wire.status_levels(Cycle.DATA, False, value if op == "idle" else 2))
@@ -134,8 +137,9 @@ def close_loop(config: DeviceConfig, columns: Columns, device: np.ndarray) -> tu
         opened = terminal is not None and terminal.state.switched_on and not terminal.state.closed
         out = pins.step({name: int(columns[name][t]) if name != "mfp_in" else int(mfp[t]) for name in names})
         do3[t], do2[t], di3s[t] = out["mfp_out"] >> DO3_PIN & 1, out["do2"], di3
-        live[t], on[t] = opened and table[lbst, 1], opened and table[lbst, int(connected)]
-        connected = (connected or di3 == wire.START_LEVEL) if pins.run_from <= t else False
+        running = pins.run_from <= t  # a power-up reset sends the transmitter's line on DO2 and idles DO3
+        live[t], on[t] = running and opened and table[lbst, 1], running and opened and table[lbst, int(connected)]
+        connected = (connected or di3 == wire.START_LEVEL) if running else False
         assert pins._branch is not None
         if pins._branch.connected != connected:
             problems.append(f"{t}: connected {pins._branch.connected}, the reading says {connected}")
@@ -152,19 +156,23 @@ def _rf(config: DeviceConfig) -> str:
 def random_history(seed: int) -> tuple[str, str, list[Op]]:
     """A BK interface, RF straps and 8 steps drawn from ``seed`` (the RTL lockstep's random histories)."""
     rng = np.random.default_rng(seed)
-    kinds = ["attach", "detach", "reset", "power", "lbst", "idle"]
+    kinds = ["attach", "detach", "reset", "power", "lbst", "idle", "switch"]
     ops: list[Op] = []
     for kind in rng.choice(kinds, 8).tolist():
-        value = int(rng.integers(0, 2)) if kind == "lbst" else int(rng.integers(1, 13)) if kind == "idle" else 0
+        value = int(rng.integers(0, 2)) if kind == "lbst" else int(rng.integers(1, 13)) if kind == "idle" \
+            else int(rng.integers(1, 4)) if kind == "switch" else 0
         ops.append((kind, value))
     return str(rng.choice(TERMINAL_INTERFACES)), str(rng.choice(RF_CODES)), ops
 
 
+OFF, ON, EXTENDED = (control.value for control in BranchControl if control is not BranchControl.NONE)
 FIXED: list[tuple[str, str, list[Op]]] = [
     ("BK-LB", "11", [("attach", 0), ("idle", 4), ("lbst", 0), ("detach", 0), ("reset", 0), ("attach", 0),
                      ("lbst", 1), ("idle", 3), ("power", 0), ("idle", 6)]),
     ("BK-LBD", "00", [("lbst", 0), ("idle", 3), ("attach", 0), ("idle", 3), ("detach", 0), ("power", 0),
                       ("lbst", 1), ("reset", 0)]),
+    ("BK-LB", "11", [("attach", 0), ("idle", 2), ("switch", OFF), ("idle", 1), ("switch", EXTENDED), ("switch", OFF),
+                     ("switch", ON), ("reset", 0), ("switch", OFF), ("reset", 0), ("idle", 2)]),
 ]  # fmt: skip
 """Histories the RTL core runs in lockstep too (every step of the reading on each), with :func:`random_history`'s."""
 
