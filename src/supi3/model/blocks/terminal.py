@@ -271,7 +271,10 @@ class BranchLines:
     the branch is in the data path (:func:`~supi3.terminal.enabled`: present by Table 2-9, switched on, not closed)
     DO2 repeats the synchronised DI3, the branch's return line: the data path runs through the BK, its branch, then
     on along the remote bus (BK-1's flattened order); the M5 loop-back takes this DO2. Otherwise DO2 is the
-    transmitter's. ``connected`` (a device answers on the branch, BK-37) latches the first start level (0) of the
+    transmitter's. Each line switches only between telegrams (BK-47, :meth:`_select`): :attr:`sel3` and
+    :attr:`sel2`, registers updated where the core's logic runs, follow ``live`` and ``enabled``; DO2 idles between
+    its two lines and leaves DI3 once the branch has drained. ``connected`` (a device answers on the branch,
+    BK-37) latches the first start level (0) of the
     synchronised DI3 at a clock edge where the core's logic runs: a following protocol chip repeats what DO3 sends
     (the master's reset pattern, its telegrams) and loops it back, and each begins with a start level; a pulled-up
     DI3 (BK-41) or a broken line (BK-30) rests at the idle level and never shows one. A power-up reset clears it.
