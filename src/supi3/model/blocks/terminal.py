@@ -222,6 +222,15 @@ class ReturnWatch:
                 if i == len(starts):
                     break
                 k = int(starts[i])
+                sample = k + half  # a whole telegram in the trace: its start and type samples give its end
+                if sample + cpb < n and line[sample] == wire.START_LEVEL:
+                    data = bool(line[sample + cpb] == wire.TYPE_DATA_LEVEL)
+                    end = sample + ((wire.DATA_TELEGRAM_BITS if data else wire.STATUS_TELEGRAM_BITS) - 1) * cpb
+                    if end < n:
+                        self.data = data
+                        busy[k + 1 : end + 1] = True
+                        k = end + 1
+                        continue
                 self.bit, self.phase, first = 0, 0, k + 1
             while True:
                 sample = k + (half - self.phase) % cpb
@@ -310,7 +319,7 @@ class BranchLines:
     """
 
     __slots__ = (
-        "_busy", "_c0", "_connected", "_events", "_initial", "_lbst", "_line", "_opens", "_restarts", "_running",
+        "_c0", "_connected", "_events", "_initial", "_lbst", "_line", "_opens", "_restarts", "_running",
         "_starts", "_strobes", "connected", "counter", "counting", "cpb", "drain", "drained", "fast", "limit",
         "present", "sel2", "sel3", "timer", "timer_at", "tx", "watch",
     )  # fmt: skip
@@ -348,10 +357,9 @@ class BranchLines:
         self._lbst = np.zeros(0, dtype=np.int64)
         self._connected = np.zeros(0, dtype=np.int64)
         self._strobes = np.zeros((0, 3), dtype=np.int64)
-        self._busy = np.zeros(0, dtype=bool)
         self._running = np.zeros(0, dtype=bool)
         self._restarts: list[int] = []
-        self._initial = (self.sel3, self.sel2, self.drained, ReturnWatch())
+        self._initial = (self.sel3, self.sel2, self.drained, ReturnWatch(), ReturnWatch())
         self._events: list[int] = []
 
     # One cycle --------------------------------------------------------------------------------------------------
@@ -489,10 +497,9 @@ class BranchLines:
         self._lbst = mfp_in >> LBST_PIN & 1
         self._strobes = np.zeros((len(mfp_in), 3), dtype=np.int64)
         self._connected = np.zeros(len(mfp_in), dtype=np.int64)
-        self._busy = np.zeros(len(mfp_in), dtype=bool)
         self._running = np.zeros(len(mfp_in), dtype=bool)
         self._restarts = []
-        self._initial = (self.sel3, self.sel2, self.drained, copy.copy(self.tx))
+        self._initial = (self.sel3, self.sel2, self.drained, copy.copy(self.tx), copy.copy(self.watch))
         self.plan(c0, run_from, restart=False)
         counting = c0 >= run_from and self._counts(c0, state)
         if counting and not self.counting:  # the timer stood at 0
@@ -522,12 +529,10 @@ class BranchLines:
                 end = starts[s] if s < len(starts) else n
                 strobes[k:end] = 0
                 connected[k:end] = 1
-                self._busy[k:end] = False
                 k = end
                 continue
             strobes[k] = self.strobes()
             connected[k] = self.connected
-            self._busy[k] = watch.busy
             self._clock_di3(int(line[k]))
             k += 1
         rises = np.flatnonzero(np.diff(connected, prepend=connected[:1]) | np.diff(self._lbst, prepend=self._lbst[:1]))
@@ -560,30 +565,33 @@ class BranchLines:
         on = self.present[self._lbst, self._connected] & opens
         sent = traces["do2"]
         live = self.present[self._lbst, 1] & opens
-        self.sel3, self.sel2, self.drained, self.tx = self._initial
+        self.sel3, self.sel2, self.drained, self.tx, di3 = self._initial
         sel3 = np.zeros(n, dtype=bool)
         sel2 = np.zeros(n, dtype=np.int64)
         for a, b in zip([0, *self._restarts], [*self._restarts, n], strict=True):
             if a:
                 self.tx.reset()
+                di3 = ReturnWatch()
                 self.sel3, self.sel2, self.drained = False, _SENT, 0
             running = np.flatnonzero(self._running[a:b])
             first = a + int(running[0]) if running.size else b
             sel3[a:first], sel2[a:first] = self.sel3, self.sel2
-            self._select_run(first, b, live, on, sent, sel3, sel2)
+            self._select_run(first, b, live, on, sent, di3, sel3, sel2)
         traces["mfp_out"] = traces["mfp_out"] | np.where(sel3, sent, wire.IDLE_LEVEL) << DO3_PIN
         traces["do2"] = np.where(sel2 == _SENT, sent, np.where(sel2 == _DI3, self._line, wire.IDLE_LEVEL))
 
     def _select_run(self, a: int, b: int, live: npt.NDArray[np.bool_], on: npt.NDArray[np.bool_],
-                    sent: npt.NDArray[np.int64], sel3: npt.NDArray[np.bool_], sel2: npt.NDArray[np.int64]) -> None:
-        """:meth:`_select` at the run's cycles ``a`` to ``b`` (the logic runs), into ``sel3`` and ``sel2``: only
-        the cycles where a line waits to switch are visited."""
+                    sent: npt.NDArray[np.int64], di3: ReturnWatch, sel3: npt.NDArray[np.bool_],
+                    sel2: npt.NDArray[np.int64]) -> None:
+        """:meth:`_select` at the run's cycles ``a`` to ``b`` (the logic runs), into ``sel3`` and ``sel2``, with
+        ``di3`` the return watch as at ``a`` (:attr:`watch`'s twin): only the cycles where a line waits to switch
+        are visited."""
         m = b - a
         if m <= 0:
             return
         tx_busy = self.tx.scan(sent[a:b], self.cpb)
         line = self._line[a:b]
-        di3_busy = self._busy[a:b]
+        di3_busy = di3.scan(line, self.cpb)
         idle = (line == wire.IDLE_LEVEL) & ~di3_busy
         last = np.maximum.accumulate(np.where(idle, -1, np.arange(m)))  # the last busy or start-level clock
         carry = self.drained
