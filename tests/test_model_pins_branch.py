@@ -12,11 +12,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from supi3.config import decode
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.wire import BranchControl
+from supi3.model.blocks.terminal import ReturnWatch
 from supi3.model.bus_terminal import BusTerminal
 from supi3.model.pins import Supi3Pins
 from supi3.pinout import SYNC_STAGES
@@ -217,3 +220,23 @@ def test_the_extended_function_closes_a_silent_branch() -> None:
 def test_a_bad_silence_limit_is_named(limit: object) -> None:
     with pytest.raises(ArgumentError, match="branch_silence must be"):
         Supi3Pins(decode(BK_STRAPS["BK-LB"], clk_conf="11"), branch_silence=limit)  # type: ignore[arg-type]
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(st.lists(st.tuples(st.integers(0, 1), st.integers(1, 40)), min_size=1, max_size=60), st.integers(0, 400),
+       st.sampled_from([16, 64]))  # fmt: skip
+def test_the_watch_scans_as_it_clocks(runs: list[tuple[int, int]], split: int, cpb: int) -> None:
+    """BK-47's telegram grid on a run (``ReturnWatch.scan``, telegram by telegram) is the clock-by-clock watch's
+    (``ReturnWatch.clock``): ``busy`` before each clock and the state after, on any line (glitches, start bits read
+    idle, telegrams cut at the end), continued from any state (the line split anywhere)."""
+    line = np.repeat([level for level, _ in runs], [length for _, length in runs]).astype(np.int64)
+    split = min(split, len(line))
+    stepped, scanned = ReturnWatch(), ReturnWatch()
+    busy = []
+    for level in line.tolist():
+        busy.append(stepped.busy)
+        stepped.clock(level, cpb)
+    got = np.concatenate([scanned.scan(line[:split], cpb), scanned.scan(line[split:], cpb)])
+    np.testing.assert_array_equal(got, busy)
+    assert (scanned.bit, scanned.data) == (stepped.bit, stepped.data)
+    assert scanned.bit < 0 or scanned.phase == stepped.phase
