@@ -19,6 +19,7 @@ in the latch phase (``InconsistentDataError``) are all tested at transaction lev
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from collections.abc import Sequence
 from types import TracebackType
@@ -327,7 +328,15 @@ class Bench:
         return self._next_at
 
     def advance(self, until: float) -> None:
-        """Run the bus up to time ``until`` and set the clock there (not backwards)."""
+        """Run the bus up to time ``until`` and set the clock there (not backwards).
+
+        Raises
+        ------
+        ArgumentError
+            ``until`` not a finite number (NaN would run nothing, infinity for ever); nothing changes.
+        """
+        if type(until) is not float or not -math.inf < until < math.inf:  # the board's float: one test
+            until = check_real("until", until)
         # Most calls (a byte, a pin read, the board's synchronisation at each peripheral access) find no bus event
         # due: one comparison with the next event's time, kept by _step_bus and _start_cycle.
         while self._next_at <= until:
