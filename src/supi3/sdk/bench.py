@@ -26,7 +26,7 @@ from types import TracebackType
 from typing import Final, Literal, NamedTuple
 
 from supi3 import tables, timing
-from supi3.checks import check_bool, check_instance, check_int, check_real, describe
+from supi3.checks import check_bool, check_instance, check_int, check_real, describe, fail
 from supi3.config import DeviceConfig, decode
 from supi3.errors import Supi3Error
 from supi3.interbus import wire
@@ -293,6 +293,8 @@ class Bench:
             raise DriverArgumentError("config", config, f"config must strap an Init-µP mode (Tables 2-4 to 2-7), "
                                       f"not {self.config.function!r}")  # fmt: skip
         self.registers: RegisterFile = self.chip.registers
+        if isinstance(others, str | bytes) or not isinstance(others, Sequence):  # Ring names each item's error
+            raise fail("others", "a sequence of the devices behind the chip (Device objects)", others)
         self.ring = Ring([self.chip, *others], bit_rate=self.config.bit_rate)
         self._bus = _ClockedBus(self.ring)
         self.master = Master(self._bus)
