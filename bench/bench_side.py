@@ -58,6 +58,9 @@ def load(src: str) -> Tree:
             importlib.import_module(module)
     finally:
         sys.path.remove(src)
+    found = Path(sys.modules["supi3"].__file__ or "").resolve()
+    if not found.is_relative_to(Path(src).resolve()):  # another supi3 on the path: never measure it silently
+        raise SystemExit(f"bench_side.py: {src} holds no supi3 package (imported {found} instead)")
     return {n: m for n, m in sys.modules.items() if _own(n)}
 
 
@@ -138,6 +141,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--calls", action="store_true", help="count the function calls of each run (cProfile) in "
                         "place of its CPU time: a measure the machine's load does not move")  # fmt: skip
     args = parser.parse_args(argv)
+    if args.rounds < 1:
+        parser.error(f"--rounds must be at least 1, not {args.rounds}")
     global COUNT_CALLS
     COUNT_CALLS = args.calls
     cases = args.cases.split(",")
