@@ -244,6 +244,37 @@ def test_a_boards_ring_refuses_the_boards_chip_and_takes_the_devices_behind_it(d
 
 
 @needs_toolchain
+@settings(max_examples=6, deadline=None, derandomize=True)
+@given(steps=st.lists(st.sampled_from([("run", 0), ("run", 1), ("run", 2), ("for", 0.0), ("for", 400e-6),
+                                       ("for", 800e-6)]), min_size=1, max_size=4))  # fmt: skip
+def test_any_history_of_run_and_run_for_counts_the_same_at_both_fidelities(
+    digital_io: Path, steps: list[tuple[str, float]]
+) -> None:
+    """MCU-22: after the power-up, any sequence of ``run(k)`` and ``run_for`` of whole cycle times (a master cycle
+    every 400 µs) gives the same master cycles, EXTI0 handler entries and firmware cycles after every call at both
+    fidelities, and bus times that stay within two status telegrams of each other (20 µs at 500 kbit/s: ``run``
+    ends once the handler is served, on the line's telegram grid at pin level; no drift over the history)."""
+    seen = []
+    for fidelity in ("transaction", "pin"):
+        board = Board(digital_io, fidelity=fidelity, cycle_time_s=400e-6)
+        board.run(3)
+        fw = board.fw_board
+        assert fw is not None
+        base = (board.now, board.cycles, board.interrupts, fw.cycles)
+        trace = []
+        for kind, value in steps:
+            if kind == "run":
+                board.run(int(value))
+            else:
+                board.run_for(value)
+            trace.append((board.cycles - base[1], board.interrupts - base[2], fw.cycles - base[3], board.now - base[0]))
+        assert board.violations == []
+        seen.append(trace)
+    for tl, pin in zip(*seen, strict=True):
+        assert tl[:3] == pin[:3] and tl[3] == pytest.approx(pin[3], abs=2 * wire.STATUS_TELEGRAM_BITS / 500_000)
+
+
+@needs_toolchain
 @pytest.mark.parametrize("devices", [0, 5, -1, "x", True, 4.0, None], ids=repr)
 def test_run_firmware_refuses_a_pin_level_ring_it_cannot_run(digital_io: Path, devices: object) -> None:
     """MCU-23: at pin level 1 to 4 chips (``MAX_PIN_DEVICES``), an integer: anything else by name."""
