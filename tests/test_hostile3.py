@@ -253,8 +253,9 @@ def test_any_history_of_run_and_run_for_counts_the_same_at_both_fidelities(
     """MCU-22: after the power-up, any sequence of ``run(k)`` and ``run_for`` of whole cycle times (a master cycle
     every 400 µs) gives the same master cycles and EXTI0 handler entries after every call at both fidelities, the
     same firmware cycles after every ``run`` (which serves the last handler; ``run_for`` may end inside it, 13 µs
-    later at one fidelity than at the other), and bus times that stay within two status telegrams of each other (20 µs at 500 kbit/s: ``run``
-    ends once the handler is served, on the line's telegram grid at pin level; no drift over the history)."""
+    later at one fidelity than at the other), and bus times that stay within two status telegrams of each other
+    (20 µs at 500 kbit/s: ``run`` ends once the handler is served, on the line's telegram grid at pin level; no drift
+    over the history)."""
     seen = []
     for fidelity in ("transaction", "pin"):
         board = Board(digital_io, fidelity=fidelity, cycle_time_s=400e-6)
