@@ -39,7 +39,7 @@ from supi3.sdk import native
 from supi3.sdk.bench import Bench
 from supi3.tables import CLOCK_HZ, clk_conf_for
 from supi3.top import Supi3Chip
-from support import quiet_inputs
+from support import assert_run_matches_step, quiet_inputs
 from test_model_pinring_tree import RECOVERY, counted, pin_tree, tl_tree, view
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -219,6 +219,20 @@ def test_the_filter_latches_after_the_same_clocks_at_both_fidelities(filter_cloc
             continue
         expected = low >= filter_clocks
         assert (_tl_latches(filter_clocks, low), _pin_latches(filter_clocks, low)) == (expected, expected)
+
+
+@pytest.mark.parametrize("filter_clocks", [1, 3, 50])
+def test_a_short_filter_steps_as_it_runs(filter_clocks: int) -> None:
+    """MCU-24: with a short filter the pin level's ``run`` (which jumps to the chip's ``due``, the filter's expiry
+    among them) gives every output of ``step`` clock by clock, for a pulse as long as the filter and one a clock
+    shorter, cut into pieces anywhere."""
+    config = decode("10000")
+    inputs = quiet_inputs(3000)
+    inputs["stat_err_n"][1000 : 1000 + filter_clocks] = 0
+    inputs["stat_err_n"][2000 : 2000 + filter_clocks - 1] = 0
+    chips = [Supi3Pins(config, Supi3(config, stat_err_filter=filter_clocks)) for _ in range(2)]
+    assert_run_matches_step(chips[0], chips[1], inputs, [0.1, 0.34, 0.5, 0.6667, 0.9])
+    assert chips[0].chip.pf and chips[1].chip.pf
 
 
 # -- the board's ring and run_firmware's devices (MCU-23) ----------------------------------------------------------
