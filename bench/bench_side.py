@@ -58,6 +58,8 @@ def load(src: str) -> Tree:
                        "supi3.interbus.master", "supi3.interbus.ring", "supi3.model.chip", "supi3.config",
                        "supi3.tables"):  # fmt: skip
             importlib.import_module(module)
+    except ImportError as error:  # a tree too old for a case's modules
+        raise SystemExit(f"bench_side.py: {src}: {error}") from error
     finally:
         sys.path.remove(src)
     return {n: m for n, m in sys.modules.items() if _own(n)}

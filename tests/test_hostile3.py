@@ -417,3 +417,15 @@ def test_bench_side_refuses_a_bad_command_line(argv: list[str], status: int, mes
     done = subprocess.run([sys.executable, str(ROOT / "bench" / "bench_side.py"), *argv], capture_output=True,
                           text=True, cwd=ROOT, timeout=120, check=False)  # fmt: skip
     assert (done.returncode, message in done.stderr, "Traceback" in done.stderr) == (status, True, False), done.stderr
+
+
+def test_bench_side_names_a_tree_too_old_for_its_cases(tmp_path: Path) -> None:
+    """``--against`` a tree whose supi3 lacks a module the cases import: one line naming the tree and the module,
+    no traceback."""
+    (tmp_path / "supi3").mkdir()
+    (tmp_path / "supi3" / "__init__.py").write_text("")
+    done = subprocess.run([sys.executable, str(ROOT / "bench" / "bench_side.py"), "--rounds", "1", "--cases", "ring512",
+                           "--against", str(tmp_path)], capture_output=True, text=True, cwd=ROOT, timeout=120,
+                          check=False)  # fmt: skip
+    assert done.returncode == 1 and "Traceback" not in done.stderr
+    assert f"bench_side.py: {tmp_path}: No module named 'supi3." in done.stderr
