@@ -25,7 +25,7 @@ from __future__ import annotations
 import copy
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Protocol, runtime_checkable
+from typing import Final, Protocol, runtime_checkable
 
 import numpy as np
 import numpy.typing as npt
@@ -170,7 +170,7 @@ def _return_inputs(items: Sequence[PinChip | PinBranch], first: int, returns: bo
     return found
 
 
-IDLE_PIECE_TELEGRAMS = 64
+IDLE_PIECE_TELEGRAMS: Final[int] = 64
 """The status telegrams :meth:`PinRing.idle` runs at a time (under 2 ms of bus time at 500 kbit/s): memory stays
 bounded over an idle of any length, as every chip's pin traces of one run are held at once (about 260 bytes a clock:
 one second of idle in one run took 8 GB)."""
