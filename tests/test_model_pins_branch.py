@@ -1,7 +1,9 @@
 """A bus terminal module's branch data lines in the pin-level chip core (supi3.model.pins.Supi3Pins with
 supi3.model.blocks.terminal.BranchLines; manual 2.4, Tables 2-7, 2-8, 2-9; BK-1, BK-2, BK-37): while the branch is
 in the data path DO3 (MFP9) carries what the chip would send on DO2 and DO2 repeats the synchronised DI3 (MFP10);
-otherwise DO3 idles and DO2 is the transmitter's. A device answers on the branch once DI3 was high (BK-37). Held
+otherwise DO2 is the transmitter's, and DO3 carries the same stream while the interface is live (BK-42: the branch
+would be present were a device answering) and idles else. A device answers on the branch once DI3 was at the start
+level (BK-37: a pulled-up DI3 never is). Held
 against the same scenario without a branch (the chip's logic does not read DI3 beyond this), step() equals run(), and
 the RTL core in lockstep (tests/test_rtl_core_branch.py).
 """
@@ -29,7 +31,8 @@ BRANCH_DELAY = 37
 
 def scenario(interface: str, rf: str, seed: int) -> tuple[CoreScript, Columns]:
     """Frames with the branch on, switched off, on again, an INTERBUS reset; the MFP inputs with LBST high but
-    during one data cycle; DI3 silent (0: nothing attached) for the first third, then the forward line delayed by
+    during one data cycle; DI3 at rest (1: nothing attached, the pull-up of BK-41) for the first third, then the
+    forward line delayed by
     :data:`BRANCH_DELAY` (a branch repeating what it gets). Returns the script and its columns with DI3 in."""
     config = decode(BK_STRAPS[interface], rf=rf, clk_conf="11")
     script = CoreScript(config, np.random.default_rng(seed))
@@ -41,7 +44,7 @@ def scenario(interface: str, rf: str, seed: int) -> tuple[CoreScript, Columns]:
     script.id_cycle(wire.command_word(), mfp_in=LBST).data_cycle(mfp_in=LBST)
     columns = script.inputs()
     n = len(columns["do1"])
-    di3 = np.zeros(n, dtype=np.int64)
+    di3 = np.ones(n, dtype=np.int64)
     di3[n // 3 :] = columns["do1"][n // 3 - BRANCH_DELAY : n - BRANCH_DELAY]
     columns["mfp_in"] = columns["mfp_in"] & ~(1 << DI3_PIN) | di3 << DI3_PIN
     script.parts = [columns]
@@ -59,25 +62,27 @@ def synced(trace: np.ndarray) -> np.ndarray:
 
 @pytest.mark.parametrize(("interface", "rf", "seed"), CASES[1:3])
 def test_the_branch_takes_the_data_path(interface: str, rf: str, seed: int) -> None:
-    """Against the same scenario with DI3 silent and LBST low (no branch by Table 2-9): where the branch is in the
-    data path (Table 2-9 with LBST and a device seen on DI3 since the core runs, not switched off: LD dark) DO2 is
-    the synchronised DI3 and DO3 the other run's DO2; elsewhere DO2 is the other run's and DO3 idles. Both happen,
-    and step() equals run()."""
+    """Against the same scenario with DI3 at rest and LBST low (no branch by Table 2-9): where the branch is in the
+    data path (Table 2-9 with LBST and a start level seen on DI3 since the core runs, not switched off: LD dark) DO2
+    is the synchronised DI3; elsewhere DO2 is the other run's. DO3 is the other run's DO2 where the interface is
+    live (Table 2-9 as if a device answered, LD dark; BK-42), else idle. All happen, and step() equals run()."""
     _, columns = scenario(interface, rf, seed)
-    silent = {**columns, "mfp_in": columns["mfp_in"] & ~(1 << DI3_PIN | LBST)}  # never present (Table 2-9)
+    silent = {**columns, "mfp_in": columns["mfp_in"] & ~LBST | 1 << DI3_PIN}  # never present (Table 2-9)
     pins = Supi3Pins(decode(BK_STRAPS[interface], rf=rf, clk_conf="11"))
     out = assert_run_matches_step(pins, Supi3Pins(pins.config), columns, [0.3, 0.71])
     reference = Supi3Pins(pins.config).run(silent)
     mfp = synced(columns["mfp_in"])
     di3 = mfp >> DI3_PIN & 1
     running = out["resu_drive"] == 0  # no power-up reset after the first: the logic runs from its end on
-    seen = np.logical_or.accumulate(di3.astype(bool) & running)
+    seen = np.logical_or.accumulate((di3 == wire.START_LEVEL) & running)
     connected = np.concatenate([[False], seen[:-1]])
     table = np.array([[branch_present(rf, bool(lbst), bool(c)) for c in (0, 1)] for lbst in (0, 1)])
-    on = table[mfp >> LBST_PIN & 1, connected.astype(np.int64)] & (out["mfp_out"] >> LD_PIN & 1 == 0)
-    assert on.any() and (~on).any()
+    opened = out["mfp_out"] >> LD_PIN & 1 == 0
+    on = table[mfp >> LBST_PIN & 1, connected.astype(np.int64)] & opened
+    live = table[mfp >> LBST_PIN & 1, 1] & opened
+    assert on.any() and (~on).any() and (live & ~on).any() and (~live).any()
     np.testing.assert_array_equal(out["do2"], np.where(on, di3, reference["do2"]))
-    np.testing.assert_array_equal(out["mfp_out"] >> DO3_PIN & 1, np.where(on, reference["do2"], wire.IDLE_LEVEL))
+    np.testing.assert_array_equal(out["mfp_out"] >> DO3_PIN & 1, np.where(live, reference["do2"], wire.IDLE_LEVEL))
     assert np.array_equal(out["mfp_out"] & ~(1 << DO3_PIN), reference["mfp_out"] & ~(1 << DO3_PIN))
     np.testing.assert_array_equal(out["di1"], out["do2"])  # no following device: the loop-back takes DO2 (M5)
 

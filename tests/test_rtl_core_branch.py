@@ -1,7 +1,8 @@
 """A bus terminal module's branch data lines in the RTL core (supi3.rtl.core.Supi3Core; manual 2.4, Tables 2-7,
 2-8, 2-9; BK-1, BK-37): the scenarios of tests/test_model_pins_branch.py (DI3 silent, then repeating the forward
 line; the branch switched off and on; LBST low for a data cycle; an INTERBUS reset) in lockstep with the pin-level
-model, every pin every clock: DO3 on MFP9, DO2 repeating DI3, the loop-back, `connected` from DI3; and in BK-LBD
+model, every pin every clock: DO3 on MFP9 (while live, BK-42), DO2 repeating DI3, the loop-back, `connected` from the
+first start level on DI3 (BK-37), also over histories of attaching and detaching the branch's device; and in BK-LBD
 the count from counter telegrams on DI3, cleared by the master's telegrams back (the status byte, E); the extended
 function closing a branch silent for 10 ms.
 """
@@ -13,12 +14,26 @@ import pytest
 from supi3.model.pins import Supi3Pins
 from supi3.terminal import BRANCH_SILENCE_CLOCKS
 from supi3.verif import Lockstep
+from support import CoreScript
 from test_model_pins_branch import CASES, COUNT_CASES, LD_PIN, count_scenario, scenario, silence_scenario
+from test_model_pins_recognition import FIXED, RANDOM_SEEDS, close_loop, history, random_history
 
 
 @pytest.mark.parametrize(("interface", "rf", "seed"), CASES)
 def test_rtl_core_matches(bench: Lockstep, interface: str, rf: str, seed: int) -> None:
     script, _ = scenario(interface, rf, seed)
+    bench.run_batch(script.stimulus())
+
+
+@pytest.mark.parametrize(("interface", "rf", "ops"), [*FIXED, *map(random_history, RANDOM_SEEDS)])
+def test_rtl_core_recognises_as_the_model(bench: Lockstep, interface: str, rf: str, ops: list[tuple[str, int]]) -> None:
+    """BK-37, BK-42: histories of attaching and detaching the branch's device (DI3 its answer or the pull-up), LBST
+    changes, INTERBUS and power-up resets: ``connected`` from the first start level on DI3, DO3 while live, DO2 in
+    the data path, every pin every clock (the DI3 the model's loop gave, tests/test_model_pins_recognition.py)."""
+    config, columns, device = history(interface, rf, ops)
+    closed, _ = close_loop(config, columns, device)
+    script = CoreScript(config)
+    script.parts = [closed]
     bench.run_batch(script.stimulus())
 
 

@@ -27,6 +27,7 @@ from supi3.terminal import (
     command,
     conf_level,
     enabled,
+    live,
     power_up,
     received,
     reset,
@@ -146,6 +147,15 @@ def test_enabled_every_state(rf: str | None, lbst: bool, connected: bool) -> Non
     assert branch_present(rf, lbst, connected) is present
     for state in STATES:
         assert enabled(state, rf, lbst, connected) is (present and state.switched_on and not state.closed)
+
+
+@pytest.mark.parametrize(("rf", "lbst"), list(itertools.product([*RF_CODES, None], [False, True])))
+def test_live_every_state(rf: str | None, lbst: bool) -> None:
+    """BK-42: the interface sends while the branch is open and Table 2-9 would make it present were a device
+    answering: not with RF = 10 and LBST = 0 (no recognition), nor with RF = 11 and LBST = 0 (switched off)."""
+    sends = lbst or rf in ("00", "01")
+    for state in STATES:
+        assert live(state, rf, lbst) is (sends and state.switched_on and not state.closed)
 
 
 def test_rf_and_mode_codes() -> None:

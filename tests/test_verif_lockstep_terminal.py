@@ -103,8 +103,9 @@ def test_every_branch_control_in_every_rf_mode(rf: int) -> None:
             script.command(branch).idle()
     block, out = lockstep(script.set(lbst=1, connected=1))
     assert block.state.extended and block.state.switched_on
-    assert out[-1]["enabled"] == int(RF_CODES[rf] in ("10", "11", "00", "01"))
+    assert out[-1]["enabled"] == int(RF_CODES[rf] in ("10", "11", "00", "01")) == out[-1]["live"]
     assert any(row["ld"] for row in out) and not out[-1]["ld"]
+    assert any(row["live"] and not row["enabled"] for row in out) == (RF_CODES[rf] != "10")  # BK-42: probing
 
 
 def test_extended_closure_after_the_silence() -> None:
@@ -114,8 +115,8 @@ def test_extended_closure_after_the_silence() -> None:
     block, out = lockstep(script)
     assert block.state == Terminal(extended=True, closed=True, closed_report=True)
     assert [row["closed"] for row in out].index(1) == 2 + LIMIT  # power-up, command, LIMIT silent clocks
-    assert out[-1] | {"status": 0} == {"enabled": 0, "status": 0, "attention": 1, "ld": 1, "e": 1, "alarm": 0,
-                                       "closed": 1}  # fmt: skip
+    assert out[-1] | {"status": 0} == {"enabled": 0, "live": 0, "status": 0, "attention": 1, "ld": 1, "e": 1,
+                                       "alarm": 0, "closed": 1}  # fmt: skip
     assert wire.decode_bk_status(out[-1]["status"]) == wire.BkStatus(False, True, 0)
     block, out = lockstep(script.command(ack=True).idle(3))
     assert block.state.closed and not block.state.closed_report and not out[-1]["attention"]

@@ -10,7 +10,8 @@ behaviour. Decisions where the manual is silent are BK-1.. of ``docs/assumptions
 
 * **CONF** (MFP12, Table 2-8; :func:`conf_level`): a positive edge raises a reconfiguration request, kept until the
   master acknowledges it (BK-8). The level at power-up is no edge (:func:`power_up`).
-* **LBST** (MFP11) with RF[1..0] (Table 2-9, BK-2): :func:`branch_present`; with the state, :func:`enabled`.
+* **LBST** (MFP11) with RF[1..0] (Table 2-9, BK-2): :func:`branch_present`; with the state, :func:`enabled`, and
+  :func:`live` (the interface sends, so that a following chip can answer: automatic recognition, BK-37, BK-42).
 * **Branch control** (:func:`command`): the master's command word switches the branch off, on, or on with the
   extended function (BK-4); its quit bit acknowledges the reports (0714h, BK-8); it sets the ALARM output (BK-12).
 * **Extended BK function** (:func:`silence`): a branch whose return line carried none of the master's telegrams for
@@ -54,6 +55,7 @@ __all__ = [
     "command",
     "conf_level",
     "enabled",
+    "live",
     "power_up",
     "received",
     "reset",
@@ -277,6 +279,14 @@ def enabled(state: Terminal, rf: str | None, lbst: bool, connected: bool) -> boo
     return branch_present(rf, lbst, connected) and state.switched_on and not state.closed
 
 
+def live(state: Terminal, rf: str | None, lbst: bool) -> bool:
+    """The branch interface sends (DO3 carries the BK's forward stream, BK-42): the branch would be in the data path
+    if a device answered (:func:`enabled` with ``connected``), so that a following protocol chip can answer before it
+    is recognised (2.1.1, BK-37). False with RF = 10 and LBST = 0 (no recognition, nothing follows), with RF = 11 and
+    LBST = 0 (the interface switched off, Table 2-9), and while the master has the branch off or the BK closed it."""
+    return enabled(state, rf, lbst, True)
+
+
 BLOCK_INPUTS: Final[tuple[Pin, ...]] = (
     Pin("ib_reset"), Pin("mode", 2), Pin("rf", 2), Pin("conf"), Pin("lbst"), Pin("connected"), Pin("cmd_valid"),
     Pin("branch", 2), Pin("ack"), Pin("alarm_set"), Pin("alarm_on"), Pin("ret_valid"), Pin("cnt_valid"),
@@ -285,18 +295,19 @@ BLOCK_INPUTS: Final[tuple[Pin, ...]] = (
 """The bus terminal block's inputs:
 
 ``ib_reset`` the core's INTERBUS reset (:func:`reset` while high); ``mode`` a :class:`TerminalMode` (static, from
-C[4..0]); ``rf`` RF[1..0] (static, :data:`RF_CODES`; 3 on a chip without RF pins); ``conf`` and ``lbst`` the levels
-of MFP12 and MFP11 after the input synchroniser; ``connected`` a device answers on the branch (automatic
-recognition, Table 2-9); ``cmd_valid`` a latched ID cycle's command word, whose fields are ``branch`` (a
-:class:`~supi3.interbus.wire.BranchControl`, bits 7..6), ``ack`` (the quit bit, 0714h), ``alarm_set`` and
-``alarm_on`` (bits 9 and 10 without a processor command, BK-12); ``ret_valid`` one of the master's telegrams (frame
-or status telegram) came back on the branch return line; ``cnt_valid``/``count`` a counter telegram came back there
-with that count (BK-6). Strobes are one clock wide."""
+C[4..0]); ``rf`` RF[1..0] (static, :data:`RF_CODES`; 3 on a chip without RF pins); ``conf`` and ``lbst`` the levels of
+MFP12 and MFP11 after the input synchroniser; ``connected`` a device answers on the branch (automatic recognition, Table
+2-9; in the chip: the first start level on DI3, BK-37); ``cmd_valid`` a latched ID cycle's command word, whose fields
+are ``branch`` (a :class:`~supi3.interbus.wire.BranchControl`, bits 7..6), ``ack`` (the quit bit, 0714h), ``alarm_set``
+and ``alarm_on`` (bits 9 and 10 without a processor command, BK-12); ``ret_valid`` one of the master's telegrams (frame
+or status telegram) came back on the branch return line; ``cnt_valid``/``count`` a counter telegram came back there with
+that count (BK-6). Strobes are one clock wide."""
 
 BLOCK_OUTPUTS: Final[tuple[Pin, ...]] = (
-    Pin("enabled"), Pin("status", 8), Pin("attention"), Pin("ld"), Pin("e"), Pin("alarm"), Pin("closed"),
+    Pin("enabled"), Pin("live"), Pin("status", 8), Pin("attention"), Pin("ld"), Pin("e"), Pin("alarm"), Pin("closed"),
 )  # fmt: skip
-"""The bus terminal block's outputs: ``enabled`` the branch is in the data path (:func:`enabled`); ``status`` the
+"""The bus terminal block's outputs: ``enabled`` the branch is in the data path (:func:`enabled`); ``live`` the
+branch interface sends (:func:`live`: DO3 carries the forward stream, so a following chip can answer); ``status`` the
 branch status byte (BK-5); ``attention`` a report waits (the BK holds ATTN); ``ld``, ``e``, ``alarm`` the LEDs and
 the ALARM output of Table 2-8 (MFP14, MFP13, MFP15; BK-11, BK-12); ``closed`` the BK closed its branch itself. All 0
 when ``mode`` is :attr:`TerminalMode.NONE`."""

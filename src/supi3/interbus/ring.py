@@ -17,14 +17,14 @@ rather than by two method calls per device (docs/interbus.md, "Ring kernel").
 Lines are numbered like the devices: line *k* (1..N) enters ring position *k*, line N + 1 is the return line
 into the master.
 
-A ring can be a tree (Figure 1-10, docs/interbus.md "Tree"): a :class:`Branch` is a bus terminal module (BK) with
-the devices of its branch. The data path runs into the BK, through the branch and back to the BK, then on along the
-remote bus, so the ring flattens the tree into :attr:`Ring.devices` in that order, leaving out every branch its BK
-has not in the data path (switched off by the master, closed by the BK itself, not present by LBST); it flattens
-again whenever a BK changes that. In a tree a fault belongs to the physical line it was injected on: it follows
-that line when branches are switched, and sleeps while the line is out of the data path. :class:`ReturnBreak`
-breaks a branch's return line, and behind a break in a branch with device-oriented diagnostics the devices send
-the counter telegram to the BK (2.2.2, ``wire.counter_telegram``).
+A ring can be a tree (Figure 1-10, docs/interbus.md "Tree"): a :class:`Branch` is a bus terminal module (BK) with the
+devices of its branch. The data path runs into the BK, through the branch and back to the BK, then on along the remote
+bus, so the ring flattens the tree into :attr:`Ring.devices` in that order, leaving out every branch its BK has not in
+the data path (switched off by the master, closed by the BK itself, not present by LBST); it flattens again whenever a
+BK changes that. In a tree a fault belongs to the physical line it was injected on: it follows that line when branches
+are switched, and sleeps while the line is out of the data path. :class:`ReturnBreak` breaks a branch's return line (a
+branch in the data path with nothing attached is broken so at its BK, BK-43), and behind a break in a branch with
+device-oriented diagnostics the devices send the counter telegram to the BK (2.2.2, ``wire.counter_telegram``).
 """
 
 from __future__ import annotations
@@ -598,6 +598,9 @@ class Ring:
         self._branches = _branches(self._tree)
         self._enabled: tuple[bool, ...] = ()
         self._spans: list[_Span] = []
+        self._unanswered: list[int] = []
+        """The ring positions of the BKs whose branch is in the data path with nothing attached (BK-43): their branch
+        return input carries nothing, as a :class:`ReturnBreak` there."""
         self._index: dict[int, int] = {}
         self._detached: dict[int, tuple[Device, float | None]] = {}
         self.devices: list[Device] = [d for d in self._tree if not isinstance(d, Branch)]
@@ -633,6 +636,7 @@ class Ring:
         """Flatten the tree again if a BK changed whether its branch is in the data path."""
         if not self._branches:
             return
+        # A device answers on a populated branch (BK-37); one present without (by LBST) breaks at its BK (BK-43).
         enabled = tuple(b.terminal.branch_enabled(bool(b.devices)) for b in self._branches)
         if enabled == self._enabled and self._index:
             return
@@ -659,6 +663,7 @@ class Ring:
         walk(self._tree)
         self.devices = flat
         self._spans = sorted(spans, key=attrgetter("at"))
+        self._unanswered = [span.at + 1 for span in self._spans if span.end == span.at + 1]
         self._index = {id(d): i for i, d in enumerate(flat)}
         self._silent_since = {self._index[k]: t for k, t in before.items() if k in self._index}
         self._silent_reset = {self._index[k] for k in was_reset if k in self._index}
@@ -759,10 +764,10 @@ class Ring:
         self._faults.clear()
 
     def _faults_on(self, segments: int) -> tuple[dict[int, list[Fault]], list[int]]:
-        """The faults on lines 1..``segments`` now, by line, and the positions whose return line is broken; each
-        counts one of its cycles."""
+        """The faults on lines 1..``segments`` now, by line, and the positions whose return line is broken (a BK with
+        nothing attached in the data path too, BK-43); each fault counts one of its cycles."""
         hits: dict[int, list[Fault]] = {}
-        returns: list[int] = []
+        returns: list[int] = list(self._unanswered)
         for active in self._faults:
             where = self._where(active)
             if where is None:
@@ -779,10 +784,11 @@ class Ring:
         return hits, returns
 
     def _breaks(self) -> tuple[list[int], list[int]]:
-        """The lines broken now (``DeadLine``) and the positions whose return line is broken, without counting a
-        fault's cycles."""
+        """The lines broken now (``DeadLine``) and the positions whose return line is broken (a BK with nothing
+        attached in the data path too, BK-43), without counting a fault's cycles."""
         lines = [(a.fault, w) for a in self._faults if (w := self._where(a)) is not None]
-        return ([w for f, w in lines if isinstance(f, DeadLine)], [w for f, w in lines if isinstance(f, ReturnBreak)])
+        return ([w for f, w in lines if isinstance(f, DeadLine)],
+                [*self._unanswered, *(w for f, w in lines if isinstance(f, ReturnBreak))])  # fmt: skip
 
     def _first_dead(self) -> int | None:
         """The first line that carries nothing on the whole ring (broken return lines of branches too)."""
@@ -926,7 +932,7 @@ class Ring:
         dead_lines: list[int] = []
         dead: int | None = None
         back_dead = False
-        if self._faults:
+        if self._faults or self._unanswered:
             faults, returns = self._faults_on(segments)
             dead_lines = [s for s, fs in faults.items() if any(isinstance(f, DeadLine) for f in fs)]
             dead = min(dead_lines, default=None)

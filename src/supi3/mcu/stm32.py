@@ -31,6 +31,7 @@ __all__ = [
     "Rcc",
     "Spi",
     "SpiWire",
+    "ValueHolder",
 ]
 
 RCC_BASE: Final[int] = 0x4002_1000
@@ -80,6 +81,8 @@ class Rcc:
     def __init__(self) -> None:
         self.apb2enr = 0
         self._other: dict[int, int] = {}
+        self.on_enable_change: list[Callable[[], None]] = []
+        """Called when APB2ENR is written: a peripheral whose register the core answers natively takes it back."""
 
     def require(self, bit: int, name: str) -> None:
         """Raise :class:`PeripheralClockError` unless APB2ENR has ``bit``."""
@@ -97,6 +100,8 @@ class Rcc:
         del size
         if offset == APB2ENR:
             self.apb2enr = value
+            for changed in self.on_enable_change:
+                changed()
         else:
             self._other[offset] = value
 
@@ -254,6 +259,28 @@ class SpiWire(Protocol):
         transfer has ended (a pin-level chip drives MISO bit by bit)."""
 
 
+class ValueHolder(Protocol):
+    """Where a peripheral says that a register holds its value (the core answers its reads natively, MCU-25):
+    :class:`supi3.mcu.core.HeldRegister`."""
+
+    def hold(self, offset: int, value: int, until: int | None, after: int | None) -> None:
+        """Reads of ``offset`` return ``value`` while their time is before cycle ``until`` (``None``: always), then
+        ``after`` (``None``: the peripheral answers)."""
+
+    def release(self) -> None:
+        """Every read goes to the peripheral again."""
+
+
+class _NoHolder:
+    """No native answers: every read goes to the peripheral."""
+
+    def hold(self, offset: int, value: int, until: int | None, after: int | None) -> None:
+        del offset, value, until, after
+
+    def release(self) -> None:
+        pass
+
+
 class Spi:
     """SPI1 as a full-duplex master (RM0008 25.3.3, 25.3.5; timing model MCU-8).
 
@@ -266,6 +293,10 @@ class Spi:
     received byte is in DR (RXNE 1), or lost with OVR if RXNE was still 1 (25.3.10). BSY is 1 from the start of a
     transfer to the end of the last one. MODF: SSM = 1 with SSI = 0 in master mode clears MSTR and SPE
     (25.3.10); /NSS is not wired (SSM = 0 reads it high, MCU-6).
+
+    After a read of SR, SR holds its value (:attr:`holder`) until the shifting byte ends, then the value after it if
+    nothing starts then, until the next access to SPI1 or RCC_APB2ENR: the core answers the reads in between
+    natively (MCU-25).
     """
 
     def __init__(
@@ -287,6 +318,15 @@ class Spi:
         self.rx_last = 0
         self.shifting: tuple[int | Callable[[], int], int, int] | None = None  # (received, start cycle, end cycle)
         self.transfers = 0
+        self.holder: ValueHolder = _NoHolder()
+        """Told when SR holds its value (:meth:`supi3.mcu.core.CortexM.mmio`'s register, MCU-25)."""
+        self._holding = False
+        rcc.on_enable_change.append(self._release)
+
+    def _release(self) -> None:
+        if self._holding:
+            self._holding = False
+            self.holder.release()
 
     @property
     def period(self) -> int:
@@ -319,12 +359,23 @@ class Spi:
         if self.shifting is not None:
             self.on_poll(self.shifting[2])
         busy = self.shifting is not None or self.tx_buffer is not None
-        return ((self.rx_buffer is not None) * SR_RXNE | (self.tx_buffer is None) * SR_TXE
-                | self.modf * SR_MODF | self.ovr * SR_OVR | busy * SR_BSY)  # fmt: skip
+        return self._flags(self.rx_buffer is not None, self.ovr, busy)
+
+    def _flags(self, rxne: bool, ovr: bool, busy: bool) -> int:
+        return (rxne * SR_RXNE | (self.tx_buffer is None) * SR_TXE | self.modf * SR_MODF | ovr * SR_OVR
+                | busy * SR_BSY)  # fmt: skip
+
+    def _after(self) -> int | None:
+        """SR once the shifting byte has ended, if nothing starts then (no byte waits) and the byte's end needs no
+        look at the wire (a received value known now): RXNE, OVR if RXNE was still 1 (25.3.10), not busy."""
+        if self.shifting is None or self.tx_buffer is not None or not isinstance(self.shifting[0], int):
+            return None
+        return self._flags(True, self.ovr or self.rx_buffer is not None, False)
 
     def read(self, offset: int, size: int) -> int:
         """CR1, CR2, SR, DR (reading DR clears RXNE; reading SR after DR clears OVR, 25.3.10)."""
         del size
+        self._release()
         self.rcc.require(SPI1EN, "SPI1")
         if offset == SPI_CR1:
             return self.cr1
@@ -334,6 +385,9 @@ class Spi:
             value = self.status()
             if self._ovr_seen:
                 self.ovr = self._ovr_seen = False
+            else:  # SR now holds until the shifting byte ends (the time a poll may skip to, MCU-10), then its value
+                self._holding = True  # after the byte if known now, until an access
+                self.holder.hold(SPI_SR, value, None if self.shifting is None else self.shifting[2], self._after())
             return value
         if offset == SPI_DR:
             self._run(self.polled())
@@ -346,6 +400,7 @@ class Spi:
     def write(self, offset: int, size: int, value: int) -> None:
         """CR1 (MODF check on enabling), CR2, DR (into the transmit buffer; starts a transfer if idle)."""
         del size
+        self._release()
         self.rcc.require(SPI1EN, "SPI1")
         cycles = self.now()
         self._run(cycles)

@@ -358,17 +358,18 @@ class Supi3Core(wiring.Component):
         ]  # fmt: skip
 
         # The bus terminal module (2.4, docs/bus-terminal.md): in reset until the core runs, so that it takes CONF as it
-        # is at the first running clock (BK-20). A device answers on the branch once the synchronised DI3 was high
-        # where the logic ran (BK-37, as M5 on DI2); a power failure forgets it. While the branch is in the data path
-        # DO3 (MFP9) takes the DO2 the core would send and DO2 repeats the synchronised DI3 (BK-1's order: the BK,
-        # its branch, on along the remote bus); else DO3 idles (the pin model's BranchLines).
+        # is at the first running clock (BK-20). A device answers on the branch once the synchronised DI3 was at the
+        # start level where the logic ran (BK-37: a pulled-up or broken DI3 never is); a power failure forgets it.
+        # While the interface is live DO3 (MFP9) takes the DO2 the core would send (BK-42), else it idles; while the
+        # branch is in the data path DO2 repeats the synchronised DI3 (BK-1's order: the BK, its branch, on along the
+        # remote bus; the pin model's BranchLines).
         terminal = TerminalRtl()
         m.submodules.terminal = ResetInserter(~running)(terminal)
         di3 = receiver.mfp_in_s[DI3_PIN]
         connected = Signal()
         with m.If(power_fail):
             m.d.sync += connected.eq(0)
-        with m.Elif(running & di3):
+        with m.Elif(running & (di3 == wire.START_LEVEL)):
             m.d.sync += connected.eq(1)
         do2 = Signal(init=wire.IDLE_LEVEL)
         m.d.comb += do2.eq(Mux(terminal.enabled, di3, lines.do2))
@@ -387,8 +388,8 @@ class Supi3Core(wiring.Component):
             terminal.alarm_set.eq(command[wire.CMD_ALARM_OUT_SET_BIT] & ~command[wire.CMD_PCMD_BIT]),
             terminal.alarm_on.eq(command[wire.CMD_ALARM_OUT_BIT]),
             terminal.connected.eq(connected),
-            terminal.ret_valid.eq(lines.returned),
-            terminal.cnt_valid.eq(lines.seen),
+            terminal.ret_valid.eq(lines.returned & terminal.enabled),  # BK-44: only while in the data path
+            terminal.cnt_valid.eq(lines.seen & terminal.enabled),
             terminal.count.eq(lines.count),
             outputs.ld.eq(terminal.ld),
             outputs.e.eq(terminal.e),
@@ -548,7 +549,7 @@ class Supi3Core(wiring.Component):
             self.do2.eq(do2),
             self.di1.eq(lines.di1),
             self.mfp_out.eq(datapath.mfp_out | Mux(spi, serial_io.mfp, 0) | outputs.mfp_diag
-                            | Mux(bus_terminal, Mux(terminal.enabled, lines.do2, wire.IDLE_LEVEL) << DO3_PIN, 0)),
+                            | Mux(bus_terminal, Mux(terminal.live, lines.do2, wire.IDLE_LEVEL) << DO3_PIN, 0)),
             self.mod_ack_n.eq(outputs.mod_ack_n),
             self.res_reg_n.eq(outputs.res_reg_n),
             self.diag1.eq(outputs.diag1),

@@ -3,19 +3,19 @@ control, the silence timer of the extended function, the status byte and the LED
 :data:`supi3.terminal.BLOCK_INPUTS` / ``BLOCK_OUTPUTS``.
 
 Manual 2.4 (Tables 2-7, 2-8, 2-9, "Extended bus terminal module functions"), 2.2.2, Table 3-19. The transitions of
-:mod:`supi3.terminal` (``power_up``, ``conf_level``, ``command``, ``received``, ``silence``, ``reset``, ``enabled``
-and the outputs of ``Terminal``) are re-implemented here in gates, with every constant taken from the spec at
-elaboration (the branch control codes, the status byte's bits, the RF codes of Table 2-9, the silence in clocks).
-The edge order and the port timing are those of the pin model ``TerminalBlock``
-(``src/supi3/model/blocks/terminal.py``, its module docstring, BK-20), which
-``tests/test_verif_lockstep_terminal.py`` holds this block to, cycle by cycle.
+:mod:`supi3.terminal` (``power_up``, ``conf_level``, ``command``, ``received``, ``silence``, ``reset``, ``enabled`` and
+the outputs of ``Terminal``) are re-implemented here in gates (``live`` is ``enabled`` with a device answering), with
+every constant taken from the spec at elaboration (the branch control codes, the status byte's bits, the RF codes of
+Table 2-9, the silence in clocks). The edge order and the port timing are those of the pin model ``TerminalBlock``
+(``src/supi3/model/blocks/terminal.py``, its module docstring, BK-20), which ``tests/test_verif_lockstep_terminal.py``
+holds this block to, cycle by cycle.
 """
 
 from __future__ import annotations
 
 from typing import Final
 
-from amaranth.hdl import Module, Mux, Signal, Value
+from amaranth.hdl import Const, Module, Mux, Signal, Value
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
@@ -54,8 +54,9 @@ class TerminalRtl(wiring.Component):
             **{pin.name: Out(pin.width) for pin in BLOCK_OUTPUTS},
         })  # fmt: skip
 
-    def _present(self, m: Module) -> Value:
-        """Table 2-9 (BK-2, ``branch_present``): RF = 10 LBST alone, 11 a device answers and LBST, 00/01 either."""
+    def _present(self, m: Module, connected: Value) -> Value:
+        """Table 2-9 (BK-2, ``branch_present``) with ``connected``: RF = 10 LBST alone, 11 a device answers and
+        LBST, 00/01 either."""
         present = Signal()
         with m.Switch(self.rf):
             for code, rf in enumerate(RF_CODES):
@@ -63,9 +64,9 @@ class TerminalRtl(wiring.Component):
                     if rf == "10":
                         m.d.comb += present.eq(self.lbst)
                     elif rf == "11":
-                        m.d.comb += present.eq(self.connected & self.lbst)
+                        m.d.comb += present.eq(connected & self.lbst)
                     else:
-                        m.d.comb += present.eq(self.connected | self.lbst)
+                        m.d.comb += present.eq(connected | self.lbst)
         return present
 
     def elaborate(self, _platform: object) -> Module:
@@ -90,11 +91,13 @@ class TerminalRtl(wiring.Component):
 
         # Outputs from the state ---------------------------------------------------------------------------------
         bk = self.mode != TerminalMode.NONE
-        on = self._present(m) & switched_on & ~closed
+        opened = switched_on & ~closed
+        on = self._present(m, self.connected) & opened
         status = Signal(8)
         comb += status.eq(count | (closed_report << BK_STATUS_CLOSED_BIT) | (conf_request << BK_STATUS_CONF_BIT))
         comb += [
             self.enabled.eq(bk & on),
+            self.live.eq(bk & self._present(m, Const(1)) & opened),  # BK-42
             self.status.eq(Mux(bk, status, 0)),
             self.attention.eq(bk & (conf_request | closed_report)),
             self.ld.eq(bk & (closed | ~switched_on)),

@@ -24,8 +24,8 @@ and the branch in the data path (:func:`~supi3.terminal.enabled` with this cycle
 ``connected``); anything else, a ``ret_valid``, or a command switching the branch on clears it. The edge at which it
 would reach ``time_limit`` (:data:`~supi3.terminal.BRANCH_SILENCE_CLOCKS`) applies the silence and clears it.
 
-Outputs during a cycle come from the state and this cycle's ``rf``, ``lbst``, ``connected`` (``enabled``); every one
-is 0 while ``mode`` is NONE.
+Outputs during a cycle come from the state and this cycle's ``rf``, ``lbst``, ``connected`` (``enabled``; ``live``
+without ``connected``); every one is 0 while ``mode`` is NONE.
 """
 
 from __future__ import annotations
@@ -57,6 +57,7 @@ from supi3.terminal import (
     command,
     conf_level,
     enabled,
+    live,
     power_up,
     received,
     reset,
@@ -123,10 +124,12 @@ class TerminalBlock:
         if v["mode"] == TerminalMode.NONE:
             return dict(_OFF)
         state = self.state
-        on = enabled(state, rf_of(v["rf"]), bool(v["lbst"]), bool(v["connected"]))
+        rf, lbst = rf_of(v["rf"]), bool(v["lbst"])
+        on = enabled(state, rf, lbst, bool(v["connected"]))
         outputs = {
-            "enabled": int(on), "status": state.status, "attention": int(state.attention), "ld": int(state.ld),
-            "e": int(state.e), "alarm": int(state.alarm), "closed": int(state.closed),
+            "enabled": int(on), "live": int(live(state, rf, lbst)), "status": state.status,
+            "attention": int(state.attention), "ld": int(state.ld), "e": int(state.e), "alarm": int(state.alarm),
+            "closed": int(state.closed),
         }  # fmt: skip
         self._edge(v, state.extended and on)
         return outputs
@@ -220,13 +223,15 @@ class BranchLines:
     """A BK's branch data lines in the chip core (manual 2.4, Tables 2-7, 2-8, 2-9; BK-1, BK-37): DO3_CU (MFP9),
     DI3 (MFP10) and the switch of DO2, for ``supi3.model.pins.Supi3Pins`` in the BK modes.
 
-    While the branch is in the data path (:func:`~supi3.terminal.enabled`: present by Table 2-9, switched on, not
-    closed) DO3 carries what the transmitter sends (the DO2 of a chip without branch) and DO2 repeats the
-    synchronised DI3, the branch's return line: the data path runs through the BK, its branch, then on along the
-    remote bus (BK-1's flattened order); the M5 loop-back takes this DO2. Otherwise DO3 idles and DO2 is the
-    transmitter's. ``connected`` (a device answers on the branch, BK-37) latches the first high level of the
-    synchronised DI3 at every clock edge where the core's logic runs (a device's idle return line, as M5 recognises
-    a following device on DI2); a power-up reset clears it.
+    While the branch interface is live (:func:`~supi3.terminal.live`: it would be in the data path if a device
+    answered, BK-42) DO3 carries what the transmitter sends (the DO2 of a chip without branch), else DO3 idles. While
+    the branch is in the data path (:func:`~supi3.terminal.enabled`: present by Table 2-9, switched on, not closed)
+    DO2 repeats the synchronised DI3, the branch's return line: the data path runs through the BK, its branch, then
+    on along the remote bus (BK-1's flattened order); the M5 loop-back takes this DO2. Otherwise DO2 is the
+    transmitter's. ``connected`` (a device answers on the branch, BK-37) latches the first start level (0) of the
+    synchronised DI3 at a clock edge where the core's logic runs: a following protocol chip repeats what DO3 sends
+    (the master's reset pattern, its telegrams) and loops it back, and each begins with a start level; a pulled-up
+    DI3 (BK-41) or a broken line (BK-30) rests at the idle level and never shows one. A power-up reset clears it.
 
     The return line's strobes for the BK (``ret_valid``, ``cnt_valid``/``count`` of
     :data:`~supi3.terminal.BLOCK_INPUTS`): a :class:`ReturnWatch` on the synchronised DI3 (BK-38) and, in BK-LBD, a
@@ -268,7 +273,8 @@ class BranchLines:
         lbd = check_bool("lbd", lbd)
         self.present = np.array([[branch_present(rf, bool(lbst), bool(connected)) for connected in (0, 1)]
                                  for lbst in (0, 1)])  # fmt: skip
-        """Table 2-9 by [LBST][connected] (:func:`~supi3.terminal.branch_present`)."""
+        """Table 2-9 by [LBST][connected] (:func:`~supi3.terminal.branch_present`); ``present[:, 1]`` is whether the
+        interface is live with the branch open (:func:`~supi3.terminal.live`, BK-42)."""
         self.cpb = cpb
         self.fast = int(cpb == clocks_per_bit(1))
         self.limit = silence_limit(time_limit)
@@ -299,10 +305,12 @@ class BranchLines:
         """Set ``do2``, ``mfp_out`` (DO3) and, when the chip loops back (M5: ``next_present`` false), ``di1`` of a
         cycle in that cycle's ``outputs`` (``do2`` the transmitter's; ``mfp_in`` the synchronised MFP inputs)."""
         sent = outputs["do2"]
-        if self.on(state, mfp_in >> LBST_PIN & 1, self.connected):
-            do2 = outputs["do2"] = mfp_in >> DI3_PIN & 1
-            if not next_present:
-                outputs["di1"] = do2
+        lbst = mfp_in >> LBST_PIN & 1
+        if self.on(state, lbst, True):  # live (BK-42)
+            if self.on(state, lbst, self.connected):
+                do2 = outputs["do2"] = mfp_in >> DI3_PIN & 1
+                if not next_present:
+                    outputs["di1"] = do2
             outputs["mfp_out"] |= sent << DO3_PIN
         else:
             outputs["mfp_out"] |= wire.IDLE_LEVEL << DO3_PIN
@@ -317,7 +325,7 @@ class BranchLines:
     def clock(self, mfp_in: int) -> None:
         """A clock edge where the core's logic runs, with the synchronised MFP inputs ``mfp_in``."""
         di3 = mfp_in >> DI3_PIN & 1
-        self.connected = self.connected or bool(di3)
+        self.connected = self.connected or di3 == wire.START_LEVEL
         self._clock_blocks(di3)
 
     def _clock_blocks(self, di3: int) -> None:
@@ -352,7 +360,10 @@ class BranchLines:
         ret, cnt, count = self._strobes[c - self._c0].tolist() if recording else self.strobes()
         if self.counting:  # the cycles between a run's visits
             self.timer += c - self.timer_at
-        counting = before.extended and self.on(before, mfp_in >> LBST_PIN & 1, connected)
+        on = self.on(before, mfp_in >> LBST_PIN & 1, connected)
+        if not on:  # BK-44: the return line's strobes count only while the branch is in the data path
+            ret = cnt = 0
+        counting = before.extended and on
         restart = bool(ret) or switched_on
         expired = counting and not restart and self.timer + 1 >= self.limit
         state = after
@@ -448,7 +459,8 @@ class BranchLines:
         opens = np.repeat([o for _, o in self._opens], np.diff([*starts, n]).clip(min=0))
         on = self.present[self._lbst, self._connected] & opens
         sent = traces["do2"]
-        traces["mfp_out"] = traces["mfp_out"] | np.where(on, sent, wire.IDLE_LEVEL) << DO3_PIN
+        live = self.present[self._lbst, 1] & opens
+        traces["mfp_out"] = traces["mfp_out"] | np.where(live, sent, wire.IDLE_LEVEL) << DO3_PIN
         traces["do2"] = np.where(on, self._line, sent)
 
 
