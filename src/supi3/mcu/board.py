@@ -321,7 +321,8 @@ class Board:
         core.mmio(GPIOB_BASE, PERIPHERAL_SIZE, self.gpio_b.read, self.gpio_b.write)
         core.mmio(AFIO_BASE, PERIPHERAL_SIZE, self.exti.read_afio, self.exti.write_afio)
         core.mmio(EXTI_BASE, PERIPHERAL_SIZE, self.exti.read, self.exti.write)
-        self.spi.holder = core.mmio(SPI1_BASE, PERIPHERAL_SIZE, self.spi.read, self.spi.write)  # SR (MCU-25)
+        held = core.mmio(SPI1_BASE, PERIPHERAL_SIZE, self.spi.read, self.spi.write)
+        self.spi.holder = self.spi.offer = held  # SR held (MCU-25), DR's read after its byte (MCU-26)
         core.entered = self._entered
         self.fw_board = FwBoard(core) if "fw_board" in core.image.symbols else None
         self.interrupts = 0

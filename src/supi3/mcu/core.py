@@ -202,6 +202,13 @@ _REGS: Final[tuple[tuple[str, int], ...]] = (
 _LOW_REGS: Final[tuple[int, ...]] = tuple(getattr(arm, f"UC_ARM_REG_R{k}") for k in range(8))
 _FRAME_REGS: Final[tuple[int, ...]] = (arm.UC_ARM_REG_R0, arm.UC_ARM_REG_R1, arm.UC_ARM_REG_R2, arm.UC_ARM_REG_R3,
                                        arm.UC_ARM_REG_R12, arm.UC_ARM_REG_LR)  # fmt: skip
+_ENTRY_READS: Final[tuple[int, ...]] = (arm.UC_ARM_REG_CONTROL, arm.UC_ARM_REG_SP, *_FRAME_REGS, arm.UC_ARM_REG_XPSR,
+                                        arm.UC_ARM_REG_PC)  # fmt: skip
+"""What an exception entry reads (B1.5.6), in one call (MCU-19)."""
+_UNSTACK_WRITES: Final[tuple[int, ...]] = (*_FRAME_REGS, arm.UC_ARM_REG_XPSR)
+"""What an exception return writes from the frame, the mode last (it selects the SP), in one call (B1.5.8)."""
+_RESUME_WRITES: Final[tuple[int, ...]] = (arm.UC_ARM_REG_SP, arm.UC_ARM_REG_PC)
+"""An exception return's SP and PC, after the mode, in one call."""
 FRAME_NAMES: Final[tuple[str, ...]] = ("r0", "r1", "r2", "r3", "r12", "lr", "pc", "xpsr")
 """The stacked frame's words in address order (B1.5.6)."""
 
@@ -594,10 +601,35 @@ WriteFn = Callable[[int, int, int], None]
 _FOREVER: Final[int] = (1 << 64) - 1
 
 
+class _Batch:
+    """Core registers read or written in one call to unicorn's C library (``uc_reg_read_batch``,
+    ``uc_reg_write_batch``; MCU-19: 32-bit values in 64-bit slots)."""
+
+    def __init__(self, handle: Any, registers: tuple[int, ...]) -> None:
+        count = self._count = len(registers)
+        self._handle = handle
+        self._ids = (ctypes.c_int32 * count)(*registers)
+        self._values = (ctypes.c_uint64 * count)()
+        base = ctypes.addressof(self._values)
+        self._slots = (ctypes.c_void_p * count)(*(base + 8 * k for k in range(count)))
+
+    def read(self) -> list[int]:
+        """The registers' values, in order."""
+        CortexM._check(_LIB.uc_reg_read_batch(self._handle, self._ids, self._slots, self._count))
+        return list(self._values)
+
+    def write(self, values: list[int]) -> None:
+        """Write the registers, in order (32-bit values)."""
+        typed: list[ctypes.c_uint64 | int] = [*values]
+        self._values[:] = typed
+        CortexM._check(_LIB.uc_reg_write_batch(self._handle, self._ids, self._slots, self._count))
+
+
 class HeldRegister:
-    """A peripheral's register that the core answers natively while the peripheral holds its value (MCU-25), from
-    :meth:`CortexM.mmio`. A peripheral holds a value for as long as its own reads would return it and change nothing
-    but what its next access catches up with (its model runs on the time), and releases it at that access."""
+    """A peripheral's register that the core answers natively while the peripheral holds its value (MCU-25), and a
+    read the peripheral offers from a cycle on (MCU-26), from :meth:`CortexM.mmio`. A peripheral holds a value (or
+    offers a read) for as long as its own reads would return it and change nothing but what its next access catches
+    up with (its model runs on the time), and releases it at that access."""
 
     def __init__(self, held: hook.Held) -> None:
         self._held = held
@@ -616,6 +648,23 @@ class HeldRegister:
     def release(self) -> None:
         """Every read goes to the peripheral again."""
         self._held.held = 0
+
+    def offer(self, offset: int, value: int, start: int, then: int) -> None:
+        """MCU-26: the first read of ``offset`` at a time (:meth:`CortexM.cycles_polled`) from cycle ``start`` on
+        returns ``value``, once, and from then on the held register reads ``then`` (as long as it is held)."""
+        held = self._held
+        held.once_offset, held.once_value, held.once_from, held.once_then = offset, value, start, then
+        held.taken, held.once = 0, 1
+
+    def withdraw(self) -> int | None:
+        """No more offered read; the time of the one taken since :meth:`offer`, if one was (the peripheral catches
+        up with it)."""
+        held = self._held
+        held.once = 0
+        if not held.taken:
+            return None
+        held.taken = 0
+        return int(held.once_at)
 
 
 class CortexM:
@@ -650,6 +699,9 @@ class CortexM:
         self._handle = self.uc._uch  # the engine (uc_engine *) for the direct calls (MCU-19)
         self._register_value = ctypes.c_uint64()
         self._register_ref = ctypes.byref(self._register_value)
+        self._entry_reads = _Batch(self._handle, _ENTRY_READS)
+        self._unstack = _Batch(self._handle, _UNSTACK_WRITES)
+        self._resume = _Batch(self._handle, _RESUME_WRITES)
         self._callbacks: list[object] = []  # the ctypes callbacks unicorn holds: kept alive with the core
         self.flash = flash
         self.ram = ram
@@ -785,7 +837,7 @@ class CortexM:
             self.error = error
         self.stop_request = True
         for held in self._held:  # the peripherals are silent now (mmio): no register is answered natively either
-            held.held = 0
+            held.held = held.once = 0
 
     # -- registers ---------------------------------------------------------------------------------------------
 
@@ -955,14 +1007,11 @@ class CortexM:
         _exception_number(number)
         uc = self.uc
         handler_mode = bool(self.active)
-        control = self._read(arm.UC_ARM_REG_CONTROL)
+        control, sp, *words, xpsr, pc = self._entry_reads.read()
         process = bool(control & CONTROL_SPSEL) and not handler_mode
-        sp = self._read(arm.UC_ARM_REG_SP)
-        words = [self._read(r) for r in _FRAME_REGS]
-        xpsr = self._read(arm.UC_ARM_REG_XPSR)
         aligned = sp & 4
         frame = (sp - FRAME_WORDS * 4) & ~7
-        words += [self.pc, xpsr | (XPSR_ALIGN if aligned else 0)]
+        words += [pc, xpsr | (XPSR_ALIGN if aligned else 0)]
         try:
             uc.mem_write(frame, struct.pack("<8I", *words))
         except UcError as error:
@@ -1023,15 +1072,12 @@ class CortexM:
         except ArgumentError:
             reason = f"unstacking error: the frame at {sp:08X}h is not in memory (B1.5.8)"
             raise FirmwareFaultError(self.report(Stop.FAULT, reason)) from None
-        for reg, value in zip(_FRAME_REGS, words[:6], strict=True):
-            self._write(reg, value)
         xpsr = words[7]
         sp += FRAME_WORDS * 4 + (4 if xpsr & XPSR_ALIGN else 0)
-        self._write(arm.UC_ARM_REG_XPSR, (xpsr & ~XPSR_ALIGN) | XPSR_T)  # the mode first: it selects the SP
+        self._unstack.write([*words[:6], (xpsr & ~XPSR_ALIGN) | XPSR_T])  # the mode last: it selects the SP
         if exc_return == EXC_RETURN_THREAD_PSP:
             self._write(arm.UC_ARM_REG_CONTROL, self._read(arm.UC_ARM_REG_CONTROL) | CONTROL_SPSEL)
-        self._write(arm.UC_ARM_REG_SP, sp)
-        self._write(arm.UC_ARM_REG_PC, words[6] & ~1)
+        self._resume.write([sp, words[6] & ~1])
         self.active.pop()
         self.cycles += self.cpu.return_cycles
 

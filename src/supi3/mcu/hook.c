@@ -14,7 +14,8 @@
  *   - note the block's address, entry cycle and end (a peripheral access is timed inside its block by the PC).
  *
  * A peripheral's reads go first to supi3_held_read: a register whose value the peripheral holds until a cycle (SPI1's
- * SR while a byte shifts) is answered here, as the peripheral would answer it; every other read goes to Python.
+ * SR while a byte shifts) is answered here, as the peripheral would answer it, and so is one read of a register the
+ * peripheral offers from a cycle on (SPI1's DR once its byte has ended, MCU-26); every other read goes to Python.
  */
 #include <stdint.h>
 
@@ -152,17 +153,38 @@ typedef struct {
     uint32_t poll;     /* a read tells the poll skip (MCU-10) the cycle `until`, the status's change */
     uint32_t after;    /* the value from `until` on, if has_after */
     uint32_t has_after;
+    uint64_t once_from; /* MCU-26: one read of once_offset at or after this cycle returns once_value */
+    uint64_t once_at;   /* the time of that read, once taken */
+    uint32_t once_offset;
+    uint32_t once_value;
+    uint32_t once;      /* offered, not yet taken */
+    uint32_t taken;     /* taken: the held register reads once_then from now on */
+    uint32_t once_then;
 } supi3_held;
 
-/* A peripheral's read callback (uc_cb_mmio_read_t): the held register as CortexM.cycles_polled and
- * CortexM.skip_poll would do it (before `until`: the value and the poll skip; from then on: `after`, no skip), or
- * Python's read. A stop request (a failure, or a change the run loop must see)
- * always goes to Python. */
+/* A peripheral's read callback (uc_cb_mmio_read_t): the offered register's one read from `once_from` on (MCU-26);
+ * the held register as CortexM.cycles_polled and CortexM.skip_poll would do it (once the offered read was taken:
+ * `once_then`; before `until`: the value and the poll skip; from then on: `after`, no skip), or Python's read. A
+ * stop request (a failure, or a change the run loop must see) always goes to Python. */
 uint64_t supi3_held_read(void *uc, uint64_t offset, unsigned size, void *data) {
     supi3_held *h = (supi3_held *)data;
     supi3_state *s = h->state;
+    if (h->once && offset == h->once_offset && !s->stop_request) { /* MCU-26 */
+        uint64_t time = s->handed > s->cycles ? s->handed : s->cycles;
+        if (time >= h->once_from) {
+            s->handed = time;
+            h->once = 0;
+            h->taken = 1;
+            h->once_at = time;
+            return h->once_value;
+        }
+    }
     if (h->held && offset == h->offset && !s->stop_request) {
         uint64_t time = s->handed > s->cycles ? s->handed : s->cycles;
+        if (h->taken) { /* the offered read was taken: the value after it, until the peripheral's next access */
+            s->handed = time;
+            return h->once_then;
+        }
         if (time < h->until) {
             s->handed = time;
             if (h->poll && s->skip_polls && s->block_poll) {

@@ -87,7 +87,8 @@ class State(ctypes.Structure):
 
 
 class Held(ctypes.Structure):
-    """A register value a peripheral holds until a cycle, answered natively (``supi3_held`` of hook.c)."""
+    """A register value a peripheral holds until a cycle, and one read a peripheral offers from a cycle on (MCU-26),
+    answered natively (``supi3_held`` of hook.c)."""
 
     _fields_ = (
         ("state", ctypes.POINTER(State)),
@@ -99,6 +100,13 @@ class Held(ctypes.Structure):
         ("poll", ctypes.c_uint32),
         ("after", ctypes.c_uint32),
         ("has_after", ctypes.c_uint32),
+        ("once_from", ctypes.c_uint64),
+        ("once_at", ctypes.c_uint64),
+        ("once_offset", ctypes.c_uint32),
+        ("once_value", ctypes.c_uint32),
+        ("once", ctypes.c_uint32),
+        ("taken", ctypes.c_uint32),
+        ("once_then", ctypes.c_uint32),
     )
 
 

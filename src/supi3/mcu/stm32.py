@@ -29,6 +29,7 @@ __all__ = [
     "Gpio",
     "PeripheralClockError",
     "Rcc",
+    "ReadOffer",
     "Spi",
     "SpiWire",
     "ValueHolder",
@@ -271,6 +272,18 @@ class ValueHolder(Protocol):
         """Every read goes to the peripheral again."""
 
 
+class ReadOffer(Protocol):
+    """Where a peripheral offers one read of a register from a cycle on (the core answers it natively, MCU-26):
+    :class:`supi3.mcu.core.HeldRegister`."""
+
+    def offer(self, offset: int, value: int, start: int, then: int) -> None:
+        """The first read of ``offset`` at a time from cycle ``start`` on returns ``value``, once; from then on the
+        held register (:class:`ValueHolder`) reads ``then``."""
+
+    def withdraw(self) -> int | None:
+        """No more offered read; the time of the one taken, if one was."""
+
+
 class _NoHolder:
     """No native answers: every read goes to the peripheral."""
 
@@ -279,6 +292,12 @@ class _NoHolder:
 
     def release(self) -> None:
         pass
+
+    def offer(self, offset: int, value: int, start: int, then: int) -> None:
+        del offset, value, start, then
+
+    def withdraw(self) -> int | None:
+        return None
 
 
 class Spi:
@@ -296,7 +315,9 @@ class Spi:
 
     After a read of SR, SR holds its value (:attr:`holder`) until the shifting byte ends, then the value after it if
     nothing starts then, until the next access to SPI1 or RCC_APB2ENR: the core answers the reads in between
-    natively (MCU-25).
+    natively (MCU-25). A write of DR holds SR as a read of it would then (MCU-26), and while SR is held with a byte
+    shifting into an empty receive buffer, the byte's read of DR from its end on is offered (:attr:`offer`): the core
+    answers it natively, SR reads as after that read, and the model catches up at its next access.
     """
 
     def __init__(
@@ -320,6 +341,8 @@ class Spi:
         self.transfers = 0
         self.holder: ValueHolder = _NoHolder()
         """Told when SR holds its value (:meth:`supi3.mcu.core.CortexM.mmio`'s register, MCU-25)."""
+        self.offer: ReadOffer = _NoHolder()
+        """Told when the read of DR after the shifting byte is known (the same register of the core, MCU-26)."""
         self._holding = False
         rcc.on_enable_change.append(self._release)
 
@@ -327,6 +350,9 @@ class Spi:
         if self._holding:
             self._holding = False
             self.holder.release()
+            taken = self.offer.withdraw()
+            if taken is not None:  # the core answered the offered read of DR at cycle `taken`: catch up with it
+                self._read_dr(taken)
 
     @property
     def period(self) -> int:
@@ -358,6 +384,10 @@ class Spi:
         self._run(self.polled())
         if self.shifting is not None:
             self.on_poll(self.shifting[2])
+        return self._status()
+
+    def _status(self) -> int:
+        """SR from the state as it is (the time caught up with)."""
         busy = self.shifting is not None or self.tx_buffer is not None
         return self._flags(self.rx_buffer is not None, self.ovr, busy)
 
@@ -385,17 +415,31 @@ class Spi:
             value = self.status()
             if self._ovr_seen:
                 self.ovr = self._ovr_seen = False
-            else:  # SR now holds until the shifting byte ends (the time a poll may skip to, MCU-10), then its value
-                self._holding = True  # after the byte if known now, until an access
-                self.holder.hold(SPI_SR, value, None if self.shifting is None else self.shifting[2], self._after())
+            else:
+                self._hold(value)
             return value
         if offset == SPI_DR:
-            self._run(self.polled())
-            if self.rx_buffer is not None:
-                self.rx_last, self.rx_buffer = self.rx_buffer, None
-            self._ovr_seen = self.ovr
-            return self.rx_last
+            return self._read_dr(self.polled())
         return 0
+
+    def _hold(self, value: int) -> None:
+        """SR now holds ``value`` until the shifting byte ends (the time a poll may skip to, MCU-10), then its value
+        after the byte if known now, until an access (MCU-25); with a byte shifting into an empty receive buffer and
+        none waiting, DR's read from the byte's end on is offered, and SR after it (MCU-26)."""
+        self._holding = True
+        shifting = self.shifting
+        self.holder.hold(SPI_SR, value, None if shifting is None else shifting[2], self._after())
+        if shifting is not None and isinstance(shifting[0], int) and self.tx_buffer is None \
+                and self.rx_buffer is None and not self.ovr:  # fmt: skip
+            self.offer.offer(SPI_DR, shifting[0], shifting[2], self._flags(False, False, False))
+
+    def _read_dr(self, cycles: int) -> int:
+        """A read of DR at cycle ``cycles``: the received byte, RXNE cleared, OVR seen (25.3.10)."""
+        self._run(cycles)
+        if self.rx_buffer is not None:
+            self.rx_last, self.rx_buffer = self.rx_buffer, None
+        self._ovr_seen = self.ovr
+        return self.rx_last
 
     def write(self, offset: int, size: int, value: int) -> None:
         """CR1 (MODF check on enabling), CR2, DR (into the transmit buffer; starts a transfer if idle)."""
@@ -417,6 +461,8 @@ class Spi:
             self.tx_buffer = value & 0xFFFF  # a write with TXE = 0 overwrites the waiting byte
             if self.cr1 & CR1_SPE and self.cr1 & CR1_MSTR and self.shifting is None:
                 self._start(cycles)
+            if not self._ovr_seen:  # SR holds what a read of it would hold now, until the byte ends (MCU-26)
+                self._hold(self._status())
 
 
 def _ignore(cycles: int) -> None:
