@@ -12,9 +12,10 @@ Figures: simulated time / CPU time of the process (``time.process_time``: the ma
 with its load; the issue's goal: >= 1x), emulated instructions per second, and two ratios measured in the same
 process: against the same binary with every poll and countdown loop iteration run (``skip_polls = False``: MCU-10
 and MCU-11 off) and against the host build. ``--profile`` also splits the CPU time of one run (cProfile, which
-slows the calls it counts, so the split is a guide, not a measure) by part: unicorn's C code with the ctypes
-transitions into the callbacks, the core's block hook, the rest of the core, the STM32 peripheral models, the board's
-bus synchronisation and checks, and the chip, ring and bench models. Run from the repository root:
+slows the calls it counts, so the split is a guide, not a measure) by part: unicorn's C code with the native block
+and memory hooks (MCU-25) and the ctypes transitions into the Python callbacks, a block's first costing, the rest of
+the core, the STM32 peripheral models, the board's bus synchronisation and checks, and the chip, ring and bench
+models. Run from the repository root:
 
     python bench/bench_mcu.py [--cycles N] [--repeat R] [--profile]
 """
@@ -79,10 +80,10 @@ def binary_run(elf: Path, bit_rate: int, cycles: int, repeat: int, skip: bool = 
 
 
 PARTS: tuple[tuple[str, str, frozenset[str] | None], ...] = (
-    ("unicorn: C code, ctypes transitions", "/unicorn/", frozenset({"emu_start"})),
+    ("unicorn: C code with the native hooks (MCU-25), ctypes transitions", "/unicorn/", frozenset({"emu_start"})),
     ("unicorn's Python binding", "/unicorn/", None),
-    ("core: block hook (MCU-1, -10, -11)", "mcu/core.py", frozenset({"_on_block", "_skip_polls", "_skip_countdown"})),
-    ("core: memory callbacks", "mcu/core.py", frozenset({"on_read", "on_write", "_exact_pc"})),
+    ("core: a block's first cost (MCU-1, -10, -11)", "mcu/core.py", frozenset({"_describe"})),
+    ("core: memory callbacks", "mcu/core.py", frozenset({"on_read", "on_write"})),
     ("core: the rest (run loop, access times, exceptions, registers)", "mcu/core.py", None),
     ("stm32: peripheral models", "mcu/stm32.py", None),
     ("board: bus synchronisation, pins, Table 3-7 checks", "mcu/board.py", None),

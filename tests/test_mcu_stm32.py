@@ -3,15 +3,19 @@
 SPI: the full-duplex master sequence of 25.3.5 (Figure 240: TXE set again as soon as the byte moves to the shift
 register, RXNE at the end of each byte, BSY over back-to-back bytes), overrun (25.3.10), mode fault (25.3.10), the
 baud-rate divider (25.5.1). GPIO: BSRR/BRR (9.2.5, 9.2.6), outputs only where MODE is not 00 (9.2.1). EXTI: the
-falling trigger, mask and pending bit (10.3). RCC: a peripheral with its clock off (7.3.7).
+falling trigger, mask and pending bit (10.3). RCC: a peripheral with its clock off (7.3.7). MCU-25: SR held for the
+core's native reads answers as the model would, over random histories of accesses.
 """
 
 from __future__ import annotations
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from supi3.mcu.stm32 import (
     AFIOEN,
+    APB2ENR,
     CR1_BR_SHIFT,
     CR1_CPHA,
     CR1_CPOL,
@@ -194,3 +198,85 @@ def test_exti_falling_edge_sets_pending_which_asks_while_unmasked() -> None:
     assert exti.pr == 0
     exti.edge(1, 0, 0)
     assert exti.pr == 1
+
+
+class Holder:
+    """What the core does with a held register (supi3_held_read in src/supi3/mcu/hook.c, MCU-25), in Python."""
+
+    def __init__(self, spi: Spi, clock: Clock) -> None:
+        self.spi, self.clock = spi, clock
+        self.held: tuple[int, int, int | None, int | None] | None = None
+        self.native = 0  # reads answered without the model
+
+    def hold(self, offset: int, value: int, until: int | None, after: int | None) -> None:
+        self.held = (offset, value, until, after)
+
+    def release(self) -> None:
+        self.held = None
+
+    def read(self, offset: int) -> int:
+        if self.held is None or self.held[0] != offset:
+            return self.spi.read(offset, 4)
+        _, value, until, after = self.held
+        if until is None or self.clock() < until:
+            self.native += 1
+            if until is not None:
+                self.spi.on_poll(until)
+            return value
+        if after is not None:
+            self.native += 1
+            return after
+        return self.spi.read(offset, 4)
+
+
+_READ = st.tuples(st.just("read"), st.sampled_from([SPI_SR] * 6 + [SPI_DR, SPI_CR1]))
+_WAIT = st.tuples(st.just("wait"), st.integers(0, 24))
+_STEP = st.one_of(
+    _READ, _READ, _READ, _WAIT, _WAIT,
+    st.tuples(st.just("poll"), st.integers(0, 40)),  # SR, a wait, SR: into or past the byte's end
+    st.tuples(st.just("write"), st.just(SPI_DR), st.integers(0, 0xFF)),
+    st.tuples(st.just("write"), st.just(SPI_CR1), st.sampled_from([0, 1, CR1_DFF]).map(lambda v: v | CR1_SPE)),
+    st.tuples(st.just("clock"), st.sampled_from([SPI1EN, 0])),
+)  # fmt: skip
+
+
+@settings(derandomize=True, max_examples=300, deadline=None)
+@given(st.lists(_STEP, min_size=20, max_size=80))
+def test_a_held_status_answers_as_the_model_would(steps: list[tuple[object, ...]]) -> None:
+    """MCU-25: the SPI holds SR after a status read until its byte ends or the next access to SPI1 or RCC_APB2ENR;
+    a core that answers SR from the hold in between (no call into the model) reads the same values, tells the poll
+    skip the same cycles and leaves the model in the same state (once it catches up with the time) as one that
+    always asks the model, over random histories of waits, reads, polls, writes, clock switches and faults (a clock
+    switched off raises in both)."""
+    runs = []
+    for holding in (True, False):
+        spi, clock, _ = _spi(br=0)
+        polls: list[int] = []
+        spi.on_poll = polls.append
+        holder = Holder(spi, clock)
+        if holding:
+            spi.holder = holder
+        seen: list[object] = []
+        for step in steps:
+            try:
+                if step[0] == "wait":
+                    clock.cycles += int(str(step[1]))
+                elif step[0] == "poll":
+                    seen.append(holder.read(SPI_SR))
+                    clock.cycles += int(str(step[1]))
+                    seen.append(holder.read(SPI_SR))
+                elif step[0] == "read":
+                    seen.append(holder.read(int(str(step[1]))))
+                elif step[0] == "write":
+                    spi.write(int(str(step[1])), 4, int(str(step[2])) | (CR1_MSTR | CR1_SSM | CR1_SSI) *
+                              (step[1] == SPI_CR1))  # fmt: skip
+                else:
+                    spi.rcc.write(APB2ENR, 4, int(str(step[1])))
+            except PeripheralClockError as error:
+                seen.append(str(error))
+        spi.rcc.write(APB2ENR, 4, SPI1EN)
+        seen.append(spi.read(SPI_SR, 4))  # the model catches up with the time (a hold leaves it behind)
+        state = (spi.cr1, spi.ovr, spi.modf, spi.tx_buffer, spi.rx_buffer, spi.rx_last, spi.shifting, spi.transfers)
+        runs.append((seen, polls, state, holder.native))
+    assert runs[0][:3] == runs[1][:3]
+    assert runs[1][3] == 0

@@ -292,7 +292,7 @@ class Board:
         else:
             if record:
                 raise fail("record", "False at transaction level (the chip has no pins: fidelity='pin')", record)
-            if stat_err_filter != STATERR_FILTER_CLOCKS:
+            if check_int("stat_err_filter", stat_err_filter, 1, STATERR_FILTER_CLOCKS) != STATERR_FILTER_CLOCKS:
                 raise fail("stat_err_filter", f"{STATERR_FILTER_CLOCKS} (200 ms) at transaction level, which runs it "
                            "in well under a second (a shorter filter is for the pin level's tests, MCU-24)",
                            stat_err_filter)  # fmt: skip
@@ -321,7 +321,8 @@ class Board:
         core.mmio(GPIOB_BASE, PERIPHERAL_SIZE, self.gpio_b.read, self.gpio_b.write)
         core.mmio(AFIO_BASE, PERIPHERAL_SIZE, self.exti.read_afio, self.exti.write_afio)
         core.mmio(EXTI_BASE, PERIPHERAL_SIZE, self.exti.read, self.exti.write)
-        core.mmio(SPI1_BASE, PERIPHERAL_SIZE, self.spi.read, self.spi.write)
+        held = core.mmio(SPI1_BASE, PERIPHERAL_SIZE, self.spi.read, self.spi.write)
+        self.spi.holder = self.spi.offer = held  # SR held (MCU-25), DR's read after its byte (MCU-26)
         core.entered = self._entered
         self.fw_board = FwBoard(core) if "fw_board" in core.image.symbols else None
         self.interrupts = 0

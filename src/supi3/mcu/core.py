@@ -17,8 +17,9 @@ access only under a memory hook, so each peripheral range has an empty one). Emu
 boundary (a block hook refuses the next block), because unicorn restarts an instruction stopped inside a memory
 callback and a peripheral would see its access twice.
 
-Speed (MCU-19): the block hook, the peripheral callbacks and the register reads they need go to unicorn's C library
-through ctypes directly; the binding's wrappers around each call cost as much again as the call.
+Speed (MCU-19): the peripheral callbacks and the register reads they need go to unicorn's C library through ctypes
+directly; the binding's wrappers around each call cost as much again as the call. The block hook and the empty memory
+hooks are native code (MCU-25, :mod:`supi3.mcu.hook`): a block calls Python only the first time it runs.
 """
 
 from __future__ import annotations
@@ -40,19 +41,17 @@ from unicorn import unicorn_const as ucc
 
 from supi3.checks import check_bytes, check_int, check_real, fail
 from supi3.errors import ArgumentError, Supi3Error
+from supi3.mcu import hook
 
 _UNICORN: Any = unicorn  # typed, but its Uc methods are not annotated
 UcError: type[Exception] = _UNICORN.UcError
 _LIB: Any = _UNICORN.unicorn_py3.unicorn.uclib
 """unicorn's C library as its binding loaded it (with the argument types it declares): the hot callbacks and
 register accesses go to it directly (MCU-19), without the binding's wrappers around each call."""
-# Callback types of unicorn.h (uc_cb_hookcode_t, uc_cb_hookmem_t, uc_cb_mmio_read_t, uc_cb_mmio_write_t).
+# Callback types of unicorn.h (uc_cb_hookcode_t, uc_cb_eventmem_t, uc_cb_mmio_write_t; mmio reads: hook.MMIO_READ).
 _HOOK_CODE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint32, ctypes.c_void_p)
-_HOOK_MEM: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_int, ctypes.c_uint64, ctypes.c_int, ctypes.c_int64,
-                                    ctypes.c_void_p)  # fmt: skip
 _HOOK_MEM_INVALID: Final = ctypes.CFUNCTYPE(ctypes.c_bool, ctypes.c_void_p, ctypes.c_int, ctypes.c_uint64, ctypes.c_int,
                                             ctypes.c_int64, ctypes.c_void_p)  # fmt: skip
-_MMIO_READ: Final = ctypes.CFUNCTYPE(ctypes.c_uint64, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint, ctypes.c_void_p)
 _MMIO_WRITE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint, ctypes.c_uint64,
                                       ctypes.c_void_p)  # fmt: skip
 
@@ -68,6 +67,7 @@ __all__ = [
     "FirmwareImage",
     "FirmwareStoppedError",
     "Frame",
+    "HeldRegister",
     "SourceLine",
     "Stop",
     "StopReport",
@@ -125,6 +125,9 @@ SYST_MAX: Final[int] = 0xFF_FFFF
 """SysTick is a 24-bit down counter (B3.3.1)."""
 BACKTRACE_DEPTH: Final[int] = 16
 """Frames :meth:`CortexM.backtrace` unwinds at most."""
+BLOCK_CACHE_SLOTS: Final[int] = 1 << 13
+"""Slots of the native block hook's cost cache (MCU-25), one per halfword address modulo their number: 16 KiB of
+code without two blocks sharing a slot (a block that finds its slot taken asks Python again)."""
 IRQ_LINES: Final[int] = 32
 """External interrupts the NVIC model has (one ISER word)."""
 CFSR: Final[int] = 0xD28
@@ -199,6 +202,13 @@ _REGS: Final[tuple[tuple[str, int], ...]] = (
 _LOW_REGS: Final[tuple[int, ...]] = tuple(getattr(arm, f"UC_ARM_REG_R{k}") for k in range(8))
 _FRAME_REGS: Final[tuple[int, ...]] = (arm.UC_ARM_REG_R0, arm.UC_ARM_REG_R1, arm.UC_ARM_REG_R2, arm.UC_ARM_REG_R3,
                                        arm.UC_ARM_REG_R12, arm.UC_ARM_REG_LR)  # fmt: skip
+_ENTRY_READS: Final[tuple[int, ...]] = (arm.UC_ARM_REG_CONTROL, arm.UC_ARM_REG_SP, *_FRAME_REGS, arm.UC_ARM_REG_XPSR,
+                                        arm.UC_ARM_REG_PC)  # fmt: skip
+"""What an exception entry reads (B1.5.6), in one call (MCU-19)."""
+_UNSTACK_WRITES: Final[tuple[int, ...]] = (*_FRAME_REGS, arm.UC_ARM_REG_XPSR)
+"""What an exception return writes from the frame, the mode last (it selects the SP), in one call (B1.5.8)."""
+_RESUME_WRITES: Final[tuple[int, ...]] = (arm.UC_ARM_REG_SP, arm.UC_ARM_REG_PC)
+"""An exception return's SP and PC, after the mode, in one call."""
 FRAME_NAMES: Final[tuple[str, ...]] = ("r0", "r1", "r2", "r3", "r12", "lr", "pc", "xpsr")
 """The stacked frame's words in address order (B1.5.6)."""
 
@@ -588,6 +598,73 @@ def block_cost(code: bytes) -> tuple[int, int]:
 
 ReadFn = Callable[[int, int], int]
 WriteFn = Callable[[int, int, int], None]
+_FOREVER: Final[int] = (1 << 64) - 1
+
+
+class _Batch:
+    """Core registers read or written in one call to unicorn's C library (``uc_reg_read_batch``,
+    ``uc_reg_write_batch``; MCU-19: 32-bit values in 64-bit slots)."""
+
+    def __init__(self, handle: Any, registers: tuple[int, ...]) -> None:
+        count = self._count = len(registers)
+        self._handle = handle
+        self._ids = (ctypes.c_int32 * count)(*registers)
+        self._values = (ctypes.c_uint64 * count)()
+        base = ctypes.addressof(self._values)
+        self._slots = (ctypes.c_void_p * count)(*(base + 8 * k for k in range(count)))
+
+    def read(self) -> list[int]:
+        """The registers' values, in order."""
+        CortexM._check(_LIB.uc_reg_read_batch(self._handle, self._ids, self._slots, self._count))
+        return list(self._values)
+
+    def write(self, values: list[int]) -> None:
+        """Write the registers, in order (32-bit values)."""
+        typed: list[ctypes.c_uint64 | int] = [*values]
+        self._values[:] = typed
+        CortexM._check(_LIB.uc_reg_write_batch(self._handle, self._ids, self._slots, self._count))
+
+
+class HeldRegister:
+    """A peripheral's register that the core answers natively while the peripheral holds its value (MCU-25), and a
+    read the peripheral offers from a cycle on (MCU-26), from :meth:`CortexM.mmio`. A peripheral holds a value (or
+    offers a read) for as long as its own reads would return it and change nothing but what its next access catches
+    up with (its model runs on the time), and releases it at that access."""
+
+    def __init__(self, held: hook.Held) -> None:
+        self._held = held
+
+    def hold(self, offset: int, value: int, until: int | None, after: int | None = None) -> None:
+        """Reads of ``offset`` return ``value`` while their time (:meth:`CortexM.cycles_polled`) is before cycle
+        ``until`` and tell the poll skip (:meth:`CortexM.skip_poll`, MCU-10) that cycle (``None``: until
+        :meth:`release`, no poll skip), then ``after`` (``None``: the peripheral answers). Any other read goes to the
+        peripheral."""
+        held = self._held
+        held.offset, held.value = offset, value
+        held.until, held.poll = (_FOREVER, 0) if until is None else (until, 1)
+        held.after, held.has_after = (0, 0) if after is None else (after, 1)
+        held.held = 1
+
+    def release(self) -> None:
+        """Every read goes to the peripheral again."""
+        self._held.held = 0
+
+    def offer(self, offset: int, value: int, start: int, then: int) -> None:
+        """MCU-26: the first read of ``offset`` at a time (:meth:`CortexM.cycles_polled`) from cycle ``start`` on
+        returns ``value``, once, and from then on the held register reads ``then`` (as long as it is held)."""
+        held = self._held
+        held.once_offset, held.once_value, held.once_from, held.once_then = offset, value, start, then
+        held.taken, held.once = 0, 1
+
+    def withdraw(self) -> int | None:
+        """No more offered read; the time of the one taken since :meth:`offer`, if one was (the peripheral catches
+        up with it)."""
+        held = self._held
+        held.once = 0
+        if not held.taken:
+            return None
+        held.taken = 0
+        return int(held.once_at)
 
 
 class CortexM:
@@ -622,6 +699,9 @@ class CortexM:
         self._handle = self.uc._uch  # the engine (uc_engine *) for the direct calls (MCU-19)
         self._register_value = ctypes.c_uint64()
         self._register_ref = ctypes.byref(self._register_value)
+        self._entry_reads = _Batch(self._handle, _ENTRY_READS)
+        self._unstack = _Batch(self._handle, _UNSTACK_WRITES)
+        self._resume = _Batch(self._handle, _RESUME_WRITES)
         self._callbacks: list[object] = []  # the ctypes callbacks unicorn holds: kept alive with the core
         self.flash = flash
         self.ram = ram
@@ -629,9 +709,20 @@ class CortexM:
             self.uc.mem_map(base, size)
         for address, data in self.image.segments:
             self.uc.mem_write(address, data)
-        self.cycles = 0
-        self.instructions = 0
-        self.deadline = 0
+        native = hook.library()
+        self._exact_pc = native.supi3_exact_pc
+        self._held_read = ctypes.cast(native.supi3_held_read, ctypes.c_void_p)
+        self._state = state = hook.State()  # cycles, instructions, deadline, ...: shared with the native hook
+        self._cache = (hook.Block * BLOCK_CACHE_SLOTS)()
+        self._describe_callback = hook.DESCRIBE(self._describe)
+        state.cache = self._cache
+        state.mask = BLOCK_CACHE_SLOTS - 1
+        state.low_registers[:] = _LOW_REGS
+        state.pc_register = arm.UC_ARM_REG_PC
+        state.emu_stop = ctypes.cast(_LIB.uc_emu_stop, ctypes.c_void_p)
+        state.reg_read = ctypes.cast(_LIB.uc_reg_read, ctypes.c_void_p)
+        state.reg_write = ctypes.cast(_LIB.uc_reg_write, ctypes.c_void_p)
+        state.describe = self._describe_callback
         self.sleeping = False
         self.active: list[int] = []  # active exceptions, outermost first
         self.pending: set[int] = set()
@@ -644,22 +735,18 @@ class CortexM:
         self.entered: Callable[[int], None] = _nothing
         """Called with the exception number after each exception entry (the board measures latency)."""
         self._costs: dict[tuple[int, int], tuple[int, int]] = {}  # the cost of a block's first instructions
-        self._block = (0, 0)  # address and cycle count at the entry of the block running
-        self._block_end = 0
         self._running = False
-        self._handed = 0  # the latest time a peripheral was given
-        self._skip: tuple[int, int] | None = None  # (poll loop address, cycle its status changes)
-        self._polls: dict[int, bool] = {}
+        self._held: list[hook.Held] = []  # the peripherals' held registers (MCU-25)
         self._idle: dict[int, bool] = {}  # address: the instruction there is ``b .``
-        self._blocks: dict[tuple[int, int], tuple[tuple[int, int], int]] = {}  # cost, countdown register (MCU-11)
+        self._sleeps: dict[int, bool] = {}  # address: the instruction before it is WFI or WFE
+        # (address, size) of a block: its cost, countdown register (MCU-11), whether a pure poll loop (MCU-10)
+        self._blocks: dict[tuple[int, int], tuple[tuple[int, int], int, bool]] = {}
         self.skip_polls = True
-        """MCU-10, MCU-11: count the iterations of pure poll loops and countdown loops without running them (the
-        same result, faster); ``False`` runs each."""
         self.vtor = 0
         self.systick = SysTick(self)
         self._scs_words: dict[int, int] = {}
         self.mmio(SCS_BASE, SCS_SIZE, self._scs_read, self._scs_write)
-        self._hook(ucc.UC_HOOK_BLOCK, _HOOK_CODE(self._on_block))
+        self._hook(ucc.UC_HOOK_BLOCK, native.supi3_block_hook, data=ctypes.byref(state))
         on_idle_loop = _HOOK_CODE(self._on_idle_loop)
         for address in idle_loops(self.image, flash):  # MCU-4: the core stops at its first ``b .``
             self._hook(ucc.UC_HOOK_CODE, on_idle_loop, address, address)
@@ -670,10 +757,11 @@ class CortexM:
 
     # -- memory ------------------------------------------------------------------------------------------------
 
-    def mmio(self, base: int, size: int, read: ReadFn, write: WriteFn) -> None:
+    def mmio(self, base: int, size: int, read: ReadFn, write: WriteFn) -> HeldRegister:
         """Map a peripheral: ``read(offset, size) -> value`` and ``write(offset, size, value)`` run on every
-        access. An exception they raise stops the run at the end of the block (:attr:`error`); the block's later
-        accesses reach no peripheral (no follow-on reports of a run that has ended)."""
+        access, but a read of a register the peripheral holds (the :class:`HeldRegister` returned) is answered
+        natively (MCU-25). An exception they raise stops the run at the end of the block (:attr:`error`); the
+        block's later accesses reach no peripheral (no follow-on reports of a run that has ended)."""
 
         def on_read(handle: int, offset: int, size: int, data: int) -> int:
             del handle, data
@@ -694,20 +782,26 @@ class CortexM:
             except BaseException as error:  # handed to the run loop, raised there
                 self.fail(error)
 
-        callbacks = (_MMIO_READ(on_read), _MMIO_WRITE(on_write))
+        callbacks = (hook.MMIO_READ(on_read), _MMIO_WRITE(on_write))
         self._callbacks += callbacks
-        self._check(_LIB.uc_mmio_map(self._handle, base, size, callbacks[0], None, callbacks[1], None))
+        held = hook.Held(ctypes.pointer(self._state), callbacks[0])
+        self._held.append(held)
+        self._check(_LIB.uc_mmio_map(self._handle, base, size, self._held_read, ctypes.byref(held), callbacks[1],
+                                     None))  # fmt: skip
         # unicorn updates the PC before a load or store only if a memory hook covers its address: without one, a
         # peripheral callback sees the PC of the block's first instruction, and the access would be timed there
-        # (MCU-1 places it by the PC).
-        self._hook(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, _EXACT_PC, base, base + size - 1)
+        # (MCU-1 places it by the PC). The native hook also notes that PC for cycles_now (MCU-25).
+        self._hook(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, self._exact_pc, base, base + size - 1,
+                   ctypes.byref(self._state))  # fmt: skip
+        return HeldRegister(held)
 
-    def _hook(self, kind: int, callback: Any, begin: int = 1, end: int = 0) -> None:
-        """Add a hook with a ctypes callback (MCU-19); ``begin > end``: every address."""
+    def _hook(self, kind: int, callback: Any, begin: int = 1, end: int = 0, data: Any = None) -> None:
+        """Add a hook with a ctypes callback or a native function (MCU-19, MCU-25) and its user data; ``begin >
+        end``: every address."""
         self._callbacks.append(callback)
         handle = ctypes.c_size_t()  # uc_hook
         self._check(_LIB.uc_hook_add(self._handle, ctypes.byref(handle), kind, ctypes.cast(callback, ctypes.c_void_p),
-                                     None, ctypes.c_uint64(begin), ctypes.c_uint64(end)))  # fmt: skip
+                                     data, ctypes.c_uint64(begin), ctypes.c_uint64(end)))  # fmt: skip
 
     @staticmethod
     def _check(status: int) -> None:
@@ -742,6 +836,8 @@ class CortexM:
         if self.error is None:
             self.error = error
         self.stop_request = True
+        for held in self._held:  # the peripherals are silent now (mmio): no register is answered natively either
+            held.held = held.once = 0
 
     # -- registers ---------------------------------------------------------------------------------------------
 
@@ -772,6 +868,54 @@ class CortexM:
         self._register_value.value = value
         _LIB.uc_reg_write(self._handle, register, self._register_ref)
 
+    # -- the clock, shared with the native block hook (MCU-1, MCU-25) ------------------------------------------------
+
+    @property
+    def cycles(self) -> int:
+        """Cycles since reset (exception entry and return cycles included)."""
+        return int(self._state.cycles)
+
+    @cycles.setter
+    def cycles(self, value: int) -> None:
+        self._state.cycles = value
+
+    @property
+    def instructions(self) -> int:
+        """Instructions since reset."""
+        return int(self._state.instructions)
+
+    @instructions.setter
+    def instructions(self, value: int) -> None:
+        self._state.instructions = value
+
+    @property
+    def deadline(self) -> int:
+        """The cycle the running :meth:`step` ends at (checked at block boundaries)."""
+        return int(self._state.deadline)
+
+    @deadline.setter
+    def deadline(self, value: int) -> None:
+        self._state.deadline = value
+
+    @property
+    def stop_request(self) -> bool:
+        """End the run at the next block boundary (a peripheral's change the run loop must see)."""
+        return bool(self._state.stop_request)
+
+    @stop_request.setter
+    def stop_request(self, value: bool) -> None:
+        self._state.stop_request = value
+
+    @property
+    def skip_polls(self) -> bool:
+        """MCU-10, MCU-11: count the iterations of pure poll loops and countdown loops without running them (the
+        same result, faster); ``False`` runs each."""
+        return bool(self._state.skip_polls)
+
+    @skip_polls.setter
+    def skip_polls(self, value: bool) -> None:
+        self._state.skip_polls = value
+
     @property
     def time_s(self) -> float:
         """Core time: cycles / cpu_hz."""
@@ -781,26 +925,30 @@ class CortexM:
         """The cycle of the instruction running now: inside a peripheral callback the block's entry plus the
         instructions before the program counter (MCU-1), between runs :attr:`cycles`. Never earlier than a time
         already handed out (:meth:`cycles_polled`)."""
+        state = self._state
         if not self._running:
-            return self.cycles
-        address, start = self._block
-        pc = self._read(arm.UC_ARM_REG_PC)
+            return int(state.cycles)
+        address, start, pc = state.block_address, state.block_start, state.access_pc
         if pc > address:
             key = (address, pc - address)
             cost = self._costs.get(key)
             if cost is None:
                 cost = self._costs[key] = block_cost(self.read_bytes(address, pc - address))
             start += cost[1]
-        self._handed = max(self._handed, start)
-        return self._handed
+        if start > state.handed:
+            state.handed = start
+        return int(state.handed)
 
     def cycles_polled(self) -> int:
         """The time of a status read (a flag the firmware polls): the end of the running block, which costs no
         register read; later times handed out are never earlier (MCU-1)."""
+        state = self._state
+        cycles = int(state.cycles)
         if not self._running:
-            return self.cycles
-        self._handed = max(self._handed, self.cycles)
-        return self._handed
+            return cycles
+        if cycles > state.handed:
+            state.handed = cycles
+        return int(state.handed)
 
     # -- reset and exceptions ----------------------------------------------------------------------------------
 
@@ -859,14 +1007,11 @@ class CortexM:
         _exception_number(number)
         uc = self.uc
         handler_mode = bool(self.active)
-        control = self._read(arm.UC_ARM_REG_CONTROL)
+        control, sp, *words, xpsr, pc = self._entry_reads.read()
         process = bool(control & CONTROL_SPSEL) and not handler_mode
-        sp = self._read(arm.UC_ARM_REG_SP)
-        words = [self._read(r) for r in _FRAME_REGS]
-        xpsr = self._read(arm.UC_ARM_REG_XPSR)
         aligned = sp & 4
         frame = (sp - FRAME_WORDS * 4) & ~7
-        words += [self.pc, xpsr | (XPSR_ALIGN if aligned else 0)]
+        words += [pc, xpsr | (XPSR_ALIGN if aligned else 0)]
         try:
             uc.mem_write(frame, struct.pack("<8I", *words))
         except UcError as error:
@@ -927,51 +1072,34 @@ class CortexM:
         except ArgumentError:
             reason = f"unstacking error: the frame at {sp:08X}h is not in memory (B1.5.8)"
             raise FirmwareFaultError(self.report(Stop.FAULT, reason)) from None
-        for reg, value in zip(_FRAME_REGS, words[:6], strict=True):
-            self._write(reg, value)
         xpsr = words[7]
         sp += FRAME_WORDS * 4 + (4 if xpsr & XPSR_ALIGN else 0)
-        self._write(arm.UC_ARM_REG_XPSR, (xpsr & ~XPSR_ALIGN) | XPSR_T)  # the mode first: it selects the SP
+        self._unstack.write([*words[:6], (xpsr & ~XPSR_ALIGN) | XPSR_T])  # the mode last: it selects the SP
         if exc_return == EXC_RETURN_THREAD_PSP:
             self._write(arm.UC_ARM_REG_CONTROL, self._read(arm.UC_ARM_REG_CONTROL) | CONTROL_SPSEL)
-        self._write(arm.UC_ARM_REG_SP, sp)
-        self._write(arm.UC_ARM_REG_PC, words[6] & ~1)
+        self._resume.write([sp, words[6] & ~1])
         self.active.pop()
         self.cycles += self.cpu.return_cycles
 
     # -- running -----------------------------------------------------------------------------------------------
 
-    def _on_block(self, handle: int, address: int, size: int, data: int) -> None:
-        """The block at ``address`` is about to run: refuse it at the deadline or on a stop request, else count its
-        cost (MCU-1) or skip the iterations of a poll or countdown loop (MCU-10, MCU-11)."""
-        del data
+    def _describe(self, address: int, size: int) -> int:
+        """The native block hook met a block not in its cache: its cost (MCU-1), countdown register (MCU-11) and
+        whether it is a pure poll loop (MCU-10) into the cache and :attr:`hook.State.fresh`; 1 (stop the run) if its
+        code cannot be read."""
         try:
-            if self.stop_request or self.cycles >= self.deadline:
-                _LIB.uc_emu_stop(handle)  # this block does not run: it is the first of the next run
-                return
             block = self._blocks.get((address, size))
             if block is None:
                 code = self.read_bytes(address, size)
-                block = self._blocks[address, size] = (block_cost(code), countdown_register(code))
-            cost = block[0]
-            skip = self._skip
-            if skip is not None:
-                self._skip = None
-                if skip[0] == address:
-                    self._skip_polls(cost, skip[1])
-                    if self.cycles >= self.deadline:
-                        _LIB.uc_emu_stop(handle)
-                        return
-            if block[1] >= 0 and self.skip_polls and self._skip_countdown(block[1], cost):
-                _LIB.uc_emu_stop(handle)
-                return
-            self._block = (address, self.cycles)
-            self._block_end = address + size
-            self.instructions += cost[0]
-            self.cycles += cost[1]
+                block = self._blocks[address, size] = (block_cost(code), countdown_register(code),
+                                                       is_poll_loop(code, address))  # fmt: skip
+            (instructions, cycles), countdown, poll = block
+            self._state.fresh = self._cache[(address >> 1) & (len(self._cache) - 1)] = \
+                hook.Block(address, size, instructions, cycles, countdown, poll)  # fmt: skip
+            return 0
         except BaseException as error:  # handed to the run loop, raised there (an escape would be lost in ctypes)
             self.fail(error)
-            _LIB.uc_emu_stop(handle)
+            return 1
 
     def _on_idle_loop(self, handle: int, address: int, size: int, data: int) -> None:
         """A ``b .`` is about to run (its block counted): stop there, at its first iteration, whatever the deadline;
@@ -980,39 +1108,12 @@ class CortexM:
         self.stop_request = True
         _LIB.uc_emu_stop(handle)
 
-    def _skip_polls(self, cost: tuple[int, int], until: int) -> None:
-        """Count, without running them, the iterations of a poll loop that would start before the deadline and
-        read before ``until`` (MCU-10): each reads at its block's end (:meth:`cycles_polled`)."""
-        instructions, cycles = cost
-        before_deadline = -(-(self.deadline - self.cycles) // cycles)
-        reading_early = -(-(until - cycles - self.cycles) // cycles)
-        skipped = max(0, min(before_deadline, reading_early))
-        self.instructions += skipped * instructions
-        self.cycles += skipped * cycles
-
-    def _skip_countdown(self, register: int, cost: tuple[int, int]) -> bool:
-        """Count, without running them, the iterations of a countdown loop on ``register`` that would start before
-        the deadline, all but its last (MCU-11); whether the deadline came first (the block must not run)."""
-        reg = _LOW_REGS[register]
-        left = self._read(reg)
-        skipped = max(0, min(left - 1, -(-(self.deadline - self.cycles) // cost[1])))
-        if skipped:
-            self._write(reg, left - skipped)
-            self.instructions += skipped * cost[0]
-            self.cycles += skipped * cost[1]
-        return self.cycles >= self.deadline
-
     def skip_poll(self, until: int) -> None:
         """The status register just read keeps its value until cycle ``until``: if the running block is a pure poll
         loop on it (:func:`is_poll_loop`), its next iterations up to then are counted without running (MCU-10)."""
-        if not self.skip_polls:
-            return
-        address = self._block[0]
-        pure = self._polls.get(address)
-        if pure is None:
-            pure = self._polls[address] = is_poll_loop(self.read_bytes(address, self._block_end - address), address)
-        if pure:
-            self._skip = (address, until)
+        state = self._state
+        if state.skip_polls and state.block_poll:  # the native hook's held_read does the same (MCU-25)
+            state.skip_address, state.skip_until, state.skip_pending = state.block_address, until, 1
 
     def _on_interrupt(self, uc: Any, number: int, data: Any) -> None:
         del data
@@ -1066,9 +1167,13 @@ class CortexM:
         if number is not None:
             what = "a breakpoint (BKPT)" if number == EXCP_BKPT else f"core exception {number}"
             raise FirmwareStoppedError(self.report(Stop.FAULT, f"{what}: not modelled"))
-        if pc == self._block_end and self.read_bytes(pc - 2, 2) in (b"\x30\xbf", b"\x20\xbf"):
-            self.sleeping = True  # the last block ended in WFI or WFE: unicorn halts the core after them
-            return "sleep"
+        if pc == self._state.block_end:
+            sleeps = self._sleeps.get(pc)  # the code does not change (as the block costs)
+            if sleeps is None:
+                sleeps = self._sleeps[pc] = self.read_bytes(pc - 2, 2) in (b"\x30\xbf", b"\x20\xbf")
+            if sleeps:
+                self.sleeping = True  # the last block ended in WFI or WFE: unicorn halts the core after them
+                return "sleep"
         if self.stop_request or self.cycles >= self.deadline:
             return "run"
         raise FirmwareStoppedError(self.report(Stop.FAULT, "the core stopped for no known reason"))
@@ -1218,14 +1323,6 @@ class CortexM:
             self._scs_words[offset] = self._scs_words.get(offset, 0) & ~value
         else:
             self._scs_words[offset] = value
-
-
-def _exact_pc(handle: int, access: int, address: int, size: int, value: int, data: int) -> None:
-    """A memory hook that does nothing: its presence makes unicorn keep the PC exact at each access it covers."""
-    del handle, access, address, size, value, data
-
-
-_EXACT_PC: Final = _HOOK_MEM(_exact_pc)
 
 
 def _nothing(number: int) -> None:

@@ -29,8 +29,10 @@ __all__ = [
     "Gpio",
     "PeripheralClockError",
     "Rcc",
+    "ReadOffer",
     "Spi",
     "SpiWire",
+    "ValueHolder",
 ]
 
 RCC_BASE: Final[int] = 0x4002_1000
@@ -80,6 +82,8 @@ class Rcc:
     def __init__(self) -> None:
         self.apb2enr = 0
         self._other: dict[int, int] = {}
+        self.on_enable_change: list[Callable[[], None]] = []
+        """Called when APB2ENR is written: a peripheral whose register the core answers natively takes it back."""
 
     def require(self, bit: int, name: str) -> None:
         """Raise :class:`PeripheralClockError` unless APB2ENR has ``bit``."""
@@ -97,6 +101,8 @@ class Rcc:
         del size
         if offset == APB2ENR:
             self.apb2enr = value
+            for changed in self.on_enable_change:
+                changed()
         else:
             self._other[offset] = value
 
@@ -254,6 +260,46 @@ class SpiWire(Protocol):
         transfer has ended (a pin-level chip drives MISO bit by bit)."""
 
 
+class ValueHolder(Protocol):
+    """Where a peripheral says that a register holds its value (the core answers its reads natively, MCU-25):
+    :class:`supi3.mcu.core.HeldRegister`."""
+
+    def hold(self, offset: int, value: int, until: int | None, after: int | None) -> None:
+        """Reads of ``offset`` return ``value`` while their time is before cycle ``until`` (``None``: always), then
+        ``after`` (``None``: the peripheral answers)."""
+
+    def release(self) -> None:
+        """Every read goes to the peripheral again."""
+
+
+class ReadOffer(Protocol):
+    """Where a peripheral offers one read of a register from a cycle on (the core answers it natively, MCU-26):
+    :class:`supi3.mcu.core.HeldRegister`."""
+
+    def offer(self, offset: int, value: int, start: int, then: int) -> None:
+        """The first read of ``offset`` at a time from cycle ``start`` on returns ``value``, once; from then on the
+        held register (:class:`ValueHolder`) reads ``then``."""
+
+    def withdraw(self) -> int | None:
+        """No more offered read; the time of the one taken, if one was."""
+
+
+class _NoHolder:
+    """No native answers: every read goes to the peripheral."""
+
+    def hold(self, offset: int, value: int, until: int | None, after: int | None) -> None:
+        del offset, value, until, after
+
+    def release(self) -> None:
+        pass
+
+    def offer(self, offset: int, value: int, start: int, then: int) -> None:
+        del offset, value, start, then
+
+    def withdraw(self) -> int | None:
+        return None
+
+
 class Spi:
     """SPI1 as a full-duplex master (RM0008 25.3.3, 25.3.5; timing model MCU-8).
 
@@ -266,6 +312,12 @@ class Spi:
     received byte is in DR (RXNE 1), or lost with OVR if RXNE was still 1 (25.3.10). BSY is 1 from the start of a
     transfer to the end of the last one. MODF: SSM = 1 with SSI = 0 in master mode clears MSTR and SPE
     (25.3.10); /NSS is not wired (SSM = 0 reads it high, MCU-6).
+
+    After a read of SR, SR holds its value (:attr:`holder`) until the shifting byte ends, then the value after it if
+    nothing starts then, until the next access to SPI1 or RCC_APB2ENR: the core answers the reads in between
+    natively (MCU-25). A write of DR holds SR as a read of it would then (MCU-26), and while SR is held with a byte
+    shifting into an empty receive buffer, the byte's read of DR from its end on is offered (:attr:`offer`): the core
+    answers it natively, SR reads as after that read, and the model catches up at its next access.
     """
 
     def __init__(
@@ -287,6 +339,20 @@ class Spi:
         self.rx_last = 0
         self.shifting: tuple[int | Callable[[], int], int, int] | None = None  # (received, start cycle, end cycle)
         self.transfers = 0
+        self.holder: ValueHolder = _NoHolder()
+        """Told when SR holds its value (:meth:`supi3.mcu.core.CortexM.mmio`'s register, MCU-25)."""
+        self.offer: ReadOffer = _NoHolder()
+        """Told when the read of DR after the shifting byte is known (the same register of the core, MCU-26)."""
+        self._holding = False
+        rcc.on_enable_change.append(self._release)
+
+    def _release(self) -> None:
+        if self._holding:
+            self._holding = False
+            self.holder.release()
+            taken = self.offer.withdraw()
+            if taken is not None:  # the core answered the offered read of DR at cycle `taken`: catch up with it
+                self._read_dr(taken)
 
     @property
     def period(self) -> int:
@@ -318,13 +384,28 @@ class Spi:
         self._run(self.polled())
         if self.shifting is not None:
             self.on_poll(self.shifting[2])
+        return self._status()
+
+    def _status(self) -> int:
+        """SR from the state as it is (the time caught up with)."""
         busy = self.shifting is not None or self.tx_buffer is not None
-        return ((self.rx_buffer is not None) * SR_RXNE | (self.tx_buffer is None) * SR_TXE
-                | self.modf * SR_MODF | self.ovr * SR_OVR | busy * SR_BSY)  # fmt: skip
+        return self._flags(self.rx_buffer is not None, self.ovr, busy)
+
+    def _flags(self, rxne: bool, ovr: bool, busy: bool) -> int:
+        return (rxne * SR_RXNE | (self.tx_buffer is None) * SR_TXE | self.modf * SR_MODF | ovr * SR_OVR
+                | busy * SR_BSY)  # fmt: skip
+
+    def _after(self) -> int | None:
+        """SR once the shifting byte has ended, if nothing starts then (no byte waits) and the byte's end needs no
+        look at the wire (a received value known now): RXNE, OVR if RXNE was still 1 (25.3.10), not busy."""
+        if self.shifting is None or self.tx_buffer is not None or not isinstance(self.shifting[0], int):
+            return None
+        return self._flags(True, self.ovr or self.rx_buffer is not None, False)
 
     def read(self, offset: int, size: int) -> int:
         """CR1, CR2, SR, DR (reading DR clears RXNE; reading SR after DR clears OVR, 25.3.10)."""
         del size
+        self._release()
         self.rcc.require(SPI1EN, "SPI1")
         if offset == SPI_CR1:
             return self.cr1
@@ -334,18 +415,36 @@ class Spi:
             value = self.status()
             if self._ovr_seen:
                 self.ovr = self._ovr_seen = False
+            else:
+                self._hold(value)
             return value
         if offset == SPI_DR:
-            self._run(self.polled())
-            if self.rx_buffer is not None:
-                self.rx_last, self.rx_buffer = self.rx_buffer, None
-            self._ovr_seen = self.ovr
-            return self.rx_last
+            return self._read_dr(self.polled())
         return 0
+
+    def _hold(self, value: int) -> None:
+        """SR now holds ``value`` until the shifting byte ends (the time a poll may skip to, MCU-10), then its value
+        after the byte if known now, until an access (MCU-25); with a byte shifting into an empty receive buffer and
+        none waiting, DR's read from the byte's end on is offered, and SR after it (MCU-26)."""
+        self._holding = True
+        shifting = self.shifting
+        self.holder.hold(SPI_SR, value, None if shifting is None else shifting[2], self._after())
+        if shifting is not None and isinstance(shifting[0], int) and self.tx_buffer is None \
+                and self.rx_buffer is None and not self.ovr:  # fmt: skip
+            self.offer.offer(SPI_DR, shifting[0], shifting[2], self._flags(False, False, False))
+
+    def _read_dr(self, cycles: int) -> int:
+        """A read of DR at cycle ``cycles``: the received byte, RXNE cleared, OVR seen (25.3.10)."""
+        self._run(cycles)
+        if self.rx_buffer is not None:
+            self.rx_last, self.rx_buffer = self.rx_buffer, None
+        self._ovr_seen = self.ovr
+        return self.rx_last
 
     def write(self, offset: int, size: int, value: int) -> None:
         """CR1 (MODF check on enabling), CR2, DR (into the transmit buffer; starts a transfer if idle)."""
         del size
+        self._release()
         self.rcc.require(SPI1EN, "SPI1")
         cycles = self.now()
         self._run(cycles)
@@ -362,6 +461,8 @@ class Spi:
             self.tx_buffer = value & 0xFFFF  # a write with TXE = 0 overwrites the waiting byte
             if self.cr1 & CR1_SPE and self.cr1 & CR1_MSTR and self.shifting is None:
                 self._start(cycles)
+            if not self._ovr_seen:  # SR holds what a read of it would hold now, until the byte ends (MCU-26)
+                self._hold(self._status())
 
 
 def _ignore(cycles: int) -> None:

@@ -1,0 +1,162 @@
+"""The core's block hook in native code (MCU-25): ``hook.c`` built for the host with the Zig toolchain from PyPI.
+
+Ref: unicorn.h (uc_cb_hookcode_t, uc_cb_hookmem_t); decisions MCU-1, MCU-10, MCU-11, MCU-25 in
+docs/assumptions/mcu.md. The C source ships with the package; :func:`library` compiles it on first use with
+
+    python -m ziglang cc -shared -fPIC -O2 -target native -mcpu=baseline -nostdlib -std=c99 -Wall -Wextra
+        -pedantic -Werror hook.c -o <cache>/_supi3_mcu_hook_<hash>.so
+
+into the native build cache (:func:`supi3.sdk.native.default_cache_dir`), keyed by the source, the flags, the
+compiler's version and the machine, and loads it with ctypes. Parallel processes (pytest-xdist workers) each build
+into a temporary file of the cache folder and rename it into place: a process sees no file or a whole one. The
+library links against nothing: the unicorn functions it calls are pointers in :class:`State`.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import importlib.metadata
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+from typing import Final
+
+from supi3.errors import Supi3Error
+from supi3.sdk.native import default_cache_dir
+
+__all__ = ["DESCRIBE", "FLAGS", "MMIO_READ", "SOURCE", "Block", "Held", "NativeHookError", "State", "cached_path",
+           "library"]
+
+SOURCE: Final[Path] = Path(__file__).with_name("hook.c")
+FLAGS: Final[tuple[str, ...]] = ("-shared", "-fPIC", "-O2", "-target", "native", "-mcpu=baseline", "-nostdlib",
+                                 "-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror")  # fmt: skip
+"""The host build of :data:`SOURCE`: position-independent, no C library, the SDK's strictness."""
+
+DESCRIBE: Final = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_uint64, ctypes.c_uint32)
+"""``describe(address, size)``: Python's cost of a block not in the cache (fills it and :attr:`State.fresh`);
+nonzero stops the run."""
+MMIO_READ: Final = ctypes.CFUNCTYPE(ctypes.c_uint64, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint, ctypes.c_void_p)
+"""unicorn.h's uc_cb_mmio_read_t: a peripheral's read (``handle, offset, size, user data -> value``)."""
+
+
+class NativeHookError(Supi3Error, RuntimeError):
+    """The native block hook cannot be built or loaded here (no ziglang, or the compiler failed): the emulated core
+    needs it (MCU-25); the firmware extra installs the compiler (``pip install supi3[firmware]``)."""
+
+
+class Block(ctypes.Structure):
+    """A cached block cost (``supi3_block``): the block's address and size (0: empty), its instructions and cycles
+    (MCU-1), the register it counts down or -1 (MCU-11), whether it is a pure poll loop (MCU-10)."""
+
+    _fields_ = (("address", ctypes.c_uint32), ("size", ctypes.c_uint32), ("instructions", ctypes.c_uint32),
+                ("cycles", ctypes.c_uint32), ("countdown", ctypes.c_int32), ("poll", ctypes.c_int32))  # fmt: skip
+
+
+class State(ctypes.Structure):
+    """The state the native hook shares with :class:`supi3.mcu.core.CortexM` (``supi3_state`` of hook.c)."""
+
+    _fields_ = (
+        ("cycles", ctypes.c_uint64),
+        ("instructions", ctypes.c_uint64),
+        ("deadline", ctypes.c_uint64),
+        ("block_start", ctypes.c_uint64),
+        ("block_address", ctypes.c_uint64),
+        ("block_end", ctypes.c_uint64),
+        ("skip_until", ctypes.c_uint64),
+        ("skip_address", ctypes.c_uint64),
+        ("handed", ctypes.c_uint64),
+        ("skip_pending", ctypes.c_uint32),
+        ("stop_request", ctypes.c_uint32),
+        ("skip_polls", ctypes.c_uint32),
+        ("mask", ctypes.c_uint32),
+        ("block_poll", ctypes.c_uint32),
+        ("cache", ctypes.POINTER(Block)),
+        ("fresh", Block),
+        ("access_pc", ctypes.c_uint64),
+        ("low_registers", ctypes.c_int32 * 8),
+        ("pc_register", ctypes.c_int32),
+        ("emu_stop", ctypes.c_void_p),
+        ("reg_read", ctypes.c_void_p),
+        ("reg_write", ctypes.c_void_p),
+        ("describe", DESCRIBE),
+    )
+
+
+class Held(ctypes.Structure):
+    """A register value a peripheral holds until a cycle, and one read a peripheral offers from a cycle on (MCU-26),
+    answered natively (``supi3_held`` of hook.c)."""
+
+    _fields_ = (
+        ("state", ctypes.POINTER(State)),
+        ("slow", MMIO_READ),
+        ("until", ctypes.c_uint64),
+        ("offset", ctypes.c_uint32),
+        ("value", ctypes.c_uint32),
+        ("held", ctypes.c_uint32),
+        ("poll", ctypes.c_uint32),
+        ("after", ctypes.c_uint32),
+        ("has_after", ctypes.c_uint32),
+        ("once_from", ctypes.c_uint64),
+        ("once_at", ctypes.c_uint64),
+        ("once_offset", ctypes.c_uint32),
+        ("once_value", ctypes.c_uint32),
+        ("once", ctypes.c_uint32),
+        ("taken", ctypes.c_uint32),
+        ("once_then", ctypes.c_uint32),
+    )
+
+
+_LOADED: list[ctypes.CDLL] = []
+
+
+def _compiler_version() -> str:
+    try:
+        return importlib.metadata.version("ziglang")
+    except importlib.metadata.PackageNotFoundError:
+        raise NativeHookError("ziglang is not installed: the emulated core's block hook is built with it (MCU-25; "
+                              "pip install supi3[firmware])") from None  # fmt: skip
+
+
+def cached_path() -> Path:
+    """Where :func:`library` keeps the build: the native build cache, named by the hash of the source, the flags,
+    the compiler's version and the machine; :class:`NativeHookError` if there is no compiler."""
+    digest = hashlib.sha256()
+    for part in (SOURCE.read_bytes(), _compiler_version().encode(), *(flag.encode() for flag in FLAGS),
+                 platform.machine().encode(), sys.platform.encode()):  # fmt: skip
+        digest.update(part + b"\0")
+    return default_cache_dir() / f"_supi3_mcu_hook_{digest.hexdigest()[:20]}.so"
+
+
+def library() -> ctypes.CDLL:
+    """The native hook library, built into the cache on first use (:func:`cached_path`), loaded once a process;
+    :class:`NativeHookError` if it cannot be built or loaded."""
+    if _LOADED:
+        return _LOADED[0]
+    target = cached_path()
+    folder = target.parent
+    if not target.is_file():
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+            handle, work = tempfile.mkstemp(dir=folder, prefix=f"{target.stem}.", suffix=".tmp")
+        except OSError as error:
+            raise NativeHookError(f"the native block hook cannot be built into {folder} (MCU-25): {error}") from error
+        os.close(handle)
+        try:
+            command = [sys.executable, "-m", "ziglang", "cc", *FLAGS, str(SOURCE), "-o", work]
+            result = subprocess.run(command, capture_output=True, text=True, check=False)
+            if result.returncode != 0:
+                raise NativeHookError(f"the native block hook does not build (MCU-25): {' '.join(command)}\n"
+                                      f"{result.stderr}")  # fmt: skip
+            os.replace(work, target)
+        finally:
+            Path(work).unlink(missing_ok=True)
+    try:
+        loaded = ctypes.CDLL(str(target))
+    except OSError as error:
+        raise NativeHookError(f"the native block hook {target} does not load (MCU-25): {error}") from error
+    _LOADED.append(loaded)
+    return loaded
