@@ -536,6 +536,11 @@ class Bus(Protocol):
         """Bus time in seconds."""
         ...
 
+    @property
+    def bit_rate(self) -> int:
+        """The ring's bit rate in bit/s (Table 1-7)."""
+        ...
+
     def transfer(self, cycle: Cycle, data: bytes, close_after: int | None = None) -> Transfer:
         """Send one frame's data and check sequences and the ring delay; return what came back."""
         ...

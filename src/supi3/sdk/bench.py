@@ -123,6 +123,10 @@ class _ClockedBus:
     def now(self) -> float:
         return self.ring.now
 
+    @property
+    def bit_rate(self) -> int:
+        return self.ring.bit_rate
+
     def flush(self) -> None:
         if self.pending is not None:
             transfer, latch, _ = self.pending
