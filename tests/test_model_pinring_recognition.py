@@ -7,7 +7,7 @@ thing: whether the start succeeds and the diagnostics it reports, the configurat
 lengths), the process data IN, and every chip's RD, LD and E LEDs. A branch present by LBST with nothing attached
 breaks the ring at both (BK-43); an empty branch that needs a device's answer (RF = 11, or fibre with LBST = 0) is
 not present and the ring runs through the BK. The transaction-level BK recognises its branch by the pin level's rule
-(BK-47): a break of the branch's loop before the master's first start and after it, in every branch kind, and any
+(BK-48): a break of the branch's loop before the master's first start and after it, in every branch kind, and any
 history of breaks, repairs, starts, cycles and branch commands give the same at both fidelities.
 """
 
@@ -127,7 +127,7 @@ def connected(ring: PinRing) -> bool:
 def read_lbd_break(step: Step, kind: BranchKind) -> Step:
     """``step`` with a CNTR error read as a dead line in an LBD branch: behind a break there the pin-level BK repeats
     its devices' counter telegrams on DO2 (BK-37), which the master's receiver reads as a CNTR error where the
-    transaction-level ring reports a dead line; the same before and after this recognition rule (BK-47), so outside
+    transaction-level ring reports a dead line; the same before and after this recognition rule (BK-48), so outside
     it (the recognition, the configuration, the data and every LED still agree)."""
     ok, kinds, seen, leds = step
     if kind.diagnostics:
@@ -158,7 +158,7 @@ def cut_history(kind: BranchKind, rf: str, lbst: bool, cut: Cut, at: int) -> tup
 @pytest.mark.parametrize(("rf", "lbst"), [("11", True), pytest.param("00", False, marks=pytest.mark.slow)])
 def test_a_branch_cut_before_or_after_the_first_start_is_the_same_at_both_fidelities(
         kind: BranchKind, rf: str, lbst: bool) -> None:
-    """BK-37, BK-47, every branch kind, the rows of Table 2-9 that need a device's answer (copper RF = 11 with
+    """BK-37, BK-48, every branch kind, the rows of Table 2-9 that need a device's answer (copper RF = 11 with
     LBST = 1, fibre with LBST = 0): a break of the branch's loop before the master's first start leaves a branch with
     return lines (BK-RB, BK-LB) unrecognised at both fidelities, and the ring runs through the BK; an LBD branch is
     recognised by its devices' counter telegrams (BK-30) unless the BK's own return input is broken, and the master
@@ -191,7 +191,7 @@ loop (an index into :func:`cuts`), every break repaired, the branch switched off
        ops=st.lists(OPS, min_size=1, max_size=7))
 def test_the_recognition_follows_any_history_the_same_at_both_fidelities(
         kind: BranchKind, row: tuple[str, bool], ops: list[Op]) -> None:
-    """BK-37, BK-47: breaks, repairs, starts (INTERBUS resets), cycles and branch commands in any order leave the
+    """BK-37, BK-48: breaks, repairs, starts (INTERBUS resets), cycles and branch commands in any order leave the
     transaction-level BK's ``branch_recognised`` equal to the pin-level BK's ``connected`` after every step; a break is
     made only where the transaction-level ring has the branch in its data path (its lines are numbered there)."""
     tl, tl_chips = tl_ring(kind, *row, 2)
@@ -217,7 +217,7 @@ def test_the_recognition_follows_any_history_the_same_at_both_fidelities(
 
 
 def test_the_recognition_stays_through_resets_and_breaks_until_the_power_up() -> None:
-    """BK-47 (BK-37's clearing rule): recognised at the master's start, a BK-LB branch stays recognised through a
+    """BK-48 (BK-37's clearing rule): recognised at the master's start, a BK-LB branch stays recognised through a
     break, INTERBUS resets and the branch switched off; the BK's power-up reset forgets it, and with the loop broken
     the next start leaves the branch out (the ring runs through the BK)."""
     ring, chips = tl_ring(BranchKind.LOCAL, "11", True, 2)
@@ -233,7 +233,7 @@ def test_the_recognition_stays_through_resets_and_breaks_until_the_power_up() ->
 
 @pytest.mark.parametrize("at", [0, 1])
 def test_a_nested_branch_cut_is_the_same_at_both_fidelities(at: int) -> None:
-    """BK-47 in Figure 1-10's nesting (RB device, BK-RB (RB device, BK-LB (LB-MR device)), RB device): a break of the
+    """BK-48 in Figure 1-10's nesting (RB device, BK-RB (RB device, BK-LB (LB-MR device)), RB device): a break of the
     inner branch's loop before the first start leaves the inner branch out and the outer one in (the inner BK, not in
     the data path, sends its own stream on DO2); a break of the outer branch's forward line leaves both out (the inner
     BK hears nothing); after the start both are recognised and the master finds the break. The same steps and both

@@ -21,7 +21,7 @@ A ring can be a tree (Figure 1-10, docs/interbus.md "Tree"): a :class:`Branch` i
 devices of its branch. The data path runs into the BK, through the branch and back to the BK, then on along the remote
 bus, so the ring flattens the tree into :attr:`Ring.devices` in that order, leaving out every branch its BK has not in
 the data path (switched off by the master, closed by the BK itself, not present by Table 2-9: a BK recognises its
-branch once a device answered, BK-47); it flattens again whenever a BK changes that. In a tree a fault belongs to the
+branch once a device answered, BK-48); it flattens again whenever a BK changes that. In a tree a fault belongs to the
 physical line it was injected on: it follows that line when branches are switched, and sleeps while the line is out
 of the data path. :class:`ReturnBreak` breaks a branch's return line (a branch in the data path with nothing attached
 is broken so at its BK, BK-43), and behind a break in a branch with device-oriented diagnostics the devices send the
@@ -180,7 +180,7 @@ class _Active:
     """In a tree: the device whose incoming line the fault is on (``None``: the return line into the master)."""
     branch: bool = False
     """A :class:`ReturnBreak` at a BK with its branch on: its branch return input, out of the data path (asleep) while
-    that branch is (BK-47)."""
+    that branch is (BK-48)."""
 
 
 # ----------------------------------------------------------------------------------------------------------------
@@ -227,11 +227,11 @@ class Terminal(Device, Protocol):
 
     @property
     def branch_recognised(self) -> bool:
-        """A device on the branch has answered since the BK's power-up (BK-37, BK-47)."""
+        """A device on the branch has answered since the BK's power-up (BK-37, BK-48)."""
         ...
 
     def recognise_branch(self) -> None:
-        """A device answered on the branch (BK-47): recognised until the BK's power-up reset."""
+        """A device answered on the branch (BK-48): recognised until the BK's power-up reset."""
         ...
 
     def branch_returned(self, traffic: bool, count: int | None, start: float, end: float) -> None:
@@ -549,6 +549,11 @@ class Bus(Protocol):
         """Bus time in seconds."""
         ...
 
+    @property
+    def bit_rate(self) -> int:
+        """The ring's bit rate in bit/s (Table 1-7)."""
+        ...
+
     def transfer(self, cycle: Cycle, data: bytes, close_after: int | None = None) -> Transfer:
         """Send one frame's data and check sequences and the ring delay; return what came back."""
         ...
@@ -612,7 +617,7 @@ class Ring:
         self._enabled: tuple[bool, ...] = ()
         self._spans: list[_Span] = []
         self._settled = False
-        """A BK's branch is in the data path by its recognition (BK-47) once the ring ran (a reset, a cycle, idle);
+        """A BK's branch is in the data path by its recognition (BK-48) once the ring ran (a reset, a cycle, idle);
         before, as if every populated branch answered, so that faults are injected on the whole tree's lines."""
         self._unanswered: list[int] = []
         """The ring positions of the BKs whose branch is in the data path with nothing attached (BK-43): their branch
@@ -652,7 +657,7 @@ class Ring:
         """Flatten the tree again if a BK changed whether its branch is in the data path."""
         if not self._branches:
             return
-        # A device answered on a recognised branch (BK-37, BK-47); one present without (by LBST) breaks at its BK
+        # A device answered on a recognised branch (BK-37, BK-48); one present without (by LBST) breaks at its BK
         # (BK-43).
         enabled = tuple(b.terminal.branch_enabled(self._answered(b)) for b in self._branches)
         if enabled == self._enabled and self._index:
@@ -691,12 +696,12 @@ class Ring:
                 self._detached.pop(id(device), None)
 
     def _answered(self, branch: Branch) -> bool:
-        """``connected`` of ``branch``'s BK: its recognition (BK-47), before the ring ran whether it is populated."""
+        """``connected`` of ``branch``'s BK: its recognition (BK-48), before the ring ran whether it is populated."""
         return branch.terminal.branch_recognised if self._settled else bool(branch.devices)
 
     def _recognise(self) -> None:
         """The ring runs (a reset, a cycle, idle telegrams): every BK whose branch device answers now recognises its
-        branch (BK-47), then the tree flattens again. A branch with return lines (BK-RB, BK-LB) answers when its BK
+        branch (BK-48), then the tree flattens again. A branch with return lines (BK-RB, BK-LB) answers when its BK
         is reached, its interface is live (BK-42) and the loop from DO3 through the branch back to DI3 is whole; an
         LBD branch when its BK's return input is whole (its devices send counter telegrams on their own, BK-30)."""
         self._settled = True
@@ -719,7 +724,7 @@ class Ring:
                 return
 
     def _loop_whole(self, branch: Branch, forward: set[int], back: set[tuple[int, bool]]) -> bool:
-        """Something sent into ``branch`` comes back to its BK's DI3 (BK-47): its BK's return input is not broken
+        """Something sent into ``branch`` comes back to its BK's DI3 (BK-48): its BK's return input is not broken
         (``back``: the devices whose return input is, with whether it is a BK's branch return input), and in a branch
         with return lines no line of the loop is (``forward``: the devices whose forward input is), nor the loop of a
         nested branch in the data path (its BK repeats its DI3 on DO2, BK-37). An LBD branch's devices send counter
@@ -1131,7 +1136,7 @@ class Ring:
 
     def reset(self) -> None:
         """An INTERBUS reset (the master's Alarm Stop, 1303h): reset pattern, then idle (assumption A12). A branch is
-        recognised in the reset's hold, before its devices reset (BK-37, BK-47)."""
+        recognised in the reset's hold, before its devices reset (BK-37, BK-48)."""
         self._recognise()
         dead = self._first_dead()
         reached = len(self.devices) if dead is None else min(len(self.devices), dead - 1)

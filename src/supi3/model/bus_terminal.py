@@ -66,7 +66,7 @@ class BusTerminal:
     closures:
         How often the BK closed its branch itself.
     recognised:
-        A device answered on the branch since the power-up (the automatic recognition of 2.1.1, BK-37, BK-47); an
+        A device answered on the branch since the power-up (the automatic recognition of 2.1.1, BK-37, BK-48); an
         INTERBUS reset keeps it. The transaction-level ring sets it (:meth:`supi3.interbus.ring.Ring`).
     switched_on_commands:
         How many commands switched the branch on (each restarts the silence, BK-3; the pin level's silence timer

@@ -741,12 +741,12 @@ class Supi3:
 
     @property
     def branch_recognised(self) -> bool:
-        """A device answered on the branch since the power-up (BK-37, BK-47); ``False`` in the modes that are no BK
+        """A device answered on the branch since the power-up (BK-37, BK-48); ``False`` in the modes that are no BK
         (Table 2-7)."""
         return self.bus_terminal is not None and self.bus_terminal.recognised
 
     def recognise_branch(self) -> None:
-        """A device answered on the branch (BK-47): recognised until the power-up reset (an INTERBUS reset keeps it).
+        """A device answered on the branch (BK-48): recognised until the power-up reset (an INTERBUS reset keeps it).
 
         Raises
         ------
