@@ -365,6 +365,12 @@ class Supi3Pins:
         return self._holding
 
     @property
+    def branch_connected(self) -> bool:
+        """A BK's ``connected``: DI3 has shown a start level since the power-up reset (BK-37), the pin-level twin of
+        the transaction level's ``Supi3.branch_recognised`` (BK-48); ``False`` in the other modes."""
+        return self._branch is not None and self._branch.connected
+
+    @property
     def branch_in_path(self) -> bool:
         """A BK's branch is in the data path in the current cycle (BK-37: present by Table 2-9 with the synchronised
         LBST and ``connected``, switched on, not closed; :meth:`BranchLines.on`); ``False`` in the other modes."""
