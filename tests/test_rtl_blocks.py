@@ -17,13 +17,15 @@ from supi3.rtl.expansion import ExpansionRtl
 from supi3.rtl.optical import OpticalRtl
 from supi3.rtl.serial_io import SerialIoRtl
 from supi3.rtl.tables import core_tables
-from supi3.rtl.terminal import TerminalRtl
+from supi3.rtl.terminal import ReturnWatchRtl, TerminalRtl
 
 BLOCKS = {"receiver": ReceiverRtl, "frame": FrameEngineRtl, "datapath": DataPathRtl, "transmitter": TransmitterRtl,
           "outputs": OutputsRtl, "serial_io": SerialIoRtl, "expansion": ExpansionRtl,
-          "counter_lines": CounterLinesRtl, "terminal": TerminalRtl, "optical": OpticalRtl}  # fmt: skip
+          "counter_lines": CounterLinesRtl, "terminal": TerminalRtl, "tx_watch": ReturnWatchRtl,
+          "optical": OpticalRtl}  # fmt: skip
 """Block name (the same in supi3.model; ``counter_lines``: ``Supi3Pins``'s ``LineCounters``, M17; ``terminal``: its
-state is the model chip's, supi3.model.bus_terminal) -> RTL component."""
+state is the model chip's, supi3.model.bus_terminal; ``tx_watch``: the telegram grid of the transmitter's line that
+times the BK's switch of DO3 and DO2, ``BranchLines``' watch, BK-47) -> RTL component."""
 
 
 @pytest.mark.parametrize("variant", list(Variant))
@@ -36,7 +38,8 @@ def blocks() -> list[wiring.Component]:
     """One of each block, elaborated on its own (so none is left unused)."""
     tables = core_tables()
     made = [ReceiverRtl(tables), FrameEngineRtl(), DataPathRtl(tables), TransmitterRtl(tables), OutputsRtl(26),
-            SerialIoRtl(), ExpansionRtl(), CounterLinesRtl(), TerminalRtl(), OpticalRtl()]  # fmt: skip
+            SerialIoRtl(), ExpansionRtl(), CounterLinesRtl(), TerminalRtl(), ReturnWatchRtl(7),
+            OpticalRtl()]  # fmt: skip
     for block in made:
         Fragment.get(block, None)
     return made
