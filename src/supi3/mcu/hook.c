@@ -57,11 +57,24 @@ typedef struct {
     uc_reg_fn reg_read;
     uc_reg_fn reg_write;
     describe_fn describe;   /* nonzero: Python failed, stop */
+    uint64_t rewritable;    /* MCU-28: blocks from this address (the RAM's base) ... */
+    uint64_t rewritable_size; /* ... up to this many bytes on are never taken from the cache: `describe` each run */
 } supi3_state;
 
+/* MCU-28: the cycles up to the deadline as a signed count: a deadline in the past is none, one more than 2^63 - 1
+ * cycles away is 2^63 - 1 (the unsigned difference must not turn negative and stop the poll skip). */
+static int64_t until_deadline(const supi3_state *s) {
+    if (s->cycles >= s->deadline) {
+        return 0;
+    }
+    uint64_t left = s->deadline - s->cycles;
+    return left > (uint64_t)INT64_MAX ? INT64_MAX : (int64_t)left;
+}
+
 static int64_t ceil_div(int64_t numerator, int64_t denominator) {
-    /* denominator > 0; C division truncates toward zero, which is the ceiling for a negative numerator */
-    return numerator >= 0 ? (numerator + denominator - 1) / denominator : numerator / denominator;
+    /* denominator > 0; C division truncates toward zero, which is the ceiling for a negative numerator; no sum that
+     * could pass INT64_MAX (MCU-28) */
+    return numerator / denominator + (numerator > 0 && numerator % denominator != 0);
 }
 
 static int64_t at_least_zero(int64_t value) { return value > 0 ? value : 0; }
@@ -70,7 +83,7 @@ static int64_t smaller(int64_t a, int64_t b) { return a < b ? a : b; }
 
 static void skip_polls(supi3_state *s, const supi3_block *cost, uint64_t until) {
     int64_t cycles = cost->cycles;
-    int64_t before_deadline = ceil_div((int64_t)(s->deadline - s->cycles), cycles);
+    int64_t before_deadline = ceil_div(until_deadline(s), cycles);
     int64_t reading_early = ceil_div((int64_t)until - cycles - (int64_t)s->cycles, cycles);
     int64_t skipped = at_least_zero(smaller(before_deadline, reading_early));
     s->instructions += (uint64_t)skipped * cost->instructions;
@@ -83,8 +96,7 @@ static int skip_countdown(supi3_state *s, void *uc, const supi3_block *cost) {
     uint64_t left = 0;
     s->reg_read(uc, regid, &left);
     left &= 0xFFFFFFFFu;
-    int64_t skipped = at_least_zero(smaller((int64_t)left - 1, ceil_div((int64_t)(s->deadline - s->cycles),
-                                                                       cost->cycles)));
+    int64_t skipped = at_least_zero(smaller((int64_t)left - 1, ceil_div(until_deadline(s), cost->cycles)));
     if (skipped) {
         uint64_t value = left - (uint64_t)skipped;
         s->reg_write(uc, regid, &value);
@@ -101,7 +113,8 @@ void supi3_block_hook(void *uc, uint64_t address, uint32_t size, void *data) {
         return;
     }
     const supi3_block *cost = &s->cache[(address >> 1) & s->mask];
-    if (cost->size != size || cost->address != address || size == 0) {
+    if (cost->size != size || cost->address != address || size == 0
+        || address - s->rewritable < s->rewritable_size) { /* MCU-28: code in RAM may have been rewritten */
         if (s->describe(address, size)) {
             s->emu_stop(uc);
             return;
@@ -201,3 +214,4 @@ uint64_t supi3_held_read(void *uc, uint64_t offset, unsigned size, void *data) {
     }
     return h->slow(uc, offset, size, 0);
 }
+

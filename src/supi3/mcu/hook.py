@@ -83,6 +83,8 @@ class State(ctypes.Structure):
         ("reg_read", ctypes.c_void_p),
         ("reg_write", ctypes.c_void_p),
         ("describe", DESCRIBE),
+        ("rewritable", ctypes.c_uint64),
+        ("rewritable_size", ctypes.c_uint64),
     )
 
 
