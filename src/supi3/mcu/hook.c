@@ -17,6 +17,7 @@
  * SR while a byte shifts) is answered here, as the peripheral would answer it, and so is one read of a register the
  * peripheral offers from a cycle on (SPI1's DR once its byte has ended, MCU-26); every other read goes to Python.
  */
+#include <stddef.h>
 #include <stdint.h>
 
 typedef struct {
@@ -215,3 +216,24 @@ uint64_t supi3_held_read(void *uc, uint64_t offset, unsigned size, void *data) {
     return h->slow(uc, offset, size, 0);
 }
 
+/* The layout of the structs above as this compiler lays them out: the number of values after it, the struct's size, then each
+ * field's offset in the order of its declaration. supi3.mcu.hook checks its ctypes mirrors against them when it loads
+ * the library (MCU-25): a mismatch is a NativeHookError, not memory written at the wrong place. */
+#define AT(type, field) (uint32_t) offsetof(type, field)
+const uint32_t supi3_block_layout[] = {7, sizeof(supi3_block), AT(supi3_block, address), AT(supi3_block, size),
+                                       AT(supi3_block, instructions), AT(supi3_block, cycles),
+                                       AT(supi3_block, countdown), AT(supi3_block, poll)};
+const uint32_t supi3_state_layout[] = {
+    26, sizeof(supi3_state), AT(supi3_state, cycles), AT(supi3_state, instructions), AT(supi3_state, deadline),
+    AT(supi3_state, block_start), AT(supi3_state, block_address), AT(supi3_state, block_end),
+    AT(supi3_state, skip_until), AT(supi3_state, skip_address), AT(supi3_state, handed),
+    AT(supi3_state, skip_pending), AT(supi3_state, stop_request), AT(supi3_state, skip_polls), AT(supi3_state, mask),
+    AT(supi3_state, block_poll), AT(supi3_state, cache), AT(supi3_state, fresh), AT(supi3_state, access_pc),
+    AT(supi3_state, low_registers), AT(supi3_state, pc_register), AT(supi3_state, emu_stop),
+    AT(supi3_state, reg_read), AT(supi3_state, reg_write), AT(supi3_state, describe), AT(supi3_state, rewritable),
+    AT(supi3_state, rewritable_size)};
+const uint32_t supi3_held_layout[] = {
+    17, sizeof(supi3_held), AT(supi3_held, state), AT(supi3_held, slow), AT(supi3_held, until), AT(supi3_held, offset),
+    AT(supi3_held, value), AT(supi3_held, held), AT(supi3_held, poll), AT(supi3_held, after),
+    AT(supi3_held, has_after), AT(supi3_held, once_from), AT(supi3_held, once_at), AT(supi3_held, once_offset),
+    AT(supi3_held, once_value), AT(supi3_held, once), AT(supi3_held, taken), AT(supi3_held, once_then)};
