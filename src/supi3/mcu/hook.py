@@ -9,7 +9,9 @@ docs/assumptions/mcu.md. The C source ships with the package; :func:`library` co
 into the native build cache (:func:`supi3.sdk.native.default_cache_dir`), keyed by the source, the flags, the
 compiler's version and the machine, and loads it with ctypes. Parallel processes (pytest-xdist workers) each build
 into a temporary file of the cache folder and rename it into place: a process sees no file or a whole one. The
-library links against nothing: the unicorn functions it calls are pointers in :class:`State`.
+library links against nothing: the unicorn functions it calls are pointers in :class:`State`. Before it is used, a
+cached file is checked whole (:func:`check_whole`) and its structs' layout against the ctypes mirrors
+(:func:`check_layout`; MCU-28).
 """
 
 from __future__ import annotations

@@ -1,0 +1,206 @@
+"""The native block hook (hook.c, supi3.mcu.hook; MCU-25, MCU-28) as a hostile user and a C reviewer drive it.
+
+MCU-28: code the firmware writes into RAM and runs is costed from its bytes each time it runs, so a block rewritten
+in place (same address, same size) never runs with the cost, countdown register (MCU-11) or poll flag of the code it
+replaced; a deadline up to 2^64 - 1 cycles away keeps the countdown skip, whose arithmetic never passes INT64_MAX, and
+counts past 2^32 instructions; a deadline past the 64-bit clock is an ArgumentError, not a wrap to cycle 0. The
+structs hook.c shares with ctypes have, field by field, the offsets the compiler gave them (checked at load); a
+cached library cut short, or a cache folder given as ".", is a named error or loads, never a crash of the process.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from supi3.errors import ArgumentError
+from supi3.mcu import build as mcu_build
+from supi3.mcu import hook
+from supi3.mcu.core import CPUS, CortexM
+from supi3.sdk.native import CACHE_ENV
+
+pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
+
+PROGRAMS = Path(__file__).parent / "mcu"
+_TOP = (1 << 64) - 1
+
+
+@pytest.fixture(scope="module")
+def programs(tmp_path_factory: pytest.TempPathFactory) -> dict[tuple[str, str], Path]:
+    """ram_rewrite.S and long_count.S built for each core, once per module."""
+    folder = tmp_path_factory.mktemp("hostile3")
+    return {(name, cpu): mcu_build.build(PROGRAMS / f"{name}.S", folder / f"{name}_{cpu}.elf", cpu=cpu, port=False)
+            for name in ("ram_rewrite", "long_count") for cpu in CPUS}  # fmt: skip
+
+
+def _run_to_done(core: CortexM, deadline: int) -> None:
+    """Step the core until it sits on the thread's ``b .`` (``done``)."""
+    for _ in range(20):
+        core.step(deadline)
+        if core.idle_loop():
+            return
+    raise AssertionError(f"the core did not reach done: PC {core.pc:08X}h, {core.cycles} cycles")
+
+
+@pytest.mark.parametrize("cpu", CPUS)
+def test_code_rewritten_in_ram_runs_with_its_own_cost(programs: dict[tuple[str, str], Path], cpu: str) -> None:
+    """ram_rewrite.S: a countdown block on R3 in RAM, rewritten in place into one on R4 (same address, same size).
+    The second loop leaves R3 = 1000 and costs what it runs, with the skips (MCU-10, MCU-11) on, off, and with the
+    deadline near (the skip bounded by it) or 2^64 - 1 away; before MCU-28 the cached block skipped R3 down to 1."""
+    results = []
+    for skip, step in ((True, 50), (True, _TOP), (False, 50), (False, _TOP)):
+        core = CortexM(programs["ram_rewrite", cpu], cpu=cpu)
+        core.skip_polls = skip
+        for _ in range(2000):
+            core.step(min(_TOP, core.cycles + step))
+            if core.idle_loop():
+                break
+        results.append((core.reg("r3"), core.reg("r4"), core.cycles, core.instructions))
+    assert results[0][:2] == (1000, 0)
+    assert results == [results[0]] * 4
+    # 12 set-up instructions, 100 iterations of 2, 1 BX, 5 re-write instructions, 100 iterations, 1 BX
+    # 9 set-up instructions, 100 iterations of SUBS and BNE, BX, 6 to rewrite and call, 100 iterations, BX, the b .
+    assert results[0][3] == 9 + 200 + 1 + 6 + 200 + 1 + 1
+
+
+@pytest.mark.parametrize("cpu", CPUS)
+def test_host_writes_into_ram_code_between_runs_are_seen(programs: dict[tuple[str, str], Path], cpu: str) -> None:
+    """The host patches the RAM function between runs (CortexM.write_bytes) after its first call: the second call
+    runs the patched bytes with their cost, as the firmware's own store would."""
+    core = CortexM(programs["ram_rewrite", cpu], cpu=cpu)
+    ramfn = core.image.address("ramfn")
+    _run_to_done(core, _TOP)
+    assert core.read_bytes(ramfn, 4) == bytes.fromhex("013cfdd1")  # subs r4, #1; bne
+    assert (core.reg("r3"), core.reg("r4")) == (1000, 0)
+    # the loop again, now on R3 (3B01h) patched by the host, called from `done` by hand: R3 counts down, R4 stays
+    core.write_bytes(ramfn, bytes.fromhex("013bfdd1"))
+    core.set_reg("r3", 7)
+    core.set_reg("r4", 5)
+    core.set_reg("lr", core.pc | 1)
+    core.set_reg("pc", ramfn)
+    _run_to_done(core, _TOP)
+    assert (core.reg("r3"), core.reg("r4")) == (0, 5)
+
+
+@pytest.mark.parametrize("cpu", CPUS)
+@pytest.mark.parametrize("deadline", [(1 << 62), (1 << 63) + (1 << 62), _TOP])
+def test_a_far_deadline_keeps_the_countdown_skip(programs: dict[tuple[str, str], Path], cpu: str,
+                                                 deadline: int) -> None:  # fmt: skip
+    """long_count.S counts R0 down from 2^32 - 1: with a deadline 2^62 to 2^64 - 1 cycles away the countdown skip
+    (MCU-11) takes all but the last iteration at once, past 2^32 instructions. Before MCU-28 a deadline more than
+    2^63 - 1 cycles away turned negative in the signed arithmetic (or its ceiling overflowed) and the 2^32 iterations
+    ran one by one: the run seemed to hang."""
+    core = CortexM(programs["long_count", cpu], cpu=cpu)
+    _run_to_done(core, deadline)
+    assert core.reg("r0") == 0
+    assert core.instructions == 3 + 2 * ((1 << 32) - 1) + 1  # movs, subs, b; 2^32 - 1 iterations of subs, bne; b .
+    assert core.instructions > 1 << 32 and core.cycles > 1 << 33
+
+
+@pytest.mark.parametrize("deadline", [1 << 64, 1 << 70, -1])
+def test_a_deadline_past_the_64_bit_clock_is_an_argument_error(programs: dict[tuple[str, str], Path],
+                                                               deadline: int) -> None:  # fmt: skip
+    """step(2^64) was stored modulo 2^64 (cycle 0): a run that returned at once, forever. Now an ArgumentError."""
+    core = CortexM(programs["long_count", "cortex_m0"], cpu="cortex_m0")
+    with pytest.raises(ArgumentError, match=r"deadline must be an integer from 0 to 18446744073709551615"):
+        core.step(deadline)
+    assert (core.cycles, core.instructions) == (0, 0)
+
+
+def test_the_shared_structs_match_the_compiled_layout() -> None:
+    """Every field of Block, State and Held sits at the offset hook.c's compiler gave it, and the sizes agree (the
+    library's own tables); a ctypes mirror that differs (a field moved) is a NativeHookError at load."""
+    loaded = hook.library()
+    for table, structure in (("supi3_block_layout", hook.Block), ("supi3_state_layout", hook.State),
+                             ("supi3_held_layout", hook.Held)):  # fmt: skip
+        assert hook.native_layout(loaded, table) == hook.layout(structure)
+        assert len(hook.layout(structure)) == len(structure._fields_) + 1
+
+    class Moved(ctypes.Structure):
+        _fields_ = (("size", ctypes.c_uint32), ("address", ctypes.c_uint32), ("instructions", ctypes.c_uint64))
+
+    original = hook._LAYOUTS["supi3_block_layout"]
+    try:
+        hook._LAYOUTS["supi3_block_layout"] = Moved
+        with pytest.raises(hook.NativeHookError, match=r"lays out Moved as \[24, 0, 4, 8, 12, 16, 20\].*another "
+                                                       r"source or for another ABI"):  # fmt: skip
+            hook.check_layout(loaded, "x.so")
+    finally:
+        hook._LAYOUTS["supi3_block_layout"] = original
+
+
+_LOAD_CUTS = """
+import sys
+from pathlib import Path
+from supi3.mcu import hook
+whole = Path(sys.argv[1]).read_bytes()
+target = hook.cached_path()
+target.parent.mkdir(parents=True, exist_ok=True)
+for cut in map(int, sys.argv[2:]):
+    target.write_bytes(whole[:cut])
+    hook._LOADED.clear()
+    try:
+        hook.library()
+        print(cut, "loaded")
+    except hook.NativeHookError as error:
+        print(cut, "named", "cut short" in str(error) or "does not load" in str(error))
+"""
+
+
+def test_a_cached_library_cut_short_is_a_named_error(tmp_path: Path) -> None:
+    """A cached library cut anywhere (a full disk, a broken copy) is refused with a NativeHookError before the loader
+    maps it: before, a cut at 1000 bytes crashed the process in dlopen (SIGSEGV). Checked for every cut from 6 bytes
+    on (in steps of 23) by check_whole, and through library() in a separate process for a few."""
+    whole = Path(hook.library()._name)
+    data = whole.read_bytes()
+    hook.check_whole(whole)
+    cut_file = tmp_path / "cut.so"
+    for cut in range(6, len(data), 23):
+        cut_file.write_bytes(data[:cut])
+        with pytest.raises(hook.NativeHookError, match=r"is cut short: \d+ bytes, its ELF headers name \d+"):
+            hook.check_whole(cut_file)
+    cuts = [0, 5, 64, 1000, len(data) // 2, len(data) - 1]
+    env = {**os.environ, CACHE_ENV: str(tmp_path / "cache"), "PYTHONPATH": os.pathsep.join(sys.path)}
+    result = subprocess.run([sys.executable, "-c", _LOAD_CUTS, str(whole), *map(str, cuts)], env=env,
+                            capture_output=True, text=True, check=False, timeout=120)  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.split("\n")[:-1] == [f"{cut} named True" for cut in cuts]
+
+
+def test_a_cache_folder_given_as_dot_builds_and_loads(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """SUPI3_NATIVE_CACHE=. (and a relative folder): the library is built there and loaded by its absolute path.
+    Before, "." made the path a bare file name, which the loader looked up on the system's library path: "cannot
+    open shared object file". An empty value is the default folder."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(hook, "_LOADED", [])
+    monkeypatch.setenv(CACHE_ENV, ".")
+    assert hook.cached_path().parent == tmp_path
+    loaded = hook.library()
+    assert Path(loaded._name).parent == tmp_path and Path(loaded._name).is_file()
+    monkeypatch.setattr(hook, "_LOADED", [])
+    monkeypatch.setenv(CACHE_ENV, "")
+    assert hook.cached_path().parent == (Path.home() / ".cache" / "supi3" / "native").absolute() or \
+        os.environ.get("XDG_CACHE_HOME")  # fmt: skip
+
+
+@pytest.mark.parametrize("cpu", CPUS)
+def test_host_writes_into_flash_code_between_runs_are_seen(programs: dict[tuple[str, str], Path], cpu: str) -> None:
+    """The host turns long_count.S's loop on R0 (flash, cached natively after its run) into one on R1: run again
+    from the loop, R1 counts down and R0 stays; before, the cached countdown (MCU-11) skipped R0 and unicorn ran its
+    old translation."""
+    core = CortexM(programs["long_count", cpu], cpu=cpu)
+    _run_to_done(core, _TOP)
+    loop = core.image.address("done") - 4
+    assert core.read_bytes(loop, 4) == bytes.fromhex("0138fdd1")  # subs r0, #1; bne
+    core.write_bytes(loop, bytes.fromhex("0139"))  # subs r1, #1
+    core.set_reg("r0", 1234)
+    core.set_reg("r1", 50)
+    core.set_reg("pc", loop)
+    before = core.instructions
+    _run_to_done(core, _TOP)
+    assert (core.reg("r0"), core.reg("r1"), core.instructions - before) == (1234, 0, 100 + 1)
