@@ -6,6 +6,9 @@ replaced; a deadline up to 2^64 - 1 cycles away keeps the countdown skip, whose 
 counts past 2^32 instructions; a deadline past the 64-bit clock is an ArgumentError, not a wrap to cycle 0. The
 structs hook.c shares with ctypes have, field by field, the offsets the compiler gave them (checked at load); a
 cached library cut short, or a cache folder given as ".", is a named error or loads, never a crash of the process.
+
+MCU-29: SPI1's reset through RCC_APB2RSTR (RM0008 7.3.4) takes back the native answers and resets SPI1, or is a named
+error (held in reset, a byte shifting).
 """
 
 from __future__ import annotations
@@ -22,6 +25,25 @@ from supi3.errors import ArgumentError
 from supi3.mcu import build as mcu_build
 from supi3.mcu import hook
 from supi3.mcu.core import CPUS, CortexM
+from supi3.mcu.stm32 import (
+    APB2ENR,
+    APB2RSTR,
+    CR1_MSTR,
+    CR1_SPE,
+    CR1_SSI,
+    CR1_SSM,
+    IOPAEN,
+    SPI1EN,
+    SPI_CR1,
+    SPI_DR,
+    SPI_SR,
+    SR_BSY,
+    SR_RXNE,
+    SR_TXE,
+    PeripheralResetError,
+    Rcc,
+    Spi,
+)
 from supi3.sdk.native import CACHE_ENV
 
 pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
@@ -182,10 +204,11 @@ def test_a_cache_folder_given_as_dot_builds_and_loads(tmp_path: Path, monkeypatc
     assert hook.cached_path().parent == tmp_path
     loaded = hook.library()
     assert Path(loaded._name).parent == tmp_path and Path(loaded._name).is_file()
-    monkeypatch.setattr(hook, "_LOADED", [])
+    monkeypatch.setenv(CACHE_ENV, "sub/dir")
+    assert hook.cached_path().parent == tmp_path / "sub" / "dir"
     monkeypatch.setenv(CACHE_ENV, "")
-    assert hook.cached_path().parent == (Path.home() / ".cache" / "supi3" / "native").absolute() or \
-        os.environ.get("XDG_CACHE_HOME")  # fmt: skip
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    assert hook.cached_path().parent == tmp_path / "xdg" / "supi3" / "native"
 
 
 @pytest.mark.parametrize("cpu", CPUS)
@@ -204,3 +227,85 @@ def test_host_writes_into_flash_code_between_runs_are_seen(programs: dict[tuple[
     before = core.instructions
     _run_to_done(core, _TOP)
     assert (core.reg("r0"), core.reg("r1"), core.instructions - before) == (1234, 0, 100 + 1)
+
+
+class _Clock:
+    """The time SPI1 sees (``now`` and ``polled``), set by the test."""
+
+    def __init__(self) -> None:
+        self.cycles = 0
+
+    def __call__(self) -> int:
+        return self.cycles
+
+
+class _Native:
+    """A HeldRegister stand-in that notes what SPI1 tells the core, and may say the offered DR read was taken."""
+
+    def __init__(self) -> None:
+        self.log: list[str] = []
+        self.taken: int | None = None
+
+    def hold(self, offset: int, value: int, until: int | None, after: int | None) -> None:
+        del value, until, after
+        self.log.append(f"hold {offset}")
+
+    def release(self) -> None:
+        self.log.append("release")
+
+    def offer(self, offset: int, value: int, start: int, then: int) -> None:
+        del value, start, then
+        self.log.append(f"offer {offset}")
+
+    def withdraw(self) -> int | None:
+        taken, self.taken = self.taken, None
+        return taken
+
+
+class _Echo:
+    def spi_byte(self, tx: int, bits: int, start: int, period: int, cr1: int) -> int:
+        del bits, start, period, cr1
+        return tx ^ 0xFF
+
+
+def _spi1() -> tuple[Rcc, Spi, _Clock, _Native]:
+    rcc, clock, native = Rcc(), _Clock(), _Native()
+    rcc.write(APB2ENR, 4, SPI1EN | IOPAEN)
+    spi = Spi(rcc, clock, _Echo(), clock)
+    spi.holder = spi.offer = native
+    spi.write(SPI_CR1, 4, CR1_MSTR | CR1_SSM | CR1_SSI | CR1_SPE)  # BR = 0: 16 clocks a byte
+    return rcc, spi, clock, native
+
+
+def test_spi1_reset_through_rcc_resets_it_or_is_a_named_error() -> None:
+    """RCC_APB2RSTR's SPI1RST (bit 12, RM0008 7.3.4; MCU-29): before, the write was kept and ignored, and SPI1 went
+    on with its CR1, received byte and held SR. Now: the native answers are taken back first (an offered DR read
+    already taken caught up with at its time), SPI1 goes to its reset values (CR1 0, SR TXE, DR 0), an access while
+    held in reset and a reset while a byte shifts are each a PeripheralResetError; other bits leave SPI1 alone."""
+    rcc, spi, clock, native = _spi1()
+    spi.write(SPI_DR, 4, 0x5A)
+    assert spi.read(SPI_SR, 4) & SR_BSY
+    clock.cycles = 8
+    with pytest.raises(PeripheralResetError, match=r"SPI1 reset \(RCC_APB2RSTR bit 12\) at cycle 8 while a byte "
+                                                   r"shifts: a cut byte is not modelled"):  # fmt: skip
+        rcc.write(APB2RSTR, 4, SPI1EN)
+    # the byte ends at 16; the core took the offered DR read at 16 natively, then the firmware resets SPI1
+    rcc, spi, clock, native = _spi1()
+    spi.write(SPI_DR, 4, 0x5A)
+    spi.read(SPI_SR, 4)
+    native.log.clear()
+    native.taken = clock.cycles = 16
+    rcc.write(APB2RSTR, 4, IOPAEN)  # GPIOA's reset bit only: SPI1 untouched but the holds taken back
+    assert native.log == ["release"] and spi.rx_last == 0xA5 and spi.rx_buffer is None
+    spi.write(SPI_DR, 4, 0x11)
+    clock.cycles = 40  # the byte has ended: RXNE
+    assert spi.read(SPI_SR, 4) & SR_RXNE
+    native.log.clear()
+    rcc.write(APB2RSTR, 4, SPI1EN | IOPAEN)
+    assert native.log == ["release"]
+    for access in (lambda: spi.read(SPI_SR, 4), lambda: spi.write(SPI_CR1, 4, CR1_SPE)):
+        with pytest.raises(PeripheralResetError, match=r"SPI1 accessed while RCC_APB2RSTR bit 12 holds it in reset"):
+            access()
+    rcc.write(APB2RSTR, 4, 0)
+    assert (spi.read(SPI_CR1, 4), spi.read(SPI_SR, 4), spi.read(SPI_DR, 4)) == (0, SR_TXE, 0)
+    assert rcc.read(APB2RSTR, 4) == 0
