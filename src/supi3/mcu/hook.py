@@ -218,6 +218,8 @@ def library() -> ctypes.CDLL:
                 raise NativeHookError(f"the native block hook does not build (MCU-25): {' '.join(command)}\n"
                                       f"{result.stderr}")  # fmt: skip
             os.replace(work, target)
+        except OSError as error:  # the place of the library taken by a folder, a full disk, ...
+            raise NativeHookError(f"the native block hook cannot be put at {target} (MCU-25): {error}") from error
         finally:
             Path(work).unlink(missing_ok=True)
     check_whole(target)
