@@ -309,3 +309,15 @@ def test_spi1_reset_through_rcc_resets_it_or_is_a_named_error() -> None:
     rcc.write(APB2RSTR, 4, 0)
     assert (spi.read(SPI_CR1, 4), spi.read(SPI_SR, 4), spi.read(SPI_DR, 4)) == (0, SR_TXE, 0)
     assert rcc.read(APB2RSTR, 4) == 0
+
+
+def test_a_folder_in_the_library_s_place_is_a_named_error(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A folder where the cached library goes: the build cannot be renamed into place. Before, an IsADirectoryError
+    with a traceback; now a NativeHookError naming the place, and no temporary file is left."""
+    monkeypatch.setattr(hook, "_LOADED", [])
+    monkeypatch.setenv(CACHE_ENV, str(tmp_path))
+    hook.cached_path().mkdir()
+    with pytest.raises(hook.NativeHookError, match=r"cannot be put at .*_supi3_mcu_hook_\w+\.so \(MCU-25\): "
+                                                   r"\[Errno 21\] Is a directory"):  # fmt: skip
+        hook.library()
+    assert [path.name for path in tmp_path.iterdir()] == [hook.cached_path().name]
