@@ -24,7 +24,7 @@ import pytest
 from supi3.errors import ArgumentError
 from supi3.mcu import build as mcu_build
 from supi3.mcu import hook
-from supi3.mcu.core import CPUS, CortexM
+from supi3.mcu.core import CPUS, CortexM, HeldRegister
 from supi3.mcu.stm32 import (
     APB2ENR,
     APB2RSTR,
@@ -35,6 +35,7 @@ from supi3.mcu.stm32 import (
     IOPAEN,
     SPI1EN,
     SPI_CR1,
+    SPI_CR2,
     SPI_DR,
     SPI_SR,
     SR_BSY,
@@ -321,3 +322,48 @@ def test_a_folder_in_the_library_s_place_is_a_named_error(tmp_path: Path, monkey
                                                    r"\[Errno 21\] Is a directory"):  # fmt: skip
         hook.library()
     assert [path.name for path in tmp_path.iterdir()] == [hook.cached_path().name]
+
+
+@pytest.mark.parametrize("late", [-1, 0, 1])
+def test_a_dr_read_at_the_byte_s_end_answers_as_the_model(late: int) -> None:
+    """DR read by the core one cycle before, exactly at and one cycle after the byte's end (MCU-26's offer starts at
+    the end, inclusive, as the model's byte ends at it): hook.c's ``supi3_held_read`` returns what the model returns,
+    and SR after it too."""
+    answers = []
+    for native in (True, False):
+        state = hook.State()
+        state.skip_polls = 1
+
+        def polled(state: hook.State = state) -> int:
+            state.handed = max(state.handed, state.cycles)
+            return int(state.handed)
+
+        rcc = Rcc()
+        rcc.write(APB2ENR, 4, SPI1EN)
+        spi = Spi(rcc, polled, _Echo(), polled)
+
+        slow_reads: list[int] = []
+
+        def slow(handle: int, offset: int, size: int, data: int, spi: Spi = spi, log: list[int] = slow_reads) -> int:
+            del handle, data
+            log.append(offset)
+            return spi.read(offset, size)
+
+        callback = hook.MMIO_READ(slow)
+        held = hook.Held(ctypes.pointer(state), callback)
+        if native:
+            spi.holder = spi.offer = HeldRegister(held)
+        read = hook.library().supi3_held_read
+        read.restype, read.argtypes = ctypes.c_uint64, (ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint,
+                                                        ctypes.c_void_p)  # fmt: skip
+        spi.write(SPI_CR1, 4, CR1_MSTR | CR1_SSM | CR1_SSI | CR1_SPE)
+        spi.write(SPI_DR, 4, 0x3C)  # ends at cycle 16
+        state.cycles = 16 + late
+        values = [int(read(None, offset, 4, ctypes.byref(held))) for offset in (SPI_DR, SPI_SR, SPI_DR, SPI_SR)]
+        spi.write(SPI_CR2, 4, 0)  # the model catches up
+        answers.append((values, spi.rx_last, spi.rx_buffer, int(state.handed)))
+        if native:  # from the end on the byte's DR read and SR after it are answered in C (a second DR read goes to
+            # the model, MCU-26); before the end, every read goes to the model
+            assert slow_reads == [SPI_DR, SPI_SR] * (1 if late >= 0 else 2), slow_reads
+    assert answers[0] == answers[1]
+    assert answers[0][0][0] == (0xC3 if late >= 0 else 0)
