@@ -2,8 +2,8 @@
 
 MCU-28: code the firmware writes into RAM and runs is costed from its bytes each time it runs, so a block rewritten
 in place (same address, same size) never runs with the cost, countdown register (MCU-11) or poll flag of the code it
-replaced; a deadline up to 2^64 - 1 cycles away keeps the countdown skip, whose arithmetic never passes INT64_MAX, and
-counts past 2^32 instructions; a deadline past the 64-bit clock is an ArgumentError, not a wrap to cycle 0. The
+replaced; a deadline up to MAX_DEADLINE (2^63 - 1) cycles away keeps the countdown skip, whose arithmetic never passes
+INT64_MAX, and counts past 2^32 instructions; a later one is an ArgumentError, not a wrap to cycle 0. The
 structs hook.c shares with ctypes have, field by field, the offsets the compiler gave them (checked at load); a
 cached library cut short, or a cache folder given as ".", is a named error or loads, never a crash of the process.
 
@@ -24,7 +24,7 @@ import pytest
 from supi3.errors import ArgumentError
 from supi3.mcu import build as mcu_build
 from supi3.mcu import hook
-from supi3.mcu.core import CPUS, CortexM, HeldRegister
+from supi3.mcu.core import CPUS, MAX_DEADLINE, CortexM, HeldRegister
 from supi3.mcu.stm32 import (
     APB2ENR,
     APB2RSTR,
@@ -74,13 +74,13 @@ def _run_to_done(core: CortexM, deadline: int) -> None:
 def test_code_rewritten_in_ram_runs_with_its_own_cost(programs: dict[tuple[str, str], Path], cpu: str) -> None:
     """ram_rewrite.S: a countdown block on R3 in RAM, rewritten in place into one on R4 (same address, same size).
     The second loop leaves R3 = 1000 and costs what it runs, with the skips (MCU-10, MCU-11) on, off, and with the
-    deadline near (the skip bounded by it) or 2^64 - 1 away; before MCU-28 the cached block skipped R3 down to 1."""
+    deadline near (the skip bounded by it) or MAX_DEADLINE; before MCU-28 the cached block skipped R3 down to 1."""
     results = []
-    for skip, step in ((True, 50), (True, _TOP), (False, 50), (False, _TOP)):
+    for skip, step in ((True, 50), (True, MAX_DEADLINE), (False, 50), (False, MAX_DEADLINE)):
         core = CortexM(programs["ram_rewrite", cpu], cpu=cpu)
         core.skip_polls = skip
         for _ in range(2000):
-            core.step(min(_TOP, core.cycles + step))
+            core.step(min(MAX_DEADLINE, core.cycles + step))
             if core.idle_loop():
                 break
         results.append((core.reg("r3"), core.reg("r4"), core.cycles, core.instructions))
@@ -97,7 +97,7 @@ def test_host_writes_into_ram_code_between_runs_are_seen(programs: dict[tuple[st
     runs the patched bytes with their cost, as the firmware's own store would."""
     core = CortexM(programs["ram_rewrite", cpu], cpu=cpu)
     ramfn = core.image.address("ramfn")
-    _run_to_done(core, _TOP)
+    _run_to_done(core, MAX_DEADLINE)
     assert core.read_bytes(ramfn, 4) == bytes.fromhex("013cfdd1")  # subs r4, #1; bne
     assert (core.reg("r3"), core.reg("r4")) == (1000, 0)
     # the loop again, now on R3 (3B01h) patched by the host, called from `done` by hand: R3 counts down, R4 stays
@@ -106,18 +106,18 @@ def test_host_writes_into_ram_code_between_runs_are_seen(programs: dict[tuple[st
     core.set_reg("r4", 5)
     core.set_reg("lr", core.pc | 1)
     core.set_reg("pc", ramfn)
-    _run_to_done(core, _TOP)
+    _run_to_done(core, MAX_DEADLINE)
     assert (core.reg("r3"), core.reg("r4")) == (0, 5)
 
 
 @pytest.mark.parametrize("cpu", CPUS)
-@pytest.mark.parametrize("deadline", [(1 << 62), (1 << 63) + (1 << 62), _TOP])
+@pytest.mark.parametrize("deadline", [(1 << 62), MAX_DEADLINE - 2, MAX_DEADLINE])
 def test_a_far_deadline_keeps_the_countdown_skip(programs: dict[tuple[str, str], Path], cpu: str,
                                                  deadline: int) -> None:  # fmt: skip
-    """long_count.S counts R0 down from 2^32 - 1: with a deadline 2^62 to 2^64 - 1 cycles away the countdown skip
-    (MCU-11) takes all but the last iteration at once, past 2^32 instructions. Before MCU-28 a deadline more than
-    2^63 - 1 cycles away turned negative in the signed arithmetic (or its ceiling overflowed) and the 2^32 iterations
-    ran one by one: the run seemed to hang."""
+    """long_count.S counts R0 down from 2^32 - 1: with a deadline 2^62 cycles away up to MAX_DEADLINE (2^63 - 1) the
+    countdown skip (MCU-11) takes all but the last iteration at once, past 2^32 instructions. Before MCU-28 the
+    ceiling of a count near INT64_MAX overflowed (and a deadline more than 2^63 - 1 cycles away turned negative) and
+    the 2^32 iterations ran one by one: the run seemed to hang."""
     core = CortexM(programs["long_count", cpu], cpu=cpu)
     _run_to_done(core, deadline)
     assert core.reg("r0") == 0
@@ -125,13 +125,16 @@ def test_a_far_deadline_keeps_the_countdown_skip(programs: dict[tuple[str, str],
     assert core.instructions > 1 << 32 and core.cycles > 1 << 33
 
 
-@pytest.mark.parametrize("deadline", [1 << 64, 1 << 70, -1])
+@pytest.mark.parametrize("deadline", [MAX_DEADLINE + 1, _TOP, 1 << 64, -1])
 def test_a_deadline_past_the_64_bit_clock_is_an_argument_error(programs: dict[tuple[str, str], Path],
                                                                deadline: int) -> None:  # fmt: skip
-    """step(2^64) was stored modulo 2^64 (cycle 0): a run that returned at once, forever. Now an ArgumentError."""
+    """step(2^64) was stored modulo 2^64 (cycle 0): a run that returned at once, forever; a deadline past 2^63 - 1
+    left the 64-bit clock no room not to wrap. Now an ArgumentError, from step and the deadline's setter."""
     core = CortexM(programs["long_count", "cortex_m0"], cpu="cortex_m0")
-    with pytest.raises(ArgumentError, match=r"deadline must be an integer from 0 to 18446744073709551615"):
-        core.step(deadline)
+    for attempt in (lambda: core.step(deadline), lambda: setattr(core, "deadline", deadline)):
+        with pytest.raises(ArgumentError, match=r"deadline must be an integer from 0 to 9223372036854775807 \(core "
+                                                r"cycles: MAX_DEADLINE \(MCU-28\)\)"):  # fmt: skip
+            attempt()
     assert (core.cycles, core.instructions) == (0, 0)
 
 
@@ -218,7 +221,7 @@ def test_host_writes_into_flash_code_between_runs_are_seen(programs: dict[tuple[
     from the loop, R1 counts down and R0 stays; before, the cached countdown (MCU-11) skipped R0 and unicorn ran its
     old translation."""
     core = CortexM(programs["long_count", cpu], cpu=cpu)
-    _run_to_done(core, _TOP)
+    _run_to_done(core, MAX_DEADLINE)
     loop = core.image.address("done") - 4
     assert core.read_bytes(loop, 4) == bytes.fromhex("0138fdd1")  # subs r0, #1; bne
     core.write_bytes(loop, bytes.fromhex("0139"))  # subs r1, #1
@@ -226,7 +229,7 @@ def test_host_writes_into_flash_code_between_runs_are_seen(programs: dict[tuple[
     core.set_reg("r1", 50)
     core.set_reg("pc", loop)
     before = core.instructions
-    _run_to_done(core, _TOP)
+    _run_to_done(core, MAX_DEADLINE)
     assert (core.reg("r0"), core.reg("r1"), core.instructions - before) == (1234, 0, 100 + 1)
 
 

@@ -599,6 +599,9 @@ def block_cost(code: bytes) -> tuple[int, int]:
 ReadFn = Callable[[int, int], int]
 WriteFn = Callable[[int, int, int], None]
 _FOREVER: Final[int] = (1 << 64) - 1
+MAX_DEADLINE: Final[int] = (1 << 63) - 1
+"""The latest cycle a run may end at (MCU-28): the native hook's clock is 64-bit and a run passes its deadline by a
+block, an exception entry or a sleep; half its range (6000 years at 48 MHz) leaves it room never to wrap."""
 
 
 class _Batch:
@@ -905,7 +908,7 @@ class CortexM:
 
     @deadline.setter
     def deadline(self, value: int) -> None:
-        self._state.deadline = value
+        self._state.deadline = check_int("deadline", value, 0, MAX_DEADLINE, "core cycles: MAX_DEADLINE (MCU-28)")
 
     @property
     def stop_request(self) -> bool:
@@ -1146,8 +1149,7 @@ class CortexM:
 
         A pending exception that may preempt (B1.5.4) is entered first; a sleeping core (WFI, or ``b .`` in thread
         mode: MCU-4) only lets the time pass."""
-        self.deadline = check_int("deadline", deadline, 0, _FOREVER, "core cycles: the 64-bit clock of the native hook "
-                                  "(MCU-25)")
+        self.deadline = deadline
         number = self._takeable()
         if number is not None:
             self.enter(number)

@@ -62,8 +62,9 @@ typedef struct {
     uint64_t rewritable_size; /* ... up to this many bytes on are never taken from the cache: `describe` each run */
 } supi3_state;
 
-/* MCU-28: the cycles up to the deadline as a signed count: a deadline in the past is none, one more than 2^63 - 1
- * cycles away is 2^63 - 1 (the unsigned difference must not turn negative and stop the poll skip). */
+/* MCU-28: the cycles up to the deadline as a signed count: a deadline in the past is none, and one more than 2^63 - 1
+ * cycles away (CortexM keeps deadlines to MAX_DEADLINE, but the state is written from outside) is 2^63 - 1: the
+ * unsigned difference never turns negative and stops the skips. */
 static int64_t until_deadline(const supi3_state *s) {
     if (s->cycles >= s->deadline) {
         return 0;
