@@ -752,6 +752,8 @@ class CortexM:
         self._scs_words: dict[int, int] = {}
         self.mmio(SCS_BASE, SCS_SIZE, self._scs_read, self._scs_write)
         self._hook(ucc.UC_HOOK_BLOCK, native.supi3_block_hook, data=ctypes.byref(state))
+        self._hook(ucc.UC_HOOK_MEM_WRITE, native.supi3_code_written, flash[0], flash[0] + flash[1] - 1,
+                   ctypes.byref(state))  # MCU-28: a store into flash may change code  # fmt: skip
         on_idle_loop = _HOOK_CODE(self._on_idle_loop)
         for address in idle_loops(self.image, flash):  # MCU-4: the core stops at its first ``b .``
             self._hook(ucc.UC_HOOK_CODE, on_idle_loop, address, address)
@@ -834,9 +836,13 @@ class CortexM:
             return
         self.uc.ctl_remove_cache(address, address + len(data))  # unicorn keeps running its old translation otherwise
         if not (self._rewritable(address) and self._rewritable(address + len(data) - 1)):  # code in flash: costed anew
-            ctypes.memset(self._cache, 0, ctypes.sizeof(self._cache))
-            for memo in (self._blocks, self._costs, self._sleeps, self._idle):
-                memo.clear()
+            self._forget_code()
+
+    def _forget_code(self) -> None:
+        """Code in flash has changed (MCU-28): every block is costed anew, every memo of code is dropped."""
+        ctypes.memset(self._cache, 0, ctypes.sizeof(self._cache))
+        for memo in (self._blocks, self._costs, self._sleeps, self._idle):
+            memo.clear()
 
     def _unmapped(self, address: int, size: int) -> ArgumentError:
         memories = ", ".join(f"{name} {base:08X}h to {base + length - 1:08X}h"
@@ -1125,8 +1131,11 @@ class CortexM:
 
     def _on_idle_loop(self, handle: int, address: int, size: int, data: int) -> None:
         """A ``b .`` is about to run (its block counted): stop there, at its first iteration, whatever the deadline;
-        the run loop takes it for a wait in thread mode and a hang in a handler (MCU-4)."""
-        del address, size, data
+        the run loop takes it for a wait in thread mode and a hang in a handler (MCU-4); unless the firmware has
+        written other code there since (MCU-28)."""
+        del size, data
+        if not self._idle_at(address):
+            return
         self.stop_request = True
         _LIB.uc_emu_stop(handle)
 
@@ -1166,6 +1175,9 @@ class CortexM:
             raise FirmwareFaultError(self._fault(error)) from None
         finally:
             self._running = False
+        if self._state.code_written:  # the firmware stored into flash (MCU-28)
+            self._state.code_written = 0
+            self._forget_code()
         failure = self.error
         if failure is not None:
             self.error = None
@@ -1204,8 +1216,11 @@ class CortexM:
 
     def idle_loop(self) -> bool:
         """The core sits on ``b .`` (a branch to itself): in thread mode it waits for an interrupt (MCU-4)."""
-        pc = self.pc
-        idle = self._idle.get(pc)  # the code does not change (as the block costs)
+        return self._idle_at(self.pc)
+
+    def _idle_at(self, pc: int) -> bool:
+        """The instruction at ``pc`` in flash is ``b .`` (memoised until code in flash changes, MCU-28)."""
+        idle = self._idle.get(pc)
         if idle is None:
             idle = self._idle[pc] = bool(self.flash[0] <= pc < self.flash[0] + self.flash[1] - 1 and
                                          self.read_bytes(pc, 2) == _IDLE_LOOP)  # fmt: skip

@@ -60,6 +60,7 @@ typedef struct {
     describe_fn describe;   /* nonzero: Python failed, stop */
     uint64_t rewritable;    /* MCU-28: blocks from this address (the RAM's base) ... */
     uint64_t rewritable_size; /* ... up to this many bytes on are never taken from the cache: `describe` each run */
+    uint32_t code_written;  /* MCU-28: the firmware stored into flash: CortexM forgets every cost of code */
 } supi3_state;
 
 /* MCU-28: the cycles up to the deadline as a signed count: a deadline in the past is none, and one more than 2^63 - 1
@@ -157,6 +158,19 @@ void supi3_exact_pc(void *uc, int type, uint64_t address, int size, int64_t valu
     s->reg_read(uc, s->pc_register, &s->access_pc);
 }
 
+/* MCU-28: the memory hook of flash (uc_cb_hookmem_t). A store there may change code whose cost the cache holds: the
+ * run stops at the end of the block and CortexM forgets every cost of code before the next. */
+void supi3_code_written(void *uc, int type, uint64_t address, int size, int64_t value, void *data) {
+    supi3_state *s = (supi3_state *)data;
+    (void)uc;
+    (void)type;
+    (void)address;
+    (void)size;
+    (void)value;
+    s->code_written = 1;
+    s->stop_request = 1;
+}
+
 /* A register value a peripheral holds while the read's time is before `until` (MCU-25). */
 typedef struct {
     supi3_state *state;
@@ -225,14 +239,14 @@ const uint32_t supi3_block_layout[] = {7, sizeof(supi3_block), AT(supi3_block, a
                                        AT(supi3_block, instructions), AT(supi3_block, cycles),
                                        AT(supi3_block, countdown), AT(supi3_block, poll)};
 const uint32_t supi3_state_layout[] = {
-    26, sizeof(supi3_state), AT(supi3_state, cycles), AT(supi3_state, instructions), AT(supi3_state, deadline),
+    27, sizeof(supi3_state), AT(supi3_state, cycles), AT(supi3_state, instructions), AT(supi3_state, deadline),
     AT(supi3_state, block_start), AT(supi3_state, block_address), AT(supi3_state, block_end),
     AT(supi3_state, skip_until), AT(supi3_state, skip_address), AT(supi3_state, handed),
     AT(supi3_state, skip_pending), AT(supi3_state, stop_request), AT(supi3_state, skip_polls), AT(supi3_state, mask),
     AT(supi3_state, block_poll), AT(supi3_state, cache), AT(supi3_state, fresh), AT(supi3_state, access_pc),
     AT(supi3_state, low_registers), AT(supi3_state, pc_register), AT(supi3_state, emu_stop),
     AT(supi3_state, reg_read), AT(supi3_state, reg_write), AT(supi3_state, describe), AT(supi3_state, rewritable),
-    AT(supi3_state, rewritable_size)};
+    AT(supi3_state, rewritable_size), AT(supi3_state, code_written)};
 const uint32_t supi3_held_layout[] = {
     17, sizeof(supi3_held), AT(supi3_held, state), AT(supi3_held, slow), AT(supi3_held, until), AT(supi3_held, offset),
     AT(supi3_held, value), AT(supi3_held, held), AT(supi3_held, poll), AT(supi3_held, after),

@@ -88,6 +88,7 @@ class State(ctypes.Structure):
         ("describe", DESCRIBE),
         ("rewritable", ctypes.c_uint64),
         ("rewritable_size", ctypes.c_uint64),
+        ("code_written", ctypes.c_uint32),
     )
 
 
