@@ -55,10 +55,10 @@ _TOP = (1 << 64) - 1
 
 @pytest.fixture(scope="module")
 def programs(tmp_path_factory: pytest.TempPathFactory) -> dict[tuple[str, str], Path]:
-    """ram_rewrite.S and long_count.S built for each core, once per module."""
+    """ram_rewrite.S, long_count.S and flash_rewrite.S built for each core, once per module."""
     folder = tmp_path_factory.mktemp("hostile3")
     return {(name, cpu): mcu_build.build(PROGRAMS / f"{name}.S", folder / f"{name}_{cpu}.elf", cpu=cpu, port=False)
-            for name in ("ram_rewrite", "long_count") for cpu in CPUS}  # fmt: skip
+            for name in ("ram_rewrite", "long_count", "flash_rewrite") for cpu in CPUS}  # fmt: skip
 
 
 def _run_to_done(core: CortexM, deadline: int) -> None:
@@ -89,6 +89,24 @@ def test_code_rewritten_in_ram_runs_with_its_own_cost(programs: dict[tuple[str, 
     # 12 set-up instructions, 100 iterations of 2, 1 BX, 5 re-write instructions, 100 iterations, 1 BX
     # 9 set-up instructions, 100 iterations of SUBS and BNE, BX, 6 to rewrite and call, 100 iterations, BX, the b .
     assert results[0][3] == 9 + 200 + 1 + 6 + 200 + 1 + 1
+
+
+@pytest.mark.parametrize("cpu", CPUS)
+def test_code_the_firmware_rewrites_in_flash_runs_with_its_own_cost(programs: dict[tuple[str, str], Path],
+                                                                    cpu: str) -> None:  # fmt: skip
+    """flash_rewrite.S: a countdown loop in flash on R0, run, then rewritten by a halfword store into one on R1: the
+    store stops the run at its block's end and the core forgets every cost of code (MCU-28), so the second call
+    leaves R0 = 1000, with the skips on and off; before, the cached block skipped R0 down."""
+    results = []
+    for skip in (True, False):
+        core = CortexM(programs["flash_rewrite", cpu], cpu=cpu)
+        core.skip_polls = skip
+        _run_to_done(core, MAX_DEADLINE)
+        results.append((core.reg("r0"), core.reg("r1"), core.cycles, core.instructions))
+    assert results[0][:2] == (1000, 0)
+    assert results[0] == results[1]
+    # movs, bl, 10 iterations, bx, ldr, ldr, strh, ldr, movs, bl, 10 iterations, bx, the b .
+    assert results[0][3] == 2 + 20 + 1 + 6 + 20 + 1 + 1
 
 
 @pytest.mark.parametrize("cpu", CPUS)
