@@ -19,7 +19,8 @@ callback and a peripheral would see its access twice.
 
 Speed (MCU-19): the peripheral callbacks and the register reads they need go to unicorn's C library through ctypes
 directly; the binding's wrappers around each call cost as much again as the call. The block hook and the empty memory
-hooks are native code (MCU-25, :mod:`supi3.mcu.hook`): a block calls Python only the first time it runs.
+hooks are native code (MCU-25, :mod:`supi3.mcu.hook`): a block in flash calls Python only the first time it runs (one
+in RAM each time it runs, MCU-28).
 """
 
 from __future__ import annotations

@@ -7,7 +7,8 @@
  * The block hook does what MCU-1, MCU-10 and MCU-11 say, to the cycle:
  *   - refuse the block (uc_emu_stop) on a stop request or at the deadline: it is the first of the next run;
  *   - otherwise take its cost (instructions, cycles) from a cache filled by Python's block_cost; a block not in the
- *     cache calls Python's `describe` once, which fills the cache and `fresh`;
+ *     cache calls Python's `describe` once, which fills the cache and `fresh`; a block in RAM calls it each time it
+ *     runs (MCU-28: the firmware may have rewritten it);
  *   - a poll loop whose status was just read (skip_address) counts its iterations up to the status change or the
  *     deadline without running them (MCU-10); a countdown block (SUBS Rd, Rd, #1; BNE) counts all but its last
  *     iteration up to the deadline and writes Rd back (MCU-11);
