@@ -48,6 +48,8 @@ def _own(name: str) -> bool:
 
 def load(src: str) -> Tree:
     """Import the modules the cases use from the ``src`` folder ``src``; return that tree's modules."""
+    if not (Path(src) / "supi3" / "__init__.py").is_file():  # else another supi3 on the path would be measured
+        raise SystemExit(f"bench_side.py: {src} holds no supi3 package")
     for name in [n for n in sys.modules if _own(n)]:
         del sys.modules[name]
     sys.path.insert(0, src)
@@ -56,6 +58,8 @@ def load(src: str) -> Tree:
                        "supi3.interbus.master", "supi3.interbus.ring", "supi3.model.chip", "supi3.config",
                        "supi3.tables"):  # fmt: skip
             importlib.import_module(module)
+    except ImportError as error:  # a tree too old for a case's modules
+        raise SystemExit(f"bench_side.py: {src}: {error}") from error
     finally:
         sys.path.remove(src)
     return {n: m for n, m in sys.modules.items() if _own(n)}
@@ -138,6 +142,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--calls", action="store_true", help="count the function calls of each run (cProfile) in "
                         "place of its CPU time: a measure the machine's load does not move")  # fmt: skip
     args = parser.parse_args(argv)
+    if args.rounds < 1:
+        parser.error(f"--rounds must be at least 1, not {args.rounds}")
     global COUNT_CALLS
     COUNT_CALLS = args.calls
     cases = args.cases.split(",")

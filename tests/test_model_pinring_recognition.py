@@ -6,20 +6,26 @@ ring (:class:`~supi3.interbus.ring.Ring` with :class:`~supi3.interbus.ring.Branc
 thing: whether the start succeeds and the diagnostics it reports, the configuration (numbers, ID codes, data
 lengths), the process data IN, and every chip's RD, LD and E LEDs. A branch present by LBST with nothing attached
 breaks the ring at both (BK-43); an empty branch that needs a device's answer (RF = 11, or fibre with LBST = 0) is
-not present and the ring runs through the BK.
+not present and the ring runs through the BK. The transaction-level BK recognises its branch by the pin level's rule
+(BK-48): a break of the branch's loop before the master's first start and after it, in every branch kind, and any
+history of breaks, repairs, starts, cycles and branch commands give the same at both fidelities.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from supi3.interbus.master import Master
-from supi3.interbus.ring import Branch, BranchKind, DeadLine, ErrorKind, Ring
+from supi3.interbus.ring import Branch, BranchKind, DeadLine, ErrorKind, Fault, ReturnBreak, Ring
 from supi3.model.chip import Supi3
 from supi3.model.pinring import PinBranch, PinRing
 from supi3.model.pins import Supi3Pins
 from supi3.terminal import RF_CODES, branch_present
-from test_model_pinring_tree import INPUTS, LBST, ROWS, _bk, _config, view
+from test_model_pinring_tree import INPUTS, LBST, ROWS, _bk, _config, nested_pin, nested_tl, view
 
 KINDS = [BranchKind.REMOTE, BranchKind.LOCAL, BranchKind.LBD_MR]
 """BK-RB, BK-LB and BK-LBD (Table 2-7)."""
@@ -53,20 +59,25 @@ def pin_ring(kind: BranchKind, rf: str, lbst: bool, m: int) -> tuple[PinRing, li
 
 View = tuple[list[tuple[str, int, int]], list[bytes]]
 Leds = list[tuple[bool, bool, bool]]
-Step = tuple[bool, list[ErrorKind], View | None, Leds]
+Step = tuple[bool, list[object], View | None, Leds]
 
 
-def history(ring: Ring | PinRing, chips: list[Supi3]) -> list[Step]:
+def history(ring: Ring | PinRing, chips: list[Supi3],
+            change: tuple[Callable[[], bool], int] | None = None, cycles: int = CYCLES) -> list[Step]:
     """Start a master on ``ring`` and cycle it: per step, whether it latched, the diagnostics' kinds, the master's
     view (configuration and process data IN, ``None`` without a configuration) and every chip's RD, LD and E (DG-5,
-    BK-11)."""
+    BK-11), for ``cycles`` cycles; ``change`` (a callable, step) is called before that step and its result is added
+    to the step's kinds."""
     master = Master(ring, locate=False, max_devices=8)
     steps: list[Step] = []
-    for k in range(CYCLES + 1):
+    for k in range(cycles + 1):
+        extra: list[object] = []
+        if change is not None and change[1] == k:
+            extra.append(change[0]())
         result = master.start() if k == 0 else master.cycle()
         leds = [(leds.rd, leds.ld, leds.e) for leds in (chip.diagnostic_outputs for chip in chips)]
         seen = view(master) if master.config is not None else None
-        steps.append((result.ok, [d.kind for d in result.diagnostics], seen, leds))
+        steps.append((result.ok, [*extra, *(d.kind for d in result.diagnostics)], seen, leds))
     return steps
 
 
@@ -91,15 +102,161 @@ def test_every_row_of_table_2_9_is_the_same_at_both_fidelities(kind: BranchKind,
                 assert leds[1][1:] == (False, False)  # the BK's LD and E dark
 
 
-def test_a_branch_cut_before_the_first_start_is_the_recorded_limit() -> None:
-    """BK-37's limit, pinned down: a BK-LB branch whose forward line into its second device is cut before the master's
-    first start returns the idle level to DI3, so the pin-level BK never recognises it and the ring runs through the
-    BK; the transaction-level ring recognised the populated branch when it was built and reports the break."""
-    pin, _ = pin_ring(BranchKind.LOCAL, "11", True, 2)
-    pin.cut(4, True)
-    tl, _ = tl_ring(BranchKind.LOCAL, "11", True, 2)
-    tl.inject(DeadLine(4))
-    pin_master, tl_master = Master(pin, locate=False, max_devices=8), Master(tl, locate=False, max_devices=8)
-    assert pin_master.start().ok and pin_master.config is not None and len(pin_master.config) == 3
-    result = tl_master.start()
-    assert not result.ok and result.diagnostics[0].kind is ErrorKind.DEAD_LINE
+Cut = tuple[Fault, tuple[int, bool, bool]]
+"""A break at both fidelities: the transaction-level fault and the pin-level ``PinRing.cut`` (position, forward,
+branch)."""
+
+
+def cuts(kind: BranchKind) -> list[Cut]:
+    """Every break of the loop from a BK (position 2) through its two branch devices (3, 4) back to its DI3: the
+    forward lines into the branch devices, the return line from the second (a branch with return lines), the BK's own
+    return input (BK-10, BK-40)."""
+    found: list[Cut] = [(DeadLine(3), (3, True, False)), (DeadLine(4), (4, True, False))]
+    if kind is not BranchKind.LBD_OR:
+        found.append((ReturnBreak(3), (3, False, False)))
+    return [*found, (ReturnBreak(2), (2, False, True))]
+
+
+def connected(ring: PinRing) -> bool:
+    """The pin-level BK's (position 2) ``connected`` (BK-37)."""
+    bk = ring.devices[1]
+    assert isinstance(bk, Supi3Pins)
+    return bk.branch_connected
+
+
+def read_lbd_break(step: Step, kind: BranchKind) -> Step:
+    """``step`` with a CNTR error read as a dead line in an LBD branch: behind a break there the pin-level BK repeats
+    its devices' counter telegrams on DO2 (BK-37), which the master's receiver reads as a CNTR error where the
+    transaction-level ring reports a dead line; the same before and after this recognition rule (BK-48), so outside
+    it (the recognition, the configuration, the data and every LED still agree)."""
+    ok, kinds, seen, leds = step
+    if kind.diagnostics:
+        kinds = [ErrorKind.DEAD_LINE if k is ErrorKind.CNTR else k for k in kinds]
+    return ok, kinds, seen, leds
+
+
+def cut_history(kind: BranchKind, rf: str, lbst: bool, cut: Cut, at: int) -> tuple[list[Step], list[Step]]:
+    """:func:`history` of the transaction-level and the pin-level tree (two branch devices) with ``cut`` made before
+    step ``at`` (0: before the master's first start), up to two cycles after it; after each step the BK's recognition
+    (``branch_recognised``, ``branch_connected``) must agree."""
+    fault, (position, forward, branch) = cut
+    tl, tl_chips = tl_ring(kind, rf, lbst, 2)
+    pin, pin_chips = pin_ring(kind, rf, lbst, 2)
+
+    def tl_cut() -> bool:
+        tl.inject(fault)
+        return tl_chips[1].branch_recognised
+
+    def pin_cut() -> bool:
+        pin.cut(position, forward, branch=branch)
+        return connected(pin)
+
+    return history(tl, tl_chips, (tl_cut, at), at + 2), history(pin, pin_chips, (pin_cut, at), at + 2)
+
+
+@pytest.mark.parametrize("kind", [*KINDS, BranchKind.LBD_OR])
+@pytest.mark.parametrize(("rf", "lbst"), [("11", True), pytest.param("00", False, marks=pytest.mark.slow)])
+def test_a_branch_cut_before_or_after_the_first_start_is_the_same_at_both_fidelities(
+        kind: BranchKind, rf: str, lbst: bool) -> None:
+    """BK-37, BK-48, every branch kind, the rows of Table 2-9 that need a device's answer (copper RF = 11 with
+    LBST = 1, fibre with LBST = 0): a break of the branch's loop before the master's first start leaves a branch with
+    return lines (BK-RB, BK-LB) unrecognised at both fidelities, and the ring runs through the BK; an LBD branch is
+    recognised by its devices' counter telegrams (BK-30) unless the BK's own return input is broken, and the master
+    then finds the break. A break after the start meets the latched recognition: the master finds the break at both.
+    Every step (start and cycles: result, diagnostics, configuration, process data, LEDs) is the same."""
+    for cut in cuts(kind):
+        for at in (0, 1):
+            tl, pin = cut_history(kind, rf, lbst, cut, at)
+            read = [[read_lbd_break(step, kind) for step in steps] for steps in (tl, pin)]
+            assert read[0] == read[1], (cut, at)
+            own_return = isinstance(cut[0], ReturnBreak) and cut[0].segment == 2
+            answered = at == 1 or (kind.diagnostics and not own_return)
+            ok, _, seen, _ = tl[0]
+            if at == 0 and not answered:
+                assert ok and seen is not None and len(seen[0]) == 3 and tl[-1][0], cut
+            else:
+                assert not all(step[0] for step in tl[at:]), (cut, at)
+
+
+Op = tuple[str, int]
+OPS = st.one_of(st.tuples(st.sampled_from(["start", "cycle", "repair", "off", "on"]), st.just(0)),
+                st.tuples(st.just("cut"), st.integers(0, 3)))
+"""A history's steps: the master's start (an INTERBUS reset and its ID cycles) or one cycle, a break of the branch's
+loop (an index into :func:`cuts`), every break repaired, the branch switched off or on by the master (BK-4)."""
+
+
+@settings(max_examples=12, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+@given(kind=st.sampled_from([*KINDS, BranchKind.LBD_OR]),
+       row=st.sampled_from([("11", True), ("00", False), ("10", False), ("10", True)]),
+       ops=st.lists(OPS, min_size=1, max_size=7))
+def test_the_recognition_follows_any_history_the_same_at_both_fidelities(
+        kind: BranchKind, row: tuple[str, bool], ops: list[Op]) -> None:
+    """BK-37, BK-48: breaks, repairs, starts (INTERBUS resets), cycles and branch commands in any order leave the
+    transaction-level BK's ``branch_recognised`` equal to the pin-level BK's ``connected`` after every step; a break is
+    made only where the transaction-level ring has the branch in its data path (its lines are numbered there)."""
+    tl, tl_chips = tl_ring(kind, *row, 2)
+    pin, _ = pin_ring(kind, *row, 2)
+    masters = [Master(tl, locate=False, max_devices=8), Master(pin, locate=False, max_devices=8)]
+    breaks = cuts(kind)
+    for name, index in ops:
+        if name in ("start", "cycle"):
+            for master in masters:
+                master.start() if name == "start" else master.cycle()
+        elif name in ("off", "on") and all(m.config is not None and len(m.config) > 1 for m in masters):
+            for master in masters:
+                master.switch_branch(2, name == "on")
+        elif name == "repair":
+            tl.clear_faults()
+            pin.cuts.clear()
+            pin.branch_cuts.clear()
+        elif name == "cut" and tl.spans and index < len(breaks):
+            fault, (position, forward, branch) = breaks[index]
+            tl.inject(fault)
+            pin.cut(position, forward, branch=branch)
+        assert tl_chips[1].branch_recognised == connected(pin), (name, index)
+
+
+def test_the_recognition_stays_through_resets_and_breaks_until_the_power_up() -> None:
+    """BK-48 (BK-37's clearing rule): recognised at the master's start, a BK-LB branch stays recognised through a
+    break, INTERBUS resets and the branch switched off; the BK's power-up reset forgets it, and with the loop broken
+    the next start leaves the branch out (the ring runs through the BK)."""
+    ring, chips = tl_ring(BranchKind.LOCAL, "11", True, 2)
+    master = Master(ring, locate=False, max_devices=8)
+    assert not chips[1].branch_recognised
+    assert master.start().ok and chips[1].branch_recognised and master.config is not None and len(master.config) == 5
+    ring.inject(DeadLine(4))
+    assert not master.start().ok and chips[1].branch_recognised
+    chips[1].power_up()
+    assert not chips[1].branch_recognised
+    assert master.start().ok and not chips[1].branch_recognised and len(master.config) == 3
+
+
+@pytest.mark.parametrize("at", [0, 1])
+def test_a_nested_branch_cut_is_the_same_at_both_fidelities(at: int) -> None:
+    """BK-48 in Figure 1-10's nesting (RB device, BK-RB (RB device, BK-LB (LB-MR device)), RB device): a break of the
+    inner branch's loop before the first start leaves the inner branch out and the outer one in (the inner BK, not in
+    the data path, sends its own stream on DO2); a break of the outer branch's forward line leaves both out (the inner
+    BK hears nothing); after the start both are recognised and the master finds the break. The same steps and both
+    BKs' recognition at both fidelities."""
+    cases: list[Cut] = [(DeadLine(5), (5, True, False)), (ReturnBreak(4), (4, False, True)),
+                        (DeadLine(3), (3, True, False))]  # fmt: skip
+    for fault, (position, forward, branch) in cases:
+        tl, pin = nested_tl(), nested_pin()
+        tl_chips = [chip for chip in tl.devices if isinstance(chip, Supi3)]
+        pin_chips = [pins.chip for pins in pin.devices]
+
+        def tl_cut(ring: Ring = tl, made: Fault = fault) -> bool:
+            ring.inject(made)
+            return False
+
+        def pin_cut(ring: PinRing = pin, cut: tuple[int, bool, bool] = (position, forward, branch)) -> bool:
+            ring.cut(cut[0], cut[1], branch=cut[2])
+            return False
+
+        steps = history(tl, tl_chips, (tl_cut, at), at + 1), history(pin, pin_chips, (pin_cut, at), at + 1)
+        assert steps[0] == steps[1], (fault, at)
+        bks = [pin.devices[k] for k in (1, 3)]
+        assert all(isinstance(bk, Supi3Pins) for bk in bks)
+        recognised = [tl_chips[k].branch_recognised for k in (1, 3)]
+        assert recognised == [bk.branch_connected for bk in bks if isinstance(bk, Supi3Pins)], (fault, at)
+        assert recognised == ([True, True] if at else [False, False] if position == 3 else [True, False]), fault

@@ -12,16 +12,20 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from supi3.config import decode
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.wire import BranchControl
+from supi3.model.blocks.terminal import ReturnWatch
 from supi3.model.bus_terminal import BusTerminal
 from supi3.model.pins import Supi3Pins
 from supi3.pinout import SYNC_STAGES
 from supi3.terminal import BRANCH_SILENCE_CLOCKS, BRANCH_SILENCE_S, DI3_PIN, DO3_PIN, LBST_PIN, branch_present
 from support import BK_STRAPS, Columns, CoreScript, assert_run_matches_step
+from test_model_pins_recognition import close_loop, line_problems, settled
 
 LBST = 1 << LBST_PIN
 LD_PIN = 14  # Table 2-8: LBDA, "local bus disabled"
@@ -31,9 +35,9 @@ BRANCH_DELAY = 37
 
 def scenario(interface: str, rf: str, seed: int) -> tuple[CoreScript, Columns]:
     """Frames with the branch on, switched off, on again, an INTERBUS reset; the MFP inputs with LBST high but
-    during one data cycle; DI3 at rest (1: nothing attached, the pull-up of BK-41) for the first third, then the
-    forward line delayed by
-    :data:`BRANCH_DELAY` (a branch repeating what it gets). Returns the script and its columns with DI3 in."""
+    during one data cycle; DI3 at rest (1: nothing attached, the pull-up of BK-41) for the first third, then a device
+    returning what DO3 sends (``close_loop`` of tests/test_model_pins_recognition.py). Returns the script and its
+    columns with DI3 in."""
     config = decode(BK_STRAPS[interface], rf=rf, clk_conf="11")
     script = CoreScript(config, np.random.default_rng(seed))
     script.pins["mfp_in"] = LBST
@@ -44,9 +48,7 @@ def scenario(interface: str, rf: str, seed: int) -> tuple[CoreScript, Columns]:
     script.id_cycle(wire.command_word(), mfp_in=LBST).data_cycle(mfp_in=LBST)
     columns = script.inputs()
     n = len(columns["do1"])
-    di3 = np.ones(n, dtype=np.int64)
-    di3[n // 3 :] = columns["do1"][n // 3 - BRANCH_DELAY : n - BRANCH_DELAY]
-    columns["mfp_in"] = columns["mfp_in"] & ~(1 << DI3_PIN) | di3 << DI3_PIN
+    columns, _ = close_loop(config, columns, np.arange(n) >= n // 3)
     script.parts = [columns]
     return script, script.columns()
 
@@ -65,7 +67,8 @@ def test_the_branch_takes_the_data_path(interface: str, rf: str, seed: int) -> N
     """Against the same scenario with DI3 at rest and LBST low (no branch by Table 2-9): where the branch is in the
     data path (Table 2-9 with LBST and a start level seen on DI3 since the core runs, not switched off: LD dark) DO2
     is the synchronised DI3; elsewhere DO2 is the other run's. DO3 is the other run's DO2 where the interface is
-    live (Table 2-9 as if a device answered, LD dark; BK-42), else idle. All happen, and step() equals run()."""
+    live (Table 2-9 as if a device answered, LD dark; BK-42), else idle. Each switches between telegrams (BK-47):
+    within ``SWITCH_WINDOW`` of a change, idling between the two. All happen, and step() equals run()."""
     _, columns = scenario(interface, rf, seed)
     silent = {**columns, "mfp_in": columns["mfp_in"] & ~LBST | 1 << DI3_PIN}  # never present (Table 2-9)
     pins = Supi3Pins(decode(BK_STRAPS[interface], rf=rf, clk_conf="11"))
@@ -81,8 +84,9 @@ def test_the_branch_takes_the_data_path(interface: str, rf: str, seed: int) -> N
     on = table[mfp >> LBST_PIN & 1, connected.astype(np.int64)] & opened
     live = table[mfp >> LBST_PIN & 1, 1] & opened
     assert on.any() and (~on).any() and (live & ~on).any() and (~live).any()
-    np.testing.assert_array_equal(out["do2"], np.where(on, di3, reference["do2"]))
-    np.testing.assert_array_equal(out["mfp_out"] >> DO3_PIN & 1, np.where(live, reference["do2"], wire.IDLE_LEVEL))
+    do3 = out["mfp_out"] >> DO3_PIN & 1
+    assert not line_problems(out["do2"], do3, reference["do2"], di3, live, on, pins.cpb)
+    assert (~settled(on, pins.cpb)).any()
     assert np.array_equal(out["mfp_out"] & ~(1 << DO3_PIN), reference["mfp_out"] & ~(1 << DO3_PIN))
     np.testing.assert_array_equal(out["di1"], out["do2"])  # no following device: the loop-back takes DO2 (M5)
 
@@ -216,3 +220,23 @@ def test_the_extended_function_closes_a_silent_branch() -> None:
 def test_a_bad_silence_limit_is_named(limit: object) -> None:
     with pytest.raises(ArgumentError, match="branch_silence must be"):
         Supi3Pins(decode(BK_STRAPS["BK-LB"], clk_conf="11"), branch_silence=limit)  # type: ignore[arg-type]
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(st.lists(st.tuples(st.integers(0, 1), st.integers(1, 40)), min_size=1, max_size=60), st.integers(0, 400),
+       st.sampled_from([16, 64]))  # fmt: skip
+def test_the_watch_scans_as_it_clocks(runs: list[tuple[int, int]], split: int, cpb: int) -> None:
+    """BK-47's telegram grid on a run (``ReturnWatch.scan``, telegram by telegram) is the clock-by-clock watch's
+    (``ReturnWatch.clock``): ``busy`` before each clock and the state after, on any line (glitches, start bits read
+    idle, telegrams cut at the end), continued from any state (the line split anywhere)."""
+    line = np.repeat([level for level, _ in runs], [length for _, length in runs]).astype(np.int64)
+    split = min(split, len(line))
+    stepped, scanned = ReturnWatch(), ReturnWatch()
+    busy = []
+    for level in line.tolist():
+        busy.append(stepped.busy)
+        stepped.clock(level, cpb)
+    got = np.concatenate([scanned.scan(line[:split], cpb), scanned.scan(line[split:], cpb)])
+    np.testing.assert_array_equal(got, busy)
+    assert (scanned.bit, scanned.data) == (stepped.bit, stepped.data)
+    assert scanned.bit < 0 or scanned.phase == stepped.phase

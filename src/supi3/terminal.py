@@ -41,6 +41,7 @@ from supi3.tables import CLOCK_HZ
 __all__ = [
     "BLOCK_INPUTS",
     "BLOCK_OUTPUTS",
+    "BRANCH_DRAIN_BITS",
     "BRANCH_SILENCE_CLOCKS",
     "BRANCH_SILENCE_S",
     "CONF_PIN",
@@ -49,6 +50,7 @@ __all__ = [
     "LBST_PIN",
     "RF_CODES",
     "TERMINAL_INTERFACES",
+    "LineSource",
     "Terminal",
     "TerminalMode",
     "branch_present",
@@ -72,6 +74,19 @@ BRANCH_SILENCE_S: Final = 0.010
 a device takes silence for a reset (A13), so the remote bus behind the BK is closed again before it resets."""
 BRANCH_SILENCE_CLOCKS: Final = round(BRANCH_SILENCE_S * CLOCK_HZ)
 """:data:`BRANCH_SILENCE_S` in chip clocks (320,000 at 32 MHz): the pin-level silence timer's limit."""
+BRANCH_DRAIN_BITS: Final = wire.STATUS_TELEGRAM_BITS
+"""BK-47: a BK leaving its branch's return line (DO2 no longer repeating DI3) waits until DI3 has been between
+telegrams at the idle level for this many bit periods (a status telegram's length: the master fills every gap with
+status telegrams, so the branch has drained what it held)."""
+
+
+class LineSource(IntEnum):
+    """What a BK's DO2 carries (BK-47): the transmitter's line, the synchronised DI3 (the branch in the data path), or
+    the idle level while it switches between the two."""
+
+    SENT = 0
+    DI3 = 1
+    IDLE = 2
 
 
 def silence_limit(time_limit: object) -> int:

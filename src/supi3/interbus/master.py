@@ -437,6 +437,8 @@ class Master:
             del self._alarm_output[ring_position]
         self._pcmd.clear()
         replan = bool(self._branch) or self._reconfigure
+        if self._branch:  # BK-46: no frame while the BKs switch their lines (BK-47)
+            self.ring.idle(wire.branch_switch_pause_bits(len(config)) / self.ring.bit_rate)
         self._branch.clear()
         self._reconfigure = False
         messages = self._take_alarms(registers, sent=True, optical=optical) + self._messages(registers)

@@ -20,11 +20,12 @@ into the master.
 A ring can be a tree (Figure 1-10, docs/interbus.md "Tree"): a :class:`Branch` is a bus terminal module (BK) with the
 devices of its branch. The data path runs into the BK, through the branch and back to the BK, then on along the remote
 bus, so the ring flattens the tree into :attr:`Ring.devices` in that order, leaving out every branch its BK has not in
-the data path (switched off by the master, closed by the BK itself, not present by LBST); it flattens again whenever a
-BK changes that. In a tree a fault belongs to the physical line it was injected on: it follows that line when branches
-are switched, and sleeps while the line is out of the data path. :class:`ReturnBreak` breaks a branch's return line (a
-branch in the data path with nothing attached is broken so at its BK, BK-43), and behind a break in a branch with
-device-oriented diagnostics the devices send the counter telegram to the BK (2.2.2, ``wire.counter_telegram``).
+the data path (switched off by the master, closed by the BK itself, not present by Table 2-9: a BK recognises its
+branch once a device answered, BK-48); it flattens again whenever a BK changes that. In a tree a fault belongs to the
+physical line it was injected on: it follows that line when branches are switched, and sleeps while the line is out
+of the data path. :class:`ReturnBreak` breaks a branch's return line (a branch in the data path with nothing attached
+is broken so at its BK, BK-43), and behind a break in a branch with device-oriented diagnostics the devices send the
+counter telegram to the BK (2.2.2, ``wire.counter_telegram``).
 """
 
 from __future__ import annotations
@@ -177,6 +178,9 @@ class _Active:
     remaining: int | None
     target: object = None
     """In a tree: the device whose incoming line the fault is on (``None``: the return line into the master)."""
+    branch: bool = False
+    """A :class:`ReturnBreak` at a BK with its branch on: its branch return input, out of the data path (asleep) while
+    that branch is (BK-48)."""
 
 
 # ----------------------------------------------------------------------------------------------------------------
@@ -219,6 +223,15 @@ class Terminal(Device, Protocol):
 
     def branch_enabled(self, connected: bool) -> bool:
         """Whether the branch is in the data path; ``connected``: a device answers on the branch."""
+        ...
+
+    @property
+    def branch_recognised(self) -> bool:
+        """A device on the branch has answered since the BK's power-up (BK-37, BK-48)."""
+        ...
+
+    def recognise_branch(self) -> None:
+        """A device answered on the branch (BK-48): recognised until the BK's power-up reset."""
         ...
 
     def branch_returned(self, traffic: bool, count: int | None, start: float, end: float) -> None:
@@ -536,6 +549,11 @@ class Bus(Protocol):
         """Bus time in seconds."""
         ...
 
+    @property
+    def bit_rate(self) -> int:
+        """The ring's bit rate in bit/s (Table 1-7)."""
+        ...
+
     def transfer(self, cycle: Cycle, data: bytes, close_after: int | None = None) -> Transfer:
         """Send one frame's data and check sequences and the ring delay; return what came back."""
         ...
@@ -598,6 +616,9 @@ class Ring:
         self._branches = _branches(self._tree)
         self._enabled: tuple[bool, ...] = ()
         self._spans: list[_Span] = []
+        self._settled = False
+        """A BK's branch is in the data path by its recognition (BK-48) once the ring ran (a reset, a cycle, idle);
+        before, as if every populated branch answered, so that faults are injected on the whole tree's lines."""
         self._unanswered: list[int] = []
         """The ring positions of the BKs whose branch is in the data path with nothing attached (BK-43): their branch
         return input carries nothing, as a :class:`ReturnBreak` there."""
@@ -636,8 +657,9 @@ class Ring:
         """Flatten the tree again if a BK changed whether its branch is in the data path."""
         if not self._branches:
             return
-        # A device answers on a populated branch (BK-37); one present without (by LBST) breaks at its BK (BK-43).
-        enabled = tuple(b.terminal.branch_enabled(bool(b.devices)) for b in self._branches)
+        # A device answered on a recognised branch (BK-37, BK-48); one present without (by LBST) breaks at its BK
+        # (BK-43).
+        enabled = tuple(b.terminal.branch_enabled(self._answered(b)) for b in self._branches)
         if enabled == self._enabled and self._index:
             return
         self._enabled = enabled
@@ -653,7 +675,7 @@ class Ring:
                     continue
                 at = len(flat)
                 flat.append(item.terminal)
-                if item.terminal.branch_enabled(bool(item.devices)):
+                if item.terminal.branch_enabled(self._answered(item)):
                     own = []
                     for device in item.devices:
                         own.append(len(flat))
@@ -673,6 +695,51 @@ class Ring:
             else:
                 self._detached.pop(id(device), None)
 
+    def _answered(self, branch: Branch) -> bool:
+        """``connected`` of ``branch``'s BK: its recognition (BK-48), before the ring ran whether it is populated."""
+        return branch.terminal.branch_recognised if self._settled else bool(branch.devices)
+
+    def _recognise(self) -> None:
+        """The ring runs (a reset, a cycle, idle telegrams): every BK whose branch device answers now recognises its
+        branch (BK-48), then the tree flattens again. A branch with return lines (BK-RB, BK-LB) answers when its BK
+        is reached, its interface is live (BK-42) and the loop from DO3 through the branch back to DI3 is whole; an
+        LBD branch when its BK's return input is whole (its devices send counter telegrams on their own, BK-30)."""
+        self._settled = True
+        while True:
+            self._sync()
+            waiting = [b for b in self._branches if b.devices and not b.terminal.branch_recognised]
+            if not waiting:
+                return
+            forward = {id(a.target) for a in self._faults if isinstance(a.fault, DeadLine)}
+            back = {(id(a.target), a.branch) for a in self._faults if isinstance(a.fault, ReturnBreak)}
+            dead = self._first_dead()
+            found = False
+            for branch in waiting:
+                at = self._index.get(id(branch.terminal))
+                reached = at is not None and (dead is None or dead > at + 1) and branch.terminal.branch_enabled(True)
+                if (branch.kind.diagnostics or reached) and self._loop_whole(branch, forward, back):
+                    branch.terminal.recognise_branch()
+                    found = True
+            if not found:
+                return
+
+    def _loop_whole(self, branch: Branch, forward: set[int], back: set[tuple[int, bool]]) -> bool:
+        """Something sent into ``branch`` comes back to its BK's DI3 (BK-48): its BK's return input is not broken
+        (``back``: the devices whose return input is, with whether it is a BK's branch return input), and in a branch
+        with return lines no line of the loop is (``forward``: the devices whose forward input is), nor the loop of a
+        nested branch in the data path (its BK repeats its DI3 on DO2, BK-37). An LBD branch's devices send counter
+        telegrams behind a break (BK-30)."""
+        if not branch.devices or (id(branch.terminal), True) in back:
+            return False
+        for item in branch.devices:
+            device = item.terminal if isinstance(item, Branch) else item
+            if not branch.kind.diagnostics and (id(device) in forward or (id(device), False) in back):
+                return False
+            if isinstance(item, Branch) and item.terminal.branch_enabled(self._answered(item)) \
+                    and not self._loop_whole(item, forward, back):
+                return False
+        return True
+
     def _silence_detached(self, start: float, end: float) -> None:
         """Devices of switched-off branches hear nothing: poll them, reset after the timeout (A13)."""
         for key, (device, since) in list(self._detached.items()):
@@ -690,7 +757,9 @@ class Ring:
         if active.target is None:
             return len(self.devices) + 1
         index = self._index.get(id(active.target))
-        return None if index is None else index + 1
+        if index is None or (active.branch and self._span_of(index, True) is None):
+            return None
+        return index + 1
 
     def _span_of(self, index: int, own: bool) -> _Span | None:
         """The innermost enabled branch whose BK (``own``) or whose device is at ``index``."""
@@ -757,7 +826,8 @@ class Ring:
                                     "a return line enters only a BK with its branch on, or a device of a branch with "
                                     "return lines that has a device behind it")  # fmt: skip
         target = None if fault.segment > n else self.devices[fault.segment - 1]
-        self._faults.append(_Active(fault, fault.cycles, target))
+        branch = isinstance(fault, ReturnBreak) and self._span_of(fault.segment - 1, True) is not None
+        self._faults.append(_Active(fault, fault.cycles, target, branch))
 
     def clear_faults(self) -> None:
         """Remove every injected fault."""
@@ -918,7 +988,7 @@ class Ring:
         if type(cycle) is not Cycle:
             check_instance("cycle", cycle, Cycle)
         if self._branches:
-            self._sync()
+            self._sync() if self._settled else self._recognise()
         n_all = len(self.devices)
         if n_all > wire.MAX_DEVICES:
             raise InterbusError("docs/interbus.md, Ring", n_all, f"a ring has at most {wire.MAX_DEVICES} devices")
@@ -1036,7 +1106,7 @@ class Ring:
             for terminal, traffic, count in transfer.branches:
                 terminal.branch_returned(traffic, count, start, end)
             self._silence_detached(start, end)
-            self._sync()
+            self._recognise()
 
     @staticmethod
     def _latch_run(run: _Run, groups: _Groups, end: float) -> None:
@@ -1065,8 +1135,9 @@ class Ring:
             counted = counted or _sends_counts(device)
 
     def reset(self) -> None:
-        """An INTERBUS reset (the master's Alarm Stop, 1303h): reset pattern, then idle (assumption A12)."""
-        self._sync()
+        """An INTERBUS reset (the master's Alarm Stop, 1303h): reset pattern, then idle (assumption A12). A branch is
+        recognised in the reset's hold, before its devices reset (BK-37, BK-48)."""
+        self._recognise()
         dead = self._first_dead()
         reached = len(self.devices) if dead is None else min(len(self.devices), dead - 1)
         end = self.now + wire.reset_bits(len(self.devices)) / self.bit_rate
@@ -1081,7 +1152,7 @@ class Ring:
     def idle(self, seconds: float) -> None:
         """The master sends only idle status telegrams for ``seconds`` (no cycles)."""
         seconds = check_real("seconds", seconds, 0.0)
-        self._sync()
+        self._recognise()
         dead = self._first_dead()
         reached = len(self.devices) if dead is None else min(len(self.devices), dead - 1)
         end = self.now + seconds

@@ -109,6 +109,12 @@ REPEATER_DELAY_BITS: Final = 3
 TURNAROUND_STATUS_TELEGRAMS: Final = 1
 LATCH_STATUS_TELEGRAMS: Final = 2
 
+# BK-46 After a latched cycle that switches a bus terminal module's branch the master sends only idle status
+# telegrams for the ring delay and this many more: the BK switches its lines between telegrams (BK-47), so the
+# switch waits up to a telegram for DO3, the drain of the branch and up to a telegram for DO2.
+BRANCH_SWITCH_PAUSE_STATUS_TELEGRAMS: Final = 3
+
+
 # A12 INTERBUS reset: the line held at START_LEVEL. Detected after RESET_DETECT_BITS such bit periods (longer
 # than any run inside legal traffic), sent for RESET_HOLD_BITS, ended by RESET_END_STATUS_TELEGRAMS idle ones.
 RESET_DETECT_BITS: Final = 16
@@ -855,6 +861,12 @@ def ring_delay_status_telegrams(devices: int) -> int:
     """Idle status telegrams the master sends while the check sequence travels the ring (assumption A10, A11)."""
     devices = _int("devices", devices, 0, MAX_DEVICES, "manual: at most 512 devices in a ring")
     return math.ceil(devices * REPEATER_DELAY_BITS / STATUS_TELEGRAM_BITS) + TURNAROUND_STATUS_TELEGRAMS
+
+
+def branch_switch_pause_bits(devices: int) -> int:
+    """Bit periods of idle status telegrams the master sends after a latched cycle switching a branch in a ring of
+    ``devices`` (BK-46): the ring delay (A10, A11) and :data:`BRANCH_SWITCH_PAUSE_STATUS_TELEGRAMS`."""
+    return (ring_delay_status_telegrams(devices) + BRANCH_SWITCH_PAUSE_STATUS_TELEGRAMS) * STATUS_TELEGRAM_BITS
 
 
 def cycle_bits(data_bytes: int, devices: int) -> int:

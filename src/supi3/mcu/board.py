@@ -292,7 +292,7 @@ class Board:
         else:
             if record:
                 raise fail("record", "False at transaction level (the chip has no pins: fidelity='pin')", record)
-            if stat_err_filter != STATERR_FILTER_CLOCKS:
+            if check_int("stat_err_filter", stat_err_filter, 1, STATERR_FILTER_CLOCKS) != STATERR_FILTER_CLOCKS:
                 raise fail("stat_err_filter", f"{STATERR_FILTER_CLOCKS} (200 ms) at transaction level, which runs it "
                            "in well under a second (a shorter filter is for the pin level's tests, MCU-24)",
                            stat_err_filter)  # fmt: skip

@@ -20,6 +20,7 @@ import copy
 import heapq
 import itertools
 import math
+import numbers
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -180,6 +181,39 @@ class LockstepRing(PinRing):
     def _catch_up(self, clock: int) -> None:
         """The runner until the board sets its own: the chip alone."""
         self.sync(clock)
+
+    # -- the devices behind the chip ------------------------------------------------------------------------------
+
+    def set_input(self, position: int, pin: str, value: int) -> None:
+        """:meth:`PinRing.set_input` for a device behind the board's chip (ring position 2 on, MCU-23); the board's
+        chip's inputs are the board's wiring (:attr:`inputs`, driven by the firmware's GPIO and SPI1).
+
+        Raises
+        ------
+        ArgumentError
+            ``position`` 1 (the board's chip), else as :meth:`PinRing.set_input`; nothing changes.
+        """
+        self._behind(position)
+        super().set_input(position, pin, value)
+
+    def cut(self, position: int, forward: bool, *, branch: bool = False) -> None:
+        """:meth:`PinRing.cut` of a line into a device behind the board's chip (ring position 2 on, MCU-23); the
+        board's chip runs in step with the core on the master's line, whose lines are not cut.
+
+        Raises
+        ------
+        ArgumentError
+            ``position`` 1 (the board's chip), else as :meth:`PinRing.cut`; nothing changes.
+        """
+        self._behind(position)
+        super().cut(position, forward, branch=branch)
+
+    def _behind(self, position: object) -> None:
+        """Refuse ring position 1, the board's chip, which :meth:`_clock` runs apart from the ring's inputs and cuts
+        (any other position :class:`PinRing` checks)."""
+        if not isinstance(position, bool) and isinstance(position, numbers.Integral) and position == 1:
+            raise fail("position", f"a device behind the board's chip (from 2; this ring has {len(self.devices) - 1} "
+                       "behind it, MCU-23): the board's chip's pins are the board's (LockstepRing.inputs)", position)
 
     # -- the µP's pins ---------------------------------------------------------------------------------------------
 

@@ -65,6 +65,9 @@ class BusTerminal:
         The LBST (MFP11) level last seen.
     closures:
         How often the BK closed its branch itself.
+    recognised:
+        A device answered on the branch since the power-up (the automatic recognition of 2.1.1, BK-37, BK-48); an
+        INTERBUS reset keeps it. The transaction-level ring sets it (:meth:`supi3.interbus.ring.Ring`).
     switched_on_commands:
         How many commands switched the branch on (each restarts the silence, BK-3; the pin level's silence timer
         reads it).
@@ -78,6 +81,7 @@ class BusTerminal:
         self.state = Terminal()
         self.closures = 0
         self.switched_on_commands = 0
+        self.recognised = False
         self._silent_since: float | None = None
 
     __hash__ = None  # type: ignore[assignment]  # mutable state, compared by value

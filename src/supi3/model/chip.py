@@ -739,6 +739,25 @@ class Supi3:
         """
         return self._terminal().enabled(_checked(check_bool, "connected", connected))
 
+    @property
+    def branch_recognised(self) -> bool:
+        """A device answered on the branch since the power-up (BK-37, BK-48); ``False`` in the modes that are no BK
+        (Table 2-7)."""
+        return self.bus_terminal is not None and self.bus_terminal.recognised
+
+    def recognise_branch(self) -> None:
+        """A device answered on the branch (BK-48): recognised until the power-up reset (an INTERBUS reset keeps it).
+
+        Raises
+        ------
+        ChipError
+            The chip is not in a BK mode (Table 2-7).
+        """
+        terminal = self._terminal()
+        if not terminal.recognised:
+            terminal.recognised = True
+            self.revision += 1
+
     def branch_returned(self, traffic: bool, count: int | None, start: float, end: float) -> None:
         """The ring drove the branch from ``start`` to ``end`` (bus seconds): ``traffic`` says whether the master's
         telegrams came back on the return line, ``count`` is the counter telegram's count received there (``None``:

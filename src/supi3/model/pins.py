@@ -339,13 +339,14 @@ class Supi3Pins:
         branch = self._branch
         if branch is not None:
             assert self.chip.bus_terminal is not None
-            branch.route(outputs, self.chip.bus_terminal.state, synced.mfp_in, tx.next_present)
+            sent, state = outputs["do2"], self.chip.bus_terminal.state
+            branch.route(outputs, synced.mfp_in, tx.next_present)
         if c >= self._run_from or self._holding or not (synced.resu_n and synced.vmon_ok):
             self._tick(c, synced, synced.do1, optical or _OPTICAL_QUIET)
             if c >= self._run_from:
                 tx.next_present = bool(synced.rbst_ext) if tx.rbst_by_pin else tx.next_present or bool(synced.di2)
                 if branch is not None:
-                    branch.clock(synced.mfp_in)
+                    branch.clock(synced.mfp_in, sent, state)
             if tx.next_present != self.chip.following:  # RD (DG-5): the outputs of the next cycle show it
                 self.chip.set_following(tx.next_present)
         if len(tx.bits) > 8:  # tested here, not in trim(): one call less per step()
@@ -362,6 +363,12 @@ class Supi3Pins:
     def holding(self) -> bool:
         """A source of the power-up reset (``vmon_ok`` low, /ResU pulled low) was seen at the last clock edge (M2)."""
         return self._holding
+
+    @property
+    def branch_connected(self) -> bool:
+        """A BK's ``connected``: DI3 has shown a start level since the power-up reset (BK-37), the pin-level twin of
+        the transaction level's ``Supi3.branch_recognised`` (BK-48); ``False`` in the other modes."""
+        return self._branch is not None and self._branch.connected
 
     @property
     def branch_in_path(self) -> bool:
@@ -387,7 +394,7 @@ class Supi3Pins:
         assert self._branch is not None and self.chip.bus_terminal is not None
         pipe = self._receiver.pipe
         synced = pipe[max(len(pipe) - 1 - (c - self.cycle), 0)]
-        self._branch.route(values, self.chip.bus_terminal.state, synced.mfp_in, self._transmitter.next_present)
+        self._branch.route(values, synced.mfp_in, self._transmitter.next_present)
         return values
 
     def output_values(self, c: int, di2: int) -> dict[str, int]:

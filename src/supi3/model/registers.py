@@ -285,7 +285,15 @@ class ViolationLog:
 
     def release(self, *, failed: bool = False) -> None:
         """Leave a block entered with :meth:`hold`: the outermost one raises the first violation held in it, unless
-        the block ``failed`` (an exception left it; the violations stay in :attr:`records`)."""
+        the block ``failed`` (an exception left it; the violations stay in :attr:`records`).
+
+        Raises
+        ------
+        RegisterFileError
+            No block is held (a release without its :meth:`hold`); nothing changes.
+        """
+        if not self._depth:  # else strict mode would hold every later violation for ever
+            raise RegisterFileError("ViolationLog.release() without a hold(): no deferred block is open")
         self._depth -= 1
         if self._depth == 0 and self._pending:
             pending, self._pending = self._pending, []

@@ -85,10 +85,10 @@ from supi3.rtl.tables import (
     core_tables,
     line_position,
 )
-from supi3.rtl.terminal import TerminalRtl
+from supi3.rtl.terminal import ReturnWatchRtl, TerminalRtl
 from supi3.rtl.upif import upif_tables
 from supi3.tables import BIT_RATES, RF_MODES, RfMode
-from supi3.terminal import CONF_PIN, DI3_PIN, DO3_PIN, LBST_PIN, TerminalMode
+from supi3.terminal import BRANCH_DRAIN_BITS, CONF_PIN, DI3_PIN, DO3_PIN, LBST_PIN, LineSource, TerminalMode
 
 __all__ = [
     "LINE",
@@ -161,6 +161,7 @@ _FIBRE: Final = next(row.medium for row in RF_MODES if row.optical_regulation)
 """Table 2-2's medium of the fibre optic rows."""
 
 
+_SENT, _DI3, _IDLE = (int(source) for source in LineSource)
 _POSITION: Final = range(wire.DATA_TELEGRAM_BITS + 1)
 """The bit counter of a telegram: the position of the next bit (docs/interbus.md, "Telegrams")."""
 
@@ -362,7 +363,9 @@ class Supi3Core(wiring.Component):
         # start level where the logic ran (BK-37: a pulled-up or broken DI3 never is); a power failure forgets it.
         # While the interface is live DO3 (MFP9) takes the DO2 the core would send (BK-42), else it idles; while the
         # branch is in the data path DO2 repeats the synchronised DI3 (BK-1's order: the BK, its branch, on along the
-        # remote bus; the pin model's BranchLines).
+        # remote bus; the pin model's BranchLines). Each switches only between telegrams (BK-47: ``sel3``, ``sel2``
+        # follow ``live`` and ``enabled`` where the logic runs; DO2 idles between its two lines and leaves DI3 once
+        # drained).
         terminal = TerminalRtl()
         m.submodules.terminal = ResetInserter(~running)(terminal)
         di3 = receiver.mfp_in_s[DI3_PIN]
@@ -371,8 +374,29 @@ class Supi3Core(wiring.Component):
             m.d.sync += connected.eq(0)
         with m.Elif(running & (di3 == wire.START_LEVEL)):
             m.d.sync += connected.eq(1)
+        tx_watch = ReturnWatchRtl(len(cpb))
+        m.submodules.tx_watch = ResetInserter(power_fail)(EnableInserter(running)(tx_watch))
+        m.d.comb += [tx_watch.line.eq(lines.do2), tx_watch.cpb.eq(cpb)]
+        sel3 = Signal()
+        sel2 = Signal(2, init=_SENT)
+        drain = Mux(cpb == clocks_per_bit(1), clocks_per_bit(1), clocks_per_bit(0)) * BRANCH_DRAIN_BITS
+        drained = Signal(range(clocks_per_bit(0) * BRANCH_DRAIN_BITS + 1))
+        tx_free = ~tx_watch.busy
+        tx_leave = tx_free & (lines.do2 == wire.IDLE_LEVEL)
+        di3_free = ~lines.branch_busy
+        di3_idle = di3_free & (di3 == wire.IDLE_LEVEL)
+        want = Mux(terminal.enabled, _DI3, _SENT)
+        leave = (sel2 == _IDLE) | Mux(sel2 == _SENT, tx_leave, di3_idle & (drained >= drain))
+        with m.If(power_fail):
+            m.d.sync += [sel3.eq(0), sel2.eq(_SENT), drained.eq(0)]
+        with m.Elif(running):
+            with m.If((sel3 != terminal.live) & Mux(sel3, tx_leave, tx_free)):
+                m.d.sync += sel3.eq(terminal.live)
+            with m.If((sel2 != want) & leave):
+                m.d.sync += sel2.eq(Mux(Mux(terminal.enabled, di3_free, tx_free), want, _IDLE))
+            m.d.sync += drained.eq(Mux(di3_idle, Mux(drained >= drain, drain, drained + 1), 0))
         do2 = Signal(init=wire.IDLE_LEVEL)
-        m.d.comb += do2.eq(Mux(terminal.enabled, di3, lines.do2))
+        m.d.comb += do2.eq(Mux(sel2 == _SENT, lines.do2, Mux(sel2 == _DI3, di3, wire.IDLE_LEVEL)))
         # The master's telegrams back on DI3 (BK-38) and, in BK-LBD, the counter block on DI3 (BK-39).
         m.d.comb += [lines.branch_line.eq(di3), lines.branch.eq(terminal_mode == TerminalMode.LBD)]
         command = datapath.words.command
@@ -549,7 +573,7 @@ class Supi3Core(wiring.Component):
             self.do2.eq(do2),
             self.di1.eq(lines.di1),
             self.mfp_out.eq(datapath.mfp_out | Mux(spi, serial_io.mfp, 0) | outputs.mfp_diag
-                            | Mux(bus_terminal, Mux(terminal.live, lines.do2, wire.IDLE_LEVEL) << DO3_PIN, 0)),
+                            | Mux(bus_terminal, Mux(sel3, lines.do2, wire.IDLE_LEVEL) << DO3_PIN, 0)),
             self.mod_ack_n.eq(outputs.mod_ack_n),
             self.res_reg_n.eq(outputs.res_reg_n),
             self.diag1.eq(outputs.diag1),

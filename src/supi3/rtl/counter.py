@@ -220,14 +220,15 @@ class CounterLinesRtl(wiring.Component):
     runs, M1); out: ``do2`` (the forward block's ``out`` while its ``drive`` is 1, else ``sent``) and ``di1`` (the
     return block's ``out`` in LBD-MR, else ``source``); ``branch_line`` the synchronised DI3, out ``seen`` and
     ``count`` of its block, the BK's counter telegram strobe and count (``cnt_valid``, ``count``), and ``returned``
-    the BK's return watch on it in every mode (``ret_valid``, BK-38: ``supi3.rtl.terminal.ReturnWatchRtl``).
+    the BK's return watch on it in every mode (``ret_valid``, BK-38: ``supi3.rtl.terminal.ReturnWatchRtl``), and
+    ``branch_busy`` its ``busy`` (BK-47).
     """
 
     def __init__(self) -> None:
         super().__init__({
             "line": In(1), "fast": In(1), "sent": In(1), "source": In(1), "forward": In(1), "looped": In(1),
             "run": In(1), "clear": In(1), "do2": Out(1), "di1": Out(1), "branch": In(1), "branch_line": In(1),
-            "seen": Out(1), "count": Out(wire.COUNTER_MAX.bit_length()), "returned": Out(1),
+            "seen": Out(1), "count": Out(wire.COUNTER_MAX.bit_length()), "returned": Out(1), "branch_busy": Out(1),
         })  # fmt: skip
 
     def elaborate(self, _platform: object) -> Module:
@@ -238,7 +239,7 @@ class CounterLinesRtl(wiring.Component):
         watch = ReturnWatchRtl(_CPB[0].bit_length())
         m.submodules.watch = ResetInserter(self.clear)(EnableInserter(self.run)(watch))
         m.d.comb += [watch.line.eq(self.branch_line), watch.cpb.eq(Mux(self.fast, _CPB[1], _CPB[0])),
-                     self.returned.eq(watch.seen)]  # fmt: skip
+                     self.returned.eq(watch.seen), self.branch_busy.eq(watch.busy)]  # fmt: skip
         m.submodules.forward = ResetInserter(self.clear | ~on)(EnableInserter(self.run)(forward))
         stages = [Signal(init=wire.IDLE_LEVEL, name=f"source_s{k}") for k in range(SYNC_STAGES)]
         m.d.sync += [stages[0].eq(self.source), *(b.eq(a) for a, b in pairwise(stages))]

@@ -147,7 +147,8 @@ class TerminalRtl(wiring.Component):
 class ReturnWatchRtl(wiring.Component):
     """The master's telegrams back on the branch return line (BK-38; the pin model's ``ReturnWatch`` in
     ``src/supi3/model/blocks/terminal.py``, whose docstring is the behaviour): ``line`` the synchronised DI3, ``cpb``
-    clocks per bit; ``seen`` is 1 in the cycle after a status telegram's stop bit was sampled at the idle level.
+    clocks per bit; ``seen`` is 1 in the cycle after a status telegram's stop bit was sampled at the idle level;
+    ``busy`` is 1 while a telegram is under way (``ReturnWatch.busy``: begun, its stop bit not yet sampled).
 
     Parameters
     ----------
@@ -161,7 +162,7 @@ class ReturnWatchRtl(wiring.Component):
         except ArgumentError:
             self._MustUse__silence = True  # rejected, never elaborated: no "created but never used" warning
             raise
-        super().__init__({"line": In(1), "cpb": In(cpb_width), "seen": Out(1)})
+        super().__init__({"line": In(1), "cpb": In(cpb_width), "seen": Out(1), "busy": Out(1)})
 
     def elaborate(self, _platform: object) -> Module:
         m = Module()
@@ -187,5 +188,5 @@ class ReturnWatchRtl(wiring.Component):
                     sync += [seen.eq(~data & (self.line == wire.IDLE_LEVEL)), busy.eq(0)]
             with m.Elif(start):
                 sync += bit.eq(0)
-        m.d.comb += self.seen.eq(seen)
+        m.d.comb += [self.seen.eq(seen), self.busy.eq(busy)]
         return m

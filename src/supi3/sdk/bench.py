@@ -19,13 +19,14 @@ in the latch phase (``InconsistentDataError``) are all tested at transaction lev
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from collections.abc import Sequence
 from types import TracebackType
 from typing import Final, Literal, NamedTuple
 
 from supi3 import tables, timing
-from supi3.checks import check_bool, check_instance, check_int, check_real, describe
+from supi3.checks import check_bool, check_instance, check_int, check_real, describe, fail
 from supi3.config import DeviceConfig, decode
 from supi3.errors import Supi3Error
 from supi3.interbus import wire
@@ -121,6 +122,10 @@ class _ClockedBus:
     @property
     def now(self) -> float:
         return self.ring.now
+
+    @property
+    def bit_rate(self) -> int:
+        return self.ring.bit_rate
 
     def flush(self) -> None:
         if self.pending is not None:
@@ -292,6 +297,8 @@ class Bench:
             raise DriverArgumentError("config", config, f"config must strap an Init-µP mode (Tables 2-4 to 2-7), "
                                       f"not {self.config.function!r}")  # fmt: skip
         self.registers: RegisterFile = self.chip.registers
+        if isinstance(others, str | bytes) or not isinstance(others, Sequence):  # Ring names each item's error
+            raise fail("others", "a sequence of the devices behind the chip (Device objects)", others)
         self.ring = Ring([self.chip, *others], bit_rate=self.config.bit_rate)
         self._bus = _ClockedBus(self.ring)
         self.master = Master(self._bus)
@@ -327,7 +334,15 @@ class Bench:
         return self._next_at
 
     def advance(self, until: float) -> None:
-        """Run the bus up to time ``until`` and set the clock there (not backwards)."""
+        """Run the bus up to time ``until`` and set the clock there (not backwards).
+
+        Raises
+        ------
+        ArgumentError
+            ``until`` not a finite number (NaN would run nothing, infinity for ever); nothing changes.
+        """
+        if type(until) is not float or not -math.inf < until < math.inf:  # the board's float: one test
+            until = check_real("until", until)
         # Most calls (a byte, a pin read, the board's synchronisation at each peripheral access) find no bus event
         # due: one comparison with the next event's time, kept by _step_bus and _start_cycle.
         while self._next_at <= until:

@@ -30,6 +30,7 @@ without ``connected``); every one is 0 while ``mode`` is NONE.
 
 from __future__ import annotations
 
+import copy
 from bisect import bisect_left, bisect_right
 from collections.abc import Mapping, Sequence
 from typing import Final
@@ -47,10 +48,12 @@ from supi3.pinlevel import EventLog, Pin
 from supi3.terminal import (
     BLOCK_INPUTS,
     BLOCK_OUTPUTS,
+    BRANCH_DRAIN_BITS,
     BRANCH_SILENCE_CLOCKS,
     DI3_PIN,
     DO3_PIN,
     LBST_PIN,
+    LineSource,
     Terminal,
     TerminalMode,
     branch_present,
@@ -199,6 +202,55 @@ class ReturnWatch:
         self.data = False
         self.seen = 0
 
+    @property
+    def busy(self) -> bool:
+        """A telegram is under way (begun, its stop bit not yet sampled)."""
+        return self.bit >= 0
+
+    def scan(self, line: npt.NDArray[np.int64], cpb: int) -> npt.NDArray[np.bool_]:
+        """:meth:`clock` at every cycle of ``line`` (``seen`` aside), jumping from sample to sample: :attr:`busy`
+        before each cycle's edge."""
+        n = len(line)
+        busy = np.zeros(n, dtype=bool)
+        starts = np.flatnonzero(line == wire.START_LEVEL)
+        half = cpb // 2
+        k = 0
+        while k < n:
+            first = k
+            if self.bit < 0:
+                i = int(np.searchsorted(starts, k))
+                if i == len(starts):
+                    break
+                k = int(starts[i])
+                sample = k + half  # a whole telegram in the trace: its start and type samples give its end
+                if sample + cpb < n and line[sample] == wire.START_LEVEL:
+                    data = bool(line[sample + cpb] == wire.TYPE_DATA_LEVEL)
+                    end = sample + ((wire.DATA_TELEGRAM_BITS if data else wire.STATUS_TELEGRAM_BITS) - 1) * cpb
+                    if end < n:
+                        self.data = data
+                        busy[k + 1 : end + 1] = True
+                        k = end + 1
+                        continue
+                self.bit, self.phase, first = 0, 0, k + 1
+            while True:
+                sample = k + (half - self.phase) % cpb
+                if sample >= n:
+                    busy[first:] = True
+                    self.phase = (self.phase + n - k) % cpb
+                    return busy
+                bit, level = self.bit, int(line[sample])
+                self.phase = (self.phase + sample + 1 - k) % cpb
+                self.bit += 1
+                k = sample + 1
+                if bit == wire.POS_TYPE:
+                    self.data = level == wire.TYPE_DATA_LEVEL
+                elif (bit == wire.POS_START and level != wire.START_LEVEL) \
+                        or bit == (wire.DATA_TELEGRAM_BITS if self.data else wire.STATUS_TELEGRAM_BITS) - 1:
+                    busy[first:k] = True
+                    self.bit = -1
+                    break
+        return busy
+
     def clock(self, line: int, cpb: int) -> None:
         """The clock edge ending a cycle with the synchronised DI3 at ``line``, ``cpb`` clocks per bit."""
         seen = 0
@@ -228,7 +280,10 @@ class BranchLines:
     the branch is in the data path (:func:`~supi3.terminal.enabled`: present by Table 2-9, switched on, not closed)
     DO2 repeats the synchronised DI3, the branch's return line: the data path runs through the BK, its branch, then
     on along the remote bus (BK-1's flattened order); the M5 loop-back takes this DO2. Otherwise DO2 is the
-    transmitter's. ``connected`` (a device answers on the branch, BK-37) latches the first start level (0) of the
+    transmitter's. Each line switches only between telegrams (BK-47, :meth:`_select`): :attr:`sel3` and
+    :attr:`sel2`, registers updated where the core's logic runs, follow ``live`` and ``enabled``; DO2 idles between
+    its two lines and leaves DI3 once the branch has drained. ``connected`` (a device answers on the branch,
+    BK-37) latches the first start level (0) of the
     synchronised DI3 at a clock edge where the core's logic runs: a following protocol chip repeats what DO3 sends
     (the master's reset pattern, its telegrams) and loops it back, and each begins with a start level; a pulled-up
     DI3 (BK-41) or a broken line (BK-30) rests at the idle level and never shows one. A power-up reset clears it.
@@ -264,8 +319,9 @@ class BranchLines:
     """
 
     __slots__ = (
-        "_c0", "_connected", "_events", "_lbst", "_line", "_opens", "_starts", "_strobes", "connected", "counter",
-        "counting", "cpb", "fast", "limit", "present", "timer", "timer_at", "watch",
+        "_c0", "_connected", "_events", "_initial", "_lbst", "_line", "_opens", "_restarts", "_running",
+        "_starts", "_strobes", "connected", "counter", "counting", "cpb", "drain", "drained", "fast", "limit",
+        "present", "sel2", "sel3", "timer", "timer_at", "tx", "watch",
     )  # fmt: skip
 
     def __init__(self, rf: str | None, cpb: int, lbd: bool, time_limit: int = BRANCH_SILENCE_CLOCKS) -> None:
@@ -281,6 +337,15 @@ class BranchLines:
         self.connected = False
         self.watch = ReturnWatch()
         self.counter = CounterBlock() if lbd else None
+        self.tx = ReturnWatch()
+        """The telegram grid of what the transmitter sends (BK-47)."""
+        self.drain = BRANCH_DRAIN_BITS * cpb
+        self.sel3 = False
+        """DO3 carries the transmitter's line (else it idles), BK-47."""
+        self.sel2 = _SENT
+        """What DO2 carries, a :class:`~supi3.terminal.LineSource` (BK-47)."""
+        self.drained = 0
+        """Clocks before this one that DI3 spent between telegrams at the idle level, at most :attr:`drain`."""
         self.timer = 0
         self.timer_at = 0
         self.counting = False
@@ -292,6 +357,9 @@ class BranchLines:
         self._lbst = np.zeros(0, dtype=np.int64)
         self._connected = np.zeros(0, dtype=np.int64)
         self._strobes = np.zeros((0, 3), dtype=np.int64)
+        self._running = np.zeros(0, dtype=bool)
+        self._restarts: list[int] = []
+        self._initial = (self.sel3, self.sel2, self.drained, ReturnWatch(), ReturnWatch())
         self._events: list[int] = []
 
     # One cycle --------------------------------------------------------------------------------------------------
@@ -301,19 +369,36 @@ class BranchLines:
         ``connected`` (:func:`~supi3.terminal.enabled`)."""
         return bool(self.present[lbst, int(connected)]) and _open(state)
 
-    def route(self, outputs: dict[str, int], state: Terminal, mfp_in: int, next_present: bool) -> None:
+    def route(self, outputs: dict[str, int], mfp_in: int, next_present: bool) -> None:
         """Set ``do2``, ``mfp_out`` (DO3) and, when the chip loops back (M5: ``next_present`` false), ``di1`` of a
-        cycle in that cycle's ``outputs`` (``do2`` the transmitter's; ``mfp_in`` the synchronised MFP inputs)."""
+        cycle in that cycle's ``outputs`` (``do2`` the transmitter's; ``mfp_in`` the synchronised MFP inputs), as
+        :attr:`sel3` and :attr:`sel2` select."""
         sent = outputs["do2"]
-        lbst = mfp_in >> LBST_PIN & 1
-        if self.on(state, lbst, True):  # live (BK-42)
-            if self.on(state, lbst, self.connected):
-                do2 = outputs["do2"] = mfp_in >> DI3_PIN & 1
-                if not next_present:
-                    outputs["di1"] = do2
-            outputs["mfp_out"] |= sent << DO3_PIN
-        else:
-            outputs["mfp_out"] |= wire.IDLE_LEVEL << DO3_PIN
+        outputs["mfp_out"] |= (sent if self.sel3 else wire.IDLE_LEVEL) << DO3_PIN
+        if self.sel2 != _SENT:
+            do2 = outputs["do2"] = mfp_in >> DI3_PIN & 1 if self.sel2 == _DI3 else wire.IDLE_LEVEL
+            if not next_present:
+                outputs["di1"] = do2
+
+    def _select(self, live: bool, on: bool, sent: int, di3: int, tx_busy: bool, di3_busy: bool,
+                drained: int) -> None:
+        """BK-47 at a clock edge: the lines switch only between telegrams. ``live`` and ``on`` (the branch interface
+        live, the branch in the data path) in the cycle ending, ``sent`` and ``di3`` its levels of the transmitter and
+        of the synchronised DI3, ``tx_busy`` and ``di3_busy`` whether a telegram was under way on them, ``drained``
+        the clocks before it that DI3 spent between telegrams at the idle level. A line is left between telegrams at
+        the idle level (DI3 once drained, :data:`~supi3.terminal.BRANCH_DRAIN_BITS`) and taken between telegrams;
+        DO2 idles between the two."""
+        tx_free = not tx_busy
+        tx_leave = tx_free and sent == wire.IDLE_LEVEL
+        if self.sel3 != live and (tx_leave if self.sel3 else tx_free):
+            self.sel3 = live
+        want = _DI3 if on else _SENT
+        sel = self.sel2
+        if sel != want:
+            di3_free = not di3_busy
+            if sel == _IDLE or (tx_leave if sel == _SENT
+                                else di3_free and di3 == wire.IDLE_LEVEL and drained >= self.drain):
+                self.sel2 = want if (tx_free if want == _SENT else di3_free) else _IDLE
 
     def strobes(self) -> tuple[int, int, int]:
         """``ret_valid``, ``cnt_valid`` and ``count`` in the cycle to come (``Supi3Pins.step``)."""
@@ -322,9 +407,20 @@ class BranchLines:
             return self.watch.seen, 0, 0
         return self.watch.seen, counter.seen, counter.state.counted
 
-    def clock(self, mfp_in: int) -> None:
-        """A clock edge where the core's logic runs, with the synchronised MFP inputs ``mfp_in``."""
+    def clock(self, mfp_in: int, sent: int, state: Terminal) -> None:
+        """A clock edge where the core's logic runs, with the synchronised MFP inputs ``mfp_in``, the transmitter's
+        level ``sent`` and the BK state ``state`` of the cycle ending."""
         di3 = mfp_in >> DI3_PIN & 1
+        lbst = mfp_in >> LBST_PIN & 1
+        di3_busy = self.watch.busy
+        self._select(self.on(state, lbst, True), self.on(state, lbst, self.connected), sent, di3, self.tx.busy,
+                     di3_busy, self.drained)
+        self.drained = min(self.drained + 1, self.drain) if di3 == wire.IDLE_LEVEL and not di3_busy else 0
+        self.tx.clock(sent, self.cpb)
+        self._clock_di3(di3)
+
+    def _clock_di3(self, di3: int) -> None:
+        """The edge on the DI3 side: ``connected`` and the blocks on DI3."""
         self.connected = self.connected or di3 == wire.START_LEVEL
         self._clock_blocks(di3)
 
@@ -342,6 +438,8 @@ class BranchLines:
         if self.counter is not None:
             self.counter.reset()
         self.timer, self.counting = 0, False
+        self.tx.reset()
+        self.sel3, self.sel2, self.drained = False, _SENT, 0
 
     def quiet(self, c: int, state: Terminal, recording: bool) -> None:
         """The BK's edge ending cycle ``c`` takes no strobe (its first running clock, an INTERBUS reset): the timer
@@ -399,19 +497,26 @@ class BranchLines:
         self._lbst = mfp_in >> LBST_PIN & 1
         self._strobes = np.zeros((len(mfp_in), 3), dtype=np.int64)
         self._connected = np.zeros(len(mfp_in), dtype=np.int64)
-        self.plan(c0, run_from)
+        self._running = np.zeros(len(mfp_in), dtype=bool)
+        self._restarts = []
+        self._initial = (self.sel3, self.sel2, self.drained, copy.copy(self.tx), copy.copy(self.watch))
+        self.plan(c0, run_from, restart=False)
         counting = c0 >= run_from and self._counts(c0, state)
         if counting and not self.counting:  # the timer stood at 0
             self.timer, self.timer_at = 0, c0
         self.counting = counting
 
-    def plan(self, c: int, run_from: int) -> None:
+    def plan(self, c: int, run_from: int, restart: bool = True) -> None:
         """Clock the lines on DI3 from cycle ``c`` to the run's end where the logic runs (from ``run_from``),
-        keeping their strobes and ``connected``: after :meth:`begin` and after each power-up reset (in cycle
-        ``c - 1``)."""
+        keeping their strobes, ``connected`` and whether a telegram was under way on DI3: after :meth:`begin` and
+        after each power-up reset (in cycle ``c - 1``; the lines' selection restarts at ``c``)."""
         line, strobes, connected, c0 = self._line, self._strobes, self._connected, self._c0
         t = min(c - c0, len(line))
+        if restart:
+            self._restarts.append(t)
         first = max(t, run_from - c0) if run_from != NEVER else len(line)
+        self._running[t:first] = False
+        self._running[first:] = True
         strobes[t:first] = self.strobes()
         connected[t:first] = self.connected
         n, k = len(line), first
@@ -428,7 +533,7 @@ class BranchLines:
                 continue
             strobes[k] = self.strobes()
             connected[k] = self.connected
-            self.clock(int(line[k]) << DI3_PIN)
+            self._clock_di3(int(line[k]))
             k += 1
         rises = np.flatnonzero(np.diff(connected, prepend=connected[:1]) | np.diff(self._lbst, prepend=self._lbst[:1]))
         self._events = sorted({*np.flatnonzero(strobes[:, 0] | strobes[:, 1]).tolist(), *rises.tolist()})
@@ -460,8 +565,61 @@ class BranchLines:
         on = self.present[self._lbst, self._connected] & opens
         sent = traces["do2"]
         live = self.present[self._lbst, 1] & opens
-        traces["mfp_out"] = traces["mfp_out"] | np.where(live, sent, wire.IDLE_LEVEL) << DO3_PIN
-        traces["do2"] = np.where(on, self._line, sent)
+        self.sel3, self.sel2, self.drained, self.tx, di3 = self._initial
+        sel3 = np.zeros(n, dtype=bool)
+        sel2 = np.zeros(n, dtype=np.int64)
+        for a, b in zip([0, *self._restarts], [*self._restarts, n], strict=True):
+            if a:
+                self.tx.reset()
+                di3 = ReturnWatch()
+                self.sel3, self.sel2, self.drained = False, _SENT, 0
+            running = np.flatnonzero(self._running[a:b])
+            first = a + int(running[0]) if running.size else b
+            sel3[a:first], sel2[a:first] = self.sel3, self.sel2
+            self._select_run(first, b, live, on, sent, di3, sel3, sel2)
+        traces["mfp_out"] = traces["mfp_out"] | np.where(sel3, sent, wire.IDLE_LEVEL) << DO3_PIN
+        traces["do2"] = np.where(sel2 == _SENT, sent, np.where(sel2 == _DI3, self._line, wire.IDLE_LEVEL))
+
+    def _select_run(self, a: int, b: int, live: npt.NDArray[np.bool_], on: npt.NDArray[np.bool_],
+                    sent: npt.NDArray[np.int64], di3: ReturnWatch, sel3: npt.NDArray[np.bool_],
+                    sel2: npt.NDArray[np.int64]) -> None:
+        """:meth:`_select` at the run's cycles ``a`` to ``b`` (the logic runs), into ``sel3`` and ``sel2``, with
+        ``di3`` the return watch as at ``a`` (:attr:`watch`'s twin): only the cycles where a line waits to switch
+        are visited."""
+        m = b - a
+        if m <= 0:
+            return
+        tx_busy = self.tx.scan(sent[a:b], self.cpb)
+        line = self._line[a:b]
+        di3_busy = di3.scan(line, self.cpb)
+        idle = (line == wire.IDLE_LEVEL) & ~di3_busy
+        last = np.maximum.accumulate(np.where(idle, -1, np.arange(m)))  # the last busy or start-level clock
+        carry = self.drained
+
+        def drained(j: int) -> int:
+            if j == 0:
+                return carry
+            return min(self.drain, j - 1 - int(last[j - 1]) if last[j - 1] >= 0 else carry + j)
+
+        want3 = live[a:b]
+        want2 = np.where(on[a:b], _DI3, _SENT)
+        changes = (np.flatnonzero((want3[1:] != want3[:-1]) | (want2[1:] != want2[:-1])) + 1).tolist()
+        j = 0
+        while j < m:
+            if self.sel3 == want3[j] and self.sel2 == want2[j]:
+                k = bisect_right(changes, j)
+                end = changes[k] if k < len(changes) else m
+                sel3[a + j : a + end], sel2[a + j : a + end] = self.sel3, self.sel2
+                j = end
+                continue
+            sel3[a + j], sel2[a + j] = self.sel3, self.sel2
+            self._select(bool(want3[j]), bool(want2[j] == _DI3), int(sent[a + j]), int(line[j]), bool(tx_busy[j]),
+                         bool(di3_busy[j]), drained(j))
+            j += 1
+        self.drained = drained(m)
+
+
+_SENT, _DI3, _IDLE = (int(source) for source in LineSource)
 
 
 def _open(state: Terminal) -> bool:
