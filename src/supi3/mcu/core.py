@@ -19,7 +19,8 @@ callback and a peripheral would see its access twice.
 
 Speed (MCU-19): the peripheral callbacks and the register reads they need go to unicorn's C library through ctypes
 directly; the binding's wrappers around each call cost as much again as the call. The block hook and the empty memory
-hooks are native code (MCU-25, :mod:`supi3.mcu.hook`): a block calls Python only the first time it runs.
+hooks are native code (MCU-25, :mod:`supi3.mcu.hook`): a block in flash calls Python only the first time it runs (one
+in RAM each time it runs, MCU-28).
 """
 
 from __future__ import annotations
@@ -599,6 +600,9 @@ def block_cost(code: bytes) -> tuple[int, int]:
 ReadFn = Callable[[int, int], int]
 WriteFn = Callable[[int, int, int], None]
 _FOREVER: Final[int] = (1 << 64) - 1
+MAX_DEADLINE: Final[int] = (1 << 63) - 1
+"""The latest cycle a run may end at (MCU-28): the native hook's clock is 64-bit and a run passes its deadline by a
+block, an exception entry or a sleep; half its range (6000 years at 48 MHz) leaves it room never to wrap."""
 
 
 class _Batch:
@@ -723,6 +727,7 @@ class CortexM:
         state.reg_read = ctypes.cast(_LIB.uc_reg_read, ctypes.c_void_p)
         state.reg_write = ctypes.cast(_LIB.uc_reg_write, ctypes.c_void_p)
         state.describe = self._describe_callback
+        state.rewritable, state.rewritable_size = ram  # MCU-28: code in RAM is costed each time it runs
         self.sleeping = False
         self.active: list[int] = []  # active exceptions, outermost first
         self.pending: set[int] = set()
@@ -739,14 +744,17 @@ class CortexM:
         self._held: list[hook.Held] = []  # the peripherals' held registers (MCU-25)
         self._idle: dict[int, bool] = {}  # address: the instruction there is ``b .``
         self._sleeps: dict[int, bool] = {}  # address: the instruction before it is WFI or WFE
-        # (address, size) of a block: its cost, countdown register (MCU-11), whether a pure poll loop (MCU-10)
-        self._blocks: dict[tuple[int, int], tuple[tuple[int, int], int, bool]] = {}
+        # (address, size, code in RAM or b"": MCU-28) of a block: its cost, countdown register (MCU-11), whether a
+        # pure poll loop (MCU-10)
+        self._blocks: dict[tuple[int, int, bytes], tuple[tuple[int, int], int, bool]] = {}
         self.skip_polls = True
         self.vtor = 0
         self.systick = SysTick(self)
         self._scs_words: dict[int, int] = {}
         self.mmio(SCS_BASE, SCS_SIZE, self._scs_read, self._scs_write)
         self._hook(ucc.UC_HOOK_BLOCK, native.supi3_block_hook, data=ctypes.byref(state))
+        self._hook(ucc.UC_HOOK_MEM_WRITE, native.supi3_code_written, flash[0], flash[0] + flash[1] - 1,
+                   ctypes.byref(state))  # MCU-28: a store into flash may change code  # fmt: skip
         on_idle_loop = _HOOK_CODE(self._on_idle_loop)
         for address in idle_loops(self.image, flash):  # MCU-4: the core stops at its first ``b .``
             self._hook(ucc.UC_HOOK_CODE, on_idle_loop, address, address)
@@ -818,12 +826,24 @@ class CortexM:
             raise self._unmapped(address, size) from None
 
     def write_bytes(self, address: int, data: bytes) -> None:
-        """Write memory (RAM) from the host, between runs; an :class:`ArgumentError` if any of it is not mapped."""
+        """Write memory (RAM) from the host, between runs; an :class:`ArgumentError` if any of it is not mapped. Code
+        written so runs as written: the emulator's translations of it are dropped (MCU-28)."""
         check_int("address", address, 0, 0xFFFF_FFFF, "the 32-bit address space")
         try:
             self.uc.mem_write(address, check_bytes("data", data))
         except UcError:
             raise self._unmapped(address, len(data)) from None
+        if not data:
+            return
+        self.uc.ctl_remove_cache(address, address + len(data))  # unicorn keeps running its old translation otherwise
+        if not (self._rewritable(address) and self._rewritable(address + len(data) - 1)):  # code in flash: costed anew
+            self._forget_code()
+
+    def _forget_code(self) -> None:
+        """Code in flash has changed (MCU-28): every block is costed anew, every memo of code is dropped."""
+        ctypes.memset(self._cache, 0, ctypes.sizeof(self._cache))
+        for memo in (self._blocks, self._costs, self._sleeps, self._idle):
+            memo.clear()
 
     def _unmapped(self, address: int, size: int) -> ArgumentError:
         memories = ", ".join(f"{name} {base:08X}h to {base + length - 1:08X}h"
@@ -895,7 +915,7 @@ class CortexM:
 
     @deadline.setter
     def deadline(self, value: int) -> None:
-        self._state.deadline = value
+        self._state.deadline = check_int("deadline", value, 0, MAX_DEADLINE, "core cycles: MAX_DEADLINE (MCU-28)")
 
     @property
     def stop_request(self) -> bool:
@@ -933,7 +953,9 @@ class CortexM:
             key = (address, pc - address)
             cost = self._costs.get(key)
             if cost is None:
-                cost = self._costs[key] = block_cost(self.read_bytes(address, pc - address))
+                cost = block_cost(self.read_bytes(address, pc - address))
+                if not self._rewritable(address):  # code in RAM may change (MCU-28)
+                    self._costs[key] = cost
             start += cost[1]
         if start > state.handed:
             state.handed = start
@@ -1088,23 +1110,33 @@ class CortexM:
         whether it is a pure poll loop (MCU-10) into the cache and :attr:`hook.State.fresh`; 1 (stop the run) if its
         code cannot be read."""
         try:
-            block = self._blocks.get((address, size))
+            rewritable = self._rewritable(address)
+            key = (address, size, self.read_bytes(address, size) if rewritable else b"")
+            block = self._blocks.get(key)
             if block is None:
-                code = self.read_bytes(address, size)
-                block = self._blocks[address, size] = (block_cost(code), countdown_register(code),
-                                                       is_poll_loop(code, address))  # fmt: skip
+                code = key[2] or self.read_bytes(address, size)
+                block = self._blocks[key] = (block_cost(code), countdown_register(code),
+                                             is_poll_loop(code, address))  # fmt: skip
             (instructions, cycles), countdown, poll = block
-            self._state.fresh = self._cache[(address >> 1) & (len(self._cache) - 1)] = \
-                hook.Block(address, size, instructions, cycles, countdown, poll)  # fmt: skip
+            self._state.fresh = fresh = hook.Block(address, size, instructions, cycles, countdown, poll)
+            if not rewritable:  # the native hook never takes a block in RAM from its cache (MCU-28)
+                self._cache[(address >> 1) & (len(self._cache) - 1)] = fresh
             return 0
         except BaseException as error:  # handed to the run loop, raised there (an escape would be lost in ctypes)
             self.fail(error)
             return 1
 
+    def _rewritable(self, address: int) -> bool:
+        """Code at ``address`` may be rewritten by the firmware as it runs: it is in RAM (MCU-28)."""
+        return 0 <= address - self.ram[0] < self.ram[1]
+
     def _on_idle_loop(self, handle: int, address: int, size: int, data: int) -> None:
         """A ``b .`` is about to run (its block counted): stop there, at its first iteration, whatever the deadline;
-        the run loop takes it for a wait in thread mode and a hang in a handler (MCU-4)."""
-        del address, size, data
+        the run loop takes it for a wait in thread mode and a hang in a handler (MCU-4); unless the firmware has
+        written other code there since (MCU-28)."""
+        del size, data
+        if not self._idle_at(address):
+            return
         self.stop_request = True
         _LIB.uc_emu_stop(handle)
 
@@ -1127,7 +1159,7 @@ class CortexM:
 
         A pending exception that may preempt (B1.5.4) is entered first; a sleeping core (WFI, or ``b .`` in thread
         mode: MCU-4) only lets the time pass."""
-        self.deadline = check_int("deadline", deadline, 0, limit="core cycles")
+        self.deadline = deadline
         number = self._takeable()
         if number is not None:
             self.enter(number)
@@ -1144,6 +1176,9 @@ class CortexM:
             raise FirmwareFaultError(self._fault(error)) from None
         finally:
             self._running = False
+        if self._state.code_written:  # the firmware stored into flash (MCU-28)
+            self._state.code_written = 0
+            self._forget_code()
         failure = self.error
         if failure is not None:
             self.error = None
@@ -1168,9 +1203,11 @@ class CortexM:
             what = "a breakpoint (BKPT)" if number == EXCP_BKPT else f"core exception {number}"
             raise FirmwareStoppedError(self.report(Stop.FAULT, f"{what}: not modelled"))
         if pc == self._state.block_end:
-            sleeps = self._sleeps.get(pc)  # the code does not change (as the block costs)
+            sleeps = self._sleeps.get(pc)  # the code in flash does not change (as the block costs; MCU-28)
             if sleeps is None:
-                sleeps = self._sleeps[pc] = self.read_bytes(pc - 2, 2) in (b"\x30\xbf", b"\x20\xbf")
+                sleeps = self.read_bytes(pc - 2, 2) in (b"\x30\xbf", b"\x20\xbf")
+                if not self._rewritable(pc):
+                    self._sleeps[pc] = sleeps
             if sleeps:
                 self.sleeping = True  # the last block ended in WFI or WFE: unicorn halts the core after them
                 return "sleep"
@@ -1180,8 +1217,11 @@ class CortexM:
 
     def idle_loop(self) -> bool:
         """The core sits on ``b .`` (a branch to itself): in thread mode it waits for an interrupt (MCU-4)."""
-        pc = self.pc
-        idle = self._idle.get(pc)  # the code does not change (as the block costs)
+        return self._idle_at(self.pc)
+
+    def _idle_at(self, pc: int) -> bool:
+        """The instruction at ``pc`` in flash is ``b .`` (memoised until code in flash changes, MCU-28)."""
+        idle = self._idle.get(pc)
         if idle is None:
             idle = self._idle[pc] = bool(self.flash[0] <= pc < self.flash[0] + self.flash[1] - 1 and
                                          self.read_bytes(pc, 2) == _IDLE_LOOP)  # fmt: skip

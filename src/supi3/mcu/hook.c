@@ -7,7 +7,8 @@
  * The block hook does what MCU-1, MCU-10 and MCU-11 say, to the cycle:
  *   - refuse the block (uc_emu_stop) on a stop request or at the deadline: it is the first of the next run;
  *   - otherwise take its cost (instructions, cycles) from a cache filled by Python's block_cost; a block not in the
- *     cache calls Python's `describe` once, which fills the cache and `fresh`;
+ *     cache calls Python's `describe` once, which fills the cache and `fresh`; a block in RAM calls it each time it
+ *     runs (MCU-28: the firmware may have rewritten it);
  *   - a poll loop whose status was just read (skip_address) counts its iterations up to the status change or the
  *     deadline without running them (MCU-10); a countdown block (SUBS Rd, Rd, #1; BNE) counts all but its last
  *     iteration up to the deadline and writes Rd back (MCU-11);
@@ -17,6 +18,7 @@
  * SR while a byte shifts) is answered here, as the peripheral would answer it, and so is one read of a register the
  * peripheral offers from a cycle on (SPI1's DR once its byte has ended, MCU-26); every other read goes to Python.
  */
+#include <stddef.h>
 #include <stdint.h>
 
 typedef struct {
@@ -57,11 +59,26 @@ typedef struct {
     uc_reg_fn reg_read;
     uc_reg_fn reg_write;
     describe_fn describe;   /* nonzero: Python failed, stop */
+    uint64_t rewritable;    /* MCU-28: blocks from this address (the RAM's base) ... */
+    uint64_t rewritable_size; /* ... up to this many bytes on are never taken from the cache: `describe` each run */
+    uint32_t code_written;  /* MCU-28: the firmware stored into flash: CortexM forgets every cost of code */
 } supi3_state;
 
+/* MCU-28: the cycles up to the deadline as a signed count: a deadline in the past is none, and one more than 2^63 - 1
+ * cycles away (CortexM keeps deadlines to MAX_DEADLINE, but the state is written from outside) is 2^63 - 1: the
+ * unsigned difference never turns negative and stops the skips. */
+static int64_t until_deadline(const supi3_state *s) {
+    if (s->cycles >= s->deadline) {
+        return 0;
+    }
+    uint64_t left = s->deadline - s->cycles;
+    return left > (uint64_t)INT64_MAX ? INT64_MAX : (int64_t)left;
+}
+
 static int64_t ceil_div(int64_t numerator, int64_t denominator) {
-    /* denominator > 0; C division truncates toward zero, which is the ceiling for a negative numerator */
-    return numerator >= 0 ? (numerator + denominator - 1) / denominator : numerator / denominator;
+    /* denominator > 0; C division truncates toward zero, which is the ceiling for a negative numerator; no sum that
+     * could pass INT64_MAX (MCU-28) */
+    return numerator / denominator + (numerator > 0 && numerator % denominator != 0);
 }
 
 static int64_t at_least_zero(int64_t value) { return value > 0 ? value : 0; }
@@ -70,7 +87,7 @@ static int64_t smaller(int64_t a, int64_t b) { return a < b ? a : b; }
 
 static void skip_polls(supi3_state *s, const supi3_block *cost, uint64_t until) {
     int64_t cycles = cost->cycles;
-    int64_t before_deadline = ceil_div((int64_t)(s->deadline - s->cycles), cycles);
+    int64_t before_deadline = ceil_div(until_deadline(s), cycles);
     int64_t reading_early = ceil_div((int64_t)until - cycles - (int64_t)s->cycles, cycles);
     int64_t skipped = at_least_zero(smaller(before_deadline, reading_early));
     s->instructions += (uint64_t)skipped * cost->instructions;
@@ -83,8 +100,7 @@ static int skip_countdown(supi3_state *s, void *uc, const supi3_block *cost) {
     uint64_t left = 0;
     s->reg_read(uc, regid, &left);
     left &= 0xFFFFFFFFu;
-    int64_t skipped = at_least_zero(smaller((int64_t)left - 1, ceil_div((int64_t)(s->deadline - s->cycles),
-                                                                       cost->cycles)));
+    int64_t skipped = at_least_zero(smaller((int64_t)left - 1, ceil_div(until_deadline(s), cost->cycles)));
     if (skipped) {
         uint64_t value = left - (uint64_t)skipped;
         s->reg_write(uc, regid, &value);
@@ -101,7 +117,8 @@ void supi3_block_hook(void *uc, uint64_t address, uint32_t size, void *data) {
         return;
     }
     const supi3_block *cost = &s->cache[(address >> 1) & s->mask];
-    if (cost->size != size || cost->address != address || size == 0) {
+    if (cost->size != size || cost->address != address || size == 0
+        || address - s->rewritable < s->rewritable_size) { /* MCU-28: code in RAM may have been rewritten */
         if (s->describe(address, size)) {
             s->emu_stop(uc);
             return;
@@ -140,6 +157,19 @@ void supi3_exact_pc(void *uc, int type, uint64_t address, int size, int64_t valu
     (void)value;
     s->access_pc = 0;
     s->reg_read(uc, s->pc_register, &s->access_pc);
+}
+
+/* MCU-28: the memory hook of flash (uc_cb_hookmem_t). A store there may change code whose cost the cache holds: the
+ * run stops at the end of the block and CortexM forgets every cost of code before the next. */
+void supi3_code_written(void *uc, int type, uint64_t address, int size, int64_t value, void *data) {
+    supi3_state *s = (supi3_state *)data;
+    (void)uc;
+    (void)type;
+    (void)address;
+    (void)size;
+    (void)value;
+    s->code_written = 1;
+    s->stop_request = 1;
 }
 
 /* A register value a peripheral holds while the read's time is before `until` (MCU-25). */
@@ -201,3 +231,25 @@ uint64_t supi3_held_read(void *uc, uint64_t offset, unsigned size, void *data) {
     }
     return h->slow(uc, offset, size, 0);
 }
+
+/* The layout of the structs above as this compiler lays them out: the number of values after it, the struct's size, then each
+ * field's offset in the order of its declaration. supi3.mcu.hook checks its ctypes mirrors against them when it loads
+ * the library (MCU-25): a mismatch is a NativeHookError, not memory written at the wrong place. */
+#define AT(type, field) (uint32_t) offsetof(type, field)
+const uint32_t supi3_block_layout[] = {7, sizeof(supi3_block), AT(supi3_block, address), AT(supi3_block, size),
+                                       AT(supi3_block, instructions), AT(supi3_block, cycles),
+                                       AT(supi3_block, countdown), AT(supi3_block, poll)};
+const uint32_t supi3_state_layout[] = {
+    27, sizeof(supi3_state), AT(supi3_state, cycles), AT(supi3_state, instructions), AT(supi3_state, deadline),
+    AT(supi3_state, block_start), AT(supi3_state, block_address), AT(supi3_state, block_end),
+    AT(supi3_state, skip_until), AT(supi3_state, skip_address), AT(supi3_state, handed),
+    AT(supi3_state, skip_pending), AT(supi3_state, stop_request), AT(supi3_state, skip_polls), AT(supi3_state, mask),
+    AT(supi3_state, block_poll), AT(supi3_state, cache), AT(supi3_state, fresh), AT(supi3_state, access_pc),
+    AT(supi3_state, low_registers), AT(supi3_state, pc_register), AT(supi3_state, emu_stop),
+    AT(supi3_state, reg_read), AT(supi3_state, reg_write), AT(supi3_state, describe), AT(supi3_state, rewritable),
+    AT(supi3_state, rewritable_size), AT(supi3_state, code_written)};
+const uint32_t supi3_held_layout[] = {
+    17, sizeof(supi3_held), AT(supi3_held, state), AT(supi3_held, slow), AT(supi3_held, until), AT(supi3_held, offset),
+    AT(supi3_held, value), AT(supi3_held, held), AT(supi3_held, poll), AT(supi3_held, after),
+    AT(supi3_held, has_after), AT(supi3_held, once_from), AT(supi3_held, once_at), AT(supi3_held, once_offset),
+    AT(supi3_held, once_value), AT(supi3_held, once), AT(supi3_held, taken), AT(supi3_held, once_then)};

@@ -9,7 +9,9 @@ docs/assumptions/mcu.md. The C source ships with the package; :func:`library` co
 into the native build cache (:func:`supi3.sdk.native.default_cache_dir`), keyed by the source, the flags, the
 compiler's version and the machine, and loads it with ctypes. Parallel processes (pytest-xdist workers) each build
 into a temporary file of the cache folder and rename it into place: a process sees no file or a whole one. The
-library links against nothing: the unicorn functions it calls are pointers in :class:`State`.
+library links against nothing: the unicorn functions it calls are pointers in :class:`State`. Before it is used, a
+cached file is checked whole (:func:`check_whole`) and its structs' layout against the ctypes mirrors
+(:func:`check_layout`; MCU-28).
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import hashlib
 import importlib.metadata
 import os
 import platform
+import struct
 import subprocess
 import sys
 import tempfile
@@ -29,7 +32,7 @@ from supi3.errors import Supi3Error
 from supi3.sdk.native import default_cache_dir
 
 __all__ = ["DESCRIBE", "FLAGS", "MMIO_READ", "SOURCE", "Block", "Held", "NativeHookError", "State", "cached_path",
-           "library"]
+           "check_layout", "check_whole", "layout", "library", "native_layout"]
 
 SOURCE: Final[Path] = Path(__file__).with_name("hook.c")
 FLAGS: Final[tuple[str, ...]] = ("-shared", "-fPIC", "-O2", "-target", "native", "-mcpu=baseline", "-nostdlib",
@@ -83,6 +86,9 @@ class State(ctypes.Structure):
         ("reg_read", ctypes.c_void_p),
         ("reg_write", ctypes.c_void_p),
         ("describe", DESCRIBE),
+        ("rewritable", ctypes.c_uint64),
+        ("rewritable_size", ctypes.c_uint64),
+        ("code_written", ctypes.c_uint32),
     )
 
 
@@ -111,6 +117,37 @@ class Held(ctypes.Structure):
 
 
 _LOADED: list[ctypes.CDLL] = []
+_LAYOUTS: Final[dict[str, type[ctypes.Structure]]] = {"supi3_block_layout": Block, "supi3_state_layout": State,
+                                                      "supi3_held_layout": Held}  # fmt: skip
+"""hook.c's layout tables and their ctypes mirrors."""
+
+
+def layout(structure: type[ctypes.Structure]) -> list[int]:
+    """``structure``'s size and its fields' offsets in ctypes, in the order of hook.c's layout tables."""
+    fields: tuple[tuple[str, object], ...] = structure._fields_  # type: ignore[assignment]
+    return [ctypes.sizeof(structure), *(getattr(structure, name).offset for name, _ in fields)]
+
+
+def native_layout(loaded: ctypes.CDLL, table: str) -> list[int]:
+    """A layout table of the loaded library (``supi3_block_layout``, ...): the struct's size and its fields'
+    offsets as the C compiler laid them out."""
+    count = ctypes.c_uint32.in_dll(loaded, table).value
+    return list((ctypes.c_uint32 * (count + 1)).in_dll(loaded, table))[1:]
+
+
+def check_layout(loaded: ctypes.CDLL, name: str) -> None:
+    """:class:`NativeHookError` unless each struct the library shares with Python has, field by field, the offsets
+    and size of its ctypes mirror (a library of another source or ABI would write the wrong memory)."""
+    for table, structure in _LAYOUTS.items():
+        try:
+            native = native_layout(loaded, table)
+        except ValueError:
+            raise NativeHookError(f"the native block hook {name} has no {table} (MCU-25): not built from "
+                                  f"{SOURCE}") from None  # fmt: skip
+        if native != layout(structure):
+            raise NativeHookError(f"the native block hook {name} lays out {structure.__name__} as {native} (size, "
+                                  f"offsets), ctypes as {layout(structure)} (MCU-25): built from another source or "
+                                  "for another ABI")  # fmt: skip
 
 
 def _compiler_version() -> str:
@@ -121,6 +158,35 @@ def _compiler_version() -> str:
                               "pip install supi3[firmware])") from None  # fmt: skip
 
 
+_ELF: Final[dict[int, tuple[str, int, str]]] = {1: ("IIIHHHHHH", 0x1C, "IIIIII"), 2: ("QQQIHHHHHH", 0x18, "IIQQQQ")}
+"""ELF class (32, 64 bit): the header from e_entry on and its offset, a program header's fields up to p_filesz (ELF
+specification, "ELF Header", "Program Header")."""
+
+
+def check_whole(path: Path) -> None:
+    """:class:`NativeHookError` if the ELF file ``path`` ends before its program's segments or its section header
+    table do: a cut-short library (a full disk, a copy broken off) that the loader may crash on instead of failing
+    (MCU-28). A file of another format is left to the loader."""
+    data = path.read_bytes()
+    if data[:4] != b"\x7fELF" or len(data) < 6 or data[4] not in _ELF or data[5] not in (1, 2):
+        return
+    header, at, program = _ELF[data[4]]
+    order = "<" if data[5] == 1 else ">"
+    try:
+        _entry, phoff, shoff, _flags, _size, phentsize, phnum, shentsize, shnum, _names = \
+            struct.unpack_from(order + header, data, at)  # fmt: skip
+        ends = [phoff + phentsize * phnum, shoff + shentsize * shnum]
+        for k in range(phnum):
+            fields = struct.unpack_from(order + program, data, phoff + k * phentsize)
+            offset, filesz = (fields[1], fields[4]) if data[4] == 1 else (fields[2], fields[5])
+            ends.append(offset + filesz)
+    except struct.error:
+        ends = [len(data) + 1]
+    if max(ends) > len(data):
+        raise NativeHookError(f"the native block hook {path} is cut short: {len(data)} bytes, its ELF headers name "
+                              f"{max(ends)} (MCU-28); delete it to build it again")  # fmt: skip
+
+
 def cached_path() -> Path:
     """Where :func:`library` keeps the build: the native build cache, named by the hash of the source, the flags,
     the compiler's version and the machine; :class:`NativeHookError` if there is no compiler."""
@@ -128,7 +194,8 @@ def cached_path() -> Path:
     for part in (SOURCE.read_bytes(), _compiler_version().encode(), *(flag.encode() for flag in FLAGS),
                  platform.machine().encode(), sys.platform.encode()):  # fmt: skip
         digest.update(part + b"\0")
-    return default_cache_dir() / f"_supi3_mcu_hook_{digest.hexdigest()[:20]}.so"
+    # absolute: a bare file name (SUPI3_NATIVE_CACHE=.) would send the loader to the system's library path
+    return default_cache_dir().absolute() / f"_supi3_mcu_hook_{digest.hexdigest()[:20]}.so"
 
 
 def library() -> ctypes.CDLL:
@@ -152,11 +219,16 @@ def library() -> ctypes.CDLL:
                 raise NativeHookError(f"the native block hook does not build (MCU-25): {' '.join(command)}\n"
                                       f"{result.stderr}")  # fmt: skip
             os.replace(work, target)
+        except OSError as error:  # the place of the library taken by a folder, a full disk, ...
+            raise NativeHookError(f"the native block hook cannot be put at {target} (MCU-25): {error}") from error
         finally:
             Path(work).unlink(missing_ok=True)
+    check_whole(target)
     try:
         loaded = ctypes.CDLL(str(target))
     except OSError as error:
-        raise NativeHookError(f"the native block hook {target} does not load (MCU-25): {error}") from error
+        raise NativeHookError(f"the native block hook {target} does not load (MCU-25): {error}; delete it to "
+                              "build it again") from error  # fmt: skip
+    check_layout(loaded, str(target))
     _LOADED.append(loaded)
     return loaded

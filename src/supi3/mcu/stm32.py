@@ -18,6 +18,7 @@ from supi3.errors import Supi3Error
 
 __all__ = [
     "AFIO_BASE",
+    "APB2RSTR",
     "EXTI0_IRQ",
     "EXTI_BASE",
     "GPIOA_BASE",
@@ -28,6 +29,7 @@ __all__ = [
     "Exti",
     "Gpio",
     "PeripheralClockError",
+    "PeripheralResetError",
     "Rcc",
     "ReadOffer",
     "Spi",
@@ -46,6 +48,8 @@ PERIPHERAL_SIZE: Final[int] = 0x400
 EXTI0_IRQ: Final[int] = 6
 """The EXTI line 0 interrupt in the STM32F10x vector table (RM0008 10.1.2, Table 63)."""
 
+APB2RSTR: Final[int] = 0x0C
+"""RCC_APB2RSTR (RM0008 7.3.4): a peripheral's reset bit is at the place of its clock enable bit in APB2ENR."""
 APB2ENR: Final[int] = 0x18
 AFIOEN: Final[int] = 1 << 0
 IOPAEN: Final[int] = 1 << 2
@@ -75,6 +79,11 @@ class PeripheralClockError(Supi3Error, RuntimeError):
     does nothing, here it stops the run (MCU-7)."""
 
 
+class PeripheralResetError(Supi3Error, RuntimeError):
+    """The firmware touched SPI1 while RCC_APB2RSTR holds it in reset, or reset it while a byte shifts (RM0008 7.3.4):
+    the access would be lost, the cut byte is not modelled; here it stops the run (MCU-29)."""
+
+
 class Rcc:
     """RCC with the APB2 clock enables only (MCU-7: the clock tree is not modelled, SYSCLK = PCLK2 = the core
     clock from reset)."""
@@ -84,6 +93,8 @@ class Rcc:
         self._other: dict[int, int] = {}
         self.on_enable_change: list[Callable[[], None]] = []
         """Called when APB2ENR is written: a peripheral whose register the core answers natively takes it back."""
+        self.on_reset: list[Callable[[int], None]] = []
+        """Called with the value when APB2RSTR is written: a peripheral whose bit is set resets (MCU-29)."""
 
     def require(self, bit: int, name: str) -> None:
         """Raise :class:`PeripheralClockError` unless APB2ENR has ``bit``."""
@@ -104,6 +115,9 @@ class Rcc:
             for changed in self.on_enable_change:
                 changed()
         else:
+            if offset == APB2RSTR:
+                for reset in self.on_reset:
+                    reset(value)
             self._other[offset] = value
 
 
@@ -344,7 +358,33 @@ class Spi:
         self.offer: ReadOffer = _NoHolder()
         """Told when the read of DR after the shifting byte is known (the same register of the core, MCU-26)."""
         self._holding = False
+        self._in_reset = False
         rcc.on_enable_change.append(self._release)
+        rcc.on_reset.append(self._reset)
+
+    def _reset(self, apb2rstr: int) -> None:
+        """RCC_APB2RSTR written (RM0008 7.3.4, MCU-29): with SPI1RST set, SPI1's registers and state go to their reset
+        values (25.5: CR1, CR2 0, SR 0002h, DR 0) and stay there until the bit is cleared; a byte shifting at the
+        write is a :class:`PeripheralResetError` (its cut is not modelled: the other end took it whole)."""
+        self._release()
+        self._in_reset = bool(apb2rstr & SPI1EN)
+        if not self._in_reset:
+            return
+        cycles = self.now()
+        self._run(cycles)
+        if self.shifting is not None:
+            raise PeripheralResetError(f"SPI1 reset (RCC_APB2RSTR bit {SPI1EN.bit_length() - 1}) at cycle {cycles} "
+                                       "while a byte shifts: a cut byte is not modelled (RM0008 7.3.4, MCU-29)")
+        self.cr1 = self.cr2 = self.rx_last = 0
+        self.modf = self.ovr = self._ovr_seen = False
+        self.rx_buffer = self.tx_buffer = None
+
+    def _accessible(self) -> None:
+        """Raise unless SPI1's clock is on and RCC does not hold it in reset (MCU-7, MCU-29)."""
+        self.rcc.require(SPI1EN, "SPI1")
+        if self._in_reset:
+            raise PeripheralResetError(f"SPI1 accessed while RCC_APB2RSTR bit {SPI1EN.bit_length() - 1} holds it in "
+                                       "reset (RM0008 7.3.4, MCU-29)")  # fmt: skip
 
     def _release(self) -> None:
         if self._holding:
@@ -406,7 +446,7 @@ class Spi:
         """CR1, CR2, SR, DR (reading DR clears RXNE; reading SR after DR clears OVR, 25.3.10)."""
         del size
         self._release()
-        self.rcc.require(SPI1EN, "SPI1")
+        self._accessible()
         if offset == SPI_CR1:
             return self.cr1
         if offset == SPI_CR2:
@@ -445,7 +485,7 @@ class Spi:
         """CR1 (MODF check on enabling), CR2, DR (into the transmit buffer; starts a transfer if idle)."""
         del size
         self._release()
-        self.rcc.require(SPI1EN, "SPI1")
+        self._accessible()
         cycles = self.now()
         self._run(cycles)
         if offset == SPI_CR1:
