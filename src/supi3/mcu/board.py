@@ -449,7 +449,7 @@ class Board:
     def _seconds(self, cycles: int) -> float:
         return cycles / self.core.cpu_hz
 
-    def sync(self, cycles: int, event: int | None = None) -> None:
+    def _sync(self, cycles: int, event: int | None = None) -> None:
         """Run the bus up to core cycle ``cycles``, then follow /IRQ; ``event``: the cycle of the bus event passed
         on the way, when /IRQ changed if it did."""
         bench = self._bench
@@ -460,7 +460,7 @@ class Board:
 
     def _now(self) -> int:
         cycles = self.core.cycles_now()
-        self.sync(cycles)
+        self._sync(cycles)
         return cycles
 
     # -- /IRQ, EXTI0 and the NVIC ------------------------------------------------------------------------------
@@ -587,7 +587,7 @@ class Board:
 
     def spi_byte(self, tx: int, bits: int, start: int, period: int, cr1: int) -> int:
         """:class:`~supi3.mcu.stm32.SpiWire`: SPI1 starts a transfer; the chip sees it inside its /SS frame."""
-        self.sync(start)
+        self._sync(start)
         period_s = self._seconds(period)
         if period_s < self._limits["t0"] * (1 - 1e-9):
             self._violation("Table 3-7 t0", f"SCLK period {period_s * 1e9:.0f} ns, shorter than t0 = "
@@ -651,7 +651,8 @@ class Board:
         FirmwareFaultError
             The core faulted (report: fault type, PC, stacked registers).
         FirmwareStoppedError
-            ``max_instructions`` ran out, or the firmware loops on ``b .`` inside a handler.
+            ``max_instructions`` ran out (checked where the core stops, at basic-block boundaries, so the run may
+            end up to one block past it, MCU-1), or the firmware loops on ``b .`` inside a handler.
         InterfaceViolationError
             In strict mode, the first rule the firmware broke, with a note: bus time, PC and function.
         """
@@ -678,7 +679,7 @@ class Board:
     def _run(self, done: Callable[[], bool], max_instructions: int, end: int | None = None) -> None:
         core = self.core
         self._set_budget(max_instructions)
-        self.sync(core.cycles)
+        self._sync(core.cycles)
         while True:
             core.systick.update()
             self._request()
@@ -690,7 +691,7 @@ class Board:
                 if bound is not None:
                     deadline = min(deadline, bound)
             self._step(deadline)
-            self.sync(core.cycles, event if event <= core.cycles else None)
+            self._sync(core.cycles, event if event <= core.cycles else None)
 
     def _set_budget(self, max_instructions: int) -> None:
         self._budget = check_int("max_instructions", max_instructions, 1)
