@@ -240,3 +240,24 @@ def test_frames_from_levels_finds_every_frame() -> None:
     idle = wire.status_levels(wire.Cycle.DATA, False, 3)
     levels = np.concatenate([idle, wire.reset_levels(1), wire.frame_levels(first), idle, wire.frame_levels(second)])
     assert wire.frames_from_levels(levels) == [first, second]
+
+
+def test_a_receiver_skips_counter_telegrams_between_frames() -> None:
+    """BK-49: a master's receiver takes an ID check telegram while no frame runs as a counter telegram (BK-6, BK-36)
+    and skips it, every byte alike: counter telegrams alone are no frame, and frames between them are found whole;
+    inside a frame an ID check telegram is the frame's check sequence, and a data-cycle check telegram always opens a
+    frame."""
+    counters = wire.telegram_levels([wire.data_telegram(b, Cycle.ID, True) for b in range(256)],
+                                    wire.DATA_TELEGRAM_BITS)  # fmt: skip
+    assert all(wire.is_counter_telegram(t) for t in wire.parse_levels(counters) if isinstance(t, Telegram))
+    assert wire.decode_counter_telegram(wire.counter_telegram(5)) == 5
+    assert wire.frames_from_levels(counters) == []
+    with pytest.raises(InterbusError, match="check sequence"):
+        wire.frame_from_telegrams(wire.parse_levels(counters))
+    first = wire.Frame.build(wire.Cycle.ID, wire.LOOPBACK_BYTES_ON_LINE + b"\x01\x02")
+    second = wire.Frame.build(wire.Cycle.DATA, b"")
+    levels = np.concatenate([counters, wire.frame_levels(first), counters, wire.frame_levels(second), counters])
+    assert wire.frames_from_levels(levels) == [first, second]
+    assert wire.frame_from_telegrams(wire.parse_levels(levels)) == first
+    assert not wire.is_counter_telegram(wire.decode_telegram(wire.status_telegram(Cycle.ID, True),
+                                                             wire.STATUS_TELEGRAM_BITS))  # fmt: skip

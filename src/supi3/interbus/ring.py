@@ -62,7 +62,7 @@ class ErrorKind(Enum):
     LOOPBACK = "loopback"
     """The loopback word is missing or not where the configuration puts it."""
     DEAD_LINE = "dead line"
-    """No telegram came back."""
+    """No frame came back: no telegram, or only counter telegrams (an interrupt in an LBD branch, BK-49)."""
     CONFIGURATION = "configuration"
     """The ID cycle found another configuration than expected, or a reserved length code."""
     PERIPHERAL_FAULT = "peripheral fault"

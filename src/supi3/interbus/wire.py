@@ -516,6 +516,13 @@ def counter_telegram(count: int) -> int:
     return data_telegram(COUNTER_MARK | count, COUNTER_CYCLE, COUNTER_CHECK)
 
 
+def is_counter_telegram(telegram: Telegram) -> bool:
+    """A receiver that no frame runs for takes ``telegram`` as a counter telegram (BK-6, BK-36, BK-49): a data
+    telegram with select = ID and control = check. Working traffic sends one only inside an ID cycle's check sequence
+    (BK-32), so between frames it is a device's count behind a break, never a frame's."""
+    return telegram.data is not None and (telegram.cycle, telegram.check) == (COUNTER_CYCLE, COUNTER_CHECK)
+
+
 def counter_count(byte: int) -> int | None:
     """The count a counter telegram's byte stands for: the count under COUNTER_MARK (1..63), ``COUNTER_MAX`` under
     COUNTER_SATURATED_MARK whatever the count bits; ``None`` for any other byte (BK-6, BK-31)."""
@@ -536,9 +543,7 @@ def decode_counter_telegram(word: int) -> int | None:
         telegram = decode_telegram(word, DATA_TELEGRAM_BITS)
     except TelegramError:
         return None
-    if telegram.data is None or (telegram.cycle, telegram.check) != (COUNTER_CYCLE, COUNTER_CHECK):
-        return None
-    return counter_count(telegram.data)
+    return counter_count(telegram.data) if telegram.data is not None and is_counter_telegram(telegram) else None
 
 
 def count_bit(position: int, level: int, carry: int) -> tuple[int, int]:
@@ -811,8 +816,9 @@ def locate_bit(frame: Frame, bit: int) -> BitLocation:
 def frame_from_telegrams(telegrams: Iterable[Telegram | LineReset]) -> Frame:
     """Assemble the first frame in a received telegram sequence.
 
-    Leading status telegrams are skipped; the frame is the run of data telegrams with the control bit clear,
-    followed by ``CHECK_TELEGRAMS`` data telegrams with it set, all of one cycle type.
+    Leading status telegrams and counter telegrams (:func:`is_counter_telegram`) are skipped; the frame is the run of
+    data telegrams with the control bit clear, followed by ``CHECK_TELEGRAMS`` data telegrams with it set, all of one
+    cycle type.
 
     Raises
     ------
@@ -830,9 +836,9 @@ def frame_from_telegrams(telegrams: Iterable[Telegram | LineReset]) -> Frame:
             _refuse("telegram", "a Telegram or LineReset", t)
         if isinstance(t, LineReset):
             raise InterbusError(rule, t, "INTERBUS reset inside a frame")
+        if cycle is None and not opens_frame(t):
+            continue
         if t.data is None:
-            if cycle is None:
-                continue
             raise InterbusError(rule, t, "status telegram inside a frame")
         if cycle is None:
             cycle = t.cycle
@@ -1037,14 +1043,20 @@ def samples_to_levels(samples: Sequence[int] | LevelArray, bit_rate: int, phase:
     return _levels("samples", samples)[at::cpb]
 
 
+def opens_frame(telegram: Telegram) -> bool:
+    """``telegram`` begins a frame where no frame runs: a data telegram, not a counter telegram (BK-49: a master's
+    receiver, :func:`frame_from_telegrams`, skips counter telegrams between frames as it skips status telegrams)."""
+    return telegram.data is not None and not is_counter_telegram(telegram)
+
+
 def frames_from_levels(levels: Sequence[int] | LevelArray) -> list[Frame]:
     """Every complete frame in a received level sequence, in order; resets and status telegrams between frames
-    are skipped (a receiving master's or testbench's view of a line)."""
+    and counter telegrams between frames are skipped (a receiving master's or testbench's view of a line)."""
     telegrams = [t for t in parse_levels(levels) if isinstance(t, Telegram)]
     frames: list[Frame] = []
-    while any(t.data is not None for t in telegrams):
+    while any(opens_frame(t) for t in telegrams):
         frame = frame_from_telegrams(telegrams)
         frames.append(frame)
-        first = next(i for i, t in enumerate(telegrams) if t.data is not None)
+        first = next(i for i, t in enumerate(telegrams) if opens_frame(t))
         telegrams = telegrams[first + len(frame.data) + CHECK_TELEGRAMS :]
     return frames

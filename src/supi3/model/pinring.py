@@ -498,7 +498,7 @@ class PinRing:
         returned: bytes | None = None
         flags = wire.CntrFlags(True, True)
         frames = [t for t in telegrams if isinstance(t, Telegram) and t.data is not None]
-        if frames:
+        if any(wire.opens_frame(t) for t in frames):  # counter telegrams alone are no frame (BK-49): a dead line
             try:
                 back = wire.frame_from_telegrams(frames)
             except InterbusError:
