@@ -46,6 +46,7 @@ from supi3.mcu.stm32 import (
     Spi,
 )
 from supi3.sdk.native import CACHE_ENV
+from test_mcu_stm32 import Clock
 
 pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
 
@@ -251,16 +252,6 @@ def test_host_writes_into_flash_code_between_runs_are_seen(programs: dict[tuple[
     assert (core.reg("r0"), core.reg("r1"), core.instructions - before) == (1234, 0, 100 + 1)
 
 
-class _Clock:
-    """The time SPI1 sees (``now`` and ``polled``), set by the test."""
-
-    def __init__(self) -> None:
-        self.cycles = 0
-
-    def __call__(self) -> int:
-        return self.cycles
-
-
 class _Native:
     """A HeldRegister stand-in that notes what SPI1 tells the core, and may say the offered DR read was taken."""
 
@@ -290,8 +281,8 @@ class _Echo:
         return tx ^ 0xFF
 
 
-def _spi1() -> tuple[Rcc, Spi, _Clock, _Native]:
-    rcc, clock, native = Rcc(), _Clock(), _Native()
+def _spi1() -> tuple[Rcc, Spi, Clock, _Native]:
+    rcc, clock, native = Rcc(), Clock(), _Native()
     rcc.write(APB2ENR, 4, SPI1EN | IOPAEN)
     spi = Spi(rcc, clock, _Echo(), clock)
     spi.holder = spi.offer = native
