@@ -89,10 +89,11 @@ class LineSource(IntEnum):
     IDLE = 2
 
 
-def silence_limit(time_limit: object) -> int:
-    """The pin-level silence timer's limit ``time_limit`` in clocks, checked: 1 up to :data:`BRANCH_SILENCE_CLOCKS`
-    (BK-3; shorter only so that a test reaches the closure quickly)."""
-    return check_int("time_limit", time_limit, 1, BRANCH_SILENCE_CLOCKS,
+def silence_limit(time_limit: object, name: str = "time_limit") -> int:
+    """The silence limit ``time_limit`` (the parameter ``name``) in clocks, checked: 1 up to
+    :data:`BRANCH_SILENCE_CLOCKS` (BK-3; shorter only so that a test reaches the closure quickly), at both
+    fidelities."""
+    return check_int(name, time_limit, 1, BRANCH_SILENCE_CLOCKS,
                      "the 10 ms of BK-3 in clocks; shorter only to test the closure quickly")  # fmt: skip
 
 CONF_PIN: Final = next(p.pin for p in tables.BUS_TERMINAL_MFP if p.signal == "CONF")

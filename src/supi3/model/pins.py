@@ -92,7 +92,7 @@ from supi3.optical.regulation import OpticalMode
 from supi3.pinlevel import EventLog, Pin
 from supi3.pinout import CORE_OUTPUTS, IB_DIAG_DIVIDER_BITS, OPTICAL_LINE_INPUTS, OPTICAL_REGISTERS, SYNC_STAGES
 from supi3.tables import BIT_RATES, CLOCK_HZ, RESET_MIN_S
-from supi3.terminal import BRANCH_SILENCE_CLOCKS, CONF_PIN, LBST_PIN
+from supi3.terminal import BRANCH_SILENCE_CLOCKS, CONF_PIN, LBST_PIN, silence_limit
 
 __all__ = [
     "IB_DIAG_DIVIDER_BITS",
@@ -197,10 +197,9 @@ class Supi3Pins:
         check_instance("config", config, DeviceConfig)
         if chip is not None and (not isinstance(chip, Supi3) or chip.config != config):
             raise fail("chip", "None or a Supi3 of the same configuration", chip)
-        check_int("branch_silence", branch_silence, 1, BRANCH_SILENCE_CLOCKS,
-                  "the 10 ms of BK-3 in clocks; shorter only to test the closure quickly")  # fmt: skip
+        silence_limit(branch_silence, "branch_silence")
         self.config = config
-        self.chip = chip if chip is not None else Supi3(config)
+        self.chip = chip if chip is not None else Supi3(config, branch_silence=branch_silence)
         self.cpb = wire.clocks_per_bit(config.bit_rate)
         self.mfp_oe = config.mfp_output_mask
         self.log = EventLog()
