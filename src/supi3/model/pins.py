@@ -430,6 +430,7 @@ class Supi3Pins:
         terminal = chip.bus_terminal
         if terminal is not None:
             before, switched_on = terminal.state, terminal.switched_on_commands
+            framing = self._frame.framing
         if chip.bus_terminal is None:
             chip.mfp_in = s.mfp_in
         elif c == self._run_from:  # a BK takes CONF as it is at the first running clock: no edge (BK-20)
@@ -464,7 +465,7 @@ class Supi3Pins:
             branch.quiet(c, terminal.state, self._recording)
             return
         state, closes = branch.edge(c, before, terminal.state, terminal.switched_on_commands != switched_on,
-                                    s.mfp_in, self._recording)  # fmt: skip
+                                    s.mfp_in, framing, self._recording)  # fmt: skip
         if state is not terminal.state:
             terminal.state = state
             chip.revision += 1  # the E LED, LD and the status byte (BK-5, BK-11)
