@@ -23,6 +23,7 @@ from supi3.interbus import wire
 from supi3.interbus.ring import Branch, BranchKind, Ring
 from supi3.interbus.wire import BranchControl
 from supi3.model.blocks.terminal import BranchLines
+from supi3.model.bus_terminal import BusTerminal
 from supi3.model.chip import ChipArgumentError, Supi3
 from supi3.model.pins import Supi3Pins
 from supi3.rtl.counter import CounterLinesRtl
@@ -58,6 +59,12 @@ BAD_CALLS: list[tuple[str, Callable[[], object], type[Exception], str]] = [
     *((f"Supi3Pins(branch_silence={v!r})", lambda v=v: Supi3Pins(terminal("BK-LB").config, branch_silence=bad(v)),
        ArgumentError, "branch_silence must be an integer from 1 to 320000")
       for v in [0, -1, BRANCH_SILENCE_CLOCKS + 1, 1.5, True, "10", None]),
+    # BK-3: the transaction level's silence is shortened the same way, checked by the same rule
+    *((f"Supi3(branch_silence={v!r})", lambda v=v: Supi3(terminal("BK-LB").config, branch_silence=bad(v)),
+       ChipArgumentError, "branch_silence must be an integer from 1 to 320000")
+      for v in [0, -1, BRANCH_SILENCE_CLOCKS + 1, 1.5, True, "10", None]),
+    *((f"BusTerminal(silence={v!r})", lambda v=v: BusTerminal("BK-LB", "11", bad(v)), ArgumentError,
+       "silence must be an integer from 1 to 320000") for v in [0, BRANCH_SILENCE_CLOCKS + 1, 2.0, True]),
     *((f"BranchLines(time_limit={v!r})", lambda v=v: BranchLines("11", 64, False, bad(v)), ArgumentError,
        "time_limit must be an integer from 1 to 320000") for v in [0, -1, BRANCH_SILENCE_CLOCKS + 1, 2.0, True]),
     *((f"BranchLines(rf={v!r})", lambda v=v: BranchLines(bad(v), 64, False), ArgumentError, "rf must be one of")

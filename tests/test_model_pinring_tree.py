@@ -49,9 +49,10 @@ def _bk(kind: BranchKind, rf: str = "11") -> DeviceConfig:
     return decode(BK_STRAPS[kind.terminal], rf=rf, clk_conf=FAST)
 
 
-def tl_tree(kind: BranchKind, m: int, lbst: bool = True) -> Ring:
-    """RB device, BK with ``m`` branch devices of ``kind``, RB device; the MFP inputs of :data:`INPUTS`."""
-    bk = Supi3(_bk(kind))
+def tl_tree(kind: BranchKind, m: int, lbst: bool = True, silence: int | None = None) -> Ring:
+    """RB device, BK with ``m`` branch devices of ``kind``, RB device; the MFP inputs of :data:`INPUTS`; ``silence``
+    shortens the BK's branch silence (BK-3), in clocks, as :func:`pin_tree`'s."""
+    bk = Supi3(_bk(kind)) if silence is None else Supi3(_bk(kind), branch_silence=silence)
     bk.set_mfp_inputs(LBST if lbst else 0)
     chips = [Supi3(_config(ROWS[BranchKind.REMOTE])), *(Supi3(_config(ROWS[kind])) for _ in range(m)),
              Supi3(_config(ROWS[BranchKind.REMOTE]))]  # fmt: skip
@@ -419,7 +420,7 @@ def per_cycle(ring: Ring | PinRing, ops: list[tuple[str, int]]) -> list[object]:
     ID codes, data lengths), every position's IN data and the BK's status byte (its count, BK-5, BK-6). Steps:
     ``off``, ``on``, ``ext`` (``Master.switch_branch``), ``reset`` (``Master.start``: an INTERBUS reset), ``cut``
     (the forward line into ring position ``k``: ``DeadLine(k)`` at transaction level; only while the branch is in
-    the data path)."""
+    the data path), ``wait`` (nothing: only the cycles)."""
     master = Master(ring, locate=False, max_devices=8)
     seen: list[object] = []
 
@@ -440,6 +441,8 @@ def per_cycle(ring: Ring | PinRing, ops: list[tuple[str, int]]) -> list[object]:
                 ring.inject(DeadLine(k))
             elif in_path and isinstance(ring, PinRing):
                 ring.cut(k, True)
+        elif op == "wait":
+            pass
         elif master.config is not None and len(master.config) > 1 and master.config[1].data_bytes == 0:
             master.switch_branch(2, op != "off", extended=op == "ext")
         for _ in range(3):
@@ -469,4 +472,34 @@ def test_a_master_sees_every_cycle_alike_over_any_history(case: tuple[BranchKind
     same count."""
     kind, m = case
     ops = [(op, min(k, 2 + m)) for op, k in ops]
-    assert per_cycle(tl_tree(kind, m), ops) == per_cycle(pin_tree(kind, m), ops)
+    # The same short silence at both (BK-3): a history switching the extended function on and cutting closes (BK-50).
+    assert per_cycle(tl_tree(kind, m, silence=SILENCE), ops) == per_cycle(pin_tree(kind, m, silence=SILENCE), ops)
+
+
+CLOSURES = st.lists(st.tuples(st.sampled_from(["off", "on", "ext", "reset", "cut", "wait"]), st.integers(3, 4)),
+                    min_size=1, max_size=3)  # fmt: skip
+
+
+@settings(max_examples=2, deadline=None, derandomize=True)  # about 4 s an example: pin level is slow
+@given(st.sampled_from(CASES), CLOSURES)
+@example((BranchKind.REMOTE, 1), [])
+@example((BranchKind.LOCAL, 2), [("wait", 3)])
+@example((BranchKind.LBD_MR, 1), [("reset", 3), ("ext", 3), ("cut", 3)])
+@example((BranchKind.LBD_OR, 1), [("off", 3)])
+def test_a_closure_is_seen_alike_cycle_by_cycle_at_both_fidelities(case: tuple[BranchKind, int],
+                                                                   ops: list[tuple[str, int]]) -> None:  # fmt: skip
+    """Issue 12, BK-3, BK-50: with the same short silence at both fidelities (``branch_silence`` in clocks), the
+    branch switched on with the extended function and cut, then any history (``wait``: 3 more cycles), the BK closes
+    its silent branch between the same two cycles at both: the pin-level BK applies a closure only when no frame runs
+    through its frame engine (BK-50), so the master never gets a frame's tail there, and the transaction level counts
+    the silence from the last telegram back, as the pin level. Every cycle's kind, success and diagnostics, the
+    configuration, IN data and the BK's status byte are equal (:func:`per_cycle`), and the BK closed at both."""
+    kind, m = case
+    ops = [("ext", 3), ("cut", 2 + m), *((op, min(k, 2 + m)) for op, k in ops), ("wait", 3), ("wait", 3)]
+    rings: list[Ring | PinRing] = [tl_tree(kind, m, silence=SILENCE), pin_tree(kind, m, silence=SILENCE)]
+    seen = [per_cycle(ring, ops) for ring in rings]
+    assert seen[0] == seen[1]
+    bks = [ring.devices[1] if isinstance(ring, Ring) else ring.devices[1].chip for ring in rings]
+    assert all(isinstance(bk, Supi3) and bk.bus_terminal is not None for bk in bks)
+    closures = [bk.bus_terminal.closures for bk in bks if isinstance(bk, Supi3) and bk.bus_terminal is not None]
+    assert closures[0] == closures[1] >= 1

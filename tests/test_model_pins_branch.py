@@ -11,6 +11,7 @@ the RTL core in lockstep (tests/test_rtl_core_branch.py).
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -158,10 +159,11 @@ SHORT_SILENCE = 3000
 """A silence limit in clocks for the model alone (BK-3's 10 ms is 320,000: the RTL lockstep runs that one)."""
 
 
-def silence_scenario(limit_frames: int, seed: int) -> tuple[CoreScript, int]:
+def silence_scenario(limit_frames: int, seed: int, extra: int = 0) -> tuple[CoreScript, int]:
     """BK-LB, RF = 10, LBST high: the extended function switched on; frames with DI3 repeating the forward line; then
-    DI3 silent at the idle level for ``limit_frames`` data cycles; a status request and the branch switched on
-    again. Returns the script (DI3 in) and the cycle DI3 falls silent."""
+    DI3 silent at the idle level for ``limit_frames`` data cycles (each ``extra`` bytes longer than the BK's: the
+    silence runs out at another point of a cycle); a status request and the branch switched on again. Returns the
+    script (DI3 in) and the cycle DI3 falls silent."""
     config = decode(BK_STRAPS["BK-LB"], rf="10", clk_conf="11")
     script = CoreScript(config, np.random.default_rng(seed))
     script.pins["mfp_in"] = LBST
@@ -169,7 +171,7 @@ def silence_scenario(limit_frames: int, seed: int) -> tuple[CoreScript, int]:
     script.data_cycle(mfp_in=LBST).data_cycle(mfp_in=LBST).data_cycle(mfp_in=LBST)
     silent = len(script.columns()["do1"])
     for _ in range(limit_frames):
-        script.data_cycle(mfp_in=LBST)
+        script.data_cycle(extra, mfp_in=LBST)
     script.id_cycle(wire.command_word(alarm_request=True), mfp_in=LBST).id_cycle(wire.command_word(), mfp_in=LBST)
     script.id_cycle(wire.command_word(branch=BranchControl.ON, quit_peripheral_error=True), mfp_in=LBST)
     columns = script.inputs()
@@ -181,10 +183,20 @@ def silence_scenario(limit_frames: int, seed: int) -> tuple[CoreScript, int]:
     return script, silent
 
 
+def frames(pins: Supi3Pins, columns: Columns) -> npt.NDArray[np.bool_]:
+    """Whether a frame runs through the frame engine of ``pins`` in each cycle of ``columns``, stepped."""
+    names = list(columns)
+    framing = []
+    for values in zip(*(columns[name].tolist() for name in names), strict=True):
+        framing.append(pins._frame.framing)
+        pins.step(dict(zip(names, values, strict=True)))
+    return np.array(framing)
+
+
 def test_the_extended_function_closes_a_silent_branch() -> None:
     """BK-3, BK-20, BK-38 at pin level: while the master's telegrams come back the branch stays open; silent for the
-    limit, the BK closes it (LD lit, DO2 the transmitter's again, the report and ATTN waiting); the master's command
-    switching it on reopens it; step() equals run()."""
+    limit, the BK closes it once the frame running then has ended (BK-50) (LD lit, DO2 the transmitter's again, the
+    report and ATTN waiting); the master's command switching it on reopens it; step() equals run()."""
     script, silent = silence_scenario(4, 7)
     columns = script.columns()
 
@@ -196,9 +208,14 @@ def test_the_extended_function_closes_a_silent_branch() -> None:
     ld = out["mfp_out"] >> LD_PIN & 1
     lit = np.flatnonzero(ld)
     # The last status telegram's stop bit is sampled mid-bit on the synchronised DI3, the watch strobes one clock
-    # later (BK-38) and restarts the timer; the limit's edge closes the branch, LD shows from the next clock.
+    # later (BK-38) and restarts the timer; the silence runs out at the limit's edge, here within a frame: the BK
+    # closes the branch at the first edge without a frame through its frame engine (BK-50), LD shows from the next
+    # clock.
     last_stop_sample = silent + BRANCH_DELAY + SYNC_STAGES - pins.cpb // 2
-    assert lit.size and lit[0] == last_stop_sample + 1 + SHORT_SILENCE + 1
+    due = last_stop_sample + 1 + SHORT_SILENCE
+    framing = frames(make(), columns)
+    assert framing[due]  # the case BK-50 decides
+    assert lit.size and lit[0] == due + int(np.argmin(framing[due:])) + 1 > due + 1
     assert not ld[-1] and lit[-1] - lit[0] + 1 == len(lit)
     closed = out["do2"][lit[0] : lit[-1]]
     assert closed.any()  # the transmitter's again, not the silent DI3's idle level only

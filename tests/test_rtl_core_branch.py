@@ -45,10 +45,13 @@ def test_rtl_core_counts(bench: Lockstep, rf: str, seed: int) -> None:
 
 
 @pytest.mark.slow
-def test_rtl_core_closes_a_silent_branch(bench: Lockstep) -> None:
+@pytest.mark.parametrize("extra", [0, 1])
+def test_rtl_core_closes_a_silent_branch(bench: Lockstep, extra: int) -> None:
     """BK-3 with its 10 ms (320,000 clocks): the extended function closes the silent branch in the RTL core at the
-    model's clock (LD, ATTN, the status byte's bit 6), and the master's command reopens it."""
-    script, silent = silence_scenario(BRANCH_SILENCE_CLOCKS // 2000 + 3, 8)
+    model's clock (LD, ATTN, the status byte's bit 6), and the master's command reopens it. With frames one byte
+    longer (``extra``) the silence runs out within a frame and the closure waits for its end (BK-50; measured with
+    the model: 331 clocks later than without the wait), in the RTL core too."""
+    script, silent = silence_scenario(BRANCH_SILENCE_CLOCKS // 2000 + 3, 8, extra)
     bench.run_batch(script.stimulus())
     out = Supi3Pins(script.config).run(script.columns())
     assert (out["mfp_out"][silent + BRANCH_SILENCE_CLOCKS + 100 :] >> LD_PIN & 1).any()

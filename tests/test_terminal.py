@@ -184,6 +184,24 @@ def test_the_transaction_level_follows_the_spec() -> None:
     assert tl.state == Terminal() and tl.closures == 1
 
 
+
+def test_the_transaction_level_counts_the_silence_from_the_last_telegram_back() -> None:
+    """BK-3 at transaction level, as the pin level's timer (BK-20): the silence counts from the end of the last
+    stretch with the master's telegrams back, also over time no stretch was reported (the BK not reached), and not
+    from the first silent stretch; ``silence`` (in clocks, 100 µs here) shortens it; a command switching the branch
+    on restarts it from the next stretch."""
+    limit = CLOCK_HZ // 10_000
+    tl = BusTerminal("BK-LBD", "00", silence=limit)
+    assert tl.silence_s == limit / CLOCK_HZ == 1e-4
+    tl.command(BranchControl.ON_EXTENDED, False)
+    assert not tl.returned(True, None, 0.0, 0.001)
+    assert not tl.returned(False, None, 0.00105, 0.00109)  # 90 µs after the last telegram back
+    assert tl.returned(False, None, 0.00109, 0.00111) and tl.closed  # 110 µs; the silent stretches span 60 µs
+    tl.command(BranchControl.ON_EXTENDED, False)
+    assert not tl.returned(False, None, 0.002, 0.00209) and not tl.closed
+    assert tl.returned(False, None, 0.00209, 0.00211) and tl.closures == 2
+
+
 HOSTILE = [
     (lambda: conf_level(bad(None), True), "state"),
     (lambda: conf_level(Terminal(), bad(1)), "conf"),

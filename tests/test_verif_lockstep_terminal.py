@@ -34,8 +34,8 @@ OFF, ON, ON_EXT = BranchControl.OFF, BranchControl.ON, BranchControl.ON_EXTENDED
 
 class TerminalScript:
     """Per-cycle inputs of the bus terminal block (``BLOCK_INPUTS``), built call by call: levels (``mode``, ``rf``,
-    ``conf``, ``lbst``, ``connected``) on every row until changed, strobes one cycle wide. It starts with the power-up
-    cycle (the block takes the CONF level at its edge, BK-20)."""
+    ``conf``, ``lbst``, ``connected``, ``framing``) on every row until changed, strobes one cycle wide. It starts with
+    the power-up cycle (the block takes the CONF level at its edge, BK-20)."""
 
     def __init__(self, mode: int = TerminalMode.LBD, *, rf: int = 3, lbst: int = 1, connected: int = 1,
                  conf: int = 0) -> None:  # fmt: skip
@@ -122,6 +122,22 @@ def test_extended_closure_after_the_silence() -> None:
     assert block.state.closed and not block.state.closed_report and not out[-1]["attention"]
     block, out = lockstep(script.command(ON).idle(3 * LIMIT))
     assert block.state == Terminal() and out[-1]["enabled"]
+
+
+def test_a_closure_waits_for_the_end_of_a_frame() -> None:
+    """BK-50: a silence running out while a frame runs through the chip's frame engine (``framing``) closes the branch
+    at the first edge without a frame, however long the frame; the timer holds meanwhile (no second silence), and
+    the master's telegram back in it restarts the silence instead."""
+    for frame in (1, 2, LIMIT + 3):
+        script = TerminalScript().command(ON_EXT).idle(LIMIT - 1).set(framing=1).idle(frame).set(framing=0).idle(2)
+        block, out = lockstep(script)
+        assert block.state.closed and block.state.closed_report
+        assert [row["closed"] for row in out].index(1) == 2 + LIMIT + frame + 1  # the frame's frame + 1 clocks
+    script = TerminalScript().command(ON_EXT).idle(LIMIT - 1).set(framing=1).idle(3).idle(ret_valid=1)
+    block, out = lockstep(script.set(framing=0).idle(LIMIT - 2))
+    assert not block.state.closed and not any(row["closed"] for row in out)
+    block, out = lockstep(script.set(framing=0).idle(LIMIT))
+    assert block.state.closed
 
 
 def test_traffic_restarts_the_silence_and_counter_telegrams_do_not() -> None:
@@ -231,7 +247,7 @@ STROBE = st.fixed_dictionaries({
 })  # fmt: skip
 EVENT = st.one_of(
     st.tuples(st.just("strobe"), STROBE),
-    st.tuples(st.just("levels"), st.integers(0, 1), st.integers(0, 1), st.integers(0, 1)),
+    st.tuples(st.just("levels"), st.integers(0, 1), st.integers(0, 1), st.integers(0, 1), st.integers(0, 1)),
     st.tuples(st.just("command"), st.sampled_from(list(BranchControl))),
     st.tuples(st.just("idle"), st.sampled_from([1, 2, LIMIT - 2, LIMIT - 1, LIMIT, 3 * LIMIT])),
 )
@@ -246,8 +262,8 @@ def random_script(run: tuple[TerminalMode, int, list[tuple[Any, ...]]]) -> Termi
         if name == "strobe":
             script.idle(**args[0])
         elif name == "levels":
-            conf, lbst, connected = args
-            script.set(conf=conf, lbst=lbst, connected=connected)
+            conf, lbst, connected, framing = args
+            script.set(conf=conf, lbst=lbst, connected=connected, framing=framing)
         elif name == "command":
             script.command(args[0])
         else:

@@ -89,10 +89,11 @@ class LineSource(IntEnum):
     IDLE = 2
 
 
-def silence_limit(time_limit: object) -> int:
-    """The pin-level silence timer's limit ``time_limit`` in clocks, checked: 1 up to :data:`BRANCH_SILENCE_CLOCKS`
-    (BK-3; shorter only so that a test reaches the closure quickly)."""
-    return check_int("time_limit", time_limit, 1, BRANCH_SILENCE_CLOCKS,
+def silence_limit(time_limit: object, name: str = "time_limit") -> int:
+    """The silence limit ``time_limit`` (the parameter ``name``) in clocks, checked: 1 up to
+    :data:`BRANCH_SILENCE_CLOCKS` (BK-3; shorter only so that a test reaches the closure quickly), at both
+    fidelities."""
+    return check_int(name, time_limit, 1, BRANCH_SILENCE_CLOCKS,
                      "the 10 ms of BK-3 in clocks; shorter only to test the closure quickly")  # fmt: skip
 
 CONF_PIN: Final = next(p.pin for p in tables.BUS_TERMINAL_MFP if p.signal == "CONF")
@@ -305,7 +306,7 @@ def live(state: Terminal, rf: str | None, lbst: bool) -> bool:
 BLOCK_INPUTS: Final[tuple[Pin, ...]] = (
     Pin("ib_reset"), Pin("mode", 2), Pin("rf", 2), Pin("conf"), Pin("lbst"), Pin("connected"), Pin("cmd_valid"),
     Pin("branch", 2), Pin("ack"), Pin("alarm_set"), Pin("alarm_on"), Pin("ret_valid"), Pin("cnt_valid"),
-    Pin("count", 6),
+    Pin("count", 6), Pin("framing"),
 )  # fmt: skip
 """The bus terminal block's inputs:
 
@@ -316,7 +317,8 @@ MFP12 and MFP11 after the input synchroniser; ``connected`` a device answers on 
 are ``branch`` (a :class:`~supi3.interbus.wire.BranchControl`, bits 7..6), ``ack`` (the quit bit, 0714h), ``alarm_set``
 and ``alarm_on`` (bits 9 and 10 without a processor command, BK-12); ``ret_valid`` one of the master's telegrams (frame
 or status telegram) came back on the branch return line; ``cnt_valid``/``count`` a counter telegram came back there with
-that count (BK-6). Strobes are one clock wide."""
+that count (BK-6); ``framing`` a frame runs through the chip's frame engine (its data or check telegrams: a silence
+running out waits for its end, BK-50). Strobes are one clock wide."""
 
 BLOCK_OUTPUTS: Final[tuple[Pin, ...]] = (
     Pin("enabled"), Pin("live"), Pin("status", 8), Pin("attention"), Pin("ld"), Pin("e"), Pin("alarm"), Pin("closed"),

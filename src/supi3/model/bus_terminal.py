@@ -26,7 +26,9 @@ from dataclasses import replace
 from supi3 import terminal as spec
 from supi3.checks import check_bits, check_bool, check_choice, check_real
 from supi3.interbus.wire import BranchControl
+from supi3.tables import CLOCK_HZ
 from supi3.terminal import (
+    BRANCH_SILENCE_CLOCKS,
     BRANCH_SILENCE_S,
     CONF_PIN,
     LBST_PIN,
@@ -54,6 +56,10 @@ class BusTerminal:
         ``"BK-RB"``, ``"BK-LB"`` or ``"BK-LBD"`` (Table 2-7).
     rf:
         The RF[1..0] straps (Table 2-2), ``None`` without RF pins.
+    silence:
+        The silence of the return line after which the extended function closes the branch (BK-3), in clocks: 1 up to
+        :data:`~supi3.terminal.BRANCH_SILENCE_CLOCKS` (the default, :data:`BRANCH_SILENCE_S`); shorter only to reach
+        the closure quickly in tests, as the pin level's (``Supi3Pins(config, branch_silence=...)``).
 
     Attributes
     ----------
@@ -73,10 +79,12 @@ class BusTerminal:
         reads it).
     """
 
-    def __init__(self, interface: str, rf: str | None) -> None:
+    def __init__(self, interface: str, rf: str | None, silence: int = BRANCH_SILENCE_CLOCKS) -> None:
         self.interface = check_choice("interface", interface, TERMINAL_INTERFACES)
         spec.rf_code(rf)
         self.rf = rf
+        self.silence_s = spec.silence_limit(silence, "silence") / CLOCK_HZ
+        """The silence limit in bus seconds."""
         self.lbst = False
         self.state = Terminal()
         self.closures = 0
@@ -161,17 +169,21 @@ class BusTerminal:
     def returned(self, traffic: bool, count: int | None, start: float, end: float) -> bool:
         """The branch was driven from ``start`` to ``end``: whether the master's telegrams came back on its return
         line (``traffic``) and the count of the counter telegram received there (``None``: none). ``True`` when the
-        extended function closes the branch now (BK-3)."""
+        extended function closes the branch now (BK-3).
+
+        The silence counts from the master's last telegram back, the end of the last stretch with ``traffic`` (the
+        pin level's timer restarts at each telegram back, BK-20), also over time not reported here (the BK not
+        reached); from ``start`` after a power-up, an INTERBUS reset or a command switching the branch on."""
         traffic = check_bool("traffic", traffic)
         start = check_real("start", start, 0.0)
         end = check_real("end", end, start)
         self.state = spec.received(self.state, 0 if count is None else count)
         if traffic:
-            self._silent_since = None
+            self._silent_since = end
             return False
         since = start if self._silent_since is None else self._silent_since
         self._silent_since = since
-        if spec.watching(self.state) and end - since >= BRANCH_SILENCE_S:
+        if spec.watching(self.state) and end - since >= self.silence_s:
             self.state = spec.silence(self.state)
             self.closures += 1
             return True

@@ -48,6 +48,7 @@ from supi3.optical.length import Medium, timer_code
 from supi3.optical.regulation import Interface, OpticalMode, OpticalStatus, Phase, Response
 from supi3.pinout import OPTICAL_REGISTERS
 from supi3.serial_io import SerialDevice, SerialSequence, clear_sequence, sequence
+from supi3.terminal import BRANCH_SILENCE_CLOCKS, silence_limit
 
 CLOCK_HZ: Final = tables.CLOCK_HZ
 _NEVER: Final = 1 << 62
@@ -233,6 +234,11 @@ class Supi3:
         The /StatErr input filter (3.6.2: t3 = 200 ms) in clocks: 1 up to :data:`STATERR_FILTER_CLOCKS` (the default);
         shorter only to reach a peripheral fault quickly in tests at pin level (MCU-24), as ``Supi3Pins``'s
         ``branch_silence``.
+    branch_silence:
+        In the BK modes, the silence of the branch return line after which the extended function closes the branch
+        (BK-3), in clocks: 1 up to :data:`~supi3.terminal.BRANCH_SILENCE_CLOCKS` (the default, 10 ms); shorter only
+        to reach the closure quickly in tests, as ``Supi3Pins``'s ``branch_silence`` (the same value at both
+        fidelities).
 
     Attributes
     ----------
@@ -245,7 +251,8 @@ class Supi3:
 
     __slots__ = (
         "__dict__",  # room beyond the declared state, so that a test can spy on a chip's methods
-        "_chain", "_cpb", "_deadline", "_due_s", "_events", "_exr_driver", "_exr_free", "_fast_valid", "_fixed_bytes",
+        "_branch_silence", "_chain", "_cpb", "_deadline", "_due_s", "_events", "_exr_driver", "_exr_free",
+        "_fast_valid", "_fixed_bytes",
         "_frame_bytes", "_in_map", "_loaded", "_mau_events", "_mau_told", "_now", "_optical", "_optical_driven",
         "_optical_held", "_optical_until", "_out", "_out_map", "_send_alarm", "_send_optical",
         "_serial_pins", "_shown", "_stat_err", "_stat_filter", "_stat_low_since", "_watch_line", "attention",
@@ -259,13 +266,15 @@ class Supi3:
     """The ring's fast path for runs of chips in a data cycle (:class:`supi3.interbus.link.DataKernel`)."""
 
     def __init__(self, config: DeviceConfig | None = None, *, strict: bool = True, pedantic: bool = False,
-                 stat_err_filter: int = STATERR_FILTER_CLOCKS) -> None:  # fmt: skip
+                 stat_err_filter: int = STATERR_FILTER_CLOCKS,
+                 branch_silence: int = BRANCH_SILENCE_CLOCKS) -> None:  # fmt: skip
         if config is not None and not isinstance(config, DeviceConfig):
             _checked(check_instance, "config", config, DeviceConfig, "a DeviceConfig (supi3.config.decode) or None")
         _checked(check_bool, "strict", strict)
         _checked(check_bool, "pedantic", pedantic)
         self._stat_filter = _checked(check_int, "stat_err_filter", stat_err_filter, 1, STATERR_FILTER_CLOCKS,
                                      "the 200 ms of 3.6.2 in clocks; shorter only to test a fault quickly")  # fmt: skip
+        self._branch_silence = _checked(silence_limit, branch_silence, "branch_silence")
         self.config = config if config is not None else decode("10000")
         kind = self.config.mfp_mode.kind
         self.registers = (
@@ -685,8 +694,8 @@ class Supi3:
     def _init_bus_terminal(self) -> None:
         """Power-up: a fresh BK state in the BK modes, taking the MFP input levels as they are (no CONF edge)."""
         interface = self.config.interface
-        self.bus_terminal = BusTerminal(interface.value, self.config.rf_mode.rf if self.config.rf_mode else None) \
-            if interface.is_bus_terminal else None
+        self.bus_terminal = BusTerminal(interface.value, self.config.rf_mode.rf if self.config.rf_mode else None,
+                                        self._branch_silence) if interface.is_bus_terminal else None  # fmt: skip
         if self.bus_terminal is not None:
             self.bus_terminal.inputs(self.mfp_in)
             self.bus_terminal.conf_request = False

@@ -92,7 +92,7 @@ from supi3.optical.regulation import OpticalMode
 from supi3.pinlevel import EventLog, Pin
 from supi3.pinout import CORE_OUTPUTS, IB_DIAG_DIVIDER_BITS, OPTICAL_LINE_INPUTS, OPTICAL_REGISTERS, SYNC_STAGES
 from supi3.tables import BIT_RATES, CLOCK_HZ, RESET_MIN_S
-from supi3.terminal import BRANCH_SILENCE_CLOCKS, CONF_PIN, LBST_PIN
+from supi3.terminal import BRANCH_SILENCE_CLOCKS, CONF_PIN, LBST_PIN, silence_limit
 
 __all__ = [
     "IB_DIAG_DIVIDER_BITS",
@@ -197,10 +197,9 @@ class Supi3Pins:
         check_instance("config", config, DeviceConfig)
         if chip is not None and (not isinstance(chip, Supi3) or chip.config != config):
             raise fail("chip", "None or a Supi3 of the same configuration", chip)
-        check_int("branch_silence", branch_silence, 1, BRANCH_SILENCE_CLOCKS,
-                  "the 10 ms of BK-3 in clocks; shorter only to test the closure quickly")  # fmt: skip
+        silence_limit(branch_silence, "branch_silence")
         self.config = config
-        self.chip = chip if chip is not None else Supi3(config)
+        self.chip = chip if chip is not None else Supi3(config, branch_silence=branch_silence)
         self.cpb = wire.clocks_per_bit(config.bit_rate)
         self.mfp_oe = config.mfp_output_mask
         self.log = EventLog()
@@ -431,6 +430,7 @@ class Supi3Pins:
         terminal = chip.bus_terminal
         if terminal is not None:
             before, switched_on = terminal.state, terminal.switched_on_commands
+            framing = self._frame.framing
         if chip.bus_terminal is None:
             chip.mfp_in = s.mfp_in
         elif c == self._run_from:  # a BK takes CONF as it is at the first running clock: no edge (BK-20)
@@ -465,7 +465,7 @@ class Supi3Pins:
             branch.quiet(c, terminal.state, self._recording)
             return
         state, closes = branch.edge(c, before, terminal.state, terminal.switched_on_commands != switched_on,
-                                    s.mfp_in, self._recording)  # fmt: skip
+                                    s.mfp_in, framing, self._recording)  # fmt: skip
         if state is not terminal.state:
             terminal.state = state
             chip.revision += 1  # the E LED, LD and the status byte (BK-5, BK-11)

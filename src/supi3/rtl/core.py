@@ -415,6 +415,7 @@ class Supi3Core(wiring.Component):
             terminal.ret_valid.eq(lines.returned & terminal.enabled),  # BK-44: only while in the data path
             terminal.cnt_valid.eq(lines.seen & terminal.enabled),
             terminal.count.eq(lines.count),
+            terminal.framing.eq(frame.framing),
             outputs.ld.eq(terminal.ld),
             outputs.e.eq(terminal.e),
             outputs.alarm.eq(terminal.alarm),
@@ -713,7 +714,7 @@ class FrameEngineRtl(wiring.Component):
         super().__init__({
             "line": In(LINE), "register": Out(REGISTER), "management": Out(MANAGEMENT), "tx": Out(TRANSMIT),
             "events": Out(EVENT_BITS), "io": Out(1), "io_set": Out(1), "io_clear": Out(1), "discard": Out(1),
-            "hold": In(1), "ended": Out(1), "lbd": In(1),
+            "hold": In(1), "ended": Out(1), "lbd": In(1), "framing": Out(1),
         })  # fmt: skip
 
     def elaborate(self, _platform: object) -> Module:
@@ -900,6 +901,7 @@ class FrameEngineRtl(wiring.Component):
             in_data.eq(fsm.ongoing("DATA")),
             in_check.eq(fsm.ongoing("CHECK")),
             in_wait.eq(fsm.ongoing("WAIT")),
+            self.framing.eq(in_data | in_check),  # a frame's data or check telegrams (BK-50)
         ]
         return m
 

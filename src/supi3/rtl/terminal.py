@@ -112,7 +112,8 @@ class TerminalRtl(wiring.Component):
         cmd_on = self.cmd_valid & branch_on
         counting = extended & on
         restart = self.ret_valid | cmd_on
-        expired = counting & ~restart & (timer == 1)
+        due = counting & ~restart & (timer == 1)
+        expired = due & ~self.framing  # BK-50: a closure waits for the frame's end, the timer holds
         with m.If(bk):
             with m.If(fresh):  # power_up: the CONF level, no edge
                 sync += [fresh.eq(0), conf.eq(self.conf)]
@@ -140,7 +141,8 @@ class TerminalRtl(wiring.Component):
                         sync += count.eq(0)
                     with m.If(expired & ~cmd_off):  # silence, on the state after the command (watching)
                         sync += [closed.eq(1), closed_report.eq(1)]
-                    sync += timer.eq(Mux(counting & ~restart & ~expired, next_state(timer), idle))
+                    with m.If(~due | expired):  # else the closure waits for the frame's end, the timer holds
+                        sync += timer.eq(Mux(counting & ~restart & ~due, next_state(timer), idle))
         return m
 
 

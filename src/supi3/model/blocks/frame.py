@@ -75,6 +75,12 @@ class FrameEngine:
         "latches", "local_error", "log", "reset_end_count", "state", "transmitter",
     )  # fmt: skip
 
+    @property
+    def framing(self) -> bool:
+        """A frame runs: its data or check telegrams (the RTL's ``framing``; a BK's closure waits for its end,
+        BK-50)."""
+        return self.state in ("data", "check")
+
     def __init__(self, chip: Supi3, log: EventLog, datapath: DataPath, transmitter: Transmitter) -> None:
         self.chip = chip
         self.log = log

@@ -22,7 +22,9 @@ What happens at the clock edge ending a cycle, from that cycle's inputs (:mod:`s
 The silence timer counts edges while the branch is watched: the state before the edge has the extended function on
 and the branch in the data path (:func:`~supi3.terminal.enabled` with this cycle's ``rf``, ``lbst``,
 ``connected``); anything else, a ``ret_valid``, or a command switching the branch on clears it. The edge at which it
-would reach ``time_limit`` (:data:`~supi3.terminal.BRANCH_SILENCE_CLOCKS`) applies the silence and clears it.
+would reach ``time_limit`` (:data:`~supi3.terminal.BRANCH_SILENCE_CLOCKS`) applies the silence and clears it, but
+while ``framing`` (a frame runs through the chip's frame engine, BK-50) the timer holds there and the silence waits
+for the first edge without a frame.
 
 Outputs during a cycle come from the state and this cycle's ``rf``, ``lbst``, ``connected`` (``enabled``; ``live``
 without ``connected``); every one is 0 while ``mode`` is NONE.
@@ -154,7 +156,8 @@ class TerminalBlock:
             return
         branch = BranchControl(v["branch"])
         restart = bool(v["ret_valid"] or (v["cmd_valid"] and restarts_silence(branch)))
-        expired = counting and not restart and self.timer + 1 >= self.time_limit
+        due = counting and not restart and self.timer + 1 >= self.time_limit
+        expired = due and not v["framing"]  # BK-50: a closure waits for the frame's end
         if v["cmd_valid"]:
             state = command(state, branch, bool(v["ack"]), bool(v["alarm_on"]) if v["alarm_set"] else None)
             self.log.add(cycle, "command {} ack={}: {}", branch.name, v["ack"], state)
@@ -165,7 +168,8 @@ class TerminalBlock:
         if expired:
             state = silence(state)
             self.log.add(cycle, "silence over: {}", state)
-        self.timer = self.timer + 1 if counting and not restart and not expired else 0
+        if not due or expired:  # else the closure waits for the frame's end and the timer holds (BK-50)
+            self.timer = self.timer + 1 if counting and not restart and not due else 0
         self.state = state
 
     def recent_events(self) -> list[str]:
@@ -447,13 +451,14 @@ class BranchLines:
         self.timer, self.timer_at = 0, c + 1
         self.counting = recording and self._counts(c + 1, state)
 
-    def edge(self, c: int, before: Terminal, after: Terminal, switched_on: bool, mfp_in: int,
+    def edge(self, c: int, before: Terminal, after: Terminal, switched_on: bool, mfp_in: int, framing: bool,
              recording: bool) -> tuple[Terminal, bool]:
         """The BK's edge ending running cycle ``c`` after the core's (BK-20's order; the chip applied CONF and a
         command there): ``before`` the state before the edge, ``after`` after the core's, ``switched_on`` a command
-        switched the branch on, ``mfp_in`` the synchronised MFP inputs; ``recording``: in a run (the strobes
-        planned). Returns the state after the master's telegram back, the counter telegram and the silence, and
-        whether the silence closed the branch."""
+        switched the branch on, ``mfp_in`` the synchronised MFP inputs, ``framing`` a frame ran through the frame
+        engine in the cycle (a silence running out waits for its end, BK-50; the timer holds); ``recording``: in a
+        run (the strobes planned). Returns the state after the master's telegram back, the counter telegram and the
+        silence, and whether the silence closed the branch."""
         connected = bool(self._connected[c - self._c0]) if recording else self.connected
         ret, cnt, count = self._strobes[c - self._c0].tolist() if recording else self.strobes()
         if self.counting:  # the cycles between a run's visits
@@ -463,7 +468,8 @@ class BranchLines:
             ret = cnt = 0
         counting = before.extended and on
         restart = bool(ret) or switched_on
-        expired = counting and not restart and self.timer + 1 >= self.limit
+        due = counting and not restart and self.timer + 1 >= self.limit
+        expired = due and not framing
         state = after
         if ret:
             state = received(state, 0)
@@ -472,7 +478,8 @@ class BranchLines:
         closes = expired and not (before.switched_on and not after.switched_on) and watching(state)
         if closes:
             state = silence(state)
-        self.timer = self.timer + 1 if counting and not restart and not expired else 0
+        if not due or expired:  # else the closure waits for the frame's end and the timer holds (BK-50)
+            self.timer = self.timer + 1 if counting and not restart and not due else 0
         self.timer_at = c + 1
         self.counting = recording and self._counts(c + 1, state)
         return state, closes
