@@ -495,8 +495,22 @@ def test_a_closure_is_seen_alike_cycle_by_cycle_at_both_fidelities(case: tuple[B
     the silence from the last telegram back, as the pin level. Every cycle's kind, success and diagnostics, the
     configuration, IN data and the BK's status byte are equal (:func:`per_cycle`), and the BK closed at both."""
     kind, m = case
-    ops = [("ext", 3), ("cut", 2 + m), *((op, min(k, 2 + m)) for op, k in ops), ("wait", 3), ("wait", 3)]
-    rings: list[Ring | PinRing] = [tl_tree(kind, m, silence=SILENCE), pin_tree(kind, m, silence=SILENCE)]
+    closes_alike(kind, m, [(op, min(k, 2 + m)) for op, k in ops], SILENCE)
+
+
+def test_a_closure_in_a_frame_s_first_telegram_waits_for_the_frame() -> None:
+    """BK-50: with ``branch_silence`` 10,250 clocks in a BK-LB tree the silence runs out while the BK's transmitter
+    repeats the first data telegram of a frame that its frame engine takes only once the telegram is complete: the
+    closure waits for the frame's end (the receiver's ``repeating``), so the master does not get the frame without
+    its head (a transmission error, where the transaction level reports a dead line)."""
+    closes_alike(BranchKind.LOCAL, 2, [], 10_250)
+
+
+def closes_alike(kind: BranchKind, m: int, ops: list[tuple[str, int]], silence: int) -> None:
+    """The branch of the tree ``kind``, ``m`` switched on with the extended function and cut, then ``ops`` and 6
+    cycles, with the silence ``silence`` (clocks) at both fidelities: every cycle alike, the BK closed at both."""
+    ops = [("ext", 3), ("cut", 2 + m), *ops, ("wait", 3), ("wait", 3)]
+    rings: list[Ring | PinRing] = [tl_tree(kind, m, silence=silence), pin_tree(kind, m, silence=silence)]
     seen = [per_cycle(ring, ops) for ring in rings]
     assert seen[0] == seen[1]
     bks = [ring.devices[1] if isinstance(ring, Ring) else ring.devices[1].chip for ring in rings]

@@ -430,7 +430,9 @@ class Supi3Pins:
         terminal = chip.bus_terminal
         if terminal is not None:
             before, switched_on = terminal.state, terminal.switched_on_commands
-            framing = self._frame.framing
+            # BK-50: a closure waits while a frame runs through the frame engine or the transmitter repeats a data
+            # telegram still being received (a frame's first one is the frame engine's only once complete)
+            framing = self._frame.framing or self._receiver.repeating_data
         if chip.bus_terminal is None:
             chip.mfp_in = s.mfp_in
         elif c == self._run_from:  # a BK takes CONF as it is at the first running clock: no edge (BK-20)

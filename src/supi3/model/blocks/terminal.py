@@ -23,7 +23,8 @@ The silence timer counts edges while the branch is watched: the state before the
 and the branch in the data path (:func:`~supi3.terminal.enabled` with this cycle's ``rf``, ``lbst``,
 ``connected``); anything else, a ``ret_valid``, or a command switching the branch on clears it. The edge at which it
 would reach ``time_limit`` (:data:`~supi3.terminal.BRANCH_SILENCE_CLOCKS`) applies the silence and clears it, but
-while ``framing`` (a frame runs through the chip's frame engine, BK-50) the timer holds there and the silence waits
+while ``framing`` (a frame runs through the chip's frame engine or its transmitter repeats a data telegram being
+received, BK-50) the timer holds there and the silence waits
 for the first edge without a frame.
 
 Outputs during a cycle come from the state and this cycle's ``rf``, ``lbst``, ``connected`` (``enabled``; ``live``
@@ -456,9 +457,9 @@ class BranchLines:
         """The BK's edge ending running cycle ``c`` after the core's (BK-20's order; the chip applied CONF and a
         command there): ``before`` the state before the edge, ``after`` after the core's, ``switched_on`` a command
         switched the branch on, ``mfp_in`` the synchronised MFP inputs, ``framing`` a frame ran through the frame
-        engine in the cycle (a silence running out waits for its end, BK-50; the timer holds); ``recording``: in a
-        run (the strobes planned). Returns the state after the master's telegram back, the counter telegram and the
-        silence, and whether the silence closed the branch."""
+        engine or its transmitter repeated a data telegram being received in the cycle (a silence running out waits for
+        its end, BK-50; the timer holds); ``recording``: in a run (the strobes planned). Returns the state after the
+        master's telegram back, the counter telegram and the silence, and whether the silence closed the branch."""
         connected = bool(self._connected[c - self._c0]) if recording else self.connected
         ret, cnt, count = self._strobes[c - self._c0].tolist() if recording else self.strobes()
         if self.counting:  # the cycles between a run's visits
