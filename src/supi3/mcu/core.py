@@ -629,6 +629,30 @@ class _Batch:
         CortexM._check(_LIB.uc_reg_write_batch(self._handle, self._ids, self._slots, self._count))
 
 
+_FORMATS: Final[dict[type, str]] = {ctypes.c_uint64: "Q", ctypes.c_uint32: "I"}
+
+
+def _field_writer(structure: type[ctypes.Structure], names: tuple[str, ...]) -> tuple[struct.Struct, int]:
+    """A ``struct.Struct`` that writes the fields ``names`` of ``structure`` (unsigned, in the order given, their
+    gaps skipped) with one ``pack_into`` at the offset returned: one call in place of one ctypes attribute write
+    each (MCU-31; the offsets are ctypes', which :func:`hook.check_layout` checks against the C library's)."""
+    fields = dict(structure._fields_)  # type: ignore[arg-type]
+    start = at = getattr(structure, names[0]).offset
+    layout = "<"
+    for name in names:
+        offset = getattr(structure, name).offset
+        if offset < at:
+            raise hook.NativeHookError(f"{structure.__name__}.{name} at {offset} overlaps the field before it")
+        layout += "x" * (offset - at) + _FORMATS[fields[name]]
+        at = offset + ctypes.sizeof(fields[name])
+    return struct.Struct(layout), start
+
+
+_HOLD, _HOLD_AT = _field_writer(hook.Held, ("until", "offset", "value", "held", "poll", "after", "has_after"))
+_OFFER, _OFFER_AT = _field_writer(hook.Held, ("once_from", "once_at", "once_offset", "once_value", "once", "taken",
+                                              "once_then"))  # fmt: skip
+
+
 class HeldRegister:
     """A peripheral's register that the core answers natively while the peripheral holds its value (MCU-25), and a
     read the peripheral offers from a cycle on (MCU-26), from :meth:`CortexM.mmio`. A peripheral holds a value (or
@@ -643,11 +667,8 @@ class HeldRegister:
         ``until`` and tell the poll skip (:meth:`CortexM.skip_poll`, MCU-10) that cycle (``None``: until
         :meth:`release`, no poll skip), then ``after`` (``None``: the peripheral answers). Any other read goes to the
         peripheral."""
-        held = self._held
-        held.offset, held.value = offset, value
-        held.until, held.poll = (_FOREVER, 0) if until is None else (until, 1)
-        held.after, held.has_after = (0, 0) if after is None else (after, 1)
-        held.held = 1
+        _HOLD.pack_into(self._held, _HOLD_AT, _FOREVER if until is None else until, offset, value, 1,
+                        0 if until is None else 1, 0 if after is None else after, 0 if after is None else 1)
 
     def release(self) -> None:
         """Every read goes to the peripheral again."""
@@ -656,9 +677,7 @@ class HeldRegister:
     def offer(self, offset: int, value: int, start: int, then: int) -> None:
         """MCU-26: the first read of ``offset`` at a time (:meth:`CortexM.cycles_polled`) from cycle ``start`` on
         returns ``value``, once, and from then on the held register reads ``then`` (as long as it is held)."""
-        held = self._held
-        held.once_offset, held.once_value, held.once_from, held.once_then = offset, value, start, then
-        held.taken, held.once = 0, 1
+        _OFFER.pack_into(self._held, _OFFER_AT, start, 0, offset, value, 1, 0, then)  # once_at: set when taken
 
     def withdraw(self) -> int | None:
         """No more offered read; the time of the one taken since :meth:`offer`, if one was (the peripheral catches
@@ -703,6 +722,7 @@ class CortexM:
         self._handle = self.uc._uch  # the engine (uc_engine *) for the direct calls (MCU-19)
         self._register_value = ctypes.c_uint64()
         self._register_ref = ctypes.byref(self._register_value)
+        self._frame_buffer = ctypes.create_string_buffer(FRAME_WORDS * 4)  # _peek's (MCU-31)
         self._entry_reads = _Batch(self._handle, _ENTRY_READS)
         self._unstack = _Batch(self._handle, _UNSTACK_WRITES)
         self._resume = _Batch(self._handle, _RESUME_WRITES)
@@ -915,7 +935,9 @@ class CortexM:
 
     @deadline.setter
     def deadline(self, value: int) -> None:
-        self._state.deadline = check_int("deadline", value, 0, MAX_DEADLINE, "core cycles: MAX_DEADLINE (MCU-28)")
+        if type(value) is not int or not 0 <= value <= MAX_DEADLINE:  # the run loop's int: one test (MCU-31)
+            value = check_int("deadline", value, 0, MAX_DEADLINE, "core cycles: MAX_DEADLINE (MCU-28)")
+        self._state.deadline = value
 
     @property
     def stop_request(self) -> bool:
@@ -987,8 +1009,17 @@ class CortexM:
         self.pending.clear()
 
     def vector(self, number: int) -> int:
-        """Entry ``number`` of the vector table."""
-        return int(struct.unpack("<I", self.read_bytes(self.vtor + 4 * number, 4))[0])
+        """Entry ``number`` of the vector table (an :class:`ArgumentError` if it is not mapped)."""
+        return int(struct.unpack("<I", self._peek(self.vtor + 4 * number, 4))[0])
+
+    def _peek(self, address: int, size: int) -> bytes:
+        """``size`` bytes of memory, a stacked frame's at most, read by unicorn's C library directly (MCU-19; the
+        exception entry's and return's, MCU-31); the :class:`ArgumentError` of :meth:`read_bytes` if any of it is not
+        mapped."""
+        buffer = self._frame_buffer
+        if _LIB.uc_mem_read(self._handle, address, buffer, size) != ucc.UC_ERR_OK:
+            raise self._unmapped(address, size)
+        return buffer.raw[:size]
 
     def priority(self, number: int) -> int:
         """The priority of exception ``number``: Reset, NMI, HardFault fixed at -3, -2, -1 (B1.5.4)."""
@@ -1027,18 +1058,16 @@ class CortexM:
         on the main stack), IPSR = ``number``, PC = its vector; costs :attr:`Cpu.entry_cycles`. Returns the
         frame's address."""
         _exception_number(number)
-        uc = self.uc
         handler_mode = bool(self.active)
         control, sp, *words, xpsr, pc = self._entry_reads.read()
         process = bool(control & CONTROL_SPSEL) and not handler_mode
         aligned = sp & 4
         frame = (sp - FRAME_WORDS * 4) & ~7
         words += [pc, xpsr | (XPSR_ALIGN if aligned else 0)]
-        try:
-            uc.mem_write(frame, struct.pack("<8I", *words))
-        except UcError as error:
+        status = _LIB.uc_mem_write(self._handle, frame, struct.pack("<8I", *words), FRAME_WORDS * 4)  # MCU-31
+        if status != ucc.UC_ERR_OK:
             raise FirmwareFaultError(self.report(Stop.FAULT, f"stacking error: the frame at {frame:08X}h is not in "
-                                            f"memory ({error})")) from None  # fmt: skip
+                                            f"memory ({UcError(status)})"))  # fmt: skip
         self._write(arm.UC_ARM_REG_SP, frame)
         if process:
             self._write(arm.UC_ARM_REG_CONTROL, control & ~CONTROL_SPSEL)  # unicorn switches SP to the MSP
@@ -1090,7 +1119,7 @@ class CortexM:
             return
         self.active.append(returning)  # until the frame is back: a fault report shows the handler still active
         try:
-            words = struct.unpack("<8I", self.read_bytes(sp, FRAME_WORDS * 4))
+            words = struct.unpack("<8I", self._peek(sp, FRAME_WORDS * 4))
         except ArgumentError:
             reason = f"unstacking error: the frame at {sp:08X}h is not in memory (B1.5.8)"
             raise FirmwareFaultError(self.report(Stop.FAULT, reason)) from None
