@@ -210,6 +210,9 @@ _UNSTACK_WRITES: Final[tuple[int, ...]] = (*_FRAME_REGS, arm.UC_ARM_REG_XPSR)
 """What an exception return writes from the frame, the mode last (it selects the SP), in one call (B1.5.8)."""
 _RESUME_WRITES: Final[tuple[int, ...]] = (arm.UC_ARM_REG_SP, arm.UC_ARM_REG_PC)
 """An exception return's SP and PC, after the mode, in one call."""
+_UNWIND_READS: Final[tuple[int, ...]] = (*(getattr(arm, f"UC_ARM_REG_R{n}") for n in range(13)), arm.UC_ARM_REG_SP,
+                                         arm.UC_ARM_REG_LR)  # fmt: skip
+"""What :meth:`CortexM.backtrace` starts from, R0 to R12, SP, LR, in one call (MCU-31: a violation's note)."""
 FRAME_NAMES: Final[tuple[str, ...]] = ("r0", "r1", "r2", "r3", "r12", "lr", "pc", "xpsr")
 """The stacked frame's words in address order (B1.5.6)."""
 
@@ -728,6 +731,7 @@ class CortexM:
         self._entry_reads = _Batch(self._handle, _ENTRY_READS)
         self._unstack = _Batch(self._handle, _UNSTACK_WRITES)
         self._resume = _Batch(self._handle, _RESUME_WRITES)
+        self._unwind_reads = _Batch(self._handle, _UNWIND_READS)
         self._callbacks: list[object] = []  # the ctypes callbacks unicorn holds: kept alive with the core
         self.flash = flash
         self.ram = ram
@@ -1049,6 +1053,8 @@ class CortexM:
         return bool(self.active) or self._takeable() is not None
 
     def _takeable(self) -> int | None:
+        if not self.pending:  # the run loop's common case (MCU-31)
+            return None
         candidates = [n for n in self.pending if n < EXTERNAL or n in self.enabled]
         if not candidates:
             return None
@@ -1316,14 +1322,14 @@ class CortexM:
         image = self.image
         pc = self.pc
         frames = [Frame(pc, image.function_at(pc), image.line_at(pc))]
-        regs = {n: self.reg(f"r{n}") for n in range(13)} | {13: self.reg("sp"), 14: self.reg("lr")}
+        regs = dict(enumerate(self._unwind_reads.read()))  # R0..R12, 13 SP, 14 LR
         while len(frames) < depth:
             rule = image.frame_rule(pc)
             if rule is None or rule[0] not in regs:
                 break
             cfa = regs[rule[0]] + rule[1]
             try:
-                saved = {reg: int(struct.unpack("<I", self.read_bytes(cfa + offset, 4))[0])
+                saved = {reg: int(struct.unpack("<I", self._peek(cfa + offset, 4))[0])
                          for reg, offset in rule[2].items()}  # fmt: skip
             except ArgumentError:
                 break
@@ -1469,6 +1475,8 @@ class SysTick:
 
     def update(self) -> None:
         """Pend the exception if the counter reached 0 since the last update (TICKINT)."""
+        if not self.csr & 1:  # disabled (CSR.ENABLE 0): no tick, nothing to pend (MCU-31: the run loop's case)
+            return
         zeros = self._zeros_until(self._ticks(self.core.cycles))
         if zeros > self._seen:
             self._seen = zeros
