@@ -7,8 +7,8 @@ access bit), Table 3-7 (t0, t1, t2, t6, t8, t_SAS_INIT), 3.6.2 (/StatErr); the b
 One clock: the core's cycle count is the bench's time (``bench.now = cycles / cpu_hz``). Before every peripheral
 access the bus runs up to the instruction's cycle (:meth:`Board.sync`), so what the firmware sees on C/D, /IRQ
 and the I/O pin, and what the chip sees on /SS and the SPI lines, happens at the firmware's own time. The run loop
-stops the core at each bus event (a cycle's phases) and at each SysTick wrap, so an edge of /IRQ enters EXTI0's
-handler at the next block boundary after it (MCU-1).
+stops the core at each bus event that may change /IRQ (a cycle's start and end, MCU-31) and at each SysTick wrap, so
+an edge of /IRQ enters EXTI0's handler at the next block boundary after it (MCU-1).
 """
 
 from __future__ import annotations
