@@ -18,6 +18,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from supi3.errors import ArgumentError
 from supi3.mcu import board as board_module
 from supi3.mcu import build as mcu_build
 from supi3.mcu import core as core_module
@@ -132,3 +133,19 @@ def test_the_field_structs_read_and_write_the_native_fields() -> None:
     with pytest.raises(hook.NativeHookError, match="overlaps"):
         core_module._fields_struct(hook.State, ("handed", "block_start"))
     assert isinstance(core_module._HOLD, struct.Struct)
+
+
+def test_the_direct_memory_read_keeps_to_its_buffer(digital_io: dict[str, Path]) -> None:
+    """MCU-31: the exception entry's and return's direct read (``CortexM._peek``) reads a stacked frame at most: a
+    longer read is a ``ValueError`` (never taken for unmapped memory), unmapped memory the ``ArgumentError`` of
+    ``read_bytes``, and mapped memory what ``read_bytes`` reads."""
+    core = Board(digital_io["cortex_m3"]).core
+    base = core.ram[0]
+    core.write_bytes(base, bytes(range(32)))
+    assert core._peek(base, 32) == core.read_bytes(base, 32) == bytes(range(32))
+    assert core._peek(base + 4, 4) == bytes(range(4, 8))
+    with pytest.raises(ValueError, match="0 to 32 bytes, not 33") as caught:
+        core._peek(base, 33)
+    assert not isinstance(caught.value, ArgumentError)
+    with pytest.raises(ArgumentError, match="mapped memory"):
+        core._peek(core.ram[0] + core.ram[1] - 2, 4)

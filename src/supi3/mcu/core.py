@@ -633,6 +633,7 @@ class _Batch:
 
 
 _FORMATS: Final[dict[type, str]] = {ctypes.c_uint64: "Q", ctypes.c_uint32: "I"}
+"""The ``struct`` format of each ctypes type the native state's packed fields have."""
 
 
 def _fields_struct(structure: type[ctypes.Structure], names: tuple[str, ...]) -> tuple[struct.Struct, int]:
@@ -1024,6 +1025,8 @@ class CortexM:
         exception entry's and return's, MCU-31); the :class:`ArgumentError` of :meth:`read_bytes` if any of it is not
         mapped."""
         buffer = self._frame_buffer
+        if not 0 <= size <= len(buffer):  # the buffer's bound (a caller's bug, never taken for unmapped memory)
+            raise ValueError(f"_peek reads 0 to {len(buffer)} bytes, not {size}")
         if _LIB.uc_mem_read(self._handle, address, buffer, size) != ucc.UC_ERR_OK:
             raise self._unmapped(address, size)
         return buffer.raw[:size]
