@@ -149,3 +149,22 @@ def test_the_direct_memory_read_keeps_to_its_buffer(digital_io: dict[str, Path])
     assert not isinstance(caught.value, ArgumentError)
     with pytest.raises(ArgumentError, match="mapped memory"):
         core._peek(core.ram[0] + core.ram[1] - 2, 4)
+
+
+def test_the_function_of_an_address_is_remembered_as_found(digital_io: dict[str, Path]) -> None:
+    """MCU-31: ``FirmwareImage.function_at`` remembers its answer per address: at each symbol's first, last and next
+    address, and at addresses between, the first and any later ask give the first symbol whose range holds it (a
+    size-0 label one byte), as a walk of the symbol table does."""
+    image = Board(digital_io["cortex_m3"]).core.image
+
+    def walk(pc: int) -> str | None:
+        return next((name for name, (address, size) in image.symbols.items() if address <= pc < address + max(size, 1)),
+                    None)  # fmt: skip
+
+    pcs = sorted({pc for address, size in image.symbols.values()
+                  for pc in (address - 1, address, address + max(size, 1) - 1, address + max(size, 1))} |
+                 set(range(image.entry - 64, image.entry + 64)))  # fmt: skip
+    assert len(pcs) > 100
+    for _ in range(2):
+        assert [image.function_at(pc) for pc in pcs] == [walk(pc) for pc in pcs]
+    assert any(image.function_at(pc) is None for pc in pcs) and any(image.function_at(pc) for pc in pcs)

@@ -369,11 +369,18 @@ class FirmwareImage:
             raise ArgumentError("name", name, f"name must be a symbol of {self.path.name}, not {name!r}") from None
 
     def function_at(self, pc: int) -> str | None:
-        """The function whose code holds ``pc``, if the symbol table says."""
-        for name, (address, size) in self.symbols.items():
-            if address <= pc < address + max(size, 1):
-                return name
-        return None
+        """The function whose code holds ``pc``, if the symbol table says (the first such symbol; remembered per
+        address: a violation's backtrace asks for the same few, MCU-31)."""
+        memo = self._functions
+        if pc in memo:
+            return memo[pc]
+        found = memo[pc] = next((name for name, (address, size) in self.symbols.items()
+                                 if address <= pc < address + max(size, 1)), None)  # fmt: skip
+        return found
+
+    @cached_property
+    def _functions(self) -> dict[int, str | None]:
+        return {}
 
     def line_at(self, pc: int) -> SourceLine | None:
         """The source line of the instruction at ``pc`` from the DWARF line program, if the ELF has one (built with
