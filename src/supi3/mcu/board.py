@@ -7,8 +7,8 @@ access bit), Table 3-7 (t0, t1, t2, t6, t8, t_SAS_INIT), 3.6.2 (/StatErr); the b
 One clock: the core's cycle count is the bench's time (``bench.now = cycles / cpu_hz``). Before every peripheral
 access the bus runs up to the instruction's cycle (:meth:`Board.sync`), so what the firmware sees on C/D, /IRQ
 and the I/O pin, and what the chip sees on /SS and the SPI lines, happens at the firmware's own time. The run loop
-stops the core at each bus event (a cycle's phases) and at each SysTick wrap, so an edge of /IRQ enters EXTI0's
-handler at the next block boundary after it (MCU-1).
+stops the core at each bus event that may change /IRQ (a cycle's start and end, MCU-31) and at each SysTick wrap, so
+an edge of /IRQ enters EXTI0's handler at the next block boundary after it (MCU-1).
 """
 
 from __future__ import annotations
@@ -107,6 +107,11 @@ SERVE_TELEGRAMS: Final[int] = 64
 telegrams while the firmware is still in a handler or has an /IRQ edge to serve."""
 
 
+FLAG_EVENTS: Final[frozenset[str]] = frozenset({"io", "latch"})
+"""MCU-31: the bench's phase events that only set a flag of the chip (``Supi3.set_io_access``, ``set_latch_phase``:
+no /IRQ, no /ModAck); the firmware sees them at its next access, which runs the bus up to its time, so the run loop
+does not stop the core at them."""
+
 _EXTI0: Final[int] = EXTERNAL + EXTI0_IRQ
 """The exception number of EXTI0, /IRQ's line."""
 
@@ -158,9 +163,13 @@ class ViolationAt:
 class _BoardBench(Bench):
     """The bench, driven by the core's clock: the run loop needs the next bus event to stop the core there."""
 
-    def next_event_s(self) -> float:
-        """The time of the next bus event (a cycle start, phase or end)."""
-        return self._next_event()
+    def next_change_s(self) -> float:
+        """The time of the next bus event that may change /IRQ or /ModAck: a cycle's start or end, not the phases
+        between, which only set the chip's I/O access bit and latch phase (MCU-31)."""
+        for at, what in reversed(self._events):  # the next first
+            if what not in FLAG_EVENTS:
+                return at
+        return self._next_start
 
 
 @dataclass(slots=True)
@@ -302,12 +311,16 @@ class Board:
             self.registers = bench.registers
             self.protocol = bench.transport.protocol
             self.config = bench.config
+        self._advance: Callable[[float], bool] = self._no_bench if self._bench is None else self._bench.advance
+        self._cpu_hz = self.core.cpu_hz
         bit_rate = self.config.bit_rate
         self._limits = {symbol: timing.limit("3-7", symbol, bit_rate) for symbol in ("t0", "t1", "t2", "t8")}
         self._limits["t6max"] = timing.limit("3-7", "t6", bit_rate, maximum=True)
         self._limits["t_SAS_INIT"] = timing.limit("3-7", "t_SAS_INIT", bit_rate)
         self._least = {symbol: self._cycles(limit) for symbol, limit in self._limits.items()}  # in core cycles
         self._least["t8"] = self._cycles(self._limits["t6max"] + self._limits["t8"])  # after /SS rises
+        self._least_t1, self._least_t2, self._least_t8 = self._least["t1"], self._least["t2"], self._least["t8"]
+        self._shortest_period_s = self._limits["t0"] * (1 - 1e-9)  # t0, a rounding's tolerance
         self.rcc = Rcc()
         self.exti = Exti(self.rcc)
         self.gpio = Gpio(self.rcc, IOPAEN, "GPIOA", self._inputs, self._on_output, PULL_UPS)
@@ -320,7 +333,7 @@ class Board:
         core.mmio(GPIOA_BASE, PERIPHERAL_SIZE, self.gpio.read, self.gpio.write)
         core.mmio(GPIOB_BASE, PERIPHERAL_SIZE, self.gpio_b.read, self.gpio_b.write)
         core.mmio(AFIO_BASE, PERIPHERAL_SIZE, self.exti.read_afio, self.exti.write_afio)
-        core.mmio(EXTI_BASE, PERIPHERAL_SIZE, self.exti.read, self.exti.write)
+        core.mmio(EXTI_BASE, PERIPHERAL_SIZE, self.exti.read, self._exti_write)
         held = core.mmio(SPI1_BASE, PERIPHERAL_SIZE, self.spi.read, self.spi.write)
         self.spi.holder = self.spi.offer = held  # SR held (MCU-25), DR's read after its byte (MCU-26)
         core.entered = self._entered
@@ -451,12 +464,15 @@ class Board:
 
     def _sync(self, cycles: int, event: int | None = None) -> None:
         """Run the bus up to core cycle ``cycles``, then follow /IRQ; ``event``: the cycle of the bus event passed
-        on the way, when /IRQ changed if it did."""
-        bench = self._bench
-        if bench is None:
-            bench = self.bench  # BoardError at pin level
-        bench.advance(cycles / self.core.cpu_hz)
-        self._follow_irq(cycles, event)
+        on the way, when /IRQ changed if it did. /IRQ and /ModAck change only at a bus event or a chip action
+        (:meth:`_chip` follows its own), and EXTI0's request only with them, a write of EXTI (:meth:`_exti_write`)
+        or an exception's return (the run loop): with no bus event on the way there is nothing to follow (MCU-31)."""
+        if self._advance(cycles / self._cpu_hz):
+            self._follow_irq(cycles, event)
+
+    def _no_bench(self, until: float) -> bool:
+        """:attr:`_advance` at pin level: :class:`BoardError` (the transaction-level bench is not there)."""
+        return self.bench.advance(until)
 
     def _now(self) -> int:
         cycles = self.core.cycles_now()
@@ -484,15 +500,24 @@ class Board:
                 self._irq_fell = cycles if event is None else event
             self.exti.edge(0, PIN_IRQ, level)
             request = True
-        if request:
-            self._request()
+        if request and self.exti.requesting(0):
+            self._pend()
 
     def _request(self) -> None:
         if self.exti.requesting(0):
-            core = self.core
-            if _EXTI0 not in core.active and _EXTI0 not in core.pending:
-                core.pend(_EXTI0)
-                core.stop_request = True
+            self._pend()
+
+    def _exti_write(self, offset: int, size: int, value: int) -> None:
+        """The firmware writes EXTI: a line it unmasks (IMR) or sets (SWIER) with PR set requests at once (MCU-31)."""
+        self.exti.write(offset, size, value)
+        self._request()
+
+    def _pend(self) -> None:
+        """EXTI0 requests its interrupt: pend it unless it is active or pending, and stop the run for it."""
+        core = self.core
+        if _EXTI0 not in core.active and _EXTI0 not in core.pending:
+            core.pend(_EXTI0)
+            core.stop_request = True
 
     def _entered(self, number: int) -> None:
         if number == _EXTI0:
@@ -541,7 +566,8 @@ class Board:
             if wire is not None:
                 ring.drive(self.core.cycles_now(), *wire, level)
             return
-        cycles = self._now()
+        cycles = self.core.cycles_now()
+        self._sync(cycles)
         if pin == PIN_SS:
             self._ss_edge(level, cycles)
         elif pin == PIN_SAS_INIT:
@@ -560,7 +586,7 @@ class Board:
     def _ss_edge(self, level: int, cycles: int) -> None:
         if not level:
             gap = cycles - self._ss_rise
-            if gap < self._least["t8"]:
+            if gap < self._least_t8:
                 need = self._limits["t6max"] + self._limits["t8"]
                 self._violation("Table 3-7 t8", f"/SS fell {self._ns(gap)} ns after it rose: C/D settles t6 "
                                 f"(max) + t8 = {need * 1e9:.0f} ns after the rise")  # fmt: skip
@@ -572,11 +598,14 @@ class Board:
             return
         self._ss_rise = cycles
         self._cd_before = self.protocol.c_d
-        edges = sum(min(bits, (cycles - start) // period) for _, bits, start, period in frame.transfers)
+        edges = 0
+        for _, bits, start, period in frame.transfers:
+            clocked = (cycles - start) // period
+            edges += bits if clocked > bits else clocked
         if edges == 8:
             tx, bits, start, period = frame.transfers[-1]
             last = start + bits * period
-            if cycles - last < self._least["t2"]:
+            if cycles - last < self._least_t2:
                 self._violation("Table 3-7 t2", f"/SS rose {self._ns(cycles - last)} ns after the last SCLK edge, "
                                 f"less than t2 = {self._limits['t2'] * 1e9:.0f} ns")  # fmt: skip
             # An Intel receive frame: the chip's driver wins on Ser_IN/OUT, it takes its own byte (MCU-18).
@@ -588,8 +617,8 @@ class Board:
     def spi_byte(self, tx: int, bits: int, start: int, period: int, cr1: int) -> int:
         """:class:`~supi3.mcu.stm32.SpiWire`: SPI1 starts a transfer; the chip sees it inside its /SS frame."""
         self._sync(start)
-        period_s = self._seconds(period)
-        if period_s < self._limits["t0"] * (1 - 1e-9):
+        period_s = period / self._cpu_hz
+        if period_s < self._shortest_period_s:
             self._violation("Table 3-7 t0", f"SCLK period {period_s * 1e9:.0f} ns, shorter than t0 = "
                             f"{self._limits['t0'] * 1e9:.0f} ns")  # fmt: skip
         if cr1 & (CR1_CPOL | CR1_CPHA) != CR1_CPOL | CR1_CPHA:
@@ -602,7 +631,7 @@ class Board:
         lsb = bool(cr1 & CR1_LSBFIRST)
         reverse = lsb != (self.protocol.mode is Mode.INTEL)  # the chip shifts LSB first in Intel mode (UP-6)
         seen = _reverse(tx & 0xFF) if reverse else tx & 0xFF
-        if not frame.transfers and start + period // 2 - frame.fall < self._least["t1"]:
+        if not frame.transfers and start + period // 2 - frame.fall < self._least_t1:
             self._violation("Table 3-7 t1", f"first SCLK edge {self._ns(start + period // 2 - frame.fall)} ns after "
                             f"/SS fell, less than t1 = {self._limits['t1'] * 1e9:.0f} ns")  # fmt: skip
         frame.transfers.append((seen, bits, start, period))
@@ -680,12 +709,13 @@ class Board:
         core = self.core
         self._set_budget(max_instructions)
         self._sync(core.cycles)
+        self._follow_irq(core.cycles)  # the chip may have changed between runs (the host's calls)
         while True:
             core.systick.update()
             self._request()
             if done():
                 return
-            deadline = event = math.ceil(self.bench.next_event_s() * core.cpu_hz)
+            deadline = event = math.ceil(self.bench.next_change_s() * core.cpu_hz)
             tick = core.systick.next_event()
             for bound in (tick, end):
                 if bound is not None:

@@ -210,6 +210,9 @@ _UNSTACK_WRITES: Final[tuple[int, ...]] = (*_FRAME_REGS, arm.UC_ARM_REG_XPSR)
 """What an exception return writes from the frame, the mode last (it selects the SP), in one call (B1.5.8)."""
 _RESUME_WRITES: Final[tuple[int, ...]] = (arm.UC_ARM_REG_SP, arm.UC_ARM_REG_PC)
 """An exception return's SP and PC, after the mode, in one call."""
+_UNWIND_READS: Final[tuple[int, ...]] = (*(getattr(arm, f"UC_ARM_REG_R{n}") for n in range(13)), arm.UC_ARM_REG_SP,
+                                         arm.UC_ARM_REG_LR)  # fmt: skip
+"""What :meth:`CortexM.backtrace` starts from, R0 to R12, SP, LR, in one call (MCU-31: a violation's note)."""
 FRAME_NAMES: Final[tuple[str, ...]] = ("r0", "r1", "r2", "r3", "r12", "lr", "pc", "xpsr")
 """The stacked frame's words in address order (B1.5.6)."""
 
@@ -366,11 +369,18 @@ class FirmwareImage:
             raise ArgumentError("name", name, f"name must be a symbol of {self.path.name}, not {name!r}") from None
 
     def function_at(self, pc: int) -> str | None:
-        """The function whose code holds ``pc``, if the symbol table says."""
-        for name, (address, size) in self.symbols.items():
-            if address <= pc < address + max(size, 1):
-                return name
-        return None
+        """The function whose code holds ``pc``, if the symbol table says (the first such symbol; remembered per
+        address: a violation's backtrace asks for the same few, MCU-31)."""
+        memo = self._functions
+        if pc in memo:
+            return memo[pc]
+        found = memo[pc] = next((name for name, (address, size) in self.symbols.items()
+                                 if address <= pc < address + max(size, 1)), None)  # fmt: skip
+        return found
+
+    @cached_property
+    def _functions(self) -> dict[int, str | None]:
+        return {}
 
     def line_at(self, pc: int) -> SourceLine | None:
         """The source line of the instruction at ``pc`` from the DWARF line program, if the ELF has one (built with
@@ -629,6 +639,33 @@ class _Batch:
         CortexM._check(_LIB.uc_reg_write_batch(self._handle, self._ids, self._slots, self._count))
 
 
+_FORMATS: Final[dict[type, str]] = {ctypes.c_uint64: "Q", ctypes.c_uint32: "I"}
+"""The ``struct`` format of each ctypes type the native state's packed fields have."""
+
+
+def _fields_struct(structure: type[ctypes.Structure], names: tuple[str, ...]) -> tuple[struct.Struct, int]:
+    """A ``struct.Struct`` that reads or writes the fields ``names`` of ``structure`` (unsigned, in the order given,
+    their gaps skipped) with one ``unpack_from`` or ``pack_into`` at the offset returned: one call in place of one
+    ctypes attribute access each (MCU-31; the offsets are ctypes', which :func:`hook.check_layout` checks against
+    the C library's)."""
+    fields = dict(structure._fields_)  # type: ignore[arg-type]
+    start = at = getattr(structure, names[0]).offset
+    layout = "<"
+    for name in names:
+        offset = getattr(structure, name).offset
+        if offset < at:
+            raise hook.NativeHookError(f"{structure.__name__}.{name} at {offset} overlaps the field before it")
+        layout += "x" * (offset - at) + _FORMATS[fields[name]]
+        at = offset + ctypes.sizeof(fields[name])
+    return struct.Struct(layout), start
+
+
+_HOLD, _HOLD_AT = _fields_struct(hook.Held, ("until", "offset", "value", "held", "poll", "after", "has_after"))
+_OFFER, _OFFER_AT = _fields_struct(hook.Held, ("once_from", "once_at", "once_offset", "once_value", "once", "taken",
+                                              "once_then"))  # fmt: skip
+_CLOCK, _CLOCK_AT = _fields_struct(hook.State, ("block_start", "block_address", "handed", "access_pc"))
+
+
 class HeldRegister:
     """A peripheral's register that the core answers natively while the peripheral holds its value (MCU-25), and a
     read the peripheral offers from a cycle on (MCU-26), from :meth:`CortexM.mmio`. A peripheral holds a value (or
@@ -643,11 +680,8 @@ class HeldRegister:
         ``until`` and tell the poll skip (:meth:`CortexM.skip_poll`, MCU-10) that cycle (``None``: until
         :meth:`release`, no poll skip), then ``after`` (``None``: the peripheral answers). Any other read goes to the
         peripheral."""
-        held = self._held
-        held.offset, held.value = offset, value
-        held.until, held.poll = (_FOREVER, 0) if until is None else (until, 1)
-        held.after, held.has_after = (0, 0) if after is None else (after, 1)
-        held.held = 1
+        _HOLD.pack_into(self._held, _HOLD_AT, _FOREVER if until is None else until, offset, value, 1,
+                        0 if until is None else 1, 0 if after is None else after, 0 if after is None else 1)
 
     def release(self) -> None:
         """Every read goes to the peripheral again."""
@@ -656,9 +690,7 @@ class HeldRegister:
     def offer(self, offset: int, value: int, start: int, then: int) -> None:
         """MCU-26: the first read of ``offset`` at a time (:meth:`CortexM.cycles_polled`) from cycle ``start`` on
         returns ``value``, once, and from then on the held register reads ``then`` (as long as it is held)."""
-        held = self._held
-        held.once_offset, held.once_value, held.once_from, held.once_then = offset, value, start, then
-        held.taken, held.once = 0, 1
+        _OFFER.pack_into(self._held, _OFFER_AT, start, 0, offset, value, 1, 0, then)  # once_at: set when taken
 
     def withdraw(self) -> int | None:
         """No more offered read; the time of the one taken since :meth:`offer`, if one was (the peripheral catches
@@ -703,9 +735,11 @@ class CortexM:
         self._handle = self.uc._uch  # the engine (uc_engine *) for the direct calls (MCU-19)
         self._register_value = ctypes.c_uint64()
         self._register_ref = ctypes.byref(self._register_value)
+        self._frame_buffer = ctypes.create_string_buffer(FRAME_WORDS * 4)  # _peek's (MCU-31)
         self._entry_reads = _Batch(self._handle, _ENTRY_READS)
         self._unstack = _Batch(self._handle, _UNSTACK_WRITES)
         self._resume = _Batch(self._handle, _RESUME_WRITES)
+        self._unwind_reads = _Batch(self._handle, _UNWIND_READS)
         self._callbacks: list[object] = []  # the ctypes callbacks unicorn holds: kept alive with the core
         self.flash = flash
         self.ram = ram
@@ -915,7 +949,9 @@ class CortexM:
 
     @deadline.setter
     def deadline(self, value: int) -> None:
-        self._state.deadline = check_int("deadline", value, 0, MAX_DEADLINE, "core cycles: MAX_DEADLINE (MCU-28)")
+        if type(value) is not int or not 0 <= value <= MAX_DEADLINE:  # the run loop's int: one test (MCU-31)
+            value = check_int("deadline", value, 0, MAX_DEADLINE, "core cycles: MAX_DEADLINE (MCU-28)")
+        self._state.deadline = value
 
     @property
     def stop_request(self) -> bool:
@@ -948,7 +984,7 @@ class CortexM:
         state = self._state
         if not self._running:
             return int(state.cycles)
-        address, start, pc = state.block_address, state.block_start, state.access_pc
+        start, address, handed, pc = _CLOCK.unpack_from(state, _CLOCK_AT)
         if pc > address:
             key = (address, pc - address)
             cost = self._costs.get(key)
@@ -957,9 +993,10 @@ class CortexM:
                 if not self._rewritable(address):  # code in RAM may change (MCU-28)
                     self._costs[key] = cost
             start += cost[1]
-        if start > state.handed:
+        if start > handed:
             state.handed = start
-        return int(state.handed)
+            return int(start)
+        return int(handed)
 
     def cycles_polled(self) -> int:
         """The time of a status read (a flag the firmware polls): the end of the running block, which costs no
@@ -987,8 +1024,19 @@ class CortexM:
         self.pending.clear()
 
     def vector(self, number: int) -> int:
-        """Entry ``number`` of the vector table."""
-        return int(struct.unpack("<I", self.read_bytes(self.vtor + 4 * number, 4))[0])
+        """Entry ``number`` of the vector table (an :class:`ArgumentError` if it is not mapped)."""
+        return int(struct.unpack("<I", self._peek(self.vtor + 4 * number, 4))[0])
+
+    def _peek(self, address: int, size: int) -> bytes:
+        """``size`` bytes of memory, a stacked frame's at most, read by unicorn's C library directly (MCU-19; the
+        exception entry's and return's, MCU-31); the :class:`ArgumentError` of :meth:`read_bytes` if any of it is not
+        mapped."""
+        buffer = self._frame_buffer
+        if not 0 <= size <= len(buffer):  # the buffer's bound (a caller's bug, never taken for unmapped memory)
+            raise ValueError(f"_peek reads 0 to {len(buffer)} bytes, not {size}")
+        if _LIB.uc_mem_read(self._handle, address, buffer, size) != ucc.UC_ERR_OK:
+            raise self._unmapped(address, size)
+        return buffer.raw[:size]
 
     def priority(self, number: int) -> int:
         """The priority of exception ``number``: Reset, NMI, HardFault fixed at -3, -2, -1 (B1.5.4)."""
@@ -1015,6 +1063,8 @@ class CortexM:
         return bool(self.active) or self._takeable() is not None
 
     def _takeable(self) -> int | None:
+        if not self.pending:  # the run loop's common case (MCU-31)
+            return None
         candidates = [n for n in self.pending if n < EXTERNAL or n in self.enabled]
         if not candidates:
             return None
@@ -1027,18 +1077,16 @@ class CortexM:
         on the main stack), IPSR = ``number``, PC = its vector; costs :attr:`Cpu.entry_cycles`. Returns the
         frame's address."""
         _exception_number(number)
-        uc = self.uc
         handler_mode = bool(self.active)
         control, sp, *words, xpsr, pc = self._entry_reads.read()
         process = bool(control & CONTROL_SPSEL) and not handler_mode
         aligned = sp & 4
         frame = (sp - FRAME_WORDS * 4) & ~7
         words += [pc, xpsr | (XPSR_ALIGN if aligned else 0)]
-        try:
-            uc.mem_write(frame, struct.pack("<8I", *words))
-        except UcError as error:
+        status = _LIB.uc_mem_write(self._handle, frame, struct.pack("<8I", *words), FRAME_WORDS * 4)  # MCU-31
+        if status != ucc.UC_ERR_OK:
             raise FirmwareFaultError(self.report(Stop.FAULT, f"stacking error: the frame at {frame:08X}h is not in "
-                                            f"memory ({error})")) from None  # fmt: skip
+                                            f"memory ({UcError(status)})"))  # fmt: skip
         self._write(arm.UC_ARM_REG_SP, frame)
         if process:
             self._write(arm.UC_ARM_REG_CONTROL, control & ~CONTROL_SPSEL)  # unicorn switches SP to the MSP
@@ -1090,7 +1138,7 @@ class CortexM:
             return
         self.active.append(returning)  # until the frame is back: a fault report shows the handler still active
         try:
-            words = struct.unpack("<8I", self.read_bytes(sp, FRAME_WORDS * 4))
+            words = struct.unpack("<8I", self._peek(sp, FRAME_WORDS * 4))
         except ArgumentError:
             reason = f"unstacking error: the frame at {sp:08X}h is not in memory (B1.5.8)"
             raise FirmwareFaultError(self.report(Stop.FAULT, reason)) from None
@@ -1284,14 +1332,14 @@ class CortexM:
         image = self.image
         pc = self.pc
         frames = [Frame(pc, image.function_at(pc), image.line_at(pc))]
-        regs = {n: self.reg(f"r{n}") for n in range(13)} | {13: self.reg("sp"), 14: self.reg("lr")}
+        regs = dict(enumerate(self._unwind_reads.read()))  # R0..R12, 13 SP, 14 LR
         while len(frames) < depth:
             rule = image.frame_rule(pc)
             if rule is None or rule[0] not in regs:
                 break
             cfa = regs[rule[0]] + rule[1]
             try:
-                saved = {reg: int(struct.unpack("<I", self.read_bytes(cfa + offset, 4))[0])
+                saved = {reg: int(struct.unpack("<I", self._peek(cfa + offset, 4))[0])
                          for reg, offset in rule[2].items()}  # fmt: skip
             except ArgumentError:
                 break
@@ -1375,6 +1423,8 @@ def _name(number: int) -> str:
 
 def _exception_number(number: object) -> int:
     """``number`` checked as an exception that can be pended or entered: NMI (2) up to the last interrupt."""
+    if type(number) is int and 2 <= number <= MAX_EXCEPTION:  # the core's own numbers: one test (MCU-31)
+        return number
     return check_int("number", number, 2, MAX_EXCEPTION, "B1.5.2: NMI (2) up to the last interrupt")
 
 
@@ -1435,6 +1485,8 @@ class SysTick:
 
     def update(self) -> None:
         """Pend the exception if the counter reached 0 since the last update (TICKINT)."""
+        if not self.csr & 1:  # disabled (CSR.ENABLE 0): no tick, nothing to pend (MCU-31: the run loop's case)
+            return
         zeros = self._zeros_until(self._ticks(self.core.cycles))
         if zeros > self._seen:
             self._seen = zeros

@@ -162,7 +162,9 @@ class Gpio:
 
     def levels(self) -> int:
         """The levels the port drives: ODR on output pins, the pull-ups elsewhere."""
-        mask = self._output_mask()
+        mask = self._mask
+        if mask is None:
+            mask = self._output_mask()
         return (self.odr & mask) | (self.pulled_up & ~mask)
 
     def _changed(self) -> None:
@@ -189,7 +191,8 @@ class Gpio:
     def write(self, offset: int, size: int, value: int) -> None:
         """CRL, CRH, ODR, BSRR (set in bits 0..15, reset in 16..31, set wins), BRR."""
         del size
-        self.rcc.require(self.enable_bit, self.name)
+        if not self.rcc.apb2enr & self.enable_bit:  # the clock check's common case without a call (MCU-31)
+            self.rcc.require(self.enable_bit, self.name)
         if offset in (0x0, 0x4):
             self.cr[offset // 4] = value
             self._mask = None
@@ -435,13 +438,6 @@ class Spi:
         return (rxne * SR_RXNE | (self.tx_buffer is None) * SR_TXE | self.modf * SR_MODF | ovr * SR_OVR
                 | busy * SR_BSY)  # fmt: skip
 
-    def _after(self) -> int | None:
-        """SR once the shifting byte has ended, if nothing starts then (no byte waits) and the byte's end needs no
-        look at the wire (a received value known now): RXNE, OVR if RXNE was still 1 (25.3.10), not busy."""
-        if self.shifting is None or self.tx_buffer is not None or not isinstance(self.shifting[0], int):
-            return None
-        return self._flags(True, self.ovr or self.rx_buffer is not None, False)
-
     def read(self, offset: int, size: int) -> int:
         """CR1, CR2, SR, DR (reading DR clears RXNE; reading SR after DR clears OVR, 25.3.10)."""
         del size
@@ -468,10 +464,18 @@ class Spi:
         none waiting, DR's read from the byte's end on is offered, and SR after it (MCU-26)."""
         self._holding = True
         shifting = self.shifting
-        self.holder.hold(SPI_SR, value, None if shifting is None else shifting[2], self._after())
-        if shifting is not None and isinstance(shifting[0], int) and self.tx_buffer is None \
-                and self.rx_buffer is None and not self.ovr:  # fmt: skip
-            self.offer.offer(SPI_DR, shifting[0], shifting[2], self._flags(False, False, False))
+        if shifting is None:
+            self.holder.hold(SPI_SR, value, None, None)
+            return
+        received, _, end = shifting
+        # SR once the shifting byte has ended, if nothing starts then (no byte waits) and the byte's end needs no
+        # look at the wire (a received value known now): RXNE, OVR if RXNE was still 1 (25.3.10), not busy
+        if type(received) is not int or self.tx_buffer is not None:
+            self.holder.hold(SPI_SR, value, end, None)
+            return
+        self.holder.hold(SPI_SR, value, end, self._flags(True, self.ovr or self.rx_buffer is not None, False))
+        if self.rx_buffer is None and not self.ovr:
+            self.offer.offer(SPI_DR, received, end, self._flags(False, False, False))
 
     def _read_dr(self, cycles: int) -> int:
         """A read of DR at cycle ``cycles``: the received byte, RXNE cleared, OVR seen (25.3.10)."""
@@ -485,9 +489,11 @@ class Spi:
         """CR1 (MODF check on enabling), CR2, DR (into the transmit buffer; starts a transfer if idle)."""
         del size
         self._release()
-        self._accessible()
+        if not self.rcc.apb2enr & SPI1EN or self._in_reset:  # the common case without a call (MCU-31)
+            self._accessible()
         cycles = self.now()
-        self._run(cycles)
+        if self.shifting is not None:
+            self._run(cycles)
         if offset == SPI_CR1:
             self.cr1 = value & 0xFFFF
             if self.cr1 & CR1_MSTR and self.cr1 & CR1_SSM and not self.cr1 & CR1_SSI:

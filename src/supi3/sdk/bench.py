@@ -333,8 +333,9 @@ class Bench:
     def _next_event(self) -> float:
         return self._next_at
 
-    def advance(self, until: float) -> None:
-        """Run the bus up to time ``until`` and set the clock there (not backwards).
+    def advance(self, until: float) -> bool:
+        """Run the bus up to time ``until`` and set the clock there (not backwards); whether a bus event (a cycle's
+        start, phase or end) ran on the way: only then can the master's cycle have changed the chip.
 
         Raises
         ------
@@ -345,10 +346,12 @@ class Bench:
             until = check_real("until", until)
         # Most calls (a byte, a pin read, the board's synchronisation at each peripheral access) find no bus event
         # due: one comparison with the next event's time, kept by _step_bus and _start_cycle.
+        stepped = self._next_at <= until
         while self._next_at <= until:
             self._step_bus()
         if until > self.now:
             self.now = until
+        return stepped
 
     def _step_bus(self) -> None:
         """The next bus event: a cycle starts, a phase begins, or the cycle ends."""

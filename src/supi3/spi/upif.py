@@ -111,6 +111,10 @@ class Phase(StrEnum):
     """A faulty initialization byte was received: nothing until power-up reset or SAS_INIT (3.4.3)."""
 
 
+_COMMAND_PHASES: Final[frozenset[Phase]] = frozenset({Phase.INIT, Phase.COMMAND})
+"""The phases in which C/D reads :data:`C_D_COMMAND` (a set: the board reads C/D at each /SS rise)."""
+
+
 ACCESS_END_PHASES: Final[tuple[Phase, ...]] = (Phase.COMMAND, Phase.DISABLED)
 """UP-28: where a register access of :class:`UpInterface` (read, write, exchange, block transfer) leaves the
 interface, whether or not it raised a violation: ready for the next command, or disabled after a write before
@@ -210,7 +214,7 @@ class UpifProtocol:
     def c_d(self) -> int:
         """The C/D level (MFP2): :data:`C_D_COMMAND` before an initialization or command byte, else
         :data:`C_D_DATA` (3.4.3, 3.4.4; UP-2, UP-4)."""
-        return C_D_COMMAND if self.phase in (Phase.INIT, Phase.COMMAND) else C_D_DATA
+        return C_D_COMMAND if self.phase in _COMMAND_PHASES else C_D_DATA
 
     @property
     def in_frame(self) -> bool:
