@@ -16,6 +16,7 @@ histories.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +24,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from supi3.cli import FIRMWARE_FAILED_STATUS, main
+from supi3.errors import ArgumentError
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import SERVE_TELEGRAMS, Board
 from supi3.mcu.core import CPUS, FirmwareStoppedError, Stop
@@ -138,6 +141,54 @@ def test_a_main_loop_that_never_comes_back_ends_the_run_unserved(tmp_path: Path,
         assert not board.served
         if cycles == 0:
             assert board.now - before == pytest.approx(wait_s, rel=0.05)
+
+
+def test_a_main_loop_too_slow_for_the_ring_ends_its_runs_unserved(variants: dict[tuple[str, str], Path]) -> None:
+    """At 2 Mbit/s with back-to-back cycles a handler's edge comes every cycle and the main-loop variant's pass with
+    fw_isr (the port's 750 kHz SCLK) outlasts it: each new EXTI0 entry forgets the passes, so the run ends after the
+    serve wait, unserved, never looping on; the polling example keeps up and is served."""
+    slow = Board(variants["main_loop", "cortex_m3"], bit_rate=2_000_000, strict=False)
+    fast = Board(variants["polling", "cortex_m3"], bit_rate=2_000_000, strict=False)
+    for board in (slow, fast):
+        board.run(3)
+        before = board.cycles
+        board.run(5)
+        assert board.cycles >= before + 5
+    assert not slow.served and fast.served
+    assert slow.now - fast.now < SERVE_TELEGRAMS * slow._telegram_s + 1e-3
+
+
+def test_supi3_firmware_run_reports_an_unserved_main_loop(
+    variants: dict[tuple[str, str], Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``supi3 firmware run``: the main-loop variant too slow for 2 Mbit/s ends UNSERVED (exit 4, ``"served":
+    false`` in the JSON) although its data arrived; at 500 kbit/s it is clean (exit 0, served)."""
+    elf = str(variants["main_loop", "cortex_m3"])
+    assert main(["firmware", "run", elf, "--bit-rate", "2M", "--cycles", "5"]) == FIRMWARE_FAILED_STATUS
+    assert "UNSERVED    the firmware's main loop did not come back" in capsys.readouterr().out
+    assert main(["firmware", "run", elf, "--cycles", "5", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["served"] is True and report["process_data"]["ok"] is True
+
+
+def test_watch_refuses_what_is_not_an_address_or_a_callable_and_raises_what_its_callback_raises(
+    variants: dict[tuple[str, str], Path],
+) -> None:
+    """``CortexM.watch``, the code hook behind MCU-30: an address outside 32 bits or a callback that is not callable is
+    an ArgumentError naming it; a callback that raises stops the run with its error (not swallowed by ctypes)."""
+    board = Board(variants["polling", "cortex_m3"])
+    with pytest.raises(ArgumentError, match="address"):
+        board.core.watch(1 << 32, lambda: None)
+    with pytest.raises(ArgumentError, match="callback"):
+        board.core.watch(0x0800_0000, "fw_loop")  # type: ignore[arg-type]
+
+    def boom() -> None:
+        raise LookupError("the callback's own error")
+
+    board.core.watch(board.core.image.address("fw_loop"), boom)
+    with pytest.raises(LookupError, match="the callback's own error"):
+        board.run(1)
+    assert not board.served
 
 
 def test_runs_cut_by_the_budget_or_given_between_changes_keep_the_serve_rule(

@@ -730,6 +730,7 @@ class Board:
         """
         target = self.cycles + check_int("cycles", cycles, 0)
         self._serve_from = self._serve_end = None
+        self.served = False  # until the run ends served (MCU-30)
         try:
             if self._ring is not None:
                 self._run_pin(lambda: self._cycles_done >= target, max_instructions)
