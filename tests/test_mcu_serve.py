@@ -119,6 +119,31 @@ def test_a_main_loop_firmware_is_served_within_the_run_as_the_interrupt_one(
         assert cycles < 2 or outputs == out_data
 
 
+@pytest.mark.parametrize(("name", "size"), [("analog_io", 4), ("irq_dispatch", 2), ("pcmd_alarm", 2),
+                                           ("fault_report", 2)])  # fmt: skip
+def test_every_interrupt_example_s_main_loop_variant_gives_its_data(tmp_path: Path, name: str, size: int) -> None:
+    """The other interrupt examples, each built as it is and with mcu/main_loop.c's fw_loop (fw_isr then runs
+    between two passes of the main loop): the same output terminals, IN data, exchange count after every run of a
+    history of data changes and runs of 1 and 2 cycles, each run ending served (MCU-30)."""
+    rng = np.random.default_rng(size)
+    history = [(bytes(rng.integers(0, 256, size, dtype=np.uint8)), int(rng.integers(1, 3))) for _ in range(5)]
+    seen = []
+    for sources in ([native.example(name)], [native.example(name), MCU / "main_loop.c"]):
+        board = Board(mcu_build.build(sources, tmp_path / f"{len(sources)}.elf"))
+        fw = board.fw_board
+        assert fw is not None
+        board.run(3)
+        steps = []
+        for word, cycles in history:
+            board.master.set_outputs(1, word)
+            fw.inputs = word[::-1]
+            board.run(cycles)
+            steps.append((fw.outputs[:size], board.master.inputs(1), fw.cycles, board.served))
+        seen.append(steps)
+    assert seen[0] == seen[1]
+    assert all(served for *_, served in seen[1]) and seen[1][-1][2] > 0
+
+
 def test_a_main_loop_firmware_is_served_within_the_run_at_pin_level(variants: dict[tuple[str, str], Path]) -> None:
     """MCU-30 at pin level: the same for a short history (the run ends at the status telegram in which the pass is
     done, the line idling in whole telegrams)."""

@@ -95,7 +95,7 @@ _CHIP_INPUTS: Final[dict[int, tuple[str, int]]] = {PIN_SS: ("mfp_in", SS_BIT), P
 MISO_IDLE: Final[int] = 0xFF
 """MCU-6: what the SPI receives when the chip drives no SerOUT (pulled up)."""
 DEFAULT_MAX_INSTRUCTIONS: Final[int] = 20_000_000
-"""The instruction budget of one :meth:`Board.run` call unless given."""
+"""The instruction budget of one :meth:`Board.run` call unless given, renewed each time the core waits (MCU-41)."""
 FIDELITIES: Final[tuple[str, ...]] = ("transaction", "pin")
 """The chip on the board: the transaction-level model (:class:`supi3.sdk.bench.Bench`) or the pin-level whole chip
 (:class:`supi3.top.Supi3Chip` in lockstep with the core, :mod:`supi3.mcu.pins`)."""
@@ -545,12 +545,10 @@ class Board:
         done (MCU-30)."""
         return not self.core.in_exception and self._passed()
 
-    def _serve_wait(self, reached: bool) -> bool:
-        """Transaction level: whether :meth:`run` is done, ``reached`` its master cycles. The first call that finds
-        them reached is the block boundary the core stopped at for the last cycle's end (the run loop stops at each
-        bus event): the main loop's passes count from there, for at most :data:`SERVE_TELEGRAMS` status telegrams."""
-        if not reached:
-            return False
+    def _serve_wait(self) -> bool:
+        """Transaction level, :meth:`run`'s master cycles done: whether the run is done. The first call is at the
+        block boundary the core stopped at for the last cycle's end (the run loop stops at each bus event): the main
+        loop's passes count from there, for at most :data:`SERVE_TELEGRAMS` status telegrams."""
         core = self.core
         if self._serve_from is None:
             self._serve_from = core.cycles
@@ -713,20 +711,28 @@ class Board:
     # -- running -----------------------------------------------------------------------------------------------
 
     def run(self, cycles: int, *, max_instructions: int = DEFAULT_MAX_INSTRUCTIONS) -> None:
-        """Run the firmware until ``cycles`` more master cycles have finished and it has served the interrupts they
-        raised (as :meth:`Bench.run` takes the last cycle's interrupt). At pin level the master's cycles run whole,
-        and the run goes on while the firmware is in a handler or has an /IRQ edge to serve, up to
-        :data:`SERVE_TELEGRAMS` status telegrams (MCU-17).
+        """Run the firmware until ``cycles`` more master cycles have finished and it has served them (MCU-30): no
+        exception active or pending (the interrupts they raised taken, as :meth:`Bench.run` takes the last cycle's)
+        and, for a firmware with :data:`SERVE_POINT` (``fw_loop``), a whole pass of its main loop begun after the
+        last cycle and the last EXTI0 handler. The wait for that pass lasts at most :data:`SERVE_TELEGRAMS` status
+        telegrams of bus time; :attr:`served` tells whether the run ended served. At pin level the master's cycles
+        run whole, then the line idles in status telegrams while the firmware is in a handler, has an /IRQ edge to
+        serve or its pass to make, up to :data:`SERVE_TELEGRAMS` of them (MCU-17). The instruction budget bounds the
+        work between two waits of the core (MCU-41).
 
         Raises
         ------
         FirmwareFaultError
             The core faulted (report: fault type, PC, stacked registers).
         FirmwareStoppedError
-            ``max_instructions`` ran out (checked where the core stops, at basic-block boundaries, so the run may
-            end up to one block past it, MCU-1), or the firmware loops on ``b .`` inside a handler.
+            ``max_instructions`` ran out since the core last waited (checked where the core stops, at basic-block
+            boundaries, so the run may end up to one block past it, MCU-1), or the firmware loops on ``b .`` inside
+            a handler.
         InterfaceViolationError
             In strict mode, the first rule the firmware broke, with a note: bus time, PC and function.
+        PeripheralClockError, PeripheralResetError
+            The firmware touched a peripheral whose clock is off or which RCC_APB2RSTR holds in reset (MCU-7,
+            MCU-29).
         """
         target = self.cycles + check_int("cycles", cycles, 0)
         self._serve_from = self._serve_end = None
@@ -735,7 +741,7 @@ class Board:
             if self._ring is not None:
                 self._run_pin(lambda: self._cycles_done >= target, max_instructions)
                 return
-            self._run(lambda: self._serve_wait(self.bench.cycles >= target), max_instructions)
+            self._run(lambda: self.bench.cycles >= target and self._serve_wait(), max_instructions)
         finally:
             self._serve_from = self._serve_end = None
 
