@@ -548,18 +548,19 @@ class Board:
     def _serve_wait(self) -> bool:
         """Transaction level, :meth:`run`'s master cycles done: whether the run is done. The first call is at the
         block boundary the core stopped at for the last cycle's end (the run loop stops at each bus event): the main
-        loop's passes count from there, for at most :data:`SERVE_TELEGRAMS` status telegrams."""
+        loop's passes count from there, for at most :data:`SERVE_TELEGRAMS` status telegrams (a bound of the run
+        loop's steps until then); an exception active or pending is waited for as before MCU-30, unbounded."""
         core = self.core
         if self._serve_from is None:
             self._serve_from = core.cycles
             self._serve_end = core.cycles + self._cycles(SERVE_TELEGRAMS * self._telegram_s)
-        if self._served():
-            self.served = True
-            return True
-        if not core.in_exception and core.cycles >= cast("int", self._serve_end):
-            self.served = False  # the main loop's pass did not come back in time: end the run as before MCU-30
-            return True
-        return False
+        end = self._serve_end
+        if end is not None and core.cycles >= end:
+            self._serve_end = end = None  # the wait for the pass is over: no longer a bound of the steps
+        if core.in_exception:
+            return False
+        self.served = self._passed()
+        return self.served or end is None
 
     # -- pins --------------------------------------------------------------------------------------------------
 
