@@ -417,6 +417,30 @@ def test_gpio_and_afio_histories_with_resets_keep_the_pins_the_board_sees(ops: l
         assert seen["levels"] == gpio.levels()
 
 
+def test_afio_s_reset_takes_modack_s_latch_off_port_b_until_selected_again() -> None:
+    """EXTICR1 selects PB1 for line 1 (the board port's /ModAck latch): a falling edge sets PR bit 1. After AFIORST
+    (RCC_APB2RSTR bit 0) EXTICR1 is 0, the same edge sets nothing, EXTI's own registers stay; selecting port B again
+    brings the latch back. Other reset bits leave EXTICR1 alone."""
+    rcc = Rcc()
+    rcc.write(APB2ENR, 4, AFIOEN)
+    exti = Exti(rcc)
+    exti.write_afio(0x8, 4, 1 << 4)
+    exti.write(0xC, 4, 0b10)  # FTSR line 1
+    rcc.write(APB2RSTR, 4, IOPAEN | IOPBEN | SPI1EN)
+    exti.edge(1, 1, 0)
+    assert exti.pr == 0b10 and exti.read_afio(0x8, 4) == 1 << 4
+    exti.write(0x14, 4, 0b10)
+    rcc.write(APB2RSTR, 4, AFIOEN)
+    with pytest.raises(PeripheralResetError, match="AFIO accessed while RCC_APB2RSTR bit 0 holds it in reset"):
+        exti.write_afio(0x8, 4, 1 << 4)
+    rcc.write(APB2RSTR, 4, 0)
+    exti.edge(1, 1, 0)
+    assert (exti.pr, exti.read_afio(0x8, 4), exti.ftsr) == (0, 0, 0b10)
+    exti.write_afio(0x8, 4, 1 << 4)
+    exti.edge(1, 1, 0)
+    assert exti.pr == 0b10
+
+
 @pytest.mark.parametrize("fidelity", ["transaction", "pin"])
 def test_a_firmware_resetting_gpioa_mid_frame_cuts_it_and_reads_reset_values(tmp_path: Path, fidelity: str) -> None:
     """mcu/gpio_reset.c lowers /SS, then resets GPIOA and AFIO through RCC_APB2RSTR: /SS floats high on the board's
