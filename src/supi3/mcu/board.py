@@ -279,6 +279,8 @@ class Board:
         The longest time from a falling edge of /IRQ to the first instruction of its handler.
     violations:
         Every interface violation with its bus time and program counter (strict mode raises the first).
+    served:
+        The last :meth:`run` ended with the firmware's work served (MCU-30).
     """
 
     def __init__(self, firmware: str | Path | FirmwareImage, *, cpu: str = "cortex_m3", cpu_hz: float = 48e6,
@@ -348,7 +350,8 @@ class Board:
         self._limit = self._budget = 0
         self._held: list[tuple[str, int, int]] | None = None  # pin level: edges held while a sleeping core waits
         self.served = True
-        """MCU-30: the last :meth:`run` ended with the firmware's work served (False: the serve wait ran out)."""
+        """MCU-30: the last :meth:`run` ended with the firmware's work served (False: the wait for the main loop's
+        pass ran out, or the run raised)."""
         self._arrivals: tuple[int, ...] = ()  # core cycles of the last arrivals at SERVE_POINT, after the last EXTI0
         self._serve_from: int | None = None  # the core cycle the run's last master cycle ended (None: no wait)
         self._serve_end: int | None = None  # the core cycle the wait for the main loop's pass gives up

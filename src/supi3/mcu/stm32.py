@@ -112,7 +112,6 @@ class Rcc:
             raise PeripheralResetError(f"{name} accessed while RCC_APB2RSTR bit {bit.bit_length() - 1} holds it in "
                                        "reset (RM0008 7.3.4)")  # fmt: skip
 
-
     def read(self, offset: int, size: int) -> int:
         """APB2ENR, APB2RSTR, or what was written."""
         del size
