@@ -819,6 +819,7 @@ class Board:
     def _run_pin(self, done: Callable[[], bool], max_instructions: int, end_s: float | None = None) -> None:
         core, ring, master = self.core, self.ring, self._master
         self._set_budget(max_instructions)
+        ended = core.cycles  # the core cycle the last master cycle ended (MCU-30)
         try:
             while not done():
                 if self._idle_to(end_s):  # the rest of the last cycle's time, left by run_for
@@ -832,13 +833,14 @@ class Board:
                         ring.status_telegram()
                     master.start()
                 self._cycles_done += 1
+                ended = core.cycles
                 if self._cycle_time_s is not None:  # on its schedule: no drift from the line's whole telegrams
                     on_time = abs(start - self._next_start) < self._telegram_s
                     self._next_start = (self._next_start if on_time else start) + self._cycle_time_s
                     self._idle_to(end_s)
             if end_s is not None:
                 return
-            self._serve_from = core.cycles  # MCU-30: the main loop's passes count from the last cycle's end
+            self._serve_from = ended  # MCU-30: the passes count from the last cycle's end (not a cycle time's idle)
             for _ in range(SERVE_TELEGRAMS):
                 if self._served() and self._irq_fell is None:
                     break
