@@ -191,6 +191,29 @@ def test_a_main_loop_too_slow_for_the_ring_ends_its_runs_unserved(variants: dict
     assert slow.now - fast.now < SERVE_TELEGRAMS * slow._telegram_s + 1e-3
 
 
+def test_the_serve_wait_adds_at_most_one_step_to_a_run(tmp_path: Path) -> None:
+    """Issue #13's case (2 Mbit/s, SPI1 at 3 MHz, non-strict): the handler outlasts the cycle, so each run waits,
+    handler after handler, until no exception is active or pending (before MCU-30 too: about 12 cycles). The run loop
+    still stops only at the bus events (about 4 a master cycle) and SysTick, plus the serve wait's end once. A draft
+    of MCU-30 kept the passed end as a bound and stepped the handlers block by block (1,132 steps more in 200
+    cycles)."""
+    elf = mcu_build.build(native.example("digital_io"), tmp_path / "issue13.elf", defines={"BOARD_SPI_BR": "3u"})
+    board = Board(elf, bit_rate=2_000_000, strict=False)
+    board.run(3)
+    steps = [0]
+    step = board._step
+
+    def counted(deadline: int) -> None:
+        steps[0] += 1
+        step(deadline)
+
+    board._step = counted  # type: ignore[method-assign]
+    for cycles in (20, 1, 3):
+        steps[0], before = 0, board.cycles
+        board.run(cycles)
+        assert board.served and steps[0] <= 5 * (board.cycles - before) + 2
+
+
 def test_supi3_firmware_run_reports_an_unserved_main_loop(
     variants: dict[tuple[str, str], Path], capsys: pytest.CaptureFixture[str]
 ) -> None:
