@@ -56,6 +56,7 @@ from supi3.mcu.stm32 import (
 )
 from supi3.model.registers import InterfaceViolationError
 from supi3.sdk import native
+from test_mcu_stm32 import Clock, Wire
 
 pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
 
@@ -273,25 +274,11 @@ def test_runs_cut_by_the_budget_or_given_between_changes_keep_the_serve_rule(
 # -- MCU-40: SPI1's CR1 during a transfer -----------------------------------------------------------------------------
 
 
-class _Clock:
-    def __init__(self) -> None:
-        self.cycles = 0
-
-    def __call__(self) -> int:
-        return self.cycles
-
-
-class _Echo:
-    def spi_byte(self, tx: int, bits: int, start: int, period: int, cr1: int) -> int:
-        del bits, start, period, cr1
-        return tx ^ 0xFF
-
-
-def _spi(cr1: int) -> tuple[Spi, list[tuple[str, str]], _Clock]:
+def _spi(cr1: int) -> tuple[Spi, list[tuple[str, str]], Clock]:
     """SPI1 alone with CR1 ``cr1``, its misuses collected."""
-    rcc, clock = Rcc(), _Clock()
+    rcc, clock = Rcc(), Clock()
     rcc.write(APB2ENR, 4, SPI1EN)
-    spi = Spi(rcc, clock, _Echo())
+    spi = Spi(rcc, clock, Wire())
     misuses: list[tuple[str, str]] = []
     spi.on_misuse = lambda rule, detail: misuses.append((rule, detail))
     spi.write(SPI_CR1, 4, cr1)
