@@ -18,12 +18,10 @@ import tempfile
 import time
 from pathlib import Path
 
+from bench_mcu import POWER_UP
 from supi3.mcu.board import Board
 from supi3.mcu.build import build
 from supi3.sdk import native
-
-POWER_UP = 3
-"""Cycles of the power-up part (as bench_mcu.py)."""
 
 
 def pin_run(elf: Path, cycles: int, repeat: int) -> tuple[tuple[float, float], tuple[float, float]]:
