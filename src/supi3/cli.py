@@ -788,8 +788,9 @@ def build_parser() -> argparse.ArgumentParser:
     steps = firmware.add_subparsers(dest="step", required=True)
     p = steps.add_parser("run", help="run a firmware ELF on the default bench and report",
                          epilog=f"exit status: 0 clean; {FIRMWARE_STOPPED_STATUS} the firmware faulted, hung or used "
-                                f"up its budget; {FIRMWARE_FAILED_STATUS} an interface violation or process data "
-                                "that did not arrive; 2 bad input")  # fmt: skip
+                                f"up its budget; {FIRMWARE_FAILED_STATUS} an interface violation, process data "
+                                "that did not arrive or a main loop that did not serve the last cycle; "
+                                "2 bad input")  # fmt: skip
     p.add_argument("firmware", metavar="FIRMWARE.elf", help="built for the board port (supi3 firmware build)")
     p.add_argument("--cpu", choices=["cortex_m3", "cortex_m0"], default="cortex_m3")
     p.add_argument("--cpu-hz", type=integer, default=48_000_000, metavar="HZ",

@@ -95,7 +95,7 @@ _CHIP_INPUTS: Final[dict[int, tuple[str, int]]] = {PIN_SS: ("mfp_in", SS_BIT), P
 MISO_IDLE: Final[int] = 0xFF
 """MCU-6: what the SPI receives when the chip drives no SerOUT (pulled up)."""
 DEFAULT_MAX_INSTRUCTIONS: Final[int] = 20_000_000
-"""The instruction budget of one :meth:`Board.run` call unless given."""
+"""The instruction budget of one :meth:`Board.run` call unless given, renewed each time the core waits (MCU-41)."""
 FIDELITIES: Final[tuple[str, ...]] = ("transaction", "pin")
 """The chip on the board: the transaction-level model (:class:`supi3.sdk.bench.Bench`) or the pin-level whole chip
 (:class:`supi3.top.Supi3Chip` in lockstep with the core, :mod:`supi3.mcu.pins`)."""
@@ -104,7 +104,15 @@ START_WAIT_S: Final[float] = 1e-3
 or after this much bus time of idle status telegrams, whichever comes first."""
 SERVE_TELEGRAMS: Final[int] = 64
 """MCU-17: at pin level, after its last master cycle :meth:`Board.run` idles the line up to this many status
-telegrams while the firmware is still in a handler or has an /IRQ edge to serve."""
+telegrams while the firmware is still in a handler or has an /IRQ edge to serve; MCU-30: at either fidelity it waits
+at most this many status telegrams' bus time for the main loop's passes (:data:`SERVE_POINT`)."""
+SERVE_POINT: Final[str] = "fw_loop"
+"""MCU-30: the main loop's idle point: the entry of the board contract's ``fw_loop`` (examples/fw_board.h), which the
+board port's ``main`` calls again and again, serving the /IRQ edge its EXTI0 handler noted after each call. A
+:meth:`Board.run` of a firmware with this symbol ends only once a whole pass (entry to entry) began after the last
+master cycle's end and after the last EXTI0 handler."""
+SERVE_PASSES: Final[int] = 2
+"""MCU-30: arrivals at :data:`SERVE_POINT` that make a whole pass: its entry and the next one."""
 
 
 FLAG_EVENTS: Final[frozenset[str]] = frozenset({"io", "latch"})
@@ -280,6 +288,8 @@ class Board:
         The longest time from a falling edge of /IRQ to the first instruction of its handler.
     violations:
         Every interface violation with its bus time and program counter (strict mode raises the first).
+    served:
+        The last :meth:`run` ended with the firmware's work served (MCU-30).
     """
 
     def __init__(self, firmware: str | Path | FirmwareImage, *, cpu: str = "cortex_m3", cpu_hz: float = 48e6,
@@ -314,6 +324,7 @@ class Board:
         self._advance: Callable[[float], bool] = self._no_bench if self._bench is None else self._bench.advance
         self._cpu_hz = self.core.cpu_hz
         bit_rate = self.config.bit_rate
+        self._telegram_s = wire.STATUS_TELEGRAM_BITS / bit_rate  # the line idles in whole telegrams (MCU-22, -30)
         self._limits = {symbol: timing.limit("3-7", symbol, bit_rate) for symbol in ("t0", "t1", "t2", "t8")}
         self._limits["t6max"] = timing.limit("3-7", "t6", bit_rate, maximum=True)
         self._limits["t_SAS_INIT"] = timing.limit("3-7", "t_SAS_INIT", bit_rate)
@@ -328,6 +339,7 @@ class Board:
         self.spi = Spi(self.rcc, self.core.cycles_now, self if self._ring is None else self._ring,
                        self.core.cycles_polled)  # fmt: skip
         self.spi.on_poll = self.core.skip_poll
+        self.spi.on_misuse = self._mcu_violation
         core = self.core
         core.mmio(RCC_BASE, PERIPHERAL_SIZE, self.rcc.read, self.rcc.write)
         core.mmio(GPIOA_BASE, PERIPHERAL_SIZE, self.gpio.read, self.gpio.write)
@@ -350,6 +362,17 @@ class Board:
         self._mod_ack_until = 0
         self._limit = self._budget = 0
         self._held: list[tuple[str, int, int]] | None = None  # pin level: edges held while a sleeping core waits
+        self.served = True
+        """MCU-30: the last :meth:`run` ended with the firmware's work served (False: the wait for the main loop's
+        pass ran out, or the run raised)."""
+        self._arrivals: tuple[int, ...] = ()  # core cycles of the last arrivals at SERVE_POINT, after the last EXTI0
+        self._serve_from: int | None = None  # the core cycle the run's last master cycle ended (None: no wait)
+        self._serve_end: int | None = None  # the core cycle the wait for the main loop's pass gives up
+        if SERVE_POINT in core.image.symbols:  # MCU-30: note the main loop's passes
+            self._serve_point: int | None = core.image.address(SERVE_POINT)
+            core.watch(self._serve_point, self._on_serve_point)
+        else:
+            self._serve_point = None
 
     def _pin_setup(self, config: DeviceConfig | None, bit_rate: int, others: Sequence[Device | PinChip | PinBranch],
                    cycle_time_s: float | None, strict: bool, pedantic: bool, record: bool,
@@ -376,7 +399,6 @@ class Board:
         self._master = Master(ring, locate=False, max_devices=len(ring.devices))
         self._cycles_done = 0
         self._next_start = 0.0  # cycle_time_s: the bus time the next master cycle starts
-        self._telegram_s = wire.STATUS_TELEGRAM_BITS / self.config.bit_rate  # the line idles in whole telegrams
 
     # -- what both fidelities show -----------------------------------------------------------------------------
 
@@ -521,10 +543,52 @@ class Board:
 
     def _entered(self, number: int) -> None:
         if number == _EXTI0:
+            self._arrivals = ()  # MCU-30: a pass serves the edge only if it begins after the handler
             self.interrupts += 1
             if self._irq_fell is not None:
                 self.irq_latency_s = max(self.irq_latency_s, self._seconds(self.core.cycles - self._irq_fell))
                 self._irq_fell = None
+
+    # -- the main loop's passes (MCU-30) --------------------------------------------------------------------------
+
+    def _on_serve_point(self) -> None:
+        """The core is about to run :data:`SERVE_POINT`: note the arrival (at the end of the block it is in, the
+        core's clock now, MCU-1); once a whole pass began after the run's last cycle, end the core's run."""
+        cycles = self.core.cycles
+        self._arrivals = (*self._arrivals[1 - SERVE_PASSES :], cycles)
+        if self._serve_from is not None and self._passed():
+            self.core.stop_request = True
+
+    def _passed(self) -> bool:
+        """A whole pass of the main loop began at or after the run's last cycle's end and after the last EXTI0
+        handler: :data:`SERVE_PASSES` arrivals at :data:`SERVE_POINT` since then (always, without the symbol)."""
+        if self._serve_point is None:
+            return True
+        since = self._serve_from
+        arrivals = self._arrivals
+        return since is not None and len(arrivals) == SERVE_PASSES and arrivals[0] >= since
+
+    def _served(self) -> bool:
+        """The firmware has served what the bus gave it: no exception active or pending and the main loop's pass
+        done (MCU-30)."""
+        return not self.core.in_exception and self._passed()
+
+    def _serve_wait(self) -> bool:
+        """Transaction level, :meth:`run`'s master cycles done: whether the run is done. The first call is at the
+        block boundary the core stopped at for the last cycle's end (the run loop stops at each bus event): the main
+        loop's passes count from there, for at most :data:`SERVE_TELEGRAMS` status telegrams (a bound of the run
+        loop's steps until then); an exception active or pending is waited for as before MCU-30, unbounded."""
+        core = self.core
+        if self._serve_from is None:
+            self._serve_from = core.cycles
+            self._serve_end = core.cycles + self._cycles(SERVE_TELEGRAMS * self._telegram_s)
+        end = self._serve_end
+        if end is not None and core.cycles >= end:
+            self._serve_end = end = None  # the wait for the pass is over: no longer a bound of the steps
+        if core.in_exception:
+            return False
+        self.served = self._passed()
+        return self.served or end is None
 
     # -- pins --------------------------------------------------------------------------------------------------
 
@@ -663,6 +727,16 @@ class Board:
     def _violation(self, rule: str, detail: str) -> None:
         self._chip(self.registers.violations.report, self.core.cycles_now(), InterfaceViolationError(rule, detail))
 
+    def _mcu_violation(self, rule: str, detail: str) -> None:
+        """A rule of the microcontroller's own peripherals broken (SPI1's CR1 during a transfer, MCU-40): reported
+        as the board's other violations, with the bus time and where the core is, at either fidelity."""
+        if self._ring is None:
+            self._violation(rule, detail)
+            return
+        error = InterfaceViolationError(rule, detail)
+        self.violations.append(ViolationAt.now(self.core, self._seconds(self.core.cycles_now()), error))
+        self.registers.violations.report(error)
+
     def _note(self, errors: list[InterfaceViolationError], cycles: int) -> None:
         for error in errors:
             self.violations.append(ViolationAt.now(self.core, self._seconds(cycles), error))
@@ -670,26 +744,39 @@ class Board:
     # -- running -----------------------------------------------------------------------------------------------
 
     def run(self, cycles: int, *, max_instructions: int = DEFAULT_MAX_INSTRUCTIONS) -> None:
-        """Run the firmware until ``cycles`` more master cycles have finished and it has served the interrupts they
-        raised (as :meth:`Bench.run` takes the last cycle's interrupt). At pin level the master's cycles run whole,
-        and the run goes on while the firmware is in a handler or has an /IRQ edge to serve, up to
-        :data:`SERVE_TELEGRAMS` status telegrams (MCU-17).
+        """Run the firmware until ``cycles`` more master cycles have finished and it has served them (MCU-30): no
+        exception active or pending (the interrupts they raised taken, as :meth:`Bench.run` takes the last cycle's)
+        and, for a firmware with :data:`SERVE_POINT` (``fw_loop``), a whole pass of its main loop begun after the
+        last cycle and the last EXTI0 handler. The wait for that pass lasts at most :data:`SERVE_TELEGRAMS` status
+        telegrams of bus time; :attr:`served` tells whether the run ended served. At pin level the master's cycles
+        run whole, then the line idles in status telegrams while the firmware is in a handler, has an /IRQ edge to
+        serve or its pass to make, up to :data:`SERVE_TELEGRAMS` of them (MCU-17). The instruction budget bounds the
+        work between two waits of the core (MCU-41).
 
         Raises
         ------
         FirmwareFaultError
             The core faulted (report: fault type, PC, stacked registers).
         FirmwareStoppedError
-            ``max_instructions`` ran out (checked where the core stops, at basic-block boundaries, so the run may
-            end up to one block past it, MCU-1), or the firmware loops on ``b .`` inside a handler.
+            ``max_instructions`` ran out since the core last waited (checked where the core stops, at basic-block
+            boundaries, so the run may end up to one block past it, MCU-1), or the firmware loops on ``b .`` inside
+            a handler.
         InterfaceViolationError
             In strict mode, the first rule the firmware broke, with a note: bus time, PC and function.
+        PeripheralClockError, PeripheralResetError
+            The firmware touched a peripheral whose clock is off or which RCC_APB2RSTR holds in reset (MCU-7,
+            MCU-29).
         """
         target = self.cycles + check_int("cycles", cycles, 0)
-        if self._ring is not None:
-            self._run_pin(lambda: self._cycles_done >= target, max_instructions)
-            return
-        self._run(lambda: self.bench.cycles >= target and not self.core.in_exception, max_instructions)
+        self._serve_from = self._serve_end = None
+        self.served = False  # until the run ends served (MCU-30)
+        try:
+            if self._ring is not None:
+                self._run_pin(lambda: self._cycles_done >= target, max_instructions)
+                return
+            self._run(lambda: self.bench.cycles >= target and self._serve_wait(), max_instructions)
+        finally:
+            self._serve_from = self._serve_end = None
 
     def run_for(self, seconds: float, *, max_instructions: int = DEFAULT_MAX_INSTRUCTIONS) -> None:
         """Run the firmware for ``seconds`` of bus time (raises as :meth:`run`). At pin level (MCU-22) the master
@@ -717,7 +804,7 @@ class Board:
                 return
             deadline = event = math.ceil(self.bench.next_change_s() * core.cpu_hz)
             tick = core.systick.next_event()
-            for bound in (tick, end):
+            for bound in (tick, end, self._serve_end):
                 if bound is not None:
                     deadline = min(deadline, bound)
             self._step(deadline)
@@ -745,6 +832,8 @@ class Board:
                 raise FirmwareStoppedError(core.report(Stop.HANG, f"endless loop (b .) in the handler of exception "
                                                   f"{core.active[-1]}"))  # fmt: skip
             core.sleeping = True
+        if core.sleeping:  # MCU-41: the budget bounds the work between two waits, renewed at each
+            self._limit = core.instructions + self._budget
 
     def _place(self, error: InterfaceViolationError) -> None:
         """Note on ``error`` where the firmware broke the rule (once)."""
@@ -760,6 +849,7 @@ class Board:
     def _run_pin(self, done: Callable[[], bool], max_instructions: int, end_s: float | None = None) -> None:
         core, ring, master = self.core, self.ring, self._master
         self._set_budget(max_instructions)
+        ended = core.cycles  # the core cycle the last master cycle ended (MCU-30)
         try:
             while not done():
                 if self._idle_to(end_s):  # the rest of the last cycle's time, left by run_for
@@ -773,16 +863,19 @@ class Board:
                         ring.status_telegram()
                     master.start()
                 self._cycles_done += 1
+                ended = core.cycles
                 if self._cycle_time_s is not None:  # on its schedule: no drift from the line's whole telegrams
                     on_time = abs(start - self._next_start) < self._telegram_s
                     self._next_start = (self._next_start if on_time else start) + self._cycle_time_s
                     self._idle_to(end_s)
             if end_s is not None:
                 return
+            self._serve_from = ended  # MCU-30: the passes count from the last cycle's end (not a cycle time's idle)
             for _ in range(SERVE_TELEGRAMS):
-                if not core.in_exception and self._irq_fell is None:
+                if self._served() and self._irq_fell is None:
                     break
                 ring.status_telegram()
+            self.served = self._served()
         except InterfaceViolationError as error:
             self._place(error)
             raise

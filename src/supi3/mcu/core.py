@@ -837,6 +837,26 @@ class CortexM:
                    ctypes.byref(self._state))  # fmt: skip
         return HeldRegister(held)
 
+    def watch(self, address: int, callback: Callable[[], None]) -> None:
+        """Call ``callback`` each time the instruction at ``address`` is about to run (a code hook on it: the board's
+        main-loop idle point, MCU-30). The callback may set :attr:`stop_request` to end the run at the next block
+        boundary (the block it is in runs whole, as MCU-1 counted it); an exception it raises stops the run there and
+        is raised by :meth:`step` (as a peripheral's, :meth:`mmio`)."""
+        check_int("address", address, 0, 0xFFFF_FFFF, "the 32-bit address space")
+        if not callable(callback):
+            raise fail("callback", "a callable taking no argument", callback)
+
+        def on_code(handle: int, at: int, size: int, data: int) -> None:
+            del handle, at, size, data
+            if self.error is not None:
+                return
+            try:
+                callback()
+            except BaseException as error:  # handed to the run loop, raised there
+                self.fail(error)
+
+        self._hook(ucc.UC_HOOK_CODE, _HOOK_CODE(on_code), address, address)
+
     def _hook(self, kind: int, callback: Any, begin: int = 1, end: int = 0, data: Any = None) -> None:
         """Add a hook with a ctypes callback or a native function (MCU-19, MCU-25) and its user data; ``begin >
         end``: every address."""

@@ -23,7 +23,7 @@ from supi3.errors import Supi3Error
 from supi3.interbus.device import PlainDevice
 from supi3.interbus.link import Device
 from supi3.interbus.master import ConfigEntry
-from supi3.mcu.board import DEFAULT_MAX_INSTRUCTIONS, FIDELITIES, Board, ViolationAt
+from supi3.mcu.board import DEFAULT_MAX_INSTRUCTIONS, FIDELITIES, SERVE_TELEGRAMS, Board, ViolationAt
 from supi3.mcu.core import FirmwareError, StopReport
 from supi3.model.pins import Supi3Pins
 from supi3.sdk.bench import DEFAULT_STRAPS
@@ -81,6 +81,9 @@ class FirmwareRun:
     """The board's wiring: the interface type the firmware initializes (MCU-18)."""
     vcd: Path | None = None
     """The VCD file written (pin level only)."""
+    served: bool = True
+    """The last run ended with the firmware's work served (:attr:`Board.served`, MCU-30): ``False`` if its main loop
+    did not come back within the serve wait, or the run stopped."""
 
     @property
     def data_ok(self) -> bool:
@@ -92,8 +95,10 @@ class FirmwareRun:
 
     @property
     def failed(self) -> bool:
-        """The run did not end cleanly: a stop, a bench error, a violation, or data that did not arrive."""
-        return self.stop is not None or self.error is not None or bool(self.violations) or not self.data_ok
+        """The run did not end cleanly: a stop, a bench error, a violation, data that did not arrive, or a main loop
+        that did not serve the last cycle (MCU-30)."""
+        return self.stop is not None or self.error is not None or bool(self.violations) or not self.data_ok \
+            or not self.served  # fmt: skip
 
     def as_dict(self) -> dict[str, object]:
         """The report as JSON data."""
@@ -116,7 +121,7 @@ class FirmwareRun:
             "stop": None if self.stop is None else {"stop": self.stop.stop.value, "reason": self.stop.reason,
                                                     "pc": self.stop.pc, "text": str(self.stop)},
             "error": self.error, "fidelity": self.fidelity,
-            "mode": self.mode.value, "vcd": None if self.vcd is None else str(self.vcd),
+            "mode": self.mode.value, "vcd": None if self.vcd is None else str(self.vcd), "served": self.served,
         }  # fmt: skip
 
     def __str__(self) -> str:
@@ -143,6 +148,9 @@ class FirmwareRun:
                   f"run         {self.bus_time_s * 1e3:.3f} ms of bus time, {self.instructions} instructions, "
                   f"{self.core_cycles} core cycles, {self.wall_s:.2f} s wall "
                   f"({self.bus_time_s / max(self.wall_s, 1e-9):.3g}x real time)"]  # fmt: skip
+        if not self.served and self.stop is None and self.error is None:
+            lines.append("UNSERVED    the firmware's main loop did not come back to fw_loop after the last cycle "
+                         f"within {SERVE_TELEGRAMS} status telegrams (MCU-30)")  # fmt: skip
         lines.append(f"violations  {len(self.violations) or 'none'}")
         lines += [f"  {v.error.rule}: {v.error}\n    at {v.place}" for v in self.violations]
         if self.stop is not None:
@@ -221,6 +229,7 @@ def run_firmware(firmware: str | Path, *, cpu: str = "cortex_m3", cpu_hz: float 
     except Supi3Error as error:  # the bench cannot go on (a stuck firmware, a chip refusing the straps' mode)
         report.error = str(error)
     report.wall_s = time.perf_counter() - started
+    report.served = board.served
     report.config = master.config
     if report.config:
         network_bytes = sum(entry.data_bytes for entry in report.config)

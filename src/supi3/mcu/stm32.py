@@ -66,6 +66,10 @@ CR1_LSBFIRST: Final[int] = 1 << 7
 CR1_SSI: Final[int] = 1 << 8
 CR1_SSM: Final[int] = 1 << 9
 CR1_DFF: Final[int] = 1 << 11
+CR1_BR: Final[int] = 0b111 << CR1_BR_SHIFT
+CR1_ONGOING: Final[dict[int, str]] = {CR1_CPHA: "CPHA", CR1_CPOL: "CPOL", CR1_MSTR: "MSTR", CR1_BR: "BR",
+                                      CR1_LSBFIRST: "LSBFIRST"}  # fmt: skip
+"""MCU-40: the CR1 fields RM0008 25.5.1 says "should not be changed when communication is ongoing" (BSY = 1)."""
 SR_RXNE: Final[int] = 1 << 0
 SR_TXE: Final[int] = 1 << 1
 SR_MODF: Final[int] = 1 << 5
@@ -80,8 +84,8 @@ class PeripheralClockError(Supi3Error, RuntimeError):
 
 
 class PeripheralResetError(Supi3Error, RuntimeError):
-    """The firmware touched SPI1 while RCC_APB2RSTR holds it in reset, or reset it while a byte shifts (RM0008 7.3.4):
-    the access would be lost, the cut byte is not modelled; here it stops the run (MCU-29)."""
+    """The firmware touched GPIOA, GPIOB, AFIO or SPI1 while RCC_APB2RSTR holds it in reset (RM0008 7.3.4: the access
+    would be lost), or reset SPI1 while a byte shifts (the cut byte is not modelled); here it stops the run (MCU-29)."""
 
 
 class Rcc:
@@ -90,6 +94,8 @@ class Rcc:
 
     def __init__(self) -> None:
         self.apb2enr = 0
+        self.apb2rstr = 0
+        """RCC_APB2RSTR: the peripherals held in reset (RM0008 7.3.4)."""
         self._other: dict[int, int] = {}
         self.on_enable_change: list[Callable[[], None]] = []
         """Called when APB2ENR is written: a peripheral whose register the core answers natively takes it back."""
@@ -97,27 +103,34 @@ class Rcc:
         """Called with the value when APB2RSTR is written: a peripheral whose bit is set resets (MCU-29)."""
 
     def require(self, bit: int, name: str) -> None:
-        """Raise :class:`PeripheralClockError` unless APB2ENR has ``bit``."""
+        """Raise :class:`PeripheralClockError` unless APB2ENR has ``bit``, :class:`PeripheralResetError` if APB2RSTR
+        has it (the peripheral is held in reset: MCU-29)."""
         if not self.apb2enr & bit:
             raise PeripheralClockError(f"{name} accessed while its clock is off (RCC_APB2ENR bit {bit.bit_length() - 1}"
                                        " = 0, RM0008 7.3.7)")  # fmt: skip
+        if self.apb2rstr & bit:
+            raise PeripheralResetError(f"{name} accessed while RCC_APB2RSTR bit {bit.bit_length() - 1} holds it in "
+                                       "reset (RM0008 7.3.4)")  # fmt: skip
 
     def read(self, offset: int, size: int) -> int:
-        """APB2ENR, or what was written."""
+        """APB2ENR, APB2RSTR, or what was written."""
         del size
-        return self.apb2enr if offset == APB2ENR else self._other.get(offset, 0)
+        if offset == APB2ENR:
+            return self.apb2enr
+        return self.apb2rstr if offset == APB2RSTR else self._other.get(offset, 0)
 
     def write(self, offset: int, size: int, value: int) -> None:
-        """APB2ENR, or kept."""
+        """APB2ENR, APB2RSTR (each peripheral whose bit is set resets: MCU-29), or kept."""
         del size
         if offset == APB2ENR:
             self.apb2enr = value
             for changed in self.on_enable_change:
                 changed()
+        elif offset == APB2RSTR:
+            self.apb2rstr = value
+            for reset in self.on_reset:
+                reset(value)
         else:
-            if offset == APB2RSTR:
-                for reset in self.on_reset:
-                    reset(value)
             self._other[offset] = value
 
 
@@ -150,6 +163,17 @@ class Gpio:
         self.odr = 0
         self._mask: int | None = None  # the output pins, from CRL and CRH
         self._levels = self.levels()
+        rcc.on_reset.append(self._reset)
+
+    def _reset(self, apb2rstr: int) -> None:
+        """RCC_APB2RSTR written (RM0008 7.3.4, MCU-29): with the port's bit set, CRL, CRH and ODR go to their reset
+        values (9.2: every pin a floating input, ODR 0), so the pins it drove float: the board's pull-ups and the
+        chip see the change (:attr:`on_output`)."""
+        if apb2rstr & self.enable_bit:
+            self.cr = [0x4444_4444, 0x4444_4444]
+            self.odr = 0
+            self._mask = None
+            self._changed()
 
     def is_output(self, pin: int) -> bool:
         """MODE of ``pin`` is not 00 (input)."""
@@ -191,8 +215,8 @@ class Gpio:
     def write(self, offset: int, size: int, value: int) -> None:
         """CRL, CRH, ODR, BSRR (set in bits 0..15, reset in 16..31, set wins), BRR."""
         del size
-        if not self.rcc.apb2enr & self.enable_bit:  # the clock check's common case without a call (MCU-31)
-            self.rcc.require(self.enable_bit, self.name)
+        if not self.rcc.apb2enr & self.enable_bit or self.rcc.apb2rstr & self.enable_bit:  # no call if fine (MCU-31)
+            self.rcc.require(self.enable_bit, self.name)  # clock on, not held in reset (MCU-7, MCU-29)
         if offset in (0x0, 0x4):
             self.cr[offset // 4] = value
             self._mask = None
@@ -220,6 +244,13 @@ class Exti:
         self.rtsr = 0
         self.ftsr = 0
         self.pr = 0
+        rcc.on_reset.append(self._reset)
+
+    def _reset(self, apb2rstr: int) -> None:
+        """RCC_APB2RSTR's AFIORST (bit 0, RM0008 7.3.4, MCU-29): EXTICR1 goes to 0 (9.4.3: every EXTI line on port A);
+        EXTI has no reset bit and keeps its registers (10.3)."""
+        if apb2rstr & AFIOEN:
+            self.exticr1 = 0
 
     def edge(self, port: int, pin: int, level: int) -> None:
         """Pin ``pin`` of port ``port`` (0 = A) went to ``level``."""
@@ -345,6 +376,9 @@ class Spi:
         self.polled = now if polled is None else polled
         self.on_poll: Callable[[int], None] = _ignore
         """Called on a status read while a byte shifts, with the cycle SR changes next (the board's poll skip)."""
+        self.on_misuse: Callable[[str, str], None] = _unreported
+        """Called with (rule, detail) when a CR1 write breaks RM0008's rules for a transfer under way (MCU-40): the
+        board reports it as its other violations (alone, the model goes on as written and nothing is reported)."""
         self.wire = wire
         self.cr1 = 0
         self.cr2 = 0
@@ -361,7 +395,6 @@ class Spi:
         self.offer: ReadOffer = _NoHolder()
         """Told when the read of DR after the shifting byte is known (the same register of the core, MCU-26)."""
         self._holding = False
-        self._in_reset = False
         rcc.on_enable_change.append(self._release)
         rcc.on_reset.append(self._reset)
 
@@ -370,8 +403,7 @@ class Spi:
         values (25.5: CR1, CR2 0, SR 0002h, DR 0) and stay there until the bit is cleared; a byte shifting at the
         write is a :class:`PeripheralResetError` (its cut is not modelled: the other end took it whole)."""
         self._release()
-        self._in_reset = bool(apb2rstr & SPI1EN)
-        if not self._in_reset:
+        if not apb2rstr & SPI1EN:
             return
         cycles = self.now()
         self._run(cycles)
@@ -381,13 +413,6 @@ class Spi:
         self.cr1 = self.cr2 = self.rx_last = 0
         self.modf = self.ovr = self._ovr_seen = False
         self.rx_buffer = self.tx_buffer = None
-
-    def _accessible(self) -> None:
-        """Raise unless SPI1's clock is on and RCC does not hold it in reset (MCU-7, MCU-29)."""
-        self.rcc.require(SPI1EN, "SPI1")
-        if self._in_reset:
-            raise PeripheralResetError(f"SPI1 accessed while RCC_APB2RSTR bit {SPI1EN.bit_length() - 1} holds it in "
-                                       "reset (RM0008 7.3.4, MCU-29)")  # fmt: skip
 
     def _release(self) -> None:
         if self._holding:
@@ -442,7 +467,7 @@ class Spi:
         """CR1, CR2, SR, DR (reading DR clears RXNE; reading SR after DR clears OVR, 25.3.10)."""
         del size
         self._release()
-        self._accessible()
+        self.rcc.require(SPI1EN, "SPI1")  # clock on, not held in reset (MCU-7, MCU-29)
         if offset == SPI_CR1:
             return self.cr1
         if offset == SPI_CR2:
@@ -457,6 +482,25 @@ class Spi:
         if offset == SPI_DR:
             return self._read_dr(self.polled())
         return 0
+
+    def _check_cr1(self, old: int, busy: bool, cycles: int) -> None:
+        """A CR1 write (``old`` before it, applied; ``busy``: a byte was shifting then) against RM0008 (MCU-40):
+        while a byte shifts the fields of :data:`CR1_ONGOING` must not change (25.5.1) and SPE must not be cleared
+        (25.3.8: wait for RXNE, TXE, then BSY = 0 before disabling, else the transfer may be corrupted); DFF is
+        written only with SPE = 0 (25.5.1). Each is reported to :attr:`on_misuse`; the model goes on as written:
+        the byte shifting ends with the settings it started with, a byte waiting starts only with SPE set."""
+        new = self.cr1
+        changed = old ^ new
+        fields = [name for mask, name in CR1_ONGOING.items() if changed & mask] if busy else []
+        if fields:
+            self.on_misuse("RM0008 25.5.1", f"SPI1 CR1 {', '.join(fields)} changed at cycle {cycles} while a byte "
+                           "shifts (BSY = 1): they should not be changed when communication is ongoing")  # fmt: skip
+        if busy and old & CR1_SPE and not new & CR1_SPE:
+            self.on_misuse("RM0008 25.3.8", f"SPI1 disabled (SPE cleared) at cycle {cycles} while a byte shifts "
+                           "(BSY = 1): wait for RXNE, TXE, then BSY = 0 before clearing SPE")  # fmt: skip
+        if changed & CR1_DFF and old & CR1_SPE:
+            self.on_misuse("RM0008 25.5.1", f"SPI1 CR1 DFF changed at cycle {cycles} while SPE = 1: it is written "
+                           "only with the SPI disabled")  # fmt: skip
 
     def _hold(self, value: int) -> None:
         """SR now holds ``value`` until the shifting byte ends (the time a poll may skip to, MCU-10), then its value
@@ -489,18 +533,19 @@ class Spi:
         """CR1 (MODF check on enabling), CR2, DR (into the transmit buffer; starts a transfer if idle)."""
         del size
         self._release()
-        if not self.rcc.apb2enr & SPI1EN or self._in_reset:  # the common case without a call (MCU-31)
-            self._accessible()
+        if not self.rcc.apb2enr & SPI1EN or self.rcc.apb2rstr & SPI1EN:  # the common case without a call (MCU-31)
+            self.rcc.require(SPI1EN, "SPI1")  # clock on, not held in reset (MCU-7, MCU-29)
         cycles = self.now()
         if self.shifting is not None:
             self._run(cycles)
         if offset == SPI_CR1:
-            self.cr1 = value & 0xFFFF
+            old, busy, self.cr1 = self.cr1, self.shifting is not None, value & 0xFFFF
             if self.cr1 & CR1_MSTR and self.cr1 & CR1_SSM and not self.cr1 & CR1_SSI:
                 self.modf = True
                 self.cr1 &= ~(CR1_MSTR | CR1_SPE)
             if self.cr1 & CR1_SPE and self.tx_buffer is not None and self.shifting is None:
                 self._start(cycles)
+            self._check_cr1(old, busy, cycles)
         elif offset == SPI_CR2:
             self.cr2 = value & 0xFF
         elif offset == SPI_DR:
@@ -513,3 +558,7 @@ class Spi:
 
 def _ignore(cycles: int) -> None:
     del cycles
+
+
+def _unreported(rule: str, detail: str) -> None:
+    del rule, detail
