@@ -8,8 +8,10 @@ lengths), the process data IN, and every chip's RD, LD and E LEDs. A branch pres
 breaks the ring at both (BK-43); an empty branch that needs a device's answer (RF = 11, or fibre with LBST = 0) is
 not present and the ring runs through the BK. The transaction-level BK recognises its branch by the pin level's rule
 (BK-48): a break of the branch's loop before the master's first start and after it, in every branch kind, and any
-history of breaks, repairs, starts, cycles and branch commands give the same at both fidelities; behind a break in an
-LBD branch the master reports a dead line at both, and the BK keeps the same count (BK-49).
+history of breaks (by physical position, BK-52), repairs, starts, cycles, branch commands and the BK's power-up give the
+same recognition and the same master's view of every start and cycle at both fidelities; a branch joining within a
+cycle loses that cycle's frame at both (BK-54); behind a break in an LBD branch the master reports a dead line at both,
+and the BK keeps the same count (BK-49).
 """
 
 from __future__ import annotations
@@ -194,12 +196,14 @@ OPS = st.one_of(st.tuples(st.sampled_from(["start", "cycle", "repair", "off", "o
                 st.tuples(st.just("cut"), st.integers(0, 3)))
 """A history's steps: the master's start (an INTERBUS reset and its ID cycles) or one cycle, a break of the branch's
 loop (an index into :func:`cuts`, made by the physical position, also while the branch is out of the data path,
-BK-52), every break repaired, the branch switched off or on by the master (BK-4), the BK's power-up reset (BK-48)."""
+BK-52), every break repaired (index 0: while the master sends idle telegrams; 1: just before the next run), the branch
+switched off or on by the master (BK-4), the BK's power-up reset (BK-48)."""
 POWER_DOWN_S = 4 * wire.STATUS_TELEGRAM_BITS / 2_000_000
 """How long the BK's /ResU is held low in a power-up step."""
 REPAIR_IDLE_S = 4 * wire.STATUS_TELEGRAM_BITS / 2_000_000
-"""Idle status telegrams after a repair behind which LBD devices sent counter telegrams (BK-54): more than a counter
-telegram (13 bit periods) and the status telegram chained to a dropped one (M16) that a device may drop (BK-30)."""
+"""Idle status telegrams after a repair (BK-54's limit): a repaired line takes up a telegram in flight at the repair
+point, and behind a break in an LBD branch a device that sends a counter telegram drops the telegram beginning then
+and the one chained to it (BK-30, M16); idle telegrams take that, not the next frame's head."""
 POWER_IDLE_S = 20 * wire.STATUS_TELEGRAM_BITS / 2_000_000
 """The idle after a power-up step: the reset stretch (M2) and the time a loop needs to answer (BK-37), an LBD branch's
 counter telegram every 33 bit periods (BK-30) included."""
@@ -234,13 +238,10 @@ def recognition_history(kind: BranchKind, row: tuple[str, bool], ops: list[Op]) 
             for master in masters:
                 master.switch_branch(2, name == "on")
         elif name == "repair":
-            # Behind a break in an LBD branch the devices send counter telegrams (BK-30): repaired under a frame, the
-            # frame's head may meet one at pin level (BK-54's limit); repaired while the master sends idle telegrams.
-            generating = kind.diagnostics and bool(pin.cuts)
             tl.clear_faults()
             pin.cuts.clear()
             pin.branch_cuts.clear()
-            if generating:
+            if not index:  # while the master sends idle telegrams, not under the next frame (BK-54's limit)
                 tl.idle(REPAIR_IDLE_S)
                 pin.idle(REPAIR_IDLE_S)
         elif name == "cut" and index < len(breaks):
@@ -297,7 +298,7 @@ def test_a_branch_joining_within_a_cycle_fails_that_cycle_at_both_fidelities(kin
     for index, (_, (_, _, branch)) in enumerate(cuts(kind)):
         if kind.diagnostics and not branch:
             continue  # the LBD branch's devices answer behind a break with counter telegrams (BK-30)
-        ops: list[Op] = [("cut", index), ("power", 0), ("start", 0), ("cycle", 0), ("repair", 0),
+        ops: list[Op] = [("cut", index), ("power", 0), ("start", 0), ("cycle", 0), ("repair", 1),
                          *[("cycle", 0)] * 4]  # fmt: skip
         steps = recognition_history(kind, ("11", True), ops)
         assert [tl for tl, _ in steps] == [pin for _, pin in steps], index

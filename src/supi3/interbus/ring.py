@@ -22,10 +22,12 @@ devices of its branch. The data path runs into the BK, through the branch and ba
 bus, so the ring flattens the tree into :attr:`Ring.devices` in that order, leaving out every branch its BK has not in
 the data path (switched off by the master, closed by the BK itself, not present by Table 2-9: a BK recognises its
 branch once a device answered, BK-48); it flattens again whenever a BK changes that. In a tree a fault belongs to the
-physical line it was injected on: it follows that line when branches are switched, and sleeps while the line is out
-of the data path. :class:`ReturnBreak` breaks a branch's return line (a branch in the data path with nothing attached
-is broken so at its BK, BK-43), and behind a break in a branch with device-oriented diagnostics the devices send the
-counter telegram to the BK (2.2.2, ``wire.counter_telegram``).
+physical line it was injected on: it follows that line when branches are switched, and sleeps while the line is out of
+the data path; :meth:`Ring.cut` injects a break by the physical position of the device it enters, as the pin level's
+``PinRing.cut`` (BK-52). A branch recognised in a cycle's run joins within its frame, which it loses (BK-54).
+:class:`ReturnBreak` breaks a branch's return line (a branch in the data path with nothing attached is broken so at
+its BK, BK-43), and behind a break in a branch with device-oriented diagnostics the devices send the counter telegram
+to the BK (2.2.2, ``wire.counter_telegram``).
 """
 
 from __future__ import annotations
@@ -155,10 +157,11 @@ class DeadLine:
 class ReturnBreak:
     """The return line *into* ring position ``segment`` of a tree carries nothing (docs/interbus.md, "Tree").
 
-    ``segment`` is a bus terminal module (its branch's return line, from the branch's first device in a branch
-    with return, from the last in an LBD-OR branch) or a device of a branch with return lines (REMOTE, LOCAL,
-    LBD_MR) that has a device behind it in the branch (the return line from that device). The ring closed early
-    uses the return line into position *k* only when it is closed behind *k*; permanent unless ``cycles`` is given.
+    ``segment`` is a bus terminal module with a branch (its branch's return line, from the branch's first device in
+    a branch with return, from the last in an LBD-OR branch; whether the branch is in the data path or not, BK-52)
+    or a device of a branch with return lines (REMOTE, LOCAL, LBD_MR) that has a device behind it in the branch (the
+    return line from that device). The ring closed early uses the return line into position *k* only when it is
+    closed behind *k*; permanent unless ``cycles`` is given.
     """
 
     segment: int

@@ -319,7 +319,8 @@ class PinRing:
         chip of a branch takes its BK's DO3), or its return input DI2 from the chip behind it (a chip that has one:
         not the last of the ring or of a branch, none in an LBD-OR branch), or with ``branch`` (``forward`` false) a
         BK's branch return input DI3 (MFP10), the line ``ring.ReturnBreak`` breaks at a BK (BK-10). A broken line
-        reads at the idle level (RS-485 fail-safe bias, BK-30): behind it the LBD chips' counter telegrams (2.2.2)
+        reads at the idle level (RS-485 fail-safe bias, BK-30); ``ring.Ring.cut`` takes the same arguments with the same
+        physical numbering, in every state (BK-52). Behind a break the LBD chips' counter telegrams (2.2.2)
         bring the master, or the branch's BK, the count of ``ring.lbd_count`` (``forward``, ``back``) for a branch of
         these chips.
 
