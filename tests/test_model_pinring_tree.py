@@ -455,6 +455,11 @@ def test_a_cut_is_numbered_by_the_physical_position_at_both_fidelities_in_every_
         tl.clear_faults()
     with pytest.raises(ArgumentError, match=r"BK-10"):
         tl.cut(1, False)
+    for bad, name in (((2, 1), "forward"), ((True, True), "position"), ((2.0, True), "position")):
+        with pytest.raises(ArgumentError, match=rf"^{name} must be"):
+            tl.cut(*bad)
+    with pytest.raises(ArgumentError, match=r"^branch must be"):
+        tl.cut(2, False, branch="yes")  # type: ignore[arg-type]
 
 
 @pytest.mark.parametrize(("kind", "m"), CASES)
