@@ -8,8 +8,10 @@ lengths), the process data IN, and every chip's RD, LD and E LEDs. A branch pres
 breaks the ring at both (BK-43); an empty branch that needs a device's answer (RF = 11, or fibre with LBST = 0) is
 not present and the ring runs through the BK. The transaction-level BK recognises its branch by the pin level's rule
 (BK-48): a break of the branch's loop before the master's first start and after it, in every branch kind, and any
-history of breaks, repairs, starts, cycles and branch commands give the same at both fidelities; behind a break in an
-LBD branch the master reports a dead line at both, and the BK keeps the same count (BK-49).
+history of breaks (by physical position, BK-52), repairs, starts, cycles, branch commands and the BK's power-up give the
+same recognition and the same master's view of every start and cycle at both fidelities; a branch joining within a
+cycle loses that cycle's frame at both (BK-54); behind a break in an LBD branch the master reports a dead line at both,
+and the BK keeps the same count (BK-49).
 """
 
 from __future__ import annotations
@@ -21,8 +23,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from supi3.interbus import wire
-from supi3.interbus.master import Master
+from supi3.interbus.master import CycleResult, Master
 from supi3.interbus.ring import Branch, BranchKind, DeadLine, ErrorKind, Fault, ReturnBreak, Ring, lbd_count
+from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
 from supi3.model.pinring import PinBranch, PinRing
 from supi3.model.pins import Supi3Pins
@@ -189,10 +192,85 @@ def test_a_branch_cut_before_or_after_the_first_start_is_the_same_at_both_fideli
 
 
 Op = tuple[str, int]
-OPS = st.one_of(st.tuples(st.sampled_from(["start", "cycle", "repair", "off", "on"]), st.just(0)),
+OPS = st.one_of(st.tuples(st.sampled_from(["start", "cycle", "repair", "off", "on", "power"]), st.just(0)),
                 st.tuples(st.just("cut"), st.integers(0, 3)))
 """A history's steps: the master's start (an INTERBUS reset and its ID cycles) or one cycle, a break of the branch's
-loop (an index into :func:`cuts`), every break repaired, the branch switched off or on by the master (BK-4)."""
+loop (an index into :func:`cuts`, made by the physical position, also while the branch is out of the data path,
+BK-52), every break repaired (index 0: while the master sends idle telegrams; 1: just before the next run), the branch
+switched off or on by the master (BK-4), the BK's power-up reset (BK-48)."""
+POWER_DOWN_S = 4 * wire.STATUS_TELEGRAM_BITS / 2_000_000
+"""How long the BK's /ResU is held low in a power-up step."""
+REPAIR_IDLE_S = 4 * wire.STATUS_TELEGRAM_BITS / 2_000_000
+"""Idle status telegrams after a repair (BK-54's limit): a repaired line takes up a telegram in flight at the repair
+point, and behind a break in an LBD branch a device that sends a counter telegram drops the telegram beginning then
+and the one chained to it (BK-30, M16); idle telegrams take that, not the next frame's head."""
+POWER_IDLE_S = 20 * wire.STATUS_TELEGRAM_BITS / 2_000_000
+"""The idle after a power-up step: the reset stretch (M2) and the time a loop needs to answer (BK-37), an LBD branch's
+counter telegram every 33 bit periods (BK-30) included."""
+
+
+Seen = tuple[Cycle, bool, list[tuple[ErrorKind | None, int | None, str | None]], View | None] | None
+Record = tuple[str, int, bool, Seen]
+"""A step of :func:`recognition_history` at one fidelity: the step, the BK's recognition, what the master saw."""
+
+
+def recognition_history(kind: BranchKind, row: tuple[str, bool], ops: list[Op]) -> list[tuple[Record, Record]]:
+    """Run ``ops`` (:data:`OPS`) on the transaction-level and the pin-level tree of two branch devices of ``kind``
+    (``row``: RF and LBST, Table 2-9) with a master on each; per step, at each fidelity, the BK's recognition
+    (``branch_recognised``, ``connected``) and what the master saw (:func:`seen`)."""
+    tl, tl_chips = tl_ring(kind, *row, 2)
+    pin, _ = pin_ring(kind, *row, 2)
+    for ring in (tl, pin):  # past the chips' power-up reset stretch (M2): a first frame would meet it at pin level
+        ring.idle(POWER_IDLE_S)
+    masters = [Master(tl, locate=False, max_devices=8), Master(pin, locate=False, max_devices=8)]
+    breaks = cuts(kind)
+    steps: list[tuple[Record, Record]] = []
+    for name, index in ops:
+        was = tl_chips[1].branch_recognised
+        results: list[CycleResult | None] = [None, None]
+        if name == "cycle" and any(master.config is None for master in masters):
+            # Without a configuration a master starts again (an INTERBUS reset): a discovery ID cycle over devices that
+            # took no reset since their power-up fails at pin level in a ring without branches too (BK-54).
+            name = "start"
+        if name in ("start", "cycle"):
+            results = [master.start() if name == "start" else master.cycle() for master in masters]
+        elif name in ("off", "on") and all(m.config is not None and len(m.config) > 1 for m in masters):
+            for master in masters:
+                master.switch_branch(2, name == "on")
+        elif name == "repair":
+            tl.clear_faults()
+            pin.cuts.clear()
+            pin.branch_cuts.clear()
+            if not index:  # while the master sends idle telegrams, not under the next frame (BK-54's limit)
+                tl.idle(REPAIR_IDLE_S)
+                pin.idle(REPAIR_IDLE_S)
+        elif name == "cut" and index < len(breaks):
+            _, (position, forward, branch) = breaks[index]
+            tl.cut(position, forward, branch=branch)
+            pin.cut(position, forward, branch=branch)
+        elif name == "power":
+            tl.idle(POWER_DOWN_S)
+            tl_chips[1].power_up()
+            tl.idle(POWER_IDLE_S)
+            pin.set_input(2, "resu_n", 0)
+            pin.idle(POWER_DOWN_S)
+            pin.set_input(2, "resu_n", 1)
+            pin.idle(POWER_IDLE_S)
+        # A branch that joins the data path in a cycle's run joins within its frame (BK-54): the cycle fails at both
+        # fidelities, with the error where the pin-level BK switched (not compared).
+        joined = name == "cycle" and not was and tl_chips[1].branch_recognised
+        steps.append(((name, index, tl_chips[1].branch_recognised, seen(masters[0], results[0], joined)),
+                      (name, index, connected(pin), seen(masters[1], results[1], joined))))  # fmt: skip
+    return steps
+
+
+def seen(master: Master, result: CycleResult | None, joined: bool) -> Seen:
+    """The master's view after a step: the cycle's kind, success and diagnostics (kind, location, device; without
+    the kinds in a cycle a branch joined, ``joined``), the configuration and the IN data."""
+    if result is None:
+        return None
+    return (result.cycle, result.ok, [(None if joined else d.kind, d.location, d.device) for d in result.diagnostics],
+            view(master) if master.config is not None else None)  # fmt: skip
 
 
 @settings(max_examples=12, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
@@ -201,29 +279,52 @@ loop (an index into :func:`cuts`), every break repaired, the branch switched off
        ops=st.lists(OPS, min_size=1, max_size=7))
 def test_the_recognition_follows_any_history_the_same_at_both_fidelities(
         kind: BranchKind, row: tuple[str, bool], ops: list[Op]) -> None:
-    """BK-37, BK-48: breaks, repairs, starts (INTERBUS resets), cycles and branch commands in any order leave the
-    transaction-level BK's ``branch_recognised`` equal to the pin-level BK's ``connected`` after every step; a break is
-    made only where the transaction-level ring has the branch in its data path (its lines are numbered there)."""
-    tl, tl_chips = tl_ring(kind, *row, 2)
-    pin, _ = pin_ring(kind, *row, 2)
-    masters = [Master(tl, locate=False, max_devices=8), Master(pin, locate=False, max_devices=8)]
-    breaks = cuts(kind)
-    for name, index in ops:
-        if name in ("start", "cycle"):
-            for master in masters:
-                master.start() if name == "start" else master.cycle()
-        elif name in ("off", "on") and all(m.config is not None and len(m.config) > 1 for m in masters):
-            for master in masters:
-                master.switch_branch(2, name == "on")
-        elif name == "repair":
-            tl.clear_faults()
-            pin.cuts.clear()
-            pin.branch_cuts.clear()
-        elif name == "cut" and tl.spans and index < len(breaks):
-            fault, (position, forward, branch) = breaks[index]
-            tl.inject(fault)
-            pin.cut(position, forward, branch=branch)
-        assert tl_chips[1].branch_recognised == connected(pin), (name, index)
+    """BK-37, BK-48, BK-52, BK-54: breaks (by physical position, also while the branch is out of the data path),
+    repairs, starts (INTERBUS resets), cycles, branch commands and the BK's power-up in any order leave the
+    transaction-level BK's ``branch_recognised`` equal to the pin-level BK's ``connected`` after every step, and the
+    master sees every start and cycle alike (a branch joining within a cycle fails it at both)."""
+    for tl, pin in recognition_history(kind, row, ops):
+        assert tl == pin
+
+
+@pytest.mark.parametrize("kind", [*KINDS, BranchKind.LBD_OR])
+def test_a_branch_joining_within_a_cycle_fails_that_cycle_at_both_fidelities(kind: BranchKind) -> None:
+    """BK-54: every break that keeps a branch unrecognised (BK-48: a loop with return lines broken anywhere, an LBD
+    branch's BK's own return input), made after the BK's power-up, leaves the branch out at the master's start; repaired
+    after the start, the branch answers in the next cycle's run and joins the data path within its frame at both
+    fidelities: that cycle fails at both (the transaction level loses the frame behind the BK; the pin-level error is
+    where the BK switched, not compared), and every cycle after it is the same (the master meets the longer ring: the
+    loopback word out of place, BK-45)."""
+    for index, (_, (_, _, branch)) in enumerate(cuts(kind)):
+        if kind.diagnostics and not branch:
+            continue  # the LBD branch's devices answer behind a break with counter telegrams (BK-30)
+        ops: list[Op] = [("cut", index), ("power", 0), ("start", 0), ("cycle", 0), ("repair", 1),
+                         *[("cycle", 0)] * 4]  # fmt: skip
+        steps = recognition_history(kind, ("11", True), ops)
+        assert [tl for tl, _ in steps] == [pin for _, pin in steps], index
+        recognised = [tl[2] for tl, _ in steps]
+        assert recognised == [True] + [False] * 4 + [True] * 4, index  # the bring-up; power-up
+        start, joined = steps[2][0][3], steps[5][0][3]
+        assert start is not None and start[1] and start[3] is not None and len(start[3][0]) == 3, index  # through BK
+        assert joined is not None and not joined[1] and joined[2] == [(None, None, None)], index
+        # The longer ring after it: the loopback word out of place; without location the table stays (BK-45).
+        after = [step[0][3] for step in steps[6:]]
+        assert all(seen is not None and seen[2] == [(ErrorKind.LOOPBACK, None, None)] for seen in after), index
+
+
+def test_the_transaction_level_loses_the_frame_a_branch_joins_within() -> None:
+    """BK-54 at transaction level: the cycle in whose run a branch is recognised delivers its frame as far as the
+    joining branch (its devices hear it) and nothing behind its BK: a dead line behind the branch, the devices after it
+    keep what they had; the next cycle runs over the longer ring."""
+    ring, chips = tl_ring(BranchKind.LOCAL, "11", True, 2)
+    ring.cut(3, True)
+    master = Master(ring, locate=False, max_devices=8)
+    assert master.start().ok and not chips[1].branch_recognised and master.config is not None
+    assert len(master.config) == 3
+    ring.clear_faults()
+    transfer = ring.transfer(Cycle.DATA, bytes(wire.LOOPBACK_BYTES + 2))
+    assert chips[1].branch_recognised and transfer.returned is None and transfer.reached == 4
+    assert [span[:2] for span in ring.spans] == [(2, 2)]
 
 
 def test_the_recognition_stays_through_resets_and_breaks_until_the_power_up() -> None:

@@ -414,13 +414,86 @@ def test_a_whole_chip_with_a_microprocessor_is_a_bk_in_a_tree() -> None:
     assert bk.chip.registers is not None and not bk.chip.registers.violations.records
 
 
+@pytest.mark.parametrize("tree", ["local", "nested"])
+def test_a_cut_is_numbered_by_the_physical_position_at_both_fidelities_in_every_state(tree: str) -> None:
+    """BK-52: ``Ring.cut`` takes the breaks ``PinRing.cut`` takes, by the same physical positions (BK-1: a BK, its
+    branch's devices, nested branches in place), whether the branch is in the data path or switched off: forward lines
+    into every device, the return line into a branch device from the one behind it, a BK's branch return input
+    (``branch``); only the remote bus's return lines outside branches stay abstract at transaction level (BK-10). A
+    ``ReturnBreak`` injected at a BK is its branch return input, also with the branch switched off."""
+    tl, pin = (tl_tree(BranchKind.LOCAL, 2), pin_tree(BranchKind.LOCAL, 2)) if tree == "local" else \
+        (nested_tl(), nested_pin())  # fmt: skip
+    outside = {1, 2}  # the return inputs of the remote bus outside branches: positions 1 and 2 (from 3 or 6)
+
+    def taken(ring: Ring | PinRing) -> set[tuple[int, bool, bool]]:
+        found, refused = set(), []
+        for position in range(len(pin.devices) + 2):
+            for forward, branch in ((True, False), (False, False), (False, True)):
+                try:
+                    ring.cut(position, forward, branch=branch)
+                except ArgumentError as error:
+                    refused.append(str(error))
+                else:
+                    found.add((position, forward, branch))
+        assert all(message.startswith("position must be") for message in refused)
+        return found
+
+    at_pin = taken(pin)
+    assert {(p, f, b) for p, f, b in at_pin if not f} == \
+        ({(1, False, False), (2, False, False), (3, False, False), (2, False, True)} if tree == "local" else
+         {(1, False, False), (2, False, False), (3, False, False), (2, False, True), (4, False, True)})  # fmt: skip
+    master = Master(tl, locate=False, max_devices=8)
+    assert master.start().ok
+    for on in (True, False):  # the branch in the data path, then switched off: the same numbering
+        if not on:
+            master.switch_branch(2, False)
+            healthy(master)
+            assert len(tl.devices) == 3
+        assert taken(tl) == {cut for cut in at_pin if cut[1] or cut[2] or cut[0] not in outside}, on
+        tl.clear_faults()
+        tl.inject(ReturnBreak(2))  # the BK's branch return input in every state
+        tl.clear_faults()
+    with pytest.raises(ArgumentError, match=r"BK-10"):
+        tl.cut(1, False)
+    for bad, name in (((2, 1), "forward"), ((True, True), "position"), ((2.0, True), "position")):
+        with pytest.raises(ArgumentError, match=rf"^{name} must be"):
+            tl.cut(*bad)
+    with pytest.raises(ArgumentError, match=r"^branch must be"):
+        tl.cut(2, False, branch="yes")  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(("kind", "m"), CASES)
+def test_a_cycle_takes_the_same_time_at_both_fidelities_with_the_branch_in_or_out(kind: BranchKind, m: int) -> None:
+    """BK-53: a data cycle's ring delay (A11) counts the devices in the data path at both fidelities, so a cycle takes
+    the same bit periods with the branch in the data path and switched off (before, the pin level counted every chip
+    of every branch, a status telegram more with the branch out); only an LBD-MR chip in the data path adds its return
+    line's repeater at pin level (BK-35)."""
+    times = []
+    for ring in (tl_tree(kind, m), pin_tree(kind, m)):
+        master = Master(ring, locate=False, max_devices=8)
+        assert master.start().ok
+        seen = []
+        for on in (True, False):
+            if not on:
+                master.switch_branch(2, False)
+            healthy(master)
+            start = ring.now
+            assert master.cycle().ok
+            seen.append(round((ring.now - start) * ring.bit_rate))
+        times.append(seen)
+    n, mr = 3 + m, m if kind is BranchKind.LBD_MR else 0  # two RB devices, the BK and its branch
+    extra = (wire.ring_delay_status_telegrams(n + mr) - wire.ring_delay_status_telegrams(n)) * wire.STATUS_TELEGRAM_BITS
+    assert times[1] == [times[0][0] + extra, times[0][1]]
+    assert times[0][0] > times[0][1]
+
+
 def per_cycle(ring: Ring | PinRing, ops: list[tuple[str, int]]) -> list[object]:
     """What a master sees of ``ring`` over a history of ``ops``: every cycle's kind, success and diagnostics (kind,
     location, device, message code), then after each step's cycles the diagnostics kept, the configuration (numbers,
     ID codes, data lengths), every position's IN data and the BK's status byte (its count, BK-5, BK-6). Steps:
     ``off``, ``on``, ``ext`` (``Master.switch_branch``), ``reset`` (``Master.start``: an INTERBUS reset), ``cut``
-    (the forward line into ring position ``k``: ``DeadLine(k)`` at transaction level; only while the branch is in
-    the data path), ``wait`` (nothing: only the cycles)."""
+    (the forward line into the device at physical position ``k``, ``cut(k, True)`` at both fidelities, BK-52, whether
+    the branch is in the data path or not: the break sleeps while it is out), ``wait`` (nothing: only the cycles)."""
     master = Master(ring, locate=False, max_devices=8)
     seen: list[object] = []
 
@@ -432,15 +505,10 @@ def per_cycle(ring: Ring | PinRing, ops: list[tuple[str, int]]) -> list[object]:
         if op == "reset":
             record(master.start())
         elif op == "cut":
-            # Only into the branch in the data path: the transaction level numbers the lines of the data path, the
-            # pin level the physical ones (BK-1); with the branch out they differ.
+            # Numbered by the physical position at both fidelities, whether the branch is in the data path (BK-52).
             bk = ring.devices[1]
-            in_path = bool(ring.spans) if isinstance(ring, Ring) else isinstance(bk, Supi3Pins) and bk.branch_in_path
-            seen.append(in_path)
-            if in_path and isinstance(ring, Ring):
-                ring.inject(DeadLine(k))
-            elif in_path and isinstance(ring, PinRing):
-                ring.cut(k, True)
+            seen.append(bool(ring.spans) if isinstance(ring, Ring) else isinstance(bk, Supi3Pins) and bk.branch_in_path)
+            ring.cut(k, True)
         elif op == "wait":
             pass
         elif master.config is not None and len(master.config) > 1 and master.config[1].data_bytes == 0:
@@ -462,14 +530,16 @@ HISTORY_OPS = st.lists(st.tuples(st.sampled_from(["off", "on", "ext", "reset", "
 @given(st.sampled_from(CASES), HISTORY_OPS)
 @example((BranchKind.LBD_MR, 1), [("cut", 3), ("reset", 3)])  # BK-49: a cut in an LBD branch, for sure
 @example((BranchKind.LBD_OR, 1), [("off", 3), ("on", 3), ("cut", 3)])
+@example((BranchKind.LOCAL, 2), [("off", 3), ("cut", 4), ("on", 3)])  # BK-52: cut while out, awake once back
 def test_a_master_sees_every_cycle_alike_over_any_history(case: tuple[BranchKind, int], ops: list[tuple[str, int]],
                                                           ) -> None:  # fmt: skip
-    """Issue 12: over any history of switching the branch off, on, on with the extended function, INTERBUS resets and
-    cuts of a line in the branch, the master's every cycle (success, diagnostics, their count, the configuration and
-    process data) is the same at both fidelities: the master idles after a latched switch (BK-46) and the BK switches
-    its lines between telegrams (BK-47), so no telegram is cut and nothing in flight is lost. A cut in an LBD branch
-    too: the counter telegrams that reach the master are no frame, a dead line at both (BK-49), and the BK keeps the
-    same count."""
+    """Issue 12: over any history of switching the branch off, on, on with the extended function, INTERBUS resets
+    and cuts of a line in the branch, also while the branch is out of the data path (numbered by the physical
+    position at both fidelities, BK-52), the master's every cycle (success, diagnostics, their count, the
+    configuration and process data) is the same at both fidelities: the master idles after a latched switch (BK-46)
+    and the BK switches its lines between telegrams (BK-47), so no telegram is cut and nothing in flight is lost. A
+    cut in an LBD branch too: the counter telegrams that reach the master are no frame, a dead line at both (BK-49),
+    and the BK keeps the same count."""
     kind, m = case
     ops = [(op, min(k, 2 + m)) for op, k in ops]
     # The same short silence at both (BK-3): a history switching the extended function on and cutting closes (BK-50).

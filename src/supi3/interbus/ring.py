@@ -22,10 +22,12 @@ devices of its branch. The data path runs into the BK, through the branch and ba
 bus, so the ring flattens the tree into :attr:`Ring.devices` in that order, leaving out every branch its BK has not in
 the data path (switched off by the master, closed by the BK itself, not present by Table 2-9: a BK recognises its
 branch once a device answered, BK-48); it flattens again whenever a BK changes that. In a tree a fault belongs to the
-physical line it was injected on: it follows that line when branches are switched, and sleeps while the line is out
-of the data path. :class:`ReturnBreak` breaks a branch's return line (a branch in the data path with nothing attached
-is broken so at its BK, BK-43), and behind a break in a branch with device-oriented diagnostics the devices send the
-counter telegram to the BK (2.2.2, ``wire.counter_telegram``).
+physical line it was injected on: it follows that line when branches are switched, and sleeps while the line is out of
+the data path; :meth:`Ring.cut` injects a break by the physical position of the device it enters, as the pin level's
+``PinRing.cut`` (BK-52). A branch recognised in a cycle's run joins within its frame, which it loses (BK-54).
+:class:`ReturnBreak` breaks a branch's return line (a branch in the data path with nothing attached is broken so at
+its BK, BK-43), and behind a break in a branch with device-oriented diagnostics the devices send the counter telegram
+to the BK (2.2.2, ``wire.counter_telegram``).
 """
 
 from __future__ import annotations
@@ -155,10 +157,11 @@ class DeadLine:
 class ReturnBreak:
     """The return line *into* ring position ``segment`` of a tree carries nothing (docs/interbus.md, "Tree").
 
-    ``segment`` is a bus terminal module (its branch's return line, from the branch's first device in a branch
-    with return, from the last in an LBD-OR branch) or a device of a branch with return lines (REMOTE, LOCAL,
-    LBD_MR) that has a device behind it in the branch (the return line from that device). The ring closed early
-    uses the return line into position *k* only when it is closed behind *k*; permanent unless ``cycles`` is given.
+    ``segment`` is a bus terminal module with a branch (its branch's return line, from the branch's first device in
+    a branch with return, from the last in an LBD-OR branch; whether the branch is in the data path or not, BK-52)
+    or a device of a branch with return lines (REMOTE, LOCAL, LBD_MR) that has a device behind it in the branch (the
+    return line from that device). The ring closed early uses the return line into position *k* only when it is
+    closed behind *k*; permanent unless ``cycles`` is given.
     """
 
     segment: int
@@ -179,8 +182,8 @@ class _Active:
     target: object = None
     """In a tree: the device whose incoming line the fault is on (``None``: the return line into the master)."""
     branch: bool = False
-    """A :class:`ReturnBreak` at a BK with its branch on: its branch return input, out of the data path (asleep) while
-    that branch is (BK-48)."""
+    """A :class:`ReturnBreak` at a BK with a branch: its branch return input (DI3), out of the data path (asleep) while
+    that branch is (BK-48, BK-52); else the return input from the device behind."""
 
 
 # ----------------------------------------------------------------------------------------------------------------
@@ -330,6 +333,36 @@ def _devices(items: Sequence[Device | Branch]) -> list[Device]:
             found += _devices(item.devices)
         else:
             found.append(item)
+    return found
+
+
+def terminal_positions(items: Sequence[Device | Branch], first: int = 1) -> set[int]:
+    """The physical positions (from ``first`` on: a BK, then its branch's devices, nested branches in place, BK-1) of
+    the BKs of :class:`Branch` items, nested ones too: where a cut of a BK's branch return input can be made (BK-52)."""
+    found: set[int] = set()
+    position = first
+    for item in items:
+        if isinstance(item, Branch):
+            found.add(position)
+            found |= terminal_positions(item.devices, position + 1)
+            position += len(_devices(item.devices))
+        position += 1
+    return found
+
+
+def return_inputs(items: Sequence[Device | Branch], first: int = 1, returns: bool = True) -> set[int]:
+    """The physical positions (from ``first`` on, BK-1) of the devices of ``items`` whose return input a device drives:
+    all but the last of a sequence with return lines (``returns``: the remote bus outside branches at pin level), in
+    branches too; none in an LBD-OR branch (BK-52)."""
+    found: set[int] = set()
+    position = first
+    for k, item in enumerate(items):
+        if returns and k + 1 < len(items):
+            found.add(position)
+        if isinstance(item, Branch):
+            found |= return_inputs(item.devices, position + 1, item.kind is not BranchKind.LBD_OR)
+            position += len(_devices(item.devices))
+        position += 1
     return found
 
 
@@ -614,6 +647,7 @@ class Ring:
                                         "place in the ring), not the same object twice", "Tree")  # fmt: skip
         self._tree: list[Device | Branch] = list(devices)
         self._branches = _branches(self._tree)
+        self._terminals = {id(branch.terminal) for branch in self._branches}
         self._enabled: tuple[bool, ...] = ()
         self._spans: list[_Span] = []
         self._settled = False
@@ -699,17 +733,19 @@ class Ring:
         """``connected`` of ``branch``'s BK: its recognition (BK-48), before the ring ran whether it is populated."""
         return branch.terminal.branch_recognised if self._settled else bool(branch.devices)
 
-    def _recognise(self) -> None:
+    def _recognise(self) -> list[Branch]:
         """The ring runs (a reset, a cycle, idle telegrams): every BK whose branch device answers now recognises its
-        branch (BK-48), then the tree flattens again. A branch with return lines (BK-RB, BK-LB) answers when its BK
-        is reached, its interface is live (BK-42) and the loop from DO3 through the branch back to DI3 is whole; an
-        LBD branch when its BK's return input is whole (its devices send counter telegrams on their own, BK-30)."""
+        branch (BK-48), then the tree flattens again; the branches recognised now. A branch with return lines (BK-RB,
+        BK-LB) answers when its BK is reached, its interface is live (BK-42) and the loop from DO3 through the branch
+        back to DI3 is whole; an LBD branch when its BK's return input is whole (its devices send counter telegrams on
+        their own, BK-30)."""
         self._settled = True
+        recognised: list[Branch] = []
         while True:
             self._sync()
             waiting = [b for b in self._branches if b.devices and not b.terminal.branch_recognised]
             if not waiting:
-                return
+                return recognised
             forward = {id(a.target) for a in self._faults if isinstance(a.fault, DeadLine)}
             back = {(id(a.target), a.branch) for a in self._faults if isinstance(a.fault, ReturnBreak)}
             dead = self._first_dead()
@@ -719,9 +755,10 @@ class Ring:
                 reached = at is not None and (dead is None or dead > at + 1) and branch.terminal.branch_enabled(True)
                 if (branch.kind.diagnostics or reached) and self._loop_whole(branch, forward, back):
                     branch.terminal.recognise_branch()
+                    recognised.append(branch)
                     found = True
             if not found:
-                return
+                return recognised
 
     def _loop_whole(self, branch: Branch, forward: set[int], back: set[tuple[int, bool]]) -> bool:
         """Something sent into ``branch`` comes back to its BK's DI3 (BK-48): its BK's return input is not broken
@@ -769,15 +806,19 @@ class Ring:
                 found = span
         return found
 
-    def _returns(self, returns: list[int], close: int | None) -> tuple[int | None, bool]:
-        """The effect of broken return lines (``returns``: 1-based positions) on a transfer closed after ``close``
+    def _returns(self, returns: list[tuple[int, bool]], close: int | None) -> tuple[int | None, bool]:
+        """The effect of broken return lines (``returns``: 1-based positions, each with whether it is the BK's branch
+        return input there or the return input from the device behind it, BK-52) on a transfer closed after ``close``
         (``None``: the whole ring): the first line that carries nothing on the way on (or ``None``), and whether
         nothing comes back from inside a branch the ring is closed in."""
         dead: int | None = None
         back_dead = False
-        for position in returns:
-            span = self._span_of(position - 1, True) or self._span_of(position - 1, False)
-            if span is None or not (close is None or close > position):
+        for position, own in returns:
+            span = self._span_of(position - 1, own)
+            # The return input from the device behind: behind a BK with its branch in the data path, after the branch.
+            inner = None if own else self._span_of(position - 1, True)
+            behind = position if inner is None else inner.end
+            if span is None or not (close is None or close > behind):
                 continue
             if close is None or close > span.end:
                 dead = span.end + 1 if dead is None else min(dead, span.end + 1)
@@ -786,7 +827,7 @@ class Ring:
         return dead, back_dead
 
     def _reports(self, reached: int, close: int | None, dead_lines: list[int],
-                 returns: list[int]) -> list[tuple[Terminal, bool, int | None]]:
+                 returns: list[tuple[int, bool]]) -> list[tuple[Terminal, bool, int | None]]:
         """What each BK whose whole branch was driven receives on its branch return line (docs/interbus.md,
         "Counter telegram")."""
         reports: list[tuple[Terminal, bool, int | None]] = []
@@ -794,7 +835,7 @@ class Ring:
             if span.at >= reached or not (close is None or close >= span.end):
                 continue
             forward = [s for s in dead_lines if span.at + 2 <= s <= span.end]
-            back = [p - 1 for p in returns if span.at <= p - 1 < span.end]
+            back = [p - 1 for p, own in returns if (own and p - 1 == span.at) or span.at < p - 1 < span.end]
             count = None
             if span.branch.kind.diagnostics:
                 own = list(span.own)
@@ -815,35 +856,67 @@ class Ring:
         if not 1 <= fault.segment <= n + (0 if isinstance(fault, ReturnBreak) else 1):
             raise InterbusError("docs/interbus.md, Fault injection", fault.segment,
                                 f"line must be in 1..{n + (0 if isinstance(fault, ReturnBreak) else 1)}")  # fmt: skip
+        target = None if fault.segment > n else self.devices[fault.segment - 1]
+        branch = False
         if isinstance(fault, ReturnBreak):
             index = fault.segment - 1
-            own = self._span_of(index, True)
+            # A BK's branch return input whether or not the branch is in the data path now (BK-52).
+            branch = id(target) in self._terminals
             inner = self._span_of(index, False)
-            has_return = own is not None or (inner is not None and inner.branch.kind is not BranchKind.LBD_OR
-                                             and index < inner.end - 1)  # fmt: skip
-            if not has_return:
+            if not branch and (inner is None or inner.branch.kind is BranchKind.LBD_OR or index >= inner.end - 1):
                 raise InterbusError("docs/interbus.md, Tree", fault.segment,
-                                    "a return line enters only a BK with its branch on, or a device of a branch with "
+                                    "a return line enters only a BK with a branch, or a device of a branch with "
                                     "return lines that has a device behind it")  # fmt: skip
-        target = None if fault.segment > n else self.devices[fault.segment - 1]
-        branch = isinstance(fault, ReturnBreak) and self._span_of(fault.segment - 1, True) is not None
         self._faults.append(_Active(fault, fault.cycles, target, branch))
+
+    def cut(self, position: int, forward: bool, *, branch: bool = False) -> None:
+        """Break a line for good, numbered as :meth:`PinRing.cut <supi3.model.pinring.PinRing.cut>` numbers it, by the
+        physical position of the device it enters in every state (BK-52): ring positions 1..N of every device of the
+        tree (a BK, then its branch's devices, nested branches in place, then on along the remote bus), whether a
+        branch is in the data path or not. ``forward``: the line into the device (a :class:`DeadLine`); else its
+        return input from the device behind it in a branch with return lines (not into the last of a branch, none in
+        an LBD-OR branch; a :class:`ReturnBreak`), or with ``branch`` a BK's branch return input (DI3). The break
+        sleeps while its line is out of the data path (BK-1). Return lines of the remote bus outside branches stay
+        abstract here (BK-10).
+
+        Raises
+        ------
+        ArgumentError
+            ``forward`` or ``branch`` not a bool, ``position`` not a device of the tree, ``branch`` with ``forward``
+            or at a device that is no BK with a :class:`Branch`, or a return input no device drives; nothing changes.
+        """
+        check_bool("forward", forward)
+        check_bool("branch", branch)
+        every = _devices(self._tree)
+        position = check_int("position", position, 1, len(every), "a device of the tree")
+        if branch:
+            terminals = terminal_positions(self._tree)
+            if forward or position not in terminals:
+                raise fail("position", f"the ring position of a BK with a branch ({sorted(terminals)}), with "
+                           "forward=False (branch=True breaks the BK's branch return input)", (position, forward))
+        elif not forward and position not in return_inputs(self._tree, returns=False):
+            raise fail("position", f"an integer from 1 to {len(every)} (a device of the tree; a return line only from "
+                       "a device behind it in a branch with return lines: not into the last of a branch, none in an "
+                       "LBD-OR branch; the remote bus's outside branches stay abstract, BK-10)", position)
+        fault: Fault = DeadLine(position) if forward else ReturnBreak(position)
+        self._faults.append(_Active(fault, None, every[position - 1], branch))
 
     def clear_faults(self) -> None:
         """Remove every injected fault."""
         self._faults.clear()
 
-    def _faults_on(self, segments: int) -> tuple[dict[int, list[Fault]], list[int]]:
-        """The faults on lines 1..``segments`` now, by line, and the positions whose return line is broken (a BK with
-        nothing attached in the data path too, BK-43); each fault counts one of its cycles."""
+    def _faults_on(self, segments: int) -> tuple[dict[int, list[Fault]], list[tuple[int, bool]]]:
+        """The faults on lines 1..``segments`` now, by line, and the positions whose return line is broken, each with
+        whether it is the BK's branch return input (a BK with nothing attached in the data path too, BK-43); each
+        fault counts one of its cycles."""
         hits: dict[int, list[Fault]] = {}
-        returns: list[int] = list(self._unanswered)
+        returns = [(at, True) for at in self._unanswered]
         for active in self._faults:
             where = self._where(active)
             if where is None:
                 continue
             if isinstance(active.fault, ReturnBreak):
-                returns.append(where)
+                returns.append((where, active.branch))
             elif where <= segments:
                 hits.setdefault(where, []).append(active.fault)
             else:
@@ -853,12 +926,14 @@ class Ring:
         self._faults = [a for a in self._faults if a.remaining is None or a.remaining > 0]
         return hits, returns
 
-    def _breaks(self) -> tuple[list[int], list[int]]:
-        """The lines broken now (``DeadLine``) and the positions whose return line is broken (a BK with nothing
-        attached in the data path too, BK-43), without counting a fault's cycles."""
-        lines = [(a.fault, w) for a in self._faults if (w := self._where(a)) is not None]
-        return ([w for f, w in lines if isinstance(f, DeadLine)],
-                [*self._unanswered, *(w for f, w in lines if isinstance(f, ReturnBreak))])  # fmt: skip
+    def _breaks(self) -> tuple[list[int], list[tuple[int, bool]]]:
+        """The lines broken now (``DeadLine``) and the positions whose return line is broken, with whether it is the
+        BK's branch return input (a BK with nothing attached in the data path too, BK-43), without counting a fault's
+        cycles."""
+        lines = [(a, w) for a in self._faults if (w := self._where(a)) is not None]
+        return ([w for a, w in lines if isinstance(a.fault, DeadLine)],
+                [*((at, True) for at in self._unanswered),
+                 *((w, a.branch) for a, w in lines if isinstance(a.fault, ReturnBreak))])  # fmt: skip
 
     def _first_dead(self) -> int | None:
         """The first line that carries nothing on the whole ring (broken return lines of branches too)."""
@@ -987,8 +1062,8 @@ class Ring:
         """
         if type(cycle) is not Cycle:
             check_instance("cycle", cycle, Cycle)
-        if self._branches:
-            self._sync() if self._settled else self._recognise()
+        # A branch answering in this run joins the data path within its frame (BK-54): what leaves its BK is cut.
+        joined = self._recognise() if self._branches else []
         n_all = len(self.devices)
         if n_all > wire.MAX_DEVICES:
             raise InterbusError("docs/interbus.md, Ring", n_all, f"a ring has at most {wire.MAX_DEVICES} devices")
@@ -998,7 +1073,7 @@ class Ring:
         # is only part of the whole ring (close_after=None), so a fault there is told from one on line N.
         segments = n + 1 if close_after is None else n
         faults: dict[int, list[Fault]] = {}
-        returns: list[int] = []
+        returns: list[tuple[int, bool]] = []
         dead_lines: list[int] = []
         dead: int | None = None
         back_dead = False
@@ -1009,6 +1084,9 @@ class Ring:
             if returns:
                 first, back_dead = self._returns(returns, None if close_after is None else n)
                 dead = first if dead is None or (first is not None and first < dead) else dead
+        if joined:
+            cut = min((span.end + 1 for span in self._spans if span.branch in joined), default=None)
+            dead = cut if dead is None or (cut is not None and cut < dead) else dead
         self.trace = []
         record = self.record
         now = self.now
@@ -1136,11 +1214,13 @@ class Ring:
 
     def reset(self) -> None:
         """An INTERBUS reset (the master's Alarm Stop, 1303h): reset pattern, then idle (assumption A12). A branch is
-        recognised in the reset's hold, before its devices reset (BK-37, BK-48)."""
+        recognised in the reset's hold, before its devices reset (BK-37, BK-48). The reset's end allows for the ring
+        delay of every device of the tree, which may all be in the data path after it (BK-9, A12; BK-53)."""
         self._recognise()
         dead = self._first_dead()
         reached = len(self.devices) if dead is None else min(len(self.devices), dead - 1)
-        end = self.now + wire.reset_bits(len(self.devices)) / self.bit_rate
+        every = len(_devices(self._tree)) if self._branches else len(self.devices)
+        end = self.now + wire.reset_bits(min(every, wire.MAX_DEVICES)) / self.bit_rate
         for device in self.devices[:reached]:
             device.reset(end)
         self._go_silent(range(reached, len(self.devices)), self.now, end)

@@ -44,7 +44,7 @@ from supi3.checks import (
 from supi3.config import DeviceConfig, Interface
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusError, TelegramError
-from supi3.interbus.ring import Branch, BranchKind, ErrorKind, Transfer
+from supi3.interbus.ring import Branch, BranchKind, ErrorKind, Transfer, return_inputs, terminal_positions
 from supi3.interbus.wire import Cycle, Frame, LineReset, Telegram
 from supi3.model.chip import Supi3
 from supi3.model.pins import PinTrace, Supi3Pins
@@ -135,39 +135,23 @@ def _chips(items: Sequence[PinChip | PinBranch]) -> list[PinChip]:
     return found
 
 
-def _in_path(items: Sequence[PinChip | PinBranch]) -> int:
-    """The chips of a tree in the data path now: every chip, but a branch's only while its BK has the branch in the
-    data path (BK-1's flattened data path, as ``Ring.devices`` counts it)."""
-    return sum(1 + (_in_path(item.devices) if item.terminal.branch_in_path else 0) if isinstance(item, PinBranch)
-               else 1 for item in items)  # fmt: skip
-
-
-def _terminal_positions(items: Sequence[PinChip | PinBranch], first: int) -> set[int]:
-    """The positions (from ``first`` on, physical order) of the BKs of :class:`PinBranch` items, nested ones too."""
-    found: set[int] = set()
-    position = first
+def _in_path(items: Sequence[PinChip | PinBranch]) -> list[PinChip]:
+    """The chips of a tree in the data path now: every chip, but a branch's only while its BK has it in the data path
+    (BK-1's flattened data path, as ``Ring.devices`` holds it)."""
+    found: list[PinChip] = []
     for item in items:
         if isinstance(item, PinBranch):
-            found.add(position)
-            found |= _terminal_positions(item.devices, position + 1)
-            position += len(_chips(item.devices))
-        position += 1
+            found.append(item.terminal)
+            found += _in_path(item.devices) if item.terminal.branch_in_path else []
+        else:
+            found.append(item)
     return found
 
 
-def _return_inputs(items: Sequence[PinChip | PinBranch], first: int, returns: bool) -> set[int]:
-    """The positions (from ``first`` on, physical order) of the chips of ``items`` whose DI2 a chip drives: all but
-    the last of a sequence with return lines (``returns``), in branches too; none in an LBD-OR branch."""
-    found: set[int] = set()
-    position = first
-    for k, item in enumerate(items):
-        if returns and k + 1 < len(items):
-            found.add(position)
-        if isinstance(item, PinBranch):
-            found |= _return_inputs(item.devices, position + 1, item.kind is not BranchKind.LBD_OR)
-            position += len(_chips(item.devices))
-        position += 1
-    return found
+def _repeaters(chips: Sequence[PinChip]) -> int:
+    """The repeaters a bit passes through ``chips`` (A10): each chip on the forward line, an LBD-MR chip once more on
+    its return line (its counter block repeats it, M17, BK-35)."""
+    return len(chips) + sum(chip.config.interface is Interface.LBD_MR for chip in chips)
 
 
 IDLE_PIECE_TELEGRAMS: Final[int] = 64
@@ -277,12 +261,13 @@ class PinRing:
         self.tree: list[PinChip | PinBranch] = list(chips)
         """The ring's items as given (:class:`PinBranch` for a BK with its branch)."""
         self.devices = every
-        self.repeaters = len(every) + sum(chip.config.interface is Interface.LBD_MR for chip in every)
-        """The repeaters a bit passes round the ring, each ``REPEATER_DELAY_BITS`` (A10): every chip on the forward
-        line, and an LBD-MR chip once more on its return line (its counter block repeats it, M17). The master's
-        ring delay (A11, ``wire.ring_delay_status_telegrams``) counts them; in a tree every chip of every branch (a
-        BK repeats DI3 without delay, BK-37), the most the data path can hold."""
-        self._return_inputs = _return_inputs(chips, 1, True)
+        self.repeaters = _repeaters(every)
+        """The repeaters a bit passes round the whole tree, each ``REPEATER_DELAY_BITS`` (A10): every chip on the
+        forward line, and an LBD-MR chip once more on its return line (its counter block repeats it, M17). The end of
+        an INTERBUS reset allows for them (A12: every branch may be in the data path after it, BK-9, BK-37); a cycle's
+        ring delay (A11) only for those in the data path when it starts (:attr:`path_repeaters`, BK-53)."""
+        transaction_level = [_transaction_level(item) for item in chips]
+        self._return_inputs = return_inputs(transaction_level)
         self.bit_rate = rates.pop()
         self.cpb = wire.clocks_per_bit(self.bit_rate)
         self.cycle = 0
@@ -296,11 +281,18 @@ class PinRing:
         """Broken lines, as ``(position, forward)``: see :meth:`cut`."""
         self.branch_cuts: set[int] = set()
         """Positions of BKs whose branch return input DI3 is broken: see :meth:`cut`."""
-        self._terminals = _terminal_positions(chips, 1)
+        self._terminals = terminal_positions(transaction_level)
         self._inputs = [
             {"di2": 0, "rbst_ext": 0, "mfp_in": 0, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 1, "from_exr": 0}
             for _ in every
         ]
+
+    @property
+    def path_repeaters(self) -> int:
+        """The repeaters of the chips in the data path now (:attr:`repeaters` of the data path, A10): a cycle's ring
+        delay (A11) counts them, as the transaction level's cycle counts ``Ring.devices`` (BK-53); a branch closed,
+        switched off or not recognised adds no delay (its BK sends on its own transmitter, BK-37)."""
+        return _repeaters(_in_path(self.tree))
 
     @property
     def now(self) -> float:
@@ -327,7 +319,8 @@ class PinRing:
         chip of a branch takes its BK's DO3), or its return input DI2 from the chip behind it (a chip that has one:
         not the last of the ring or of a branch, none in an LBD-OR branch), or with ``branch`` (``forward`` false) a
         BK's branch return input DI3 (MFP10), the line ``ring.ReturnBreak`` breaks at a BK (BK-10). A broken line
-        reads at the idle level (RS-485 fail-safe bias, BK-30): behind it the LBD chips' counter telegrams (2.2.2)
+        reads at the idle level (RS-485 fail-safe bias, BK-30); ``ring.Ring.cut`` takes the same arguments with the same
+        physical numbering, in every state (BK-52). Behind a break the LBD chips' counter telegrams (2.2.2)
         bring the master, or the branch's BK, the count of ``ring.lbd_count`` (``forward``, ``back``) for a branch of
         these chips.
 
@@ -489,9 +482,10 @@ class PinRing:
             # The master does not ask (PinRing has no ``closes_early``): it reports such errors as not located.
             raise InterbusError("docs/interbus.md, Segment search", close_after,
                                 "the pin-level ring does not close early")
-        n = _in_path(self.tree)
+        path = _in_path(self.tree)
+        n = len(path)
         frame = Frame.build(cycle, data)
-        delay = wire.ring_delay_status_telegrams(self.repeaters)
+        delay = wire.ring_delay_status_telegrams(_repeaters(path))
         self.run_levels(np.concatenate([wire.frame_levels(frame), wire.status_levels(cycle, False, delay)]))
         telegrams, error = self._received()
         receiver_error: ErrorKind | None = ErrorKind.TELEGRAM if error else None
@@ -527,7 +521,7 @@ class PinRing:
         self._received()
 
     def settle(self) -> None:
-        """Idle status telegrams for the ring delay, so the last telegrams sent reach every chip."""
+        """Idle status telegrams for the ring delay of the whole tree, so the last telegrams sent reach every chip."""
         delay = wire.ring_delay_status_telegrams(self.repeaters)
         self.run_levels(wire.status_levels(Cycle.DATA, False, delay))
         self._received()
