@@ -27,7 +27,7 @@ from hypothesis import strategies as st
 from supi3.cli import FIRMWARE_FAILED_STATUS, main
 from supi3.errors import ArgumentError
 from supi3.mcu import build as mcu_build
-from supi3.mcu.board import SERVE_TELEGRAMS, Board
+from supi3.mcu.board import Board
 from supi3.mcu.core import CPUS, FirmwareStoppedError, Stop
 from supi3.mcu.stm32 import (
     AFIOEN,
@@ -56,6 +56,7 @@ from supi3.mcu.stm32 import (
 )
 from supi3.model.registers import InterfaceViolationError
 from supi3.sdk import native
+from supi3.sdk.bench import SERVE_TELEGRAMS
 from test_mcu_stm32 import Clock, Wire
 
 pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
