@@ -77,6 +77,7 @@ class NotingDigitalIo(DigitalIo):
         self.pass_us = pass_us
 
     def isr(self, drv: Supi3Driver) -> None:
+        del drv
         self.noted = True
 
     def loop(self, drv: Supi3Driver) -> None:
@@ -198,7 +199,8 @@ def test_a_run_that_raises_ends_unserved() -> None:
 C_VARIANTS = {"interrupt": [native.example("digital_io")],
               "main_loop": [native.example("digital_io"), MCU / "main_loop.c"],
               "polling": [native.example("polling_io")]}  # fmt: skip
-"""As tests/test_mcu_serve.py's VARIANTS: digital_io, with tests/mcu/main_loop.c's fw_loop, polling_io."""
+"""digital_io, with tests/mcu/main_loop.c's fw_loop, polling_io (the variants tests/test_mcu_serve.py runs on the
+board and against this bench)."""
 
 
 @pytest.mark.parametrize("mode", [Mode.MOTOROLA, Mode.INTEL])
