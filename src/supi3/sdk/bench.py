@@ -1,7 +1,7 @@
 """The firmware test bench: INTERBUS master, ring, SUPI 3 chip and firmware on one clock (transaction level).
 
 Ref: IBS SUPI 3 OPC UM E rev. 05, 3.4.14 (interrupts, I/O access bit, latch phase, Figure 3-22), Table 3-7 (byte
-times); decisions FW-1 to FW-6 in docs/assumptions/sdk.md; guide docs/sdk.md, "Firmware tests".
+times); decisions FW-1 to FW-6 and FW-14 in docs/assumptions/sdk.md; guide docs/sdk.md, "Firmware tests".
 
 One clock, :attr:`Bench.now` (seconds), is bus time and firmware time at once:
 
@@ -12,6 +12,9 @@ One clock, :attr:`Bench.now` (seconds), is bus time and firmware time at once:
   sequence begins and the latch phase runs over the last latch telegram (:func:`supi3.interbus.wire.cycle_phases`);
 - a falling edge of /IRQ calls the firmware's :meth:`Firmware.isr`, at the next point where the firmware may be
   interrupted: when it is idle, or when a driver call of its main code has ended (FW-3).
+- a run ends once the firmware has served its last cycle: for a firmware with a main loop, a whole pass of it after
+  that cycle and the last service routine (FW-14), the emulated board's rule (MCU-30), defined once here
+  (:class:`MainLoopPasses`).
 
 So the interrupt method, the polling method with its 30-bit window and a firmware that touches the data registers
 in the latch phase (``InconsistentDataError``) are all tested at transaction level.
