@@ -120,11 +120,11 @@ def test_python_main_loop_and_polling_firmware_give_the_interrupt_firmware_s_dat
     polling example exchanges whenever the I/O bit reads 0, a cycle's start included, so its IN data may reach the
     master a cycle before the interrupt example's.)"""
     history = _history(seed, 12)
-    devices: dict[str, tuple[DigitalIo | PollingIo, dict[str, bool]]] = {
-        "interrupt": (DigitalIo(mode), {}), "noting": (NotingDigitalIo(mode), {}),
-        "polling": (PollingIo(mode), {}), "polling_bit": (PollingIo(mode), {"io_pin": False})}  # fmt: skip
-    seen = {name: _play_python(Bench(firmware=device, mode=mode, **options), device, history)
-            for name, (device, options) in devices.items()}  # fmt: skip
+    devices: dict[str, tuple[DigitalIo | PollingIo, bool]] = {
+        "interrupt": (DigitalIo(mode), True), "noting": (NotingDigitalIo(mode), True),
+        "polling": (PollingIo(mode), True), "polling_bit": (PollingIo(mode), False)}  # fmt: skip
+    seen = {name: _play_python(Bench(firmware=device, mode=mode, io_pin=io_pin), device, history)
+            for name, (device, io_pin) in devices.items()}  # fmt: skip
     assert seen["noting"] == seen["interrupt"] and seen["polling"] == seen["polling_bit"]
     assert [outputs for outputs, *_ in seen["polling"]] == [outputs for outputs, *_ in seen["interrupt"]]
     assert all(served for *_, served in seen["noting"] + seen["polling"])
