@@ -11,11 +11,14 @@ port's ``main``, examples/fw_board.h). Ref: 3.4.14 (the interrupt and the pollin
 from __future__ import annotations
 
 import itertools
+import math
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from supi3.errors import ArgumentError
 from supi3.sdk import native
 from supi3.sdk.bench import SERVE_PASSES, SERVE_TELEGRAMS, Bench, BenchError, MainLoopPasses, serve_wait_s
 from supi3.sdk.driver import Mode, Supi3Driver
@@ -62,6 +65,28 @@ def test_the_wait_is_serve_telegrams_status_telegrams(bit_rate: int) -> None:
     assert SERVE_TELEGRAMS == 64
     assert serve_wait_s(bit_rate) == pytest.approx(64 * 5 / bit_rate)
     assert Bench(bit_rate=bit_rate)._serve_s == serve_wait_s(bit_rate)
+
+
+@pytest.mark.parametrize(
+    ("call", "match"),
+    [
+        (lambda p: p.arrive(float("nan")), r"at must be a finite number, not nan"),
+        (lambda p: p.arrive("1"), r"at must be a finite number, not '1'"),
+        (lambda p: p.begin(math.inf), r"since must be a finite number, not inf"),
+        (lambda p: (p.arrive(5.0), p.arrive(4.0)), r"at must be a time at or after the last arrival .*\(FW-14\)"),
+        (lambda p: (p.arrive(5.0), p.begin(4.0)), r"since must be a time at or after the last arrival .*\(FW-14\)"),
+        (lambda p: (p.begin(5.0), p.arrive(4.0)), r"at must be a time at or after .*the wait's begin \(5.0\)"),
+        (lambda _: serve_wait_s(0), r"bit_rate .*Table 1-7"),
+        (lambda _: serve_wait_s(True), r"bit_rate .*Table 1-7"),
+    ],
+)
+def test_the_rule_s_entries_name_bad_input(call: Callable[[MainLoopPasses], object], match: str) -> None:
+    """A time that is no finite number or goes back, a bit rate Table 1-7 does not list: a named ``ArgumentError``,
+    the passes unchanged."""
+    passes = MainLoopPasses()
+    with pytest.raises(ArgumentError, match=match):
+        call(passes)
+    assert not passes.passed() and len(passes.arrivals) <= 1
 
 
 # Python firmware -----------------------------------------------------------------------------------------------------

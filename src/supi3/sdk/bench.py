@@ -76,7 +76,7 @@ SERVE_PASSES: Final[int] = 2
 def serve_wait_s(bit_rate: int) -> float:
     """MCU-30, FW-14: the longest wait for the main loop's pass after a run's last cycle at ``bit_rate``:
     :data:`SERVE_TELEGRAMS` status telegrams (0.64 ms at 500 kbit/s)."""
-    return SERVE_TELEGRAMS * (wire.STATUS_TELEGRAM_BITS / bit_rate)
+    return SERVE_TELEGRAMS * (wire.STATUS_TELEGRAM_BITS / wire.check_bit_rate(bit_rate))
 
 
 class MainLoopPasses:
@@ -100,7 +100,17 @@ class MainLoopPasses:
         """The last arrivals at the idle point (at most :data:`SERVE_PASSES`) since the last handler."""
 
     def begin(self, since: float) -> None:
-        """The run's last cycle was seen to end at ``since``: the passes count from there."""
+        """The run's last cycle was seen to end at ``since``: the passes count from there.
+
+        Raises
+        ------
+        ArgumentError
+            ``since`` not a finite number, or before the last arrival (the runner's clock does not go back).
+        """
+        since = check_real("since", since)
+        arrivals = self.arrivals
+        if arrivals and since < arrivals[-1]:
+            raise fail("since", f"a time at or after the last arrival ({arrivals[-1]})", since, "FW-14")
         self.since = since
 
     def end(self) -> None:
@@ -112,8 +122,19 @@ class MainLoopPasses:
         self.arrivals = ()
 
     def arrive(self, at: float) -> bool:
-        """The firmware comes to its main loop's idle point at ``at``; whether that makes the run served."""
-        self.arrivals = (*self.arrivals[1 - SERVE_PASSES :], at)
+        """The firmware comes to its main loop's idle point at ``at``; whether that makes the run served.
+
+        Raises
+        ------
+        ArgumentError
+            ``at`` not a finite number, or before the last arrival or :attr:`since` (the clock does not go back).
+        """
+        at = check_real("at", at)
+        arrivals, since = self.arrivals, self.since
+        last = max(arrivals[-1] if arrivals else -math.inf, -math.inf if since is None else since)
+        if at < last:
+            raise fail("at", f"a time at or after the last arrival or the wait's begin ({last})", at, "FW-14")
+        self.arrivals = (*arrivals[1 - SERVE_PASSES :], at)
         return self.passed()
 
     def passed(self) -> bool:
