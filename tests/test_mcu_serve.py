@@ -56,10 +56,9 @@ from supi3.mcu.stm32 import (
 )
 from supi3.model.registers import InterfaceViolationError
 from supi3.sdk import native
-from supi3.sdk.bench import SERVE_TELEGRAMS, Bench
-from support import c_firmware
+from supi3.sdk.bench import SERVE_TELEGRAMS
 from test_mcu_stm32 import Clock, Wire
-from test_sdk_serve import C_VARIANTS
+from test_sdk_serve import C_VARIANTS, play_c
 
 pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
 
@@ -129,24 +128,6 @@ def test_a_main_loop_firmware_is_served_within_the_run_as_the_interrupt_one(
         assert cycles < 2 or outputs == out_data
 
 
-def _play_host(pytestconfig: pytest.Config, name: str, history: list[Step]) -> list[tuple[bytes, bytes, bool]]:
-    """:func:`_play` with the variant built for the host on the firmware bench (FW-14): (output terminals, master IN
-    data, served) after each step."""
-    assert pytestconfig.cache is not None
-    host = c_firmware(pytestconfig.cache, C_VARIANTS[name])  # type: ignore[arg-type]
-    bench = Bench(firmware=host)
-    bench.run(3)
-    seen = []
-    for out_data, in_data, wait_s, cycles in history:
-        bench.master.set_outputs(1, out_data)
-        host.board.inputs[0:2] = in_data
-        if wait_s:
-            bench.run_for(wait_s)
-        bench.run(cycles)
-        seen.append((bytes(host.board.outputs[0:2]), bench.master.inputs(1), bench.served))
-    return seen
-
-
 @pytest.mark.parametrize("name", VARIANTS)
 def test_the_host_build_gives_the_binary_s_data_after_every_run(
     pytestconfig: pytest.Config, variants: dict[tuple[str, str], Path], name: str
@@ -158,7 +139,8 @@ def test_the_host_build_gives_the_binary_s_data_after_every_run(
     history = _history(4, 12, (1, 2, 3), (0.0, 30e-6, 150e-6, 1e-3))
     board = [(outputs, inputs, served) for outputs, inputs, _, served in _play(Board(variants[name, "cortex_m3"]),
                                                                                history)]  # fmt: skip
-    assert _play_host(pytestconfig, name, history) == board
+    assert pytestconfig.cache is not None
+    assert play_c(pytestconfig.cache, name, history) == board
     assert all(served for *_, served in board)
 
 

@@ -228,6 +228,26 @@ C_VARIANTS = {"interrupt": [native.example("digital_io")],
 board and against this bench)."""
 
 
+def play_c(cache: pytest.Cache, name: str, history: list[tuple[bytes, bytes, float, int]],
+           mode: Mode = Mode.MOTOROLA) -> list[tuple[bytes, bytes, bool]]:  # fmt: skip
+    """The C variant ``name`` (:data:`C_VARIANTS`) built for the host on the bench: power-up (3 cycles), then per
+    step of ``history`` (OUT word, input terminals, a ``run_for`` first in seconds or 0, the run's cycles) the data
+    set, the ``run_for``, the run; (output terminals, the master's IN data, served) after each."""
+    defines = {"FW_MODE": "SUPI3_MODE_INTEL"} if mode is Mode.INTEL else None
+    firmware = c_firmware(cache, C_VARIANTS[name], defines=defines)  # type: ignore[arg-type]
+    bench = Bench(firmware=firmware, mode=mode)
+    bench.run(3)
+    seen = []
+    for out_data, in_data, wait_s, cycles in history:
+        bench.master.set_outputs(1, out_data)
+        firmware.board.inputs[0 : len(in_data)] = in_data
+        if wait_s:
+            bench.run_for(wait_s)
+        bench.run(cycles)
+        seen.append((bytes(firmware.board.outputs[0 : len(out_data)]), bench.master.inputs(1), bench.served))
+    return seen
+
+
 @pytest.mark.parametrize("mode", [Mode.MOTOROLA, Mode.INTEL])
 def test_c_main_loop_and_polling_firmware_give_the_interrupt_firmware_s_data(
     pytestconfig: pytest.Config, mode: Mode
@@ -236,23 +256,10 @@ def test_c_main_loop_and_polling_firmware_give_the_interrupt_firmware_s_data(
     variant of digital_io and polling_io show the interrupt variant's output terminals and IN data, each run
     ending served. Before FW-14 polling_io's output terminals were a step behind."""
     assert pytestconfig.cache is not None
-    defines = {"FW_MODE": "SUPI3_MODE_INTEL"} if mode is Mode.INTEL else None
-    history = _history(4, 12)  # runs of 2 and 3 cycles straight after a data change among them
-    seen = {}
-    for name, sources in C_VARIANTS.items():
-        firmware = c_firmware(pytestconfig.cache, sources, defines=defines)  # type: ignore[arg-type]
-        bench = Bench(firmware=firmware, mode=mode)
-        bench.run(3)
-        steps = []
-        for out, value, wait_s, cycles in history:
-            bench.master.set_outputs(1, out.to_bytes(2, "big"))
-            firmware.board.inputs[0:2] = value.to_bytes(2, "big")
-            if wait_s:
-                bench.run_for(wait_s)
-            bench.run(cycles)
-            steps.append((bytes(firmware.board.outputs[0:2]), bench.master.inputs(1), bench.served))
-        seen[name] = steps
+    history = [(out.to_bytes(2, "big"), value.to_bytes(2, "big"), wait_s, cycles)
+               for out, value, wait_s, cycles in _history(4, 12)]  # runs of 2 and 3 straight after a data change
+    seen = {name: play_c(pytestconfig.cache, name, history, mode) for name in C_VARIANTS}
     assert seen["main_loop"] == seen["interrupt"] == seen["polling"]
     assert all(served for *_, served in seen["polling"] + seen["main_loop"])
     for (out, *_, cycles), (outputs, *_) in zip(history, seen["polling"], strict=True):
-        assert cycles < 2 or outputs == out.to_bytes(2, "big")
+        assert cycles < 2 or outputs == out
