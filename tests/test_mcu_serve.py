@@ -27,7 +27,7 @@ from hypothesis import strategies as st
 from supi3.cli import FIRMWARE_FAILED_STATUS, main
 from supi3.errors import ArgumentError
 from supi3.mcu import build as mcu_build
-from supi3.mcu.board import SERVE_TELEGRAMS, Board
+from supi3.mcu.board import Board
 from supi3.mcu.core import CPUS, FirmwareStoppedError, Stop
 from supi3.mcu.stm32 import (
     AFIOEN,
@@ -56,20 +56,20 @@ from supi3.mcu.stm32 import (
 )
 from supi3.model.registers import InterfaceViolationError
 from supi3.sdk import native
+from supi3.sdk.bench import SERVE_TELEGRAMS
 from test_mcu_stm32 import Clock, Wire
+from test_sdk_serve import C_VARIANTS, play_c
 
 pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
 
 MCU = Path(__file__).parent / "mcu"
-VARIANTS = ("interrupt", "main_loop", "polling")
+VARIANTS = tuple(C_VARIANTS)
 """digital_io as it is (fw_isr in the EXTI0 handler), digital_io with mcu/main_loop.c's fw_loop (fw_isr between two
 passes of the main loop), polling_io (its main loop polls the I/O bit, no interrupt)."""
 
 
 def _variant(name: str, folder: Path, cpu: str, **defines: str) -> Path:
-    sources = {"interrupt": [native.example("digital_io")],
-               "main_loop": [native.example("digital_io"), MCU / "main_loop.c"],
-               "polling": [native.example("polling_io")]}[name]  # fmt: skip
+    sources = C_VARIANTS[name]
     tag = "_".join(f"{k}{v}" for k, v in sorted(defines.items()))
     return mcu_build.build(sources, folder / f"{name}_{cpu}{tag}.elf", cpu=cpu, defines=defines or None)
 
@@ -126,6 +126,22 @@ def test_a_main_loop_firmware_is_served_within_the_run_as_the_interrupt_one(
     assert all(served for *_, served in seen["interrupt"])
     for (out_data, _, _, cycles), (outputs, *_) in zip(history, seen["interrupt"], strict=True):
         assert cycles < 2 or outputs == out_data
+
+
+@pytest.mark.parametrize("name", VARIANTS)
+def test_the_host_build_gives_the_binary_s_data_after_every_run(
+    pytestconfig: pytest.Config, variants: dict[tuple[str, str], Path], name: str
+) -> None:
+    """Issue #13: each variant's host build on the firmware bench and its binary on the board show the same output
+    terminals and IN data after every run of a random history of data changes, ``run_for`` calls of 0 to 1 ms and
+    runs of 1 to 3 cycles, both ending each run served (FW-14 = MCU-30). Before FW-14 the host build of polling_io
+    was a step behind after a run of two cycles straight after a data change."""
+    history = _history(4, 12, (1, 2, 3), (0.0, 30e-6, 150e-6, 1e-3))
+    board = [(outputs, inputs, served) for outputs, inputs, _, served in _play(Board(variants[name, "cortex_m3"]),
+                                                                               history)]  # fmt: skip
+    assert pytestconfig.cache is not None
+    assert play_c(pytestconfig.cache, name, history) == board
+    assert all(served for *_, served in board)
 
 
 @pytest.mark.parametrize(("name", "size"), [("analog_io", 4), ("irq_dispatch", 2), ("pcmd_alarm", 2),

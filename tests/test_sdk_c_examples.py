@@ -180,7 +180,7 @@ def test_digital_io_without_id_cycle_handler_sends_zeros_first(cache: pytest.Cac
 def test_polling_io_exchanges_every_cycle_without_interrupts(cache: pytest.Cache, mode: Mode) -> None:
     """3.4.14 polling: the 1 -> 0 edge of the I/O access bit, then four accesses inside the 30-bit window."""
     bench, firmware = _bench(cache, "polling_io", mode)
-    bench.run(5)  # both runs end at a cycle's end, before the firmware sees that fall
+    bench.run(5)  # each run ends once a main-loop pass after its last cycle has seen that fall (FW-14)
     served = firmware.board.cycles
     bench.master.set_outputs(1, b"\xbe\xef")
     _set_inputs(firmware, b"\xca\xfe")

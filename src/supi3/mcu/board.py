@@ -54,7 +54,7 @@ from supi3.model.pinring import PinBranch, PinChip
 from supi3.model.registers import InterfaceViolationError
 from supi3.model.vcd import write_vcd
 from supi3.pinout import C_D_COMMAND
-from supi3.sdk.bench import Bench, default_config
+from supi3.sdk.bench import SERVE_TELEGRAMS, Bench, MainLoopPasses, default_config, serve_wait_s
 from supi3.spi.upif import Mode, UpifProtocol
 from supi3.tables import CLOCK_HZ
 from supi3.top import Supi3Chip
@@ -102,17 +102,12 @@ FIDELITIES: Final[tuple[str, ...]] = ("transaction", "pin")
 START_WAIT_S: Final[float] = 1e-3
 """MCU-17: at pin level the master starts (Alarm Stop, ID cycle) once the firmware first sleeps, its set-up done,
 or after this much bus time of idle status telegrams, whichever comes first."""
-SERVE_TELEGRAMS: Final[int] = 64
-"""MCU-17: at pin level, after its last master cycle :meth:`Board.run` idles the line up to this many status
-telegrams while the firmware is still in a handler or has an /IRQ edge to serve; MCU-30: at either fidelity it waits
-at most this many status telegrams' bus time for the main loop's passes (:data:`SERVE_POINT`)."""
 SERVE_POINT: Final[str] = "fw_loop"
 """MCU-30: the main loop's idle point: the entry of the board contract's ``fw_loop`` (examples/fw_board.h), which the
 board port's ``main`` calls again and again, serving the /IRQ edge its EXTI0 handler noted after each call. A
 :meth:`Board.run` of a firmware with this symbol ends only once a whole pass (entry to entry) began after the last
-master cycle's end and after the last EXTI0 handler."""
-SERVE_PASSES: Final[int] = 2
-"""MCU-30: arrivals at :data:`SERVE_POINT` that make a whole pass: its entry and the next one."""
+master cycle's end and after the last EXTI0 handler (the rule of :class:`supi3.sdk.bench.MainLoopPasses`, which
+the firmware bench shares, FW-14), waiting at most :data:`supi3.sdk.bench.SERVE_TELEGRAMS` status telegrams."""
 
 
 FLAG_EVENTS: Final[frozenset[str]] = frozenset({"io", "latch"})
@@ -325,6 +320,7 @@ class Board:
         self._cpu_hz = self.core.cpu_hz
         bit_rate = self.config.bit_rate
         self._telegram_s = wire.STATUS_TELEGRAM_BITS / bit_rate  # the line idles in whole telegrams (MCU-22, -30)
+        self._serve_s = serve_wait_s(bit_rate)  # the longest wait for the main loop's pass (MCU-30)
         self._limits = {symbol: timing.limit("3-7", symbol, bit_rate) for symbol in ("t0", "t1", "t2", "t8")}
         self._limits["t6max"] = timing.limit("3-7", "t6", bit_rate, maximum=True)
         self._limits["t_SAS_INIT"] = timing.limit("3-7", "t_SAS_INIT", bit_rate)
@@ -365,8 +361,7 @@ class Board:
         self.served = True
         """MCU-30: the last :meth:`run` ended with the firmware's work served (False: the wait for the main loop's
         pass ran out, or the run raised)."""
-        self._arrivals: tuple[int, ...] = ()  # core cycles of the last arrivals at SERVE_POINT, after the last EXTI0
-        self._serve_from: int | None = None  # the core cycle the run's last master cycle ended (None: no wait)
+        self._passes = MainLoopPasses()  # arrivals at SERVE_POINT (core cycles), counted from the last cycle's end
         self._serve_end: int | None = None  # the core cycle the wait for the main loop's pass gives up
         if SERVE_POINT in core.image.symbols:  # MCU-30: note the main loop's passes
             self._serve_point: int | None = core.image.address(SERVE_POINT)
@@ -543,7 +538,7 @@ class Board:
 
     def _entered(self, number: int) -> None:
         if number == _EXTI0:
-            self._arrivals = ()  # MCU-30: a pass serves the edge only if it begins after the handler
+            self._passes.handler()  # MCU-30: a pass serves the edge only if it begins after the handler
             self.interrupts += 1
             if self._irq_fell is not None:
                 self.irq_latency_s = max(self.irq_latency_s, self._seconds(self.core.cycles - self._irq_fell))
@@ -554,19 +549,13 @@ class Board:
     def _on_serve_point(self) -> None:
         """The core is about to run :data:`SERVE_POINT`: note the arrival (at the end of the block it is in, the
         core's clock now, MCU-1); once a whole pass began after the run's last cycle, end the core's run."""
-        cycles = self.core.cycles
-        self._arrivals = (*self._arrivals[1 - SERVE_PASSES :], cycles)
-        if self._serve_from is not None and self._passed():
+        if self._passes.arrive(self.core.cycles):
             self.core.stop_request = True
 
     def _passed(self) -> bool:
         """A whole pass of the main loop began at or after the run's last cycle's end and after the last EXTI0
-        handler: :data:`SERVE_PASSES` arrivals at :data:`SERVE_POINT` since then (always, without the symbol)."""
-        if self._serve_point is None:
-            return True
-        since = self._serve_from
-        arrivals = self._arrivals
-        return since is not None and len(arrivals) == SERVE_PASSES and arrivals[0] >= since
+        handler (:meth:`MainLoopPasses.passed`; always, without :data:`SERVE_POINT`)."""
+        return self._serve_point is None or self._passes.passed()
 
     def _served(self) -> bool:
         """The firmware has served what the bus gave it: no exception active or pending and the main loop's pass
@@ -579,9 +568,9 @@ class Board:
         loop's passes count from there, for at most :data:`SERVE_TELEGRAMS` status telegrams (a bound of the run
         loop's steps until then); an exception active or pending is waited for as before MCU-30, unbounded."""
         core = self.core
-        if self._serve_from is None:
-            self._serve_from = core.cycles
-            self._serve_end = core.cycles + self._cycles(SERVE_TELEGRAMS * self._telegram_s)
+        if self._passes.since is None:
+            self._passes.begin(core.cycles)
+            self._serve_end = core.cycles + self._cycles(self._serve_s)
         end = self._serve_end
         if end is not None and core.cycles >= end:
             self._serve_end = end = None  # the wait for the pass is over: no longer a bound of the steps
@@ -768,7 +757,8 @@ class Board:
             MCU-29).
         """
         target = self.cycles + check_int("cycles", cycles, 0)
-        self._serve_from = self._serve_end = None
+        self._passes.end()
+        self._serve_end = None
         self.served = False  # until the run ends served (MCU-30)
         try:
             if self._ring is not None:
@@ -776,7 +766,8 @@ class Board:
                 return
             self._run(lambda: self.bench.cycles >= target and self._serve_wait(), max_instructions)
         finally:
-            self._serve_from = self._serve_end = None
+            self._passes.end()
+            self._serve_end = None
 
     def run_for(self, seconds: float, *, max_instructions: int = DEFAULT_MAX_INSTRUCTIONS) -> None:
         """Run the firmware for ``seconds`` of bus time (raises as :meth:`run`). At pin level (MCU-22) the master
@@ -870,7 +861,7 @@ class Board:
                     self._idle_to(end_s)
             if end_s is not None:
                 return
-            self._serve_from = ended  # MCU-30: the passes count from the last cycle's end (not a cycle time's idle)
+            self._passes.begin(ended)  # MCU-30: the passes count from the last cycle's end (not a cycle time's idle)
             for _ in range(SERVE_TELEGRAMS):
                 if self._served() and self._irq_fell is None:
                     break

@@ -23,10 +23,10 @@ from supi3.errors import Supi3Error
 from supi3.interbus.device import PlainDevice
 from supi3.interbus.link import Device
 from supi3.interbus.master import ConfigEntry
-from supi3.mcu.board import DEFAULT_MAX_INSTRUCTIONS, FIDELITIES, SERVE_TELEGRAMS, Board, ViolationAt
+from supi3.mcu.board import DEFAULT_MAX_INSTRUCTIONS, FIDELITIES, Board, ViolationAt
 from supi3.mcu.core import FirmwareError, StopReport
 from supi3.model.pins import Supi3Pins
-from supi3.sdk.bench import DEFAULT_STRAPS
+from supi3.sdk.bench import DEFAULT_STRAPS, SERVE_TELEGRAMS
 from supi3.spi.upif import Mode
 
 __all__ = ["DEFAULT_CYCLES", "MAX_PIN_DEVICES", "POWER_UP_CYCLES", "RING_DEVICE", "RING_DEVICE_STRAPS", "FirmwareRun",

@@ -1,7 +1,7 @@
 """The firmware test bench: INTERBUS master, ring, SUPI 3 chip and firmware on one clock (transaction level).
 
 Ref: IBS SUPI 3 OPC UM E rev. 05, 3.4.14 (interrupts, I/O access bit, latch phase, Figure 3-22), Table 3-7 (byte
-times); decisions FW-1 to FW-6 in docs/assumptions/sdk.md; guide docs/sdk.md, "Firmware tests".
+times); decisions FW-1 to FW-6 and FW-14 in docs/assumptions/sdk.md; guide docs/sdk.md, "Firmware tests".
 
 One clock, :attr:`Bench.now` (seconds), is bus time and firmware time at once:
 
@@ -12,6 +12,9 @@ One clock, :attr:`Bench.now` (seconds), is bus time and firmware time at once:
   sequence begins and the latch phase runs over the last latch telegram (:func:`supi3.interbus.wire.cycle_phases`);
 - a falling edge of /IRQ calls the firmware's :meth:`Firmware.isr`, at the next point where the firmware may be
   interrupted: when it is idle, or when a driver call of its main code has ended (FW-3).
+- a run ends once the firmware has served its last cycle: for a firmware with a main loop, a whole pass of it after
+  that cycle and the last service routine (FW-14), the emulated board's rule (MCU-30), defined once here
+  (:class:`MainLoopPasses`).
 
 So the interrupt method, the polling method with its 30-bit window and a firmware that touches the data registers
 in the latch phase (``InconsistentDataError``) are all tested at transaction level.
@@ -21,7 +24,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from types import TracebackType
 from typing import Final, Literal, NamedTuple
 
@@ -39,7 +42,19 @@ from supi3.model.registers import RegisterFile
 from supi3.sdk.driver import DriverArgumentError, Mode, Supi3Driver
 from supi3.sdk.transports import ModelTransport
 
-__all__ = ["DEFAULT_STRAPS", "Bench", "BenchError", "BenchTransport", "CycleTiming", "Firmware", "default_config"]
+__all__ = [
+    "DEFAULT_STRAPS",
+    "SERVE_PASSES",
+    "SERVE_TELEGRAMS",
+    "Bench",
+    "BenchError",
+    "BenchTransport",
+    "CycleTiming",
+    "Firmware",
+    "MainLoopPasses",
+    "default_config",
+    "serve_wait_s",
+]
 
 DEFAULT_STRAPS: Final[tuple[str, str]] = ("10011", "1110")
 """C[4..0] and MFP[15..12] of the bench's default chip: a remote bus device in the Init-µP mode (Table 2-4)."""
@@ -49,6 +64,83 @@ KEPT: Final[int] = 1000
 """FW-6: how many cycles :attr:`Bench.results` and :attr:`Bench.timeline` keep (a long run stays bounded)."""
 IDLE_LOOPS_LIMIT: Final[int] = 1000
 """FW-5: main-loop calls in a row that clock no byte and wait for nothing before the bench calls it stuck."""
+SERVE_TELEGRAMS: Final[int] = 64
+"""MCU-30, FW-14: after a run's last master cycle, the wait for the main loop's pass (:class:`MainLoopPasses`) lasts
+at most this many status telegrams' bus time (:func:`serve_wait_s`), on the firmware bench and on the emulated
+board at either fidelity; at pin level the board also idles the line up to this many status telegrams while its
+firmware is in a handler or has an /IRQ edge to serve (MCU-17)."""
+SERVE_PASSES: Final[int] = 2
+"""MCU-30, FW-14: arrivals at the main loop's idle point that make a whole pass: its entry and the next one."""
+
+
+def serve_wait_s(bit_rate: int) -> float:
+    """MCU-30, FW-14: the longest wait for the main loop's pass after a run's last cycle at ``bit_rate``:
+    :data:`SERVE_TELEGRAMS` status telegrams (0.64 ms at 500 kbit/s)."""
+    return SERVE_TELEGRAMS * (wire.STATUS_TELEGRAM_BITS / wire.check_bit_rate(bit_rate))
+
+
+class MainLoopPasses:
+    """MCU-30, FW-14: when a firmware with a main loop has served a run's last cycle, the one rule of the firmware
+    bench (:meth:`Bench.run`) and the emulated board (``supi3.mcu.board.Board.run``).
+
+    The runner calls :meth:`begin` with the time it saw the run's last cycle end, :meth:`arrive` each time the
+    firmware comes to its main loop's idle point (a pass's entry), :meth:`handler` each time an interrupt handler
+    begins. The last cycle is served once a whole pass (:data:`SERVE_PASSES` arrivals, entry to entry) began at or
+    after :attr:`since` and after the last handler: a handler forgets the arrivals before it, since a pass that
+    began before it may have missed what the handler noted. Times are in the runner's unit (bench seconds, core
+    cycles), only compared.
+    """
+
+    __slots__ = ("arrivals", "since")
+
+    def __init__(self) -> None:
+        self.since: float | None = None
+        """When the run's last cycle was seen to end; ``None``: no wait under way (nothing is served)."""
+        self.arrivals: tuple[float, ...] = ()
+        """The last arrivals at the idle point (at most :data:`SERVE_PASSES`) since the last handler."""
+
+    def begin(self, since: float) -> None:
+        """The run's last cycle was seen to end at ``since``: the passes count from there.
+
+        Raises
+        ------
+        ArgumentError
+            ``since`` not a finite number, or before the last arrival (the runner's clock does not go back).
+        """
+        since = check_real("since", since)
+        arrivals = self.arrivals
+        if arrivals and since < arrivals[-1]:
+            raise fail("since", f"a time at or after the last arrival ({arrivals[-1]})", since, "FW-14")
+        self.since = since
+
+    def end(self) -> None:
+        """The wait is over (the run ended)."""
+        self.since = None
+
+    def handler(self) -> None:
+        """An interrupt handler begins: passes count only from after it."""
+        self.arrivals = ()
+
+    def arrive(self, at: float) -> bool:
+        """The firmware comes to its main loop's idle point at ``at``; whether that makes the run served.
+
+        Raises
+        ------
+        ArgumentError
+            ``at`` not a finite number, or before the last arrival or :attr:`since` (the clock does not go back).
+        """
+        at = check_real("at", at)
+        arrivals, since = self.arrivals, self.since
+        last = max(arrivals[-1] if arrivals else -math.inf, -math.inf if since is None else since)
+        if at < last:
+            raise fail("at", f"a time at or after the last arrival or the wait's begin ({last})", at, "FW-14")
+        self.arrivals = (*arrivals[1 - SERVE_PASSES :], at)
+        return self.passed()
+
+    def passed(self) -> bool:
+        """A whole pass began at or after :attr:`since` and after the last handler."""
+        since, arrivals = self.since, self.arrivals
+        return since is not None and len(arrivals) == SERVE_PASSES and arrivals[0] >= since
 
 
 class CycleTiming(NamedTuple):
@@ -268,6 +360,8 @@ class Bench:
         The master's :class:`CycleResult` of every cycle started, the last :data:`KEPT` (FW-6).
     timeline:
         The :class:`CycleTiming` of every cycle started, the last :data:`KEPT`.
+    served:
+        The last :meth:`run` ended with the firmware's work served (FW-14).
     """
 
     def __init__(
@@ -327,6 +421,11 @@ class Bench:
         self._irq_fell_at: float | None = None
         self._in_isr = False
         self._set_up = False
+        self.served = True
+        """FW-14: the last :meth:`run` ended with the firmware's work served (False: the wait for the main loop's
+        pass ran out, or the run raised)."""
+        self._passes = MainLoopPasses()
+        self._serve_s = serve_wait_s(self.config.bit_rate)
 
     # -- the bus side ------------------------------------------------------------------------------------------
 
@@ -456,8 +555,14 @@ class Bench:
                 self.firmware.setup(self.driver)
 
     def run(self, cycles: int) -> None:
-        """Run until ``cycles`` more master cycles have finished, the firmware's main loop and service routine
-        running as the clock goes.
+        """Run until ``cycles`` more master cycles have finished and the firmware has served them (FW-14, as the
+        emulated board's run, MCU-30), the firmware's main loop and service routine running as the clock goes.
+
+        Served: the interrupt of the last cycle taken (as the firmware would take it) and, for a firmware with a
+        main loop, a whole pass of it (one :meth:`Firmware.loop` call) begun after the last cycle's end and after
+        the last :meth:`Firmware.isr` (:class:`MainLoopPasses`). The wait for that pass lasts at most
+        :data:`SERVE_TELEGRAMS` status telegrams of bus time (:func:`serve_wait_s`), checked between passes (the
+        bench cannot cut a pass); :attr:`served` tells whether the run ended served.
 
         Raises
         ------
@@ -465,29 +570,74 @@ class Bench:
             If the firmware's main loop runs :data:`IDLE_LOOPS_LIMIT` times without clocking a byte or waiting.
         """
         target = self.cycles + check_int("cycles", cycles, 0)
+        self.served = False  # until the run ends served (FW-14)
+        self._run_to(target)
+        self.served = self._serve()
+
+    def _run_to(self, target: int) -> None:
+        """Run until :attr:`cycles` reaches ``target``, then take the last cycle's interrupt."""
         self.power_up()
-        firmware = self.firmware
-        has_loop = firmware is not None and type(firmware).loop is not Firmware.loop
+        loop = self._main_loop()
         idle_loops = 0
         while self.cycles < target:
             if self._irq_fell_at is not None:
                 self.take_interrupt()
-            if has_loop and firmware is not None:
-                before = (self.now, self.bytes_clocked)
-                firmware.loop(self.driver)
-                if (self.now, self.bytes_clocked) != before:
-                    idle_loops = 0
-                    continue
-                idle_loops += 1
-                if idle_loops < IDLE_LOOPS_LIMIT:
-                    continue
-                raise BenchError(f"the firmware's main loop ran {IDLE_LOOPS_LIMIT} times without clocking a byte or "
-                                 f"waiting, at t = {self.now:.6f} s (FW-5)")  # fmt: skip
+            if loop is not None:
+                idle_loops = self._pass(loop, idle_loops)
+                continue
             self._step_bus()  # sleep until the bus does something
         self.take_interrupt()  # the last cycle's interrupt, as the firmware would take it
 
+    def _main_loop(self) -> Callable[[Supi3Driver], None] | None:
+        """The firmware's :meth:`Firmware.loop` if it overrides it (a firmware without one sleeps)."""
+        firmware = self.firmware
+        if firmware is None or type(firmware).loop is Firmware.loop:
+            return None
+        return firmware.loop
+
+    def _pass(self, loop: Callable[[Supi3Driver], None], idle_loops: int) -> int:
+        """One pass of the main loop; the passes in a row before it and with it that clocked no byte and waited for
+        nothing (FW-5)."""
+        before = (self.now, self.bytes_clocked)
+        loop(self.driver)
+        if (self.now, self.bytes_clocked) != before:
+            return 0
+        if idle_loops + 1 < IDLE_LOOPS_LIMIT:
+            return idle_loops + 1
+        raise BenchError(f"the firmware's main loop ran {IDLE_LOOPS_LIMIT} times without clocking a byte or "
+                         f"waiting, at t = {self.now:.6f} s (FW-5)")  # fmt: skip
+
+    def _serve(self) -> bool:
+        """FW-14 (MCU-30): after the run's last cycle, run the main loop until a whole pass began after that cycle
+        and the last service routine (:class:`MainLoopPasses`), for at most :func:`serve_wait_s` of bus time;
+        whether the run ended served. A firmware without a main loop is served once the last interrupt is taken."""
+        loop = self._main_loop()
+        if loop is None:
+            return True
+        passes = self._passes
+        passes.begin(self.now)
+        end = self.now + self._serve_s
+        interrupts = self.interrupts
+        idle_loops = 0
+        try:
+            while True:
+                if self._irq_fell_at is not None:
+                    self.take_interrupt()
+                if self.interrupts != interrupts:  # a service routine ran, before or within the last pass
+                    interrupts = self.interrupts
+                    passes.handler()
+                if passes.arrive(self.now) and self.now <= end:
+                    return True
+                if self.now >= end:  # a pass that ends past the bound does not count (the board's core stops there)
+                    return False
+                idle_loops = self._pass(loop, idle_loops)
+        finally:
+            passes.end()
+            passes.handler()
+
     def run_for(self, seconds: float) -> None:
-        """Run until the clock has moved on by ``seconds`` (at least to the next bus event)."""
+        """Run until the clock has moved on by ``seconds`` (at least to the next bus event); unlike :meth:`run`, the
+        end does not wait for the main loop's pass (FW-14, as the emulated board's ``run_for``)."""
         end = self.now + check_real("seconds", seconds, 0.0)
         while self.now < end:
-            self.run(1)
+            self._run_to(self.cycles + 1)

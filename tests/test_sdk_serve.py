@@ -1,0 +1,265 @@
+"""FW-14 (docs/assumptions/sdk.md): the firmware bench's ``Bench.run`` ends once the firmware has served the last
+cycle, by the emulated board's rule (MCU-30), one definition for both (``supi3.sdk.bench.MainLoopPasses``).
+
+A firmware with a main loop is served when a whole pass of it (one ``Firmware.loop`` call) began after the run's last
+cycle and after the last service routine, within ``SERVE_TELEGRAMS`` status telegrams of bus time. Before, the
+bench returned inside the pass that saw the last cycle end: a polling firmware (the C ``polling_io``) showed its
+output terminals one step behind, and so did a main loop that serves what its service routine noted (the board
+port's ``main``, examples/fw_board.h). Ref: 3.4.14 (the interrupt and the polling method, Fig. 3-22).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from supi3.errors import ArgumentError
+from supi3.sdk import native
+from supi3.sdk.bench import SERVE_PASSES, SERVE_TELEGRAMS, Bench, BenchError, MainLoopPasses, serve_wait_s
+from supi3.sdk.driver import Mode, Supi3Driver
+from supi3.sdk.examples import DigitalIo, PollingIo
+from support import c_firmware
+
+MCU = Path(__file__).parent / "mcu"
+PASS_US = 20.0
+"""The other work of one pass of the test's main loops (as tests/mcu/main_loop.c's PASS_US)."""
+
+
+# The rule itself -----------------------------------------------------------------------------------------------------
+
+
+def test_the_pass_rule_over_every_short_history() -> None:
+    """Every history of up to 7 events (an arrival at the idle point, a handler, the wait's begin; times rising by
+    one per event): served exactly when at least two arrivals came after the wait began and after the last
+    handler, told at each arrival and by ``passed`` after each event."""
+    assert SERVE_PASSES == 2
+    for length in range(8):
+        for events in itertools.product("abh", repeat=length):
+            passes = MainLoopPasses()
+            since: int | None = None
+            counted = 0  # arrivals at or after since, after the last handler
+            for at, event in enumerate(events):
+                if event == "b":
+                    passes.begin(at)
+                    since = at
+                    counted = 0
+                elif event == "h":
+                    passes.handler()
+                    counted = 0
+                else:
+                    counted += since is not None
+                    assert passes.arrive(at) is (counted >= SERVE_PASSES), events
+                assert passes.passed() is (since is not None and counted >= SERVE_PASSES), events
+            passes.end()
+            assert not passes.passed()
+
+
+@pytest.mark.parametrize("bit_rate", [500_000, 2_000_000])
+def test_the_wait_is_serve_telegrams_status_telegrams(bit_rate: int) -> None:
+    """64 status telegrams of 5 bits (0.64 ms at 500 kbit/s), the bound the board uses too (MCU-30)."""
+    assert SERVE_TELEGRAMS == 64
+    assert serve_wait_s(bit_rate) == pytest.approx(64 * 5 / bit_rate)
+    assert Bench(bit_rate=bit_rate)._serve_s == serve_wait_s(bit_rate)
+
+
+@pytest.mark.parametrize(
+    ("call", "match"),
+    [
+        (lambda p: p.arrive(float("nan")), r"at must be a finite number, not nan"),
+        (lambda p: p.arrive("1"), r"at must be a finite number, not '1'"),
+        (lambda p: p.begin(math.inf), r"since must be a finite number, not inf"),
+        (lambda p: (p.arrive(5.0), p.arrive(4.0)), r"at must be a time at or after the last arrival .*\(FW-14\)"),
+        (lambda p: (p.arrive(5.0), p.begin(4.0)), r"since must be a time at or after the last arrival .*\(FW-14\)"),
+        (lambda p: (p.begin(5.0), p.arrive(4.0)), r"at must be a time at or after .*the wait's begin \(5.0\)"),
+        (lambda _: serve_wait_s(0), r"bit_rate .*Table 1-7"),
+        (lambda _: serve_wait_s(True), r"bit_rate .*Table 1-7"),
+    ],
+)
+def test_the_rule_s_entries_name_bad_input(call: Callable[[MainLoopPasses], object], match: str) -> None:
+    """A time that is no finite number or goes back, a bit rate Table 1-7 does not list: a named ``ArgumentError``,
+    the passes unchanged."""
+    passes = MainLoopPasses()
+    with pytest.raises(ArgumentError, match=match):
+        call(passes)
+    assert not passes.passed() and len(passes.arrivals) <= 1
+
+
+# Python firmware -----------------------------------------------------------------------------------------------------
+
+
+class NotingDigitalIo(DigitalIo):
+    """DigitalIo as the board port runs a firmware with a main loop: the service routine only notes the /IRQ edge,
+    the main loop does PASS_US of other work, then serves a noted edge (examples/fw_board.h)."""
+
+    def __init__(self, mode: Mode = Mode.MOTOROLA, pass_us: float = PASS_US) -> None:
+        super().__init__(mode)
+        self.noted = False
+        self.pass_us = pass_us
+
+    def isr(self, drv: Supi3Driver) -> None:
+        del drv
+        self.noted = True
+
+    def loop(self, drv: Supi3Driver) -> None:
+        drv.transport.delay_us(self.pass_us)
+        if self.noted:
+            self.noted = False
+            super().isr(drv)
+
+
+Step = tuple[int, int, float, int]
+"""The master's OUT word, the input terminals, a ``run_for`` first (seconds, 0: none), the cycles of the run."""
+
+
+def _history(seed: int, steps: int) -> list[Step]:
+    rng = np.random.default_rng(seed)
+    return [(int(rng.integers(0, 1 << 16)), int(rng.integers(0, 1 << 16)),
+             float(rng.choice((0.0, 30e-6, 150e-6, 1e-3))), int(rng.integers(1, 4))) for _ in range(steps)]  # fmt: skip
+
+
+def _play_python(bench: Bench, device: DigitalIo | PollingIo, history: list[Step]) -> list[tuple[int, int, bool]]:
+    bench.run(6)
+    seen = []
+    for out, value, wait_s, cycles in history:
+        bench.master.set_outputs(1, out.to_bytes(2, "big"))
+        device.inputs = value
+        if wait_s:
+            bench.run_for(wait_s)
+        bench.run(cycles)
+        seen.append((device.outputs, int.from_bytes(bench.master.inputs(1), "big"), bench.served))
+    return seen
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+@pytest.mark.parametrize("mode", list(Mode))
+def test_python_main_loop_and_polling_firmware_give_the_interrupt_firmware_s_data(seed: int, mode: Mode) -> None:
+    """After every run of a random history (data changes, ``run_for`` of 0 to 1 ms cutting cycles anywhere, runs of
+    1 to 3 cycles): the noting main loop shows the interrupt example's output terminals and IN data, the polling
+    example (pin and register bit) its output terminals, each run ending served; a run of two or more cycles has its
+    step's master word in the output terminals. Before FW-14 the noting main loop was a step behind. (The Python
+    polling example exchanges whenever the I/O bit reads 0, a cycle's start included, so its IN data may reach the
+    master a cycle before the interrupt example's.)"""
+    history = _history(seed, 12)
+    devices: dict[str, tuple[DigitalIo | PollingIo, bool]] = {
+        "interrupt": (DigitalIo(mode), True), "noting": (NotingDigitalIo(mode), True),
+        "polling": (PollingIo(mode), True), "polling_bit": (PollingIo(mode), False)}  # fmt: skip
+    seen = {name: _play_python(Bench(firmware=device, mode=mode, io_pin=io_pin), device, history)
+            for name, (device, io_pin) in devices.items()}  # fmt: skip
+    assert seen["noting"] == seen["interrupt"] and seen["polling"] == seen["polling_bit"]
+    assert [outputs for outputs, *_ in seen["polling"]] == [outputs for outputs, *_ in seen["interrupt"]]
+    assert all(served for *_, served in seen["noting"] + seen["polling"])
+    for name in ("noting", "polling"):
+        for (out, *_, cycles), (outputs, *_) in zip(history, seen[name], strict=True):
+            assert cycles < 2 or outputs == out, name
+
+
+def test_the_wait_adds_at_most_a_pass_and_a_service_routine() -> None:
+    """The noting main loop: each run ends within two passes and one service routine after its last cycle's end
+    (the pass running at the end, then the whole pass), never before the end; ``run_for`` does not wait and leaves
+    ``served`` as the last run left it."""
+    device = NotingDigitalIo()
+    bench = Bench(firmware=device)
+    bench.run(6)
+    routine_s = 8 * bench.byte_s  # IRQ_EVT read, OUT0, OUT1, IN0, IN1: at most 4 accesses of 2 bytes more
+    for cycles in (1, 2, 3, 1, 5):
+        target = bench.cycles + cycles
+        bench.run(cycles)
+        ended = [t.end for t in bench.timeline if t.end <= bench.now]
+        last_end = sorted(ended)[-(bench.cycles - target) - 1]  # the run's last cycle (the wait may end more)
+        assert bench.served and bench.cycles >= target
+        assert 0 <= bench.now - last_end <= 2 * PASS_US * 1e-6 + 2 * routine_s
+    bench.run_for(1e-3)
+    assert bench.served
+
+
+@pytest.mark.parametrize("pass_us", [700.0, 3000.0])
+def test_a_pass_longer_than_the_wait_ends_the_run_unserved_and_the_next_run_goes_on(pass_us: float) -> None:
+    """A main loop whose pass (0.7 ms, 3 ms) outlasts SERVE_TELEGRAMS status telegrams (0.64 ms at 500 kbit/s): the
+    pass after the last cycle does not count, the run ends unserved after it (the bench cannot cut a pass, where
+    the board's core stops at the bound); the next run goes on with the data of its cycles."""
+    device = NotingDigitalIo(pass_us=pass_us)
+    bench = Bench(firmware=device)
+    bench.run(3)
+    assert not bench.served
+    bench.master.set_outputs(1, b"\x12\x34")
+    bench.run(6)
+    assert not bench.served and device.outputs == 0x1234
+    device.pass_us = PASS_US
+    bench.run(1)
+    assert bench.served
+
+
+def test_a_run_that_raises_ends_unserved() -> None:
+    """A main loop that goes wrong in the wait (FW-5: nothing clocked, no wait, 1,000 times): ``BenchError``, and
+    ``served`` is False until a run ends served."""
+
+    class Stalling(NotingDigitalIo):
+        stall = False
+
+        def loop(self, drv: Supi3Driver) -> None:
+            if not self.stall:
+                super().loop(drv)
+
+    device = Stalling()
+    bench = Bench(firmware=device)
+    bench.run(3)
+    assert bench.served
+    device.stall = True
+    with pytest.raises(BenchError, match=r"main loop ran 1000 times .*\(FW-5\)"):
+        bench.run(1)
+    assert not bench.served
+    device.stall = False
+    bench.run(1)
+    assert bench.served
+
+
+# C firmware: the board's variants on the host ------------------------------------------------------------------------
+
+
+C_VARIANTS = {"interrupt": [native.example("digital_io")],
+              "main_loop": [native.example("digital_io"), MCU / "main_loop.c"],
+              "polling": [native.example("polling_io")]}  # fmt: skip
+"""digital_io, with tests/mcu/main_loop.c's fw_loop, polling_io (the variants tests/test_mcu_serve.py runs on the
+board and against this bench)."""
+
+
+def play_c(cache: pytest.Cache, name: str, history: list[tuple[bytes, bytes, float, int]],
+           mode: Mode = Mode.MOTOROLA) -> list[tuple[bytes, bytes, bool]]:  # fmt: skip
+    """The C variant ``name`` (:data:`C_VARIANTS`) built for the host on the bench: power-up (3 cycles), then per
+    step of ``history`` (OUT word, input terminals, a ``run_for`` first in seconds or 0, the run's cycles) the data
+    set, the ``run_for``, the run; (output terminals, the master's IN data, served) after each."""
+    defines = {"FW_MODE": "SUPI3_MODE_INTEL"} if mode is Mode.INTEL else None
+    firmware = c_firmware(cache, C_VARIANTS[name], defines=defines)  # type: ignore[arg-type]
+    bench = Bench(firmware=firmware, mode=mode)
+    bench.run(3)
+    seen = []
+    for out_data, in_data, wait_s, cycles in history:
+        bench.master.set_outputs(1, out_data)
+        firmware.board.inputs[0 : len(in_data)] = in_data
+        if wait_s:
+            bench.run_for(wait_s)
+        bench.run(cycles)
+        seen.append((bytes(firmware.board.outputs[0 : len(out_data)]), bench.master.inputs(1), bench.served))
+    return seen
+
+
+@pytest.mark.parametrize("mode", [Mode.MOTOROLA, Mode.INTEL])
+def test_c_main_loop_and_polling_firmware_give_the_interrupt_firmware_s_data(
+    pytestconfig: pytest.Config, mode: Mode
+) -> None:
+    """The C variants the board tests (MCU-30) on the host bench: after every run of a random history the main-loop
+    variant of digital_io and polling_io show the interrupt variant's output terminals and IN data, each run
+    ending served. Before FW-14 polling_io's output terminals were a step behind."""
+    assert pytestconfig.cache is not None
+    history = [(out.to_bytes(2, "big"), value.to_bytes(2, "big"), wait_s, cycles)
+               for out, value, wait_s, cycles in _history(4, 12)]  # runs of 2 and 3 straight after a data change
+    seen = {name: play_c(pytestconfig.cache, name, history, mode) for name in C_VARIANTS}
+    assert seen["main_loop"] == seen["interrupt"] == seen["polling"]
+    assert all(served for *_, served in seen["polling"] + seen["main_loop"])
+    for (out, *_, cycles), (outputs, *_) in zip(history, seen["polling"], strict=True):
+        assert cycles < 2 or outputs == out
