@@ -293,6 +293,11 @@ def _active(start: float, duration: float | None, t: float) -> bool:
     return start <= t and (duration is None or t < start + duration)
 
 
+def _at(direction: object, t: object) -> tuple[Direction, float]:
+    """The arguments of an event's ``loss``: a :class:`Direction` and a bus time, checked by name."""
+    return check_instance("direction", direction, Direction), _time("t", t)
+
+
 @dataclass(frozen=True)
 class Bend:
     """A fibre bent (or squeezed) from ``start_s`` for ``duration_s`` (``None``: until the end): ``loss_db`` more
@@ -311,6 +316,7 @@ class Bend:
 
     def loss(self, direction: Direction, t: float) -> float:
         """The extra loss on ``direction`` at bus time ``t``."""
+        direction, t = _at(direction, t)
         hit = self.direction is None or self.direction is direction
         return self.loss_db if hit and _active(self.start_s, self.duration_s, t) else 0.0
 
@@ -329,7 +335,7 @@ class Pull:
 
     def loss(self, direction: Direction, t: float) -> float:
         """``inf`` while pulled, else 0."""
-        check_instance("direction", direction, Direction)
+        _, t = _at(direction, t)
         return math.inf if _active(self.start_s, self.duration_s, t) else 0.0
 
 
@@ -351,6 +357,7 @@ class Ageing:
 
     def loss(self, direction: Direction, t: float) -> float:
         """The light lost on ``direction`` by bus time ``t``."""
+        direction, t = _at(direction, t)
         if (self.direction is not None and self.direction is not direction) or t < self.start_s:
             return 0.0
         return min(self.limit_db, (t - self.start_s) * self.rate_db_per_s)
@@ -374,6 +381,7 @@ class Temperature:
 
     def loss(self, direction: Direction, t: float) -> float:
         """The light lost (negative: gained) on ``direction`` at bus time ``t``."""
+        direction, t = _at(direction, t)
         if (self.direction is not None and self.direction is not direction) or t < self.start_s:
             return 0.0
         delta_k = self.amplitude_k * math.sin(2 * math.pi * (t - self.start_s) / self.period_s)
@@ -461,8 +469,7 @@ class FibreLink:
 
     def extra_loss_db(self, direction: Direction, t: float) -> float:
         """The loss the events add on ``direction`` at bus time ``t`` (``inf`` while pulled)."""
-        check_instance("direction", direction, Direction)
-        now = _time("t", t)
+        direction, now = _at(direction, t)
         return sum(event.loss(direction, now) for event in self.events)
 
     def received_dbm(self, direction: Direction, level: int, test: int, t: float) -> float:

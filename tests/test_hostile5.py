@@ -1,0 +1,127 @@
+"""Hostile inputs and histories against issue 12's optical and diagnostic parts (a user's review, round 5):
+the fibre-link events of :mod:`supi3.optical.link` (1.6.1, OPT-45), the transmitter states of
+:mod:`supi3.optical.regulation` (1.6.1-1.6.3), the ``supi3 optical`` and ``supi3 timing --optical-count`` command
+lines (OPT-1), and the chip's transaction-level optical API (:meth:`supi3.model.chip.Supi3.optical_start`).
+
+Every bad input is refused by name (which argument, which rule, which value); a state no history reaches cannot be
+built by hand; every history of online tests keeps 1.6.3's hysteresis; one timer count means one length wherever a
+user converts it.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from supi3.errors import ArgumentError
+from supi3.optical.link import Ageing, Bend, Direction, Pull, Temperature
+from supi3.optical.regulation import (
+    DECREASE_AFTER,
+    INIT_MAX_STEPS,
+    MAX_LEVEL,
+    MIN_LEVEL,
+    OpticalMode,
+    Phase,
+    Response,
+    Transmitter,
+    apply_test,
+    fo_lit,
+    init_response,
+    init_timeout,
+    start,
+)
+from support import bad
+
+# -- fibre-link events: loss(direction, t) is a public entry (OPT-45) -------------------------------------------------
+
+EVENTS = [Bend(0.0, 1.0, 2.0), Bend(0.0, None, 2.0, Direction.FORWARD), Pull(0.0, 1.0),
+          Ageing(0.0, 1.0, direction=Direction.RETURN), Temperature(0.0, 5.0, 1.0)]  # fmt: skip
+
+
+@pytest.mark.parametrize("event", EVENTS, ids=lambda e: type(e).__name__)
+@pytest.mark.parametrize(("direction", "t", "name"), [
+    (0, 0.5, "direction"), ("forward", 0.5, "direction"), (None, 0.5, "direction"),
+    (Direction.FORWARD, math.nan, "t"), (Direction.FORWARD, -1.0, "t"), (Direction.FORWARD, "0.5", "t"),
+    (Direction.FORWARD, math.inf, "t"), (Direction.FORWARD, True, "t"),
+])  # fmt: skip
+def test_event_loss_refuses_a_bad_direction_or_time(event: object, direction: object, t: object, name: str) -> None:
+    # Before: Bend.loss(0, ...) counted an int as a direction, Ageing.loss("x", ...) took any direction, a NaN time
+    # was "not yet" and a string time a TypeError deep inside.
+    with pytest.raises(ArgumentError, match=rf"^{name} must be"):
+        event.loss(bad(direction), bad(t))  # type: ignore[attr-defined]
+
+
+# -- transmitter states: only those a history reaches (1.6.1-1.6.3) -------------------------------------------------
+
+
+def _reached() -> set[Transmitter]:
+    """Every transmitter state some history of start, responses, timeouts and online tests reaches (breadth first;
+    the space is small)."""
+    seen = {start(mode, present) for mode in OpticalMode for present in (False, True)}
+    todo = list(seen)
+    while todo:
+        tx = todo.pop()
+        after = [init_response(tx, r) for r in Response] + [init_timeout(tx)]
+        after += [apply_test(tx, a1, a2) for a1, a2 in itertools.product((False, True), repeat=2)]
+        for new in after:
+            if new not in seen:
+                seen.add(new)
+                todo.append(new)
+    return seen
+
+
+def test_transmitter_accepts_exactly_the_reachable_states() -> None:
+    # Before: Transmitter(Phase.OFF, mau=True) lit FO in RUN for an interface not in use, Transmitter(Phase.FIXED, 3)
+    # showed level 3 for "an unregulated transmitter at maximum power" (1.6.1), INIT at level 15 after 5 lowerings...
+    reached = _reached()
+    shapes = {(tx.phase, tx.level, tx.steps, tx.passes, tx.mau) for tx in reached}
+    built = 0
+    for phase, level, steps, passes, mau in itertools.product(Phase, range(MIN_LEVEL, MAX_LEVEL + 1),
+                                                              range(INIT_MAX_STEPS + 1), range(DECREASE_AFTER),
+                                                              (False, True)):  # fmt: skip
+        if (phase, level, steps, passes, mau) not in shapes:
+            with pytest.raises(ArgumentError, match=r"^(level|steps|passes|mau) must be"):
+                Transmitter(phase, level, steps, passes, mau)
+            continue
+        built += 1
+        assert Transmitter(phase, level, steps, passes, mau) in reached
+    assert built == len(reached)
+
+
+@pytest.mark.parametrize(("kwargs", "name"), [
+    ({"phase": Phase.OFF, "mau": True}, "mau"),
+    ({"phase": Phase.FIXED, "level": 3}, "level"),
+    ({"phase": Phase.DIAGNOSTIC, "level": 14}, "level"),
+    ({"phase": Phase.INIT, "steps": 5}, "level"),
+    ({"phase": Phase.ONLINE, "steps": 2, "level": 13}, "steps"),
+    ({"phase": Phase.FIXED, "passes": 1}, "passes"),
+    ({"phase": Phase.ONLINE, "level": 9, "mau": True}, "mau"),
+])  # fmt: skip
+def test_unreachable_transmitter_states_are_refused_by_name(kwargs: dict[str, object], name: str) -> None:
+    with pytest.raises(ArgumentError, match=rf"^{name} must be .*\(1\.6|^{name} must be .*OPT-6"):
+        Transmitter(**kwargs)  # type: ignore[arg-type]
+
+
+@given(st.lists(st.tuples(st.booleans(), st.booleans()), max_size=80), st.integers(MIN_LEVEL, MAX_LEVEL))
+def test_mau_warning_follows_the_level_history_of_1_6_3(tests: list[tuple[bool, bool]], first_light_on: int) -> None:
+    """Over any history of online tests the warning is exactly 1.6.3's hysteresis of the level path: on after the
+    step MAX-1 -> MAX (or a failed test at MAX), off after the step MAX-1 -> MAX-2, unchanged otherwise; FO in RUN
+    shows it (Table 3-17)."""
+    tx = start(OpticalMode.REGULATION, True)
+    while tx.phase is Phase.INIT and tx.level > max(first_light_on, MAX_LEVEL - INIT_MAX_STEPS + 1):
+        tx = init_response(tx, Response.DETECTED)
+    tx = init_response(tx, Response.NOT_DETECTED)
+    warned = tx.mau
+    for ack1, ack2 in tests:
+        new = apply_test(tx, ack1, ack2)
+        assert abs(new.level - tx.level) <= 1
+        if (tx.level, new.level) == (MAX_LEVEL - 1, MAX_LEVEL) or (tx.level == MAX_LEVEL and not ack1):
+            warned = True
+        elif (tx.level, new.level) == (MAX_LEVEL - 1, MAX_LEVEL - 2):
+            warned = False
+        assert new.mau is warned and fo_lit(new, True) is warned
+        tx = new
