@@ -11,13 +11,17 @@ user converts it.
 from __future__ import annotations
 
 import itertools
+import json
 import math
 
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from supi3 import timing
+from supi3.cli import main
 from supi3.errors import ArgumentError
+from supi3.optical import length
 from supi3.optical.link import Ageing, Bend, Direction, Pull, Temperature
 from supi3.optical.regulation import (
     DECREASE_AFTER,
@@ -125,3 +129,56 @@ def test_mau_warning_follows_the_level_history_of_1_6_3(tests: list[tuple[bool, 
             warned = False
         assert new.mau is warned and fo_lit(new, True) is warned
         tx = new
+
+
+# -- the command line: supi3 optical and supi3 timing --optical-count (OPT-1) ----------------------------------------
+
+
+def _cli(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    try:
+        code = main(list(argv))
+    except SystemExit as exc:
+        code = exc.code if isinstance(exc.code, int) else 1
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.mark.parametrize(("argv", "expect"), [
+    # Before: the register's MEDIUM bit silently overrode an explicit --medium.
+    (["--register", "0x18", "--medium", "glass"], "--medium is not for --register"),
+    (["--register", "0x58", "--medium", "polymer"], "--medium is not for --register"),
+    # Before: --bit-rate was ignored, even when it was no bit rate at all, unless --count was given.
+    (["--code", "3", "--bit-rate", "9"], "--bit-rate is for --count only"),
+    (["--metres", "5", "--bit-rate", "2M"], "--bit-rate is for --count only"),
+    (["--register", "0x18", "--bit-rate", "500k"], "--bit-rate is for --count only"),
+    # Before: the error named the library's argument (one_way_m), not the option.
+    (["--metres", "20000.5"], "--metres must be a finite number from 0.0 to 20000.0"),
+    (["--count", "12", "--bit-rate", "1M"], "--bit-rate must be 500k or 2M"),
+])  # fmt: skip
+def test_optical_command_refuses_options_it_would_ignore(capsys: pytest.CaptureFixture[str], argv: list[str],
+                                                         expect: str) -> None:
+    code, out, err = _cli(capsys, "optical", *argv)
+    assert code == 2 and out == "" and err.count("\n") == 1 and expect in err
+
+
+@pytest.mark.parametrize("bit_rate", [500_000, 2_000_000], ids=["500k", "2M"])
+def test_one_timer_count_means_one_length_in_both_commands(capsys: pytest.CaptureFixture[str],
+                                                           bit_rate: int) -> None:
+    """``supi3 timing --optical-count n`` (L = n / (f t), forward and return, 1.6.1) and ``supi3 optical --count n``
+    (the one-way code, OPT-1) take the same timer results, up to a 20 km path there and back: half of timing's L
+    lies in the range of optical's code. Before: timing refused every n above 63 as "Table 1-5" (the code's range),
+    so the 2 Mbit/s count of a 387.5 m path (124) had a length in one command and none in the other."""
+    rate = "2M" if bit_rate == 2_000_000 else "500k"
+    most = length.timer_count(length.MAX_PATH_M, bit_rate)
+    assert timing.max_optical_count(bit_rate) == most
+    for n in sorted({0, 1, 31, 32, 63, 64, 124, 125, 127, 128, most - 1, most}):
+        code, out, err = _cli(capsys, "timing", "--bit-rate", rate, "--optical-count", str(n), "--json")
+        assert code == 0 and err == "", err
+        there_and_back = json.loads(out)["optical_length_m"]
+        code, out, err = _cli(capsys, "optical", "--count", str(n), "--bit-rate", rate, "--json")
+        assert code == 0 and err == "", err
+        data = json.loads(out)
+        assert data["one_way_m_from"] <= there_and_back / 2 <= data["one_way_m_below"]
+        assert data["code"] == length.length_code(there_and_back / 2, length.Medium.POLYMER)
+    code, _, err = _cli(capsys, "timing", "--bit-rate", rate, "--optical-count", str(most + 1))
+    assert code == 2 and f"--optical-count must be an integer from 0 to {most}" in err
