@@ -38,6 +38,7 @@ from supi3.optical.regulation import (
     init_timeout,
     start,
 )
+from supi3.sdk.driver import DriverArgumentError, OpticalStatus
 from support import bad
 
 # -- fibre-link events: loss(direction, t) is a public entry (OPT-45) -------------------------------------------------
@@ -182,3 +183,14 @@ def test_one_timer_count_means_one_length_in_both_commands(capsys: pytest.Captur
         assert data["code"] == length.length_code(there_and_back / 2, length.Medium.POLYMER)
     code, _, err = _cli(capsys, "timing", "--bit-rate", rate, "--optical-count", str(most + 1))
     assert code == 2 and f"--optical-count must be an integer from 0 to {most}" in err
+
+
+# -- the Python SDK: OpticalStatus.decode (3.4.12, 3.4.13) ------------------------------------------------------------
+
+
+@pytest.mark.parametrize("raw", [b"", b"\0\0\0", b"\0" * 5, "abcd", [1, 2, 3, 4], None, 0x01020304])
+def test_optical_status_decode_takes_exactly_the_four_bytes_of_reads_8_to_11(raw: object) -> None:
+    # Before: 3 bytes were an IndexError, a str a TypeError, 5 bytes and a list of ints decoded silently.
+    with pytest.raises(DriverArgumentError, match=r"^raw must be"):
+        OpticalStatus.decode(bad(raw))
+    assert OpticalStatus.decode(bytearray(b"\x58\xbf\x8f\x3c")) == OpticalStatus(24, 1, 0, 63, 0, 1, 15, 1, 12, 3)
