@@ -20,9 +20,12 @@ from hypothesis import strategies as st
 
 from supi3 import timing
 from supi3.cli import main
+from supi3.config import decode
 from supi3.errors import ArgumentError
+from supi3.interbus.master import Master
+from supi3.model.chip import Supi3
 from supi3.optical import length
-from supi3.optical.link import Ageing, Bend, Direction, Pull, Temperature
+from supi3.optical.link import Ageing, Bend, Direction, FibreLink, Pull, Temperature
 from supi3.optical.regulation import (
     DECREASE_AFTER,
     INIT_MAX_STEPS,
@@ -38,6 +41,7 @@ from supi3.optical.regulation import (
     init_timeout,
     start,
 )
+from supi3.optical.ring import OpticalRing, diagnostic_table
 from supi3.sdk.driver import DriverArgumentError, OpticalStatus
 from support import bad
 
@@ -194,3 +198,21 @@ def test_optical_status_decode_takes_exactly_the_four_bytes_of_reads_8_to_11(raw
     with pytest.raises(DriverArgumentError, match=r"^raw must be"):
         OpticalStatus.decode(bad(raw))
     assert OpticalStatus.decode(bytearray(b"\x58\xbf\x8f\x3c")) == OpticalStatus(24, 1, 0, 63, 0, 1, 15, 1, 12, 3)
+
+
+# -- the master's optical diagnostic table (Figure 1-10) --------------------------------------------------------------
+
+
+def _optical_ring(n: int) -> OpticalRing:
+    return OpticalRing([Supi3(decode("10000", rf="00")) for _ in range(n)], [FibreLink(20.0) for _ in range(n)])
+
+
+def test_diagnostic_table_refuses_the_master_of_another_ring() -> None:
+    # Before: the other master's configuration named this ring's devices silently (a 3-chip ring's table with the
+    # device numbers of a 5-chip ring's master).
+    ring, other = _optical_ring(3), _optical_ring(5)
+    master, stranger = Master(ring), Master(other)
+    assert master.start().ok and stranger.start().ok
+    with pytest.raises(ArgumentError, match=r"^master must be the Master of this ring"):
+        diagnostic_table(ring, stranger)
+    assert [row.path for row in diagnostic_table(ring, master)] == ["1.0<->2.0", "2.0<->3.0"]
