@@ -18,7 +18,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from supi3 import timing
+from supi3 import demo, timing
 from supi3.cli import main
 from supi3.config import decode
 from supi3.errors import ArgumentError
@@ -216,3 +216,14 @@ def test_diagnostic_table_refuses_the_master_of_another_ring() -> None:
     with pytest.raises(ArgumentError, match=r"^master must be the Master of this ring"):
         diagnostic_table(ring, stranger)
     assert [row.path for row in diagnostic_table(ring, master)] == ["1.0<->2.0", "2.0<->3.0"]
+
+
+# -- demo --optical from Python -------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("plot", ["power.html", 3, b"power.html"])
+def test_optical_demo_refuses_a_plot_that_is_no_path_before_the_run(plot: object) -> None:
+    # Before: the whole run went by, then an AttributeError ('str' object has no attribute 'write_text').
+    lines = demo.run_optical(5, bad(plot))
+    with pytest.raises(ArgumentError, match=r"^plot must be a pathlib.Path or None"):
+        next(lines)
