@@ -227,3 +227,12 @@ def test_optical_demo_refuses_a_plot_that_is_no_path_before_the_run(plot: object
     lines = demo.run_optical(5, bad(plot))
     with pytest.raises(ArgumentError, match=r"^plot must be a pathlib.Path or None"):
         next(lines)
+
+
+def test_optical_ring_refuses_one_cable_in_two_places() -> None:
+    # Before: the same FibreLink entering chips 1 and 3 was taken; a connector pulled on "cable 1" broke both.
+    chips = [Supi3(decode("10000", rf="00")) for _ in range(3)]
+    cable = FibreLink(20.0)
+    with pytest.raises(ArgumentError, match=r"^link into chip 3 must be a FibreLink of its own"):
+        OpticalRing(chips, [cable, FibreLink(20.0), cable])
+    OpticalRing(chips, [cable, None, None])  # copper (None) may repeat

@@ -232,6 +232,9 @@ class OpticalRing:
         for k, cable in enumerate(links, 1):
             if cable is not None:
                 check_instance(f"link into chip {k}", cable, FibreLink, "a FibreLink or None")
+                if any(cable is other for other in links[: k - 1]):
+                    raise fail(f"link into chip {k}", "a FibreLink of its own (one cable is one place in the "
+                               "ring: an event on it would hit both places)", cable)
         self._cables: list[_Cable] = []
         _walk(chips, None, Interface.OUT, None, self._cables, links)
         self.chips: list[OpticalChip] = [c.downstream for c in self._cables]
