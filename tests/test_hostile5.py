@@ -236,3 +236,18 @@ def test_optical_ring_refuses_one_cable_in_two_places() -> None:
     with pytest.raises(ArgumentError, match=r"^link into chip 3 must be a FibreLink of its own"):
         OpticalRing(chips, [cable, FibreLink(20.0), cable])
     OpticalRing(chips, [cable, None, None])  # copper (None) may repeat
+
+
+@pytest.mark.parametrize("bit_rate", [500_000, 2_000_000])
+def test_optical_range_takes_what_the_length_functions_take(bit_rate: int) -> None:
+    # Before: 20 km, which length_code, timer_count and FibreLink take (Table 1-5's "to 20 km"), was "outside Table
+    # 1-5"; a string was a TypeError and True a length of 1 m.
+    for metres in (0.0, 393.7, 400.0, 12_345.0, length.MAX_PATH_M):  # 393.75 m to 400 m reads 63 (OPT-1)
+        row = timing.optical_range(metres, bit_rate)
+        assert row.values == ((0, 62) if metres < 400 else (63, 63))
+        assert length.length_code(metres, length.Medium.POLYMER) in range(row.values[0], row.values[1] + 1)
+    for value in ("5", None, True, math.nan):
+        with pytest.raises(ArgumentError, match=r"^length_m must be a number"):
+            timing.optical_range(bad(value), bit_rate)
+    with pytest.raises(timing.TimingError, match="Table 1-5"):
+        timing.optical_range(length.MAX_PATH_M + 0.5, bit_rate)

@@ -215,11 +215,13 @@ def optical_length_m(timer_count: int, bit_rate: int) -> float:
 
 
 def optical_range(length_m: float, bit_rate: int) -> tables.OpticalLengthRange:
-    """The Table 1-5 row that applies to a one-way path length at a bit rate."""
+    """The Table 1-5 row that applies to a one-way path length at a bit rate (20 km itself is the last row's, as
+    everywhere else: :data:`supi3.optical.length.MAX_PATH_M`)."""
+    metres = check_real("length_m", length_m, finite=False)
     bit_period_s(bit_rate)
     rows = [r for r in tables.OPTICAL_LENGTH_RANGES if r.bit_rate == bit_rate]
     for row in rows:
-        if row.min_m <= length_m < row.max_m:
+        if row.min_m <= metres < row.max_m or metres == row.max_m == optical_length.MAX_PATH_M:
             return row
     raise TimingError(f"{length_m} m is outside Table 1-5's 0 m to 20 km")
 
