@@ -197,7 +197,7 @@ def test_optical_status_decode_takes_exactly_the_four_bytes_of_reads_8_to_11(raw
     # Before: 3 bytes were an IndexError, a str a TypeError, 5 bytes and a list of ints decoded silently.
     with pytest.raises(DriverArgumentError, match=r"^raw must be"):
         OpticalStatus.decode(bad(raw))
-    assert OpticalStatus.decode(bytearray(b"\x58\xbf\x8f\x3c")) == OpticalStatus(24, 1, 0, 63, 0, 1, 15, 1, 12, 3)
+    assert OpticalStatus.decode(bad(bytearray(b"\x58\xbf\x8f\x3c")) ) == OpticalStatus(24, 1, 0, 63, 0, 1, 15, 1, 12, 3)
 
 
 # -- the master's optical diagnostic table (Figure 1-10) --------------------------------------------------------------
