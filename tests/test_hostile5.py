@@ -15,7 +15,7 @@ import json
 import math
 
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from supi3 import demo, timing
@@ -197,7 +197,7 @@ def test_optical_status_decode_takes_exactly_the_four_bytes_of_reads_8_to_11(raw
     # Before: 3 bytes were an IndexError, a str a TypeError, 5 bytes and a list of ints decoded silently.
     with pytest.raises(DriverArgumentError, match=r"^raw must be"):
         OpticalStatus.decode(bad(raw))
-    assert OpticalStatus.decode(bad(bytearray(b"\x58\xbf\x8f\x3c")) ) == OpticalStatus(24, 1, 0, 63, 0, 1, 15, 1, 12, 3)
+    assert OpticalStatus.decode(bad(bytearray(b"\x58\xbf\x8f\x3c"))) == OpticalStatus(24, 1, 0, 63, 0, 1, 15, 1, 12, 3)
 
 
 # -- the master's optical diagnostic table (Figure 1-10) --------------------------------------------------------------
@@ -251,3 +251,60 @@ def test_optical_range_takes_what_the_length_functions_take(bit_rate: int) -> No
             timing.optical_range(bad(value), bit_rate)
     with pytest.raises(timing.TimingError, match="Table 1-5"):
         timing.optical_range(length.MAX_PATH_M + 0.5, bit_rate)
+
+
+# -- histories of resets, power-ups, fibre events and cycles on a fibre ring (1.6, 1.6.1) ----------------------------
+
+_OPS = st.lists(st.one_of(
+    st.just(("cycle",)), st.just(("start",)), st.tuples(st.just("power"), st.integers(0, 2)),
+    st.tuples(st.just("bend"), st.integers(0, 2), st.sampled_from([2.0, 6.0, 12.0]), st.sampled_from([1e-3, 5e-3])),
+    st.tuples(st.just("pull"), st.integers(0, 2), st.sampled_from([1e-3, 30e-3])),
+), min_size=1, max_size=25)  # fmt: skip
+
+
+def _assert_recognised_and_measured(ring: OpticalRing, chips: list[Supi3], links: list[FibreLink]) -> None:
+    for k, chip in enumerate(chips):
+        phases = [tx.phase for tx in chip.optical.transmitters]
+        assert phases == [Phase.FIXED if k == 0 else Phase.ONLINE, Phase.ONLINE if k + 1 < len(chips) else Phase.OFF,
+                          Phase.OFF]  # fmt: skip
+        if k + 1 < len(chips):
+            cable = links[k + 1]
+            assert chip.optical.length[0] == length.timer_code(cable.timer_count(ring.bit_rate), ring.bit_rate,
+                                                               cable.medium)  # fmt: skip
+
+
+@settings(max_examples=60, deadline=None)
+@given(_OPS, st.lists(st.sampled_from([3.0, 12.5, 20.0, 47.0, 70.0]), min_size=3, max_size=3))
+def test_every_clean_reset_recognises_and_measures_every_cable(ops: list[tuple[object, ...]],
+                                                               metres: list[float]) -> None:
+    """1.6: "automatic interface recognition after every reset"; 1.6.1: initialization ends (none left
+    initializing) with every regulated partner online, the master's partner and the unused outgoing interface
+    unregulated, and every outgoing interface's length measured anew (OPT-1, OPT-21), whatever came before: power-ups
+    (lengths forgotten), pulled connectors and bends (a failed start), cycles. Checked after every reset whose
+    window no event touched, and after a last one once every event is over."""
+    chips = [Supi3(decode("10000", rf="00")) for _ in metres]
+    links = [FibreLink(m) for m in metres]
+    ring = OpticalRing(chips, links)
+    master = Master(ring)
+    events: list[Bend | Pull] = []
+    for op in ops:
+        if op[0] == "cycle":
+            master.cycle()
+        elif op[0] == "power":
+            chips[int(op[1])].power_up()  # type: ignore[call-overload]
+        elif op[0] == "bend":
+            events.append(Bend(ring.now, float(op[3]), float(op[2])))  # type: ignore[arg-type]
+            links[int(op[1])].add(events[-1])  # type: ignore[call-overload]
+        elif op[0] == "pull":
+            events.append(Pull(ring.now, float(op[2])))  # type: ignore[arg-type]
+            links[int(op[1])].add(events[-1])  # type: ignore[call-overload]
+        else:
+            t0 = ring.now
+            ok = master.start().ok
+            if not any(e.start_s <= ring.now and (e.duration_s is None or e.start_s + e.duration_s > t0)
+                       for e in events):  # fmt: skip
+                assert ok
+                _assert_recognised_and_measured(ring, chips, links)
+    ring.idle(0.04)  # every event is over (the longest, a pull, lasts 30 ms)
+    assert master.start().ok
+    _assert_recognised_and_measured(ring, chips, links)
