@@ -63,7 +63,8 @@ from supi3.tables import BIT_RATES
 __all__ = ["LENGTH_COUNT_BITS", "MEASURED", "RESP_BITS", "OpticalBlock", "block_mode"]
 
 LENGTH_COUNT_BITS: Final = 14
-"""Width of a length timer: 20 km one way at 2 Mbit/s is 12,800 counts (1.6.1, Table 1-5); it saturates (OPT-24)."""
+"""Width of a length timer: 20 km one way at 2 Mbit/s is 6,400 counts there and back (1.6.1, Table 1-5), inside 13
+bits with room to spare; it saturates (OPT-24)."""
 RESP_BITS: Final = 2
 """Bits of one interface's ``resp`` (a :class:`~supi3.optical.regulation.Response`)."""
 MEASURED: Final[tuple[Interface, Interface]] = (Interface.OUT, Interface.BRANCH)
