@@ -159,6 +159,7 @@ def _cli(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]
     # Before: the error named the library's argument (one_way_m), not the option.
     (["--metres", "20000.5"], "--metres must be a finite number from 0.0 to 20000.0"),
     (["--count", "12", "--bit-rate", "1M"], "--bit-rate must be 500k or 2M"),
+    (["--count", "99999999999999999999"], "--count must be an integer from 0 to 1600"),
 ])  # fmt: skip
 def test_optical_command_refuses_options_it_would_ignore(capsys: pytest.CaptureFixture[str], argv: list[str],
                                                          expect: str) -> None:
@@ -187,6 +188,8 @@ def test_one_timer_count_means_one_length_in_both_commands(capsys: pytest.Captur
         assert data["code"] == length.length_code(there_and_back / 2, length.Medium.POLYMER)
     code, _, err = _cli(capsys, "timing", "--bit-rate", rate, "--optical-count", str(most + 1))
     assert code == 2 and f"--optical-count must be an integer from 0 to {most}" in err
+    code, _, err = _cli(capsys, "optical", "--count", str(most + 1), "--bit-rate", rate)
+    assert code == 2 and f"--count must be an integer from 0 to {most}" in err
 
 
 # -- the Python SDK: OpticalStatus.decode (3.4.12, 3.4.13) ------------------------------------------------------------

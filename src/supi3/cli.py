@@ -425,8 +425,10 @@ def cmd_optical(args: argparse.Namespace) -> None:
         metres = check_real("--metres", args.metres, 0.0, optical_length.MAX_PATH_M, limit="Table 1-5: 0 m to 20 km")
         code, enable = optical_length.length_code(metres, medium), 0
     else:
-        count = check_int("--count", args.count, 0, None, "the length timer result n (1.6.1)")
-        code, enable = optical_length.timer_code(count, _parse_bit_rate(args.bit_rate or "500k"), medium), 0
+        bit_rate = _parse_bit_rate(args.bit_rate or "500k")
+        count = check_int("--count", args.count, 0, timing.max_optical_count(bit_rate),
+                          "the length timer result n of a 20 km path there and back at --bit-rate, 1.6.1 and OPT-1")
+        code, enable = optical_length.timer_code(count, bit_rate, medium), 0
     low, high = optical_length.code_range_m(code, medium)
     register = LENGTH_OUT.encode(LENGTH=code, MEDIUM=int(medium), ENABLE=enable)
     data = {"code": code, "medium": medium.name.lower(), "enable": enable, "register": f"0x{register:02X}",
@@ -767,7 +769,8 @@ def build_parser() -> argparse.ArgumentParser:
                       help="a read 8 or 9 byte (LENGTH, MEDIUM, ENABLE; 3.4.12) to decode")
     what.add_argument("--code", type=integer, metavar="N", help="a LENGTH code, 0 to 63, to turn into metres")
     what.add_argument("--metres", type=metres, metavar="M", help="a one-way path length to turn into its code")
-    what.add_argument("--count", type=integer, metavar="N", help="a length timer result n (1.6.1) at --bit-rate")
+    what.add_argument("--count", type=integer, metavar="N", help="a length timer result n (1.6.1) at --bit-rate, 0 to "
+                      f"{timing.max_optical_count(500_000)} at 500k, to {MAX_OPTICAL_COUNT} at 2M (20 km there and back)")
     p.add_argument("--medium", choices=sorted(_MEDIA),
                    help="fibre medium for --code, --metres, --count (default polymer; a register byte has its own)")
     p.add_argument("--bit-rate", help="500k (default) or 2M, for --count only")
