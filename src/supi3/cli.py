@@ -769,8 +769,9 @@ def build_parser() -> argparse.ArgumentParser:
                       help="a read 8 or 9 byte (LENGTH, MEDIUM, ENABLE; 3.4.12) to decode")
     what.add_argument("--code", type=integer, metavar="N", help="a LENGTH code, 0 to 63, to turn into metres")
     what.add_argument("--metres", type=metres, metavar="M", help="a one-way path length to turn into its code")
-    what.add_argument("--count", type=integer, metavar="N", help="a length timer result n (1.6.1) at --bit-rate, 0 to "
-                      f"{timing.max_optical_count(500_000)} at 500k, to {MAX_OPTICAL_COUNT} at 2M (20 km there and back)")
+    what.add_argument("--count", type=integer, metavar="N",
+                      help=f"a length timer result n (1.6.1) at --bit-rate, 0 to {timing.max_optical_count(500_000)} "
+                           f"at 500k, to {MAX_OPTICAL_COUNT} at 2M (20 km there and back)")
     p.add_argument("--medium", choices=sorted(_MEDIA),
                    help="fibre medium for --code, --metres, --count (default polymer; a register byte has its own)")
     p.add_argument("--bit-rate", help="500k (default) or 2M, for --count only")
