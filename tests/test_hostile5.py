@@ -23,10 +23,12 @@ from supi3.cli import main
 from supi3.config import decode
 from supi3.errors import ArgumentError
 from supi3.interbus.master import Master
+from supi3.model.blocks.optical import OpticalBlock
 from supi3.model.chip import Supi3
 from supi3.optical import length
 from supi3.optical.link import Ageing, Bend, Direction, FibreLink, Pull, Temperature
 from supi3.optical.regulation import (
+    BLOCK_INPUTS,
     DECREASE_AFTER,
     INIT_MAX_STEPS,
     MAX_LEVEL,
@@ -311,3 +313,26 @@ def test_every_clean_reset_recognises_and_measures_every_cable(ops: list[tuple[o
     ring.idle(0.04)  # every event is over (the longest, a pull, lasts 30 ms)
     assert master.start().ok
     _assert_recognised_and_measured(ring, chips, links)
+
+
+# -- the optical block at pin level: quiet() (OPT-24, OPT-25) ---------------------------------------------------------
+
+
+@pytest.mark.parametrize(("n", "pins", "name"), [
+    ("5", {}, "n"), (5.5, {}, "n"), (True, {}, "n"), (-1, {}, "n"), (5, None, "inputs"),
+    (5, {"resp_valid": 1, "resp": 1}, "resp_valid"), (5, {"test_valid": 2}, "test_valid"),
+    (5, {"len_start": 2}, "len_start"), (5, {"len_stop": 4}, "len_stop"),
+    (5, {"run": 1, "test_valid": 1}, "test_valid"),
+])  # fmt: skip
+def test_optical_block_quiet_refuses_what_is_not_quiet(n: object, pins: dict[str, int] | None, name: str) -> None:
+    # Before: a string n was a TypeError, 5.5 and True were taken as clocks, a missing input a KeyError, and a
+    # strobe held through quiet() was applied at edges the method's contract says do not change the state.
+    block = OpticalBlock()
+    values = {pin.name: 0 for pin in BLOCK_INPUTS} | {"mode": 1, "present": 0b111}
+    block.quiet(3, values | {"ib_reset": 1})
+    block.quiet(1, values)
+    before = block.status
+    given = None if pins is None else values | pins
+    with pytest.raises(ArgumentError, match=rf"^{name}"):
+        block.quiet(bad(n), bad(given))
+    assert block.status is before
