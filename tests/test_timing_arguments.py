@@ -18,7 +18,8 @@ from supi3.errors import ArgumentError, Supi3Error
     lambda: timing.data_cycle_time_s(10**400, 1, 500_000),
     lambda: timing.report(10**400, 500_000),
     lambda: timing.report(4, 500_000, 513),
-    lambda: timing.optical_length_m(timing.MAX_OPTICAL_COUNT + 1, 500_000),
+    lambda: timing.optical_length_m(timing.MAX_OPTICAL_COUNT + 1, 2_000_000),
+    lambda: timing.optical_length_m(timing.max_optical_count(500_000) + 1, 500_000),
     lambda: timing.optical_length_m(10**400, 500_000),
     lambda: timing.timing_table("3-4", 500_000, 10**400),
     lambda: timing.evaluate("1 +", 500_000),
@@ -50,5 +51,6 @@ def test_wrong_type_is_an_argument_error(call: Callable[[], object]) -> None:
 def test_limits_themselves_pass() -> None:
     assert timing.cpu_access_time_s(timing.MAX_NETWORK_BYTES, 2_000_000) > 0
     assert timing.data_cycle_time_s(0, 512, 500_000) > 0
-    assert timing.optical_length_m(timing.MAX_OPTICAL_COUNT, 500_000) == pytest.approx(63 * 25.0)
+    assert timing.optical_length_m(timing.MAX_OPTICAL_COUNT, 2_000_000) == pytest.approx(2 * 20_000.0)  # OPT-1
+    assert timing.optical_length_m(timing.max_optical_count(500_000), 500_000) == pytest.approx(2 * 20_000.0)
     assert issubclass(timing.TimingError, Supi3Error)

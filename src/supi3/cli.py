@@ -41,7 +41,7 @@ from pathlib import Path
 from typing import Any, NoReturn, TextIO
 
 from supi3 import campaign, serial_io, tables, timing
-from supi3.checks import check_int, fail
+from supi3.checks import check_int, check_real, fail
 from supi3.checks import describe as _shown
 from supi3.config import DeviceConfig, Interface, MfpKind, Variant, decode, mode_rows
 from supi3.errors import Supi3Error
@@ -53,7 +53,8 @@ MAX_NETWORK_BYTES = timing.MAX_NETWORK_BYTES
 """``timing --bytes`` limit: 512 devices (the INTERBUS limit) of the longest data length, 32 words (Table 3-11)."""
 
 MAX_OPTICAL_COUNT = timing.MAX_OPTICAL_COUNT
-"""``timing --optical-count`` limit: the length timer's value range, 0 to 63 (Table 1-5)."""
+"""``timing --optical-count`` limit: the length timer's result for a 20 km path at 2 Mbit/s, 6,400 (1,600 at 500
+kbit/s; Table 1-5, OPT-1)."""
 
 DEMO_CYCLES = 4
 """``demo --cycles`` default (``--optical`` runs its whole scenario by default)."""
@@ -355,7 +356,8 @@ def cmd_timing(args: argparse.Namespace) -> None:
                         f"{timing.MAX_DEVICES} devices of at most 32 words")
     devices = check_int("--devices", args.devices, 1, timing.MAX_DEVICES, "the INTERBUS limit")
     if args.optical_count is not None:
-        check_int("--optical-count", args.optical_count, 0, MAX_OPTICAL_COUNT, "Table 1-5")
+        check_int("--optical-count", args.optical_count, 0, timing.max_optical_count(bit_rate),
+                  "a 20 km path there and back at --bit-rate, Table 1-5 and OPT-1")
     data = timing.report(n_bytes, bit_rate, devices)
     if args.optical_count is not None:
         length = timing.optical_length_m(args.optical_count, bit_rate)
@@ -407,7 +409,12 @@ def register_byte(text: str) -> int:
 
 def cmd_optical(args: argparse.Namespace) -> None:
     """Reads 8 and 9 (LENGTH, MEDIUM, ENABLE) to metres and back, and length timer results to codes (OPT-1)."""
-    medium = _MEDIA[args.medium]
+    if args.register is not None and args.medium is not None:
+        raise CommandLineError("--medium is not for --register: the byte's MEDIUM bit gives the medium (3.4.12)")
+    if args.count is None and args.bit_rate is not None:
+        raise CommandLineError("--bit-rate is for --count only: a LENGTH code means the same length at both bit "
+                               "rates (OPT-1)")
+    medium = _MEDIA[args.medium or "polymer"]
     if args.register is not None:
         fields = LENGTH_OUT.decode(args.register)
         medium = optical_length.Medium(fields["MEDIUM"])
@@ -415,10 +422,13 @@ def cmd_optical(args: argparse.Namespace) -> None:
     elif args.code is not None:
         code, enable = check_int("--code", args.code, 0, optical_length.LENGTH_MAX_CODE, "LENGTH, 6 bits"), 0
     elif args.metres is not None:
-        code, enable = optical_length.length_code(args.metres, medium), 0
+        metres = check_real("--metres", args.metres, 0.0, optical_length.MAX_PATH_M, limit="Table 1-5: 0 m to 20 km")
+        code, enable = optical_length.length_code(metres, medium), 0
     else:
-        count = check_int("--count", args.count, 0, None, "the length timer result n (1.6.1)")
-        code, enable = optical_length.timer_code(count, _parse_bit_rate(args.bit_rate), medium), 0
+        bit_rate = _parse_bit_rate(args.bit_rate or "500k")
+        count = check_int("--count", args.count, 0, timing.max_optical_count(bit_rate),
+                          "the length timer result n of a 20 km path there and back at --bit-rate, 1.6.1 and OPT-1")
+        code, enable = optical_length.timer_code(count, bit_rate, medium), 0
     low, high = optical_length.code_range_m(code, medium)
     register = LENGTH_OUT.encode(LENGTH=code, MEDIUM=int(medium), ENABLE=enable)
     data = {"code": code, "medium": medium.name.lower(), "enable": enable, "register": f"0x{register:02X}",
@@ -747,7 +757,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--devices", type=integer, default=1, metavar="N",
                    help=f"devices in the ring, 1 to {timing.MAX_DEVICES} (default 1)")
     p.add_argument("--optical-count", type=integer, metavar="N",
-                   help=f"length timer result n, 0 to {MAX_OPTICAL_COUNT} (1.6.1, Table 1-5)")
+                   help=f"length timer result n, 0 to {timing.max_optical_count(500_000)} at 500k, to "
+                        f"{MAX_OPTICAL_COUNT} at 2M (20 km there and back; 1.6.1, Table 1-5, OPT-1)")
     p.add_argument("--table", choices=sorted(timing.TIMING_TABLES), help="also evaluate a timing table")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_timing)
@@ -758,9 +769,12 @@ def build_parser() -> argparse.ArgumentParser:
                       help="a read 8 or 9 byte (LENGTH, MEDIUM, ENABLE; 3.4.12) to decode")
     what.add_argument("--code", type=integer, metavar="N", help="a LENGTH code, 0 to 63, to turn into metres")
     what.add_argument("--metres", type=metres, metavar="M", help="a one-way path length to turn into its code")
-    what.add_argument("--count", type=integer, metavar="N", help="a length timer result n (1.6.1) at --bit-rate")
-    p.add_argument("--medium", choices=sorted(_MEDIA), default="polymer", help="fibre medium (default polymer)")
-    p.add_argument("--bit-rate", default="500k", help="500k or 2M, for --count")
+    what.add_argument("--count", type=integer, metavar="N",
+                      help=f"a length timer result n (1.6.1) at --bit-rate, 0 to {timing.max_optical_count(500_000)} "
+                           f"at 500k, to {MAX_OPTICAL_COUNT} at 2M (20 km there and back)")
+    p.add_argument("--medium", choices=sorted(_MEDIA),
+                   help="fibre medium for --code, --metres, --count (default polymer; a register byte has its own)")
+    p.add_argument("--bit-rate", help="500k (default) or 2M, for --count only")
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_optical)
 

@@ -24,7 +24,7 @@ from html import escape
 from pathlib import Path
 
 from supi3 import serial_io
-from supi3.checks import check_int
+from supi3.checks import check_instance, check_int
 from supi3.config import DeviceConfig, decode
 from supi3.errors import Supi3Error
 from supi3.interbus import wire
@@ -334,11 +334,13 @@ def run_optical(cycles: int = OPTICAL_CYCLES, plot: Path | None = None, clk_conf
     Raises
     ------
     ArgumentError
-        If ``cycles`` is not an integer >= 1.
+        If ``cycles`` is not an integer >= 1 or ``plot`` not a :class:`~pathlib.Path` (checked before the run).
     DemoError
         If the plot cannot be written (the command line checks the path before the run).
     """
     check_int("cycles", cycles, 1)
+    if plot is not None:
+        check_instance("plot", plot, Path, "a pathlib.Path or None")  # before the run, not after it
 
     def chip(straps: str) -> Supi3:
         return Supi3(decode(straps, rf="00", clk_conf=clk_conf))

@@ -12,6 +12,7 @@ from supi3 import tables
 from supi3.checks import check_instance, check_int, check_real
 from supi3.errors import Supi3Error
 from supi3.interbus import wire
+from supi3.optical import length as optical_length
 
 
 class TimingError(Supi3Error, ValueError):
@@ -24,8 +25,15 @@ MAX_DEVICES = wire.MAX_DEVICES
 MAX_NETWORK_BYTES = MAX_DEVICES * max(lc.bits or 0 for lc in tables.LENGTH_CODES) // 8
 """Data bytes in a whole network: 512 devices of the longest data length, 32 words (Table 3-11)."""
 
-MAX_OPTICAL_COUNT = max(r.values[1] for r in tables.OPTICAL_LENGTH_RANGES)
-"""Largest length timer result, 63 (Table 1-5's value range)."""
+def max_optical_count(bit_rate: int) -> int:
+    """Largest length timer result n at ``bit_rate``: a 20 km path (Table 1-5) there and back (1.6.1, OPT-1), 1,600
+    at 500 kbit/s and 6,400 at 2 Mbit/s. (Table 1-5's 0 to 63 is the LENGTH code's range, not the timer's.)"""
+    bit_period_s(bit_rate)
+    return optical_length.timer_count(optical_length.MAX_PATH_M, bit_rate)
+
+
+MAX_OPTICAL_COUNT = max(optical_length.timer_count(optical_length.MAX_PATH_M, rate) for rate in tables.BIT_RATES)
+"""Largest length timer result at any bit rate (:func:`max_optical_count`), 6,400 at 2 Mbit/s."""
 
 _MAX_EXPRESSION = 200
 """Longest timing expression evaluated; the manual's are a few dozen characters."""
@@ -198,20 +206,22 @@ def optical_length_m(timer_count: int, bit_rate: int) -> float:
     f is the timer clock, 16 times the bit rate (8 MHz at 500 kbit/s), t = 5 ns/m.
     """
     check_int("timer_count", timer_count)
-    if not 0 <= timer_count <= MAX_OPTICAL_COUNT:
-        raise TimingError(f"timer count must be >= 0 and <= {MAX_OPTICAL_COUNT} (Table 1-5), not "
-                          f"{_shown(timer_count)}")
-    bit_period_s(bit_rate)
+    most = max_optical_count(bit_rate)
+    if not 0 <= timer_count <= most:
+        raise TimingError(f"timer count must be >= 0 and <= {most} (a 20 km path there and back, Table 1-5, OPT-1) "
+                          f"at {bit_rate} bit/s, not {_shown(timer_count)}")
     f = tables.LENGTH_TIMER_CLOCKS_PER_BIT * bit_rate
     return timer_count / (f * tables.LIGHT_RUNTIME_S_PER_M)
 
 
 def optical_range(length_m: float, bit_rate: int) -> tables.OpticalLengthRange:
-    """The Table 1-5 row that applies to a one-way path length at a bit rate."""
+    """The Table 1-5 row that applies to a one-way path length at a bit rate (20 km itself is the last row's, as
+    everywhere else: :data:`supi3.optical.length.MAX_PATH_M`)."""
+    metres = check_real("length_m", length_m, finite=False)
     bit_period_s(bit_rate)
     rows = [r for r in tables.OPTICAL_LENGTH_RANGES if r.bit_rate == bit_rate]
     for row in rows:
-        if row.min_m <= length_m < row.max_m:
+        if row.min_m <= metres < row.max_m or metres == row.max_m == optical_length.MAX_PATH_M:
             return row
     raise TimingError(f"{length_m} m is outside Table 1-5's 0 m to 20 km")
 

@@ -293,8 +293,25 @@ def _active(start: float, duration: float | None, t: float) -> bool:
     return start <= t and (duration is None or t < start + duration)
 
 
+def _at(direction: object, t: object) -> tuple[Direction, float]:
+    """The arguments of an event's ``loss``: a :class:`Direction` and a bus time, checked by name."""
+    return check_instance("direction", direction, Direction), _time("t", t)
+
+
+class _Timed:
+    """What every event offers: :meth:`loss` with its arguments checked; the subclass's ``_loss`` computes it (the
+    link checks once for all its events, :meth:`FibreLink.extra_loss_db`)."""
+
+    def loss(self, direction: Direction, t: float) -> float:
+        """The extra loss (dB; ``inf`` without light, negative for a gain) on ``direction`` at bus time ``t``."""
+        return self._loss(*_at(direction, t))
+
+    def _loss(self, direction: Direction, t: float) -> float:
+        raise NotImplementedError
+
+
 @dataclass(frozen=True)
-class Bend:
+class Bend(_Timed):
     """A fibre bent (or squeezed) from ``start_s`` for ``duration_s`` (``None``: until the end): ``loss_db`` more
     loss on ``direction`` (``None``: both fibres of the cable)."""
 
@@ -309,14 +326,14 @@ class Bend:
         check_real("loss_db", self.loss_db, 0.0, MAX_EXTRA_LOSS_DB, limit="an event's extra loss")
         _direction(self.direction)
 
-    def loss(self, direction: Direction, t: float) -> float:
+    def _loss(self, direction: Direction, t: float) -> float:
         """The extra loss on ``direction`` at bus time ``t``."""
         hit = self.direction is None or self.direction is direction
         return self.loss_db if hit and _active(self.start_s, self.duration_s, t) else 0.0
 
 
 @dataclass(frozen=True)
-class Pull:
+class Pull(_Timed):
     """The cable's connector pulled at ``start_s`` and put back after ``duration_s`` (``None``: never): no light on
     either fibre meanwhile."""
 
@@ -327,14 +344,13 @@ class Pull:
         _time("start_s", self.start_s)
         _duration(self.duration_s)
 
-    def loss(self, direction: Direction, t: float) -> float:
+    def _loss(self, direction: Direction, t: float) -> float:  # noqa: ARG002 (a pull darkens both fibres)
         """``inf`` while pulled, else 0."""
-        check_instance("direction", direction, Direction)
         return math.inf if _active(self.start_s, self.duration_s, t) else 0.0
 
 
 @dataclass(frozen=True)
-class Ageing:
+class Ageing(_Timed):
     """The transmitter of ``direction`` (``None``: both) losing light from ``start_s`` at ``rate_db_per_s`` (time is
     compressed: a simulated second stands for months) up to ``limit_db``."""
 
@@ -349,7 +365,7 @@ class Ageing:
         check_real("limit_db", self.limit_db, 0.0, MAX_EXTRA_LOSS_DB, limit="an event's extra loss")
         _direction(self.direction)
 
-    def loss(self, direction: Direction, t: float) -> float:
+    def _loss(self, direction: Direction, t: float) -> float:
         """The light lost on ``direction`` by bus time ``t``."""
         if (self.direction is not None and self.direction is not direction) or t < self.start_s:
             return 0.0
@@ -357,7 +373,7 @@ class Ageing:
 
 
 @dataclass(frozen=True)
-class Temperature:
+class Temperature(_Timed):
     """The transmitters of ``direction`` (``None``: both) swinging by ``amplitude_k`` kelvin around their
     temperature with period ``period_s`` from ``start_s``: ``-LED_TEMPCO_DB_PER_K * dT`` dB more loss when warmer."""
 
@@ -372,7 +388,7 @@ class Temperature:
         check_real("period_s", self.period_s, 1e-6)
         _direction(self.direction)
 
-    def loss(self, direction: Direction, t: float) -> float:
+    def _loss(self, direction: Direction, t: float) -> float:
         """The light lost (negative: gained) on ``direction`` at bus time ``t``."""
         if (self.direction is not None and self.direction is not direction) or t < self.start_s:
             return 0.0
@@ -461,9 +477,8 @@ class FibreLink:
 
     def extra_loss_db(self, direction: Direction, t: float) -> float:
         """The loss the events add on ``direction`` at bus time ``t`` (``inf`` while pulled)."""
-        check_instance("direction", direction, Direction)
-        now = _time("t", t)
-        return sum(event.loss(direction, now) for event in self.events)
+        direction, now = _at(direction, t)
+        return sum(event._loss(direction, now) for event in self.events)  # checked once here
 
     def received_dbm(self, direction: Direction, level: int, test: int, t: float) -> float:
         """The light at the receiver of ``direction`` when its transmitter sends at ``level`` and ``test`` (0:

@@ -161,7 +161,7 @@ class Transmitter:
     level:
         Power level, :data:`MIN_LEVEL` to :data:`MAX_LEVEL`.
     steps:
-        Lowerings made in the initialization so far (0 to :data:`INIT_MAX_STEPS`).
+        Lowerings made in the initialization so far (0 to :data:`INIT_MAX_STEPS` - 1: the last one ends it).
     passes:
         Online tests passed at both levels in a row since the last change (0 to :data:`DECREASE_AFTER` - 1).
     mau:
@@ -177,14 +177,41 @@ class Transmitter:
     def __post_init__(self) -> None:
         check_instance("phase", self.phase, Phase)
         check_int("level", self.level, MIN_LEVEL, MAX_LEVEL, "1.6.1: 15 power levels")
-        check_int("steps", self.steps, 0, INIT_MAX_STEPS, "1.6.1: at most 13 regulation procedures")
+        check_int("steps", self.steps, 0, INIT_MAX_STEPS - 1, "1.6.1: the 13th regulation procedure ends it")
         check_int("passes", self.passes, 0, DECREASE_AFTER - 1, "OPT-6")
         check_bool("mau", self.mau)
+        _check_reachable(self)
 
     @property
     def enable(self) -> bool:
         """Enable status of 3.4.12/3.4.13: initialization detected a regulated device."""
         return self.phase is Phase.ONLINE
+
+
+_AT_MAX: Final = frozenset({Phase.OFF, Phase.FIXED, Phase.DIAGNOSTIC})
+"""Phases that send at :data:`MAX_LEVEL` whatever happens: not regulated (1.6.1 fallback, 1.6.2 diagnostics)."""
+_WARNS: Final = frozenset({Phase.ONLINE, Phase.DIAGNOSTIC})
+"""Phases whose tests set a MAU warning (1.6.2, 1.6.3); a transmitter off, initializing or fixed has none."""
+
+
+def _check_reachable(tx: Transmitter) -> None:
+    """Refuse a state no history of :func:`start` and the transitions reaches (so a hand-made state cannot show,
+    e.g., an FO LED or a power level for an interface that is off)."""
+    phase = tx.phase.name
+    if tx.steps and tx.phase is not Phase.INIT:
+        raise fail("steps", f"0 in Phase.{phase} (1.6.1: lowerings are counted while initializing)", tx.steps)
+    if tx.passes and tx.phase is not Phase.ONLINE:
+        raise fail("passes", f"0 in Phase.{phase} (OPT-6: passes are counted by online regulation)", tx.passes)
+    if tx.phase is Phase.INIT and tx.level != MAX_LEVEL - tx.steps:
+        raise fail("level", f"{MAX_LEVEL - tx.steps} in Phase.INIT after {tx.steps} lowerings (1.6.1: from "
+                   f"{MAX_LEVEL} down by one per step)", tx.level)
+    if tx.phase in _AT_MAX and tx.level != MAX_LEVEL:
+        raise fail("level", f"{MAX_LEVEL} in Phase.{phase} (1.6.1, 1.6.2: maximum power)", tx.level)
+    if tx.mau and tx.phase not in _WARNS:
+        raise fail("mau", f"False in Phase.{phase} (1.6.3: warnings come from online tests)", tx.mau)
+    if tx.phase is Phase.ONLINE and tx.mau != (tx.level == MAX_LEVEL) and tx.level != MAX_LEVEL - 1:
+        raise fail("mau", f"{tx.level == MAX_LEVEL} at level {tx.level} in Phase.ONLINE (1.6.3: on at the step MAX-1 "
+                   "-> MAX, off at the step MAX-1 -> MAX-2)", tx.mau)
 
 
 def _tx(tx: object) -> Transmitter:

@@ -232,6 +232,9 @@ class OpticalRing:
         for k, cable in enumerate(links, 1):
             if cable is not None:
                 check_instance(f"link into chip {k}", cable, FibreLink, "a FibreLink or None")
+                if any(cable is other for other in links[: k - 1]):
+                    raise fail(f"link into chip {k}", "a FibreLink of its own (one cable is one place in the "
+                               "ring: an event on it would hit both places)", cable)
         self._cables: list[_Cable] = []
         _walk(chips, None, Interface.OUT, None, self._cables, links)
         self.chips: list[OpticalChip] = [c.downstream for c in self._cables]
@@ -545,10 +548,11 @@ def diagnostic_table(ring: OpticalRing, master: Master | None = None) -> list[Pa
     ring order, as the master reads it from the upstream chip's registers 8 or 9 (length and medium of its outgoing
     or branch interface) and 11 (their levels), and register 10 of the downstream chip (return level; 3.4.12,
     3.4.13), with each direction's quality from the MAU warnings and enable status. Devices are named by the master's
-    configuration (``"1.0<->2.0"``, a BK's branch ``"3.0<->3.1"``), by ring position without one."""
+    configuration (``"1.0<->2.0"``, a BK's branch ``"3.0<->3.1"``; ``master`` must be the one driving ``ring``), by
+    ring position without one."""
     check_instance("ring", ring, OpticalRing)
-    if master is not None:
-        check_instance("master", master, Master, "a Master or None")
+    if master is not None and check_instance("master", master, Master, "a Master or None").ring is not ring:
+        raise fail("master", "the Master of this ring or None (its configuration names the devices)", master)
     rows = []
     at = ring._positions()
     for cable in sorted(ring._cables, key=lambda c: at.get(id(c.downstream), 0)):

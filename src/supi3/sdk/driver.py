@@ -177,6 +177,10 @@ _IO_ACCESS_MASK: Final[int] = IRQ_EVT.field("IO_ACCESS").mask
 _EVENT_MASK: Final[int] = IRQ_EN.mask
 
 
+_OPTICAL_READS: Final = (LENGTH_OUT, LENGTH_BRANCH, POWER_IN, POWER_OUT_BRANCH)
+"""Reads 8 to 11 (3.4.12, 3.4.13), in the order :meth:`OpticalStatus.decode` takes their bytes."""
+
+
 @dataclass(frozen=True)
 class OpticalStatus:
     """Registers 8 to 11 decoded (3.4.12, 3.4.13, Figs. 3-16 to 3-18); ``supi3_optical_t``. Lengths are the
@@ -195,7 +199,14 @@ class OpticalStatus:
 
     @classmethod
     def decode(cls, raw: bytes) -> OpticalStatus:
-        """From the four bytes read at addresses 8, 9, 10, 11."""
+        """From the four bytes read at addresses 8, 9, 10, 11.
+
+        Raises
+        ------
+        DriverArgumentError
+            ``raw`` is not 4 bytes.
+        """
+        raw = _exact(raw, len(_OPTICAL_READS), "raw")
         out, branch, power_in, power = (LENGTH_OUT.decode(raw[0]), LENGTH_BRANCH.decode(raw[1]),
                                         POWER_IN.decode(raw[2]), POWER_OUT_BRANCH.decode(raw[3]))  # fmt: skip
         return cls(out["LENGTH"], out["MEDIUM"], out["ENABLE"], branch["LENGTH"], branch["MEDIUM"], branch["ENABLE"],
@@ -246,10 +257,10 @@ def get_u32(data: bytes) -> int:
     return int.from_bytes(_exact(data, 4), "big")
 
 
-def _exact(data: object, length: int) -> bytes:
-    raw = _checked(check_bytes, "data", data)
+def _exact(data: object, length: int, name: str = "data") -> bytes:
+    raw = _checked(check_bytes, name, data)
     if len(raw) != length:
-        raise DriverArgumentError("data", data, f"data must be {length} bytes, not {describe(data)}")
+        raise DriverArgumentError(name, data, f"{name} must be {length} bytes, not {describe(data)}")
     return raw
 
 
@@ -593,7 +604,7 @@ class _Core:
 
     def _optical(self) -> _Call[OpticalStatus]:
         raw = bytearray()
-        for register in (LENGTH_OUT, LENGTH_BRANCH, POWER_IN, POWER_OUT_BRANCH):
+        for register in _OPTICAL_READS:
             raw.append((yield from self._read(register.address)))
         return OpticalStatus.decode(bytes(raw))
 

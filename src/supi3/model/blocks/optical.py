@@ -36,7 +36,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Final
 
-from supi3.checks import check_inputs, check_int
+from supi3.checks import check_inputs, check_int, fail
 from supi3.optical.length import Medium, timer_code
 from supi3.optical.regulation import (
     BLOCK_INPUTS,
@@ -63,7 +63,8 @@ from supi3.tables import BIT_RATES
 __all__ = ["LENGTH_COUNT_BITS", "MEASURED", "RESP_BITS", "OpticalBlock", "block_mode"]
 
 LENGTH_COUNT_BITS: Final = 14
-"""Width of a length timer: 20 km one way at 2 Mbit/s is 12,800 counts (1.6.1, Table 1-5); it saturates (OPT-24)."""
+"""Width of a length timer: 20 km one way at 2 Mbit/s is 6,400 counts there and back (1.6.1, Table 1-5), inside 13
+bits with room to spare; it saturates (OPT-24)."""
 RESP_BITS: Final = 2
 """Bits of one interface's ``resp`` (a :class:`~supi3.optical.regulation.Response`)."""
 MEASURED: Final[tuple[Interface, Interface]] = (Interface.OUT, Interface.BRANCH)
@@ -80,6 +81,16 @@ def block_mode(value: int) -> OpticalMode:
     """The ``mode`` port's value as an :class:`OpticalMode`; the unused code 3 is off (OPT-23)."""
     return _MODES.get(value, OpticalMode.OFF)
 
+
+
+def _quiet_arguments(n: object, values: object) -> int:
+    """:meth:`OpticalBlock.quiet`'s arguments checked by name: ``n`` as an int, or the error."""
+    count = check_int("n", n, 0, limit="clocks")
+    inputs = check_inputs(values, _WIDTHS)
+    for name in _STROBES[1:]:
+        if inputs[name]:
+            raise fail(name, "0 in quiet() (a strobe changes the state at its edge: step() it)", inputs[name])
+    return count
 
 
 class _Timer:
@@ -180,7 +191,16 @@ class OpticalBlock:
     def quiet(self, n: int, values: Mapping[str, int]) -> None:
         """``n`` clocks (outputs and edges) with the inputs ``values`` held, which must have no strobe but possibly
         ``ib_reset``: the same state as ``n`` :meth:`step` calls, in one go once only the counters move (the 6 ms
-        counter and the length timers; the event-driven pin level, :meth:`supi3.model.pins.Supi3Pins.run`)."""
+        counter and the length timers; the event-driven pin level, :meth:`supi3.model.pins.Supi3Pins.run`).
+
+        Raises
+        ------
+        ArgumentError
+            ``n`` is not an integer >= 0, ``values`` not the block's inputs, or a strobe in ``values`` is set.
+        """
+        if (type(n) is not int or n < 0 or not isinstance(values, Mapping) or not values.keys() >= _WIDTHS.keys()
+                or any(values[name] for name in _STROBES[1:])):  # fmt: skip
+            n = _quiet_arguments(n, values)
         run = values["run"]
         while n > 0 and not (self._in_reset == bool(values["ib_reset"]) and not 0 < self.countdown <= n
                              and self._outputs_of is self.status and self._shown is self._regs):  # fmt: skip
