@@ -336,3 +336,19 @@ def test_optical_block_quiet_refuses_what_is_not_quiet(n: object, pins: dict[str
     with pytest.raises(ArgumentError, match=rf"^{name}"):
         block.quiet(bad(n), bad(given))
     assert block.status is before
+
+
+@pytest.mark.parametrize("call", ["poll", "reset", "optical_start"])
+def test_a_chip_refuses_a_bus_time_before_its_last(call: str) -> None:
+    """A bus call whose time lies before the chip's last one (``poll(1.0)``, then ``optical_start(..., 0.5)``) is
+    refused by name and leaves the chip's clock where it was: the 6 ms budget (OPT-5) and the /StatErr filter count
+    from times that have passed, so a clock that went back would re-run them."""
+    chip = Supi3(decode("10000", rf="00"))
+    chip.poll(1.0)
+    before = chip._clock()
+    calls = {"poll": lambda: chip.poll(0.5), "reset": lambda: chip.reset(0.5),
+             "optical_start": lambda: chip.optical_start((True, True, False), 0.5)}  # fmt: skip
+    with pytest.raises(ArgumentError, match="bus time went back"):
+        calls[call]()
+    assert chip._clock() == before
+    chip.poll(1.0)  # the same time again is fine
