@@ -185,12 +185,16 @@ class SerialIoRtl(wiring.Component):
         in_write = busy & write_on & (slot >= write_start) & (slot < write_end)
         in_frame = in_read | in_write
         high = sub >= (t0 >> 1)
-        # the shift registers and the waiting word are written before they are read (every sequence loads
-        # ``out_shift`` and a read sequence clears ``in_shift``; ``pending`` says when the word counts): no reset
+        # The shift registers and the waiting word are written before they are read: every sequence loads
+        # ``out_shift`` (a clear sequence sends 0s whatever it holds: ``clearing``), a read frame shifts a whole
+        # word into ``in_shift`` (a 16-bit word's upper half is left out when taken over), ``pending`` says when
+        # the waiting word counts: no reset, no clear. A 16-bit word is sent from bit 15 (the bits above are not
+        # sent), so the OUT word is loaded as it comes.
         out_shift = Signal(WORD_BITS, reset_less=True)
         in_shift = Signal(WORD_BITS, reset_less=True)
         pending = Signal()
         pending_word = Signal(WORD_BITS, reset_less=True)
+        clearing = kind >= _CLEAR
         frame_probe = spec.SerialFrame(0, WIDTHS[0], False, max(self.t0s))
         sample_after = frame_probe.sample(0) + SYNC_STAGES - frame_probe.rising(0)  # clocks after SCLK rose
 
@@ -198,7 +202,7 @@ class SerialIoRtl(wiring.Component):
             "conv_n": ~(busy & conv_on & (slot >= conv_start) & (slot < conv_end)),
             "sclk": in_frame & ~lead & ~pause & high,
             "ss_n": ~in_frame,
-            "ser_out": in_write & ~lead & out_shift[-1],
+            "ser_out": in_write & ~lead & ~clearing & Mux(self.wide, out_shift[-1], out_shift[WIDTHS[0] - 1]),
         }
         comb += [getattr(self, name).eq(level) for name, level in levels.items()]
         comb += self.mfp.eq(sum((level << MFP_BITS[name] for name, level in levels.items()), Value.cast(0)))
@@ -228,14 +232,12 @@ class SerialIoRtl(wiring.Component):
         with m.If(last):
             sync += busy.eq(0)
             with m.If(read_on):
-                sync += self.in_word.eq(in_shift)
+                sync += self.in_word.eq(Mux(self.wide, in_shift, in_shift[: WIDTHS[0]]))
 
         # Start, pending start, reset (SM-2, SM-9) -------------------------------------------------------------
         free = ~busy | last | self.reset
         want = self.start | (pending & ~self.reset)
         go = want & free
-        word = Mux(self.start, self.out_word, pending_word)
-        width_shift = Mux(self.wide, 0, WORD_BITS - WIDTHS[0])
         with m.If(self.start & ~free):
             sync += [pending.eq(1), pending_word.eq(self.out_word)]
         with m.If(self.reset):
@@ -243,7 +245,6 @@ class SerialIoRtl(wiring.Component):
                 busy.eq(has_clear),
                 kind.eq(_CLEAR + self.direction),
                 slot.eq(0),
-                out_shift.eq(0),
                 pending.eq(0),
                 self.in_word.eq(0),
                 *frame_begins(),
@@ -253,8 +254,7 @@ class SerialIoRtl(wiring.Component):
                 busy.eq(1),
                 kind.eq(self.direction),
                 slot.eq(0),
-                out_shift.eq(word << width_shift),
-                in_shift.eq(0),
+                out_shift.eq(Mux(self.start, self.out_word, pending_word)),
                 pending.eq(0),
                 *frame_begins(),
             ]
