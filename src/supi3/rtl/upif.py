@@ -231,7 +231,10 @@ class _Builder:
         self.blk_addr = Signal(range(DATA_BYTES))
         self.blk_rd, self.blk_wr, self.blk_then_wr = Signal(), Signal(), Signal()
         self.in_frame, self.frame_s_r, self.tx_valid = Signal(), Signal(), Signal()
-        self.tx, self.rx = Signal(BYTE_BITS), Signal(BYTE_BITS)
+        self.tx = Signal(BYTE_BITS)
+        self.rx = Signal(BYTE_BITS, reset_less=True)
+        """The byte shifted in: read only after exactly 8 SCLK edges of a frame (``end``), which replace all of it,
+        so it has neither reset nor clear."""
         self.bits = Signal(range(_BIT_COUNT_LIMIT + 1))
 
     def build(self) -> None:
@@ -300,23 +303,23 @@ class _Builder:
             with m.If(ss.fell):
                 self.begin(s_r.s2)
             with m.If((self.in_frame | ss.fell) & ~ss.s2 & sclk.rose):
-                self.shift_in(Mux(ss.fell, 0, self.bits), Mux(ss.fell, 0, self.rx), data.s2)
+                self.shift_in(Mux(ss.fell, 0, self.bits), data.s2)
             with m.If(self.in_frame & ss.rose):
                 self.clear_frame()
                 with m.If(self.bits == BYTE_BITS):
                     self.end()
 
     def clear_frame(self) -> None:
-        self.m.d.sync += [self.in_frame.eq(0), self.tx_valid.eq(0), self.bits.eq(0), self.rx.eq(0)]
+        self.m.d.sync += [self.in_frame.eq(0), self.tx_valid.eq(0), self.bits.eq(0)]
 
-    def shift_in(self, count: Value, rx: Value, bit: Value) -> None:
-        """One SCLK rising edge (``SlavePins._shift_in``): Intel LSB first, else MSB first (UP-6)."""
+    def shift_in(self, count: Value, bit: Value) -> None:
+        """One SCLK rising edge (``SlavePins._shift_in``): Intel LSB first, else MSB first (UP-6). The byte is a
+        shift register (right for Intel, left for Motorola): after the 8 edges ``end`` takes, the first bit is at
+        bit 0 or bit 7, as the model's bit insertion puts it."""
         m = self.m
+        rx = self.rx
+        m.d.sync += rx.eq(Mux(self.intel, Cat(rx[1:], bit), Cat(bit, rx[:-1])))
         with m.If(count < BYTE_BITS):
-            with m.If(self.intel):
-                m.d.sync += self.rx.eq(rx | (bit << count)[:BYTE_BITS])
-            with m.Else():
-                m.d.sync += self.rx.eq(Cat(bit, rx[:-1]))
             m.d.sync += self.bits.eq(count + 1)
         with m.Else():
             m.d.sync += self.bits.eq(_BIT_COUNT_LIMIT)
@@ -330,7 +333,6 @@ class _Builder:
             self.frame_s_r.eq(s_r),
             self.tx_valid.eq(drives),
             self.bits.eq(0),
-            self.rx.eq(0),
             self.tx.eq(self.last_rx),
         ]
         reads, address = Signal(), Signal(_ADDRESS.width)
