@@ -447,26 +447,37 @@ class _Builder:
 
     def outputs(self) -> None:
         m, b = self.m, self.b
-        index = Mux(self.bits > BYTE_BITS - 1, BYTE_BITS - 1, self.bits)
-        bit = Mux(self.intel, self.tx, self.tx[::-1]).bit_select(index, 1)
+        # Intel sends LSB first, Motorola MSB first: bit ``index`` or ``7 - index`` (the index inverted) of ``tx``
+        index = Mux(self.bits > BYTE_BITS - 1, BYTE_BITS - 1, self.bits)[: (BYTE_BITS - 1).bit_length()]
+        bit = self.tx.bit_select(index ^ Mux(self.intel, 0, BYTE_BITS - 1), 1)
         drive = self.in_frame & self.tx_valid
         phase = self.phase
         decoded: dict[str, Value] = {
             "io": self.io, "io_oe": Const(1),
             "c_d": Mux(phase.matches(_Phase.INIT, _Phase.COMMAND), C_D_COMMAND, C_D_DATA), "c_d_oe": Const(1),
             "irq_n": self.regs[_IRQ_EVT.name] == 0, "irq_n_oe": Const(1),
-            "mfp6": bit & drive & self.intel, "mfp6_oe": drive & self.intel,
-            "mfp7": bit & drive & self.motorola, "mfp7_oe": drive & self.motorola,
+            "mfp6_oe": drive & self.intel, "mfp7_oe": drive & self.motorola,
         }  # fmt: skip
-        reset = self.tables.reset_outputs
-        delays = self.tables.output_delay
-        for name, value in decoded.items():
-            taps: list[Value] = [value]
-            for stage in range(max(delays)):
-                delayed = Signal(name=f"{name}_d{stage + 1}", init=reset[name])
-                m.d.sync += delayed.eq(taps[-1])
-                taps.append(delayed)
-            m.d.comb += getattr(b, name).eq(Array(taps[delay] for delay in delays)[b.rate])
+        # The bit sent goes through one pipeline for both data pins, each gated by its delayed enable (so it needs
+        # no reset: the enables' pipelines have theirs).
+        delayed = {name: self.delay(name, value, reset=True) for name, value in decoded.items()}
+        sent = self.delay("bit", bit, reset=False)
+        delayed.update({"mfp6": sent & delayed["mfp6_oe"], "mfp7": sent & delayed["mfp7_oe"]})
+        m.d.comb += [getattr(b, name).eq(value) for name, value in delayed.items()]
+
+    def delay(self, name: str, value: Value, *, reset: bool) -> Value:
+        """``value`` through the bit rate's output pipeline (UP-14): its stages start from the output's power-up
+        level (``reset``) or have no reset."""
+        m = self.m
+        taps: list[Value] = [value]
+        for stage in range(max(self.tables.output_delay)):
+            if reset:
+                stage_signal = Signal(name=f"{name}_d{stage + 1}", init=self.tables.reset_outputs[name])
+            else:
+                stage_signal = Signal(name=f"{name}_d{stage + 1}", reset_less=True)
+            m.d.sync += stage_signal.eq(taps[-1])
+            taps.append(stage_signal)
+        return Array(taps[delay] for delay in self.tables.output_delay)[self.b.rate]
 
 
 def verilog() -> str:
