@@ -364,8 +364,10 @@ class _Builder:
                             m.d.sync += self.tx.eq(value)
 
     def end(self) -> None:
-        """/SS rose after 8 bits (``UpifProtocol.end``): process the received byte ``rx``."""
+        """/SS rose after 8 bits (``UpifProtocol.end``): process the received byte ``rx``; a data byte's and a block
+        transfer's writes share one address decoder (``write``, ``address``)."""
         m, rx = self.m, self.rx
+        write, address = Signal(), Signal(_ADDRESS.width)
         with m.Switch(self.phase):
             with m.Case(_Phase.INIT):
                 m.d.sync += self.phase.eq(_Phase.DISABLED)
@@ -376,9 +378,11 @@ class _Builder:
                 # An Intel command byte needs S/R = 1 (Table 3-9); the received byte is kept either way.
                 self.command(rx[_RD.lsb], rx[_WR.lsb], rx[_ADDRESS.lsb : _ADDRESS.lsb + _ADDRESS.width])
             with m.Case(_Phase.DATA):
-                self.data()
+                self.data(write, address)
             with m.Case(_Phase.BLOCK):
-                self.block()
+                self.block(write, address)
+        with m.If(write):
+            self.cpu_write(address, rx)
         with m.If(self.phase != _Phase.DISABLED):
             m.d.sync += self.last_rx.eq(rx)
 
@@ -395,20 +399,18 @@ class _Builder:
             with m.Else():
                 m.d.sync += [self.blk_rd.eq(rd), self.blk_wr.eq(~rd), self.blk_then_wr.eq(rd & wr)]
 
-    def data(self) -> None:
+    def data(self, write: Signal, address: Signal) -> None:
         """The data byte of a command (3.4.4): a write where RD/WR and S/R allow it (UP-9); 4 and 5 ignored."""
         m, s_r = self.m, self.frame_s_r
         m.d.sync += self.phase.eq(_Phase.COMMAND)
         refused = self.intel & (self.cmd_rd != self.cmd_wr) & (self.cmd_rd == s_r)
-        with m.If(self.cmd_wr & (self.motorola | s_r) & ~refused):
-            self.cpu_write(self.cmd_addr, self.rx)
+        m.d.comb += [write.eq(self.cmd_wr & (self.motorola | s_r) & ~refused), address.eq(self.cmd_addr)]
 
-    def block(self) -> None:
+    def block(self, write: Signal, address: Signal) -> None:
         """One byte of a block transfer: write IN k in a write slot; then the next slot (UP-11)."""
         m = self.m
         refused = self.intel & (self.blk_rd == self.frame_s_r)
-        with m.If(self.blk_wr & ~refused):
-            self.cpu_write(self.blk_addr, self.rx)
+        m.d.comb += [write.eq(self.blk_wr & ~refused), address.eq(self.blk_addr)]
         with m.If(self.blk_addr == self.n_bytes - 1):
             with m.If(self.blk_then_wr):
                 m.d.sync += [self.blk_addr.eq(0), self.blk_rd.eq(0), self.blk_wr.eq(1), self.blk_then_wr.eq(0)]
@@ -420,7 +422,7 @@ class _Builder:
     def cpu_write(self, address: Value, value: Value) -> None:
         """``RegisterFile.cpu_write``: store the byte's register bits; SET also applies a valid configuration."""
         m = self.m
-        with m.Switch(Cat(address, Const(0, _ADDRESS.width - len(address)))):
+        with m.Switch(address):
             for a, port in _WRITE_PORTS.items():
                 register = port.register
                 if port.access is Access.W and register is not None:
