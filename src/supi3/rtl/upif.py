@@ -432,18 +432,21 @@ class _Builder:
                             self.apply_set(value)
 
     def apply_set(self, value: Value) -> None:
-        """A SET value with an applicable length code configures the device (Tables 3-11, 3-12; UP-20)."""
+        """A SET value with an applicable length code configures the device (Tables 3-11, 3-12; UP-20). The table
+        is a ROM indexed by (ExtReg, ID12..8): an entry per key, not a comparator per applicable key."""
         m = self.m
         key = Cat(value[_LENGTH_CODE.lsb : _LENGTH_CODE.lsb + _LENGTH_CODE.width], value[_EXTREG.lsb])
-        with m.Switch(key):
-            for (extreg, low), code in self.tables.set_codes.items():
-                with m.Case(low | extreg << _LENGTH_CODE.width):
-                    m.d.sync += [
-                        self.configured.eq(1),
-                        self.cfg_extreg.eq(extreg),
-                        self.cfg_code.eq(code),
-                        self.cfg_pcp_n.eq(value[_PCP_N.lsb]),
-                    ]
+        codes = self.tables.set_codes
+        entries = [codes.get(divmod(key_value, 1 << _LENGTH_CODE.width)) for key_value in range(1 << len(key))]
+        applies = Array(Const(code is not None) for code in entries)[key]
+        code = Array(Const(code or 0, _LENGTH_CODE.width) for code in entries)[key]
+        with m.If(applies):
+            m.d.sync += [
+                self.configured.eq(1),
+                self.cfg_extreg.eq(value[_EXTREG.lsb]),
+                self.cfg_code.eq(code),
+                self.cfg_pcp_n.eq(value[_PCP_N.lsb]),
+            ]
 
     # 3. Outputs: the state decoded (SlavePins._decode), then the bit rate's pipeline (UP-14) ---------------------
 
