@@ -247,10 +247,9 @@ class _Builder:
 
     def configuration(self) -> None:
         m, b, regs = self.m, self.b, self.regs
-        with m.If(self.configured & ~self.cfg_extreg), m.Switch(self.cfg_code):
-            for code, count in self.tables.internal_bytes.items():
-                with m.Case(code):
-                    m.d.comb += self.n_bytes.eq(count)
+        counts = [self.tables.internal_bytes.get(code, 0) for code in range(1 << _LENGTH_CODE.width)]
+        with m.If(self.configured & ~self.cfg_extreg):  # a ROM indexed by the code
+            m.d.comb += self.n_bytes.eq(Array(Const(count) for count in counts)[self.cfg_code])
         m.d.comb += [
             self.pcp_device.eq(self.configured & ~self.cfg_extreg & ~self.cfg_pcp_n),
             b.in_data.eq(Cat(*(regs[r.name] for r in IN_BYTES))),
