@@ -58,14 +58,13 @@ class ExpansionRtl(wiring.Component):
     def elaborate(self, _platform: object) -> Module:
         m = Module()
         sync, comb = m.d.sync, m.d.comb
-        longest = max(
-            max(spec.end_pulses(True, cpb).length, spec.clock_high(cpb)[1]) for cpb in self.cpbs
-        )
+        # each counter as wide as its longest run at any bit rate
+        clk_range = range(max(spec.clock_high(cpb)[1] for cpb in self.cpbs) + 1)
+        count_range = range(max(spec.end_pulses(data, cpb).length for cpb in self.cpbs for data in (True, False)) + 1)
 
         # The bit rate's constants (Table 3-15) ---------------------------------------------------------------
-        count_range = range(longest + 1)
         latched_end = Signal()  # the last cycle end was a valid data cycle's latch: LaOuD, then /LaInD
-        clk_first, clk_end = Signal(count_range), Signal(count_range)
+        clk_first, clk_end = Signal(clk_range), Signal(clk_range)
         ou_end, in_first, in_end, ends = (Signal(count_range, name=n) for n in ("ou_end", "in_first", "in_end", "ends"))
         with m.Switch(self.rate):
             for rate, cpb in enumerate(self.cpbs):
@@ -89,7 +88,7 @@ class ExpansionRtl(wiring.Component):
         comb += self.send.eq(self.from_exr)
         to_exr = Signal(init=spec.IDLE.to_exr)
         clk_run = Signal()
-        clk_count = Signal(count_range)
+        clk_count = Signal(clk_range)
         first_bit = Signal()  # no bit of this data cycle has gone out yet
         rises = Signal()  # this clock bit's ClkExR rises
         with m.If(self.load):
