@@ -63,7 +63,9 @@ class ExpansionRtl(wiring.Component):
         count_range = range(max(spec.end_pulses(data, cpb).length for cpb in self.cpbs for data in (True, False)) + 1)
 
         # The bit rate's constants (Table 3-15) ---------------------------------------------------------------
-        latched_end = Signal()  # the last cycle end was a valid data cycle's latch: LaOuD, then /LaInD
+        # What is read only while a counter runs (``clk_run``, ``end_run``, which have their reset) or after the
+        # frame's load that sets it (``first_bit``, read under ``active``) is set where it starts: no reset.
+        latched_end = Signal(reset_less=True)  # the last cycle end was a valid data cycle's latch: LaOuD, /LaInD
         clk_first, clk_end = Signal(clk_range), Signal(clk_range)
         ou_end, in_first, in_end, ends = (Signal(count_range, name=n) for n in ("ou_end", "in_first", "in_end", "ends"))
         with m.Switch(self.rate):
@@ -88,8 +90,8 @@ class ExpansionRtl(wiring.Component):
         comb += self.send.eq(self.from_exr)
         to_exr = Signal(init=spec.IDLE.to_exr)
         clk_run = Signal()
-        clk_count = Signal(clk_range)
-        first_bit = Signal()  # no bit of this data cycle has gone out yet
+        clk_count = Signal(clk_range, reset_less=True)
+        first_bit = Signal(reset_less=True)  # no bit of this data cycle has gone out yet
         rises = Signal()  # this clock bit's ClkExR rises
         with m.If(self.load):
             sync += first_bit.eq(1)
@@ -103,14 +105,14 @@ class ExpansionRtl(wiring.Component):
 
         # End pulses (RX-4) and /ResReg (RX-5) ----------------------------------------------------------------
         end_run = Signal()
-        end_count = Signal(count_range)
+        end_count = Signal(count_range, reset_less=True)
         with m.If(end_run):
             sync += end_count.eq(end_count + 1)
             with m.If(end_count + 1 == ends):
                 sync += end_run.eq(0)
         with m.If(self.ext & self.ended):
             sync += [end_run.eq(1), end_count.eq(0), latched_end.eq(self.latched)]
-        first_rise = Signal()  # the data cycle's first ClkExR clock bit
+        first_rise = Signal(reset_less=True)  # the data cycle's first ClkExR clock bit
         with m.If(active & self.shift):
             sync += first_rise.eq(first_bit)
         comb += rises.eq(clk_run & (clk_count == clk_first))
