@@ -142,7 +142,9 @@ class SerialIoRtl(wiring.Component):
 
         # The running sequence's constants in t0 slots (from the spec's schedule) ------------------------------
         busy = self.busy
-        kind = Signal(range(2 * _CLEAR))
+        # The sequence's kind and counters are read only while ``busy`` (which has its reset) and set where a
+        # sequence begins: no reset.
+        kind = Signal(range(2 * _CLEAR), reset_less=True)
         read_on, write_on, conv_on = Signal(), Signal(), Signal()
         read_start, read_end, write_start, write_end = (Signal(slot_range, name=n) for n in ("rs", "re", "ws", "we"))
         conv_start, conv_end, length = Signal(slot_range), Signal(slot_range), Signal(slot_range)
@@ -175,11 +177,11 @@ class SerialIoRtl(wiring.Component):
         # sequence counter counts t0 slots: ``slot`` steps at the clock ending each t0 of the sequence. ``sub``
         # is (clocks since the sequence began + t0/2) mod t0 throughout (every sequence and frame starts it at
         # t0/2 and each begins on a whole t0), so that clock is the one with ``sub == t0/2 - 1``.
-        slot = Signal(slot_range)
-        sub = Signal(range(max(self.t0s)))  # clock within a t0, 0 at a bit slot's first cycle
+        slot = Signal(slot_range, reset_less=True)
+        sub = Signal(range(max(self.t0s)), reset_less=True)  # clock within a t0, 0 at a bit slot's first cycle
         slot_ends = sub == (t0 >> 1) - 1
-        lead = Signal()  # the half t0 between /SS falling and the first slot
-        within = Signal(range(spec.BYTE_SLOTS))  # slot within a byte: bits 0..7, then the pause slot
+        lead = Signal(reset_less=True)  # the half t0 between /SS falling and the first slot
+        within = Signal(range(spec.BYTE_SLOTS), reset_less=True)  # slot within a byte: bits 0..7, then the pause slot
         pause = within == spec.BYTE_SLOTS - 1
         in_read = busy & read_on & (slot >= read_start) & (slot < read_end)
         in_write = busy & write_on & (slot >= write_start) & (slot < write_end)
