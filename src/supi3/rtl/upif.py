@@ -216,8 +216,15 @@ class _Builder:
         self.core = {name: Signal(BYTE_BITS, name=f"{name.lower()}_core") for name in self.regs}
         """The registers after the core's inputs of this edge: what a read at this edge sees."""
         self.io = Signal()
-        self.configured, self.cfg_extreg, self.cfg_pcp_n = Signal(), Signal(), Signal()
-        self.cfg_code = Signal(_LENGTH_CODE.width)
+        # No reset (nor clear) where every reader is gated by state that has one and the state is written before
+        # that gate opens: the applied SET fields (read only while ``configured``), the command and block transfer
+        # fields (read only in the DATA and BLOCK phases their command byte enters), the frame's S/R, byte sent,
+        # bit count and whether it drives (read only in a frame, set at its /SS falling edge), and the last byte
+        # received (sent back only once Motorola or Intel mode is set, by the initialization byte's end, which also
+        # stores it).
+        self.configured = Signal()
+        self.cfg_extreg, self.cfg_pcp_n = Signal(reset_less=True), Signal(reset_less=True)
+        self.cfg_code = Signal(_LENGTH_CODE.width, reset_less=True)
         self.n_bytes = Signal(range(DATA_BYTES + 1))
         """Data bytes of the internal data path: 0 before SET and with ExtReg = 1 (``data_bytes()`` gated by
         ``internal_data_path``)."""
@@ -225,17 +232,18 @@ class _Builder:
         # Protocol (UpifProtocol) and frame (SlavePins) state.
         self.phase = Signal(_Phase, init=_Phase.INIT)
         self.motorola, self.intel = Signal(), Signal()
-        self.cmd_rd, self.cmd_wr = Signal(), Signal()
-        self.cmd_addr = Signal(_ADDRESS.width)
-        self.last_rx = Signal(BYTE_BITS)
-        self.blk_addr = Signal(range(DATA_BYTES))
-        self.blk_rd, self.blk_wr, self.blk_then_wr = Signal(), Signal(), Signal()
-        self.in_frame, self.frame_s_r, self.tx_valid = Signal(), Signal(), Signal()
-        self.tx = Signal(BYTE_BITS)
+        self.cmd_rd, self.cmd_wr = Signal(reset_less=True), Signal(reset_less=True)
+        self.cmd_addr = Signal(_ADDRESS.width, reset_less=True)
+        self.last_rx = Signal(BYTE_BITS, reset_less=True)
+        self.blk_addr = Signal(range(DATA_BYTES), reset_less=True)
+        self.blk_rd, self.blk_wr, self.blk_then_wr = (Signal(reset_less=True) for _ in range(3))
+        self.in_frame = Signal()
+        self.frame_s_r, self.tx_valid = Signal(reset_less=True), Signal(reset_less=True)
+        self.tx = Signal(BYTE_BITS, reset_less=True)
         self.rx = Signal(BYTE_BITS, reset_less=True)
         """The byte shifted in: read only after exactly 8 SCLK edges of a frame (``end``), which replace all of it,
         so it has neither reset nor clear."""
-        self.bits = Signal(range(_BIT_COUNT_LIMIT + 1))
+        self.bits = Signal(range(_BIT_COUNT_LIMIT + 1), reset_less=True)
 
     def build(self) -> None:
         self.configuration()
@@ -296,7 +304,7 @@ class _Builder:
         data = _Sync(m, "data", Mux(b.mfp6_oe, b.mfp6, b.mfp6_in), idle["mfp6"])
         s_r = _Sync(m, "s_r", b.mfp7_in, idle["mfp7"])
         with m.If(sas.s2):
-            m.d.sync += [self.phase.eq(_Phase.INIT), self.motorola.eq(0), self.intel.eq(0), self.last_rx.eq(0)]
+            m.d.sync += [self.phase.eq(_Phase.INIT), self.motorola.eq(0), self.intel.eq(0)]
             self.clear_frame()
         with m.Else():
             with m.If(ss.fell):
@@ -309,7 +317,7 @@ class _Builder:
                     self.end()
 
     def clear_frame(self) -> None:
-        self.m.d.sync += [self.in_frame.eq(0), self.tx_valid.eq(0), self.bits.eq(0)]
+        self.m.d.sync += self.in_frame.eq(0)
 
     def shift_in(self, count: Value, bit: Value) -> None:
         """One SCLK rising edge (``SlavePins._shift_in``): Intel LSB first, else MSB first (UP-6). The byte is a
