@@ -191,11 +191,15 @@ class SerialIoRtl(wiring.Component):
         # ``out_shift`` (a clear sequence sends 0s whatever it holds: ``clearing``), a read frame shifts a whole
         # word into ``in_shift`` (a 16-bit word's upper half is left out when taken over), ``pending`` says when
         # the waiting word counts: no reset, no clear. A 16-bit word is sent from bit 15 (the bits above are not
-        # sent), so the OUT word is loaded as it comes.
+        # sent), so the OUT word is loaded as it comes. Every start's word goes to ``pending_word`` and
+        # ``out_shift`` takes it there on the clock after its sequence began (``loading``): SerOut shows it only
+        # after a frame's lead half t0 (at least one clock), and this spares a 32-bit choice between the word now
+        # and the waiting one.
         out_shift = Signal(WORD_BITS, reset_less=True)
         in_shift = Signal(WORD_BITS, reset_less=True)
         pending = Signal()
         pending_word = Signal(WORD_BITS, reset_less=True)
+        loading = Signal(reset_less=True)
         clearing = kind >= _CLEAR
         frame_probe = spec.SerialFrame(0, WIDTHS[0], False, max(self.t0s))
         sample_after = frame_probe.sample(0) + SYNC_STAGES - frame_probe.rising(0)  # clocks after SCLK rose
@@ -240,8 +244,10 @@ class SerialIoRtl(wiring.Component):
         free = ~busy | last | self.reset
         want = self.start | (pending & ~self.reset)
         go = want & free
+        with m.If(self.start):
+            sync += pending_word.eq(self.out_word)
         with m.If(self.start & ~free):
-            sync += [pending.eq(1), pending_word.eq(self.out_word)]
+            sync += pending.eq(1)
         with m.If(self.reset):
             sync += [
                 busy.eq(has_clear),
@@ -256,8 +262,10 @@ class SerialIoRtl(wiring.Component):
                 busy.eq(1),
                 kind.eq(self.direction),
                 slot.eq(0),
-                out_shift.eq(Mux(self.start, self.out_word, pending_word)),
                 pending.eq(0),
                 *frame_begins(),
             ]
+        sync += loading.eq(go)
+        with m.If(loading):
+            sync += out_shift.eq(pending_word)
         return m
