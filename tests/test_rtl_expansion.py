@@ -20,7 +20,7 @@ from amaranth.sim import Simulator
 from supi3 import expansion
 from supi3.expansion import IDLE, ExpansionLevels
 from supi3.interbus import wire
-from supi3.rtl.expansion import PIN_NAMES, ExpansionRtl
+from supi3.rtl.expansion import PIN_NAMES, ExpansionRtl, _in_bits
 from supi3.tables import BIT_RATES
 from supi3.verif.timing import EXPANSION_PINS, check_expansion
 
@@ -132,3 +132,18 @@ def test_overrun_when_a_data_bit_comes_before_the_end_pulses_are_over(bit_rate: 
         levels, seen = simulate(bit_rate, rows())
         assert [c for c, row in enumerate(seen) if row["overrun"]] == ([gap + 1 + first] if overrun else [])
         assert [level.clk_exr for level in levels].index(1) == gap + 1 + first
+
+
+def test_end_pulses_are_whole_bit_periods() -> None:
+    """The block counts the end pulses in bit periods: ``expansion.end_pulses`` gives whole bit periods at both rates
+    (Table 3-15, RX-4), and pulses between bit periods are refused at elaboration, named."""
+    for bit_rate in BIT_RATES:
+        cpb = wire.clocks_per_bit(bit_rate)
+        for data in (True, False):
+            pulses = expansion.end_pulses(data, cpb)
+            bits = _in_bits(pulses, cpb)
+            assert bits.la_in_d_n == (pulses.la_in_d_n[0] // cpb, pulses.la_in_d_n[1] // cpb)
+            assert (bits.la_ou_d is None) == (pulses.la_ou_d is None)
+            assert bits.length * cpb == pulses.length
+    with pytest.raises(ValueError, match="whole bit period, not at 17 clocks"):
+        _in_bits(expansion.EndPulses(None, (0, 17)), 16)

@@ -22,7 +22,7 @@ from amaranth.sim import Simulator
 from supi3 import serial_io
 from supi3.config import DataDirection
 from supi3.pinout import SYNC_STAGES
-from supi3.rtl.serial_io import DIRECTIONS, MFP_BITS, SER_IN_PIN, WIDTHS, SerialIoRtl
+from supi3.rtl.serial_io import DIRECTIONS, MFP_BITS, SER_IN_PIN, WIDTHS, SerialIoRtl, _in_slots, _schedules
 from supi3.serial_io import IDLE, Levels
 from supi3.tables import BIT_RATES
 from supi3.verif.timing import check_serial_io
@@ -192,3 +192,23 @@ def test_a_start_at_the_reset_edge_wins() -> None:
 
     run = simulate(DataDirection.OUT, bits, bit_rate, script)
     assert run.levels == [IDLE, *serial_io.render(seq, 0x8001), IDLE]
+
+
+def test_sequence_constants_are_whole_t0() -> None:
+    """The block counts a sequence in t0 slots: every schedule's offsets are whole t0 (SM-3, SM-7, Table 3-4 t6, t7),
+    and a schedule with an offset between slots is refused at elaboration, named."""
+    for (_, _, rate), seq in _schedules().items():
+        if seq is None:
+            continue
+        t0 = serial_io.t0_clocks(BIT_RATES[rate])
+        slots = _in_slots(seq, t0)
+        assert slots.length * t0 == seq.length
+        for frame, got in ((seq.read, slots.read), (seq.write, slots.write)):
+            assert got == (None if frame is None else (frame.start // t0, frame.end // t0))
+            assert frame is None or (frame.start % t0, frame.end % t0) == (0, 0)
+        assert slots.conv == (None if seq.conv is None else (seq.conv[0] // t0, seq.conv[1] // t0))
+    seq = serial_io.sequence(DataDirection.OUT, WIDTHS[0], BIT_RATES[-1])
+    t0 = serial_io.t0_clocks(BIT_RATES[-1])
+    shifted = serial_io.SerialSequence(seq.frames, seq.conv, seq.length + 1)
+    with pytest.raises(ValueError, match=f"length must fall on a whole t0, not at {seq.length + 1} clocks"):
+        _in_slots(shifted, t0)

@@ -20,6 +20,7 @@ the outputs block's pulse counter, which also times the 375 ns pulse without exp
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Final
 
 from amaranth.hdl import Module, Mux, Signal, Value
@@ -34,6 +35,22 @@ __all__ = ["PIN_NAMES", "ExpansionRtl"]
 
 PIN_NAMES: Final = ("clk_exr", "to_exr", "la_ou_d", "la_in_d_n")
 """The outputs of :class:`supi3.expansion.ExpansionLevels` this block drives, as ports of the same names."""
+
+
+def _in_bits(pulses: spec.EndPulses, cpb: int) -> spec.EndPulses:
+    """``pulses`` in bit periods of ``cpb`` clocks: each edge must fall on a whole bit period (Table 3-15 gives them
+    in t_Bit, RX-4)."""
+
+    def bits(clocks: int) -> int:
+        if clocks % cpb:
+            raise ValueError(f"an end pulse edge must fall on a whole bit period, not at {clocks} clocks (cpb = {cpb})")
+        return clocks // cpb
+
+    def window(edges: tuple[int, int]) -> tuple[int, int]:
+        return bits(edges[0]), bits(edges[1])
+
+    la_ou_d = None if pulses.la_ou_d is None else window(pulses.la_ou_d)
+    return replace(pulses, la_ou_d=la_ou_d, la_in_d_n=window(pulses.la_in_d_n))
 
 
 class ExpansionRtl(wiring.Component):
@@ -58,23 +75,26 @@ class ExpansionRtl(wiring.Component):
     def elaborate(self, _platform: object) -> Module:
         m = Module()
         sync, comb = m.d.sync, m.d.comb
-        longest = max(
-            max(spec.end_pulses(True, cpb).length, spec.clock_high(cpb)[1]) for cpb in self.cpbs
-        )
+        # each counter as wide as its longest run at any bit rate; the end pulses in whole bit periods
+        clk_range = range(max(spec.clock_high(cpb)[1] for cpb in self.cpbs) + 1)
+        pulses = {cpb: {data: _in_bits(spec.end_pulses(data, cpb), cpb) for data in (True, False)} for cpb in self.cpbs}
+        count_range = range(max(p.length for by_data in pulses.values() for p in by_data.values()) + 1)
 
         # The bit rate's constants (Table 3-15) ---------------------------------------------------------------
-        count_range = range(longest + 1)
-        latched_end = Signal()  # the last cycle end was a valid data cycle's latch: LaOuD, then /LaInD
-        clk_first, clk_end = Signal(count_range), Signal(count_range)
+        # What is read only while a counter runs (``clk_run``, ``end_run``, which have their reset) or after the
+        # frame's load that sets it (``first_bit``, read under ``active``) is set where it starts: no reset.
+        latched_end = Signal(reset_less=True)  # the last cycle end was a valid data cycle's latch: LaOuD, /LaInD
+        clk_first, clk_end = Signal(clk_range), Signal(clk_range)
         ou_end, in_first, in_end, ends = (Signal(count_range, name=n) for n in ("ou_end", "in_first", "in_end", "ends"))
+        last_clock = Signal(range(max(self.cpbs)))  # the bit period's last clock
         with m.Switch(self.rate):
             for rate, cpb in enumerate(self.cpbs):
                 with m.Case(rate):
                     first, end = spec.clock_high(cpb)
-                    data, other = spec.end_pulses(True, cpb), spec.end_pulses(False, cpb)
+                    data, other = pulses[cpb][True], pulses[cpb][False]
                     if data.la_ou_d is None or data.la_ou_d[0] != 0 or other.la_ou_d is not None:
                         raise ValueError("LaOuD must begin at a latched data cycle's end and only there (RX-4)")
-                    comb += [clk_first.eq(first), clk_end.eq(end)]
+                    comb += [clk_first.eq(first), clk_end.eq(end), last_clock.eq(cpb - 1)]
                     comb += [
                         ou_end.eq(data.la_ou_d[1]),
                         in_first.eq(Mux(latched_end, data.la_in_d_n[0], other.la_in_d_n[0])),
@@ -89,8 +109,8 @@ class ExpansionRtl(wiring.Component):
         comb += self.send.eq(self.from_exr)
         to_exr = Signal(init=spec.IDLE.to_exr)
         clk_run = Signal()
-        clk_count = Signal(count_range)
-        first_bit = Signal()  # no bit of this data cycle has gone out yet
+        clk_count = Signal(clk_range, reset_less=True)
+        first_bit = Signal(reset_less=True)  # no bit of this data cycle has gone out yet
         rises = Signal()  # this clock bit's ClkExR rises
         with m.If(self.load):
             sync += first_bit.eq(1)
@@ -104,14 +124,17 @@ class ExpansionRtl(wiring.Component):
 
         # End pulses (RX-4) and /ResReg (RX-5) ----------------------------------------------------------------
         end_run = Signal()
-        end_count = Signal(count_range)
+        end_count = Signal(count_range, reset_less=True)  # whole bit periods since the end pulses began
+        end_clock = Signal.like(last_clock, reset_less=True)  # clock within the bit period
         with m.If(end_run):
-            sync += end_count.eq(end_count + 1)
-            with m.If(end_count + 1 == ends):
-                sync += end_run.eq(0)
+            sync += end_clock.eq(end_clock + 1)
+            with m.If(end_clock == last_clock):
+                sync += [end_clock.eq(0), end_count.eq(end_count + 1)]
+                with m.If(end_count + 1 == ends):
+                    sync += end_run.eq(0)
         with m.If(self.ext & self.ended):
-            sync += [end_run.eq(1), end_count.eq(0), latched_end.eq(self.latched)]
-        first_rise = Signal()  # the data cycle's first ClkExR clock bit
+            sync += [end_run.eq(1), end_count.eq(0), end_clock.eq(0), latched_end.eq(self.latched)]
+        first_rise = Signal(reset_less=True)  # the data cycle's first ClkExR clock bit
         with m.If(active & self.shift):
             sync += first_rise.eq(first_bit)
         comb += rises.eq(clk_run & (clk_count == clk_first))

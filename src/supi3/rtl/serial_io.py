@@ -2,10 +2,11 @@
 
 :class:`SerialIoRtl` drives /Conv, SCLK, /SS and SerOut exactly as :func:`supi3.serial_io.sequence` schedules
 them (Tables 3-3, 3-4, Figures 3-1 to 3-3; decisions SM-1 to SM-9 of ``docs/assumptions/serial-io.md``), and reads
-SerIn into the IN word. Nothing is stored as a waveform: a sequence counter ``k`` places the frames and the /Conv
-pulse (their offsets are constants taken from the spec's :class:`~supi3.serial_io.SerialSequence` for every
-direction, width and bit rate at elaboration), and a slot counter (``sub`` within a t0, ``within`` a byte of nine
-slots, ``lead`` for the half t0 before the first slot) gives SCLK, the SerOut shifts and the sample points.
+SerIn into the IN word. Nothing is stored as a waveform: a sequence counter ``slot`` of t0 slots places the frames
+and the /Conv pulse (their offsets, whole t0 all, are constants taken from the spec's
+:class:`~supi3.serial_io.SerialSequence` for every direction, width and bit rate at elaboration), and the
+counters ``sub`` (clock within a t0), ``within`` (slot within a byte of nine slots) and ``lead`` (the half t0
+before a frame's first slot) give SCLK, the SerOut shifts and the sample points.
 
 * ``start`` (the core's latch of a valid data cycle) with ``out_word``: a sequence begins on the next cycle (SM-2);
   while one runs, the word waits (one deep, the newest wins) and its sequence begins on the cycle after the running
@@ -22,6 +23,7 @@ slots, ``lead`` for the half t0 before the first slot) gives SCLK, the SerOut sh
 from __future__ import annotations
 
 import itertools
+from dataclasses import dataclass
 from typing import Final
 
 from amaranth.hdl import Cat, Module, Mux, Signal, Value
@@ -75,6 +77,38 @@ def _schedules() -> dict[tuple[int, int, int], spec.SerialSequence | None]:
     }
 
 
+@dataclass(frozen=True)
+class _Slots:
+    """A sequence's constants in t0 slots from its first cycle: its length and each frame's and /Conv's first and
+    end slot (None where it has none)."""
+
+    length: int
+    read: tuple[int, int] | None
+    write: tuple[int, int] | None
+    conv: tuple[int, int] | None
+
+
+def _in_slots(seq: spec.SerialSequence, t0: int) -> _Slots:
+    """``seq``'s offsets in t0: each must be a whole number of t0 (frames start on whole t0, SM-3; t10 in whole t0,
+    SM-7; /Conv after whole t0, Table 3-4 t6, t7)."""
+
+    def slots(name: str, first: int, end: int) -> tuple[int, int]:
+        for clocks in (first, end):
+            if clocks % t0:
+                raise ValueError(f"a sequence's {name} must fall on a whole t0, not at {clocks} clocks (t0 = {t0})")
+        return first // t0, end // t0
+
+    def frame(name: str, frame: spec.SerialFrame | None) -> tuple[int, int] | None:
+        return None if frame is None else slots(name, frame.start, frame.end)
+
+    return _Slots(
+        slots("length", 0, seq.length)[1],
+        frame("read frame", seq.read),
+        frame("write frame", seq.write),
+        None if seq.conv is None else slots("/Conv pulse", *seq.conv),
+    )
+
+
 class SerialIoRtl(wiring.Component):
     """The serial I/O block of the SPI master modes (block ``serial_io``).
 
@@ -86,11 +120,12 @@ class SerialIoRtl(wiring.Component):
 
     def __init__(self) -> None:
         self.schedules = _schedules()
-        self.longest = max(seq.length for seq in self.schedules.values() if seq is not None)
         self.t0s = tuple(spec.t0_clocks(bit_rate) for bit_rate in BIT_RATES)
         for t0 in self.t0s:
             if t0 // 2 + SYNC_STAGES - 1 >= t0:
                 raise ValueError(f"a SerIn sample needs SYNC_STAGES < t0/2 + 1, not t0 = {t0}")
+        self.slots = {key: _in_slots(seq, self.t0s[key[2]]) for key, seq in self.schedules.items() if seq is not None}
+        self.longest = max(constants.length for constants in self.slots.values())
         super().__init__({
             "start": In(1), "out_word": In(WORD_BITS), "reset": In(1), "ser_in": In(1),
             "direction": In(range(len(DIRECTIONS))), "wide": In(1), "rate": In(range(len(BIT_RATES))),
@@ -103,26 +138,28 @@ class SerialIoRtl(wiring.Component):
     def elaborate(self, _platform: object) -> Module:
         m = Module()
         sync, comb = m.d.sync, m.d.comb
-        k_range = range(self.longest + 1)
+        slot_range = range(self.longest + 1)
 
-        # The running sequence's constants (from the spec's schedule) ------------------------------------------
+        # The running sequence's constants in t0 slots (from the spec's schedule) ------------------------------
         busy = self.busy
-        kind = Signal(range(2 * _CLEAR))
+        # The sequence's kind and counters are read only while ``busy`` (which has its reset) and set where a
+        # sequence begins: no reset.
+        kind = Signal(range(2 * _CLEAR), reset_less=True)
         read_on, write_on, conv_on = Signal(), Signal(), Signal()
-        read_start, read_end, write_start, write_end = (Signal(k_range, name=n) for n in ("rs", "re", "ws", "we"))
-        conv_start, conv_end, length = Signal(k_range), Signal(k_range), Signal(k_range)
+        read_start, read_end, write_start, write_end = (Signal(slot_range, name=n) for n in ("rs", "re", "ws", "we"))
+        conv_start, conv_end, length = Signal(slot_range), Signal(slot_range), Signal(slot_range)
+        cases: dict[_Slots, list[int]] = {}
+        for (kind_value, wide, rate), constants in self.slots.items():
+            cases.setdefault(constants, []).append(kind_value | (wide << len(kind)) | (rate << (len(kind) + 1)))
         with m.Switch(Cat(kind, self.wide, self.rate)):
-            for (kind_value, wide, rate), seq in self.schedules.items():
-                if seq is None:
-                    continue
-                with m.Case(kind_value | (wide << len(kind)) | (rate << (len(kind) + 1))):
-                    comb += length.eq(seq.length)
-                    for frame, on, first, end in ((seq.read, read_on, read_start, read_end),
-                                                  (seq.write, write_on, write_start, write_end)):  # fmt: skip
+            for constants, patterns in cases.items():
+                with m.Case(*patterns):
+                    comb += length.eq(constants.length)
+                    for frame, on, first, end in ((constants.read, read_on, read_start, read_end),
+                                                  (constants.write, write_on, write_start, write_end),
+                                                  (constants.conv, conv_on, conv_start, conv_end)):  # fmt: skip
                         if frame is not None:
-                            comb += [on.eq(1), first.eq(frame.start), end.eq(frame.end)]
-                    if seq.conv is not None:
-                        comb += [conv_on.eq(1), conv_start.eq(seq.conv[0]), conv_end.eq(seq.conv[1])]
+                            comb += [on.eq(1), first.eq(frame[0]), end.eq(frame[1])]
         # Sequences a reset starts: the clear sequence of this mode's direction, if it has one.
         has_clear = Signal()
         with m.Switch(self.direction):
@@ -136,29 +173,42 @@ class SerialIoRtl(wiring.Component):
                     comb += t0.eq(value)
 
         # Counters ---------------------------------------------------------------------------------------------
-        k = Signal(k_range)
-        sub = Signal(range(max(self.t0s)))  # clock within a t0, 0 at a slot's first cycle
-        lead = Signal()  # the half t0 between /SS falling and the first slot
-        within = Signal(range(spec.BYTE_SLOTS))  # slot within a byte: bits 0..7, then the pause slot
+        # Every frame and /Conv edge of a sequence falls on a whole t0 from its first cycle (``_in_slots``), so the
+        # sequence counter counts t0 slots: ``slot`` steps at the clock ending each t0 of the sequence. ``sub``
+        # is (clocks since the sequence began + t0/2) mod t0 throughout (every sequence and frame starts it at
+        # t0/2 and each begins on a whole t0), so that clock is the one with ``sub == t0/2 - 1``.
+        slot = Signal(slot_range, reset_less=True)
+        sub = Signal(range(max(self.t0s)), reset_less=True)  # clock within a t0, 0 at a bit slot's first cycle
+        slot_ends = sub == (t0 >> 1) - 1
+        lead = Signal(reset_less=True)  # the half t0 between /SS falling and the first slot
+        within = Signal(range(spec.BYTE_SLOTS), reset_less=True)  # slot within a byte: bits 0..7, then the pause slot
         pause = within == spec.BYTE_SLOTS - 1
-        in_read = busy & read_on & (k >= read_start) & (k < read_end)
-        in_write = busy & write_on & (k >= write_start) & (k < write_end)
+        in_read = busy & read_on & (slot >= read_start) & (slot < read_end)
+        in_write = busy & write_on & (slot >= write_start) & (slot < write_end)
         in_frame = in_read | in_write
         high = sub >= (t0 >> 1)
-        # the shift registers and the waiting word are written before they are read (every sequence loads
-        # ``out_shift`` and a read sequence clears ``in_shift``; ``pending`` says when the word counts): no reset
+        # The shift registers and the waiting word are written before they are read: every sequence loads
+        # ``out_shift`` (a clear sequence sends 0s whatever it holds: ``clearing``), a read frame shifts a whole
+        # word into ``in_shift`` (a 16-bit word's upper half is left out when taken over), ``pending`` says when
+        # the waiting word counts: no reset, no clear. A 16-bit word is sent from bit 15 (the bits above are not
+        # sent), so the OUT word is loaded as it comes. Every start's word goes to ``pending_word`` and
+        # ``out_shift`` takes it there on the clock after its sequence began (``loading``): SerOut shows it only
+        # after a frame's lead half t0 (at least one clock), and this spares a 32-bit choice between the word now
+        # and the waiting one.
         out_shift = Signal(WORD_BITS, reset_less=True)
         in_shift = Signal(WORD_BITS, reset_less=True)
         pending = Signal()
         pending_word = Signal(WORD_BITS, reset_less=True)
+        loading = Signal(reset_less=True)
+        clearing = kind >= _CLEAR
         frame_probe = spec.SerialFrame(0, WIDTHS[0], False, max(self.t0s))
         sample_after = frame_probe.sample(0) + SYNC_STAGES - frame_probe.rising(0)  # clocks after SCLK rose
 
         levels = {
-            "conv_n": ~(busy & conv_on & (k >= conv_start) & (k < conv_end)),
+            "conv_n": ~(busy & conv_on & (slot >= conv_start) & (slot < conv_end)),
             "sclk": in_frame & ~lead & ~pause & high,
             "ss_n": ~in_frame,
-            "ser_out": in_write & ~lead & out_shift[-1],
+            "ser_out": in_write & ~lead & ~clearing & Mux(self.wide, out_shift[-1], out_shift[WIDTHS[0] - 1]),
         }
         comb += [getattr(self, name).eq(level) for name, level in levels.items()]
         comb += self.mfp.eq(sum((level << MFP_BITS[name] for name, level in levels.items()), Value.cast(0)))
@@ -167,9 +217,10 @@ class SerialIoRtl(wiring.Component):
             """The slot counters as they stand in a frame's first cycle: in the lead half t0."""
             return [sub.eq(t0 >> 1), lead.eq(1), within.eq(0)]
 
-        last = busy & (k == length - 1)
+        last = busy & slot_ends & (slot == length - 1)
         with m.If(busy):
-            sync += k.eq(k + 1)
+            with m.If(slot_ends):
+                sync += slot.eq(slot + 1)
             with m.If(sub == t0 - 1):
                 sync += sub.eq(0)
                 with m.If(lead):
@@ -182,27 +233,26 @@ class SerialIoRtl(wiring.Component):
                 sync += sub.eq(sub + 1)
             with m.If(in_read & ~lead & ~pause & (sub == (t0 >> 1) + sample_after)):
                 sync += in_shift.eq(Cat(self.ser_in, in_shift[:-1]))
-            with m.If(write_on & (k + 1 == write_start)):
+            with m.If(write_on & slot_ends & (slot + 1 == write_start)):
                 sync += frame_begins()
         with m.If(last):
             sync += busy.eq(0)
             with m.If(read_on):
-                sync += self.in_word.eq(in_shift)
+                sync += self.in_word.eq(Mux(self.wide, in_shift, in_shift[: WIDTHS[0]]))
 
         # Start, pending start, reset (SM-2, SM-9) -------------------------------------------------------------
         free = ~busy | last | self.reset
         want = self.start | (pending & ~self.reset)
         go = want & free
-        word = Mux(self.start, self.out_word, pending_word)
-        width_shift = Mux(self.wide, 0, WORD_BITS - WIDTHS[0])
+        with m.If(self.start):
+            sync += pending_word.eq(self.out_word)
         with m.If(self.start & ~free):
-            sync += [pending.eq(1), pending_word.eq(self.out_word)]
+            sync += pending.eq(1)
         with m.If(self.reset):
             sync += [
                 busy.eq(has_clear),
                 kind.eq(_CLEAR + self.direction),
-                k.eq(0),
-                out_shift.eq(0),
+                slot.eq(0),
                 pending.eq(0),
                 self.in_word.eq(0),
                 *frame_begins(),
@@ -211,10 +261,11 @@ class SerialIoRtl(wiring.Component):
             sync += [
                 busy.eq(1),
                 kind.eq(self.direction),
-                k.eq(0),
-                out_shift.eq(word << width_shift),
-                in_shift.eq(0),
+                slot.eq(0),
                 pending.eq(0),
                 *frame_begins(),
             ]
+        sync += loading.eq(go)
+        with m.If(loading):
+            sync += out_shift.eq(pending_word)
         return m

@@ -216,8 +216,15 @@ class _Builder:
         self.core = {name: Signal(BYTE_BITS, name=f"{name.lower()}_core") for name in self.regs}
         """The registers after the core's inputs of this edge: what a read at this edge sees."""
         self.io = Signal()
-        self.configured, self.cfg_extreg, self.cfg_pcp_n = Signal(), Signal(), Signal()
-        self.cfg_code = Signal(_LENGTH_CODE.width)
+        # No reset (nor clear) where every reader is gated by state that has one and the state is written before
+        # that gate opens: the applied SET fields (read only while ``configured``), the command and block transfer
+        # fields (read only in the DATA and BLOCK phases their command byte enters), the frame's S/R, byte sent,
+        # bit count and whether it drives (read only in a frame, set at its /SS falling edge), and the last byte
+        # received (sent back only once Motorola or Intel mode is set, by the initialization byte's end, which also
+        # stores it).
+        self.configured = Signal()
+        self.cfg_extreg, self.cfg_pcp_n = Signal(reset_less=True), Signal(reset_less=True)
+        self.cfg_code = Signal(_LENGTH_CODE.width, reset_less=True)
         self.n_bytes = Signal(range(DATA_BYTES + 1))
         """Data bytes of the internal data path: 0 before SET and with ExtReg = 1 (``data_bytes()`` gated by
         ``internal_data_path``)."""
@@ -225,14 +232,18 @@ class _Builder:
         # Protocol (UpifProtocol) and frame (SlavePins) state.
         self.phase = Signal(_Phase, init=_Phase.INIT)
         self.motorola, self.intel = Signal(), Signal()
-        self.cmd_rd, self.cmd_wr = Signal(), Signal()
-        self.cmd_addr = Signal(_ADDRESS.width)
-        self.last_rx = Signal(BYTE_BITS)
-        self.blk_addr = Signal(range(DATA_BYTES))
-        self.blk_rd, self.blk_wr, self.blk_then_wr = Signal(), Signal(), Signal()
-        self.in_frame, self.frame_s_r, self.tx_valid = Signal(), Signal(), Signal()
-        self.tx, self.rx = Signal(BYTE_BITS), Signal(BYTE_BITS)
-        self.bits = Signal(range(_BIT_COUNT_LIMIT + 1))
+        self.cmd_rd, self.cmd_wr = Signal(reset_less=True), Signal(reset_less=True)
+        self.cmd_addr = Signal(_ADDRESS.width, reset_less=True)
+        self.last_rx = Signal(BYTE_BITS, reset_less=True)
+        self.blk_addr = Signal(range(DATA_BYTES), reset_less=True)
+        self.blk_rd, self.blk_wr, self.blk_then_wr = (Signal(reset_less=True) for _ in range(3))
+        self.in_frame = Signal()
+        self.frame_s_r, self.tx_valid = Signal(reset_less=True), Signal(reset_less=True)
+        self.tx = Signal(BYTE_BITS, reset_less=True)
+        self.rx = Signal(BYTE_BITS, reset_less=True)
+        """The byte shifted in: read only after exactly 8 SCLK edges of a frame (``end``), which replace all of it,
+        so it has neither reset nor clear."""
+        self.bits = Signal(range(_BIT_COUNT_LIMIT + 1), reset_less=True)
 
     def build(self) -> None:
         self.configuration()
@@ -244,10 +255,9 @@ class _Builder:
 
     def configuration(self) -> None:
         m, b, regs = self.m, self.b, self.regs
-        with m.If(self.configured & ~self.cfg_extreg), m.Switch(self.cfg_code):
-            for code, count in self.tables.internal_bytes.items():
-                with m.Case(code):
-                    m.d.comb += self.n_bytes.eq(count)
+        counts = [self.tables.internal_bytes.get(code, 0) for code in range(1 << _LENGTH_CODE.width)]
+        with m.If(self.configured & ~self.cfg_extreg):  # a ROM indexed by the code
+            m.d.comb += self.n_bytes.eq(Array(Const(count) for count in counts)[self.cfg_code])
         m.d.comb += [
             self.pcp_device.eq(self.configured & ~self.cfg_extreg & ~self.cfg_pcp_n),
             b.in_data.eq(Cat(*(regs[r.name] for r in IN_BYTES))),
@@ -294,29 +304,29 @@ class _Builder:
         data = _Sync(m, "data", Mux(b.mfp6_oe, b.mfp6, b.mfp6_in), idle["mfp6"])
         s_r = _Sync(m, "s_r", b.mfp7_in, idle["mfp7"])
         with m.If(sas.s2):
-            m.d.sync += [self.phase.eq(_Phase.INIT), self.motorola.eq(0), self.intel.eq(0), self.last_rx.eq(0)]
+            m.d.sync += [self.phase.eq(_Phase.INIT), self.motorola.eq(0), self.intel.eq(0)]
             self.clear_frame()
         with m.Else():
             with m.If(ss.fell):
                 self.begin(s_r.s2)
             with m.If((self.in_frame | ss.fell) & ~ss.s2 & sclk.rose):
-                self.shift_in(Mux(ss.fell, 0, self.bits), Mux(ss.fell, 0, self.rx), data.s2)
+                self.shift_in(Mux(ss.fell, 0, self.bits), data.s2)
             with m.If(self.in_frame & ss.rose):
                 self.clear_frame()
                 with m.If(self.bits == BYTE_BITS):
                     self.end()
 
     def clear_frame(self) -> None:
-        self.m.d.sync += [self.in_frame.eq(0), self.tx_valid.eq(0), self.bits.eq(0), self.rx.eq(0)]
+        self.m.d.sync += self.in_frame.eq(0)
 
-    def shift_in(self, count: Value, rx: Value, bit: Value) -> None:
-        """One SCLK rising edge (``SlavePins._shift_in``): Intel LSB first, else MSB first (UP-6)."""
+    def shift_in(self, count: Value, bit: Value) -> None:
+        """One SCLK rising edge (``SlavePins._shift_in``): Intel LSB first, else MSB first (UP-6). The byte is a
+        shift register (right for Intel, left for Motorola): after the 8 edges ``end`` takes, the first bit is at
+        bit 0 or bit 7, as the model's bit insertion puts it."""
         m = self.m
+        rx = self.rx
+        m.d.sync += rx.eq(Mux(self.intel, Cat(rx[1:], bit), Cat(bit, rx[:-1])))
         with m.If(count < BYTE_BITS):
-            with m.If(self.intel):
-                m.d.sync += self.rx.eq(rx | (bit << count)[:BYTE_BITS])
-            with m.Else():
-                m.d.sync += self.rx.eq(Cat(bit, rx[:-1]))
             m.d.sync += self.bits.eq(count + 1)
         with m.Else():
             m.d.sync += self.bits.eq(_BIT_COUNT_LIMIT)
@@ -330,7 +340,6 @@ class _Builder:
             self.frame_s_r.eq(s_r),
             self.tx_valid.eq(drives),
             self.bits.eq(0),
-            self.rx.eq(0),
             self.tx.eq(self.last_rx),
         ]
         reads, address = Signal(), Signal(_ADDRESS.width)
@@ -362,8 +371,10 @@ class _Builder:
                             m.d.sync += self.tx.eq(value)
 
     def end(self) -> None:
-        """/SS rose after 8 bits (``UpifProtocol.end``): process the received byte ``rx``."""
+        """/SS rose after 8 bits (``UpifProtocol.end``): process the received byte ``rx``; a data byte's and a block
+        transfer's writes share one address decoder (``write``, ``address``)."""
         m, rx = self.m, self.rx
+        write, address = Signal(), Signal(_ADDRESS.width)
         with m.Switch(self.phase):
             with m.Case(_Phase.INIT):
                 m.d.sync += self.phase.eq(_Phase.DISABLED)
@@ -374,9 +385,11 @@ class _Builder:
                 # An Intel command byte needs S/R = 1 (Table 3-9); the received byte is kept either way.
                 self.command(rx[_RD.lsb], rx[_WR.lsb], rx[_ADDRESS.lsb : _ADDRESS.lsb + _ADDRESS.width])
             with m.Case(_Phase.DATA):
-                self.data()
+                self.data(write, address)
             with m.Case(_Phase.BLOCK):
-                self.block()
+                self.block(write, address)
+        with m.If(write):
+            self.cpu_write(address, rx)
         with m.If(self.phase != _Phase.DISABLED):
             m.d.sync += self.last_rx.eq(rx)
 
@@ -393,20 +406,18 @@ class _Builder:
             with m.Else():
                 m.d.sync += [self.blk_rd.eq(rd), self.blk_wr.eq(~rd), self.blk_then_wr.eq(rd & wr)]
 
-    def data(self) -> None:
+    def data(self, write: Signal, address: Signal) -> None:
         """The data byte of a command (3.4.4): a write where RD/WR and S/R allow it (UP-9); 4 and 5 ignored."""
         m, s_r = self.m, self.frame_s_r
         m.d.sync += self.phase.eq(_Phase.COMMAND)
         refused = self.intel & (self.cmd_rd != self.cmd_wr) & (self.cmd_rd == s_r)
-        with m.If(self.cmd_wr & (self.motorola | s_r) & ~refused):
-            self.cpu_write(self.cmd_addr, self.rx)
+        m.d.comb += [write.eq(self.cmd_wr & (self.motorola | s_r) & ~refused), address.eq(self.cmd_addr)]
 
-    def block(self) -> None:
+    def block(self, write: Signal, address: Signal) -> None:
         """One byte of a block transfer: write IN k in a write slot; then the next slot (UP-11)."""
         m = self.m
         refused = self.intel & (self.blk_rd == self.frame_s_r)
-        with m.If(self.blk_wr & ~refused):
-            self.cpu_write(self.blk_addr, self.rx)
+        m.d.comb += [write.eq(self.blk_wr & ~refused), address.eq(self.blk_addr)]
         with m.If(self.blk_addr == self.n_bytes - 1):
             with m.If(self.blk_then_wr):
                 m.d.sync += [self.blk_addr.eq(0), self.blk_rd.eq(0), self.blk_wr.eq(1), self.blk_then_wr.eq(0)]
@@ -418,7 +429,7 @@ class _Builder:
     def cpu_write(self, address: Value, value: Value) -> None:
         """``RegisterFile.cpu_write``: store the byte's register bits; SET also applies a valid configuration."""
         m = self.m
-        with m.Switch(Cat(address, Const(0, _ADDRESS.width - len(address)))):
+        with m.Switch(address):
             for a, port in _WRITE_PORTS.items():
                 register = port.register
                 if port.access is Access.W and register is not None:
@@ -428,43 +439,57 @@ class _Builder:
                             self.apply_set(value)
 
     def apply_set(self, value: Value) -> None:
-        """A SET value with an applicable length code configures the device (Tables 3-11, 3-12; UP-20)."""
+        """A SET value with an applicable length code configures the device (Tables 3-11, 3-12; UP-20). The table
+        is a ROM indexed by (ExtReg, ID12..8): an entry per key, not a comparator per applicable key."""
         m = self.m
         key = Cat(value[_LENGTH_CODE.lsb : _LENGTH_CODE.lsb + _LENGTH_CODE.width], value[_EXTREG.lsb])
-        with m.Switch(key):
-            for (extreg, low), code in self.tables.set_codes.items():
-                with m.Case(low | extreg << _LENGTH_CODE.width):
-                    m.d.sync += [
-                        self.configured.eq(1),
-                        self.cfg_extreg.eq(extreg),
-                        self.cfg_code.eq(code),
-                        self.cfg_pcp_n.eq(value[_PCP_N.lsb]),
-                    ]
+        codes = self.tables.set_codes
+        entries = [codes.get(divmod(key_value, 1 << _LENGTH_CODE.width)) for key_value in range(1 << len(key))]
+        applies = Array(Const(code is not None) for code in entries)[key]
+        code = Array(Const(code or 0, _LENGTH_CODE.width) for code in entries)[key]
+        with m.If(applies):
+            m.d.sync += [
+                self.configured.eq(1),
+                self.cfg_extreg.eq(value[_EXTREG.lsb]),
+                self.cfg_code.eq(code),
+                self.cfg_pcp_n.eq(value[_PCP_N.lsb]),
+            ]
 
     # 3. Outputs: the state decoded (SlavePins._decode), then the bit rate's pipeline (UP-14) ---------------------
 
     def outputs(self) -> None:
         m, b = self.m, self.b
-        index = Mux(self.bits > BYTE_BITS - 1, BYTE_BITS - 1, self.bits)
-        bit = Mux(self.intel, self.tx, self.tx[::-1]).bit_select(index, 1)
+        # Intel sends LSB first, Motorola MSB first: bit ``index`` or ``7 - index`` (the index inverted) of ``tx``
+        index = Mux(self.bits > BYTE_BITS - 1, BYTE_BITS - 1, self.bits)[: (BYTE_BITS - 1).bit_length()]
+        bit = self.tx.bit_select(index ^ Mux(self.intel, 0, BYTE_BITS - 1), 1)
         drive = self.in_frame & self.tx_valid
         phase = self.phase
         decoded: dict[str, Value] = {
             "io": self.io, "io_oe": Const(1),
             "c_d": Mux(phase.matches(_Phase.INIT, _Phase.COMMAND), C_D_COMMAND, C_D_DATA), "c_d_oe": Const(1),
             "irq_n": self.regs[_IRQ_EVT.name] == 0, "irq_n_oe": Const(1),
-            "mfp6": bit & drive & self.intel, "mfp6_oe": drive & self.intel,
-            "mfp7": bit & drive & self.motorola, "mfp7_oe": drive & self.motorola,
+            "mfp6_oe": drive & self.intel, "mfp7_oe": drive & self.motorola,
         }  # fmt: skip
-        reset = self.tables.reset_outputs
-        delays = self.tables.output_delay
-        for name, value in decoded.items():
-            taps: list[Value] = [value]
-            for stage in range(max(delays)):
-                delayed = Signal(name=f"{name}_d{stage + 1}", init=reset[name])
-                m.d.sync += delayed.eq(taps[-1])
-                taps.append(delayed)
-            m.d.comb += getattr(b, name).eq(Array(taps[delay] for delay in delays)[b.rate])
+        # The bit sent goes through one pipeline for both data pins, each gated by its delayed enable (so it needs
+        # no reset: the enables' pipelines have theirs).
+        delayed = {name: self.delay(name, value, reset=True) for name, value in decoded.items()}
+        sent = self.delay("bit", bit, reset=False)
+        delayed.update({"mfp6": sent & delayed["mfp6_oe"], "mfp7": sent & delayed["mfp7_oe"]})
+        m.d.comb += [getattr(b, name).eq(value) for name, value in delayed.items()]
+
+    def delay(self, name: str, value: Value, *, reset: bool) -> Value:
+        """``value`` through the bit rate's output pipeline (UP-14): its stages start from the output's power-up
+        level (``reset``) or have no reset."""
+        m = self.m
+        taps: list[Value] = [value]
+        for stage in range(max(self.tables.output_delay)):
+            if reset:
+                stage_signal = Signal(name=f"{name}_d{stage + 1}", init=self.tables.reset_outputs[name])
+            else:
+                stage_signal = Signal(name=f"{name}_d{stage + 1}", reset_less=True)
+            m.d.sync += stage_signal.eq(taps[-1])
+            taps.append(stage_signal)
+        return Array(taps[delay] for delay in self.tables.output_delay)[self.b.rate]
 
 
 def verilog() -> str:
