@@ -159,17 +159,19 @@ SHORT_SILENCE = 3000
 """A silence limit in clocks for the model alone (BK-3's 10 ms is 320,000: the RTL lockstep runs that one)."""
 
 
-def silence_scenario(limit_frames: int, seed: int, extra: int = 0) -> tuple[CoreScript, int]:
+def silence_scenario(limit_frames: int, seed: int, extra: int = 0, shift: int = 0) -> tuple[CoreScript, int]:
     """BK-LB, RF = 10, LBST high: the extended function switched on; frames with DI3 repeating the forward line; then
-    DI3 silent at the idle level for ``limit_frames`` data cycles (each ``extra`` bytes longer than the BK's: the
-    silence runs out at another point of a cycle); a status request and the branch switched on again. Returns the
-    script (DI3 in) and the cycle DI3 falls silent."""
+    DI3 silent at the idle level for ``limit_frames`` data cycles (each ``extra`` bytes longer than the BK's, after
+    ``shift`` bit periods of idle line: the silence runs out at another point of a cycle); a status request and the
+    branch switched on again. Returns the script (DI3 in) and the cycle DI3 falls silent."""
     config = decode(BK_STRAPS["BK-LB"], rf="10", clk_conf="11")
     script = CoreScript(config, np.random.default_rng(seed))
     script.pins["mfp_in"] = LBST
     script.bring_up().id_cycle(wire.command_word(branch=BranchControl.ON_EXTENDED), mfp_in=LBST)
     script.data_cycle(mfp_in=LBST).data_cycle(mfp_in=LBST).data_cycle(mfp_in=LBST)
     silent = len(script.columns()["do1"])
+    if shift:
+        script.line(np.ones(shift, dtype=np.uint8))
     for _ in range(limit_frames):
         script.data_cycle(extra, mfp_in=LBST)
     script.id_cycle(wire.command_word(alarm_request=True), mfp_in=LBST).id_cycle(wire.command_word(), mfp_in=LBST)

@@ -9,13 +9,24 @@ function closing a branch silent for 10 ms.
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
+from supi3.interbus import wire
 from supi3.model.pins import Supi3Pins
+from supi3.pinout import SYNC_STAGES
 from supi3.terminal import BRANCH_SILENCE_CLOCKS
 from supi3.verif import Lockstep
 from support import CoreScript
-from test_model_pins_branch import CASES, COUNT_CASES, LD_PIN, count_scenario, scenario, silence_scenario
+from test_model_pins_branch import (
+    BRANCH_DELAY,
+    CASES,
+    COUNT_CASES,
+    LD_PIN,
+    count_scenario,
+    scenario,
+    silence_scenario,
+)
 from test_model_pins_recognition import FIXED, RANDOM_SEEDS, close_loop, history, random_history
 
 
@@ -55,6 +66,30 @@ def test_rtl_core_closes_a_silent_branch(bench: Lockstep, extra: int) -> None:
     bench.run_batch(script.stimulus())
     out = Supi3Pins(script.config).run(script.columns())
     assert (out["mfp_out"][silent + BRANCH_SILENCE_CLOCKS + 100 :] >> LD_PIN & 1).any()
+
+
+FIRST_TELEGRAM_SHIFT = 127
+"""Idle bit periods before the silent frames of :func:`silence_scenario` that make BK-3's 10 ms run out while the BK's
+transmitter repeats the first data telegram of a frame its frame engine does not hold yet (found with the model; the
+test checks it)."""
+
+
+@pytest.mark.slow
+def test_rtl_core_closure_waits_for_a_frame_whose_first_telegram_is_under_way(bench: Lockstep) -> None:
+    """BK-50 with its 10 ms (the core's limit, no second build): the silence runs out while the receiver is in the
+    first data telegram of a frame and the transmitter repeats it already (the receiver's ``repeating``), before the
+    frame engine takes the frame: the closure waits for the frame's end in the RTL core as in the model, every pin
+    every clock, so the frame is not cut at its head."""
+    script, silent = silence_scenario(BRANCH_SILENCE_CLOCKS // 2000 + 3, 8, shift=FIRST_TELEGRAM_SHIFT)
+    columns = script.columns()
+    model = Supi3Pins(script.config)
+    due = silent + BRANCH_DELAY + SYNC_STAGES - model.cpb // 2 + 1 + BRANCH_SILENCE_CLOCKS
+    model.run({name: trace[:due] for name, trace in columns.items()})
+    assert model._receiver.repeating_data and not model._frame.framing  # the case: the frame's first telegram
+    bench.run_batch(script.stimulus())
+    out = Supi3Pins(script.config).run(columns)
+    lit = np.flatnonzero(out["mfp_out"] >> LD_PIN & 1)
+    assert lit.size and lit[0] > due + wire.DATA_TELEGRAM_BITS * model.cpb  # closed after the frame, not at due
 
 
 @pytest.fixture(scope="session")
