@@ -516,6 +516,10 @@ while DO2 still passes a counter telegram from the cut LBD branch; the next fram
 
 @settings(max_examples=14, deadline=None, derandomize=True)  # about 0.5 s an example
 @given(st.sampled_from(CASES), st.sampled_from(SWEEP))
+@example((BranchKind.REMOTE, 1), 9_000)  # the other kinds at the limit's silence
+@example((BranchKind.LOCAL, 2), 9_000)
+@example((BranchKind.LBD_OR, 1), 8_750)  # the limit's neighbours
+@example((BranchKind.LBD_MR, 1), 9_250)
 def test_a_closure_is_seen_alike_over_the_silence_sweep(case: tuple[BranchKind, int], silence: int) -> None:
     """Issue 12, BK-3, BK-50: a sample of the sweep (kind x ``branch_silence`` 6,000..13,750 clocks in steps of 250,
     the branch switched on with the extended function and cut, 6 cycles): the BK closes between the same two cycles
