@@ -12,14 +12,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from supi3.interbus import wire
 from supi3.model.pins import Supi3Pins
-from supi3.pinout import SYNC_STAGES
 from supi3.terminal import BRANCH_SILENCE_CLOCKS
 from supi3.verif import Lockstep
 from support import CoreScript
 from test_model_pins_branch import (
-    BRANCH_DELAY,
     CASES,
     COUNT_CASES,
     LD_PIN,
@@ -55,41 +52,29 @@ def test_rtl_core_counts(bench: Lockstep, rf: str, seed: int) -> None:
     bench.run_batch(script.stimulus())
 
 
+SHIFT = 127
+"""Idle bit periods before the silent frames of :func:`silence_scenario` that move BK-3's 10 ms to another point of a
+cycle (before BK-50's rule, into the first data telegram of a frame)."""
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("extra", [0, 1])
-def test_rtl_core_closes_a_silent_branch(bench: Lockstep, extra: int) -> None:
+@pytest.mark.parametrize(("extra", "shift"), [(0, 0), (1, 0), (0, SHIFT)])
+def test_rtl_core_closes_a_silent_branch(bench: Lockstep, extra: int, shift: int) -> None:
     """BK-3 with its 10 ms (320,000 clocks): the extended function closes the silent branch in the RTL core at the
-    model's clock (LD, ATTN, the status byte's bit 6), and the master's command reopens it. With frames one byte
-    longer (``extra``) the silence runs out within a frame and the closure waits for its end (BK-50; measured with
-    the model: 331 clocks later than without the wait), in the RTL core too."""
-    script, silent = silence_scenario(BRANCH_SILENCE_CLOCKS // 2000 + 3, 8, extra)
+    model's clock (LD, ATTN, the status byte's bit 6), at the end of a frame (BK-50: the edge completes the frame
+    engine's check sequence), and the master's command reopens it. Frames one byte longer (``extra``) or the silent
+    frames ``shift`` idle bit periods later put the silence's end at other points of a cycle."""
+    script, silent = silence_scenario(BRANCH_SILENCE_CLOCKS // 2000 + 3, 8, extra, shift)
     bench.run_batch(script.stimulus())
-    out = Supi3Pins(script.config).run(script.columns())
-    assert (out["mfp_out"][silent + BRANCH_SILENCE_CLOCKS + 100 :] >> LD_PIN & 1).any()
-
-
-FIRST_TELEGRAM_SHIFT = 127
-"""Idle bit periods before the silent frames of :func:`silence_scenario` that make BK-3's 10 ms run out while the BK's
-transmitter repeats the first data telegram of a frame its frame engine does not hold yet (found with the model; the
-test checks it)."""
-
-
-@pytest.mark.slow
-def test_rtl_core_closure_waits_for_a_frame_whose_first_telegram_is_under_way(bench: Lockstep) -> None:
-    """BK-50 with its 10 ms (the core's limit, no second build): the silence runs out while the receiver is in the
-    first data telegram of a frame and the transmitter repeats it already (the receiver's ``repeating``), before the
-    frame engine takes the frame: the closure waits for the frame's end in the RTL core as in the model, every pin
-    every clock, so the frame is not cut at its head."""
-    script, silent = silence_scenario(BRANCH_SILENCE_CLOCKS // 2000 + 3, 8, shift=FIRST_TELEGRAM_SHIFT)
     columns = script.columns()
-    model = Supi3Pins(script.config)
-    due = silent + BRANCH_DELAY + SYNC_STAGES - model.cpb // 2 + 1 + BRANCH_SILENCE_CLOCKS
-    model.run({name: trace[:due] for name, trace in columns.items()})
-    assert model._receiver.repeating_data and not model._frame.framing  # the case: the frame's first telegram
-    bench.run_batch(script.stimulus())
     out = Supi3Pins(script.config).run(columns)
     lit = np.flatnonzero(out["mfp_out"] >> LD_PIN & 1)
-    assert lit.size and lit[0] > due + wire.DATA_TELEGRAM_BITS * model.cpb  # closed after the frame, not at due
+    assert lit.size and lit[0] > silent + BRANCH_SILENCE_CLOCKS
+    model = Supi3Pins(script.config)
+    model.run({name: trace[: lit[0] - 1] for name, trace in columns.items()})
+    checks = model._frame.checks
+    model.run({name: trace[lit[0] - 1 : lit[0]] for name, trace in columns.items()})
+    assert model._frame.checks == checks + 1  # the edge that closed the branch ended a frame's check sequence
 
 
 @pytest.fixture(scope="session")
