@@ -137,7 +137,8 @@ def test_a_chip_that_is_no_bk_refuses_branch_calls_by_name() -> None:
 @pytest.mark.parametrize(("args", "name"), [
     (("yes", None, 0.0, 1.0), "traffic"), ((True, 0, 0.0, 1.0), "count"), ((True, 64, 0.0, 1.0), "count"),
     ((True, 1.5, 0.0, 1.0), "count"), ((True, None, -1.0, 1.0), "start"), ((True, None, 1.0, 0.5), "end"),
-    ((True, None, 0.0, float("nan")), "end"),
+    ((True, None, 0.0, float("nan")), "end"), ((True, None, 0.5, 1.0, 0.25), "frame_end"),
+    ((True, None, 0.0, 1.0, 1.5), "frame_end"), ((True, None, 0.0, 1.0, "0.5"), "frame_end"),
 ])  # fmt: skip
 def test_branch_returned_refuses_wrong_types_and_ranges(args: tuple[object, ...], name: str) -> None:
     with pytest.raises(ChipArgumentError, match=rf"^{name} must be"):

@@ -23,6 +23,7 @@ from supi3.interbus.wire import BranchControl
 from supi3.model.blocks.terminal import TerminalBlock
 from supi3.model.bus_terminal import BRANCH_SILENCE_S, CONF_PIN, LBST_PIN, BusTerminal
 from supi3.rtl.terminal import TerminalRtl
+from supi3.tables import CLOCK_HZ
 from supi3.terminal import BLOCK_INPUTS, BRANCH_SILENCE_CLOCKS, RF_CODES, Terminal, TerminalMode
 from supi3.verif.amaranth_sim import run_amaranth_sim
 
@@ -289,3 +290,44 @@ def test_random_strobes(run: tuple[TerminalMode, int, list[tuple[Any, ...]]]) ->
     """Any mix of strobes, level changes, commands, idle stretches and INTERBUS resets, in every mode and RF code:
     the RTL equals the model on every output, every clock."""
     lockstep(random_script(run))
+
+
+STRETCH = st.tuples(st.integers(4, 40), st.one_of(st.none(), st.integers(1, 1000)), st.booleans(), st.booleans())
+"""A stretch of the master's traffic: its length in clocks, where its frame ends at the BK (a fraction of the length;
+``None``: no frame, the master idles), whether the master's telegrams came back (before and after the frame), and
+whether the master switches the branch on with the extended function at its end."""
+
+
+@settings(max_examples=60, derandomize=True)
+@given(st.integers(1, 60), st.lists(STRETCH, min_size=1, max_size=30))
+def test_the_transaction_level_closes_at_the_block_s_clock(limit: int,
+                                                           stretches: list[tuple[int, int | None, bool, bool]]) -> None:
+    """BK-50 at both fidelities, to the clock: over any history of stretches with or without a frame, with or without
+    the master's telegrams back, and commands switching the branch on again, the transaction-level BK (bus seconds,
+    the frames' ends given) and the block (a clock per row: ``frame_end`` at the frame's end, ``ret_valid`` before
+    and after it) close the branch after the same stretches and end every stretch in the same state."""
+    tl = BusTerminal("BK-LBD", "00", silence=limit)
+    block = TerminalBlock(limit)
+    script = TerminalScript(rf=0).command(ON_EXT)
+    tl.inputs(1 << LBST_PIN)
+    tl.command(ON_EXT, False)
+    for row in script.rows:
+        block.step(row)
+    for length, frame, traffic, command in stretches:
+        start = len(script.rows)
+        end = frame and 1 + frame * (length - 3) // 1000  # inside, apart from the telegrams back
+        rows = [dict.fromkeys(INPUTS, 0) | script.levels for _ in range(length)]
+        if end:
+            rows[end]["frame_end"] = 1
+        if traffic:
+            rows[0]["ret_valid"] = rows[-1]["ret_valid"] = 1
+        if command:
+            rows[-1] |= {"ret_valid": 0, "cmd_valid": 1, "branch": ON_EXT.value}
+        script.rows.extend(rows)
+        for row in rows:
+            block.step(row)
+        tl.returned(traffic, None, start / CLOCK_HZ, (start + length) / CLOCK_HZ,
+                    None if not end else (start + end) / CLOCK_HZ)  # fmt: skip
+        if command:
+            tl.command(ON_EXT, False)
+        assert block.state == tl.state
