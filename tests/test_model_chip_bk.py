@@ -85,12 +85,15 @@ def test_branch_control_switches_and_extended_function_closes_a_silent_branch() 
     chip.branch_returned(False, None, 0.0, 1.0)  # silent for 1 s, but the extended function is off
     assert chip.branch_enabled(True) and not chip.attention
     id_latch(chip, 1.001, branch=BranchControl.ON_EXTENDED)
-    chip.branch_returned(False, 3, 1.01, 1.01 + BRANCH_SILENCE_S / 2)
+    chip.branch_returned(False, 3, 1.01, 1.01 + BRANCH_SILENCE_S / 2, 1.011)  # the silence starts (BK-50)
     assert chip.branch_enabled(True)
-    chip.branch_returned(True, None, 1.02, 1.03)  # telegrams came back: the silence starts again
-    chip.branch_returned(False, 3, 1.03, 1.03 + BRANCH_SILENCE_S * 0.99)
+    chip.branch_returned(True, None, 1.02, 1.03, 1.021)  # telegrams came back: the silence starts again
+    chip.branch_returned(False, 3, 1.03, 1.03 + BRANCH_SILENCE_S * 0.99, 1.031)  # at this frame's end
     assert chip.branch_enabled(True)
-    chip.branch_returned(False, 3, 1.03 + BRANCH_SILENCE_S * 0.99, 1.03 + BRANCH_SILENCE_S)
+    chip.branch_returned(False, 3, 1.031 + BRANCH_SILENCE_S * 0.99, 1.031 + BRANCH_SILENCE_S * 1.2)  # no frame
+    assert chip.branch_enabled(True)
+    chip.branch_returned(False, 3, 1.031 + BRANCH_SILENCE_S * 1.2, 1.031 + BRANCH_SILENCE_S * 1.3,
+                         1.031 + BRANCH_SILENCE_S * 1.25)  # fmt: skip
     assert not chip.branch_enabled(True) and chip.attention
     assert chip.bus_terminal is not None
     assert wire.decode_bk_status(chip.bus_terminal.status()) == wire.BkStatus(False, True, 3)
@@ -104,7 +107,8 @@ def test_branch_control_switches_and_extended_function_closes_a_silent_branch() 
 def test_reset_reopens_the_branch_and_ends_the_extended_function_keeps_conf() -> None:
     chip = terminal("BK-RB")
     id_latch(chip, 0.001, branch=BranchControl.ON_EXTENDED)
-    chip.branch_returned(False, None, 0.0, 1.0)
+    chip.branch_returned(False, None, 0.0, 0.5, 0.1)  # the silence starts at this frame's end (BK-50)
+    chip.branch_returned(False, None, 0.5, 1.0, 0.6)  # and closes the branch at this one
     chip.set_mfp_inputs((1 << LBST_PIN) | (1 << CONF_PIN))
     assert not chip.branch_enabled(True)
     chip.reset(1.1)
@@ -133,7 +137,8 @@ def test_a_chip_that_is_no_bk_refuses_branch_calls_by_name() -> None:
 @pytest.mark.parametrize(("args", "name"), [
     (("yes", None, 0.0, 1.0), "traffic"), ((True, 0, 0.0, 1.0), "count"), ((True, 64, 0.0, 1.0), "count"),
     ((True, 1.5, 0.0, 1.0), "count"), ((True, None, -1.0, 1.0), "start"), ((True, None, 1.0, 0.5), "end"),
-    ((True, None, 0.0, float("nan")), "end"),
+    ((True, None, 0.0, float("nan")), "end"), ((True, None, 0.5, 1.0, 0.25), "frame_end"),
+    ((True, None, 0.0, 1.0, 1.5), "frame_end"), ((True, None, 0.0, 1.0, "0.5"), "frame_end"),
 ])  # fmt: skip
 def test_branch_returned_refuses_wrong_types_and_ranges(args: tuple[object, ...], name: str) -> None:
     with pytest.raises(ChipArgumentError, match=rf"^{name} must be"):
@@ -175,6 +180,7 @@ def test_ld_and_e_leds_follow_the_branch_state() -> None:
     assert leds(chip) == (False, True, 0b01) and chip.revision > revision
     chip.branch_returned(True, None, 0.003, 0.004)
     assert leds(chip) == (False, False, 0b00)
-    chip.branch_returned(False, None, 0.004, 0.004 + BRANCH_SILENCE_S)  # silent: the BK closes its branch
+    chip.branch_returned(False, None, 0.004, 0.005, 0.0045)
+    chip.branch_returned(False, None, 0.005, 0.005 + BRANCH_SILENCE_S, 0.0045 + BRANCH_SILENCE_S)  # silent: closed
     assert leds(chip) == (True, True, 0b11)
     assert Supi3(decode("10000")).diagnostic_outputs.ld is False  # no BK, no LD

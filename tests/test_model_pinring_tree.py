@@ -554,26 +554,63 @@ CLOSURES = st.lists(st.tuples(st.sampled_from(["off", "on", "ext", "reset", "cut
 @given(st.sampled_from(CASES), CLOSURES)
 @example((BranchKind.REMOTE, 1), [])
 @example((BranchKind.LOCAL, 2), [("wait", 3)])
-@example((BranchKind.LBD_MR, 1), [("reset", 3), ("ext", 3), ("cut", 3)])
+@example((BranchKind.LBD_MR, 1), [("wait", 3), ("reset", 3), ("ext", 3), ("cut", 3)])  # closed, then reset
 @example((BranchKind.LBD_OR, 1), [("off", 3)])
 def test_a_closure_is_seen_alike_cycle_by_cycle_at_both_fidelities(case: tuple[BranchKind, int],
                                                                    ops: list[tuple[str, int]]) -> None:  # fmt: skip
     """Issue 12, BK-3, BK-50: with the same short silence at both fidelities (``branch_silence`` in clocks), the
     branch switched on with the extended function and cut, then any history (``wait``: 3 more cycles), the BK closes
-    its silent branch between the same two cycles at both: the pin-level BK applies a closure only when no frame runs
-    through its frame engine (BK-50), so the master never gets a frame's tail there, and the transaction level counts
-    the silence from the last telegram back, as the pin level. Every cycle's kind, success and diagnostics, the
+    its silent branch between the same two cycles at both: the silence restarts at the first frame's end at the BK
+    after the return line was heard and closes the branch at the first frame's end by which it lasted the limit, at
+    both fidelities (BK-50), so the master never gets a frame's tail or a frame without its head, and the transaction
+    level places the frame's end at the BK to the clock. Every cycle's kind, success and diagnostics, the
     configuration, IN data and the BK's status byte are equal (:func:`per_cycle`), and the BK closed at both."""
     kind, m = case
     closes_alike(kind, m, [(op, min(k, 2 + m)) for op, k in ops], SILENCE)
 
 
 def test_a_closure_in_a_frame_s_first_telegram_waits_for_the_frame() -> None:
-    """BK-50: with ``branch_silence`` 10,250 clocks in a BK-LB tree the silence runs out while the BK's transmitter
-    repeats the first data telegram of a frame that its frame engine takes only once the telegram is complete: the
-    closure waits for the frame's end (the receiver's ``repeating``), so the master does not get the frame without
-    its head (a transmission error, where the transaction level reports a dead line)."""
+    """BK-50: with ``branch_silence`` 10,250 clocks in a BK-LB tree the silence ran out, under BK-50's first rule,
+    while the BK's transmitter repeated the first data telegram of a frame that its frame engine takes only once the
+    telegram is complete (the master got the frame without its head, a transmission error, where the transaction
+    level reports a dead line); the closure now comes at that frame's end or a later one, alike at both."""
     closes_alike(BranchKind.LOCAL, 2, [], 10_250)
+
+
+SWEEP = range(6_000, 14_000, 250)
+"""The ``branch_silence`` values of issue 12's closure sweep, in clocks: with the 4 kinds of :data:`CASES`, 128 runs of
+:func:`closes_alike` without further steps (about 0.5 s each: the whole sweep is too slow for the suite)."""
+
+
+@settings(max_examples=14, deadline=None, derandomize=True)  # about 0.5 s an example
+@given(st.sampled_from(CASES), st.sampled_from(SWEEP))
+@example((BranchKind.REMOTE, 1), 9_000)
+@example((BranchKind.LOCAL, 2), 9_000)
+@example((BranchKind.LBD_OR, 1), 8_750)
+@example((BranchKind.LBD_MR, 1), 9_250)
+def test_a_closure_is_seen_alike_over_the_silence_sweep(case: tuple[BranchKind, int], silence: int) -> None:
+    """Issue 12, BK-3, BK-50: a sample of the sweep (kind x ``branch_silence`` 6,000..13,750 clocks in steps of 250,
+    the branch switched on with the extended function and cut, 6 cycles): the BK closes between the same two cycles
+    at both fidelities, every cycle alike (:func:`closes_alike`)."""
+    kind, m = case
+    closes_alike(kind, m, [], silence)
+
+
+NEAR_BOUNDARY = ((BranchKind.LBD_MR, 9_000), (BranchKind.LBD_OR, 9_000), (BranchKind.LBD_MR, 8_975),
+                 (BranchKind.LBD_OR, 9_150), (BranchKind.REMOTE, 9_125), (BranchKind.REMOTE, 12_550))  # fmt: skip
+"""Silences that ran out just before the next frame with BK-50's earlier rule (a closure at the first edge without a
+frame): the windows of the 25-clock sweep, where the two fidelities differed."""
+
+
+@pytest.mark.parametrize(("kind", "silence"), NEAR_BOUNDARY)
+def test_a_closure_while_do2_passes_a_counter_telegram_is_alike(kind: BranchKind, silence: int) -> None:
+    """BK-50 (issue 12), measured clock by clock with the earlier rule at LBD-MR, 9,000 clocks: the closure came
+    125 clocks before the BK's transmitter began the next frame's first telegram, 35 clocks after DO2 began to repeat
+    a counter telegram of the cut branch (13 bit periods on DI3, BK-30); DO2 left DI3 only after it and the drain
+    (BK-47), and the next frame lost its head at pin level (a transmission error where the transaction level had the
+    loopback word out of place). The closure now comes at a frame's end at both fidelities, which leaves DO2 the
+    whole gap before the next frame (30 bit periods; at most 25 needed): every cycle alike."""
+    closes_alike(kind, 1, [], silence)
 
 
 def closes_alike(kind: BranchKind, m: int, ops: list[tuple[str, int]], silence: int) -> None:

@@ -159,17 +159,19 @@ SHORT_SILENCE = 3000
 """A silence limit in clocks for the model alone (BK-3's 10 ms is 320,000: the RTL lockstep runs that one)."""
 
 
-def silence_scenario(limit_frames: int, seed: int, extra: int = 0) -> tuple[CoreScript, int]:
+def silence_scenario(limit_frames: int, seed: int, extra: int = 0, shift: int = 0) -> tuple[CoreScript, int]:
     """BK-LB, RF = 10, LBST high: the extended function switched on; frames with DI3 repeating the forward line; then
-    DI3 silent at the idle level for ``limit_frames`` data cycles (each ``extra`` bytes longer than the BK's: the
-    silence runs out at another point of a cycle); a status request and the branch switched on again. Returns the
-    script (DI3 in) and the cycle DI3 falls silent."""
+    DI3 silent at the idle level for ``limit_frames`` data cycles (each ``extra`` bytes longer than the BK's, after
+    ``shift`` bit periods of idle line: the silence runs out at another point of a cycle); a status request and the
+    branch switched on again. Returns the script (DI3 in) and the cycle DI3 falls silent."""
     config = decode(BK_STRAPS["BK-LB"], rf="10", clk_conf="11")
     script = CoreScript(config, np.random.default_rng(seed))
     script.pins["mfp_in"] = LBST
     script.bring_up().id_cycle(wire.command_word(branch=BranchControl.ON_EXTENDED), mfp_in=LBST)
     script.data_cycle(mfp_in=LBST).data_cycle(mfp_in=LBST).data_cycle(mfp_in=LBST)
     silent = len(script.columns()["do1"])
+    if shift:
+        script.line(np.ones(shift, dtype=np.uint8))
     for _ in range(limit_frames):
         script.data_cycle(extra, mfp_in=LBST)
     script.id_cycle(wire.command_word(alarm_request=True), mfp_in=LBST).id_cycle(wire.command_word(), mfp_in=LBST)
@@ -183,20 +185,23 @@ def silence_scenario(limit_frames: int, seed: int, extra: int = 0) -> tuple[Core
     return script, silent
 
 
-def frames(pins: Supi3Pins, columns: Columns) -> npt.NDArray[np.bool_]:
-    """Whether a frame runs through the frame engine of ``pins`` in each cycle of ``columns``, stepped."""
+def frame_ends(pins: Supi3Pins, columns: Columns) -> npt.NDArray[np.int64]:
+    """The cycles of ``columns`` whose edge completes a frame's check sequence in the frame engine of ``pins``
+    (``frame_end`` of the BK, BK-50), stepped."""
     names = list(columns)
-    framing = []
+    checks = []
     for values in zip(*(columns[name].tolist() for name in names), strict=True):
-        framing.append(pins._frame.framing)
+        checks.append(pins._frame.checks)
         pins.step(dict(zip(names, values, strict=True)))
-    return np.array(framing)
+    checks.append(pins._frame.checks)
+    return np.flatnonzero(np.diff(checks))
 
 
 def test_the_extended_function_closes_a_silent_branch() -> None:
-    """BK-3, BK-20, BK-38 at pin level: while the master's telegrams come back the branch stays open; silent for the
-    limit, the BK closes it once the frame running then has ended (BK-50) (LD lit, DO2 the transmitter's again, the
-    report and ATTN waiting); the master's command switching it on reopens it; step() equals run()."""
+    """BK-3, BK-20, BK-38, BK-50 at pin level: while the master's telegrams come back the branch stays open; silent,
+    the silence restarts at the first frame's end after the last telegram back and the BK closes the branch at the
+    first frame's end by which it has lasted the limit (LD lit, DO2 the transmitter's again, the report and ATTN
+    waiting); the master's command switching it on reopens it; step() equals run()."""
     script, silent = silence_scenario(4, 7)
     columns = script.columns()
 
@@ -208,14 +213,14 @@ def test_the_extended_function_closes_a_silent_branch() -> None:
     ld = out["mfp_out"] >> LD_PIN & 1
     lit = np.flatnonzero(ld)
     # The last status telegram's stop bit is sampled mid-bit on the synchronised DI3, the watch strobes one clock
-    # later (BK-38) and restarts the timer; the silence runs out at the limit's edge, here within a frame: the BK
-    # closes the branch at the first edge without a frame through its frame engine (BK-50), LD shows from the next
-    # clock.
-    last_stop_sample = silent + BRANCH_DELAY + SYNC_STAGES - pins.cpb // 2
-    due = last_stop_sample + 1 + SHORT_SILENCE
-    framing = frames(make(), columns)
-    assert framing[due]  # the case BK-50 decides
-    assert lit.size and lit[0] == due + int(np.argmin(framing[due:])) + 1 > due + 1
+    # later (BK-38): the return line was heard; the next frame's end restarts the silence, the first frame's end
+    # SHORT_SILENCE clocks or more after that closes the branch, LD shows from the next clock.
+    heard = silent + BRANCH_DELAY + SYNC_STAGES - pins.cpb // 2 + 1
+    ends = frame_ends(make(), columns)
+    restart = ends[ends > heard][0]
+    closing = ends[ends >= restart + SHORT_SILENCE][0]
+    assert closing > restart + SHORT_SILENCE  # the silence ran out between two frames' ends: it waited
+    assert lit.size and lit[0] == closing + 1
     assert not ld[-1] and lit[-1] - lit[0] + 1 == len(lit)
     closed = out["do2"][lit[0] : lit[-1]]
     assert closed.any()  # the transmitter's again, not the silent DI3's idle level only
@@ -228,8 +233,9 @@ def test_the_extended_function_closes_a_silent_branch() -> None:
     tl = BusTerminal("BK-LB", "10")
     tl.inputs(LBST)
     tl.command(BranchControl.ON_EXTENDED, False)
-    tl.returned(True, None, 0.0, 0.001)
-    assert tl.returned(False, None, 0.001, 0.002 + BRANCH_SILENCE_S)
+    tl.returned(True, None, 0.0, 0.001, 0.0005)
+    tl.returned(False, None, 0.001, 0.002, 0.0015)
+    assert tl.returned(False, None, 0.002, 0.002 + BRANCH_SILENCE_S, 0.0015 + BRANCH_SILENCE_S)
     assert bulk.chip.bus_terminal.state == tl.state
 
 

@@ -9,13 +9,21 @@ function closing a branch silent for 10 ms.
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from supi3.model.pins import Supi3Pins
 from supi3.terminal import BRANCH_SILENCE_CLOCKS
 from supi3.verif import Lockstep
 from support import CoreScript
-from test_model_pins_branch import CASES, COUNT_CASES, LD_PIN, count_scenario, scenario, silence_scenario
+from test_model_pins_branch import (
+    CASES,
+    COUNT_CASES,
+    LD_PIN,
+    count_scenario,
+    scenario,
+    silence_scenario,
+)
 from test_model_pins_recognition import FIXED, RANDOM_SEEDS, close_loop, history, random_history
 
 
@@ -44,17 +52,29 @@ def test_rtl_core_counts(bench: Lockstep, rf: str, seed: int) -> None:
     bench.run_batch(script.stimulus())
 
 
+SHIFT = 127
+"""Idle bit periods before the silent frames of :func:`silence_scenario` that move BK-3's 10 ms to another point of a
+cycle (before BK-50's rule, into the first data telegram of a frame)."""
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("extra", [0, 1])
-def test_rtl_core_closes_a_silent_branch(bench: Lockstep, extra: int) -> None:
+@pytest.mark.parametrize(("extra", "shift"), [(0, 0), (1, 0), (0, SHIFT)])
+def test_rtl_core_closes_a_silent_branch(bench: Lockstep, extra: int, shift: int) -> None:
     """BK-3 with its 10 ms (320,000 clocks): the extended function closes the silent branch in the RTL core at the
-    model's clock (LD, ATTN, the status byte's bit 6), and the master's command reopens it. With frames one byte
-    longer (``extra``) the silence runs out within a frame and the closure waits for its end (BK-50; measured with
-    the model: 331 clocks later than without the wait), in the RTL core too."""
-    script, silent = silence_scenario(BRANCH_SILENCE_CLOCKS // 2000 + 3, 8, extra)
+    model's clock (LD, ATTN, the status byte's bit 6), at the end of a frame (BK-50: the edge completes the frame
+    engine's check sequence), and the master's command reopens it. Frames one byte longer (``extra``) or the silent
+    frames ``shift`` idle bit periods later put the silence's end at other points of a cycle."""
+    script, silent = silence_scenario(BRANCH_SILENCE_CLOCKS // 2000 + 3, 8, extra, shift)
     bench.run_batch(script.stimulus())
-    out = Supi3Pins(script.config).run(script.columns())
-    assert (out["mfp_out"][silent + BRANCH_SILENCE_CLOCKS + 100 :] >> LD_PIN & 1).any()
+    columns = script.columns()
+    out = Supi3Pins(script.config).run(columns)
+    lit = np.flatnonzero(out["mfp_out"] >> LD_PIN & 1)
+    assert lit.size and lit[0] > silent + BRANCH_SILENCE_CLOCKS
+    model = Supi3Pins(script.config)
+    model.run({name: trace[: lit[0] - 1] for name, trace in columns.items()})
+    checks = model._frame.checks
+    model.run({name: trace[lit[0] - 1 : lit[0]] for name, trace in columns.items()})
+    assert model._frame.checks == checks + 1  # the edge that closed the branch ended a frame's check sequence
 
 
 @pytest.fixture(scope="session")

@@ -178,28 +178,34 @@ def test_the_transaction_level_follows_the_spec() -> None:
     assert tl.state == Terminal()
     tl.command(BranchControl.ON_EXTENDED, False, True)
     assert tl.state == command(Terminal(), BranchControl.ON_EXTENDED, False, True)
-    assert tl.returned(False, 5, 0.0, BRANCH_SILENCE_S)
+    assert not tl.returned(False, 5, 0.0, 0.001, 0.0005)  # the silence starts at this frame's end (BK-50)
+    assert tl.returned(False, 5, 0.001, 0.001 + BRANCH_SILENCE_S, 0.0005 + BRANCH_SILENCE_S)
     assert tl.state == silence(received(command(Terminal(), BranchControl.ON_EXTENDED, False, True), 5))
     tl.reset()
     assert tl.state == Terminal() and tl.closures == 1
 
 
 
-def test_the_transaction_level_counts_the_silence_from_the_last_telegram_back() -> None:
-    """BK-3 at transaction level, as the pin level's timer (BK-20): the silence counts from the end of the last
-    stretch with the master's telegrams back, also over time no stretch was reported (the BK not reached), and not
-    from the first silent stretch; ``silence`` (in clocks, 100 µs here) shortens it; a command switching the branch
-    on restarts it from the next stretch."""
+def test_the_transaction_level_judges_the_silence_at_the_ends_of_frames() -> None:
+    """BK-3, BK-50 at transaction level, as the pin level's timer (``silence_edge``): the silence restarts at the
+    first frame's end after the master's telegrams came back (a stretch with traffic, a command switching the branch
+    on), counts also over time no stretch was reported (the BK not reached) and closes the branch at the first
+    frame's end by which it has lasted the limit, to the clock; a stretch without a frame (an idle master) closes
+    nothing; ``silence`` (in clocks, 100 µs here) shortens it."""
     limit = CLOCK_HZ // 10_000
     tl = BusTerminal("BK-LBD", "00", silence=limit)
     assert tl.silence_s == limit / CLOCK_HZ == 1e-4
     tl.command(BranchControl.ON_EXTENDED, False)
-    assert not tl.returned(True, None, 0.0, 0.001)
-    assert not tl.returned(False, None, 0.00105, 0.00109)  # 90 µs after the last telegram back
-    assert tl.returned(False, None, 0.00109, 0.00111) and tl.closed  # 110 µs; the silent stretches span 60 µs
+    assert not tl.returned(True, None, 0.0, 0.001, 0.0005)
+    assert not tl.returned(False, None, 0.001, 0.00151, 0.0015)  # the silence starts at this frame's end
+    assert not tl.returned(False, None, 0.00151, 0.00155)  # no frame: an idle master closes nothing
+    assert not tl.returned(False, None, 0.00155, 0.0016, 0.0015 + (limit - 1) / CLOCK_HZ)  # a clock short
+    assert tl.returned(False, None, 0.0016, 0.0017, 0.0015 + limit / CLOCK_HZ) and tl.closed
     tl.command(BranchControl.ON_EXTENDED, False)
-    assert not tl.returned(False, None, 0.002, 0.00209) and not tl.closed
-    assert tl.returned(False, None, 0.00209, 0.00211) and tl.closures == 2
+    assert not tl.returned(False, None, 0.0017, 0.0018, 0.00175) and not tl.closed  # restarts here
+    assert not tl.returned(True, None, 0.0018, 0.0019, 0.00185)  # heard: restarts at the next frame's end
+    assert not tl.returned(False, None, 0.0019, 0.0020, 0.00195)
+    assert tl.returned(False, None, 0.0020, 0.0021, 0.00195 + limit / CLOCK_HZ) and tl.closures == 2
 
 
 HOSTILE = [
@@ -225,6 +231,7 @@ HOSTILE = [
     (lambda: Terminal(closed=bad(1)), "closed"),
     (lambda: BusTerminal("BK-LB", bad("12")), "rf"),
     (lambda: BusTerminal("BK-LB", None).returned(False, 64, 0.0, 1.0), "count"),
+    (lambda: BusTerminal("BK-LB", None).returned(False, None, 0.0, 1.0, 1.5), "frame_end"),
     (lambda: setattr(BusTerminal("BK-LB", None), "conf_request", bad(1)), "conf_request"),
     (lambda: TerminalBlock(0), "time_limit"),
     (lambda: TerminalBlock(BRANCH_SILENCE_CLOCKS + 1), "time_limit"),

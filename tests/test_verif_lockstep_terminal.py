@@ -23,6 +23,7 @@ from supi3.interbus.wire import BranchControl
 from supi3.model.blocks.terminal import TerminalBlock
 from supi3.model.bus_terminal import BRANCH_SILENCE_S, CONF_PIN, LBST_PIN, BusTerminal
 from supi3.rtl.terminal import TerminalRtl
+from supi3.tables import CLOCK_HZ
 from supi3.terminal import BLOCK_INPUTS, BRANCH_SILENCE_CLOCKS, RF_CODES, Terminal, TerminalMode
 from supi3.verif.amaranth_sim import run_amaranth_sim
 
@@ -34,7 +35,7 @@ OFF, ON, ON_EXT = BranchControl.OFF, BranchControl.ON, BranchControl.ON_EXTENDED
 
 class TerminalScript:
     """Per-cycle inputs of the bus terminal block (``BLOCK_INPUTS``), built call by call: levels (``mode``, ``rf``,
-    ``conf``, ``lbst``, ``connected``, ``framing``) on every row until changed, strobes one cycle wide. It starts with
+    ``conf``, ``lbst``, ``connected``) on every row until changed, strobes one cycle wide. It starts with
     the power-up cycle (the block takes the CONF level at its edge, BK-20)."""
 
     def __init__(self, mode: int = TerminalMode.LBD, *, rf: int = 3, lbst: int = 1, connected: int = 1,
@@ -68,6 +69,10 @@ class TerminalScript:
 
     def counter(self, count: int) -> TerminalScript:
         return self.idle(cnt_valid=1, count=count)
+
+    def frame(self, **pins: int) -> TerminalScript:
+        """A cycle whose edge ends a frame's check sequence (``frame_end``, BK-50), with ``pins``."""
+        return self.idle(frame_end=1, **pins)
 
 
 def lockstep(script: TerminalScript, limit: int = LIMIT) -> tuple[TerminalBlock, list[dict[str, int]]]:
@@ -109,12 +114,15 @@ def test_every_branch_control_in_every_rf_mode(rf: int) -> None:
 
 
 def test_extended_closure_after_the_silence() -> None:
-    """BK-3: switched on with the extended function, the branch silent for the limit is closed by the BK: closed
-    report, ATTN, LD and E; the acknowledgement ends the report, not the closure; switching it on opens it."""
-    script = TerminalScript().command(ON_EXT).idle(LIMIT + 2)
+    """BK-3, BK-50: switched on with the extended function, the branch silent from a frame's end to one the limit
+    later is closed by the BK at that frame's end: closed report, ATTN, LD and E; the acknowledgement ends the report,
+    not the closure; switching it on opens it."""
+    block, out = lockstep(TerminalScript().command(ON_EXT).frame().idle(LIMIT - 2).frame().idle(2))
+    assert not block.state.closed and not any(row["closed"] for row in out)  # a clock short
+    script = TerminalScript().command(ON_EXT).frame().idle(LIMIT - 1).frame().idle()
     block, out = lockstep(script)
     assert block.state == Terminal(extended=True, closed=True, closed_report=True)
-    assert [row["closed"] for row in out].index(1) == 2 + LIMIT  # power-up, command, LIMIT silent clocks
+    assert [row["closed"] for row in out].index(1) == 3 + LIMIT  # power-up, command, frame, LIMIT clocks
     assert out[-1] | {"status": 0} == {"enabled": 0, "live": 0, "status": 0, "attention": 1, "ld": 1, "e": 1,
                                        "alarm": 0, "closed": 1}  # fmt: skip
     assert wire.decode_bk_status(out[-1]["status"]) == wire.BkStatus(False, True, 0)
@@ -124,39 +132,42 @@ def test_extended_closure_after_the_silence() -> None:
     assert block.state == Terminal() and out[-1]["enabled"]
 
 
-def test_a_closure_waits_for_the_end_of_a_frame() -> None:
-    """BK-50: a silence running out while a frame runs through the chip's frame engine (``framing``) closes the branch
-    at the first edge without a frame, however long the frame; the timer holds meanwhile (no second silence), and
-    the master's telegram back in it restarts the silence instead."""
-    for frame in (1, 2, LIMIT + 3):
-        script = TerminalScript().command(ON_EXT).idle(LIMIT - 1).set(framing=1).idle(frame).set(framing=0).idle(2)
+def test_a_closure_comes_only_at_the_end_of_a_frame() -> None:
+    """BK-50: the silence restarts at the first frame's end after the return line was heard and closes the branch
+    only at a frame's end (``frame_end``), the first by which it has lasted the limit, however long after; without
+    frames (a master that idles) nothing closes, the timer holds; the master's telegram back before that frame's
+    end, or in its clock, restarts the silence at the next one instead."""
+    for wait in (0, 1, 3 * LIMIT):
+        script = TerminalScript().command(ON_EXT).frame().idle(LIMIT - 1 + wait).frame().idle(2)
         block, out = lockstep(script)
         assert block.state.closed and block.state.closed_report
-        assert [row["closed"] for row in out].index(1) == 2 + LIMIT + frame + 1  # the frame's frame + 1 clocks
-    script = TerminalScript().command(ON_EXT).idle(LIMIT - 1).set(framing=1).idle(3).idle(ret_valid=1)
-    block, out = lockstep(script.set(framing=0).idle(LIMIT - 2))
-    assert not block.state.closed and not any(row["closed"] for row in out)
-    block, out = lockstep(script.set(framing=0).idle(LIMIT))
-    assert block.state.closed
+        assert [row["closed"] for row in out].index(1) == 3 + LIMIT + wait
+    for heard in ({"ret_valid": 1}, {"frame_end": 1, "ret_valid": 1}):  # before the frame's end, in its clock
+        script = TerminalScript().command(ON_EXT).frame().idle(LIMIT + 3).idle(**heard)
+        block, out = lockstep(script.frame().idle(LIMIT - 2).frame().idle(2))  # restarted at the first of these
+        assert not block.state.closed and not any(row["closed"] for row in out)
+        block, out = lockstep(script.frame().idle())
+        assert block.state.closed
 
 
 def test_traffic_restarts_the_silence_and_counter_telegrams_do_not() -> None:
     """BK-3: the master's telegrams back restart the silence; counter telegrams (BK-6) do not; nor does a branch
     switched off or absent count as watched (BK-20)."""
-    script = TerminalScript().command(ON_EXT)
+    script = TerminalScript().command(ON_EXT).frame()
     for _ in range(4):
-        script.idle(LIMIT - 2).back()
+        script.idle(LIMIT - 2).back().frame()
     block, _ = lockstep(script)
     assert not block.state.closed
     script.command(OFF).idle(3 * LIMIT).command(ON_EXT).set(lbst=0).idle(3 * LIMIT).set(lbst=1)
     block, _ = lockstep(script)
     assert not block.state.closed and block.state.extended
-    block, _ = lockstep(script.back().idle(LIMIT - 1).command(OFF))  # off at the edge the silence runs out
+    script.back().frame().idle(LIMIT - 1).frame(cmd_valid=1, branch=OFF.value)  # off at the closure's edge
+    block, _ = lockstep(script)
     assert block.state == Terminal(switched_on=False, extended=True)
-    script.command(ON_EXT)
+    script.command(ON_EXT).frame()
     for count in (3, 4, 5):
         script.idle(3).counter(count)
-    block, out = lockstep(script.idle(LIMIT))
+    block, out = lockstep(script.idle(LIMIT).frame().idle())
     assert block.state.closed and block.state.count == 5
     assert wire.decode_bk_status(out[-1]["status"]) == wire.BkStatus(False, True, 5)
 
@@ -178,17 +189,17 @@ def test_counts_and_the_e_led() -> None:
 def test_resets_in_the_middle_and_the_alarm_output() -> None:
     """BK-9, BK-12: a reset reopens a closed branch, switches the extended function and the ALARM output off and
     keeps a waiting request; strobes inside the reset are ignored; the silence starts anew."""
-    script = TerminalScript().command(alarm=True).set(conf=1).command(ON_EXT).idle(LIMIT + 1)
+    script = TerminalScript().command(alarm=True).set(conf=1).command(ON_EXT).frame().idle(LIMIT).frame().idle()
     block, out = lockstep(script)
     assert block.state.closed and block.state.alarm and out[-1]["alarm"] and block.state.conf_request
     script.idle(ib_reset=1, cmd_valid=1, branch=OFF.value, alarm_set=1, alarm_on=1).idle(ib_reset=1, cnt_valid=1,
                                                                                       count=9)  # fmt: skip
     block, out = lockstep(script.idle())
     assert block.state == Terminal(conf=True, conf_request=True) and out[-1]["enabled"] and not out[-1]["alarm"]
-    script.command(ON_EXT).idle(LIMIT - 3).reset(2).command(ON_EXT).idle(LIMIT - 1)
-    block, _ = lockstep(script)
+    script.command(ON_EXT).frame().idle(LIMIT - 3).reset(2).command(ON_EXT).frame(cmd_valid=1).idle(LIMIT - 2)
+    block, _ = lockstep(script.frame().idle())  # the reset restarted the silence at the frame after it
     assert not block.state.closed
-    block, _ = lockstep(script.command(alarm=False).idle(2))
+    block, _ = lockstep(script.command(alarm=False).frame().idle(2))
     assert block.state.closed and not block.state.alarm
 
 
@@ -201,11 +212,11 @@ def test_a_chip_that_is_no_bus_terminal_module() -> None:
 
 @pytest.mark.parametrize("limit", [1, 2, 300])
 def test_silence_limits(limit: int) -> None:
-    """BK-3: the branch closes ``limit`` edges after the last restart; the RTL's and the model's default is the
-    spec's 10 ms."""
-    script = TerminalScript().command(ON_EXT).idle(limit + 1)
+    """BK-3, BK-50: the branch closes at a frame's end ``limit`` edges after the one that restarted the silence; the
+    RTL's and the model's default is the spec's 10 ms."""
+    script = TerminalScript().command(ON_EXT).frame().idle(limit - 1).frame().idle()
     _, out = lockstep(script, limit)
-    assert [row["closed"] for row in out].index(1) == 2 + limit
+    assert [row["closed"] for row in out].index(1) == 3 + limit
     default = inspect.signature(TerminalRtl).parameters["time_limit"].default
     assert default == TerminalBlock().time_limit == BRANCH_SILENCE_CLOCKS
 
@@ -221,7 +232,9 @@ def test_transaction_level_reaches_the_same_state() -> None:
         (lambda: tl.inputs(1 << LBST_PIN | 1 << CONF_PIN), lambda: script.set(conf=1)),
         (lambda: tl.command(ON_EXT, False, True), lambda: script.command(ON_EXT, alarm=True)),
         (lambda: tl.returned(True, None, 0.0, 0.001), lambda: script.back()),
-        (lambda: tl.returned(False, 4, 0.002, 0.002 + 2 * BRANCH_SILENCE_S), lambda: script.counter(4).idle(LIMIT)),
+        (lambda: tl.returned(False, 4, 0.002, 0.003, 0.0025), lambda: script.counter(4).frame()),
+        (lambda: tl.returned(False, 4, 0.003, 0.003 + BRANCH_SILENCE_S, 0.0025 + BRANCH_SILENCE_S),
+         lambda: script.idle(LIMIT - 1).frame()),
         (lambda: tl.command(BranchControl.NONE, True), lambda: script.command(ack=True)),
         (lambda: tl.reset(), lambda: script.reset()),
         (lambda: tl.command(OFF, False), lambda: script.command(OFF)),
@@ -243,11 +256,11 @@ STROBE = st.fixed_dictionaries({
     "cmd_valid": st.integers(0, 1), "branch": st.integers(0, 3), "ack": st.integers(0, 1),
     "alarm_set": st.integers(0, 1), "alarm_on": st.integers(0, 1), "ret_valid": st.sampled_from([0, 0, 0, 1]),
     "cnt_valid": st.integers(0, 1), "count": st.integers(0, wire.COUNTER_MAX),
-    "ib_reset": st.sampled_from([0] * 7 + [1]),
+    "ib_reset": st.sampled_from([0] * 7 + [1]), "frame_end": st.sampled_from([0, 0, 1]),
 })  # fmt: skip
 EVENT = st.one_of(
     st.tuples(st.just("strobe"), STROBE),
-    st.tuples(st.just("levels"), st.integers(0, 1), st.integers(0, 1), st.integers(0, 1), st.integers(0, 1)),
+    st.tuples(st.just("levels"), st.integers(0, 1), st.integers(0, 1), st.integers(0, 1)),
     st.tuples(st.just("command"), st.sampled_from(list(BranchControl))),
     st.tuples(st.just("idle"), st.sampled_from([1, 2, LIMIT - 2, LIMIT - 1, LIMIT, 3 * LIMIT])),
 )
@@ -262,8 +275,8 @@ def random_script(run: tuple[TerminalMode, int, list[tuple[Any, ...]]]) -> Termi
         if name == "strobe":
             script.idle(**args[0])
         elif name == "levels":
-            conf, lbst, connected, framing = args
-            script.set(conf=conf, lbst=lbst, connected=connected, framing=framing)
+            conf, lbst, connected = args
+            script.set(conf=conf, lbst=lbst, connected=connected)
         elif name == "command":
             script.command(args[0])
         else:
@@ -277,3 +290,44 @@ def test_random_strobes(run: tuple[TerminalMode, int, list[tuple[Any, ...]]]) ->
     """Any mix of strobes, level changes, commands, idle stretches and INTERBUS resets, in every mode and RF code:
     the RTL equals the model on every output, every clock."""
     lockstep(random_script(run))
+
+
+STRETCH = st.tuples(st.integers(4, 40), st.one_of(st.none(), st.integers(1, 1000)), st.booleans(), st.booleans())
+"""A stretch of the master's traffic: its length in clocks, where its frame ends at the BK (a fraction of the length;
+``None``: no frame, the master idles), whether the master's telegrams came back (before and after the frame), and
+whether the master switches the branch on with the extended function at its end."""
+
+
+@settings(max_examples=60, derandomize=True)
+@given(st.integers(1, 60), st.lists(STRETCH, min_size=1, max_size=30))
+def test_the_transaction_level_closes_at_the_block_s_clock(limit: int,
+                                                           stretches: list[tuple[int, int | None, bool, bool]]) -> None:
+    """BK-50 at both fidelities, to the clock: over any history of stretches with or without a frame, with or without
+    the master's telegrams back, and commands switching the branch on again, the transaction-level BK (bus seconds,
+    the frames' ends given) and the block (a clock per row: ``frame_end`` at the frame's end, ``ret_valid`` before
+    and after it) close the branch after the same stretches and end every stretch in the same state."""
+    tl = BusTerminal("BK-LBD", "00", silence=limit)
+    block = TerminalBlock(limit)
+    script = TerminalScript(rf=0).command(ON_EXT)
+    tl.inputs(1 << LBST_PIN)
+    tl.command(ON_EXT, False)
+    for row in script.rows:
+        block.step(row)
+    for length, frame, traffic, command in stretches:
+        start = len(script.rows)
+        end = frame and 1 + frame * (length - 3) // 1000  # inside, apart from the telegrams back
+        rows = [dict.fromkeys(INPUTS, 0) | script.levels for _ in range(length)]
+        if end:
+            rows[end]["frame_end"] = 1
+        if traffic:
+            rows[0]["ret_valid"] = rows[-1]["ret_valid"] = 1
+        if command:
+            rows[-1] |= {"ret_valid": 0, "cmd_valid": 1, "branch": ON_EXT.value}
+        script.rows.extend(rows)
+        for row in rows:
+            block.step(row)
+        tl.returned(traffic, None, start / CLOCK_HZ, (start + length) / CLOCK_HZ,
+                    None if not end else (start + end) / CLOCK_HZ)  # fmt: skip
+        if command:
+            tl.command(ON_EXT, False)
+        assert block.state == tl.state

@@ -306,7 +306,7 @@ def live(state: Terminal, rf: str | None, lbst: bool) -> bool:
 BLOCK_INPUTS: Final[tuple[Pin, ...]] = (
     Pin("ib_reset"), Pin("mode", 2), Pin("rf", 2), Pin("conf"), Pin("lbst"), Pin("connected"), Pin("cmd_valid"),
     Pin("branch", 2), Pin("ack"), Pin("alarm_set"), Pin("alarm_on"), Pin("ret_valid"), Pin("cnt_valid"),
-    Pin("count", 6), Pin("framing"),
+    Pin("count", 6), Pin("frame_end"),
 )  # fmt: skip
 """The bus terminal block's inputs:
 
@@ -317,8 +317,8 @@ MFP12 and MFP11 after the input synchroniser; ``connected`` a device answers on 
 are ``branch`` (a :class:`~supi3.interbus.wire.BranchControl`, bits 7..6), ``ack`` (the quit bit, 0714h), ``alarm_set``
 and ``alarm_on`` (bits 9 and 10 without a processor command, BK-12); ``ret_valid`` one of the master's telegrams (frame
 or status telegram) came back on the branch return line; ``cnt_valid``/``count`` a counter telegram came back there with
-that count (BK-6); ``framing`` a frame runs through the chip's frame engine (its data or check telegrams: a silence
-running out waits for its end, BK-50). Strobes are one clock wide."""
+that count (BK-6); ``frame_end`` the chip's frame engine completes a frame's check sequence at this edge (the only edges
+at which the silence can close the branch, BK-50). Strobes are one clock wide."""
 
 BLOCK_OUTPUTS: Final[tuple[Pin, ...]] = (
     Pin("enabled"), Pin("live"), Pin("status", 8), Pin("attention"), Pin("ld"), Pin("e"), Pin("alarm"), Pin("closed"),

@@ -237,9 +237,11 @@ class Terminal(Device, Protocol):
         """A device answered on the branch (BK-48): recognised until the BK's power-up reset."""
         ...
 
-    def branch_returned(self, traffic: bool, count: int | None, start: float, end: float) -> None:
+    def branch_returned(self, traffic: bool, count: int | None, start: float, end: float,
+                        frame_end: float | None = None) -> None:
         """The ring drove the whole branch from ``start`` to ``end``: the master's telegrams came back on the return
-        line (``traffic``), and the count of the counter telegram received there (``None``: none)."""
+        line (``traffic``), and the count of the counter telegram received there (``None``: none); ``frame_end``:
+        when the cycle's frame ended at the BK (``None``: no frame, an idle stretch or a reset, BK-50)."""
         ...
 
 
@@ -1163,6 +1165,12 @@ class Ring:
         end = start + bits / self.bit_rate
         cycle = transfer.cycle
         kernels = cycle is Cycle.DATA and type(end) is float and 0.0 <= end < math.inf
+        if transfer.branches:  # before the latch telegrams, as a BK's closure at its frame's end (BK-50)
+            frame = wire.frame_bits(len(transfer.sent))
+            for terminal, traffic, count in transfer.branches:
+                # The frame's end passes the BK REPEATER_DELAY_BITS later per device before it (A10)
+                passed = start + (frame + wire.REPEATER_DELAY_BITS * self._index[id(terminal)]) / self.bit_rate
+                terminal.branch_returned(traffic, count, start, end, passed)
         for run in transfer.runs:
             if latch and run.eligible:
                 if kernels and run.groups is not None:
@@ -1181,8 +1189,6 @@ class Ring:
             self._go_silent(range(transfer.reached, len(self.devices)), start, end)
         self.now = end
         if self._branches:
-            for terminal, traffic, count in transfer.branches:
-                terminal.branch_returned(traffic, count, start, end)
             self._silence_detached(start, end)
             self._recognise()
 

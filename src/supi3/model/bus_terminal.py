@@ -83,7 +83,8 @@ class BusTerminal:
         self.interface = check_choice("interface", interface, TERMINAL_INTERFACES)
         spec.rf_code(rf)
         self.rf = rf
-        self.silence_s = spec.silence_limit(silence, "silence") / CLOCK_HZ
+        self._limit = spec.silence_limit(silence, "silence")
+        self.silence_s = self._limit / CLOCK_HZ
         """The silence limit in bus seconds."""
         self.lbst = False
         self.state = Terminal()
@@ -166,28 +167,38 @@ class BusTerminal:
             self._silent_since = None
             self.switched_on_commands += 1
 
-    def returned(self, traffic: bool, count: int | None, start: float, end: float) -> bool:
+    def returned(self, traffic: bool, count: int | None, start: float, end: float,
+                 frame_end: float | None = None) -> bool:
         """The branch was driven from ``start`` to ``end``: whether the master's telegrams came back on its return
-        line (``traffic``) and the count of the counter telegram received there (``None``: none). ``True`` when the
-        extended function closes the branch now (BK-3).
+        line (``traffic``) and the count of the counter telegram received there (``None``: none); ``frame_end``: when
+        the stretch's frame ended at the BK (``start`` to ``end``; ``None``: no frame, an idle stretch or a reset).
+        ``True`` when the extended function closes the branch now (BK-3).
 
-        The silence counts from the master's last telegram back, the end of the last stretch with ``traffic`` (the
-        pin level's timer restarts at each telegram back, BK-20), also over time not reported here (the BK not
-        reached); from ``start`` after a power-up, an INTERBUS reset or a command switching the branch on."""
+        The silence is judged at the ends of frames, as the pin level's timer (BK-50): it restarts at the first
+        frame's end after the master's telegrams came back (a stretch with ``traffic``: back before and after its
+        frame), after a power-up, an INTERBUS reset, a command switching the branch on or a stretch not watched;
+        it closes the branch at the first frame's end by which it has lasted the limit (to the clock), counting
+        also time not reported here (the BK not reached). Without a frame nothing closes."""
         traffic = check_bool("traffic", traffic)
         start = check_real("start", start, 0.0)
         end = check_real("end", end, start)
+        if frame_end is not None:
+            frame_end = check_real("frame_end", frame_end, start, end)
         self.state = spec.received(self.state, 0 if count is None else count)
+        closes = False
+        if not spec.watching(self.state):
+            self._silent_since = None
+        elif frame_end is not None:
+            since = self._silent_since
+            if since is None or traffic:
+                self._silent_since = frame_end
+            elif round((frame_end - since) * CLOCK_HZ) >= self._limit:
+                self.state = spec.silence(self.state)
+                self.closures += 1
+                closes = True
         if traffic:
-            self._silent_since = end
-            return False
-        since = start if self._silent_since is None else self._silent_since
-        self._silent_since = since
-        if spec.watching(self.state) and end - since >= self.silence_s:
-            self.state = spec.silence(self.state)
-            self.closures += 1
-            return True
-        return False
+            self._silent_since = None
+        return closes
 
     def reset(self) -> None:
         """INTERBUS reset: the branch switched on again (also one the BK closed), the extended function off, the

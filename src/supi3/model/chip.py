@@ -767,15 +767,17 @@ class Supi3:
             terminal.recognised = True
             self.revision += 1
 
-    def branch_returned(self, traffic: bool, count: int | None, start: float, end: float) -> None:
+    def branch_returned(self, traffic: bool, count: int | None, start: float, end: float,
+                        frame_end: float | None = None) -> None:
         """The ring drove the branch from ``start`` to ``end`` (bus seconds): ``traffic`` says whether the master's
         telegrams came back on the return line, ``count`` is the counter telegram's count received there (``None``:
-        none). The extended function may close the branch; that asks for the master's attention (BK-3)."""
+        none), ``frame_end`` when the stretch's frame ended at the BK (``None``: no frame). The extended function may
+        close the branch at a frame's end; that asks for the master's attention (BK-3, BK-50)."""
         if count is not None:
             _checked(check_int, "count", count, 1, wire.COUNTER_MAX, "BK-6: a counter telegram counts 1..63")
         terminal = self._terminal()
         before = terminal.count
-        if _checked(terminal.returned, traffic, count, start, end):
+        if _checked(terminal.returned, traffic, count, start, end, frame_end):
             self.attention = True
             self.revision += 1
         elif terminal.count != before:  # the E LED follows the count (BK-11)

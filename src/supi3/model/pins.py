@@ -430,9 +430,7 @@ class Supi3Pins:
         terminal = chip.bus_terminal
         if terminal is not None:
             before, switched_on = terminal.state, terminal.switched_on_commands
-            # BK-50: a closure waits while a frame runs through the frame engine or the transmitter repeats a data
-            # telegram still being received (a frame's first one is the frame engine's only once complete)
-            framing = self._frame.framing or self._receiver.repeating_data
+            checks = self._frame.checks  # BK-50: the silence closes the branch only where a frame's check ends
         if chip.bus_terminal is None:
             chip.mfp_in = s.mfp_in
         elif c == self._run_from:  # a BK takes CONF as it is at the first running clock: no edge (BK-20)
@@ -467,7 +465,7 @@ class Supi3Pins:
             branch.quiet(c, terminal.state, self._recording)
             return
         state, closes = branch.edge(c, before, terminal.state, terminal.switched_on_commands != switched_on,
-                                    s.mfp_in, framing, self._recording)  # fmt: skip
+                                    s.mfp_in, self._frame.checks != checks, self._recording)  # fmt: skip
         if state is not terminal.state:
             terminal.state = state
             chip.revision += 1  # the E LED, LD and the status byte (BK-5, BK-11)

@@ -168,16 +168,15 @@ _POSITION: Final = range(wire.DATA_TELEGRAM_BITS + 1)
 LINE: Final = wiring.Signature({
     "level": Out(1), "sample": Out(1), "frame_bit": Out(1), "telegram_end": Out(1), "position": Out(_POSITION),
     "data_now": Out(1), "in_reset": Out(1), "select": Out(1), "control": Out(1), "bus_reset": Out(1),
-    "idle_timeout": Out(1), "counted": Out(1), "repeating": Out(1), "counter": In(1),
+    "idle_timeout": Out(1), "counted": Out(1), "counter": In(1),
 })  # fmt: skip
 """Receiver -> frame engine, as the receiver sees it: the synchronised line ``level``; ``sample``, the mid-bit
 sample of a telegram bit; ``frame_bit``, a sample in a data telegram outside an INTERBUS reset; ``telegram_end``, the
 stop bit's sample; ``position``, the sampled bit's place in the telegram; ``data_now``, the telegram is a data
 telegram; ``in_reset``, an INTERBUS reset runs (this clock included); ``select`` and ``control``, the bits received;
 ``bus_reset``, an INTERBUS reset begins (A12); ``idle_timeout``, 20 ms without a telegram (A13); ``counted``, a
-counter telegram came since the last other telegram (DG-9); ``repeating``, a data telegram whose bit
-``REPEATER_DELAY_BITS`` is next or later (the transmitter repeats it already; a BK's closure waits, BK-50); back comes
-``counter``, the control bit sampled now is a counter telegram's (BK-36): the idle time-out runs on through it."""
+counter telegram came since the last other telegram (DG-9); back comes ``counter``, the control bit sampled now is a
+counter telegram's (BK-36): the idle time-out runs on through it."""
 
 REGISTER: Final = wiring.Signature({
     "load": Out(1), "load_id": Out(1), "shift": Out(1), "level": Out(1), "latch": Out(1), "clear": Out(1),
@@ -416,7 +415,7 @@ class Supi3Core(wiring.Component):
             terminal.ret_valid.eq(lines.returned & terminal.enabled),  # BK-44: only while in the data path
             terminal.cnt_valid.eq(lines.seen & terminal.enabled),
             terminal.count.eq(lines.count),
-            terminal.framing.eq(frame.framing | receiver.line.repeating),  # BK-50
+            terminal.frame_end.eq(frame.checked),  # BK-50: the silence is judged at a frame's end
             outputs.ld.eq(terminal.ld),
             outputs.e.eq(terminal.e),
             outputs.alarm.eq(terminal.alarm),
@@ -694,7 +693,6 @@ class ReceiverRtl(wiring.Component):
             out.bus_reset.eq(enter_reset),
             out.idle_timeout.eq(idle_timeout),
             out.counted.eq(counted),
-            out.repeating.eq(busy & is_data & (bit >= wire.REPEATER_DELAY_BITS)),
         ]
         return m
 
@@ -716,7 +714,7 @@ class FrameEngineRtl(wiring.Component):
         super().__init__({
             "line": In(LINE), "register": Out(REGISTER), "management": Out(MANAGEMENT), "tx": Out(TRANSMIT),
             "events": Out(EVENT_BITS), "io": Out(1), "io_set": Out(1), "io_clear": Out(1), "discard": Out(1),
-            "hold": In(1), "ended": Out(1), "lbd": In(1), "framing": Out(1),
+            "hold": In(1), "ended": Out(1), "lbd": In(1), "checked": Out(1),
         })  # fmt: skip
 
     def elaborate(self, _platform: object) -> Module:
@@ -903,7 +901,7 @@ class FrameEngineRtl(wiring.Component):
             in_data.eq(fsm.ongoing("DATA")),
             in_check.eq(fsm.ongoing("CHECK")),
             in_wait.eq(fsm.ongoing("WAIT")),
-            self.framing.eq(in_data | in_check),  # a frame's data or check telegrams (BK-50)
+            self.checked.eq(check_done),  # a frame's check sequence completes at this edge (BK-50)
         ]
         return m
 

@@ -62,6 +62,9 @@ class FrameEngine:
     state:
         ``"idle"`` (no frame), ``"data"`` (data telegrams), ``"check"`` (check telegrams) or ``"wait"`` (check
         sequence complete, waiting for the latch telegrams).
+    checks:
+        Frames whose check sequence this engine completed (``"check"`` to ``"wait"``, the RTL's ``checked`` strobe):
+        a BK closes its silent branch only at such an edge (BK-50).
     in_reset:
         An INTERBUS reset is in progress (until :data:`~supi3.interbus.wire.RESET_END_STATUS_TELEGRAMS` status
         telegrams): data telegrams are repeated as received.
@@ -70,16 +73,9 @@ class FrameEngine:
     """
 
     __slots__ = (
-        "attn", "check_index", "check_rx", "chip", "counter_telegrams", "crc_rx", "crc_tx", "cycle", "datapath",
-        "err_in", "in_reset",
-        "latches", "local_error", "log", "reset_end_count", "state", "transmitter",
+        "attn", "check_index", "check_rx", "checks", "chip", "counter_telegrams", "crc_rx", "crc_tx", "cycle",
+        "datapath", "err_in", "in_reset", "latches", "local_error", "log", "reset_end_count", "state", "transmitter",
     )  # fmt: skip
-
-    @property
-    def framing(self) -> bool:
-        """A frame runs: its data or check telegrams (the RTL's ``framing``; a BK's closure waits for its end,
-        BK-50)."""
-        return self.state in ("data", "check")
 
     def __init__(self, chip: Supi3, log: EventLog, datapath: DataPath, transmitter: Transmitter) -> None:
         self.chip = chip
@@ -92,6 +88,7 @@ class FrameEngine:
     def power_up(self) -> None:
         """Power-up reset: no frame, no INTERBUS reset in progress."""
         self.state = "idle"  # idle | data | check | wait
+        self.checks = 0
         self.cycle = Cycle.DATA
         """The current frame's cycle type (its select bit)."""
         self.crc_rx = wire.CRC_INIT
@@ -230,6 +227,7 @@ class FrameEngine:
         if last_check and length == wire.DATA_TELEGRAM_BITS and not self.in_reset:
             self._close_check(c)
             self.state = "wait"
+            self.checks += 1
         if stop != wire.STOP_LEVEL:
             return
         if self.in_reset:

@@ -241,12 +241,6 @@ class Receiver:
                 self._begin(c - self.half_bit)
             frame.telegram_end(level, c, word, length)
 
-    @property
-    def repeating_data(self) -> bool:
-        """In a data telegram that the transmitter repeats already (its bit ``REPEATER_DELAY_BITS`` is next or
-        later): the RTL's ``busy & is_data & (bit >= REPEATER_DELAY_BITS)`` (a BK's closure waits, BK-50)."""
-        return self.busy and self.length == wire.DATA_TELEGRAM_BITS and self.bit >= wire.REPEATER_DELAY_BITS
-
     def next_due(self, c: int, line: int, run_from: int) -> int:
         """The next cycle after ``c`` at which the logic acts with unchanged inputs (the line at ``line``, the logic
         running from ``run_from``): the receiver's next sample, reset detection or time-out, or the chip's."""

@@ -19,13 +19,14 @@ What happens at the clock edge ending a cycle, from that cycle's inputs (:mod:`s
    (``cnt_valid``: :func:`~supi3.terminal.received` ``count``), and the silence running out
    (:func:`~supi3.terminal.silence`).
 
-The silence timer counts edges while the branch is watched: the state before the edge has the extended function on
-and the branch in the data path (:func:`~supi3.terminal.enabled` with this cycle's ``rf``, ``lbst``,
-``connected``); anything else, a ``ret_valid``, or a command switching the branch on clears it. The edge at which it
-would reach ``time_limit`` (:data:`~supi3.terminal.BRANCH_SILENCE_CLOCKS`) applies the silence and clears it, but
-while ``framing`` (a frame runs through the chip's frame engine or its transmitter repeats a data telegram being
-received, BK-50) the timer holds there and the silence waits
-for the first edge without a frame.
+The silence is judged at the ends of frames (BK-50, :func:`silence_edge`): the branch is watched while the state
+before the edge has the extended function on and the branch in the data path (:func:`~supi3.terminal.enabled` with
+this cycle's ``rf``, ``lbst``, ``connected``). A ``ret_valid``, a command switching the branch on, or an edge not
+watched marks the return line heard; the next ``frame_end`` (the frame engine completes a check sequence) with the
+mark set restarts the silence timer there and clears the mark. The timer counts the edges since (holding at
+``time_limit - 1``); a ``frame_end`` without the mark at which the silence has lasted ``time_limit``
+(:data:`~supi3.terminal.BRANCH_SILENCE_CLOCKS`) edges applies the silence. Without frames (a master that idles)
+nothing closes.
 
 Outputs during a cycle come from the state and this cycle's ``rf``, ``lbst``, ``connected`` (``enabled``; ``live``
 without ``connected``); every one is 0 while ``mode`` is NONE.
@@ -74,13 +75,31 @@ from supi3.terminal import (
     watching,
 )
 
-__all__ = ["BranchLines", "ReturnWatch", "TerminalBlock"]
+__all__ = ["BranchLines", "ReturnWatch", "TerminalBlock", "silence_edge"]
 
 _WIDTHS: Final[dict[str, int]] = {pin.name: pin.width for pin in BLOCK_INPUTS}
 _OFF: Final[dict[str, int]] = {pin.name: 0 for pin in BLOCK_OUTPUTS}
 _CPBS: Final[tuple[int, int]] = (clocks_per_bit(0), clocks_per_bit(1))
 """Clocks per bit at 500 kbit/s and 2 Mbit/s (Table 1-7)."""
 
+
+def silence_edge(timer: int, heard: bool, counting: bool, restart: bool, frame_end: bool,
+                 limit: int) -> tuple[int, bool, bool]:
+    """The silence timer at one clock edge (BK-3, BK-20, BK-50): ``timer`` the edges since the silence (re)started,
+    ``heard`` the return line was heard since the last frame's end, ``counting`` the branch is watched in the cycle
+    ending, ``restart`` a master's telegram came back or a command switched the branch on, ``frame_end`` the frame
+    engine completed a check sequence at this edge, ``limit`` the silence in clocks. Returns the timer, the mark and
+    whether the silence closes the branch at this edge (the caller applies :func:`~supi3.terminal.silence`).
+
+    The silence restarts at the end of the first frame after the return line was heard (or the branch was not
+    watched) and closes the branch at the end of the first frame by which it has lasted ``limit`` edges: a closure
+    so comes only where a frame has just passed the BK, leaving DO2 the whole gap before the next one (BK-47)."""
+    if not counting:
+        return 0, True, False
+    expired = frame_end and not heard and not restart and timer + 1 >= limit
+    if frame_end and (heard or expired):
+        return 0, restart, expired
+    return min(timer + 1, limit - 1), heard or restart, False
 
 
 class TerminalBlock:
@@ -97,7 +116,10 @@ class TerminalBlock:
     state:
         The branch state, a :class:`~supi3.terminal.Terminal` (the state of the cycle to come).
     timer:
-        Edges of silence counted so far.
+        Edges since the silence (re)started at a frame's end (:func:`silence_edge`).
+    heard:
+        The return line was heard (or the branch not watched) since the last frame's end: the next one restarts the
+        silence.
     """
 
     inputs: Sequence[Pin] = BLOCK_INPUTS
@@ -112,6 +134,7 @@ class TerminalBlock:
         """The state after the ``sync`` reset: the power-up state, waiting for the first edge in a BK mode."""
         self.state = Terminal()
         self.timer = 0
+        self.heard = True
         self._fresh = True
         self.cycle = 0
         self.log.clear()
@@ -153,12 +176,12 @@ class TerminalBlock:
             self.log.add(cycle, "CONF edge: reconfiguration request")
         if v["ib_reset"]:
             self.state = reset(state)
-            self.timer = 0
+            self.timer, self.heard = 0, True
             return
         branch = BranchControl(v["branch"])
         restart = bool(v["ret_valid"] or (v["cmd_valid"] and restarts_silence(branch)))
-        due = counting and not restart and self.timer + 1 >= self.time_limit
-        expired = due and not v["framing"]  # BK-50: a closure waits for the frame's end
+        self.timer, self.heard, expired = silence_edge(self.timer, self.heard, counting, restart,
+                                                       bool(v["frame_end"]), self.time_limit)  # fmt: skip
         if v["cmd_valid"]:
             state = command(state, branch, bool(v["ack"]), bool(v["alarm_on"]) if v["alarm_set"] else None)
             self.log.add(cycle, "command {} ack={}: {}", branch.name, v["ack"], state)
@@ -169,8 +192,6 @@ class TerminalBlock:
         if expired:
             state = silence(state)
             self.log.add(cycle, "silence over: {}", state)
-        if not due or expired:  # else the closure waits for the frame's end and the timer holds (BK-50)
-            self.timer = self.timer + 1 if counting and not restart and not due else 0
         self.state = state
 
     def recent_events(self) -> list[str]:
@@ -319,14 +340,14 @@ class BranchLines:
         A device answered on the branch (for the cycle to come).
     watch, counter:
         The blocks on DI3 (``counter`` ``None`` but in BK-LBD).
-    timer:
-        Edges of silence counted up to cycle :attr:`timer_at` (BK-20).
+    timer, heard:
+        :class:`TerminalBlock`'s, the timer counted up to cycle :attr:`timer_at` (BK-20, BK-50).
     """
 
     __slots__ = (
-        "_c0", "_connected", "_events", "_initial", "_lbst", "_line", "_opens", "_restarts", "_running",
-        "_starts", "_strobes", "connected", "counter", "counting", "cpb", "drain", "drained", "fast", "limit",
-        "present", "sel2", "sel3", "timer", "timer_at", "tx", "watch",
+        "_c0", "_connected", "_events", "_initial", "_lbst", "_line", "_opens", "_restarts", "_running", "_starts",
+        "_strobes", "connected", "counter", "counting", "cpb", "drain", "drained", "fast", "heard", "limit", "present",
+        "sel2", "sel3", "timer", "timer_at", "tx", "watch",
     )  # fmt: skip
 
     def __init__(self, rf: str | None, cpb: int, lbd: bool, time_limit: int = BRANCH_SILENCE_CLOCKS) -> None:
@@ -352,6 +373,7 @@ class BranchLines:
         self.drained = 0
         """Clocks before this one that DI3 spent between telegrams at the idle level, at most :attr:`drain`."""
         self.timer = 0
+        self.heard = True
         self.timer_at = 0
         self.counting = False
         """The timer counts in the cycles from :attr:`timer_at` on (a run's view, until its next visit)."""
@@ -442,23 +464,23 @@ class BranchLines:
         self.watch.reset()
         if self.counter is not None:
             self.counter.reset()
-        self.timer, self.counting = 0, False
+        self.timer, self.heard, self.counting = 0, True, False
         self.tx.reset()
         self.sel3, self.sel2, self.drained = False, _SENT, 0
 
     def quiet(self, c: int, state: Terminal, recording: bool) -> None:
         """The BK's edge ending cycle ``c`` takes no strobe (its first running clock, an INTERBUS reset): the timer
         starts from 0 (BK-20); ``state`` the BK state after it, ``recording`` in a run."""
-        self.timer, self.timer_at = 0, c + 1
+        self.timer, self.heard, self.timer_at = 0, True, c + 1
         self.counting = recording and self._counts(c + 1, state)
 
-    def edge(self, c: int, before: Terminal, after: Terminal, switched_on: bool, mfp_in: int, framing: bool,
+    def edge(self, c: int, before: Terminal, after: Terminal, switched_on: bool, mfp_in: int, frame_end: bool,
              recording: bool) -> tuple[Terminal, bool]:
         """The BK's edge ending running cycle ``c`` after the core's (BK-20's order; the chip applied CONF and a
         command there): ``before`` the state before the edge, ``after`` after the core's, ``switched_on`` a command
-        switched the branch on, ``mfp_in`` the synchronised MFP inputs, ``framing`` a frame ran through the frame
-        engine or its transmitter repeated a data telegram being received in the cycle (a silence running out waits for
-        its end, BK-50; the timer holds); ``recording``: in a run (the strobes planned). Returns the state after the
+        switched the branch on, ``mfp_in`` the synchronised MFP inputs, ``frame_end`` the frame engine completed a
+        check sequence at this edge (the silence is judged there, BK-50, :func:`silence_edge`); ``recording``: in a
+        run (the strobes planned). Returns the state after the
         master's telegram back, the counter telegram and the silence, and whether the silence closed the branch."""
         connected = bool(self._connected[c - self._c0]) if recording else self.connected
         ret, cnt, count = self._strobes[c - self._c0].tolist() if recording else self.strobes()
@@ -469,8 +491,8 @@ class BranchLines:
             ret = cnt = 0
         counting = before.extended and on
         restart = bool(ret) or switched_on
-        due = counting and not restart and self.timer + 1 >= self.limit
-        expired = due and not framing
+        self.timer, self.heard, expired = silence_edge(self.timer, self.heard, counting, restart, frame_end,
+                                                       self.limit)  # fmt: skip
         state = after
         if ret:
             state = received(state, 0)
@@ -479,8 +501,6 @@ class BranchLines:
         closes = expired and not (before.switched_on and not after.switched_on) and watching(state)
         if closes:
             state = silence(state)
-        if not due or expired:  # else the closure waits for the frame's end and the timer holds (BK-50)
-            self.timer = self.timer + 1 if counting and not restart and not due else 0
         self.timer_at = c + 1
         self.counting = recording and self._counts(c + 1, state)
         return state, closes
@@ -548,11 +568,10 @@ class BranchLines:
 
     def next_event(self, t: int) -> int:
         """The first cycle of the run after its cycle ``t`` that the BK must see: a strobe, a change of ``connected``
-        or LBST, the silence running out (the run's length if none)."""
+        or LBST (the run's length if none); the ends of frames, where the silence is judged (BK-50), are the
+        receiver's."""
         k = bisect_right(self._events, t)
         event = self._events[k] if k < len(self._events) else len(self._line)
-        if self.counting:
-            event = min(event, self.timer_at - self._c0 + self.limit - 1 - self.timer)
         return max(event, t + 1)
 
     def record(self, t: int, state: Terminal) -> None:
