@@ -35,7 +35,7 @@ from itertools import pairwise
 from typing import Final
 
 from amaranth.back import verilog as amaranth_verilog
-from amaranth.hdl import Array, Cat, Const, Elaboratable, EnableInserter, Module, Mux, ResetInserter, Signal, Value
+from amaranth.hdl import Array, Cat, Const, Elaboratable, Module, Mux, ResetInserter, Signal, Value
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
@@ -317,8 +317,8 @@ class Supi3Core(wiring.Component):
         ]
 
         # The blocks (docs/rtl.md, "Architecture"). Each block's clocked logic runs on the clocks where the model's
-        # _tick runs (``running``) and is cleared by a power failure; the receiver's synchronisers always run, so the
-        # receiver applies the enable and reset to its line receiver itself.
+        # _tick runs (``running``) and is held in its reset state otherwise (``gated``); the receiver's synchronisers
+        # always run, so the receiver applies ``run`` and ``clear`` to its line receiver itself.
         m.submodules.receiver = receiver = ReceiverRtl(tables)
         frame = FrameEngineRtl()
         datapath = DataPathRtl(tables)
@@ -341,7 +341,11 @@ class Supi3Core(wiring.Component):
         running = ~power_fail & ~holding & (stretch == 0)
 
         def gated(block: wiring.Component) -> Elaboratable:
-            gated_block: Elaboratable = ResetInserter(power_fail)(EnableInserter(running)(block))
+            # Held in reset while not running, which is the same as stopping it: every stop begins with a power
+            # failure, which resets it, and the initial state is the reset state, so it stays in that state until
+            # ``running`` rises; a reset costs a gate per flip-flop, an enable a multiplexer (docs/rtl.md "Size and
+            # build time", round 3). The registers without reset may change meanwhile: each is written before read.
+            gated_block: Elaboratable = ResetInserter(~running)(block)
             return gated_block
 
         m.submodules.frame = gated(frame)
@@ -376,7 +380,7 @@ class Supi3Core(wiring.Component):
         with m.Elif(running & (di3 == wire.START_LEVEL)):
             m.d.sync += connected.eq(1)
         tx_watch = ReturnWatchRtl(len(cpb))
-        m.submodules.tx_watch = ResetInserter(power_fail)(EnableInserter(running)(tx_watch))
+        m.submodules.tx_watch = ResetInserter(~running)(tx_watch)
         m.d.comb += [tx_watch.line.eq(lines.do2), tx_watch.cpb.eq(cpb)]
         sel3 = Signal()
         sel2 = Signal(2, init=_SENT)
@@ -619,7 +623,7 @@ class ReceiverRtl(wiring.Component):
             m.d.sync += [stages[0].eq(getattr(self, pin.name)), *(b.eq(a) for a, b in pairwise(stages))]
             m.d.comb += getattr(self, f"{pin.name}_s").eq(stages[-1])
         rx = Module()
-        m.submodules.line = ResetInserter(self.clear)(EnableInserter(self.run)(rx))
+        m.submodules.line = ResetInserter(self.clear | ~self.run)(rx)
         sync, comb = rx.d.sync, rx.d.comb
         line = self.do1_s
         out = self.line

@@ -20,7 +20,7 @@ from collections.abc import Callable
 from itertools import pairwise
 from typing import Final
 
-from amaranth.hdl import Cat, Const, EnableInserter, Module, Mux, ResetInserter, Signal, Value
+from amaranth.hdl import Cat, Const, Module, Mux, ResetInserter, Signal, Value
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
@@ -234,13 +234,13 @@ class CounterLinesRtl(wiring.Component):
     def elaborate(self, _platform: object) -> Module:
         m = Module()
         forward, back = CounterRtl(), CounterRtl()
-        m.submodules.back = ResetInserter(self.clear | ~self.looped)(EnableInserter(self.run)(back))
+        m.submodules.back = ResetInserter(self.clear | ~self.run | ~self.looped)(back)
         on = self.forward | self.branch
         watch = ReturnWatchRtl(_CPB[0].bit_length())
-        m.submodules.watch = ResetInserter(self.clear)(EnableInserter(self.run)(watch))
+        m.submodules.watch = ResetInserter(self.clear | ~self.run)(watch)
         m.d.comb += [watch.line.eq(self.branch_line), watch.cpb.eq(Mux(self.fast, _CPB[1], _CPB[0])),
                      self.returned.eq(watch.seen), self.branch_busy.eq(watch.busy)]  # fmt: skip
-        m.submodules.forward = ResetInserter(self.clear | ~on)(EnableInserter(self.run)(forward))
+        m.submodules.forward = ResetInserter(self.clear | ~self.run | ~on)(forward)
         stages = [Signal(init=wire.IDLE_LEVEL, name=f"source_s{k}") for k in range(SYNC_STAGES)]
         m.d.sync += [stages[0].eq(self.source), *(b.eq(a) for a, b in pairwise(stages))]
         m.d.comb += [
