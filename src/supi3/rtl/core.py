@@ -31,6 +31,7 @@ terminal modes, the core sends IN data 0 and the straps' ID code, which is what 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from itertools import pairwise
 from typing import Final
 
@@ -218,6 +219,16 @@ def _crc_word(crc: Value) -> Value:
     return word ^ wire.CRC_XOROUT
 
 
+def _per_rate(rate: Value, clocks: tuple[ClockEntry, ...], value: Callable[[ClockEntry], Value | int]) -> Value:
+    """``value`` of the clock entry whose bit rate is ``rate``, one term per entry (the first for any other
+    ``rate``): a compare or load with a constant per bit rate costs a few gates where one with the bit period as a
+    signal needs an adder or a magnitude comparator (docs/rtl.md "Size and build time", round 3)."""
+    result = Value.cast(value(clocks[0]))
+    for entry in clocks[1:]:
+        result = Mux(rate == entry.rate, value(entry), result)
+    return result
+
+
 class Supi3Core(wiring.Component):
     """The SUPI 3 chip core with the pins of :data:`supi3.pinout.CORE_INPUTS` and ``CORE_OUTPUTS`` and the strap ports.
 
@@ -263,9 +274,6 @@ class Supi3Core(wiring.Component):
         io_map = Signal(range(len(tables.io_maps)))
         clocks = tables.clocks
         cpb = Signal(range(max(e.clocks_per_bit for e in clocks) + 1))
-        reset_run = Signal(range(max(e.reset_run for e in clocks) + 1))
-        tx_countdown = max(e.forward_delay + e.clocks_per_bit // 2 - 1 for e in clocks)
-        tx_init = Signal(range(tx_countdown + 1))
         dclk = Signal()
         rbst_by_pin = Signal()
         complete_diag = Signal()
@@ -300,8 +308,6 @@ class Supi3Core(wiring.Component):
             return [
                 rate.eq(entry.rate),
                 cpb.eq(entry.clocks_per_bit),
-                reset_run.eq(entry.reset_run),
-                tx_init.eq(entry.forward_delay + entry.clocks_per_bit // 2 - 1),
                 dclk.eq(~cycle[cpb_bits - 1]),  # c % cpb < cpb // 2 (the model's DCLK_OUT)
             ]
 
@@ -439,10 +445,8 @@ class Supi3Core(wiring.Component):
         m.d.comb += [
             receiver.run.eq(running),
             receiver.clear.eq(power_fail),
-            receiver.cpb.eq(cpb),
-            receiver.reset_run.eq(reset_run),
-            transmitter.cpb.eq(cpb),
-            transmitter.tx_init.eq(tx_init),
+            receiver.rate.eq(rate),
+            transmitter.rate.eq(rate),
             datapath.mfp_in.eq(receiver.mfp_in_s),
             datapath.io_map.eq(io_map),
             outputs.stat_err_n_s.eq(receiver.stat_err_n_s),
@@ -610,10 +614,10 @@ class ReceiverRtl(wiring.Component):
         members.update(
             run=In(1),
             clear=In(1),
-            cpb=In(range(max(e.clocks_per_bit for e in clocks) + 1)),
-            reset_run=In(range(max(e.reset_run for e in clocks) + 1)),
+            rate=In(range(max(e.rate for e in clocks) + 1)),
             line=Out(LINE),
         )
+        self.clocks = clocks
         super().__init__(members)
 
     def elaborate(self, _platform: object) -> Module:
@@ -627,19 +631,23 @@ class ReceiverRtl(wiring.Component):
         sync, comb = rx.d.sync, rx.d.comb
         line = self.do1_s
         out = self.line
+        clocks = self.clocks
+
+        def per_rate(value: Callable[[ClockEntry], Value | int]) -> Value:
+            return _per_rate(self.rate, clocks, value)
 
         # INTERBUS reset, idle time-out (docs/interbus.md A12, A13)
         in_reset = Signal()
         reset_end = Signal(range(wire.RESET_END_STATUS_TELEGRAMS + 1))
-        low_run = Signal.like(self.reset_run)
+        low_run = Signal(range(max(e.reset_run for e in clocks) + 1))
         silent = Signal(range(IDLE_TIMEOUT_CLOCKS + 2), init=1)  # clocks since the last start of no counter telegram
         counted = Signal()  # a counter telegram since then (DG-9)
         low = line == wire.START_LEVEL
-        enter_reset = low & (low_run + 1 == self.reset_run)
+        enter_reset = low & per_rate(lambda e: low_run == e.reset_run - 1)
         idle_timeout = silent == IDLE_TIMEOUT_CLOCKS  # once per silence: the count stops one beyond
         with rx.If(~low):
             sync += low_run.eq(0)
-        with rx.Elif(low_run != self.reset_run):
+        with rx.Elif(per_rate(lambda e: low_run != e.reset_run)):
             sync += low_run.eq(low_run + 1)
         with rx.If(silent != IDLE_TIMEOUT_CLOCKS + 1):
             sync += silent.eq(silent + 1)
@@ -649,12 +657,12 @@ class ReceiverRtl(wiring.Component):
 
         # Framing and mid-bit sampling
         busy = Signal()  # in a telegram (the FSM below)
-        phase = Signal.like(self.cpb)  # clocks since the start bit began, modulo the bit period
+        phase = Signal(range(max(e.clocks_per_bit for e in clocks)))  # clocks since the start bit, modulo the bit
         bit = Signal(_POSITION)
         select = Signal()
         control = Signal()
         is_data = Signal(init=1)
-        sample = busy & (phase == self.cpb // 2)
+        sample = busy & per_rate(lambda e: phase == e.clocks_per_bit // 2)
         data_now = Mux(bit == wire.POS_TYPE, line == wire.TYPE_DATA_LEVEL, is_data)
         end = bit == Mux(data_now, _DATA_TELEGRAM_END, _STATUS_TELEGRAM_END)
         with rx.FSM(name="telegram") as fsm:
@@ -662,7 +670,7 @@ class ReceiverRtl(wiring.Component):
                 sync += [phase.eq(1), bit.eq(0), is_data.eq(1)]
                 rx.next = "TELEGRAM"
             with rx.State("TELEGRAM"):
-                sync += phase.eq(Mux(phase == self.cpb - 1, 0, phase + 1))
+                sync += phase.eq(Mux(per_rate(lambda e: phase == e.clocks_per_bit - 1), 0, phase + 1))
                 with rx.If(sample & end & (line == wire.STOP_LEVEL)):
                     rx.next = "BETWEEN"
         comb += busy.eq(fsm.ongoing("TELEGRAM"))
@@ -675,7 +683,8 @@ class ReceiverRtl(wiring.Component):
                 # 3 cpb clocks after it) unless it is a counter telegram (DG-9, BK-36).
                 sync += [control.eq(line), counted.eq(out.counter)]
                 with rx.If(~out.counter):
-                    sync += silent.eq(self.cpb // 2 + wire.POS_CONTROL * self.cpb + 1)
+                    start = per_rate(lambda e: e.clocks_per_bit // 2 + wire.POS_CONTROL * e.clocks_per_bit + 1)
+                    sync += silent.eq(start)
             with rx.If(end & (line != wire.STOP_LEVEL)):  # M16: the stop bit's period is the next start bit
                 sync += [bit.eq(1), is_data.eq(1)]
 
@@ -1001,11 +1010,9 @@ class TransmitterRtl(wiring.Component):
     def __init__(self, tables: CoreTables) -> None:
         self.tables = tables
         clocks = tables.clocks
-        countdown = max(e.forward_delay + e.clocks_per_bit // 2 - 1 for e in clocks)
         members: dict[str, object] = {
             "frame": In(TRANSMIT),
-            "cpb": In(range(max(e.clocks_per_bit for e in clocks) + 1)),
-            "tx_init": In(range(countdown + 1)),
+            "rate": In(range(max(e.rate for e in clocks) + 1)),
             "do2": Out(1, init=wire.IDLE_LEVEL),
         }
         super().__init__(members)
@@ -1015,7 +1022,8 @@ class TransmitterRtl(wiring.Component):
         sync, comb = m.d.sync, m.d.comb
         f = self.frame
         slots = _tx_slots(self.tables)
-        width = len(self.tx_init)
+        clocks = self.tables.clocks
+        width = max(_tx_init(e) for e in clocks).bit_length()
         countdown = [Signal(width, name=f"tx{k}_count") for k in range(slots)]
         # a level counts while its countdown runs, and each push sets both: the levels need no reset
         level = [Signal(name=f"tx{k}_level", reset_less=True) for k in range(slots)]
@@ -1023,7 +1031,7 @@ class TransmitterRtl(wiring.Component):
             with m.If(r != 0):
                 sync += r.eq(r - 1)
         with m.If(f.push):
-            sync += [countdown[0].eq(self.tx_init), level[0].eq(f.level)]
+            sync += [countdown[0].eq(_per_rate(self.rate, clocks, _tx_init)), level[0].eq(f.level)]
             for k in range(1, slots):
                 sync += [
                     countdown[k].eq(Mux(countdown[k - 1] != 0, countdown[k - 1] - 1, 0)),
@@ -1033,7 +1041,9 @@ class TransmitterRtl(wiring.Component):
             sync += [level[1].eq(f.err), level[2].eq(~f.err)]
         do2 = Const(wire.IDLE_LEVEL)
         for r, v in reversed(list(zip(countdown, level, strict=True))):
-            do2 = Mux(r <= self.cpb, Mux(r != 0, v, wire.IDLE_LEVEL), do2)
+            do2 = Mux(
+                _per_rate(self.rate, clocks, lambda e, r=r: r <= e.clocks_per_bit), Mux(r != 0, v, wire.IDLE_LEVEL), do2
+            )
         comb += self.do2.eq(do2)
         return m
 
@@ -1210,6 +1220,12 @@ class OutputsRtl(wiring.Component):
             self.mfp_diag.eq(Mux(self.bus_terminal, mfp, 0)),
         ]  # fmt: skip
         return m
+
+
+def _tx_init(entry: ClockEntry) -> int:
+    """A transmitter entry's countdown at its push: to the end of its bit on DO2 (``cpb`` clocks from its begin,
+    ``forward_delay`` after the bit began on DO1, pushed at its mid-bit sample)."""
+    return entry.forward_delay + entry.clocks_per_bit // 2 - 1
 
 
 def _tx_slots(tables: CoreTables) -> int:
