@@ -1,9 +1,12 @@
 """The LFSR down counter of the RTL (supi3.rtl.lfsr; docs/rtl.md, "Size and build time"): every tap set of the
 table gives a maximal-length sequence, the jump ``advance`` equals stepping, and ``Countdown`` on Amaranth's
 simulator counts exactly as a binary down counter from its limit (load, clear, ``last``, ``idle``), for random
-load and clear strobes."""
+load and clear strobes; an up counter's states (``count_state``) are distinct up to its end and step by
+``next_state``."""
 
 from __future__ import annotations
+
+from itertools import pairwise
 
 import pytest
 from amaranth.hdl import Module, Signal
@@ -11,7 +14,7 @@ from amaranth.sim import Simulator, SimulatorContext
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from supi3.rtl.lfsr import TAPS, Countdown, advance, step
+from supi3.rtl.lfsr import TAPS, Countdown, advance, count_state, count_width, next_state, step
 
 
 def _prime_factors(n: int) -> set[int]:
@@ -75,3 +78,36 @@ def test_countdown_rejects_a_limit_out_of_range(limit: int) -> None:
     m._MustUse__silence = True  # rejected, never elaborated
     with pytest.raises(ValueError, match="limit must be from 1"):
         Countdown(m, limit, load=Signal(), clear=Signal(), name="c")
+
+
+@pytest.mark.parametrize("most", [0, 1, 2, 3, 6, 7, 255, 256, 1024])
+def test_up_count_states_are_distinct_and_step(most: int) -> None:
+    width = count_width(most)
+    states = [count_state(v, width) for v in range(most + 1)]
+    assert len(set(states)) == most + 1
+    assert all(step(a, width) == b for a, b in pairwise(states))
+    assert count_state(0, width) == 1
+
+
+@given(st.integers(1, 1 << 12))
+def test_next_state_in_gates_is_step(seed: int) -> None:
+    width = count_width(seed)
+    m = Module()
+    state, after = Signal(width), Signal(width)
+    m.d.comb += after.eq(next_state(state))
+    got: list[int] = []
+
+    async def bench(ctx: SimulatorContext) -> None:
+        ctx.set(state, seed % (1 << width))
+        got.append(ctx.get(after))
+
+    sim = Simulator(m)
+    sim.add_testbench(bench)
+    sim.run()
+    assert got == [step(seed % (1 << width), width)]
+
+
+@pytest.mark.parametrize("most", [-1, (1 << max(TAPS)) - 1])
+def test_count_width_rejects_a_count_out_of_range(most: int) -> None:
+    with pytest.raises(ValueError, match="most must be from 0"):
+        count_width(most)

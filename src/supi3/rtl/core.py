@@ -70,7 +70,7 @@ from supi3.regmap.core import BYTE_BITS
 from supi3.rtl.counter import CounterLinesRtl, lbd_lines
 from supi3.rtl.expansion import PIN_NAMES as EXPANSION_PINS
 from supi3.rtl.expansion import ExpansionRtl
-from supi3.rtl.lfsr import Countdown, before, next_state
+from supi3.rtl.lfsr import Countdown, before, count_state, count_width, next_state
 from supi3.rtl.optical import OpticalRtl
 from supi3.rtl.serial_io import DIRECTIONS, SER_IN_PIN, WIDTHS, SerialIoRtl
 from supi3.rtl.tables import (
@@ -639,18 +639,28 @@ class ReceiverRtl(wiring.Component):
         # INTERBUS reset, idle time-out (docs/interbus.md A12, A13)
         in_reset = Signal()
         reset_end = Signal(range(wire.RESET_END_STATUS_TELEGRAMS + 1))
-        low_run = Signal(range(max(e.reset_run for e in clocks) + 1))
-        silent = Signal(range(IDLE_TIMEOUT_CLOCKS + 2), init=1)  # clocks since the last start of no counter telegram
+        # Both counters count up as LFSRs (supi3.rtl.lfsr): only loaded, stepped and compared with constants, so the
+        # count v is the state v steps after 1 (``lfsr.count_state``) and a step is an XOR instead of a carry chain.
+        run_width = count_width(max(e.reset_run for e in clocks))
+        low_run = Signal(run_width, init=count_state(0, run_width))  # clocks at the start level, stopping at reset_run
+        silent_width = count_width(IDLE_TIMEOUT_CLOCKS + 1)
+        # clocks since the last start of no counter telegram, from 1 on, stopping one beyond the time-out
+        silent = Signal(silent_width, init=count_state(1, silent_width))
+
+        def since_start(e: ClockEntry) -> int:
+            """``silent`` after a control bit's sample, cpb // 2 + 3 cpb clocks after its telegram's start bit."""
+            return count_state(e.clocks_per_bit // 2 + wire.POS_CONTROL * e.clocks_per_bit + 1, silent_width)
+
         counted = Signal()  # a counter telegram since then (DG-9)
         low = line == wire.START_LEVEL
-        enter_reset = low & per_rate(lambda e: low_run == e.reset_run - 1)
-        idle_timeout = silent == IDLE_TIMEOUT_CLOCKS  # once per silence: the count stops one beyond
+        enter_reset = low & per_rate(lambda e: low_run == count_state(e.reset_run - 1, run_width))
+        idle_timeout = silent == count_state(IDLE_TIMEOUT_CLOCKS, silent_width)  # once per silence
         with rx.If(~low):
-            sync += low_run.eq(0)
-        with rx.Elif(per_rate(lambda e: low_run != e.reset_run)):
-            sync += low_run.eq(low_run + 1)
-        with rx.If(silent != IDLE_TIMEOUT_CLOCKS + 1):
-            sync += silent.eq(silent + 1)
+            sync += low_run.eq(count_state(0, run_width))
+        with rx.Elif(per_rate(lambda e: low_run != count_state(e.reset_run, run_width))):
+            sync += low_run.eq(next_state(low_run))
+        with rx.If(silent != count_state(IDLE_TIMEOUT_CLOCKS + 1, silent_width)):
+            sync += silent.eq(next_state(silent))
         with rx.If(enter_reset):
             sync += [in_reset.eq(1), reset_end.eq(0)]
         in_reset_now = in_reset | enter_reset
@@ -683,8 +693,7 @@ class ReceiverRtl(wiring.Component):
                 # 3 cpb clocks after it) unless it is a counter telegram (DG-9, BK-36).
                 sync += [control.eq(line), counted.eq(out.counter)]
                 with rx.If(~out.counter):
-                    start = per_rate(lambda e: e.clocks_per_bit // 2 + wire.POS_CONTROL * e.clocks_per_bit + 1)
-                    sync += silent.eq(start)
+                    sync += silent.eq(per_rate(since_start))
             with rx.If(end & (line != wire.STOP_LEVEL)):  # M16: the stop bit's period is the next start bit
                 sync += [bit.eq(1), is_data.eq(1)]
 
