@@ -757,14 +757,15 @@ class FrameEngineRtl(wiring.Component):
 
         id_cycle = Signal()  # the frame's cycle type: 1 = ID cycle
         latches = Signal(range(wire.LATCH_STATUS_TELEGRAMS + 1))
-        crc_rx = Signal(WORD_BITS, init=wire.CRC_INIT)
-        crc_tx = Signal(WORD_BITS, init=wire.CRC_INIT)
-        index = Signal(range(wire.CHECK_TELEGRAMS + 2))
+        # Read only in CHECK, and set when a frame is loaded (the CRCs) or enters CHECK (the rest): no reset
+        crc_rx = Signal(WORD_BITS, init=wire.CRC_INIT, reset_less=True)
+        crc_tx = Signal(WORD_BITS, init=wire.CRC_INIT, reset_less=True)
+        index = Signal(range(wire.CHECK_TELEGRAMS + 2), reset_less=True)
+        crc_bad = Signal(reset_less=True)
+        cntr_bad = Signal(reset_less=True)
         local_error = Signal()
         err_in = Signal()
         attn = Signal()
-        crc_bad = Signal()
-        cntr_bad = Signal()
         err_bit = Signal()
         pairs = [
             tuple(sorted(p))
