@@ -67,7 +67,7 @@ from supi3.pinout import (
 )
 from supi3.regmap import INTERRUPT_SOURCES
 from supi3.regmap.core import BYTE_BITS
-from supi3.rtl.counter import CounterLinesRtl, lbd_lines
+from supi3.rtl.counter import CounterLinesRtl, LineQueue, lbd_lines
 from supi3.rtl.expansion import PIN_NAMES as EXPANSION_PINS
 from supi3.rtl.expansion import ExpansionRtl
 from supi3.rtl.lfsr import Countdown, before, count_state, count_width, next_state
@@ -1010,16 +1010,19 @@ class DataPathRtl(wiring.Component):
 class TransmitterRtl(wiring.Component):
     """Transmitter and repeater (block ``transmitter``).
 
-    A short queue of (countdown to the end of the bit period, level) entries, newest first: each sample pushes the
-    level it sends, which goes out on DO2 ``tx_init`` clocks later for one bit period (``cpb``), so every bit is
-    repeated :data:`supi3.interbus.wire.REPEATER_DELAY_BITS` after it began on DO1 (A10); DO2 is the newest begun
-    entry while it lasts. The ERR pair of the CNTR word is rewritten at the last stop bit (``tx``,
-    :data:`TRANSMIT`, flipped).
+    Each sample pushes the level it sends, which goes out on DO2 from ``forward_delay - cpb // 2`` clocks later for
+    one bit period (``cpb``) or until the next one begins, so every bit is repeated
+    :data:`supi3.interbus.wire.REPEATER_DELAY_BITS` after it began on DO1 (A10): the levels wait in the time-stamp
+    queue of the counter telegram block (:class:`supi3.rtl.counter.LineQueue`, the same timing, M8). The ERR pair of
+    the CNTR word is rewritten at the last stop bit (``tx``, :data:`TRANSMIT`, flipped) in the two levels pushed
+    before it, which are still waiting (``_tx_waiting``).
     """
 
     def __init__(self, tables: CoreTables) -> None:
         self.tables = tables
         clocks = tables.clocks
+        if sorted(e.rate for e in clocks) != list(range(len(clocks))):
+            raise ValueError("the transmitter needs one clock entry per bit rate, by rate index")
         members: dict[str, object] = {
             "frame": In(TRANSMIT),
             "rate": In(range(max(e.rate for e in clocks) + 1)),
@@ -1029,32 +1032,14 @@ class TransmitterRtl(wiring.Component):
 
     def elaborate(self, _platform: object) -> Module:
         m = Module()
-        sync, comb = m.d.sync, m.d.comb
         f = self.frame
-        slots = _tx_slots(self.tables)
-        clocks = self.tables.clocks
-        width = max(_tx_init(e) for e in clocks).bit_length()
-        countdown = [Signal(width, name=f"tx{k}_count") for k in range(slots)]
-        # a level counts while its countdown runs, and each push sets both: the levels need no reset
-        level = [Signal(name=f"tx{k}_level", reset_less=True) for k in range(slots)]
-        for r in countdown:
-            with m.If(r != 0):
-                sync += r.eq(r - 1)
-        with m.If(f.push):
-            sync += [countdown[0].eq(_per_rate(self.rate, clocks, _tx_init)), level[0].eq(f.level)]
-            for k in range(1, slots):
-                sync += [
-                    countdown[k].eq(Mux(countdown[k - 1] != 0, countdown[k - 1] - 1, 0)),
-                    level[k].eq(level[k - 1]),
-                ]
+        by_rate = sorted(self.tables.clocks, key=lambda e: e.rate)
+        queue = LineQueue(m, push=f.push, value=f.level, rate=self.rate,
+                          timing=tuple((_tx_begins(e), e.clocks_per_bit) for e in by_rate),
+                          slots=_tx_waiting(self.tables), idle=wire.IDLE_LEVEL, name="tx")  # fmt: skip
         with m.If(f.set_err):
-            sync += [level[1].eq(f.err), level[2].eq(~f.err)]
-        do2 = Const(wire.IDLE_LEVEL)
-        for r, v in reversed(list(zip(countdown, level, strict=True))):
-            do2 = Mux(
-                _per_rate(self.rate, clocks, lambda e, r=r: r <= e.clocks_per_bit), Mux(r != 0, v, wire.IDLE_LEVEL), do2
-            )
-        comb += self.do2.eq(do2)
+            m.d.sync += [queue.values[1].eq(f.err), queue.values[2].eq(~f.err)]
+        m.d.comb += self.do2.eq(queue.shown)
         return m
 
 
@@ -1232,25 +1217,28 @@ class OutputsRtl(wiring.Component):
         return m
 
 
-def _tx_init(entry: ClockEntry) -> int:
-    """A transmitter entry's countdown at its push: to the end of its bit on DO2 (``cpb`` clocks from its begin,
-    ``forward_delay`` after the bit began on DO1, pushed at its mid-bit sample)."""
-    return entry.forward_delay + entry.clocks_per_bit // 2 - 1
+def _tx_begins(entry: ClockEntry) -> int:
+    """Clocks from a bit's push (its mid-bit sample, ``cpb // 2`` clocks into the bit on DO1) to its first clock on
+    DO2, ``forward_delay`` after it began on DO1."""
+    return entry.forward_delay - entry.clocks_per_bit // 2
 
 
-def _tx_slots(tables: CoreTables) -> int:
-    """Transmitter entries needed: every bit not yet begun on DO2 plus the one being sent.
+def _tx_waiting(tables: CoreTables) -> int:
+    """Transmitter levels pushed and not yet begun on DO2, at most.
 
-    A bit goes out ``forward_delay - cpb // 2`` clocks after its sample; samples are at least ``cpb // 2 + 1``
-    clocks apart (a stop bit sampled mid-bit, then a start bit on the next clock). The model keeps more entries
-    (eight); the older ones can no longer be on the line.
+    A bit goes out ``_tx_begins`` clocks after its sample; samples are at least ``cpb // 2 + 1`` clocks apart (a
+    stop bit sampled mid-bit, then a start bit on the next clock). The ERR pair needs the two levels pushed before a
+    stop bit to be waiting: they were pushed ``cpb`` and ``2 cpb`` clocks before it (one telegram's grid), and
+    ``2 cpb + 1`` is less than ``_tx_begins`` at every bit rate (checked here). The model keeps more entries (eight).
     """
     most = 0
     for entry in tables.clocks:
-        delay = entry.forward_delay - entry.clocks_per_bit // 2
+        delay = _tx_begins(entry)
+        if 2 * entry.clocks_per_bit + 1 >= delay:  # not begun, nor beginning at that clock
+            raise ValueError("the ERR pair's levels must still be waiting when the last stop bit is sampled")
         spacing = entry.clocks_per_bit // 2 + 1
         most = max(most, (delay - 2) // spacing + 1)
-    return max(most + 1, 3)  # the ERR pair rewrites the two entries before the last stop bit
+    return max(most, 3)  # the ERR pair rewrites the two entries before the last stop bit
 
 
 def verilog(variant: Variant | str = Variant.OPC) -> str:

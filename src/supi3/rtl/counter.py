@@ -42,7 +42,7 @@ from supi3.pinout import SYNC_STAGES
 from supi3.rtl.tables import core_tables
 from supi3.rtl.terminal import ReturnWatchRtl
 
-__all__ = ["CounterLinesRtl", "CounterRtl", "lbd_lines"]
+__all__ = ["CounterLinesRtl", "CounterRtl", "LineQueue", "lbd_lines"]
 
 _CPB: Final = (clocks_per_bit(0), clocks_per_bit(1))
 _IDLE_VALUE: Final = wire.IDLE_LEVEL
@@ -57,14 +57,52 @@ def _begins(cpb: int) -> int:
     return send_countdown(cpb) - cpb + 1
 
 
-_STAMP_BITS: Final = max(_begins(cpb) for cpb in _CPB).bit_length()
-"""Width of the free-running clock count and of a waiting bit's sample time: the waiting bits' ages (under
-``_begins``) are distinct modulo ``2 ** _STAMP_BITS``."""
+class LineQueue:
+    """The bits on their way to a line, each sent for a bit period a fixed time after it was pushed, as time stamps
+    (docs/rtl.md "Counter telegram block"), built in ``m``: a free-running clock count ``now``, the ``waiting``
+    bits pushed but not yet begun (``values`` and their push times, newest first, shifted at each push), and the
+    bit on the line (``sent``) with the clocks it has ``left``. The oldest waiting bit goes on the line from the
+    clock ``begins`` after its push and stays there for ``length`` clocks or until the next one begins; then the
+    line shows ``idle``. ``timing[rate]`` is (``begins``, ``length``) for each value of ``rate``.
 
+    ``slots`` waiting bits at most: the caller proves that no more are pushed within the longest ``begins``. The
+    time stamps, values and ``sent`` need no reset (``waiting`` and ``left`` say which count). A push's statements
+    come after this constructor's, so a caller may overwrite ``values`` after the shift (later assignments win).
+    """
 
-def _by_rate(fast: Value, values: tuple[int, int]) -> Value:
-    """``values[fast]`` as a gate (500 kbit/s, 2 Mbit/s)."""
-    return Mux(fast, values[1], values[0])
+    def __init__(self, m: Module, *, push: Value, value: Value, rate: Value, timing: tuple[tuple[int, int], ...],
+                 slots: int, idle: int, name: str) -> None:  # fmt: skip
+        sync = m.d.sync
+        bits = max(begins for begins, _ in timing).bit_length()  # the waiting bits' ages are distinct modulo 2**bits
+        now = Signal(bits, name=f"{name}_now", reset_less=True)
+        stamp = [Signal(bits, name=f"{name}{k}_stamp", reset_less=True) for k in range(slots)]
+        self.values = [Signal(len(value), name=f"{name}{k}_value", reset_less=True) for k in range(slots)]
+        waiting = Signal(range(slots + 1), name=f"{name}_waiting")
+        sent = Signal(len(value), name=f"{name}_sent", reset_less=True)
+        left = Signal(range(max(length for _, length in timing) + 1), name=f"{name}_left")
+
+        def by_rate(pick: Callable[[int, int], int]) -> Value:
+            result = Value.cast(pick(*timing[0]))
+            for k, entry in enumerate(timing[1:], 1):
+                result = Mux(rate == k, pick(*entry), result)
+            return result
+
+        sync += now.eq(now + 1)
+        # the oldest waiting bit begins on the line in the next cycle (``begins`` clocks after its push)
+        due = (now + by_rate(lambda begins, _: (1 - begins) % (1 << bits)))[:bits]
+        head = [(waiting == k + 1) & (stamp[k] == due) for k in range(slots)]
+        begin_now = Cat(*head).any()
+        oldest = functools.reduce(operator.or_, (Mux(h, v, 0) for h, v in zip(head, self.values, strict=True)))
+        with m.If(begin_now):
+            sync += [sent.eq(oldest), left.eq(by_rate(lambda _, length: length))]
+        with m.Elif(left != 0):
+            sync += left.eq(left - 1)
+        sync += waiting.eq(waiting - begin_now)
+        with m.If(push):
+            sync += [stamp[0].eq(now), self.values[0].eq(value), waiting.eq(waiting + 1 - begin_now),
+                     *(stamp[k].eq(stamp[k - 1]) for k in range(1, slots)),
+                     *(self.values[k].eq(self.values[k - 1]) for k in range(1, slots))]  # fmt: skip
+        self.shown: Value = Mux(left != 0, sent, idle)  # the line: the bit being sent, else ``idle``
 
 
 def _at_rate(fast: Value, test: Callable[[int], Value]) -> Value:
@@ -89,6 +127,7 @@ class CounterRtl(wiring.Component):
         line, fast = self.line, self.fast
 
         # State ---------------------------------------------------------------------------------------------------
+        out, drive = Signal(), Signal()  # the bit sampled now on its way out (the output queue below)
         phase = Signal(range(max(_CPB)))
         pending = Signal()
         bit = Signal(range(IDLE_BIT + 1), init=IDLE_BIT)
@@ -103,18 +142,8 @@ class CounterRtl(wiring.Component):
         gen = Signal(range(IDLE_BIT + 1), init=IDLE_BIT)
         drop = Signal()
         seen = Signal()
-        # the output queue: the ``waiting`` bits not yet begun (newest first) with their sample times on a free-running
-        # clock count, and the bit on the line with the clocks it has ``left`` (docs/rtl.md "Counter telegram
-        # block"); ``waiting`` and ``left`` say which of them count, so the rest need no reset
-        now = Signal(_STAMP_BITS, reset_less=True)
-        stamp = [Signal(_STAMP_BITS, name=f"tx{k}_stamp", reset_less=True) for k in range(_WAITING)]
-        value = [Signal(2, name=f"tx{k}_value", reset_less=True) for k in range(_WAITING)]
-        waiting = Signal(range(_WAITING + 1))
-        sent = Signal(2, reset_less=True)
-        left = Signal(range(max(_CPB) + 1))
 
         # The bit grid and the sample -----------------------------------------------------------------------------
-        cpb = _by_rate(fast, _CPB)
         idle_rx = bit == IDLE_BIT
         restart = idle_rx & ~pending & (line == wire.START_LEVEL)
         ph = Mux(restart, 0, phase)
@@ -122,18 +151,7 @@ class CounterRtl(wiring.Component):
         sync += phase.eq(Mux(_at_rate(fast, lambda c: ph >= c - 1), 0, ph + 1))
         with m.If(restart):
             sync += pending.eq(1)
-        sync += [seen.eq(0), now.eq(now + 1)]
-        # the oldest waiting bit begins on the line in the next cycle (``_begins`` clocks after its sample)
-        ahead = [(1 - _begins(c)) % (1 << _STAMP_BITS) for c in _CPB]
-        due = (now + _by_rate(fast, (ahead[0], ahead[1])))[:_STAMP_BITS]
-        head = [(waiting == k + 1) & (stamp[k] == due) for k in range(_WAITING)]
-        begin_now = Cat(*head).any()
-        with m.If(begin_now):
-            sync += [sent.eq(functools.reduce(operator.or_, (Mux(h, v, 0) for h, v in zip(head, value, strict=True)))),
-                     left.eq(cpb)]  # fmt: skip
-        with m.Elif(left != 0):
-            sync += left.eq(left - 1)
-        sync += waiting.eq(waiting - begin_now)
+        sync += seen.eq(0)
 
         # The receiver (counter_step's _receive) ------------------------------------------------------------------
         rx_out, rx_drive, begin, seen_now = Signal(), Signal(), Signal(), Signal()
@@ -185,7 +203,6 @@ class CounterRtl(wiring.Component):
 
             # The generator and what goes out ----------------------------------------------------------------------
             silent = idle_rx & (line == wire.IDLE_LEVEL) & (quiet == COUNTER_SILENCE_BITS)
-            out, drive = Signal(), Signal()
             with m.If((gen != IDLE_BIT) | silent):
                 k = Mux(silent, 0, gen)
                 comb += [out.eq(Const(GENERATED_TELEGRAM, wire.DATA_TELEGRAM_BITS).bit_select(k, 1)), drive.eq(1)]
@@ -196,13 +213,12 @@ class CounterRtl(wiring.Component):
                 comb += [out.eq(wire.IDLE_LEVEL), drive.eq(1)]
             with m.Else():
                 comb += [out.eq(rx_out), drive.eq(rx_drive)]
-            sync += [seen.eq(seen_now), stamp[0].eq(now), value[0].eq(Cat(out, drive)),
-                     waiting.eq(waiting + 1 - begin_now),
-                     *(stamp[k].eq(stamp[k - 1]) for k in range(1, _WAITING)),
-                     *(value[k].eq(value[k - 1]) for k in range(1, _WAITING))]  # fmt: skip
+            sync += seen.eq(seen_now)
 
-        # Outputs -------------------------------------------------------------------------------------------------
-        shown = Mux(left != 0, sent, _IDLE_VALUE)
+        # The output queue and the outputs ------------------------------------------------------------------------
+        queue = LineQueue(m, push=sample, value=Cat(out, drive), rate=fast, timing=tuple((_begins(c), c) for c in _CPB),
+                          slots=_WAITING, idle=_IDLE_VALUE, name="tx")  # fmt: skip
+        shown = queue.shown
         comb += [self.out.eq(shown[0]), self.drive.eq(shown[1]), self.seen.eq(seen), self.count.eq(counted)]
         return m
 
