@@ -67,7 +67,7 @@ from supi3.pinout import (
 )
 from supi3.regmap import INTERRUPT_SOURCES
 from supi3.regmap.core import BYTE_BITS
-from supi3.rtl.counter import CounterLinesRtl, LineQueue, lbd_lines
+from supi3.rtl.counter import CounterLinesRtl, LineQueue, lbd_lines, stamp_bits
 from supi3.rtl.expansion import PIN_NAMES as EXPANSION_PINS
 from supi3.rtl.expansion import ExpansionRtl
 from supi3.rtl.lfsr import Countdown, before, count_state, count_width, next_state
@@ -366,7 +366,7 @@ class Supi3Core(wiring.Component):
         m.d.comb += [
             lines.line.eq(receiver.do1_s), lines.fast.eq(cpb == clocks_per_bit(1)), lines.sent.eq(transmitter.do2),
             lines.source.eq(outputs.di1), lines.forward.eq(lbd), lines.looped.eq(lbd_mr), lines.run.eq(running),
-            lines.clear.eq(power_fail), frame.lbd.eq(lbd),
+            lines.clear.eq(power_fail), frame.lbd.eq(lbd), lines.now.eq(cycle),
         ]  # fmt: skip
 
         # The bus terminal module (2.4, docs/bus-terminal.md): in reset until the core runs, so that it takes CONF as it
@@ -447,6 +447,7 @@ class Supi3Core(wiring.Component):
             receiver.clear.eq(power_fail),
             receiver.rate.eq(rate),
             transmitter.rate.eq(rate),
+            transmitter.now.eq(cycle),  # the free-running clock count (never reset) the output queues share
             datapath.mfp_in.eq(receiver.mfp_in_s),
             datapath.io_map.eq(io_map),
             outputs.stat_err_n_s.eq(receiver.stat_err_n_s),
@@ -1026,6 +1027,7 @@ class TransmitterRtl(wiring.Component):
         members: dict[str, object] = {
             "frame": In(TRANSMIT),
             "rate": In(range(max(e.rate for e in clocks) + 1)),
+            "now": In(stamp_bits(_tx_timing(tables))),
             "do2": Out(1, init=wire.IDLE_LEVEL),
         }
         super().__init__(members)
@@ -1033,10 +1035,8 @@ class TransmitterRtl(wiring.Component):
     def elaborate(self, _platform: object) -> Module:
         m = Module()
         f = self.frame
-        by_rate = sorted(self.tables.clocks, key=lambda e: e.rate)
-        queue = LineQueue(m, push=f.push, value=f.level, rate=self.rate,
-                          timing=tuple((_tx_begins(e), e.clocks_per_bit) for e in by_rate),
-                          slots=_tx_waiting(self.tables), idle=wire.IDLE_LEVEL, name="tx")  # fmt: skip
+        queue = LineQueue(m, push=f.push, value=f.level, rate=self.rate, timing=_tx_timing(self.tables),
+                          slots=_tx_waiting(self.tables), idle=wire.IDLE_LEVEL, name="tx", now=self.now)  # fmt: skip
         with m.If(f.set_err):
             m.d.sync += [queue.values[1].eq(f.err), queue.values[2].eq(~f.err)]
         m.d.comb += self.do2.eq(queue.shown)
@@ -1221,6 +1221,11 @@ def _tx_begins(entry: ClockEntry) -> int:
     """Clocks from a bit's push (its mid-bit sample, ``cpb // 2`` clocks into the bit on DO1) to its first clock on
     DO2, ``forward_delay`` after it began on DO1."""
     return entry.forward_delay - entry.clocks_per_bit // 2
+
+
+def _tx_timing(tables: CoreTables) -> tuple[tuple[int, int], ...]:
+    """The transmitter's :class:`~supi3.rtl.counter.LineQueue` timing: (``_tx_begins``, ``cpb``) by rate index."""
+    return tuple((_tx_begins(e), e.clocks_per_bit) for e in sorted(tables.clocks, key=lambda e: e.rate))
 
 
 def _tx_waiting(tables: CoreTables) -> int:

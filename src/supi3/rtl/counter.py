@@ -24,6 +24,7 @@ from amaranth.hdl import Cat, Const, Module, Mux, ResetInserter, Signal, Value
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
+from supi3.checks import check_bool
 from supi3.config import Interface, Variant, decode, mode_rows
 from supi3.interbus import wire
 from supi3.lbd import (
@@ -42,7 +43,7 @@ from supi3.pinout import SYNC_STAGES
 from supi3.rtl.tables import core_tables
 from supi3.rtl.terminal import ReturnWatchRtl
 
-__all__ = ["CounterLinesRtl", "CounterRtl", "LineQueue", "lbd_lines"]
+__all__ = ["CLOCK_BITS", "CounterLinesRtl", "CounterRtl", "LineQueue", "lbd_lines", "stamp_bits"]
 
 _CPB: Final = (clocks_per_bit(0), clocks_per_bit(1))
 _IDLE_VALUE: Final = wire.IDLE_LEVEL
@@ -57,13 +58,27 @@ def _begins(cpb: int) -> int:
     return send_countdown(cpb) - cpb + 1
 
 
+def stamp_bits(timing: tuple[tuple[int, int], ...]) -> int:
+    """The width of a :class:`LineQueue`'s time stamps for ``timing``: the waiting bits' ages (under the longest
+    ``begins``) are distinct modulo ``2 ** stamp_bits``."""
+    return max(begins for begins, _ in timing).bit_length()
+
+
+_TIMING: Final = tuple((_begins(c), c) for c in _CPB)
+"""The output queue's (``begins``, ``length``) per bit rate (``fast`` 0, 1)."""
+CLOCK_BITS: Final = stamp_bits(_TIMING)
+"""The width of the ``now`` port of :class:`CounterRtl` and :class:`CounterLinesRtl` with a shared clock count."""
+
+
 class LineQueue:
     """The bits on their way to a line, each sent for a bit period a fixed time after it was pushed, as time stamps
     (docs/rtl.md "Counter telegram block"), built in ``m``: a free-running clock count ``now``, the ``waiting``
     bits pushed but not yet begun (``values`` and their push times, newest first, shifted at each push), and the
     bit on the line (``sent``) with the clocks it has ``left``. The oldest waiting bit goes on the line from the
     clock ``begins`` after its push and stays there for ``length`` clocks or until the next one begins; then the
-    line shows ``idle``. ``timing[rate]`` is (``begins``, ``length``) for each value of ``rate``.
+    line shows ``idle``. ``timing[rate]`` is (``begins``, ``length``) for each value of ``rate``. ``now`` may come
+    from outside: any count of at least :func:`stamp_bits` bits that steps by one every clock and is never reset
+    (only its differences are read), so that several queues share one.
 
     ``slots`` waiting bits at most: the caller proves that no more are pushed within the longest ``begins``. The
     time stamps, values and ``sent`` need no reset (``waiting`` and ``left`` say which count). A push's statements
@@ -71,10 +86,15 @@ class LineQueue:
     """
 
     def __init__(self, m: Module, *, push: Value, value: Value, rate: Value, timing: tuple[tuple[int, int], ...],
-                 slots: int, idle: int, name: str) -> None:  # fmt: skip
+                 slots: int, idle: int, name: str, now: Value | None = None) -> None:  # fmt: skip
         sync = m.d.sync
-        bits = max(begins for begins, _ in timing).bit_length()  # the waiting bits' ages are distinct modulo 2**bits
-        now = Signal(bits, name=f"{name}_now", reset_less=True)
+        bits = stamp_bits(timing)
+        if now is None:
+            now = Signal(bits, name=f"{name}_now", reset_less=True)
+            sync += now.eq(now + 1)
+        elif len(now) < bits:
+            raise ValueError(f"now must have at least {bits} bits, not {len(now)}")
+        now = now[:bits]
         stamp = [Signal(bits, name=f"{name}{k}_stamp", reset_less=True) for k in range(slots)]
         self.values = [Signal(len(value), name=f"{name}{k}_value", reset_less=True) for k in range(slots)]
         waiting = Signal(range(slots + 1), name=f"{name}_waiting")
@@ -87,7 +107,6 @@ class LineQueue:
                 result = Mux(rate == k, pick(*entry), result)
             return result
 
-        sync += now.eq(now + 1)
         # the oldest waiting bit begins on the line in the next cycle (``begins`` clocks after its push)
         due = (now + by_rate(lambda begins, _: (1 - begins) % (1 << bits)))[:bits]
         head = [(waiting == k + 1) & (stamp[k] == due) for k in range(slots)]
@@ -113,12 +132,15 @@ def _at_rate(fast: Value, test: Callable[[int], Value]) -> Value:
 class CounterRtl(wiring.Component):
     """The counter telegram block (ports: :data:`~supi3.lbd.COUNTER_INPUTS` in,
     :data:`~supi3.lbd.COUNTER_OUTPUTS` out; the pin model ``CounterBlock`` defines their timing).
-    ``fast`` is a strap: change it only while the line is idle."""
+    ``fast`` is a strap: change it only while the line is idle. With ``shared_clock`` the output queue takes its
+    clock count from an extra port ``now`` (:data:`CLOCK_BITS` wide, see :class:`LineQueue`) instead of its own."""
 
-    def __init__(self) -> None:
+    def __init__(self, *, shared_clock: bool = False) -> None:
+        self.shared_clock = check_bool("shared_clock", shared_clock)
         super().__init__({
             **{pin.name: In(pin.width) for pin in COUNTER_INPUTS},
             **{pin.name: Out(pin.width) for pin in COUNTER_OUTPUTS},
+            **({"now": In(CLOCK_BITS)} if shared_clock else {}),
         })  # fmt: skip
 
     def elaborate(self, _platform: object) -> Module:
@@ -216,8 +238,8 @@ class CounterRtl(wiring.Component):
             sync += seen.eq(seen_now)
 
         # The output queue and the outputs ------------------------------------------------------------------------
-        queue = LineQueue(m, push=sample, value=Cat(out, drive), rate=fast, timing=tuple((_begins(c), c) for c in _CPB),
-                          slots=_WAITING, idle=_IDLE_VALUE, name="tx")  # fmt: skip
+        queue = LineQueue(m, push=sample, value=Cat(out, drive), rate=fast, timing=_TIMING, slots=_WAITING,
+                          idle=_IDLE_VALUE, name="tx", now=self.now if self.shared_clock else None)  # fmt: skip
         shown = queue.shown
         comb += [self.out.eq(shown[0]), self.drive.eq(shown[1]), self.seen.eq(seen), self.count.eq(counted)]
         return m
@@ -237,7 +259,7 @@ class CounterLinesRtl(wiring.Component):
     return block's ``out`` in LBD-MR, else ``source``); ``branch_line`` the synchronised DI3, out ``seen`` and
     ``count`` of its block, the BK's counter telegram strobe and count (``cnt_valid``, ``count``), and ``returned``
     the BK's return watch on it in every mode (``ret_valid``, BK-38: ``supi3.rtl.terminal.ReturnWatchRtl``), and
-    ``branch_busy`` its ``busy`` (BK-47).
+    ``branch_busy`` its ``busy`` (BK-47); ``now`` the clock count both blocks' output queues share (:class:`LineQueue`).
     """
 
     def __init__(self) -> None:
@@ -245,11 +267,12 @@ class CounterLinesRtl(wiring.Component):
             "line": In(1), "fast": In(1), "sent": In(1), "source": In(1), "forward": In(1), "looped": In(1),
             "run": In(1), "clear": In(1), "do2": Out(1), "di1": Out(1), "branch": In(1), "branch_line": In(1),
             "seen": Out(1), "count": Out(wire.COUNTER_MAX.bit_length()), "returned": Out(1), "branch_busy": Out(1),
+            "now": In(CLOCK_BITS),
         })  # fmt: skip
 
     def elaborate(self, _platform: object) -> Module:
         m = Module()
-        forward, back = CounterRtl(), CounterRtl()
+        forward, back = CounterRtl(shared_clock=True), CounterRtl(shared_clock=True)
         m.submodules.back = ResetInserter(self.clear | ~self.run | ~self.looped)(back)
         on = self.forward | self.branch
         watch = ReturnWatchRtl(_CPB[0].bit_length())
@@ -261,7 +284,7 @@ class CounterLinesRtl(wiring.Component):
         m.d.sync += [stages[0].eq(self.source), *(b.eq(a) for a, b in pairwise(stages))]
         m.d.comb += [
             forward.line.eq(Mux(self.branch, self.branch_line, self.line)), forward.fast.eq(self.fast),
-            back.line.eq(stages[-1]), back.fast.eq(self.fast),
+            back.line.eq(stages[-1]), back.fast.eq(self.fast), forward.now.eq(self.now), back.now.eq(self.now),
             self.do2.eq(Mux(forward.drive & self.forward, forward.out, self.sent)),
             self.di1.eq(Mux(self.looped, back.out, self.source)),
             self.seen.eq(forward.seen), self.count.eq(forward.count),
