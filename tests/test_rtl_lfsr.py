@@ -14,7 +14,17 @@ from amaranth.sim import Simulator, SimulatorContext
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from supi3.rtl.lfsr import TAPS, Countdown, advance, count_state, count_width, next_state, step
+from supi3.rtl.lfsr import (
+    TAPS,
+    Countdown,
+    advance,
+    count_state,
+    count_width,
+    down_state,
+    down_step,
+    next_state,
+    step,
+)
 
 
 def _prime_factors(n: int) -> set[int]:
@@ -111,3 +121,25 @@ def test_next_state_in_gates_is_step(seed: int) -> None:
 def test_count_width_rejects_a_count_out_of_range(most: int) -> None:
     with pytest.raises(ValueError, match="most must be from 0"):
         count_width(most)
+
+
+@pytest.mark.parametrize(("value", "width"), [(0, 2), (1, 2), (3, 2), (12, 9), (64, 9), (256, 9)])
+def test_down_counter_reaches_zero_after_its_value(value: int, width: int) -> None:
+    m = Module()
+    state, after = Signal(width), Signal(width)
+    m.d.comb += after.eq(down_step(state))
+    trail: list[int] = []
+
+    async def bench(ctx: SimulatorContext) -> None:
+        current = down_state(value, width)
+        for _ in range(value + 2):
+            trail.append(current)
+            ctx.set(state, current)
+            current = ctx.get(after)
+
+    sim = Simulator(m)
+    sim.add_testbench(bench)
+    sim.run()
+    assert trail[value:] == [0, 0]
+    assert 0 not in trail[:value]
+    assert value == 0 or trail[value - 1] == 1

@@ -70,7 +70,7 @@ from supi3.regmap.core import BYTE_BITS
 from supi3.rtl.counter import CounterLinesRtl, LineQueue, lbd_lines, stamp_bits
 from supi3.rtl.expansion import PIN_NAMES as EXPANSION_PINS
 from supi3.rtl.expansion import ExpansionRtl
-from supi3.rtl.lfsr import Countdown, before, count_state, count_width, next_state
+from supi3.rtl.lfsr import TAPS, Countdown, before, count_state, count_width, down_state, down_step, next_state
 from supi3.rtl.optical import OpticalRtl
 from supi3.rtl.serial_io import DIRECTIONS, SER_IN_PIN, WIDTHS, SerialIoRtl
 from supi3.rtl.tables import (
@@ -539,7 +539,7 @@ class Supi3Core(wiring.Component):
             datapath.chain.eq(expansion.active),
             datapath.chain_bit.eq(expansion.send),
             outputs.expansion.eq(ext),
-            outputs.expansion_pulse.eq(cpb * PULSE_T0),
+            outputs.rate.eq(rate),
         ]
 
         # Init-µP modes: the ID register, the data length and the IN data from the register file (docs/upif.md)
@@ -1072,7 +1072,7 @@ class OutputsRtl(wiring.Component):
             "frame": In(MANAGEMENT), "words": In(WORDS),
             "stat_err_n_s": In(1), "di2_s": In(1), "rbst_ext_s": In(1), "di2": In(1), "do2": In(1),
             "divider": In(divider_bits), "rbst_by_pin": In(1), "complete_diag": In(1),
-            "expansion": In(1), "expansion_pulse": In(range(_EXPANSION_PULSE_MAX + 1)),
+            "expansion": In(1), "rate": In(range(len(BIT_RATES))),
             "local_bus": In(1), "bus_terminal": In(1), "idle_timeout": In(1), "counted": In(1), "ended": In(1),
             "fo": In(3), "ld": In(1), "e": In(1), "alarm": In(1), "bk_attention": In(1),
             "mau": In(len(wire.MAU_WARNINGS)), "optical_quiet": In(1),
@@ -1119,12 +1119,16 @@ class OutputsRtl(wiring.Component):
 
         # Pulse counters: loaded with the width at the edge that starts the pulse, the pin low while non-zero, so
         # low for exactly the width's clocks (Table 3-13: 375 ns = tables.RESREG_PULSE_CLOCKS; /ModAck M3).
+        # /ResReg's counter counts down as an LFSR (lfsr.down_state): loaded with constants, ``0`` when done.
         mod_ack = Signal(range(MODACK_PULSE_CLOCKS + 1))
-        res_reg = Signal(range(max(RESREG_PULSE_CLOCKS, _EXPANSION_PULSE_MAX) + 1))
+        res_width = max(min(TAPS), max(RESREG_PULSE_CLOCKS, _EXPANSION_PULSE_MAX).bit_length())
+        res_reg = Signal(res_width)
+        # 4 t0 with the register expansion (RX-5), per bit rate
+        expansion_pulse = Array(Const(down_state(PULSE_T0 * clocks_per_bit(rate), res_width), res_width)
+                                for rate in range(len(BIT_RATES)))[self.rate]  # fmt: skip
         with m.If(mod_ack != 0):
             sync += mod_ack.eq(mod_ack - 1)
-        with m.If(res_reg != 0):
-            sync += res_reg.eq(res_reg - 1)
+        sync += res_reg.eq(down_step(res_reg))
         # RC (DG-4): /ResReg is low while the incoming line is silent, too.
         line_silent, line_interrupt = self.line_silent, Signal()
         comb += [self.mod_ack_n.eq(mod_ack == 0), self.res_reg_n.eq((res_reg == 0) & ~line_silent)]
@@ -1145,9 +1149,10 @@ class OutputsRtl(wiring.Component):
         attention_now = attention | (filtered & ~pf) | fire | (pending & ~events).any()
         sync += [pf.eq(pf_now), wd.eq(wd_now), attention.eq(attention_now)]
         with m.If(fire):  # the watchdog resets process data (Table 3-13); 4 t0 with the register expansion (RX-5)
-            sync += [wd_active.eq(0), res_reg.eq(Mux(self.expansion, self.expansion_pulse, RESREG_PULSE_CLOCKS))]
+            sync += [wd_active.eq(0),
+                     res_reg.eq(Mux(self.expansion, expansion_pulse, down_state(RESREG_PULSE_CLOCKS, res_width)))]
         with m.If(f.clear & self.expansion):  # /ResReg on an INTERBUS reset with the register expansion (RX-5)
-            sync += res_reg.eq(self.expansion_pulse)
+            sync += res_reg.eq(expansion_pulse)
         comb += words.watchdog_reset.eq(fire)
 
         # The following device (Table 2-2, M5)

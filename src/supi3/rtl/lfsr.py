@@ -15,9 +15,12 @@ from __future__ import annotations
 
 from typing import Final
 
-from amaranth.hdl import Cat, Module, Signal, Value
+from amaranth.hdl import Cat, Module, Mux, Signal, Value
 
-__all__ = ["TAPS", "Countdown", "advance", "before", "count_state", "count_width", "next_state", "step"]
+__all__ = [
+    "TAPS", "Countdown", "advance", "before", "count_state", "count_width", "down_state", "down_step", "next_state",
+    "step",
+]  # fmt: skip
 
 TAPS: Final[dict[int, tuple[int, ...]]] = {
     2: (2, 1), 3: (3, 2), 4: (4, 3), 5: (5, 3), 6: (6, 5), 7: (7, 6), 8: (8, 6, 5, 4), 9: (9, 5), 10: (10, 7),
@@ -81,6 +84,17 @@ def count_state(value: int, width: int) -> int:
     return advance(1, width, value)
 
 
+def down_state(value: int, width: int) -> int:
+    """The state that stands for the value ``value`` of a down counter as an LFSR that ends at ``1`` then ``0``
+    (:class:`Countdown`'s states): ``0`` is ``0``, ``v`` the state ``v - 1`` steps before ``1``."""
+    return 0 if value == 0 else before(value - 1, width)
+
+
+def down_step(state: Value) -> Value:
+    """One step of such a down counter in gates: ``1`` goes to ``0``, ``0`` stays, any other state steps."""
+    return Mux(state == 1, 0, next_state(state))
+
+
 def next_state(state: Value) -> Value:
     """:func:`step` in gates, for a signal whose width has taps."""
     return Cat(Cat(*(state[tap - 1] for tap in TAPS[len(state)])).xor(), state[:-1])
@@ -97,7 +111,7 @@ class Countdown:
         if not 1 <= limit < 1 << max(TAPS):
             raise ValueError(f"limit must be from 1 to {(1 << max(TAPS)) - 1}, not {limit}")
         width = max(min(TAPS), limit.bit_length())  # limit < 2 ** width: the states limit..1 are distinct
-        start = before(limit - 1, width)
+        start = down_state(limit, width)
         state = Signal(width, name=name)
         self.last: Value = state == 1
         self.idle: Value = state == 0
