@@ -337,13 +337,14 @@ class Supi3Core(wiring.Component):
         # The power-up reset with its stretch (1.7.2, M2), from the synchronised /ResU and voltage monitor ---------
         power_fail = ~(receiver.resu_n_s & receiver.vmon_ok_s)
         holding = Signal()
-        stretch = Signal(range(RESET_STRETCH_CLOCKS + 1), init=RESET_STRETCH_CLOCKS)
+        stretch_width = max(min(TAPS), RESET_STRETCH_CLOCKS.bit_length())  # counts down as an LFSR (lfsr.down_state)
+        stretch = Signal(stretch_width, init=down_state(RESET_STRETCH_CLOCKS, stretch_width))
         with m.If(power_fail):
             m.d.sync += holding.eq(1)
         with m.Elif(holding):
-            m.d.sync += [holding.eq(0), stretch.eq(RESET_STRETCH_CLOCKS - 1)]
-        with m.Elif(stretch != 0):
-            m.d.sync += stretch.eq(stretch - 1)
+            m.d.sync += [holding.eq(0), stretch.eq(down_state(RESET_STRETCH_CLOCKS - 1, stretch_width))]
+        with m.Else():
+            m.d.sync += stretch.eq(down_step(stretch))
         running = ~power_fail & ~holding & (stretch == 0)
 
         def gated(block: wiring.Component) -> Elaboratable:
@@ -1119,16 +1120,15 @@ class OutputsRtl(wiring.Component):
 
         # Pulse counters: loaded with the width at the edge that starts the pulse, the pin low while non-zero, so
         # low for exactly the width's clocks (Table 3-13: 375 ns = tables.RESREG_PULSE_CLOCKS; /ModAck M3).
-        # /ResReg's counter counts down as an LFSR (lfsr.down_state): loaded with constants, ``0`` when done.
-        mod_ack = Signal(range(MODACK_PULSE_CLOCKS + 1))
+        # Both count down as LFSRs (lfsr.down_state): loaded with constants, ``0`` when done.
+        mod_width = max(min(TAPS), MODACK_PULSE_CLOCKS.bit_length())
+        mod_ack = Signal(mod_width)
         res_width = max(min(TAPS), max(RESREG_PULSE_CLOCKS, _EXPANSION_PULSE_MAX).bit_length())
         res_reg = Signal(res_width)
         # 4 t0 with the register expansion (RX-5), per bit rate
         expansion_pulse = Array(Const(down_state(PULSE_T0 * clocks_per_bit(rate), res_width), res_width)
                                 for rate in range(len(BIT_RATES)))[self.rate]  # fmt: skip
-        with m.If(mod_ack != 0):
-            sync += mod_ack.eq(mod_ack - 1)
-        sync += res_reg.eq(down_step(res_reg))
+        sync += [mod_ack.eq(down_step(mod_ack)), res_reg.eq(down_step(res_reg))]
         # RC (DG-4): /ResReg is low while the incoming line is silent, too.
         line_silent, line_interrupt = self.line_silent, Signal()
         comb += [self.mod_ack_n.eq(mod_ack == 0), self.res_reg_n.eq((res_reg == 0) & ~line_silent)]
@@ -1188,7 +1188,7 @@ class OutputsRtl(wiring.Component):
             with m.If(command[wire.CMD_WD_SET_BIT]):
                 sync += [wd_code.eq(code), *arm(code)]
             with m.If(command[wire.CMD_QUIT_BIT]):  # Quit Peripheral Error (3.6.2)
-                sync += [pf.eq(module_error), mod_ack.eq(MODACK_PULSE_CLOCKS)]
+                sync += [pf.eq(module_error), mod_ack.eq(down_state(MODACK_PULSE_CLOCKS, mod_width))]
             # OPT-50, OPT-53: the status byte sent in this cycle is read; the next request; ATTN while an event waits
             told_next = Mux(send_optical, told ^ events_now, told)
             events_next = Mux(send_optical, self.mau ^ told_next, events_now)
