@@ -40,6 +40,7 @@ from supi3.lbd import (
     send_countdown,
 )
 from supi3.pinout import SYNC_STAGES
+from supi3.rtl.lfsr import count_state, count_width, next_state
 from supi3.rtl.tables import core_tables
 from supi3.rtl.terminal import ReturnWatchRtl
 
@@ -158,7 +159,11 @@ class CounterRtl(wiring.Component):
         kind = Signal(range(len(Kind)), init=Kind.PASS, reset_less=True)
         carry = Signal(reset_less=True)
         frame = Signal()
-        quiet = Signal(range(COUNTER_SILENCE_BITS + 1))
+        # idle bits since the last telegram, up to COUNTER_SILENCE_BITS, counted as an LFSR (lfsr.count_state)
+        quiet_width = count_width(COUNTER_SILENCE_BITS)
+        quiet = Signal(quiet_width, init=count_state(0, quiet_width))
+        quiet_full = quiet == count_state(COUNTER_SILENCE_BITS, quiet_width)
+        quiet_start = count_state(0, quiet_width)
         byte = Signal(8, reset_less=True)
         counted = Signal(wire.COUNT_BITS)
         gen = Signal(range(IDLE_BIT + 1), init=IDLE_BIT)
@@ -190,8 +195,8 @@ class CounterRtl(wiring.Component):
                 with m.If(line == wire.START_LEVEL):
                     comb += begin.eq(1)
                 with m.Else():
-                    sync += quiet.eq(Mux(quiet == COUNTER_SILENCE_BITS, quiet, quiet + 1))
-                    with m.If(quiet + 1 >= COUNTER_SILENCE_BITS):
+                    sync += quiet.eq(Mux(quiet_full, quiet, next_state(quiet)))
+                    with m.If(quiet_full | (quiet == count_state(COUNTER_SILENCE_BITS - 1, quiet_width))):
                         sync += frame.eq(0)
             with m.Else():
                 sync += bit.eq(bit + 1)
@@ -221,16 +226,16 @@ class CounterRtl(wiring.Component):
                             comb += seen_now.eq(1)
             with m.If(begin):
                 sync += [bit.eq(1), data.eq(1), kind.eq(Mux(frame, Kind.PASS, Kind.MAYBE)), carry.eq(1),
-                         quiet.eq(0), drop.eq((gen != IDLE_BIT) | (drop & ~idle_rx))]  # fmt: skip
+                         quiet.eq(quiet_start), drop.eq((gen != IDLE_BIT) | (drop & ~idle_rx))]  # fmt: skip
 
             # The generator and what goes out ----------------------------------------------------------------------
-            silent = idle_rx & (line == wire.IDLE_LEVEL) & (quiet == COUNTER_SILENCE_BITS)
+            silent = idle_rx & (line == wire.IDLE_LEVEL) & quiet_full
             with m.If((gen != IDLE_BIT) | silent):
                 k = Mux(silent, 0, gen)
                 comb += [out.eq(Const(GENERATED_TELEGRAM, wire.DATA_TELEGRAM_BITS).bit_select(k, 1)), drive.eq(1)]
                 sync += gen.eq(k + 1)  # the stop bit's k + 1 is IDLE_BIT
                 with m.If(silent):
-                    sync += quiet.eq(0)
+                    sync += quiet.eq(quiet_start)
             with m.Elif(drop & ~idle_rx):
                 comb += [out.eq(wire.IDLE_LEVEL), drive.eq(1)]
             with m.Else():
