@@ -78,12 +78,12 @@ class LineQueue:
     bit on the line (``sent``) with the clocks it has ``left``. The oldest waiting bit goes on the line from the
     clock ``begins`` after its push and stays there for ``length`` clocks or until the next one begins; then the
     line shows ``idle``. ``timing[rate]`` is (``begins``, ``length``) for each value of ``rate``. ``now`` may come
-    from outside: any count of at least :func:`stamp_bits` bits that steps by one every clock and is never reset
-    (only its differences are read), so that several queues share one.
+    from outside: any count of at least :func:`stamp_bits` bits that steps by one every clock and is reset only
+    with the queue (only its differences are read), so that several queues share one.
 
     ``slots`` waiting bits at most: the caller proves that no more are pushed within the longest ``begins``. The
-    time stamps, values and ``sent`` need no reset (``waiting`` and ``left`` say which count). A push's statements
-    come after this constructor's, so a caller may overwrite ``values`` after the shift (later assignments win).
+    time stamps, values and ``sent`` need no reset (``waiting`` and ``left`` say which count). A caller's later
+    assignments to ``values`` win over the push's shift (the ERR pair of the transmitter).
     """
 
     def __init__(self, m: Module, *, push: Value, value: Value, rate: Value, timing: tuple[tuple[int, int], ...],
