@@ -40,7 +40,7 @@ from supi3.lbd import (
     send_countdown,
 )
 from supi3.pinout import SYNC_STAGES
-from supi3.rtl.lfsr import count_state, count_width, next_state
+from supi3.rtl.lfsr import TAPS, count_state, count_width, down_state, down_step, next_state
 from supi3.rtl.tables import core_tables
 from supi3.rtl.terminal import ReturnWatchRtl
 
@@ -100,7 +100,9 @@ class LineQueue:
         self.values = [Signal(len(value), name=f"{name}{k}_value", reset_less=True) for k in range(slots)]
         waiting = Signal(range(slots + 1), name=f"{name}_waiting")
         sent = Signal(len(value), name=f"{name}_sent", reset_less=True)
-        left = Signal(range(max(length for _, length in timing) + 1), name=f"{name}_left")
+        # the clocks left count down as an LFSR (lfsr.down_state), 0 when the line is idle
+        left_width = max(min(TAPS), max(length for _, length in timing).bit_length())
+        left = Signal(left_width, name=f"{name}_left")
 
         def by_rate(pick: Callable[[int, int], int]) -> Value:
             result = Value.cast(pick(*timing[0]))
@@ -114,9 +116,9 @@ class LineQueue:
         begin_now = Cat(*head).any()
         oldest = functools.reduce(operator.or_, (Mux(h, v, 0) for h, v in zip(head, self.values, strict=True)))
         with m.If(begin_now):
-            sync += [sent.eq(oldest), left.eq(by_rate(lambda _, length: length))]
-        with m.Elif(left != 0):
-            sync += left.eq(left - 1)
+            sync += [sent.eq(oldest), left.eq(by_rate(lambda _, length: down_state(length, left_width)))]
+        with m.Else():
+            sync += left.eq(down_step(left))
         sync += waiting.eq(waiting - begin_now)
         with m.If(push):
             sync += [stamp[0].eq(now), self.values[0].eq(value), waiting.eq(waiting + 1 - begin_now),
