@@ -31,11 +31,12 @@ terminal modes, the core sends IN data 0 and the straps' ID code, which is what 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from itertools import pairwise
 from typing import Final
 
 from amaranth.back import verilog as amaranth_verilog
-from amaranth.hdl import Array, Cat, Const, Elaboratable, EnableInserter, Module, Mux, ResetInserter, Signal, Value
+from amaranth.hdl import Array, Cat, Const, Elaboratable, Module, Mux, ResetInserter, Signal, Value
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
@@ -66,10 +67,10 @@ from supi3.pinout import (
 )
 from supi3.regmap import INTERRUPT_SOURCES
 from supi3.regmap.core import BYTE_BITS
-from supi3.rtl.counter import CounterLinesRtl, lbd_lines
+from supi3.rtl.counter import CounterLinesRtl, LineQueue, lbd_lines, stamp_bits
 from supi3.rtl.expansion import PIN_NAMES as EXPANSION_PINS
 from supi3.rtl.expansion import ExpansionRtl
-from supi3.rtl.lfsr import Countdown, before, next_state
+from supi3.rtl.lfsr import TAPS, Countdown, before, count_state, count_width, down_state, down_step, next_state
 from supi3.rtl.optical import OpticalRtl
 from supi3.rtl.serial_io import DIRECTIONS, SER_IN_PIN, WIDTHS, SerialIoRtl
 from supi3.rtl.tables import (
@@ -217,6 +218,16 @@ def _crc_word(crc: Value) -> Value:
     return word ^ wire.CRC_XOROUT
 
 
+def _per_rate(rate: Value, clocks: tuple[ClockEntry, ...], value: Callable[[ClockEntry], Value | int]) -> Value:
+    """``value`` of the clock entry whose bit rate is ``rate``, one term per entry (the first for any other
+    ``rate``): a compare or load with a constant per bit rate costs a few gates where one with the bit period as a
+    signal needs an adder or a magnitude comparator (docs/rtl.md "Size and build time", round 3)."""
+    result = Value.cast(value(clocks[0]))
+    for entry in clocks[1:]:
+        result = Mux(rate == entry.rate, value(entry), result)
+    return result
+
+
 class Supi3Core(wiring.Component):
     """The SUPI 3 chip core with the pins of :data:`supi3.pinout.CORE_INPUTS` and ``CORE_OUTPUTS`` and the strap ports.
 
@@ -262,9 +273,6 @@ class Supi3Core(wiring.Component):
         io_map = Signal(range(len(tables.io_maps)))
         clocks = tables.clocks
         cpb = Signal(range(max(e.clocks_per_bit for e in clocks) + 1))
-        reset_run = Signal(range(max(e.reset_run for e in clocks) + 1))
-        tx_countdown = max(e.forward_delay + e.clocks_per_bit // 2 - 1 for e in clocks)
-        tx_init = Signal(range(tx_countdown + 1))
         dclk = Signal()
         rbst_by_pin = Signal()
         complete_diag = Signal()
@@ -299,8 +307,6 @@ class Supi3Core(wiring.Component):
             return [
                 rate.eq(entry.rate),
                 cpb.eq(entry.clocks_per_bit),
-                reset_run.eq(entry.reset_run),
-                tx_init.eq(entry.forward_delay + entry.clocks_per_bit // 2 - 1),
                 dclk.eq(~cycle[cpb_bits - 1]),  # c % cpb < cpb // 2 (the model's DCLK_OUT)
             ]
 
@@ -316,8 +322,8 @@ class Supi3Core(wiring.Component):
         ]
 
         # The blocks (docs/rtl.md, "Architecture"). Each block's clocked logic runs on the clocks where the model's
-        # _tick runs (``running``) and is cleared by a power failure; the receiver's synchronisers always run, so the
-        # receiver applies the enable and reset to its line receiver itself.
+        # _tick runs (``running``) and is held in its reset state otherwise (``gated``); the receiver's synchronisers
+        # always run, so the receiver applies ``run`` and ``clear`` to its line receiver itself.
         m.submodules.receiver = receiver = ReceiverRtl(tables)
         frame = FrameEngineRtl()
         datapath = DataPathRtl(tables)
@@ -330,17 +336,22 @@ class Supi3Core(wiring.Component):
         # The power-up reset with its stretch (1.7.2, M2), from the synchronised /ResU and voltage monitor ---------
         power_fail = ~(receiver.resu_n_s & receiver.vmon_ok_s)
         holding = Signal()
-        stretch = Signal(range(RESET_STRETCH_CLOCKS + 1), init=RESET_STRETCH_CLOCKS)
+        stretch_width = max(min(TAPS), RESET_STRETCH_CLOCKS.bit_length())  # counts down as an LFSR (lfsr.down_state)
+        stretch = Signal(stretch_width, init=down_state(RESET_STRETCH_CLOCKS, stretch_width))
         with m.If(power_fail):
             m.d.sync += holding.eq(1)
         with m.Elif(holding):
-            m.d.sync += [holding.eq(0), stretch.eq(RESET_STRETCH_CLOCKS - 1)]
-        with m.Elif(stretch != 0):
-            m.d.sync += stretch.eq(stretch - 1)
+            m.d.sync += [holding.eq(0), stretch.eq(down_state(RESET_STRETCH_CLOCKS - 1, stretch_width))]
+        with m.Else():
+            m.d.sync += stretch.eq(down_step(stretch))
         running = ~power_fail & ~holding & (stretch == 0)
 
         def gated(block: wiring.Component) -> Elaboratable:
-            gated_block: Elaboratable = ResetInserter(power_fail)(EnableInserter(running)(block))
+            # Held in reset while not running, which is the same as stopping it: every stop begins with a power
+            # failure, which resets it, and the initial state is the reset state, so it stays in that state until
+            # ``running`` rises; a reset costs a gate per flip-flop, an enable a multiplexer (docs/rtl.md "Size and
+            # build time", round 3). The registers without reset may change meanwhile: each is written before read.
+            gated_block: Elaboratable = ResetInserter(~running)(block)
             return gated_block
 
         m.submodules.frame = gated(frame)
@@ -355,7 +366,7 @@ class Supi3Core(wiring.Component):
         m.d.comb += [
             lines.line.eq(receiver.do1_s), lines.fast.eq(cpb == clocks_per_bit(1)), lines.sent.eq(transmitter.do2),
             lines.source.eq(outputs.di1), lines.forward.eq(lbd), lines.looped.eq(lbd_mr), lines.run.eq(running),
-            lines.clear.eq(power_fail), frame.lbd.eq(lbd),
+            lines.clear.eq(power_fail), frame.lbd.eq(lbd), lines.now.eq(cycle),
         ]  # fmt: skip
 
         # The bus terminal module (2.4, docs/bus-terminal.md): in reset until the core runs, so that it takes CONF as it
@@ -375,26 +386,29 @@ class Supi3Core(wiring.Component):
         with m.Elif(running & (di3 == wire.START_LEVEL)):
             m.d.sync += connected.eq(1)
         tx_watch = ReturnWatchRtl(len(cpb))
-        m.submodules.tx_watch = ResetInserter(power_fail)(EnableInserter(running)(tx_watch))
+        m.submodules.tx_watch = ResetInserter(~running)(tx_watch)
         m.d.comb += [tx_watch.line.eq(lines.do2), tx_watch.cpb.eq(cpb)]
         sel3 = Signal()
         sel2 = Signal(2, init=_SENT)
-        drain = Mux(cpb == clocks_per_bit(1), clocks_per_bit(1), clocks_per_bit(0)) * BRANCH_DRAIN_BITS
-        drained = Signal(range(clocks_per_bit(0) * BRANCH_DRAIN_BITS + 1))
+        # DI3's idle clocks up to BRANCH_DRAIN_BITS bit periods, counted up as an LFSR (lfsr.count_state)
+        drain_width = count_width(max(e.clocks_per_bit for e in clocks) * BRANCH_DRAIN_BITS)
+        drained = Signal(drain_width, init=count_state(0, drain_width))
+        full = _per_rate(rate, clocks, lambda e: drained == count_state(e.clocks_per_bit * BRANCH_DRAIN_BITS,
+                                                                         drain_width))  # fmt: skip
         tx_free = ~tx_watch.busy
         tx_leave = tx_free & (lines.do2 == wire.IDLE_LEVEL)
         di3_free = ~lines.branch_busy
         di3_idle = di3_free & (di3 == wire.IDLE_LEVEL)
         want = Mux(terminal.enabled, _DI3, _SENT)
-        leave = (sel2 == _IDLE) | Mux(sel2 == _SENT, tx_leave, di3_idle & (drained >= drain))
-        with m.If(power_fail):
-            m.d.sync += [sel3.eq(0), sel2.eq(_SENT), drained.eq(0)]
-        with m.Elif(running):
+        leave = (sel2 == _IDLE) | Mux(sel2 == _SENT, tx_leave, di3_idle & full)
+        with m.If(~running):  # reset, and held so until the core runs (as ``gated``)
+            m.d.sync += [sel3.eq(0), sel2.eq(_SENT), drained.eq(count_state(0, drain_width))]
+        with m.Else():
             with m.If((sel3 != terminal.live) & Mux(sel3, tx_leave, tx_free)):
                 m.d.sync += sel3.eq(terminal.live)
             with m.If((sel2 != want) & leave):
                 m.d.sync += sel2.eq(Mux(Mux(terminal.enabled, di3_free, tx_free), want, _IDLE))
-            m.d.sync += drained.eq(Mux(di3_idle, Mux(drained >= drain, drain, drained + 1), 0))
+            m.d.sync += drained.eq(Mux(di3_idle, Mux(full, drained, next_state(drained)), count_state(0, drain_width)))
         do2 = Signal(init=wire.IDLE_LEVEL)
         m.d.comb += do2.eq(Mux(sel2 == _SENT, lines.do2, Mux(sel2 == _DI3, di3, wire.IDLE_LEVEL)))
         # The master's telegrams back on DI3 (BK-38) and, in BK-LBD, the counter block on DI3 (BK-39).
@@ -434,10 +448,9 @@ class Supi3Core(wiring.Component):
         m.d.comb += [
             receiver.run.eq(running),
             receiver.clear.eq(power_fail),
-            receiver.cpb.eq(cpb),
-            receiver.reset_run.eq(reset_run),
-            transmitter.cpb.eq(cpb),
-            transmitter.tx_init.eq(tx_init),
+            receiver.rate.eq(rate),
+            transmitter.rate.eq(rate),
+            transmitter.now.eq(cycle),  # the free-running clock count (never reset) the output queues share
             datapath.mfp_in.eq(receiver.mfp_in_s),
             datapath.io_map.eq(io_map),
             outputs.stat_err_n_s.eq(receiver.stat_err_n_s),
@@ -526,7 +539,7 @@ class Supi3Core(wiring.Component):
             datapath.chain.eq(expansion.active),
             datapath.chain_bit.eq(expansion.send),
             outputs.expansion.eq(ext),
-            outputs.expansion_pulse.eq(cpb * PULSE_T0),
+            outputs.rate.eq(rate),
         ]
 
         # Init-µP modes: the ID register, the data length and the IN data from the register file (docs/upif.md)
@@ -605,10 +618,10 @@ class ReceiverRtl(wiring.Component):
         members.update(
             run=In(1),
             clear=In(1),
-            cpb=In(range(max(e.clocks_per_bit for e in clocks) + 1)),
-            reset_run=In(range(max(e.reset_run for e in clocks) + 1)),
+            rate=In(range(max(e.rate for e in clocks) + 1)),
             line=Out(LINE),
         )
+        self.clocks = clocks
         super().__init__(members)
 
     def elaborate(self, _platform: object) -> Module:
@@ -618,38 +631,52 @@ class ReceiverRtl(wiring.Component):
             m.d.sync += [stages[0].eq(getattr(self, pin.name)), *(b.eq(a) for a, b in pairwise(stages))]
             m.d.comb += getattr(self, f"{pin.name}_s").eq(stages[-1])
         rx = Module()
-        m.submodules.line = ResetInserter(self.clear)(EnableInserter(self.run)(rx))
+        m.submodules.line = ResetInserter(self.clear | ~self.run)(rx)
         sync, comb = rx.d.sync, rx.d.comb
         line = self.do1_s
         out = self.line
+        clocks = self.clocks
+
+        def per_rate(value: Callable[[ClockEntry], Value | int]) -> Value:
+            return _per_rate(self.rate, clocks, value)
 
         # INTERBUS reset, idle time-out (docs/interbus.md A12, A13)
         in_reset = Signal()
         reset_end = Signal(range(wire.RESET_END_STATUS_TELEGRAMS + 1))
-        low_run = Signal.like(self.reset_run)
-        silent = Signal(range(IDLE_TIMEOUT_CLOCKS + 2), init=1)  # clocks since the last start of no counter telegram
+        # Both counters count up as LFSRs (supi3.rtl.lfsr): only loaded, stepped and compared with constants, so the
+        # count v is the state v steps after 1 (``lfsr.count_state``) and a step is an XOR instead of a carry chain.
+        run_width = count_width(max(e.reset_run for e in clocks))
+        low_run = Signal(run_width, init=count_state(0, run_width))  # clocks at the start level, stopping at reset_run
+        silent_width = count_width(IDLE_TIMEOUT_CLOCKS + 1)
+        # clocks since the last start of no counter telegram, from 1 on, stopping one beyond the time-out
+        silent = Signal(silent_width, init=count_state(1, silent_width))
+
+        def since_start(e: ClockEntry) -> int:
+            """``silent`` after a control bit's sample, cpb // 2 + 3 cpb clocks after its telegram's start bit."""
+            return count_state(e.clocks_per_bit // 2 + wire.POS_CONTROL * e.clocks_per_bit + 1, silent_width)
+
         counted = Signal()  # a counter telegram since then (DG-9)
         low = line == wire.START_LEVEL
-        enter_reset = low & (low_run + 1 == self.reset_run)
-        idle_timeout = silent == IDLE_TIMEOUT_CLOCKS  # once per silence: the count stops one beyond
+        enter_reset = low & per_rate(lambda e: low_run == count_state(e.reset_run - 1, run_width))
+        idle_timeout = silent == count_state(IDLE_TIMEOUT_CLOCKS, silent_width)  # once per silence
         with rx.If(~low):
-            sync += low_run.eq(0)
-        with rx.Elif(low_run != self.reset_run):
-            sync += low_run.eq(low_run + 1)
-        with rx.If(silent != IDLE_TIMEOUT_CLOCKS + 1):
-            sync += silent.eq(silent + 1)
+            sync += low_run.eq(count_state(0, run_width))
+        with rx.Elif(per_rate(lambda e: low_run != count_state(e.reset_run, run_width))):
+            sync += low_run.eq(next_state(low_run))
+        with rx.If(silent != count_state(IDLE_TIMEOUT_CLOCKS + 1, silent_width)):
+            sync += silent.eq(next_state(silent))
         with rx.If(enter_reset):
             sync += [in_reset.eq(1), reset_end.eq(0)]
         in_reset_now = in_reset | enter_reset
 
         # Framing and mid-bit sampling
         busy = Signal()  # in a telegram (the FSM below)
-        phase = Signal.like(self.cpb)  # clocks since the start bit began, modulo the bit period
+        phase = Signal(range(max(e.clocks_per_bit for e in clocks)))  # clocks since the start bit, modulo the bit
         bit = Signal(_POSITION)
         select = Signal()
         control = Signal()
         is_data = Signal(init=1)
-        sample = busy & (phase == self.cpb // 2)
+        sample = busy & per_rate(lambda e: phase == e.clocks_per_bit // 2)
         data_now = Mux(bit == wire.POS_TYPE, line == wire.TYPE_DATA_LEVEL, is_data)
         end = bit == Mux(data_now, _DATA_TELEGRAM_END, _STATUS_TELEGRAM_END)
         with rx.FSM(name="telegram") as fsm:
@@ -657,7 +684,7 @@ class ReceiverRtl(wiring.Component):
                 sync += [phase.eq(1), bit.eq(0), is_data.eq(1)]
                 rx.next = "TELEGRAM"
             with rx.State("TELEGRAM"):
-                sync += phase.eq(Mux(phase == self.cpb - 1, 0, phase + 1))
+                sync += phase.eq(Mux(per_rate(lambda e: phase == e.clocks_per_bit - 1), 0, phase + 1))
                 with rx.If(sample & end & (line == wire.STOP_LEVEL)):
                     rx.next = "BETWEEN"
         comb += busy.eq(fsm.ongoing("TELEGRAM"))
@@ -670,7 +697,7 @@ class ReceiverRtl(wiring.Component):
                 # 3 cpb clocks after it) unless it is a counter telegram (DG-9, BK-36).
                 sync += [control.eq(line), counted.eq(out.counter)]
                 with rx.If(~out.counter):
-                    sync += silent.eq(self.cpb // 2 + wire.POS_CONTROL * self.cpb + 1)
+                    sync += silent.eq(per_rate(since_start))
             with rx.If(end & (line != wire.STOP_LEVEL)):  # M16: the stop bit's period is the next start bit
                 sync += [bit.eq(1), is_data.eq(1)]
 
@@ -733,14 +760,15 @@ class FrameEngineRtl(wiring.Component):
 
         id_cycle = Signal()  # the frame's cycle type: 1 = ID cycle
         latches = Signal(range(wire.LATCH_STATUS_TELEGRAMS + 1))
-        crc_rx = Signal(WORD_BITS, init=wire.CRC_INIT)
-        crc_tx = Signal(WORD_BITS, init=wire.CRC_INIT)
-        index = Signal(range(wire.CHECK_TELEGRAMS + 2))
+        # Read only in CHECK, and set when a frame is loaded (the CRCs) or enters CHECK (the rest): no reset
+        crc_rx = Signal(WORD_BITS, init=wire.CRC_INIT, reset_less=True)
+        crc_tx = Signal(WORD_BITS, init=wire.CRC_INIT, reset_less=True)
+        index = Signal(range(wire.CHECK_TELEGRAMS + 2), reset_less=True)
+        crc_bad = Signal(reset_less=True)
+        cntr_bad = Signal(reset_less=True)
         local_error = Signal()
         err_in = Signal()
         attn = Signal()
-        crc_bad = Signal()
-        cntr_bad = Signal()
         err_bit = Signal()
         pairs = [
             tuple(sorted(p))
@@ -985,50 +1013,35 @@ class DataPathRtl(wiring.Component):
 class TransmitterRtl(wiring.Component):
     """Transmitter and repeater (block ``transmitter``).
 
-    A short queue of (countdown to the end of the bit period, level) entries, newest first: each sample pushes the
-    level it sends, which goes out on DO2 ``tx_init`` clocks later for one bit period (``cpb``), so every bit is
-    repeated :data:`supi3.interbus.wire.REPEATER_DELAY_BITS` after it began on DO1 (A10); DO2 is the newest begun
-    entry while it lasts. The ERR pair of the CNTR word is rewritten at the last stop bit (``tx``,
-    :data:`TRANSMIT`, flipped).
+    Each sample pushes the level it sends, which goes out on DO2 from ``forward_delay - cpb // 2`` clocks later for
+    one bit period (``cpb``) or until the next one begins, so every bit is repeated
+    :data:`supi3.interbus.wire.REPEATER_DELAY_BITS` after it began on DO1 (A10): the levels wait in the time-stamp
+    queue of the counter telegram block (:class:`supi3.rtl.counter.LineQueue`, the same timing, M8). The ERR pair of
+    the CNTR word is rewritten at the last stop bit (``tx``, :data:`TRANSMIT`, flipped) in the two levels pushed
+    before it, which are still waiting (``_tx_waiting``).
     """
 
     def __init__(self, tables: CoreTables) -> None:
         self.tables = tables
         clocks = tables.clocks
-        countdown = max(e.forward_delay + e.clocks_per_bit // 2 - 1 for e in clocks)
+        if sorted(e.rate for e in clocks) != list(range(len(clocks))):
+            raise ValueError("the transmitter needs one clock entry per bit rate, by rate index")
         members: dict[str, object] = {
             "frame": In(TRANSMIT),
-            "cpb": In(range(max(e.clocks_per_bit for e in clocks) + 1)),
-            "tx_init": In(range(countdown + 1)),
+            "rate": In(range(max(e.rate for e in clocks) + 1)),
+            "now": In(stamp_bits(_tx_timing(tables))),
             "do2": Out(1, init=wire.IDLE_LEVEL),
         }
         super().__init__(members)
 
     def elaborate(self, _platform: object) -> Module:
         m = Module()
-        sync, comb = m.d.sync, m.d.comb
         f = self.frame
-        slots = _tx_slots(self.tables)
-        width = len(self.tx_init)
-        countdown = [Signal(width, name=f"tx{k}_count") for k in range(slots)]
-        # a level counts while its countdown runs, and each push sets both: the levels need no reset
-        level = [Signal(name=f"tx{k}_level", reset_less=True) for k in range(slots)]
-        for r in countdown:
-            with m.If(r != 0):
-                sync += r.eq(r - 1)
-        with m.If(f.push):
-            sync += [countdown[0].eq(self.tx_init), level[0].eq(f.level)]
-            for k in range(1, slots):
-                sync += [
-                    countdown[k].eq(Mux(countdown[k - 1] != 0, countdown[k - 1] - 1, 0)),
-                    level[k].eq(level[k - 1]),
-                ]
+        queue = LineQueue(m, push=f.push, value=f.level, rate=self.rate, timing=_tx_timing(self.tables),
+                          slots=_tx_waiting(self.tables), idle=wire.IDLE_LEVEL, name="tx", now=self.now)  # fmt: skip
         with m.If(f.set_err):
-            sync += [level[1].eq(f.err), level[2].eq(~f.err)]
-        do2 = Const(wire.IDLE_LEVEL)
-        for r, v in reversed(list(zip(countdown, level, strict=True))):
-            do2 = Mux(r <= self.cpb, Mux(r != 0, v, wire.IDLE_LEVEL), do2)
-        comb += self.do2.eq(do2)
+            m.d.sync += [queue.values[1].eq(f.err), queue.values[2].eq(~f.err)]
+        m.d.comb += self.do2.eq(queue.shown)
         return m
 
 
@@ -1058,7 +1071,7 @@ class OutputsRtl(wiring.Component):
             "frame": In(MANAGEMENT), "words": In(WORDS),
             "stat_err_n_s": In(1), "di2_s": In(1), "rbst_ext_s": In(1), "di2": In(1), "do2": In(1),
             "divider": In(divider_bits), "rbst_by_pin": In(1), "complete_diag": In(1),
-            "expansion": In(1), "expansion_pulse": In(range(_EXPANSION_PULSE_MAX + 1)),
+            "expansion": In(1), "rate": In(range(len(BIT_RATES))),
             "local_bus": In(1), "bus_terminal": In(1), "idle_timeout": In(1), "counted": In(1), "ended": In(1),
             "fo": In(3), "ld": In(1), "e": In(1), "alarm": In(1), "bk_attention": In(1),
             "mau": In(len(wire.MAU_WARNINGS)), "optical_quiet": In(1),
@@ -1105,12 +1118,15 @@ class OutputsRtl(wiring.Component):
 
         # Pulse counters: loaded with the width at the edge that starts the pulse, the pin low while non-zero, so
         # low for exactly the width's clocks (Table 3-13: 375 ns = tables.RESREG_PULSE_CLOCKS; /ModAck M3).
-        mod_ack = Signal(range(MODACK_PULSE_CLOCKS + 1))
-        res_reg = Signal(range(max(RESREG_PULSE_CLOCKS, _EXPANSION_PULSE_MAX) + 1))
-        with m.If(mod_ack != 0):
-            sync += mod_ack.eq(mod_ack - 1)
-        with m.If(res_reg != 0):
-            sync += res_reg.eq(res_reg - 1)
+        # Both count down as LFSRs (lfsr.down_state): loaded with constants, ``0`` when done.
+        mod_width = max(min(TAPS), MODACK_PULSE_CLOCKS.bit_length())
+        mod_ack = Signal(mod_width)
+        res_width = max(min(TAPS), max(RESREG_PULSE_CLOCKS, _EXPANSION_PULSE_MAX).bit_length())
+        res_reg = Signal(res_width)
+        # 4 t0 with the register expansion (RX-5), per bit rate
+        expansion_pulse = Array(Const(down_state(PULSE_T0 * clocks_per_bit(rate), res_width), res_width)
+                                for rate in range(len(BIT_RATES)))[self.rate]  # fmt: skip
+        sync += [mod_ack.eq(down_step(mod_ack)), res_reg.eq(down_step(res_reg))]
         # RC (DG-4): /ResReg is low while the incoming line is silent, too.
         line_silent, line_interrupt = self.line_silent, Signal()
         comb += [self.mod_ack_n.eq(mod_ack == 0), self.res_reg_n.eq((res_reg == 0) & ~line_silent)]
@@ -1131,9 +1147,10 @@ class OutputsRtl(wiring.Component):
         attention_now = attention | (filtered & ~pf) | fire | (pending & ~events).any()
         sync += [pf.eq(pf_now), wd.eq(wd_now), attention.eq(attention_now)]
         with m.If(fire):  # the watchdog resets process data (Table 3-13); 4 t0 with the register expansion (RX-5)
-            sync += [wd_active.eq(0), res_reg.eq(Mux(self.expansion, self.expansion_pulse, RESREG_PULSE_CLOCKS))]
+            sync += [wd_active.eq(0),
+                     res_reg.eq(Mux(self.expansion, expansion_pulse, down_state(RESREG_PULSE_CLOCKS, res_width)))]
         with m.If(f.clear & self.expansion):  # /ResReg on an INTERBUS reset with the register expansion (RX-5)
-            sync += res_reg.eq(self.expansion_pulse)
+            sync += res_reg.eq(expansion_pulse)
         comb += words.watchdog_reset.eq(fire)
 
         # The following device (Table 2-2, M5)
@@ -1169,7 +1186,7 @@ class OutputsRtl(wiring.Component):
             with m.If(command[wire.CMD_WD_SET_BIT]):
                 sync += [wd_code.eq(code), *arm(code)]
             with m.If(command[wire.CMD_QUIT_BIT]):  # Quit Peripheral Error (3.6.2)
-                sync += [pf.eq(module_error), mod_ack.eq(MODACK_PULSE_CLOCKS)]
+                sync += [pf.eq(module_error), mod_ack.eq(down_state(MODACK_PULSE_CLOCKS, mod_width))]
             # OPT-50, OPT-53: the status byte sent in this cycle is read; the next request; ATTN while an event waits
             told_next = Mux(send_optical, told ^ events_now, told)
             events_next = Mux(send_optical, self.mau ^ told_next, events_now)
@@ -1206,19 +1223,33 @@ class OutputsRtl(wiring.Component):
         return m
 
 
-def _tx_slots(tables: CoreTables) -> int:
-    """Transmitter entries needed: every bit not yet begun on DO2 plus the one being sent.
+def _tx_begins(entry: ClockEntry) -> int:
+    """Clocks from a bit's push (its mid-bit sample, ``cpb // 2`` clocks into the bit on DO1) to its first clock on
+    DO2, ``forward_delay`` after it began on DO1."""
+    return entry.forward_delay - entry.clocks_per_bit // 2
 
-    A bit goes out ``forward_delay - cpb // 2`` clocks after its sample; samples are at least ``cpb // 2 + 1``
-    clocks apart (a stop bit sampled mid-bit, then a start bit on the next clock). The model keeps more entries
-    (eight); the older ones can no longer be on the line.
+
+def _tx_timing(tables: CoreTables) -> tuple[tuple[int, int], ...]:
+    """The transmitter's :class:`~supi3.rtl.counter.LineQueue` timing: (``_tx_begins``, ``cpb``) by rate index."""
+    return tuple((_tx_begins(e), e.clocks_per_bit) for e in sorted(tables.clocks, key=lambda e: e.rate))
+
+
+def _tx_waiting(tables: CoreTables) -> int:
+    """Transmitter levels pushed and not yet begun on DO2, at most.
+
+    A bit goes out ``_tx_begins`` clocks after its sample; samples are at least ``cpb // 2 + 1`` clocks apart (a
+    stop bit sampled mid-bit, then a start bit on the next clock). The ERR pair needs the two levels pushed before a
+    stop bit to be waiting: they were pushed ``cpb`` and ``2 cpb`` clocks before it (one telegram's grid), and
+    ``2 cpb + 1`` is less than ``_tx_begins`` at every bit rate (checked here). The model keeps more entries (eight).
     """
     most = 0
     for entry in tables.clocks:
-        delay = entry.forward_delay - entry.clocks_per_bit // 2
+        delay = _tx_begins(entry)
+        if 2 * entry.clocks_per_bit + 1 >= delay:  # not begun, nor beginning at that clock
+            raise ValueError("the ERR pair's levels must still be waiting when the last stop bit is sampled")
         spacing = entry.clocks_per_bit // 2 + 1
         most = max(most, (delay - 2) // spacing + 1)
-    return max(most + 1, 3)  # the ERR pair rewrites the two entries before the last stop bit
+    return max(most, 3)  # the ERR pair rewrites the two entries before the last stop bit
 
 
 def verilog(variant: Variant | str = Variant.OPC) -> str:

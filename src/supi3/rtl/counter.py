@@ -20,10 +20,11 @@ from collections.abc import Callable
 from itertools import pairwise
 from typing import Final
 
-from amaranth.hdl import Cat, Const, EnableInserter, Module, Mux, ResetInserter, Signal, Value
+from amaranth.hdl import Cat, Const, Module, Mux, ResetInserter, Signal, Value
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
+from supi3.checks import check_bool
 from supi3.config import Interface, Variant, decode, mode_rows
 from supi3.interbus import wire
 from supi3.lbd import (
@@ -39,10 +40,11 @@ from supi3.lbd import (
     send_countdown,
 )
 from supi3.pinout import SYNC_STAGES
+from supi3.rtl.lfsr import TAPS, count_state, count_width, down_state, down_step, next_state
 from supi3.rtl.tables import core_tables
 from supi3.rtl.terminal import ReturnWatchRtl
 
-__all__ = ["CounterLinesRtl", "CounterRtl", "lbd_lines"]
+__all__ = ["CLOCK_BITS", "CounterLinesRtl", "CounterRtl", "LineQueue", "lbd_lines", "stamp_bits"]
 
 _CPB: Final = (clocks_per_bit(0), clocks_per_bit(1))
 _IDLE_VALUE: Final = wire.IDLE_LEVEL
@@ -57,14 +59,72 @@ def _begins(cpb: int) -> int:
     return send_countdown(cpb) - cpb + 1
 
 
-_STAMP_BITS: Final = max(_begins(cpb) for cpb in _CPB).bit_length()
-"""Width of the free-running clock count and of a waiting bit's sample time: the waiting bits' ages (under
-``_begins``) are distinct modulo ``2 ** _STAMP_BITS``."""
+def stamp_bits(timing: tuple[tuple[int, int], ...]) -> int:
+    """The width of a :class:`LineQueue`'s time stamps for ``timing``: the waiting bits' ages (under the longest
+    ``begins``) are distinct modulo ``2 ** stamp_bits``."""
+    return max(begins for begins, _ in timing).bit_length()
 
 
-def _by_rate(fast: Value, values: tuple[int, int]) -> Value:
-    """``values[fast]`` as a gate (500 kbit/s, 2 Mbit/s)."""
-    return Mux(fast, values[1], values[0])
+_TIMING: Final = tuple((_begins(c), c) for c in _CPB)
+"""The output queue's (``begins``, ``length``) per bit rate (``fast`` 0, 1)."""
+CLOCK_BITS: Final = stamp_bits(_TIMING)
+"""The width of the ``now`` port of :class:`CounterRtl` and :class:`CounterLinesRtl` with a shared clock count."""
+
+
+class LineQueue:
+    """The bits on their way to a line, each sent for a bit period a fixed time after it was pushed, as time stamps
+    (docs/rtl.md "Counter telegram block"), built in ``m``: a free-running clock count ``now``, the ``waiting``
+    bits pushed but not yet begun (``values`` and their push times, newest first, shifted at each push), and the
+    bit on the line (``sent``) with the clocks it has ``left``. The oldest waiting bit goes on the line from the
+    clock ``begins`` after its push and stays there for ``length`` clocks or until the next one begins; then the
+    line shows ``idle``. ``timing[rate]`` is (``begins``, ``length``) for each value of ``rate``. ``now`` may come
+    from outside: any count of at least :func:`stamp_bits` bits that steps by one every clock and is reset only
+    with the queue (only its differences are read), so that several queues share one.
+
+    ``slots`` waiting bits at most: the caller proves that no more are pushed within the longest ``begins``. The
+    time stamps, values and ``sent`` need no reset (``waiting`` and ``left`` say which count). A caller's later
+    assignments to ``values`` win over the push's shift (the ERR pair of the transmitter).
+    """
+
+    def __init__(self, m: Module, *, push: Value, value: Value, rate: Value, timing: tuple[tuple[int, int], ...],
+                 slots: int, idle: int, name: str, now: Value | None = None) -> None:  # fmt: skip
+        sync = m.d.sync
+        bits = stamp_bits(timing)
+        if now is None:
+            now = Signal(bits, name=f"{name}_now", reset_less=True)
+            sync += now.eq(now + 1)
+        elif len(now) < bits:
+            raise ValueError(f"now must have at least {bits} bits, not {len(now)}")
+        now = now[:bits]
+        stamp = [Signal(bits, name=f"{name}{k}_stamp", reset_less=True) for k in range(slots)]
+        self.values = [Signal(len(value), name=f"{name}{k}_value", reset_less=True) for k in range(slots)]
+        waiting = Signal(range(slots + 1), name=f"{name}_waiting")
+        sent = Signal(len(value), name=f"{name}_sent", reset_less=True)
+        # the clocks left count down as an LFSR (lfsr.down_state), 0 when the line is idle
+        left_width = max(min(TAPS), max(length for _, length in timing).bit_length())
+        left = Signal(left_width, name=f"{name}_left")
+
+        def by_rate(pick: Callable[[int, int], int]) -> Value:
+            result = Value.cast(pick(*timing[0]))
+            for k, entry in enumerate(timing[1:], 1):
+                result = Mux(rate == k, pick(*entry), result)
+            return result
+
+        # the oldest waiting bit begins on the line in the next cycle (``begins`` clocks after its push)
+        due = (now + by_rate(lambda begins, _: (1 - begins) % (1 << bits)))[:bits]
+        head = [(waiting == k + 1) & (stamp[k] == due) for k in range(slots)]
+        begin_now = Cat(*head).any()
+        oldest = functools.reduce(operator.or_, (Mux(h, v, 0) for h, v in zip(head, self.values, strict=True)))
+        with m.If(begin_now):
+            sync += [sent.eq(oldest), left.eq(by_rate(lambda _, length: down_state(length, left_width)))]
+        with m.Else():
+            sync += left.eq(down_step(left))
+        sync += waiting.eq(waiting - begin_now)
+        with m.If(push):
+            sync += [stamp[0].eq(now), self.values[0].eq(value), waiting.eq(waiting + 1 - begin_now),
+                     *(stamp[k].eq(stamp[k - 1]) for k in range(1, slots)),
+                     *(self.values[k].eq(self.values[k - 1]) for k in range(1, slots))]  # fmt: skip
+        self.shown: Value = Mux(left != 0, sent, idle)  # the line: the bit being sent, else ``idle``
 
 
 def _at_rate(fast: Value, test: Callable[[int], Value]) -> Value:
@@ -75,12 +135,15 @@ def _at_rate(fast: Value, test: Callable[[int], Value]) -> Value:
 class CounterRtl(wiring.Component):
     """The counter telegram block (ports: :data:`~supi3.lbd.COUNTER_INPUTS` in,
     :data:`~supi3.lbd.COUNTER_OUTPUTS` out; the pin model ``CounterBlock`` defines their timing).
-    ``fast`` is a strap: change it only while the line is idle."""
+    ``fast`` is a strap: change it only while the line is idle. With ``shared_clock`` the output queue takes its
+    clock count from an extra port ``now`` (:data:`CLOCK_BITS` wide, see :class:`LineQueue`) instead of its own."""
 
-    def __init__(self) -> None:
+    def __init__(self, *, shared_clock: bool = False) -> None:
+        self.shared_clock = check_bool("shared_clock", shared_clock)
         super().__init__({
             **{pin.name: In(pin.width) for pin in COUNTER_INPUTS},
             **{pin.name: Out(pin.width) for pin in COUNTER_OUTPUTS},
+            **({"now": In(CLOCK_BITS)} if shared_clock else {}),
         })  # fmt: skip
 
     def elaborate(self, _platform: object) -> Module:
@@ -89,6 +152,7 @@ class CounterRtl(wiring.Component):
         line, fast = self.line, self.fast
 
         # State ---------------------------------------------------------------------------------------------------
+        out, drive = Signal(), Signal()  # the bit sampled now on its way out (the output queue below)
         phase = Signal(range(max(_CPB)))
         pending = Signal()
         bit = Signal(range(IDLE_BIT + 1), init=IDLE_BIT)
@@ -97,24 +161,18 @@ class CounterRtl(wiring.Component):
         kind = Signal(range(len(Kind)), init=Kind.PASS, reset_less=True)
         carry = Signal(reset_less=True)
         frame = Signal()
-        quiet = Signal(range(COUNTER_SILENCE_BITS + 1))
+        # idle bits since the last telegram, up to COUNTER_SILENCE_BITS, counted as an LFSR (lfsr.count_state)
+        quiet_width = count_width(COUNTER_SILENCE_BITS)
+        quiet = Signal(quiet_width, init=count_state(0, quiet_width))
+        quiet_full = quiet == count_state(COUNTER_SILENCE_BITS, quiet_width)
+        quiet_start = count_state(0, quiet_width)
         byte = Signal(8, reset_less=True)
         counted = Signal(wire.COUNT_BITS)
         gen = Signal(range(IDLE_BIT + 1), init=IDLE_BIT)
         drop = Signal()
         seen = Signal()
-        # the output queue: the ``waiting`` bits not yet begun (newest first) with their sample times on a free-running
-        # clock count, and the bit on the line with the clocks it has ``left`` (docs/rtl.md "Counter telegram
-        # block"); ``waiting`` and ``left`` say which of them count, so the rest need no reset
-        now = Signal(_STAMP_BITS, reset_less=True)
-        stamp = [Signal(_STAMP_BITS, name=f"tx{k}_stamp", reset_less=True) for k in range(_WAITING)]
-        value = [Signal(2, name=f"tx{k}_value", reset_less=True) for k in range(_WAITING)]
-        waiting = Signal(range(_WAITING + 1))
-        sent = Signal(2, reset_less=True)
-        left = Signal(range(max(_CPB) + 1))
 
         # The bit grid and the sample -----------------------------------------------------------------------------
-        cpb = _by_rate(fast, _CPB)
         idle_rx = bit == IDLE_BIT
         restart = idle_rx & ~pending & (line == wire.START_LEVEL)
         ph = Mux(restart, 0, phase)
@@ -122,18 +180,7 @@ class CounterRtl(wiring.Component):
         sync += phase.eq(Mux(_at_rate(fast, lambda c: ph >= c - 1), 0, ph + 1))
         with m.If(restart):
             sync += pending.eq(1)
-        sync += [seen.eq(0), now.eq(now + 1)]
-        # the oldest waiting bit begins on the line in the next cycle (``_begins`` clocks after its sample)
-        ahead = [(1 - _begins(c)) % (1 << _STAMP_BITS) for c in _CPB]
-        due = (now + _by_rate(fast, (ahead[0], ahead[1])))[:_STAMP_BITS]
-        head = [(waiting == k + 1) & (stamp[k] == due) for k in range(_WAITING)]
-        begin_now = Cat(*head).any()
-        with m.If(begin_now):
-            sync += [sent.eq(functools.reduce(operator.or_, (Mux(h, v, 0) for h, v in zip(head, value, strict=True)))),
-                     left.eq(cpb)]  # fmt: skip
-        with m.Elif(left != 0):
-            sync += left.eq(left - 1)
-        sync += waiting.eq(waiting - begin_now)
+        sync += seen.eq(0)
 
         # The receiver (counter_step's _receive) ------------------------------------------------------------------
         rx_out, rx_drive, begin, seen_now = Signal(), Signal(), Signal(), Signal()
@@ -150,8 +197,8 @@ class CounterRtl(wiring.Component):
                 with m.If(line == wire.START_LEVEL):
                     comb += begin.eq(1)
                 with m.Else():
-                    sync += quiet.eq(Mux(quiet == COUNTER_SILENCE_BITS, quiet, quiet + 1))
-                    with m.If(quiet + 1 >= COUNTER_SILENCE_BITS):
+                    sync += quiet.eq(Mux(quiet_full, quiet, next_state(quiet)))
+                    with m.If(quiet_full | (quiet == count_state(COUNTER_SILENCE_BITS - 1, quiet_width))):
                         sync += frame.eq(0)
             with m.Else():
                 sync += bit.eq(bit + 1)
@@ -181,28 +228,26 @@ class CounterRtl(wiring.Component):
                             comb += seen_now.eq(1)
             with m.If(begin):
                 sync += [bit.eq(1), data.eq(1), kind.eq(Mux(frame, Kind.PASS, Kind.MAYBE)), carry.eq(1),
-                         quiet.eq(0), drop.eq((gen != IDLE_BIT) | (drop & ~idle_rx))]  # fmt: skip
+                         quiet.eq(quiet_start), drop.eq((gen != IDLE_BIT) | (drop & ~idle_rx))]  # fmt: skip
 
             # The generator and what goes out ----------------------------------------------------------------------
-            silent = idle_rx & (line == wire.IDLE_LEVEL) & (quiet == COUNTER_SILENCE_BITS)
-            out, drive = Signal(), Signal()
+            silent = idle_rx & (line == wire.IDLE_LEVEL) & quiet_full
             with m.If((gen != IDLE_BIT) | silent):
                 k = Mux(silent, 0, gen)
                 comb += [out.eq(Const(GENERATED_TELEGRAM, wire.DATA_TELEGRAM_BITS).bit_select(k, 1)), drive.eq(1)]
                 sync += gen.eq(k + 1)  # the stop bit's k + 1 is IDLE_BIT
                 with m.If(silent):
-                    sync += quiet.eq(0)
+                    sync += quiet.eq(quiet_start)
             with m.Elif(drop & ~idle_rx):
                 comb += [out.eq(wire.IDLE_LEVEL), drive.eq(1)]
             with m.Else():
                 comb += [out.eq(rx_out), drive.eq(rx_drive)]
-            sync += [seen.eq(seen_now), stamp[0].eq(now), value[0].eq(Cat(out, drive)),
-                     waiting.eq(waiting + 1 - begin_now),
-                     *(stamp[k].eq(stamp[k - 1]) for k in range(1, _WAITING)),
-                     *(value[k].eq(value[k - 1]) for k in range(1, _WAITING))]  # fmt: skip
+            sync += seen.eq(seen_now)
 
-        # Outputs -------------------------------------------------------------------------------------------------
-        shown = Mux(left != 0, sent, _IDLE_VALUE)
+        # The output queue and the outputs ------------------------------------------------------------------------
+        queue = LineQueue(m, push=sample, value=Cat(out, drive), rate=fast, timing=_TIMING, slots=_WAITING,
+                          idle=_IDLE_VALUE, name="tx", now=self.now if self.shared_clock else None)  # fmt: skip
+        shown = queue.shown
         comb += [self.out.eq(shown[0]), self.drive.eq(shown[1]), self.seen.eq(seen), self.count.eq(counted)]
         return m
 
@@ -221,7 +266,7 @@ class CounterLinesRtl(wiring.Component):
     return block's ``out`` in LBD-MR, else ``source``); ``branch_line`` the synchronised DI3, out ``seen`` and
     ``count`` of its block, the BK's counter telegram strobe and count (``cnt_valid``, ``count``), and ``returned``
     the BK's return watch on it in every mode (``ret_valid``, BK-38: ``supi3.rtl.terminal.ReturnWatchRtl``), and
-    ``branch_busy`` its ``busy`` (BK-47).
+    ``branch_busy`` its ``busy`` (BK-47); ``now`` the clock count both blocks' output queues share (:class:`LineQueue`).
     """
 
     def __init__(self) -> None:
@@ -229,23 +274,24 @@ class CounterLinesRtl(wiring.Component):
             "line": In(1), "fast": In(1), "sent": In(1), "source": In(1), "forward": In(1), "looped": In(1),
             "run": In(1), "clear": In(1), "do2": Out(1), "di1": Out(1), "branch": In(1), "branch_line": In(1),
             "seen": Out(1), "count": Out(wire.COUNTER_MAX.bit_length()), "returned": Out(1), "branch_busy": Out(1),
+            "now": In(CLOCK_BITS),
         })  # fmt: skip
 
     def elaborate(self, _platform: object) -> Module:
         m = Module()
-        forward, back = CounterRtl(), CounterRtl()
-        m.submodules.back = ResetInserter(self.clear | ~self.looped)(EnableInserter(self.run)(back))
+        forward, back = CounterRtl(shared_clock=True), CounterRtl(shared_clock=True)
+        m.submodules.back = ResetInserter(self.clear | ~self.run | ~self.looped)(back)
         on = self.forward | self.branch
         watch = ReturnWatchRtl(_CPB[0].bit_length())
-        m.submodules.watch = ResetInserter(self.clear)(EnableInserter(self.run)(watch))
+        m.submodules.watch = ResetInserter(self.clear | ~self.run)(watch)
         m.d.comb += [watch.line.eq(self.branch_line), watch.cpb.eq(Mux(self.fast, _CPB[1], _CPB[0])),
                      self.returned.eq(watch.seen), self.branch_busy.eq(watch.busy)]  # fmt: skip
-        m.submodules.forward = ResetInserter(self.clear | ~on)(EnableInserter(self.run)(forward))
+        m.submodules.forward = ResetInserter(self.clear | ~self.run | ~on)(forward)
         stages = [Signal(init=wire.IDLE_LEVEL, name=f"source_s{k}") for k in range(SYNC_STAGES)]
         m.d.sync += [stages[0].eq(self.source), *(b.eq(a) for a, b in pairwise(stages))]
         m.d.comb += [
             forward.line.eq(Mux(self.branch, self.branch_line, self.line)), forward.fast.eq(self.fast),
-            back.line.eq(stages[-1]), back.fast.eq(self.fast),
+            back.line.eq(stages[-1]), back.fast.eq(self.fast), forward.now.eq(self.now), back.now.eq(self.now),
             self.do2.eq(Mux(forward.drive & self.forward, forward.out, self.sent)),
             self.di1.eq(Mux(self.looped, back.out, self.source)),
             self.seen.eq(forward.seen), self.count.eq(forward.count),

@@ -7,16 +7,20 @@ decrement needs a carry chain of its width. :class:`Countdown` gives the behavio
 stops at ``0``; its states are the LFSR's, the idle state ``0`` (the LFSR's fixed point) is the counter's ``0``
 and the state ``1`` is the counter's ``1``, so a counter value ``v`` is the state ``v - 1`` steps before ``1``.
 The feedback taps are the maximal-length ones of Xilinx XAPP052 (Table 3), for every width from 2 to 25;
-``tests/test_rtl_lfsr.py`` checks each sequence's period.
+``tests/test_rtl_lfsr.py`` checks each sequence's period. An up counter that is only loaded with constants,
+stepped and compared with constants is the same LFSR read the other way (:func:`count_state`).
 """
 
 from __future__ import annotations
 
 from typing import Final
 
-from amaranth.hdl import Cat, Module, Signal, Value
+from amaranth.hdl import Cat, Module, Mux, Signal, Value
 
-__all__ = ["TAPS", "Countdown", "advance", "before", "next_state", "step"]
+__all__ = [
+    "TAPS", "Countdown", "advance", "before", "count_state", "count_width", "down_state", "down_step", "next_state",
+    "step",
+]  # fmt: skip
 
 TAPS: Final[dict[int, tuple[int, ...]]] = {
     2: (2, 1), 3: (3, 2), 4: (4, 3), 5: (5, 3), 6: (6, 5), 7: (7, 6), 8: (8, 6, 5, 4), 9: (9, 5), 10: (10, 7),
@@ -65,6 +69,32 @@ def before(steps: int, width: int) -> int:
     return advance(1, width, (1 << width) - 1 - steps)
 
 
+def count_width(most: int) -> int:
+    """The width of an LFSR that counts from 0 to ``most`` (``most`` from 0 to ``2 ** 25 - 2``): its first
+    ``most + 1`` states from ``1`` (:func:`count_state`) are distinct."""
+    if not 0 <= most < (1 << max(TAPS)) - 1:
+        raise ValueError(f"most must be from 0 to {(1 << max(TAPS)) - 2}, not {most}")
+    return max(min(TAPS), (most + 1).bit_length())
+
+
+def count_state(value: int, width: int) -> int:
+    """The state that stands for the count ``value`` of an up counter as an LFSR, ``value`` steps after the state
+    ``1``: a counter that is only loaded with constants, stepped and compared with constants counts ``v`` to
+    ``v + 1`` by :func:`next_state`."""
+    return advance(1, width, value)
+
+
+def down_state(value: int, width: int) -> int:
+    """The state that stands for the value ``value`` of a down counter as an LFSR that ends at ``1`` then ``0``
+    (:class:`Countdown`'s states): ``0`` is ``0``, ``v`` the state ``v - 1`` steps before ``1``."""
+    return 0 if value == 0 else before(value - 1, width)
+
+
+def down_step(state: Value) -> Value:
+    """One step of such a down counter in gates: ``1`` goes to ``0``, ``0`` stays, any other state steps."""
+    return Mux(state == 1, 0, next_state(state))
+
+
 def next_state(state: Value) -> Value:
     """:func:`step` in gates, for a signal whose width has taps."""
     return Cat(Cat(*(state[tap - 1] for tap in TAPS[len(state)])).xor(), state[:-1])
@@ -81,7 +111,7 @@ class Countdown:
         if not 1 <= limit < 1 << max(TAPS):
             raise ValueError(f"limit must be from 1 to {(1 << max(TAPS)) - 1}, not {limit}")
         width = max(min(TAPS), limit.bit_length())  # limit < 2 ** width: the states limit..1 are distinct
-        start = before(limit - 1, width)
+        start = down_state(limit, width)
         state = Signal(width, name=name)
         self.last: Value = state == 1
         self.idle: Value = state == 0
