@@ -125,11 +125,14 @@ def test_master_starts_the_ring_after_any_idle_from_power_up(
 
 @pytest.mark.parametrize("clk_conf", [CLK_CONF_500K, CLK_CONF_2M])
 def test_a_chip_leaving_reset_mid_telegram_repeats_the_line_bit_for_bit(clk_conf: str) -> None:
-    """M16: once the chip has read the telegram it woke up in (misframed: at 2 Mbit/s it reads a data telegram and
-    sends its register in place of the data bits, M8), a stop bit read at start level puts its receiver back on the
-    telegram grid, and DO2 is the master's line 3 bit periods later (A10), read mid-bit. Before M16 such a stop bit
-    restarted the receiver in the middle of a bit period, and the repeated line slipped by half a bit period."""
-    ring = PinRing([Supi3Pins(decode("10000", None, clk_conf=clk_conf))], record=True)
+    """M16, M19: the chip misreads the telegram it woke up in (at 2 Mbit/s as a data telegram), and a stop bit read at
+    start level puts its receiver back on the telegram grid; no frame begins before a whole status telegram (M19), so
+    it sends the misread bits on as received (before M19 it began a frame there and sent its register in their place,
+    M8) and DO2 is the master's line 3 bit periods later (A10), read mid-bit, from the first bit period the chip sees
+    whole. Before M16 such a stop bit restarted the receiver in the middle of a bit period, and the repeated line
+    slipped by half a bit period."""
+    chip = Supi3Pins(decode("10000", None, clk_conf=clk_conf))
+    ring = PinRing([chip], record=True)
     count = 40
     ring.run_levels(wire.status_levels(Cycle.DATA, False, count))
     sent = wire.status_levels(Cycle.DATA, False, count)
@@ -137,10 +140,10 @@ def test_a_chip_leaving_reset_mid_telegram_repeats_the_line_bit_for_bit(clk_conf
     first = -(-RESET_STRETCH_CLOCKS // ring.cpb)  # the first bit period the chip sees whole after its reset
     assert first % wire.STATUS_TELEGRAM_BITS != 0  # it wakes up inside a telegram at both bit rates
     delay = wire.REPEATER_DELAY_BITS
-    synced = first + wire.DATA_TELEGRAM_BITS  # the misframed telegram is at most a data telegram long
     for phase in (ring.cpb // 4, ring.cpb // 2, 3 * ring.cpb // 4):  # whole bit periods, not just their middles
         repeated = wire.samples_to_levels(do2, ring.bit_rate, phase)
-        assert np.array_equal(repeated[synced + delay :], sent[synced : len(sent) - delay]), phase
+        assert np.array_equal(repeated[first + delay :], sent[first : len(sent) - delay]), phase
+    assert not any("load" in entry for entry in chip.log.recent())  # no frame began
 
 
 def test_the_rings_receiver_resynchronises_after_a_fragment() -> None:

@@ -229,8 +229,9 @@ def recognition_history(kind: BranchKind, row: tuple[str, bool], ops: list[Op]) 
         was = tl_chips[1].branch_recognised
         results: list[CycleResult | None] = [None, None]
         if name == "cycle" and any(master.config is None for master in masters):
-            # Without a configuration a master starts again (an INTERBUS reset): a discovery ID cycle over devices that
-            # took no reset since their power-up fails at pin level in a ring without branches too (BK-54).
+            # Without a configuration a master starts again (an INTERBUS reset), as this history always did; a discovery
+            # ID cycle over chips that took no reset since their power-up (it failed at pin level, BK-54's limit 2) is
+            # compared on flat rings since M19, M20 (tests/test_model_pinring_powerup.py).
             name = "start"
         if name in ("start", "cycle"):
             results = [master.start() if name == "start" else master.cycle() for master in masters]

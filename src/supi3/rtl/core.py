@@ -757,6 +757,7 @@ class FrameEngineRtl(wiring.Component):
         # The FSM's state as flags, for the conditions below; the transitions are at the end.
         idle, in_data, in_check, in_wait = Signal(), Signal(), Signal(), Signal()
         load, check_start, check_done, latch_done = Signal(), Signal(), Signal(), Signal()
+        broken = Signal()  # a status telegram inside a frame: the frame ends, discarded with its local error (M20)
 
         id_cycle = Signal()  # the frame's cycle type: 1 = ID cycle
         latches = Signal(range(wire.LATCH_STATUS_TELEGRAMS + 1))
@@ -770,6 +771,7 @@ class FrameEngineRtl(wiring.Component):
         err_in = Signal()
         attn = Signal()
         err_bit = Signal()
+        on_grid = Signal()  # a whole status telegram since the power-up: a frame may begin (M19)
         pairs = [
             tuple(sorted(p))
             for p in ((wire.CNTR_ATTN_BIT, wire.CNTR_NATTN_BIT), (wire.CNTR_NERR_BIT, wire.CNTR_ERR_BIT))
@@ -786,7 +788,7 @@ class FrameEngineRtl(wiring.Component):
         io = self.io
         sync += io.eq(self.io_set | (io & ~self.io_clear))
         comb += [tx.push.eq(rx.sample), tx.level.eq(line), reg.level.eq(line),
-                 mg.frame_error.eq(~idle & local_error & ~self.hold)]  # fmt: skip
+                 mg.frame_error.eq(~idle & (local_error | broken) & ~self.hold)]  # fmt: skip
 
         # INTERBUS reset and idle time-out: the frame is dropped, the chip reset (chip.reset_at)
         clear = rx.bus_reset | rx.idle_timeout
@@ -818,7 +820,7 @@ class FrameEngineRtl(wiring.Component):
         counter_bit = rx.sample & rx.data_now & (rx.position == wire.POS_CONTROL)
         comb += rx.counter.eq(counter_bit & self.lbd & cycle_id & check & (idle | in_wait | rx.idle_timeout))
         with m.If(control_bit & ~rx.counter):
-            with m.If(~check & ~in_data):  # a frame begins: the register's parallel load
+            with m.If(~check & ~in_data), m.If(on_grid):  # a frame begins: the register's parallel load
                 abandon()
                 comb += [load.eq(1), reg.load.eq(1), reg.load_id.eq(cycle_id)]
                 sync += [
@@ -879,9 +881,13 @@ class FrameEngineRtl(wiring.Component):
                 err = error_now | cntr_bad | err_bit
                 sync += [local_error.eq(error_now), err_in.eq(cntr_bad | err_bit)]
                 comb += [check_done.eq(1), tx.set_err.eq(1), tx.err.eq(err)]
+            with m.If(~stop_bad & ~rx.data_now):
+                sync += on_grid.eq(1)
             with m.If(~stop_bad & ~rx.data_now & ~rx.in_reset):
                 with m.If(in_data | in_check):
                     sync += error()
+                    comb += broken.eq(1)
+                    abandon()
                 with m.Elif(in_wait):
                     latched = Mux(rx.control == wire.CONTROL_CHECK_LEVEL, latches + 1, 0)
                     sync += latches.eq(latched)
@@ -906,12 +912,12 @@ class FrameEngineRtl(wiring.Component):
             with m.State("IDLE"), m.If(load):
                 m.next = "DATA"
             with m.State("DATA"):
-                with m.If(clear):
+                with m.If(clear | broken):
                     m.next = "IDLE"
                 with m.If(check_start):
                     m.next = "CHECK"
             with m.State("CHECK"):
-                with m.If(clear):
+                with m.If(clear | broken):
                     m.next = "IDLE"
                 with m.If(load):
                     m.next = "DATA"

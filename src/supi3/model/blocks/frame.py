@@ -70,11 +70,15 @@ class FrameEngine:
         telegrams): data telegrams are repeated as received.
     counter_telegrams:
         The chip is in an LBD mode (Table 2-5): it takes counter telegrams as such (BK-36); set by the core.
+    on_grid:
+        A whole status telegram has been received since the power-up reset: the receiver is on the telegram grid
+        (M16), and only now does a data telegram begin a frame (M19).
     """
 
     __slots__ = (
         "attn", "check_index", "check_rx", "checks", "chip", "counter_telegrams", "crc_rx", "crc_tx", "cycle",
-        "datapath", "err_in", "in_reset", "latches", "local_error", "log", "reset_end_count", "state", "transmitter",
+        "datapath", "err_in", "in_reset", "latches", "local_error", "log", "on_grid", "reset_end_count", "state",
+        "transmitter",
     )  # fmt: skip
 
     def __init__(self, chip: Supi3, log: EventLog, datapath: DataPath, transmitter: Transmitter) -> None:
@@ -110,6 +114,7 @@ class FrameEngine:
         self.in_reset = False
         self.reset_end_count = 0
         """Status telegrams seen since the INTERBUS reset ended on the line."""
+        self.on_grid = False
 
     def enter_reset(self, c: int) -> None:
         """The receiver saw an INTERBUS reset at cycle ``c``."""
@@ -151,8 +156,9 @@ class FrameEngine:
             cycle = Cycle.ID if (word >> wire.POS_SELECT) & 1 == wire.SELECT_ID_LEVEL else Cycle.DATA
             check = level == wire.CONTROL_CHECK_LEVEL
             if not check and self.state != "data":
-                self.abandon(c)
-                self._start_frame(cycle, c)
+                if self.on_grid:  # M19: not off the grid a chip woke up on, after its power-up
+                    self.abandon(c)
+                    self._start_frame(cycle, c)
             elif cycle is not self.cycle:
                 self._error(c, "select bit changes inside a frame")
             if check:
@@ -230,6 +236,8 @@ class FrameEngine:
             self.checks += 1
         if stop != wire.STOP_LEVEL:
             return
+        if length == wire.STATUS_TELEGRAM_BITS:
+            self.on_grid = True
         if self.in_reset:
             if length == wire.STATUS_TELEGRAM_BITS:
                 self.reset_end_count += 1
@@ -242,6 +250,7 @@ class FrameEngine:
         latch = (word >> wire.POS_CONTROL) & 1 == wire.CONTROL_CHECK_LEVEL
         if self.state in ("data", "check"):
             self._error(c, "status telegram inside a frame")
+            self.abandon(c)
         elif self.state == "wait":
             self.latches = self.latches + 1 if latch else 0
             if self.latches == 1 and self.chip.io_access:
