@@ -700,3 +700,15 @@ def optical_script(config: DeviceConfig, ops: list[OpticalOp]) -> tuple[CoreScri
             script.id_cycle(int(args[0]))
         ends.append(sum(len(part["do1"]) for part in script.parts))
     return script, ends
+
+
+def digital_io_elves(folder: Path) -> dict[str, Path]:
+    """The digital 16/16 example built for each core at the board port's SPI1 clock (keys: the CPUs), and for the
+    Cortex-M3 with SPI1 at 3 MHz (key ``"br3"``: issue #13's bench case). Imported here on use: the emulated board's
+    modules are needed only by the firmware-in-the-loop tests."""
+    from supi3.mcu import build as mcu_build
+    from supi3.mcu.core import CPUS
+
+    elves = {cpu: mcu_build.build(native.example("digital_io"), folder / f"dio_{cpu}.elf", cpu=cpu) for cpu in CPUS}
+    elves["br3"] = mcu_build.build(native.example("digital_io"), folder / "br3.elf", defines={"BOARD_SPI_BR": "3u"})
+    return elves

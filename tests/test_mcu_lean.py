@@ -24,10 +24,10 @@ from supi3.mcu import build as mcu_build
 from supi3.mcu import core as core_module
 from supi3.mcu import hook
 from supi3.mcu.board import Board
-from supi3.mcu.core import CPUS, EXTERNAL
+from supi3.mcu.core import EXTERNAL
 from supi3.mcu.stm32 import EXTI0_IRQ
-from supi3.sdk import native
 from supi3.sdk.bench import Bench
+from support import digital_io_elves
 
 pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
 
@@ -36,10 +36,7 @@ pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reaso
 def digital_io(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     """The digital 16/16 example for each core at the port's SPI1 clock, and for the Cortex-M3 at 3 MHz (issue
     #13's bench case)."""
-    folder = tmp_path_factory.mktemp("lean")
-    elves = {cpu: mcu_build.build(native.example("digital_io"), folder / f"dio_{cpu}.elf", cpu=cpu) for cpu in CPUS}
-    elves["br3"] = mcu_build.build(native.example("digital_io"), folder / "br3.elf", defines={"BOARD_SPI_BR": "3u"})
-    return elves
+    return digital_io_elves(tmp_path_factory.mktemp("lean"))
 
 
 class EveryAccess(Board):

@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 from supi3.mcu import build as mcu_build
 from supi3.mcu import hook
 from supi3.mcu.board import Board
-from supi3.mcu.core import CPUS, HeldRegister
+from supi3.mcu.core import HeldRegister
 from supi3.mcu.stm32 import (
     APB2ENR,
     CR1_CPHA,
@@ -38,7 +38,7 @@ from supi3.mcu.stm32 import (
     Rcc,
     Spi,
 )
-from supi3.sdk import native
+from support import digital_io_elves
 
 pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
 
@@ -207,10 +207,7 @@ def test_a_byte_costs_the_model_no_read() -> None:
 def digital_io(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     """The digital 16/16 example for each core at the port's SPI1 clock, and for the Cortex-M3 at 3 MHz (issue
     #13's bench case)."""
-    folder = tmp_path_factory.mktemp("offer")
-    elves = {cpu: mcu_build.build(native.example("digital_io"), folder / f"dio_{cpu}.elf", cpu=cpu) for cpu in CPUS}
-    elves["br3"] = mcu_build.build(native.example("digital_io"), folder / "br3.elf", defines={"BOARD_SPI_BR": "3u"})
-    return elves
+    return digital_io_elves(tmp_path_factory.mktemp("offer"))
 
 
 class NoOffer:
