@@ -19,6 +19,7 @@ import time
 from pathlib import Path
 
 from bench_mcu import POWER_UP
+from supi3.cli import positive_integer
 from supi3.mcu.board import Board
 from supi3.mcu.build import build
 from supi3.sdk import native
@@ -42,19 +43,11 @@ def pin_run(elf: Path, cycles: int, repeat: int) -> tuple[tuple[float, float], t
     return best[0], best[1]
 
 
-def _count(text: str) -> int:
-    """A whole number from 1 up (argparse's type: anything else is a usage error naming the value)."""
-    value = int(text) if text.strip().isdigit() else 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"a whole number from 1 up, not {text!r}")
-    return value
-
-
 def main() -> None:
     """Build the example, run the parts, print the figures."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--cycles", type=_count, default=10, help="data cycles measured after the power-up")
-    parser.add_argument("--repeat", type=_count, default=3, help="fresh boards; the fastest part is reported")
+    parser.add_argument("--cycles", type=positive_integer, default=10, help="data cycles measured after the power-up")
+    parser.add_argument("--repeat", type=positive_integer, default=3, help="fresh boards; the fastest part is reported")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as folder:
         elf = build(native.example("digital_io"), Path(folder) / "digital_io.elf", cpu="cortex_m3")

@@ -21,16 +21,19 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
+from supi3.cli import positive_integer
 from test_model_pinring_tree import CASES, closes_alike  # the tests' helpers, on the path above
 
 
 def main() -> int:
     """Run the sweep given on the command line; 0 if every run is alike."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--start", type=int, default=6_000, help="first silence limit, clocks")
-    parser.add_argument("--stop", type=int, default=13_750, help="last silence limit (included), clocks")
-    parser.add_argument("--step", type=int, default=250, help="step, clocks")
+    parser.add_argument("--start", type=positive_integer, default=6_000, help="first silence limit, clocks")
+    parser.add_argument("--stop", type=positive_integer, default=13_750, help="last silence limit (included), clocks")
+    parser.add_argument("--step", type=positive_integer, default=250, help="step, clocks")
     args = parser.parse_args()
+    if args.stop < args.start:
+        parser.error(f"--stop ({args.stop}) must not be before --start ({args.start})")
     differing: list[tuple[int, str]] = []
     runs = 0
     for silence in range(args.start, args.stop + 1, args.step):

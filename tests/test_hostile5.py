@@ -10,6 +10,7 @@ user converts it.
 
 from __future__ import annotations
 
+import argparse
 import itertools
 import json
 import math
@@ -19,7 +20,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from supi3 import demo, timing
-from supi3.cli import main
+from supi3.cli import main, positive_integer
 from supi3.config import decode
 from supi3.errors import ArgumentError
 from supi3.interbus.master import Master
@@ -355,3 +356,15 @@ def test_a_chip_s_clock_never_goes_back(call: str) -> None:
         assert chip.optical_holding
         chip.poll(1.0 + 7e-3)  # 7 ms after: the 6 ms budget ran out (OPT-5)
         assert not chip.optical_holding
+
+
+@pytest.mark.parametrize("text", ["0", "-3", "x", "1e3", "1_000", " 5", "1.5", ""])
+def test_positive_integer_refuses_what_is_no_count(text: str) -> None:
+    """``supi3.cli.positive_integer``, the argparse type of the bench scripts' counts and steps: a named usage error,
+    never a traceback (``closure_sweep.py --step 0`` used to end in range()'s ValueError)."""
+    with pytest.raises(argparse.ArgumentTypeError, match="must be"):
+        positive_integer(text)
+
+
+def test_positive_integer_takes_counts() -> None:
+    assert [positive_integer(t) for t in ("1", "250", "13750")] == [1, 250, 13_750]

@@ -688,6 +688,14 @@ def integer(text: str) -> int:
     return int(text)
 
 
+def positive_integer(text: str) -> int:
+    """An argparse type: a decimal integer from 1 up (counts, repeats, steps; :func:`integer`'s digits)."""
+    value = integer(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a whole number from 1 up, not {_shown(text)}")
+    return value
+
+
 class _Parser(argparse.ArgumentParser):
     """An argument parser whose usage errors are one :class:`UsageError` line, like every other supi3 error, and
     which takes options only spelt out in full."""
