@@ -22,9 +22,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.master import CycleResult, Master
-from supi3.errors import ArgumentError
 from supi3.interbus.ring import (
     Branch,
     BranchKind,
@@ -41,6 +41,7 @@ from supi3.model.chip import Supi3
 from supi3.model.pinring import PinBranch, PinRing
 from supi3.model.pins import Supi3Pins
 from supi3.terminal import RF_CODES, branch_present
+from support import REPAIR_IDLE_TELEGRAMS
 from test_model_pinring_tree import INPUTS, LBST, ROWS, _bk, _config, nested_pin, nested_tl, view
 
 KINDS = [BranchKind.REMOTE, BranchKind.LOCAL, BranchKind.LBD_MR]
@@ -211,10 +212,10 @@ BK-52), every break repaired (index 0: while the master sends idle telegrams; 1:
 switched off or on by the master (BK-4), the BK's power-up reset (BK-48)."""
 POWER_DOWN_S = 4 * wire.STATUS_TELEGRAM_BITS / 2_000_000
 """How long the BK's /ResU is held low in a power-up step."""
-REPAIR_IDLE_S = 4 * wire.STATUS_TELEGRAM_BITS / 2_000_000
-"""Idle status telegrams after a repair (BK-54's limit): a repaired line takes up a telegram in flight at the repair
-point, and behind a break in an LBD branch a device that sends a counter telegram drops the telegram beginning then
-and the one chained to it (BK-30, M16); idle telegrams take that, not the next frame's head."""
+REPAIR_IDLE_S = REPAIR_IDLE_TELEGRAMS * wire.STATUS_TELEGRAM_BITS / 2_000_000
+"""Idle after a repair (M21): a repaired line takes up a telegram in flight at the repair point, and behind a break in
+an LBD branch a device that sends a counter telegram drops the telegram beginning then and the one chained to it
+(BK-30, M16); idle telegrams take that, not the next frame's head."""
 POWER_IDLE_S = 20 * wire.STATUS_TELEGRAM_BITS / 2_000_000
 """The idle after a power-up step: the reset stretch (M2) and the time a loop needs to answer (BK-37), an LBD branch's
 counter telegram every 33 bit periods (BK-30) included."""
