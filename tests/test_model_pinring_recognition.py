@@ -298,7 +298,7 @@ def test_the_recognition_follows_any_history_the_same_at_both_fidelities(
         assert tl == pin
 
 
-JOIN_ERRORS = {DeadLine(3): ErrorKind.TRANSMISSION, DeadLine(4): ErrorKind.TELEGRAM}
+JOIN_ERRORS: dict[Fault, ErrorKind] = {DeadLine(3): ErrorKind.TRANSMISSION, DeadLine(4): ErrorKind.TELEGRAM}
 """BK-56, measured at pin level: the error of the cycle a branch of two devices joins within, by the one line of its
 loop repaired before that cycle's run: the first device's forward input, the second's; any other (a return line) is a
 dead line."""

@@ -24,7 +24,8 @@ the data path (switched off by the master, closed by the BK itself, not present 
 branch once a device answered, BK-48); it flattens again whenever a BK changes that. In a tree a fault belongs to the
 physical line it was injected on: it follows that line when branches are switched, and sleeps while the line is out of
 the data path; :meth:`Ring.cut` injects a break by the physical position of the device it enters, as the pin level's
-``PinRing.cut`` (BK-52). A branch recognised in a cycle's run joins within its frame, which it loses (BK-54).
+``PinRing.cut`` (BK-52). A branch recognised in a cycle's run joins within its frame, which it loses (BK-54), with
+the error of the first line of its loop repaired before that run (BK-56).
 :class:`ReturnBreak` breaks a branch's return line (a branch in the data path with nothing attached is broken so at
 its BK, BK-43), and behind a break in a branch with device-oriented diagnostics the devices send the counter telegram
 to the BK (2.2.2, ``wire.counter_telegram``).
