@@ -87,6 +87,11 @@ OPTICAL_LINES = [pin.name for pin in Supi3Pins.optical_inputs]
 LOOPBACK = wire.LOOPBACK_BYTES_ON_LINE
 IDLE = wire.status_levels(Cycle.DATA, False, 8)
 """Eight idle status telegrams on the line."""
+REPAIR_IDLE_TELEGRAMS = 8
+"""Idle status telegrams a comparison of the fidelities sends after a repair, before the master's next frame (M21):
+the pin level repairs between two runs (a master's telegram boundary, inside a telegram at the repair point), and
+its chips are back on the telegram grid after at most 7 (measured at 2 Mbit/s: every line of the branch loops of
+``test_model_pinring_tree.CASES``), where the transaction level repairs between telegrams."""
 RB_INIT_UP = ("10011", "1110")
 """Remote bus device, Init-µP (Table 2-4): the C and MFP straps of a µP-mode chip."""
 

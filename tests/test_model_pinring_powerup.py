@@ -25,7 +25,7 @@ from supi3.model.chip import Supi3
 from supi3.model.pinring import PinRing
 from supi3.model.pins import Supi3Pins
 from supi3.verif import Lockstep
-from support import IDLE, CoreScript, frame_levels, quiet_inputs
+from support import IDLE, REPAIR_IDLE_TELEGRAMS, CoreScript, frame_levels, quiet_inputs
 from test_model_pinring_tree import view
 
 RB = next(row for row in tables.MODE_ROWS if row.function == "RB, 8 IN/8 OUT")
@@ -53,9 +53,10 @@ def history(ring: Ring | PinRing, start: bool, ops: list[Op]) -> list[object]:
     """What a master sees of the flat ``ring`` (fresh chips, powered up together, then idle past their wake-up) over
     ``ops``: the master starts first (``start``: an INTERBUS reset and a discovery ID cycle) or not; then per step
     ``power`` (the chip at ring position ``k`` powered up: /ResU low at pin level, ``Supi3.power_up`` at transaction
-    level, then idle), ``cut`` (the forward line into position ``k``), ``repair`` (every cut, then 4 idle status
-    telegrams, BK-54's limit), ``start`` or ``wait``, and two of the master's cycles. Every cycle's kind, success and
-    diagnostics (kind, location, device, message code), after each step the configuration and IN data."""
+    level, then idle), ``cut`` (the forward line into position ``k``), ``repair`` (every cut, then
+    :data:`~support.REPAIR_IDLE_TELEGRAMS` idle status telegrams, M21), ``start`` or ``wait``, and two of the master's
+    cycles. Every cycle's kind, success and diagnostics (kind, location, device, message code), after each step the
+    configuration and IN data."""
     _idle(ring, WAKE_TELEGRAMS)
     master = Master(ring, locate=False, max_devices=8)
     seen: list[object] = []
@@ -85,7 +86,7 @@ def history(ring: Ring | PinRing, start: bool, ops: list[Op]) -> list[object]:
                 ring.cuts.clear()
             else:
                 ring.clear_faults()
-            _idle(ring, 4)
+            _idle(ring, REPAIR_IDLE_TELEGRAMS)
         elif op == "start":
             record(master.start())
         for _ in range(2):

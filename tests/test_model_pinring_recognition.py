@@ -22,14 +22,26 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.master import CycleResult, Master
-from supi3.interbus.ring import Branch, BranchKind, DeadLine, ErrorKind, Fault, ReturnBreak, Ring, lbd_count
+from supi3.interbus.ring import (
+    Branch,
+    BranchKind,
+    DeadLine,
+    ErrorKind,
+    Fault,
+    ReturnBreak,
+    Ring,
+    join_error,
+    lbd_count,
+)
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
 from supi3.model.pinring import PinBranch, PinRing
 from supi3.model.pins import Supi3Pins
 from supi3.terminal import RF_CODES, branch_present
+from support import REPAIR_IDLE_TELEGRAMS
 from test_model_pinring_tree import INPUTS, LBST, ROWS, _bk, _config, nested_pin, nested_tl, view
 
 KINDS = [BranchKind.REMOTE, BranchKind.LOCAL, BranchKind.LBD_MR]
@@ -200,10 +212,10 @@ BK-52), every break repaired (index 0: while the master sends idle telegrams; 1:
 switched off or on by the master (BK-4), the BK's power-up reset (BK-48)."""
 POWER_DOWN_S = 4 * wire.STATUS_TELEGRAM_BITS / 2_000_000
 """How long the BK's /ResU is held low in a power-up step."""
-REPAIR_IDLE_S = 4 * wire.STATUS_TELEGRAM_BITS / 2_000_000
-"""Idle status telegrams after a repair (BK-54's limit): a repaired line takes up a telegram in flight at the repair
-point, and behind a break in an LBD branch a device that sends a counter telegram drops the telegram beginning then
-and the one chained to it (BK-30, M16); idle telegrams take that, not the next frame's head."""
+REPAIR_IDLE_S = REPAIR_IDLE_TELEGRAMS * wire.STATUS_TELEGRAM_BITS / 2_000_000
+"""Idle after a repair (M21): a repaired line takes up a telegram in flight at the repair point, and behind a break in
+an LBD branch a device that sends a counter telegram drops the telegram beginning then and the one chained to it
+(BK-30, M16); idle telegrams take that, not the next frame's head."""
 POWER_IDLE_S = 20 * wire.STATUS_TELEGRAM_BITS / 2_000_000
 """The idle after a power-up step: the reset stretch (M2) and the time a loop needs to answer (BK-37), an LBD branch's
 counter telegram every 33 bit periods (BK-30) included."""
@@ -226,7 +238,6 @@ def recognition_history(kind: BranchKind, row: tuple[str, bool], ops: list[Op]) 
     breaks = cuts(kind)
     steps: list[tuple[Record, Record]] = []
     for name, index in ops:
-        was = tl_chips[1].branch_recognised
         results: list[CycleResult | None] = [None, None]
         if name == "cycle" and any(master.config is None for master in masters):
             # Without a configuration a master starts again (an INTERBUS reset), as this history always did; a discovery
@@ -258,19 +269,18 @@ def recognition_history(kind: BranchKind, row: tuple[str, bool], ops: list[Op]) 
             pin.set_input(2, "resu_n", 1)
             pin.idle(POWER_IDLE_S)
         # A branch that joins the data path in a cycle's run joins within its frame (BK-54): the cycle fails at both
-        # fidelities, with the error where the pin-level BK switched (not compared).
-        joined = name == "cycle" and not was and tl_chips[1].branch_recognised
-        steps.append(((name, index, tl_chips[1].branch_recognised, seen(masters[0], results[0], joined)),
-                      (name, index, connected(pin), seen(masters[1], results[1], joined))))  # fmt: skip
+        # fidelities, with the error of the first repaired line of its loop (BK-56), compared too.
+        steps.append(((name, index, tl_chips[1].branch_recognised, seen(masters[0], results[0])),
+                      (name, index, connected(pin), seen(masters[1], results[1]))))  # fmt: skip
     return steps
 
 
-def seen(master: Master, result: CycleResult | None, joined: bool) -> Seen:
-    """The master's view after a step: the cycle's kind, success and diagnostics (kind, location, device; without
-    the kinds in a cycle a branch joined, ``joined``), the configuration and the IN data."""
+def seen(master: Master, result: CycleResult | None) -> Seen:
+    """The master's view after a step: the cycle's kind, success and diagnostics (kind, location, device), the
+    configuration and the IN data."""
     if result is None:
         return None
-    return (result.cycle, result.ok, [(None if joined else d.kind, d.location, d.device) for d in result.diagnostics],
+    return (result.cycle, result.ok, [(d.kind, d.location, d.device) for d in result.diagnostics],
             view(master) if master.config is not None else None)  # fmt: skip
 
 
@@ -288,15 +298,21 @@ def test_the_recognition_follows_any_history_the_same_at_both_fidelities(
         assert tl == pin
 
 
+JOIN_ERRORS: dict[Fault, ErrorKind] = {DeadLine(3): ErrorKind.TRANSMISSION, DeadLine(4): ErrorKind.TELEGRAM}
+"""BK-56, measured at pin level: the error of the cycle a branch of two devices joins within, by the one line of its
+loop repaired before that cycle's run: the first device's forward input, the second's; any other (a return line) is a
+dead line."""
+
+
 @pytest.mark.parametrize("kind", [*KINDS, BranchKind.LBD_OR])
 def test_a_branch_joining_within_a_cycle_fails_that_cycle_at_both_fidelities(kind: BranchKind) -> None:
-    """BK-54: every break that keeps a branch unrecognised (BK-48: a loop with return lines broken anywhere, an LBD
-    branch's BK's own return input), made after the BK's power-up, leaves the branch out at the master's start; repaired
-    after the start, the branch answers in the next cycle's run and joins the data path within its frame at both
-    fidelities: that cycle fails at both (the transaction level loses the frame behind the BK; the pin-level error is
-    where the BK switched, not compared), and every cycle after it is the same (the master meets the longer ring: the
-    loopback word out of place, BK-45)."""
-    for index, (_, (_, _, branch)) in enumerate(cuts(kind)):
+    """BK-54, BK-56: every break that keeps a branch unrecognised (BK-48: a loop with return lines broken anywhere, an
+    LBD branch's BK's own return input), made after the BK's power-up, leaves the branch out at the master's start;
+    repaired after the start, the branch answers in the next cycle's run and joins the data path within its frame at
+    both fidelities: that cycle fails at both with the same error (:data:`JOIN_ERRORS`: where the pin-level BK switched,
+    given by the repaired line), not located, and every cycle after it is the same (the master meets the longer ring:
+    the loopback word out of place, BK-45)."""
+    for index, (fault, (_, _, branch)) in enumerate(cuts(kind)):
         if kind.diagnostics and not branch:
             continue  # the LBD branch's devices answer behind a break with counter telegrams (BK-30)
         ops: list[Op] = [("cut", index), ("power", 0), ("start", 0), ("cycle", 0), ("repair", 1),
@@ -307,7 +323,8 @@ def test_a_branch_joining_within_a_cycle_fails_that_cycle_at_both_fidelities(kin
         assert recognised == [True] + [False] * 4 + [True] * 4, index  # the bring-up; power-up
         start, joined = steps[2][0][3], steps[5][0][3]
         assert start is not None and start[1] and start[3] is not None and len(start[3][0]) == 3, index  # through BK
-        assert joined is not None and not joined[1] and joined[2] == [(None, None, None)], index
+        error = JOIN_ERRORS.get(fault, ErrorKind.DEAD_LINE)
+        assert joined is not None and not joined[1] and joined[2] == [(error, None, None)], index
         # The longer ring after it: the loopback word out of place; without location the table stays (BK-45).
         after = [step[0][3] for step in steps[6:]]
         assert all(seen is not None and seen[2] == [(ErrorKind.LOOPBACK, None, None)] for seen in after), index
@@ -317,15 +334,49 @@ def test_the_transaction_level_loses_the_frame_a_branch_joins_within() -> None:
     """BK-54 at transaction level: the cycle in whose run a branch is recognised delivers its frame as far as the
     joining branch (its devices hear it) and nothing behind its BK: a dead line behind the branch, the devices after it
     keep what they had; the next cycle runs over the longer ring."""
-    ring, chips = tl_ring(BranchKind.LOCAL, "11", True, 2)
-    ring.cut(3, True)
-    master = Master(ring, locate=False, max_devices=8)
-    assert master.start().ok and not chips[1].branch_recognised and master.config is not None
-    assert len(master.config) == 3
-    ring.clear_faults()
-    transfer = ring.transfer(Cycle.DATA, bytes(wire.LOOPBACK_BYTES + 2))
-    assert chips[1].branch_recognised and transfer.returned is None and transfer.reached == 4
-    assert [span[:2] for span in ring.spans] == [(2, 2)]
+    for forward, error in ((False, ErrorKind.DEAD_LINE), (True, ErrorKind.TRANSMISSION)):
+        ring, chips = tl_ring(BranchKind.LOCAL, "11", True, 2)
+        ring.cut(3, forward)
+        master = Master(ring, locate=False, max_devices=8)
+        assert master.start().ok and not chips[1].branch_recognised and master.config is not None
+        assert len(master.config) == 3
+        ring.clear_faults()
+        transfer = ring.transfer(Cycle.DATA, bytes(wire.LOOPBACK_BYTES + 2))
+        assert chips[1].branch_recognised and transfer.reached == 4 and transfer.spliced
+        assert [span[:2] for span in ring.spans] == [(2, 2)]
+        # BK-56: the repaired line gives the error; a cut frame comes back with its CNTR's ERR set.
+        assert (transfer.returned is None) == (error is ErrorKind.DEAD_LINE)
+        assert transfer.flags.error == (error is ErrorKind.TRANSMISSION) and transfer.receiver_error is None
+
+
+LOOP_REPAIRS = [(BranchKind.LOCAL, (0, 1)), (BranchKind.REMOTE, (1, 2)), (BranchKind.LOCAL, (2, 3)),
+                (BranchKind.LBD_OR, (0, 2)), (BranchKind.LBD_OR, (1, 2)), (BranchKind.LBD_MR, (0, 3))]  # fmt: skip
+"""Two breaks of a loop (indices into :func:`cuts`) repaired together before the cycle the branch joins within."""
+
+
+@pytest.mark.parametrize(("kind", "pair"), LOOP_REPAIRS)
+def test_a_branch_joining_after_two_repairs_fails_with_the_first_repaired_line_s_error(
+        kind: BranchKind, pair: tuple[int, int]) -> None:
+    """BK-56: with two lines of the loop repaired together, the first along the loop (forward inputs first, then the
+    return lines to DI3) gives the error at both fidelities: a forward input by :data:`JOIN_ERRORS`, a return line a
+    dead line; in an LBD-MR branch always a dead line (its return repeaters' counter telegrams reach DI3 first)."""
+    ops: list[Op] = [*[("cut", index) for index in pair], ("power", 0), ("start", 0), ("cycle", 0), ("repair", 1),
+                     ("cycle", 0), ("cycle", 0)]  # fmt: skip
+    steps = recognition_history(kind, ("11", True), ops)
+    assert [tl for tl, _ in steps] == [pin for _, pin in steps]
+    first = cuts(kind)[min(pair)][0]
+    error = ErrorKind.DEAD_LINE if kind is BranchKind.LBD_MR else JOIN_ERRORS.get(first, ErrorKind.DEAD_LINE)
+    joined = steps[len(pair) + 4][0][3]
+    assert joined is not None and not joined[1] and joined[2] == [(error, None, None)]
+
+
+def test_join_error_refuses_bad_input_by_name() -> None:
+    """BK-56's rule (``ring.join_error``) names a bad argument."""
+    with pytest.raises(ArgumentError, match=r"^kind must be"):
+        join_error("BK-RB", 0)  # type: ignore[arg-type]
+    with pytest.raises(ArgumentError, match=r"^first_forward must be"):
+        join_error(BranchKind.REMOTE, -1)
+    assert [join_error(kind, None) for kind in BranchKind] == [ErrorKind.DEAD_LINE] * len(BranchKind)
 
 
 def test_the_recognition_stays_through_resets_and_breaks_until_the_power_up() -> None:

@@ -493,7 +493,8 @@ def per_cycle(ring: Ring | PinRing, ops: list[tuple[str, int]]) -> list[object]:
     ID codes, data lengths), every position's IN data and the BK's status byte (its count, BK-5, BK-6). Steps:
     ``off``, ``on``, ``ext`` (``Master.switch_branch``), ``reset`` (``Master.start``: an INTERBUS reset), ``cut``
     (the forward line into the device at physical position ``k``, ``cut(k, True)`` at both fidelities, BK-52, whether
-    the branch is in the data path or not: the break sleeps while it is out), ``wait`` (nothing: only the cycles)."""
+    the branch is in the data path or not: the break sleeps while it is out), ``repair`` (every break, between two
+    cycles), ``wait`` (nothing: only the cycles)."""
     master = Master(ring, locate=False, max_devices=8)
     seen: list[object] = []
 
@@ -509,6 +510,11 @@ def per_cycle(ring: Ring | PinRing, ops: list[tuple[str, int]]) -> list[object]:
             bk = ring.devices[1]
             seen.append(bool(ring.spans) if isinstance(ring, Ring) else isinstance(bk, Supi3Pins) and bk.branch_in_path)
             ring.cut(k, True)
+        elif op == "repair":  # every break, between two cycles (the next frame follows at once)
+            if isinstance(ring, Ring):
+                ring.clear_faults()
+            else:
+                ring.cuts.clear()
         elif op == "wait":
             pass
         elif master.config is not None and len(master.config) > 1 and master.config[1].data_bytes == 0:
@@ -611,6 +617,27 @@ def test_a_closure_while_do2_passes_a_counter_telegram_is_alike(kind: BranchKind
     loopback word out of place). The closure now comes at a frame's end at both fidelities, which leaves DO2 the
     whole gap before the next frame (30 bit periods; at most 25 needed): every cycle alike."""
     closes_alike(kind, 1, [], silence)
+
+
+REPAIR_SILENCE = 20_300
+"""A silence (clocks) that runs out between the last frame's end before a repair and the end of the frame right after
+it in every tree of :data:`CASES` (the branch cut, switched on with the extended function, 3 cycles before): the BK
+closes at that frame's end unless the return line was heard before it."""
+
+
+@pytest.mark.parametrize(("kind", "m"), CASES)
+def test_a_repair_between_cycles_restarts_the_silence_alike(kind: BranchKind, m: int) -> None:
+    """Issue 12, BK-50, BK-57: the forward line into the branch's first device repaired between two cycles, with the
+    silence running out at the end of the frame right after the repair: at pin level the telegrams in flight between
+    the repair point and that frame (a whole status telegram, the line into the BK's branch being 2 repeaters, 6 bit
+    periods, behind the master) come back before the frame's end at the BK, as the transaction level's stretch with
+    traffic has them: neither closes, and every cycle and the BK's status are alike."""
+    ops = [("ext", 3), ("cut", 3), ("wait", 3), ("repair", 3), ("wait", 3)]
+    rings: list[Ring | PinRing] = [tl_tree(kind, m, silence=REPAIR_SILENCE), pin_tree(kind, m, silence=REPAIR_SILENCE)]
+    seen = [per_cycle(ring, ops) for ring in rings]
+    assert seen[0] == seen[1]
+    bks = [ring.devices[1] if isinstance(ring, Ring) else ring.devices[1].chip for ring in rings]
+    assert [bk.bus_terminal.closures for bk in bks if isinstance(bk, Supi3) and bk.bus_terminal is not None] == [0, 0]
 
 
 def closes_alike(kind: BranchKind, m: int, ops: list[tuple[str, int]], silence: int) -> None:

@@ -523,7 +523,8 @@ class Master:
         if transfer.receiver_error is not None:
             # Only a ring whose return line N + 1 is one line into the master (the transaction-level Ring) pins a
             # receiver error there; at pin level the return path runs through every chip, so it is located anew.
-            where = n + 1 if getattr(self.ring, "direct_return_line", False) else None
+            # Nor does a frame cut where a BK switched its branch into it (BK-54, BK-56).
+            where = n + 1 if getattr(self.ring, "direct_return_line", False) and not transfer.spliced else None
             return Diagnostic(transfer.receiver_error, where, None, None, "error on the return line")
         if transfer.flags.error:
             return Diagnostic(ErrorKind.TRANSMISSION, None, None, None, "CNTR came back with ERR set")

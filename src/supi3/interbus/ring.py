@@ -24,7 +24,8 @@ the data path (switched off by the master, closed by the BK itself, not present 
 branch once a device answered, BK-48); it flattens again whenever a BK changes that. In a tree a fault belongs to the
 physical line it was injected on: it follows that line when branches are switched, and sleeps while the line is out of
 the data path; :meth:`Ring.cut` injects a break by the physical position of the device it enters, as the pin level's
-``PinRing.cut`` (BK-52). A branch recognised in a cycle's run joins within its frame, which it loses (BK-54).
+``PinRing.cut`` (BK-52). A branch recognised in a cycle's run joins within its frame, which it loses (BK-54), with
+the error of the first line of its loop repaired before that run (BK-56).
 :class:`ReturnBreak` breaks a branch's return line (a branch in the data path with nothing attached is broken so at
 its BK, BK-43), and behind a break in a branch with device-oriented diagnostics the devices send the counter telegram
 to the BK (2.2.2, ``wire.counter_telegram``).
@@ -316,6 +317,26 @@ class _Span:
     own: tuple[int, ...]
 
 
+def join_error(kind: BranchKind, first_forward: int | None) -> ErrorKind:
+    """The error a master reports for the cycle within whose frame a branch of ``kind`` joins the data path after a
+    repair (BK-54, BK-56): ``first_forward`` is the place in the branch (0: its first device) of the first device whose
+    forward input was among the lines repaired just before that cycle's run, ``None`` if only return lines were (a
+    device's return input, the BK's branch return input DI3).
+
+    The pin-level BK switches DO2 to DI3 at the telegram boundary after the first start level back on DI3 (BK-37,
+    BK-47), and where that falls in the frame follows from the first repaired line of the loop the frame travels
+    (measured, BK-56): the first device's forward input repaired, the device joins the frame mid-way with a local error
+    (``TRANSMISSION``); a later device's, the frame comes back cut inside a telegram (``TELEGRAM``); only return lines,
+    or any repair in an LBD-MR branch (its devices' return repeaters send counter telegrams on DI3 first, BK-30,
+    BK-35), DO2 switches before the frame's head is back (``DEAD_LINE``)."""
+    check_instance("kind", kind, BranchKind)
+    if first_forward is not None:
+        check_int("first_forward", first_forward, 0, wire.MAX_DEVICES - 1, _LIMIT_DEVICES)
+    if first_forward is None or kind is BranchKind.LBD_MR:
+        return ErrorKind.DEAD_LINE
+    return ErrorKind.TRANSMISSION if first_forward == 0 else ErrorKind.TELEGRAM
+
+
 def _branches(items: Sequence[Device | Branch]) -> list[Branch]:
     """Every branch of a tree, nested ones too, in data-path order."""
     found: list[Branch] = []
@@ -560,6 +581,9 @@ class Transfer:
     branches: list[tuple[Terminal, bool, int | None]] = field(default_factory=list, repr=False)
     """In a tree: each bus terminal module whose whole branch this cycle drove, whether the master's telegrams came
     back on the branch's return line, and the count of the counter telegram received there."""
+    spliced: bool = False
+    """A branch joined the data path within this frame (BK-54): what came back was cut where its BK switched, so a
+    receiver error is not on the return line N + 1 (BK-56)."""
 
 
 @dataclass
@@ -667,6 +691,9 @@ class Ring:
         self._faults: list[_Active] = []
         self._silent_since: dict[int, float] = {}
         self._silent_reset: set[int] = set()
+        self._repaired: list[_Active] = []
+        """In a tree: the breaks :meth:`clear_faults` removed since the ring last ran; a branch joining in the next
+        cycle's run fails it with the error of its first repaired line (BK-56)."""
         # Caches of the data-cycle hot path, each for the last run it served: the classes of the run's devices and
         # their groups; the registers loaded and the frame size, the registers joined, and the slices that cut each
         # device's received bytes.
@@ -904,8 +931,22 @@ class Ring:
         self._faults.append(_Active(fault, None, every[position - 1], branch))
 
     def clear_faults(self) -> None:
-        """Remove every injected fault."""
+        """Remove every injected fault (a repair: in a tree the breaks removed decide the error of a cycle a branch
+        joins within, BK-56)."""
+        if self._branches:
+            self._repaired += [a for a in self._faults if isinstance(a.fault, (DeadLine, ReturnBreak))]
         self._faults.clear()
+
+    def _join_error(self, joined: list[Branch]) -> ErrorKind | None:
+        """The error of a cycle within whose frame the branches ``joined`` join (BK-54): by the first line of the
+        first one's loop repaired since the ring last ran (:func:`join_error`); ``None``: none joins the data path (an
+        LBD branch recognised while out of it)."""
+        span = next((span for span in self._spans if span.branch in joined), None)
+        if span is None:
+            return None
+        forward = {id(a.target) for a in self._repaired if isinstance(a.fault, DeadLine)}
+        first = next((k for k, index in enumerate(span.own) if id(self.devices[index]) in forward), None)
+        return join_error(span.branch.kind, first)
 
     def _faults_on(self, segments: int) -> tuple[dict[int, list[Fault]], list[tuple[int, bool]]]:
         """The faults on lines 1..``segments`` now, by line, and the positions whose return line is broken, each with
@@ -1066,6 +1107,8 @@ class Ring:
             check_instance("cycle", cycle, Cycle)
         # A branch answering in this run joins the data path within its frame (BK-54): what leaves its BK is cut.
         joined = self._recognise() if self._branches else []
+        spliced = self._join_error(joined) if joined else None  # BK-56: the error of a branch joining the frame
+        self._repaired = []
         n_all = len(self.devices)
         if n_all > wire.MAX_DEVICES:
             raise InterbusError("docs/interbus.md, Ring", n_all, f"a ring has at most {wire.MAX_DEVICES} devices")
@@ -1086,9 +1129,11 @@ class Ring:
             if returns:
                 first, back_dead = self._returns(returns, None if close_after is None else n)
                 dead = first if dead is None or (first is not None and first < dead) else dead
-        if joined:
-            cut = min((span.end + 1 for span in self._spans if span.branch in joined), default=None)
-            dead = cut if dead is None or (cut is not None and cut < dead) else dead
+        if spliced is not None:
+            cut = min(span.end + 1 for span in self._spans if span.branch in joined)
+            # Only the whole ring, unbroken but for the joining branch, brings its cut frame back (BK-56).
+            spliced = spliced if close_after is None and dead is None and not back_dead else ErrorKind.DEAD_LINE
+            dead = cut if dead is None or cut < dead else dead
         self.trace = []
         record = self.record
         now = self.now
@@ -1147,9 +1192,14 @@ class Ring:
         elif record:
             silent = _Line(stream, crc, wire.cntr_word(attention, error))
             self.trace.append(SegmentTrace(segments if dead is None else dead, silent.frame(cycle), None, None))
+        if spliced is ErrorKind.TELEGRAM:
+            returned, receiver_error = stream, spliced
+        elif spliced is ErrorKind.TRANSMISSION:
+            returned, flags_back = stream, wire.CntrFlags(attention, True)
         reports = self._reports(len(devices), None if close_after is None else n, dead_lines, returns) \
             if self._spans else []
-        return Transfer(cycle, bytes(data), n, returned, flags_back, receiver_error, runs, len(devices), reports)
+        return Transfer(cycle, bytes(data), n, returned, flags_back, receiver_error, runs, len(devices), reports,
+                        spliced is not None)
 
     def finish(self, transfer: Transfer, latch: bool) -> None:
         """End a cycle with the master's verdict: the latch telegrams (``latch``) or idle telegrams.
@@ -1223,6 +1273,7 @@ class Ring:
         recognised in the reset's hold, before its devices reset (BK-37, BK-48). The reset's end allows for the ring
         delay of every device of the tree, which may all be in the data path after it (BK-9, A12; BK-53)."""
         self._recognise()
+        self._repaired = []
         dead = self._first_dead()
         reached = len(self.devices) if dead is None else min(len(self.devices), dead - 1)
         every = len(_devices(self._tree)) if self._branches else len(self.devices)
@@ -1239,6 +1290,7 @@ class Ring:
         """The master sends only idle status telegrams for ``seconds`` (no cycles)."""
         seconds = check_real("seconds", seconds, 0.0)
         self._recognise()
+        self._repaired = []
         dead = self._first_dead()
         reached = len(self.devices) if dead is None else min(len(self.devices), dead - 1)
         end = self.now + seconds
