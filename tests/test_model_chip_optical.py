@@ -39,17 +39,20 @@ from support import bad
 
 IN, OUT, BRANCH = Interface.IN, Interface.OUT, Interface.BRANCH
 ALL = (True, True, True)
+NO_BRANCH = (True, True, False)
 RF = {OpticalMode.REGULATION: "00", OpticalMode.DIAGNOSTIC: "01"}
 LIMIT_S = INIT_TIME_LIMIT_CLOCKS / CLOCK_HZ
 
 
 def up_chip(rf: str = "00", bit_rate: int = BIT_RATES[0]) -> Supi3:
-    """A remote bus device in an Init-µP mode (Table 2-4), with a register file."""
-    return Supi3(decode("10011", "1110", rf=rf, clk_conf=clk_conf_for(bit_rate)))
+    """A bus terminal module in an Init-µP mode (BK-RB, Init-µP, Table 2-7), with a register file: it has all three
+    interfaces, so reads 9 and 11 show its branch (OPT-55)."""
+    return Supi3(decode("00011", rf=rf, clk_conf=clk_conf_for(bit_rate)))
 
 
 def io_chip(rf: str = "00") -> Supi3:
-    """The demo device (binary I/O, 8 IN / 8 OUT): no register file; its data cycles take the ring kernel."""
+    """The demo device (binary I/O, 8 IN / 8 OUT): no register file; its data cycles take the ring kernel; no branch
+    interface (OPT-55)."""
     return Supi3(decode("10000", rf=rf))
 
 
@@ -73,7 +76,7 @@ def test_ls_has_no_optics() -> None:
     """1.6: the SUPI 3 LS does not support optical regulation; calls change nothing, IN lengths are refused."""
     chip = Supi3(decode("10000", variant=Variant.LS))
     assert chip.optical_mode is OpticalMode.OFF
-    chip.optical_start(ALL)
+    chip.optical_start(NO_BRANCH)
     chip.optical_init_response(OUT, Response.DETECTED)
     chip.optical_test(OUT, False, False)
     chip.optical_length(OUT, 100, Medium.GLASS)
@@ -82,6 +85,32 @@ def test_ls_has_no_optics() -> None:
     assert not chip.optical_holding
     with pytest.raises(ChipArgumentError, match=r"interface must be Interface\.OUT or Interface\.BRANCH"):
         chip.optical_length(IN, 1, Medium.POLYMER)
+
+
+@pytest.mark.parametrize(("c", "mfp"), [("10000", None), ("10011", "1110"), ("11011", "1110"), ("01000", None)])
+def test_branch_refused_outside_the_bk_modes(c: str, mfp: str | None) -> None:
+    """OPT-55: only a bus terminal module has the branch interface (Table 2-8: DI3, DO3_CU, FO3 on MFP10..8 in the
+    BK modes; 1.6.3: MAUWS "for bus terminal modules only"); elsewhere a start with the branch in use, or a branch
+    length, is refused by name and changes nothing."""
+    chip = Supi3(decode(c, mfp, rf="00"))
+    assert chip.terminal_interface is None
+    for present in [(a, b, True) for a in (False, True) for b in (False, True)]:
+        with pytest.raises(ChipArgumentError, match=r"present\[BRANCH\] must be False outside the bus terminal"):
+            chip.optical_start(present)
+    with pytest.raises(ChipArgumentError, match=r"interface must be Interface\.OUT outside the bus terminal"):
+        chip.optical_length(BRANCH, 9, Medium.POLYMER)
+    assert chip.optical == OpticalStatus()
+    assert not chip.optical_holding
+
+
+@pytest.mark.parametrize("c", ["00000", "00001", "00010", "00011", "00100"])
+def test_every_bk_mode_has_the_branch(c: str) -> None:
+    """Table 2-7: every BK mode starts its branch interface and measures its branch (read 9, OPT-55)."""
+    chip = Supi3(decode(c, rf="00"))
+    chip.optical_start(ALL)
+    chip.optical_length(BRANCH, 9, Medium.POLYMER)
+    assert chip.optical[BRANCH].phase is Phase.INIT
+    assert chip.optical.length[1] == timer_code(9, chip.config.bit_rate, Medium.POLYMER)
 
 
 @pytest.mark.parametrize("rf", ["10", "11"])
@@ -219,14 +248,14 @@ def test_core_held_latches_nothing_until_initialized(path: str) -> None:
 def test_core_held_until_the_budget_ends_on_the_kernel_path() -> None:
     """The fast path honours the budget's end: the first cycle at or after 6 ms latches."""
     chip = io_chip()
-    chip.optical_start(ALL)
+    chip.optical_start(NO_BRANCH)
     Supi3.data_kernel.load((chip,), LIMIT_S / 2)
     Supi3.data_kernel.latch((chip,), (b"\x11",), LIMIT_S / 2)
     assert chip.out_word == 0
     Supi3.data_kernel.load((chip,), LIMIT_S)
     Supi3.data_kernel.latch((chip,), (b"\x22",), LIMIT_S)
     assert chip.out_word == 0x22
-    assert {tx.phase for tx in chip.optical.transmitters} == {Phase.FIXED}
+    assert [tx.phase for tx in chip.optical.transmitters] == [Phase.FIXED, Phase.FIXED, Phase.OFF]
 
 
 # Lengths and tests --------------------------------------------------------------------------------------------------
@@ -280,7 +309,7 @@ def test_diagnostic_mode_tests_set_the_warning() -> None:
 def test_binary_io_chip_keeps_the_status_only() -> None:
     chip = io_chip()
     assert chip.registers is None
-    chip.optical_start(ALL)
+    chip.optical_start(NO_BRANCH)
     chip.optical_init_response(IN, Response.NONE)
     assert chip.optical[IN].phase is Phase.FIXED
 

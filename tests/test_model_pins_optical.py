@@ -34,6 +34,11 @@ def up_config(rf: str) -> DeviceConfig:
     return decode("10011", "1110", rf=rf, clk_conf="11", diag_conf=1)
 
 
+def bk_up_config(rf: str) -> DeviceConfig:
+    """A µP-mode BK (BK-RB, Init-µP, Table 2-7): the branch interface is its own (OPT-55)."""
+    return decode("00011", rf=rf, clk_conf="11", diag_conf=1)
+
+
 @pytest.mark.parametrize("rf", ["00", "01"])
 def test_step_equals_run(rf: str) -> None:
     """One scenario with every optical strobe, stepped cycle by cycle and run in pieces: the same outputs (the 6 ms
@@ -75,7 +80,7 @@ def test_hold_latches_nothing_and_the_block_drives_the_chip() -> None:
 def test_transaction_level_ends_where_the_pin_level_does(rf: str) -> None:
     """The optical API of the TL chip and the pin level's strobes, op by op: the same optical status, reads 8..11,
     ID register and ATTN after every op."""
-    config = up_config(rf)
+    config = bk_up_config(rf)
     ops = optical_ops(OpticalMode(int(rf == "01") + 1))
     script, ends = optical_script(config, ops)
     pins = Supi3Pins(config)

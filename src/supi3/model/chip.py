@@ -858,12 +858,17 @@ class Supi3:
         Raises
         ------
         ChipArgumentError
-            ``present`` is not a tuple of three bools, or ``now`` is not a time.
+            ``present`` is not a tuple of three bools, ``present[BRANCH]`` is set on a chip that is not a bus terminal
+            module (OPT-55), or ``now`` is not a time.
         """
         if not (type(present) is tuple and len(present) == len(Interface)
                 and all(type(p) is bool for p in present)):  # fmt: skip
             raise ChipArgumentError("present", present, "present must be a tuple of 3 bools (IN, OUT, BRANCH in "
                                     f"use), not {present!r:.60}")
+        if present[Interface.BRANCH] and self.bus_terminal is None:
+            raise ChipArgumentError("present", present, "present[BRANCH] must be False outside the bus terminal "
+                                    "modes of Table 2-7 (OPT-55: the branch interface DI3/DO3/FO3 is a BK's, "
+                                    f"Table 2-8, 1.6.3), not True in {self.config.function!r}")
         if now is not None:
             self.poll(now)
         mode = self.optical_mode
@@ -900,12 +905,16 @@ class Supi3:
         Raises
         ------
         ChipArgumentError
-            ``interface`` is not OUT or BRANCH (the incoming path is not measured, 3.4.12), ``count`` not an int
-            >= 0, or ``medium`` not a :class:`Medium`.
+            ``interface`` is not OUT or BRANCH (the incoming path is not measured, 3.4.12), BRANCH on a chip that
+            is not a bus terminal module (OPT-55), ``count`` not an int >= 0, or ``medium`` not a :class:`Medium`.
         """
         if _interface(interface) is Interface.IN:
             raise ChipArgumentError("interface", interface, "interface must be Interface.OUT or Interface.BRANCH "
                                     "(the incoming path is not measured, 3.4.12), not Interface.IN")
+        if interface is Interface.BRANCH and self.bus_terminal is None:
+            raise ChipArgumentError("interface", interface, "interface must be Interface.OUT outside the bus terminal "
+                                    "modes of Table 2-7 (OPT-55: only a BK has a branch path, read 9), not "
+                                    f"Interface.BRANCH in {self.config.function!r}")
         count = _checked(check_int, "count", count, 0, limit="length timer counts")
         medium = _checked(check_instance, "medium", medium, Medium)
         if self.optical_mode is not OpticalMode.OFF:
