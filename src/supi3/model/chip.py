@@ -861,7 +861,11 @@ class Supi3:
         ChipArgumentError
             ``present`` is not a tuple of three bools, ``present[BRANCH]`` is set on a chip that is not a bus terminal
             module (OPT-55), or ``now`` is not a time.
+        ChipError
+            The chip's optical block runs at pin level (:class:`~supi3.model.pins.Supi3Pins`, OPT-26): so does every
+            ``optical_*`` call.
         """
+        self._transaction_level_optics()
         if not (type(present) is tuple and len(present) == len(Interface)
                 and all(type(p) is bool for p in present)):  # fmt: skip
             raise ChipArgumentError("present", present, "present must be a tuple of 3 bools (IN, OUT, BRANCH in "
@@ -889,6 +893,7 @@ class Supi3:
         ChipArgumentError
             ``interface`` is not an :class:`Interface` or ``response`` not a :class:`Response`.
         """
+        self._transaction_level_optics()
         interface = _interface(interface)
         response = _checked(check_instance, "response", response, Response)
         self._optical_set(self._optical.with_transmitter(
@@ -898,7 +903,15 @@ class Supi3:
         """The running 6 ms budget ran out (1.6.1, OPT-5, OPT-56): the interface initializing now
         (:func:`~supi3.optical.regulation.initializing`) falls back to maximum power and the next one's budget
         starts. The chip also does this by itself at the first bus call at or after a budget's end."""
+        self._transaction_level_optics()
         self._optical_timeout(self._now)
+
+    def _transaction_level_optics(self) -> None:
+        """Refuse the transaction-level optical API on a chip whose optical block runs at pin level (OPT-26): the
+        block makes every transition there, so a call here would leave the chip and the block apart."""
+        if self._optical_driven:
+            raise ChipError("the optical block of a pin-level chip (Supi3Pins, OPT-26) is driven by its line side "
+                            "(Supi3Pins.step/run with pinout.OPTICAL_LINE_INPUTS), not by the Supi3.optical_* calls")
 
     def _optical_timeout(self, ends: int) -> None:
         """The budget that ran to clock ``ends`` is over: the interface initializing falls back; the next one's
@@ -920,6 +933,7 @@ class Supi3:
             ``interface`` is not OUT or BRANCH (the incoming path is not measured, 3.4.12), BRANCH on a chip that
             is not a bus terminal module (OPT-55), ``count`` not an int >= 0, or ``medium`` not a :class:`Medium`.
         """
+        self._transaction_level_optics()
         if _interface(interface) is Interface.IN:
             raise ChipArgumentError("interface", interface, "interface must be Interface.OUT or Interface.BRANCH "
                                     "(the incoming path is not measured, 3.4.12), not Interface.IN")
@@ -943,6 +957,7 @@ class Supi3:
         ChipArgumentError
             ``interface`` is not an :class:`Interface`, ``ack1`` or ``ack2`` not a bool.
         """
+        self._transaction_level_optics()
         interface = _interface(interface)
         ack1 = _checked(check_bool, "ack1", ack1)
         ack2 = _checked(check_bool, "ack2", ack2)
