@@ -260,11 +260,12 @@ class OpticalRtl(wiring.Component):
                                  for k in range(len(changed)))))  # fmt: skip
 
         # The edge: strobes and the 6 ms counter, unless a reset or the start --------------------------------------
-        # (the 6 ms counter: loaded with the budget when another interface begins to initialize, in INIT_ORDER, zero
-        # in reset, ``last`` one clock before it ends; it ends the budget of the one initializing: OPT-56)
-        current, following = _initializing(state), _initializing(new)
-        countdown = Countdown(m, self.time_limit, load=following.any() & (following != current),
-                              clear=self.ib_reset, name="countdown")  # fmt: skip
+        # (the 6 ms counter: loaded with the budget at the start and when the interface initializing is done, so the
+        # next in INIT_ORDER has its own; zero in reset, ``last`` one clock before it ends; it ends the budget of the
+        # one initializing only: OPT-56)
+        current = _initializing(state)
+        done = (current & ~Cat(*(tx.is_(Phase.INIT) for tx in new))).any()
+        countdown = Countdown(m, self.time_limit, load=in_reset | done, clear=self.ib_reset, name="countdown")
         for i in Interface:
             strobes = (self.resp_valid[i], self.resp.word_select(i, 2), self.test_valid[i], self.ack1[i], self.ack2[i])
             _transitions(m, state[i], new[i], strobes, countdown.last & current[i])

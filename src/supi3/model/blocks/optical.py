@@ -11,16 +11,16 @@ What happens at the clock edge ending a cycle, from that cycle's inputs (:mod:`s
 
 1. ``ib_reset`` high: every transmitter off (OPT-21), the length timers stop, the 6 ms counter stops.
 2. The first cycle with ``ib_reset`` low after it was high (its falling edge): every interface starts
-   (:func:`~supi3.optical.regulation.start` with ``mode`` and ``present``).
+   (:func:`~supi3.optical.regulation.start` with ``mode`` and ``present``) and the 6 ms counter is loaded with
+   :data:`~supi3.optical.regulation.INIT_TIME_LIMIT_CLOCKS`.
 3. Otherwise, per interface: a response strobe (``resp_valid``) applies
    :func:`~supi3.optical.regulation.init_response`, then a test strobe (``test_valid``) the online test
    (:func:`~supi3.optical.regulation.apply_test`: regulation, or the diagnostics MAU warning, OPT-22); then, on the
    edge where the 6 ms counter runs out, :func:`~supi3.optical.regulation.init_timeout` for the interface that was
    initializing (:func:`~supi3.optical.regulation.initializing` of the state before the edge, OPT-56).
 
-After 2 or 3, when the interface initializing (:func:`~supi3.optical.regulation.initializing`) is another one than
-before the edge, the 6 ms counter is loaded with :data:`~supi3.optical.regulation.INIT_TIME_LIMIT_CLOCKS`: each
-interface has its own budget, in :data:`~supi3.optical.regulation.INIT_ORDER` (OPT-56).
+After 3, when the interface that was initializing no longer is (regulated, fallen back or timed out), the 6 ms counter
+is loaded again: each interface has its own budget, in :data:`~supi3.optical.regulation.INIT_ORDER` (OPT-56).
 
 The length timers of the outgoing interface and the branch run at every edge, ib_reset aside: ``len_start`` clears
 and starts one; while it runs, every :func:`~supi3.optical.regulation.length_timer_enable_every`-th edge after the
@@ -250,6 +250,7 @@ class OpticalBlock:
         current = initializing(status.transmitters)
         if self._in_reset:
             self._in_reset = False
+            self.countdown = self.time_limit
             txs = tuple(start(mode, bool(v["present"] >> i & 1)) for i in Interface)
             self.log.add(self.cycle, "start in {}: {}", mode.name, [tx.phase.value for tx in txs])
         else:
@@ -263,8 +264,7 @@ class OpticalBlock:
                     self.log.add(self.cycle, "{} 6 ms budget over", current.name)
         if txs != status.transmitters:
             status = OpticalStatus((txs[0], txs[1], txs[2]), status.length, status.medium)
-            following = initializing(status.transmitters)
-            if following is not None and following is not current:  # its own 6 ms begin (OPT-56)
+            if current is not None and txs[current].phase is not Phase.INIT:  # the next one's own 6 ms (OPT-56)
                 self.countdown = self.time_limit
         if v["len_start"] or v["len_stop"] or self._timers[0].running or self._timers[1].running:
             status = self._lengths(status, v, mode, bit_rate)
