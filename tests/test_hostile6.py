@@ -10,6 +10,7 @@ with refused calls in it ends where the same history without them ends.
 
 from __future__ import annotations
 
+import itertools
 import subprocess
 import sys
 from collections.abc import Callable
@@ -22,13 +23,15 @@ from hypothesis import strategies as st
 from supi3.config import decode
 from supi3.diagnostics import bus_terminal_mfp, diag_pins
 from supi3.errors import ArgumentError
-from supi3.interbus.ring import Branch, BranchKind, return_inputs, terminal_positions
+from supi3.interbus.master import Master
+from supi3.interbus.ring import Branch, BranchKind, Ring, return_inputs, terminal_positions
 from supi3.model.chip import ChipArgumentError, ChipError, Supi3
 from supi3.model.pins import Supi3Pins
 from supi3.optical.length import Medium
 from supi3.optical.regulation import Interface, Response
 from supi3.terminal import BRANCH_SILENCE_CLOCKS
 from support import BK_STRAPS, bad
+from test_model_pinring_tree import tl_tree
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -198,3 +201,45 @@ def test_refused_branch_calls_leave_no_trace(c: str, history: list[tuple[object,
             twin.optical, twin.optical_holding, twin.due, twin.attention)  # fmt: skip
         assert chip.optical[Interface.BRANCH].phase.value == "off"
         assert chip.optical.length[1] == 0
+
+
+# Ring.cut histories: a broken cycle latches nothing (BK-52) ------------------------------------------------------
+
+
+def latched(ring: Ring) -> list[tuple[int, bool]]:
+    """Every chip's OUT data and bus active, in ring order."""
+    chips = [d for d in ring.devices if isinstance(d, Supi3)]
+    assert len(chips) == len(ring.devices)
+    return [(chip.out_word, chip.bus_active) for chip in chips]
+
+
+@pytest.mark.parametrize("kind", list(BranchKind))
+def test_a_cycle_broken_by_any_cut_latches_nothing(kind: BranchKind) -> None:
+    """Every line :meth:`~supi3.interbus.ring.Ring.cut` accepts in a tree (RB device, BK with 3 devices of ``kind``,
+    RB device; forward lines, return inputs, the BK's branch return input), cut after three good cycles: the cycle
+    that fails changes no device's OUT data or bus active (3.4.14: data are taken over only after a valid check
+    sequence); the lines it refuses are refused by name."""
+    failed = 0
+    for position, forward, branch in itertools.product(range(1, 6), (True, False), (False, True)):
+        ring = tl_tree(kind, 3)
+        master = Master(ring)
+        assert master.start().ok
+        for _ in range(3):
+            assert master.cycle().ok
+        tree = ring._tree
+        if not forward and position not in (terminal_positions(tree) if branch else return_inputs(tree, returns=False)):
+            with pytest.raises(ArgumentError, match="position must be"):
+                ring.cut(position, forward, branch=branch)
+            continue
+        if forward and branch:
+            with pytest.raises(ArgumentError, match="position must be"):
+                ring.cut(position, forward, branch=branch)
+            continue
+        ring.cut(position, forward, branch=branch)
+        before = latched(ring)
+        for entry in master.config or ():
+            master.set_outputs(entry.number, b"\xa5" * entry.data_bytes)
+        if not master.cycle().ok:
+            failed += 1
+            assert latched(ring) == before, (position, forward, branch)
+    assert failed >= 5
