@@ -886,7 +886,8 @@ class Supi3:
 
     def optical_init_response(self, interface: Interface, response: Response) -> None:
         """One initialization step's response on ``interface`` (:func:`~supi3.optical.regulation.init_response`,
-        1.6.1); a transmitter not initializing does not change.
+        1.6.1); a transmitter not initializing does not change. When it ends the initialization of the interface whose
+        turn it is, the next one's 6 ms budget counts from the chip's clock (its last bus call: ``poll`` first, OPT-56).
 
         Raises
         ------
