@@ -20,6 +20,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from supi3.config import Interface as ConfigInterface
 from supi3.config import decode
 from supi3.diagnostics import bus_terminal_mfp, diag_pins
 from supi3.errors import ArgumentError
@@ -29,7 +30,7 @@ from supi3.model.chip import ChipArgumentError, ChipError, Supi3
 from supi3.model.pins import Supi3Pins
 from supi3.optical.length import Medium
 from supi3.optical.regulation import Interface, Response
-from supi3.terminal import BRANCH_SILENCE_CLOCKS
+from supi3.terminal import BRANCH_SILENCE_CLOCKS, TerminalMode
 from support import BK_STRAPS, bad
 from test_model_pinring_tree import tl_tree
 
@@ -114,6 +115,24 @@ def test_bus_terminal_mfp_checks_the_levels_on_every_chip(bus_terminal: bool, in
         bus_terminal_mfp(*args)  # type: ignore[arg-type]
     assert bus_terminal_mfp(False, True, True, True, True) == 0
     assert bus_terminal_mfp(True, True, True, True, True) == 0xE100
+
+
+# supi3.terminal (Table 2-7) -------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", ["BK_RB", "bk-rb", "BK-RB ", "", "none", "BK-LBD-MR"])
+def test_terminal_mode_refuses_a_name_that_is_no_interface(name: str) -> None:
+    """Found in round 6: a misspelt interface ("BK_RB", "bk-rb") was silently no BK (:attr:`TerminalMode.NONE`)."""
+    with pytest.raises(ArgumentError, match=r"interface must be one of 'RB', .* \(supi3.config.Interface\)"):
+        TerminalMode.of(name)
+
+
+def test_terminal_mode_of_every_interface() -> None:
+    """Table 2-7: the three BK interfaces have their modes; every other interface of the chip, and None, none."""
+    modes = {interface: TerminalMode.of(interface.value) for interface in ConfigInterface}
+    assert {i.value: m for i, m in modes.items() if m is not TerminalMode.NONE} == {
+        "BK-RB": TerminalMode.RB, "BK-LB": TerminalMode.LB, "BK-LBD": TerminalMode.LBD}  # fmt: skip
+    assert TerminalMode.of(None) is TerminalMode.NONE
 
 
 # bench/closure_sweep.py ------------------------------------------------------------------------------------------
