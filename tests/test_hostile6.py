@@ -1,11 +1,12 @@
 """Hostile inputs and histories against the last session's tree, branch and diagnostic entries and issue 12's chip
 optics (a user's review, round 6): the tree helpers :func:`supi3.interbus.ring.terminal_positions` and
-:func:`~supi3.interbus.ring.return_inputs` (BK-52), :mod:`supi3.diagnostics` (Tables 3-16, 2-8), ``bench/
+:func:`~supi3.interbus.ring.return_inputs` (BK-52), :meth:`~supi3.interbus.ring.Ring.cut` histories (3.4.14),
+:mod:`supi3.diagnostics` (Tables 3-16, 2-8), :meth:`supi3.terminal.TerminalMode.of` (Table 2-7), ``bench/
 closure_sweep.py`` (BK-50, BK-3), and the chip's transaction-level optical API on a chip without a branch interface
 (OPT-55) or whose optical block runs at pin level (OPT-26).
 
 Every bad input is refused by name (which argument, which rule, which value) and changes nothing; an optical history
-with refused calls in it ends where the same history without them ends.
+with refused calls in it ends where the same history without them ends; a cycle broken by a cut latches nothing.
 """
 
 from __future__ import annotations
