@@ -22,6 +22,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
 from supi3.cli import positive_integer
+from supi3.terminal import BRANCH_SILENCE_CLOCKS
 from test_model_pinring_tree import CASES, closes_alike  # the tests' helpers, on the path above
 
 
@@ -34,6 +35,9 @@ def main() -> int:
     args = parser.parse_args()
     if args.stop < args.start:
         parser.error(f"--stop ({args.stop}) must not be before --start ({args.start})")
+    if args.stop > BRANCH_SILENCE_CLOCKS:
+        parser.error(f"--stop ({args.stop}) must be at most {BRANCH_SILENCE_CLOCKS} clocks (BK-3's 10 ms: a chip's "
+                     "branch_silence)")
     differing: list[tuple[int, str]] = []
     runs = 0
     for silence in range(args.start, args.stop + 1, args.step):

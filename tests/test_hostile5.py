@@ -34,6 +34,7 @@ from supi3.optical.regulation import (
     INIT_MAX_STEPS,
     MAX_LEVEL,
     MIN_LEVEL,
+    Interface,
     OpticalMode,
     Phase,
     Response,
@@ -354,7 +355,9 @@ def test_a_chip_s_clock_never_goes_back(call: str) -> None:
         assert chip.optical_holding
         chip.poll(1.0 + 5e-3)  # 5 ms after the chip's clock, 4.5 ms after the stamp: within the budget
         assert chip.optical_holding
-        chip.poll(1.0 + 7e-3)  # 7 ms after: the 6 ms budget ran out (OPT-5)
+        chip.poll(1.0 + 7e-3)  # 7 ms: the incoming interface's 6 ms ran out (OPT-5); the outgoing one's (OPT-56) run
+        assert chip.optical[Interface.IN].phase is Phase.FIXED and chip.optical_holding
+        chip.poll(1.0 + 13e-3)  # and ran out too
         assert not chip.optical_holding
 
 

@@ -39,17 +39,20 @@ from support import bad
 
 IN, OUT, BRANCH = Interface.IN, Interface.OUT, Interface.BRANCH
 ALL = (True, True, True)
+NO_BRANCH = (True, True, False)
 RF = {OpticalMode.REGULATION: "00", OpticalMode.DIAGNOSTIC: "01"}
 LIMIT_S = INIT_TIME_LIMIT_CLOCKS / CLOCK_HZ
 
 
 def up_chip(rf: str = "00", bit_rate: int = BIT_RATES[0]) -> Supi3:
-    """A remote bus device in an Init-µP mode (Table 2-4), with a register file."""
-    return Supi3(decode("10011", "1110", rf=rf, clk_conf=clk_conf_for(bit_rate)))
+    """A bus terminal module in an Init-µP mode (BK-RB, Init-µP, Table 2-7), with a register file: it has all three
+    interfaces, so reads 9 and 11 show its branch (OPT-55)."""
+    return Supi3(decode("00011", rf=rf, clk_conf=clk_conf_for(bit_rate)))
 
 
 def io_chip(rf: str = "00") -> Supi3:
-    """The demo device (binary I/O, 8 IN / 8 OUT): no register file; its data cycles take the ring kernel."""
+    """The demo device (binary I/O, 8 IN / 8 OUT): no register file; its data cycles take the ring kernel; no branch
+    interface (OPT-55)."""
     return Supi3(decode("10000", rf=rf))
 
 
@@ -73,7 +76,7 @@ def test_ls_has_no_optics() -> None:
     """1.6: the SUPI 3 LS does not support optical regulation; calls change nothing, IN lengths are refused."""
     chip = Supi3(decode("10000", variant=Variant.LS))
     assert chip.optical_mode is OpticalMode.OFF
-    chip.optical_start(ALL)
+    chip.optical_start(NO_BRANCH)
     chip.optical_init_response(OUT, Response.DETECTED)
     chip.optical_test(OUT, False, False)
     chip.optical_length(OUT, 100, Medium.GLASS)
@@ -82,6 +85,32 @@ def test_ls_has_no_optics() -> None:
     assert not chip.optical_holding
     with pytest.raises(ChipArgumentError, match=r"interface must be Interface\.OUT or Interface\.BRANCH"):
         chip.optical_length(IN, 1, Medium.POLYMER)
+
+
+@pytest.mark.parametrize(("c", "mfp"), [("10000", None), ("10011", "1110"), ("11011", "1110"), ("01000", None)])
+def test_branch_refused_outside_the_bk_modes(c: str, mfp: str | None) -> None:
+    """OPT-55: only a bus terminal module has the branch interface (Table 2-8: DI3, DO3_CU, FO3 on MFP10..8 in the
+    BK modes; 1.6.3: MAUWS "for bus terminal modules only"); elsewhere a start with the branch in use, or a branch
+    length, is refused by name and changes nothing."""
+    chip = Supi3(decode(c, mfp, rf="00"))
+    assert chip.terminal_interface is None
+    for present in [(a, b, True) for a in (False, True) for b in (False, True)]:
+        with pytest.raises(ChipArgumentError, match=r"present\[BRANCH\] must be False outside the bus terminal"):
+            chip.optical_start(present)
+    with pytest.raises(ChipArgumentError, match=r"interface must be Interface\.OUT outside the bus terminal"):
+        chip.optical_length(BRANCH, 9, Medium.POLYMER)
+    assert chip.optical == OpticalStatus()
+    assert not chip.optical_holding
+
+
+@pytest.mark.parametrize("c", ["00000", "00001", "00010", "00011", "00100"])
+def test_every_bk_mode_has_the_branch(c: str) -> None:
+    """Table 2-7: every BK mode starts its branch interface and measures its branch (read 9, OPT-55)."""
+    chip = Supi3(decode(c, rf="00"))
+    chip.optical_start(ALL)
+    chip.optical_length(BRANCH, 9, Medium.POLYMER)
+    assert chip.optical[BRANCH].phase is Phase.INIT
+    assert chip.optical.length[1] == timer_code(9, chip.config.bit_rate, Medium.POLYMER)
 
 
 @pytest.mark.parametrize("rf", ["10", "11"])
@@ -141,8 +170,10 @@ def test_not_detected_at_max_warns() -> None:
 
 
 def test_budget_runs_out_in_chip_time() -> None:
-    """OPT-5, OPT-20: 6 ms after the start (in the chip's time) the hold ends and initializing transmitters fall
-    back to FIXED at the first bus call at or after the limit; optical_init_timeout does it on request."""
+    """OPT-5, OPT-20, OPT-56: 6 ms after the start (in the chip's time) the incoming interface, still initializing,
+    falls back to FIXED at the first bus call at or after the limit; the branch's own 6 ms start there, and the hold
+    ends when it runs out too; optical_init_timeout ends the running budget on request, one interface at a time in
+    INIT_ORDER."""
     chip = up_chip()
     chip.poll(1e-3)
     chip.optical_start(ALL)
@@ -151,13 +182,44 @@ def test_budget_runs_out_in_chip_time() -> None:
     chip.poll(1e-3 + LIMIT_S - 1 / CLOCK_HZ)
     assert chip.optical_holding
     chip.poll(1e-3 + LIMIT_S)
+    assert chip.optical_holding
+    assert [tx.phase for tx in chip.optical.transmitters] == [Phase.FIXED, Phase.ONLINE, Phase.INIT]
+    assert chip.due == clocks(1e-3) + 2 * INIT_TIME_LIMIT_CLOCKS
+    chip.poll(1e-3 + 2 * LIMIT_S)
     assert not chip.optical_holding
     assert [tx.phase for tx in chip.optical.transmitters] == [Phase.FIXED, Phase.ONLINE, Phase.FIXED]
     other = up_chip()
     other.optical_start(ALL)
-    other.optical_init_timeout()
+    for done in regulation.INIT_ORDER:
+        assert other.optical_holding
+        other.optical_init_timeout()
+        assert other.optical[done].phase is Phase.FIXED
     assert not other.optical_holding
-    assert {tx.phase for tx in other.optical.transmitters} == {Phase.FIXED}
+
+
+def test_each_interface_has_its_own_budget_from_the_end_of_the_one_before() -> None:
+    """OPT-56 (1.6.1: an interface's initialization takes 6 ms at most, the outgoing interface's after the direction
+    change): the incoming interface's budget counts from the start, the branch's from the incoming one's end, the
+    outgoing one's from the branch's end, whatever ends them (a response or a timeout); an interface that finishes
+    out of turn moves no budget."""
+    chip = up_chip()
+    chip.optical_start(ALL, 0.0)
+    chip.optical_init_response(OUT, Response.NONE)  # out of turn: IN's budget runs on
+    assert chip.due == INIT_TIME_LIMIT_CLOCKS
+    chip.poll(1e-3)
+    chip.optical_init_response(IN, Response.NOT_DETECTED)
+    assert chip.due == clocks(1e-3) + INIT_TIME_LIMIT_CLOCKS  # the branch's 6 ms
+    chip.poll(1e-3 + LIMIT_S)
+    assert [tx.phase for tx in chip.optical.transmitters] == [Phase.ONLINE, Phase.FIXED, Phase.FIXED]
+    assert not chip.optical_holding
+    other = up_chip()
+    other.optical_start((True, True, False), 0.0)
+    other.poll(LIMIT_S)  # IN timed out; OUT's 6 ms from there, not from the start
+    assert other.optical[IN].phase is Phase.FIXED and other.optical_holding
+    other.poll(2 * LIMIT_S - 1e-6)
+    assert other.optical_holding
+    other.optical_init_response(OUT, Response.NOT_DETECTED)
+    assert other.optical[OUT].phase is Phase.ONLINE and not other.optical_holding
 
 
 def test_a_second_start_restarts_the_budget() -> None:
@@ -217,16 +279,18 @@ def test_core_held_latches_nothing_until_initialized(path: str) -> None:
 
 
 def test_core_held_until_the_budget_ends_on_the_kernel_path() -> None:
-    """The fast path honours the budget's end: the first cycle at or after 6 ms latches."""
+    """The fast path honours the budgets' end (OPT-56: the incoming interface's 6 ms, then the outgoing one's): the
+    first cycle at or after 12 ms latches."""
     chip = io_chip()
-    chip.optical_start(ALL)
-    Supi3.data_kernel.load((chip,), LIMIT_S / 2)
-    Supi3.data_kernel.latch((chip,), (b"\x11",), LIMIT_S / 2)
-    assert chip.out_word == 0
-    Supi3.data_kernel.load((chip,), LIMIT_S)
-    Supi3.data_kernel.latch((chip,), (b"\x22",), LIMIT_S)
+    chip.optical_start(NO_BRANCH)
+    for now in (LIMIT_S / 2, LIMIT_S, 1.5 * LIMIT_S):
+        Supi3.data_kernel.load((chip,), now)
+        Supi3.data_kernel.latch((chip,), (b"\x11",), now)
+        assert chip.out_word == 0
+    Supi3.data_kernel.load((chip,), 2 * LIMIT_S)
+    Supi3.data_kernel.latch((chip,), (b"\x22",), 2 * LIMIT_S)
     assert chip.out_word == 0x22
-    assert {tx.phase for tx in chip.optical.transmitters} == {Phase.FIXED}
+    assert [tx.phase for tx in chip.optical.transmitters] == [Phase.FIXED, Phase.FIXED, Phase.OFF]
 
 
 # Lengths and tests --------------------------------------------------------------------------------------------------
@@ -280,7 +344,7 @@ def test_diagnostic_mode_tests_set_the_warning() -> None:
 def test_binary_io_chip_keeps_the_status_only() -> None:
     chip = io_chip()
     assert chip.registers is None
-    chip.optical_start(ALL)
+    chip.optical_start(NO_BRANCH)
     chip.optical_init_response(IN, Response.NONE)
     assert chip.optical[IN].phase is Phase.FIXED
 
@@ -377,8 +441,8 @@ def test_histories_keep_the_invariants(rf: str, bit_rate: int, history: list[tup
         status = chip.optical
         assert read_8_to_11(chip) == registers(status)
         assert chip.optical_holding is any(tx.phase is Phase.INIT for tx in status.transmitters)
-        if chip.optical_holding:
-            assert clocks(now) < clocks(started) + INIT_TIME_LIMIT_CLOCKS
+        if chip.optical_holding:  # each interface in turn, 6 ms at most each (OPT-56)
+            assert clocks(now) < clocks(started) + len(regulation.INIT_ORDER) * INIT_TIME_LIMIT_CLOCKS
         for old, new in zip(before.transmitters, status.transmitters, strict=True):
             assert 1 <= new.level <= MAX_LEVEL
             if name in ("start", "reset") or new.phase is Phase.DIAGNOSTIC:
@@ -396,8 +460,12 @@ def test_start_at_a_bus_time_counts_the_budget_from_it() -> None:
     chip.poll(1.0 + regulation.INIT_TIME_LIMIT_S * 0.99)
     assert chip.optical_holding
     chip.poll(1.0 + regulation.INIT_TIME_LIMIT_S * 1.01)
+    assert chip.optical_holding  # the incoming interface fell back; the branch has its own 6 ms (OPT-56)
+    assert [tx.phase for tx in chip.optical.transmitters] == [Phase.FIXED, Phase.INIT, Phase.INIT]
+    chip.poll(1.0 + regulation.INIT_TIME_LIMIT_S * 3.01)  # one call past all three budgets
     assert not chip.optical_holding
     assert all(tx.phase is Phase.FIXED for tx in chip.optical.transmitters)
+    assert chip.due == Supi3(chip.config).due
     before = chip.optical
     for now in (-1.0, float("nan"), "1.0", True):
         with pytest.raises(ChipArgumentError):

@@ -250,9 +250,10 @@ Outcome = tuple[Supi3, OpticalBlock, list[dict[str, int]]]
 
 
 def tl_and_pin(mode: OpticalMode, fast: int, operations: list[tuple[object, ...]]) -> Outcome:
-    """The operations on a µP-mode chip (transaction level) and on the block (pin level)."""
+    """The operations on a µP-mode BK (BK-RB, Init-µP: all three interfaces, OPT-55; transaction level) and on the
+    block (pin level)."""
     rf = {REG: "00", DIAG: "01", OFF: "11"}[mode]
-    chip = Supi3(decode("10011", "1110", rf=rf, clk_conf=clk_conf_for(BIT_RATES[fast])))
+    chip = Supi3(decode("00011", rf=rf, clk_conf=clk_conf_for(BIT_RATES[fast])))
     script = OpticalScript(mode, fast=fast)
     every = length_timer_enable_every(BIT_RATES[fast])
     for operation in operations:

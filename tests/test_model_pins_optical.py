@@ -20,6 +20,7 @@ from supi3.optical.regulation import (
     MAX_LEVEL,
     Interface,
     OpticalMode,
+    OpticalStatus,
     Phase,
     Response,
     length_timer_enable_every,
@@ -32,6 +33,11 @@ IN, OUT, BRANCH = Interface.IN, Interface.OUT, Interface.BRANCH
 
 def up_config(rf: str) -> DeviceConfig:
     return decode("10011", "1110", rf=rf, clk_conf="11", diag_conf=1)
+
+
+def bk_up_config(rf: str) -> DeviceConfig:
+    """A µP-mode BK (BK-RB, Init-µP, Table 2-7): the branch interface is its own (OPT-55)."""
+    return decode("00011", rf=rf, clk_conf="11", diag_conf=1)
 
 
 @pytest.mark.parametrize("rf", ["00", "01"])
@@ -75,14 +81,31 @@ def test_hold_latches_nothing_and_the_block_drives_the_chip() -> None:
 def test_transaction_level_ends_where_the_pin_level_does(rf: str) -> None:
     """The optical API of the TL chip and the pin level's strobes, op by op: the same optical status, reads 8..11,
     ID register and ATTN after every op."""
-    config = up_config(rf)
-    ops = optical_ops(OpticalMode(int(rf == "01") + 1))
+    assert_tl_equals_pins(bk_up_config(rf), optical_ops(OpticalMode(int(rf == "01") + 1)))
+
+
+def test_each_interface_times_out_in_turn_at_both_levels() -> None:
+    """OPT-56: with IN and OUT in use and no response, the incoming interface falls back 6 ms after the start and the
+    outgoing one 6 ms after that, at pin level as at transaction level (the hold spans both; an ID cycle in between
+    is not latched)."""
+    ops: list[OpticalOp] = [("reset", 0b011), ("timeout",), ("id", 0), ("timeout",), ("id", 0)]
+    seen = assert_tl_equals_pins(up_config("00"), ops)
+    phases = [[tx.phase for tx in status.transmitters] for status, _ in seen]
+    assert phases[1] == phases[2] == [Phase.FIXED, Phase.INIT, Phase.OFF]
+    assert phases[3] == [Phase.FIXED, Phase.FIXED, Phase.OFF]
+    assert [events for _, events in seen] == [0, 0, 0, 0, 1]  # the ID cycle during the hold is not latched
+
+
+def assert_tl_equals_pins(config: DeviceConfig, ops: list[OpticalOp]) -> list[tuple[OpticalStatus, int]]:
+    """``ops`` on the TL chip's optical API and as the pin level's strobes, op by op: the same optical status, reads
+    8..11, ID register and ATTN after every op; the pin level's status and ID_CYCLE events after each."""
     script, ends = optical_script(config, ops)
     pins = Supi3Pins(config)
     tl = Supi3(config)
     columns = script.inputs()
     every = length_timer_enable_every(config.bit_rate)
     clk = 0
+    seen = []
     for op, a, b in zip(ops, [0, *ends[:-1]], ends, strict=True):
         pins.run({name: trace[a:b] for name, trace in columns.items()})
         clk += 1000
@@ -93,6 +116,8 @@ def test_transaction_level_ends_where_the_pin_level_does(rf: str) -> None:
         assert tl.registers is not None and pins.chip.registers is not None
         assert [tl.registers.value(r) for r in OPTICAL_REGISTERS] == [
             pins.chip.registers.value(r) for r in OPTICAL_REGISTERS], op  # fmt: skip
+        seen.append((pins.chip.optical, pins.chip.events["ID_CYCLE"]))
+    return seen
 
 
 def tl_op(chip: Supi3, op: OpticalOp, clk: int, every: int) -> None:

@@ -116,3 +116,14 @@ def test_a_bent_branch_fibre_warns_at_the_branch_interface_and_lights_fo3() -> N
     warnings = [(d.device, d.mau) for d in master.diagnostics if d.kind is ErrorKind.MAU_WARNING]
     assert ("3.0", ("MAUWS", True)) in warnings and ("3.1", ("MAUWH", True)) in warnings
     assert master.mau_warnings[BK_AT] == (False, False, True)
+
+
+def test_each_bk_interface_has_its_own_budget() -> None:
+    """OPT-56 (1.6.1: an interface's initialization takes 6 ms at most): on 1 m cables at 500 kbit/s each of the
+    BK's transmitters takes all 13 steps (2.5 ms each, 7.5 ms in a row), yet every one ends regulated; with one 6 ms
+    budget for the chip its outgoing interface would fall back to FIXED."""
+    ring, _, bk, _ = tree(lengths=(1.0,) * len(LENGTHS))
+    assert ring.bit_rate == 500_000
+    assert [bk.optical[i].phase for i in Interface] == [Phase.ONLINE] * 3
+    assert [bk.optical[i].level for i in Interface] == [MAX_LEVEL - 13] * 3
+    assert all(c.optical[Interface.IN].phase is Phase.ONLINE for c in ring.chips[1:])  # the master is not regulated

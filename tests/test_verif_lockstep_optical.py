@@ -107,17 +107,23 @@ def test_lengths_media_and_resets(fast: int) -> None:
 
 @pytest.mark.parametrize("limit", [1, 2, 300])
 def test_initialization_timeout(limit: int) -> None:
-    """OPT-5: the budget runs out ``time_limit`` clocks after the start. Both sides are elaborated with a short
-    budget here (the full 192,000 clocks take minutes on Amaranth's simulator); the model block's own tests run the
-    full INIT_TIME_LIMIT_CLOCKS, and the RTL's default is checked below."""
+    """OPT-5, OPT-56: the incoming interface's budget runs out ``time_limit`` clocks after the start, the branch's
+    ``time_limit`` clocks after that. Both sides are elaborated with a short budget here (the full 192,000 clocks
+    take minutes on Amaranth's simulator); the model block's own tests run the full INIT_TIME_LIMIT_CLOCKS, and the
+    RTL's default is checked below."""
     script = OpticalScript(REG, present=0b101).reset().response(IN, Response.DETECTED)
-    rows = script.idle(limit + 2).rows
+    rows = script.idle(2 * limit + 2).rows
     assert run_amaranth_sim(lambda: OpticalRtl(limit), lambda: OpticalBlock(limit), rows).cycles == len(rows)
     block = OpticalBlock(limit)
+    phases = []
     for row in rows:
         block.step(row)
+        phases.append((block.status[IN].phase, block.status[BRANCH].phase))
     assert block.status[BRANCH].phase is Phase.FIXED
     assert block.status[IN].phase is Phase.FIXED
+    fixed_in = next(k for k, p in enumerate(phases) if p[0] is Phase.FIXED)
+    fixed_branch = next(k for k, p in enumerate(phases) if p[1] is Phase.FIXED)
+    assert fixed_branch - fixed_in == limit  # the branch's own budget, from the incoming one's end
     default = inspect.signature(OpticalRtl).parameters["time_limit"].default
     assert default == OpticalBlock().time_limit == INIT_TIME_LIMIT_CLOCKS
 
@@ -183,3 +189,13 @@ def test_random_strobes(segments: list[tuple[int, int, int, int, list[tuple[obje
 def test_random_strobes_more(segments: list[tuple[int, int, int, int, list[tuple[object, ...]]]]) -> None:
     """:func:`test_random_strobes` on about three times as many examples, with longer histories."""
     lockstep(random_script(segments))
+
+
+@settings(max_examples=3)
+@given(segments=st.lists(SEGMENT, min_size=4, max_size=8), limit=st.integers(1, 12))
+def test_random_strobes_with_short_budgets(segments: list[tuple[int, int, int, int, list[tuple[object, ...]]]],
+                                           limit: int) -> None:  # fmt: skip
+    """:func:`test_random_strobes` with a budget of a few clocks, so that the budgets of the interfaces run out one
+    after the other among responses and resets (OPT-56): the RTL equals the model on every output, every clock."""
+    rows = random_script(segments).rows
+    assert run_amaranth_sim(lambda: OpticalRtl(limit), lambda: OpticalBlock(limit), rows).cycles == len(rows)

@@ -139,10 +139,12 @@ def remote_bus_disabled(following: bool) -> bool:
 
 
 def diag_pins(complete: bool, ba: bool, rd: bool, fo1: bool, fo2: bool) -> tuple[int, int]:
-    """DIAG1 and DIAG2 (Table 3-16): BA and RD with complete diagnostics, else FO1 and FO2 (Table 3-17)."""
-    if check_bool("complete", complete):
-        return int(check_bool("ba", ba)), int(check_bool("rd", rd))
-    return int(check_bool("fo1", fo1)), int(check_bool("fo2", fo2))
+    """DIAG1 and DIAG2 (Table 3-16): BA and RD with complete diagnostics, else FO1 and FO2 (Table 3-17). Every
+    argument is checked, the ones not shown too."""
+    levels = {"ba": ba, "rd": rd, "fo1": fo1, "fo2": fo2}
+    shown = ("ba", "rd") if check_bool("complete", complete) else ("fo1", "fo2")
+    checked = {name: check_bool(name, value) for name, value in levels.items()}
+    return int(checked[shown[0]]), int(checked[shown[1]])
 
 
 def fo_leds(status: OpticalStatus, run: bool) -> tuple[bool, bool, bool]:
@@ -228,11 +230,11 @@ class DiagnosticOutputs:
 
 
 def bus_terminal_mfp(bus_terminal: bool, alarm: bool, ld: bool, e: bool, fo3: bool) -> int:
-    """ALARM, LD, E and FO3 at their MFPs (Table 2-8) on a bus terminal module, whatever DIAG_CONF (DG-6); else 0."""
-    if not check_bool("bus_terminal", bus_terminal):
-        return 0
+    """ALARM, LD, E and FO3 at their MFPs (Table 2-8) on a bus terminal module, whatever DIAG_CONF (DG-6); else 0.
+    Every level is checked, on other chips too."""
     levels = {"alarm": alarm, "ld": ld, "e": e, "fo3": fo3}
-    return sum(int(check_bool(name, levels[name])) << pin for name, pin in BUS_TERMINAL_PINS.items())
+    mfp = sum(int(check_bool(name, levels[name])) << pin for name, pin in BUS_TERMINAL_PINS.items())
+    return mfp if check_bool("bus_terminal", bus_terminal) else 0
 
 
 def diagnostic_outputs(config: DeviceConfig, *, supply_ok: bool, line_heard: bool, bus_active: bool,

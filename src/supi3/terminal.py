@@ -33,6 +33,7 @@ from typing import Final
 
 from supi3 import tables
 from supi3.checks import check_bits, check_bool, check_choice, check_instance, check_int
+from supi3.config import Interface
 from supi3.interbus import wire
 from supi3.interbus.wire import BranchControl
 from supi3.pinlevel import Pin
@@ -109,6 +110,8 @@ TERMINAL_INTERFACES: Final = ("BK-RB", "BK-LB", "BK-LBD")
 """The interfaces of Table 2-7: remote bus branch, local bus branch, local bus branch with device-oriented
 diagnostics."""
 
+_CHIP_INTERFACES: Final = tuple(interface.value for interface in Interface)
+"""Every chip interface name (:class:`supi3.config.Interface`): what :meth:`TerminalMode.of` takes."""
 RF_CODES: Final = ("00", "01", "10", "11")
 """RF[1..0] (Table 2-2) by the value of the block's 2-bit ``rf`` port."""
 
@@ -127,10 +130,12 @@ class TerminalMode(IntEnum):
 
     @classmethod
     def of(cls, interface: str | None) -> TerminalMode:
-        """The mode of a chip interface (``"BK-RB"``, ``"BK-LB"``, ``"BK-LBD"``; anything else, ``None`` included,
-        is :attr:`NONE`)."""
+        """The mode of a chip interface (``"BK-RB"``, ``"BK-LB"``, ``"BK-LBD"``; the other interfaces of
+        :class:`supi3.config.Interface`, and ``None``, are :attr:`NONE`; a name that is no chip interface is refused
+        by name)."""
         if interface is not None:
             check_instance("interface", interface, str, "a chip interface name (a str) or None")
+            check_choice("interface", interface, _CHIP_INTERFACES, "supi3.config.Interface")
         if interface is None or interface not in TERMINAL_INTERFACES:
             return cls.NONE
         return cls(TERMINAL_INTERFACES.index(interface) + 1)

@@ -359,9 +359,24 @@ def _devices(items: Sequence[Device | Branch]) -> list[Device]:
     return found
 
 
+def _check_tree(items: object, first: object) -> None:
+    """``items`` a sequence of devices and :class:`Branch` items, ``first`` a ring position; else the named error."""
+    if isinstance(items, (str, bytes)) or not isinstance(items, Sequence) or not all(
+            isinstance(item, (Device, Branch)) for item in items):  # fmt: skip
+        raise fail("items", "a sequence of devices and Branch items (a tree, docs/interbus.md)", items)
+    check_int("first", first, 1, wire.MAX_DEVICES, _LIMIT_DEVICES)
+
+
 def terminal_positions(items: Sequence[Device | Branch], first: int = 1) -> set[int]:
     """The physical positions (from ``first`` on: a BK, then its branch's devices, nested branches in place, BK-1) of
-    the BKs of :class:`Branch` items, nested ones too: where a cut of a BK's branch return input can be made (BK-52)."""
+    the BKs of :class:`Branch` items, nested ones too: where a cut of a BK's branch return input can be made (BK-52).
+
+    Raises
+    ------
+    ArgumentError
+        ``items`` is not a sequence of devices and branches, or ``first`` not a ring position (1 to 512).
+    """
+    _check_tree(items, first)
     found: set[int] = set()
     position = first
     for item in items:
@@ -376,7 +391,16 @@ def terminal_positions(items: Sequence[Device | Branch], first: int = 1) -> set[
 def return_inputs(items: Sequence[Device | Branch], first: int = 1, returns: bool = True) -> set[int]:
     """The physical positions (from ``first`` on, BK-1) of the devices of ``items`` whose return input a device drives:
     all but the last of a sequence with return lines (``returns``: the remote bus outside branches at pin level), in
-    branches too; none in an LBD-OR branch (BK-52)."""
+    branches too; none in an LBD-OR branch (BK-52).
+
+    Raises
+    ------
+    ArgumentError
+        ``items`` is not a sequence of devices and branches, ``first`` not a ring position (1 to 512), or ``returns``
+        not a bool.
+    """
+    _check_tree(items, first)
+    check_bool("returns", returns)
     found: set[int] = set()
     position = first
     for k, item in enumerate(items):

@@ -792,8 +792,9 @@ class Supi3:
     # --------------------------------------------------------------------------------------------------------
     # Optical regulation block (manual 1.6, 3.4.12, 3.4.13; OPT-20 onward of docs/assumptions/optical.md)
     # --------------------------------------------------------------------------------------------------------
-    # State: _optical, the block's OpticalStatus; _optical_until, the clock at which the initialization budget
-    # (INIT_TIME_LIMIT_CLOCKS from optical_start) runs out while a transmitter initializes, _NEVER otherwise. While it
+    # State: _optical, the block's OpticalStatus; _optical_until, the clock at which the budget of the interface
+    # initializing now runs out (INIT_TIME_LIMIT_CLOCKS from optical_start for the first of INIT_ORDER, from the end of
+    # the one before for the others: OPT-56) while a transmitter initializes, _NEVER otherwise. While it
     # is not _NEVER the core is held in reset (latch_at and discard_at do nothing) and the ring kernel takes the slow
     # path (_reschedule). Every change goes through a pure transition of supi3.optical.regulation and _optical_set.
 
@@ -846,8 +847,8 @@ class Supi3:
 
     @property
     def optical_holding(self) -> bool:
-        """The protocol core is held in reset (1.6): a transmitter still initializes and the 6 ms budget, counted
-        from :meth:`optical_start` in the chip's time (the last bus call), has not run out."""
+        """The protocol core is held in reset (1.6): a transmitter still initializes (each interface in turn with its
+        own 6 ms budget, OPT-56, the first counted from :meth:`optical_start` in the chip's time, the last bus call)."""
         return self._optical_held or (self._optical_until != _NEVER and self._now < self._optical_until)
 
     def optical_start(self, present: tuple[bool, bool, bool], now: float | None = None) -> None:
@@ -858,12 +859,21 @@ class Supi3:
         Raises
         ------
         ChipArgumentError
-            ``present`` is not a tuple of three bools, or ``now`` is not a time.
+            ``present`` is not a tuple of three bools, ``present[BRANCH]`` is set on a chip that is not a bus terminal
+            module (OPT-55), or ``now`` is not a time.
+        ChipError
+            The chip's optical block runs at pin level (:class:`~supi3.model.pins.Supi3Pins`, OPT-26): so does every
+            ``optical_*`` call.
         """
+        self._transaction_level_optics()
         if not (type(present) is tuple and len(present) == len(Interface)
                 and all(type(p) is bool for p in present)):  # fmt: skip
             raise ChipArgumentError("present", present, "present must be a tuple of 3 bools (IN, OUT, BRANCH in "
                                     f"use), not {present!r:.60}")
+        if present[Interface.BRANCH] and self.bus_terminal is None:
+            raise ChipArgumentError("present", present, "present[BRANCH] must be False outside the bus terminal "
+                                    "modes of Table 2-7 (OPT-55: the branch interface DI3/DO3/FO3 is a BK's, "
+                                    f"Table 2-8, 1.6.3), not True in {self.config.function!r}")
         if now is not None:
             self.poll(now)
         mode = self.optical_mode
@@ -876,22 +886,43 @@ class Supi3:
 
     def optical_init_response(self, interface: Interface, response: Response) -> None:
         """One initialization step's response on ``interface`` (:func:`~supi3.optical.regulation.init_response`,
-        1.6.1); a transmitter not initializing does not change.
+        1.6.1); a transmitter not initializing does not change. When it ends the initialization of the interface whose
+        turn it is, the next one's 6 ms budget counts from the chip's clock (its last bus call: ``poll`` first, OPT-56).
 
         Raises
         ------
         ChipArgumentError
             ``interface`` is not an :class:`Interface` or ``response`` not a :class:`Response`.
         """
+        self._transaction_level_optics()
         interface = _interface(interface)
         response = _checked(check_instance, "response", response, Response)
         self._optical_set(self._optical.with_transmitter(
             interface, regulation.init_response(self._optical[interface], response)))
 
     def optical_init_timeout(self) -> None:
-        """The 6 ms budget ran out (1.6.1, OPT-5): transmitters still initializing fall back to maximum power. The
-        chip also does this by itself at the first bus call at or after the budget's end."""
-        self._optical_apply(regulation.init_timeout)
+        """The running 6 ms budget ran out (1.6.1, OPT-5, OPT-56): the interface initializing now
+        (:func:`~supi3.optical.regulation.initializing`) falls back to maximum power and the next one's budget
+        starts. The chip also does this by itself at the first bus call at or after a budget's end."""
+        self._transaction_level_optics()
+        self._optical_timeout(self._now)
+
+    def _transaction_level_optics(self) -> None:
+        """Refuse the transaction-level optical API on a chip whose optical block runs at pin level (OPT-26): the
+        block makes every transition there, so a call here would leave the chip and the block apart."""
+        if self._optical_driven:
+            raise ChipError("the optical block of a pin-level chip (Supi3Pins, OPT-26) is driven by its line side "
+                            "(Supi3Pins.step/run with pinout.OPTICAL_LINE_INPUTS), not by the Supi3.optical_* calls")
+
+    def _optical_timeout(self, ends: int) -> None:
+        """The budget that ran to clock ``ends`` is over: the interface initializing falls back; the next one's
+        budget counts from ``ends`` (OPT-56)."""
+        current = regulation.initializing(self._optical.transmitters)
+        if current is None:
+            self._optical_until = _NEVER
+            return
+        tx = regulation.init_timeout(self._optical[current])
+        self._optical_set(self._optical.with_transmitter(current, tx), since=ends)
 
     def optical_length(self, interface: Interface, count: int, medium: Medium) -> None:
         """The length timer's result ``count`` for the outgoing interface or the branch, at the chip's bit rate
@@ -900,12 +931,17 @@ class Supi3:
         Raises
         ------
         ChipArgumentError
-            ``interface`` is not OUT or BRANCH (the incoming path is not measured, 3.4.12), ``count`` not an int
-            >= 0, or ``medium`` not a :class:`Medium`.
+            ``interface`` is not OUT or BRANCH (the incoming path is not measured, 3.4.12), BRANCH on a chip that
+            is not a bus terminal module (OPT-55), ``count`` not an int >= 0, or ``medium`` not a :class:`Medium`.
         """
+        self._transaction_level_optics()
         if _interface(interface) is Interface.IN:
             raise ChipArgumentError("interface", interface, "interface must be Interface.OUT or Interface.BRANCH "
                                     "(the incoming path is not measured, 3.4.12), not Interface.IN")
+        if interface is Interface.BRANCH and self.bus_terminal is None:
+            raise ChipArgumentError("interface", interface, "interface must be Interface.OUT outside the bus terminal "
+                                    "modes of Table 2-7 (OPT-55: only a BK has a branch path, read 9), not "
+                                    f"Interface.BRANCH in {self.config.function!r}")
         count = _checked(check_int, "count", count, 0, limit="length timer counts")
         medium = _checked(check_instance, "medium", medium, Medium)
         if self.optical_mode is not OpticalMode.OFF:
@@ -922,6 +958,7 @@ class Supi3:
         ChipArgumentError
             ``interface`` is not an :class:`Interface`, ``ack1`` or ``ack2`` not a bool.
         """
+        self._transaction_level_optics()
         interface = _interface(interface)
         ack1 = _checked(check_bool, "ack1", ack1)
         ack2 = _checked(check_bool, "ack2", ack2)
@@ -942,9 +979,10 @@ class Supi3:
         self._mau_told = self._mau_events = (False, False, False)
         self._send_optical = False
 
-    def _optical_set(self, status: OpticalStatus, report: bool = True) -> None:
+    def _optical_set(self, status: OpticalStatus, report: bool = True, since: int | None = None) -> None:
         """Take ``status``; the hold ends once no transmitter initializes; reads 8..11 follow (3.4.12). A MAU
-        change is an event for the master when ``report`` (not in the reset period: OPT-26, OPT-53)."""
+        change is an event for the master when ``report`` (not in the reset period: OPT-26, OPT-53). When another
+        interface's initialization begins, its 6 ms budget counts from clock ``since`` (``None``: now; OPT-56)."""
         if status == self._optical:
             return
         old = self._optical.transmitters
@@ -955,8 +993,12 @@ class Supi3:
         if report and events != self._mau_events:  # a MAU warning came on or went off: an event for the master (OPT-53)
             self._mau_events = (events[0], events[1], events[2])
             self.attention = True
-        if not any(tx.phase is Phase.INIT for tx in status.transmitters):
-            self._optical_until = _NEVER
+        if not self._optical_driven:  # the budgets (OPT-56); at pin level the block counts them
+            current = regulation.initializing(status.transmitters)
+            if current is None:
+                self._optical_until = _NEVER
+            elif current is not regulation.initializing(old):
+                self._optical_until = (self._now if since is None else since) + regulation.INIT_TIME_LIMIT_CLOCKS
         self._optical_publish()
         self._reschedule()
 
@@ -1011,8 +1053,8 @@ class Supi3:
 
     def _expire(self, clk: int) -> None:
         self.revision += 1
-        if clk >= self._optical_until:  # optical block: the initialization budget ran out (OPT-5, OPT-20)
-            self._optical_apply(regulation.init_timeout)
+        while clk >= self._optical_until:  # optical block: an interface's budget ran out (OPT-5, OPT-20, OPT-56)
+            self._optical_timeout(self._optical_until)
         if self._filtered and not self.pf:
             self.pf = True
             self.attention = True

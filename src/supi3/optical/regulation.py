@@ -50,6 +50,7 @@ __all__ = [
     "BLOCK_OUTPUTS",
     "DECREASE_AFTER",
     "INIT_MAX_STEPS",
+    "INIT_ORDER",
     "INIT_STEP_BITS",
     "INIT_TIME_LIMIT_CLOCKS",
     "INIT_TIME_LIMIT_S",
@@ -69,6 +70,7 @@ __all__ = [
     "fo_lit",
     "init_response",
     "init_timeout",
+    "initializing",
     "length_timer_enable_every",
     "mau_after",
     "online_test",
@@ -84,9 +86,11 @@ MIN_LEVEL: Final = 1
 INIT_MAX_STEPS: Final = 13
 """At most 13 regulation procedures (lowerings) in an initialization (1.6.1): from 15 down to 2."""
 INIT_TIME_LIMIT_S: Final = 6e-3
-"""Initialization takes 6 ms at most (1.6.1); a transmitter not done by then falls back (OPT-5)."""
+"""An interface's initialization takes 6 ms at most (1.6.1); a transmitter not done by then falls back (OPT-5). Each
+interface has its own budget, counted from the moment its initialization begins (:data:`INIT_ORDER`, OPT-56)."""
 INIT_TIME_LIMIT_CLOCKS: Final = round(INIT_TIME_LIMIT_S * CLOCK_HZ)
-""":data:`INIT_TIME_LIMIT_S` in chip clocks (192,000 at 32 MHz), counted from the end of the INTERBUS reset."""
+""":data:`INIT_TIME_LIMIT_S` in chip clocks (192,000 at 32 MHz), counted from the end of the INTERBUS reset for the
+first interface, from the end of the one before it for the others (OPT-56)."""
 INIT_STEP_BITS: Final = 96
 """One initialization step (pattern out, response back) takes 96 bit periods (OPT-5): two directions of 14 steps
 are 5.4 ms at 500 kbit/s, inside :data:`INIT_TIME_LIMIT_S`."""
@@ -111,6 +115,13 @@ class Interface(IntEnum):
     """Outgoing interface: transmits the forward line to the next device (read 11 bits 3..0, read 8; FO2; MAUWR)."""
     BRANCH = 2
     """Branch of a bus terminal module (read 11 bits 7..4, read 9; FO3 on MFP8; MAUWS)."""
+
+
+INIT_ORDER: Final[tuple[Interface, Interface, Interface]] = (Interface.IN, Interface.BRANCH, Interface.OUT)
+"""The order in which a chip's transmitters initialize after the end of an INTERBUS reset (OPT-56): the incoming
+interface first (the direction change of the path from the previous device, 1.6.1), then a bus terminal module's
+branch, then the outgoing interface (OPT-54). Each has its own :data:`INIT_TIME_LIMIT_CLOCKS` budget, counted from
+the moment the interfaces before it are done (regulated, fallen back or timed out), not one budget for the chip."""
 
 
 class OpticalMode(IntEnum):
@@ -258,9 +269,18 @@ def init_response(tx: Transmitter, response: Response) -> Transmitter:
 
 
 def init_timeout(tx: Transmitter) -> Transmitter:
-    """The 6 ms budget ran out (1.6.1, OPT-5): a transmitter still initializing falls back to maximum power."""
+    """Its 6 ms budget ran out (1.6.1, OPT-5, OPT-56): a transmitter still initializing falls back to maximum power."""
     tx = _tx(tx)
     return Transmitter(Phase.FIXED) if tx.phase is Phase.INIT else tx
+
+
+def initializing(transmitters: tuple[Transmitter, Transmitter, Transmitter]) -> Interface | None:
+    """The interface whose initialization runs now and whose 6 ms budget counts (OPT-56): the first of
+    :data:`INIT_ORDER` in :attr:`Phase.INIT`; ``None`` when none initializes."""
+    for interface in INIT_ORDER:
+        if transmitters[interface].phase is Phase.INIT:
+            return interface
+    return None
 
 
 def online_test(tx: Transmitter, ack1: bool, ack2: bool) -> Transmitter:

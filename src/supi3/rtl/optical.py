@@ -19,7 +19,7 @@ import functools
 from dataclasses import dataclass
 from typing import Final
 
-from amaranth.hdl import Cat, Module, Mux, Signal, Value
+from amaranth.hdl import Cat, Const, Module, Mux, Signal, Value
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
@@ -29,6 +29,7 @@ from supi3.optical.regulation import (
     BLOCK_OUTPUTS,
     DECREASE_AFTER,
     INIT_MAX_STEPS,
+    INIT_ORDER,
     INIT_TIME_LIMIT_CLOCKS,
     MAX_LEVEL,
     MIN_LEVEL,
@@ -182,6 +183,17 @@ def _transitions(m: Module, tx: _Tx, new: _Tx, strobes: tuple[Value, Value, Valu
         comb += new.set(Phase.FIXED)
 
 
+def _initializing(txs: list[_Tx]) -> Value:
+    """:func:`~supi3.optical.regulation.initializing` one-hot (bit i = Interface i): the first of
+    :data:`~supi3.optical.regulation.INIT_ORDER` initializing (OPT-56)."""
+    bits: dict[Interface, Value] = {}
+    earlier: Value = Const(0)
+    for i in INIT_ORDER:
+        bits[i] = txs[i].is_(Phase.INIT) & ~earlier
+        earlier = earlier | txs[i].is_(Phase.INIT)
+    return Cat(*(bits[i] for i in Interface))
+
+
 def _reads(txs: list[_Tx], length: list[Signal], medium: list[Signal]) -> Value:
     """Reads 8..11 (:func:`~supi3.optical.regulation.registers`, 3.4.12, 3.4.13) of the transmitters ``txs`` and
     the measured paths' ``length`` and ``medium``, byte k = read 8 + k."""
@@ -248,11 +260,15 @@ class OpticalRtl(wiring.Component):
                                  for k in range(len(changed)))))  # fmt: skip
 
         # The edge: strobes and the 6 ms counter, unless a reset or the start --------------------------------------
-        # (the 6 ms counter: loaded with the budget at the start, zero in reset, ``last`` one clock before it ends)
-        countdown = Countdown(m, self.time_limit, load=in_reset, clear=self.ib_reset, name="countdown")
+        # (the 6 ms counter: loaded with the budget at the start and when the interface initializing is done, so the
+        # next in INIT_ORDER has its own; zero in reset, ``last`` one clock before it ends; it ends the budget of the
+        # one initializing only: OPT-56)
+        current = _initializing(state)
+        done = (current & ~Cat(*(tx.is_(Phase.INIT) for tx in new))).any()
+        countdown = Countdown(m, self.time_limit, load=in_reset | done, clear=self.ib_reset, name="countdown")
         for i in Interface:
             strobes = (self.resp_valid[i], self.resp.word_select(i, 2), self.test_valid[i], self.ack1[i], self.ack2[i])
-            _transitions(m, state[i], new[i], strobes, countdown.last)
+            _transitions(m, state[i], new[i], strobes, countdown.last & current[i])
         with m.If(self.ib_reset):
             sync += in_reset.eq(1)
             for i in Interface:

@@ -16,7 +16,11 @@ What happens at the clock edge ending a cycle, from that cycle's inputs (:mod:`s
 3. Otherwise, per interface: a response strobe (``resp_valid``) applies
    :func:`~supi3.optical.regulation.init_response`, then a test strobe (``test_valid``) the online test
    (:func:`~supi3.optical.regulation.apply_test`: regulation, or the diagnostics MAU warning, OPT-22); then, on the
-   edge where the 6 ms counter runs out, :func:`~supi3.optical.regulation.init_timeout` for every transmitter.
+   edge where the 6 ms counter runs out, :func:`~supi3.optical.regulation.init_timeout` for the interface that was
+   initializing (:func:`~supi3.optical.regulation.initializing` of the state before the edge, OPT-56).
+
+After 3, when the interface that was initializing no longer is (regulated, fallen back or timed out), the 6 ms counter
+is loaded again: each interface has its own budget, in :data:`~supi3.optical.regulation.INIT_ORDER` (OPT-56).
 
 The length timers of the outgoing interface and the branch run at every edge, ib_reset aside: ``len_start`` clears
 and starts one; while it runs, every :func:`~supi3.optical.regulation.length_timer_enable_every`-th edge after the
@@ -52,6 +56,7 @@ from supi3.optical.regulation import (
     fo_lit,
     init_response,
     init_timeout,
+    initializing,
     length_timer_enable_every,
     registers,
     start,
@@ -242,6 +247,7 @@ class OpticalBlock:
             if status.transmitters != off:
                 self.status = OpticalStatus(off, status.length, status.medium)
             return
+        current = initializing(status.transmitters)
         if self._in_reset:
             self._in_reset = False
             self.countdown = self.time_limit
@@ -253,11 +259,13 @@ class OpticalBlock:
                 txs = tuple(self._strobes(status[i], i, v) for i in Interface)
             if self.countdown:
                 self.countdown -= 1
-                if not self.countdown:
-                    txs = tuple(init_timeout(tx) for tx in txs)
-                    self.log.add(self.cycle, "6 ms budget over")
+                if not self.countdown and current is not None:
+                    txs = tuple(init_timeout(tx) if i is current else tx for i, tx in zip(Interface, txs, strict=True))
+                    self.log.add(self.cycle, "{} 6 ms budget over", current.name)
         if txs != status.transmitters:
             status = OpticalStatus((txs[0], txs[1], txs[2]), status.length, status.medium)
+            if current is not None and txs[current].phase is not Phase.INIT:  # the next one's own 6 ms (OPT-56)
+                self.countdown = self.time_limit
         if v["len_start"] or v["len_stop"] or self._timers[0].running or self._timers[1].running:
             status = self._lengths(status, v, mode, bit_rate)
         self.status = status
