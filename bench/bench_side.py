@@ -12,9 +12,11 @@ Cases, each simulated time / CPU time (``time.process_time``, the machine is sha
 ``--against SRC`` loads a second tree's ``src`` folder beside this one (e.g. ``git worktree add /tmp/base <commit>``,
 then ``--against /tmp/base/src``): the rounds alternate the trees' order, each run starts after a garbage collection,
 and the figures are the fastest and slowest run of each tree, the ratio of the fastest, and whether both trees did
-the same work (instructions, interrupts, violations, process data). Run from the repository root:
+the same work (instructions, interrupts, violations, process data). ``--tree SRC`` measures another ``src`` folder in
+place of this repository's (``bench/bench_mypyc.py`` measures a compiled copy of this tree so). Run from the
+repository root:
 
-    python bench/bench_side.py [--against SRC] [--rounds N] [--cases issue13,500k,host2M,host500k,ring512]
+    python bench/bench_side.py [--against SRC] [--tree SRC] [--rounds N] [--cases issue13,500k,host2M,host500k,ring512]
 """
 
 from __future__ import annotations
@@ -137,6 +139,7 @@ def main(argv: list[str] | None = None) -> None:
     """Measure and print."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--against", help="another tree's src folder, measured interleaved with this one")
+    parser.add_argument("--tree", help="the src folder measured as this tree (default: this repository's)")
     parser.add_argument("--rounds", type=int, default=3, help="runs of each case and tree")
     parser.add_argument("--cases", default=",".join(CYCLES), help="comma-separated: " + ", ".join(CYCLES))
     parser.add_argument("--calls", action="store_true", help="count the function calls of each run (cProfile) in "
@@ -151,8 +154,9 @@ def main(argv: list[str] | None = None) -> None:
     if unknown:
         parser.error(f"unknown case(s) {sorted(unknown)}: choose from {list(CYCLES)}")
     print(f"reproduce: python bench/bench_side.py --rounds {args.rounds} --cases {args.cases}"
-          + (f" --against {args.against}" if args.against else "") + " --calls" * args.calls)  # fmt: skip
-    here = str(Path(__file__).resolve().parents[1] / "src")
+          + (f" --against {args.against}" if args.against else "") + (f" --tree {args.tree}" if args.tree else "")
+          + " --calls" * args.calls)  # fmt: skip
+    here = args.tree or str(Path(__file__).resolve().parents[1] / "src")
     trees = {"this": load(here)}
     if args.against:
         trees = {"before": load(args.against), "after": trees["this"]}

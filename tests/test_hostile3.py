@@ -2,7 +2,8 @@
 ``PinRing.cut(..., branch=True)`` and ``Transfer.devices`` of a pin-level tree (BK-1, BK-10), ``stat_err_filter`` on
 ``Supi3``, ``Supi3Chip`` and ``Board`` (3.6.2, MCU-24), ``Board(fidelity="pin", others=...)`` and its ring (MCU-23),
 ``run_firmware``'s ``devices`` at pin level, ``Bench.advance`` and ``Bench``'s ``others``, ``ViolationLog.hold`` and
-``release``, ``PinRing.idle``'s memory over a long idle, and ``bench/bench_side.py``'s command line.
+``release``, ``PinRing.idle``'s memory over a long idle, ``bench/bench_side.py``'s command line and
+``bench/bench_mypyc.py``'s markers and command line (MCU-42).
 
 Every bad input is refused by name (which argument, which rule, which value) and changes nothing; over any history of
 branch switching, DI3 cuts, repairs and INTERBUS resets the pin-level tree gives the master what the transaction-level
@@ -11,11 +12,13 @@ tree gives it; the /StatErr filter latches a peripheral fault after the same num
 
 from __future__ import annotations
 
+import importlib
 import math
 import subprocess
 import sys
 import tracemalloc
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -410,6 +413,8 @@ def test_a_long_idle_runs_in_pieces_with_the_same_pins_and_bounded_memory(kind: 
     (["--cases", "nope"], 2, "unknown case(s) ['nope']"),
     (["--rounds", "1", "--cases", "ring512", "--against", "/nonexistent/src"], 1,
      "/nonexistent/src holds no supi3 package"),
+    (["--rounds", "1", "--cases", "ring512", "--tree", "/nonexistent/src"], 1,
+     "/nonexistent/src holds no supi3 package"),
 ])  # fmt: skip
 def test_bench_side_refuses_a_bad_command_line(argv: list[str], status: int, message: str) -> None:
     """No round (an IndexError after the firmware builds before) and a tree without supi3 (this tree measured twice,
@@ -429,3 +434,31 @@ def test_bench_side_names_a_tree_too_old_for_its_cases(tmp_path: Path) -> None:
                           check=False)  # fmt: skip
     assert done.returncode == 1 and "Traceback" not in done.stderr
     assert f"bench_side.py: {tmp_path}: No module named 'supi3." in done.stderr
+
+
+# -- bench/bench_mypyc.py (MCU-42) ------------------------------------------------------------------------------
+
+
+def test_bench_mypyc_marks_the_exception_classes_and_the_subclassed_ones_only() -> None:
+    """The scratch copy's markers: mypyc's ``native_class=False`` on each exception class (two builtin bases are not
+    implemented), ``allow_interpreted_subclasses`` on the classes named, nothing else changed but the import."""
+    sys.path.insert(0, str(ROOT / "bench"))
+    try:
+        tool: Any = importlib.import_module("bench_mypyc")
+    finally:
+        sys.path.remove(str(ROOT / "bench"))
+    source = ("from __future__ import annotations\n\n\nclass LinkError(Supi3Error, RuntimeError):\n    pass\n\n\n"
+              "class Firmware:\n    pass\n\n\nclass Other(Base):\n    error: LinkError\n")  # fmt: skip
+    assert tool.mark(source, ("Firmware",)) == (
+        "from __future__ import annotations\n\nfrom mypy_extensions import mypyc_attr\n\n\n"
+        "@mypyc_attr(native_class=False)\nclass LinkError(Supi3Error, RuntimeError):\n    pass\n\n\n"
+        "@mypyc_attr(allow_interpreted_subclasses=True)\nclass Firmware:\n    pass\n\n\n"
+        "class Other(Base):\n    error: LinkError\n")  # fmt: skip
+
+
+def test_bench_mypyc_names_a_module_that_is_not_there() -> None:
+    """A module to compile that the tree does not hold: one line naming it, before any compiler runs."""
+    done = subprocess.run([sys.executable, str(ROOT / "bench" / "bench_mypyc.py"), "--modules", "supi3/nope.py"],
+                          capture_output=True, text=True, cwd=ROOT, timeout=120, check=False)  # fmt: skip
+    assert done.returncode == 1 and "Traceback" not in done.stderr
+    assert "bench_mypyc.py: no module supi3/nope.py in " in done.stderr

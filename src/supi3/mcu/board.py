@@ -699,14 +699,18 @@ class Board:
         log = self.registers.violations
         records = log.records
         before = len(records)
-        log.hold()  # log.deferred() without the with statement's cost (the per-byte hot path)
+        defer = log.strict  # a non-strict log only records: nothing to defer (MCU-42)
+        if defer:
+            log.hold()  # log.deferred() without the with statement's cost (the per-byte hot path)
         try:
             try:
                 result = action(argument)
             except BaseException:
-                log.release(failed=True)
+                if defer:
+                    log.release(failed=True)
                 raise
-            log.release()
+            if defer:
+                log.release()
             return result
         finally:
             if len(records) > before:

@@ -805,7 +805,7 @@ class CortexM:
         natively (MCU-25). An exception they raise stops the run at the end of the block (:attr:`error`); the
         block's later accesses reach no peripheral (no follow-on reports of a run that has ended)."""
 
-        def on_read(handle: int, offset: int, size: int, data: int) -> int:
+        def on_read(handle: int, offset: int, size: int, data: int | None) -> int:
             del handle, data
             if self.error is not None:  # the run ends with this block: its later accesses reach no peripheral
                 return 0
@@ -815,7 +815,7 @@ class CortexM:
                 self.fail(error)
                 return 0
 
-        def on_write(handle: int, offset: int, size: int, value: int, data: int) -> None:
+        def on_write(handle: int, offset: int, size: int, value: int, data: int | None) -> None:
             del handle, data
             if self.error is not None:
                 return
@@ -846,7 +846,7 @@ class CortexM:
         if not callable(callback):
             raise fail("callback", "a callable taking no argument", callback)
 
-        def on_code(handle: int, at: int, size: int, data: int) -> None:
+        def on_code(handle: int, at: int, size: int, data: int | None) -> None:
             del handle, at, size, data
             if self.error is not None:
                 return
@@ -1198,7 +1198,7 @@ class CortexM:
         """Code at ``address`` may be rewritten by the firmware as it runs: it is in RAM (MCU-28)."""
         return 0 <= address - self.ram[0] < self.ram[1]
 
-    def _on_idle_loop(self, handle: int, address: int, size: int, data: int) -> None:
+    def _on_idle_loop(self, handle: int, address: int, size: int, data: int | None) -> None:
         """A ``b .`` is about to run (its block counted): stop there, at its first iteration, whatever the deadline;
         the run loop takes it for a wait in thread mode and a hang in a handler (MCU-4); unless the firmware has
         written other code there since (MCU-28)."""
@@ -1295,7 +1295,8 @@ class CortexM:
                                          self.read_bytes(pc, 2) == _IDLE_LOOP)  # fmt: skip
         return idle
 
-    def _on_invalid_access(self, handle: int, access: int, address: int, size: int, value: int, data: int) -> bool:
+    def _on_invalid_access(self, handle: int, access: int, address: int, size: int, value: int,
+                           data: int | None) -> bool:  # fmt: skip
         """An access to unmapped or protected memory is about to fault: note its address (BFAR, MMFAR); unicorn then
         stops with the error (``False``: not handled)."""
         del handle, access, size, value, data
