@@ -46,7 +46,9 @@ from supi3.config import DeviceConfig, Interface
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusArgumentError, InterbusError, TelegramError
 from supi3.interbus.link import DataKernel, Device
+from supi3.interbus.wake import wake_end
 from supi3.interbus.wire import Cycle, Frame
+from supi3.tables import CLOCK_HZ, RESET_MIN_S
 
 
 class ErrorKind(Enum):
@@ -700,6 +702,10 @@ class Ring:
         self._layout: tuple[list[type], _Groups] = ([], [])
         self._cuts: tuple[list[bytes], int, bytes, list[slice] | None, int] = ([], -1, b"", None, 0)
         self._bits = ((-1, -1), 0)  # (bytes sent, devices) of the last cycle finished, and its wire.cycle_bits
+        self._wakes: dict[int, float] = {}
+        """M22: ring index -> bus time a chip powered up by :meth:`power_up` ends its reset stretch (M2)."""
+        self._grid = 0.0
+        """M22: bus time the master's idle status telegrams began (the end of its last cycle or reset)."""
         _tell_following(self._tree)
         self._sync()
 
@@ -1194,6 +1200,8 @@ class Ring:
             self.trace.append(SegmentTrace(segments if dead is None else dead, silent.frame(cycle), None, None))
         if spliced is ErrorKind.TELEGRAM:
             returned, receiver_error = stream, spliced
+        if self._wakes and self._waking():  # M22: a receiver of the ring is not on the telegram grid yet
+            receiver_error = receiver_error or ErrorKind.TELEGRAM
         elif spliced is ErrorKind.TRANSMISSION:
             returned, flags_back = stream, wire.CntrFlags(attention, True)
         reports = self._reports(len(devices), None if close_after is None else n, dead_lines, returns) \
@@ -1237,7 +1245,7 @@ class Ring:
                 self._silent_reset.discard(index)
         if transfer.reached < len(self.devices):
             self._go_silent(range(transfer.reached, len(self.devices)), start, end)
-        self.now = end
+        self.now = self._grid = end
         if self._branches:
             self._silence_detached(start, end)
             self._recognise()
@@ -1283,8 +1291,35 @@ class Ring:
         self._go_silent(range(reached, len(self.devices)), self.now, end)
         if self._branches:
             self._silence_detached(self.now, end)
-        self.now = end
+        self.now = self._grid = end
+        self._wakes = {}  # M22: the reset's low line and status telegrams put every receiver on the grid (M11)
         self._sync()
+
+    def power_up(self, position: int) -> None:
+        """Power up the chip at ring ``position`` now (its power-up reset, 1.7.2): a master's cycle fails, as at pin
+        level, until the chip and those behind it, then the master's receiver, are on the telegram grid (M22).
+
+        Raises
+        ------
+        ArgumentError
+            ``position`` not from 1 to N, or the device there has no power-up reset (``power_up``).
+        """
+        position = check_int("position", position, 1, len(self.devices))
+        device = self.devices[position - 1]
+        power_up = getattr(device, "power_up", None)
+        if not callable(power_up):
+            raise fail(f"device at ring position {position}", "a chip with a power-up reset (power_up)", device)
+        power_up()
+        self._wakes[position - 1] = self.now + round(RESET_MIN_S * CLOCK_HZ) / CLOCK_HZ  # the stretch, M2
+
+    def _waking(self) -> bool:
+        """M22: a cycle starting now meets the window after a power-up (:func:`~supi3.interbus.wake.wake_end`);
+        past it the window is forgotten."""
+        wakes = {index: round((at - self._grid) * CLOCK_HZ) for index, at in self._wakes.items()}
+        if round((self.now - self._grid) * CLOCK_HZ) < wake_end(self.bit_rate, len(self.devices), wakes):
+            return True
+        self._wakes = {}
+        return False
 
     def idle(self, seconds: float) -> None:
         """The master sends only idle status telegrams for ``seconds`` (no cycles)."""

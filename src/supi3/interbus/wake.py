@@ -1,0 +1,78 @@
+"""A chip's wake-up after its power-up reset at transaction level (M22 of docs/assumptions/model.md).
+
+The power-up reset's stretch (M2, 128 clocks, manual 1.7.2) ends at no telegram boundary: the woken chip's receiver
+and those behind it (their line resumes when the woken chip's transmitter does, M12) find the telegram grid of the
+master's gapless idle status telegrams by M16, a chip begins a frame after a whole status telegram (M19), and the
+master's receiver finds the grid last. :func:`wake_end` gives the first clock from which a master's cycle passes,
+from the receiver itself (:func:`supi3.interbus.receiver.receive`) run over the idle status telegrams.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Mapping
+
+import numpy as np
+import numpy.typing as npt
+
+from supi3.interbus import wire
+from supi3.interbus.receiver import receive
+from supi3.interbus.wire import Cycle, Telegram
+
+_PROBE_TELEGRAMS = 64
+"""Idle status telegrams the receiver is run over: far more than it needs to find the grid (M16: within two)."""
+
+
+@functools.cache
+def _idle_samples(bit_rate: int) -> npt.NDArray[np.int64]:
+    return wire.levels_to_samples(wire.status_levels(Cycle.DATA, False, _PROBE_TELEGRAMS), bit_rate).astype(np.int64)
+
+
+@functools.cache
+def resync(bit_rate: int, phase: int) -> tuple[int, int, int]:
+    """A receiver (M16) that begins listening ``phase`` clocks into an idle status telegram of a gapless run: the
+    clocks from then to its first start level (where a woken chip's transmitter resumes, M12), to the end of its first
+    whole telegram on the grid (a good stop bit, M19), and to just past its last telegram error (0: none)."""
+    cpb = wire.clocks_per_bit(bit_rate)
+    telegram = wire.STATUS_TELEGRAM_BITS * cpb
+    samples = _idle_samples(bit_rate)[phase:]
+    first = int(np.flatnonzero(samples == wire.START_LEVEL)[0])
+    for count in range(1, _PROBE_TELEGRAMS):
+        end = count * telegram - phase
+        if end <= 0:
+            continue
+        out, index, error = receive(samples[:end], 0, cpb)
+        if index == end and out and isinstance(out[-1], Telegram):
+            # M16: the telegram error before the grid restarts on its stop bit, the start of the grid's telegram.
+            return first, end, end - telegram + cpb // 2 + 1 if error else 0
+    raise AssertionError("the receiver finds the telegram grid within two status telegrams (M16)")
+
+
+def wake_end(bit_rate: int, devices: int, wakes: Mapping[int, int]) -> int:
+    """The master's first clock from which its cycle passes after chips of a flat ring woke up (M22).
+
+    ``wakes`` maps a ring index (0 = position 1) to the clock its reset stretch ended; clocks count from the start of
+    the master's idle status telegrams. Chip ``j`` sees the master's line ``REPEATER_DELAY_BITS`` (A10) later per chip
+    before it, from its wake-up or from when the chip before it resumed; it takes a frame from the end of its first
+    whole telegram on the grid; the master's receiver (behind the last chip, no added delay) must have made its last
+    telegram error before the cycle's first clock.
+    """
+    cpb = wire.clocks_per_bit(bit_rate)
+    telegram = wire.STATUS_TELEGRAM_BITS * cpb
+    delay = wire.REPEATER_DELAY_BITS * cpb
+    resumed: int | None = None
+    end = 0
+    for index in range(devices + 1):  # the chips, then the master's receiver
+        lag = index * delay
+        listen = wakes.get(index) if index < devices else None
+        if resumed is not None:
+            listen = resumed if listen is None else max(listen, resumed)
+        if listen is None:
+            continue
+        first, grid, error = resync(bit_rate, (listen - lag) % telegram)
+        if index < devices:
+            end = max(end, listen + grid - lag)
+        elif error:
+            end = max(end, listen + error)
+        resumed = listen + first + delay
+    return end
