@@ -3,7 +3,7 @@
 The power-up reset's stretch (M2, 128 clocks, manual 1.7.2) ends at no telegram boundary: the woken chip's receiver
 and those behind it (their line resumes when the woken chip's transmitter does, M12) find the telegram grid of the
 master's gapless idle status telegrams by M16, a chip begins a frame after a whole status telegram (M19), and the
-master's receiver finds the grid last. :func:`wake_end` gives the first clock from which a master's cycle passes,
+master's receiver finds the grid last. :func:`wake_window` gives the clocks from which a master's frame finds each chip, and its receiver the line, on the grid,
 from the receiver itself (:func:`supi3.interbus.receiver.receive`) run over the idle status telegrams.
 """
 
@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Mapping
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -48,20 +49,38 @@ def resync(bit_rate: int, phase: int) -> tuple[int, int, int]:
     raise AssertionError("the receiver finds the telegram grid within two status telegrams (M16)")
 
 
-def wake_end(bit_rate: int, devices: int, wakes: Mapping[int, int]) -> int:
-    """The master's first clock from which its cycle passes after chips of a flat ring woke up (M22).
+class Window(NamedTuple):
+    """What a master's cycle meets after chips of a flat ring woke up (M22), in clocks from the start of the master's
+    idle status telegrams."""
 
-    ``wakes`` maps a ring index (0 = position 1) to the clock its reset stretch ended; clocks count from the start of
+    ready: list[int]
+    """Per ring index, the first clock from which a cycle's frame finds the chip on the grid (0: at once); a frame
+    before passes through the chip as received, with no frame of its own (M19)."""
+    heard: int
+    """The first clock from which a cycle meets no telegram error of the master's receiver (0: at once)."""
+
+    @property
+    def end(self) -> int:
+        """The first clock from which a cycle meets nothing of the window."""
+        return max(self.heard, *self.ready)
+
+
+def wake_window(bit_rate: int, devices: int, wakes: Mapping[int, int]) -> Window:
+    """The window after chips of a flat ring of ``devices`` woke up (M22).
+
+    ``wakes`` maps a ring index (0 = position 1) to the clock its reset stretch (M2) ended, counted from the start of
     the master's idle status telegrams. Chip ``j`` sees the master's line ``REPEATER_DELAY_BITS`` (A10) later per chip
-    before it, from its wake-up or from when the chip before it resumed; it takes a frame from the end of its first
-    whole telegram on the grid; the master's receiver (behind the last chip, no added delay) must have made its last
-    telegram error before the cycle's first clock.
+    before it, from its wake-up or, if later, from when the chip before it resumed sending (its first start level after
+    its own resumption or wake-up, M12); the chip takes a frame from the end of its first whole status telegram
+    (M19); the master's receiver, behind the last chip with no added delay, listens from the last chip's resumption and
+    makes its last telegram error before finding the grid (M16).
     """
     cpb = wire.clocks_per_bit(bit_rate)
     telegram = wire.STATUS_TELEGRAM_BITS * cpb
     delay = wire.REPEATER_DELAY_BITS * cpb
     resumed: int | None = None
-    end = 0
+    ready = [0] * devices
+    heard = 0
     for index in range(devices + 1):  # the chips, then the master's receiver
         lag = index * delay
         listen = wakes.get(index) if index < devices else None
@@ -71,8 +90,8 @@ def wake_end(bit_rate: int, devices: int, wakes: Mapping[int, int]) -> int:
             continue
         first, grid, error = resync(bit_rate, (listen - lag) % telegram)
         if index < devices:
-            end = max(end, listen + grid - lag)
+            ready[index] = listen + grid - lag
         elif error:
-            end = max(end, listen + error)
+            heard = listen + error
         resumed = listen + first + delay
-    return end
+    return Window(ready, heard)
