@@ -3,8 +3,9 @@
 The power-up reset's stretch (M2, 128 clocks, manual 1.7.2) ends at no telegram boundary: the woken chip's receiver
 and those behind it (their line resumes when the woken chip's transmitter does, M12) find the telegram grid of the
 master's gapless idle status telegrams by M16, a chip begins a frame after a whole status telegram (M19), and the
-master's receiver finds the grid last. :func:`wake_window` gives the clocks from which a master's frame finds each chip, and its receiver the line, on the grid,
-from the receiver itself (:func:`supi3.interbus.receiver.receive`) run over the idle status telegrams.
+master's receiver finds the grid last. :func:`wake_window` gives the clocks from which a master's frame finds each
+chip on the grid and its receiver meets no telegram error, from the receiver itself
+(:func:`supi3.interbus.receiver.receive`) run over idle status telegrams.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from supi3.checks import check_int, fail
 from supi3.interbus import wire
 from supi3.interbus.receiver import receive
 from supi3.interbus.wire import Cycle, Telegram
@@ -30,7 +32,7 @@ def _idle_samples(bit_rate: int) -> npt.NDArray[np.int64]:
 
 
 @functools.cache
-def resync(bit_rate: int, phase: int) -> tuple[int, int, int]:
+def _resync(bit_rate: int, phase: int) -> tuple[int, int, int]:
     """A receiver (M16) that begins listening ``phase`` clocks into an idle status telegram of a gapless run: the
     clocks from then to its first start level (where a woken chip's transmitter resumes, M12), to the end of its first
     whole telegram on the grid (a good stop bit, M19), and to just past its last telegram error (0: none)."""
@@ -74,8 +76,19 @@ def wake_window(bit_rate: int, devices: int, wakes: Mapping[int, int]) -> Window
     its own resumption or wake-up, M12); the chip takes a frame from the end of its first whole status telegram
     (M19); the master's receiver, behind the last chip with no added delay, listens from the last chip's resumption and
     makes its last telegram error before finding the grid (M16).
+
+    Raises
+    ------
+    ArgumentError
+        ``bit_rate`` not one of Table 1-7, ``devices`` not from 1 to ``wire.MAX_DEVICES``, or ``wakes`` not a mapping
+        of ring indices (0 to ``devices`` - 1) to integer clocks.
     """
     cpb = wire.clocks_per_bit(bit_rate)
+    devices = check_int("devices", devices, 1, wire.MAX_DEVICES)
+    if not isinstance(wakes, Mapping) or not all(
+        type(index) is int and 0 <= index < devices and type(clock) is int for index, clock in wakes.items()
+    ):
+        raise fail("wakes", f"a mapping of ring indices (0 to {devices - 1}) to integer clocks", wakes, "M22")
     telegram = wire.STATUS_TELEGRAM_BITS * cpb
     delay = wire.REPEATER_DELAY_BITS * cpb
     resumed: int | None = None
@@ -88,7 +101,7 @@ def wake_window(bit_rate: int, devices: int, wakes: Mapping[int, int]) -> Window
             listen = resumed if listen is None else max(listen, resumed)
         if listen is None:
             continue
-        first, grid, error = resync(bit_rate, (listen - lag) % telegram)
+        first, grid, error = _resync(bit_rate, (listen - lag) % telegram)
         if index < devices:
             ready[index] = listen + grid - lag
         elif error:
