@@ -16,12 +16,12 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from supi3 import tables
-from supi3.checks import ArgumentError
 from supi3.config import DeviceConfig, decode
+from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.master import CycleResult, Master
 from supi3.interbus.ring import Ring
-from supi3.interbus.wake import wake_window
+from supi3.interbus.wake import wake_return, wake_window
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
 from supi3.model.pinring import PinRing
@@ -196,6 +196,8 @@ def test_a_power_up_names_the_chip_it_takes() -> None:
         wake_window(500_000, 1, {1: 0})
     with pytest.raises(ArgumentError, match="bit"):
         wake_window(1_000_000, 1, {})
+    with pytest.raises(ArgumentError, match="frame"):
+        wake_return(500_000, 1, {0: 128}, 0, b"\x00")  # type: ignore[arg-type]
 
 
 def test_a_status_telegram_ends_a_frame() -> None:

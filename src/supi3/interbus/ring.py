@@ -46,7 +46,7 @@ from supi3.config import DeviceConfig, Interface
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusArgumentError, InterbusError, TelegramError
 from supi3.interbus.link import DataKernel, Device
-from supi3.interbus.wake import wake_window
+from supi3.interbus.wake import wake_return, wake_window
 from supi3.interbus.wire import Cycle, Frame
 from supi3.tables import CLOCK_HZ, RESET_MIN_S
 
@@ -1152,11 +1152,12 @@ class Ring:
         runs: list[_Run] = []
         devices = self.devices[: n if dead is None else min(n, dead - 1)]
         reached = len(devices)
-        heard = True
+        woken: tuple[dict[int, int], int] | None = None
+        unheard = False
         if self._wakes:  # M22: a chip not on the telegram grid yet passes the frame on as received (M19)
-            late, heard = self._waking()
+            late, woken = self._waking()
             if late and faults:  # not modelled on a faulty ring: the master's receiver fails the cycle instead
-                heard = False
+                unheard = True
             elif late:
                 devices = [device for index, device in enumerate(devices) if index not in late]
         slow = range(len(devices)) if record else sorted(s - 1 for s in faults if s <= len(devices)) if faults else ()
@@ -1209,14 +1210,18 @@ class Ring:
             self.trace.append(SegmentTrace(segments if dead is None else dead, silent.frame(cycle), None, None))
         if spliced is ErrorKind.TELEGRAM:
             returned, receiver_error = stream, spliced
-        if not heard:  # M22: the master's receiver is not on the telegram grid yet (no fault of line N + 1)
+        if woken is not None and returned is not None:  # M22: the master's receiver, bit by bit in the window
+            error, opened = wake_return(self.bit_rate, len(self.devices), *woken, Frame.build(cycle, returned))
+            unheard = unheard or error
+            returned = returned if opened else None
+        if unheard:  # not on the telegram grid yet: no fault of the return line N + 1
             receiver_error = receiver_error or ErrorKind.TELEGRAM
         elif spliced is ErrorKind.TRANSMISSION:
             returned, flags_back = stream, wire.CntrFlags(attention, True)
         reports = self._reports(reached, None if close_after is None else n, dead_lines, returns) \
             if self._spans else []
         return Transfer(cycle, bytes(data), n, returned, flags_back, receiver_error, runs, reached, reports,
-                        spliced is not None or not heard)
+                        spliced is not None or unheard)
 
     def finish(self, transfer: Transfer, latch: bool) -> None:
         """End a cycle with the master's verdict: the latch telegrams (``latch``) or idle telegrams.
@@ -1321,15 +1326,17 @@ class Ring:
         power_up()
         self._wakes[position - 1] = self.now + round(RESET_MIN_S * CLOCK_HZ) / CLOCK_HZ  # the stretch, M2
 
-    def _waking(self) -> tuple[set[int], bool]:
-        """M22: the ring indices of the chips a frame starting now finds off the telegram grid, and whether the
-        master's receiver is on it (:func:`~supi3.interbus.wake.wake_window`); past the window it is forgotten."""
+    def _waking(self) -> tuple[set[int], tuple[dict[int, int], int] | None]:
+        """M22: the ring indices of the chips a frame starting now finds off the telegram grid, and the wake-ups and
+        the frame's start in clocks of the master's idle (:func:`~supi3.interbus.wake.wake_window`); ``None`` past the
+        window, which is then forgotten."""
         wakes = {index: round((at - self._grid) * CLOCK_HZ) for index, at in self._wakes.items()}
         window = wake_window(self.bit_rate, len(self.devices), wakes)
         now = round((self.now - self._grid) * CLOCK_HZ)
         if now >= window.end:
             self._wakes = {}
-        return {index for index, ready in enumerate(window.ready) if now < ready}, now >= window.heard
+            return set(), None
+        return {index for index, ready in enumerate(window.ready) if now < ready}, (wakes, now)
 
     def idle(self, seconds: float) -> None:
         """The master sends only idle status telegrams for ``seconds`` (no cycles)."""

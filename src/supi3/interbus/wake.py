@@ -17,10 +17,10 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from supi3.checks import check_int, fail
+from supi3.checks import check_instance, check_int, fail
 from supi3.interbus import wire
 from supi3.interbus.receiver import receive
-from supi3.interbus.wire import Cycle, Telegram
+from supi3.interbus.wire import Cycle, Frame, Telegram
 
 _PROBE_TELEGRAMS = 64
 """Idle status telegrams the receiver is run over: far more than it needs to find the grid (M16: within two)."""
@@ -49,6 +49,16 @@ def _resync(bit_rate: int, phase: int) -> tuple[int, int, int]:
             # M16: the telegram error before the grid restarts on its stop bit, the start of the grid's telegram.
             return first, end, end - telegram + cpb // 2 + 1 if error else 0
     raise AssertionError("the receiver finds the telegram grid within two status telegrams (M16)")
+
+
+def _check(bit_rate: int, devices: int, wakes: Mapping[int, int]) -> int:
+    wire.check_bit_rate(bit_rate)
+    devices = check_int("devices", devices, 1, wire.MAX_DEVICES)
+    if not isinstance(wakes, Mapping) or not all(
+        type(index) is int and 0 <= index < devices and type(clock) is int for index, clock in wakes.items()
+    ):
+        raise fail("wakes", f"a mapping of ring indices (0 to {devices - 1}) to integer clocks", wakes, "M22")
+    return devices
 
 
 class Window(NamedTuple):
@@ -83,12 +93,8 @@ def wake_window(bit_rate: int, devices: int, wakes: Mapping[int, int]) -> Window
         ``bit_rate`` not one of Table 1-7, ``devices`` not from 1 to ``wire.MAX_DEVICES``, or ``wakes`` not a mapping
         of ring indices (0 to ``devices`` - 1) to integer clocks.
     """
+    devices = _check(bit_rate, devices, wakes)
     cpb = wire.clocks_per_bit(bit_rate)
-    devices = check_int("devices", devices, 1, wire.MAX_DEVICES)
-    if not isinstance(wakes, Mapping) or not all(
-        type(index) is int and 0 <= index < devices and type(clock) is int for index, clock in wakes.items()
-    ):
-        raise fail("wakes", f"a mapping of ring indices (0 to {devices - 1}) to integer clocks", wakes, "M22")
     telegram = wire.STATUS_TELEGRAM_BITS * cpb
     delay = wire.REPEATER_DELAY_BITS * cpb
     resumed: int | None = None
@@ -108,3 +114,50 @@ def wake_window(bit_rate: int, devices: int, wakes: Mapping[int, int]) -> Window
             heard = listen + error
         resumed = listen + first + delay
     return Window(ready, heard)
+
+
+def wake_return(bit_rate: int, devices: int, wakes: Mapping[int, int], start: int,
+                frame: Frame) -> tuple[bool, bool]:
+    """What the master's receiver makes of a cycle in the window after chips of a flat ring woke up (M22): whether it
+    meets a telegram error, and whether a telegram that opens a frame comes back (else a dead line).
+
+    The master's line is followed bit by bit from the earliest wake-up: idle status telegrams, from clock ``start``
+    (counted as in :func:`wake_window`) ``frame`` as it comes back and the ring delay's status telegrams (A11), the
+    line of each chip silent from a wake-up until it resumes sending (its first start level after it began listening,
+    M12, then ``REPEATER_DELAY_BITS`` later); the receiver (:func:`supi3.interbus.receiver.receive`) takes the line in
+    two pieces, the idle before ``start`` and the cycle, as the pin level's master does.
+
+    Raises
+    ------
+    ArgumentError
+        As :func:`wake_window`; ``start`` not an integer clock, ``frame`` not a :class:`~supi3.interbus.wire.Frame`.
+    """
+    devices = _check(bit_rate, devices, wakes)
+    start = check_int("start", start)
+    check_instance("frame", frame, Frame)
+    cpb = wire.clocks_per_bit(bit_rate)
+    telegram = wire.STATUS_TELEGRAM_BITS * cpb
+    delay = wire.REPEATER_DELAY_BITS * cpb
+    origin = min(0, start, *wakes.values()) // telegram * telegram  # followed from a telegram boundary
+    idle = wire.status_levels(Cycle.DATA, False, -(-(start - origin) // telegram))
+    tail = np.concatenate([wire.frame_levels(frame),
+                           wire.status_levels(frame.cycle, False, wire.ring_delay_status_telegrams(devices))])
+    sent = np.concatenate([wire.levels_to_samples(idle, bit_rate)[: start - origin],
+                           wire.levels_to_samples(tail, bit_rate)]).astype(np.int64)
+    end = len(sent)
+    resumed: int | None = None
+    for index in range(devices):
+        listen = wakes.get(index)
+        if resumed is not None:
+            listen = resumed if listen is None else max(listen, resumed)
+        if listen is not None:
+            lows = np.flatnonzero(sent[max(0, listen - origin - index * delay):] == wire.START_LEVEL)
+            resumed = listen + (int(lows[0]) if lows.size else end) + delay
+    lag = devices * delay
+    line = np.full(end, wire.IDLE_LEVEL, dtype=np.int64)  # the master's line: the last chip's, no further delay
+    line[lag:] = sent[: end - lag]
+    if resumed is not None:
+        line[: max(0, min(end, resumed - origin))] = wire.IDLE_LEVEL
+    _, index, _ = receive(line[: start - origin], 0, cpb)
+    telegrams, _, error = receive(line, index, cpb)
+    return error, any(isinstance(t, Telegram) and wire.opens_frame(t) for t in telegrams)
