@@ -46,7 +46,7 @@ from supi3.config import DeviceConfig, Interface
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusArgumentError, InterbusError, TelegramError
 from supi3.interbus.link import DataKernel, Device
-from supi3.interbus.wake import wake_return, wake_window
+from supi3.interbus.wake import reset_ready, wake_return, wake_window
 from supi3.interbus.wire import Cycle, Frame
 from supi3.tables import CLOCK_HZ, RESET_MIN_S
 
@@ -705,6 +705,8 @@ class Ring:
         self._bits = ((-1, -1), 0)  # (bytes sent, devices) of the last cycle finished, and its wire.cycle_bits
         self._wakes: dict[int, float] = {}
         """M22: ring index -> bus time a chip powered up by :meth:`power_up` ends its reset stretch (M2)."""
+        self._late: dict[int, float] = {}
+        """M22: ring index -> bus time from which a frame finds the chip out of an INTERBUS reset it woke up in."""
         self._grid = 0.0
         """M22: bus time the master's idle status telegrams began (the end of its last cycle or reset)."""
         _tell_following(self._tree)
@@ -1154,7 +1156,7 @@ class Ring:
         reached = len(devices)
         woken: tuple[dict[int, int], int] | None = None
         unheard = False
-        if self._wakes:  # M22: a chip not on the telegram grid yet passes the frame on as received (M19)
+        if self._wakes or self._late:  # M22: a chip not on the telegram grid yet passes the frame on (M19)
             late, woken = self._waking()
             if late and faults:  # not modelled on a faulty ring: the master's receiver fails the cycle instead
                 unheard = True
@@ -1305,8 +1307,12 @@ class Ring:
         self._go_silent(range(reached, len(self.devices)), self.now, end)
         if self._branches:
             self._silence_detached(self.now, end)
+        if self._wakes:  # M22: a chip off the telegram grid at the hold may leave the reset late
+            wakes = {index: round((at - self._grid) * CLOCK_HZ) for index, at in self._wakes.items()}
+            ready = reset_ready(self.bit_rate, len(self.devices), wakes, round((self.now - self._grid) * CLOCK_HZ))
+            self._late = {index: self._grid + at / CLOCK_HZ for index, at in enumerate(ready) if at}
         self.now = self._grid = end
-        self._wakes = {}  # M22: the reset's low line and status telegrams put every receiver on the grid (M11)
+        self._wakes = {}  # the master's receiver leaves the hold on the grid (a line reset, M11)
         self._sync()
 
     def power_up(self, position: int) -> None:
@@ -1330,13 +1336,18 @@ class Ring:
         """M22: the ring indices of the chips a frame starting now finds off the telegram grid, and the wake-ups and
         the frame's start in clocks of the master's idle (:func:`~supi3.interbus.wake.wake_window`); ``None`` past the
         window, which is then forgotten."""
+        late = {index for index, at in self._late.items() if self.now < at}
+        if len(late) < len(self._late):
+            self._late = {index: self._late[index] for index in late}
         wakes = {index: round((at - self._grid) * CLOCK_HZ) for index, at in self._wakes.items()}
+        if not wakes:
+            return late, None
         window = wake_window(self.bit_rate, len(self.devices), wakes)
         now = round((self.now - self._grid) * CLOCK_HZ)
         if now >= window.end:
             self._wakes = {}
-            return set(), None
-        return {index for index, ready in enumerate(window.ready) if now < ready}, (wakes, now)
+            return late, None
+        return late | {index for index, ready in enumerate(window.ready) if now < ready}, (wakes, now)
 
     def idle(self, seconds: float) -> None:
         """The master sends only idle status telegrams for ``seconds`` (no cycles)."""

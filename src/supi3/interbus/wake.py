@@ -161,3 +161,68 @@ def wake_return(bit_rate: int, devices: int, wakes: Mapping[int, int], start: in
     _, index, _ = receive(line[: start - origin], 0, cpb)
     telegrams, _, error = receive(line, index, cpb)
     return error, any(isinstance(t, Telegram) and wire.opens_frame(t) for t in telegrams)
+
+
+_SHORT_HOLD_BITS = 12
+"""The reset's low line as :func:`reset_ready` hands it to the receiver: as long as any telegram begun before it reads
+into it (a data telegram's stop bit at most 11 bits in), shorter than ``RESET_DETECT_BITS`` (no line reset, which
+the chip's receiver does not know: it reads status telegrams of 4 bit periods through the low, M16) and as long as
+the hold modulo 4, so that the receiver leaves it where it leaves the whole hold."""
+
+
+def reset_ready(bit_rate: int, devices: int, wakes: Mapping[int, int], start: int) -> list[int]:
+    """Per ring index, the first clock from which a frame finds the chip out of an INTERBUS reset that the master
+    begins at clock ``start`` (``wire.reset_levels``, A12) within the window after chips woke up (M22, counted as in
+    :func:`wake_window`): a chip that reads the hold from its wake-up (or the chip before it resuming) for
+    ``RESET_DETECT_BITS`` or more ends the reset at its fourth whole status telegram after the hold (M11), one that
+    does not takes a frame from its first (M19); 0 for a chip on the telegram grid when the hold begins.
+
+    Raises
+    ------
+    ArgumentError
+        As :func:`wake_window`; ``start`` not an integer clock.
+    """
+    devices = _check(bit_rate, devices, wakes)
+    start = check_int("start", start)
+    window = wake_window(bit_rate, devices, wakes)
+    cpb = wire.clocks_per_bit(bit_rate)
+    telegram = wire.STATUS_TELEGRAM_BITS * cpb
+    delay = wire.REPEATER_DELAY_BITS * cpb
+    cut = (wire.RESET_HOLD_BITS - _SHORT_HOLD_BITS) * cpb
+    origin = min(0, start, *wakes.values()) // telegram * telegram
+    after = wire.status_levels(Cycle.DATA, False, wire.RESET_END_STATUS_TELEGRAMS + _PROBE_TELEGRAMS)
+    idle = wire.levels_to_samples(wire.status_levels(Cycle.DATA, False, -(-(start - origin) // telegram)), bit_rate)
+    low = np.full(_SHORT_HOLD_BITS * cpb, wire.START_LEVEL, dtype=np.int64)
+    sent = np.concatenate([idle[: start - origin], low, wire.levels_to_samples(after, bit_rate)]).astype(np.int64)
+    hold = wire.RESET_HOLD_BITS * cpb
+    short_end = start - origin + len(low)  # the hold's end in the short line
+    ready = [0] * devices
+    resumed: int | None = None
+    for index in range(devices):
+        lag = index * delay
+        listen = wakes.get(index)
+        if resumed is not None:
+            listen = resumed if listen is None else max(listen, resumed)
+        if listen is None or window.ready[index] <= start:  # on the grid at the hold: it leaves the hold on the grid
+            resumed = None
+            continue
+        at = listen - lag - origin  # where the chip begins to listen, on the master's line
+        at = at % telegram if at < 0 else at  # before the line followed: idle status telegrams, periodic
+        rest = start - origin + hold - at  # the hold it reads
+        if at < start - origin:
+            rest = hold
+        elif rest <= 0:  # woken after the hold
+            at -= cut
+        else:  # inside the hold: as far from the short hold's end modulo 4 bit periods
+            at = short_end - (rest if rest <= len(low) else rest % (4 * cpb) + (_SHORT_HOLD_BITS - 4) * cpb)
+        lows = np.flatnonzero(sent[at:] == wire.START_LEVEL)
+        resumed = listen + (int(lows[0]) if lows.size else 0) + delay
+        line = sent[at:]
+        _, begun, _ = receive(line[: max(0, short_end - at)], 0, cpb)
+        need = wire.RESET_END_STATUS_TELEGRAMS if rest >= wire.RESET_DETECT_BITS * cpb else 1
+        for count in range(1, _PROBE_TELEGRAMS):
+            telegrams, _, _ = receive(line[: short_end - at + count * telegram], begun, cpb)
+            if sum(isinstance(t, Telegram) and t.data is None for t in telegrams) >= need:
+                ready[index] = start + hold + count * telegram
+                break
+    return ready
