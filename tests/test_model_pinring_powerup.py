@@ -21,7 +21,7 @@ from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.master import CycleResult, Master
 from supi3.interbus.ring import Ring
-from supi3.interbus.wake import wake_return, wake_window
+from supi3.interbus.wake import reset_ready, wake_return, wake_window
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
 from supi3.model.pinring import PinRing
@@ -119,6 +119,7 @@ OPS = st.lists(st.tuples(st.sampled_from(["power", "cut", "repair", "start", "wa
 @example(500_000, 4, False, [("wait", 1)], 4)  # the master's receiver is the last on the grid (M22: 5 telegrams)
 @example(2_000_000, 4, False, [("power", 3), ("wait", 1)], 4)  # a chip behind others woken: 5 telegrams
 @example(2_000_000, 4, False, [("power", 4), ("wait", 1)], 0)  # chips off the grid pass the discovery frame on
+@example(2_000_000, 1, True, [("cut", 1)], 1)  # the start's hold meets the chip off the grid: it misses the discovery
 def test_a_master_sees_every_cycle_alike_after_power_ups(rate: int, chips: int, start: bool, ops: list[Op],
                                                          wake: int) -> None:
     """M19, M20, M22: over any history of power-ups of any chips, cuts, repairs, starts or none, with ``wake`` idle
@@ -187,6 +188,34 @@ def test_the_window_after_a_power_up_ends_alike(rate: int) -> None:
     assert min(windows) == 1
 
 
+def _start_after(ring: Ring | PinRing, chips: int, telegrams: int) -> tuple[bool, int, bool]:
+    """Every chip powered up at the ring's first clock, ``telegrams`` idle status telegrams, then the master's start
+    and a data cycle: the start's success, the devices it found, the data cycle's success."""
+    if isinstance(ring, Ring):
+        for k in range(1, chips + 1):
+            ring.power_up(k)
+    _idle(ring, telegrams)
+    master = Master(ring, locate=False, max_devices=8)
+    started = master.start().ok
+    return started, len(master.config or ()), master.cycle().ok
+
+
+def test_a_chip_woken_in_the_reset_s_hold_ends_it_alike() -> None:
+    """M22 (``reset_ready``): a start right after the power-up, its hold meeting chips off the telegram grid (their
+    receivers read the hold as status telegrams, M16, and find the grid after it late): the discovery and the data
+    cycle after it alike at both fidelities, 1 to 4 chips, both bit rates, 0 to 2 idle telegrams before the start;
+    one chip at 2 Mbit/s started after 1 telegram ends its reset after the discovery (found with no device)."""
+    seen = {}
+    for rate in RATES:
+        for chips in range(1, 5):
+            for telegrams in range(3):
+                tl = _start_after(Ring([Supi3(_config(rate)) for _ in range(chips)], bit_rate=rate), chips, telegrams)
+                pin = _start_after(PinRing([Supi3Pins(_config(rate)) for _ in range(chips)]), chips, telegrams)
+                assert tl == pin, (rate, chips, telegrams)
+                seen[rate, chips, telegrams] = tl
+    assert seen[2_000_000, 1, 1] == (True, 0, False)
+
+
 def test_a_power_up_names_the_chip_it_takes() -> None:
     """M22's entries refuse bad input with the rule and the value."""
     ring = Ring([Supi3(_config(500_000))], bit_rate=500_000)
@@ -196,6 +225,8 @@ def test_a_power_up_names_the_chip_it_takes() -> None:
         wake_window(500_000, 1, {1: 0})
     with pytest.raises(ArgumentError, match="bit"):
         wake_window(1_000_000, 1, {})
+    with pytest.raises(ArgumentError, match="start"):
+        reset_ready(500_000, 1, {0: 128}, 0.5)  # type: ignore[arg-type]
     with pytest.raises(ArgumentError, match="frame"):
         wake_return(500_000, 1, {0: 128}, 0, b"\x00")  # type: ignore[arg-type]
 
