@@ -33,12 +33,12 @@ from supi3.config import DeviceConfig, decode
 from supi3.expansion import IDLE as EXPANSION_IDLE
 from supi3.expansion import ExpansionLevels, chain_to_line, line_to_chain
 from supi3.interbus import wire
+from supi3.interbus.receiver import receive
 from supi3.interbus.ring import BranchKind
 from supi3.interbus.wire import Cycle, Frame
 from supi3.model.blocks.optical import OpticalBlock
 from supi3.model.bus_terminal import LBST_PIN
 from supi3.model.chip import Supi3
-from supi3.model.pinring import receive
 from supi3.model.pins import IDLE_TIMEOUT_CLOCKS, Supi3Pins
 from supi3.model.registers import RegisterFile
 from supi3.optical.regulation import BLOCK_INPUTS, INIT_TIME_LIMIT_CLOCKS, Interface, OpticalMode, Response

@@ -14,8 +14,9 @@ from hypothesis import strategies as st
 from supi3.config import decode
 from supi3.interbus import wire
 from supi3.interbus.master import Master
+from supi3.interbus.receiver import receive
 from supi3.interbus.wire import Cycle, Telegram
-from supi3.model.pinring import PinChip, PinRing, receive
+from supi3.model.pinring import PinChip, PinRing
 from supi3.model.pins import RESET_STRETCH_CLOCKS, Supi3Pins
 from supi3.regmap import ID, IN0, IN1, OUT0, OUT1, SET, Register, encode_command
 from supi3.spi.master import SoftMaster

@@ -17,9 +17,11 @@ from hypothesis import strategies as st
 
 from supi3 import tables
 from supi3.config import DeviceConfig, decode
+from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.master import CycleResult, Master
 from supi3.interbus.ring import Ring
+from supi3.interbus.wake import reset_ready, wake_return, wake_window
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
 from supi3.model.pinring import PinRing
@@ -32,10 +34,8 @@ RB = next(row for row in tables.MODE_ROWS if row.function == "RB, 8 IN/8 OUT")
 RATES = [500_000, 2_000_000]
 POWER_DOWN_TELEGRAMS = 4
 """Idle status telegrams a power-up step holds the chip's /ResU low (its reset source, 1.7.2)."""
-WAKE_TELEGRAMS = 20
-"""Idle status telegrams after a power-up: the reset stretch (M2) and the search for the telegram grid of the woken
-chip and of the chips behind it (M16, M19); measured at pin level, the first cycle passes after 3 (one chip, 500
-kbit/s) to 8 (four chips, 2 Mbit/s). The transaction level has no such window (its chips are ready at once)."""
+PAST_WINDOW_TELEGRAMS = 8
+"""Idle status telegrams past M22's window after a power-up (at most 7: four chips, 2 Mbit/s, all at once)."""
 
 
 def _config(rate: int) -> DeviceConfig:
@@ -49,15 +49,15 @@ def _idle(ring: Ring | PinRing, telegrams: int) -> None:
 Op = tuple[str, int]
 
 
-def history(ring: Ring | PinRing, start: bool, ops: list[Op]) -> list[object]:
+def history(ring: Ring | PinRing, start: bool, ops: list[Op], wake: int) -> list[object]:
     """What a master sees of the flat ``ring`` (fresh chips, powered up together, then idle past their wake-up) over
     ``ops``: the master starts first (``start``: an INTERBUS reset and a discovery ID cycle) or not; then per step
     ``power`` (the chip at ring position ``k`` powered up: /ResU low at pin level, ``Supi3.power_up`` at transaction
     level, then idle), ``cut`` (the forward line into position ``k``), ``repair`` (every cut, then
     :data:`~support.REPAIR_IDLE_TELEGRAMS` idle status telegrams, M21), ``start`` or ``wait``, and two of the master's
     cycles. Every cycle's kind, success and diagnostics (kind, location, device, message code), after each step the
-    configuration and IN data."""
-    _idle(ring, WAKE_TELEGRAMS)
+    configuration and IN data. ``wake``: idle status telegrams after a power-up (M22)."""
+    _idle(ring, wake)
     master = Master(ring, locate=False, max_devices=8)
     seen: list[object] = []
 
@@ -75,10 +75,8 @@ def history(ring: Ring | PinRing, start: bool, ops: list[Op]) -> list[object]:
                 ring.set_input(k, "resu_n", 1)
             else:
                 _idle(ring, POWER_DOWN_TELEGRAMS)
-                chip = ring.devices[k - 1]
-                assert isinstance(chip, Supi3)
-                chip.power_up()
-            _idle(ring, WAKE_TELEGRAMS)
+                ring.power_up(k)
+            _idle(ring, wake)
         elif op == "cut":
             ring.cut(k, True)
         elif op == "repair":
@@ -95,32 +93,39 @@ def history(ring: Ring | PinRing, start: bool, ops: list[Op]) -> list[object]:
     return seen
 
 
-def both(rate: int, chips: int, start: bool, ops: list[Op]) -> tuple[list[object], list[object]]:
+def both(rate: int, chips: int, start: bool, ops: list[Op], wake: int) -> tuple[list[object], list[object]]:
     config = _config(rate)
     tl_chips = [Supi3(config) for _ in range(chips)]
     tl = Ring(tl_chips, bit_rate=rate)
+    for position in range(1, chips + 1):  # powered up at the first clock, as the pin level's fresh chips (M22)
+        tl.power_up(position)
     pin = PinRing([Supi3Pins(config) for _ in range(chips)])
     for position, chip in enumerate(tl_chips, 1):  # the process data IN: each chip's MFP inputs
         chip.set_mfp_inputs(0x11 * position)
         pin.set_input(position, "mfp_in", 0x11 * position)
-    return history(tl, start, ops), history(pin, start, ops)
+    return history(tl, start, ops, wake), history(pin, start, ops, wake)
 
 
 OPS = st.lists(st.tuples(st.sampled_from(["power", "cut", "repair", "start", "wait"]), st.integers(1, 4)),
                min_size=1, max_size=4)  # fmt: skip
 
 
-@settings(max_examples=8, deadline=None, derandomize=True)  # about 2 s an example: pin level is slow
-@given(st.sampled_from(RATES), st.integers(1, 4), st.booleans(), OPS)
-@example(2_000_000, 4, False, [("wait", 1)])  # the master's first cycle() without start(): failed before M19
-@example(2_000_000, 4, False, [("cut", 3), ("start", 1), ("repair", 1)])  # the RB cut before start, repaired
-@example(2_000_000, 3, True, [("power", 1), ("wait", 1)])  # the chips behind a woken one: failed before M20
-@example(500_000, 2, False, [("power", 2), ("cut", 1), ("repair", 1), ("power", 1)])
-def test_a_master_sees_every_cycle_alike_after_power_ups(rate: int, chips: int, start: bool, ops: list[Op]) -> None:
-    """M19, M20: over any history of power-ups of any chips, cuts, repairs, starts or none, the master's every cycle
-    (kind, success, diagnostics) and its configuration and IN data after each step are the same at both
-    fidelities."""
-    tl, pin = both(rate, chips, start, ops)
+@settings(max_examples=12, deadline=None, derandomize=True)  # about 1 s an example: pin level is slow
+@given(st.sampled_from(RATES), st.integers(1, 4), st.booleans(), OPS, st.integers(0, 7))
+@example(2_000_000, 4, False, [("wait", 1)], 0)  # the master's first cycle() without start(): failed before M19
+@example(2_000_000, 4, False, [("cut", 3), ("start", 1), ("repair", 1)], 0)  # the RB cut before start, repaired
+@example(2_000_000, 3, True, [("power", 1), ("wait", 1)], 0)  # the chips behind a woken one: failed before M20
+@example(500_000, 2, False, [("power", 2), ("cut", 1), ("repair", 1), ("power", 1)], 0)
+@example(500_000, 4, False, [("wait", 1)], 4)  # the master's receiver is the last on the grid (M22: 5 telegrams)
+@example(2_000_000, 4, False, [("power", 3), ("wait", 1)], 4)  # a chip behind others woken: 5 telegrams
+@example(2_000_000, 4, False, [("power", 4), ("wait", 1)], 0)  # chips off the grid pass the discovery frame on
+@example(2_000_000, 1, True, [("cut", 1)], 1)  # the start's hold meets the chip off the grid: it misses the discovery
+def test_a_master_sees_every_cycle_alike_after_power_ups(rate: int, chips: int, start: bool, ops: list[Op],
+                                                         wake: int) -> None:
+    """M19, M20, M22: over any history of power-ups of any chips, cuts, repairs, starts or none, with ``wake`` idle
+    status telegrams after each power-up (0 to 7: M22's window is up to 7), the master's every cycle (kind, success,
+    diagnostics) and its configuration and IN data after each step are the same at both fidelities."""
+    tl, pin = both(rate, chips, start, ops, wake)
     assert tl == pin
 
 
@@ -128,13 +133,102 @@ def test_a_master_sees_every_cycle_alike_after_power_ups(rate: int, chips: int, 
 def test_a_frame_that_meets_the_reset_stretch_fails_at_pin_level(rate: int) -> None:
     """M19's window: a master's first cycle at the chips' power-up meets their reset stretch (M2), and the chip
     that wakes inside the frame takes no part in it (no frame before a whole status telegram): the cycle fails at pin
-    level, the next passes. The transaction level, whose chips are ready at once, passes it (the abstraction every
-    comparison waits out: :data:`WAKE_TELEGRAMS`)."""
+    level, the next passes; so at transaction level after ``Ring.power_up`` (M22), and a ring whose chips were not
+    powered up by it (ready at once) passes it."""
     ring = PinRing([Supi3Pins(_config(rate))])
     master = Master(ring, locate=False, max_devices=8)
     assert not master.cycle().ok
     assert master.cycle().ok
     assert Master(Ring([Supi3(_config(rate))], bit_rate=rate), locate=False, max_devices=8).cycle().ok
+    tl = Ring([Supi3(_config(rate))], bit_rate=rate)
+    tl.power_up(1)
+    master = Master(tl, locate=False, max_devices=8)
+    assert not master.cycle().ok
+    assert master.cycle().ok
+
+
+def _first_cycle(ring: Ring | PinRing, chips: int, position: int, telegrams: int) -> bool:
+    """Whether the master's cycle passes ``telegrams`` idle status telegrams after the power-up of ``position`` (0:
+    every chip, at the ring's first clock; else one chip of a running ring, /ResU low for 4 idle status telegrams)."""
+    if position:
+        _idle(ring, PAST_WINDOW_TELEGRAMS)
+        master = Master(ring, locate=False, max_devices=8)
+        assert master.cycle().ok
+        if isinstance(ring, PinRing):
+            ring.set_input(position, "resu_n", 0)
+            _idle(ring, POWER_DOWN_TELEGRAMS)
+            ring.set_input(position, "resu_n", 1)
+        else:
+            _idle(ring, POWER_DOWN_TELEGRAMS)
+            ring.power_up(position)
+    else:
+        if isinstance(ring, Ring):
+            for k in range(1, chips + 1):
+                ring.power_up(k)
+        master = Master(ring, locate=False, max_devices=8)
+    _idle(ring, telegrams)
+    return master.cycle().ok
+
+
+@pytest.mark.parametrize("rate", RATES)
+def test_the_window_after_a_power_up_ends_alike(rate: int) -> None:
+    """M22, exhaustively over flat rings of 1 to 4 chips, every chip at once at the first clock or any one chip of a
+    running ring: the master's first cycle that passes after the power-up is the same at both fidelities (the last
+    that fails before it too); the window is 1 to 7 idle status telegrams."""
+    windows = []
+    for chips in range(1, 5):
+        for position in range(chips + 1):
+            first = next(k for k in range(10) if _first_cycle(Ring([Supi3(_config(rate)) for _ in range(chips)],
+                                                                    bit_rate=rate), chips, position, k))
+            for k in (first - 1, first):
+                pin = PinRing([Supi3Pins(_config(rate)) for _ in range(chips)])
+                assert k < 0 or _first_cycle(pin, chips, position, k) is (k == first), (chips, position, k)
+            windows.append(first)
+    assert max(windows) == (5 if rate == 500_000 else 7)
+    assert min(windows) == 1
+
+
+def _start_after(ring: Ring | PinRing, chips: int, telegrams: int) -> tuple[bool, int, bool]:
+    """Every chip powered up at the ring's first clock, ``telegrams`` idle status telegrams, then the master's start
+    and a data cycle: the start's success, the devices it found, the data cycle's success."""
+    if isinstance(ring, Ring):
+        for k in range(1, chips + 1):
+            ring.power_up(k)
+    _idle(ring, telegrams)
+    master = Master(ring, locate=False, max_devices=8)
+    started = master.start().ok
+    return started, len(master.config or ()), master.cycle().ok
+
+
+def test_a_chip_woken_in_the_reset_s_hold_ends_it_alike() -> None:
+    """M22 (``reset_ready``): a start right after the power-up, its hold meeting chips off the telegram grid (their
+    receivers read the hold as status telegrams, M16, and find the grid after it late): the discovery and the data
+    cycle after it alike at both fidelities, 1 to 4 chips, both bit rates, 0 to 2 idle telegrams before the start;
+    one chip at 2 Mbit/s started after 1 telegram ends its reset after the discovery (found with no device)."""
+    seen = {}
+    for rate in RATES:
+        for chips in range(1, 5):
+            for telegrams in range(3):
+                tl = _start_after(Ring([Supi3(_config(rate)) for _ in range(chips)], bit_rate=rate), chips, telegrams)
+                pin = _start_after(PinRing([Supi3Pins(_config(rate)) for _ in range(chips)]), chips, telegrams)
+                assert tl == pin, (rate, chips, telegrams)
+                seen[rate, chips, telegrams] = tl
+    assert seen[2_000_000, 1, 1] == (True, 0, False)
+
+
+def test_a_power_up_names_the_chip_it_takes() -> None:
+    """M22's entries refuse bad input with the rule and the value."""
+    ring = Ring([Supi3(_config(500_000))], bit_rate=500_000)
+    with pytest.raises(ArgumentError, match="position"):
+        ring.power_up(2)
+    with pytest.raises(ArgumentError, match="wakes"):
+        wake_window(500_000, 1, {1: 0})
+    with pytest.raises(ArgumentError, match="bit"):
+        wake_window(1_000_000, 1, {})
+    with pytest.raises(ArgumentError, match="start"):
+        reset_ready(500_000, 1, {0: 128}, 0.5)  # type: ignore[arg-type]
+    with pytest.raises(ArgumentError, match="frame"):
+        wake_return(500_000, 1, {0: 128}, 0, b"\x00")  # type: ignore[arg-type]
 
 
 def test_a_status_telegram_ends_a_frame() -> None:

@@ -21,9 +21,10 @@ from supi3.config import decode
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusError
+from supi3.interbus.receiver import receive
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
-from supi3.model.pinring import PinRing, receive
+from supi3.model.pinring import PinRing
 from supi3.model.pins import Supi3Pins
 from supi3.model.registers import InterfaceViolationError, RegisterFile
 from supi3.model.vcd import write_vcd

@@ -46,7 +46,9 @@ from supi3.config import DeviceConfig, Interface
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusArgumentError, InterbusError, TelegramError
 from supi3.interbus.link import DataKernel, Device
+from supi3.interbus.wake import reset_ready, wake_return, wake_window
 from supi3.interbus.wire import Cycle, Frame
+from supi3.tables import CLOCK_HZ, RESET_MIN_S
 
 
 class ErrorKind(Enum):
@@ -607,7 +609,8 @@ class Transfer:
     back on the branch's return line, and the count of the counter telegram received there."""
     spliced: bool = False
     """A branch joined the data path within this frame (BK-54): what came back was cut where its BK switched, so a
-    receiver error is not on the return line N + 1 (BK-56)."""
+    receiver error is not on the return line N + 1 (BK-56); so too a receiver off the telegram grid after a chip's
+    power-up (M22)."""
 
 
 @dataclass
@@ -724,6 +727,12 @@ class Ring:
         self._layout: tuple[list[type], _Groups] = ([], [])
         self._cuts: tuple[list[bytes], int, bytes, list[slice] | None, int] = ([], -1, b"", None, 0)
         self._bits = ((-1, -1), 0)  # (bytes sent, devices) of the last cycle finished, and its wire.cycle_bits
+        self._wakes: dict[int, float] = {}
+        """M22: ring index -> bus time a chip powered up by :meth:`power_up` ends its reset stretch (M2)."""
+        self._late: dict[int, float] = {}
+        """M22: ring index -> bus time from which a frame finds the chip out of an INTERBUS reset it woke up in."""
+        self._grid = 0.0
+        """M22: bus time the master's idle status telegrams began (the end of its last cycle or reset)."""
         _tell_following(self._tree)
         self._sync()
 
@@ -1168,6 +1177,15 @@ class Ring:
         error = False
         runs: list[_Run] = []
         devices = self.devices[: n if dead is None else min(n, dead - 1)]
+        reached = len(devices)
+        woken: tuple[dict[int, int], int] | None = None
+        unheard = False
+        if self._wakes or self._late:  # M22: a chip not on the telegram grid yet passes the frame on (M19)
+            late, woken = self._waking()
+            if late and faults:  # not modelled on a faulty ring: the master's receiver fails the cycle instead
+                unheard = True
+            elif late:
+                devices = [device for index, device in enumerate(devices) if index not in late]
         slow = range(len(devices)) if record else sorted(s - 1 for s in faults if s <= len(devices)) if faults else ()
         index = 0
         for stop in [*slow, len(devices)]:
@@ -1218,12 +1236,18 @@ class Ring:
             self.trace.append(SegmentTrace(segments if dead is None else dead, silent.frame(cycle), None, None))
         if spliced is ErrorKind.TELEGRAM:
             returned, receiver_error = stream, spliced
+        if woken is not None and returned is not None:  # M22: the master's receiver, bit by bit in the window
+            error, opened = wake_return(self.bit_rate, len(self.devices), *woken, Frame.build(cycle, returned))
+            unheard = unheard or error
+            returned = returned if opened else None
+        if unheard:  # not on the telegram grid yet: no fault of the return line N + 1
+            receiver_error = receiver_error or ErrorKind.TELEGRAM
         elif spliced is ErrorKind.TRANSMISSION:
             returned, flags_back = stream, wire.CntrFlags(attention, True)
-        reports = self._reports(len(devices), None if close_after is None else n, dead_lines, returns) \
+        reports = self._reports(reached, None if close_after is None else n, dead_lines, returns) \
             if self._spans else []
-        return Transfer(cycle, bytes(data), n, returned, flags_back, receiver_error, runs, len(devices), reports,
-                        spliced is not None)
+        return Transfer(cycle, bytes(data), n, returned, flags_back, receiver_error, runs, reached, reports,
+                        spliced is not None or unheard)
 
     def finish(self, transfer: Transfer, latch: bool) -> None:
         """End a cycle with the master's verdict: the latch telegrams (``latch``) or idle telegrams.
@@ -1261,7 +1285,7 @@ class Ring:
                 self._silent_reset.discard(index)
         if transfer.reached < len(self.devices):
             self._go_silent(range(transfer.reached, len(self.devices)), start, end)
-        self.now = end
+        self.now = self._grid = end
         if self._branches:
             self._silence_detached(start, end)
             self._recognise()
@@ -1307,8 +1331,47 @@ class Ring:
         self._go_silent(range(reached, len(self.devices)), self.now, end)
         if self._branches:
             self._silence_detached(self.now, end)
-        self.now = end
+        if self._wakes:  # M22: a chip off the telegram grid at the hold may leave the reset late
+            wakes = {index: round((at - self._grid) * CLOCK_HZ) for index, at in self._wakes.items()}
+            ready = reset_ready(self.bit_rate, len(self.devices), wakes, round((self.now - self._grid) * CLOCK_HZ))
+            self._late = {index: self._grid + at / CLOCK_HZ for index, at in enumerate(ready) if at}
+        self.now = self._grid = end
+        self._wakes = {}  # the master's receiver leaves the hold on the grid (a line reset, M11)
         self._sync()
+
+    def power_up(self, position: int) -> None:
+        """Power up the chip at ring ``position`` now (its power-up reset, 1.7.2): a master's cycle fails, as at pin
+        level, until the chip and those behind it, then the master's receiver, are on the telegram grid (M22).
+
+        Raises
+        ------
+        ArgumentError
+            ``position`` not from 1 to N, or the device there has no power-up reset (``power_up``).
+        """
+        position = check_int("position", position, 1, len(self.devices))
+        device = self.devices[position - 1]
+        power_up = getattr(device, "power_up", None)
+        if not callable(power_up):
+            raise fail(f"device at ring position {position}", "a chip with a power-up reset (power_up)", device)
+        power_up()
+        self._wakes[position - 1] = self.now + round(RESET_MIN_S * CLOCK_HZ) / CLOCK_HZ  # the stretch, M2
+
+    def _waking(self) -> tuple[set[int], tuple[dict[int, int], int] | None]:
+        """M22: the ring indices of the chips a frame starting now finds off the telegram grid, and the wake-ups and
+        the frame's start in clocks of the master's idle (:func:`~supi3.interbus.wake.wake_window`); ``None`` past the
+        window, which is then forgotten."""
+        late = {index for index, at in self._late.items() if self.now < at}
+        if len(late) < len(self._late):
+            self._late = {index: self._late[index] for index in late}
+        wakes = {index: round((at - self._grid) * CLOCK_HZ) for index, at in self._wakes.items()}
+        if not wakes:
+            return late, None
+        window = wake_window(self.bit_rate, len(self.devices), wakes)
+        now = round((self.now - self._grid) * CLOCK_HZ)
+        if now >= window.end:
+            self._wakes = {}
+            return late, None
+        return late | {index for index, ready in enumerate(window.ready) if now < ready}, (wakes, now)
 
     def idle(self, seconds: float) -> None:
         """The master sends only idle status telegrams for ``seconds`` (no cycles)."""

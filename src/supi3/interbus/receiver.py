@@ -1,0 +1,70 @@
+"""The master's and a chip's receiver at pin level, over 32 MHz line samples (M7, M16 of docs/assumptions/model.md):
+``supi3.model.pinring.PinRing``'s master receives the return line with it, and the transaction level's wake-up window
+(``supi3.interbus.wake``, M22) runs it over idle status telegrams."""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+
+from supi3.checks import check_choice, check_int, check_trace
+from supi3.interbus import wire
+from supi3.interbus.errors import TelegramError
+from supi3.interbus.wire import LineReset, Telegram
+from supi3.tables import BIT_RATES
+
+
+def receive(samples: npt.NDArray[np.integer], start: int, cpb: int) -> tuple[list[Telegram | LineReset], int, bool]:
+    """Receive the telegrams in a 32 MHz sample trace from index ``start``.
+
+    Returns the telegrams, the index to continue from (before any unfinished telegram) and whether a telegram
+    error was seen (the erroneous telegram is skipped). The receiver resynchronises as the chip's does (M7, M16):
+    on the first start level after a stop bit, or on the period of a stop bit read at start level.
+
+    Raises
+    ------
+    ArgumentError
+        ``samples`` is not a 1-D sequence of 0/1 integers, ``start`` not an index into it, or ``cpb`` not a number of
+        clocks per bit (Table 1-7).
+    """
+    if not isinstance(samples, np.ndarray):
+        samples = check_trace("samples", samples, 1)
+    start = check_int("start", start, 0, len(samples))
+    # An array is checked from ``start`` on: the return line grows run by run and is received piecewise.
+    check_trace(f"samples[{start}:]", samples[start:], 1)
+    cpb = check_choice("cpb", cpb, sorted({wire.clocks_per_bit(rate) for rate in BIT_RATES}), "Table 1-7")
+    out: list[Telegram | LineReset] = []
+    error = False
+    n = len(samples)
+    i = start
+    while i < n:
+        lows = np.flatnonzero(samples[i:] == wire.START_LEVEL)
+        if not lows.size:
+            return out, n, error
+        t0 = i + int(lows[0])
+        highs = np.flatnonzero(samples[t0:] != wire.START_LEVEL)
+        run = int(highs[0]) if highs.size else n - t0
+        if run >= wire.RESET_DETECT_BITS * cpb:
+            if not highs.size:
+                return out, t0, error
+            out.append(LineReset(t0 // cpb))
+            i = t0 + run
+            continue
+        mid = t0 + cpb // 2
+        if mid + wire.POS_TYPE * cpb >= n:
+            return out, t0, error
+        is_data = samples[mid + wire.POS_TYPE * cpb] == wire.TYPE_DATA_LEVEL
+        length = wire.DATA_TELEGRAM_BITS if is_data else wire.STATUS_TELEGRAM_BITS
+        last = mid + (length - 1) * cpb
+        if last >= n:
+            return out, t0, error
+        word = sum(int(level) << k for k, level in enumerate(samples[mid : last + 1 : cpb]))
+        try:
+            out.append(wire.decode_telegram(word, length))
+        except TelegramError:
+            error = True
+            # As the chip's receiver (M16): a stop bit at start level is the next telegram's start bit.
+            i = last - cpb // 2
+        else:
+            i = last + 1
+    return out, n, error
