@@ -218,10 +218,9 @@ class _Builder:
         self.io = Signal()
         # No reset (nor clear) where every reader is gated by state that has one and the state is written before
         # that gate opens: the applied SET fields (read only while ``configured``), the command and block transfer
-        # fields (read only in the DATA and BLOCK phases their command byte enters), the frame's S/R, byte sent,
-        # bit count and whether it drives (read only in a frame, set at its /SS falling edge), and the last byte
-        # received (sent back only once Motorola or Intel mode is set, by the initialization byte's end, which also
-        # stores it).
+        # fields (read only in the DATA and BLOCK phases their command byte enters), the frame's S/R, bit count and
+        # whether it drives (read only in a frame, set at its /SS falling edge), and the byte sent (``tx``: sent
+        # only once Motorola or Intel mode is set, by the initialization byte's end, which also stores it).
         self.configured = Signal()
         self.cfg_extreg, self.cfg_pcp_n = Signal(reset_less=True), Signal(reset_less=True)
         self.cfg_code = Signal(_LENGTH_CODE.width, reset_less=True)
@@ -234,12 +233,17 @@ class _Builder:
         self.motorola, self.intel = Signal(), Signal()
         self.cmd_rd, self.cmd_wr = Signal(reset_less=True), Signal(reset_less=True)
         self.cmd_addr = Signal(_ADDRESS.width, reset_less=True)
-        self.last_rx = Signal(BYTE_BITS, reset_less=True)
         self.blk_addr = Signal(range(DATA_BYTES), reset_less=True)
         self.blk_rd, self.blk_wr, self.blk_then_wr = (Signal(reset_less=True) for _ in range(3))
         self.in_frame = Signal()
         self.frame_s_r, self.tx_valid = Signal(reset_less=True), Signal(reset_less=True)
         self.tx = Signal(BYTE_BITS, reset_less=True)
+        """The byte sent: the last byte received (the model's ``last_rx``, stored at each ``end`` outside DISABLED),
+        replaced by the value a frame's /SS falling edge reads. One register serves both: the model sends
+        ``last_rx`` in a frame without a read, and after a frame that read (``tx`` then holds the value read, not
+        ``last_rx``) every frame reads again until an ``end`` stores the byte received: the read depends only on the
+        phase and the command, which change only at an ``end``, or at SAS_INIT and power-up, after which nothing is
+        driven until the initialization byte's ``end``."""
         self.rx = Signal(BYTE_BITS, reset_less=True)
         """The byte shifted in: read only after exactly 8 SCLK edges of a frame (``end``), which replace all of it,
         so it has neither reset nor clear."""
@@ -340,7 +344,6 @@ class _Builder:
             self.frame_s_r.eq(s_r),
             self.tx_valid.eq(drives),
             self.bits.eq(0),
-            self.tx.eq(self.last_rx),
         ]
         reads, address = Signal(), Signal(_ADDRESS.width)
         with m.Switch(self.phase):
@@ -391,7 +394,7 @@ class _Builder:
         with m.If(write):
             self.cpu_write(address, rx)
         with m.If(self.phase != _Phase.DISABLED):
-            m.d.sync += self.last_rx.eq(rx)
+            m.d.sync += self.tx.eq(rx)
 
     def command(self, rd: Value, wr: Value, address: Value) -> None:
         """A command byte (3.4.4): a data byte follows, or address 15 starts a block transfer (3.4.6, UP-10/11)."""
