@@ -14,7 +14,8 @@ Nothing is read off the model (``tests/test_rtl_tables.py`` compares).
 
 One clock edge does what the model does between two ticks, in the same order (UP-13, UP-14, ``docs/upif.md``):
 
-1. the core's inputs update the registers (latch, processor command, events, optical registers, INTERBUS reset);
+1. the core's inputs update the registers (latch, processor command, events, INTERBUS reset); reads 8 to 11 are
+   the optical block's ``optical`` port itself (UP-39);
 2. the µP pins act on the synchronised edges: SAS_INIT, /SS falling (``begin``: the byte to send, reads and their
    side effects), SCLK rising (shift in), /SS rising (``end``: the received byte, writes);
 3. the outputs are decoded from the new state and delayed by the bit rate's output pipeline.
@@ -211,9 +212,14 @@ class _Builder:
         self.m = m
         self.b = block
         self.tables = tables
-        self.regs = {r.name: Signal(BYTE_BITS, name=r.name.lower(), init=r.reset) for r in REGISTER_MAP.registers}
-        """The registers as stored (at the start of the cycle)."""
-        self.core = {name: Signal(BYTE_BITS, name=f"{name.lower()}_core") for name in self.regs}
+        self.regs = {
+            r.name: Signal(BYTE_BITS, name=r.name.lower(), init=r.reset)
+            for r in REGISTER_MAP.registers
+            if r.name not in OPTICAL_REGISTERS
+        }
+        """The registers as stored (at the start of the cycle). Reads 8..11 are not stored: they are the optical
+        block's ``optical`` port as it is now (UP-39)."""
+        self.core = {r.name: Signal(BYTE_BITS, name=f"{r.name.lower()}_core") for r in REGISTER_MAP.registers}
         """The registers after the core's inputs of this edge: what a read at this edge sees."""
         self.io = Signal()
         # No reset (nor clear) where every reader is gated by state that has one and the state is written before
@@ -288,13 +294,12 @@ class _Builder:
             m.d.comb += core["PCMD"].eq(b.pcmd)
         raised = b.events | (b.pcmd_we << _SOURCE_BIT["PCMD"]) | (b.ib_reset << _SOURCE_BIT["IB_RESET"])
         m.d.comb += core[_IRQ_EVT.name].eq(regs[_IRQ_EVT.name] | (raised & regs[_IRQ_EN.name]))
-        for k, name in enumerate(OPTICAL_REGISTERS):
-            with m.If(b.optical_we[k]):
-                mask = REGISTER_MAP.register(name).mask
-                m.d.comb += core[name].eq(b.optical.word_select(k, BYTE_BITS) & mask)
+        for k, name in enumerate(OPTICAL_REGISTERS):  # read as the optical block shows them now (UP-39)
+            mask = REGISTER_MAP.register(name).mask
+            m.d.comb += core[name].eq(b.optical.word_select(k, BYTE_BITS) & mask)
         with m.If(b.ib_reset):
             m.d.comb += [core[r.name].eq(r.reset) for r in REGISTER_MAP.cleared_by(Reset.INTERBUS)]
-        m.d.sync += [regs[name].eq(value) for name, value in core.items()]
+        m.d.sync += [regs[name].eq(core[name]) for name in regs]
         m.d.sync += self.io.eq(b.io_access)
 
     # 2. The µP pins: SAS_INIT, /SS falling, SCLK rising, /SS rising (SlavePins._edge) ---------------------------
