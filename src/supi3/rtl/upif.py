@@ -239,8 +239,10 @@ class _Builder:
         self.motorola, self.intel = Signal(), Signal()
         self.cmd_rd, self.cmd_wr = Signal(reset_less=True), Signal(reset_less=True)
         self.cmd_addr = Signal(_ADDRESS.width, reset_less=True)
-        self.blk_addr = Signal(range(DATA_BYTES), reset_less=True)
-        self.blk_rd, self.blk_wr, self.blk_then_wr = (Signal(reset_less=True) for _ in range(3))
+        """The command's RD, WR and address (DATA phase); in a block transfer (BLOCK phase) the slot's: whether it
+        reads OUT k and writes IN k, and k (UP-11). The two phases never read each other's values: a command byte
+        sets them for the phase it enters."""
+        self.blk_then_wr = Signal(reset_less=True)
         self.in_frame = Signal()
         self.frame_s_r, self.tx_valid = Signal(reset_less=True), Signal(reset_less=True)
         self.tx = Signal(BYTE_BITS, reset_less=True)
@@ -350,19 +352,15 @@ class _Builder:
             self.tx_valid.eq(drives),
             self.bits.eq(0),
         ]
-        reads, address = Signal(), Signal(_ADDRESS.width)
-        with m.Switch(self.phase):
-            with m.Case(_Phase.BLOCK):
-                m.d.comb += [reads.eq(self.blk_rd), address.eq(self.blk_addr)]
-            with m.Case(_Phase.DATA):
-                readable = Signal()
-                with m.Switch(self.cmd_addr):
-                    for a, port in _READ_PORTS.items():
-                        if port.access is not Access.RESERVED_IGNORED:
-                            with m.Case(a):
-                                m.d.comb += readable.eq(1)
-                m.d.comb += [reads.eq(self.cmd_rd & readable), address.eq(self.cmd_addr)]
-        with m.If(reads), m.Switch(address):
+        # A block transfer's slot addresses OUT k, which is readable: one address for both phases.
+        readable = Signal()
+        with m.Switch(self.cmd_addr):
+            for a, port in _READ_PORTS.items():
+                if port.access is not Access.RESERVED_IGNORED:
+                    with m.Case(a):
+                        m.d.comb += readable.eq(1)
+        reads = self.phase.matches(_Phase.DATA, _Phase.BLOCK) & self.cmd_rd & readable
+        with m.If(reads), m.Switch(self.cmd_addr):
             for a, port in _READ_PORTS.items():
                 register = port.register
                 if port.access is Access.RESERVED_ZERO:
@@ -380,9 +378,9 @@ class _Builder:
 
     def end(self) -> None:
         """/SS rose after 8 bits (``UpifProtocol.end``): process the received byte ``rx``; a data byte's and a block
-        transfer's writes share one address decoder (``write``, ``address``)."""
+        transfer's writes share one address decoder (``write`` at ``cmd_addr``)."""
         m, rx = self.m, self.rx
-        write, address = Signal(), Signal(_ADDRESS.width)
+        write = Signal()
         with m.Switch(self.phase):
             with m.Case(_Phase.INIT):
                 m.d.sync += self.phase.eq(_Phase.DISABLED)
@@ -393,11 +391,11 @@ class _Builder:
                 # An Intel command byte needs S/R = 1 (Table 3-9); the received byte is kept either way.
                 self.command(rx[_RD.lsb], rx[_WR.lsb], rx[_ADDRESS.lsb : _ADDRESS.lsb + _ADDRESS.width])
             with m.Case(_Phase.DATA):
-                self.data(write, address)
+                self.data(write)
             with m.Case(_Phase.BLOCK):
-                self.block(write, address)
+                self.block(write)
         with m.If(write):
-            self.cpu_write(address, rx)
+            self.cpu_write(self.cmd_addr, rx)
         with m.If(self.phase != _Phase.DISABLED):
             m.d.sync += self.tx.eq(rx)
 
@@ -405,34 +403,36 @@ class _Builder:
         """A command byte (3.4.4): a data byte follows, or address 15 starts a block transfer (3.4.6, UP-10/11)."""
         m = self.m
         m.d.sync += [self.cmd_rd.eq(rd), self.cmd_wr.eq(wr), self.cmd_addr.eq(address), self.phase.eq(_Phase.DATA)]
-        with m.If(address.matches(*_BLOCK_ADDRESSES)):
-            m.d.sync += [self.phase.eq(_Phase.BLOCK), self.blk_addr.eq(0)]
+        with m.If(address.matches(*_BLOCK_ADDRESSES)):  # the first slot: k = 0, what it reads and writes
+            m.d.sync += [self.phase.eq(_Phase.BLOCK), self.cmd_addr.eq(0)]
             with m.If((self.n_bytes == 0) | (self.intel & ~rd & ~wr)):
                 m.d.sync += self.phase.eq(_Phase.COMMAND)
             with m.If(self.motorola):
-                m.d.sync += [self.blk_rd.eq(1), self.blk_wr.eq(1), self.blk_then_wr.eq(0)]
+                m.d.sync += [self.cmd_rd.eq(1), self.cmd_wr.eq(1), self.blk_then_wr.eq(0)]
             with m.Else():
-                m.d.sync += [self.blk_rd.eq(rd), self.blk_wr.eq(~rd), self.blk_then_wr.eq(rd & wr)]
+                m.d.sync += [self.cmd_rd.eq(rd), self.cmd_wr.eq(~rd), self.blk_then_wr.eq(rd & wr)]
 
-    def data(self, write: Signal, address: Signal) -> None:
+    def data(self, write: Signal) -> None:
         """The data byte of a command (3.4.4): a write where RD/WR and S/R allow it (UP-9); 4 and 5 ignored."""
         m, s_r = self.m, self.frame_s_r
         m.d.sync += self.phase.eq(_Phase.COMMAND)
         refused = self.intel & (self.cmd_rd != self.cmd_wr) & (self.cmd_rd == s_r)
-        m.d.comb += [write.eq(self.cmd_wr & (self.motorola | s_r) & ~refused), address.eq(self.cmd_addr)]
+        m.d.comb += write.eq(self.cmd_wr & (self.motorola | s_r) & ~refused)
 
-    def block(self, write: Signal, address: Signal) -> None:
-        """One byte of a block transfer: write IN k in a write slot; then the next slot (UP-11)."""
+    def block(self, write: Signal) -> None:
+        """One byte of a block transfer: write IN k in a write slot; then the next slot (UP-11). The slot's k is
+        ``cmd_addr`` (below 4: only its low bits count), what it reads and writes ``cmd_rd``, ``cmd_wr``."""
         m = self.m
-        refused = self.intel & (self.blk_rd == self.frame_s_r)
-        m.d.comb += [write.eq(self.blk_wr & ~refused), address.eq(self.blk_addr)]
-        with m.If(self.blk_addr == self.n_bytes - 1):
+        refused = self.intel & (self.cmd_rd == self.frame_s_r)
+        m.d.comb += write.eq(self.cmd_wr & ~refused)
+        slot = self.cmd_addr[: (DATA_BYTES - 1).bit_length()]
+        with m.If(slot == self.n_bytes - 1):
             with m.If(self.blk_then_wr):
-                m.d.sync += [self.blk_addr.eq(0), self.blk_rd.eq(0), self.blk_wr.eq(1), self.blk_then_wr.eq(0)]
+                m.d.sync += [self.cmd_addr.eq(0), self.cmd_rd.eq(0), self.cmd_wr.eq(1), self.blk_then_wr.eq(0)]
             with m.Else():
                 m.d.sync += self.phase.eq(_Phase.COMMAND)
         with m.Else():
-            m.d.sync += self.blk_addr.eq(self.blk_addr + 1)
+            m.d.sync += slot.eq(slot + 1)
 
     def cpu_write(self, address: Value, value: Value) -> None:
         """``RegisterFile.cpu_write``: store the byte's register bits; SET also applies a valid configuration."""
