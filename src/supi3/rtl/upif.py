@@ -478,23 +478,26 @@ class _Builder:
             "irq_n": self.regs[_IRQ_EVT.name] == 0, "irq_n_oe": Const(1),
             "mfp6_oe": drive & self.intel, "mfp7_oe": drive & self.motorola,
         }  # fmt: skip
-        # The bit sent goes through one pipeline for both data pins, each gated by its delayed enable (so it needs
-        # no reset: the enables' pipelines have theirs).
-        delayed = {name: self.delay(name, value, reset=True) for name, value in decoded.items()}
-        sent = self.delay("bit", bit, reset=False)
+        # No pipeline stage has a reset: one more pipeline, of 1s with a reset to 0 (``filled``), says whether the
+        # output stage holds a value decoded since the power-up reset, else the output shows its power-up level
+        # (as stages reset to it would). The bit sent goes through one pipeline for both data pins, each gated by
+        # its delayed enable.
+        filled = self.delay("filled", Const(1), init=0)
+        power_up = self.tables.reset_outputs
+        delayed = {
+            name: value if isinstance(value, Const) else Mux(filled, self.delay(name, value), power_up[name])
+            for name, value in decoded.items()
+        }
+        sent = self.delay("bit", bit)
         delayed.update({"mfp6": sent & delayed["mfp6_oe"], "mfp7": sent & delayed["mfp7_oe"]})
         m.d.comb += [getattr(b, name).eq(value) for name, value in delayed.items()]
 
-    def delay(self, name: str, value: Value, *, reset: bool) -> Value:
-        """``value`` through the bit rate's output pipeline (UP-14): its stages start from the output's power-up
-        level (``reset``) or have no reset."""
+    def delay(self, name: str, value: Value, *, init: int | None = None) -> Value:
+        """``value`` through the bit rate's output pipeline (UP-14): stages without reset, or reset to ``init``."""
         m = self.m
         taps: list[Value] = [value]
         for stage in range(max(self.tables.output_delay)):
-            if reset:
-                stage_signal = Signal(name=f"{name}_d{stage + 1}", init=self.tables.reset_outputs[name])
-            else:
-                stage_signal = Signal(name=f"{name}_d{stage + 1}", reset_less=True)
+            stage_signal = Signal(name=f"{name}_d{stage + 1}", init=init or 0, reset_less=init is None)
             m.d.sync += stage_signal.eq(taps[-1])
             taps.append(stage_signal)
         return Array(taps[delay] for delay in self.tables.output_delay)[self.b.rate]
