@@ -110,7 +110,7 @@ def output_delay(bit_rate: int) -> int:
 
 
 def _reset_outputs() -> dict[str, int]:
-    """The outputs decoded from the power-up state (the output pipeline's initial contents, UP-14): no I/O access,
+    """The outputs decoded from the power-up state (shown until the output pipeline has filled, UP-14): no I/O access,
     the initialization byte next (C/D = command, UP-2), /IRQ from IRQ_EVT's reset value, no frame: nothing sent."""
     return {
         "io": 0, "io_oe": 1,
@@ -130,7 +130,7 @@ class UpifTables:
     output_delay:
         Output pipeline stages per bit rate, in :data:`~supi3.tables.BIT_RATES` order (UP-14).
     reset_outputs:
-        The pin outputs after a power-up reset (the pipeline's initial contents).
+        The pin outputs after a power-up reset (shown until the output pipeline has filled).
     set_codes:
         For each applicable (ExtReg, ID12..8 field) of a SET value: the complete length code applied; SET values
         missing here (reserved codes) are stored but not applied (Tables 3-11, 3-12; UP-20).
