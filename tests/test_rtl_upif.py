@@ -186,6 +186,20 @@ def test_optical_reads_are_live(bench: Lockstep) -> None:
     assert driven == [*shown[0], shown[0][1], shown[1][2], shown[1][0]]
 
 
+def test_power_up_pulse_inside_a_driven_frame(bench: Lockstep) -> None:
+    # The output pipeline (UP-14, 6 stages at 500 kbit/s) has no reset in the RTL: after a one-clock power-up pulse in
+    # the middle of a driven frame the outputs show their power-up levels from the next cycle on (C/D = command, MFP7
+    # undriven), not what the stages held.
+    script = UpifScript(SLOW).init(Mode.MOTOROLA).write(ID, 0x5A)
+    start = script.cycles
+    script.read(ID)
+    pulse = start + (script.cycles - start) * 3 // 4  # inside the data byte's frame
+    script.strobes.append((pulse, {"power_up": 1}))
+    outcome = check(bench, script.run(40))
+    assert outcome["mfp7_oe"][pulse] == 1 and outcome["c_d"][pulse] != C_D_COMMAND
+    assert not outcome["mfp7_oe"][pulse + 1 :].any() and (outcome["c_d"][pulse + 1 :] == C_D_COMMAND).all()
+
+
 def test_straps_and_power_up(bench: Lockstep) -> None:
     # The µP_Not_Ready code comes from the straps until SET is written; power-up clears everything, SAS_INIT keeps
     # SET and ID (3.4.3).
