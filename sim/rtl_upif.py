@@ -78,8 +78,8 @@ async def spi_master_reads_and_writes_registers(dut: Any) -> None:
     Clock(dut.clk, 1e9 / CLOCK_HZ, unit="ns").start()
     for name, value in strap_values(BIT_RATES[0], NOT_READY_ID).items():
         getattr(dut, name).value = value
-    for name in ("power_up", "ib_reset", "events", "io_access", "latch", "latch_out", "pcmd_we", "pcmd",
-                 "optical_we", "optical", "sas_init"):
+    for name in ("power_up", "ib_reset", "events", "io_access", "latch", "latch_out", "pcmd_we", "pcmd", "optical",
+                 "sas_init"):
         getattr(dut, name).value = 0
     dut.mfp7_in.value = 1
     bus = SpiBus.from_entity(dut, sclk_name="sclk", mosi_name="mfp6_in", miso_name="mfp7", cs_name="ss_n")

@@ -272,6 +272,9 @@ class UpifScript:
     """The bit order of the next frames (set by :meth:`init`)."""
     segments: list[tuple[int, dict[str, int]]] = field(default_factory=list)
     strobes: list[tuple[int, dict[str, int]]] = field(default_factory=list)
+    levels: list[tuple[int, dict[str, int]]] = field(default_factory=list)
+    """Core inputs set from a cycle to the end of the script (after the segments, before the strobes), at any cycle
+    (the optical block's ``optical``, read live: UP-39)."""
     samples: list[list[int]] = field(default_factory=list)
     """Per frame: the cycles in which SCLK first shows high (the master samples the chip's bit there)."""
 
@@ -328,6 +331,9 @@ class UpifScript:
     def stimulus(self) -> CycleMatrix:
         array = np.concatenate([np.tile(np.array([pins[name] for name in UPIF_INPUTS], dtype=np.uint64), (n, 1))
                                 for n, pins in self.segments])
+        for cycle, pins in sorted(self.levels, key=lambda level: level[0]):
+            for name, value in pins.items():
+                array[cycle:, UPIF_INPUTS.index(name)] = value
         for cycle, pins in self.strobes:
             for name, value in pins.items():
                 array[cycle, UPIF_INPUTS.index(name)] = value

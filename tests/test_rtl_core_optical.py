@@ -45,8 +45,9 @@ def chip(chip_bench: Lockstep) -> Lockstep:
 
 
 def test_reads_8_to_11_through_the_up_interface(chip: Lockstep) -> None:
-    """3.4.12, 3.4.13: the µP reads the optical block's registers, written through the register file's
-    ``optical_we`` ports; the model's register file gets the same bytes at the same clocks."""
+    """3.4.12, 3.4.13: the µP reads the optical block's registers, which the RTL's register file reads from the
+    block without storing them (UP-39); the model's register file gets the same bytes through the block's
+    ``optical_we``, one clock after each change."""
     pins = ChipPins(decode(*RB_INIT_UP, rf="00", clk_conf="11"))
     up = Firmware(pins, Mode.MOTOROLA)
     up.idle(300)

@@ -29,10 +29,12 @@ from supi3.regmap import (
     INTERRUPT_SOURCES,
     IRQ_EN,
     IRQ_EVT,
+    LENGTH_BRANCH,
     LENGTH_OUT,
     OUT0,
     OUT1,
     PCMD,
+    POWER_IN,
     REGISTER_MAP,
     SET,
     encode_command,
@@ -154,7 +156,7 @@ def test_interrupts_and_core_ports(bench: Lockstep, mode: Mode) -> None:
     pcp_word = SET.encode(PCP_N=0, CL=SET.field("CL").value("LEN_1_WORD").value)
     script = UpifScript(FAST).init(mode).write(IRQ_EN, enabled).write(SET, pcp_word).write(IN0, 0x12).write(IN1, 0x34)
     script.strobe(events=(1 << SOURCE_BIT["VALID"]) | (1 << SOURCE_BIT["INVALID"]), latch=1, latch_out=0xBEEF)
-    script.strobe(pcmd_we=1, pcmd=0x5A, optical_we=0b0101, optical=0xFF00FF)
+    script.run(0, optical=0xFF00FF).strobe(pcmd_we=1, pcmd=0x5A)
     script.run(10, io_access=1).write(ALARM, 0x77).read(IRQ_EVT).read(PCMD).read(LENGTH_OUT).read(OUT0).read(OUT1)
     script.strobe(ib_reset=1).run(10).read(IRQ_EVT).read(OUT0)
     outcome = check(bench, script)
@@ -166,6 +168,36 @@ def test_interrupts_and_core_ports(bench: Lockstep, mode: Mode) -> None:
     assert outcome.final("alarm") == 0x77
     assert outcome.final("pcp") == 1 and outcome.final("in_data") == 0
     assert outcome.final("irq_n") == 1 and outcome["irq_n"].min() == 0
+
+
+def test_optical_reads_are_live(bench: Lockstep) -> None:
+    # UP-39: reads 8..11 are the optical block's ``optical`` port at the read's /SS falling edge (reserved bits of
+    # read 10 dropped), not stored: a power-up reset does not clear them, a change shows at the next read.
+    first, second = 0xF1E2D3C4, 0x8B7A6958
+    script = UpifScript(FAST).run(0, optical=first).init(Mode.INTEL)
+    for register in OPTICAL_REGISTERS:
+        script.read(REGISTER_MAP.register(register))
+    script.strobe(power_up=1).run(20).init(Mode.INTEL).read(LENGTH_BRANCH)
+    script.run(0, optical=second).read(POWER_IN).read(LENGTH_OUT)
+    outcome = check(bench, script)
+    masks = [REGISTER_MAP.register(register).mask for register in OPTICAL_REGISTERS]
+    shown = [[value >> 8 * k & mask for k, mask in enumerate(masks)] for value in (first, second)]
+    driven = [frame for frame in outcome.frames() if frame is not None]  # Intel: only the reads' data bytes
+    assert driven == [*shown[0], shown[0][1], shown[1][2], shown[1][0]]
+
+
+def test_power_up_pulse_inside_a_driven_frame(bench: Lockstep) -> None:
+    # The output pipeline (UP-14, 6 stages at 500 kbit/s) has no reset in the RTL: after a one-clock power-up pulse in
+    # the middle of a driven frame the outputs show their power-up levels from the next cycle on (C/D = command, MFP7
+    # undriven), not what the stages held.
+    script = UpifScript(SLOW).init(Mode.MOTOROLA).write(ID, 0x5A)
+    start = script.cycles
+    script.read(ID)
+    pulse = start + (script.cycles - start) * 3 // 4  # inside the data byte's frame
+    script.strobes.append((pulse, {"power_up": 1}))
+    outcome = check(bench, script.run(40))
+    assert outcome["mfp7_oe"][pulse] == 1 and outcome["c_d"][pulse] != C_D_COMMAND
+    assert not outcome["mfp7_oe"][pulse + 1 :].any() and (outcome["c_d"][pulse + 1 :] == C_D_COMMAND).all()
 
 
 def test_straps_and_power_up(bench: Lockstep) -> None:
@@ -229,12 +261,13 @@ def random_script(mode: Mode, rate: int, ops: list[tuple[str, int, int]],
             "events": {"events": value},
             "latch": {"latch": 1, "latch_out": value},
             "pcmd": {"pcmd_we": 1, "pcmd": value & 0xFF},
-            "optical": {"optical_we": value & 0xF, "optical": value},
             "ib_reset": {"ib_reset": 1},
             "io_access": {"io_access": 1},
             "power_up": {"power_up": 1},
+            "optical": {"optical": value},  # a level from this cycle on (UP-39)
         }[what]
-        script.strobes.append((cycle, {name: value & WIDTH_MASK[name] for name, value in pins.items()}))
+        changes = script.levels if what == "optical" else script.strobes
+        changes.append((cycle, {name: value & WIDTH_MASK[name] for name, value in pins.items()}))
     return script
 
 

@@ -189,10 +189,10 @@ TO_REGISTER_FILE: Final[tuple[Pin, ...]] = (
     Pin("latch_out", BYTE_BITS * DATA_BYTES),
     Pin("pcmd_we"),
     Pin("pcmd", BYTE_BITS),
-    Pin("optical_we", len(OPTICAL_REGISTERS)),
     Pin("optical", BYTE_BITS * len(OPTICAL_REGISTERS)),
 )
-"""What the INTERBUS core (and the optical block) give the register file."""
+"""What the INTERBUS core (and the optical block) give the register file; ``optical`` is reads 8 to 11 as the optical
+block shows them now, which the register file reads without storing them (UP-39)."""
 FROM_REGISTER_FILE: Final[tuple[Pin, ...]] = (
     Pin("in_data", BYTE_BITS * DATA_BYTES),
     Pin("bus_id", LENGTH_CODE_BITS + BYTE_BITS),

@@ -117,7 +117,7 @@ REGISTER_FILE_OUTPUTS: Final = (
     *BLOCK_STRAPS,
     *(pin for pin in TO_REGISTER_FILE
       if pin.name in ("power_up", "ib_reset", "events", "io_access", "latch", "latch_out", "pcmd_we", "pcmd",
-                      "optical_we", "optical")),
+                      "optical")),
 )  # fmt: skip
 """What the core gives the register file (the block's inputs of the same names; reads 8..11 from the optical
 block)."""
@@ -579,7 +579,6 @@ class Supi3Core(wiring.Component):
                 self.latch_out.eq(datapath.register),
                 self.pcmd_we.eq(running & frame.management.latch_id & command[wire.CMD_PCMD_BIT]),
                 self.pcmd.eq(Mux(frame.management.latch_id, command[wire.CMD_PCMD_SHIFT :][:BYTE_BITS], 0)),
-                self.optical_we.eq(optical.optical_we),
                 self.optical.eq(optical.optical),
             ]
 

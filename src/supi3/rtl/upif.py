@@ -14,7 +14,8 @@ Nothing is read off the model (``tests/test_rtl_tables.py`` compares).
 
 One clock edge does what the model does between two ticks, in the same order (UP-13, UP-14, ``docs/upif.md``):
 
-1. the core's inputs update the registers (latch, processor command, events, optical registers, INTERBUS reset);
+1. the core's inputs update the registers (latch, processor command, events, INTERBUS reset); reads 8 to 11 are
+   the optical block's ``optical`` port itself (UP-39);
 2. the µP pins act on the synchronised edges: SAS_INIT, /SS falling (``begin``: the byte to send, reads and their
    side effects), SCLK rising (shift in), /SS rising (``end``: the received byte, writes);
 3. the outputs are decoded from the new state and delayed by the bit rate's output pipeline.
@@ -109,7 +110,7 @@ def output_delay(bit_rate: int) -> int:
 
 
 def _reset_outputs() -> dict[str, int]:
-    """The outputs decoded from the power-up state (the output pipeline's initial contents, UP-14): no I/O access,
+    """The outputs decoded from the power-up state (shown until the output pipeline has filled, UP-14): no I/O access,
     the initialization byte next (C/D = command, UP-2), /IRQ from IRQ_EVT's reset value, no frame: nothing sent."""
     return {
         "io": 0, "io_oe": 1,
@@ -129,7 +130,7 @@ class UpifTables:
     output_delay:
         Output pipeline stages per bit rate, in :data:`~supi3.tables.BIT_RATES` order (UP-14).
     reset_outputs:
-        The pin outputs after a power-up reset (the pipeline's initial contents).
+        The pin outputs after a power-up reset (shown until the output pipeline has filled).
     set_codes:
         For each applicable (ExtReg, ID12..8 field) of a SET value: the complete length code applied; SET values
         missing here (reserved codes) are stored but not applied (Tables 3-11, 3-12; UP-20).
@@ -211,17 +212,21 @@ class _Builder:
         self.m = m
         self.b = block
         self.tables = tables
-        self.regs = {r.name: Signal(BYTE_BITS, name=r.name.lower(), init=r.reset) for r in REGISTER_MAP.registers}
-        """The registers as stored (at the start of the cycle)."""
-        self.core = {name: Signal(BYTE_BITS, name=f"{name.lower()}_core") for name in self.regs}
+        self.regs = {
+            r.name: Signal(BYTE_BITS, name=r.name.lower(), init=r.reset)
+            for r in REGISTER_MAP.registers
+            if r.name not in OPTICAL_REGISTERS
+        }
+        """The registers as stored (at the start of the cycle). Reads 8..11 are not stored: they are the optical
+        block's ``optical`` port as it is now (UP-39)."""
+        self.core = {r.name: Signal(BYTE_BITS, name=f"{r.name.lower()}_core") for r in REGISTER_MAP.registers}
         """The registers after the core's inputs of this edge: what a read at this edge sees."""
         self.io = Signal()
         # No reset (nor clear) where every reader is gated by state that has one and the state is written before
         # that gate opens: the applied SET fields (read only while ``configured``), the command and block transfer
-        # fields (read only in the DATA and BLOCK phases their command byte enters), the frame's S/R, byte sent,
-        # bit count and whether it drives (read only in a frame, set at its /SS falling edge), and the last byte
-        # received (sent back only once Motorola or Intel mode is set, by the initialization byte's end, which also
-        # stores it).
+        # fields (read only in the DATA and BLOCK phases their command byte enters), the frame's S/R, bit count and
+        # whether it drives (read only in a frame, set at its /SS falling edge), and the byte sent (``tx``: sent
+        # only once Motorola or Intel mode is set, by the initialization byte's end, which also stores it).
         self.configured = Signal()
         self.cfg_extreg, self.cfg_pcp_n = Signal(reset_less=True), Signal(reset_less=True)
         self.cfg_code = Signal(_LENGTH_CODE.width, reset_less=True)
@@ -234,12 +239,19 @@ class _Builder:
         self.motorola, self.intel = Signal(), Signal()
         self.cmd_rd, self.cmd_wr = Signal(reset_less=True), Signal(reset_less=True)
         self.cmd_addr = Signal(_ADDRESS.width, reset_less=True)
-        self.last_rx = Signal(BYTE_BITS, reset_less=True)
-        self.blk_addr = Signal(range(DATA_BYTES), reset_less=True)
-        self.blk_rd, self.blk_wr, self.blk_then_wr = (Signal(reset_less=True) for _ in range(3))
+        """The command's RD, WR and address (DATA phase); in a block transfer (BLOCK phase) the slot's: whether it
+        reads OUT k and writes IN k, and k (UP-11). The two phases never read each other's values: a command byte
+        sets them for the phase it enters."""
+        self.blk_then_wr = Signal(reset_less=True)
         self.in_frame = Signal()
         self.frame_s_r, self.tx_valid = Signal(reset_less=True), Signal(reset_less=True)
         self.tx = Signal(BYTE_BITS, reset_less=True)
+        """The byte sent: the last byte received (the model's ``last_rx``, stored at each ``end`` outside DISABLED),
+        replaced by the value a frame's /SS falling edge reads. One register serves both: the model sends
+        ``last_rx`` in a frame without a read, and after a frame that read (``tx`` then holds the value read, not
+        ``last_rx``) every frame reads again until an ``end`` stores the byte received: the read depends only on the
+        phase and the command, which change only at an ``end``, or at SAS_INIT and power-up, after which nothing is
+        driven until the initialization byte's ``end``."""
         self.rx = Signal(BYTE_BITS, reset_less=True)
         """The byte shifted in: read only after exactly 8 SCLK edges of a frame (``end``), which replace all of it,
         so it has neither reset nor clear."""
@@ -284,13 +296,12 @@ class _Builder:
             m.d.comb += core["PCMD"].eq(b.pcmd)
         raised = b.events | (b.pcmd_we << _SOURCE_BIT["PCMD"]) | (b.ib_reset << _SOURCE_BIT["IB_RESET"])
         m.d.comb += core[_IRQ_EVT.name].eq(regs[_IRQ_EVT.name] | (raised & regs[_IRQ_EN.name]))
-        for k, name in enumerate(OPTICAL_REGISTERS):
-            with m.If(b.optical_we[k]):
-                mask = REGISTER_MAP.register(name).mask
-                m.d.comb += core[name].eq(b.optical.word_select(k, BYTE_BITS) & mask)
+        for k, name in enumerate(OPTICAL_REGISTERS):  # read as the optical block shows them now (UP-39)
+            mask = REGISTER_MAP.register(name).mask
+            m.d.comb += core[name].eq(b.optical.word_select(k, BYTE_BITS) & mask)
         with m.If(b.ib_reset):
             m.d.comb += [core[r.name].eq(r.reset) for r in REGISTER_MAP.cleared_by(Reset.INTERBUS)]
-        m.d.sync += [regs[name].eq(value) for name, value in core.items()]
+        m.d.sync += [regs[name].eq(core[name]) for name in regs]
         m.d.sync += self.io.eq(b.io_access)
 
     # 2. The µP pins: SAS_INIT, /SS falling, SCLK rising, /SS rising (SlavePins._edge) ---------------------------
@@ -340,21 +351,16 @@ class _Builder:
             self.frame_s_r.eq(s_r),
             self.tx_valid.eq(drives),
             self.bits.eq(0),
-            self.tx.eq(self.last_rx),
         ]
-        reads, address = Signal(), Signal(_ADDRESS.width)
-        with m.Switch(self.phase):
-            with m.Case(_Phase.BLOCK):
-                m.d.comb += [reads.eq(self.blk_rd), address.eq(self.blk_addr)]
-            with m.Case(_Phase.DATA):
-                readable = Signal()
-                with m.Switch(self.cmd_addr):
-                    for a, port in _READ_PORTS.items():
-                        if port.access is not Access.RESERVED_IGNORED:
-                            with m.Case(a):
-                                m.d.comb += readable.eq(1)
-                m.d.comb += [reads.eq(self.cmd_rd & readable), address.eq(self.cmd_addr)]
-        with m.If(reads), m.Switch(address):
+        # A block transfer's slot addresses OUT k, which is readable: one address for both phases.
+        readable = Signal()
+        with m.Switch(self.cmd_addr):
+            for a, port in _READ_PORTS.items():
+                if port.access is not Access.RESERVED_IGNORED:
+                    with m.Case(a):
+                        m.d.comb += readable.eq(1)
+        reads = self.phase.matches(_Phase.DATA, _Phase.BLOCK) & self.cmd_rd & readable
+        with m.If(reads), m.Switch(self.cmd_addr):
             for a, port in _READ_PORTS.items():
                 register = port.register
                 if port.access is Access.RESERVED_ZERO:
@@ -372,9 +378,9 @@ class _Builder:
 
     def end(self) -> None:
         """/SS rose after 8 bits (``UpifProtocol.end``): process the received byte ``rx``; a data byte's and a block
-        transfer's writes share one address decoder (``write``, ``address``)."""
+        transfer's writes share one address decoder (``write`` at ``cmd_addr``)."""
         m, rx = self.m, self.rx
-        write, address = Signal(), Signal(_ADDRESS.width)
+        write = Signal()
         with m.Switch(self.phase):
             with m.Case(_Phase.INIT):
                 m.d.sync += self.phase.eq(_Phase.DISABLED)
@@ -385,46 +391,48 @@ class _Builder:
                 # An Intel command byte needs S/R = 1 (Table 3-9); the received byte is kept either way.
                 self.command(rx[_RD.lsb], rx[_WR.lsb], rx[_ADDRESS.lsb : _ADDRESS.lsb + _ADDRESS.width])
             with m.Case(_Phase.DATA):
-                self.data(write, address)
+                self.data(write)
             with m.Case(_Phase.BLOCK):
-                self.block(write, address)
+                self.block(write)
         with m.If(write):
-            self.cpu_write(address, rx)
+            self.cpu_write(self.cmd_addr, rx)
         with m.If(self.phase != _Phase.DISABLED):
-            m.d.sync += self.last_rx.eq(rx)
+            m.d.sync += self.tx.eq(rx)
 
     def command(self, rd: Value, wr: Value, address: Value) -> None:
         """A command byte (3.4.4): a data byte follows, or address 15 starts a block transfer (3.4.6, UP-10/11)."""
         m = self.m
         m.d.sync += [self.cmd_rd.eq(rd), self.cmd_wr.eq(wr), self.cmd_addr.eq(address), self.phase.eq(_Phase.DATA)]
-        with m.If(address.matches(*_BLOCK_ADDRESSES)):
-            m.d.sync += [self.phase.eq(_Phase.BLOCK), self.blk_addr.eq(0)]
+        with m.If(address.matches(*_BLOCK_ADDRESSES)):  # the first slot: k = 0, what it reads and writes
+            m.d.sync += [self.phase.eq(_Phase.BLOCK), self.cmd_addr.eq(0)]
             with m.If((self.n_bytes == 0) | (self.intel & ~rd & ~wr)):
                 m.d.sync += self.phase.eq(_Phase.COMMAND)
             with m.If(self.motorola):
-                m.d.sync += [self.blk_rd.eq(1), self.blk_wr.eq(1), self.blk_then_wr.eq(0)]
+                m.d.sync += [self.cmd_rd.eq(1), self.cmd_wr.eq(1), self.blk_then_wr.eq(0)]
             with m.Else():
-                m.d.sync += [self.blk_rd.eq(rd), self.blk_wr.eq(~rd), self.blk_then_wr.eq(rd & wr)]
+                m.d.sync += [self.cmd_rd.eq(rd), self.cmd_wr.eq(~rd), self.blk_then_wr.eq(rd & wr)]
 
-    def data(self, write: Signal, address: Signal) -> None:
+    def data(self, write: Signal) -> None:
         """The data byte of a command (3.4.4): a write where RD/WR and S/R allow it (UP-9); 4 and 5 ignored."""
         m, s_r = self.m, self.frame_s_r
         m.d.sync += self.phase.eq(_Phase.COMMAND)
         refused = self.intel & (self.cmd_rd != self.cmd_wr) & (self.cmd_rd == s_r)
-        m.d.comb += [write.eq(self.cmd_wr & (self.motorola | s_r) & ~refused), address.eq(self.cmd_addr)]
+        m.d.comb += write.eq(self.cmd_wr & (self.motorola | s_r) & ~refused)
 
-    def block(self, write: Signal, address: Signal) -> None:
-        """One byte of a block transfer: write IN k in a write slot; then the next slot (UP-11)."""
+    def block(self, write: Signal) -> None:
+        """One byte of a block transfer: write IN k in a write slot; then the next slot (UP-11). The slot's k is
+        ``cmd_addr`` (below 4: only its low bits count), what it reads and writes ``cmd_rd``, ``cmd_wr``."""
         m = self.m
-        refused = self.intel & (self.blk_rd == self.frame_s_r)
-        m.d.comb += [write.eq(self.blk_wr & ~refused), address.eq(self.blk_addr)]
-        with m.If(self.blk_addr == self.n_bytes - 1):
+        refused = self.intel & (self.cmd_rd == self.frame_s_r)
+        m.d.comb += write.eq(self.cmd_wr & ~refused)
+        slot = self.cmd_addr[: (DATA_BYTES - 1).bit_length()]
+        with m.If(slot == self.n_bytes - 1):
             with m.If(self.blk_then_wr):
-                m.d.sync += [self.blk_addr.eq(0), self.blk_rd.eq(0), self.blk_wr.eq(1), self.blk_then_wr.eq(0)]
+                m.d.sync += [self.cmd_addr.eq(0), self.cmd_rd.eq(0), self.cmd_wr.eq(1), self.blk_then_wr.eq(0)]
             with m.Else():
                 m.d.sync += self.phase.eq(_Phase.COMMAND)
         with m.Else():
-            m.d.sync += self.blk_addr.eq(self.blk_addr + 1)
+            m.d.sync += slot.eq(slot + 1)
 
     def cpu_write(self, address: Value, value: Value) -> None:
         """``RegisterFile.cpu_write``: store the byte's register bits; SET also applies a valid configuration."""
@@ -470,23 +478,26 @@ class _Builder:
             "irq_n": self.regs[_IRQ_EVT.name] == 0, "irq_n_oe": Const(1),
             "mfp6_oe": drive & self.intel, "mfp7_oe": drive & self.motorola,
         }  # fmt: skip
-        # The bit sent goes through one pipeline for both data pins, each gated by its delayed enable (so it needs
-        # no reset: the enables' pipelines have theirs).
-        delayed = {name: self.delay(name, value, reset=True) for name, value in decoded.items()}
-        sent = self.delay("bit", bit, reset=False)
+        # No pipeline stage has a reset: one more pipeline, of 1s with a reset to 0 (``filled``), says whether the
+        # output stage holds a value decoded since the power-up reset, else the output shows its power-up level
+        # (as stages reset to it would). The bit sent goes through one pipeline for both data pins, each gated by
+        # its delayed enable.
+        filled = self.delay("filled", Const(1), init=0)
+        power_up = self.tables.reset_outputs
+        delayed = {
+            name: value if isinstance(value, Const) else Mux(filled, self.delay(name, value), power_up[name])
+            for name, value in decoded.items()
+        }
+        sent = self.delay("bit", bit)
         delayed.update({"mfp6": sent & delayed["mfp6_oe"], "mfp7": sent & delayed["mfp7_oe"]})
         m.d.comb += [getattr(b, name).eq(value) for name, value in delayed.items()]
 
-    def delay(self, name: str, value: Value, *, reset: bool) -> Value:
-        """``value`` through the bit rate's output pipeline (UP-14): its stages start from the output's power-up
-        level (``reset``) or have no reset."""
+    def delay(self, name: str, value: Value, *, init: int | None = None) -> Value:
+        """``value`` through the bit rate's output pipeline (UP-14): stages without reset, or reset to ``init``."""
         m = self.m
         taps: list[Value] = [value]
         for stage in range(max(self.tables.output_delay)):
-            if reset:
-                stage_signal = Signal(name=f"{name}_d{stage + 1}", init=self.tables.reset_outputs[name])
-            else:
-                stage_signal = Signal(name=f"{name}_d{stage + 1}", reset_less=True)
+            stage_signal = Signal(name=f"{name}_d{stage + 1}", init=init or 0, reset_less=init is None)
             m.d.sync += stage_signal.eq(taps[-1])
             taps.append(stage_signal)
         return Array(taps[delay] for delay in self.tables.output_delay)[self.b.rate]

@@ -11,8 +11,9 @@ model the same ports, so the lockstep harness compares every one of them on ever
 * core inputs, sampled at the clock edge ending the cycle, *before* the µP pins act at that edge (``docs/upif.md``,
   "core call between ticks"), in this order: ``io_access`` (level), ``latch`` with ``latch_out`` (a valid data
   cycle, ignored with ExtReg = 1), ``pcmd_we`` with ``pcmd`` (management message), ``events`` (one bit per
-  interrupt source, at the source's IRQ_EVT bit), ``optical_we`` with ``optical`` (reads 8 to 11, reserved bits
-  dropped), ``ib_reset``. ``power_up`` resets the whole block at that edge and overrides everything else.
+  interrupt source, at the source's IRQ_EVT bit), ``optical`` (reads 8 to 11 as the optical block shows them now,
+  reserved bits dropped: taken at every edge, so a read at an edge sees the value of the cycle it ends, UP-39),
+  ``ib_reset``. ``power_up`` resets the whole block at that edge and overrides everything else.
 * core outputs, decoded from the registers (they change in the cycle after the edge that changed them):
   ``in_data`` (IN0..IN3), ``bus_id`` (bits 12..0 of the ID register, :meth:`RegisterFile.bus_id_register`),
   ``ext_reg`` (ExtReg applied: the internal data registers are not in the data path), ``pcp`` (a PCP device,
@@ -217,9 +218,8 @@ class UpifBlockPins:
             if events >> source.bit & 1:
                 registers.event(source.name)
         optical = _bytes(int(inputs["optical"]), len(OPTICAL_REGISTERS))
-        for k, name in enumerate(OPTICAL_REGISTERS):
-            if int(inputs["optical_we"]) >> k & 1:
-                registers.set_optical(name, optical[k] & REGISTER_MAP.register(name).mask)
+        for name, value in zip(OPTICAL_REGISTERS, optical, strict=True):  # every edge: read as shown now (UP-39)
+            registers.set_optical(name, value & REGISTER_MAP.register(name).mask)
         if inputs["ib_reset"]:
             registers.interbus_reset()
 
