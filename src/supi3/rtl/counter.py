@@ -14,13 +14,11 @@ into ``Supi3Core`` (docs/rtl.md, "Counter telegram block").
 
 from __future__ import annotations
 
-import functools
-import operator
 from collections.abc import Callable
 from itertools import pairwise
 from typing import Final
 
-from amaranth.hdl import Cat, Const, Module, Mux, ResetInserter, Signal, Value
+from amaranth.hdl import Array, Cat, Const, Module, Mux, ResetInserter, Signal, Value
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
@@ -110,11 +108,11 @@ class LineQueue:
                 result = Mux(rate == k, pick(*entry), result)
             return result
 
-        # the oldest waiting bit begins on the line in the next cycle (``begins`` clocks after its push)
+        # the oldest waiting bit (entry ``waiting - 1``, chosen by ``waiting``: one compare, not one per entry)
+        # begins on the line in the next cycle (``begins`` clocks after its push)
         due = (now + by_rate(lambda begins, _: (1 - begins) % (1 << bits)))[:bits]
-        head = [(waiting == k + 1) & (stamp[k] == due) for k in range(slots)]
-        begin_now = Cat(*head).any()
-        oldest = functools.reduce(operator.or_, (Mux(h, v, 0) for h, v in zip(head, self.values, strict=True)))
+        begin_now = (waiting != 0) & (Array([stamp[0], *stamp])[waiting] == due)
+        oldest = Array([self.values[0], *self.values])[waiting]
         with m.If(begin_now):
             sync += [sent.eq(oldest), left.eq(by_rate(lambda _, length: down_state(length, left_width)))]
         with m.Else():
