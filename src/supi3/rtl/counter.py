@@ -280,9 +280,9 @@ class CounterLinesRtl(wiring.Component):
         forward, back = CounterRtl(shared_clock=True), CounterRtl(shared_clock=True)
         m.submodules.back = ResetInserter(self.clear | ~self.run | ~self.looped)(back)
         on = self.forward | self.branch
-        watch = ReturnWatchRtl(_CPB[0].bit_length())
+        watch = ReturnWatchRtl()
         m.submodules.watch = ResetInserter(self.clear | ~self.run)(watch)
-        m.d.comb += [watch.line.eq(self.branch_line), watch.cpb.eq(Mux(self.fast, _CPB[1], _CPB[0])),
+        m.d.comb += [watch.line.eq(self.branch_line), watch.fast.eq(self.fast),
                      self.returned.eq(watch.seen), self.branch_busy.eq(watch.busy)]  # fmt: skip
         m.submodules.forward = ResetInserter(self.clear | ~self.run | ~on)(forward)
         stages = [Signal(init=wire.IDLE_LEVEL, name=f"source_s{k}") for k in range(SYNC_STAGES)]
