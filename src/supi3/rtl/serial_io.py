@@ -8,9 +8,11 @@ and the /Conv pulse (their offsets, whole t0 all, are constants taken from the s
 counters ``sub`` (clock within a t0), ``within`` (slot within a byte of nine slots) and ``lead`` (the half t0
 before a frame's first slot) give SCLK, the SerOut shifts and the sample points.
 
-* ``start`` (the core's latch of a valid data cycle) with ``out_word``: a sequence begins on the next cycle (SM-2);
-  while one runs, the word waits (one deep, the newest wins) and its sequence begins on the cycle after the running
-  one ends.
+* ``start`` (the core's latch of a valid data cycle) with ``out_word``: a sequence begins on the next cycle (SM-2).
+  While a clear sequence runs the word waits (one deep, the newest wins) and its sequence begins on the cycle after
+  the clear sequence ends; a start while a data sequence runs abandons it (nothing taken over) and begins anew
+  (SM-12), which INTERBUS cycles never ask: two valid data cycles' latches are a whole frame apart, longer than
+  every sequence (:func:`~supi3.serial_io.shortest_latch_gap`, checked at elaboration).
 * ``reset`` (INTERBUS reset or watchdog reset of process data): the running sequence is aborted, a waiting one
   dropped, the IN word cleared, and the clear sequence of the mode (:func:`~supi3.serial_io.clear_sequence`,
   none in input mode) begins on the next cycle (SM-9). A ``start`` at the same edge wins (the core applies a latch
@@ -126,6 +128,11 @@ class SerialIoRtl(wiring.Component):
                 raise ValueError(f"a SerIn sample needs SYNC_STAGES < t0/2 + 1, not t0 = {t0}")
         self.slots = {key: _in_slots(seq, self.t0s[key[2]]) for key, seq in self.schedules.items() if seq is not None}
         self.longest = max(constants.length for constants in self.slots.values())
+        for (kind, wide, rate), seq in self.schedules.items():
+            gap = spec.shortest_latch_gap(WIDTHS[wide], BIT_RATES[rate])
+            if kind < _CLEAR and seq is not None and seq.length > gap:
+                raise ValueError(f"a data sequence of {seq.length} clocks must end within {gap} clocks, the shortest "
+                                 "time between two valid data cycles' latches (SM-12)")  # fmt: skip
         super().__init__({
             "start": In(1), "out_word": In(WORD_BITS), "reset": In(1), "ser_in": In(1),
             "direction": In(range(len(DIRECTIONS))), "wide": In(1), "rate": In(range(len(BIT_RATES))),
@@ -187,19 +194,15 @@ class SerialIoRtl(wiring.Component):
         in_write = busy & write_on & (slot >= write_start) & (slot < write_end)
         in_frame = in_read | in_write
         high = sub >= (t0 >> 1)
-        # The shift registers and the waiting word are written before they are read: every sequence loads
-        # ``out_shift`` (a clear sequence sends 0s whatever it holds: ``clearing``), a read frame shifts a whole
-        # word into ``in_shift`` (a 16-bit word's upper half is left out when taken over), ``pending`` says when
-        # the waiting word counts: no reset, no clear. A 16-bit word is sent from bit 15 (the bits above are not
-        # sent), so the OUT word is loaded as it comes. Every start's word goes to ``pending_word`` and
-        # ``out_shift`` takes it there on the clock after its sequence began (``loading``): SerOut shows it only
-        # after a frame's lead half t0 (at least one clock), and this spares a 32-bit choice between the word now
-        # and the waiting one.
+        # The shift registers are written before they are read: every start loads ``out_shift`` (a clear sequence
+        # sends 0s whatever it holds, ``clearing``, and leaves it alone), a read frame shifts a whole word into
+        # ``in_shift`` (a 16-bit word's upper half is left out when taken over): no reset, no clear. A 16-bit word
+        # is sent from bit 15 (the bits above are not sent), so the OUT word is loaded as it comes. A start while a
+        # clear sequence runs waits in ``out_shift`` (``pending``; the newest wins), one while a data sequence runs
+        # abandons it (SM-12): no second word register.
         out_shift = Signal(WORD_BITS, reset_less=True)
         in_shift = Signal(WORD_BITS, reset_less=True)
         pending = Signal()
-        pending_word = Signal(WORD_BITS, reset_less=True)
-        loading = Signal(reset_less=True)
         clearing = kind >= _CLEAR
         frame_probe = spec.SerialFrame(0, WIDTHS[0], False, max(self.t0s))
         sample_after = frame_probe.sample(0) + SYNC_STAGES - frame_probe.rising(0)  # clocks after SCLK rose
@@ -227,7 +230,7 @@ class SerialIoRtl(wiring.Component):
                     sync += lead.eq(0)
                 with m.Else():
                     sync += within.eq(Mux(pause, 0, within + 1))
-                    with m.If(in_write & (within != spec.BYTE_SLOTS - 2)):  # the next slot carries bit j > 0
+                    with m.If(in_write & ~clearing & (within != spec.BYTE_SLOTS - 2)):  # the next slot: bit j > 0
                         sync += out_shift.eq(out_shift << 1)
             with m.Else():
                 sync += sub.eq(sub + 1)
@@ -240,12 +243,11 @@ class SerialIoRtl(wiring.Component):
             with m.If(read_on):
                 sync += self.in_word.eq(Mux(self.wide, in_shift, in_shift[: WIDTHS[0]]))
 
-        # Start, pending start, reset (SM-2, SM-9) -------------------------------------------------------------
-        free = ~busy | last | self.reset
-        want = self.start | (pending & ~self.reset)
-        go = want & free
+        # Start, waiting start, reset (SM-2, SM-9, SM-12) -------------------------------------------------------
+        free = ~busy | ~clearing | last | self.reset  # a running data sequence is abandoned (SM-12)
+        go = (self.start | (pending & ~self.reset)) & free
         with m.If(self.start):
-            sync += pending_word.eq(self.out_word)
+            sync += out_shift.eq(self.out_word)
         with m.If(self.start & ~free):
             sync += pending.eq(1)
         with m.If(self.reset):
@@ -265,7 +267,4 @@ class SerialIoRtl(wiring.Component):
                 pending.eq(0),
                 *frame_begins(),
             ]
-        sync += loading.eq(go)
-        with m.If(loading):
-            sync += out_shift.eq(pending_word)
         return m
