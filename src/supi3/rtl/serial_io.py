@@ -154,14 +154,19 @@ class SerialIoRtl(wiring.Component):
         kind = Signal(range(2 * _CLEAR), reset_less=True)
         read_on, write_on, conv_on = Signal(), Signal(), Signal()
         read_start, read_end, write_start, write_end = (Signal(slot_range, name=n) for n in ("rs", "re", "ws", "we"))
-        conv_start, conv_end, length = Signal(slot_range), Signal(slot_range), Signal(slot_range)
+        conv_start, conv_end = Signal(slot_range), Signal(slot_range)
+        final = Signal(slot_range)  # the sequence's last slot
+        write_after = Signal()  # the write frame follows a read frame, from the slot after ``write_before``
+        write_before = Signal(slot_range)
         cases: dict[_Slots, list[int]] = {}
         for (kind_value, wide, rate), constants in self.slots.items():
             cases.setdefault(constants, []).append(kind_value | (wide << len(kind)) | (rate << (len(kind) + 1)))
         with m.Switch(Cat(kind, self.wide, self.rate)):
             for constants, patterns in cases.items():
                 with m.Case(*patterns):
-                    comb += length.eq(constants.length)
+                    comb += final.eq(constants.length - 1)
+                    if constants.write is not None and constants.write[0] > 0:
+                        comb += [write_after.eq(1), write_before.eq(constants.write[0] - 1)]
                     for frame, on, first, end in ((constants.read, read_on, read_start, read_end),
                                                   (constants.write, write_on, write_start, write_end),
                                                   (constants.conv, conv_on, conv_start, conv_end)):  # fmt: skip
@@ -220,7 +225,7 @@ class SerialIoRtl(wiring.Component):
             """The slot counters as they stand in a frame's first cycle: in the lead half t0."""
             return [sub.eq(t0 >> 1), lead.eq(1), within.eq(0)]
 
-        last = busy & slot_ends & (slot == length - 1)
+        last = busy & slot_ends & (slot == final)
         with m.If(busy):
             with m.If(slot_ends):
                 sync += slot.eq(slot + 1)
@@ -236,7 +241,7 @@ class SerialIoRtl(wiring.Component):
                 sync += sub.eq(sub + 1)
             with m.If(in_read & ~lead & ~pause & (sub == (t0 >> 1) + sample_after)):
                 sync += in_shift.eq(Cat(self.ser_in, in_shift[:-1]))
-            with m.If(write_on & slot_ends & (slot + 1 == write_start)):
+            with m.If(write_after & slot_ends & (slot == write_before)):
                 sync += frame_begins()
         with m.If(last):
             sync += busy.eq(0)
