@@ -84,12 +84,16 @@ class TerminalRtl(wiring.Component):
         alarm = Signal()
         fresh = Signal(init=1)
         # the silence timer counts the clocks since it was restarted as an LFSR (supi3.rtl.lfsr): ``idle`` is its 0,
-        # and it is at the state 1 when the silence ends (time_limit - 1 clocks on), where it holds; ``heard``: the
-        # return line was heard (or not watched) since the last frame's end (model: silence_edge, BK-50)
+        # and it is at the state 1 when the silence ends (time_limit - 1 clocks on); ``over`` holds that it was (the
+        # timer steps on, no hold); ``heard``: the return line was heard (or not watched) since the last frame's end
+        # (model: silence_edge, BK-50). The three are read only while the extended function counts, which starts
+        # with ``extended`` at 0 after a reset: set (restarted) on every edge before, so no reset.
         width = max(min(TAPS), self.time_limit.bit_length())
         idle = before(self.time_limit - 1, width)
-        timer = Signal(width, init=idle)
-        heard = Signal(init=1)
+        timer = Signal(width, reset_less=True)
+        over = Signal(reset_less=True)
+        heard = Signal(reset_less=True)
+        ended = over | (timer == 1)  # the silence has lasted the limit
 
         # Outputs from the state ---------------------------------------------------------------------------------
         bk = self.mode != TerminalMode.NONE
@@ -115,7 +119,7 @@ class TerminalRtl(wiring.Component):
         counting = extended & on
         restart = self.ret_valid | cmd_on
         ends = self.frame_end
-        expired = counting & ends & ~heard & ~restart & (timer == 1)  # BK-50: judged at a frame's end only
+        expired = counting & ends & ~heard & ~restart & ended  # BK-50: judged at a frame's end only
         with m.If(bk):
             with m.If(fresh):  # power_up: the CONF level, no edge
                 sync += [fresh.eq(0), conf.eq(self.conf)]
@@ -125,7 +129,7 @@ class TerminalRtl(wiring.Component):
                     sync += conf_request.eq(1)
                 with m.If(self.ib_reset):  # reset: all but the CONF level and the request
                     sync += [switched_on.eq(1), extended.eq(0), closed.eq(0), closed_report.eq(0), count.eq(0),
-                             alarm.eq(0), timer.eq(idle), heard.eq(1)]  # fmt: skip
+                             alarm.eq(0), timer.eq(idle), over.eq(0), heard.eq(1)]  # fmt: skip
                 with m.Else():
                     with m.If(self.cmd_valid):  # command
                         with m.If(self.alarm_set):
@@ -144,9 +148,9 @@ class TerminalRtl(wiring.Component):
                     with m.If(expired & ~cmd_off):  # silence, on the state after the command (watching)
                         sync += [closed.eq(1), closed_report.eq(1)]
                     with m.If(~counting | (ends & (heard | expired))):  # the silence (re)starts here
-                        sync += [timer.eq(idle), heard.eq(~counting | restart)]
+                        sync += [timer.eq(idle), over.eq(0), heard.eq(~counting | restart)]
                     with m.Else():
-                        sync += [timer.eq(Mux(timer == 1, timer, next_state(timer))), heard.eq(heard | restart)]
+                        sync += [timer.eq(next_state(timer)), over.eq(ended), heard.eq(heard | restart)]
         return m
 
 
