@@ -239,7 +239,8 @@ def test_a_start_at_the_reset_edge_wins() -> None:
 
 def test_sequence_constants_are_whole_t0() -> None:
     """The block counts a sequence in t0 slots: every schedule's offsets are whole t0 (SM-3, SM-7, Table 3-4 t6, t7),
-    and a schedule with an offset between slots is refused at elaboration, named."""
+    and a schedule with an offset between slots, or a /Conv pulse before its last slot, is refused at elaboration,
+    named."""
     for (_, _, rate), seq in _schedules().items():
         if seq is None:
             continue
@@ -255,3 +256,7 @@ def test_sequence_constants_are_whole_t0() -> None:
     shifted = serial_io.SerialSequence(seq.frames, seq.conv, seq.length + 1)
     with pytest.raises(ValueError, match=f"length must fall on a whole t0, not at {seq.length + 1} clocks"):
         _in_slots(shifted, t0)
+    assert seq.conv is not None  # the block shows /Conv in the sequence's last slot: a pulse elsewhere is refused
+    longer = serial_io.SerialSequence(seq.frames, seq.conv, seq.length + t0)
+    with pytest.raises(ValueError, match=r"/Conv pulse must be its last t0, not slots \(19, 20\) of 21"):
+        _in_slots(longer, t0)
