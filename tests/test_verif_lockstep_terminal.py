@@ -12,6 +12,7 @@ strobes (hypothesis, the seeded profile of tests/conftest.py) in every BK mode a
 from __future__ import annotations
 
 import inspect
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -343,8 +344,8 @@ class _Watch:
     """``ReturnWatch`` behind ``ReturnWatchRtl``'s ports (``line``, ``fast`` in; ``seen``, ``busy`` out, as they
     stand before each clock edge) for the lockstep."""
 
-    inputs = (Pin("line"), Pin("fast"))
-    outputs = (Pin("seen"), Pin("busy"))
+    inputs: Sequence[Pin] = (Pin("line"), Pin("fast"))
+    outputs: Sequence[Pin] = (Pin("seen"), Pin("busy"))
 
     def __init__(self) -> None:
         self.watch = ReturnWatch()
@@ -352,7 +353,7 @@ class _Watch:
     def reset(self) -> None:
         self.watch.reset()
 
-    def step(self, row: dict[str, int]) -> dict[str, int]:
+    def step(self, row: Mapping[str, int]) -> dict[str, int]:
         out = {"seen": self.watch.seen, "busy": int(self.watch.busy)}
         self.watch.clock(row["line"], clocks_per_bit(row["fast"]))
         return out
