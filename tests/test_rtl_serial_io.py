@@ -21,7 +21,7 @@ import pytest
 from amaranth.sim import Simulator
 
 from supi3 import serial_io
-from supi3.config import DataDirection
+from supi3.config import DataDirection, MfpKind, Variant, decode, mode_rows
 from supi3.interbus import wire
 from supi3.pinout import SYNC_STAGES
 from supi3.rtl.serial_io import DIRECTIONS, MFP_BITS, SER_IN_PIN, WIDTHS, SerialIoRtl, _in_slots, _schedules
@@ -214,6 +214,11 @@ def test_interbus_cycles_never_start_while_a_data_sequence_runs() -> None:
     """SM-12: every data sequence (every direction, width, bit rate) ends within the shortest time between two
     valid data cycles' latches, the frame of the loopback word, the chip's data bytes and the check sequence; a
     schedule that outlasted it is refused at elaboration, named."""
+    for variant in Variant:  # the chip's data bytes in every SPI master row are the word's (the frame's share)
+        for row in mode_rows(variant):
+            config = decode(row.c, row.mfp, variant=variant)
+            if config.mfp_mode is not None and config.mfp_mode.kind is MfpKind.SPI_MASTER:
+                assert config.data_bytes == config.mfp_mode.width // 8
     for direction, bits, bit_rate in itertools.product(DIRECTIONS, WIDTHS, BIT_RATES):
         gap = serial_io.shortest_latch_gap(bits, bit_rate)
         assert gap == wire.frame_bits(wire.LOOPBACK_BYTES + bits // 8) * wire.clocks_per_bit(bit_rate)
