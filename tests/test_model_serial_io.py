@@ -185,6 +185,10 @@ def test_device_answer_must_be_a_level() -> None:
 # ------------------------------------------------------------------------------------------------------------
 
 
+_WRITING = [r for r in SPI_ROWS if _config(r).mfp_mode.direction is not DataDirection.IN]
+"""The SPI master rows with OUT data (a clear sequence after a reset, SM-9)."""
+
+
 def _after_power_up(config: DeviceConfig) -> Supi3Pins:
     model = Supi3Pins(config)
     model.run(quiet_inputs(RESET_STRETCH_CLOCKS + 10))
@@ -212,8 +216,7 @@ def test_latch_during_a_data_sequence_begins_anew(row: tables.ModeRow) -> None:
     assert chip.in_word == 0  # the first read frame was abandoned, the last read the idle MFP6 (0)
 
 
-@pytest.mark.parametrize("row", [r for r in SPI_ROWS if _config(r).mfp_mode.direction is not DataDirection.IN][:4],
-                         ids=str)  # fmt: skip
+@pytest.mark.parametrize("row", _WRITING[:4], ids=[f"{r.c}-{r.mfp}" for r in _WRITING[:4]])
 def test_latch_during_the_clear_sequence_waits_and_the_newest_word_wins(row: tables.ModeRow) -> None:
     """SM-2, SM-9: a watchdog reset of process data, then two latches while its clear sequence runs: the newer
     word's sequence begins on the cycle after the clear sequence ends."""
