@@ -181,8 +181,12 @@ def test_device_answer_must_be_a_level() -> None:
 
 
 # ------------------------------------------------------------------------------------------------------------
-# SM-2: a latch while a sequence runs; SM-9: resets abort it
+# SM-2, SM-12: a latch while a sequence runs; SM-9: resets abort it
 # ------------------------------------------------------------------------------------------------------------
+
+
+_WRITING = [r for r in SPI_ROWS if _config(r).mfp_mode.direction is not DataDirection.IN]
+"""The SPI master rows with OUT data (a clear sequence after a reset, SM-9)."""
 
 
 def _after_power_up(config: DeviceConfig) -> Supi3Pins:
@@ -192,20 +196,47 @@ def _after_power_up(config: DeviceConfig) -> Supi3Pins:
 
 
 @pytest.mark.parametrize("row", SPI_ROWS[:6], ids=[f"{r.c}-{r.mfp}" for r in SPI_ROWS[:6]])
-def test_latch_during_a_sequence_waits_and_the_newest_word_wins(row: tables.ModeRow) -> None:
+def test_latch_during_a_data_sequence_begins_anew(row: tables.ModeRow) -> None:
+    """SM-12: a latch while a data sequence runs abandons it (nothing taken over) and begins anew; two at one
+    edge: the newer (INTERBUS cycles never ask it: tests/test_rtl_serial_io.py)."""
     config = _config(row)
     seq, _ = _sequences(config)
     model = _after_power_up(config)
     chip = model.chip
     nbytes = config.data_bytes
     chip.latch_at(Cycle.DATA, b"\x81" * nbytes, model.cycle - 1)  # the edge that ended the last cycle run
+    first = model.run({**quiet_inputs(10), "mfp_in": np.full(10, SER_IN)})
+    chip.latch_at(Cycle.DATA, b"\x42" * nbytes, model.cycle - 1)  # abandons the running sequence
+    chip.latch_at(Cycle.DATA, b"\x3c" * nbytes, model.cycle - 1)  # and this one the one not yet begun
+    second = model.run(quiet_inputs(seq.length + 40))
+    expected = np.full(seq.length + 50, IDLE_MFP, dtype=np.int64)
+    _overlay(expected, 0, seq, int.from_bytes(b"\x81" * nbytes, "big"), stop=10)
+    _overlay(expected, 10, seq, int.from_bytes(b"\x3c" * nbytes, "big"))
+    assert np.array_equal(np.concatenate([first["mfp_out"], second["mfp_out"]]), expected)
+    assert chip.in_word == 0  # the first read frame was abandoned, the last read the idle MFP6 (0)
+
+
+@pytest.mark.parametrize("row", _WRITING[:4], ids=[f"{r.c}-{r.mfp}" for r in _WRITING[:4]])
+def test_latch_during_the_clear_sequence_waits_and_the_newest_word_wins(row: tables.ModeRow) -> None:
+    """SM-2, SM-9: a watchdog reset of process data, then two latches while its clear sequence runs: the newer
+    word's sequence begins on the cycle after the clear sequence ends."""
+    config = _config(row)
+    seq, clear = _sequences(config)
+    assert clear is not None
+    model = _after_power_up(config)
+    chip = model.chip
+    chip._deadline = model.cycle - 1  # the layer-2 watchdog's expiry resets process data (3.4.14)
+    chip._reschedule()
+    chip._advance(model.cycle - 1)
+    assert chip.events["WATCHDOG"] == 1
     first = model.run(quiet_inputs(10))
+    nbytes = config.data_bytes
     chip.latch_at(Cycle.DATA, b"\x42" * nbytes, model.cycle - 1)  # waits
     chip.latch_at(Cycle.DATA, b"\x3c" * nbytes, model.cycle - 1)  # replaces the waiting word
-    second = model.run(quiet_inputs(2 * seq.length + 40))
-    expected = np.full(2 * seq.length + 50, IDLE_MFP, dtype=np.int64)
-    _overlay(expected, 0, seq, int.from_bytes(b"\x81" * nbytes, "big"))
-    _overlay(expected, seq.length, seq, int.from_bytes(b"\x3c" * nbytes, "big"))
+    second = model.run(quiet_inputs(clear.length + seq.length + 30))
+    expected = np.full(clear.length + seq.length + 40, IDLE_MFP, dtype=np.int64)
+    _overlay(expected, 0, clear, 0)
+    _overlay(expected, clear.length, seq, int.from_bytes(b"\x3c" * nbytes, "big"))
     assert np.array_equal(np.concatenate([first["mfp_out"], second["mfp_out"]]), expected)
 
 
@@ -218,7 +249,6 @@ def test_reset_in_a_sequence_aborts_it_and_clears(row: tables.ModeRow, how: str)
     chip = model.chip
     start = model.cycle
     chip.latch_at(Cycle.DATA, b"\xff" * config.data_bytes, start - 1)
-    model.chip.latch_at(Cycle.DATA, b"\x0f" * config.data_bytes, start - 1)  # waiting: dropped by the reset
     cut = seq.length // 2
     first = model.run({**quiet_inputs(cut), "mfp_in": np.full(cut, SER_IN)})
     if how == "interbus":

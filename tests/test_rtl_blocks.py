@@ -38,7 +38,7 @@ def blocks() -> list[wiring.Component]:
     """One of each block, elaborated on its own (so none is left unused)."""
     tables = core_tables()
     made = [ReceiverRtl(tables), FrameEngineRtl(), DataPathRtl(tables), TransmitterRtl(tables), OutputsRtl(26),
-            SerialIoRtl(), ExpansionRtl(), CounterLinesRtl(), TerminalRtl(), ReturnWatchRtl(7),
+            SerialIoRtl(), ExpansionRtl(), CounterLinesRtl(), TerminalRtl(), ReturnWatchRtl(),
             OpticalRtl()]  # fmt: skip
     for block in made:
         Fragment.get(block, None)

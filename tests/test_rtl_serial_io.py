@@ -4,7 +4,8 @@ Manual 3.3 (Tables 3-3, 3-4, Figures 3-1 to 3-3) and SM-1 to SM-9 of docs/assump
 ``serial_io.render`` cycle for cycle for every direction, width and bit rate and meet Table 3-4
 (supi3.verif.timing); SerIn, read through the core's
 synchroniser (SYNC_STAGES), lands in the IN word at the sample cycles; a reset aborts and runs the clear sequence;
-a start while a sequence runs waits (SM-2). On Amaranth's own simulator (no external tools).
+a start while the clear sequence runs waits (SM-2), one while a data sequence runs begins anew (SM-12). On
+Amaranth's own simulator (no external tools).
 """
 
 from __future__ import annotations
@@ -20,7 +21,8 @@ import pytest
 from amaranth.sim import Simulator
 
 from supi3 import serial_io
-from supi3.config import DataDirection
+from supi3.config import DataDirection, MfpKind, Variant, decode, mode_rows
+from supi3.interbus import wire
 from supi3.pinout import SYNC_STAGES
 from supi3.rtl.serial_io import DIRECTIONS, MFP_BITS, SER_IN_PIN, WIDTHS, SerialIoRtl, _in_slots, _schedules
 from supi3.serial_io import IDLE, Levels
@@ -160,25 +162,71 @@ def test_reset_aborts_and_runs_the_clear_sequence(direction: DataDirection, bits
 
 
 @pytest.mark.parametrize("direction", DIRECTIONS)
-def test_start_while_busy_waits_newest_wins(direction: DataDirection) -> None:
-    """SM-2: two latches while a sequence runs: the newer word's sequence begins on the cycle after the running one
-    ends; the older is dropped."""
+def test_start_while_a_data_sequence_runs_begins_anew(direction: DataDirection) -> None:
+    """SM-12: a start while a data sequence runs abandons it (its IN word is not taken over) and begins the new one
+    on the next cycle; two at once: the newer; INTERBUS cycles never ask it (below)."""
     bits, bit_rate = WIDTHS[0], BIT_RATES[-1]
     seq = serial_io.sequence(direction, bits, bit_rate)
     words = [0xA5C3, 0x1234, 0xFEDC]
 
     def script(_run: Run) -> Iterator[dict[str, int]]:
         yield {"start": 1, "out_word": words[0]}
+        yield from quiet(seq.length - 2)  # the first sequence's last cycle is the next: still running
+        yield {"start": 1, "out_word": words[1]}
+        yield {"start": 1, "out_word": words[2]}
+        yield from quiet(seq.length + 1)
+
+    run = simulate(direction, bits, bit_rate, script, seed=2)
+    cut = seq.length - 1  # cycles of the first sequence run
+    want = [IDLE, *serial_io.render(seq, words[0])[:cut], serial_io.render(seq, words[1])[0],
+            *serial_io.render(seq, words[2])]  # fmt: skip
+    assert run.levels[: len(want) + 1] == [*want, IDLE]
+    assert set(run.in_words[: len(want)]) == {0}  # nothing taken over before the last sequence's end
+    if seq.read is not None:
+        assert run.in_words[len(want)] == expected_in(run, 2 + cut, seq)
+
+
+@pytest.mark.parametrize("direction", [DataDirection.OUT, DataDirection.IN_OUT])
+def test_start_while_the_clear_sequence_runs_waits_newest_wins(direction: DataDirection) -> None:
+    """SM-2, SM-9: two starts while a reset's clear sequence runs (a watchdog reset just before a data cycle's
+    latch): the newer word's sequence begins on the cycle after the clear sequence ends; the older is dropped."""
+    bits, bit_rate = WIDTHS[1], BIT_RATES[-1]
+    seq = serial_io.sequence(direction, bits, bit_rate)
+    clear = serial_io.clear_sequence(direction, bits, bit_rate)
+    assert clear is not None
+    words = [0xA5C3_0F0F, 0x1234_5678, 0xFEDC_BA98]
+
+    def script(_run: Run) -> Iterator[dict[str, int]]:
+        yield {"reset": 1}
         yield from quiet(9)
         yield {"start": 1, "out_word": words[1]}
         yield {"start": 1, "out_word": words[2]}
-        yield from quiet(2 * seq.length)
+        yield from quiet(clear.length + seq.length)
 
-    run = simulate(direction, bits, bit_rate, script, seed=2)
-    want = [IDLE, *serial_io.render(seq, words[0]), *serial_io.render(seq, words[2])]
+    run = simulate(direction, bits, bit_rate, script, seed=3)
+    want = [IDLE, *serial_io.render(clear, 0), *serial_io.render(seq, words[2])]
     assert run.levels[: len(want) + 1] == [*want, IDLE]
     if seq.read is not None:
-        assert run.in_words[1 + 2 * seq.length] == expected_in(run, 1 + seq.length, seq)
+        assert run.in_words[len(want)] == expected_in(run, 1 + clear.length, seq)
+
+
+def test_interbus_cycles_never_start_while_a_data_sequence_runs() -> None:
+    """SM-12: every data sequence (every direction, width, bit rate) ends within the shortest time between two
+    valid data cycles' latches, the frame of the loopback word, the chip's data bytes and the check sequence; a
+    schedule that outlasted it is refused at elaboration, named."""
+    for variant in Variant:  # the chip's data bytes in every SPI master row are the word's (the frame's share)
+        for row in mode_rows(variant):
+            config = decode(row.c, row.mfp, variant=variant)
+            if config.mfp_mode is not None and config.mfp_mode.kind is MfpKind.SPI_MASTER:
+                assert config.data_bytes == config.mfp_mode.width // 8
+    for direction, bits, bit_rate in itertools.product(DIRECTIONS, WIDTHS, BIT_RATES):
+        gap = serial_io.shortest_latch_gap(bits, bit_rate)
+        assert gap == wire.frame_bits(wire.LOOPBACK_BYTES + bits // 8) * wire.clocks_per_bit(bit_rate)
+        assert serial_io.sequence(direction, bits, bit_rate).length <= gap
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(serial_io, "shortest_latch_gap", lambda _bits, _bit_rate: 100)
+        with pytest.raises(ValueError, match=r"must end within 100 clocks.*\(SM-12\)"):
+            SerialIoRtl()
 
 
 def test_a_start_at_the_reset_edge_wins() -> None:
@@ -196,7 +244,8 @@ def test_a_start_at_the_reset_edge_wins() -> None:
 
 def test_sequence_constants_are_whole_t0() -> None:
     """The block counts a sequence in t0 slots: every schedule's offsets are whole t0 (SM-3, SM-7, Table 3-4 t6, t7),
-    and a schedule with an offset between slots is refused at elaboration, named."""
+    and a schedule with an offset between slots, or a /Conv pulse before its last slot, is refused at elaboration,
+    named."""
     for (_, _, rate), seq in _schedules().items():
         if seq is None:
             continue
@@ -212,3 +261,7 @@ def test_sequence_constants_are_whole_t0() -> None:
     shifted = serial_io.SerialSequence(seq.frames, seq.conv, seq.length + 1)
     with pytest.raises(ValueError, match=f"length must fall on a whole t0, not at {seq.length + 1} clocks"):
         _in_slots(shifted, t0)
+    assert seq.conv is not None  # the block shows /Conv in the sequence's last slot: a pulse elsewhere is refused
+    longer = serial_io.SerialSequence(seq.frames, seq.conv, seq.length + t0)
+    with pytest.raises(ValueError, match=r"/Conv pulse must be its last t0, not slots \(19, 20\) of 21"):
+        _in_slots(longer, t0)

@@ -12,18 +12,22 @@ strobes (hypothesis, the seeded profile of tests/conftest.py) in every BK mode a
 from __future__ import annotations
 
 import inspect
+from collections.abc import Mapping, Sequence
 from typing import Any
 
+import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from supi3.interbus import wire
-from supi3.interbus.wire import BranchControl
-from supi3.model.blocks.terminal import TerminalBlock
+from supi3.interbus.wire import BranchControl, Cycle
+from supi3.lbd import clocks_per_bit
+from supi3.model.blocks.terminal import ReturnWatch, TerminalBlock
 from supi3.model.bus_terminal import BRANCH_SILENCE_S, CONF_PIN, LBST_PIN, BusTerminal
-from supi3.rtl.terminal import TerminalRtl
-from supi3.tables import CLOCK_HZ
+from supi3.pinlevel import Pin
+from supi3.rtl.terminal import ReturnWatchRtl, TerminalRtl
+from supi3.tables import BIT_RATES, CLOCK_HZ
 from supi3.terminal import BLOCK_INPUTS, BRANCH_SILENCE_CLOCKS, RF_CODES, Terminal, TerminalMode
 from supi3.verif.amaranth_sim import run_amaranth_sim
 
@@ -331,3 +335,54 @@ def test_the_transaction_level_closes_at_the_block_s_clock(limit: int,
         if command:
             tl.command(ON_EXT, False)
         assert block.state == tl.state
+
+
+# The return watch (BK-38) ----------------------------------------------------------------------------------------
+
+
+class _Watch:
+    """``ReturnWatch`` behind ``ReturnWatchRtl``'s ports (``line``, ``fast`` in; ``seen``, ``busy`` out, as they
+    stand before each clock edge) for the lockstep."""
+
+    inputs: Sequence[Pin] = (Pin("line"), Pin("fast"))
+    outputs: Sequence[Pin] = (Pin("seen"), Pin("busy"))
+
+    def __init__(self) -> None:
+        self.watch = ReturnWatch()
+
+    def reset(self) -> None:
+        self.watch.reset()
+
+    def step(self, row: Mapping[str, int]) -> dict[str, int]:
+        out = {"seen": self.watch.seen, "busy": int(self.watch.busy)}
+        self.watch.clock(row["line"], clocks_per_bit(row["fast"]))
+        return out
+
+
+_PIECE = st.one_of(
+    st.tuples(st.sampled_from(list(Cycle)), st.booleans(), st.integers(1, 3)).map(
+        lambda a: ("status", a[2], wire.status_levels(*a))),
+    st.tuples(st.integers(0, 0xFF), st.sampled_from(list(Cycle)), st.booleans()).map(
+        lambda a: ("data", 0, wire.telegram_levels([wire.data_telegram(*a)], wire.DATA_TELEGRAM_BITS))),
+    st.tuples(st.sampled_from([wire.START_LEVEL, wire.IDLE_LEVEL]), st.integers(1, 40)).map(
+        lambda a: ("clocks", 0, np.full(a[1], a[0], dtype=np.uint8))),  # glitches, skews off the grid, a held line
+)
+"""Pieces of a return line: status telegrams (with how many), data telegrams (counter telegrams among them), and
+levels held for some clocks."""
+
+
+@settings(max_examples=4, deadline=None)
+@given(fast=st.integers(0, 1), pieces=st.lists(_PIECE, min_size=4, max_size=8))
+def test_the_return_watch_follows_its_model_every_clock(fast: int, pieces: list[tuple[str, int, Any]]) -> None:
+    """``ReturnWatchRtl`` (its bit grid's constants per rate, its counters without reset) equals ``ReturnWatch`` on
+    ``seen`` and ``busy`` every clock at both bit rates: status and data telegrams (counter telegrams among them),
+    glitches, skews off the bit grid, a line held at either level; with whole telegrams only, every status
+    telegram is seen and no data telegram."""
+    rate = BIT_RATES[fast]
+    line = np.concatenate([*(wire.levels_to_samples(levels, rate) if kind != "clocks" else levels
+                             for kind, _, levels in pieces), np.ones(2 * clocks_per_bit(fast), dtype=np.uint8)])
+    rows = [{"line": int(level), "fast": fast} for level in line]
+    assert run_amaranth_sim(ReturnWatchRtl, _Watch, rows).cycles == len(rows)
+    if all(kind != "clocks" for kind, _, _ in pieces):
+        model = _Watch()
+        assert sum(model.step(row)["seen"] for row in rows) == sum(n for _, n, _ in pieces)

@@ -42,6 +42,7 @@ __all__ = [
     "Wire",
     "clear_sequence",
     "sequence",
+    "shortest_latch_gap",
     "t0_clocks",
 ]
 
@@ -144,6 +145,16 @@ def t0_clocks(bit_rate: int) -> int:
     """t0 = t_Bit_IBS / 2 in 32 MHz clocks (Table 3-4): 32 at 500 kbit/s (1 MHz SCLK), 8 at 2 Mbit/s (4 MHz)."""
     check_choice("bit_rate", bit_rate, BIT_RATES, limit="Table 1-7")
     return wire.clocks_per_bit(bit_rate) // 2
+
+
+def shortest_latch_gap(bits: int, bit_rate: int) -> int:
+    """Clocks between the latches of two valid data cycles of a chip in an SPI master mode with ``bits`` (16 or 32)
+    per transfer at ``bit_rate``, at the least (SM-12): the second cycle's whole frame passes the chip between them
+    (its telegrams follow the first one's latch telegrams on the ring), with the loopback word, at least the chip's
+    own ``bits // 8`` data bytes (the OUT word's, SM-4) and the check sequence (``wire.frame_bits``)."""
+    check_choice("bits", bits, (16, 32), limit="Tables 2-4 to 2-6")
+    check_choice("bit_rate", bit_rate, BIT_RATES, limit="Table 1-7")
+    return wire.frame_bits(wire.LOOPBACK_BYTES + bits // 8) * wire.clocks_per_bit(bit_rate)
 
 
 @dataclass(frozen=True)

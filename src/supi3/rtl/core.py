@@ -385,9 +385,9 @@ class Supi3Core(wiring.Component):
             m.d.sync += connected.eq(0)
         with m.Elif(running & (di3 == wire.START_LEVEL)):
             m.d.sync += connected.eq(1)
-        tx_watch = ReturnWatchRtl(len(cpb))
+        tx_watch = ReturnWatchRtl()
         m.submodules.tx_watch = ResetInserter(~running)(tx_watch)
-        m.d.comb += [tx_watch.line.eq(lines.do2), tx_watch.cpb.eq(cpb)]
+        m.d.comb += [tx_watch.line.eq(lines.do2), tx_watch.fast.eq(lines.fast)]
         sel3 = Signal()
         sel2 = Signal(2, init=_SENT)
         # DI3's idle clocks up to BRANCH_DRAIN_BITS bit periods, counted up as an LFSR (lfsr.count_state)

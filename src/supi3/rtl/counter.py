@@ -14,13 +14,11 @@ into ``Supi3Core`` (docs/rtl.md, "Counter telegram block").
 
 from __future__ import annotations
 
-import functools
-import operator
 from collections.abc import Callable
 from itertools import pairwise
 from typing import Final
 
-from amaranth.hdl import Cat, Const, Module, Mux, ResetInserter, Signal, Value
+from amaranth.hdl import Array, Cat, Const, Module, Mux, ResetInserter, Signal, Value
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
@@ -110,11 +108,11 @@ class LineQueue:
                 result = Mux(rate == k, pick(*entry), result)
             return result
 
-        # the oldest waiting bit begins on the line in the next cycle (``begins`` clocks after its push)
+        # the oldest waiting bit (entry ``waiting - 1``, chosen by ``waiting``: one compare, not one per entry)
+        # begins on the line in the next cycle (``begins`` clocks after its push)
         due = (now + by_rate(lambda begins, _: (1 - begins) % (1 << bits)))[:bits]
-        head = [(waiting == k + 1) & (stamp[k] == due) for k in range(slots)]
-        begin_now = Cat(*head).any()
-        oldest = functools.reduce(operator.or_, (Mux(h, v, 0) for h, v in zip(head, self.values, strict=True)))
+        begin_now = (waiting != 0) & (Array([stamp[0], *stamp])[waiting] == due)
+        oldest = Array([self.values[0], *self.values])[waiting]
         with m.If(begin_now):
             sync += [sent.eq(oldest), left.eq(by_rate(lambda _, length: down_state(length, left_width)))]
         with m.Else():
@@ -282,9 +280,9 @@ class CounterLinesRtl(wiring.Component):
         forward, back = CounterRtl(shared_clock=True), CounterRtl(shared_clock=True)
         m.submodules.back = ResetInserter(self.clear | ~self.run | ~self.looped)(back)
         on = self.forward | self.branch
-        watch = ReturnWatchRtl(_CPB[0].bit_length())
+        watch = ReturnWatchRtl()
         m.submodules.watch = ResetInserter(self.clear | ~self.run)(watch)
-        m.d.comb += [watch.line.eq(self.branch_line), watch.cpb.eq(Mux(self.fast, _CPB[1], _CPB[0])),
+        m.d.comb += [watch.line.eq(self.branch_line), watch.fast.eq(self.fast),
                      self.returned.eq(watch.seen), self.branch_busy.eq(watch.busy)]  # fmt: skip
         m.submodules.forward = ResetInserter(self.clear | ~self.run | ~on)(forward)
         stages = [Signal(init=wire.IDLE_LEVEL, name=f"source_s{k}") for k in range(SYNC_STAGES)]

@@ -8,9 +8,11 @@ and the /Conv pulse (their offsets, whole t0 all, are constants taken from the s
 counters ``sub`` (clock within a t0), ``within`` (slot within a byte of nine slots) and ``lead`` (the half t0
 before a frame's first slot) give SCLK, the SerOut shifts and the sample points.
 
-* ``start`` (the core's latch of a valid data cycle) with ``out_word``: a sequence begins on the next cycle (SM-2);
-  while one runs, the word waits (one deep, the newest wins) and its sequence begins on the cycle after the running
-  one ends.
+* ``start`` (the core's latch of a valid data cycle) with ``out_word``: a sequence begins on the next cycle (SM-2).
+  While a clear sequence runs the word waits (one deep, the newest wins) and its sequence begins on the cycle after
+  the clear sequence ends; a start while a data sequence runs abandons it (nothing taken over) and begins anew
+  (SM-12), which INTERBUS cycles never ask: two valid data cycles' latches are a whole frame apart, longer than
+  every sequence (:func:`~supi3.serial_io.shortest_latch_gap`, checked at elaboration).
 * ``reset`` (INTERBUS reset or watchdog reset of process data): the running sequence is aborted, a waiting one
   dropped, the IN word cleared, and the clear sequence of the mode (:func:`~supi3.serial_io.clear_sequence`,
   none in input mode) begins on the next cycle (SM-9). A ``start`` at the same edge wins (the core applies a latch
@@ -23,6 +25,7 @@ before a frame's first slot) give SCLK, the SerOut shifts and the sample points.
 from __future__ import annotations
 
 import itertools
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Final
 
@@ -101,12 +104,11 @@ def _in_slots(seq: spec.SerialSequence, t0: int) -> _Slots:
     def frame(name: str, frame: spec.SerialFrame | None) -> tuple[int, int] | None:
         return None if frame is None else slots(name, frame.start, frame.end)
 
-    return _Slots(
-        slots("length", 0, seq.length)[1],
-        frame("read frame", seq.read),
-        frame("write frame", seq.write),
-        None if seq.conv is None else slots("/Conv pulse", *seq.conv),
-    )
+    length = slots("length", 0, seq.length)[1]
+    conv = None if seq.conv is None else slots("/Conv pulse", *seq.conv)
+    if conv is not None and conv != (length - 1, length):  # the block shows /Conv in the last slot (Table 3-4 t7)
+        raise ValueError(f"a sequence's /Conv pulse must be its last t0, not slots {conv} of {length}")
+    return _Slots(length, frame("read frame", seq.read), frame("write frame", seq.write), conv)
 
 
 class SerialIoRtl(wiring.Component):
@@ -126,6 +128,12 @@ class SerialIoRtl(wiring.Component):
                 raise ValueError(f"a SerIn sample needs SYNC_STAGES < t0/2 + 1, not t0 = {t0}")
         self.slots = {key: _in_slots(seq, self.t0s[key[2]]) for key, seq in self.schedules.items() if seq is not None}
         self.longest = max(constants.length for constants in self.slots.values())
+        for (kind, wide, rate), seq in self.schedules.items():
+            gap = spec.shortest_latch_gap(WIDTHS[wide], BIT_RATES[rate])
+            if kind < _CLEAR and seq is not None and seq.length > gap:
+                self._MustUse__silence = True  # rejected, never elaborated: no "created but never used" warning
+                raise ValueError(f"a data sequence of {seq.length} clocks must end within {gap} clocks, the shortest "
+                                 "time between two valid data cycles' latches (SM-12)")  # fmt: skip
         super().__init__({
             "start": In(1), "out_word": In(WORD_BITS), "reset": In(1), "ser_in": In(1),
             "direction": In(range(len(DIRECTIONS))), "wide": In(1), "rate": In(range(len(BIT_RATES))),
@@ -147,17 +155,21 @@ class SerialIoRtl(wiring.Component):
         kind = Signal(range(2 * _CLEAR), reset_less=True)
         read_on, write_on, conv_on = Signal(), Signal(), Signal()
         read_start, read_end, write_start, write_end = (Signal(slot_range, name=n) for n in ("rs", "re", "ws", "we"))
-        conv_start, conv_end, length = Signal(slot_range), Signal(slot_range), Signal(slot_range)
+        final = Signal(slot_range)  # the sequence's last slot
+        write_after = Signal()  # the write frame follows a read frame, from the slot after ``write_before``
+        write_before = Signal(slot_range)
         cases: dict[_Slots, list[int]] = {}
         for (kind_value, wide, rate), constants in self.slots.items():
             cases.setdefault(constants, []).append(kind_value | (wide << len(kind)) | (rate << (len(kind) + 1)))
         with m.Switch(Cat(kind, self.wide, self.rate)):
             for constants, patterns in cases.items():
                 with m.Case(*patterns):
-                    comb += length.eq(constants.length)
+                    comb += final.eq(constants.length - 1)
+                    if constants.write is not None and constants.write[0] > 0:
+                        comb += [write_after.eq(1), write_before.eq(constants.write[0] - 1)]
+                    comb += conv_on.eq(constants.conv is not None)  # in the last slot (``_in_slots``)
                     for frame, on, first, end in ((constants.read, read_on, read_start, read_end),
-                                                  (constants.write, write_on, write_start, write_end),
-                                                  (constants.conv, conv_on, conv_start, conv_end)):  # fmt: skip
+                                                  (constants.write, write_on, write_start, write_end)):  # fmt: skip
                         if frame is not None:
                             comb += [on.eq(1), first.eq(frame[0]), end.eq(frame[1])]
         # Sequences a reset starts: the clear sequence of this mode's direction, if it has one.
@@ -166,11 +178,13 @@ class SerialIoRtl(wiring.Component):
             for direction in range(_CLEAR):
                 with m.Case(direction):
                     comb += has_clear.eq(schedule(_CLEAR + direction, WIDTHS[0], BIT_RATES[0]) is not None)
-        t0 = Signal(range(max(self.t0s) + 1))
-        with m.Switch(self.rate):
-            for rate, value in enumerate(self.t0s):
-                with m.Case(rate):
-                    comb += t0.eq(value)
+
+        def per_t0(pick: Callable[[int], int | Value]) -> Value:
+            """``pick(t0)`` at the ``rate`` port's t0: a constant, or a compare with one, per rate."""
+            result = Value.cast(pick(self.t0s[0]))
+            for rate, t0 in enumerate(self.t0s[1:], 1):
+                result = Mux(self.rate == rate, pick(t0), result)
+            return result
 
         # Counters ---------------------------------------------------------------------------------------------
         # Every frame and /Conv edge of a sequence falls on a whole t0 from its first cycle (``_in_slots``), so the
@@ -179,33 +193,29 @@ class SerialIoRtl(wiring.Component):
         # t0/2 and each begins on a whole t0), so that clock is the one with ``sub == t0/2 - 1``.
         slot = Signal(slot_range, reset_less=True)
         sub = Signal(range(max(self.t0s)), reset_less=True)  # clock within a t0, 0 at a bit slot's first cycle
-        slot_ends = sub == (t0 >> 1) - 1
+        slot_ends = per_t0(lambda t0: sub == (t0 >> 1) - 1)
         lead = Signal(reset_less=True)  # the half t0 between /SS falling and the first slot
         within = Signal(range(spec.BYTE_SLOTS), reset_less=True)  # slot within a byte: bits 0..7, then the pause slot
         pause = within == spec.BYTE_SLOTS - 1
         in_read = busy & read_on & (slot >= read_start) & (slot < read_end)
         in_write = busy & write_on & (slot >= write_start) & (slot < write_end)
         in_frame = in_read | in_write
-        high = sub >= (t0 >> 1)
-        # The shift registers and the waiting word are written before they are read: every sequence loads
-        # ``out_shift`` (a clear sequence sends 0s whatever it holds: ``clearing``), a read frame shifts a whole
-        # word into ``in_shift`` (a 16-bit word's upper half is left out when taken over), ``pending`` says when
-        # the waiting word counts: no reset, no clear. A 16-bit word is sent from bit 15 (the bits above are not
-        # sent), so the OUT word is loaded as it comes. Every start's word goes to ``pending_word`` and
-        # ``out_shift`` takes it there on the clock after its sequence began (``loading``): SerOut shows it only
-        # after a frame's lead half t0 (at least one clock), and this spares a 32-bit choice between the word now
-        # and the waiting one.
+        high = per_t0(lambda t0: sub >= (t0 >> 1))
+        # The shift registers are written before they are read: every start loads ``out_shift`` (a clear sequence
+        # sends 0s whatever it holds, ``clearing``, and leaves it alone), a read frame shifts a whole word into
+        # ``in_shift`` (a 16-bit word's upper half is left out when taken over): no reset, no clear. A 16-bit word
+        # is sent from bit 15 (the bits above are not sent), so the OUT word is loaded as it comes. A start while a
+        # clear sequence runs waits in ``out_shift`` (``pending``; the newest wins), one while a data sequence runs
+        # abandons it (SM-12): no second word register.
         out_shift = Signal(WORD_BITS, reset_less=True)
         in_shift = Signal(WORD_BITS, reset_less=True)
         pending = Signal()
-        pending_word = Signal(WORD_BITS, reset_less=True)
-        loading = Signal(reset_less=True)
         clearing = kind >= _CLEAR
         frame_probe = spec.SerialFrame(0, WIDTHS[0], False, max(self.t0s))
         sample_after = frame_probe.sample(0) + SYNC_STAGES - frame_probe.rising(0)  # clocks after SCLK rose
 
         levels = {
-            "conv_n": ~(busy & conv_on & (slot >= conv_start) & (slot < conv_end)),
+            "conv_n": ~(busy & conv_on & (slot == final)),
             "sclk": in_frame & ~lead & ~pause & high,
             "ss_n": ~in_frame,
             "ser_out": in_write & ~lead & ~clearing & Mux(self.wide, out_shift[-1], out_shift[WIDTHS[0] - 1]),
@@ -215,37 +225,36 @@ class SerialIoRtl(wiring.Component):
 
         def frame_begins() -> list[Value]:
             """The slot counters as they stand in a frame's first cycle: in the lead half t0."""
-            return [sub.eq(t0 >> 1), lead.eq(1), within.eq(0)]
+            return [sub.eq(per_t0(lambda t0: t0 >> 1)), lead.eq(1), within.eq(0)]
 
-        last = busy & slot_ends & (slot == length - 1)
+        last = busy & slot_ends & (slot == final)
         with m.If(busy):
             with m.If(slot_ends):
                 sync += slot.eq(slot + 1)
-            with m.If(sub == t0 - 1):
+            with m.If(per_t0(lambda t0: sub == t0 - 1)):
                 sync += sub.eq(0)
                 with m.If(lead):
                     sync += lead.eq(0)
                 with m.Else():
                     sync += within.eq(Mux(pause, 0, within + 1))
-                    with m.If(in_write & (within != spec.BYTE_SLOTS - 2)):  # the next slot carries bit j > 0
+                    with m.If(in_write & ~clearing & (within != spec.BYTE_SLOTS - 2)):  # the next slot: bit j > 0
                         sync += out_shift.eq(out_shift << 1)
             with m.Else():
                 sync += sub.eq(sub + 1)
-            with m.If(in_read & ~lead & ~pause & (sub == (t0 >> 1) + sample_after)):
+            with m.If(in_read & ~lead & ~pause & per_t0(lambda t0: sub == (t0 >> 1) + sample_after)):
                 sync += in_shift.eq(Cat(self.ser_in, in_shift[:-1]))
-            with m.If(write_on & slot_ends & (slot + 1 == write_start)):
+            with m.If(write_after & slot_ends & (slot == write_before)):
                 sync += frame_begins()
         with m.If(last):
             sync += busy.eq(0)
             with m.If(read_on):
                 sync += self.in_word.eq(Mux(self.wide, in_shift, in_shift[: WIDTHS[0]]))
 
-        # Start, pending start, reset (SM-2, SM-9) -------------------------------------------------------------
-        free = ~busy | last | self.reset
-        want = self.start | (pending & ~self.reset)
-        go = want & free
+        # Start, waiting start, reset (SM-2, SM-9, SM-12) -------------------------------------------------------
+        free = ~busy | ~clearing | last | self.reset  # a running data sequence is abandoned (SM-12)
+        go = (self.start | (pending & ~self.reset)) & free
         with m.If(self.start):
-            sync += pending_word.eq(self.out_word)
+            sync += out_shift.eq(self.out_word)
         with m.If(self.start & ~free):
             sync += pending.eq(1)
         with m.If(self.reset):
@@ -265,7 +274,4 @@ class SerialIoRtl(wiring.Component):
                 pending.eq(0),
                 *frame_begins(),
             ]
-        sync += loading.eq(go)
-        with m.If(loading):
-            sync += out_shift.eq(pending_word)
         return m

@@ -13,24 +13,24 @@ holds this block to, cycle by cycle.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Final
 
 from amaranth.hdl import Const, Module, Mux, Signal, Value
 from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
-from supi3.checks import check_int
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.wire import BK_STATUS_CLOSED_BIT, BK_STATUS_CONF_BIT, COUNTER_MAX, BranchControl
 from supi3.lbd import clocks_per_bit
-from supi3.rtl.lfsr import TAPS, before, next_state
+from supi3.rtl.lfsr import TAPS, before, count_state, count_width, next_state
 from supi3.terminal import BLOCK_INPUTS, BLOCK_OUTPUTS, BRANCH_SILENCE_CLOCKS, RF_CODES, TerminalMode, silence_limit
 
 __all__ = ["ReturnWatchRtl", "TerminalRtl"]
 
-_CPB_BITS: Final[int] = clocks_per_bit(0).bit_length()
-"""Bits of a ``cpb`` port: the clocks per bit of 500 kbit/s (64, Table 1-7)."""
+_CPB: Final = (clocks_per_bit(0), clocks_per_bit(1))
+"""Clocks per bit by the ``fast`` port (Table 1-7)."""
 
 
 class TerminalRtl(wiring.Component):
@@ -84,12 +84,16 @@ class TerminalRtl(wiring.Component):
         alarm = Signal()
         fresh = Signal(init=1)
         # the silence timer counts the clocks since it was restarted as an LFSR (supi3.rtl.lfsr): ``idle`` is its 0,
-        # and it is at the state 1 when the silence ends (time_limit - 1 clocks on), where it holds; ``heard``: the
-        # return line was heard (or not watched) since the last frame's end (model: silence_edge, BK-50)
+        # and it is at the state 1 when the silence ends (time_limit - 1 clocks on); ``over`` holds that it was (the
+        # timer steps on, no hold); ``heard``: the return line was heard (or not watched) since the last frame's end
+        # (model: silence_edge, BK-50). The three are read only while the extended function counts, which starts
+        # with ``extended`` at 0 after a reset: set (restarted) on every edge before, so no reset.
         width = max(min(TAPS), self.time_limit.bit_length())
         idle = before(self.time_limit - 1, width)
-        timer = Signal(width, init=idle)
-        heard = Signal(init=1)
+        timer = Signal(width, reset_less=True)
+        over = Signal(reset_less=True)
+        heard = Signal(reset_less=True)
+        ended = over | (timer == 1)  # the silence has lasted the limit
 
         # Outputs from the state ---------------------------------------------------------------------------------
         bk = self.mode != TerminalMode.NONE
@@ -115,7 +119,7 @@ class TerminalRtl(wiring.Component):
         counting = extended & on
         restart = self.ret_valid | cmd_on
         ends = self.frame_end
-        expired = counting & ends & ~heard & ~restart & (timer == 1)  # BK-50: judged at a frame's end only
+        expired = counting & ends & ~heard & ~restart & ended  # BK-50: judged at a frame's end only
         with m.If(bk):
             with m.If(fresh):  # power_up: the CONF level, no edge
                 sync += [fresh.eq(0), conf.eq(self.conf)]
@@ -125,7 +129,7 @@ class TerminalRtl(wiring.Component):
                     sync += conf_request.eq(1)
                 with m.If(self.ib_reset):  # reset: all but the CONF level and the request
                     sync += [switched_on.eq(1), extended.eq(0), closed.eq(0), closed_report.eq(0), count.eq(0),
-                             alarm.eq(0), timer.eq(idle), heard.eq(1)]  # fmt: skip
+                             alarm.eq(0), timer.eq(idle), over.eq(0), heard.eq(1)]  # fmt: skip
                 with m.Else():
                     with m.If(self.cmd_valid):  # command
                         with m.If(self.alarm_set):
@@ -144,55 +148,59 @@ class TerminalRtl(wiring.Component):
                     with m.If(expired & ~cmd_off):  # silence, on the state after the command (watching)
                         sync += [closed.eq(1), closed_report.eq(1)]
                     with m.If(~counting | (ends & (heard | expired))):  # the silence (re)starts here
-                        sync += [timer.eq(idle), heard.eq(~counting | restart)]
+                        sync += [timer.eq(idle), over.eq(0), heard.eq(~counting | restart)]
                     with m.Else():
-                        sync += [timer.eq(Mux(timer == 1, timer, next_state(timer))), heard.eq(heard | restart)]
+                        sync += [timer.eq(next_state(timer)), over.eq(ended), heard.eq(heard | restart)]
         return m
 
 
 class ReturnWatchRtl(wiring.Component):
     """The master's telegrams back on the branch return line (BK-38; the pin model's ``ReturnWatch`` in
-    ``src/supi3/model/blocks/terminal.py``, whose docstring is the behaviour): ``line`` the synchronised DI3, ``cpb``
-    clocks per bit; ``seen`` is 1 in the cycle after a status telegram's stop bit was sampled at the idle level;
-    ``busy`` is 1 while a telegram is under way (``ReturnWatch.busy``: begun, its stop bit not yet sampled).
+    ``src/supi3/model/blocks/terminal.py``, whose docstring is the behaviour): ``line`` the synchronised DI3, ``fast``
+    the bit rate (a strap: 1 is 2 Mbit/s, ``supi3.lbd.clocks_per_bit``); ``seen`` is 1 in the cycle after a status
+    telegram's stop bit was sampled at the idle level; ``busy`` is 1 while a telegram is under way
+    (``ReturnWatch.busy``: begun, its stop bit not yet sampled).
 
-    Parameters
-    ----------
-    cpb_width:
-        The width of the ``cpb`` port: :data:`_CPB_BITS` at least, to hold the clocks per bit of 500 kbit/s.
+    The bit grid's end and mid-bit sample are constants per rate (one compare each); the bit within a telegram
+    counts up as an LFSR (:mod:`supi3.rtl.lfsr`: only set to constants, stepped and compared with constants); it,
+    the clock within a bit and the telegram's type have no reset: they are set where a telegram begins and read
+    only while ``busy``, which has one.
     """
 
-    def __init__(self, cpb_width: int) -> None:
-        try:
-            check_int("cpb_width", cpb_width, _CPB_BITS, limit="bits: cpb holds 64 clocks per bit at 500 kbit/s")
-        except ArgumentError:
-            self._MustUse__silence = True  # rejected, never elaborated: no "created but never used" warning
-            raise
-        super().__init__({"line": In(1), "cpb": In(cpb_width), "seen": Out(1), "busy": Out(1)})
+    def __init__(self) -> None:
+        super().__init__({"line": In(1), "fast": In(1), "seen": Out(1), "busy": Out(1)})
 
     def elaborate(self, _platform: object) -> Module:
         m = Module()
         sync = m.d.sync
         busy = Signal()
-        data = Signal()
-        bit = Signal(range(wire.DATA_TELEGRAM_BITS))
-        phase = Signal.like(self.cpb)
+        data = Signal(reset_less=True)
+        bit_width = count_width(wire.DATA_TELEGRAM_BITS)
+        bit = Signal(bit_width, reset_less=True)
+        phase = Signal(range(max(_CPB)), reset_less=True)
         seen = Signal()
+
+        def at_rate(test: Callable[[int], Value]) -> Value:
+            return Mux(self.fast, test(_CPB[1]), test(_CPB[0]))
+
+        def bit_is(position: int) -> int:
+            return count_state(position, bit_width)
+
         start = ~busy & (self.line == wire.START_LEVEL)
         now = Mux(start, 0, phase)
         sync += seen.eq(0)
         with m.If(busy | start):
-            sync += [busy.eq(1), phase.eq(Mux(now >= self.cpb - 1, 0, now + 1))]
-            with m.If(now == self.cpb >> 1):
-                k = Mux(start, 0, bit)
-                sync += bit.eq(k + 1)
-                with m.If(k == wire.POS_START), m.If(self.line != wire.START_LEVEL):
+            sync += [busy.eq(1), phase.eq(Mux(at_rate(lambda cpb: now == cpb - 1), 0, now + 1))]
+            with m.If(at_rate(lambda cpb: now == cpb >> 1)):
+                k = Mux(start, bit_is(0), bit)
+                sync += bit.eq(next_state(k))
+                with m.If(k == bit_is(wire.POS_START)), m.If(self.line != wire.START_LEVEL):
                     sync += busy.eq(0)
-                with m.Elif(k == wire.POS_TYPE):
+                with m.Elif(k == bit_is(wire.POS_TYPE)):
                     sync += data.eq(self.line == wire.TYPE_DATA_LEVEL)
-                with m.Elif(k == Mux(data, wire.DATA_TELEGRAM_BITS - 1, wire.STATUS_TELEGRAM_BITS - 1)):
+                with m.Elif(k == Mux(data, bit_is(wire.DATA_TELEGRAM_BITS - 1), bit_is(wire.STATUS_TELEGRAM_BITS - 1))):
                     sync += [seen.eq(~data & (self.line == wire.IDLE_LEVEL)), busy.eq(0)]
             with m.Elif(start):
-                sync += bit.eq(0)
+                sync += bit.eq(bit_is(0))
         m.d.comb += [self.seen.eq(seen), self.busy.eq(busy)]
         return m

@@ -6,8 +6,9 @@ Manual: 3.3 (serial I/O, SPI master mode), Table 3-3 (the MFP pins), Table 3-4 (
 this block places the sequences in time and takes SerIn in. Decisions: SM-1 to SM-11 of
 ``docs/assumptions/serial-io.md``:
 
-* a sequence starts on the cycle after the edge that latches a valid data cycle; a latch while one runs waits, one
-  deep, the newest OUT word winning (SM-2);
+* a sequence starts on the cycle after the edge that latches a valid data cycle; a latch while a clear sequence
+  runs waits, one deep, the newest OUT word winning (SM-2); one while a data sequence runs abandons it and starts
+  anew (SM-12: INTERBUS cycles never ask it);
 * SerIn bit ``j`` is the level of the cycle before SCLK rises, taken through the synchroniser at the tick of cycle
   ``S + frame.sample(j) + SYNC_STAGES``; with a device attached to the chip
   (:meth:`supi3.model.chip.Supi3.attach_serial`) the device's answer in that cycle instead (SM-5, SM-10);
@@ -87,8 +88,8 @@ class SerialIo:
     """
 
     __slots__ = (
-        "_answer", "_cycles", "_device", "_end", "_feed_i", "_given", "_j", "_lag", "_levels", "_mfp", "_pending",
-        "_read", "_samples", "_word", "chip", "clear_sequence", "due", "keep_from", "sequence",
+        "_answer", "_clearing", "_cycles", "_device", "_end", "_feed_i", "_given", "_j", "_lag", "_levels", "_mfp",
+        "_pending", "_read", "_samples", "_word", "chip", "clear_sequence", "due", "keep_from", "sequence",
     )  # fmt: skip
 
     def __init__(self, chip: Supi3) -> None:
@@ -111,6 +112,7 @@ class SerialIo:
 
     def _stop(self) -> None:
         self._pending: int | None = None
+        self._clearing = False  # the running sequence is a clear sequence
         self._samples: list[int] = []
         self._read = False
         self._j = 0
@@ -134,10 +136,12 @@ class SerialIo:
         self._stop()
 
     def start(self, c: int, word: int) -> None:
-        """A valid data cycle latched ``word`` (the OUT word) at the edge ending cycle ``c`` (SM-2)."""
+        """A valid data cycle latched ``word`` (the OUT word) at the edge ending cycle ``c`` (SM-2, SM-12)."""
         if self.running:
-            self._pending = word  # one deep: the newest OUT word wins
-            return
+            if self._clearing:
+                self._pending = word  # one deep: the newest OUT word wins
+                return
+            self.power_up(c)  # a data sequence is abandoned, nothing taken over (SM-12)
         self._begin(c + 1, self.sequence, word)
 
     def clear(self, c: int) -> None:
@@ -146,6 +150,7 @@ class SerialIo:
         self.power_up(c)
         if self.clear_sequence is not None:
             self._begin(c + 1, self.clear_sequence, 0)
+            self._clearing = True
 
     def clock(self, c: int, mfp_in: int) -> None:
         """The tick ending cycle ``c`` = :attr:`due`, with the synchronised MFP inputs ``mfp_in``."""
