@@ -80,11 +80,12 @@ def _matches(pattern: str, bits: str) -> bool:
 
 def rtl_decode(tables: CoreTables, combination: tuple[str, str | None, str | None, str, str | None]) -> tuple[
         ModeEntry | None, ClockEntry, bool, bool]:  # fmt: skip
-    """What the RTL's strap decode selects for ``combination``: the first mode row whose pattern matches C[4..0]
-    and MFP[15..12] (``Switch``/``Case``), the clock row of CLK_CONF or the first (reserved values), the flags."""
+    """What the RTL's strap decode selects for ``combination``: the mode row of the strap ROM's entry for C[4..0]
+    and MFP[15..12] (:attr:`CoreTables.strap_modes`), the clock row of CLK_CONF or the first (reserved values), the
+    flags."""
     c, mfp, rf, clk, diag = combination
-    bits = c + (mfp if mfp is not None else "0" * pinout.EXPANSION_BITS)
-    mode = next((entry for entry in tables.modes if _matches(entry.pattern, bits)), None)
+    index = tables.strap_modes[int(c + (mfp if mfp is not None else "0" * pinout.EXPANSION_BITS), 2)]
+    mode = None if index is None else tables.modes[index]
     clock = next((entry for entry in tables.clocks if entry.clk_conf == int(clk, 2)), tables.clocks[0])
     rbst = int(rf or "0", 2) in tables.rbst_by_pin
     complete = int(diag or "0", 2) in tables.complete_diagnostics
@@ -126,6 +127,20 @@ def test_rtl_decode_equals_spec_derivation(variant: Variant) -> None:
         assert mode == mode_entry(config), combination
         assert clock == clock_entry(int(combination[3], 2), config), combination
         assert (rbst, complete) == (rbst_by_pin(config), complete_diagnostics(config)), combination
+
+
+@pytest.mark.parametrize("variant", VARIANTS)
+def test_strap_rom_selects_the_first_matching_row(variant: Variant) -> None:
+    """Every value of C[4..0] and MFP[15..12] addresses the first mode row whose pattern it matches (the order of
+    Tables 2-4 to 2-7), or no mode; every row is reached."""
+    tables = core_tables(variant)
+    width = pinout.C_BITS + pinout.EXPANSION_BITS
+    assert len(tables.strap_modes) == 1 << width
+    for value, index in enumerate(tables.strap_modes):
+        bits = format(value, f"0{width}b")
+        matching = [k for k, mode in enumerate(tables.modes) if _matches(mode.pattern, bits)]
+        assert index == (matching[0] if matching else None), bits
+    assert set(tables.strap_modes) - {None} == set(range(len(tables.modes)))
 
 
 @pytest.mark.parametrize("variant", VARIANTS)

@@ -280,23 +280,21 @@ class Supi3Core(wiring.Component):
         bus_terminal = Signal()  # a bus terminal module: LEDs on MFP15, 14, 13, 8 (Table 2-8)
         terminal_mode = Signal(range(len(TerminalMode)))  # which one (Table 2-7)
         maps = tables.io_maps
-        with m.Switch(Cat(self.mfp_in[MFP_PINS - EXPANSION_BITS :], self.c)):
-            for mode, serial, (watch, bk) in zip(tables.modes, tables.serial, tables.diagnostics, strict=True):
-                with m.Case(mode.pattern):
-                    m.d.comb += [local_bus.eq(watch), bus_terminal.eq(bk != TerminalMode.NONE), terminal_mode.eq(bk)]
-                    if serial is not None:
-                        m.d.comb += [
-                            spi.eq(1),
-                            spi_direction.eq(DIRECTIONS.index(serial.direction)),
-                            spi_wide.eq(WIDTHS.index(serial.bits)),
-                        ]
-                    m.d.comb += [
-                        strap_id.eq(mode.id_register),
-                        strap_bytes.eq(mode.data_bytes),
-                        init_up.eq(mode.init_up),
-                        io_map.eq(maps.index(mode.io_map)),
-                        self.mfp_oe.eq(mode.mfp_oe),
-                    ]
+        # One ROM word per strap value (reserved values: 0, no mode), looked up by the straps: smaller than a case
+        # per mode row (docs/rtl.md, round 4)
+        fields = (local_bus, bus_terminal, terminal_mode, spi, spi_direction, spi_wide, strap_id, strap_bytes, init_up,
+                  io_map, self.mfp_oe)  # fmt: skip
+        words = []
+        for index in tables.strap_modes:
+            values = (0,) * len(fields)
+            if index is not None:
+                mode, serial, (watch, bk) = tables.modes[index], tables.serial[index], tables.diagnostics[index]
+                direction, wide = (0, 0) if serial is None else (DIRECTIONS.index(serial.direction),
+                                                                  WIDTHS.index(serial.bits))  # fmt: skip
+                values = (watch, bk != TerminalMode.NONE, bk, serial is not None, direction, wide, mode.id_register,
+                          mode.data_bytes, mode.init_up, maps.index(mode.io_map), mode.mfp_oe)  # fmt: skip
+            words.append(Cat(*(Const(int(v), len(f)) for v, f in zip(values, fields, strict=True))))
+        m.d.comb += Cat(*fields).eq(Array(words)[Cat(self.mfp_in[MFP_PINS - EXPANSION_BITS :], self.c)])
         cycle = Signal(max(*IB_DIAG_DIVIDER_BITS.values(), *(_width(e.clocks_per_bit) for e in clocks)))
         m.d.sync += cycle.eq(cycle + 1)
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import cache
+from functools import cache, cached_property
 from typing import Final
 
 from supi3.checks import fail
@@ -161,6 +161,20 @@ class CoreTables:
     def io_maps(self) -> tuple[tuple[tuple[int | None, ...], tuple[int | None, ...]], ...]:
         """The distinct MFP maps, in first-use order."""
         return tuple(dict.fromkeys(mode.io_map for mode in self.modes))
+
+    @cached_property
+    def strap_modes(self) -> tuple[int | None, ...]:
+        """For every value of the mode straps C[4..0] and MFP[15..12] (C in the upper bits), the index of the first
+        mode whose :attr:`ModeEntry.pattern` it matches, or ``None`` (reserved): the address decode of the strap
+        ROM (docs/rtl.md, round 4: a lookup by the strap value synthesises smaller than one case per row)."""
+        width = C_BITS + EXPANSION_BITS
+        found: list[int | None] = []
+        for value in range(1 << width):
+            bits = _bits(value, width)
+            matches = (k for k, mode in enumerate(self.modes)
+                       if all(p in ("-", b) for p, b in zip(mode.pattern, bits, strict=True)))  # fmt: skip
+            found.append(next(matches, None))
+        return tuple(found)
 
     @property
     def register_bits(self) -> int:
