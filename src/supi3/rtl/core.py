@@ -516,11 +516,8 @@ class Supi3Core(wiring.Component):
         has_data = Signal()
         if up and self.variant is Variant.OPC:
             m.d.comb += ext.eq(init_up & self.ext_reg)
-            with m.Switch(self.bus_id[BYTE_BITS:]):  # the complete length code (Table 3-11)
-                for code in range(1 << len(self.bus_id[BYTE_BITS:])):
-                    if _code_bytes(code):
-                        with m.Case(code):
-                            m.d.comb += has_data.eq(1)
+            codes = range(1 << len(self.bus_id[BYTE_BITS:]))  # the complete length code (Table 3-11), a ROM
+            m.d.comb += has_data.eq(Array(Const(_code_bytes(code) > 0) for code in codes)[self.bus_id[BYTE_BITS:]])
         register = frame.register
         management = frame.management
         m.d.comb += [
@@ -551,10 +548,9 @@ class Supi3Core(wiring.Component):
         ]
         if up:
             up_bytes = Signal.like(strap_bytes)
-            with m.Switch(self.bus_id[BYTE_BITS:]):  # the length code (Table 3-11) as the register file applies it
-                for code, count in upif_tables().internal_bytes.items():
-                    with m.Case(code):
-                        m.d.comb += up_bytes.eq(count)
+            counts = [upif_tables().internal_bytes.get(code, 0) for code in range(1 << len(self.bus_id[BYTE_BITS:]))]
+            # the length code (Table 3-11) as the register file applies it, a ROM
+            m.d.comb += up_bytes.eq(Array(Const(count, len(up_bytes)) for count in counts)[self.bus_id[BYTE_BITS:]])
             with m.If(init_up):
                 # A18: the processor alarm in place of the ID code when the master asked for it
                 up_id = Mux(outputs.send_alarm, self.alarm, self.bus_id[:BYTE_BITS])
