@@ -19,7 +19,7 @@ import pytest
 
 from supi3 import pinout
 from supi3 import top as model_top
-from supi3.config import DeviceConfig, Variant, decode
+from supi3.config import DeviceConfig, Interface, Variant, decode
 from supi3.errors import ConfigurationError
 from supi3.interbus.wire import Cycle
 from supi3.model import chip as model_chip
@@ -42,6 +42,8 @@ from supi3.spi import upif as spi_upif
 from supi3.tables import BIT_RATES
 
 VARIANTS = list(Variant)
+LBD_INTERFACES = (Interface.LBD_MR, Interface.LBD_OR)
+"""The local bus with counter telegrams, Table 2-5: the chip runs the counter telegram blocks (BK-34)."""
 RTL_SOURCES = Path(rtl_tables.__file__).parent
 
 
@@ -125,6 +127,8 @@ def test_rtl_decode_equals_spec_derivation(variant: Variant) -> None:
         config = _config(variant, combination)
         mode, clock, rbst, complete = rtl_decode(tables, combination)
         assert mode == mode_entry(config), combination
+        lines = tables.lines[tables.modes.index(mode)]
+        assert lines == (config.interface in LBD_INTERFACES, config.interface is Interface.LBD_MR), combination
         assert clock == clock_entry(int(combination[3], 2), config), combination
         assert (rbst, complete) == (rbst_by_pin(config), complete_diagnostics(config)), combination
 

@@ -67,7 +67,7 @@ from supi3.pinout import (
 )
 from supi3.regmap import INTERRUPT_SOURCES
 from supi3.regmap.core import BYTE_BITS
-from supi3.rtl.counter import CounterLinesRtl, LineQueue, lbd_lines, stamp_bits
+from supi3.rtl.counter import CounterLinesRtl, LineQueue, stamp_bits
 from supi3.rtl.expansion import PIN_NAMES as EXPANSION_PINS
 from supi3.rtl.expansion import ExpansionRtl
 from supi3.rtl.lfsr import TAPS, Countdown, before, count_state, count_width, down_state, down_step, next_state
@@ -280,21 +280,29 @@ class Supi3Core(wiring.Component):
         bus_terminal = Signal()  # a bus terminal module: LEDs on MFP15, 14, 13, 8 (Table 2-8)
         terminal_mode = Signal(range(len(TerminalMode)))  # which one (Table 2-7)
         maps = tables.io_maps
+        lbd, lbd_mr = Signal(), Signal()  # an LBD mode, LBD-MR (Table 2-5): the counter telegram blocks run
+        serial = tables.serial
+        rom: tuple[tuple[Signal, Callable[[int], int]], ...] = (  # each field and its value in mode k
+            (lbd, lambda k: tables.lines[k][0]),
+            (lbd_mr, lambda k: tables.lines[k][1]),
+            (local_bus, lambda k: tables.diagnostics[k][0]),
+            (bus_terminal, lambda k: tables.diagnostics[k][1] != TerminalMode.NONE),
+            (terminal_mode, lambda k: tables.diagnostics[k][1]),
+            (spi, lambda k: serial[k] is not None),
+            (spi_direction, lambda k: 0 if (mode := serial[k]) is None else DIRECTIONS.index(mode.direction)),
+            (spi_wide, lambda k: 0 if (mode := serial[k]) is None else WIDTHS.index(mode.bits)),
+            (strap_id, lambda k: tables.modes[k].id_register),
+            (strap_bytes, lambda k: tables.modes[k].data_bytes),
+            (init_up, lambda k: tables.modes[k].init_up),
+            (io_map, lambda k: maps.index(tables.modes[k].io_map)),
+            (self.mfp_oe, lambda k: tables.modes[k].mfp_oe),
+        )
         # One ROM word per strap value (reserved values: 0, no mode), looked up by the straps: smaller than a case
         # per mode row (docs/rtl.md, round 4)
-        fields = (local_bus, bus_terminal, terminal_mode, spi, spi_direction, spi_wide, strap_id, strap_bytes, init_up,
-                  io_map, self.mfp_oe)  # fmt: skip
-        words = []
-        for index in tables.strap_modes:
-            values = (0,) * len(fields)
-            if index is not None:
-                mode, serial, (watch, bk) = tables.modes[index], tables.serial[index], tables.diagnostics[index]
-                direction, wide = (0, 0) if serial is None else (DIRECTIONS.index(serial.direction),
-                                                                  WIDTHS.index(serial.bits))  # fmt: skip
-                values = (watch, bk != TerminalMode.NONE, bk, serial is not None, direction, wide, mode.id_register,
-                          mode.data_bytes, mode.init_up, maps.index(mode.io_map), mode.mfp_oe)  # fmt: skip
-            words.append(Cat(*(Const(int(v), len(f)) for v, f in zip(values, fields, strict=True))))
-        m.d.comb += Cat(*fields).eq(Array(words)[Cat(self.mfp_in[MFP_PINS - EXPANSION_BITS :], self.c)])
+        words = [Cat(*(Const(0 if k is None else int(value(k)), len(field)) for field, value in rom))
+                 for k in tables.strap_modes]  # fmt: skip
+        straps = Cat(self.mfp_in[MFP_PINS - EXPANSION_BITS :], self.c)  # C[4..0] above MFP[15..12]
+        m.d.comb += Cat(*(field for field, _ in rom)).eq(Array(words)[straps])
         cycle = Signal(max(*IB_DIAG_DIVIDER_BITS.values(), *(_width(e.clocks_per_bit) for e in clocks)))
         m.d.sync += cycle.eq(cycle + 1)
 
@@ -360,7 +368,6 @@ class Supi3Core(wiring.Component):
         m.submodules.expansion = gated(expansion)
         # LBD modes (Table 2-5): the counter telegram blocks on DO2 and DI1 (docs/rtl.md, "Counter telegram block")
         m.submodules.counter_lines = lines = CounterLinesRtl()
-        lbd, lbd_mr = lbd_lines(m, Cat(self.mfp_in[MFP_PINS - EXPANSION_BITS :], self.c), self.variant)
         m.d.comb += [
             lines.line.eq(receiver.do1_s), lines.fast.eq(cpb == clocks_per_bit(1)), lines.sent.eq(transmitter.do2),
             lines.source.eq(outputs.di1), lines.forward.eq(lbd), lines.looped.eq(lbd_mr), lines.run.eq(running),

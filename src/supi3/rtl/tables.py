@@ -17,7 +17,7 @@ from functools import cache, cached_property
 from typing import Final
 
 from supi3.checks import fail
-from supi3.config import DataDirection, DeviceConfig, MfpKind, Variant, decode, mode_rows
+from supi3.config import DataDirection, DeviceConfig, Interface, MfpKind, Variant, decode, mode_rows
 from supi3.diagnostics import watches_line_interrupt
 from supi3.errors import ConfigurationError
 from supi3.interbus import wire
@@ -156,6 +156,9 @@ class CoreTables:
     diagnostics: tuple[tuple[bool, TerminalMode], ...]
     """For each mode, (it raises the line interrupt ahead, its bus terminal interface or NONE): ``supi3.diagnostics``
     (DG-3), ``supi3.terminal`` (Tables 2-7, 2-8)."""
+    lines: tuple[tuple[bool, bool], ...]
+    """For each mode, (an LBD mode: the counter telegram blocks run on the forward line, LBD-MR: on the return line
+    too), Table 2-5 (BK-34)."""
 
     @property
     def io_maps(self) -> tuple[tuple[tuple[int | None, ...], tuple[int | None, ...]], ...]:
@@ -299,4 +302,6 @@ def core_tables(variant: Variant | str = Variant.OPC) -> CoreTables:
         rbst = tuple(value for value, config in rf if rbst_by_pin(config))
         complete = tuple(value for value, config in diag if complete_diagnostics(config))
     diagnostics = tuple((watches_line_interrupt(config), TerminalMode.of(config.interface.value)) for config in configs)
-    return CoreTables(variant, modes, serial, tuple(clocks), rbst, complete, diagnostics)
+    lbd = (Interface.LBD_MR, Interface.LBD_OR)
+    lines = tuple((config.interface in lbd, config.interface is Interface.LBD_MR) for config in configs)
+    return CoreTables(variant, modes, serial, tuple(clocks), rbst, complete, diagnostics, lines)
