@@ -499,12 +499,24 @@ class Supi3Core(wiring.Component):
 
         # SPI master modes (3.3): the serial I/O block takes the OUT word of a valid data cycle's latch and gives
         # the IN word the next data cycle loads (SM-2, SM-4, SM-6); resets clear it (SM-9).
-        word_bits = {bits: [datapath.register[line_position(w, bits // 8)] for w in range(bits)] for bits in WIDTHS}
-        out_word = Mux(spi_wide, Cat(*word_bits[WIDTHS[1]]), Cat(*word_bits[WIDTHS[0]]))
+        # The word's bit w is the register's bit line_position(w, bytes) in either width. A 16-bit sequence reads
+        # only the OUT word's low 16 bits (SerOut from D15), and a 2-byte data cycle only the register's low 16 bits,
+        # so only those choose by the width; the rest are the 32-bit word's in both (round 4).
+        narrow, wide = WIDTHS
+        out_word = Signal(wide)
         in_data = Signal(tables.register_bits)
-        for bits in WIDTHS:
-            with m.If(spi_wide == WIDTHS.index(bits)):
-                m.d.comb += [in_data[line_position(w, bits // 8)].eq(serial_io.in_word[w]) for w in range(bits)]
+        in_word = serial_io.in_word
+        for w in range(wide):
+            at = line_position(w, wide // 8)
+            word_bit = datapath.register[at]
+            if w < narrow:
+                word_bit = Mux(spi_wide, word_bit, datapath.register[line_position(w, narrow // 8)])
+            m.d.comb += out_word[w].eq(word_bit)
+            if at < narrow:
+                in_bit = next(k for k in range(narrow) if line_position(k, narrow // 8) == at)
+                m.d.comb += in_data[at].eq(Mux(spi_wide, in_word[w], in_word[in_bit]))
+            else:
+                m.d.comb += in_data[at].eq(in_word[w])
         m.d.comb += [
             serial_io.start.eq(spi & frame.management.latch_data),
             serial_io.out_word.eq(out_word),
