@@ -75,3 +75,16 @@ def test_ports_are_the_spec_and_it_converts_to_verilog() -> None:
     assert header is not None
     ports = {port.strip(" \\") for port in header.group(1).split(",")}
     assert ports == {pin.name for pin in (*BLOCK_INPUTS, *BLOCK_OUTPUTS)} | {"clk", "rst"}
+
+
+def test_a_phase_decode_tells_its_code_from_every_other() -> None:
+    """The phase register compares only the bits that tell a phase's code apart (round 4): on every code the
+    register can hold exactly one phase decodes true, and no bit of a decode can be left out."""
+    codes = range(len(optical.PHASES))
+    for phase in optical.PHASES:
+        bits = optical._decode_bits(optical._phase(phase))
+        own = optical._phase(phase)
+        assert [all((c >> b & 1) == (own >> b & 1) for b in bits) for c in codes] == [c == own for c in codes]
+        for b in bits:  # leaving out any one bit lets another code through
+            narrower = [x for x in bits if x != b]
+            assert any(all((c >> x & 1) == (own >> x & 1) for x in narrower) for c in codes if c != own)

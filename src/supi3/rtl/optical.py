@@ -16,6 +16,7 @@ module docstring, OPT-25), which ``tests/test_verif_lockstep_optical.py`` holds 
 from __future__ import annotations
 
 import functools
+import itertools
 from dataclasses import dataclass
 from typing import Final
 
@@ -78,6 +79,15 @@ def _phase(phase: Phase) -> int:
 
 
 @functools.cache
+def _decode_bits(code: int) -> tuple[int, ...]:
+    """The fewest bits of the phase register whose values tell ``code`` from every other phase's code."""
+    width = (len(PHASES) - 1).bit_length()
+    others = [c for c in range(len(PHASES)) if c != code]
+    return next(bits for size in range(width + 1) for bits in itertools.combinations(range(width), size)
+                if all(any((code ^ other) >> b & 1 for b in bits) for other in others))  # fmt: skip
+
+
+@functools.cache
 def _clock_bits() -> int:
     """The narrowest count of clocks whose largest value already reads as :data:`~supi3.optical.length.LENGTH_MAX_CODE`
     at every bit rate and medium (its count is the clocks shifted right by :func:`_prescale_bits`): a timer of that
@@ -135,7 +145,10 @@ class _Tx:
         return [self.phase.eq(code), self.level.eq(level), self.passes.eq(0), self.mau.eq(mau)]
 
     def is_(self, phase: Phase) -> Value:
-        return self.phase == _phase(phase)
+        """The phase register holds ``phase``: a compare of only the bits that tell its code from the other codes
+        (:func:`_decode_bits`; the register holds no other value)."""
+        code = _phase(phase)
+        return Cat(*(self.phase[b] == (code >> b & 1) for b in _decode_bits(code))).all()
 
 
 def _start(mode: Value, present: Value) -> Value:
