@@ -38,16 +38,17 @@ def test_a_length_code_that_is_no_shift_is_refused(monkeypatch: pytest.MonkeyPat
         length_shift.__wrapped__(BIT_RATES[0], Medium.POLYMER)
 
 
-def test_the_rtl_timer_keeps_the_narrowest_count_that_gives_every_code() -> None:
-    """OPT-24: the RTL's 12 bits of count (of 14 bits of clocks at 500 kbit/s) read as code 63 when saturated at every
-    rate and medium, so its codes are the model's 14-bit count's; 11 bits would not."""
-    bits = optical._timer_bits()
-    shifts = [length_shift(rate, medium) for rate in BIT_RATES for medium in Medium]
+def test_the_rtl_timer_keeps_the_narrowest_clock_count_that_gives_every_code() -> None:
+    """OPT-24: the RTL's 12 bits of clocks (10 bits of count at 500 kbit/s, 12 at 2 Mbit/s) read as code 63 when all
+    ones at every rate and medium, so with its wrapped flag its codes are the model's 14-bit count's; 11 bits would
+    not."""
+    bits = optical._clock_bits()
+    reads = [(optical._prescale_bits(rate), length_shift(rate, medium)) for rate in BIT_RATES for medium in Medium]
     assert bits == 12
     for width, saturates in ((bits, True), (bits - 1, False)):
         count = (1 << width) - 1
-        assert all(min(LENGTH_MAX_CODE, count << s if s >= 0 else count >> -s) == LENGTH_MAX_CODE
-                   for s in shifts) is saturates  # fmt: skip
+        assert all(min(LENGTH_MAX_CODE, count >> p << s if s >= 0 else count >> p >> -s) == LENGTH_MAX_CODE
+                   for p, s in reads) is saturates  # fmt: skip
 
 
 def test_a_length_timer_enable_period_that_is_no_power_of_two_is_refused(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -74,3 +75,16 @@ def test_ports_are_the_spec_and_it_converts_to_verilog() -> None:
     assert header is not None
     ports = {port.strip(" \\") for port in header.group(1).split(",")}
     assert ports == {pin.name for pin in (*BLOCK_INPUTS, *BLOCK_OUTPUTS)} | {"clk", "rst"}
+
+
+def test_a_phase_decode_tells_its_code_from_every_other() -> None:
+    """The phase register compares only the bits that tell a phase's code apart (round 4): on every code the
+    register can hold exactly one phase decodes true, and no bit of a decode can be left out."""
+    codes = range(len(optical.PHASES))
+    for phase in optical.PHASES:
+        bits = optical._decode_bits(optical._phase(phase))
+        own = optical._phase(phase)
+        assert [all((c >> b & 1) == (own >> b & 1) for b in bits) for c in codes] == [c == own for c in codes]
+        for b in bits:  # leaving out any one bit lets another code through
+            narrower = [x for x in bits if x != b]
+            assert any(all((c >> x & 1) == (own >> x & 1) for x in narrower) for c in codes if c != own)

@@ -19,7 +19,7 @@ import pytest
 
 from supi3 import pinout
 from supi3 import top as model_top
-from supi3.config import DeviceConfig, Variant, decode
+from supi3.config import DeviceConfig, Interface, Variant, decode
 from supi3.errors import ConfigurationError
 from supi3.interbus.wire import Cycle
 from supi3.model import chip as model_chip
@@ -42,6 +42,8 @@ from supi3.spi import upif as spi_upif
 from supi3.tables import BIT_RATES
 
 VARIANTS = list(Variant)
+LBD_INTERFACES = (Interface.LBD_MR, Interface.LBD_OR)
+"""The local bus with counter telegrams, Table 2-5: the chip runs the counter telegram blocks (BK-34)."""
 RTL_SOURCES = Path(rtl_tables.__file__).parent
 
 
@@ -80,11 +82,12 @@ def _matches(pattern: str, bits: str) -> bool:
 
 def rtl_decode(tables: CoreTables, combination: tuple[str, str | None, str | None, str, str | None]) -> tuple[
         ModeEntry | None, ClockEntry, bool, bool]:  # fmt: skip
-    """What the RTL's strap decode selects for ``combination``: the first mode row whose pattern matches C[4..0]
-    and MFP[15..12] (``Switch``/``Case``), the clock row of CLK_CONF or the first (reserved values), the flags."""
+    """What the RTL's strap decode selects for ``combination``: the mode row of the strap ROM's entry for C[4..0]
+    and MFP[15..12] (:attr:`CoreTables.strap_modes`), the clock row of CLK_CONF or the first (reserved values), the
+    flags."""
     c, mfp, rf, clk, diag = combination
-    bits = c + (mfp if mfp is not None else "0" * pinout.EXPANSION_BITS)
-    mode = next((entry for entry in tables.modes if _matches(entry.pattern, bits)), None)
+    index = tables.strap_modes[int(c + (mfp if mfp is not None else "0" * pinout.EXPANSION_BITS), 2)]
+    mode = None if index is None else tables.modes[index]
     clock = next((entry for entry in tables.clocks if entry.clk_conf == int(clk, 2)), tables.clocks[0])
     rbst = int(rf or "0", 2) in tables.rbst_by_pin
     complete = int(diag or "0", 2) in tables.complete_diagnostics
@@ -124,8 +127,24 @@ def test_rtl_decode_equals_spec_derivation(variant: Variant) -> None:
         config = _config(variant, combination)
         mode, clock, rbst, complete = rtl_decode(tables, combination)
         assert mode == mode_entry(config), combination
+        lines = tables.lines[tables.modes.index(mode)]
+        assert lines == (config.interface in LBD_INTERFACES, config.interface is Interface.LBD_MR), combination
         assert clock == clock_entry(int(combination[3], 2), config), combination
         assert (rbst, complete) == (rbst_by_pin(config), complete_diagnostics(config)), combination
+
+
+@pytest.mark.parametrize("variant", VARIANTS)
+def test_strap_rom_selects_the_first_matching_row(variant: Variant) -> None:
+    """Every value of C[4..0] and MFP[15..12] addresses the first mode row whose pattern it matches (the order of
+    Tables 2-4 to 2-7), or no mode; every row is reached."""
+    tables = core_tables(variant)
+    width = pinout.C_BITS + pinout.EXPANSION_BITS
+    assert len(tables.strap_modes) == 1 << width
+    for value, index in enumerate(tables.strap_modes):
+        bits = format(value, f"0{width}b")
+        matching = [k for k, mode in enumerate(tables.modes) if _matches(mode.pattern, bits)]
+        assert index == (matching[0] if matching else None), bits
+    assert set(tables.strap_modes) - {None} == set(range(len(tables.modes)))
 
 
 @pytest.mark.parametrize("variant", VARIANTS)

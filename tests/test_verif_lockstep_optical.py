@@ -105,6 +105,17 @@ def test_lengths_media_and_resets(fast: int) -> None:
     assert block.status.length == (0, 0)
 
 
+def test_long_lengths_read_as_the_top_code() -> None:
+    """OPT-24: the RTL timer's 12 bits of clocks wrap at 4,096; a stop just before the wrap (the branch, polymer) and
+    one just after it (the outgoing interface, glass, which reads 63 only from 4,032 clocks at 2 Mbit/s) read as the
+    model's saturating count does, and a start at the edge of such a stop clears the wrap (short lengths after)."""
+    script = OpticalScript(REG, fast=1, medium=0b010).reset().idle(len_start=0b110).idle(4_093)
+    script.idle(len_stop=0b100, len_start=0b100).idle().idle(len_stop=0b010, len_start=0b010).idle(40)
+    assert run_optical(script.rows)[0].status.length == (63, 63)
+    block = lockstep(script.idle(len_stop=0b110).idle(2))
+    assert block.status.length == (0, 21)
+
+
 @pytest.mark.parametrize("limit", [1, 2, 300])
 def test_initialization_timeout(limit: int) -> None:
     """OPT-5, OPT-56: the incoming interface's budget runs out ``time_limit`` clocks after the start, the branch's

@@ -67,7 +67,7 @@ from supi3.pinout import (
 )
 from supi3.regmap import INTERRUPT_SOURCES
 from supi3.regmap.core import BYTE_BITS
-from supi3.rtl.counter import CounterLinesRtl, LineQueue, lbd_lines, stamp_bits
+from supi3.rtl.counter import CounterLinesRtl, LineQueue, stamp_bits
 from supi3.rtl.expansion import PIN_NAMES as EXPANSION_PINS
 from supi3.rtl.expansion import ExpansionRtl
 from supi3.rtl.lfsr import TAPS, Countdown, before, count_state, count_width, down_state, down_step, next_state
@@ -280,23 +280,29 @@ class Supi3Core(wiring.Component):
         bus_terminal = Signal()  # a bus terminal module: LEDs on MFP15, 14, 13, 8 (Table 2-8)
         terminal_mode = Signal(range(len(TerminalMode)))  # which one (Table 2-7)
         maps = tables.io_maps
-        with m.Switch(Cat(self.mfp_in[MFP_PINS - EXPANSION_BITS :], self.c)):
-            for mode, serial, (watch, bk) in zip(tables.modes, tables.serial, tables.diagnostics, strict=True):
-                with m.Case(mode.pattern):
-                    m.d.comb += [local_bus.eq(watch), bus_terminal.eq(bk != TerminalMode.NONE), terminal_mode.eq(bk)]
-                    if serial is not None:
-                        m.d.comb += [
-                            spi.eq(1),
-                            spi_direction.eq(DIRECTIONS.index(serial.direction)),
-                            spi_wide.eq(WIDTHS.index(serial.bits)),
-                        ]
-                    m.d.comb += [
-                        strap_id.eq(mode.id_register),
-                        strap_bytes.eq(mode.data_bytes),
-                        init_up.eq(mode.init_up),
-                        io_map.eq(maps.index(mode.io_map)),
-                        self.mfp_oe.eq(mode.mfp_oe),
-                    ]
+        lbd, lbd_mr = Signal(), Signal()  # an LBD mode, LBD-MR (Table 2-5): the counter telegram blocks run
+        serial = tables.serial
+        rom: tuple[tuple[Signal, Callable[[int], int]], ...] = (  # each field and its value in mode k
+            (lbd, lambda k: tables.lines[k][0]),
+            (lbd_mr, lambda k: tables.lines[k][1]),
+            (local_bus, lambda k: tables.diagnostics[k][0]),
+            (bus_terminal, lambda k: tables.diagnostics[k][1] != TerminalMode.NONE),
+            (terminal_mode, lambda k: tables.diagnostics[k][1]),
+            (spi, lambda k: serial[k] is not None),
+            (spi_direction, lambda k: 0 if (mode := serial[k]) is None else DIRECTIONS.index(mode.direction)),
+            (spi_wide, lambda k: 0 if (mode := serial[k]) is None else WIDTHS.index(mode.bits)),
+            (strap_id, lambda k: tables.modes[k].id_register),
+            (strap_bytes, lambda k: tables.modes[k].data_bytes),
+            (init_up, lambda k: tables.modes[k].init_up),
+            (io_map, lambda k: maps.index(tables.modes[k].io_map)),
+            (self.mfp_oe, lambda k: tables.modes[k].mfp_oe),
+        )
+        # One ROM word per strap value (reserved values: 0, no mode), looked up by the straps: smaller than a case
+        # per mode row (docs/rtl.md, round 4)
+        words = [Cat(*(Const(0 if k is None else int(value(k)), len(field)) for field, value in rom))
+                 for k in tables.strap_modes]  # fmt: skip
+        straps = Cat(self.mfp_in[MFP_PINS - EXPANSION_BITS :], self.c)  # C[4..0] above MFP[15..12]
+        m.d.comb += Cat(*(field for field, _ in rom)).eq(Array(words)[straps])
         cycle = Signal(max(*IB_DIAG_DIVIDER_BITS.values(), *(_width(e.clocks_per_bit) for e in clocks)))
         m.d.sync += cycle.eq(cycle + 1)
 
@@ -362,7 +368,6 @@ class Supi3Core(wiring.Component):
         m.submodules.expansion = gated(expansion)
         # LBD modes (Table 2-5): the counter telegram blocks on DO2 and DI1 (docs/rtl.md, "Counter telegram block")
         m.submodules.counter_lines = lines = CounterLinesRtl()
-        lbd, lbd_mr = lbd_lines(m, Cat(self.mfp_in[MFP_PINS - EXPANSION_BITS :], self.c), self.variant)
         m.d.comb += [
             lines.line.eq(receiver.do1_s), lines.fast.eq(cpb == clocks_per_bit(1)), lines.sent.eq(transmitter.do2),
             lines.source.eq(outputs.di1), lines.forward.eq(lbd), lines.looped.eq(lbd_mr), lines.run.eq(running),
@@ -494,12 +499,24 @@ class Supi3Core(wiring.Component):
 
         # SPI master modes (3.3): the serial I/O block takes the OUT word of a valid data cycle's latch and gives
         # the IN word the next data cycle loads (SM-2, SM-4, SM-6); resets clear it (SM-9).
-        word_bits = {bits: [datapath.register[line_position(w, bits // 8)] for w in range(bits)] for bits in WIDTHS}
-        out_word = Mux(spi_wide, Cat(*word_bits[WIDTHS[1]]), Cat(*word_bits[WIDTHS[0]]))
+        # The word's bit w is the register's bit line_position(w, bytes) in either width. A 16-bit sequence reads
+        # only the OUT word's low 16 bits (SerOut from D15), and a 2-byte data cycle only the register's low 16 bits,
+        # so only those choose by the width; the rest are the 32-bit word's in both (round 4).
+        narrow, wide = WIDTHS
+        out_word = Signal(wide)
         in_data = Signal(tables.register_bits)
-        for bits in WIDTHS:
-            with m.If(spi_wide == WIDTHS.index(bits)):
-                m.d.comb += [in_data[line_position(w, bits // 8)].eq(serial_io.in_word[w]) for w in range(bits)]
+        in_word = serial_io.in_word
+        for w in range(wide):
+            at = line_position(w, wide // 8)
+            word_bit = datapath.register[at]
+            if w < narrow:
+                word_bit = Mux(spi_wide, word_bit, datapath.register[line_position(w, narrow // 8)])
+            m.d.comb += out_word[w].eq(word_bit)
+            if at < narrow:
+                in_bit = next(k for k in range(narrow) if line_position(k, narrow // 8) == at)
+                m.d.comb += in_data[at].eq(Mux(spi_wide, in_word[w], in_word[in_bit]))
+            else:
+                m.d.comb += in_data[at].eq(in_word[w])
         m.d.comb += [
             serial_io.start.eq(spi & frame.management.latch_data),
             serial_io.out_word.eq(out_word),
@@ -518,11 +535,8 @@ class Supi3Core(wiring.Component):
         has_data = Signal()
         if up and self.variant is Variant.OPC:
             m.d.comb += ext.eq(init_up & self.ext_reg)
-            with m.Switch(self.bus_id[BYTE_BITS:]):  # the complete length code (Table 3-11)
-                for code in range(1 << len(self.bus_id[BYTE_BITS:])):
-                    if _code_bytes(code):
-                        with m.Case(code):
-                            m.d.comb += has_data.eq(1)
+            codes = range(1 << len(self.bus_id[BYTE_BITS:]))  # the complete length code (Table 3-11), a ROM
+            m.d.comb += has_data.eq(Array(Const(_code_bytes(code) > 0) for code in codes)[self.bus_id[BYTE_BITS:]])
         register = frame.register
         management = frame.management
         m.d.comb += [
@@ -553,10 +567,9 @@ class Supi3Core(wiring.Component):
         ]
         if up:
             up_bytes = Signal.like(strap_bytes)
-            with m.Switch(self.bus_id[BYTE_BITS:]):  # the length code (Table 3-11) as the register file applies it
-                for code, count in upif_tables().internal_bytes.items():
-                    with m.Case(code):
-                        m.d.comb += up_bytes.eq(count)
+            counts = [upif_tables().internal_bytes.get(code, 0) for code in range(1 << len(self.bus_id[BYTE_BITS:]))]
+            # the length code (Table 3-11) as the register file applies it, a ROM
+            m.d.comb += up_bytes.eq(Array(Const(count, len(up_bytes)) for count in counts)[self.bus_id[BYTE_BITS:]])
             with m.If(init_up):
                 # A18: the processor alarm in place of the ID code when the master asked for it
                 up_id = Mux(outputs.send_alarm, self.alarm, self.bus_id[:BYTE_BITS])

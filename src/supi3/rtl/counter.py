@@ -23,7 +23,6 @@ from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
 from supi3.checks import check_bool
-from supi3.config import Interface, Variant, decode, mode_rows
 from supi3.interbus import wire
 from supi3.lbd import (
     COUNTER_INPUTS,
@@ -39,10 +38,9 @@ from supi3.lbd import (
 )
 from supi3.pinout import SYNC_STAGES
 from supi3.rtl.lfsr import TAPS, count_state, count_width, down_state, down_step, next_state
-from supi3.rtl.tables import core_tables
 from supi3.rtl.terminal import ReturnWatchRtl
 
-__all__ = ["CLOCK_BITS", "CounterLinesRtl", "CounterRtl", "LineQueue", "lbd_lines", "stamp_bits"]
+__all__ = ["CLOCK_BITS", "CounterLinesRtl", "CounterRtl", "LineQueue", "stamp_bits"]
 
 _CPB: Final = (clocks_per_bit(0), clocks_per_bit(1))
 _IDLE_VALUE: Final = wire.IDLE_LEVEL
@@ -296,14 +294,3 @@ class CounterLinesRtl(wiring.Component):
         ]  # fmt: skip
         return m
 
-
-def lbd_lines(m: Module, straps: Value, variant: Variant) -> tuple[Signal, Signal]:
-    """Decode the LBD modes of Table 2-5 from ``straps``, the core's C[4..0] and MFP[15..12] (the patterns of
-    ``CoreTables.modes``): (``forward``: an LBD mode, ``looped``: LBD-MR), driven in ``m``."""
-    forward, looped = Signal(), Signal()
-    configs = (decode(row.c, row.mfp, variant=variant) for row in mode_rows(variant))
-    for config, mode in zip(configs, core_tables(variant).modes, strict=True):
-        if config.interface in (Interface.LBD_MR, Interface.LBD_OR):
-            with m.If(straps.matches(mode.pattern)):
-                m.d.comb += [forward.eq(1), looped.eq(config.interface is Interface.LBD_MR)]
-    return forward, looped

@@ -16,6 +16,7 @@ module docstring, OPT-25), which ``tests/test_verif_lockstep_optical.py`` holds 
 from __future__ import annotations
 
 import functools
+import itertools
 from dataclasses import dataclass
 from typing import Final
 
@@ -79,12 +80,23 @@ def _phase(phase: Phase) -> int:
 
 
 @functools.cache
-def _timer_bits() -> int:
-    """The narrowest timer that gives every LENGTH code of a :data:`LENGTH_COUNT_BITS`-bit count: its saturated
-    count already reads as :data:`~supi3.optical.length.LENGTH_MAX_CODE` at every bit rate and medium."""
-    shifts = [length_shift(rate, medium) for rate in BIT_RATES for medium in Medium]
+def _decode_bits(code: int) -> tuple[int, ...]:
+    """The fewest bits of the phase register whose values tell ``code`` from every other phase's code."""
+    width = (len(PHASES) - 1).bit_length()
+    others = [c for c in range(len(PHASES)) if c != code]
+    return next(bits for size in range(width + 1) for bits in itertools.combinations(range(width), size)
+                if all(any((code ^ other) >> b & 1 for b in bits) for other in others))  # fmt: skip
+
+
+@functools.cache
+def _clock_bits() -> int:
+    """The narrowest count of clocks whose largest value already reads as :data:`~supi3.optical.length.LENGTH_MAX_CODE`
+    at every bit rate and medium (its count is the clocks shifted right by :func:`_prescale_bits`): a timer of that
+    many bits that wraps and keeps a flag for having wrapped, read as all ones from then on, gives every LENGTH code of
+    the model's saturating :data:`LENGTH_COUNT_BITS`-bit count (OPT-24)."""
+    reads = [(_prescale_bits(rate), length_shift(rate, medium)) for rate in BIT_RATES for medium in Medium]
     return next(bits for bits in range(1, LENGTH_COUNT_BITS + 1)
-                if all(_shifted((1 << bits) - 1, shift) >= LENGTH_MAX_CODE for shift in shifts))  # fmt: skip
+                if all(_shifted((1 << bits) - 1 >> p, s) >= LENGTH_MAX_CODE for p, s in reads))  # fmt: skip
 
 
 def _prescale_bits(bit_rate: int) -> int:
@@ -134,7 +146,10 @@ class _Tx:
         return [self.phase.eq(code), self.level.eq(level), self.passes.eq(0), self.mau.eq(mau)]
 
     def is_(self, phase: Phase) -> Value:
-        return self.phase == _phase(phase)
+        """The phase register holds ``phase``: a compare of only the bits that tell its code from the other codes
+        (:func:`_decode_bits`; the register holds no other value)."""
+        code = _phase(phase)
+        return Cat(*(self.phase[b] == (code >> b & 1) for b in _decode_bits(code))).all()
 
 
 def _start(mode: Value, present: Value) -> Value:
@@ -282,30 +297,33 @@ class OpticalRtl(wiring.Component):
         # the clocks shifted right by log2 of the bit rate's enable period (OPT-24)
         prescale = [_prescale_bits(rate) for rate in BIT_RATES]
         block_on = (self.mode == OpticalMode.REGULATION) | (self.mode == OpticalMode.DIAGNOSTIC)
-        clock_bits = _timer_bits() + max(prescale)
-        saturated = (1 << clock_bits) - 1
         for k, i in ((_OUT_K, Interface.OUT), (_BRANCH_K, Interface.BRANCH)):
             running = Signal(name=f"timer_running_{k}")
-            clocks = Signal(clock_bits, name=f"timer_clocks_{k}", reset_less=True)  # cleared at each start
-            counted = Mux(clocks != saturated, clocks + 1, clocks)
+            # the clocks since the start modulo 2 ** _clock_bits() and whether that many have passed (then read as all
+            # ones, code 63): both cleared at each start, so without reset; no saturating multiplexer on the count
+            clocks = Signal(_clock_bits(), name=f"timer_clocks_{k}", reset_less=True)
+            over = Signal(name=f"timer_over_{k}", reset_less=True)
+            counted = (clocks + 1)[: len(clocks)]
+            counted_over = over | clocks.all()
+            read = Mux(counted_over, (1 << len(clocks)) - 1, counted)
             code = Signal(len(length[k]), name=f"timer_code_{k}")
             with m.Switch(Cat(self.medium[i], self.fast)):
                 for fast, rate in enumerate(BIT_RATES):
                     for medium_bit in (0, 1):
                         with m.Case(medium_bit | fast << 1):
                             shift = length_shift(rate, Medium(medium_bit))
-                            comb += code.eq(self._code(counted[prescale[fast] :], shift))
+                            comb += code.eq(self._code(read[prescale[fast] :], shift))
             with m.If(self.ib_reset):
                 sync += running.eq(0)
             with m.Else():
                 with m.If(running):
-                    sync += clocks.eq(counted)
+                    sync += [clocks.eq(counted), over.eq(counted_over)]
                     with m.If(self.len_stop[i]):
                         sync += running.eq(0)
                         with m.If(block_on):
                             comb += [new_length[k].eq(code), new_medium[k].eq(self.medium[i])]
                 with m.If(self.len_start[i]):
-                    sync += [running.eq(1), clocks.eq(0)]
+                    sync += [running.eq(1), clocks.eq(0), over.eq(0)]
         return m
 
     @staticmethod

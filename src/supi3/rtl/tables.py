@@ -13,11 +13,11 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import cache
+from functools import cache, cached_property
 from typing import Final
 
 from supi3.checks import fail
-from supi3.config import DataDirection, DeviceConfig, MfpKind, Variant, decode, mode_rows
+from supi3.config import DataDirection, DeviceConfig, Interface, MfpKind, Variant, decode, mode_rows
 from supi3.diagnostics import watches_line_interrupt
 from supi3.errors import ConfigurationError
 from supi3.interbus import wire
@@ -156,11 +156,28 @@ class CoreTables:
     diagnostics: tuple[tuple[bool, TerminalMode], ...]
     """For each mode, (it raises the line interrupt ahead, its bus terminal interface or NONE): ``supi3.diagnostics``
     (DG-3), ``supi3.terminal`` (Tables 2-7, 2-8)."""
+    lines: tuple[tuple[bool, bool], ...]
+    """For each mode, (an LBD mode: the counter telegram blocks run on the forward line, LBD-MR: on the return line
+    too), Table 2-5 (BK-34)."""
 
     @property
     def io_maps(self) -> tuple[tuple[tuple[int | None, ...], tuple[int | None, ...]], ...]:
         """The distinct MFP maps, in first-use order."""
         return tuple(dict.fromkeys(mode.io_map for mode in self.modes))
+
+    @cached_property
+    def strap_modes(self) -> tuple[int | None, ...]:
+        """For every value of the mode straps C[4..0] and MFP[15..12] (C in the upper bits), the index of the first
+        mode whose :attr:`ModeEntry.pattern` it matches, or ``None`` (reserved): the address decode of the strap
+        ROM (docs/rtl.md, round 4: a lookup by the strap value synthesises smaller than one case per row)."""
+        width = C_BITS + EXPANSION_BITS
+        found: list[int | None] = []
+        for value in range(1 << width):
+            bits = _bits(value, width)
+            matches = (k for k, mode in enumerate(self.modes)
+                       if all(p in ("-", b) for p, b in zip(mode.pattern, bits, strict=True)))  # fmt: skip
+            found.append(next(matches, None))
+        return tuple(found)
 
     @property
     def register_bits(self) -> int:
@@ -285,4 +302,6 @@ def core_tables(variant: Variant | str = Variant.OPC) -> CoreTables:
         rbst = tuple(value for value, config in rf if rbst_by_pin(config))
         complete = tuple(value for value, config in diag if complete_diagnostics(config))
     diagnostics = tuple((watches_line_interrupt(config), TerminalMode.of(config.interface.value)) for config in configs)
-    return CoreTables(variant, modes, serial, tuple(clocks), rbst, complete, diagnostics)
+    lbd = (Interface.LBD_MR, Interface.LBD_OR)
+    lines = tuple((config.interface in lbd, config.interface is Interface.LBD_MR) for config in configs)
+    return CoreTables(variant, modes, serial, tuple(clocks), rbst, complete, diagnostics, lines)
