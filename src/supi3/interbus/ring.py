@@ -33,7 +33,7 @@ to the BK (2.2.2, ``wire.counter_telegram``).
 from __future__ import annotations
 
 import math
-from collections.abc import Collection, Sequence
+from collections.abc import Collection, Iterable, Sequence
 from dataclasses import dataclass, field
 from enum import Enum
 from itertools import accumulate
@@ -488,11 +488,24 @@ def _tell_following(items: Sequence[Device | Branch]) -> None:
             _tell_following(item.devices)
 
 
+def _interface(device: object) -> Interface | None:
+    """The interface of a device that has a :class:`~supi3.config.DeviceConfig` (a SUPI 3 chip at either fidelity),
+    else ``None``."""
+    config = getattr(device, "config", None)
+    return config.interface if isinstance(config, DeviceConfig) else None
+
+
 def _sends_counts(device: Device) -> bool:
     """The device sends counter telegrams behind a break (an LBD chip, Table 2-5, BK-30): every device after it in
     the silent stretch hears them (DG-9)."""
-    config = getattr(device, "config", None)
-    return isinstance(config, DeviceConfig) and config.interface in (Interface.LBD_MR, Interface.LBD_OR)
+    return _interface(device) in (Interface.LBD_MR, Interface.LBD_OR)
+
+
+def return_repeaters(devices: Iterable[object]) -> int:
+    """The repeaters on the return lines of ``devices`` (A10): one per LBD-MR chip, whose counter block repeats its
+    looped return line 3 bit periods later (2.2.2, BK-35). A cycle's ring delay (A11) counts them with the devices at
+    both fidelities (BK-55)."""
+    return sum(_interface(device) is Interface.LBD_MR for device in devices)
 
 
 def _shift(registers: list[bytes], stream: bytes) -> tuple[list[bytes], bytes, int]:
@@ -560,6 +573,9 @@ class Transfer:
     branches: list[tuple[Terminal, bool, int | None]] = field(default_factory=list, repr=False)
     """In a tree: each bus terminal module whose whole branch this cycle drove, whether the master's telegrams came
     back on the branch's return line, and the count of the counter telegram received there."""
+    return_repeaters: int = 0
+    """Repeaters on the return lines of the cycle's ring (its LBD-MR devices, :func:`return_repeaters`): with
+    :attr:`devices` they make the cycle's ring delay (A11, BK-55)."""
 
 
 @dataclass
@@ -672,7 +688,7 @@ class Ring:
         # device's received bytes.
         self._layout: tuple[list[type], _Groups] = ([], [])
         self._cuts: tuple[list[bytes], int, bytes, list[slice] | None, int] = ([], -1, b"", None, 0)
-        self._bits = ((-1, -1), 0)  # (bytes sent, devices) of the last cycle finished, and its wire.cycle_bits
+        self._bits = ((-1, -1, -1), 0)  # (bytes sent, devices, return repeaters) of the last cycle, its cycle_bits
         _tell_following(self._tree)
         self._sync()
 
@@ -1149,7 +1165,8 @@ class Ring:
             self.trace.append(SegmentTrace(segments if dead is None else dead, silent.frame(cycle), None, None))
         reports = self._reports(len(devices), None if close_after is None else n, dead_lines, returns) \
             if self._spans else []
-        return Transfer(cycle, bytes(data), n, returned, flags_back, receiver_error, runs, len(devices), reports)
+        return Transfer(cycle, bytes(data), n, returned, flags_back, receiver_error, runs, len(devices), reports,
+                        return_repeaters(self.devices[:n]))
 
     def finish(self, transfer: Transfer, latch: bool) -> None:
         """End a cycle with the master's verdict: the latch telegrams (``latch``) or idle telegrams.
@@ -1157,9 +1174,9 @@ class Ring:
         Advances bus time by ``wire.cycle_bits``; a device latches only if its own check passed, no error was
         flagged upstream of it, and the master latches.
         """
-        size = (len(transfer.sent), transfer.devices)
+        size = (len(transfer.sent), transfer.devices, transfer.return_repeaters)
         if size != self._bits[0]:
-            self._bits = (size, wire.cycle_bits(size[0] - wire.LOOPBACK_BYTES, size[1]))
+            self._bits = (size, wire.cycle_bits(size[0] - wire.LOOPBACK_BYTES, size[1], size[2]))
         bits = self._bits[1]
         start = self.now
         end = start + bits / self.bit_rate
@@ -1168,8 +1185,10 @@ class Ring:
         if transfer.branches:  # before the latch telegrams, as a BK's closure at its frame's end (BK-50)
             frame = wire.frame_bits(len(transfer.sent))
             for terminal, traffic, count in transfer.branches:
-                # The frame's end passes the BK REPEATER_DELAY_BITS later per device before it (A10)
-                passed = start + (frame + wire.REPEATER_DELAY_BITS * self._index[id(terminal)]) / self.bit_rate
+                # The frame's end passes the BK REPEATER_DELAY_BITS later per repeater before it (A10, BK-55)
+                before = self.devices[: self._index[id(terminal)]]
+                repeaters = len(before) + return_repeaters(before)
+                passed = start + (frame + wire.REPEATER_DELAY_BITS * repeaters) / self.bit_rate
                 terminal.branch_returned(traffic, count, start, end, passed)
         for run in transfer.runs:
             if latch and run.eligible:
@@ -1225,8 +1244,8 @@ class Ring:
         self._recognise()
         dead = self._first_dead()
         reached = len(self.devices) if dead is None else min(len(self.devices), dead - 1)
-        every = len(_devices(self._tree)) if self._branches else len(self.devices)
-        end = self.now + wire.reset_bits(min(every, wire.MAX_DEVICES)) / self.bit_rate
+        every = _devices(self._tree) if self._branches else self.devices
+        end = self.now + wire.reset_bits(min(len(every), wire.MAX_DEVICES), return_repeaters(every)) / self.bit_rate
         for device in self.devices[:reached]:
             device.reset(end)
         self._go_silent(range(reached, len(self.devices)), self.now, end)
