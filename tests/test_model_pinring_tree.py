@@ -498,7 +498,8 @@ def per_cycle(ring: Ring | PinRing, ops: list[tuple[str, int]]) -> list[object]:
     ID codes, data lengths), every position's IN data and the BK's status byte (its count, BK-5, BK-6). Steps:
     ``off``, ``on``, ``ext`` (``Master.switch_branch``), ``reset`` (``Master.start``: an INTERBUS reset), ``cut``
     (the forward line into the device at physical position ``k``, ``cut(k, True)`` at both fidelities, BK-52, whether
-    the branch is in the data path or not: the break sleeps while it is out), ``wait`` (nothing: only the cycles)."""
+    the branch is in the data path or not: the break sleeps while it is out), ``di3`` (the BK's branch return input,
+    ``cut(2, False, branch=True)``; ``k`` unused), ``wait`` (nothing: only the cycles)."""
     master = Master(ring, locate=False, max_devices=8)
     seen: list[object] = []
 
@@ -509,11 +510,14 @@ def per_cycle(ring: Ring | PinRing, ops: list[tuple[str, int]]) -> list[object]:
     for op, k in ops:
         if op == "reset":
             record(master.start())
-        elif op == "cut":
+        elif op in ("cut", "di3"):
             # Numbered by the physical position at both fidelities, whether the branch is in the data path (BK-52).
             bk = ring.devices[1]
             seen.append(bool(ring.spans) if isinstance(ring, Ring) else isinstance(bk, Supi3Pins) and bk.branch_in_path)
-            ring.cut(k, True)
+            if op == "cut":
+                ring.cut(k, True)
+            else:
+                ring.cut(2, False, branch=True)
         elif op == "wait":
             pass
         elif master.config is not None and len(master.config) > 1 and master.config[1].data_bytes == 0:
@@ -527,7 +531,7 @@ def per_cycle(ring: Ring | PinRing, ops: list[tuple[str, int]]) -> list[object]:
     return seen
 
 
-HISTORY_OPS = st.lists(st.tuples(st.sampled_from(["off", "on", "ext", "reset", "cut"]), st.integers(3, 4)),
+HISTORY_OPS = st.lists(st.tuples(st.sampled_from(["off", "on", "ext", "reset", "cut", "di3"]), st.integers(3, 4)),
                        min_size=2, max_size=4)  # fmt: skip
 
 
@@ -536,15 +540,17 @@ HISTORY_OPS = st.lists(st.tuples(st.sampled_from(["off", "on", "ext", "reset", "
 @example((BranchKind.LBD_MR, 1), [("cut", 3), ("reset", 3)])  # BK-49: a cut in an LBD branch, for sure
 @example((BranchKind.LBD_OR, 1), [("off", 3), ("on", 3), ("cut", 3)])
 @example((BranchKind.LOCAL, 2), [("off", 3), ("cut", 4), ("on", 3)])  # BK-52: cut while out, awake once back
+@example((BranchKind.LBD_OR, 1), [("di3", 3), ("off", 3)])  # BK-56: the phantom 63 of BK-32 was left at pin level
+@example((BranchKind.LBD_MR, 2), [("cut", 4), ("di3", 3)])  # BK-56: a count, then DI3 cut: 0 at both
 def test_a_master_sees_every_cycle_alike_over_any_history(case: tuple[BranchKind, int], ops: list[tuple[str, int]],
                                                           ) -> None:  # fmt: skip
     """Issue 12: over any history of switching the branch off, on, on with the extended function, INTERBUS resets
-    and cuts of a line in the branch, also while the branch is out of the data path (numbered by the physical
-    position at both fidelities, BK-52), the master's every cycle (success, diagnostics, their count, the
+    and cuts of a line in the branch or of the BK's DI3, also while the branch is out of the data path (numbered by
+    the physical position at both fidelities, BK-52), the master's every cycle (success, diagnostics, their count, the
     configuration and process data) is the same at both fidelities: the master idles after a latched switch (BK-46)
     and the BK switches its lines between telegrams (BK-47), so no telegram is cut and nothing in flight is lost. A
     cut in an LBD branch too: the counter telegrams that reach the master are no frame, a dead line at both (BK-49),
-    and the BK keeps the same count."""
+    and the BK keeps the same count (0 with its DI3 cut, BK-56)."""
     kind, m = case
     ops = [(op, min(k, 2 + m)) for op, k in ops]
     # The same short silence at both (BK-3): a history switching the extended function on and cutting closes (BK-50).
