@@ -1,13 +1,14 @@
 """Sweep: a BK's self-closure of a silent branch seen alike at both fidelities (BK-50), over ``branch_silence``.
 
-For every silence limit (clocks) and every branch kind of the tree cases (BK-RB, BK-LB, LBD-MR, LBD-OR), the branch
+For every silence limit (clocks) and every tree of the tests' ``CASES`` (BK-RB, BK-LB, LBD-MR, LBD-OR, and LBD-MR
+branches of 2 and 3 devices, BK-55), the branch
 is switched on with the extended function and cut, then the master runs 6 cycles at the transaction level and at
 pin level: every cycle's view (kind, success, diagnostics, configuration, data, BK status) must be alike and the BK
 closed at both (``closes_alike`` of tests/test_model_pinring_tree.py, about 0.5 s a run: too slow for the suite,
 which runs a seeded sample and the old window points). Run from the repository root:
 
-    python bench/closure_sweep.py                          # 6,000..13,750 in steps of 250: 128 runs
-    python bench/closure_sweep.py --start 8900 --stop 12800 --step 25   # the fine sweep: 628 runs
+    python bench/closure_sweep.py                          # 6,000..13,750 in steps of 250: 192 runs
+    python bench/closure_sweep.py --start 8900 --stop 12800 --step 25   # the fine sweep: 942 runs
 
 Prints one line per run and the differing runs; exits 1 if any differs.
 """
@@ -48,10 +49,10 @@ def main() -> int:
                 alike = True
             except AssertionError:
                 alike = False
-                differing.append((silence, kind.name))
+                differing.append((silence, f"{kind.name} x {devices}"))
             runs += 1
-            print(f"{silence} {kind.name} {'alike' if alike else 'DIFFERS'} {time.process_time() - began:.1f} s",
-                  flush=True)  # fmt: skip
+            print(f"{silence} {kind.name} x {devices} {'alike' if alike else 'DIFFERS'} "
+                  f"{time.process_time() - began:.1f} s", flush=True)  # fmt: skip
     print(f"{runs - len(differing)} of {runs} alike; differing: {differing or 'none'}")
     return 1 if differing else 0
 

@@ -152,6 +152,8 @@ HOSTILE: list[tuple[str, Callable[[], object], str]] = [
     ("cycle_bits(-1, 1)", lambda: wire.cycle_bits(-1, 1), "data_bytes"),
     ("cycle_bits(0, 1.5)", lambda: wire.cycle_bits(0, 1.5), "devices"),  # type: ignore[arg-type]
     ("reset_bits(-1)", lambda: wire.reset_bits(-1), "devices"),
+    ("cycle_bits(0, 2, 3)", lambda: wire.cycle_bits(0, 2, 3), "return_repeaters"),  # BK-55: at most one a device
+    ("reset_bits(2, -1)", lambda: wire.reset_bits(2, -1), "return_repeaters"),
     ("check_bit_rate('500k')", lambda: wire.check_bit_rate("500k"), "bit_rate"),  # type: ignore[arg-type]
     ("clocks_per_bit(None)", lambda: wire.clocks_per_bit(None), "bit_rate"),  # type: ignore[arg-type]
     ("telegram_levels([1 << 13], 13)", lambda: wire.telegram_levels([1 << 13], 13), "words"),

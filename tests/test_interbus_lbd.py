@@ -12,14 +12,26 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from supi3 import tables
+from supi3.config import decode
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.device import PlainDevice
 from supi3.interbus.errors import InterbusError
 from supi3.interbus.link import Device
 from supi3.interbus.master import Master
-from supi3.interbus.ring import Branch, BranchKind, DeadLine, ReturnBreak, Ring, lbd_count, lbd_position
+from supi3.interbus.ring import (
+    Branch,
+    BranchKind,
+    DeadLine,
+    ReturnBreak,
+    Ring,
+    lbd_count,
+    lbd_position,
+    return_repeaters,
+)
 from supi3.interbus.wire import Cycle
+from supi3.model.chip import Supi3
 from support import terminal
 
 RECOVERY_CYCLES = 12
@@ -257,3 +269,31 @@ def test_a_count_that_disagrees_with_the_search_locates_nothing() -> None:
     ring.inject(ReturnBreak(4))
     found = master.cycle().diagnostics[0]
     assert found.location is None and "fits no break" in found.detail
+
+
+LOOP_EDITS = st.lists(st.tuples(st.integers(0, 3), st.sampled_from(["LBD-MR", "LBD-OR", "plain"])), max_size=6)
+
+
+@settings(max_examples=20, deadline=None, derandomize=True)
+@given(LOOP_EDITS)
+def test_the_ring_delay_counts_lbd_mr_chips_over_edits_of_a_plain_ring(edits: list[tuple[int, str]]) -> None:
+    """BK-55: a transaction-level cycle takes ``wire.cycle_bits`` with the ring's LBD-MR chips as return repeaters
+    (``ring.return_repeaters``, ``Transfer.return_repeaters``), also after a plain ring's devices are replaced in place
+    (the count is cached for the data path and taken again when it holds other devices)."""
+    def device(kind: str) -> Device:
+        if kind == "plain":
+            return PlainDevice(0xBF, 0b01001)
+        row = next(r for r in tables.MODE_ROWS if r.function == f"{kind}, 8 IN/8 OUT")
+        return Supi3(decode(row.c, row.mfp, clk_conf=tables.clk_conf_for(2_000_000)))
+
+    ring = Ring([device("LBD-MR") for _ in range(4)], bit_rate=2_000_000)
+    data = bytes(wire.LOOPBACK_BYTES + 4)
+    for at, kind in [(0, "LBD-MR"), *edits]:
+        ring.devices[at] = device(kind)
+        start = ring.now
+        transfer = ring.transfer(Cycle.DATA, data)
+        ring.finish(transfer, False)
+        loops = return_repeaters(ring.devices)
+        assert transfer.return_repeaters == loops == sum(isinstance(d, Supi3) and d.config.interface.value == "LBD-MR"
+                                                         for d in ring.devices)  # fmt: skip
+        assert round((ring.now - start) * ring.bit_rate) == wire.cycle_bits(4, 4, loops)

@@ -223,13 +223,20 @@ def test_frame_from_telegrams_rejects_short_check() -> None:
 # -- timing ------------------------------------------------------------------------------------------------------
 
 
-@given(st.integers(0, 1024), st.integers(0, 512))
-def test_cycle_bits(data_bytes: int, devices: int) -> None:
-    bits = wire.cycle_bits(data_bytes, devices)
+@given(st.integers(0, 1024), st.integers(0, 512), st.data())
+def test_cycle_bits(data_bytes: int, devices: int, data: st.DataObject) -> None:
+    loops = data.draw(st.integers(0, devices))  # LBD-MR devices among them, each a second repeater (BK-55)
+    bits = wire.cycle_bits(data_bytes, devices, loops)
     # The frame is Beckhoff's 13 x (6 + N); the rest is whole status telegrams covering the ring delay.
     rest = bits - 13 * (6 + data_bytes)
     assert rest % wire.STATUS_TELEGRAM_BITS == 0
-    assert rest >= devices * wire.REPEATER_DELAY_BITS + wire.STATUS_TELEGRAM_BITS * wire.LATCH_STATUS_TELEGRAMS
+    delay = (devices + loops) * wire.REPEATER_DELAY_BITS
+    assert rest >= delay + wire.STATUS_TELEGRAM_BITS * wire.LATCH_STATUS_TELEGRAMS
+    # no status telegram more than needed
+    assert rest - wire.STATUS_TELEGRAM_BITS < delay + wire.STATUS_TELEGRAM_BITS * (
+        wire.LATCH_STATUS_TELEGRAMS + wire.TURNAROUND_STATUS_TELEGRAMS)  # fmt: skip
+    assert bits == wire.cycle_phases(data_bytes, devices, loops).total_bits
+    assert wire.reset_bits(devices, loops) - wire.reset_bits(devices) == bits - wire.cycle_bits(data_bytes, devices)
     # The manual's CPU access window after the latch, 13 x (5 + n) bit periods (3.4.14), fits in one cycle.
     assert bits >= 13 * (5 + data_bytes)
 

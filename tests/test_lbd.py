@@ -190,7 +190,8 @@ def bit_chain(devices: int, head: Sequence[int], periods: int) -> list[int]:
 
 
 def counts_at_bk(levels: Sequence[int], since: int = 0) -> list[int]:
-    """The counts a BK's receiver keeps from a line, of the counter telegrams that end from bit period ``since``."""
+    """The counts a BK's receiver keeps from a line, at each ``seen`` from bit period ``since`` on: a counter
+    telegram's end (its count) or the line fallen silent (0, BK-58)."""
     state, counts = CounterState(), []
     for i, level in enumerate(levels):
         state, bit = counter_step(state, level)
@@ -237,14 +238,33 @@ def test_every_break_gives_the_transaction_levels_count(kind: BranchKind) -> Non
                 assert len(counts) >= 2 and set(counts) == {expected}, (m, forward, back, cut, counts)
 
 
+@pytest.mark.parametrize("cut", [-7, *PHANTOM_CUTS, 4, 80])
+def test_a_break_at_the_bks_own_input_reads_0(cut: int) -> None:
+    """BK-58 (issue 12): a break right at the BK's return input (no device behind it, ``ring.lbd_count`` ``None``)
+    leaves the BK's count 0 within a telegram and the silence after the break (13 + 33 bit periods), however the
+    master's traffic was cut: a cut in a frame's first header still brings the saturated phantom of BK-32 (63)
+    first, and the silence overwrites it; then only 0s, one every 33 bit periods."""
+    head = traffic(0, cut)
+    counts = counts_behind(0, cut)
+    if cut in PHANTOM_CUTS:
+        assert counts[0] == wire.COUNTER_MAX
+        del counts[0]
+    assert len(counts) >= 2 and set(counts) == {0}
+    state = CounterState()
+    for level in [*head, *[wire.IDLE_LEVEL] * (wire.DATA_TELEGRAM_BITS + S + 1)]:
+        state, _ = counter_step(state, level)
+    assert state.counted == 0 and lbd_count(BranchKind.LBD_OR, 1, set(), {0}) is None
+
+
 @pytest.mark.parametrize("devices", [2, 8, 12])
 def test_a_branch_silent_from_power_up_settles(devices: int) -> None:
     """Every line silent at once (before the master's first telegram): each device generates and drops its
     neighbour's telegram; then only the first device generates, and the BK's count is right after at most
-    1 + devices // 4 counts of 1."""
+    1 + devices // 4 counts of 1; before, the BK's own input falls silent between them (count 0, BK-58: first, and
+    between the counts of 1 where a dropped telegram leaves a gap of more than 32 bit periods)."""
     counts = counts_at_bk(bit_chain(devices, [], 10 * (S + 1) + 3 * devices))
     wrong = counts.index(devices)
-    assert set(counts[:wrong]) == {1} and wrong <= 1 + devices // 4
+    assert counts[0] == 0 and set(counts[:wrong]) == {0, 1} and counts[:wrong].count(1) <= 1 + devices // 4
     assert set(counts[wrong:]) == {devices} and len(counts) - wrong >= 3
 
 

@@ -49,26 +49,28 @@ def counter_words(*bytes_: int) -> Levels:
 
 def test_every_count_byte_and_working_traffic() -> None:
     """2 Mbit/s: an ID cycle, then counter telegrams of every count under the mark (0..63), saturated ones, then
-    silence: the generator twice; the BK's count follows every counter telegram."""
+    silence: the generator twice; the BK's count follows every counter telegram, and is 0 at each generated one (the
+    input silent, BK-58)."""
     frame = wire.Frame.build(Cycle.ID, wire.LOOPBACK_BYTES_ON_LINE + bytes([0x0C, 0x01]))
     counts = [wire.COUNTER_MARK | c for c in range(wire.COUNTER_MAX + 1)]
     levels = np.concatenate([wire.status_levels(Cycle.DATA, False, 2), wire.cycle_levels(frame, 2, True),
                              counter_words(*counts, 0xC0, 0xFF, 0xFE), idle(2 * (S + 1) + 4)])  # fmt: skip
     outputs = lockstep(wire.levels_to_samples(levels, RATES[1]), 1)
     seen = [o["count"] for o in outputs if o["seen"]]
-    assert seen == [*range(1, wire.COUNTER_MAX + 1), wire.COUNTER_MAX, wire.COUNTER_MAX, wire.COUNTER_MAX]
+    assert seen == [*range(1, wire.COUNTER_MAX + 1), wire.COUNTER_MAX, wire.COUNTER_MAX, wire.COUNTER_MAX, 0, 0]
     generated = sum(1 for a, b in itertools.pairwise(outputs) if b["drive"] and not a["drive"])
     assert generated == len(counts) + 3 + 2  # every counter telegram passed on, two generated
 
 
 def test_slow_rate_generator_collision_and_reset() -> None:
     """500 kbit/s: a counter telegram, silence, the generated telegram with a counter telegram colliding with it
-    (dropped, its count kept), then an INTERBUS reset (repeated, never a counter telegram)."""
+    (dropped, its count kept; the silence before it reads 0, BK-58), then an INTERBUS reset (repeated, never a
+    counter telegram)."""
     levels = np.concatenate([wire.status_levels(Cycle.DATA, False, 1), counter_words(0x85), idle(S + 3),
                              counter_words(0x8A), idle(8), np.zeros(wire.RESET_DETECT_BITS + 2, dtype=np.uint8),
                              wire.status_levels(Cycle.DATA, False, 2)])  # fmt: skip
     outputs = lockstep(wire.levels_to_samples(levels, RATES[0]), 0)
-    assert [o["count"] for o in outputs if o["seen"]] == [5, 10]
+    assert [o["count"] for o in outputs if o["seen"]] == [5, 0, 10]
     cpb = wire.clocks_per_bit(RATES[0])
     sent = wire.samples_to_levels(np.asarray([o["out"] for o in outputs])[3 * cpb :], RATES[0])
     telegrams = wire.parse_levels(sent[: 6 + 2 * 13 + S + 3])

@@ -20,7 +20,8 @@ send for that bit period (it goes out ``REPEATER_DELAY_BITS`` after the bit bega
 * A counter telegram's count bits are incremented serially (``wire.count_bit``): LSB first, the carry from bit to
   bit, the carry out of bit 9 sets the saturation mark bit 10 (BK-31).
 * After :data:`COUNTER_SILENCE_BITS` idle bit periods, the next idle bit period starts a counter telegram of
-  count 1 (``wire.count_on(None)``) that the block sends itself (the generator); every telegram begun, received or
+  count 1 (``wire.count_on(None)``) that the block sends itself (the generator), and the count the block keeps becomes
+  0: the break is at its own input, with no device behind it (a BK's count, BK-58); every telegram begun, received or
   generated, starts the idle count afresh, so a silent line gets one every ``COUNTER_SILENCE_BITS + 1`` bit
   periods, with ``COUNTER_SILENCE_BITS - 12`` idle ones between (the next device never reaches its own silence).
   A telegram that begins on the line while the generator sends is received (a counter telegram's count is kept)
@@ -75,8 +76,9 @@ COUNTER_OUTPUTS: Final[tuple[Pin, ...]] = (
 """The block's outputs: ``out``, the line it sends (every bit period of the input, ``REPEATER_DELAY_BITS`` later
 pin to pin, idle between); ``drive``, 1 while ``out`` is a bit the block changed or made (count bits 4..12 of a
 counter telegram passed on, all 13 of a generated one); ``seen``, one clock after a counter telegram ended on the
-input (its stop bit sampled); ``count``, the count of the last counter telegram received (``wire.counter_count``;
-0: none since reset)."""
+input (its stop bit sampled) or the input fell silent (the generator begins: count 0, BK-58); ``count``, the count of
+the last counter telegram received (``wire.counter_count``), 0 if none since reset or since the input fell silent
+(the break is at the block's own input, BK-58)."""
 
 
 class Kind(IntEnum):
@@ -109,7 +111,7 @@ class CounterState(NamedTuple):
     byte: int = 0
     """The data bits received so far of the counter telegram being received."""
     counted: int = 0
-    """The count of the last counter telegram received (0: none)."""
+    """The count of the last counter telegram received (0: none, or the line fell silent since, BK-58)."""
     gen: int = IDLE_BIT
     """The bit of :data:`GENERATED_TELEGRAM` sent next, :data:`IDLE_BIT` while the generator is not sending."""
     drop: int = 0
@@ -124,7 +126,8 @@ class CounterBit(NamedTuple):
     drive: int
     """1 if ``out`` is the block's (a counter telegram's bits 4..12, a generated telegram)."""
     seen: int
-    """1 if a counter telegram ended with this bit period (its count is the new :attr:`CounterState.counted`)."""
+    """1 if a counter telegram ended with this bit period or the generator began (the line fell silent, BK-58): the
+    new :attr:`CounterState.counted` is the telegram's count, or 0."""
 
 
 _LIMITS: Final = {
@@ -229,9 +232,9 @@ def counter_step(state: CounterState, level: int) -> tuple[CounterState, Counter
     if gen != IDLE_BIT or silent:
         k = 0 if silent else gen
         new = new._replace(gen=k + 1 if k + 1 < wire.DATA_TELEGRAM_BITS else IDLE_BIT)
-        if silent:
-            new = new._replace(quiet=0)
-        return new, CounterBit((GENERATED_TELEGRAM >> k) & 1, 1, seen)
+        if silent:  # BK-58: the line fell silent, the break is at this block's input: no device behind it, count 0
+            new = new._replace(quiet=0, counted=0)
+        return new, CounterBit((GENERATED_TELEGRAM >> k) & 1, 1, seen | silent)
     if state.drop and state.bit != IDLE_BIT:
         return new, CounterBit(wire.IDLE_LEVEL, 1, seen)
     return new, CounterBit(out, drive, seen)

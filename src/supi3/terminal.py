@@ -19,7 +19,7 @@ behaviour. Decisions where the manual is silent are BK-1.. of ``docs/assumptions
   silence is measured by the implementations (seconds at transaction level, :data:`BRANCH_SILENCE_CLOCKS` clocks at
   pin level); the master's telegrams and a branch switched on restart it, counter telegrams do not.
 * **Counter telegram** (:func:`received`): the BK keeps the last count received on its branch return line, 0 when
-  the master's own telegrams come back (BK-6).
+  the master's own telegrams come back (BK-6) or the line falls silent, a break at the BK's own input (BK-58).
 * **INTERBUS reset** (:func:`reset`, BK-9).
 * Outputs: :attr:`Terminal.status` (the branch status byte, BK-5), :attr:`Terminal.attention`, the LEDs
   :attr:`Terminal.ld` and :attr:`Terminal.e` (BK-11) and :attr:`Terminal.alarm` (BK-12).

@@ -34,7 +34,7 @@ to the BK (2.2.2, ``wire.counter_telegram``).
 from __future__ import annotations
 
 import math
-from collections.abc import Collection, Sequence
+from collections.abc import Collection, Iterable, Sequence
 from dataclasses import dataclass, field
 from enum import Enum
 from itertools import accumulate
@@ -535,11 +535,29 @@ def _tell_following(items: Sequence[Device | Branch]) -> None:
             _tell_following(item.devices)
 
 
+def _interface(device: object) -> Interface | None:
+    """The interface of a device that has a :class:`~supi3.config.DeviceConfig` (a SUPI 3 chip at either fidelity),
+    else ``None``."""
+    config = getattr(device, "config", None)
+    return config.interface if isinstance(config, DeviceConfig) else None
+
+
 def _sends_counts(device: Device) -> bool:
     """The device sends counter telegrams behind a break (an LBD chip, Table 2-5, BK-30): every device after it in
     the silent stretch hears them (DG-9)."""
-    config = getattr(device, "config", None)
-    return isinstance(config, DeviceConfig) and config.interface in (Interface.LBD_MR, Interface.LBD_OR)
+    return _interface(device) in (Interface.LBD_MR, Interface.LBD_OR)
+
+
+def _return_repeater(device: object) -> bool:
+    """An LBD-MR chip: its counter block repeats its looped return line 3 bit periods later (2.2.2, BK-35)."""
+    return _interface(device) is Interface.LBD_MR
+
+
+def return_repeaters(devices: Iterable[object]) -> int:
+    """The repeaters on the return lines of ``devices`` (A10): one per LBD-MR chip, whose counter block repeats its
+    looped return line 3 bit periods later (2.2.2, BK-35). A cycle's ring delay (A11) counts them with the devices at
+    both fidelities (BK-55)."""
+    return sum(map(_return_repeater, devices))
 
 
 def _shift(registers: list[bytes], stream: bytes) -> tuple[list[bytes], bytes, int]:
@@ -611,6 +629,9 @@ class Transfer:
     """A branch joined the data path within this frame (BK-54): what came back was cut where its BK switched, so a
     receiver error is not on the return line N + 1 (BK-56); so too a receiver off the telegram grid after a chip's
     power-up (M22)."""
+    return_repeaters: int = 0
+    """Repeaters on the return lines of the cycle's ring (its LBD-MR devices, :func:`return_repeaters`): with
+    :attr:`devices` they make the cycle's ring delay (A11, BK-55)."""
 
 
 @dataclass
@@ -726,13 +747,15 @@ class Ring:
         # device's received bytes.
         self._layout: tuple[list[type], _Groups] = ([], [])
         self._cuts: tuple[list[bytes], int, bytes, list[slice] | None, int] = ([], -1, b"", None, 0)
-        self._bits = ((-1, -1), 0)  # (bytes sent, devices) of the last cycle finished, and its wire.cycle_bits
+        self._bits = ((-1, -1, -1), 0)  # (bytes sent, devices, return repeaters) of the last cycle, its cycle_bits
         self._wakes: dict[int, float] = {}
         """M22: ring index -> bus time a chip powered up by :meth:`power_up` ends its reset stretch (M2)."""
         self._late: dict[int, float] = {}
         """M22: ring index -> bus time from which a frame finds the chip out of an INTERBUS reset it woke up in."""
         self._grid = 0.0
         """M22: bus time the master's idle status telegrams began (the end of its last cycle or reset)."""
+        self._loops: tuple[list[Device], list[int]] = ([], [0])
+        """The data path whose LBD-MR devices :meth:`_loops_before` counted last, the counts before each position."""
         _tell_following(self._tree)
         self._sync()
 
@@ -1247,7 +1270,7 @@ class Ring:
         reports = self._reports(reached, None if close_after is None else n, dead_lines, returns) \
             if self._spans else []
         return Transfer(cycle, bytes(data), n, returned, flags_back, receiver_error, runs, reached, reports,
-                        spliced is not None or unheard)
+                        spliced is not None or unheard, self._loops_before(n))
 
     def finish(self, transfer: Transfer, latch: bool) -> None:
         """End a cycle with the master's verdict: the latch telegrams (``latch``) or idle telegrams.
@@ -1255,9 +1278,9 @@ class Ring:
         Advances bus time by ``wire.cycle_bits``; a device latches only if its own check passed, no error was
         flagged upstream of it, and the master latches.
         """
-        size = (len(transfer.sent), transfer.devices)
+        size = (len(transfer.sent), transfer.devices, transfer.return_repeaters)
         if size != self._bits[0]:
-            self._bits = (size, wire.cycle_bits(size[0] - wire.LOOPBACK_BYTES, size[1]))
+            self._bits = (size, wire.cycle_bits(size[0] - wire.LOOPBACK_BYTES, size[1], size[2]))
         bits = self._bits[1]
         start = self.now
         end = start + bits / self.bit_rate
@@ -1266,8 +1289,10 @@ class Ring:
         if transfer.branches:  # before the latch telegrams, as a BK's closure at its frame's end (BK-50)
             frame = wire.frame_bits(len(transfer.sent))
             for terminal, traffic, count in transfer.branches:
-                # The frame's end passes the BK REPEATER_DELAY_BITS later per device before it (A10)
-                passed = start + (frame + wire.REPEATER_DELAY_BITS * self._index[id(terminal)]) / self.bit_rate
+                # The frame's end passes the BK REPEATER_DELAY_BITS later per repeater before it (A10, BK-55)
+                before = self._index[id(terminal)]
+                repeaters = before + self._loops_before(before)
+                passed = start + (frame + wire.REPEATER_DELAY_BITS * repeaters) / self.bit_rate
                 terminal.branch_returned(traffic, count, start, end, passed)
         for run in transfer.runs:
             if latch and run.eligible:
@@ -1289,6 +1314,17 @@ class Ring:
         if self._branches:
             self._silence_detached(start, end)
             self._recognise()
+
+    def _loops_before(self, n: int) -> int:
+        """The return repeaters (:func:`return_repeaters`, BK-55) of the first ``n`` devices of the data path, counted
+        again only when :attr:`devices` holds other devices than last time (a tree's switch, an edited plain ring; the
+        list comparison takes the same object as equal at once: under a µs for 512 devices, where a scan takes 100)."""
+        devices, counts = self._loops
+        path = self.devices
+        if devices != path:
+            counts = list(accumulate(map(_return_repeater, path), initial=0))
+            self._loops = (list(path), counts)
+        return counts[n]
 
     @staticmethod
     def _latch_run(run: _Run, groups: _Groups, end: float) -> None:
@@ -1324,8 +1360,8 @@ class Ring:
         self._repaired = []
         dead = self._first_dead()
         reached = len(self.devices) if dead is None else min(len(self.devices), dead - 1)
-        every = len(_devices(self._tree)) if self._branches else len(self.devices)
-        end = self.now + wire.reset_bits(min(every, wire.MAX_DEVICES)) / self.bit_rate
+        every = _devices(self._tree) if self._branches else self.devices
+        end = self.now + wire.reset_bits(min(len(every), wire.MAX_DEVICES), return_repeaters(every)) / self.bit_rate
         for device in self.devices[:reached]:
             device.reset(end)
         self._go_silent(range(reached, len(self.devices)), self.now, end)

@@ -863,10 +863,14 @@ def frame_from_telegrams(telegrams: Iterable[Telegram | LineReset]) -> Frame:
 # ================================================================================================================
 
 
-def ring_delay_status_telegrams(devices: int) -> int:
-    """Idle status telegrams the master sends while the check sequence travels the ring (assumption A10, A11)."""
+def ring_delay_status_telegrams(devices: int, return_repeaters: int = 0) -> int:
+    """Idle status telegrams the master sends while the check sequence travels the ring (assumption A10, A11): a
+    repeater delay for each of the ``devices`` on the forward line and for each of the ``return_repeaters`` on the
+    return lines (an LBD-MR device's counter block repeats its return line, BK-35, BK-55: at most one a device)."""
     devices = _int("devices", devices, 0, MAX_DEVICES, "manual: at most 512 devices in a ring")
-    return math.ceil(devices * REPEATER_DELAY_BITS / STATUS_TELEGRAM_BITS) + TURNAROUND_STATUS_TELEGRAMS
+    return_repeaters = _int("return_repeaters", return_repeaters, 0, devices, "BK-35: one per LBD-MR device")
+    repeaters = devices + return_repeaters
+    return math.ceil(repeaters * REPEATER_DELAY_BITS / STATUS_TELEGRAM_BITS) + TURNAROUND_STATUS_TELEGRAMS
 
 
 def branch_switch_pause_bits(devices: int) -> int:
@@ -875,7 +879,7 @@ def branch_switch_pause_bits(devices: int) -> int:
     return (ring_delay_status_telegrams(devices) + BRANCH_SWITCH_PAUSE_STATUS_TELEGRAMS) * STATUS_TELEGRAM_BITS
 
 
-def cycle_bits(data_bytes: int, devices: int) -> int:
+def cycle_bits(data_bytes: int, devices: int, return_repeaters: int = 0) -> int:
     """Bit periods of one cycle (docs/interbus.md, "Cycle timing").
 
     Parameters
@@ -884,6 +888,8 @@ def cycle_bits(data_bytes: int, devices: int) -> int:
         Bytes of device data in the data sequence (all devices' registers; ``2 * devices`` in an ID cycle).
     devices:
         Devices in the ring.
+    return_repeaters:
+        Repeaters on the ring's return lines: its LBD-MR devices (BK-35, BK-55; ``ring.return_repeaters``).
 
     Returns
     -------
@@ -892,8 +898,7 @@ def cycle_bits(data_bytes: int, devices: int) -> int:
         turnaround and the latch: compare Beckhoff's (13 x (6 + N) + 1.5 x M) x T_bit.
     """
     data_bytes = _int("data_bytes", data_bytes, 0, None, "docs/interbus.md, Cycle timing")
-    devices = _int("devices", devices, 0, MAX_DEVICES, "manual: at most 512 devices in a ring")
-    status = ring_delay_status_telegrams(devices) + LATCH_STATUS_TELEGRAMS
+    status = ring_delay_status_telegrams(devices, return_repeaters) + LATCH_STATUS_TELEGRAMS
     return frame_bits(LOOPBACK_BYTES + data_bytes) + STATUS_TELEGRAM_BITS * status
 
 
@@ -912,17 +917,20 @@ class CyclePhases(NamedTuple):
     """The cycle's length (:func:`cycle_bits`)."""
 
 
-def cycle_phases(data_bytes: int, devices: int) -> CyclePhases:
-    """The phases of one cycle with ``data_bytes`` bytes of device data and ``devices`` devices (3.4.14, A11)."""
-    total = cycle_bits(data_bytes, devices)
+def cycle_phases(data_bytes: int, devices: int, return_repeaters: int = 0) -> CyclePhases:
+    """The phases of one cycle with ``data_bytes`` bytes of device data, ``devices`` devices and ``return_repeaters``
+    LBD-MR devices among them (3.4.14, A11, :func:`cycle_bits`)."""
+    total = cycle_bits(data_bytes, devices, return_repeaters)
     check = DATA_TELEGRAM_BITS * (LOOPBACK_BYTES + data_bytes) + POS_CONTROL
     last_stop = total - 1
     return CyclePhases(check, last_stop - STATUS_TELEGRAM_BITS * (LATCH_STATUS_TELEGRAMS - 1), last_stop, total)
 
 
-def reset_bits(devices: int) -> int:
-    """Bit periods of an INTERBUS reset sequence, including the ring delay of its end (assumption A12)."""
-    return RESET_HOLD_BITS + STATUS_TELEGRAM_BITS * (RESET_END_STATUS_TELEGRAMS + ring_delay_status_telegrams(devices))
+def reset_bits(devices: int, return_repeaters: int = 0) -> int:
+    """Bit periods of an INTERBUS reset sequence, including the ring delay of its end (assumption A12) over
+    ``devices`` with ``return_repeaters`` LBD-MR devices among them (:func:`ring_delay_status_telegrams`)."""
+    delay = ring_delay_status_telegrams(devices, return_repeaters)
+    return RESET_HOLD_BITS + STATUS_TELEGRAM_BITS * (RESET_END_STATUS_TELEGRAMS + delay)
 
 
 def check_bit_rate(bit_rate: int) -> int:
@@ -985,10 +993,11 @@ def cycle_levels(frame: Frame, devices: int, latch: bool) -> LevelArray:
     )
 
 
-def reset_levels(devices: int) -> LevelArray:
-    """Level sequence of an INTERBUS reset (Alarm Stop): the line held low, then idle status telegrams."""
+def reset_levels(devices: int, return_repeaters: int = 0) -> LevelArray:
+    """Level sequence of an INTERBUS reset (Alarm Stop): the line held low, then idle status telegrams (their count
+    :func:`reset_bits`'s)."""
     low = np.full(RESET_HOLD_BITS, START_LEVEL, dtype=np.uint8)
-    end = RESET_END_STATUS_TELEGRAMS + ring_delay_status_telegrams(devices)
+    end = RESET_END_STATUS_TELEGRAMS + ring_delay_status_telegrams(devices, return_repeaters)
     return np.concatenate([low, status_levels(Cycle.DATA, False, end)])
 
 

@@ -40,11 +40,19 @@ from supi3.checks import (
     check_trace,
     fail,
 )
-from supi3.config import DeviceConfig, Interface
+from supi3.config import DeviceConfig
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusError
 from supi3.interbus.receiver import receive
-from supi3.interbus.ring import Branch, BranchKind, ErrorKind, Transfer, return_inputs, terminal_positions
+from supi3.interbus.ring import (
+    Branch,
+    BranchKind,
+    ErrorKind,
+    Transfer,
+    return_inputs,
+    return_repeaters,
+    terminal_positions,
+)
 from supi3.interbus.wire import Cycle, Frame, LineReset, Telegram
 from supi3.model.chip import Supi3
 from supi3.model.pins import PinTrace, Supi3Pins
@@ -148,12 +156,6 @@ def _in_path(items: Sequence[PinChip | PinBranch]) -> list[PinChip]:
     return found
 
 
-def _repeaters(chips: Sequence[PinChip]) -> int:
-    """The repeaters a bit passes through ``chips`` (A10): each chip on the forward line, an LBD-MR chip once more on
-    its return line (its counter block repeats it, M17, BK-35)."""
-    return len(chips) + sum(chip.config.interface is Interface.LBD_MR for chip in chips)
-
-
 IDLE_PIECE_TELEGRAMS: Final[int] = 64
 """The status telegrams :meth:`PinRing.idle` runs at a time (under 2 ms of bus time at 500 kbit/s): memory stays
 bounded over an idle of any length, as every chip's pin traces of one run are held at once (about 260 bytes a clock:
@@ -205,7 +207,8 @@ class PinRing:
         self.tree: list[PinChip | PinBranch] = list(chips)
         """The ring's items as given (:class:`PinBranch` for a BK with its branch)."""
         self.devices = every
-        self.repeaters = _repeaters(every)
+        self._loops = return_repeaters(every)
+        self.repeaters = len(every) + self._loops
         """The repeaters a bit passes round the whole tree, each ``REPEATER_DELAY_BITS`` (A10): every chip on the
         forward line, and an LBD-MR chip once more on its return line (its counter block repeats it, M17). The end of
         an INTERBUS reset allows for them (A12: every branch may be in the data path after it, BK-9, BK-37); a cycle's
@@ -236,7 +239,8 @@ class PinRing:
         """The repeaters of the chips in the data path now (:attr:`repeaters` of the data path, A10): a cycle's ring
         delay (A11) counts them, as the transaction level's cycle counts ``Ring.devices`` (BK-53); a branch closed,
         switched off or not recognised adds no delay (its BK sends on its own transmitter, BK-37)."""
-        return _repeaters(_in_path(self.tree))
+        path = _in_path(self.tree)
+        return len(path) + return_repeaters(path)
 
     @property
     def now(self) -> float:
@@ -429,7 +433,8 @@ class PinRing:
         path = _in_path(self.tree)
         n = len(path)
         frame = Frame.build(cycle, data)
-        delay = wire.ring_delay_status_telegrams(_repeaters(path))
+        loops = return_repeaters(path)
+        delay = wire.ring_delay_status_telegrams(n, loops)
         self.run_levels(np.concatenate([wire.frame_levels(frame), wire.status_levels(cycle, False, delay)]))
         telegrams, error = self._received()
         receiver_error: ErrorKind | None = ErrorKind.TELEGRAM if error else None
@@ -450,7 +455,7 @@ class PinRing:
                     flags = decoded
                 if wire.crc16(back.data) != back.crc:
                     receiver_error = receiver_error or ErrorKind.CRC
-        return Transfer(cycle, bytes(data), n, returned, flags, receiver_error, [], n)
+        return Transfer(cycle, bytes(data), n, returned, flags, receiver_error, [], n, return_repeaters=loops)
 
     def finish(self, transfer: Transfer, latch: bool) -> None:
         """Send the verdict: the latch telegrams, or idle ones."""
@@ -461,12 +466,12 @@ class PinRing:
 
     def reset(self) -> None:
         """INTERBUS reset: the line held low, then idle status telegrams (``wire.reset_levels``)."""
-        self.run_levels(wire.reset_levels(self.repeaters))
+        self.run_levels(wire.reset_levels(len(self.devices), self._loops))
         self._received()
 
     def settle(self) -> None:
         """Idle status telegrams for the ring delay of the whole tree, so the last telegrams sent reach every chip."""
-        delay = wire.ring_delay_status_telegrams(self.repeaters)
+        delay = wire.ring_delay_status_telegrams(len(self.devices), self._loops)
         self.run_levels(wire.status_levels(Cycle.DATA, False, delay))
         self._received()
 

@@ -232,8 +232,9 @@ class CounterRtl(wiring.Component):
                 k = Mux(silent, 0, gen)
                 comb += [out.eq(Const(GENERATED_TELEGRAM, wire.DATA_TELEGRAM_BITS).bit_select(k, 1)), drive.eq(1)]
                 sync += gen.eq(k + 1)  # the stop bit's k + 1 is IDLE_BIT
-                with m.If(silent):
-                    sync += quiet.eq(quiet_start)
+                with m.If(silent):  # BK-58: count 0, seen
+                    sync += [quiet.eq(quiet_start), counted.eq(0)]
+                    comb += seen_now.eq(1)
             with m.Elif(drop & ~idle_rx):
                 comb += [out.eq(wire.IDLE_LEVEL), drive.eq(1)]
             with m.Else():

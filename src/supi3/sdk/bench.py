@@ -415,7 +415,7 @@ class Bench:
         self._events: list[tuple[float, str]] = []  # this cycle's phase changes, latest first
         self._next_start = 0.0
         self._next_at = 0.0  # the time of the next bus event: the last of _events, else _next_start
-        self._phases = ((-1, -1), wire.CyclePhases(0, 0, 0, 0))  # (data bytes, devices) of the last cycle, its phases
+        self._phases = ((-1, -1, -1), wire.CyclePhases(0, 0, 0, 0))  # (data bytes, devices, return repeaters), phases
         self._started = False
         self._irq_level = 1
         self._irq_fell_at: float | None = None
@@ -487,7 +487,7 @@ class Bench:
         if pending is None:  # cannot happen: every master cycle ends with a finish
             raise BenchError("the master ran a cycle without finishing it")
         transfer, _, start = pending
-        size = (len(transfer.sent) - wire.LOOPBACK_BYTES, transfer.devices)
+        size = (len(transfer.sent) - wire.LOOPBACK_BYTES, transfer.devices, transfer.return_repeaters)
         if size != self._phases[0]:
             self._phases = (size, wire.cycle_phases(*size))
         timing = CycleTiming(start, transfer.cycle, self._phases[1], self._bit_s)

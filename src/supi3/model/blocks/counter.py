@@ -20,7 +20,8 @@ What happens at the clock edge ending a cycle, from that cycle's inputs (:mod:`s
 Outputs during a cycle come from the state: ``out`` and ``drive`` from the newest queue entry whose countdown is
 1..``cpb`` (the chip transmitter's rule, M8: the bit is sent ``REPEATER_DELAY_BITS`` after it began on the pin), the
 idle level and 0 when that entry has run out or none has begun; ``seen`` is 1 in the cycle after a counter
-telegram's stop bit was sampled; ``count`` is the spec state's ``counted``.
+telegram's stop bit was sampled or the generator began on a silent line (``count`` 0 then, BK-58); ``count`` is the
+spec state's ``counted``.
 
 In the chip core (:class:`LineCounters`, M17: ``supi3.model.pins.Supi3Pins`` in the LBD modes) the same block is
 clocked by :meth:`CounterBlock.clock`, replayed over a ``run()`` by :meth:`CounterBlock.advance` (only the cycles
