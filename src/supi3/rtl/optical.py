@@ -312,7 +312,7 @@ class OpticalRtl(wiring.Component):
                     for medium_bit in (0, 1):
                         with m.Case(medium_bit | fast << 1):
                             shift = length_shift(rate, Medium(medium_bit))
-                            comb += code.eq(self._code(read[prescale[fast] :], shift))
+                            comb += code.eq(self._code(read, prescale[fast], shift))
             with m.If(self.ib_reset):
                 sync += running.eq(0)
             with m.Else():
@@ -327,8 +327,11 @@ class OpticalRtl(wiring.Component):
         return m
 
     @staticmethod
-    def _code(counter: Value, shift: int) -> Value:
-        """``min(63, counter << shift)`` (``>>`` for a negative shift)."""
-        scaled = counter << shift if shift >= 0 else counter >> -shift
-        return Mux(scaled > LENGTH_MAX_CODE, LENGTH_MAX_CODE, scaled)
-
+    def _code(clocks: Value, prescale: int, shift: int) -> Value:
+        """``min(63, (clocks >> prescale) << shift)`` (``>>`` for a negative shift) as ``clocks`` shifted right by
+        ``prescale - shift`` with its low ``shift`` bits cleared: the saturation compare depends only on the net
+        shift, so the rates and media with the same one share it (and synthesis merges their identical cells)."""
+        net = prescale - shift
+        scaled = clocks >> net if net >= 0 else clocks << -net
+        cleared = (1 << LENGTH_MAX_CODE.bit_length()) - (1 << max(shift, 0))  # the bits the prescale shifted out
+        return Mux(scaled > LENGTH_MAX_CODE, LENGTH_MAX_CODE, scaled[: LENGTH_MAX_CODE.bit_length()] & cleared)
