@@ -159,6 +159,14 @@ def _start(mode: Value, present: Value) -> Value:
     return Mux(present, phase, _phase(Phase.OFF))
 
 
+def _moved(level: Value, up: Value) -> Value:
+    """``level`` one step up (``up``) or down, held at :data:`~supi3.optical.regulation.MAX_LEVEL` and
+    :data:`~supi3.optical.regulation.MIN_LEVEL`: one adder of +1 or -1 (all ones) for both directions."""
+    step = Mux(up, 1, (1 << len(level)) - 1)
+    held = Mux(up, level == MAX_LEVEL, level == MIN_LEVEL)
+    return Mux(held, level, (level + step)[: len(level)])
+
+
 def _transitions(m: Module, tx: _Tx, new: _Tx, strobes: tuple[Value, Value, Value, Value, Value],
                  timeout: Value) -> None:
     """``new`` = ``tx`` after this edge's strobes (``resp_valid``, ``resp``, ``test_valid``, ``ack1``, ``ack2`` of
@@ -170,27 +178,29 @@ def _transitions(m: Module, tx: _Tx, new: _Tx, strobes: tuple[Value, Value, Valu
     resp_valid, resp, test_valid, ack1, ack2 = strobes
     mid = _Tx.signals("mid", tx)
     comb += mid.eq(tx)
+    # an initializing transmitter's level is above MIN_LEVEL (INIT_MAX_STEPS steps down from MAX_LEVEL at most)
+    resp_moved = _moved(tx.level, resp == Response.NOT_DETECTED)
     with m.If(resp_valid & tx.is_(Phase.INIT)), m.Switch(resp):
         with m.Case(Response.NONE):
             comb += mid.set(Phase.FIXED)
         with m.Case(Response.NOT_DETECTED):  # one up; MAU at MAX itself or reaching it from MAX - 1
-            comb += mid.set(Phase.ONLINE, Mux(tx.level == MAX_LEVEL, MAX_LEVEL, tx.level + 1),
-                            tx.level >= MAX_LEVEL - 1)  # fmt: skip
+            comb += mid.set(Phase.ONLINE, resp_moved, tx.level >= MAX_LEVEL - 1)
         with m.Case(Response.DETECTED):  # one down; online after the last of INIT_MAX_STEPS steps
-            comb += mid.level.eq(tx.level - 1)
+            comb += mid.level.eq(resp_moved)
             with m.If(tx.level == MAX_LEVEL - INIT_MAX_STEPS + 1):
                 comb += mid.phase.eq(_phase(Phase.ONLINE))
     comb += new.eq(mid)
+    test_moved = _moved(mid.level, ~ack1)
     with m.If(test_valid & mid.is_(Phase.ONLINE)):
         with m.If(~ack1):  # failed: one up, MAU at MAX or reaching it
-            comb += [new.level.eq(Mux(mid.level == MAX_LEVEL, MAX_LEVEL, mid.level + 1)), new.passes.eq(0),
+            comb += [new.level.eq(test_moved), new.passes.eq(0),
                      new.mau.eq(mid.mau | (mid.level >= MAX_LEVEL - 1))]  # fmt: skip
         with m.Elif(~ack2):
             comb += new.passes.eq(0)
         with m.Elif(mid.passes + 1 < DECREASE_AFTER):
             comb += new.passes.eq(mid.passes + 1)
         with m.Else():  # passed DECREASE_AFTER times: one down, MAU off leaving MAX - 1
-            comb += [new.level.eq(Mux(mid.level == MIN_LEVEL, MIN_LEVEL, mid.level - 1)), new.passes.eq(0),
+            comb += [new.level.eq(test_moved), new.passes.eq(0),
                      new.mau.eq(mid.mau & (mid.level != MAX_LEVEL - 1))]  # fmt: skip
     with m.Elif(test_valid & mid.is_(Phase.DIAGNOSTIC)):  # diagnostic_mau
         comb += new.mau.eq(~ack1 | (~ack2 & mid.mau))
@@ -312,7 +322,7 @@ class OpticalRtl(wiring.Component):
                     for medium_bit in (0, 1):
                         with m.Case(medium_bit | fast << 1):
                             shift = length_shift(rate, Medium(medium_bit))
-                            comb += code.eq(self._code(read[prescale[fast] :], shift))
+                            comb += code.eq(self._code(read, prescale[fast], shift))
             with m.If(self.ib_reset):
                 sync += running.eq(0)
             with m.Else():
@@ -327,8 +337,11 @@ class OpticalRtl(wiring.Component):
         return m
 
     @staticmethod
-    def _code(counter: Value, shift: int) -> Value:
-        """``min(63, counter << shift)`` (``>>`` for a negative shift)."""
-        scaled = counter << shift if shift >= 0 else counter >> -shift
-        return Mux(scaled > LENGTH_MAX_CODE, LENGTH_MAX_CODE, scaled)
-
+    def _code(clocks: Value, prescale: int, shift: int) -> Value:
+        """``min(63, (clocks >> prescale) << shift)`` (``>>`` for a negative shift) as ``clocks`` shifted right by
+        ``prescale - shift`` with its low ``shift`` bits cleared: the saturation compare depends only on the net
+        shift, so the rates and media with the same one share it (and synthesis merges their identical cells)."""
+        net = prescale - shift
+        scaled = clocks >> net if net >= 0 else clocks << -net
+        cleared = (1 << LENGTH_MAX_CODE.bit_length()) - (1 << max(shift, 0))  # the bits the prescale shifted out
+        return Mux(scaled > LENGTH_MAX_CODE, LENGTH_MAX_CODE, scaled[: LENGTH_MAX_CODE.bit_length()] & cleared)

@@ -153,25 +153,26 @@ class SerialIoRtl(wiring.Component):
         # The sequence's kind and counters are read only while ``busy`` (which has its reset) and set where a
         # sequence begins: no reset.
         kind = Signal(range(2 * _CLEAR), reset_less=True)
-        read_on, write_on, conv_on = Signal(), Signal(), Signal()
-        read_start, read_end, write_start, write_end = (Signal(slot_range, name=n) for n in ("rs", "re", "ws", "we"))
-        final = Signal(slot_range)  # the sequence's last slot
-        write_after = Signal()  # the write frame follows a read frame, from the slot after ``write_before``
-        write_before = Signal(slot_range)
+        # Each case compares the slot count with its own constants (a few gates each) and only the 1-bit results
+        # are chosen by the case: no multiplexed slot constants and no comparators between two signals.
+        slot = Signal(slot_range, reset_less=True)
+        read_on, conv_on = Signal(), Signal()
+        reading, writing = Signal(), Signal()  # the slot is in the read frame, in the write frame
+        final = Signal()  # the slot is the sequence's last
+        write_next = Signal()  # the write frame follows a read frame and begins with the next slot
         cases: dict[_Slots, list[int]] = {}
         for (kind_value, wide, rate), constants in self.slots.items():
             cases.setdefault(constants, []).append(kind_value | (wide << len(kind)) | (rate << (len(kind) + 1)))
         with m.Switch(Cat(kind, self.wide, self.rate)):
             for constants, patterns in cases.items():
                 with m.Case(*patterns):
-                    comb += final.eq(constants.length - 1)
+                    comb += final.eq(slot == constants.length - 1)
                     if constants.write is not None and constants.write[0] > 0:
-                        comb += [write_after.eq(1), write_before.eq(constants.write[0] - 1)]
-                    comb += conv_on.eq(constants.conv is not None)  # in the last slot (``_in_slots``)
-                    for frame, on, first, end in ((constants.read, read_on, read_start, read_end),
-                                                  (constants.write, write_on, write_start, write_end)):  # fmt: skip
+                        comb += write_next.eq(slot == constants.write[0] - 1)
+                    comb += [conv_on.eq(constants.conv is not None), read_on.eq(constants.read is not None)]
+                    for frame, window in ((constants.read, reading), (constants.write, writing)):
                         if frame is not None:
-                            comb += [on.eq(1), first.eq(frame[0]), end.eq(frame[1])]
+                            comb += window.eq((slot >= frame[0]) & (slot < frame[1]))
         # Sequences a reset starts: the clear sequence of this mode's direction, if it has one.
         has_clear = Signal()
         with m.Switch(self.direction):
@@ -191,14 +192,13 @@ class SerialIoRtl(wiring.Component):
         # sequence counter counts t0 slots: ``slot`` steps at the clock ending each t0 of the sequence. ``sub``
         # is (clocks since the sequence began + t0/2) mod t0 throughout (every sequence and frame starts it at
         # t0/2 and each begins on a whole t0), so that clock is the one with ``sub == t0/2 - 1``.
-        slot = Signal(slot_range, reset_less=True)
         sub = Signal(range(max(self.t0s)), reset_less=True)  # clock within a t0, 0 at a bit slot's first cycle
         slot_ends = per_t0(lambda t0: sub == (t0 >> 1) - 1)
         lead = Signal(reset_less=True)  # the half t0 between /SS falling and the first slot
         within = Signal(range(spec.BYTE_SLOTS), reset_less=True)  # slot within a byte: bits 0..7, then the pause slot
         pause = within == spec.BYTE_SLOTS - 1
-        in_read = busy & read_on & (slot >= read_start) & (slot < read_end)
-        in_write = busy & write_on & (slot >= write_start) & (slot < write_end)
+        in_read = busy & reading
+        in_write = busy & writing
         in_frame = in_read | in_write
         high = per_t0(lambda t0: sub >= (t0 >> 1))
         # The shift registers are written before they are read: every start loads ``out_shift`` (a clear sequence
@@ -215,7 +215,7 @@ class SerialIoRtl(wiring.Component):
         sample_after = frame_probe.sample(0) + SYNC_STAGES - frame_probe.rising(0)  # clocks after SCLK rose
 
         levels = {
-            "conv_n": ~(busy & conv_on & (slot == final)),
+            "conv_n": ~(busy & conv_on & final),
             "sclk": in_frame & ~lead & ~pause & high,
             "ss_n": ~in_frame,
             "ser_out": in_write & ~lead & ~clearing & Mux(self.wide, out_shift[-1], out_shift[WIDTHS[0] - 1]),
@@ -227,7 +227,7 @@ class SerialIoRtl(wiring.Component):
             """The slot counters as they stand in a frame's first cycle: in the lead half t0."""
             return [sub.eq(per_t0(lambda t0: t0 >> 1)), lead.eq(1), within.eq(0)]
 
-        last = busy & slot_ends & (slot == final)
+        last = busy & slot_ends & final
         with m.If(busy):
             with m.If(slot_ends):
                 sync += slot.eq(slot + 1)
@@ -243,7 +243,7 @@ class SerialIoRtl(wiring.Component):
                 sync += sub.eq(sub + 1)
             with m.If(in_read & ~lead & ~pause & per_t0(lambda t0: sub == (t0 >> 1) + sample_after)):
                 sync += in_shift.eq(Cat(self.ser_in, in_shift[:-1]))
-            with m.If(write_after & slot_ends & (slot == write_before)):
+            with m.If(write_next & slot_ends):
                 sync += frame_begins()
         with m.If(last):
             sync += busy.eq(0)
