@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 
 from supi3 import tables
 from supi3.config import DeviceConfig, decode
+from supi3.diagnostics import IbDiag
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusError
@@ -474,6 +475,10 @@ def test_a_cut_is_numbered_by_the_physical_position_at_both_fidelities_in_every_
         tl.cut(2, False, branch="yes")  # type: ignore[arg-type]
 
 
+ChipView = tuple[bool, bool, bool, bool, bool, bool, IbDiag, int, int]
+"""A chip's RC, BA, RD, LD, E, ALARM, IB_DIAG pattern, OUT data and valid data cycles latched."""
+
+
 def remote_return_cut(ring: Ring | PinRing, position: int, locate: bool) -> list[object]:
     """What a master sees when the remote bus's return input into ``position`` is cut (BK-59) after a latched data
     cycle: three cycles with new OUT data, then the repair and :data:`~support.REPAIR_IDLE_TELEGRAMS` idle telegrams
@@ -488,11 +493,11 @@ def remote_return_cut(ring: Ring | PinRing, position: int, locate: bool) -> list
             if entry.data_bytes:
                 master.set_outputs(entry.number, bytes([value + entry.ring_position]))
 
-    def chips() -> list[tuple[object, ...]]:
+    def chips() -> list[ChipView]:
         if isinstance(ring, PinRing):
             ring.settle()
-        found = []
-        for device in ring.devices if isinstance(ring, PinRing) else ring.devices:
+        found: list[ChipView] = []
+        for device in ring.devices:
             chip = device.chip if isinstance(device, Supi3Pins) else device
             assert isinstance(chip, Supi3)
             leds = chip.diagnostic_outputs
@@ -551,8 +556,9 @@ def test_a_remote_bus_return_cut_is_the_same_at_both_fidelities(n: int, bit_rate
         seen = remote_return_cut(tl, k, False)
         assert seen == remote_return_cut(pin, k, False), k
         assert seen[2] == (Cycle.DATA, False, [(ErrorKind.DEAD_LINE, None, None, "no telegram came back", False)])
-        assert all(chip[0] and chip[6].name == "STEADY" for chip in seen[5])  # type: ignore[union-attr, index]
-        assert [chip[8] for chip in seen[5]] == [1] * n  # type: ignore[union-attr, index]
+        leds = seen[5]
+        assert isinstance(leds, list) and all(chip[0] and chip[6] is IbDiag.STEADY for chip in leds)
+        assert [chip[8] for chip in leds] == [1] * n
         tl, _ = flat_rings(n, bit_rate)
         located = remote_return_cut(tl, k, True)[2]
         assert located == (Cycle.DATA, False, [(ErrorKind.DEAD_LINE, k + 1, f"{k + 1}.0", "no telegram came back; "
@@ -572,10 +578,12 @@ def test_a_remote_bus_return_cut_around_a_bk_is_the_same_at_both_fidelities(kind
     device behind its branch (5), the device driving the broken line."""
     seen = remote_return_cut(tl_tree(kind, 2), position, False)
     assert seen == remote_return_cut(pin_tree(kind, 2), position, False)
-    assert not any(chip[4] for chip in seen[5])  # type: ignore[union-attr, index]
+    leds = seen[5]
+    assert isinstance(leds, list) and not any(chip[4] for chip in leds)
     found = remote_return_cut(tl_tree(kind, 2), position, True)[2]
     behind = 2 if position == 1 else 5
-    assert isinstance(found, tuple) and found[2][0][:3] == (ErrorKind.DEAD_LINE, behind, f"{behind - 2 * (position - 1)}.0")
+    number = "2.0" if position == 1 else "3.0"
+    assert isinstance(found, tuple) and found[2][0][:3] == (ErrorKind.DEAD_LINE, behind, number)
 
 
 @pytest.mark.parametrize(("kind", "m"), CASES)
@@ -672,8 +680,9 @@ def test_a_master_sees_every_cycle_alike_over_any_history(case: tuple[BranchKind
     the physical position at both fidelities, BK-52), the master's every cycle (success, diagnostics, their count, the
     configuration and process data) is the same at both fidelities, with cuts of the remote bus's return lines before
     and after the BK too (BK-59): the master idles after a latched switch (BK-46) and the BK switches its lines between
-    telegrams (BK-47), so no telegram is cut and nothing in flight is lost. A cut in an LBD branch too: the counter telegrams that reach the master are no frame, a dead line at both (BK-49),
-    and the BK keeps the same count (0 with its DI3 cut, BK-58)."""
+    telegrams (BK-47), so no telegram is cut and nothing in flight is lost. A cut in an LBD branch too: the counter
+    telegrams that reach the master are no frame, a dead line at both (BK-49), and the BK keeps the same count (0 with
+    its DI3 cut, BK-58)."""
     kind, m = case
     ops = [(op, min(k, 2 + m)) for op, k in ops]
     # The same short silence at both (BK-3): a history switching the extended function on and cutting closes (BK-50).
