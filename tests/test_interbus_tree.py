@@ -76,6 +76,27 @@ def test_a_flat_ring_is_no_tree() -> None:
     assert not ring.tree and ring.spans == []
     with pytest.raises(InterbusError, match="return line"):
         ring.inject(ReturnBreak(1))
+    with pytest.raises(ArgumentError, match=r"^position must be .*not into the last of the ring"):
+        ring.cut(1, False)
+
+
+def test_a_flat_ring_breaks_its_return_lines_by_one_rule() -> None:
+    """BK-59: in a flat ring every device but the last has a return input from the next (``return_inputs``): a
+    ``ReturnBreak`` or ``cut(k, False)`` there, refused by name at the last device and outside the ring."""
+    ring = Ring([PlainDevice(0x03, 0b01001) for _ in range(3)])
+    master = Master(ring, locate=True)
+    assert master.start().ok
+    ring.inject(ReturnBreak(2))
+    found = master.cycle().diagnostics[0]
+    assert (found.kind, found.location, found.return_line) == (ErrorKind.DEAD_LINE, 3, False)
+    ring.clear_faults()
+    ring.cut(1, False)
+    assert master.cycle().diagnostics[0].location == 2
+    with pytest.raises(InterbusError, match=r"a return line enters only .*not the last of the ring"):
+        ring.inject(ReturnBreak(3))
+    for bad in (0, 3, 4):
+        with pytest.raises(ArgumentError, match=r"^position must be"):
+            ring.cut(bad, False)
 
 
 def test_master_switches_a_branch_off_and_on_without_a_configuration_error() -> None:
