@@ -247,7 +247,7 @@ def test_a_cycle_broken_by_any_cut_latches_nothing(kind: BranchKind) -> None:
         for _ in range(3):
             assert master.cycle().ok
         tree = ring._tree
-        if not forward and position not in (terminal_positions(tree) if branch else return_inputs(tree, returns=False)):
+        if not forward and position not in (terminal_positions(tree) if branch else return_inputs(tree)):
             with pytest.raises(ArgumentError, match="position must be"):
                 ring.cut(position, forward, branch=branch)
             continue

@@ -76,6 +76,27 @@ def test_a_flat_ring_is_no_tree() -> None:
     assert not ring.tree and ring.spans == []
     with pytest.raises(InterbusError, match="return line"):
         ring.inject(ReturnBreak(1))
+    with pytest.raises(ArgumentError, match=r"^position must be .*not into the last of the ring"):
+        ring.cut(1, False)
+
+
+def test_a_flat_ring_breaks_its_return_lines_by_one_rule() -> None:
+    """BK-59: in a flat ring every device but the last has a return input from the next (``return_inputs``): a
+    ``ReturnBreak`` or ``cut(k, False)`` there, refused by name at the last device and outside the ring."""
+    ring = Ring([PlainDevice(0x03, 0b01001) for _ in range(3)])
+    master = Master(ring, locate=True)
+    assert master.start().ok
+    ring.inject(ReturnBreak(2))
+    found = master.cycle().diagnostics[0]
+    assert (found.kind, found.location, found.return_line) == (ErrorKind.DEAD_LINE, 3, False)
+    ring.clear_faults()
+    ring.cut(1, False)
+    assert master.cycle().diagnostics[0].location == 2
+    with pytest.raises(InterbusError, match=r"a return line enters only .*not the last of the ring"):
+        ring.inject(ReturnBreak(3))
+    for bad in (0, 3, 4):
+        with pytest.raises(ArgumentError, match=r"^position must be"):
+            ring.cut(bad, False)
 
 
 def test_master_switches_a_branch_off_and_on_without_a_configuration_error() -> None:
@@ -148,6 +169,22 @@ def test_return_break_in_a_branch_without_diagnostics_is_where_the_search_finds_
     ring.inject(ReturnBreak(9))  # BK-LB's return input: the ring fails first when closed after 5.1
     found = master.cycle().diagnostics[0]
     assert (found.location, found.return_line) == (10, False)
+
+
+@pytest.mark.parametrize(("cut", "found"), [(1, 2), (2, 9), (9, 12), (12, 16)])
+def test_a_remote_bus_return_break_is_located_behind_the_branches(cut: int, found: int) -> None:
+    """BK-59: the remote bus's return input into ``cut`` (1.0, the BK-RB 2.0, the BK-LB 5.0, the BK-LBD 6.0) from the
+    next remote bus device: nothing comes back (a dead line); the segment search finds the ring failing first when
+    closed after that device, behind the branches between (2.0's nested BK-LBD with them: the return line into 2.0
+    comes from 5.0, at 9); no BK reports a break of its branch."""
+    ring, master, bks = figure_1_10()
+    ring.cut(cut, False)
+    diagnostic = master.cycle().diagnostics[0]
+    assert (diagnostic.kind, diagnostic.location, diagnostic.return_line) == (ErrorKind.DEAD_LINE, found, False)
+    assert "segment search" in diagnostic.detail
+    assert not any(bk.diagnostic_outputs.e for bk in bks.values())
+    ring.clear_faults()
+    healthy(master, ring)
 
 
 def test_conf_edge_is_an_acknowledged_reconfiguration_request() -> None:
@@ -270,9 +307,10 @@ def test_ring_refuses_one_device_twice_and_bad_return_breaks() -> None:
     with pytest.raises(ArgumentError, match=r"^devices must be distinct objects"):
         Ring([Branch(terminal("BK-LB"), [device], BranchKind.LOCAL), device])
     ring, _, _ = figure_1_10()
-    for segment in (1, 8, 13, 16):  # a remote device, the last of an MR branch, an OR device, the last device
+    for segment in (8, 13, 16):  # the last of an MR branch, an OR device, the last device
         with pytest.raises(InterbusError, match="a return line enters only"):
             ring.inject(ReturnBreak(segment))
+    ring.inject(ReturnBreak(1))  # the remote bus's return input into 1.0 from 2.0 (BK-59)
     with pytest.raises(InterbusError, match=r"line must be in 1\.\.16"):
         ring.inject(ReturnBreak(17))
     with pytest.raises(ArgumentError, match=r"^fault must be"):

@@ -13,8 +13,10 @@ from hypothesis import strategies as st
 
 from supi3 import tables
 from supi3.config import DeviceConfig, decode
+from supi3.diagnostics import IbDiag
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
+from supi3.interbus.errors import InterbusError
 from supi3.interbus.master import CycleResult, Master
 from supi3.interbus.ring import Branch, BranchKind, DeadLine, ErrorKind, ReturnBreak, Ring, Transfer, lbd_count
 from supi3.interbus.wire import Cycle
@@ -27,7 +29,7 @@ from supi3.spi.upif import Mode
 from supi3.tables import CLOCK_HZ
 from supi3.terminal import DO3_PIN, LBST_PIN
 from supi3.top import UP_REST, Supi3Chip
-from support import BK_STRAPS
+from support import BK_STRAPS, REPAIR_IDLE_TELEGRAMS
 from test_model_pinring import ONE_BYTE, Firmware
 
 FAST = tables.clk_conf_for(2_000_000)
@@ -425,11 +427,11 @@ def test_a_cut_is_numbered_by_the_physical_position_at_both_fidelities_in_every_
     """BK-52: ``Ring.cut`` takes the breaks ``PinRing.cut`` takes, by the same physical positions (BK-1: a BK, its
     branch's devices, nested branches in place), whether the branch is in the data path or switched off: forward lines
     into every device, the return line into a branch device from the one behind it, a BK's branch return input
-    (``branch``); only the remote bus's return lines outside branches stay abstract at transaction level (BK-10). A
-    ``ReturnBreak`` injected at a BK is its branch return input, also with the branch switched off."""
+    (``branch``), and the remote bus's return inputs outside branches (BK-59: positions 1 and 2, from the BK or from the
+    device behind its branch; before, abstract at transaction level). A ``ReturnBreak`` injected at a BK is its branch
+    return input, also with the branch switched off; one at a remote bus device the return input from the next."""
     tl, pin = (tl_tree(BranchKind.LOCAL, 2), pin_tree(BranchKind.LOCAL, 2)) if tree == "local" else \
         (nested_tl(), nested_pin())  # fmt: skip
-    outside = {1, 2}  # the return inputs of the remote bus outside branches: positions 1 and 2 (from 3 or 6)
 
     def taken(ring: Ring | PinRing) -> set[tuple[int, bool, bool]]:
         found, refused = set(), []
@@ -455,17 +457,133 @@ def test_a_cut_is_numbered_by_the_physical_position_at_both_fidelities_in_every_
             master.switch_branch(2, False)
             healthy(master)
             assert len(tl.devices) == 3
-        assert taken(tl) == {cut for cut in at_pin if cut[1] or cut[2] or cut[0] not in outside}, on
+        assert taken(tl) == at_pin, on
         tl.clear_faults()
         tl.inject(ReturnBreak(2))  # the BK's branch return input in every state
+        tl.inject(ReturnBreak(1))  # the remote bus's return input from the BK (BK-59)
         tl.clear_faults()
-    with pytest.raises(ArgumentError, match=r"BK-10"):
-        tl.cut(1, False)
+    last = len(pin.devices)  # the last device of the ring: no return input (it closes the ring itself)
+    for ring in (tl, pin):
+        with pytest.raises(ArgumentError, match=r"^position must be .*not into the last of the ring"):
+            ring.cut(last, False)
+    with pytest.raises(InterbusError, match=r"a return line enters only .*not the last of the ring"):
+        tl.inject(ReturnBreak(len(tl.devices)))
     for bad, name in (((2, 1), "forward"), ((True, True), "position"), ((2.0, True), "position")):
         with pytest.raises(ArgumentError, match=rf"^{name} must be"):
             tl.cut(*bad)
     with pytest.raises(ArgumentError, match=r"^branch must be"):
         tl.cut(2, False, branch="yes")  # type: ignore[arg-type]
+
+
+ChipView = tuple[bool, bool, bool, bool, bool, bool, IbDiag, int, int]
+"""A chip's RC, BA, RD, LD, E, ALARM, IB_DIAG pattern, OUT data and valid data cycles latched."""
+
+
+def remote_return_cut(ring: Ring | PinRing, position: int, locate: bool) -> list[object]:
+    """What a master sees when the remote bus's return input into ``position`` is cut (BK-59) after a latched data
+    cycle: three cycles with new OUT data, then the repair and :data:`~support.REPAIR_IDLE_TELEGRAMS` idle telegrams
+    (M21) and three cycles; after each part every chip's LEDs (Tables 3-16 to 3-19: UL aside, the transaction level
+    has no supply, RC, BA, RD, LD, E, ALARM, the IB_DIAG pattern with its 4 Hz line interrupt ahead, DG-3), its OUT
+    data and how many valid data cycles it latched (3.4.14)."""
+    master = Master(ring, locate=locate, max_devices=8)
+    seen: list[object] = [master.start().ok]
+
+    def send(value: int) -> None:
+        for entry in master.config or ():
+            if entry.data_bytes:
+                master.set_outputs(entry.number, bytes([value + entry.ring_position]))
+
+    def chips() -> list[ChipView]:
+        if isinstance(ring, PinRing):
+            ring.settle()
+        found: list[ChipView] = []
+        for device in ring.devices:
+            chip = device.chip if isinstance(device, Supi3Pins) else device
+            assert isinstance(chip, Supi3)
+            leds = chip.diagnostic_outputs
+            found.append((leds.rc, leds.ba, leds.rd, leds.ld, leds.e, leds.alarm, leds.ib_diag, chip.mfp_outputs,
+                          chip.events["VALID"]))  # fmt: skip
+        return found
+
+    def cycles() -> None:
+        for _ in range(3):
+            result = master.cycle()
+            seen.append((result.cycle, result.ok, [(d.kind, d.location, d.device, d.detail, d.return_line)
+                                                   for d in result.diagnostics]))  # fmt: skip
+
+    send(0x10)
+    seen.append(master.cycle().ok)
+    ring.cut(position, False)
+    send(0x80)
+    cycles()
+    seen.append(chips())
+    if isinstance(ring, Ring):
+        ring.clear_faults()
+    else:
+        ring.cuts.clear()
+    ring.idle(REPAIR_IDLE_TELEGRAMS * wire.STATUS_TELEGRAM_BITS / ring.bit_rate)
+    cycles()
+    seen.append(chips())
+    return seen
+
+
+def flat_rings(n: int, bit_rate: int) -> tuple[Ring, PinRing]:
+    """``n`` RB devices at ``bit_rate`` at both fidelities, reading 10h, 20h, ... on their MFP inputs."""
+    row = next(r for r in tables.MODE_ROWS if r.function == ROWS[BranchKind.REMOTE])
+    config = decode(row.c, row.mfp, clk_conf=tables.clk_conf_for(bit_rate))
+    tl, pin = [Supi3(config) for _ in range(n)], PinRing([Supi3Pins(config) for _ in range(n)])
+    for k, chip in enumerate(tl, 1):
+        chip.set_mfp_inputs(0x10 * k)
+        pin.set_input(k, "mfp_in", 0x10 * k)
+    return Ring(tl, bit_rate=bit_rate), pin
+
+
+NOT_LOCATED = "no telegram came back; not located: this ring cannot be closed early for a segment search"
+
+
+@pytest.mark.parametrize("bit_rate", [500_000, 2_000_000])
+@pytest.mark.parametrize("n", [2, 3, 4])
+def test_a_remote_bus_return_cut_is_the_same_at_both_fidelities(n: int, bit_rate: int) -> None:
+    """BK-59, issue 12: the remote bus's return input into device k from device k + 1 (a flat ring of ``n`` RB
+    devices), cut at both fidelities: nothing comes back, a dead line (``locate=False``: not located) at both; the
+    devices behind the break hear the frame but no latch (3.4.14: OUT data and the valid count stay), no chip's LEDs
+    differ (RC lit everywhere: every incoming forward line carries telegrams, so no 4 Hz line interrupt ahead, DG-3);
+    repaired (M21), the master's next start and cycles pass alike. With ``locate=True`` the segment search of the
+    transaction level finds the first failing closure after k + 1 (the cable between k and k + 1), where the pin
+    level cannot close the ring early and reports it not located (A22)."""
+    for k in range(1, n):
+        tl, pin = flat_rings(n, bit_rate)
+        seen = remote_return_cut(tl, k, False)
+        assert seen == remote_return_cut(pin, k, False), k
+        assert seen[2] == (Cycle.DATA, False, [(ErrorKind.DEAD_LINE, None, None, "no telegram came back", False)])
+        leds = seen[5]
+        assert isinstance(leds, list) and all(chip[0] and chip[6] is IbDiag.STEADY for chip in leds)
+        assert [chip[8] for chip in leds] == [1] * n
+        tl, _ = flat_rings(n, bit_rate)
+        located = remote_return_cut(tl, k, True)[2]
+        assert located == (Cycle.DATA, False, [(ErrorKind.DEAD_LINE, k + 1, f"{k + 1}.0", "no telegram came back; "
+                           f"segment search: the ring fails when closed after position {k + 1}", False)])  # fmt: skip
+    _, pin = flat_rings(n, bit_rate)
+    assert remote_return_cut(pin, 1, True)[2] == (Cycle.DATA, False, [(ErrorKind.DEAD_LINE, None, None, NOT_LOCATED,
+                                                                       False)])  # fmt: skip
+
+
+@pytest.mark.parametrize("kind", [BranchKind.LOCAL, BranchKind.LBD_MR])
+@pytest.mark.parametrize("position", [1, 2])
+def test_a_remote_bus_return_cut_around_a_bk_is_the_same_at_both_fidelities(kind: BranchKind, position: int) -> None:
+    """BK-59: in a tree (RB device, BK with 2 branch devices, RB device) the remote bus's return input before the BK
+    (into the RB device from the BK, ``position`` 1) and after it (into the BK from the RB device behind its branch,
+    2): the same at both fidelities as in a flat ring, the BK's branch untouched (its return line whole: no E, no
+    count); the segment search of the transaction level fails first when closed after the BK (2) or after the RB
+    device behind its branch (5), the device driving the broken line."""
+    seen = remote_return_cut(tl_tree(kind, 2), position, False)
+    assert seen == remote_return_cut(pin_tree(kind, 2), position, False)
+    leds = seen[5]
+    assert isinstance(leds, list) and not any(chip[4] for chip in leds)
+    found = remote_return_cut(tl_tree(kind, 2), position, True)[2]
+    behind = 2 if position == 1 else 5
+    number = "2.0" if position == 1 else "3.0"
+    assert isinstance(found, tuple) and found[2][0][:3] == (ErrorKind.DEAD_LINE, behind, number)
 
 
 @pytest.mark.parametrize(("kind", "m"), CASES)
@@ -499,7 +617,9 @@ def per_cycle(ring: Ring | PinRing, ops: list[tuple[str, int]]) -> list[object]:
     ``off``, ``on``, ``ext`` (``Master.switch_branch``), ``reset`` (``Master.start``: an INTERBUS reset), ``cut``
     (the forward line into the device at physical position ``k``, ``cut(k, True)`` at both fidelities, BK-52, whether
     the branch is in the data path or not: the break sleeps while it is out), ``di3`` (the BK's branch return input,
-    ``cut(2, False, branch=True)``; ``k`` unused), ``repair`` (every break, between two cycles), ``wait`` (nothing:
+    ``cut(2, False, branch=True)``; ``k`` unused), ``ret`` (a return line of the remote bus outside the branch,
+    ``cut(k - 2, False)``: into the first RB device from the BK, or into the BK from the RB device behind its
+    branch, BK-59), ``repair`` (every break, between two cycles), ``wait`` (nothing:
     only the cycles)."""
     master = Master(ring, locate=False, max_devices=8)
     seen: list[object] = []
@@ -511,12 +631,14 @@ def per_cycle(ring: Ring | PinRing, ops: list[tuple[str, int]]) -> list[object]:
     for op, k in ops:
         if op == "reset":
             record(master.start())
-        elif op in ("cut", "di3"):
+        elif op in ("cut", "di3", "ret"):
             # Numbered by the physical position at both fidelities, whether the branch is in the data path (BK-52).
             bk = ring.devices[1]
             seen.append(bool(ring.spans) if isinstance(ring, Ring) else isinstance(bk, Supi3Pins) and bk.branch_in_path)
             if op == "cut":
                 ring.cut(k, True)
+            elif op == "ret":
+                ring.cut(k - 2, False)
             else:
                 ring.cut(2, False, branch=True)
         elif op == "repair":  # every break, between two cycles (the next frame follows at once)
@@ -537,7 +659,8 @@ def per_cycle(ring: Ring | PinRing, ops: list[tuple[str, int]]) -> list[object]:
     return seen
 
 
-HISTORY_OPS = st.lists(st.tuples(st.sampled_from(["off", "on", "ext", "reset", "cut", "di3"]), st.integers(3, 4)),
+HISTORY_OPS = st.lists(st.tuples(st.sampled_from(["off", "on", "ext", "reset", "cut", "di3", "ret"]),
+                                  st.integers(3, 4)),
                        min_size=2, max_size=4)  # fmt: skip
 
 
@@ -548,15 +671,18 @@ HISTORY_OPS = st.lists(st.tuples(st.sampled_from(["off", "on", "ext", "reset", "
 @example((BranchKind.LOCAL, 2), [("off", 3), ("cut", 4), ("on", 3)])  # BK-52: cut while out, awake once back
 @example((BranchKind.LBD_OR, 1), [("di3", 3), ("off", 3)])  # BK-58: the phantom 63 of BK-32 was left at pin level
 @example((BranchKind.LBD_MR, 2), [("cut", 4), ("di3", 3)])  # BK-58: a count, then DI3 cut: 0 at both
+@example((BranchKind.LOCAL, 2), [("ret", 4), ("off", 3), ("reset", 3)])  # BK-59: the remote bus's return, into the BK
+@example((BranchKind.LBD_MR, 1), [("off", 3), ("ret", 3), ("on", 3)])  # BK-59: into the RB device from the BK
 def test_a_master_sees_every_cycle_alike_over_any_history(case: tuple[BranchKind, int], ops: list[tuple[str, int]],
                                                           ) -> None:  # fmt: skip
     """Issue 12: over any history of switching the branch off, on, on with the extended function, INTERBUS resets
     and cuts of a line in the branch or of the BK's DI3, also while the branch is out of the data path (numbered by
     the physical position at both fidelities, BK-52), the master's every cycle (success, diagnostics, their count, the
-    configuration and process data) is the same at both fidelities: the master idles after a latched switch (BK-46)
-    and the BK switches its lines between telegrams (BK-47), so no telegram is cut and nothing in flight is lost. A
-    cut in an LBD branch too: the counter telegrams that reach the master are no frame, a dead line at both (BK-49),
-    and the BK keeps the same count (0 with its DI3 cut, BK-58)."""
+    configuration and process data) is the same at both fidelities, with cuts of the remote bus's return lines before
+    and after the BK too (BK-59): the master idles after a latched switch (BK-46) and the BK switches its lines between
+    telegrams (BK-47), so no telegram is cut and nothing in flight is lost. A cut in an LBD branch too: the counter
+    telegrams that reach the master are no frame, a dead line at both (BK-49), and the BK keeps the same count (0 with
+    its DI3 cut, BK-58)."""
     kind, m = case
     ops = [(op, min(k, 2 + m)) for op, k in ops]
     # The same short silence at both (BK-3): a history switching the extended function on and cutting closes (BK-50).

@@ -26,9 +26,9 @@ physical line it was injected on: it follows that line when branches are switche
 the data path; :meth:`Ring.cut` injects a break by the physical position of the device it enters, as the pin level's
 ``PinRing.cut`` (BK-52). A branch recognised in a cycle's run joins within its frame, which it loses (BK-54), with
 the error of the first line of its loop repaired before that run (BK-56).
-:class:`ReturnBreak` breaks a branch's return line (a branch in the data path with nothing attached is broken so at
-its BK, BK-43), and behind a break in a branch with device-oriented diagnostics the devices send the counter telegram
-to the BK (2.2.2, ``wire.counter_telegram``).
+:class:`ReturnBreak` breaks a return line: a branch's (a branch in the data path with nothing attached is broken so at
+its BK, BK-43) or the remote bus's (BK-59); behind a break in a branch with device-oriented diagnostics the devices
+send the counter telegram to the BK (2.2.2, ``wire.counter_telegram``).
 """
 
 from __future__ import annotations
@@ -162,9 +162,10 @@ class ReturnBreak:
 
     ``segment`` is a bus terminal module with a branch (its branch's return line, from the branch's first device in
     a branch with return, from the last in an LBD-OR branch; whether the branch is in the data path or not, BK-52)
-    or a device of a branch with return lines (REMOTE, LOCAL, LBD_MR) that has a device behind it in the branch (the
-    return line from that device). The ring closed early uses the return line into position *k* only when it is
-    closed behind *k*; permanent unless ``cycles`` is given.
+    or a device with return lines that has a device behind it (the return line from that device): in a branch with
+    return lines (REMOTE, LOCAL, LBD_MR), or on the remote bus outside branches, whose return lines run back into the
+    master (BK-59; :func:`return_inputs`). The ring closed early uses the return line into position *k* only when it
+    is closed behind *k*; permanent unless ``cycles`` is given.
     """
 
     segment: int
@@ -392,8 +393,9 @@ def terminal_positions(items: Sequence[Device | Branch], first: int = 1) -> set[
 
 def return_inputs(items: Sequence[Device | Branch], first: int = 1, returns: bool = True) -> set[int]:
     """The physical positions (from ``first`` on, BK-1) of the devices of ``items`` whose return input a device drives:
-    all but the last of a sequence with return lines (``returns``: the remote bus outside branches at pin level), in
-    branches too; none in an LBD-OR branch (BK-52).
+    all but the last of a sequence with return lines (``returns``: the remote bus outside branches), in branches too;
+    none in an LBD-OR branch (BK-52): where ``Ring.cut`` and ``PinRing.cut`` break a return input, and where
+    ``Ring.inject`` takes a :class:`ReturnBreak` at a device that is no BK with a branch (BK-59).
 
     Raises
     ------
@@ -703,7 +705,8 @@ class Ring:
     direct_return_line: Final = True
     """The return line N + 1 runs from device N straight into the master: an error the master's receiver finds
     is on that line (at pin level the return path runs through every chip, and :class:`PinRing` has neither
-    attribute)."""
+    attribute). A break of a return line before it (a :class:`ReturnBreak`, BK-59) brings back nothing: a dead line,
+    which the segment search locates."""
 
     def __init__(self, devices: Sequence[Device | Branch], bit_rate: int = 500_000, record: bool = False) -> None:
         if isinstance(devices, (str, bytes)) or not isinstance(devices, Sequence):
@@ -903,10 +906,12 @@ class Ring:
             # The return input from the device behind: behind a BK with its branch in the data path, after the branch.
             inner = None if own else self._span_of(position - 1, True)
             behind = position if inner is None else inner.end
-            if span is None or not (close is None or close > behind):
+            if (own and span is None) or not (close is None or close > behind):
                 continue
-            if close is None or close > span.end:
-                dead = span.end + 1 if dead is None else min(dead, span.end + 1)
+            # Outside branches, the remote bus's return lines run back into the master: the whole ring (BK-59).
+            end = len(self.devices) if span is None else span.end
+            if close is None or close > end:
+                dead = end + 1 if dead is None else min(dead, end + 1)
             else:
                 back_dead = True
         return dead, back_dead
@@ -932,8 +937,9 @@ class Ring:
     # -- faults --------------------------------------------------------------------------------------------------
 
     def inject(self, fault: Fault) -> None:
-        """Add a fault. Lines are 1..N + 1 (N + 1: the return line into the master); a :class:`ReturnBreak` only in
-        a tree, on a return line that exists (docs/interbus.md, "Tree")."""
+        """Add a fault. Lines are 1..N + 1 (N + 1: the return line into the master); a :class:`ReturnBreak` only on
+        a return line that exists: a BK's branch return input, or a return input :func:`return_inputs` names (the
+        remote bus's too, BK-59; docs/interbus.md, "Tree")."""
         if not isinstance(fault, (BitFlip, Truncate, CorruptLoopback, DeadLine, ReturnBreak)):
             raise fail("fault", "a BitFlip, Truncate, CorruptLoopback, DeadLine or ReturnBreak", fault)
         self._sync()
@@ -944,14 +950,15 @@ class Ring:
         target = None if fault.segment > n else self.devices[fault.segment - 1]
         branch = False
         if isinstance(fault, ReturnBreak):
-            index = fault.segment - 1
-            # A BK's branch return input whether or not the branch is in the data path now (BK-52).
+            # A BK's branch return input whether or not the branch is in the data path now (BK-52); else the return
+            # input from the device behind, by the one rule of positions (BK-59).
             branch = id(target) in self._terminals
-            inner = self._span_of(index, False)
-            if not branch and (inner is None or inner.branch.kind is BranchKind.LBD_OR or index >= inner.end - 1):
+            physical = next(k for k, device in enumerate(_devices(self._tree), 1) if device is target)
+            if not branch and physical not in return_inputs(self._tree):
                 raise InterbusError("docs/interbus.md, Tree", fault.segment,
-                                    "a return line enters only a BK with a branch, or a device of a branch with "
-                                    "return lines that has a device behind it")  # fmt: skip
+                                    "a return line enters only a BK with a branch, or a device with return lines "
+                                    "that has a device behind it (not the last of the ring or of a branch, none in "
+                                    "an LBD-OR branch)")  # fmt: skip
         self._faults.append(_Active(fault, fault.cycles, target, branch))
 
     def cut(self, position: int, forward: bool, *, branch: bool = False) -> None:
@@ -961,8 +968,8 @@ class Ring:
         branch is in the data path or not. ``forward``: the line into the device (a :class:`DeadLine`); else its
         return input from the device behind it in a branch with return lines (not into the last of a branch, none in
         an LBD-OR branch; a :class:`ReturnBreak`), or with ``branch`` a BK's branch return input (DI3). The break
-        sleeps while its line is out of the data path (BK-1). Return lines of the remote bus outside branches stay
-        abstract here (BK-10).
+        sleeps while its line is out of the data path (BK-1). The remote bus's return lines outside branches too
+        (BK-59): nothing comes back to the master, the devices behind the break hear the frame and latch nothing.
 
         Raises
         ------
@@ -979,10 +986,10 @@ class Ring:
             if forward or position not in terminals:
                 raise fail("position", f"the ring position of a BK with a branch ({sorted(terminals)}), with "
                            "forward=False (branch=True breaks the BK's branch return input)", (position, forward))
-        elif not forward and position not in return_inputs(self._tree, returns=False):
+        elif not forward and position not in return_inputs(self._tree):
             raise fail("position", f"an integer from 1 to {len(every)} (a device of the tree; a return line only from "
-                       "a device behind it in a branch with return lines: not into the last of a branch, none in an "
-                       "LBD-OR branch; the remote bus's outside branches stay abstract, BK-10)", position)
+                       "a device behind it: not into the last of the ring or of a branch, none in an LBD-OR branch, "
+                       "BK-59)", position)  # fmt: skip
         fault: Fault = DeadLine(position) if forward else ReturnBreak(position)
         self._faults.append(_Active(fault, None, every[position - 1], branch))
 
