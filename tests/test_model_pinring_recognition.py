@@ -379,6 +379,16 @@ def test_join_error_refuses_bad_input_by_name() -> None:
     assert [join_error(kind, None) for kind in BranchKind] == [ErrorKind.DEAD_LINE] * len(BranchKind)
 
 
+def test_a_tree_s_power_up_through_the_ring_is_refused_by_name() -> None:
+    """M22's limit 2: ``Ring.power_up`` follows the wake-up of a flat ring's chips only; on a tree (a BK's recognition
+    after its power-up, BK-37, and the branch's repeaters are not followed) it names the rule, nothing powered up."""
+    ring, chips = tl_ring(BranchKind.REMOTE, "11", True, 2)
+    assert Master(ring, locate=False, max_devices=8).start().ok and chips[1].branch_recognised
+    with pytest.raises(ArgumentError, match=r"^ring must be a flat ring \(M22"):
+        ring.power_up(2)
+    assert chips[1].branch_recognised
+
+
 def test_the_recognition_stays_through_resets_and_breaks_until_the_power_up() -> None:
     """BK-48 (BK-37's clearing rule): recognised at the master's start, a BK-LB branch stays recognised through a
     break, INTERBUS resets and the branch switched off; the BK's power-up reset forgets it, and with the loop broken
