@@ -216,9 +216,15 @@ REPAIR_IDLE_S = REPAIR_IDLE_TELEGRAMS * wire.STATUS_TELEGRAM_BITS / 2_000_000
 """Idle after a repair (M21): a repaired line takes up a telegram in flight at the repair point, and behind a break in
 an LBD branch a device that sends a counter telegram drops the telegram beginning then and the one chained to it
 (BK-30, M16); idle telegrams take that, not the next frame's head."""
-POWER_IDLE_S = 20 * wire.STATUS_TELEGRAM_BITS / 2_000_000
-"""The idle after a power-up step: the reset stretch (M2) and the time a loop needs to answer (BK-37), an LBD branch's
-counter telegram every 33 bit periods (BK-30) included."""
+FIRST_IDLE_TELEGRAMS = 9
+"""Idle status telegrams before a history's first step, every chip powered up at the ring's first clock (M22's limit
+2: no tree followed at transaction level, measured): the least from which the histories of M22's limit 2 agree."""
+POWER_IDLE_TELEGRAMS = 6
+"""Idle status telegrams after the BK's power-up step (/ResU released; M22's limit 2, measured): the BK's reset
+stretch (M2), its transmitter's resumption (M12) and its branch's answer on DI3 (BK-37) before the next step; LBD-MR's
+return repeaters (BK-35) make it the longest. Before: 20."""
+FIRST_IDLE_S = FIRST_IDLE_TELEGRAMS * wire.STATUS_TELEGRAM_BITS / 2_000_000
+POWER_IDLE_S = POWER_IDLE_TELEGRAMS * wire.STATUS_TELEGRAM_BITS / 2_000_000
 
 
 Seen = tuple[Cycle, bool, list[tuple[ErrorKind | None, int | None, str | None]], View | None] | None
@@ -226,14 +232,16 @@ Record = tuple[str, int, bool, Seen]
 """A step of :func:`recognition_history` at one fidelity: the step, the BK's recognition, what the master saw."""
 
 
-def recognition_history(kind: BranchKind, row: tuple[str, bool], ops: list[Op]) -> list[tuple[Record, Record]]:
+def recognition_history(kind: BranchKind, row: tuple[str, bool], ops: list[Op], first_idle_s: float = FIRST_IDLE_S,
+                        power_idle_s: float = POWER_IDLE_S) -> list[tuple[Record, Record]]:
     """Run ``ops`` (:data:`OPS`) on the transaction-level and the pin-level tree of two branch devices of ``kind``
-    (``row``: RF and LBST, Table 2-9) with a master on each; per step, at each fidelity, the BK's recognition
-    (``branch_recognised``, ``connected``) and what the master saw (:func:`seen`)."""
+    (``row``: RF and LBST, Table 2-9) with a master on each, after ``first_idle_s`` of idle and with ``power_idle_s``
+    after each power-up step (M22's limit 2); per step, at each fidelity, the BK's recognition (``branch_recognised``,
+    ``connected``) and what the master saw (:func:`seen`)."""
     tl, tl_chips = tl_ring(kind, *row, 2)
     pin, _ = pin_ring(kind, *row, 2)
     for ring in (tl, pin):  # past the chips' power-up reset stretch (M2): a first frame would meet it at pin level
-        ring.idle(POWER_IDLE_S)
+        ring.idle(first_idle_s)
     masters = [Master(tl, locate=False, max_devices=8), Master(pin, locate=False, max_devices=8)]
     breaks = cuts(kind)
     steps: list[tuple[Record, Record]] = []
@@ -263,11 +271,11 @@ def recognition_history(kind: BranchKind, row: tuple[str, bool], ops: list[Op]) 
         elif name == "power":
             tl.idle(POWER_DOWN_S)
             tl_chips[1].power_up()
-            tl.idle(POWER_IDLE_S)
+            tl.idle(power_idle_s)
             pin.set_input(2, "resu_n", 0)
             pin.idle(POWER_DOWN_S)
             pin.set_input(2, "resu_n", 1)
-            pin.idle(POWER_IDLE_S)
+            pin.idle(power_idle_s)
         # A branch that joins the data path in a cycle's run joins within its frame (BK-54): the cycle fails at both
         # fidelities, with the error of the first repaired line of its loop (BK-56), compared too.
         steps.append(((name, index, tl_chips[1].branch_recognised, seen(masters[0], results[0])),
@@ -377,6 +385,16 @@ def test_join_error_refuses_bad_input_by_name() -> None:
     with pytest.raises(ArgumentError, match=r"^first_forward must be"):
         join_error(BranchKind.REMOTE, -1)
     assert [join_error(kind, None) for kind in BranchKind] == [ErrorKind.DEAD_LINE] * len(BranchKind)
+
+
+def test_a_tree_s_power_up_through_the_ring_is_refused_by_name() -> None:
+    """M22's limit 2: ``Ring.power_up`` follows the wake-up of a flat ring's chips only; on a tree (a BK's recognition
+    after its power-up, BK-37, and the branch's repeaters are not followed) it names the rule, nothing powered up."""
+    ring, chips = tl_ring(BranchKind.REMOTE, "11", True, 2)
+    assert Master(ring, locate=False, max_devices=8).start().ok and chips[1].branch_recognised
+    with pytest.raises(ArgumentError, match=r"^ring must be a flat ring \(M22"):
+        ring.power_up(2)
+    assert chips[1].branch_recognised
 
 
 def test_the_recognition_stays_through_resets_and_breaks_until_the_power_up() -> None:

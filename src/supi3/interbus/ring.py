@@ -1389,8 +1389,12 @@ class Ring:
         Raises
         ------
         ArgumentError
-            ``position`` not from 1 to N, or the device there has no power-up reset (``power_up``).
+            ``position`` not from 1 to N, the device there has no power-up reset (``power_up``), or the ring is a
+            tree: M22's window counts one repeater per chip of a flat ring, and a BK's recognition of its branch after
+            its power-up (BK-37) is not followed (M22's limit 2; power a tree's chip up with ``Supi3.power_up``).
         """
+        if self._branches:
+            raise fail("ring", "a flat ring", f"a tree of {len(self._branches)} branches", "M22: no tree followed")
         position = check_int("position", position, 1, len(self.devices))
         device = self.devices[position - 1]
         power_up = getattr(device, "power_up", None)
