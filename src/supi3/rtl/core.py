@@ -212,10 +212,41 @@ def _crc_step(crc: Value, bit: Value) -> Value:
     return (crc << 1)[:WORD_BITS] ^ Mux(feedback, wire.CRC_POLY, 0)
 
 
-def _crc_word(crc: Value) -> Value:
-    """The CRC word a register stands for (``wire.crc16``'s output stage: reflection and final XOR)."""
-    word = Cat(*reversed([crc[i] for i in range(WORD_BITS)])) if wire.CRC_REFOUT else crc
-    return word ^ wire.CRC_XOROUT
+def _crc_check_constants() -> tuple[int, int]:
+    """The bit flip of the CRC word sent and the residue of the received one, checked at elaboration.
+
+    The CRC word goes out LSB first and is the register reflected (``wire.CRC_REFOUT``) and XORed with
+    ``wire.CRC_XOROUT``, so its bit k is register bit 15 - k flipped by XOROUT's bit k: the transmitter sends bit 15
+    of a register shifted left once per bit, flipped by one constant (XOROUT all zeros or all ones). The received
+    word is fed on through the CRC step instead of being compared bit by bit with the register: every correct bit
+    makes the feedback XOROUT's bit, so after the 16 bits the register holds a constant (the residue) whatever the
+    data, and a wrong bit k adds ``CRC_POLY << (15 - k)`` (truncated), whose lowest set bit is k (the polynomial's bit
+    0 is 1): any error changes it. Checked on register states below (docs/rtl.md, round 5).
+    """
+    full = (1 << WORD_BITS) - 1
+    if not wire.CRC_REFOUT or wire.CRC_XOROUT not in (0, full) or not wire.CRC_POLY & 1:
+        raise ValueError("the check sequence's CRC needs CRC_REFOUT, CRC_XOROUT 0 or all ones and CRC_POLY odd")
+    flip = wire.CRC_XOROUT & 1
+    residues = set()
+    for data in (b"", b"\x00", b"\xa5\x5a", b"123456789"):
+        crc = wire.CRC_INIT
+        for byte in data:
+            for i in range(BYTE_BITS):
+                crc = wire.crc_update_bit(crc, (byte >> (i if wire.CRC_REFIN else BYTE_BITS - 1 - i)) & 1)
+        word = wire.crc16(data)
+        if word != int(f"{crc:016b}"[::-1], 2) ^ wire.CRC_XOROUT:
+            raise ValueError("the bit-serial CRC register differs from wire.crc16")
+        for k in range(WORD_BITS):
+            crc = wire.crc_update_bit(crc, (word >> k) & 1)
+        residues.add(crc)
+    if len(residues) != 1:
+        raise ValueError("the CRC has no residue")
+    return flip, residues.pop()
+
+
+_CRC_SENT_FLIP, _CRC_RESIDUE = _crc_check_constants()
+"""The CRC word's bits are bit 15 of a register shifted left, XOR ``_CRC_SENT_FLIP``; a received CRC word fed into
+the register after its data leaves ``_CRC_RESIDUE`` there exactly when it is right."""
 
 
 def _per_rate(rate: Value, clocks: tuple[ClockEntry, ...], value: Callable[[ClockEntry], Value | int]) -> Value:
@@ -740,8 +771,8 @@ class FrameEngineRtl(wiring.Component):
     """Frame engine (block ``frame``): telegram framing into cycles, CRC and check sequence, latch and discard.
 
     An ``m.FSM`` with the model's states IDLE, DATA (data field), CHECK (check sequence), WAIT (latch telegrams).
-    Bit-serial CRC-16 of the data received and sent; the received check sequence is compared bit-serially (CRC word,
-    CNTR legality, ERR) instead of stored; the CNTR word is forwarded with the chip's ATTN. It drives the data path
+    Bit-serial CRC-16 of the data received and sent; the received check sequence is checked bit-serially (the CRC
+    word fed on into its register up to the residue, CNTR legality, ERR) instead of stored; the CNTR word is forwarded with the chip's ATTN. It drives the data path
     through ``register`` (:data:`REGISTER`), the chip registers through ``management`` (:data:`MANAGEMENT`) and the
     transmitter through ``tx`` (:data:`TRANSMIT`); ``events`` are the frame's interrupt sources at their IRQ_EVT
     bits, ``io`` the I/O access bit with this clock's ``io_set`` and ``io_clear``, ``discard`` a frame ending
@@ -777,7 +808,6 @@ class FrameEngineRtl(wiring.Component):
         crc_rx = Signal(WORD_BITS, init=wire.CRC_INIT, reset_less=True)
         crc_tx = Signal(WORD_BITS, init=wire.CRC_INIT, reset_less=True)
         index = Signal(range(wire.CHECK_TELEGRAMS + 2), reset_less=True)
-        crc_bad = Signal(reset_less=True)
         cntr_bad = Signal(reset_less=True)
         local_error = Signal()
         err_in = Signal()
@@ -847,7 +877,7 @@ class FrameEngineRtl(wiring.Component):
                 sync += error()
             with m.If(check):
                 with m.If(in_data):
-                    sync += [index.eq(0), crc_bad.eq(0), cntr_bad.eq(0)]
+                    sync += [index.eq(0), cntr_bad.eq(0)]
                     comb += [check_start.eq(1), self.io_set.eq(~id_cycle)]  # the I/O access window (Fig. 3-22)
                 with m.Elif(in_check):
                     sync += index.eq(index + 1)
@@ -857,10 +887,9 @@ class FrameEngineRtl(wiring.Component):
             comb += [tx.level.eq(reg.shift_out), reg.shift.eq(1)]
             sync += [crc_rx.eq(_crc_step(crc_rx, line)), crc_tx.eq(_crc_step(crc_tx, reg.shift_out))]
         with m.Elif(rx.frame_bit & data_field & in_check & (index < wire.CHECK_TELEGRAMS)):
-            with m.If(check_n < WORD_BITS):  # own CRC word out, the received one compared
-                comb += tx.level.eq(_crc_word(crc_tx).bit_select(check_n[:4], 1))
-                with m.If(line != _crc_word(crc_rx).bit_select(check_n[:4], 1)):
-                    sync += crc_bad.eq(1)
+            with m.If(check_n < WORD_BITS):  # own CRC word out, the received one fed on (_CRC_RESIDUE)
+                comb += tx.level.eq(crc_tx[WORD_BITS - 1] ^ _CRC_SENT_FLIP)
+                sync += [crc_rx.eq(_crc_step(crc_rx, line)), crc_tx.eq(crc_tx << 1)]
             with m.Else():  # CNTR forwarded (wire.forward_cntr); the ERR pair is settled at the last stop bit
                 comb += tx.level.eq(0)
                 with m.Switch(cntr_b):
@@ -889,7 +918,7 @@ class FrameEngineRtl(wiring.Component):
             with m.If(stop_bad):
                 sync += error()
             with m.If(in_check & (index == wire.CHECK_TELEGRAMS - 1) & rx.data_now & ~rx.in_reset):
-                error_now = local_error | stop_bad | crc_bad | cntr_bad
+                error_now = local_error | stop_bad | (crc_rx != _CRC_RESIDUE) | cntr_bad
                 err = error_now | cntr_bad | err_bit
                 sync += [local_error.eq(error_now), err_in.eq(cntr_bad | err_bit)]
                 comb += [check_done.eq(1), tx.set_err.eq(1), tx.err.eq(err)]
