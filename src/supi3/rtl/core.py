@@ -714,11 +714,13 @@ class ReceiverRtl(wiring.Component):
 
         # Framing and mid-bit sampling
         busy = Signal()  # in a telegram (the FSM below)
-        phase = Signal(range(max(e.clocks_per_bit for e in clocks)))  # clocks since the start bit, modulo the bit
-        bit = Signal(_POSITION)
-        select = Signal()
-        control = Signal()
-        is_data = Signal(init=1)
+        # Set at every start bit (phase, bit, is_data) or sampled in every telegram before its control bit and its
+        # end (select, control: positions 2 and 3 of both kinds), read only with ``sample`` (in a telegram): no reset.
+        phase = Signal(range(max(e.clocks_per_bit for e in clocks)), reset_less=True)  # clocks since the start bit,
+        bit = Signal(_POSITION, reset_less=True)  # modulo the bit; the position of the next bit
+        select = Signal(reset_less=True)
+        control = Signal(reset_less=True)
+        is_data = Signal(init=1, reset_less=True)
         sample = busy & per_rate(lambda e: phase == e.clocks_per_bit // 2)
         data_now = Mux(bit == wire.POS_TYPE, line == wire.TYPE_DATA_LEVEL, is_data)
         end = bit == Mux(data_now, _DATA_TELEGRAM_END, _STATUS_TELEGRAM_END)
@@ -802,23 +804,25 @@ class FrameEngineRtl(wiring.Component):
         load, check_start, check_done, latch_done = Signal(), Signal(), Signal(), Signal()
         broken = Signal()  # a status telegram inside a frame: the frame ends, discarded with its local error (M20)
 
-        id_cycle = Signal()  # the frame's cycle type: 1 = ID cycle
-        latches = Signal(range(wire.LATCH_STATUS_TELEGRAMS + 1))
-        # Read only in CHECK, and set when a frame is loaded (the CRCs) or enters CHECK (the rest): no reset
+        # Read only outside IDLE (id_cycle, latches, local_error, err_in) or in CHECK (the rest), and set when a frame is
+        # loaded, enters CHECK or receives the CNTR bit before the one that reads it (attn, err_bit, the pairs' first
+        # bits); a frame leaves IDLE only by its load: no reset.
+        id_cycle = Signal(reset_less=True)  # the frame's cycle type: 1 = ID cycle
+        latches = Signal(range(wire.LATCH_STATUS_TELEGRAMS + 1), reset_less=True)
         crc_rx = Signal(WORD_BITS, init=wire.CRC_INIT, reset_less=True)
         crc_tx = Signal(WORD_BITS, init=wire.CRC_INIT, reset_less=True)
         index = Signal(range(wire.CHECK_TELEGRAMS + 2), reset_less=True)
         cntr_bad = Signal(reset_less=True)
-        local_error = Signal()
-        err_in = Signal()
-        attn = Signal()
-        err_bit = Signal()
+        local_error = Signal(reset_less=True)
+        err_in = Signal(reset_less=True)
+        attn = Signal(reset_less=True)
+        err_bit = Signal(reset_less=True)
         on_grid = Signal()  # a whole status telegram since the power-up: a frame may begin (M19)
         pairs = [
             tuple(sorted(p))
             for p in ((wire.CNTR_ATTN_BIT, wire.CNTR_NATTN_BIT), (wire.CNTR_NERR_BIT, wire.CNTR_ERR_BIT))
         ]
-        firsts = [Signal(name=f"cntr_pair{k}") for k in range(len(pairs))]
+        firsts = [Signal(name=f"cntr_pair{k}", reset_less=True) for k in range(len(pairs))]
         paired = {b for p in pairs for b in p}
         if (wire.CNTR_NERR_BIT, wire.CNTR_ERR_BIT) != (
             WORD_BITS - 2,
