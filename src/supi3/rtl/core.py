@@ -689,7 +689,10 @@ class ReceiverRtl(wiring.Component):
         # Both counters count up as LFSRs (supi3.rtl.lfsr): only loaded, stepped and compared with constants, so the
         # count v is the state v steps after 1 (``lfsr.count_state``) and a step is an XOR instead of a carry chain.
         run_width = count_width(max(e.reset_run for e in clocks))
-        low_run = Signal(run_width, init=count_state(0, run_width))  # clocks at the start level, stopping at reset_run
+        # clocks at the start level, stepping on while it lasts; ``ran``: this run began an INTERBUS reset (the LFSR
+        # passes the state again 2 ** run_width - 1 clocks later)
+        low_run = Signal(run_width, init=count_state(0, run_width))
+        ran = Signal()
         silent_width = count_width(IDLE_TIMEOUT_CLOCKS + 1)
         # clocks since the last start of no counter telegram, from 1 on, stopping one beyond the time-out
         silent = Signal(silent_width, init=count_state(1, silent_width))
@@ -700,12 +703,12 @@ class ReceiverRtl(wiring.Component):
 
         counted = Signal()  # a counter telegram since then (DG-9)
         low = line == wire.START_LEVEL
-        enter_reset = low & per_rate(lambda e: low_run == count_state(e.reset_run - 1, run_width))
+        enter_reset = low & ~ran & per_rate(lambda e: low_run == count_state(e.reset_run - 1, run_width))
         idle_timeout = silent == count_state(IDLE_TIMEOUT_CLOCKS, silent_width)  # once per silence
         with rx.If(~low):
-            sync += low_run.eq(count_state(0, run_width))
-        with rx.Elif(per_rate(lambda e: low_run != count_state(e.reset_run, run_width))):
-            sync += low_run.eq(next_state(low_run))
+            sync += [low_run.eq(count_state(0, run_width)), ran.eq(0)]
+        with rx.Else():
+            sync += [low_run.eq(next_state(low_run)), ran.eq(ran | enter_reset)]
         with rx.If(silent != count_state(IDLE_TIMEOUT_CLOCKS + 1, silent_width)):
             sync += silent.eq(next_state(silent))
         with rx.If(enter_reset):
