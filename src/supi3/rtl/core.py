@@ -777,12 +777,12 @@ class FrameEngineRtl(wiring.Component):
 
     An ``m.FSM`` with the model's states IDLE, DATA (data field), CHECK (check sequence), WAIT (latch telegrams).
     Bit-serial CRC-16 of the data received and sent; the received check sequence is checked bit-serially (the CRC
-    word fed on into its register up to the residue, CNTR legality, ERR) instead of stored; the CNTR word is forwarded with the chip's ATTN. It drives the data path
-    through ``register`` (:data:`REGISTER`), the chip registers through ``management`` (:data:`MANAGEMENT`) and the
-    transmitter through ``tx`` (:data:`TRANSMIT`); ``events`` are the frame's interrupt sources at their IRQ_EVT
-    bits, ``io`` the I/O access bit with this clock's ``io_set`` and ``io_clear``, ``discard`` a frame ending
-    unlatched (``chip.discard_at``). The statements follow the model's order within one clock, later assignments
-    winning as later Python assignments do.
+    word fed on into its register up to the residue, CNTR legality, ERR) instead of stored; the CNTR word is forwarded
+    with the chip's ATTN. It drives the data path through ``register`` (:data:`REGISTER`), the chip registers through
+    ``management`` (:data:`MANAGEMENT`) and the transmitter through ``tx`` (:data:`TRANSMIT`); ``events`` are the
+    frame's interrupt sources at their IRQ_EVT bits, ``io`` the I/O access bit with this clock's ``io_set`` and
+    ``io_clear``, ``discard`` a frame ending unlatched (``chip.discard_at``). The statements follow the model's order
+    within one clock, later assignments winning as later Python assignments do.
     """
 
     def __init__(self) -> None:
@@ -807,9 +807,9 @@ class FrameEngineRtl(wiring.Component):
         load, check_start, check_done, latch_done = Signal(), Signal(), Signal(), Signal()
         broken = Signal()  # a status telegram inside a frame: the frame ends, discarded with its local error (M20)
 
-        # Read only outside IDLE (id_cycle, latches, local_error, err_in) or in CHECK (the rest), and set when a frame is
-        # loaded, enters CHECK or receives the CNTR bit before the one that reads it (attn, err_bit, the pairs' first
-        # bits); a frame leaves IDLE only by its load: no reset.
+        # Read only outside IDLE (id_cycle, latches, local_error, err_in) or in CHECK (the rest), and set when a frame
+        # is loaded, enters CHECK or receives the CNTR bit before the one that reads it (attn, err_bit, the pairs'
+        # first bits); a frame leaves IDLE only by its load: no reset.
         id_cycle = Signal(reset_less=True)  # the frame's cycle type: 1 = ID cycle
         latches = Signal(range(wire.LATCH_STATUS_TELEGRAMS + 1), reset_less=True)
         crc_rx = Signal(WORD_BITS, init=wire.CRC_INIT, reset_less=True)
