@@ -10,6 +10,7 @@ from amaranth.hdl import Fragment
 from amaranth.lib import wiring
 
 from supi3.config import Variant
+from supi3.interbus import wire
 from supi3.rtl import core
 from supi3.rtl.core import DataPathRtl, FrameEngineRtl, OutputsRtl, ReceiverRtl, Supi3Core, TransmitterRtl
 from supi3.rtl.counter import CounterLinesRtl
@@ -65,3 +66,27 @@ def test_block_interfaces_fit() -> None:
     for source, sink, signature in pairs:
         assert source.signature == signature
         assert sink.signature == signature.flip()
+
+
+def _feed(crc: int, word: int) -> int:
+    for k in range(core.WORD_BITS):
+        crc = wire.crc_update_bit(crc, (word >> k) & 1)
+    return crc
+
+
+def test_the_crc_word_is_checked_by_its_residue() -> None:
+    """The frame engine feeds the received CRC word on into its register (docs/rtl.md, round 5): every register
+    state followed by its own word (``wire.crc16``'s output stage) ends at the residue, and the 16 single wrong bits
+    change it by linearly independent amounts, so every set of wrong bits is caught."""
+    for state in range(0, 1 << core.WORD_BITS, 257):
+        word = int(f"{state:016b}"[::-1], 2) ^ wire.CRC_XOROUT
+        assert _feed(state, word) == core._CRC_RESIDUE
+        # the bit sent: register bit 15 of the register shifted left k times, flipped
+        assert all((word >> k) & 1 == ((state << k) >> 15 & 1) ^ core._CRC_SENT_FLIP for k in range(16))
+        pivots: dict[int, int] = {}  # GF(2) elimination of the changes caused by one wrong bit each, by leading bit
+        for k in range(core.WORD_BITS):
+            delta = _feed(state, word ^ (1 << k)) ^ core._CRC_RESIDUE
+            while delta and delta.bit_length() in pivots:
+                delta ^= pivots[delta.bit_length()]
+            assert delta
+            pivots[delta.bit_length()] = delta

@@ -212,10 +212,41 @@ def _crc_step(crc: Value, bit: Value) -> Value:
     return (crc << 1)[:WORD_BITS] ^ Mux(feedback, wire.CRC_POLY, 0)
 
 
-def _crc_word(crc: Value) -> Value:
-    """The CRC word a register stands for (``wire.crc16``'s output stage: reflection and final XOR)."""
-    word = Cat(*reversed([crc[i] for i in range(WORD_BITS)])) if wire.CRC_REFOUT else crc
-    return word ^ wire.CRC_XOROUT
+def _crc_check_constants() -> tuple[int, int]:
+    """The bit flip of the CRC word sent and the residue of the received one, checked at elaboration.
+
+    The CRC word goes out LSB first and is the register reflected (``wire.CRC_REFOUT``) and XORed with
+    ``wire.CRC_XOROUT``, so its bit k is register bit 15 - k flipped by XOROUT's bit k: the transmitter sends bit 15
+    of a register shifted left once per bit, flipped by one constant (XOROUT all zeros or all ones). The received
+    word is fed on through the CRC step instead of being compared bit by bit with the register: every correct bit
+    makes the feedback XOROUT's bit, so after the 16 bits the register holds a constant (the residue) whatever the
+    data, and a wrong bit k adds ``CRC_POLY << (15 - k)`` (truncated), whose lowest set bit is k (the polynomial's bit
+    0 is 1): any error changes it. Checked on register states below (docs/rtl.md, round 5).
+    """
+    full = (1 << WORD_BITS) - 1
+    if not wire.CRC_REFOUT or wire.CRC_XOROUT not in (0, full) or not wire.CRC_POLY & 1:
+        raise ValueError("the check sequence's CRC needs CRC_REFOUT, CRC_XOROUT 0 or all ones and CRC_POLY odd")
+    flip = wire.CRC_XOROUT & 1
+    residues = set()
+    for data in (b"", b"\x00", b"\xa5\x5a", b"123456789"):
+        crc = wire.CRC_INIT
+        for byte in data:
+            for i in range(BYTE_BITS):
+                crc = wire.crc_update_bit(crc, (byte >> (i if wire.CRC_REFIN else BYTE_BITS - 1 - i)) & 1)
+        word = wire.crc16(data)
+        if word != int(f"{crc:016b}"[::-1], 2) ^ wire.CRC_XOROUT:
+            raise ValueError("the bit-serial CRC register differs from wire.crc16")
+        for k in range(WORD_BITS):
+            crc = wire.crc_update_bit(crc, (word >> k) & 1)
+        residues.add(crc)
+    if len(residues) != 1:
+        raise ValueError("the CRC has no residue")
+    return flip, residues.pop()
+
+
+_CRC_SENT_FLIP, _CRC_RESIDUE = _crc_check_constants()
+"""The CRC word's bits are bit 15 of a register shifted left, XOR ``_CRC_SENT_FLIP``; a received CRC word fed into
+the register after its data leaves ``_CRC_RESIDUE`` there exactly when it is right."""
 
 
 def _per_rate(rate: Value, clocks: tuple[ClockEntry, ...], value: Callable[[ClockEntry], Value | int]) -> Value:
@@ -658,7 +689,10 @@ class ReceiverRtl(wiring.Component):
         # Both counters count up as LFSRs (supi3.rtl.lfsr): only loaded, stepped and compared with constants, so the
         # count v is the state v steps after 1 (``lfsr.count_state``) and a step is an XOR instead of a carry chain.
         run_width = count_width(max(e.reset_run for e in clocks))
-        low_run = Signal(run_width, init=count_state(0, run_width))  # clocks at the start level, stopping at reset_run
+        # clocks at the start level, stepping on while it lasts; ``ran``: this run began an INTERBUS reset (the LFSR
+        # passes the state again 2 ** run_width - 1 clocks later)
+        low_run = Signal(run_width, init=count_state(0, run_width))
+        ran = Signal()
         silent_width = count_width(IDLE_TIMEOUT_CLOCKS + 1)
         # clocks since the last start of no counter telegram, from 1 on, stopping one beyond the time-out
         silent = Signal(silent_width, init=count_state(1, silent_width))
@@ -669,12 +703,12 @@ class ReceiverRtl(wiring.Component):
 
         counted = Signal()  # a counter telegram since then (DG-9)
         low = line == wire.START_LEVEL
-        enter_reset = low & per_rate(lambda e: low_run == count_state(e.reset_run - 1, run_width))
+        enter_reset = low & ~ran & per_rate(lambda e: low_run == count_state(e.reset_run - 1, run_width))
         idle_timeout = silent == count_state(IDLE_TIMEOUT_CLOCKS, silent_width)  # once per silence
         with rx.If(~low):
-            sync += low_run.eq(count_state(0, run_width))
-        with rx.Elif(per_rate(lambda e: low_run != count_state(e.reset_run, run_width))):
-            sync += low_run.eq(next_state(low_run))
+            sync += [low_run.eq(count_state(0, run_width)), ran.eq(0)]
+        with rx.Else():
+            sync += [low_run.eq(next_state(low_run)), ran.eq(ran | enter_reset)]
         with rx.If(silent != count_state(IDLE_TIMEOUT_CLOCKS + 1, silent_width)):
             sync += silent.eq(next_state(silent))
         with rx.If(enter_reset):
@@ -683,11 +717,13 @@ class ReceiverRtl(wiring.Component):
 
         # Framing and mid-bit sampling
         busy = Signal()  # in a telegram (the FSM below)
-        phase = Signal(range(max(e.clocks_per_bit for e in clocks)))  # clocks since the start bit, modulo the bit
-        bit = Signal(_POSITION)
-        select = Signal()
-        control = Signal()
-        is_data = Signal(init=1)
+        # Set at every start bit (phase, bit, is_data) or sampled in every telegram before its control bit and its
+        # end (select, control: positions 2 and 3 of both kinds), read only with ``sample`` (in a telegram): no reset.
+        phase = Signal(range(max(e.clocks_per_bit for e in clocks)), reset_less=True)  # clocks since the start bit,
+        bit = Signal(_POSITION, reset_less=True)  # modulo the bit; the position of the next bit
+        select = Signal(reset_less=True)
+        control = Signal(reset_less=True)
+        is_data = Signal(init=1, reset_less=True)
         sample = busy & per_rate(lambda e: phase == e.clocks_per_bit // 2)
         data_now = Mux(bit == wire.POS_TYPE, line == wire.TYPE_DATA_LEVEL, is_data)
         end = bit == Mux(data_now, _DATA_TELEGRAM_END, _STATUS_TELEGRAM_END)
@@ -740,13 +776,13 @@ class FrameEngineRtl(wiring.Component):
     """Frame engine (block ``frame``): telegram framing into cycles, CRC and check sequence, latch and discard.
 
     An ``m.FSM`` with the model's states IDLE, DATA (data field), CHECK (check sequence), WAIT (latch telegrams).
-    Bit-serial CRC-16 of the data received and sent; the received check sequence is compared bit-serially (CRC word,
-    CNTR legality, ERR) instead of stored; the CNTR word is forwarded with the chip's ATTN. It drives the data path
-    through ``register`` (:data:`REGISTER`), the chip registers through ``management`` (:data:`MANAGEMENT`) and the
-    transmitter through ``tx`` (:data:`TRANSMIT`); ``events`` are the frame's interrupt sources at their IRQ_EVT
-    bits, ``io`` the I/O access bit with this clock's ``io_set`` and ``io_clear``, ``discard`` a frame ending
-    unlatched (``chip.discard_at``). The statements follow the model's order within one clock, later assignments
-    winning as later Python assignments do.
+    Bit-serial CRC-16 of the data received and sent; the received check sequence is checked bit-serially (the CRC
+    word fed on into its register up to the residue, CNTR legality, ERR) instead of stored; the CNTR word is forwarded
+    with the chip's ATTN. It drives the data path through ``register`` (:data:`REGISTER`), the chip registers through
+    ``management`` (:data:`MANAGEMENT`) and the transmitter through ``tx`` (:data:`TRANSMIT`); ``events`` are the
+    frame's interrupt sources at their IRQ_EVT bits, ``io`` the I/O access bit with this clock's ``io_set`` and
+    ``io_clear``, ``discard`` a frame ending unlatched (``chip.discard_at``). The statements follow the model's order
+    within one clock, later assignments winning as later Python assignments do.
     """
 
     def __init__(self) -> None:
@@ -771,24 +807,25 @@ class FrameEngineRtl(wiring.Component):
         load, check_start, check_done, latch_done = Signal(), Signal(), Signal(), Signal()
         broken = Signal()  # a status telegram inside a frame: the frame ends, discarded with its local error (M20)
 
-        id_cycle = Signal()  # the frame's cycle type: 1 = ID cycle
-        latches = Signal(range(wire.LATCH_STATUS_TELEGRAMS + 1))
-        # Read only in CHECK, and set when a frame is loaded (the CRCs) or enters CHECK (the rest): no reset
+        # Read only outside IDLE (id_cycle, latches, local_error, err_in) or in CHECK (the rest), and set when a frame
+        # is loaded, enters CHECK or receives the CNTR bit before the one that reads it (attn, err_bit, the pairs'
+        # first bits); a frame leaves IDLE only by its load: no reset.
+        id_cycle = Signal(reset_less=True)  # the frame's cycle type: 1 = ID cycle
+        latches = Signal(range(wire.LATCH_STATUS_TELEGRAMS + 1), reset_less=True)
         crc_rx = Signal(WORD_BITS, init=wire.CRC_INIT, reset_less=True)
         crc_tx = Signal(WORD_BITS, init=wire.CRC_INIT, reset_less=True)
         index = Signal(range(wire.CHECK_TELEGRAMS + 2), reset_less=True)
-        crc_bad = Signal(reset_less=True)
         cntr_bad = Signal(reset_less=True)
-        local_error = Signal()
-        err_in = Signal()
-        attn = Signal()
-        err_bit = Signal()
+        local_error = Signal(reset_less=True)
+        err_in = Signal(reset_less=True)
+        attn = Signal(reset_less=True)
+        err_bit = Signal(reset_less=True)
         on_grid = Signal()  # a whole status telegram since the power-up: a frame may begin (M19)
         pairs = [
             tuple(sorted(p))
             for p in ((wire.CNTR_ATTN_BIT, wire.CNTR_NATTN_BIT), (wire.CNTR_NERR_BIT, wire.CNTR_ERR_BIT))
         ]
-        firsts = [Signal(name=f"cntr_pair{k}") for k in range(len(pairs))]
+        firsts = [Signal(name=f"cntr_pair{k}", reset_less=True) for k in range(len(pairs))]
         paired = {b for p in pairs for b in p}
         if (wire.CNTR_NERR_BIT, wire.CNTR_ERR_BIT) != (
             WORD_BITS - 2,
@@ -847,7 +884,7 @@ class FrameEngineRtl(wiring.Component):
                 sync += error()
             with m.If(check):
                 with m.If(in_data):
-                    sync += [index.eq(0), crc_bad.eq(0), cntr_bad.eq(0)]
+                    sync += [index.eq(0), cntr_bad.eq(0)]
                     comb += [check_start.eq(1), self.io_set.eq(~id_cycle)]  # the I/O access window (Fig. 3-22)
                 with m.Elif(in_check):
                     sync += index.eq(index + 1)
@@ -857,10 +894,9 @@ class FrameEngineRtl(wiring.Component):
             comb += [tx.level.eq(reg.shift_out), reg.shift.eq(1)]
             sync += [crc_rx.eq(_crc_step(crc_rx, line)), crc_tx.eq(_crc_step(crc_tx, reg.shift_out))]
         with m.Elif(rx.frame_bit & data_field & in_check & (index < wire.CHECK_TELEGRAMS)):
-            with m.If(check_n < WORD_BITS):  # own CRC word out, the received one compared
-                comb += tx.level.eq(_crc_word(crc_tx).bit_select(check_n[:4], 1))
-                with m.If(line != _crc_word(crc_rx).bit_select(check_n[:4], 1)):
-                    sync += crc_bad.eq(1)
+            with m.If(check_n < WORD_BITS):  # own CRC word out, the received one fed on (_CRC_RESIDUE)
+                comb += tx.level.eq(crc_tx[WORD_BITS - 1] ^ _CRC_SENT_FLIP)
+                sync += [crc_rx.eq(_crc_step(crc_rx, line)), crc_tx.eq(crc_tx << 1)]
             with m.Else():  # CNTR forwarded (wire.forward_cntr); the ERR pair is settled at the last stop bit
                 comb += tx.level.eq(0)
                 with m.Switch(cntr_b):
@@ -889,7 +925,7 @@ class FrameEngineRtl(wiring.Component):
             with m.If(stop_bad):
                 sync += error()
             with m.If(in_check & (index == wire.CHECK_TELEGRAMS - 1) & rx.data_now & ~rx.in_reset):
-                error_now = local_error | stop_bad | crc_bad | cntr_bad
+                error_now = local_error | stop_bad | (crc_rx != _CRC_RESIDUE) | cntr_bad
                 err = error_now | cntr_bad | err_bit
                 sync += [local_error.eq(error_now), err_in.eq(cntr_bad | err_bit)]
                 comb += [check_done.eq(1), tx.set_err.eq(1), tx.err.eq(err)]
