@@ -70,7 +70,7 @@ from supi3.regmap.core import BYTE_BITS
 from supi3.rtl.counter import CounterLinesRtl, LineQueue, stamp_bits
 from supi3.rtl.expansion import PIN_NAMES as EXPANSION_PINS
 from supi3.rtl.expansion import ExpansionRtl
-from supi3.rtl.lfsr import TAPS, Countdown, before, count_state, count_width, down_state, down_step, next_state
+from supi3.rtl.lfsr import TAPS, before, count_state, count_width, down_state, down_step, next_state
 from supi3.rtl.optical import OpticalRtl
 from supi3.rtl.serial_io import DIRECTIONS, SER_IN_PIN, WIDTHS, SerialIoRtl
 from supi3.rtl.tables import (
@@ -1109,13 +1109,17 @@ class OutputsRtl(wiring.Component):
         next_present = Signal()
 
         # The model calls chip._advance at the start of every running clock: the /StatErr filter and the watchdog.
-        # The clocks /StatErr has been low, counted down from STATERR_FILTER_CLOCKS - 1 (one clock old at the edge
-        # after it fell) to 0 (filtered) as an LFSR (supi3.rtl.lfsr); it is read only while /StatErr stays low
-        # (``st_valid``), so it may run on after it rose.
-        st_valid = Signal()
-        st_count = Countdown(m, STATERR_FILTER_CLOCKS - 1, load=stat & ~st_valid, clear=Const(0), name="st_count")
-        filtered = st_valid & st_count.idle
-        sync += st_valid.eq(stat)
+        # The clocks /StatErr has been low, counted up as an LFSR (lfsr.count_state) from 0 at its first low clock,
+        # held at 0 while it is high (one gate a bit, no load, no end state); ``filtered`` is set on the clock after
+        # the count read STATERR_FILTER_CLOCKS - 1 and stays while /StatErr stays low, so the LFSR may run on past
+        # its end (round 5).
+        st_width = count_width(STATERR_FILTER_CLOCKS - 1)
+        st_count = Signal(st_width, init=count_state(0, st_width))
+        filtered = Signal()
+        sync += [
+            st_count.eq(Mux(stat, next_state(st_count), count_state(0, st_width))),
+            filtered.eq(stat & (filtered | (st_count == count_state(STATERR_FILTER_CLOCKS - 1, st_width)))),
+        ]
         module_error = stat & filtered
 
         timeouts = [t for t in WATCHDOG_CLOCKS if t is not None]
