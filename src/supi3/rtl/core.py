@@ -395,11 +395,13 @@ class Supi3Core(wiring.Component):
         m.d.comb += [tx_watch.line.eq(lines.do2), tx_watch.fast.eq(lines.fast)]
         sel3 = Signal()
         sel2 = Signal(2, init=_SENT)
-        # DI3's idle clocks up to BRANCH_DRAIN_BITS bit periods, counted up as an LFSR (lfsr.count_state)
+        # DI3's idle clocks, counted up as an LFSR (lfsr.count_state) that runs on past its end, and ``full`` set on
+        # the clock after it read BRANCH_DRAIN_BITS bit periods less one, kept while DI3 stays idle (round 5: no hold)
         drain_width = count_width(max(e.clocks_per_bit for e in clocks) * BRANCH_DRAIN_BITS)
         drained = Signal(drain_width, init=count_state(0, drain_width))
-        full = _per_rate(rate, clocks, lambda e: drained == count_state(e.clocks_per_bit * BRANCH_DRAIN_BITS,
-                                                                         drain_width))  # fmt: skip
+        full = Signal()
+        ending = _per_rate(rate, clocks, lambda e: drained == count_state(e.clocks_per_bit * BRANCH_DRAIN_BITS - 1,
+                                                                           drain_width))  # fmt: skip
         tx_free = ~tx_watch.busy
         tx_leave = tx_free & (lines.do2 == wire.IDLE_LEVEL)
         di3_free = ~lines.branch_busy
@@ -407,13 +409,14 @@ class Supi3Core(wiring.Component):
         want = Mux(terminal.enabled, _DI3, _SENT)
         leave = (sel2 == _IDLE) | Mux(sel2 == _SENT, tx_leave, di3_idle & full)
         with m.If(~running):  # reset, and held so until the core runs (as ``gated``)
-            m.d.sync += [sel3.eq(0), sel2.eq(_SENT), drained.eq(count_state(0, drain_width))]
+            m.d.sync += [sel3.eq(0), sel2.eq(_SENT), drained.eq(count_state(0, drain_width)), full.eq(0)]
         with m.Else():
             with m.If((sel3 != terminal.live) & Mux(sel3, tx_leave, tx_free)):
                 m.d.sync += sel3.eq(terminal.live)
             with m.If((sel2 != want) & leave):
                 m.d.sync += sel2.eq(Mux(Mux(terminal.enabled, di3_free, tx_free), want, _IDLE))
-            m.d.sync += drained.eq(Mux(di3_idle, Mux(full, drained, next_state(drained)), count_state(0, drain_width)))
+            m.d.sync += [drained.eq(Mux(di3_idle, next_state(drained), count_state(0, drain_width))),
+                         full.eq(di3_idle & (full | ending))]
         do2 = Signal(init=wire.IDLE_LEVEL)
         m.d.comb += do2.eq(Mux(sel2 == _SENT, lines.do2, Mux(sel2 == _DI3, di3, wire.IDLE_LEVEL)))
         # The master's telegrams back on DI3 (BK-38) and, in BK-LBD, the counter block on DI3 (BK-39).
