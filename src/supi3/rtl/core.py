@@ -67,6 +67,7 @@ from supi3.pinout import (
 )
 from supi3.regmap import INTERRUPT_SOURCES
 from supi3.regmap.core import BYTE_BITS
+from supi3.regmap.registers import IN_BYTES
 from supi3.rtl.counter import CounterLinesRtl, LineQueue, stamp_bits
 from supi3.rtl.expansion import PIN_NAMES as EXPANSION_PINS
 from supi3.rtl.expansion import ExpansionRtl
@@ -566,8 +567,14 @@ class Supi3Core(wiring.Component):
                                         Cat(terminal.status, strap_id[BYTE_BITS:]), strap_id)),
             datapath.data_bytes.eq(strap_bytes),
             datapath.external.eq(spi | init_up if up else spi),
-            datapath.in_data.eq(Mux(init_up, self.in_data, in_data) if up else in_data),
+            # Init-µP modes have no SPI master (checked here), so the serial I/O's IN word stays at its reset 0 in them;
+            # outside them the register file is held in its power-up reset (``power_up``), where the IN bytes are 0
+            # (checked here): so the two words are ORed, not chosen (round 5)
+            datapath.in_data.eq(self.in_data | in_data if up else in_data),
         ]
+        if up and (any(tables.modes[k].init_up and serial[k] is not None for k in tables.strap_modes if k is not None)
+                   or any(register.reset for register in IN_BYTES)):
+            raise ValueError("the IN data are ORed: no SPI master in Init-µP modes, IN bytes reset to 0")
         if up:
             up_bytes = Signal.like(strap_bytes)
             counts = [upif_tables().internal_bytes.get(code, 0) for code in range(1 << len(self.bus_id[BYTE_BITS:]))]
