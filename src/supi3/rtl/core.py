@@ -342,16 +342,12 @@ class Supi3Core(wiring.Component):
 
         # The power-up reset with its stretch (1.7.2, M2), from the synchronised /ResU and voltage monitor ---------
         power_fail = ~(receiver.resu_n_s & receiver.vmon_ok_s)
-        holding = Signal()
-        stretch_width = max(min(TAPS), RESET_STRETCH_CLOCKS.bit_length())  # counts down as an LFSR (lfsr.down_state)
+        # The stretch counts down as an LFSR (lfsr.down_state), loaded with one clock more than it while the power
+        # fails: that clock is the one after the failure the model holds the chip in (its ``holding``, round 5).
+        stretch_width = max(min(TAPS), RESET_STRETCH_CLOCKS.bit_length())
         stretch = Signal(stretch_width, init=down_state(RESET_STRETCH_CLOCKS, stretch_width))
-        with m.If(power_fail):
-            m.d.sync += holding.eq(1)
-        with m.Elif(holding):
-            m.d.sync += [holding.eq(0), stretch.eq(down_state(RESET_STRETCH_CLOCKS - 1, stretch_width))]
-        with m.Else():
-            m.d.sync += stretch.eq(down_step(stretch))
-        running = ~power_fail & ~holding & (stretch == 0)
+        m.d.sync += stretch.eq(Mux(power_fail, down_state(RESET_STRETCH_CLOCKS, stretch_width), down_step(stretch)))
+        running = ~power_fail & (stretch == 0)
 
         def gated(block: wiring.Component) -> Elaboratable:
             # Held in reset while not running, which is the same as stopping it: every stop begins with a power
@@ -616,7 +612,7 @@ class Supi3Core(wiring.Component):
             self.diag2.eq(outputs.diag2),
             self.ib_diag.eq(outputs.ib_diag),
             self.dclk_out.eq(dclk),
-            self.resu_drive.eq(holding | (stretch != 0)),
+            self.resu_drive.eq(stretch != 0),
             *(getattr(self, name).eq(getattr(expansion, name)) for name in EXPANSION_PINS),
         ]
         return m
