@@ -1141,7 +1141,7 @@ class OutputsRtl(wiring.Component):
             """The deadline for a watchdog code: clk + timeout, or none ("off")."""
             on = Array(Const(int(t is not None), 1) for t in WATCHDOG_CLOCKS)[code]
             width = len(wd_count)
-            # "off" loads a don't-care (``wd_active`` is 0): code 1's value (code 3 = 0b11, code 1 = 0b01), one term less
+            # "off" loads a don't-care (``wd_active`` is 0): code 1's value (codes 0b11 and 0b01), one term less
             loads = [before((t or timeouts[1]) - 1, width) for t in WATCHDOG_CLOCKS]
             count = Array(Const(load, width) for load in loads)[code]
             return [wd_active.eq(on), wd_count.eq(count)]
