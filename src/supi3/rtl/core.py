@@ -67,10 +67,11 @@ from supi3.pinout import (
 )
 from supi3.regmap import INTERRUPT_SOURCES
 from supi3.regmap.core import BYTE_BITS
+from supi3.regmap.registers import IN_BYTES
 from supi3.rtl.counter import CounterLinesRtl, LineQueue, stamp_bits
 from supi3.rtl.expansion import PIN_NAMES as EXPANSION_PINS
 from supi3.rtl.expansion import ExpansionRtl
-from supi3.rtl.lfsr import TAPS, Countdown, before, count_state, count_width, down_state, down_step, next_state
+from supi3.rtl.lfsr import TAPS, before, count_state, count_width, down_state, down_step, next_state
 from supi3.rtl.optical import OpticalRtl
 from supi3.rtl.serial_io import DIRECTIONS, SER_IN_PIN, WIDTHS, SerialIoRtl
 from supi3.rtl.tables import (
@@ -372,16 +373,12 @@ class Supi3Core(wiring.Component):
 
         # The power-up reset with its stretch (1.7.2, M2), from the synchronised /ResU and voltage monitor ---------
         power_fail = ~(receiver.resu_n_s & receiver.vmon_ok_s)
-        holding = Signal()
-        stretch_width = max(min(TAPS), RESET_STRETCH_CLOCKS.bit_length())  # counts down as an LFSR (lfsr.down_state)
+        # The stretch counts down as an LFSR (lfsr.down_state), loaded with one clock more than it while the power
+        # fails: that clock is the one after the failure the model holds the chip in (its ``holding``, round 5).
+        stretch_width = max(min(TAPS), RESET_STRETCH_CLOCKS.bit_length())
         stretch = Signal(stretch_width, init=down_state(RESET_STRETCH_CLOCKS, stretch_width))
-        with m.If(power_fail):
-            m.d.sync += holding.eq(1)
-        with m.Elif(holding):
-            m.d.sync += [holding.eq(0), stretch.eq(down_state(RESET_STRETCH_CLOCKS - 1, stretch_width))]
-        with m.Else():
-            m.d.sync += stretch.eq(down_step(stretch))
-        running = ~power_fail & ~holding & (stretch == 0)
+        m.d.sync += stretch.eq(Mux(power_fail, down_state(RESET_STRETCH_CLOCKS, stretch_width), down_step(stretch)))
+        running = ~power_fail & (stretch == 0)
 
         def gated(block: wiring.Component) -> Elaboratable:
             # Held in reset while not running, which is the same as stopping it: every stop begins with a power
@@ -426,11 +423,13 @@ class Supi3Core(wiring.Component):
         m.d.comb += [tx_watch.line.eq(lines.do2), tx_watch.fast.eq(lines.fast)]
         sel3 = Signal()
         sel2 = Signal(2, init=_SENT)
-        # DI3's idle clocks up to BRANCH_DRAIN_BITS bit periods, counted up as an LFSR (lfsr.count_state)
+        # DI3's idle clocks, counted up as an LFSR (lfsr.count_state) that runs on past its end, and ``full`` set on
+        # the clock after it read BRANCH_DRAIN_BITS bit periods less one, kept while DI3 stays idle (round 5: no hold)
         drain_width = count_width(max(e.clocks_per_bit for e in clocks) * BRANCH_DRAIN_BITS)
         drained = Signal(drain_width, init=count_state(0, drain_width))
-        full = _per_rate(rate, clocks, lambda e: drained == count_state(e.clocks_per_bit * BRANCH_DRAIN_BITS,
-                                                                         drain_width))  # fmt: skip
+        full = Signal()
+        ending = _per_rate(rate, clocks, lambda e: drained == count_state(e.clocks_per_bit * BRANCH_DRAIN_BITS - 1,
+                                                                           drain_width))  # fmt: skip
         tx_free = ~tx_watch.busy
         tx_leave = tx_free & (lines.do2 == wire.IDLE_LEVEL)
         di3_free = ~lines.branch_busy
@@ -438,13 +437,14 @@ class Supi3Core(wiring.Component):
         want = Mux(terminal.enabled, _DI3, _SENT)
         leave = (sel2 == _IDLE) | Mux(sel2 == _SENT, tx_leave, di3_idle & full)
         with m.If(~running):  # reset, and held so until the core runs (as ``gated``)
-            m.d.sync += [sel3.eq(0), sel2.eq(_SENT), drained.eq(count_state(0, drain_width))]
+            m.d.sync += [sel3.eq(0), sel2.eq(_SENT), drained.eq(count_state(0, drain_width)), full.eq(0)]
         with m.Else():
             with m.If((sel3 != terminal.live) & Mux(sel3, tx_leave, tx_free)):
                 m.d.sync += sel3.eq(terminal.live)
             with m.If((sel2 != want) & leave):
                 m.d.sync += sel2.eq(Mux(Mux(terminal.enabled, di3_free, tx_free), want, _IDLE))
-            m.d.sync += drained.eq(Mux(di3_idle, Mux(full, drained, next_state(drained)), count_state(0, drain_width)))
+            m.d.sync += [drained.eq(Mux(di3_idle, next_state(drained), count_state(0, drain_width))),
+                         full.eq(di3_idle & (full | ending))]
         do2 = Signal(init=wire.IDLE_LEVEL)
         m.d.comb += do2.eq(Mux(sel2 == _SENT, lines.do2, Mux(sel2 == _DI3, di3, wire.IDLE_LEVEL)))
         # The master's telegrams back on DI3 (BK-38) and, in BK-LBD, the counter block on DI3 (BK-39).
@@ -594,8 +594,14 @@ class Supi3Core(wiring.Component):
                                         Cat(terminal.status, strap_id[BYTE_BITS:]), strap_id)),
             datapath.data_bytes.eq(strap_bytes),
             datapath.external.eq(spi | init_up if up else spi),
-            datapath.in_data.eq(Mux(init_up, self.in_data, in_data) if up else in_data),
+            # Init-µP modes have no SPI master (checked here), so the serial I/O's IN word stays at its reset 0 in them;
+            # outside them the register file is held in its power-up reset (``power_up``), where the IN bytes are 0
+            # (checked here): so the two words are ORed, not chosen (round 5)
+            datapath.in_data.eq(self.in_data | in_data if up else in_data),
         ]
+        if up and (any(tables.modes[k].init_up and serial[k] is not None for k in tables.strap_modes if k is not None)
+                   or any(register.reset for register in IN_BYTES)):
+            raise ValueError("the IN data are ORed: no SPI master in Init-µP modes, IN bytes reset to 0")
         if up:
             up_bytes = Signal.like(strap_bytes)
             counts = [upif_tables().internal_bytes.get(code, 0) for code in range(1 << len(self.bus_id[BYTE_BITS:]))]
@@ -637,7 +643,7 @@ class Supi3Core(wiring.Component):
             self.diag2.eq(outputs.diag2),
             self.ib_diag.eq(outputs.ib_diag),
             self.dclk_out.eq(dclk),
-            self.resu_drive.eq(holding | (stretch != 0)),
+            self.resu_drive.eq(stretch != 0),
             *(getattr(self, name).eq(getattr(expansion, name)) for name in EXPANSION_PINS),
         ]
         return m
@@ -1145,13 +1151,17 @@ class OutputsRtl(wiring.Component):
         next_present = Signal()
 
         # The model calls chip._advance at the start of every running clock: the /StatErr filter and the watchdog.
-        # The clocks /StatErr has been low, counted down from STATERR_FILTER_CLOCKS - 1 (one clock old at the edge
-        # after it fell) to 0 (filtered) as an LFSR (supi3.rtl.lfsr); it is read only while /StatErr stays low
-        # (``st_valid``), so it may run on after it rose.
-        st_valid = Signal()
-        st_count = Countdown(m, STATERR_FILTER_CLOCKS - 1, load=stat & ~st_valid, clear=Const(0), name="st_count")
-        filtered = st_valid & st_count.idle
-        sync += st_valid.eq(stat)
+        # The clocks /StatErr has been low, counted up as an LFSR (lfsr.count_state) from 0 at its first low clock,
+        # held at 0 while it is high (one gate a bit, no load, no end state); ``filtered`` is set on the clock after
+        # the count read STATERR_FILTER_CLOCKS - 1 and stays while /StatErr stays low, so the LFSR may run on past
+        # its end (round 5).
+        st_width = count_width(STATERR_FILTER_CLOCKS - 1)
+        st_count = Signal(st_width, init=count_state(0, st_width))
+        filtered = Signal()
+        sync += [
+            st_count.eq(Mux(stat, next_state(st_count), count_state(0, st_width))),
+            filtered.eq(stat & (filtered | (st_count == count_state(STATERR_FILTER_CLOCKS - 1, st_width)))),
+        ]
         module_error = stat & filtered
 
         timeouts = [t for t in WATCHDOG_CLOCKS if t is not None]
@@ -1167,7 +1177,9 @@ class OutputsRtl(wiring.Component):
             """The deadline for a watchdog code: clk + timeout, or none ("off")."""
             on = Array(Const(int(t is not None), 1) for t in WATCHDOG_CLOCKS)[code]
             width = len(wd_count)
-            count = Array(Const(before(max(t or 1, 1) - 1, width), width) for t in WATCHDOG_CLOCKS)[code]
+            # "off" loads a don't-care (``wd_active`` is 0): code 1's value (codes 0b11 and 0b01), one term less
+            loads = [before((t or timeouts[1]) - 1, width) for t in WATCHDOG_CLOCKS]
+            count = Array(Const(load, width) for load in loads)[code]
             return [wd_active.eq(on), wd_count.eq(count)]
 
         # Pulse counters: loaded with the width at the edge that starts the pulse, the pin low while non-zero, so
