@@ -69,13 +69,7 @@ def history(ring: Ring | PinRing, start: bool, ops: list[Op], wake: int) -> list
     for op, k in ops:
         k = min(k, len(ring.devices))
         if op == "power":
-            if isinstance(ring, PinRing):
-                ring.set_input(k, "resu_n", 0)
-                _idle(ring, POWER_DOWN_TELEGRAMS)
-                ring.set_input(k, "resu_n", 1)
-            else:
-                _idle(ring, POWER_DOWN_TELEGRAMS)
-                ring.power_up(k)
+            _power_cycle(ring, k)
             _idle(ring, wake)
         elif op == "cut":
             ring.cut(k, True)
@@ -147,6 +141,18 @@ def test_a_frame_that_meets_the_reset_stretch_fails_at_pin_level(rate: int) -> N
     assert master.cycle().ok
 
 
+def _power_cycle(ring: Ring | PinRing, position: int) -> None:
+    """Power the chip at ``position`` down for :data:`POWER_DOWN_TELEGRAMS` idle status telegrams and up again: /ResU
+    low then high at pin level, ``Ring.power_up`` at the transaction level (M22)."""
+    if isinstance(ring, PinRing):
+        ring.set_input(position, "resu_n", 0)
+        _idle(ring, POWER_DOWN_TELEGRAMS)
+        ring.set_input(position, "resu_n", 1)
+    else:
+        _idle(ring, POWER_DOWN_TELEGRAMS)
+        ring.power_up(position)
+
+
 def _first_cycle(ring: Ring | PinRing, chips: int, position: int, telegrams: int) -> bool:
     """Whether the master's cycle passes ``telegrams`` idle status telegrams after the power-up of ``position`` (0:
     every chip, at the ring's first clock; else one chip of a running ring, /ResU low for 4 idle status telegrams)."""
@@ -154,13 +160,7 @@ def _first_cycle(ring: Ring | PinRing, chips: int, position: int, telegrams: int
         _idle(ring, PAST_WINDOW_TELEGRAMS)
         master = Master(ring, locate=False, max_devices=8)
         assert master.cycle().ok
-        if isinstance(ring, PinRing):
-            ring.set_input(position, "resu_n", 0)
-            _idle(ring, POWER_DOWN_TELEGRAMS)
-            ring.set_input(position, "resu_n", 1)
-        else:
-            _idle(ring, POWER_DOWN_TELEGRAMS)
-            ring.power_up(position)
+        _power_cycle(ring, position)
     else:
         if isinstance(ring, Ring):
             for k in range(1, chips + 1):
