@@ -95,7 +95,8 @@ _CHIP_INPUTS: Final[dict[int, tuple[str, int]]] = {PIN_SS: ("mfp_in", SS_BIT), P
 MISO_IDLE: Final[int] = 0xFF
 """MCU-6: what the SPI receives when the chip drives no SerOUT (pulled up)."""
 DEFAULT_MAX_INSTRUCTIONS: Final[int] = 20_000_000
-"""The instruction budget of one :meth:`Board.run` call unless given, renewed each time the core waits (MCU-41)."""
+"""The instruction budget of one :meth:`Board.run` call unless given, renewed each time the core waits (MCU-41) and
+each time the main loop comes to :data:`SERVE_POINT` (MCU-43)."""
 FIDELITIES: Final[tuple[str, ...]] = ("transaction", "pin")
 """The chip on the board: the transaction-level model (:class:`supi3.sdk.bench.Bench`) or the pin-level whole chip
 (:class:`supi3.top.Supi3Chip` in lockstep with the core, :mod:`supi3.mcu.pins`)."""
@@ -548,9 +549,12 @@ class Board:
 
     def _on_serve_point(self) -> None:
         """The core is about to run :data:`SERVE_POINT`: note the arrival (at the end of the block it is in, the
-        core's clock now, MCU-1); once a whole pass began after the run's last cycle, end the core's run."""
-        if self._passes.arrive(self.core.cycles):
-            self.core.stop_request = True
+        core's clock now, MCU-1); once a whole pass began after the run's last cycle, end the core's run. A pass of
+        the main loop renews the instruction budget, as a wait does (MCU-43)."""
+        core = self.core
+        self._limit = core.instructions + self._budget
+        if self._passes.arrive(core.cycles):
+            core.stop_request = True
 
     def _passed(self) -> bool:
         """A whole pass of the main loop began at or after the run's last cycle's end and after the last EXTI0
@@ -744,14 +748,15 @@ class Board:
         telegrams of bus time; :attr:`served` tells whether the run ended served. At pin level the master's cycles
         run whole, then the line idles in status telegrams while the firmware is in a handler, has an /IRQ edge to
         serve or its pass to make, up to :data:`SERVE_TELEGRAMS` of them (MCU-17). The instruction budget bounds the
-        work between two waits of the core (MCU-41).
+        work between two waits of the core (MCU-41) or two passes of its main loop (MCU-43).
 
         Raises
         ------
         FirmwareFaultError
             The core faulted (report: fault type, PC, stacked registers).
         FirmwareStoppedError
-            ``max_instructions`` ran out since the core last waited (checked where the core stops, at basic-block
+            ``max_instructions`` ran out since the core last waited or its main loop last came to
+            :data:`SERVE_POINT` (checked where the core stops, at basic-block
             boundaries, so the run may end up to one block past it, MCU-1), or the firmware loops on ``b .`` inside
             a handler.
         InterfaceViolationError
@@ -827,7 +832,7 @@ class Board:
                 raise FirmwareStoppedError(core.report(Stop.HANG, f"endless loop (b .) in the handler of exception "
                                                   f"{core.active[-1]}"))  # fmt: skip
             core.sleeping = True
-        if core.sleeping:  # MCU-41: the budget bounds the work between two waits, renewed at each
+        if core.sleeping:  # MCU-41: the budget bounds the work between two waits (and passes, MCU-43)
             self._limit = core.instructions + self._budget
 
     def _place(self, error: InterfaceViolationError) -> None:
