@@ -513,7 +513,7 @@ def test_a_small_budget_gives_the_same_verdict_at_both_fidelities_with_systick_r
 # -- MCU-43: the budget renewed at each pass of the main loop -------------------------------------------------------
 
 
-def _verdict(board: Board, runs: tuple[int, ...], budget: int) -> tuple[Stop, str, int | None, int] | None:
+def _verdict(board: Board, runs: tuple[int, ...], budget: int) -> tuple[Stop, str | None, int | None, int] | None:
     """The history's verdict: ``None`` if every run ended, else the stop, the function and source line it stopped
     in, and the instructions it ran since its main loop last came to ``fw_loop`` (or since reset)."""
     arrivals = [0]

@@ -773,7 +773,8 @@ class Board:
             if self._ring is not None:
                 self._run_pin(lambda: self._cycles_done >= target, max_instructions)
                 return
-            self._run(lambda: self.bench.cycles >= target and self._serve_wait(), max_instructions)
+            bench = self.bench
+            self._run(lambda: bench.cycles >= target and self._serve_wait(), max_instructions)
         finally:
             self._passes.end()
             self._serve_end = None
@@ -797,18 +798,20 @@ class Board:
         self._set_budget(max_instructions)
         self._sync(core.cycles)
         self._follow_irq(core.cycles)  # the chip may have changed between runs (the host's calls)
+        systick, exti, bench = core.systick, self.exti, self.bench
         while True:
-            core.systick.update()
-            self._request()
+            tick = systick.due()
+            if exti.requesting(0):
+                self._pend()
             if done():
                 return
-            deadline = event = math.ceil(self.bench.next_change_s() * core.cpu_hz)
-            tick = core.systick.next_event()
+            deadline = event = math.ceil(bench.next_change_s() * core.cpu_hz)
             for bound in (tick, end, self._serve_end):
                 if bound is not None:
                     deadline = min(deadline, bound)
             self._step(deadline)
-            self._sync(core.cycles, event if event <= core.cycles else None)
+            cycles = core.cycles
+            self._sync(cycles, event if event <= cycles else None)
 
     def _set_budget(self, max_instructions: int) -> None:
         self._budget = check_int("max_instructions", max_instructions, 1)
@@ -817,13 +820,15 @@ class Board:
     def _step(self, deadline: int) -> None:
         """One run of the core up to ``deadline`` (at least one block), within the instruction budget."""
         core = self.core
-        if core.instructions >= self._limit and not core.sleeping:  # a sleeping core runs no instruction (MCU-4)
-            raise FirmwareStoppedError(core.report(Stop.BUDGET, f"instruction budget of {self._budget} used up "
-                                                   "(an endless loop?)"))  # fmt: skip
-        if not core.sleeping:  # within the budget: an instruction costs a cycle at least (MCU-1)
-            deadline = min(deadline, core.cycles + self._limit - core.instructions)
+        cycles = core.cycles
+        if not core.sleeping:  # a sleeping core runs no instruction (MCU-4)
+            left = self._limit - core.instructions
+            if left <= 0:
+                raise FirmwareStoppedError(core.report(Stop.BUDGET, f"instruction budget of {self._budget} used up "
+                                                       "(an endless loop?)"))  # fmt: skip
+            deadline = min(deadline, cycles + left)  # within the budget: an instruction costs a cycle at least (MCU-1)
         try:
-            state = core.step(max(deadline, core.cycles + 1))
+            state = core.step(max(deadline, cycles + 1))
         except InterfaceViolationError as error:
             self._place(error)
             raise
@@ -900,9 +905,8 @@ class Board:
             if core.cycles >= end:  # the core ran past the chip's target in its last block
                 ring.sync(clock)
                 break
-            core.systick.update()
+            tick = core.systick.due()
             self._request()
-            tick = core.systick.next_event()
             if core.sleeping:
                 stop = clock if tick is None else min(clock, ring.clock_of(tick))
                 held: list[tuple[str, int, int]] = []
