@@ -28,7 +28,16 @@ from supi3.errors import Supi3Error
 from supi3.interbus import wire
 from supi3.interbus.link import Device
 from supi3.interbus.master import Master
-from supi3.mcu.core import EXTERNAL, CortexM, FirmwareImage, FirmwareStoppedError, Frame, SourceLine, Stop
+from supi3.mcu.core import (
+    EXTERNAL,
+    MAX_DEADLINE,
+    CortexM,
+    FirmwareImage,
+    FirmwareStoppedError,
+    Frame,
+    SourceLine,
+    Stop,
+)
 from supi3.mcu.pins import SAS_INIT_BIT, SR_BIT, SS_BIT, SYNC_S, Cause, LockstepRing, mcu_lines
 from supi3.mcu.stm32 import (
     AFIO_BASE,
@@ -166,6 +175,15 @@ class ViolationAt:
 
 class _BoardBench(Bench):
     """The bench, driven by the core's clock: the run loop needs the next bus event to stop the core there."""
+
+    low_at: float | None = None
+    """The bus time of the first bus event since the board last followed /IRQ at which /IRQ was low (MCU-44: the
+    board times a fall it finds later, at a peripheral access or a stop, at that event); the board takes it back."""
+
+    def irq_edge(self) -> None:
+        super().irq_edge()
+        if self.low_at is None and not self.registers.irq_n:
+            self.low_at = self.now
 
     def next_change_s(self) -> float:
         """The time of the next bus event that may change /IRQ or /ModAck: a cycle's start or end, not the phases
@@ -342,7 +360,7 @@ class Board:
         core.mmio(GPIOA_BASE, PERIPHERAL_SIZE, self.gpio.read, self.gpio.write)
         core.mmio(GPIOB_BASE, PERIPHERAL_SIZE, self.gpio_b.read, self.gpio_b.write)
         core.mmio(AFIO_BASE, PERIPHERAL_SIZE, self.exti.read_afio, self.exti.write_afio)
-        core.mmio(EXTI_BASE, PERIPHERAL_SIZE, self.exti.read, self._exti_write)
+        core.mmio(EXTI_BASE, PERIPHERAL_SIZE, self._exti_read, self._exti_write)
         held = core.mmio(SPI1_BASE, PERIPHERAL_SIZE, self.spi.read, self.spi.write)
         self.spi.holder = self.spi.offer = held  # SR held (MCU-25), DR's read after its byte (MCU-26)
         core.entered = self._entered
@@ -480,13 +498,13 @@ class Board:
     def _seconds(self, cycles: int) -> float:
         return cycles / self.core.cpu_hz
 
-    def _sync(self, cycles: int, event: int | None = None) -> None:
-        """Run the bus up to core cycle ``cycles``, then follow /IRQ; ``event``: the cycle of the bus event passed
-        on the way, when /IRQ changed if it did. /IRQ and /ModAck change only at a bus event or a chip action
-        (:meth:`_chip` follows its own), and EXTI0's request only with them, a write of EXTI (:meth:`_exti_write`)
-        or an exception's return (the run loop): with no bus event on the way there is nothing to follow (MCU-31)."""
+    def _sync(self, cycles: int) -> None:
+        """Run the bus up to core cycle ``cycles``, then follow /IRQ. /IRQ and /ModAck change only at a bus event or
+        a chip action (:meth:`_chip` follows its own), and EXTI0's request only with them, a write of EXTI
+        (:meth:`_exti_write`) or an exception's return (the run loop): with no bus event on the way there is nothing
+        to follow (MCU-31)."""
         if self._advance(cycles / self._cpu_hz):
-            self._follow_irq(cycles, event)
+            self._follow_irq(cycles)
 
     def _no_bench(self, until: float) -> bool:
         """:attr:`_advance` at pin level: :class:`BoardError` (the transaction-level bench is not there)."""
@@ -499,12 +517,14 @@ class Board:
 
     # -- /IRQ, EXTI0 and the NVIC ------------------------------------------------------------------------------
 
-    def _follow_irq(self, cycles: int, event: int | None = None, *, request: bool = True) -> None:
+    def _follow_irq(self, cycles: int, *, request: bool = True) -> None:
         """Pass /IRQ's and /ModAck's edges since the last call to EXTI, then let EXTI0 request its interrupt;
         ``request=False``: only if an edge was passed (the caller requested since, and nothing else changes EXTI or
-        the NVIC within one peripheral access)."""
+        the NVIC within one peripheral access). A fall is timed at the first bus event since the last call at which
+        /IRQ was low (the core cycle at or after it), else at ``cycles`` (a chip action's, MCU-44)."""
         bench = self._bench
         assert bench is not None
+        low_at, bench.low_at = bench.low_at, None
         pulse = bench.chip.mod_ack_until
         if pulse != self._mod_ack_until:  # a new /ModAck pulse (375 ns, 3.6.2): both edges, the falling one latched
             self._mod_ack_until = pulse
@@ -515,7 +535,7 @@ class Board:
         if level != self._irq_level:
             self._irq_level = level
             if not level and self._irq_fell is None:
-                self._irq_fell = cycles if event is None else event
+                self._irq_fell = cycles if low_at is None else math.ceil(low_at * self._cpu_hz)
             self.exti.edge(0, PIN_IRQ, level)
             request = True
         if request and self.exti.requesting(0):
@@ -525,8 +545,18 @@ class Board:
         if self.exti.requesting(0):
             self._pend()
 
+    def _exti_read(self, offset: int, size: int) -> int:
+        """The firmware reads EXTI: at transaction level the bus runs up to the access first, so PR holds every edge
+        of /IRQ before it (MCU-44: the run loop does not stop at a bus event while EXTI0 is active)."""
+        if self._ring is None:
+            self._now()
+        return self.exti.read(offset, size)
+
     def _exti_write(self, offset: int, size: int, value: int) -> None:
-        """The firmware writes EXTI: a line it unmasks (IMR) or sets (SWIER) with PR set requests at once (MCU-31)."""
+        """The firmware writes EXTI (the bus run up to it first, as :meth:`_exti_read`): a line it unmasks (IMR) or
+        sets (SWIER) with PR set requests at once (MCU-31)."""
+        if self._ring is None:
+            self._now()
         self.exti.write(offset, size, value)
         self._request()
 
@@ -798,20 +828,29 @@ class Board:
         self._set_budget(max_instructions)
         self._sync(core.cycles)
         self._follow_irq(core.cycles)  # the chip may have changed between runs (the host's calls)
-        systick, exti, bench = core.systick, self.exti, self.bench
+        systick, exti = core.systick, self.exti
         while True:
             tick = systick.due()
             if exti.requesting(0):
                 self._pend()
             if done():
                 return
-            deadline = event = math.ceil(bench.next_change_s() * core.cpu_hz)
+            deadline = self._bus_deadline()
             for bound in (tick, end, self._serve_end):
                 if bound is not None:
                     deadline = min(deadline, bound)
             self._step(deadline)
-            cycles = core.cycles
-            self._sync(cycles, event if event <= cycles else None)
+            self._sync(core.cycles)
+
+    def _bus_deadline(self) -> int:
+        """The core cycle the run loop stops the core at for the bus: the next bus event that may change /IRQ or
+        /ModAck (MCU-31); none while EXTI0 is active or about to be entered at the step's start (MCU-44: an edge of
+        /IRQ then only sets EXTI's pending bit, and the firmware's next access, or the next stop, at the latest the
+        handler's return, runs the bus up to it)."""
+        core = self.core
+        if _EXTI0 in core.active or (_EXTI0 in core.pending and core.next_entry() == _EXTI0):
+            return MAX_DEADLINE
+        return math.ceil(self.bench.next_change_s() * core.cpu_hz)
 
     def _set_budget(self, max_instructions: int) -> None:
         self._budget = check_int("max_instructions", max_instructions, 1)

@@ -1084,6 +1084,11 @@ class CortexM:
         """An exception is active, or pending and allowed to preempt: the core has interrupt work to do."""
         return bool(self.active) or self._takeable() is not None
 
+    def next_entry(self) -> int | None:
+        """The pending exception the next :meth:`step` enters first (the highest priority allowed to preempt,
+        B1.5.4), ``None`` if none."""
+        return self._takeable()
+
     def _takeable(self) -> int | None:
         pending = self.pending
         if not pending:  # the run loop's common case (MCU-31)
