@@ -181,7 +181,8 @@ class _BoardBench(Bench):
     board times a fall it finds later, at a peripheral access or a stop, at that event); the board takes it back."""
 
     def irq_edge(self) -> None:
-        super().irq_edge()
+        """The board's watch of /IRQ at a bus event, in place of the firmware bench's (its service routine is the
+        board's EXTI0 handler): note the first event since the board last looked at which /IRQ was low."""
         if self.low_at is None and not self.registers.irq_n:
             self.low_at = self.now
 
@@ -847,10 +848,11 @@ class Board:
         /ModAck (MCU-31); none while EXTI0 is active or about to be entered at the step's start (MCU-44: an edge of
         /IRQ then only sets EXTI's pending bit, and the firmware's next access, or the next stop, at the latest the
         handler's return, runs the bus up to it)."""
-        core = self.core
+        core, bench = self.core, self._bench
+        assert bench is not None  # transaction level
         if _EXTI0 in core.active or (_EXTI0 in core.pending and core.next_entry() == _EXTI0):
             return MAX_DEADLINE
-        return math.ceil(self.bench.next_change_s() * core.cpu_hz)
+        return math.ceil(bench.next_change_s() * core.cpu_hz)
 
     def _set_budget(self, max_instructions: int) -> None:
         self._budget = check_int("max_instructions", max_instructions, 1)
