@@ -11,7 +11,9 @@ violations (time, PC, rule) are the same as with the synchronisation of every ac
 from __future__ import annotations
 
 import ctypes
+import math
 import struct
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -40,11 +42,15 @@ def digital_io(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
 
 
 class EveryAccess(Board):
-    """The board before MCU-31: every bus synchronisation follows /IRQ and /ModAck and lets EXTI0 request."""
+    """The board before MCU-31 and MCU-44: every bus synchronisation follows /IRQ and /ModAck and lets EXTI0
+    request, and the run loop stops the core at every bus event, EXTI0's handler running or not."""
 
-    def _sync(self, cycles: int, event: int | None = None) -> None:
+    def _sync(self, cycles: int) -> None:
         self._advance(cycles / self._cpu_hz)
-        self._follow_irq(cycles, event)
+        self._follow_irq(cycles)
+
+    def _bus_deadline(self) -> int:
+        return math.ceil(self.bench.next_change_s() * self.core.cpu_hz)
 
 
 @pytest.mark.parametrize(("case", "bit_rate"), [("cortex_m3", 500_000), ("cortex_m0", 500_000), ("br3", 2_000_000)])
@@ -73,6 +79,38 @@ def test_the_lean_path_changes_nothing_on_the_board(digital_io: dict[str, Path],
         runs.append(history)
     assert runs[0] == runs[1]
     assert runs[0][-1][6:8] == (b"\x9a\xbc\0\0", b"\xde\xf0")
+
+
+def test_a_bus_event_inside_exti0_s_handler_stops_nothing_and_changes_nothing(digital_io: dict[str, Path]) -> None:
+    """MCU-44, issue #13's case (its handler outlasts the master cycle): the run loop stops the core about once a
+    master cycle (at the handler's return) where the reference board stops it twice (also at the cycle's end inside
+    the handler), and after every run of a history both show the same cycles, instructions, registers, bus time,
+    interrupts, /IRQ latency, violations (time, PC, rule), EXTI's pending register and process data."""
+    seen = []
+    for board_class in (Board, EveryAccess):
+        board = board_class(digital_io["br3"], bit_rate=2_000_000, strict=False)
+        board.run(3)
+        before = board.bench.cycles
+        stops = [0]
+        step = board.core.step
+
+        def counted(deadline: int, step: Callable[[int], str] = step, stops: list[int] = stops) -> str:
+            stops[0] += 1
+            return step(deadline)
+
+        board.core.step = counted  # type: ignore[method-assign]
+        history = []
+        for cycles in (1, 4, 2, 13):
+            board.run(cycles)
+            core = board.core
+            history.append((core.cycles, core.instructions, core.registers(), board.bench.now, board.interrupts,
+                            board.irq_latency_s, [(v.time_s, v.pc, v.error.rule) for v in board.violations],
+                            board.exti.read(0x14, 4), board.bench.master.inputs(1)))  # fmt: skip
+        seen.append((history, stops[0], board.bench.cycles - before))
+    (lean, lean_stops, cycles), (reference, reference_stops, _) = seen
+    assert lean == reference
+    assert reference_stops - lean_stops >= cycles * 3 // 4  # about one stop fewer a master cycle (68 against 123)
+    assert lean_stops <= cycles * 5 // 4
 
 
 def test_an_exti_write_that_unmasks_a_pending_line_requests_at_once(digital_io: dict[str, Path]) -> None:

@@ -508,3 +508,54 @@ def test_a_small_budget_gives_the_same_verdict_at_both_fidelities_with_systick_r
             verdicts.append((None, int(board.core.sleeping)))
     assert verdicts[0] == verdicts[1]
     assert verdicts[0][0] is (Stop.BUDGET if stop else None)
+
+
+# -- MCU-43: the budget renewed at each pass of the main loop -------------------------------------------------------
+
+
+def _verdict(board: Board, runs: tuple[int, ...], budget: int) -> tuple[Stop, str | None, int | None, int] | None:
+    """The history's verdict: ``None`` if every run ended, else the stop, the function and source line it stopped
+    in, and the instructions it ran since its main loop last came to ``fw_loop`` (or since reset)."""
+    arrivals = [0]
+    board.core.watch(board.core.image.address("fw_loop"), lambda: arrivals.append(board.core.instructions))
+    try:
+        for cycles in runs:
+            board.run(cycles, max_instructions=budget)
+    except FirmwareStoppedError as error:
+        frame = error.report.backtrace[0]
+        line = None if frame.source is None else frame.source.line
+        return error.report.stop, frame.function, line, board.core.instructions - arrivals[-1]
+    return None
+
+
+@pytest.mark.parametrize(("budget", "where"), [(1, "Reset_Handler"), (1000, "board_xfer"), (3000, "board_delay_us"),
+                                               (100_000, None)])  # fmt: skip
+def test_a_polling_firmware_gets_the_same_verdict_at_both_fidelities(
+    variants: dict[tuple[str, str], Path], budget: int, where: str | None
+) -> None:
+    """polling_io never waits (its main loop polls the I/O bit), so before MCU-43 its budget ran over the run's bus
+    time, which the two masters make different during power-up (MCU-17): a budget of 100,000 stopped the
+    transaction level in the power-up (1.3 million instructions over its 54 ms) and not the pin level (50,000 over
+    2 ms). Now each pass of the main loop renews the budget: over power-up and two data cycles a budget below the
+    set-up (2,000 instructions) stops both fidelities in it at the same instruction (a budget of 1: in the reset
+    handler's first block, 7 instructions), one below a pass that exchanges
+    data (3,210) stops both in such a pass, after the same instructions since its start, and a larger one stops
+    neither."""
+    verdicts = [_verdict(Board(variants["polling", "cortex_m3"], fidelity=fidelity), (3, 2), budget)
+                for fidelity in ("transaction", "pin")]  # fmt: skip
+    assert verdicts[0] == verdicts[1]
+    if where is None:
+        assert verdicts[0] is None
+    else:
+        assert verdicts[0] is not None and verdicts[0][:2] == (Stop.BUDGET, where)
+        assert budget <= verdicts[0][3] < budget + 8  # checked at block boundaries (MCU-1)
+
+
+@pytest.mark.parametrize("fidelity", ["transaction", "pin"])
+def test_a_main_loop_pass_that_never_returns_still_uses_up_its_budget(tmp_path: Path, fidelity: str) -> None:
+    """The renewal at each pass leaves a runaway pass bounded: main_loop.c's first pass never returns (STUCK), so
+    the budget, renewed at its start, runs out in it at both fidelities after the same instructions."""
+    board = Board(_variant("main_loop", tmp_path, "cortex_m3", STUCK="1"), fidelity=fidelity)
+    verdict = _verdict(board, (3,), 20_000)
+    assert verdict is not None and verdict[:2] == (Stop.BUDGET, "board_delay_us")
+    assert 20_000 <= verdict[3] < 20_008

@@ -149,7 +149,10 @@ def test_inconsistent_data_without_a_clock_says_so_and_pickles() -> None:
 
 
 def chip_state(chip: Supi3) -> object:
-    """Every attribute of the chip (copied) and of its register file."""
+    """Every attribute of the chip (copied) and of its register file; the µP modes' data path cache made fresh first,
+    as any call that asks for the data length leaves it (tests/test_cycle_caches.py holds it to the configuration)."""
+    if chip.registers is not None:
+        chip._data_path()
     own = {k: copy.copy(v) for k, v in fields(chip).items() if k != "registers"}
     return own, None if chip.registers is None else registers_state(chip.registers)
 

@@ -28,7 +28,16 @@ from supi3.errors import Supi3Error
 from supi3.interbus import wire
 from supi3.interbus.link import Device
 from supi3.interbus.master import Master
-from supi3.mcu.core import EXTERNAL, CortexM, FirmwareImage, FirmwareStoppedError, Frame, SourceLine, Stop
+from supi3.mcu.core import (
+    EXTERNAL,
+    MAX_DEADLINE,
+    CortexM,
+    FirmwareImage,
+    FirmwareStoppedError,
+    Frame,
+    SourceLine,
+    Stop,
+)
 from supi3.mcu.pins import SAS_INIT_BIT, SR_BIT, SS_BIT, SYNC_S, Cause, LockstepRing, mcu_lines
 from supi3.mcu.stm32 import (
     AFIO_BASE,
@@ -95,7 +104,8 @@ _CHIP_INPUTS: Final[dict[int, tuple[str, int]]] = {PIN_SS: ("mfp_in", SS_BIT), P
 MISO_IDLE: Final[int] = 0xFF
 """MCU-6: what the SPI receives when the chip drives no SerOUT (pulled up)."""
 DEFAULT_MAX_INSTRUCTIONS: Final[int] = 20_000_000
-"""The instruction budget of one :meth:`Board.run` call unless given, renewed each time the core waits (MCU-41)."""
+"""The instruction budget of one :meth:`Board.run` call unless given, renewed each time the core waits (MCU-41) and
+each time the main loop comes to :data:`SERVE_POINT` (MCU-43)."""
 FIDELITIES: Final[tuple[str, ...]] = ("transaction", "pin")
 """The chip on the board: the transaction-level model (:class:`supi3.sdk.bench.Bench`) or the pin-level whole chip
 (:class:`supi3.top.Supi3Chip` in lockstep with the core, :mod:`supi3.mcu.pins`)."""
@@ -165,6 +175,16 @@ class ViolationAt:
 
 class _BoardBench(Bench):
     """The bench, driven by the core's clock: the run loop needs the next bus event to stop the core there."""
+
+    low_at: float | None = None
+    """The bus time of the first bus event since the board last followed /IRQ at which /IRQ was low (MCU-44: the
+    board times a fall it finds later, at a peripheral access or a stop, at that event); the board takes it back."""
+
+    def irq_edge(self) -> None:
+        """The board's watch of /IRQ at a bus event, in place of the firmware bench's (its service routine is the
+        board's EXTI0 handler): note the first event since the board last looked at which /IRQ was low."""
+        if self.low_at is None and not self.registers.irq_n:
+            self.low_at = self.now
 
     def next_change_s(self) -> float:
         """The time of the next bus event that may change /IRQ or /ModAck: a cycle's start or end, not the phases
@@ -341,7 +361,7 @@ class Board:
         core.mmio(GPIOA_BASE, PERIPHERAL_SIZE, self.gpio.read, self.gpio.write)
         core.mmio(GPIOB_BASE, PERIPHERAL_SIZE, self.gpio_b.read, self.gpio_b.write)
         core.mmio(AFIO_BASE, PERIPHERAL_SIZE, self.exti.read_afio, self.exti.write_afio)
-        core.mmio(EXTI_BASE, PERIPHERAL_SIZE, self.exti.read, self._exti_write)
+        core.mmio(EXTI_BASE, PERIPHERAL_SIZE, self._exti_read, self._exti_write)
         held = core.mmio(SPI1_BASE, PERIPHERAL_SIZE, self.spi.read, self.spi.write)
         self.spi.holder = self.spi.offer = held  # SR held (MCU-25), DR's read after its byte (MCU-26)
         core.entered = self._entered
@@ -479,13 +499,13 @@ class Board:
     def _seconds(self, cycles: int) -> float:
         return cycles / self.core.cpu_hz
 
-    def _sync(self, cycles: int, event: int | None = None) -> None:
-        """Run the bus up to core cycle ``cycles``, then follow /IRQ; ``event``: the cycle of the bus event passed
-        on the way, when /IRQ changed if it did. /IRQ and /ModAck change only at a bus event or a chip action
-        (:meth:`_chip` follows its own), and EXTI0's request only with them, a write of EXTI (:meth:`_exti_write`)
-        or an exception's return (the run loop): with no bus event on the way there is nothing to follow (MCU-31)."""
+    def _sync(self, cycles: int) -> None:
+        """Run the bus up to core cycle ``cycles``, then follow /IRQ. /IRQ and /ModAck change only at a bus event or
+        a chip action (:meth:`_chip` follows its own), and EXTI0's request only with them, a write of EXTI
+        (:meth:`_exti_write`) or an exception's return (the run loop): with no bus event on the way there is nothing
+        to follow (MCU-31)."""
         if self._advance(cycles / self._cpu_hz):
-            self._follow_irq(cycles, event)
+            self._follow_irq(cycles)
 
     def _no_bench(self, until: float) -> bool:
         """:attr:`_advance` at pin level: :class:`BoardError` (the transaction-level bench is not there)."""
@@ -498,12 +518,14 @@ class Board:
 
     # -- /IRQ, EXTI0 and the NVIC ------------------------------------------------------------------------------
 
-    def _follow_irq(self, cycles: int, event: int | None = None, *, request: bool = True) -> None:
+    def _follow_irq(self, cycles: int, *, request: bool = True) -> None:
         """Pass /IRQ's and /ModAck's edges since the last call to EXTI, then let EXTI0 request its interrupt;
         ``request=False``: only if an edge was passed (the caller requested since, and nothing else changes EXTI or
-        the NVIC within one peripheral access)."""
+        the NVIC within one peripheral access). A fall is timed at the first bus event since the last call at which
+        /IRQ was low (the core cycle at or after it), else at ``cycles`` (a chip action's, MCU-44)."""
         bench = self._bench
         assert bench is not None
+        low_at, bench.low_at = bench.low_at, None
         pulse = bench.chip.mod_ack_until
         if pulse != self._mod_ack_until:  # a new /ModAck pulse (375 ns, 3.6.2): both edges, the falling one latched
             self._mod_ack_until = pulse
@@ -514,7 +536,7 @@ class Board:
         if level != self._irq_level:
             self._irq_level = level
             if not level and self._irq_fell is None:
-                self._irq_fell = cycles if event is None else event
+                self._irq_fell = cycles if low_at is None else math.ceil(low_at * self._cpu_hz)
             self.exti.edge(0, PIN_IRQ, level)
             request = True
         if request and self.exti.requesting(0):
@@ -524,8 +546,18 @@ class Board:
         if self.exti.requesting(0):
             self._pend()
 
+    def _exti_read(self, offset: int, size: int) -> int:
+        """The firmware reads EXTI: at transaction level the bus runs up to the access first, so PR holds every edge
+        of /IRQ before it (MCU-44: the run loop does not stop at a bus event while EXTI0 is active)."""
+        if self._ring is None:
+            self._now()
+        return self.exti.read(offset, size)
+
     def _exti_write(self, offset: int, size: int, value: int) -> None:
-        """The firmware writes EXTI: a line it unmasks (IMR) or sets (SWIER) with PR set requests at once (MCU-31)."""
+        """The firmware writes EXTI (the bus run up to it first, as :meth:`_exti_read`): a line it unmasks (IMR) or
+        sets (SWIER) with PR set requests at once (MCU-31)."""
+        if self._ring is None:
+            self._now()
         self.exti.write(offset, size, value)
         self._request()
 
@@ -548,9 +580,12 @@ class Board:
 
     def _on_serve_point(self) -> None:
         """The core is about to run :data:`SERVE_POINT`: note the arrival (at the end of the block it is in, the
-        core's clock now, MCU-1); once a whole pass began after the run's last cycle, end the core's run."""
-        if self._passes.arrive(self.core.cycles):
-            self.core.stop_request = True
+        core's clock now, MCU-1); once a whole pass began after the run's last cycle, end the core's run. A pass of
+        the main loop renews the instruction budget, as a wait does (MCU-43)."""
+        core = self.core
+        self._limit = core.instructions + self._budget
+        if self._passes.arrive(core.cycles):
+            core.stop_request = True
 
     def _passed(self) -> bool:
         """A whole pass of the main loop began at or after the run's last cycle's end and after the last EXTI0
@@ -744,14 +779,15 @@ class Board:
         telegrams of bus time; :attr:`served` tells whether the run ended served. At pin level the master's cycles
         run whole, then the line idles in status telegrams while the firmware is in a handler, has an /IRQ edge to
         serve or its pass to make, up to :data:`SERVE_TELEGRAMS` of them (MCU-17). The instruction budget bounds the
-        work between two waits of the core (MCU-41).
+        work between two waits of the core (MCU-41) or two passes of its main loop (MCU-43).
 
         Raises
         ------
         FirmwareFaultError
             The core faulted (report: fault type, PC, stacked registers).
         FirmwareStoppedError
-            ``max_instructions`` ran out since the core last waited (checked where the core stops, at basic-block
+            ``max_instructions`` ran out since the core last waited or its main loop last came to
+            :data:`SERVE_POINT` (checked where the core stops, at basic-block
             boundaries, so the run may end up to one block past it, MCU-1), or the firmware loops on ``b .`` inside
             a handler.
         InterfaceViolationError
@@ -768,7 +804,8 @@ class Board:
             if self._ring is not None:
                 self._run_pin(lambda: self._cycles_done >= target, max_instructions)
                 return
-            self._run(lambda: self.bench.cycles >= target and self._serve_wait(), max_instructions)
+            bench = self.bench
+            self._run(lambda: bench.cycles >= target and self._serve_wait(), max_instructions)
         finally:
             self._passes.end()
             self._serve_end = None
@@ -792,18 +829,30 @@ class Board:
         self._set_budget(max_instructions)
         self._sync(core.cycles)
         self._follow_irq(core.cycles)  # the chip may have changed between runs (the host's calls)
+        systick, exti = core.systick, self.exti
         while True:
-            core.systick.update()
-            self._request()
+            tick = systick.due()
+            if exti.requesting(0):
+                self._pend()
             if done():
                 return
-            deadline = event = math.ceil(self.bench.next_change_s() * core.cpu_hz)
-            tick = core.systick.next_event()
+            deadline = self._bus_deadline()
             for bound in (tick, end, self._serve_end):
                 if bound is not None:
                     deadline = min(deadline, bound)
             self._step(deadline)
-            self._sync(core.cycles, event if event <= core.cycles else None)
+            self._sync(core.cycles)
+
+    def _bus_deadline(self) -> int:
+        """The core cycle the run loop stops the core at for the bus: the next bus event that may change /IRQ or
+        /ModAck (MCU-31); none while EXTI0 is active or about to be entered at the step's start (MCU-44: an edge of
+        /IRQ then only sets EXTI's pending bit, and the firmware's next access, or the next stop, at the latest the
+        handler's return, runs the bus up to it)."""
+        core, bench = self.core, self._bench
+        assert bench is not None  # transaction level
+        if _EXTI0 in core.active or (_EXTI0 in core.pending and core.next_entry() == _EXTI0):
+            return MAX_DEADLINE
+        return math.ceil(bench.next_change_s() * core.cpu_hz)
 
     def _set_budget(self, max_instructions: int) -> None:
         self._budget = check_int("max_instructions", max_instructions, 1)
@@ -812,13 +861,15 @@ class Board:
     def _step(self, deadline: int) -> None:
         """One run of the core up to ``deadline`` (at least one block), within the instruction budget."""
         core = self.core
-        if core.instructions >= self._limit and not core.sleeping:  # a sleeping core runs no instruction (MCU-4)
-            raise FirmwareStoppedError(core.report(Stop.BUDGET, f"instruction budget of {self._budget} used up "
-                                                   "(an endless loop?)"))  # fmt: skip
-        if not core.sleeping:  # within the budget: an instruction costs a cycle at least (MCU-1)
-            deadline = min(deadline, core.cycles + self._limit - core.instructions)
+        cycles = core.cycles
+        if not core.sleeping:  # a sleeping core runs no instruction (MCU-4)
+            left = self._limit - core.instructions
+            if left <= 0:
+                raise FirmwareStoppedError(core.report(Stop.BUDGET, f"instruction budget of {self._budget} used up "
+                                                       "(an endless loop?)"))  # fmt: skip
+            deadline = min(deadline, cycles + left)  # within the budget: an instruction costs a cycle at least (MCU-1)
         try:
-            state = core.step(max(deadline, core.cycles + 1))
+            state = core.step(max(deadline, cycles + 1))
         except InterfaceViolationError as error:
             self._place(error)
             raise
@@ -827,7 +878,7 @@ class Board:
                 raise FirmwareStoppedError(core.report(Stop.HANG, f"endless loop (b .) in the handler of exception "
                                                   f"{core.active[-1]}"))  # fmt: skip
             core.sleeping = True
-        if core.sleeping:  # MCU-41: the budget bounds the work between two waits, renewed at each
+        if core.sleeping:  # MCU-41: the budget bounds the work between two waits (and passes, MCU-43)
             self._limit = core.instructions + self._budget
 
     def _place(self, error: InterfaceViolationError) -> None:
@@ -895,9 +946,8 @@ class Board:
             if core.cycles >= end:  # the core ran past the chip's target in its last block
                 ring.sync(clock)
                 break
-            core.systick.update()
+            tick = core.systick.due()
             self._request()
-            tick = core.systick.next_event()
             if core.sleeping:
                 stop = clock if tick is None else min(clock, ring.clock_of(tick))
                 held: list[tuple[str, int, int]] = []

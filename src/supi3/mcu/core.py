@@ -51,6 +51,7 @@ _LIB: Any = _UNICORN.unicorn_py3.unicorn.uclib
 register accesses go to it directly (MCU-19), without the binding's wrappers around each call."""
 # Callback types of unicorn.h (uc_cb_hookcode_t, uc_cb_eventmem_t, uc_cb_mmio_write_t; mmio reads: hook.MMIO_READ).
 _HOOK_CODE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint32, ctypes.c_void_p)
+_HOOK_INTR: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint32, ctypes.c_void_p)
 _HOOK_MEM_INVALID: Final = ctypes.CFUNCTYPE(ctypes.c_bool, ctypes.c_void_p, ctypes.c_int, ctypes.c_uint64, ctypes.c_int,
                                             ctypes.c_int64, ctypes.c_void_p)  # fmt: skip
 _MMIO_WRITE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint, ctypes.c_uint64,
@@ -792,7 +793,7 @@ class CortexM:
         on_idle_loop = _HOOK_CODE(self._on_idle_loop)
         for address in idle_loops(self.image, flash):  # MCU-4: the core stops at its first ``b .``
             self._hook(ucc.UC_HOOK_CODE, on_idle_loop, address, address)
-        self.uc.hook_add(ucc.UC_HOOK_INTR, self._on_interrupt)
+        self._hook(ucc.UC_HOOK_INTR, _HOOK_INTR(self._on_interrupt))  # registered directly (MCU-19)
         self._fault_address: int | None = None  # the address of the last unmapped or protected access (BFAR, MMFAR)
         self._hook(ucc.UC_HOOK_MEM_INVALID, _HOOK_MEM_INVALID(self._on_invalid_access))
         self.reset()
@@ -1067,7 +1068,8 @@ class CortexM:
     def execution_priority(self) -> int:
         """The running priority: the highest (lowest number) active exception, 0 under PRIMASK (B1.5.4); 256 in
         thread mode with nothing masked."""
-        running = min((self.priority(n) for n in self.active), default=256)
+        active = self.active
+        running = min((self.priority(n) for n in active), default=256) if active else 256
         if self._read(arm.UC_ARM_REG_PRIMASK) & 1:
             running = min(running, 0)
         return running
@@ -1082,13 +1084,24 @@ class CortexM:
         """An exception is active, or pending and allowed to preempt: the core has interrupt work to do."""
         return bool(self.active) or self._takeable() is not None
 
+    def next_entry(self) -> int | None:
+        """The pending exception the next :meth:`step` enters first (the highest priority allowed to preempt,
+        B1.5.4), ``None`` if none."""
+        return self._takeable()
+
     def _takeable(self) -> int | None:
-        if not self.pending:  # the run loop's common case (MCU-31)
+        pending = self.pending
+        if not pending:  # the run loop's common case (MCU-31)
             return None
-        candidates = [n for n in self.pending if n < EXTERNAL or n in self.enabled]
-        if not candidates:
-            return None
-        best = min(candidates, key=lambda n: (self.priority(n), n))
+        if len(pending) == 1:  # the next common one: EXTI0 alone
+            best = next(iter(pending))
+            if best >= EXTERNAL and best not in self.enabled:
+                return None
+        else:
+            candidates = [n for n in pending if n < EXTERNAL or n in self.enabled]
+            if not candidates:
+                return None
+            best = min(candidates, key=lambda n: (self.priority(n), n))
         return best if self.priority(best) < self.execution_priority() else None
 
     def enter(self, number: int) -> int:
@@ -1128,7 +1141,7 @@ class CortexM:
         self._write(arm.UC_ARM_REG_PC, target & ~1)
         self.pending.discard(number)
         self.active.append(number)
-        self.cycles += cycles
+        self._state.cycles += cycles
         self.sleeping = False
         self.entered(number)
         if not target & 1:
@@ -1169,7 +1182,7 @@ class CortexM:
             self._write(arm.UC_ARM_REG_CONTROL, self._read(arm.UC_ARM_REG_CONTROL) | CONTROL_SPSEL)
         self._resume.write([sp, words[6] & ~1])
         self.active.pop()
-        self.cycles += self.cpu.return_cycles
+        self._state.cycles += self.cpu.return_cycles
 
     # -- running -----------------------------------------------------------------------------------------------
 
@@ -1215,10 +1228,12 @@ class CortexM:
         if state.skip_polls and state.block_poll:  # the native hook's held_read does the same (MCU-25)
             state.skip_address, state.skip_until, state.skip_pending = state.block_address, until, 1
 
-    def _on_interrupt(self, uc: Any, number: int, data: Any) -> None:
+    def _on_interrupt(self, handle: int, number: int, data: int | None) -> None:
+        """unicorn raised a CPU exception (an exception exit, SVC, BKPT, a prefetch abort): stop, the run loop
+        takes it (:meth:`_after_stop`)."""
         del data
         self.interrupt = number
-        uc.emu_stop()
+        _LIB.uc_emu_stop(handle)
 
     def step(self, deadline: int) -> str:
         """Run from the current PC until the clock reaches ``deadline`` (cycles; checked at block boundaries), a
@@ -1231,12 +1246,13 @@ class CortexM:
         number = self._takeable()
         if number is not None:
             self.enter(number)
+        state = self._state
         if self.sleeping:
-            self.cycles = max(self.cycles, deadline)
+            state.cycles = max(state.cycles, deadline)
             return "sleep"
-        self.stop_request = False
+        state.stop_request = False
         self.interrupt = None
-        pc = self.pc
+        pc = self._read(arm.UC_ARM_REG_PC)
         self._running = True
         try:
             self.uc.emu_start(pc | 1, 0)
@@ -1254,7 +1270,7 @@ class CortexM:
         return self._after_stop()
 
     def _after_stop(self) -> str:
-        pc = self.pc
+        pc = self._read(arm.UC_ARM_REG_PC)
         number = self.interrupt
         if number == EXCP_EXCEPTION_EXIT:
             self.exception_return(pc | 1)
@@ -1279,7 +1295,8 @@ class CortexM:
             if sleeps:
                 self.sleeping = True  # the last block ended in WFI or WFE: unicorn halts the core after them
                 return "sleep"
-        if self.stop_request or self.cycles >= self.deadline:
+        state = self._state
+        if state.stop_request or state.cycles >= state.deadline:
             return "run"
         raise FirmwareStoppedError(self.report(Stop.FAULT, "the core stopped for no known reason"))
 
@@ -1503,6 +1520,13 @@ class SysTick:
             return None
         at = self._first() + self._seen * (self.rvr + 1)
         return self._start + at * self._divider()
+
+    def due(self) -> int | None:
+        """:meth:`update`, then :meth:`next_event`: the run loop's one call at each stop (none with SysTick off)."""
+        if not self.csr & 1:
+            return None
+        self.update()
+        return self.next_event()
 
     def update(self) -> None:
         """Pend the exception if the counter reached 0 since the last update (TICKINT)."""

@@ -254,7 +254,7 @@ class Supi3:
         "_branch_silence", "_chain", "_cpb", "_deadline", "_due_s", "_events", "_exr_driver", "_exr_free",
         "_fast_valid", "_fixed_bytes",
         "_frame_bytes", "_in_map", "_loaded", "_mau_events", "_mau_told", "_now", "_optical", "_optical_driven",
-        "_optical_held", "_optical_until", "_out", "_out_map", "_send_alarm", "_send_optical",
+        "_optical_held", "_optical_until", "_out", "_out_map", "_path", "_send_alarm", "_send_optical",
         "_serial_pins", "_shown", "_stat_err", "_stat_filter", "_stat_low_since", "_watch_line", "attention",
         "bus_active", "config",
         "due", "following", "in_word", "io_access", "led_inputs", "line_interrupt", "line_silent", "mfp_in",
@@ -290,6 +290,7 @@ class Supi3:
         self._stat_err = False
         # Pin-strapped modes have a fixed data length; the µP modes ask the register file every time.
         self._fixed_bytes = None if self.registers is not None else wire.data_bytes(self.config.length_code)
+        self._path = (-1, False, 0)  # µP modes: (the register file's configurations, expansion, data bytes)
         self._loaded = (-1, b"")  # (MFP levels, IN bytes) of the last data-cycle load
         self._frame_bytes = -1  # µP modes: the data bytes the last data-cycle load gave (M15)
         self._shown: tuple[bytes | None, int] = (None, 0)  # (OUT bytes, MFP levels) last driven
@@ -514,7 +515,20 @@ class Supi3:
         """Bytes the chip occupies on the line in a data cycle (Table 3-11, assumption A15)."""
         if self._fixed_bytes is not None:
             return self._fixed_bytes
-        return wire.data_bytes((self._id_and_length() >> 8) & 0x1F)
+        return self._data_path()[2]
+
+    def _data_path(self) -> tuple[int, bool, int]:
+        """µP modes: (the register file's :attr:`~supi3.model.registers.RegisterFile.configurations`, whether data
+        cycles go through the expansion, :meth:`data_bytes`), worked out again only when a configuration was taken
+        since (SET applied or dropped): both follow SET alone (the length code of the ID register; a processor
+        alarm replaces only its ID code), and every master cycle asks for them."""
+        registers = self.registers
+        assert registers is not None  # the µP modes only (their _fixed_bytes is None)
+        path = self._path
+        if path[0] != registers.configurations:
+            path = self._path = (registers.configurations, not registers.internal_data_path,
+                                 wire.data_bytes((self._id_and_length() >> 8) & 0x1F))  # fmt: skip
+        return path
 
     def _sample_inputs(self) -> int:
         if self._in_map:
@@ -1099,10 +1113,13 @@ class Supi3:
         if cycle is Cycle.ID:
             return wire.word_bytes(self.id_register())
         if self.registers is not None:
-            if self.expansion:
+            _, expansion, size = self._data_path()
+            if expansion:
                 data = self._expansion_load(clk)
+            elif size:
+                data = self.registers.in_bytes()
             else:
-                data = self.registers.in_bytes() if self.data_bytes() else b""
+                data = b""
             self._frame_bytes = len(data)
             return data
         if not self._in_map:
@@ -1155,7 +1172,7 @@ class Supi3:
                 if self.spi_sequences is not None:
                     self._serial_latched(clk)
                 return
-            if self.expansion:
+            if self._data_path()[1]:  # the expansion
                 self._expansion_end(clk, received)
             elif received:
                 self.registers.latch(received)

@@ -353,6 +353,7 @@ class RegisterFile:
         self._clock: Callable[[], int] | None = None
         self._values: dict[str, int] = {r.name: r.reset for r in REGISTER_MAP.registers}
         self._set: SetConfig | None = None
+        self._internal = True  # derived from _set by _configure: the internal data registers are in the data path
         self._in_names: tuple[str, ...] = ()  # derived from _set by _configure: the IN registers of a data cycle
         self._erased: tuple[str, ...] = ()  # and those a PCP device erases after their transfer (3.4.11)
         self._length_code = 0  # and SET's length code (Table 3-12) as a number
@@ -361,6 +362,10 @@ class RegisterFile:
         self._io_access = False
         self._out_latched = False
         self._configured: set[str] = set()
+        self.configurations = 0
+        """How often a configuration was taken (SET applied, or dropped by a power-up reset): everything derived
+        from SET (the data path, the data length, the ID register's length code) changes only when this moves, so
+        a cache of it is keyed on this count (``Supi3``'s data path)."""
         self.power_up_reset()
 
     @property
@@ -544,6 +549,8 @@ class RegisterFile:
     def _configure(self, decoded: SetConfig | None) -> None:
         """Take ``decoded`` as the configuration (``None``: none), with the tables a data cycle reads from it."""
         self._set = decoded
+        self.configurations += 1
+        self._internal = decoded is None or not decoded.extreg
         self._length_code = 0 if decoded is None else int(decoded.length.code, 2)
         self._in_names = tuple(r.name for r in IN_BYTES[: self.data_bytes()]) if self.internal_data_path else ()
         self._erased = tuple(name for name in _PCP_ERASED if name in self._in_names) if self.pcp_device else ()
@@ -666,7 +673,7 @@ class RegisterFile:
     @property
     def internal_data_path(self) -> bool:
         """``False`` with ExtReg = 1: the internal data registers are not in the data path (3.4.8, 3.4.11)."""
-        return self._set is None or not self._set.extreg
+        return self._internal
 
     @property
     def pcp_device(self) -> bool:
@@ -712,7 +719,7 @@ class RegisterFile:
         return self._io_access
 
     def _in_registers(self) -> tuple[str, ...]:
-        if not self.internal_data_path:
+        if not self._internal:
             raise RegisterFileError("ExtReg = 1: the internal data registers are not in the data path (3.4.8)")
         return self._in_names
 

@@ -143,6 +143,11 @@ class MainLoopPasses:
         return since is not None and len(arrivals) == SERVE_PASSES and arrivals[0] >= since
 
 
+def bit_offset(bit: int, bit_s: float) -> float:
+    """From a cycle's start to the mid-bit sample of its bit period ``bit`` (:meth:`CycleTiming.at`, A1)."""
+    return (bit + 0.5) * bit_s
+
+
 class CycleTiming(NamedTuple):
     """When one master cycle ran on the bench clock: its start (first bit), its kind and its phases."""
 
@@ -153,7 +158,7 @@ class CycleTiming(NamedTuple):
 
     def at(self, bit: int) -> float:
         """The mid-bit sample of bit period ``bit`` (0 = the cycle's first): when the chip decides on it (A1)."""
-        return self.start + (bit + 0.5) * self.bit_s
+        return self.start + bit_offset(bit, self.bit_s)
 
     @property
     def io_busy(self) -> float:
@@ -415,7 +420,9 @@ class Bench:
         self._events: list[tuple[float, str]] = []  # this cycle's phase changes, latest first
         self._next_start = 0.0
         self._next_at = 0.0  # the time of the next bus event: the last of _events, else _next_start
-        self._phases = ((-1, -1, -1), wire.CyclePhases(0, 0, 0, 0))  # (data bytes, devices, return repeaters), phases
+        # (data bytes, devices, return repeaters), their phases, and the end, latch and I/O bit's offsets from the
+        # start (CycleTiming's end, latch, io_busy): worked out again only when the cycle's size changes
+        self._phases = ((-1, -1, -1), wire.CyclePhases(0, 0, 0, 0), (0.0, 0.0, 0.0))
         self._started = False
         self._irq_level = 1
         self._irq_fell_at: float | None = None
@@ -489,13 +496,16 @@ class Bench:
         transfer, _, start = pending
         size = (len(transfer.sent) - wire.LOOPBACK_BYTES, transfer.devices, transfer.return_repeaters)
         if size != self._phases[0]:
-            self._phases = (size, wire.cycle_phases(*size))
-        timing = CycleTiming(start, transfer.cycle, self._phases[1], self._bit_s)
-        self.timeline.append(timing)
-        end = timing.end
+            phases = wire.cycle_phases(*size)
+            offsets = tuple(bit_offset(bit, self._bit_s) for bit in (phases.end_bit, phases.latch_bit,
+                                                                       phases.check_bit))  # fmt: skip
+            self._phases = (size, phases, (offsets[0], offsets[1], offsets[2]))
+        _, phases, (to_end, to_latch, to_io) = self._phases
+        self.timeline.append(CycleTiming(start, transfer.cycle, phases, self._bit_s))
+        end = start + to_end  # CycleTiming.end, .latch, .io_busy: the same sums
         events = [(end, "end")]
         if transfer.cycle is Cycle.DATA:
-            events += [(timing.latch, "latch"), (timing.io_busy, "io")]
+            events += [(start + to_latch, "latch"), (start + to_io, "io")]
         self._events = events
         self._next_start = end if self.cycle_time_s is None else max(end, start + self.cycle_time_s)
         self._next_at = events[-1][0]
