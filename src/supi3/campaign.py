@@ -605,13 +605,20 @@ def format_result(result: CampaignResult) -> str:
 
 
 def parse_mix(text: str) -> dict[str, int]:
-    """``"bitflip=4,reset=1"`` as a weight mapping (validated by :class:`CampaignConfig`)."""
+    """``"bitflip=4,reset=1"`` as a weight mapping (validated by :class:`CampaignConfig`): weights in ASCII decimal
+    digits, each event once."""
     mix: dict[str, int] = {}
     for item in filter(None, (part.strip() for part in text.split(","))):
-        event, sep, weight = item.partition("=")
-        if not sep or not weight.strip().isdigit():
+        event, sep, weight = (part.strip() for part in item.partition("="))
+        try:  # int() refuses over 4,300 digits
+            value = int(weight) if sep and weight.isascii() and weight.isdigit() else None
+        except ValueError:
+            value = None
+        if value is None:
             raise fail("--mix", "EVENT=WEIGHT pairs separated by commas", item)
-        mix[event.strip()] = int(weight)
+        if event in mix:
+            raise fail("--mix", "EVENT=WEIGHT pairs naming each event once", text)
+        mix[event] = value
     if not mix:
         raise fail("--mix", "EVENT=WEIGHT pairs separated by commas", text)
     return mix

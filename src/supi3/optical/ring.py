@@ -273,9 +273,9 @@ class OpticalRing:
     def finish(self, transfer: Transfer, latch: bool) -> None:
         """See :meth:`supi3.interbus.ring.Ring.finish`; every :data:`~supi3.optical.regulation.REPEAT_CYCLES` data
         cycles over the whole ring, an online test round."""
-        whole = transfer.devices == len(self.ring.devices)
+        devices = len(self.ring.devices)
         self.ring.finish(transfer, latch)
-        if transfer.cycle is Cycle.DATA and whole:
+        if transfer.cycle is Cycle.DATA and transfer.devices == devices:
             self._data_cycles += 1
             if self._data_cycles % REPEAT_CYCLES == 0:
                 self._test_round(transfer.reached)
