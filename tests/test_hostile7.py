@@ -112,7 +112,8 @@ def _optical(n: int) -> OpticalRing:
 def _outputs(ring: Bus) -> list[int]:
     """Every chip's OUT data, in ring order."""
     devices: list[object] = list(ring.chips if isinstance(ring, OpticalRing) else ring.devices)  # type: ignore[attr-defined]
-    words = [chip.out_word for chip in (getattr(device, "chip", device) for device in devices) if isinstance(chip, Supi3)]
+    chips = [getattr(device, "chip", device) for device in devices]
+    words = [chip.out_word for chip in chips if isinstance(chip, Supi3)]
     assert len(words) == len(devices)
     return words
 
