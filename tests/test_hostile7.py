@@ -4,11 +4,11 @@ a cycle on the :class:`~supi3.interbus.ring.Bus` rings (:meth:`Ring.finish <supi
 :meth:`PinRing.finish <supi3.model.pinring.PinRing.finish>`, :meth:`OpticalRing.finish
 <supi3.optical.ring.OpticalRing.finish>`) given another ring's transfer, a finished one or no bool, the optical
 block's :func:`supi3.optical.regulation.initializing` (OPT-56), :class:`supi3.diagnostics.DiagnosticOutputs` (Tables
-3-16 to 3-19, 2-8), ``supi3 campaign --mix`` (``bench/fault_campaign.py``), and :meth:`Ring.power_up
-<supi3.interbus.ring.Ring.power_up>` (M22) on a plain ring edited in place and in its wake window against the pin
-level; and a history property of
-:meth:`Ring.cut <supi3.interbus.ring.Ring.cut>`: after any history of faults, repairs, power-ups and starts a new cut
-is located where a fresh ring locates it.
+3-16 to 3-19, 2-8), the optical diagnostic table's :class:`~supi3.optical.ring.PathRow` and
+:func:`~supi3.optical.ring.format_table` (Figure 1-10), ``supi3 campaign --mix`` (``bench/fault_campaign.py``), and
+:meth:`Ring.power_up <supi3.interbus.ring.Ring.power_up>` (M22) on a plain ring edited in place and in its wake window
+against the pin level; and a history property of :meth:`Ring.cut <supi3.interbus.ring.Ring.cut>`: after any history of
+faults, repairs, power-ups and starts a new cut is located where a fresh ring locates it.
 
 Every bad input is refused by name (which argument, which rule, which value) and changes nothing.
 """
@@ -36,9 +36,10 @@ from supi3.interbus.wire import Cycle, Frame, LineReset, Telegram
 from supi3.model.chip import Supi3
 from supi3.model.pinring import PinRing
 from supi3.model.pins import Supi3Pins
+from supi3.optical.length import Medium
 from supi3.optical.link import FibreLink
 from supi3.optical.regulation import Interface, OpticalMode, Transmitter, initializing, start
-from supi3.optical.ring import OpticalRing
+from supi3.optical.ring import OpticalRing, PathRow, format_table
 from support import bad
 
 RATES = [500_000, 2_000_000]
@@ -202,6 +203,33 @@ def test_diagnostic_outputs_refuse_levels_that_are_no_leds(field: str, value: ob
     DiagnosticOutputs(**OUTPUTS)  # type: ignore[arg-type]
     with pytest.raises(ArgumentError, match=rf"^{name} must be"):
         DiagnosticOutputs(**(OUTPUTS | {field: value}))  # type: ignore[arg-type]
+
+
+# -- the master's optical diagnostic table (Figure 1-10) --------------------------------------------------------------
+
+ROW: dict[str, object] = {"path": "1.0<->2.0", "forward_quality": "optimal", "return_quality": "optimal",
+                          "forward_level": 2, "return_level": 2, "length_m": 12.5, "medium": Medium.POLYMER}
+
+
+@pytest.mark.parametrize(("field", "value", "name"), [
+    ("path", 5, "path"), ("forward_quality", None, "forward_quality"), ("forward_level", 16, "forward_level"),
+    ("return_level", True, "return_level"), ("return_level", 2.0, "return_level"), ("length_m", "12", "length_m"),
+    ("length_m", -1.0, "length_m"), ("medium", 0, "medium"),
+])  # fmt: skip
+def test_a_table_row_refuses_what_the_table_cannot_show(field: str, value: object, name: str) -> None:
+    """Found in round 7: a :class:`PathRow` took any field; :func:`format_table` then failed on it with a TypeError (a
+    path that is no str) or a ValueError (a length that is no number)."""
+    assert format_table([PathRow(**ROW)])[1].split() == ["1.0<->2.0", "optimal", "optimal", "2", "(of", "15)", "2",
+                                                         "(of", "15)", "12.5m", "polymer"]  # type: ignore[arg-type]
+    with pytest.raises(ArgumentError, match=rf"^{name} must be"):
+        PathRow(**(ROW | {field: value}))  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("rows", [None, 5, iter([]), "rows"])
+def test_format_table_refuses_what_is_no_sequence_of_rows(rows: object) -> None:
+    """Found in round 7: ``None`` and an integer were TypeErrors; a string was refused row by row."""
+    with pytest.raises(ArgumentError, match=r"^rows must be a sequence of PathRow"):
+        format_table(bad(rows))
 
 
 # -- supi3 campaign --mix (bench/fault_campaign.py) ------------------------------------------------------------------
