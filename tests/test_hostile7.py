@@ -219,8 +219,9 @@ ROW: dict[str, object] = {"path": "1.0<->2.0", "forward_quality": "optimal", "re
 def test_a_table_row_refuses_what_the_table_cannot_show(field: str, value: object, name: str) -> None:
     """Found in round 7: a :class:`PathRow` took any field; :func:`format_table` then failed on it with a TypeError (a
     path that is no str) or a ValueError (a length that is no number)."""
-    assert format_table([PathRow(**ROW)])[1].split() == ["1.0<->2.0", "optimal", "optimal", "2", "(of", "15)", "2",
-                                                         "(of", "15)", "12.5m", "polymer"]  # type: ignore[arg-type]
+    row = PathRow(**ROW)  # type: ignore[arg-type]
+    assert format_table([row])[1].split() == ["1.0<->2.0", "optimal", "optimal", "2", "(of", "15)", "2", "(of", "15)",
+                                              "12.5m", "polymer"]  # fmt: skip
     with pytest.raises(ArgumentError, match=rf"^{name} must be"):
         PathRow(**(ROW | {field: value}))  # type: ignore[arg-type]
 
