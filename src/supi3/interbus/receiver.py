@@ -36,9 +36,9 @@ def receive(samples: npt.NDArray[np.integer], start: int, cpb: int) -> tuple[lis
     out: list[Telegram | LineReset] = []
     error = False
     n = len(samples)
-    # The level changes once (edges), found in one pass: each telegram's search for its start level and the length of
-    # a low run is a binary search there, so a long trace takes time in proportion to its length (a search over the
-    # rest of the trace per telegram took time in its square: 4,000 status telegrams, 2.9 s).
+    # Where the level changes (its edges) is found in one pass; each telegram's search for its start level and for the
+    # end of a low run is a binary search among them, so a long trace takes time in proportion to its length (a search
+    # over the rest of the trace per telegram took time in its square: 4,000 status telegrams, 2.9 s).
     tail = samples[start:]
     edges = np.flatnonzero(tail[1:] != tail[:-1]) + (start + 1)
     i = start
