@@ -5,10 +5,11 @@ a cycle on the :class:`~supi3.interbus.ring.Bus` rings (:meth:`Ring.finish <supi
 <supi3.optical.ring.OpticalRing.finish>`) given another ring's transfer, a finished one or no bool, the optical
 block's :func:`supi3.optical.regulation.initializing` (OPT-56), :class:`supi3.diagnostics.DiagnosticOutputs` (Tables
 3-16 to 3-19, 2-8), the optical diagnostic table's :class:`~supi3.optical.ring.PathRow` and
-:func:`~supi3.optical.ring.format_table` (Figure 1-10), ``supi3 campaign --mix`` (``bench/fault_campaign.py``), and
-:meth:`Ring.power_up <supi3.interbus.ring.Ring.power_up>` (M22) on a plain ring edited in place and in its wake window
-against the pin level; and a history property of :meth:`Ring.cut <supi3.interbus.ring.Ring.cut>`: after any history of
-faults, repairs, power-ups and starts a new cut is located where a fresh ring locates it.
+:func:`~supi3.optical.ring.format_table` (Figure 1-10), ``supi3 campaign --mix`` and its rings' plain devices
+(``bench/fault_campaign.py``), and :meth:`Ring.power_up <supi3.interbus.ring.Ring.power_up>` (M22) on a plain ring
+edited in place and in its wake window against the pin level; and a history property of :meth:`Ring.cut
+<supi3.interbus.ring.Ring.cut>`: after any history of faults, repairs, power-ups and starts a new cut is located where a
+fresh ring locates it.
 
 Every bad input is refused by name (which argument, which rule, which value) and changes nothing.
 """
@@ -23,15 +24,16 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from supi3 import campaign
+from supi3 import campaign, tables
 from supi3.cli import main
 from supi3.config import decode
 from supi3.diagnostics import DiagnosticOutputs, IbDiag
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
-from supi3.interbus.master import Master
+from supi3.interbus.device import PlainDevice
+from supi3.interbus.master import BK_LBD_ID_CODE, STATUS_TERMINAL_ID_CODES, Master
 from supi3.interbus.receiver import receive
-from supi3.interbus.ring import BitFlip, Bus, Ring, Transfer
+from supi3.interbus.ring import BitFlip, Bus, DeadLine, Ring, Transfer
 from supi3.interbus.wire import Cycle, Frame, LineReset, Telegram
 from supi3.model.chip import Supi3
 from supi3.model.pinring import PinRing
@@ -251,6 +253,25 @@ def test_campaign_mix_refuses_weights_that_are_no_decimal_digits_and_events_twic
     out, err = capsys.readouterr()
     assert (code, out) == (2, "") and err.count("\n") == 1 and expect in err
     assert campaign.parse_mix(" bitflip = 3 , reset=1") == {"bitflip": 3, "reset": 1}
+
+
+def test_a_plain_device_with_a_bk_s_id_code_is_trusted_as_a_bk() -> None:
+    """Why the campaign's plain devices carry no bus terminal module's ID code (``campaign._IDS``): the master reads
+    the branch status of a device whose ID code says BK-LBD (04h) and trusts its count (BK-5, BK-7); a plain register
+    device keeps none (its ID register read as one), so a break the segment search found is left not located. Found
+    in round 7: ``supi3 campaign --fidelity ring --seed 4 --devices 16`` missed its goal (a corrupted loopback word
+    reported one line off, the campaign's own rings at fault)."""
+    lbd_mr = next(r.id_code for r in tables.MODE_ROWS if r.function.startswith("LBD-MR"))
+    devices = [PlainDevice(3, 9), PlainDevice(BK_LBD_ID_CODE, 9), *(PlainDevice(lbd_mr, 9) for _ in range(4)),
+               PlainDevice(3, 9)]  # fmt: skip
+    ring = Ring(devices)
+    master = Master(ring)
+    assert master.start().ok and master.cycle().ok
+    ring.inject(DeadLine(5))
+    (diagnostic,) = master.cycle().diagnostics
+    assert diagnostic.location is None and "BK 2.0 counted" in diagnostic.detail
+    assert not set(campaign._IDS) & STATUS_TERMINAL_ID_CODES
+    assert BK_LBD_ID_CODE in STATUS_TERMINAL_ID_CODES
 
 
 # -- Ring.cut after any history: located where a fresh ring locates it (BK-59) --------------------------------------
