@@ -40,7 +40,7 @@ from supi3.checks import check_choice, check_int, fail
 from supi3.config import DeviceConfig, MfpKind, decode
 from supi3.interbus import wire
 from supi3.interbus.device import PlainDevice
-from supi3.interbus.master import MSG_PERIPHERAL_FAULT, CycleResult, Diagnostic, Master
+from supi3.interbus.master import MSG_PERIPHERAL_FAULT, STATUS_TERMINAL_ID_CODES, CycleResult, Diagnostic, Master
 from supi3.interbus.ring import BitFlip, CorruptLoopback, DeadLine, Fault, Ring, Truncate
 from supi3.interbus.wire import Cycle
 
@@ -73,7 +73,11 @@ WARM_UP_SHARE: Final = 0.1
 _USABLE: Final = [int(r.code, 2) for r in tables.LENGTH_CODES if r.bits is not None and 0 < r.bits <= 64]
 """Length codes of 1 to 8 data bytes: every ring change then changes the data cycle's length, so the master can
 see it in a data cycle (a change that keeps the length is only seen by the next ID cycle)."""
-_IDS: Final = sorted({r.code for r in tables.ID_CODES})
+_IDS: Final = sorted({r.code for r in tables.ID_CODES} - STATUS_TERMINAL_ID_CODES)
+"""The ring's plain register devices take any ID code of the table but a bus terminal module's that answers a status
+request (BK-5: 04h, 08h, 0Ch): the master trusts such a device's branch status, whose counter telegram count locates a
+break in a BK-LBD's branch (BK-7), and a plain device keeps none (its ID register read as one: a count that put a
+corrupted loopback word one line off, ``--seed 4 --devices 16``, or left a located break not located)."""
 _PIN_ROW: Final = next(r for r in tables.MODE_ROWS if decode(r.c, r.mfp).mfp_mode.kind is MfpKind.BINARY_IO)
 _PIN_CLK_CONF: Final = "11"  # 2 Mbit/s: 16 clocks per bit keeps the pin level short
 
@@ -605,13 +609,20 @@ def format_result(result: CampaignResult) -> str:
 
 
 def parse_mix(text: str) -> dict[str, int]:
-    """``"bitflip=4,reset=1"`` as a weight mapping (validated by :class:`CampaignConfig`)."""
+    """``"bitflip=4,reset=1"`` as a weight mapping (validated by :class:`CampaignConfig`): weights in ASCII decimal
+    digits, each event once."""
     mix: dict[str, int] = {}
     for item in filter(None, (part.strip() for part in text.split(","))):
-        event, sep, weight = item.partition("=")
-        if not sep or not weight.strip().isdigit():
+        event, sep, weight = (part.strip() for part in item.partition("="))
+        try:  # int() refuses over 4,300 digits
+            value = int(weight) if sep and weight.isascii() and weight.isdigit() else None
+        except ValueError:
+            value = None
+        if value is None:
             raise fail("--mix", "EVENT=WEIGHT pairs separated by commas", item)
-        mix[event.strip()] = int(weight)
+        if event in mix:
+            raise fail("--mix", "EVENT=WEIGHT pairs naming each event once", text)
+        mix[event] = value
     if not mix:
         raise fail("--mix", "EVENT=WEIGHT pairs separated by commas", text)
     return mix

@@ -156,6 +156,14 @@ def fo_leds(status: OpticalStatus, run: bool) -> tuple[bool, bool, bool]:
     return fo1, fo2, fo3
 
 
+def _check_leds(leds: LedInputs | DiagnosticOutputs, names: tuple[str, ...]) -> None:
+    """``leds.fo`` a tuple of 3 bool (FO1, FO2, FO3) and each attribute of ``names`` a bool, else the named error."""
+    if not (isinstance(leds.fo, tuple) and len(leds.fo) == len(OpticalInterface)):
+        raise fail("fo", "a tuple of 3 bool (FO1, FO2, FO3)", leds.fo)
+    for name, value in (*zip(("fo1", "fo2", "fo3"), leds.fo, strict=True), *((n, getattr(leds, n)) for n in names)):
+        check_bool(name, value)
+
+
 @dataclass(frozen=True)
 class LedInputs:
     """What the chip's other blocks give the outputs block: 0 until those blocks drive them (DG-6, DG-7).
@@ -178,11 +186,7 @@ class LedInputs:
     alarm: bool = False
 
     def __post_init__(self) -> None:
-        if not (isinstance(self.fo, tuple) and len(self.fo) == len(OpticalInterface)):
-            raise fail("fo", "a tuple of 3 bool (FO1, FO2, FO3)", self.fo)
-        for name, value in (("fo1", self.fo[0]), ("fo2", self.fo[1]), ("fo3", self.fo[2]), ("ld", self.ld),
-                            ("e", self.e), ("alarm", self.alarm)):  # fmt: skip
-            check_bool(name, value)
+        _check_leds(self, ("ld", "e", "alarm"))
 
 
 @dataclass(frozen=True)
@@ -212,6 +216,10 @@ class DiagnosticOutputs:
     """FO1, FO2, FO3 (Table 3-17)."""
     ib_diag: IbDiag
     """The IB_DIAG pattern (Table 3-18)."""
+
+    def __post_init__(self) -> None:
+        _check_leds(self, ("complete", "ul", "rc", "ba", "rd", "ld", "e", "alarm"))
+        check_instance("ib_diag", self.ib_diag, IbDiag, "an IbDiag (Table 3-18)")
 
     @property
     def diag1(self) -> int:

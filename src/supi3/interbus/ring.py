@@ -668,7 +668,8 @@ class Bus(Protocol):
         ...
 
     def finish(self, transfer: Transfer, latch: bool) -> None:
-        """End the cycle with the latch telegrams (``latch``) or idle ones."""
+        """End the cycle with the latch telegrams (``latch``) or idle ones; ``transfer`` is what this ring's last
+        :meth:`transfer` returned, not finished yet (:func:`check_finish`)."""
         ...
 
     def reset(self) -> None:
@@ -678,6 +679,23 @@ class Bus(Protocol):
     def idle(self, seconds: float) -> None:
         """Only idle status telegrams for ``seconds``."""
         ...
+
+
+def check_finish(transfer: object, pending: Transfer | None, latch: object) -> bool:
+    """The checks of a :class:`Bus`'s ``finish``: ``transfer`` must be ``pending``, the :class:`Transfer` the ring's
+    last ``transfer`` returned and no ``finish``, ``reset`` or ``idle`` has ended since (a cycle ends once, on the ring
+    it ran on: another ring's transfer would latch that ring's devices on this ring's clock, a second finish latch them
+    again), and ``latch`` a bool; ``latch`` as a bool.
+
+    Raises
+    ------
+    ArgumentError
+        ``transfer`` is not the pending transfer, or ``latch`` not a bool.
+    """
+    if transfer is not pending or pending is None:
+        raise fail("transfer", "the Transfer this ring's last transfer() returned, not yet finished (a cycle ends "
+                   "once, on its own ring)", transfer)  # fmt: skip
+    return latch if latch is True or latch is False else check_bool("latch", latch)
 
 
 class Ring:
@@ -751,6 +769,8 @@ class Ring:
         self._layout: tuple[list[type], _Groups] = ([], [])
         self._cuts: tuple[list[bytes], int, bytes, list[slice] | None, int] = ([], -1, b"", None, 0)
         self._bits = ((-1, -1, -1), 0)  # (bytes sent, devices, return repeaters) of the last cycle, its cycle_bits
+        self._pending: Transfer | None = None
+        """What the last :meth:`transfer` returned, until :meth:`finish`, :meth:`reset` or :meth:`idle`."""
         self._wakes: dict[int, float] = {}
         """M22: ring index -> bus time a chip powered up by :meth:`power_up` ends its reset stretch (M2)."""
         self._late: dict[int, float] = {}
@@ -1276,15 +1296,24 @@ class Ring:
             returned, flags_back = stream, wire.CntrFlags(attention, True)
         reports = self._reports(reached, None if close_after is None else n, dead_lines, returns) \
             if self._spans else []
-        return Transfer(cycle, bytes(data), n, returned, flags_back, receiver_error, runs, reached, reports,
-                        spliced is not None or unheard, self._loops_before(n))
+        self._pending = Transfer(cycle, bytes(data), n, returned, flags_back, receiver_error, runs, reached, reports,
+                                 spliced is not None or unheard, self._loops_before(n))
+        return self._pending
 
     def finish(self, transfer: Transfer, latch: bool) -> None:
         """End a cycle with the master's verdict: the latch telegrams (``latch``) or idle telegrams.
 
         Advances bus time by ``wire.cycle_bits``; a device latches only if its own check passed, no error was
         flagged upstream of it, and the master latches.
+
+        Raises
+        ------
+        ArgumentError
+            ``transfer`` is not what this ring's last :meth:`transfer` returned, or it was finished already, or a
+            reset or idle came between (:func:`check_finish`); ``latch`` not a bool. Nothing changes.
         """
+        latch = check_finish(transfer, self._pending, latch)
+        self._pending = None
         size = (len(transfer.sent), transfer.devices, transfer.return_repeaters)
         if size != self._bits[0]:
             self._bits = (size, wire.cycle_bits(size[0] - wire.LOOPBACK_BYTES, size[1], size[2]))
@@ -1363,6 +1392,7 @@ class Ring:
         """An INTERBUS reset (the master's Alarm Stop, 1303h): reset pattern, then idle (assumption A12). A branch is
         recognised in the reset's hold, before its devices reset (BK-37, BK-48). The reset's end allows for the ring
         delay of every device of the tree, which may all be in the data path after it (BK-9, A12; BK-53)."""
+        self._pending = None
         self._recognise()
         self._repaired = []
         dead = self._first_dead()
@@ -1423,6 +1453,7 @@ class Ring:
     def idle(self, seconds: float) -> None:
         """The master sends only idle status telegrams for ``seconds`` (no cycles)."""
         seconds = check_real("seconds", seconds, 0.0)
+        self._pending = None
         self._recognise()
         self._repaired = []
         dead = self._first_dead()

@@ -931,7 +931,7 @@ class Supi3:
     def _optical_timeout(self, ends: int) -> None:
         """The budget that ran to clock ``ends`` is over: the interface initializing falls back; the next one's
         budget counts from ``ends`` (OPT-56)."""
-        current = regulation.initializing(self._optical.transmitters)
+        current = self._optical.initializing
         if current is None:
             self._optical_until = _NEVER
             return
@@ -999,7 +999,7 @@ class Supi3:
         interface's initialization begins, its 6 ms budget counts from clock ``since`` (``None``: now; OPT-56)."""
         if status == self._optical:
             return
-        old = self._optical.transmitters
+        old, was_initializing = self._optical.transmitters, self._optical.initializing
         self._optical = status
         self.revision += 1
         events = tuple(e or new.mau != was.mau for e, new, was in zip(self._mau_events, status.transmitters, old,
@@ -1008,10 +1008,10 @@ class Supi3:
             self._mau_events = (events[0], events[1], events[2])
             self.attention = True
         if not self._optical_driven:  # the budgets (OPT-56); at pin level the block counts them
-            current = regulation.initializing(status.transmitters)
+            current = status.initializing
             if current is None:
                 self._optical_until = _NEVER
-            elif current is not regulation.initializing(old):
+            elif current is not was_initializing:
                 self._optical_until = (self._now if since is None else since) + regulation.INIT_TIME_LIMIT_CLOCKS
         self._optical_publish()
         self._reschedule()

@@ -49,6 +49,7 @@ from supi3.interbus.ring import (
     BranchKind,
     ErrorKind,
     Transfer,
+    check_finish,
     return_inputs,
     return_repeaters,
     terminal_positions,
@@ -226,6 +227,8 @@ class PinRing:
         self._chunks: list[list[dict[str, npt.NDArray[np.int64]]]] = []
         self.cuts: set[tuple[int, bool]] = set()
         """Broken lines, as ``(position, forward)``: see :meth:`cut`."""
+        self._pending: Transfer | None = None
+        """What the last :meth:`transfer` returned, until :meth:`finish`, :meth:`reset` or :meth:`idle`."""
         self.branch_cuts: set[int] = set()
         """Positions of BKs whose branch return input DI3 is broken: see :meth:`cut`."""
         self._terminals = terminal_positions(transaction_level)
@@ -455,17 +458,26 @@ class PinRing:
                     flags = decoded
                 if wire.crc16(back.data) != back.crc:
                     receiver_error = receiver_error or ErrorKind.CRC
-        return Transfer(cycle, bytes(data), n, returned, flags, receiver_error, [], n, return_repeaters=loops)
+        self._pending = Transfer(cycle, bytes(data), n, returned, flags, receiver_error, [], n, return_repeaters=loops)
+        return self._pending
 
     def finish(self, transfer: Transfer, latch: bool) -> None:
-        """Send the verdict: the latch telegrams, or idle ones."""
-        check_instance("transfer", transfer, Transfer)
-        check_bool("latch", latch)
+        """Send the verdict: the latch telegrams, or idle ones.
+
+        Raises
+        ------
+        ArgumentError
+            ``transfer`` is not what this ring's last :meth:`transfer` returned, or it was finished already, or a
+            reset or idle came between (``ring.check_finish``); ``latch`` not a bool. Nothing changes.
+        """
+        latch = check_finish(transfer, self._pending, latch)
+        self._pending = None
         self.run_levels(wire.status_levels(transfer.cycle, latch, wire.LATCH_STATUS_TELEGRAMS))
         self._received()
 
     def reset(self) -> None:
         """INTERBUS reset: the line held low, then idle status telegrams (``wire.reset_levels``)."""
+        self._pending = None
         self.run_levels(wire.reset_levels(len(self.devices), self._loops))
         self._received()
 
@@ -480,6 +492,7 @@ class PinRing:
         check_real("seconds", seconds, finite=True)
         if seconds < 0:
             raise InterbusError("docs/interbus.md, Idle", seconds, "idle time must be >= 0")
+        self._pending = None
         count = round(seconds * self.bit_rate / wire.STATUS_TELEGRAM_BITS)
         while count > 0:  # in pieces: the chips' traces of one run take about 260 bytes a clock
             piece = min(count, IDLE_PIECE_TELEGRAMS)

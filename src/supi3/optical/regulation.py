@@ -276,11 +276,14 @@ def init_timeout(tx: Transmitter) -> Transmitter:
 
 def initializing(transmitters: tuple[Transmitter, Transmitter, Transmitter]) -> Interface | None:
     """The interface whose initialization runs now and whose 6 ms budget counts (OPT-56): the first of
-    :data:`INIT_ORDER` in :attr:`Phase.INIT`; ``None`` when none initializes."""
-    for interface in INIT_ORDER:
-        if transmitters[interface].phase is Phase.INIT:
-            return interface
-    return None
+    :data:`INIT_ORDER` in :attr:`Phase.INIT`; ``None`` when none initializes (:attr:`OpticalStatus.initializing`).
+
+    Raises
+    ------
+    ArgumentError
+        ``transmitters`` is not a tuple of 3 :class:`Transmitter` (one per :class:`Interface`).
+    """
+    return OpticalStatus(transmitters).initializing
 
 
 def online_test(tx: Transmitter, ack1: bool, ack2: bool) -> Transmitter:
@@ -375,6 +378,15 @@ class OpticalStatus:
 
     def __getitem__(self, interface: Interface) -> Transmitter:
         return self.transmitters[check_instance("interface", interface, Interface)]
+
+    @property
+    def initializing(self) -> Interface | None:
+        """The interface whose initialization runs now and whose 6 ms budget counts (OPT-56): the first of
+        :data:`INIT_ORDER` in :attr:`Phase.INIT`; ``None`` when none initializes."""
+        for interface in INIT_ORDER:
+            if self.transmitters[interface].phase is Phase.INIT:
+                return interface
+        return None
 
     def with_transmitter(self, interface: Interface, tx: Transmitter) -> OpticalStatus:
         """This status with one transmitter replaced."""

@@ -143,6 +143,14 @@ class PathRow:
     length_m: float
     medium: Medium
 
+    def __post_init__(self) -> None:
+        for name in ("path", "forward_quality", "return_quality"):
+            check_instance(name, getattr(self, name), str, "a str")
+        for name in ("forward_level", "return_level"):
+            check_int(name, getattr(self, name), 0, MAX_LEVEL, "a power level of reads 10 and 11, 3.4.13")
+        check_real("length_m", self.length_m, 0.0)
+        check_instance("medium", self.medium, Medium)
+
     def cells(self) -> tuple[str, ...]:
         """The row as the table prints it."""
         medium = "glass" if self.medium is Medium.GLASS else "polymer"
@@ -273,9 +281,9 @@ class OpticalRing:
     def finish(self, transfer: Transfer, latch: bool) -> None:
         """See :meth:`supi3.interbus.ring.Ring.finish`; every :data:`~supi3.optical.regulation.REPEAT_CYCLES` data
         cycles over the whole ring, an online test round."""
-        whole = transfer.devices == len(self.ring.devices)
+        devices = len(self.ring.devices)
         self.ring.finish(transfer, latch)
-        if transfer.cycle is Cycle.DATA and whole:
+        if transfer.cycle is Cycle.DATA and transfer.devices == devices:
             self._data_cycles += 1
             if self._data_cycles % REPEAT_CYCLES == 0:
                 self._test_round(transfer.reached)
@@ -575,7 +583,15 @@ def diagnostic_table(ring: OpticalRing, master: Master | None = None) -> list[Pa
 
 
 def format_table(rows: Sequence[PathRow]) -> list[str]:
-    """The table as lines of text, with a header (Figure 1-10's columns)."""
+    """The table as lines of text, with a header (Figure 1-10's columns).
+
+    Raises
+    ------
+    ArgumentError
+        ``rows`` is not a sequence of :class:`PathRow`.
+    """
+    if isinstance(rows, (str, bytes)) or not isinstance(rows, Sequence):
+        raise fail("rows", "a sequence of PathRow (diagnostic_table's)", rows)
     header = ("Path", "Forward path", "Return path", "PFor", "PReturn", "Dist.", "Medium")
     cells = [header, *(check_instance("row", row, PathRow).cells() for row in rows)]
     widths = [max(len(row[i]) for row in cells) for i in range(len(header))]

@@ -17,7 +17,7 @@ What happens at the clock edge ending a cycle, from that cycle's inputs (:mod:`s
    :func:`~supi3.optical.regulation.init_response`, then a test strobe (``test_valid``) the online test
    (:func:`~supi3.optical.regulation.apply_test`: regulation, or the diagnostics MAU warning, OPT-22); then, on the
    edge where the 6 ms counter runs out, :func:`~supi3.optical.regulation.init_timeout` for the interface that was
-   initializing (:func:`~supi3.optical.regulation.initializing` of the state before the edge, OPT-56).
+   initializing (:attr:`~supi3.optical.regulation.OpticalStatus.initializing` of the state before the edge, OPT-56).
 
 After 3, when the interface that was initializing no longer is (regulated, fallen back or timed out), the 6 ms counter
 is loaded again: each interface has its own budget, in :data:`~supi3.optical.regulation.INIT_ORDER` (OPT-56).
@@ -56,7 +56,6 @@ from supi3.optical.regulation import (
     fo_lit,
     init_response,
     init_timeout,
-    initializing,
     length_timer_enable_every,
     registers,
     start,
@@ -247,7 +246,7 @@ class OpticalBlock:
             if status.transmitters != off:
                 self.status = OpticalStatus(off, status.length, status.medium)
             return
-        current = initializing(status.transmitters)
+        current = status.initializing
         if self._in_reset:
             self._in_reset = False
             self.countdown = self.time_limit
