@@ -150,6 +150,21 @@ def test_reset_in_the_middle_of_a_cycle(bench: Lockstep, seed: int, how: str, at
     bench.run_batch(script.id_cycle(wire.command_word()).data_cycle().data_cycle().stimulus())
 
 
+@pytest.mark.parametrize("seed", range(3))
+def test_the_start_from_any_input_levels(bench: Lockstep, seed: int) -> None:
+    # M23: no reset edge before cycle 0, the synchronisers, the clock count and the power-up stretch without reset:
+    # the RTL starts from its initial values as the model from reset(). Random levels on every input for the first
+    # clocks (a power failure, the start level, /StatErr low among them; MFP[15..12] stay the straps) reach the
+    # synchronisers' last stage at the same clocks in both; then the chip comes up and runs a cycle.
+    rng = np.random.default_rng(60 + seed)
+    config = fast_config("10000")
+    stimulus = CoreScript(config, rng).bring_up().id_cycle(wire.command_word(2)).data_cycle().stimulus()
+    first = int(rng.integers(1, 8))
+    for column, name in enumerate(CORE_INPUTS):
+        stimulus[:first, column] = rng.integers(0, 0x1000 if name == "mfp_in" else 2, first)
+    bench.run_batch(stimulus)
+
+
 def test_staterr_short_and_quit(bench: Lockstep) -> None:
     script = CoreScript(fast_config("10000"), np.random.default_rng(5)).bring_up()
     script.data_cycle(stat_err_n=0).id_cycle(wire.command_word(quit_peripheral_error=True))

@@ -335,7 +335,10 @@ class Supi3Core(wiring.Component):
                  for k in tables.strap_modes]  # fmt: skip
         straps = Cat(self.mfp_in[MFP_PINS - EXPANSION_BITS :], self.c)  # C[4..0] above MFP[15..12]
         m.d.comb += Cat(*(field for field, _ in rom)).eq(Array(words)[straps])
-        cycle = Signal(max(*IB_DIAG_DIVIDER_BITS.values(), *(_width(e.clocks_per_bit) for e in clocks)))
+        # The free-running clock count: never reset (M23), it starts at 0 as the model's clock; the queues read only
+        # differences of it, DCLK_OUT and IB_DIAG their phase.
+        cycle = Signal(max(*IB_DIAG_DIVIDER_BITS.values(), *(_width(e.clocks_per_bit) for e in clocks)),
+                       reset_less=True)  # fmt: skip
         m.d.sync += cycle.eq(cycle + 1)
 
         def clock(entry: ClockEntry) -> list[Value]:
@@ -376,7 +379,8 @@ class Supi3Core(wiring.Component):
         # The stretch counts down as an LFSR (lfsr.down_state), loaded with one clock more than it while the power
         # fails: that clock is the one after the failure the model holds the chip in (its ``holding``, round 5).
         stretch_width = max(min(TAPS), RESET_STRETCH_CLOCKS.bit_length())
-        stretch = Signal(stretch_width, init=down_state(RESET_STRETCH_CLOCKS, stretch_width))
+        # No reset (M23): it starts loaded, as the model starts in the power-up reset; on the chip /ResU loads it.
+        stretch = Signal(stretch_width, init=down_state(RESET_STRETCH_CLOCKS, stretch_width), reset_less=True)
         m.d.sync += stretch.eq(Mux(power_fail, down_state(RESET_STRETCH_CLOCKS, stretch_width), down_step(stretch)))
         running = ~power_fail & (stretch == 0)
 
@@ -676,7 +680,10 @@ class ReceiverRtl(wiring.Component):
     def elaborate(self, _platform: object) -> Module:
         m = Module()
         for pin, idle in zip(CORE_INPUTS, CORE_IDLE, strict=True):
-            stages = [Signal(pin.width, init=idle, name=f"{pin.name}_s{k}") for k in range(SYNC_STAGES)]
+            # No reset (M23): the stages start at the idle levels, as the model's; on the chip the power-up reset
+            # (/ResU low while the power comes up, 1.7.2) holds the core while they fill.
+            stages = [Signal(pin.width, init=idle, name=f"{pin.name}_s{k}", reset_less=True)
+                      for k in range(SYNC_STAGES)]  # fmt: skip
             m.d.sync += [stages[0].eq(getattr(self, pin.name)), *(b.eq(a) for a, b in pairwise(stages))]
             m.d.comb += getattr(self, f"{pin.name}_s").eq(stages[-1])
         rx = Module()
