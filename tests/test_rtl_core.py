@@ -28,7 +28,7 @@ from supi3.tables import RF_MODES, ModeRow
 from supi3.verif import Lockstep, first_mismatch
 from supi3.verif.amaranth_sim import run_amaranth_sim
 from supi3.verif.straps import StrapPins, strap_stimulus
-from support import CORE_INPUTS, IDLE, LOOPBACK, Columns, CoreScript, pulses, quiet_inputs
+from support import CORE_INPUTS, IDLE, LOOPBACK, WATCHDOG_LATEST, Columns, CoreScript, pulses, quiet_inputs
 
 OPC_ROWS = list(mode_rows(Variant.OPC))
 BINARY_ROWS = [row for row in OPC_ROWS if decode(row.c, row.mfp).mfp_mode.kind is MfpKind.BINARY_IO]
@@ -252,7 +252,7 @@ def test_watchdog_expiry(bench: Lockstep, tmp_path: Path) -> None:
     # process data reset, /ResReg pulse, WD reported in the next ID cycle.
     config = fast_config("10000")
     script = CoreScript(config, np.random.default_rng(8)).bring_up().id_cycle(wire.command_word(0)).data_cycle()
-    telegrams = (WATCHDOG_CLOCKS[0] or 0) // (wire.STATUS_TELEGRAM_BITS * wire.clocks_per_bit(config.bit_rate))
+    telegrams = WATCHDOG_LATEST // (wire.STATUS_TELEGRAM_BITS * wire.clocks_per_bit(config.bit_rate))
     script.line(wire.status_levels(Cycle.DATA, False, telegrams + 100)).id_cycle(wire.command_word())
     expected = long_lockstep(bench, config, script.columns(), tmp_path)
     assert [length for _, length in pulses(expected["res_reg_n"])] == [12]  # 375 ns (Table 3-13), RTL alike
@@ -264,7 +264,7 @@ def test_watchdog_expiry_clears_the_serial_outputs(bench: Lockstep, tmp_path: Pa
     # sequence, the data cycle's write, the watchdog's clear sequence.
     config = fast_config("10011", "1001")
     script = CoreScript(config, np.random.default_rng(9)).bring_up().id_cycle(wire.command_word(0)).data_cycle()
-    telegrams = (WATCHDOG_CLOCKS[0] or 0) // (wire.STATUS_TELEGRAM_BITS * wire.clocks_per_bit(config.bit_rate))
+    telegrams = WATCHDOG_LATEST // (wire.STATUS_TELEGRAM_BITS * wire.clocks_per_bit(config.bit_rate))
     script.line(wire.status_levels(Cycle.DATA, False, telegrams + 100))
     expected = long_lockstep(bench, config, script.columns(), tmp_path)
     ss_n = (expected["mfp_out"] >> 5) & 1

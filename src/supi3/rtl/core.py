@@ -63,7 +63,9 @@ from supi3.pinout import (
     OPTICAL_LINE_INPUTS,
     STRAP_PINS,
     SYNC_STAGES,
+    TIME_BASE_BITS,
     TO_REGISTER_FILE,
+    time_base_ticks,
 )
 from supi3.regmap import INTERRUPT_SOURCES
 from supi3.regmap.core import BYTE_BITS
@@ -1158,34 +1160,40 @@ class OutputsRtl(wiring.Component):
         next_present = Signal()
 
         # The model calls chip._advance at the start of every running clock: the /StatErr filter and the watchdog.
-        # The clocks /StatErr has been low, counted up as an LFSR (lfsr.count_state) from 0 at its first low clock,
-        # held at 0 while it is high (one gate a bit, no load, no end state); ``filtered`` is set on the clock after
-        # the count read STATERR_FILTER_CLOCKS - 1 and stays while /StatErr stays low, so the LFSR may run on past
-        # its end (round 5).
-        st_width = count_width(STATERR_FILTER_CLOCKS - 1)
+        # Both count ticks of the time base (M24: the free-running ``divider``'s low TIME_BASE_BITS all ones, every
+        # 1.024 ms), one shared prescaler instead of a counter of clocks each (round 6).
+        tick = self.divider[:TIME_BASE_BITS].all()
+        # The ticks /StatErr has been low, counted up as an LFSR (lfsr.count_state) from 0 at its first low clock,
+        # held at 0 while it is high (one gate a bit, no load, no end state); ``filtered`` is set at the tick that
+        # reads the last count and stays while /StatErr stays low, so the LFSR may run on past its end (round 5).
+        st_ticks = time_base_ticks(STATERR_FILTER_CLOCKS)
+        st_width = count_width(st_ticks - 1)
         st_count = Signal(st_width, init=count_state(0, st_width))
         filtered = Signal()
-        sync += [
-            st_count.eq(Mux(stat, next_state(st_count), count_state(0, st_width))),
-            filtered.eq(stat & (filtered | (st_count == count_state(STATERR_FILTER_CLOCKS - 1, st_width)))),
-        ]
+        with m.If(~stat):
+            sync += st_count.eq(count_state(0, st_width))
+        with m.Elif(tick):
+            sync += st_count.eq(next_state(st_count))
+        sync += filtered.eq(stat & (filtered | (tick & (st_count == count_state(st_ticks - 1, st_width)))))
         module_error = stat & filtered
 
         timeouts = [t for t in WATCHDOG_CLOCKS if t is not None]
         wd_code = Signal(_WD_CODE_BITS, init=_WD_OFF)
-        # The watchdog's clocks to its deadline as an LFSR (supi3.rtl.lfsr) that fires at the state 1: loaded with
-        # the state timeout - 1 steps before it, stepping every clock; read only while ``wd_active`` (no reset).
+        # The watchdog's ticks to its deadline as an LFSR (supi3.rtl.lfsr) that fires at the tick it reads the state
+        # 1: loaded with the state ticks - 1 steps before it, stepping at every tick; read only while ``wd_active``
+        # (no reset).
         wd_active = Signal()
-        wd_count = Signal(range(max(timeouts)), reset_less=True)
-        fire = wd_active & (wd_count == 1)
-        sync += wd_count.eq(next_state(wd_count))
+        wd_count = Signal(max(min(TAPS), time_base_ticks(max(timeouts)).bit_length()), reset_less=True)
+        fire = wd_active & tick & (wd_count == 1)
+        with m.If(tick):
+            sync += wd_count.eq(next_state(wd_count))
 
         def arm(code: Value) -> list[Value]:
             """The deadline for a watchdog code: clk + timeout, or none ("off")."""
             on = Array(Const(int(t is not None), 1) for t in WATCHDOG_CLOCKS)[code]
             width = len(wd_count)
             # "off" loads a don't-care (``wd_active`` is 0): code 1's value (codes 0b11 and 0b01), one term less
-            loads = [before((t or timeouts[1]) - 1, width) for t in WATCHDOG_CLOCKS]
+            loads = [before(time_base_ticks(t or timeouts[1]) - 1, width) for t in WATCHDOG_CLOCKS]
             count = Array(Const(load, width) for load in loads)[code]
             return [wd_active.eq(on), wd_count.eq(count)]
 
