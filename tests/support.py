@@ -38,11 +38,12 @@ from supi3.interbus.ring import BranchKind
 from supi3.interbus.wire import Cycle, Frame
 from supi3.model.blocks.optical import OpticalBlock
 from supi3.model.bus_terminal import LBST_PIN
-from supi3.model.chip import Supi3
+from supi3.model.chip import STATERR_FILTER_CLOCKS, WATCHDOG_CLOCKS, Supi3
 from supi3.model.pins import IDLE_TIMEOUT_CLOCKS, Supi3Pins
 from supi3.model.registers import RegisterFile
 from supi3.optical.regulation import BLOCK_INPUTS, INIT_TIME_LIMIT_CLOCKS, Interface, OpticalMode, Response
 from supi3.pinlevel import OE_SUFFIX
+from supi3.pinout import TIME_BASE_BITS, time_base_ticks
 from supi3.regmap import Register, encode_command
 from supi3.sdk import native
 from supi3.sdk.native import CFirmware
@@ -92,6 +93,12 @@ REPAIR_IDLE_TELEGRAMS = 8
 the pin level repairs between two runs (a master's telegram boundary, inside a telegram at the repair point), and
 its chips are back on the telegram grid after at most 7 (measured at 2 Mbit/s: every line of the branch loops of
 ``test_model_pinring_tree.CASES``), where the transaction level repairs between telegrams."""
+WATCHDOG_LATEST = time_base_ticks(WATCHDOG_CLOCKS[0] or 0) << TIME_BASE_BITS
+"""The most clocks from the arm of the 50 ms watchdog (code 0, Table 3-13) to its expiry: it counts ticks of the time
+base (M24), never less than 50 ms, at most two ticks more."""
+STATERR_LATEST = time_base_ticks(STATERR_FILTER_CLOCKS) << TIME_BASE_BITS
+"""The most clocks from /StatErr's first low clock to the peripheral fault latched (3.6.2): the filter counts ticks of
+the time base (M24), never less than 200 ms, at most two ticks more."""
 RB_INIT_UP = ("10011", "1110")
 """Remote bus device, Init-µP (Table 2-4): the C and MFP straps of a µP-mode chip."""
 

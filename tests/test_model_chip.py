@@ -13,7 +13,8 @@ from supi3.interbus import wire
 from supi3.interbus.errors import InterbusError
 from supi3.interbus.master import Master
 from supi3.interbus.ring import BitFlip, CorruptLoopback, Ring, Truncate
-from supi3.model.chip import STATERR_FILTER_CLOCKS, Supi3
+from supi3.model.chip import STATERR_FILTER_CLOCKS, WATCHDOG_CLOCKS, Supi3
+from supi3.pinout import TIME_BASE_BITS, time_base_ticks
 
 BINARY_ROWS = [r for r in tables.MODE_ROWS if decode(r.c, r.mfp).mfp_mode.kind is MfpKind.BINARY_IO]
 
@@ -102,6 +103,52 @@ def test_stat_err_filter_then_0bb1_then_quit() -> None:
 
 def test_filter_constant_is_200_ms_of_32_mhz_clocks() -> None:
     assert STATERR_FILTER_CLOCKS == 6_400_000
+
+
+TICK = 1 << TIME_BASE_BITS
+
+
+@settings(max_examples=40, derandomize=True)
+@given(start=st.integers(0, 4 * TICK), end=st.integers(0, 3 * TICK))
+def test_the_filter_latches_on_the_time_base(start: int, end: int) -> None:
+    """M24, 3.6.2: /StatErr low from any clock latches the fault at a tick's edge (a clock whose count's low 15 bits
+    are all ones), never before 200 ms low and at most two ticks later (inside the ±31.5 %); released a clock before,
+    nothing latches."""
+    chip = Supi3()
+    chip.set_stat_err(True, start / tables.CLOCK_HZ)
+    latch = chip.due  # the first clock that sees the fault
+    assert (latch - 1) % TICK == TICK - 1
+    assert STATERR_FILTER_CLOCKS <= latch - start <= time_base_ticks(STATERR_FILTER_CLOCKS) * TICK
+    chip.poll((latch - 1) / tables.CLOCK_HZ)
+    assert not chip.pf
+    released = Supi3()
+    released.set_stat_err(True, start / tables.CLOCK_HZ)
+    released.set_stat_err(False, (latch - 1) / tables.CLOCK_HZ)
+    released.poll((latch + end) / tables.CLOCK_HZ)
+    assert not released.pf
+    chip.poll((latch + end) / tables.CLOCK_HZ)
+    assert chip.pf
+
+
+@settings(max_examples=30, derandomize=True)
+@given(code=st.sampled_from([0, 1, 2]), arm=st.integers(1000, 3 * TICK))
+def test_the_watchdog_fires_on_the_time_base(code: int, arm: int) -> None:
+    """M24, Table 3-13: the watchdog armed by a data cycle's latch at any clock fires at a tick, never before the
+    preset time and at most two ticks after it; a data cycle before then restarts it."""
+    timeout = WATCHDOG_CLOCKS[code]
+    assert timeout is not None
+    chip = Supi3(decode("10000"))
+    chip.latch_at(wire.Cycle.ID, wire.word_bytes(wire.command_word(code)), 100)
+    chip.latch_at(wire.Cycle.DATA, b"\x0f" * chip.data_bytes(), arm)
+    deadline = chip.due
+    assert deadline % TICK == TICK - 1
+    assert timeout <= deadline - arm <= time_base_ticks(timeout) * TICK
+    chip.poll((deadline - 1) / tables.CLOCK_HZ)
+    assert chip.events["WATCHDOG"] == 0
+    chip.latch_at(wire.Cycle.DATA, b"\x0f" * chip.data_bytes(), deadline - 1)  # a valid cycle just in time
+    assert chip.due > deadline and chip.events["WATCHDOG"] == 0
+    chip.poll(chip.due / tables.CLOCK_HZ)
+    assert chip.events["WATCHDOG"] == 1
 
 
 @pytest.mark.parametrize("timeout", [0.05, 0.2, 1.0])

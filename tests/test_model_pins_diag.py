@@ -14,7 +14,7 @@ from supi3.interbus.wire import BranchControl, Cycle
 from supi3.model.chip import STATERR_FILTER_CLOCKS, ChipArgumentError, Supi3
 from supi3.model.pins import IDLE_TIMEOUT_CLOCKS, Supi3Pins
 from supi3.optical.regulation import Interface, Response
-from support import IDLE, Columns, CoreScript, assert_run_matches_step, quiet_inputs
+from support import IDLE, STATERR_LATEST, Columns, CoreScript, assert_run_matches_step, quiet_inputs
 
 SILENCE_BITS = round(wire.IDLE_TIMEOUT_S * 2_000_000) + 1000
 """Bit periods of a silent line at 2 Mbit/s (CLK_CONF = 11) that pass the idle time-out (A13)."""
@@ -105,7 +105,7 @@ def test_peripheral_fault_flashes_fast() -> None:
     agrees(pins, out, view)
     chip = tl_chip(cfg)
     chip.set_stat_err(True, 0.0)
-    chip.poll((STATERR_FILTER_CLOCKS + 1) / 32e6)
+    chip.poll((STATERR_LATEST + 1) / 32e6)  # M24: on the time base's ticks
     assert chip.diagnostic_outputs == view
 
 

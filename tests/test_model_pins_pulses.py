@@ -17,7 +17,7 @@ from supi3.interbus import wire
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import WATCHDOG_CLOCKS
 from supi3.model.pins import Supi3Pins
-from support import IDLE, Columns, frame_levels, pulses
+from support import IDLE, WATCHDOG_LATEST, Columns, frame_levels, pulses
 
 WIDTH = 12
 """375 ns at 32 MHz (Table 3-13), counted here independently of the code under test."""
@@ -71,7 +71,7 @@ def test_res_reg_pulse_is_12_clocks(how: str) -> None:
     # data are reset and /ResReg pulses once. The long idle part runs event-driven; the pulse itself is stepped.
     config = _config()
     head = np.concatenate([_bring_up(wire.command_word(0)), _cycle(Cycle.DATA, b"\x5a\xa5")])
-    clocks = (WATCHDOG_CLOCKS[0] or 0) + 20_000
+    clocks = WATCHDOG_LATEST + 20_000  # M24: the deadline counts ticks of the time base
     telegrams = clocks // (wire.STATUS_TELEGRAM_BITS * wire.clocks_per_bit(config.bit_rate))
     columns = _columns(config, np.concatenate([head, wire.status_levels(Cycle.DATA, False, telegrams)]))
     model = Supi3Pins(config)

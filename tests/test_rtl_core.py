@@ -28,7 +28,7 @@ from supi3.tables import RF_MODES, ModeRow
 from supi3.verif import Lockstep, first_mismatch
 from supi3.verif.amaranth_sim import run_amaranth_sim
 from supi3.verif.straps import StrapPins, strap_stimulus
-from support import CORE_INPUTS, IDLE, LOOPBACK, Columns, CoreScript, pulses, quiet_inputs
+from support import CORE_INPUTS, IDLE, LOOPBACK, WATCHDOG_LATEST, Columns, CoreScript, pulses, quiet_inputs
 
 OPC_ROWS = list(mode_rows(Variant.OPC))
 BINARY_ROWS = [row for row in OPC_ROWS if decode(row.c, row.mfp).mfp_mode.kind is MfpKind.BINARY_IO]
@@ -150,6 +150,21 @@ def test_reset_in_the_middle_of_a_cycle(bench: Lockstep, seed: int, how: str, at
     bench.run_batch(script.id_cycle(wire.command_word()).data_cycle().data_cycle().stimulus())
 
 
+@pytest.mark.parametrize("seed", range(3))
+def test_the_start_from_any_input_levels(bench: Lockstep, seed: int) -> None:
+    # M23: no reset edge before cycle 0, the synchronisers, the clock count and the power-up stretch without reset:
+    # the RTL starts from its initial values as the model from reset(). Random levels on every input for the first
+    # clocks (a power failure, the start level, /StatErr low among them; MFP[15..12] stay the straps) reach the
+    # synchronisers' last stage at the same clocks in both; then the chip comes up and runs a cycle.
+    rng = np.random.default_rng(60 + seed)
+    config = fast_config("10000")
+    stimulus = CoreScript(config, rng).bring_up().id_cycle(wire.command_word(2)).data_cycle().stimulus()
+    first = int(rng.integers(1, 8))
+    for column, name in enumerate(CORE_INPUTS):
+        stimulus[:first, column] = rng.integers(0, 0x1000 if name == "mfp_in" else 2, first)
+    bench.run_batch(stimulus)
+
+
 def test_staterr_short_and_quit(bench: Lockstep) -> None:
     script = CoreScript(fast_config("10000"), np.random.default_rng(5)).bring_up()
     script.data_cycle(stat_err_n=0).id_cycle(wire.command_word(quit_peripheral_error=True))
@@ -237,7 +252,7 @@ def test_watchdog_expiry(bench: Lockstep, tmp_path: Path) -> None:
     # process data reset, /ResReg pulse, WD reported in the next ID cycle.
     config = fast_config("10000")
     script = CoreScript(config, np.random.default_rng(8)).bring_up().id_cycle(wire.command_word(0)).data_cycle()
-    telegrams = (WATCHDOG_CLOCKS[0] or 0) // (wire.STATUS_TELEGRAM_BITS * wire.clocks_per_bit(config.bit_rate))
+    telegrams = WATCHDOG_LATEST // (wire.STATUS_TELEGRAM_BITS * wire.clocks_per_bit(config.bit_rate))
     script.line(wire.status_levels(Cycle.DATA, False, telegrams + 100)).id_cycle(wire.command_word())
     expected = long_lockstep(bench, config, script.columns(), tmp_path)
     assert [length for _, length in pulses(expected["res_reg_n"])] == [12]  # 375 ns (Table 3-13), RTL alike
@@ -249,7 +264,7 @@ def test_watchdog_expiry_clears_the_serial_outputs(bench: Lockstep, tmp_path: Pa
     # sequence, the data cycle's write, the watchdog's clear sequence.
     config = fast_config("10011", "1001")
     script = CoreScript(config, np.random.default_rng(9)).bring_up().id_cycle(wire.command_word(0)).data_cycle()
-    telegrams = (WATCHDOG_CLOCKS[0] or 0) // (wire.STATUS_TELEGRAM_BITS * wire.clocks_per_bit(config.bit_rate))
+    telegrams = WATCHDOG_LATEST // (wire.STATUS_TELEGRAM_BITS * wire.clocks_per_bit(config.bit_rate))
     script.line(wire.status_levels(Cycle.DATA, False, telegrams + 100))
     expected = long_lockstep(bench, config, script.columns(), tmp_path)
     ss_n = (expected["mfp_out"] >> 5) & 1

@@ -53,6 +53,7 @@ __all__ = [
     "RF_BITS",
     "STRAP_PINS",
     "SYNC_STAGES",
+    "TIME_BASE_BITS",
     "TO_REGISTER_FILE",
     "UP_BLOCK_INPUTS",
     "UP_BLOCK_OUTPUTS",
@@ -63,6 +64,8 @@ __all__ = [
     "UP_PINS",
     "UP_SERIAL_INPUTS",
     "UP_SERIAL_OUTPUTS",
+    "time_base_end",
+    "time_base_ticks",
     "up_input_port",
 ]
 
@@ -138,6 +141,25 @@ IB_DIAG_DIVIDER_BITS: Final[dict[str, int]] = {"slow": 26, "fast": 24, "very_fas
 """IB_DIAG flashes from a free-running binary divider: 2**26 clocks (0.48 Hz) for "bus not active", 2**24
 (1.9 Hz) for "peripheral fault", 2**23 (3.8 Hz) for "line interrupt ahead on the local bus" (Table 3-18 asks
 0.5 Hz, 2 Hz and 4 Hz; M6, DG-2 of ``docs/assumptions/diagnostics.md``)."""
+TIME_BASE_BITS: Final = 15
+"""The /StatErr filter (3.6.2) and the layer-2 watchdog (Table 3-13) count ticks of one time base, the same
+free-running divider: a tick at the edge ending every clock whose count's low 15 bits are all ones, every 2**15
+clocks (1.024 ms; M24 of ``docs/assumptions/model.md``)."""
+
+
+def time_base_ticks(clocks: int, bits: int = TIME_BASE_BITS) -> int:
+    """The ticks that stand for a time of ``clocks`` (1 or more) on a time base of ``2**bits`` clocks: the fewest
+    ``n`` for which the ``n``-th tick after a start is never less than ``clocks`` clocks after it (at most
+    ``2 * 2**bits - 2`` more; ``bits`` 0: ``clocks``; M24)."""
+    return (clocks - 2) // (1 << bits) + 2
+
+
+def time_base_end(start: int, clocks: int, bits: int = TIME_BASE_BITS) -> int:
+    """The clock whose edge ends a time of ``clocks`` counted from clock ``start`` on a time base of ``2**bits``
+    clocks: the :func:`time_base_ticks`-th clock at or after ``start`` whose edge is a tick (``bits`` 0:
+    ``start + clocks - 1``; M24)."""
+    period = 1 << bits
+    return start + (period - 1 - start) % period + (time_base_ticks(clocks, bits) - 1) * period
 
 # ----------------------------------------------------------------------------------------------------------------
 # The serial µP interface (3.4) and its place on the MFPs

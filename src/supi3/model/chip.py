@@ -46,7 +46,7 @@ from supi3.model.registers import RegisterFile
 from supi3.optical import regulation
 from supi3.optical.length import Medium, timer_code
 from supi3.optical.regulation import Interface, OpticalMode, OpticalStatus, Phase, Response
-from supi3.pinout import OPTICAL_REGISTERS
+from supi3.pinout import OPTICAL_REGISTERS, TIME_BASE_BITS, time_base_end
 from supi3.serial_io import SerialDevice, SerialSequence, clear_sequence, sequence
 from supi3.terminal import BRANCH_SILENCE_CLOCKS, silence_limit
 
@@ -255,7 +255,7 @@ class Supi3:
         "_fast_valid", "_fixed_bytes",
         "_frame_bytes", "_in_map", "_loaded", "_mau_events", "_mau_told", "_now", "_optical", "_optical_driven",
         "_optical_held", "_optical_until", "_out", "_out_map", "_path", "_send_alarm", "_send_optical",
-        "_serial_pins", "_shown", "_stat_err", "_stat_filter", "_stat_low_since", "_watch_line", "attention",
+        "_serial_pins", "_shown", "_stat_due", "_stat_err", "_stat_filter", "_watch_line", "attention",
         "bus_active", "config",
         "due", "following", "in_word", "io_access", "led_inputs", "line_interrupt", "line_silent", "mfp_in",
         "mod_ack_until", "pf", "registers", "resreg_until", "revision", "serial_device", "spi_sequences", "te",
@@ -329,7 +329,7 @@ class Supi3:
         self.watchdog_code: int | None = None
         self._now = 0
         self._deadline: int | None = None
-        self._stat_low_since: int | None = 0 if self._stat_err else None
+        self._stat_due: int | None = self._stat_end(0) if self._stat_err else None
         self.mod_ack_until = 0
         self.resreg_until = 0
         self.io_access = False
@@ -398,16 +398,16 @@ class Supi3:
     def _set_stat_err(self, active: bool, clk: int) -> None:
         self._advance(clk)
         if active and not self._stat_err:
-            self._stat_low_since = clk
+            self._stat_due = self._stat_end(clk)
         elif not active:
-            self._stat_low_since = None
+            self._stat_due = None
         self._stat_err = active
         self._reschedule()
 
     @property
     def module_error(self) -> bool:
         """/StatErr has been low for the whole filter time (3.6.2)."""
-        return self._stat_low_since is not None and self._filtered
+        return self._filtered
 
     # --------------------------------------------------------------------------------------------------------
     # Diagnostic outputs (3.6.1, Tables 3-16 to 3-19, 2-8): the LED view, the silent line and the line interrupt
@@ -1036,16 +1036,24 @@ class Supi3:
     # Time
     # --------------------------------------------------------------------------------------------------------
 
+    def _stat_end(self, since: int) -> int:
+        """The clock from which /StatErr, low since clock ``since``, has passed the filter: the edge of the time base's
+        tick that ends the filter time (M24), seen on the next clock; a shorter filter (a test's, MCU-24) counts
+        clocks."""
+        filter_clocks = self._stat_filter
+        bits = TIME_BASE_BITS if filter_clocks == STATERR_FILTER_CLOCKS else 0
+        return time_base_end(since, filter_clocks, bits) + 1
+
     @property
     def _filtered(self) -> bool:
-        return self._stat_low_since is not None and self._now - self._stat_low_since >= self._stat_filter
+        return self._stat_due is not None and self._now >= self._stat_due
 
     def _reschedule(self) -> None:
         # due (public, read-only): the next clock at which time alone changes the chip (filter expiry, watchdog),
         # _NEVER if none; the pin level (supi3.model.pins and its receiver) reads it on every cycle it visits.
         due = _NEVER if self._deadline is None else self._deadline
-        if self._stat_low_since is not None and not self.pf:
-            due = min(due, self._stat_low_since + self._stat_filter)
+        if self._stat_due is not None and not self.pf:
+            due = min(due, self._stat_due)
         due = min(due, self._optical_until)  # optical block: the 6 ms initialization budget (OPT-20)
         self.due = due
         # See "The ring kernel"; a serial device takes the latch's slow path (the sequence runs there).
@@ -1164,7 +1172,7 @@ class Supi3:
             self.bus_active = True
             if self.watchdog_code is not None:
                 timeout = WATCHDOG_CLOCKS[self.watchdog_code]
-                self._deadline = None if timeout is None else clk + timeout
+                self._deadline = None if timeout is None else time_base_end(clk + 1, timeout)
                 self._reschedule()
             if self.registers is None:
                 self._out = received
@@ -1184,7 +1192,7 @@ class Supi3:
             if command.watchdog_code is not None:
                 self.watchdog_code = command.watchdog_code
                 timeout = WATCHDOG_CLOCKS[command.watchdog_code]
-                self._deadline = None if timeout is None else clk + timeout
+                self._deadline = None if timeout is None else time_base_end(clk + 1, timeout)
                 self._reschedule()
             if command.quit_peripheral_error:
                 self.pf = self.module_error

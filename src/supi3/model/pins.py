@@ -242,7 +242,8 @@ class Supi3Pins:
     # ------------------------------------------------------------------------------------------------------------
 
     def reset(self) -> None:
-        """The state right after the ``sync`` reset: power-up reset in progress (it lasts the reset stretch)."""
+        """The state right after the ``sync`` reset, which is the RTL's initial state (M23): power-up reset in progress
+        (it lasts the reset stretch), the synchronisers at the idle levels, the clock count at 0."""
         self.cycle = 0
         self.log.clear()
         self._receiver.reset()

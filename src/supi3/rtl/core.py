@@ -63,7 +63,9 @@ from supi3.pinout import (
     OPTICAL_LINE_INPUTS,
     STRAP_PINS,
     SYNC_STAGES,
+    TIME_BASE_BITS,
     TO_REGISTER_FILE,
+    time_base_ticks,
 )
 from supi3.regmap import INTERRUPT_SOURCES
 from supi3.regmap.core import BYTE_BITS
@@ -335,7 +337,10 @@ class Supi3Core(wiring.Component):
                  for k in tables.strap_modes]  # fmt: skip
         straps = Cat(self.mfp_in[MFP_PINS - EXPANSION_BITS :], self.c)  # C[4..0] above MFP[15..12]
         m.d.comb += Cat(*(field for field, _ in rom)).eq(Array(words)[straps])
-        cycle = Signal(max(*IB_DIAG_DIVIDER_BITS.values(), *(_width(e.clocks_per_bit) for e in clocks)))
+        # The free-running clock count: never reset (M23), it starts at 0 as the model's clock; the queues read only
+        # differences of it, DCLK_OUT and IB_DIAG their phase.
+        cycle = Signal(max(*IB_DIAG_DIVIDER_BITS.values(), *(_width(e.clocks_per_bit) for e in clocks)),
+                       reset_less=True)  # fmt: skip
         m.d.sync += cycle.eq(cycle + 1)
 
         def clock(entry: ClockEntry) -> list[Value]:
@@ -376,7 +381,8 @@ class Supi3Core(wiring.Component):
         # The stretch counts down as an LFSR (lfsr.down_state), loaded with one clock more than it while the power
         # fails: that clock is the one after the failure the model holds the chip in (its ``holding``, round 5).
         stretch_width = max(min(TAPS), RESET_STRETCH_CLOCKS.bit_length())
-        stretch = Signal(stretch_width, init=down_state(RESET_STRETCH_CLOCKS, stretch_width))
+        # No reset (M23): it starts loaded, as the model starts in the power-up reset; on the chip /ResU loads it.
+        stretch = Signal(stretch_width, init=down_state(RESET_STRETCH_CLOCKS, stretch_width), reset_less=True)
         m.d.sync += stretch.eq(Mux(power_fail, down_state(RESET_STRETCH_CLOCKS, stretch_width), down_step(stretch)))
         running = ~power_fail & (stretch == 0)
 
@@ -676,7 +682,10 @@ class ReceiverRtl(wiring.Component):
     def elaborate(self, _platform: object) -> Module:
         m = Module()
         for pin, idle in zip(CORE_INPUTS, CORE_IDLE, strict=True):
-            stages = [Signal(pin.width, init=idle, name=f"{pin.name}_s{k}") for k in range(SYNC_STAGES)]
+            # No reset (M23): the stages start at the idle levels, as the model's; on the chip the power-up reset
+            # (/ResU low while the power comes up, 1.7.2) holds the core while they fill.
+            stages = [Signal(pin.width, init=idle, name=f"{pin.name}_s{k}", reset_less=True)
+                      for k in range(SYNC_STAGES)]  # fmt: skip
             m.d.sync += [stages[0].eq(getattr(self, pin.name)), *(b.eq(a) for a, b in pairwise(stages))]
             m.d.comb += getattr(self, f"{pin.name}_s").eq(stages[-1])
         rx = Module()
@@ -1151,34 +1160,40 @@ class OutputsRtl(wiring.Component):
         next_present = Signal()
 
         # The model calls chip._advance at the start of every running clock: the /StatErr filter and the watchdog.
-        # The clocks /StatErr has been low, counted up as an LFSR (lfsr.count_state) from 0 at its first low clock,
-        # held at 0 while it is high (one gate a bit, no load, no end state); ``filtered`` is set on the clock after
-        # the count read STATERR_FILTER_CLOCKS - 1 and stays while /StatErr stays low, so the LFSR may run on past
-        # its end (round 5).
-        st_width = count_width(STATERR_FILTER_CLOCKS - 1)
+        # Both count ticks of the time base (M24: the free-running ``divider``'s low TIME_BASE_BITS all ones, every
+        # 1.024 ms), one shared prescaler instead of a counter of clocks each (round 6).
+        tick = self.divider[:TIME_BASE_BITS].all()
+        # The ticks /StatErr has been low, counted up as an LFSR (lfsr.count_state) from 0 at its first low clock,
+        # held at 0 while it is high (one gate a bit, no load, no end state); ``filtered`` is set at the tick that
+        # reads the last count and stays while /StatErr stays low, so the LFSR may run on past its end (round 5).
+        st_ticks = time_base_ticks(STATERR_FILTER_CLOCKS)
+        st_width = count_width(st_ticks - 1)
         st_count = Signal(st_width, init=count_state(0, st_width))
         filtered = Signal()
-        sync += [
-            st_count.eq(Mux(stat, next_state(st_count), count_state(0, st_width))),
-            filtered.eq(stat & (filtered | (st_count == count_state(STATERR_FILTER_CLOCKS - 1, st_width)))),
-        ]
+        with m.If(~stat):
+            sync += st_count.eq(count_state(0, st_width))
+        with m.Elif(tick):
+            sync += st_count.eq(next_state(st_count))
+        sync += filtered.eq(stat & (filtered | (tick & (st_count == count_state(st_ticks - 1, st_width)))))
         module_error = stat & filtered
 
         timeouts = [t for t in WATCHDOG_CLOCKS if t is not None]
         wd_code = Signal(_WD_CODE_BITS, init=_WD_OFF)
-        # The watchdog's clocks to its deadline as an LFSR (supi3.rtl.lfsr) that fires at the state 1: loaded with
-        # the state timeout - 1 steps before it, stepping every clock; read only while ``wd_active`` (no reset).
+        # The watchdog's ticks to its deadline as an LFSR (supi3.rtl.lfsr) that fires at the tick it reads the state
+        # 1: loaded with the state ticks - 1 steps before it, stepping at every tick; read only while ``wd_active``
+        # (no reset).
         wd_active = Signal()
-        wd_count = Signal(range(max(timeouts)), reset_less=True)
-        fire = wd_active & (wd_count == 1)
-        sync += wd_count.eq(next_state(wd_count))
+        wd_count = Signal(max(min(TAPS), time_base_ticks(max(timeouts)).bit_length()), reset_less=True)
+        fire = wd_active & tick & (wd_count == 1)
+        with m.If(tick):
+            sync += wd_count.eq(next_state(wd_count))
 
         def arm(code: Value) -> list[Value]:
             """The deadline for a watchdog code: clk + timeout, or none ("off")."""
             on = Array(Const(int(t is not None), 1) for t in WATCHDOG_CLOCKS)[code]
             width = len(wd_count)
             # "off" loads a don't-care (``wd_active`` is 0): code 1's value (codes 0b11 and 0b01), one term less
-            loads = [before((t or timeouts[1]) - 1, width) for t in WATCHDOG_CLOCKS]
+            loads = [before(time_base_ticks(t or timeouts[1]) - 1, width) for t in WATCHDOG_CLOCKS]
             count = Array(Const(load, width) for load in loads)[code]
             return [wd_active.eq(on), wd_count.eq(count)]
 

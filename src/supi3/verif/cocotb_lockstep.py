@@ -26,7 +26,7 @@ POLL_CYCLES = 1024
 
 
 async def lockstep(
-    dut: Any, model: PinModel, stimulus: CycleMatrix, *, reset_cycles: int = 1, window: int = 64
+    dut: Any, model: PinModel, stimulus: CycleMatrix, *, reset_cycles: int = 0, window: int = 64
 ) -> Outcome:
     """Clock the DUT and the model together; the top's comparator checks every output signal on every cycle.
 
@@ -34,7 +34,8 @@ async def lockstep(
     the model's outputs for cycle ``n`` are written to the DUT (each word only when it changes); the rising edge
     ending the cycle updates the design and compares its outputs with the expected words. One wait per cycle and
     no read: the mismatch flag is read every :data:`POLL_CYCLES` cycles and at the end. Before cycle 0 the ``sync``
-    reset is held for ``reset_cycles`` rising edges with all inputs at 0, and the model is reset.
+    reset is held for ``reset_cycles`` rising edges with all inputs at 0 (by default none: the design starts from its
+    initial values, M23), and the model is reset.
 
     Parameters
     ----------
@@ -45,7 +46,7 @@ async def lockstep(
     stimulus:
         Input values ``(cycles, inputs)`` in the model's input order.
     reset_cycles:
-        Rising edges with reset asserted before cycle 0.
+        Rising edges with reset asserted before cycle 0 (0: none, the design starts from its initial values).
     window:
         The comparator's history: cycles of the RTL's outputs kept for the mismatch waveform (the top's build
         parameter).
@@ -64,9 +65,10 @@ async def lockstep(
     # resumes a timer faster than an edge trigger (by 2-15 %, measured).
     period = Timer(CYCLE_NS, unit="ns")
 
-    dut.rst.value = 1
-    for port in (*in_ports, *expected_ports):
-        port.value = 0
+    if reset_cycles:  # else cycle 0 writes every port (one write per port and step)
+        dut.rst.value = 1
+        for port in (*in_ports, *expected_ports):
+            port.value = 0
     Clock(dut.clk, CYCLE_NS, unit="ns").start(start_high=False)
     for _ in range(reset_cycles):
         await falling

@@ -163,7 +163,10 @@ class Lockstep:
     vcd_on_mismatch:
         Write a VCD of the last ``window`` cycles on a mismatch.
     reset_cycles:
-        Clock edges with the ``sync`` reset asserted before cycle 0.
+        Clock edges with the ``sync`` reset asserted before cycle 0; by default none: the design starts from its
+        initial values (each register's ``init``, its reset value; Verilog initialisers, which Verilator and Icarus
+        apply at time 0), as on Amaranth's simulator, so a register without reset starts at its ``init`` too
+        (docs/assumptions/model.md M23).
     window:
         Cycles before and at a mismatch kept for the waveform.
     """
@@ -175,11 +178,11 @@ class Lockstep:
         *,
         build_dir: Path | None = None,
         vcd_on_mismatch: bool = True,
-        reset_cycles: int = 1,
+        reset_cycles: int = 0,
         window: int = 64,
     ) -> None:
-        if reset_cycles < 1:
-            raise PinSpecError(f"reset_cycles must be a positive integer, not {reset_cycles!r}")
+        if type(reset_cycles) is not int or reset_cycles < 0:
+            raise PinSpecError(f"reset_cycles must be an integer from 0, not {reset_cycles!r}")
         if window < 1:
             raise PinSpecError(f"window must be a positive integer, not {window!r}")
         self.design_factory = design_factory
