@@ -8,6 +8,7 @@ wait at 20): prints per kind and row the k at which some step differs (the BK's 
 
     python bench/wake_tree_sweep.py power          # after the BK's power-up step: 1,120 runs
     python bench/wake_tree_sweep.py initial        # before the first step: 896 runs
+    python bench/wake_tree_sweep.py power --max-k 6   # k = 0..6 and 20 only (M23: the transaction level follows)
 
 Exits 1 if a k at or above the tests' wait differs.
 """
@@ -46,6 +47,7 @@ def main() -> int:
     """Run the sweep named on the command line; 0 if nothing differs at or above the tests' wait."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("where", choices=sorted(HISTORIES), help="the wait swept")
+    parser.add_argument("--max-k", type=int, default=12, choices=range(13), help="the largest k below 20 swept")
     args = parser.parse_args()
     wait = POWER_IDLE_TELEGRAMS if args.where == "power" else FIRST_IDLE_TELEGRAMS
     started = time.process_time()
@@ -53,7 +55,7 @@ def main() -> int:
     for kind in BranchKind:
         for row in ROWS:
             differ = []
-            for k in [*range(13), 20]:
+            for k in [*range(args.max_k + 1), 20]:
                 first, power = (20, k) if args.where == "power" else (k, 20)
                 if any(a != b for ops in HISTORIES[args.where]
                        for a, b in recognition_history(kind, row, ops, first * TELEGRAM_S, power * TELEGRAM_S)):

@@ -240,7 +240,9 @@ def recognition_history(kind: BranchKind, row: tuple[str, bool], ops: list[Op], 
     ``connected``) and what the master saw (:func:`seen`)."""
     tl, tl_chips = tl_ring(kind, *row, 2)
     pin, _ = pin_ring(kind, *row, 2)
-    for ring in (tl, pin):  # past the chips' power-up reset stretch (M2): a first frame would meet it at pin level
+    for position in range(1, len(tl_chips) + 1):  # powered up at the first clock, as the pin level's chips (M22, M23)
+        tl.power_up(position)
+    for ring in (tl, pin):
         ring.idle(first_idle_s)
     masters = [Master(tl, locate=False, max_devices=8), Master(pin, locate=False, max_devices=8)]
     breaks = cuts(kind)
@@ -270,7 +272,7 @@ def recognition_history(kind: BranchKind, row: tuple[str, bool], ops: list[Op], 
             pin.cut(position, forward, branch=branch)
         elif name == "power":
             tl.idle(POWER_DOWN_S)
-            tl_chips[1].power_up()
+            tl.power_up(2)  # M23: the BK's wake-up and its branch's answer followed
             tl.idle(power_idle_s)
             pin.set_input(2, "resu_n", 0)
             pin.idle(POWER_DOWN_S)
@@ -385,16 +387,6 @@ def test_join_error_refuses_bad_input_by_name() -> None:
     with pytest.raises(ArgumentError, match=r"^first_forward must be"):
         join_error(BranchKind.REMOTE, -1)
     assert [join_error(kind, None) for kind in BranchKind] == [ErrorKind.DEAD_LINE] * len(BranchKind)
-
-
-def test_a_tree_s_power_up_through_the_ring_is_refused_by_name() -> None:
-    """M22's limit 2: ``Ring.power_up`` follows the wake-up of a flat ring's chips only; on a tree (a BK's recognition
-    after its power-up, BK-37, and the branch's repeaters are not followed) it names the rule, nothing powered up."""
-    ring, chips = tl_ring(BranchKind.REMOTE, "11", True, 2)
-    assert Master(ring, locate=False, max_devices=8).start().ok and chips[1].branch_recognised
-    with pytest.raises(ArgumentError, match=r"^ring must be a flat ring \(M22"):
-        ring.power_up(2)
-    assert chips[1].branch_recognised
 
 
 def test_the_recognition_stays_through_resets_and_breaks_until_the_power_up() -> None:
