@@ -9,6 +9,12 @@ wait at 20): prints per kind and row the k at which some step differs (the BK's 
     python bench/wake_tree_sweep.py power          # after the BK's power-up step: 1,120 runs
     python bench/wake_tree_sweep.py initial        # before the first step: 896 runs
     python bench/wake_tree_sweep.py power --max-k 6   # k = 0..6 and 20 only (M23: the transaction level follows)
+    python bench/wake_tree_sweep.py window --rate 2000000   # M23: one chip of a running tree powered up, k = 0..7
+
+``window`` runs the trees of ``test_model_pinring_tree.CASES`` (RF = 11, LBST = 1): every chip in turn powered up in a
+running tree (/ResU low for 4 status telegrams; ``Ring.power_up``), k idle status telegrams, two cycles, and prints per
+tree and physical position both fidelities' cycles (``P``: passed, else the first error kind's first three letters;
+``r``: the branch recognised after it) and the k where they differ; exits 1 if the first passing k differs.
 
 Exits 1 if a k at or above the tests' wait differs.
 """
@@ -30,6 +36,8 @@ from test_model_pinring_recognition import (  # the tests' helpers, on the path 
     Op,
     recognition_history,
 )
+from test_model_pinring_tree import CASES
+from test_model_pinring_tree_powerup import RATES, Seen, after_power_up, trees
 
 ROWS = [("11", True), ("00", False), ("10", False), ("10", True)]
 START, POWER, CYCLE = ("start", 0), ("power", 0), ("cycle", 0)
@@ -43,12 +51,36 @@ HISTORIES: dict[str, list[list[Op]]] = {
 TELEGRAM_S = wire.STATUS_TELEGRAM_BITS / 2_000_000
 
 
+def _short(seen: Seen) -> str:
+    return "".join(("P" if seen[i] else seen[i + 1][0].name[:3] if seen[i + 1] else "F") + ("r" if seen[i + 2] else "-")
+                   for i in (0, 3))
+
+
+def window(rate: int) -> int:
+    """The ``window`` sweep at ``rate``: 0 if every first passing k is the same at both fidelities."""
+    started = time.process_time()
+    firsts_differ = 0
+    for kind, m in CASES:
+        for position in range(1, m + 4):
+            tl = [_short(after_power_up(trees(kind, m, rate)[0], position, k)) for k in range(8)]
+            pin = [_short(after_power_up(trees(kind, m, rate)[1], position, k)) for k in range(8)]
+            first = [next((k for k, seen in enumerate(side) if seen[0] == "P"), None) for side in (tl, pin)]
+            firsts_differ += first[0] != first[1]
+            print(f"{kind.name} m={m} position {position}: first passing k {first[0]}/{first[1]}, differ at k = "
+                  f"{[k for k in range(8) if tl[k] != pin[k]]}; TL {' '.join(tl)} | pin {' '.join(pin)}", flush=True)
+    print(f"first passing k differing: {firsts_differ}; CPU {time.process_time() - started:.0f} s")
+    return 1 if firsts_differ else 0
+
+
 def main() -> int:
     """Run the sweep named on the command line; 0 if nothing differs at or above the tests' wait."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("where", choices=sorted(HISTORIES), help="the wait swept")
+    parser.add_argument("where", choices=[*sorted(HISTORIES), "window"], help="the wait swept, or M23's window")
     parser.add_argument("--max-k", type=int, default=12, choices=range(13), help="the largest k below 20 swept")
+    parser.add_argument("--rate", type=int, default=2_000_000, choices=RATES, help="the window's bit rate")
     args = parser.parse_args()
+    if args.where == "window":
+        return window(args.rate)
     wait = POWER_IDLE_TELEGRAMS if args.where == "power" else FIRST_IDLE_TELEGRAMS
     started = time.process_time()
     worst = -1

@@ -872,6 +872,9 @@ class Ring:
                     if due is not None:
                         self._woke_joins.add(id(branch.terminal))
                     recognised.append(branch)
+                elif due is not None and due <= now:
+                    # M23: nothing came back at the answer instant (a broken loop): it answers as any branch after
+                    self._answers.pop(id(branch.terminal))
             if not found:
                 return recognised
 
