@@ -52,8 +52,8 @@ TELEGRAM_S = wire.STATUS_TELEGRAM_BITS / 2_000_000
 
 
 def _short(seen: Seen) -> str:
-    return "".join(("P" if seen[i] else seen[i + 1][0].name[:3] if seen[i + 1] else "F") + ("r" if seen[i + 2] else "-")
-                   for i in (0, 3))
+    return "".join(("P" if ok else kinds[0].name[:3] if kinds else "F") + ("r" if recognised else "-")
+                   for ok, kinds, recognised in seen)
 
 
 def window(rate: int) -> int:
