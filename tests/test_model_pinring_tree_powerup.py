@@ -101,13 +101,15 @@ def after_power_up(ring: Ring | PinRing, position: int, telegrams: int) -> Seen:
 RESIDUAL = {(2_000_000, BranchKind.LBD_MR, 1, 2): (3, 3), (2_000_000, BranchKind.LBD_MR, 2, 2): (4, 5),
             (2_000_000, BranchKind.LBD_MR, 3, 2): (5, 6), (2_000_000, BranchKind.LBD_MR, 2, 4): (1, 2),
             (2_000_000, BranchKind.LBD_MR, 3, 4): (1, 1), (500_000, BranchKind.LBD_MR, 1, 2): (2, 2),
-            (500_000, BranchKind.LBD_MR, 2, 2): (3, 4)}
+            (500_000, BranchKind.LBD_MR, 2, 2): (3, 4), (500_000, BranchKind.LBD_MR, 3, 2): (4, 5),
+            (500_000, BranchKind.LBD_MR, 3, 4): (7, 2)}
 """M23's limit (``python bench/wake_tree_sweep.py window --rate R``): (bit rate, tree, physical position) -> the first
 passing k at transaction level and at pin level, where the cycles before are compared by success only. The BK's
 power-up in an LBD-MR branch: with 1 device the cycles before fail with ``TRANSMISSION`` at pin level and
 ``DEAD_LINE`` at transaction level (BK-56's LBD-MR rule), with 2 and 3 devices the pin level loses one more cycle; the
 second device of an LBD-MR branch of 2 or 3 powered up at 2 Mbit/s, the frame meeting its stretch: ``TRANSMISSION``
-at pin level, ``LOOPBACK`` at transaction level, with 2 devices for one cycle more."""
+at pin level, ``LOOPBACK`` at transaction level, with 2 devices for one cycle more; at 500 kbit/s, of 3, the
+transaction level's master hears no grid until k = 7 (``TELEGRAM``) where the pin level passes from k = 2."""
 
 
 def _window(kind: BranchKind, m: int, rate: int, positions: range) -> list[int]:
