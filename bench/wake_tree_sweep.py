@@ -1,4 +1,4 @@
-"""Sweep: the idle a tree's history needs after its chips' power-up before both fidelities agree (M22's limit 2).
+"""Sweep: the idle a tree's history needs after its chips' power-up before both fidelities agree (M22's limit 2, M23).
 
 The tree of tests/test_model_pinring_recognition.py (RB, a BK with 2 branch devices, RB; 2 Mbit/s), every branch kind
 and the rows RF = 11 with LBST = 1, 00, 10 with LBST = 0 and 1; a few histories around the BK's power-up (``power``)
