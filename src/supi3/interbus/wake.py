@@ -5,7 +5,10 @@ and those behind it (their line resumes when the woken chip's transmitter does, 
 master's gapless idle status telegrams by M16, a chip begins a frame after a whole status telegram (M19), and the
 master's receiver finds the grid last. :func:`wake_window` gives the clocks from which a master's frame finds each
 chip on the grid and its receiver meets no telegram error, from the receiver itself
-(:func:`supi3.interbus.receiver.receive`) run over idle status telegrams.
+(:func:`supi3.interbus.receiver.receive`) run over idle status telegrams. In a tree (M23) the chips follow one another
+along the data path, each at its lag (:func:`path_lags`: a branch's return repeaters and its BK's synchroniser add to
+what follows it), and :attr:`Window.resumed` gives when a woken BK's output, DO3 with DO2, resumes: its branch
+answers a loop later.
 """
 
 from __future__ import annotations
@@ -111,8 +114,8 @@ def path_lags(bit_rate: int, devices: int, branches: Sequence[tuple[int, int, in
 
 
 class Window(NamedTuple):
-    """What a master's cycle meets after chips of a flat ring woke up (M22), in clocks from the start of the master's
-    idle status telegrams."""
+    """What a master's cycle meets after chips of a ring woke up (M22; a tree's data path, M23), in clocks from the
+    start of the master's idle status telegrams."""
 
     ready: list[int]
     """Per ring index, the first clock from which a cycle's frame finds the chip on the grid (0: at once); a frame
