@@ -1,4 +1,4 @@
-"""Sweep: the idle a tree's history needs after its chips' power-up before both fidelities agree (M22's limit 2, M23).
+"""Sweep: the idle a tree's history needs after its chips' power-up before both fidelities agree (M22's limit 2, M25).
 
 The tree of tests/test_model_pinring_recognition.py (RB, a BK with 2 branch devices, RB; 2 Mbit/s), every branch kind
 and the rows RF = 11 with LBST = 1, 00, 10 with LBST = 0 and 1; a few histories around the BK's power-up (``power``)
@@ -8,8 +8,8 @@ wait at 20): prints per kind and row the k at which some step differs (the BK's 
 
     python bench/wake_tree_sweep.py power          # after the BK's power-up step: 1,120 runs
     python bench/wake_tree_sweep.py initial        # before the first step: 896 runs
-    python bench/wake_tree_sweep.py power --max-k 6   # k = 0..6 and 20 only (M23: the transaction level follows)
-    python bench/wake_tree_sweep.py window --rate 2000000   # M23: one chip of a running tree powered up, k = 0..7
+    python bench/wake_tree_sweep.py power --max-k 6   # k = 0..6 and 20 only (M25: the transaction level follows)
+    python bench/wake_tree_sweep.py window --rate 2000000   # M25: one chip of a running tree powered up, k = 0..7
 
 ``window`` runs the trees of ``test_model_pinring_tree.CASES`` (RF = 11, LBST = 1): every chip in turn powered up in a
 running tree (/ResU low for 4 status telegrams; ``Ring.power_up``), k idle status telegrams, two cycles, and prints per
@@ -74,7 +74,7 @@ def window(rate: int) -> int:
 def main() -> int:
     """Run the sweep named on the command line; 0 if nothing differs at or above the tests' wait."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("where", choices=[*sorted(HISTORIES), "window"], help="the wait swept, or M23's window")
+    parser.add_argument("where", choices=[*sorted(HISTORIES), "window"], help="the wait swept, or M25's window")
     parser.add_argument("--max-k", type=int, default=12, choices=range(13), help="the largest k below 20 swept")
     parser.add_argument("--rate", type=int, default=2_000_000, choices=RATES, help="the window's bit rate")
     args = parser.parse_args()

@@ -218,14 +218,14 @@ an LBD branch a device that sends a counter telegram drops the telegram beginnin
 (BK-30, M16); idle telegrams take that, not the next frame's head."""
 FIRST_IDLE_TELEGRAMS: dict[BranchKind, int] = {BranchKind.REMOTE: 5, BranchKind.LOCAL: 5, BranchKind.LBD_MR: 9,
                                                BranchKind.LBD_OR: 9}
-"""Idle status telegrams before a history's first step, every chip powered up at the ring's first clock (M22, M23:
+"""Idle status telegrams before a history's first step, every chip powered up at the ring's first clock (M22, M25:
 ``Ring.power_up`` at transaction level), per branch kind: the least from which the histories of
-``bench/wake_tree_sweep.py initial`` agree (M23's limits; before M23: 9 for every kind, 20 before that)."""
+``bench/wake_tree_sweep.py initial`` agree (M25's limits; before M25: 9 for every kind, 20 before that)."""
 POWER_IDLE_TELEGRAMS: dict[BranchKind, int] = {BranchKind.REMOTE: 3, BranchKind.LOCAL: 3, BranchKind.LBD_MR: 6,
                                                BranchKind.LBD_OR: 6}
-"""Idle status telegrams after the BK's power-up step (/ResU released, ``Ring.power_up`` at transaction level: M23
+"""Idle status telegrams after the BK's power-up step (/ResU released, ``Ring.power_up`` at transaction level: M25
 follows the BK's wake-up and its branch's answer), per branch kind: the least from which the histories of
-``bench/wake_tree_sweep.py power`` agree (M23's limits, LBD-MR's the longest; before M23: 6 for every kind, 20
+``bench/wake_tree_sweep.py power`` agree (M25's limits, LBD-MR's the longest; before M25: 6 for every kind, 20
 before that)."""
 TELEGRAM_S = wire.STATUS_TELEGRAM_BITS / 2_000_000
 
@@ -239,14 +239,14 @@ def recognition_history(kind: BranchKind, row: tuple[str, bool], ops: list[Op], 
                         power_idle_s: float | None = None) -> list[tuple[Record, Record]]:
     """Run ``ops`` (:data:`OPS`) on the transaction-level and the pin-level tree of two branch devices of ``kind``
     (``row``: RF and LBST, Table 2-9) with a master on each, after ``first_idle_s`` of idle and with ``power_idle_s``
-    after each power-up step (M22, M23; ``None``: :data:`FIRST_IDLE_TELEGRAMS`, :data:`POWER_IDLE_TELEGRAMS` of
+    after each power-up step (M22, M25; ``None``: :data:`FIRST_IDLE_TELEGRAMS`, :data:`POWER_IDLE_TELEGRAMS` of
     ``kind``); per step, at each fidelity, the BK's recognition (``branch_recognised``, ``connected``) and what the
     master saw (:func:`seen`)."""
     first_idle_s = FIRST_IDLE_TELEGRAMS[kind] * TELEGRAM_S if first_idle_s is None else first_idle_s
     power_idle_s = POWER_IDLE_TELEGRAMS[kind] * TELEGRAM_S if power_idle_s is None else power_idle_s
     tl, tl_chips = tl_ring(kind, *row, 2)
     pin, _ = pin_ring(kind, *row, 2)
-    for position in range(1, len(tl_chips) + 1):  # powered up at the first clock, as the pin level's chips (M22, M23)
+    for position in range(1, len(tl_chips) + 1):  # powered up at the first clock, as the pin level's chips (M22, M25)
         tl.power_up(position)
     for ring in (tl, pin):
         ring.idle(first_idle_s)
@@ -278,7 +278,7 @@ def recognition_history(kind: BranchKind, row: tuple[str, bool], ops: list[Op], 
             pin.cut(position, forward, branch=branch)
         elif name == "power":
             tl.idle(POWER_DOWN_S)
-            tl.power_up(2)  # M23: the BK's wake-up and its branch's answer followed
+            tl.power_up(2)  # M25: the BK's wake-up and its branch's answer followed
             tl.idle(power_idle_s)
             pin.set_input(2, "resu_n", 0)
             pin.idle(POWER_DOWN_S)

@@ -1,4 +1,4 @@
-"""A chip's power-up in a tree at both fidelities (M22, M23 of docs/assumptions/model.md; manual 1.7.2, 2.4; BK-37,
+"""A chip's power-up in a tree at both fidelities (M22, M25 of docs/assumptions/model.md; manual 1.7.2, 2.4; BK-37,
 BK-54, BK-56): ``Ring.power_up`` takes any device of a tree by its physical position (a remote bus device, the BK, a
 branch device) and the transaction level fails and passes the same cycles as the pin level
 (:class:`~supi3.model.pinring.PinRing` with /ResU held low), with the same error kinds: the window of the woken chip
@@ -103,7 +103,7 @@ RESIDUAL = {(2_000_000, BranchKind.LBD_MR, 1, 2): (3, 3), (2_000_000, BranchKind
             (2_000_000, BranchKind.LBD_MR, 3, 4): (1, 1), (500_000, BranchKind.LBD_MR, 1, 2): (2, 2),
             (500_000, BranchKind.LBD_MR, 2, 2): (3, 4), (500_000, BranchKind.LBD_MR, 3, 2): (4, 5),
             (500_000, BranchKind.LBD_MR, 3, 4): (7, 2)}
-"""M23's limit (``python bench/wake_tree_sweep.py window --rate R``): (bit rate, tree, physical position) -> the first
+"""M25's limit (``python bench/wake_tree_sweep.py window --rate R``): (bit rate, tree, physical position) -> the first
 passing k at transaction level and at pin level, where the cycles before are compared by success only. The BK's
 power-up in an LBD-MR branch: with 1 device the cycles before fail with ``TRANSMISSION`` at pin level and
 ``DEAD_LINE`` at transaction level (BK-56's LBD-MR rule), with 2 and 3 devices the pin level loses one more cycle; the
@@ -133,7 +133,7 @@ def _window(kind: BranchKind, m: int, rate: int, positions: range) -> list[int]:
 
 @pytest.mark.parametrize(("kind", "m"), CASES)
 def test_a_bk_s_power_up_ends_its_window_alike(kind: BranchKind, m: int) -> None:
-    """M23 over the trees of ``CASES`` at 2 Mbit/s: the BK powered up in a running tree, k idle status telegrams, two
+    """M25 over the trees of ``CASES`` at 2 Mbit/s: the BK powered up in a running tree, k idle status telegrams, two
     cycles: the first passing k is the same at both fidelities (BK-54: the cycle its branch joins within is lost at
     both, or the branch joins before it), and that cycle and the one before fail or pass alike, with the same error
     kinds and the same recognition (but :data:`RESIDUAL`)."""
@@ -144,7 +144,7 @@ def test_a_bk_s_power_up_ends_its_window_alike(kind: BranchKind, m: int) -> None
 @pytest.mark.parametrize("rate", RATES)
 @pytest.mark.parametrize(("kind", "m"), CASES)
 def test_the_window_after_a_power_up_in_a_tree_ends_alike(kind: BranchKind, m: int, rate: int) -> None:
-    """M23, exhaustively over the trees of ``CASES`` at both bit rates: any one chip (a remote bus device, the BK, a
+    """M25, exhaustively over the trees of ``CASES`` at both bit rates: any one chip (a remote bus device, the BK, a
     branch device) powered up in a running tree: as :func:`test_a_bk_s_power_up_ends_its_window_alike` (at 500 kbit/s
     every cycle of k = 0..7 alike: ``python bench/wake_tree_sweep.py window --rate 500000``)."""
     _window(kind, m, rate, range(1, m + 4))

@@ -757,10 +757,10 @@ class Ring:
         self._late: dict[int, float] = {}
         """M22: ``id`` of a chip -> bus time from which a frame finds it out of an INTERBUS reset it woke up in."""
         self._answers: dict[int, float] = {}
-        """M23: ``id`` of a BK powered up by :meth:`power_up` -> bus time its branch's first start level is back on its
+        """M25: ``id`` of a BK powered up by :meth:`power_up` -> bus time its branch's first start level is back on its
         synchronised DI3 (BK-37): its branch answers from then."""
         self._woke_joins: set[int] = set()
-        """M23: ``id`` of the BKs whose branch joins the data path within this cycle's frame after their power-up."""
+        """M25: ``id`` of the BKs whose branch joins the data path within this cycle's frame after their power-up."""
         self._grid = 0.0
         """M22: bus time the master's idle status telegrams began (the end of its last cycle or reset)."""
         self._loops: tuple[list[Device], list[int]] = ([], [0])
@@ -834,7 +834,7 @@ class Ring:
         back to DI3 is whole; an LBD branch when its BK's return input is whole (its devices send counter telegrams on
         their own, BK-30).
 
-        A BK powered up by :meth:`power_up` answers from its answer instant (M23), by bus time ``now`` (the run's time;
+        A BK powered up by :meth:`power_up` answers from its answer instant (M25), by bus time ``now`` (the run's time;
         :attr:`now` if ``None``); with ``frame`` (a cycle's frame of that many bits from ``now``) one answering before
         the frame's head reaches its BK joins before the frame (not returned), one answering while the frame passes
         joins within it (returned, BK-54), one answering later waits."""
@@ -868,12 +868,12 @@ class Ring:
                     self._answers.pop(id(branch.terminal), None)
                     found = True
                     if due is not None and frame is not None and due <= head:
-                        continue  # M23: joined before the frame, between telegrams (BK-47)
+                        continue  # M25: joined before the frame, between telegrams (BK-47)
                     if due is not None:
                         self._woke_joins.add(id(branch.terminal))
                     recognised.append(branch)
                 elif due is not None and due <= now:
-                    # M23: nothing came back at the answer instant (a broken loop): it answers as any branch after
+                    # M25: nothing came back at the answer instant (a broken loop): it answers as any branch after
                     self._answers.pop(id(branch.terminal))
             if not found:
                 return recognised
@@ -1040,7 +1040,7 @@ class Ring:
         forward = {id(a.target) for a in self._repaired if isinstance(a.fault, DeadLine)}
         first = next((k for k, index in enumerate(span.own) if id(self.devices[index]) in forward), None)
         if id(span.branch.terminal) in self._woke_joins:
-            first = 0  # M23: the BK's DO3 resumed after its power-up, as the first device's forward input repaired
+            first = 0  # M25: the BK's DO3 resumed after its power-up, as the first device's forward input repaired
         return join_error(span.branch.kind, first)
 
     def _faults_on(self, segments: int) -> tuple[dict[int, list[Fault]], list[tuple[int, bool]]]:
@@ -1246,7 +1246,7 @@ class Ring:
         if self._wakes or self._late:  # M22: a chip not on the telegram grid yet passes the frame on (M19)
             late, woken = self._waking()
             if spliced is ErrorKind.TRANSMISSION and woken is not None:
-                # M23: a joining BK whose output resumed after the frame's head passed it sent no head: nothing
+                # M25: a joining BK whose output resumed after the frame's head passed it sent no head: nothing
                 # that opens a frame comes back, on its line before the join or on DI3 after it
                 wakes, start, lags = woken
                 at = next(span.at for span in self._spans if span.branch in joined)
@@ -1318,7 +1318,7 @@ class Ring:
         if unheard:  # not on the telegram grid yet: no fault of the return line N + 1
             receiver_error = receiver_error or ErrorKind.TELEGRAM
         elif spliced is ErrorKind.TRANSMISSION and opened:
-            # M23: a frame whose head a woken chip's stretch cut comes back as no frame, whatever joins after it
+            # M25: a frame whose head a woken chip's stretch cut comes back as no frame, whatever joins after it
             flags_back = wire.CntrFlags(attention, True)
         reports = self._reports(reached, None if close_after is None else n, dead_lines, returns) \
             if self._spans else []
@@ -1411,7 +1411,7 @@ class Ring:
         delay of every device of the tree, which may all be in the data path after it (BK-9, A12; BK-53)."""
         every = _devices(self._tree) if self._branches else self.devices
         end = self.now + wire.reset_bits(min(len(every), wire.MAX_DEVICES), return_repeaters(every)) / self.bit_rate
-        self._recognise(end)  # in the hold (BK-37); a BK powered up answers by the reset's end (M23)
+        self._recognise(end)  # in the hold (BK-37); a BK powered up answers by the reset's end (M25)
         self._repaired = []
         dead = self._first_dead()
         reached = len(self.devices) if dead is None else min(len(self.devices), dead - 1)
@@ -1433,8 +1433,8 @@ class Ring:
         """Power up the chip at ring ``position`` now (its power-up reset, 1.7.2): a master's cycle fails, as at pin
         level, until the chip and those behind it, then the master's receiver, are on the telegram grid (M22). In a
         tree ``position`` is the physical one (1..N over every device of the tree, a BK then its branch's devices, as
-        :meth:`cut` numbers them, BK-52) and the window follows the data path's repeaters (M23); a BK's branch answers
-        again once the first start level the BK sends after its wake-up is back on its DI3 (BK-37, M23), and joins the
+        :meth:`cut` numbers them, BK-52) and the window follows the data path's repeaters (M25); a BK's branch answers
+        again once the first start level the BK sends after its wake-up is back on its DI3 (BK-37, M25), and joins the
         data path then: before a frame, within it (that cycle lost, BK-54) or after it.
 
         Raises
@@ -1452,12 +1452,12 @@ class Ring:
         power_up()
         self._wakes[id(device)] = self.now + round(RESET_MIN_S * CLOCK_HZ) / CLOCK_HZ  # the stretch, M2
         self._late.pop(id(device), None)
-        if id(device) in self._terminals:  # M23: its recognition cleared (BK-37): the branch may leave the data path
+        if id(device) in self._terminals:  # M25: its recognition cleared (BK-37): the branch may leave the data path
             self._sync()
             self._answer(next(branch for branch in self._branches if branch.terminal is device))
 
     def _lags(self) -> list[int]:
-        """M23: the clocks from the master's line to each device's input along the data path now, then to the master's
+        """M25: the clocks from the master's line to each device's input along the data path now, then to the master's
         receiver (:func:`~supi3.interbus.wake.path_lags`: every branch in it adds its return repeaters, BK-35, and its
         BK's synchroniser)."""
         branches = [(span.at, span.end, sum(_return_repeater(self.devices[i]) for i in span.own))
@@ -1465,7 +1465,7 @@ class Ring:
         return path_lags(self.bit_rate, len(self.devices), branches)
 
     def _loop_clocks(self, branch: Branch) -> int:
-        """M23: the clocks a start level takes from a BK's DO3 round its branch to the BK's synchronised DI3: a
+        """M25: the clocks a start level takes from a BK's DO3 round its branch to the BK's synchronised DI3: a
         repeater a device (A10; a nested BK with its branch in the data path, that loop too), a repeater a LBD-MR
         device's return line (BK-35), the synchroniser (M1)."""
         delay = wire.REPEATER_DELAY_BITS * wire.clocks_per_bit(self.bit_rate)
@@ -1478,7 +1478,7 @@ class Ring:
         return clocks
 
     def _answer(self, branch: Branch) -> None:
-        """M23: note when the branch of a BK just powered up answers: the BK's output resumes (M12, by
+        """M25: note when the branch of a BK just powered up answers: the BK's output resumes (M12, by
         :func:`~supi3.interbus.wake.wake_window` over the data path; its DO3 with its DO2) and that start level runs
         round the branch (:meth:`_loop_clocks`); a BK out of the data path answers at its next run, as before."""
         index = {id(device): k for k, device in enumerate(self.devices)}.get(id(branch.terminal))
@@ -1501,7 +1501,7 @@ class Ring:
     def _waking(self) -> tuple[set[int], tuple[dict[int, int], int, list[int]] | None]:
         """M22: the ring indices of the chips a frame starting now finds off the telegram grid, and the wake-ups, the
         frame's start in clocks of the master's idle (:func:`~supi3.interbus.wake.wake_window`) and the data path's
-        lags (M23); ``None`` past the window, which is then forgotten."""
+        lags (M25); ``None`` past the window, which is then forgotten."""
         index = {id(device): k for k, device in enumerate(self.devices)}
         late = {index[key] for key, at in self._late.items() if key in index and self.now < at}
         self._late = {key: at for key, at in self._late.items() if self.now < at}
@@ -1533,5 +1533,5 @@ class Ring:
             self._silence_detached(self.now, end)
         self.now = end
         if self._answers:
-            self._recognise()  # M23: a BK powered up whose branch answered within the idle
+            self._recognise()  # M25: a BK powered up whose branch answered within the idle
         self._sync()

@@ -5,7 +5,7 @@ and those behind it (their line resumes when the woken chip's transmitter does, 
 master's gapless idle status telegrams by M16, a chip begins a frame after a whole status telegram (M19), and the
 master's receiver finds the grid last. :func:`wake_window` gives the clocks from which a master's frame finds each
 chip on the grid and its receiver meets no telegram error, from the receiver itself
-(:func:`supi3.interbus.receiver.receive`) run over idle status telegrams. In a tree (M23) the chips follow one another
+(:func:`supi3.interbus.receiver.receive`) run over idle status telegrams. In a tree (M25) the chips follow one another
 along the data path, each at its lag (:func:`path_lags`: a branch's return repeaters and its BK's synchroniser add to
 what follows it), and :attr:`Window.resumed` gives when a woken BK's output, DO3 with DO2, resumes: its branch
 answers a loop later.
@@ -39,7 +39,7 @@ def _idle_samples(bit_rate: int) -> npt.NDArray[np.int64]:
 def _first_start(samples: npt.NDArray[np.int64], cpb: int) -> int | None:
     """Where a receiver that begins listening at ``samples[0]`` takes its first start bit, from which a woken chip's
     transmitter resumes (M12): the first start level still low at its mid-bit sample (M7: a start bit sampled at the
-    idle level is no telegram; M23: the tail of a low bit heard first, shorter than that, is none, found behind a BK's
+    idle level is no telegram; M25: the tail of a low bit heard first, shorter than that, is none, found behind a BK's
     synchroniser, 2 clocks off the bit grid); ``None``: none."""
     low = samples == wire.START_LEVEL
     edges = np.flatnonzero(np.diff(np.concatenate([[0], low.astype(np.int8), [0]])))
@@ -81,13 +81,13 @@ def _check(bit_rate: int, devices: int, wakes: Mapping[int, int], lags: Sequence
     if isinstance(lags, (str, bytes)) or not isinstance(lags, Sequence) or len(lags) != devices + 1 or not all(
             type(lag) is int for lag in lags) or any(b <= a for a, b in itertools.pairwise(lags)):
         raise fail("lags", f"{devices + 1} increasing integer clocks (each chip's input, then the master's receiver, "
-                   "path_lags)", lags, "M23")  # fmt: skip
+                   "path_lags)", lags, "M25")  # fmt: skip
     return devices, list(lags)
 
 
 def path_lags(bit_rate: int, devices: int, branches: Sequence[tuple[int, int, int]] = ()) -> list[int]:
     """The clocks from the master's line to each chip's input along a data path of ``devices`` chips, then to the
-    master's receiver (M22, M23): ``REPEATER_DELAY_BITS`` a chip before it (A10), and after a branch (``branches``:
+    master's receiver (M22, M25): ``REPEATER_DELAY_BITS`` a chip before it (A10), and after a branch (``branches``:
     the ring index of its BK, the index after its last device, its LBD-MR devices) that branch's return line, a repeater
     for each LBD-MR device (BK-35) and the BK's synchroniser on DI3 (``SYNC_STAGES``, M1; DO2 repeats it, BK-37).
 
@@ -104,7 +104,7 @@ def path_lags(bit_rate: int, devices: int, branches: Sequence[tuple[int, int, in
     for branch in branches:
         if not (isinstance(branch, tuple) and len(branch) == 3 and all(type(v) is int for v in branch)
                 and 0 <= branch[0] < branch[1] <= devices and 0 <= branch[2] < branch[1] - branch[0]):
-            raise fail("branches", f"(BK index, end, LBD-MR devices) triples within {devices} chips", branch, "M23")
+            raise fail("branches", f"(BK index, end, LBD-MR devices) triples within {devices} chips", branch, "M25")
         extra[branch[1]] += branch[2] * delay + SYNC_STAGES
     lags, added = [], 0
     for index in range(devices + 1):
@@ -114,7 +114,7 @@ def path_lags(bit_rate: int, devices: int, branches: Sequence[tuple[int, int, in
 
 
 class Window(NamedTuple):
-    """What a master's cycle meets after chips of a ring woke up (M22; a tree's data path, M23), in clocks from the
+    """What a master's cycle meets after chips of a ring woke up (M22; a tree's data path, M25), in clocks from the
     start of the master's idle status telegrams."""
 
     ready: list[int]
@@ -124,7 +124,7 @@ class Window(NamedTuple):
     """The first clock from which a cycle meets no telegram error of the master's receiver (0: at once)."""
     resumed: tuple[int | None, ...] = ()
     """Per ring index, the clock the chip's output resumes (its first start level after it began listening, on its
-    output, M12), ``None`` for a chip on the grid all along: a BK's branch answers from its own (M23)."""
+    output, M12), ``None`` for a chip on the grid all along: a BK's branch answers from its own (M25)."""
 
     @property
     def end(self) -> int:
@@ -141,7 +141,7 @@ def wake_window(bit_rate: int, devices: int, wakes: Mapping[int, int], lags: Seq
     its own resumption or wake-up, M12); the chip takes a frame from the end of its first whole status telegram
     (M19); the master's receiver, behind the last chip with no added delay, listens from the last chip's resumption and
     makes its last telegram error before finding the grid (M16). ``lags``: the clocks from the master's line to each
-    chip's input and to the master's receiver (:func:`path_lags`: a tree's data path, M23; ``None``: a flat ring's).
+    chip's input and to the master's receiver (:func:`path_lags`: a tree's data path, M25; ``None``: a flat ring's).
 
     Raises
     ------
@@ -166,7 +166,7 @@ def wake_window(bit_rate: int, devices: int, wakes: Mapping[int, int], lags: Seq
         first, grid, error = _resync(bit_rate, (listen - lag) % telegram)
         if index < devices:
             # A chip not powered up keeps its frame block (M19): its line resuming at a telegram's start, it reads
-            # that telegram on the grid (M23: found behind a BK with no data register, BK-RB with RF = 10).
+            # that telegram on the grid (M25: found behind a BK with no data register, BK-RB with RF = 10).
             on_grid = index not in wakes and (listen - lag) % telegram == 0
             ready[index] = listen - lag if on_grid else listen + grid - lag
             resumed = outputs[index] = listen + first + lags[index + 1] - lag
