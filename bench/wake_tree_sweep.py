@@ -1,4 +1,4 @@
-"""Sweep: the idle a tree's history needs after its chips' power-up before both fidelities agree (M22's limit 2).
+"""Sweep: the idle a tree's history needs after its chips' power-up before both fidelities agree (M22's limit 2, M25).
 
 The tree of tests/test_model_pinring_recognition.py (RB, a BK with 2 branch devices, RB; 2 Mbit/s), every branch kind
 and the rows RF = 11 with LBST = 1, 00, 10 with LBST = 0 and 1; a few histories around the BK's power-up (``power``)
@@ -8,8 +8,15 @@ wait at 20): prints per kind and row the k at which some step differs (the BK's 
 
     python bench/wake_tree_sweep.py power          # after the BK's power-up step: 1,120 runs
     python bench/wake_tree_sweep.py initial        # before the first step: 896 runs
+    python bench/wake_tree_sweep.py power --max-k 6   # k = 0..6 and 20 only (M25: the transaction level follows)
+    python bench/wake_tree_sweep.py window --rate 2000000   # M25: one chip of a running tree powered up, k = 0..7
 
-Exits 1 if a k at or above the tests' wait differs.
+``window`` runs the trees of ``test_model_pinring_tree.CASES`` (RF = 11, LBST = 1): every chip in turn powered up in a
+running tree (/ResU low for 4 status telegrams; ``Ring.power_up``), k idle status telegrams, two cycles, and prints per
+tree and physical position both fidelities' cycles (``P``: passed, else the first error kind's first three letters;
+``r``: the branch recognised after it) and the k where they differ; exits 1 if the first passing k differs.
+
+Exits 1 if a k at or above the tests' wait (per branch kind) differs.
 """
 
 from __future__ import annotations
@@ -21,14 +28,16 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
-from supi3.interbus import wire
 from supi3.interbus.ring import BranchKind
 from test_model_pinring_recognition import (  # the tests' helpers, on the path above
     FIRST_IDLE_TELEGRAMS,
     POWER_IDLE_TELEGRAMS,
+    TELEGRAM_S,
     Op,
     recognition_history,
 )
+from test_model_pinring_tree import CASES
+from test_model_pinring_tree_powerup import RATES, Seen, after_power_up, trees
 
 ROWS = [("11", True), ("00", False), ("10", False), ("10", True)]
 START, POWER, CYCLE = ("start", 0), ("power", 0), ("cycle", 0)
@@ -39,29 +48,56 @@ HISTORIES: dict[str, list[list[Op]]] = {
     "initial": [[START, CYCLE, CYCLE], [CYCLE, CYCLE], [("cut", 0), START, ("repair", 0), CYCLE],
                 [("off", 0), CYCLE, CYCLE]],
 }
-TELEGRAM_S = wire.STATUS_TELEGRAM_BITS / 2_000_000
+
+
+def _short(seen: Seen) -> str:
+    return "".join(("P" if ok else kinds[0].name[:3] if kinds else "F") + ("r" if recognised else "-")
+                   for ok, kinds, recognised in seen)
+
+
+def window(rate: int) -> int:
+    """The ``window`` sweep at ``rate``: 0 if every first passing k is the same at both fidelities."""
+    started = time.process_time()
+    firsts_differ = 0
+    for kind, m in CASES:
+        for position in range(1, m + 4):
+            tl = [_short(after_power_up(trees(kind, m, rate)[0], position, k)) for k in range(8)]
+            pin = [_short(after_power_up(trees(kind, m, rate)[1], position, k)) for k in range(8)]
+            first = [next((k for k, seen in enumerate(side) if seen[0] == "P"), None) for side in (tl, pin)]
+            firsts_differ += first[0] != first[1]
+            print(f"{kind.name} m={m} position {position}: first passing k {first[0]}/{first[1]}, differ at k = "
+                  f"{[k for k in range(8) if tl[k] != pin[k]]}; TL {' '.join(tl)} | pin {' '.join(pin)}", flush=True)
+    print(f"first passing k differing: {firsts_differ}; CPU {time.process_time() - started:.0f} s")
+    return 1 if firsts_differ else 0
 
 
 def main() -> int:
     """Run the sweep named on the command line; 0 if nothing differs at or above the tests' wait."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("where", choices=sorted(HISTORIES), help="the wait swept")
+    parser.add_argument("where", choices=[*sorted(HISTORIES), "window"], help="the wait swept, or M25's window")
+    parser.add_argument("--max-k", type=int, default=12, choices=range(13), help="the largest k below 20 swept")
+    parser.add_argument("--rate", type=int, default=2_000_000, choices=RATES, help="the window's bit rate")
     args = parser.parse_args()
-    wait = POWER_IDLE_TELEGRAMS if args.where == "power" else FIRST_IDLE_TELEGRAMS
+    if args.where == "window":
+        return window(args.rate)
+    waits = POWER_IDLE_TELEGRAMS if args.where == "power" else FIRST_IDLE_TELEGRAMS
     started = time.process_time()
-    worst = -1
+    late = []
     for kind in BranchKind:
+        worst = -1
         for row in ROWS:
             differ = []
-            for k in [*range(13), 20]:
+            for k in [*range(args.max_k + 1), 20]:
                 first, power = (20, k) if args.where == "power" else (k, 20)
                 if any(a != b for ops in HISTORIES[args.where]
                        for a, b in recognition_history(kind, row, ops, first * TELEGRAM_S, power * TELEGRAM_S)):
                     differ.append(k)
             worst = max(worst, *differ) if differ else worst
             print(f"{args.where} {kind.name} RF={row[0]} LBST={int(row[1])}: differ at k = {differ}", flush=True)
-    print(f"last differing k: {worst}; the tests wait {wait}; CPU {time.process_time() - started:.0f} s")
-    return 1 if worst >= wait else 0
+        print(f"{kind.name}: last differing k {worst}; the tests wait {waits[kind]}", flush=True)
+        late += [kind.name] if worst >= waits[kind] else []
+    print(f"waits too short: {late}; CPU {time.process_time() - started:.0f} s")
+    return 1 if late else 0
 
 
 if __name__ == "__main__":

@@ -216,15 +216,18 @@ REPAIR_IDLE_S = REPAIR_IDLE_TELEGRAMS * wire.STATUS_TELEGRAM_BITS / 2_000_000
 """Idle after a repair (M21): a repaired line takes up a telegram in flight at the repair point, and behind a break in
 an LBD branch a device that sends a counter telegram drops the telegram beginning then and the one chained to it
 (BK-30, M16); idle telegrams take that, not the next frame's head."""
-FIRST_IDLE_TELEGRAMS = 9
-"""Idle status telegrams before a history's first step, every chip powered up at the ring's first clock (M22's limit
-2: no tree followed at transaction level, measured): the least from which the histories of M22's limit 2 agree."""
-POWER_IDLE_TELEGRAMS = 6
-"""Idle status telegrams after the BK's power-up step (/ResU released; M22's limit 2, measured): the BK's reset
-stretch (M2), its transmitter's resumption (M12) and its branch's answer on DI3 (BK-37) before the next step; LBD-MR's
-return repeaters (BK-35) make it the longest. Before: 20."""
-FIRST_IDLE_S = FIRST_IDLE_TELEGRAMS * wire.STATUS_TELEGRAM_BITS / 2_000_000
-POWER_IDLE_S = POWER_IDLE_TELEGRAMS * wire.STATUS_TELEGRAM_BITS / 2_000_000
+FIRST_IDLE_TELEGRAMS: dict[BranchKind, int] = {BranchKind.REMOTE: 5, BranchKind.LOCAL: 5, BranchKind.LBD_MR: 9,
+                                               BranchKind.LBD_OR: 9}
+"""Idle status telegrams before a history's first step, every chip powered up at the ring's first clock (M22, M25:
+``Ring.power_up`` at transaction level), per branch kind: the least from which the histories of
+``bench/wake_tree_sweep.py initial`` agree (M25's limits; before M25: 9 for every kind, 20 before that)."""
+POWER_IDLE_TELEGRAMS: dict[BranchKind, int] = {BranchKind.REMOTE: 3, BranchKind.LOCAL: 3, BranchKind.LBD_MR: 6,
+                                               BranchKind.LBD_OR: 6}
+"""Idle status telegrams after the BK's power-up step (/ResU released, ``Ring.power_up`` at transaction level: M25
+follows the BK's wake-up and its branch's answer), per branch kind: the least from which the histories of
+``bench/wake_tree_sweep.py power`` agree (M25's limits, LBD-MR's the longest; before M25: 6 for every kind, 20
+before that)."""
+TELEGRAM_S = wire.STATUS_TELEGRAM_BITS / 2_000_000
 
 
 Seen = tuple[Cycle, bool, list[tuple[ErrorKind | None, int | None, str | None]], View | None] | None
@@ -232,15 +235,20 @@ Record = tuple[str, int, bool, Seen]
 """A step of :func:`recognition_history` at one fidelity: the step, the BK's recognition, what the master saw."""
 
 
-def recognition_history(kind: BranchKind, row: tuple[str, bool], ops: list[Op], first_idle_s: float = FIRST_IDLE_S,
-                        power_idle_s: float = POWER_IDLE_S) -> list[tuple[Record, Record]]:
+def recognition_history(kind: BranchKind, row: tuple[str, bool], ops: list[Op], first_idle_s: float | None = None,
+                        power_idle_s: float | None = None) -> list[tuple[Record, Record]]:
     """Run ``ops`` (:data:`OPS`) on the transaction-level and the pin-level tree of two branch devices of ``kind``
     (``row``: RF and LBST, Table 2-9) with a master on each, after ``first_idle_s`` of idle and with ``power_idle_s``
-    after each power-up step (M22's limit 2); per step, at each fidelity, the BK's recognition (``branch_recognised``,
-    ``connected``) and what the master saw (:func:`seen`)."""
+    after each power-up step (M22, M25; ``None``: :data:`FIRST_IDLE_TELEGRAMS`, :data:`POWER_IDLE_TELEGRAMS` of
+    ``kind``); per step, at each fidelity, the BK's recognition (``branch_recognised``, ``connected``) and what the
+    master saw (:func:`seen`)."""
+    first_idle_s = FIRST_IDLE_TELEGRAMS[kind] * TELEGRAM_S if first_idle_s is None else first_idle_s
+    power_idle_s = POWER_IDLE_TELEGRAMS[kind] * TELEGRAM_S if power_idle_s is None else power_idle_s
     tl, tl_chips = tl_ring(kind, *row, 2)
     pin, _ = pin_ring(kind, *row, 2)
-    for ring in (tl, pin):  # past the chips' power-up reset stretch (M2): a first frame would meet it at pin level
+    for position in range(1, len(tl_chips) + 1):  # powered up at the first clock, as the pin level's chips (M22, M25)
+        tl.power_up(position)
+    for ring in (tl, pin):
         ring.idle(first_idle_s)
     masters = [Master(tl, locate=False, max_devices=8), Master(pin, locate=False, max_devices=8)]
     breaks = cuts(kind)
@@ -270,7 +278,7 @@ def recognition_history(kind: BranchKind, row: tuple[str, bool], ops: list[Op], 
             pin.cut(position, forward, branch=branch)
         elif name == "power":
             tl.idle(POWER_DOWN_S)
-            tl_chips[1].power_up()
+            tl.power_up(2)  # M25: the BK's wake-up and its branch's answer followed
             tl.idle(power_idle_s)
             pin.set_input(2, "resu_n", 0)
             pin.idle(POWER_DOWN_S)
@@ -385,16 +393,6 @@ def test_join_error_refuses_bad_input_by_name() -> None:
     with pytest.raises(ArgumentError, match=r"^first_forward must be"):
         join_error(BranchKind.REMOTE, -1)
     assert [join_error(kind, None) for kind in BranchKind] == [ErrorKind.DEAD_LINE] * len(BranchKind)
-
-
-def test_a_tree_s_power_up_through_the_ring_is_refused_by_name() -> None:
-    """M22's limit 2: ``Ring.power_up`` follows the wake-up of a flat ring's chips only; on a tree (a BK's recognition
-    after its power-up, BK-37, and the branch's repeaters are not followed) it names the rule, nothing powered up."""
-    ring, chips = tl_ring(BranchKind.REMOTE, "11", True, 2)
-    assert Master(ring, locate=False, max_devices=8).start().ok and chips[1].branch_recognised
-    with pytest.raises(ArgumentError, match=r"^ring must be a flat ring \(M22"):
-        ring.power_up(2)
-    assert chips[1].branch_recognised
 
 
 def test_the_recognition_stays_through_resets_and_breaks_until_the_power_up() -> None:

@@ -46,8 +46,9 @@ from supi3.config import DeviceConfig, Interface
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusArgumentError, InterbusError, TelegramError
 from supi3.interbus.link import DataKernel, Device
-from supi3.interbus.wake import reset_ready, wake_return, wake_window
+from supi3.interbus.wake import path_lags, reset_ready, wake_return, wake_window
 from supi3.interbus.wire import Cycle, Frame
+from supi3.pinout import SYNC_STAGES
 from supi3.tables import CLOCK_HZ, RESET_MIN_S
 
 
@@ -772,9 +773,14 @@ class Ring:
         self._pending: Transfer | None = None
         """What the last :meth:`transfer` returned, until :meth:`finish`, :meth:`reset` or :meth:`idle`."""
         self._wakes: dict[int, float] = {}
-        """M22: ring index -> bus time a chip powered up by :meth:`power_up` ends its reset stretch (M2)."""
+        """M22: ``id`` of a chip powered up by :meth:`power_up` -> bus time its reset stretch (M2) ends."""
         self._late: dict[int, float] = {}
-        """M22: ring index -> bus time from which a frame finds the chip out of an INTERBUS reset it woke up in."""
+        """M22: ``id`` of a chip -> bus time from which a frame finds it out of an INTERBUS reset it woke up in."""
+        self._answers: dict[int, float] = {}
+        """M25: ``id`` of a BK powered up by :meth:`power_up` -> bus time its branch's first start level is back on its
+        synchronised DI3 (BK-37): its branch answers from then."""
+        self._woke_joins: set[int] = set()
+        """M25: ``id`` of the BKs whose branch joins the data path within this cycle's frame after their power-up."""
         self._grid = 0.0
         """M22: bus time the master's idle status telegrams began (the end of its last cycle or reset)."""
         self._loops: tuple[list[Device], list[int]] = ([], [0])
@@ -841,14 +847,21 @@ class Ring:
         """``connected`` of ``branch``'s BK: its recognition (BK-48), before the ring ran whether it is populated."""
         return branch.terminal.branch_recognised if self._settled else bool(branch.devices)
 
-    def _recognise(self) -> list[Branch]:
+    def _recognise(self, now: float | None = None, frame: int | None = None) -> list[Branch]:
         """The ring runs (a reset, a cycle, idle telegrams): every BK whose branch device answers now recognises its
         branch (BK-48), then the tree flattens again; the branches recognised now. A branch with return lines (BK-RB,
         BK-LB) answers when its BK is reached, its interface is live (BK-42) and the loop from DO3 through the branch
         back to DI3 is whole; an LBD branch when its BK's return input is whole (its devices send counter telegrams on
-        their own, BK-30)."""
+        their own, BK-30).
+
+        A BK powered up by :meth:`power_up` answers from its answer instant (M25), by bus time ``now`` (the run's time;
+        :attr:`now` if ``None``); with ``frame`` (a cycle's frame of that many bits from ``now``) one answering before
+        the frame's head reaches its BK joins before the frame (not returned), one answering while the frame passes
+        joins within it (returned, BK-54), one answering later waits."""
         self._settled = True
         recognised: list[Branch] = []
+        now = self.now if now is None else now
+        lags = self._lags() if frame is not None and self._answers else []
         while True:
             self._sync()
             waiting = [b for b in self._branches if b.devices and not b.terminal.branch_recognised]
@@ -861,10 +874,27 @@ class Ring:
             for branch in waiting:
                 at = self._index.get(id(branch.terminal))
                 reached = at is not None and (dead is None or dead > at + 1) and branch.terminal.branch_enabled(True)
+                due = self._answers.get(id(branch.terminal))
+                head = now
+                if due is not None and frame is not None and at is not None:
+                    # the frame's head leaving the BK: DO2 leaves its transmitter's line between telegrams (BK-47)
+                    head += (lags[at] + wire.REPEATER_DELAY_BITS * wire.clocks_per_bit(self.bit_rate)) / CLOCK_HZ
+                    if due > head + frame / self.bit_rate:
+                        continue
+                elif due is not None and due > now:
+                    continue
                 if (branch.kind.diagnostics or reached) and self._loop_whole(branch, forward, back):
                     branch.terminal.recognise_branch()
-                    recognised.append(branch)
+                    self._answers.pop(id(branch.terminal), None)
                     found = True
+                    if due is not None and frame is not None and due <= head:
+                        continue  # M25: joined before the frame, between telegrams (BK-47)
+                    if due is not None:
+                        self._woke_joins.add(id(branch.terminal))
+                    recognised.append(branch)
+                elif due is not None and due <= now:
+                    # M25: nothing came back at the answer instant (a broken loop): it answers as any branch after
+                    self._answers.pop(id(branch.terminal))
             if not found:
                 return recognised
 
@@ -1029,6 +1059,8 @@ class Ring:
             return None
         forward = {id(a.target) for a in self._repaired if isinstance(a.fault, DeadLine)}
         first = next((k for k, index in enumerate(span.own) if id(self.devices[index]) in forward), None)
+        if id(span.branch.terminal) in self._woke_joins:
+            first = 0  # M25: the BK's DO3 resumed after its power-up, as the first device's forward input repaired
         return join_error(span.branch.kind, first)
 
     def _faults_on(self, segments: int) -> tuple[dict[int, list[Fault]], list[tuple[int, bool]]]:
@@ -1189,9 +1221,10 @@ class Ring:
         if type(cycle) is not Cycle:
             check_instance("cycle", cycle, Cycle)
         # A branch answering in this run joins the data path within its frame (BK-54): what leaves its BK is cut.
-        joined = self._recognise() if self._branches else []
+        joined = self._recognise(frame=wire.frame_bits(len(data))) if self._branches else []
         spliced = self._join_error(joined) if joined else None  # BK-56: the error of a branch joining the frame
         self._repaired = []
+        self._woke_joins = set()
         n_all = len(self.devices)
         if n_all > wire.MAX_DEVICES:
             raise InterbusError("docs/interbus.md, Ring", n_all, f"a ring has at most {wire.MAX_DEVICES} devices")
@@ -1228,10 +1261,17 @@ class Ring:
         runs: list[_Run] = []
         devices = self.devices[: n if dead is None else min(n, dead - 1)]
         reached = len(devices)
-        woken: tuple[dict[int, int], int] | None = None
+        woken: tuple[dict[int, int], int, list[int]] | None = None
         unheard = False
         if self._wakes or self._late:  # M22: a chip not on the telegram grid yet passes the frame on (M19)
             late, woken = self._waking()
+            if spliced is ErrorKind.TRANSMISSION and woken is not None:
+                # M25: a joining BK whose output resumed after the frame's head passed it sent no head: nothing
+                # that opens a frame comes back, on its line before the join or on DI3 after it
+                wakes, start, lags = woken
+                at = next(span.at for span in self._spans if span.branch in joined)
+                out = wake_window(self.bit_rate, len(self.devices), wakes, lags).resumed[at]
+                spliced = ErrorKind.DEAD_LINE if out is not None and out > start + lags[at + 1] else spliced
             if late and faults:  # not modelled on a faulty ring: the master's receiver fails the cycle instead
                 unheard = True
             elif late:
@@ -1286,14 +1326,20 @@ class Ring:
             self.trace.append(SegmentTrace(segments if dead is None else dead, silent.frame(cycle), None, None))
         if spliced is ErrorKind.TELEGRAM:
             returned, receiver_error = stream, spliced
+        opened = True
+        if spliced is ErrorKind.TRANSMISSION:  # the frame comes back whole but for the join (BK-56)
+            returned = stream
         if woken is not None and returned is not None:  # M22: the master's receiver, bit by bit in the window
-            error, opened = wake_return(self.bit_rate, len(self.devices), *woken, Frame.build(cycle, returned))
+            wakes, start, lags = woken
+            error, opened = wake_return(self.bit_rate, len(self.devices), wakes, start, Frame.build(cycle, returned),
+                                        lags)
             unheard = unheard or error
             returned = returned if opened else None
         if unheard:  # not on the telegram grid yet: no fault of the return line N + 1
             receiver_error = receiver_error or ErrorKind.TELEGRAM
-        elif spliced is ErrorKind.TRANSMISSION:
-            returned, flags_back = stream, wire.CntrFlags(attention, True)
+        elif spliced is ErrorKind.TRANSMISSION and opened:
+            # M25: a frame whose head a woken chip's stretch cut comes back as no frame, whatever joins after it
+            flags_back = wire.CntrFlags(attention, True)
         reports = self._reports(reached, None if close_after is None else n, dead_lines, returns) \
             if self._spans else []
         self._pending = Transfer(cycle, bytes(data), n, returned, flags_back, receiver_error, runs, reached, reports,
@@ -1393,62 +1439,112 @@ class Ring:
         recognised in the reset's hold, before its devices reset (BK-37, BK-48). The reset's end allows for the ring
         delay of every device of the tree, which may all be in the data path after it (BK-9, A12; BK-53)."""
         self._pending = None
-        self._recognise()
+        every = _devices(self._tree) if self._branches else self.devices
+        end = self.now + wire.reset_bits(min(len(every), wire.MAX_DEVICES), return_repeaters(every)) / self.bit_rate
+        self._recognise(end)  # in the hold (BK-37); a BK powered up answers by the reset's end (M25)
         self._repaired = []
         dead = self._first_dead()
         reached = len(self.devices) if dead is None else min(len(self.devices), dead - 1)
-        every = _devices(self._tree) if self._branches else self.devices
-        end = self.now + wire.reset_bits(min(len(every), wire.MAX_DEVICES), return_repeaters(every)) / self.bit_rate
         for device in self.devices[:reached]:
             device.reset(end)
         self._go_silent(range(reached, len(self.devices)), self.now, end)
         if self._branches:
             self._silence_detached(self.now, end)
         if self._wakes:  # M22: a chip off the telegram grid at the hold may leave the reset late
-            wakes = {index: round((at - self._grid) * CLOCK_HZ) for index, at in self._wakes.items()}
-            ready = reset_ready(self.bit_rate, len(self.devices), wakes, round((self.now - self._grid) * CLOCK_HZ))
-            self._late = {index: self._grid + at / CLOCK_HZ for index, at in enumerate(ready) if at}
+            wakes = self._wake_clocks()
+            ready = reset_ready(self.bit_rate, len(self.devices), wakes, round((self.now - self._grid) * CLOCK_HZ),
+                                self._lags())
+            self._late = {id(self.devices[index]): self._grid + at / CLOCK_HZ for index, at in enumerate(ready) if at}
         self.now = self._grid = end
         self._wakes = {}  # the master's receiver leaves the hold on the grid (a line reset, M11)
         self._sync()
 
     def power_up(self, position: int) -> None:
         """Power up the chip at ring ``position`` now (its power-up reset, 1.7.2): a master's cycle fails, as at pin
-        level, until the chip and those behind it, then the master's receiver, are on the telegram grid (M22).
+        level, until the chip and those behind it, then the master's receiver, are on the telegram grid (M22). In a
+        tree ``position`` is the physical one (1..N over every device of the tree, a BK then its branch's devices, as
+        :meth:`cut` numbers them, BK-52) and the window follows the data path's repeaters (M25); a BK's branch answers
+        again once the first start level the BK sends after its wake-up is back on its DI3 (BK-37, M25), and joins the
+        data path then: before a frame, within it (that cycle lost, BK-54) or after it.
 
         Raises
         ------
         ArgumentError
-            ``position`` not from 1 to N, the device there has no power-up reset (``power_up``), or the ring is a
-            tree: M22's window counts one repeater per chip of a flat ring, and a BK's recognition of its branch after
-            its power-up (BK-37) is not followed (M22's limit 2; power a tree's chip up with ``Supi3.power_up``).
+            ``position`` not a device of the ring (1 to N), or the device there has no power-up reset
+            (``power_up``); nothing changes.
         """
-        if self._branches:
-            raise fail("ring", "a flat ring", f"a tree of {len(self._branches)} branches", "M22: no tree followed")
-        position = check_int("position", position, 1, len(self.devices))
-        device = self.devices[position - 1]
+        every = _devices(self._tree) if self._branches else self.devices
+        position = check_int("position", position, 1, len(every), "a device of the ring (of a tree: physical, BK-52)")
+        device = every[position - 1]
         power_up = getattr(device, "power_up", None)
         if not callable(power_up):
             raise fail(f"device at ring position {position}", "a chip with a power-up reset (power_up)", device)
         power_up()
-        self._wakes[position - 1] = self.now + round(RESET_MIN_S * CLOCK_HZ) / CLOCK_HZ  # the stretch, M2
+        self._wakes[id(device)] = self.now + round(RESET_MIN_S * CLOCK_HZ) / CLOCK_HZ  # the stretch, M2
+        self._late.pop(id(device), None)
+        if id(device) in self._terminals:  # M25: its recognition cleared (BK-37): the branch may leave the data path
+            self._sync()
+            self._answer(next(branch for branch in self._branches if branch.terminal is device))
 
-    def _waking(self) -> tuple[set[int], tuple[dict[int, int], int] | None]:
-        """M22: the ring indices of the chips a frame starting now finds off the telegram grid, and the wake-ups and
-        the frame's start in clocks of the master's idle (:func:`~supi3.interbus.wake.wake_window`); ``None`` past the
-        window, which is then forgotten."""
-        late = {index for index, at in self._late.items() if self.now < at}
-        if len(late) < len(self._late):
-            self._late = {index: self._late[index] for index in late}
-        wakes = {index: round((at - self._grid) * CLOCK_HZ) for index, at in self._wakes.items()}
+    def _lags(self) -> list[int]:
+        """M25: the clocks from the master's line to each device's input along the data path now, then to the master's
+        receiver (:func:`~supi3.interbus.wake.path_lags`: every branch in it adds its return repeaters, BK-35, and its
+        BK's synchroniser)."""
+        branches = [(span.at, span.end, sum(_return_repeater(self.devices[i]) for i in span.own))
+                    for span in self._spans]  # fmt: skip
+        return path_lags(self.bit_rate, len(self.devices), branches)
+
+    def _loop_clocks(self, branch: Branch) -> int:
+        """M25: the clocks a start level takes from a BK's DO3 round its branch to the BK's synchronised DI3: a
+        repeater a device (A10; a nested BK with its branch in the data path, that loop too), a repeater a LBD-MR
+        device's return line (BK-35), the synchroniser (M1)."""
+        delay = wire.REPEATER_DELAY_BITS * wire.clocks_per_bit(self.bit_rate)
+        clocks = SYNC_STAGES
+        for item in branch.devices:
+            device = item.terminal if isinstance(item, Branch) else item
+            clocks += delay * (1 + _return_repeater(device))
+            if isinstance(item, Branch) and item.terminal.branch_enabled(self._answered(item)):
+                clocks += self._loop_clocks(item)
+        return clocks
+
+    def _answer(self, branch: Branch) -> None:
+        """M25: note when the branch of a BK just powered up answers: the BK's output resumes (M12, by
+        :func:`~supi3.interbus.wake.wake_window` over the data path; its DO3 with its DO2) and that start level runs
+        round the branch (:meth:`_loop_clocks`); a BK out of the data path answers at its next run, as before."""
+        index = {id(device): k for k, device in enumerate(self.devices)}.get(id(branch.terminal))
+        if index is None or not branch.devices:
+            return
+        if not branch.terminal.branch_enabled(True):  # DO3 idles (BK-42): only an LBD branch's counter telegrams
+            # answer (BK-30), every 33 bit periods at a phase not followed: from the wake-up on, the earliest
+            self._answers[id(branch.terminal)] = self._wakes[id(branch.terminal)] + SYNC_STAGES / CLOCK_HZ
+            return
+        resumed = wake_window(self.bit_rate, len(self.devices), self._wake_clocks(), self._lags()).resumed[index]
+        assert resumed is not None  # the BK was just woken
+        self._answers[id(branch.terminal)] = self._grid + (resumed + self._loop_clocks(branch)) / CLOCK_HZ
+
+    def _wake_clocks(self) -> dict[int, int]:
+        """M22: the ring index of each chip in the data path woken by :meth:`power_up` -> the clock its stretch ends,
+        counted from the master's idle status telegrams."""
+        index = {id(device): k for k, device in enumerate(self.devices)}
+        return {index[key]: round((at - self._grid) * CLOCK_HZ) for key, at in self._wakes.items() if key in index}
+
+    def _waking(self) -> tuple[set[int], tuple[dict[int, int], int, list[int]] | None]:
+        """M22: the ring indices of the chips a frame starting now finds off the telegram grid, and the wake-ups, the
+        frame's start in clocks of the master's idle (:func:`~supi3.interbus.wake.wake_window`) and the data path's
+        lags (M25); ``None`` past the window, which is then forgotten."""
+        index = {id(device): k for k, device in enumerate(self.devices)}
+        late = {index[key] for key, at in self._late.items() if key in index and self.now < at}
+        self._late = {key: at for key, at in self._late.items() if self.now < at}
+        wakes = self._wake_clocks()
         if not wakes:
             return late, None
-        window = wake_window(self.bit_rate, len(self.devices), wakes)
+        lags = self._lags()
+        window = wake_window(self.bit_rate, len(self.devices), wakes, lags)
         now = round((self.now - self._grid) * CLOCK_HZ)
         if now >= window.end:
             self._wakes = {}
             return late, None
-        return late | {index for index, ready in enumerate(window.ready) if now < ready}, (wakes, now)
+        return late | {index for index, ready in enumerate(window.ready) if now < ready}, (wakes, now, lags)
 
     def idle(self, seconds: float) -> None:
         """The master sends only idle status telegrams for ``seconds`` (no cycles)."""
@@ -1467,4 +1563,6 @@ class Ring:
                 terminal.branch_returned(traffic, count, self.now, end)
             self._silence_detached(self.now, end)
         self.now = end
+        if self._answers:
+            self._recognise()  # M25: a BK powered up whose branch answered within the idle
         self._sync()

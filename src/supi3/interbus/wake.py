@@ -5,13 +5,17 @@ and those behind it (their line resumes when the woken chip's transmitter does, 
 master's gapless idle status telegrams by M16, a chip begins a frame after a whole status telegram (M19), and the
 master's receiver finds the grid last. :func:`wake_window` gives the clocks from which a master's frame finds each
 chip on the grid and its receiver meets no telegram error, from the receiver itself
-(:func:`supi3.interbus.receiver.receive`) run over idle status telegrams.
+(:func:`supi3.interbus.receiver.receive`) run over idle status telegrams. In a tree (M25) the chips follow one another
+along the data path, each at its lag (:func:`path_lags`: a branch's return repeaters and its BK's synchroniser add to
+what follows it), and :attr:`Window.resumed` gives when a woken BK's output, DO3 with DO2, resumes: its branch
+answers a loop later.
 """
 
 from __future__ import annotations
 
 import functools
-from collections.abc import Mapping
+import itertools
+from collections.abc import Mapping, Sequence
 from typing import NamedTuple
 
 import numpy as np
@@ -21,6 +25,7 @@ from supi3.checks import check_instance, check_int, fail
 from supi3.interbus import wire
 from supi3.interbus.receiver import receive
 from supi3.interbus.wire import Cycle, Frame, Telegram
+from supi3.pinout import SYNC_STAGES
 
 _PROBE_TELEGRAMS = 64
 """Idle status telegrams the receiver is run over: far more than it needs to find the grid (M16: within two)."""
@@ -31,6 +36,17 @@ def _idle_samples(bit_rate: int) -> npt.NDArray[np.int64]:
     return wire.levels_to_samples(wire.status_levels(Cycle.DATA, False, _PROBE_TELEGRAMS), bit_rate).astype(np.int64)
 
 
+def _first_start(samples: npt.NDArray[np.int64], cpb: int) -> int | None:
+    """Where a receiver that begins listening at ``samples[0]`` takes its first start bit, from which a woken chip's
+    transmitter resumes (M12): the first start level still low at its mid-bit sample (M7: a start bit sampled at the
+    idle level is no telegram; M25: the tail of a low bit heard first, shorter than that, is none, found behind a BK's
+    synchroniser, 2 clocks off the bit grid); ``None``: none."""
+    low = samples == wire.START_LEVEL
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], low.astype(np.int8), [0]])))
+    return next((int(a) for a, b in zip(edges[::2], edges[1::2], strict=True) if b - a > cpb // 2 or b == len(low)),
+                None)
+
+
 @functools.cache
 def _resync(bit_rate: int, phase: int) -> tuple[int, int, int]:
     """A receiver (M16) that begins listening ``phase`` clocks into an idle status telegram of a gapless run: the
@@ -39,7 +55,8 @@ def _resync(bit_rate: int, phase: int) -> tuple[int, int, int]:
     cpb = wire.clocks_per_bit(bit_rate)
     telegram = wire.STATUS_TELEGRAM_BITS * cpb
     samples = _idle_samples(bit_rate)[phase:]
-    first = int(np.flatnonzero(samples == wire.START_LEVEL)[0])
+    first = _first_start(samples, cpb)
+    assert first is not None  # idle status telegrams begin with start bits
     for count in range(1, _PROBE_TELEGRAMS):
         end = count * telegram - phase
         if end <= 0:
@@ -51,25 +68,63 @@ def _resync(bit_rate: int, phase: int) -> tuple[int, int, int]:
     raise AssertionError("the receiver finds the telegram grid within two status telegrams (M16)")
 
 
-def _check(bit_rate: int, devices: int, wakes: Mapping[int, int]) -> int:
+def _check(bit_rate: int, devices: int, wakes: Mapping[int, int], lags: Sequence[int] | None) -> tuple[int, list[int]]:
+    """The checked ``devices`` and the lags (:func:`path_lags`'s, a flat ring's when ``None``), else the named error."""
     wire.check_bit_rate(bit_rate)
     devices = check_int("devices", devices, 1, wire.MAX_DEVICES)
     if not isinstance(wakes, Mapping) or not all(
         type(index) is int and 0 <= index < devices and type(clock) is int for index, clock in wakes.items()
     ):
         raise fail("wakes", f"a mapping of ring indices (0 to {devices - 1}) to integer clocks", wakes, "M22")
-    return devices
+    if lags is None:
+        return devices, path_lags(bit_rate, devices)
+    if isinstance(lags, (str, bytes)) or not isinstance(lags, Sequence) or len(lags) != devices + 1 or not all(
+            type(lag) is int for lag in lags) or any(b <= a for a, b in itertools.pairwise(lags)):
+        raise fail("lags", f"{devices + 1} increasing integer clocks (each chip's input, then the master's receiver, "
+                   "path_lags)", lags, "M25")  # fmt: skip
+    return devices, list(lags)
+
+
+def path_lags(bit_rate: int, devices: int, branches: Sequence[tuple[int, int, int]] = ()) -> list[int]:
+    """The clocks from the master's line to each chip's input along a data path of ``devices`` chips, then to the
+    master's receiver (M22, M25): ``REPEATER_DELAY_BITS`` a chip before it (A10), and after a branch (``branches``:
+    the ring index of its BK, the index after its last device, its LBD-MR devices) that branch's return line, a repeater
+    for each LBD-MR device (BK-35) and the BK's synchroniser on DI3 (``SYNC_STAGES``, M1; DO2 repeats it, BK-37).
+
+    Raises
+    ------
+    ArgumentError
+        ``bit_rate`` not one of Table 1-7, ``devices`` not from 1 to ``wire.MAX_DEVICES``, or ``branches`` not
+        triples of a BK's index, the end of its branch (after the BK, at most ``devices``) and a count.
+    """
+    wire.check_bit_rate(bit_rate)
+    devices = check_int("devices", devices, 1, wire.MAX_DEVICES)
+    delay = wire.REPEATER_DELAY_BITS * wire.clocks_per_bit(bit_rate)
+    extra = [0] * (devices + 2)
+    for branch in branches:
+        if not (isinstance(branch, tuple) and len(branch) == 3 and all(type(v) is int for v in branch)
+                and 0 <= branch[0] < branch[1] <= devices and 0 <= branch[2] < branch[1] - branch[0]):
+            raise fail("branches", f"(BK index, end, LBD-MR devices) triples within {devices} chips", branch, "M25")
+        extra[branch[1]] += branch[2] * delay + SYNC_STAGES
+    lags, added = [], 0
+    for index in range(devices + 1):
+        added += extra[index]
+        lags.append(index * delay + added)
+    return lags
 
 
 class Window(NamedTuple):
-    """What a master's cycle meets after chips of a flat ring woke up (M22), in clocks from the start of the master's
-    idle status telegrams."""
+    """What a master's cycle meets after chips of a ring woke up (M22; a tree's data path, M25), in clocks from the
+    start of the master's idle status telegrams."""
 
     ready: list[int]
     """Per ring index, the first clock from which a cycle's frame finds the chip on the grid (0: at once); a frame
     before passes through the chip as received, with no frame of its own (M19)."""
     heard: int
     """The first clock from which a cycle meets no telegram error of the master's receiver (0: at once)."""
+    resumed: tuple[int | None, ...] = ()
+    """Per ring index, the clock the chip's output resumes (its first start level after it began listening, on its
+    output, M12), ``None`` for a chip on the grid all along: a BK's branch answers from its own (M25)."""
 
     @property
     def end(self) -> int:
@@ -77,7 +132,7 @@ class Window(NamedTuple):
         return max(self.heard, *self.ready)
 
 
-def wake_window(bit_rate: int, devices: int, wakes: Mapping[int, int]) -> Window:
+def wake_window(bit_rate: int, devices: int, wakes: Mapping[int, int], lags: Sequence[int] | None = None) -> Window:
     """The window after chips of a flat ring of ``devices`` woke up (M22).
 
     ``wakes`` maps a ring index (0 = position 1) to the clock its reset stretch (M2) ended, counted from the start of
@@ -85,23 +140,24 @@ def wake_window(bit_rate: int, devices: int, wakes: Mapping[int, int]) -> Window
     before it, from its wake-up or, if later, from when the chip before it resumed sending (its first start level after
     its own resumption or wake-up, M12); the chip takes a frame from the end of its first whole status telegram
     (M19); the master's receiver, behind the last chip with no added delay, listens from the last chip's resumption and
-    makes its last telegram error before finding the grid (M16).
+    makes its last telegram error before finding the grid (M16). ``lags``: the clocks from the master's line to each
+    chip's input and to the master's receiver (:func:`path_lags`: a tree's data path, M25; ``None``: a flat ring's).
 
     Raises
     ------
     ArgumentError
-        ``bit_rate`` not one of Table 1-7, ``devices`` not from 1 to ``wire.MAX_DEVICES``, or ``wakes`` not a mapping
-        of ring indices (0 to ``devices`` - 1) to integer clocks.
+        ``bit_rate`` not one of Table 1-7, ``devices`` not from 1 to ``wire.MAX_DEVICES``, ``wakes`` not a mapping
+        of ring indices (0 to ``devices`` - 1) to integer clocks, or ``lags`` not ``devices`` + 1 increasing clocks.
     """
-    devices = _check(bit_rate, devices, wakes)
+    devices, lags = _check(bit_rate, devices, wakes, lags)
     cpb = wire.clocks_per_bit(bit_rate)
     telegram = wire.STATUS_TELEGRAM_BITS * cpb
-    delay = wire.REPEATER_DELAY_BITS * cpb
     resumed: int | None = None
     ready = [0] * devices
+    outputs: list[int | None] = [None] * devices
     heard = 0
     for index in range(devices + 1):  # the chips, then the master's receiver
-        lag = index * delay
+        lag = lags[index]
         listen = wakes.get(index) if index < devices else None
         if resumed is not None:
             listen = resumed if listen is None else max(listen, resumed)
@@ -109,30 +165,33 @@ def wake_window(bit_rate: int, devices: int, wakes: Mapping[int, int]) -> Window
             continue
         first, grid, error = _resync(bit_rate, (listen - lag) % telegram)
         if index < devices:
-            ready[index] = listen + grid - lag
+            # A chip not powered up keeps its frame block (M19): its line resuming at a telegram's start, it reads
+            # that telegram on the grid (M25: found behind a BK with no data register, BK-RB with RF = 10).
+            on_grid = index not in wakes and (listen - lag) % telegram == 0
+            ready[index] = listen - lag if on_grid else listen + grid - lag
+            resumed = outputs[index] = listen + first + lags[index + 1] - lag
         elif error:
             heard = listen + error
-        resumed = listen + first + delay
-    return Window(ready, heard)
+    return Window(ready, heard, tuple(outputs))
 
 
 def wake_return(bit_rate: int, devices: int, wakes: Mapping[int, int], start: int,
-                frame: Frame) -> tuple[bool, bool]:
+                frame: Frame, lags: Sequence[int] | None = None) -> tuple[bool, bool]:
     """What the master's receiver makes of a cycle in the window after chips of a flat ring woke up (M22): whether it
     meets a telegram error, and whether a telegram that opens a frame comes back (else a dead line).
 
     The master's line is followed bit by bit from the earliest wake-up: idle status telegrams, from clock ``start``
     (counted as in :func:`wake_window`) ``frame`` as it comes back and the ring delay's status telegrams (A11), the
     line of each chip silent from a wake-up until it resumes sending (its first start level after it began listening,
-    M12, then ``REPEATER_DELAY_BITS`` later); the receiver (:func:`supi3.interbus.receiver.receive`) takes the line in
-    two pieces, the idle before ``start`` and the cycle, as the pin level's master does.
+    M12, then as much later as the next chip's input, ``lags``); the receiver (:func:`supi3.interbus.receiver.receive`)
+    takes the line in two pieces, the idle before ``start`` and the cycle, as the pin level's master does.
 
     Raises
     ------
     ArgumentError
         As :func:`wake_window`; ``start`` not an integer clock, ``frame`` not a :class:`~supi3.interbus.wire.Frame`.
     """
-    devices = _check(bit_rate, devices, wakes)
+    devices, lags = _check(bit_rate, devices, wakes, lags)
     start = check_int("start", start)
     check_instance("frame", frame, Frame)
     cpb = wire.clocks_per_bit(bit_rate)
@@ -140,8 +199,9 @@ def wake_return(bit_rate: int, devices: int, wakes: Mapping[int, int], start: in
     delay = wire.REPEATER_DELAY_BITS * cpb
     origin = min(0, start, *wakes.values()) // telegram * telegram  # followed from a telegram boundary
     idle = wire.status_levels(Cycle.DATA, False, -(-(start - origin) // telegram))
-    tail = np.concatenate([wire.frame_levels(frame),
-                           wire.status_levels(frame.cycle, False, wire.ring_delay_status_telegrams(devices))])
+    loops = (lags[devices] - devices * delay) // delay  # the return repeaters (BK-55; a synchroniser is < a repeater)
+    tail = np.concatenate([wire.frame_levels(frame), wire.status_levels(
+        frame.cycle, False, wire.ring_delay_status_telegrams(devices, loops))])
     sent = np.concatenate([wire.levels_to_samples(idle, bit_rate)[: start - origin],
                            wire.levels_to_samples(tail, bit_rate)]).astype(np.int64)
     end = len(sent)
@@ -151,9 +211,9 @@ def wake_return(bit_rate: int, devices: int, wakes: Mapping[int, int], start: in
         if resumed is not None:
             listen = resumed if listen is None else max(listen, resumed)
         if listen is not None:
-            lows = np.flatnonzero(sent[max(0, listen - origin - index * delay):] == wire.START_LEVEL)
-            resumed = listen + (int(lows[0]) if lows.size else end) + delay
-    lag = devices * delay
+            first = _first_start(sent[max(0, listen - origin - lags[index]):], cpb)
+            resumed = listen + (end if first is None else first) + lags[index + 1] - lags[index]
+    lag = lags[devices]
     line = np.full(end, wire.IDLE_LEVEL, dtype=np.int64)  # the master's line: the last chip's, no further delay
     line[lag:] = sent[: end - lag]
     if resumed is not None:
@@ -170,24 +230,25 @@ the chip's receiver does not know: it reads status telegrams of 4 bit periods th
 the hold modulo 4, so that the receiver leaves it where it leaves the whole hold."""
 
 
-def reset_ready(bit_rate: int, devices: int, wakes: Mapping[int, int], start: int) -> list[int]:
+def reset_ready(bit_rate: int, devices: int, wakes: Mapping[int, int], start: int,
+                lags: Sequence[int] | None = None) -> list[int]:
     """Per ring index, the first clock from which a frame finds the chip out of an INTERBUS reset that the master
     begins at clock ``start`` (``wire.reset_levels``, A12) within the window after chips woke up (M22, counted as in
     :func:`wake_window`): a chip that reads the hold from its wake-up (or the chip before it resuming) for
     ``RESET_DETECT_BITS`` or more ends the reset at its fourth whole status telegram after the hold (M11), one that
-    does not takes a frame from its first (M19); 0 for a chip on the telegram grid when the hold begins.
+    does not takes a frame from its first (M19); 0 for a chip on the telegram grid when the hold begins. ``lags`` as
+    :func:`wake_window`'s.
 
     Raises
     ------
     ArgumentError
         As :func:`wake_window`; ``start`` not an integer clock.
     """
-    devices = _check(bit_rate, devices, wakes)
+    devices, lags = _check(bit_rate, devices, wakes, lags)
     start = check_int("start", start)
-    window = wake_window(bit_rate, devices, wakes)
+    window = wake_window(bit_rate, devices, wakes, lags)
     cpb = wire.clocks_per_bit(bit_rate)
     telegram = wire.STATUS_TELEGRAM_BITS * cpb
-    delay = wire.REPEATER_DELAY_BITS * cpb
     cut = (wire.RESET_HOLD_BITS - _SHORT_HOLD_BITS) * cpb
     origin = min(0, start, *wakes.values()) // telegram * telegram
     after = wire.status_levels(Cycle.DATA, False, wire.RESET_END_STATUS_TELEGRAMS + _PROBE_TELEGRAMS)
@@ -199,7 +260,7 @@ def reset_ready(bit_rate: int, devices: int, wakes: Mapping[int, int], start: in
     ready = [0] * devices
     resumed: int | None = None
     for index in range(devices):
-        lag = index * delay
+        lag = lags[index]
         listen = wakes.get(index)
         if resumed is not None:
             listen = resumed if listen is None else max(listen, resumed)
@@ -215,8 +276,8 @@ def reset_ready(bit_rate: int, devices: int, wakes: Mapping[int, int], start: in
             at -= cut
         else:  # inside the hold: as far from the short hold's end modulo 4 bit periods
             at = short_end - (rest if rest <= len(low) else rest % (4 * cpb) + (_SHORT_HOLD_BITS - 4) * cpb)
-        lows = np.flatnonzero(sent[at:] == wire.START_LEVEL)
-        resumed = listen + (int(lows[0]) if lows.size else 0) + delay
+        first = _first_start(sent[at:], cpb)
+        resumed = listen + (first or 0) + lags[index + 1] - lag
         line = sent[at:]
         _, begun, _ = receive(line[: max(0, short_end - at)], 0, cpb)
         need = wire.RESET_END_STATUS_TELEGRAMS if rest >= wire.RESET_DETECT_BITS * cpb else 1

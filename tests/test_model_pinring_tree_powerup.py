@@ -1,0 +1,159 @@
+"""A chip's power-up in a tree at both fidelities (M22, M25 of docs/assumptions/model.md; manual 1.7.2, 2.4; BK-37,
+BK-54, BK-56): ``Ring.power_up`` takes any device of a tree by its physical position (a remote bus device, the BK, a
+branch device) and the transaction level fails and passes the same cycles as the pin level
+(:class:`~supi3.model.pinring.PinRing` with /ResU held low), with the same error kinds: the window of the woken chip
+and of those behind it along the data path (its repeaters, a branch's return repeaters and its BK's synchroniser), and
+after a BK's power-up its branch's answer (the first start level the BK sends after its wake-up, back on its DI3) that
+joins the branch before, within (the cycle lost, BK-54) or after the master's next frame.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from supi3 import tables
+from supi3.config import DeviceConfig, decode
+from supi3.errors import ArgumentError
+from supi3.interbus import wire
+from supi3.interbus.master import Master
+from supi3.interbus.ring import Branch, BranchKind, ErrorKind, Ring
+from supi3.model.chip import Supi3
+from supi3.model.pinring import PinBranch, PinRing
+from supi3.model.pins import Supi3Pins
+from support import BK_STRAPS
+from test_model_pinring_powerup import POWER_DOWN_TELEGRAMS
+from test_model_pinring_tree import CASES, INPUTS, LBST, ROWS
+
+RATES = [500_000, 2_000_000]
+FIRST_IDLE_TELEGRAMS = 12
+"""Idle status telegrams after the ring's first clock before the master's start: past every chip's wake-up window."""
+
+
+def _config(row: str, rate: int) -> DeviceConfig:
+    found = next(r for r in tables.MODE_ROWS if r.function == row)
+    return decode(found.c, found.mfp, clk_conf=tables.clk_conf_for(rate))
+
+
+def _bk(kind: BranchKind, rate: int) -> DeviceConfig:
+    return decode(BK_STRAPS[kind.terminal], rf="11", clk_conf=tables.clk_conf_for(rate))
+
+
+def trees(kind: BranchKind, m: int, rate: int) -> tuple[Ring, PinRing]:
+    """RB device, BK (RF = 11, LBST = 1) with ``m`` branch devices of ``kind``, RB device at ``rate``, at both
+    fidelities, every chip powered up at the ring's first clock (``Ring.power_up`` at transaction level)."""
+    bk = Supi3(_bk(kind, rate))
+    bk.set_mfp_inputs(LBST)
+    chips = [Supi3(_config(ROWS[BranchKind.REMOTE], rate)), *(Supi3(_config(ROWS[kind], rate)) for _ in range(m)),
+             Supi3(_config(ROWS[BranchKind.REMOTE], rate))]  # fmt: skip
+    for chip, value in zip(chips, [0x5A, *INPUTS], strict=False):
+        chip.set_mfp_inputs(value)
+    tl = Ring([chips[0], Branch(bk, chips[1:-1], kind), chips[-1]], bit_rate=rate)
+    for position in range(1, m + 4):
+        tl.power_up(position)
+    pin = PinRing([Supi3Pins(_config(ROWS[BranchKind.REMOTE], rate)),
+                   PinBranch(Supi3Pins(_bk(kind, rate)), [Supi3Pins(_config(ROWS[kind], rate)) for _ in range(m)],
+                             kind),
+                   Supi3Pins(_config(ROWS[BranchKind.REMOTE], rate))])  # fmt: skip
+    pin.set_input(2, "mfp_in", LBST)
+    for position, value in zip([1, *range(3, m + 4)], [0x5A, *INPUTS], strict=False):
+        pin.set_input(position, "mfp_in", value)
+    return tl, pin
+
+
+def _idle(ring: Ring | PinRing, telegrams: int) -> None:
+    ring.idle(telegrams * wire.STATUS_TELEGRAM_BITS / ring.bit_rate)
+
+
+def _power_cycle(ring: Ring | PinRing, position: int) -> None:
+    """/ResU of the chip at physical ``position`` low for :data:`POWER_DOWN_TELEGRAMS` idle status telegrams, then
+    high; ``Ring.power_up`` at its end at transaction level."""
+    if isinstance(ring, PinRing):
+        ring.set_input(position, "resu_n", 0)
+        _idle(ring, POWER_DOWN_TELEGRAMS)
+        ring.set_input(position, "resu_n", 1)
+    else:
+        _idle(ring, POWER_DOWN_TELEGRAMS)
+        ring.power_up(position)
+
+
+Seen = list[tuple[bool, list[ErrorKind], bool]]
+"""Per cycle: its success, its error kinds, whether the BK recognised its branch after it."""
+
+
+def after_power_up(ring: Ring | PinRing, position: int, telegrams: int) -> Seen:
+    """The master starts and runs a data cycle; the chip at ``position`` powers up, ``telegrams`` idle status
+    telegrams, two cycles: per cycle its success and error kinds, and whether the BK recognised its branch then."""
+    _idle(ring, FIRST_IDLE_TELEGRAMS)
+    master = Master(ring, locate=False, max_devices=8)
+    assert master.start().ok and master.cycle().ok
+    _power_cycle(ring, position)
+    _idle(ring, telegrams)
+    seen: Seen = []
+    for _ in range(2):
+        result = master.cycle()
+        bk = ring.devices[1]
+        recognised = bk.branch_connected if isinstance(bk, Supi3Pins) else isinstance(bk, Supi3) and \
+            bk.branch_recognised
+        seen.append((result.ok, [d.kind for d in result.diagnostics], recognised))
+    return seen
+
+
+RESIDUAL = {(2_000_000, BranchKind.LBD_MR, 1, 2): (3, 3), (2_000_000, BranchKind.LBD_MR, 2, 2): (4, 5),
+            (2_000_000, BranchKind.LBD_MR, 3, 2): (5, 6), (2_000_000, BranchKind.LBD_MR, 2, 4): (1, 2),
+            (2_000_000, BranchKind.LBD_MR, 3, 4): (1, 1), (500_000, BranchKind.LBD_MR, 1, 2): (2, 2),
+            (500_000, BranchKind.LBD_MR, 2, 2): (3, 4), (500_000, BranchKind.LBD_MR, 3, 2): (4, 5),
+            (500_000, BranchKind.LBD_MR, 3, 4): (7, 2)}
+"""M25's limit (``python bench/wake_tree_sweep.py window --rate R``): (bit rate, tree, physical position) -> the first
+passing k at transaction level and at pin level, where the cycles before are compared by success only. The BK's
+power-up in an LBD-MR branch: with 1 device the cycles before fail with ``TRANSMISSION`` at pin level and
+``DEAD_LINE`` at transaction level (BK-56's LBD-MR rule), with 2 and 3 devices the pin level loses one more cycle; the
+second device of an LBD-MR branch of 2 or 3 powered up at 2 Mbit/s, the frame meeting its stretch: ``TRANSMISSION``
+at pin level, ``LOOPBACK`` at transaction level, with 2 devices for one cycle more; at 500 kbit/s, of 3, the
+transaction level's master hears no grid until k = 7 (``TELEGRAM``) where the pin level passes from k = 2."""
+
+
+def _window(kind: BranchKind, m: int, rate: int, positions: range) -> list[int]:
+    """Per physical position of ``positions``, the first k from which the cycle after the power-up passes at
+    transaction level; the cycle then and the one before (k - 1) alike at pin level, kinds and recognition too
+    (:data:`RESIDUAL` aside)."""
+    firsts = []
+    for position in positions:
+        tl_seen = [after_power_up(trees(kind, m, rate)[0], position, k) for k in range(14)]
+        first = next(k for k, seen in enumerate(tl_seen) if seen[0][0])
+        residual = RESIDUAL.get((rate, kind, m, position))
+        for k in range(max(0, first - 1), first + 1):
+            pin = after_power_up(trees(kind, m, rate)[1], position, k)
+            if residual is None:
+                assert pin == tl_seen[k], (position, k, tl_seen[k])
+            else:
+                assert pin[0][0] is (k >= residual[1]) and tl_seen[k][0][0] is (k >= residual[0]), (position, k, pin)
+        firsts.append(first)
+    return firsts
+
+
+@pytest.mark.parametrize(("kind", "m"), CASES)
+def test_a_bk_s_power_up_ends_its_window_alike(kind: BranchKind, m: int) -> None:
+    """M25 over the trees of ``CASES`` at 2 Mbit/s: the BK powered up in a running tree, k idle status telegrams, two
+    cycles: the first passing k is the same at both fidelities (BK-54: the cycle its branch joins within is lost at
+    both, or the branch joins before it), and that cycle and the one before fail or pass alike, with the same error
+    kinds and the same recognition (but :data:`RESIDUAL`)."""
+    assert _window(kind, m, 2_000_000, range(2, 3))[0] >= 1  # the BK's own window, then its branch's answer
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("rate", RATES)
+@pytest.mark.parametrize(("kind", "m"), CASES)
+def test_the_window_after_a_power_up_in_a_tree_ends_alike(kind: BranchKind, m: int, rate: int) -> None:
+    """M25, exhaustively over the trees of ``CASES`` at both bit rates: any one chip (a remote bus device, the BK, a
+    branch device) powered up in a running tree: as :func:`test_a_bk_s_power_up_ends_its_window_alike` (at 500 kbit/s
+    every cycle of k = 0..7 alike: ``python bench/wake_tree_sweep.py window --rate 500000``)."""
+    _window(kind, m, rate, range(1, m + 4))
+
+
+def test_a_tree_s_power_up_names_the_device() -> None:
+    """``Ring.power_up`` on a tree takes a physical position (BK-52's numbering) and names a bad one."""
+    tl, _ = trees(BranchKind.LOCAL, 2, 2_000_000)
+    with pytest.raises(ArgumentError, match=r"^position must be"):
+        tl.power_up(6)
+    with pytest.raises(ArgumentError, match=r"^position must be"):
+        tl.power_up(0)
