@@ -331,17 +331,16 @@ def test_a_cut_after_any_history_is_located_as_on_a_fresh_ring(n: int, bit_rate:
 # -- Ring.power_up on a plain ring edited in place (M22) -------------------------------------------------------------
 
 
-@pytest.mark.xfail(strict=True, reason="round 7: Ring.power_up keeps its wake-ups by ring index, so a plain ring "
-                   "edited in place (campaign's remove/insert) after a power-up refuses every cycle and start; "
-                   "waketree2 is changing Ring.power_up's bookkeeping this session (reported, not fixed here)")
-def test_a_plain_ring_edited_after_a_power_up_keeps_running() -> None:
+@pytest.mark.parametrize("removed", [0, 2])
+def test_a_plain_ring_edited_after_a_power_up_keeps_running(removed: int) -> None:
     """A plain ring's :attr:`~supi3.interbus.ring.Ring.devices` may be edited in place (the campaign removes and
     inserts devices, ``Ring._loops_before``). After ``power_up(3)`` and the removal of that chip, every cycle and every
     start of the master raised ``ArgumentError: wakes must be a mapping of ring indices (0 to 1) ...`` (an argument
-    the user never gave): the master was stuck for good. The wake-up should follow the chip (gone: forgotten)."""
+    the user never gave): the master was stuck for good. The wake-up now follows the chip (M25 keys it by the chip, not
+    by its ring index): removed, it is forgotten; moved by another chip's removal, it stays with the chip."""
     ring, master = _ring(3, 500_000)
     ring.power_up(3)
-    del ring.devices[2]
+    del ring.devices[removed]
     master.start()
     assert any(master.cycle().ok for _ in range(4))
 
