@@ -26,7 +26,7 @@ from supi3.model.blocks.terminal import BranchLines
 from supi3.model.bus_terminal import BusTerminal
 from supi3.model.chip import ChipArgumentError, Supi3
 from supi3.model.pins import Supi3Pins
-from supi3.rtl.counter import CounterLinesRtl
+from supi3.rtl.counter import CounterLinesRtl, CounterRtl
 from supi3.rtl.terminal import ReturnWatchRtl
 from supi3.terminal import BRANCH_SILENCE_CLOCKS, CONF_PIN, DI3_PIN, LBST_PIN, Terminal
 from support import BK_STRAPS, Columns, CoreScript, bad, quiet_inputs, terminal
@@ -105,6 +105,10 @@ def test_the_rtl_blocks_elaborate() -> None:
     # the watch (its bit grid per rate: no width to choose) and the counter lines that hold it
     Fragment.get(ReturnWatchRtl(), None)
     Fragment.get(CounterLinesRtl(), None)
+    # the counter block as the watch on DI3 (its ``watch`` ports): a flag that is no bool is named
+    Fragment.get(CounterRtl(watch=True), None)
+    with pytest.raises(ArgumentError, match="watch must be True or False"):
+        CounterRtl(watch=1)  # type: ignore[arg-type]
 
 
 # -- the Ring's following-device wiring (DG-5) ----------------------------------------------------------------------
