@@ -105,10 +105,12 @@ def test_the_rtl_blocks_elaborate() -> None:
     # the watch (its bit grid per rate: no width to choose) and the counter lines that hold it
     Fragment.get(ReturnWatchRtl(), None)
     Fragment.get(CounterLinesRtl(), None)
-    # the counter block as the watch on DI3 (its ``watch`` ports): a flag that is no bool is named
-    Fragment.get(CounterRtl(watch=True), None)
-    with pytest.raises(ArgumentError, match="watch must be True or False"):
-        CounterRtl(watch=1)  # type: ignore[arg-type]
+    # the counter block as the watch on DI3 (its ``watch`` ports) and with the count taken with ``seen``: a flag
+    # that is no bool is named
+    Fragment.get(CounterRtl(watch=True, strobed_count=True), None)
+    for flag in ("watch", "strobed_count", "shared_clock"):
+        with pytest.raises(ArgumentError, match=f"{flag} must be True or False"):
+            CounterRtl(**{flag: 1})  # type: ignore[arg-type]
 
 
 # -- the Ring's following-device wiring (DG-5) ----------------------------------------------------------------------

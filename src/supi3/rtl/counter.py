@@ -141,12 +141,18 @@ class CounterRtl(wiring.Component):
     a telegram ends there and the next start level restarts the grid, as the watch's (``ReturnWatch`` keeps no M16):
     the block's receiver is then the watch, ``returned`` is 1 in the cycle after a status telegram's stop bit was
     sampled at the idle level and ``busy`` while a telegram is under way (begun, its stop bit not yet sampled).
-    ``chain`` is a strap as ``fast``."""
+    ``chain`` is a strap as ``fast``.
 
-    def __init__(self, *, shared_clock: bool = False, watch: bool = False) -> None:
+    With ``strobed_count`` the ``count`` port is the model's only in the cycle of ``seen`` (as the bus terminal block
+    takes it, ``cnt_valid``, BK-39) and undefined in the others: it comes from the received byte, which holds the
+    telegram's count byte until the next counter telegram's data bits, or is 0 after a silent input's ``seen``
+    (BK-58), without a register of its own (docs/rtl.md, round 6)."""
+
+    def __init__(self, *, shared_clock: bool = False, watch: bool = False, strobed_count: bool = False) -> None:
         try:
             self.shared_clock = check_bool("shared_clock", shared_clock)
             self.watch = check_bool("watch", watch)
+            self.strobed_count = check_bool("strobed_count", strobed_count)
         except ArgumentError:
             self._MustUse__silence = True  # rejected, never elaborated: no "created but never used" warning
             raise
@@ -178,7 +184,8 @@ class CounterRtl(wiring.Component):
         quiet_full = quiet == count_state(COUNTER_SILENCE_BITS, quiet_width)
         quiet_start = count_state(0, quiet_width)
         byte = Signal(8, reset_less=True)
-        counted = Signal(wire.COUNT_BITS)
+        counted = Signal(wire.COUNT_BITS)  # the count kept (unread with ``strobed_count``: synthesis drops it)
+        quiet_seen = Signal(reset_less=True)  # the last sample was between telegrams (read with ``seen``: silent input)
         gen = Signal(range(IDLE_BIT + 1), init=IDLE_BIT)
         drop = Signal()
         seen = Signal()
@@ -204,8 +211,9 @@ class CounterRtl(wiring.Component):
         mark = byte[_MARK_SHIFT:]
         saturated = mark == wire.COUNTER_SATURATED_MARK >> _MARK_SHIFT
         valid = saturated | ((mark == wire.COUNTER_MARK >> _MARK_SHIFT) & (byte[:_MARK_SHIFT] != 0))
+        received = Mux(saturated, wire.COUNTER_MAX, byte[:_MARK_SHIFT])  # the count of the byte received
         with m.If(sample):
-            sync += pending.eq(0)
+            sync += [pending.eq(0), quiet_seen.eq(idle_rx)]  # a ``seen`` at an idle sample is a silent input's
             with m.If(idle_rx):
                 with m.If(line == wire.START_LEVEL):
                     comb += begin.eq(1)
@@ -238,7 +246,7 @@ class CounterRtl(wiring.Component):
                     with m.Else():
                         sync += [bit.eq(IDLE_BIT), drop.eq(0), returned.eq(stop & ~data)]
                         with m.If((kind == Kind.COUNT) & valid & stop):
-                            sync += counted.eq(Mux(saturated, wire.COUNTER_MAX, byte[:_MARK_SHIFT]))
+                            sync += counted.eq(received)
                             comb += seen_now.eq(1)
             with m.If(begin):
                 sync += [bit.eq(1), data.eq(1), kind.eq(Mux(frame, Kind.PASS, Kind.MAYBE)), carry.eq(1),
@@ -263,7 +271,8 @@ class CounterRtl(wiring.Component):
         queue = LineQueue(m, push=sample, value=Cat(out, drive), rate=fast, timing=_TIMING, slots=_WAITING,
                           idle=_IDLE_VALUE, name="tx", now=self.now if self.shared_clock else None)  # fmt: skip
         shown = queue.shown
-        comb += [self.out.eq(shown[0]), self.drive.eq(shown[1]), self.seen.eq(seen), self.count.eq(counted)]
+        comb += [self.out.eq(shown[0]), self.drive.eq(shown[1]), self.seen.eq(seen),
+                 self.count.eq(Mux(quiet_seen, 0, received) if self.strobed_count else counted)]  # fmt: skip
         if self.watch:
             comb += [self.returned.eq(returned), self.busy.eq(~idle_rx | pending)]
         return m
@@ -299,7 +308,8 @@ class CounterLinesRtl(wiring.Component):
 
     def elaborate(self, _platform: object) -> Module:
         m = Module()
-        forward, back = CounterRtl(shared_clock=True), CounterRtl(shared_clock=True, watch=True)
+        forward = CounterRtl(shared_clock=True, strobed_count=True)
+        back = CounterRtl(shared_clock=True, watch=True)
         m.submodules.back = ResetInserter(self.clear | ~self.run)(back)
         on = self.forward | self.branch
         m.submodules.forward = ResetInserter(self.clear | ~self.run | ~on)(forward)
