@@ -187,7 +187,7 @@ class CounterRtl(wiring.Component):
         counted = Signal(wire.COUNT_BITS)  # the count kept (unread with ``strobed_count``: synthesis drops it)
         quiet_seen = Signal(reset_less=True)  # the last sample was between telegrams (read with ``seen``: silent input)
         gen = Signal(range(IDLE_BIT + 1), init=IDLE_BIT)
-        drop = Signal()
+        drop = Signal(reset_less=True)  # read only in a telegram (``~idle_rx``), set at every telegram's begin
         seen = Signal()
         returned = Signal()
         chain = self.chain if self.watch else Const(1)
