@@ -218,8 +218,10 @@ class CounterRtl(wiring.Component):
                 with m.If(line == wire.START_LEVEL):
                     comb += begin.eq(1)
                 with m.Else():
-                    sync += quiet.eq(Mux(quiet_full, quiet, next_state(quiet)))
-                    with m.If(quiet_full | (quiet == count_state(COUNTER_SILENCE_BITS - 1, quiet_width))):
+                    # no hold at the end: an idle sample with the count full is silent and restarts it below; the
+                    # frame flag, cleared when the count fills, can be set again only by a telegram, which restarts it
+                    sync += quiet.eq(next_state(quiet))
+                    with m.If(quiet == count_state(COUNTER_SILENCE_BITS - 1, quiet_width)):
                         sync += frame.eq(0)
             with m.Else():
                 sync += bit.eq(bit + 1)
