@@ -79,8 +79,10 @@ class LineQueue:
     with the queue (only its differences are read), so that several queues share one.
 
     ``slots`` waiting bits at most: the caller proves that no more are pushed within the longest ``begins``. The
-    time stamps, values and ``sent`` need no reset (``waiting`` and ``left`` say which count). A caller's later
-    assignments to ``values`` win over the push's shift (the ERR pair of the transmitter).
+    time stamps and values need no reset (``waiting`` says which count), nor does ``left``: a reset sets ``sent`` to
+    ``idle``, so the line is idle whatever ``left`` holds until the next bit begins and loads both (``left`` steps on
+    to 0 and stays there, the LFSR's fixed point). A caller's later assignments to ``values`` win over the push's
+    shift (the ERR pair of the transmitter).
     """
 
     def __init__(self, m: Module, *, push: Value, value: Value, rate: Value, timing: tuple[tuple[int, int], ...],
@@ -96,10 +98,10 @@ class LineQueue:
         stamp = [Signal(bits, name=f"{name}{k}_stamp", reset_less=True) for k in range(slots)]
         self.values = [Signal(len(value), name=f"{name}{k}_value", reset_less=True) for k in range(slots)]
         waiting = Signal(range(slots + 1), name=f"{name}_waiting")
-        sent = Signal(len(value), name=f"{name}_sent", reset_less=True)
+        sent = Signal(len(value), name=f"{name}_sent", init=idle)
         # the clocks left count down as an LFSR (lfsr.down_state), 0 when the line is idle
         left_width = max(min(TAPS), max(length for _, length in timing).bit_length())
-        left = Signal(left_width, name=f"{name}_left")
+        left = Signal(left_width, name=f"{name}_left", reset_less=True)
 
         def by_rate(pick: Callable[[int, int], int]) -> Value:
             result = Value.cast(pick(*timing[0]))
