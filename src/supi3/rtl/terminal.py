@@ -129,7 +129,7 @@ class TerminalRtl(wiring.Component):
                     sync += conf_request.eq(1)
                 with m.If(self.ib_reset):  # reset: all but the CONF level and the request
                     sync += [switched_on.eq(1), extended.eq(0), closed.eq(0), closed_report.eq(0), count.eq(0),
-                             alarm.eq(0), timer.eq(idle), over.eq(0), heard.eq(1)]  # fmt: skip
+                             alarm.eq(0)]  # fmt: skip
                 with m.Else():
                     with m.If(self.cmd_valid):  # command
                         with m.If(self.alarm_set):
@@ -147,10 +147,11 @@ class TerminalRtl(wiring.Component):
                         sync += count.eq(0)
                     with m.If(expired & ~cmd_off):  # silence, on the state after the command (watching)
                         sync += [closed.eq(1), closed_report.eq(1)]
-                    with m.If(~counting | (ends & (heard | expired))):  # the silence (re)starts here
-                        sync += [timer.eq(idle), over.eq(0), heard.eq(~counting | restart)]
-                    with m.Else():
-                        sync += [timer.eq(next_state(timer)), over.eq(ended), heard.eq(heard | restart)]
+            with m.If(~fresh):
+                with m.If(self.ib_reset | ~counting | (ends & (heard | expired))):  # the silence (re)starts here
+                    sync += [timer.eq(idle), over.eq(0), heard.eq(self.ib_reset | ~counting | restart)]
+                with m.Else():
+                    sync += [timer.eq(next_state(timer)), over.eq(ended), heard.eq(heard | restart)]
         return m
 
 
