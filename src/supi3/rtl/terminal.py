@@ -74,7 +74,7 @@ class TerminalRtl(wiring.Component):
         sync, comb = m.d.sync, m.d.comb
 
         # State (Terminal's fields), the power-up flag and the silence timer -------------------------------------
-        conf = Signal()
+        conf = Signal(reset_less=True)  # read only after the first edge in a BK mode, which sets it (``fresh``)
         switched_on = Signal(init=1)
         extended = Signal()
         closed = Signal()
