@@ -16,6 +16,7 @@ from collections.abc import Mapping
 
 import numpy as np
 import numpy.typing as npt
+import pytest
 from amaranth.hdl import Module, Mux
 from amaranth.lib import wiring
 from hypothesis import given, settings
@@ -162,6 +163,7 @@ def _strobed_lockstep(line: Levels, fast: int) -> list[dict[str, int]]:
     return [model.step(row) for row in rows]
 
 
+@pytest.mark.slow  # about 6 s
 @settings(max_examples=3, deadline=None)
 @given(segments=st.lists(SEGMENT, min_size=6, max_size=14))
 def test_the_strobed_count_is_the_model_s_with_every_seen(segments: list[Levels]) -> None:
