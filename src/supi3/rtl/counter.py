@@ -296,7 +296,8 @@ class CounterLinesRtl(wiring.Component):
     core's enable and power-up reset (they gate both blocks; the return line's ``SYNC_STAGES`` synchroniser always
     runs, M1); out: ``do2`` (the forward block's ``out`` while its ``drive`` is 1, else ``sent``) and ``di1`` (the
     return block's ``out`` in LBD-MR, else ``source``); ``branch_line`` the synchronised DI3, out ``seen`` and
-    ``count`` of the forward block, the BK's counter telegram strobe and count in BK-LBD (``cnt_valid``, ``count``),
+    ``count`` of the forward block, the BK's counter telegram strobe and count in BK-LBD (``cnt_valid``, ``count``;
+    ``count`` holds the count only with ``seen``: ``CounterRtl(strobed_count=True)``),
     and ``returned`` the BK's return watch on DI3 outside LBD-MR (``ret_valid``, BK-38), ``branch_busy`` its
     ``busy`` (BK-47; in LBD-MR, where no BK is, both are the return line's); ``now`` the clock count both blocks'
     output queues share (:class:`LineQueue`).
