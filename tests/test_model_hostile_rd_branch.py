@@ -26,9 +26,9 @@ from supi3.model.blocks.terminal import BranchLines
 from supi3.model.bus_terminal import BusTerminal
 from supi3.model.chip import ChipArgumentError, Supi3
 from supi3.model.pins import Supi3Pins
-from supi3.rtl.counter import CounterLinesRtl
+from supi3.rtl.counter import CounterLinesRtl, CounterRtl, check_watched_modes
 from supi3.rtl.terminal import ReturnWatchRtl
-from supi3.terminal import BRANCH_SILENCE_CLOCKS, CONF_PIN, DI3_PIN, LBST_PIN, Terminal
+from supi3.terminal import BRANCH_SILENCE_CLOCKS, CONF_PIN, DI3_PIN, LBST_PIN, Terminal, TerminalMode
 from support import BK_STRAPS, Columns, CoreScript, bad, quiet_inputs, terminal
 
 NOT_BOOLS: list[object] = [0, 1, None, "yes", 1.0, np.int64(1)]
@@ -105,6 +105,16 @@ def test_the_rtl_blocks_elaborate() -> None:
     # the watch (its bit grid per rate: no width to choose) and the counter lines that hold it
     Fragment.get(ReturnWatchRtl(), None)
     Fragment.get(CounterLinesRtl(), None)
+    # the counter block as the watch on DI3 (its ``watch`` ports) and with the count taken with ``seen``: a flag
+    # that is no bool is named
+    Fragment.get(CounterRtl(watch=True, strobed_count=True), None)
+    for flag in ("watch", "strobed_count", "shared_clock"):
+        with pytest.raises(ArgumentError, match=f"{flag} must be True or False"):
+            CounterRtl(**{flag: 1})  # type: ignore[arg-type]
+    # a mode table with a row that is LBD-MR and a BK is refused at elaboration (the return block watches DI3 there)
+    with pytest.raises(ValueError, match="mode row 1 is LBD-MR and a bus terminal module"):
+        check_watched_modes([(False, False), (True, True)], [TerminalMode.NONE, TerminalMode.LBD])
+    check_watched_modes([(True, True), (False, False)], [TerminalMode.NONE, TerminalMode.LBD])
 
 
 # -- the Ring's following-device wiring (DG-5) ----------------------------------------------------------------------

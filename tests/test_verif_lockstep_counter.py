@@ -12,15 +12,19 @@ telegrams off the bit grid.
 from __future__ import annotations
 
 import itertools
+from collections.abc import Mapping
 
 import numpy as np
 import numpy.typing as npt
+import pytest
+from amaranth.hdl import Module, Mux
+from amaranth.lib import wiring
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from supi3.interbus import wire
 from supi3.interbus.wire import Cycle
-from supi3.lbd import COUNTER_SILENCE_BITS
+from supi3.lbd import COUNTER_INPUTS, COUNTER_OUTPUTS, COUNTER_SILENCE_BITS
 from supi3.model.blocks.counter import CounterBlock
 from supi3.rtl.counter import CounterRtl
 from supi3.verif.amaranth_sim import run_amaranth_sim
@@ -122,3 +126,54 @@ def test_random_line_streams(segments: list[Levels]) -> None:
     # the generator runs at the latest S + 16 bit periods into the final silence (a telegram may end 13 in), one
     # telegram every S + 1: the last S + 16 bit periods hold driven bits
     assert any(o["drive"] for o in outputs[-16 * (S + 16) :])
+
+
+# The count taken with ``seen`` (``CounterRtl(strobed_count=True)``, the core's forward block) ------------------------
+
+
+class _Strobed(wiring.Component):  # type: ignore[misc]  # Amaranth is untyped (pyproject's mypy overrides)
+    """``CounterRtl(strobed_count=True)`` with ``count`` shown only with ``seen`` (0 otherwise), as the bus terminal
+    block reads it (``cnt_valid``, BK-39)."""
+
+    def __init__(self) -> None:
+        super().__init__({**{pin.name: wiring.In(pin.width) for pin in COUNTER_INPUTS},
+                          **{pin.name: wiring.Out(pin.width) for pin in COUNTER_OUTPUTS}})  # fmt: skip
+
+    def elaborate(self, _platform: object) -> Module:
+        m = Module()
+        m.submodules.block = block = CounterRtl(strobed_count=True)
+        m.d.comb += [block.line.eq(self.line), block.fast.eq(self.fast), self.out.eq(block.out),
+                     self.drive.eq(block.drive), self.seen.eq(block.seen),
+                     self.count.eq(Mux(block.seen, block.count, 0))]  # fmt: skip
+        return m
+
+
+class _StrobedModel(CounterBlock):
+    """``CounterBlock`` with ``count`` shown only with ``seen``."""
+
+    def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
+        out = super().step(inputs)
+        return {**out, "count": out["count"] if out["seen"] else 0}
+
+
+def _strobed_lockstep(line: Levels, fast: int) -> list[dict[str, int]]:
+    rows = [{"line": int(level), "fast": fast} for level in line]
+    assert run_amaranth_sim(_Strobed, _StrobedModel, rows).cycles == len(rows)
+    model = _StrobedModel()
+    return [model.step(row) for row in rows]
+
+
+@pytest.mark.slow  # about 6 s
+@settings(max_examples=3, deadline=None)
+@given(segments=st.lists(SEGMENT, min_size=6, max_size=14))
+def test_the_strobed_count_is_the_model_s_with_every_seen(segments: list[Levels]) -> None:
+    """With ``strobed_count`` (no count register: the received byte, or 0 after a silent input) ``count`` is the
+    model's in every cycle of ``seen`` and every other output equals it every clock, over any mix of telegrams,
+    counter telegrams, silences (BK-58's 0), resets, glitches and skews at 2 Mbit/s, and a directed stream at
+    500 kbit/s (a count, the silence's 0, a count taken while the generator runs)."""
+    line = np.concatenate([*segments, samples(idle(2 * S + 30))])
+    assert any(o["seen"] for o in _strobed_lockstep(line, 1))
+    levels = np.concatenate([wire.status_levels(Cycle.DATA, False, 1), counter_words(0x85), idle(S + 3),
+                             counter_words(0x8A), idle(8)])  # fmt: skip
+    slow = _strobed_lockstep(wire.levels_to_samples(levels, RATES[0]), 0)
+    assert [o["count"] for o in slow if o["seen"]] == [5, 0, 10]

@@ -12,7 +12,7 @@ strobes (hypothesis, the seeded profile of tests/conftest.py) in every BK mode a
 from __future__ import annotations
 
 import inspect
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -26,6 +26,7 @@ from supi3.lbd import clocks_per_bit
 from supi3.model.blocks.terminal import ReturnWatch, TerminalBlock
 from supi3.model.bus_terminal import BRANCH_SILENCE_S, CONF_PIN, LBST_PIN, BusTerminal
 from supi3.pinlevel import Pin
+from supi3.rtl.counter import CounterRtl
 from supi3.rtl.terminal import ReturnWatchRtl, TerminalRtl
 from supi3.tables import BIT_RATES, CLOCK_HZ
 from supi3.terminal import BLOCK_INPUTS, BRANCH_SILENCE_CLOCKS, RF_CODES, Terminal, TerminalMode
@@ -354,9 +355,17 @@ class _Watch:
         self.watch.reset()
 
     def step(self, row: Mapping[str, int]) -> dict[str, int]:
-        out = {"seen": self.watch.seen, "busy": int(self.watch.busy)}
+        strobe, busy = (pin.name for pin in self.outputs)
+        out = {strobe: self.watch.seen, busy: int(self.watch.busy)}
         self.watch.clock(row["line"], clocks_per_bit(row["fast"]))
         return out
+
+
+class _CounterWatch(_Watch):
+    """``ReturnWatch`` behind the watch ports of ``CounterRtl(watch=True)`` (``returned``, ``busy``; its ``chain``
+    left at 0: the BK's return watch on DI3 in the core, ``CounterLinesRtl``'s return block outside LBD-MR)."""
+
+    outputs: Sequence[Pin] = (Pin("returned"), Pin("busy"))
 
 
 _PIECE = st.one_of(
@@ -370,19 +379,50 @@ _PIECE = st.one_of(
 """Pieces of a return line: status telegrams (with how many), data telegrams (counter telegrams among them), and
 levels held for some clocks."""
 
+_WATCHES: dict[str, tuple[Callable[[], Any], type[_Watch]]] = {
+    "ReturnWatchRtl": (ReturnWatchRtl, _Watch),
+    "CounterRtl(watch=True)": (lambda: CounterRtl(watch=True), _CounterWatch),
+}
+"""The RTL watches: the one on the transmitter's line and the counter block that is the one on DI3."""
 
+
+@pytest.mark.parametrize("design", list(_WATCHES))
 @settings(max_examples=4, deadline=None)
 @given(fast=st.integers(0, 1), pieces=st.lists(_PIECE, min_size=4, max_size=8))
-def test_the_return_watch_follows_its_model_every_clock(fast: int, pieces: list[tuple[str, int, Any]]) -> None:
-    """``ReturnWatchRtl`` (its bit grid's constants per rate, its counters without reset) equals ``ReturnWatch`` on
-    ``seen`` and ``busy`` every clock at both bit rates: status and data telegrams (counter telegrams among them),
-    glitches, skews off the bit grid, a line held at either level; with whole telegrams only, every status
-    telegram is seen and no data telegram."""
+def test_the_return_watch_follows_its_model_every_clock(design: str, fast: int,
+                                                        pieces: list[tuple[str, int, Any]]) -> None:  # fmt: skip
+    """``ReturnWatchRtl`` (its bit grid's constants per rate, its counters without reset) and the watch ports of
+    ``CounterRtl(watch=True)`` with ``chain`` 0 equal ``ReturnWatch`` on the strobe and ``busy`` every clock at both
+    bit rates: status and data telegrams (counter telegrams among them), glitches, stop bits at the start level, skews
+    off the bit grid, a line held at either level; with whole telegrams only, every status telegram is seen and no
+    data telegram."""
+    factory, model_class = _WATCHES[design]
     rate = BIT_RATES[fast]
     line = np.concatenate([*(wire.levels_to_samples(levels, rate) if kind != "clocks" else levels
                              for kind, _, levels in pieces), np.ones(2 * clocks_per_bit(fast), dtype=np.uint8)])
     rows = [{"line": int(level), "fast": fast} for level in line]
-    assert run_amaranth_sim(ReturnWatchRtl, _Watch, rows).cycles == len(rows)
+    assert run_amaranth_sim(factory, model_class, rows).cycles == len(rows)
     if all(kind != "clocks" for kind, _, _ in pieces):
         model = _Watch()
         assert sum(model.step(row)["seen"] for row in rows) == sum(n for _, n, _ in pieces)
+
+
+@pytest.mark.parametrize("design", list(_WATCHES))
+@pytest.mark.parametrize("fast", [0, 1])
+def test_a_stop_bit_at_the_start_level_ends_the_watched_telegram(design: str, fast: int) -> None:
+    """A status telegram whose stop bit is sampled at the start level is not seen and ends there (the watch keeps no
+    M16, BK-38): ``busy`` falls for a clock and the next clock's start level restarts the grid, so the status
+    telegram chained to it (its start bit the first one's stop bit) is not found on its grid; both RTL watches
+    follow the model every clock, the counter block's with ``chain`` 0."""
+    factory, model_class = _WATCHES[design]
+    rate = BIT_RATES[fast]
+    status = wire.status_levels(Cycle.DATA, False, 1)
+    chained = np.concatenate([status[:-1], status])  # the first stop bit replaced by the second's start bit
+    line = np.concatenate([np.ones(3, dtype=np.uint8), wire.levels_to_samples(chained, rate),
+                           np.ones(2 * clocks_per_bit(fast), dtype=np.uint8)])  # fmt: skip
+    rows = [{"line": int(level), "fast": fast} for level in line]
+    assert run_amaranth_sim(factory, model_class, rows).cycles == len(rows)
+    model = _Watch()
+    busy = [model.step(row)["busy"] for row in rows]
+    stop = 3 + (wire.STATUS_TELEGRAM_BITS - 1) * clocks_per_bit(fast) + clocks_per_bit(fast) // 2
+    assert busy[stop] == 1 and busy[stop + 1] == 0 and busy[stop + 2] == 1

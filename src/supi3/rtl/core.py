@@ -70,7 +70,7 @@ from supi3.pinout import (
 from supi3.regmap import INTERRUPT_SOURCES
 from supi3.regmap.core import BYTE_BITS
 from supi3.regmap.registers import IN_BYTES
-from supi3.rtl.counter import CounterLinesRtl, LineQueue, stamp_bits
+from supi3.rtl.counter import CounterLinesRtl, LineQueue, check_watched_modes, stamp_bits
 from supi3.rtl.expansion import PIN_NAMES as EXPANSION_PINS
 from supi3.rtl.expansion import ExpansionRtl
 from supi3.rtl.lfsr import TAPS, before, count_state, count_width, down_state, down_step, next_state
@@ -402,6 +402,7 @@ class Supi3Core(wiring.Component):
         m.submodules.expansion = gated(expansion)
         # LBD modes (Table 2-5): the counter telegram blocks on DO2 and DI1 (docs/rtl.md, "Counter telegram block")
         m.submodules.counter_lines = lines = CounterLinesRtl()
+        check_watched_modes(tables.lines, [terminal for _, terminal in tables.diagnostics])  # the DI3 watch
         m.d.comb += [
             lines.line.eq(receiver.do1_s), lines.fast.eq(cpb == clocks_per_bit(1)), lines.sent.eq(transmitter.do2),
             lines.source.eq(outputs.di1), lines.forward.eq(lbd), lines.looped.eq(lbd_mr), lines.run.eq(running),

@@ -14,7 +14,7 @@ into ``Supi3Core`` (docs/rtl.md, "Counter telegram block").
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from itertools import pairwise
 from typing import Final
 
@@ -23,6 +23,7 @@ from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
 from supi3.checks import check_bool
+from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.lbd import (
     COUNTER_INPUTS,
@@ -38,9 +39,9 @@ from supi3.lbd import (
 )
 from supi3.pinout import SYNC_STAGES
 from supi3.rtl.lfsr import TAPS, count_state, count_width, down_state, down_step, next_state
-from supi3.rtl.terminal import ReturnWatchRtl
+from supi3.terminal import TerminalMode
 
-__all__ = ["CLOCK_BITS", "CounterLinesRtl", "CounterRtl", "LineQueue", "stamp_bits"]
+__all__ = ["CLOCK_BITS", "CounterLinesRtl", "CounterRtl", "LineQueue", "check_watched_modes", "stamp_bits"]
 
 _CPB: Final = (clocks_per_bit(0), clocks_per_bit(1))
 _IDLE_VALUE: Final = wire.IDLE_LEVEL
@@ -78,8 +79,10 @@ class LineQueue:
     with the queue (only its differences are read), so that several queues share one.
 
     ``slots`` waiting bits at most: the caller proves that no more are pushed within the longest ``begins``. The
-    time stamps, values and ``sent`` need no reset (``waiting`` and ``left`` say which count). A caller's later
-    assignments to ``values`` win over the push's shift (the ERR pair of the transmitter).
+    time stamps and values need no reset (``waiting`` says which count), nor does ``left``: a reset sets ``sent`` to
+    ``idle``, so the line is idle whatever ``left`` holds until the next bit begins and loads both (``left`` steps on
+    to 0 and stays there, the LFSR's fixed point). A caller's later assignments to ``values`` win over the push's
+    shift (the ERR pair of the transmitter).
     """
 
     def __init__(self, m: Module, *, push: Value, value: Value, rate: Value, timing: tuple[tuple[int, int], ...],
@@ -95,10 +98,10 @@ class LineQueue:
         stamp = [Signal(bits, name=f"{name}{k}_stamp", reset_less=True) for k in range(slots)]
         self.values = [Signal(len(value), name=f"{name}{k}_value", reset_less=True) for k in range(slots)]
         waiting = Signal(range(slots + 1), name=f"{name}_waiting")
-        sent = Signal(len(value), name=f"{name}_sent", reset_less=True)
+        sent = Signal(len(value), name=f"{name}_sent", init=idle)
         # the clocks left count down as an LFSR (lfsr.down_state), 0 when the line is idle
         left_width = max(min(TAPS), max(length for _, length in timing).bit_length())
-        left = Signal(left_width, name=f"{name}_left")
+        left = Signal(left_width, name=f"{name}_left", reset_less=True)
 
         def by_rate(pick: Callable[[int, int], int]) -> Value:
             result = Value.cast(pick(*timing[0]))
@@ -132,14 +135,34 @@ class CounterRtl(wiring.Component):
     """The counter telegram block (ports: :data:`~supi3.lbd.COUNTER_INPUTS` in,
     :data:`~supi3.lbd.COUNTER_OUTPUTS` out; the pin model ``CounterBlock`` defines their timing).
     ``fast`` is a strap: change it only while the line is idle. With ``shared_clock`` the output queue takes its
-    clock count from an extra port ``now`` (:data:`CLOCK_BITS` wide, see :class:`LineQueue`) instead of its own."""
+    clock count from an extra port ``now`` (:data:`CLOCK_BITS` wide, see :class:`LineQueue`) instead of its own.
 
-    def __init__(self, *, shared_clock: bool = False) -> None:
-        self.shared_clock = check_bool("shared_clock", shared_clock)
+    With ``watch`` the block can also be a return watch on its line (BK-38, the pin model's ``ReturnWatch``), three
+    extra ports: in ``chain``, out ``returned`` and ``busy``. While ``chain`` is 1 the block is the counter block
+    above (a stop bit sampled at the start level starts the next telegram on the same grid, M16); while it is 0 such
+    a telegram ends there and the next start level restarts the grid, as the watch's (``ReturnWatch`` keeps no M16):
+    the block's receiver is then the watch, ``returned`` is 1 in the cycle after a status telegram's stop bit was
+    sampled at the idle level and ``busy`` while a telegram is under way (begun, its stop bit not yet sampled).
+    ``chain`` is a strap as ``fast``.
+
+    With ``strobed_count`` the ``count`` port is the model's only in the cycle of ``seen`` (as the bus terminal block
+    takes it, ``cnt_valid``, BK-39) and undefined in the others: it comes from the received byte, which holds the
+    telegram's count byte until the next counter telegram's data bits, or is 0 after a silent input's ``seen``
+    (BK-58), without a register of its own (docs/rtl.md, round 6)."""
+
+    def __init__(self, *, shared_clock: bool = False, watch: bool = False, strobed_count: bool = False) -> None:
+        try:
+            self.shared_clock = check_bool("shared_clock", shared_clock)
+            self.watch = check_bool("watch", watch)
+            self.strobed_count = check_bool("strobed_count", strobed_count)
+        except ArgumentError:
+            self._MustUse__silence = True  # rejected, never elaborated: no "created but never used" warning
+            raise
         super().__init__({
             **{pin.name: In(pin.width) for pin in COUNTER_INPUTS},
             **{pin.name: Out(pin.width) for pin in COUNTER_OUTPUTS},
             **({"now": In(CLOCK_BITS)} if shared_clock else {}),
+            **({"chain": In(1), "returned": Out(1), "busy": Out(1)} if watch else {}),
         })  # fmt: skip
 
     def elaborate(self, _platform: object) -> Module:
@@ -163,10 +186,13 @@ class CounterRtl(wiring.Component):
         quiet_full = quiet == count_state(COUNTER_SILENCE_BITS, quiet_width)
         quiet_start = count_state(0, quiet_width)
         byte = Signal(8, reset_less=True)
-        counted = Signal(wire.COUNT_BITS)
+        counted = Signal(wire.COUNT_BITS)  # the count kept (unread with ``strobed_count``: synthesis drops it)
+        quiet_seen = Signal(reset_less=True)  # the last sample was between telegrams (read with ``seen``: silent input)
         gen = Signal(range(IDLE_BIT + 1), init=IDLE_BIT)
-        drop = Signal()
+        drop = Signal(reset_less=True)  # read only in a telegram (``~idle_rx``), set at every telegram's begin
         seen = Signal()
+        returned = Signal()
+        chain = self.chain if self.watch else Const(1)
 
         # The bit grid and the sample -----------------------------------------------------------------------------
         idle_rx = bit == IDLE_BIT
@@ -176,7 +202,7 @@ class CounterRtl(wiring.Component):
         sync += phase.eq(Mux(_at_rate(fast, lambda c: ph >= c - 1), 0, ph + 1))
         with m.If(restart):
             sync += pending.eq(1)
-        sync += seen.eq(0)
+        sync += [seen.eq(0), returned.eq(0)]
 
         # The receiver (counter_step's _receive) ------------------------------------------------------------------
         rx_out, rx_drive, begin, seen_now = Signal(), Signal(), Signal(), Signal()
@@ -187,14 +213,17 @@ class CounterRtl(wiring.Component):
         mark = byte[_MARK_SHIFT:]
         saturated = mark == wire.COUNTER_SATURATED_MARK >> _MARK_SHIFT
         valid = saturated | ((mark == wire.COUNTER_MARK >> _MARK_SHIFT) & (byte[:_MARK_SHIFT] != 0))
+        received = Mux(saturated, wire.COUNTER_MAX, byte[:_MARK_SHIFT])  # the count of the byte received
         with m.If(sample):
-            sync += pending.eq(0)
+            sync += [pending.eq(0), quiet_seen.eq(idle_rx)]  # a ``seen`` at an idle sample is a silent input's
             with m.If(idle_rx):
                 with m.If(line == wire.START_LEVEL):
                     comb += begin.eq(1)
                 with m.Else():
-                    sync += quiet.eq(Mux(quiet_full, quiet, next_state(quiet)))
-                    with m.If(quiet_full | (quiet == count_state(COUNTER_SILENCE_BITS - 1, quiet_width))):
+                    # no hold at the end: an idle sample with the count full is silent and restarts it below; the
+                    # frame flag, cleared when the count fills, can be set again only by a telegram, which restarts it
+                    sync += quiet.eq(next_state(quiet))
+                    with m.If(quiet == count_state(COUNTER_SILENCE_BITS - 1, quiet_width)):
                         sync += frame.eq(0)
             with m.Else():
                 sync += bit.eq(bit + 1)
@@ -215,12 +244,13 @@ class CounterRtl(wiring.Component):
                     with m.If(bit < wire.POS_DATA + 8):
                         sync += byte.eq(Cat(byte[1:], line))
                 with m.If(last):
-                    with m.If(line != wire.STOP_LEVEL):
+                    stop = line == wire.STOP_LEVEL
+                    with m.If(~stop & chain):
                         comb += begin.eq(1)  # M16
                     with m.Else():
-                        sync += [bit.eq(IDLE_BIT), drop.eq(0)]
-                        with m.If((kind == Kind.COUNT) & valid):
-                            sync += counted.eq(Mux(saturated, wire.COUNTER_MAX, byte[:_MARK_SHIFT]))
+                        sync += [bit.eq(IDLE_BIT), drop.eq(0), returned.eq(stop & ~data)]
+                        with m.If((kind == Kind.COUNT) & valid & stop):
+                            sync += counted.eq(received)
                             comb += seen_now.eq(1)
             with m.If(begin):
                 sync += [bit.eq(1), data.eq(1), kind.eq(Mux(frame, Kind.PASS, Kind.MAYBE)), carry.eq(1),
@@ -245,25 +275,32 @@ class CounterRtl(wiring.Component):
         queue = LineQueue(m, push=sample, value=Cat(out, drive), rate=fast, timing=_TIMING, slots=_WAITING,
                           idle=_IDLE_VALUE, name="tx", now=self.now if self.shared_clock else None)  # fmt: skip
         shown = queue.shown
-        comb += [self.out.eq(shown[0]), self.drive.eq(shown[1]), self.seen.eq(seen), self.count.eq(counted)]
+        comb += [self.out.eq(shown[0]), self.drive.eq(shown[1]), self.seen.eq(seen),
+                 self.count.eq(Mux(quiet_seen, 0, received) if self.strobed_count else counted)]  # fmt: skip
+        if self.watch:
+            comb += [self.returned.eq(returned), self.busy.eq(~idle_rx | pending)]
         return m
 
 
 class CounterLinesRtl(wiring.Component):
     """The counter blocks in the chip core (docs/rtl.md "Counter telegram block"; the pin model's
     ``LineCounters`` in ``src/supi3/model/blocks/counter.py``): one :class:`CounterRtl` on the forward line in the
-    LBD modes (``forward``), one on the return line in LBD-MR (``looped``), each held in reset otherwise; in BK-LBD
-    (``branch``) the forward block takes the branch return line instead (BK-39, the pin model's
-    ``BranchLines.counter``: a BK has no counter block on its forward line, so the two share one block).
+    LBD modes (``forward``), one on the return line in LBD-MR (``looped``); in BK-LBD (``branch``) the forward block
+    takes the branch return line instead (BK-39, the pin model's ``BranchLines.counter``: a BK has no counter block on
+    its forward line, so the two share one block), and it is held in reset in the other modes. Outside LBD-MR the
+    return block is the BK's return watch on the branch return line (BK-38, the pin model's ``ReturnWatch``:
+    ``CounterRtl(watch=True)`` with ``chain`` 0; no mode is LBD-MR and a BK, :func:`check_watched_modes`).
 
     Ports: ``line`` the synchronised DO1 (the receiver's), ``fast`` the bit rate (1: 2 Mbit/s), ``sent`` the
     transmitter's DO2, ``source`` the return line's source (M5: DI2 or the chip's DO2), ``run`` and ``clear`` the
     core's enable and power-up reset (they gate both blocks; the return line's ``SYNC_STAGES`` synchroniser always
     runs, M1); out: ``do2`` (the forward block's ``out`` while its ``drive`` is 1, else ``sent``) and ``di1`` (the
     return block's ``out`` in LBD-MR, else ``source``); ``branch_line`` the synchronised DI3, out ``seen`` and
-    ``count`` of its block, the BK's counter telegram strobe and count (``cnt_valid``, ``count``), and ``returned``
-    the BK's return watch on it in every mode (``ret_valid``, BK-38: ``supi3.rtl.terminal.ReturnWatchRtl``), and
-    ``branch_busy`` its ``busy`` (BK-47); ``now`` the clock count both blocks' output queues share (:class:`LineQueue`).
+    ``count`` of the forward block, the BK's counter telegram strobe and count in BK-LBD (``cnt_valid``, ``count``;
+    ``count`` holds the count only with ``seen``: ``CounterRtl(strobed_count=True)``),
+    and ``returned`` the BK's return watch on DI3 outside LBD-MR (``ret_valid``, BK-38), ``branch_busy`` its
+    ``busy`` (BK-47; in LBD-MR, where no BK is, both are the return line's); ``now`` the clock count both blocks'
+    output queues share (:class:`LineQueue`).
     """
 
     def __init__(self) -> None:
@@ -276,22 +313,30 @@ class CounterLinesRtl(wiring.Component):
 
     def elaborate(self, _platform: object) -> Module:
         m = Module()
-        forward, back = CounterRtl(shared_clock=True), CounterRtl(shared_clock=True)
-        m.submodules.back = ResetInserter(self.clear | ~self.run | ~self.looped)(back)
+        forward = CounterRtl(shared_clock=True, strobed_count=True)
+        back = CounterRtl(shared_clock=True, watch=True)
+        m.submodules.back = ResetInserter(self.clear | ~self.run)(back)
         on = self.forward | self.branch
-        watch = ReturnWatchRtl()
-        m.submodules.watch = ResetInserter(self.clear | ~self.run)(watch)
-        m.d.comb += [watch.line.eq(self.branch_line), watch.fast.eq(self.fast),
-                     self.returned.eq(watch.seen), self.branch_busy.eq(watch.busy)]  # fmt: skip
         m.submodules.forward = ResetInserter(self.clear | ~self.run | ~on)(forward)
         stages = [Signal(init=wire.IDLE_LEVEL, name=f"source_s{k}") for k in range(SYNC_STAGES)]
         m.d.sync += [stages[0].eq(self.source), *(b.eq(a) for a, b in pairwise(stages))]
         m.d.comb += [
             forward.line.eq(Mux(self.branch, self.branch_line, self.line)), forward.fast.eq(self.fast),
-            back.line.eq(stages[-1]), back.fast.eq(self.fast), forward.now.eq(self.now), back.now.eq(self.now),
+            back.line.eq(Mux(self.looped, stages[-1], self.branch_line)), back.fast.eq(self.fast),
+            back.chain.eq(self.looped), forward.now.eq(self.now), back.now.eq(self.now),
             self.do2.eq(Mux(forward.drive & self.forward, forward.out, self.sent)),
             self.di1.eq(Mux(self.looped, back.out, self.source)),
             self.seen.eq(forward.seen), self.count.eq(forward.count),
+            self.returned.eq(back.returned), self.branch_busy.eq(back.busy),
         ]  # fmt: skip
         return m
 
+
+def check_watched_modes(lines: Sequence[tuple[bool, bool]], terminals: Sequence[TerminalMode]) -> None:
+    """Outside LBD-MR the return block of :class:`CounterLinesRtl` is the BK's return watch (BK-38), so no mode may be
+    LBD-MR and a BK (``lines`` and ``terminals`` per mode row: ``CoreTables.lines`` and the bus terminal interface of
+    ``CoreTables.diagnostics``); else :class:`ValueError` naming the row."""
+    for k, ((_, looped), terminal) in enumerate(zip(lines, terminals, strict=True)):
+        if looped and terminal != TerminalMode.NONE:
+            raise ValueError(f"mode row {k} is LBD-MR and a bus terminal module ({terminal.name}): the return counter "
+                             "block cannot watch its branch return line (BK-38)")  # fmt: skip

@@ -74,7 +74,7 @@ class TerminalRtl(wiring.Component):
         sync, comb = m.d.sync, m.d.comb
 
         # State (Terminal's fields), the power-up flag and the silence timer -------------------------------------
-        conf = Signal()
+        conf = Signal(reset_less=True)  # read only after the first edge in a BK mode, which sets it (``fresh``)
         switched_on = Signal(init=1)
         extended = Signal()
         closed = Signal()
@@ -129,7 +129,7 @@ class TerminalRtl(wiring.Component):
                     sync += conf_request.eq(1)
                 with m.If(self.ib_reset):  # reset: all but the CONF level and the request
                     sync += [switched_on.eq(1), extended.eq(0), closed.eq(0), closed_report.eq(0), count.eq(0),
-                             alarm.eq(0), timer.eq(idle), over.eq(0), heard.eq(1)]  # fmt: skip
+                             alarm.eq(0)]  # fmt: skip
                 with m.Else():
                     with m.If(self.cmd_valid):  # command
                         with m.If(self.alarm_set):
@@ -147,10 +147,11 @@ class TerminalRtl(wiring.Component):
                         sync += count.eq(0)
                     with m.If(expired & ~cmd_off):  # silence, on the state after the command (watching)
                         sync += [closed.eq(1), closed_report.eq(1)]
-                    with m.If(~counting | (ends & (heard | expired))):  # the silence (re)starts here
-                        sync += [timer.eq(idle), over.eq(0), heard.eq(~counting | restart)]
-                    with m.Else():
-                        sync += [timer.eq(next_state(timer)), over.eq(ended), heard.eq(heard | restart)]
+            with m.If(~fresh):
+                with m.If(self.ib_reset | ~counting | (ends & (heard | expired))):  # the silence (re)starts here
+                    sync += [timer.eq(idle), over.eq(0), heard.eq(self.ib_reset | ~counting | restart)]
+                with m.Else():
+                    sync += [timer.eq(next_state(timer)), over.eq(ended), heard.eq(heard | restart)]
         return m
 
 
@@ -163,8 +164,9 @@ class ReturnWatchRtl(wiring.Component):
 
     The bit grid's end and mid-bit sample are constants per rate (one compare each); the bit within a telegram
     counts up as an LFSR (:mod:`supi3.rtl.lfsr`: only set to constants, stepped and compared with constants); it,
-    the clock within a bit and the telegram's type have no reset: they are set where a telegram begins and read
-    only while ``busy``, which has one.
+    the clock within a bit and the telegram's type have no reset and no enable: between telegrams the clock steps on
+    and the bit is held at the start bit (round 6), a start restarts the clock, and all three are read only while
+    ``busy``, which has a reset.
     """
 
     def __init__(self) -> None:
@@ -189,18 +191,20 @@ class ReturnWatchRtl(wiring.Component):
         start = ~busy & (self.line == wire.START_LEVEL)
         now = Mux(start, 0, phase)
         sync += seen.eq(0)
-        with m.If(busy | start):
-            sync += [busy.eq(1), phase.eq(Mux(at_rate(lambda cpb: now == cpb - 1), 0, now + 1))]
-            with m.If(at_rate(lambda cpb: now == cpb >> 1)):
-                k = Mux(start, bit_is(0), bit)
-                sync += bit.eq(next_state(k))
-                with m.If(k == bit_is(wire.POS_START)), m.If(self.line != wire.START_LEVEL):
-                    sync += busy.eq(0)
-                with m.Elif(k == bit_is(wire.POS_TYPE)):
-                    sync += data.eq(self.line == wire.TYPE_DATA_LEVEL)
-                with m.Elif(k == Mux(data, bit_is(wire.DATA_TELEGRAM_BITS - 1), bit_is(wire.STATUS_TELEGRAM_BITS - 1))):
-                    sync += [seen.eq(~data & (self.line == wire.IDLE_LEVEL)), busy.eq(0)]
-            with m.Elif(start):
-                sync += bit.eq(bit_is(0))
+        # the clock within a bit steps on between telegrams too, and the bit is set to the start bit there: both are
+        # read only in a telegram (a start restarts the clock; its clock is no sample, so the bit is set by then)
+        sync += phase.eq(Mux(at_rate(lambda cpb: now == cpb - 1), 0, now + 1))
+        with m.If(start):
+            sync += busy.eq(1)
+        with m.If(~busy):
+            sync += bit.eq(bit_is(0))
+        with m.Elif(at_rate(lambda cpb: now == cpb >> 1)):
+            sync += bit.eq(next_state(bit))
+            with m.If(bit == bit_is(wire.POS_START)), m.If(self.line != wire.START_LEVEL):
+                sync += busy.eq(0)
+            with m.Elif(bit == bit_is(wire.POS_TYPE)):
+                sync += data.eq(self.line == wire.TYPE_DATA_LEVEL)
+            with m.Elif(bit == Mux(data, bit_is(wire.DATA_TELEGRAM_BITS - 1), bit_is(wire.STATUS_TELEGRAM_BITS - 1))):
+                sync += [seen.eq(~data & (self.line == wire.IDLE_LEVEL)), busy.eq(0)]
         m.d.comb += [self.seen.eq(seen), self.busy.eq(busy)]
         return m

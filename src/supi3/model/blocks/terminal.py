@@ -206,8 +206,10 @@ class ReturnWatch:
 
     The bit grid is the chip receiver's (M7): between telegrams a start level makes that clock the first of a bit
     period; the line is sampled mid-bit (``cpb // 2``); a start bit sampled at the idle level is no telegram; the type
-    bit (``wire.POS_TYPE``) gives the length; after the stop bit's sample the watch is between telegrams again. The RTL
-    counterpart is ``supi3.rtl.terminal.ReturnWatchRtl``, clocked and reset as the core's logic.
+    bit (``wire.POS_TYPE``) gives the length; after the stop bit's sample the watch is between telegrams again, also
+    when it was sampled at the start level (no M16, BK-60). The RTL counterparts, clocked and reset as the core's
+    logic: ``supi3.rtl.terminal.ReturnWatchRtl`` on the transmitter's line, and on DI3 the return counter block
+    outside LBD-MR (``supi3.rtl.counter.CounterRtl(watch=True)`` with ``chain`` 0).
 
     Attributes
     ----------
