@@ -31,9 +31,14 @@ from __future__ import annotations
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Protocol, runtime_checkable
+from typing import Final, Protocol, runtime_checkable
 
 from supi3.errors import Supi3Error
+
+SYNC_STAGES: Final = 2
+"""Every asynchronous input passes two flip-flops before use (M1). Here, at the bottom of the layers, so that the bus
+models (:mod:`supi3.interbus`, whose package :mod:`supi3.pinout` imports) can use it too; :mod:`supi3.pinout` names it
+with the other pin facts."""
 
 __all__ = [
     "OE_SUFFIX",

@@ -24,6 +24,7 @@ from typing import Final
 
 from supi3.interbus import wire
 from supi3.optical.regulation import BLOCK_INPUTS
+from supi3.pinlevel import SYNC_STAGES as SYNC_STAGES
 from supi3.pinlevel import Pin
 from supi3.regmap import INTERRUPT_SOURCES, REGISTER_MAP, Access, AccessDirection
 from supi3.regmap.core import BYTE_BITS
@@ -135,8 +136,6 @@ initialization responses, online test results, length timer start and stop; :dat
 BLOCK_INPUTS`): inputs of the chip core beside :data:`CORE_INPUTS`, taken as they are at each clock (no synchroniser,
 OPT-26); 0 is quiet."""
 
-SYNC_STAGES: Final = 2
-"""Every asynchronous input passes two flip-flops before use (M1)."""
 IB_DIAG_DIVIDER_BITS: Final[dict[str, int]] = {"slow": 26, "fast": 24, "very_fast": 23}
 """IB_DIAG flashes from a free-running binary divider: 2**26 clocks (0.48 Hz) for "bus not active", 2**24
 (1.9 Hz) for "peripheral fault", 2**23 (3.8 Hz) for "line interrupt ahead on the local bus" (Table 3-18 asks

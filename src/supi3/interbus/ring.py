@@ -48,7 +48,7 @@ from supi3.interbus.errors import InterbusArgumentError, InterbusError, Telegram
 from supi3.interbus.link import DataKernel, Device
 from supi3.interbus.wake import path_lags, reset_ready, wake_return, wake_window
 from supi3.interbus.wire import Cycle, Frame
-from supi3.pinout import SYNC_STAGES
+from supi3.pinlevel import SYNC_STAGES
 from supi3.tables import CLOCK_HZ, RESET_MIN_S
 
 

@@ -25,7 +25,7 @@ from supi3.checks import check_instance, check_int, fail
 from supi3.interbus import wire
 from supi3.interbus.receiver import receive
 from supi3.interbus.wire import Cycle, Frame, Telegram
-from supi3.pinout import SYNC_STAGES
+from supi3.pinlevel import SYNC_STAGES
 
 _PROBE_TELEGRAMS = 64
 """Idle status telegrams the receiver is run over: far more than it needs to find the grid (M16: within two)."""
