@@ -41,6 +41,7 @@ from supi3.pinout import (
     C_D_DATA,
     DATA_BYTES,
     OPTICAL_REGISTERS,
+    SYNC_STAGES,
     UP_BLOCK_INPUTS,
     UP_BLOCK_OUTPUTS,
     UP_INPUT_IDLE,
@@ -165,13 +166,19 @@ def upif_tables() -> UpifTables:
 
 
 class _Sync:
-    """A 2-flop synchroniser plus the edge-detect flop, reset to the pin's idle level (UP-13)."""
+    """A 2-flop synchroniser plus the edge-detect flop, as if reset to the pin's idle level (UP-13).
 
-    def __init__(self, m: Module, name: str, pin: Value, idle: int) -> None:
-        self.s1 = Signal(name=f"{name}_s1", init=idle)
-        self.s2 = Signal(name=f"{name}_s2", init=idle)
+    The two synchroniser flops have no reset: ``s2`` reads as the idle level until ``settled`` (two clocks after the
+    power-up reset, when flops reset to the idle level would first hold the pin), so the edges come on the same
+    clocks; the edge-detect flop ``s3`` keeps its reset.
+    """
+
+    def __init__(self, m: Module, name: str, pin: Value, idle: int, settled: Value) -> None:
+        s1 = Signal(name=f"{name}_s1", init=idle, reset_less=True)
+        s2 = Signal(name=f"{name}_s2", init=idle, reset_less=True)
+        self.s2 = Mux(settled, s2, idle)
         self.s3 = Signal(name=f"{name}_s3", init=idle)
-        m.d.sync += [self.s1.eq(pin), self.s2.eq(self.s1), self.s3.eq(self.s2)]
+        m.d.sync += [s1.eq(pin), s2.eq(s1), self.s3.eq(self.s2)]
 
     @property
     def rose(self) -> Value:
@@ -258,6 +265,8 @@ class _Builder:
         self.bits = Signal(range(_BIT_COUNT_LIMIT + 1), reset_less=True)
 
     def build(self) -> None:
+        # A pipeline of 1s reset to 0: stage k is 1 from the k-th clock after the power-up reset (``filled``, below).
+        self.filled_stages = self.stages("filled", Const(1), init=0)
         self.configuration()
         self.core_inputs()
         self.pins()
@@ -309,11 +318,12 @@ class _Builder:
     def pins(self) -> None:
         m, b = self.m, self.b
         idle = UP_INPUT_IDLE
-        ss = _Sync(m, "ss", b.ss_n, idle["ss_n"])
-        sclk = _Sync(m, "sclk", b.sclk, idle["sclk"])
-        sas = _Sync(m, "sas", b.sas_init, idle["sas_init"])
-        data = _Sync(m, "data", Mux(b.mfp6_oe, b.mfp6, b.mfp6_in), idle["mfp6"])
-        s_r = _Sync(m, "s_r", b.mfp7_in, idle["mfp7"])
+        settled = self.filled_stages[SYNC_STAGES]  # 1 from the second clock after the power-up reset
+        ss = _Sync(m, "ss", b.ss_n, idle["ss_n"], settled)
+        sclk = _Sync(m, "sclk", b.sclk, idle["sclk"], settled)
+        sas = _Sync(m, "sas", b.sas_init, idle["sas_init"], settled)
+        data = _Sync(m, "data", Mux(b.mfp6_oe, b.mfp6, b.mfp6_in), idle["mfp6"], settled)
+        s_r = _Sync(m, "s_r", b.mfp7_in, idle["mfp7"], settled)
         with m.If(sas.s2):
             m.d.sync += [self.phase.eq(_Phase.INIT), self.motorola.eq(0), self.intel.eq(0)]
             self.clear_frame()
@@ -482,7 +492,7 @@ class _Builder:
         # output stage holds a value decoded since the power-up reset, else the output shows its power-up level
         # (as stages reset to it would). The bit sent goes through one pipeline for both data pins, each gated by
         # its delayed enable.
-        filled = self.delay("filled", Const(1), init=0)
+        filled = self.tap(self.filled_stages)
         power_up = self.tables.reset_outputs
         delayed = {
             name: value if isinstance(value, Const) else Mux(filled, self.delay(name, value), power_up[name])
@@ -492,14 +502,31 @@ class _Builder:
         delayed.update({"mfp6": sent & delayed["mfp6_oe"], "mfp7": sent & delayed["mfp7_oe"]})
         m.d.comb += [getattr(b, name).eq(value) for name, value in delayed.items()]
 
-    def delay(self, name: str, value: Value, *, init: int | None = None) -> Value:
-        """``value`` through the bit rate's output pipeline (UP-14): stages without reset, or reset to ``init``."""
+    def delay(self, name: str, value: Value) -> Value:
+        """``value`` through the bit rate's output pipeline (UP-14), of stages without reset."""
+        return self.tap(self.stages(name, value))
+
+    def stages(self, name: str, value: Value, *, init: int | None = None) -> list[Value]:
+        """``value`` and the longest output pipeline's stages after it: without reset, or reset to ``init``. The
+        synchronisers read the second stage of the ``filled`` pipeline, so there are at least that many.
+
+        Raises
+        ------
+        ValueError
+            If the longest output pipeline is shorter than the synchronisers (UP-13, UP-14).
+        """
+        if max(self.tables.output_delay) < SYNC_STAGES:
+            raise ValueError(f"the output pipeline needs at least {SYNC_STAGES} stages, the synchronisers' flops")
         m = self.m
         taps: list[Value] = [value]
         for stage in range(max(self.tables.output_delay)):
             stage_signal = Signal(name=f"{name}_d{stage + 1}", init=init or 0, reset_less=init is None)
             m.d.sync += stage_signal.eq(taps[-1])
             taps.append(stage_signal)
+        return taps
+
+    def tap(self, taps: list[Value]) -> Value:
+        """The output of a pipeline's ``taps`` (:meth:`stages`) at the bit rate's delay (UP-14)."""
         return Array(taps[delay] for delay in self.tables.output_delay)[self.b.rate]
 
 
