@@ -522,22 +522,27 @@ class RegisterFile:
         return again
 
     def _apply_set(self, value: int) -> None:
+        """Configure the device with the SET value ``value``, or with none if it cannot apply (UP-20, UP-40: the
+        configuration is always the stored SET's)."""
         try:
             decoded = decode_set(value)
         except RegisterMapError as error:
             self.violations.report(SetRegisterError("Table 3-12", f"{error}; configuration not applied"))
+            self._configure(None)
             return
         if decoded.length.bits is None:
             self.violations.report(
                 SetRegisterError("Table 3-11", f"SET {value:02X}h: length code {decoded.length.code} is reserved; "
                                  "configuration not applied")
             )
+            self._configure(None)
             return
         if decoded.extreg and self.config.variant is Variant.LS:
             self.violations.report(
                 SetRegisterError("3.5", f"SET {value:02X}h: ExtReg = 1 selects the serial register expansion, not "
                                  "possible with the SUPI 3 LS; configuration not applied")
             )
+            self._configure(None)
             return
         self._configure(decoded)
 

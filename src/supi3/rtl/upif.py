@@ -134,7 +134,7 @@ class UpifTables:
         The pin outputs after a power-up reset (shown until the output pipeline has filled).
     set_codes:
         For each applicable (ExtReg, ID12..8 field) of a SET value: the complete length code applied; SET values
-        missing here (reserved codes) are stored but not applied (Tables 3-11, 3-12; UP-20).
+        missing here (reserved codes) are stored and configure nothing (Tables 3-11, 3-12; UP-20, UP-40).
     internal_bytes:
         For each length code applicable with ExtReg = 0: the data bytes of the internal data path (3.4.8).
     """
@@ -230,13 +230,16 @@ class _Builder:
         """The registers after the core's inputs of this edge: what a read at this edge sees."""
         self.io = Signal()
         # No reset (nor clear) where every reader is gated by state that has one and the state is written before
-        # that gate opens: the applied SET fields (read only while ``configured``), the command and block transfer
+        # that gate opens: the command and block transfer
         # fields (read only in the DATA and BLOCK phases their command byte enters), the frame's S/R, bit count and
         # whether it drives (read only in a frame, set at its /SS falling edge), and the byte sent (``tx``: sent
         # only once Motorola or Intel mode is set, by the initialization byte's end, which also stores it).
+        self.set_written = Signal()
+        """SET was written since the power-up reset; the configuration is then the stored SET's, if its length code
+        applies (UP-40: the applied configuration is not stored apart from SET)."""
         self.configured = Signal()
-        self.cfg_extreg, self.cfg_pcp_n = Signal(reset_less=True), Signal(reset_less=True)
-        self.cfg_code = Signal(_LENGTH_CODE.width, reset_less=True)
+        self.cfg_code = Signal(_LENGTH_CODE.width)
+        """The complete length code of the stored SET (Tables 3-11, 3-12), read only while ``configured``."""
         self.n_bytes = Signal(range(DATA_BYTES + 1))
         """Data bytes of the internal data path: 0 before SET and with ExtReg = 1 (``data_bytes()`` gated by
         ``internal_data_path``)."""
@@ -276,14 +279,26 @@ class _Builder:
 
     def configuration(self) -> None:
         m, b, regs = self.m, self.b, self.regs
-        counts = [self.tables.internal_bytes.get(code, 0) for code in range(1 << _LENGTH_CODE.width)]
-        with m.If(self.configured & ~self.cfg_extreg):  # a ROM indexed by the code
-            m.d.comb += self.n_bytes.eq(Array(Const(count) for count in counts)[self.cfg_code])
+        # ROMs indexed by the stored SET's (ExtReg, ID12..8) (Tables 3-11, 3-12; UP-20, UP-40): whether its length
+        # code applies, the complete code, the internal data path's bytes (0 with ExtReg = 1)
+        stored = regs[_SET.name]
+        extreg, pcp_n = stored[_EXTREG.lsb], stored[_PCP_N.lsb]
+        key = Cat(stored[_LENGTH_CODE.lsb : _LENGTH_CODE.lsb + _LENGTH_CODE.width], extreg)
+        codes = self.tables.set_codes
+        entries = [codes.get(divmod(key_value, 1 << _LENGTH_CODE.width)) for key_value in range(1 << len(key))]
+        counts = [0 if code is None else self.tables.internal_bytes.get(code, 0) for code in entries]
+        counts[1 << _LENGTH_CODE.width :] = [0] * (len(counts) >> 1)  # ExtReg = 1: no internal data path
         m.d.comb += [
-            self.pcp_device.eq(self.configured & ~self.cfg_extreg & ~self.cfg_pcp_n),
+            self.configured.eq(self.set_written & Array(Const(code is not None) for code in entries)[key]),
+            self.cfg_code.eq(Array(Const(code or 0, _LENGTH_CODE.width) for code in entries)[key]),
+        ]
+        with m.If(self.set_written):  # a SET whose code does not apply gives 0
+            m.d.comb += self.n_bytes.eq(Array(Const(count) for count in counts)[key])
+        m.d.comb += [
+            self.pcp_device.eq(self.configured & ~extreg & ~pcp_n),
             b.in_data.eq(Cat(*(regs[r.name] for r in IN_BYTES))),
             b.bus_id.eq(Mux(self.configured, Cat(regs["ID"], self.cfg_code), Cat(b.np_id, b.np_length))),
-            b.ext_reg.eq(self.configured & self.cfg_extreg),
+            b.ext_reg.eq(self.configured & extreg),
             b.pcp.eq(self.pcp_device),
             b.alarm.eq(regs["ALARM"]),
         ]
@@ -362,14 +377,9 @@ class _Builder:
             self.tx_valid.eq(drives),
             self.bits.eq(0),
         ]
-        # A block transfer's slot addresses OUT k, which is readable: one address for both phases.
-        readable = Signal()
-        with m.Switch(self.cmd_addr):
-            for a, port in _READ_PORTS.items():
-                if port.access is not Access.RESERVED_IGNORED:
-                    with m.Case(a):
-                        m.d.comb += readable.eq(1)
-        reads = self.phase.matches(_Phase.DATA, _Phase.BLOCK) & self.cmd_rd & readable
+        # A block transfer's slot addresses OUT k, which is readable: one address for both phases. An address
+        # without a read (4, 5: reserved, ignored) has no case, so it reads nothing.
+        reads = self.phase.matches(_Phase.DATA, _Phase.BLOCK) & self.cmd_rd
         with m.If(reads), m.Switch(self.cmd_addr):
             for a, port in _READ_PORTS.items():
                 register = port.register
@@ -445,7 +455,8 @@ class _Builder:
             m.d.sync += slot.eq(slot + 1)
 
     def cpu_write(self, address: Value, value: Value) -> None:
-        """``RegisterFile.cpu_write``: store the byte's register bits; SET also applies a valid configuration."""
+        """``RegisterFile.cpu_write``: store the byte's register bits; a SET write configures the device with the
+        stored SET if its length code applies (UP-40)."""
         m = self.m
         with m.Switch(address):
             for a, port in _WRITE_PORTS.items():
@@ -454,24 +465,7 @@ class _Builder:
                     with m.Case(a):
                         m.d.sync += self.regs[register.name].eq(value & register.mask)
                         if register is _SET:
-                            self.apply_set(value)
-
-    def apply_set(self, value: Value) -> None:
-        """A SET value with an applicable length code configures the device (Tables 3-11, 3-12; UP-20). The table
-        is a ROM indexed by (ExtReg, ID12..8): an entry per key, not a comparator per applicable key."""
-        m = self.m
-        key = Cat(value[_LENGTH_CODE.lsb : _LENGTH_CODE.lsb + _LENGTH_CODE.width], value[_EXTREG.lsb])
-        codes = self.tables.set_codes
-        entries = [codes.get(divmod(key_value, 1 << _LENGTH_CODE.width)) for key_value in range(1 << len(key))]
-        applies = Array(Const(code is not None) for code in entries)[key]
-        code = Array(Const(code or 0, _LENGTH_CODE.width) for code in entries)[key]
-        with m.If(applies):
-            m.d.sync += [
-                self.configured.eq(1),
-                self.cfg_extreg.eq(value[_EXTREG.lsb]),
-                self.cfg_code.eq(code),
-                self.cfg_pcp_n.eq(value[_PCP_N.lsb]),
-            ]
+                            self.m.d.sync += self.set_written.eq(1)
 
     # 3. Outputs: the state decoded (SlavePins._decode), then the bit rate's pipeline (UP-14) ---------------------
 
