@@ -137,7 +137,7 @@ class ReconfigurationError(InterfaceViolationError):
 
 class SetRegisterError(InterfaceViolationError):
     """SET written with a length code that Tables 3-11/3-12 reserve, or with ExtReg = 1 on the SUPI 3 LS (3.5,
-    docs/assumptions/expansion.md RX-1); the configuration is not applied."""
+    docs/assumptions/expansion.md RX-1); the configuration is not applied: the device is then unconfigured (UP-40)."""
 
 
 class InconsistentDataError(InterfaceViolationError):
@@ -471,7 +471,8 @@ class RegisterFile:
 
         Writing SET applies the configuration (:meth:`bus_id_register`, :meth:`data_bits`); writing SET or ID
         while the bus runs reports :class:`ReconfigurationError` (3.4.3, 3.4.11); a SET value with a reserved
-        length code reports :class:`SetRegisterError` and is stored but not applied.
+        length code reports :class:`SetRegisterError` and is stored but not applied: the device is then unconfigured,
+        also after an earlier SET (UP-40).
 
         Raises
         ------
