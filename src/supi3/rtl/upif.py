@@ -240,9 +240,10 @@ class _Builder:
         self.configured = Signal()
         self.cfg_code = Signal(_LENGTH_CODE.width)
         """The complete length code of the stored SET (Tables 3-11, 3-12), read only while ``configured``."""
-        self.n_bytes = Signal(range(DATA_BYTES + 1))
-        """Data bytes of the internal data path: 0 before SET and with ExtReg = 1 (``data_bytes()`` gated by
-        ``internal_data_path``)."""
+        self.n_bytes = Signal(DATA_BYTES)
+        """Data bytes of the internal data path as a thermometer code (bit k: byte k is exchanged): none before SET
+        and with ExtReg = 1 (``data_bytes()`` gated by ``internal_data_path``). Its users ask only whether byte k
+        is in it, whether there is none and whether k is the last: each a bit or two of the ROM's word."""
         self.pcp_device = Signal()
         # Protocol (UpifProtocol) and frame (SlavePins) state.
         self.phase = Signal(_Phase, init=_Phase.INIT)
@@ -292,8 +293,8 @@ class _Builder:
             self.configured.eq(self.set_written & Array(Const(code is not None) for code in entries)[key]),
             self.cfg_code.eq(Array(Const(code or 0, _LENGTH_CODE.width) for code in entries)[key]),
         ]
-        with m.If(self.set_written):  # a SET whose code does not apply gives 0
-            m.d.comb += self.n_bytes.eq(Array(Const(count) for count in counts)[key])
+        with m.If(self.set_written):  # a SET whose code does not apply gives none
+            m.d.comb += self.n_bytes.eq(Array(Const((1 << count) - 1, DATA_BYTES) for count in counts)[key])
         m.d.comb += [
             self.pcp_device.eq(self.configured & ~extreg & ~pcp_n),
             b.in_data.eq(Cat(*(regs[r.name] for r in IN_BYTES))),
@@ -310,11 +311,11 @@ class _Builder:
         m.d.comb += [core[name].eq(value) for name, value in regs.items()]
         with m.If(b.latch):
             for k, register in enumerate(OUT_BYTES):
-                with m.If(k < self.n_bytes):
+                with m.If(self.n_bytes[k]):
                     m.d.comb += core[register.name].eq(b.latch_out.word_select(k, BYTE_BITS))
             with m.If(self.pcp_device):
                 for k in _PCP_ERASED:
-                    with m.If(k < self.n_bytes):
+                    with m.If(self.n_bytes[k]):
                         m.d.comb += core[IN_BYTES[k].name].eq(0)
         with m.If(b.pcmd_we):
             m.d.comb += core["PCMD"].eq(b.pcmd)
@@ -425,7 +426,7 @@ class _Builder:
         m.d.sync += [self.cmd_rd.eq(rd), self.cmd_wr.eq(wr), self.cmd_addr.eq(address), self.phase.eq(_Phase.DATA)]
         with m.If(address.matches(*_BLOCK_ADDRESSES)):  # the first slot: k = 0, what it reads and writes
             m.d.sync += [self.phase.eq(_Phase.BLOCK), self.cmd_addr.eq(0)]
-            with m.If((self.n_bytes == 0) | (self.intel & ~rd & ~wr)):
+            with m.If(~self.n_bytes[0] | (self.intel & ~rd & ~wr)):
                 m.d.sync += self.phase.eq(_Phase.COMMAND)
             with m.If(self.motorola):
                 m.d.sync += [self.cmd_rd.eq(1), self.cmd_wr.eq(1), self.blk_then_wr.eq(0)]
@@ -446,7 +447,8 @@ class _Builder:
         refused = self.intel & (self.cmd_rd == self.frame_s_r)
         m.d.comb += write.eq(self.cmd_wr & ~refused)
         slot = self.cmd_addr[: (DATA_BYTES - 1).bit_length()]
-        with m.If(slot == self.n_bytes - 1):
+        last = self.n_bytes.bit_select(slot, 1) & ~Cat(self.n_bytes[1:], 0).bit_select(slot, 1)  # slot k, no k + 1
+        with m.If(last):
             with m.If(self.blk_then_wr):
                 m.d.sync += [self.cmd_addr.eq(0), self.cmd_rd.eq(0), self.cmd_wr.eq(1), self.blk_then_wr.eq(0)]
             with m.Else():
