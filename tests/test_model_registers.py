@@ -67,6 +67,22 @@ def test_set_with_extreg_gives_the_full_length_code() -> None:
 
 
 @pytest.mark.parametrize("value", [0x06, 0x07, 0x40 | 0b01010, 0x40 | 0b11000])
+@pytest.mark.parametrize("before", [SET_IO_1_BYTE, SET_PCP_1_WORD, 0x40 | 0b10010])
+def test_a_reserved_set_code_after_a_configuration_leaves_none(value: int, before: int) -> None:
+    """UP-20, UP-40: the configuration is the stored SET's: a reserved code written after an applied one leaves the
+    device unconfigured (the µP_Not_Ready ID and length, no data), and an applicable one configures it again."""
+    r = regs(strict=False)
+    unconfigured = r.bus_id_register()
+    r.cpu_write(13, before)
+    assert r.configured
+    r.cpu_write(13, value)
+    assert (r.configured, r.bus_id_register(), r.data_bits(), r.pcp_device) == (False, unconfigured, 0, False)
+    assert r.cpu_read(13) == value
+    r.cpu_write(13, before)
+    assert r.configured and r.bus_id_register() != unconfigured
+
+
+@pytest.mark.parametrize("value", [0x06, 0x07, 0x40 | 0b01010, 0x40 | 0b11000])
 def test_reserved_set_codes_are_stored_but_not_applied(value: int) -> None:
     r = regs(strict=False)
     r.cpu_write(13, value)

@@ -93,27 +93,45 @@ def test_diagnostics_mode() -> None:
 
 @pytest.mark.parametrize("fast", [0, 1])
 def test_lengths_media_and_resets(fast: int) -> None:
-    """1.6.1, OPT-1, OPT-21, OPT-24: both timers, both media; a reset stops a running timer and keeps the lengths;
+    """1.6.1, OPT-1, OPT-21, OPT-24: both paths, both media; a reset stops the running timer and keeps the lengths;
     mode 3 is off and resp 3 no response (OPT-23)."""
     script = OpticalScript(REG, fast=fast).reset().length(OUT, 517, 1).length(BRANCH, 93, 0)
-    script.idle(len_start=0b110).idle(7).idle(len_stop=0b010, len_start=0b010).idle(3).idle(len_stop=0b110)
+    measured = run_optical(script.rows)[0].status.length
     script.idle(len_start=0b100).reset().idle(4, len_stop=0b100).response(IN, 3)
     block = lockstep(script)
-    assert block.status.length[1] != 0  # the branch, polymer, re-measured over 12 clocks
+    assert block.status.length == measured
+    assert 0 not in measured
     assert block.status[IN].phase is Phase.INIT
     block = lockstep(OpticalScript(3, fast=fast).reset().length(OUT, 100).idle())
     assert block.status.length == (0, 0)
 
 
+@pytest.mark.parametrize("fast", [0, 1])
+def test_one_timer_for_both_paths(fast: int) -> None:
+    """OPT-57: one timer measures the outgoing interface or the branch: both started at one edge measure the
+    outgoing interface (the branch's stop does nothing), a start of the other path abandons the running measurement
+    (the first path's stop then does nothing), a start at the edge of a stop measures anew."""
+    script = OpticalScript(REG, fast=fast, medium=0b110).reset().length(OUT, 517, 1).length(BRANCH, 1_093, 1)
+    measured = run_optical(script.rows)[0].status.length
+    script.idle(len_start=0b110).idle(300).idle(len_stop=0b100)  # the branch's stop: not its measurement
+    assert run_optical(script.rows)[0].status.length == measured
+    script.idle(len_start=0b100).idle(80).idle(len_stop=0b010)  # the outgoing interface's was abandoned
+    assert run_optical(script.rows)[0].status.length == measured
+    script.idle(len_stop=0b100, len_start=0b010).idle(600).idle(len_stop=0b010)
+    block = lockstep(script.idle(2))
+    assert block.status.length[0] != measured[0]  # 601 clocks against 517: one more count of 64 clocks
+    assert block.status.length[1] != measured[1]  # 82 clocks against 1,093: fewer counts
+
+
 def test_long_lengths_read_as_the_top_code() -> None:
     """OPT-24: the RTL timer's 12 bits of clocks wrap at 4,096; a stop just before the wrap (the branch, polymer) and
     one just after it (the outgoing interface, glass, which reads 63 only from 4,032 clocks at 2 Mbit/s) read as the
-    model's saturating count does, and a start at the edge of such a stop clears the wrap (short lengths after)."""
-    script = OpticalScript(REG, fast=1, medium=0b010).reset().idle(len_start=0b110).idle(4_093)
-    script.idle(len_stop=0b100, len_start=0b100).idle().idle(len_stop=0b010, len_start=0b010).idle(40)
+    model's saturating count does, and a start at the edge of such a stop clears the wrap (a short length after)."""
+    script = OpticalScript(REG, fast=1, medium=0b010).reset().idle(len_start=0b100).idle(4_093)
+    script.idle(len_stop=0b100, len_start=0b010).idle(4_095).idle(len_stop=0b010, len_start=0b010).idle(40)
     assert run_optical(script.rows)[0].status.length == (63, 63)
-    block = lockstep(script.idle(len_stop=0b110).idle(2))
-    assert block.status.length == (0, 21)
+    block = lockstep(script.idle(len_stop=0b010).idle(2))
+    assert block.status.length == (0, 63)
 
 
 @pytest.mark.parametrize("limit", [1, 2, 300])

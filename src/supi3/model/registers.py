@@ -137,7 +137,7 @@ class ReconfigurationError(InterfaceViolationError):
 
 class SetRegisterError(InterfaceViolationError):
     """SET written with a length code that Tables 3-11/3-12 reserve, or with ExtReg = 1 on the SUPI 3 LS (3.5,
-    docs/assumptions/expansion.md RX-1); the configuration is not applied."""
+    docs/assumptions/expansion.md RX-1); the configuration is not applied: the device is then unconfigured (UP-40)."""
 
 
 class InconsistentDataError(InterfaceViolationError):
@@ -476,7 +476,8 @@ class RegisterFile:
 
         Writing SET applies the configuration (:meth:`bus_id_register`, :meth:`data_bits`); writing SET or ID
         while the bus runs reports :class:`ReconfigurationError` (3.4.3, 3.4.11); a SET value with a reserved
-        length code reports :class:`SetRegisterError` and is stored but not applied.
+        length code reports :class:`SetRegisterError` and is stored but not applied: the device is then unconfigured,
+        also after an earlier SET (UP-40).
 
         Raises
         ------
@@ -527,22 +528,27 @@ class RegisterFile:
         return again
 
     def _apply_set(self, value: int) -> None:
+        """Configure the device with the SET value ``value``, or with none if it cannot apply (UP-20, UP-40: the
+        configuration is always the stored SET's)."""
         try:
             decoded = decode_set(value)
         except RegisterMapError as error:
             self.violations.report(SetRegisterError("Table 3-12", f"{error}; configuration not applied"))
+            self._configure(None)
             return
         if decoded.length.bits is None:
             self.violations.report(
                 SetRegisterError("Table 3-11", f"SET {value:02X}h: length code {decoded.length.code} is reserved; "
                                  "configuration not applied")
             )
+            self._configure(None)
             return
         if decoded.extreg and self.config.variant is Variant.LS:
             self.violations.report(
                 SetRegisterError("3.5", f"SET {value:02X}h: ExtReg = 1 selects the serial register expansion, not "
                                  "possible with the SUPI 3 LS; configuration not applied")
             )
+            self._configure(None)
             return
         self._configure(decoded)
 

@@ -1,5 +1,6 @@
-"""The optical regulation block in Amaranth: three transmitters, the 6 ms initialization counter, two length timers
-and reads 8 to 11, with the ports of :data:`supi3.optical.regulation.BLOCK_INPUTS` / ``BLOCK_OUTPUTS``.
+"""The optical regulation block in Amaranth: three transmitters, the 6 ms initialization counter, one length timer
+for the outgoing interface or the branch (OPT-57) and reads 8 to 11, with the ports of
+:data:`supi3.optical.regulation.BLOCK_INPUTS` / ``BLOCK_OUTPUTS``.
 
 Manual 1.6 (reset behaviour), 1.6.1 (initialization, length timer), 1.6.2 (online regulation, optical
 diagnostics), 1.6.3 (MAU warnings), Table 3-17 (FO LEDs), 3.4.12/3.4.13 (reads 8 to 11). The transitions of
@@ -303,37 +304,44 @@ class OpticalRtl(wiring.Component):
             for i in Interface:
                 comb += new[i].set(_start(self.mode, self.present[i]))
 
-        # Length timers of the outgoing interface and the branch: the clocks since the start, of which the count is
-        # the clocks shifted right by log2 of the bit rate's enable period (OPT-24)
+        # The length timer of the outgoing interface or the branch (OPT-57): the clocks since the start, of which the
+        # count is the clocks shifted right by log2 of the bit rate's enable period (OPT-24)
         prescale = [_prescale_bits(rate) for rate in BIT_RATES]
         block_on = (self.mode == OpticalMode.REGULATION) | (self.mode == OpticalMode.DIAGNOSTIC)
-        for k, i in ((_OUT_K, Interface.OUT), (_BRANCH_K, Interface.BRANCH)):
-            running = Signal(name=f"timer_running_{k}")
-            # the clocks since the start modulo 2 ** _clock_bits() and whether that many have passed (then read as all
-            # ones, code 63): both cleared at each start, so without reset; no saturating multiplexer on the count
-            clocks = Signal(_clock_bits(), name=f"timer_clocks_{k}", reset_less=True)
-            over = Signal(name=f"timer_over_{k}", reset_less=True)
-            counted = (clocks + 1)[: len(clocks)]
-            counted_over = over | clocks.all()
-            read = Mux(counted_over, (1 << len(clocks)) - 1, counted)
-            code = Signal(len(length[k]), name=f"timer_code_{k}")
-            with m.Switch(Cat(self.medium[i], self.fast)):
-                for fast, rate in enumerate(BIT_RATES):
-                    for medium_bit in (0, 1):
-                        with m.Case(medium_bit | fast << 1):
-                            shift = length_shift(rate, Medium(medium_bit))
-                            comb += code.eq(self._code(read, prescale[fast], shift))
-            with m.If(self.ib_reset):
-                sync += running.eq(0)
-            with m.Else():
-                with m.If(running):
-                    sync += [clocks.eq(counted), over.eq(counted_over)]
-                    with m.If(self.len_stop[i]):
-                        sync += running.eq(0)
-                        with m.If(block_on):
-                            comb += [new_length[k].eq(code), new_medium[k].eq(self.medium[i])]
-                with m.If(self.len_start[i]):
-                    sync += [running.eq(1), clocks.eq(0), over.eq(0)]
+        running = Signal(name="timer_running")
+        # the path it measures (index into MEASURED, set at each start: read only while running, so without reset);
+        # the outgoing interface's start wins over the branch's at one edge
+        path = Signal(name="timer_path", reset_less=True)
+        paths = (Interface.OUT, Interface.BRANCH)  # in the order of the lengths (_OUT_K, _BRANCH_K)
+        stop = Mux(path, self.len_stop[Interface.BRANCH], self.len_stop[Interface.OUT])
+        path_medium = Mux(path, self.medium[Interface.BRANCH], self.medium[Interface.OUT])
+        # the clocks since the start modulo 2 ** _clock_bits() and whether that many have passed (then read as all
+        # ones, code 63): both cleared at each start, so without reset; no saturating multiplexer on the count
+        clocks = Signal(_clock_bits(), name="timer_clocks", reset_less=True)
+        over = Signal(name="timer_over", reset_less=True)
+        counted = (clocks + 1)[: len(clocks)]
+        counted_over = over | clocks.all()
+        read = Mux(counted_over, (1 << len(clocks)) - 1, counted)
+        code = Signal(LENGTH_MAX_CODE.bit_length(), name="timer_code")
+        with m.Switch(Cat(path_medium, self.fast)):
+            for fast, rate in enumerate(BIT_RATES):
+                for medium_bit in (0, 1):
+                    with m.Case(medium_bit | fast << 1):
+                        shift = length_shift(rate, Medium(medium_bit))
+                        comb += code.eq(self._code(read, prescale[fast], shift))
+        with m.If(self.ib_reset):
+            sync += running.eq(0)
+        with m.Else():
+            with m.If(running):
+                sync += [clocks.eq(counted), over.eq(counted_over)]
+                with m.If(stop):
+                    sync += running.eq(0)
+                    with m.If(block_on):
+                        for k in range(len(paths)):
+                            with m.If(path == k):
+                                comb += [new_length[k].eq(code), new_medium[k].eq(path_medium)]
+            with m.If(Cat(*(self.len_start[i] for i in paths)).any()):
+                sync += [running.eq(1), path.eq(~self.len_start[Interface.OUT]), clocks.eq(0), over.eq(0)]
         return m
 
     @staticmethod

@@ -41,6 +41,7 @@ from supi3.pinout import (
     C_D_DATA,
     DATA_BYTES,
     OPTICAL_REGISTERS,
+    SYNC_STAGES,
     UP_BLOCK_INPUTS,
     UP_BLOCK_OUTPUTS,
     UP_INPUT_IDLE,
@@ -133,7 +134,7 @@ class UpifTables:
         The pin outputs after a power-up reset (shown until the output pipeline has filled).
     set_codes:
         For each applicable (ExtReg, ID12..8 field) of a SET value: the complete length code applied; SET values
-        missing here (reserved codes) are stored but not applied (Tables 3-11, 3-12; UP-20).
+        missing here (reserved codes) are stored and configure nothing (Tables 3-11, 3-12; UP-20, UP-40).
     internal_bytes:
         For each length code applicable with ExtReg = 0: the data bytes of the internal data path (3.4.8).
     """
@@ -165,13 +166,19 @@ def upif_tables() -> UpifTables:
 
 
 class _Sync:
-    """A 2-flop synchroniser plus the edge-detect flop, reset to the pin's idle level (UP-13)."""
+    """A 2-flop synchroniser plus the edge-detect flop, as if reset to the pin's idle level (UP-13).
 
-    def __init__(self, m: Module, name: str, pin: Value, idle: int) -> None:
-        self.s1 = Signal(name=f"{name}_s1", init=idle)
-        self.s2 = Signal(name=f"{name}_s2", init=idle)
+    The two synchroniser flops have no reset: ``s2`` reads as the idle level until ``settled`` (two clocks after the
+    power-up reset, when flops reset to the idle level would first hold the pin), so the edges come on the same
+    clocks; the edge-detect flop ``s3`` keeps its reset.
+    """
+
+    def __init__(self, m: Module, name: str, pin: Value, idle: int, settled: Value) -> None:
+        s1 = Signal(name=f"{name}_s1", init=idle, reset_less=True)
+        s2 = Signal(name=f"{name}_s2", init=idle, reset_less=True)
+        self.s2 = Mux(settled, s2, idle)
         self.s3 = Signal(name=f"{name}_s3", init=idle)
-        m.d.sync += [self.s1.eq(pin), self.s2.eq(self.s1), self.s3.eq(self.s2)]
+        m.d.sync += [s1.eq(pin), s2.eq(s1), self.s3.eq(self.s2)]
 
     @property
     def rose(self) -> Value:
@@ -223,16 +230,20 @@ class _Builder:
         """The registers after the core's inputs of this edge: what a read at this edge sees."""
         self.io = Signal()
         # No reset (nor clear) where every reader is gated by state that has one and the state is written before
-        # that gate opens: the applied SET fields (read only while ``configured``), the command and block transfer
+        # that gate opens: the command and block transfer
         # fields (read only in the DATA and BLOCK phases their command byte enters), the frame's S/R, bit count and
         # whether it drives (read only in a frame, set at its /SS falling edge), and the byte sent (``tx``: sent
         # only once Motorola or Intel mode is set, by the initialization byte's end, which also stores it).
+        self.set_written = Signal()
+        """SET was written since the power-up reset; the configuration is then the stored SET's, if its length code
+        applies (UP-40: the applied configuration is not stored apart from SET)."""
         self.configured = Signal()
-        self.cfg_extreg, self.cfg_pcp_n = Signal(reset_less=True), Signal(reset_less=True)
-        self.cfg_code = Signal(_LENGTH_CODE.width, reset_less=True)
-        self.n_bytes = Signal(range(DATA_BYTES + 1))
-        """Data bytes of the internal data path: 0 before SET and with ExtReg = 1 (``data_bytes()`` gated by
-        ``internal_data_path``)."""
+        self.cfg_code = Signal(_LENGTH_CODE.width)
+        """The complete length code of the stored SET (Tables 3-11, 3-12), read only while ``configured``."""
+        self.n_bytes = Signal(DATA_BYTES)
+        """Data bytes of the internal data path as a thermometer code (bit k: byte k is exchanged): none before SET
+        and with ExtReg = 1 (``data_bytes()`` gated by ``internal_data_path``). Its users ask only whether byte k
+        is in it, whether there is none and whether k is the last: each a bit or two of the ROM's word."""
         self.pcp_device = Signal()
         # Protocol (UpifProtocol) and frame (SlavePins) state.
         self.phase = Signal(_Phase, init=_Phase.INIT)
@@ -258,6 +269,8 @@ class _Builder:
         self.bits = Signal(range(_BIT_COUNT_LIMIT + 1), reset_less=True)
 
     def build(self) -> None:
+        # A pipeline of 1s reset to 0: stage k is 1 from the k-th clock after the power-up reset (``filled``, below).
+        self.filled_stages = self.stages("filled", Const(1), init=0)
         self.configuration()
         self.core_inputs()
         self.pins()
@@ -267,14 +280,26 @@ class _Builder:
 
     def configuration(self) -> None:
         m, b, regs = self.m, self.b, self.regs
-        counts = [self.tables.internal_bytes.get(code, 0) for code in range(1 << _LENGTH_CODE.width)]
-        with m.If(self.configured & ~self.cfg_extreg):  # a ROM indexed by the code
-            m.d.comb += self.n_bytes.eq(Array(Const(count) for count in counts)[self.cfg_code])
+        # ROMs indexed by the stored SET's (ExtReg, ID12..8) (Tables 3-11, 3-12; UP-20, UP-40): whether its length
+        # code applies, the complete code, the internal data path's bytes (0 with ExtReg = 1)
+        stored = regs[_SET.name]
+        extreg, pcp_n = stored[_EXTREG.lsb], stored[_PCP_N.lsb]
+        key = Cat(stored[_LENGTH_CODE.lsb : _LENGTH_CODE.lsb + _LENGTH_CODE.width], extreg)
+        codes = self.tables.set_codes
+        entries = [codes.get(divmod(key_value, 1 << _LENGTH_CODE.width)) for key_value in range(1 << len(key))]
+        counts = [0 if code is None else self.tables.internal_bytes.get(code, 0) for code in entries]
+        counts[1 << _LENGTH_CODE.width :] = [0] * (len(counts) >> 1)  # ExtReg = 1: no internal data path
         m.d.comb += [
-            self.pcp_device.eq(self.configured & ~self.cfg_extreg & ~self.cfg_pcp_n),
+            self.configured.eq(self.set_written & Array(Const(code is not None) for code in entries)[key]),
+            self.cfg_code.eq(Array(Const(code or 0, _LENGTH_CODE.width) for code in entries)[key]),
+        ]
+        with m.If(self.set_written):  # a SET whose code does not apply gives none
+            m.d.comb += self.n_bytes.eq(Array(Const((1 << count) - 1, DATA_BYTES) for count in counts)[key])
+        m.d.comb += [
+            self.pcp_device.eq(self.configured & ~extreg & ~pcp_n),
             b.in_data.eq(Cat(*(regs[r.name] for r in IN_BYTES))),
             b.bus_id.eq(Mux(self.configured, Cat(regs["ID"], self.cfg_code), Cat(b.np_id, b.np_length))),
-            b.ext_reg.eq(self.configured & self.cfg_extreg),
+            b.ext_reg.eq(self.configured & extreg),
             b.pcp.eq(self.pcp_device),
             b.alarm.eq(regs["ALARM"]),
         ]
@@ -286,11 +311,11 @@ class _Builder:
         m.d.comb += [core[name].eq(value) for name, value in regs.items()]
         with m.If(b.latch):
             for k, register in enumerate(OUT_BYTES):
-                with m.If(k < self.n_bytes):
+                with m.If(self.n_bytes[k]):
                     m.d.comb += core[register.name].eq(b.latch_out.word_select(k, BYTE_BITS))
             with m.If(self.pcp_device):
                 for k in _PCP_ERASED:
-                    with m.If(k < self.n_bytes):
+                    with m.If(self.n_bytes[k]):
                         m.d.comb += core[IN_BYTES[k].name].eq(0)
         with m.If(b.pcmd_we):
             m.d.comb += core["PCMD"].eq(b.pcmd)
@@ -309,11 +334,12 @@ class _Builder:
     def pins(self) -> None:
         m, b = self.m, self.b
         idle = UP_INPUT_IDLE
-        ss = _Sync(m, "ss", b.ss_n, idle["ss_n"])
-        sclk = _Sync(m, "sclk", b.sclk, idle["sclk"])
-        sas = _Sync(m, "sas", b.sas_init, idle["sas_init"])
-        data = _Sync(m, "data", Mux(b.mfp6_oe, b.mfp6, b.mfp6_in), idle["mfp6"])
-        s_r = _Sync(m, "s_r", b.mfp7_in, idle["mfp7"])
+        settled = self.filled_stages[SYNC_STAGES]  # 1 from the second clock after the power-up reset
+        ss = _Sync(m, "ss", b.ss_n, idle["ss_n"], settled)
+        sclk = _Sync(m, "sclk", b.sclk, idle["sclk"], settled)
+        sas = _Sync(m, "sas", b.sas_init, idle["sas_init"], settled)
+        data = _Sync(m, "data", Mux(b.mfp6_oe, b.mfp6, b.mfp6_in), idle["mfp6"], settled)
+        s_r = _Sync(m, "s_r", b.mfp7_in, idle["mfp7"], settled)
         with m.If(sas.s2):
             m.d.sync += [self.phase.eq(_Phase.INIT), self.motorola.eq(0), self.intel.eq(0)]
             self.clear_frame()
@@ -352,14 +378,9 @@ class _Builder:
             self.tx_valid.eq(drives),
             self.bits.eq(0),
         ]
-        # A block transfer's slot addresses OUT k, which is readable: one address for both phases.
-        readable = Signal()
-        with m.Switch(self.cmd_addr):
-            for a, port in _READ_PORTS.items():
-                if port.access is not Access.RESERVED_IGNORED:
-                    with m.Case(a):
-                        m.d.comb += readable.eq(1)
-        reads = self.phase.matches(_Phase.DATA, _Phase.BLOCK) & self.cmd_rd & readable
+        # A block transfer's slot addresses OUT k, which is readable: one address for both phases. An address
+        # without a read (4, 5: reserved, ignored) has no case, so it reads nothing.
+        reads = self.phase.matches(_Phase.DATA, _Phase.BLOCK) & self.cmd_rd
         with m.If(reads), m.Switch(self.cmd_addr):
             for a, port in _READ_PORTS.items():
                 register = port.register
@@ -405,7 +426,7 @@ class _Builder:
         m.d.sync += [self.cmd_rd.eq(rd), self.cmd_wr.eq(wr), self.cmd_addr.eq(address), self.phase.eq(_Phase.DATA)]
         with m.If(address.matches(*_BLOCK_ADDRESSES)):  # the first slot: k = 0, what it reads and writes
             m.d.sync += [self.phase.eq(_Phase.BLOCK), self.cmd_addr.eq(0)]
-            with m.If((self.n_bytes == 0) | (self.intel & ~rd & ~wr)):
+            with m.If(~self.n_bytes[0] | (self.intel & ~rd & ~wr)):
                 m.d.sync += self.phase.eq(_Phase.COMMAND)
             with m.If(self.motorola):
                 m.d.sync += [self.cmd_rd.eq(1), self.cmd_wr.eq(1), self.blk_then_wr.eq(0)]
@@ -426,7 +447,8 @@ class _Builder:
         refused = self.intel & (self.cmd_rd == self.frame_s_r)
         m.d.comb += write.eq(self.cmd_wr & ~refused)
         slot = self.cmd_addr[: (DATA_BYTES - 1).bit_length()]
-        with m.If(slot == self.n_bytes - 1):
+        last = self.n_bytes.bit_select(slot, 1) & ~Cat(self.n_bytes[1:], 0).bit_select(slot, 1)  # slot k, no k + 1
+        with m.If(last):
             with m.If(self.blk_then_wr):
                 m.d.sync += [self.cmd_addr.eq(0), self.cmd_rd.eq(0), self.cmd_wr.eq(1), self.blk_then_wr.eq(0)]
             with m.Else():
@@ -435,7 +457,8 @@ class _Builder:
             m.d.sync += slot.eq(slot + 1)
 
     def cpu_write(self, address: Value, value: Value) -> None:
-        """``RegisterFile.cpu_write``: store the byte's register bits; SET also applies a valid configuration."""
+        """``RegisterFile.cpu_write``: store the byte's register bits; a SET write configures the device with the
+        stored SET if its length code applies (UP-40)."""
         m = self.m
         with m.Switch(address):
             for a, port in _WRITE_PORTS.items():
@@ -444,24 +467,7 @@ class _Builder:
                     with m.Case(a):
                         m.d.sync += self.regs[register.name].eq(value & register.mask)
                         if register is _SET:
-                            self.apply_set(value)
-
-    def apply_set(self, value: Value) -> None:
-        """A SET value with an applicable length code configures the device (Tables 3-11, 3-12; UP-20). The table
-        is a ROM indexed by (ExtReg, ID12..8): an entry per key, not a comparator per applicable key."""
-        m = self.m
-        key = Cat(value[_LENGTH_CODE.lsb : _LENGTH_CODE.lsb + _LENGTH_CODE.width], value[_EXTREG.lsb])
-        codes = self.tables.set_codes
-        entries = [codes.get(divmod(key_value, 1 << _LENGTH_CODE.width)) for key_value in range(1 << len(key))]
-        applies = Array(Const(code is not None) for code in entries)[key]
-        code = Array(Const(code or 0, _LENGTH_CODE.width) for code in entries)[key]
-        with m.If(applies):
-            m.d.sync += [
-                self.configured.eq(1),
-                self.cfg_extreg.eq(value[_EXTREG.lsb]),
-                self.cfg_code.eq(code),
-                self.cfg_pcp_n.eq(value[_PCP_N.lsb]),
-            ]
+                            self.m.d.sync += self.set_written.eq(1)
 
     # 3. Outputs: the state decoded (SlavePins._decode), then the bit rate's pipeline (UP-14) ---------------------
 
@@ -482,7 +488,7 @@ class _Builder:
         # output stage holds a value decoded since the power-up reset, else the output shows its power-up level
         # (as stages reset to it would). The bit sent goes through one pipeline for both data pins, each gated by
         # its delayed enable.
-        filled = self.delay("filled", Const(1), init=0)
+        filled = self.tap(self.filled_stages)
         power_up = self.tables.reset_outputs
         delayed = {
             name: value if isinstance(value, Const) else Mux(filled, self.delay(name, value), power_up[name])
@@ -492,14 +498,31 @@ class _Builder:
         delayed.update({"mfp6": sent & delayed["mfp6_oe"], "mfp7": sent & delayed["mfp7_oe"]})
         m.d.comb += [getattr(b, name).eq(value) for name, value in delayed.items()]
 
-    def delay(self, name: str, value: Value, *, init: int | None = None) -> Value:
-        """``value`` through the bit rate's output pipeline (UP-14): stages without reset, or reset to ``init``."""
+    def delay(self, name: str, value: Value) -> Value:
+        """``value`` through the bit rate's output pipeline (UP-14), of stages without reset."""
+        return self.tap(self.stages(name, value))
+
+    def stages(self, name: str, value: Value, *, init: int | None = None) -> list[Value]:
+        """``value`` and the longest output pipeline's stages after it: without reset, or reset to ``init``. The
+        synchronisers read the second stage of the ``filled`` pipeline, so there are at least that many.
+
+        Raises
+        ------
+        ValueError
+            If the longest output pipeline is shorter than the synchronisers (UP-13, UP-14).
+        """
+        if max(self.tables.output_delay) < SYNC_STAGES:
+            raise ValueError(f"the output pipeline needs at least {SYNC_STAGES} stages, the synchronisers' flops")
         m = self.m
         taps: list[Value] = [value]
         for stage in range(max(self.tables.output_delay)):
             stage_signal = Signal(name=f"{name}_d{stage + 1}", init=init or 0, reset_less=init is None)
             m.d.sync += stage_signal.eq(taps[-1])
             taps.append(stage_signal)
+        return taps
+
+    def tap(self, taps: list[Value]) -> Value:
+        """The output of a pipeline's ``taps`` (:meth:`stages`) at the bit rate's delay (UP-14)."""
         return Array(taps[delay] for delay in self.tables.output_delay)[self.b.rate]
 
 

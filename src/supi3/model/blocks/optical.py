@@ -9,7 +9,7 @@ by cycle (``tests/test_verif_lockstep_optical.py``). Decisions: OPT-20 onward of
 
 What happens at the clock edge ending a cycle, from that cycle's inputs (:mod:`supi3.pinlevel`), first match wins:
 
-1. ``ib_reset`` high: every transmitter off (OPT-21), the length timers stop, the 6 ms counter stops.
+1. ``ib_reset`` high: every transmitter off (OPT-21), the length timer stops, the 6 ms counter stops.
 2. The first cycle with ``ib_reset`` low after it was high (its falling edge): every interface starts
    (:func:`~supi3.optical.regulation.start` with ``mode`` and ``present``) and the 6 ms counter is loaded with
    :data:`~supi3.optical.regulation.INIT_TIME_LIMIT_CLOCKS`.
@@ -22,11 +22,13 @@ What happens at the clock edge ending a cycle, from that cycle's inputs (:mod:`s
 After 3, when the interface that was initializing no longer is (regulated, fallen back or timed out), the 6 ms counter
 is loaded again: each interface has its own budget, in :data:`~supi3.optical.regulation.INIT_ORDER` (OPT-56).
 
-The length timers of the outgoing interface and the branch run at every edge, ib_reset aside: ``len_start`` clears
-and starts one; while it runs, every :func:`~supi3.optical.regulation.length_timer_enable_every`-th edge after the
-start counts one (saturating at :data:`LENGTH_COUNT_BITS` bits); ``len_stop`` stops it after that edge's count and,
-unless the block is off, stores :func:`~supi3.optical.length.timer_code` of the count with the ``medium`` bit
-(OPT-24). A ``len_start`` in the same cycle as a ``len_stop`` restarts it.
+One length timer measures the outgoing interface or the branch (OPT-57), at every edge, ib_reset aside: a
+``len_start`` of either clears and starts it for that path (the outgoing interface's when both start at one edge; a
+start for one path while it runs for the other abandons that measurement); while it runs, every
+:func:`~supi3.optical.regulation.length_timer_enable_every`-th edge after the start counts one (saturating at
+:data:`LENGTH_COUNT_BITS` bits); the ``len_stop`` of the path it runs for stops it after that edge's count and, unless
+the block is off, stores :func:`~supi3.optical.length.timer_code` of the count with that path's ``medium`` bit
+(OPT-24); the other path's ``len_stop`` does nothing. A ``len_start`` in the same cycle as a ``len_stop`` restarts it.
 
 Outputs during a cycle come from the state (``fo`` also from ``run``): ``optical`` is
 :func:`~supi3.optical.regulation.registers` of the status, byte k = read 8 + k; ``optical_we`` bit k is set while
@@ -98,12 +100,14 @@ def _quiet_arguments(n: object, values: object) -> int:
 
 
 class _Timer:
-    """One length timer: running, the clocks since the last count, the count."""
+    """The length timer (OPT-57): running, the path it measures (index into :data:`MEASURED`), the clocks since the
+    last count, the count."""
 
-    __slots__ = ("count", "prescale", "running")
+    __slots__ = ("count", "path", "prescale", "running")
 
     def __init__(self) -> None:
         self.running = False
+        self.path = 0
         self.prescale = 0
         self.count = 0
 
@@ -129,11 +133,11 @@ class OpticalBlock:
         self.reset()
 
     def reset(self) -> None:
-        """The state after the ``sync`` reset (power-up): every transmitter off, nothing measured, timers idle."""
+        """The state after the ``sync`` reset (power-up): every transmitter off, nothing measured, the timer idle."""
         self.status = OpticalStatus()
         self.countdown = 0
         self._in_reset = False
-        self._timers = (_Timer(), _Timer())
+        self._timer = _Timer()
         self._outputs_of: OpticalStatus | None = None
         self._regs = self._shown = registers(self.status)
         self._optical = self._mau = self._hold = 0
@@ -186,8 +190,7 @@ class OpticalBlock:
         """The clock edge ending the current cycle, with that cycle's inputs ``values`` (checked by the caller: every
         input pin, each within its width); :meth:`outputs_now` must have been called in the cycle (it keeps what the
         cycle showed for ``optical_we``)."""
-        if self._in_reset or self.countdown or any(values[name] for name in _STROBES) or any(
-                timer.running for timer in self._timers):  # fmt: skip
+        if self._in_reset or self.countdown or self._timer.running or any(values[name] for name in _STROBES):
             self._edge(values)
         self._shown = self._regs
         self.cycle += 1
@@ -195,7 +198,7 @@ class OpticalBlock:
     def quiet(self, n: int, values: Mapping[str, int]) -> None:
         """``n`` clocks (outputs and edges) with the inputs ``values`` held, which must have no strobe but possibly
         ``ib_reset``: the same state as ``n`` :meth:`step` calls, in one go once only the counters move (the 6 ms
-        counter and the length timers; the event-driven pin level, :meth:`supi3.model.pins.Supi3Pins.run`).
+        counter and the length timer; the event-driven pin level, :meth:`supi3.model.pins.Supi3Pins.run`).
 
         Raises
         ------
@@ -215,11 +218,11 @@ class OpticalBlock:
             return
         if not self._in_reset:  # no edge changes the status: the counters move by n (OPT-24, OPT-25)
             self.countdown = max(self.countdown - n, 0)
-            every = length_timer_enable_every(BIT_RATES[values["fast"]])
-            for timer in self._timers:
-                if timer.running:
-                    ticks, timer.prescale = divmod(timer.prescale + n, every)
-                    timer.count = min(timer.count + ticks, (1 << LENGTH_COUNT_BITS) - 1)
+            timer = self._timer
+            if timer.running:
+                every = length_timer_enable_every(BIT_RATES[values["fast"]])
+                ticks, timer.prescale = divmod(timer.prescale + n, every)
+                timer.count = min(timer.count + ticks, (1 << LENGTH_COUNT_BITS) - 1)
         self.cycle += n
 
     def next_change(self, ib_reset: int) -> int | None:
@@ -240,8 +243,7 @@ class OpticalBlock:
                 self.log.add(self.cycle, "INTERBUS reset: transmitters off")
             self._in_reset = True
             self.countdown = 0
-            for timer in self._timers:
-                timer.running = False
+            self._timer.running = False
             off = (Transmitter(), Transmitter(), Transmitter())
             if status.transmitters != off:
                 self.status = OpticalStatus(off, status.length, status.medium)
@@ -265,7 +267,7 @@ class OpticalBlock:
             status = OpticalStatus((txs[0], txs[1], txs[2]), status.length, status.medium)
             if current is not None and txs[current].phase is not Phase.INIT:  # the next one's own 6 ms (OPT-56)
                 self.countdown = self.time_limit
-        if v["len_start"] or v["len_stop"] or self._timers[0].running or self._timers[1].running:
+        if v["len_start"] or v["len_stop"] or self._timer.running:
             status = self._lengths(status, v, mode, bit_rate)
         self.status = status
 
@@ -283,22 +285,23 @@ class OpticalBlock:
         return tx
 
     def _lengths(self, status: OpticalStatus, v: Mapping[str, int], mode: OpticalMode, bit_rate: int) -> OpticalStatus:
-        """The length timers' edge (see the module docstring)."""
-        every = length_timer_enable_every(bit_rate)
-        for timer, i in zip(self._timers, MEASURED, strict=True):
-            if timer.running:
-                timer.prescale += 1
-                if timer.prescale == every:
-                    timer.prescale = 0
-                    timer.count = min(timer.count + 1, (1 << LENGTH_COUNT_BITS) - 1)
-                if v["len_stop"] >> i & 1:
-                    timer.running = False
-                    if mode is not OpticalMode.OFF:
-                        medium = Medium(v["medium"] >> i & 1)
-                        status = status.with_length(i, timer_code(timer.count, bit_rate, medium), medium)
-                        self.log.add(self.cycle, "{} length: {} counts", i.name, timer.count)
-            if v["len_start"] >> i & 1:
-                timer.running, timer.prescale, timer.count = True, 0, 0
+        """The length timer's edge (see the module docstring)."""
+        timer = self._timer
+        if timer.running:
+            timer.prescale += 1
+            if timer.prescale == length_timer_enable_every(bit_rate):
+                timer.prescale = 0
+                timer.count = min(timer.count + 1, (1 << LENGTH_COUNT_BITS) - 1)
+            i = MEASURED[timer.path]
+            if v["len_stop"] >> i & 1:
+                timer.running = False
+                if mode is not OpticalMode.OFF:
+                    medium = Medium(v["medium"] >> i & 1)
+                    status = status.with_length(i, timer_code(timer.count, bit_rate, medium), medium)
+                    self.log.add(self.cycle, "{} length: {} counts", i.name, timer.count)
+        started = [k for k, i in enumerate(MEASURED) if v["len_start"] >> i & 1]
+        if started:  # the first of MEASURED wins (OPT-57)
+            timer.running, timer.path, timer.prescale, timer.count = True, started[0], 0, 0
         return status
 
     def recent_events(self) -> list[str]:
