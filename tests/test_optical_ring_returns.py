@@ -12,7 +12,7 @@ from supi3 import tables
 from supi3.config import DeviceConfig, decode
 from supi3.diagnostics import IbDiag
 from supi3.interbus import wire
-from supi3.interbus.ring import Branch, BranchKind, Bus, DeadLine, ErrorKind, Ring
+from supi3.interbus.ring import Branch, BranchKind, Bus, ErrorKind, Ring
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
 from supi3.model.pinring import PinBranch, PinRing
@@ -89,17 +89,21 @@ def _dark(ring: OpticalRing, k: int, locate: bool) -> list[object]:
     return line_break(ring, lambda: ring.ring.devices, locate, cut, repair)
 
 
-def _cut(ring: PinRing, position: int, branch: bool) -> list[object]:
+def _cut(ring: PinRing | Ring, position: int, branch: bool, forward: bool = False) -> list[object]:
     """:func:`~test_model_pinring_tree.line_break` with the return input into ``position`` cut (``branch``: the BK's
-    DI3 there) after :func:`_settle`, the twin of :func:`_dark`."""
+    DI3 there; ``forward`` at N + 1: the return line into the master, BK-60) after :func:`_settle`, the twin of
+    :func:`_dark`."""
 
     def cut() -> None:
         _settle(ring)
-        ring.cut(position, False, branch=branch)
+        ring.cut(position, forward, branch=branch)
 
     def repair() -> None:
-        ring.cuts.clear()
-        ring.branch_cuts.clear()
+        if isinstance(ring, Ring):
+            ring.clear_faults()
+        else:
+            ring.cuts.clear()
+            ring.branch_cuts.clear()
 
     return line_break(ring, lambda: ring.devices, False, cut, repair)
 
@@ -147,25 +151,22 @@ def test_a_dark_return_fibre_in_a_tree_is_a_return_break_at_both_fidelities(kind
     assert [(d[1], d[4]) for d in located[2]] == [(ends[0], True) if in_branch else (ends[1], False)]
 
 
-def test_the_first_return_fibre_is_the_return_line_into_the_master() -> None:
-    """OPT-57: the return fibre of cable 1 carries the return line into the master (the transaction level's line
-    N + 1): every chip hears the frames and latches nothing, the master gets nothing back, as with ``DeadLine(N +
-    1)`` on the plain ring; its segment search names the return line (before, a dead line into chip 1: no chip heard
-    anything)."""
-    ring, _ = _flat(3)
+@pytest.mark.parametrize("n", [1, 3])
+def test_the_first_return_fibre_is_the_return_line_into_the_master(n: int) -> None:
+    """OPT-57, BK-60: the return fibre of cable 1 carries the return line into the master (line N + 1): every chip
+    hears the frames and latches nothing, the master gets nothing back, as with the pin-level ring's and the plain
+    transaction-level ring's ``cut(N + 1, True)``; the optical ring's segment search names the return line (before,
+    a dead line into chip 1: no chip heard anything)."""
+    ring, pin = _flat(n)
     seen = _dark(ring, 1, False)
-    tl = [Supi3(_config(ROWS[BranchKind.REMOTE])) for _ in range(3)]
+    assert seen == _cut(pin, n + 1, False, forward=True)
+    tl = [Supi3(_config(ROWS[BranchKind.REMOTE])) for _ in range(n)]
     for k, chip in enumerate(tl, 1):
         chip.set_mfp_inputs(0x10 * k)
-    twin = Ring(tl, bit_rate=2_000_000)
-
-    def cut() -> None:
-        _settle(twin)
-        twin.inject(DeadLine(4))
-
-    assert seen == line_break(twin, lambda: twin.devices, False, cut, twin.clear_faults)
+    assert seen == _cut(Ring(tl, bit_rate=2_000_000), n + 1, False, forward=True)
+    assert seen[2] == (Cycle.DATA, False, [(ErrorKind.DEAD_LINE, None, None, "no telegram came back", False)])
     leds = seen[5]
-    assert isinstance(leds, list) and [chip[8] for chip in leds] == [1, 1, 1]
-    located = _dark(_flat(3)[0], 1, True)[2]
-    assert located == (Cycle.DATA, False, [(ErrorKind.DEAD_LINE, 4, None, "no telegram came back; segment search: "
-                                            "the return line", False)])  # fmt: skip
+    assert isinstance(leds, list) and [chip[8] for chip in leds] == [1] * n
+    located = _dark(_flat(n)[0], 1, True)[2]
+    assert located == (Cycle.DATA, False, [(ErrorKind.DEAD_LINE, n + 1, None, "no telegram came back; segment "
+                                            "search: the return line", False)])  # fmt: skip
