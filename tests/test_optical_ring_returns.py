@@ -6,12 +6,15 @@ every chip's LEDs, OUT data and valid data cycles, before and after the repair, 
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+
 import pytest
 
 from supi3 import tables
 from supi3.config import DeviceConfig, decode
 from supi3.diagnostics import IbDiag
 from supi3.interbus import wire
+from supi3.interbus.master import CycleResult, Master
 from supi3.interbus.ring import Branch, BranchKind, Bus, ErrorKind, Ring
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
@@ -129,8 +132,15 @@ def test_a_dark_return_fibre_is_a_return_break_at_both_fidelities(n: int) -> Non
                            f"segment search: the ring fails when closed after position {k}", False)])  # fmt: skip
 
 
-@pytest.mark.parametrize("kind", [BranchKind.LOCAL, BranchKind.LBD_MR])
-@pytest.mark.parametrize("k", sorted(TREE_RETURNS))
+SLOW = pytest.mark.slow
+"""The longer cases: the remote bus's return fibres around a BK-LB (the same lines as around a BK-LBD, compared in the
+quick runs), a return fibre dark through the reset beyond a branch."""
+
+
+@pytest.mark.parametrize(("kind", "k"), [
+    *((BranchKind.LBD_MR, k) for k in sorted(TREE_RETURNS)), (BranchKind.LOCAL, 3), (BranchKind.LOCAL, 4),
+    pytest.param(BranchKind.LOCAL, 2, marks=SLOW), pytest.param(BranchKind.LOCAL, 5, marks=SLOW),
+])  # fmt: skip
 def test_a_dark_return_fibre_in_a_tree_is_a_return_break_at_both_fidelities(kind: BranchKind, k: int) -> None:
     """OPT-57, OPT-54, BK-59: every return fibre of the tree RB, BK, 2 branch chips, RB: on the remote bus (before
     the BK, and from the RB chip behind the branch into the BK's outgoing interface) and in the branch (into the
@@ -170,3 +180,65 @@ def test_the_first_return_fibre_is_the_return_line_into_the_master(n: int) -> No
     located = _dark(_flat(n)[0], 1, True)[2]
     assert located == (Cycle.DATA, False, [(ErrorKind.DEAD_LINE, n + 1, None, "no telegram came back; segment "
                                             "search: the return line", False)])  # fmt: skip
+
+
+def _restarts(ring: Bus, devices: Callable[[], Sequence[object]], cut: Callable[[], None],
+              repair: Callable[[], None]) -> list[object]:  # fmt: skip
+    """What a master sees when a line is broken from before its start: two starts (an INTERBUS reset, the optical
+    initialization on the optical ring) each with a cycle, every chip's LEDs, OUT data and valid count; then the
+    repair, a start and two cycles, and the chips again."""
+    master = Master(ring, locate=False, max_devices=8)
+    cut()
+    seen: list[object] = []
+
+    def record(result: CycleResult) -> None:
+        seen.append((result.cycle, result.ok, [(d.kind, d.location, d.detail) for d in result.diagnostics]))
+
+    def chips() -> None:
+        if isinstance(ring, PinRing):
+            ring.settle()
+        found = []
+        for device in devices():
+            chip = device.chip if isinstance(device, Supi3Pins) else device
+            assert isinstance(chip, Supi3)
+            leds = chip.diagnostic_outputs
+            found.append((leds.rc, leds.ba, leds.rd, leds.ld, leds.e, leds.ib_diag, chip.mfp_outputs,
+                          chip.events["VALID"]))  # fmt: skip
+        seen.append(found)
+
+    for _ in range(2):
+        record(master.start())
+        record(master.cycle())
+    chips()
+    repair()
+    record(master.start())
+    for _ in range(2):
+        record(master.cycle())
+    chips()
+    return seen
+
+
+@pytest.mark.parametrize(("kind", "k"), [
+    (None, 2), (BranchKind.LOCAL, 3), pytest.param(BranchKind.LOCAL, 5, marks=SLOW),
+    pytest.param(BranchKind.LBD_MR, 4, marks=SLOW),
+])  # fmt: skip
+def test_a_return_fibre_dark_through_the_reset_is_the_same_at_both_fidelities(kind: BranchKind | None, k: int) -> None:
+    """OPT-57: a return fibre dark from before the master's start: the INTERBUS reset reaches every chip (a return line
+    of the remote bus stops nothing, BK-59; one of a branch stops it behind that branch, BK-10, the optical ring's
+    initialization with it), the starts fail alike at both fidelities, the chips show the same; repaired, the start
+    and the cycles pass alike. Cases: a flat ring's, the BK-LB branch's DI3 and the return line into the BK from the
+    chip behind its branch, a return line inside an LBD-MR branch."""
+    ring, pin = _flat(3) if kind is None else _tree(kind)
+    link = ring.links[k - 1]
+    assert link is not None
+    position, branch = (k - 1, False) if kind is None else TREE_RETURNS[k]
+
+    def repair() -> None:
+        pin.cuts.clear()
+        pin.branch_cuts.clear()
+
+    seen = _restarts(ring, lambda: ring.ring.devices, lambda: link.add(Bend(0.0, None, DARK_DB, Direction.RETURN)),
+                     link.events.clear)  # fmt: skip
+    assert seen == _restarts(pin, lambda: pin.devices, lambda: pin.cut(position, False, branch=branch), repair)
+    assert not any(result[1] for result in seen[:4])  # type: ignore[index]
+    assert all(result[1] for result in seen[5:8])  # type: ignore[index]
