@@ -491,6 +491,21 @@ ChipView = tuple[bool, bool, bool, bool, bool, bool, IbDiag, int, int]
 """A chip's RC, BA, RD, LD, E, ALARM, IB_DIAG pattern, OUT data and valid data cycles latched."""
 
 
+def chip_views(ring: Bus, devices: Sequence[object]) -> list[ChipView]:
+    """Every chip's :data:`ChipView` of ``devices`` (the data path of ``ring``), once the telegrams sent have reached
+    every chip (``PinRing.settle``)."""
+    if isinstance(ring, PinRing):
+        ring.settle()
+    found: list[ChipView] = []
+    for device in devices:
+        chip = device.chip if isinstance(device, Supi3Pins) else device
+        assert isinstance(chip, Supi3)
+        leds = chip.diagnostic_outputs
+        found.append((leds.rc, leds.ba, leds.rd, leds.ld, leds.e, leds.alarm, leds.ib_diag, chip.mfp_outputs,
+                      chip.events["VALID"]))  # fmt: skip
+    return found
+
+
 def remote_return_cut(ring: Ring | PinRing, position: int, locate: bool) -> list[object]:
     """What a master sees when the remote bus's return input into ``position`` is cut (BK-59): :func:`line_break`
     with ``ring.cut(position, False)`` and its repair."""
@@ -520,16 +535,7 @@ def line_break(ring: Bus, devices: Callable[[], Sequence[object]], locate: bool,
                 master.set_outputs(entry.number, bytes([value + entry.ring_position]))
 
     def chips() -> list[ChipView]:
-        if isinstance(ring, PinRing):
-            ring.settle()
-        found: list[ChipView] = []
-        for device in devices():
-            chip = device.chip if isinstance(device, Supi3Pins) else device
-            assert isinstance(chip, Supi3)
-            leds = chip.diagnostic_outputs
-            found.append((leds.rc, leds.ba, leds.rd, leds.ld, leds.e, leds.alarm, leds.ib_diag, chip.mfp_outputs,
-                          chip.events["VALID"]))  # fmt: skip
-        return found
+        return chip_views(ring, devices())
 
     def cycles() -> None:
         for _ in range(3):

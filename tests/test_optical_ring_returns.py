@@ -24,7 +24,7 @@ from supi3.optical.link import Bend, Direction, FibreLink
 from supi3.optical.ring import OpticalRing
 from supi3.terminal import LBST_PIN
 from support import BK_STRAPS, REPAIR_IDLE_TELEGRAMS
-from test_model_pinring_tree import ROWS, line_break
+from test_model_pinring_tree import ROWS, chip_views, line_break
 
 FAST = tables.clk_conf_for(2_000_000)
 DARK_DB = 60.0
@@ -194,27 +194,15 @@ def _restarts(ring: Bus, devices: Callable[[], Sequence[object]], cut: Callable[
     def record(result: CycleResult) -> None:
         seen.append((result.cycle, result.ok, [(d.kind, d.location, d.detail) for d in result.diagnostics]))
 
-    def chips() -> None:
-        if isinstance(ring, PinRing):
-            ring.settle()
-        found = []
-        for device in devices():
-            chip = device.chip if isinstance(device, Supi3Pins) else device
-            assert isinstance(chip, Supi3)
-            leds = chip.diagnostic_outputs
-            found.append((leds.rc, leds.ba, leds.rd, leds.ld, leds.e, leds.ib_diag, chip.mfp_outputs,
-                          chip.events["VALID"]))  # fmt: skip
-        seen.append(found)
-
     for _ in range(2):
         record(master.start())
         record(master.cycle())
-    chips()
+    seen.append(chip_views(ring, devices()))
     repair()
     record(master.start())
     for _ in range(2):
         record(master.cycle())
-    chips()
+    seen.append(chip_views(ring, devices()))
     return seen
 
 
