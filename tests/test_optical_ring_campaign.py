@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 from supi3.config import decode
 from supi3.interbus import wire
 from supi3.interbus.master import Master
-from supi3.interbus.ring import BitFlip, Branch, BranchKind, ErrorKind, Fault, Transfer
+from supi3.interbus.ring import Branch, BranchKind, ErrorKind, Fault, Transfer
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
 from supi3.optical.link import Ageing, Bend, Direction, Event, FibreLink, Pull, Temperature
@@ -98,8 +98,8 @@ def _build(scenario: Scenario, seed: int) -> tuple[OpticalRing, list[Supi3]]:
 
 
 Break = tuple[str, int, bool]
-"""A line the fibres broke, as the ring got it: ``("DeadLine", line, False)`` or ``("ReturnBreak", p, branch)``, the
-return input into ring position p (``branch``: the BK's DI3 there)."""
+"""A fault the fibres put on the ring, as the ring got it: ``("DeadLine", line, False)``, ``("BitFlip", line, False)``
+or ``("ReturnBreak", p, branch)``, the return input into ring position p (``branch``: the BK's DI3 there)."""
 
 
 def _cable_faults(ring: OpticalRing, kind: BranchKind | None, k: int) -> tuple[int, int, set[Break], Break | None]:
@@ -167,9 +167,8 @@ def _campaign(scenario: Scenario, cycles: int, seed: int) -> None:
     inject, cut, transfer = ring.ring.inject, ring.ring.cut, ring.ring.transfer
 
     def spy_inject(fault: Fault) -> None:
-        if not isinstance(fault, BitFlip):
-            injected.append((type(fault).__name__, fault.segment, False))
-            pending.append(injected[-1])
+        injected.append((type(fault).__name__, fault.segment, False))
+        pending.append(injected[-1])
         inject(fault)
 
     def spy_cut(position: int, forward: bool, *, branch: bool = False) -> None:
@@ -218,15 +217,19 @@ def _campaign(scenario: Scenario, cycles: int, seed: int) -> None:
                 assert chip.out_word in (latched[k], 0)  # unchanged, or cleared by a reset
             latched[k] = chip.out_word
         # -- every break is located at the right position: on a line the fibres broke (a broken return line: by the
-        #    counter telegram at its position in an LBD branch, by the segment search at the device driving it)
+        #    counter telegram at its position in an LBD branch, by the segment search at the device driving it); a
+        #    marginal fibre's random bit errors hit some probes of the segment search and miss others, and every
+        #    probe closed at or behind its line crosses it, so the search lands there or behind it
         allowed = {(s, False) for kind, s, _ in injected if kind == "DeadLine"}
+        flips = [s for kind, s, _ in injected if kind == "BitFlip"]
         for kind, p, branch in injected:
             if kind == "ReturnBreak":
                 allowed |= {(p, True), (_driver(ring, p, branch), False)}
         for d in result.diagnostics:
             if d.location is None or d.kind in (ErrorKind.PERIPHERAL_FAULT, ErrorKind.WATCHDOG, ErrorKind.MAU_WARNING):
                 continue
-            assert (d.location, d.return_line) in allowed, (d, injected)
+            behind = not d.return_line and any(d.location >= s for s in flips)
+            assert (d.location, d.return_line) in allowed or behind, (d, injected)
         met = set(per_transfer)
         if configured and not result.ok and len(met) == 1 and (faults := met.pop()):
             # the same breaks of one cable all through the cycle and its search: located exactly (OPT-54, OPT-57,
@@ -304,9 +307,19 @@ def test_tree_campaign_quick(scenario: Scenario, seed: int) -> None:
     _campaign(scenario, 300, seed)
 
 
+SEARCH_BEHIND_BIT_ERRORS = Scenario(BranchKind.LOCAL, [63.0, 68.0, 41.0, 58.0, 27.0, 18.0, 47.0], [
+    (2, Bend(0.086944, 0.015048, DARK_DB, Direction.RETURN)), (6, Ageing(0.246202, 60.0, limit_db=3.0)),
+    (4, Bend(0.331056, 0.086526, 2.5)), (3, Bend(0.0, 0.023826, 6.0, Direction.FORWARD)), (2, Pull(0.0, 0.003344)),
+])  # fmt: skip
+"""Found by a soak of 200 random histories (seed 36428): right after the pull, the marginal forward fibre of cable 3
+flips bits in the probes closed after 6 and not in those closed after 4 and 5, so the segment search names 6, behind
+the line the bit errors are on."""
+
+
 @pytest.mark.slow
 @settings(max_examples=8, deadline=None, phases=(Phase.explicit, Phase.generate))
 @given(scenarios(cycles=1500, kinds=TREES), st.integers(0, 2**16))
+@example(SEARCH_BEHIND_BIT_ERRORS, 36428)
 def test_tree_campaign_long(scenario: Scenario, seed: int) -> None:
     _campaign(scenario, 1500, seed)
 
