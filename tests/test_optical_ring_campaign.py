@@ -248,8 +248,9 @@ def _campaign(scenario: Scenario, cycles: int, seed: int) -> None:
         elif failed and not any(ring.dark(k) for k in range(1, len(cables) + 1)):
             restarts.append(ring.now)  # repaired: the master restarts the bus (a marginal fibre may fail it)
             failed = not master.start().ok
-    # -- regulation never oscillates: each transmitter's level moves one way only between jumps of the physics
-    #    (anywhere) and the restarts; a MAU warning comes on at MAX only
+    # -- regulation never oscillates: between jumps of the physics (anywhere) and the restarts, each transmitter's
+    #    level never falls after it rose (it may still be settling down when an ageing drift, whose loss only grows,
+    #    begins to push it up again); a MAU warning comes on at MAX only
     # -- the master knows every MAU warning on (OPT-52), once the physics is still and the ring runs
     assert quiet <= QUIET or master.mau_warnings == {
         k: mau for k, chip in enumerate(ring.ring.devices, 1)
@@ -261,7 +262,7 @@ def _campaign(scenario: Scenario, cycles: int, seed: int) -> None:
             for low, high in itertools.pairwise(cuts):
                 levels = [getattr(s, attr) for s in samples if low < s.time_s < high]
                 steps = [b - a for a, b in itertools.pairwise(levels) if b != a]
-                assert all(s > 0 for s in steps) or all(s < 0 for s in steps), (k, attr, low, levels)
+                assert not any(a > 0 > b for a, b in itertools.combinations(steps, 2)), (k, attr, low, levels)
     for report in ring.reports:
         if report.on:
             if report.interface is Interface.IN:
@@ -272,6 +273,30 @@ def _campaign(scenario: Scenario, cycles: int, seed: int) -> None:
                 k, attr = sent_to[report.interface is Interface.OUT and len(sent_to) > 1], "forward_level"
             sample = next(s for s in ring.history[k - 1] if s.time_s == report.time_s)
             assert getattr(sample, attr) == MAX_LEVEL
+
+
+SEARCH_BEHIND_BIT_ERRORS = Scenario(BranchKind.LOCAL, [63.0, 68.0, 41.0, 58.0, 27.0, 18.0, 47.0], [
+    (2, Bend(0.086944, 0.015048, DARK_DB, Direction.RETURN)), (6, Ageing(0.246202, 60.0, limit_db=3.0)),
+    (4, Bend(0.331056, 0.086526, 2.5)), (3, Bend(0.0, 0.023826, 6.0, Direction.FORWARD)), (2, Pull(0.0, 0.003344)),
+])  # fmt: skip
+"""Found by a soak of 200 random histories: right after the pull, the marginal forward fibre of cable 3 flips bits in
+the probes closed after 6 and not in those closed after 4 and 5, so the segment search names 6, behind the line the
+bit errors are on."""
+SEARCH_BEHIND_A_NEW_BREAK = Scenario(BranchKind.LBD_MR, [72.0, 58.0, 8.0, 26.0, 47.0, 53.0, 18.0], [
+    (1, Bend(0.012958, 0.173888, DARK_DB, Direction.RETURN)), (6, Pull(0.173888, 0.15884)),
+    (1, Bend(0.0, 0.000418, 1.0, Direction.FORWARD)), (7, Pull(0.288002, 0.023826)), (6, Bend(0.068552, 0.03135, 2.5)),
+    (4, Pull(0.0, 0.055176)),
+])  # fmt: skip
+"""Found by the same soak: the first cable's return fibre dark (nothing comes back, every probe closed early passes,
+OPT-57), then cable 6 pulled while the segment search has passed position 6: the probe closed after 7 fails, twice,
+and the search names 7, behind the new break."""
+SETTLING_INTO_A_DRIFT = Scenario(None, [26.0, 13.0, 70.0, 62.0, 8.0], [
+    (1, Ageing(0.368836, 20.0, limit_db=1.0)), (1, Pull(0.134248, 0.019376)), (5, Ageing(0.191338, 60.0, limit_db=1.0)),
+    (1, Ageing(0.011072, 20.0, limit_db=1.0)), (3, Ageing(0.232166, 60.0, limit_db=3.0)),
+])  # fmt: skip
+"""Found by the same soak (seed 1111): after the restart cable 5's forward transmitter still settles down (2 -> 1)
+when its ageing begins, which then pushes it up again (1 -> 2) within the same drift: no oscillation (the earlier
+check, one direction only between jumps, failed it on main too)."""
 
 
 def _dark_returns(kind: BranchKind | None, cables: tuple[int, ...]) -> Scenario:
@@ -293,6 +318,7 @@ def test_campaign_quick(scenario: Scenario, seed: int) -> None:
 @pytest.mark.slow
 @settings(max_examples=8, deadline=None, phases=(Phase.explicit, Phase.generate))
 @given(scenarios(cycles=1500), st.integers(0, 2**16))
+@example(SETTLING_INTO_A_DRIFT, 1111)
 def test_campaign_long(scenario: Scenario, seed: int) -> None:
     _campaign(scenario, 1500, seed)
 
@@ -306,23 +332,6 @@ TREES = (BranchKind.LBD_MR, BranchKind.LBD_OR, BranchKind.LOCAL)
 @example(_dark_returns(BranchKind.LBD_MR, (4, 6, 7)), 0)  # the count names the return line (BK-7)
 def test_tree_campaign_quick(scenario: Scenario, seed: int) -> None:
     _campaign(scenario, 300, seed)
-
-
-SEARCH_BEHIND_BIT_ERRORS = Scenario(BranchKind.LOCAL, [63.0, 68.0, 41.0, 58.0, 27.0, 18.0, 47.0], [
-    (2, Bend(0.086944, 0.015048, DARK_DB, Direction.RETURN)), (6, Ageing(0.246202, 60.0, limit_db=3.0)),
-    (4, Bend(0.331056, 0.086526, 2.5)), (3, Bend(0.0, 0.023826, 6.0, Direction.FORWARD)), (2, Pull(0.0, 0.003344)),
-])  # fmt: skip
-"""Found by a soak of 200 random histories: right after the pull, the marginal forward fibre of cable 3 flips bits in
-the probes closed after 6 and not in those closed after 4 and 5, so the segment search names 6, behind the line the
-bit errors are on."""
-SEARCH_BEHIND_A_NEW_BREAK = Scenario(BranchKind.LBD_MR, [72.0, 58.0, 8.0, 26.0, 47.0, 53.0, 18.0], [
-    (1, Bend(0.012958, 0.173888, DARK_DB, Direction.RETURN)), (6, Pull(0.173888, 0.15884)),
-    (1, Bend(0.0, 0.000418, 1.0, Direction.FORWARD)), (7, Pull(0.288002, 0.023826)), (6, Bend(0.068552, 0.03135, 2.5)),
-    (4, Pull(0.0, 0.055176)),
-])  # fmt: skip
-"""Found by the same soak: the first cable's return fibre dark (nothing comes back, every probe closed early passes,
-OPT-57), then cable 6 pulled while the segment search has passed position 6: the probe closed after 7 fails, twice,
-and the search names 7, behind the new break."""
 
 
 @pytest.mark.slow
