@@ -133,13 +133,14 @@ def test_a_dark_return_fibre_is_a_return_break_at_both_fidelities(n: int) -> Non
 
 
 SLOW = pytest.mark.slow
-"""The longer cases: the remote bus's return fibres around a BK-LB (the same lines as around a BK-LBD, compared in the
-quick runs), a return fibre dark through the reset beyond a branch."""
+"""The longer cases: the return fibres of a BK-LB tree but its DI3 (the same lines as in a BK-LBD tree, compared in
+the quick runs), a return fibre dark through the reset beyond a branch."""
 
 
 @pytest.mark.parametrize(("kind", "k"), [
-    *((BranchKind.LBD_MR, k) for k in sorted(TREE_RETURNS)), (BranchKind.LOCAL, 3), (BranchKind.LOCAL, 4),
-    pytest.param(BranchKind.LOCAL, 2, marks=SLOW), pytest.param(BranchKind.LOCAL, 5, marks=SLOW),
+    *((BranchKind.LBD_MR, k) for k in sorted(TREE_RETURNS)), (BranchKind.LOCAL, 3),
+    pytest.param(BranchKind.LOCAL, 4, marks=SLOW), pytest.param(BranchKind.LOCAL, 2, marks=SLOW),
+    pytest.param(BranchKind.LOCAL, 5, marks=SLOW),
 ])  # fmt: skip
 def test_a_dark_return_fibre_in_a_tree_is_a_return_break_at_both_fidelities(kind: BranchKind, k: int) -> None:
     """OPT-57, OPT-54, BK-59: every return fibre of the tree RB, BK, 2 branch chips, RB: on the remote bus (before
