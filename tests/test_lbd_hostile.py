@@ -77,7 +77,7 @@ def _ring(n: int) -> PinRing:
     (2, None, True), (2, "1", True),
 ])  # fmt: skip
 def test_a_cut_where_no_line_is_refused(n: int, position: object, forward: bool) -> None:
-    """A ring of N chips has forward inputs 1..N (and N + 1, the return line into the master, BK-60) and return
+    """A ring of N chips has forward inputs 1..N (and N + 1, the return line into the master, BK-61) and return
     inputs 1..N - 1 (the last chip loops its own): any other position is refused by name, with the rule, and nothing
     is cut."""
     ring = _ring(n)

@@ -1,5 +1,5 @@
 """The optical fault campaign (issue 12, "Reliability"): random fibre events (bends, drift, pulled connectors and
-reconnects, return fibres going dark and back: OPT-57) on a fibre-linked ring over many cycles, a plain ring and a
+reconnects, return fibres going dark and back: OPT-58) on a fibre-linked ring over many cycles, a plain ring and a
 tree with a bus terminal module and a local bus (LBD-MR, LBD-OR or LB-MR; 2.4, 2.2.2; OPT-54). Every break is
 located at the right position (the exact line in an LBD branch, BK-7; a return line at the device driving it, or
 the return line into the master); no lost or corrupted process data is ever latched; regulation never oscillates
@@ -58,7 +58,7 @@ class Scenario:
 def _event(draw: st.DrawFn, tick: float, cycles: int) -> Event:
     start = draw(st.integers(0, cycles)) * tick
     duration = draw(st.integers(1, cycles // 3)) * tick
-    # a pull is a cable break and its repair; a dark return fibre a return-line break and its repair (OPT-57)
+    # a pull is a cable break and its repair; a dark return fibre a return-line break and its repair (OPT-58)
     kind = draw(st.sampled_from(["bend", "pull", "ageing", "dark return"]))
     if kind == "bend":
         return Bend(start, duration, draw(st.sampled_from([1.0, 2.5, 4.0, 6.0, 9.0, 14.0])),
@@ -104,7 +104,7 @@ or ``("ReturnBreak", p, branch)``, the return input into ring position p (``bran
 
 def _cable_faults(ring: OpticalRing, kind: BranchKind | None, k: int) -> tuple[int, int, set[Break], Break | None]:
     """Cable *k*'s ends (ring positions), the break of its forward fibre and that of its return fibre (OPT-47,
-    OPT-57: the return line into the master, line N + 1, for the first cable; none of its own in an LBD-OR branch)."""
+    OPT-58: the return line into the master, line N + 1, for the first cable; none of its own in an LBD-OR branch)."""
     ends = ring.ends(k)
     assert ends is not None
     up, down = ends
@@ -172,7 +172,7 @@ def _campaign(scenario: Scenario, cycles: int, seed: int) -> None:
         inject(fault)
 
     def spy_cut(position: int, forward: bool, *, branch: bool = False) -> None:
-        assert not forward  # the optical ring cuts return lines only (by the physical position, OPT-57)
+        assert not forward  # the optical ring cuts return lines only (by the physical position, OPT-58)
         device = ring.chips[position - 1]
         injected.append(("ReturnBreak", next(k for k, d in enumerate(ring.ring.devices, 1) if d is device), branch))
         pending.append(injected[-1])
@@ -233,7 +233,7 @@ def _campaign(scenario: Scenario, cycles: int, seed: int) -> None:
             assert (d.location, d.return_line) in allowed or behind, (d, injected)
         met = set(per_transfer)
         if configured and not result.ok and len(met) == 1 and (faults := met.pop()):
-            # the same breaks of one cable all through the cycle and its search: located exactly (OPT-54, OPT-57,
+            # the same breaks of one cable all through the cycle and its search: located exactly (OPT-54, OPT-58,
             # BK-7): a pulled connector by its forward line (in an LBD-MR branch the count names the return line)
             for up, down, breaks, back in lines:
                 if faults <= breaks:
@@ -288,7 +288,7 @@ SEARCH_BEHIND_A_NEW_BREAK = Scenario(BranchKind.LBD_MR, [72.0, 58.0, 8.0, 26.0, 
     (4, Pull(0.0, 0.055176)),
 ])  # fmt: skip
 """Found by the same soak: the first cable's return fibre dark (nothing comes back, every probe closed early passes,
-OPT-57), then cable 6 pulled while the segment search has passed position 6: the probe closed after 7 fails, twice,
+OPT-58), then cable 6 pulled while the segment search has passed position 6: the probe closed after 7 fails, twice,
 and the search names 7, behind the new break."""
 SETTLING_INTO_A_DRIFT = Scenario(None, [26.0, 13.0, 70.0, 62.0, 8.0], [
     (1, Ageing(0.368836, 20.0, limit_db=1.0)), (1, Pull(0.134248, 0.019376)), (5, Ageing(0.191338, 60.0, limit_db=1.0)),
@@ -300,7 +300,7 @@ check, one direction only between jumps, failed it on main too)."""
 
 
 def _dark_returns(kind: BranchKind | None, cables: tuple[int, ...]) -> Scenario:
-    """Cables 20 m long whose return fibres go dark one after another, 40 cycle times each, 60 apart (OPT-57)."""
+    """Cables 20 m long whose return fibres go dark one after another, 40 cycle times each, 60 apart (OPT-58)."""
     n = N if kind is None else BK_AT + BRANCH + 1
     tick = wire.cycle_bits(n, n) / 500_000
     return Scenario(kind, [20.0] * n, [(k, Bend(60 * i * tick, 40 * tick, DARK_DB, Direction.RETURN))

@@ -1,5 +1,5 @@
 """A dark return fibre of the fibre-linked ring (supi3.optical.ring.OpticalRing; manual 1.6.1, 2.1, 2.2, Figure 1-10;
-OPT-47, OPT-57, BK-59): the return fibre of a cable is the return line out of its downstream chip, so a return fibre
+OPT-47, OPT-58, BK-59): the return fibre of a cable is the return line out of its downstream chip, so a return fibre
 going dark is a return-line break at that position, and a master sees on the optical ring what it sees on the
 pin-level ring (supi3.model.pinring.PinRing) with that return input cut: every cycle's kind, success and diagnostics,
 every chip's LEDs, OUT data and valid data cycles, before and after the repair, in flat rings and trees."""
@@ -94,7 +94,7 @@ def _dark(ring: OpticalRing, k: int, locate: bool) -> list[object]:
 
 def _cut(ring: PinRing | Ring, position: int, branch: bool, forward: bool = False) -> list[object]:
     """:func:`~test_model_pinring_tree.line_break` with the return input into ``position`` cut (``branch``: the BK's
-    DI3 there; ``forward`` at N + 1: the return line into the master, BK-60) after :func:`_settle`, the twin of
+    DI3 there; ``forward`` at N + 1: the return line into the master, BK-61) after :func:`_settle`, the twin of
     :func:`_dark`."""
 
     def cut() -> None:
@@ -113,7 +113,7 @@ def _cut(ring: PinRing | Ring, position: int, branch: bool, forward: bool = Fals
 
 @pytest.mark.parametrize("n", [2, 3])
 def test_a_dark_return_fibre_is_a_return_break_at_both_fidelities(n: int) -> None:
-    """OPT-57: in a flat ring the return fibre of cable k >= 2 going dark is the return input into chip k - 1 cut
+    """OPT-58: in a flat ring the return fibre of cable k >= 2 going dark is the return input into chip k - 1 cut
     (BK-59): with ``locate=False`` the master sees the same at both fidelities: one failed data cycle after another,
     a dead line not located, the chips behind the break hearing every frame but latching nothing (OUT data and the
     valid count stay), every chip's RC lit and IB_DIAG steady (no line interrupt ahead, DG-3); repaired, the same
@@ -143,7 +143,7 @@ the quick runs), a return fibre dark through the reset beyond a branch."""
     pytest.param(BranchKind.LOCAL, 5, marks=SLOW),
 ])  # fmt: skip
 def test_a_dark_return_fibre_in_a_tree_is_a_return_break_at_both_fidelities(kind: BranchKind, k: int) -> None:
-    """OPT-57, OPT-54, BK-59: every return fibre of the tree RB, BK, 2 branch chips, RB: on the remote bus (before
+    """OPT-58, OPT-54, BK-59: every return fibre of the tree RB, BK, 2 branch chips, RB: on the remote bus (before
     the BK, and from the RB chip behind the branch into the BK's outgoing interface) and in the branch (into the
     BK's DI3, between the branch chips) the master sees the same at both fidelities with ``locate=False``; the
     transaction level's search locates the cable's far end, in an LBD-MR branch the BK's count names the return line
@@ -164,7 +164,7 @@ def test_a_dark_return_fibre_in_a_tree_is_a_return_break_at_both_fidelities(kind
 
 @pytest.mark.parametrize("n", [1, 3])
 def test_the_first_return_fibre_is_the_return_line_into_the_master(n: int) -> None:
-    """OPT-57, BK-60: the return fibre of cable 1 carries the return line into the master (line N + 1): every chip
+    """OPT-58, BK-61: the return fibre of cable 1 carries the return line into the master (line N + 1): every chip
     hears the frames and latches nothing, the master gets nothing back, as with the pin-level ring's and the plain
     transaction-level ring's ``cut(N + 1, True)``; the optical ring's segment search names the return line (before,
     a dead line into chip 1: no chip heard anything)."""
@@ -212,7 +212,7 @@ def _restarts(ring: Bus, devices: Callable[[], Sequence[object]], cut: Callable[
     pytest.param(BranchKind.LBD_MR, 4, marks=SLOW),
 ])  # fmt: skip
 def test_a_return_fibre_dark_through_the_reset_is_the_same_at_both_fidelities(kind: BranchKind | None, k: int) -> None:
-    """OPT-57: a return fibre dark from before the master's start: the INTERBUS reset reaches every chip (a return line
+    """OPT-58: a return fibre dark from before the master's start: the INTERBUS reset reaches every chip (a return line
     of the remote bus stops nothing, BK-59; one of a branch stops it behind that branch, BK-10, the optical ring's
     initialization with it), the starts fail alike at both fidelities, the chips show the same; repaired, the start
     and the cycles pass alike. Cases: a flat ring's, the BK-LB branch's DI3 and the return line into the BK from the

@@ -966,7 +966,7 @@ class Ring:
         physical position of the device it enters in every state (BK-52): ring positions 1..N of every device of the
         tree (a BK, then its branch's devices, nested branches in place, then on along the remote bus), whether a
         branch is in the data path or not. ``forward``: the line into the device (a :class:`DeadLine`; ``position``
-        N + 1, one past the last device of the tree: the return line into the master, BK-60); else its
+        N + 1, one past the last device of the tree: the return line into the master, BK-61); else its
         return input from the device behind it in a branch with return lines (not into the last of a branch, none in
         an LBD-OR branch; a :class:`ReturnBreak`), or with ``branch`` a BK's branch return input (DI3). The break
         sleeps while its line is out of the data path (BK-1). The remote bus's return lines outside branches too

@@ -18,7 +18,7 @@ and the light that no longer gets through into ring faults the master locates.
 * **Online regulation** (1.6.2): every :data:`~supi3.optical.regulation.REPEAT_CYCLES` data cycles, each
   regulated transmitter's two tests (at the reserve and one level further) are sent at the current bus time and
   acknowledged over the other fibre; in optical diagnostics mode the receiver evaluates them (OPT-7).
-* **Faults** (OPT-47, OPT-57): before every cycle a fibre whose light does not get through at the current levels
+* **Faults** (OPT-47, OPT-58): before every cycle a fibre whose light does not get through at the current levels
   (:attr:`~supi3.optical.link.LightState.DARK`) is a break of the line it carries: the forward fibre of cable *k* a
   :class:`~supi3.interbus.ring.DeadLine` into the device at position *k*, its return fibre the return line out of
   that device (a :class:`~supi3.interbus.ring.ReturnBreak` of the device before it, BK-59, or for the first cable
@@ -333,7 +333,7 @@ class OpticalRing:
         return cable.state(direction, self._level(k, direction), t)
 
     def _line(self, cable: _Cable, direction: Direction, at: dict[int, int]) -> _Break:
-        """The ring fault of a dark fibre of ``cable`` (OPT-47, OPT-54, OPT-57): the forward fibre is the line into
+        """The ring fault of a dark fibre of ``cable`` (OPT-47, OPT-54, OPT-58): the forward fibre is the line into
         the downstream chip; the return fibre is the return line out of the downstream chip: into the master (line
         N + 1) for the first cable of the remote bus, into the BK's branch return input (DI3) for a branch's first
         cable, else into the upstream chip from the one behind it (the return input ``Ring.cut`` breaks, BK-59); in an
@@ -365,7 +365,7 @@ class OpticalRing:
 
     def _faults(self, frame_bits: int) -> None:
         """The ring's faults from the fibres at the current bus time (OPT-47): a dark fibre is a dead line or a
-        broken return line (OPT-54, OPT-57), a marginal cable hits a frame of ``frame_bits`` bits with one bit error
+        broken return line (OPT-54, OPT-58), a marginal cable hits a frame of ``frame_bits`` bits with one bit error
         at its bit-error rate."""
         self.ring.clear_faults()
         t = self.now
@@ -520,7 +520,7 @@ class OpticalRing:
 
     def dark(self, k: int) -> bool:
         """Cable *k* carries no light now in one of its fibres (the master's segment search fails first when the ring
-        is closed after the device it enters: OPT-47, OPT-57)."""
+        is closed after the device it enters: OPT-47, OPT-58)."""
         k = check_int("k", k, 1, len(self.links))
         cable = self.links[k - 1]
         return cable is not None and any(self._state(k, cable, d, self.now) is LightState.DARK for d in Direction)
