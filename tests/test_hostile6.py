@@ -236,11 +236,11 @@ def latched(ring: Ring) -> list[tuple[int, bool]]:
 @pytest.mark.parametrize("kind", list(BranchKind))
 def test_a_cycle_broken_by_any_cut_latches_nothing(kind: BranchKind) -> None:
     """Every line :meth:`~supi3.interbus.ring.Ring.cut` accepts in a tree (RB device, BK with 3 devices of ``kind``,
-    RB device; forward lines, return inputs, the BK's branch return input), cut after three good cycles: the cycle
-    that fails changes no device's OUT data or bus active (3.4.14: data are taken over only after a valid check
-    sequence); the lines it refuses are refused by name."""
+    RB device; forward lines, the return line into the master at N + 1 (BK-61), return inputs, the BK's branch return
+    input), cut after three good cycles: the cycle that fails changes no device's OUT data or bus active (3.4.14: data
+    are taken over only after a valid check sequence); the lines it refuses are refused by name."""
     failed = 0
-    for position, forward, branch in itertools.product(range(1, 6), (True, False), (False, True)):
+    for position, forward, branch in itertools.product(range(1, 9), (True, False), (False, True)):
         ring = tl_tree(kind, 3)
         master = Master(ring)
         assert master.start().ok
@@ -251,7 +251,7 @@ def test_a_cycle_broken_by_any_cut_latches_nothing(kind: BranchKind) -> None:
             with pytest.raises(ArgumentError, match="position must be"):
                 ring.cut(position, forward, branch=branch)
             continue
-        if forward and branch:
+        if (forward and branch) or position > len(ring.devices) + forward:
             with pytest.raises(ArgumentError, match="position must be"):
                 ring.cut(position, forward, branch=branch)
             continue

@@ -73,12 +73,13 @@ def _ring(n: int) -> PinRing:
 
 
 @pytest.mark.parametrize(("n", "position", "forward"), [
-    (1, 1, False), (1, 0, True), (1, 2, True), (3, 3, False), (3, 4, True), (2, True, True), (2, 1.0, True),
+    (1, 1, False), (1, 0, True), (1, 3, True), (3, 3, False), (3, 5, True), (2, True, True), (2, 1.0, True),
     (2, None, True), (2, "1", True),
 ])  # fmt: skip
 def test_a_cut_where_no_line_is_refused(n: int, position: object, forward: bool) -> None:
-    """A ring of N chips has forward inputs 1..N and return inputs 1..N - 1 (the last chip loops its own): any
-    other position is refused by name, with the rule, and nothing is cut."""
+    """A ring of N chips has forward inputs 1..N (and N + 1, the return line into the master, BK-61) and return
+    inputs 1..N - 1 (the last chip loops its own): any other position is refused by name, with the rule, and nothing
+    is cut."""
     ring = _ring(n)
     with pytest.raises(ArgumentError, match=r"^position must be an integer from 1 to \d+ \(a chip of the ring"):
         ring.cut(bad(position), forward)

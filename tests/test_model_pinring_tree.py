@@ -7,6 +7,8 @@ recognised by no one (BK-37); tests/test_model_pinring_recognition.py compares e
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+
 import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
@@ -18,7 +20,17 @@ from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusError
 from supi3.interbus.master import CycleResult, Master
-from supi3.interbus.ring import Branch, BranchKind, DeadLine, ErrorKind, ReturnBreak, Ring, Transfer, lbd_count
+from supi3.interbus.ring import (
+    Branch,
+    BranchKind,
+    Bus,
+    DeadLine,
+    ErrorKind,
+    ReturnBreak,
+    Ring,
+    Transfer,
+    lbd_count,
+)
 from supi3.interbus.wire import Cycle
 from supi3.model.bus_terminal import BRANCH_SILENCE_S
 from supi3.model.chip import Supi3
@@ -479,12 +491,41 @@ ChipView = tuple[bool, bool, bool, bool, bool, bool, IbDiag, int, int]
 """A chip's RC, BA, RD, LD, E, ALARM, IB_DIAG pattern, OUT data and valid data cycles latched."""
 
 
+def chip_views(ring: Bus, devices: Sequence[object]) -> list[ChipView]:
+    """Every chip's :data:`ChipView` of ``devices`` (the data path of ``ring``), once the telegrams sent have reached
+    every chip (``PinRing.settle``)."""
+    if isinstance(ring, PinRing):
+        ring.settle()
+    found: list[ChipView] = []
+    for device in devices:
+        chip = device.chip if isinstance(device, Supi3Pins) else device
+        assert isinstance(chip, Supi3)
+        leds = chip.diagnostic_outputs
+        found.append((leds.rc, leds.ba, leds.rd, leds.ld, leds.e, leds.alarm, leds.ib_diag, chip.mfp_outputs,
+                      chip.events["VALID"]))  # fmt: skip
+    return found
+
+
 def remote_return_cut(ring: Ring | PinRing, position: int, locate: bool) -> list[object]:
-    """What a master sees when the remote bus's return input into ``position`` is cut (BK-59) after a latched data
-    cycle: three cycles with new OUT data, then the repair and :data:`~support.REPAIR_IDLE_TELEGRAMS` idle telegrams
-    (M21) and three cycles; after each part every chip's LEDs (Tables 3-16 to 3-19: UL aside, the transaction level
-    has no supply, RC, BA, RD, LD, E, ALARM, the IB_DIAG pattern with its 4 Hz line interrupt ahead, DG-3), its OUT
-    data and how many valid data cycles it latched (3.4.14)."""
+    """What a master sees when the remote bus's return input into ``position`` is cut (BK-59): :func:`line_break`
+    with ``ring.cut(position, False)`` and its repair."""
+
+    def repair() -> None:
+        if isinstance(ring, Ring):
+            ring.clear_faults()
+        else:
+            ring.cuts.clear()
+
+    return line_break(ring, lambda: ring.devices, locate, lambda: ring.cut(position, False), repair)
+
+
+def line_break(ring: Bus, devices: Callable[[], Sequence[object]], locate: bool, cut: Callable[[], None],
+               repair: Callable[[], None]) -> list[object]:  # fmt: skip
+    """What a master sees when a line of ``ring`` (whose data path ``devices`` gives) breaks (``cut``)
+    after a latched data cycle: three cycles with new OUT data, then the ``repair`` and
+    :data:`~support.REPAIR_IDLE_TELEGRAMS` idle telegrams (M21) and three cycles; after each part every chip's LEDs
+    (Tables 3-16 to 3-19: UL aside, the transaction level has no supply, RC, BA, RD, LD, E, ALARM, the IB_DIAG pattern
+    with its 4 Hz line interrupt ahead, DG-3), its OUT data and how many valid data cycles it latched (3.4.14)."""
     master = Master(ring, locate=locate, max_devices=8)
     seen: list[object] = [master.start().ok]
 
@@ -494,16 +535,7 @@ def remote_return_cut(ring: Ring | PinRing, position: int, locate: bool) -> list
                 master.set_outputs(entry.number, bytes([value + entry.ring_position]))
 
     def chips() -> list[ChipView]:
-        if isinstance(ring, PinRing):
-            ring.settle()
-        found: list[ChipView] = []
-        for device in ring.devices:
-            chip = device.chip if isinstance(device, Supi3Pins) else device
-            assert isinstance(chip, Supi3)
-            leds = chip.diagnostic_outputs
-            found.append((leds.rc, leds.ba, leds.rd, leds.ld, leds.e, leds.alarm, leds.ib_diag, chip.mfp_outputs,
-                          chip.events["VALID"]))  # fmt: skip
-        return found
+        return chip_views(ring, devices())
 
     def cycles() -> None:
         for _ in range(3):
@@ -513,14 +545,11 @@ def remote_return_cut(ring: Ring | PinRing, position: int, locate: bool) -> list
 
     send(0x10)
     seen.append(master.cycle().ok)
-    ring.cut(position, False)
+    cut()
     send(0x80)
     cycles()
     seen.append(chips())
-    if isinstance(ring, Ring):
-        ring.clear_faults()
-    else:
-        ring.cuts.clear()
+    repair()
     ring.idle(REPAIR_IDLE_TELEGRAMS * wire.STATUS_TELEGRAM_BITS / ring.bit_rate)
     cycles()
     seen.append(chips())

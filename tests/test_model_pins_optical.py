@@ -96,9 +96,11 @@ def test_each_interface_times_out_in_turn_at_both_levels() -> None:
     assert [events for _, events in seen] == [0, 0, 0, 0, 1]  # the ID cycle during the hold is not latched
 
 
-def assert_tl_equals_pins(config: DeviceConfig, ops: list[OpticalOp]) -> list[tuple[OpticalStatus, int]]:
-    """``ops`` on the TL chip's optical API and as the pin level's strobes, op by op: the same optical status, reads
-    8..11, ID register and ATTN after every op; the pin level's status and ID_CYCLE events after each."""
+def assert_tl_equals_pins(config: DeviceConfig, ops: list[OpticalOp],
+                          tl_ops: list[OpticalOp] | None = None) -> list[tuple[OpticalStatus, int]]:  # fmt: skip
+    """``ops`` on the TL chip's optical API (``tl_ops`` in their place if given, one for each) and as the pin level's
+    strobes, op by op: the same optical status, reads 8..11, ID register and ATTN after every op; the pin level's
+    status and ID_CYCLE events after each."""
     script, ends = optical_script(config, ops)
     pins = Supi3Pins(config)
     tl = Supi3(config)
@@ -106,10 +108,10 @@ def assert_tl_equals_pins(config: DeviceConfig, ops: list[OpticalOp]) -> list[tu
     every = length_timer_enable_every(config.bit_rate)
     clk = 0
     seen = []
-    for op, a, b in zip(ops, [0, *ends[:-1]], ends, strict=True):
+    for op, tl_side, a, b in zip(ops, tl_ops or ops, [0, *ends[:-1]], ends, strict=True):
         pins.run({name: trace[a:b] for name, trace in columns.items()})
         clk += 1000
-        tl_op(tl, op, clk, every)
+        tl_op(tl, tl_side, clk, every)
         assert tl.optical == pins.chip.optical, op
         assert tl.id_register() == pins.chip.id_register(), op
         assert tl.attention == pins.chip.attention, op
@@ -121,8 +123,10 @@ def assert_tl_equals_pins(config: DeviceConfig, ops: list[OpticalOp]) -> list[tu
 
 
 def tl_op(chip: Supi3, op: OpticalOp, clk: int, every: int) -> None:
-    """``op`` through the TL chip's optical API and bus calls."""
+    """``op`` through the TL chip's optical API and bus calls (``("none",)``: nothing)."""
     kind, *args = op
+    if kind == "none":
+        return
     if kind == "reset":
         chip.reset_at(clk)
         present = args[0]
@@ -138,6 +142,35 @@ def tl_op(chip: Supi3, op: OpticalOp, clk: int, every: int) -> None:
     else:
         chip.load_at(Cycle.ID, clk)
         chip.latch_at(Cycle.ID, wire.word_bytes(args[0]), clk + 1)
+
+
+BRANCH_OPS: list[OpticalOp] = [
+    ("reset", 0b111), ("id", 0), ("resp", BRANCH, Response.DETECTED), ("resp", IN, Response.NONE),
+    ("resp", OUT, Response.NONE), ("length", BRANCH, 160, 1), ("length", OUT, 96, 0), ("test", BRANCH, True, True),
+    ("id", 0), ("reset", 0b100), ("id", 0),
+]  # fmt: skip
+"""The line side of a BK's branch interface on a chip: in use at the reset (with IN and OUT, then alone), its response,
+length measurement and online test."""
+
+
+def test_a_chip_without_the_branch_interface_never_starts_a_branch_transmitter() -> None:
+    """OPT-55 (2.1, Table 2-8, 1.6.3): the branch bits of the line side on a chip outside the bus terminal modes (an
+    RB Init-µP chip) start no branch transmitter and measure no branch path, op by op as the transaction level, which
+    refuses ``present[BRANCH]`` and ``optical_length(BRANCH)`` (given the ops without the branch there): the same
+    status, reads 8..11 (read 9 and read 11 bits 7..4 stay 0), ID register and ATTN; FO3 stays dark. A BK (BK-RB,
+    Init-µP) given the same line side starts and measures its branch."""
+    without: list[OpticalOp] = []
+    for kind, *args in BRANCH_OPS:
+        if kind == "reset":
+            without.append((kind, args[0] & ~(1 << BRANCH)))
+        else:
+            without.append(("none",) if kind in ("resp", "length", "test") and args[0] is BRANCH else (kind, *args))
+    seen = assert_tl_equals_pins(up_config("00"), BRANCH_OPS, without)
+    assert all(status[BRANCH].phase is Phase.OFF and not status.length[1] for status, _ in seen)
+    bk = Supi3Pins(bk_up_config("00"))
+    script, _ = optical_script(bk.config, BRANCH_OPS[:6])
+    bk.run(script.inputs())
+    assert bk.chip.optical[BRANCH].phase is Phase.INIT and bk.chip.optical.length[1]
 
 
 def test_copper_and_quiet_line_side_leave_the_core_alone() -> None:

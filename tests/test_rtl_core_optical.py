@@ -21,6 +21,7 @@ from supi3.regmap import REGISTER_MAP
 from supi3.spi.upif import Mode
 from supi3.verif import Lockstep
 from support import RB_INIT_UP, ChipPins, Firmware, bring_up, optical_ops, optical_script
+from test_model_pins_optical import BRANCH_OPS
 
 IN, OUT = Interface.IN, Interface.OUT
 
@@ -36,6 +37,16 @@ def test_optical_scenario(bench: Lockstep, rf: str, c: str) -> None:
     Table 2-8)."""
     config = decode(c, rf=rf, clk_conf="11", diag_conf=1)
     script, _ = optical_script(config, optical_ops(OpticalMode.REGULATION if rf == "00" else OpticalMode.DIAGNOSTIC))
+    assert bench.run_batch(script.stimulus()).cycles == len(script.inputs()["do1"])
+
+
+@pytest.mark.parametrize("c", ["10000", "00001"])
+def test_the_branch_line_side_starts_a_branch_in_a_bk_only(bench: Lockstep, c: str) -> None:
+    """OPT-55: the branch bits of the line side (in use at the reset with IN and OUT, then alone; a response, a length
+    measurement, an online test) reach the block in a bus terminal mode only (BK-LB, FO3 on MFP8): the RTL core holds
+    them at 0 elsewhere (an RB chip), as the model, every pin every clock."""
+    config = decode(c, rf="00", clk_conf="11", diag_conf=1)
+    script, _ = optical_script(config, BRANCH_OPS)
     assert bench.run_batch(script.stimulus()).cycles == len(script.inputs()["do1"])
 
 

@@ -23,7 +23,7 @@ from __future__ import annotations
 from typing import Final
 
 from supi3.interbus import wire
-from supi3.optical.regulation import BLOCK_INPUTS
+from supi3.optical.regulation import BLOCK_INPUTS, Interface
 from supi3.pinlevel import SYNC_STAGES as SYNC_STAGES
 from supi3.pinlevel import Pin
 from supi3.regmap import INTERRUPT_SOURCES, REGISTER_MAP, Access, AccessDirection
@@ -48,6 +48,8 @@ __all__ = [
     "IB_DIAG_DIVIDER_BITS",
     "LENGTH_CODE_BITS",
     "MFP_PINS",
+    "OPTICAL_BRANCH_BIT",
+    "OPTICAL_BRANCH_INPUTS",
     "OPTICAL_CORE_DRIVEN",
     "OPTICAL_LINE_INPUTS",
     "OPTICAL_REGISTERS",
@@ -136,6 +138,14 @@ initialization responses, online test results, length timer start and stop; :dat
 BLOCK_INPUTS`): inputs of the chip core beside :data:`CORE_INPUTS`, taken as they are at each clock (no synchroniser,
 OPT-26); 0 is quiet."""
 
+OPTICAL_BRANCH_INPUTS: Final[tuple[str, ...]] = ("present", "len_start", "len_stop")
+"""The line-side inputs whose bit :attr:`~supi3.optical.regulation.Interface.BRANCH` the chip core passes to the
+optical block in the bus terminal modes (Table 2-7) only; elsewhere it holds that bit at 0 (OPT-55): the branch
+transmitter never starts and the branch path is never measured (reads 9 and 11 bits 7..4 stay 0), as the transaction
+level refuses ``present[BRANCH]`` and ``optical_length(BRANCH)``. The other inputs' branch bits act on the branch
+transmitter only, which then stays off (OPT-22)."""
+OPTICAL_BRANCH_BIT: Final = 1 << Interface.BRANCH
+"""The branch interface's bit in the per-interface line-side inputs (:data:`OPTICAL_BRANCH_INPUTS`)."""
 IB_DIAG_DIVIDER_BITS: Final[dict[str, int]] = {"slow": 26, "fast": 24, "very_fast": 23}
 """IB_DIAG flashes from a free-running binary divider: 2**26 clocks (0.48 Hz) for "bus not active", 2**24
 (1.9 Hz) for "peripheral fault", 2**23 (3.8 Hz) for "line interrupt ahead on the local bus" (Table 3-18 asks

@@ -1015,7 +1015,8 @@ class Ring:
         """Break a line for good, numbered as :meth:`PinRing.cut <supi3.model.pinring.PinRing.cut>` numbers it, by the
         physical position of the device it enters in every state (BK-52): ring positions 1..N of every device of the
         tree (a BK, then its branch's devices, nested branches in place, then on along the remote bus), whether a
-        branch is in the data path or not. ``forward``: the line into the device (a :class:`DeadLine`); else its
+        branch is in the data path or not. ``forward``: the line into the device (a :class:`DeadLine`; ``position``
+        N + 1, one past the last device of the tree: the return line into the master, BK-61); else its
         return input from the device behind it in a branch with return lines (not into the last of a branch, none in
         an LBD-OR branch; a :class:`ReturnBreak`), or with ``branch`` a BK's branch return input (DI3). The break
         sleeps while its line is out of the data path (BK-1). The remote bus's return lines outside branches too
@@ -1024,13 +1025,18 @@ class Ring:
         Raises
         ------
         ArgumentError
-            ``forward`` or ``branch`` not a bool, ``position`` not a device of the tree, ``branch`` with ``forward``
-            or at a device that is no BK with a :class:`Branch`, or a return input no device drives; nothing changes.
+            ``forward`` or ``branch`` not a bool, ``position`` not a device of the tree (nor N + 1 with ``forward``),
+            ``branch`` with ``forward`` or at a device that is no BK with a :class:`Branch`, or a return input no device
+            drives; nothing changes.
         """
         check_bool("forward", forward)
         check_bool("branch", branch)
         every = _devices(self._tree)
-        position = check_int("position", position, 1, len(every), "a device of the tree")
+        if forward and not branch:
+            position = check_int("position", position, 1, len(every) + 1,
+                                 "a device of the tree, or N + 1: the return line into the master")  # fmt: skip
+        else:
+            position = check_int("position", position, 1, len(every), "a device of the tree")
         if branch:
             terminals = terminal_positions(self._tree)
             if forward or position not in terminals:
@@ -1041,7 +1047,7 @@ class Ring:
                        "a device behind it: not into the last of the ring or of a branch, none in an LBD-OR branch, "
                        "BK-59)", position)  # fmt: skip
         fault: Fault = DeadLine(position) if forward else ReturnBreak(position)
-        self._faults.append(_Active(fault, None, every[position - 1], branch))
+        self._faults.append(_Active(fault, None, every[position - 1] if position <= len(every) else None, branch))
 
     def clear_faults(self) -> None:
         """Remove every injected fault (a repair: in a tree the breaks removed decide the error of a cycle a branch

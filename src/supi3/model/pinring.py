@@ -267,7 +267,8 @@ class PinRing:
 
     def cut(self, position: int, forward: bool, *, branch: bool = False) -> None:
         """Break the line into the chip at ring ``position``: its forward input DO1 (``forward``, any chip; the first
-        chip of a branch takes its BK's DO3), or its return input DI2 from the chip behind it (a chip that has one:
+        chip of a branch takes its BK's DO3; ``position`` N + 1, one past the last chip of the tree: the return line
+        into the master, BK-61), or its return input DI2 from the chip behind it (a chip that has one:
         not the last of the ring or of a branch, none in an LBD-OR branch), or with ``branch`` (``forward`` false) a
         BK's branch return input DI3 (MFP10), the line ``ring.ReturnBreak`` breaks at a BK (BK-10). A broken line
         reads at the idle level (RS-485 fail-safe bias, BK-30); ``ring.Ring.cut`` takes the same arguments with the same
@@ -278,12 +279,17 @@ class PinRing:
         Raises
         ------
         ArgumentError
-            ``forward`` or ``branch`` not a bool, ``position`` out of range, or ``branch`` with ``forward`` or at a
-            chip that is not a BK with a branch (:class:`PinBranch`); nothing changes.
+            ``forward`` or ``branch`` not a bool, ``position`` out of range (1 to N, N + 1 with ``forward``), or
+            ``branch`` with ``forward`` or at a chip that is not a BK with a branch (:class:`PinBranch`); nothing
+            changes.
         """
         check_bool("forward", forward)
         check_bool("branch", branch)
-        position = check_int("position", position, 1, len(self.devices), "a chip of the ring")
+        if forward and not branch:
+            position = check_int("position", position, 1, len(self.devices) + 1,
+                                 "a chip of the ring, or N + 1: the return line into the master")  # fmt: skip
+        else:
+            position = check_int("position", position, 1, len(self.devices), "a chip of the ring")
         if branch:
             if forward or position not in self._terminals:
                 raise fail("position", f"the ring position of a BK with a branch ({sorted(self._terminals)}), with "
@@ -313,6 +319,8 @@ class PinRing:
         chunk: dict[int, dict[str, npt.NDArray[np.int64]]] | None = {} if self.record else None
         _, sent = self._forward(self.tree, 1, forward, chunk)
         back = self._back(sent, np.zeros(n, dtype=np.int64), chunk)
+        if (len(self.devices) + 1, True) in self.cuts:  # the return line into the master (BK-61)
+            back = np.full(n, wire.IDLE_LEVEL, dtype=np.int64)
         if chunk is not None:
             self._chunks.append([chunk[k] for k in range(1, len(self.devices) + 1)])
         self.cycle += n

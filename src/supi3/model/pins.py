@@ -90,7 +90,15 @@ from supi3.model.blocks.transmitter import NEVER, PinTrace, Transmitter
 from supi3.model.chip import Supi3
 from supi3.optical.regulation import OpticalMode
 from supi3.pinlevel import EventLog, Pin
-from supi3.pinout import CORE_OUTPUTS, IB_DIAG_DIVIDER_BITS, OPTICAL_LINE_INPUTS, OPTICAL_REGISTERS, SYNC_STAGES
+from supi3.pinout import (
+    CORE_OUTPUTS,
+    IB_DIAG_DIVIDER_BITS,
+    OPTICAL_BRANCH_BIT,
+    OPTICAL_BRANCH_INPUTS,
+    OPTICAL_LINE_INPUTS,
+    OPTICAL_REGISTERS,
+    SYNC_STAGES,
+)
 from supi3.tables import BIT_RATES, CLOCK_HZ, RESET_MIN_S
 from supi3.terminal import BRANCH_SILENCE_CLOCKS, CONF_PIN, LBST_PIN, silence_limit
 
@@ -181,7 +189,7 @@ class Supi3Pins:
 
     __slots__ = (
         "_branch", "_counters", "_datapath", "_diag2", "_expansion", "_frame", "_holding", "_optical", "_optical_at",
-        "_optical_fixed", "_outputs", "_power_ups", "_receiver", "_recording",
+        "_optical_fixed", "_optical_gated", "_outputs", "_power_ups", "_receiver", "_recording",
         "_return_start", "_run_from", "_serial", "_stat_active", "_synced_run", "_transmitter", "chip",
         "complete_diagnostics",
         "config", "cpb", "cycle", "forward_delay", "log", "mfp_oe", "rbst_by_pin", "reset_run",
@@ -235,6 +243,8 @@ class Supi3Pins:
         self.chip._optical_driven = self._optical is not None
         self._optical_fixed = {"mode": int(mode), "fast": BIT_RATES.index(config.bit_rate)}
         """The block's inputs from the straps."""
+        self._optical_gated = () if config.interface.is_bus_terminal else OPTICAL_BRANCH_INPUTS
+        """The line-side inputs whose branch bit the core holds at 0: a chip without the branch interface (OPT-55)."""
         self.reset()
 
     # ------------------------------------------------------------------------------------------------------------
@@ -484,7 +494,8 @@ class Supi3Pins:
         # to the one ending it) or the idle time-out until the line is heard (the RTL's in_reset | idle_timeout |
         # line_silent).
         ib = int(resetting or self._frame.in_reset or chip.line_silent)
-        values = {**line, **self._optical_fixed, "ib_reset": ib, "run": int(chip.bus_active)}
+        values = {**line, **self._optical_fixed, "ib_reset": ib, "run": int(chip.bus_active),
+                  **{name: line[name] & ~OPTICAL_BRANCH_BIT for name in self._optical_gated}}  # fmt: skip
         if c > self._optical_at:
             block.quiet(c - self._optical_at, {**values, **_OPTICAL_QUIET, "ib_reset": int(resetting)})
         shown = block.outputs_now(values["run"])

@@ -18,15 +18,18 @@ and the light that no longer gets through into ring faults the master locates.
 * **Online regulation** (1.6.2): every :data:`~supi3.optical.regulation.REPEAT_CYCLES` data cycles, each
   regulated transmitter's two tests (at the reserve and one level further) are sent at the current bus time and
   acknowledged over the other fibre; in optical diagnostics mode the receiver evaluates them (OPT-7).
-* **Faults** (OPT-47): before every cycle a cable whose light does not get through at the current levels
-  (:attr:`~supi3.optical.link.LightState.DARK`) is a :class:`~supi3.interbus.ring.DeadLine` on its line; a
-  marginal one gets bit errors at its bit-error rate (seeded). Cable *k* enters ring position *k*, so its faults are
-  on line *k*, where the master's location puts them.
+* **Faults** (OPT-47, OPT-58): before every cycle a fibre whose light does not get through at the current levels
+  (:attr:`~supi3.optical.link.LightState.DARK`) is a break of the line it carries: the forward fibre of cable *k* a
+  :class:`~supi3.interbus.ring.DeadLine` into the device at position *k*, its return fibre the return line out of
+  that device (a :class:`~supi3.interbus.ring.ReturnBreak` of the device before it, BK-59, or for the first cable
+  the return line N + 1 into the master): the devices behind it still hear every frame, and the master's segment
+  search fails first when the ring is closed after *k*. A marginal cable gets bit errors at its bit-error rate
+  (seeded).
 * **Trees** (OPT-54): the chips may hold :class:`~supi3.interbus.ring.Branch` items; a bus terminal module's branch
   interface sends the cable into its branch's first device, its outgoing interface the cable into the device after
-  the branch. In a branch with return lines a dark return fibre is the branch's return line into the upstream device
-  (:class:`~supi3.interbus.ring.ReturnBreak`), so the counter telegram of an LBD branch names the exact fibre; cables
-  out of the data path carry no faults and no tests.
+  the branch. A dark return fibre in a branch with return lines is the branch's return line into the upstream device
+  too, so the counter telegram of an LBD branch names the exact fibre; in an LBD-OR branch (no return lines) both
+  fibres are the line into the downstream device; cables out of the data path carry no faults and no tests.
 * **Diagnostics**: MAU warning changes are reported (:attr:`OpticalRing.reports`, 1.6.3), every path's levels are
   kept over time (:attr:`OpticalRing.history`), and :func:`diagnostic_table` is the master's optical diagnostic
   table of Figure 1-10, read from registers 8 to 11 (3.4.12, 3.4.13).
@@ -172,6 +175,17 @@ class _Cable:
     kind: BranchKind | None
 
 
+@dataclass(frozen=True)
+class _Break:
+    """A dark fibre as a ring fault: ``fault`` numbered by the data path now; a :class:`ReturnBreak` also by the
+    physical position of the device it enters (``physical``, ``Ring.cut``'s numbering; 0 for a dead line) and whether
+    it is that BK's branch return input (``branch``)."""
+
+    fault: DeadLine | ReturnBreak
+    physical: int
+    branch: bool
+
+
 def _walk(items: Sequence[OpticalChip | Branch], upstream: OpticalChip | None, interface: Interface,
           kind: BranchKind | None, cables: list[_Cable], links: Sequence[FibreLink | None]) -> None:  # fmt: skip
     """The cables of a tree in walk order: into every device from the one before it (its BK's branch for the first
@@ -256,6 +270,7 @@ class OpticalRing:
         self.history: list[list[PathSample]] = [[] for _ in self.links]
         self._data_cycles = 0
         self._into = {id(c.downstream): c for c in self._cables}
+        self._physical = {id(chip): k for k, chip in enumerate(self.chips, 1)}
         self._out: dict[tuple[int, Interface], _Cable] = {
             (id(c.upstream), c.interface): c for c in self._cables if c.upstream is not None}
         self._mau = [tuple(tx.mau for tx in chip.optical.transmitters) for chip in self.chips]
@@ -325,25 +340,28 @@ class OpticalRing:
     def _state(self, k: int, cable: FibreLink, direction: Direction, t: float) -> LightState:
         return cable.state(direction, self._level(k, direction), t)
 
-    def _line(self, cable: _Cable, direction: Direction, at: dict[int, int]) -> DeadLine | ReturnBreak:
-        """The ring fault of a dark fibre of ``cable`` (OPT-47, OPT-54): the forward fibre is the line into the
-        downstream chip; in a branch with return lines the return fibre is the return line into the upstream chip
-        (a BK's branch return input for the branch's first cable), elsewhere the line into the downstream chip too."""
+    def _line(self, cable: _Cable, direction: Direction, at: dict[int, int]) -> _Break:
+        """The ring fault of a dark fibre of ``cable`` (OPT-47, OPT-54, OPT-58): the forward fibre is the line into
+        the downstream chip; the return fibre is the return line out of the downstream chip: into the master (line
+        N + 1) for the first cable of the remote bus, into the BK's branch return input (DI3) for a branch's first
+        cable, else into the upstream chip from the one behind it (the return input ``Ring.cut`` breaks, BK-59); in an
+        LBD-OR branch (no return lines) the line into the downstream chip too."""
         down = at[id(cable.downstream)]
-        if direction is Direction.FORWARD or cable.kind in (None, BranchKind.LBD_OR) or cable.upstream is None:
-            return DeadLine(down)
-        if cable.interface is Interface.OUT and cable.upstream.terminal_interface is not None:
-            return DeadLine(down)  # from a nested BK's outgoing interface: not a return line of the ring model
-        return ReturnBreak(at[id(cable.upstream)])
+        if direction is Direction.FORWARD or cable.kind is BranchKind.LBD_OR:
+            return _Break(DeadLine(down), 0, False)
+        if cable.upstream is None:
+            return _Break(DeadLine(len(at) + 1), 0, False)
+        return _Break(ReturnBreak(at[id(cable.upstream)]), self._physical[id(cable.upstream)],
+                      cable.interface is Interface.BRANCH)  # fmt: skip
 
     def _in_path(self, cable: _Cable, at: dict[int, int]) -> bool:
         return cable.link is not None and id(cable.downstream) in at and (
             cable.upstream is None or id(cable.upstream) in at)  # fmt: skip
 
-    def _breaks(self, t: float) -> list[DeadLine | ReturnBreak]:
+    def _breaks(self, t: float) -> list[_Break]:
         """The ring faults of every dark fibre in the data path at bus time ``t``."""
         at = self._positions()
-        found: list[DeadLine | ReturnBreak] = []
+        found: list[_Break] = []
         for cable in self._cables:
             if not self._in_path(cable, at):
                 continue
@@ -354,14 +372,16 @@ class OpticalRing:
         return found
 
     def _faults(self, frame_bits: int) -> None:
-        """The ring's faults from the fibres at the current bus time (OPT-47): a dark fibre is a dead line (or a
-        branch's broken return line, OPT-54), a marginal cable hits a frame of ``frame_bits`` bits with one bit error
+        """The ring's faults from the fibres at the current bus time (OPT-47): a dark fibre is a dead line or a
+        broken return line (OPT-54, OPT-58), a marginal cable hits a frame of ``frame_bits`` bits with one bit error
         at its bit-error rate."""
         self.ring.clear_faults()
         t = self.now
-        breaks = self._breaks(t)
-        for fault in dict.fromkeys(breaks):
-            self.ring.inject(fault)
+        for found in dict.fromkeys(self._breaks(t)):
+            if isinstance(found.fault, ReturnBreak):  # by the physical position: a BK's two return inputs (BK-52)
+                self.ring.cut(found.physical, False, branch=found.branch)
+            else:
+                self.ring.inject(found.fault)
         if not frame_bits:
             return
         at = self._positions()
@@ -382,17 +402,18 @@ class OpticalRing:
 
     def _reach(self) -> int:
         """How many positions of the data path the reset reaches: those before the first dead line, all of a
-        branch whose return line is broken (the ring's reading, BK-10)."""
+        branch whose return line is broken (the ring's reading, BK-10; a return line of the remote bus outside
+        branches stops nothing, BK-59)."""
         reach = len(self.ring.devices)
         spans = self.ring.spans
-        for fault in self._breaks(self.now):
-            if isinstance(fault, DeadLine):
-                reach = min(reach, fault.segment - 1)
+        for found in self._breaks(self.now):
+            k = found.fault.segment
+            if isinstance(found.fault, DeadLine):
+                reach = min(reach, k - 1)
                 continue
-            inner = [(bk, size) for bk, size, _ in spans if bk == fault.segment]
-            inner = inner or [(bk, size) for bk, size, _ in spans if bk < fault.segment <= bk + size][-1:]
+            inner = [bk + size for bk, size, _ in spans if (bk == k if found.branch else bk < k <= bk + size)]
             if inner:
-                reach = min(reach, inner[0][0] + inner[0][1])
+                reach = min(reach, inner[-1])
         return reach
 
     def _initialize(self) -> None:
@@ -506,7 +527,8 @@ class OpticalRing:
                 cable.received_dbm(Direction.RETURN, levels[1], 0, t)))
 
     def dark(self, k: int) -> bool:
-        """Cable *k* carries no light now in one of its fibres (the master finds a dead line where it enters)."""
+        """Cable *k* carries no light now in one of its fibres (the master's segment search fails first when the ring
+        is closed after the device it enters: OPT-47, OPT-58)."""
         k = check_int("k", k, 1, len(self.links))
         cable = self.links[k - 1]
         return cable is not None and any(self._state(k, cable, d, self.now) is LightState.DARK for d in Direction)

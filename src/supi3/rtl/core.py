@@ -60,6 +60,8 @@ from supi3.pinout import (
     FROM_REGISTER_FILE,
     IB_DIAG_DIVIDER_BITS,
     MFP_PINS,
+    OPTICAL_BRANCH_BIT,
+    OPTICAL_BRANCH_INPUTS,
     OPTICAL_LINE_INPUTS,
     STRAP_PINS,
     SYNC_STAGES,
@@ -151,6 +153,12 @@ def _code_bytes(code: int) -> int:
 
 def _width(value: int) -> int:
     return max(1, value.bit_length())
+
+
+def _branch_gated(line: Signal, bus_terminal: Signal) -> Value:
+    """A per-interface line-side input with its branch bit held at 0 outside the bus terminal modes (OPT-55:
+    :data:`~supi3.pinout.OPTICAL_BRANCH_INPUTS`)."""
+    return Mux(bus_terminal, line, line & ((1 << len(line)) - 1 - OPTICAL_BRANCH_BIT))
 
 
 def _optical_mode(row: RfMode) -> OpticalMode:
@@ -522,7 +530,11 @@ class Supi3Core(wiring.Component):
                     with m.Case(int(row.rf, 2)):
                         m.d.comb += optical_mode.eq(_optical_mode(row))
         m.d.comb += [
-            *(getattr(optical, pin.name).eq(getattr(self, pin.name)) for pin in OPTICAL_LINE_INPUTS),
+            *(getattr(optical, pin.name).eq(getattr(self, pin.name)) for pin in OPTICAL_LINE_INPUTS
+              if pin.name not in OPTICAL_BRANCH_INPUTS),
+            # OPT-55: the branch interface is a BK's (Table 2-8); elsewhere its line-side bits are held at 0.
+            *(getattr(optical, name).eq(_branch_gated(getattr(self, name), bus_terminal))
+              for name in OPTICAL_BRANCH_INPUTS),
             optical.ib_reset.eq(receiver.line.in_reset | receiver.line.idle_timeout | outputs.line_silent),
             optical.mode.eq(optical_mode),
             optical.fast.eq(rate == BIT_RATES.index(max(BIT_RATES))),
