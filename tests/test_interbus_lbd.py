@@ -21,9 +21,11 @@ from supi3.interbus.errors import InterbusError
 from supi3.interbus.link import Device
 from supi3.interbus.master import Master
 from supi3.interbus.ring import (
+    BitFlip,
     Branch,
     BranchKind,
     DeadLine,
+    ErrorKind,
     ReturnBreak,
     Ring,
     lbd_count,
@@ -148,7 +150,7 @@ def test_counts_follow_the_principle_of_2_2_2() -> None:
 
 # -- the master over random trees and histories ----------------------------------------------------------------------
 
-CODES = {BranchKind.LBD_MR: 0xBF, BranchKind.LBD_OR: 0xB3, BranchKind.LOCAL: 0xBE}
+CODES = {BranchKind.LBD_MR: 0xBF, BranchKind.LBD_OR: 0xB3, BranchKind.LOCAL: 0xBE, BranchKind.REMOTE: 0x03}
 
 
 @dataclass
@@ -269,6 +271,69 @@ def test_a_count_that_disagrees_with_the_search_locates_nothing() -> None:
     ring.inject(ReturnBreak(4))
     found = master.cycle().diagnostics[0]
     assert found.location is None and "fits no break" in found.detail
+
+
+def branch_tree(kind: BranchKind, m: int) -> Tree:
+    """The smallest tree around a branch: a remote bus device, the BK with ``m`` devices of ``kind``, another one."""
+    bk = terminal(kind.terminal)
+    devices = [PlainDevice(CODES[kind], 0b01001) for _ in range(m)]
+    ring = Ring([PlainDevice(0x03, 0b01001), Branch(bk, devices, kind), PlainDevice(0x02, 0b01001)])
+    lbd = {id(d): (kind, k) for k, d in enumerate([bk, *devices])} if kind.diagnostics else {}
+    tree = Tree(ring, Master(ring), lbd)
+    tree.master.start()
+    healthy(tree)
+    return tree
+
+
+@pytest.mark.parametrize("kind", [BranchKind.LBD_OR, BranchKind.LBD_MR])
+@pytest.mark.parametrize("m", [1, 3])
+def test_bit_errors_into_an_lbd_branchs_first_device_are_its_forward_line(kind: BranchKind, m: int) -> None:
+    """Issue 12 (BK-62): bit errors on the forward line into the first device of an LBD branch (line 3 here) come
+    back as a transmission error; the segment search fails first at 3 and the BK, with no interrupt to count, reads
+    0, which also fits a break of its own return input (BK-7). Before, the master trusted the count and reported
+    "the return line into the BK" (position 2); the count locates only an interrupt (2.2.2), so the forward line
+    into device 3 stands. The break of the BK's return input itself still reads as such (a dead line)."""
+    tree = branch_tree(kind, m)
+    tree.ring.inject(BitFlip(3, 40, None))
+    found = tree.master.cycle().diagnostics[0]
+    assert (found.kind, found.location, found.device, found.return_line) == (ErrorKind.TRANSMISSION, 3, "2.1", False)
+    assert "counted" not in found.detail, found.detail
+    tree.ring.clear_faults()
+    healthy(tree)
+    tree.ring.inject(ReturnBreak(2))
+    found = tree.master.cycle().diagnostics[0]
+    assert (found.kind, found.location, found.return_line) == (ErrorKind.DEAD_LINE, 2, True)
+    assert "counted 0" in found.detail
+
+
+def located_faults(tree: Tree) -> st.SearchStrategy[BitFlip | DeadLine | ReturnBreak]:
+    """A fault of the tree now: bit errors on any forward line (the return line into the master too) at any bit
+    period of the frame, or a break of any line."""
+    n = len(tree.ring.devices)
+    flips = st.builds(BitFlip, st.integers(1, n + 1), st.integers(0, wire.cycle_bits(2 * n, n)), st.none())
+    return st.one_of(flips, st.sampled_from(breaks(tree)))
+
+
+@settings(max_examples=100, deadline=None, derandomize=True)
+@given(st.sampled_from(list(BranchKind)), st.integers(1, 4), st.data())
+def test_every_bit_error_or_break_in_every_branch_kind_is_located_on_its_line(kind: BranchKind, m: int,
+                                                                              data: st.DataObject) -> None:  # fmt: skip
+    """BK-7, BK-62 over histories of faults in one tree of every branch kind (BK-RB, BK-LB, LBD-MR, LBD-OR): bit
+    errors are located at the forward line they hit (the count of an LBD branch is not asked), a break on its own
+    line (LBD: by the count) or, on a return line without the counter, at the first probe that crosses it."""
+    tree = branch_tree(kind, m)
+    for _ in range(data.draw(st.integers(1, 5), label="faults")):
+        fault = data.draw(located_faults(tree), label="fault")
+        tree.ring.inject(fault)
+        result = tree.master.cycle()
+        if isinstance(fault, BitFlip) and result.ok:  # a bit period no receiver checks
+            tree.ring.clear_faults()
+            continue
+        where = (fault.segment, False) if isinstance(fault, BitFlip) else expected(tree, fault)
+        found = result.diagnostics[0]
+        assert not result.ok and (found.location, found.return_line) == where, (fault, found)
+        tree.ring.clear_faults()
+        healthy(tree)
 
 
 LOOP_EDITS = st.lists(st.tuples(st.integers(0, 3), st.sampled_from(["LBD-MR", "LBD-OR", "plain"])), max_size=6)

@@ -53,6 +53,11 @@ STATUS_TERMINAL_ID_CODES: Final = frozenset(
 """The BKs without a µP (0Ch, 08h, 04h, Table 2-7): they answer a status request with their branch status (BK-5)."""
 LBD_OR_ID_CODES: Final = frozenset(row.id_code for row in MODE_ROWS if row.function.startswith("LBD-OR"))
 """The ID codes of LBD-OR devices (Table 2-5): a BK-LBD branch of them has no return lines (BK-7)."""
+COUNTED_KINDS: Final = frozenset({ErrorKind.DEAD_LINE})
+"""The errors a BK-LBD's count can locate: an interrupt, the failing probe got no frame back (2.2.2: the diagnostic
+telegram locates "a physical interrupt"). A frame that came back with errors (bit errors on a branch line) sent no
+counter telegram, so the count (0: none, or the stale count of an earlier break) says nothing about it: the
+segment search's position stands, the forward line into it (BK-62)."""
 
 
 class InterfaceType(Enum):
@@ -642,12 +647,13 @@ class Master:
             return _changed(problem, failed.location, failed.detail)
         where = "the return line" if low == n + 1 else f"the ring fails when closed after position {low}"
         problem = Diagnostic(problem.kind, low, None, None, f"{problem.detail}; segment search: {where}")
-        return self._counted(problem, low)
+        return self._counted(problem, low) if failed.kind in COUNTED_KINDS else problem
 
     def _counted(self, problem: Diagnostic, low: int) -> Diagnostic:
-        """A failure the segment search put at ``low`` inside a BK-LBD's branch: the BK's count of the counter
+        """An interrupt the segment search put at ``low`` inside a BK-LBD's branch: the BK's count of the counter
         telegram gives the exact line (2.2.2, BK-7); the search and the count must agree, else not located.
-        Outside such a branch ``problem`` stands as the search found it."""
+        Outside such a branch ``problem`` stands as the search found it. Only a probe that found an interrupt
+        asks the count (:data:`COUNTED_KINDS`, BK-62)."""
         config = self._require_config()
         for entry in config:
             at = entry.ring_position
