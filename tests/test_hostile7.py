@@ -376,9 +376,6 @@ def _after_a_power_up(ring: Ring | PinRing, position: int, wake: int) -> list[tu
     return seen
 
 
-@pytest.mark.xfail(strict=True, reason="round 7: M22's window at 2 Mbit/s with 2 chips, chip 1 powered up and 3 idle "
-                   "telegrams: the transaction level's master reports TELEGRAM where the pin level's reports a dead "
-                   "line; interbus.wake is waketree2's this session (reported, not fixed here)")
 def test_a_cycle_in_the_wake_window_fails_alike_at_both_fidelities() -> None:
     """M22 (docs/assumptions/model.md): the master's cycles in the window after a power-up fail at the transaction
     level as at pin level, with the same error. Found in round 7 with ``test_model_pinring_powerup.both`` over every
