@@ -153,9 +153,11 @@ def _power_cycle(ring: Ring | PinRing, position: int) -> None:
         ring.power_up(position)
 
 
-def _first_cycle(ring: Ring | PinRing, chips: int, position: int, telegrams: int) -> bool:
-    """Whether the master's cycle passes ``telegrams`` idle status telegrams after the power-up of ``position`` (0:
-    every chip, at the ring's first clock; else one chip of a running ring, /ResU low for 4 idle status telegrams)."""
+def first_cycle(ring: Ring | PinRing, chips: int, position: int,
+                telegrams: int) -> tuple[Cycle, bool, list[ErrorKind]]:
+    """The master's cycle ``telegrams`` idle status telegrams after the power-up of ``position`` (0: every chip, at the
+    ring's first clock; else one chip of a running ring, /ResU low for 4 idle status telegrams): its kind, success and
+    error kinds (``bench/wake_flat_sweep.py window``)."""
     if position:
         _idle(ring, PAST_WINDOW_TELEGRAMS)
         master = Master(ring, locate=False, max_devices=8)
@@ -167,7 +169,8 @@ def _first_cycle(ring: Ring | PinRing, chips: int, position: int, telegrams: int
                 ring.power_up(k)
         master = Master(ring, locate=False, max_devices=8)
     _idle(ring, telegrams)
-    return master.cycle().ok
+    result = master.cycle()
+    return result.cycle, result.ok, [d.kind for d in result.diagnostics]
 
 
 @pytest.mark.parametrize("rate", RATES)
@@ -178,11 +181,11 @@ def test_the_window_after_a_power_up_ends_alike(rate: int) -> None:
     windows = []
     for chips in range(1, 5):
         for position in range(chips + 1):
-            first = next(k for k in range(10) if _first_cycle(Ring([Supi3(_config(rate)) for _ in range(chips)],
-                                                                    bit_rate=rate), chips, position, k))
+            first = next(k for k in range(10) if first_cycle(Ring([Supi3(_config(rate)) for _ in range(chips)],
+                                                                   bit_rate=rate), chips, position, k)[1])
             for k in (first - 1, first):
                 pin = PinRing([Supi3Pins(_config(rate)) for _ in range(chips)])
-                assert k < 0 or _first_cycle(pin, chips, position, k) is (k == first), (chips, position, k)
+                assert k < 0 or first_cycle(pin, chips, position, k)[1] is (k == first), (chips, position, k)
             windows.append(first)
     assert max(windows) == (5 if rate == 500_000 else 7)
     assert min(windows) == 1
