@@ -23,6 +23,7 @@ import numpy.typing as npt
 
 from supi3.checks import check_instance, check_int, fail
 from supi3.interbus import wire
+from supi3.interbus.errors import InterbusError
 from supi3.interbus.receiver import receive
 from supi3.interbus.wire import Cycle, Frame, Telegram
 from supi3.pinlevel import SYNC_STAGES
@@ -220,7 +221,11 @@ def wake_return(bit_rate: int, devices: int, wakes: Mapping[int, int], start: in
         line[: max(0, min(end, resumed - origin))] = wire.IDLE_LEVEL
     _, index, _ = receive(line[: start - origin], 0, cpb)
     telegrams, _, error = receive(line, index, cpb)
-    return error, any(isinstance(t, Telegram) and wire.opens_frame(t) for t in telegrams)
+    try:  # a frame comes back only if the master assembles one (as the pin level's master, PinRing.transfer)
+        wire.frame_from_telegrams(telegrams)
+    except InterbusError:
+        return error, False
+    return error, True
 
 
 _SHORT_HOLD_BITS = 12
