@@ -42,7 +42,7 @@ def _config(rate: int) -> DeviceConfig:
     return decode(RB.c, RB.mfp, clk_conf=tables.clk_conf_for(rate))
 
 
-def _idle(ring: Ring | PinRing, telegrams: int) -> None:
+def idle(ring: Ring | PinRing, telegrams: int) -> None:
     ring.idle(telegrams * wire.STATUS_TELEGRAM_BITS / ring.bit_rate)
 
 
@@ -57,7 +57,7 @@ def history(ring: Ring | PinRing, start: bool, ops: list[Op], wake: int) -> list
     :data:`~support.REPAIR_IDLE_TELEGRAMS` idle status telegrams, M21), ``start`` or ``wait``, and two of the master's
     cycles. Every cycle's kind, success and diagnostics (kind, location, device, message code), after each step the
     configuration and IN data. ``wake``: idle status telegrams after a power-up (M22)."""
-    _idle(ring, wake)
+    idle(ring, wake)
     master = Master(ring, locate=False, max_devices=8)
     seen: list[object] = []
 
@@ -69,8 +69,8 @@ def history(ring: Ring | PinRing, start: bool, ops: list[Op], wake: int) -> list
     for op, k in ops:
         k = min(k, len(ring.devices))
         if op == "power":
-            _power_cycle(ring, k)
-            _idle(ring, wake)
+            power_cycle(ring, k)
+            idle(ring, wake)
         elif op == "cut":
             ring.cut(k, True)
         elif op == "repair":
@@ -78,7 +78,7 @@ def history(ring: Ring | PinRing, start: bool, ops: list[Op], wake: int) -> list
                 ring.cuts.clear()
             else:
                 ring.clear_faults()
-            _idle(ring, REPAIR_IDLE_TELEGRAMS)
+            idle(ring, REPAIR_IDLE_TELEGRAMS)
         elif op == "start":
             record(master.start())
         for _ in range(2):
@@ -141,15 +141,15 @@ def test_a_frame_that_meets_the_reset_stretch_fails_at_pin_level(rate: int) -> N
     assert master.cycle().ok
 
 
-def _power_cycle(ring: Ring | PinRing, position: int) -> None:
-    """Power the chip at ``position`` down for :data:`POWER_DOWN_TELEGRAMS` idle status telegrams and up again: /ResU
-    low then high at pin level, ``Ring.power_up`` at the transaction level (M22)."""
+def power_cycle(ring: Ring | PinRing, position: int) -> None:
+    """Power the chip at physical ``position`` down for :data:`POWER_DOWN_TELEGRAMS` idle status telegrams and up
+    again: /ResU low then high at pin level, ``Ring.power_up`` at the transaction level (M22; trees too, M25)."""
     if isinstance(ring, PinRing):
         ring.set_input(position, "resu_n", 0)
-        _idle(ring, POWER_DOWN_TELEGRAMS)
+        idle(ring, POWER_DOWN_TELEGRAMS)
         ring.set_input(position, "resu_n", 1)
     else:
-        _idle(ring, POWER_DOWN_TELEGRAMS)
+        idle(ring, POWER_DOWN_TELEGRAMS)
         ring.power_up(position)
 
 
@@ -159,16 +159,16 @@ def first_cycle(ring: Ring | PinRing, chips: int, position: int,
     ring's first clock; else one chip of a running ring, /ResU low for 4 idle status telegrams): its kind, success and
     error kinds (``bench/wake_flat_sweep.py window``)."""
     if position:
-        _idle(ring, PAST_WINDOW_TELEGRAMS)
+        idle(ring, PAST_WINDOW_TELEGRAMS)
         master = Master(ring, locate=False, max_devices=8)
         assert master.cycle().ok
-        _power_cycle(ring, position)
+        power_cycle(ring, position)
     else:
         if isinstance(ring, Ring):
             for k in range(1, chips + 1):
                 ring.power_up(k)
         master = Master(ring, locate=False, max_devices=8)
-    _idle(ring, telegrams)
+    idle(ring, telegrams)
     result = master.cycle()
     return result.cycle, result.ok, [d.kind for d in result.diagnostics]
 
@@ -217,7 +217,7 @@ def _start_after(ring: Ring | PinRing, chips: int, telegrams: int) -> tuple[bool
     if isinstance(ring, Ring):
         for k in range(1, chips + 1):
             ring.power_up(k)
-    _idle(ring, telegrams)
+    idle(ring, telegrams)
     master = Master(ring, locate=False, max_devices=8)
     started = master.start().ok
     return started, len(master.config or ()), master.cycle().ok

@@ -14,14 +14,13 @@ import pytest
 from supi3 import tables
 from supi3.config import DeviceConfig, decode
 from supi3.errors import ArgumentError
-from supi3.interbus import wire
 from supi3.interbus.master import Master
 from supi3.interbus.ring import Branch, BranchKind, ErrorKind, Ring
 from supi3.model.chip import Supi3
 from supi3.model.pinring import PinBranch, PinRing
 from supi3.model.pins import Supi3Pins
 from support import BK_STRAPS
-from test_model_pinring_powerup import POWER_DOWN_TELEGRAMS
+from test_model_pinring_powerup import idle, power_cycle
 from test_model_pinring_tree import CASES, INPUTS, LBST, ROWS
 
 RATES = [500_000, 2_000_000]
@@ -60,22 +59,6 @@ def trees(kind: BranchKind, m: int, rate: int) -> tuple[Ring, PinRing]:
     return tl, pin
 
 
-def _idle(ring: Ring | PinRing, telegrams: int) -> None:
-    ring.idle(telegrams * wire.STATUS_TELEGRAM_BITS / ring.bit_rate)
-
-
-def _power_cycle(ring: Ring | PinRing, position: int) -> None:
-    """/ResU of the chip at physical ``position`` low for :data:`POWER_DOWN_TELEGRAMS` idle status telegrams, then
-    high; ``Ring.power_up`` at its end at transaction level."""
-    if isinstance(ring, PinRing):
-        ring.set_input(position, "resu_n", 0)
-        _idle(ring, POWER_DOWN_TELEGRAMS)
-        ring.set_input(position, "resu_n", 1)
-    else:
-        _idle(ring, POWER_DOWN_TELEGRAMS)
-        ring.power_up(position)
-
-
 Seen = list[tuple[bool, list[ErrorKind], bool]]
 """Per cycle: its success, its error kinds, whether the BK recognised its branch after it."""
 
@@ -83,11 +66,11 @@ Seen = list[tuple[bool, list[ErrorKind], bool]]
 def after_power_up(ring: Ring | PinRing, position: int, telegrams: int) -> Seen:
     """The master starts and runs a data cycle; the chip at ``position`` powers up, ``telegrams`` idle status
     telegrams, two cycles: per cycle its success and error kinds, and whether the BK recognised its branch then."""
-    _idle(ring, FIRST_IDLE_TELEGRAMS)
+    idle(ring, FIRST_IDLE_TELEGRAMS)
     master = Master(ring, locate=False, max_devices=8)
     assert master.start().ok and master.cycle().ok
-    _power_cycle(ring, position)
-    _idle(ring, telegrams)
+    power_cycle(ring, position)
+    idle(ring, telegrams)
     seen: Seen = []
     for _ in range(2):
         result = master.cycle()
