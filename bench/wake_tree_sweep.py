@@ -10,11 +10,18 @@ wait at 20): prints per kind and row the k at which some step differs (the BK's 
     python bench/wake_tree_sweep.py initial        # before the first step: 896 runs
     python bench/wake_tree_sweep.py power --max-k 6   # k = 0..6 and 20 only (M25: the transaction level follows)
     python bench/wake_tree_sweep.py window --rate 2000000   # M25: one chip of a running tree powered up, k = 0..7
+    python bench/wake_tree_sweep.py trace --rate 500000 --devices 3 --position 4 --k 2   # M25's limit 1, at pin level
 
 ``window`` runs the trees of ``test_model_pinring_tree.CASES`` (RF = 11, LBST = 1): every chip in turn powered up in a
 running tree (/ResU low for 4 status telegrams; ``Ring.power_up``), k idle status telegrams, two cycles, and prints per
 tree and physical position both fidelities' cycles (``P``: passed, else the first error kind's first three letters;
 ``r``: the branch recognised after it) and the k where they differ; exits 1 if the first passing k differs.
+
+``trace`` runs one case of ``window`` in an LBD-MR branch of ``--devices`` at pin level with its pins recorded from the
+power-down on: the first cycle's success and error kinds, then each chip's forward output (DO2) and return output
+(DI1, an LBD-MR chip's looped return line, BK-35) from the power-down to the cycle's start + 40 bit periods, as runs of
+level x bit periods (M25's limit 1: the return block of the device before the woken one generates a counter telegram
+after 32 idle bit periods, BK-30).
 
 Exits 1 if a k at or above the tests' wait (per branch kind) differs.
 """
@@ -26,9 +33,15 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
+from supi3.interbus import wire
+from supi3.interbus.master import Master
 from supi3.interbus.ring import BranchKind
+from supi3.model.pinring import PinRing
+from test_model_pinring_powerup import idle, power_cycle
 from test_model_pinring_recognition import (  # the tests' helpers, on the path above
     FIRST_IDLE_TELEGRAMS,
     POWER_IDLE_TELEGRAMS,
@@ -37,6 +50,7 @@ from test_model_pinring_recognition import (  # the tests' helpers, on the path 
     recognition_history,
 )
 from test_model_pinring_tree import CASES
+from test_model_pinring_tree_powerup import FIRST_IDLE_TELEGRAMS as TREE_IDLE_TELEGRAMS
 from test_model_pinring_tree_powerup import RATES, Seen, after_power_up, trees
 
 ROWS = [("11", True), ("00", False), ("10", False), ("10", True)]
@@ -71,13 +85,48 @@ def window(rate: int) -> int:
     return 1 if firsts_differ else 0
 
 
+def _runs(samples: np.ndarray, cpb: int) -> str:
+    """``samples`` as runs of level x bit periods."""
+    edges = np.flatnonzero(np.diff(samples)) + 1
+    starts = np.concatenate([[0], edges])
+    lengths = np.diff(np.concatenate([starts, [len(samples)]]))
+    return " ".join(f"{int(samples[a])}x{n / cpb:g}" for a, n in zip(starts, lengths, strict=True))
+
+
+def trace(rate: int, devices: int, position: int, telegrams: int) -> int:
+    """The ``trace`` of one LBD-MR case at pin level (the history of ``after_power_up``, its first cycle)."""
+    pin = trees(BranchKind.LBD_MR, devices, rate)[1]
+    assert isinstance(pin, PinRing)
+    idle(pin, TREE_IDLE_TELEGRAMS)
+    master = Master(pin, locate=False, max_devices=8)
+    assert master.start().ok and master.cycle().ok
+    pin.record = True
+    power_cycle(pin, position)
+    idle(pin, telegrams)
+    start = len(pin.recorded()[0]["do2"])
+    result = master.cycle()
+    print(f"cycle ok {result.ok}, {[d.kind.name for d in result.diagnostics]}; cycle starts {start} clocks after the "
+          "power-down")
+    cpb = wire.clocks_per_bit(rate)
+    for number, pins in enumerate(pin.recorded(), 1):
+        for name in ("do2", "di1"):
+            print(f"position {number} {name}: {_runs(np.asarray(pins[name][: start + 40 * cpb]), cpb)}")
+    return 0
+
+
 def main() -> int:
     """Run the sweep named on the command line; 0 if nothing differs at or above the tests' wait."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("where", choices=[*sorted(HISTORIES), "window"], help="the wait swept, or M25's window")
+    parser.add_argument("where", choices=[*sorted(HISTORIES), "window", "trace"],
+                        help="the wait swept, M25's window, or one LBD-MR case traced")
     parser.add_argument("--max-k", type=int, default=12, choices=range(13), help="the largest k below 20 swept")
     parser.add_argument("--rate", type=int, default=2_000_000, choices=RATES, help="the window's bit rate")
+    parser.add_argument("--devices", type=int, default=3, choices=range(1, 4), help="trace: LBD-MR devices")
+    parser.add_argument("--position", type=int, default=4, help="trace: the physical position powered up")
+    parser.add_argument("--k", type=int, default=2, choices=range(13), help="trace: idle telegrams after it")
     args = parser.parse_args()
+    if args.where == "trace":
+        return trace(args.rate, args.devices, args.position, args.k)
     if args.where == "window":
         return window(args.rate)
     waits = POWER_IDLE_TELEGRAMS if args.where == "power" else FIRST_IDLE_TELEGRAMS

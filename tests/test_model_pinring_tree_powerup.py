@@ -92,7 +92,11 @@ power-up in an LBD-MR branch: with 1 device the cycles before fail with ``TRANSM
 ``DEAD_LINE`` at transaction level (BK-56's LBD-MR rule), with 2 and 3 devices the pin level loses one more cycle; the
 second device of an LBD-MR branch of 2 or 3 powered up at 2 Mbit/s, the frame meeting its stretch: ``TRANSMISSION``
 at pin level, ``LOOPBACK`` at transaction level, with 2 devices for one cycle more; at 500 kbit/s, of 3, the
-transaction level's master hears no grid until k = 7 (``TELEGRAM``) where the pin level passes from k = 2."""
+transaction level's master hears no grid until k = 7 (``TELEGRAM``) where the pin level passes from k = 2: traced
+(``python bench/wake_tree_sweep.py trace --rate 500000 --devices 3 --position 4 --k 2``), the powered-up device's
+return output is silent 34 bit periods, the first device's return block generates a counter telegram after 32 (BK-30),
+drops what begins meanwhile and resends on the master's grid; the transaction level does not follow the generator
+(M25's limit 1)."""
 
 
 def _window(kind: BranchKind, m: int, rate: int, positions: range) -> list[int]:
