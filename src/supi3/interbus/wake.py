@@ -80,9 +80,9 @@ def _check(bit_rate: int, devices: int, wakes: Mapping[int, int], lags: Sequence
     if lags is None:
         return devices, path_lags(bit_rate, devices)
     if isinstance(lags, (str, bytes)) or not isinstance(lags, Sequence) or len(lags) != devices + 1 or not all(
-            type(lag) is int for lag in lags) or any(b <= a for a, b in itertools.pairwise(lags)):
-        raise fail("lags", f"{devices + 1} increasing integer clocks (each chip's input, then the master's receiver, "
-                   "path_lags)", lags, "M25")  # fmt: skip
+            type(lag) is int for lag in lags) or lags[0] < 0 or any(b <= a for a, b in itertools.pairwise(lags)):
+        raise fail("lags", f"{devices + 1} increasing integer clocks from 0 (each chip's input, then the master's "
+                   "receiver, path_lags)", lags, "M25")  # fmt: skip
     return devices, list(lags)
 
 
@@ -155,7 +155,7 @@ def wake_window(bit_rate: int, devices: int, wakes: Mapping[int, int], lags: Seq
     ------
     ArgumentError
         ``bit_rate`` not one of Table 1-7, ``devices`` not from 1 to ``wire.MAX_DEVICES``, ``wakes`` not a mapping
-        of ring indices (0 to ``devices`` - 1) to integer clocks, or ``lags`` not ``devices`` + 1 increasing clocks.
+        of ring indices (0 to ``devices`` - 1) to integer clocks, or ``lags`` not ``devices`` + 1 increasing clocks from 0.
     """
     devices, lags = _check(bit_rate, devices, wakes, lags)
     cpb = wire.clocks_per_bit(bit_rate)
