@@ -155,7 +155,8 @@ def wake_window(bit_rate: int, devices: int, wakes: Mapping[int, int], lags: Seq
     ------
     ArgumentError
         ``bit_rate`` not one of Table 1-7, ``devices`` not from 1 to ``wire.MAX_DEVICES``, ``wakes`` not a mapping
-        of ring indices (0 to ``devices`` - 1) to integer clocks, or ``lags`` not ``devices`` + 1 increasing clocks from 0.
+        of ring indices (0 to ``devices`` - 1) to integer clocks, or ``lags`` not ``devices`` + 1 increasing clocks
+        from 0.
     """
     devices, lags = _check(bit_rate, devices, wakes, lags)
     cpb = wire.clocks_per_bit(bit_rate)
