@@ -119,13 +119,25 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("where", choices=[*sorted(HISTORIES), "window", "trace"],
                         help="the wait swept, M25's window, or one LBD-MR case traced")
-    parser.add_argument("--max-k", type=int, default=12, choices=range(13), help="the largest k below 20 swept")
-    parser.add_argument("--rate", type=int, default=2_000_000, choices=RATES, help="the window's bit rate")
-    parser.add_argument("--devices", type=int, default=3, choices=range(1, 4), help="trace: LBD-MR devices")
-    parser.add_argument("--position", type=int, default=4, help="trace: the physical position powered up")
-    parser.add_argument("--k", type=int, default=2, choices=range(13), help="trace: idle telegrams after it")
+    parser.add_argument("--max-k", type=int, choices=range(13), help="the largest k below 20 swept (12)")
+    parser.add_argument("--rate", type=int, choices=RATES, help="the window's bit rate (2000000)")
+    parser.add_argument("--devices", type=int, choices=range(1, 4), help="trace: LBD-MR devices (3)")
+    parser.add_argument("--position", type=int, help="trace: the physical position powered up (4)")
+    parser.add_argument("--k", type=int, choices=range(13), help="trace: idle telegrams after it (2)")
     args = parser.parse_args()
+    # option: (its default, the sweeps that read it); one given to another sweep would be ignored silently
+    used = {"max_k": (12, ("initial", "power")), "rate": (2_000_000, ("window", "trace")),
+            "devices": (3, ("trace",)), "position": (4, ("trace",)), "k": (2, ("trace",))}  # fmt: skip
+    for dest, (default, sweeps) in used.items():
+        if getattr(args, dest) is None:
+            setattr(args, dest, default)
+        elif args.where not in sweeps:
+            parser.error(f"--{dest.replace('_', '-')} is for {' and '.join(sweeps)} only, not {args.where}")
     if args.where == "trace":
+        positions = args.devices + 3  # trees(): the RB device, the BK, its branch devices, the RB device
+        if not 1 <= args.position <= positions:
+            parser.error(f"--position must be a physical position from 1 to {positions} (--devices "
+                         f"{args.devices}), not {args.position}")
         return trace(args.rate, args.devices, args.position, args.k)
     if args.where == "window":
         return window(args.rate)

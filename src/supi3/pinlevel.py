@@ -28,6 +28,7 @@ return any value for a pin it does not drive.
 
 from __future__ import annotations
 
+import numbers
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -47,6 +48,7 @@ __all__ = [
     "Pin",
     "PinModel",
     "PinSpecError",
+    "check_cycles",
     "compared_signals",
     "recent_events",
 ]
@@ -54,6 +56,14 @@ __all__ = [
 
 class PinSpecError(Supi3Error, ValueError):
     """A pin list, a design's ports or a stimulus that do not fit together."""
+
+
+def check_cycles(name: str, value: object, lo: int) -> int:
+    """``value`` as a count of clock cycles from ``lo`` (a lockstep's ``reset_cycles`` from 0, M23; its ``window`` from
+    1): Python and numpy integers pass, ``bool``, floats and strings do not (:class:`PinSpecError`)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or int(value) < lo:
+        raise PinSpecError(f"{name} must be an integer from {lo}, not {value!r}")
+    return int(value)
 
 
 OE_SUFFIX = "_oe"

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 from typing import Final
 
+from supi3.checks import check_int
 from supi3.interbus import wire
 from supi3.optical.regulation import BLOCK_INPUTS, Interface
 from supi3.pinlevel import SYNC_STAGES as SYNC_STAGES
@@ -159,16 +160,32 @@ clocks (1.024 ms; M24 of ``docs/assumptions/model.md``)."""
 def time_base_ticks(clocks: int, bits: int = TIME_BASE_BITS) -> int:
     """The ticks that stand for a time of ``clocks`` (1 or more) on a time base of ``2**bits`` clocks: the fewest
     ``n`` for which the ``n``-th tick after a start is never less than ``clocks`` clocks after it (at most
-    ``2 * 2**bits - 2`` more; ``bits`` 0: ``clocks``; M24)."""
+    ``2 * 2**bits - 2`` more; ``bits`` 0: ``clocks``; M24).
+
+    Raises
+    ------
+    ArgumentError
+        ``clocks`` not an integer from 1, or ``bits`` not one from 0 (M24).
+    """
+    clocks = check_int("clocks", clocks, 1, None, "M24")
+    bits = check_int("bits", bits, 0, None, "M24")
     return (clocks - 2) // (1 << bits) + 2
 
 
 def time_base_end(start: int, clocks: int, bits: int = TIME_BASE_BITS) -> int:
     """The clock whose edge ends a time of ``clocks`` counted from clock ``start`` on a time base of ``2**bits``
     clocks: the :func:`time_base_ticks`-th clock at or after ``start`` whose edge is a tick (``bits`` 0:
-    ``start + clocks - 1``; M24)."""
-    period = 1 << bits
-    return start + (period - 1 - start) % period + (time_base_ticks(clocks, bits) - 1) * period
+    ``start + clocks - 1``; M24).
+
+    Raises
+    ------
+    ArgumentError
+        ``start`` not an integer from 0, ``clocks`` not one from 1, or ``bits`` not one from 0 (M24).
+    """
+    start = check_int("start", start, 0, None, "M24")
+    ticks = time_base_ticks(clocks, bits)
+    period = 1 << int(bits)
+    return start + (period - 1 - start) % period + (ticks - 1) * period
 
 # ----------------------------------------------------------------------------------------------------------------
 # The serial µP interface (3.4) and its place on the MFPs

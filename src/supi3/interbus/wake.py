@@ -80,9 +80,9 @@ def _check(bit_rate: int, devices: int, wakes: Mapping[int, int], lags: Sequence
     if lags is None:
         return devices, path_lags(bit_rate, devices)
     if isinstance(lags, (str, bytes)) or not isinstance(lags, Sequence) or len(lags) != devices + 1 or not all(
-            type(lag) is int for lag in lags) or any(b <= a for a, b in itertools.pairwise(lags)):
-        raise fail("lags", f"{devices + 1} increasing integer clocks (each chip's input, then the master's receiver, "
-                   "path_lags)", lags, "M25")  # fmt: skip
+            type(lag) is int for lag in lags) or lags[0] < 0 or any(b <= a for a, b in itertools.pairwise(lags)):
+        raise fail("lags", f"{devices + 1} increasing integer clocks from 0 (each chip's input, then the master's "
+                   "receiver, path_lags)", lags, "M25")  # fmt: skip
     return devices, list(lags)
 
 
@@ -96,16 +96,23 @@ def path_lags(bit_rate: int, devices: int, branches: Sequence[tuple[int, int, in
     ------
     ArgumentError
         ``bit_rate`` not one of Table 1-7, ``devices`` not from 1 to ``wire.MAX_DEVICES``, or ``branches`` not
-        triples of a BK's index, the end of its branch (after the BK, at most ``devices``) and a count.
+        triples of a BK's index, the end of its branch (after the BK, at most ``devices``) and a count, or two
+        branches of one BK or crossing (not a tree).
     """
     wire.check_bit_rate(bit_rate)
     devices = check_int("devices", devices, 1, wire.MAX_DEVICES)
     delay = wire.REPEATER_DELAY_BITS * wire.clocks_per_bit(bit_rate)
+    if isinstance(branches, (str, bytes)) or not isinstance(branches, Sequence):
+        raise fail("branches", "a sequence of (BK index, end, LBD-MR devices) triples", branches, "M25")
     extra = [0] * (devices + 2)
-    for branch in branches:
+    for number, branch in enumerate(branches):
         if not (isinstance(branch, tuple) and len(branch) == 3 and all(type(v) is int for v in branch)
                 and 0 <= branch[0] < branch[1] <= devices and 0 <= branch[2] < branch[1] - branch[0]):
             raise fail("branches", f"(BK index, end, LBD-MR devices) triples within {devices} chips", branch, "M25")
+        for other in branches[:number]:  # one branch a BK, and a tree's branches nest: disjoint or one inside another
+            if other[0] == branch[0] or other[0] < branch[0] < other[1] < branch[1] or (
+                    branch[0] < other[0] < branch[1] < other[1]):
+                raise fail("branches", "one branch a BK, nested or disjoint (a tree)", branch, "M25")
         extra[branch[1]] += branch[2] * delay + SYNC_STAGES
     lags, added = [], 0
     for index in range(devices + 1):
@@ -148,7 +155,8 @@ def wake_window(bit_rate: int, devices: int, wakes: Mapping[int, int], lags: Seq
     ------
     ArgumentError
         ``bit_rate`` not one of Table 1-7, ``devices`` not from 1 to ``wire.MAX_DEVICES``, ``wakes`` not a mapping
-        of ring indices (0 to ``devices`` - 1) to integer clocks, or ``lags`` not ``devices`` + 1 increasing clocks.
+        of ring indices (0 to ``devices`` - 1) to integer clocks, or ``lags`` not ``devices`` + 1 increasing clocks
+        from 0.
     """
     devices, lags = _check(bit_rate, devices, wakes, lags)
     cpb = wire.clocks_per_bit(bit_rate)

@@ -14,7 +14,7 @@ import numpy as np
 from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, Timer
 
-from supi3.pinlevel import PinModel, PinSpecError, recent_events
+from supi3.pinlevel import PinModel, PinSpecError, check_cycles, recent_events
 from supi3.verif.layout import CycleMatrix, WordLayout, model_columns, model_trace
 from supi3.verif.report import MismatchRecord, Outcome
 from supi3.verif.vcd import CYCLE_NS
@@ -55,7 +55,14 @@ async def lockstep(
     -------
     Outcome
         Cycles compared, time taken, and the first mismatch if there was one (the loop stops soon after it).
+
+    Raises
+    ------
+    PinSpecError
+        ``reset_cycles`` not an integer from 0 or ``window`` not one from 1 (before the clock starts).
     """
+    reset_cycles = check_cycles("reset_cycles", reset_cycles, 0)
+    window = check_cycles("window", window, 1)
     layout = WordLayout.of(model)
     in_ports = [getattr(dut, f"stim_word{index}") for index in range(layout.in_words)]
     expected_ports = [getattr(dut, f"expected_word{index}") for index in range(layout.out_words)]

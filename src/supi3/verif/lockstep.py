@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from supi3.pinlevel import ModelFactory, PinSpecError, recent_events
+from supi3.pinlevel import ModelFactory, PinSpecError, check_cycles, recent_events
 from supi3.verif.errors import SimulationError
 from supi3.verif.layout import CycleMatrix, Stimulus, WordLayout, model_columns, model_trace, stimulus_array
 from supi3.verif.report import LockstepResult, Outcome, raise_mismatch, window_trace
@@ -181,10 +181,8 @@ class Lockstep:
         reset_cycles: int = 0,
         window: int = 64,
     ) -> None:
-        if type(reset_cycles) is not int or reset_cycles < 0:
-            raise PinSpecError(f"reset_cycles must be an integer from 0, not {reset_cycles!r}")
-        if window < 1:
-            raise PinSpecError(f"window must be a positive integer, not {window!r}")
+        reset_cycles = check_cycles("reset_cycles", reset_cycles, 0)
+        window = check_cycles("window", window, 1)
         self.design_factory = design_factory
         self.model_factory = model_factory
         self.build_dir = (build_dir if build_dir is not None else Path.cwd() / "sim_build" / "lockstep").resolve()
