@@ -566,8 +566,13 @@ def render(fmt: str, out: Path | None = None) -> str:
     Raises
     ------
     RegisterMapError
-        If ``fmt`` is not a known format, or ``html`` is asked for without ``out``.
+        If ``fmt`` is not a known format, ``out`` is neither a :class:`~pathlib.Path` nor ``None``, or ``html`` is
+        asked for without ``out``.
     """
+    if not isinstance(fmt, str):
+        raise RegisterMapError(f"format must be one of {', '.join(FORMATS)}, not {fmt!r:.40}")
+    if out is not None and not isinstance(out, Path):
+        raise RegisterMapError(f"out must be a pathlib.Path or None, not {out!r:.60}")
     if fmt == "html":
         if out is None:
             raise RegisterMapError("format 'html' writes a directory: give an output path")

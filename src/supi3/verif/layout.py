@@ -10,13 +10,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
+from numbers import Integral
 from operator import itemgetter
 from typing import TypeAlias
 
 import numpy as np
 import numpy.typing as npt
 
-from supi3.pinlevel import Pin, PinModel, PinSpecError, compared_signals
+from supi3.pinlevel import Pin, PinModel, PinSpecError, check_cycles, compared_signals
 
 __all__ = [
     "CycleMatrix",
@@ -270,10 +271,23 @@ def stimulus_array(stimulus: Stimulus, inputs: Sequence[Pin], max_cycles: int | 
     inputs:
         The model's input pins.
     max_cycles:
-        Take at most this many cycles (needed for an endless generator).
+        Take at most this many cycles (needed for an endless generator): an integer from 0, or ``None`` for all.
+
+    Raises
+    ------
+    PinSpecError
+        ``max_cycles`` not ``None`` nor an integer from 0; an array that is not 1-D (one input) or 2-D of shape
+        ``(cycles, inputs)``, or holds no integers or negative ones; an iterable whose cycle is no mapping, names no
+        input pin, or gives a value that is no integer (``bool``, floats and strings are not: a level is never cast)
+        or does not fit the pin, named with its cycle.
     """
+    if max_cycles is not None:
+        max_cycles = check_cycles("max_cycles", max_cycles, 0)
+    if isinstance(stimulus, (str, bytes, Mapping)) or not isinstance(stimulus, (np.ndarray, Iterable)):
+        raise PinSpecError(f"stimulus must be an integer array (cycles, inputs) or an iterable of per-cycle dicts, "
+                           f"not {stimulus!r:.80}")  # fmt: skip
     if isinstance(stimulus, np.ndarray):
-        array = stimulus if stimulus.ndim == 2 else stimulus.reshape(-1, 1)
+        array = stimulus if stimulus.ndim == 2 else stimulus.reshape(-1, 1) if stimulus.ndim == 1 else stimulus
         if array.ndim != 2 or array.shape[1] != len(inputs):
             raise PinSpecError(f"array stimulus must have shape (cycles, {len(inputs)}), not {stimulus.shape}")
         if not np.issubdtype(array.dtype, np.integer):
@@ -288,10 +302,20 @@ def stimulus_array(stimulus: Stimulus, inputs: Sequence[Pin], max_cycles: int | 
         for cycle, values in enumerate(stimulus):
             if max_cycles is not None and cycle >= max_cycles:
                 break
+            if not isinstance(values, Mapping):
+                raise PinSpecError(f"cycle {cycle}: stimulus must be a mapping of input pins to values, not "
+                                   f"{values!r:.80}")  # fmt: skip
             for name, value in values.items():
                 if name not in names:
                     raise PinSpecError(f"cycle {cycle}: {name!r} is not an input pin of the model")
-                current[names[name]] = int(value)
+                pin = inputs[names[name]]
+                level = int(value) if isinstance(value, Integral) and not isinstance(value, bool | np.bool_) else -1
+                if level < 0:
+                    raise PinSpecError(f"cycle {cycle}: input {name!r} must be an integer from 0 to {pin.mask:#x} "
+                                       f"({pin.width} bits), not {value!r:.40}")  # fmt: skip
+                if level > pin.mask:
+                    raise PinSpecError(f"cycle {cycle}: input {name!r} = {level:#x} exceeds {pin.width} bits")
+                current[names[name]] = level
             rows.append(list(current))
         result = np.array(rows, dtype=np.uint64).reshape(len(rows), len(inputs))
     for index, pin in enumerate(inputs):
