@@ -22,12 +22,16 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from supi3 import cli, timing
-from supi3.errors import Supi3Error
+from supi3.config import decode
+from supi3.errors import ArgumentError, Supi3Error
 from supi3.interbus import wire
+from supi3.interbus.device import PlainDevice
 from supi3.interbus.master import Master
 from supi3.interbus.ring import BitFlip, BranchKind, CorruptLoopback, Ring, Truncate, _devices, return_inputs
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
+from supi3.optical.link import FibreLink
+from supi3.optical.ring import OpticalRing
 from supi3.pinlevel import Pin, PinSpecError
 from supi3.regmap import SET, RegisterMapError, decode_command, decode_set, encode_command, render
 from supi3.verif.layout import stimulus_array
@@ -171,6 +175,45 @@ def test_the_command_line_names_what_it_cannot_take(capsys: pytest.CaptureFixtur
     """``supi3 timing --bytes 32768`` (one device) printed a cycle no ring can have; ``supi3 campaign --mix ""`` ran
     the default mix, which the user had not asked for (an empty option taken as none). Exit 2, one line."""
     assert _main(capsys, argv) == (2, "", message)
+
+
+# -- a refused transfer leaves no trace -------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("data", [5, None, "ab", [0x3C, 0x5A]], ids=repr)
+def test_a_transfer_of_no_bytes_is_refused_by_name(data: object) -> None:
+    """``Ring.transfer(Cycle.ID, 5)`` sent a frame of five zero bytes (``bytes(5)``, a silent guess), a list its bytes;
+    ``None`` and a string were TypeErrors, and so was any of them on a tree or an optical ring (``len(data)``)."""
+    for ring in (Ring([PlainDevice(0xBF, 1)]), tl_tree(BranchKind.LOCAL, 1), _optical_ring(20.0)):
+        with pytest.raises(ArgumentError, match=r"^data must be bytes, not "):
+            ring.transfer(Cycle.ID, data)  # type: ignore[arg-type]
+
+
+def _optical_ring(metres: float) -> OpticalRing:
+    chips = [Supi3(decode("10000", rf="00")) for _ in range(3)]
+    return OpticalRing(chips, [FibreLink(20.0), FibreLink(metres), FibreLink(20.0)], seed=5)
+
+
+def _optical_history(refuse: bool) -> list[object]:
+    ring = _optical_ring(104.0)  # a marginal fibre: its bit errors are drawn per frame (OPT-47)
+    master = Master(ring)
+    seen: list[object] = [master.start().ok]
+    for _ in range(30):
+        if refuse:
+            with pytest.raises(ArgumentError, match=r"^close_after must be an integer >= 0, not -1"):
+                ring.transfer(Cycle.DATA, wire.LOOPBACK_BYTES_ON_LINE, -1)
+        result = master.cycle()
+        seen.append((result.ok, result.cycle, [(d.kind, d.location) for d in result.diagnostics]))
+    return seen
+
+
+def test_a_refused_transfer_draws_no_bit_error_of_a_marginal_fibre() -> None:
+    """``OpticalRing.transfer`` set the fibres' faults (drawing from the ring's seeded bit errors) before its ring
+    refused ``close_after=-1``: a history with refused calls in it failed other cycles than the same history without
+    them. The arguments are now checked first (``ring.check_transfer``), on every ring."""
+    plain = _optical_history(False)
+    assert plain == _optical_history(True)
+    assert any(not ok for ok, *_ in plain[1:])  # type: ignore[misc]
 
 
 # -- what held: histories on a transaction-level tree -------------------------------------------------------------
