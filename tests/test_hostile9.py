@@ -194,10 +194,10 @@ def _optical_ring(metres: float) -> OpticalRing:
     return OpticalRing(chips, [FibreLink(20.0), FibreLink(metres), FibreLink(20.0)], seed=5)
 
 
-def _optical_history(refuse: bool) -> list[object]:
+def _optical_history(refuse: bool) -> list[tuple[bool, Cycle | None, list[object]]]:
     ring = _optical_ring(104.0)  # a marginal fibre: its bit errors are drawn per frame (OPT-47)
     master = Master(ring)
-    seen: list[object] = [master.start().ok]
+    seen: list[tuple[bool, Cycle | None, list[object]]] = [(master.start().ok, None, [])]
     for _ in range(30):
         if refuse:
             with pytest.raises(ArgumentError, match=r"^close_after must be an integer >= 0, not -1"):
@@ -213,7 +213,7 @@ def test_a_refused_transfer_draws_no_bit_error_of_a_marginal_fibre() -> None:
     them. The arguments are now checked first (``ring.check_transfer``), on every ring."""
     plain = _optical_history(False)
     assert plain == _optical_history(True)
-    assert any(not ok for ok, *_ in plain[1:])  # type: ignore[misc]
+    assert any(not ok for ok, _, _ in plain[1:])
 
 
 # -- what held: histories on a transaction-level tree -------------------------------------------------------------
