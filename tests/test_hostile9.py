@@ -14,6 +14,7 @@ Every bad input is refused by name (which argument, which rule, which value), ne
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -34,7 +35,9 @@ from supi3.optical.link import FibreLink
 from supi3.optical.ring import OpticalRing
 from supi3.pinlevel import Pin, PinSpecError
 from supi3.regmap import SET, RegisterMapError, decode_command, decode_set, encode_command, render
+from supi3.verif.example import ShiftCounterModel
 from supi3.verif.layout import stimulus_array
+from supi3.verif.lockstep import react
 from test_model_pinring_tree import RECOVERY, tl_tree
 
 # -- the lockstep's stimulus --------------------------------------------------------------------------------------
@@ -91,6 +94,32 @@ def test_a_stimulus_that_is_no_stimulus_is_refused_by_name(stimulus: object, mes
     if isinstance(stimulus, np.ndarray):
         with pytest.raises(PinSpecError, match=r"^array stimulus must have shape \(cycles, 1\), not \(3, 2, 1\)"):
             stimulus_array(stimulus, [Pin("a", 1)])
+
+
+@pytest.mark.parametrize(("cycles", "agent", "message"), [
+    (-1, lambda *_: {"en": 1}, r"^cycles must be an integer from 0, not -1"),
+    (1.5, lambda *_: {"en": 1}, r"^cycles must be an integer from 0, not 1.5"),
+    (2, None, r"^agent must be a function agent\(cycle, outputs\) -> inputs, not None"),
+    (2, lambda *_: [1], r"^cycle 0: stimulus must be a mapping of input pins to values, not \[1\]"),
+    (2, lambda *_: {"din": 1.7}, r"^cycle 0: input 'din' must be an integer from 0 to 0xff \(8 bits\), not 1.7"),
+    (2, lambda *_: {"en": True}, r"^cycle 0: input 'en' must be an integer from 0 to 0x1 \(1 bits\), not True"),
+    (2, lambda *_: {"din": 300}, r"^cycle 0: input 'din' = 0x12c exceeds 8 bits"),
+])  # fmt: skip
+def test_a_reacting_agent_s_bad_inputs_are_refused_before_the_model_steps(cycles: object, agent: object,
+                                                                          message: str) -> None:  # fmt: skip
+    """``react`` kept its own copy of the per-cycle rule: ``cycles=-1`` gave an empty stimulus, 1.5 and an agent of
+    ``None`` TypeErrors, a list an AttributeError, 1.7 and ``True`` were cast to 1, and 300 reached the model's
+    ``step`` before the width check refused it. It now shares :func:`~supi3.verif.layout.apply_inputs`."""
+    stepped: list[int] = []
+
+    class Spy(ShiftCounterModel):
+        def step(self, inputs: Mapping[str, int]) -> dict[str, int]:
+            stepped.append(inputs["din"])
+            return super().step(inputs)
+
+    with pytest.raises(PinSpecError, match=message):
+        react(Spy, agent, cycles)  # type: ignore[arg-type]
+    assert all(0 <= level <= 0xFF for level in stepped)
 
 
 # -- the register map's byte helpers ------------------------------------------------------------------------------

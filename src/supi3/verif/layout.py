@@ -24,6 +24,7 @@ __all__ = [
     "Stimulus",
     "WordField",
     "WordLayout",
+    "apply_inputs",
     "first_mismatch",
     "model_columns",
     "model_trace",
@@ -261,6 +262,33 @@ def _pack(fields: Sequence[WordField], words: int, columns: Sequence[npt.NDArray
     return packed.T
 
 
+def apply_inputs(cycle: int, values: object, inputs: Sequence[Pin], names: Mapping[str, int],
+                 current: list[int]) -> None:  # fmt: skip
+    """Set ``current`` (the input levels in ``inputs`` order; ``names`` maps a pin's name to its index) from one
+    cycle's dict of a stimulus or a reacting agent: pins it leaves out keep their level.
+
+    Raises
+    ------
+    PinSpecError
+        ``values`` is no mapping, names no input pin, or gives a level that is no integer (``bool``, floats and strings
+        are not: a level is never cast) or does not fit the pin; named with ``cycle``. ``current`` may be changed for
+        the pins before the one refused.
+    """
+    if not isinstance(values, Mapping):
+        raise PinSpecError(f"cycle {cycle}: stimulus must be a mapping of input pins to values, not {values!r:.80}")
+    for name, value in values.items():
+        if name not in names:
+            raise PinSpecError(f"cycle {cycle}: {name!r} is not an input pin of the model")
+        pin = inputs[names[name]]
+        level = int(value) if isinstance(value, Integral) and not isinstance(value, bool | np.bool_) else -1
+        if level < 0:
+            raise PinSpecError(f"cycle {cycle}: input {name!r} must be an integer from 0 to {pin.mask:#x} "
+                               f"({pin.width} bits), not {value!r:.40}")  # fmt: skip
+        if level > pin.mask:
+            raise PinSpecError(f"cycle {cycle}: input {name!r} = {level:#x} exceeds {pin.width} bits")
+        current[names[name]] = level
+
+
 def stimulus_array(stimulus: Stimulus, inputs: Sequence[Pin], max_cycles: int | None = None) -> CycleMatrix:
     """Normalise stimulus to a ``uint64`` array ``(cycles, inputs)``, checking names and value ranges.
 
@@ -302,20 +330,7 @@ def stimulus_array(stimulus: Stimulus, inputs: Sequence[Pin], max_cycles: int | 
         for cycle, values in enumerate(stimulus):
             if max_cycles is not None and cycle >= max_cycles:
                 break
-            if not isinstance(values, Mapping):
-                raise PinSpecError(f"cycle {cycle}: stimulus must be a mapping of input pins to values, not "
-                                   f"{values!r:.80}")  # fmt: skip
-            for name, value in values.items():
-                if name not in names:
-                    raise PinSpecError(f"cycle {cycle}: {name!r} is not an input pin of the model")
-                pin = inputs[names[name]]
-                level = int(value) if isinstance(value, Integral) and not isinstance(value, bool | np.bool_) else -1
-                if level < 0:
-                    raise PinSpecError(f"cycle {cycle}: input {name!r} must be an integer from 0 to {pin.mask:#x} "
-                                       f"({pin.width} bits), not {value!r:.40}")  # fmt: skip
-                if level > pin.mask:
-                    raise PinSpecError(f"cycle {cycle}: input {name!r} = {level:#x} exceeds {pin.width} bits")
-                current[names[name]] = level
+            apply_inputs(cycle, values, inputs, names, current)
             rows.append(list(current))
         result = np.array(rows, dtype=np.uint64).reshape(len(rows), len(inputs))
     for index, pin in enumerate(inputs):
