@@ -13,6 +13,7 @@ Every bad input is refused by name (which argument, which rule, which value), ne
 
 from __future__ import annotations
 
+import asyncio
 import math
 from collections.abc import Mapping
 from pathlib import Path
@@ -35,6 +36,7 @@ from supi3.optical.link import FibreLink
 from supi3.optical.ring import OpticalRing
 from supi3.pinlevel import Pin, PinSpecError
 from supi3.regmap import SET, RegisterMapError, decode_command, decode_set, encode_command, render
+from supi3.verif.cocotb_lockstep import lockstep
 from supi3.verif.example import ShiftCounterModel
 from supi3.verif.layout import stimulus_array
 from supi3.verif.lockstep import react
@@ -120,6 +122,19 @@ def test_a_reacting_agent_s_bad_inputs_are_refused_before_the_model_steps(cycles
     with pytest.raises(PinSpecError, match=message):
         react(Spy, agent, cycles)  # type: ignore[arg-type]
     assert all(0 <= level <= 0xFF for level in stepped)
+
+
+@pytest.mark.parametrize(("stimulus", "message"), [
+    ([{"en": 1}, {"din": 1.5}], r"^cycle 1: input 'din' must be an integer from 0 to 0xff \(8 bits\), not 1.5"),
+    (np.zeros((2, 4), dtype=np.uint8), r"^array stimulus must have shape \(cycles, 5\), not \(2, 4\)"),
+    (np.full((2, 5), 2, dtype=np.uint8), r"^cycle 0: input 'en' = 0x2 exceeds 1 bits"),
+])  # fmt: skip
+def test_the_cocotb_lockstep_checks_its_stimulus_before_the_clock_starts(stimulus: object, message: str) -> None:
+    """The cocotb coroutine packed its stimulus unchecked: a list of dicts ended in an AttributeError, an array of
+    the wrong width in a numpy error, a level too wide for its pin was driven into the design. It now takes what
+    ``stimulus_array`` takes, checked first (``dut`` is never touched here)."""
+    with pytest.raises(PinSpecError, match=message):
+        asyncio.run(lockstep(None, ShiftCounterModel(), stimulus))  # type: ignore[arg-type]
 
 
 # -- the register map's byte helpers ------------------------------------------------------------------------------
