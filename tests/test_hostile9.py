@@ -260,6 +260,28 @@ def test_a_refused_transfer_draws_no_bit_error_of_a_marginal_fibre() -> None:
     assert any(not ok for ok, _, _ in plain[1:])
 
 
+# -- M31: a ring grown past the master's discovery window ------------------------------------------------------
+
+
+def test_devices_added_past_max_devices_are_not_located_at_the_return_line() -> None:
+    """M31: ``Master(ring, max_devices=2)`` on two devices, a third appended: every cycle reported a loopback error at
+    position 3 ("segment search: the return line"), a wrong location, for good. Nothing proves the return line: a
+    ring longer than the discovery window looks the same. With the protocol's 512 the return line stands."""
+    ring = Ring([PlainDevice(0xBF, 1) for _ in range(2)])
+    master = Master(ring, max_devices=2)
+    assert master.start().ok
+    ring.devices.append(PlainDevice(0xBF, 1))
+    for _ in range(3):
+        (diagnostic,) = master.cycle().diagnostics
+        assert diagnostic.location is None and "more devices than max_devices (2)" in diagnostic.detail
+    wide = Ring([PlainDevice(0xBF, 1) for _ in range(2)])
+    default = Master(wide)
+    assert default.start().ok
+    wide.inject(CorruptLoopback(3, 0x1234, None))
+    located = [d.location for _ in range(3) for d in default.cycle().diagnostics]
+    assert located and set(located) == {3}
+
+
 # -- what held: histories on a transaction-level tree -------------------------------------------------------------
 
 STEPS = ["on", "off", "extended", "cut", "back", "di3", "repair", "start", "power", "idle", "flip", "alarm"]

@@ -645,6 +645,11 @@ class Master:
             return _not_located(problem, "the error went away during the segment search")
         if failed.kind is ErrorKind.CONFIGURATION:
             return _changed(problem, failed.location, failed.detail)
+        if low == n + 1 and failed.kind is ErrorKind.LOOPBACK and self.max_devices < wire.MAX_DEVICES:
+            # M31: devices added behind the last one, beyond the discovery window (max_devices), keep the loopback
+            # word from coming back as a fault on the return line does: nothing proves the return line.
+            return _not_located(problem, f"the loopback word is missing behind device {n}: a fault on the return "
+                                f"line or more devices than max_devices ({self.max_devices})")  # fmt: skip
         where = "the return line" if low == n + 1 else f"the ring fails when closed after position {low}"
         problem = Diagnostic(problem.kind, low, None, None, f"{problem.detail}; segment search: {where}")
         return self._counted(problem, low) if failed.kind in COUNTED_KINDS else problem
