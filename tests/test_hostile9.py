@@ -29,7 +29,17 @@ from supi3.errors import ArgumentError, Supi3Error
 from supi3.interbus import wire
 from supi3.interbus.device import PlainDevice
 from supi3.interbus.master import Master
-from supi3.interbus.ring import BitFlip, BranchKind, CorruptLoopback, Ring, Truncate, _devices, return_inputs
+from supi3.interbus.ring import (
+    BitFlip,
+    BranchKind,
+    CorruptLoopback,
+    ErrorKind,
+    Ring,
+    Transfer,
+    Truncate,
+    _devices,
+    return_inputs,
+)
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
 from supi3.optical.link import FibreLink
@@ -280,6 +290,35 @@ def test_devices_added_past_max_devices_are_not_located_at_the_return_line() -> 
     wide.inject(CorruptLoopback(3, 0x1234, None))
     located = [d.location for _ in range(3) for d in default.cycle().diagnostics]
     assert located and set(located) == {3}
+
+
+# -- A19: commands by ring position do not outlive their table ----------------------------------------------------
+
+
+def test_a_command_by_position_is_not_sent_to_the_device_a_ring_change_moved_there() -> None:
+    """A19: ``quit_peripheral_error(3)`` and ``processor_command(4, ...)`` waiting when device 1 was removed: the
+    configuration error dropped the table, but the quit went out in the first ID cycle on the new one, to ring
+    position 3, now the device that was 4 (a Quit Peripheral Error for a fault it may not have, the one at 2 never
+    acknowledged). Commands not yet sent are dropped with the table; the application sends them again."""
+    ring = Ring([PlainDevice(0xBF, 1) for _ in range(4)])
+    master = Master(ring)
+    assert master.start().ok
+    words: list[list[int]] = []
+    transfer = ring.transfer
+
+    def spy(cycle: Cycle, data: bytes, close_after: int | None = None) -> Transfer:
+        if cycle is Cycle.ID and len(data) < 2 * wire.MAX_DEVICES:
+            words.append([int.from_bytes(data[k : k + 2], "little") for k in range(2, len(data), 2)])
+        return transfer(cycle, data, close_after)
+
+    ring.transfer = spy  # type: ignore[method-assign]
+    master.quit_peripheral_error(3)
+    master.processor_command(4, 0x55)
+    del ring.devices[0]
+    kinds = [d.kind for _ in range(4) for d in master.cycle().diagnostics]
+    assert kinds == [ErrorKind.CONFIGURATION]
+    assert words[0] == [0x5510, 0x8, 0, 0]  # the commands went out once, in the cycle that found the change
+    assert all(not any(w) for w in words[1:]), words
 
 
 # -- what held: histories on a transaction-level tree -------------------------------------------------------------

@@ -564,9 +564,12 @@ class Master:
             problem = self._locate(problem, trusted)
         located = self._with_device(problem)
         if problem.kind is ErrorKind.CONFIGURATION and self.config is not None:
-            # A configuration difference: the table is dropped (A19); rebuilt by the next cycle() or by start().
+            # A configuration difference: the table is dropped (A19); rebuilt by the next cycle() or by start(). The
+            # commands not yet sent name ring positions a new table may give other devices: dropped with it (A19).
             self._set_config(None)
             self.stopped = not self.rediscover
+            for pending in (self._quit, self._pcmd, self._alarm_request, self._branch):
+                pending.clear()
         self._record((located,))
         return CycleResult(cycle, False, (located,))
 
