@@ -45,7 +45,16 @@ from supi3.model.chip import Supi3
 from supi3.optical.link import FibreLink
 from supi3.optical.ring import OpticalRing
 from supi3.pinlevel import Pin, PinSpecError
-from supi3.regmap import SET, RegisterMapError, decode_command, decode_set, encode_command, render
+from supi3.regmap import (
+    SET,
+    RegisterMapError,
+    decode_command,
+    decode_set,
+    encode_command,
+    render,
+    to_html,
+    write_checked_in,
+)
 from supi3.verif.cocotb_lockstep import lockstep
 from supi3.verif.example import ShiftCounterModel
 from supi3.verif.layout import stimulus_array
@@ -185,10 +194,15 @@ def test_rd_and_wr_are_bools(flag: object) -> None:
 
 
 def test_render_refuses_a_format_or_an_output_of_the_wrong_type(tmp_path: Path) -> None:
-    """``render("md", "map.md")`` was an AttributeError ('str' object has no attribute 'parent'), ``render(["md"])``
-    a TypeError (unhashable list); nothing is written."""
-    with pytest.raises(RegisterMapError, match=r"^out must be a pathlib.Path or None, not "):
+    """``render("md", "map.md")`` and ``to_html("site")`` were AttributeErrors ('str' object has no attribute
+    'parent', 'mkdir'), ``write_checked_in(".")`` a TypeError (str / str), ``render(["md"])`` one too (unhashable
+    list); nothing is written."""
+    with pytest.raises(RegisterMapError, match=r"^out must be a pathlib.Path, not "):
         render("md", str(tmp_path / "map.md"))  # type: ignore[arg-type]
+    with pytest.raises(RegisterMapError, match=r"^outdir must be a pathlib.Path, not "):
+        to_html(str(tmp_path))  # type: ignore[arg-type]
+    with pytest.raises(RegisterMapError, match=r"^root must be a pathlib.Path, not "):
+        write_checked_in(str(tmp_path))  # type: ignore[arg-type]
     with pytest.raises(RegisterMapError, match=r"^format must be one of html, md, rdl, h, json, not \['md'\]"):
         render(["md"])  # type: ignore[arg-type]
     assert list(tmp_path.iterdir()) == []
