@@ -28,6 +28,7 @@ from supi3.config import decode
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.interbus import wire
 from supi3.interbus.device import PlainDevice
+from supi3.interbus.errors import InterbusError
 from supi3.interbus.master import Master
 from supi3.interbus.ring import (
     BitFlip,
@@ -333,6 +334,22 @@ def test_a_command_by_position_is_not_sent_to_the_device_a_ring_change_moved_the
     assert kinds == [ErrorKind.CONFIGURATION]
     assert words[0] == [0x5510, 0x8, 0, 0]  # the commands went out once, in the cycle that found the change
     assert all(not any(w) for w in words[1:]), words
+
+
+def test_a_stopped_master_waits_for_start_in_every_cycle_entry() -> None:
+    """A19: with ``rediscover=False`` a configuration error stops the master until ``start()``; ``cycle()`` refused,
+    but ``id_cycle()`` ran a discovery, rebuilt the table and cleared ``stopped``: running again without the Alarm
+    Stop the rule asks for. Every cycle entry now refuses alike; ``start()`` runs."""
+    ring = Ring([PlainDevice(0xBF, 1) for _ in range(3)])
+    master = Master(ring, rediscover=False)
+    assert master.start().ok
+    del ring.devices[1]
+    assert [d.kind for d in master.cycle().diagnostics] == [ErrorKind.CONFIGURATION] and master.stopped
+    for entry in (master.cycle, master.id_cycle, master.data_cycle):
+        with pytest.raises(InterbusError):
+            entry()
+        assert master.stopped and master.config is None
+    assert master.start().ok and not master.stopped
 
 
 # -- what held: histories on a transaction-level tree -------------------------------------------------------------

@@ -393,9 +393,7 @@ class Master:
         """Run the next cycle a master would: an ID cycle when there is no configuration, a command to send
         or a device asking for attention, and after a failed cycle until an ID cycle is latched (so that no TE
         bit outlives the error it belongs to, assumption A21); else a data cycle."""
-        if self.stopped:
-            raise InterbusError("docs/interbus.md, Configuration changes", "rediscover=False",
-                                "the configuration changed and the master waits for start()")  # fmt: skip
+        self._require_running()
         pending = self._pcmd or self._alarm_request or self._alarm_expected or self._recover or self._branch \
             or self._optical_request or self._optical_expected or self._alarm_output
         if self.config is None or self._attention or self._watchdog_pending or self._quit or pending:
@@ -418,8 +416,10 @@ class Master:
 
     def id_cycle(self) -> CycleResult:
         """One ID cycle: a discovery cycle without a configuration (the loopback word is searched for), else
-        a cycle over the known ring that also carries the command words."""
+        a cycle over the known ring that also carries the command words; stopped (``rediscover=False``, A19) it waits
+        for :meth:`start` as :meth:`cycle` does."""
         if self.config is None:
+            self._require_running()
             return self._discovery()
         config = self.config
         optical = self._optical_request - self._alarm_request - self._pcmd.keys()  # one answer each (OPT-50)
@@ -453,6 +453,11 @@ class Master:
         return CycleResult(Cycle.ID, True, messages)
 
     # -- internals -----------------------------------------------------------------------------------------------
+
+    def _require_running(self) -> None:
+        if self.stopped:
+            raise InterbusError("docs/interbus.md, Configuration changes", "rediscover=False",
+                                "the configuration changed and the master waits for start()")  # fmt: skip
 
     def _require_config(self) -> tuple[ConfigEntry, ...]:
         if self.config is None:
