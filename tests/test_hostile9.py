@@ -336,6 +336,23 @@ def test_a_command_by_position_is_not_sent_to_the_device_a_ring_change_moved_the
     assert all(not any(w) for w in words[1:]), words
 
 
+def test_a_peripheral_fault_moved_onto_a_reported_position_is_reported() -> None:
+    """A19: device A's PF reported at position 1 (0BB1h), then A removed while device B, behind it, raised its own PF:
+    B moved to position 1, whose PF the master took as the one already reported, and B's fault was never reported
+    (a message lost). The reported PF bits are dropped with the table: B's is reported on the new one."""
+    a, b = PlainDevice(0xBF, 1), PlainDevice(0xBF, 1)
+    ring = Ring([a, b])
+    master = Master(ring)
+    assert master.start().ok
+    a.set_peripheral_fault(True)
+    assert [(d.kind, d.location) for _ in range(3) for d in master.cycle().diagnostics] == [
+        (ErrorKind.PERIPHERAL_FAULT, 1)]
+    b.set_peripheral_fault(True)
+    del ring.devices[0]
+    seen = [(d.kind, d.location) for _ in range(5) for d in master.cycle().diagnostics]
+    assert seen == [(ErrorKind.CONFIGURATION, 2), (ErrorKind.PERIPHERAL_FAULT, 1)]
+
+
 def test_a_stopped_master_waits_for_start_in_every_cycle_entry() -> None:
     """A19: with ``rediscover=False`` a configuration error stops the master until ``start()``; ``cycle()`` refused,
     but ``id_cycle()`` ran a discovery, rebuilt the table and cleared ``stopped``: running again without the Alarm

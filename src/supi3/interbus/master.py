@@ -570,10 +570,11 @@ class Master:
         located = self._with_device(problem)
         if problem.kind is ErrorKind.CONFIGURATION and self.config is not None:
             # A configuration difference: the table is dropped (A19); rebuilt by the next cycle() or by start(). The
-            # commands not yet sent name ring positions a new table may give other devices: dropped with it (A19).
+            # commands not yet sent and the PF bits reported name ring positions a new table may give other devices:
+            # dropped with it, so a PF standing on the new table is reported there (A19).
             self._set_config(None)
             self.stopped = not self.rediscover
-            for pending in (self._quit, self._pcmd, self._alarm_request, self._branch):
+            for pending in (self._quit, self._pcmd, self._alarm_request, self._branch, self._pf_active):
                 pending.clear()
         self._record((located,))
         return CycleResult(cycle, False, (located,))
