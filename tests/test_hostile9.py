@@ -1,14 +1,19 @@
-"""Hostile inputs, orders and histories against the INTERBUS, tree, optical, diagnostic, verification, register-map
-and command-line entries (a user's review, round 9): the lockstep's stimulus
-(:func:`supi3.verif.layout.stimulus_array`, behind ``Lockstep.stimulus``, ``run``, ``run_batch`` and the Amaranth
-path), the register map's byte helpers (:func:`supi3.regmap.encode_command`, :func:`~supi3.regmap.decode_command`,
-:func:`~supi3.regmap.decode_set`, ``ByteLayout.encode`` and ``decode``) and :func:`supi3.regmap.render`, the data
-cycle time of :func:`supi3.timing.data_cycle_time_s` and ``supi3 timing --bytes`` (A23), ``supi3 campaign --mix``;
-and what held: any history of branch switching, extended closures, cuts and repairs (forward, return, DI3), bit
-errors, power-ups, idle stretches, ALARM outputs and Alarm Stops on a transaction-level tree leaves no latched
-output changed by a cycle that failed, every latched data cycle delivered, and the master never stuck.
+"""Hostile inputs, orders and histories against the INTERBUS, tree, optical, verification, register-map and
+command-line entries (a user's review, round 9): the lockstep's stimulus (:func:`supi3.verif.layout.stimulus_array`
+behind ``Lockstep.stimulus``, ``run``, ``run_batch`` and the Amaranth path; :func:`supi3.verif.lockstep.react`; the
+cocotb coroutine :func:`supi3.verif.cocotb_lockstep.lockstep`), the register map's byte helpers
+(:func:`supi3.regmap.encode_command`, :func:`~supi3.regmap.decode_command`, :func:`~supi3.regmap.decode_set`,
+``ByteLayout.encode`` and ``decode``) and exporters (:func:`~supi3.regmap.render`, ``to_html``, ``write_checked_in``),
+the data cycle time (:func:`supi3.timing.data_cycle_time_s`, ``supi3 timing --bytes``, A23), ``supi3 campaign --mix``,
+a bus's ``transfer`` (:class:`~supi3.interbus.ring.Ring`, :class:`~supi3.optical.ring.OpticalRing`: its arguments
+checked before the ring changes anything), and the master's state across a ring change (commands by ring position,
+reported PF bits, ``rediscover=False``: A19; a ring grown past ``max_devices``: M31); and what held: any history of
+branch switching, extended closures, cuts and repairs (forward, return, DI3), bit errors, power-ups, idle stretches,
+ALARM outputs and Alarm Stops on a transaction-level tree leaves no latched output changed by a cycle that failed,
+every latched data cycle delivered, and the master never stuck.
 
-Every bad input is refused by name (which argument, which rule, which value), never a traceback or a silent guess.
+Every bad input is refused by name (which argument, which rule, which value), never a traceback or a silent guess; a
+refused call leaves no trace.
 """
 
 from __future__ import annotations
