@@ -431,7 +431,7 @@ def _checked_cycle(ring: Ring, master: Master, data: st.DataObject) -> None:
         assert chip.out_word == int.from_bytes(master.outputs(entry.ring_position), "big") or not entry.data_bytes
 
 
-@settings(max_examples=12, deadline=None)
+@settings(max_examples=30, deadline=None)
 @given(kind=st.sampled_from([BranchKind.REMOTE, BranchKind.LOCAL, BranchKind.LBD_MR, BranchKind.LBD_OR]),
        m=st.integers(1, 2), history=st.lists(st.tuples(st.sampled_from(STEPS), st.integers(1, 5)), max_size=6),
        data=st.data())  # fmt: skip
