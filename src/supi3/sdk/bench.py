@@ -128,7 +128,7 @@ class MasterStart:
         the telegram in which :attr:`at` falls (the pin-level board's telegrams, checked with :meth:`due`, end
         there too)."""
         telegram_s = wire.STATUS_TELEGRAM_BITS / bit_rate
-        return math.ceil(self.at / telegram_s - 1e-9) * telegram_s
+        return math.ceil(self.at / telegram_s - 1e-9) * telegram_s  # a telegram's end itself, not the next
 
 
 def serve_wait_s(bit_rate: int) -> float:
@@ -628,8 +628,9 @@ class Bench:
 
     def set_up_done(self, at: float) -> None:
         """The firmware's set-up ended at bus time ``at`` (:class:`MasterStart`: only the first call counts): the
-        master's first cycle starts then if it has not started yet, at the latest at :data:`START_WAIT_S` (MCU-45,
-        FW-15). :meth:`power_up` calls it; the emulated board calls it at its core's first wait or first pass.
+        master's first cycle starts at the end of that status telegram if it has not started yet, at the latest at
+        :data:`START_WAIT_S` (MCU-45, FW-15). :meth:`power_up` calls it; the emulated board calls it at its core's
+        first wait or first pass.
 
         Raises
         ------
