@@ -105,5 +105,5 @@ def frame_start(samples: npt.NDArray[np.integer], cpb: int, cycle: Cycle, data_b
             continue
         if frame.cycle is cycle and len(frame.data) == data_bytes and isinstance(found[0], Telegram) \
                 and wire.opens_frame(found[0]):
-            return at
+            return int(at)
     return None
