@@ -95,7 +95,11 @@ def frame_start(samples: npt.NDArray[np.integer], cpb: int, cycle: Cycle, data_b
     low = samples == wire.START_LEVEL
     starts = np.flatnonzero(low[1:] & ~low[:-1]) + 1
     candidates = ([0] if len(samples) and low[0] else []) + starts[starts <= len(samples) - length].tolist()
+    mid = cpb // 2
     for at in candidates:
+        if samples[at + mid + wire.POS_TYPE * cpb] != wire.TYPE_DATA_LEVEL \
+                or samples[at + mid + (wire.DATA_TELEGRAM_BITS - 1) * cpb] != wire.STOP_LEVEL:
+            continue  # no data telegram begins here
         found, end, error = receive(samples[at : at + length], 0, cpb)
         if error or end != length or len(found) != telegrams:
             continue
