@@ -886,7 +886,7 @@ KIND_OPS = st.lists(st.tuples(st.sampled_from(["off", "on", "start", "reset", "c
                     min_size=1, max_size=6)  # fmt: skip
 
 
-@settings(max_examples=60, deadline=None, derandomize=True)
+@settings(max_examples=30, deadline=None, derandomize=True)
 @given(st.integers(1, 3), KIND_OPS)
 @example(2, SWITCHED_OFF_CUT)
 @example(2, [("off", 3), ("cut", 4), ("start", 3), ("repair", 3), ("on", 3)])
