@@ -1,0 +1,326 @@
+"""The firmware SDK as a hostile firmware developer drives it (round 10): the Python driver and the C driver, one API.
+
+docs/sdk.md promises one API shape: ``supi3_read`` is ``Supi3Driver.read``, each C error code a Python exception
+(docs/sdk-api.md). Here both drivers run the same history of calls (any order: before initialize, after a refused
+call, after a transport failure, SAS_INIT with and without the pin, a pin that fails) against the same scripted
+board, and must return the same code, the same values, send the same frames and read the same pins. The C driver is
+built strictly (``-Wall -Wextra -Werror -pedantic``) and loaded with ctypes; a callback that raises ``OSError``
+is a failing callback (return -1), a pin the board does not wire is a NULL callback.
+
+Also: the model's direct path (``Transport.direct``) against the frames after a strict-mode violation on SET.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import shutil
+import subprocess
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from supi3 import sdk
+from supi3.config import decode
+from supi3.model.registers import ReconfigurationError, RegisterFile
+from supi3.regmap import REGISTER_MAP, SET, AccessDirection
+from supi3.sdk.driver import (
+    DriverError,
+    IoWindowTimeoutError,
+    Mode,
+    Supi3Driver,
+    Transport,
+)
+from supi3.sdk.transports import ModelTransport
+
+XFER = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_uint8, ctypes.POINTER(ctypes.c_uint8), ctypes.c_int)
+DELAY = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint32)
+READ_PIN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.POINTER(ctypes.c_int))
+WRITE_PIN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_int)
+
+
+class Config(ctypes.Structure):
+    """``supi3_config_t``."""
+
+    _fields_ = [
+        ("xfer", XFER),
+        ("delay_us", DELAY),
+        ("read_irq", READ_PIN),
+        ("read_cd", READ_PIN),
+        ("set_sas_init", WRITE_PIN),
+        ("user", ctypes.c_void_p),
+        ("frame_gap_us", ctypes.c_uint32),
+        ("read_io", READ_PIN),
+    ]
+
+
+class Optical(ctypes.Structure):
+    """``supi3_optical_t``."""
+
+    _fields_ = [(name, ctypes.c_uint8) for name in ("out_length", "out_medium", "out_enable", "branch_length",
+                                                      "branch_medium", "branch_enable", "in_level", "in_enable",
+                                                      "out_level", "branch_level")]  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def lib(tmp_path_factory: pytest.TempPathFactory) -> ctypes.CDLL:
+    gcc = shutil.which("gcc")
+    if gcc is None:
+        pytest.skip("gcc not found: the C driver tests need it")
+    out = tmp_path_factory.mktemp("sdk") / "libsupi3.so"
+    build = subprocess.run(
+        [gcc, "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-shared", "-fPIC",
+         f"-I{sdk.include_dir()}", *map(str, sdk.sources()), "-o", str(out)],
+        capture_output=True, text=True, check=False,
+    )  # fmt: skip
+    assert build.returncode == 0, build.stderr
+    return ctypes.CDLL(str(out))
+
+
+class Scripted(Transport):
+    """A board whose chip answers from a script: received bytes and pin levels cycle through their lists; the
+    ``fail``-th callback (counted over all of them) raises ``OSError``. Every callback is logged."""
+
+    def __init__(self, rx: list[int], levels: list[int], fail: frozenset[int], wired: tuple[bool, bool, bool, bool]):
+        self.rx, self.levels, self.fail = rx, levels, fail
+        self.cd_wired, self.irq_wired, self.io_wired, self.sas_wired = wired
+        self.log: list[tuple[object, ...]] = []
+        self._rx = self._level = 0
+
+    def _count(self, *entry: object) -> None:
+        self.log.append(entry)
+        if len(self.log) - 1 in self.fail:
+            raise OSError(f"callback {len(self.log) - 1} failed")
+
+    def _next_level(self) -> int:
+        self._level += 1
+        return self.levels[(self._level - 1) % len(self.levels)]
+
+    def xfer(self, tx: int, s_r: bool) -> int:
+        self._count("xfer", tx, s_r)
+        self._rx += 1
+        return self.rx[(self._rx - 1) % len(self.rx)]
+
+    def read_cd(self) -> int | None:
+        if not self.cd_wired:
+            return None
+        self._count("cd")
+        return self._next_level()
+
+    def read_irq(self) -> int | None:
+        if not self.irq_wired:
+            return None
+        self._count("irq")
+        return self._next_level()
+
+    def read_io(self) -> int | None:
+        if not self.io_wired:
+            return None
+        self._count("io")
+        return self._next_level()
+
+    def set_sas_init(self, level: int) -> bool:
+        if not self.sas_wired:
+            return False
+        self._count("sas", level)
+        return True
+
+
+class CDriver:
+    """The C driver on a :class:`Scripted` board: each call returns (code, value) as the Python driver's would."""
+
+    def __init__(self, lib: ctypes.CDLL, board: Scripted) -> None:
+        self.lib, self.board = lib, board
+
+        def guard(call: Callable[[], int | None], store: Any = None) -> int:
+            try:
+                value = call()
+            except OSError:
+                return -1
+            if store is not None:
+                store[0] = value
+            return 0
+
+        self._callbacks = (
+            XFER(lambda _u, tx, rx, s_r: guard(lambda: board.xfer(tx, bool(s_r)), rx)),
+            DELAY(lambda _u, _us: None),
+            READ_PIN(lambda _u, level: guard(board.read_irq, level)) if board.irq_wired else READ_PIN(),
+            READ_PIN(lambda _u, level: guard(board.read_cd, level)) if board.cd_wired else READ_PIN(),
+            WRITE_PIN(lambda _u, level: guard(lambda: board.set_sas_init(level) and None)) if board.sas_wired
+            else WRITE_PIN(),
+        )  # fmt: skip
+        self._io = READ_PIN(lambda _u, level: guard(board.read_io, level)) if board.io_wired else READ_PIN()
+        self.cfg = Config(*self._callbacks, None, 0, self._io)
+        self.ctx = ctypes.create_string_buffer(256)
+        assert lib.supi3_init(self.ctx, ctypes.byref(self.cfg)) == 0
+
+    def run(self, op: tuple[Any, ...]) -> tuple[int, object]:
+        lib, ctx, u8 = self.lib, self.ctx, ctypes.c_uint8
+        value = u8(0)
+        name = op[0]
+        if name == "initialize":
+            return lib.supi3_initialize(ctx, ctypes.c_int(0 if op[1] is Mode.MOTOROLA else 1)), None
+        if name == "sas_init":
+            return lib.supi3_sas_init(ctx), None
+        if name == "read":
+            rc = lib.supi3_read(ctx, u8(op[1]), ctypes.byref(value))
+            return rc, value.value if rc == 0 else None
+        if name == "write":
+            return lib.supi3_write(ctx, u8(op[1]), u8(op[2])), None
+        if name == "exchange":
+            rc = lib.supi3_exchange(ctx, u8(op[1]), u8(op[2]), ctypes.byref(value))
+            return rc, value.value if rc == 0 else None
+        if name == "block":
+            data, rd, wr = op[1], op[2], op[3]
+            out = (u8 * 4)()
+            rc = lib.supi3_block_transfer(ctx, ctypes.c_int(rd), ctypes.c_int(wr), out if rd else None,
+                                          (u8 * 4)(*data), ctypes.c_size_t(len(data)))  # fmt: skip
+            return rc, (bytes(out[: len(data)]) if rd else b"") if rc == 0 else None
+        if name == "configure":
+            return lib.supi3_configure(ctx, u8(op[1]), u8(op[2])), None
+        if name == "irq_service":
+            rc = lib.supi3_irq_service(ctx, ctypes.byref(value))
+            return rc, value.value if rc == 0 else None
+        if name == "irq_enable":
+            return lib.supi3_irq_enable(ctx, u8(op[1])), None
+        if name == "poll":
+            rc = lib.supi3_poll_io_window(ctx, ctypes.c_uint32(op[1]), ctypes.byref(value))
+            return rc, value.value if rc in (0, -7) else None
+        if name == "alarm":
+            return lib.supi3_processor_alarm(ctx, u8(op[1])), None
+        if name == "pcmd":
+            rc = lib.supi3_processor_command(ctx, ctypes.byref(value))
+            return rc, value.value if rc == 0 else None
+        assert name == "optical"
+        status = Optical()
+        rc = lib.supi3_optical_status(ctx, ctypes.byref(status))
+        return rc, tuple(getattr(status, f) for f, _ in Optical._fields_) if rc == 0 else None
+
+
+def py_run(drv: Supi3Driver, op: tuple[Any, ...]) -> tuple[int, object]:
+    """The same call on the Python driver: (the C code of its exception or 0, the value)."""
+    name = op[0]
+    port = REGISTER_MAP.port
+    calls: dict[str, Callable[[], object]] = {
+        "initialize": lambda: drv.initialize(op[1]),
+        "sas_init": drv.sas_init,
+        "read": lambda: drv.read(port(op[1], AccessDirection.READ).register),
+        "write": lambda: drv.write(port(op[1], AccessDirection.WRITE).register, op[2]),
+        "exchange": lambda: drv.exchange(port(op[1], AccessDirection.READ).register, op[2]),
+        "block": lambda: drv.block_transfer(op[1], read=bool(op[2]), write=bool(op[3])),
+        "configure": lambda: drv.configure(op[1], op[2]),
+        "irq_service": lambda: int(drv.irq_service()),
+        "irq_enable": lambda: drv.irq_enable(op[1]),
+        "poll": lambda: int(drv.poll_io_window(op[1])),
+        "alarm": lambda: drv.processor_alarm(op[1]),
+        "pcmd": drv.processor_command,
+        "optical": lambda: tuple(vars(drv.optical_status()).values()),
+    }
+    try:
+        return 0, calls[name]()
+    except IoWindowTimeoutError as error:
+        return int(error.code), int(error.events)
+    except DriverError as error:
+        return int(error.code), None
+
+
+READABLE = [a for a in range(15) if REGISTER_MAP.port(a, AccessDirection.READ).register is not None]
+WRITABLE = [a for a in range(15) if REGISTER_MAP.port(a, AccessDirection.WRITE).register is not None]
+BOTH = sorted(set(READABLE) & set(WRITABLE))
+BYTE = st.integers(0, 255)
+OPS = st.one_of(
+    st.tuples(st.just("initialize"), st.sampled_from(list(Mode))),
+    st.tuples(st.just("sas_init")),
+    st.tuples(st.just("read"), st.sampled_from(READABLE)),
+    st.tuples(st.just("write"), st.sampled_from(WRITABLE), BYTE),
+    st.tuples(st.just("exchange"), st.sampled_from(BOTH), BYTE),
+    st.tuples(st.just("block"), st.binary(min_size=1, max_size=4), st.integers(0, 1), st.integers(0, 1)),
+    st.tuples(st.just("configure"), st.sampled_from([0x82, 0x83, 0x85, 0x87, 0xC3, 0x00]), BYTE),
+    st.tuples(st.just("irq_service")),
+    st.tuples(st.just("irq_enable"), BYTE),
+    st.tuples(st.just("poll"), st.integers(1, 4)),
+    st.tuples(st.just("alarm"), BYTE),
+    st.tuples(st.just("pcmd")),
+    st.tuples(st.just("optical")),
+)
+
+
+def _parity(lib: ctypes.CDLL, rx: list[int], levels: list[int], fail: frozenset[int],
+            wired: tuple[bool, bool, bool, bool], ops: list[tuple[Any, ...]]) -> None:  # fmt: skip
+    py_board, c_board = Scripted(rx, levels, fail, wired), Scripted(rx, levels, fail, wired)
+    drv, c = Supi3Driver(py_board), CDriver(lib, c_board)
+    for k, op in enumerate(ops):
+        try:
+            py = py_run(drv, op)
+        except OSError as error:  # not a driver error: the Python driver let the board's failure through
+            py = (f"raw {type(error).__name__}", None)
+        assert py == c.run(op), (k, op, py_board.log, c_board.log)
+        assert py_board.log == c_board.log, (k, op)
+
+
+@settings(max_examples=150)
+@given(rx=st.lists(BYTE, min_size=1, max_size=6), levels=st.lists(st.integers(0, 1), min_size=1, max_size=6),
+       fail=st.frozensets(st.integers(0, 40), max_size=3), wired=st.tuples(*[st.booleans()] * 4),
+       ops=st.lists(OPS, max_size=14))  # fmt: skip
+def test_c_and_python_drivers_agree_on_any_history(lib: ctypes.CDLL, rx: list[int], levels: list[int],
+                                                   fail: frozenset[int], wired: tuple[bool, bool, bool, bool],
+                                                   ops: list[tuple[Any, ...]]) -> None:  # fmt: skip
+    """FW-16: every call of any history, on any scripted board, gives the same code, value, frames and pin reads
+    in both drivers."""
+    _parity(lib, rx, levels, fail, wired, ops)
+
+
+M = Mode.MOTOROLA
+CASES: dict[str, tuple[list[int], list[int], frozenset[int], tuple[bool, bool, bool, bool], list[tuple[Any, ...]]]] = {
+    # sas_init without the pin is refused (SUPI3_E_UNSUPPORTED) and leaves the driver initialized
+    "refused sas_init keeps the mode": ([0], [0], frozenset(), (False,) * 4, [("initialize", M), ("sas_init",),
+                                                                              ("read", 0)]),
+    # a pin callback that fails is SUPI3_E_TRANSPORT, not the board's own exception
+    "failing /IRQ pin": ([0], [0], frozenset({1}), (False, True, False, False), [("initialize", M),
+                                                                                ("irq_service",)]),
+    "failing C/D pin": ([0], [0], frozenset({0}), (True, False, False, False), [("initialize", M)]),
+    "failing I/O pin": ([0], [1], frozenset({1}), (False, False, True, False), [("initialize", M), ("poll", 2)]),
+    "failing SAS_INIT pin": ([0], [0], frozenset({1}), (False, False, False, True), [("initialize", M),
+                                                                                    ("sas_init",), ("read", 0)]),
+    # before initialize, a block of a bad length is SUPI3_E_NOT_INIT in both (the state is checked first)
+    "block before initialize": ([0], [0], frozenset(), (False,) * 4, [("block", b"\0", 1, 1)]),
+    # a write of SET that failed leaves SET unknown: any block length 2..4 may follow
+    "SET lost in a failed write": ([0], [0], frozenset({5}), (False,) * 4,
+                                   [("initialize", M), ("write", SET.address, 0x82), ("initialize", M),
+                                    ("write", SET.address, 0x83), ("initialize", M), ("block", b"\0\0", 1, 1)]),
+    # irq_service returns the events D6..D0; D7 is the I/O access status (RM-7, RM-8)
+    "irq_service with D7 set": ([0xC4], [0], frozenset(), (False,) * 4, [("initialize", M), ("irq_service",)]),
+}
+
+
+@pytest.mark.parametrize("case", list(CASES), ids=list(CASES))
+def test_c_and_python_drivers_agree_on_the_histories_that_differed(lib: ctypes.CDLL, case: str) -> None:
+    _parity(lib, *CASES[case])
+
+
+class Slow(ModelTransport):
+    """The model without the direct path (a subclass that changes how a frame goes)."""
+
+    def xfer(self, tx: int, s_r: bool) -> int:
+        return super().xfer(tx, s_r)
+
+
+def test_a_refused_write_of_set_leaves_the_driver_with_the_chips_set_on_both_paths() -> None:
+    """FW-17: a strict model raises ReconfigurationError after a write of SET while the bus runs; the chip holds the
+    new SET, and so does the driver, whether the access went through the model's direct path or frame by frame."""
+    lengths = []
+    for cls in (ModelTransport, Slow):
+        t = cls(RegisterFile(decode("10011", "1110"), strict=True))
+        drv = Supi3Driver(t)
+        drv.initialize(Mode.MOTOROLA)
+        drv.configure(0x82, 0x01)  # 1 byte: no block transfer
+        t.registers.set_bus_running(True)
+        with pytest.raises(ReconfigurationError):
+            drv.write(SET, 0x83)  # 1 word
+        assert t.registers.value("SET") == 0x83
+        lengths.append(len(drv.block_transfer(b"\x12\x34")))
+    assert lengths == [2, 2]
+
