@@ -7,7 +7,9 @@ board, and must return the same code, the same values, send the same frames and 
 built strictly (``-Wall -Wextra -Werror -pedantic``) and loaded with ctypes; a callback that raises ``OSError``
 is a failing callback (return -1), a pin the board does not wire is a NULL callback.
 
-Also: the model's direct path (``Transport.direct``) against the frames after a strict-mode violation on SET.
+Also: the model's direct path (``Transport.direct``) against the frames after a strict-mode violation on SET; the
+pytest plugin's marker firmware handed to a second test (FW-17); ELF files whose segments the file does not hold
+(MCU-47).
 """
 
 from __future__ import annotations
@@ -35,6 +37,8 @@ from supi3.sdk.driver import (
     Transport,
 )
 from supi3.sdk.transports import ModelTransport
+
+pytest_plugins = ["pytester"]
 
 XFER = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_uint8, ctypes.POINTER(ctypes.c_uint8), ctypes.c_int)
 DELAY = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint32)
@@ -309,7 +313,7 @@ class Slow(ModelTransport):
 
 
 def test_a_refused_write_of_set_leaves_the_driver_with_the_chips_set_on_both_paths() -> None:
-    """FW-17: a strict model raises ReconfigurationError after a write of SET while the bus runs; the chip holds the
+    """FW-16 (6): a strict model raises ReconfigurationError after a write of SET while the bus runs; the chip holds the
     new SET, and so does the driver, whether the access went through the model's direct path or frame by frame."""
     lengths = []
     for cls in (ModelTransport, Slow):
@@ -324,3 +328,58 @@ def test_a_refused_write_of_set_leaves_the_driver_with_the_chips_set_on_both_pat
         lengths.append(len(drv.block_transfer(b"\x12\x34")))
     assert lengths == [2, 2]
 
+
+
+# ------------------------------------------------------------------------------------------------------------
+# The pytest plugin: one firmware object per test (FW-17)
+# ------------------------------------------------------------------------------------------------------------
+
+SHARED_FIRMWARE_TEST = '''
+import pytest
+from supi3.regmap import OUT0
+from supi3.sdk.bench import Firmware
+from supi3.sdk.driver import Irq, Mode
+
+
+class Dio(Firmware):
+    def __init__(self):
+        self.out = None
+
+    def setup(self, drv):
+        drv.initialize(Mode.MOTOROLA)
+        drv.configure(0x82, 0x01)
+        drv.irq_enable(Irq.VALID)
+
+    def isr(self, drv):
+        if drv.irq_service() & Irq.VALID:
+            self.out = drv.read(OUT0)
+
+
+@pytest.mark.parametrize("value", [0x5A, 0xA5])
+@pytest.mark.supi3(firmware=Dio())
+def test_shared(supi3_bench, supi3_master, value):
+    assert supi3_bench.firmware.out is None  # a fresh firmware at power-up
+    supi3_bench.run(3)
+    supi3_master.set_outputs(1, bytes([value]))
+    supi3_bench.run(3)
+    assert supi3_bench.firmware.out == value
+
+
+@pytest.mark.parametrize("value", [pytest.param(v, marks=pytest.mark.supi3(firmware=Dio())) for v in (1, 2)])
+def test_one_each(supi3_bench, supi3_master, value):
+    assert supi3_bench.firmware.out is None
+    supi3_bench.run(3)
+    supi3_master.set_outputs(1, bytes([value]))
+    supi3_bench.run(3)
+    assert supi3_bench.firmware.out == value
+'''
+
+
+def test_a_marker_firmware_that_ran_in_an_earlier_test_is_refused_by_name(pytester: pytest.Pytester) -> None:
+    """A firmware object keeps its state (Python attributes; a C firmware's statics and ``fw_board_t``): the
+    marker's object handed to a second test (parametrize, a class or module mark) would start there with the first
+    test's outputs. The second test is an error naming the first; ``pytest.param(marks=...)`` gives each its own."""
+    pytester.makepyfile(test_firmware=SHARED_FIRMWARE_TEST)
+    result = pytester.runpytest("--strict-markers", "-p", "no:cacheprovider")
+    result.assert_outcomes(passed=3, errors=1)
+    result.stdout.fnmatch_lines(["*firmware object already ran in test_firmware.py::test_shared?90?*one per test*"])

@@ -698,7 +698,7 @@ class Supi3Driver(_DriverApi):
         direct = self._direct
         if direct is not None and direct.ready():
             address = _address(register, AccessDirection.READ)
-            if address != SET.address:  # SET frame by frame: the driver keeps it when the model raises after (FW-17)
+            if address != SET.address:  # SET frame by frame: the driver keeps it when the model raises after (FW-16)
                 self._core._ready()
                 return direct.read(address)
         return self._run(self._core.read(register))
@@ -708,7 +708,7 @@ class Supi3Driver(_DriverApi):
         direct = self._direct
         if direct is not None and direct.ready():
             address = _address(register, AccessDirection.WRITE)
-            if address != SET.address:  # as in read() (FW-17)
+            if address != SET.address:  # as in read() (FW-16)
                 byte = _byte("value", value)
                 self._core._ready()
                 direct.write(address, byte)
