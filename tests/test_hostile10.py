@@ -383,3 +383,31 @@ def test_a_marker_firmware_that_ran_in_an_earlier_test_is_refused_by_name(pytest
     result = pytester.runpytest("--strict-markers", "-p", "no:cacheprovider")
     result.assert_outcomes(passed=3, errors=1)
     result.stdout.fnmatch_lines(["*firmware object already ran in test_firmware.py::test_shared?90?*one per test*"])
+
+
+# ------------------------------------------------------------------------------------------------------------
+# An ELF file cut short: a segment the file does not hold (MCU-47)
+# ------------------------------------------------------------------------------------------------------------
+
+
+def test_an_elf_whose_segment_runs_past_its_end_is_a_named_error(tmp_path: Path,
+                                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    """An ELF without section headers (stripped, or made by objcopy) cut short in the middle of a segment: before,
+    the loader took the bytes that were there and the firmware ran with the rest of the segment missing."""
+    pytest.importorskip("elftools")
+    from test_mcu_hostile import LOOP, firmware
+
+    from supi3.cli import main
+    from supi3.errors import ArgumentError
+    from supi3.mcu.core import FirmwareImage
+
+    whole = firmware(LOOP + bytes(64))
+    path = tmp_path / "cut.elf"
+    path.write_bytes(whole[:-40])
+    with pytest.raises(ArgumentError, match=r"path must be an ELF file that holds its segments, not .*cut.elf "
+                                            r"\(the segment at 0x8000000 has 130 bytes in the file, 90 there\)"):
+        FirmwareImage.load(path)
+    assert main(["firmware", "run", str(path)]) == 2
+    assert "holds its segments" in capsys.readouterr().err
+    path.write_bytes(whole)
+    assert FirmwareImage.load(path).segments[0][1] == whole[-130:]
