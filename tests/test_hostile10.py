@@ -30,6 +30,8 @@ from supi3.config import decode
 from supi3.model.registers import ReconfigurationError, RegisterFile
 from supi3.regmap import REGISTER_MAP, SET, AccessDirection
 from supi3.sdk.driver import (
+    AsyncSupi3Driver,
+    AsyncTransport,
     DriverError,
     IoWindowTimeoutError,
     Mode,
@@ -204,7 +206,49 @@ class CDriver:
         return rc, tuple(getattr(status, f) for f, _ in Optical._fields_) if rc == 0 else None
 
 
-def py_run(drv: Supi3Driver, op: tuple[Any, ...]) -> tuple[int, object]:
+class AsyncScripted(AsyncTransport):
+    """A :class:`Scripted` board behind the async driver (every callback answers at once)."""
+
+    def __init__(self, board: Scripted) -> None:
+        self.board = board
+
+    async def xfer(self, tx: int, s_r: bool) -> int:
+        return self.board.xfer(tx, s_r)
+
+    async def read_cd(self) -> int | None:
+        return self.board.read_cd()
+
+    async def read_irq(self) -> int | None:
+        return self.board.read_irq()
+
+    async def read_io(self) -> int | None:
+        return self.board.read_io()
+
+    async def set_sas_init(self, level: int) -> bool:
+        return self.board.set_sas_init(level)
+
+
+class Awaited:
+    """The async driver's calls run to their end at once (its transport never waits): the sync driver's shape."""
+
+    def __init__(self, drv: AsyncSupi3Driver) -> None:
+        self.drv = drv
+
+    def __getattr__(self, name: str) -> Callable[..., object]:
+        call = getattr(self.drv, name)
+
+        def run(*args: object, **kwargs: object) -> object:
+            coroutine = call(*args, **kwargs)
+            try:
+                coroutine.send(None)
+            except StopIteration as stop:
+                return stop.value
+            raise AssertionError("the async driver waited")  # pragma: no cover
+
+        return run
+
+
+def py_run(drv: Supi3Driver | Awaited, op: tuple[Any, ...]) -> tuple[int, object]:
     """The same call on the Python driver: (the C code of its exception or 0, the value)."""
     name = op[0]
     port = REGISTER_MAP.port
@@ -254,15 +298,18 @@ OPS = st.one_of(
 
 def _parity(lib: ctypes.CDLL, rx: list[int], levels: list[int], fail: frozenset[int],
             wired: tuple[bool, bool, bool, bool], ops: list[tuple[Any, ...]]) -> None:  # fmt: skip
-    py_board, c_board = Scripted(rx, levels, fail, wired), Scripted(rx, levels, fail, wired)
-    drv, c = Supi3Driver(py_board), CDriver(lib, c_board)
+    py_board, async_board, c_board = (Scripted(rx, levels, fail, wired) for _ in range(3))
+    drivers = (Supi3Driver(py_board), Awaited(AsyncSupi3Driver(AsyncScripted(async_board))))
+    c = CDriver(lib, c_board)
     for k, op in enumerate(ops):
-        try:
-            py = py_run(drv, op)
-        except OSError as error:  # not a driver error: the Python driver let the board's failure through
-            py = (f"raw {type(error).__name__}", None)
-        assert py == c.run(op), (k, op, py_board.log, c_board.log)
-        assert py_board.log == c_board.log, (k, op)
+        expected = c.run(op)
+        for drv, board in zip(drivers, (py_board, async_board), strict=True):
+            try:
+                py = py_run(drv, op)
+            except OSError as error:  # not a driver error: the Python driver let the board's failure through
+                py = (f"raw {type(error).__name__}", None)
+            assert py == expected, (k, op, type(drv).__name__, board.log, c_board.log)
+            assert board.log == c_board.log, (k, op, type(drv).__name__)
 
 
 @settings(max_examples=150)
@@ -273,7 +320,7 @@ def test_c_and_python_drivers_agree_on_any_history(lib: ctypes.CDLL, rx: list[in
                                                    fail: frozenset[int], wired: tuple[bool, bool, bool, bool],
                                                    ops: list[tuple[Any, ...]]) -> None:  # fmt: skip
     """FW-16: every call of any history, on any scripted board, gives the same code, value, frames and pin reads
-    in both drivers."""
+    in the C driver, the Python driver and the async Python driver."""
     _parity(lib, rx, levels, fail, wired, ops)
 
 
