@@ -28,7 +28,7 @@ from hypothesis import strategies as st
 from supi3 import sdk
 from supi3.config import decode
 from supi3.model.registers import ReconfigurationError, RegisterFile
-from supi3.regmap import REGISTER_MAP, SET, AccessDirection
+from supi3.regmap import REGISTER_MAP, SET, AccessDirection, Register
 from supi3.sdk.driver import (
     AsyncSupi3Driver,
     AsyncTransport,
@@ -63,12 +63,14 @@ class Config(ctypes.Structure):
     ]
 
 
+OPTICAL_FIELDS = ("out_length", "out_medium", "out_enable", "branch_length", "branch_medium", "branch_enable",
+                  "in_level", "in_enable", "out_level", "branch_level")  # fmt: skip
+
+
 class Optical(ctypes.Structure):
     """``supi3_optical_t``."""
 
-    _fields_ = [(name, ctypes.c_uint8) for name in ("out_length", "out_medium", "out_enable", "branch_length",
-                                                      "branch_medium", "branch_enable", "in_level", "in_enable",
-                                                      "out_level", "branch_level")]  # fmt: skip
+    _fields_ = [(name, ctypes.c_uint8) for name in OPTICAL_FIELDS]
 
 
 @pytest.fixture(scope="module")
@@ -163,7 +165,7 @@ class CDriver:
         self.ctx = ctypes.create_string_buffer(256)
         assert lib.supi3_init(self.ctx, ctypes.byref(self.cfg)) == 0
 
-    def run(self, op: tuple[Any, ...]) -> tuple[int, object]:
+    def run(self, op: tuple[Any, ...]) -> tuple[object, object]:
         lib, ctx, u8 = self.lib, self.ctx, ctypes.c_uint8
         value = u8(0)
         name = op[0]
@@ -203,7 +205,7 @@ class CDriver:
         assert name == "optical"
         status = Optical()
         rc = lib.supi3_optical_status(ctx, ctypes.byref(status))
-        return rc, tuple(getattr(status, f) for f, _ in Optical._fields_) if rc == 0 else None
+        return rc, tuple(getattr(status, f) for f in OPTICAL_FIELDS) if rc == 0 else None
 
 
 class AsyncScripted(AsyncTransport):
@@ -248,16 +250,23 @@ class Awaited:
         return run
 
 
-def py_run(drv: Supi3Driver | Awaited, op: tuple[Any, ...]) -> tuple[int, object]:
-    """The same call on the Python driver: (the C code of its exception or 0, the value)."""
+def register(address: int, direction: AccessDirection) -> Register:
+    """The register an access of ``direction`` at ``address`` reaches (Table 3-10)."""
+    found = REGISTER_MAP.port(address, direction).register
+    assert found is not None
+    return found
+
+
+def py_run(drv: Any, op: tuple[Any, ...]) -> tuple[object, object]:
+    """The same call on the Python driver (sync, or async through :class:`Awaited`): (the C code of its exception
+    or 0, the value)."""
     name = op[0]
-    port = REGISTER_MAP.port
     calls: dict[str, Callable[[], object]] = {
         "initialize": lambda: drv.initialize(op[1]),
         "sas_init": drv.sas_init,
-        "read": lambda: drv.read(port(op[1], AccessDirection.READ).register),
-        "write": lambda: drv.write(port(op[1], AccessDirection.WRITE).register, op[2]),
-        "exchange": lambda: drv.exchange(port(op[1], AccessDirection.READ).register, op[2]),
+        "read": lambda: drv.read(register(op[1], AccessDirection.READ)),
+        "write": lambda: drv.write(register(op[1], AccessDirection.WRITE), op[2]),
+        "exchange": lambda: drv.exchange(register(op[1], AccessDirection.READ), op[2]),
         "block": lambda: drv.block_transfer(op[1], read=bool(op[2]), write=bool(op[3])),
         "configure": lambda: drv.configure(op[1], op[2]),
         "irq_service": lambda: int(drv.irq_service()),
@@ -442,11 +451,10 @@ def test_an_elf_whose_segment_runs_past_its_end_is_a_named_error(tmp_path: Path,
     """An ELF without section headers (stripped, or made by objcopy) cut short in the middle of a segment: before,
     the loader took the bytes that were there and the firmware ran with the rest of the segment missing."""
     pytest.importorskip("elftools")
-    from test_mcu_hostile import LOOP, firmware
-
     from supi3.cli import main
     from supi3.errors import ArgumentError
     from supi3.mcu.core import FirmwareImage
+    from test_mcu_hostile import LOOP, firmware
 
     whole = firmware(LOOP + bytes(64))
     path = tmp_path / "cut.elf"
