@@ -107,6 +107,9 @@ class Scripted(Transport):
         self._level += 1
         return self.levels[(self._level - 1) % len(self.levels)]
 
+    def delay_us(self, us: float) -> None:
+        self.log.append(("delay", float(us)))
+
     def xfer(self, tx: int, s_r: bool) -> int:
         self._count("xfer", tx, s_r)
         self._rx += 1
@@ -140,7 +143,7 @@ class Scripted(Transport):
 class CDriver:
     """The C driver on a :class:`Scripted` board: each call returns (code, value) as the Python driver's would."""
 
-    def __init__(self, lib: ctypes.CDLL, board: Scripted) -> None:
+    def __init__(self, lib: ctypes.CDLL, board: Scripted, frame_gap_us: int = 0) -> None:
         self.lib, self.board = lib, board
 
         def guard(call: Callable[[], int | None], store: Any = None) -> int:
@@ -154,14 +157,14 @@ class CDriver:
 
         self._callbacks = (
             XFER(lambda _u, tx, rx, s_r: guard(lambda: board.xfer(tx, bool(s_r)), rx)),
-            DELAY(lambda _u, _us: None),
+            DELAY(lambda _u, us: board.delay_us(us)),
             READ_PIN(lambda _u, level: guard(board.read_irq, level)) if board.irq_wired else READ_PIN(),
             READ_PIN(lambda _u, level: guard(board.read_cd, level)) if board.cd_wired else READ_PIN(),
             WRITE_PIN(lambda _u, level: guard(lambda: board.set_sas_init(level) and None)) if board.sas_wired
             else WRITE_PIN(),
         )  # fmt: skip
         self._io = READ_PIN(lambda _u, level: guard(board.read_io, level)) if board.io_wired else READ_PIN()
-        self.cfg = Config(*self._callbacks, None, 0, self._io)
+        self.cfg = Config(*self._callbacks, None, frame_gap_us, self._io)
         self.ctx = ctypes.create_string_buffer(256)
         assert lib.supi3_init(self.ctx, ctypes.byref(self.cfg)) == 0
 
@@ -170,7 +173,8 @@ class CDriver:
         value = u8(0)
         name = op[0]
         if name == "initialize":
-            return lib.supi3_initialize(ctx, ctypes.c_int(0 if op[1] is Mode.MOTOROLA else 1)), None
+            modes = {Mode.MOTOROLA: 0, Mode.INTEL: 1}
+            return lib.supi3_initialize(ctx, ctypes.c_int(modes.get(op[1], 2))), None
         if name == "sas_init":
             return lib.supi3_sas_init(ctx), None
         if name == "read":
@@ -216,6 +220,9 @@ class AsyncScripted(AsyncTransport):
 
     async def xfer(self, tx: int, s_r: bool) -> int:
         return self.board.xfer(tx, s_r)
+
+    async def delay_us(self, us: float) -> None:
+        self.board.delay_us(us)
 
     async def read_cd(self) -> int | None:
         return self.board.read_cd()
@@ -289,7 +296,7 @@ WRITABLE = [a for a in range(15) if REGISTER_MAP.port(a, AccessDirection.WRITE).
 BOTH = sorted(set(READABLE) & set(WRITABLE))
 BYTE = st.integers(0, 255)
 OPS = st.one_of(
-    st.tuples(st.just("initialize"), st.sampled_from(list(Mode))),
+    st.tuples(st.just("initialize"), st.sampled_from([*Mode, "intel"])),  # a mode that is none: SUPI3_E_ARG
     st.tuples(st.just("sas_init")),
     st.tuples(st.just("read"), st.sampled_from(READABLE)),
     st.tuples(st.just("write"), st.sampled_from(WRITABLE), BYTE),
@@ -298,7 +305,7 @@ OPS = st.one_of(
     st.tuples(st.just("configure"), st.sampled_from([0x82, 0x83, 0x85, 0x87, 0xC3, 0x00]), BYTE),
     st.tuples(st.just("irq_service")),
     st.tuples(st.just("irq_enable"), BYTE),
-    st.tuples(st.just("poll"), st.integers(1, 4)),
+    st.tuples(st.just("poll"), st.integers(0, 4)),
     st.tuples(st.just("alarm"), BYTE),
     st.tuples(st.just("pcmd")),
     st.tuples(st.just("optical")),
@@ -306,10 +313,11 @@ OPS = st.one_of(
 
 
 def _parity(lib: ctypes.CDLL, rx: list[int], levels: list[int], fail: frozenset[int],
-            wired: tuple[bool, bool, bool, bool], ops: list[tuple[Any, ...]]) -> None:  # fmt: skip
+            wired: tuple[bool, bool, bool, bool], ops: list[tuple[Any, ...]], gap: int = 0) -> None:  # fmt: skip
     py_board, async_board, c_board = (Scripted(rx, levels, fail, wired) for _ in range(3))
-    drivers = (Supi3Driver(py_board), Awaited(AsyncSupi3Driver(AsyncScripted(async_board))))
-    c = CDriver(lib, c_board)
+    drivers = (Supi3Driver(py_board, frame_gap_us=gap),
+               Awaited(AsyncSupi3Driver(AsyncScripted(async_board), frame_gap_us=gap)))  # fmt: skip
+    c = CDriver(lib, c_board, gap)
     for k, op in enumerate(ops):
         expected = c.run(op)
         for drv, board in zip(drivers, (py_board, async_board), strict=True):
@@ -324,13 +332,13 @@ def _parity(lib: ctypes.CDLL, rx: list[int], levels: list[int], fail: frozenset[
 @settings(max_examples=150)
 @given(rx=st.lists(BYTE, min_size=1, max_size=6), levels=st.lists(st.integers(0, 1), min_size=1, max_size=6),
        fail=st.frozensets(st.integers(0, 40), max_size=3), wired=st.tuples(*[st.booleans()] * 4),
-       ops=st.lists(OPS, max_size=14))  # fmt: skip
+       ops=st.lists(OPS, max_size=14), gap=st.sampled_from([0, 3]))  # fmt: skip
 def test_c_and_python_drivers_agree_on_any_history(lib: ctypes.CDLL, rx: list[int], levels: list[int],
                                                    fail: frozenset[int], wired: tuple[bool, bool, bool, bool],
-                                                   ops: list[tuple[Any, ...]]) -> None:  # fmt: skip
+                                                   ops: list[tuple[Any, ...]], gap: int) -> None:  # fmt: skip
     """FW-16: every call of any history, on any scripted board, gives the same code, value, frames and pin reads
-    in the C driver, the Python driver and the async Python driver."""
-    _parity(lib, rx, levels, fail, wired, ops)
+    in the C driver, the Python driver and the async Python driver, with and without a frame gap."""
+    _parity(lib, rx, levels, fail, wired, ops, gap)
 
 
 M = Mode.MOTOROLA
@@ -466,3 +474,31 @@ def test_an_elf_whose_segment_runs_past_its_end_is_a_named_error(tmp_path: Path,
     assert "holds its segments" in capsys.readouterr().err
     path.write_bytes(whole)
     assert FirmwareImage.load(path).segments[0][1] == whole[-130:]
+
+
+# ------------------------------------------------------------------------------------------------------------
+# supi3 firmware build: the output never overwrites a source (MCU-48)
+# ------------------------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("output", ["a.c", "b.c", "board.S", "fw.h", None, 3])
+def test_a_build_output_that_is_a_source_file_is_refused_and_writes_nothing(tmp_path: Path, output: object,
+                                                                            capsys: pytest.CaptureFixture[str]) -> None:
+    """``supi3 firmware build -o a.c a.c`` (or ``-o a.c b.c``, "build both" with the -o forgotten) replaced the
+    source a.c with the ELF; ``build(sources, None)`` wrote a file named "None"."""
+    from supi3.cli import main
+    from supi3.errors import ArgumentError
+    from supi3.mcu import build as mcu_build
+
+    text = "void fw_setup(void *chip, void *board) { (void)chip; (void)board; }\n"
+    for name in ("a.c", "b.c"):
+        (tmp_path / name).write_text(text, encoding="utf-8")
+    sources = [tmp_path / "a.c"]
+    target = output if not isinstance(output, str) else tmp_path / output
+    with pytest.raises(ArgumentError, match=r"output must be a path of the ELF file to write"):
+        mcu_build.build_command(sources, target)  # type: ignore[arg-type]
+    if isinstance(output, str):
+        assert main(["firmware", "build", "-o", str(target), str(tmp_path / "a.c")]) == 2
+        assert "output must be a path of the ELF file to write" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.c", "b.c"]
+    assert all((tmp_path / name).read_text(encoding="utf-8") == text for name in ("a.c", "b.c"))
