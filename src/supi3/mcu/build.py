@@ -27,7 +27,16 @@ from supi3.checks import fail
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.mcu.core import check_cpu
 
-__all__ = ["BOARD_DIR", "FLAGS", "MACRO_NAME", "SOURCE_SUFFIXES", "BuildError", "build", "build_command", "toolchain_missing"]
+__all__ = [
+    "BOARD_DIR",
+    "FLAGS",
+    "MACRO_NAME",
+    "SOURCE_SUFFIXES",
+    "BuildError",
+    "build",
+    "build_command",
+    "toolchain_missing",
+]
 
 BOARD_DIR: Final[Path] = sdk.SDK_DIR / "board"
 """The board port: ``board.h``, ``board.c``, ``startup.c``, ``board.ld``."""
