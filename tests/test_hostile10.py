@@ -502,3 +502,46 @@ def test_a_build_output_that_is_a_source_file_is_refused_and_writes_nothing(tmp_
         assert "output must be a path of the ELF file to write" in capsys.readouterr().err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.c", "b.c"]
     assert all((tmp_path / name).read_text(encoding="utf-8") == text for name in ("a.c", "b.c"))
+
+
+# ------------------------------------------------------------------------------------------------------------
+# SpidevTransport: a refused construction opens no device (FW-16)
+# ------------------------------------------------------------------------------------------------------------
+
+
+class CountingSpiDev:
+    """A stand-in for ``spidev.SpiDev`` that counts the devices left open."""
+
+    open_devices = 0
+
+    def __init__(self) -> None:
+        self.mode, self.lsbfirst, self.max_speed_hz = 0, False, 0
+
+    def open(self, bus: int, device: int) -> None:
+        del bus, device
+        CountingSpiDev.open_devices += 1
+
+    def close(self) -> None:
+        CountingSpiDev.open_devices -= 1
+
+
+class CountingSpidevModule:
+    SpiDev = CountingSpiDev
+
+
+@pytest.mark.parametrize(("args", "options", "message"), [
+    ((0, 0), {"speed_hz": 0}, r"speed_hz must be an integer >= 1"),
+    ((0, 0), {"speed_hz": 1.5e6}, r"speed_hz must be an integer"),
+    ((-1, 0), {}, r"bus must be an integer >= 0"),
+    ((0, "0"), {}, r"device must be an integer >= 0"),
+])  # fmt: skip
+def test_a_refused_spidev_transport_leaves_no_device_open(args: tuple[object, object], options: dict[str, Any],
+                                                          message: str) -> None:
+    """Before, ``speed_hz`` was checked after the device was opened: a refused transport kept /dev/spidevB.D open."""
+    from supi3.errors import ArgumentError
+    from supi3.sdk.transports import SpidevTransport
+
+    CountingSpiDev.open_devices = 0
+    with pytest.raises(ArgumentError, match=message):
+        SpidevTransport(*args, spidev_module=CountingSpidevModule, **options)  # type: ignore[arg-type]
+    assert CountingSpiDev.open_devices == 0
