@@ -173,8 +173,8 @@ class CDriver:
         value = u8(0)
         name = op[0]
         if name == "initialize":
-            modes = {Mode.MOTOROLA: 0, Mode.INTEL: 1}
-            return lib.supi3_initialize(ctx, ctypes.c_int(modes.get(op[1], 2))), None
+            mode = 2 if type(op[1]) is not Mode else 0 if op[1] is Mode.MOTOROLA else 1  # "intel" is no Mode
+            return lib.supi3_initialize(ctx, ctypes.c_int(mode)), None
         if name == "sas_init":
             return lib.supi3_sas_init(ctx), None
         if name == "read":
@@ -329,7 +329,7 @@ def _parity(lib: ctypes.CDLL, rx: list[int], levels: list[int], fail: frozenset[
             assert board.log == c_board.log, (k, op, type(drv).__name__)
 
 
-@settings(max_examples=150)
+@settings(max_examples=300)
 @given(rx=st.lists(BYTE, min_size=1, max_size=6), levels=st.lists(st.integers(0, 1), min_size=1, max_size=6),
        fail=st.frozensets(st.integers(0, 40), max_size=3), wired=st.tuples(*[st.booleans()] * 4),
        ops=st.lists(OPS, max_size=14), gap=st.sampled_from([0, 3]))  # fmt: skip
@@ -359,6 +359,8 @@ CASES: dict[str, tuple[list[int], list[int], frozenset[int], tuple[bool, bool, b
     "SET lost in a failed write": ([0], [0], frozenset({5}), (False,) * 4,
                                    [("initialize", M), ("write", SET.address, 0x82), ("initialize", M),
                                     ("write", SET.address, 0x83), ("initialize", M), ("block", b"\0\0", 1, 1)]),
+    # a mode that is none is SUPI3_E_ARG and leaves the driver initialized
+    "bad mode": ([0], [0], frozenset(), (False,) * 4, [("initialize", M), ("initialize", "intel"), ("read", 0)]),
     # irq_service returns the events D6..D0; D7 is the I/O access status (RM-7, RM-8)
     "irq_service with D7 set": ([0xC4], [0], frozenset(), (False,) * 4, [("initialize", M), ("irq_service",)]),
 }
