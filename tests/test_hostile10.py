@@ -431,6 +431,12 @@ def test_shared(supi3_bench, supi3_master, value):
     assert supi3_bench.firmware.out == value
 
 
+@pytest.mark.parametrize("value", [1, 2])
+@pytest.mark.supi3(firmware=Dio)
+def test_a_class(supi3_bench, value):
+    pass
+
+
 @pytest.mark.parametrize("value", [pytest.param(v, marks=pytest.mark.supi3(firmware=Dio())) for v in (1, 2)])
 def test_one_each(supi3_bench, supi3_master, value):
     assert supi3_bench.firmware.out is None
@@ -444,11 +450,13 @@ def test_one_each(supi3_bench, supi3_master, value):
 def test_a_marker_firmware_that_ran_in_an_earlier_test_is_refused_by_name(pytester: pytest.Pytester) -> None:
     """A firmware object keeps its state (Python attributes; a C firmware's statics and ``fw_board_t``): the
     marker's object handed to a second test (parametrize, a class or module mark) would start there with the first
-    test's outputs. The second test is an error naming the first; ``pytest.param(marks=...)`` gives each its own."""
+    test's outputs. The second test is an error naming the first; ``pytest.param(marks=...)`` gives each its own.
+    A firmware class in the marker is Bench's own error in every test, not "already ran"."""
     pytester.makepyfile(test_firmware=SHARED_FIRMWARE_TEST)
     result = pytester.runpytest("--strict-markers", "-p", "no:cacheprovider")
-    result.assert_outcomes(passed=3, errors=1)
+    result.assert_outcomes(passed=3, errors=3)
     result.stdout.fnmatch_lines(["*firmware object already ran in test_firmware.py::test_shared?90?*one per test*"])
+    assert result.stdout.str().count("DriverArgumentError: firmware must be a supi3.sdk.bench.Firmware") == 2
 
 
 # ------------------------------------------------------------------------------------------------------------

@@ -52,7 +52,8 @@ def supi3_bench(request: pytest.FixtureRequest) -> Bench:
         shown = repr(marker.args) if marker.args else ", ".join(unknown)
         raise pytest.UsageError(f"@pytest.mark.{MARKER} takes keyword arguments of Bench only "
                                 f"({', '.join(inspect.signature(Bench).parameters)}), not {shown}")
-    firmware = marker.kwargs.get("firmware")
+    bench = Bench(**marker.kwargs)  # its own errors first (a firmware class, say)
+    firmware = bench.firmware
     if firmware is not None:
         ran = request.config.stash.setdefault(_FIRMWARE_TESTS, {})
         _, first = ran.setdefault(id(firmware), (firmware, request.node.nodeid))
@@ -61,7 +62,7 @@ def supi3_bench(request: pytest.FixtureRequest) -> Bench:
                                     f"{first} and keeps its state there; a firmware is one per test: "
                                     f"pytest.param(..., marks=pytest.mark.{MARKER}(firmware=...)) per case, or a "
                                     f"marker per test (FW-17)")  # fmt: skip
-    return Bench(**marker.kwargs)
+    return bench
 
 
 @pytest.fixture
