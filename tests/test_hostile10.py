@@ -15,8 +15,6 @@ pytest plugin's marker firmware handed to a second test (FW-17); ELF files whose
 from __future__ import annotations
 
 import ctypes
-import shutil
-import subprocess
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -25,7 +23,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from supi3 import sdk
+import test_sdk_c_model
 from supi3.config import decode
 from supi3.model.registers import ReconfigurationError, RegisterFile
 from supi3.regmap import REGISTER_MAP, SET, AccessDirection, Register
@@ -39,54 +37,12 @@ from supi3.sdk.driver import (
     Transport,
 )
 from supi3.sdk.transports import ModelTransport
+from test_sdk_c_model import DELAY, OPTICAL_FIELDS, READ_PIN, WRITE_PIN, XFER, Config, Optical
 
 pytest_plugins = ["pytester"]
-
-XFER = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_uint8, ctypes.POINTER(ctypes.c_uint8), ctypes.c_int)
-DELAY = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint32)
-READ_PIN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.POINTER(ctypes.c_int))
-WRITE_PIN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_int)
-
-
-class Config(ctypes.Structure):
-    """``supi3_config_t``."""
-
-    _fields_ = [
-        ("xfer", XFER),
-        ("delay_us", DELAY),
-        ("read_irq", READ_PIN),
-        ("read_cd", READ_PIN),
-        ("set_sas_init", WRITE_PIN),
-        ("user", ctypes.c_void_p),
-        ("frame_gap_us", ctypes.c_uint32),
-        ("read_io", READ_PIN),
-    ]
-
-
-OPTICAL_FIELDS = ("out_length", "out_medium", "out_enable", "branch_length", "branch_medium", "branch_enable",
-                  "in_level", "in_enable", "out_level", "branch_level")  # fmt: skip
-
-
-class Optical(ctypes.Structure):
-    """``supi3_optical_t``."""
-
-    _fields_ = [(name, ctypes.c_uint8) for name in OPTICAL_FIELDS]
-
-
-@pytest.fixture(scope="module")
-def lib(tmp_path_factory: pytest.TempPathFactory) -> ctypes.CDLL:
-    gcc = shutil.which("gcc")
-    if gcc is None:
-        pytest.skip("gcc not found: the C driver tests need it")
-    out = tmp_path_factory.mktemp("sdk") / "libsupi3.so"
-    build = subprocess.run(
-        [gcc, "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-shared", "-fPIC",
-         f"-I{sdk.include_dir()}", *map(str, sdk.sources()), "-o", str(out)],
-        capture_output=True, text=True, check=False,
-    )  # fmt: skip
-    assert build.returncode == 0, build.stderr
-    return ctypes.CDLL(str(out))
-
+lib = test_sdk_c_model.lib
+"""The fixture: the C driver built strictly, loaded with ctypes (with ``supi3_config_t`` and ``supi3_optical_t``, as
+tests/test_sdk_c_model.py has them)."""
 
 class Scripted(Transport):
     """A board whose chip answers from a script: received bytes and pin levels cycle through their lists; the
