@@ -317,7 +317,7 @@ CASES: dict[str, tuple[list[int], list[int], frozenset[int], tuple[bool, bool, b
                                     ("write", SET.address, 0x83), ("initialize", M), ("block", b"\0\0", 1, 1)]),
     # a mode that is none is SUPI3_E_ARG and leaves the driver initialized
     "bad mode": ([0], [0], frozenset(), (False,) * 4, [("initialize", M), ("initialize", "intel"), ("read", 0)]),
-    # irq_service returns the events D6..D0; D7 is the I/O access status (RM-7, RM-8)
+    # irq_service returns the byte read, D7 (the I/O access status, RM-7, RM-8) too, in both
     "irq_service with D7 set": ([0xC4], [0], frozenset(), (False,) * 4, [("initialize", M), ("irq_service",)]),
 }
 

@@ -261,8 +261,7 @@ class Reference:
                     return OK, 0  # /IRQ high: nothing sent
             except TransportError:
                 return E_TRANSPORT, None
-        rc, value = self.read(IRQ_EVT.address)
-        return rc, None if value is None else value & ~IRQ_EVT.field("IO_ACCESS").mask  # the events (FW-16)
+        return self.read(IRQ_EVT.address)
 
     def poll(self, max_polls: int, null: bool) -> tuple[int, int | None]:
         rc = self.entry_ok(max_polls != 0)

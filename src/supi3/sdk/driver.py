@@ -575,7 +575,7 @@ class _Core:
     def _irq_service(self) -> _Call[Irq]:
         if (yield (_IRQ, 0, False)):
             return Irq(0)
-        return Irq((yield from self._read(IRQ_EVT.address)) & _EVENT_MASK)
+        return Irq((yield from self._read(IRQ_EVT.address)))  # D7 too, as supi3_irq_service (FW-16)
 
     def poll_io_window(self, max_polls: object) -> _Call[Irq]:
         polls = _checked(check_int, "max_polls", max_polls, 1, None, "polls of the I/O access bit")
@@ -735,7 +735,9 @@ class Supi3Driver(_DriverApi):
         self._run(self._core.irq_enable(mask))
 
     def irq_service(self) -> Irq:
-        """Read-clear IRQ_EVT (3.4.14); with /IRQ wired and high, return no events and send nothing."""
+        """Read-clear IRQ_EVT (3.4.14): its events and, as ``supi3_irq_service``, D7, the I/O access status (RM-7,
+        RM-8; a bit that is no :class:`Irq` member: test events with ``&``); with /IRQ wired and high, return no
+        events and send nothing."""
         return self._run(self._core.irq_service())
 
     def poll_io_window(self, max_polls: int) -> Irq:

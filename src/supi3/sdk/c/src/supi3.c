@@ -299,11 +299,7 @@ int supi3_irq_service(supi3_t *ctx, uint8_t *events)
             return SUPI3_OK;
         }
     }
-    err = supi3_read(ctx, (uint8_t)SUPI3_IRQ_EVT_ADDR, events);
-    if (err == SUPI3_OK) {
-        *events = (uint8_t)(*events & SUPI3_IRQ_EVT_CLEAR_ON_READ_MSK); /* D7 is a status, not an event (FW-16) */
-    }
-    return err;
+    return supi3_read(ctx, (uint8_t)SUPI3_IRQ_EVT_ADDR, events);
 }
 
 int supi3_irq_enable(supi3_t *ctx, uint8_t mask)
