@@ -505,10 +505,12 @@ class Bench:
         Raises
         ------
         ArgumentError
-            ``until`` not a finite number (NaN would run nothing, infinity for ever); nothing changes.
+            ``until`` not a finite number (NaN would run nothing, infinity for ever), or past
+            :data:`~supi3.interbus.wire.MAX_BUS_TIME_S` (A26); nothing changes.
         """
-        if type(until) is not float or not -math.inf < until < math.inf:  # the board's float: one test
+        if type(until) is not float or not -math.inf < until <= wire.MAX_BUS_TIME_S:  # the board's float: one test
             until = check_real("until", until)
+            wire.check_bus_time("until", until, self.now, until - self.now)
         # Most calls (a byte, a pin read, the board's synchronisation at each peripheral access) find no bus event
         # due: one comparison with the next event's time, kept by _step_bus and _start_cycle.
         stepped = self._next_at <= until

@@ -1,0 +1,89 @@
+"""Four defects today's hostile review (round 9, ``test_hostile9.py``) found and left: bus time frozen by a long idle
+(A26: :data:`supi3.interbus.wire.MAX_BUS_TIME_S`, one check, :func:`supi3.interbus.wire.check_bus_time`, at every entry
+that advances bus time: ``Ring``, ``PinRing``, ``OpticalRing``, the firmware bench's ``advance``); the master's
+:attr:`~supi3.interbus.master.Master.processor_alarms` kept by ring position across a new configuration (A19: now
+dropped with ``branch_status`` and ``mau_warnings``); ``supi3 campaign --fidelity both`` with a mix naming no event
+of one fidelity ran that fidelity with its default mix (a silent guess, now refused by name, A27); and
+``supi3 campaign --cycles`` without an upper bound (A27).
+
+Every bad input is refused by name (which argument, which rule, which value); a refused call leaves no trace.
+"""
+
+from __future__ import annotations
+
+import math
+import pytest
+
+from supi3 import cli
+from supi3.config import decode
+from supi3.interbus import wire
+from supi3.interbus.device import PlainDevice
+from supi3.interbus.errors import InterbusArgumentError
+from supi3.interbus.master import Master
+from supi3.interbus.ring import Ring
+from supi3.model.chip import Supi3
+from supi3.model.pinring import PinRing
+from supi3.model.pins import Supi3Pins
+from supi3.optical.link import FibreLink
+from supi3.optical.ring import OpticalRing
+from supi3.sdk.bench import Bench
+
+# -- A26: the bus time's maximum ------------------------------------------------------------------------------------
+
+
+def test_a_cycle_moves_bus_time_by_whole_clocks_up_to_the_maximum() -> None:
+    """``Ring.idle(1e300)`` froze bus time (a cycle added nothing to 1e300): now refused by name, and at A26's maximum
+    a cycle still moves bus time by its clocks (so a watchdog or an idle timeout still expires)."""
+    ring = Ring([PlainDevice(0xBF, 1)])
+    master = Master(ring)
+    assert master.start().ok
+    with pytest.raises(InterbusArgumentError, match=r"seconds 1e\+300 at bus time .*A26"):
+        ring.idle(1e300)
+    ring.idle(wire.MAX_BUS_TIME_S - ring.now - 1.0)
+    before = ring.now
+    assert master.cycle().ok
+    cycle_s = ring.now - before
+    assert 0 < cycle_s and abs(cycle_s * 32e6 - round(cycle_s * 32e6)) < 0.05  # whole clocks of 32 MHz still
+
+
+@pytest.mark.parametrize("entry", ["ring", "pin", "optical"])
+def test_every_bus_refuses_an_idle_past_the_maximum_and_changes_nothing(entry: str) -> None:
+    """One check (A26) at every bus: an idle past :data:`~supi3.interbus.wire.MAX_BUS_TIME_S` is refused by name
+    (the pin level ran ``idle(1e300)`` for ever, one status telegram piece after another) and bus time stays."""
+    bus: Ring | PinRing | OpticalRing
+    if entry == "ring":
+        bus = Ring([PlainDevice(0xBF, 1)])
+    elif entry == "pin":
+        bus = PinRing([Supi3Pins(decode("10000"))])
+    else:
+        bus = OpticalRing([Supi3(decode("10000", rf="00"))], [FibreLink(20.0)], seed=5)
+    for seconds in (1e300, wire.MAX_BUS_TIME_S + 1.0):
+        with pytest.raises(InterbusArgumentError, match="seconds .* past 1048576 s \\(A26"):
+            bus.idle(seconds)
+    assert bus.now == 0.0
+
+
+def test_a_cycle_and_a_reset_at_the_maximum_are_refused() -> None:
+    """Past the maximum (reached by the cycle begun just before it) no cycle or reset starts: refused by name, the
+    master's cycle raises before the ring changes anything."""
+    ring = Ring([PlainDevice(0xBF, 1)])
+    master = Master(ring)
+    assert master.start().ok
+    ring.idle(wire.MAX_BUS_TIME_S - ring.now)
+    assert ring.now == wire.MAX_BUS_TIME_S
+    assert master.cycle().ok  # begun at the maximum: it runs
+    after = ring.now
+    with pytest.raises(InterbusArgumentError, match="cycle .*A26"):
+        master.cycle()
+    with pytest.raises(InterbusArgumentError, match="reset 'INTERBUS reset' .*A26"):
+        ring.reset()
+    assert ring.now == after
+
+
+@pytest.mark.parametrize("until", [1e300, wire.MAX_BUS_TIME_S * 2, math.inf], ids=repr)
+def test_the_bench_refuses_to_advance_past_the_maximum(until: float) -> None:
+    """The firmware bench's clock follows the same rule (A26): ``advance`` past it is refused, nothing runs."""
+    bench = Bench()
+    with pytest.raises(ValueError, match="until"):
+        bench.advance(until)
+    assert bench.now == 0.0 and bench.cycles == 0
