@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import math
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from supi3 import cli
 from supi3.config import decode
@@ -87,3 +89,65 @@ def test_the_bench_refuses_to_advance_past_the_maximum(until: float) -> None:
     with pytest.raises(ValueError, match="until"):
         bench.advance(until)
     assert bench.now == 0.0 and bench.cycles == 0
+
+
+# -- A19: the master's records by ring position ---------------------------------------------------------------------
+
+
+def _alarm_chip(alarm: int) -> Supi3:
+    """An RB Init-µP chip (as ``test_model_chip``'s management test) whose processor alarm register holds ``alarm``."""
+    chip = Supi3(decode("10011", "1110"))
+    assert chip.registers is not None
+    chip.registers.cpu_write(13, 0x82)
+    chip.registers.cpu_write(12, 0x01)
+    chip.registers.cpu_write(7, alarm)  # 3.4.9: the processor alarm for the master
+    return chip
+
+
+def _settle(master: Master) -> None:
+    for _ in range(8):
+        if master.cycle().ok and master.config is not None and len(master.config) == len(master.ring.devices):
+            return
+
+
+def test_a_processor_alarm_read_before_a_ring_change_is_dropped_with_the_table() -> None:
+    """Round 9's A19 left :attr:`Master.processor_alarms` out: the alarm read from position 2 still stood at position
+    2 after position 1 was removed and the table rebuilt, now the position of another device."""
+    chips = [_alarm_chip(0x10 + k) for k in range(3)]
+    ring = Ring(list(chips))
+    master = Master(ring)
+    assert master.start().ok
+    master.request_processor_alarm(2)
+    _settle(master)
+    _settle(master)
+    assert master.processor_alarms == {2: 0x11}
+    del ring.devices[0]
+    _settle(master)
+    assert master.config is not None and len(master.config) == 2
+    assert master.processor_alarms == {}
+
+
+@given(st.lists(st.tuples(st.sampled_from(["request", "remove", "insert"]), st.integers(1, 4)), max_size=6))
+@settings(max_examples=25, deadline=None)
+def test_after_any_ring_change_no_record_names_another_device(steps: list[tuple[str, int]]) -> None:
+    """Over any history of processor alarm requests, removals and insertions (each followed by the master's cycles
+    until its table matches the ring again), every record kept by ring position (processor alarms) is the one of the
+    device at that position now."""
+    pool = [_alarm_chip(0x10 + k) for k in range(5)]
+    alarm = {id(chip): 0x10 + k for k, chip in enumerate(pool)}
+    ring = Ring(pool[:3])
+    master = Master(ring)
+    assert master.start().ok
+    for step, at in steps:
+        n = len(ring.devices)
+        if step == "request":
+            master.request_processor_alarm(min(at, n))
+        elif step == "remove" and n > 1:
+            del ring.devices[min(at, n) - 1]
+        elif step == "insert" and n < len(pool):
+            ring.devices.insert(min(at, n + 1) - 1, next(c for c in pool if c not in ring.devices))
+        _settle(master)
+        _settle(master)  # a request goes out in the next ID cycle and is answered in the one after (A18)
+        assert master.config is not None and len(master.config) == len(ring.devices)
+        for position, value in master.processor_alarms.items():
+            assert value == alarm[id(ring.devices[position - 1])], (position, steps)
