@@ -17,7 +17,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from supi3 import cli
+from supi3.campaign import MAX_CYCLES, CampaignConfig, Fidelity
 from supi3.config import decode
+from supi3.errors import ArgumentError
 from supi3.interbus import wire
 from supi3.interbus.device import PlainDevice
 from supi3.interbus.errors import InterbusArgumentError
@@ -151,3 +153,55 @@ def test_after_any_ring_change_no_record_names_another_device(steps: list[tuple[
         assert master.config is not None and len(master.config) == len(ring.devices)
         for position, value in master.processor_alarms.items():
             assert value == alarm[id(ring.devices[position - 1])], (position, steps)
+
+
+# -- A27: supi3 campaign's limits -----------------------------------------------------------------------------------
+
+
+def _refused(capsys: pytest.CaptureFixture[str], argv: list[str]) -> str:
+    """``main(argv)`` exits 2 with one line on stderr, no traceback; that line."""
+    try:
+        code = cli.main(argv)
+    except SystemExit as exc:
+        code = exc.code if isinstance(exc.code, int) else 1
+    out, err = capsys.readouterr()
+    assert code == 2 and out == "" and "Traceback" not in err and err.count("\n") == 1 and err.endswith("\n"), err
+    return err
+
+
+@pytest.mark.parametrize(("argv", "expect"), [
+    (["--cycles", str(10**20)], "--cycles must be an integer from 1 to 1000000 (A27: hours of run time), not 10"),
+    (["--cycles", "1000001"], "--cycles must be an integer from 1 to 1000000"),
+    (["--pin-cycles", "10001"], "--pin-cycles must be an integer from 1 to 10000 (A27"),
+], ids=["cycles 10**20", "cycles 1000001", "pin-cycles 10001"])
+def test_campaign_cycles_have_an_upper_bound(capsys: pytest.CaptureFixture[str], argv: list[str],
+                                             expect: str) -> None:
+    """``supi3 campaign --cycles 10**20`` ran until killed: now refused by name, one line, exit status 2 (A27); the
+    API (:class:`~supi3.campaign.CampaignConfig`) follows the same limit."""
+    assert expect in _refused(capsys, ["campaign", *argv])
+
+
+@pytest.mark.parametrize(("fidelity", "cycles"), [("ring", 1_000_001), ("pin", 10_001)])
+def test_campaign_config_refuses_cycles_past_the_bound(fidelity: Fidelity, cycles: int) -> None:
+    with pytest.raises(ArgumentError, match=r"cycles must be an integer from 1 to \d+ \(A27"):
+        CampaignConfig(cycles=cycles, fidelity=fidelity)
+    assert CampaignConfig(cycles=MAX_CYCLES[fidelity], fidelity=fidelity).cycles == MAX_CYCLES[fidelity]
+
+
+@pytest.mark.parametrize(("mix", "expect"), [
+    ("bitflip=1", "--mix must be an event the pin campaign runs (vmon, reset) with --fidelity both, not 'bitflip=1'"),
+    ("vmon=2", "--mix must be an event the ring campaign runs (bitflip, "),
+], ids=["bitflip", "vmon"])
+def test_campaign_mix_with_both_fidelities_names_an_event_of_each(capsys: pytest.CaptureFixture[str], mix: str,
+                                                                   expect: str) -> None:
+    """``--mix bitflip=1 --fidelity both`` ran the pin-level campaign with its default mix (a silent guess): now each
+    fidelity needs an event of the mix it runs, else the mix is refused by name (A27)."""
+    assert expect in _refused(capsys, ["campaign", "--fidelity", "both", "--mix", mix])
+
+
+def test_campaign_mix_with_both_fidelities_is_split_between_them() -> None:
+    """A mix naming events of both fidelities (``reset`` is in both) gives each its own, as documented."""
+    args = cli.build_parser().parse_args(["campaign", "--mix", "bitflip=2,vmon=1,reset=1"])
+    configs = cli._campaign_configs(args)
+    assert [(c.fidelity, c.mix) for c in configs] == [("ring", {"bitflip": 2, "reset": 1}),
+                                                       ("pin", {"vmon": 1, "reset": 1})]
