@@ -12,6 +12,7 @@ Every bad input is refused by name (which argument, which rule, which value); a 
 from __future__ import annotations
 
 import math
+
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -47,7 +48,7 @@ def test_a_cycle_moves_bus_time_by_whole_clocks_up_to_the_maximum() -> None:
     before = ring.now
     assert master.cycle().ok
     cycle_s = ring.now - before
-    assert 0 < cycle_s and abs(cycle_s * 32e6 - round(cycle_s * 32e6)) < 0.05  # whole clocks of 32 MHz still
+    assert cycle_s > 0 and abs(cycle_s * 32e6 - round(cycle_s * 32e6)) < 0.05  # whole clocks of 32 MHz still
 
 
 @pytest.mark.parametrize("entry", ["ring", "pin", "optical"])
@@ -62,7 +63,7 @@ def test_every_bus_refuses_an_idle_past_the_maximum_and_changes_nothing(entry: s
     else:
         bus = OpticalRing([Supi3(decode("10000", rf="00"))], [FibreLink(20.0)], seed=5)
     for seconds in (1e300, wire.MAX_BUS_TIME_S + 1.0):
-        with pytest.raises(InterbusArgumentError, match="seconds .* past 1048576 s \\(A26"):
+        with pytest.raises(InterbusArgumentError, match=r"seconds .* past 1048576 s \(A26"):
             bus.idle(seconds)
     assert bus.now == 0.0
 
@@ -77,9 +78,9 @@ def test_a_cycle_and_a_reset_at_the_maximum_are_refused() -> None:
     assert ring.now == wire.MAX_BUS_TIME_S
     assert master.cycle().ok  # begun at the maximum: it runs
     after = ring.now
-    with pytest.raises(InterbusArgumentError, match="cycle .*A26"):
+    with pytest.raises(InterbusArgumentError, match=r"cycle .*A26"):
         master.cycle()
-    with pytest.raises(InterbusArgumentError, match="reset 'INTERBUS reset' .*A26"):
+    with pytest.raises(InterbusArgumentError, match=r"reset 'INTERBUS reset' .*A26"):
         ring.reset()
     assert ring.now == after
 
@@ -106,9 +107,10 @@ def _alarm_chip(alarm: int) -> Supi3:
     return chip
 
 
-def _settle(master: Master) -> None:
+def _settle(master: Master, ring: Ring) -> None:
+    """The master's cycles until one is latched on a table as long as the ring (at most 8)."""
     for _ in range(8):
-        if master.cycle().ok and master.config is not None and len(master.config) == len(master.ring.devices):
+        if master.cycle().ok and master.config is not None and len(master.config) == len(ring.devices):
             return
 
 
@@ -120,11 +122,11 @@ def test_a_processor_alarm_read_before_a_ring_change_is_dropped_with_the_table()
     master = Master(ring)
     assert master.start().ok
     master.request_processor_alarm(2)
-    _settle(master)
-    _settle(master)
+    _settle(master, ring)
+    _settle(master, ring)
     assert master.processor_alarms == {2: 0x11}
     del ring.devices[0]
-    _settle(master)
+    _settle(master, ring)
     assert master.config is not None and len(master.config) == 2
     assert master.processor_alarms == {}
 
@@ -148,8 +150,8 @@ def test_after_any_ring_change_no_record_names_another_device(steps: list[tuple[
             del ring.devices[min(at, n) - 1]
         elif step == "insert" and n < len(pool):
             ring.devices.insert(min(at, n + 1) - 1, next(c for c in pool if c not in ring.devices))
-        _settle(master)
-        _settle(master)  # a request goes out in the next ID cycle and is answered in the one after (A18)
+        _settle(master, ring)
+        _settle(master, ring)  # a request goes out in the next ID cycle and is answered in the one after (A18)
         assert master.config is not None and len(master.config) == len(ring.devices)
         for position, value in master.processor_alarms.items():
             assert value == alarm[id(ring.devices[position - 1])], (position, steps)
