@@ -78,7 +78,7 @@ def test_a_cycle_and_a_reset_at_the_maximum_are_refused() -> None:
     assert ring.now == wire.MAX_BUS_TIME_S
     assert master.cycle().ok  # begun at the maximum: it runs
     after = ring.now
-    with pytest.raises(InterbusArgumentError, match=r"cycle .*A26"):
+    with pytest.raises(InterbusArgumentError, match=r"cycle <Cycle.DATA: .data.> \(Cycle\) at bus time .*A26"):
         master.cycle()
     with pytest.raises(InterbusArgumentError, match=r"reset 'INTERBUS reset' .*A26"):
         ring.reset()
@@ -207,3 +207,14 @@ def test_campaign_mix_with_both_fidelities_is_split_between_them() -> None:
     configs = cli._campaign_configs(args)
     assert [(c.fidelity, c.mix) for c in configs] == [("ring", {"bitflip": 2, "reset": 1}),
                                                        ("pin", {"vmon": 1, "reset": 1})]
+
+
+@pytest.mark.parametrize("cycles", [10**20, 10**400], ids=["10**20", "10**400"])
+def test_the_bench_refuses_a_run_of_more_cycles_than_fit_before_the_maximum(cycles: int) -> None:
+    """``Bench.run(10**20)`` would run until the ring refused its cycle at the maximum, 10^8 cycles later: refused
+    first, by name, nothing run (A26: no cycle is shorter than the shortest of a one-device ring)."""
+    bench = Bench()
+    refused = r"cycles (1\d*|<1329-bit integer>) at bus time 0.0 s would take it past 1048576 s"
+    with pytest.raises(ValueError, match=refused):
+        bench.run(cycles)
+    assert bench.now == 0.0 and bench.cycles == 0

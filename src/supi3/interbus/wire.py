@@ -22,7 +22,7 @@ from typing import Final, NamedTuple, NoReturn
 import numpy as np
 import numpy.typing as npt
 
-from supi3.checks import check_bool, check_bytes, check_choice, check_instance, check_int, fail
+from supi3.checks import check_bool, check_bytes, check_choice, check_instance, check_int, describe, fail
 from supi3.interbus.errors import InterbusArgumentError, InterbusError, TelegramError, checked
 from supi3.tables import BIT_RATES, CLOCK_HZ, LENGTH_CODE_BY_VALUE, WATCHDOG_TIMEOUTS_S
 
@@ -243,7 +243,7 @@ def check_bus_time(name: str, value: object, now: float, seconds: float = 0.0) -
         Bus time would pass :data:`MAX_BUS_TIME_S` (or ``now + seconds`` is NaN).
     """
     if not now + seconds <= MAX_BUS_TIME_S:
-        raise InterbusArgumentError(name, value, f"{name} {value!r} at bus time {now!r} s would take it past "
+        raise InterbusArgumentError(name, value, f"{name} {describe(value)} at bus time {now!r} s would take it past "
                                     f"{MAX_BUS_TIME_S:.0f} s (A26: the most where a float resolves a 32 MHz clock)",
                                     "docs/assumptions/interbus.md, A26")  # fmt: skip
 
