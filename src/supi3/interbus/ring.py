@@ -1494,9 +1494,8 @@ class Ring:
             raise fail(f"device at ring position {position}", "a chip with a power-up reset (power_up)", device)
         if down is None:
             down = min(self.now, max(self._grid, self._wakes.get(id(device), self._grid)))
-        elif not self._grid <= check_real("down", down) <= self.now:
-            raise fail("down", f"a bus time from the master's idle's start ({self._grid} s) to now ({self.now} s)",
-                       down, "M26")
+        else:
+            down = check_real("down", down, self._grid, self.now, limit="M26: from the master's idle's start to now")
         power_up()
         self._downs[id(device)] = down
         self._wakes[id(device)] = self.now + round(RESET_MIN_S * CLOCK_HZ) / CLOCK_HZ  # the stretch, M2
