@@ -493,7 +493,7 @@ def _counter_window(bit_rate: int, wakes: tuple[tuple[int, int], ...], downs: tu
 
 
 def counter_return(bit_rate: int, devices: int, wakes: Mapping[int, int], start: int, frame: Frame,
-                   lags: Sequence[int], counters: Counters, downs: Mapping[int, int] | None = None,
+                   lags: Sequence[int] | None, counters: Counters, downs: Mapping[int, int] | None = None,
                    ) -> tuple[bool, bool, bool]:
     """:func:`wake_return` with the counter blocks of LBD chips along the data path (M26: ``counters``; ``downs``: the
     clock each woken chip's power-down began, its outputs silent from then, else the master's idle's start) over the
