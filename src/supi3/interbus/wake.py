@@ -23,7 +23,14 @@ import numpy.typing as npt
 
 from supi3.checks import check_instance, check_int, fail
 from supi3.interbus import wire
-from supi3.interbus.counter_rule import COUNTER_SILENCE_BITS, IDLE_BIT, CounterState, counter_step, send_countdown
+from supi3.interbus.counter_rule import (
+    COUNTER_SILENCE_BITS,
+    IDLE_BIT,
+    CounterState,
+    counter_step,
+    sample_phase,
+    send_countdown,
+)
 from supi3.interbus.errors import InterbusError
 from supi3.interbus.receiver import receive
 from supi3.interbus.wire import Cycle, Frame, Telegram
@@ -152,13 +159,17 @@ def wake_window(bit_rate: int, devices: int, wakes: Mapping[int, int], lags: Seq
     (M19); the master's receiver, behind the last chip with no added delay, listens from the last chip's resumption and
     makes its last telegram error before finding the grid (M16). ``lags``: the clocks from the master's line to each
     chip's input and to the master's receiver (:func:`path_lags`: a tree's data path, M25; ``None``: a flat ring's).
+    ``counters``: the counter blocks of LBD chips along the data path, followed on the lines (M26: ``ready`` and
+    ``heard`` from :func:`_follow`'s lines); ``downs``: the clock each woken chip's power-down began (its outputs
+    silent from then, M27; ``None``: the master's idle's start, clock 0).
 
     Raises
     ------
     ArgumentError
         ``bit_rate`` not one of Table 1-7, ``devices`` not from 1 to ``wire.MAX_DEVICES``, ``wakes`` not a mapping
-        of ring indices (0 to ``devices`` - 1) to integer clocks, or ``lags`` not ``devices`` + 1 increasing clocks
-        from 0.
+        of ring indices (0 to ``devices`` - 1) to integer clocks, ``lags`` not ``devices`` + 1 increasing clocks
+        from 0, ``counters`` not a :class:`Counters` of ring indices, or ``downs`` not a mapping of woken ring
+        indices to integer clocks.
     """
     devices, lags = _check(bit_rate, devices, wakes, lags)
     cpb = wire.clocks_per_bit(bit_rate)
@@ -346,11 +357,11 @@ def _counter_line(synced: npt.NDArray[np.int64], begin: int, cpb: int) -> tuple[
     """The line a counter block sends, ``out`` and ``drive`` per clock, over ``synced`` (its input after the chip's
     synchroniser, one sample a clock), the block reset at index ``begin`` and clocked from there by the pin block's
     clock rule (:meth:`supi3.model.blocks.counter.CounterBlock.clock`, BK-33): between telegrams a start level
-    restarts the bit grid (M7) unless one waits for its sample, the line is sampled mid-bit (``cpb // 2``) and
+    restarts the bit grid (M7) unless one waits for its sample, the line is sampled mid-bit (``sample_phase``) and
     :func:`~supi3.interbus.counter_rule.counter_step` decides the bit period sent for it, ``send_countdown`` later
     (M8); the idle level, not driven, where nothing is sent."""
     n = len(synced)
-    half = cpb // 2
+    half = sample_phase(cpb)
     shown = 1 + send_countdown(cpb) - cpb  # from a sample to the first clock of the bit period sent for it
     out = np.full(n, wire.IDLE_LEVEL, dtype=np.int64)
     drive = np.zeros(n, dtype=np.int64)
@@ -475,7 +486,7 @@ def _counter_window(bit_rate: int, wakes: tuple[tuple[int, int], ...], downs: tu
     telegram = wire.STATUS_TELEGRAM_BITS * cpb
     woken, down = dict(wakes), dict(downs)
     origin = _counter_origin(cpb, woken, down, lags)
-    count = -(-(max(woken.values()) - origin + lags[-1]) // telegram) + 2 * _PROBE_TELEGRAMS // 4
+    count = -(-(max(woken.values()) - origin + lags[-1]) // telegram) + _PROBE_TELEGRAMS // 2
     sent = wire.levels_to_samples(wire.status_levels(Cycle.DATA, False, count), bit_rate).astype(np.int64)
     relative = {index: clock - origin for index, clock in woken.items()}
     lines, _ = _follow(cpb, relative, {index: clock - origin for index, clock in down.items()}, lags, counters, sent)
