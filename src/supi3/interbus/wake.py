@@ -399,8 +399,11 @@ def _follow(cpb: int, wakes: Mapping[int, int], downs: Mapping[int, int], lags: 
     after its wake-up (M12); an LBD chip's DO2 sends what its forward block drives (BK-30: a generated counter
     telegram, a telegram dropped while one is generated, a counter telegram's count), and an LBD-MR branch's return
     line runs through each device's return block (DI1, BK-35: its block's line) into its BK's synchroniser, DO2
-    repeating it (BK-37). A woken chip's blocks idle from its power-down and run afresh from its wake-up (M2). Second,
-    each block's ``drive`` and the lag of its output behind the master's line."""
+    repeating it (BK-37). A woken chip's blocks idle from its power-down and run afresh from its wake-up (M2). What the
+    master sent before a chip's power-down is followed as idle status telegrams (the last cycle's have other bits), so
+    a woken chip listens from its wake-up or, if later, from when the master's line of its power-down's instant
+    reaches it (M22's reading: the line followed from then). Second, each block's ``drive`` and the lag of its output
+    behind the master's line."""
     n = len(sent)
     delay = wire.REPEATER_DELAY_BITS * cpb
     returns = dict(counters.returns)
@@ -410,7 +413,7 @@ def _follow(cpb: int, wakes: Mapping[int, int], downs: Mapping[int, int], lags: 
         synced = _later(line, SYNC_STAGES)
         out, drive = _counter_line(synced, lag + SYNC_STAGES, cpb)  # its line's first telegram: on the grid
         if index in wakes:  # the power-up reset: idle from the clock after the power-down, clocked again from M2's end
-            again, again_drive = _counter_line(synced, wakes[index], cpb)
+            again, again_drive = _counter_line(synced, max(wakes[index], downs[index] + lag + SYNC_STAGES), cpb)
             reset = downs[index] + 1
             out[reset:], drive[reset:] = again[reset:], again_drive[reset:]
         return out, drive
@@ -422,8 +425,9 @@ def _follow(cpb: int, wakes: Mapping[int, int], downs: Mapping[int, int], lags: 
         out = _later(line, delay)
         lag = lags[index] + delay
         if index in wakes:
-            start = _first_start(line[wakes[index] :], cpb)
-            out[downs[index] : n if start is None else wakes[index] + start + delay] = wire.IDLE_LEVEL
+            listen = max(wakes[index], downs[index] + lags[index])
+            start = _first_start(line[listen:], cpb)
+            out[downs[index] : n if start is None else listen + start + delay] = wire.IDLE_LEVEL
         if index in counters.forward:
             counted, drive = block(line, lags[index], index)
             out = np.where(drive == 1, counted, out)
