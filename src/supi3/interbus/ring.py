@@ -1051,6 +1051,26 @@ class Ring:
         fault: Fault = DeadLine(position) if forward else ReturnBreak(position)
         self._faults.append(_Active(fault, None, every[position - 1] if position <= len(every) else None, branch))
 
+    def bit_error(self, position: int, bit: int, cycles: int | None = 1) -> None:
+        """Invert bit period ``bit`` of the frame on the forward line into the device at ``position``, numbered as
+        :meth:`cut` numbers it (the physical position in every state, BK-52; N + 1: the return line into the master),
+        in the next ``cycles`` cycles whose data path holds that line (``None``: every one): a :class:`BitFlip` on
+        that device's line, which follows it when positions move and sleeps while it is out of the data path (BK-1).
+        ``PinRing.bit_error <supi3.model.pinring.PinRing.bit_error>`` is its pin-level twin, with the same arguments
+        (BK-65).
+
+        Raises
+        ------
+        ArgumentError
+            ``position`` not from 1 to N + 1 (N: every device of the tree), ``bit`` not an integer >= 0 or ``cycles``
+            not ``None`` or an integer >= 1; nothing changes.
+        """
+        every = _devices(self._tree)
+        position = check_int("position", position, 1, len(every) + 1,
+                             "a device of the tree, or N + 1: the return line into the master")  # fmt: skip
+        flip = BitFlip(position, bit, cycles)
+        self._faults.append(_Active(flip, flip.cycles, every[position - 1] if position <= len(every) else None))
+
     def clear_faults(self) -> None:
         """Remove every injected fault (a repair: in a tree the breaks removed decide the error of a cycle a branch
         joins within, BK-56)."""
