@@ -16,7 +16,7 @@ from __future__ import annotations
 import functools
 import itertools
 from collections.abc import Mapping, Sequence
-from typing import NamedTuple
+from typing import NamedTuple, Protocol, runtime_checkable
 
 import numpy as np
 import numpy.typing as npt
@@ -27,7 +27,10 @@ from supi3.interbus.errors import InterbusError
 from supi3.interbus.receiver import receive
 from supi3.interbus.wire import Cycle, Frame, Telegram
 from supi3.pinlevel import SYNC_STAGES
+from supi3.tables import CLOCK_HZ, RESET_MIN_S
 
+_STRETCH_CLOCKS = round(RESET_MIN_S * CLOCK_HZ)
+"""The power-up reset's stretch (M2, 1.7.2): a chip's logic runs this many clocks after its power-up."""
 _PROBE_TELEGRAMS = 64
 """Idle status telegrams the receiver is run over: far more than it needs to find the grid (M16: within two)."""
 
@@ -185,7 +188,8 @@ def wake_window(bit_rate: int, devices: int, wakes: Mapping[int, int], lags: Seq
 
 
 def wake_return(bit_rate: int, devices: int, wakes: Mapping[int, int], start: int,
-                frame: Frame, lags: Sequence[int] | None = None) -> tuple[bool, bool]:
+                frame: Frame, lags: Sequence[int] | None = None,
+                chips: Mapping[int, WokenChip] | None = None) -> tuple[bool, bool]:
     """What the master's receiver makes of a cycle in the window after chips of a flat ring woke up (M22): whether it
     meets a telegram error, and whether a telegram that opens a frame comes back (else a dead line).
 
@@ -193,12 +197,16 @@ def wake_return(bit_rate: int, devices: int, wakes: Mapping[int, int], start: in
     (counted as in :func:`wake_window`) ``frame`` as it comes back and the ring delay's status telegrams (A11), the
     line of each chip silent from a wake-up until it resumes sending (its first start level after it began listening,
     M12, then as much later as the next chip's input, ``lags``); the receiver (:func:`supi3.interbus.receiver.receive`)
-    takes the line in two pieces, the idle before ``start`` and the cycle, as the pin level's master does.
+    takes the line in two pieces, the idle before ``start`` and the cycle, as the pin level's master does. A woken
+    chip of ``chips`` (ring index -> its transaction-level chip, :func:`follows_woken`) sends on what its own core
+    sends over its line from its wake-up (:meth:`WokenChip.woken_output`, M28: off the grid its frame engine opens
+    frames at misread telegrams, M19).
 
     Raises
     ------
     ArgumentError
-        As :func:`wake_window`; ``start`` not an integer clock, ``frame`` not a :class:`~supi3.interbus.wire.Frame`.
+        As :func:`wake_window`; ``start`` not an integer clock, ``frame`` not a :class:`~supi3.interbus.wire.Frame`,
+        ``chips`` not a mapping of woken ring indices (keys of ``wakes``) to :class:`WokenChip` objects.
     """
     devices, lags = _check(bit_rate, devices, wakes, lags)
     start = check_int("start", start)
@@ -214,6 +222,7 @@ def wake_return(bit_rate: int, devices: int, wakes: Mapping[int, int], start: in
     sent = np.concatenate([wire.levels_to_samples(idle, bit_rate)[: start - origin],
                            wire.levels_to_samples(tail, bit_rate)]).astype(np.int64)
     end = len(sent)
+    chips = _check_chips(chips, wakes)
     resumed: int | None = None
     for index in range(devices):
         listen = wakes.get(index)
@@ -221,6 +230,10 @@ def wake_return(bit_rate: int, devices: int, wakes: Mapping[int, int], start: in
             listen = resumed if listen is None else max(listen, resumed)
         if listen is not None:
             first = _first_start(sent[max(0, listen - origin - lags[index]):], cpb)
+            if index in chips:  # M28: the woken chip's own core over its line (silent before the chip before resumed)
+                if resumed is not None:
+                    sent[: max(0, resumed - origin - lags[index])] = wire.IDLE_LEVEL
+                sent = _woken_line(chips[index], sent, listen - origin - lags[index], bit_rate)
             resumed = listen + (end if first is None else first) + lags[index + 1] - lags[index]
     lag = lags[devices]
     line = np.full(end, wire.IDLE_LEVEL, dtype=np.int64)  # the master's line: the last chip's, no further delay
@@ -230,10 +243,54 @@ def wake_return(bit_rate: int, devices: int, wakes: Mapping[int, int], start: in
     _, index, _ = receive(line[: start - origin], 0, cpb)
     telegrams, _, error = receive(line, index, cpb)
     try:  # a frame comes back only if the master assembles one (as the pin level's master, PinRing.transfer)
-        wire.frame_from_telegrams(telegrams)
+        back = wire.returned_frame(telegrams)
     except InterbusError:
         return error, False
-    return error, True
+    return error, back is not None
+
+
+@runtime_checkable
+class WokenChip(Protocol):
+    """A chip whose own core :func:`wake_return` runs over its line after its power-up (M28):
+    :class:`supi3.model.chip.Supi3`."""
+
+    def woken_output(self, do1: npt.NDArray[np.int64]) -> npt.NDArray[np.int64] | None:
+        """What the chip, powered up at ``do1``'s first clock, sends on DO2 over the forward line ``do1``; ``None``:
+        not followed (its output depends on other lines)."""
+
+
+def _check_chips(chips: Mapping[int, WokenChip] | None, wakes: Mapping[int, int]) -> dict[int, WokenChip]:
+    if chips is None:
+        return {}
+    if not isinstance(chips, Mapping) or not all(
+            index in wakes and isinstance(chip, WokenChip) for index, chip in chips.items()):
+        raise fail("chips", "a mapping of woken ring indices (keys of wakes) to chips with woken_output", chips, "M28")
+    return dict(chips)
+
+
+def _woken_line(chip: WokenChip, line: npt.NDArray[np.int64], wake: int, bit_rate: int) -> npt.NDArray[np.int64]:
+    """M28: ``line`` (the master's line as the woken chip's input sees it: index ``i`` there ``i`` clocks after the
+    line's first, a telegram boundary of the master's idle) as the chip sends it on, in the same clocks (its repeater's
+    delay, A10, is in the lags of the chips behind): the chip's DO2 (:meth:`WokenChip.woken_output`), its logic
+    running from index ``wake``, the end of its stretch (M2), seeing that index first through its synchroniser (M1);
+    ``line`` itself for a chip not followed."""
+    cpb = wire.clocks_per_bit(bit_rate)
+    delay = wire.REPEATER_DELAY_BITS * cpb
+    first = wake - (_STRETCH_CLOCKS - SYNC_STAGES)  # the power-up: the run's first index
+    size = len(line) + delay - first
+    at = np.arange(first, first + size)
+    do1 = np.full(size, wire.IDLE_LEVEL, dtype=np.int64)
+    inside = (at >= 0) & (at < len(line))
+    do1[inside] = line[at[inside]]
+    before = at < 0  # before the line followed: the master's idle status telegrams, periodic from its first index
+    do1[before] = _idle_samples(bit_rate)[at[before] % (wire.STATUS_TELEGRAM_BITS * cpb)]
+    sent = chip.woken_output(do1)
+    if sent is None:
+        return line
+    out = np.full(len(line), wire.IDLE_LEVEL, dtype=np.int64)
+    lo = max(0, first - delay)  # DO2 at the run's index p: the line's index p + first - delay
+    out[lo:] = sent[lo + delay - first : len(line) + delay - first]
+    return out
 
 
 _SHORT_HOLD_BITS = 12

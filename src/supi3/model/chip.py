@@ -32,9 +32,13 @@ from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import ClassVar, Final, Protocol, TypeVar
 
+import numpy as np
+import numpy.typing as npt
+
 from supi3 import tables
 from supi3.checks import check_bits, check_bool, check_bytes, check_instance, check_int, check_real, fail
 from supi3.config import DeviceConfig, MfpKind, Variant, decode
+from supi3.config import Interface as LineInterface
 from supi3.diagnostics import DiagnosticOutputs, LedInputs, diagnostic_outputs, fo_leds, watches_line_interrupt
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.expansion import PULSE_T0, ExternalRegisters, end_pulses
@@ -313,6 +317,24 @@ class Supi3:
     # --------------------------------------------------------------------------------------------------------
     # Power-up and pins
     # --------------------------------------------------------------------------------------------------------
+
+    def woken_output(self, do1: npt.NDArray[np.int64]) -> npt.NDArray[np.int64] | None:
+        """What this chip, powered up at the first clock of the forward line ``do1`` (32 MHz samples; its power-up
+        reset's stretch from there, M2), sends on DO2 over it: its own core's, a fresh
+        :class:`~supi3.model.pins.Supi3Pins` of its configuration with its MFP inputs (the power-up clears the rest,
+        1.7.2), the other inputs quiet. The transaction level's wake-up window follows a woken chip's line with it
+        (``interbus.wake.wake_return``, M28). ``None`` for a BK or an LBD chip, whose DO2 depends on lines ``do1``
+        does not give (the branch's DI3, the counter blocks' return line; M25's limit 1)."""
+        from supi3.model.pins import Supi3Pins  # the pin model drives this class: imported when first needed
+
+        interface = self.config.interface
+        if interface.is_bus_terminal or interface in (LineInterface.LBD_MR, LineInterface.LBD_OR):
+            return None
+        n = len(do1)
+        ones, zeros = np.ones(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
+        return np.asarray(Supi3Pins(self.config).run_forward({
+            "do1": do1, "di2": zeros, "rbst_ext": zeros, "mfp_in": np.full(n, self.mfp_in, dtype=np.int64),
+            "stat_err_n": ones, "resu_n": ones, "vmon_ok": ones, "from_exr": zeros})["do2"], dtype=np.int64)
 
     def power_up(self) -> None:
         """Power-up reset (1.7.2): every register 0, watchdog off, no fault latched (3.4.7)."""
