@@ -20,6 +20,7 @@ from supi3.interbus.ring import BranchKind, ErrorKind
 from supi3.interbus.wake import wake_return
 from supi3.interbus.wire import Cycle, Frame, Telegram
 from supi3.model.chip import Supi3
+from supi3.model.pins import Supi3Pins
 from test_model_pinring_powerup import RATES, _config, both
 from test_model_pinring_recognition import TELEGRAM_S, recognition_history
 from test_model_pinring_tree import CASES
@@ -61,7 +62,7 @@ def test_returned_frame_takes_the_data_telegrams() -> None:
     assert wire.returned_frame([status, telegrams[0], status, *telegrams[1:]]) == frame
     assert wire.returned_frame([status, status]) is None
     with pytest.raises(ArgumentError, match="telegrams"):
-        wire.returned_frame(b"\x00")
+        wire.returned_frame(b"\x00")  # type: ignore[arg-type]
 
 
 def test_a_woken_chip_s_core_is_followed_only_where_its_line_alone_decides() -> None:
@@ -69,12 +70,21 @@ def test_a_woken_chip_s_core_is_followed_only_where_its_line_alone_decides() -> 
     stretch ends and its receiver begins a telegram, M12); a BK or an LBD chip gives ``None``; ``wake_return``
     refuses chips of indices not woken."""
     chip = Supi3(_config(2_000_000))
-    levels = wire.status_levels(Cycle.DATA, False, 8)
-    out = chip.woken_output(wire.levels_to_samples(levels, 2_000_000).astype(np.int64))
+    chip.set_mfp_inputs(0x33)
+    levels = np.concatenate([wire.status_levels(Cycle.DATA, False, 2),
+                             wire.frame_levels(Frame.build(Cycle.DATA, b"\x5a\x3c\x81")), wire.status_levels(
+                                 Cycle.DATA, False, 4)])  # fmt: skip
+    do1 = wire.levels_to_samples(levels, 2_000_000).astype(np.int64)[37:]  # woken inside a telegram
+    out = chip.woken_output(do1)
     assert out is not None and out[:128].min() == wire.IDLE_LEVEL and out.min() == wire.START_LEVEL
-    bk, lbd = (trees(kind, 1, 2_000_000)[0] for kind in (BranchKind.REMOTE, BranchKind.LBD_OR))
-    assert bk.devices[1].woken_output(np.ones(64, dtype=np.int64)) is None
-    assert lbd.devices[2].woken_output(np.ones(64, dtype=np.int64)) is None
+    n = len(do1)
+    quiet = {"di2": 0, "rbst_ext": 0, "mfp_in": 0x33, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 1, "from_exr": 0}
+    pins = Supi3Pins(_config(2_000_000)).run_forward(
+        {"do1": do1, **{name: np.full(n, value, dtype=np.int64) for name, value in quiet.items()}})
+    assert np.array_equal(out, pins["do2"])  # the same blocks as the pin-level core
+    for kind, index in ((BranchKind.REMOTE, 1), (BranchKind.LBD_OR, 2)):  # the BK; the LBD-OR branch's device
+        device = trees(kind, 1, 2_000_000)[0].devices[index]
+        assert isinstance(device, Supi3) and device.woken_output(np.ones(64, dtype=np.int64)) is None
     frame = Frame.build(Cycle.DATA, b"\x5a\x3c")
     with pytest.raises(ArgumentError, match="chips"):
         wake_return(2_000_000, 2, {0: 128}, 0, frame, None, {1: chip})

@@ -45,12 +45,18 @@ from supi3.expansion import PULSE_T0, ExternalRegisters, end_pulses
 from supi3.interbus import wire
 from supi3.interbus.link import DataKernel
 from supi3.interbus.wire import Cycle
+from supi3.model.blocks.datapath import DataPath
+from supi3.model.blocks.expansion import Expansion
+from supi3.model.blocks.frame import FrameEngine
+from supi3.model.blocks.receiver import Receiver
+from supi3.model.blocks.transmitter import Transmitter
 from supi3.model.bus_terminal import BusTerminal
 from supi3.model.registers import RegisterFile
 from supi3.optical import regulation
 from supi3.optical.length import Medium, timer_code
 from supi3.optical.regulation import Interface, OpticalMode, OpticalStatus, Phase, Response
-from supi3.pinout import OPTICAL_REGISTERS, TIME_BASE_BITS, time_base_end
+from supi3.pinlevel import EventLog
+from supi3.pinout import OPTICAL_REGISTERS, SYNC_STAGES, TIME_BASE_BITS, time_base_end
 from supi3.serial_io import SerialDevice, SerialSequence, clear_sequence, sequence
 from supi3.terminal import BRANCH_SILENCE_CLOCKS, silence_limit
 
@@ -319,22 +325,29 @@ class Supi3:
     # --------------------------------------------------------------------------------------------------------
 
     def woken_output(self, do1: npt.NDArray[np.int64]) -> npt.NDArray[np.int64] | None:
-        """What this chip, powered up at the first clock of the forward line ``do1`` (32 MHz samples; its power-up
-        reset's stretch from there, M2), sends on DO2 over it: its own core's, a fresh
-        :class:`~supi3.model.pins.Supi3Pins` of its configuration with its MFP inputs (the power-up clears the rest,
-        1.7.2), the other inputs quiet. The transaction level's wake-up window follows a woken chip's line with it
-        (``interbus.wake.wake_return``, M28). ``None`` for a BK or an LBD chip, whose DO2 depends on lines ``do1``
-        does not give (the branch's DI3, the counter blocks' return line; M25's limit 1)."""
-        from supi3.model.pins import Supi3Pins  # the pin model drives this class: imported when first needed
-
+        """What this chip, powered up at the first clock of the forward line ``do1`` (32 MHz samples), sends on DO2
+        over it: its core's forward path (the blocks :class:`~supi3.model.pins.Supi3Pins` wires: the synchroniser
+        and receiver, M1, M7, M16; the frame engine and data path, M8, M19; the transmitter, M12) on a fresh chip of its
+        configuration with its MFP inputs (the power-up clears the rest, 1.7.2), its logic running from the end of the
+        reset's stretch (M2). The transaction level's wake-up window follows a woken chip's line with it
+        (``interbus.wake.wake_return``, M28). ``None`` for a BK or an LBD chip, whose DO2 also depends on lines ``do1``
+        does not give (the branch's DI3, the counter blocks, M17, M18; M25's limit 1)."""
         interface = self.config.interface
         if interface.is_bus_terminal or interface in (LineInterface.LBD_MR, LineInterface.LBD_OR):
             return None
-        n = len(do1)
-        ones, zeros = np.ones(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
-        return np.asarray(Supi3Pins(self.config).run_forward({
-            "do1": do1, "di2": zeros, "rbst_ext": zeros, "mfp_in": np.full(n, self.mfp_in, dtype=np.int64),
-            "stat_err_n": ones, "resu_n": ones, "vmon_ok": ones, "from_exr": zeros})["do2"], dtype=np.int64)
+        chip = Supi3(self.config)
+        chip.set_mfp_inputs(self.mfp_in)
+        cpb = wire.clocks_per_bit(self.config.bit_rate)
+        log = EventLog()
+        transmitter = Transmitter(cpb, wire.REPEATER_DELAY_BITS * cpb - SYNC_STAGES, False)
+        frame = FrameEngine(chip, log, DataPath(chip, log, Expansion(chip, cpb)), transmitter)
+        receiver = Receiver(cpb, wire.RESET_DETECT_BITS * cpb, chip, log, frame, transmitter)
+        stretch = round(tables.RESET_MIN_S * tables.CLOCK_HZ)
+        receiver.power_up(stretch)
+        synced = np.concatenate([np.full(SYNC_STAGES, wire.IDLE_LEVEL, dtype=np.int64), do1])  # M1
+        for c in range(stretch, len(do1)):
+            receiver.clock(int(synced[c]), c)
+        return np.asarray(transmitter.render(0, len(do1)), dtype=np.int64)
 
     def power_up(self) -> None:
         """Power-up reset (1.7.2): every register 0, watchdog off, no fault latched (3.4.7)."""
