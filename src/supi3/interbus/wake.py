@@ -8,7 +8,8 @@ chip on the grid and its receiver meets no telegram error, from the receiver its
 (:func:`supi3.interbus.receiver.receive`) run over idle status telegrams. In a tree (M25) the chips follow one another
 along the data path, each at its lag (:func:`path_lags`: a branch's return repeaters and its BK's synchroniser add to
 what follows it), and :attr:`Window.resumed` gives when a woken BK's output, DO3 with DO2, resumes: its branch
-answers a loop later.
+answers a loop later. In :func:`wake_return` a woken chip's line is what its own core sends over it (M28: a chip off
+the grid may open a frame at a misread telegram inside the master's).
 """
 
 from __future__ import annotations
@@ -198,7 +199,7 @@ def wake_return(bit_rate: int, devices: int, wakes: Mapping[int, int], start: in
     line of each chip silent from a wake-up until it resumes sending (its first start level after it began listening,
     M12, then as much later as the next chip's input, ``lags``); the receiver (:func:`supi3.interbus.receiver.receive`)
     takes the line in two pieces, the idle before ``start`` and the cycle, as the pin level's master does. A woken
-    chip of ``chips`` (ring index -> its transaction-level chip, :func:`follows_woken`) sends on what its own core
+    chip of ``chips`` (ring index -> its transaction-level chip, :class:`WokenChip`) sends on what its own core
     sends over its line from its wake-up (:meth:`WokenChip.woken_output`, M28: off the grid its frame engine opens
     frames at misread telegrams, M19).
 
