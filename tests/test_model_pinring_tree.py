@@ -702,6 +702,7 @@ HISTORY_OPS = st.lists(st.tuples(st.sampled_from(["off", "on", "ext", "reset", "
 @example((BranchKind.LBD_MR, 2), [("cut", 4), ("di3", 3)])  # BK-58: a count, then DI3 cut: 0 at both
 @example((BranchKind.LOCAL, 2), [("ret", 4), ("off", 3), ("reset", 3)])  # BK-59: the remote bus's return, into the BK
 @example((BranchKind.LBD_MR, 1), [("off", 3), ("ret", 3), ("on", 3)])  # BK-59: into the RB device from the BK
+@example((BranchKind.LBD_MR, 2), [("off", 3), ("cut", 3), ("reset", 3)])  # BK-66: the review's history, not stuck
 def test_a_master_sees_every_cycle_alike_over_any_history(case: tuple[BranchKind, int], ops: list[tuple[str, int]],
                                                           ) -> None:  # fmt: skip
     """Issue 12: over any history of switching the branch off, on, on with the extended function, INTERBUS resets
@@ -822,3 +823,81 @@ def closes_alike(kind: BranchKind, m: int, ops: list[tuple[str, int]], silence: 
     assert all(isinstance(bk, Supi3) and bk.bus_terminal is not None for bk in bks)
     closures = [bk.bus_terminal.closures for bk in bks if isinstance(bk, Supi3) and bk.bus_terminal is not None]
     assert closures[0] == closures[1] >= 1
+
+
+def statuses(ring: Ring | PinRing, ops: list[tuple[str, int]]) -> list[object]:
+    """Every cycle's success and diagnostic kinds a master (``locate=False``) sees over ``ops``, each followed by
+    three cycles: ``off``, ``on`` (``Master.switch_branch``; ``None`` where the master has no table with the BK),
+    ``start`` (``Master.start``), ``reset`` (``ring.reset()``, then ``Master.start``), ``cut`` (the forward line into
+    physical position ``k``, after idle telegrams: M21), ``repair`` (every break, then idle telegrams: M21)."""
+    master = Master(ring, locate=False, max_devices=8)
+    seen: list[object] = []
+
+    def record(result: CycleResult) -> None:
+        seen.append((result.ok, [d.kind for d in result.diagnostics]))
+
+    def idle() -> None:
+        ring.idle(REPAIR_IDLE_TELEGRAMS * wire.STATUS_TELEGRAM_BITS / ring.bit_rate)
+
+    record(master.start())
+    for op, k in ops:
+        if op in ("start", "reset"):
+            if op == "reset":
+                ring.reset()
+            record(master.start())
+        elif op == "cut":
+            idle()
+            ring.cut(k, True)
+        elif op == "repair":
+            if isinstance(ring, Ring):
+                ring.clear_faults()
+            else:
+                ring.cuts.clear()
+            idle()
+        elif master.config is not None and len(master.config) > 1 and master.config[1].data_bytes == 0:
+            master.switch_branch(2, op == "on")
+        else:
+            seen.append(None)
+        for _ in range(3):
+            record(master.cycle())
+    return seen
+
+
+SWITCHED_OFF_CUT = [("off", 3), ("cut", 3), ("reset", 3)]
+"""The hostile review's history (issue 12): the branch switched off, the forward line into its first device cut,
+then ``reset()`` and ``start()`` (which switches the branch on again, BK-9)."""
+
+
+@pytest.mark.parametrize("kind", [BranchKind.LBD_MR, BranchKind.LBD_OR,
+                                  pytest.param(BranchKind.REMOTE, marks=pytest.mark.slow),
+                                  pytest.param(BranchKind.LOCAL, marks=pytest.mark.slow)])  # fmt: skip
+def test_a_cut_in_a_switched_off_branch_stops_every_kind_alike_after_a_start(kind: BranchKind) -> None:
+    """BK-66: a cut inside a switched-off branch sleeps (BK-1, BK-52): every cycle passes while the branch is off;
+    the reset switches the branch on again (BK-9) and the start fails with a dead line, as every cycle after it, in
+    every kind of branch at both fidelities (the review reported LBD-MR and LBD-OR trees stuck where BK-RB and BK-LB
+    trees ran again: not reproduced, here or over the histories of the next test)."""
+    seen = [statuses(tl_tree(kind, 1), SWITCHED_OFF_CUT), statuses(pin_tree(kind, 1), SWITCHED_OFF_CUT)]
+    passed: tuple[bool, list[ErrorKind]] = (True, [])
+    dead = (False, [ErrorKind.DEAD_LINE])
+    assert seen[0] == seen[1] == [passed] * 7 + [dead] * 4
+
+
+KIND_OPS = st.lists(st.tuples(st.sampled_from(["off", "on", "start", "reset", "cut", "repair"]), st.integers(3, 5)),
+                    min_size=1, max_size=6)  # fmt: skip
+
+
+@settings(max_examples=30, deadline=None, derandomize=True)
+@given(st.integers(1, 3), KIND_OPS)
+@example(2, SWITCHED_OFF_CUT)
+@example(2, [("off", 3), ("cut", 4), ("start", 3), ("repair", 3), ("on", 3)])
+def test_every_kind_of_branch_sees_every_cycle_alike_over_any_history(m: int, ops: list[tuple[str, int]]) -> None:
+    """BK-66 at transaction level over histories of switching the branch off and on, starts, resets, cuts of a line
+    into a branch device (also while the branch is off) and repairs: BK-RB, BK-LB, BK-LBD with LBD-MR and LBD-OR
+    devices give the master the same success and diagnostic kinds in every cycle (an LBD branch's counter telegrams
+    are no frame: a dead line, BK-49). The pin level is compared with it over such histories in
+    :func:`test_a_master_sees_every_cycle_alike_over_any_history` and the test before this one. Histories with the
+    extended function differ by the kind's cycle length alone (an LBD-MR branch's return repeaters, BK-55, move the
+    closure's frame end, BK-50)."""
+    ops = [(op, min(k, 2 + m)) for op, k in ops]
+    seen = [statuses(tl_tree(kind, m), ops) for kind in BranchKind]
+    assert all(other == seen[0] for other in seen[1:]), seen

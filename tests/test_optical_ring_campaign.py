@@ -104,7 +104,8 @@ or ``("ReturnBreak", p, branch)``, the return input into ring position p (``bran
 
 def _cable_faults(ring: OpticalRing, kind: BranchKind | None, k: int) -> tuple[int, int, set[Break], Break | None]:
     """Cable *k*'s ends (ring positions), the break of its forward fibre and that of its return fibre (OPT-47,
-    OPT-58: the return line into the master, line N + 1, for the first cable; none of its own in an LBD-OR branch)."""
+    OPT-58: the return line into the master, line N + 1, for the first cable; in an LBD-OR branch the BK's DI3 for
+    every cable of the branch, OPT-59)."""
     ends = ring.ends(k)
     assert ends is not None
     up, down = ends
@@ -112,7 +113,7 @@ def _cable_faults(ring: OpticalRing, kind: BranchKind | None, k: int) -> tuple[i
     if up == 0:
         back: Break | None = ("DeadLine", len(ring.ring.devices) + 1, False)
     elif kind is BranchKind.LBD_OR and BK_AT < down <= BK_AT + BRANCH:
-        back = None
+        back = ("ReturnBreak", BK_AT, True)
     else:
         back = ("ReturnBreak", up, kind is not None and up == BK_AT and down == BK_AT + 1)
     return up, down, {forward, *([] if back is None else [back])}, back
@@ -237,8 +238,9 @@ def _campaign(scenario: Scenario, cycles: int, seed: int) -> None:
             # BK-7): a pulled connector by its forward line (in an LBD-MR branch the count names the return line)
             for up, down, breaks, back in lines:
                 if faults <= breaks:
-                    counted = scenario.kind is BranchKind.LBD_MR and BK_AT < down <= BK_AT + BRANCH
-                    where = (up, True) if back in faults and counted else (down, False)
+                    counted = scenario.kind is not None and scenario.kind.diagnostics and BK_AT < down <= BK_AT + BRANCH
+                    # the count names the broken return line: in an LBD-OR branch the BK's DI3 (OPT-59)
+                    where = (back[1], True) if back is not None and back in faults and counted else (down, False)
                     if faults == {back} and up == 0:
                         where = (len(ring.ring.devices) + 1, False)  # the return line into the master
                     assert [(d.location, d.return_line) for d in result.diagnostics] == [where], (result, faults)

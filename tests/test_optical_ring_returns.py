@@ -162,6 +162,23 @@ def test_a_dark_return_fibre_in_a_tree_is_a_return_break_at_both_fidelities(kind
     assert [(d[1], d[4]) for d in located[2]] == [(ends[0], True) if in_branch else (ends[1], False)]
 
 
+@pytest.mark.parametrize("k", [3, pytest.param(4, marks=SLOW)])
+def test_a_dark_return_fibre_in_an_lbd_or_branch_is_the_bks_di3_at_both_fidelities(k: int) -> None:
+    """OPT-59: an LBD-OR branch's return fibres carry the loop back from its last chip to the BK (each OR chip passes
+    its DI2 on to DI1, the last loops its DO2 back: the first chip's DI1 is the last chip's DO2, M5), so a dark one,
+    into the first branch chip or into the second, is the BK's DI3 broken: the master sees what it sees on the
+    pin-level ring with ``cut(2, False, branch=True)``, every chip hearing every frame; the transaction level's count
+    0 names the return line into the BK (BK-7). Before, the dead forward line into the cable's far end."""
+    ring, pin = _tree(BranchKind.LBD_OR)
+    seen = _dark(ring, k, False)
+    assert seen == _cut(pin, 2, True)
+    assert isinstance(seen[2], tuple) and seen[2][2][0][0] is ErrorKind.DEAD_LINE
+    leds = seen[5]
+    assert isinstance(leds, list) and [chip[8] for chip in leds] == [1] * 5
+    located = _dark(_tree(BranchKind.LBD_OR)[0], k, True)[2]
+    assert isinstance(located, tuple) and [(d[1], d[4]) for d in located[2]] == [(2, True)]
+
+
 @pytest.mark.parametrize("n", [1, 3])
 def test_the_first_return_fibre_is_the_return_line_into_the_master(n: int) -> None:
     """OPT-58, BK-61: the return fibre of cable 1 carries the return line into the master (line N + 1): every chip

@@ -9,8 +9,8 @@ import numpy.typing as npt
 
 from supi3.checks import check_choice, check_int, check_trace
 from supi3.interbus import wire
-from supi3.interbus.errors import TelegramError
-from supi3.interbus.wire import LineReset, Telegram
+from supi3.interbus.errors import InterbusError, TelegramError
+from supi3.interbus.wire import Cycle, LineReset, Telegram
 from supi3.tables import BIT_RATES
 
 
@@ -78,3 +78,36 @@ def _next_edge(edges: npt.NDArray[np.intp], i: int, n: int) -> int:
     """The first index after ``i`` where the level changes (``n``: none before the end of the trace)."""
     k = int(np.searchsorted(edges, i, side="right"))
     return int(edges[k]) if k < len(edges) else n
+
+
+def frame_start(samples: npt.NDArray[np.integer], cpb: int, cycle: Cycle, data_bytes: int) -> int | None:
+    """Where a whole frame of ``cycle`` with ``data_bytes`` bytes in its data sequence begins on a line: the index of
+    its first start bit in ``samples`` (32 MHz samples of one line, at ``cpb`` clocks per bit), or ``None`` if no
+    such frame lies whole in the trace. Its telegrams follow one another without a gap (``wire.frame_bits``), so
+    bit period ``b`` of the frame (``wire.locate_bit``) spans ``cpb`` samples from the start plus ``b * cpb``.
+
+    A start is a sample at the start level after the idle or stop level (or the trace's first, at the start level)
+    from which :func:`receive` reads the whole frame, telegram after telegram, and nothing else: a telegram read
+    from within another (the trace may begin inside one) does not continue into a frame.
+    """
+    telegrams = data_bytes + wire.CHECK_TELEGRAMS
+    length = wire.DATA_TELEGRAM_BITS * telegrams * cpb
+    low = samples == wire.START_LEVEL
+    starts = np.flatnonzero(low[1:] & ~low[:-1]) + 1
+    candidates = ([0] if len(samples) and low[0] else []) + starts[starts <= len(samples) - length].tolist()
+    mid = cpb // 2
+    for at in candidates:
+        if samples[at + mid + wire.POS_TYPE * cpb] != wire.TYPE_DATA_LEVEL \
+                or samples[at + mid + (wire.DATA_TELEGRAM_BITS - 1) * cpb] != wire.STOP_LEVEL:
+            continue  # no data telegram begins here
+        found, end, error = receive(samples[at : at + length], 0, cpb)
+        if error or end != length or len(found) != telegrams:
+            continue
+        try:
+            frame = wire.frame_from_telegrams(found)
+        except InterbusError:
+            continue
+        if frame.cycle is cycle and len(frame.data) == data_bytes and isinstance(found[0], Telegram) \
+                and wire.opens_frame(found[0]):
+            return int(at)
+    return None

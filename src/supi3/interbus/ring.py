@@ -41,7 +41,7 @@ from itertools import accumulate
 from operator import attrgetter, sub
 from typing import Final, NamedTuple, Protocol, runtime_checkable
 
-from supi3.checks import check_bool, check_instance, check_int, check_real, fail
+from supi3.checks import check_bool, check_bytes, check_instance, check_int, check_real, fail
 from supi3.config import DeviceConfig, Interface
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusArgumentError, InterbusError, TelegramError
@@ -682,6 +682,23 @@ class Bus(Protocol):
         ...
 
 
+def check_transfer(cycle: object, data: object, close_after: object) -> tuple[bytes, int | None]:
+    """The checks of a :class:`Bus`'s ``transfer``, made before the ring changes anything (a refused call leaves no
+    trace: no branch recognised, no repair forgotten, no fibre's bit error drawn): ``cycle`` a :class:`Cycle`,
+    ``data`` bytes (a ``bytes``, ``bytearray`` or ``memoryview``: an integer is no frame of that many zero bytes),
+    ``close_after`` ``None`` or an integer from 0; ``data`` as ``bytes`` and ``close_after`` as an ``int``.
+
+    Raises
+    ------
+    ArgumentError
+        One of them is not what it must be.
+    """
+    if type(cycle) is not Cycle:
+        check_instance("cycle", cycle, Cycle)
+    stream = data if type(data) is bytes else check_bytes("data", data)
+    return stream, None if close_after is None else check_int("close_after", close_after, 0)
+
+
 def check_finish(transfer: object, pending: Transfer | None, latch: object) -> bool:
     """The checks of a :class:`Bus`'s ``finish``: ``transfer`` must be ``pending``, the :class:`Transfer` the ring's
     last ``transfer`` returned and no ``finish``, ``reset`` or ``idle`` has ended since (a cycle ends once, on the ring
@@ -1092,6 +1109,26 @@ class Ring:
             if at < self.now:
                 self._passed.setdefault(id(branch.terminal), set()).add(id(active))
 
+    def bit_error(self, position: int, bit: int, cycles: int | None = 1) -> None:
+        """Invert bit period ``bit`` of the frame on the forward line into the device at ``position``, numbered as
+        :meth:`cut` numbers it (the physical position in every state, BK-52; N + 1: the return line into the master),
+        in the next ``cycles`` cycles whose data path holds that line (``None``: every one): a :class:`BitFlip` on
+        that device's line, which follows it when positions move and sleeps while it is out of the data path (BK-1).
+        ``PinRing.bit_error <supi3.model.pinring.PinRing.bit_error>`` is its pin-level twin, with the same arguments
+        (BK-65).
+
+        Raises
+        ------
+        ArgumentError
+            ``position`` not from 1 to N + 1 (N: every device of the tree), ``bit`` not an integer >= 0 or ``cycles``
+            not ``None`` or an integer >= 1; nothing changes.
+        """
+        every = _devices(self._tree)
+        position = check_int("position", position, 1, len(every) + 1,
+                             "a device of the tree, or N + 1: the return line into the master")  # fmt: skip
+        flip = BitFlip(position, bit, cycles)
+        self._faults.append(_Active(flip, flip.cycles, every[position - 1] if position <= len(every) else None))
+
     def clear_faults(self) -> None:
         """Remove every injected fault (a repair: in a tree the breaks removed decide the error of a cycle a branch
         joins within, BK-56)."""
@@ -1268,8 +1305,7 @@ class Ring:
         Transfer
             Hand it to :meth:`finish` with the master's verdict.
         """
-        if type(cycle) is not Cycle:
-            check_instance("cycle", cycle, Cycle)
+        data, close_after = check_transfer(cycle, data, close_after)
         # A branch answering in this run joins the data path within its frame (BK-54): what leaves its BK is cut.
         joined = self._recognise(frame=wire.frame_bits(len(data))) if self._branches else []
         spliced = self._join_error(joined) if joined else None  # BK-56: the error of a branch joining the frame
@@ -1279,7 +1315,7 @@ class Ring:
         if n_all > wire.MAX_DEVICES:
             raise InterbusError("docs/interbus.md, Ring", n_all, f"a ring has at most {wire.MAX_DEVICES} devices")
         # A position beyond the ring (the master's table may be older than the ring) closes it at its last device.
-        n = n_all if close_after is None else min(check_int("close_after", close_after, 0), n_all)
+        n = n_all if close_after is None else min(close_after, n_all)
         # Closed after a position (even the last), the ring returns inside that device: the return line N + 1
         # is only part of the whole ring (close_after=None), so a fault there is told from one on line N.
         segments = n + 1 if close_after is None else n

@@ -43,8 +43,9 @@ from supi3.checks import (
 from supi3.config import DeviceConfig
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusError
-from supi3.interbus.receiver import receive
+from supi3.interbus.receiver import frame_start, receive
 from supi3.interbus.ring import (
+    BitFlip,
     Branch,
     BranchKind,
     ErrorKind,
@@ -157,6 +158,15 @@ def _in_path(items: Sequence[PinChip | PinBranch]) -> list[PinChip]:
     return found
 
 
+@dataclass
+class _BitError:
+    """A bit error :meth:`PinRing.bit_error` injected: its line, the frame's bit period, the cycles left."""
+
+    position: int
+    bit: int
+    remaining: int | None
+
+
 IDLE_PIECE_TELEGRAMS: Final[int] = 64
 """The status telegrams :meth:`PinRing.idle` runs at a time (under 2 ms of bus time at 500 kbit/s): memory stays
 bounded over an idle of any length, as every chip's pin traces of one run are held at once (about 260 bytes a clock:
@@ -231,6 +241,12 @@ class PinRing:
         """What the last :meth:`transfer` returned, until :meth:`finish`, :meth:`reset` or :meth:`idle`."""
         self.branch_cuts: set[int] = set()
         """Positions of BKs whose branch return input DI3 is broken: see :meth:`cut`."""
+        self.bit_errors: list[_BitError] = []
+        """Bit errors still to hit a frame: see :meth:`bit_error`."""
+        self._hits: dict[int, list[int]] = {}
+        """The frame bit periods inverted on each line in the transfer running now (:meth:`bit_error`)."""
+        self._frame: tuple[Cycle, int] = (Cycle.DATA, 0)
+        """The cycle and data sequence length of the frame the transfer running now sends."""
         self._terminals = terminal_positions(transaction_level)
         self._inputs = [
             {"di2": 0, "rbst_ext": 0, "mfp_in": 0, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 1, "from_exr": 0}
@@ -302,6 +318,52 @@ class PinRing:
                        position)  # fmt: skip
         self.cuts.add((position, forward))
 
+    def bit_error(self, position: int, bit: int, cycles: int | None = 1) -> None:
+        """Invert bit period ``bit`` of the frame (0: its first start bit, ``wire.locate_bit``) on the forward line
+        into the chip at ring ``position`` (numbered as :meth:`cut`; N + 1: the return line into the master), in the
+        next ``cycles`` transfers (``None``: every one) whose data path holds that line: the pin-level twin of
+        ``ring.Ring.bit_error`` (``ring.BitFlip`` by physical position, BK-65). The line's level is inverted for the
+        ``clocks_per_bit`` samples of that bit period where the frame passes the line (``receiver.frame_start``); a
+        bit period past the frame's end, or a line the whole frame does not reach in that transfer, is not hit (the
+        transfer counts).
+
+        Raises
+        ------
+        ArgumentError
+            ``position`` not from 1 to N + 1, ``bit`` not an integer >= 0 or ``cycles`` not ``None`` or an integer
+            >= 1; nothing changes.
+        """
+        position = check_int("position", position, 1, len(self.devices) + 1,
+                             "a chip of the ring, or N + 1: the return line into the master")  # fmt: skip
+        flip = BitFlip(position, bit, cycles)  # the transaction level's checks of bit and cycles
+        self.bit_errors.append(_BitError(position, flip.bit, flip.cycles))
+
+    def _aim(self, cycle: Cycle, data_bytes: int) -> None:
+        """The bit errors that hit this transfer's frame (:meth:`bit_error`): each on a line in the data path now
+        counts one of its cycles."""
+        lines = {id(chip) for chip in _in_path(self.tree)}
+        self._hits = {}
+        self._frame = (cycle, data_bytes)
+        every = [*self.devices, None]
+        for error in self.bit_errors:
+            chip = every[error.position - 1]
+            if chip is None or id(chip) in lines:
+                self._hits.setdefault(error.position, []).append(error.bit)
+                error.remaining = None if error.remaining is None else error.remaining - 1
+        self.bit_errors = [e for e in self.bit_errors if e.remaining is None or e.remaining > 0]
+
+    def _hit(self, line: npt.NDArray[np.int64], position: int) -> npt.NDArray[np.int64]:
+        """``line`` with this transfer's bit errors on the line into ``position`` (:meth:`bit_error`)."""
+        start = frame_start(line, self.cpb, *self._frame)
+        if start is None:
+            return line
+        hit = line.copy()
+        for bit in self._hits[position]:
+            if bit < wire.frame_bits(self._frame[1]):
+                at = start + bit * self.cpb
+                hit[at : at + self.cpb] ^= 1
+        return hit
+
     def run_levels(self, levels: npt.NDArray[np.uint8]) -> None:
         """Send master line levels (one per bit period, 0 or 1) through the ring."""
         checked = check_trace("levels", levels, 1)
@@ -321,6 +383,8 @@ class PinRing:
         back = self._back(sent, np.zeros(n, dtype=np.int64), chunk)
         if (len(self.devices) + 1, True) in self.cuts:  # the return line into the master (BK-61)
             back = np.full(n, wire.IDLE_LEVEL, dtype=np.int64)
+        elif len(self.devices) + 1 in self._hits:
+            back = self._hit(back, len(self.devices) + 1)
         if chunk is not None:
             self._chunks.append([chunk[k] for k in range(1, len(self.devices) + 1)])
         self.cycle += n
@@ -366,7 +430,11 @@ class PinRing:
         on DI3."""
         n = len(line)
         traces = {name: np.full(n, value, dtype=np.int64) for name, value in self._inputs[position - 1].items()}
-        traces["do1"] = np.full(n, wire.IDLE_LEVEL, dtype=np.int64) if (position, True) in self.cuts else line
+        if (position, True) in self.cuts:
+            line = np.full(n, wire.IDLE_LEVEL, dtype=np.int64)
+        elif position in self._hits:
+            line = self._hit(line, position)
+        traces["do1"] = line
         traces["di2"] = np.zeros(n, dtype=np.int64)  # the return line comes in _back
         if di3 is not None:
             traces["mfp_in"] = traces["mfp_in"] & ~(1 << DI3_PIN) | di3 << DI3_PIN
@@ -446,7 +514,12 @@ class PinRing:
         frame = Frame.build(cycle, data)
         loops = return_repeaters(path)
         delay = wire.ring_delay_status_telegrams(n, loops)
-        self.run_levels(np.concatenate([wire.frame_levels(frame), wire.status_levels(cycle, False, delay)]))
+        if self.bit_errors:
+            self._aim(cycle, len(data))
+        try:
+            self.run_levels(np.concatenate([wire.frame_levels(frame), wire.status_levels(cycle, False, delay)]))
+        finally:
+            self._hits = {}
         telegrams, error = self._received()
         receiver_error: ErrorKind | None = ErrorKind.TELEGRAM if error else None
         returned: bytes | None = None

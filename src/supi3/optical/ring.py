@@ -28,8 +28,9 @@ and the light that no longer gets through into ring faults the master locates.
 * **Trees** (OPT-54): the chips may hold :class:`~supi3.interbus.ring.Branch` items; a bus terminal module's branch
   interface sends the cable into its branch's first device, its outgoing interface the cable into the device after
   the branch. A dark return fibre in a branch with return lines is the branch's return line into the upstream device
-  too, so the counter telegram of an LBD branch names the exact fibre; in an LBD-OR branch (no return lines) both
-  fibres are the line into the downstream device; cables out of the data path carry no faults and no tests.
+  too, so the counter telegram of an LBD branch names the exact fibre; in an LBD-OR branch the return fibres carry
+  the loop back from its last device to the BK, so a dark one is the break of the BK's DI3 (OPT-59); cables out of
+  the data path carry no faults and no tests.
 * **Diagnostics**: MAU warning changes are reported (:attr:`OpticalRing.reports`, 1.6.3), every path's levels are
   kept over time (:attr:`OpticalRing.history`), and :func:`diagnostic_table` is the master's optical diagnostic
   table of Figure 1-10, read from registers 8 to 11 (3.4.12, 3.4.13).
@@ -47,7 +48,7 @@ from supi3.config import DeviceConfig
 from supi3.interbus import wire
 from supi3.interbus.link import Device
 from supi3.interbus.master import Master
-from supi3.interbus.ring import BitFlip, Branch, BranchKind, DeadLine, ReturnBreak, Ring, Transfer
+from supi3.interbus.ring import BitFlip, Branch, BranchKind, DeadLine, ReturnBreak, Ring, Transfer, check_transfer
 from supi3.interbus.wire import Cycle
 from supi3.optical.length import Medium, length_m
 from supi3.optical.link import Direction, FibreLink, LightState
@@ -289,7 +290,7 @@ class OpticalRing:
 
     def transfer(self, cycle: Cycle, data: bytes, close_after: int | None = None) -> Transfer:
         """See :meth:`supi3.interbus.ring.Ring.transfer`; the fibres' faults at the current bus time come first."""
-        check_instance("cycle", cycle, Cycle)
+        data, close_after = check_transfer(cycle, data, close_after)  # before the fibres draw their bit errors
         self._faults(wire.frame_bits(len(data)))
         return self.ring.transfer(cycle, data, close_after)
 
@@ -345,10 +346,12 @@ class OpticalRing:
         the downstream chip; the return fibre is the return line out of the downstream chip: into the master (line
         N + 1) for the first cable of the remote bus, into the BK's branch return input (DI3) for a branch's first
         cable, else into the upstream chip from the one behind it (the return input ``Ring.cut`` breaks, BK-59); in an
-        LBD-OR branch (no return lines) the line into the downstream chip too."""
+        LBD-OR branch the loop back to its BK: the BK's DI3 for every cable of the branch (OPT-59)."""
         down = at[id(cable.downstream)]
-        if direction is Direction.FORWARD or cable.kind is BranchKind.LBD_OR:
+        if direction is Direction.FORWARD:
             return _Break(DeadLine(down), 0, False)
+        while cable.kind is BranchKind.LBD_OR and cable.interface is not Interface.BRANCH:
+            cable = self._into[id(cable.upstream)]  # up the branch to its first cable, sent by the BK
         if cable.upstream is None:
             return _Break(DeadLine(len(at) + 1), 0, False)
         return _Break(ReturnBreak(at[id(cable.upstream)]), self._physical[id(cable.upstream)],
