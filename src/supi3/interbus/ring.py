@@ -46,7 +46,7 @@ from supi3.config import DeviceConfig, Interface
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusArgumentError, InterbusError, TelegramError
 from supi3.interbus.link import DataKernel, Device
-from supi3.interbus.wake import Counters, counter_return, path_lags, reset_ready, wake_window
+from supi3.interbus.wake import Counters, WokenChip, counter_return, path_lags, reset_ready, wake_window
 from supi3.interbus.wire import Cycle, Frame
 from supi3.pinlevel import SYNC_STAGES
 from supi3.tables import CLOCK_HZ, RESET_MIN_S
@@ -798,6 +798,9 @@ class Ring:
         self._answers: dict[int, float] = {}
         """M25: ``id`` of a BK powered up by :meth:`power_up` -> bus time its branch's first start level is back on its
         synchronised DI3 (BK-37): its branch answers from then."""
+        self._passed: dict[int, set[int]] = {}
+        """BK-64: ``id`` of a BK with an answer due -> ``id`` of the breaks of its loop made after its start level
+        passed them (:meth:`_pass_cut`): not in that answer's way."""
         self._woke_joins: set[int] = set()
         """M25: ``id`` of the BKs whose branch joins the data path within this cycle's frame after their power-up."""
         self._grid = 0.0
@@ -894,6 +897,11 @@ class Ring:
                 at = self._index.get(id(branch.terminal))
                 reached = at is not None and (dead is None or dead > at + 1) and branch.terminal.branch_enabled(True)
                 due = self._answers.get(id(branch.terminal))
+                passed = self._passed.get(id(branch.terminal)) if due is not None else None
+                loop = (forward, back) if not passed else (  # BK-64: breaks its start level passed are no break
+                    {id(a.target) for a in self._faults if isinstance(a.fault, DeadLine) and id(a) not in passed},
+                    {(id(a.target), a.branch) for a in self._faults
+                     if isinstance(a.fault, ReturnBreak) and id(a) not in passed})  # fmt: skip
                 head = now
                 if due is not None and frame is not None and at is not None:
                     # the frame's head leaving the BK: DO2 leaves its transmitter's line between telegrams (BK-47)
@@ -902,18 +910,22 @@ class Ring:
                         continue
                 elif due is not None and due > now:
                     continue
-                if (branch.kind.diagnostics or reached) and self._loop_whole(branch, forward, back):
+                if (branch.kind.diagnostics or reached) and self._loop_whole(branch, *loop):
                     branch.terminal.recognise_branch()
                     self._answers.pop(id(branch.terminal), None)
+                    self._passed.pop(id(branch.terminal), None)
                     found = True
-                    if due is not None and frame is not None and due <= head:
-                        continue  # M25: joined before the frame, between telegrams (BK-47)
+                    if due is not None and frame is not None and (due <= head or branch.terminal.branch_enabled(False)):
+                        # M25: joined before the frame, between telegrams (BK-47); M29: or in the data path without
+                        # an answer (present by LBST, Table 2-9): DO2 repeats DI3 from the wake-up, nothing joins
+                        continue
                     if due is not None:
                         self._woke_joins.add(id(branch.terminal))
                     recognised.append(branch)
                 elif due is not None and due <= now:
                     # M25: nothing came back at the answer instant (a broken loop): it answers as any branch after
                     self._answers.pop(id(branch.terminal))
+                    self._passed.pop(id(branch.terminal), None)
             if not found:
                 return recognised
 
@@ -1029,6 +1041,8 @@ class Ring:
                                     "that has a device behind it (not the last of the ring or of a branch, none in "
                                     "an LBD-OR branch)")  # fmt: skip
         self._faults.append(_Active(fault, fault.cycles, target, branch))
+        if self._answers:
+            self._pass_cut(self._faults[-1])
 
     def cut(self, position: int, forward: bool, *, branch: bool = False) -> None:
         """Break a line for good, numbered as :meth:`PinRing.cut <supi3.model.pinring.PinRing.cut>` numbers it, by the
@@ -1067,6 +1081,35 @@ class Ring:
                        "BK-59)", position)  # fmt: skip
         fault: Fault = DeadLine(position) if forward else ReturnBreak(position)
         self._faults.append(_Active(fault, None, every[position - 1] if position <= len(every) else None, branch))
+        if self._answers:
+            self._pass_cut(self._faults[-1])
+
+    def _pass_cut(self, active: _Active) -> None:
+        """BK-64: a BK powered up whose answer is due (M25) answers through a break of its branch's loop made after its
+        first start level passed the broken line (in the repeaters behind, it comes back on DI3 all the same, BK-37):
+        a forward line once the device behind has sampled it mid-bit (M7), a return line or DI3 (wires, M5) once it
+        began. A branch of devices with return lines (BK-RB, BK-LB; LBD branches answer by counter telegrams, BK-30)
+        and no nested branch; the start level reaches the branch's first device a loop (:meth:`_loop_clocks`) before
+        the answer, then the next a repeater later (A10), and comes back on the return lines from the last device's
+        output."""
+        cpb = wire.clocks_per_bit(self.bit_rate)
+        delay = wire.REPEATER_DELAY_BITS * cpb
+        for branch in self._branches:
+            due = self._answers.get(id(branch.terminal))
+            if due is None or branch.kind.diagnostics or any(isinstance(item, Branch) for item in branch.devices):
+                continue
+            out = due - self._loop_clocks(branch) / CLOCK_HZ  # the start level at the first device's input
+            ids = [id(device) for device in branch.devices]
+            if isinstance(active.fault, DeadLine) and id(active.target) in ids:
+                at = out + (ids.index(id(active.target)) * delay + cpb // 2) / CLOCK_HZ
+            elif isinstance(active.fault, ReturnBreak) and not active.branch and id(active.target) in ids:
+                at = out + len(ids) * delay / CLOCK_HZ
+            elif isinstance(active.fault, ReturnBreak) and active.branch and active.target is branch.terminal:
+                at = due - SYNC_STAGES / CLOCK_HZ
+            else:
+                continue
+            if at < self.now:
+                self._passed.setdefault(id(branch.terminal), set()).add(id(active))
 
     def bit_error(self, position: int, bit: int, cycles: int | None = 1) -> None:
         """Invert bit period ``bit`` of the frame on the forward line into the device at ``position``, numbered as
@@ -1094,6 +1137,7 @@ class Ring:
         if self._branches:
             self._repaired += [a for a in self._faults if isinstance(a.fault, (DeadLine, ReturnBreak))]
         self._faults.clear()
+        self._passed.clear()
 
     def _join_error(self, joined: list[Branch]) -> ErrorKind | None:
         """The error of a cycle within whose frame the branches ``joined`` join (BK-54): by the first line of the
@@ -1376,8 +1420,9 @@ class Ring:
             returned = stream
         if woken is not None and returned is not None:  # M22: the master's receiver, bit by bit in the window
             wakes, start, lags = woken
+            chips = {index: device for index in wakes if isinstance(device := self.devices[index], WokenChip)}
             error, opened, dropped = counter_return(self.bit_rate, len(self.devices), wakes, start,
-                                                Frame.build(cycle, returned), lags, *self._counter_lines())
+                                                Frame.build(cycle, returned), lags, *self._counter_lines(), chips=chips)
             unheard = unheard or error
             returned = returned if opened else None
         if unheard:  # not on the telegram grid yet: no fault of the return line N + 1

@@ -8,7 +8,8 @@ chip on the grid and its receiver meets no telegram error, from the receiver its
 (:func:`supi3.interbus.receiver.receive`) run over idle status telegrams. In a tree (M25) the chips follow one another
 along the data path, each at its lag (:func:`path_lags`: a branch's return repeaters and its BK's synchroniser add to
 what follows it), and :attr:`Window.resumed` gives when a woken BK's output, DO3 with DO2, resumes: its branch
-answers a loop later.
+answers a loop later. In :func:`wake_return` a woken chip's line is what its own core sends over it (M28: a chip off
+the grid may open a frame at a misread telegram inside the master's).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from __future__ import annotations
 import functools
 import itertools
 from collections.abc import Mapping, Sequence
-from typing import NamedTuple
+from typing import NamedTuple, Protocol, runtime_checkable
 
 import numpy as np
 import numpy.typing as npt
@@ -35,7 +36,10 @@ from supi3.interbus.errors import InterbusError
 from supi3.interbus.receiver import receive
 from supi3.interbus.wire import Cycle, Frame, Telegram
 from supi3.pinlevel import SYNC_STAGES
+from supi3.tables import CLOCK_HZ, RESET_MIN_S
 
+_STRETCH_CLOCKS = round(RESET_MIN_S * CLOCK_HZ)
+"""The power-up reset's stretch (M2, 1.7.2): a chip's logic runs this many clocks after its power-up."""
 _PROBE_TELEGRAMS = 64
 """Idle status telegrams the receiver is run over: far more than it needs to find the grid (M16: within two)."""
 
@@ -203,7 +207,8 @@ def wake_window(bit_rate: int, devices: int, wakes: Mapping[int, int], lags: Seq
 
 
 def wake_return(bit_rate: int, devices: int, wakes: Mapping[int, int], start: int,
-                frame: Frame, lags: Sequence[int] | None = None) -> tuple[bool, bool]:
+                frame: Frame, lags: Sequence[int] | None = None,
+                chips: Mapping[int, WokenChip] | None = None) -> tuple[bool, bool]:
     """What the master's receiver makes of a cycle in the window after chips of a flat ring woke up (M22): whether it
     meets a telegram error, and whether a telegram that opens a frame comes back (else a dead line).
 
@@ -211,12 +216,16 @@ def wake_return(bit_rate: int, devices: int, wakes: Mapping[int, int], start: in
     (counted as in :func:`wake_window`) ``frame`` as it comes back and the ring delay's status telegrams (A11), the
     line of each chip silent from a wake-up until it resumes sending (its first start level after it began listening,
     M12, then as much later as the next chip's input, ``lags``); the receiver (:func:`supi3.interbus.receiver.receive`)
-    takes the line in two pieces, the idle before ``start`` and the cycle, as the pin level's master does.
+    takes the line in two pieces, the idle before ``start`` and the cycle, as the pin level's master does. A woken
+    chip of ``chips`` (ring index -> its transaction-level chip, :class:`WokenChip`) sends on what its own core
+    sends over its line from its wake-up (:meth:`WokenChip.woken_output`, M28: off the grid its frame engine opens
+    frames at misread telegrams, M19).
 
     Raises
     ------
     ArgumentError
-        As :func:`wake_window`; ``start`` not an integer clock, ``frame`` not a :class:`~supi3.interbus.wire.Frame`.
+        As :func:`wake_window`; ``start`` not an integer clock, ``frame`` not a :class:`~supi3.interbus.wire.Frame`,
+        ``chips`` not a mapping of woken ring indices (keys of ``wakes``) to :class:`WokenChip` objects.
     """
     devices, lags = _check(bit_rate, devices, wakes, lags)
     start = check_int("start", start)
@@ -226,6 +235,7 @@ def wake_return(bit_rate: int, devices: int, wakes: Mapping[int, int], start: in
     origin = min(0, start, *wakes.values()) // telegram * telegram  # followed from a telegram boundary
     sent = _cycle_line(bit_rate, lags, start, origin, frame)
     end = len(sent)
+    chips = _check_chips(chips, wakes)
     resumed: int | None = None
     for index in range(devices):
         listen = wakes.get(index)
@@ -233,6 +243,10 @@ def wake_return(bit_rate: int, devices: int, wakes: Mapping[int, int], start: in
             listen = resumed if listen is None else max(listen, resumed)
         if listen is not None:
             first = _first_start(sent[max(0, listen - origin - lags[index]):], cpb)
+            if index in chips:  # M28: the woken chip's own core over its line (silent before the chip before resumed)
+                if resumed is not None:
+                    sent[: max(0, resumed - origin - lags[index])] = wire.IDLE_LEVEL
+                sent = _woken_line(chips[index], sent, listen - origin - lags[index], bit_rate)
             resumed = listen + (end if first is None else first) + lags[index + 1] - lags[index]
     lag = lags[devices]
     line = np.full(end, wire.IDLE_LEVEL, dtype=np.int64)  # the master's line: the last chip's, no further delay
@@ -262,10 +276,54 @@ def _master_reads(line: npt.NDArray[np.int64], start: int, cpb: int) -> tuple[bo
     _, index, _ = receive(line[:start], 0, cpb)
     telegrams, _, error = receive(line, index, cpb)
     try:  # a frame comes back only if the master assembles one (as the pin level's master, PinRing.transfer)
-        wire.frame_from_telegrams(telegrams)
+        back = wire.returned_frame(telegrams)
     except InterbusError:
         return error, False
-    return error, True
+    return error, back is not None
+
+
+@runtime_checkable
+class WokenChip(Protocol):
+    """A chip whose own core :func:`wake_return` runs over its line after its power-up (M28):
+    :class:`supi3.model.chip.Supi3`."""
+
+    def woken_output(self, do1: npt.NDArray[np.int64]) -> npt.NDArray[np.int64] | None:
+        """What the chip, powered up at ``do1``'s first clock, sends on DO2 over the forward line ``do1``; ``None``:
+        not followed (its output depends on other lines)."""
+
+
+def _check_chips(chips: Mapping[int, WokenChip] | None, wakes: Mapping[int, int]) -> dict[int, WokenChip]:
+    if chips is None:
+        return {}
+    if not isinstance(chips, Mapping) or not all(
+            index in wakes and isinstance(chip, WokenChip) for index, chip in chips.items()):
+        raise fail("chips", "a mapping of woken ring indices (keys of wakes) to chips with woken_output", chips, "M28")
+    return dict(chips)
+
+
+def _woken_line(chip: WokenChip, line: npt.NDArray[np.int64], wake: int, bit_rate: int) -> npt.NDArray[np.int64]:
+    """M28: ``line`` (the master's line as the woken chip's input sees it: index ``i`` there ``i`` clocks after the
+    line's first, a telegram boundary of the master's idle) as the chip sends it on, in the same clocks (its repeater's
+    delay, A10, is in the lags of the chips behind): the chip's DO2 (:meth:`WokenChip.woken_output`), its logic
+    running from index ``wake``, the end of its stretch (M2), seeing that index first through its synchroniser (M1);
+    ``line`` itself for a chip not followed."""
+    cpb = wire.clocks_per_bit(bit_rate)
+    delay = wire.REPEATER_DELAY_BITS * cpb
+    first = wake - (_STRETCH_CLOCKS - SYNC_STAGES)  # the power-up: the run's first index
+    size = len(line) + delay - first
+    at = np.arange(first, first + size)
+    do1 = np.full(size, wire.IDLE_LEVEL, dtype=np.int64)
+    inside = (at >= 0) & (at < len(line))
+    do1[inside] = line[at[inside]]
+    before = at < 0  # before the line followed: the master's idle status telegrams, periodic from its first index
+    do1[before] = _idle_samples(bit_rate)[at[before] % (wire.STATUS_TELEGRAM_BITS * cpb)]
+    sent = chip.woken_output(do1)
+    if sent is None:
+        return line
+    out = np.full(len(line), wire.IDLE_LEVEL, dtype=np.int64)
+    lo = max(0, first - delay)  # DO2 at the run's index p: the line's index p + first - delay
+    out[lo:] = sent[lo + delay - first : len(line) + delay - first]
+    return out
 
 
 _SHORT_HOLD_BITS = 12
@@ -390,7 +448,8 @@ def _later(line: npt.NDArray[np.int64], clocks: int) -> npt.NDArray[np.int64]:
 
 
 def _follow(cpb: int, wakes: Mapping[int, int], downs: Mapping[int, int], lags: Sequence[int], counters: Counters,
-            sent: npt.NDArray[np.int64]) -> tuple[list[npt.NDArray[np.int64]], list[tuple[npt.NDArray[np.int64], int]]]:
+            sent: npt.NDArray[np.int64], chips: Mapping[int, WokenChip] | None = None,
+            ) -> tuple[list[npt.NDArray[np.int64]], list[tuple[npt.NDArray[np.int64], int]]]:
     """M26: the line into each chip of the data path and into the master's receiver (the last), from ``sent``, the
     master's line from a telegram boundary, all indexed alike (``wakes``, ``downs`` in those indices; every chip on the
     telegram grid before the first power-down, ``lags`` behind the master's line: a block is reset at its line's first
@@ -402,8 +461,9 @@ def _follow(cpb: int, wakes: Mapping[int, int], downs: Mapping[int, int], lags: 
     repeating it (BK-37). A woken chip's blocks idle from its power-down and run afresh from its wake-up (M2). What the
     master sent before a chip's power-down is followed as idle status telegrams (the last cycle's have other bits), so
     a woken chip listens from its wake-up or, if later, from when the master's line of its power-down's instant
-    reaches it (M22's reading: the line followed from then). Second, each block's ``drive`` and the lag of its output
-    behind the master's line."""
+    reaches it (M22's reading: the line followed from then). A woken chip of ``chips`` sends what its own core sends
+    over its line from its power-down on (M28, :func:`_woken_line`). Second, each block's ``drive`` and the lag of its
+    output behind the master's line."""
     n = len(sent)
     delay = wire.REPEATER_DELAY_BITS * cpb
     returns = dict(counters.returns)
@@ -428,6 +488,10 @@ def _follow(cpb: int, wakes: Mapping[int, int], downs: Mapping[int, int], lags: 
             listen = max(wakes[index], downs[index] + lags[index])
             start = _first_start(line[listen:], cpb)
             out[downs[index] : n if start is None else listen + start + delay] = wire.IDLE_LEVEL
+            if chips and index in chips:  # M28: its own core over its line
+                own = _woken_line(chips[index], line, wakes[index], CLOCK_HZ // cpb)
+                if own is not line:
+                    out[downs[index] :] = _later(own, delay)[downs[index] :]
         if index in counters.forward:
             counted, drive = block(line, lags[index], index)
             out = np.where(drive == 1, counted, out)
@@ -509,12 +573,12 @@ def _counter_window(bit_rate: int, wakes: tuple[tuple[int, int], ...], downs: tu
 
 def counter_return(bit_rate: int, devices: int, wakes: Mapping[int, int], start: int, frame: Frame,
                    lags: Sequence[int] | None, counters: Counters, downs: Mapping[int, int] | None = None,
-                   ) -> tuple[bool, bool, bool]:
+                   chips: Mapping[int, WokenChip] | None = None) -> tuple[bool, bool, bool]:
     """:func:`wake_return` with the counter blocks of LBD chips along the data path (M26: ``counters``; ``downs``: the
     clock each woken chip's power-down began, its outputs silent from then, else the master's idle's start) over the
     lines :func:`_follow` gives; and, third, whether a block drove the line inside the frame (BK-30: a telegram
     dropped while it generates one), which the chip behind it takes as a local error (the frame comes back with its
-    CNTR's ERR set).
+    CNTR's ERR set). A woken chip of ``chips`` sends what its own core sends (M28), as in :func:`wake_return`.
 
     Raises
     ------
@@ -526,14 +590,15 @@ def counter_return(bit_rate: int, devices: int, wakes: Mapping[int, int], start:
     start = check_int("start", start)
     check_instance("frame", frame, Frame)
     checked = _check_counters(devices, wakes, counters, downs)
+    chips = _check_chips(chips, wakes)
     if checked is None:
-        return *wake_return(bit_rate, devices, wakes, start, frame, lags), False
+        return *wake_return(bit_rate, devices, wakes, start, frame, lags, chips), False
     cpb = wire.clocks_per_bit(bit_rate)
     downs = _downs(cpb, wakes, downs)
     origin = _counter_origin(cpb, wakes, downs, lags, start)
     sent = _cycle_line(bit_rate, lags, start, origin, frame)
     lines, driven = _follow(cpb, {index: clock - origin for index, clock in wakes.items()},
-                            {index: clock - origin for index, clock in downs.items()}, lags, checked, sent)
+                            {index: clock - origin for index, clock in downs.items()}, lags, checked, sent, chips)
     span = len(wire.frame_levels(frame)) * cpb
     cut = any(drive[start - origin + lag : start - origin + lag + span].any() for drive, lag in driven)
     return *_master_reads(lines[-1], start - origin, cpb), cut
