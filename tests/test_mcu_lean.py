@@ -46,11 +46,11 @@ class EveryAccess(Board):
     request, and the run loop stops the core at every bus event, EXTI0's handler running or not."""
 
     def _sync(self, cycles: int) -> None:
-        self._advance(cycles / self._cpu_hz)
+        self._advance((cycles + board_module.NOISE_CYCLES) / self._cpu_hz)
         self._follow_irq(cycles)
 
     def _bus_deadline(self) -> int:
-        return math.ceil(self.bench.next_change_s() * self.core.cpu_hz)
+        return math.ceil(self.bench.next_change_s() * self.core.cpu_hz - board_module.NOISE_CYCLES)
 
 
 @pytest.mark.parametrize(("case", "bit_rate"), [("cortex_m3", 500_000), ("cortex_m0", 500_000), ("br3", 2_000_000)])

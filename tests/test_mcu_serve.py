@@ -177,6 +177,31 @@ def test_a_main_loop_firmware_is_served_within_the_run_at_pin_level(variants: di
     assert seen["main_loop"] == seen["interrupt"] == seen["polling"]
     assert all(served for *_, served in seen["interrupt"])
     assert [outputs for outputs, *_ in seen["interrupt"]] == [out_data for out_data, *_ in history]
+    # MCU-45: the transaction level's power-up leaves the same cycles unexchanged: its ID cycle alone (before, the
+    # reset ID's configuration error and the rediscovery made it 3); each run ends served
+    transaction = _play(Board(variants["polling", "cortex_m3"]), history)
+    pin = seen["polling"]
+    assert [(unexchanged, served) for *_, unexchanged, served in transaction] == \
+        [(unexchanged, served) for *_, unexchanged, served in pin] == [(1, True)] * len(history)  # fmt: skip
+
+
+@pytest.mark.parametrize("name", VARIANTS)
+def test_both_fidelities_power_up_alike(variants: dict[tuple[str, str], Path], name: str) -> None:
+    """MCU-45: both masters wait for the firmware's set-up (its first wait or first pass of ``fw_loop``), so
+    ``run(3)`` is one discovery ID cycle that reads the firmware's ID code and two data cycles the firmware serves,
+    at both fidelities, for the interrupt, main-loop and polling firmware. Before, the transaction level's master
+    started at once: its ID cycle read the chip's reset ID, the first data cycle failed with the configuration
+    changed, a second discovery followed, and the firmware exchanged no data cycle in the power-up."""
+    seen = []
+    for fidelity in ("transaction", "pin"):
+        board = Board(variants[name, "cortex_m3"], fidelity=fidelity)
+        board.run(3)
+        assert board.fw_board is not None
+        seen.append((board.master.config, board.fw_board.cycles, board.cycles, board.served))
+        if fidelity == "transaction":
+            assert [result.cycle.name for result in board.bench.results][:3] == ["ID", "DATA", "DATA"]
+    assert seen[0] == seen[1]
+    assert seen[0][1:] == (2, 3, True) and seen[0][0] is not None and seen[0][0][0].id_code == 0x03
 
 
 @pytest.mark.parametrize("fidelity", ["transaction", "pin"])
@@ -542,6 +567,28 @@ def test_a_polling_firmware_gets_the_same_verdict_at_both_fidelities(
     data (3,210) stops both in such a pass, after the same instructions since its start, and a larger one stops
     neither."""
     verdicts = [_verdict(Board(variants["polling", "cortex_m3"], fidelity=fidelity), (3, 2), budget)
+                for fidelity in ("transaction", "pin")]  # fmt: skip
+    assert verdicts[0] == verdicts[1]
+    if where is None:
+        assert verdicts[0] is None
+    else:
+        assert verdicts[0] is not None and verdicts[0][:2] == (Stop.BUDGET, where)
+        assert budget <= verdicts[0][3] < budget + 8  # checked at block boundaries (MCU-1)
+
+
+@pytest.mark.parametrize(("budget", "where"), [(7, "Reset_Handler"), (8, "Reset_Handler"), (1990, "fw_loop"),
+                                               (1991, "board_xfer"), (2500, "board_xfer"), (3200, "fw_loop"),
+                                               (3201, None)])  # fmt: skip
+def test_a_polling_firmware_s_power_up_gets_the_same_verdict_at_both_fidelities(
+    variants: dict[tuple[str, str], Path], budget: int, where: str | None
+) -> None:
+    """MCU-45 closes MCU-43's window: ``run(3)`` alone, the power-up. Both masters now wait for the set-up and serve
+    two data cycles in it, so a budget between the longest idle pass (412 instructions) and a pass that exchanges
+    data (3,210) stops both fidelities in the first exchanging pass, after the same instructions since its start:
+    the edges of the set-up (7, 8: the reset handler's first blocks; 1,990: the set-up's 2,000 instructions up to
+    the first pass), 1,991 to 3,200 in the exchanging pass, none from 3,201. Before, the transaction level served no
+    data cycle in its power-up: 1,991 to 3,200 stopped the pin level only."""
+    verdicts = [_verdict(Board(variants["polling", "cortex_m3"], fidelity=fidelity), (3,), budget)
                 for fidelity in ("transaction", "pin")]  # fmt: skip
     assert verdicts[0] == verdicts[1]
     if where is None:

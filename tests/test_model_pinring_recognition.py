@@ -278,7 +278,7 @@ def recognition_history(kind: BranchKind, row: tuple[str, bool], ops: list[Op], 
             pin.cut(position, forward, branch=branch)
         elif name == "power":
             tl.idle(POWER_DOWN_S)
-            tl.power_up(2)  # M25: the BK's wake-up and its branch's answer followed
+            tl.power_up(2, down=tl.now - POWER_DOWN_S)  # M25: the BK's wake-up and its branch's answer followed (M26)
             tl.idle(power_idle_s)
             pin.set_input(2, "resu_n", 0)
             pin.idle(POWER_DOWN_S)

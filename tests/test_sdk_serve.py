@@ -19,8 +19,18 @@ import numpy as np
 import pytest
 
 from supi3.errors import ArgumentError
+from supi3.interbus import wire
 from supi3.sdk import native
-from supi3.sdk.bench import SERVE_PASSES, SERVE_TELEGRAMS, Bench, BenchError, MainLoopPasses, serve_wait_s
+from supi3.sdk.bench import (
+    SERVE_PASSES,
+    SERVE_TELEGRAMS,
+    START_WAIT_S,
+    Bench,
+    BenchError,
+    MainLoopPasses,
+    MasterStart,
+    serve_wait_s,
+)
 from supi3.sdk.driver import Mode, Supi3Driver
 from supi3.sdk.examples import DigitalIo, PollingIo
 from support import c_firmware
@@ -177,11 +187,14 @@ def test_the_wait_adds_at_most_a_pass_and_a_service_routine() -> None:
     assert bench.served
 
 
-@pytest.mark.parametrize("pass_us", [700.0, 3000.0])
+@pytest.mark.parametrize("pass_us", [750.0, 3000.0])
 def test_a_pass_longer_than_the_wait_ends_the_run_unserved_and_the_next_run_goes_on(pass_us: float) -> None:
-    """A main loop whose pass (0.7 ms, 3 ms) outlasts SERVE_TELEGRAMS status telegrams (0.64 ms at 500 kbit/s): the
+    """A main loop whose pass (0.75 ms, 3 ms) outlasts SERVE_TELEGRAMS status telegrams (0.64 ms at 500 kbit/s): the
     pass after the last cycle does not count, the run ends unserved after it (the bench cannot cut a pass, where
-    the board's core stops at the bound); the next run goes on with the data of its cycles."""
+    the board's core stops at the bound); the next run goes on with the data of its cycles. (A pass this long serves
+    an edge cycles late: where its reads fall depends on the cycles' phase. With the master's start at the set-up's
+    end, FW-15, a 0.7 ms pass reads IRQ_EVT in the frame in which the next cycle's event comes, so /IRQ never rises
+    again and the edge-triggered firmware waits for ever, 3.4.14; 0.65 and 0.8 ms read OUT0 in a latch phase.)"""
     device = NotingDigitalIo(pass_us=pass_us)
     bench = Bench(firmware=device)
     bench.run(3)
@@ -263,3 +276,67 @@ def test_c_main_loop_and_polling_firmware_give_the_interrupt_firmware_s_data(
     assert all(served for *_, served in seen["polling"] + seen["main_loop"])
     for (out, *_, cycles), (outputs, *_) in zip(history, seen["polling"], strict=True):
         assert cycles < 2 or outputs == out
+
+
+# -- FW-15 (MCU-45): the master starts when the set-up has ended ----------------------------------------------------
+
+
+class SlowSetup(DigitalIo):
+    """DigitalIo whose set-up first does ``setup_us`` of other work."""
+
+    def __init__(self, setup_us: float) -> None:
+        super().__init__()
+        self.setup_us = setup_us
+
+    def setup(self, drv: Supi3Driver) -> None:
+        drv.transport.delay_us(self.setup_us)
+        super().setup(drv)
+
+
+def test_the_master_start_rule() -> None:
+    """MasterStart: START_WAIT_S until the set-up is noted, then its time (the first note only, never after
+    START_WAIT_S); the start on the status telegrams' grid; bad times refused by name."""
+    start = MasterStart()
+    assert (start.at, start.due(START_WAIT_S - 1e-9), start.due(START_WAIT_S)) == (START_WAIT_S, False, True)
+    assert start.set_up(45e-6) and not start.set_up(10e-6) and start.at == 45e-6 and start.due(45e-6)
+    for bit_rate in (500_000, 2_000_000):
+        telegram_s = wire.STATUS_TELEGRAM_BITS / bit_rate
+        assert start.start_s(bit_rate) == pytest.approx(math.ceil(45e-6 / telegram_s) * telegram_s, abs=1e-15)
+    late = MasterStart()
+    late.set_up(5e-3)
+    assert late.at == START_WAIT_S
+    for bad in (-1e-6, math.nan, math.inf, "0"):
+        with pytest.raises(ArgumentError, match="at"):
+            MasterStart().set_up(bad)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("setup_us", [0.0, 100.0, 2000.0])
+def test_the_bench_s_master_starts_when_the_set_up_has_ended(setup_us: float) -> None:
+    """FW-15: the master's Alarm Stop begins at the end of the status telegram in which ``setup`` returned, at the
+    latest at START_WAIT_S (a 2 ms set-up gets the master during it, and its ID cycle the chip's reset ID); the
+    first ID cycle of a set-up done in time reads the firmware's ID code (3, no rediscovery), and ``run(3)``
+    serves two data cycles. Without a firmware the master starts at the first run, after the test's own driver
+    calls."""
+    bare = Bench()
+    bare.run(1)
+    reset_s = bare.timeline[0].start  # a master started at 0: its ID cycle begins after the reset alone
+    device = SlowSetup(setup_us)
+    bench = Bench(firmware=device)
+    bench.power_up()
+    setup_end = bench.now
+    bench.run(3)
+    telegram_s = wire.STATUS_TELEGRAM_BITS / bench.config.bit_rate
+    started = math.ceil(min(setup_end, START_WAIT_S) / telegram_s - 1e-9) * telegram_s
+    assert bench.timeline[0].start - reset_s == pytest.approx(started, abs=1e-12)
+    if setup_end < START_WAIT_S:
+        assert [t.cycle.name for t in bench.timeline][:3] == ["ID", "DATA", "DATA"]
+        assert bench.master.config is not None and bench.master.config[0].id_code == 0x03
+        assert bench.interrupts == 2 and bench.served
+    tested = Bench()
+    tested.driver.initialize(Mode.MOTOROLA)
+    tested.driver.configure(0x83, 0x03)
+    driven = tested.now
+    tested.run(1)
+    assert tested.timeline[0].start - reset_s == pytest.approx(math.ceil(driven / telegram_s) * telegram_s, abs=1e-12)
+    assert tested.master.config is not None and tested.master.config[0].id_code == 0x03
+

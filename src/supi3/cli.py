@@ -355,6 +355,8 @@ def cmd_timing(args: argparse.Namespace) -> None:
     n_bytes = check_int("--bytes", args.bytes, 0, MAX_NETWORK_BYTES,
                         f"{timing.MAX_DEVICES} devices of at most 32 words")
     devices = check_int("--devices", args.devices, 1, timing.MAX_DEVICES, "the INTERBUS limit")
+    check_int("--bytes", n_bytes, 0, devices * timing.MAX_DEVICE_BYTES,
+              f"--devices {devices} of at most 32 words, Table 3-11 and A23")
     if args.optical_count is not None:
         check_int("--optical-count", args.optical_count, 0, timing.max_optical_count(bit_rate),
                   "a 20 km path there and back at --bit-rate, Table 1-5 and OPT-1")
@@ -524,7 +526,7 @@ def _campaign_configs(args: argparse.Namespace) -> list[campaign.CampaignConfig]
     check_int("--devices", args.devices, 1, campaign.MAX_DEVICES["ring"], campaign.DEVICE_LIMITS["ring"])
     check_int("--pin-devices", args.pin_devices, 1, campaign.MAX_DEVICES["pin"], campaign.DEVICE_LIMITS["pin"])
     fidelities: list[campaign.Fidelity] = ["ring", "pin"] if args.fidelity == "both" else [args.fidelity]
-    mix = campaign.parse_mix(args.mix) if args.mix else None
+    mix = campaign.parse_mix(args.mix) if args.mix is not None else None  # "" is no mix: refused, not the default
     unknown = sorted(set(mix or ()) - set(campaign.RING_EVENTS) - set(campaign.PIN_EVENTS))
     if unknown:
         known = dict.fromkeys(campaign.RING_EVENTS + campaign.PIN_EVENTS)  # "reset" is in both
@@ -761,7 +763,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("timing", help="CPU access time, I/O access window, cycle time, optical length")
     p.add_argument("--bit-rate", default="500k", help="500k or 2M")
     p.add_argument("--bytes", type=integer, default=4, metavar="N",
-                   help=f"data bytes in the whole network, 0 to {MAX_NETWORK_BYTES} (default 4)")
+                   help=f"data bytes in the whole network, 0 to 64 per device, {MAX_NETWORK_BYTES} at most (default 4)")
     p.add_argument("--devices", type=integer, default=1, metavar="N",
                    help=f"devices in the ring, 1 to {timing.MAX_DEVICES} (default 1)")
     p.add_argument("--optical-count", type=integer, metavar="N",

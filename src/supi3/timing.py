@@ -22,7 +22,11 @@ class TimingError(Supi3Error, ValueError):
 MAX_DEVICES = wire.MAX_DEVICES
 """Devices in one INTERBUS ring, 512."""
 
-MAX_NETWORK_BYTES = MAX_DEVICES * max(lc.bits or 0 for lc in tables.LENGTH_CODES) // 8
+MAX_DEVICE_BYTES = max(lc.bits or 0 for lc in tables.LENGTH_CODES) // 8
+"""Data bytes of one device at most: the longest data length, 32 words (Table 3-11); ``devices`` devices carry at
+most ``devices`` times as many (A23)."""
+
+MAX_NETWORK_BYTES = MAX_DEVICES * MAX_DEVICE_BYTES
 """Data bytes in a whole network: 512 devices of the longest data length, 32 words (Table 3-11)."""
 
 def max_optical_count(bit_rate: int) -> int:
@@ -228,12 +232,16 @@ def optical_range(length_m: float, bit_rate: int) -> tables.OpticalLengthRange:
 
 def data_cycle_time_s(network_bytes: int, devices: int, bit_rate: int) -> float:
     """Duration of one INTERBUS data cycle on the wire: frame, ring delay, turnaround and latch
-    (``supi3.interbus.wire.cycle_bits``, docs/interbus.md "Cycle timing")."""
-    _network_bytes(network_bytes)
+    (``supi3.interbus.wire.cycle_bits``, docs/interbus.md "Cycle timing"). ``network_bytes`` are at most 64 per
+    device (32 words, Table 3-11; A23): more is a :class:`TimingError`, not a longer cycle no ring can have."""
+    network_bytes = _network_bytes(network_bytes)
     check_int("devices", devices)
     if not 1 <= devices <= MAX_DEVICES:
         raise TimingError(f"need devices >= 1 and <= {MAX_DEVICES} (the INTERBUS limit), not "
                           f"{_shown(devices)}")
+    if network_bytes > devices * MAX_DEVICE_BYTES:  # A23
+        raise TimingError(f"network byte count must be at most {devices * MAX_DEVICE_BYTES} for {devices} device"
+                          f"{'s' if devices != 1 else ''} (at most 32 words each, Table 3-11), not {network_bytes}")
     return wire.cycle_bits(network_bytes, devices) * bit_period_s(bit_rate)
 
 

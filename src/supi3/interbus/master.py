@@ -396,9 +396,7 @@ class Master:
         """Run the next cycle a master would: an ID cycle when there is no configuration, a command to send
         or a device asking for attention, and after a failed cycle until an ID cycle is latched (so that no TE
         bit outlives the error it belongs to, assumption A21); else a data cycle."""
-        if self.stopped:
-            raise InterbusError("docs/interbus.md, Configuration changes", "rediscover=False",
-                                "the configuration changed and the master waits for start()")  # fmt: skip
+        self._require_running()
         pending = self._pcmd or self._alarm_request or self._alarm_expected or self._recover or self._branch \
             or self._optical_request or self._optical_expected or self._alarm_output
         if self.config is None or self._attention or self._watchdog_pending or self._quit or pending:
@@ -421,8 +419,10 @@ class Master:
 
     def id_cycle(self) -> CycleResult:
         """One ID cycle: a discovery cycle without a configuration (the loopback word is searched for), else
-        a cycle over the known ring that also carries the command words."""
+        a cycle over the known ring that also carries the command words; stopped (``rediscover=False``, A19) it waits
+        for :meth:`start` as :meth:`cycle` does."""
         if self.config is None:
+            self._require_running()
             return self._discovery()
         config = self.config
         optical = self._optical_request - self._alarm_request - self._pcmd.keys()  # one answer each (OPT-50)
@@ -458,6 +458,11 @@ class Master:
         return CycleResult(Cycle.ID, True, messages)
 
     # -- internals -----------------------------------------------------------------------------------------------
+
+    def _require_running(self) -> None:
+        if self.stopped:
+            raise InterbusError("docs/interbus.md, Configuration changes", "rediscover=False",
+                                "the configuration changed and the master waits for start()")  # fmt: skip
 
     def _require_config(self) -> tuple[ConfigEntry, ...]:
         if self.config is None:
@@ -575,9 +580,13 @@ class Master:
                 problem = found if found is not None and found.kind is ErrorKind.CONFIGURATION else problem
         located = self._with_device(problem)
         if problem.kind is ErrorKind.CONFIGURATION and self.config is not None:
-            # A configuration difference: the table is dropped (A19); rebuilt by the next cycle() or by start().
+            # A configuration difference: the table is dropped (A19); rebuilt by the next cycle() or by start(). The
+            # commands not yet sent and the PF bits reported name ring positions a new table may give other devices:
+            # dropped with it, so a PF standing on the new table is reported there (A19).
             self._set_config(None)
             self.stopped = not self.rediscover
+            for pending in (self._quit, self._pcmd, self._alarm_request, self._branch, self._pf_active):
+                pending.clear()
         self._record((located,))
         return CycleResult(cycle, False, (located,))
 
@@ -656,6 +665,11 @@ class Master:
             return _not_located(problem, "the error went away during the segment search")
         if failed.kind is ErrorKind.CONFIGURATION:
             return _changed(problem, failed.location, failed.detail)
+        if low == n + 1 and failed.kind is ErrorKind.LOOPBACK and self.max_devices < wire.MAX_DEVICES:
+            # M31: devices added behind the last one, beyond the discovery window (max_devices), keep the loopback
+            # word from coming back as a fault on the return line does: nothing proves the return line.
+            return _not_located(problem, f"the loopback word is missing behind device {n}: a fault on the return "
+                                f"line or more devices than max_devices ({self.max_devices})")  # fmt: skip
         where = "the return line" if low == n + 1 else f"the ring fails when closed after position {low}"
         problem = Diagnostic(problem.kind, low, None, None, f"{problem.detail}; segment search: {where}")
         return self._counted(problem, low) if failed.kind in COUNTED_KINDS else problem

@@ -41,12 +41,12 @@ from itertools import accumulate
 from operator import attrgetter, sub
 from typing import Final, NamedTuple, Protocol, runtime_checkable
 
-from supi3.checks import check_bool, check_instance, check_int, check_real, fail
+from supi3.checks import check_bool, check_bytes, check_instance, check_int, check_real, fail
 from supi3.config import DeviceConfig, Interface
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusArgumentError, InterbusError, TelegramError
 from supi3.interbus.link import DataKernel, Device
-from supi3.interbus.wake import path_lags, reset_ready, wake_return, wake_window
+from supi3.interbus.wake import Counters, counter_return, path_lags, reset_ready, wake_window
 from supi3.interbus.wire import Cycle, Frame
 from supi3.pinlevel import SYNC_STAGES
 from supi3.tables import CLOCK_HZ, RESET_MIN_S
@@ -682,6 +682,23 @@ class Bus(Protocol):
         ...
 
 
+def check_transfer(cycle: object, data: object, close_after: object) -> tuple[bytes, int | None]:
+    """The checks of a :class:`Bus`'s ``transfer``, made before the ring changes anything (a refused call leaves no
+    trace: no branch recognised, no repair forgotten, no fibre's bit error drawn): ``cycle`` a :class:`Cycle`,
+    ``data`` bytes (a ``bytes``, ``bytearray`` or ``memoryview``: an integer is no frame of that many zero bytes),
+    ``close_after`` ``None`` or an integer from 0; ``data`` as ``bytes`` and ``close_after`` as an ``int``.
+
+    Raises
+    ------
+    ArgumentError
+        One of them is not what it must be.
+    """
+    if type(cycle) is not Cycle:
+        check_instance("cycle", cycle, Cycle)
+    stream = data if type(data) is bytes else check_bytes("data", data)
+    return stream, None if close_after is None else check_int("close_after", close_after, 0)
+
+
 def check_finish(transfer: object, pending: Transfer | None, latch: object) -> bool:
     """The checks of a :class:`Bus`'s ``finish``: ``transfer`` must be ``pending``, the :class:`Transfer` the ring's
     last ``transfer`` returned and no ``finish``, ``reset`` or ``idle`` has ended since (a cycle ends once, on the ring
@@ -774,6 +791,8 @@ class Ring:
         """What the last :meth:`transfer` returned, until :meth:`finish`, :meth:`reset` or :meth:`idle`."""
         self._wakes: dict[int, float] = {}
         """M22: ``id`` of a chip powered up by :meth:`power_up` -> bus time its reset stretch (M2) ends."""
+        self._downs: dict[int, float] = {}
+        """M26: ``id`` of a chip powered up by :meth:`power_up` -> bus time its power-down began (outputs silent)."""
         self._late: dict[int, float] = {}
         """M22: ``id`` of a chip -> bus time from which a frame finds it out of an INTERBUS reset it woke up in."""
         self._answers: dict[int, float] = {}
@@ -1244,8 +1263,7 @@ class Ring:
         Transfer
             Hand it to :meth:`finish` with the master's verdict.
         """
-        if type(cycle) is not Cycle:
-            check_instance("cycle", cycle, Cycle)
+        data, close_after = check_transfer(cycle, data, close_after)
         # A branch answering in this run joins the data path within its frame (BK-54): what leaves its BK is cut.
         joined = self._recognise(frame=wire.frame_bits(len(data))) if self._branches else []
         spliced = self._join_error(joined) if joined else None  # BK-56: the error of a branch joining the frame
@@ -1255,7 +1273,7 @@ class Ring:
         if n_all > wire.MAX_DEVICES:
             raise InterbusError("docs/interbus.md, Ring", n_all, f"a ring has at most {wire.MAX_DEVICES} devices")
         # A position beyond the ring (the master's table may be older than the ring) closes it at its last device.
-        n = n_all if close_after is None else min(check_int("close_after", close_after, 0), n_all)
+        n = n_all if close_after is None else min(close_after, n_all)
         # Closed after a position (even the last), the ring returns inside that device: the return line N + 1
         # is only part of the whole ring (close_after=None), so a fault there is told from one on line N.
         segments = n + 1 if close_after is None else n
@@ -1288,6 +1306,7 @@ class Ring:
         devices = self.devices[: n if dead is None else min(n, dead - 1)]
         reached = len(devices)
         woken: tuple[dict[int, int], int, list[int]] | None = None
+        dropped = False  # M26: an LBD chip's counter block dropped telegrams of the frame in the window
         unheard = False
         if self._wakes or self._late:  # M22: a chip not on the telegram grid yet passes the frame on (M19)
             late, woken = self._waking()
@@ -1357,13 +1376,13 @@ class Ring:
             returned = stream
         if woken is not None and returned is not None:  # M22: the master's receiver, bit by bit in the window
             wakes, start, lags = woken
-            error, opened = wake_return(self.bit_rate, len(self.devices), wakes, start, Frame.build(cycle, returned),
-                                        lags)
+            error, opened, dropped = counter_return(self.bit_rate, len(self.devices), wakes, start,
+                                                Frame.build(cycle, returned), lags, *self._counter_lines())
             unheard = unheard or error
             returned = returned if opened else None
         if unheard:  # not on the telegram grid yet: no fault of the return line N + 1
             receiver_error = receiver_error or ErrorKind.TELEGRAM
-        elif spliced is ErrorKind.TRANSMISSION and opened:
+        elif (spliced is ErrorKind.TRANSMISSION or dropped) and opened:
             # M25: a frame whose head a woken chip's stretch cut comes back as no frame, whatever joins after it
             flags_back = wire.CntrFlags(attention, True)
         reports = self._reports(reached, None if close_after is None else n, dead_lines, returns) \
@@ -1485,7 +1504,7 @@ class Ring:
         self._wakes = {}  # the master's receiver leaves the hold on the grid (a line reset, M11)
         self._sync()
 
-    def power_up(self, position: int) -> None:
+    def power_up(self, position: int, down: float | None = None) -> None:
         """Power up the chip at ring ``position`` now (its power-up reset, 1.7.2): a master's cycle fails, as at pin
         level, until the chip and those behind it, then the master's receiver, are on the telegram grid (M22). In a
         tree ``position`` is the physical one (1..N over every device of the tree, a BK then its branch's devices, as
@@ -1493,11 +1512,15 @@ class Ring:
         again once the first start level the BK sends after its wake-up is back on its DI3 (BK-37, M25), and joins the
         data path then: before a frame, within it (that cycle lost, BK-54) or after it.
 
+        ``down``: the bus time the chip's power-down began (/ResU low, 1.7.2: its outputs silent from then; an LBD
+        branch's counter blocks count that silence, BK-30, M26); ``None``: when the master's idle began (the end of
+        its last cycle or reset), or the chip's previous wake-up in it if later.
+
         Raises
         ------
         ArgumentError
-            ``position`` not a device of the ring (1 to N), or the device there has no power-up reset
-            (``power_up``); nothing changes.
+            ``position`` not a device of the ring (1 to N), the device there has no power-up reset (``power_up``),
+            or ``down`` not a bus time from the master's idle's start to now; nothing changes.
         """
         every = _devices(self._tree) if self._branches else self.devices
         position = check_int("position", position, 1, len(every), "a device of the ring (of a tree: physical, BK-52)")
@@ -1505,7 +1528,12 @@ class Ring:
         power_up = getattr(device, "power_up", None)
         if not callable(power_up):
             raise fail(f"device at ring position {position}", "a chip with a power-up reset (power_up)", device)
+        if down is None:
+            down = min(self.now, max(self._grid, self._wakes.get(id(device), self._grid)))
+        else:
+            down = check_real("down", down, self._grid, self.now, limit="M26: from the master's idle's start to now")
         power_up()
+        self._downs[id(device)] = down
         self._wakes[id(device)] = self.now + round(RESET_MIN_S * CLOCK_HZ) / CLOCK_HZ  # the stretch, M2
         self._late.pop(id(device), None)
         if id(device) in self._terminals:  # M25: its recognition cleared (BK-37): the branch may leave the data path
@@ -1554,6 +1582,16 @@ class Ring:
         index = {id(device): k for k, device in enumerate(self.devices)}
         return {index[key]: round((at - self._grid) * CLOCK_HZ) for key, at in self._wakes.items() if key in index}
 
+    def _counter_lines(self) -> tuple[Counters, dict[int, int]]:
+        """M26: the counter blocks along the data path now (an LBD chip's on its forward line, an LBD-MR branch's
+        return blocks, BK-35) and the power-down of each chip woken in it, in clocks of the master's idle."""
+        forward = frozenset(k for k, device in enumerate(self.devices) if _sends_counts(device))
+        returns = tuple((span.end, tuple(i for i in reversed(span.own) if _return_repeater(self.devices[i])))
+                        for span in self._spans if any(_return_repeater(self.devices[i]) for i in span.own))
+        index = {id(device): k for k, device in enumerate(self.devices)}
+        downs = {index[key]: round((self._downs[key] - self._grid) * CLOCK_HZ) for key in self._wakes if key in index}
+        return Counters(forward, returns), downs
+
     def _waking(self) -> tuple[set[int], tuple[dict[int, int], int, list[int]] | None]:
         """M22: the ring indices of the chips a frame starting now finds off the telegram grid, and the wake-ups, the
         frame's start in clocks of the master's idle (:func:`~supi3.interbus.wake.wake_window`) and the data path's
@@ -1565,7 +1603,7 @@ class Ring:
         if not wakes:
             return late, None
         lags = self._lags()
-        window = wake_window(self.bit_rate, len(self.devices), wakes, lags)
+        window = wake_window(self.bit_rate, len(self.devices), wakes, lags, *self._counter_lines())
         now = round((self.now - self._grid) * CLOCK_HZ)
         if now >= window.end:
             self._wakes = {}

@@ -63,7 +63,7 @@ from supi3.model.pinring import PinBranch, PinChip
 from supi3.model.registers import InterfaceViolationError
 from supi3.model.vcd import write_vcd
 from supi3.pinout import C_D_COMMAND
-from supi3.sdk.bench import SERVE_TELEGRAMS, Bench, MainLoopPasses, default_config, serve_wait_s
+from supi3.sdk.bench import SERVE_TELEGRAMS, Bench, MainLoopPasses, MasterStart, default_config, serve_wait_s
 from supi3.spi.upif import Mode, UpifProtocol
 from supi3.tables import CLOCK_HZ
 from supi3.top import Supi3Chip
@@ -109,9 +109,6 @@ each time the main loop comes to :data:`SERVE_POINT` (MCU-43)."""
 FIDELITIES: Final[tuple[str, ...]] = ("transaction", "pin")
 """The chip on the board: the transaction-level model (:class:`supi3.sdk.bench.Bench`) or the pin-level whole chip
 (:class:`supi3.top.Supi3Chip` in lockstep with the core, :mod:`supi3.mcu.pins`)."""
-START_WAIT_S: Final[float] = 1e-3
-"""MCU-17: at pin level the master starts (Alarm Stop, ID cycle) once the firmware first sleeps, its set-up done,
-or after this much bus time of idle status telegrams, whichever comes first."""
 SERVE_POINT: Final[str] = "fw_loop"
 """MCU-30: the main loop's idle point: the entry of the board contract's ``fw_loop`` (examples/fw_board.h), which the
 board port's ``main`` calls again and again, serving the /IRQ edge its EXTI0 handler noted after each call. A
@@ -127,6 +124,10 @@ does not stop the core at them."""
 
 _EXTI0: Final[int] = EXTERNAL + EXTI0_IRQ
 """The exception number of EXTI0, /IRQ's line."""
+NOISE_CYCLES: Final[float] = 1e-6
+"""A bus time's float rounding, in core cycles: a time within this much after a core cycle is at that cycle (the bus
+events are sums of bit times in seconds; MCU-45 moved their origin off 0, where a cycle's end came a float's ulp
+after its core cycle and the board took its /IRQ edge a cycle late)."""
 
 _T = TypeVar("_T")
 _R = TypeVar("_R")
@@ -378,6 +379,7 @@ class Board:
         self._mod_ack_until = 0
         self._limit = self._budget = 0
         self._held: list[tuple[str, int, int]] | None = None  # pin level: edges held while a sleeping core waits
+        self._setting_up = True  # MCU-45: the firmware has not yet first waited or come to SERVE_POINT
         self.served = True
         """MCU-30: the last :meth:`run` ended with the firmware's work served (False: the wait for the main loop's
         pass ran out, or the run raised)."""
@@ -412,6 +414,7 @@ class Board:
         ring.on_edge = self._pin_edge
         ring.on_violation = self._pin_violation
         self._master = Master(ring, locate=False, max_devices=len(ring.devices))
+        self._start = MasterStart()  # MCU-45: the master's first cycle waits for the set-up's end
         self._cycles_done = 0
         self._next_start = 0.0  # cycle_time_s: the bus time the next master cycle starts
 
@@ -504,7 +507,7 @@ class Board:
         a chip action (:meth:`_chip` follows its own), and EXTI0's request only with them, a write of EXTI
         (:meth:`_exti_write`) or an exception's return (the run loop): with no bus event on the way there is nothing
         to follow (MCU-31)."""
-        if self._advance(cycles / self._cpu_hz):
+        if self._advance((cycles + NOISE_CYCLES) / self._cpu_hz):
             self._follow_irq(cycles)
 
     def _no_bench(self, until: float) -> bool:
@@ -536,7 +539,7 @@ class Board:
         if level != self._irq_level:
             self._irq_level = level
             if not level and self._irq_fell is None:
-                self._irq_fell = cycles if low_at is None else math.ceil(low_at * self._cpu_hz)
+                self._irq_fell = cycles if low_at is None else math.ceil(low_at * self._cpu_hz - NOISE_CYCLES)
             self.exti.edge(0, PIN_IRQ, level)
             request = True
         if request and self.exti.requesting(0):
@@ -584,6 +587,9 @@ class Board:
         the main loop renews the instruction budget, as a wait does (MCU-43)."""
         core = self.core
         self._limit = core.instructions + self._budget
+        if self._setting_up:  # MCU-45: the first pass ends the set-up; at transaction level the master starts now
+            self._set_up()
+            core.stop_request = True
         if self._passes.arrive(core.cycles):
             core.stop_request = True
 
@@ -645,7 +651,7 @@ class Board:
             self._s_r = level
 
     def _cycles(self, seconds: float) -> int:
-        return math.ceil(seconds * self.core.cpu_hz - 1e-6)
+        return math.ceil(seconds * self.core.cpu_hz - NOISE_CYCLES)
 
     def _on_output(self, pin: int, level: int) -> None:
         ring = self._ring
@@ -852,7 +858,7 @@ class Board:
         assert bench is not None  # transaction level
         if _EXTI0 in core.active or (_EXTI0 in core.pending and core.next_entry() == _EXTI0):
             return MAX_DEADLINE
-        return math.ceil(bench.next_change_s() * core.cpu_hz)
+        return math.ceil(bench.next_change_s() * core.cpu_hz - NOISE_CYCLES)
 
     def _set_budget(self, max_instructions: int) -> None:
         self._budget = check_int("max_instructions", max_instructions, 1)
@@ -880,6 +886,19 @@ class Board:
             core.sleeping = True
         if core.sleeping:  # MCU-41: the budget bounds the work between two waits (and passes, MCU-43)
             self._limit = core.instructions + self._budget
+            if self._setting_up:  # MCU-45: the first wait ends the set-up
+                self._set_up()
+
+    def _set_up(self) -> None:
+        """MCU-45: the firmware's set-up has ended (the core's first wait or first arrival at :data:`SERVE_POINT`,
+        the core's clock now): the master starts now (:class:`~supi3.sdk.bench.MasterStart`, the firmware bench's
+        rule), unless :data:`~supi3.sdk.bench.START_WAIT_S` has passed."""
+        self._setting_up = False
+        at = self._seconds(self.core.cycles)
+        if self._bench is None:
+            self._start.set_up(at)
+        else:
+            self._bench.set_up_done(at)
 
     def _place(self, error: InterfaceViolationError) -> None:
         """Note on ``error`` where the firmware broke the rule (once)."""
@@ -905,7 +924,7 @@ class Board:
                     master.cycle()
                 else:
                     ring.settle()  # the power-up reset stretch (as supi3 demo --vcd)
-                    while not core.sleeping and ring.now < START_WAIT_S:
+                    while not self._start.due(ring.now):  # MCU-45: the set-up's end, at the latest START_WAIT_S
                         ring.status_telegram()
                     master.start()
                 self._cycles_done += 1

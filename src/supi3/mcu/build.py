@@ -27,7 +27,16 @@ from supi3.checks import fail
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.mcu.core import check_cpu
 
-__all__ = ["BOARD_DIR", "FLAGS", "MACRO_NAME", "BuildError", "build", "build_command", "toolchain_missing"]
+__all__ = [
+    "BOARD_DIR",
+    "FLAGS",
+    "MACRO_NAME",
+    "SOURCE_SUFFIXES",
+    "BuildError",
+    "build",
+    "build_command",
+    "toolchain_missing",
+]
 
 BOARD_DIR: Final[Path] = sdk.SDK_DIR / "board"
 """The board port: ``board.h``, ``board.c``, ``startup.c``, ``board.ld``."""
@@ -36,6 +45,8 @@ FLAGS: Final[tuple[str, ...]] = ("-target", "thumb-freestanding-eabi", "-ffreest
 """Flags of every firmware build besides ``-mcpu`` and the paths: the SDK's strict C99 flags, no library."""
 MACRO_NAME: Final[re.Pattern[str]] = re.compile(r"[A-Za-z_][A-Za-z0-9_]*", re.ASCII)
 """A macro name of ``defines``: a C identifier."""
+SOURCE_SUFFIXES: Final[tuple[str, ...]] = (".c", ".S", ".h")
+"""Suffixes ``output`` may not have: the ELF would replace a source (``-o a.c a.c``; MCU-48)."""
 
 
 class BuildError(Supi3Error, RuntimeError):
@@ -77,6 +88,10 @@ def build_command(sources: Sequence[str | Path], output: str | Path, *, cpu: str
     for path in paths:
         if not path.is_file() or path.suffix not in (".c", ".S"):
             raise ArgumentError("sources", path, f"sources must be paths of existing .c or .S files, not {str(path)!r}")
+    if not isinstance(output, str | PathLike) or Path(output).suffix in SOURCE_SUFFIXES \
+            or any(Path(output).resolve() == path.resolve() for path in paths):  # fmt: skip
+        raise fail("output", "a path of the ELF file to write, neither one of the sources nor a .c, .S or .h file "
+                   "(MCU-48)", output)
     for name, value in (defines or {}).items():
         if not isinstance(name, str) or not MACRO_NAME.fullmatch(name) or not isinstance(value, str):
             raise fail("defines", "a mapping of C identifiers to str values", {name: value})

@@ -346,7 +346,7 @@ class FirmwareImage:
                 elf = ELFFile(stream)
                 if elf["e_machine"] != "EM_ARM" or elf.elfclass != 32 or not elf.little_endian:
                     raise ArgumentError("path", path, f"path must be a 32-bit little-endian ARM ELF, not {path}")
-                segments = tuple((int(seg["p_paddr"]), bytes(seg.data())) for seg in elf.iter_segments()
+                segments = tuple(_segment(path, seg) for seg in elf.iter_segments()
                                  if seg["p_type"] == "PT_LOAD" and seg["p_filesz"])  # fmt: skip
                 table = elf.get_section_by_name(".symtab")
                 symbols = {} if not isinstance(table, SymbolTableSection) else {
@@ -485,6 +485,17 @@ def _register(name: object) -> int:
     if not isinstance(number, int):
         raise fail("name", "a register name (r0..r12, sp, lr, pc, xpsr, msp, psp, primask, control, ...)", name)
     return number
+
+
+def _segment(path: Path, segment: Any) -> tuple[int, bytes]:
+    """A loadable segment of an ELF file as (physical address, bytes); a file cut short inside it is an
+    :class:`ArgumentError`, never a part of it run (MCU-47)."""
+    data = bytes(segment.data())
+    if len(data) != segment["p_filesz"]:
+        raise ArgumentError("path", path, f"path must be an ELF file that holds its segments, not {path} (the "
+                            f"segment at {segment['p_paddr']:#x} has {segment['p_filesz']} bytes in the file, "
+                            f"{len(data)} there)")  # fmt: skip
+    return int(segment["p_paddr"]), data
 
 
 def _check_memories(image: FirmwareImage, flash: object, ram: object) -> None:

@@ -48,7 +48,7 @@ from supi3.config import DeviceConfig
 from supi3.interbus import wire
 from supi3.interbus.link import Device
 from supi3.interbus.master import Master
-from supi3.interbus.ring import BitFlip, Branch, BranchKind, DeadLine, ReturnBreak, Ring, Transfer
+from supi3.interbus.ring import BitFlip, Branch, BranchKind, DeadLine, ReturnBreak, Ring, Transfer, check_transfer
 from supi3.interbus.wire import Cycle
 from supi3.optical.length import Medium, length_m
 from supi3.optical.link import Direction, FibreLink, LightState
@@ -290,7 +290,7 @@ class OpticalRing:
 
     def transfer(self, cycle: Cycle, data: bytes, close_after: int | None = None) -> Transfer:
         """See :meth:`supi3.interbus.ring.Ring.transfer`; the fibres' faults at the current bus time come first."""
-        check_instance("cycle", cycle, Cycle)
+        data, close_after = check_transfer(cycle, data, close_after)  # before the fibres draw their bit errors
         self._faults(wire.frame_bits(len(data)))
         return self.ring.transfer(cycle, data, close_after)
 

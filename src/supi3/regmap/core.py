@@ -5,6 +5,7 @@ Nothing in this module knows the SUPI 3 OPC; :mod:`supi3.regmap.registers` decla
 
 from __future__ import annotations
 
+import numbers
 import re
 from dataclasses import dataclass, field
 from enum import StrEnum
@@ -21,6 +22,13 @@ BYTE_MASK: Final[int] = (1 << BYTE_BITS) - 1
 
 class RegisterMapError(Supi3Error, ValueError):
     """A register-map declaration, look-up, value or export request that breaks a rule of the map."""
+
+
+def integer(what: str, value: object) -> int:
+    """``value`` as an ``int`` (Python and numpy integers; ``bool``, floats and strings are no register value)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise RegisterMapError(f"{what} must be an integer, not {value!r:.40} ({type(value).__name__})")
+    return int(value)
 
 
 class AccessDirection(StrEnum):
@@ -179,6 +187,7 @@ class Field:
         RegisterMapError
             If ``value`` does not fit in the field.
         """
+        value = integer(f"field {self.name}", value)
         if not 0 <= value < 1 << self.width:
             raise RegisterMapError(f"field {self.name}: {value!r} does not fit in {self.width} bits")
         return (byte & ~self.mask & BYTE_MASK) | (value << self.lsb)
@@ -260,6 +269,7 @@ class ByteLayout:
 
     def decode(self, byte: int) -> dict[str, int]:
         """Split a byte into the values of its base fields."""
+        byte = integer(self.name, byte)
         if not 0 <= byte <= BYTE_MASK:
             raise RegisterMapError(f"{self.name}: {byte!r} is not a byte")
         return {f.name: f.extract(byte) for f in self.base_fields}

@@ -218,6 +218,13 @@ def compile_systemrdl(text: str) -> Any:
 # ----------------------------------------------------------------------------------------------------------------
 
 
+def _path(name: str, value: object) -> Path:
+    """``value`` if it is a :class:`~pathlib.Path`, else the named error (a string is no path here: no guess)."""
+    if not isinstance(value, Path):
+        raise RegisterMapError(f"{name} must be a pathlib.Path, not {value!r:.60}")
+    return value
+
+
 def to_html(outdir: Path) -> Path:
     """Write a browsable HTML register map (peakrdl-html, per-register bit diagrams) into ``outdir``.
 
@@ -226,6 +233,7 @@ def to_html(outdir: Path) -> Path:
     Path
         The ``index.html`` of the generated site.
     """
+    _path("outdir", outdir)
     from peakrdl_html import HTMLExporter
 
     outdir.mkdir(parents=True, exist_ok=True)
@@ -566,8 +574,13 @@ def render(fmt: str, out: Path | None = None) -> str:
     Raises
     ------
     RegisterMapError
-        If ``fmt`` is not a known format, or ``html`` is asked for without ``out``.
+        If ``fmt`` is not a known format, ``out`` is neither a :class:`~pathlib.Path` nor ``None``, or ``html`` is
+        asked for without ``out``.
     """
+    if not isinstance(fmt, str):
+        raise RegisterMapError(f"format must be one of {', '.join(FORMATS)}, not {fmt!r:.40}")
+    if out is not None:
+        _path("out", out)
     if fmt == "html":
         if out is None:
             raise RegisterMapError("format 'html' writes a directory: give an output path")
@@ -583,7 +596,7 @@ def render(fmt: str, out: Path | None = None) -> str:
 
 def write_checked_in(root: Path) -> list[Path]:
     """Regenerate the checked-in files (:data:`CHECKED_IN`) under the repository ``root``; return their paths."""
-    paths = [root / path for path in CHECKED_IN.values()]
+    paths = [_path("root", root) / path for path in CHECKED_IN.values()]
     for fmt, path in zip(CHECKED_IN, paths, strict=True):
         render(fmt, path)
     return paths

@@ -24,6 +24,7 @@ from supi3.regmap.core import (
     RegisterMap,
     RegisterMapError,
     Reset,
+    integer,
 )
 from supi3.tables import (
     ABBREVIATED_LENGTHS,
@@ -430,27 +431,38 @@ class CommandByte:
         return REGISTER_MAP.port(self.address, AccessDirection.WRITE).access is Access.BLOCK_TRANSFER
 
 
-@cache  # a pure function of 64 possible arguments, on the µP interface's hot path
 def encode_command(address: int, *, rd: bool = False, wr: bool = False) -> int:
     """Build a command byte: ``encode_command(13, wr=True) == 0x4D`` (Fig. 3-10).
 
     Raises
     ------
     RegisterMapError
-        If ``address`` is outside 0..15.
+        If ``address`` is no integer from 0 to 15, or ``rd`` or ``wr`` is no bool.
     """
+    for name, flag in (("rd", rd), ("wr", wr)):
+        if not isinstance(flag, bool):
+            raise RegisterMapError(f"{name} must be True or False, not {flag!r:.40}")
+    return _encode_command(integer("field A", address), rd, wr)
+
+
+@cache  # a pure function of 64 possible arguments, on the µP interface's hot path: checked before, so 1 is no True
+def _encode_command(address: int, rd: bool, wr: bool) -> int:
     return COMMAND_BYTE.encode(RD=int(rd), WR=int(wr), A=address)
 
 
-@cache  # a pure function of a byte, on the µP interface's hot path
 def decode_command(byte: int) -> CommandByte:
     """Split a command byte into RD, WR and the address A3..0 (3.4.4).
 
     Raises
     ------
     RegisterMapError
-        If ``byte`` is not a byte or sets a reserved bit (5 or 4).
+        If ``byte`` is not a byte (an integer from 0 to 255) or sets a reserved bit (5 or 4).
     """
+    return _decode_command(integer("CMD", byte))
+
+
+@cache  # a pure function of a byte, on the µP interface's hot path: checked before, so True is no byte
+def _decode_command(byte: int) -> CommandByte:
     fields = COMMAND_BYTE.decode(byte)
     if byte & ~COMMAND_BYTE.mask:
         raise RegisterMapError(f"command byte {byte:02X}h sets reserved bits {byte & ~COMMAND_BYTE.mask:02X}h")

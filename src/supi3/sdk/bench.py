@@ -46,12 +46,14 @@ __all__ = [
     "DEFAULT_STRAPS",
     "SERVE_PASSES",
     "SERVE_TELEGRAMS",
+    "START_WAIT_S",
     "Bench",
     "BenchError",
     "BenchTransport",
     "CycleTiming",
     "Firmware",
     "MainLoopPasses",
+    "MasterStart",
     "default_config",
     "serve_wait_s",
 ]
@@ -71,6 +73,62 @@ board at either fidelity; at pin level the board also idles the line up to this 
 firmware is in a handler or has an /IRQ edge to serve (MCU-17)."""
 SERVE_PASSES: Final[int] = 2
 """MCU-30, FW-14: arrivals at the main loop's idle point that make a whole pass: its entry and the next one."""
+
+
+START_WAIT_S: Final[float] = 1e-3
+"""MCU-17, MCU-45, FW-15: the latest bus time after power-up at which the master starts (Alarm Stop, discovery ID
+cycle), if the firmware's set-up has not ended before (:class:`MasterStart`)."""
+
+
+class MasterStart:
+    """MCU-45, FW-15: when the master starts (its Alarm Stop and discovery ID cycle), the one rule of the firmware
+    bench (:class:`Bench`) and the emulated board at both fidelities (``supi3.mcu.board.Board``).
+
+    The master waits for the firmware's set-up, so that its first ID cycle reads the configuration the firmware
+    writes (3.4.3: SET and ID), not the chip's reset values: the line idles in status telegrams up to :attr:`at`,
+    the bus time the runner said the set-up ended (:meth:`set_up`), at the latest :data:`START_WAIT_S` after
+    power-up (a firmware that never says so), and the master starts at the end of that telegram (:meth:`start_s`).
+    The set-up has ended when the firmware first waits for the bus or first comes to its main loop's idle point: on
+    the board, the core's first sleep (WFI, WFE, a thread-mode ``b .``, MCU-4) or its first arrival at ``fw_loop``
+    (MCU-30); on the firmware bench, :meth:`Bench.power_up` (the firmware's :meth:`Firmware.setup` returned, or the
+    test's own driver calls before its first run). Times are bus seconds since power-up.
+    """
+
+    __slots__ = ("set_up_at",)
+
+    def __init__(self) -> None:
+        self.set_up_at: float | None = None
+        """When the firmware's set-up ended; ``None``: not yet."""
+
+    @property
+    def at(self) -> float:
+        """The bus time the master starts: the set-up's end, at the latest :data:`START_WAIT_S`."""
+        set_up = self.set_up_at
+        return START_WAIT_S if set_up is None or set_up > START_WAIT_S else set_up
+
+    def set_up(self, at: float) -> bool:
+        """The firmware's set-up ended at ``at`` (only the first call counts); whether this call noted it.
+
+        Raises
+        ------
+        ArgumentError
+            ``at`` not a finite number >= 0.
+        """
+        if self.set_up_at is not None:
+            return False
+        self.set_up_at = check_real("at", at, 0.0)
+        return True
+
+    def due(self, now: float) -> bool:
+        """Whether the master starts at bus time ``now`` (at or after :attr:`at`)."""
+        return now >= self.at
+
+    def start_s(self, bit_rate: int) -> float:
+        """The bus time the master starts on a line that idles in whole status telegrams from power-up: the end of
+        the telegram in which :attr:`at` falls (the pin-level board's telegrams, checked with :meth:`due`, end
+        there too)."""
+        telegram_s = wire.STATUS_TELEGRAM_BITS / bit_rate
+        return math.ceil(self.at / telegram_s - 1e-9) * telegram_s  # a telegram's end itself, not the next
 
 
 def serve_wait_s(bit_rate: int) -> float:
@@ -418,8 +476,9 @@ class Bench:
         self.registers.use_clock(lambda: clocks(self.now))
         self._bit_s = 1.0 / self.config.bit_rate
         self._events: list[tuple[float, str]] = []  # this cycle's phase changes, latest first
-        self._next_start = 0.0
-        self._next_at = 0.0  # the time of the next bus event: the last of _events, else _next_start
+        self._start = MasterStart()  # MCU-45, FW-15: the master's first cycle waits for the set-up's end
+        self._next_start = self._start.start_s(self.config.bit_rate)
+        self._next_at = self._next_start  # the time of the next bus event: the last of _events, else _next_start
         # (data bytes, devices, return repeaters), their phases, and the end, latch and I/O bit's offsets from the
         # start (CycleTiming's end, latch, io_busy): worked out again only when the cycle's size changes
         self._phases = ((-1, -1, -1), wire.CyclePhases(0, 0, 0, 0), (0.0, 0.0, 0.0))
@@ -558,11 +617,28 @@ class Bench:
     # -- running -----------------------------------------------------------------------------------------------
 
     def power_up(self) -> None:
-        """Run the firmware's :meth:`Firmware.setup` (once; :meth:`run` does it if needed)."""
+        """Run the firmware's :meth:`Firmware.setup` (once; :meth:`run` does it if needed). Its end is the set-up's
+        end: the master starts then (:class:`MasterStart`, FW-15), unless :data:`START_WAIT_S` came first. Without a
+        firmware the test's own driver calls before its first run are the set-up."""
         if not self._set_up:
             self._set_up = True
             if self.firmware is not None:
                 self.firmware.setup(self.driver)
+            self.set_up_done(self.now)
+
+    def set_up_done(self, at: float) -> None:
+        """The firmware's set-up ended at bus time ``at`` (:class:`MasterStart`: only the first call counts): the
+        master's first cycle starts at the end of that status telegram if it has not started yet, at the latest at
+        :data:`START_WAIT_S` (MCU-45, FW-15). :meth:`power_up` calls it; the emulated board calls it at its core's
+        first wait or first pass.
+
+        Raises
+        ------
+        ArgumentError
+            ``at`` not a finite number >= 0.
+        """
+        if self._start.set_up(at) and not self._started:
+            self._next_start = self._next_at = self._start.start_s(self.config.bit_rate)
 
     def run(self, cycles: int) -> None:
         """Run until ``cycles`` more master cycles have finished and the firmware has served them (FW-14, as the

@@ -447,7 +447,9 @@ class _Core:
             raise NotInitializedError("driver not initialized: call initialize(Mode.MOTOROLA or Mode.INTEL) first "
                                       "(3.4.3), and again after SAS_INIT or a transport error; nothing sent")
 
-    def _note_set(self, address: int, value: int) -> None:
+    def _note_set(self, address: int, value: int | None) -> None:
+        """Keep SET as an access to it left it; ``None`` (unknown) while the access is under way, so that a
+        transport failure leaves it unknown, as ``supi3.c`` does (FW-16)."""
         if address == SET.address:
             self.set_value = value
 
@@ -473,8 +475,9 @@ class _Core:
         self.initialized = True
 
     def sas_init(self) -> _Call[None]:
-        self.initialized = False  # the interface waits for the init byte; every register is kept (3.4.3)
+        initialized, self.initialized = self.initialized, False  # the interface waits for the init byte (3.4.3)
         if not (yield (_SAS, 1, False)):
+            self.initialized = initialized  # refused, nothing driven: the state is kept (FW-16)
             raise UnsupportedError("sas_init(): the transport has no SAS_INIT pin")
         yield (_DELAY, SAS_INIT_PULSE_US, False)
         yield (_SAS, 0, False)
@@ -485,6 +488,7 @@ class _Core:
         return self._read(address)
 
     def _read(self, address: int) -> _Call[int]:
+        self._note_set(address, None)
         yield (_XFER, _READ[address], _S_R_UP_SENDS)
         value: int = yield (_XFER, 0x00, _S_R_CHIP_DRIVES)
         self._note_set(address, value)
@@ -497,6 +501,7 @@ class _Core:
         return self._write(address, byte)
 
     def _write(self, address: int, value: int) -> _Call[None]:
+        self._note_set(address, None)
         yield (_XFER, _WRITE[address], _S_R_UP_SENDS)
         yield (_XFER, value, _S_R_UP_SENDS)
         self._note_set(address, value)
@@ -510,6 +515,7 @@ class _Core:
         return self._exchange(address, byte)
 
     def _exchange(self, address: int, value: int) -> _Call[int]:
+        self._note_set(address, None)
         yield (_XFER, _EXCHANGE[address], _S_R_UP_SENDS)
         result: int = yield (_XFER, value, _S_R_UP_SENDS)
         self._note_set(address, value)
@@ -518,6 +524,7 @@ class _Core:
     def block_transfer(self, in_data: object, read: object, write: object) -> _Call[bytes]:
         data = _checked(check_bytes, "in_data", in_data)
         rd, wr = _checked(check_bool, "read", read), _checked(check_bool, "write", write)
+        self._ready()  # before the length, as supi3_block_transfer (FW-16)
         n = len(data)
         if not BLOCK_MIN_BYTES <= n <= BLOCK_MAX_BYTES:
             raise DriverArgumentError("in_data", in_data, f"in_data must be {BLOCK_MIN_BYTES} to {BLOCK_MAX_BYTES} "
@@ -526,7 +533,6 @@ class _Core:
             raise DriverArgumentError("in_data", in_data, f"in_data must be {_BLOCK_BYTES[self.set_value]} bytes, "
                                       f"the block length of SET = {self.set_value:02X}h (UP-10; 0: no block "
                                       f"transfer), not {describe(in_data)}")  # fmt: skip
-        self._ready()
         intel = self.mode is Mode.INTEL
         if intel and not (rd or wr):
             raise DriverArgumentError("read", read, "read or write must be True in Intel mode (UP-11)")
@@ -569,7 +575,7 @@ class _Core:
     def _irq_service(self) -> _Call[Irq]:
         if (yield (_IRQ, 0, False)):
             return Irq(0)
-        return Irq((yield from self._read(IRQ_EVT.address)) & _EVENT_MASK)
+        return Irq((yield from self._read(IRQ_EVT.address)))  # D7 too, as supi3_irq_service (FW-16)
 
     def poll_io_window(self, max_polls: object) -> _Call[Irq]:
         polls = _checked(check_int, "max_polls", max_polls, 1, None, "polls of the I/O access bit")
@@ -668,7 +674,10 @@ class Supi3Driver(_DriverApi):
                         answer = None
                         transport.delay_us(argument)
                     else:
-                        answer = _pin(transport, kind, int(argument))
+                        try:
+                            answer = _pin(transport, kind, int(argument))
+                        except (OSError, TransportError) as error:  # a pin: the chip's state is as it was
+                            raise _transport_error(error) from error
             except StopIteration as stop:
                 return stop.value  # type: ignore[no-any-return]
 
@@ -688,25 +697,22 @@ class Supi3Driver(_DriverApi):
         """Read one register (3.4.4): ``drv.read(OUT0)``; reading IRQ_EVT clears the events (3.4.14)."""
         direct = self._direct
         if direct is not None and direct.ready():
-            core = self._core
             address = _address(register, AccessDirection.READ)
-            core._ready()
-            value = direct.read(address)
-            core._note_set(address, value)
-            return value
+            if address != SET.address:  # SET frame by frame: the driver keeps it when the model raises after (FW-16)
+                self._core._ready()
+                return direct.read(address)
         return self._run(self._core.read(register))
 
     def write(self, register: Register, value: int) -> None:
         """Write one register (3.4.4): ``drv.write(IN0, 0x12)``."""
         direct = self._direct
         if direct is not None and direct.ready():
-            core = self._core
             address = _address(register, AccessDirection.WRITE)
-            byte = _byte("value", value)
-            core._ready()
-            direct.write(address, byte)
-            core._note_set(address, byte)
-            return
+            if address != SET.address:  # as in read() (FW-16)
+                byte = _byte("value", value)
+                self._core._ready()
+                direct.write(address, byte)
+                return
         self._run(self._core.write(register, value))
 
     def exchange(self, register: Register, value: int) -> int:
@@ -729,7 +735,9 @@ class Supi3Driver(_DriverApi):
         self._run(self._core.irq_enable(mask))
 
     def irq_service(self) -> Irq:
-        """Read-clear IRQ_EVT (3.4.14); with /IRQ wired and high, return no events and send nothing."""
+        """Read-clear IRQ_EVT (3.4.14): its events and, as ``supi3_irq_service``, D7, the I/O access status (RM-7,
+        RM-8; a bit that is no :class:`Irq` member: test events with ``&``); with /IRQ wired and high, return no
+        events and send nothing."""
         return self._run(self._core.irq_service())
 
     def poll_io_window(self, max_polls: int) -> Irq:
@@ -779,7 +787,10 @@ class AsyncSupi3Driver(_DriverApi):
                     answer = None
                     await transport.delay_us(argument)
                 else:
-                    answer = await _async_pin(transport, kind, int(argument))
+                    try:
+                        answer = await _async_pin(transport, kind, int(argument))
+                    except (OSError, TransportError) as error:  # a pin: the chip's state is as it was
+                        raise _transport_error(error) from error
         except StopIteration as stop:
             return stop.value  # type: ignore[no-any-return]
 

@@ -13,6 +13,10 @@
   argument of ``Bench``: ``config``, ``firmware``, ``mode``, ``bit_rate``, ``others``, ``sclk_hz``,
   ``frame_gap_us``, ``cycle_time_s``, ``strict``); without the marker, the defaults.
 - ``supi3_ring``, ``supi3_master``: that bench's ring and INTERBUS master.
+
+A firmware object keeps its state (a C firmware its statics and ``fw_board_t``), so the marker's ``firmware`` serves
+one test: a second test given the same object (``parametrize``, a class or module mark) is an error naming the
+first (FW-17); ``pytest.param(..., marks=pytest.mark.supi3(firmware=...))`` gives each case its own.
 """
 
 from __future__ import annotations
@@ -27,6 +31,8 @@ from supi3.sdk.bench import Bench
 
 MARKER = "supi3"
 """The marker whose keyword arguments configure ``supi3_bench``."""
+_FIRMWARE_TESTS = pytest.StashKey[dict[int, tuple[object, str]]]()
+"""id of each marker firmware that ran -> (the object, kept so that the id stays its, the test it ran in)."""
 
 
 def pytest_configure(config: pytest.Config) -> None:
@@ -46,7 +52,17 @@ def supi3_bench(request: pytest.FixtureRequest) -> Bench:
         shown = repr(marker.args) if marker.args else ", ".join(unknown)
         raise pytest.UsageError(f"@pytest.mark.{MARKER} takes keyword arguments of Bench only "
                                 f"({', '.join(inspect.signature(Bench).parameters)}), not {shown}")
-    return Bench(**marker.kwargs)
+    bench = Bench(**marker.kwargs)  # its own errors first (a firmware class, say)
+    firmware = bench.firmware
+    if firmware is not None:
+        ran = request.config.stash.setdefault(_FIRMWARE_TESTS, {})
+        _, first = ran.setdefault(id(firmware), (firmware, request.node.nodeid))
+        if first != request.node.nodeid:
+            raise pytest.UsageError(f"@pytest.mark.{MARKER}(firmware=...): this firmware object already ran in "
+                                    f"{first} and keeps its state there; a firmware is one per test: "
+                                    f"pytest.param(..., marks=pytest.mark.{MARKER}(firmware=...)) per case, or a "
+                                    f"marker per test (FW-17)")  # fmt: skip
+    return bench
 
 
 @pytest.fixture

@@ -146,12 +146,14 @@ class SpidevTransport(Transport):
                           ("set_sas_init", set_sas_init), ("set_s_r", set_s_r)):  # fmt: skip
             if pin is not None and not callable(pin):
                 raise DriverArgumentError(name, pin, f"{name} must be a callable or None, not {describe(pin)}")
+        bus, device = check_int("bus", bus, 0), check_int("device", device, 0)
+        speed_hz = check_int("speed_hz", speed_hz, 1)
         module = importlib.import_module("spidev") if spidev_module is None else spidev_module
         self.spi = module.SpiDev()
-        self.spi.open(check_int("bus", bus, 0), check_int("device", device, 0))
+        self.spi.open(bus, device)  # every argument checked first: a refused transport leaves no device open
         self.spi.mode = 0b11
         self.spi.lsbfirst = mode is Mode.INTEL
-        self.spi.max_speed_hz = check_int("speed_hz", speed_hz, 1)
+        self.spi.max_speed_hz = speed_hz
         self._pins = (read_cd, read_irq, read_io)
         self._sas = set_sas_init
         self._s_r = set_s_r

@@ -15,7 +15,7 @@ from cocotb.clock import Clock
 from cocotb.triggers import FallingEdge, Timer
 
 from supi3.pinlevel import PinModel, PinSpecError, check_cycles, recent_events
-from supi3.verif.layout import CycleMatrix, WordLayout, model_columns, model_trace
+from supi3.verif.layout import Stimulus, WordLayout, model_columns, model_trace, stimulus_array
 from supi3.verif.report import MismatchRecord, Outcome
 from supi3.verif.vcd import CYCLE_NS
 
@@ -26,7 +26,7 @@ POLL_CYCLES = 1024
 
 
 async def lockstep(
-    dut: Any, model: PinModel, stimulus: CycleMatrix, *, reset_cycles: int = 0, window: int = 64
+    dut: Any, model: PinModel, stimulus: Stimulus, *, reset_cycles: int = 0, window: int = 64
 ) -> Outcome:
     """Clock the DUT and the model together; the top's comparator checks every output signal on every cycle.
 
@@ -44,7 +44,8 @@ async def lockstep(
     model:
         A fresh model.
     stimulus:
-        Input values ``(cycles, inputs)`` in the model's input order.
+        Input values ``(cycles, inputs)`` in the model's input order, or per-cycle dicts
+        (:func:`~supi3.verif.layout.stimulus_array`).
     reset_cycles:
         Rising edges with reset asserted before cycle 0 (0: none, the design starts from its initial values).
     window:
@@ -59,11 +60,13 @@ async def lockstep(
     Raises
     ------
     PinSpecError
-        ``reset_cycles`` not an integer from 0 or ``window`` not one from 1 (before the clock starts).
+        ``reset_cycles`` not an integer from 0 or ``window`` not one from 1, or a stimulus
+        :func:`~supi3.verif.layout.stimulus_array` refuses (before the clock starts).
     """
     reset_cycles = check_cycles("reset_cycles", reset_cycles, 0)
     window = check_cycles("window", window, 1)
     layout = WordLayout.of(model)
+    stimulus = stimulus_array(stimulus, layout.inputs)  # checked before the clock starts
     in_ports = [getattr(dut, f"stim_word{index}") for index in range(layout.in_words)]
     expected_ports = [getattr(dut, f"expected_word{index}") for index in range(layout.out_words)]
     flag = dut.mismatch

@@ -10,19 +10,21 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
+from numbers import Integral
 from operator import itemgetter
 from typing import TypeAlias
 
 import numpy as np
 import numpy.typing as npt
 
-from supi3.pinlevel import Pin, PinModel, PinSpecError, compared_signals
+from supi3.pinlevel import Pin, PinModel, PinSpecError, check_cycles, compared_signals
 
 __all__ = [
     "CycleMatrix",
     "Stimulus",
     "WordField",
     "WordLayout",
+    "apply_inputs",
     "first_mismatch",
     "model_columns",
     "model_trace",
@@ -260,6 +262,33 @@ def _pack(fields: Sequence[WordField], words: int, columns: Sequence[npt.NDArray
     return packed.T
 
 
+def apply_inputs(cycle: int, values: object, inputs: Sequence[Pin], names: Mapping[str, int],
+                 current: list[int]) -> None:  # fmt: skip
+    """Set ``current`` (the input levels in ``inputs`` order; ``names`` maps a pin's name to its index) from one
+    cycle's dict of a stimulus or a reacting agent: pins it leaves out keep their level.
+
+    Raises
+    ------
+    PinSpecError
+        ``values`` is no mapping, names no input pin, or gives a level that is no integer (``bool``, floats and strings
+        are not: a level is never cast) or does not fit the pin; named with ``cycle``. ``current`` may be changed for
+        the pins before the one refused.
+    """
+    if not isinstance(values, Mapping):
+        raise PinSpecError(f"cycle {cycle}: stimulus must be a mapping of input pins to values, not {values!r:.80}")
+    for name, value in values.items():
+        if name not in names:
+            raise PinSpecError(f"cycle {cycle}: {name!r} is not an input pin of the model")
+        pin = inputs[names[name]]
+        level = int(value) if isinstance(value, Integral) and not isinstance(value, bool | np.bool_) else -1
+        if level < 0:
+            raise PinSpecError(f"cycle {cycle}: input {name!r} must be an integer from 0 to {pin.mask:#x} "
+                               f"({pin.width} bits), not {value!r:.40}")  # fmt: skip
+        if level > pin.mask:
+            raise PinSpecError(f"cycle {cycle}: input {name!r} = {level:#x} exceeds {pin.width} bits")
+        current[names[name]] = level
+
+
 def stimulus_array(stimulus: Stimulus, inputs: Sequence[Pin], max_cycles: int | None = None) -> CycleMatrix:
     """Normalise stimulus to a ``uint64`` array ``(cycles, inputs)``, checking names and value ranges.
 
@@ -270,10 +299,23 @@ def stimulus_array(stimulus: Stimulus, inputs: Sequence[Pin], max_cycles: int | 
     inputs:
         The model's input pins.
     max_cycles:
-        Take at most this many cycles (needed for an endless generator).
+        Take at most this many cycles (needed for an endless generator): an integer from 0, or ``None`` for all.
+
+    Raises
+    ------
+    PinSpecError
+        ``max_cycles`` not ``None`` nor an integer from 0; an array that is not 1-D (one input) or 2-D of shape
+        ``(cycles, inputs)``, or holds no integers or negative ones; an iterable whose cycle is no mapping, names no
+        input pin, or gives a value that is no integer (``bool``, floats and strings are not: a level is never cast)
+        or does not fit the pin, named with its cycle.
     """
+    if max_cycles is not None:
+        max_cycles = check_cycles("max_cycles", max_cycles, 0)
+    if isinstance(stimulus, (str, bytes, Mapping)) or not isinstance(stimulus, (np.ndarray, Iterable)):
+        raise PinSpecError(f"stimulus must be an integer array (cycles, inputs) or an iterable of per-cycle dicts, "
+                           f"not {stimulus!r:.80}")  # fmt: skip
     if isinstance(stimulus, np.ndarray):
-        array = stimulus if stimulus.ndim == 2 else stimulus.reshape(-1, 1)
+        array = stimulus if stimulus.ndim == 2 else stimulus.reshape(-1, 1) if stimulus.ndim == 1 else stimulus
         if array.ndim != 2 or array.shape[1] != len(inputs):
             raise PinSpecError(f"array stimulus must have shape (cycles, {len(inputs)}), not {stimulus.shape}")
         if not np.issubdtype(array.dtype, np.integer):
@@ -288,10 +330,7 @@ def stimulus_array(stimulus: Stimulus, inputs: Sequence[Pin], max_cycles: int | 
         for cycle, values in enumerate(stimulus):
             if max_cycles is not None and cycle >= max_cycles:
                 break
-            for name, value in values.items():
-                if name not in names:
-                    raise PinSpecError(f"cycle {cycle}: {name!r} is not an input pin of the model")
-                current[names[name]] = int(value)
+            apply_inputs(cycle, values, inputs, names, current)
             rows.append(list(current))
         result = np.array(rows, dtype=np.uint64).reshape(len(rows), len(inputs))
     for index, pin in enumerate(inputs):

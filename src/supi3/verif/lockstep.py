@@ -32,7 +32,15 @@ import numpy as np
 
 from supi3.pinlevel import ModelFactory, PinSpecError, check_cycles, recent_events
 from supi3.verif.errors import SimulationError
-from supi3.verif.layout import CycleMatrix, Stimulus, WordLayout, model_columns, model_trace, stimulus_array
+from supi3.verif.layout import (
+    CycleMatrix,
+    Stimulus,
+    WordLayout,
+    apply_inputs,
+    model_columns,
+    model_trace,
+    stimulus_array,
+)
 from supi3.verif.report import LockstepResult, Outcome, raise_mismatch, window_trace
 from supi3.verif.rtl import TOP, DesignFactory, build_slot, ensure_toolchain, to_verilog
 
@@ -440,7 +448,16 @@ def react(
     ``agent(cycle, outputs)`` returns the inputs of ``cycle`` (a dict; missing pins keep their value) given the
     outputs of the previous cycle (``None`` for cycle 0). Replaying the result into the RTL is exact up to the first
     mismatch, since until then the RTL's outputs equal the model's.
+
+    Raises
+    ------
+    PinSpecError
+        ``cycles`` no integer from 0, ``agent`` not callable, or an agent's dict that
+        :func:`~supi3.verif.layout.apply_inputs` refuses (named with its cycle; the model never steps with it).
     """
+    cycles = check_cycles("cycles", cycles, 0)
+    if not callable(agent):
+        raise PinSpecError(f"agent must be a function agent(cycle, outputs) -> inputs, not {agent!r:.80}")
     model = model_factory()
     layout = WordLayout.of(model)
     names = {pin.name: index for index, pin in enumerate(layout.inputs)}
@@ -449,10 +466,7 @@ def react(
     outputs: Mapping[str, int] | None = None
     model.reset()
     for cycle in range(cycles):
-        for name, value in agent(cycle, outputs).items():
-            if name not in names:
-                raise PinSpecError(f"cycle {cycle}: {name!r} is not an input pin of the model")
-            current[names[name]] = int(value)
+        apply_inputs(cycle, agent(cycle, outputs), layout.inputs, names, current)  # checked before the model steps
         rows.append(list(current))
         outputs = dict(model.step(dict(zip(names, current, strict=True))))
     return stimulus_array(np.array(rows, dtype=np.uint64).reshape(cycles, len(names)), layout.inputs)

@@ -108,8 +108,8 @@ int supi3_block_transfer(supi3_t *ctx, int rd, int wr, uint8_t *out, const uint8
 int supi3_configure(supi3_t *ctx, uint8_t set_value, uint8_t id_value);
 
 /**
- * Read-clear the interrupt event register (3.4.14, read 14). With read_irq and /IRQ high, *events = 0
- * and nothing is sent.
+ * Read-clear the interrupt event register (3.4.14, read 14): *events = the byte read, the events D6..D0 and D7, the
+ * I/O access status (RM-7, RM-8). With read_irq and /IRQ high, *events = 0 and nothing is sent.
  */
 int supi3_irq_service(supi3_t *ctx, uint8_t *events);
 
