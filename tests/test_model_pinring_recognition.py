@@ -331,7 +331,7 @@ def test_a_branch_joining_within_a_cycle_fails_that_cycle_at_both_fidelities(kin
     repaired after the start, the branch answers in the next cycle's run and joins the data path within its frame at
     both fidelities: that cycle fails at both with the same error (:data:`JOIN_ERRORS`: where the pin-level BK switched,
     given by the repaired line), not located, and every cycle after it is the same (the master meets the longer ring:
-    the loopback word out of place, BK-45)."""
+    the loopback word left out: a configuration error, then data cycles on it, BK-45, A25)."""
     for index, (fault, (_, _, branch)) in enumerate(cuts(kind)):
         if kind.diagnostics and not branch:
             continue  # the LBD branch's devices answer behind a break with counter telegrams (BK-30)
@@ -346,9 +346,11 @@ def test_a_branch_joining_within_a_cycle_fails_that_cycle_at_both_fidelities(kin
         assert start is not None and start[1] and start[3] is not None and len(start[3][0]) == 3, index  # through BK
         error = JOIN_ERRORS.get(fault, ErrorKind.DEAD_LINE)
         assert joined is not None and not joined[1] and joined[2] == [(error, None, None)], index
-        # The longer ring after it: the loopback word out of place; without location the table stays (BK-45).
-        after = [step[0][3] for step in steps[6:]]
-        assert all(seen is not None and seen[2] == [(ErrorKind.LOOPBACK, None, None)] for seen in after), index
+        # The longer ring after it: the loopback word left out, the rescan finds it without location too (A25),
+        # a configuration error, then the master runs on the longer ring.
+        first, last = steps[6][0][3], steps[-1][0][3]
+        assert first is not None and [d[0] for d in first[2]] == [ErrorKind.CONFIGURATION], index
+        assert last is not None and last[1] and last[3] is not None and len(last[3][0]) > 3, index
 
 
 def test_the_transaction_level_loses_the_frame_a_branch_joins_within() -> None:
