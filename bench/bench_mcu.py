@@ -15,7 +15,9 @@ and MCU-11 off) and against the host build. ``--profile`` also splits the CPU ti
 slows the calls it counts, so the split is a guide, not a measure) by part: unicorn's C code with the native block
 and memory hooks (MCU-25) and the ctypes transitions into the Python callbacks, a block's first costing, the rest of
 the core, the STM32 peripheral models, the board's bus synchronisation and checks, and the chip, ring and bench
-models. Run from the repository root:
+models. Every measured window (each mode, ``--profile`` too) begins after the power-up and after the firmware's
+DWARF line tables have been read (``_board``): the first violation's backtrace reads them once, and whether that
+violation falls in the power-up or in the window depends on the run. Run from the repository root:
 
     python bench/bench_mcu.py [--cycles N] [--repeat R] [--profile]
 """
@@ -36,11 +38,9 @@ from pathlib import Path
 
 from supi3.mcu.board import Board
 from supi3.mcu.build import build
+from supi3.mcu.session import POWER_UP_CYCLES
 from supi3.sdk import native
 from supi3.sdk.bench import Bench
-
-POWER_UP = 3
-"""Cycles before the measured ones: set-up, the ID cycle, the first data cycle."""
 
 
 def _cpu_s(run: Callable[[], None], repeat: int) -> float:
@@ -54,13 +54,16 @@ def _cpu_s(run: Callable[[], None], repeat: int) -> float:
 
 
 def _board(elf: Path, bit_rate: int, skip: bool) -> Board:
-    """The board after power-up, the master's outputs and the firmware's inputs set."""
+    """The board after power-up, the master's outputs and the firmware's inputs set, and the firmware's DWARF line
+    tables read (a violation's backtrace reads them once, at the first; whether that falls in the power-up depends
+    on the run, so it is done here, outside every measured window)."""
     board = Board(elf, bit_rate=bit_rate, strict=False)
     board.core.skip_polls = skip
-    board.run(POWER_UP)
+    board.run(POWER_UP_CYCLES)
     board.bench.master.set_outputs(1, b"\x12\x34")
     assert board.fw_board is not None
     board.fw_board.inputs = b"\xab\xcd"
+    _ = board.core.image.line_at(0)  # the DWARF tables, else read at the first backtrace
     return board
 
 
@@ -98,7 +101,6 @@ def profile_split(elf: Path, bit_rate: int, cycles: int) -> list[tuple[str, floa
     """The own CPU time of ``cycles`` master cycles under cProfile, by part (:data:`PARTS`), largest first, as
     fractions of the whole."""
     board = _board(elf, bit_rate, skip=True)
-    _ = board.core.image.line_at(0)  # the DWARF tables (for the violations' lines) are read once, before
     profiler = cProfile.Profile()
     profiler.runcall(board.run, cycles)
     split: collections.Counter[str] = collections.Counter()
@@ -116,7 +118,7 @@ def host_run(bit_rate: int, cycles: int, repeat: int) -> tuple[float, float]:
     fastest = float("inf")
     for _ in range(repeat):
         bench = Bench(firmware=firmware, bit_rate=bit_rate)
-        bench.run(POWER_UP)
+        bench.run(POWER_UP_CYCLES)
         start = bench.now
         fastest = min(fastest, _cpu_s(partial(bench.run, cycles), 1))
         simulated = bench.now - start

@@ -64,7 +64,8 @@ def test_devices_behind_the_chip_at_pin_level_are_the_transaction_levels(
 @pytest.mark.parametrize(("argv", "expect"), [
     (["--vcd", "{tmp}/x.vcd"], "--vcd needs --fidelity pin (the transaction-level chip has no pins)"),
     (["--fidelity", "pin", "--devices", "5"], "--devices must be an integer from 1 to 4 (with --fidelity pin"),
-    (["--fidelity", "pin", "--cycles", "51"], "--cycles must be an integer from 3 to 50 (with --fidelity pin"),
+    (["--fidelity", "pin", "--cycles", "51"],
+     "--cycles must be an integer from 6 to 50 (the power-up's 3 and 3 to check the exchange; with --fidelity pin"),
     (["--fidelity", "gate"], "invalid choice: 'gate'"),
     (["--mode", "spi"], "invalid choice: 'spi'"),
     (["--fidelity", "pin", "--vcd", "{tmp}/no/x.vcd"], "--vcd"),

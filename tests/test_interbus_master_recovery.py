@@ -1,11 +1,13 @@
 """Issue #8, parts 1 and 2: the master recovers from ring changes, locates errors right or not at all, and keeps
 its diagnostics bounded. Scenarios from the issue, then properties over histories of faults, changes and resets.
+Issue #12: a master without error location finds a ring shortened by a BK's closure or lengthened by a reset (A25)
+and runs again on it, over any history of a tree.
 """
 
 from __future__ import annotations
 
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from supi3 import tables
@@ -14,12 +16,13 @@ from supi3.interbus import wire
 from supi3.interbus.device import PlainDevice
 from supi3.interbus.errors import InterbusError
 from supi3.interbus.link import Device
-from supi3.interbus.master import Master
-from supi3.interbus.ring import BitFlip, CorruptLoopback, DeadLine, ErrorKind, Fault, Ring, Truncate
+from supi3.interbus.master import CycleResult, Master
+from supi3.interbus.ring import BitFlip, BranchKind, CorruptLoopback, DeadLine, ErrorKind, Fault, Ring, Truncate
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
 from supi3.model.pinring import PinRing
 from supi3.model.pins import Supi3Pins
+from test_model_pinring_tree import CASES, SILENCE, pin_tree, tl_tree
 
 USABLE_LENGTHS = [int(row.code, 2) for row in tables.LENGTH_CODES if row.bits is not None]
 ID_CODE_VALUES = sorted({row.code for row in tables.ID_CODES})
@@ -115,6 +118,176 @@ def test_a_changed_id_code_at_same_length_is_found_in_the_next_id_cycle() -> Non
     (diagnostic,) = master.cycle().diagnostics
     assert diagnostic.kind is ErrorKind.CONFIGURATION and diagnostic.location == 2
     healthy(master)
+
+
+@pytest.mark.parametrize("change", ["remove", "insert"])
+def test_without_location_a_device_removed_or_inserted_is_found_then_rediscovered(change: str) -> None:
+    """A25: fewer devices put the loopback word of the ID cycle over the table out of place, more leave it out (the
+    discovery-sized rescan then finds the count); both a configuration error at the first position that differs,
+    then data cycles on the new ring, with ``locate=False``."""
+    ring, master = started(distinct(4), locate=False)
+    if change == "remove":
+        del ring.devices[2]
+    else:
+        ring.devices.insert(2, PlainDevice(0x40, 0b01001))
+    kinds = [d.kind for _ in range(3) for d in master.cycle().diagnostics]
+    assert kinds[-1] is ErrorKind.CONFIGURATION and master.diagnostics[-1].location == 3
+    healthy(master)
+    assert master.config is not None and len(master.config) == len(ring.devices)
+
+
+def test_without_location_a_corrupted_loopback_word_is_no_configuration_error() -> None:
+    """A25: a loopback word missing while the ring keeps its length (a sender's fault, CRC good) is reported as it
+    is, not located, and the table stays."""
+    ring, master = started(distinct(3), locate=False)
+    ring.inject(CorruptLoopback(2, 0x1234, None))
+    kinds = {d.kind for _ in range(4) for d in master.cycle().diagnostics}
+    assert kinds == {ErrorKind.LOOPBACK} and master.config is not None and len(master.config) == 3
+    ring.clear_faults()
+    healthy(master)
+
+
+def closed(kind: BranchKind, m: int, **options: bool) -> tuple[Ring, Master, list[ErrorKind]]:
+    """The tree of ``kind`` with ``m`` branch devices, the branch switched on with the extended function (BK-3) and
+    its last device's forward line cut, then cycles until the BK closed the branch (BK-50) and 3 more; the
+    diagnostic kinds seen."""
+    ring = tl_tree(kind, m, silence=SILENCE)
+    master = Master(ring, max_devices=8, **options)
+    assert master.start().ok
+    master.switch_branch(2, True, extended=True)
+    healthy(master)
+    ring.cut(2 + m, True)
+    bk = ring.devices[1]
+    assert isinstance(bk, Supi3)
+    kinds: list[ErrorKind] = []
+    after = 0
+    while after < 3 and len(kinds) < 40 and not master.stopped:
+        kinds += [d.kind for d in master.cycle().diagnostics]
+        after += bool(bk.bus_terminal is not None and bk.bus_terminal.closures)
+    return ring, master, kinds
+
+
+@pytest.mark.parametrize(("kind", "m"), CASES[:4])
+def test_without_location_a_master_runs_on_after_a_bk_closed_its_branch(kind: BranchKind, m: int) -> None:
+    """Issue #12 (BK-45, A25): a BK that closes its silent branch (2.4) shortens the ring; the master without error
+    location reads the loopback word after fewer ID registers, a configuration error at the BK's branch, rediscovers
+    (A19) and runs data cycles on the shorter ring, then reads the BK's report."""
+    ring, master, kinds = closed(kind, m, locate=False)
+    assert ErrorKind.CONFIGURATION in kinds
+    healthy(master)
+    assert master.config is not None and len(master.config) == 3
+    for _ in range(3):
+        master.cycle()
+    assert ErrorKind.BRANCH_CLOSED in [d.kind for d in master.diagnostics]
+    ring.clear_faults()
+    ring.reset()  # the reset switches the branch on again (BK-9): a longer ring than the table, found by the rescan
+    kinds = [d.kind for _ in range(2) for d in master.cycle().diagnostics]
+    assert kinds[-1] is ErrorKind.CONFIGURATION
+    healthy(master)
+    assert len(master.config) == 3 + m
+
+
+def test_without_rediscover_a_closure_waits_for_start() -> None:
+    """A19, A25: with ``rediscover=False`` the closure's configuration error stops the master until ``start()``."""
+    _, master, kinds = closed(BranchKind.LOCAL, 2, locate=False, rediscover=False)
+    assert ErrorKind.CONFIGURATION in kinds and master.stopped
+    with pytest.raises(InterbusError, match="waits for start"):
+        master.cycle()
+    master.start()  # the reset switches the branch on again (BK-9), into the cut: the ring carries no frame
+    assert not master.stopped
+
+
+SETTLE_CYCLES = 16
+"""After a tree's last change a master without location runs data cycles again within this many cycles, if a
+fresh master (no reset) can run on that ring: the closure (``SILENCE``, about 3 cycles) and its rediscovery."""
+
+TREE_OPS = ["off", "on", "ext", "start", "reset", "cut", "di3", "ret", "repair", "wait"]
+TREE_STEPS = st.lists(
+    st.tuples(st.sampled_from(TREE_OPS), st.integers(3, 4), st.integers(0, 3)), min_size=1, max_size=6
+)
+
+
+def run_tree(ring: Ring | PinRing, master: Master, steps: list[tuple[str, int, int]]) -> list[CycleResult]:
+    """``steps`` on the tree: ``off``, ``on``, ``ext`` (``switch_branch``, if the table has the BK's entry),
+    ``start``, ``reset`` (``ring.reset()`` alone: the BK switches its branch on again, BK-9), ``cut`` (the forward line
+    into physical position ``k``), ``di3`` (the BK's branch return input), ``ret`` (a remote bus return line next to
+    the BK), ``repair`` (every break), ``wait`` (nothing); each followed by its number of cycles, then
+    ``SETTLE_CYCLES`` cycles. Returns every cycle's result."""
+    seen: list[CycleResult] = []
+    for op, k, cycles in steps:
+        if op == "start":
+            seen.append(master.start())
+        elif op == "reset":
+            ring.reset()
+        elif op == "cut":
+            ring.cut(k, True)
+        elif op == "di3":
+            ring.cut(2, False, branch=True)
+        elif op == "ret":
+            ring.cut(k - 2, False)
+        elif op == "repair":
+            if isinstance(ring, Ring):
+                ring.clear_faults()
+            else:
+                ring.cuts.clear()
+        elif op != "wait" and master.config is not None and len(master.config) > 1 and master.config[1].data_bytes == 0:
+            master.switch_branch(2, op != "off", extended=op == "ext")
+        seen += [master.cycle() for _ in range(cycles)]
+    return seen + [master.cycle() for _ in range(SETTLE_CYCLES)]
+
+
+def passes_data(results: list[CycleResult]) -> bool:
+    return any(r.ok and r.cycle is Cycle.DATA for r in results)
+
+
+@settings(max_examples=100, deadline=None)  # about 0.07 s an example
+@given(st.sampled_from(CASES), TREE_STEPS)
+@example((BranchKind.LOCAL, 2), [("ext", 3, 3), ("cut", 4, 0)])  # issue #12: the closure, a shorter ring
+@example((BranchKind.LBD_MR, 1), [("off", 3, 3), ("reset", 3, 0)])  # the reset switches the branch on: longer
+@example((BranchKind.LBD_OR, 1), [("ext", 3, 1), ("cut", 3, 3), ("wait", 3, 3), ("repair", 3, 1), ("reset", 3, 0)])
+def test_without_location_a_master_is_never_stuck_after_any_tree_history(
+    case: tuple[BranchKind, int], steps: list[tuple[str, int, int]]
+) -> None:
+    """Issue #12 (A25): over any history of branch switches (with and without the extended function), INTERBUS
+    resets, starts, cuts (in the branch, of the BK's DI3, of a remote bus return line), repairs and the closures they
+    bring, a master with ``locate=False`` and ``rediscover=True`` is never stuck: once the tree stops changing it
+    latches data cycles within ``SETTLE_CYCLES`` on whatever ring is left, whenever a fresh master (no reset) can,
+    and with the same configuration."""
+    kind, m = case
+    ring = tl_tree(kind, m, silence=SILENCE)
+    master = Master(ring, locate=False, max_devices=8)
+    assert master.start().ok
+    ours = run_tree(ring, master, [(op, min(k, 2 + m), cycles) for op, k, cycles in steps])[-SETTLE_CYCLES:]
+    fresh = Master(ring, locate=False, max_devices=8)
+    if not passes_data([fresh.cycle() for _ in range(SETTLE_CYCLES)]):
+        return  # the ring carries no frame: nothing to run on
+    assert passes_data(ours), [d.kind for r in ours for d in r.diagnostics]
+    assert master.cycle().ok and master.config == fresh.config
+
+
+PIN_HISTORIES = [
+    ((BranchKind.LBD_MR, 1), [("off", 3, 3), ("reset", 3, 0)]),
+    pytest.param((BranchKind.LBD_MR, 2), [("ext", 3, 3), ("cut", 4, 3), ("off", 3, 2), ("on", 3, 3)],
+                 marks=pytest.mark.slow),
+]  # fmt: skip
+"""Histories of the property above run at both fidelities (about 5 s each: the pin level is slow); the quick tier
+keeps the longer ring after a reset, ``test_model_pinring_tree`` the closure, its repair and a reset (BK-45)."""
+
+
+@pytest.mark.parametrize(("case", "steps"), PIN_HISTORIES)
+def test_without_location_a_master_runs_on_alike_at_both_fidelities(
+    case: tuple[BranchKind, int], steps: list[tuple[str, int, int]]
+) -> None:
+    """Issue #12 (A25): a sample of the histories above at the pin level (``PinRing``): every cycle's success and
+    diagnostics (kind, location, device) as at transaction level, and data cycles latched at the end."""
+    kind, m = case
+    seen = []
+    for ring in (tl_tree(kind, m, silence=SILENCE), pin_tree(kind, m, silence=SILENCE)):
+        master = Master(ring, locate=False, max_devices=8)
+        results = [master.start(), *run_tree(ring, master, steps)]
+        seen.append([(r.cycle, r.ok, [(d.kind, d.location, d.device) for d in r.diagnostics]) for r in results])
+        assert passes_data(results[-3:])
+    assert seen[0] == seen[1]
 
 
 # -- part 2: error locations ---------------------------------------------------------------------------------------

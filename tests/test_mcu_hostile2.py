@@ -25,7 +25,7 @@ from supi3.interbus.device import PlainDevice
 from supi3.mcu.board import Board, BoardError
 from supi3.mcu.core import CortexM
 from supi3.mcu.pins import mcu_lines
-from supi3.mcu.session import run_firmware
+from supi3.mcu.session import MIN_CYCLES, run_firmware
 from supi3.spi.upif import Mode
 from support import bad
 from test_mcu_hostile import FILES, RAM_TOP, firmware
@@ -135,7 +135,7 @@ def test_the_budget_ends_a_runaway_with_a_report(files: Path, budget: int, fidel
     # within one block of it (was 648,168 instructions for a budget of 1 at transaction level), or by its fault.
     if fidelity == "pin":
         budget = min(budget, 2000)  # every chip clock is stepped
-    report = run_firmware(files / name, fidelity=fidelity, cycles=3, max_instructions=budget)
+    report = run_firmware(files / name, fidelity=fidelity, cycles=MIN_CYCLES, max_instructions=budget)
     assert report.stop is not None and report.error is None
     if name == "udf.elf":
         assert report.stop.stop == "fault"
@@ -148,14 +148,14 @@ def test_the_budget_ends_a_runaway_with_a_report(files: Path, budget: int, fidel
 CLI_BAD: list[tuple[list[str], str]] = [
     (["--fidelity", "pin", "--devices", "5"], "--devices must be an integer from 1 to 4 (with --fidelity pin"),
     (["--fidelity", "pin", "--devices", "0"], "--devices must be an integer from 1 to 4 (with --fidelity pin"),
-    (["--fidelity", "pin", "--cycles", "2"], "--cycles must be an integer from 3 to 50"),
-    (["--fidelity", "pin", "--cycles", "51"], "--cycles must be an integer from 3 to 50"),
+    (["--fidelity", "pin", "--cycles", "5"], "--cycles must be an integer from 6 to 50"),
+    (["--fidelity", "pin", "--cycles", "51"], "--cycles must be an integer from 6 to 50"),
     (["--fidelity", "PIN"], "argument --fidelity: invalid choice"),
     (["--mode", "INTEL"], "argument --mode: invalid choice"),
     (["--mode", ""], "argument --mode: invalid choice"),
     (["--vcd", "{d}/x.vcd"], "--vcd needs --fidelity pin"),
-    (["--fidelity", "pin", "--cycles", "3", "--vcd", "{d}"], "(--vcd): is a directory"),
-    (["--fidelity", "pin", "--cycles", "3", "--vcd", "{d}/missing/x.vcd"], "does not exist"),
+    (["--fidelity", "pin", "--cycles", "6", "--vcd", "{d}"], "(--vcd): is a directory"),
+    (["--fidelity", "pin", "--cycles", "6", "--vcd", "{d}/missing/x.vcd"], "does not exist"),
     (["--devices", "x"], "argument --devices: must be an integer"),
     (["--cycles", "1e3"], "argument --cycles: must be an integer"),
 ]
@@ -172,11 +172,11 @@ def test_bad_firmware_run_options_are_one_line_and_status_2(capsys: pytest.Captu
 
 
 @pytest.mark.parametrize(("name", "argv", "status"), [
-    ("udf.elf", ["--fidelity", "pin", "--cycles", "3"], 3),
-    ("udf.elf", ["--fidelity", "pin", "--cycles", "3", "--mode", "intel", "--vcd", "{d}/udf.vcd"], 3),
-    ("nop.elf", ["--fidelity", "pin", "--cycles", "3", "--max-instructions", "1000"], 3),
-    pytest.param("loop.elf", ["--fidelity", "pin", "--cycles", "3", "--max-instructions", "1000"], 4,
-                 marks=pytest.mark.slow),  # b .: a wait (MCU-4), three whole cycles stepped: 1.3 to 2.6 s
+    ("udf.elf", ["--fidelity", "pin", "--cycles", "6"], 3),
+    ("udf.elf", ["--fidelity", "pin", "--cycles", "6", "--mode", "intel", "--vcd", "{d}/udf.vcd"], 3),
+    ("nop.elf", ["--fidelity", "pin", "--cycles", "6", "--max-instructions", "1000"], 3),
+    pytest.param("loop.elf", ["--fidelity", "pin", "--cycles", "6", "--max-instructions", "1000"], 4,
+                 marks=pytest.mark.slow),  # b .: a wait (MCU-4), six whole cycles stepped
 ])  # fmt: skip
 def test_a_stopped_or_failed_firmware_gives_3_or_4_and_its_report(capsys: pytest.CaptureFixture[str], files: Path,
                                                                   name: str, argv: list[str], status: int) -> None:

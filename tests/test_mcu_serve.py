@@ -262,9 +262,9 @@ def test_supi3_firmware_run_reports_an_unserved_main_loop(
     """``supi3 firmware run``: the main-loop variant too slow for 2 Mbit/s ends UNSERVED (exit 4, ``"served":
     false`` in the JSON) although its data arrived; at 500 kbit/s it is clean (exit 0, served)."""
     elf = str(variants["main_loop", "cortex_m3"])
-    assert main(["firmware", "run", elf, "--bit-rate", "2M", "--cycles", "5"]) == FIRMWARE_FAILED_STATUS
+    assert main(["firmware", "run", elf, "--bit-rate", "2M", "--cycles", "6"]) == FIRMWARE_FAILED_STATUS
     assert "UNSERVED    the firmware's main loop did not come back" in capsys.readouterr().out
-    assert main(["firmware", "run", elf, "--cycles", "5", "--json"]) == 0
+    assert main(["firmware", "run", elf, "--cycles", "6", "--json"]) == 0
     report = json.loads(capsys.readouterr().out)
     assert report["served"] is True and report["process_data"]["ok"] is True
 

@@ -49,14 +49,15 @@ def idle(ring: Ring | PinRing, telegrams: int) -> None:
 Op = tuple[str, int]
 
 
-def history(ring: Ring | PinRing, start: bool, ops: list[Op], wake: int) -> list[object]:
+def history(ring: Ring | PinRing, start: bool, ops: list[Op], wake: int, phase: int = 0) -> list[object]:
     """What a master sees of the flat ``ring`` (fresh chips, powered up together, then idle past their wake-up) over
     ``ops``: the master starts first (``start``: an INTERBUS reset and a discovery ID cycle) or not; then per step
     ``power`` (the chip at ring position ``k`` powered up: /ResU low at pin level, ``Supi3.power_up`` at transaction
     level, then idle), ``cut`` (the forward line into position ``k``), ``repair`` (every cut, then
     :data:`~support.REPAIR_IDLE_TELEGRAMS` idle status telegrams, M21), ``start`` or ``wait``, and two of the master's
     cycles. Every cycle's kind, success and diagnostics (kind, location, device, message code), after each step the
-    configuration and IN data. ``wake``: idle status telegrams after a power-up (M22)."""
+    configuration and IN data. ``wake``: idle status telegrams after a power-up (M22); ``phase``: bit periods into an
+    idle status telegram at which a power-up releases /ResU (:func:`power_cycle`)."""
     idle(ring, wake)
     master = Master(ring, locate=False, max_devices=8)
     seen: list[object] = []
@@ -69,7 +70,7 @@ def history(ring: Ring | PinRing, start: bool, ops: list[Op], wake: int) -> list
     for op, k in ops:
         k = min(k, len(ring.devices))
         if op == "power":
-            power_cycle(ring, k)
+            power_cycle(ring, k, phase)
             idle(ring, wake)
         elif op == "cut":
             ring.cut(k, True)
@@ -87,7 +88,8 @@ def history(ring: Ring | PinRing, start: bool, ops: list[Op], wake: int) -> list
     return seen
 
 
-def both(rate: int, chips: int, start: bool, ops: list[Op], wake: int) -> tuple[list[object], list[object]]:
+def both(rate: int, chips: int, start: bool, ops: list[Op], wake: int,
+         phase: int = 0) -> tuple[list[object], list[object]]:
     config = _config(rate)
     tl_chips = [Supi3(config) for _ in range(chips)]
     tl = Ring(tl_chips, bit_rate=rate)
@@ -97,7 +99,7 @@ def both(rate: int, chips: int, start: bool, ops: list[Op], wake: int) -> tuple[
     for position, chip in enumerate(tl_chips, 1):  # the process data IN: each chip's MFP inputs
         chip.set_mfp_inputs(0x11 * position)
         pin.set_input(position, "mfp_in", 0x11 * position)
-    return history(tl, start, ops, wake), history(pin, start, ops, wake)
+    return history(tl, start, ops, wake, phase), history(pin, start, ops, wake, phase)
 
 
 OPS = st.lists(st.tuples(st.sampled_from(["power", "cut", "repair", "start", "wait"]), st.integers(1, 4)),
@@ -141,16 +143,27 @@ def test_a_frame_that_meets_the_reset_stretch_fails_at_pin_level(rate: int) -> N
     assert master.cycle().ok
 
 
-def power_cycle(ring: Ring | PinRing, position: int) -> None:
+def power_cycle(ring: Ring | PinRing, position: int, phase: int = 0) -> None:
     """Power the chip at physical ``position`` down for :data:`POWER_DOWN_TELEGRAMS` idle status telegrams and up
-    again: /ResU low then high at pin level, ``Ring.power_up`` at the transaction level (M22; trees too, M25)."""
+    again: /ResU low then high at pin level, ``Ring.power_up`` at the transaction level (M22; trees too, M25). With
+    ``phase`` (1 to 4) /ResU rises that many bit periods into a further idle status telegram, sent whole (M22's limit 4:
+    a power-up off the master's telegram boundaries; the pin level's master receives that telegram on its own, as
+    :meth:`PinRing.idle` receives its pieces)."""
     if isinstance(ring, PinRing):
         ring.set_input(position, "resu_n", 0)
         idle(ring, POWER_DOWN_TELEGRAMS)
+        levels = wire.status_levels(Cycle.DATA, False, 1)
+        if phase:
+            ring.run_levels(levels[:phase])
         ring.set_input(position, "resu_n", 1)
+        if phase:
+            ring.run_levels(levels[phase:])
+            ring._received()  # the idle received on its own (PinRing.idle's pieces)
     else:
         idle(ring, POWER_DOWN_TELEGRAMS)
+        ring.idle(phase / ring.bit_rate)
         ring.power_up(position)
+        ring.idle((wire.STATUS_TELEGRAM_BITS - phase) / ring.bit_rate if phase else 0.0)
 
 
 def first_cycle(ring: Ring | PinRing, chips: int, position: int,

@@ -216,17 +216,21 @@ REPAIR_IDLE_S = REPAIR_IDLE_TELEGRAMS * wire.STATUS_TELEGRAM_BITS / 2_000_000
 """Idle after a repair (M21): a repaired line takes up a telegram in flight at the repair point, and behind a break in
 an LBD branch a device that sends a counter telegram drops the telegram beginning then and the one chained to it
 (BK-30, M16); idle telegrams take that, not the next frame's head."""
-FIRST_IDLE_TELEGRAMS: dict[BranchKind, int] = {BranchKind.REMOTE: 5, BranchKind.LOCAL: 5, BranchKind.LBD_MR: 9,
+FIRST_IDLE_TELEGRAMS: dict[BranchKind, int] = {BranchKind.REMOTE: 0, BranchKind.LOCAL: 0, BranchKind.LBD_MR: 9,
                                                BranchKind.LBD_OR: 9}
 """Idle status telegrams before a history's first step, every chip powered up at the ring's first clock (M22, M25:
 ``Ring.power_up`` at transaction level), per branch kind: the least from which the histories of
-``bench/wake_tree_sweep.py initial`` agree (M25's limits; before M25: 9 for every kind, 20 before that)."""
-POWER_IDLE_TELEGRAMS: dict[BranchKind, int] = {BranchKind.REMOTE: 3, BranchKind.LOCAL: 3, BranchKind.LBD_MR: 6,
+``bench/wake_tree_sweep.py initial`` agree (M25's limits; BK-RB and BK-LB 5 before BK-64; before M25: 9 for every
+kind, 20 before that)."""
+BRING_UP_TELEGRAMS = 5
+"""Idle status telegrams after the first clock by which every BK of these trees has its branch's answer (M25: BK-RB's
+322 clocks at 2 Mbit/s): a history that breaks the loop after the bring-up waits them."""
+POWER_IDLE_TELEGRAMS: dict[BranchKind, int] = {BranchKind.REMOTE: 2, BranchKind.LOCAL: 0, BranchKind.LBD_MR: 6,
                                                BranchKind.LBD_OR: 6}
 """Idle status telegrams after the BK's power-up step (/ResU released, ``Ring.power_up`` at transaction level: M25
 follows the BK's wake-up and its branch's answer), per branch kind: the least from which the histories of
-``bench/wake_tree_sweep.py power`` agree (M25's limits, LBD-MR's the longest; before M25: 6 for every kind, 20
-before that)."""
+``bench/wake_tree_sweep.py power`` agree (M25's limits, LBD-MR's the longest; BK-RB's M25's limit 6; BK-RB and
+BK-LB 3 before M28, M29 and BK-64; before M25: 6 for every kind, 20 before that)."""
 TELEGRAM_S = wire.STATUS_TELEGRAM_BITS / 2_000_000
 
 
@@ -278,7 +282,7 @@ def recognition_history(kind: BranchKind, row: tuple[str, bool], ops: list[Op], 
             pin.cut(position, forward, branch=branch)
         elif name == "power":
             tl.idle(POWER_DOWN_S)
-            tl.power_up(2)  # M25: the BK's wake-up and its branch's answer followed
+            tl.power_up(2, down=tl.now - POWER_DOWN_S)  # M25: the BK's wake-up and its branch's answer followed (M26)
             tl.idle(power_idle_s)
             pin.set_input(2, "resu_n", 0)
             pin.idle(POWER_DOWN_S)
@@ -327,13 +331,14 @@ def test_a_branch_joining_within_a_cycle_fails_that_cycle_at_both_fidelities(kin
     repaired after the start, the branch answers in the next cycle's run and joins the data path within its frame at
     both fidelities: that cycle fails at both with the same error (:data:`JOIN_ERRORS`: where the pin-level BK switched,
     given by the repaired line), not located, and every cycle after it is the same (the master meets the longer ring:
-    the loopback word out of place, BK-45)."""
+    the loopback word left out: a configuration error, then data cycles on it, BK-45, A25)."""
     for index, (fault, (_, _, branch)) in enumerate(cuts(kind)):
         if kind.diagnostics and not branch:
             continue  # the LBD branch's devices answer behind a break with counter telegrams (BK-30)
         ops: list[Op] = [("cut", index), ("power", 0), ("start", 0), ("cycle", 0), ("repair", 1),
                          *[("cycle", 0)] * 4]  # fmt: skip
-        steps = recognition_history(kind, ("11", True), ops)
+        steps = recognition_history(kind, ("11", True), ops,
+                                    max(FIRST_IDLE_TELEGRAMS[kind], BRING_UP_TELEGRAMS) * TELEGRAM_S)
         assert [tl for tl, _ in steps] == [pin for _, pin in steps], index
         recognised = [tl[2] for tl, _ in steps]
         assert recognised == [True] + [False] * 4 + [True] * 4, index  # the bring-up; power-up
@@ -341,9 +346,11 @@ def test_a_branch_joining_within_a_cycle_fails_that_cycle_at_both_fidelities(kin
         assert start is not None and start[1] and start[3] is not None and len(start[3][0]) == 3, index  # through BK
         error = JOIN_ERRORS.get(fault, ErrorKind.DEAD_LINE)
         assert joined is not None and not joined[1] and joined[2] == [(error, None, None)], index
-        # The longer ring after it: the loopback word out of place; without location the table stays (BK-45).
-        after = [step[0][3] for step in steps[6:]]
-        assert all(seen is not None and seen[2] == [(ErrorKind.LOOPBACK, None, None)] for seen in after), index
+        # The longer ring after it: the loopback word left out, the rescan finds it without location too (A25),
+        # a configuration error, then the master runs on the longer ring.
+        first, last = steps[6][0][3], steps[-1][0][3]
+        assert first is not None and [d[0] for d in first[2]] == [ErrorKind.CONFIGURATION], index
+        assert last is not None and last[1] and last[3] is not None and len(last[3][0]) > 3, index
 
 
 def test_the_transaction_level_loses_the_frame_a_branch_joins_within() -> None:

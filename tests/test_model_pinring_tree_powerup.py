@@ -16,6 +16,8 @@ from supi3.config import DeviceConfig, decode
 from supi3.errors import ArgumentError
 from supi3.interbus.master import Master
 from supi3.interbus.ring import Branch, BranchKind, ErrorKind, Ring
+from supi3.interbus.wake import Counters, counter_return, wake_return
+from supi3.interbus.wire import Cycle, Frame
 from supi3.model.chip import Supi3
 from supi3.model.pinring import PinBranch, PinRing
 from supi3.model.pins import Supi3Pins
@@ -82,21 +84,14 @@ def after_power_up(ring: Ring | PinRing, position: int, telegrams: int) -> Seen:
 
 
 RESIDUAL = {(2_000_000, BranchKind.LBD_MR, 1, 2): (3, 3), (2_000_000, BranchKind.LBD_MR, 2, 2): (4, 5),
-            (2_000_000, BranchKind.LBD_MR, 3, 2): (5, 6), (2_000_000, BranchKind.LBD_MR, 2, 4): (1, 2),
-            (2_000_000, BranchKind.LBD_MR, 3, 4): (1, 1), (500_000, BranchKind.LBD_MR, 1, 2): (2, 2),
-            (500_000, BranchKind.LBD_MR, 2, 2): (3, 4), (500_000, BranchKind.LBD_MR, 3, 2): (4, 5),
-            (500_000, BranchKind.LBD_MR, 3, 4): (7, 2)}
-"""M25's limit (``python bench/wake_tree_sweep.py window --rate R``): (bit rate, tree, physical position) -> the first
-passing k at transaction level and at pin level, where the cycles before are compared by success only. The BK's
+            (2_000_000, BranchKind.LBD_MR, 3, 2): (5, 6), (500_000, BranchKind.LBD_MR, 1, 2): (2, 2),
+            (500_000, BranchKind.LBD_MR, 2, 2): (3, 4), (500_000, BranchKind.LBD_MR, 3, 2): (4, 5)}
+"""M25's limit 1 (``python bench/wake_tree_sweep.py window --rate R``): (bit rate, tree, physical position) -> the
+first passing k at transaction level and at pin level, where the cycles before are compared by success only. The BK's
 power-up in an LBD-MR branch: with 1 device the cycles before fail with ``TRANSMISSION`` at pin level and
-``DEAD_LINE`` at transaction level (BK-56's LBD-MR rule), with 2 and 3 devices the pin level loses one more cycle; the
-second device of an LBD-MR branch of 2 or 3 powered up at 2 Mbit/s, the frame meeting its stretch: ``TRANSMISSION``
-at pin level, ``LOOPBACK`` at transaction level, with 2 devices for one cycle more; at 500 kbit/s, of 3, the
-transaction level's master hears no grid until k = 7 (``TELEGRAM``) where the pin level passes from k = 2: traced
-(``python bench/wake_tree_sweep.py trace --rate 500000 --devices 3 --position 4 --k 2``), the powered-up device's
-return output is silent 34 bit periods, the first device's return block generates a counter telegram after 32 (BK-30),
-drops what begins meanwhile and resends on the master's grid; the transaction level does not follow the generator
-(M25's limit 1)."""
+``DEAD_LINE`` at transaction level (BK-56's LBD-MR rule), with 2 and 3 devices the pin level loses one more cycle (its
+switch, BK-47, later than ``Ring._answer``; no counter block drives there, M26). The second device of an LBD-MR branch
+powered up (the first device's return block generating a counter telegram, BK-30) is followed since M26 and alike."""
 
 
 def _window(kind: BranchKind, m: int, rate: int, positions: range) -> list[int]:
@@ -135,6 +130,38 @@ def test_the_window_after_a_power_up_in_a_tree_ends_alike(kind: BranchKind, m: i
     branch device) powered up in a running tree: as :func:`test_a_bk_s_power_up_ends_its_window_alike` (at 500 kbit/s
     every cycle of k = 0..7 alike: ``python bench/wake_tree_sweep.py window --rate 500000``)."""
     _window(kind, m, rate, range(1, m + 4))
+
+
+@pytest.mark.parametrize(("rate", "m", "ks"), [(2_000_000, 2, range(3)), (500_000, 3, range(1, 3))])
+def test_an_lbd_mr_device_s_power_up_follows_the_counter_generator(rate: int, m: int, ks: range) -> None:
+    """M26: the second device of an LBD-MR branch powered up in a running tree: its return output is silent longer
+    than ``COUNTER_SILENCE_BITS`` (from its power-down through its stretch), the return block of the device before it
+    generates a counter telegram and drops what begins meanwhile (BK-30), the frame's head too for the first k (the
+    chip behind flags it: ``TRANSMISSION``), then repeats on the master's grid: every cycle, its error kinds and the
+    recognition alike at both fidelities (before M26: ``LOOPBACK`` for ``TRANSMISSION``, and at 500 kbit/s
+    ``TELEGRAM`` until k = 7 where the pin level passes from k = 2)."""
+    for k in ks:
+        tl, pin = trees(BranchKind.LBD_MR, m, rate)
+        assert after_power_up(tl, 4, k) == after_power_up(pin, 4, k), k
+
+
+def test_a_power_down_is_named_by_its_bus_time() -> None:
+    """M26: ``Ring.power_up``'s ``down`` is a bus time from the master's idle's start to now, else refused by name;
+    ``counter_return`` refuses counters or power-downs that name no chip."""
+    tl, _ = trees(BranchKind.LBD_MR, 2, 2_000_000)
+    for bad in (-1.0, tl.now + 1.0, "0"):
+        with pytest.raises(ArgumentError, match=r"^down must be"):
+            tl.power_up(4, down=bad)  # type: ignore[arg-type]
+    tl.power_up(4, down=tl.now)
+    frame = Frame.build(Cycle.DATA, bytes(4))
+    with pytest.raises(ArgumentError, match=r"^counters must be"):
+        counter_return(2_000_000, 3, {1: 10}, 0, frame, None, Counters(frozenset({3})))
+    with pytest.raises(ArgumentError, match=r"^counters must be"):
+        counter_return(2_000_000, 3, {1: 10}, 0, frame, None, "forward")  # type: ignore[arg-type]
+    with pytest.raises(ArgumentError, match=r"^downs must be"):
+        counter_return(2_000_000, 3, {1: 10}, 0, frame, None, Counters(frozenset({1})), {2: 0})
+    assert counter_return(2_000_000, 3, {1: 10}, 0, frame, None, Counters(), {1: 0}) == (
+        *wake_return(2_000_000, 3, {1: 10}, 0, frame), False)
 
 
 def test_a_tree_s_power_up_names_the_device() -> None:

@@ -44,7 +44,7 @@ from supi3 import campaign, serial_io, tables, timing
 from supi3.checks import check_int, check_real, fail
 from supi3.checks import describe as _shown
 from supi3.config import DeviceConfig, Interface, MfpKind, Variant, decode, mode_rows
-from supi3.errors import Supi3Error
+from supi3.errors import ArgumentError, Supi3Error
 from supi3.optical import length as optical_length
 from supi3.regmap import LENGTH_OUT
 from supi3.sdk.bench import DEFAULT_STRAPS
@@ -600,6 +600,10 @@ MAX_PIN_FIRMWARE_CYCLES = MAX_VCD_CYCLES
 0.5 s of wall time a cycle at 500 kbit/s), and with ``--vcd`` every pin of every clock is kept, as ``demo --vcd``."""
 
 
+_FIRMWARE_DATA_OPTIONS = {"out_data": "--out", "in_data": "--in"}
+"""``run_firmware``'s data arguments and their options: an argument error names the option (MCU-49)."""
+
+
 def _firmware_extra() -> None:
     """Refuse ``firmware`` without the firmware extra (unicorn, pyelftools, ziglang), one line, before any work."""
     import importlib.util
@@ -613,7 +617,8 @@ def _firmware_extra() -> None:
 def cmd_firmware_run(args: argparse.Namespace) -> None:
     """Run a firmware ELF on the emulated board against the chip and report (docs/firmware-in-the-loop.md)."""
     _firmware_extra()
-    from supi3.mcu.session import MAX_PIN_DEVICES, run_firmware
+    from supi3.mcu.board import MAX_CPU_HZ
+    from supi3.mcu.session import MAX_PIN_DEVICES, MIN_CYCLES, MIN_CYCLES_LIMIT, run_firmware
     from supi3.spi.upif import Mode
 
     if not Path(args.firmware).is_file():
@@ -622,9 +627,9 @@ def cmd_firmware_run(args: argparse.Namespace) -> None:
     pin = args.fidelity == "pin"
     if args.vcd is not None and not pin:
         raise CommandLineError("--vcd needs --fidelity pin (the transaction-level chip has no pins)")
-    check_int("--cycles", args.cycles, 3, MAX_PIN_FIRMWARE_CYCLES if pin else MAX_FIRMWARE_CYCLES,
-              "with --fidelity pin: every chip clock is stepped" if pin else "")  # fmt: skip
-    check_int("--cpu-hz", args.cpu_hz, 1_000_000, 1_000_000_000)
+    check_int("--cycles", args.cycles, MIN_CYCLES, MAX_PIN_FIRMWARE_CYCLES if pin else MAX_FIRMWARE_CYCLES,
+              MIN_CYCLES_LIMIT + ("; with --fidelity pin: every chip clock is stepped" if pin else ""))  # fmt: skip
+    check_int("--cpu-hz", args.cpu_hz, 1_000_000, MAX_CPU_HZ, "the STM32F10x's highest SYSCLK, RM0008 7.2; MCU-50")
     check_int("--devices", args.devices, 1, MAX_PIN_DEVICES if pin else 64,
               "with --fidelity pin: each further chip is stepped with it" if pin else "")  # fmt: skip
     check_int("--max-instructions", args.max_instructions, 1000, 10**10)
@@ -635,6 +640,11 @@ def cmd_firmware_run(args: argparse.Namespace) -> None:
                               bit_rate=_parse_bit_rate(args.bit_rate), devices=args.devices, cycles=args.cycles,
                               out_data=args.out_data, in_data=args.in_data, max_instructions=args.max_instructions,
                               fidelity=args.fidelity, vcd=vcd, mode=Mode(args.mode))  # fmt: skip
+    except ArgumentError as exc:  # MCU-49: --out or --in of another length than the firmware's configuration's
+        option = _FIRMWARE_DATA_OPTIONS.get(exc.name)
+        if option is None:
+            raise
+        raise CommandLineError(option + str(exc).removeprefix(exc.name)) from None
     except OSError as exc:
         raise CommandLineError(f"cannot write {_shown(str(vcd))} (--vcd): {exc.strerror or exc}") from None
     if args.json:
@@ -823,7 +833,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("firmware", metavar="FIRMWARE.elf", help="built for the board port (supi3 firmware build)")
     p.add_argument("--cpu", choices=["cortex_m3", "cortex_m0"], default="cortex_m3")
     p.add_argument("--cpu-hz", type=integer, default=48_000_000, metavar="HZ",
-                   help="core clock, 1 MHz to 1 GHz (default 48000000, the board port's BOARD_SYSCLK_HZ)")
+                   help="core clock, 1 MHz to 72 MHz, the STM32F10x's highest (default 48000000, the board port's "
+                        "BOARD_SYSCLK_HZ: its busy waits count cycles of that clock, so build the firmware with "
+                        "-D BOARD_SYSCLK_HZ=HZ for another)")
     p.add_argument("--c", default=DEFAULT_STRAPS[0], metavar="BITS",
                    help=f"the chip's C[4..0] straps, an Init-µP mode (default {DEFAULT_STRAPS[0]})")
     p.add_argument("--mfp", metavar="BITS",
@@ -833,11 +845,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--devices", type=integer, default=1, metavar="N",
                    help="devices in the ring, the chip first, 1 to 64, fewer with --fidelity pin (default 1)")
     p.add_argument("--cycles", type=integer, default=10, metavar="N",
-                   help=f"master cycles in all, 3 to {MAX_FIRMWARE_CYCLES} (default 10)")
+                   help=f"master cycles in all, 6 (the power-up's 3 and 3 to check the exchange) to "
+                        f"{MAX_FIRMWARE_CYCLES} (default 10)")
     p.add_argument("--max-instructions", type=integer, default=20_000_000, metavar="N",
                    help="instruction budget of the power-up and of the exchange (default 20000000)")
-    p.add_argument("--out", dest="out_data", type=hex_bytes, metavar="HEX", help="the master's OUT data")
-    p.add_argument("--in", dest="in_data", type=hex_bytes, metavar="HEX", help="the firmware's input terminals")
+    p.add_argument("--out", dest="out_data", type=hex_bytes, metavar="HEX",
+                   help="the master's OUT data, as many bytes as the chip's data as the firmware configures it "
+                        "(checked when the master has read it, after the power-up)")
+    p.add_argument("--in", dest="in_data", type=hex_bytes, metavar="HEX",
+                   help="the firmware's input terminals, as many bytes as --out")
     p.add_argument("--fidelity", choices=["transaction", "pin"], default="transaction",
                    help="the chip: transaction level (default), or the pin-level whole chip with SPI1 and the GPIO "
                         "pins on its MFP pins, Table 3-7 checked by the chip (1 device, up to "

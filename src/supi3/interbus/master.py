@@ -177,7 +177,10 @@ class Master:
         The ring the master drives.
     locate:
         After a failed cycle, locate the error with a diagnostic ID cycle and, if that fails too, a segment
-        search (ID cycles with the ring closed after ring position *j*).
+        search (ID cycles with the ring closed after ring position *j*). Without it the master still finds a
+        changed device count (manual 2.4: the data length change "triggers the diagnostic mechanisms"): an ID
+        cycle whose loopback word comes back after fewer ID registers, or none, followed by a discovery-sized
+        ID cycle (assumption A25).
     max_devices:
         Ring size the discovery ID cycle allows for (its filler is two bytes per device, assumption A14).
     rediscover:
@@ -433,6 +436,8 @@ class Master:
             assert transfer.returned is not None
             registers = _id_registers(transfer.returned, len(config))
             problem = _compare(config, registers, self._answering)
+        elif problem.kind is ErrorKind.LOOPBACK and transfer.returned is not None:
+            problem = _fewer(config, transfer.returned, self._answering) or problem
         self.ring.finish(transfer, problem is None)
         if problem is not None:
             return self._failed(Cycle.ID, problem)
@@ -572,8 +577,14 @@ class Master:
         # a device may still hold TE from the earlier error (a data cycle does not clear TE in every device).
         trusted = not self._recover
         self._recover = True
-        if problem.kind is not ErrorKind.CONFIGURATION and problem.location is None and self.locate and self.config:
-            problem = self._locate(problem, trusted)
+        if problem.kind is not ErrorKind.CONFIGURATION and problem.location is None and self.config:
+            if self.locate:
+                problem = self._locate(problem, trusted)
+            elif cycle is Cycle.ID and problem.kind is ErrorKind.LOOPBACK:
+                # A25: the loopback word missing from an ID cycle over the table, the ring may be longer; without
+                # location only a configuration difference the rescan finds is reported, else the failure stands
+                found = self._rescan(problem, trusted)
+                problem = found if found is not None and found.kind is ErrorKind.CONFIGURATION else problem
         located = self._with_device(problem)
         if problem.kind is ErrorKind.CONFIGURATION and self.config is not None:
             # A configuration difference: the table is dropped (A19); rebuilt by the next cycle() or by start(). The
@@ -881,6 +892,20 @@ def _first_difference(config: tuple[ConfigEntry, ...], registers: list[int], ala
     if len(registers) != len(config):
         return min(len(registers), len(config)) + 1
     return None
+
+
+def _fewer(config: tuple[ConfigEntry, ...], returned: bytes, alarms: Collection[int]) -> Diagnostic | None:
+    """A25: the loopback word of an ID cycle over the table came back word-aligned after fewer ID registers than the
+    table has (CRC and CNTR good): the ring has that many devices (no ID register can imitate the loopback word, A5),
+    a configuration error at the first position that differs (A19); ``None`` if the loopback word is not there."""
+    at = _find_loopback(returned)
+    if not 0 <= at < 2 * len(config):
+        return None
+    registers = _id_registers(returned, at // 2)
+    where = _first_difference(config, registers, alarms)
+    return Diagnostic(ErrorKind.CONFIGURATION, where, None, None,
+                      f"loopback word after {at // 2} ID registers, the table has {len(config)}: configuration "
+                      f"changed at ring position {where}")  # fmt: skip
 
 
 def _changed(problem: Diagnostic, position: int | None, detail: str) -> Diagnostic:

@@ -46,7 +46,7 @@ from supi3.config import DeviceConfig, Interface
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusArgumentError, InterbusError, TelegramError
 from supi3.interbus.link import DataKernel, Device
-from supi3.interbus.wake import path_lags, reset_ready, wake_return, wake_window
+from supi3.interbus.wake import Counters, WokenChip, counter_return, path_lags, reset_ready, wake_window
 from supi3.interbus.wire import Cycle, Frame
 from supi3.pinlevel import SYNC_STAGES
 from supi3.tables import CLOCK_HZ, RESET_MIN_S
@@ -791,11 +791,16 @@ class Ring:
         """What the last :meth:`transfer` returned, until :meth:`finish`, :meth:`reset` or :meth:`idle`."""
         self._wakes: dict[int, float] = {}
         """M22: ``id`` of a chip powered up by :meth:`power_up` -> bus time its reset stretch (M2) ends."""
+        self._downs: dict[int, float] = {}
+        """M26: ``id`` of a chip powered up by :meth:`power_up` -> bus time its power-down began (outputs silent)."""
         self._late: dict[int, float] = {}
         """M22: ``id`` of a chip -> bus time from which a frame finds it out of an INTERBUS reset it woke up in."""
         self._answers: dict[int, float] = {}
         """M25: ``id`` of a BK powered up by :meth:`power_up` -> bus time its branch's first start level is back on its
         synchronised DI3 (BK-37): its branch answers from then."""
+        self._passed: dict[int, set[int]] = {}
+        """BK-64: ``id`` of a BK with an answer due -> ``id`` of the breaks of its loop made after its start level
+        passed them (:meth:`_pass_cut`): not in that answer's way."""
         self._woke_joins: set[int] = set()
         """M25: ``id`` of the BKs whose branch joins the data path within this cycle's frame after their power-up."""
         self._grid = 0.0
@@ -892,6 +897,11 @@ class Ring:
                 at = self._index.get(id(branch.terminal))
                 reached = at is not None and (dead is None or dead > at + 1) and branch.terminal.branch_enabled(True)
                 due = self._answers.get(id(branch.terminal))
+                passed = self._passed.get(id(branch.terminal)) if due is not None else None
+                loop = (forward, back) if not passed else (  # BK-64: breaks its start level passed are no break
+                    {id(a.target) for a in self._faults if isinstance(a.fault, DeadLine) and id(a) not in passed},
+                    {(id(a.target), a.branch) for a in self._faults
+                     if isinstance(a.fault, ReturnBreak) and id(a) not in passed})  # fmt: skip
                 head = now
                 if due is not None and frame is not None and at is not None:
                     # the frame's head leaving the BK: DO2 leaves its transmitter's line between telegrams (BK-47)
@@ -900,18 +910,22 @@ class Ring:
                         continue
                 elif due is not None and due > now:
                     continue
-                if (branch.kind.diagnostics or reached) and self._loop_whole(branch, forward, back):
+                if (branch.kind.diagnostics or reached) and self._loop_whole(branch, *loop):
                     branch.terminal.recognise_branch()
                     self._answers.pop(id(branch.terminal), None)
+                    self._passed.pop(id(branch.terminal), None)
                     found = True
-                    if due is not None and frame is not None and due <= head:
-                        continue  # M25: joined before the frame, between telegrams (BK-47)
+                    if due is not None and frame is not None and (due <= head or branch.terminal.branch_enabled(False)):
+                        # M25: joined before the frame, between telegrams (BK-47); M29: or in the data path without
+                        # an answer (present by LBST, Table 2-9): DO2 repeats DI3 from the wake-up, nothing joins
+                        continue
                     if due is not None:
                         self._woke_joins.add(id(branch.terminal))
                     recognised.append(branch)
                 elif due is not None and due <= now:
                     # M25: nothing came back at the answer instant (a broken loop): it answers as any branch after
                     self._answers.pop(id(branch.terminal))
+                    self._passed.pop(id(branch.terminal), None)
             if not found:
                 return recognised
 
@@ -1027,6 +1041,8 @@ class Ring:
                                     "that has a device behind it (not the last of the ring or of a branch, none in "
                                     "an LBD-OR branch)")  # fmt: skip
         self._faults.append(_Active(fault, fault.cycles, target, branch))
+        if self._answers:
+            self._pass_cut(self._faults[-1])
 
     def cut(self, position: int, forward: bool, *, branch: bool = False) -> None:
         """Break a line for good, numbered as :meth:`PinRing.cut <supi3.model.pinring.PinRing.cut>` numbers it, by the
@@ -1065,6 +1081,35 @@ class Ring:
                        "BK-59)", position)  # fmt: skip
         fault: Fault = DeadLine(position) if forward else ReturnBreak(position)
         self._faults.append(_Active(fault, None, every[position - 1] if position <= len(every) else None, branch))
+        if self._answers:
+            self._pass_cut(self._faults[-1])
+
+    def _pass_cut(self, active: _Active) -> None:
+        """BK-64: a BK powered up whose answer is due (M25) answers through a break of its branch's loop made after its
+        first start level passed the broken line (in the repeaters behind, it comes back on DI3 all the same, BK-37):
+        a forward line once the device behind has sampled it mid-bit (M7), a return line or DI3 (wires, M5) once it
+        began. A branch of devices with return lines (BK-RB, BK-LB; LBD branches answer by counter telegrams, BK-30)
+        and no nested branch; the start level reaches the branch's first device a loop (:meth:`_loop_clocks`) before
+        the answer, then the next a repeater later (A10), and comes back on the return lines from the last device's
+        output."""
+        cpb = wire.clocks_per_bit(self.bit_rate)
+        delay = wire.REPEATER_DELAY_BITS * cpb
+        for branch in self._branches:
+            due = self._answers.get(id(branch.terminal))
+            if due is None or branch.kind.diagnostics or any(isinstance(item, Branch) for item in branch.devices):
+                continue
+            out = due - self._loop_clocks(branch) / CLOCK_HZ  # the start level at the first device's input
+            ids = [id(device) for device in branch.devices]
+            if isinstance(active.fault, DeadLine) and id(active.target) in ids:
+                at = out + (ids.index(id(active.target)) * delay + cpb // 2) / CLOCK_HZ
+            elif isinstance(active.fault, ReturnBreak) and not active.branch and id(active.target) in ids:
+                at = out + len(ids) * delay / CLOCK_HZ
+            elif isinstance(active.fault, ReturnBreak) and active.branch and active.target is branch.terminal:
+                at = due - SYNC_STAGES / CLOCK_HZ
+            else:
+                continue
+            if at < self.now:
+                self._passed.setdefault(id(branch.terminal), set()).add(id(active))
 
     def bit_error(self, position: int, bit: int, cycles: int | None = 1) -> None:
         """Invert bit period ``bit`` of the frame on the forward line into the device at ``position``, numbered as
@@ -1092,6 +1137,7 @@ class Ring:
         if self._branches:
             self._repaired += [a for a in self._faults if isinstance(a.fault, (DeadLine, ReturnBreak))]
         self._faults.clear()
+        self._passed.clear()
 
     def _join_error(self, joined: list[Branch]) -> ErrorKind | None:
         """The error of a cycle within whose frame the branches ``joined`` join (BK-54): by the first line of the
@@ -1305,6 +1351,7 @@ class Ring:
         devices = self.devices[: n if dead is None else min(n, dead - 1)]
         reached = len(devices)
         woken: tuple[dict[int, int], int, list[int]] | None = None
+        dropped = False  # M26: an LBD chip's counter block dropped telegrams of the frame in the window
         unheard = False
         if self._wakes or self._late:  # M22: a chip not on the telegram grid yet passes the frame on (M19)
             late, woken = self._waking()
@@ -1374,13 +1421,14 @@ class Ring:
             returned = stream
         if woken is not None and returned is not None:  # M22: the master's receiver, bit by bit in the window
             wakes, start, lags = woken
-            error, opened = wake_return(self.bit_rate, len(self.devices), wakes, start, Frame.build(cycle, returned),
-                                        lags)
+            chips = {index: device for index in wakes if isinstance(device := self.devices[index], WokenChip)}
+            error, opened, dropped = counter_return(self.bit_rate, len(self.devices), wakes, start,
+                                                Frame.build(cycle, returned), lags, *self._counter_lines(), chips=chips)
             unheard = unheard or error
             returned = returned if opened else None
         if unheard:  # not on the telegram grid yet: no fault of the return line N + 1
             receiver_error = receiver_error or ErrorKind.TELEGRAM
-        elif spliced is ErrorKind.TRANSMISSION and opened:
+        elif (spliced is ErrorKind.TRANSMISSION or dropped) and opened:
             # M25: a frame whose head a woken chip's stretch cut comes back as no frame, whatever joins after it
             flags_back = wire.CntrFlags(attention, True)
         reports = self._reports(reached, None if close_after is None else n, dead_lines, returns) \
@@ -1503,7 +1551,7 @@ class Ring:
         self._wakes = {}  # the master's receiver leaves the hold on the grid (a line reset, M11)
         self._sync()
 
-    def power_up(self, position: int) -> None:
+    def power_up(self, position: int, down: float | None = None) -> None:
         """Power up the chip at ring ``position`` now (its power-up reset, 1.7.2): a master's cycle fails, as at pin
         level, until the chip and those behind it, then the master's receiver, are on the telegram grid (M22). In a
         tree ``position`` is the physical one (1..N over every device of the tree, a BK then its branch's devices, as
@@ -1511,11 +1559,15 @@ class Ring:
         again once the first start level the BK sends after its wake-up is back on its DI3 (BK-37, M25), and joins the
         data path then: before a frame, within it (that cycle lost, BK-54) or after it.
 
+        ``down``: the bus time the chip's power-down began (/ResU low, 1.7.2: its outputs silent from then; an LBD
+        branch's counter blocks count that silence, BK-30, M26); ``None``: when the master's idle began (the end of
+        its last cycle or reset), or the chip's previous wake-up in it if later.
+
         Raises
         ------
         ArgumentError
-            ``position`` not a device of the ring (1 to N), or the device there has no power-up reset
-            (``power_up``); nothing changes.
+            ``position`` not a device of the ring (1 to N), the device there has no power-up reset (``power_up``),
+            or ``down`` not a bus time from the master's idle's start to now; nothing changes.
         """
         every = _devices(self._tree) if self._branches else self.devices
         position = check_int("position", position, 1, len(every), "a device of the ring (of a tree: physical, BK-52)")
@@ -1523,7 +1575,12 @@ class Ring:
         power_up = getattr(device, "power_up", None)
         if not callable(power_up):
             raise fail(f"device at ring position {position}", "a chip with a power-up reset (power_up)", device)
+        if down is None:
+            down = min(self.now, max(self._grid, self._wakes.get(id(device), self._grid)))
+        else:
+            down = check_real("down", down, self._grid, self.now, limit="M26: from the master's idle's start to now")
         power_up()
+        self._downs[id(device)] = down
         self._wakes[id(device)] = self.now + round(RESET_MIN_S * CLOCK_HZ) / CLOCK_HZ  # the stretch, M2
         self._late.pop(id(device), None)
         if id(device) in self._terminals:  # M25: its recognition cleared (BK-37): the branch may leave the data path
@@ -1572,6 +1629,16 @@ class Ring:
         index = {id(device): k for k, device in enumerate(self.devices)}
         return {index[key]: round((at - self._grid) * CLOCK_HZ) for key, at in self._wakes.items() if key in index}
 
+    def _counter_lines(self) -> tuple[Counters, dict[int, int]]:
+        """M26: the counter blocks along the data path now (an LBD chip's on its forward line, an LBD-MR branch's
+        return blocks, BK-35) and the power-down of each chip woken in it, in clocks of the master's idle."""
+        forward = frozenset(k for k, device in enumerate(self.devices) if _sends_counts(device))
+        returns = tuple((span.end, tuple(i for i in reversed(span.own) if _return_repeater(self.devices[i])))
+                        for span in self._spans if any(_return_repeater(self.devices[i]) for i in span.own))
+        index = {id(device): k for k, device in enumerate(self.devices)}
+        downs = {index[key]: round((self._downs[key] - self._grid) * CLOCK_HZ) for key in self._wakes if key in index}
+        return Counters(forward, returns), downs
+
     def _waking(self) -> tuple[set[int], tuple[dict[int, int], int, list[int]] | None]:
         """M22: the ring indices of the chips a frame starting now finds off the telegram grid, and the wake-ups, the
         frame's start in clocks of the master's idle (:func:`~supi3.interbus.wake.wake_window`) and the data path's
@@ -1583,7 +1650,7 @@ class Ring:
         if not wakes:
             return late, None
         lags = self._lags()
-        window = wake_window(self.bit_rate, len(self.devices), wakes, lags)
+        window = wake_window(self.bit_rate, len(self.devices), wakes, lags, *self._counter_lines())
         now = round((self.now - self._grid) * CLOCK_HZ)
         if now >= window.end:
             self._wakes = {}

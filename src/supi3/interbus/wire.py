@@ -1079,6 +1079,23 @@ def opens_frame(telegram: Telegram) -> bool:
     return telegram.data is not None and not is_counter_telegram(telegram)
 
 
+def returned_frame(telegrams: Iterable[Telegram | LineReset]) -> Frame | None:
+    """The frame a master's receiver assembles from the telegrams that came back in a cycle: from its data telegrams
+    alone (the status telegrams and line resets among them dropped), ``None`` if none opens a frame (a dead line;
+    counter telegrams alone are none, BK-49). ``model.pinring.PinRing``'s master and the transaction level's
+    wake-up window (``interbus.wake.wake_return``, M22) alike.
+
+    Raises
+    ------
+    InterbusError
+        The data telegrams open a frame that does not assemble (:func:`frame_from_telegrams`).
+    """
+    if isinstance(telegrams, (str, bytes)) or not isinstance(telegrams, Iterable):
+        _refuse("telegrams", "an iterable of telegrams (Telegram or LineReset)", telegrams)
+    frames = [t for t in telegrams if isinstance(t, Telegram) and t.data is not None]
+    return frame_from_telegrams(frames) if any(opens_frame(t) for t in frames) else None
+
+
 def frames_from_levels(levels: Sequence[int] | LevelArray) -> list[Frame]:
     """Every complete frame in a received level sequence, in order; resets and status telegrams between frames
     and counter telegrams between frames are skipped (a receiving master's or testbench's view of a line)."""

@@ -71,6 +71,7 @@ from supi3.top import Supi3Chip
 __all__ = [
     "DEFAULT_MAX_INSTRUCTIONS",
     "FIDELITIES",
+    "MAX_CPU_HZ",
     "PIN_CD",
     "PIN_IO",
     "PIN_IRQ",
@@ -85,6 +86,9 @@ __all__ = [
 ]
 
 # GPIOA pins of board.h (BOARD_PIN_*); tests/test_mcu_board.py checks they agree.
+MAX_CPU_HZ: Final[int] = 72_000_000
+"""MCU-50: the board's highest core clock, the STM32F10x's 72 MHz (RM0008 7.2: SYSCLK, AHB and APB2, which clocks
+SPI1, at most 72 MHz); a faster clock is refused, not run as a part that does not exist."""
 PIN_IRQ: Final[int] = 0
 PIN_CD: Final[int] = 1
 PIN_IO: Final[int] = 2
@@ -269,7 +273,7 @@ class Board:
         ``board.h``'s wiring and ``board.ld``'s memory map).
     cpu, cpu_hz:
         The core (``"cortex_m3"``, ``"cortex_m0"``) and its clock (MCU-1; the board port's ``BOARD_SYSCLK_HZ``
-        must agree: 48 MHz by default).
+        must agree: 48 MHz by default), at most :data:`MAX_CPU_HZ` (MCU-50).
     config, bit_rate, others, cycle_time_s, strict, pedantic:
         The bench's (:class:`supi3.sdk.bench.Bench`): the chip's straps, the ring, the master's cycle, and whether
         an interface violation raises (strict) or is only recorded in :attr:`violations`.
@@ -319,6 +323,8 @@ class Board:
         self._s_r = 1  # PB0: S/R, 1 = the µP sends
         check_bool("record", record)
         self.core = CortexM(firmware, cpu=cpu, cpu_hz=cpu_hz)
+        if self.core.cpu_hz > MAX_CPU_HZ:
+            raise fail("cpu_hz", f"at most {MAX_CPU_HZ} (the STM32F10x's highest SYSCLK, RM0008 7.2; MCU-50)", cpu_hz)
         self._bench: _BoardBench | None = None
         self._ring: LockstepRing | None = None
         self.protocol: UpifProtocol

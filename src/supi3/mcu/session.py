@@ -19,7 +19,7 @@ from typing import Final
 from supi3 import tables, timing
 from supi3.checks import check_bytes, check_choice, check_int, fail
 from supi3.config import decode
-from supi3.errors import Supi3Error
+from supi3.errors import ArgumentError, Supi3Error
 from supi3.interbus.device import PlainDevice
 from supi3.interbus.link import Device
 from supi3.interbus.master import ConfigEntry
@@ -29,13 +29,23 @@ from supi3.model.pins import Supi3Pins
 from supi3.sdk.bench import DEFAULT_STRAPS, SERVE_TELEGRAMS
 from supi3.spi.upif import Mode
 
-__all__ = ["DEFAULT_CYCLES", "MAX_PIN_DEVICES", "POWER_UP_CYCLES", "RING_DEVICE", "RING_DEVICE_STRAPS", "FirmwareRun",
-           "run_firmware"]
+__all__ = ["DEFAULT_CYCLES", "MAX_PIN_DEVICES", "MIN_CYCLES", "MIN_CYCLES_LIMIT", "POWER_UP_CYCLES", "RING_DEVICE",
+           "RING_DEVICE_STRAPS", "FirmwareRun", "run_firmware"]
 
 DEFAULT_CYCLES: Final[int] = 10
 """Master cycles a run has unless told (ID cycles included)."""
 POWER_UP_CYCLES: Final[int] = 3
 """Cycles before the process data is set: the firmware's set-up, the ID cycle, the first data cycle."""
+MIN_CYCLES: Final[int] = POWER_UP_CYCLES + 3
+"""The fewest cycles of a run whose exchange is checked (MCU-45's master start): after the power-up one data cycle
+carries the master's OUT data to the chip and the firmware's handler answers with its inputs, one latches them, one
+brings them to the master. The transaction level needs only two of the three (its chip loads IN at the latch, the
+pin level's when the next frame begins, MCU-17); one minimum serves both fidelities (measured: ``digital_io`` and
+``polling_io`` on the Cortex-M3 and M0 at 500 kbit/s, 1 and 3 devices, exchange their data from 5 cycles at
+transaction level and from 6 at pin level; with fewer every firmware reports MISMATCH)."""
+MIN_CYCLES_LIMIT: Final[str] = (f"the power-up's {POWER_UP_CYCLES} and {MIN_CYCLES - POWER_UP_CYCLES} to check the "
+                                 "exchange")
+"""Why :data:`MIN_CYCLES`, as an error about a run's cycles says it."""
 RING_DEVICE: Final[tuple[int, int]] = (0x02, 0b00001)
 """ID code and length code of each further device in the ring, behind the chip: a plain digital output module of
 one word (Table A-3, Table 3-11)."""
@@ -179,16 +189,19 @@ def run_firmware(firmware: str | Path, *, cpu: str = "cortex_m3", cpu_hz: float 
 
     ``straps``: C[4..0] and MFP[15..12] (``None``: unset) of the chip (CLK_CONF follows ``bit_rate``);
     ``devices``: the ring's length, the chip first and :data:`RING_DEVICE` modules behind it; ``cycles``: master
-    cycles in all;
-    ``out_data``/``in_data``: the master's OUT data and the firmware's input terminals (default: a pattern as long
-    as the chip's data); ``max_instructions``: the budget of each of the two runs (power-up, exchange);
-    ``fidelity``: the chip at transaction level or the pin-level whole chip (:data:`~supi3.mcu.board.FIDELITIES`;
-    at pin level the devices behind it are pin-level chips strapped :data:`RING_DEVICE_STRAPS`, ``devices`` up to
-    :data:`MAX_PIN_DEVICES`); ``vcd``: pin level only, the VCD file to write the chip's
-    pins and the MCU's lines to (:meth:`Board.write_vcd`), also when the run stopped; ``mode``: the board's wiring
+    cycles in all, at least :data:`MIN_CYCLES`; ``out_data``/``in_data``: the master's OUT data and the firmware's
+    input terminals (default: a pattern as long as the chip's data), each exactly as long as the chip's data as the
+    firmware configures it (MCU-49: checked when the master has read the configuration, after the power-up; not
+    if it read none); ``max_instructions``: the budget of each of the two runs (power-up, exchange); ``fidelity``:
+    the chip at transaction level or the pin-level whole chip (:data:`~supi3.mcu.board.FIDELITIES`; at pin level
+    the devices behind it are pin-level chips strapped :data:`RING_DEVICE_STRAPS`, ``devices`` up to
+    :data:`MAX_PIN_DEVICES`); ``vcd``: pin level only, the VCD file to write the chip's pins and the MCU's lines to
+    (:meth:`Board.write_vcd`), also when the run stopped; ``mode``: the board's wiring
     for the interface type the firmware initializes (``Board``'s ``mode``, MCU-18).
 
-    Bad arguments raise :class:`~supi3.errors.Supi3Error` subclasses; what the firmware does wrong is in the report.
+    Bad arguments raise :class:`~supi3.errors.Supi3Error` subclasses (``out_data`` or ``in_data`` of the wrong length
+    after the power-up, MCU-49: :class:`~supi3.errors.ArgumentError`, no report, no VCD); what the firmware does wrong
+    is in the report.
     ``OSError`` if the VCD file cannot be written.
     """
     fidelity = check_choice("fidelity", fidelity, FIDELITIES)
@@ -196,7 +209,7 @@ def run_firmware(firmware: str | Path, *, cpu: str = "cortex_m3", cpu_hz: float 
         raise fail("vcd", "None at transaction level (a VCD holds pins: fidelity='pin')", vcd)
     pin = fidelity == "pin"
     devices = check_int("devices", devices, 1, MAX_PIN_DEVICES if pin else 64, "at pin level, MCU-23" if pin else "")
-    cycles = check_int("cycles", cycles, POWER_UP_CYCLES, 100_000)
+    cycles = check_int("cycles", cycles, MIN_CYCLES, 100_000, MIN_CYCLES_LIMIT)
     max_instructions = check_int("max_instructions", max_instructions, 1)
     out_data = None if out_data is None else check_bytes("out_data", out_data)
     in_data = None if in_data is None else check_bytes("in_data", in_data)
@@ -213,21 +226,16 @@ def run_firmware(firmware: str | Path, *, cpu: str = "cortex_m3", cpu_hz: float 
                          mode=mode)  # fmt: skip
     master = board.master
     started = time.perf_counter()
-    try:
-        board.run(POWER_UP_CYCLES, max_instructions=max_instructions)
+    if _run(board, report, POWER_UP_CYCLES, max_instructions):
         report.config = master.config
-        size = report.config[0].data_bytes if report.config else 0
-        report.sent_out = (bytes([0x12, 0x34, 0x56, 0x78] * 8) if out_data is None else out_data)[:size]
-        report.firmware_inputs = (bytes([0xAB, 0xCD, 0xEF, 0x01] * 8) if in_data is None else in_data)[:size]
-        if size:
+        entry = report.config[0] if report.config else None
+        report.sent_out = _data("out_data", out_data, entry, bytes([0x12, 0x34, 0x56, 0x78] * 64))
+        report.firmware_inputs = _data("in_data", in_data, entry, bytes([0xAB, 0xCD, 0xEF, 0x01] * 64))
+        if report.sent_out:
             master.set_outputs(1, report.sent_out)
             if board.fw_board is not None:
                 board.fw_board.inputs = report.firmware_inputs
-        board.run(cycles - POWER_UP_CYCLES, max_instructions=max_instructions)
-    except FirmwareError as error:
-        report.stop = error.report
-    except Supi3Error as error:  # the bench cannot go on (a stuck firmware, a chip refusing the straps' mode)
-        report.error = str(error)
+        _run(board, report, cycles - POWER_UP_CYCLES, max_instructions)
     report.wall_s = time.perf_counter() - started
     report.served = board.served
     report.config = master.config
@@ -247,3 +255,32 @@ def run_firmware(firmware: str | Path, *, cpu: str = "cortex_m3", cpu_hz: float 
     if vcd is not None:
         report.vcd = board.write_vcd(vcd)
     return report
+
+
+def _run(board: Board, report: FirmwareRun, cycles: int, max_instructions: int) -> bool:
+    """``board.run(cycles)``; a stop or a bench error goes into ``report``. Whether the run went on to the end."""
+    try:
+        board.run(cycles, max_instructions=max_instructions)
+    except FirmwareError as error:
+        report.stop = error.report
+    except Supi3Error as error:  # the bench cannot go on (a stuck firmware, a chip refusing the straps' mode)
+        report.error = str(error)
+    else:
+        return True
+    return False
+
+
+def _data(name: str, data: bytes | None, entry: ConfigEntry | None, default: bytes) -> bytes:
+    """MCU-49: ``data`` checked against the chip's data length, which the master's ID cycle has read from the
+    configuration the firmware wrote (``entry``; ``None``: no configuration, no data to send); ``None``: as much of
+    ``default`` as the chip takes."""
+    size = 0 if entry is None else entry.data_bytes
+    if data is None:
+        return default[:size]
+    if entry is None or len(data) == size:
+        return data[:size]
+    shown = data[:8].hex(" ") + (" ..." if len(data) > 8 else "")
+    raise ArgumentError(name, data, f"{name} must be {entry.data_bytes} byte{'s' * (entry.data_bytes != 1)}, the "
+                        f"data of device {entry.number} (the chip) as the firmware configured it (ID code "
+                        f"{entry.id_code:02X}h, length code {entry.length_code:05b}, Table 3-11; MCU-49), not "
+                        f"{len(data)} byte{'s' * (len(data) != 1)} ({shown})")  # fmt: skip

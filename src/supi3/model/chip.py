@@ -32,21 +32,27 @@ from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import ClassVar, Final, Protocol, TypeVar
 
+import numpy as np
+import numpy.typing as npt
+
 from supi3 import tables
 from supi3.checks import check_bits, check_bool, check_bytes, check_instance, check_int, check_real, fail
 from supi3.config import DeviceConfig, MfpKind, Variant, decode
+from supi3.config import Interface as LineInterface
 from supi3.diagnostics import DiagnosticOutputs, LedInputs, diagnostic_outputs, fo_leds, watches_line_interrupt
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.expansion import PULSE_T0, ExternalRegisters, end_pulses
 from supi3.interbus import wire
 from supi3.interbus.link import DataKernel
 from supi3.interbus.wire import Cycle
+from supi3.model.blocks.forward import forward_path
 from supi3.model.bus_terminal import BusTerminal
 from supi3.model.registers import RegisterFile
 from supi3.optical import regulation
 from supi3.optical.length import Medium, timer_code
 from supi3.optical.regulation import Interface, OpticalMode, OpticalStatus, Phase, Response
-from supi3.pinout import OPTICAL_REGISTERS, TIME_BASE_BITS, time_base_end
+from supi3.pinlevel import EventLog
+from supi3.pinout import OPTICAL_REGISTERS, SYNC_STAGES, TIME_BASE_BITS, time_base_end
 from supi3.serial_io import SerialDevice, SerialSequence, clear_sequence, sequence
 from supi3.terminal import BRANCH_SILENCE_CLOCKS, silence_limit
 
@@ -313,6 +319,28 @@ class Supi3:
     # --------------------------------------------------------------------------------------------------------
     # Power-up and pins
     # --------------------------------------------------------------------------------------------------------
+
+    def woken_output(self, do1: npt.NDArray[np.int64]) -> npt.NDArray[np.int64] | None:
+        """What this chip, powered up at the first clock of the forward line ``do1`` (32 MHz samples), sends on DO2
+        over it: its core's forward path (the blocks :class:`~supi3.model.pins.Supi3Pins` wires: the synchroniser
+        and receiver, M1, M7, M16; the frame engine and data path, M8, M19; the transmitter, M12) on a fresh chip of its
+        configuration with its MFP inputs (the power-up clears the rest, 1.7.2), its logic running from the end of the
+        reset's stretch (M2). The transaction level's wake-up window follows a woken chip's line with it
+        (``interbus.wake.wake_return``, M28). ``None`` for a BK or an LBD chip, whose DO2 also depends on lines ``do1``
+        does not give (the branch's DI3, the counter blocks, M17, M18; M25's limit 1)."""
+        interface = self.config.interface
+        if interface.is_bus_terminal or interface in (LineInterface.LBD_MR, LineInterface.LBD_OR):
+            return None
+        chip = Supi3(self.config)
+        chip.set_mfp_inputs(self.mfp_in)
+        path = forward_path(chip, EventLog())
+        transmitter, receiver = path.transmitter, path.receiver
+        stretch = round(tables.RESET_MIN_S * tables.CLOCK_HZ)
+        receiver.power_up(stretch)
+        synced = np.concatenate([np.full(SYNC_STAGES, wire.IDLE_LEVEL, dtype=np.int64), do1])  # M1
+        for c in range(stretch, len(do1)):
+            receiver.clock(int(synced[c]), c)
+        return np.asarray(transmitter.render(0, len(do1)), dtype=np.int64)
 
     def power_up(self) -> None:
         """Power-up reset (1.7.2): every register 0, watchdog off, no fault latched (3.4.7)."""

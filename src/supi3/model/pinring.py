@@ -525,13 +525,12 @@ class PinRing:
         receiver_error: ErrorKind | None = ErrorKind.TELEGRAM if error else None
         returned: bytes | None = None
         flags = wire.CntrFlags(True, True)
-        frames = [t for t in telegrams if isinstance(t, Telegram) and t.data is not None]
-        if any(wire.opens_frame(t) for t in frames):  # counter telegrams alone are no frame (BK-49): a dead line
-            try:
-                back = wire.frame_from_telegrams(frames)
-            except InterbusError:
-                receiver_error = receiver_error or ErrorKind.SEQUENCE
-            else:
+        try:  # counter telegrams alone are no frame (BK-49): a dead line
+            back = wire.returned_frame(telegrams)
+        except InterbusError:
+            receiver_error = receiver_error or ErrorKind.SEQUENCE
+        else:
+            if back is not None:
                 returned = back.data
                 decoded = wire.decode_cntr(back.cntr)
                 if decoded is None:

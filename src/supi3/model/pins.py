@@ -68,9 +68,7 @@ from supi3.config import DeviceConfig, Interface
 from supi3.diagnostics import is_complete
 from supi3.interbus import wire
 from supi3.model.blocks.counter import LineCounters
-from supi3.model.blocks.datapath import DataPath
-from supi3.model.blocks.expansion import Expansion
-from supi3.model.blocks.frame import FrameEngine
+from supi3.model.blocks.forward import forward_path
 from supi3.model.blocks.optical import OpticalBlock
 from supi3.model.blocks.outputs import Outputs, Snapshot
 from supi3.model.blocks.receiver import (
@@ -78,7 +76,6 @@ from supi3.model.blocks.receiver import (
     IDLE_TIMEOUT_CLOCKS,
     INPUT_NAMES,
     INPUT_PINS,
-    Receiver,
     Synced,
     check_names,
     input_row,
@@ -86,7 +83,7 @@ from supi3.model.blocks.receiver import (
 )
 from supi3.model.blocks.serial_io import SerialIo
 from supi3.model.blocks.terminal import BranchLines
-from supi3.model.blocks.transmitter import NEVER, PinTrace, Transmitter
+from supi3.model.blocks.transmitter import NEVER, PinTrace
 from supi3.model.chip import Supi3
 from supi3.optical.regulation import OpticalMode
 from supi3.pinlevel import EventLog, Pin
@@ -213,19 +210,16 @@ class Supi3Pins:
         self.log = EventLog()
         self.complete_diagnostics = is_complete(config)
         """DIAG1 shows BA (DIAG_CONF = 0, Table 3-16)."""
-        self.rbst_by_pin = config.rf_mode is not None and config.rf_mode.rf == "10"
-        """A following device is told by RBST_EXT (RF = 10, Table 2-2), not recognised on DI2 (M5)."""
-        self.forward_delay = wire.REPEATER_DELAY_BITS * self.cpb - SYNC_STAGES
-        """Clocks from a bit's mid-bit sample to its first clock on DO2, plus cpb/2 (M8)."""
-        self.reset_run = wire.RESET_DETECT_BITS * self.cpb
-        """Clocks of start level that make an INTERBUS reset (M11)."""
         # The blocks, wired to each other (supi3.model.blocks; the RTL core's blocks of the same names).
-        self._transmitter = Transmitter(self.cpb, self.forward_delay, self.rbst_by_pin)
-        self._expansion = Expansion(self.chip, self.cpb)
+        (self._transmitter, self._expansion, self._datapath, self._frame,
+         self._receiver) = forward_path(self.chip, self.log)
+        self.rbst_by_pin = self._transmitter.rbst_by_pin
+        """A following device is told by RBST_EXT (RF = 10, Table 2-2), not recognised on DI2 (M5)."""
+        self.forward_delay = self._transmitter.delay + self.cpb // 2
+        """Clocks from a bit's mid-bit sample to its first clock on DO2, plus cpb/2 (M8)."""
+        self.reset_run = self._receiver.reset_run
+        """Clocks of start level that make an INTERBUS reset (M11)."""
         self.chip._exr_driver = self._expansion  # cycle ends and resets move the expansion pins (RX-3 to RX-5)
-        self._datapath = DataPath(self.chip, self.log, self._expansion)
-        self._frame = FrameEngine(self.chip, self.log, self._datapath, self._transmitter)
-        self._receiver = Receiver(self.cpb, self.reset_run, self.chip, self.log, self._frame, self._transmitter)
         # Serial I/O in the SPI master modes (3.3): the chip starts its sequences at each latch (Supi3.attach_serial).
         self._serial = SerialIo(self.chip) if self.chip.spi_sequences is not None else None
         self.chip._serial_pins = self._serial
