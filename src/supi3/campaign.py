@@ -85,6 +85,11 @@ _PIN_CLK_CONF: Final = "11"  # 2 Mbit/s: 16 clocks per bit keeps the pin level s
 MAX_DEVICES: Final[dict[Fidelity, int]] = {"ring": 64, "pin": 8}
 """The largest ring a campaign runs, per fidelity (a pin-level ring of more chips runs too slowly to be useful)."""
 DEVICE_LIMITS: Final[dict[Fidelity, str]] = {"ring": "the campaign's ring sizes", "pin": "pin level: at most 8 chips"}
+MAX_CYCLES: Final[dict[Fidelity, int]] = {"ring": 1_000_000, "pin": 10_000}
+"""A27: the most master cycles a campaign runs, per fidelity: hours of run time (measured 25 to 76 cycles/s at
+transaction level, 8 to 64 devices, 1.5 cycles/s at pin level, 3 chips, on a loaded 2-core machine); the bus time of
+the longest ring's cycles stays far within A26's maximum. A soak beyond is several seeds."""
+CYCLE_LIMITS: Final = "A27: hours of run time"
 
 
 @dataclass(frozen=True)
@@ -94,7 +99,8 @@ class CampaignConfig:
     Attributes
     ----------
     cycles:
-        Master cycles to run in all (every cycle counts: healthy, faulted and recovery cycles).
+        Master cycles to run in all (every cycle counts: healthy, faulted and recovery cycles), at most
+        :data:`MAX_CYCLES` (A27).
     seed:
         Seed of the campaign's only random generator.
     devices:
@@ -112,9 +118,9 @@ class CampaignConfig:
     mix: Mapping[str, int] | None = None
 
     def __post_init__(self) -> None:
-        check_int("cycles", self.cycles, 1)
-        check_int("seed", self.seed)
         check_choice("fidelity", self.fidelity, FIDELITIES)
+        check_int("cycles", self.cycles, 1, MAX_CYCLES[self.fidelity], CYCLE_LIMITS)
+        check_int("seed", self.seed)
         check_int("devices", self.devices, 1, MAX_DEVICES[self.fidelity], DEVICE_LIMITS[self.fidelity])
         if self.mix is not None:
             events = RING_EVENTS if self.fidelity == "ring" else PIN_EVENTS

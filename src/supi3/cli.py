@@ -505,8 +505,9 @@ def cmd_campaign(args: argparse.Namespace) -> None:
 def _campaign_arguments(parser: argparse.ArgumentParser) -> None:
     """The campaign's command-line options."""
     parser.add_argument("--cycles", type=integer, default=2000,
-                        help="master cycles at transaction level (default 2000)")
-    parser.add_argument("--pin-cycles", type=integer, default=200, help="master cycles at pin level (default 200)")
+                        help=f"master cycles at transaction level, 1 to {campaign.MAX_CYCLES['ring']} (default 2000)")
+    parser.add_argument("--pin-cycles", type=integer, default=200,
+                        help=f"master cycles at pin level, 1 to {campaign.MAX_CYCLES['pin']} (default 200)")
     parser.add_argument("--seed", type=integer, default=1, help="seed of the campaign (default 1)")
     parser.add_argument("--devices", type=integer, default=8, help="ring size at transaction level (1..64, default 8)")
     parser.add_argument("--pin-devices", type=integer, default=3, help="chips at pin level (1..8, default 3)")
@@ -515,14 +516,15 @@ def _campaign_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--mix", metavar="EVENT=W,...",
                         help=f"event weights; ring: {', '.join(campaign.RING_EVENTS)}; "
                              f"pin: {', '.join(campaign.PIN_EVENTS)} "
-                             "(with --fidelity both, events of the other fidelity are ignored)")  # fmt: skip
+                             "(with --fidelity both, events of the other fidelity are ignored; each fidelity needs "
+                             "one)")  # fmt: skip
     parser.add_argument("--json", action="store_true", help="print the results as JSON")
 
 
 def _campaign_configs(args: argparse.Namespace) -> list[campaign.CampaignConfig]:
     """The campaigns the options ask for."""
-    check_int("--cycles", args.cycles, 1)
-    check_int("--pin-cycles", args.pin_cycles, 1)
+    check_int("--cycles", args.cycles, 1, campaign.MAX_CYCLES["ring"], campaign.CYCLE_LIMITS)
+    check_int("--pin-cycles", args.pin_cycles, 1, campaign.MAX_CYCLES["pin"], campaign.CYCLE_LIMITS)
     check_int("--devices", args.devices, 1, campaign.MAX_DEVICES["ring"], campaign.DEVICE_LIMITS["ring"])
     check_int("--pin-devices", args.pin_devices, 1, campaign.MAX_DEVICES["pin"], campaign.DEVICE_LIMITS["pin"])
     fidelities: list[campaign.Fidelity] = ["ring", "pin"] if args.fidelity == "both" else [args.fidelity]
@@ -536,7 +538,10 @@ def _campaign_configs(args: argparse.Namespace) -> list[campaign.CampaignConfig]
         own = None
         if mix is not None:
             events = campaign.RING_EVENTS if fidelity == "ring" else campaign.PIN_EVENTS
-            own = {e: w for e, w in mix.items() if e in events or args.fidelity != "both"} or None
+            own = {e: w for e, w in mix.items() if e in events or args.fidelity != "both"}
+            if not own:  # A27: not the fidelity's default mix, a silent guess
+                raise fail("--mix", f"an event the {fidelity} campaign runs ({', '.join(events)}) with --fidelity "
+                           f"both", args.mix)  # fmt: skip
         ring = fidelity == "ring"
         configs.append(campaign.CampaignConfig(args.cycles if ring else args.pin_cycles, args.seed,
                                       args.devices if ring else args.pin_devices, fidelity, own))  # fmt: skip

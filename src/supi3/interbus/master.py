@@ -241,7 +241,8 @@ class Master:
         self._alarm_request: set[int] = set()
         self._alarm_expected: set[int] = set()
         self.processor_alarms: dict[int, int] = {}
-        """Ring position -> the last processor alarm byte read from it (management channel, 3.4.9)."""
+        """Ring position -> the last processor alarm byte read from it (management channel, 3.4.9; emptied when the
+        configuration is read anew, A19)."""
         self.branch_status: dict[int, wire.BkStatus] = {}
         """Ring position of a BK without µP -> its last branch status (BK-5), read after an ATTN no PF or WD bit
         explains and by the LBD location (emptied when the configuration is read anew)."""
@@ -482,6 +483,13 @@ class Master:
         """Ring positions that send an answer in place of their ID code in the next ID cycle (A18, BK-5, OPT-50)."""
         return self._alarm_expected | self._optical_expected
 
+    def _forget_positions(self) -> None:
+        """A configuration read anew (A19): the records kept by ring position (branch status, processor alarms, MAU
+        warnings) are dropped, as a position may now hold another device; a MAU warning on is asked again."""
+        self.branch_status.clear()
+        self.processor_alarms.clear()
+        self._forget_optical(True)
+
     def _forget_optical(self, ask_again: bool) -> None:
         """A new configuration: forget the MAU warnings and requests by ring position; ``ask_again``: ask every
         device once if a warning was on, since positions may have moved (OPT-52)."""
@@ -524,8 +532,7 @@ class Master:
             return self._failed(Cycle.ID, problem)
         self._set_config(config)
         self.stopped = self._recover = False
-        self.branch_status.clear()
-        self._forget_optical(True)
+        self._forget_positions()
         messages = self._messages(registers)
         self._record(messages)
         return CycleResult(Cycle.ID, True, messages)

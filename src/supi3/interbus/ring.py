@@ -1308,6 +1308,7 @@ class Ring:
             Hand it to :meth:`finish` with the master's verdict.
         """
         data, close_after = check_transfer(cycle, data, close_after)
+        wire.check_bus_time("cycle", cycle, self.now)
         # A branch answering in this run joins the data path within its frame (BK-54): what leaves its BK is cut.
         joined = self._recognise(frame=wire.frame_bits(len(data))) if self._branches else []
         spliced = self._join_error(joined) if joined else None  # BK-56: the error of a branch joining the frame
@@ -1528,6 +1529,7 @@ class Ring:
         """An INTERBUS reset (the master's Alarm Stop, 1303h): reset pattern, then idle (assumption A12). A branch is
         recognised in the reset's hold, before its devices reset (BK-37, BK-48). The reset's end allows for the ring
         delay of every device of the tree, which may all be in the data path after it (BK-9, A12; BK-53)."""
+        wire.check_bus_time("reset", "INTERBUS reset", self.now)
         self._pending = None
         every = _devices(self._tree) if self._branches else self.devices
         end = self.now + wire.reset_bits(min(len(every), wire.MAX_DEVICES), return_repeaters(every)) / self.bit_rate
@@ -1658,6 +1660,7 @@ class Ring:
     def idle(self, seconds: float) -> None:
         """The master sends only idle status telegrams for ``seconds`` (no cycles)."""
         seconds = check_real("seconds", seconds, 0.0)
+        wire.check_bus_time("seconds", seconds, self.now, seconds)
         self._pending = None
         self._recognise()
         self._repaired = []

@@ -22,7 +22,7 @@ from typing import Final, NamedTuple, NoReturn
 import numpy as np
 import numpy.typing as npt
 
-from supi3.checks import check_bool, check_bytes, check_choice, check_instance, check_int, fail
+from supi3.checks import check_bool, check_bytes, check_choice, check_instance, check_int, describe, fail
 from supi3.interbus.errors import InterbusArgumentError, InterbusError, TelegramError, checked
 from supi3.tables import BIT_RATES, CLOCK_HZ, LENGTH_CODE_BY_VALUE, WATCHDOG_TIMEOUTS_S
 
@@ -132,6 +132,11 @@ DISCOVERY_FILLER: Final = 0x00
 # A16 Check sequence: CRC word, then CNTR word.
 CHECK_SEQUENCE_WORDS: Final = ("crc", "cntr")
 
+# A26 Bus time (seconds, a float) stays at most 2**20 s (about 12 days): there a float still resolves 2**-32 s, 1/134
+# of a 32 MHz clock (1/67 at twice the time, the margin for a cycle or reset begun just before). Past it cycles stop
+# moving the clock (at 1e300 s not at all) and no watchdog or idle timeout ever expires: refused by name.
+MAX_BUS_TIME_S: Final = float(2**20)
+
 # ================================================================================================================
 # Derived constants
 # ================================================================================================================
@@ -225,6 +230,22 @@ class LineReset(NamedTuple):
     """An INTERBUS reset seen on the line: ``bit`` is where the low level began."""
 
     bit: int
+
+
+def check_bus_time(name: str, value: object, now: float, seconds: float = 0.0) -> None:
+    """A26: refuse a step of bus time from ``now`` by ``seconds`` (an idle; a cycle or a reset: 0, checked at its
+    start) that would pass :data:`MAX_BUS_TIME_S`; ``name`` and ``value`` are the argument the error names. The one
+    check of every entry that advances bus time (``Ring``, ``PinRing``, ``OpticalRing``, the firmware bench).
+
+    Raises
+    ------
+    InterbusArgumentError
+        Bus time would pass :data:`MAX_BUS_TIME_S` (or ``now + seconds`` is NaN).
+    """
+    if not now + seconds <= MAX_BUS_TIME_S:
+        raise InterbusArgumentError(name, value, f"{name} {describe(value)} at bus time {now!r} s would take it past "
+                                    f"{MAX_BUS_TIME_S:.0f} s (A26: the most where a float resolves a 32 MHz clock)",
+                                    "docs/assumptions/interbus.md, A26")  # fmt: skip
 
 
 def _header(type_level: int, cycle: Cycle, check: bool) -> int:

@@ -505,6 +505,7 @@ class PinRing:
         """Send a frame and the ring delay; receive what came back (see :class:`~supi3.interbus.ring.Bus`)."""
         check_instance("cycle", cycle, Cycle)
         data = check_bytes("data", data)
+        wire.check_bus_time("cycle", cycle, self.now)
         if close_after is not None:
             # The master does not ask (PinRing has no ``closes_early``): it reports such errors as not located.
             raise InterbusError("docs/interbus.md, Segment search", close_after,
@@ -557,6 +558,7 @@ class PinRing:
 
     def reset(self) -> None:
         """INTERBUS reset: the line held low, then idle status telegrams (``wire.reset_levels``)."""
+        wire.check_bus_time("reset", "INTERBUS reset", self.now)
         self._pending = None
         self.run_levels(wire.reset_levels(len(self.devices), self._loops))
         self._received()
@@ -572,6 +574,7 @@ class PinRing:
         check_real("seconds", seconds, finite=True)
         if seconds < 0:
             raise InterbusError("docs/interbus.md, Idle", seconds, "idle time must be >= 0")
+        wire.check_bus_time("seconds", seconds, self.now, seconds)
         self._pending = None
         count = round(seconds * self.bit_rate / wire.STATUS_TELEGRAM_BITS)
         while count > 0:  # in pieces: the chips' traces of one run take about 260 bytes a clock

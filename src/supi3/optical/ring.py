@@ -291,6 +291,7 @@ class OpticalRing:
     def transfer(self, cycle: Cycle, data: bytes, close_after: int | None = None) -> Transfer:
         """See :meth:`supi3.interbus.ring.Ring.transfer`; the fibres' faults at the current bus time come first."""
         data, close_after = check_transfer(cycle, data, close_after)  # before the fibres draw their bit errors
+        wire.check_bus_time("cycle", cycle, self.ring.now)
         self._faults(wire.frame_bits(len(data)))
         return self.ring.transfer(cycle, data, close_after)
 
@@ -307,6 +308,7 @@ class OpticalRing:
     def reset(self) -> None:
         """An INTERBUS reset (Alarm Stop), then the optical initialization of every cable the reset reached; the
         bus time moves on until it is done (the master waits, 1.6)."""
+        wire.check_bus_time("reset", "INTERBUS reset", self.ring.now)
         self._faults(0)
         self.ring.reset()
         self._initialize()
@@ -314,6 +316,7 @@ class OpticalRing:
     def idle(self, seconds: float) -> None:
         """See :meth:`supi3.interbus.ring.Ring.idle`."""
         seconds = check_real("seconds", seconds, 0.0)
+        wire.check_bus_time("seconds", seconds, self.ring.now, seconds)
         self._faults(0)
         self.ring.idle(seconds)
 

@@ -505,10 +505,12 @@ class Bench:
         Raises
         ------
         ArgumentError
-            ``until`` not a finite number (NaN would run nothing, infinity for ever); nothing changes.
+            ``until`` not a finite number (NaN would run nothing, infinity for ever), or past
+            :data:`~supi3.interbus.wire.MAX_BUS_TIME_S` (A26); nothing changes.
         """
-        if type(until) is not float or not -math.inf < until < math.inf:  # the board's float: one test
+        if type(until) is not float or not -math.inf < until <= wire.MAX_BUS_TIME_S:  # the board's float: one test
             until = check_real("until", until)
+            wire.check_bus_time("until", until, self.now, until - self.now)
         # Most calls (a byte, a pin read, the board's synchronisation at each peripheral access) find no bus event
         # due: one comparison with the next event's time, kept by _step_bus and _start_cycle.
         stepped = self._next_at <= until
@@ -654,8 +656,15 @@ class Bench:
         ------
         BenchError
             If the firmware's main loop runs :data:`IDLE_LOOPS_LIMIT` times without clocking a byte or waiting.
+        ArgumentError
+            ``cycles`` not an integer from 0, or more than fit before the bus time's maximum (A26); nothing runs.
         """
-        target = self.cycles + check_int("cycles", cycles, 0)
+        count = check_int("cycles", cycles, 0)
+        # A26: no cycle is shorter than the shortest of a one-device ring; more than fit before the maximum are refused
+        # (2**53 of them pass it: a count too large for a float is refused as that many)
+        shortest = wire.cycle_bits(0, 1) / self.config.bit_rate
+        wire.check_bus_time("cycles", cycles, self.now, min(count, 2**53) * shortest)
+        target = self.cycles + count
         self.served = False  # until the run ends served (FW-14)
         self._run_to(target)
         self.served = self._serve()
