@@ -566,14 +566,7 @@ def test_a_polling_firmware_gets_the_same_verdict_at_both_fidelities(
     handler's first block, 7 instructions), one below a pass that exchanges
     data (3,210) stops both in such a pass, after the same instructions since its start, and a larger one stops
     neither."""
-    verdicts = [_verdict(Board(variants["polling", "cortex_m3"], fidelity=fidelity), (3, 2), budget)
-                for fidelity in ("transaction", "pin")]  # fmt: skip
-    assert verdicts[0] == verdicts[1]
-    if where is None:
-        assert verdicts[0] is None
-    else:
-        assert verdicts[0] is not None and verdicts[0][:2] == (Stop.BUDGET, where)
-        assert budget <= verdicts[0][3] < budget + 8  # checked at block boundaries (MCU-1)
+    _assert_same_verdict(variants, (3, 2), budget, where)
 
 
 @pytest.mark.parametrize(("budget", "where"), [(7, "Reset_Handler"), (8, "Reset_Handler"), (1990, "fw_loop"),
@@ -588,14 +581,21 @@ def test_a_polling_firmware_s_power_up_gets_the_same_verdict_at_both_fidelities(
     the edges of the set-up (7, 8: the reset handler's first blocks; 1,990: the set-up's 2,000 instructions up to
     the first pass), 1,991 to 3,200 in the exchanging pass, none from 3,201. Before, the transaction level served no
     data cycle in its power-up: 1,991 to 3,200 stopped the pin level only."""
-    verdicts = [_verdict(Board(variants["polling", "cortex_m3"], fidelity=fidelity), (3,), budget)
+    _assert_same_verdict(variants, (3,), budget, where)
+
+
+def _assert_same_verdict(variants: dict[tuple[str, str], Path], runs: tuple[int, ...], budget: int,
+                         where: str | None) -> None:
+    """polling_io on the Cortex-M3 with ``budget``, ``runs`` at both fidelities: the same verdict, a budget stop in
+    ``where`` (``None``: no stop) after at least ``budget`` instructions, checked at block boundaries (MCU-1)."""
+    verdicts = [_verdict(Board(variants["polling", "cortex_m3"], fidelity=fidelity), runs, budget)
                 for fidelity in ("transaction", "pin")]  # fmt: skip
     assert verdicts[0] == verdicts[1]
     if where is None:
         assert verdicts[0] is None
     else:
         assert verdicts[0] is not None and verdicts[0][:2] == (Stop.BUDGET, where)
-        assert budget <= verdicts[0][3] < budget + 8  # checked at block boundaries (MCU-1)
+        assert budget <= verdicts[0][3] < budget + 8
 
 
 @pytest.mark.parametrize("fidelity", ["transaction", "pin"])
