@@ -4,7 +4,8 @@ that advances bus time: ``Ring``, ``PinRing``, ``OpticalRing``, the firmware ben
 :attr:`~supi3.interbus.master.Master.processor_alarms` kept by ring position across a new configuration (A19: now
 dropped with ``branch_status`` and ``mau_warnings``); ``supi3 campaign --fidelity both`` with a mix naming no event
 of one fidelity ran that fidelity with its default mix (a silent guess, now refused by name, A27); and
-``supi3 campaign --cycles`` without an upper bound (A27).
+``supi3 campaign --cycles`` without an upper bound (A27). Then the lead's pass over today's new entries:
+``receiver.frame_start`` (BK-65) and ``wire.returned_frame`` (M29) took anything.
 
 Every bad input is refused by name (which argument, which rule, which value); a refused call leaves no trace.
 """
@@ -25,6 +26,7 @@ from supi3.interbus import wire
 from supi3.interbus.device import PlainDevice
 from supi3.interbus.errors import InterbusArgumentError
 from supi3.interbus.master import Master
+from supi3.interbus.receiver import frame_start
 from supi3.interbus.ring import Ring
 from supi3.model.chip import Supi3
 from supi3.model.pinring import PinRing
@@ -218,3 +220,28 @@ def test_the_bench_refuses_a_run_of_more_cycles_than_fit_before_the_maximum(cycl
     with pytest.raises(ValueError, match=refused):
         bench.run(cycles)
     assert bench.now == 0.0 and bench.cycles == 0
+
+
+# ------------------------------------------------------------------------------------------------------------
+# The lead's own pass over today's new entries: the frame finder of the pin level's bit errors (BK-65) and the
+# master's frame from its data telegrams (M29) check what they are given
+# ------------------------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(("args", "name"), [
+    ((None, 16, wire.Cycle.ID, 2), "samples"), (("0101", 16, wire.Cycle.ID, 2), "samples"),
+    (([0, 2, 1], 16, wire.Cycle.ID, 2), "samples"), (([0.5, 1.0], 16, wire.Cycle.ID, 2), "samples"),
+    (([1, 1], 15, wire.Cycle.ID, 2), "cpb"), (([1, 1], 16, "id", 2), "cycle"),
+    (([1, 1], 16, wire.Cycle.ID, -1), "data_bytes"), (([1, 1], 16, wire.Cycle.ID, 1.5), "data_bytes"),
+])  # fmt: skip
+def test_frame_start_refuses_what_is_no_line_by_name(args: tuple[object, ...], name: str) -> None:
+    with pytest.raises(ArgumentError) as caught:
+        frame_start(*args)  # type: ignore[arg-type]
+    assert caught.value.name.split("[")[0] == name  # a sample is named by its index: samples[1]
+
+
+@pytest.mark.parametrize("telegrams", [None, "ab", b"ab", [1], [wire.LineReset(0), "telegram"]])
+def test_returned_frame_refuses_what_is_no_telegram_by_name(telegrams: object) -> None:
+    """Before, items of another type were dropped silently: ``returned_frame([1])`` was a dead line."""
+    with pytest.raises(InterbusArgumentError, match="telegrams must be an iterable of telegrams"):
+        wire.returned_frame(telegrams)  # type: ignore[arg-type]

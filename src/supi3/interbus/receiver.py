@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from supi3.checks import check_choice, check_int, check_trace
+from supi3.checks import check_choice, check_instance, check_int, check_trace
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusError, TelegramError
 from supi3.interbus.wire import Cycle, LineReset, Telegram
@@ -89,7 +89,17 @@ def frame_start(samples: npt.NDArray[np.integer], cpb: int, cycle: Cycle, data_b
     A start is a sample at the start level after the idle or stop level (or the trace's first, at the start level)
     from which :func:`receive` reads the whole frame, telegram after telegram, and nothing else: a telegram read
     from within another (the trace may begin inside one) does not continue into a frame.
+
+    Raises
+    ------
+    ArgumentError
+        ``samples`` is not a 1-D sequence of 0/1 integers, ``cpb`` not a number of clocks per bit (Table 1-7),
+        ``cycle`` not a :class:`~supi3.interbus.wire.Cycle` or ``data_bytes`` not an integer >= 0.
     """
+    samples = check_trace("samples", samples, 1)
+    cpb = check_choice("cpb", cpb, sorted({wire.clocks_per_bit(rate) for rate in BIT_RATES}), "Table 1-7")
+    check_instance("cycle", cycle, Cycle)
+    data_bytes = check_int("data_bytes", data_bytes, 0)
     telegrams = data_bytes + wire.CHECK_TELEGRAMS
     length = wire.DATA_TELEGRAM_BITS * telegrams * cpb
     low = samples == wire.START_LEVEL

@@ -1087,11 +1087,17 @@ def returned_frame(telegrams: Iterable[Telegram | LineReset]) -> Frame | None:
 
     Raises
     ------
+    InterbusArgumentError
+        ``telegrams`` is not an iterable of :class:`Telegram` and :class:`LineReset` items.
     InterbusError
         The data telegrams open a frame that does not assemble (:func:`frame_from_telegrams`).
     """
+    wanted = "an iterable of telegrams (Telegram or LineReset)"
     if isinstance(telegrams, (str, bytes)) or not isinstance(telegrams, Iterable):
-        _refuse("telegrams", "an iterable of telegrams (Telegram or LineReset)", telegrams)
+        _refuse("telegrams", wanted, telegrams)
+    telegrams = list(telegrams)
+    if not all(isinstance(t, (Telegram, LineReset)) for t in telegrams):
+        _refuse("telegrams", wanted, telegrams)
     frames = [t for t in telegrams if isinstance(t, Telegram) and t.data is not None]
     return frame_from_telegrams(frames) if any(opens_frame(t) for t in frames) else None
 
