@@ -24,7 +24,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from supi3 import sdk
-from supi3.sdk.driver import IRQ_SERVICE_MAX_READS
 from supi3.regmap import (
     ALARM,
     ID,
@@ -41,6 +40,7 @@ from supi3.regmap import (
     decode_set,
     encode_command,
 )
+from supi3.sdk.driver import IRQ_SERVICE_MAX_READS
 
 HARNESS = Path(__file__).parent / "c" / "fuzz_driver.c"
 SANITIZE = ["-fsanitize=address,undefined", "-fno-omit-frame-pointer", "-fno-sanitize-recover=all"]

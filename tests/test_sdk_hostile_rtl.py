@@ -183,11 +183,11 @@ def test_the_drivers_take_only_the_transport_of_their_kind() -> None:
     says; the other way round is refused by name, and a bridge over what is no ``AsyncTransport`` too."""
     transport = rtl.RtlTransport(board())
     with pytest.raises(DriverArgumentError, match=r"transport must be a supi3.sdk.driver.Transport"):
-        Supi3Driver(transport)  # type: ignore[arg-type]
+        Supi3Driver(transport)
     with pytest.raises(DriverArgumentError, match=r"transport must be a supi3.sdk.driver.AsyncTransport"):
-        AsyncSupi3Driver(rtl.BridgedTransport(transport))  # type: ignore[arg-type]
+        AsyncSupi3Driver(rtl.BridgedTransport(transport))
     with pytest.raises(DriverArgumentError, match=r"inner must be a supi3.sdk.driver.AsyncTransport"):
-        rtl.BridgedTransport(rtl.BridgedTransport(transport))  # type: ignore[arg-type]
+        rtl.BridgedTransport(rtl.BridgedTransport(transport))
     assert isinstance(rtl.BridgedTransport(transport), rtl.Transport)
 
 
@@ -198,12 +198,12 @@ def test_the_ring_checks_its_board_and_its_samples_as_the_pin_level_ring() -> No
     """``RtlRing("x")`` was an ``AttributeError``; samples other than 0/1 went to ``do1`` as they were (PinRing
     refuses them: ``check_trace``); before ``start`` the line is not driven."""
     with pytest.raises(ArgumentError, match=r"board must be"):
-        rtl.RtlRing("board")  # type: ignore[arg-type]
+        rtl.RtlRing("board")
     ring = rtl.RtlRing(board())
     for samples in ([0, 2, 1], [[0, 1]], "0101", [0.0, 1.0]):
         with pytest.raises(ArgumentError, match=r"samples(\[1\])? must be (a 1-D sequence of integers|an integer) "
                                                 r"from 0 to 1"):
-            ring.run_samples(samples)  # type: ignore[arg-type]
+            ring.run_samples(samples)
     ring.run_samples([])  # nothing to drive
     with pytest.raises(rtl.RtlBoardError, match=r"run_samples\(\) before RtlBoard.start\(\)"):
         ring.run_samples([1, 1, 0])
@@ -230,7 +230,7 @@ def test_the_bench_s_call_checks_its_scenario_state_and_order() -> None:
     before ``start``, a call while another runs: refused by name, before the firmware's setup."""
     bench = rtl.RtlBench(board(), Quiet())
     with pytest.raises(DriverArgumentError, match=r"scenario must be a callable, not 'play'"):
-        refused_at_once(bench.call("play"))  # type: ignore[arg-type]
+        refused_at_once(bench.call("play"))
     with pytest.raises(rtl.RtlBoardError, match=r"call\(\) before RtlBoard.start\(\)"):
         refused_at_once(bench.call(lambda: None))
     bench.board.started = True

@@ -1,7 +1,7 @@
 /*
- * late_service.c - digital_io.c's device whose service routine first does SERVICE_DELAY_US of other work, then
- * reads the interrupt events (FW-22, tests/test_sdk_lost_edge.py). With
- * the master's cycle a little longer than the delay, the events are read in the frame in which the next cycle's
+ * late_service.c - a 16 IN / 16 OUT device (SET 83h, one block transfer per VALID event, 3.4.6) whose first service
+ * routine does SERVICE_DELAY_US of other work before it reads the interrupt events (FW-22, tests/test_sdk_lost_edge.py).
+ * With the master's cycle a little longer than the delay, the events are read in the frame in which the next cycle's
  * VALID event comes (3.4.14): /IRQ stays low, and no new falling edge follows. ONCE = 1 reads register 14 once
  * (supi3_read), as a firmware that serves one event per edge; ONCE = 0 calls supi3_irq_service, which reads until
  * /IRQ is high.
@@ -29,18 +29,16 @@ void fw_setup(supi3_t *chip, fw_board_t *board)
 
 void fw_isr(supi3_t *chip, fw_board_t *board)
 {
+    static int delayed;
     uint8_t events = 0u;
-    board->delay_us(board->user, SERVICE_DELAY_US);
-    if (fw_note(board, ONCE ? supi3_read(chip, SUPI3_IRQ_EVT_ADDR, &events) : supi3_irq_service(chip, &events)) !=
-            SUPI3_OK ||
-        (events & SUPI3_IRQ_EVT_VALID_MSK) == 0u) {
-        return;
+    int err;
+    if (!delayed) { /* once: later entries (the edge of the event read in this one, too) come at once */
+        delayed = 1;
+        board->delay_us(board->user, SERVICE_DELAY_US);
     }
-    if (fw_note(board, supi3_read(chip, SUPI3_OUT0_ADDR, &board->outputs[0])) != SUPI3_OK ||
-        fw_note(board, supi3_read(chip, SUPI3_OUT1_ADDR, &board->outputs[1])) != SUPI3_OK ||
-        fw_note(board, supi3_write(chip, SUPI3_IN0_ADDR, board->inputs[0])) != SUPI3_OK ||
-        fw_note(board, supi3_write(chip, SUPI3_IN1_ADDR, board->inputs[1])) != SUPI3_OK) {
-        return;
+    err = ONCE ? supi3_read(chip, SUPI3_IRQ_EVT_ADDR, &events) : supi3_irq_service(chip, &events);
+    if (fw_note(board, err) == SUPI3_OK && (events & SUPI3_IRQ_EVT_VALID_MSK) != 0u &&
+        fw_note(board, supi3_block_transfer(chip, 1, 1, board->outputs, board->inputs, 2u)) == SUPI3_OK) {
+        board->cycles++; /* OUT0..1 to the outputs, the inputs to IN0..1 (3.4.6) */
     }
-    board->cycles++;
 }
