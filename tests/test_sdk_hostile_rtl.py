@@ -11,6 +11,7 @@ runs one ``RtlBench`` through two calls on it.
 from __future__ import annotations
 
 from collections.abc import Callable, Coroutine
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -240,6 +241,15 @@ def test_the_bench_s_call_checks_its_scenario_state_and_order() -> None:
     with pytest.raises(ArgumentError, match=r"cycles must be an integer >= 0"):
         bench.run(-1)
     assert bench.cycles == 0 and not bench._set_up
+
+
+def test_one_bench_called_twice_on_the_rtl(chip_build: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """On the Verilator build (sim/sdk_rtl.py ``bench_called_twice``): the setup once, the firmware served in both
+    calls (before, the second call ran the setup again and its scenario without a firmware), a second start
+    refused, the status pins levels."""
+    from test_sdk_rtl import simulate
+
+    simulate(chip_build, tmp_path, monkeypatch, "bench_called_twice")
 
 
 def test_timing_other_than_the_fastest_is_kept() -> None:
