@@ -24,11 +24,13 @@ from hypothesis import strategies as st
 from supi3 import expansion, serial_io, timing
 from supi3.config import DataDirection, Variant, decode, mode_rows
 from supi3.errors import ArgumentError
+from supi3.figures import expansion_wavejson, serial_io_wavejson, write_figures
 from supi3.pinlevel import EventLog, Pin, PinSpecError
 from supi3.rtl import lfsr
 from supi3.rtl import serial_io as rtl_serial_io
 from supi3.rtl import tables as rtl_tables
 from supi3.spi.block_pins import block_model
+from supi3.spi.figures import to_wavejson
 from supi3.spi.master import MasterTiming, SoftMaster, SpiTrace, decode_bytes, write_spi_vcd
 from supi3.spi.upif import Mode
 from supi3.tables import BIT_RATES
@@ -312,3 +314,39 @@ def test_evaluate_alternatives_follow_the_bit_rate() -> None:
     assert timing.evaluate("667 ns | 167 ns", 500_000) == pytest.approx(667e-9)
     assert timing.evaluate("667 ns | 167 ns", 2_000_000) == pytest.approx(167e-9)
     assert timing.evaluate("2 * t0", 500_000, t0_s=1e-6) == pytest.approx(2e-6)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# The figures' WaveJSON (supi3.spi.figures, supi3.figures)
+# ---------------------------------------------------------------------------------------------------------------
+
+BAD_FIGURES: list[tuple[str, Callable[[], object], str]] = [
+    # Before: step 0 silently meant the default, a negative step drew a figure of no column, 1.5 a TypeError from
+    # range(); a trace of another kind an AttributeError.
+    ("to_wavejson step 0", lambda: to_wavejson(_trace(), "t", step=0), "step"),
+    ("to_wavejson step -2", lambda: to_wavejson(_trace(), "t", step=-2), "step"),
+    ("to_wavejson step 1.5", lambda: to_wavejson(_trace(), "t", step=1.5), "step"),  # type: ignore[arg-type]
+    ("to_wavejson trace", lambda: to_wavejson(None, "t"), "trace"),  # type: ignore[arg-type]
+    ("to_wavejson title", lambda: to_wavejson(_trace(), None), "title"),  # type: ignore[arg-type]
+    ("serial_io_wavejson trace", lambda: serial_io_wavejson(None, "t"), "trace"),  # type: ignore[arg-type]
+    ("expansion_wavejson trace", lambda: expansion_wavejson("x", "t"), "trace"),  # type: ignore[arg-type]
+    # Before: an AttributeError (a str has no mkdir), and vcd=1 taken as True.
+    ("write_figures str", lambda: write_figures("/tmp/never-figures"), "out"),  # type: ignore[arg-type]
+    ("write_figures vcd 1", lambda: write_figures(Path("never-figures"), vcd=1), "vcd"),  # type: ignore[arg-type]
+]
+
+
+@pytest.mark.parametrize(("call", "name"), [pytest.param(c, n, id=label) for label, c, n in BAD_FIGURES])
+def test_figures_refuse_by_name(call: Callable[[], object], name: str) -> None:
+    """Each call used to guess or fail deep inside (see the comments of BAD_FIGURES); nothing is written."""
+    with pytest.raises(ArgumentError, match=rf"^{name} must be .*, not "):
+        call()
+    assert not Path("never-figures").exists()
+
+
+def test_to_wavejson_step_one_draws_every_cycle() -> None:
+    """A step of 1 (the finest) gives one column per recorded cycle."""
+    trace = _trace()
+    wave = to_wavejson(trace, "every cycle", step=1)
+    lanes = wave["signal"]
+    assert isinstance(lanes, list) and all(len(lane["wave"]) == len(trace) for lane in lanes)
