@@ -22,6 +22,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from supi3 import expansion, serial_io, timing
+from supi3.expansion import chain_to_line, line_to_chain
+from supi3.interbus import wire
+from supi3.interbus.master import Master
+from supi3.interbus.ring import Ring
+from supi3.model.blocks.expansion import overrun_gap_clocks
+from supi3.model.chip import Supi3
+from supi3.peripherals.sre import Sre1
+from supi3.regmap import ID, SET
 from supi3.config import DataDirection, Variant, decode, mode_rows
 from supi3.errors import ArgumentError
 from supi3.figures import expansion_wavejson, serial_io_wavejson, write_figures
@@ -33,7 +41,7 @@ from supi3.spi.block_pins import block_model
 from supi3.spi.figures import to_wavejson
 from supi3.spi.master import MasterTiming, SoftMaster, SpiTrace, decode_bytes, write_spi_vcd
 from supi3.spi.upif import Mode
-from supi3.tables import BIT_RATES
+from supi3.tables import BIT_RATES, clk_conf_for
 from supi3.verif.timing import raise_first
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -350,3 +358,64 @@ def test_to_wavejson_step_one_draws_every_cycle() -> None:
     wave = to_wavejson(trace, "every cycle", step=1)
     lanes = wave["signal"]
     assert isinstance(lanes, list) and all(len(lane["wave"]) == len(trace) for lane in lanes)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Serial register expansion over histories (3.5, RX-2, RX-4, RX-5): what the external registers hold
+# ---------------------------------------------------------------------------------------------------------------
+
+_EXT_LENGTH_CODES = {1: 0b01001, 3: 0b01011, 6: 0b00011}
+"""Data lengths in bytes with ExtReg = 1 and their complete length codes (Table 3-11)."""
+
+_EXT_OP = st.one_of(
+    st.tuples(st.just("data"), st.binary(min_size=6, max_size=6), st.integers(0, 0)),
+    st.tuples(st.just("error"), st.binary(min_size=6, max_size=6), st.integers(8, 60)),
+    st.tuples(st.just("reset"), st.just(b""), st.integers(0, 0)),
+    st.tuples(st.just("inputs"), st.binary(min_size=6, max_size=6), st.integers(0, 0)),
+    st.tuples(st.just("idle"), st.just(b""), st.integers(0, 2000)),
+)
+
+
+@settings(max_examples=40, deadline=None)
+@given(length=st.sampled_from(sorted(_EXT_LENGTH_CODES)), rate=st.sampled_from(BIT_RATES),
+       ops=st.lists(_EXT_OP, max_size=14))
+def test_history_external_registers_hold_the_last_valid_out_data(
+        length: int, rate: int, ops: list[tuple[str, bytes, int]]) -> None:
+    """Over any history of data cycles, bit errors on either line, INTERBUS resets, idle time and input changes, the
+    IBS SRE 1's output registers hold the OUT data of the last valid data cycle in chain order (LaOuD only after a
+    latched cycle, RX-4; cleared by /ResReg on the reset, RX-5): a corrupted cycle never changes them. A valid data
+    cycle right after a valid one brings the IN data the chain loaded at that one's end (/LaInD)."""
+    chip = Supi3(decode("10011", "1110", clk_conf=clk_conf_for(rate)))
+    assert chip.registers is not None
+    chip.registers.cpu_write(SET.address, SET.encode(EXTREG=1, LENGTH_CODE=_EXT_LENGTH_CODES[length]))
+    chip.registers.cpu_write(ID.address, 0x01)
+    sre = Sre1(length)
+    chip.attach_expansion(sre)
+    ring = Ring([chip])
+    master = Master(ring)
+    assert master.start().ok
+    cpb = wire.clocks_per_bit(rate)
+    gap_s = -(-overrun_gap_clocks(True, cpb) // cpb) / rate  # no expansion overrun between cycles (RX-4)
+    expected = bytes(length)
+    loaded: bytes | None = sre.inputs  # what /LaInD took at the end of the last cycle, if that was valid
+    for kind, data, n in ops:
+        if kind in ("data", "error"):
+            out = data[:length]
+            ring.idle(gap_s)
+            master.set_outputs(1, out)
+            if kind == "error":
+                ring.bit_error(1 + n % 2, n)
+            result = master.data_cycle()
+            if result.ok:
+                assert loaded is None or master.inputs(1) == chain_to_line(loaded)
+                expected = line_to_chain(out)
+            loaded = sre.inputs if result.ok else None
+        elif kind == "reset":
+            ring.idle(gap_s)
+            assert master.start().ok
+            expected, loaded = bytes(length), None
+        elif kind == "inputs":
+            sre.set_inputs(data[:length])
+        else:
+            ring.idle(n * 1e-6)
+        assert sre.outputs == expected
