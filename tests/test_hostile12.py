@@ -22,18 +22,18 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from supi3 import expansion, serial_io, timing
+from supi3.config import DataDirection, Variant, decode, mode_rows
+from supi3.errors import ArgumentError
 from supi3.expansion import chain_to_line, line_to_chain
+from supi3.figures import expansion_wavejson, serial_io_wavejson, write_figures
 from supi3.interbus import wire
 from supi3.interbus.master import Master
 from supi3.interbus.ring import Ring
 from supi3.model.blocks.expansion import overrun_gap_clocks
 from supi3.model.chip import Supi3
 from supi3.peripherals.sre import Sre1
-from supi3.regmap import ID, SET
-from supi3.config import DataDirection, Variant, decode, mode_rows
-from supi3.errors import ArgumentError
-from supi3.figures import expansion_wavejson, serial_io_wavejson, write_figures
 from supi3.pinlevel import EventLog, Pin, PinSpecError
+from supi3.regmap import ID, SET
 from supi3.rtl import lfsr
 from supi3.rtl import serial_io as rtl_serial_io
 from supi3.rtl import tables as rtl_tables
