@@ -1,14 +1,17 @@
 """Hostile inputs, orders and histories against the public entries no earlier round attacked (a user's review,
 round 12): the software µP on the serial µP interface's pins (:mod:`supi3.spi.master`: ``SoftMaster``,
-``MasterTiming``, ``SpiTrace``, ``decode_bytes``, ``write_spi_vcd``), the RTL's LFSR counters
-(:mod:`supi3.rtl.lfsr`), the RTL's strap tables (:mod:`supi3.rtl.tables`) and serial I/O schedules
+``MasterTiming`` (UP-45), ``SpiTrace``, ``decode_bytes``, ``write_spi_vcd``), the figures' WaveJSON
+(:func:`supi3.spi.figures.to_wavejson`, :mod:`supi3.figures`), the RTL's LFSR counters (:mod:`supi3.rtl.lfsr`: a
+negative count looped for ever), the RTL's strap tables (:mod:`supi3.rtl.tables`) and serial I/O schedules
 (:func:`supi3.rtl.serial_io.schedule`), the serial I/O and register-expansion schedules (:mod:`supi3.serial_io`,
 :mod:`supi3.expansion`), the timing expressions (:func:`supi3.timing.evaluate`), the pin-list helpers
 (:mod:`supi3.pinlevel`) and the timing checkers' :func:`supi3.verif.timing.raise_first`.
 
-Every bad input is refused by name (which argument, which rule, which value) and changes nothing; over any history of
+Every bad input is refused by name (which argument, which rule, which value) and changes nothing. Over any history of
 bytes, deselects, SAS_INIT pulses, holds and refused calls, the bytes read back from the pins alone
-(``decode_bytes``) are the bytes the software µP sent and received (UP-5, UP-6, UP-7).
+(``decode_bytes``) are the bytes the software µP sent and received (UP-5, UP-6, UP-7); over any history of data
+cycles, bit errors, INTERBUS resets, idle time and input changes, external registers on the expansion interface
+hold the OUT data of the last valid data cycle (3.5, RX-4, RX-5).
 """
 
 from __future__ import annotations
@@ -40,6 +43,7 @@ from supi3.rtl import tables as rtl_tables
 from supi3.spi.block_pins import block_model
 from supi3.spi.figures import to_wavejson
 from supi3.spi.master import MasterTiming, SoftMaster, SpiTrace, decode_bytes, write_spi_vcd
+from supi3.spi.slave_pins import PinsIn
 from supi3.spi.upif import Mode
 from supi3.tables import BIT_RATES, clk_conf_for
 from supi3.verif.timing import raise_first
@@ -107,6 +111,12 @@ BAD_MASTER: list[tuple[str, Callable[[], object], str]] = [
     ("window stop float", lambda: _trace().window(0, 2.0), "stop"),  # type: ignore[arg-type]
     ("mfp6_line past", lambda: _trace().mfp6_line(10**6), "k"),
     ("mfp7_line -1", lambda: _trace().mfp7_line(-1), "k"),
+    # Before: a trace of lists of different lengths, or of a str mode, was made and failed later in decode_bytes
+    # or write_spi_vcd with an IndexError or AttributeError.
+    ("SpiTrace lengths", lambda: SpiTrace(Mode.INTEL, _FASTEST, 32_000_000, 2_000_000, inputs=[PinsIn()]),
+     "outputs"),
+    ("SpiTrace mode str", lambda: SpiTrace("intel", _FASTEST, 32_000_000, 2_000_000), "mode"),  # type: ignore[arg-type]
+    ("SpiTrace clock 0", lambda: SpiTrace(Mode.INTEL, _FASTEST, 0, 2_000_000), "clock_hz"),
     ("vcd str path", lambda: write_spi_vcd("/tmp/never.vcd", _trace()), "path"),  # type: ignore[arg-type]
     ("vcd not a trace", lambda: write_spi_vcd(Path("never.vcd"), None), "trace"),  # type: ignore[arg-type]
     ("vcd empty trace", lambda: write_spi_vcd(Path("never.vcd"), _trace().window(0, 0)), "trace"),

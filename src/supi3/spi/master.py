@@ -153,6 +153,19 @@ class SpiTrace:
     mosi_oe: list[int] = field(default_factory=list)
     """1 while the µP drives MFP6 (always in Motorola mode; in Intel mode while /SS is low and S/R = 1)."""
 
+    def __post_init__(self) -> None:
+        check_instance("mode", self.mode, Mode, "a supi3.spi.upif.Mode")
+        check_instance("timing", self.timing, MasterTiming)
+        check_int("clock_hz", self.clock_hz, 1)
+        check_int("bit_rate", self.bit_rate, 1)
+        check_int("first_cycle", self.first_cycle, 0)
+        lists = {"inputs": self.inputs, "outputs": self.outputs, "mosi_oe": self.mosi_oe}
+        for name, items in lists.items():
+            check_instance(name, items, list, "a list, one item per cycle")
+        if not len(self.inputs) == len(self.outputs) == len(self.mosi_oe):
+            raise fail("outputs", f"one item per cycle of inputs ({len(self.inputs)}), as mosi_oe",
+                       f"{len(self.outputs)} outputs and {len(self.mosi_oe)} mosi_oe")
+
     def __len__(self) -> int:
         return len(self.inputs)
 
