@@ -25,7 +25,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from supi3 import expansion, serial_io, timing
-from supi3.config import DataDirection, Variant, decode, mode_rows
+from supi3.config import DataDirection, Variant, decode, decode_straps, mode_rows, parse_function
 from supi3.errors import ArgumentError
 from supi3.expansion import chain_to_line, line_to_chain
 from supi3.figures import expansion_wavejson, serial_io_wavejson, write_figures
@@ -36,6 +36,7 @@ from supi3.model.blocks.expansion import overrun_gap_clocks
 from supi3.model.chip import Supi3
 from supi3.peripherals.sre import Sre1
 from supi3.pinlevel import EventLog, Pin, PinSpecError
+from supi3.pinout import up_input_port
 from supi3.regmap import ID, SET
 from supi3.rtl import lfsr
 from supi3.rtl import serial_io as rtl_serial_io
@@ -305,6 +306,15 @@ BAD_SPEC: list[tuple[str, Callable[[], object], type[Exception], str]] = [
     ("Pin name 5", lambda: Pin(5), PinSpecError, "pin name"),  # type: ignore[arg-type]
     ("Pin tristate 1", lambda: Pin("a", 1, 1), PinSpecError, "tristate"),  # type: ignore[arg-type]
     ("EventLog str", lambda: EventLog("a"), PinSpecError, "depth"),  # type: ignore[arg-type]
+    # Before: a name not of the µP interface came back unchanged ("zz" -> "zz"); a bad variant or interface of
+    # mode_rows raised only at the first row taken (a generator), as a bare ValueError of the enum; parse_function
+    # of None a TypeError from re, decode_straps of None an AttributeError.
+    ("up_input_port zz", lambda: up_input_port("zz"), ArgumentError, "name"),
+    ("mode_rows variant", lambda: mode_rows("xx"), ArgumentError, "variant"),
+    ("mode_rows interface", lambda: mode_rows("opc", "zz"), ArgumentError, "interface"),
+    ("parse_function None", lambda: parse_function(None), ArgumentError, "function"),  # type: ignore[arg-type]
+    ("parse_function xyz", lambda: parse_function("xyz"), ArgumentError, "function"),
+    ("decode_straps None", lambda: decode_straps(None), ArgumentError, "straps"),  # type: ignore[arg-type]
     # Before: a TypeError from iterating None.
     ("raise_first None", lambda: raise_first(None), ArgumentError, "violations"),  # type: ignore[arg-type]
 ]
