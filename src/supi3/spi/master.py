@@ -3,7 +3,8 @@
 :class:`SoftMaster` drives :class:`~supi3.spi.slave_pins.SlavePins` (or a :class:`PinPort` such as
 :class:`supi3.top.ChipPort`) pin by pin at the chip clock, within Table 3-7 (IBS SUPI 3 OPC UM E rev. 05, 3.4.2):
 SCLK idles high, the µP changes its data on falling edges and both sides sample on rising edges (UP-5), one byte per
-/SS low period (UP-7); the edges are placed by :class:`MasterTiming`. Every pin of every cycle can be recorded in a :class:`SpiTrace`, which can be
+/SS low period (UP-7); the edges are placed by :class:`MasterTiming`. Every pin of every cycle can be recorded in
+a :class:`SpiTrace`, which can be
 
 * decoded back into bytes from the pins alone (:func:`decode_bytes`),
 * written as a VCD (:func:`write_spi_vcd`),
