@@ -20,6 +20,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
+import numpy.typing as npt
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -47,6 +48,8 @@ from supi3.spi.master import MasterTiming, SoftMaster, SpiTrace, decode_bytes, w
 from supi3.spi.slave_pins import PinsIn
 from supi3.spi.upif import Mode
 from supi3.tables import BIT_RATES, clk_conf_for
+from supi3.verif.example import ShiftCounterModel
+from supi3.verif.layout import WordLayout, first_mismatch
 from supi3.verif.timing import raise_first
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -439,3 +442,60 @@ def test_history_external_registers_hold_the_last_valid_out_data(
         else:
             ring.idle(n * 1e-6)
         assert sre.outputs == expected
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# The lockstep's scoreboard on whole traces (supi3.verif.layout.first_mismatch)
+# ---------------------------------------------------------------------------------------------------------------
+
+_LAYOUT = WordLayout.of(ShiftCounterModel())
+_SIGNALS = len(_LAYOUT.out_fields)
+
+
+def _outputs(*rows: dict[str, int]) -> npt.NDArray[np.uint64]:
+    names = [field.name for field in _LAYOUT.out_fields]
+    return np.array([[row.get(name, 0) for name in names] for row in rows], dtype=np.uint64).reshape(-1, _SIGNALS)
+
+
+def test_first_mismatch_never_accepts_a_value_that_spills_into_the_next_signal() -> None:
+    """Before: a value wider than its signal was packed into the next signal's bits, so count 256 with sr 0 equalled
+    count 0 with sr 1 (no mismatch reported), and count 256 alone was reported on sr; now the value is refused by
+    name (which trace, cycle and signal)."""
+    expected = _outputs({"count": 0, "sr": 1})
+    with pytest.raises(ArgumentError, match=r"^actual\[0, 0\] must be a value of 'count' within 8 bits, not 256"):
+        first_mismatch(_LAYOUT, expected, _outputs({"count": 256, "sr": 0}))
+    with pytest.raises(ArgumentError, match=r"^expected\[0, 0\] .* not -1"):
+        first_mismatch(_LAYOUT, np.full((1, _SIGNALS), -1, dtype=np.int64), expected)
+
+
+@pytest.mark.parametrize(("expected", "actual", "name"), [
+    pytest.param(np.zeros((3, _SIGNALS), np.uint64), np.zeros((2, _SIGNALS), np.uint64), "actual", id="lengths"),
+    pytest.param(np.zeros((3, _SIGNALS), np.uint64), np.zeros((3, 2), np.uint64), "actual", id="columns"),
+    pytest.param(np.zeros((3, _SIGNALS)), np.zeros((3, _SIGNALS)), "expected", id="floats"),
+    pytest.param(np.zeros(_SIGNALS, np.uint64), np.zeros(_SIGNALS, np.uint64), "expected", id="1-D"),
+])  # fmt: skip
+def test_first_mismatch_refuses_traces_by_name(expected: object, actual: object, name: str) -> None:
+    """Before: a broadcast ValueError, a zip() ValueError, a ufunc TypeError; now the trace is named."""
+    with pytest.raises(ArgumentError, match=rf"^{name} must be "):
+        first_mismatch(_LAYOUT, expected, actual)  # type: ignore[arg-type]
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.data())
+def test_first_mismatch_finds_the_first_difference(data: st.DataObject) -> None:
+    """Over random traces within their signals' widths and random changes to one copy, the scoreboard reports
+    exactly the first compared difference (a tri-state value compared only while the model's enable is 1), and
+    never accepts a trace that differs in a compared signal."""
+    cycles = data.draw(st.integers(1, 6))
+    rows = [{field.name: data.draw(st.integers(0, field.mask)) for field in _LAYOUT.out_fields}
+            for _ in range(cycles)]
+    expected = _outputs(*rows)
+    actual = expected.copy()
+    for _ in range(data.draw(st.integers(0, 3))):
+        cycle, index = data.draw(st.integers(0, cycles - 1)), data.draw(st.integers(0, _SIGNALS - 1))
+        actual[cycle, index] = data.draw(st.integers(0, _LAYOUT.out_fields[index].mask))
+    enables = {field.name: i for i, field in enumerate(_LAYOUT.out_fields)}
+    differences = [(c, i) for c in range(cycles) for i, field in enumerate(_LAYOUT.out_fields)
+                   if expected[c, i] != actual[c, i]
+                   and (field.enable is None or expected[c, enables[field.enable]])]
+    assert first_mismatch(_LAYOUT, expected, actual) == (differences[0] if differences else None)

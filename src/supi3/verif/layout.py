@@ -17,6 +17,7 @@ from typing import TypeAlias
 import numpy as np
 import numpy.typing as npt
 
+from supi3.checks import check_instance, fail
 from supi3.pinlevel import Pin, PinModel, PinSpecError, check_cycles, compared_signals
 
 __all__ = [
@@ -389,5 +390,37 @@ def first_mismatch(layout: WordLayout, expected: CycleMatrix, actual: CycleMatri
 
     Within the first differing cycle the lowest signal index (comparison order) is reported. The traces are compared
     as packed words, like the batch path (:meth:`WordLayout.first_word_mismatch`).
+
+    Raises
+    ------
+    ArgumentError
+        ``layout`` not a :class:`WordLayout`; a trace not a 2-D integer array of one column per compared signal, a
+        value outside its signal's width (packed, it spilled into the next signal: a difference named the wrong
+        pin, or two differences cancelled), or the traces of different lengths.
     """
+    check_instance("layout", layout, WordLayout)
+    expected = _output_trace("expected", expected, layout)
+    actual = _output_trace("actual", actual, layout)
+    if actual.shape[0] != expected.shape[0]:
+        raise fail("actual", f"as many cycles as expected ({expected.shape[0]})", f"{actual.shape[0]} cycles")
     return layout.first_word_mismatch(layout.output_words(expected), layout.output_words(actual))
+
+
+def _output_trace(name: str, trace: object, layout: WordLayout) -> CycleMatrix:
+    """``trace`` as a ``(cycles, signals)`` array of compared output values, each within its signal's width."""
+    signals = len(layout.out_fields)
+    wanted = f"a (cycles, {signals}) integer array of the compared outputs"
+    try:
+        array = np.asarray(trace)
+    except (TypeError, ValueError) as error:
+        raise fail(name, wanted, trace) from error
+    if array.ndim != 2 or array.shape[1] != signals or (array.size and array.dtype.kind not in "iu"):
+        raise fail(name, wanted, trace)
+    for index, field in enumerate(layout.out_fields):
+        column = array[:, index]
+        bad = (column < 0) | (column > field.mask) if column.dtype.kind == "i" else column > field.mask
+        if bad.any():
+            cycle = int(np.argmax(bad))
+            raise fail(f"{name}[{cycle}, {index}]", f"a value of {field.name!r} within {field.width} bits",
+                       column[cycle].item())
+    return array.astype(np.uint64, copy=False)
