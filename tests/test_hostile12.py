@@ -5,13 +5,15 @@ round 12): the software µP on the serial µP interface's pins (:mod:`supi3.spi.
 negative count looped for ever), the RTL's strap tables (:mod:`supi3.rtl.tables`) and serial I/O schedules
 (:func:`supi3.rtl.serial_io.schedule`), the serial I/O and register-expansion schedules (:mod:`supi3.serial_io`,
 :mod:`supi3.expansion`), the timing expressions (:func:`supi3.timing.evaluate`), the pin-list helpers
-(:mod:`supi3.pinlevel`) and the timing checkers' :func:`supi3.verif.timing.raise_first`.
+(:mod:`supi3.pinlevel`, :mod:`supi3.pinout`, :mod:`supi3.config`), the timing checkers'
+:func:`supi3.verif.timing.raise_first` and the lockstep's scoreboard :func:`supi3.verif.layout.first_mismatch`.
 
 Every bad input is refused by name (which argument, which rule, which value) and changes nothing. Over any history of
 bytes, deselects, SAS_INIT pulses, holds and refused calls, the bytes read back from the pins alone
 (``decode_bytes``) are the bytes the software µP sent and received (UP-5, UP-6, UP-7); over any history of data
 cycles, bit errors, INTERBUS resets, idle time and input changes, external registers on the expansion interface
-hold the OUT data of the last valid data cycle (3.5, RX-4, RX-5).
+hold the OUT data of the last valid data cycle (3.5, RX-4, RX-5); the scoreboard reports exactly the first
+compared difference of any two traces and never accepts one that differs.
 """
 
 from __future__ import annotations
