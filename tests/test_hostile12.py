@@ -37,6 +37,7 @@ from supi3.interbus.master import Master
 from supi3.interbus.ring import Ring
 from supi3.model.blocks.expansion import overrun_gap_clocks
 from supi3.model.chip import Supi3
+from supi3.model.pins import Supi3Pins
 from supi3.peripherals.sre import Sre1
 from supi3.pinlevel import EventLog, Pin, PinSpecError
 from supi3.pinout import up_input_port
@@ -52,6 +53,7 @@ from supi3.spi.upif import Mode
 from supi3.tables import BIT_RATES, clk_conf_for
 from supi3.verif.example import ShiftCounterModel
 from supi3.verif.layout import WordLayout, first_mismatch
+from supi3.verif.straps import strap_stimulus
 from supi3.verif.timing import raise_first
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -501,3 +503,18 @@ def test_first_mismatch_finds_the_first_difference(data: st.DataObject) -> None:
                    if expected[c, i] != actual[c, i]
                    and (field.enable is None or expected[c, enables[field.enable]])]
     assert first_mismatch(_LAYOUT, expected, actual) == (differences[0] if differences else None)
+
+
+@pytest.mark.parametrize("value", [9, -1])
+def test_strap_stimulus_refuses_an_optical_value_past_its_width(value: int) -> None:
+    """Before: ``strap_stimulus``'s ``optical`` lines were taken unchecked (9 in a 3-bit port, -1 as 2**64 - 1), and
+    ``WordLayout.input_words`` (which packs a range-checked stimulus by one matrix product) spilled them into the next
+    port of the RTL's input words; now the column is named."""
+    config = decode("10011", "1110")
+    stimulus = np.zeros((3, len(Supi3Pins.inputs)), np.int64)
+    optical = np.zeros((3, len(Supi3Pins.optical_inputs)), np.int64)
+    optical[1, 1] = value
+    with pytest.raises(ArgumentError, match=r"^optical column 1 \('medium'\)\[1\] must be an integer from 0 to 7"):
+        strap_stimulus(config, stimulus, optical)
+    optical[1, 1] = 7
+    assert strap_stimulus(config, stimulus, optical)[1, -len(Supi3Pins.optical_inputs) + 1] == 7
