@@ -518,3 +518,16 @@ def test_strap_stimulus_refuses_an_optical_value_past_its_width(value: int) -> N
         strap_stimulus(config, stimulus, optical)
     optical[1, 1] = 7
     assert strap_stimulus(config, stimulus, optical)[1, -len(Supi3Pins.optical_inputs) + 1] == 7
+
+
+def test_input_words_refuse_a_value_past_its_pin() -> None:
+    """Before: ``WordLayout.input_words`` packed by one matrix product, so a value past its pin's width (or a negative
+    one) spilled into the next field: the design saw other inputs than the model. Now it is named."""
+    layout = WordLayout([Pin("a", 3), Pin("b", 1)], [Pin("x")])
+    with pytest.raises(ArgumentError, match=r"^stimulus\[1, 0\] must be a value of 'a' within 3 bits, not 8"):
+        layout.input_words(np.array([[7, 1], [8, 0]], dtype=np.uint64))
+    with pytest.raises(ArgumentError, match=r"^stimulus\[0, 1\] must be a value of 'b' within 1 bit, not -1"):
+        layout.input_words(np.array([[0, -1]], dtype=np.int64))
+    with pytest.raises(ArgumentError, match=r"^stimulus must be a \(cycles, 2\) integer array"):
+        layout.input_words(np.zeros((2, 3), dtype=np.uint64))
+    assert layout.input_words(np.array([[7, 1]], dtype=np.uint64)).tolist() == [[7 | 1 << 3]]
