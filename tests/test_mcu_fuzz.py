@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Final
 
 import pytest
+from hypothesis import Phase as Stage
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -34,7 +35,7 @@ from supi3.model.registers import InterfaceViolationError, RegisterFile
 from supi3.regmap import REGISTER_MAP
 from supi3.regmap.core import AccessDirection
 from supi3.regmap.registers import encode_command
-from supi3.sdk.bench import PIN_READ_S, Bench, Firmware
+from supi3.sdk.bench import Bench, Firmware
 from supi3.sdk.driver import DriverError, ErrorCode, Mode, Supi3Driver
 from supi3.spi.upif import Phase, UpifProtocol
 
@@ -194,9 +195,10 @@ class _Scripted(Firmware):
         elif op == Op.POLL_IO:
             result[0] = int(drv.poll_io_window(a))
         elif op == Op.RAW:
-            undriven = protocol.mode is None or protocol.phase is Phase.DISABLED
+            # MCU-6: MISO reads FFh while the chip drives nothing (before the mode, disabled, an Intel send frame)
+            undriven = protocol.mode is not Mode.MOTOROLA or protocol.phase is Phase.DISABLED
             driven = transport.xfer(a, True)
-            result[0] = MISO_IDLE if undriven else driven  # MCU-6: MISO reads FFh while the chip drives nothing
+            result[0] = MISO_IDLE if undriven else driven
         elif op == Op.SS_HIGH:
             bench.advance(bench.now + bench.byte_s)  # the board's oracle: the chip sees nothing (3.4.2)
             transport.registers.violations.report(InterfaceViolationError("3.4.2", "byte clocked with /SS high"))
@@ -245,10 +247,10 @@ class _Scripted(Firmware):
         return 0
 
 
-def run_on_bench(script: list[Step], pin_read_s: float = PIN_READ_S) -> Outcome:
-    """``script`` through the Python driver on the transaction-level firmware bench, the board's SCLK (750 kHz),
-    run and ended as :func:`run_script` ends it."""
-    bench = Bench(strict=False, cycle_time_s=CYCLE_TIME_S, sclk_hz=1 / SPI_BIT_S, pin_read_s=pin_read_s)
+def run_on_bench(script: list[Step], mode: Mode = Mode.MOTOROLA) -> Outcome:
+    """``script`` through the Python driver on the transaction-level firmware bench in ``mode``, at the board's SCLK
+    (750 kHz), run and ended as :func:`run_script` ends it."""
+    bench = Bench(strict=False, cycle_time_s=CYCLE_TIME_S, sclk_hz=1 / SPI_BIT_S, mode=mode)
     firmware = _Scripted(bench, script)
     bench.firmware = firmware
     bench.power_up()  # the whole script, the bus running along
@@ -260,73 +262,102 @@ def run_on_bench(script: list[Step], pin_read_s: float = PIN_READ_S) -> Outcome:
 
 @pytest.fixture(scope="module")
 def scripted(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
-    """scripted.c built once per core."""
+    """scripted.c built once per core for the Motorola board, and for the Intel board (``"intel"``, Cortex-M3)."""
     folder = tmp_path_factory.mktemp("fuzz")
-    return {cpu: mcu_build.build(SOURCE, folder / f"scripted_{cpu}.elf", cpu=cpu) for cpu in ("cortex_m3", "cortex_m0")}
-
+    elves = {cpu: mcu_build.build(SOURCE, folder / f"scripted_{cpu}.elf", cpu=cpu)
+             for cpu in ("cortex_m3", "cortex_m0")}  # fmt: skip
+    elves["intel"] = mcu_build.build(SOURCE, folder / "scripted_intel.elf", defines={"FW_MODE": "SUPI3_MODE_INTEL"})
+    return elves
 
 
 # -- the scripts ---------------------------------------------------------------------------------------------------
 
 BYTE = st.integers(0, 0xFF)
 ADDRESS = st.integers(0, 15)
-SS_HIGH: Final = st.tuples(st.just(Op.SS_HIGH), BYTE, st.just(0), st.just(0))
-PIN_ALIKE: Final = st.one_of(
-    st.tuples(st.just(Op.INIT), st.sampled_from((0, 0, 0, 7)), st.just(0), st.just(0)),  # 7: no mode (E_ARG)
-    st.tuples(st.just(Op.CONFIG), st.sampled_from((0x83, 0x82, 0x84, 0x80, 0x03)) | BYTE, BYTE, st.just(0)),
-    st.tuples(st.sampled_from((Op.READ, Op.WRITE, Op.EXCHANGE)), ADDRESS, BYTE, st.just(0)),
-    st.tuples(st.just(Op.BLOCK), st.integers(0, 3), st.integers(0, 5), BYTE),
-    st.tuples(st.just(Op.IRQ_ENABLE), st.sampled_from((0x10, 0x00, 0x7F)) | BYTE, st.just(0), st.just(0)),
-    st.tuples(st.sampled_from((Op.IRQ_SERVICE, Op.SAS_INIT)), st.just(0), st.just(0), st.just(0)),
-    st.tuples(st.just(Op.DELAY), st.integers(0, 50), st.just(0), st.just(0)),
-    st.tuples(st.just(Op.RAW), BYTE, st.just(0), st.just(0)),
-    st.tuples(st.just(Op.SS_CUT), BYTE, st.integers(0, 7), st.just(0)),
-)
-"""The untimed steps but a byte with /SS high, which only the transaction-level board reports (MCU-61)."""
-UNTIMED: Final = PIN_ALIKE | SS_HIGH
-"""Steps whose results do not hang on the bus's timing: before the master's first cycle (1 ms, MCU-45) a prefix of
-at most six takes well under a millisecond on either clock."""
-RECOVER: Final[list[Step]] = [(Op.SAS_INIT, 0, 0, 0), (Op.INIT, 0, 0, 0), (Op.CONFIG, 0x83, 0x03, 0),
-                              (Op.IRQ_ENABLE, 0x10, 0, 0), (Op.IRQ_SERVICE, 0, 0, 0), (Op.WAIT_IRQ, 40, 0, 0)]
-"""Whatever the prefix left: SAS_INIT, initialize, one word of digital I/O, the VALID interrupt (3.4.14), and the
-wait for its /IRQ: both sides then start the body at the same data cycle's end, with the idle gap of
-:data:`CYCLE_TIME_S` before the next."""
-BODY: Final = st.one_of(UNTIMED, st.tuples(st.just(Op.POLL_IO), BYTE, st.just(0), st.just(0)),
-                        st.tuples(st.just(Op.DELAY), st.integers(0, 255), st.just(0), st.just(0)))
+INIT_BYTES: Final = {Mode.MOTOROLA: 0, Mode.INTEL: 1}
+"""scripted.c's INIT argument for each mode (supi3_mode_t)."""
+
+
+def untimed(mode: Mode = Mode.MOTOROLA, *, ss_high: bool = True) -> st.SearchStrategy[tuple[int, int, int, int]]:
+    """Steps whose results do not hang on the bus's timing (MCU-60): before the master's first cycle (1 ms, MCU-45)
+    six of them take well under a millisecond on either clock. The initialization mostly in the board's ``mode``,
+    sometimes in the other or in none (7: ``SUPI3_E_ARG``). The Intel board has no step that drives SPI1 directly
+    (its S/R line, PB0, is the transport's, MCU-18); ``ss_high=False`` leaves out the byte with /SS high, which
+    only the transaction-level board reports (MCU-61)."""
+    own = INIT_BYTES[mode]
+    steps = [
+        st.tuples(st.just(Op.INIT), st.sampled_from((own, own, own, 1 - own, 7)), st.just(0), st.just(0)),
+        st.tuples(st.just(Op.CONFIG), st.sampled_from((0x83, 0x82, 0x84, 0x80, 0x03)) | BYTE, BYTE, st.just(0)),
+        st.tuples(st.sampled_from((Op.READ, Op.WRITE, Op.EXCHANGE)), ADDRESS, BYTE, st.just(0)),
+        st.tuples(st.just(Op.BLOCK), st.integers(0, 3), st.integers(0, 5), BYTE),
+        st.tuples(st.just(Op.IRQ_ENABLE), st.sampled_from((0x10, 0x00, 0x7F)) | BYTE, st.just(0), st.just(0)),
+        st.tuples(st.sampled_from((Op.IRQ_SERVICE, Op.SAS_INIT)), st.just(0), st.just(0), st.just(0)),
+        st.tuples(st.just(Op.DELAY), st.integers(0, 50), st.just(0), st.just(0)),
+        st.tuples(st.just(Op.RAW), BYTE, st.just(0), st.just(0)),
+    ]
+    if mode is Mode.MOTOROLA:
+        steps.append(st.tuples(st.just(Op.SS_CUT), BYTE, st.integers(0, 7), st.just(0)))
+        if ss_high:
+            steps.append(st.tuples(st.just(Op.SS_HIGH), BYTE, st.just(0), st.just(0)))
+    return st.one_of(steps)
+
+
+def recover(mode: Mode) -> list[Step]:
+    """Whatever the prefix left: SAS_INIT, initialize, one word of digital I/O, the VALID interrupt (3.4.14), and
+    the wait for its /IRQ: both sides then start the body at the same data cycle's end, with the idle gap of
+    :data:`CYCLE_TIME_S` before the next."""
+    return [(Op.SAS_INIT, 0, 0, 0), (Op.INIT, INIT_BYTES[mode], 0, 0), (Op.CONFIG, 0x83, 0x03, 0),
+            (Op.IRQ_ENABLE, 0x10, 0, 0), (Op.IRQ_SERVICE, 0, 0, 0), (Op.WAIT_IRQ, 40, 0, 0)]  # fmt: skip
+
+
+NO_SHRINK: Final = (Stage.explicit, Stage.reuse, Stage.generate)
+"""An example costs up to half a second of bus emulation: a failure prints its script as generated (shrinking one
+took over five minutes)."""
 LATCH_DELAYS_US: Final = (60, 117, 150)
 """A read timed from the I/O access bit's rise (the check sequence, 111 µs into a one-word data cycle at 500 kbit/s)
 so that its data byte begins before the latch phase (237 to 247 µs), in its middle, or after the cycle (3.4.14)."""
 
 
 @st.composite
-def scripts(draw: st.DrawFn) -> list[Step]:
-    """A hostile prefix, the recovery and the wait for /IRQ, a body in the idle gap, maybe a timed read."""
-    script = [*draw(st.lists(UNTIMED, max_size=6)), *RECOVER, *draw(st.lists(BODY, max_size=6))]
+def scripts(draw: st.DrawFn, mode: Mode = Mode.MOTOROLA) -> list[Step]:
+    """A hostile prefix, the recovery and the wait for /IRQ, a body in the idle gap (window polls and waits too),
+    maybe a timed read."""
+    body = st.one_of(untimed(mode), st.tuples(st.just(Op.POLL_IO), BYTE, st.just(0), st.just(0)),
+                     st.tuples(st.just(Op.DELAY), st.integers(0, 255), st.just(0), st.just(0)))  # fmt: skip
+    script = [*draw(st.lists(untimed(mode), max_size=6)), *recover(mode), *draw(st.lists(body, max_size=6))]
     if draw(st.booleans()):
         script.append((Op.LATCH, draw(st.sampled_from(LATCH_DELAYS_US)), draw(st.integers(0, 3)), 3))
     return [(int(op), a, b, c) for op, a, b, c in script]
 
 
 @pytest.mark.parametrize("cpu", ["cortex_m3", "cortex_m0"])
-@settings(max_examples=20)
+@settings(max_examples=20, phases=NO_SHRINK)
 @given(script=scripts())
 def test_a_script_on_the_binary_does_what_the_python_driver_does_on_the_bench(
         scripted: dict[str, Path], cpu: str, script: list[Step]) -> None:  # fmt: skip
     """(a) The binary at transaction level against the Python driver on the firmware bench: every step's error code
-    and result bytes, the chip's registers, the violations by rule and the cycles run are the same."""
+    and result bytes, the chip's registers, the violations by rule, the cycles run, the master's IN data and the
+    interface's phase are the same."""
     assert run_script(scripted[cpu], script, cpu=cpu) == run_on_bench(script)
 
 
-@settings(max_examples=4)
-@given(script=st.lists(PIN_ALIKE, min_size=1, max_size=6))
+@settings(max_examples=8, phases=NO_SHRINK)
+@given(script=scripts(Mode.INTEL))
+def test_an_intel_script_on_the_binary_does_what_the_python_driver_does_on_the_bench(
+        scripted: dict[str, Path], script: list[Step]) -> None:  # fmt: skip
+    """(a) on the Intel board (MCU-18): the Intel build at transaction level against the Python driver in Intel
+    mode."""
+    assert run_script(scripted["intel"], script, mode=Mode.INTEL) == run_on_bench(script, Mode.INTEL)
+
+
+@settings(max_examples=4, phases=NO_SHRINK)
+@given(script=st.lists(untimed(ss_high=False), min_size=1, max_size=6))
 def test_a_short_script_does_the_same_at_both_fidelities(scripted: dict[str, Path], script: list[Step]) -> None:
     """(b) Short scripts, all before the master's first cycle (the pin level's discovery ID cycle is not the
     transaction level's, MCU-17), on the binary at transaction and at pin level."""
     script = [(int(op), a, b, c) for op, a, b, c in script]
     elf = scripted["cortex_m3"]
     assert run_script(elf, script) == run_script(elf, script, fidelity="pin")
-
-
 
 EVERY_OP: Final[list[Step]] = [
     (Op.RAW, 0x55, 0, 0), (Op.INIT, 0, 0, 0), (Op.READ, 13, 0, 0), (Op.SAS_INIT, 0, 0, 0), (Op.INIT, 7, 0, 0),
