@@ -39,7 +39,8 @@ enum {
     OP_POLL_IO = 12,    /* supi3_poll_io_window(a) */
     OP_RAW = 13,        /* one frame of byte a through the driver's transport (cfg.xfer) */
     OP_SS_HIGH = 14,    /* byte a clocked on SPI1 with /SS high (3.4.2: the chip ignores it) */
-    OP_SS_CUT = 15,     /* byte a with /SS raised after b SCLK periods, b < 8 (3.4.2: a frame cut short) */
+    OP_SS_CUT = 15,     /* byte a with /SS raised after b SCLK periods and a half, b < 8 (3.4.2: a frame cut
+                           short; half a period clear of t2; the byte received is not logged: MCU-61) */
     OP_LATCH = 16       /* poll the I/O pin without a pause until 1, at most (c + 1) * 10000 times, then spin a us
                            (a countdown, not delay_us: its division costs the Cortex-M0 a software divide) and
                            supi3_read(b): a read timed into the latch phase or beside it (3.4.14) */
