@@ -3,12 +3,14 @@
 ``mcu/scripted.c`` is a firmware whose behaviour is data: its ``fw_setup`` runs a script of driver calls, raw frames
 and deliberately bad SPI1 use that the test writes into its ``fw_script`` (flash) before the first run, and keeps
 every result byte and error code in ``fw_log``. Hypothesis writes random scripts (derandomized by the conftest
-profile), every example runs on ONE binary per core, and each script gives an :class:`Outcome` (the log, the chip's
-registers, the violations by rule):
+profile), every example runs on ONE binary per core (and one Intel build), and each script gives an
+:class:`Outcome` (the log, the chip's registers, the violations by rule, the master's cycles and IN data, the
+interface's phase):
 
 - (a) the binary on the board at transaction level against the same script through the Python driver on the
-  transaction-level firmware bench (:func:`run_on_bench`);
-- (b) short scripts, no waits, the binary at transaction level against pin level.
+  transaction-level firmware bench (:func:`run_on_bench`), both chips pedantic, on both cores and in Intel mode;
+- (b) short scripts before the master's start, and scripts served after the first VALID interrupt, on the binary at
+  transaction level against pin level.
 
 :func:`run_script` takes the board's options as keywords, so a further board flag (another per-byte path, say) is
 one more comparison: ``run_script(elf, script, flag=False) == run_script(elf, script, flag=True)``.
