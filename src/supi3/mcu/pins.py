@@ -244,8 +244,6 @@ class LockstepRing(PinRing):
         its last sample (MCU-16). A transfer that starts with /SS high is reported as :func:`ss_high_byte` (MCU-63);
         its edges still reach the chip, which ignores them."""
         cause = self.where()
-        if self._ss_n:
-            self._lint(ss_high_byte(tx), self.clock_of(start), cause)
         lsb = bool(cr1 & CR1_LSBFIRST)
         cpol, cpha = int(bool(cr1 & CR1_CPOL)), int(bool(cr1 & CR1_CPHA))
         half = period // 2
@@ -261,6 +259,8 @@ class LockstepRing(PinRing):
         sample = Sample(sample_at, lsb, {})
         for clock in sample_at:
             self._samples.setdefault(clock, []).append(sample)
+        if self._ss_n:  # the edges are queued first: a strict log's raise leaves the transfer whole
+            self._lint(ss_high_byte(tx), self.clock_of(start), cause)
         return lambda: self._miso(sample)
 
     def _lint(self, error: InterfaceViolationError, clock: int, cause: Cause) -> None:
