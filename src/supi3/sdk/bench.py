@@ -289,7 +289,8 @@ class _ClockedBus:
             self.ring.finish(transfer, latch)
 
     def transfer(self, cycle: Cycle, data: bytes, close_after: int | None = None) -> Transfer:
-        self.flush()
+        if self.pending is not None:  # a second transfer in one master call
+            self.flush()
         return self.ring.transfer(cycle, data, close_after)
 
     def finish(self, transfer: Transfer, latch: bool) -> None:
@@ -316,7 +317,8 @@ class BenchTransport(ModelTransport):
         """One frame: the chip decides what it drives at /SS falling, takes the byte at /SS rising (UP-18, UP-19);
         the bus runs up to each edge."""
         bench = self.bench
-        bench.advance(bench.now)
+        if bench._next_at <= bench.now:  # a bus event due now (else advance(now) would only compare)
+            bench.advance(bench.now)
         driven = super().xfer(tx, s_r)
         bench.bytes_clocked += 1
         bench.irq_edge()
@@ -324,7 +326,11 @@ class BenchTransport(ModelTransport):
 
     def _during_frame(self) -> None:
         bench = self.bench
-        bench.advance(bench.now + bench.byte_s)
+        until = bench.now + bench.byte_s
+        if until < bench._next_at and until <= wire.MAX_BUS_TIME_S:  # advance's own shortcut: no bus event due
+            bench.now = until
+        else:
+            bench.advance(until)
 
     def delay_us(self, us: float) -> None:
         """Busy wait: the bus runs on."""
@@ -522,13 +528,14 @@ class Bench:
 
     def _step_bus(self) -> None:
         """The next bus event: a cycle starts, a phase begins, or the cycle ends."""
-        if not self._events:
+        events = self._events
+        if not events:
             self._start_cycle()
             return
-        events = self._events
         at, what = events.pop()
         self._next_at = events[-1][0] if events else self._next_start
-        self.now = max(self.now, at)
+        if at > self.now:
+            self.now = at
         if what == "io":
             for chip in self._chips:
                 chip.set_io_access(True)
@@ -545,7 +552,8 @@ class Bench:
 
     def _start_cycle(self) -> None:
         at = self._next_start
-        self.now = max(self.now, at)
+        if at > self.now:
+            self.now = at
         if at > self.ring.now:
             self.ring.idle(at - self.ring.now)
         result = self.master.cycle() if self._started else self.master.start()
