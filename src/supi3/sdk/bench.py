@@ -321,7 +321,8 @@ class BenchTransport(ModelTransport):
             bench.advance(bench.now)
         driven = super().xfer(tx, s_r)
         bench.bytes_clocked += 1
-        bench.irq_edge()
+        if not bench._irq_level:  # FW-18: a byte may release /IRQ (a read of IRQ_EVT), never pull it low
+            bench.irq_edge()
         return driven
 
     def _during_frame(self) -> None:
@@ -501,9 +502,6 @@ class Bench:
 
     # -- the bus side ------------------------------------------------------------------------------------------
 
-    def _next_event(self) -> float:
-        return self._next_at
-
     def advance(self, until: float) -> bool:
         """Run the bus up to time ``until`` and set the clock there (not backwards); whether a bus event (a cycle's
         start, phase or end) ran on the way: only then can the master's cycle have changed the chip.
@@ -518,37 +516,45 @@ class Bench:
             until = check_real("until", until)
             wire.check_bus_time("until", until, self.now, until - self.now)
         # Most calls (a byte, a pin read, the board's synchronisation at each peripheral access) find no bus event
-        # due: one comparison with the next event's time, kept by _step_bus and _start_cycle.
+        # due: one comparison with the next event's time, kept by _run_bus and _start_cycle.
         stepped = self._next_at <= until
-        while self._next_at <= until:
-            self._step_bus()
+        if stepped:
+            self._run_bus(until, False)
         if until > self.now:
             self.now = until
         return stepped
 
-    def _step_bus(self) -> None:
-        """The next bus event: a cycle starts, a phase begins, or the cycle ends."""
-        events = self._events
-        if not events:
-            self._start_cycle()
-            return
-        at, what = events.pop()
-        self._next_at = events[-1][0] if events else self._next_start
-        if at > self.now:
-            self.now = at
-        if what == "io":
-            for chip in self._chips:
-                chip.set_io_access(True)
-        elif what == "latch":
-            for chip in self._chips:
-                chip.set_latch_phase(True)
-        else:
-            self._bus.flush()
-            for chip in self._chips:
-                chip.set_latch_phase(False)
-                chip.set_io_access(False)
-            self.cycles += 1
-            self.irq_edge()
+    def _run_bus(self, until: float, sleep: bool) -> None:
+        """Run the bus events due by ``until`` in their order: a cycle starts, a phase begins, or the cycle ends;
+        ``sleep``: only up to the next start or end, the events that may change /IRQ (a sleeping firmware wakes at
+        most there; the phases between only set the chip's I/O access bit and latch phase, MCU-31)."""
+        while self._next_at <= until:
+            events = self._events
+            if not events:
+                self._start_cycle()
+                if sleep:
+                    return
+                continue
+            at, what = events[-1]
+            del events[-1]
+            self._next_at = events[-1][0] if events else self._next_start
+            if at > self.now:
+                self.now = at
+            if what == "io":
+                for chip in self._chips:
+                    chip.set_io_access(True)
+            elif what == "latch":
+                for chip in self._chips:
+                    chip.set_latch_phase(True)
+            else:
+                self._bus.flush()
+                for chip in self._chips:
+                    chip.set_latch_phase(False)
+                    chip.set_io_access(False)
+                self.cycles += 1
+                self.irq_edge()
+                if sleep:
+                    return
 
     def _start_cycle(self) -> None:
         at = self._next_start
@@ -615,7 +621,9 @@ class Bench:
         firmware = self.firmware
         if self._irq_fell_at is None or self._in_isr or firmware is None or not self._set_up:
             return
-        self.irq_latency_s = max(self.irq_latency_s, self.now - self._irq_fell_at)
+        latency = self.now - self._irq_fell_at
+        if latency > self.irq_latency_s:
+            self.irq_latency_s = latency
         self._irq_fell_at = None
         self._in_isr = True
         self.interrupts += 1
@@ -688,7 +696,7 @@ class Bench:
             if loop is not None:
                 idle_loops = self._pass(loop, idle_loops)
                 continue
-            self._step_bus()  # sleep until the bus does something
+            self._run_bus(math.inf, True)  # sleep until the bus may change /IRQ
         self.take_interrupt()  # the last cycle's interrupt, as the firmware would take it
 
     def _main_loop(self) -> Callable[[Supi3Driver], None] | None:
