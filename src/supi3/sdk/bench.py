@@ -525,9 +525,11 @@ class Bench:
         return stepped
 
     def _run_bus(self, until: float, sleep: bool) -> None:
-        """Run the bus events due by ``until`` in their order: a cycle starts, a phase begins, or the cycle ends;
-        ``sleep``: only up to the next start or end, the events that may change /IRQ (a sleeping firmware wakes at
-        most there; the phases between only set the chip's I/O access bit and latch phase, MCU-31)."""
+        """Run the bus events due by ``until`` in their order: a cycle starts, a phase begins, or the cycle ends.
+
+        ``sleep``: the firmware sleeps (FW-18): only up to the next start or end, the events that may change /IRQ
+        (it wakes at most there), and the phases on the way are not set: they only set the chip's I/O access bit and
+        latch phase (MCU-31), which no one reads before the cycle's end, due in the same call, clears them."""
         while self._next_at <= until:
             events = self._events
             if not events:
@@ -541,11 +543,13 @@ class Bench:
             if at > self.now:
                 self.now = at
             if what == "io":
-                for chip in self._chips:
-                    chip.set_io_access(True)
+                if not sleep:
+                    for chip in self._chips:
+                        chip.set_io_access(True)
             elif what == "latch":
-                for chip in self._chips:
-                    chip.set_latch_phase(True)
+                if not sleep:
+                    for chip in self._chips:
+                        chip.set_latch_phase(True)
             else:
                 self._bus.flush()
                 for chip in self._chips:
