@@ -614,7 +614,8 @@ class Bench:
     # -- interrupts --------------------------------------------------------------------------------------------
 
     def irq_edge(self) -> None:
-        """Watch /IRQ for a falling edge (FW-3: edge-triggered, as an MCU's external interrupt)."""
+        """Watch /IRQ for a falling edge (FW-3: edge-triggered, as an MCU's external interrupt): after each cycle's
+        start and end, and after a byte while /IRQ is low (FW-18: a byte may release it, only a cycle pulls it low)."""
         level = self.registers.irq_n
         if level < self._irq_level and self._irq_fell_at is None:
             self._irq_fell_at = self.now
