@@ -38,6 +38,7 @@ from supi3.mcu.core import (
     SourceLine,
     Stop,
 )
+from supi3.mcu.frames import NativeFrames
 from supi3.mcu.pins import SAS_INIT_BIT, SR_BIT, SS_BIT, SYNC_S, Cause, LockstepRing, mcu_lines
 from supi3.mcu.stm32 import (
     AFIO_BASE,
@@ -291,6 +292,10 @@ class Board:
         The board's wiring for the interface type the firmware initializes (Table 3-8): ``Mode.MOTOROLA`` (MISO on
         SerOUT, MFP7) or ``Mode.INTEL`` (MCU-18: MISO on Ser_IN/OUT, MFP6, MOSI on it through a resistor, S/R from
         PB0 to MFP7; build the firmware with ``-DFW_MODE=SUPI3_MODE_INTEL``).
+    native_frames:
+        MCU-51: the plain µP interface frames (/SS edges and SPI1's DR write) taken in native code without a Python
+        call, their net effect set in the model at the next entry into Python (:mod:`supi3.mcu.frames`; the same run
+        to the cycle). Transaction level on the Motorola board only; ``False`` runs every frame through Python.
 
     Attributes
     ----------
@@ -317,7 +322,7 @@ class Board:
                  others: Sequence[Device | PinChip | PinBranch] = (),
                  cycle_time_s: float | None = None, strict: bool = True, pedantic: bool = False,
                  fidelity: str = "transaction", record: bool = False, mode: Mode = Mode.MOTOROLA,
-                 stat_err_filter: int = STATERR_FILTER_CLOCKS) -> None:  # fmt: skip
+                 stat_err_filter: int = STATERR_FILTER_CLOCKS, native_frames: bool = True) -> None:  # fmt: skip
         self.fidelity = check_choice("fidelity", fidelity, FIDELITIES)
         self.intel = check_instance("mode", mode, Mode) is Mode.INTEL
         self._s_r = 1  # PB0: S/R, 1 = the µP sends
@@ -364,12 +369,16 @@ class Board:
         self.spi.on_poll = self.core.skip_poll
         self.spi.on_misuse = self._mcu_violation
         core = self.core
+        # MCU-51: the native frames at transaction level on the Motorola board, GPIOA's and SPI1's writes through them
+        native = check_bool("native_frames", native_frames) and self._ring is None and not self.intel
         core.mmio(RCC_BASE, PERIPHERAL_SIZE, self.rcc.read, self.rcc.write)
-        core.mmio(GPIOA_BASE, PERIPHERAL_SIZE, self.gpio.read, self.gpio.write)
+        core.mmio(GPIOA_BASE, PERIPHERAL_SIZE, self.gpio.read, self._gpio_write if native else self.gpio.write,
+                  port=0 if native else None)  # fmt: skip
         core.mmio(GPIOB_BASE, PERIPHERAL_SIZE, self.gpio_b.read, self.gpio_b.write)
         core.mmio(AFIO_BASE, PERIPHERAL_SIZE, self.exti.read_afio, self.exti.write_afio)
         core.mmio(EXTI_BASE, PERIPHERAL_SIZE, self._exti_read, self._exti_write)
-        held = core.mmio(SPI1_BASE, PERIPHERAL_SIZE, self.spi.read, self.spi.write)
+        held = core.mmio(SPI1_BASE, PERIPHERAL_SIZE, self.spi.read, self._spi_write if native else self.spi.write,
+                         port=1 if native else None)  # fmt: skip
         self.spi.holder = self.spi.offer = held  # SR held (MCU-25), DR's read after its byte (MCU-26)
         core.entered = self._entered
         self.fw_board = FwBoard(core) if "fw_board" in core.image.symbols else None
@@ -384,6 +393,9 @@ class Board:
         self._irq_fell: int | None = None
         self._mod_ack_until = 0
         self._limit = self._budget = 0
+        self.native_frames = NativeFrames(self, held, PIN_SS, NOISE_CYCLES, _Frame) if native else None
+        """MCU-51: the native per-frame fast path (``native_frames=True`` at transaction level on the Motorola
+        board), else ``None``."""
         self._held: list[tuple[str, int, int]] | None = None  # pin level: edges held while a sleeping core waits
         self._setting_up = True  # MCU-45: the firmware has not yet first waited or come to SERVE_POINT
         self.served = True
@@ -658,6 +670,20 @@ class Board:
 
     def _cycles(self, seconds: float) -> int:
         return math.ceil(seconds * self.core.cpu_hz - NOISE_CYCLES)
+
+    def _gpio_write(self, offset: int, size: int, value: int) -> None:
+        """GPIOA's write in Python (what the native frames did not take, MCU-51), then their mirror refreshed."""
+        self.gpio.write(offset, size, value)
+        frames = self.native_frames
+        assert frames is not None
+        frames.refresh()
+
+    def _spi_write(self, offset: int, size: int, value: int) -> None:
+        """SPI1's write in Python (what the native frames did not take, MCU-51), then their mirror refreshed."""
+        self.spi.write(offset, size, value)
+        frames = self.native_frames
+        assert frames is not None
+        frames.refresh()
 
     def _on_output(self, pin: int, level: int) -> None:
         ring = self._ring

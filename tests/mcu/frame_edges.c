@@ -1,0 +1,123 @@
+/*
+ * frame_edges.c - raw µP interface frames across every boundary of the board's native frames (tests/test_mcu_fastbyte.py,
+ * MCU-51): plain command and data frames, and each kind the native frames leave to Python: a read of IRQ_EVT
+ * (read-clear), writes of SET and ID, a byte clocked with /SS high, /SS falling too soon after it rose (Table 3-7 t8),
+ * /SS rising too soon after the last SCLK edge (t2), a frame of two bytes, a frame of no byte, a reserved command byte,
+ * SAS_INIT, and data registers read and written whenever the handler runs (inside the latch phase too, 3.4.14).
+ * Every frame is raw GPIOA and SPI1 accesses, as board.c's transport makes them.
+ */
+#include "board.h"
+#include "fw_board.h"
+
+#define SS (1u << BOARD_PIN_SS)
+#define SAS (1u << BOARD_PIN_SAS_INIT)
+#define SETTLE 60u /* cycles after /SS rises: more than t6 (max) + t8 at 500 kbit/s (24 cycles at 48 MHz) */
+#define READ(address) (0x80u | (address))
+#define WRITE(address) (0x40u | (address))
+#define ROUNDS 9u /* handlers that run the edges; later ones serve the data cycle only */
+
+static void wait(uint32_t cycles)
+{
+    for (volatile uint32_t k = 0u; k < cycles / 4u; k++) {
+    }
+}
+
+/* One byte in one /SS frame: `low` = drive /SS; `t2` = wait before /SS rises; `after` = wait after it rose. */
+static uint8_t frame(uint8_t tx, int low, uint32_t t2, uint32_t after)
+{
+    if (low) {
+        GPIOA_BRR = SS;
+    }
+    SPI1_DR = tx;
+    while ((SPI1_SR & SPI_SR_RXNE) == 0u) {
+    }
+    uint8_t rx = (uint8_t)SPI1_DR;
+    while ((SPI1_SR & SPI_SR_BSY) != 0u) {
+    }
+    wait(t2);
+    if (low) {
+        GPIOA_BSRR = SS;
+    }
+    wait(after);
+    return rx;
+}
+
+static uint8_t access(uint8_t command, uint8_t data)
+{
+    (void)frame(command, 1, 40u, SETTLE);
+    return frame(data, 1, 40u, SETTLE);
+}
+
+static uint32_t round_number;
+
+static void edges(fw_board_t *board)
+{
+    uint32_t n = round_number++;
+    board->outputs[0] = access(READ(7u), 0u);       /* PCMD: plain */
+    (void)access(WRITE(14u), SUPI3_IRQ_EN_VALID_MSK); /* IRQ_EN: plain */
+    board->outputs[1] = access(READ(14u), 0u);      /* IRQ_EVT: read-clear */
+    (void)access(WRITE(0u), (uint8_t)n);            /* IN0: a data register */
+    board->outputs[2] = access(READ(0u), 0u);       /* OUT0: a data register */
+    (void)frame(0x55u, 0, 40u, SETTLE);             /* a byte with /SS high */
+    GPIOA_BRR = SS;                                 /* /SS falls again at once after it rose: t8 */
+    (void)frame(READ(7u), 0, 40u, 0u);
+    GPIOA_BSRR = SS;
+    GPIOA_BRR = SS;
+    (void)frame(0u, 0, 40u, 0u);
+    GPIOA_BSRR = SS;
+    wait(SETTLE);
+    (void)frame(READ(7u), 1, 40u, SETTLE);
+    GPIOA_BRR = SS;                                 /* /SS rises at once: t2 */
+    SPI1_DR = 0u;
+    while ((SPI1_SR & SPI_SR_RXNE) == 0u) {
+    }
+    (void)SPI1_DR;
+    while ((SPI1_SR & SPI_SR_BSY) != 0u) {
+    }
+    GPIOA_BSRR = SS;
+    wait(SETTLE);
+    GPIOA_BRR = SS;                                 /* two bytes in one frame */
+    (void)frame(READ(7u), 0, 40u, 0u);
+    (void)frame(0u, 0, 40u, 0u);
+    GPIOA_BSRR = SS;
+    wait(SETTLE);
+    GPIOA_BRR = SS;                                 /* a frame of no byte */
+    wait(SETTLE);
+    GPIOA_BSRR = SS;
+    wait(SETTLE);
+    (void)access(0x30u | READ(7u), 0u);             /* reserved command bits */
+    if (n == 0u) {
+        (void)access(WRITE(13u), 0x83u);            /* SET, ID: configuration (3.4.3) */
+        (void)access(WRITE(12u), 0x03u);
+    }
+    if (n == 2u) {                                  /* SAS_INIT, then the initialization byte again */
+        GPIOA_BSRR = SAS;
+        wait(SETTLE);
+        GPIOA_BRR = SAS;
+        wait(SETTLE);
+        (void)frame(0x00u, 1, 40u, SETTLE);
+    }
+    board->outputs[3] = access(READ(1u), 0u);       /* OUT1 */
+}
+
+void fw_setup(supi3_t *chip, fw_board_t *board)
+{
+    if (fw_note(board, supi3_initialize(chip, FW_MODE)) != SUPI3_OK ||
+        fw_note(board, supi3_configure(chip, 0x83u, 0x03u)) != SUPI3_OK) {
+        return;
+    }
+    (void)access(WRITE(14u), SUPI3_IRQ_EN_VALID_MSK);
+    edges(board);
+}
+
+void fw_isr(supi3_t *chip, fw_board_t *board)
+{
+    (void)chip;
+    if (round_number < ROUNDS) {
+        edges(board);
+        return;
+    }
+    (void)access(READ(14u), 0u); /* the plain service: IRQ_EVT, IN0, OUT0 */
+    (void)access(WRITE(0u), board->inputs[0]);
+    board->outputs[0] = access(READ(0u), 0u);
+}
