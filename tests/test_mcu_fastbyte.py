@@ -20,6 +20,7 @@ from typing import Any
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
+
 from supi3.interbus.errors import InterbusError
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import NOISE_CYCLES, Board
@@ -65,16 +66,16 @@ def snapshot(board: Board) -> dict[str, Any]:
     assert board.fw_board is not None
     return {
         "core": (core.instructions, core.cycles, core.registers(), core._state.handed, board.interrupts,
-                 board.irq_latency_s),  # fmt: skip
+                 board.irq_latency_s),
         "bus": (board.bench.now, board.cycles, _master_inputs(board)),
         "violations": [(v.time_s, v.pc, v.error.rule, str(v.error)) for v in board.violations],
         "protocol": (protocol.mode, protocol.phase, protocol.command, protocol.last_rx, protocol._frame),
         "registers": (dict(registers._values), registers.latch_phase, registers.io_access, registers.irq_n),
         "gpio": (board.gpio.odr, board.gpio._levels),
         "spi": (spi.cr1, spi.rx_last, spi.rx_buffer, spi.tx_buffer, spi.shifting, spi.transfers, spi.ovr,
-                spi._ovr_seen, spi._holding, spi.modf),  # fmt: skip
+                spi._ovr_seen, spi._holding, spi.modf),
         "board": (None if frame is None else (frame.fall, frame.driven, list(frame.transfers)), board._ss_rise,
-                  board._cd_before, board._irq_level),  # fmt: skip
+                  board._cd_before, board._irq_level),
         "process data": (board.fw_board.outputs, board.fw_board.inputs),
     }
 
@@ -88,7 +89,7 @@ def side_by_side(elf: Path, bit_rate: int, steps: int, *, strict: bool = False, 
               Board(elf, bit_rate=bit_rate, strict=strict, pedantic=pedantic, native_frames=False))  # fmt: skip
     assert boards[0].native_frames is not None and boards[1].native_frames is None
     for step in range(steps):
-        errors = []
+        errors: list[tuple[type[InterfaceViolationError], str] | None] = []
         for board in boards:
             try:
                 board.run(cycles)

@@ -28,7 +28,8 @@ from __future__ import annotations
 import ctypes
 import math
 import struct
-from typing import TYPE_CHECKING, Final
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Final, Protocol
 
 from supi3.interbus import wire
 from supi3.mcu.core import HeldRegister
@@ -55,10 +56,68 @@ from supi3.spi import upif as _upif
 from supi3.spi.upif import Mode, Phase
 
 if TYPE_CHECKING:
-    from supi3.mcu.board import Board, _Frame
+    from supi3.mcu.core import CortexM
+    from supi3.mcu.stm32 import Exti, Gpio, Rcc, Spi
+    from supi3.model.chip import Supi3
+    from supi3.model.registers import RegisterFile
+    from supi3.spi.upif import UpifProtocol
 
-__all__ = ["FAST_READS", "FAST_WRITES", "NativeFrames", "first_due"]
+__all__ = ["FAST_READS", "FAST_WRITES", "FrameBoard", "NativeFrames", "SsFrame", "first_due"]
 
+@dataclass(slots=True)
+class SsFrame:
+    """A /SS frame the board has seen begin (3.4.2): the cycle /SS fell, what the chip drives on SerOUT (UP-18) and
+    the bytes clocked in it, each (the byte as the chip sees it, bits, start cycle, SCLK period in cycles)."""
+
+    fall: int
+    driven: int | None
+    transfers: list[tuple[int, int, int, int]]
+
+
+class FrameBench(Protocol):
+    """What the native frames read of the board's bench (``supi3.mcu.board._BoardBench``)."""
+
+    low_at: float | None
+    _events: list[tuple[float, str]]
+    _next_start: float
+
+    @property
+    def chip(self) -> Supi3: ...
+
+
+class FrameBoard(Protocol):
+    """What the native frames read and set of the transaction-level board (:class:`supi3.mcu.board.Board`): its
+    parts, its frame and /SS bookkeeping, /IRQ and /ModAck as it last followed them, its Table 3-7 thresholds in
+    core cycles and its bus clock."""
+
+    core: CortexM
+    gpio: Gpio
+    spi: Spi
+    rcc: Rcc
+    protocol: UpifProtocol
+    registers: RegisterFile
+    _frame: SsFrame | None
+    _ss_rise: int
+    _cd_before: int
+    _irq_level: int
+    _mod_ack_until: int
+    _least_t1: int
+    _least_t2: int
+    _least_t8: int
+    _shortest_period_s: float
+    exti: Exti
+
+    def _sync(self, cycles: int) -> None: ...
+
+    @property
+    def bench(self) -> FrameBench: ...
+
+
+_IO: Final[str] = "io"
+_LATCH: Final[str] = "latch"
+"""The bench's phase events (``Bench._step_bus``; ``supi3.mcu.board.FLAG_EVENTS``): the I/O access bit set, the latch
+phase begun; they set flags of the chips only."""
+_NEVER: Final[int] = (1 << 63) - 1
 _PHASE_COMMAND: Final[int] = 1
 _PHASE_DATA: Final[int] = 2
 _PHASES: Final[dict[Phase, int]] = {Phase.COMMAND: _PHASE_COMMAND, Phase.DATA: _PHASE_DATA}
@@ -95,8 +154,9 @@ _STATE_FIELDS: Final[tuple[str, ...]] = (
     "transfer_seen", "transfer_start", "transfer_period", "ss_rise", "cd_before", "written", "dr_writes", "rx_last",
     "shift_received", "shift_start", "shift_end")  # fmt: skip
 """The fields of :class:`~supi3.mcu.hook.Frames` the native frames change, in their order there."""
-_MIRROR_FIELDS: Final[tuple[str, ...]] = ("valid", "due", "latch", "gpio_ok", "gpio_mask", "gpio_pulled_up", "gpio_levels",
-                                          "spi_ok", "period", "sr_modf", *_STATE_FIELDS[:-3])  # fmt: skip
+_MIRROR_FIELDS: Final[tuple[str, ...]] = (
+    "valid", "due", "latch", "latch_at", "gpio_ok", "gpio_mask", "gpio_pulled_up", "gpio_levels", "spi_ok", "period",
+    "sr_modf", *_STATE_FIELDS[:-3])  # fmt: skip
 """The fields :meth:`NativeFrames.refresh` writes, in their order there."""
 
 
@@ -124,32 +184,29 @@ def first_due(next_at: float, cpu_hz: float, noise: float) -> int:
     time (:data:`~supi3.interbus.wire.MAX_BUS_TIME_S`); a cycle before it synchronises without a Python effect beyond
     the clock. At most 2^63 - 1."""
     limit = (1 << 63) - 1
-
-    def due(cycles: int) -> bool:
-        until = (cycles + noise) / cpu_hz
-        return next_at <= until or until > wire.MAX_BUS_TIME_S
-
-    if not due(limit):
+    at = min(next_at, wire.MAX_BUS_TIME_S)
+    if not at * cpu_hz < limit:
         return limit
-    low = max(0, math.floor(min(next_at, wire.MAX_BUS_TIME_S) * cpu_hz) - 4)
-    while low > 0 and due(low):
-        low = max(0, low - 16)
-    while not due(low):
-        low += 1
-    return low
+    top = wire.MAX_BUS_TIME_S
+    # the board's rounding (Board._cycles): the answer or one of its neighbours, found by the expression itself
+    cycles = max(0, math.ceil(at * cpu_hz - noise))
+    while cycles > 0 and (next_at <= (until := (cycles - 1 + noise) / cpu_hz) or until > top):
+        cycles -= 1
+    while not (next_at <= (until := (cycles + noise) / cpu_hz) or until > top):
+        cycles += 1
+    return cycles
 
 
 class NativeFrames:
     """The native per-frame fast path of a transaction-level board (MCU-51): the tables handed to hook.c, the
     mirror refreshed after Python's writes of GPIOA and SPI1, the catch-up at each entry into Python."""
 
-    def __init__(self, board: Board, spi_held: HeldRegister, ss_pin: int, noise: float, frame: type[_Frame]) -> None:
+    def __init__(self, board: FrameBoard, spi_held: HeldRegister, ss_pin: int, noise: float, exti0: int) -> None:
         self._board = board
         core = board.core
         self._frames = frames = core.frames
         self._hz = core.cpu_hz
         self._noise = noise
-        self._frame = frame
         self._spi_held = spi_held
         frames.spi = ctypes.pointer(spi_held.native)
         frames.least_t1, frames.least_t2, frames.least_t8 = board._least_t1, board._least_t2, board._least_t8
@@ -173,6 +230,9 @@ class NativeFrames:
         self._reads: tuple[str | None, ...] = tuple(name if FAST_READS[address] else None
                                                     for address, name in enumerate(read_names))  # fmt: skip
         self._written: tuple[str | None, ...] = _registers._WRITE_NAMES
+        self._exti0 = exti0
+        self._command: object = None
+        self._code = _NO_COMMAND
         frames.valid = 0
         frames.pending = 0
         core.entry = self.enter
@@ -190,15 +250,16 @@ class NativeFrames:
     def catch_up(self) -> None:
         """Set the native frames' net effect in the Python objects (what their slow path would have set)."""
         frames = self._frames
+        state = _STATE.unpack_from(frames, _STATE_AT)
         (_, odr, synced, phase, command, last_rx, frame_open, fall, driven, transfer, seen, start, period, ss_rise,
-         cd_before, written, dr_writes, rx_last, received, shift_start, shift_end) = _STATE.unpack_from(frames, _STATE_AT)
+         cd_before, written, dr_writes, rx_last, received, shift_start, shift_end) = state
         frames.pending = frames.written = frames.dr_writes = frames.synced = 0
         board = self._board
         gpio = board.gpio
         gpio.odr = odr
         gpio._levels = frames.gpio_levels
-        if synced:  # the bus clock at the latest synchronisation (no bus event was due: first_due)
-            board._advance((synced - 1 + self._noise) / self._hz)
+        if synced:  # the bus run up to the latest synchronisation: no event but the phases' flags (MCU-52)
+            board._sync(synced - 1)
         protocol = board.protocol
         protocol.phase = _PHASE_OF[phase]
         if command < _NO_COMMAND:
@@ -213,7 +274,7 @@ class NativeFrames:
                     values[names[address]] = masked[address]  # type: ignore[index]  # FAST_WRITES: a register
         board._ss_rise, board._cd_before = ss_rise, cd_before
         if frame_open:
-            board._frame = self._frame(fall, driven, [(seen, 8, start, period)] if transfer else [])
+            board._frame = SsFrame(fall, driven, [(seen, 8, start, period)] if transfer else [])
             protocol._frame = (True, driven)
         else:
             board._frame = None
@@ -234,11 +295,17 @@ class NativeFrames:
         bench = board.bench
         phase = _PHASES.get(protocol.phase, 0)
         command = protocol.command
-        code = _NO_COMMAND if command is None else _CODES[command]
+        if command is not self._command:  # a CommandByte's hash is a Python call: the last one's code kept
+            self._command = command
+            self._code = _NO_COMMAND if command is None else _CODES[command]
+        code = self._code
         frame = board._frame
+        core = board.core
         valid = (protocol.mode is Mode.MOTOROLA and not registers.pedantic and bench.low_at is None
                  and board._irq_level == registers.irq_n and bench.chip.mod_ack_until == board._mod_ack_until
-                 and phase and (phase != _PHASE_DATA or code != _NO_COMMAND))  # fmt: skip
+                 and phase and (phase != _PHASE_DATA or code != _NO_COMMAND)
+                 and (not board.exti.requesting(0) or self._exti0 in core.active
+                      or self._exti0 in core.pending))  # _sync's _pend: nothing to do  # fmt: skip
         transfer = (0, 0, 0, 0)
         if frame is not None:  # a frame Python began: the native frames may go on with it
             valid = valid and protocol._frame is not None and frame.driven is not None and len(frame.transfers) <= 1
@@ -259,8 +326,18 @@ class NativeFrames:
                   and not spi.period / self._hz < board._shortest_period_s)  # fmt: skip
         values = registers._values
         frames.values[:] = [0 if name is None else values[name] for name in self._reads]
+        hz, noise = self._hz, self._noise
+        latch_at = _NEVER
+        for at, what in reversed(bench._events):  # the next first; the phases only set the chips' flags (MCU-52)
+            if what == _LATCH:
+                latch_at = first_due(at, hz, noise)
+            elif what != _IO:
+                due = first_due(at, hz, noise)
+                break
+        else:
+            due = first_due(bench._next_start, hz, noise)
         _MIRROR.pack_into(
-            frames, _MIRROR_AT, 1, first_due(bench._next_at, self._hz, self._noise), int(registers.latch_phase),
+            frames, _MIRROR_AT, 1, due, int(registers.latch_phase), latch_at,
             int(bool(rcc.apb2enr & IOPAEN) and not rcc.apb2rstr & IOPAEN), gpio._output_mask(), gpio.pulled_up,
             gpio._levels, int(bool(spi_ok)), spi.period, SR_MODF if spi.modf else 0, 0, gpio.odr, 0, phase, code,
             protocol.last_rx, int(frame is not None), 0 if frame is None else frame.fall,

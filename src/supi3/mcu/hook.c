@@ -260,6 +260,7 @@ typedef struct {
     uint64_t valid;      /* the fast path may run: Python's objects are as mirrored here */
     uint64_t due;        /* the first core cycle whose bus synchronisation would run a bus event */
     uint64_t latch;      /* the latch phase (3.4.14) */
+    uint64_t latch_at;   /* the first core cycle whose synchronisation runs the latch phase's start (MCU-52) */
     uint64_t gpio_ok;    /* GPIOA's clock on, not held in reset */
     uint64_t gpio_mask, gpio_pulled_up, gpio_levels;
     uint64_t spi_ok;     /* SPI1 clocked, enabled master, 8 bits, mode 3, MSB first, SCLK period >= t0 */
@@ -312,8 +313,10 @@ static int frames_now(const supi3_frames *f, uint64_t *now) {
     return 1;
 }
 
-static int fast_access(const supi3_frames *f, const uint8_t *table, unsigned address) {
-    return table[address] == 1 || (table[address] == 2 && !f->latch);
+/* An access of `address` at `now` without side effects: a data register only outside the latch phase, which begins at
+ * `latch_at` if it has not begun (MCU-52: the phase events the native frames pass over). */
+static int fast_access(const supi3_frames *f, const uint8_t *table, unsigned address, uint64_t now) {
+    return table[address] == 1 || (table[address] == 2 && !f->latch && now < f->latch_at);
 }
 
 /* /SS fell at `now`: Board._ss_edge's t8 check and UpifProtocol.begin, if plain. */
@@ -326,7 +329,7 @@ static int frame_fall(supi3_frames *f, uint64_t now) {
         unsigned command = (unsigned)f->command & 0xFF;
         unsigned address = f->address[command];
         if (f->rd[command] && f->reads_register[address]) {
-            if (!fast_access(f, f->fast_read, address)) {
+            if (!fast_access(f, f->fast_read, address, now)) {
                 return 0;
             }
             driven = f->values[address];
@@ -359,7 +362,7 @@ static int frame_rise(supi3_frames *f, uint64_t now) {
         unsigned command = (unsigned)f->command & 0xFF;
         unsigned address = f->address[command];
         if (f->writes_register[address] && f->wr[command]) {
-            if (!fast_access(f, f->fast_write, address)) {
+            if (!fast_access(f, f->fast_write, address, now)) {
                 return 0;
             }
             uint8_t value = (uint8_t)(rx & f->write_mask[address]);
@@ -476,12 +479,13 @@ const uint32_t supi3_held_layout[] = {
 const uint32_t supi3_prefix_layout[] = {
     4, sizeof(supi3_prefix), AT(supi3_prefix, address), AT(supi3_prefix, pc), AT(supi3_prefix, cycles)};
 const uint32_t supi3_frames_layout[] = {
-    62, sizeof(supi3_frames), AT(supi3_frames, state), AT(supi3_frames, spi), AT(supi3_frames, prefixes),
+    63, sizeof(supi3_frames), AT(supi3_frames, state), AT(supi3_frames, spi), AT(supi3_frames, prefixes),
     AT(supi3_frames, prefix_mask), AT(supi3_frames, least_t1), AT(supi3_frames, least_t2), AT(supi3_frames,
     least_t8), AT(supi3_frames, ss_pin), AT(supi3_frames, cd_command), AT(supi3_frames, cd_data), AT(supi3_frames,
     phase_command), AT(supi3_frames, phase_data), AT(supi3_frames, sr_txe), AT(supi3_frames, sr_bsy),
     AT(supi3_frames, sr_rxne), AT(supi3_frames, spi_dr), AT(supi3_frames, spi_sr), AT(supi3_frames, valid),
-    AT(supi3_frames, due), AT(supi3_frames, latch), AT(supi3_frames, gpio_ok), AT(supi3_frames, gpio_mask),
+    AT(supi3_frames, due), AT(supi3_frames, latch), AT(supi3_frames, latch_at), AT(supi3_frames, gpio_ok),
+    AT(supi3_frames, gpio_mask),
     AT(supi3_frames, gpio_pulled_up), AT(supi3_frames, gpio_levels), AT(supi3_frames, spi_ok), AT(supi3_frames,
     period), AT(supi3_frames, sr_modf), AT(supi3_frames, pending), AT(supi3_frames, odr), AT(supi3_frames, synced),
     AT(supi3_frames, phase), AT(supi3_frames, command), AT(supi3_frames, last_rx), AT(supi3_frames, frame_open),

@@ -31,8 +31,9 @@ from typing import Final
 from supi3.errors import Supi3Error
 from supi3.sdk.native import default_cache_dir
 
-__all__ = ["DESCRIBE", "FLAGS", "MMIO_READ", "MMIO_WRITE", "SOURCE", "Block", "Frames", "Held", "NativeHookError", "Port",
-           "Prefix", "State", "cached_path", "check_layout", "check_whole", "layout", "library", "native_layout"]
+__all__ = ["DESCRIBE", "FLAGS", "MMIO_READ", "MMIO_WRITE", "SOURCE", "Block", "Frames", "Held", "NativeHookError",
+           "Port", "Prefix", "State", "cached_path", "check_layout", "check_whole", "layout", "library",
+           "native_layout"]
 
 SOURCE: Final[Path] = Path(__file__).with_name("hook.c")
 FLAGS: Final[tuple[str, ...]] = ("-shared", "-fPIC", "-O2", "-target", "native", "-mcpu=baseline", "-nostdlib",
@@ -154,6 +155,7 @@ class Frames(ctypes.Structure):
         ("valid", ctypes.c_uint64),
         ("due", ctypes.c_uint64),
         ("latch", ctypes.c_uint64),
+        ("latch_at", ctypes.c_uint64),
         ("gpio_ok", ctypes.c_uint64),
         ("gpio_mask", ctypes.c_uint64),
         ("gpio_pulled_up", ctypes.c_uint64),
@@ -205,9 +207,9 @@ class Port(ctypes.Structure):
 
 
 _LOADED: list[ctypes.CDLL] = []
-_LAYOUTS: Final[dict[str, type[ctypes.Structure]]] = {"supi3_block_layout": Block, "supi3_state_layout": State,
-                                                      "supi3_held_layout": Held, "supi3_prefix_layout": Prefix,
-                                                      "supi3_frames_layout": Frames, "supi3_port_layout": Port}  # fmt: skip
+_LAYOUTS: Final[dict[str, type[ctypes.Structure]]] = {
+    "supi3_block_layout": Block, "supi3_state_layout": State, "supi3_held_layout": Held,
+    "supi3_prefix_layout": Prefix, "supi3_frames_layout": Frames, "supi3_port_layout": Port}  # fmt: skip
 """hook.c's layout tables and their ctypes mirrors."""
 
 
