@@ -71,6 +71,7 @@ def snapshot(board: Board) -> dict[str, Any]:
         "violations": [(v.time_s, v.pc, v.error.rule, str(v.error)) for v in board.violations],
         "protocol": (protocol.mode, protocol.phase, protocol.command, protocol.last_rx, protocol._frame),
         "registers": (dict(registers._values), registers.latch_phase, registers.io_access, registers.irq_n),
+        "chip": (board.bench.chip._stat_err, board.bench.chip._stat_due),
         "gpio": (board.gpio.odr, board.gpio._levels),
         "spi": (spi.cr1, spi.rx_last, spi.rx_buffer, spi.tx_buffer, spi.shifting, spi.transfers, spi.ovr,
                 spi._ovr_seen, spi._holding, spi.modf),

@@ -1,19 +1,23 @@
 /*
- * frame_edges.c - raw µP interface frames across every boundary of the board's native frames (tests/test_mcu_fastbyte.py,
- * MCU-51): plain command and data frames, and each kind the native frames leave to Python: a read of IRQ_EVT
- * (read-clear), writes of SET and ID, a byte clocked with /SS high, /SS falling too soon after it rose (Table 3-7 t8),
- * /SS rising too soon after the last SCLK edge (t2), a frame of two bytes, a frame of no byte, a reserved command byte,
- * SAS_INIT, and data registers read and written whenever the handler runs (inside the latch phase too, 3.4.14).
- * Every frame is raw GPIOA and SPI1 accesses, as board.c's transport makes them.
+ * frame_edges.c - raw µP interface frames across every boundary of the board's native frames
+ * (tests/test_mcu_fastbyte.py, MCU-51): plain command and data frames, and each kind the native frames leave to
+ * Python: a read of IRQ_EVT (read-clear), writes of SET and ID, a byte clocked with /SS high, /SS falling too soon
+ * after it rose (Table 3-7 t8), /SS rising too soon after the last SCLK edge (t2), a frame of two bytes, a frame of no
+ * byte, a reserved command byte, a byte whose DR is not read (an overrun), SPI mode 0, LSB first, a long wait inside
+ * a frame (bus events in it), /StatErr changed in the write of an /SS edge, SAS_INIT, and data registers read and
+ * written whenever the handler runs (in the latch phase too, 3.4.14). Every frame is raw GPIOA and SPI1 accesses, as
+ * board.c's transport makes them.
  */
 #include "board.h"
 #include "fw_board.h"
 
 #define SS (1u << BOARD_PIN_SS)
 #define SAS (1u << BOARD_PIN_SAS_INIT)
+#define STATERR (1u << BOARD_PIN_STAT_ERR)
 #define SETTLE 60u /* cycles after /SS rises: more than t6 (max) + t8 at 500 kbit/s (24 cycles at 48 MHz) */
 #define READ(address) (0x80u | (address))
 #define WRITE(address) (0x40u | (address))
+#define GAP 1500u /* cycles: a 2 Mbit/s cycle's time at 48 MHz */
 #define ROUNDS 9u /* handlers that run the edges; later ones serve the data cycle only */
 
 static void wait(uint32_t cycles)
@@ -85,12 +89,42 @@ static void edges(fw_board_t *board)
     wait(SETTLE);
     GPIOA_BSRR = SS;
     wait(SETTLE);
+    GPIOA_BRR = SS;                                 /* long between /SS falling and the byte: bus events */
+    wait(GAP);
+    (void)frame(READ(7u), 0, 40u, 0u);
+    GPIOA_BSRR = SS;
+    wait(SETTLE);
+    (void)frame(0u, 1, GAP, SETTLE);                /* and between the byte and /SS rising */
+    GPIOA_BRR = SS;                                 /* a byte whose DR is not read, SR read after it in the model */
+    SPI1_DR = READ(7u);
+    wait(SETTLE);
+    (void)SPI1_CR1;
+    while ((SPI1_SR & SPI_SR_BSY) != 0u) {
+    }
+    wait(40u);
+    GPIOA_BSRR = SS;
+    wait(SETTLE);
+    (void)frame(0u, 1, 40u, SETTLE);                /* its data byte: DR overruns (RM0008 25.3.10) */
+    (void)SPI1_SR;
     (void)access(0x30u | READ(7u), 0u);             /* reserved command bits */
     if (n == 0u) {
         (void)access(WRITE(13u), 0x83u);            /* SET, ID: configuration (3.4.3) */
         (void)access(WRITE(12u), 0x03u);
     }
-    if (n == 2u) {                                  /* SAS_INIT, then the initialization byte again */
+    GPIOA_BRR = SS | STATERR;                       /* /StatErr lowered with /SS's fall, raised with its rise */
+    (void)frame(READ(7u), 0, 40u, 0u);
+    GPIOA_BSRR = SS | STATERR;
+    wait(SETTLE);
+    (void)frame(0u, 1, 40u, SETTLE);
+    if (n == 1u) { /* between bytes (RM0008 25.5.1 allows it): SPI mode 0, then LSB first (the chip sees E1h, 00h) */
+        uint32_t cr1 = SPI1_CR1;
+        SPI1_CR1 = cr1 & ~(SPI_CR1_CPOL | SPI_CR1_CPHA);
+        (void)access(READ(7u), 0u);
+        SPI1_CR1 = cr1 | SPI_CR1_LSBFIRST;
+        (void)access(READ(7u), 0u);
+        SPI1_CR1 = cr1;
+    }
+    if (n == 2u) { /* SAS_INIT, then the initialization byte again */
         GPIOA_BSRR = SAS;
         wait(SETTLE);
         GPIOA_BRR = SAS;

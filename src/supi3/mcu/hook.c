@@ -377,6 +377,7 @@ static int frame_rise(supi3_frames *f, uint64_t now) {
     }
     f->last_rx = rx;
     f->frame_open = 0;
+    f->transfer = 0;
     f->ss_rise = (int64_t)now;
     return 1;
 }
@@ -480,21 +481,23 @@ const uint32_t supi3_prefix_layout[] = {
     4, sizeof(supi3_prefix), AT(supi3_prefix, address), AT(supi3_prefix, pc), AT(supi3_prefix, cycles)};
 const uint32_t supi3_frames_layout[] = {
     63, sizeof(supi3_frames), AT(supi3_frames, state), AT(supi3_frames, spi), AT(supi3_frames, prefixes),
-    AT(supi3_frames, prefix_mask), AT(supi3_frames, least_t1), AT(supi3_frames, least_t2), AT(supi3_frames,
-    least_t8), AT(supi3_frames, ss_pin), AT(supi3_frames, cd_command), AT(supi3_frames, cd_data), AT(supi3_frames,
-    phase_command), AT(supi3_frames, phase_data), AT(supi3_frames, sr_txe), AT(supi3_frames, sr_bsy),
-    AT(supi3_frames, sr_rxne), AT(supi3_frames, spi_dr), AT(supi3_frames, spi_sr), AT(supi3_frames, valid),
-    AT(supi3_frames, due), AT(supi3_frames, latch), AT(supi3_frames, latch_at), AT(supi3_frames, gpio_ok),
-    AT(supi3_frames, gpio_mask),
-    AT(supi3_frames, gpio_pulled_up), AT(supi3_frames, gpio_levels), AT(supi3_frames, spi_ok), AT(supi3_frames,
-    period), AT(supi3_frames, sr_modf), AT(supi3_frames, pending), AT(supi3_frames, odr), AT(supi3_frames, synced),
-    AT(supi3_frames, phase), AT(supi3_frames, command), AT(supi3_frames, last_rx), AT(supi3_frames, frame_open),
-    AT(supi3_frames, frame_fall), AT(supi3_frames, frame_driven), AT(supi3_frames, transfer), AT(supi3_frames,
-    transfer_seen), AT(supi3_frames, transfer_start), AT(supi3_frames, transfer_period), AT(supi3_frames, ss_rise),
-    AT(supi3_frames, cd_before), AT(supi3_frames, written), AT(supi3_frames, dr_writes), AT(supi3_frames, rx_last),
-    AT(supi3_frames, shift_received), AT(supi3_frames, shift_start), AT(supi3_frames, shift_end), AT(supi3_frames, taken),
-    AT(supi3_frames, values), AT(supi3_frames, written_values), AT(supi3_frames, plain), AT(supi3_frames, address), AT(supi3_frames,
-    rd), AT(supi3_frames, wr), AT(supi3_frames, reads_register), AT(supi3_frames, writes_register), AT(supi3_frames,
-    fast_read), AT(supi3_frames, fast_write), AT(supi3_frames, write_mask), AT(supi3_frames, alias)};
+    AT(supi3_frames, prefix_mask), AT(supi3_frames, least_t1), AT(supi3_frames, least_t2),
+    AT(supi3_frames, least_t8), AT(supi3_frames, ss_pin), AT(supi3_frames, cd_command), AT(supi3_frames, cd_data),
+    AT(supi3_frames, phase_command), AT(supi3_frames, phase_data), AT(supi3_frames, sr_txe),
+    AT(supi3_frames, sr_bsy), AT(supi3_frames, sr_rxne), AT(supi3_frames, spi_dr), AT(supi3_frames, spi_sr),
+    AT(supi3_frames, valid), AT(supi3_frames, due), AT(supi3_frames, latch), AT(supi3_frames, latch_at),
+    AT(supi3_frames, gpio_ok), AT(supi3_frames, gpio_mask), AT(supi3_frames, gpio_pulled_up),
+    AT(supi3_frames, gpio_levels), AT(supi3_frames, spi_ok), AT(supi3_frames, period), AT(supi3_frames, sr_modf),
+    AT(supi3_frames, pending), AT(supi3_frames, odr), AT(supi3_frames, synced), AT(supi3_frames, phase),
+    AT(supi3_frames, command), AT(supi3_frames, last_rx), AT(supi3_frames, frame_open),
+    AT(supi3_frames, frame_fall), AT(supi3_frames, frame_driven), AT(supi3_frames, transfer),
+    AT(supi3_frames, transfer_seen), AT(supi3_frames, transfer_start), AT(supi3_frames, transfer_period),
+    AT(supi3_frames, ss_rise), AT(supi3_frames, cd_before), AT(supi3_frames, written), AT(supi3_frames, dr_writes),
+    AT(supi3_frames, rx_last), AT(supi3_frames, shift_received), AT(supi3_frames, shift_start),
+    AT(supi3_frames, shift_end), AT(supi3_frames, taken), AT(supi3_frames, values),
+    AT(supi3_frames, written_values), AT(supi3_frames, plain), AT(supi3_frames, address), AT(supi3_frames, rd),
+    AT(supi3_frames, wr), AT(supi3_frames, reads_register), AT(supi3_frames, writes_register),
+    AT(supi3_frames, fast_read), AT(supi3_frames, fast_write), AT(supi3_frames, write_mask),
+    AT(supi3_frames, alias)};
 const uint32_t supi3_port_layout[] = {
     4, sizeof(supi3_port), AT(supi3_port, frames), AT(supi3_port, slow), AT(supi3_port, spi)};
