@@ -21,11 +21,11 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from supi3.errors import Supi3Error
 from supi3.interbus.errors import InterbusError
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import NOISE_CYCLES, Board
 from supi3.mcu.frames import FAST_READS, FAST_WRITES, first_due
-from supi3.model.registers import InterfaceViolationError
 from supi3.sdk import native
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning:unicorn")
@@ -46,7 +46,9 @@ def elves(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
         "dio_br0": mcu_build.build(example, folder / "dio_br0.elf", defines={"BOARD_SPI_BR": "0u"}),
         "edges": mcu_build.build(MCU / "frame_edges.c", folder / "edges.elf"),
         "edges_br3": mcu_build.build(MCU / "frame_edges.c", folder / "edges_br3.elf", defines=BR3),
-        "misuse": mcu_build.build(MCU / "spi_misuse.c", folder / "misuse.elf", defines={"MISUSE": "1"}),
+        **{f"misuse{misuse}": mcu_build.build(MCU / "spi_misuse.c", folder / f"misuse{misuse}.elf",
+                                              defines={"MISUSE": str(misuse)}) for misuse in (1, 2, 3)},
+        "clock_off": mcu_build.build(MCU / "frame_edges.c", folder / "clock_off.elf", defines={"CLOCK_OFF": "1u"}),
         "gpio_reset": mcu_build.build(MCU / "gpio_reset.c", folder / "gpio_reset.elf"),
     }
 
@@ -90,11 +92,11 @@ def side_by_side(elf: Path, bit_rate: int, steps: int, *, strict: bool = False, 
               Board(elf, bit_rate=bit_rate, strict=strict, pedantic=pedantic, native_frames=False))  # fmt: skip
     assert boards[0].native_frames is not None and boards[1].native_frames is None
     for step in range(steps):
-        errors: list[tuple[type[InterfaceViolationError], str] | None] = []
+        errors: list[tuple[type[Supi3Error], str] | None] = []
         for board in boards:
             try:
                 board.run(cycles)
-            except InterfaceViolationError as error:
+            except Supi3Error as error:
                 errors.append((type(error), str(error)))
             else:
                 errors.append(None)
@@ -132,7 +134,10 @@ def test_frame_edges_crosses_every_fallback(elves: dict[str, Path]) -> None:
 
 @pytest.mark.parametrize(("case", "bit_rate", "strict", "pedantic"), [
     ("dio_br0", 2_000_000, False, False),  # SCLK faster than t0, the first edge before t1
-    ("misuse", 500_000, False, False),  # CR1 changed while a byte shifts (MCU-40)
+    ("misuse1", 500_000, False, False),  # CR1's BR changed while a byte shifts (MCU-40)
+    ("misuse2", 500_000, False, False),  # SPE cleared while a byte shifts
+    ("misuse3", 500_000, False, False),  # DFF set with SPE set
+    ("clock_off", 500_000, False, False),  # SPI1's clock turned off, then a frame: PeripheralClockError
     ("gpio_reset", 500_000, False, False),  # GPIOA reset while /SS is low
     ("edges_br3", 2_000_000, True, False),  # strict: the first violation raised, at the same step
     ("dio_br3", 2_000_000, False, True),  # pedantic: no native frame

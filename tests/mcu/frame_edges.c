@@ -18,7 +18,10 @@
 #define READ(address) (0x80u | (address))
 #define WRITE(address) (0x40u | (address))
 #define GAP 1500u /* cycles: a 2 Mbit/s cycle's time at 48 MHz */
-#define ROUNDS 9u /* handlers that run the edges; later ones serve the data cycle only */
+#define ROUNDS 9u
+#ifndef CLOCK_OFF
+#define CLOCK_OFF 0u
+#endif /* handlers that run the edges; later ones serve the data cycle only */
 
 static void wait(uint32_t cycles)
 {
@@ -142,6 +145,10 @@ void fw_setup(supi3_t *chip, fw_board_t *board)
     }
     (void)access(WRITE(14u), SUPI3_IRQ_EN_VALID_MSK);
     edges(board);
+    if (CLOCK_OFF) { /* SPI1's clock turned off (RCC_APB2ENR, RM0008 7.3.7), then a frame: the board stops (MCU-7) */
+        RCC_APB2ENR &= ~(1u << 12);
+        (void)access(READ(7u), 0u);
+    }
 }
 
 void fw_isr(supi3_t *chip, fw_board_t *board)
