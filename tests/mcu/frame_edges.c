@@ -3,7 +3,7 @@
  * (tests/test_mcu_fastbyte.py, MCU-51): plain command and data frames, and each kind the native frames leave to
  * Python: a read of IRQ_EVT (read-clear), writes of SET and ID, a byte clocked with /SS high, /SS falling too soon
  * after it rose (Table 3-7 t8), /SS rising too soon after the last SCLK edge (t2), a frame of two bytes, a frame of no
- * byte, a reserved command byte, a byte whose DR is not read (an overrun), SPI mode 0, LSB first, a long wait inside
+ * byte, a reserved command byte, a byte whose DR is not read, SPI mode 0, LSB first, a long wait inside
  * a frame (bus events in it), /StatErr changed in the write of an /SS edge, SAS_INIT, and data registers read and
  * written whenever the handler runs (in the latch phase too, 3.4.14). Every frame is raw GPIOA and SPI1 accesses, as
  * board.c's transport makes them.
@@ -107,8 +107,8 @@ static void edges(fw_board_t *board)
     wait(40u);
     GPIOA_BSRR = SS;
     wait(SETTLE);
-    (void)frame(0u, 1, 40u, SETTLE);                /* its data byte: DR overruns (RM0008 25.3.10) */
-    (void)SPI1_SR;
+    (void)frame(0u, 1, 40u, SETTLE);                /* its data byte reads the byte before (RXNE was still set) */
+    (void)SPI1_DR;                                  /* the data byte's: the receive buffer empty again */
     (void)access(0x30u | READ(7u), 0u);             /* reserved command bits */
     if (n == 0u) {
         (void)access(WRITE(13u), 0x83u);            /* SET, ID: configuration (3.4.3) */

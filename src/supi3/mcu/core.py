@@ -680,6 +680,12 @@ _CLOCK, _CLOCK_AT = _fields_struct(hook.State, ("block_start", "block_address", 
 _PREFIX, _ = _fields_struct(hook.Prefix, ("address", "pc", "cycles"))
 
 
+def _prefix_slot(address: int, pc: int) -> int:
+    """The slot of the prefix cost of the block at ``address`` up to ``pc`` in the native memo (hook.c's
+    ``prefix_slot``, the same sum modulo 2^64; a PC may be reached from more than one block)."""
+    return ((pc >> 1) * 31 + (address >> 1)) & (PREFIX_SLOTS - 1)
+
+
 class HeldRegister:
     """A peripheral's register that the core answers natively while the peripheral holds its value (MCU-25), and a
     read the peripheral offers from a cycle on (MCU-26), from :meth:`CortexM.mmio`. A peripheral holds a value (or
@@ -1061,7 +1067,7 @@ class CortexM:
                 if not self._rewritable(address):  # code in RAM may change (MCU-28)
                     self._costs[key] = cost
             if not self._rewritable(address):  # the native frames' memo (MCU-51): its slot, taken or not
-                _PREFIX.pack_into(self._prefixes, (pc >> 1 & PREFIX_SLOTS - 1) * _PREFIX.size, address, pc, cost[1])
+                _PREFIX.pack_into(self._prefixes, _prefix_slot(address, pc) * _PREFIX.size, address, pc, cost[1])
             start += cost[1]
         if start > handed:
             state.handed = start

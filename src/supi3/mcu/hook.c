@@ -298,12 +298,15 @@ typedef struct {
     uint64_t spi;       /* 0: GPIOA, 1: SPI1 */
 } supi3_port;
 
+/* The slot of a block's prefix cost (CortexM._prefix_slot computes the same; a PC is reached from more than one block). */
+static uint64_t prefix_slot(uint64_t address, uint64_t pc) { return (pc >> 1) * 31 + (address >> 1); }
+
 /* CortexM.cycles_now within the access, if its prefix cost is known: 0 (and nothing) if not. */
 static int frames_now(const supi3_frames *f, uint64_t *now) {
     const supi3_state *s = f->state;
     uint64_t start = s->block_start;
     if (s->access_pc > s->block_address) {
-        const supi3_prefix *p = &f->prefixes[(s->access_pc >> 1) & f->prefix_mask];
+        const supi3_prefix *p = &f->prefixes[prefix_slot(s->block_address, s->access_pc) & f->prefix_mask];
         if (p->address != s->block_address || p->pc != s->access_pc || p->address == 0) {
             return 0;
         }
