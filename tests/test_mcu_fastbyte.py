@@ -87,7 +87,7 @@ def side_by_side(elf: Path, bit_rate: int, steps: int, *, strict: bool = False, 
                  cycles: int = 1) -> tuple[Board, Board]:  # fmt: skip
     """A board with the native frames and one without, run ``steps`` times ``cycles`` master cycles, compared after
     each step (and the error of a strict run: the same, at the same step); the master's outputs and the firmware's
-    inputs change after the third step."""
+    inputs change after each step from the third."""
     boards = (Board(elf, bit_rate=bit_rate, strict=strict, pedantic=pedantic),
               Board(elf, bit_rate=bit_rate, strict=strict, pedantic=pedantic, native_frames=False))  # fmt: skip
     assert boards[0].native_frames is not None and boards[1].native_frames is None
@@ -104,11 +104,11 @@ def side_by_side(elf: Path, bit_rate: int, steps: int, *, strict: bool = False, 
         assert snapshot(boards[0]) == snapshot(boards[1]), step
         if errors[0] is not None:
             break
-        if step == 2 and _master_inputs(boards[0]):
+        if step >= 2 and _master_inputs(boards[0]):  # new process data each step from the third (a device with data)
             for board in boards:
-                board.bench.master.set_outputs(1, b"\x12\x34")
+                board.bench.master.set_outputs(1, bytes([0x12 + step, 0x34 ^ step]))
                 assert board.fw_board is not None
-                board.fw_board.inputs = b"\xab\xcd"
+                board.fw_board.inputs = bytes([0xAB ^ step, 0xCD])
     return boards
 
 
