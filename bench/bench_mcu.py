@@ -91,6 +91,7 @@ PARTS: tuple[tuple[str, str, frozenset[str] | None], ...] = (
     ("core: the rest (run loop, access times, exceptions, registers)", "mcu/core.py", None),
     ("stm32: peripheral models", "mcu/stm32.py", None),
     ("board: bus synchronisation, pins, Table 3-7 checks", "mcu/board.py", None),
+    ("board: the native frames' mirror and catch-up (MCU-51)", "mcu/frames.py", None),
     ("chip, ring and bench models (supi3 outside mcu)", "/supi3/", None),
     ("Python builtins and the rest", "", None),
 )

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import ctypes
 import math
+import operator
 import struct
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Final, Protocol
@@ -227,8 +228,12 @@ class NativeFrames:
         frames.write_mask[:] = _registers._WRITE_MASKS
         read_names = _registers._READ_NAMES
         frames.alias[:] = [read_names.index(name) if name in read_names else -1 for name in _registers._WRITE_NAMES]
-        self._reads: tuple[str | None, ...] = tuple(name if FAST_READS[address] else None
-                                                    for address, name in enumerate(read_names))  # fmt: skip
+        reads = [name for address, name in enumerate(read_names) if name is not None and FAST_READS[address]]
+        self._read_values = operator.itemgetter(*reads)  # the fast-readable registers' values, in address order
+        self._values = struct.Struct("<" + "".join("B" if name in reads else "x" for name in read_names))
+        self._values_at = Frames.values.offset
+        self._due_key: tuple[int, float | None, float] | None = None  # the bench's next events, as last mirrored
+        self._due = (0, _NEVER)
         self._written: tuple[str | None, ...] = _registers._WRITE_NAMES
         self._exti0 = exti0
         self._command: object = None
@@ -286,6 +291,18 @@ class NativeFrames:
             spi.transfers += dr_writes
             spi._holding = True
 
+    def _thresholds(self, events: list[tuple[float, str]], next_start: float) -> tuple[int, int]:
+        """The first core cycle whose synchronisation runs a cycle's start or end, and the one that runs the latch
+        phase's start (or :data:`_NEVER`): the phases only set the chips' flags (MCU-52)."""
+        hz, noise = self._hz, self._noise
+        latch_at = _NEVER
+        for at, what in reversed(events):  # the next first
+            if what == _LATCH:
+                latch_at = first_due(at, hz, noise)
+            elif what != _IO:
+                return first_due(at, hz, noise), latch_at
+        return first_due(next_start, hz, noise), latch_at
+
     def refresh(self) -> None:
         """After Python's write of GPIOA or SPI1: mirror the model's state for the native frames, valid if the
         conditions they need hold (module docstring)."""
@@ -325,17 +342,13 @@ class NativeFrames:
                   and not cr1 & (CR1_DFF | CR1_LSBFIRST) and cr1 & (CR1_CPOL | CR1_CPHA) == CR1_CPOL | CR1_CPHA
                   and not spi.period / self._hz < board._shortest_period_s)  # fmt: skip
         values = registers._values
-        frames.values[:] = [0 if name is None else values[name] for name in self._reads]
-        hz, noise = self._hz, self._noise
-        latch_at = _NEVER
-        for at, what in reversed(bench._events):  # the next first; the phases only set the chips' flags (MCU-52)
-            if what == _LATCH:
-                latch_at = first_due(at, hz, noise)
-            elif what != _IO:
-                due = first_due(at, hz, noise)
-                break
-        else:
-            due = first_due(bench._next_start, hz, noise)
+        self._values.pack_into(frames, self._values_at, *self._read_values(values))
+        events = bench._events  # only popped from the end until the next cycle's start makes a new list
+        key = (len(events), events[-1][0] if events else None, bench._next_start)
+        if key != self._due_key:
+            self._due_key = key
+            self._due = self._thresholds(events, bench._next_start)
+        due, latch_at = self._due
         _MIRROR.pack_into(
             frames, _MIRROR_AT, 1, due, int(registers.latch_phase), latch_at,
             int(bool(rcc.apb2enr & IOPAEN) and not rcc.apb2rstr & IOPAEN), gpio._output_mask(), gpio.pulled_up,
