@@ -98,6 +98,7 @@ static void edges(fw_board_t *board)
     GPIOA_BSRR = SS;
     wait(SETTLE);
     (void)frame(0u, 1, GAP, SETTLE);                /* and between the byte and /SS rising */
+    (void)access(WRITE(0u), (uint8_t)(n + 0x40u));  /* IN0, then a wait a cycle's end may fall in */
     (void)frame(READ(0u), 1, 40u, GAP);             /* and before /SS falls for OUT0's data byte */
     board->outputs[2] ^= frame(0u, 1, 40u, SETTLE);
     GPIOA_BRR = SS;                                 /* a byte whose DR is not read, SR read after it in the model */
