@@ -75,7 +75,9 @@ CACHE_ENV: Final[str] = "SUPI3_NATIVE_CACHE"
 CALLBACK_FAILED: Final[int] = -1
 """What a callback returns to C after it caught an exception (the C driver reports ``SUPI3_E_TRANSPORT``)."""
 NOT_WIRED: Final[int] = -6
-"""What a board callback returns when the transport has no such pin (``SUPI3_E_UNSUPPORTED``)."""
+"""What a board callback returns when the transport has no such pin (``SUPI3_E_UNSUPPORTED``): the C driver then
+works as with a NULL callback, its state kept (FW-21; a transport's ``set_sas_init`` returning ``False``, a pin read
+returning ``None``)."""
 
 _CDEF: Final[str] = """
 typedef int (*supi3_xfer_fn)(void *user, uint8_t tx, uint8_t *rx, int s_r);
