@@ -16,7 +16,7 @@ from supi3.config import decode
 from supi3.interbus import wire
 from supi3.model.registers import RegisterFile
 from supi3.regmap import ID, IN0, IN1, IRQ_EVT, OUT0, OUT1, SET
-from supi3.sdk.driver import DriverArgumentError, Irq, Mode, Supi3Driver, put_u16
+from supi3.sdk.driver import UNDRIVEN_BYTE, DriverArgumentError, Irq, Mode, Supi3Driver, put_u16
 from supi3.sdk.pins import PinTransport
 from supi3.sdk.transports import ModelTransport
 from supi3.tables import BIT_RATES, clk_conf_for
@@ -83,6 +83,16 @@ def test_pin_level_and_transaction_level_give_the_same_results(mode: Mode, steps
                 results[k].append(type(error))
     assert results[0] == results[1]
     assert pt.port.registers.in_bytes() == model.transport.registers.in_bytes()  # type: ignore[attr-defined]
+
+
+@pytest.mark.parametrize("mode", list(Mode))
+def test_a_frame_the_chip_does_not_drive_reads_ffh_on_both_transports(mode: Mode) -> None:
+    """FW-26: before the initialization byte and in the interface 55h disabled (UP-4) the chip drives no data; the
+    line's pull-up reads FFh at both fidelities, as on the emulated board (MCU-6)."""
+    _, pin = pin_driver(mode)
+    model = ModelTransport(RegisterFile(decode(*RB_INIT_UP, clk_conf=clk_conf_for(2_000_000))))
+    for transport in (pin, model):
+        assert [transport.xfer(0x55, True), transport.xfer(0x00, True)] == [UNDRIVEN_BYTE] * 2 == [0xFF] * 2
 
 
 def test_bad_mode_is_refused() -> None:

@@ -42,8 +42,9 @@ enum {
     OP_SS_CUT = 15,     /* byte a with /SS raised after b SCLK periods and a half, b < 8 (3.4.2: a frame cut
                            short; half a period clear of t2; the byte received is not logged: MCU-61) */
     OP_LATCH = 16       /* poll the I/O pin without a pause until 1, at most (c + 1) * 10000 times, then spin a us
-                           (a countdown, not delay_us: its division costs the Cortex-M0 a software divide) and
-                           supi3_read(b): a read timed into the latch phase or beside it (3.4.14) */
+                           (a countdown of a us on the emulated core, as the bench's wait: delay_us lasts 4/3 of
+                           its time there, MCU-11) and supi3_read(b): a read timed into the latch phase or beside it
+                           (3.4.14) */
 };
 
 const volatile uint8_t fw_script[SCRIPT_STEPS * STEP_BYTES] = {OP_END, 0xA5u}; /* not all zero: kept in .rodata */

@@ -39,7 +39,7 @@ from supi3.pinout import UP_INPUTS, UP_OUTPUTS
 from supi3.tables import CLOCK_HZ
 from supi3.top import QUIET_BOARD, STEP_BELOW, Supi3Chip
 
-__all__ = ["MCU_LINES", "MISO_PULL_UP", "SYNC_S", "Cause", "LockstepRing", "Sample", "mcu_lines"]
+__all__ = ["MCU_LINES", "MISO_PULL_UP", "SYNC_S", "Cause", "LockstepRing", "Sample", "mcu_lines", "ss_high_byte"]
 
 SYNC_S: Final[float] = 1e-6
 """MCU-14: while the core runs (not asleep), the chip catches up with it at least this often of bus time, so an edge
@@ -78,6 +78,15 @@ the chip (:meth:`LockstepRing.sync` with ``until_edge``); a shorter one is stepp
 about as much as 60 clock steps, each run of the chip in one piece about as much as :data:`~supi3.top.STEP_BELOW`."""
 RECENT: Final[int] = 256
 """Pin changes kept to name the cause of a violation the chip finds later."""
+SS_HIGH_RULE: Final[str] = "3.4.2"
+"""The rule a byte clocked with /SS high breaks (:func:`ss_high_byte`)."""
+
+
+def ss_high_byte(tx: int) -> InterfaceViolationError:
+    """The board's lint of a byte ``tx`` SPI1 clocks while /SS is high, at either fidelity (MCU-63): the chip ignores
+    SCLK while it is not selected (3.4.2, Table 3-5), so no chip rule is broken, but the firmware has most likely
+    forgotten /SS."""
+    return InterfaceViolationError(SS_HIGH_RULE, f"byte {tx:02X}h clocked with /SS high: the chip ignores it")
 
 
 @dataclass(frozen=True)
@@ -148,6 +157,7 @@ class LockstepRing(PinRing):
         self.on_edge: Callable[[str, int, int], None] = _no_edge
         self.on_violation: Callable[[InterfaceViolationError, int, Cause | None], None] = _no_violation
         self.inputs = dict(QUIET_BOARD)
+        self._ss_n = self.inputs["mfp_in"] >> SS_BIT & 1  # /SS as the board drives it last (pulled up, MCU-6)
         self.last: dict[str, int] = {"mfp_out": 0, "mfp_oe": 0, "mod_ack_n": 1}
         self.irq_n = 1
         self.mod_ack_n = 1
@@ -221,6 +231,8 @@ class LockstepRing(PinRing):
         """The board drives input ``pin`` (bit ``bit`` of ``mfp_in``, or a one-bit pin with ``bit`` 0) to ``level``
         from core cycle ``cycles`` on."""
         clock = max(self.clock_of(cycles), self.cycle)
+        if pin == "mfp_in" and bit == SS_BIT:
+            self._ss_n = level
         self._order += 1
         heapq.heappush(self._events, (clock, self._order, pin, bit, level, self.where() if cause is None else cause))
 
@@ -229,7 +241,8 @@ class LockstepRing(PinRing):
         SCLK idles at CPOL, bit ``k``'s leading edge half a period after ``start + k * period``, its trailing edge at
         ``start + (k + 1) * period``; MOSI changes on the leading edge with CPHA = 1, half a period before it with
         CPHA = 0, MISO is sampled on the other edge); returns what reads the received word once the chip has run past
-        its last sample (MCU-16)."""
+        its last sample (MCU-16). A transfer that starts with /SS high is reported as :func:`ss_high_byte` (MCU-63);
+        its edges still reach the chip, which ignores them."""
         cause = self.where()
         lsb = bool(cr1 & CR1_LSBFIRST)
         cpol, cpha = int(bool(cr1 & CR1_CPOL)), int(bool(cr1 & CR1_CPHA))
@@ -246,7 +259,19 @@ class LockstepRing(PinRing):
         sample = Sample(sample_at, lsb, {})
         for clock in sample_at:
             self._samples.setdefault(clock, []).append(sample)
+        if self._ss_n:  # the edges are queued first: a strict log's raise leaves the transfer whole
+            self._lint(ss_high_byte(tx), self.clock_of(start), cause)
         return lambda: self._miso(sample)
+
+    def _lint(self, error: InterfaceViolationError, clock: int, cause: Cause) -> None:
+        """A rule the board checks itself, not the chip: into the chip's violation log (strict mode raises it) and
+        handed on as the chip's findings are."""
+        registers = self.chip.core.chip.registers
+        assert registers is not None
+        try:
+            registers.violations.report(error)
+        finally:
+            self.on_violation(error, clock, cause)
 
     def _miso(self, sample: Sample) -> int:
         self.sync(sample.cycles[-1] + 1)

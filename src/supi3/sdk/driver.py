@@ -50,6 +50,7 @@ __all__ = [
     "BLOCK_MIN_BYTES",
     "ERROR_CODES",
     "IRQ_SERVICE_MAX_READS",
+    "UNDRIVEN_BYTE",
     "AsyncSupi3Driver",
     "AsyncTransport",
     "DirectAccess",
@@ -86,6 +87,10 @@ IRQ_SERVICE_MAX_READS: Final[int] = 4
 ``SUPI3_IRQ_SERVICE_MAX_READS``."""
 SAS_INIT_PULSE_US: Final[float] = 1.0
 """SAS_INIT active time the driver holds (t_SAS_INIT >= 250 ns, 3.4.3), as ``supi3_sas_init``."""
+UNDRIVEN_BYTE: Final[int] = 0xFF
+"""What :meth:`Transport.xfer` returns for a frame in which the chip drives no data (before its initialization, a
+disabled interface, an Intel send frame; 3.4.1, 3.4.3, UP-25): the data line's pull-up, as on the emulated board
+(MCU-6, FW-26)."""
 
 
 class ErrorCode(IntEnum):
@@ -286,9 +291,9 @@ class Transport(ABC):
 
     @abstractmethod
     def xfer(self, tx: int, s_r: bool) -> int:
-        """One byte as one frame: /SS low, 8 SCLK periods, /SS high; return the byte the chip drove (0 when it drove
-        none). Motorola: SPI mode 3, MSB first. Intel: LSB first, S/R set to ``s_r`` before /SS falls (``True``:
-        the µP sends; Table 3-9, UP-9)."""
+        """One byte as one frame: /SS low, 8 SCLK periods, /SS high; return the byte the chip drove
+        (:data:`UNDRIVEN_BYTE`, FFh, when it drove none: the data line's pull-up, FW-26). Motorola: SPI mode 3, MSB
+        first. Intel: LSB first, S/R set to ``s_r`` before /SS falls (``True``: the µP sends; Table 3-9, UP-9)."""
 
     def delay_us(self, us: float) -> None:
         """Wait ``us`` microseconds (frame gap, SAS_INIT pulse); the default does not wait."""

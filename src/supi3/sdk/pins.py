@@ -16,7 +16,7 @@ from typing import Final
 
 from supi3.checks import check_real, describe
 from supi3.model.pins import RESET_STRETCH_CLOCKS
-from supi3.sdk.driver import DriverArgumentError, Mode, Transport
+from supi3.sdk.driver import UNDRIVEN_BYTE, DriverArgumentError, Mode, Transport
 from supi3.spi.master import MasterTiming, SoftMaster
 from supi3.top import ChipPort, Supi3Chip
 
@@ -63,11 +63,12 @@ class PinTransport(Transport):
         return self.port.chip
 
     def xfer(self, tx: int, s_r: bool) -> int:
-        """One frame: the gap, /SS low, 8 SCLK periods, /SS high (the chip takes the byte at its rising edge)."""
+        """One frame: the gap, /SS low, 8 SCLK periods, /SS high (the chip takes the byte at its rising edge). A
+        frame the chip does not drive reads FFh (FW-26)."""
         master = self.master
         rx = master.byte(tx, s_r=s_r)
         master.deselect()
-        return rx or 0
+        return UNDRIVEN_BYTE if rx is None else rx
 
     def delay_us(self, us: float) -> None:
         """Hold the pins for ``us`` microseconds (rounded up to whole clocks)."""

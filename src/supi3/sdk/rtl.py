@@ -259,7 +259,8 @@ class RtlTransport(AsyncTransport):
     async def xfer(self, tx: int, s_r: bool) -> int:
         """/SS high for the gap (S/R set at its start in Intel mode), /SS low, eight SCLK periods (data out at each
         fall, the chip's bit sampled at each rise), SCLK high until /SS rises (UP-5 to UP-9). ``tx`` one byte,
-        ``s_r`` a bool, as from the driver (checked: a direct caller's 300 would go out as 2Ch)."""
+        ``s_r`` a bool, as from the driver (checked: a direct caller's 300 would go out as 2Ch). A bit the chip does not
+        drive reads 1: a frame it does not drive reads FFh (FW-26)."""
         if type(tx) is not int or not 0 <= tx <= 0xFF:
             tx = check_int("tx", tx, 0, 0xFF, "one byte")
         s_r = check_bool("s_r", s_r)
@@ -278,7 +279,7 @@ class RtlTransport(AsyncTransport):
             board.drive_up(sclk=0, **({"mfp6": (tx >> shift) & 1} if sends else {}))
             await board.clocks(t.low)
             bit = board.up_output("mfp6" if intel else "mfp7")
-            received |= (bit or 0) << shift
+            received |= (1 if bit is None else bit) << shift  # an undriven line reads its pull-up (FW-26)
             board.drive_up(sclk=1)
             await board.clocks(t.high if i < 7 else t.trail)
         board.drive_up(ss_n=1)

@@ -21,7 +21,7 @@ from typing import Any
 from supi3.checks import check_int, describe
 from supi3.model.chip import Supi3
 from supi3.model.registers import RegisterFile
-from supi3.sdk.driver import DirectAccess, DriverArgumentError, Mode, Transport
+from supi3.sdk.driver import UNDRIVEN_BYTE, DirectAccess, DriverArgumentError, Mode, Transport
 from supi3.spi.upif import Phase, UpInterface
 
 __all__ = ["ModelTransport", "SpidevTransport"]
@@ -49,8 +49,8 @@ class ModelTransport(Transport):
 
     def xfer(self, tx: int, s_r: bool) -> int:
         """One frame: /SS falls (the chip decides what it drives, UP-18), /SS rises (it takes the byte on the data
-        line: its own in an Intel receive frame). As :meth:`UpInterface.transfer`, without its argument checks:
-        the driver sends only bytes."""
+        line: its own in an Intel receive frame). As :meth:`UpInterface.transfer`, without its argument checks: the
+        driver sends only bytes. A frame the chip does not drive reads :data:`UNDRIVEN_BYTE` (FW-26)."""
         protocol = self.protocol
         log = self._log
         log.hold()  # a deferred() block without the with statement's cost (the per-byte hot path)
@@ -62,7 +62,7 @@ class ModelTransport(Transport):
             log.release(failed=True)
             raise
         log.release()
-        return driven or 0
+        return UNDRIVEN_BYTE if driven is None else driven
 
     def _during_frame(self) -> None:
         """Between /SS falling and rising: no time passes on the bare model (a bench runs its bus here)."""

@@ -26,23 +26,31 @@ static volatile uint32_t irq_noted;
 #define BOARD_T2_NS 375u
 #define BOARD_T6_MAX_NS 375u
 #define BOARD_T8_NS 125u
-#define BOARD_NS_CYCLES(ns) (((ns) * (BOARD_SYSCLK_HZ / 1000000u) + 999u) / 1000u)
+#define BOARD_CYCLES_PER_US ((BOARD_SYSCLK_HZ + 999999u) / 1000000u)
+#define BOARD_NS_CYCLES(ns) (((ns) * BOARD_CYCLES_PER_US + 999u) / 1000u)
 
-/* Busy wait for at least `cycles` CPU clocks: a countdown loop of two 16-bit instructions (SUBS, BNE) that takes at
- * least BOARD_SPIN_CYCLES clocks an iteration on either core (Cortex-M3: SUBS 1, a taken branch 2 or more; Cortex-M0:
+/* Busy wait: a countdown loop of `n` >= 1 iterations of two 16-bit instructions (SUBS, BNE) that takes at least
+ * BOARD_SPIN_CYCLES clocks an iteration on either core (Cortex-M3: SUBS 1, a taken branch 2 or more; Cortex-M0:
  * 1 + 3). Registers only: safe in a handler and in the code it interrupts, SysTick stays the firmware's. The emulator
- * counts the iterations without running them (MCU-11). */
+ * counts the iterations without running them (MCU-11). Every count is a compile-time constant or a product with one:
+ * no run-time division, which the Cortex-M0 (no divide instruction) would make a call of __aeabi_uidiv of about 850
+ * clocks (MCU-62). */
 #define BOARD_SPIN_CYCLES 3u
-static void board_wait_cycles(uint32_t cycles)
+/* Iterations for at least `cycles` clocks (a constant expression). */
+#define BOARD_SPINS(cycles) ((cycles) / BOARD_SPIN_CYCLES + 1u)
+/* Iterations per microsecond, rounded up: delay_us(n) lasts at least n us. */
+#define BOARD_SPINS_PER_US ((BOARD_CYCLES_PER_US + BOARD_SPIN_CYCLES - 1u) / BOARD_SPIN_CYCLES)
+static void board_spin(uint32_t n)
 {
-    uint32_t n = cycles / BOARD_SPIN_CYCLES + 1u;
     __asm__ volatile("1: subs %0, %0, #1\n\tbne 1b" : "+l"(n) : : "cc");
 }
 
+/* At least `us` microseconds: us * BOARD_SPINS_PER_US + 1 iterations (the product wraps above 2^32 /
+ * BOARD_SPINS_PER_US us, 268 s at 48 MHz). */
 static void board_delay_us(void *user, uint32_t us)
 {
     (void)user;
-    board_wait_cycles(us * (BOARD_SYSCLK_HZ / 1000000u));
+    board_spin(us * BOARD_SPINS_PER_US + 1u);
 }
 
 /* One byte, one /SS frame (supi3.h transport contract; RM0008 25.3.5, full-duplex master sequence). Table 3-7 at
@@ -66,9 +74,9 @@ static int board_xfer(void *user, uint8_t tx, uint8_t *rx, int s_r)
     *rx = (uint8_t)SPI1_DR;
     while ((SPI1_SR & SPI_SR_BSY) != 0u) {
     }
-    board_wait_cycles(BOARD_NS_CYCLES(BOARD_T2_NS));
+    board_spin(BOARD_SPINS(BOARD_NS_CYCLES(BOARD_T2_NS)));
     GPIOA_BSRR = PIN(BOARD_PIN_SS);
-    board_wait_cycles(BOARD_NS_CYCLES(BOARD_T6_MAX_NS + BOARD_T8_NS));
+    board_spin(BOARD_SPINS(BOARD_NS_CYCLES(BOARD_T6_MAX_NS + BOARD_T8_NS)));
     return 0;
 }
 
