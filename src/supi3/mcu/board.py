@@ -39,7 +39,7 @@ from supi3.mcu.core import (
     Stop,
 )
 from supi3.mcu.frames import NativeFrames, SsFrame
-from supi3.mcu.pins import SAS_INIT_BIT, SR_BIT, SS_BIT, SYNC_S, Cause, LockstepRing, mcu_lines
+from supi3.mcu.pins import SAS_INIT_BIT, SR_BIT, SS_BIT, SYNC_S, Cause, LockstepRing, mcu_lines, ss_high_byte
 from supi3.mcu.stm32 import (
     AFIO_BASE,
     CR1_CPHA,
@@ -761,7 +761,8 @@ class Board:
                             "idles high, data taken on the rising edge, UP-5)")  # fmt: skip
         frame = self._frame
         if frame is None:
-            self._violation("3.4.2", f"byte {tx:02X}h clocked with /SS high: the chip ignores it")
+            lint = ss_high_byte(tx)  # the same lint as the pin-level board's (MCU-63)
+            self._violation(lint.rule, lint.detail)
             return MISO_IDLE
         lsb = bool(cr1 & CR1_LSBFIRST)
         reverse = lsb != (self.protocol.mode is Mode.INTEL)  # the chip shifts LSB first in Intel mode (UP-6)
