@@ -24,6 +24,7 @@ from supi3.mcu.core import CPUS, FirmwareStoppedError, Stop
 from supi3.model.registers import InconsistentDataError, InterfaceViolationError
 from supi3.sdk import native
 from supi3.sdk.bench import Bench
+from supi3.sdk.examples.history import SETTLE_CYCLES
 from supi3.spi.upif import Mode
 from support import c_firmware
 from test_mcu_hostile import FILES
@@ -60,8 +61,9 @@ def test_the_board_pins_are_board_h_s() -> None:
 
 
 def _binary_exchange(board: Board, words: tuple[bytes, ...]) -> list[tuple[bytes, bytes]]:
-    """Per step: the master's outputs and the device's inputs set, two cycles run; (the firmware's output
-    terminals, the master's inputs) after them."""
+    """Per step: the master's outputs and the device's inputs set, SETTLE_CYCLES (3) cycles run; (the firmware's
+    output terminals, the master's inputs) after them. (Back to back the firmware's IN goes out with the third
+    cycle; before MCU-55 two were run, the master having started the third in the run's wait.)"""
     fw = board.fw_board
     assert fw is not None
     n = len(words[0])
@@ -69,7 +71,7 @@ def _binary_exchange(board: Board, words: tuple[bytes, ...]) -> list[tuple[bytes
     for out_data, in_data in zip(words, reversed(words), strict=True):
         board.bench.master.set_outputs(1, out_data)
         fw.inputs = in_data
-        board.run(2)
+        board.run(SETTLE_CYCLES)
         seen.append((fw.outputs[:n], board.bench.master.inputs(1)))
     return seen
 
@@ -87,7 +89,7 @@ def _host_exchange(pytestconfig: pytest.Config, name: str, words: tuple[bytes, .
         bench.master.set_outputs(1, out_data)
         for k, value in enumerate(in_data):
             host.board.inputs[k] = value
-        bench.run(2)
+        bench.run(SETTLE_CYCLES)
         assert bench.served  # FW-14: a main loop's pass after the last cycle, as on the board (MCU-30)
         seen.append((bytes(host.board.outputs[0:n]), bench.master.inputs(1)))
     return seen

@@ -63,7 +63,15 @@ from supi3.model.pinring import PinBranch, PinChip
 from supi3.model.registers import InterfaceViolationError
 from supi3.model.vcd import write_vcd
 from supi3.pinout import C_D_COMMAND
-from supi3.sdk.bench import Bench, MainLoopPasses, MasterStart, ServeWait, default_config, discovery_master
+from supi3.sdk.bench import (
+    Bench,
+    MainLoopPasses,
+    MasterStart,
+    ServeWait,
+    default_config,
+    discovery_master,
+    serve_wait_s,
+)
 from supi3.spi.upif import Mode, UpifProtocol
 from supi3.tables import CLOCK_HZ
 from supi3.top import Supi3Chip
@@ -348,6 +356,7 @@ class Board:
         bit_rate = self.config.bit_rate
         self._telegram_s = wire.STATUS_TELEGRAM_BITS / bit_rate  # the line idles in whole telegrams (MCU-22, -30)
         self._wait = ServeWait(bit_rate)  # MCU-55: the run's end, at most SERVE_TELEGRAMS after its last cycle
+        self._wait_s = serve_wait_s(bit_rate)
         self._last: float = math.inf  # MCU-55: the cycle count a run(n) ends at (its master holds there)
         self._limits = {symbol: timing.limit("3-7", symbol, bit_rate) for symbol in ("t0", "t1", "t2", "t8")}
         self._limits["t6max"] = timing.limit("3-7", "t6", bit_rate, maximum=True)
@@ -865,14 +874,16 @@ class Board:
         """The core cycle the run loop stops the core at for the bus: the next bus event that may change /IRQ or
         /ModAck (MCU-31); none while EXTI0 is active or about to be entered at the step's start (MCU-44: an edge of
         /IRQ then only sets EXTI's pending bit, and the firmware's next access, or the next stop, at the latest the
-        handler's return, runs the bus up to it), except in a run's last cycle (MCU-55: its end begins the run's
-        bounded wait, which must stop a handler that outlasts it); none while the master holds (MCU-55)."""
+        handler's return, runs the bus up to it); in a run's last cycle then the wait's bound after its start or
+        end (MCU-55: a handler that outlasts the run's bounded wait stops there at the latest); none while the master
+        holds (MCU-55: no bus event comes)."""
         core, bench = self.core, self._bench
         assert bench is not None  # transaction level
-        if bench.cycles + 1 < self._last and (
-                _EXTI0 in core.active or (_EXTI0 in core.pending and core.next_entry() == _EXTI0)):  # fmt: skip
-            return MAX_DEADLINE
         at = bench.next_change_s()
+        if _EXTI0 in core.active or (_EXTI0 in core.pending and core.next_entry() == _EXTI0):
+            if bench.cycles + 1 < self._last or at == math.inf:
+                return MAX_DEADLINE
+            at += self._wait_s
         return MAX_DEADLINE if at == math.inf else math.ceil(at * core.cpu_hz - NOISE_CYCLES)
 
     def _set_budget(self, max_instructions: int) -> None:

@@ -799,19 +799,23 @@ class Bench:
         if held is not None:
             self._next_start = self._next_at = resume_s(held[1], held[0], self.now, self.config.bit_rate)
 
-    def _run_to(self, target: int) -> None:
-        """Run until :attr:`cycles` reaches ``target``, then take the last cycle's interrupt."""
+    def _run_to(self, target: float, end: float = math.inf) -> None:
+        """Run until :attr:`cycles` reaches ``target``, or the clock ``end`` (:meth:`run_for`: a sleeping firmware
+        sleeps to it, a main loop's pass or a service routine may end past it); then take a pending interrupt (the
+        last cycle's, as the firmware would take it)."""
         self.power_up()
         loop = self._main_loop()
         idle_loops = 0
-        while self.cycles < target:
+        while self.cycles < target and self.now < end:
             if self._irq_fell_at is not None:
                 self.take_interrupt()
             if loop is not None:
                 idle_loops = self._pass(loop, idle_loops)
-                continue
-            self._step_bus()  # sleep until the bus does something
-        self.take_interrupt()  # the last cycle's interrupt, as the firmware would take it
+            elif self._next_event() > end:
+                self.advance(end)  # sleep to the end
+            else:
+                self._step_bus()  # sleep until the bus does something
+        self.take_interrupt()
 
     def _main_loop(self) -> Callable[[Supi3Driver], None] | None:
         """The firmware's :meth:`Firmware.loop` if it overrides it (a firmware without one sleeps)."""
@@ -871,8 +875,7 @@ class Bench:
             passes.handler()
 
     def run_for(self, seconds: float) -> None:
-        """Run until the clock has moved on by ``seconds`` (at least to the next bus event); unlike :meth:`run`, the
-        end does not wait for the main loop's pass (FW-14, as the emulated board's ``run_for``)."""
-        end = self.now + check_real("seconds", seconds, 0.0)
-        while self.now < end:
-            self._run_to(self.cycles + 1)
+        """Run until the clock has moved on by ``seconds``, the master going on (a cycle under way at the end stays
+        under way, as the emulated board's ``run_for`` at transaction level; FW-19: before, the bench ran on to the
+        end of a cycle); unlike :meth:`run`, the end does not wait for the main loop's pass (FW-14)."""
+        self._run_to(math.inf, self.now + check_real("seconds", seconds, 0.0))
