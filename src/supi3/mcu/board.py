@@ -357,7 +357,6 @@ class Board:
         self._telegram_s = wire.STATUS_TELEGRAM_BITS / bit_rate  # the line idles in whole telegrams (MCU-22, -30)
         self._wait = ServeWait(bit_rate)  # MCU-55: the run's end, at most SERVE_TELEGRAMS after its last cycle
         self._wait_s = serve_wait_s(bit_rate)
-        self._last: float = math.inf  # MCU-55: the cycle count a run(n) ends at (its master holds there)
         self._limits = {symbol: timing.limit("3-7", symbol, bit_rate) for symbol in ("t0", "t1", "t2", "t8")}
         self._limits["t6max"] = timing.limit("3-7", "t6", bit_rate, maximum=True)
         self._limits["t_SAS_INIT"] = timing.limit("3-7", "t_SAS_INIT", bit_rate)
@@ -826,14 +825,12 @@ class Board:
                 return
             bench = self.bench
             self._began = bench.now
-            self._last = target
             bench.hold_after(target)  # MCU-55: exactly the run's cycles, then the line idles while it waits
             self._run(lambda: bench.cycles >= target and self._serve_wait(), max_instructions)
         finally:
             self._passes.end()
             self._wait.end()
             self._serve_end = None
-            self._last = math.inf
             if self._bench is not None:
                 self._bench.resume()
 
@@ -872,19 +869,19 @@ class Board:
 
     def _bus_deadline(self) -> int:
         """The core cycle the run loop stops the core at for the bus: the next bus event that may change /IRQ or
-        /ModAck (MCU-31); none while EXTI0 is active or about to be entered at the step's start (MCU-44: an edge of
-        /IRQ then only sets EXTI's pending bit, and the firmware's next access, or the next stop, at the latest the
-        handler's return, runs the bus up to it); in a run's last cycle then the wait's bound after its start or
-        end (MCU-55: a handler that outlasts the run's bounded wait stops there at the latest); none while the master
-        holds (MCU-55: no bus event comes)."""
+        /ModAck (MCU-31); while EXTI0 is active or about to be entered at the step's start, :func:`serve_wait_s`
+        after it (MCU-44: an edge of /IRQ then only sets EXTI's pending bit, and the firmware's next access, or the
+        next stop, at the latest the handler's return, runs the bus up to it; MCU-55: a handler that makes no access
+        for that long, spinning, still lets the bus run on, and a run's wait ends at its bound); none while the
+        master holds at a run's end (MCU-55: no bus event comes)."""
         core, bench = self.core, self._bench
         assert bench is not None  # transaction level
         at = bench.next_change_s()
+        if at == math.inf:
+            return MAX_DEADLINE
         if _EXTI0 in core.active or (_EXTI0 in core.pending and core.next_entry() == _EXTI0):
-            if bench.cycles + 1 < self._last or at == math.inf:
-                return MAX_DEADLINE
             at += self._wait_s
-        return MAX_DEADLINE if at == math.inf else math.ceil(at * core.cpu_hz - NOISE_CYCLES)
+        return math.ceil(at * core.cpu_hz - NOISE_CYCLES)
 
     def _set_budget(self, max_instructions: int) -> None:
         self._budget = check_int("max_instructions", max_instructions, 1)
