@@ -811,6 +811,8 @@ class Bench:
                 self.take_interrupt()
             if loop is not None:
                 idle_loops = self._pass(loop, idle_loops)
+            elif self.cycles >= target or self.now >= end:
+                break  # the service routine ran the bus to the end
             elif self._next_event() > end:
                 self.advance(end)  # sleep to the end
             else:
