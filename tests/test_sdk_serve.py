@@ -376,14 +376,16 @@ HOLD_FIRMWARE: dict[str, Callable[[], Firmware]] = {
 @given(name=st.sampled_from(sorted(HOLD_FIRMWARE)), bit_rate=st.sampled_from([500_000, 2_000_000]),
        history=st.lists(st.tuples(st.sampled_from([0.0, 20e-6, 300e-6]), st.integers(0, 4)), min_size=1,
                         max_size=5))  # fmt: skip
-def test_the_bench_s_run_n_runs_exactly_n_cycles_then_waits_boundedly(name: str, bit_rate: int,
-                                                                     history: list[tuple[float, int]]) -> None:  # fmt: skip
+def test_the_bench_s_run_n_runs_exactly_n_cycles_then_waits_boundedly(
+    name: str, bit_rate: int, history: list[tuple[float, int]]
+) -> None:
     """FW-19 (MCU-55) on the firmware bench, back to back: ``run(n)`` runs exactly n master cycles (a cycle a
     ``run_for`` left under way is the run's first: run(0) follows no ``run_for`` here), the master holding while the
     firmware serves the last; a served run ends within SERVE_TELEGRAMS status telegrams of the last cycle's end; a
-    service routine longer than that (700 µs) that runs after the last cycle ends its run unserved; the next run's first cycle starts at the end of
-    the status telegram the line idled in. Before, the master went on during the last service routine and the
-    passes (run(1) of the slow routine ran 3 cycles at 500 kbit/s)."""
+    service routine longer than that (700 µs) that runs after the last cycle ends its run unserved; the next run's
+    first cycle starts at the end of the status telegram the line idled in. Before, the master went on during the
+    last service routine and the passes: the slow routine's run(3), run(1), run(2) from power-up ran 8, 4 and 6
+    cycles at 500 kbit/s, each "served"."""
     bench = Bench(firmware=HOLD_FIRMWARE[name](), bit_rate=bit_rate, strict=False)  # the slow one: latch-phase reads
     bench.run(3)
     wait_s = serve_wait_s(bit_rate)
@@ -399,9 +401,10 @@ def test_the_bench_s_run_n_runs_exactly_n_cycles_then_waits_boundedly(name: str,
             assert bench.served is (bench.now - last.end <= wait_s)
             assert bench.served or name == "slow"
         if cycles:  # the next cycle starts at the end of the status telegram the line idled in when the run ended
-            ended = bench.now
+            ended = bench.now  # (its first bit: the ring's time, within a bit after the bench's start)
             bench.run(1)
-            assert bench.timeline[-1].start == pytest.approx(telegram_end_s(last.end, ended, bit_rate), abs=1e-9)
+            late = bench.timeline[-1].start - telegram_end_s(last.end, ended, bit_rate)
+            assert -1e-12 <= late < 1 / bit_rate
 
 
 def test_the_serve_wait_and_the_resume_rule() -> None:
