@@ -623,9 +623,10 @@ class Board:
         """Transaction level, :meth:`run`'s master cycles done (the bench's master holds, MCU-55): whether the run is
         done. The first call is at the block boundary the core stopped at for the last cycle's end (the run loop
         stops at each bus event; while EXTI0's handler runs, at its return or at most the wait's bound after it,
-        MCU-44): the main loop's passes count from there; the run ends once the firmware has served the cycles (no exception active or pending, the pass
-        made) or at the latest :data:`~supi3.sdk.bench.SERVE_TELEGRAMS` status telegrams after the last cycle's end
-        (:class:`~supi3.sdk.bench.ServeWait`, a bound of the run loop's steps)."""
+        MCU-44): the main loop's passes count from there; the run ends once the firmware has served the cycles (no
+        exception active or pending, the pass made) or at the latest :data:`~supi3.sdk.bench.SERVE_TELEGRAMS` status
+        telegrams after the last cycle's end (:class:`~supi3.sdk.bench.ServeWait`, a bound of the run loop's
+        steps)."""
         core = self.core
         if self._serve_end is None:
             self._passes.begin(core.cycles)
