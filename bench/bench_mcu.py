@@ -11,7 +11,8 @@ the same process (the baseline: the C driver through cffi, bytes at their Table 
 Figures: simulated time / CPU time of the process (``time.process_time``: the machine is shared, wall time swings
 with its load; the issue's goal: >= 1x), emulated instructions per second, and two ratios measured in the same
 process: against the same binary with every poll and countdown loop iteration run (``skip_polls = False``: MCU-10
-and MCU-11 off) and against the host build. ``--profile`` also splits the CPU time of one run (cProfile, which
+and MCU-11 off), against it with every µP interface frame through Python (``native_frames=False``: MCU-51 off) and
+against the host build. ``--profile`` also splits the CPU time of one run (cProfile, which
 slows the calls it counts, so the split is a guide, not a measure) by part: unicorn's C code with the native block
 and memory hooks (MCU-25) and the ctypes transitions into the Python callbacks, a block's first costing, the rest of
 the core, the STM32 peripheral models, the board's bus synchronisation and checks, and the chip, ring and bench
@@ -53,11 +54,11 @@ def _cpu_s(run: Callable[[], None], repeat: int) -> float:
     return fastest
 
 
-def _board(elf: Path, bit_rate: int, skip: bool) -> Board:
+def _board(elf: Path, bit_rate: int, skip: bool, native_frames: bool = True) -> Board:
     """The board after power-up, the master's outputs and the firmware's inputs set, and the firmware's DWARF line
     tables read (a violation's backtrace reads them once, at the first; whether that falls in the power-up depends
     on the run, so it is done here, outside every measured window)."""
-    board = Board(elf, bit_rate=bit_rate, strict=False)
+    board = Board(elf, bit_rate=bit_rate, strict=False, native_frames=native_frames)
     board.core.skip_polls = skip
     board.run(POWER_UP_CYCLES)
     board.bench.master.set_outputs(1, b"\x12\x34")
@@ -67,14 +68,14 @@ def _board(elf: Path, bit_rate: int, skip: bool) -> Board:
     return board
 
 
-def binary_run(elf: Path, bit_rate: int, cycles: int, repeat: int, skip: bool = True
+def binary_run(elf: Path, bit_rate: int, cycles: int, repeat: int, skip: bool = True, native_frames: bool = True
                ) -> tuple[float, float, int, int, int]:  # fmt: skip
     """CPU seconds for ``cycles`` master cycles of ``elf`` after power-up (the fastest of ``repeat``), simulated
-    seconds, instructions, interrupts, violations; ``skip``: MCU-10 and MCU-11 on."""
+    seconds, instructions, interrupts, violations; ``skip``: MCU-10 and MCU-11 on; ``native_frames``: MCU-51 on."""
     outcome = (0.0, 0, 0, 0)
     fastest = float("inf")
     for _ in range(repeat):
-        board = _board(elf, bit_rate, skip)
+        board = _board(elf, bit_rate, skip, native_frames)
         start_s, start_i = board.bench.now, board.core.instructions
         fastest = min(fastest, _cpu_s(partial(board.run, cycles), 1))
         outcome = (board.bench.now - start_s, board.core.instructions - start_i, board.interrupts,
@@ -90,6 +91,7 @@ PARTS: tuple[tuple[str, str, frozenset[str] | None], ...] = (
     ("core: the rest (run loop, access times, exceptions, registers)", "mcu/core.py", None),
     ("stm32: peripheral models", "mcu/stm32.py", None),
     ("board: bus synchronisation, pins, Table 3-7 checks", "mcu/board.py", None),
+    ("board: the native frames' mirror and catch-up (MCU-51)", "mcu/frames.py", None),
     ("chip, ring and bench models (supi3 outside mcu)", "/supi3/", None),
     ("Python builtins and the rest", "", None),
 )
@@ -145,6 +147,8 @@ def main(argv: list[str] | None = None) -> None:
             cpu, simulated, instructions, interrupts, violations = binary_run(elf, bit_rate, args.cycles,
                                                                               args.repeat)  # fmt: skip
             slow_cpu, slow_simulated = binary_run(elf, bit_rate, args.cycles, args.repeat, skip=False)[:2]
+            python_cpu, python_simulated = binary_run(elf, bit_rate, args.cycles, args.repeat,
+                                                      native_frames=False)[:2]  # fmt: skip
             host_cpu, host_simulated = host_run(bit_rate, args.cycles, args.repeat)
             speed = simulated / cpu
             print(
@@ -152,8 +156,9 @@ def main(argv: list[str] | None = None) -> None:
                 f"{simulated * 1e3:.2f} ms simulated in {cpu:.3f} CPU s = {speed:.3f}x real time; "
                 f"{instructions / cpu / 1e6:.2f} M instructions/s; {interrupts} interrupts, {violations} "
                 f"violations; {speed / (slow_simulated / slow_cpu):.2f}x the speed with every loop iteration "
-                f"run; the host build on the bench {host_simulated / host_cpu:.2f}x real time (binary / host "
-                f"{speed / (host_simulated / host_cpu):.3f})"
+                f"run; {speed / (python_simulated / python_cpu):.2f}x the speed with every frame in Python "
+                f"(native_frames=False, MCU-51); the host build on the bench {host_simulated / host_cpu:.2f}x real "
+                f"time (binary / host {speed / (host_simulated / host_cpu):.3f})"
             )
             if args.profile:
                 for part, share in profile_split(elf, bit_rate, args.cycles):

@@ -1,7 +1,8 @@
 """cocotb tests: the Python driver and example firmware (supi3.sdk) on the RTL chip.
 
 Ref: guide docs/sdk-firmware-python.md, "The RTL back end"; 3.4.3 to 3.4.5, 3.4.14. ``async_driver_registers``
-drives the chip with the async driver straight from a coroutine. ``example_on_rtl`` runs an example firmware with an
+drives the chip with the async driver straight from a coroutine; ``bench_called_twice`` calls one ``RtlBench`` twice
+(FW-23). ``example_on_rtl`` runs an example firmware with an
 INTERBUS master on the chip's line: the job (JSON, path in ``SUPI3_SDK_RTL_JOB``) is a list of cases, each naming
 the example, the interface mode, the bit rate, the cycle time, whether the I/O pin is wired and a process data
 history (or, for the management channel, the processor commands); one simulation runs them all, one parametrized
@@ -26,7 +27,7 @@ from supi3.sdk.bench import default_config
 from supi3.sdk.driver import AsyncSupi3Driver, Irq, Mode, NotResetError
 from supi3.sdk.examples.digital import DIO_ID, ONE_WORD_IO
 from supi3.sdk.examples.management import ask
-from supi3.sdk.rtl import RtlBench, RtlBoard, RtlTransport
+from supi3.sdk.rtl import RtlBench, RtlBoard, RtlBoardError, RtlTransport
 
 JOB_ENV = "SUPI3_SDK_RTL_JOB"
 MODE_ENV = "SUPI3_SDK_RTL_MODE"
@@ -94,3 +95,30 @@ async def async_driver_registers(dut: Any) -> None:
     await drv.sas_init()
     await drv.initialize(mode)
     assert (await drv.read(SET), await drv.read(ID)) == (ONE_WORD_IO, DIO_ID)  # SAS_INIT keeps the registers
+
+
+@cocotb.test()
+async def bench_called_twice(dut: Any) -> None:
+    """FW-23: one ``RtlBench`` called twice: the firmware's setup at the first call only (a second initialization
+    byte would be taken as a command, UP-3: ``NotResetError``), the firmware served in both; the board refuses a
+    second start; the status pins read as levels (UP-24)."""
+    board = RtlBoard(dut, default_config(2_000_000))
+    await board.start()
+    device = examples.DigitalIo(Mode.MOTOROLA)
+    bench = RtlBench(board, device, cycle_time_s=0.25e-3)
+
+    def first() -> list[tuple[int, int]]:
+        bench.run(START_CYCLES)
+        return examples.play(bench, device, [(0x1234, 0xBEEF)])
+
+    assert await bench.call(first) == [(0x1234, 0xBEEF)]
+    assert await bench.call(lambda: examples.play(bench, device, [(0x8001, 0x7FFE)])) == [(0x8001, 0x7FFE)]
+    try:
+        await board.start()
+    except RtlBoardError:
+        pass
+    else:
+        raise AssertionError("a second start must be refused")
+    transport = bench.transport
+    assert (await transport.read_cd(), await transport.read_irq(), await transport.read_io()) in {
+        (0, level, io) for level in (0, 1) for io in (0, 1)}

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 import pytest
 from hypothesis import settings
 
-from support import VerilatorBuild, verilator_missing
+from support import SDK_CHIP_TOP, VerilatorBuild, verilator_missing
 
 if TYPE_CHECKING:
     from supi3.verif import Lockstep
@@ -60,6 +60,25 @@ def verilator_build(tmp_path_factory: pytest.TempPathFactory) -> VerilatorBuild:
     if reason is not None:
         pytest.skip(reason)
     return tmp_path_factory.mktemp
+
+
+@pytest.fixture(scope="session")
+def chip_build(verilator_build: VerilatorBuild) -> Path:
+    """The Verilator build of the RTL chip (top ``supi3_chip``) for the SDK's cocotb tests (sim/sdk_rtl.py): one per
+    session for tests/test_sdk_rtl.py and tests/test_sdk_hostile_rtl.py."""
+    from cocotb_tools.runner import get_runner
+
+    from supi3.rtl.chip import verilog
+    from supi3.verif.rtl import ensure_toolchain
+
+    ensure_toolchain("verilator")
+    build = verilator_build("sdk_rtl")
+    source = build / f"{SDK_CHIP_TOP}.v"
+    source.write_text(verilog(), encoding="utf-8")
+    get_runner("verilator").build(sources=[source], hdl_toplevel=SDK_CHIP_TOP, build_dir=build,
+                                  build_args=["-Wno-fatal"], timescale=("1ns", "1ps"),
+                                  log_file=build / "build.log")  # fmt: skip
+    return build
 
 
 @pytest.fixture(scope="session")

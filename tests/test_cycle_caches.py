@@ -1,11 +1,15 @@
-"""The master cycle's caches of issue #13's round 9 (docs/firmware-in-the-loop.md, Figures), held to the values they
-stand for over histories of changes:
+"""The master cycle's caches and shortcuts of issue #13's rounds 9 and 10 (docs/firmware-in-the-loop.md, Figures),
+held to the values they stand for over histories of changes:
 
 - ``Supi3._data_path``: a µP-mode chip's data path (the expansion or the internal registers) and data length, worked
   out again only when its register file took a configuration (``RegisterFile.configurations``: SET applied or
   dropped), against the same chip with the cache bypassed;
 - the bench's cycle offsets: a cycle's end, latch phase and I/O access bit from its start, kept per cycle size, against
-  the cycle's :class:`~supi3.sdk.bench.CycleTiming`.
+  the cycle's :class:`~supi3.sdk.bench.CycleTiming`;
+- the ring's run layout (A28): a data cycle's run of devices, its groups for the data kernels and the kernel of a run
+  of one class, worked out again only when the run holds other devices, against a ring that works it out every cycle;
+- the bench's watch of /IRQ (FW-18): after a byte only while /IRQ is low, and no phase set in a sleeping firmware's
+  batch, against a bench that watches after every byte.
 """
 
 from __future__ import annotations
@@ -15,15 +19,19 @@ from typing import Any
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from supi3.config import decode
+from supi3 import tables
+from supi3.config import MfpKind, decode
 from supi3.interbus import wire
 from supi3.interbus.device import PlainDevice
+from supi3.interbus.link import DataKernel, Device
 from supi3.interbus.master import Master
-from supi3.interbus.ring import Ring
+from supi3.interbus.ring import Ring, _Groups
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
-from supi3.regmap import ID, IN0, SET
-from supi3.sdk.bench import Bench, CycleTiming
+from supi3.regmap import ID, IN0, OUT0, SET
+from supi3.sdk.bench import Bench, BenchTransport, CycleTiming, Firmware
+from supi3.sdk.driver import Irq, Mode, Supi3Driver
+from supi3.sdk.examples.digital import DIO_ID, ONE_WORD_IO
 from support import RB_INIT_UP
 
 Op = tuple[str, int]
@@ -136,3 +144,200 @@ def test_the_bench_s_cycle_offsets_agree_with_each_cycle_s_timing(ops: list[Op])
         else:
             bench.registers.cpu_write((SET if kind == "set" else ID).address, value)
     assert len(seen) == bench.cycles + (1 if bench._events else 0)
+
+
+# -- the ring's run layout (A28) ---------------------------------------------------------------------------------
+
+BINARY = next(decode(r.c, r.mfp) for r in tables.MODE_ROWS if decode(r.c, r.mfp).mfp_mode.kind is MfpKind.BINARY_IO)
+
+
+class _NoKernel(PlainDevice):
+    """A plain device whose class offers no kernel: its run is loaded and latched device by device."""
+
+    data_kernel = None
+
+
+class _EveryCycle(Ring):
+    """A ring that works out its run layout at every data cycle (the cache emptied first)."""
+
+    def _load_run(self, cycle: Cycle, run: list[Device], now: float) \
+            -> tuple[list[bytes], bool, _Groups | None, DataKernel | None]:  # fmt: skip
+        self._layout = ([], [], None)
+        return super()._load_run(cycle, run, now)
+
+
+def _made(kind: int, k: int) -> Device:
+    """A fresh device of ``kind``: a binary-I/O chip, a µP-mode chip, a plain device, one without a kernel."""
+    if kind == 0:
+        chip = Supi3(BINARY)
+        chip.set_mfp_inputs((k * 0x1357) & 0xFFFF)
+        return chip
+    if kind == 1:
+        return Supi3(decode(*RB_INIT_UP), strict=False)
+    return (PlainDevice if kind == 2 else _NoKernel)(0x03, 0b01001)
+
+
+def _device_state(device: Device) -> object:
+    if isinstance(device, Supi3):
+        registers = None if device.registers is None else dict(device.registers._values)
+        return type(device), dict(device.events), device._out, device.pf, device.te, device.wd, registers
+    state = dict(vars(device))
+    state["watchdog"] = vars(state["watchdog"])
+    return type(device), state
+
+
+def _ring_step(ring: Ring, master: Master, op: tuple[str, int, int]) -> object:
+    kind, k, value = op
+    devices = ring.devices
+    k %= len(devices)
+    try:
+        if kind == "swap":  # the ring's list edited in place: another device, maybe of another class
+            devices[k] = _made(value % 4, k)
+        elif kind == "turn":
+            devices.reverse()
+        elif kind == "cut":
+            ring.cut(k + 1, True)
+        elif kind == "flip":
+            ring.bit_error(k + 1, value, 2)
+        elif kind == "repair":
+            ring.clear_faults()
+        elif kind == "power":
+            if isinstance(devices[k], Supi3):
+                ring.power_up(k + 1)
+        elif kind == "stop":
+            master.alarm_stop()
+        else:
+            result = master.cycle()
+            return result.cycle, result.ok, [d.kind for d in result.diagnostics], master._in
+    except Exception as error:  # both rings must raise the same
+        return type(error).__name__, str(error)
+    return None
+
+
+RING_OPS = st.lists(st.tuples(
+    st.sampled_from(["cycle"] * 6 + ["swap", "swap", "turn", "cut", "flip", "repair", "power", "stop"]),
+    st.integers(0, 7), st.integers(0, 200)), max_size=40)  # fmt: skip
+
+
+@settings(derandomize=True, max_examples=40, deadline=None)
+@given(st.lists(st.integers(0, 3), min_size=1, max_size=5), RING_OPS)
+def test_the_rings_run_layout_agrees_with_one_worked_out_every_cycle(kinds: list[int],
+                                                                   ops: list[tuple[str, int, int]]) -> None:
+    """Two rings of the same devices (binary-I/O and µP-mode chips, plain devices, devices without a kernel), one
+    keeping its run layout (A28: the groups and the one kernel of the last run, keyed on the run's devices), one
+    working it out at every data cycle, take the same history of master cycles, devices swapped in place in the ring's
+    list (of the same class or another), the list turned round, cuts, bit errors, repairs, power-ups and Alarm Stops:
+    after every step both show the same outcome, IN data and device states."""
+    sides = []
+    for ring_class in (Ring, _EveryCycle):
+        ring = ring_class([_made(kind, k) for k, kind in enumerate(kinds)], bit_rate=2_000_000)
+        master = Master(ring)
+        master.start()
+        sides.append((ring, master))
+    for op in ops:
+        outcomes = [_ring_step(ring, master, op) for ring, master in sides]
+        assert outcomes[0] == outcomes[1]
+        assert [_device_state(d) for d in sides[0][0].devices] == [_device_state(d) for d in sides[1][0].devices]
+        assert sides[0][0].now == sides[1][0].now
+
+
+# -- the bench's watch of /IRQ (FW-18) ---------------------------------------------------------------------------
+
+
+class _WatchEveryByte(BenchTransport):
+    """The bench's transport as before FW-18: /IRQ watched after every byte (a second watch changes nothing)."""
+
+    def xfer(self, tx: int, s_r: bool) -> int:
+        driven = super().xfer(tx, s_r)
+        self.bench.irq_edge()
+        return driven
+
+
+class _Service(Firmware):
+    """An interrupt-driven firmware (it sleeps between its service routines) that reads and clears the events, moves
+    data and, as its plan says, waits, enables other sources or drives /StatErr."""
+
+    def __init__(self, plan: list[int]) -> None:
+        self.plan = plan
+        self.seen: list[tuple[int, int, float]] = []
+        self.phases: list[bool] = []
+        """At each entry: the I/O access bit and latch phase are what the last cycle's timing gives now."""
+
+    def setup(self, drv: Supi3Driver) -> None:
+        drv.initialize(Mode.MOTOROLA)
+        drv.configure(ONE_WORD_IO, DIO_ID)
+        drv.irq_enable(Irq.VALID | Irq.ID_CYCLE | Irq.IB_RESET)
+
+    def isr(self, drv: Supi3Driver) -> None:
+        step = self.plan[len(self.seen) % len(self.plan)] if self.plan else 0
+        transport = drv.transport
+        assert isinstance(transport, BenchTransport)
+        bench = transport.bench
+        last = bench.timeline[-1]
+        data = last.cycle is Cycle.DATA
+        now = bench.now
+        self.phases.append((bench.registers.io_access, bench.registers.latch_phase)
+                           == (data and last.io_busy <= now < last.end, data and last.latch <= now < last.end))
+        events = drv.irq_service()
+        out = drv.read(OUT0)
+        drv.write(IN0, out ^ step)
+        if step % 5 == 1:
+            transport.delay_us(step)
+        if step % 7 == 2:
+            drv.irq_enable(Irq(step & 0x7F))
+        if step % 11 == 3:
+            transport.bench.set_stat_err(bool(step & 8))
+        self.seen.append((int(events), out, transport.bench.now))
+
+
+@settings(derandomize=True, max_examples=20, deadline=None)
+@given(st.lists(st.integers(0, 255), max_size=12),
+       st.lists(st.tuples(st.sampled_from(["run", "run", "run", "outputs", "cut", "repair", "stop", "power",
+                                           "watchdog"]), st.integers(1, 6)), max_size=12))  # fmt: skip
+def test_the_bench_s_watch_of_irq_agrees_with_one_after_every_byte(plan: list[int], ops: list[tuple[str, int]]) \
+        -> None:  # fmt: skip
+    """Two benches, one watching /IRQ after a byte only while it is low and setting no phase in a sleeping firmware's
+    batch (FW-18), one watching after every byte, run the same interrupt-driven firmware (its service routine reads
+    and clears the events, moves data, waits, writes IRQ_EN and drives /StatErr as its plan says) through the same
+    history of runs, new OUT data, cuts, repairs, Alarm Stops, power-ups and watchdog settings: after every step both
+    took the same interrupts with the same latency and saw the same, at the same times."""
+    sides = []
+    for transport in (BenchTransport, _WatchEveryByte):
+        firmware = _Service(plan)
+        bench = Bench(firmware=firmware, bit_rate=2_000_000, strict=False)
+        bench.transport.__class__ = transport
+        sides.append((bench, firmware))
+
+    def step(bench: Bench, op: tuple[str, int]) -> object:
+        kind, value = op
+        try:
+            if kind == "run":
+                bench.run(value)
+            elif kind == "outputs" and bench.master.config:
+                bench.master.set_outputs(1, bytes([value * 37 & 0xFF]))
+            elif kind == "cut":
+                bench.ring.cut(2 if value % 2 else 1, True)
+            elif kind == "repair":
+                bench.ring.clear_faults()
+            elif kind == "stop":
+                bench.master.alarm_stop()
+            elif kind == "power":
+                bench.ring.power_up(1)
+            elif kind == "watchdog" and bench.master.config:
+                bench.master.set_watchdog(0.05)
+        except Exception as error:  # both benches must raise the same
+            return type(error).__name__, str(error)
+        return None
+
+    for op in ops:
+        outcomes = [step(bench, op) for bench, _ in sides]
+        assert outcomes[0] == outcomes[1]
+        (one, fw_one), (two, fw_two) = sides
+        assert (one.interrupts, one.irq_latency_s, one.now, one.cycles, fw_one.seen, list(one.timeline),
+                dict(one.registers._values), one.registers.io_access, one.registers.latch_phase) == \
+               (two.interrupts, two.irq_latency_s, two.now, two.cycles, fw_two.seen, list(two.timeline),
+                dict(two.registers._values), two.registers.io_access, two.registers.latch_phase)  # fmt: skip
+        assert [(type(v), str(v)) for v in one.registers.violations.records] == \
+               [(type(v), str(v)) for v in two.registers.violations.records]  # fmt: skip
+    assert sides[0][0].interrupts >= min(sides[0][0].cycles, 1)  # the routine ran (a history of no runs: none)
+    assert all(sides[0][1].phases)

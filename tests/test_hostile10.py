@@ -31,6 +31,7 @@ from supi3.sdk.driver import (
     AsyncSupi3Driver,
     AsyncTransport,
     DriverError,
+    ErrorCode,
     IoWindowTimeoutError,
     Mode,
     Supi3Driver,
@@ -44,13 +45,21 @@ lib = test_sdk_c_model.lib
 """The fixture: the C driver built strictly, loaded with ctypes (with ``supi3_config_t`` and ``supi3_optical_t``, as
 tests/test_sdk_c_model.py has them)."""
 
+NULL, WIRED, SAYS_UNWIRED = 0, 1, 2
+"""How a board has each pin (C/D, /IRQ, I/O, SAS_INIT): no callback (``False`` too), wired (``True`` too), or a
+callback that says the board does not wire it (FW-21: C returns ``SUPI3_E_UNSUPPORTED``; Python's transport returns
+``None`` or ``False``, as for no pin)."""
+Wired = tuple[int, int, int, int]
+
+
 class Scripted(Transport):
     """A board whose chip answers from a script: received bytes and pin levels cycle through their lists; the
     ``fail``-th callback (counted over all of them) raises ``OSError``. Every callback is logged."""
 
-    def __init__(self, rx: list[int], levels: list[int], fail: frozenset[int], wired: tuple[bool, bool, bool, bool]):
+    def __init__(self, rx: list[int], levels: list[int], fail: frozenset[int], wired: Wired):
         self.rx, self.levels, self.fail = rx, levels, fail
-        self.cd_wired, self.irq_wired, self.io_wired, self.sas_wired = wired
+        self.wired = wired
+        self.cd_wired, self.irq_wired, self.io_wired, self.sas_wired = (pin == WIRED for pin in wired)
         self.log: list[tuple[object, ...]] = []
         self._rx = self._level = 0
 
@@ -111,15 +120,19 @@ class CDriver:
                 store[0] = value
             return 0
 
+        def pin(kind: Any, how: int, callback: Callable[..., int]) -> Any:
+            """A wired pin's callback, NULL, or one that says "not wired" (FW-21)."""
+            return kind(callback) if how == WIRED else kind(lambda *_: UNSUPPORTED) if how == SAYS_UNWIRED else kind()
+
+        cd, irq, io, sas = board.wired
         self._callbacks = (
             XFER(lambda _u, tx, rx, s_r: guard(lambda: board.xfer(tx, bool(s_r)), rx)),
             DELAY(lambda _u, us: board.delay_us(us)),
-            READ_PIN(lambda _u, level: guard(board.read_irq, level)) if board.irq_wired else READ_PIN(),
-            READ_PIN(lambda _u, level: guard(board.read_cd, level)) if board.cd_wired else READ_PIN(),
-            WRITE_PIN(lambda _u, level: guard(lambda: board.set_sas_init(level) and None)) if board.sas_wired
-            else WRITE_PIN(),
+            pin(READ_PIN, irq, lambda _u, level: guard(board.read_irq, level)),
+            pin(READ_PIN, cd, lambda _u, level: guard(board.read_cd, level)),
+            pin(WRITE_PIN, sas, lambda _u, level: guard(lambda: board.set_sas_init(level) and None)),
         )  # fmt: skip
-        self._io = READ_PIN(lambda _u, level: guard(board.read_io, level)) if board.io_wired else READ_PIN()
+        self._io = pin(READ_PIN, io, lambda _u, level: guard(board.read_io, level))
         self.cfg = Config(*self._callbacks, None, frame_gap_us, self._io)
         self.ctx = ctypes.create_string_buffer(256)
         assert lib.supi3_init(self.ctx, ctypes.byref(self.cfg)) == 0
@@ -151,7 +164,7 @@ class CDriver:
             return lib.supi3_configure(ctx, u8(op[1]), u8(op[2])), None
         if name == "irq_service":
             rc = lib.supi3_irq_service(ctx, ctypes.byref(value))
-            return rc, value.value if rc == 0 else None
+            return rc, value.value if rc in (0, -7) else None
         if name == "irq_enable":
             return lib.supi3_irq_enable(ctx, u8(op[1])), None
         if name == "poll":
@@ -251,6 +264,9 @@ READABLE = [a for a in range(15) if REGISTER_MAP.port(a, AccessDirection.READ).r
 WRITABLE = [a for a in range(15) if REGISTER_MAP.port(a, AccessDirection.WRITE).register is not None]
 BOTH = sorted(set(READABLE) & set(WRITABLE))
 BYTE = st.integers(0, 255)
+WIRINGS = (NULL, WIRED, SAYS_UNWIRED)
+UNSUPPORTED = int(ErrorCode.E_UNSUPPORTED)
+"""``SUPI3_E_UNSUPPORTED``: what a C pin callback returns to say the board does not wire the pin (FW-21)."""
 OPS = st.one_of(
     st.tuples(st.just("initialize"), st.sampled_from([*Mode, "intel"])),  # a mode that is none: SUPI3_E_ARG
     st.tuples(st.just("sas_init")),
@@ -269,7 +285,7 @@ OPS = st.one_of(
 
 
 def _parity(lib: ctypes.CDLL, rx: list[int], levels: list[int], fail: frozenset[int],
-            wired: tuple[bool, bool, bool, bool], ops: list[tuple[Any, ...]], gap: int = 0) -> None:  # fmt: skip
+            wired: Wired, ops: list[tuple[Any, ...]], gap: int = 0) -> None:  # fmt: skip
     py_board, async_board, c_board = (Scripted(rx, levels, fail, wired) for _ in range(3))
     drivers = (Supi3Driver(py_board, frame_gap_us=gap),
                Awaited(AsyncSupi3Driver(AsyncScripted(async_board), frame_gap_us=gap)))  # fmt: skip
@@ -287,18 +303,20 @@ def _parity(lib: ctypes.CDLL, rx: list[int], levels: list[int], fail: frozenset[
 
 @settings(max_examples=300)
 @given(rx=st.lists(BYTE, min_size=1, max_size=6), levels=st.lists(st.integers(0, 1), min_size=1, max_size=6),
-       fail=st.frozensets(st.integers(0, 40), max_size=3), wired=st.tuples(*[st.booleans()] * 4),
+       fail=st.frozensets(st.integers(0, 40), max_size=3), wired=st.tuples(*[st.sampled_from(WIRINGS)] * 4),
        ops=st.lists(OPS, max_size=14), gap=st.sampled_from([0, 3]))  # fmt: skip
 def test_c_and_python_drivers_agree_on_any_history(lib: ctypes.CDLL, rx: list[int], levels: list[int],
-                                                   fail: frozenset[int], wired: tuple[bool, bool, bool, bool],
+                                                   fail: frozenset[int], wired: Wired,
                                                    ops: list[tuple[Any, ...]], gap: int) -> None:  # fmt: skip
     """FW-16: every call of any history, on any scripted board, gives the same code, value, frames and pin reads
-    in the C driver, the Python driver and the async Python driver, with and without a frame gap."""
+    in the C driver, the Python driver and the async Python driver, with and without a frame gap; each pin wired,
+    without a callback, or with one that says "not wired" (FW-21), /IRQ staying low over IRQ_EVT reads (FW-22)."""
     _parity(lib, rx, levels, fail, wired, ops, gap)
 
 
 M = Mode.MOTOROLA
-CASES: dict[str, tuple[list[int], list[int], frozenset[int], tuple[bool, bool, bool, bool], list[tuple[Any, ...]]]] = {
+U = SAYS_UNWIRED
+CASES: dict[str, tuple[list[int], list[int], frozenset[int], Wired, list[tuple[Any, ...]]]] = {
     # sas_init without the pin is refused (SUPI3_E_UNSUPPORTED) and leaves the driver initialized
     "refused sas_init keeps the mode": ([0], [0], frozenset(), (False,) * 4, [("initialize", M), ("sas_init",),
                                                                               ("read", 0)]),
@@ -319,6 +337,18 @@ CASES: dict[str, tuple[list[int], list[int], frozenset[int], tuple[bool, bool, b
     "bad mode": ([0], [0], frozenset(), (False,) * 4, [("initialize", M), ("initialize", "intel"), ("read", 0)]),
     # irq_service returns the byte read, D7 (the I/O access status, RM-7, RM-8) too, in both
     "irq_service with D7 set": ([0xC4], [0], frozenset(), (False,) * 4, [("initialize", M), ("irq_service",)]),
+    # FW-21: a SAS_INIT callback that says "not wired" is SUPI3_E_UNSUPPORTED, the mode kept (was SUPI3_E_TRANSPORT
+    # and the mode lost in C), as the Python driver's UnsupportedError
+    "sas_init callback says not wired": ([0], [0], frozenset(), (0, 0, 0, U), [("initialize", M), ("sas_init",),
+                                                                             ("read", 0)]),
+    # FW-21: pin callbacks that say "not wired" work as NULL ones (the C driver used to report a transport error)
+    "C/D callback says not wired": ([0], [0], frozenset(), (U, 0, 0, 0), [("initialize", M), ("read", 0)]),
+    "/IRQ callback says not wired": ([0x90], [0], frozenset(), (0, U, 0, 0), [("initialize", M), ("irq_service",)]),
+    "I/O callback says not wired": ([0x00], [0], frozenset(), (0, 0, U, 0), [("initialize", M), ("poll", 2)]),
+    # FW-22: /IRQ low after the read (an event came during it): read again until high; stuck low: SUPI3_E_TIMEOUT
+    "event during the IRQ_EVT read": ([0x10, 0x40], [0, 0, 1], frozenset(), (0, 1, 0, 0),
+                                      [("initialize", M), ("irq_service",), ("read", 0)]),
+    "/IRQ stuck low": ([0x10], [0], frozenset(), (0, 1, 0, 0), [("initialize", M), ("irq_service",), ("read", 0)]),
 }
 
 

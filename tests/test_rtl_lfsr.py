@@ -119,7 +119,7 @@ def test_next_state_in_gates_is_step(seed: int) -> None:
 
 @pytest.mark.parametrize("most", [-1, (1 << max(TAPS)) - 1])
 def test_count_width_rejects_a_count_out_of_range(most: int) -> None:
-    with pytest.raises(ValueError, match="most must be from 0"):
+    with pytest.raises(ValueError, match="most must be an integer from 0"):
         count_width(most)
 
 

@@ -40,6 +40,7 @@ from supi3.regmap import (
     decode_set,
     encode_command,
 )
+from supi3.sdk.driver import IRQ_SERVICE_MAX_READS
 
 HARNESS = Path(__file__).parent / "c" / "fuzz_driver.c"
 SANITIZE = ["-fsanitize=address,undefined", "-fno-omit-frame-pointer", "-fno-sanitize-recover=all"]
@@ -255,13 +256,23 @@ class Reference:
             rc = E_ARG
         if rc != OK:
             return rc, None
-        if self.case.with_irq:
-            try:
-                if self.pin(2):
-                    return OK, 0  # /IRQ high: nothing sent
-            except TransportError:
-                return E_TRANSPORT, None
-        return self.read(IRQ_EVT.address)
+        events = 0  # written whatever the result: the events read, and so cleared (FW-22)
+        for reads in range(IRQ_SERVICE_MAX_READS + 1):
+            if self.case.with_irq:
+                try:
+                    if self.pin(2):
+                        return OK, events  # /IRQ high: nothing (left) pending
+                except TransportError:
+                    return E_TRANSPORT, events
+            if reads == IRQ_SERVICE_MAX_READS:
+                break
+            rc, value = self.read(IRQ_EVT.address)
+            if rc != OK or value is None:
+                return rc, events
+            events = (events & ~IRQ_EVT.field("IO_ACCESS").mask) | value  # D6..D0 OR-ed, D7 of the last read
+            if not self.case.with_irq:
+                return OK, events  # without /IRQ: one read
+        return E_TIMEOUT, events  # /IRQ stayed low
 
     def poll(self, max_polls: int, null: bool) -> tuple[int, int | None]:
         rc = self.entry_ok(max_polls != 0)

@@ -23,11 +23,11 @@ from supi3.sdk.examples.analog import AIO_ID
 from supi3.sdk.examples.digital import DIO_ID
 from supi3.sdk.examples.management import STATUS_REQUEST, ask
 from supi3.tables import BIT_RATES
-from support import VerilatorBuild
+from support import SDK_CHIP_TOP
 
 Example = AnalogIo | DigitalIo | InterruptDriven | ManagementChannel | PollingIo
 SIM_DIR = Path(__file__).resolve().parents[1] / "sim"
-TOP = "supi3_chip"
+TOP = SDK_CHIP_TOP
 CYCLE_TIME_S = 1e-3
 """A master cycle every millisecond on both benches: the firmware's service routine ends between two cycles."""
 START_CYCLES = 4
@@ -37,23 +37,6 @@ FAST_CYCLE_TIME_S = 0.25e-3
 HISTORY = [(0x1234, 0xBEEF), (0xFFFF, 0x0001), (0x8001, 0x7FFE), (0x0000, 0xA55A)]
 COMMANDS = [STATUS_REQUEST, 0x3C]
 LONG_HISTORY = [(0x1234_5678, 0xDEAD_BEEF), (0xFFFF_FFFF, 0x0000_0001), (0x8000_0001, 0x7FFF_FFFE)]
-
-
-@pytest.fixture(scope="session")
-def chip_build(verilator_build: VerilatorBuild) -> Path:
-    """The Verilator build of the RTL chip for cocotb."""
-    from cocotb_tools.runner import get_runner
-
-    from supi3.rtl.chip import verilog
-    from supi3.verif.rtl import ensure_toolchain
-
-    ensure_toolchain("verilator")
-    build = verilator_build("sdk_rtl")
-    source = build / f"{TOP}.v"
-    source.write_text(verilog(), encoding="utf-8")
-    get_runner("verilator").build(sources=[source], hdl_toplevel=TOP, build_dir=build, build_args=["-Wno-fatal"],
-                                  timescale=("1ns", "1ps"), log_file=build / "build.log")  # fmt: skip
-    return build
 
 
 def simulate(build: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, testcase: str, tests: int = 1,

@@ -18,7 +18,7 @@ from enum import StrEnum
 from functools import cache
 
 from supi3 import tables
-from supi3.checks import describe
+from supi3.checks import check_instance, describe, fail
 from supi3.errors import ConfigurationError
 from supi3.tables import PinDirection, PinFunction
 
@@ -217,10 +217,18 @@ _FUNCTION = re.compile(
 
 
 def parse_function(function: str) -> tuple[Interface, MfpMode]:
-    """Split a mode table's function text ("LBD-OR, SPI 16 IN/16 OUT") into interface and MFP mode."""
-    m = _FUNCTION.match(function)
+    """Split a mode table's function text ("LBD-OR, SPI 16 IN/16 OUT") into interface and MFP mode.
+
+    Raises
+    ------
+    ArgumentError
+        ``function`` not a str, or not a function text of Tables 2-4 to 2-7 (an ``ArgumentError`` is a
+        ``ValueError``).
+    """
+    m = _FUNCTION.match(function) if isinstance(function, str) else None
     if m is None:
-        raise ValueError(f"unrecognised mode-table function text {function!r}")
+        raise fail("function", "a mode table's function text such as 'LBD-OR, SPI 16 IN/16 OUT'", function,
+                   "Tables 2-4 to 2-7")
     interface = Interface(m["iface"])
     if m["up"]:
         return interface, MfpMode(MfpKind.INIT_UP, DataDirection.NONE, 0)
@@ -422,15 +430,41 @@ def decode(
 
 
 def decode_straps(straps: Straps) -> DeviceConfig:
-    """:func:`decode` applied to a :class:`Straps` record."""
+    """:func:`decode` applied to a :class:`Straps` record.
+
+    Raises
+    ------
+    ArgumentError
+        ``straps`` not a :class:`Straps`.
+    """
+    check_instance("straps", straps, Straps)
     return decode(straps.c, straps.mfp, straps.rf, straps.clk_conf, straps.diag_conf, straps.variant)
 
 
 def mode_rows(variant: Variant | str = Variant.OPC, interface: Interface | str | None = None
               ) -> Iterator[tables.ModeRow]:
-    """The mode-table rows available on a variant, optionally for one interface, in manual order."""
-    variant = Variant(variant)
-    wanted = Interface(interface) if interface is not None else None
+    """The mode-table rows available on a variant, optionally for one interface, in manual order.
+
+    Raises
+    ------
+    ArgumentError
+        ``variant`` not a :class:`Variant` or its value, ``interface`` neither ``None`` nor an :class:`Interface` or its
+        value; raised by the call, not at the first row taken.
+    """
+    variant = Variant(_member("variant", variant, Variant, "Table 1-1"))
+    wanted = Interface(_member("interface", interface, Interface, "Tables 2-4 to 2-7")) if interface is not None \
+        else None
+    return _rows_of(variant, wanted)
+
+
+def _member(name: str, value: object, kind: type[StrEnum], limit: str) -> str:
+    """``value`` if it is a member of ``kind`` or a member's value (a str), else the named error."""
+    if isinstance(value, str) and value in {member.value for member in kind}:
+        return value
+    raise fail(name, f"one of {', '.join(repr(member.value) for member in kind)}", value, limit)
+
+
+def _rows_of(variant: Variant, wanted: Interface | None) -> Iterator[tables.ModeRow]:
     for row in tables.MODE_ROWS:
         if variant is Variant.LS and row.c[0] == "0":
             continue

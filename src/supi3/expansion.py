@@ -22,10 +22,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Final, Protocol, runtime_checkable
 
-from supi3.checks import check_bool, check_bytes, check_int
+from supi3.checks import check_bool, check_bytes, check_choice
+from supi3.interbus import wire
 from supi3.serial_io import check_levels
+from supi3.tables import BIT_RATES
 
 __all__ = [
+    "CLOCKS_PER_BIT",
     "LAIND_AFTER_LAOUD_T0",
     "PULSE_T0",
     "EndPulses",
@@ -43,10 +46,24 @@ LAIND_AFTER_LAOUD_T0: Final = 5
 """/LaInD falls 5 t0 after LaOuD fell (Table 3-15 minimum)."""
 
 
+CLOCKS_PER_BIT: Final = tuple(wire.clocks_per_bit(rate) for rate in BIT_RATES)
+"""The chip clocks of one bit at the bit rates of Table 1-7 (64, 16): the ``cpb`` the schedules take."""
+
+
+def _cpb(cpb: int) -> int:
+    return check_choice("cpb", cpb, CLOCKS_PER_BIT, limit="clocks per bit at a rate of Table 1-7")
+
+
 def clock_high(cpb: int) -> tuple[int, int]:
     """(first, end) offsets of ClkExR's high phase from the first cycle ToExR shows a bit, in clocks: a quarter of
-    a bit to three quarters (RX-3). ``cpb``: clocks per bit (64 or 16)."""
-    check_int("cpb", cpb, 4)
+    a bit to three quarters (RX-3). ``cpb``: clocks per bit (64 or 16, :data:`CLOCKS_PER_BIT`).
+
+    Raises
+    ------
+    ArgumentError
+        ``cpb`` not one of :data:`CLOCKS_PER_BIT` (another count has no bit rate of Table 1-7 behind it).
+    """
+    _cpb(cpb)
     return cpb // 4, 3 * cpb // 4
 
 
@@ -66,9 +83,15 @@ class EndPulses:
 
 
 def end_pulses(latched_data: bool, cpb: int) -> EndPulses:
-    """The pulses after a cycle ends: a latched data cycle (``latched_data``) or anything else (RX-4)."""
+    """The pulses after a cycle ends: a latched data cycle (``latched_data``) or anything else (RX-4).
+
+    Raises
+    ------
+    ArgumentError
+        ``latched_data`` not a bool, ``cpb`` not one of :data:`CLOCKS_PER_BIT`.
+    """
     check_bool("latched_data", latched_data)
-    check_int("cpb", cpb, 4)
+    _cpb(cpb)
     width = PULSE_T0 * cpb
     if not latched_data:
         return EndPulses(None, (0, width))

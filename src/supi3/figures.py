@@ -30,6 +30,7 @@ import numpy as np
 import numpy.typing as npt
 
 from supi3 import tables
+from supi3.checks import check_bool, check_instance
 from supi3.config import DataDirection, DeviceConfig, MfpKind, decode
 from supi3.errors import Supi3Error
 from supi3.expansion import ExpansionLevels, ExternalRegisters
@@ -280,7 +281,14 @@ def serial_io_wavejson(trace: SerialIoTrace, title: str) -> dict[str, object]:
     Lanes /SS, SCLK, SerOut, SerIn and /Conv (MFP5, 4, 7, 6, 3); SerIn is drawn in read frames only (``x``
     elsewhere: not sampled). Below them the bit names D15..D0 (t11: D15 first) of SerOut where the chip drives
     each and of SerIn up to the sample that takes each.
+
+    Raises
+    ------
+    ArgumentError
+        ``trace`` not a :class:`SerialIoTrace`, ``title`` not a str.
     """
+    check_instance("trace", trace, SerialIoTrace)
+    check_instance("title", title, str, "a str")
     seq = trace.sequence
     bits = seq.frames[0].bits
     step = seq.frames[0].t0 // 2
@@ -530,7 +538,14 @@ def expansion_wavejson(trace: ExpansionTrace, title: str) -> dict[str, object]:
     data cycle's last byte, D0 first: LSB first, Figure 3-24) from the first clock it shows each; under FromExR the
     bits the chip takes, each after the sample of the bit before up to its own (RX-3). Arrows: t6 (LaOuD high), t7
     (LaOuD fall to /LaInD fall) and t5 (/LaInD low) of Table 3-15.
+
+    Raises
+    ------
+    ArgumentError
+        ``trace`` not an :class:`ExpansionTrace`, ``title`` not a str.
     """
+    check_instance("trace", trace, ExpansionTrace)
+    check_instance("title", title, str, "a str")
     step = (trace.rises[1] - trace.rises[0]) // 4  # ClkExR's period is a bit (Table 3-15 t0)
     length = len(trace.pins["clk_exr"])
     columns = _columns(length, step, trace.cut)
@@ -588,7 +603,11 @@ def write_figures(out: Path, *, vcd: bool = False) -> list[Path]:
     ------
     ModuleNotFoundError
         When ``wavedrom`` (the ``docs`` extra) is not installed; checked before anything is written.
+    ArgumentError
+        ``out`` not a :class:`~pathlib.Path`, ``vcd`` not a bool (checked before anything is written).
     """
+    check_instance("out", out, Path, "a pathlib.Path")
+    check_bool("vcd", vcd)
     wavedrom_module()
     out.mkdir(parents=True, exist_ok=True)
     written: list[Path] = []

@@ -90,10 +90,12 @@ class Pin:
     tristate: bool = False
 
     def __post_init__(self) -> None:
-        if not self.name.isidentifier():
+        if not isinstance(self.name, str) or not self.name.isidentifier():
             raise PinSpecError(f"pin name must be a Python identifier, not {self.name!r}")
         if isinstance(self.width, bool) or not isinstance(self.width, int) or not 1 <= self.width <= 64:
             raise PinSpecError(f"pin {self.name!r}: width must be an integer from 1 to 64, not {self.width!r}")
+        if not isinstance(self.tristate, bool):
+            raise PinSpecError(f"pin {self.name!r}: tristate must be True or False, not {self.tristate!r}")
 
     @property
     def mask(self) -> int:
@@ -154,7 +156,7 @@ class EventLog:
     """
 
     def __init__(self, depth: int = 32) -> None:
-        if depth < 1:
+        if isinstance(depth, bool) or not isinstance(depth, int) or depth < 1:
             raise PinSpecError(f"event log depth must be a positive integer, not {depth!r}")
         self._events: deque[tuple[int, str, tuple[object, ...]]] = deque(maxlen=depth)
 

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from typing import Final
 
-from supi3.checks import check_int
+from supi3.checks import check_int, fail
 from supi3.interbus import wire
 from supi3.optical.regulation import BLOCK_INPUTS, Interface
 from supi3.pinlevel import SYNC_STAGES as SYNC_STAGES
@@ -209,7 +209,15 @@ C_D_DATA: Final = 1
 
 
 def up_input_port(name: str) -> str:
-    """The µP block's input port of µP pin ``name``: pins that are also outputs (MFP6, MFP7) get ``_in``."""
+    """The µP block's input port of µP pin ``name``: pins that are also outputs (MFP6, MFP7) get ``_in``.
+
+    Raises
+    ------
+    ArgumentError
+        ``name`` not an input of the µP interface (:data:`UP_INPUT_IDLE`; another name used to pass unchanged).
+    """
+    if name not in UP_INPUT_IDLE:
+        raise fail("name", f"an input of the µP interface ({', '.join(UP_INPUT_IDLE)})", name, "Tables 3-5, 3-6")
     return f"{name}_in" if name in UP_OUTPUT_NAMES else name
 
 

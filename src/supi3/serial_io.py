@@ -78,7 +78,8 @@ def check_levels(levels: object) -> None:
     expansion's ``ExpansionLevels``)."""
     for name, level in vars(levels).items():
         if type(level) is not int or level >> 1 or level < 0:
-            check_bits(f"{type(levels).__name__}.{name}", level, 1)
+            # a numpy level is stored as the int it is, so that every level of a frozen dataclass is a plain int
+            object.__setattr__(levels, name, check_bits(f"{type(levels).__name__}.{name}", level, 1))
 
 
 IDLE: Final = Levels(conv_n=1, sclk=0, ss_n=1, ser_out=0)
@@ -215,9 +216,13 @@ class SerialSequence:
         if type(self.frames) is not tuple or not self.frames or not all(
                 isinstance(frame, SerialFrame) for frame in self.frames):  # fmt: skip
             raise fail("frames", "a non-empty tuple of SerialFrame", self.frames)
-        if self.conv is not None and (type(self.conv) is not tuple or len(self.conv) != 2):
-            raise fail("conv", "None or the (first, end) cycles of the /Conv pulse", self.conv)
-        check_int("length", self.length, 1)
+        if self.conv is not None and (type(self.conv) is not tuple or len(self.conv) != 2
+                                      or not all(type(c) is int for c in self.conv)
+                                      or not 0 <= self.conv[0] < self.conv[1] <= self.length):
+            raise fail("conv", f"None or the (first, end) cycles of the /Conv pulse, 0 <= first < end <= length "
+                               f"{self.length!r}", self.conv)
+        ends = max(frame.end for frame in self.frames)
+        check_int("length", self.length, max(1, ends), limit="the sequence holds its frames")
 
     @property
     def read(self) -> SerialFrame | None:

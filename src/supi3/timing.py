@@ -9,7 +9,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from supi3 import tables
-from supi3.checks import check_instance, check_int, check_real
+from supi3.checks import check_instance, check_int, check_real, fail
 from supi3.errors import Supi3Error
 from supi3.interbus import wire
 from supi3.optical import length as optical_length
@@ -107,14 +107,30 @@ def evaluate(expression: str, bit_rate: int, n_bytes: int = 1, t0_s: float | Non
     Names: ``t_Bit_IBS`` (bit period), ``TCLK`` (t_Bit_IBS / 16, Table 3-7), ``t0`` (the table's clock period,
     passed in ``t0_s``), ``n`` (bytes, Table 3-4 t8), ``ns`` (1e-9). ``"a | b"`` gives ``a`` at 500 kbit/s and
     ``b`` at 2 Mbit/s.
+
+    Raises
+    ------
+    ArgumentError
+        ``expression`` not a str, ``n_bytes`` not an integer, ``t0_s`` neither ``None`` nor a finite number > 0.
+    TimingError
+        A bit rate not of Table 1-7, ``n_bytes`` outside 0 to :data:`MAX_NETWORK_BYTES`, an expression too long,
+        with more than one ``|`` or that is not the manual's arithmetic.
     """
     check_instance("expression", expression, str, "a timing expression (str)")
     if len(expression) > _MAX_EXPRESSION:
         raise TimingError(f"timing expression of {len(expression)} characters; at most {_MAX_EXPRESSION}")
-    if "|" in expression:
-        low, high = expression.split("|")
-        expression = low if bit_rate == tables.BIT_RATES[0] else high
     t_bit = bit_period_s(bit_rate)
+    n_bytes = _network_bytes(n_bytes, "n_bytes")
+    if t0_s is not None:
+        t0_s = check_real("t0_s", t0_s, limit="a clock period in seconds")
+        if t0_s <= 0:
+            raise fail("t0_s", "a finite number > 0", t0_s, "a clock period in seconds")
+    if "|" in expression:
+        parts = expression.split("|")
+        if len(parts) != len(tables.BIT_RATES):
+            raise TimingError(f"timing expression {expression!r} has {len(parts)} alternatives; "
+                              f"'a | b' gives one per bit rate of Table 1-7")
+        expression = parts[tables.BIT_RATES.index(bit_rate)]
     names = {"t_Bit_IBS": t_bit, "TCLK": t_bit / tables.TCLK_PER_BIT, "n": float(n_bytes), "ns": 1e-9}
     if t0_s is not None:
         names["t0"] = t0_s

@@ -459,7 +459,68 @@ static void test_irq_service(void)
     CHECK_EQ(ev, SUPI3_IRQ_EVT_VALID_MSK | SUPI3_IRQ_EVT_IO_ACCESS_MSK);
     CHECK_EQ(f.tx[0], SUPI3_CMD_READ(SUPI3_IRQ_EVT_ADDR));
     CHECK_EQ(f.irq_evt, SUPI3_IRQ_EVT_IO_ACCESS_MSK); /* read-clear of bits 6..0 (3.4.14) */
-    CHECK_EQ(f.irq_pin_reads, 2);
+    CHECK_EQ(f.irq_pin_reads, 3); /* before, and after the read: /IRQ high, nothing left (FW-22) */
+    /* an event that comes during the read keeps /IRQ low (no new edge): read again until /IRQ is high (FW-22) */
+    f.ntx = 0u; f.irq_pin_reads = 0;
+    f.irq_evt = SUPI3_IRQ_EVT_VALID_MSK;
+    f.evt_after[0] = SUPI3_IRQ_EVT_PCMD_MSK; f.n_evt_after = 1u; f.evt_idx = 0u;
+    CHECK_EQ(supi3_irq_service(&ctx, &ev), SUPI3_OK);
+    CHECK_EQ(ev, SUPI3_IRQ_EVT_VALID_MSK | SUPI3_IRQ_EVT_PCMD_MSK);
+    CHECK_EQ(f.ntx, 4u);
+    CHECK_EQ(f.irq_pin_reads, 3);
+    CHECK_EQ(f.irq_evt, 0u);
+    /* /IRQ still low after SUPI3_IRQ_SERVICE_MAX_READS reads: SUPI3_E_TIMEOUT, the events read kept */
+    f.ntx = 0u; f.irq_pin_reads = 0;
+    f.irq_evt = SUPI3_IRQ_EVT_VALID_MSK;
+    memset(f.evt_after, SUPI3_IRQ_EVT_VALID_MSK, sizeof f.evt_after); f.n_evt_after = 4u; f.evt_idx = 0u;
+    CHECK_EQ(SUPI3_IRQ_SERVICE_MAX_READS, 4u);
+    CHECK_EQ(supi3_irq_service(&ctx, &ev), SUPI3_E_TIMEOUT);
+    CHECK_EQ(ev, SUPI3_IRQ_EVT_VALID_MSK);
+    CHECK_EQ(f.ntx, 2u * SUPI3_IRQ_SERVICE_MAX_READS);
+    CHECK_EQ(f.irq_pin_reads, SUPI3_IRQ_SERVICE_MAX_READS + 1u);
+    CHECK_EQ(supi3_irq_service(&ctx, &ev), SUPI3_OK); /* the driver stays initialized: the next call serves it */
+    CHECK_EQ(ev, SUPI3_IRQ_EVT_VALID_MSK);
+}
+
+static int unwired_pin(void *user, int *level)
+{
+    (void)user;
+    *level = 0;
+    return SUPI3_E_UNSUPPORTED;
+}
+
+static int unwired_sas(void *user, int level)
+{
+    (void)user; (void)level;
+    return SUPI3_E_UNSUPPORTED;
+}
+
+static void test_pin_callbacks_saying_not_wired(void)
+{
+    /* FW-21: a callback that returns SUPI3_E_UNSUPPORTED is a pin the board does not wire, as a NULL callback */
+    supi3_t ctx; fake_t f; uint8_t ev = 0xFFu; uint8_t v = 0u;
+    static const uint8_t poll[] = {0x8Eu, 0x00u};
+    setup(&ctx, &f, 1);
+    ctx.cfg.read_cd = unwired_pin; /* the init byte goes out unchecked */
+    CHECK_EQ(supi3_initialize(&ctx, SUPI3_MODE_MOTOROLA), SUPI3_OK);
+    ctx.cfg.set_sas_init = unwired_sas; /* refused, nothing driven, still initialized */
+    CHECK_EQ(supi3_sas_init(&ctx), SUPI3_E_UNSUPPORTED);
+    CHECK_EQ(f.sas_pulses, 0);
+    CHECK_EQ(supi3_read(&ctx, 0u, &v), SUPI3_OK);
+    ctx.cfg.read_irq = unwired_pin; /* one read of 14, as without read_irq */
+    f.ntx = 0u; f.irq_evt = SUPI3_IRQ_EVT_VALID_MSK;
+    CHECK_EQ(supi3_irq_service(&ctx, &ev), SUPI3_OK);
+    CHECK_EQ(ev, SUPI3_IRQ_EVT_VALID_MSK);
+    CHECK_EQ(f.ntx, 2u);
+    ctx.cfg.read_io = unwired_pin; /* polls register 14 */
+    f.ntx = 0u; f.irq_evt = SUPI3_IRQ_EVT_PCMD_MSK;
+    CHECK_EQ(supi3_poll_io_window(&ctx, 2u, &ev), SUPI3_OK);
+    CHECK_EQ(ev, SUPI3_IRQ_EVT_PCMD_MSK);
+    log_is(&f, poll, sizeof poll);
+    f.ntx = 0u;
+    CHECK_EQ(supi3_poll_io_window(&ctx, 2u, NULL), SUPI3_E_ARG); /* nowhere to keep the events: nothing sent */
+    CHECK_EQ(f.ntx, 0u);
+    CHECK_EQ(supi3_read(&ctx, 0u, &v), SUPI3_OK);
 }
 
 static void test_transport_error(void)
@@ -681,6 +742,7 @@ int main(void)
         test_transport_error, test_irq_enable, test_poll_io_window_by_register, test_poll_io_window_by_pin,
         test_processor_alarm_and_command, test_optical_status, test_optical_length_conversions,
         test_helpers_and_strerror,
+        test_pin_callbacks_saying_not_wired,
         test_frame_gap_and_no_globals,
     };
     size_t k, n = sizeof tests / sizeof tests[0];

@@ -397,7 +397,8 @@ class Master:
         """Run the next cycle a master would: an ID cycle when there is no configuration, a command to send
         or a device asking for attention, and after a failed cycle until an ID cycle is latched (so that no TE
         bit outlives the error it belongs to, assumption A21); else a data cycle."""
-        self._require_running()
+        if self.stopped:
+            self._require_running()  # raises
         pending = self._pcmd or self._alarm_request or self._alarm_expected or self._recover or self._branch \
             or self._optical_request or self._optical_expected or self._alarm_output
         if self.config is None or self._attention or self._watchdog_pending or self._quit or pending:
@@ -406,7 +407,8 @@ class Master:
 
     def data_cycle(self) -> CycleResult:
         """One data cycle: send the OUT data, receive the IN data, latch if every check passes."""
-        self._require_config()
+        if self.config is None:
+            self._require_config()  # raises
         data_len = len(self._out) - wire.LOOPBACK_BYTES
         transfer = self.ring.transfer(Cycle.DATA, bytes(self._out))
         problem = self._check(transfer, data_len)

@@ -38,6 +38,7 @@ from supi3.mcu.core import (
     SourceLine,
     Stop,
 )
+from supi3.mcu.frames import NativeFrames, SsFrame
 from supi3.mcu.pins import SAS_INIT_BIT, SR_BIT, SS_BIT, SYNC_S, Cause, LockstepRing, mcu_lines
 from supi3.mcu.stm32 import (
     AFIO_BASE,
@@ -208,13 +209,6 @@ class _BoardBench(Bench):
         return self._next_start
 
 
-@dataclass(slots=True)
-class _Frame:
-    fall: int  # cycle of /SS falling
-    driven: int | None  # what the chip drives on SerOUT (UP-18)
-    transfers: list[tuple[int, int, int, int]]  # (tx as the chip sees it, bits, start cycle, period)
-
-
 class FwBoard:
     """The firmware's ``fw_board_t fw_board`` (examples/fw_board.h) in the emulated RAM: the terminals the host
     writes (inputs, fault) and what the firmware keeps (outputs, command, cycles, error). Offsets are the
@@ -299,6 +293,10 @@ class Board:
         The board's wiring for the interface type the firmware initializes (Table 3-8): ``Mode.MOTOROLA`` (MISO on
         SerOUT, MFP7) or ``Mode.INTEL`` (MCU-18: MISO on Ser_IN/OUT, MFP6, MOSI on it through a resistor, S/R from
         PB0 to MFP7; build the firmware with ``-DFW_MODE=SUPI3_MODE_INTEL``).
+    native_frames:
+        MCU-51: the plain µP interface frames (/SS edges and SPI1's DR write) taken in native code without a Python
+        call, their net effect set in the model at the next entry into Python (:mod:`supi3.mcu.frames`; the same run
+        to the cycle). Transaction level on the Motorola board only; ``False`` runs every frame through Python.
 
     Attributes
     ----------
@@ -325,7 +323,7 @@ class Board:
                  others: Sequence[Device | PinChip | PinBranch] = (),
                  cycle_time_s: float | None = None, strict: bool = True, pedantic: bool = False,
                  fidelity: str = "transaction", record: bool = False, mode: Mode = Mode.MOTOROLA,
-                 stat_err_filter: int = STATERR_FILTER_CLOCKS) -> None:  # fmt: skip
+                 stat_err_filter: int = STATERR_FILTER_CLOCKS, native_frames: bool = True) -> None:  # fmt: skip
         self.fidelity = check_choice("fidelity", fidelity, FIDELITIES)
         self.intel = check_instance("mode", mode, Mode) is Mode.INTEL
         self._s_r = 1  # PB0: S/R, 1 = the µP sends
@@ -373,19 +371,27 @@ class Board:
         self.spi.on_poll = self.core.skip_poll
         self.spi.on_misuse = self._mcu_violation
         core = self.core
+        # MCU-51: the native frames at transaction level on the Motorola board, GPIOA's and SPI1's writes through them
+        native = check_bool("native_frames", native_frames) and self._ring is None and not self.intel
         core.mmio(RCC_BASE, PERIPHERAL_SIZE, self.rcc.read, self.rcc.write)
-        core.mmio(GPIOA_BASE, PERIPHERAL_SIZE, self.gpio.read, self.gpio.write)
+        if native:
+            core.mmio(GPIOA_BASE, PERIPHERAL_SIZE, self._gpio_read, self._gpio_write, port=0)
+        else:
+            core.mmio(GPIOA_BASE, PERIPHERAL_SIZE, self.gpio.read, self.gpio.write)
         core.mmio(GPIOB_BASE, PERIPHERAL_SIZE, self.gpio_b.read, self.gpio_b.write)
         core.mmio(AFIO_BASE, PERIPHERAL_SIZE, self.exti.read_afio, self.exti.write_afio)
         core.mmio(EXTI_BASE, PERIPHERAL_SIZE, self._exti_read, self._exti_write)
-        held = core.mmio(SPI1_BASE, PERIPHERAL_SIZE, self.spi.read, self.spi.write)
+        if native:
+            held = core.mmio(SPI1_BASE, PERIPHERAL_SIZE, self._spi_read, self._spi_write, port=1)
+        else:
+            held = core.mmio(SPI1_BASE, PERIPHERAL_SIZE, self.spi.read, self.spi.write)
         self.spi.holder = self.spi.offer = held  # SR held (MCU-25), DR's read after its byte (MCU-26)
         core.entered = self._entered
         self.fw_board = FwBoard(core) if "fw_board" in core.image.symbols else None
         self.interrupts = 0
         self.irq_latency_s = 0.0
         self.violations: list[ViolationAt] = []
-        self._frame: _Frame | None = None
+        self._frame: SsFrame | None = None
         self._ss_rise = -(1 << 62)
         self._cd_before = C_D_COMMAND  # C/D until t6 max after /SS rises (MCU-9)
         self._sas_rise = 0
@@ -393,6 +399,9 @@ class Board:
         self._irq_fell: int | None = None
         self._mod_ack_until = 0
         self._limit = self._budget = 0
+        self.native_frames = NativeFrames(self, held, PIN_SS, NOISE_CYCLES, _EXTI0) if native else None
+        """MCU-51: the native per-frame fast path (``native_frames=True`` at transaction level on the Motorola
+        board), else ``None``."""
         self._held: list[tuple[str, int, int]] | None = None  # pin level: edges held while a sleeping core waits
         self._setting_up = True  # MCU-45: the firmware has not yet first waited or come to SERVE_POINT
         self.served = True
@@ -667,6 +676,32 @@ class Board:
     def _cycles(self, seconds: float) -> int:
         return math.ceil(seconds * self.core.cpu_hz - NOISE_CYCLES)
 
+    # MCU-51: GPIOA's and SPI1's accesses that reach Python (the native frames did not take them), each followed by
+    # the native frames' mirror refreshed, valid again for the frames after it
+
+    def _gpio_read(self, offset: int, size: int) -> int:
+        value = self.gpio.read(offset, size)
+        self._refresh()
+        return value
+
+    def _gpio_write(self, offset: int, size: int, value: int) -> None:
+        self.gpio.write(offset, size, value)
+        self._refresh()
+
+    def _spi_read(self, offset: int, size: int) -> int:
+        value = self.spi.read(offset, size)
+        self._refresh()
+        return value
+
+    def _spi_write(self, offset: int, size: int, value: int) -> None:
+        self.spi.write(offset, size, value)
+        self._refresh()
+
+    def _refresh(self) -> None:
+        frames = self.native_frames
+        assert frames is not None  # the wrappers are mapped only with the native frames
+        frames.refresh()
+
     def _on_output(self, pin: int, level: int) -> None:
         ring = self._ring
         if ring is not None:
@@ -699,7 +734,7 @@ class Board:
                 self._violation("Table 3-7 t8", f"/SS fell {self._ns(gap)} ns after it rose: C/D settles t6 "
                                 f"(max) + t8 = {need * 1e9:.0f} ns after the rise")  # fmt: skip
             driven = self._chip(self.protocol.begin, cycles, bool(self._s_r) if self.intel else True)
-            self._frame = _Frame(cycles, driven, [])
+            self._frame = SsFrame(cycles, driven, [])
             return
         frame, self._frame = self._frame, None
         if frame is None:

@@ -49,13 +49,11 @@ UcError: type[Exception] = _UNICORN.UcError
 _LIB: Any = _UNICORN.unicorn_py3.unicorn.uclib
 """unicorn's C library as its binding loaded it (with the argument types it declares): the hot callbacks and
 register accesses go to it directly (MCU-19), without the binding's wrappers around each call."""
-# Callback types of unicorn.h (uc_cb_hookcode_t, uc_cb_eventmem_t, uc_cb_mmio_write_t; mmio reads: hook.MMIO_READ).
+# Callback types of unicorn.h (uc_cb_hookcode_t, uc_cb_eventmem_t; mmio reads and writes: hook.MMIO_READ, MMIO_WRITE).
 _HOOK_CODE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint32, ctypes.c_void_p)
 _HOOK_INTR: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint32, ctypes.c_void_p)
 _HOOK_MEM_INVALID: Final = ctypes.CFUNCTYPE(ctypes.c_bool, ctypes.c_void_p, ctypes.c_int, ctypes.c_uint64, ctypes.c_int,
                                             ctypes.c_int64, ctypes.c_void_p)  # fmt: skip
-_MMIO_WRITE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint, ctypes.c_uint64,
-                                      ctypes.c_void_p)  # fmt: skip
 
 __all__ = [
     "CPUS",
@@ -128,6 +126,9 @@ SYST_MAX: Final[int] = 0xFF_FFFF
 BACKTRACE_DEPTH: Final[int] = 16
 """Frames :meth:`CortexM.backtrace` unwinds at most."""
 BLOCK_CACHE_SLOTS: Final[int] = 1 << 13
+PREFIX_SLOTS: Final[int] = 1 << 10
+"""MCU-51: the slots of the native memo of :meth:`CortexM.cycles_now`'s prefix costs (a power of two; a PC whose slot
+another took is timed by Python, through the slow path)."""
 """Slots of the native block hook's cost cache (MCU-25), one per halfword address modulo their number: 16 KiB of
 code without two blocks sharing a slot (a block that finds its slot taken asks Python again)."""
 IRQ_LINES: Final[int] = 32
@@ -676,6 +677,13 @@ _HOLD, _HOLD_AT = _fields_struct(hook.Held, ("until", "offset", "value", "held",
 _OFFER, _OFFER_AT = _fields_struct(hook.Held, ("once_from", "once_at", "once_offset", "once_value", "once", "taken",
                                               "once_then"))  # fmt: skip
 _CLOCK, _CLOCK_AT = _fields_struct(hook.State, ("block_start", "block_address", "handed", "access_pc"))
+_PREFIX, _ = _fields_struct(hook.Prefix, ("address", "pc", "cycles"))
+
+
+def _prefix_slot(address: int, pc: int) -> int:
+    """The slot of the prefix cost of the block at ``address`` up to ``pc`` in the native memo (hook.c's
+    ``prefix_slot``, the same sum modulo 2^64; a PC may be reached from more than one block)."""
+    return ((pc >> 1) * 31 + (address >> 1)) & (PREFIX_SLOTS - 1)
 
 
 class HeldRegister:
@@ -686,6 +694,11 @@ class HeldRegister:
 
     def __init__(self, held: hook.Held) -> None:
         self._held = held
+
+    @property
+    def native(self) -> hook.Held:
+        """The native structure (the native frames write it as :meth:`hold` and :meth:`offer` would, MCU-51)."""
+        return self._held
 
     def hold(self, offset: int, value: int, until: int | None, after: int | None = None) -> None:
         """Reads of ``offset`` return ``value`` while their time (:meth:`CortexM.cycles_polled`) is before cycle
@@ -774,6 +787,18 @@ class CortexM:
         state.reg_write = ctypes.cast(_LIB.uc_reg_write, ctypes.c_void_p)
         state.describe = self._describe_callback
         state.rewritable, state.rewritable_size = ram  # MCU-28: code in RAM is costed each time it runs
+        self._prefixes = (hook.Prefix * PREFIX_SLOTS)()  # cycles_now's memo for the native frames (MCU-51)
+        self.frames = frames = hook.Frames()
+        """The native per-frame fast path's state (MCU-51; :mod:`supi3.mcu.frames` sets it up: off until then)."""
+        frames.state = ctypes.pointer(state)
+        frames.prefixes = self._prefixes
+        frames.prefix_mask = PREFIX_SLOTS - 1
+        self.entry: Callable[[], None] | None = None
+        """MCU-51: called first at each entry into Python while the core runs (a peripheral's read or write, a watched
+        address) and when a run ends: the native frames' catch-up."""
+        self.resume: Callable[[], None] | None = None
+        """MCU-51: called when a run starts: the native frames' mirror refreshed."""
+        self._port_write = ctypes.cast(native.supi3_port_write, ctypes.c_void_p)
         self.sleeping = False
         self.active: list[int] = []  # active exceptions, outermost first
         self.pending: set[int] = set()
@@ -811,14 +836,18 @@ class CortexM:
 
     # -- memory ------------------------------------------------------------------------------------------------
 
-    def mmio(self, base: int, size: int, read: ReadFn, write: WriteFn) -> HeldRegister:
+    def mmio(self, base: int, size: int, read: ReadFn, write: WriteFn, *, port: int | None = None) -> HeldRegister:
         """Map a peripheral: ``read(offset, size) -> value`` and ``write(offset, size, value)`` run on every
         access, but a read of a register the peripheral holds (the :class:`HeldRegister` returned) is answered
-        natively (MCU-25). An exception they raise stops the run at the end of the block (:attr:`error`); the
+        natively (MCU-25), and with ``port`` (0: GPIOA, 1: SPI1) a write the native frames take (:attr:`frames`,
+        MCU-51) is too. An exception they raise stops the run at the end of the block (:attr:`error`); the
         block's later accesses reach no peripheral (no follow-on reports of a run that has ended)."""
 
         def on_read(handle: int, offset: int, size: int, data: int | None) -> int:
             del handle, data
+            entry = self.entry
+            if entry is not None:
+                entry()
             if self.error is not None:  # the run ends with this block: its later accesses reach no peripheral
                 return 0
             try:
@@ -829,6 +858,9 @@ class CortexM:
 
         def on_write(handle: int, offset: int, size: int, value: int, data: int | None) -> None:
             del handle, data
+            entry = self.entry
+            if entry is not None:
+                entry()
             if self.error is not None:
                 return
             try:
@@ -836,12 +868,18 @@ class CortexM:
             except BaseException as error:  # handed to the run loop, raised there
                 self.fail(error)
 
-        callbacks = (hook.MMIO_READ(on_read), _MMIO_WRITE(on_write))
+        callbacks = (hook.MMIO_READ(on_read), hook.MMIO_WRITE(on_write))
         self._callbacks += callbacks
         held = hook.Held(ctypes.pointer(self._state), callbacks[0])
         self._held.append(held)
-        self._check(_LIB.uc_mmio_map(self._handle, base, size, self._held_read, ctypes.byref(held), callbacks[1],
-                                     None))  # fmt: skip
+        if port is None:
+            self._check(_LIB.uc_mmio_map(self._handle, base, size, self._held_read, ctypes.byref(held), callbacks[1],
+                                         None))  # fmt: skip
+        else:  # MCU-51: the write goes to the native frames, which call Python's write for what they do not take
+            native = hook.Port(ctypes.pointer(self.frames), callbacks[1], check_int("port", port, 0, 1))
+            self._callbacks.append(native)
+            self._check(_LIB.uc_mmio_map(self._handle, base, size, self._held_read, ctypes.byref(held),
+                                         self._port_write, ctypes.byref(native)))  # fmt: skip
         # unicorn updates the PC before a load or store only if a memory hook covers its address: without one, a
         # peripheral callback sees the PC of the block's first instruction, and the access would be timed there
         # (MCU-1 places it by the PC). The native hook also notes that PC for cycles_now (MCU-25).
@@ -860,6 +898,9 @@ class CortexM:
 
         def on_code(handle: int, at: int, size: int, data: int | None) -> None:
             del handle, at, size, data
+            entry = self.entry
+            if entry is not None:
+                entry()
             if self.error is not None:
                 return
             try:
@@ -908,6 +949,7 @@ class CortexM:
     def _forget_code(self) -> None:
         """Code in flash has changed (MCU-28): every block is costed anew, every memo of code is dropped."""
         ctypes.memset(self._cache, 0, ctypes.sizeof(self._cache))
+        ctypes.memset(self._prefixes, 0, ctypes.sizeof(self._prefixes))
         for memo in (self._blocks, self._costs, self._sleeps, self._idle):
             memo.clear()
 
@@ -1024,6 +1066,8 @@ class CortexM:
                 cost = block_cost(self.read_bytes(address, pc - address))
                 if not self._rewritable(address):  # code in RAM may change (MCU-28)
                     self._costs[key] = cost
+            if not self._rewritable(address):  # the native frames' memo (MCU-51): its slot, taken or not
+                _PREFIX.pack_into(self._prefixes, _prefix_slot(address, pc) * _PREFIX.size, address, pc, cost[1])
             start += cost[1]
         if start > handed:
             state.handed = start
@@ -1264,6 +1308,9 @@ class CortexM:
         state.stop_request = False
         self.interrupt = None
         pc = self._read(arm.UC_ARM_REG_PC)
+        resume = self.resume
+        if resume is not None:  # MCU-51: the native frames' mirror, valid for the run
+            resume()
         self._running = True
         try:
             self.uc.emu_start(pc | 1, 0)
@@ -1271,6 +1318,9 @@ class CortexM:
             raise FirmwareFaultError(self._fault(error)) from None
         finally:
             self._running = False
+            entry = self.entry
+            if entry is not None:  # MCU-51: the native frames' effects into the Python objects
+                entry()
         if self._state.code_written:  # the firmware stored into flash (MCU-28)
             self._state.code_written = 0
             self._forget_code()

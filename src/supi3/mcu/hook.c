@@ -232,6 +232,233 @@ uint64_t supi3_held_read(void *uc, uint64_t offset, unsigned size, void *data) {
     return h->slow(uc, offset, size, 0);
 }
 
+/* MCU-51: the per-frame fast path. The board's /SS edges (GPIOA BSRR/BRR writes that change only /SS) and SPI1's DR
+ * write that clocks a frame's byte are taken here, without Python, for frames whose whole effect on the Python model
+ * is plain (supi3.mcu.frames decides which from its own tables and the model's state, hands them over at set-up and
+ * refreshes what it mirrors after each Python write of GPIOA or SPI1: `valid`); any other write goes to Python's
+ * write (`slow`). What the frames changed is noted here (`pending`) and set in the Python objects, as its net effect,
+ * at the next entry into Python (supi3.mcu.frames.NativeFrames.catch_up). */
+typedef void (*mmio_write_fn)(void *uc, uint64_t offset, unsigned size, uint64_t value, void *data);
+
+/* The cost in cycles of a block's instructions before the PC of an access (CortexM.cycles_now's memo, MCU-1). */
+typedef struct {
+    uint64_t address; /* the block's first instruction; 0: an empty slot */
+    uint64_t pc;
+    uint64_t cycles;
+} supi3_prefix;
+
+typedef struct {
+    supi3_state *state;
+    supi3_held *spi;        /* SPI1's held register (MCU-25, MCU-26) */
+    supi3_prefix *prefixes; /* CortexM.cycles_now's prefix costs, filled by Python */
+    uint64_t prefix_mask;   /* slots - 1 (a power of two) */
+    /* set up once from Python's tables (supi3.spi.upif, supi3.model.registers, the board's Table 3-7 limits) */
+    int64_t least_t1, least_t2, least_t8; /* core cycles */
+    uint64_t ss_pin, cd_command, cd_data, phase_command, phase_data;
+    uint64_t sr_txe, sr_bsy, sr_rxne, spi_dr, spi_sr;
+    /* refreshed by Python after each of its writes of GPIOA or SPI1 */
+    uint64_t valid;      /* the fast path may run: Python's objects are as mirrored here */
+    uint64_t due;        /* the first core cycle whose bus synchronisation would run a bus event */
+    uint64_t latch;      /* the latch phase (3.4.14) */
+    uint64_t latch_at;   /* the first core cycle whose synchronisation runs the latch phase's start (MCU-52) */
+    uint64_t gpio_ok;    /* GPIOA's clock on, not held in reset */
+    uint64_t gpio_mask, gpio_pulled_up, gpio_levels;
+    uint64_t spi_ok;     /* SPI1 clocked, enabled master, 8 bits, mode 3, MSB first, SCLK period >= t0 */
+    uint64_t period;     /* SCLK period in core cycles */
+    uint64_t sr_modf;    /* SPI1's MODF flag in SR */
+    /* the state the fast path runs on: refreshed by Python, changed here, read back by Python's catch-up */
+    uint64_t pending;    /* a frame's effect not yet in the Python objects */
+    uint64_t odr;
+    uint64_t synced;     /* 1 + the latest core cycle the bus was synchronised to; 0: none */
+    uint64_t phase, command, last_rx;
+    uint64_t frame_open, frame_fall, frame_driven;
+    uint64_t transfer, transfer_seen, transfer_start, transfer_period;
+    int64_t ss_rise;
+    uint64_t cd_before;
+    uint64_t written;    /* a bit per address written */
+    uint64_t dr_writes, rx_last, shift_received, shift_start, shift_end;
+    uint64_t taken;      /* writes taken here since set-up (a count for tests and benchmarks) */
+    uint8_t values[16];   /* what a read of each address returns (fast reads only) */
+    uint8_t written_values[16];
+    uint8_t plain[256];   /* upif._PLAIN_COMMANDS */
+    uint8_t address[256]; /* each command byte's address, rd and wr (upif._COMMANDS) */
+    uint8_t rd[256];
+    uint8_t wr[256];
+    uint8_t reads_register[16];  /* upif._READS_REGISTER */
+    uint8_t writes_register[16]; /* upif._WRITES_REGISTER */
+    uint8_t fast_read[16];       /* a read without side effects: 1, 2 = a data register (not in the latch phase) */
+    uint8_t fast_write[16];      /* a write that only stores: 1, 2 = a data register (not in the latch phase) */
+    uint8_t write_mask[16];
+    int8_t alias[16];            /* the address a written register is read at, or -1 */
+} supi3_frames;
+
+typedef struct {
+    supi3_frames *frames;
+    mmio_write_fn slow; /* the peripheral's write in Python */
+    uint64_t spi;       /* 0: GPIOA, 1: SPI1 */
+} supi3_port;
+
+/* The slot of a block's prefix cost (CortexM._prefix_slot computes the same; a PC is reached from more than one block). */
+static uint64_t prefix_slot(uint64_t address, uint64_t pc) { return (pc >> 1) * 31 + (address >> 1); }
+
+/* CortexM.cycles_now within the access, if its prefix cost is known: 0 (and nothing) if not. */
+static int frames_now(const supi3_frames *f, uint64_t *now) {
+    const supi3_state *s = f->state;
+    uint64_t start = s->block_start;
+    if (s->access_pc > s->block_address) {
+        const supi3_prefix *p = &f->prefixes[prefix_slot(s->block_address, s->access_pc) & f->prefix_mask];
+        if (p->address != s->block_address || p->pc != s->access_pc || p->address == 0) {
+            return 0;
+        }
+        start += p->cycles;
+    }
+    *now = start > s->handed ? start : s->handed;
+    return 1;
+}
+
+/* An access of `address` at `now` without side effects: a data register only outside the latch phase, which begins at
+ * `latch_at` if it has not begun (MCU-52: the phase events the native frames pass over). */
+static int fast_access(const supi3_frames *f, const uint8_t *table, unsigned address, uint64_t now) {
+    return table[address] == 1 || (table[address] == 2 && !f->latch && now < f->latch_at);
+}
+
+/* /SS fell at `now`: Board._ss_edge's t8 check and UpifProtocol.begin, if plain. */
+static int frame_fall(supi3_frames *f, uint64_t now) {
+    if (f->frame_open || (int64_t)now - f->ss_rise < f->least_t8) {
+        return 0;
+    }
+    uint64_t driven = f->last_rx;
+    if (f->phase == f->phase_data) {
+        unsigned command = (unsigned)f->command & 0xFF;
+        unsigned address = f->address[command];
+        if (f->rd[command] && f->reads_register[address]) {
+            if (!fast_access(f, f->fast_read, address, now)) {
+                return 0;
+            }
+            driven = f->values[address];
+        }
+    } else if (f->phase != f->phase_command) {
+        return 0;
+    }
+    f->frame_open = 1;
+    f->frame_fall = now;
+    f->frame_driven = driven;
+    f->transfer = 0;
+    return 1;
+}
+
+/* /SS rose at `now`: Board._ss_edge's edge count and t2 check and UpifProtocol.end, if plain. */
+static int frame_rise(supi3_frames *f, uint64_t now) {
+    if (!f->frame_open || !f->transfer || (now - f->transfer_start) / f->transfer_period < 8
+        || (int64_t)(now - (f->transfer_start + 8 * f->transfer_period)) < f->least_t2) {
+        return 0;
+    }
+    unsigned rx = (unsigned)f->transfer_seen;
+    if (f->phase == f->phase_command) {
+        if (!f->plain[rx]) {
+            return 0;
+        }
+        f->cd_before = f->cd_command;
+        f->command = rx;
+        f->phase = f->phase_data;
+    } else { /* the data phase (frame_fall took no other) */
+        unsigned command = (unsigned)f->command & 0xFF;
+        unsigned address = f->address[command];
+        if (f->writes_register[address] && f->wr[command]) {
+            if (!fast_access(f, f->fast_write, address, now)) {
+                return 0;
+            }
+            uint8_t value = (uint8_t)(rx & f->write_mask[address]);
+            f->written |= 1u << address;
+            f->written_values[address] = value;
+            if (f->alias[address] >= 0) {
+                f->values[f->alias[address]] = value;
+            }
+        }
+        f->cd_before = f->cd_data;
+        f->phase = f->phase_command;
+    }
+    f->last_rx = rx;
+    f->frame_open = 0;
+    f->transfer = 0;
+    f->ss_rise = (int64_t)now;
+    return 1;
+}
+
+/* SPI1's DR written at `now`: Spi.write's release of the read taken, its start of the byte (Board.spi_byte's checks)
+ * and its hold of SR and offer of DR (Spi._hold), if plain. */
+static int frame_byte(supi3_frames *f, uint64_t now, uint64_t value) {
+    supi3_held *h = f->spi;
+    if (!f->spi_ok || !f->frame_open || f->transfer || !h->held || h->offset != f->spi_sr || !h->taken || h->once
+        || h->once_offset != f->spi_dr || (int64_t)(now + f->period / 2 - f->frame_fall) < f->least_t1) {
+        return 0;
+    }
+    uint64_t end = now + 8 * f->period;
+    f->rx_last = h->once_value;
+    f->transfer = 1;
+    f->transfer_seen = value & 0xFF;
+    f->transfer_start = now;
+    f->transfer_period = f->period;
+    f->dr_writes += 1;
+    f->shift_received = f->frame_driven;
+    f->shift_start = now;
+    f->shift_end = end;
+    h->until = end;
+    h->offset = (uint32_t)f->spi_sr;
+    h->value = (uint32_t)(f->sr_txe | f->sr_bsy | f->sr_modf);
+    h->held = 1;
+    h->poll = 1;
+    h->after = (uint32_t)(f->sr_rxne | f->sr_txe | f->sr_modf);
+    h->has_after = 1;
+    h->once_from = end;
+    h->once_at = 0;
+    h->once_offset = (uint32_t)f->spi_dr;
+    h->once_value = (uint32_t)f->frame_driven;
+    h->once = 1;
+    h->taken = 0;
+    h->once_then = (uint32_t)(f->sr_txe | f->sr_modf);
+    return 1;
+}
+
+/* The write callback (uc_cb_mmio_write_t) of GPIOA and SPI1: a frame's edge or byte taken here, or Python's write. */
+void supi3_port_write(void *uc, uint64_t offset, unsigned size, uint64_t value, void *data) {
+    supi3_port *p = (supi3_port *)data;
+    supi3_frames *f = p->frames;
+    supi3_state *s = f->state;
+    uint64_t now = 0;
+    if (f->valid && !s->stop_request) {
+        if (p->spi) {
+            if (offset == f->spi_dr && frames_now(f, &now) && now < f->due && frame_byte(f, now, value)) {
+                f->synced = now + 1;
+                f->pending = 1;
+                f->taken += 1;
+                s->handed = now;
+                return;
+            }
+        } else if (f->gpio_ok && (offset == 0x10 || offset == 0x14)) {
+            uint64_t odr = offset == 0x10 ? ((f->odr & ~(value >> 16)) | value) & 0xFFFF : f->odr & ~value & 0xFFFF;
+            uint64_t levels = (odr & f->gpio_mask) | (f->gpio_pulled_up & ~f->gpio_mask);
+            uint64_t changed = levels ^ f->gpio_levels;
+            int taken = changed == 0;
+            if (changed == (uint64_t)1 << f->ss_pin && frames_now(f, &now) && now < f->due) {
+                taken = levels >> f->ss_pin & 1 ? frame_rise(f, now) : frame_fall(f, now);
+                if (taken) {
+                    f->synced = now + 1;
+                    s->handed = now;
+                }
+            }
+            if (taken) {
+                f->odr = odr;
+                f->gpio_levels = levels;
+                f->pending = 1;
+                f->taken += 1;
+                return;
+            }
+        }
+    }
+    p->slow(uc, offset, size, value, 0);
+}
+
 /* The layout of the structs above as this compiler lays them out: the number of values after it, the struct's size, then each
  * field's offset in the order of its declaration. supi3.mcu.hook checks its ctypes mirrors against them when it loads
  * the library (MCU-25): a mismatch is a NativeHookError, not memory written at the wrong place. */
@@ -253,3 +480,27 @@ const uint32_t supi3_held_layout[] = {
     AT(supi3_held, value), AT(supi3_held, held), AT(supi3_held, poll), AT(supi3_held, after),
     AT(supi3_held, has_after), AT(supi3_held, once_from), AT(supi3_held, once_at), AT(supi3_held, once_offset),
     AT(supi3_held, once_value), AT(supi3_held, once), AT(supi3_held, taken), AT(supi3_held, once_then)};
+const uint32_t supi3_prefix_layout[] = {
+    4, sizeof(supi3_prefix), AT(supi3_prefix, address), AT(supi3_prefix, pc), AT(supi3_prefix, cycles)};
+const uint32_t supi3_frames_layout[] = {
+    63, sizeof(supi3_frames), AT(supi3_frames, state), AT(supi3_frames, spi), AT(supi3_frames, prefixes),
+    AT(supi3_frames, prefix_mask), AT(supi3_frames, least_t1), AT(supi3_frames, least_t2),
+    AT(supi3_frames, least_t8), AT(supi3_frames, ss_pin), AT(supi3_frames, cd_command), AT(supi3_frames, cd_data),
+    AT(supi3_frames, phase_command), AT(supi3_frames, phase_data), AT(supi3_frames, sr_txe),
+    AT(supi3_frames, sr_bsy), AT(supi3_frames, sr_rxne), AT(supi3_frames, spi_dr), AT(supi3_frames, spi_sr),
+    AT(supi3_frames, valid), AT(supi3_frames, due), AT(supi3_frames, latch), AT(supi3_frames, latch_at),
+    AT(supi3_frames, gpio_ok), AT(supi3_frames, gpio_mask), AT(supi3_frames, gpio_pulled_up),
+    AT(supi3_frames, gpio_levels), AT(supi3_frames, spi_ok), AT(supi3_frames, period), AT(supi3_frames, sr_modf),
+    AT(supi3_frames, pending), AT(supi3_frames, odr), AT(supi3_frames, synced), AT(supi3_frames, phase),
+    AT(supi3_frames, command), AT(supi3_frames, last_rx), AT(supi3_frames, frame_open),
+    AT(supi3_frames, frame_fall), AT(supi3_frames, frame_driven), AT(supi3_frames, transfer),
+    AT(supi3_frames, transfer_seen), AT(supi3_frames, transfer_start), AT(supi3_frames, transfer_period),
+    AT(supi3_frames, ss_rise), AT(supi3_frames, cd_before), AT(supi3_frames, written), AT(supi3_frames, dr_writes),
+    AT(supi3_frames, rx_last), AT(supi3_frames, shift_received), AT(supi3_frames, shift_start),
+    AT(supi3_frames, shift_end), AT(supi3_frames, taken), AT(supi3_frames, values),
+    AT(supi3_frames, written_values), AT(supi3_frames, plain), AT(supi3_frames, address), AT(supi3_frames, rd),
+    AT(supi3_frames, wr), AT(supi3_frames, reads_register), AT(supi3_frames, writes_register),
+    AT(supi3_frames, fast_read), AT(supi3_frames, fast_write), AT(supi3_frames, write_mask),
+    AT(supi3_frames, alias)};
+const uint32_t supi3_port_layout[] = {
+    4, sizeof(supi3_port), AT(supi3_port, frames), AT(supi3_port, slow), AT(supi3_port, spi)};

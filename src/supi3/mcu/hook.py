@@ -31,8 +31,9 @@ from typing import Final
 from supi3.errors import Supi3Error
 from supi3.sdk.native import default_cache_dir
 
-__all__ = ["DESCRIBE", "FLAGS", "MMIO_READ", "SOURCE", "Block", "Held", "NativeHookError", "State", "cached_path",
-           "check_layout", "check_whole", "layout", "library", "native_layout"]
+__all__ = ["DESCRIBE", "FLAGS", "MMIO_READ", "MMIO_WRITE", "SOURCE", "Block", "Frames", "Held", "NativeHookError",
+           "Port", "Prefix", "State", "cached_path", "check_layout", "check_whole", "layout", "library",
+           "native_layout"]
 
 SOURCE: Final[Path] = Path(__file__).with_name("hook.c")
 FLAGS: Final[tuple[str, ...]] = ("-shared", "-fPIC", "-O2", "-target", "native", "-mcpu=baseline", "-nostdlib",
@@ -116,9 +117,99 @@ class Held(ctypes.Structure):
     )
 
 
+MMIO_WRITE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint, ctypes.c_uint64,
+                                     ctypes.c_void_p)  # fmt: skip
+"""unicorn.h's uc_cb_mmio_write_t: a peripheral's write (``handle, offset, size, value, user data``)."""
+
+
+class Prefix(ctypes.Structure):
+    """The cost in cycles of a block's instructions before an access's PC (``supi3_prefix``: the memo of
+    :meth:`supi3.mcu.core.CortexM.cycles_now`, MCU-51); address 0: an empty slot."""
+
+    _fields_ = (("address", ctypes.c_uint64), ("pc", ctypes.c_uint64), ("cycles", ctypes.c_uint64))
+
+
+class Frames(ctypes.Structure):
+    """The per-frame fast path's state (``supi3_frames`` of hook.c, MCU-51; :mod:`supi3.mcu.frames` fills and reads
+    it): the tables and thresholds it is given once, what Python mirrors into it after its writes of GPIOA and SPI1,
+    and what the native frames changed since the last catch-up."""
+
+    _fields_ = (
+        ("state", ctypes.POINTER(State)),
+        ("spi", ctypes.POINTER(Held)),
+        ("prefixes", ctypes.POINTER(Prefix)),
+        ("prefix_mask", ctypes.c_uint64),
+        ("least_t1", ctypes.c_int64),
+        ("least_t2", ctypes.c_int64),
+        ("least_t8", ctypes.c_int64),
+        ("ss_pin", ctypes.c_uint64),
+        ("cd_command", ctypes.c_uint64),
+        ("cd_data", ctypes.c_uint64),
+        ("phase_command", ctypes.c_uint64),
+        ("phase_data", ctypes.c_uint64),
+        ("sr_txe", ctypes.c_uint64),
+        ("sr_bsy", ctypes.c_uint64),
+        ("sr_rxne", ctypes.c_uint64),
+        ("spi_dr", ctypes.c_uint64),
+        ("spi_sr", ctypes.c_uint64),
+        ("valid", ctypes.c_uint64),
+        ("due", ctypes.c_uint64),
+        ("latch", ctypes.c_uint64),
+        ("latch_at", ctypes.c_uint64),
+        ("gpio_ok", ctypes.c_uint64),
+        ("gpio_mask", ctypes.c_uint64),
+        ("gpio_pulled_up", ctypes.c_uint64),
+        ("gpio_levels", ctypes.c_uint64),
+        ("spi_ok", ctypes.c_uint64),
+        ("period", ctypes.c_uint64),
+        ("sr_modf", ctypes.c_uint64),
+        ("pending", ctypes.c_uint64),
+        ("odr", ctypes.c_uint64),
+        ("synced", ctypes.c_uint64),
+        ("phase", ctypes.c_uint64),
+        ("command", ctypes.c_uint64),
+        ("last_rx", ctypes.c_uint64),
+        ("frame_open", ctypes.c_uint64),
+        ("frame_fall", ctypes.c_uint64),
+        ("frame_driven", ctypes.c_uint64),
+        ("transfer", ctypes.c_uint64),
+        ("transfer_seen", ctypes.c_uint64),
+        ("transfer_start", ctypes.c_uint64),
+        ("transfer_period", ctypes.c_uint64),
+        ("ss_rise", ctypes.c_int64),
+        ("cd_before", ctypes.c_uint64),
+        ("written", ctypes.c_uint64),
+        ("dr_writes", ctypes.c_uint64),
+        ("rx_last", ctypes.c_uint64),
+        ("shift_received", ctypes.c_uint64),
+        ("shift_start", ctypes.c_uint64),
+        ("shift_end", ctypes.c_uint64),
+        ("taken", ctypes.c_uint64),
+        ("values", ctypes.c_uint8 * 16),
+        ("written_values", ctypes.c_uint8 * 16),
+        ("plain", ctypes.c_uint8 * 256),
+        ("address", ctypes.c_uint8 * 256),
+        ("rd", ctypes.c_uint8 * 256),
+        ("wr", ctypes.c_uint8 * 256),
+        ("reads_register", ctypes.c_uint8 * 16),
+        ("writes_register", ctypes.c_uint8 * 16),
+        ("fast_read", ctypes.c_uint8 * 16),
+        ("fast_write", ctypes.c_uint8 * 16),
+        ("write_mask", ctypes.c_uint8 * 16),
+        ("alias", ctypes.c_int8 * 16),
+    )
+
+
+class Port(ctypes.Structure):
+    """The user data of :func:`supi3_port_write`, GPIOA's or SPI1's write in native code (``supi3_port``)."""
+
+    _fields_ = (("frames", ctypes.POINTER(Frames)), ("slow", MMIO_WRITE), ("spi", ctypes.c_uint64))
+
+
 _LOADED: list[ctypes.CDLL] = []
-_LAYOUTS: Final[dict[str, type[ctypes.Structure]]] = {"supi3_block_layout": Block, "supi3_state_layout": State,
-                                                      "supi3_held_layout": Held}  # fmt: skip
+_LAYOUTS: Final[dict[str, type[ctypes.Structure]]] = {
+    "supi3_block_layout": Block, "supi3_state_layout": State, "supi3_held_layout": Held,
+    "supi3_prefix_layout": Prefix, "supi3_frames_layout": Frames, "supi3_port_layout": Port}  # fmt: skip
 """hook.c's layout tables and their ctypes mirrors."""
 
 

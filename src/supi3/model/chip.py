@@ -1128,10 +1128,13 @@ class Supi3:
         if self.registers is not None:
             self.registers.interbus_reset()
 
-    def _event(self, source: str) -> None:
-        self._events[source] += 1
+    def _event(self, *sources: str) -> None:
+        """Interrupt events of ``sources`` (Table 3-13), counted and told to the register file at once."""
+        events = self._events
+        for source in sources:
+            events[source] += 1
         if self.registers is not None:
-            self.registers.event(source)
+            self.registers.event(*sources)
 
     # --------------------------------------------------------------------------------------------------------
     # The ring's Device protocol (supi3.interbus.link.Device), in clocks
@@ -1179,7 +1182,9 @@ class Supi3:
             cycle = _cycle(cycle)
         if type(clk) is not int or clk < 0:
             clk = _clock(clk)
-        length = self.data_bytes() if cycle is _DATA else _WORD_BYTES
+        # µP modes: the data path and length once (SET does not change within a latch)
+        path = self._data_path() if cycle is _DATA and self._fixed_bytes is None else None
+        length = _WORD_BYTES if cycle is not _DATA else self._fixed_bytes if path is None else path[2]
         if type(received) is not bytes or len(received) != length:
             if cycle is _DATA and type(received) is bytes and len(received) == self._frame_bytes:
                 # SET was rewritten while this frame ran (ReconfigurationError, 3.4.11): the frame's length is
@@ -1208,35 +1213,34 @@ class Supi3:
                 if self.spi_sequences is not None:
                     self._serial_latched(clk)
                 return
-            if self._data_path()[1]:  # the expansion
+            assert path is not None  # the µP modes (registers), whose _fixed_bytes is None
+            if path[1]:  # the expansion
                 self._expansion_end(clk, received)
             elif received:
                 self.registers.latch(received)
             self.registers.set_bus_running(True)
-            self._event("VALID")
-            self._event("PCP_RX")
-        else:
-            command = wire.decode_command_word(wire.word_from_bytes(received))
-            if command.watchdog_code is not None:
-                self.watchdog_code = command.watchdog_code
-                timeout = WATCHDOG_CLOCKS[command.watchdog_code]
-                self._deadline = None if timeout is None else time_base_end(clk + 1, timeout)
-                self._reschedule()
-            if command.quit_peripheral_error:
-                self.pf = self.module_error
-                self.mod_ack_until = clk + MODACK_PULSE_CLOCKS
-                events["MODACK"] += 1
-                self._reschedule()
-            if self.registers is not None:
-                if command.processor_command is not None:
-                    self.registers.processor_command(command.processor_command)
-                self._send_alarm = command.alarm_request
-            self.wd = self.te = False
-            self.attention = self._bus_terminal_command(command) | self._optical_command(command)  # BK-5, OPT-53
-            if self.expansion:
-                self._expansion_end(clk, None)
-            self._event("ID_CYCLE")
-        self._event("PCP_TX")
+            self._event("VALID", "PCP_RX", "PCP_TX")
+            return
+        command = wire.decode_command_word(wire.word_from_bytes(received))
+        if command.watchdog_code is not None:
+            self.watchdog_code = command.watchdog_code
+            timeout = WATCHDOG_CLOCKS[command.watchdog_code]
+            self._deadline = None if timeout is None else time_base_end(clk + 1, timeout)
+            self._reschedule()
+        if command.quit_peripheral_error:
+            self.pf = self.module_error
+            self.mod_ack_until = clk + MODACK_PULSE_CLOCKS
+            events["MODACK"] += 1
+            self._reschedule()
+        if self.registers is not None:
+            if command.processor_command is not None:
+                self.registers.processor_command(command.processor_command)
+            self._send_alarm = command.alarm_request
+        self.wd = self.te = False
+        self.attention = self._bus_terminal_command(command) | self._optical_command(command)  # BK-5, OPT-53
+        if self.expansion:
+            self._expansion_end(clk, None)
+        self._event("ID_CYCLE", "PCP_TX")
 
     def discard_at(self, cycle: Cycle, local_error: bool, clk: int) -> None:
         """The cycle ended without a latch: nothing latched changes (Table 3-13, invalid data cycle)."""

@@ -739,8 +739,8 @@ class RegisterFile:
         RegisterFileError
             With ExtReg = 1 (the data come from the external registers).
         """
-        values = self._values
-        return bytes([values[name] for name in self._in_registers()])
+        # the call only where it raises (ExtReg = 1); map: no Python call a byte (the data cycle's hot path)
+        return bytes(map(self._values.__getitem__, self._in_names if self._internal else self._in_registers()))
 
     def latch(self, out: bytes) -> bytes:
         """The latch phase of a valid data cycle: return the IN bytes sent, store ``out`` in OUT0.., and in a
@@ -758,36 +758,39 @@ class RegisterFile:
         RegisterFileError
             With ExtReg = 1.
         """
-        names = self._in_registers()
+        names = self._in_names if self._internal else self._in_registers()  # the call only where it raises
         if type(out) is not bytes or len(out) != len(names):
             out = _checked(check_bytes, "out", out, len(names),
                            f"the OUT bytes of the cycle: latch needs {len(names)} OUT bytes for {self.data_bits()} "
                            "data bits, 3.4.8")
         values = self._values
-        sent = bytes([values[name] for name in names])
+        sent = bytes(map(values.__getitem__, names))
         values.update(zip(_OUT_NAMES, out, strict=False))
         self._out_latched = True
         for name in self._erased:
             values[name] = 0
         return sent
 
-    def event(self, source: str) -> None:
-        """An interrupt event of ``source`` (a name of :data:`supi3.regmap.INTERRUPT_SOURCES`, Table 3-13).
+    def event(self, *sources: str) -> None:
+        """An interrupt event of each of ``sources`` (names of :data:`supi3.regmap.INTERRUPT_SOURCES`, Table 3-13),
+        at once (a valid data cycle's latch raises VALID, PCP_RX and PCP_TX together).
 
-        The event bit is set only if the source is enabled in IRQ_EN; /IRQ is low while any event bit is set
+        An event bit is set only if its source is enabled in IRQ_EN; /IRQ is low while any event bit is set
         (3.4.14). Works whatever the data length, even 0.
 
         Raises
         ------
         RegisterArgumentError
-            If ``source`` is not a source name.
+            If a source is not a source name; no event bit is set then.
         """
-        if type(source) is not str or source not in _SOURCE_BITS:
-            raise RegisterArgumentError("source", source, f"source must be one of {sorted(_SOURCE_BITS)} (Table "
-                                        f"3-13), not {describe(source)}: no interrupt source {source!r}")
-        mask = 1 << _SOURCE_BITS[source]
-        if self._values["IRQ_EN"] & mask:
-            self._values["IRQ_EVT"] |= mask
+        mask = 0
+        for source in sources:
+            if type(source) is not str or source not in _SOURCE_BITS:
+                raise RegisterArgumentError("source", source, f"source must be one of {sorted(_SOURCE_BITS)} (Table "
+                                            f"3-13), not {describe(source)}: no interrupt source {source!r}")
+            mask |= 1 << _SOURCE_BITS[source]
+        values = self._values
+        values["IRQ_EVT"] |= values["IRQ_EN"] & mask
 
     @property
     def irq_n(self) -> int:

@@ -17,6 +17,8 @@ from typing import Final
 
 from amaranth.hdl import Cat, Module, Mux, Signal, Value
 
+from supi3.checks import check_bits, check_int
+
 __all__ = [
     "TAPS", "Countdown", "advance", "before", "count_state", "count_width", "down_state", "down_step", "next_state",
     "step",
@@ -32,8 +34,20 @@ TAPS: Final[dict[int, tuple[int, ...]]] = {
 runs through all ``2 ** width - 1`` non-zero states."""
 
 
+def _width(width: object) -> int:
+    """``width`` as a width with taps (2 to 25), else the named error."""
+    return check_int("width", width, min(TAPS), max(TAPS), limit="XAPP052 Table 3 taps")
+
+
 def step(state: int, width: int) -> int:
-    """The state after ``state`` (the new bit, the XOR of the taps, enters at bit 0; ``0`` stays ``0``)."""
+    """The state after ``state`` (the new bit, the XOR of the taps, enters at bit 0; ``0`` stays ``0``).
+
+    Raises
+    ------
+    ArgumentError
+        ``width`` not 2 to 25, ``state`` not a ``width``-bit state.
+    """
+    state = check_bits("state", state, _width(width))
     feedback = 0
     for tap in TAPS[width]:
         feedback ^= state >> (tap - 1) & 1
@@ -42,7 +56,16 @@ def step(state: int, width: int) -> int:
 
 def advance(state: int, width: int, steps: int) -> int:
     """The state ``steps`` steps after ``state``: the step is linear over GF(2), so its power is found by squaring
-    (the images of the unit vectors), in a few dozen operations for any count."""
+    (the images of the unit vectors), in a few dozen operations for any count.
+
+    Raises
+    ------
+    ArgumentError
+        ``width`` not 2 to 25, ``state`` not a ``width``-bit state, ``steps`` not an integer >= 0 (a negative
+        count used to loop for ever).
+    """
+    state = check_bits("state", state, _width(width))
+    steps = check_int("steps", steps, 0)
     power = [1 << i for i in range(width)]  # the identity: images of the unit vectors
     square = [step(1 << i, width) for i in range(width)]  # one step
 
@@ -63,30 +86,55 @@ def advance(state: int, width: int, steps: int) -> int:
 
 def before(steps: int, width: int) -> int:
     """The state ``steps`` steps before the state ``1`` (``steps`` below ``2 ** width - 1``): what a counter that
-    ends at ``1`` is loaded with to end ``steps`` clocks later."""
-    if not 0 <= steps < (1 << width) - 1:
-        raise ValueError(f"steps must be from 0 to {(1 << width) - 2}, not {steps}")
+    ends at ``1`` is loaded with to end ``steps`` clocks later.
+
+    Raises
+    ------
+    ArgumentError
+        ``width`` not 2 to 25, ``steps`` not from 0 to ``2 ** width - 2``.
+    """
+    steps = check_int("steps", steps, 0, (1 << _width(width)) - 2, limit="within one period of the LFSR")
     return advance(1, width, (1 << width) - 1 - steps)
 
 
 def count_width(most: int) -> int:
     """The width of an LFSR that counts from 0 to ``most`` (``most`` from 0 to ``2 ** 25 - 2``): its first
-    ``most + 1`` states from ``1`` (:func:`count_state`) are distinct."""
-    if not 0 <= most < (1 << max(TAPS)) - 1:
-        raise ValueError(f"most must be from 0 to {(1 << max(TAPS)) - 2}, not {most}")
+    ``most + 1`` states from ``1`` (:func:`count_state`) are distinct.
+
+    Raises
+    ------
+    ArgumentError
+        ``most`` not an integer from 0 to ``2 ** 25 - 2``.
+    """
+    most = check_int("most", most, 0, (1 << max(TAPS)) - 2, limit="the widest LFSR's period")
     return max(min(TAPS), (most + 1).bit_length())
 
 
 def count_state(value: int, width: int) -> int:
     """The state that stands for the count ``value`` of an up counter as an LFSR, ``value`` steps after the state
     ``1``: a counter that is only loaded with constants, stepped and compared with constants counts ``v`` to
-    ``v + 1`` by :func:`next_state`."""
+    ``v + 1`` by :func:`next_state`.
+
+    Raises
+    ------
+    ArgumentError
+        ``width`` not 2 to 25, ``value`` not from 0 to ``2 ** width - 2``: past the period a count's state is that
+        of a smaller count, and a comparison with it would fire early.
+    """
+    value = check_int("value", value, 0, (1 << _width(width)) - 2, limit="within one period of the LFSR")
     return advance(1, width, value)
 
 
 def down_state(value: int, width: int) -> int:
     """The state that stands for the value ``value`` of a down counter as an LFSR that ends at ``1`` then ``0``
-    (:class:`Countdown`'s states): ``0`` is ``0``, ``v`` the state ``v - 1`` steps before ``1``."""
+    (:class:`Countdown`'s states): ``0`` is ``0``, ``v`` the state ``v - 1`` steps before ``1``.
+
+    Raises
+    ------
+    ArgumentError
+        ``width`` not 2 to 25, ``value`` not from 0 to ``2 ** width - 1``.
+    """
+    value = check_int("value", value, 0, (1 << _width(width)) - 1, limit="within one period of the LFSR")
     return 0 if value == 0 else before(value - 1, width)
 
 

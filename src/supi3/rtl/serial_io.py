@@ -34,6 +34,7 @@ from amaranth.lib import wiring
 from amaranth.lib.wiring import In, Out
 
 from supi3 import serial_io as spec
+from supi3.checks import check_int
 from supi3.config import DataDirection
 from supi3.pinout import SYNC_STAGES
 from supi3.tables import BIT_RATES, SPI_MASTER_MFP
@@ -64,7 +65,15 @@ SER_IN_PIN: Final = next(function.pin for function in SPI_MASTER_MFP if function
 
 def schedule(kind: int, bits: int, bit_rate: int) -> spec.SerialSequence | None:
     """The spec's sequence of a kind: direction ``DIRECTIONS[kind]``, or that direction's clear sequence for
-    ``kind >= len(DIRECTIONS)`` (None in input mode)."""
+    ``kind >= len(DIRECTIONS)`` (None in input mode).
+
+    Raises
+    ------
+    ArgumentError
+        ``kind`` not from 0 to ``2 * len(DIRECTIONS) - 1`` (a negative kind took a direction from the end), ``bits``
+        or ``bit_rate`` not of Tables 2-4 to 2-6 and 1-7.
+    """
+    kind = check_int("kind", kind, 0, 2 * _CLEAR - 1, limit="a direction or its clear sequence")
     if kind < _CLEAR:
         return spec.sequence(DIRECTIONS[kind], bits, bit_rate)
     return spec.clear_sequence(DIRECTIONS[kind - _CLEAR], bits, bit_rate)

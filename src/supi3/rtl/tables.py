@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from functools import cache, cached_property
 from typing import Final
 
-from supi3.checks import fail
+from supi3.checks import check_instance, check_int, fail
 from supi3.config import DataDirection, DeviceConfig, Interface, MfpKind, Variant, decode, mode_rows
 from supi3.diagnostics import watches_line_interrupt
 from supi3.errors import ConfigurationError
@@ -192,8 +192,15 @@ def _bits(value: int, width: int) -> str:
 def line_position(word_bit: int, n: int) -> int:
     """The shift-register position (line order, 0 goes out first) of bit ``word_bit`` of an ``n``-byte data word:
     byte 0, the most significant, first (docs/interbus.md "Frame", 3.4.8), each byte LSB first or MSB first as
-    :data:`supi3.interbus.wire.DATA_LSB_FIRST` says."""
-    byte, k = divmod(word_bit, 8)
+    :data:`supi3.interbus.wire.DATA_LSB_FIRST` says.
+
+    Raises
+    ------
+    ArgumentError
+        ``n`` not an integer >= 1, ``word_bit`` not a bit of the word (0 to ``8 n - 1``).
+    """
+    n = check_int("n", n, 1, limit="bytes in the data word")
+    byte, k = divmod(check_int("word_bit", word_bit, 0, 8 * n - 1, limit=f"a bit of the {n}-byte word"), 8)
     return 8 * (n - 1 - byte) + (k if wire.DATA_LSB_FIRST else 7 - k)
 
 
@@ -211,6 +218,7 @@ def mode_entry(config: DeviceConfig) -> ModeEntry:
     ``In<k>``/``Out<k>`` signals of the binary I/O modes (Tables 3-1, 3-2), placed in line order; the output
     enables are the pins the mode drives (Tables 3-1 to 3-6, 2-8).
     """
+    check_instance("config", config, DeviceConfig)
     n = wire.data_bytes(config.length_code)
     binary = config.mfp_mode.kind is MfpKind.BINARY_IO
     in_pins: list[int | None] = [None] * (8 * n)
@@ -231,6 +239,8 @@ def clock_entry(clk_conf: int, config: DeviceConfig) -> ClockEntry:
     """The timing of the bit rate ``config`` selects through CLK_CONF = ``clk_conf`` (Table 1-7): the bit period
     (1.7.1), the repeater delay (docs/interbus.md A10, less the synchroniser's stages, M8) and the reset run
     (A12, M11)."""
+    check_int("clk_conf", clk_conf, 0, (1 << CLK_CONF_BITS) - 1, limit="CLK_CONF, Table 1-7")
+    check_instance("config", config, DeviceConfig)
     cpb = wire.clocks_per_bit(config.bit_rate)
     forward_delay = wire.REPEATER_DELAY_BITS * cpb - SYNC_STAGES
     return ClockEntry(clk_conf, BIT_RATES.index(config.bit_rate), cpb, forward_delay, wire.RESET_DETECT_BITS * cpb)
@@ -238,6 +248,7 @@ def clock_entry(clk_conf: int, config: DeviceConfig) -> ClockEntry:
 
 def serial_mode(config: DeviceConfig) -> SerialMode | None:
     """The serial I/O of ``config``'s MFP mode (SM-1: the "SPI" rows), or ``None``."""
+    check_instance("config", config, DeviceConfig)
     mode = config.mfp_mode
     return SerialMode(mode.direction, mode.width) if mode.kind is MfpKind.SPI_MASTER else None
 
@@ -245,11 +256,13 @@ def serial_mode(config: DeviceConfig) -> SerialMode | None:
 def rbst_by_pin(config: DeviceConfig) -> bool:
     """A following device is told by RBST_EXT (the row of Table 2-2 where RBST_EXT is "Controlled"), not
     recognised on DI2 (M5)."""
+    check_instance("config", config, DeviceConfig)
     return config.rf_mode is not None and config.rf_mode.rbst_ext == RBST_EXT_CONTROLLED
 
 
 def complete_diagnostics(config: DeviceConfig) -> bool:
     """DIAG1 shows BA: complete diagnostics (Table 3-16)."""
+    check_instance("config", config, DeviceConfig)
     return config.diagnostics is not None and config.diagnostics.diag1 == DIAG1_BA
 
 

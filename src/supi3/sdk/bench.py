@@ -378,7 +378,8 @@ class _ClockedBus:
             self.ring.finish(transfer, latch)
 
     def transfer(self, cycle: Cycle, data: bytes, close_after: int | None = None) -> Transfer:
-        self.flush()
+        if self.pending is not None:  # a second transfer in one master call
+            self.flush()
         return self.ring.transfer(cycle, data, close_after)
 
     def finish(self, transfer: Transfer, latch: bool) -> None:
@@ -405,15 +406,21 @@ class BenchTransport(ModelTransport):
         """One frame: the chip decides what it drives at /SS falling, takes the byte at /SS rising (UP-18, UP-19);
         the bus runs up to each edge."""
         bench = self.bench
-        bench.advance(bench.now)
+        if bench._next_at <= bench.now:  # a bus event due now (else advance(now) would only compare)
+            bench.advance(bench.now)
         driven = super().xfer(tx, s_r)
         bench.bytes_clocked += 1
-        bench.irq_edge()
+        if not bench._irq_level:  # FW-18: a byte may release /IRQ (a read of IRQ_EVT), never pull it low
+            bench.irq_edge()
         return driven
 
     def _during_frame(self) -> None:
         bench = self.bench
-        bench.advance(bench.now + bench.byte_s)
+        until = bench.now + bench.byte_s
+        if until < bench._next_at and until <= wire.MAX_BUS_TIME_S:  # advance's own shortcut: no bus event due
+            bench.now = until
+        else:
+            bench.advance(until)
 
     def delay_us(self, us: float) -> None:
         """Busy wait: the bus runs on."""
@@ -587,9 +594,6 @@ class Bench:
 
     # -- the bus side ------------------------------------------------------------------------------------------
 
-    def _next_event(self) -> float:
-        return self._next_at
-
     def advance(self, until: float) -> bool:
         """Run the bus up to time ``until`` and set the clock there (not backwards); whether a bus event (a cycle's
         start, phase or end) ran on the way: only then can the master's cycle have changed the chip.
@@ -604,36 +608,49 @@ class Bench:
             until = check_real("until", until)
             wire.check_bus_time("until", until, self.now, until - self.now)
         # Most calls (a byte, a pin read, the board's synchronisation at each peripheral access) find no bus event
-        # due: one comparison with the next event's time, kept by _step_bus and _start_cycle.
+        # due: one comparison with the next event's time, kept by _run_bus and _start_cycle.
         stepped = self._next_at <= until
-        while self._next_at <= until:
-            self._step_bus()
+        if stepped:
+            self._run_bus(until, False)
         if until > self.now:
             self.now = until
         return stepped
 
-    def _step_bus(self) -> None:
-        """The next bus event: a cycle starts, a phase begins, or the cycle ends."""
-        if not self._events:
-            self._start_cycle()
-            return
-        events = self._events
-        at, what = events.pop()
-        self._next_at = events[-1][0] if events else self._next_start
-        self.now = max(self.now, at)
-        if what == "io":
-            for chip in self._chips:
-                chip.set_io_access(True)
-        elif what == "latch":
-            for chip in self._chips:
-                chip.set_latch_phase(True)
-        else:
-            self._bus.flush()
-            for chip in self._chips:
-                chip.set_latch_phase(False)
-                chip.set_io_access(False)
-            self.cycles += 1
-            self.irq_edge()
+    def _run_bus(self, until: float, sleep: bool) -> None:
+        """Run the bus events due by ``until`` in their order: a cycle starts, a phase begins, or the cycle ends.
+
+        ``sleep``: the firmware sleeps (FW-18): only up to the next start or end, the events that may change /IRQ
+        (it wakes at most there), and the phases on the way are not set: they only set the chip's I/O access bit and
+        latch phase (MCU-31), which no one reads before the cycle's end, due in the same call, clears them."""
+        while self._next_at <= until:
+            events = self._events
+            if not events:
+                self._start_cycle()
+                if sleep:
+                    return
+                continue
+            at, what = events[-1]
+            del events[-1]
+            self._next_at = events[-1][0] if events else self._next_start
+            if at > self.now:
+                self.now = at
+            if what == "io":
+                if not sleep:
+                    for chip in self._chips:
+                        chip.set_io_access(True)
+            elif what == "latch":
+                if not sleep:
+                    for chip in self._chips:
+                        chip.set_latch_phase(True)
+            else:
+                self._bus.flush()
+                for chip in self._chips:
+                    chip.set_latch_phase(False)
+                    chip.set_io_access(False)
+                self.cycles += 1
+                self.irq_edge()
+                if sleep:
+                    return
 
     def _start_cycle(self) -> None:
         if self.cycles >= self._hold:  # MCU-55, FW-19: the run's cycles are done, the line idles until it ends
@@ -641,7 +658,8 @@ class Bench:
             self._next_start = self._next_at = math.inf
             return
         at = self._next_start
-        self.now = max(self.now, at)
+        if at > self.now:
+            self.now = at
         if at > self.ring.now:
             self.ring.idle(at - self.ring.now)
         result = self.master.cycle() if self._started else self.master.start()
@@ -692,7 +710,8 @@ class Bench:
     # -- interrupts --------------------------------------------------------------------------------------------
 
     def irq_edge(self) -> None:
-        """Watch /IRQ for a falling edge (FW-3: edge-triggered, as an MCU's external interrupt)."""
+        """Watch /IRQ for a falling edge (FW-3: edge-triggered, as an MCU's external interrupt): after each cycle's
+        start and end, and after a byte while /IRQ is low (FW-18: a byte may release it, only a cycle pulls it low)."""
         level = self.registers.irq_n
         if level < self._irq_level and self._irq_fell_at is None:
             self._irq_fell_at = self.now
@@ -703,7 +722,9 @@ class Bench:
         firmware = self.firmware
         if self._irq_fell_at is None or self._in_isr or firmware is None or not self._set_up:
             return
-        self.irq_latency_s = max(self.irq_latency_s, self.now - self._irq_fell_at)
+        latency = self.now - self._irq_fell_at
+        if latency > self.irq_latency_s:
+            self.irq_latency_s = latency
         self._irq_fell_at = None
         self._in_isr = True
         self.interrupts += 1
@@ -813,10 +834,10 @@ class Bench:
                 idle_loops = self._pass(loop, idle_loops)
             elif self.cycles >= target or self.now >= end:
                 break  # the service routine ran the bus to the end
-            elif self._next_event() > end:
-                self.advance(end)  # sleep to the end
+            elif (self._events[0][0] if self._events else self._next_start) > end:  # the next start or end
+                self.advance(end)  # sleep to the end, the phases on the way set (the cycle goes on after it)
             else:
-                self._step_bus()  # sleep until the bus does something
+                self._run_bus(math.inf, True)  # sleep until the bus may change /IRQ
         self.take_interrupt()
 
     def _main_loop(self) -> Callable[[Supi3Driver], None] | None:

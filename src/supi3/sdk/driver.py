@@ -49,6 +49,7 @@ __all__ = [
     "BLOCK_MAX_BYTES",
     "BLOCK_MIN_BYTES",
     "ERROR_CODES",
+    "IRQ_SERVICE_MAX_READS",
     "AsyncSupi3Driver",
     "AsyncTransport",
     "DirectAccess",
@@ -80,6 +81,9 @@ BLOCK_MIN_BYTES: Final[int] = 2
 """Shortest block transfer: one word (3.4.6, "lengths >= 1 word"); ``SUPI3_BLOCK_MIN_BYTES``."""
 BLOCK_MAX_BYTES: Final[int] = 4
 """Longest block transfer: IN0..IN3 / OUT0..OUT3 (3.4.8); ``SUPI3_BLOCK_MAX_BYTES``."""
+IRQ_SERVICE_MAX_READS: Final[int] = 4
+"""Most reads of IRQ_EVT in one :meth:`Supi3Driver.irq_service` while /IRQ stays low (3.4.14, FW-22);
+``SUPI3_IRQ_SERVICE_MAX_READS``."""
 SAS_INIT_PULSE_US: Final[float] = 1.0
 """SAS_INIT active time the driver holds (t_SAS_INIT >= 250 ns, 3.4.3), as ``supi3_sas_init``."""
 
@@ -148,8 +152,10 @@ class UnsupportedError(DriverError):
 
 
 class IoWindowTimeoutError(DriverError):
-    """``SUPI3_E_TIMEOUT``: the I/O access window did not open within ``max_polls`` polls (3.4.14). The events
-    the polls read (and so cleared) are in :attr:`events`."""
+    """``SUPI3_E_TIMEOUT``: a bounded wait of 3.4.14 ended: the I/O access window did not open within ``max_polls``
+    polls (:meth:`Supi3Driver.poll_io_window`), or /IRQ stayed low after :data:`IRQ_SERVICE_MAX_READS` reads of
+    IRQ_EVT (:meth:`Supi3Driver.irq_service`, FW-22). The events the reads returned (and so cleared) are in
+    :attr:`events`."""
 
     code = ErrorCode.E_TIMEOUT
 
@@ -477,10 +483,12 @@ class _Core:
     def sas_init(self) -> _Call[None]:
         initialized, self.initialized = self.initialized, False  # the interface waits for the init byte (3.4.3)
         if not (yield (_SAS, 1, False)):
-            self.initialized = initialized  # refused, nothing driven: the state is kept (FW-16)
+            self.initialized = initialized  # refused, nothing driven: the state is kept (FW-16, FW-21)
             raise UnsupportedError("sas_init(): the transport has no SAS_INIT pin")
         yield (_DELAY, SAS_INIT_PULSE_US, False)
-        yield (_SAS, 0, False)
+        if not (yield (_SAS, 0, False)):  # driven, then "not wired": a failure, as supi3_sas_init (FW-21)
+            raise TransportError("sas_init(): the transport drove SAS_INIT, then said it has no such pin; chip state "
+                                 "unknown: pulse SAS_INIT and initialize again")  # fmt: skip
 
     def read(self, register: object) -> _Call[int]:
         address = _address(register, AccessDirection.READ)
@@ -573,9 +581,20 @@ class _Core:
         return self._irq_service()
 
     def _irq_service(self) -> _Call[Irq]:
-        if (yield (_IRQ, 0, False)):
-            return Irq(0)
-        return Irq((yield from self._read(IRQ_EVT.address)))  # D7 too, as supi3_irq_service (FW-16)
+        # Read IRQ_EVT until /IRQ is high (3.4.14): an event that came during a read gives no new edge (FW-22).
+        events = 0
+        for reads in range(IRQ_SERVICE_MAX_READS + 1):
+            level = yield (_IRQ, 0, False)
+            if level:  # high: nothing (left) pending
+                break
+            if reads == IRQ_SERVICE_MAX_READS:
+                raise IoWindowTimeoutError(f"irq_service(): /IRQ still low after {reads} reads of IRQ_EVT (3.4.14, "
+                                           "FW-22)", events)  # fmt: skip
+            value = yield from self._read(IRQ_EVT.address)
+            events = (events & _EVENT_MASK) | value  # D6..D0 of every read, D7 of the last (FW-16)
+            if level is None:  # /IRQ not wired: one read (no edge to lose)
+                break
+        return Irq(events)
 
     def poll_io_window(self, max_polls: object) -> _Call[Irq]:
         polls = _checked(check_int, "max_polls", max_polls, 1, None, "polls of the I/O access bit")
@@ -736,8 +755,10 @@ class Supi3Driver(_DriverApi):
 
     def irq_service(self) -> Irq:
         """Read-clear IRQ_EVT (3.4.14): its events and, as ``supi3_irq_service``, D7, the I/O access status (RM-7,
-        RM-8; a bit that is no :class:`Irq` member: test events with ``&``); with /IRQ wired and high, return no
-        events and send nothing."""
+        RM-8; a bit that is no :class:`Irq` member: test events with ``&``). With /IRQ wired: high at once, no
+        events and nothing sent; else IRQ_EVT is read until /IRQ is high (an event that came during a read gives no
+        new falling edge, FW-22), the events of every read OR-ed, D7 of the last; :class:`IoWindowTimeoutError`
+        after :data:`IRQ_SERVICE_MAX_READS` reads. Without the pin: one read."""
         return self._run(self._core.irq_service())
 
     def poll_io_window(self, max_polls: int) -> Irq:

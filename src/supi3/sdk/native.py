@@ -75,7 +75,9 @@ CACHE_ENV: Final[str] = "SUPI3_NATIVE_CACHE"
 CALLBACK_FAILED: Final[int] = -1
 """What a callback returns to C after it caught an exception (the C driver reports ``SUPI3_E_TRANSPORT``)."""
 NOT_WIRED: Final[int] = -6
-"""What a board callback returns when the transport has no such pin (``SUPI3_E_UNSUPPORTED``)."""
+"""What a board callback returns when the transport has no such pin (``SUPI3_E_UNSUPPORTED``): the C driver then
+works as with a NULL callback, its state kept (FW-21; a transport's ``set_sas_init`` returning ``False``, a pin read
+returning ``None``)."""
 
 _CDEF: Final[str] = """
 typedef int (*supi3_xfer_fn)(void *user, uint8_t tx, uint8_t *rx, int s_r);
@@ -237,8 +239,18 @@ class NativeLibrary:
 
             ffi.def_extern(name=f"supi3_native_{name}", error=error)(callback)
 
-        def xfer(user: Any, tx: int, rx: Any, s_r: int) -> int:  # the hot path: no *args
-            return from_handle(user)._xfer(tx, rx, s_r)  # type: ignore[no-any-return]
+        def xfer(user: Any, tx: int, rx: Any, s_r: int) -> int:
+            """The hot path, one byte: inline, no method call and no ``*args`` (issue #13's speed, round 10)."""
+            firmware: CFirmware = from_handle(user)
+            if firmware._error is not None:
+                return CALLBACK_FAILED
+            protocol = firmware._protocol
+            phase = protocol.phase if protocol is not None else None
+            try:
+                rx[0] = firmware._xfer_to(tx, bool(s_r))
+            except BaseException as error:
+                return firmware._fail(error, firmware._describe_byte(tx, phase))
+            return 0
 
         ffi.def_extern(name="supi3_native_xfer", error=CALLBACK_FAILED)(xfer)
         register("delay_us", CFirmware._delay_us, None)
@@ -539,17 +551,6 @@ class CFirmware(Firmware):
             self._error = error
             self._where = where
         return CALLBACK_FAILED
-
-    def _xfer(self, tx: int, rx: Any, s_r: int) -> int:
-        if self._error is not None:
-            return CALLBACK_FAILED
-        protocol = self._protocol
-        phase = protocol.phase if protocol is not None else None
-        try:
-            rx[0] = self._xfer_to(tx, bool(s_r))
-        except BaseException as error:
-            return self._fail(error, self._describe_byte(tx, phase))
-        return 0
 
     def _describe_byte(self, tx: int, phase: Phase | None) -> str:
         if phase is Phase.INIT:

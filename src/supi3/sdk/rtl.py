@@ -41,8 +41,9 @@ from cocotb.task import bridge, resume
 from cocotb.triggers import Edge, Event, FallingEdge, First, Timer
 from cocotb.utils import get_sim_time
 
-from supi3.checks import check_bool, check_instance, check_int, check_real, describe
-from supi3.config import DeviceConfig
+from supi3.checks import check_bool, check_instance, check_int, check_real, check_trace, describe
+from supi3.config import DeviceConfig, MfpKind
+from supi3.errors import Supi3Error
 from supi3.interbus import wire
 from supi3.interbus.master import Master
 from supi3.model.pinring import PinRing
@@ -60,6 +61,7 @@ __all__ = [
     "BridgedTransport",
     "RtlBench",
     "RtlBoard",
+    "RtlBoardError",
     "RtlRing",
     "RtlTransport",
 ]
@@ -74,6 +76,11 @@ PIN_READ_CLOCKS: Final[int] = math.ceil(PIN_READ_S * CLOCK_HZ)
 """FW-9 on the RTL: one read of the I/O pin by the firmware costs :data:`supi3.sdk.bench.PIN_READ_S` (8 clocks)."""
 _RESET_POLL_CLOCKS: Final[int] = 16
 """How often :meth:`RtlBoard.start` looks whether the power-up reset has ended."""
+
+
+class RtlBoardError(Supi3Error, RuntimeError):
+    """The RTL board used out of order: before :meth:`RtlBoard.start`, started twice, a pin the chip does not drive
+    read as a level, :meth:`RtlBench.call` while another runs."""
 
 
 class RtlBoard:
@@ -96,6 +103,13 @@ class RtlBoard:
         self.mfp_in = expansion | sum(level << UP_INPUTS[name] for name, level in UP_INPUT_IDLE.items())
         self._di1: list[tuple[int, int]] = []  # (first clock index, level) of each change of di1
         self._di1_level = 1
+        self.started = False
+        """Whether :meth:`start` ran: the clock runs and the power-up reset is over."""
+
+    def require_started(self, what: str) -> None:
+        """Raise :class:`RtlBoardError` unless :meth:`start` ran (without the clock every wait would hang)."""
+        if not self.started:
+            raise RtlBoardError(f"{what} before RtlBoard.start(): the chip's clock does not run yet")
 
     # -- time --------------------------------------------------------------------------------------------------
 
@@ -111,15 +125,21 @@ class RtlBoard:
 
     @staticmethod
     async def clocks(count: int) -> None:
-        """Let ``count`` clock cycles pass (from a falling edge, to a falling edge)."""
-        if count > 0:
+        """Let ``count`` (>= 0) clock cycles pass (from a falling edge, to a falling edge)."""
+        if check_int("count", count, 0) > 0:
             await Timer(count * CLOCK_PS, unit="ps")
 
     # -- power-up ----------------------------------------------------------------------------------------------
 
     async def start(self) -> None:
         """Straps and quiet inputs, the clock, ``rst`` over a rising edge, then wait out the chip's power-up reset (the
-        µP block is held in reset while ``resu_drive`` is 1) and start recording ``di1``."""
+        µP block is held in reset while ``resu_drive`` is 1) and start recording ``di1``. Once per board object (a
+        second clock on ``clk`` and a second record of ``di1`` would run beside the first): make a new
+        :class:`RtlBoard` for each cocotb test."""
+        if self.started:
+            raise RtlBoardError("RtlBoard.start() called again: the clock and di1's record run already; make a new "
+                                "RtlBoard for each cocotb test")  # fmt: skip
+        self.started = True
         dut = self.dut
         for name, value in {**self._straps, **_QUIET, "do1": wire.IDLE_LEVEL}.items():
             getattr(dut, name).value = value
@@ -143,7 +163,8 @@ class RtlBoard:
             self._di1.append((math.ceil(int(get_sim_time("ps")) / CLOCK_PS - 0.5), int(di1.value)))
 
     def returned(self, first: int, count: int) -> npt.NDArray[np.uint8]:
-        """``di1`` in clock cycles ``first`` to ``first + count - 1``; forgets what came before them."""
+        """``di1`` in clock cycles ``first`` to ``first + count - 1`` (both >= 0); forgets what came before them."""
+        first, count = check_int("first", first, 0), check_int("count", count, 0)
         samples = np.full(count, self._di1_level, dtype=np.uint8)
         kept: list[tuple[int, int]] = []
         for cycle, level in self._di1:
@@ -158,17 +179,24 @@ class RtlBoard:
     # -- pins --------------------------------------------------------------------------------------------------
 
     def drive_up(self, **levels: int) -> None:
-        """Set µP input pins by name (``sclk``, ``ss_n``, ``mfp6``, ``mfp7``, ``sas_init``; Tables 3-5, 3-6)."""
+        """Set µP input pins by name (``sclk``, ``ss_n``, ``mfp6``, ``mfp7``, ``sas_init``; Tables 3-5, 3-6) to 0 or
+        1; a name that is no µP input or a level that is no bit changes no pin."""
         value = self.mfp_in
         for name, level in levels.items():
+            if name not in UP_INPUTS:
+                raise DriverArgumentError("name", name, f"pin must be one of the µP inputs {sorted(UP_INPUTS)} "
+                                          f"(Tables 3-5, 3-6), not {name!r}")  # fmt: skip
             bit = 1 << UP_INPUTS[name]
-            value = value | bit if level else value & ~bit
+            value = value | bit if check_int(name, level, 0, 1) else value & ~bit
         if value != self.mfp_in:
             self.mfp_in = value
             self.dut.mfp_in.value = value
 
     def up_output(self, name: str) -> int | None:
         """A µP output pin's level (``io``, ``c_d``, ``irq_n``, ``mfp6``, ``mfp7``), ``None`` while undriven."""
+        if name not in UP_OUTPUTS:
+            raise DriverArgumentError("name", name, f"name must be one of the µP outputs {sorted(UP_OUTPUTS)} "
+                                      f"(Tables 3-5, 3-6), not {describe(name)}")  # fmt: skip
         bit = UP_OUTPUTS[name]
         if not (int(self.dut.mfp_oe.value) >> bit) & 1:
             return None
@@ -176,7 +204,17 @@ class RtlBoard:
 
     def set_stat_err(self, active: bool) -> None:
         """Drive /StatErr (3.6.2): ``True`` pulls it low."""
-        self.dut.stat_err_n.value = int(not active)
+        self.dut.stat_err_n.value = int(not check_bool("active", active))
+
+    def status_pin(self, name: str) -> int:
+        """A status output the chip always drives in the µP modes (``c_d``, ``irq_n``, ``io``; UP-24) as a level;
+        :class:`RtlBoardError` if it is undriven (the board not started, or not strapped for Init-µP): ``None``
+        would tell the driver the board does not wire the pin and turn its checks off."""
+        level = self.up_output(name)
+        if level is None:
+            raise RtlBoardError(f"{name} is not driven by the chip: a status output is driven in the Init-µP mode "
+                                "once the power-up reset is over (UP-24)")  # fmt: skip
+        return level
 
     async def irq_low_or(self, stop: Event) -> None:
         """Return once /IRQ is low, or ``stop`` is set."""
@@ -205,17 +243,28 @@ class RtlTransport(AsyncTransport):
     def __init__(self, board: RtlBoard, mode: Mode = Mode.MOTOROLA, timing: MasterTiming | None = None, *,
                  io_pin: bool = True) -> None:  # fmt: skip
         self.board = check_instance("board", board, RtlBoard)
+        if board.config.mfp_mode.kind is not MfpKind.INIT_UP:
+            raise DriverArgumentError("board", board, f"board must be strapped for the Init-µP mode (Tables 3-1, "
+                                      f"3-2): in {board.config.mfp_mode.name} the chip has no serial µP interface "
+                                      "(as UpInterface)")  # fmt: skip
         if type(mode) is not Mode:
             raise DriverArgumentError("mode", mode, f"mode must be Mode.MOTOROLA or Mode.INTEL, not {describe(mode)}")
         self.mode = mode
-        self.timing = timing or MasterTiming.fastest(board.config.bit_rate)
+        if timing is None:
+            timing = MasterTiming.fastest(board.config.bit_rate)
+        self.timing = check_instance("timing", timing, MasterTiming)
         self.io_pin = check_bool("io_pin", io_pin)
         self.frames = 0
 
     async def xfer(self, tx: int, s_r: bool) -> int:
         """/SS high for the gap (S/R set at its start in Intel mode), /SS low, eight SCLK periods (data out at each
-        fall, the chip's bit sampled at each rise), SCLK high until /SS rises (UP-5 to UP-9)."""
+        fall, the chip's bit sampled at each rise), SCLK high until /SS rises (UP-5 to UP-9). ``tx`` one byte,
+        ``s_r`` a bool, as from the driver (checked: a direct caller's 300 would go out as 2Ch)."""
+        if type(tx) is not int or not 0 <= tx <= 0xFF:
+            tx = check_int("tx", tx, 0, 0xFF, "one byte")
+        s_r = check_bool("s_r", s_r)
         board, t = self.board, self.timing
+        board.require_started("RtlTransport.xfer()")
         intel = self.mode is Mode.INTEL
         sends = not intel or s_r
         await board.align()
@@ -237,33 +286,40 @@ class RtlTransport(AsyncTransport):
         return received
 
     async def delay_us(self, us: float) -> None:
-        """Wait whole clocks, at least ``us``."""
+        """Wait whole clocks, at least ``us`` (a finite number >= 0)."""
+        clocks = math.ceil(check_real("us", us, 0.0) * 1e6 / CLOCK_PS)
+        self.board.require_started("RtlTransport.delay_us()")
         await self.board.align()
-        await self.board.clocks(math.ceil(check_real("us", us, 0.0) * 1e6 / CLOCK_PS))
+        await self.board.clocks(clocks)
 
     async def read_cd(self) -> int | None:
         """C/D (MFP2) once the last frame's /SS rise has settled (t6 of Table 3-7, a gap)."""
+        self.board.require_started("RtlTransport.read_cd()")
         await self.board.align()
         await self.board.clocks(self.timing.gap)
-        return self.board.up_output("c_d")
+        return self.board.status_pin("c_d")
 
     async def read_irq(self) -> int | None:
         """/IRQ (MFP3)."""
-        return self.board.up_output("irq_n")
+        self.board.require_started("RtlTransport.read_irq()")
+        return self.board.status_pin("irq_n")
 
     async def read_io(self) -> int | None:
         """The I/O access pin (MFP1), read in :data:`PIN_READ_CLOCKS` (so a loop polling it lets the bus run);
         ``None`` if the pin is not wired (``io_pin``)."""
         if not self.io_pin:
             return None
+        self.board.require_started("RtlTransport.read_io()")
         await self.board.align()
         await self.board.clocks(PIN_READ_CLOCKS)
-        return self.board.up_output("io")
+        return self.board.status_pin("io")
 
     async def set_sas_init(self, level: int) -> bool:
-        """SAS_INIT (MFP0)."""
+        """SAS_INIT (MFP0), 1 = active."""
+        level = check_int("level", level, 0, 1)
+        self.board.require_started("RtlTransport.set_sas_init()")
         await self.board.align()
-        self.board.drive_up(sas_init=check_int("level", level, 0, 1))
+        self.board.drive_up(sas_init=level)
         return True
 
 
@@ -310,14 +366,16 @@ class RtlRing(PinRing):
     def __init__(self, board: RtlBoard) -> None:
         # The model of the same straps stands for the chip in PinRing's bookkeeping (bit rate, ring size); the
         # line runs through the RTL.
-        super().__init__([Supi3Pins(board.config)])
+        super().__init__([Supi3Pins(check_instance("board", board, RtlBoard).config)])
         self.board = board
 
     def run_samples(self, samples: npt.NDArray[np.uint8]) -> None:
-        """Drive ``samples`` (one per clock) on ``do1`` and append what ``di1`` returned meanwhile."""
-        forward = np.asarray(samples, dtype=np.uint8)
+        """Drive ``samples`` (one level per clock, 0 or 1, as :meth:`PinRing.run_samples`) on ``do1`` and append what
+        ``di1`` returned meanwhile."""
+        forward = check_trace("samples", samples, 1).astype(np.uint8, copy=False)
         if not len(forward):
             return
+        self.board.require_started("RtlRing.run_samples()")
         returned = resume(self._drive)(forward)
         self.cycle += len(forward)
         self.returned = np.concatenate([self.returned, returned])
@@ -371,6 +429,8 @@ class RtlBench:
         self.interrupts = 0
         self._stop = Event()
         self._stopping = threading.Event()
+        self._set_up = False
+        self._calling = False
 
     def run(self, cycles: int) -> None:
         """Run ``cycles`` more master cycles (the first call starts the master: Alarm Stop and discovery)."""
@@ -407,9 +467,27 @@ class RtlBench:
         self._stop.set()
 
     async def call(self, scenario: Callable[[], _T]) -> _T:
-        """Run the firmware's setup, then ``scenario()`` with the firmware running; return what it returns."""
-        await bridge(self.firmware.setup)(self.driver)
-        running = cocotb.start_soon(bridge(self._firmware)())
-        result = await bridge(self._scenario)(scenario)
-        await running
+        """Run the firmware's setup (at the first call only: power-up, as ``Bench.power_up``), then ``scenario()``
+        with the firmware running; return what it returns. Calls run one after the other (each starts the firmware
+        again where the last left it); one while another runs is an :class:`RtlBoardError`. Whatever the scenario
+        raises is raised once the firmware has stopped."""
+        if not callable(scenario):
+            raise DriverArgumentError("scenario", scenario, f"scenario must be a callable, not {describe(scenario)}")
+        self.board.require_started("RtlBench.call()")
+        if self._calling:
+            raise RtlBoardError("RtlBench.call() while another call runs: await it first")
+        self._calling = True
+        try:
+            if not self._set_up:
+                self._set_up = True
+                await bridge(self.firmware.setup)(self.driver)
+            self._stop = Event()
+            self._stopping.clear()
+            running = cocotb.start_soon(bridge(self._firmware)())
+            try:
+                result = await bridge(self._scenario)(scenario)
+            finally:
+                await running
+        finally:
+            self._calling = False
         return result

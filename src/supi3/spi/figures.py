@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from types import ModuleType
 from typing import Final, Generic, TypeVar
 
+from supi3.checks import check_instance, check_int
 from supi3.config import decode
 from supi3.model.registers import RegisterFile
 from supi3.regmap import BLOCK_ADDRESS, REGISTER_MAP, encode_command
@@ -96,8 +97,16 @@ def to_wavejson(trace: SpiTrace, title: str, *, step: int | None = None) -> dict
 
     With :meth:`MasterTiming.aligned` every edge of the µP starts a column; the chip's outputs (2 TCLK + 1
     clock after their cause, UP-14) then show one column after it as long as that is less than ``step``.
+
+    Raises
+    ------
+    ArgumentError
+        ``trace`` not a :class:`SpiTrace`, ``title`` not a str, ``step`` neither ``None`` nor an integer >= 1 (0
+        used to mean the default, a negative step drew no column).
     """
-    step = step or trace.timing.low
+    check_instance("trace", trace, SpiTrace)
+    check_instance("title", title, str, "a str")
+    step = trace.timing.low if step is None else check_int("step", step, 1, limit="chip clocks per column")
     columns = range(0, len(trace), step)
     signal: list[object] = []
     for name, level in _lanes(trace):

@@ -1,9 +1,10 @@
 """A software µP on the serial µP interface's pins: a bus-functional model of the SPI master, and its traces.
 
-:class:`SoftMaster` drives :class:`~supi3.spi.slave_pins.SlavePins` (or any model with its ``tick``) pin by pin at
-the chip clock, within Table 3-7 (IBS SUPI 3 OPC UM E rev. 05, 3.4.2): SCLK idles high, the µP changes its data on
-falling edges and both sides sample on rising edges (UP-5), one byte per /SS low period (UP-7); the edges are placed
-by :class:`MasterTiming`. Every pin of every cycle can be recorded in a :class:`SpiTrace`, which can be
+:class:`SoftMaster` drives :class:`~supi3.spi.slave_pins.SlavePins` (or a :class:`PinPort` such as
+:class:`supi3.top.ChipPort`) pin by pin at the chip clock, within Table 3-7 (IBS SUPI 3 OPC UM E rev. 05, 3.4.2):
+SCLK idles high, the µP changes its data on falling edges and both sides sample on rising edges (UP-5), one byte per
+/SS low period (UP-7); the edges are placed by :class:`MasterTiming`. Every pin of every cycle can be recorded in
+a :class:`SpiTrace`, which can be
 
 * decoded back into bytes from the pins alone (:func:`decode_bytes`),
 * written as a VCD (:func:`write_spi_vcd`),
@@ -18,12 +19,12 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Final, Protocol
+from typing import Final, Protocol, runtime_checkable
 
 from vcd import VCDWriter
 
 from supi3 import tables
-from supi3.checks import check_int
+from supi3.checks import check_bits, check_bool, check_instance, check_int, check_real, fail
 from supi3.model.registers import RegisterFile
 from supi3.model.vcd import CLOCK_PS
 from supi3.spi.slave_pins import INPUT_PINS, OUTPUT_PINS, PinsIn, PinsOut, SlavePins
@@ -42,6 +43,15 @@ __all__ = [
 
 _EPSILON: Final[float] = 1e-6
 """Tolerance (in clock cycles) when rounding Table 3-7's times up to whole chip clocks."""
+
+_LEAST_CLOCKS: Final[dict[str, int]] = {"low": 1, "high": 1, "lead": 0, "trail": 1, "gap": 1}
+"""The fewest clocks each :class:`MasterTiming` field may hold and still make a byte (UP-45)."""
+_LEAST_WHY: Final[dict[str, str]] = {
+    "low": "SCLK low for a whole clock", "high": "SCLK high for a whole clock",
+    "lead": "a count of clocks", "trail": "the eighth SCLK rise before /SS rises",
+    "gap": "/SS high between bytes, UP-7",
+}
+"""Why each field has its floor, as the error quotes it."""
 
 
 # ------------------------------------------------------------------------------------------------------------
@@ -69,6 +79,12 @@ class MasterTiming:
     gap: int
     """/SS high between bytes: t6 (maximum, C/D settles) plus t8 (C/D stable before /SS falls)."""
 
+    def __post_init__(self) -> None:
+        # A timing may break Table 3-7 on purpose (a test of the chip's checks), but it must still be a byte: each
+        # SCLK phase and the trail at least one clock, /SS high for at least one clock between bytes (UP-7).
+        for name, lowest in _LEAST_CLOCKS.items():
+            object.__setattr__(self, name, check_int(name, getattr(self, name), lowest, limit=_LEAST_WHY[name]))
+
     @property
     def period(self) -> int:
         """The SCLK period in chip clocks (t0)."""
@@ -84,7 +100,13 @@ class MasterTiming:
         ------
         UpifUsageError
             If ``sclk_hz`` is faster than t0 allows.
+        ArgumentError
+            ``sclk_hz`` not a finite number >= 1, ``clock_hz`` not an integer >= 1.
         """
+
+        clock_hz = check_int("clock_hz", clock_hz, 1, limit="chip clock in Hz")
+        if sclk_hz is not None:
+            sclk_hz = check_real("sclk_hz", sclk_hz, 1.0, limit="SCLK frequency in Hz")
 
         def cycles(seconds: float) -> int:
             return math.ceil(seconds * clock_hz - _EPSILON)
@@ -132,16 +154,45 @@ class SpiTrace:
     mosi_oe: list[int] = field(default_factory=list)
     """1 while the µP drives MFP6 (always in Motorola mode; in Intel mode while /SS is low and S/R = 1)."""
 
+    def __post_init__(self) -> None:
+        check_instance("mode", self.mode, Mode, "a supi3.spi.upif.Mode")
+        check_instance("timing", self.timing, MasterTiming)
+        check_int("clock_hz", self.clock_hz, 1)
+        check_int("bit_rate", self.bit_rate, 1)
+        check_int("first_cycle", self.first_cycle, 0)
+        lists = {"inputs": self.inputs, "outputs": self.outputs, "mosi_oe": self.mosi_oe}
+        for name, items in lists.items():
+            check_instance(name, items, list, "a list, one item per cycle")
+        if not len(self.inputs) == len(self.outputs) == len(self.mosi_oe):
+            raise fail("outputs", f"one item per cycle of inputs ({len(self.inputs)}), as mosi_oe",
+                       f"{len(self.outputs)} outputs and {len(self.mosi_oe)} mosi_oe")
+
     def __len__(self) -> int:
         return len(self.inputs)
 
+    def _cycle(self, k: int) -> int:
+        """``k`` as an index of a recorded cycle (0 to ``len - 1``), else the named error."""
+        if type(k) is int and 0 <= k < len(self.inputs):
+            return k
+        return check_int("k", k, 0, len(self.inputs) - 1, limit="a recorded cycle")
+
     def window(self, start: int, stop: int | None = None) -> SpiTrace:
-        """The cycles ``start`` to ``stop`` (indices into this trace) as a trace of their own."""
+        """The cycles ``start`` to ``stop`` (indices into this trace, as a slice takes them) as a trace of their own.
+
+        Raises
+        ------
+        ArgumentError
+            ``start`` not an integer, ``stop`` neither an integer nor ``None``.
+        """
+        start = check_int("start", start)
+        if stop is not None:
+            stop = check_int("stop", stop)
         return replace(self, first_cycle=self.first_cycle + start, inputs=self.inputs[start:stop],
                        outputs=self.outputs[start:stop], mosi_oe=self.mosi_oe[start:stop])
 
     def mfp6_line(self, k: int) -> str:
         """The level on MFP6 in cycle ``k``: ``"0"``/``"1"``, ``"z"`` if nobody drives, ``"x"`` if both do."""
+        k = self._cycle(k)
         chip, mosi = self.outputs[k].mfp6_oe, self.mosi_oe[k]
         if chip and mosi:
             return "x"
@@ -151,11 +202,13 @@ class SpiTrace:
 
     def mfp7_line(self, k: int) -> str:
         """The level on MFP7 in cycle ``k``: the chip's SerOUT (Motorola) or the µP's S/R (Intel)."""
+        k = self._cycle(k)
         if self.outputs[k].mfp7_oe:
             return str(self.outputs[k].mfp7)
         return str(self.inputs[k].mfp7) if self.mode is Mode.INTEL else "z"
 
 
+@runtime_checkable
 class PinPort(Protocol):
     """Pins :class:`SoftMaster` drives besides :class:`SlavePins`: the whole chip's, :class:`supi3.top.ChipPort`."""
 
@@ -190,10 +243,22 @@ class SoftMaster:
         Edge placement; default :meth:`MasterTiming.fastest` at the chip's bit rate.
     record:
         Keep every cycle's pins for :meth:`trace` (off for benchmarks).
+
+    Raises
+    ------
+    ArgumentError
+        ``chip`` neither a :class:`SlavePins` nor a :class:`PinPort`, ``mode`` not a :class:`Mode`, ``timing`` not a
+        :class:`MasterTiming` or ``None``, ``record`` not a bool.
     """
 
     def __init__(self, chip: SlavePins | PinPort, mode: Mode, timing: MasterTiming | None = None, *,
                  record: bool = True) -> None:
+        if not isinstance(chip, SlavePins | PinPort):
+            raise fail("chip", "a SlavePins or a PinPort (such as supi3.top.ChipPort)", chip)
+        check_instance("mode", mode, Mode, "a supi3.spi.upif.Mode")
+        if timing is not None:
+            check_instance("timing", timing, MasterTiming, "a MasterTiming or None")
+        check_bool("record", record)
         bit_rate = chip.registers.config.bit_rate
         self.chip = chip
         """What the master drives: the interface's pins (:class:`SlavePins` or a :class:`PinPort`)."""
@@ -213,7 +278,18 @@ class SoftMaster:
 
     def run(self, cycles: int, **changes: int) -> list[PinsOut]:
         """Apply ``changes`` (pin names of :class:`PinsIn`) and hold the pins for ``cycles`` cycles; return the
-        outputs of those cycles (the first is what the µP sees right at its edge)."""
+        outputs of those cycles (the first is what the µP sees right at its edge).
+
+        Raises
+        ------
+        ArgumentError
+            ``cycles`` not an integer >= 0, a name not a pin of :class:`PinsIn` or a level not 0 or 1 (nothing
+            changes).
+        """
+        check_int("cycles", cycles, 0)
+        for name in changes:
+            if name not in INPUT_PINS:
+                raise fail("pin", f"one of {', '.join(INPUT_PINS)}", name)
         self._pins = replace(self._pins, **changes)
         chip = self.chip
         outputs = [chip.tick(self._pins) for _ in range(cycles)] if isinstance(chip, SlavePins) \
@@ -272,7 +348,15 @@ class SoftMaster:
 
     def deselect(self, *, s_r: bool | None = None) -> None:
         """/SS high (it rises now if it was low) for the gap between bytes; in Intel mode S/R takes ``s_r`` in
-        the same cycle (t10, t11) and the µP releases Ser_IN/OUT."""
+        the same cycle (t10, t11) and the µP releases Ser_IN/OUT.
+
+        Raises
+        ------
+        ArgumentError
+            ``s_r`` neither a bool nor ``None``.
+        """
+        if s_r is not None:
+            check_bool("s_r", s_r)
         self._mosi_oe = int(self.mode is Mode.MOTOROLA)
         level = self._pins.mfp7 if s_r is None or self.mode is Mode.MOTOROLA else int(s_r)
         self.run(self.timing.gap, ss_n=1, mfp7=level)
@@ -294,7 +378,14 @@ class SoftMaster:
         int | None
             The byte the µP sampled from the chip at the rising edges (SerOUT, or Ser_IN/OUT with S/R = 0),
             ``None`` if the chip did not drive at all eight.
+
+        Raises
+        ------
+        ArgumentError
+            ``mosi`` not a byte (0 to 255), ``s_r`` not a bool (nothing is sent).
         """
+        mosi = check_bits("mosi", mosi, 8, "one byte per /SS low period, UP-7")
+        check_bool("s_r", s_r)
         t = self.timing
         intel = self.mode is Mode.INTEL
         sends = not intel or s_r
@@ -355,7 +446,14 @@ def _assemble(bits: Sequence[int | None], lsb_first: bool) -> int | None:
 
 def decode_bytes(trace: SpiTrace) -> list[DecodedByte]:
     """Every complete /SS low period of ``trace`` (a /SS fall and the following rise), sampled at the rising
-    SCLK edges as the µP and the chip sample them (UP-5, UP-6)."""
+    SCLK edges as the µP and the chip sample them (UP-5, UP-6).
+
+    Raises
+    ------
+    ArgumentError
+        ``trace`` not a :class:`SpiTrace`.
+    """
+    check_instance("trace", trace, SpiTrace)
     intel = trace.mode is Mode.INTEL
     found: list[DecodedByte] = []
     start: int | None = None
@@ -395,7 +493,17 @@ def write_spi_vcd(path: Path, trace: SpiTrace) -> Path:
     Scopes: ``upif.up`` the µP's pins (:data:`~supi3.spi.slave_pins.INPUT_PINS` plus ``mosi_oe``), ``upif.chip``
     the chip's outputs and enables (:data:`~supi3.spi.slave_pins.OUTPUT_PINS`), ``upif.line`` the resolved
     levels of MFP6 and MFP7 (``z`` undriven, ``x`` driven by both).
+
+    Raises
+    ------
+    ArgumentError
+        ``path`` not a :class:`~pathlib.Path`, ``trace`` not a :class:`SpiTrace` or without a cycle (nothing is
+        written).
     """
+    check_instance("path", path, Path, "a pathlib.Path")
+    check_instance("trace", trace, SpiTrace)
+    if not len(trace):
+        raise fail("trace", "a trace of at least one cycle", trace)
     probes: list[tuple[str, str, Callable[[int], int | str]]] = [
         *(("upif.up", name, lambda k, name=name: int(getattr(trace.inputs[k], name))) for name in INPUT_PINS),
         ("upif.up", "mosi_oe", lambda k: trace.mosi_oe[k]),

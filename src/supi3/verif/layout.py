@@ -17,6 +17,7 @@ from typing import TypeAlias
 import numpy as np
 import numpy.typing as npt
 
+from supi3.checks import check_instance, fail
 from supi3.pinlevel import Pin, PinModel, PinSpecError, check_cycles, compared_signals
 
 __all__ = [
@@ -174,7 +175,15 @@ class WordLayout:
         return None
 
     def input_words(self, stimulus: CycleMatrix) -> npt.NDArray[np.uint32]:
-        """Stimulus ``(cycles, inputs)`` packed into ``uint32`` input words ``(cycles, words)``."""
+        """Stimulus ``(cycles, inputs)`` packed into ``uint32`` input words ``(cycles, words)``.
+
+        Raises
+        ------
+        ArgumentError
+            ``stimulus`` not a 2-D integer array of one column per input pin, or a value past its pin's width (it
+            would spill into the next field of the word, so the design would see other inputs than the model).
+        """
+        stimulus = _input_matrix(stimulus, self.in_fields)
         # One integer matrix product places every field of up to 32 bits (the fields of a word are disjoint and
         # the stimulus is range-checked, so the sums are exact); a wider field fills its two words alone.
         weights = np.zeros((len(self.in_fields), max(self.in_words, 1)), dtype=np.uint64)
@@ -389,5 +398,58 @@ def first_mismatch(layout: WordLayout, expected: CycleMatrix, actual: CycleMatri
 
     Within the first differing cycle the lowest signal index (comparison order) is reported. The traces are compared
     as packed words, like the batch path (:meth:`WordLayout.first_word_mismatch`).
+
+    Raises
+    ------
+    ArgumentError
+        ``layout`` not a :class:`WordLayout`; a trace not a 2-D integer array of one column per compared signal, a
+        value outside its signal's width (packed, it spilled into the next signal: a difference named the wrong
+        pin, or two differences cancelled), or the traces of different lengths.
     """
+    check_instance("layout", layout, WordLayout)
+    expected = _output_trace("expected", expected, layout)
+    actual = _output_trace("actual", actual, layout)
+    if actual.shape[0] != expected.shape[0]:
+        raise fail("actual", f"as many cycles as expected ({expected.shape[0]})", f"{actual.shape[0]} cycles")
     return layout.first_word_mismatch(layout.output_words(expected), layout.output_words(actual))
+
+
+def _within(field: WordField) -> str:
+    return f"a value of {field.name!r} within {field.width} bit{'s' if field.width != 1 else ''}"
+
+
+def _input_matrix(stimulus: object, fields: Sequence[WordField]) -> CycleMatrix:
+    """``stimulus`` as a ``(cycles, inputs)`` integer array whose every value fits its pin, else the named error."""
+    wanted = f"a (cycles, {len(fields)}) integer array of the input pins"
+    if not isinstance(stimulus, np.ndarray) or stimulus.ndim != 2 or stimulus.shape[1] != len(fields) \
+            or (stimulus.size and stimulus.dtype.kind not in "iu"):
+        raise fail("stimulus", wanted, stimulus)
+    if stimulus.size:
+        if stimulus.dtype.kind == "i" and stimulus.min() < 0:
+            cycle, index = np.argwhere(stimulus < 0)[0].tolist()
+            raise fail(f"stimulus[{cycle}, {index}]", _within(fields[index]), stimulus[cycle, index].item())
+        masks = np.array([field.mask for field in fields], dtype=np.uint64)
+        over = stimulus.astype(np.uint64, copy=False) > masks
+        if over.any():
+            cycle, index = np.argwhere(over)[0].tolist()
+            raise fail(f"stimulus[{cycle}, {index}]", _within(fields[index]), stimulus[cycle, index].item())
+    return stimulus
+
+
+def _output_trace(name: str, trace: object, layout: WordLayout) -> CycleMatrix:
+    """``trace`` as a ``(cycles, signals)`` array of compared output values, each within its signal's width."""
+    signals = len(layout.out_fields)
+    wanted = f"a (cycles, {signals}) integer array of the compared outputs"
+    try:
+        array = np.asarray(trace)
+    except (TypeError, ValueError) as error:
+        raise fail(name, wanted, trace) from error
+    if array.ndim != 2 or array.shape[1] != signals or (array.size and array.dtype.kind not in "iu"):
+        raise fail(name, wanted, trace)
+    for index, field in enumerate(layout.out_fields):
+        column = array[:, index]
+        bad = (column < 0) | (column > field.mask) if column.dtype.kind == "i" else column > field.mask
+        if bad.any():
+            cycle = int(np.argmax(bad))
+            raise fail(f"{name}[{cycle}, {index}]", _within(field), column[cycle].item())
+    return array.astype(np.uint64, copy=False)

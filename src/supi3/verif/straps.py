@@ -15,7 +15,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import numpy.typing as npt
 
-from supi3.checks import check_bits, check_instance, fail
+from supi3.checks import check_bits, check_instance, check_trace, fail
 from supi3.config import DeviceConfig, Variant, decode, mode_rows
 from supi3.model.pins import Supi3Pins, check_names, input_row, input_traces, split_optical, split_optical_traces
 from supi3.pinlevel import Pin, PinSpecError
@@ -72,8 +72,8 @@ def strap_stimulus(config: DeviceConfig, stimulus: npt.NDArray[np.integer],
     Raises
     ------
     ArgumentError
-        ``config`` is not a :class:`DeviceConfig`, or ``stimulus`` not a 2-D integer array of that shape whose
-        columns fit their pins' widths.
+        ``config`` is not a :class:`DeviceConfig`, or ``stimulus`` (``optical``) not a 2-D integer array of that
+        shape whose columns fit their pins' widths.
     """
     values = strap_inputs(config)
     pins = Supi3Pins.inputs
@@ -92,6 +92,8 @@ def strap_stimulus(config: DeviceConfig, stimulus: npt.NDArray[np.integer],
         given_lines = np.asarray(optical)
         if given_lines.shape != lines.shape or (given_lines.size and given_lines.dtype.kind not in "iu"):
             raise fail("optical", f"a 2-D integer array of {lines.shape} in Supi3Pins.optical_inputs order", optical)
+        for k, pin in enumerate(Supi3Pins.optical_inputs):  # a value past its width would spill into the next port
+            check_trace(f"optical column {k} ({pin.name!r})", given_lines[:, k], pin.width)
         lines = given_lines.astype(np.uint64)
     return np.concatenate([array, straps, lines], axis=1)
 

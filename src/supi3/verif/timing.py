@@ -132,10 +132,12 @@ def raise_first(violations: Iterable[TimingViolation]) -> None:
     Raises
     ------
     ArgumentError
-        An item of ``violations`` is not a :class:`TimingViolation`.
+        ``violations`` not an iterable (a string included), or an item of it not a :class:`TimingViolation`.
     TraceTimingError
         ``violations`` is not empty.
     """
+    if isinstance(violations, str | bytes) or not isinstance(violations, Iterable):
+        raise fail("violations", "an iterable of TimingViolation", violations)
     found = [check_instance("violation", v, TimingViolation) for v in violations]
     if found:
         raise TraceTimingError(sorted(found, key=lambda v: v.clock))

@@ -12,7 +12,10 @@
  *  - Intel (8051 serial mode 0): LSB first on the wire (UP-6); the callback sets the S/R pin to s_r before
  *    /SS falls: 1 = the uP sends (chip writes), 0 = the chip drives Ser_IN/OUT (Table 3-9, UP-9).
  *  - Byte values in this API are always the manual's values (bit 7 = RD etc.); bit order is the transport's job.
- *  - Every callback returns 0 on success, anything else is reported as SUPI3_E_TRANSPORT.
+ *  - Every callback returns 0 on success, anything else is reported as SUPI3_E_TRANSPORT, except that a pin
+ *    callback (read_irq, read_cd, read_io, set_sas_init) may return SUPI3_E_UNSUPPORTED to say "this board does not
+ *    wire the pin" (one image for board variants): the driver then works as with a NULL callback, its state kept
+ *    (FW-21, docs/sdk.md). set_sas_init may say so only when asked to drive the pin active (level 1).
  */
 #ifndef SUPI3_H
 #define SUPI3_H
@@ -35,7 +38,7 @@ typedef enum {
     SUPI3_E_NOT_READY = -4,   /**< C/D showed "data" before the init byte: command interrupted or interface disabled (UP-4, UP-27); nothing sent */
     SUPI3_E_NOT_RESET = -5,   /**< the chip was not reset: it took the init byte as a command (UP-3); pulse SAS_INIT, initialize again */
     SUPI3_E_UNSUPPORTED = -6, /**< not possible in this mode or without an optional callback (exchange in Intel mode, 3.4.4) */
-    SUPI3_E_TIMEOUT = -7      /**< the I/O access window did not open within max_polls (supi3_poll_io_window, 3.4.14) */
+    SUPI3_E_TIMEOUT = -7      /**< a bounded wait ended: the I/O access window did not open within max_polls (supi3_poll_io_window), /IRQ stayed low (supi3_irq_service), 3.4.14 */
 } supi3_err_t;
 
 /** Interface mode selected by the initialization byte (3.4.3, Table 3-8). */
@@ -49,6 +52,9 @@ typedef enum {
 #define SUPI3_BLOCK_MAX_BYTES 4u
 /** Highest address a single access may name; 15 is the block transfer (3.4.6, 3.4.7). */
 #define SUPI3_ADDR_MAX 14u
+/** Most reads of IRQ_EVT in one supi3_irq_service() while /IRQ stays low (3.4.14; FW-22): events come at most once
+ * per INTERBUS cycle, a read takes far less, so two reads are the most a working board needs. */
+#define SUPI3_IRQ_SERVICE_MAX_READS 4u
 
 typedef int (*supi3_xfer_fn)(void *user, uint8_t tx, uint8_t *rx, int s_r);
 typedef void (*supi3_delay_us_fn)(void *user, uint32_t us);
@@ -83,7 +89,8 @@ int supi3_init(supi3_t *ctx, const supi3_config_t *cfg);
 /** Send the initialization byte (3.4.3). With read_cd, check the first-initialization signature (UP-3). */
 int supi3_initialize(supi3_t *ctx, supi3_mode_t mode);
 
-/** Pulse SAS_INIT (>= 1 us, t_SAS_INIT >= 250 ns) with set_sas_init; the driver forgets the mode (3.4.3). */
+/** Pulse SAS_INIT (>= 1 us, t_SAS_INIT >= 250 ns) with set_sas_init; the driver forgets the mode (3.4.3).
+ * SUPI3_E_UNSUPPORTED, the driver's state kept: set_sas_init NULL or returning SUPI3_E_UNSUPPORTED (FW-21). */
 int supi3_sas_init(supi3_t *ctx);
 
 /** Read one register (3.4.4): command RD|A, then one data byte. addr 0..14. */
@@ -108,8 +115,12 @@ int supi3_block_transfer(supi3_t *ctx, int rd, int wr, uint8_t *out, const uint8
 int supi3_configure(supi3_t *ctx, uint8_t set_value, uint8_t id_value);
 
 /**
- * Read-clear the interrupt event register (3.4.14, read 14): *events = the byte read, the events D6..D0 and D7, the
- * I/O access status (RM-7, RM-8). With read_irq and /IRQ high, *events = 0 and nothing is sent.
+ * Read-clear the interrupt event register (3.4.14, read 14): *events = the events D6..D0 and D7, the I/O access
+ * status (RM-7, RM-8). With read_irq, /IRQ is read first and after each read, and IRQ_EVT read again while it is low
+ * (an event that came during the read gives no new falling edge, FW-22): D6..D0 of every read OR-ed, D7 of the last;
+ * /IRQ high at once: *events = 0 and nothing is sent. Still low after SUPI3_IRQ_SERVICE_MAX_READS reads:
+ * SUPI3_E_TIMEOUT, *events holding what was read. Without read_irq: one read. *events holds the events read
+ * (and so cleared) whatever the result.
  */
 int supi3_irq_service(supi3_t *ctx, uint8_t *events);
 

@@ -34,13 +34,21 @@ static int frame(supi3_t *ctx, uint8_t tx, uint8_t *rx, int s_r)
     return SUPI3_OK;
 }
 
-/* A pin level through an optional callback (C/D, /IRQ, I/O); reading a pin leaves the chip's state as it was. */
+/* A pin level through an optional callback (C/D, /IRQ, I/O); reading a pin leaves the chip's state as it was.
+ * SUPI3_E_UNSUPPORTED: the pin is not wired, by a NULL callback or by a callback that returns SUPI3_E_UNSUPPORTED
+ * (a board revision without the pin, FW-21); the caller then works as without the pin. Any other non-zero return
+ * is SUPI3_E_TRANSPORT. */
 static int read_pin(const supi3_t *ctx, supi3_read_pin_fn read, int *level)
 {
-    if (read(ctx->cfg.user, level) != 0) {
-        return SUPI3_E_TRANSPORT;
+    int rc;
+    if (read == NULL) {
+        return SUPI3_E_UNSUPPORTED;
     }
-    return SUPI3_OK;
+    rc = read(ctx->cfg.user, level);
+    if (rc == SUPI3_OK || rc == SUPI3_E_UNSUPPORTED) {
+        return rc;
+    }
+    return SUPI3_E_TRANSPORT;
 }
 
 /* Common entry check of the register accesses (UP-25: refused before the first byte): the context, then the
@@ -108,6 +116,7 @@ int supi3_initialize(supi3_t *ctx, supi3_mode_t mode)
 {
     uint8_t init_byte;
     int cd = 0;
+    int checked;
     int err;
     if (ctx == NULL || (mode != SUPI3_MODE_MOTOROLA && mode != SUPI3_MODE_INTEL)) {
         return SUPI3_E_ARG;
@@ -117,27 +126,26 @@ int supi3_initialize(supi3_t *ctx, supi3_mode_t mode)
     }
     init_byte = mode == SUPI3_MODE_INTEL ? (uint8_t)SUPI3_INIT_INTEL : (uint8_t)SUPI3_INIT_MOTOROLA;
     ctx->initialized = 0u;
-    if (ctx->cfg.read_cd != NULL) {
-        /* C/D = 1 before the init byte: a command waits for its data byte (uP reset mid-command, UP-27) or the
-         * interface is disabled (UP-4). The init byte would be taken as data: send nothing, ask for SAS_INIT. */
-        err = read_pin(ctx, ctx->cfg.read_cd, &cd);
-        if (err != SUPI3_OK) {
-            return err;
-        }
-        if (cd != 0) {
-            return SUPI3_E_NOT_READY;
-        }
+    /* C/D = 1 before the init byte: a command waits for its data byte (uP reset mid-command, UP-27) or the
+     * interface is disabled (UP-4). The init byte would be taken as data: send nothing, ask for SAS_INIT. */
+    err = read_pin(ctx, ctx->cfg.read_cd, &cd);
+    if (err == SUPI3_E_TRANSPORT) {
+        return err;
+    }
+    checked = err == SUPI3_OK; /* C/D wired */
+    if (checked && cd != 0) {
+        return SUPI3_E_NOT_READY;
     }
     err = frame(ctx, init_byte, NULL, SR_UP_SENDS);
     if (err != SUPI3_OK) {
         return err;
     }
-    if (ctx->cfg.read_cd != NULL) {
+    if (checked) {
         err = read_pin(ctx, ctx->cfg.read_cd, &cd);
-        if (err != SUPI3_OK) {
+        if (err == SUPI3_E_TRANSPORT) {
             return err;
         }
-        if (cd != 0) {
+        if (err == SUPI3_OK && cd != 0) {
             /* "Command status twice" missing (3.4.3, UP-3): the chip was initialized already and took the byte
              * as a command (00h: no direction, address 0; 81h: read OUT1). Complete it with a no-op data
              * byte so the chip is back in its command phase, then report: the mode cannot be changed now. */
@@ -152,6 +160,7 @@ int supi3_initialize(supi3_t *ctx, supi3_mode_t mode)
 
 int supi3_sas_init(supi3_t *ctx)
 {
+    int rc;
     if (ctx == NULL) {
         return SUPI3_E_ARG;
     }
@@ -159,17 +168,21 @@ int supi3_sas_init(supi3_t *ctx)
         return SUPI3_E_NOT_INIT;
     }
     if (ctx->cfg.set_sas_init == NULL) {
-        return SUPI3_E_UNSUPPORTED;
+        return SUPI3_E_UNSUPPORTED; /* not wired: nothing driven, the driver's state kept (FW-16) */
+    }
+    rc = ctx->cfg.set_sas_init(ctx->cfg.user, 1);
+    if (rc == SUPI3_E_UNSUPPORTED) {
+        return SUPI3_E_UNSUPPORTED; /* the callback says the board does not wire the pin: as NULL (FW-21) */
     }
     ctx->initialized = 0u; /* the interface waits for the init byte again; registers are kept (3.4.3) */
-    if (ctx->cfg.set_sas_init(ctx->cfg.user, 1) != 0) {
+    if (rc != SUPI3_OK) {
         return SUPI3_E_TRANSPORT;
     }
     if (ctx->cfg.delay_us != NULL) {
         ctx->cfg.delay_us(ctx->cfg.user, 1u); /* t_SAS_INIT >= 250 ns */
     }
-    if (ctx->cfg.set_sas_init(ctx->cfg.user, 0) != 0) {
-        return SUPI3_E_TRANSPORT;
+    if (ctx->cfg.set_sas_init(ctx->cfg.user, 0) != SUPI3_OK) {
+        return SUPI3_E_TRANSPORT; /* the pin was driven: any failure to release it, "not wired" too */
     }
     return SUPI3_OK;
 }
@@ -281,7 +294,11 @@ int supi3_configure(supi3_t *ctx, uint8_t set_value, uint8_t id_value)
 
 int supi3_irq_service(supi3_t *ctx, uint8_t *events)
 {
+    uint8_t value = 0u;
+    uint8_t seen = 0u;
+    uint32_t reads;
     int irq_n = 0;
+    int wired;
     int err = access_ok(ctx, (uint8_t)SUPI3_IRQ_EVT_ADDR);
     if (err == SUPI3_OK && events == NULL) {
         err = SUPI3_E_ARG;
@@ -289,17 +306,35 @@ int supi3_irq_service(supi3_t *ctx, uint8_t *events)
     if (err != SUPI3_OK) {
         return err;
     }
-    if (ctx->cfg.read_irq != NULL) {
+    /* /IRQ is low while IRQ_EVT holds an event (3.4.14); an MCU's external interrupt takes its falling edge. An
+     * event that comes while IRQ_EVT is read gives no new edge (or one too short to see): read until /IRQ is high,
+     * at most SUPI3_IRQ_SERVICE_MAX_READS times, so no event is left pending on return (FW-22). */
+    for (reads = 0u;; ++reads) {
         err = read_pin(ctx, ctx->cfg.read_irq, &irq_n);
-        if (err != SUPI3_OK) {
-            return err;
+        if (err == SUPI3_E_TRANSPORT) {
+            break;
         }
-        if (irq_n != 0) {
-            *events = 0u;
-            return SUPI3_OK;
+        wired = err == SUPI3_OK;
+        if (wired && irq_n != 0) {
+            err = SUPI3_OK; /* /IRQ high: nothing (left) pending */
+            break;
+        }
+        if (reads == SUPI3_IRQ_SERVICE_MAX_READS) {
+            err = SUPI3_E_TIMEOUT; /* /IRQ stayed low */
+            break;
+        }
+        err = supi3_read(ctx, (uint8_t)SUPI3_IRQ_EVT_ADDR, &value);
+        if (err != SUPI3_OK) {
+            break;
+        }
+        /* each read clears the events it returns: keep them all; D7 (live, RM-8) is the last read's */
+        seen = (uint8_t)((seen & SUPI3_IRQ_EVT_CLEAR_ON_READ_MSK) | value);
+        if (!wired) {
+            break; /* without /IRQ: one read (no edge to lose: such a firmware polls) */
         }
     }
-    return supi3_read(ctx, (uint8_t)SUPI3_IRQ_EVT_ADDR, events);
+    *events = seen;
+    return err;
 }
 
 int supi3_irq_enable(supi3_t *ctx, uint8_t mask)
@@ -316,6 +351,7 @@ int supi3_poll_io_window(supi3_t *ctx, uint32_t max_polls, uint8_t *events)
 {
     uint32_t k;
     uint8_t value = 0u;
+    uint8_t seen = 0u;
     int level = 1;
     int err = entry_ok(ctx, max_polls != 0u);
     if (err == SUPI3_OK && events == NULL && ctx->cfg.read_io == NULL) {
@@ -324,28 +360,28 @@ int supi3_poll_io_window(supi3_t *ctx, uint32_t max_polls, uint8_t *events)
     if (err != SUPI3_OK) {
         return err;
     }
-    if (events != NULL) {
-        *events = 0u;
-    }
-    for (k = 0u; k < max_polls; ++k) {
-        if (ctx->cfg.read_io != NULL) {
-            err = read_pin(ctx, ctx->cfg.read_io, &level); /* MFP1 mirrors D7 (Table 3-5): nothing sent */
-        } else {
-            /* Reading 14 clears D6..D0 (3.4.14): keep every event; D7 is live (RM-8). */
-            err = supi3_read(ctx, (uint8_t)SUPI3_IRQ_EVT_ADDR, &value);
+    for (k = 0u; err == SUPI3_OK && k < max_polls; ++k) {
+        err = read_pin(ctx, ctx->cfg.read_io, &level); /* MFP1 mirrors D7 (Table 3-5): nothing sent */
+        if (err == SUPI3_E_UNSUPPORTED) {
+            /* Not wired (FW-21): read 14, which clears D6..D0 (3.4.14): keep every event; D7 is live (RM-8). A
+             * callback that says so with events NULL has nowhere to keep them: SUPI3_E_ARG, as a NULL read_io. */
+            err = events == NULL ? SUPI3_E_ARG : supi3_read(ctx, (uint8_t)SUPI3_IRQ_EVT_ADDR, &value);
             if (err == SUPI3_OK) {
-                *events = (uint8_t)(*events | (value & SUPI3_IRQ_EVT_CLEAR_ON_READ_MSK));
+                seen = (uint8_t)(seen | (value & SUPI3_IRQ_EVT_CLEAR_ON_READ_MSK));
                 level = (value & SUPI3_IRQ_EVT_IO_ACCESS_MSK) != 0u;
             }
         }
-        if (err != SUPI3_OK) {
-            return err;
-        }
-        if (level == 0) {
-            return SUPI3_OK; /* the window is open: 30 bit periods from now (Fig. 3-22) */
+        if (err == SUPI3_OK && level == 0) {
+            break; /* the window is open: 30 bit periods from now (Fig. 3-22) */
         }
     }
-    return SUPI3_E_TIMEOUT;
+    if (events != NULL) {
+        *events = seen;
+    }
+    if (err == SUPI3_OK && level != 0) {
+        err = SUPI3_E_TIMEOUT;
+    }
+    return err;
 }
 
 int supi3_processor_alarm(supi3_t *ctx, uint8_t value)
@@ -409,9 +445,9 @@ const char *supi3_strerror(int err)
     case SUPI3_E_NOT_RESET:
         return "chip was not reset: initialization byte taken as a command, pulse SAS_INIT (3.4.3)";
     case SUPI3_E_UNSUPPORTED:
-        return "not supported in this mode or without the optional callback";
+        return "not supported in this mode or without the optional callback (pin not wired)";
     case SUPI3_E_TIMEOUT:
-        return "timeout: the I/O access window did not open within max_polls (3.4.14)";
+        return "timeout: the I/O access window did not open within max_polls, or /IRQ stayed low (3.4.14)";
     default:
         return "unknown error";
     }

@@ -1,0 +1,358 @@
+"""The board's per-frame fast path in native code (MCU-51): plain µP interface frames without a Python call.
+
+Ref: IBS SUPI 3 OPC UM E rev. 05, 3.4.2 (one /SS frame per byte), 3.4.4 (command and data bytes), Table 3-7 (t0, t1,
+t2, t8), Table 3-10 (the registers); decisions MCU-51 to MCU-53 in docs/assumptions/mcu.md.
+
+hook.c's ``supi3_port_write`` is GPIOA's and SPI1's write callback. It takes a /SS edge (a BSRR or BRR write that
+changes only /SS) or SPI1's DR write that clocks the frame's byte itself when the frame's whole effect on the
+Python model is plain, and calls the Python write (the existing board code, the one slow path) for everything else:
+
+- a command frame in the command phase with a plain command byte (``upif._PLAIN_COMMANDS``), or the data frame of a
+  read of a register without side effects (not read-clear; a data register outside the latch phase) or of a write of
+  a register that only stores (not SET or ID, not the read-clear event register /IRQ follows; a data register outside
+  the latch phase), in Motorola mode, with a register file that is not pedantic, at transaction level;
+- with every Table 3-7 check of the board passing (t8, t1, t2, t0, SPI mode 3, MSB first), by the board's thresholds
+  in core cycles, and no bus event due up to the edge (:func:`first_due`: the first core cycle whose
+  ``Board._sync`` would run one, by the same float expression), /IRQ and /ModAck followed, nothing else pending.
+
+Python hands the native side its tables once (:meth:`NativeFrames.__init__`), mirrors the state those conditions read
+after each of its writes of GPIOA or SPI1 (:meth:`NativeFrames.refresh`: ``valid``), and at each entry into Python
+(:attr:`supi3.mcu.core.CortexM.entry`: a peripheral's callback, a watched address, the end of a run) takes the
+mirror's validity back and sets what the native frames changed, as its net effect, in the Python objects
+(:meth:`NativeFrames.catch_up`): the protocol's phase, command and last byte, the written registers, the board's
+frame, /SS rise and C/D, GPIOA's ODR, SPI1's transfer and received byte, and the bus clock.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import math
+import operator
+import struct
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Final, Protocol
+
+from supi3.interbus import wire
+from supi3.mcu.core import HeldRegister
+from supi3.mcu.hook import Frames, NativeHookError
+from supi3.mcu.stm32 import (
+    CR1_CPHA,
+    CR1_CPOL,
+    CR1_DFF,
+    CR1_LSBFIRST,
+    CR1_MSTR,
+    CR1_SPE,
+    IOPAEN,
+    SPI1EN,
+    SPI_DR,
+    SPI_SR,
+    SR_BSY,
+    SR_MODF,
+    SR_RXNE,
+    SR_TXE,
+)
+from supi3.model import registers as _registers
+from supi3.pinout import C_D_COMMAND, C_D_DATA
+from supi3.spi import upif as _upif
+from supi3.spi.upif import Mode, Phase
+
+if TYPE_CHECKING:
+    from supi3.mcu.core import CortexM
+    from supi3.mcu.stm32 import Exti, Gpio, Rcc, Spi
+    from supi3.model.chip import Supi3
+    from supi3.model.registers import RegisterFile
+    from supi3.spi.upif import UpifProtocol
+
+__all__ = ["FAST_READS", "FAST_WRITES", "FrameBoard", "NativeFrames", "SsFrame", "first_due"]
+
+@dataclass(slots=True)
+class SsFrame:
+    """A /SS frame the board has seen begin (3.4.2): the cycle /SS fell, what the chip drives on SerOUT (UP-18) and
+    the bytes clocked in it, each (the byte as the chip sees it, bits, start cycle, SCLK period in cycles)."""
+
+    fall: int
+    driven: int | None
+    transfers: list[tuple[int, int, int, int]]
+
+
+class FrameBench(Protocol):
+    """What the native frames read of the board's bench (``supi3.mcu.board._BoardBench``)."""
+
+    low_at: float | None
+    _events: list[tuple[float, str]]
+    _next_start: float
+
+    @property
+    def chip(self) -> Supi3: ...
+
+
+class FrameBoard(Protocol):
+    """What the native frames read and set of the transaction-level board (:class:`supi3.mcu.board.Board`): its
+    parts, its frame and /SS bookkeeping, /IRQ and /ModAck as it last followed them, its Table 3-7 thresholds in
+    core cycles and its bus clock."""
+
+    core: CortexM
+    gpio: Gpio
+    spi: Spi
+    rcc: Rcc
+    protocol: UpifProtocol
+    registers: RegisterFile
+    _frame: SsFrame | None
+    _ss_rise: int
+    _cd_before: int
+    _irq_level: int
+    _mod_ack_until: int
+    _least_t1: int
+    _least_t2: int
+    _least_t8: int
+    _shortest_period_s: float
+    exti: Exti
+
+    def _sync(self, cycles: int) -> None: ...
+
+    @property
+    def bench(self) -> FrameBench: ...
+
+
+_IO: Final[str] = "io"
+_LATCH: Final[str] = "latch"
+"""The bench's phase events (``Bench._step_bus``; ``supi3.mcu.board.FLAG_EVENTS``): the I/O access bit set, the latch
+phase begun; they set flags of the chips only."""
+_NEVER: Final[int] = (1 << 63) - 1
+_PHASE_COMMAND: Final[int] = 1
+_PHASE_DATA: Final[int] = 2
+_PHASES: Final[dict[Phase, int]] = {Phase.COMMAND: _PHASE_COMMAND, Phase.DATA: _PHASE_DATA}
+"""The protocol phases the native frames run in, by the number hook.c knows them by (0: any other)."""
+_PHASE_OF: Final[dict[int, Phase]] = {number: phase for phase, number in _PHASES.items()}
+_NO_COMMAND: Final[int] = 0x100
+"""The protocol has no command (hook.c reads the command only in the data phase, which always has one)."""
+_CODES: Final[dict[object, int]] = {}
+for _byte in range(255, -1, -1):  # each decoded command by its lowest byte
+    _CODES[_upif._COMMANDS[_byte]] = _byte
+
+_EVENT_REGISTERS: Final[frozenset[str]] = frozenset(
+    name for name, clears in zip(_registers._READ_NAMES, _registers._READ_CLEARS, strict=True) if name and clears
+)
+"""The read-clear registers (IRQ_EVT, 3.4.14): /IRQ follows them, so no native frame reads or writes them."""
+
+
+def _access(name: str | None, side_effects: frozenset[str]) -> int:
+    if name is None or name in side_effects:
+        return 0
+    return 2 if name in _registers._DATA_REGISTERS else 1
+
+
+FAST_READS: Final[tuple[int, ...]] = tuple(_access(name, _EVENT_REGISTERS) for name in _registers._READ_NAMES)
+"""Per address, a read data frame a native frame may take: 0 never (no register, or read-clear), 1 always, 2 outside
+the latch phase (a data register, 3.4.14: inside it the read reports inconsistent data)."""
+FAST_WRITES: Final[tuple[int, ...]] = tuple(_access(name, _EVENT_REGISTERS | _registers._CONFIGURATION)
+                                            for name in _registers._WRITE_NAMES)  # fmt: skip
+"""Per address, a write data frame a native frame may take (0, 1, 2 as :data:`FAST_READS`): never SET or ID (they
+configure the chip, 3.4.3), nor an address without a register (pedantic mode may report it: left to Python)."""
+
+_STATE_FIELDS: Final[tuple[str, ...]] = (
+    "pending", "odr", "synced", "phase", "command", "last_rx", "frame_open", "frame_fall", "frame_driven", "transfer",
+    "transfer_seen", "transfer_start", "transfer_period", "ss_rise", "cd_before", "written", "dr_writes", "rx_last",
+    "shift_received", "shift_start", "shift_end")  # fmt: skip
+"""The fields of :class:`~supi3.mcu.hook.Frames` the native frames change, in their order there."""
+_MIRROR_FIELDS: Final[tuple[str, ...]] = (
+    "valid", "due", "latch", "latch_at", "gpio_ok", "gpio_mask", "gpio_pulled_up", "gpio_levels", "spi_ok", "period",
+    "sr_modf", *_STATE_FIELDS[:-3])  # fmt: skip
+"""The fields :meth:`NativeFrames.refresh` writes, in their order there."""
+
+
+def _packed(names: tuple[str, ...]) -> tuple[struct.Struct, int]:
+    """A ``struct.Struct`` of :class:`~supi3.mcu.hook.Frames`'s fields ``names`` (8-byte integers one after the
+    other, which hook.check_layout holds to hook.c's) and its offset: one call reads or writes them all."""
+    start = at = getattr(Frames, names[0]).offset
+    layout = "<"
+    for name in names:
+        field = getattr(Frames, name)
+        if field.offset != at or field.size != 8:
+            raise NativeHookError(f"Frames.{name} is not an 8-byte field at offset {at}")
+        layout += "q" if name == "ss_rise" else "Q"
+        at += 8
+    return struct.Struct(layout), start
+
+
+_STATE, _STATE_AT = _packed(_STATE_FIELDS)
+_MIRROR, _MIRROR_AT = _packed(_MIRROR_FIELDS)
+
+
+def first_due(next_at: float, cpu_hz: float, noise: float) -> int:
+    """The first core cycle ``c`` at which ``Board._sync(c)`` would run a bus event, by its own float expression
+    (``Bench.advance((c + noise) / cpu_hz)`` runs the events at or before that time), or past which it would refuse the
+    time (:data:`~supi3.interbus.wire.MAX_BUS_TIME_S`); a cycle before it synchronises without a Python effect beyond
+    the clock. At most 2^63 - 1."""
+    limit = (1 << 63) - 1
+    at = min(next_at, wire.MAX_BUS_TIME_S)
+    if not at * cpu_hz < limit:
+        return limit
+    top = wire.MAX_BUS_TIME_S
+    # the board's rounding (Board._cycles): the answer or one of its neighbours, found by the expression itself
+    cycles = max(0, math.ceil(at * cpu_hz - noise))
+    while cycles > 0 and (next_at <= (until := (cycles - 1 + noise) / cpu_hz) or until > top):
+        cycles -= 1
+    while not (next_at <= (until := (cycles + noise) / cpu_hz) or until > top):
+        cycles += 1
+    return cycles
+
+
+class NativeFrames:
+    """The native per-frame fast path of a transaction-level board (MCU-51): the tables handed to hook.c, the
+    mirror refreshed after Python's writes of GPIOA and SPI1, the catch-up at each entry into Python."""
+
+    def __init__(self, board: FrameBoard, spi_held: HeldRegister, ss_pin: int, noise: float, exti0: int) -> None:
+        self._board = board
+        core = board.core
+        self._frames = frames = core.frames
+        self._hz = core.cpu_hz
+        self._noise = noise
+        self._spi_held = spi_held
+        frames.spi = ctypes.pointer(spi_held.native)
+        frames.least_t1, frames.least_t2, frames.least_t8 = board._least_t1, board._least_t2, board._least_t8
+        frames.ss_pin = ss_pin
+        frames.cd_command, frames.cd_data = C_D_COMMAND, C_D_DATA
+        frames.phase_command, frames.phase_data = _PHASE_COMMAND, _PHASE_DATA
+        frames.sr_txe, frames.sr_bsy, frames.sr_rxne = SR_TXE, SR_BSY, SR_RXNE
+        frames.spi_dr, frames.spi_sr = SPI_DR, SPI_SR
+        commands = _upif._COMMANDS
+        frames.plain[:] = [int(plain) for plain in _upif._PLAIN_COMMANDS]
+        frames.address[:] = [command.address for command in commands]
+        frames.rd[:] = [int(command.rd) for command in commands]
+        frames.wr[:] = [int(command.wr) for command in commands]
+        frames.reads_register[:] = [int(reads) for reads in _upif._READS_REGISTER]
+        frames.writes_register[:] = [int(writes) for writes in _upif._WRITES_REGISTER]
+        frames.fast_read[:] = FAST_READS
+        frames.fast_write[:] = FAST_WRITES
+        frames.write_mask[:] = _registers._WRITE_MASKS
+        read_names = _registers._READ_NAMES
+        frames.alias[:] = [read_names.index(name) if name in read_names else -1 for name in _registers._WRITE_NAMES]
+        reads = [name for address, name in enumerate(read_names) if name is not None and FAST_READS[address]]
+        self._read_values = operator.itemgetter(*reads)  # the fast-readable registers' values, in address order
+        self._values = struct.Struct("<" + "".join("B" if name in reads else "x" for name in read_names))
+        self._values_at = Frames.values.offset
+        self._due_key: tuple[int, float | None, float] | None = None  # the bench's next events, as last mirrored
+        self._due = (0, _NEVER)
+        self._written: tuple[str | None, ...] = _registers._WRITE_NAMES
+        self._exti0 = exti0
+        self._command: object = None
+        self._code = _NO_COMMAND
+        frames.valid = 0
+        frames.pending = 0
+        core.entry = self.enter
+        core.resume = self.refresh
+
+    def enter(self) -> None:
+        """An entry into Python (:attr:`CortexM.entry`): the mirror is no longer valid (Python may change what it
+        mirrors); what the native frames changed goes into the Python objects."""
+        frames = self._frames
+        if frames.valid:
+            frames.valid = 0
+            if frames.pending:
+                self.catch_up()
+
+    def catch_up(self) -> None:
+        """Set the native frames' net effect in the Python objects (what their slow path would have set)."""
+        frames = self._frames
+        state = _STATE.unpack_from(frames, _STATE_AT)
+        (_, odr, synced, phase, command, last_rx, frame_open, fall, driven, transfer, seen, start, period, ss_rise,
+         cd_before, written, dr_writes, rx_last, received, shift_start, shift_end) = state
+        frames.pending = frames.written = frames.dr_writes = frames.synced = 0
+        board = self._board
+        gpio = board.gpio
+        gpio.odr = odr
+        gpio._levels = frames.gpio_levels
+        if synced:  # the bus run up to the latest synchronisation: no event but the phases' flags (MCU-52)
+            board._sync(synced - 1)
+        protocol = board.protocol
+        protocol.phase = _PHASE_OF[phase]
+        if command < _NO_COMMAND:
+            protocol.command = _upif._COMMANDS[command]
+        protocol.last_rx = last_rx
+        if written:
+            values = board.registers._values
+            masked = frames.written_values
+            names = self._written
+            for address in range(16):
+                if written >> address & 1:
+                    values[names[address]] = masked[address]  # type: ignore[index]  # FAST_WRITES: a register
+        board._ss_rise, board._cd_before = ss_rise, cd_before
+        if frame_open:
+            board._frame = SsFrame(fall, driven, [(seen, 8, start, period)] if transfer else [])
+            protocol._frame = (True, driven)
+        else:
+            board._frame = None
+            protocol._frame = None
+        if dr_writes:
+            spi = board.spi
+            spi.rx_last, spi.rx_buffer, spi._ovr_seen = rx_last, None, False
+            spi.shifting = (received, shift_start, shift_end)
+            spi.transfers += dr_writes
+            spi._holding = True
+
+    def _thresholds(self, events: list[tuple[float, str]], next_start: float) -> tuple[int, int]:
+        """The first core cycle whose synchronisation runs a cycle's start or end, and the one that runs the latch
+        phase's start (or :data:`_NEVER`): the phases only set the chips' flags (MCU-52)."""
+        hz, noise = self._hz, self._noise
+        latch_at = _NEVER
+        for at, what in reversed(events):  # the next first
+            if what == _LATCH:
+                latch_at = first_due(at, hz, noise)
+            elif what != _IO:
+                return first_due(at, hz, noise), latch_at
+        return first_due(next_start, hz, noise), latch_at
+
+    def refresh(self) -> None:
+        """After Python's write of GPIOA or SPI1: mirror the model's state for the native frames, valid if the
+        conditions they need hold (module docstring)."""
+        frames = self._frames
+        board = self._board
+        protocol, registers = board.protocol, board.registers
+        bench = board.bench
+        phase = _PHASES.get(protocol.phase, 0)
+        command = protocol.command
+        if command is not self._command:  # a CommandByte's hash is a Python call: the last one's code kept
+            self._command = command
+            self._code = _NO_COMMAND if command is None else _CODES[command]
+        code = self._code
+        frame = board._frame
+        core = board.core
+        valid = (protocol.mode is Mode.MOTOROLA and not registers.pedantic and bench.low_at is None
+                 and board._irq_level == registers.irq_n and bench.chip.mod_ack_until == board._mod_ack_until
+                 and phase and (phase != _PHASE_DATA or code != _NO_COMMAND)
+                 and (not board.exti.requesting(0) or self._exti0 in core.active
+                      or self._exti0 in core.pending))  # _sync's _pend: nothing to do  # fmt: skip
+        transfer = (0, 0, 0, 0)
+        if frame is not None:  # a frame Python began: the native frames may go on with it
+            valid = valid and protocol._frame is not None and frame.driven is not None and len(frame.transfers) <= 1
+            if valid and frame.transfers:
+                seen, bits, start, period = frame.transfers[0]
+                valid = bits == 8
+                transfer = (1, seen, start, period)
+        elif protocol._frame is not None:
+            valid = False
+        if not valid:
+            frames.valid = 0
+            return
+        gpio, spi, rcc = board.gpio, board.spi, board.rcc
+        cr1 = spi.cr1
+        spi_ok = (spi.holder is self._spi_held and spi.offer is self._spi_held  # hook.c holds and offers as they would
+                  and rcc.apb2enr & SPI1EN and not rcc.apb2rstr & SPI1EN and cr1 & CR1_SPE and cr1 & CR1_MSTR
+                  and not cr1 & (CR1_DFF | CR1_LSBFIRST) and cr1 & (CR1_CPOL | CR1_CPHA) == CR1_CPOL | CR1_CPHA
+                  and not spi.period / self._hz < board._shortest_period_s)  # fmt: skip
+        values = registers._values
+        self._values.pack_into(frames, self._values_at, *self._read_values(values))
+        events = bench._events  # only popped from the end until the next cycle's start makes a new list
+        key = (len(events), events[-1][0] if events else None, bench._next_start)
+        if key != self._due_key:
+            self._due_key = key
+            self._due = self._thresholds(events, bench._next_start)
+        due, latch_at = self._due
+        _MIRROR.pack_into(
+            frames, _MIRROR_AT, 1, due, int(registers.latch_phase), latch_at,
+            int(bool(rcc.apb2enr & IOPAEN) and not rcc.apb2rstr & IOPAEN), gpio._output_mask(), gpio.pulled_up,
+            gpio._levels, int(bool(spi_ok)), spi.period, SR_MODF if spi.modf else 0, 0, gpio.odr, 0, phase, code,
+            protocol.last_rx, int(frame is not None), 0 if frame is None else frame.fall,
+            0 if frame is None or frame.driven is None else frame.driven, *transfer, board._ss_rise,
+            board._cd_before, 0, 0, 0)  # fmt: skip

@@ -1,0 +1,189 @@
+"""The board's native per-frame fast path (MCU-51): the same run with it as without it, to the cycle.
+
+MCU-51: hook.c takes the /SS edges and SPI1's DR write of plain µP interface frames without a Python call and sets
+their net effect in the model at the next entry into Python (``supi3.mcu.frames``). A board with it and one without
+(``native_frames=False``, every frame through the Python model) run the same firmware side by side and must agree after
+every step: instructions, cycles, bus time, interrupts and /IRQ latency, violations with their time, PC and rule, the
+chip's registers and protocol state, SPI1's and GPIOA's state, the board's frame and the process data. The firmwares
+cross every boundary of the fast path: the examples at both bit rates (a bus event inside a frame at 500 kbit/s, data
+registers read in the latch phase at 2 Mbit/s, IRQ_EVT read each cycle, SET and ID in the set-up, master data
+changed between steps), tests/mcu/frame_edges.c (a byte with /SS high, t8, t2, two bytes and no byte in a frame, a
+reserved command byte, SAS_INIT), SCLK faster than t0 (t0, t1), SPI1's CR1 changed while a byte shifts, GPIOA reset
+while /SS is low, strict and pedantic boards.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from supi3.errors import Supi3Error
+from supi3.interbus.errors import InterbusError
+from supi3.mcu import build as mcu_build
+from supi3.mcu.board import NOISE_CYCLES, Board
+from supi3.mcu.frames import FAST_READS, FAST_WRITES, first_due
+from supi3.sdk import native
+
+pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning:unicorn")
+
+MCU = Path(__file__).parent / "mcu"
+BR3 = {"BOARD_SPI_BR": "3u"}
+"""SPI1 at 3 MHz: issue #13's case, the fastest within t0 at 2 Mbit/s."""
+
+
+@pytest.fixture(scope="module")
+def elves(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """The firmwares of the cases, built once."""
+    folder = tmp_path_factory.mktemp("fastbyte")
+    example = native.example("digital_io")
+    return {
+        "dio": mcu_build.build(example, folder / "dio.elf"),
+        "dio_br3": mcu_build.build(example, folder / "dio_br3.elf", defines=BR3),
+        "dio_br0": mcu_build.build(example, folder / "dio_br0.elf", defines={"BOARD_SPI_BR": "0u"}),
+        "edges": mcu_build.build(MCU / "frame_edges.c", folder / "edges.elf"),
+        "edges_br3": mcu_build.build(MCU / "frame_edges.c", folder / "edges_br3.elf", defines=BR3),
+        **{f"misuse{misuse}": mcu_build.build(MCU / "spi_misuse.c", folder / f"misuse{misuse}.elf",
+                                              defines={"MISUSE": str(misuse)}) for misuse in (1, 2, 3)},
+        "clock_off": mcu_build.build(MCU / "frame_edges.c", folder / "clock_off.elf", defines={"CLOCK_OFF": "1u"}),
+        "gpio_reset": mcu_build.build(MCU / "gpio_reset.c", folder / "gpio_reset.elf"),
+    }
+
+
+def _master_inputs(board: Board) -> bytes | None:
+    """The device's inputs as the master last received them, ``None`` before its configuration or with no data."""
+    try:
+        return board.bench.master.inputs(1)
+    except InterbusError:
+        return None
+
+
+def snapshot(board: Board) -> dict[str, Any]:
+    """Everything a run shows and every piece of state the native frames change (their catch-up sets it)."""
+    core, protocol, spi, registers = board.core, board.protocol, board.spi, board.registers
+    frame = board._frame
+    assert board.fw_board is not None
+    return {
+        "core": (core.instructions, core.cycles, core.registers(), core._state.handed, board.interrupts,
+                 board.irq_latency_s),
+        "bus": (board.bench.now, board.cycles, _master_inputs(board)),
+        "violations": [(v.time_s, v.pc, v.error.rule, str(v.error)) for v in board.violations],
+        "protocol": (protocol.mode, protocol.phase, protocol.command, protocol.last_rx, protocol._frame),
+        "registers": (dict(registers._values), registers.latch_phase, registers.io_access, registers.irq_n),
+        "chip": (board.bench.chip._stat_err, board.bench.chip._stat_due),
+        "gpio": (board.gpio.odr, board.gpio._levels),
+        "spi": (spi.cr1, spi.rx_last, spi.rx_buffer, spi.tx_buffer, spi.shifting, spi.transfers, spi.ovr,
+                spi._ovr_seen, spi._holding, spi.modf),
+        "board": (None if frame is None else (frame.fall, frame.driven, list(frame.transfers)), board._ss_rise,
+                  board._cd_before, board._irq_level),
+        "process data": (board.fw_board.outputs, board.fw_board.inputs),
+    }
+
+
+def side_by_side(elf: Path, bit_rate: int, steps: int, *, strict: bool = False, pedantic: bool = False,
+                 cycles: int = 1) -> tuple[Board, Board]:  # fmt: skip
+    """A board with the native frames and one without, run ``steps`` times ``cycles`` master cycles, compared after
+    each step (and the error of a strict run: the same, at the same step); the master's outputs and the firmware's
+    inputs change after each step from the third."""
+    boards = (Board(elf, bit_rate=bit_rate, strict=strict, pedantic=pedantic),
+              Board(elf, bit_rate=bit_rate, strict=strict, pedantic=pedantic, native_frames=False))  # fmt: skip
+    assert boards[0].native_frames is not None and boards[1].native_frames is None
+    for step in range(steps):
+        errors: list[tuple[type[Supi3Error], str] | None] = []
+        for board in boards:
+            try:
+                board.run(cycles)
+            except Supi3Error as error:
+                errors.append((type(error), str(error)))
+            else:
+                errors.append(None)
+        assert errors[0] == errors[1], step
+        assert snapshot(boards[0]) == snapshot(boards[1]), step
+        if errors[0] is not None:
+            break
+        if step >= 2 and _master_inputs(boards[0]):  # new process data each step from the third (a device with data)
+            for board in boards:
+                board.bench.master.set_outputs(1, bytes([0x12 + step, 0x34 ^ step]))
+                assert board.fw_board is not None
+                board.fw_board.inputs = bytes([0xAB ^ step, 0xCD])
+    return boards
+
+
+@pytest.mark.parametrize(("case", "bit_rate", "steps"), [("dio", 500_000, 12), ("dio_br3", 2_000_000, 14),
+                                                         ("edges", 500_000, 16), ("edges_br3", 2_000_000, 20)])
+def test_the_native_frames_run_as_the_python_model(elves: dict[str, Path], case: str, bit_rate: int,
+                                                   steps: int) -> None:  # fmt: skip
+    """The examples at both bit rates and frame_edges.c: the same run after every step, most writes taken natively."""
+    fast, slow = side_by_side(elves[case], bit_rate, steps)
+    assert fast.core.frames.taken > 20 * steps  # the fast path ran (at least two frames a master cycle)
+    assert slow.core.frames.taken == 0
+    assert fast.violations or case == "dio"
+
+
+@pytest.mark.parametrize(("case", "bit_rate"), [("edges_br3", 2_000_000), ("dio_br3", 2_000_000)])
+def test_the_native_frames_agree_between_cycles(elves: dict[str, Path], case: str, bit_rate: int) -> None:
+    """Steps of 7 µs of bus time (a quarter of a 2 Mbit/s cycle, the master's process data new at each): the state
+    between two cycles' ends agrees too (what the master received from a cycle that a native frame ran across)."""
+    boards = (Board(elves[case], bit_rate=bit_rate, strict=False),
+              Board(elves[case], bit_rate=bit_rate, strict=False, native_frames=False))  # fmt: skip
+    for board in boards:
+        board.run(3)
+    for step in range(120):
+        for board in boards:
+            board.run_for(7e-6)
+            board.bench.master.set_outputs(1, bytes([step & 0xFF, 0x34]))
+        assert snapshot(boards[0]) == snapshot(boards[1]), step
+
+
+def test_frame_edges_crosses_every_fallback(elves: dict[str, Path]) -> None:
+    """frame_edges.c breaks what it should (else the comparison above would not cross those boundaries)."""
+    fast, _ = side_by_side(elves["edges"], 500_000, 4)
+    rules = {v.error.rule for v in fast.violations}
+    assert {"Table 3-7 t8", "Table 3-7 t2", "3.4.2", "3.4.4, RM-1"} <= rules
+    details = " ".join(str(v.error) for v in fast.violations)
+    assert "clocked with /SS high" in details and "held low across bytes" in details and "incomplete" in details
+
+
+@pytest.mark.parametrize(("case", "bit_rate", "strict", "pedantic"), [
+    ("dio_br0", 2_000_000, False, False),  # SCLK faster than t0, the first edge before t1
+    ("misuse1", 500_000, False, False),  # CR1's BR changed while a byte shifts (MCU-40)
+    ("misuse2", 500_000, False, False),  # SPE cleared while a byte shifts
+    ("misuse3", 500_000, False, False),  # DFF set with SPE set
+    ("clock_off", 500_000, False, False),  # SPI1's clock turned off, then a frame: PeripheralClockError
+    ("gpio_reset", 500_000, False, False),  # GPIOA reset while /SS is low
+    ("edges_br3", 2_000_000, True, False),  # strict: the first violation raised, at the same step
+    ("dio_br3", 2_000_000, False, True),  # pedantic: no native frame
+])  # fmt: skip
+def test_the_native_frames_leave_the_rest_to_python(elves: dict[str, Path], case: str, bit_rate: int, strict: bool,
+                                                    pedantic: bool) -> None:  # fmt: skip
+    """The firmwares whose frames break Table 3-7 or RM0008, a strict board and a pedantic one: the same run."""
+    fast, _ = side_by_side(elves[case], bit_rate, 5, strict=strict, pedantic=pedantic)
+    if pedantic:
+        assert fast.core.frames.taken == 0
+
+
+def test_the_fast_sets_follow_the_register_map() -> None:
+    """MCU-51: no native frame reads a read-clear register or writes SET, ID or one /IRQ follows; data registers only
+    outside the latch phase."""
+    from supi3.model import registers
+
+    for address, name in enumerate(registers._READ_NAMES):
+        if name is None or registers._READ_CLEARS[address]:
+            assert FAST_READS[address] == 0
+        elif name in registers._DATA_REGISTERS:
+            assert FAST_READS[address] == 2
+    assert FAST_READS[14] == 0  # IRQ_EVT
+    assert FAST_WRITES[12] == FAST_WRITES[13] == 0  # ID, SET
+    assert FAST_WRITES[0] == 2 and FAST_WRITES[14] == 1  # IN0, IRQ_EN
+
+
+@given(st.floats(1e-9, 1e3), st.sampled_from([8e6, 24e6, 48e6, 72e6, 1e3 * 3.3]))
+def test_first_due_is_the_boards_own_threshold(next_at: float, cpu_hz: float) -> None:
+    """The first core cycle at which the board's synchronisation (``(c + NOISE_CYCLES) / cpu_hz``) reaches the next bus
+    event: that cycle reaches it, the one before does not."""
+    first = first_due(next_at, cpu_hz, NOISE_CYCLES)
+    assert next_at <= (first + NOISE_CYCLES) / cpu_hz
+    assert first == 0 or (first - 1 + NOISE_CYCLES) / cpu_hz < next_at
