@@ -272,7 +272,8 @@ def test_digital_io_with_a_3_mhz_sclk_at_2_mbit_s_reaches_the_latch_phase(tmp_pa
 
 
 FINGERPRINTS = {
-    2_000_000: (111_834, 51_721, 29, [(t, "board_xfer") for t in (550_083, 1_046_542, 1_292_833, 1_789_292, 2_160_938)]),
+    2_000_000: (111_834, 51_721, 29, [(t, "board_xfer")
+                                      for t in (550_083, 1_046_542, 1_292_833, 1_789_292, 2_160_938)]),
     500_000: (421_868, 118_642, 32, []),
 }
 """MCU-21: power-up and 30 data cycles of bench/bench_mcu.py's cases, as measured before the round-4 speed work (the
