@@ -339,5 +339,8 @@ def test_the_bench_s_watch_of_irq_agrees_with_one_after_every_byte(plan: list[in
                 dict(two.registers._values), two.registers.io_access, two.registers.latch_phase)  # fmt: skip
         assert [(type(v), str(v)) for v in one.registers.violations.records] == \
                [(type(v), str(v)) for v in two.registers.violations.records]  # fmt: skip
-    assert sides[0][0].interrupts >= min(sides[0][0].cycles, 1)  # the routine ran (a history of no runs: none)
+    # the routine ran once a cycle went through (a history of no runs, or of cycles a cut failed: none; before
+    # MCU-56 three failed discovery ID cycles of 512 devices, 6.7 ms each at 2 Mbit/s, reached the chip's reset event
+    # at 20.18 ms)
+    assert sides[0][0].interrupts >= min(sum(result.ok for result in sides[0][0].results), 1)
     assert all(sides[0][1].phases)

@@ -24,6 +24,7 @@ from supi3.mcu.core import CPUS, FirmwareStoppedError, Stop
 from supi3.model.registers import InconsistentDataError, InterfaceViolationError
 from supi3.sdk import native
 from supi3.sdk.bench import Bench
+from supi3.sdk.examples.history import SETTLE_CYCLES
 from supi3.spi.upif import Mode
 from support import c_firmware
 from test_mcu_hostile import FILES
@@ -60,8 +61,9 @@ def test_the_board_pins_are_board_h_s() -> None:
 
 
 def _binary_exchange(board: Board, words: tuple[bytes, ...]) -> list[tuple[bytes, bytes]]:
-    """Per step: the master's outputs and the device's inputs set, two cycles run; (the firmware's output
-    terminals, the master's inputs) after them."""
+    """Per step: the master's outputs and the device's inputs set, SETTLE_CYCLES (3) cycles run; (the firmware's
+    output terminals, the master's inputs) after them. (Back to back the firmware's IN goes out with the third
+    cycle; before MCU-55 two were run, the master having started the third in the run's wait.)"""
     fw = board.fw_board
     assert fw is not None
     n = len(words[0])
@@ -69,7 +71,7 @@ def _binary_exchange(board: Board, words: tuple[bytes, ...]) -> list[tuple[bytes
     for out_data, in_data in zip(words, reversed(words), strict=True):
         board.bench.master.set_outputs(1, out_data)
         fw.inputs = in_data
-        board.run(2)
+        board.run(SETTLE_CYCLES)
         seen.append((fw.outputs[:n], board.bench.master.inputs(1)))
     return seen
 
@@ -87,7 +89,7 @@ def _host_exchange(pytestconfig: pytest.Config, name: str, words: tuple[bytes, .
         bench.master.set_outputs(1, out_data)
         for k, value in enumerate(in_data):
             host.board.inputs[k] = value
-        bench.run(2)
+        bench.run(SETTLE_CYCLES)
         assert bench.served  # FW-14: a main loop's pass after the last cycle, as on the board (MCU-30)
         seen.append((bytes(host.board.outputs[0:n]), bench.master.inputs(1)))
     return seen
@@ -253,10 +255,12 @@ def test_digital_io_with_a_3_mhz_sclk_at_2_mbit_s_reaches_the_latch_phase(tmp_pa
     """Round 1's finding: SPI1 at f_PCLK / 16 = 3 MHz (BOARD_SPI_BR = 3, the fastest that meets t0 = 333 ns at
     2 Mbit/s) with back-to-back cycles: the handler's four single accesses (3.4.4) end after the next cycle's latch
     phase has begun (3.4.14), which the host build (bytes at their Table 3-7 time) does not show. Every report
-    names a data register access of fw_isr in digital_io.c."""
+    names a data register access of fw_isr in digital_io.c. 16 back-to-back cycles from power-up reach three, the
+    first at 0.35 ms (MCU-55, MCU-56: before, ``run(8)`` ran many more cycles after a 6.7 ms discovery ID cycle, the
+    master going on while the run waited for the handler)."""
     elf = mcu_build.build(native.example("digital_io"), tmp_path / "br3.elf", defines={"BOARD_SPI_BR": "3u"})
     board = Board(elf, bit_rate=2_000_000, strict=False)
-    board.run(8)
+    board.run(16)
     assert board.violations
     source = native.example("digital_io")
     accesses = range(_line_of(source, "SUPI3_OUT0_ADDR"), _line_of(source, "SUPI3_IN1_ADDR") + 1)
@@ -268,11 +272,9 @@ def test_digital_io_with_a_3_mhz_sclk_at_2_mbit_s_reaches_the_latch_phase(tmp_pa
 
 
 FINGERPRINTS = {
-    2_000_000: (764_052, 224_584, 128, [(t, "board_xfer") for t in (
-        6_991_833, 7_488_292, 7_734_583, 8_231_042, 8_602_688, 8_727_500, 9_099_146, 9_223_958, 9_595_604, 9_720_417,
-        10_092_062, 10_588_521, 11_517_833, 12_014_292, 12_260_583, 12_757_042, 13_128_688, 13_253_500, 13_625_146,
-        13_749_958, 14_121_604, 14_246_417, 14_618_062, 15_114_521)]),
-    500_000: (1_690_172, 118_642, 32, []),
+    2_000_000: (111_834, 51_721, 29, [(t, "board_xfer")
+                                      for t in (550_083, 1_046_542, 1_292_833, 1_789_292, 2_160_938)]),
+    500_000: (421_868, 118_642, 32, []),
 }
 """MCU-21: power-up and 30 data cycles of bench/bench_mcu.py's cases, as measured before the round-4 speed work (the
 core's cycles, instructions, EXTI0 entries, each violation's time in ns and function); pinned to the firmware the
@@ -292,7 +294,13 @@ instructions). At 2 Mbit/s the handler outlasts the cycle, so the next cycle's e
 the handler reads it too (before: 472,366 cycles, 74,496 instructions, 44 entries, four latch-phase reads from
 7.36 ms every 744 µs): each read's clear and the next event are an /IRQ edge that re-enters EXTI0, and the handler's
 data accesses fall in more latch phases (24 in the run, from 6.99 ms): an overloaded handler stays wrong, the
-violations only move."""
+violations only move. Re-measured for MCU-55 and MCU-56 (run(n) runs exactly n master cycles,
+the master holding while the firmware serves the last; the discovery ID cycle sized for the ring, 62 µs and 0.25 ms,
+not 6.76 and 27.0 ms): at 500 kbit/s the same instructions and interrupts, 1,268,304 core cycles fewer (26.42 ms:
+the ID cycle 26.57 ms shorter, the 30 cycles 0.15 ms longer, starting once run(3) has returned instead of during its
+wait): 8.79 ms. At 2 Mbit/s run(3) is 3 cycles and 2 interrupts (before 74 cycles and 64 interrupts: it waited for
+the re-entered handler with the master cycling on), run(30) 30 cycles and 27 interrupts, 2.33 ms in all; five
+latch-phase reads, from 0.55 ms."""
 
 
 @pytest.mark.parametrize("bit_rate", list(FINGERPRINTS))

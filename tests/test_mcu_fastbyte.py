@@ -116,8 +116,10 @@ def side_by_side(elf: Path, bit_rate: int, steps: int, *, strict: bool = False, 
                                                          ("edges", 500_000, 16), ("edges_br3", 2_000_000, 20)])
 def test_the_native_frames_run_as_the_python_model(elves: dict[str, Path], case: str, bit_rate: int,
                                                    steps: int) -> None:  # fmt: skip
-    """The examples at both bit rates and frame_edges.c: the same run after every step, most writes taken natively."""
-    fast, slow = side_by_side(elves[case], bit_rate, steps)
+    """The examples at both bit rates and frame_edges.c: the same run after every step, most writes taken natively.
+    Issue #13's case runs four cycles a step: its handler's accesses reach the latch phase only after a few cycles
+    back to back (MCU-55: a run's master holds at its end; with one cycle a step none of 14 reaches it)."""
+    fast, slow = side_by_side(elves[case], bit_rate, steps, cycles=4 if case == "dio_br3" else 1)
     assert fast.core.frames.taken > 20 * steps  # the fast path ran (at least two frames a master cycle)
     assert slow.core.frames.taken == 0
     assert fast.violations or case == "dio"

@@ -234,8 +234,9 @@ def test_a_main_loop_too_slow_for_the_ring_ends_its_runs_unserved(variants: dict
 
 
 def test_the_serve_wait_adds_at_most_one_step_to_a_run(tmp_path: Path) -> None:
-    """Issue #13's case (2 Mbit/s, SPI1 at 3 MHz, non-strict): the handler outlasts the cycle, so each run waits,
-    handler after handler, until no exception is active or pending (before MCU-30 too: about 12 cycles). The run loop
+    """Issue #13's case (2 Mbit/s, SPI1 at 3 MHz, non-strict): the handler outlasts the cycle, so each run waits for
+    the last handler, the master holding (MCU-55; before, the master went on and the run waited handler after
+    handler, about 12 cycles more). The run loop
     still stops only at the bus events (about 4 a master cycle) and SysTick, plus the serve wait's end once. A draft
     of MCU-30 kept the passed end as a bound and stepped the handlers block by block (1,132 steps more in 200
     cycles)."""
@@ -609,3 +610,77 @@ def test_a_main_loop_pass_that_never_returns_still_uses_up_its_budget(tmp_path: 
     verdict = _verdict(board, (3,), 20_000)
     assert verdict is not None and verdict[:2] == (Stop.BUDGET, "board_delay_us")
     assert 20_000 <= verdict[3] < 20_008
+
+
+STUCK_HANDLER = """\
+/* digital_io whose EXTI0 handler spins while input terminal byte 1 reads EEh (tests/test_mcu_serve.py, MCU-55) */
+#define fw_isr digital_fw_isr
+#include "digital_io.c"
+#undef fw_isr
+volatile uint32_t spins;
+
+void fw_isr(supi3_t *chip, fw_board_t *board)
+{
+    while (board->inputs[1] == 0xEEu) {
+        spins++;
+    }
+    digital_fw_isr(chip, board);
+}
+"""
+
+
+@pytest.fixture(scope="module")
+def stuck_handler(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Issue #13's case (digital_io, SPI1 at 3 MHz for 2 Mbit/s) with a handler that spins while told to."""
+    folder = tmp_path_factory.mktemp("hold")
+    source = folder / "stuck_handler.c"
+    source.write_text(STUCK_HANDLER, encoding="utf-8")
+    return mcu_build.build(source, folder / "stuck_handler.elf", defines={"BOARD_SPI_BR": "3u"})
+
+
+def _hold_step(board: Board, stuck: bool, wait_s: float, cycles: int) -> tuple[int, bool, float]:
+    """One step of a history: input byte 1 EEh (the handler spins) or not, a ``run_for`` (0: none), ``run``; (the
+    run's master cycles, served, its bus time after its last cycle's start at transaction level, else 0)."""
+    assert board.fw_board is not None
+    board.fw_board.inputs = bytes([0x5A, 0xEE if stuck else 0x11])
+    if wait_s:
+        board.run_for(wait_s)
+    before = board.cycles
+    board.run(cycles)
+    tail = board.now - board.bench.timeline[-1].end if board.fidelity == "transaction" else 0.0
+    return board.cycles - before, board.served, tail
+
+
+@settings(max_examples=6, derandomize=True, deadline=None)
+@given(history=st.lists(st.tuples(st.booleans(), st.sampled_from([0.0, 20e-6, 100e-6]), st.integers(0, 3)),
+                        min_size=1, max_size=3))  # fmt: skip
+def test_run_n_runs_exactly_n_cycles_then_waits_boundedly_alike_at_both_fidelities(
+    stuck_handler: Path, history: list[tuple[bool, float, int]]
+) -> None:
+    """MCU-55 over random histories in issue #13's case (2 Mbit/s back to back, the handler outlasting a master
+    cycle), some runs with a handler that spins until the next step: ``run(n)`` runs exactly n master cycles at both
+    fidelities (a cycle a ``run_for`` left under way at transaction level is the run's first: run(0) follows no
+    ``run_for`` here); the wait after the last cycle lasts at most SERVE_TELEGRAMS status telegrams (transaction
+    level: the run ends within a microsecond of the bound after the last cycle's end; the pin level's bus time within
+    5 µs of it until a ``run_for``, the line idling in whole telegrams), a spinning handler's run ending there
+    unserved, every other run served; the same cycles and verdict at both fidelities. Before, the transaction
+    level's run(3) after power-up ran 13 master cycles, and a spinning handler froze its bus (MCU-44: no stop while
+    EXTI0 runs) until the instruction budget ran out, 416 ms of bus time later."""
+    boards = [Board(stuck_handler, bit_rate=2_000_000, strict=False, fidelity=fidelity)
+              for fidelity in ("transaction", "pin")]  # fmt: skip
+    for board in boards:
+        board.run(3)
+        assert board.cycles == 3 and board.served
+    wait_s = SERVE_TELEGRAMS * boards[0]._telegram_s
+    alike = True  # the same bus time until a run_for (the pin level's runs the cycles it starts whole, MCU-22)
+    for stuck, run_for_s, cycles in history:
+        cycles = max(cycles, 1) if run_for_s else cycles
+        (ran, served, tail), (pin_ran, pin_served, _) = (_hold_step(board, stuck, run_for_s, cycles)
+                                                          for board in boards)  # fmt: skip
+        assert ran == pin_ran == cycles
+        assert served == pin_served
+        if cycles:  # (a run(0) waits for a handler the run before left spinning, if any)
+            assert served is not stuck
+            assert tail <= wait_s + 1e-6 and (not stuck or tail >= wait_s - 1e-6)
+        alike = alike and not run_for_s
+        assert not alike or abs(boards[0].now - boards[1].now) <= 5e-6

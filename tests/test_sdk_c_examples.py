@@ -70,7 +70,9 @@ def test_digital_io_moves_16_bits_each_way_end_to_end(cache: pytest.Cache, mode:
     for out_word, in_word in zip(WORDS, reversed(WORDS), strict=True):
         bench.master.set_outputs(1, out_word.to_bytes(2, "big"))
         _set_inputs(firmware, in_word.to_bytes(2, "big"))
-        bench.run(2)  # one cycle brings OUT to the firmware, whose IN goes out with the next
+        bench.run(3)  # one cycle brings OUT to the firmware, whose IN is written in the next and goes out with the
+        # third, back to back (MCU-55, FW-19: the master holds after a run's cycles; before, it had started the
+        # third in the run's wait)
         assert _outputs(firmware, 2) == out_word.to_bytes(2, "big")
         assert bench.master.inputs(1) == in_word.to_bytes(2, "big")
     assert firmware.board.error == 0
@@ -129,7 +131,7 @@ def test_analog_io_carries_any_32_bit_values(pytestconfig: pytest.Config, values
     for value in values:
         bench.master.set_outputs(1, value.to_bytes(4, "big"))
         _set_inputs(firmware, value.to_bytes(4, "little"))
-        bench.run(2)
+        bench.run(3)  # the round trip back to back (FW-19)
         assert _outputs(firmware, 4) == value.to_bytes(4, "big")
         assert bench.master.inputs(1) == value.to_bytes(4, "little")
 
@@ -146,11 +148,12 @@ def test_analog_io_moves_32_bits_with_one_block_transfer(cache: pytest.Cache, mo
     for value in (0x0000_0000, 0xFFFF_FFFF, 0x1234_5678, 0x8000_0001):
         bench.master.set_outputs(1, value.to_bytes(4, "big"))
         _set_inputs(firmware, (value ^ 0xFFFF_FFFF).to_bytes(4, "big"))
-        bench.run(2)
+        bench.run(3)  # the round trip back to back (FW-19)
         assert _outputs(firmware, 4) == value.to_bytes(4, "big")
         assert bench.master.inputs(1) == (value ^ 0xFFFF_FFFF).to_bytes(4, "big")
-    # per data cycle: /IRQ service (2 bytes) + block transfer (command + its data bytes), no single accesses
-    assert bench.bytes_clocked - bytes_before == (2 + 1 + block_bytes) * 8
+    # per data cycle: /IRQ service (2 bytes) + block transfer (command + its data bytes), no single accesses; four
+    # steps of three data cycles (MCU-55, FW-19: exactly the run's cycles; before, two a step)
+    assert bench.bytes_clocked - bytes_before == (2 + 1 + block_bytes) * 12
 
 
 @pytest.mark.parametrize("mode", MODES)
@@ -259,8 +262,8 @@ def test_pcmd_alarm_reports_its_data_cycles(cache: pytest.Cache) -> None:
     bench, firmware = _bench(cache, "pcmd_alarm")
     bench.run(10)
     bench.master.processor_command(1, 0x02)
-    bench.run(2)
-    cycles = firmware.board.cycles
+    bench.run(1)  # the command goes out with the run's first cycle, answered after it (FW-19: no cycle under way
+    cycles = firmware.board.cycles  # between runs; before, the first cycle of run(2) had started before the command)
     bench.master.request_processor_alarm(1)
     bench.run(3)
     assert bench.master.processor_alarms == {1: cycles & 0xFF}

@@ -22,7 +22,6 @@ import pytest
 
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import Board
-from supi3.model.registers import InconsistentDataError
 from supi3.regmap import IN0, IN1, IRQ_EVT, OUT0, OUT1
 from supi3.sdk.bench import Bench
 from supi3.sdk.driver import IRQ_SERVICE_MAX_READS, Irq, Supi3Driver
@@ -95,15 +94,17 @@ def test_the_last_stop_s_700_us_main_loop_no_longer_hangs() -> None:
     """tests/test_sdk_serve.py's noting main loop with a 0.7 ms pass (FW-15's note): its service routine read IRQ_EVT
     in the frame of the next cycle's event and the firmware waited for ever on a low /IRQ (one interrupt in nine
     cycles). Now the routine takes that event too; a pass that long (back-to-back cycles of some 0.2 ms) puts the
-    routine's data accesses anywhere in the cycle, and the model says so: the next access falls in a latch phase
-    (3.4.14) instead of the firmware going silent."""
+    routine's data accesses anywhere in the cycle. Since MCU-55 and MCU-56 (the master holds at a run's end, the
+    discovery ID cycle is sized for the ring) they miss the latch phases here: 40 cycles take 8 routines, each run
+    ending unserved (the pass outlasts the wait), none silent; before, the next access fell in a latch phase (3.4.14)
+    within six cycles."""
     device = NotingDigitalIo(pass_us=700.0)
     bench = Bench(firmware=device)
     bench.run(3)
     bench.master.set_outputs(1, b"\x12\x34")
-    with pytest.raises(InconsistentDataError, match=r"during the latch phase"):
-        bench.run(6)
-    assert bench.interrupts > 1
+    bench.run(40)
+    assert (bench.interrupts, bench.cycles, bench.served) == (8, 43, False)
+    assert bench.registers.violations.records == []
 
 
 @pytest.mark.parametrize(("once", "served"), [("1", False), ("0", True)])

@@ -17,9 +17,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from supi3.errors import ArgumentError
 from supi3.interbus import wire
+from supi3.interbus.device import PlainDevice
+from supi3.interbus.ring import Branch, BranchKind
 from supi3.sdk import native
 from supi3.sdk.bench import (
     SERVE_PASSES,
@@ -27,13 +31,19 @@ from supi3.sdk.bench import (
     START_WAIT_S,
     Bench,
     BenchError,
+    Firmware,
     MainLoopPasses,
     MasterStart,
+    ServeWait,
+    discovery_master,
+    resume_s,
+    ring_positions,
     serve_wait_s,
+    telegram_end_s,
 )
 from supi3.sdk.driver import Mode, Supi3Driver
 from supi3.sdk.examples import DigitalIo, PollingIo
-from support import c_firmware
+from support import c_firmware, terminal
 
 MCU = Path(__file__).parent / "mcu"
 PASS_US = 20.0
@@ -74,7 +84,7 @@ def test_the_wait_is_serve_telegrams_status_telegrams(bit_rate: int) -> None:
     """64 status telegrams of 5 bits (0.64 ms at 500 kbit/s), the bound the board uses too (MCU-30)."""
     assert SERVE_TELEGRAMS == 64
     assert serve_wait_s(bit_rate) == pytest.approx(64 * 5 / bit_rate)
-    assert Bench(bit_rate=bit_rate)._serve_s == serve_wait_s(bit_rate)
+    assert Bench(bit_rate=bit_rate)._wait.begin(0.0) == serve_wait_s(bit_rate)  # ServeWait: from the last end (MCU-55)
 
 
 @pytest.mark.parametrize(
@@ -316,12 +326,14 @@ def test_the_bench_s_master_starts_when_the_set_up_has_ended(setup_us: float) ->
     latest at START_WAIT_S (a 2 ms set-up gets the master during it, and its ID cycle the chip's reset ID); the
     first ID cycle of a set-up done in time reads the firmware's ID code (3, no rediscovery), and ``run(3)``
     serves two data cycles. Without a firmware the master starts at the first run, after the test's own driver
-    calls."""
+    calls. The 2 ms set-up writes SET after the master's ID cycle (sized for the ring, MCU-56, FW-20: 0.25 ms at
+    500 kbit/s), during its data cycles: a ReconfigurationError (before, the 27 ms ID cycle of the largest ring
+    covered it), kept by a bench that is not strict."""
     bare = Bench()
     bare.run(1)
     reset_s = bare.timeline[0].start  # a master started at 0: its ID cycle begins after the reset alone
     device = SlowSetup(setup_us)
-    bench = Bench(firmware=device)
+    bench = Bench(firmware=device, strict=False)
     bench.power_up()
     setup_end = bench.now
     bench.run(3)
@@ -332,6 +344,8 @@ def test_the_bench_s_master_starts_when_the_set_up_has_ended(setup_us: float) ->
         assert [t.cycle.name for t in bench.timeline][:3] == ["ID", "DATA", "DATA"]
         assert bench.master.config is not None and bench.master.config[0].id_code == 0x03
         assert bench.interrupts == 2 and bench.served
+    late = {type(error).__name__ for error in bench.registers.violations.records}
+    assert late == (set() if setup_end < START_WAIT_S else {"ReconfigurationError"})
     tested = Bench()
     tested.driver.initialize(Mode.MOTOROLA)
     tested.driver.configure(0x83, 0x03)
@@ -340,3 +354,94 @@ def test_the_bench_s_master_starts_when_the_set_up_has_ended(setup_us: float) ->
     assert tested.timeline[0].start - reset_s == pytest.approx(math.ceil(driven / telegram_s) * telegram_s, abs=1e-12)
     assert tested.master.config is not None and tested.master.config[0].id_code == 0x03
 
+
+
+class SlowIsr(DigitalIo):
+    """DigitalIo whose service routine first does ``isr_us`` of other work (longer than the serve wait: unserved)."""
+
+    def __init__(self, isr_us: float) -> None:
+        super().__init__()
+        self.isr_us = isr_us
+
+    def isr(self, drv: Supi3Driver) -> None:
+        drv.transport.delay_us(self.isr_us)
+        super().isr(drv)
+
+
+HOLD_FIRMWARE: dict[str, Callable[[], Firmware]] = {
+    "interrupt": DigitalIo, "polling": PollingIo, "slow": lambda: SlowIsr(700.0)}
+
+
+@settings(max_examples=25, derandomize=True, deadline=None)
+@given(name=st.sampled_from(sorted(HOLD_FIRMWARE)), bit_rate=st.sampled_from([500_000, 2_000_000]),
+       history=st.lists(st.tuples(st.sampled_from([0.0, 20e-6, 300e-6]), st.integers(0, 4)), min_size=1,
+                        max_size=5))  # fmt: skip
+def test_the_bench_s_run_n_runs_exactly_n_cycles_then_waits_boundedly(
+    name: str, bit_rate: int, history: list[tuple[float, int]]
+) -> None:
+    """FW-19 (MCU-55) on the firmware bench, back to back: ``run(n)`` runs exactly n master cycles (a cycle a
+    ``run_for`` left under way is the run's first: run(0) follows no ``run_for`` here), the master holding while the
+    firmware serves the last; a served run ends within SERVE_TELEGRAMS status telegrams of the last cycle's end; a
+    service routine longer than that (700 µs) that runs after the last cycle ends its run unserved; the next run's
+    first cycle starts at the end of the status telegram the line idled in. Before, the master went on during the
+    last service routine and the passes: the slow routine's run(3), run(1), run(2) from power-up ran 8, 4 and 6
+    cycles at 500 kbit/s, each "served"."""
+    bench = Bench(firmware=HOLD_FIRMWARE[name](), bit_rate=bit_rate, strict=False)  # the slow one: latch-phase reads
+    bench.run(3)
+    wait_s = serve_wait_s(bit_rate)
+    for run_for_s, cycles in history:
+        cycles = max(cycles, 1) if run_for_s else cycles
+        if run_for_s:
+            bench.run_for(run_for_s)
+        before = bench.cycles
+        bench.run(cycles)
+        assert bench.cycles - before == cycles
+        last = bench.timeline[-1]
+        if cycles:  # served: within the bound after the last cycle's end (the slow routine's only if none ran)
+            assert bench.served is (bench.now - last.end <= wait_s)
+            assert bench.served or name == "slow"
+        if cycles:  # the next cycle starts at the end of the status telegram the line idled in when the run ended
+            ended = bench.now  # (its first bit: the ring's time, within a bit after the bench's start)
+            bench.run(1)
+            late = bench.timeline[-1].start - telegram_end_s(last.end, ended, bit_rate)
+            assert -1e-12 <= late < 1 / bit_rate
+
+
+def test_the_serve_wait_and_the_resume_rule() -> None:
+    """ServeWait: the bound SERVE_TELEGRAMS telegrams after the last cycle's end, over to half a telegram (the pin
+    level's float sums); telegram_end_s and resume_s on the idle line's grid; bad times refused by name."""
+    telegram_s = wire.STATUS_TELEGRAM_BITS / 500_000
+    wait = ServeWait(500_000)
+    with pytest.raises(BenchError, match="before begin"):
+        _ = wait.until
+    assert wait.begin(1e-3) == pytest.approx(1e-3 + SERVE_TELEGRAMS * telegram_s)
+    assert not wait.over(wait.until - telegram_s) and wait.over(wait.until - telegram_s / 4)
+    wait.end()
+    assert wait.ended is None
+    for bad in (-1.0, math.nan, math.inf):
+        with pytest.raises(ArgumentError, match="ended"):
+            wait.begin(bad)
+    assert telegram_end_s(1e-3, 1e-3, 500_000) == 1e-3
+    assert telegram_end_s(1e-3, 1e-3 + 0.5 * telegram_s, 500_000) == pytest.approx(1e-3 + telegram_s)
+    assert telegram_end_s(1e-3, 0.0, 500_000) == 1e-3
+    assert resume_s(1e-3, 5e-3, 2e-3, 500_000) == 5e-3  # the cycle time's schedule is later
+    assert resume_s(1e-3, 1e-3, 1e-3 + 2.2 * telegram_s, 500_000) == pytest.approx(1e-3 + 3 * telegram_s)
+
+
+def test_the_discovery_id_cycle_is_sized_for_the_ring() -> None:
+    """FW-20 (MCU-56): the bench's master allows for the ring's positions (a branch: its bus terminal module and
+    each device), not 512: one chip's discovery ID cycle at 500 kbit/s lasts 0.25 ms, not 27 ms; a ring of the chip
+    and two devices reads all three. discovery_master refuses a count outside 1..MAX_DEVICES by name."""
+    bench = Bench()
+    bench.run(1)
+    assert bench.master.max_devices == 1
+    first = bench.timeline[0]
+    assert first.cycle.name == "ID" and first.end - first.start < 0.3e-3
+    others = [PlainDevice(0x02, 0b00001), PlainDevice(0x02, 0b00001)]
+    ring = Bench(others=others)
+    ring.run(2)
+    assert ring.master.max_devices == 3 and ring.master.config is not None and len(ring.master.config) == 3
+    assert ring_positions([others[0], Branch(terminal("BK-LB"), others, BranchKind.LOCAL)]) == 4
+    for bad in (0, wire.MAX_DEVICES + 1):
+        with pytest.raises(ArgumentError, match="max_devices"):
+            discovery_master(ring.ring, bad)

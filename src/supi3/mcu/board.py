@@ -64,7 +64,15 @@ from supi3.model.pinring import PinBranch, PinChip
 from supi3.model.registers import InterfaceViolationError
 from supi3.model.vcd import write_vcd
 from supi3.pinout import C_D_COMMAND
-from supi3.sdk.bench import SERVE_TELEGRAMS, Bench, MainLoopPasses, MasterStart, default_config, serve_wait_s
+from supi3.sdk.bench import (
+    Bench,
+    MainLoopPasses,
+    MasterStart,
+    ServeWait,
+    default_config,
+    discovery_master,
+    serve_wait_s,
+)
 from supi3.spi.upif import Mode, UpifProtocol
 from supi3.tables import CLOCK_HZ
 from supi3.top import Supi3Chip
@@ -345,7 +353,8 @@ class Board:
         self._cpu_hz = self.core.cpu_hz
         bit_rate = self.config.bit_rate
         self._telegram_s = wire.STATUS_TELEGRAM_BITS / bit_rate  # the line idles in whole telegrams (MCU-22, -30)
-        self._serve_s = serve_wait_s(bit_rate)  # the longest wait for the main loop's pass (MCU-30)
+        self._wait = ServeWait(bit_rate)  # MCU-55: the run's end, at most SERVE_TELEGRAMS after its last cycle
+        self._wait_s = serve_wait_s(bit_rate)
         self._limits = {symbol: timing.limit("3-7", symbol, bit_rate) for symbol in ("t0", "t1", "t2", "t8")}
         self._limits["t6max"] = timing.limit("3-7", "t6", bit_rate, maximum=True)
         self._limits["t_SAS_INIT"] = timing.limit("3-7", "t_SAS_INIT", bit_rate)
@@ -399,6 +408,7 @@ class Board:
         """MCU-30: the last :meth:`run` ended with the firmware's work served (False: the wait for the main loop's
         pass ran out, or the run raised)."""
         self._passes = MainLoopPasses()  # arrivals at SERVE_POINT (core cycles), counted from the last cycle's end
+        self._began = 0.0  # the bus time the current run began (MCU-55: its wait counts from its last cycle's end)
         self._serve_end: int | None = None  # the core cycle the wait for the main loop's pass gives up
         if SERVE_POINT in core.image.symbols:  # MCU-30: note the main loop's passes
             self._serve_point: int | None = core.image.address(SERVE_POINT)
@@ -428,7 +438,7 @@ class Board:
         ring.runner = self._lockstep
         ring.on_edge = self._pin_edge
         ring.on_violation = self._pin_violation
-        self._master = Master(ring, locate=False, max_devices=len(ring.devices))
+        self._master = discovery_master(ring, len(ring.devices), locate=False)  # MCU-56: sized for the ring
         self._start = MasterStart()  # MCU-45: the master's first cycle waits for the set-up's end
         self._cycles_done = 0
         self._next_start = 0.0  # cycle_time_s: the bus time the next master cycle starts
@@ -619,21 +629,19 @@ class Board:
         return not self.core.in_exception and self._passed()
 
     def _serve_wait(self) -> bool:
-        """Transaction level, :meth:`run`'s master cycles done: whether the run is done. The first call is at the
-        block boundary the core stopped at for the last cycle's end (the run loop stops at each bus event): the main
-        loop's passes count from there, for at most :data:`SERVE_TELEGRAMS` status telegrams (a bound of the run
-        loop's steps until then); an exception active or pending is waited for as before MCU-30, unbounded."""
+        """Transaction level, :meth:`run`'s master cycles done (the bench's master holds, MCU-55): whether the run is
+        done. The first call is at the block boundary the core stopped at for the last cycle's end (the run loop
+        stops at each bus event; while EXTI0's handler runs, at its return or at most the wait's bound after it,
+        MCU-44): the main loop's passes count from there; the run ends once the firmware has served the cycles (no
+        exception active or pending, the pass made) or at the latest :data:`~supi3.sdk.bench.SERVE_TELEGRAMS` status
+        telegrams after the last cycle's end (:class:`~supi3.sdk.bench.ServeWait`, a bound of the run loop's
+        steps)."""
         core = self.core
-        if self._passes.since is None:
+        if self._serve_end is None:
             self._passes.begin(core.cycles)
-            self._serve_end = core.cycles + self._cycles(self._serve_s)
-        end = self._serve_end
-        if end is not None and core.cycles >= end:
-            self._serve_end = end = None  # the wait for the pass is over: no longer a bound of the steps
-        if core.in_exception:
-            return False
-        self.served = self._passed()
-        return self.served or end is None
+            self._serve_end = self._cycles(self._wait.begin(self.bench.last_end(self._began)))
+        self.served = self._served()
+        return self.served or core.cycles >= self._serve_end
 
     # -- pins --------------------------------------------------------------------------------------------------
 
@@ -853,10 +861,15 @@ class Board:
                 self._run_pin(lambda: self._cycles_done >= target, max_instructions)
                 return
             bench = self.bench
+            self._began = bench.now
+            bench.hold_after(target)  # MCU-55: exactly the run's cycles, then the line idles while it waits
             self._run(lambda: bench.cycles >= target and self._serve_wait(), max_instructions)
         finally:
             self._passes.end()
+            self._wait.end()
             self._serve_end = None
+            if self._bench is not None:
+                self._bench.resume()
 
     def run_for(self, seconds: float, *, max_instructions: int = DEFAULT_MAX_INSTRUCTIONS) -> None:
         """Run the firmware for ``seconds`` of bus time (raises as :meth:`run`). At pin level (MCU-22) the master
@@ -893,14 +906,19 @@ class Board:
 
     def _bus_deadline(self) -> int:
         """The core cycle the run loop stops the core at for the bus: the next bus event that may change /IRQ or
-        /ModAck (MCU-31); none while EXTI0 is active or about to be entered at the step's start (MCU-44: an edge of
-        /IRQ then only sets EXTI's pending bit, and the firmware's next access, or the next stop, at the latest the
-        handler's return, runs the bus up to it)."""
+        /ModAck (MCU-31); while EXTI0 is active or about to be entered at the step's start, :func:`serve_wait_s`
+        after it (MCU-44: an edge of /IRQ then only sets EXTI's pending bit, and the firmware's next access, or the
+        next stop, at the latest the handler's return, runs the bus up to it; MCU-55: a handler that makes no access
+        for that long, spinning, still lets the bus run on, and a run's wait ends at its bound); none while the
+        master holds at a run's end (MCU-55: no bus event comes)."""
         core, bench = self.core, self._bench
         assert bench is not None  # transaction level
-        if _EXTI0 in core.active or (_EXTI0 in core.pending and core.next_entry() == _EXTI0):
+        at = bench.next_change_s()
+        if at == math.inf:
             return MAX_DEADLINE
-        return math.ceil(bench.next_change_s() * core.cpu_hz - NOISE_CYCLES)
+        if _EXTI0 in core.active or (_EXTI0 in core.pending and core.next_entry() == _EXTI0):
+            at += self._wait_s
+        return math.ceil(at * core.cpu_hz - NOISE_CYCLES)
 
     def _set_budget(self, max_instructions: int) -> None:
         self._budget = check_int("max_instructions", max_instructions, 1)
@@ -956,7 +974,7 @@ class Board:
     def _run_pin(self, done: Callable[[], bool], max_instructions: int, end_s: float | None = None) -> None:
         core, ring, master = self.core, self.ring, self._master
         self._set_budget(max_instructions)
-        ended = core.cycles  # the core cycle the last master cycle ended (MCU-30)
+        ended, ended_s = core.cycles, ring.now  # the core cycle and bus time the last master cycle ended (MCU-30)
         try:
             while not done():
                 if self._idle_to(end_s):  # the rest of the last cycle's time, left by run_for
@@ -970,7 +988,7 @@ class Board:
                         ring.status_telegram()
                     master.start()
                 self._cycles_done += 1
-                ended = core.cycles
+                ended, ended_s = core.cycles, ring.now
                 if self._cycle_time_s is not None:  # on its schedule: no drift from the line's whole telegrams
                     on_time = abs(start - self._next_start) < self._telegram_s
                     self._next_start = (self._next_start if on_time else start) + self._cycle_time_s
@@ -978,9 +996,9 @@ class Board:
             if end_s is not None:
                 return
             self._passes.begin(ended)  # MCU-30: the passes count from the last cycle's end (not a cycle time's idle)
-            for _ in range(SERVE_TELEGRAMS):
-                if self._served() and self._irq_fell is None:
-                    break
+            wait = self._wait
+            wait.begin(ended_s)  # MCU-55: the line idles in status telegrams, at most SERVE_TELEGRAMS of them
+            while not (self._served() and self._irq_fell is None) and not wait.over(ring.now):
                 ring.status_telegram()
             self.served = self._served()
         except InterfaceViolationError as error:

@@ -39,10 +39,10 @@ POWER_UP_CYCLES: Final[int] = 3
 MIN_CYCLES: Final[int] = POWER_UP_CYCLES + 3
 """The fewest cycles of a run whose exchange is checked (MCU-45's master start): after the power-up one data cycle
 carries the master's OUT data to the chip and the firmware's handler answers with its inputs, one latches them, one
-brings them to the master. The transaction level needs only two of the three (its chip loads IN at the latch, the
-pin level's when the next frame begins, MCU-17); one minimum serves both fidelities (measured: ``digital_io`` and
-``polling_io`` on the Cortex-M3 and M0 at 500 kbit/s, 1 and 3 devices, exchange their data from 5 cycles at
-transaction level and from 6 at pin level; with fewer every firmware reports MISMATCH)."""
+brings them to the master. Both fidelities need all three since MCU-55 (before, the transaction level needed two,
+its master having started the third in the run's wait); measured: ``digital_io`` and ``polling_io`` on the
+Cortex-M3 and M0 at 500 kbit/s, 1 and 3 devices, exchange their data from 6 cycles at both fidelities; with fewer
+every firmware reports MISMATCH."""
 MIN_CYCLES_LIMIT: Final[str] = (f"the power-up's {POWER_UP_CYCLES} and {MIN_CYCLES - POWER_UP_CYCLES} to check the "
                                  "exchange")
 """Why :data:`MIN_CYCLES`, as an error about a run's cycles says it."""

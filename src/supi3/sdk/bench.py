@@ -35,7 +35,7 @@ from supi3.errors import Supi3Error
 from supi3.interbus import wire
 from supi3.interbus.link import Device
 from supi3.interbus.master import CycleResult, Master
-from supi3.interbus.ring import Ring, Transfer
+from supi3.interbus.ring import Branch, Bus, Ring, Transfer
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3, clocks
 from supi3.model.registers import RegisterFile
@@ -54,8 +54,13 @@ __all__ = [
     "Firmware",
     "MainLoopPasses",
     "MasterStart",
+    "ServeWait",
     "default_config",
+    "discovery_master",
+    "resume_s",
+    "ring_positions",
     "serve_wait_s",
+    "telegram_end_s",
 ]
 
 DEFAULT_STRAPS: Final[tuple[str, str]] = ("10011", "1110")
@@ -127,8 +132,92 @@ class MasterStart:
         """The bus time the master starts on a line that idles in whole status telegrams from power-up: the end of
         the telegram in which :attr:`at` falls (the pin-level board's telegrams, checked with :meth:`due`, end
         there too)."""
-        telegram_s = wire.STATUS_TELEGRAM_BITS / bit_rate
-        return math.ceil(self.at / telegram_s - 1e-9) * telegram_s  # a telegram's end itself, not the next
+        return telegram_end_s(0.0, self.at, bit_rate)
+
+
+def telegram_end_s(since: float, at: float, bit_rate: int) -> float:
+    """The end of the status telegram in which bus time ``at`` falls, on a line idling in whole status telegrams
+    (:data:`~supi3.interbus.wire.STATUS_TELEGRAM_BITS` at ``bit_rate``) from ``since``; ``at`` itself if it is
+    such an end (to a float's rounding), ``since`` if ``at`` is not after it."""
+    telegram_s = wire.STATUS_TELEGRAM_BITS / bit_rate
+    return since + max(0, math.ceil((at - since) / telegram_s - 1e-9)) * telegram_s
+
+
+def discovery_master(bus: Bus, devices: int, *, locate: bool = True) -> Master:
+    """MCU-56, FW-20: the master of the firmware bench (:class:`Bench`) and the emulated board at both fidelities
+    (``supi3.mcu.board.Board``): its discovery ID cycle sized for the ``devices`` the ring holds (A14: two filler
+    bytes a device), not for the largest ring (:data:`~supi3.interbus.wire.MAX_DEVICES`), so both fidelities power
+    up in the same bus time (1.2 ms for ``run(3)`` of one chip at 500 kbit/s, not 27 ms). ``locate=False`` for a
+    ring that cannot close early (the pin-level one, MCU-17).
+
+    Raises
+    ------
+    ArgumentError
+        ``devices`` not an integer from 1 to :data:`~supi3.interbus.wire.MAX_DEVICES`.
+    """
+    return Master(bus, locate=locate, max_devices=devices)
+
+
+def ring_positions(devices: Sequence[Device | Branch]) -> int:
+    """The ring positions of a ring of ``devices`` (a tree: each :class:`~supi3.interbus.ring.Branch` its bus
+    terminal module and every device of its branch), the most its discovery ID cycle can find (MCU-56)."""
+    return sum(1 + ring_positions(item.devices) if isinstance(item, Branch) else 1 for item in devices)
+
+
+class ServeWait:
+    """MCU-55, FW-19: the end of a run of ``n`` master cycles, the one rule of the firmware bench (:meth:`Bench.run`)
+    and the emulated board at both fidelities (``supi3.mcu.board.Board.run``).
+
+    The master runs exactly the ``n`` cycles; from the last one's end (:meth:`begin`) the line idles in status
+    telegrams (the master starts no cycle) while the firmware finishes: an interrupt handler active or pending, an
+    /IRQ edge not yet taken, its main loop's pass to make (:class:`MainLoopPasses`). The wait lasts at most
+    :func:`serve_wait_s` (:data:`SERVE_TELEGRAMS` telegrams) from that end, a handler's as a pass's (:meth:`over`):
+    a run that reaches the bound ends there, unserved. The next run's first cycle starts at the end of the status
+    telegram in which the run ended, or on the cycle time's schedule if that is later (:meth:`resume_s`). Times are
+    bus seconds.
+    """
+
+    __slots__ = ("_half_s", "_wait_s", "ended")
+
+    def __init__(self, bit_rate: int) -> None:
+        self._wait_s = serve_wait_s(bit_rate)
+        self._half_s = wire.STATUS_TELEGRAM_BITS / bit_rate / 2
+        self.ended: float | None = None
+        """When the run's last cycle ended; ``None``: no wait under way."""
+
+    def begin(self, ended: float) -> float:
+        """The run's last cycle ended at ``ended``: the wait's bound (:attr:`until`).
+
+        Raises
+        ------
+        ArgumentError
+            ``ended`` not a finite number >= 0.
+        """
+        self.ended = check_real("ended", ended, 0.0)
+        return self.until
+
+    @property
+    def until(self) -> float:
+        """The latest bus time the run ends: :func:`serve_wait_s` after the last cycle's end."""
+        if self.ended is None:
+            raise BenchError("ServeWait.until before begin (no run's last cycle has ended)")
+        return self.ended + self._wait_s
+
+    def over(self, now: float) -> bool:
+        """Whether the wait has reached its bound at bus time ``now`` (to half a status telegram: the pin-level line
+        idles in whole telegrams, whose float sum may fall an ulp short)."""
+        return now >= self.until - self._half_s
+
+    def end(self) -> None:
+        """The run ended."""
+        self.ended = None
+
+
+def resume_s(since: float, scheduled: float, now: float, bit_rate: int) -> float:
+    """MCU-55, FW-19: when the master's next cycle starts after a run that held it from ``since`` (the last cycle's
+    end; 0 before the master's first cycle) and ended at ``now``: the end of the status telegram the line idled in
+    then (:func:`telegram_end_s`), or ``scheduled`` (the cycle time's next start) if later."""
+    return max(scheduled, telegram_end_s(since, now, bit_rate))
 
 
 def serve_wait_s(bit_rate: int) -> float:
@@ -463,9 +552,10 @@ class Bench:
         self.registers: RegisterFile = self.chip.registers
         if isinstance(others, str | bytes) or not isinstance(others, Sequence):  # Ring names each item's error
             raise fail("others", "a sequence of the devices behind the chip (Device objects)", others)
-        self.ring = Ring([self.chip, *others], bit_rate=self.config.bit_rate)
+        tree = [self.chip, *others]
+        self.ring = Ring(tree, bit_rate=self.config.bit_rate)
         self._bus = _ClockedBus(self.ring)
-        self.master = Master(self._bus)
+        self.master = discovery_master(self._bus, ring_positions(tree))  # MCU-56, FW-20
         self.byte_s = timing.upif_byte_s(self.config.bit_rate, sclk_hz)
         self.io_pin = check_bool("io_pin", io_pin)
         self.pin_read_s = check_real("pin_read_s", pin_read_s, 0.0, 1e-3)
@@ -498,7 +588,9 @@ class Bench:
         """FW-14: the last :meth:`run` ended with the firmware's work served (False: the wait for the main loop's
         pass ran out, or the run raised)."""
         self._passes = MainLoopPasses()
-        self._serve_s = serve_wait_s(self.config.bit_rate)
+        self._wait = ServeWait(self.config.bit_rate)  # MCU-55, FW-19: the end of a run's wait
+        self._hold: float = math.inf  # MCU-55, FW-19: the master starts no cycle once this many have ended
+        self._held: tuple[float, float] | None = None  # held: (the next cycle's start as scheduled, the hold's since)
 
     # -- the bus side ------------------------------------------------------------------------------------------
 
@@ -561,6 +653,10 @@ class Bench:
                     return
 
     def _start_cycle(self) -> None:
+        if self.cycles >= self._hold:  # MCU-55, FW-19: the run's cycles are done, the line idles until it ends
+            self._held = (self._next_start, self.timeline[-1].end if self.timeline else 0.0)
+            self._next_start = self._next_at = math.inf
+            return
         at = self._next_start
         if at > self.now:
             self.now = at
@@ -667,11 +763,14 @@ class Bench:
         """Run until ``cycles`` more master cycles have finished and the firmware has served them (FW-14, as the
         emulated board's run, MCU-30), the firmware's main loop and service routine running as the clock goes.
 
-        Served: the interrupt of the last cycle taken (as the firmware would take it) and, for a firmware with a
-        main loop, a whole pass of it (one :meth:`Firmware.loop` call) begun after the last cycle's end and after
-        the last :meth:`Firmware.isr` (:class:`MainLoopPasses`). The wait for that pass lasts at most
-        :data:`SERVE_TELEGRAMS` status telegrams of bus time (:func:`serve_wait_s`), checked between passes (the
-        bench cannot cut a pass); :attr:`served` tells whether the run ended served.
+        The master runs exactly ``cycles`` cycles; after the last one the line idles in status telegrams until the
+        run ends (:class:`ServeWait`, FW-19, MCU-55), and the next run's first cycle starts at the end of the
+        telegram the run ended in (or on the cycle time's schedule). Served: the interrupt of the last cycle taken
+        (as the firmware would take it) and, for a firmware with a main loop, a whole pass of it (one
+        :meth:`Firmware.loop` call) begun after the last cycle's end and after the last :meth:`Firmware.isr`
+        (:class:`MainLoopPasses`), all within :data:`SERVE_TELEGRAMS` status telegrams of bus time from the last
+        cycle's end (:func:`serve_wait_s`), checked between passes and after the service routine (the bench cannot
+        cut a Python call); :attr:`served` tells whether the run ended served.
 
         Raises
         ------
@@ -687,22 +786,59 @@ class Bench:
         wire.check_bus_time("cycles", cycles, self.now, min(count, 2**53) * shortest)
         target = self.cycles + count
         self.served = False  # until the run ends served (FW-14)
-        self._run_to(target)
-        self.served = self._serve()
+        began = self.now
+        self.hold_after(target)
+        try:
+            self._run_to(target)
+            self.served = self._serve(self.last_end(began))
+        finally:
+            self.resume()
 
-    def _run_to(self, target: int) -> None:
-        """Run until :attr:`cycles` reaches ``target``, then take the last cycle's interrupt."""
+    def hold_after(self, cycles: int) -> None:
+        """MCU-55, FW-19: the master starts no cycle once :attr:`cycles` has reached ``cycles`` (a cycle under way
+        ends), until :meth:`resume`: :meth:`run` and the emulated board's run hold it for their wait.
+
+        Raises
+        ------
+        ArgumentError
+            ``cycles`` not an integer from 0.
+        """
+        self._hold = check_int("cycles", cycles, 0)
+
+    def last_end(self, began: float) -> float:
+        """MCU-55, FW-19: the bus time the last cycle of a run begun at ``began`` ended (``began`` if none has ended
+        since; :meth:`run` and the board's run count their wait from here)."""
+        if self._held is not None:
+            return max(began, self._held[1])
+        return max(began, self.timeline[-1].end) if self.timeline and self.timeline[-1].end <= self.now else began
+
+    def resume(self) -> None:
+        """MCU-55, FW-19: the run ended: the master goes on, its next cycle at the end of the status telegram the
+        line idles in now, or on the cycle time's schedule if later (:func:`resume_s`)."""
+        self._hold = math.inf
+        held, self._held = self._held, None
+        if held is not None:
+            self._next_start = self._next_at = resume_s(held[1], held[0], self.now, self.config.bit_rate)
+
+    def _run_to(self, target: float, end: float = math.inf) -> None:
+        """Run until :attr:`cycles` reaches ``target``, or the clock ``end`` (:meth:`run_for`: a sleeping firmware
+        sleeps to it, a main loop's pass or a service routine may end past it); then take a pending interrupt (the
+        last cycle's, as the firmware would take it)."""
         self.power_up()
         loop = self._main_loop()
         idle_loops = 0
-        while self.cycles < target:
+        while self.cycles < target and self.now < end:
             if self._irq_fell_at is not None:
                 self.take_interrupt()
             if loop is not None:
                 idle_loops = self._pass(loop, idle_loops)
-                continue
-            self._run_bus(math.inf, True)  # sleep until the bus may change /IRQ
-        self.take_interrupt()  # the last cycle's interrupt, as the firmware would take it
+            elif self.cycles >= target or self.now >= end:
+                break  # the service routine ran the bus to the end
+            elif (self._events[0][0] if self._events else self._next_start) > end:  # the next start or end
+                self.advance(end)  # sleep to the end, the phases on the way set (the cycle goes on after it)
+            else:
+                self._run_bus(math.inf, True)  # sleep until the bus may change /IRQ
+        self.take_interrupt()
 
     def _main_loop(self) -> Callable[[Supi3Driver], None] | None:
         """The firmware's :meth:`Firmware.loop` if it overrides it (a firmware without one sleeps)."""
@@ -723,16 +859,26 @@ class Bench:
         raise BenchError(f"the firmware's main loop ran {IDLE_LOOPS_LIMIT} times without clocking a byte or "
                          f"waiting, at t = {self.now:.6f} s (FW-5)")  # fmt: skip
 
-    def _serve(self) -> bool:
-        """FW-14 (MCU-30): after the run's last cycle, run the main loop until a whole pass began after that cycle
-        and the last service routine (:class:`MainLoopPasses`), for at most :func:`serve_wait_s` of bus time;
-        whether the run ended served. A firmware without a main loop is served once the last interrupt is taken."""
-        loop = self._main_loop()
-        if loop is None:
-            return True
+    def _serve(self, ended: float) -> bool:
+        """FW-14 (MCU-30): after the run's last cycle, which ended at ``ended``, run the main loop until a whole pass
+        began after that cycle and the last service routine (:class:`MainLoopPasses`), within :func:`serve_wait_s`
+        of bus time from ``ended`` (:class:`ServeWait`, FW-19); whether the run ended served. A firmware without a
+        main loop is served once the last interrupt is taken, if its service routine ended within the bound."""
+        wait = self._wait
+        wait.begin(ended)
+        try:
+            loop = self._main_loop()
+            if loop is None:
+                return self.now <= wait.until
+            return self._passes_within(loop, wait)
+        finally:
+            wait.end()
+
+    def _passes_within(self, loop: Callable[[Supi3Driver], None], wait: ServeWait) -> bool:
+        """:meth:`_serve`'s wait for the main loop's pass, bounded by ``wait``."""
         passes = self._passes
         passes.begin(self.now)
-        end = self.now + self._serve_s
+        end = wait.until
         interrupts = self.interrupts
         idle_loops = 0
         try:
@@ -752,8 +898,7 @@ class Bench:
             passes.handler()
 
     def run_for(self, seconds: float) -> None:
-        """Run until the clock has moved on by ``seconds`` (at least to the next bus event); unlike :meth:`run`, the
-        end does not wait for the main loop's pass (FW-14, as the emulated board's ``run_for``)."""
-        end = self.now + check_real("seconds", seconds, 0.0)
-        while self.now < end:
-            self._run_to(self.cycles + 1)
+        """Run until the clock has moved on by ``seconds``, the master going on (a cycle under way at the end stays
+        under way, as the emulated board's ``run_for`` at transaction level; FW-19: before, the bench ran on to the
+        end of a cycle); unlike :meth:`run`, the end does not wait for the main loop's pass (FW-14)."""
+        self._run_to(math.inf, self.now + check_real("seconds", seconds, 0.0))

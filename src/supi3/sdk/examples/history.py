@@ -14,9 +14,11 @@ from supi3.interbus.master import Master
 
 __all__ = ["SETTLE_CYCLES", "ProcessBench", "ProcessDevice", "play"]
 
-SETTLE_CYCLES: Final = 2
-"""Master cycles per history step: a word set before the first is latched by its end, and the firmware's answer
-(written after the latch, or in the next access window) is loaded by the start of the second."""
+SETTLE_CYCLES: Final = 3
+"""Master cycles per history step: a word set before the first is latched by its end, the firmware's answer is
+written after that latch (or in the next access window), during the second when cycles run back to back, and goes
+out with the third. (Before MCU-55 and FW-19 two were enough on the transaction-level benches only because their
+master had already started a third cycle, and taken its IN data, by the time the run returned.)"""
 
 
 class ProcessDevice(Protocol):
