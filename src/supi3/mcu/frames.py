@@ -123,6 +123,8 @@ _PHASE_COMMAND: Final[int] = 1
 _PHASE_DATA: Final[int] = 2
 _PHASES: Final[dict[Phase, int]] = {Phase.COMMAND: _PHASE_COMMAND, Phase.DATA: _PHASE_DATA}
 """The protocol phases the native frames run in, by the number hook.c knows them by (0: any other)."""
+_PHASE_NUMBERS: Final[dict[Phase, int]] = {phase: _PHASES.get(phase, 0) for phase in Phase}
+"""Every phase's number (MCU-65: a subscript, not a Python call)."""
 _PHASE_OF: Final[dict[int, Phase]] = {number: phase for phase, number in _PHASES.items()}
 _MEMO_SIZE: Final[int] = 64
 """MCU-65: the bench times whose :func:`first_due` the native frames keep (a master cycle has a few events)."""
@@ -263,21 +265,19 @@ class NativeFrames:
         self._code = _NO_COMMAND
         frames.valid = 0
         frames.pending = 0
-        core.entry = self.enter
+        core.entry = self.catch_up
         core.resume = self.refresh
 
-    def enter(self) -> None:
-        """An entry into Python (:attr:`CortexM.entry`): the mirror is no longer valid (Python may change what it
-        mirrors); what the native frames changed goes into the Python objects."""
-        frames = self._frames
-        if frames.valid:
-            frames.valid = 0
-            if frames.pending:
-                self.catch_up()
-
     def catch_up(self) -> None:
-        """Set the native frames' net effect in the Python objects (what their slow path would have set)."""
+        """An entry into Python (:attr:`CortexM.entry`): the mirror is no longer valid (Python may change what it
+        mirrors); the native frames' net effect, if they took any, set in the Python objects (what their slow path
+        would have set). One Python call an entry (MCU-65)."""
         frames = self._frames
+        if not frames.valid:
+            return
+        frames.valid = 0
+        if not frames.pending:
+            return
         state = _STATE.unpack_from(frames, _STATE_AT)
         (_, odr, synced, phase, command, last_rx, frame_open, fall, driven, transfer, seen, start, period, ss_rise,
          cd_before, written, dr_writes, rx_last, received, shift_start, shift_end) = state
@@ -334,7 +334,7 @@ class NativeFrames:
         board = self._board
         protocol, registers = board.protocol, board.registers
         bench = self._bench
-        phase = _PHASES.get(protocol.phase, 0)
+        phase = _PHASE_NUMBERS[protocol.phase]
         command = protocol.command
         if command is not self._command:  # a CommandByte's hash is a Python call: the last one's code kept
             self._command = command
