@@ -402,6 +402,8 @@ class Board:
         self.native_frames = NativeFrames(self, held, PIN_SS, NOISE_CYCLES, _EXTI0) if native else None
         """MCU-51: the native per-frame fast path (``native_frames=True`` at transaction level on the Motorola
         board), else ``None``."""
+        if self.native_frames is not None:  # the wrappers' refresh, one Python call (MCU-65)
+            self._refresh = self.native_frames.refresh
         self._held: list[tuple[str, int, int]] | None = None  # pin level: edges held while a sleeping core waits
         self._setting_up = True  # MCU-45: the firmware has not yet first waited or come to SERVE_POINT
         self.served = True
@@ -696,11 +698,6 @@ class Board:
     def _spi_write(self, offset: int, size: int, value: int) -> None:
         self.spi.write(offset, size, value)
         self._refresh()
-
-    def _refresh(self) -> None:
-        frames = self.native_frames
-        assert frames is not None  # the wrappers are mapped only with the native frames
-        frames.refresh()
 
     def _on_output(self, pin: int, level: int) -> None:
         ring = self._ring

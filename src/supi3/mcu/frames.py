@@ -123,12 +123,19 @@ _PHASE_COMMAND: Final[int] = 1
 _PHASE_DATA: Final[int] = 2
 _PHASES: Final[dict[Phase, int]] = {Phase.COMMAND: _PHASE_COMMAND, Phase.DATA: _PHASE_DATA}
 """The protocol phases the native frames run in, by the number hook.c knows them by (0: any other)."""
+_PHASE_NUMBERS: Final[dict[Phase, int]] = {phase: _PHASES.get(phase, 0) for phase in Phase}
+"""Every phase's number (MCU-65: a subscript, not a Python call)."""
 _PHASE_OF: Final[dict[int, Phase]] = {number: phase for phase, number in _PHASES.items()}
+_MEMO_SIZE: Final[int] = 64
+"""MCU-65: the bench times whose :func:`first_due` the native frames keep (a master cycle has a few events)."""
 _NO_COMMAND: Final[int] = 0x100
 """The protocol has no command (hook.c reads the command only in the data phase, which always has one)."""
 _CODES: Final[dict[object, int]] = {}
 for _byte in range(255, -1, -1):  # each decoded command by its lowest byte
     _CODES[_upif._COMMANDS[_byte]] = _byte
+_CODES_BY_ID: Final[dict[int, int]] = {id(command): code for command, code in _CODES.items()}
+"""MCU-65: :data:`_CODES` by the identity of ``upif._COMMANDS``'s objects (which the table keeps alive), without a
+``CommandByte``'s hash (a Python call); an equal command of another identity is looked up by value."""
 
 _EVENT_REGISTERS: Final[frozenset[str]] = frozenset(
     name for name, clears in zip(_registers._READ_NAMES, _registers._READ_CLEARS, strict=True) if name and clears
@@ -198,6 +205,22 @@ def first_due(next_at: float, cpu_hz: float, noise: float) -> int:
     return cycles
 
 
+class _FirstDue(dict[float, int]):
+    """:func:`first_due` by a bench time, each computed once (MCU-65: the thresholds' own Python call only when a
+    time is new); emptied when it grows past :data:`_MEMO_SIZE`."""
+
+    def __init__(self, cpu_hz: float, noise: float) -> None:
+        super().__init__()
+        self._hz = cpu_hz
+        self._noise = noise
+
+    def __missing__(self, at: float) -> int:
+        if len(self) >= _MEMO_SIZE:
+            self.clear()
+        cycles = self[at] = first_due(at, self._hz, self._noise)
+        return cycles
+
+
 class NativeFrames:
     """The native per-frame fast path of a transaction-level board (MCU-51): the tables handed to hook.c, the
     mirror refreshed after Python's writes of GPIOA and SPI1, the catch-up at each entry into Python."""
@@ -232,29 +255,29 @@ class NativeFrames:
         self._read_values = operator.itemgetter(*reads)  # the fast-readable registers' values, in address order
         self._values = struct.Struct("<" + "".join("B" if name in reads else "x" for name in read_names))
         self._values_at = Frames.values.offset
+        self._bench = board.bench  # the transaction-level bench, set once at the board's construction
         self._due_key: tuple[int, float | None, float] | None = None  # the bench's next events, as last mirrored
         self._due = (0, _NEVER)
+        self._first_due = _FirstDue(self._hz, noise)
         self._written: tuple[str | None, ...] = _registers._WRITE_NAMES
         self._exti0 = exti0
         self._command: object = None
         self._code = _NO_COMMAND
         frames.valid = 0
         frames.pending = 0
-        core.entry = self.enter
+        core.entry = self.catch_up
         core.resume = self.refresh
 
-    def enter(self) -> None:
-        """An entry into Python (:attr:`CortexM.entry`): the mirror is no longer valid (Python may change what it
-        mirrors); what the native frames changed goes into the Python objects."""
-        frames = self._frames
-        if frames.valid:
-            frames.valid = 0
-            if frames.pending:
-                self.catch_up()
-
     def catch_up(self) -> None:
-        """Set the native frames' net effect in the Python objects (what their slow path would have set)."""
+        """An entry into Python (:attr:`CortexM.entry`): the mirror is no longer valid (Python may change what it
+        mirrors); the native frames' net effect, if they took any, set in the Python objects (what their slow path
+        would have set). One Python call an entry (MCU-65)."""
         frames = self._frames
+        if not frames.valid:
+            return
+        frames.valid = 0
+        if not frames.pending:
+            return
         state = _STATE.unpack_from(frames, _STATE_AT)
         (_, odr, synced, phase, command, last_rx, frame_open, fall, driven, transfer, seen, start, period, ss_rise,
          cd_before, written, dr_writes, rx_last, received, shift_start, shift_end) = state
@@ -294,14 +317,15 @@ class NativeFrames:
     def _thresholds(self, events: list[tuple[float, str]], next_start: float) -> tuple[int, int]:
         """The first core cycle whose synchronisation runs a cycle's start or end, and the one that runs the latch
         phase's start (or :data:`_NEVER`): the phases only set the chips' flags (MCU-52)."""
-        hz, noise = self._hz, self._noise
+        due = self._first_due
         latch_at = _NEVER
         for at, what in reversed(events):  # the next first
             if what == _LATCH:
-                latch_at = first_due(at, hz, noise)
+                latch_at = due[at]
             elif what != _IO:
-                return first_due(at, hz, noise), latch_at
-        return first_due(next_start, hz, noise), latch_at
+                return due[at], latch_at
+        return due[next_start], latch_at
+
 
     def refresh(self) -> None:
         """After Python's write of GPIOA or SPI1: mirror the model's state for the native frames, valid if the
@@ -309,12 +333,16 @@ class NativeFrames:
         frames = self._frames
         board = self._board
         protocol, registers = board.protocol, board.registers
-        bench = board.bench
-        phase = _PHASES.get(protocol.phase, 0)
+        bench = self._bench
+        phase = _PHASE_NUMBERS[protocol.phase]
         command = protocol.command
         if command is not self._command:  # a CommandByte's hash is a Python call: the last one's code kept
             self._command = command
-            self._code = _NO_COMMAND if command is None else _CODES[command]
+            if command is None:
+                self._code = _NO_COMMAND
+            else:  # by identity first (MCU-65)
+                code = _CODES_BY_ID.get(id(command), -1)
+                self._code = _CODES[command] if code < 0 else code
         code = self._code
         frame = board._frame
         core = board.core
@@ -336,11 +364,11 @@ class NativeFrames:
             frames.valid = 0
             return
         gpio, spi, rcc = board.gpio, board.spi, board.rcc
-        cr1 = spi.cr1
+        cr1, period = spi.cr1, spi.period
         spi_ok = (spi.holder is self._spi_held and spi.offer is self._spi_held  # hook.c holds and offers as they would
                   and rcc.apb2enr & SPI1EN and not rcc.apb2rstr & SPI1EN and cr1 & CR1_SPE and cr1 & CR1_MSTR
                   and not cr1 & (CR1_DFF | CR1_LSBFIRST) and cr1 & (CR1_CPOL | CR1_CPHA) == CR1_CPOL | CR1_CPHA
-                  and not spi.period / self._hz < board._shortest_period_s)  # fmt: skip
+                  and not period / self._hz < board._shortest_period_s)  # fmt: skip
         values = registers._values
         self._values.pack_into(frames, self._values_at, *self._read_values(values))
         events = bench._events  # only popped from the end until the next cycle's start makes a new list
@@ -352,7 +380,7 @@ class NativeFrames:
         _MIRROR.pack_into(
             frames, _MIRROR_AT, 1, due, int(registers.latch_phase), latch_at,
             int(bool(rcc.apb2enr & IOPAEN) and not rcc.apb2rstr & IOPAEN), gpio._output_mask(), gpio.pulled_up,
-            gpio._levels, int(bool(spi_ok)), spi.period, SR_MODF if spi.modf else 0, 0, gpio.odr, 0, phase, code,
+            gpio._levels, int(bool(spi_ok)), period, SR_MODF if spi.modf else 0, 0, gpio.odr, 0, phase, code,
             protocol.last_rx, int(frame is not None), 0 if frame is None else frame.fall,
             0 if frame is None or frame.driven is None else frame.driven, *transfer, board._ss_rise,
             board._cd_before, 0, 0, 0)  # fmt: skip
