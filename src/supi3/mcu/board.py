@@ -440,7 +440,7 @@ class Board:
         ring.runner = self._lockstep
         ring.on_edge = self._pin_edge
         ring.on_violation = self._pin_violation
-        self._master = discovery_master(ring, len(ring.devices), locate=False)  # MCU-56: sized for the ring
+        self._master = discovery_master(ring, len(ring.devices))  # MCU-56: sized for the ring; MCU-64: locates
         self._start = MasterStart()  # MCU-45: the master's first cycle waits for the set-up's end
         self._cycles_done = 0
         self._next_start = 0.0  # cycle_time_s: the bus time the next master cycle starts
@@ -974,7 +974,7 @@ class Board:
         ended, ended_s = core.cycles, ring.now  # the core cycle and bus time the last master cycle ended (MCU-30)
         try:
             while not done():
-                if self._idle_to(end_s):  # the rest of the last cycle's time, left by run_for
+                if self._idle_to(end_s):  # to the next start, in the next run as at transaction level (MCU-64)
                     continue
                 start = ring.now
                 if self._cycles_done:
@@ -989,13 +989,12 @@ class Board:
                 if self._cycle_time_s is not None:  # on its schedule: no drift from the line's whole telegrams
                     on_time = abs(start - self._next_start) < self._telegram_s
                     self._next_start = (self._next_start if on_time else start) + self._cycle_time_s
-                    self._idle_to(end_s)
             if end_s is not None:
                 return
             self._passes.begin(ended)  # MCU-30: the passes count from the last cycle's end (not a cycle time's idle)
             wait = self._wait
             wait.begin(ended_s)  # MCU-55: the line idles in status telegrams, at most SERVE_TELEGRAMS of them
-            while not (self._served() and self._irq_fell is None) and not wait.over(ring.now):
+            while not self._served() and not wait.over(ring.now):  # an /IRQ edge counts once it pends EXTI0 (MCU-64)
                 ring.status_telegram()
             self.served = self._served()
         except InterfaceViolationError as error:
