@@ -18,6 +18,7 @@ compared difference of any two traces and never accepts one that differs.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from pathlib import Path
 
@@ -45,6 +46,7 @@ from supi3.regmap import ID, SET
 from supi3.rtl import lfsr
 from supi3.rtl import serial_io as rtl_serial_io
 from supi3.rtl import tables as rtl_tables
+from supi3.sdk import bench
 from supi3.spi.block_pins import block_model
 from supi3.spi.figures import to_wavejson
 from supi3.spi.master import MasterTiming, SoftMaster, SpiTrace, decode_bytes, write_spi_vcd
@@ -531,3 +533,31 @@ def test_input_words_refuse_a_value_past_its_pin() -> None:
     with pytest.raises(ArgumentError, match=r"^stimulus must be a \(cycles, 2\) integer array"):
         layout.input_words(np.zeros((2, 3), dtype=np.uint64))
     assert layout.input_words(np.array([[7, 1]], dtype=np.uint64)).tolist() == [[7 | 1 << 3]]
+
+
+@pytest.mark.parametrize(("call", "name"), [
+    (lambda: bench.telegram_end_s(0.0, 1.0, 0), "bit_rate"),
+    (lambda: bench.telegram_end_s(0.0, math.nan, 500_000), "at"),
+    (lambda: bench.telegram_end_s("a", 1.0, 500_000), "since"),  # type: ignore[arg-type]
+    (lambda: bench.telegram_end_s(-1.0, 1.0, 500_000), "since"),
+    (lambda: bench.resume_s(0.0, 1.0, 2.0, -5), "bit_rate"),
+    (lambda: bench.resume_s(0.0, math.nan, 2.0, 500_000), "scheduled"),
+    (lambda: bench.ring_positions(5), "devices"),  # type: ignore[arg-type]
+    (lambda: bench.ring_positions("ab"), "devices"),  # type: ignore[arg-type]
+    (lambda: bench.ring_positions([object()]), "devices"),  # type: ignore[list-item]
+])  # fmt: skip
+def test_the_run_rule_s_helpers_refuse_by_name(call: Callable[[], object], name: str) -> None:
+    """MCU-55/56's public helpers of ``supi3.sdk.bench`` (added the same day, the lead's probe): a zero or negative
+    bit rate was a ``ZeroDivisionError`` or a silent wrong time (``resume_s(..., -5)`` returned 1.0), NaN a
+    conversion error, a string a ``TypeError`` deep inside, ``ring_positions(5)`` "not iterable"."""
+    with pytest.raises(ArgumentError, match=name):
+        call()
+
+
+def test_the_run_rule_s_helpers_still_answer() -> None:
+    """The same helpers with good arguments: a status telegram's end, the schedule when later, a tree's positions."""
+    telegram = wire.STATUS_TELEGRAM_BITS / 500_000
+    assert bench.telegram_end_s(0.0, 0.5 * telegram, 500_000) == telegram
+    assert bench.resume_s(0.0, math.inf, 0.0, 500_000) == math.inf
+    assert bench.resume_s(0.0, 0.0, 0.5 * telegram, 500_000) == telegram
+    assert bench.ring_positions([]) == 0

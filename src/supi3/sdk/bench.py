@@ -138,8 +138,16 @@ class MasterStart:
 def telegram_end_s(since: float, at: float, bit_rate: int) -> float:
     """The end of the status telegram in which bus time ``at`` falls, on a line idling in whole status telegrams
     (:data:`~supi3.interbus.wire.STATUS_TELEGRAM_BITS` at ``bit_rate``) from ``since``; ``at`` itself if it is
-    such an end (to a float's rounding), ``since`` if ``at`` is not after it."""
-    telegram_s = wire.STATUS_TELEGRAM_BITS / bit_rate
+    such an end (to a float's rounding), ``since`` if ``at`` is not after it.
+
+    Raises
+    ------
+    ArgumentError
+        ``since`` not a finite number >= 0, ``at`` not a finite number; ``bit_rate`` not one of Table 1-7's.
+    """
+    since = check_real("since", since, 0.0)
+    at = check_real("at", at)
+    telegram_s = wire.STATUS_TELEGRAM_BITS / wire.check_bit_rate(bit_rate)
     return since + max(0, math.ceil((at - since) / telegram_s - 1e-9)) * telegram_s
 
 
@@ -160,8 +168,24 @@ def discovery_master(bus: Bus, devices: int, *, locate: bool = True) -> Master:
 
 def ring_positions(devices: Sequence[Device | Branch]) -> int:
     """The ring positions of a ring of ``devices`` (a tree: each :class:`~supi3.interbus.ring.Branch` its bus
-    terminal module and every device of its branch), the most its discovery ID cycle can find (MCU-56)."""
-    return sum(1 + ring_positions(item.devices) if isinstance(item, Branch) else 1 for item in devices)
+    terminal module and every device of its branch), the most its discovery ID cycle can find (MCU-56).
+
+    Raises
+    ------
+    ArgumentError
+        ``devices`` not a sequence of devices and branches.
+    """
+    if isinstance(devices, (str, bytes)) or not isinstance(devices, Sequence):
+        raise fail("devices", "a sequence of devices and branches", devices)
+    positions = 0
+    for item in devices:
+        if isinstance(item, Branch):
+            positions += 1 + ring_positions(item.devices)
+        elif isinstance(item, Device):
+            positions += 1
+        else:
+            raise fail("devices", "a sequence of devices and branches", item, "an item is neither")
+    return positions
 
 
 class ServeWait:
@@ -216,8 +240,14 @@ class ServeWait:
 def resume_s(since: float, scheduled: float, now: float, bit_rate: int) -> float:
     """MCU-55, FW-19: when the master's next cycle starts after a run that held it from ``since`` (the last cycle's
     end; 0 before the master's first cycle) and ended at ``now``: the end of the status telegram the line idled in
-    then (:func:`telegram_end_s`), or ``scheduled`` (the cycle time's next start) if later."""
-    return max(scheduled, telegram_end_s(since, now, bit_rate))
+    then (:func:`telegram_end_s`), or ``scheduled`` (the cycle time's next start) if later.
+
+    Raises
+    ------
+    ArgumentError
+        ``scheduled`` not a number >= 0 (infinity: no schedule), or :func:`telegram_end_s`'s arguments.
+    """
+    return max(check_real("scheduled", scheduled, 0.0, finite=False), telegram_end_s(since, now, bit_rate))
 
 
 def serve_wait_s(bit_rate: int) -> float:
