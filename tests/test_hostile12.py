@@ -36,6 +36,7 @@ from supi3.figures import expansion_wavejson, serial_io_wavejson, write_figures
 from supi3.interbus import wire
 from supi3.interbus.master import Master
 from supi3.interbus.ring import Ring
+from supi3.mcu.pins import ss_high_byte
 from supi3.model.blocks.expansion import overrun_gap_clocks
 from supi3.model.chip import Supi3
 from supi3.model.pins import Supi3Pins
@@ -561,3 +562,12 @@ def test_the_run_rule_s_helpers_still_answer() -> None:
     assert bench.resume_s(0.0, math.inf, 0.0, 500_000) == math.inf
     assert bench.resume_s(0.0, 0.0, 0.5 * telegram, 500_000) == telegram
     assert bench.ring_positions([]) == 0
+
+
+@pytest.mark.parametrize("tx", [-1, 1 << 16, "a", 1.5, True, None])
+def test_the_ss_high_lint_refuses_what_is_no_data_frame(tx: object) -> None:
+    """MCU-63's public ``ss_high_byte`` (the lead's probe): a string or a float was a format ``ValueError``; -1 and
+    10000h went into the report as "byte -1h" and "byte 10000h"."""
+    with pytest.raises(ArgumentError, match="tx"):
+        ss_high_byte(tx)  # type: ignore[arg-type]
+    assert ss_high_byte(0xA5).rule == "3.4.2"

@@ -29,7 +29,7 @@ from typing import Final
 import numpy as np
 import numpy.typing as npt
 
-from supi3.checks import check_bool, check_trace, fail
+from supi3.checks import check_bits, check_bool, check_trace, fail
 from supi3.interbus import wire
 from supi3.mcu.core import Frame
 from supi3.mcu.stm32 import CR1_CPHA, CR1_CPOL, CR1_LSBFIRST
@@ -85,7 +85,14 @@ SS_HIGH_RULE: Final[str] = "3.4.2"
 def ss_high_byte(tx: int) -> InterfaceViolationError:
     """The board's lint of a byte ``tx`` SPI1 clocks while /SS is high, at either fidelity (MCU-63): the chip ignores
     SCLK while it is not selected (3.4.2, Table 3-5), so no chip rule is broken, but the firmware has most likely
-    forgotten /SS."""
+    forgotten /SS.
+
+    Raises
+    ------
+    ArgumentError
+        ``tx`` not SPI1's data frame: an integer of 16 bits at most (RM0008 25.3.3, DFF).
+    """
+    tx = check_bits("tx", tx, 16, "SPI1's data frame, 8 or 16 bits (RM0008 25.3.3)")
     return InterfaceViolationError(SS_HIGH_RULE, f"byte {tx:02X}h clocked with /SS high: the chip ignores it")
 
 
