@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from hypothesis import given
+from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from supi3.errors import Supi3Error
@@ -148,6 +148,42 @@ def test_frames_past_a_cycle_s_end_leave_the_latch_its_new_in_data(elves: dict[s
     threshold taken out of hook.c the master gets the IN data a cycle late and this test fails)."""
     fast, _ = side_by_side(elves["due_cross"], 2_000_000, 6, cycles=4)
     assert fast.core.frames.taken > 6 * 4 * 20  # most of the PCMD reads ran natively
+
+
+_FAULTS = st.lists(st.tuples(st.sampled_from(["cut", "clear", "bit error", "power-up", "outputs", "run"]),
+                              st.integers(1, 3)), min_size=3, max_size=8)  # fmt: skip
+
+
+@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(_FAULTS)
+def test_the_native_frames_agree_through_any_history_of_faults(elves: dict[str, Path],
+                                                               history: list[tuple[str, int]]) -> None:  # fmt: skip
+    """The lead's probe as a property: issue #13's case with the ring's faults between runs (a cut of the chip's
+    forward line, the faults cleared, a bit error, the chip powered up, new master outputs): the boards with and
+    without the native frames agree after every run, whatever the order (a failed or rediscovering master cycle
+    changes what the handler reads)."""
+    boards = (Board(elves["dio_br3"], bit_rate=2_000_000, strict=False),
+              Board(elves["dio_br3"], bit_rate=2_000_000, strict=False, native_frames=False))  # fmt: skip
+    for step, (what, cycles) in enumerate(history):
+        refused: list[bool] = []
+        for board in boards:
+            ring = board.bench._bus.ring
+            if what == "cut":
+                ring.cut(1, True)
+            elif what == "clear":
+                ring.clear_faults()
+            elif what == "bit error":
+                ring.bit_error(1, 10 + cycles)
+            elif what == "power-up":
+                ring.power_up(1)
+            elif what == "outputs":
+                try:
+                    board.bench.master.set_outputs(1, bytes([step, cycles]))
+                except InterbusError:  # no configuration after a cut: refused by name, alike on both
+                    refused.append(True)
+            board.run(cycles)
+        assert len(refused) in (0, 2), (step, what)
+        assert snapshot(boards[0]) == snapshot(boards[1]), (step, what)
 
 
 def test_frame_edges_crosses_every_fallback(elves: dict[str, Path]) -> None:
