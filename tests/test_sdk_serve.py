@@ -291,16 +291,22 @@ def test_c_main_loop_and_polling_firmware_give_the_interrupt_firmware_s_data(
 # -- FW-15 (MCU-45): the master starts when the set-up has ended ----------------------------------------------------
 
 
-class SlowSetup(DigitalIo):
-    """DigitalIo whose set-up first does ``setup_us`` of other work."""
+class Slow(DigitalIo):
+    """DigitalIo whose set-up first does ``setup_us`` and whose service routine first does ``isr_us`` of other work
+    (a service routine longer than the serve wait: unserved)."""
 
-    def __init__(self, setup_us: float) -> None:
+    def __init__(self, setup_us: float = 0.0, isr_us: float = 0.0) -> None:
         super().__init__()
         self.setup_us = setup_us
+        self.isr_us = isr_us
 
     def setup(self, drv: Supi3Driver) -> None:
         drv.transport.delay_us(self.setup_us)
         super().setup(drv)
+
+    def isr(self, drv: Supi3Driver) -> None:
+        drv.transport.delay_us(self.isr_us)
+        super().isr(drv)
 
 
 def test_the_master_start_rule() -> None:
@@ -332,7 +338,7 @@ def test_the_bench_s_master_starts_when_the_set_up_has_ended(setup_us: float) ->
     bare = Bench()
     bare.run(1)
     reset_s = bare.timeline[0].start  # a master started at 0: its ID cycle begins after the reset alone
-    device = SlowSetup(setup_us)
+    device = Slow(setup_us=setup_us)
     bench = Bench(firmware=device, strict=False)
     bench.power_up()
     setup_end = bench.now
@@ -356,20 +362,8 @@ def test_the_bench_s_master_starts_when_the_set_up_has_ended(setup_us: float) ->
 
 
 
-class SlowIsr(DigitalIo):
-    """DigitalIo whose service routine first does ``isr_us`` of other work (longer than the serve wait: unserved)."""
-
-    def __init__(self, isr_us: float) -> None:
-        super().__init__()
-        self.isr_us = isr_us
-
-    def isr(self, drv: Supi3Driver) -> None:
-        drv.transport.delay_us(self.isr_us)
-        super().isr(drv)
-
-
 HOLD_FIRMWARE: dict[str, Callable[[], Firmware]] = {
-    "interrupt": DigitalIo, "polling": PollingIo, "slow": lambda: SlowIsr(700.0)}
+    "interrupt": DigitalIo, "polling": PollingIo, "slow": lambda: Slow(isr_us=700.0)}
 
 
 @settings(max_examples=25, derandomize=True, deadline=None)
