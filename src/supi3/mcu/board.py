@@ -73,6 +73,7 @@ from supi3.sdk.bench import (
     discovery_master,
     serve_wait_s,
 )
+from supi3.sdk.driver import UNDRIVEN_BYTE
 from supi3.spi.upif import Mode, UpifProtocol
 from supi3.tables import CLOCK_HZ
 from supi3.top import Supi3Chip
@@ -114,8 +115,9 @@ PULL_UPS: Final[int] = (1 << PIN_SS) | (1 << PIN_STAT_ERR)
 _CHIP_INPUTS: Final[dict[int, tuple[str, int]]] = {PIN_SS: ("mfp_in", SS_BIT), PIN_SAS_INIT: ("mfp_in", SAS_INIT_BIT),
                                                    PIN_STAT_ERR: ("stat_err_n", 0)}  # fmt: skip
 """At pin level, the chip input (pin, bit) each GPIOA output drives: /SS on MFP5, SAS_INIT on MFP0, /StatErr."""
-MISO_IDLE: Final[int] = 0xFF
-"""MCU-6: what the SPI receives when the chip drives no SerOUT (pulled up)."""
+MISO_IDLE: Final[int] = UNDRIVEN_BYTE
+"""MCU-6: what the SPI receives when the chip drives no SerOUT (pulled up): the firmware bench's undriven byte, one
+value for both (FW-26)."""
 DEFAULT_MAX_INSTRUCTIONS: Final[int] = 20_000_000
 """The instruction budget of one :meth:`Board.run` call unless given, renewed each time the core waits (MCU-41) and
 each time the main loop comes to :data:`SERVE_POINT` (MCU-43)."""
