@@ -90,6 +90,22 @@ class State(ctypes.Structure):
         ("rewritable", ctypes.c_uint64),
         ("rewritable_size", ctypes.c_uint64),
         ("code_written", ctypes.c_uint32),
+        ("mem_read", ctypes.c_void_p),
+        ("mem_write", ctypes.c_void_p),
+        ("emu_start", ctypes.c_void_p),
+        ("exc_registers", ctypes.c_int32 * 11),
+        ("exc_return_handler", ctypes.c_uint32),
+        ("exc_return_thread_msp", ctypes.c_uint32),
+        ("exc_return_thread_psp", ctypes.c_uint32),
+        ("xpsr_t", ctypes.c_uint32),
+        ("xpsr_align", ctypes.c_uint32),
+        ("control_spsel", ctypes.c_uint32),
+        ("interrupt", ctypes.c_uint32),
+        ("no_interrupt", ctypes.c_uint32),
+        ("frame", ctypes.c_int64),
+        ("vector", ctypes.c_uint64),
+        ("pc", ctypes.c_uint64),
+        ("status", ctypes.c_int32),
     )
 
 
