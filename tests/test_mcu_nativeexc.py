@@ -21,6 +21,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from unicorn.arm_const import UC_ARM_REG_CONTROL, UC_ARM_REG_MSP, UC_ARM_REG_PSP
 
+from supi3.errors import ArgumentError
 from supi3.mcu import build as mcu_build
 from supi3.mcu import core as mcu_core
 from supi3.mcu.board import Board
@@ -232,3 +233,12 @@ def test_the_example_firmwares_run_alike_with_either_path(tmp_path: Path, exampl
     fast, slow = (_board_run(elf, cpu, bit_rate, flag) for flag in (True, False))
     assert fast == slow
     assert isinstance(fast[10], int) and fast[10] >= 10
+
+
+@pytest.mark.parametrize("value", [1, "yes", None])
+def test_the_switch_takes_a_bool_only(exceptions_elf: Path, value: object) -> None:
+    """``native_exceptions`` set to anything but a bool is an ArgumentError naming it; the core keeps its path."""
+    core = CortexM(exceptions_elf)
+    with pytest.raises(ArgumentError, match="native_exceptions"):
+        core.native_exceptions = value  # type: ignore[assignment]
+    assert core.native_exceptions is True

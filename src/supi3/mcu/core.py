@@ -40,7 +40,7 @@ import unicorn
 from unicorn import arm_const as arm
 from unicorn import unicorn_const as ucc
 
-from supi3.checks import check_bytes, check_int, check_real, fail
+from supi3.checks import check_bool, check_bytes, check_int, check_real, fail
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.mcu import hook
 
@@ -812,9 +812,7 @@ class CortexM:
         self._native_take = _native(native.supi3_take, ctypes.c_uint32, ctypes.c_uint32, ctypes.c_uint64)
         self._native_return = _native(native.supi3_return, ctypes.c_uint32)
         self._native_run = _native(native.supi3_run)
-        self.native_exceptions = True
-        """MCU-70, MCU-71: the exception entry's and return's register and memory traffic in native code (one call
-        each); ``False``: through ctypes call by call, the reference path the tests compare it with."""
+        self._native_exceptions = True
         self._prefixes = (hook.Prefix * PREFIX_SLOTS)()  # cycles_now's memo for the native frames (MCU-51)
         self.frames = frames = hook.Frames()
         """The native per-frame fast path's state (MCU-51; :mod:`supi3.mcu.frames` sets it up: off until then)."""
@@ -1073,6 +1071,17 @@ class CortexM:
         self._state.skip_polls = value
 
     @property
+    def native_exceptions(self) -> bool:
+        """MCU-70, MCU-71: the exception entry's, tail-chain's and return's register and memory traffic in native code,
+        one call each (the default); ``False``: through ctypes call by call, the reference path the tests compare it
+        with. The same registers, frames, cycles and reports either way."""
+        return self._native_exceptions
+
+    @native_exceptions.setter
+    def native_exceptions(self, value: bool) -> None:
+        self._native_exceptions = check_bool("native_exceptions", value)
+
+    @property
     def time_s(self) -> float:
         """Core time: cycles / cpu_hz."""
         return self.cycles / self.cpu_hz
@@ -1158,7 +1167,8 @@ class CortexM:
     def pend(self, number: int) -> None:
         """Make exception ``number`` pending (an external interrupt: ``EXTERNAL + irq``)."""
         self.pending.add(_exception_number(number))
-        self.sleeping = False if self._takeable() is not None else self.sleeping
+        if self.sleeping and self._takeable() is not None:  # only a sleeping core asks (MCU-72)
+            self.sleeping = False
 
     @property
     def in_exception(self) -> bool:
@@ -1192,7 +1202,7 @@ class CortexM:
         frame's address."""
         _exception_number(number)
         handler_mode = bool(self.active)
-        if self.native_exceptions:  # MCU-71: the same traffic in one call
+        if self._native_exceptions:  # MCU-71: the same traffic in one call
             failed = self._native_enter(self._handle, self._state_ref, number, handler_mode, self.vtor + 4 * number)
             frame = int(self._state.frame)
             if failed == 1:
@@ -1223,7 +1233,7 @@ class CortexM:
         """The part of an entry after the stacking (B1.5.6), also a tail-chain's: LR = ``exc_return``, IPSR, PC =
         the vector of ``number``, which becomes active; costs ``cycles``. ``frame``: the stacked frame, for a
         report."""
-        if self.native_exceptions:  # MCU-71: the same traffic in one call
+        if self._native_exceptions:  # MCU-71: the same traffic in one call
             failed = self._native_take(self._handle, self._state_ref, number, exc_return, self.vtor + 4 * number)
             self._took(number, frame, cycles, None if failed else int(self._state.vector))
             return
@@ -1274,7 +1284,7 @@ class CortexM:
             self._take(chained, exc_return, sp, self.cpu.tail_chain_cycles)
             return
         self.active.append(returning)  # until the frame is back: a fault report shows the handler still active
-        if self.native_exceptions:  # MCU-70: the same traffic in one call
+        if self._native_exceptions:  # MCU-70: the same traffic in one call
             if self._native_return(self._handle, self._state_ref, exc_return):
                 self._unstacking_error(int(self._state.frame))
             self.active.pop()
