@@ -5,9 +5,11 @@ to B1.5.8).
 plain return with one call to the native library each; ``False`` does the same steps through ctypes call by call
 (the reference). Both paths leave the same registers (both stack pointers and CONTROL), the same stack bytes, cycles,
 instructions, active and pending exceptions, over the hand-written exception programs (nesting, the alignment word,
-the process stack, tail-chaining), random register contents and stack depths, the fault reports (stacking,
+the process stack, tail-chaining), the fault reports (stacking,
 unstacking and vector-table errors, INVSTATE, a bad EXC_RETURN, a core fault's HardFault frame) and the example
 firmwares on the board (registers, RAM, cycles, instructions, interrupts, latency, bus time, data, violations).
+Random register contents, stack depths and stacks: ``test_mcu_batch.py`` (the native path, the batches and single
+accesses).
 """
 
 from __future__ import annotations
@@ -17,9 +19,6 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
-from hypothesis import given, settings
-from hypothesis import strategies as st
-from unicorn.arm_const import UC_ARM_REG_CONTROL, UC_ARM_REG_MSP, UC_ARM_REG_PSP
 
 from supi3.errors import ArgumentError
 from supi3.mcu import build as mcu_build
@@ -128,11 +127,18 @@ def _bad_return(core: CortexM) -> object:
     return None
 
 
+def _spsel_in_handler(core: CortexM) -> object:
+    _sleep(core)
+    core.enter(EXTERNAL + 0)
+    core.set_reg("control", mcu_core.CONTROL_SPSEL)  # a host write: handler mode still stacks as handler mode
+    return core.enter(mcu_core.HARDFAULT), core.reg("lr")
+
+
 SCENARIOS: dict[str, Callable[[CortexM], object]] = {
     **{f"nested{'_psp' * process}_{misalign}": _nested(misalign, process) for misalign in (0, 4)
        for process in (False, True)},
     "stacking_error": _stacking_error, "unstacking_error": _unstacking_error, "vector_error": _vector_error,
-    "invstate": _invstate, "bad_return": _bad_return,
+    "invstate": _invstate, "bad_return": _bad_return, "spsel_in_handler": _spsel_in_handler,
 }  # fmt: skip
 
 
@@ -145,60 +151,13 @@ def test_the_native_traffic_is_the_python_paths_over_the_exception_programs(exce
     state with the native traffic as with the Python path."""
     native_run, python_run = _both(exceptions_elf, cpu, SCENARIOS[name])
     assert native_run == python_run
-    if name.startswith("nested"):
+    if name == "spsel_in_handler":
+        assert native_run[0][1] == mcu_core.EXC_RETURN_HANDLER  # type: ignore[index]
+    elif name.startswith("nested"):
         assert native_run[1] == [EXTERNAL + 0, EXTERNAL + 1, EXTERNAL + 1, EXTERNAL + 0, EXTERNAL + 1]  # IRQ 0 pends 1
     else:
         assert isinstance(native_run[0], tuple)
         assert "UsageFault" in native_run[0][0] or " error: " in native_run[0][0]
-
-
-_WORD = st.integers(0, 0xFFFF_FFFF)
-_GENERAL = [f"r{k}" for k in range(13)] + ["lr"]
-
-
-@pytest.fixture(scope="module")
-def cores(exceptions_elf: Path) -> dict[tuple[str, bool], CortexM]:
-    """A core of each kind with each path, once per module; each example resets the registers."""
-    made = {}
-    for cpu in CPUS:
-        for fast in (True, False):
-            core = made[cpu, fast] = CortexM(exceptions_elf, cpu=cpu)
-            core.native_exceptions = fast
-    return made
-
-
-@settings(derandomize=True, max_examples=60, deadline=None)
-@given(st.sampled_from(sorted(CPUS)), st.lists(_WORD, min_size=len(_GENERAL), max_size=len(_GENERAL)),
-       st.integers(0, 15), st.booleans(), st.booleans(), st.sampled_from([15, EXTERNAL + 6]))  # fmt: skip
-def test_random_registers_and_stacks_enter_and_return_alike(
-    cores: dict[tuple[str, bool], CortexM], cpu: str, values: list[int], depth: int, process: bool, nested: bool,
-    number: int,
-) -> None:
-    """MCU-70, MCU-71: from random registers, stack depths (the alignment word comes and goes) and stacks (main or
-    process in thread mode), an entry (SysTick or EXTI6), a nested one and the returns leave the same state after
-    each step with the native traffic as with the Python path."""
-    results = []
-    for fast in (True, False):
-        core = cores[cpu, fast]
-        core.reset()
-        core.active.clear()
-        core.cycles = 0
-        for name, value in zip(_GENERAL, values, strict=True):
-            core.set_reg(name, value)
-        top = core.ram[0] + core.ram[1] - 4 * depth
-        core._write(UC_ARM_REG_PSP, top - 512)
-        core._write(UC_ARM_REG_MSP, top)
-        if process:
-            core._write(UC_ARM_REG_CONTROL, mcu_core.CONTROL_SPSEL)
-        steps = [_state(core), core.enter(number)]
-        if nested:
-            steps += [_state(core), core.enter(mcu_core.HARDFAULT)]
-            core.exception_return(core.reg("lr"))
-        steps.append(_state(core))
-        core.exception_return(core.reg("lr"))
-        steps.append(_state(core))
-        results.append(steps)
-    assert results[0] == results[1]
 
 
 def _board_run(elf: Path, cpu: str, bit_rate: int, fast: bool) -> tuple[object, ...]:
