@@ -17,6 +17,9 @@
  * A peripheral's reads go first to supi3_held_read: a register whose value the peripheral holds until a cycle (SPI1's
  * SR while a byte shifts) is answered here, as the peripheral would answer it, and so is one read of a register the
  * peripheral offers from a cycle on (SPI1's DR once its byte has ended, MCU-26); every other read goes to Python.
+ *
+ * The exception entry's, tail-chain's and return's register and memory traffic, a run's start and the interrupt hook
+ * are here too (MCU-70 to MCU-72): CortexM keeps every decision and report and calls them once each.
  */
 #include <stddef.h>
 #include <stdint.h>

@@ -1,4 +1,6 @@
-"""The core's block hook in native code (MCU-25): ``hook.c`` built for the host with the Zig toolchain from PyPI.
+"""The core's block hook in native code (MCU-25): ``hook.c`` built for the host with the Zig toolchain from PyPI. It
+also holds the exception entry's, tail-chain's and return's register and memory traffic, a run's start and the
+interrupt hook (MCU-70 to MCU-72), which :class:`supi3.mcu.core.CortexM` calls with its :class:`State`.
 
 Ref: unicorn.h (uc_cb_hookcode_t, uc_cb_hookmem_t); decisions MCU-1, MCU-10, MCU-11, MCU-25 in
 docs/assumptions/mcu.md. The C source ships with the package; :func:`library` compiles it on first use with
