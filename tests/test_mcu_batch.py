@@ -66,20 +66,24 @@ def _state(core: CortexM) -> tuple[object, ...]:
 
 @settings(derandomize=True, max_examples=60, deadline=None)
 @given(st.sampled_from(sorted(CPUS)), st.lists(_WORD, min_size=len(_GENERAL), max_size=len(_GENERAL)),
-       st.integers(0, 15), st.booleans(), st.sampled_from([15, mcu_core.EXTERNAL + 6]))  # fmt: skip
+       st.integers(0, 15), st.booleans(), st.booleans(), st.sampled_from([15, mcu_core.EXTERNAL + 6]))  # fmt: skip
 def test_a_batched_entry_and_return_are_the_single_accesses(
-    cores: dict[str, CortexM], cpu: str, values: list[int], depth: int, process: bool, number: int
+    cores: dict[str, CortexM], cpu: str, values: list[int], depth: int, process: bool, nested: bool, number: int
 ) -> None:
     """MCU-27: from random registers, stack depths (word-aligned, so the alignment word comes and goes) and stacks
     (main or process in thread mode), an entry (SysTick or EXTI0) with batched reads stacks the same frame and leaves
     the same registers, cycles and active list as one with single reads; its return with batched writes restores
-    what was there before the entry."""
+    what was there before the entry. MCU-70, MCU-71: the native traffic (one call each, the default) does the same,
+    also with a HardFault entered and returned from inside the handler (a nested frame, EXC_RETURN to handler
+    mode)."""
     core = cores[cpu]
     results = []
-    for batched in (True, False):
+    for path in ("native", "batched", "single"):
+        core.native_exceptions = path == "native"
         core.reset()
         core.active.clear()
         core.cycles = 0
+        core.write_bytes(core.ram[0] + core.ram[1] - 1024, bytes(1024))  # no frame of the path before (nested)
         for name, value in zip(_GENERAL, values, strict=True):
             core.set_reg(name, value)
         top = core.ram[0] + core.ram[1] - 4 * depth
@@ -88,10 +92,17 @@ def test_a_batched_entry_and_return_are_the_single_accesses(
         if process:
             core._write(UC_ARM_REG_CONTROL, mcu_core.CONTROL_SPSEL)
         before = _state(core)
-        frame = core.enter(number) if batched else _single_enter(core, number)
-        entered = (_state(core), frame)
+        enter = _single_enter if path == "single" else CortexM.enter
+        frame = enter(core, number)
+        entered = [_state(core), frame]
+        if nested:
+            entered += [enter(core, mcu_core.HARDFAULT), _state(core)]
+            core.exception_return(core.reg("lr"))
+            entered.append(_state(core))
+            core.cycles -= core.cpu.return_cycles + core.cpu.entry_cycles
         core.exception_return(core.reg("lr"))
         core.cycles -= core.cpu.return_cycles + core.cpu.entry_cycles
         results.append((entered, _state(core)[:-1] == before[:-1]))  # the frame stays in RAM below the SP
-    assert results[0] == results[1]
+    core.native_exceptions = True
+    assert results[0] == results[1] == results[2]
     assert results[0][1]

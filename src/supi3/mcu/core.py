@@ -40,7 +40,7 @@ import unicorn
 from unicorn import arm_const as arm
 from unicorn import unicorn_const as ucc
 
-from supi3.checks import check_bytes, check_int, check_real, fail
+from supi3.checks import check_bool, check_bytes, check_int, check_real, fail
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.mcu import hook
 
@@ -51,7 +51,6 @@ _LIB: Any = _UNICORN.unicorn_py3.unicorn.uclib
 register accesses go to it directly (MCU-19), without the binding's wrappers around each call."""
 # Callback types of unicorn.h (uc_cb_hookcode_t, uc_cb_eventmem_t; mmio reads and writes: hook.MMIO_READ, MMIO_WRITE).
 _HOOK_CODE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, ctypes.c_uint32, ctypes.c_void_p)
-_HOOK_INTR: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint32, ctypes.c_void_p)
 _HOOK_MEM_INVALID: Final = ctypes.CFUNCTYPE(ctypes.c_bool, ctypes.c_void_p, ctypes.c_int, ctypes.c_uint64, ctypes.c_int,
                                             ctypes.c_int64, ctypes.c_void_p)  # fmt: skip
 
@@ -628,6 +627,18 @@ MAX_DEADLINE: Final[int] = (1 << 63) - 1
 block, an exception entry or a sleep; half its range (6000 years at 48 MHz) leaves it room never to wrap."""
 
 
+_NO_INTERRUPT: Final[int] = 0xFFFF_FFFF
+"""The native state's ``interrupt`` after a run in which unicorn raised no CPU exception (MCU-72)."""
+
+
+def _native(function: Any, *arguments: Any) -> Any:
+    """A function of the native hook library taking unicorn's engine, the core's state and ``arguments`` (ctypes
+    types), returning an ``int`` (MCU-70 to MCU-72)."""
+    function.argtypes = (ctypes.c_void_p, ctypes.c_void_p, *arguments)
+    function.restype = ctypes.c_int
+    return function
+
+
 class _Batch:
     """Core registers read or written in one call to unicorn's C library (``uc_reg_read_batch``,
     ``uc_reg_write_batch``; MCU-19: 32-bit values in 64-bit slots)."""
@@ -787,6 +798,21 @@ class CortexM:
         state.reg_write = ctypes.cast(_LIB.uc_reg_write, ctypes.c_void_p)
         state.describe = self._describe_callback
         state.rewritable, state.rewritable_size = ram  # MCU-28: code in RAM is costed each time it runs
+        # MCU-70 to MCU-72: the entry's and return's traffic and a run's start in native code, with unicorn's
+        # functions and numbers and the architecture's constants from here
+        for name in ("mem_read", "mem_write", "emu_start"):
+            setattr(state, name, ctypes.cast(getattr(_LIB, f"uc_{name}"), ctypes.c_void_p))
+        state.exc_registers[:] = (*_ENTRY_READS, arm.UC_ARM_REG_PSP)
+        state.exc_return_handler, state.exc_return_thread_msp = EXC_RETURN_HANDLER, EXC_RETURN_THREAD_MSP
+        state.exc_return_thread_psp = EXC_RETURN_THREAD_PSP
+        state.xpsr_t, state.xpsr_align, state.control_spsel = XPSR_T, XPSR_ALIGN, CONTROL_SPSEL
+        state.no_interrupt = _NO_INTERRUPT
+        self._state_ref = ctypes.byref(state)
+        self._native_enter = _native(native.supi3_enter, ctypes.c_uint32, ctypes.c_uint32, ctypes.c_uint64)
+        self._native_take = _native(native.supi3_take, ctypes.c_uint32, ctypes.c_uint32, ctypes.c_uint64)
+        self._native_return = _native(native.supi3_return, ctypes.c_uint32)
+        self._native_run = _native(native.supi3_run)
+        self._native_exceptions = True
         self._prefixes = (hook.Prefix * PREFIX_SLOTS)()  # cycles_now's memo for the native frames (MCU-51)
         self.frames = frames = hook.Frames()
         """The native per-frame fast path's state (MCU-51; :mod:`supi3.mcu.frames` sets it up: off until then)."""
@@ -806,8 +832,6 @@ class CortexM:
         self.priorities: dict[int, int] = {}
         self.stop_request = False
         self.error: BaseException | None = None
-        self.exception_exit = False
-        self.interrupt: int | None = None
         self.entered: Callable[[int], None] = _nothing
         """Called with the exception number after each exception entry (the board measures latency)."""
         self._costs: dict[tuple[int, int], tuple[int, int]] = {}  # the cost of a block's first instructions
@@ -829,7 +853,7 @@ class CortexM:
         on_idle_loop = _HOOK_CODE(self._on_idle_loop)
         for address in idle_loops(self.image, flash):  # MCU-4: the core stops at its first ``b .``
             self._hook(ucc.UC_HOOK_CODE, on_idle_loop, address, address)
-        self._hook(ucc.UC_HOOK_INTR, _HOOK_INTR(self._on_interrupt))  # registered directly (MCU-19)
+        self._hook(ucc.UC_HOOK_INTR, native.supi3_interrupt, data=self._state_ref)  # native (MCU-72)
         self._fault_address: int | None = None  # the address of the last unmapped or protected access (BFAR, MMFAR)
         self._hook(ucc.UC_HOOK_MEM_INVALID, _HOOK_MEM_INVALID(self._on_invalid_access))
         self.reset()
@@ -1047,6 +1071,17 @@ class CortexM:
         self._state.skip_polls = value
 
     @property
+    def native_exceptions(self) -> bool:
+        """MCU-70, MCU-71: the exception entry's, tail-chain's and return's register and memory traffic in native code,
+        one call each (the default); ``False``: through ctypes call by call, the reference path the tests compare it
+        with. The same registers, frames, cycles and reports either way."""
+        return self._native_exceptions
+
+    @native_exceptions.setter
+    def native_exceptions(self, value: bool) -> None:
+        self._native_exceptions = check_bool("native_exceptions", value)
+
+    @property
     def time_s(self) -> float:
         """Core time: cycles / cpu_hz."""
         return self.cycles / self.cpu_hz
@@ -1132,7 +1167,8 @@ class CortexM:
     def pend(self, number: int) -> None:
         """Make exception ``number`` pending (an external interrupt: ``EXTERNAL + irq``)."""
         self.pending.add(_exception_number(number))
-        self.sleeping = False if self._takeable() is not None else self.sleeping
+        if self.sleeping and self._takeable() is not None:  # only a sleeping core asks (MCU-72)
+            self.sleeping = False
 
     @property
     def in_exception(self) -> bool:
@@ -1166,6 +1202,13 @@ class CortexM:
         frame's address."""
         _exception_number(number)
         handler_mode = bool(self.active)
+        if self._native_exceptions:  # MCU-71: the same traffic in one call
+            failed = self._native_enter(self._handle, self._state_ref, number, handler_mode, self.vtor + 4 * number)
+            frame = int(self._state.frame)
+            if failed == 1:
+                self._stacking_error(frame, self._state.status)
+            self._took(number, frame, self.cpu.entry_cycles, None if failed else int(self._state.vector))
+            return frame
         control, sp, *words, xpsr, pc = self._entry_reads.read()
         process = bool(control & CONTROL_SPSEL) and not handler_mode
         aligned = sp & 4
@@ -1173,8 +1216,7 @@ class CortexM:
         words += [pc, xpsr | (XPSR_ALIGN if aligned else 0)]
         status = _LIB.uc_mem_write(self._handle, frame, struct.pack("<8I", *words), FRAME_WORDS * 4)  # MCU-31
         if status != ucc.UC_ERR_OK:
-            raise FirmwareFaultError(self.report(Stop.FAULT, f"stacking error: the frame at {frame:08X}h is not in "
-                                            f"memory ({UcError(status)})"))  # fmt: skip
+            self._stacking_error(frame, status)
         self._write(arm.UC_ARM_REG_SP, frame)
         if process:
             self._write(arm.UC_ARM_REG_CONTROL, control & ~CONTROL_SPSEL)  # unicorn switches SP to the MSP
@@ -1182,18 +1224,35 @@ class CortexM:
         self._take(number, exc_return, frame, self.cpu.entry_cycles)
         return frame
 
+    def _stacking_error(self, frame: int, status: int) -> None:
+        """The entry's frame at ``frame`` is not in memory (unicorn's ``status``): a fault report (B1.5.6)."""
+        raise FirmwareFaultError(self.report(Stop.FAULT, f"stacking error: the frame at {frame:08X}h is not in "
+                                             f"memory ({UcError(status)})"))  # fmt: skip
+
     def _take(self, number: int, exc_return: int, frame: int, cycles: int) -> None:
         """The part of an entry after the stacking (B1.5.6), also a tail-chain's: LR = ``exc_return``, IPSR, PC =
         the vector of ``number``, which becomes active; costs ``cycles``. ``frame``: the stacked frame, for a
         report."""
+        if self._native_exceptions:  # MCU-71: the same traffic in one call
+            failed = self._native_take(self._handle, self._state_ref, number, exc_return, self.vtor + 4 * number)
+            self._took(number, frame, cycles, None if failed else int(self._state.vector))
+            return
         self._write(arm.UC_ARM_REG_LR, exc_return)
         self._write(arm.UC_ARM_REG_XPSR, XPSR_T | number)
         try:
-            target = self.vector(number)
+            target: int | None = self.vector(number)
         except ArgumentError:
+            target = None
+        if target is not None:
+            self._write(arm.UC_ARM_REG_PC, target & ~1)
+        self._took(number, frame, cycles, target)
+
+    def _took(self, number: int, frame: int, cycles: int, target: int | None) -> None:
+        """The rest of :meth:`_take` once LR, xPSR and PC are written: ``number`` active at the vector ``target``
+        (``None``: its entry in the vector table is not in memory, a fault)."""
+        if target is None:
             reason = f"vector table read error: entry {number} ({_name(number)}) at VTOR {self.vtor:08X}h is unmapped"
-            raise FirmwareFaultError(self.report(Stop.FAULT, reason, stacked=frame)) from None
-        self._write(arm.UC_ARM_REG_PC, target & ~1)
+            raise FirmwareFaultError(self.report(Stop.FAULT, reason, stacked=frame))
         self.pending.discard(number)
         self.active.append(number)
         self._state.cycles += cycles
@@ -1218,18 +1277,24 @@ class CortexM:
             nesting = f"{len(self.active)} active exception(s)"
             reason = f"EXC_RETURN {exc_return:08X}h does not match the nesting of {nesting}: INVPC UsageFault (B1.5.8)"
             raise FirmwareFaultError(self.report(Stop.FAULT, reason))
-        sp = self._read(arm.UC_ARM_REG_PSP if exc_return == EXC_RETURN_THREAD_PSP else arm.UC_ARM_REG_SP)
         returning = self.active.pop()
         chained = self._takeable()
         if chained is not None:
+            sp = self._read(arm.UC_ARM_REG_PSP if exc_return == EXC_RETURN_THREAD_PSP else arm.UC_ARM_REG_SP)
             self._take(chained, exc_return, sp, self.cpu.tail_chain_cycles)
             return
         self.active.append(returning)  # until the frame is back: a fault report shows the handler still active
+        if self._native_exceptions:  # MCU-70: the same traffic in one call
+            if self._native_return(self._handle, self._state_ref, exc_return):
+                self._unstacking_error(int(self._state.frame))
+            self.active.pop()
+            self._state.cycles += self.cpu.return_cycles
+            return
+        sp = self._read(arm.UC_ARM_REG_PSP if exc_return == EXC_RETURN_THREAD_PSP else arm.UC_ARM_REG_SP)
         try:
             words = struct.unpack("<8I", self._peek(sp, FRAME_WORDS * 4))
         except ArgumentError:
-            reason = f"unstacking error: the frame at {sp:08X}h is not in memory (B1.5.8)"
-            raise FirmwareFaultError(self.report(Stop.FAULT, reason)) from None
+            self._unstacking_error(sp)
         xpsr = words[7]
         sp += FRAME_WORDS * 4 + (4 if xpsr & XPSR_ALIGN else 0)
         self._unstack.write([*words[:6], (xpsr & ~XPSR_ALIGN) | XPSR_T])  # the mode last: it selects the SP
@@ -1238,6 +1303,11 @@ class CortexM:
         self._resume.write([sp, words[6] & ~1])
         self.active.pop()
         self._state.cycles += self.cpu.return_cycles
+
+    def _unstacking_error(self, sp: int) -> None:
+        """The frame to unstack at ``sp`` is not in memory: a fault report (B1.5.8)."""
+        raise FirmwareFaultError(self.report(Stop.FAULT, f"unstacking error: the frame at {sp:08X}h is not in "
+                                             "memory (B1.5.8)"))  # fmt: skip
 
     # -- running -----------------------------------------------------------------------------------------------
 
@@ -1283,13 +1353,6 @@ class CortexM:
         if state.skip_polls and state.block_poll:  # the native hook's held_read does the same (MCU-25)
             state.skip_address, state.skip_until, state.skip_pending = state.block_address, until, 1
 
-    def _on_interrupt(self, handle: int, number: int, data: int | None) -> None:
-        """unicorn raised a CPU exception (an exception exit, SVC, BKPT, a prefetch abort): stop, the run loop
-        takes it (:meth:`_after_stop`)."""
-        del data
-        self.interrupt = number
-        _LIB.uc_emu_stop(handle)
-
     def step(self, deadline: int) -> str:
         """Run from the current PC until the clock reaches ``deadline`` (cycles; checked at block boundaries), a
         peripheral asks to stop, or the core sleeps, faults or returns from an exception. Returns ``"run"`` or
@@ -1306,16 +1369,14 @@ class CortexM:
             state.cycles = max(state.cycles, deadline)
             return "sleep"
         state.stop_request = False
-        self.interrupt = None
-        pc = self._read(arm.UC_ARM_REG_PC)
         resume = self.resume
         if resume is not None:  # MCU-51: the native frames' mirror, valid for the run
             resume()
         self._running = True
-        try:
-            self.uc.emu_start(pc | 1, 0)
-        except UcError as error:
-            raise FirmwareFaultError(self._fault(error)) from None
+        try:  # from the PC; unicorn's CPU exception noted in the state (MCU-72: supi3_run, supi3_interrupt)
+            status = self._native_run(self._handle, self._state_ref)
+            if status != ucc.UC_ERR_OK:
+                raise FirmwareFaultError(self._fault(UcError(status)))
         finally:
             self._running = False
             entry = self.entry
@@ -1331,8 +1392,9 @@ class CortexM:
         return self._after_stop()
 
     def _after_stop(self) -> str:
-        pc = self._read(arm.UC_ARM_REG_PC)
-        number = self.interrupt
+        state = self._state
+        pc = int(state.pc)
+        number = state.interrupt
         if number == EXCP_EXCEPTION_EXIT:
             self.exception_return(pc | 1)
             return "run"
@@ -1344,7 +1406,7 @@ class CortexM:
                 raise FirmwareFaultError(self._fault_report(f"memory fault: execute from a peripheral region at "
                                                             f"{pc:08X}h (Execute Never)", IACCVIOL))  # fmt: skip
             raise FirmwareFaultError(self._fault_report(*_FAULTS[ucc.UC_ERR_FETCH_UNMAPPED]))
-        if number is not None:
+        if number != _NO_INTERRUPT:
             what = "a breakpoint (BKPT)" if number == EXCP_BKPT else f"core exception {number}"
             raise FirmwareStoppedError(self.report(Stop.FAULT, f"{what}: not modelled"))
         if pc == self._state.block_end:
@@ -1356,7 +1418,6 @@ class CortexM:
             if sleeps:
                 self.sleeping = True  # the last block ended in WFI or WFE: unicorn halts the core after them
                 return "sleep"
-        state = self._state
         if state.stop_request or state.cycles >= state.deadline:
             return "run"
         raise FirmwareStoppedError(self.report(Stop.FAULT, "the core stopped for no known reason"))

@@ -17,6 +17,9 @@
  * A peripheral's reads go first to supi3_held_read: a register whose value the peripheral holds until a cycle (SPI1's
  * SR while a byte shifts) is answered here, as the peripheral would answer it, and so is one read of a register the
  * peripheral offers from a cycle on (SPI1's DR once its byte has ended, MCU-26); every other read goes to Python.
+ *
+ * The exception entry's, tail-chain's and return's register and memory traffic, a run's start and the interrupt hook
+ * are here too (MCU-70 to MCU-72): CortexM keeps every decision and report and calls them once each.
  */
 #include <stddef.h>
 #include <stdint.h>
@@ -34,6 +37,8 @@ typedef int (*uc_emu_stop_fn)(void *uc);
 typedef int (*uc_reg_fn)(void *uc, int regid, void *value);
 typedef int (*describe_fn)(uint64_t address, uint32_t size);
 typedef uint64_t (*mmio_read_fn)(void *uc, uint64_t offset, unsigned size, void *data);
+typedef int (*uc_mem_fn)(void *uc, uint64_t address, void *bytes, uint64_t size); /* uc_mem_read, uc_mem_write */
+typedef int (*uc_emu_start_fn)(void *uc, uint64_t begin, uint64_t until, uint64_t timeout, uint64_t count);
 
 typedef struct {
     uint64_t cycles;
@@ -62,6 +67,20 @@ typedef struct {
     uint64_t rewritable;    /* MCU-28: blocks from this address (the RAM's base) ... */
     uint64_t rewritable_size; /* ... up to this many bytes on are never taken from the cache: `describe` each run */
     uint32_t code_written;  /* MCU-28: the firmware stored into flash: CortexM forgets every cost of code */
+    /* MCU-70 to MCU-72: the exception entry's and return's register and memory traffic (B1.5.6, B1.5.8) and the run's
+     * start, done here; unicorn's functions and numbers and the architecture's constants handed over by CortexM */
+    uc_mem_fn mem_read;
+    uc_mem_fn mem_write;
+    uc_emu_start_fn emu_start;
+    int32_t exc_registers[11]; /* unicorn's numbers of CONTROL, SP, R0-R3, R12, LR, xPSR, PC, PSP */
+    uint32_t exc_return_handler, exc_return_thread_msp, exc_return_thread_psp;
+    uint32_t xpsr_t, xpsr_align, control_spsel;
+    uint32_t interrupt;     /* the CPU exception unicorn raised in the last run (supi3_interrupt), or no_interrupt */
+    uint32_t no_interrupt;
+    int64_t frame;          /* the frame an entry stacked (or failed to), an unstacking failed at */
+    uint64_t vector;        /* the vector an entry or a tail-chain read */
+    uint64_t pc;            /* the PC after supi3_run */
+    int32_t status;         /* unicorn's error of a failed stacking */
 } supi3_state;
 
 /* MCU-28: the cycles up to the deadline as a signed count: a deadline in the past is none, and one more than 2^63 - 1
@@ -230,6 +249,123 @@ uint64_t supi3_held_read(void *uc, uint64_t offset, unsigned size, void *data) {
         }
     }
     return h->slow(uc, offset, size, 0);
+}
+
+/* MCU-70 to MCU-72: CortexM's exception entry and return (B1.5.6, B1.5.8) and the start of a run, without a register
+ * or memory access of its own through ctypes. CortexM decides what to take and when, keeps the active and pending
+ * exceptions, the cycles and every fault report; these only move the registers and the frame, each step as its Python
+ * path does it (CortexM.native_exceptions = False), in the same order. */
+enum { EXC_CONTROL, EXC_SP, EXC_R0, EXC_LR = EXC_R0 + 5, EXC_XPSR, EXC_PC, EXC_PSP };
+enum { FRAME_WORDS = 8 }; /* the basic frame: R0-R3, R12, LR, the return address, xPSR, in address order */
+
+static uint32_t core_read(void *uc, const supi3_state *s, int index) {
+    uint64_t value = 0;
+    s->reg_read(uc, s->exc_registers[index], &value);
+    return (uint32_t)value;
+}
+
+static void core_write(void *uc, const supi3_state *s, int index, uint32_t value) {
+    uint64_t wide = value;
+    s->reg_write(uc, s->exc_registers[index], &wide);
+}
+
+static uint32_t little_endian(const uint8_t *bytes) {
+    return (uint32_t)bytes[0] | (uint32_t)bytes[1] << 8 | (uint32_t)bytes[2] << 16 | (uint32_t)bytes[3] << 24;
+}
+
+/* CortexM._take's traffic (also a tail-chain's): LR = exc_return, xPSR = T | number, PC = the vector read at
+ * vector_address, bit 0 cleared (`vector`: as read). 1 if the vector is not in memory (LR and xPSR written, as the
+ * Python path leaves them for its report). */
+int supi3_take(void *uc, supi3_state *s, uint32_t number, uint32_t exc_return, uint64_t vector_address) {
+    uint8_t bytes[4];
+    core_write(uc, s, EXC_LR, exc_return);
+    core_write(uc, s, EXC_XPSR, s->xpsr_t | number);
+    if (s->mem_read(uc, vector_address, bytes, sizeof bytes) != 0) {
+        return 1;
+    }
+    s->vector = little_endian(bytes);
+    core_write(uc, s, EXC_PC, (uint32_t)s->vector & ~1u);
+    return 0;
+}
+
+/* CortexM.enter's traffic: the basic frame stacked on the current stack (the process stack in thread mode with
+ * CONTROL.SPSEL set), aligned to 8 bytes with xPSR bit 9 (B1.5.7), SP = the frame (`frame`), SPSEL cleared, then
+ * supi3_take with the EXC_RETURN of the mode. 1: the frame is not in memory (nothing written; `status`: unicorn's
+ * error); 2: the vector is not (supi3_take's 1). */
+int supi3_enter(void *uc, supi3_state *s, uint32_t number, uint32_t handler_mode, uint64_t vector_address) {
+    uint32_t r[EXC_PC + 1];
+    uint8_t bytes[4 * FRAME_WORDS];
+    for (int k = 0; k <= EXC_PC; k++) {
+        r[k] = core_read(uc, s, k);
+    }
+    int process = (r[EXC_CONTROL] & s->control_spsel) && !handler_mode;
+    int64_t frame = ((int64_t)r[EXC_SP] - 4 * FRAME_WORDS) & ~(int64_t)7;
+    uint32_t words[FRAME_WORDS] = {r[EXC_R0], r[EXC_R0 + 1], r[EXC_R0 + 2], r[EXC_R0 + 3], r[EXC_R0 + 4], r[EXC_LR],
+                                   r[EXC_PC], r[EXC_XPSR] | (r[EXC_SP] & 4 ? s->xpsr_align : 0)};
+    for (int k = 0; k < 4 * FRAME_WORDS; k++) {
+        bytes[k] = (uint8_t)(words[k / 4] >> (8 * (k % 4)));
+    }
+    s->frame = frame;
+    s->status = s->mem_write(uc, (uint64_t)frame, bytes, sizeof bytes);
+    if (s->status != 0) {
+        return 1;
+    }
+    core_write(uc, s, EXC_SP, (uint32_t)frame);
+    if (process) {
+        core_write(uc, s, EXC_CONTROL, r[EXC_CONTROL] & ~s->control_spsel); /* unicorn switches SP to the MSP */
+    }
+    uint32_t exc_return = handler_mode ? s->exc_return_handler
+                          : process    ? s->exc_return_thread_psp
+                                       : s->exc_return_thread_msp;
+    return supi3_take(uc, s, number, exc_return, vector_address) ? 2 : 0;
+}
+
+/* CortexM.exception_return's traffic once it has found the return plain (an EXC_RETURN valid for the nesting, nothing
+ * to tail-chain): the frame at the stack pointer EXC_RETURN names unstacked, R0-R3, R12, LR, then xPSR without the
+ * alignment bit (the mode: it selects the SP), SPSEL set again on a return to the process stack, then SP (past the
+ * frame and the alignment word) and PC. 1 if the frame is not in memory (nothing written; `frame`: its address). */
+int supi3_return(void *uc, supi3_state *s, uint32_t exc_return) {
+    int process = exc_return == s->exc_return_thread_psp;
+    uint32_t sp = core_read(uc, s, process ? EXC_PSP : EXC_SP);
+    uint8_t bytes[4 * FRAME_WORDS];
+    uint32_t words[FRAME_WORDS];
+    s->frame = sp;
+    if (s->mem_read(uc, sp, bytes, sizeof bytes) != 0) {
+        return 1;
+    }
+    for (int k = 0; k < FRAME_WORDS; k++) {
+        words[k] = little_endian(bytes + 4 * k);
+    }
+    for (int k = 0; k < 6; k++) {
+        core_write(uc, s, EXC_R0 + k, words[k]);
+    }
+    core_write(uc, s, EXC_XPSR, (words[7] & ~s->xpsr_align) | s->xpsr_t);
+    if (process) {
+        core_write(uc, s, EXC_CONTROL, core_read(uc, s, EXC_CONTROL) | s->control_spsel);
+    }
+    core_write(uc, s, EXC_SP, sp + 4 * FRAME_WORDS + (words[7] & s->xpsr_align ? 4 : 0));
+    core_write(uc, s, EXC_PC, words[6] & ~1u);
+    return 0;
+}
+
+/* The interrupt hook (uc_cb_hookintr_t): unicorn raised a CPU exception (the exception exit, SVC, BKPT, a prefetch
+ * abort); note it and stop, CortexM takes it after the run (MCU-72: no Python call). */
+void supi3_interrupt(void *uc, uint32_t number, void *data) {
+    supi3_state *s = (supi3_state *)data;
+    s->interrupt = number;
+    s->emu_stop(uc);
+}
+
+/* A run from the PC (its Thumb bit set) until a hook stops it (MCU-72): no interrupt yet, the PC afterwards in `pc`;
+ * unicorn's status. */
+int supi3_run(void *uc, supi3_state *s) {
+    uint64_t pc = 0;
+    s->interrupt = s->no_interrupt;
+    s->reg_read(uc, s->pc_register, &pc);
+    int status = s->emu_start(uc, pc | 1, 0, 0, 0);
+    s->pc = 0;
+    s->reg_read(uc, s->pc_register, &s->pc);
+    return status;
 }
 
 /* MCU-51: the per-frame fast path. The board's /SS edges (GPIOA BSRR/BRR writes that change only /SS) and SPI1's DR
@@ -467,14 +603,19 @@ const uint32_t supi3_block_layout[] = {7, sizeof(supi3_block), AT(supi3_block, a
                                        AT(supi3_block, instructions), AT(supi3_block, cycles),
                                        AT(supi3_block, countdown), AT(supi3_block, poll)};
 const uint32_t supi3_state_layout[] = {
-    27, sizeof(supi3_state), AT(supi3_state, cycles), AT(supi3_state, instructions), AT(supi3_state, deadline),
+    43, sizeof(supi3_state), AT(supi3_state, cycles), AT(supi3_state, instructions), AT(supi3_state, deadline),
     AT(supi3_state, block_start), AT(supi3_state, block_address), AT(supi3_state, block_end),
     AT(supi3_state, skip_until), AT(supi3_state, skip_address), AT(supi3_state, handed),
     AT(supi3_state, skip_pending), AT(supi3_state, stop_request), AT(supi3_state, skip_polls), AT(supi3_state, mask),
     AT(supi3_state, block_poll), AT(supi3_state, cache), AT(supi3_state, fresh), AT(supi3_state, access_pc),
     AT(supi3_state, low_registers), AT(supi3_state, pc_register), AT(supi3_state, emu_stop),
     AT(supi3_state, reg_read), AT(supi3_state, reg_write), AT(supi3_state, describe), AT(supi3_state, rewritable),
-    AT(supi3_state, rewritable_size), AT(supi3_state, code_written)};
+    AT(supi3_state, rewritable_size), AT(supi3_state, code_written), AT(supi3_state, mem_read),
+    AT(supi3_state, mem_write), AT(supi3_state, emu_start), AT(supi3_state, exc_registers),
+    AT(supi3_state, exc_return_handler), AT(supi3_state, exc_return_thread_msp), AT(supi3_state, exc_return_thread_psp),
+    AT(supi3_state, xpsr_t), AT(supi3_state, xpsr_align), AT(supi3_state, control_spsel), AT(supi3_state, interrupt),
+    AT(supi3_state, no_interrupt), AT(supi3_state, frame), AT(supi3_state, vector), AT(supi3_state, pc),
+    AT(supi3_state, status)};
 const uint32_t supi3_held_layout[] = {
     17, sizeof(supi3_held), AT(supi3_held, state), AT(supi3_held, slow), AT(supi3_held, until), AT(supi3_held, offset),
     AT(supi3_held, value), AT(supi3_held, held), AT(supi3_held, poll), AT(supi3_held, after),

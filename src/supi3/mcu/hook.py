@@ -1,4 +1,6 @@
-"""The core's block hook in native code (MCU-25): ``hook.c`` built for the host with the Zig toolchain from PyPI.
+"""The core's block hook in native code (MCU-25): ``hook.c`` built for the host with the Zig toolchain from PyPI. It
+also holds the exception entry's, tail-chain's and return's register and memory traffic, a run's start and the
+interrupt hook (MCU-70 to MCU-72), which :class:`supi3.mcu.core.CortexM` calls with its :class:`State`.
 
 Ref: unicorn.h (uc_cb_hookcode_t, uc_cb_hookmem_t); decisions MCU-1, MCU-10, MCU-11, MCU-25 in
 docs/assumptions/mcu.md. The C source ships with the package; :func:`library` compiles it on first use with
@@ -90,6 +92,22 @@ class State(ctypes.Structure):
         ("rewritable", ctypes.c_uint64),
         ("rewritable_size", ctypes.c_uint64),
         ("code_written", ctypes.c_uint32),
+        ("mem_read", ctypes.c_void_p),
+        ("mem_write", ctypes.c_void_p),
+        ("emu_start", ctypes.c_void_p),
+        ("exc_registers", ctypes.c_int32 * 11),
+        ("exc_return_handler", ctypes.c_uint32),
+        ("exc_return_thread_msp", ctypes.c_uint32),
+        ("exc_return_thread_psp", ctypes.c_uint32),
+        ("xpsr_t", ctypes.c_uint32),
+        ("xpsr_align", ctypes.c_uint32),
+        ("control_spsel", ctypes.c_uint32),
+        ("interrupt", ctypes.c_uint32),
+        ("no_interrupt", ctypes.c_uint32),
+        ("frame", ctypes.c_int64),
+        ("vector", ctypes.c_uint64),
+        ("pc", ctypes.c_uint64),
+        ("status", ctypes.c_int32),
     )
 
 
