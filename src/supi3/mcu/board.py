@@ -401,7 +401,8 @@ class Board:
         self._irq_fell: int | None = None
         self._mod_ack_until = 0
         self._limit = self._budget = 0
-        self.native_frames = NativeFrames(self, held, PIN_SS, NOISE_CYCLES, _EXTI0) if native else None
+        pins = (PIN_IRQ, PIN_CD, PIN_IO)
+        self.native_frames = NativeFrames(self, held, PIN_SS, pins, NOISE_CYCLES, _EXTI0) if native else None
         """MCU-51: the native per-frame fast path (``native_frames=True`` at transaction level on the Motorola
         board), else ``None``."""
         if self.native_frames is not None:  # the wrappers' refresh, one Python call (MCU-65)
@@ -583,7 +584,10 @@ class Board:
         of /IRQ before it (MCU-44: the run loop does not stop at a bus event while EXTI0 is active)."""
         if self._ring is None:
             self._now()
-        return self.exti.read(offset, size)
+        value = self.exti.read(offset, size)
+        if self.native_frames is not None:  # MCU-66: the mirror valid again for GPIOA's reads after it
+            self._refresh()
+        return value
 
     def _exti_write(self, offset: int, size: int, value: int) -> None:
         """The firmware writes EXTI (the bus run up to it first, as :meth:`_exti_read`): a line it unmasks (IMR) or
@@ -592,6 +596,8 @@ class Board:
             self._now()
         self.exti.write(offset, size, value)
         self._request()
+        if self.native_frames is not None:  # MCU-66: the mirror valid again for GPIOA's reads after it
+            self._refresh()
 
     def _pend(self) -> None:
         """EXTI0 requests its interrupt: pend it unless it is active or pending, and stop the run for it."""

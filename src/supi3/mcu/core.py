@@ -799,6 +799,7 @@ class CortexM:
         self.resume: Callable[[], None] | None = None
         """MCU-51: called when a run starts: the native frames' mirror refreshed."""
         self._port_write = ctypes.cast(native.supi3_port_write, ctypes.c_void_p)
+        self._port_read = ctypes.cast(native.supi3_port_read, ctypes.c_void_p)
         self.sleeping = False
         self.active: list[int] = []  # active exceptions, outermost first
         self.pending: set[int] = set()
@@ -875,10 +876,11 @@ class CortexM:
         if port is None:
             self._check(_LIB.uc_mmio_map(self._handle, base, size, self._held_read, ctypes.byref(held), callbacks[1],
                                          None))  # fmt: skip
-        else:  # MCU-51: the write goes to the native frames, which call Python's write for what they do not take
-            native = hook.Port(ctypes.pointer(self.frames), callbacks[1], check_int("port", port, 0, 1))
+        else:  # MCU-51, MCU-66: the native frames take the write (and GPIOA's input read) or call Python's
+            native = hook.Port(ctypes.pointer(self.frames), callbacks[1], check_int("port", port, 0, 1),
+                               ctypes.pointer(held))  # fmt: skip
             self._callbacks.append(native)
-            self._check(_LIB.uc_mmio_map(self._handle, base, size, self._held_read, ctypes.byref(held),
+            self._check(_LIB.uc_mmio_map(self._handle, base, size, self._port_read, ctypes.byref(native),
                                          self._port_write, ctypes.byref(native)))  # fmt: skip
         # unicorn updates the PC before a load or store only if a memory hook covers its address: without one, a
         # peripheral callback sees the PC of the block's first instruction, and the access would be timed there

@@ -105,6 +105,7 @@ class FrameBoard(Protocol):
     _least_t1: int
     _least_t2: int
     _least_t8: int
+    _least: dict[str, int]
     _shortest_period_s: float
     exti: Exti
 
@@ -159,12 +160,12 @@ configure the chip, 3.4.3), nor an address without a register (pedantic mode may
 
 _STATE_FIELDS: Final[tuple[str, ...]] = (
     "pending", "odr", "synced", "phase", "command", "last_rx", "frame_open", "frame_fall", "frame_driven", "transfer",
-    "transfer_seen", "transfer_start", "transfer_period", "ss_rise", "cd_before", "written", "dr_writes", "rx_last",
-    "shift_received", "shift_start", "shift_end")  # fmt: skip
+    "transfer_seen", "transfer_start", "transfer_period", "ss_rise", "cd_before", "irq_level", "written", "dr_writes",
+    "rx_last", "shift_received", "shift_start", "shift_end")  # fmt: skip
 """The fields of :class:`~supi3.mcu.hook.Frames` the native frames change, in their order there."""
 _MIRROR_FIELDS: Final[tuple[str, ...]] = (
     "valid", "due", "latch", "latch_at", "gpio_ok", "gpio_mask", "gpio_pulled_up", "gpio_levels", "spi_ok", "period",
-    "sr_modf", *_STATE_FIELDS[:-3])  # fmt: skip
+    "sr_modf", "io", "io_at", *_STATE_FIELDS[:-3])  # fmt: skip
 """The fields :meth:`NativeFrames.refresh` writes, in their order there."""
 
 
@@ -225,7 +226,8 @@ class NativeFrames:
     """The native per-frame fast path of a transaction-level board (MCU-51): the tables handed to hook.c, the
     mirror refreshed after Python's writes of GPIOA and SPI1, the catch-up at each entry into Python."""
 
-    def __init__(self, board: FrameBoard, spi_held: HeldRegister, ss_pin: int, noise: float, exti0: int) -> None:
+    def __init__(self, board: FrameBoard, spi_held: HeldRegister, ss_pin: int, pins: tuple[int, int, int],
+                 noise: float, exti0: int) -> None:
         self._board = board
         core = board.core
         self._frames = frames = core.frames
@@ -239,6 +241,8 @@ class NativeFrames:
         frames.phase_command, frames.phase_data = _PHASE_COMMAND, _PHASE_DATA
         frames.sr_txe, frames.sr_bsy, frames.sr_rxne = SR_TXE, SR_BSY, SR_RXNE
         frames.spi_dr, frames.spi_sr = SPI_DR, SPI_SR
+        frames.least_t6max = board._least["t6max"]
+        frames.irq_pin, frames.cd_pin, frames.io_pin = pins
         commands = _upif._COMMANDS
         frames.plain[:] = [int(plain) for plain in _upif._PLAIN_COMMANDS]
         frames.address[:] = [command.address for command in commands]
@@ -257,7 +261,7 @@ class NativeFrames:
         self._values_at = Frames.values.offset
         self._bench = board.bench  # the transaction-level bench, set once at the board's construction
         self._due_key: tuple[int, float | None, float] | None = None  # the bench's next events, as last mirrored
-        self._due = (0, _NEVER)
+        self._due = (0, _NEVER, _NEVER)
         self._first_due = _FirstDue(self._hz, noise)
         self._written: tuple[str | None, ...] = _registers._WRITE_NAMES
         self._exti0 = exti0
@@ -280,7 +284,7 @@ class NativeFrames:
             return
         state = _STATE.unpack_from(frames, _STATE_AT)
         (_, odr, synced, phase, command, last_rx, frame_open, fall, driven, transfer, seen, start, period, ss_rise,
-         cd_before, written, dr_writes, rx_last, received, shift_start, shift_end) = state
+         cd_before, irq_level, written, dr_writes, rx_last, received, shift_start, shift_end) = state
         frames.pending = frames.written = frames.dr_writes = frames.synced = 0
         board = self._board
         gpio = board.gpio
@@ -300,7 +304,7 @@ class NativeFrames:
             for address in range(16):
                 if written >> address & 1:
                     values[names[address]] = masked[address]  # type: ignore[index]  # FAST_WRITES: a register
-        board._ss_rise, board._cd_before = ss_rise, cd_before
+        board._ss_rise, board._cd_before, board._irq_level = ss_rise, cd_before, irq_level
         if frame_open:
             board._frame = SsFrame(fall, driven, [(seen, 8, start, period)] if transfer else [])
             protocol._frame = (True, driven)
@@ -314,17 +318,20 @@ class NativeFrames:
             spi.transfers += dr_writes
             spi._holding = True
 
-    def _thresholds(self, events: list[tuple[float, str]], next_start: float) -> tuple[int, int]:
-        """The first core cycle whose synchronisation runs a cycle's start or end, and the one that runs the latch
-        phase's start (or :data:`_NEVER`): the phases only set the chips' flags (MCU-52)."""
+    def _thresholds(self, events: list[tuple[float, str]], next_start: float) -> tuple[int, int, int]:
+        """The first core cycle whose synchronisation runs a cycle's start or end, the one that runs the latch
+        phase's start and the one that sets the I/O access bit (each :data:`_NEVER` if none comes before): the phases
+        only set the chips' flags (MCU-52, MCU-66)."""
         due = self._first_due
-        latch_at = _NEVER
+        latch_at = io_at = _NEVER
         for at, what in reversed(events):  # the next first
             if what == _LATCH:
                 latch_at = due[at]
-            elif what != _IO:
-                return due[at], latch_at
-        return due[next_start], latch_at
+            elif what == _IO:
+                io_at = due[at]
+            else:
+                return due[at], latch_at, io_at
+        return due[next_start], latch_at, io_at
 
 
     def refresh(self) -> None:
@@ -376,11 +383,11 @@ class NativeFrames:
         if key != self._due_key:
             self._due_key = key
             self._due = self._thresholds(events, bench._next_start)
-        due, latch_at = self._due
+        due, latch_at, io_at = self._due
         _MIRROR.pack_into(
             frames, _MIRROR_AT, 1, due, int(registers.latch_phase), latch_at,
             int(bool(rcc.apb2enr & IOPAEN) and not rcc.apb2rstr & IOPAEN), gpio._output_mask(), gpio.pulled_up,
-            gpio._levels, int(bool(spi_ok)), period, SR_MODF if spi.modf else 0, 0, gpio.odr, 0, phase, code,
-            protocol.last_rx, int(frame is not None), 0 if frame is None else frame.fall,
+            gpio._levels, int(bool(spi_ok)), period, SR_MODF if spi.modf else 0, int(registers.io_access), io_at, 0,
+            gpio.odr, 0, phase, code, protocol.last_rx, int(frame is not None), 0 if frame is None else frame.fall,
             0 if frame is None or frame.driven is None else frame.driven, *transfer, board._ss_rise,
-            board._cd_before, 0, 0, 0)  # fmt: skip
+            board._cd_before, board._irq_level, 0, 0, 0)  # fmt: skip

@@ -256,6 +256,8 @@ typedef struct {
     int64_t least_t1, least_t2, least_t8; /* core cycles */
     uint64_t ss_pin, cd_command, cd_data, phase_command, phase_data;
     uint64_t sr_txe, sr_bsy, sr_rxne, spi_dr, spi_sr;
+    int64_t least_t6max;  /* MCU-66: C/D follows the phase from t6 max after /SS rose (Board._inputs) */
+    uint64_t irq_pin, cd_pin, io_pin; /* GPIOA's input pins the chip drives */
     /* refreshed by Python after each of its writes of GPIOA or SPI1 */
     uint64_t valid;      /* the fast path may run: Python's objects are as mirrored here */
     uint64_t due;        /* the first core cycle whose bus synchronisation would run a bus event */
@@ -266,6 +268,8 @@ typedef struct {
     uint64_t spi_ok;     /* SPI1 clocked, enabled master, 8 bits, mode 3, MSB first, SCLK period >= t0 */
     uint64_t period;     /* SCLK period in core cycles */
     uint64_t sr_modf;    /* SPI1's MODF flag in SR */
+    uint64_t io;         /* MCU-66: the chip's I/O access bit */
+    uint64_t io_at;      /* the first core cycle whose synchronisation sets it (the bench's `io` event) */
     /* the state the fast path runs on: refreshed by Python, changed here, read back by Python's catch-up */
     uint64_t pending;    /* a frame's effect not yet in the Python objects */
     uint64_t odr;
@@ -275,9 +279,10 @@ typedef struct {
     uint64_t transfer, transfer_seen, transfer_start, transfer_period;
     int64_t ss_rise;
     uint64_t cd_before;
+    uint64_t irq_level;  /* /IRQ as the board last followed it (Board._irq_level) */
     uint64_t written;    /* a bit per address written */
     uint64_t dr_writes, rx_last, shift_received, shift_start, shift_end;
-    uint64_t taken;      /* writes taken here since set-up (a count for tests and benchmarks) */
+    uint64_t taken;      /* accesses taken here since set-up (a count for tests and benchmarks) */
     uint8_t values[16];   /* what a read of each address returns (fast reads only) */
     uint8_t written_values[16];
     uint8_t plain[256];   /* upif._PLAIN_COMMANDS */
@@ -296,6 +301,7 @@ typedef struct {
     supi3_frames *frames;
     mmio_write_fn slow; /* the peripheral's write in Python */
     uint64_t spi;       /* 0: GPIOA, 1: SPI1 */
+    supi3_held *held;   /* the peripheral's held register: its reads not taken here go to supi3_held_read */
 } supi3_port;
 
 /* The slot of a block's prefix cost (CortexM._prefix_slot computes the same; a PC is reached from more than one block). */
@@ -459,6 +465,50 @@ void supi3_port_write(void *uc, uint64_t offset, unsigned size, uint64_t value, 
     p->slow(uc, offset, size, value, 0);
 }
 
+/* MCU-66: GPIOA's register `offset` as Gpio.read would answer it at `now`, if a pure function of the mirrored state:
+ * IDR (the chip's /IRQ, C/D and I/O access pins by Board._inputs, the outputs' ODR), ODR, and the offsets that read 0;
+ * not CRL and CRH (not mirrored). The inputs need the bus synchronised to `now` without a bus event (`due`); the I/O
+ * access bit is set by the bench's `io` event, which the synchronisation runs from `io_at` on; C/D follows the phase
+ * from t6 max after /SS rose, the level before until then. */
+static int gpio_read(supi3_frames *f, uint64_t offset, uint64_t *value) {
+    if (offset == 0xC) {
+        *value = f->odr;
+        return 1;
+    }
+    if (offset >= 0x10) {
+        *value = 0;
+        return 1;
+    }
+    uint64_t now = 0;
+    if (offset != 0x8 || !frames_now(f, &now) || now >= f->due) {
+        return 0;
+    }
+    uint64_t io = f->io || now >= f->io_at;
+    uint64_t cd = f->cd_before;
+    if ((int64_t)now >= f->ss_rise + f->least_t6max) {
+        cd = f->phase == f->phase_command ? f->cd_command : f->cd_data;
+    }
+    uint64_t inputs = (f->irq_level << f->irq_pin) | (cd << f->cd_pin) | (io << f->io_pin);
+    *value = ((inputs & ~f->gpio_mask) | (f->odr & f->gpio_mask)) & 0xFFFF;
+    f->synced = now + 1;
+    f->pending = 1;
+    f->state->handed = now;
+    return 1;
+}
+
+/* The read callback (uc_cb_mmio_read_t) of GPIOA and SPI1: a GPIOA read taken here (MCU-66), or the held register's
+ * read (supi3_held_read), which answers SPI1's held and offered registers and calls Python's read for the rest. */
+uint64_t supi3_port_read(void *uc, uint64_t offset, unsigned size, void *data) {
+    supi3_port *p = (supi3_port *)data;
+    supi3_frames *f = p->frames;
+    uint64_t value = 0;
+    if (!p->spi && f->valid && !f->state->stop_request && f->gpio_ok && gpio_read(f, offset, &value)) {
+        f->taken += 1;
+        return value;
+    }
+    return supi3_held_read(uc, offset, size, p->held);
+}
+
 /* The layout of the structs above as this compiler lays them out: the number of values after it, the struct's size, then each
  * field's offset in the order of its declaration. supi3.mcu.hook checks its ctypes mirrors against them when it loads
  * the library (MCU-25): a mismatch is a NativeHookError, not memory written at the wrong place. */
@@ -483,19 +533,20 @@ const uint32_t supi3_held_layout[] = {
 const uint32_t supi3_prefix_layout[] = {
     4, sizeof(supi3_prefix), AT(supi3_prefix, address), AT(supi3_prefix, pc), AT(supi3_prefix, cycles)};
 const uint32_t supi3_frames_layout[] = {
-    63, sizeof(supi3_frames), AT(supi3_frames, state), AT(supi3_frames, spi), AT(supi3_frames, prefixes),
+    70, sizeof(supi3_frames), AT(supi3_frames, state), AT(supi3_frames, spi), AT(supi3_frames, prefixes),
     AT(supi3_frames, prefix_mask), AT(supi3_frames, least_t1), AT(supi3_frames, least_t2),
     AT(supi3_frames, least_t8), AT(supi3_frames, ss_pin), AT(supi3_frames, cd_command), AT(supi3_frames, cd_data),
     AT(supi3_frames, phase_command), AT(supi3_frames, phase_data), AT(supi3_frames, sr_txe),
     AT(supi3_frames, sr_bsy), AT(supi3_frames, sr_rxne), AT(supi3_frames, spi_dr), AT(supi3_frames, spi_sr),
+    AT(supi3_frames, least_t6max), AT(supi3_frames, irq_pin), AT(supi3_frames, cd_pin), AT(supi3_frames, io_pin),
     AT(supi3_frames, valid), AT(supi3_frames, due), AT(supi3_frames, latch), AT(supi3_frames, latch_at),
     AT(supi3_frames, gpio_ok), AT(supi3_frames, gpio_mask), AT(supi3_frames, gpio_pulled_up),
     AT(supi3_frames, gpio_levels), AT(supi3_frames, spi_ok), AT(supi3_frames, period), AT(supi3_frames, sr_modf),
-    AT(supi3_frames, pending), AT(supi3_frames, odr), AT(supi3_frames, synced), AT(supi3_frames, phase),
+    AT(supi3_frames, io), AT(supi3_frames, io_at), AT(supi3_frames, pending), AT(supi3_frames, odr), AT(supi3_frames, synced), AT(supi3_frames, phase),
     AT(supi3_frames, command), AT(supi3_frames, last_rx), AT(supi3_frames, frame_open),
     AT(supi3_frames, frame_fall), AT(supi3_frames, frame_driven), AT(supi3_frames, transfer),
     AT(supi3_frames, transfer_seen), AT(supi3_frames, transfer_start), AT(supi3_frames, transfer_period),
-    AT(supi3_frames, ss_rise), AT(supi3_frames, cd_before), AT(supi3_frames, written), AT(supi3_frames, dr_writes),
+    AT(supi3_frames, ss_rise), AT(supi3_frames, cd_before), AT(supi3_frames, irq_level), AT(supi3_frames, written), AT(supi3_frames, dr_writes),
     AT(supi3_frames, rx_last), AT(supi3_frames, shift_received), AT(supi3_frames, shift_start),
     AT(supi3_frames, shift_end), AT(supi3_frames, taken), AT(supi3_frames, values),
     AT(supi3_frames, written_values), AT(supi3_frames, plain), AT(supi3_frames, address), AT(supi3_frames, rd),
@@ -503,4 +554,4 @@ const uint32_t supi3_frames_layout[] = {
     AT(supi3_frames, fast_read), AT(supi3_frames, fast_write), AT(supi3_frames, write_mask),
     AT(supi3_frames, alias)};
 const uint32_t supi3_port_layout[] = {
-    4, sizeof(supi3_port), AT(supi3_port, frames), AT(supi3_port, slow), AT(supi3_port, spi)};
+    5, sizeof(supi3_port), AT(supi3_port, frames), AT(supi3_port, slow), AT(supi3_port, spi), AT(supi3_port, held)};

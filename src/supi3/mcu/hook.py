@@ -152,6 +152,10 @@ class Frames(ctypes.Structure):
         ("sr_rxne", ctypes.c_uint64),
         ("spi_dr", ctypes.c_uint64),
         ("spi_sr", ctypes.c_uint64),
+        ("least_t6max", ctypes.c_int64),
+        ("irq_pin", ctypes.c_uint64),
+        ("cd_pin", ctypes.c_uint64),
+        ("io_pin", ctypes.c_uint64),
         ("valid", ctypes.c_uint64),
         ("due", ctypes.c_uint64),
         ("latch", ctypes.c_uint64),
@@ -163,6 +167,8 @@ class Frames(ctypes.Structure):
         ("spi_ok", ctypes.c_uint64),
         ("period", ctypes.c_uint64),
         ("sr_modf", ctypes.c_uint64),
+        ("io", ctypes.c_uint64),
+        ("io_at", ctypes.c_uint64),
         ("pending", ctypes.c_uint64),
         ("odr", ctypes.c_uint64),
         ("synced", ctypes.c_uint64),
@@ -178,6 +184,7 @@ class Frames(ctypes.Structure):
         ("transfer_period", ctypes.c_uint64),
         ("ss_rise", ctypes.c_int64),
         ("cd_before", ctypes.c_uint64),
+        ("irq_level", ctypes.c_uint64),
         ("written", ctypes.c_uint64),
         ("dr_writes", ctypes.c_uint64),
         ("rx_last", ctypes.c_uint64),
@@ -201,9 +208,12 @@ class Frames(ctypes.Structure):
 
 
 class Port(ctypes.Structure):
-    """The user data of :func:`supi3_port_write`, GPIOA's or SPI1's write in native code (``supi3_port``)."""
+    """The user data of :func:`supi3_port_write` and :func:`supi3_port_read`, GPIOA's or SPI1's write and read in
+    native code (``supi3_port``): the frames, Python's write, which port, and the held register its other reads go to
+    (:func:`supi3_held_read`)."""
 
-    _fields_ = (("frames", ctypes.POINTER(Frames)), ("slow", MMIO_WRITE), ("spi", ctypes.c_uint64))
+    _fields_ = (("frames", ctypes.POINTER(Frames)), ("slow", MMIO_WRITE), ("spi", ctypes.c_uint64),
+                ("held", ctypes.POINTER(Held)))
 
 
 _LOADED: list[ctypes.CDLL] = []
