@@ -53,6 +53,7 @@ from supi3.mcu.stm32 import (
 )
 from supi3.model import registers as _registers
 from supi3.pinout import C_D_COMMAND, C_D_DATA
+from supi3.regmap.registers import IO_ACCESS_BIT
 from supi3.spi import upif as _upif
 from supi3.spi.upif import Mode, Phase
 
@@ -63,7 +64,7 @@ if TYPE_CHECKING:
     from supi3.model.registers import RegisterFile
     from supi3.spi.upif import UpifProtocol
 
-__all__ = ["FAST_READS", "FAST_WRITES", "FrameBoard", "NativeFrames", "SsFrame", "first_due"]
+__all__ = ["FAST_READS", "FAST_WRITES", "IRQ_ADDRESS", "FrameBoard", "NativeFrames", "SsFrame", "first_due"]
 
 @dataclass(slots=True)
 class SsFrame:
@@ -141,7 +142,14 @@ _CODES_BY_ID: Final[dict[int, int]] = {id(command): code for command, code in _C
 _EVENT_REGISTERS: Final[frozenset[str]] = frozenset(
     name for name, clears in zip(_registers._READ_NAMES, _registers._READ_CLEARS, strict=True) if name and clears
 )
-"""The read-clear registers (IRQ_EVT, 3.4.14): /IRQ follows them, so no native frame reads or writes them."""
+"""The read-clear registers (IRQ_EVT, 3.4.14): /IRQ follows them, so no native frame writes them; a native frame
+reads one only by hook.c's ``read_clear`` (MCU-67), not as a fast read."""
+_IRQ_ADDRESSES: Final[tuple[int, ...]] = tuple(address for address, name in enumerate(_registers._READ_NAMES)
+                                               if name in _EVENT_REGISTERS)  # fmt: skip
+if len(_IRQ_ADDRESSES) != 1:  # RegisterFile.irq_n follows the one event register
+    raise NativeHookError(f"the register map has {len(_IRQ_ADDRESSES)} read-clear registers, MCU-67 knows one")
+IRQ_ADDRESS: Final[int] = _IRQ_ADDRESSES[0]
+"""MCU-67: the address of the read-clear register /IRQ follows (IRQ_EVT, 3.4.14), whose reads hook.c takes."""
 
 
 def _access(name: str | None, side_effects: frozenset[str]) -> int:
@@ -160,12 +168,12 @@ configure the chip, 3.4.3), nor an address without a register (pedantic mode may
 
 _STATE_FIELDS: Final[tuple[str, ...]] = (
     "pending", "odr", "synced", "phase", "command", "last_rx", "frame_open", "frame_fall", "frame_driven", "transfer",
-    "transfer_seen", "transfer_start", "transfer_period", "ss_rise", "cd_before", "irq_level", "written", "dr_writes",
-    "rx_last", "shift_received", "shift_start", "shift_end")  # fmt: skip
+    "transfer_seen", "transfer_start", "transfer_period", "ss_rise", "cd_before", "irq_level", "written", "cleared",
+    "cleared_at", "dr_writes", "rx_last", "shift_received", "shift_start", "shift_end")  # fmt: skip
 """The fields of :class:`~supi3.mcu.hook.Frames` the native frames change, in their order there."""
 _MIRROR_FIELDS: Final[tuple[str, ...]] = (
     "valid", "due", "latch", "latch_at", "gpio_ok", "gpio_mask", "gpio_pulled_up", "gpio_levels", "spi_ok", "period",
-    "sr_modf", "io", "io_at", *_STATE_FIELDS[:-3])  # fmt: skip
+    "sr_modf", "io", "io_at", "exti_rise", *_STATE_FIELDS[:-3])  # fmt: skip
 """The fields :meth:`NativeFrames.refresh` writes, in their order there."""
 
 
@@ -243,6 +251,9 @@ class NativeFrames:
         frames.spi_dr, frames.spi_sr = SPI_DR, SPI_SR
         frames.least_t6max = board._least["t6max"]
         frames.irq_pin, frames.cd_pin, frames.io_pin = pins
+        self._irq_pin = pins[0]
+        frames.irq_address, frames.irq_clear = IRQ_ADDRESS, _registers._READ_CLEARS[IRQ_ADDRESS]
+        frames.io_bit = IO_ACCESS_BIT
         commands = _upif._COMMANDS
         frames.plain[:] = [int(plain) for plain in _upif._PLAIN_COMMANDS]
         frames.address[:] = [command.address for command in commands]
@@ -255,7 +266,8 @@ class NativeFrames:
         frames.write_mask[:] = _registers._WRITE_MASKS
         read_names = _registers._READ_NAMES
         frames.alias[:] = [read_names.index(name) if name in read_names else -1 for name in _registers._WRITE_NAMES]
-        reads = [name for address, name in enumerate(read_names) if name is not None and FAST_READS[address]]
+        reads = [name for address, name in enumerate(read_names)
+                 if name is not None and (FAST_READS[address] or address == IRQ_ADDRESS)]  # fmt: skip
         self._read_values = operator.itemgetter(*reads)  # the fast-readable registers' values, in address order
         self._values = struct.Struct("<" + "".join("B" if name in reads else "x" for name in read_names))
         self._values_at = Frames.values.offset
@@ -284,12 +296,19 @@ class NativeFrames:
             return
         state = _STATE.unpack_from(frames, _STATE_AT)
         (_, odr, synced, phase, command, last_rx, frame_open, fall, driven, transfer, seen, start, period, ss_rise,
-         cd_before, irq_level, written, dr_writes, rx_last, received, shift_start, shift_end) = state
-        frames.pending = frames.written = frames.dr_writes = frames.synced = 0
+         cd_before, irq_level, written, cleared, cleared_at, dr_writes, rx_last, received, shift_start,
+         shift_end) = state
+        frames.pending = frames.written = frames.cleared = frames.dr_writes = frames.synced = 0
         board = self._board
         gpio = board.gpio
         gpio.odr = odr
         gpio._levels = frames.gpio_levels
+        if cleared:  # MCU-67: the register file's own read-clear, each read at the latest one's time (no bus event)
+            board._sync(cleared_at - 1)
+            read = board.registers.cpu_read
+            for _ in range(cleared):
+                read(IRQ_ADDRESS)
+        board._irq_level = irq_level  # /IRQ rose with the clear: the board followed it (no EXTI bit, MCU-67)
         if synced:  # the bus run up to the latest synchronisation: no event but the phases' flags (MCU-52)
             board._sync(synced - 1)
         protocol = board.protocol
@@ -304,7 +323,7 @@ class NativeFrames:
             for address in range(16):
                 if written >> address & 1:
                     values[names[address]] = masked[address]  # type: ignore[index]  # FAST_WRITES: a register
-        board._ss_rise, board._cd_before, board._irq_level = ss_rise, cd_before, irq_level
+        board._ss_rise, board._cd_before = ss_rise, cd_before
         if frame_open:
             board._frame = SsFrame(fall, driven, [(seen, 8, start, period)] if transfer else [])
             protocol._frame = (True, driven)
@@ -387,7 +406,8 @@ class NativeFrames:
         _MIRROR.pack_into(
             frames, _MIRROR_AT, 1, due, int(registers.latch_phase), latch_at,
             int(bool(rcc.apb2enr & IOPAEN) and not rcc.apb2rstr & IOPAEN), gpio._output_mask(), gpio.pulled_up,
-            gpio._levels, int(bool(spi_ok)), period, SR_MODF if spi.modf else 0, int(registers.io_access), io_at, 0,
-            gpio.odr, 0, phase, code, protocol.last_rx, int(frame is not None), 0 if frame is None else frame.fall,
-            0 if frame is None or frame.driven is None else frame.driven, *transfer, board._ss_rise,
-            board._cd_before, board._irq_level, 0, 0, 0)  # fmt: skip
+            gpio._levels, int(bool(spi_ok)), period, SR_MODF if spi.modf else 0, int(registers.io_access), io_at,
+            int(board.exti.triggers(0, self._irq_pin, 1)), 0, gpio.odr, 0, phase, code, protocol.last_rx,
+            int(frame is not None), 0 if frame is None else frame.fall,
+            0 if frame is None or frame.driven is None else frame.driven, *transfer, board._ss_rise, board._cd_before,
+            board._irq_level, 0, 0, 0, 0, 0)  # fmt: skip

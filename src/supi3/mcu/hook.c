@@ -258,6 +258,9 @@ typedef struct {
     uint64_t sr_txe, sr_bsy, sr_rxne, spi_dr, spi_sr;
     int64_t least_t6max;  /* MCU-66: C/D follows the phase from t6 max after /SS rose (Board._inputs) */
     uint64_t irq_pin, cd_pin, io_pin; /* GPIOA's input pins the chip drives */
+    uint64_t irq_address; /* MCU-67: the read-clear register /IRQ follows (IRQ_EVT, 3.4.14) */
+    uint64_t irq_clear;   /* the bits a read of it clears */
+    uint64_t io_bit;      /* the live I/O access bit a read of it joins */
     /* refreshed by Python after each of its writes of GPIOA or SPI1 */
     uint64_t valid;      /* the fast path may run: Python's objects are as mirrored here */
     uint64_t due;        /* the first core cycle whose bus synchronisation would run a bus event */
@@ -270,6 +273,7 @@ typedef struct {
     uint64_t sr_modf;    /* SPI1's MODF flag in SR */
     uint64_t io;         /* MCU-66: the chip's I/O access bit */
     uint64_t io_at;      /* the first core cycle whose synchronisation sets it (the bench's `io` event) */
+    uint64_t exti_rise;  /* MCU-67: a rise of /IRQ sets EXTI's pending bit (Exti.triggers) */
     /* the state the fast path runs on: refreshed by Python, changed here, read back by Python's catch-up */
     uint64_t pending;    /* a frame's effect not yet in the Python objects */
     uint64_t odr;
@@ -281,6 +285,8 @@ typedef struct {
     uint64_t cd_before;
     uint64_t irq_level;  /* /IRQ as the board last followed it (Board._irq_level) */
     uint64_t written;    /* a bit per address written */
+    uint64_t cleared;    /* MCU-67: reads of the register /IRQ follows taken here */
+    uint64_t cleared_at; /* 1 + the core cycle of the latest of them */
     uint64_t dr_writes, rx_last, shift_received, shift_start, shift_end;
     uint64_t taken;      /* accesses taken here since set-up (a count for tests and benchmarks) */
     uint8_t values[16];   /* what a read of each address returns (fast reads only) */
@@ -328,6 +334,28 @@ static int fast_access(const supi3_frames *f, const uint8_t *table, unsigned add
     return table[address] == 1 || (table[address] == 2 && !f->latch && now < f->latch_at);
 }
 
+/* MCU-66: the chip's I/O access bit at `now` (the bench's `io` event sets it; only a cycle's end, past `due`, clears
+ * it). */
+static uint64_t io_now(const supi3_frames *f, uint64_t now) { return f->io || now >= f->io_at; }
+
+/* MCU-67: a read of the register /IRQ follows at `now` (RegisterFile.cpu_read: its value with the live I/O access bit
+ * joined; the bits read cleared), if /IRQ's rise it may cause sets no pending bit of EXTI (Board._follow_irq: then
+ * nothing else changes, the board's request already settled when the mirror was made). The read is noted for the
+ * catch-up, which makes it in the register file. */
+static int read_clear(supi3_frames *f, unsigned address, uint64_t now, uint64_t *driven) {
+    uint8_t value = f->values[address];
+    uint8_t left = (uint8_t)(value & ~f->irq_clear);
+    if (left == 0 && f->irq_level == 0 && f->exti_rise) {
+        return 0;
+    }
+    *driven = value | (io_now(f, now) << f->io_bit);
+    f->values[address] = left;
+    f->irq_level = left == 0;
+    f->cleared += 1;
+    f->cleared_at = now + 1;
+    return 1;
+}
+
 /* /SS fell at `now`: Board._ss_edge's t8 check and UpifProtocol.begin, if plain. */
 static int frame_fall(supi3_frames *f, uint64_t now) {
     if (f->frame_open || (int64_t)now - f->ss_rise < f->least_t8) {
@@ -338,10 +366,15 @@ static int frame_fall(supi3_frames *f, uint64_t now) {
         unsigned command = (unsigned)f->command & 0xFF;
         unsigned address = f->address[command];
         if (f->rd[command] && f->reads_register[address]) {
-            if (!fast_access(f, f->fast_read, address, now)) {
+            if (address == f->irq_address) {
+                if (!read_clear(f, address, now, &driven)) {
+                    return 0;
+                }
+            } else if (!fast_access(f, f->fast_read, address, now)) {
                 return 0;
+            } else {
+                driven = f->values[address];
             }
-            driven = f->values[address];
         }
     } else if (f->phase != f->phase_command) {
         return 0;
@@ -483,7 +516,7 @@ static int gpio_read(supi3_frames *f, uint64_t offset, uint64_t *value) {
     if (offset != 0x8 || !frames_now(f, &now) || now >= f->due) {
         return 0;
     }
-    uint64_t io = f->io || now >= f->io_at;
+    uint64_t io = io_now(f, now);
     uint64_t cd = f->cd_before;
     if ((int64_t)now >= f->ss_rise + f->least_t6max) {
         cd = f->phase == f->phase_command ? f->cd_command : f->cd_data;
@@ -533,20 +566,22 @@ const uint32_t supi3_held_layout[] = {
 const uint32_t supi3_prefix_layout[] = {
     4, sizeof(supi3_prefix), AT(supi3_prefix, address), AT(supi3_prefix, pc), AT(supi3_prefix, cycles)};
 const uint32_t supi3_frames_layout[] = {
-    70, sizeof(supi3_frames), AT(supi3_frames, state), AT(supi3_frames, spi), AT(supi3_frames, prefixes),
+    76, sizeof(supi3_frames), AT(supi3_frames, state), AT(supi3_frames, spi), AT(supi3_frames, prefixes),
     AT(supi3_frames, prefix_mask), AT(supi3_frames, least_t1), AT(supi3_frames, least_t2),
     AT(supi3_frames, least_t8), AT(supi3_frames, ss_pin), AT(supi3_frames, cd_command), AT(supi3_frames, cd_data),
     AT(supi3_frames, phase_command), AT(supi3_frames, phase_data), AT(supi3_frames, sr_txe),
     AT(supi3_frames, sr_bsy), AT(supi3_frames, sr_rxne), AT(supi3_frames, spi_dr), AT(supi3_frames, spi_sr),
     AT(supi3_frames, least_t6max), AT(supi3_frames, irq_pin), AT(supi3_frames, cd_pin), AT(supi3_frames, io_pin),
+    AT(supi3_frames, irq_address), AT(supi3_frames, irq_clear), AT(supi3_frames, io_bit),
     AT(supi3_frames, valid), AT(supi3_frames, due), AT(supi3_frames, latch), AT(supi3_frames, latch_at),
     AT(supi3_frames, gpio_ok), AT(supi3_frames, gpio_mask), AT(supi3_frames, gpio_pulled_up),
     AT(supi3_frames, gpio_levels), AT(supi3_frames, spi_ok), AT(supi3_frames, period), AT(supi3_frames, sr_modf),
-    AT(supi3_frames, io), AT(supi3_frames, io_at), AT(supi3_frames, pending), AT(supi3_frames, odr), AT(supi3_frames, synced), AT(supi3_frames, phase),
+    AT(supi3_frames, io), AT(supi3_frames, io_at), AT(supi3_frames, exti_rise), AT(supi3_frames, pending), AT(supi3_frames, odr), AT(supi3_frames, synced), AT(supi3_frames, phase),
     AT(supi3_frames, command), AT(supi3_frames, last_rx), AT(supi3_frames, frame_open),
     AT(supi3_frames, frame_fall), AT(supi3_frames, frame_driven), AT(supi3_frames, transfer),
     AT(supi3_frames, transfer_seen), AT(supi3_frames, transfer_start), AT(supi3_frames, transfer_period),
-    AT(supi3_frames, ss_rise), AT(supi3_frames, cd_before), AT(supi3_frames, irq_level), AT(supi3_frames, written), AT(supi3_frames, dr_writes),
+    AT(supi3_frames, ss_rise), AT(supi3_frames, cd_before), AT(supi3_frames, irq_level), AT(supi3_frames, written),
+    AT(supi3_frames, cleared), AT(supi3_frames, cleared_at), AT(supi3_frames, dr_writes),
     AT(supi3_frames, rx_last), AT(supi3_frames, shift_received), AT(supi3_frames, shift_start),
     AT(supi3_frames, shift_end), AT(supi3_frames, taken), AT(supi3_frames, values),
     AT(supi3_frames, written_values), AT(supi3_frames, plain), AT(supi3_frames, address), AT(supi3_frames, rd),

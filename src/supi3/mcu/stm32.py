@@ -254,11 +254,15 @@ class Exti:
 
     def edge(self, port: int, pin: int, level: int) -> None:
         """Pin ``pin`` of port ``port`` (0 = A) went to ``level``."""
-        if pin >= 4 or (self.exticr1 >> (4 * pin)) & 0xF != port:
-            return
-        trigger = self.rtsr if level else self.ftsr
-        if trigger >> pin & 1:
+        if self.triggers(port, pin, level):
             self.pr |= 1 << pin
+
+    def triggers(self, port: int, pin: int, level: int) -> bool:
+        """Whether pin ``pin`` of port ``port`` going to ``level`` sets its line's pending bit: the line selects that
+        port (EXTICR1) and the edge's trigger is enabled (RTSR, FTSR)."""
+        if pin >= 4 or (self.exticr1 >> (4 * pin)) & 0xF != port:
+            return False
+        return bool((self.rtsr if level else self.ftsr) >> pin & 1)
 
     def requesting(self, line: int) -> bool:
         """Line ``line`` asks the NVIC for its interrupt."""
