@@ -81,6 +81,7 @@ def snapshot(board: Board) -> dict[str, Any]:
         "registers": (dict(registers._values), registers.latch_phase, registers.io_access, registers.irq_n),
         "chip": (board.bench.chip._stat_err, board.bench.chip._stat_due),
         "gpio": (board.gpio.odr, board.gpio._levels),
+        "exti": (board.exti.pr, board.exti.imr, board.exti.rtsr, board.exti.ftsr),
         "spi": (spi.cr1, spi.rx_last, spi.rx_buffer, spi.tx_buffer, spi.shifting, spi.transfers, spi.ovr,
                 spi._ovr_seen, spi._holding, spi.modf),
         "board": (None if frame is None else (frame.fall, frame.driven, list(frame.transfers)), board._ss_rise,

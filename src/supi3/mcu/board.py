@@ -382,7 +382,7 @@ class Board:
             core.mmio(GPIOA_BASE, PERIPHERAL_SIZE, self.gpio.read, self.gpio.write)
         core.mmio(GPIOB_BASE, PERIPHERAL_SIZE, self.gpio_b.read, self.gpio_b.write)
         core.mmio(AFIO_BASE, PERIPHERAL_SIZE, self.exti.read_afio, self.exti.write_afio)
-        core.mmio(EXTI_BASE, PERIPHERAL_SIZE, self._exti_read, self._exti_write)
+        core.mmio(EXTI_BASE, PERIPHERAL_SIZE, self._exti_read, self._exti_write, port=2 if native else None)
         if native:
             held = core.mmio(SPI1_BASE, PERIPHERAL_SIZE, self._spi_read, self._spi_write, port=1)
         else:

@@ -840,9 +840,10 @@ class CortexM:
     def mmio(self, base: int, size: int, read: ReadFn, write: WriteFn, *, port: int | None = None) -> HeldRegister:
         """Map a peripheral: ``read(offset, size) -> value`` and ``write(offset, size, value)`` run on every
         access, but a read of a register the peripheral holds (the :class:`HeldRegister` returned) is answered
-        natively (MCU-25), and with ``port`` (0: GPIOA, 1: SPI1) a write the native frames take (:attr:`frames`,
-        MCU-51) is too. An exception they raise stops the run at the end of the block (:attr:`error`); the
-        block's later accesses reach no peripheral (no follow-on reports of a run that has ended)."""
+        natively (MCU-25), and with ``port`` (0: GPIOA, 1: SPI1, 2: EXTI) a write (and a GPIOA read) the native
+        frames take (:attr:`frames`, MCU-51, MCU-66 to MCU-68) is too. An exception they raise stops the run at the end
+        of the block (:attr:`error`); the block's later accesses reach no peripheral (no follow-on reports of a run
+        that has ended)."""
 
         def on_read(handle: int, offset: int, size: int, data: int | None) -> int:
             del handle, data
@@ -877,7 +878,7 @@ class CortexM:
             self._check(_LIB.uc_mmio_map(self._handle, base, size, self._held_read, ctypes.byref(held), callbacks[1],
                                          None))  # fmt: skip
         else:  # MCU-51, MCU-66: the native frames take the write (and GPIOA's input read) or call Python's
-            native = hook.Port(ctypes.pointer(self.frames), callbacks[1], check_int("port", port, 0, 1),
+            native = hook.Port(ctypes.pointer(self.frames), callbacks[1], check_int("port", port, 0, 2),
                                ctypes.pointer(held))  # fmt: skip
             self._callbacks.append(native)
             self._check(_LIB.uc_mmio_map(self._handle, base, size, self._port_read, ctypes.byref(native),

@@ -42,6 +42,7 @@ from supi3.mcu.stm32 import (
     CR1_LSBFIRST,
     CR1_MSTR,
     CR1_SPE,
+    EXTI_PR,
     IOPAEN,
     SPI1EN,
     SPI_DR,
@@ -169,7 +170,7 @@ configure the chip, 3.4.3), nor an address without a register (pedantic mode may
 _STATE_FIELDS: Final[tuple[str, ...]] = (
     "pending", "odr", "synced", "phase", "command", "last_rx", "frame_open", "frame_fall", "frame_driven", "transfer",
     "transfer_seen", "transfer_start", "transfer_period", "ss_rise", "cd_before", "irq_level", "written", "cleared",
-    "cleared_at", "dr_writes", "rx_last", "shift_received", "shift_start", "shift_end")  # fmt: skip
+    "cleared_at", "exti_pr", "dr_writes", "rx_last", "shift_received", "shift_start", "shift_end")  # fmt: skip
 """The fields of :class:`~supi3.mcu.hook.Frames` the native frames change, in their order there."""
 _MIRROR_FIELDS: Final[tuple[str, ...]] = (
     "valid", "due", "latch", "latch_at", "gpio_ok", "gpio_mask", "gpio_pulled_up", "gpio_levels", "spi_ok", "period",
@@ -254,6 +255,7 @@ class NativeFrames:
         self._irq_pin = pins[0]
         frames.irq_address, frames.irq_clear = IRQ_ADDRESS, _registers._READ_CLEARS[IRQ_ADDRESS]
         frames.io_bit = IO_ACCESS_BIT
+        frames.exti_pr_offset = EXTI_PR
         commands = _upif._COMMANDS
         frames.plain[:] = [int(plain) for plain in _upif._PLAIN_COMMANDS]
         frames.address[:] = [command.address for command in commands]
@@ -296,13 +298,14 @@ class NativeFrames:
             return
         state = _STATE.unpack_from(frames, _STATE_AT)
         (_, odr, synced, phase, command, last_rx, frame_open, fall, driven, transfer, seen, start, period, ss_rise,
-         cd_before, irq_level, written, cleared, cleared_at, dr_writes, rx_last, received, shift_start,
+         cd_before, irq_level, written, cleared, cleared_at, exti_pr, dr_writes, rx_last, received, shift_start,
          shift_end) = state
         frames.pending = frames.written = frames.cleared = frames.dr_writes = frames.synced = 0
         board = self._board
         gpio = board.gpio
         gpio.odr = odr
         gpio._levels = frames.gpio_levels
+        board.exti.pr = exti_pr  # MCU-68: the handler's writes of PR (before the bus runs on: its edges come after)
         if cleared:  # MCU-67: the register file's own read-clear, each read at the latest one's time (no bus event)
             board._sync(cleared_at - 1)
             read = board.registers.cpu_read
@@ -389,7 +392,7 @@ class NativeFrames:
         if not valid:
             frames.valid = 0
             return
-        gpio, spi, rcc = board.gpio, board.spi, board.rcc
+        gpio, spi, rcc, exti = board.gpio, board.spi, board.rcc, board.exti
         cr1, period = spi.cr1, spi.period
         spi_ok = (spi.holder is self._spi_held and spi.offer is self._spi_held  # hook.c holds and offers as they would
                   and rcc.apb2enr & SPI1EN and not rcc.apb2rstr & SPI1EN and cr1 & CR1_SPE and cr1 & CR1_MSTR
@@ -407,7 +410,7 @@ class NativeFrames:
             frames, _MIRROR_AT, 1, due, int(registers.latch_phase), latch_at,
             int(bool(rcc.apb2enr & IOPAEN) and not rcc.apb2rstr & IOPAEN), gpio._output_mask(), gpio.pulled_up,
             gpio._levels, int(bool(spi_ok)), period, SR_MODF if spi.modf else 0, int(registers.io_access), io_at,
-            int(board.exti.triggers(0, self._irq_pin, 1)), 0, gpio.odr, 0, phase, code, protocol.last_rx,
+            int(exti.triggers(0, self._irq_pin, 1)), 0, gpio.odr, 0, phase, code, protocol.last_rx,
             int(frame is not None), 0 if frame is None else frame.fall,
             0 if frame is None or frame.driven is None else frame.driven, *transfer, board._ss_rise, board._cd_before,
-            board._irq_level, 0, 0, 0, 0, 0)  # fmt: skip
+            board._irq_level, 0, 0, 0, exti.pr, 0, 0)  # fmt: skip

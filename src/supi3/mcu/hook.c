@@ -261,6 +261,7 @@ typedef struct {
     uint64_t irq_address; /* MCU-67: the read-clear register /IRQ follows (IRQ_EVT, 3.4.14) */
     uint64_t irq_clear;   /* the bits a read of it clears */
     uint64_t io_bit;      /* the live I/O access bit a read of it joins */
+    uint64_t exti_pr_offset; /* MCU-68: EXTI_PR's offset */
     /* refreshed by Python after each of its writes of GPIOA or SPI1 */
     uint64_t valid;      /* the fast path may run: Python's objects are as mirrored here */
     uint64_t due;        /* the first core cycle whose bus synchronisation would run a bus event */
@@ -287,6 +288,7 @@ typedef struct {
     uint64_t written;    /* a bit per address written */
     uint64_t cleared;    /* MCU-67: reads of the register /IRQ follows taken here */
     uint64_t cleared_at; /* 1 + the core cycle of the latest of them */
+    uint64_t exti_pr;    /* MCU-68: EXTI's PR */
     uint64_t dr_writes, rx_last, shift_received, shift_start, shift_end;
     uint64_t taken;      /* accesses taken here since set-up (a count for tests and benchmarks) */
     uint8_t values[16];   /* what a read of each address returns (fast reads only) */
@@ -306,7 +308,7 @@ typedef struct {
 typedef struct {
     supi3_frames *frames;
     mmio_write_fn slow; /* the peripheral's write in Python */
-    uint64_t spi;       /* 0: GPIOA, 1: SPI1 */
+    uint64_t port;      /* 0: GPIOA, 1: SPI1, 2: EXTI */
     supi3_held *held;   /* the peripheral's held register: its reads not taken here go to supi3_held_read */
 } supi3_port;
 
@@ -459,14 +461,36 @@ static int frame_byte(supi3_frames *f, uint64_t now, uint64_t value) {
     return 1;
 }
 
-/* The write callback (uc_cb_mmio_write_t) of GPIOA and SPI1: a frame's edge or byte taken here, or Python's write. */
+/* MCU-68: EXTI's register `offset` written with `value`: PR (Exti.write: a 1 clears its bit) taken here at the access's
+ * time, if no bus event is due (Board._exti_write synchronises the bus first). Its request (Board._request) has nothing
+ * to do: the mirror is valid only while /IRQ's line does not request or its exception is active or pending (refresh),
+ * and a write of PR only clears bits. */
+static int exti_write(supi3_frames *f, uint64_t offset, uint64_t value) {
+    uint64_t now = 0;
+    if (offset != f->exti_pr_offset || !frames_now(f, &now) || now >= f->due) {
+        return 0;
+    }
+    f->exti_pr &= ~value;
+    f->synced = now + 1;
+    f->pending = 1;
+    f->state->handed = now;
+    return 1;
+}
+
+/* The write callback (uc_cb_mmio_write_t) of GPIOA, SPI1 and EXTI: a frame's edge or byte, or EXTI's PR write, taken
+ * here, or Python's write. */
 void supi3_port_write(void *uc, uint64_t offset, unsigned size, uint64_t value, void *data) {
     supi3_port *p = (supi3_port *)data;
     supi3_frames *f = p->frames;
     supi3_state *s = f->state;
     uint64_t now = 0;
     if (f->valid && !s->stop_request) {
-        if (p->spi) {
+        if (p->port == 2) {
+            if (exti_write(f, offset, value)) {
+                f->taken += 1;
+                return;
+            }
+        } else if (p->port == 1) {
             if (offset == f->spi_dr && frames_now(f, &now) && now < f->due && frame_byte(f, now, value)) {
                 f->synced = now + 1;
                 f->pending = 1;
@@ -529,13 +553,13 @@ static int gpio_read(supi3_frames *f, uint64_t offset, uint64_t *value) {
     return 1;
 }
 
-/* The read callback (uc_cb_mmio_read_t) of GPIOA and SPI1: a GPIOA read taken here (MCU-66), or the held register's
+/* The read callback (uc_cb_mmio_read_t) of GPIOA, SPI1 and EXTI: a GPIOA read taken here (MCU-66), or the held register's
  * read (supi3_held_read), which answers SPI1's held and offered registers and calls Python's read for the rest. */
 uint64_t supi3_port_read(void *uc, uint64_t offset, unsigned size, void *data) {
     supi3_port *p = (supi3_port *)data;
     supi3_frames *f = p->frames;
     uint64_t value = 0;
-    if (!p->spi && f->valid && !f->state->stop_request && f->gpio_ok && gpio_read(f, offset, &value)) {
+    if (p->port == 0 && f->valid && !f->state->stop_request && f->gpio_ok && gpio_read(f, offset, &value)) {
         f->taken += 1;
         return value;
     }
@@ -566,13 +590,14 @@ const uint32_t supi3_held_layout[] = {
 const uint32_t supi3_prefix_layout[] = {
     4, sizeof(supi3_prefix), AT(supi3_prefix, address), AT(supi3_prefix, pc), AT(supi3_prefix, cycles)};
 const uint32_t supi3_frames_layout[] = {
-    76, sizeof(supi3_frames), AT(supi3_frames, state), AT(supi3_frames, spi), AT(supi3_frames, prefixes),
+    78, sizeof(supi3_frames), AT(supi3_frames, state), AT(supi3_frames, spi), AT(supi3_frames, prefixes),
     AT(supi3_frames, prefix_mask), AT(supi3_frames, least_t1), AT(supi3_frames, least_t2),
     AT(supi3_frames, least_t8), AT(supi3_frames, ss_pin), AT(supi3_frames, cd_command), AT(supi3_frames, cd_data),
     AT(supi3_frames, phase_command), AT(supi3_frames, phase_data), AT(supi3_frames, sr_txe),
     AT(supi3_frames, sr_bsy), AT(supi3_frames, sr_rxne), AT(supi3_frames, spi_dr), AT(supi3_frames, spi_sr),
     AT(supi3_frames, least_t6max), AT(supi3_frames, irq_pin), AT(supi3_frames, cd_pin), AT(supi3_frames, io_pin),
     AT(supi3_frames, irq_address), AT(supi3_frames, irq_clear), AT(supi3_frames, io_bit),
+    AT(supi3_frames, exti_pr_offset),
     AT(supi3_frames, valid), AT(supi3_frames, due), AT(supi3_frames, latch), AT(supi3_frames, latch_at),
     AT(supi3_frames, gpio_ok), AT(supi3_frames, gpio_mask), AT(supi3_frames, gpio_pulled_up),
     AT(supi3_frames, gpio_levels), AT(supi3_frames, spi_ok), AT(supi3_frames, period), AT(supi3_frames, sr_modf),
@@ -581,7 +606,7 @@ const uint32_t supi3_frames_layout[] = {
     AT(supi3_frames, frame_fall), AT(supi3_frames, frame_driven), AT(supi3_frames, transfer),
     AT(supi3_frames, transfer_seen), AT(supi3_frames, transfer_start), AT(supi3_frames, transfer_period),
     AT(supi3_frames, ss_rise), AT(supi3_frames, cd_before), AT(supi3_frames, irq_level), AT(supi3_frames, written),
-    AT(supi3_frames, cleared), AT(supi3_frames, cleared_at), AT(supi3_frames, dr_writes),
+    AT(supi3_frames, cleared), AT(supi3_frames, cleared_at), AT(supi3_frames, exti_pr), AT(supi3_frames, dr_writes),
     AT(supi3_frames, rx_last), AT(supi3_frames, shift_received), AT(supi3_frames, shift_start),
     AT(supi3_frames, shift_end), AT(supi3_frames, taken), AT(supi3_frames, values),
     AT(supi3_frames, written_values), AT(supi3_frames, plain), AT(supi3_frames, address), AT(supi3_frames, rd),
@@ -589,4 +614,4 @@ const uint32_t supi3_frames_layout[] = {
     AT(supi3_frames, fast_read), AT(supi3_frames, fast_write), AT(supi3_frames, write_mask),
     AT(supi3_frames, alias)};
 const uint32_t supi3_port_layout[] = {
-    5, sizeof(supi3_port), AT(supi3_port, frames), AT(supi3_port, slow), AT(supi3_port, spi), AT(supi3_port, held)};
+    5, sizeof(supi3_port), AT(supi3_port, frames), AT(supi3_port, slow), AT(supi3_port, port), AT(supi3_port, held)};

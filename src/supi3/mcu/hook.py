@@ -159,6 +159,7 @@ class Frames(ctypes.Structure):
         ("irq_address", ctypes.c_uint64),
         ("irq_clear", ctypes.c_uint64),
         ("io_bit", ctypes.c_uint64),
+        ("exti_pr_offset", ctypes.c_uint64),
         ("valid", ctypes.c_uint64),
         ("due", ctypes.c_uint64),
         ("latch", ctypes.c_uint64),
@@ -192,6 +193,7 @@ class Frames(ctypes.Structure):
         ("written", ctypes.c_uint64),
         ("cleared", ctypes.c_uint64),
         ("cleared_at", ctypes.c_uint64),
+        ("exti_pr", ctypes.c_uint64),
         ("dr_writes", ctypes.c_uint64),
         ("rx_last", ctypes.c_uint64),
         ("shift_received", ctypes.c_uint64),
@@ -214,11 +216,11 @@ class Frames(ctypes.Structure):
 
 
 class Port(ctypes.Structure):
-    """The user data of :func:`supi3_port_write` and :func:`supi3_port_read`, GPIOA's or SPI1's write and read in
-    native code (``supi3_port``): the frames, Python's write, which port, and the held register its other reads go to
-    (:func:`supi3_held_read`)."""
+    """The user data of :func:`supi3_port_write` and :func:`supi3_port_read`, GPIOA's, SPI1's or EXTI's write and read
+    in native code (``supi3_port``): the frames, Python's write, which peripheral (0: GPIOA, 1: SPI1, 2: EXTI), and the
+    held register its other reads go to (:func:`supi3_held_read`)."""
 
-    _fields_ = (("frames", ctypes.POINTER(Frames)), ("slow", MMIO_WRITE), ("spi", ctypes.c_uint64),
+    _fields_ = (("frames", ctypes.POINTER(Frames)), ("slow", MMIO_WRITE), ("port", ctypes.c_uint64),
                 ("held", ctypes.POINTER(Held)))
 
 
