@@ -3,12 +3,15 @@
 Ref: IBS SUPI 3 OPC UM E rev. 05, 3.4.2 (one /SS frame per byte), 3.4.4 (command and data bytes), Table 3-7 (t0, t1,
 t2, t8), Table 3-10 (the registers); decisions MCU-51 to MCU-53 in docs/assumptions/mcu.md.
 
-hook.c's ``supi3_port_write`` is GPIOA's and SPI1's write callback. It takes a /SS edge (a BSRR or BRR write that
-changes only /SS) or SPI1's DR write that clocks the frame's byte itself when the frame's whole effect on the
-Python model is plain, and calls the Python write (the existing board code, the one slow path) for everything else:
+hook.c's ``supi3_port_write`` is GPIOA's, SPI1's and EXTI's write callback. It takes a /SS edge (a BSRR or BRR write
+that changes only /SS) or SPI1's DR write that clocks the frame's byte itself when the frame's whole effect on the
+Python model is plain, and EXTI's PR write (MCU-68), and calls the Python write (the existing board code, the one slow
+path) for everything else; ``supi3_port_read`` answers GPIOA's IDR and ODR reads (MCU-66) and sends every other read
+on to the held register's read (MCU-25) and Python:
 
 - a command frame in the command phase with a plain command byte (``upif._PLAIN_COMMANDS``), or the data frame of a
-  read of a register without side effects (not read-clear; a data register outside the latch phase) or of a write of
+  read of a register without side effects (a data register outside the latch phase) or of IRQ_EVT (read-clear: the
+  read noted for the catch-up, /IRQ's rise followed unless it would set EXTI's pending bit, MCU-67) or of a write of
   a register that only stores (not SET or ID, not the read-clear event register /IRQ follows; a data register outside
   the latch phase), in Motorola mode, with a register file that is not pedantic, at transaction level;
 - with every Table 3-7 check of the board passing (t8, t1, t2, t0, SPI mode 3, MSB first), by the board's thresholds
@@ -16,11 +19,12 @@ Python model is plain, and calls the Python write (the existing board code, the 
   ``Board._sync`` would run one, by the same float expression), /IRQ and /ModAck followed, nothing else pending.
 
 Python hands the native side its tables once (:meth:`NativeFrames.__init__`), mirrors the state those conditions read
-after each of its writes of GPIOA or SPI1 (:meth:`NativeFrames.refresh`: ``valid``), and at each entry into Python
-(:attr:`supi3.mcu.core.CortexM.entry`: a peripheral's callback, a watched address, the end of a run) takes the
+after each of its accesses of GPIOA, SPI1 or EXTI (:meth:`NativeFrames.refresh`: ``valid``), and at each entry into
+Python (:attr:`supi3.mcu.core.CortexM.entry`: a peripheral's callback, a watched address, the end of a run) takes the
 mirror's validity back and sets what the native frames changed, as its net effect, in the Python objects
 (:meth:`NativeFrames.catch_up`): the protocol's phase, command and last byte, the written registers, the board's
-frame, /SS rise and C/D, GPIOA's ODR, SPI1's transfer and received byte, and the bus clock.
+frame, /SS rise and C/D, /IRQ's level, GPIOA's ODR, EXTI's PR, SPI1's transfer and received byte, IRQ_EVT's reads
+(the register file's own ``cpu_read``), and the bus clock.
 """
 
 from __future__ import annotations
