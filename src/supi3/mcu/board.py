@@ -296,9 +296,10 @@ class Board:
         SerOUT, MFP7) or ``Mode.INTEL`` (MCU-18: MISO on Ser_IN/OUT, MFP6, MOSI on it through a resistor, S/R from
         PB0 to MFP7; build the firmware with ``-DFW_MODE=SUPI3_MODE_INTEL``).
     native_frames:
-        MCU-51: the plain µP interface frames (/SS edges and SPI1's DR write) taken in native code without a Python
-        call, their net effect set in the model at the next entry into Python (:mod:`supi3.mcu.frames`; the same run
-        to the cycle). Transaction level on the Motorola board only; ``False`` runs every frame through Python.
+        MCU-51: the plain µP interface frames (/SS edges and SPI1's DR write; MCU-67: IRQ_EVT's read-clear frame too),
+        GPIOA's input reads (MCU-66) and EXTI's PR write (MCU-68) taken in native code without a Python call, their
+        net effect set in the model at the next entry into Python (:mod:`supi3.mcu.frames`; the same run to the
+        cycle). Transaction level on the Motorola board only; ``False`` runs every frame through Python.
 
     Attributes
     ----------
