@@ -33,6 +33,8 @@ pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning:unicorn")
 MCU = Path(__file__).parent / "mcu"
 BR3 = {"BOARD_SPI_BR": "3u"}
 """SPI1 at 3 MHz: issue #13's case, the fastest within t0 at 2 Mbit/s."""
+SEEN = 128
+"""pin_watch.c's SEEN."""
 
 
 @pytest.fixture(scope="module")
@@ -51,6 +53,9 @@ def elves(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
         "clock_off": mcu_build.build(MCU / "frame_edges.c", folder / "clock_off.elf", defines={"CLOCK_OFF": "1u"}),
         "gpio_reset": mcu_build.build(MCU / "gpio_reset.c", folder / "gpio_reset.elf"),
         "due_cross": mcu_build.build(MCU / "due_cross.c", folder / "due_cross.elf", defines=BR3),
+        "pin_watch": mcu_build.build(MCU / "pin_watch.c", folder / "pin_watch.elf", defines=BR3),
+        "pin_watch_rise": mcu_build.build(MCU / "pin_watch.c", folder / "pin_watch_rise.elf",
+                                          defines={**BR3, "RISING": "1u"}),
     }
 
 
@@ -76,12 +81,23 @@ def snapshot(board: Board) -> dict[str, Any]:
         "registers": (dict(registers._values), registers.latch_phase, registers.io_access, registers.irq_n),
         "chip": (board.bench.chip._stat_err, board.bench.chip._stat_due),
         "gpio": (board.gpio.odr, board.gpio._levels),
+        "exti": (board.exti.pr, board.exti.imr, board.exti.rtsr, board.exti.ftsr),
         "spi": (spi.cr1, spi.rx_last, spi.rx_buffer, spi.tx_buffer, spi.shifting, spi.transfers, spi.ovr,
                 spi._ovr_seen, spi._holding, spi.modf),
         "board": (None if frame is None else (frame.fall, frame.driven, list(frame.transfers)), board._ss_rise,
                   board._cd_before, board._irq_level),
         "process data": (board.fw_board.outputs, board.fw_board.inputs),
+        "seen": _seen(board),
     }
+
+
+def _seen(board: Board) -> tuple[int, ...]:
+    """pin_watch.c's record of GPIOA's reads (none for another firmware)."""
+    image = board.core.image
+    if "seen" not in image.symbols:
+        return ()
+    data = board.core.read_bytes(image.address("seen"), 4 * SEEN)
+    return tuple(int.from_bytes(data[at:at + 4], "little") for at in range(0, len(data), 4))
 
 
 def side_by_side(elf: Path, bit_rate: int, steps: int, *, strict: bool = False, pedantic: bool = False,
@@ -126,7 +142,8 @@ def test_the_native_frames_run_as_the_python_model(elves: dict[str, Path], case:
     assert fast.violations or case == "dio"
 
 
-@pytest.mark.parametrize(("case", "bit_rate"), [("edges_br3", 2_000_000), ("dio_br3", 2_000_000)])
+@pytest.mark.parametrize(("case", "bit_rate"), [("edges_br3", 2_000_000), ("dio_br3", 2_000_000),
+                                             ("pin_watch", 2_000_000)])
 def test_the_native_frames_agree_between_cycles(elves: dict[str, Path], case: str, bit_rate: int) -> None:
     """Steps of 7 µs of bus time (a quarter of a 2 Mbit/s cycle, the master's process data new at each): the state
     between two cycles' ends agrees too (what the master received from a cycle that a native frame ran across)."""
@@ -184,6 +201,32 @@ def test_the_native_frames_agree_through_any_history_of_faults(elves: dict[str, 
             board.run(cycles)
         assert len(refused) in (0, 2), (step, what)
         assert snapshot(boards[0]) == snapshot(boards[1]), (step, what)
+
+
+@pytest.mark.parametrize(("case", "bit_rate", "strict", "pedantic"), [
+    ("pin_watch", 2_000_000, False, False), ("pin_watch", 500_000, False, False),
+    ("pin_watch", 2_000_000, True, False), ("pin_watch", 2_000_000, False, True),
+    ("pin_watch_rise", 500_000, False, False)])  # fmt: skip
+def test_gpio_reads_run_as_the_python_model(elves: dict[str, Path], case: str, bit_rate: int, strict: bool,
+                                            pedantic: bool) -> None:  # fmt: skip
+    """MCU-66, MCU-67: pin_watch.c reads GPIOA's IDR right after /SS rises (C/D inside t6 max) and at waits that
+    step through the cycle's bus events, for longer than a 2 Mbit/s cycle, then reads IRQ_EVT again (/IRQ fell while
+    it ran, EXTI's pending bit set): the same values at the same times with the native reads as through Python, at
+    both bit rates, on strict and pedantic boards too, and with EXTI0's rising trigger on (each IRQ_EVT read that
+    raises /IRQ pends the handler again: left to Python); at 2 Mbit/s the reads saw /IRQ, C/D and the I/O access pin
+    at both levels (the record crosses every input's change)."""
+    fast, slow = side_by_side(elves[case], bit_rate, 6, strict=strict, pedantic=pedantic)
+    if pedantic:
+        assert fast.core.frames.taken == 0
+        return
+    assert fast.core.frames.taken > 6 * 50
+    if case == "pin_watch_rise":
+        assert fast.exti.rtsr & 1 and fast.interrupts == slow.interrupts
+    if strict or bit_rate != 2_000_000:  # at 500 kbit/s the handler ends before the next cycle's events
+        return
+    idr = [value & 0xFFFF for value in _seen(fast)]
+    for pin in (0, 1, 2):  # /IRQ, C/D, I/O access (board.h)
+        assert {value >> pin & 1 for value in idr} == {0, 1}, pin
 
 
 def test_frame_edges_crosses_every_fallback(elves: dict[str, Path]) -> None:

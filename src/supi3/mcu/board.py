@@ -296,9 +296,10 @@ class Board:
         SerOUT, MFP7) or ``Mode.INTEL`` (MCU-18: MISO on Ser_IN/OUT, MFP6, MOSI on it through a resistor, S/R from
         PB0 to MFP7; build the firmware with ``-DFW_MODE=SUPI3_MODE_INTEL``).
     native_frames:
-        MCU-51: the plain µP interface frames (/SS edges and SPI1's DR write) taken in native code without a Python
-        call, their net effect set in the model at the next entry into Python (:mod:`supi3.mcu.frames`; the same run
-        to the cycle). Transaction level on the Motorola board only; ``False`` runs every frame through Python.
+        MCU-51: the plain µP interface frames (/SS edges and SPI1's DR write; MCU-67: IRQ_EVT's read-clear frame too),
+        GPIOA's input reads (MCU-66) and EXTI's PR write (MCU-68) taken in native code without a Python call, their
+        net effect set in the model at the next entry into Python (:mod:`supi3.mcu.frames`; the same run to the
+        cycle). Transaction level on the Motorola board only; ``False`` runs every frame through Python.
 
     Attributes
     ----------
@@ -382,7 +383,7 @@ class Board:
             core.mmio(GPIOA_BASE, PERIPHERAL_SIZE, self.gpio.read, self.gpio.write)
         core.mmio(GPIOB_BASE, PERIPHERAL_SIZE, self.gpio_b.read, self.gpio_b.write)
         core.mmio(AFIO_BASE, PERIPHERAL_SIZE, self.exti.read_afio, self.exti.write_afio)
-        core.mmio(EXTI_BASE, PERIPHERAL_SIZE, self._exti_read, self._exti_write)
+        core.mmio(EXTI_BASE, PERIPHERAL_SIZE, self._exti_read, self._exti_write, port=2 if native else None)
         if native:
             held = core.mmio(SPI1_BASE, PERIPHERAL_SIZE, self._spi_read, self._spi_write, port=1)
         else:
@@ -401,7 +402,8 @@ class Board:
         self._irq_fell: int | None = None
         self._mod_ack_until = 0
         self._limit = self._budget = 0
-        self.native_frames = NativeFrames(self, held, PIN_SS, NOISE_CYCLES, _EXTI0) if native else None
+        pins = (PIN_IRQ, PIN_CD, PIN_IO)
+        self.native_frames = NativeFrames(self, held, PIN_SS, pins, NOISE_CYCLES, _EXTI0) if native else None
         """MCU-51: the native per-frame fast path (``native_frames=True`` at transaction level on the Motorola
         board), else ``None``."""
         if self.native_frames is not None:  # the wrappers' refresh, one Python call (MCU-65)
@@ -583,7 +585,10 @@ class Board:
         of /IRQ before it (MCU-44: the run loop does not stop at a bus event while EXTI0 is active)."""
         if self._ring is None:
             self._now()
-        return self.exti.read(offset, size)
+        value = self.exti.read(offset, size)
+        if self.native_frames is not None:  # MCU-66: the mirror valid again for GPIOA's reads after it
+            self._refresh()
+        return value
 
     def _exti_write(self, offset: int, size: int, value: int) -> None:
         """The firmware writes EXTI (the bus run up to it first, as :meth:`_exti_read`): a line it unmasks (IMR) or
@@ -592,6 +597,8 @@ class Board:
             self._now()
         self.exti.write(offset, size, value)
         self._request()
+        if self.native_frames is not None:  # MCU-66: the mirror valid again for GPIOA's reads after it
+            self._refresh()
 
     def _pend(self) -> None:
         """EXTI0 requests its interrupt: pend it unless it is active or pending, and stop the run for it."""

@@ -825,6 +825,7 @@ class CortexM:
         self.resume: Callable[[], None] | None = None
         """MCU-51: called when a run starts: the native frames' mirror refreshed."""
         self._port_write = ctypes.cast(native.supi3_port_write, ctypes.c_void_p)
+        self._port_read = ctypes.cast(native.supi3_port_read, ctypes.c_void_p)
         self.sleeping = False
         self.active: list[int] = []  # active exceptions, outermost first
         self.pending: set[int] = set()
@@ -863,9 +864,10 @@ class CortexM:
     def mmio(self, base: int, size: int, read: ReadFn, write: WriteFn, *, port: int | None = None) -> HeldRegister:
         """Map a peripheral: ``read(offset, size) -> value`` and ``write(offset, size, value)`` run on every
         access, but a read of a register the peripheral holds (the :class:`HeldRegister` returned) is answered
-        natively (MCU-25), and with ``port`` (0: GPIOA, 1: SPI1) a write the native frames take (:attr:`frames`,
-        MCU-51) is too. An exception they raise stops the run at the end of the block (:attr:`error`); the
-        block's later accesses reach no peripheral (no follow-on reports of a run that has ended)."""
+        natively (MCU-25), and with ``port`` (0: GPIOA, 1: SPI1, 2: EXTI) a write (and a GPIOA read) the native
+        frames take (:attr:`frames`, MCU-51, MCU-66 to MCU-68) is too. An exception they raise stops the run at the end
+        of the block (:attr:`error`); the block's later accesses reach no peripheral (no follow-on reports of a run
+        that has ended)."""
 
         def on_read(handle: int, offset: int, size: int, data: int | None) -> int:
             del handle, data
@@ -899,10 +901,11 @@ class CortexM:
         if port is None:
             self._check(_LIB.uc_mmio_map(self._handle, base, size, self._held_read, ctypes.byref(held), callbacks[1],
                                          None))  # fmt: skip
-        else:  # MCU-51: the write goes to the native frames, which call Python's write for what they do not take
-            native = hook.Port(ctypes.pointer(self.frames), callbacks[1], check_int("port", port, 0, 1))
+        else:  # MCU-51, MCU-66: the native frames take the write (and GPIOA's input read) or call Python's
+            native = hook.Port(ctypes.pointer(self.frames), callbacks[1], check_int("port", port, 0, 2),
+                               ctypes.pointer(held))  # fmt: skip
             self._callbacks.append(native)
-            self._check(_LIB.uc_mmio_map(self._handle, base, size, self._held_read, ctypes.byref(held),
+            self._check(_LIB.uc_mmio_map(self._handle, base, size, self._port_read, ctypes.byref(native),
                                          self._port_write, ctypes.byref(native)))  # fmt: skip
         # unicorn updates the PC before a load or store only if a memory hook covers its address: without one, a
         # peripheral callback sees the PC of the block's first instruction, and the access would be timed there

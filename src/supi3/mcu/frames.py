@@ -3,12 +3,15 @@
 Ref: IBS SUPI 3 OPC UM E rev. 05, 3.4.2 (one /SS frame per byte), 3.4.4 (command and data bytes), Table 3-7 (t0, t1,
 t2, t8), Table 3-10 (the registers); decisions MCU-51 to MCU-53 in docs/assumptions/mcu.md.
 
-hook.c's ``supi3_port_write`` is GPIOA's and SPI1's write callback. It takes a /SS edge (a BSRR or BRR write that
-changes only /SS) or SPI1's DR write that clocks the frame's byte itself when the frame's whole effect on the
-Python model is plain, and calls the Python write (the existing board code, the one slow path) for everything else:
+hook.c's ``supi3_port_write`` is GPIOA's, SPI1's and EXTI's write callback. It takes a /SS edge (a BSRR or BRR write
+that changes only /SS) or SPI1's DR write that clocks the frame's byte itself when the frame's whole effect on the
+Python model is plain, and EXTI's PR write (MCU-68), and calls the Python write (the existing board code, the one slow
+path) for everything else; ``supi3_port_read`` answers GPIOA's IDR and ODR reads (MCU-66) and sends every other read
+on to the held register's read (MCU-25) and Python:
 
 - a command frame in the command phase with a plain command byte (``upif._PLAIN_COMMANDS``), or the data frame of a
-  read of a register without side effects (not read-clear; a data register outside the latch phase) or of a write of
+  read of a register without side effects (a data register outside the latch phase) or of IRQ_EVT (read-clear: the
+  read noted for the catch-up, /IRQ's rise followed unless it would set EXTI's pending bit, MCU-67) or of a write of
   a register that only stores (not SET or ID, not the read-clear event register /IRQ follows; a data register outside
   the latch phase), in Motorola mode, with a register file that is not pedantic, at transaction level;
 - with every Table 3-7 check of the board passing (t8, t1, t2, t0, SPI mode 3, MSB first), by the board's thresholds
@@ -16,11 +19,12 @@ Python model is plain, and calls the Python write (the existing board code, the 
   ``Board._sync`` would run one, by the same float expression), /IRQ and /ModAck followed, nothing else pending.
 
 Python hands the native side its tables once (:meth:`NativeFrames.__init__`), mirrors the state those conditions read
-after each of its writes of GPIOA or SPI1 (:meth:`NativeFrames.refresh`: ``valid``), and at each entry into Python
-(:attr:`supi3.mcu.core.CortexM.entry`: a peripheral's callback, a watched address, the end of a run) takes the
+after each of its accesses of GPIOA, SPI1 or EXTI (:meth:`NativeFrames.refresh`: ``valid``), and at each entry into
+Python (:attr:`supi3.mcu.core.CortexM.entry`: a peripheral's callback, a watched address, the end of a run) takes the
 mirror's validity back and sets what the native frames changed, as its net effect, in the Python objects
 (:meth:`NativeFrames.catch_up`): the protocol's phase, command and last byte, the written registers, the board's
-frame, /SS rise and C/D, GPIOA's ODR, SPI1's transfer and received byte, and the bus clock.
+frame, /SS rise and C/D, /IRQ's level, GPIOA's ODR, EXTI's PR, SPI1's transfer and received byte, IRQ_EVT's reads
+(the register file's own ``cpu_read``), and the bus clock.
 """
 
 from __future__ import annotations
@@ -42,6 +46,7 @@ from supi3.mcu.stm32 import (
     CR1_LSBFIRST,
     CR1_MSTR,
     CR1_SPE,
+    EXTI_PR,
     IOPAEN,
     SPI1EN,
     SPI_DR,
@@ -53,6 +58,7 @@ from supi3.mcu.stm32 import (
 )
 from supi3.model import registers as _registers
 from supi3.pinout import C_D_COMMAND, C_D_DATA
+from supi3.regmap.registers import IO_ACCESS_BIT
 from supi3.spi import upif as _upif
 from supi3.spi.upif import Mode, Phase
 
@@ -63,7 +69,7 @@ if TYPE_CHECKING:
     from supi3.model.registers import RegisterFile
     from supi3.spi.upif import UpifProtocol
 
-__all__ = ["FAST_READS", "FAST_WRITES", "FrameBoard", "NativeFrames", "SsFrame", "first_due"]
+__all__ = ["FAST_READS", "FAST_WRITES", "IRQ_ADDRESS", "FrameBoard", "NativeFrames", "SsFrame", "first_due"]
 
 @dataclass(slots=True)
 class SsFrame:
@@ -105,6 +111,7 @@ class FrameBoard(Protocol):
     _least_t1: int
     _least_t2: int
     _least_t8: int
+    _least: dict[str, int]
     _shortest_period_s: float
     exti: Exti
 
@@ -140,7 +147,14 @@ _CODES_BY_ID: Final[dict[int, int]] = {id(command): code for command, code in _C
 _EVENT_REGISTERS: Final[frozenset[str]] = frozenset(
     name for name, clears in zip(_registers._READ_NAMES, _registers._READ_CLEARS, strict=True) if name and clears
 )
-"""The read-clear registers (IRQ_EVT, 3.4.14): /IRQ follows them, so no native frame reads or writes them."""
+"""The read-clear registers (IRQ_EVT, 3.4.14): /IRQ follows them, so no native frame writes them; a native frame
+reads one only by hook.c's ``read_clear`` (MCU-67), not as a fast read."""
+_IRQ_ADDRESSES: Final[tuple[int, ...]] = tuple(address for address, name in enumerate(_registers._READ_NAMES)
+                                               if name in _EVENT_REGISTERS)  # fmt: skip
+if len(_IRQ_ADDRESSES) != 1:  # RegisterFile.irq_n follows the one event register
+    raise NativeHookError(f"the register map has {len(_IRQ_ADDRESSES)} read-clear registers, MCU-67 knows one")
+IRQ_ADDRESS: Final[int] = _IRQ_ADDRESSES[0]
+"""MCU-67: the address of the read-clear register /IRQ follows (IRQ_EVT, 3.4.14), whose reads hook.c takes."""
 
 
 def _access(name: str | None, side_effects: frozenset[str]) -> int:
@@ -159,12 +173,12 @@ configure the chip, 3.4.3), nor an address without a register (pedantic mode may
 
 _STATE_FIELDS: Final[tuple[str, ...]] = (
     "pending", "odr", "synced", "phase", "command", "last_rx", "frame_open", "frame_fall", "frame_driven", "transfer",
-    "transfer_seen", "transfer_start", "transfer_period", "ss_rise", "cd_before", "written", "dr_writes", "rx_last",
-    "shift_received", "shift_start", "shift_end")  # fmt: skip
+    "transfer_seen", "transfer_start", "transfer_period", "ss_rise", "cd_before", "irq_level", "written", "cleared",
+    "cleared_at", "exti_pr", "dr_writes", "rx_last", "shift_received", "shift_start", "shift_end")  # fmt: skip
 """The fields of :class:`~supi3.mcu.hook.Frames` the native frames change, in their order there."""
 _MIRROR_FIELDS: Final[tuple[str, ...]] = (
     "valid", "due", "latch", "latch_at", "gpio_ok", "gpio_mask", "gpio_pulled_up", "gpio_levels", "spi_ok", "period",
-    "sr_modf", *_STATE_FIELDS[:-3])  # fmt: skip
+    "sr_modf", "io", "io_at", "exti_rise", *_STATE_FIELDS[:-3])  # fmt: skip
 """The fields :meth:`NativeFrames.refresh` writes, in their order there."""
 
 
@@ -225,7 +239,8 @@ class NativeFrames:
     """The native per-frame fast path of a transaction-level board (MCU-51): the tables handed to hook.c, the
     mirror refreshed after Python's writes of GPIOA and SPI1, the catch-up at each entry into Python."""
 
-    def __init__(self, board: FrameBoard, spi_held: HeldRegister, ss_pin: int, noise: float, exti0: int) -> None:
+    def __init__(self, board: FrameBoard, spi_held: HeldRegister, ss_pin: int, pins: tuple[int, int, int],
+                 noise: float, exti0: int) -> None:
         self._board = board
         core = board.core
         self._frames = frames = core.frames
@@ -239,6 +254,12 @@ class NativeFrames:
         frames.phase_command, frames.phase_data = _PHASE_COMMAND, _PHASE_DATA
         frames.sr_txe, frames.sr_bsy, frames.sr_rxne = SR_TXE, SR_BSY, SR_RXNE
         frames.spi_dr, frames.spi_sr = SPI_DR, SPI_SR
+        frames.least_t6max = board._least["t6max"]
+        frames.irq_pin, frames.cd_pin, frames.io_pin = pins
+        self._irq_pin = pins[0]
+        frames.irq_address, frames.irq_clear = IRQ_ADDRESS, _registers._READ_CLEARS[IRQ_ADDRESS]
+        frames.io_bit = IO_ACCESS_BIT
+        frames.exti_pr_offset = EXTI_PR
         commands = _upif._COMMANDS
         frames.plain[:] = [int(plain) for plain in _upif._PLAIN_COMMANDS]
         frames.address[:] = [command.address for command in commands]
@@ -251,13 +272,14 @@ class NativeFrames:
         frames.write_mask[:] = _registers._WRITE_MASKS
         read_names = _registers._READ_NAMES
         frames.alias[:] = [read_names.index(name) if name in read_names else -1 for name in _registers._WRITE_NAMES]
-        reads = [name for address, name in enumerate(read_names) if name is not None and FAST_READS[address]]
+        reads = [name for address, name in enumerate(read_names)
+                 if name is not None and (FAST_READS[address] or address == IRQ_ADDRESS)]  # fmt: skip
         self._read_values = operator.itemgetter(*reads)  # the fast-readable registers' values, in address order
         self._values = struct.Struct("<" + "".join("B" if name in reads else "x" for name in read_names))
         self._values_at = Frames.values.offset
         self._bench = board.bench  # the transaction-level bench, set once at the board's construction
         self._due_key: tuple[int, float | None, float] | None = None  # the bench's next events, as last mirrored
-        self._due = (0, _NEVER)
+        self._due = (0, _NEVER, _NEVER)
         self._first_due = _FirstDue(self._hz, noise)
         self._written: tuple[str | None, ...] = _registers._WRITE_NAMES
         self._exti0 = exti0
@@ -280,12 +302,20 @@ class NativeFrames:
             return
         state = _STATE.unpack_from(frames, _STATE_AT)
         (_, odr, synced, phase, command, last_rx, frame_open, fall, driven, transfer, seen, start, period, ss_rise,
-         cd_before, written, dr_writes, rx_last, received, shift_start, shift_end) = state
-        frames.pending = frames.written = frames.dr_writes = frames.synced = 0
+         cd_before, irq_level, written, cleared, cleared_at, exti_pr, dr_writes, rx_last, received, shift_start,
+         shift_end) = state
+        frames.pending = frames.written = frames.cleared = frames.dr_writes = frames.synced = 0
         board = self._board
         gpio = board.gpio
         gpio.odr = odr
         gpio._levels = frames.gpio_levels
+        board.exti.pr = exti_pr  # MCU-68: the handler's writes of PR (before the bus runs on: its edges come after)
+        if cleared:  # MCU-67: the register file's own read-clear, each read at the latest one's time (no bus event)
+            board._sync(cleared_at - 1)
+            read = board.registers.cpu_read
+            for _ in range(cleared):
+                read(IRQ_ADDRESS)
+        board._irq_level = irq_level  # /IRQ rose with the clear: the board followed it (no EXTI bit, MCU-67)
         if synced:  # the bus run up to the latest synchronisation: no event but the phases' flags (MCU-52)
             board._sync(synced - 1)
         protocol = board.protocol
@@ -314,17 +344,20 @@ class NativeFrames:
             spi.transfers += dr_writes
             spi._holding = True
 
-    def _thresholds(self, events: list[tuple[float, str]], next_start: float) -> tuple[int, int]:
-        """The first core cycle whose synchronisation runs a cycle's start or end, and the one that runs the latch
-        phase's start (or :data:`_NEVER`): the phases only set the chips' flags (MCU-52)."""
+    def _thresholds(self, events: list[tuple[float, str]], next_start: float) -> tuple[int, int, int]:
+        """The first core cycle whose synchronisation runs a cycle's start or end, the one that runs the latch
+        phase's start and the one that sets the I/O access bit (each :data:`_NEVER` if none comes before): the phases
+        only set the chips' flags (MCU-52, MCU-66)."""
         due = self._first_due
-        latch_at = _NEVER
+        latch_at = io_at = _NEVER
         for at, what in reversed(events):  # the next first
             if what == _LATCH:
                 latch_at = due[at]
-            elif what != _IO:
-                return due[at], latch_at
-        return due[next_start], latch_at
+            elif what == _IO:
+                io_at = due[at]
+            else:
+                return due[at], latch_at, io_at
+        return due[next_start], latch_at, io_at
 
 
     def refresh(self) -> None:
@@ -363,7 +396,7 @@ class NativeFrames:
         if not valid:
             frames.valid = 0
             return
-        gpio, spi, rcc = board.gpio, board.spi, board.rcc
+        gpio, spi, rcc, exti = board.gpio, board.spi, board.rcc, board.exti
         cr1, period = spi.cr1, spi.period
         spi_ok = (spi.holder is self._spi_held and spi.offer is self._spi_held  # hook.c holds and offers as they would
                   and rcc.apb2enr & SPI1EN and not rcc.apb2rstr & SPI1EN and cr1 & CR1_SPE and cr1 & CR1_MSTR
@@ -376,11 +409,12 @@ class NativeFrames:
         if key != self._due_key:
             self._due_key = key
             self._due = self._thresholds(events, bench._next_start)
-        due, latch_at = self._due
+        due, latch_at, io_at = self._due
         _MIRROR.pack_into(
             frames, _MIRROR_AT, 1, due, int(registers.latch_phase), latch_at,
             int(bool(rcc.apb2enr & IOPAEN) and not rcc.apb2rstr & IOPAEN), gpio._output_mask(), gpio.pulled_up,
-            gpio._levels, int(bool(spi_ok)), period, SR_MODF if spi.modf else 0, 0, gpio.odr, 0, phase, code,
-            protocol.last_rx, int(frame is not None), 0 if frame is None else frame.fall,
-            0 if frame is None or frame.driven is None else frame.driven, *transfer, board._ss_rise,
-            board._cd_before, 0, 0, 0)  # fmt: skip
+            gpio._levels, int(bool(spi_ok)), period, SR_MODF if spi.modf else 0, int(registers.io_access), io_at,
+            int(exti.triggers(0, self._irq_pin, 1)), 0, gpio.odr, 0, phase, code, protocol.last_rx,
+            int(frame is not None), 0 if frame is None else frame.fall,
+            0 if frame is None or frame.driven is None else frame.driven, *transfer, board._ss_rise, board._cd_before,
+            board._irq_level, 0, 0, 0, exti.pr, 0, 0)  # fmt: skip

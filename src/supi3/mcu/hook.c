@@ -392,6 +392,12 @@ typedef struct {
     int64_t least_t1, least_t2, least_t8; /* core cycles */
     uint64_t ss_pin, cd_command, cd_data, phase_command, phase_data;
     uint64_t sr_txe, sr_bsy, sr_rxne, spi_dr, spi_sr;
+    int64_t least_t6max;  /* MCU-66: C/D follows the phase from t6 max after /SS rose (Board._inputs) */
+    uint64_t irq_pin, cd_pin, io_pin; /* GPIOA's input pins the chip drives */
+    uint64_t irq_address; /* MCU-67: the read-clear register /IRQ follows (IRQ_EVT, 3.4.14) */
+    uint64_t irq_clear;   /* the bits a read of it clears */
+    uint64_t io_bit;      /* the live I/O access bit a read of it joins */
+    uint64_t exti_pr_offset; /* MCU-68: EXTI_PR's offset */
     /* refreshed by Python after each of its writes of GPIOA or SPI1 */
     uint64_t valid;      /* the fast path may run: Python's objects are as mirrored here */
     uint64_t due;        /* the first core cycle whose bus synchronisation would run a bus event */
@@ -402,6 +408,9 @@ typedef struct {
     uint64_t spi_ok;     /* SPI1 clocked, enabled master, 8 bits, mode 3, MSB first, SCLK period >= t0 */
     uint64_t period;     /* SCLK period in core cycles */
     uint64_t sr_modf;    /* SPI1's MODF flag in SR */
+    uint64_t io;         /* MCU-66: the chip's I/O access bit */
+    uint64_t io_at;      /* the first core cycle whose synchronisation sets it (the bench's `io` event) */
+    uint64_t exti_rise;  /* MCU-67: a rise of /IRQ sets EXTI's pending bit (Exti.triggers) */
     /* the state the fast path runs on: refreshed by Python, changed here, read back by Python's catch-up */
     uint64_t pending;    /* a frame's effect not yet in the Python objects */
     uint64_t odr;
@@ -411,9 +420,13 @@ typedef struct {
     uint64_t transfer, transfer_seen, transfer_start, transfer_period;
     int64_t ss_rise;
     uint64_t cd_before;
+    uint64_t irq_level;  /* /IRQ as the board last followed it (Board._irq_level) */
     uint64_t written;    /* a bit per address written */
+    uint64_t cleared;    /* MCU-67: reads of the register /IRQ follows taken here */
+    uint64_t cleared_at; /* 1 + the core cycle of the latest of them */
+    uint64_t exti_pr;    /* MCU-68: EXTI's PR */
     uint64_t dr_writes, rx_last, shift_received, shift_start, shift_end;
-    uint64_t taken;      /* writes taken here since set-up (a count for tests and benchmarks) */
+    uint64_t taken;      /* accesses taken here since set-up (a count for tests and benchmarks) */
     uint8_t values[16];   /* what a read of each address returns (fast reads only) */
     uint8_t written_values[16];
     uint8_t plain[256];   /* upif._PLAIN_COMMANDS */
@@ -431,7 +444,8 @@ typedef struct {
 typedef struct {
     supi3_frames *frames;
     mmio_write_fn slow; /* the peripheral's write in Python */
-    uint64_t spi;       /* 0: GPIOA, 1: SPI1 */
+    uint64_t port;      /* 0: GPIOA, 1: SPI1, 2: EXTI */
+    supi3_held *held;   /* the peripheral's held register: its reads not taken here go to supi3_held_read */
 } supi3_port;
 
 /* The slot of a block's prefix cost (CortexM._prefix_slot computes the same; a PC is reached from more than one block). */
@@ -458,6 +472,28 @@ static int fast_access(const supi3_frames *f, const uint8_t *table, unsigned add
     return table[address] == 1 || (table[address] == 2 && !f->latch && now < f->latch_at);
 }
 
+/* MCU-66: the chip's I/O access bit at `now` (the bench's `io` event sets it; only a cycle's end, past `due`, clears
+ * it). */
+static uint64_t io_now(const supi3_frames *f, uint64_t now) { return f->io || now >= f->io_at; }
+
+/* MCU-67: a read of the register /IRQ follows at `now` (RegisterFile.cpu_read: its value with the live I/O access bit
+ * joined; the bits read cleared), if /IRQ's rise it may cause sets no pending bit of EXTI (Board._follow_irq: then
+ * nothing else changes, the board's request already settled when the mirror was made). The read is noted for the
+ * catch-up, which makes it in the register file. */
+static int read_clear(supi3_frames *f, unsigned address, uint64_t now, uint64_t *driven) {
+    uint8_t value = f->values[address];
+    uint8_t left = (uint8_t)(value & ~f->irq_clear);
+    if (left == 0 && f->irq_level == 0 && f->exti_rise) {
+        return 0;
+    }
+    *driven = value | (io_now(f, now) << f->io_bit);
+    f->values[address] = left;
+    f->irq_level = left == 0;
+    f->cleared += 1;
+    f->cleared_at = now + 1;
+    return 1;
+}
+
 /* /SS fell at `now`: Board._ss_edge's t8 check and UpifProtocol.begin, if plain. */
 static int frame_fall(supi3_frames *f, uint64_t now) {
     if (f->frame_open || (int64_t)now - f->ss_rise < f->least_t8) {
@@ -468,10 +504,15 @@ static int frame_fall(supi3_frames *f, uint64_t now) {
         unsigned command = (unsigned)f->command & 0xFF;
         unsigned address = f->address[command];
         if (f->rd[command] && f->reads_register[address]) {
-            if (!fast_access(f, f->fast_read, address, now)) {
+            if (address == f->irq_address) {
+                if (!read_clear(f, address, now, &driven)) {
+                    return 0;
+                }
+            } else if (!fast_access(f, f->fast_read, address, now)) {
                 return 0;
+            } else {
+                driven = f->values[address];
             }
-            driven = f->values[address];
         }
     } else if (f->phase != f->phase_command) {
         return 0;
@@ -556,14 +597,36 @@ static int frame_byte(supi3_frames *f, uint64_t now, uint64_t value) {
     return 1;
 }
 
-/* The write callback (uc_cb_mmio_write_t) of GPIOA and SPI1: a frame's edge or byte taken here, or Python's write. */
+/* MCU-68: EXTI's register `offset` written with `value`: PR (Exti.write: a 1 clears its bit) taken here at the access's
+ * time, if no bus event is due (Board._exti_write synchronises the bus first). Its request (Board._request) has nothing
+ * to do: the mirror is valid only while /IRQ's line does not request or its exception is active or pending (refresh),
+ * and a write of PR only clears bits. */
+static int exti_write(supi3_frames *f, uint64_t offset, uint64_t value) {
+    uint64_t now = 0;
+    if (offset != f->exti_pr_offset || !frames_now(f, &now) || now >= f->due) {
+        return 0;
+    }
+    f->exti_pr &= ~value;
+    f->synced = now + 1;
+    f->pending = 1;
+    f->state->handed = now;
+    return 1;
+}
+
+/* The write callback (uc_cb_mmio_write_t) of GPIOA, SPI1 and EXTI: a frame's edge or byte, or EXTI's PR write, taken
+ * here, or Python's write. */
 void supi3_port_write(void *uc, uint64_t offset, unsigned size, uint64_t value, void *data) {
     supi3_port *p = (supi3_port *)data;
     supi3_frames *f = p->frames;
     supi3_state *s = f->state;
     uint64_t now = 0;
     if (f->valid && !s->stop_request) {
-        if (p->spi) {
+        if (p->port == 2) {
+            if (exti_write(f, offset, value)) {
+                f->taken += 1;
+                return;
+            }
+        } else if (p->port == 1) {
             if (offset == f->spi_dr && frames_now(f, &now) && now < f->due && frame_byte(f, now, value)) {
                 f->synced = now + 1;
                 f->pending = 1;
@@ -595,6 +658,50 @@ void supi3_port_write(void *uc, uint64_t offset, unsigned size, uint64_t value, 
     p->slow(uc, offset, size, value, 0);
 }
 
+/* MCU-66: GPIOA's register `offset` as Gpio.read would answer it at `now`, if a pure function of the mirrored state:
+ * IDR (the chip's /IRQ, C/D and I/O access pins by Board._inputs, the outputs' ODR), ODR, and the offsets that read 0;
+ * not CRL and CRH (not mirrored). The inputs need the bus synchronised to `now` without a bus event (`due`); the I/O
+ * access bit is set by the bench's `io` event, which the synchronisation runs from `io_at` on; C/D follows the phase
+ * from t6 max after /SS rose, the level before until then. */
+static int gpio_read(supi3_frames *f, uint64_t offset, uint64_t *value) {
+    if (offset == 0xC) {
+        *value = f->odr;
+        return 1;
+    }
+    if (offset >= 0x10) {
+        *value = 0;
+        return 1;
+    }
+    uint64_t now = 0;
+    if (offset != 0x8 || !frames_now(f, &now) || now >= f->due) {
+        return 0;
+    }
+    uint64_t io = io_now(f, now);
+    uint64_t cd = f->cd_before;
+    if ((int64_t)now >= f->ss_rise + f->least_t6max) {
+        cd = f->phase == f->phase_command ? f->cd_command : f->cd_data;
+    }
+    uint64_t inputs = (f->irq_level << f->irq_pin) | (cd << f->cd_pin) | (io << f->io_pin);
+    *value = ((inputs & ~f->gpio_mask) | (f->odr & f->gpio_mask)) & 0xFFFF;
+    f->synced = now + 1;
+    f->pending = 1;
+    f->state->handed = now;
+    return 1;
+}
+
+/* The read callback (uc_cb_mmio_read_t) of GPIOA, SPI1 and EXTI: a GPIOA read taken here (MCU-66), or the held register's
+ * read (supi3_held_read), which answers SPI1's held and offered registers and calls Python's read for the rest. */
+uint64_t supi3_port_read(void *uc, uint64_t offset, unsigned size, void *data) {
+    supi3_port *p = (supi3_port *)data;
+    supi3_frames *f = p->frames;
+    uint64_t value = 0;
+    if (p->port == 0 && f->valid && !f->state->stop_request && f->gpio_ok && gpio_read(f, offset, &value)) {
+        f->taken += 1;
+        return value;
+    }
+    return supi3_held_read(uc, offset, size, p->held);
+}
+
 /* The layout of the structs above as this compiler lays them out: the number of values after it, the struct's size, then each
  * field's offset in the order of its declaration. supi3.mcu.hook checks its ctypes mirrors against them when it loads
  * the library (MCU-25): a mismatch is a NativeHookError, not memory written at the wrong place. */
@@ -624,19 +731,23 @@ const uint32_t supi3_held_layout[] = {
 const uint32_t supi3_prefix_layout[] = {
     4, sizeof(supi3_prefix), AT(supi3_prefix, address), AT(supi3_prefix, pc), AT(supi3_prefix, cycles)};
 const uint32_t supi3_frames_layout[] = {
-    63, sizeof(supi3_frames), AT(supi3_frames, state), AT(supi3_frames, spi), AT(supi3_frames, prefixes),
+    78, sizeof(supi3_frames), AT(supi3_frames, state), AT(supi3_frames, spi), AT(supi3_frames, prefixes),
     AT(supi3_frames, prefix_mask), AT(supi3_frames, least_t1), AT(supi3_frames, least_t2),
     AT(supi3_frames, least_t8), AT(supi3_frames, ss_pin), AT(supi3_frames, cd_command), AT(supi3_frames, cd_data),
     AT(supi3_frames, phase_command), AT(supi3_frames, phase_data), AT(supi3_frames, sr_txe),
     AT(supi3_frames, sr_bsy), AT(supi3_frames, sr_rxne), AT(supi3_frames, spi_dr), AT(supi3_frames, spi_sr),
+    AT(supi3_frames, least_t6max), AT(supi3_frames, irq_pin), AT(supi3_frames, cd_pin), AT(supi3_frames, io_pin),
+    AT(supi3_frames, irq_address), AT(supi3_frames, irq_clear), AT(supi3_frames, io_bit),
+    AT(supi3_frames, exti_pr_offset),
     AT(supi3_frames, valid), AT(supi3_frames, due), AT(supi3_frames, latch), AT(supi3_frames, latch_at),
     AT(supi3_frames, gpio_ok), AT(supi3_frames, gpio_mask), AT(supi3_frames, gpio_pulled_up),
     AT(supi3_frames, gpio_levels), AT(supi3_frames, spi_ok), AT(supi3_frames, period), AT(supi3_frames, sr_modf),
-    AT(supi3_frames, pending), AT(supi3_frames, odr), AT(supi3_frames, synced), AT(supi3_frames, phase),
+    AT(supi3_frames, io), AT(supi3_frames, io_at), AT(supi3_frames, exti_rise), AT(supi3_frames, pending), AT(supi3_frames, odr), AT(supi3_frames, synced), AT(supi3_frames, phase),
     AT(supi3_frames, command), AT(supi3_frames, last_rx), AT(supi3_frames, frame_open),
     AT(supi3_frames, frame_fall), AT(supi3_frames, frame_driven), AT(supi3_frames, transfer),
     AT(supi3_frames, transfer_seen), AT(supi3_frames, transfer_start), AT(supi3_frames, transfer_period),
-    AT(supi3_frames, ss_rise), AT(supi3_frames, cd_before), AT(supi3_frames, written), AT(supi3_frames, dr_writes),
+    AT(supi3_frames, ss_rise), AT(supi3_frames, cd_before), AT(supi3_frames, irq_level), AT(supi3_frames, written),
+    AT(supi3_frames, cleared), AT(supi3_frames, cleared_at), AT(supi3_frames, exti_pr), AT(supi3_frames, dr_writes),
     AT(supi3_frames, rx_last), AT(supi3_frames, shift_received), AT(supi3_frames, shift_start),
     AT(supi3_frames, shift_end), AT(supi3_frames, taken), AT(supi3_frames, values),
     AT(supi3_frames, written_values), AT(supi3_frames, plain), AT(supi3_frames, address), AT(supi3_frames, rd),
@@ -644,4 +755,4 @@ const uint32_t supi3_frames_layout[] = {
     AT(supi3_frames, fast_read), AT(supi3_frames, fast_write), AT(supi3_frames, write_mask),
     AT(supi3_frames, alias)};
 const uint32_t supi3_port_layout[] = {
-    4, sizeof(supi3_port), AT(supi3_port, frames), AT(supi3_port, slow), AT(supi3_port, spi)};
+    5, sizeof(supi3_port), AT(supi3_port, frames), AT(supi3_port, slow), AT(supi3_port, port), AT(supi3_port, held)};

@@ -170,6 +170,14 @@ class Frames(ctypes.Structure):
         ("sr_rxne", ctypes.c_uint64),
         ("spi_dr", ctypes.c_uint64),
         ("spi_sr", ctypes.c_uint64),
+        ("least_t6max", ctypes.c_int64),
+        ("irq_pin", ctypes.c_uint64),
+        ("cd_pin", ctypes.c_uint64),
+        ("io_pin", ctypes.c_uint64),
+        ("irq_address", ctypes.c_uint64),
+        ("irq_clear", ctypes.c_uint64),
+        ("io_bit", ctypes.c_uint64),
+        ("exti_pr_offset", ctypes.c_uint64),
         ("valid", ctypes.c_uint64),
         ("due", ctypes.c_uint64),
         ("latch", ctypes.c_uint64),
@@ -181,6 +189,9 @@ class Frames(ctypes.Structure):
         ("spi_ok", ctypes.c_uint64),
         ("period", ctypes.c_uint64),
         ("sr_modf", ctypes.c_uint64),
+        ("io", ctypes.c_uint64),
+        ("io_at", ctypes.c_uint64),
+        ("exti_rise", ctypes.c_uint64),
         ("pending", ctypes.c_uint64),
         ("odr", ctypes.c_uint64),
         ("synced", ctypes.c_uint64),
@@ -196,7 +207,11 @@ class Frames(ctypes.Structure):
         ("transfer_period", ctypes.c_uint64),
         ("ss_rise", ctypes.c_int64),
         ("cd_before", ctypes.c_uint64),
+        ("irq_level", ctypes.c_uint64),
         ("written", ctypes.c_uint64),
+        ("cleared", ctypes.c_uint64),
+        ("cleared_at", ctypes.c_uint64),
+        ("exti_pr", ctypes.c_uint64),
         ("dr_writes", ctypes.c_uint64),
         ("rx_last", ctypes.c_uint64),
         ("shift_received", ctypes.c_uint64),
@@ -219,9 +234,12 @@ class Frames(ctypes.Structure):
 
 
 class Port(ctypes.Structure):
-    """The user data of :func:`supi3_port_write`, GPIOA's or SPI1's write in native code (``supi3_port``)."""
+    """The user data of :func:`supi3_port_write` and :func:`supi3_port_read`, GPIOA's, SPI1's or EXTI's write and read
+    in native code (``supi3_port``): the frames, Python's write, which peripheral (0: GPIOA, 1: SPI1, 2: EXTI), and the
+    held register its other reads go to (:func:`supi3_held_read`)."""
 
-    _fields_ = (("frames", ctypes.POINTER(Frames)), ("slow", MMIO_WRITE), ("spi", ctypes.c_uint64))
+    _fields_ = (("frames", ctypes.POINTER(Frames)), ("slow", MMIO_WRITE), ("port", ctypes.c_uint64),
+                ("held", ctypes.POINTER(Held)))
 
 
 _LOADED: list[ctypes.CDLL] = []

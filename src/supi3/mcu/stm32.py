@@ -21,6 +21,7 @@ __all__ = [
     "APB2RSTR",
     "EXTI0_IRQ",
     "EXTI_BASE",
+    "EXTI_PR",
     "GPIOA_BASE",
     "GPIOB_BASE",
     "PERIPHERAL_SIZE",
@@ -47,6 +48,8 @@ PERIPHERAL_SIZE: Final[int] = 0x400
 """Each peripheral's address block (RM0008 3.3, Table 3)."""
 EXTI0_IRQ: Final[int] = 6
 """The EXTI line 0 interrupt in the STM32F10x vector table (RM0008 10.1.2, Table 63)."""
+EXTI_PR: Final[int] = 0x14
+"""EXTI's pending register, by its offset (RM0008 10.3.6: a 1 written clears its bit)."""
 
 APB2RSTR: Final[int] = 0x0C
 """RCC_APB2RSTR (RM0008 7.3.4): a peripheral's reset bit is at the place of its clock enable bit in APB2ENR."""
@@ -254,11 +257,15 @@ class Exti:
 
     def edge(self, port: int, pin: int, level: int) -> None:
         """Pin ``pin`` of port ``port`` (0 = A) went to ``level``."""
-        if pin >= 4 or (self.exticr1 >> (4 * pin)) & 0xF != port:
-            return
-        trigger = self.rtsr if level else self.ftsr
-        if trigger >> pin & 1:
+        if self.triggers(port, pin, level):
             self.pr |= 1 << pin
+
+    def triggers(self, port: int, pin: int, level: int) -> bool:
+        """Whether pin ``pin`` of port ``port`` going to ``level`` sets its line's pending bit: the line selects that
+        port (EXTICR1) and the edge's trigger is enabled (RTSR, FTSR)."""
+        if pin >= 4 or (self.exticr1 >> (4 * pin)) & 0xF != port:
+            return False
+        return bool((self.rtsr if level else self.ftsr) >> pin & 1)
 
     def requesting(self, line: int) -> bool:
         """Line ``line`` asks the NVIC for its interrupt."""
@@ -280,7 +287,7 @@ class Exti:
     def read(self, offset: int, size: int) -> int:
         """IMR, EMR, RTSR, FTSR, SWIER (0), PR."""
         del size
-        return {0x0: self.imr, 0x4: self.emr, 0x8: self.rtsr, 0xC: self.ftsr, 0x14: self.pr}.get(offset, 0)
+        return {0x0: self.imr, 0x4: self.emr, 0x8: self.rtsr, 0xC: self.ftsr, EXTI_PR: self.pr}.get(offset, 0)
 
     def write(self, offset: int, size: int, value: int) -> None:
         """IMR, EMR, RTSR, FTSR, SWIER (sets PR), PR (write 1 to clear)."""
@@ -295,7 +302,7 @@ class Exti:
             self.ftsr = value
         elif offset == 0x10:
             self.pr |= value & self.imr
-        elif offset == 0x14:
+        elif offset == EXTI_PR:
             self.pr &= ~value
 
 
