@@ -887,8 +887,10 @@ class Board:
         last cycle and the last EXTI0 handler. The wait for that pass lasts at most :data:`SERVE_TELEGRAMS` status
         telegrams of bus time; :attr:`served` tells whether the run ended served. At pin level the master's cycles
         run whole, then the line idles in status telegrams while the firmware is in a handler, has an /IRQ edge to
-        serve or its pass to make, up to :data:`SERVE_TELEGRAMS` of them (MCU-17). The instruction budget bounds the
-        work between two waits of the core (MCU-41) or two passes of its main loop (MCU-43).
+        serve or its pass to make, up to :data:`SERVE_TELEGRAMS` of them (MCU-17). A cycle a transaction-level
+        :meth:`run_for` left under way ends first, then the run's ``cycles`` start (MCU-76: the pin level's
+        :meth:`run_for` has run it whole). The instruction budget bounds the work between two waits of the core
+        (MCU-41) or two passes of its main loop (MCU-43).
 
         Raises
         ------
@@ -905,7 +907,10 @@ class Board:
             The firmware touched a peripheral whose clock is off or which RCC_APB2RSTR holds in reset (MCU-7,
             MCU-29).
         """
-        target = self.cycles + check_int("cycles", cycles, 0)
+        count = check_int("cycles", cycles, 0)
+        # MCU-76: a cycle a run_for left under way (transaction level) ends first, then the run's own cycles start,
+        # as at pin level, whose run_for runs it whole
+        target = self.cycles + count + (self._bench is not None and self._bench.under_way)
         self._passes.end()
         self._serve_end = None
         self.served = False  # until the run ends served (MCU-30)
