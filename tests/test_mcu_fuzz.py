@@ -264,7 +264,7 @@ def run_on_bench(script: list[Step], **bench_options: object) -> Outcome:
     firmware = _Scripted(bench, script)
     bench.firmware = firmware
     bench.power_up()  # the whole script, the bus running along
-    bench.run(1)  # to the end of the first master cycle after it, as run_script
+    bench.run(0 if bench.under_way else 1)  # to the end of the first master cycle after it, as run_script (MCU-76)
     bench.run(1)
     return Outcome(tuple(firmware.log), _registers(bench.registers), _rules(bench.registers.violations.records),
                    bench.cycles, _inputs(bench.master), _interface(bench.transport.protocol))

@@ -765,20 +765,22 @@ class Board:
             if clocked:
                 last = start + clocked * period
             edges += clocked
-        if edges == 8 and cycles - last >= self._least_t2:  # whole and clear of t2 at any chip clock's phase
+        if edges != 8 or cycles - last < self._least_t2:  # not whole and clear of t2 at any chip clock's phase
+            edges = self._ss_rose_near_an_edge(frame, cycles)
+        if edges == 8:
             # An Intel receive frame: the chip's driver wins on Ser_IN/OUT, it takes its own byte (MCU-18).
             on_line = frame.driven if self.intel and frame.driven is not None else frame.transfers[-1][0]
             self._chip(self.protocol.end, cycles, on_line)
         else:
-            self._ss_rose_near_an_edge(frame, cycles)
+            self._chip(self.protocol.abort, cycles, edges)
 
-    def _ss_rose_near_an_edge(self, frame: SsFrame, cycles: int) -> None:
+    def _ss_rose_near_an_edge(self, frame: SsFrame, cycles: int) -> int:
         """/SS rose at core cycle ``cycles`` within a few chip clocks of t2 after the frame's last SCLK edge, or before
-        its 8th: the frame's end as the pin-level chip sees it, at chip-clock resolution (MCU-74). An SCLK rise the
-        chip sees before the /SS rise is the frame's bit (in the same clock it is not: the edge detectors act on /SS
-        first, ``SlavePins._edge``); t2 is timed from the last SCLK rise up to the /SS rise's clock (TimingChecker);
-        SerOUT stays driven until the chip reacts to the rise (:func:`~supi3.spi.slave_pins.reaction_clocks`), then
-        MISO reads its pull-up."""
+        its 8th: the frame's SCLK edges as the pin-level chip sees them, at chip-clock resolution (MCU-74). An SCLK
+        rise the chip sees before the /SS rise is the frame's bit (in the same clock it is not: the edge detectors act
+        on /SS first, ``SlavePins._edge``); t2 is timed from the last SCLK rise up to the /SS rise's clock
+        (TimingChecker); SerOUT stays driven until the chip reacts to the rise
+        (:func:`~supi3.spi.slave_pins.reaction_clocks`), then SPI1 samples MISO's pull-up."""
         cpu_hz = self._cpu_hz
         rise = chip_clock(cycles, cpu_hz)
         until = rise + self._serout_release
@@ -804,11 +806,7 @@ class Board:
             received = spi.shifting[0]
             assert type(received) is int
             spi.replace_received(released(received, bits, sampled, bool(spi.cr1 & CR1_LSBFIRST)))
-        if edges == 8:
-            on_line = frame.driven if self.intel and frame.driven is not None else frame.transfers[-1][0]
-            self._chip(self.protocol.end, cycles, on_line)
-        else:
-            self._chip(self.protocol.abort, cycles, edges)
+        return edges
 
     def spi_byte(self, tx: int, bits: int, start: int, period: int, cr1: int) -> int:
         """:class:`~supi3.mcu.stm32.SpiWire`: SPI1 starts a transfer; the chip sees it inside its /SS frame."""
