@@ -429,7 +429,7 @@ RUNNING_RECONFIGURATIONS: Final[list[list[Step]]] = [
 ]
 """Bodies served after the VALID interrupt that write SET or ID while the bus runs (MCU-64). ExtReg = 0: with
 ExtReg = 1 and nothing on FromExR the data cycles after the rediscovery differ by RX-11 (the pin-level chip sends
-FromExR's level, the transaction level zeros for its own bytes)."""
+FromExR's level, the transaction level zeros for its own bytes; a recorded limit, RX-12)."""
 
 
 @pytest.mark.parametrize("body", RUNNING_RECONFIGURATIONS)

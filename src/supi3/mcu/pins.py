@@ -109,7 +109,7 @@ def released(word: int, bits: int, sampled: int, lsb_first: bool) -> int:
     the first ``sampled`` sampling edges only and releases it then (/SS rose, MCU-74): those bits of ``word``, and
     MISO's pull-up (:data:`MISO_PULL_UP`, MCU-6) for the rest, as :meth:`LockstepRing.spi_byte` samples the pins."""
     late = (1 << bits) - (1 << sampled) if lsb_first else (1 << (bits - sampled)) - 1  # the bits sampled after
-    return word | late if MISO_PULL_UP else word & ~late
+    return word | late  # MISO_PULL_UP: they read 1
 
 
 @dataclass(frozen=True)

@@ -827,8 +827,9 @@ class Bench:
 
     @property
     def under_way(self) -> bool:
-        """A master cycle has started and not ended: a :meth:`run_for` ended inside it. The next run ends it first and
-        then runs its cycles (MCU-76: as at pin level, whose ``run_for`` runs the cycles it starts whole, MCU-22)."""
+        """A master cycle has started and not ended: a :meth:`run_for`, :meth:`power_up`'s set-up or a run that raised
+        ended inside it. The next run ends it first and then runs its cycles (MCU-76: as at pin level, whose
+        ``run_for`` runs the cycles it starts whole, MCU-22)."""
         return bool(self.timeline) and self.timeline[-1].end > self.now
 
     def hold_after(self, cycles: int) -> None:
