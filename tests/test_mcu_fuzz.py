@@ -390,6 +390,23 @@ def test_a_short_script_does_the_same_at_both_fidelities(scripted: dict[str, Pat
     assert run_script(elf, script, pedantic=True) == run_script(elf, script, fidelity="pin", pedantic=True)
 
 
+@pytest.mark.parametrize("bit_rate", [500_000, 2_000_000])
+@pytest.mark.parametrize("cpu", ["cortex_m3", "cortex_m0"])
+def test_frames_cut_anywhere_do_the_same_at_both_fidelities(scripted: dict[str, Path], cpu: str,
+                                                            bit_rate: int) -> None:  # fmt: skip
+    """MCU-74: :data:`CUT_FRAMES` on both cores (their own instruction timing puts the cuts elsewhere against the
+    edges) and at both bit rates (the chip's reaction to /SS is 9 chip clocks at 500 kbit/s, 3 at 2 Mbit/s): the
+    bytes SPI1 received, the t2 and 3.4.2 violations and the interface's phase are the same at both fidelities, and
+    the cuts reach the cases they are for (t2 broken, bytes cut short)."""
+    outcomes = [run_script(scripted[cpu], CUT_FRAMES, cpu=cpu, bit_rate=bit_rate, fidelity=fidelity, pedantic=True)
+                for fidelity in ("transaction", "pin")]  # fmt: skip
+    assert outcomes[0] == outcomes[1]
+    rules = dict(outcomes[0].violations)
+    assert rules.get("Table 3-7 t2", 0) > 0 and rules.get("3.4.2", 0) > 0
+    received = {entry[1] for entry in outcomes[0].log[3:]}
+    assert {0xFF, 0xA5} < received and len(received) > 4  # nothing sampled, the whole byte, and bits of it
+
+
 @st.composite
 def synced_scripts(draw: st.DrawFn) -> list[Step]:
     """A short prefix, the recovery and the wait for /IRQ, a body in the idle gap; no timed read: the pin-level latch
