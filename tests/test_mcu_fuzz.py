@@ -1,4 +1,4 @@
-"""A hostile, random differential test of the firmware path (issue #13; docs/assumptions/mcu.md MCU-59 to 61, 63).
+"""A hostile, random differential test of the firmware path (issue #13; docs/assumptions/mcu.md MCU-59 to 61, 63, 74).
 
 ``mcu/scripted.c`` is a firmware whose behaviour is data: its ``fw_setup`` runs a script of driver calls, raw frames
 and deliberately bad SPI1 use that the test writes into its ``fw_script`` (flash) before the first run, and keeps
