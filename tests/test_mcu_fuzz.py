@@ -1,4 +1,4 @@
-"""A hostile, random differential test of the firmware path (issue #13; docs/assumptions/mcu.md MCU-59 to 61, 63).
+"""A hostile, random differential test of the firmware path (issue #13; docs/assumptions/mcu.md MCU-59 to 61, 63, 74).
 
 ``mcu/scripted.c`` is a firmware whose behaviour is data: its ``fw_setup`` runs a script of driver calls, raw frames
 and deliberately bad SPI1 use that the test writes into its ``fw_script`` (flash) before the first run, and keeps
@@ -33,7 +33,7 @@ from supi3.interbus.errors import InterbusError
 from supi3.interbus.master import Master
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import MISO_IDLE, Board
-from supi3.mcu.pins import ss_high_byte
+from supi3.mcu.pins import released, ss_high_byte
 from supi3.model.registers import InterfaceViolationError, RegisterFile
 from supi3.regmap import REGISTER_MAP
 from supi3.regmap.core import AccessDirection
@@ -56,6 +56,8 @@ LATCH_POLLS_PER_UNIT: Final = 10_000
 the I/O pin at most (a + 1) * 10,000 times without a pause."""
 SPI_BIT_S: Final = 64 / 48e6
 """One SCLK period of the board port (BR = 5 at 48 MHz): what a byte with /SS cut short counts its edges in."""
+HALF_PERIOD: Final = 8
+"""``SS_CUT``'s c for a cut half an SCLK period after the b-th edge (8 spin units of 4 core clocks, MCU-61)."""
 CYCLE_TIME_S: Final = 2e-3
 """The master's cycle time on both sides: data cycles with long idle gaps between them, so that the two firmware
 clocks (the board's instructions, the bench's Table 3-7 byte times, FW-1) rarely straddle a bus event (MCU-60)."""
@@ -210,11 +212,12 @@ class _Scripted(Firmware):
             bench.advance(bench.now + bench.byte_s)  # the board's oracle: the chip sees nothing (3.4.2)
             transport.registers.violations.report(ss_high_byte(a))
             result[0] = MISO_IDLE
-        elif op == Op.SS_CUT:
+        elif op == Op.SS_CUT:  # half a period after the b-th edge (HALF_PERIOD): b bits of the chip's byte
             bench.advance(bench.now)
-            protocol.begin(True)
+            driven = protocol.begin(True)
             bench.advance(bench.now + (b + 1) * SPI_BIT_S)
             protocol.abort(b)  # 3.4.2: a frame cut short is dropped
+            result[0] = released(MISO_IDLE if driven is None else driven, 8, b, False)  # then MISO's pull-up (MCU-74)
             bench.irq_edge()
             bench.advance(bench.now + 8 * SPI_BIT_S)
         elif op == Op.LATCH:
@@ -261,7 +264,7 @@ def run_on_bench(script: list[Step], **bench_options: object) -> Outcome:
     firmware = _Scripted(bench, script)
     bench.firmware = firmware
     bench.power_up()  # the whole script, the bus running along
-    bench.run(1)  # to the end of the first master cycle after it, as run_script
+    bench.run(0 if bench.under_way else 1)  # to the end of the first master cycle after it, as run_script (MCU-76)
     bench.run(1)
     return Outcome(tuple(firmware.log), _registers(bench.registers), _rules(bench.registers.violations.records),
                    bench.cycles, _inputs(bench.master), _interface(bench.transport.protocol))
@@ -285,13 +288,16 @@ INIT_BYTES: Final = {Mode.MOTOROLA: 0, Mode.INTEL: 1}
 """scripted.c's INIT argument for each mode (supi3_mode_t)."""
 
 
-def untimed(mode: Mode = Mode.MOTOROLA, *, other_mode: bool = False) -> st.SearchStrategy[tuple[int, int, int, int]]:
+def untimed(mode: Mode = Mode.MOTOROLA, *, other_mode: bool = False,
+            any_cut: bool = False) -> st.SearchStrategy[tuple[int, int, int, int]]:  # fmt: skip
     """Steps whose results do not hang on the bus's timing (MCU-60): before the master's first cycle (1 ms, MCU-45)
     six of them take well under a millisecond on either clock. The initialization in the board's ``mode`` or in
     none (7: ``SUPI3_E_ARG``), with ``other_mode`` in the other mode too: a board wired for one mode sends the other's
     bytes in the wrong bit order and S/R, which the firmware bench, whose transport leaves the bit order to the
     wiring, does not model (MCU-60). The Intel board has no step that drives SPI1 directly (its S/R line, PB0, is
-    the transport's, MCU-18)."""
+    the transport's, MCU-18). A frame cut short (``SS_CUT``) ends half an SCLK period after an edge, whose bits the
+    bench's firmware counts, or with ``any_cut`` at any point of the byte, within t2 of an edge and across the chip
+    clock's phase too, for the comparison of the fidelities (MCU-74)."""
     own = INIT_BYTES[mode]
     modes = (own, own, own, 7, 1 - own) if other_mode else (own, own, own, 7)
     steps = [
@@ -305,7 +311,9 @@ def untimed(mode: Mode = Mode.MOTOROLA, *, other_mode: bool = False) -> st.Searc
         st.tuples(st.just(Op.RAW), BYTE, st.just(0), st.just(0)),
     ]
     if mode is Mode.MOTOROLA:
-        steps.append(st.tuples(st.just(Op.SS_CUT), BYTE, st.integers(0, 7), st.just(0)))
+        cut = (st.tuples(st.just(Op.SS_CUT), BYTE, st.integers(0, 8), st.integers(0, 15)) if any_cut
+               else st.tuples(st.just(Op.SS_CUT), BYTE, st.integers(0, 7), st.just(HALF_PERIOD)))  # fmt: skip
+        steps.append(cut)
         steps.append(st.tuples(st.just(Op.SS_HIGH), BYTE, st.just(0), st.just(0)))
     return st.one_of(steps)
 
@@ -318,6 +326,14 @@ def recover(mode: Mode) -> list[Step]:
             (Op.IRQ_ENABLE, 0x10, 0, 0), (Op.IRQ_SERVICE, 0, 0, 0), (Op.WAIT_IRQ, 40, 0, 0)]  # fmt: skip
 
 
+CUT_FRAMES: Final[list[Step]] = [
+    (Op.INIT, 0, 0, 0), (Op.CONFIG, 0x83, 0xA5, 0),
+    (Op.RAW, 0x8C, 0, 0),  # a read of ID: each cut frame drives its data byte, A5h, until a whole one ends it
+    *((Op.SS_CUT, 0x00, b, c) for b in range(9) for c in (1, 11, 13, 14)),
+]  # fmt: skip
+"""Frames cut at each edge of the byte, at four points of each SCLK period: just after the rising edge (t2), in the
+chip's reaction time before the next (SerOUT still driven), and around the edge itself (the chip takes an SCLK rise
+only in a clock before /SS rises; MCU-74)."""
 NO_SHRINK: Final = (Stage.explicit, Stage.reuse, Stage.generate)
 """An example costs up to half a second of bus emulation: a failure prints its script as generated (shrinking one
 took over five minutes)."""
@@ -363,8 +379,9 @@ def test_an_intel_script_on_the_binary_does_what_the_python_driver_does_on_the_b
 
 
 @settings(max_examples=4, phases=NO_SHRINK)
-@given(script=st.lists(untimed(other_mode=True), min_size=1, max_size=6))
-@example(script=[(Op.SS_HIGH, 0x0B, 0, 0), (Op.SS_CUT, 0x00, 2, 0)])  # 3.4.2 twice at both fidelities (MCU-63)
+@given(script=st.lists(untimed(other_mode=True, any_cut=True), min_size=1, max_size=6))
+@example(script=[(Op.SS_HIGH, 0x0B, 0, 0), (Op.SS_CUT, 0x00, 2, HALF_PERIOD)])  # 3.4.2 twice at both (MCU-63)
+@example(script=CUT_FRAMES)  # MCU-74: the bits SPI1 received, t2 and the edges the chip took, at every cut
 def test_a_short_script_does_the_same_at_both_fidelities(scripted: dict[str, Path], script: list[Step]) -> None:
     """(b) Short scripts, all before the master's first cycle (the pin level's discovery ID cycle is not the
     transaction level's, MCU-17), on the binary at transaction and at pin level."""
@@ -373,13 +390,30 @@ def test_a_short_script_does_the_same_at_both_fidelities(scripted: dict[str, Pat
     assert run_script(elf, script, pedantic=True) == run_script(elf, script, fidelity="pin", pedantic=True)
 
 
+@pytest.mark.parametrize("bit_rate", [500_000, 2_000_000])
+@pytest.mark.parametrize("cpu", ["cortex_m3", "cortex_m0"])
+def test_frames_cut_anywhere_do_the_same_at_both_fidelities(scripted: dict[str, Path], cpu: str,
+                                                            bit_rate: int) -> None:  # fmt: skip
+    """MCU-74: :data:`CUT_FRAMES` on both cores (their own instruction timing puts the cuts elsewhere against the
+    edges) and at both bit rates (the chip's reaction to /SS is 9 chip clocks at 500 kbit/s, 3 at 2 Mbit/s): the
+    bytes SPI1 received, the t2 and 3.4.2 violations and the interface's phase are the same at both fidelities, and
+    the cuts reach the cases they are for (t2 broken, bytes cut short)."""
+    outcomes = [run_script(scripted[cpu], CUT_FRAMES, cpu=cpu, bit_rate=bit_rate, fidelity=fidelity, pedantic=True)
+                for fidelity in ("transaction", "pin")]  # fmt: skip
+    assert outcomes[0] == outcomes[1]
+    rules = dict(outcomes[0].violations)
+    assert rules.get("Table 3-7 t2", 0) > 0 and rules.get("3.4.2", 0) > 0
+    received = {entry[1] for entry in outcomes[0].log[3:]}
+    assert {0xFF, 0xA5} < received and len(received) > 4  # nothing sampled, the whole byte, and bits of it
+
+
 @st.composite
 def synced_scripts(draw: st.DrawFn) -> list[Step]:
     """A short prefix, the recovery and the wait for /IRQ, a body in the idle gap; no timed read: the pin-level latch
     phase is the time between the two latch telegrams' receipt, not the transaction level's (docs/model.md M10)."""
-    body = st.one_of(untimed(), st.tuples(st.just(Op.POLL_IO), BYTE, st.just(0), st.just(0)),
+    body = st.one_of(untimed(any_cut=True), st.tuples(st.just(Op.POLL_IO), BYTE, st.just(0), st.just(0)),
                      st.tuples(st.just(Op.DELAY), st.integers(0, 120), st.just(0), st.just(0)))  # fmt: skip
-    script = [*draw(st.lists(untimed(), max_size=3)), *recover(Mode.MOTOROLA),
+    script = [*draw(st.lists(untimed(any_cut=True), max_size=3)), *recover(Mode.MOTOROLA),
               *draw(st.lists(body, min_size=1, max_size=4))]  # fmt: skip
     return [(int(op), a, b, c) for op, a, b, c in script]
 
@@ -390,7 +424,7 @@ RECONFIGURED: Final = "3.4.3, 3.4.11"
 
 @settings(max_examples=2, phases=NO_SHRINK)
 @given(script=synced_scripts())
-@example(script=[(Op.SS_CUT, 0x1D, 6, 0), *recover(Mode.MOTOROLA), (Op.BLOCK, 2, 2, 0x5A),
+@example(script=[(Op.SS_CUT, 0x1D, 6, HALF_PERIOD), *recover(Mode.MOTOROLA), (Op.BLOCK, 2, 2, 0x5A),
                  (Op.CONFIG, 0x77, 0xBB, 0)])  # SET written while the bus runs: 28 bytes against 2 before MCU-64
 def test_a_script_served_after_an_interrupt_does_the_same_at_both_fidelities(
         scripted: dict[str, Path], script: list[Step]) -> None:  # fmt: skip
@@ -412,7 +446,7 @@ RUNNING_RECONFIGURATIONS: Final[list[list[Step]]] = [
 ]
 """Bodies served after the VALID interrupt that write SET or ID while the bus runs (MCU-64). ExtReg = 0: with
 ExtReg = 1 and nothing on FromExR the data cycles after the rediscovery differ by RX-11 (the pin-level chip sends
-FromExR's level, the transaction level zeros for its own bytes)."""
+FromExR's level, the transaction level zeros for its own bytes; a recorded limit, RX-12)."""
 
 
 @pytest.mark.parametrize("body", RUNNING_RECONFIGURATIONS)
@@ -441,7 +475,7 @@ EVERY_OP: Final[list[Step]] = [
     (Op.INIT, 0, 0, 0), (Op.CONFIG, 0x83, 0x03, 0),
     (Op.IRQ_ENABLE, 0x80, 0, 0), (Op.IRQ_ENABLE, 0x10, 0, 0), (Op.READ, 12, 0, 0), (Op.RAW, 0x8D, 0, 0),
     (Op.RAW, 0, 0, 0), (Op.BLOCK, 3, 4, 0), (Op.BLOCK, 3, 2, 0x12), (Op.READ, 4, 0, 0), (Op.WRITE, 9, 1, 0),
-    (Op.EXCHANGE, 7, 0x5A, 0), (Op.SS_HIGH, 0x55, 0, 0), (Op.SS_CUT, 0x8E, 3, 0), (Op.DELAY, 20, 0, 0),
+    (Op.EXCHANGE, 7, 0x5A, 0), (Op.SS_HIGH, 0x55, 0, 0), (Op.SS_CUT, 0x8E, 3, HALF_PERIOD), (Op.DELAY, 20, 0, 0),
     (Op.WAIT_IRQ, 40, 0, 0), (Op.IRQ_SERVICE, 0, 0, 0), (Op.POLL_IO, 0, 0, 0), (Op.POLL_IO, 5, 0, 0),
     (Op.BLOCK, 3, 2, 0x34),
     (Op.LATCH, 117, 0, 3), (Op.READ, 15, 0, 0),

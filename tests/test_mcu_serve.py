@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from supi3.cli import FIRMWARE_FAILED_STATUS, main
@@ -638,9 +638,10 @@ def stuck_handler(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return mcu_build.build(source, folder / "stuck_handler.elf", defines={"BOARD_SPI_BR": "3u"})
 
 
-def _hold_step(board: Board, stuck: bool, wait_s: float, cycles: int) -> tuple[int, bool, float]:
+def _hold_step(board: Board, stuck: bool, wait_s: float, cycles: int) -> tuple[int, int, bool, float]:
     """One step of a history: input byte 1 EEh (the handler spins) or not, a ``run_for`` (0: none), ``run``; (the
-    run's master cycles, served, its bus time after its last cycle's start at transaction level, else 0)."""
+    master cycles finished before the run, and after it, served, its bus time after its last cycle's start at
+    transaction level, else 0)."""
     assert board.fw_board is not None
     board.fw_board.inputs = bytes([0x5A, 0xEE if stuck else 0x11])
     if wait_s:
@@ -648,39 +649,41 @@ def _hold_step(board: Board, stuck: bool, wait_s: float, cycles: int) -> tuple[i
     before = board.cycles
     board.run(cycles)
     tail = board.now - board.bench.timeline[-1].end if board.fidelity == "transaction" else 0.0
-    return board.cycles - before, board.served, tail
+    return before, board.cycles, board.served, tail
 
 
 @settings(max_examples=6, derandomize=True, deadline=None)
 @given(history=st.lists(st.tuples(st.booleans(), st.sampled_from([0.0, 20e-6, 100e-6]), st.integers(0, 3)),
                         min_size=1, max_size=3))  # fmt: skip
+@example(history=[(False, 100e-6, 0), (False, 20e-6, 0), (True, 20e-6, 1)])  # run(0) after a cut (MCU-76)
 def test_run_n_runs_exactly_n_cycles_then_waits_boundedly_alike_at_both_fidelities(
     stuck_handler: Path, history: list[tuple[bool, float, int]]
 ) -> None:
     """MCU-55 over random histories in issue #13's case (2 Mbit/s back to back, the handler outlasting a master
-    cycle), some runs with a handler that spins until the next step: ``run(n)`` runs exactly n master cycles at both
-    fidelities (a cycle a ``run_for`` left under way at transaction level is the run's first: run(0) follows no
-    ``run_for`` here); the wait after the last cycle lasts at most SERVE_TELEGRAMS status telegrams (transaction
-    level: the run ends within a microsecond of the bound after the last cycle's end; the pin level's bus time within
-    5 µs of it until a ``run_for``, the line idling in whole telegrams), a spinning handler's run ending there
-    unserved, every other run served; the same cycles and verdict at both fidelities. Before, the transaction
-    level's run(3) after power-up ran 13 master cycles, and a spinning handler froze its bus (MCU-44: no stop while
-    EXTI0 runs) until the instruction budget ran out, 416 ms of bus time later."""
+    cycle), some runs with a handler that spins until the next step: ``run(n)`` starts exactly n master cycles at both
+    fidelities, after a cycle a ``run_for`` left under way at transaction level, which ends first (MCU-76: at pin
+    level the ``run_for`` ran it whole, MCU-22), so that both have finished the same cycles after every run, ``run(0)``
+    too; the wait after the last cycle lasts at most SERVE_TELEGRAMS status telegrams (transaction level: the run ends
+    within a microsecond of the bound after the last cycle's end; the pin level's bus time within 5 µs of it, the line
+    idling in whole telegrams), a spinning handler's run ending there unserved, every other run served; the same
+    cycles and verdict at both fidelities. Before, the transaction level's run(3) after power-up ran 13 master cycles,
+    and a spinning handler froze its bus (MCU-44: no stop while EXTI0 runs) until the instruction budget ran out,
+    416 ms of bus time later; before MCU-76 a run(0) after a cut ended with the cycle still under way, or saw it end
+    in its wait."""
     boards = [Board(stuck_handler, bit_rate=2_000_000, strict=False, fidelity=fidelity)
               for fidelity in ("transaction", "pin")]  # fmt: skip
     for board in boards:
         board.run(3)
         assert board.cycles == 3 and board.served
     wait_s = SERVE_TELEGRAMS * boards[0]._telegram_s
-    alike = True  # the same bus time until a run_for (the pin level's runs the cycles it starts whole, MCU-22)
     for stuck, run_for_s, cycles in history:
-        cycles = max(cycles, 1) if run_for_s else cycles
-        (ran, served, tail), (pin_ran, pin_served, _) = (_hold_step(board, stuck, run_for_s, cycles)
-                                                          for board in boards)  # fmt: skip
-        assert ran == pin_ran == cycles
+        (before, after, served, tail), (pin_before, pin_after, pin_served, _) = (
+            _hold_step(board, stuck, run_for_s, cycles) for board in boards)  # fmt: skip
+        assert pin_after - pin_before == cycles
+        assert after == pin_after and after - before in (cycles, cycles + 1)
+        assert not boards[0].bench.under_way
         assert served == pin_served
         if cycles:  # (a run(0) waits for a handler the run before left spinning, if any)
             assert served is not stuck
             assert tail <= wait_s + 1e-6 and (not stuck or tail >= wait_s - 1e-6)
-        alike = alike and not run_for_s
-        assert not alike or abs(boards[0].now - boards[1].now) <= 5e-6
+        assert abs(boards[0].now - boards[1].now) <= 5e-6

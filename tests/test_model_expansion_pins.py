@@ -167,14 +167,21 @@ def test_without_extreg_the_pins_stay_idle() -> None:
 def test_nothing_on_from_exr_breaks_the_ring_at_pin_level() -> None:
     """RX-2, RX-11: with ExtReg = 1 and FromExR held (grounded or high) every data bit the chip sends is that level,
     the loopback word included: the master sees a loopback error. With FromExR wired to ToExR (the chain of the
-    data length) it works (test_every_length_at_pin_level)."""
+    data length) it works (test_every_length_at_pin_level). RX-12, the limit: the transaction level, whose ring
+    shifts whole registers, sends zeros for the chip's own byte only and the cycle passes."""
     for level in (0, 1):
         pins = up_pins(1)
         ring, master = pin_master(pins)
         ring.set_input(1, "from_exr", level)
         ring.idle(GAP_BITS / ring.bit_rate)
-        result = master.data_cycle()
-        assert not result.ok and result.diagnostics[0].kind is ErrorKind.LOOPBACK
+        for _ in range(2):  # every cycle, the master's table kept (the diagnostic ID cycle finds the ring whole)
+            result = master.data_cycle()
+            assert not result.ok and result.diagnostics[0].kind is ErrorKind.LOOPBACK
+    chip = up_chip(1)
+    master = Master(Ring([chip]))
+    assert master.start().ok
+    result = master.data_cycle()
+    assert result.ok and master.inputs(1) == b"\x00"  # RX-12: not the pin level's loopback error
 
 
 @pytest.mark.parametrize("bit_rate", tables.BIT_RATES)

@@ -39,8 +39,9 @@ enum {
     OP_POLL_IO = 12,    /* supi3_poll_io_window(a) */
     OP_RAW = 13,        /* one frame of byte a through the driver's transport (cfg.xfer) */
     OP_SS_HIGH = 14,    /* byte a clocked on SPI1 with /SS high (3.4.2: the chip ignores it) */
-    OP_SS_CUT = 15,     /* byte a with /SS raised after b SCLK periods and a half, b < 8 (3.4.2: a frame cut
-                           short; half a period clear of t2; the byte received is not logged: MCU-61) */
+    OP_SS_CUT = 15,     /* byte a with /SS raised b SCLK periods and c spin units (4 core clocks each, c < 16)
+                           after the DR write, b <= 8: a frame cut short (3.4.2) at any point of the byte, within
+                           t2 of an SCLK edge too; r[0] the byte SPI1 received (MCU-74) */
     OP_LATCH = 16       /* poll the I/O pin without a pause until 1, at most (c + 1) * 10000 times, then spin a us
                            (a countdown of a us on the emulated core, as the bench's wait: delay_us lasts 4/3 of
                            its time there, MCU-11) and supi3_read(b): a read timed into the latch phase or beside it
@@ -134,9 +135,9 @@ static int step(supi3_t *chip, fw_board_t *board, const uint8_t *s, uint8_t *r)
         GPIOA_BRR = PIN(BOARD_PIN_SS);
         spin(SPI_BIT_CYCLES);                                     /* t1 */
         SPI1_DR = s[1];
-        spin(s[2] * SPI_BIT_CYCLES + SPI_BIT_CYCLES / 2u);        /* b SCLK periods and half of the next */
+        spin(s[2] * SPI_BIT_CYCLES + s[3] * 4u);                  /* b SCLK periods and c spin units */
         GPIOA_BSRR = PIN(BOARD_PIN_SS);
-        (void)spi_finish();                                       /* the rest of the byte, /SS high */
+        r[0] = spi_finish();                                      /* the rest of the byte, /SS high */
         spin(2u * SPI_BIT_CYCLES);                                /* t6 max + t8 */
         return 0;
     case OP_LATCH:

@@ -13,6 +13,7 @@ an edge of /IRQ enters EXTI0's handler at the next block boundary after it (MCU-
 
 from __future__ import annotations
 
+import itertools
 import math
 import struct
 from collections.abc import Callable, Sequence
@@ -39,7 +40,18 @@ from supi3.mcu.core import (
     Stop,
 )
 from supi3.mcu.frames import NativeFrames, SsFrame
-from supi3.mcu.pins import SAS_INIT_BIT, SR_BIT, SS_BIT, SYNC_S, Cause, LockstepRing, mcu_lines, ss_high_byte
+from supi3.mcu.pins import (
+    SAS_INIT_BIT,
+    SR_BIT,
+    SS_BIT,
+    SYNC_S,
+    Cause,
+    LockstepRing,
+    chip_clock,
+    mcu_lines,
+    released,
+    ss_high_byte,
+)
 from supi3.mcu.stm32 import (
     AFIO_BASE,
     CR1_CPHA,
@@ -74,6 +86,7 @@ from supi3.sdk.bench import (
     serve_wait_s,
 )
 from supi3.sdk.driver import UNDRIVEN_BYTE
+from supi3.spi.slave_pins import reaction_clocks, shorter_than
 from supi3.spi.upif import Mode, UpifProtocol
 from supi3.tables import CLOCK_HZ
 from supi3.top import Supi3Chip
@@ -363,7 +376,12 @@ class Board:
         self._limits["t_SAS_INIT"] = timing.limit("3-7", "t_SAS_INIT", bit_rate)
         self._least = {symbol: self._cycles(limit) for symbol, limit in self._limits.items()}  # in core cycles
         self._least["t8"] = self._cycles(self._limits["t6max"] + self._limits["t8"])  # after /SS rises
+        # t2 in core cycles such that any /SS rise this long after an SCLK rise is t2 or more in chip clocks, whatever
+        # the two clocks' phase (MCU-74: the chip times it in whole clocks, a core cycle is 2/3 of one at 48 MHz)
+        t2_clocks = next(n for n in itertools.count() if not shorter_than(n, CLOCK_HZ, self._limits["t2"]))
+        self._least["t2"] = math.ceil(t2_clocks * self._cpu_hz / CLOCK_HZ) + 1
         self._least_t1, self._least_t2, self._least_t8 = self._least["t1"], self._least["t2"], self._least["t8"]
+        self._serout_release = reaction_clocks(bit_rate)  # SerOUT released after /SS rose (MCU-74)
         self._shortest_period_s = self._limits["t0"] * (1 - 1e-9)  # t0, a rounding's tolerance
         self.rcc = Rcc()
         self.exti = Exti(self.rcc)
@@ -748,20 +766,56 @@ class Board:
         self._ss_rise = cycles
         self._cd_before = self.protocol.c_d
         edges = 0
+        last = -1  # the frame's last rising SCLK edge
         for _, bits, start, period in frame.transfers:
             clocked = (cycles - start) // period
-            edges += bits if clocked > bits else clocked
+            if clocked > bits:  # not min(): no call on the per-byte path (MCU-42)
+                clocked = bits
+            if clocked:
+                last = start + clocked * period
+            edges += clocked
+        if edges != 8 or cycles - last < self._least_t2:  # not whole and clear of t2 at any chip clock's phase
+            edges = self._ss_rose_near_an_edge(frame, cycles)
         if edges == 8:
-            tx, bits, start, period = frame.transfers[-1]
-            last = start + bits * period
-            if cycles - last < self._least_t2:
-                self._violation("Table 3-7 t2", f"/SS rose {self._ns(cycles - last)} ns after the last SCLK edge, "
-                                f"less than t2 = {self._limits['t2'] * 1e9:.0f} ns")  # fmt: skip
             # An Intel receive frame: the chip's driver wins on Ser_IN/OUT, it takes its own byte (MCU-18).
-            on_line = frame.driven if self.intel and frame.driven is not None else tx
+            on_line = frame.driven if self.intel and frame.driven is not None else frame.transfers[-1][0]
             self._chip(self.protocol.end, cycles, on_line)
         else:
             self._chip(self.protocol.abort, cycles, edges)
+
+    def _ss_rose_near_an_edge(self, frame: SsFrame, cycles: int) -> int:
+        """/SS rose at core cycle ``cycles`` within a few chip clocks of t2 after the frame's last SCLK edge, or before
+        its 8th: the frame's SCLK edges as the pin-level chip sees them, at chip-clock resolution (MCU-74). An SCLK
+        rise the chip sees before the /SS rise is the frame's bit (in the same clock it is not: the edge detectors act
+        on /SS first, ``SlavePins._edge``); t2 is timed from the last SCLK rise up to the /SS rise's clock
+        (TimingChecker); SerOUT stays driven until the chip reacts to the rise
+        (:func:`~supi3.spi.slave_pins.reaction_clocks`), then SPI1 samples MISO's pull-up."""
+        cpu_hz = self._cpu_hz
+        rise = chip_clock(cycles, cpu_hz)
+        until = rise + self._serout_release
+        edges = sampled = bits = 0
+        last = -1
+        for _, bits, start, period in frame.transfers:
+            sampled = 0
+            for k in range(1, bits + 1):
+                edge = chip_clock(start + k * period, cpu_hz)
+                if edge > until:
+                    break
+                sampled += 1
+                if edge <= rise:
+                    last = edge
+                    edges += edge < rise
+        if last >= 0 and shorter_than(rise - last, CLOCK_HZ, self._limits["t2"]):
+            self._violation("Table 3-7 t2", f"/SS rose {(rise - last) / CLOCK_HZ * 1e9:.0f} ns after the last SCLK "
+                            f"edge, less than t2 = {self._limits['t2'] * 1e9:.0f} ns")  # fmt: skip
+        spi = self.spi
+        if sampled < bits and not self.intel and spi.shifting is not None and cycles < spi.shifting[2]:
+            # SPI1 samples MISO's pull-up from the release on (MCU-6); the Intel board's line reads MOSI through its
+            # resistor then, not modelled (MCU-74's limit)
+            received = spi.shifting[0]
+            assert type(received) is int
+            spi.replace_received(released(received, bits, sampled, bool(spi.cr1 & CR1_LSBFIRST)))
+        return edges
 
     def spi_byte(self, tx: int, bits: int, start: int, period: int, cr1: int) -> int:
         """:class:`~supi3.mcu.stm32.SpiWire`: SPI1 starts a transfer; the chip sees it inside its /SS frame."""
@@ -840,8 +894,10 @@ class Board:
         last cycle and the last EXTI0 handler. The wait for that pass lasts at most :data:`SERVE_TELEGRAMS` status
         telegrams of bus time; :attr:`served` tells whether the run ended served. At pin level the master's cycles
         run whole, then the line idles in status telegrams while the firmware is in a handler, has an /IRQ edge to
-        serve or its pass to make, up to :data:`SERVE_TELEGRAMS` of them (MCU-17). The instruction budget bounds the
-        work between two waits of the core (MCU-41) or two passes of its main loop (MCU-43).
+        serve or its pass to make, up to :data:`SERVE_TELEGRAMS` of them (MCU-17). A cycle a transaction-level
+        :meth:`run_for` left under way ends first, then the run's ``cycles`` start (MCU-76: the pin level's
+        :meth:`run_for` has run it whole). The instruction budget bounds the work between two waits of the core
+        (MCU-41) or two passes of its main loop (MCU-43).
 
         Raises
         ------
@@ -858,7 +914,10 @@ class Board:
             The firmware touched a peripheral whose clock is off or which RCC_APB2RSTR holds in reset (MCU-7,
             MCU-29).
         """
-        target = self.cycles + check_int("cycles", cycles, 0)
+        count = check_int("cycles", cycles, 0)
+        # MCU-76: a cycle a run_for left under way (transaction level) ends first, then the run's own cycles start,
+        # as at pin level, whose run_for runs it whole
+        target = self.cycles + count + (self._bench is not None and self._bench.under_way)
         self._passes.end()
         self._serve_end = None
         self.served = False  # until the run ends served (MCU-30)

@@ -39,7 +39,8 @@ from supi3.pinout import UP_INPUTS, UP_OUTPUTS
 from supi3.tables import CLOCK_HZ
 from supi3.top import QUIET_BOARD, STEP_BELOW, Supi3Chip
 
-__all__ = ["MCU_LINES", "MISO_PULL_UP", "SYNC_S", "Cause", "LockstepRing", "Sample", "mcu_lines", "ss_high_byte"]
+__all__ = ["MCU_LINES", "MISO_PULL_UP", "SYNC_S", "Cause", "LockstepRing", "Sample", "chip_clock", "mcu_lines",
+           "released", "ss_high_byte"]
 
 SYNC_S: Final[float] = 1e-6
 """MCU-14: while the core runs (not asleep), the chip catches up with it at least this often of bus time, so an edge
@@ -94,6 +95,21 @@ def ss_high_byte(tx: int) -> InterfaceViolationError:
     """
     tx = check_bits("tx", tx, 16, "SPI1's data frame, 8 or 16 bits (RM0008 25.3.3)")
     return InterfaceViolationError(SS_HIGH_RULE, f"byte {tx:02X}h clocked with /SS high: the chip ignores it")
+
+
+def chip_clock(cycles: int, cpu_hz: float) -> int:
+    """The chip clocks run when a core of ``cpu_hz`` is at cycle ``cycles``: those that began at or before it (a read
+    then sees the outputs of the clock running; a write acts from the next clock, MCU-15); a pin the board drives
+    from core cycle ``cycles`` changes at the chip's pins in this clock."""
+    return math.floor(cycles * CLOCK_HZ / cpu_hz + 1e-9) + 1
+
+
+def released(word: int, bits: int, sampled: int, lsb_first: bool) -> int:
+    """What SPI1 receives of ``word`` (``bits`` bits, as its data register holds them) when the chip drives MISO for
+    the first ``sampled`` sampling edges only and releases it then (/SS rose, MCU-74): those bits of ``word``, and
+    MISO's pull-up (:data:`MISO_PULL_UP`, MCU-6) for the rest, as :meth:`LockstepRing.spi_byte` samples the pins."""
+    late = (1 << bits) - (1 << sampled) if lsb_first else (1 << (bits - sampled)) - 1  # the bits sampled after
+    return word | late  # MISO_PULL_UP: they read 1
 
 
 @dataclass(frozen=True)
@@ -178,9 +194,8 @@ class LockstepRing(PinRing):
     # -- time --------------------------------------------------------------------------------------------------
 
     def clock_of(self, cycles: int) -> int:
-        """The chip clocks run when the core is at cycle ``cycles``: those that began at or before it (a read then
-        sees the outputs of the clock running; a write acts from the next clock, MCU-15)."""
-        return math.floor(cycles * CLOCK_HZ / self.cpu_hz + 1e-9) + 1
+        """:func:`chip_clock` of ``cycles`` on this board's core clock."""
+        return chip_clock(cycles, self.cpu_hz)
 
     def core_cycle(self, clock: int) -> int:
         """The first core cycle at or after the start of chip clock ``clock``."""

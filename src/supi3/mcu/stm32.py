@@ -528,6 +528,18 @@ class Spi:
         if self.rx_buffer is None and not self.ovr:
             self.offer.offer(SPI_DR, received, end, self._flags(False, False, False))
 
+    def replace_received(self, word: int) -> None:
+        """The other end changed the word the shifting transfer receives (the chip released MISO before its end,
+        MCU-74): the transfer ends with ``word``, and SR's hold and DR's offered read (MCU-25, MCU-26) are made
+        again for it. The offered read starts at the transfer's end, so none can have been taken yet."""
+        shifting = self.shifting
+        assert shifting is not None and type(shifting[0]) is int, "a transaction-level transfer must be shifting"
+        self.shifting = (word, shifting[1], shifting[2])
+        if self._holding:
+            self.holder.release()
+            self.offer.withdraw()
+            self._hold(self._status())
+
     def _read_dr(self, cycles: int) -> int:
         """A read of DR at cycle ``cycles``: the received byte, RXNE cleared, OVR seen (25.3.10)."""
         self._run(cycles)

@@ -793,7 +793,8 @@ class Bench:
         """Run until ``cycles`` more master cycles have finished and the firmware has served them (FW-14, as the
         emulated board's run, MCU-30), the firmware's main loop and service routine running as the clock goes.
 
-        The master runs exactly ``cycles`` cycles; after the last one the line idles in status telegrams until the
+        The master runs exactly ``cycles`` cycles, after ending one a :meth:`run_for` left under way (MCU-76,
+        :attr:`under_way`); after the last one the line idles in status telegrams until the
         run ends (:class:`ServeWait`, FW-19, MCU-55), and the next run's first cycle starts at the end of the
         telegram the run ended in (or on the cycle time's schedule). Served: the interrupt of the last cycle taken
         (as the firmware would take it) and, for a firmware with a main loop, a whole pass of it (one
@@ -814,7 +815,7 @@ class Bench:
         # (2**53 of them pass it: a count too large for a float is refused as that many)
         shortest = wire.cycle_bits(0, 1) / self.config.bit_rate
         wire.check_bus_time("cycles", cycles, self.now, min(count, 2**53) * shortest)
-        target = self.cycles + count
+        target = self.cycles + self.under_way + count  # a cycle a run_for left under way ends first (MCU-76)
         self.served = False  # until the run ends served (FW-14)
         began = self.now
         self.hold_after(target)
@@ -823,6 +824,13 @@ class Bench:
             self.served = self._serve(self.last_end(began))
         finally:
             self.resume()
+
+    @property
+    def under_way(self) -> bool:
+        """A master cycle has started and not ended: a :meth:`run_for`, :meth:`power_up`'s set-up or a run that raised
+        ended inside it. The next run ends it first and then runs its cycles (MCU-76: as at pin level, whose
+        ``run_for`` runs the cycles it starts whole, MCU-22)."""
+        return bool(self.timeline) and self.timeline[-1].end > self.now
 
     def hold_after(self, cycles: int) -> None:
         """MCU-55, FW-19: the master starts no cycle once :attr:`cycles` has reached ``cycles`` (a cycle under way

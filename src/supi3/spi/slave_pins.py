@@ -36,15 +36,34 @@ __all__ = [
     "INPUT_PINS",
     "OUTPUT_PINS",
     "QUIET_FOREVER",
+    "SYNC_STAGES",
     "PinsIn",
     "PinsOut",
     "SlavePins",
     "TimingChecker",
     "TimingViolationError",
+    "reaction_clocks",
+    "shorter_than",
 ]
 
 _EPSILON_S: Final[float] = 1e-12
 """Tolerance of the timing comparisons (the table's limits are floats)."""
+SYNC_STAGES: Final[int] = 3
+"""Clocks from an input's change at the pins (cycle ``n``) to the decoded state that shows it (after the edge ending
+cycle ``n + 2``): the synchroniser's two flops, then the edge that acts."""
+
+
+def reaction_clocks(bit_rate: int, clock_hz: int = tables.CLOCK_HZ) -> int:
+    """Chip clocks from the cycle an input changes at the pins to the first cycle the outputs show its effect:
+    :data:`SYNC_STAGES`, then the output pipeline (``SlavePins.output_delay``): 2 TCLK + 1 clock (UP-14); e.g. SerOUT
+    released after /SS rose (MCU-74)."""
+    return SYNC_STAGES + 2 * (clock_hz // (tables.TCLK_PER_BIT * bit_rate)) - 2
+
+
+def shorter_than(clocks: int, clock_hz: int, minimum_s: float) -> bool:
+    """Whether ``clocks`` chip clocks measure less than ``minimum_s``, within the timing checks' tolerance (the rule
+    of :class:`TimingChecker`)."""
+    return clocks / clock_hz + _EPSILON_S < minimum_s
 
 
 class TimingViolationError(InterfaceViolationError):
@@ -244,7 +263,7 @@ class TimingChecker:
             return
         limit = self._limits[symbol]
         assert limit.minimum_s is not None
-        if (cycle - since) / self._clock_hz + _EPSILON_S < limit.minimum_s:
+        if shorter_than(cycle - since, self._clock_hz, limit.minimum_s):
             self._violation(symbol, cycle, cycle - since)
 
     def check(self, cycle: int, pins: PinsIn, out: PinsOut, intel: bool) -> None:
@@ -350,7 +369,7 @@ class SlavePins:
         self.protocol = UpifProtocol(registers)
         self.clocks_per_tclk = clock_hz // (tables.TCLK_PER_BIT * bit_rate)
         """Chip clocks per TCLK: 4 at 500 kbit/s, 1 at 2 Mbit/s."""
-        self.output_delay = 2 * self.clocks_per_tclk - 2
+        self.output_delay = reaction_clocks(bit_rate, clock_hz) - SYNC_STAGES
         """Output pipeline stages after the decoded state (UP-14): 6 at 500 kbit/s, 0 at 2 Mbit/s."""
         self.clock_hz = clock_hz
         self._checker = TimingChecker(bit_rate, clock_hz, registers.violations.report)
