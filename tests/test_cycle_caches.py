@@ -241,6 +241,56 @@ def test_the_rings_run_layout_agrees_with_one_worked_out_every_cycle(kinds: list
         assert sides[0][0].now == sides[1][0].now
 
 
+class _General(Ring):
+    """A ring whose data cycles all take the general path (A29's plain path off)."""
+
+    _PLAIN = False
+
+
+class _Replanned(Ring):
+    """A ring that takes the plain path with its plan worked out anew at every data cycle (the plan emptied first)."""
+
+    def _plain_plan(self) -> tuple[list[Device], _Groups, DataKernel | None, int]:
+        self._plan = ([], [], None, 0)
+        return super()._plain_plan()
+
+
+def _plain_step(ring: Ring, master: Master, op: tuple[str, int, int]) -> object:
+    """:func:`_ring_step`, and ``record`` switched (the ring's trace kept, then not)."""
+    if op[0] == "record":
+        ring.record = not ring.record
+        return None
+    outcome = _ring_step(ring, master, op)
+    return outcome, [(t.segment, t.sent, t.received, t.error) for t in ring.trace]
+
+
+@settings(derandomize=True, max_examples=40, deadline=None)
+@given(st.lists(st.integers(0, 3), min_size=1, max_size=5),
+       st.lists(st.tuples(st.sampled_from(["cycle"] * 6 + ["swap", "swap", "turn", "cut", "flip", "repair", "power",
+                                                          "stop", "record"]),
+                          st.integers(0, 7), st.integers(0, 200)), max_size=40))  # fmt: skip
+def test_the_plain_rings_path_agrees_with_the_general_one_over_any_history(kinds: list[int],
+                                                                         ops: list[tuple[str, int, int]]) -> None:
+    """A29: three rings of the same devices (binary-I/O and µP-mode chips, plain devices, devices without a kernel),
+    one taking the plain ring's path with its plan kept (keyed on the ring's devices), one planning anew every cycle,
+    one through the general path only, take the same history of master cycles, devices swapped in place in the
+    ring's list, the list turned round, cuts, bit errors, repairs, power-ups (chips waking up), Alarm Stops and the
+    trace switched on and off: after every step all three show the same outcome, IN data, trace, device states and
+    bus time."""
+    sides = []
+    for ring_class in (Ring, _Replanned, _General):
+        ring = ring_class([_made(kind, k) for k, kind in enumerate(kinds)], bit_rate=2_000_000)
+        master = Master(ring)
+        master.start()
+        sides.append((ring, master))
+    for op in ops:
+        outcomes = [_plain_step(ring, master, op) for ring, master in sides]
+        assert outcomes[0] == outcomes[1] == outcomes[2]
+        states = [[_device_state(d) for d in ring.devices] for ring, _ in sides]
+        assert states[0] == states[1] == states[2]
+        assert sides[0][0].now == sides[1][0].now == sides[2][0].now
+
+
 # -- the bench's watch of /IRQ (FW-18) ---------------------------------------------------------------------------
 
 
