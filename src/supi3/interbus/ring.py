@@ -487,6 +487,9 @@ _FLAGS: Final = {(a, e): wire.CntrFlags(a, e) for a in (False, True) for e in (F
 """The CNTR flags by (attention, error): immutable, so one object each serves every cycle."""
 
 
+_new_tuple: Final = tuple.__new__
+"""A named tuple made from all its fields in order, as its class's own ``__new__`` does, without that Python call
+(A29: a :class:`_Run` a data cycle)."""
 _Groups = list[tuple[int, int, DataKernel | None]]
 """A run's devices in groups of one class: (start, stop, the class's data kernel or None)."""
 
@@ -1475,7 +1478,8 @@ class Ring:
         received, returned, _ = self._shift(registers, data)
         n = len(run)
         self._pending = Transfer(Cycle.DATA, data, n, returned, _FLAGS[attention, False], None,
-                                 [_Run(run, received, True, False, groups, kernel)], n, [], False, repeaters)
+                                 [_new_tuple(_Run, (run, received, True, False, groups, kernel))], n, [], False,
+                                 repeaters)  # fmt: skip
         return self._pending
 
     def _plain_plan(self) -> tuple[list[Device], _Groups, DataKernel | None, int]:
