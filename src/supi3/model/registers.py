@@ -92,7 +92,6 @@ _WRITE_MASKS: Final[tuple[int, ...]] = tuple(
 """The bits a write of each address stores; the others are reserved (write 0, read back 0)."""
 
 
-
 def event_mask(*sources: str) -> int:
     """M33: the bits of IRQ_EVT (and IRQ_EN) of the interrupt ``sources`` (names of
     :data:`supi3.regmap.INTERRUPT_SOURCES`, Table 3-13), for :meth:`RegisterFile.raise_events`.
@@ -109,6 +108,7 @@ def event_mask(*sources: str) -> int:
                                         f"3-13), not {describe(source)}: no interrupt source {source!r}")
         mask |= 1 << _SOURCE_BITS[source]
     return mask
+
 
 class RegisterFileError(Supi3Error, ValueError):
     """A call that breaks the register file's API contract (a bad byte, an unknown source or register)."""
