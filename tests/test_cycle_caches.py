@@ -9,14 +9,18 @@ held to the values they stand for over histories of changes:
 - the ring's run layout (A28): a data cycle's run of devices, its groups for the data kernels and the kernel of a run
   of one class, worked out again only when the run holds other devices, against a ring that works it out every cycle;
 - the bench's watch of /IRQ (FW-18): after a byte only while /IRQ is low, and no phase set in a sleeping firmware's
-  batch, against a bench that watches after every byte.
+  batch, against a bench that watches after every byte;
+- round 12: the plain ring's data-cycle path and its plan (A29) against the general path and a plan made every
+  cycle; a µP-mode chip's latch raising its events by one mask (M33) against the sources one by one.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
-from hypothesis import given, settings
+import pytest
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from supi3 import tables
@@ -28,7 +32,8 @@ from supi3.interbus.master import Master
 from supi3.interbus.ring import Ring, _Groups
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
-from supi3.regmap import ID, IN0, OUT0, SET
+from supi3.model.registers import RegisterArgumentError, RegisterFile, event_mask
+from supi3.regmap import ID, IN0, INTERRUPT_SOURCES, IRQ_EN, OUT0, SET
 from supi3.sdk.bench import Bench, BenchTransport, CycleTiming, Firmware
 from supi3.sdk.driver import Irq, Mode, Supi3Driver
 from supi3.sdk.examples.digital import DIO_ID, ONE_WORD_IO
@@ -228,17 +233,64 @@ def test_the_rings_run_layout_agrees_with_one_worked_out_every_cycle(kinds: list
     working it out at every data cycle, take the same history of master cycles, devices swapped in place in the ring's
     list (of the same class or another), the list turned round, cuts, bit errors, repairs, power-ups and Alarm Stops:
     after every step both show the same outcome, IN data and device states."""
+    _side_by_side((Ring, _EveryCycle), kinds, ops, _ring_step)
+
+
+def _side_by_side(ring_classes: tuple[type[Ring], ...], kinds: list[int], ops: list[tuple[str, int, int]],
+                  step: Callable[[Ring, Master, tuple[str, int, int]], object]) -> None:  # fmt: skip
+    """Rings of ``ring_classes``, each of fresh devices of ``kinds`` (:func:`_made`) with its master started, take
+    ``ops`` by ``step``: after every step all show the same outcome, device states and bus time."""
     sides = []
-    for ring_class in (Ring, _EveryCycle):
+    for ring_class in ring_classes:
         ring = ring_class([_made(kind, k) for k, kind in enumerate(kinds)], bit_rate=2_000_000)
         master = Master(ring)
         master.start()
         sides.append((ring, master))
     for op in ops:
-        outcomes = [_ring_step(ring, master, op) for ring, master in sides]
-        assert outcomes[0] == outcomes[1]
-        assert [_device_state(d) for d in sides[0][0].devices] == [_device_state(d) for d in sides[1][0].devices]
-        assert sides[0][0].now == sides[1][0].now
+        outcomes = [step(ring, master, op) for ring, master in sides]
+        assert all(outcome == outcomes[0] for outcome in outcomes)
+        states = [([_device_state(d) for d in ring.devices], ring.now) for ring, _ in sides]
+        assert all(state == states[0] for state in states)
+
+
+class _General(Ring):
+    """A ring whose data cycles all take the general path (A29's plain path off)."""
+
+    _PLAIN = False
+
+
+class _Replanned(Ring):
+    """A ring that takes the plain path with its plan worked out anew at every data cycle (the plan emptied first)."""
+
+    def _plain_plan(self) -> tuple[list[Device], _Groups, DataKernel | None, int]:
+        self._plan = ([], [], None, 0)
+        return super()._plain_plan()
+
+
+def _plain_step(ring: Ring, master: Master, op: tuple[str, int, int]) -> object:
+    """:func:`_ring_step`, and ``record`` switched (the ring's trace kept, then not)."""
+    if op[0] == "record":
+        ring.record = not ring.record
+        return None
+    outcome = _ring_step(ring, master, op)
+    return outcome, [(t.segment, t.sent, t.received, t.error) for t in ring.trace]
+
+
+@settings(derandomize=True, max_examples=40, deadline=None)
+@given(st.lists(st.integers(0, 3), min_size=1, max_size=5),
+       st.lists(st.tuples(st.sampled_from(["cycle"] * 6 + ["swap", "swap", "turn", "cut", "flip", "repair", "power",
+                                                          "stop", "record"]),
+                          st.integers(0, 7), st.integers(0, 200)), max_size=40))  # fmt: skip
+@example([2, 0], [("cycle", 0, 0), ("swap", 0, 2), ("cycle", 0, 0), ("turn", 0, 0), ("cycle", 0, 0)])
+def test_the_plain_rings_path_agrees_with_the_general_one_over_any_history(kinds: list[int],
+                                                                         ops: list[tuple[str, int, int]]) -> None:
+    """A29: three rings of the same devices (binary-I/O and µP-mode chips, plain devices, devices without a kernel),
+    one taking the plain ring's path with its plan kept (keyed on the ring's devices), one planning anew every cycle,
+    one through the general path only, take the same history of master cycles, devices swapped in place in the
+    ring's list, the list turned round, cuts, bit errors, repairs, power-ups (chips waking up), Alarm Stops and the
+    trace switched on and off: after every step all three show the same outcome, IN data, trace, device states and
+    bus time."""
+    _side_by_side((Ring, _Replanned, _General), kinds, ops, _plain_step)
 
 
 # -- the bench's watch of /IRQ (FW-18) ---------------------------------------------------------------------------
@@ -344,3 +396,63 @@ def test_the_bench_s_watch_of_irq_agrees_with_one_after_every_byte(plan: list[in
     # at 20.18 ms)
     assert sides[0][0].interrupts >= min(sum(result.ok for result in sides[0][0].results), 1)
     assert all(sides[0][1].phases)
+
+
+# -- a µP-mode chip's events by one mask (M33) -------------------------------------------------------------------
+
+SOURCES = [source.name for source in INTERRUPT_SOURCES]
+
+
+@settings(derandomize=True, max_examples=60, deadline=None)
+@given(st.lists(st.sampled_from(SOURCES), max_size=6), st.integers(0, 255), st.integers(0, 255))
+def test_raising_a_sources_mask_is_raising_the_sources(sources: list[str], enabled: int, pending: int) -> None:
+    """M33: :meth:`RegisterFile.raise_events` of :func:`event_mask` of any sources sets the event bits and /IRQ that
+    :meth:`RegisterFile.event` of those sources sets, whatever IRQ_EN and the events already pending."""
+    files = []
+    for _ in range(2):
+        registers = RegisterFile(decode(*RB_INIT_UP))
+        registers.cpu_write(IRQ_EN.address, enabled)
+        registers.raise_events(pending & event_mask(*SOURCES))
+        files.append(registers)
+    files[0].event(*sources)
+    files[1].raise_events(event_mask(*sources))
+    assert files[0]._values == files[1]._values
+    assert files[0].irq_n == files[1].irq_n
+
+
+@pytest.mark.parametrize("mask", [-1, 1 << 8, 0x80, 1.0, True, "VALID", None])
+def test_raise_events_names_a_mask_that_is_no_sources_bits(mask: object) -> None:
+    """M33: a mask with a bit that is no interrupt source's (D7 is the live I/O access bit), or not an integer, is
+    refused by name, and no event bit is set."""
+    registers = RegisterFile(decode(*RB_INIT_UP))
+    registers.cpu_write(IRQ_EN.address, 0xFF)
+    with pytest.raises(RegisterArgumentError, match="mask must be an integer of the interrupt source bits"):
+        registers.raise_events(mask)  # type: ignore[arg-type]
+    assert registers.value("IRQ_EVT") == 0
+
+
+def test_event_mask_names_a_source_that_is_none() -> None:
+    """M33: :func:`event_mask` checks each source by name (Table 3-13), as :meth:`RegisterFile.event` does."""
+    with pytest.raises(RegisterArgumentError, match="no interrupt source 'NOPE'"):
+        event_mask("VALID", "NOPE")
+
+
+def test_a_chips_valid_cycles_count_its_events_and_raise_them() -> None:
+    """M32, M33: each valid data cycle a µP-mode chip latches counts VALID, PCP_RX and PCP_TX once each
+    (:attr:`Supi3.events`) and sets the enabled ones in IRQ_EVT; an ID cycle counts ID_CYCLE and PCP_TX."""
+    chip = Supi3(decode(*RB_INIT_UP), strict=False)
+    registers = chip.registers
+    assert registers is not None
+    registers.cpu_write(SET.address, ONE_WORD_IO)
+    registers.cpu_write(ID.address, DIO_ID)
+    ring = Ring([chip], bit_rate=2_000_000)
+    master = Master(ring)
+    assert master.start().ok
+    registers.cpu_write(IRQ_EN.address, event_mask("VALID"))
+    before = chip.events
+    results = [master.cycle() for _ in range(5)]
+    valid = sum(result.ok and result.cycle is Cycle.DATA for result in results)
+    assert valid == 5
+    after = chip.events
+    assert [after[s] - before[s] for s in ("VALID", "PCP_RX", "PCP_TX", "ID_CYCLE")] == [valid, valid, valid, 0]
+    assert registers.value("IRQ_EVT") == event_mask("VALID")

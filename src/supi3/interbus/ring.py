@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 from enum import Enum
 from itertools import accumulate
 from operator import attrgetter, sub
-from typing import Final, NamedTuple, Protocol, runtime_checkable
+from typing import ClassVar, Final, NamedTuple, Protocol, runtime_checkable
 
 from supi3.checks import check_bool, check_bytes, check_instance, check_int, check_real, fail
 from supi3.config import DeviceConfig, Interface
@@ -487,6 +487,9 @@ _FLAGS: Final = {(a, e): wire.CntrFlags(a, e) for a in (False, True) for e in (F
 """The CNTR flags by (attention, error): immutable, so one object each serves every cycle."""
 
 
+_new_tuple: Final = tuple.__new__
+"""A named tuple made from all its fields in order, as its class's own ``__new__`` does, without that Python call
+(A29: a :class:`_Run` a data cycle)."""
 _Groups = list[tuple[int, int, DataKernel | None]]
 """A run's devices in groups of one class: (start, stop, the class's data kernel or None)."""
 
@@ -739,6 +742,10 @@ class Ring:
         Bus time in seconds.
     """
 
+    _PLAIN: ClassVar[bool] = True
+    """A29: a plain ring's data cycles take :meth:`_plain` (``False``: the general path, held to it by
+    ``tests/test_cycle_caches.py``)."""
+
     closes_early: Final = True
     """The ring can be closed after any position (``transfer(close_after=...)``), for the segment search."""
     direct_return_line: Final = True
@@ -810,6 +817,9 @@ class Ring:
         """M22: bus time the master's idle status telegrams began (the end of its last cycle or reset)."""
         self._loops: tuple[list[Device], list[int]] = ([], [0])
         """The data path whose LBD-MR devices :meth:`_loops_before` counted last, the counts before each position."""
+        self._plan: tuple[list[Device], _Groups, DataKernel | None, int] = ([], [], None, 0)
+        """A29: the plain ring's data-cycle plan (:meth:`_plain_plan`): a copy of :attr:`devices` as last planned, their
+        groups for the data kernels, the kernel of a ring of one class and the ring's return repeaters."""
         _tell_following(self._tree)
         self._sync()
 
@@ -1254,18 +1264,24 @@ class Ring:
         if single is not None:
             registers, attention = single.load(run, now)
             return registers, attention, groups, single
-        registers = []
+        return *self._load_groups(run, groups, now), groups, None
+
+    @staticmethod
+    def _load_groups(run: list[Device], groups: _Groups, now: float) -> tuple[list[bytes], bool]:
+        """A data cycle's loads of ``run`` by its ``groups`` (through each group's kernel, if it has one) at bus time
+        ``now`` (a finite float), and whether one of the devices wants attention."""
+        registers: list[bytes] = []
         attention = False
         for start, stop, kernel in groups:
             part = run[start:stop]
             if kernel is None:
-                registers += [device.load(cycle, now) for device in part]
+                registers += [device.load(Cycle.DATA, now) for device in part]
                 attention = attention or any(map(_ATTENTION, part))
             else:
                 loaded, wants = kernel.load(part, now)
                 registers += loaded
                 attention = attention or wants
-        return registers, attention, groups, None
+        return registers, attention
 
     def _shift(self, registers: list[bytes], stream: bytes) -> tuple[list[bytes], bytes, int]:
         """``_shift(registers, stream)``, with what depends only on the registers and the frame size cached for
@@ -1312,8 +1328,13 @@ class Ring:
         """
         if type(cycle) is not Cycle or type(data) is not bytes or close_after is not None:  # the master's own call
             data, close_after = check_transfer(cycle, data, close_after)  # passes these: no call for them
-        if not self.now <= wire.MAX_BUS_TIME_S:  # NaN too: the condition of check_bus_time, which raises
-            wire.check_bus_time("cycle", cycle, self.now)
+        now = self.now
+        if not now <= wire.MAX_BUS_TIME_S:  # NaN too: the condition of check_bus_time, which raises
+            wire.check_bus_time("cycle", cycle, now)
+        if (self._PLAIN and cycle is Cycle.DATA and close_after is None and type(now) is float and now >= 0.0
+                and not (self._branches or self._faults or self._unanswered or self._wakes or self._late
+                         or self.record)):  # fmt: skip
+            return self._plain(data, now)
         # A branch answering in this run joins the data path within its frame (BK-54): what leaves its BK is cut.
         joined = self._recognise(frame=wire.frame_bits(len(data))) if self._branches else []
         spliced = self._join_error(joined) if joined else None  # BK-56: the error of a branch joining the frame
@@ -1346,7 +1367,6 @@ class Ring:
             dead = cut if dead is None or cut < dead else dead
         self.trace = []
         record = self.record
-        now = self.now
         stream = bytes(data)
         shifted = 0
         crc: int | None = None
@@ -1442,6 +1462,40 @@ class Ring:
         self._pending = Transfer(cycle, bytes(data), n, returned, flags_back, receiver_error, runs, reached, reports,
                                  spliced is not None or unheard, self._loops_before(n))
         return self._pending
+
+    def _plain(self, data: bytes, now: float) -> Transfer:
+        """A29: :meth:`transfer`'s data cycle through the whole of a plain ring (no fault, branch, chip waking up or
+        record; bus time a finite float): what the general path gives there, one run on unfaulted lines whose CNTR
+        flags only the devices' attention, with what depends only on the ring's devices planned once
+        (:meth:`_plain_plan`)."""
+        if self.trace:  # record was on before (the general path empties it every cycle)
+            self.trace = []
+        run, groups, kernel, repeaters = self._plain_plan()
+        if kernel is not None:
+            registers, attention = kernel.load(run, now)
+        else:
+            registers, attention = self._load_groups(run, groups, now)
+        received, returned, _ = self._shift(registers, data)
+        n = len(run)
+        self._pending = Transfer(Cycle.DATA, data, n, returned, _FLAGS[attention, False], None,
+                                 [_new_tuple(_Run, (run, received, True, False, groups, kernel))], n, [], False,
+                                 repeaters)  # fmt: skip
+        return self._pending
+
+    def _plain_plan(self) -> tuple[list[Device], _Groups, DataKernel | None, int]:
+        """A29: the plain ring's plan, worked out again only when :attr:`devices` holds other devices than last time
+        (compared element by element, by identity first: the list edited in place is seen, as A28's layout)."""
+        plan = self._plan
+        devices = self.devices
+        if devices != plan[0]:
+            if len(devices) > wire.MAX_DEVICES:
+                raise InterbusError("docs/interbus.md, Ring", len(devices),
+                                    f"a ring has at most {wire.MAX_DEVICES} devices")  # fmt: skip
+            run = list(devices)
+            groups = _group(run)
+            plan = self._plan = (run, groups, groups[0][2] if len(groups) == 1 else None,
+                                 self._loops_before(len(run)))  # fmt: skip
+        return plan
 
     def finish(self, transfer: Transfer, latch: bool) -> None:
         """End a cycle with the master's verdict: the latch telegrams (``latch``) or idle telegrams.

@@ -47,7 +47,7 @@ from supi3.interbus.link import DataKernel
 from supi3.interbus.wire import Cycle
 from supi3.model.blocks.forward import forward_path
 from supi3.model.bus_terminal import BusTerminal
-from supi3.model.registers import RegisterFile
+from supi3.model.registers import RegisterFile, event_mask
 from supi3.optical import regulation
 from supi3.optical.length import Medium, timer_code
 from supi3.optical.regulation import Interface, OpticalMode, OpticalStatus, Phase, Response
@@ -148,6 +148,8 @@ def _cycle(cycle: object) -> Cycle:
     return checked
 
 
+_VALID_EVENTS: Final[int] = event_mask("VALID", "PCP_RX", "PCP_TX")
+"""M32, M33: the interrupt events of a valid data cycle's latch (Table 3-13), as one mask made once."""
 _OPTICAL_MODES: Final[dict[str, OpticalMode]] = {"00": OpticalMode.REGULATION, "01": OpticalMode.DIAGNOSTIC}
 """RF[1..0] patterns with an optical block at work (Table 2-2, OPT-2); the others are copper (OFF)."""
 
@@ -169,7 +171,7 @@ def _interface(interface: object) -> Interface:
 #   _loaded       (MFP levels, IN bytes) of the last data-cycle sample (binary I/O modes; (-1, b"") otherwise);
 #   _fixed_bytes  the data length of a pin-strapped mode (None in the µP modes, which never take the shortcut);
 #   watchdog_code None while the master has set no watchdog (a latch then leaves the schedule alone);
-#   _fast_valid   valid data cycles latched by the shortcut, merged into Supi3.events.
+#   _fast_valid   valid data cycles latched by the shortcut (and by a µP-mode chip, M33), merged into Supi3.events.
 # Supi3 declares its state in __slots__, so these reads are fixed-offset loads whatever the number of attributes.
 # tests/test_interbus_ring_kernel.py holds the kernel to the per-chip path.
 
@@ -184,7 +186,7 @@ def _load_data_run(chips: Sequence[Supi3], now: float) -> tuple[list[bytes], boo
         if now < chip._due_s and chip.mfp_in == loaded[0]:
             append(loaded[1])
         else:
-            append(chip.load_at(_DATA, clocks(now)))
+            append(chip.load_at(_DATA, round(now * CLOCK_HZ)))  # clocks(now): the callers' now is a finite float >= 0
         if chip.attention:
             attention = True
     return registers, attention
@@ -200,7 +202,7 @@ def _latch_data_run(chips: Sequence[Supi3], received: Sequence[bytes], now: floa
             chip.revision += 1
             chip._fast_valid += 1
         else:
-            chip.latch_at(_DATA, data, clocks(now))
+            chip.latch_at(_DATA, data, round(now * CLOCK_HZ))  # clocks(now), as in _load_data_run
 
 
 class _SerialPins(Protocol):
@@ -1195,7 +1197,8 @@ class Supi3:
             received = _checked(check_bytes, "received", received, length, f"{what} of the {cycle.value} cycle")
         self.revision += 1
         self._now = clk
-        self._line_heard()
+        if self.line_silent:  # only then does the line's hearing change anything (M33: no call a cycle)
+            self._line_heard()
         if clk >= self.due:
             self._expire(clk)
         if self._optical_until != _NEVER or self._optical_held:  # optical block: held in reset, no latch (OPT-20)
@@ -1219,7 +1222,8 @@ class Supi3:
             elif received:
                 self.registers.latch(received)
             self.registers.set_bus_running(True)
-            self._event("VALID", "PCP_RX", "PCP_TX")
+            self._fast_valid += 1  # M33: VALID, PCP_RX and PCP_TX counted at once (Supi3.events merges them)
+            self.registers.raise_events(_VALID_EVENTS)
             return
         command = wire.decode_command_word(wire.word_from_bytes(received))
         if command.watchdog_code is not None:

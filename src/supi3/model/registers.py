@@ -51,12 +51,14 @@ __all__ = [
     "SuspiciousAccess",
     "SuspiciousAccessError",
     "ViolationLog",
+    "event_mask",
 ]
 
 _DATA_REGISTERS: Final[frozenset[str]] = frozenset(r.name for r in IN_BYTES + OUT_BYTES)
 """The INTERBUS data registers (3.4.8), the only ones the latch phase touches (3.4.14)."""
 _OPTICAL_REGISTERS: Final[frozenset[str]] = frozenset({"LENGTH_OUT", "LENGTH_BRANCH", "POWER_IN", "POWER_OUT_BRANCH"})
 _SOURCE_BITS: Final[dict[str, int]] = {s.name: s.bit for s in INTERRUPT_SOURCES}
+_ALL_SOURCES: Final[int] = sum(1 << bit for bit in _SOURCE_BITS.values())
 _PCP_ERASED: Final[tuple[str, ...]] = ("IN0", "IN1")
 """IN bytes erased after their transfer in a PCP device (/PCP = 0, 3.4.11)."""
 _CONFIGURATION: Final[frozenset[str]] = frozenset({"SET", "ID"})
@@ -88,6 +90,24 @@ _WRITE_MASKS: Final[tuple[int, ...]] = tuple(
     for a in REGISTER_MAP.addresses
 )
 """The bits a write of each address stores; the others are reserved (write 0, read back 0)."""
+
+
+def event_mask(*sources: str) -> int:
+    """M33: the bits of IRQ_EVT (and IRQ_EN) of the interrupt ``sources`` (names of
+    :data:`supi3.regmap.INTERRUPT_SOURCES`, Table 3-13), for :meth:`RegisterFile.raise_events`.
+
+    Raises
+    ------
+    RegisterArgumentError
+        If a source is not a source name.
+    """
+    mask = 0
+    for source in sources:
+        if type(source) is not str or source not in _SOURCE_BITS:
+            raise RegisterArgumentError("source", source, f"source must be one of {sorted(_SOURCE_BITS)} (Table "
+                                        f"3-13), not {describe(source)}: no interrupt source {source!r}")
+        mask |= 1 << _SOURCE_BITS[source]
+    return mask
 
 
 class RegisterFileError(Supi3Error, ValueError):
@@ -783,12 +803,20 @@ class RegisterFile:
         RegisterArgumentError
             If a source is not a source name; no event bit is set then.
         """
-        mask = 0
-        for source in sources:
-            if type(source) is not str or source not in _SOURCE_BITS:
-                raise RegisterArgumentError("source", source, f"source must be one of {sorted(_SOURCE_BITS)} (Table "
-                                            f"3-13), not {describe(source)}: no interrupt source {source!r}")
-            mask |= 1 << _SOURCE_BITS[source]
+        self.raise_events(event_mask(*sources))
+
+    def raise_events(self, mask: int) -> None:
+        """M33: :meth:`event` of the sources whose bits :func:`event_mask` gave as ``mask`` (checked once, where the
+        mask was made: a chip's latch raises the same sources every cycle).
+
+        Raises
+        ------
+        RegisterArgumentError
+            If ``mask`` is not an integer of interrupt source bits only (Table 3-13); no event bit is set then.
+        """
+        if type(mask) is not int or mask & ~_ALL_SOURCES:  # a negative mask has bits beyond them too
+            raise RegisterArgumentError("mask", mask, f"mask must be an integer of the interrupt source bits "
+                                        f"{_ALL_SOURCES:02X}h (event_mask, Table 3-13), not {describe(mask)}")
         values = self._values
         values["IRQ_EVT"] |= values["IRQ_EN"] & mask
 

@@ -353,6 +353,14 @@ class CycleTiming(NamedTuple):
         return self.at(self.phases.end_bit)
 
 
+_NO_TIME: Final = -math.inf
+_LAST_TIME: Final = wire.MAX_BUS_TIME_S
+"""The bounds of :meth:`Bench.advance`'s one test of a valid time (A26), without an attribute lookup a call."""
+_new_tuple: Final = tuple.__new__
+"""A named tuple made from its fields in order, as its class's own ``__new__`` does, without that Python call (FW-27:
+a :class:`CycleTiming` a master cycle)."""
+
+
 class BenchError(Supi3Error, RuntimeError):
     """The bench cannot go on: the firmware is stuck, or the bus has nothing left to do."""
 
@@ -634,17 +642,19 @@ class Bench:
             ``until`` not a finite number (NaN would run nothing, infinity for ever), or past
             :data:`~supi3.interbus.wire.MAX_BUS_TIME_S` (A26); nothing changes.
         """
-        if type(until) is not float or not -math.inf < until <= wire.MAX_BUS_TIME_S:  # the board's float: one test
+        if type(until) is not float or not _NO_TIME < until <= _LAST_TIME:  # the board's float: one test
             until = check_real("until", until)
             wire.check_bus_time("until", until, self.now, until - self.now)
-        # Most calls (a byte, a pin read, the board's synchronisation at each peripheral access) find no bus event
-        # due: one comparison with the next event's time, kept by _run_bus and _start_cycle.
-        stepped = self._next_at <= until
-        if stepped:
+        # Most calls (a byte, a pin read) find no bus event due: one comparison with the next event's time, kept by
+        # _run_bus and _start_cycle (the board's synchronisation makes it without this call, FW-27).
+        if self._next_at <= until:
             self._run_bus(until, False)
+            if until > self.now:
+                self.now = until
+            return True
         if until > self.now:
             self.now = until
-        return stepped
+        return False
 
     def _run_bus(self, until: float, sleep: bool) -> None:
         """Run the bus events due by ``until`` in their order: a cycle starts, a phase begins, or the cycle ends.
@@ -659,8 +669,7 @@ class Bench:
                 if sleep:
                     return
                 continue
-            at, what = events[-1]
-            del events[-1]
+            at, what = events.pop()
             self._next_at = events[-1][0] if events else self._next_start
             if at > self.now:
                 self.now = at
@@ -706,11 +715,10 @@ class Bench:
                                                                        phases.check_bit))  # fmt: skip
             self._phases = (size, phases, (offsets[0], offsets[1], offsets[2]))
         _, phases, (to_end, to_latch, to_io) = self._phases
-        self.timeline.append(CycleTiming(start, transfer.cycle, phases, self._bit_s))
+        self.timeline.append(_new_tuple(CycleTiming, (start, transfer.cycle, phases, self._bit_s)))
         end = start + to_end  # CycleTiming.end, .latch, .io_busy: the same sums
-        events = [(end, "end")]
-        if transfer.cycle is Cycle.DATA:
-            events += [(start + to_latch, "latch"), (start + to_io, "io")]
+        events = [(end, "end"), (start + to_latch, "latch"), (start + to_io, "io")] \
+            if transfer.cycle is Cycle.DATA else [(end, "end")]  # fmt: skip
         self._events = events
         self._next_start = end if self.cycle_time_s is None else max(end, start + self.cycle_time_s)
         self._next_at = events[-1][0]
