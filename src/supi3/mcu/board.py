@@ -69,6 +69,8 @@ from supi3.sdk.bench import (
     MainLoopPasses,
     MasterStart,
     ServeWait,
+    check_run_cycles,
+    check_run_seconds,
     default_config,
     discovery_master,
     serve_wait_s,
@@ -851,7 +853,7 @@ class Board:
             The firmware touched a peripheral whose clock is off or which RCC_APB2RSTR holds in reset (MCU-7,
             MCU-29).
         """
-        target = self.cycles + check_int("cycles", cycles, 0)
+        target = self.cycles + check_run_cycles(cycles, self.now, self.config.bit_rate)  # A26
         self._passes.end()
         self._serve_end = None
         self.served = False  # until the run ends served (MCU-30)
@@ -875,7 +877,7 @@ class Board:
         cycles that start before the end run whole, then the line idles up to the end, to the nearest status
         telegram; a cycle that runs past the end ends the call there, and the rest of a cycle time's idle is left
         to the next call; the firmware's handler of the last cycle is not waited for (as at transaction level)."""
-        seconds = check_real("seconds", seconds, 0.0)
+        seconds = check_run_seconds(seconds, self.now)  # A26
         ring = self._ring
         if ring is not None:
             end_s = ring.now + seconds

@@ -55,6 +55,8 @@ __all__ = [
     "MainLoopPasses",
     "MasterStart",
     "ServeWait",
+    "check_run_cycles",
+    "check_run_seconds",
     "default_config",
     "discovery_master",
     "resume_s",
@@ -248,6 +250,38 @@ def resume_s(since: float, scheduled: float, now: float, bit_rate: int) -> float
         ``scheduled`` not a number >= 0 (infinity: no schedule), or :func:`telegram_end_s`'s arguments.
     """
     return max(check_real("scheduled", scheduled, 0.0, finite=False), telegram_end_s(since, now, bit_rate))
+
+
+def check_run_cycles(cycles: object, now: float, bit_rate: int) -> int:
+    """A26: ``cycles``, the master cycles of a run from bus time ``now`` at ``bit_rate``, the one check of the firmware
+    bench's :meth:`Bench.run` and the emulated board's run: an integer from 0, no more than fit before the bus
+    time's maximum (no cycle is shorter than the shortest of a one-device ring; a count too large for a float,
+    2**53 and more, is refused as that many).
+
+    Raises
+    ------
+    ArgumentError
+        ``cycles`` not an integer from 0, or more than fit before :data:`~supi3.interbus.wire.MAX_BUS_TIME_S`.
+    """
+    count = check_int("cycles", cycles, 0)
+    shortest = wire.cycle_bits(0, 1) / wire.check_bit_rate(bit_rate)
+    wire.check_bus_time("cycles", cycles, now, min(count, 2**53) * shortest)
+    return count
+
+
+def check_run_seconds(seconds: object, now: float) -> float:
+    """A26: ``seconds``, the bus time a timed run from ``now`` lasts, the one check of the firmware bench's
+    :meth:`Bench.run_for` and the emulated board's: a finite number >= 0 that does not take bus time past its
+    maximum (1e30 s ran for ever).
+
+    Raises
+    ------
+    ArgumentError
+        ``seconds`` not a finite number >= 0, or past :data:`~supi3.interbus.wire.MAX_BUS_TIME_S` from ``now``.
+    """
+    value = check_real("seconds", seconds, 0.0)
+    wire.check_bus_time("seconds", seconds, now, value)
+    return value
 
 
 def serve_wait_s(bit_rate: int) -> float:
@@ -809,12 +843,7 @@ class Bench:
         ArgumentError
             ``cycles`` not an integer from 0, or more than fit before the bus time's maximum (A26); nothing runs.
         """
-        count = check_int("cycles", cycles, 0)
-        # A26: no cycle is shorter than the shortest of a one-device ring; more than fit before the maximum are refused
-        # (2**53 of them pass it: a count too large for a float is refused as that many)
-        shortest = wire.cycle_bits(0, 1) / self.config.bit_rate
-        wire.check_bus_time("cycles", cycles, self.now, min(count, 2**53) * shortest)
-        target = self.cycles + count
+        target = self.cycles + check_run_cycles(cycles, self.now, self.config.bit_rate)
         self.served = False  # until the run ends served (FW-14)
         began = self.now
         self.hold_after(target)
@@ -837,7 +866,14 @@ class Bench:
 
     def last_end(self, began: float) -> float:
         """MCU-55, FW-19: the bus time the last cycle of a run begun at ``began`` ended (``began`` if none has ended
-        since; :meth:`run` and the board's run count their wait from here)."""
+        since; :meth:`run` and the board's run count their wait from here).
+
+        Raises
+        ------
+        ArgumentError
+            ``began`` not a finite number >= 0.
+        """
+        began = check_real("began", began, 0.0)
         if self._held is not None:
             return max(began, self._held[1])
         return max(began, self.timeline[-1].end) if self.timeline and self.timeline[-1].end <= self.now else began
@@ -930,5 +966,11 @@ class Bench:
     def run_for(self, seconds: float) -> None:
         """Run until the clock has moved on by ``seconds``, the master going on (a cycle under way at the end stays
         under way, as the emulated board's ``run_for`` at transaction level; FW-19: before, the bench ran on to the
-        end of a cycle); unlike :meth:`run`, the end does not wait for the main loop's pass (FW-14)."""
-        self._run_to(math.inf, self.now + check_real("seconds", seconds, 0.0))
+        end of a cycle); unlike :meth:`run`, the end does not wait for the main loop's pass (FW-14).
+
+        Raises
+        ------
+        ArgumentError
+            ``seconds`` not a finite number >= 0, or past the bus time's maximum (A26); nothing runs.
+        """
+        self._run_to(math.inf, self.now + check_run_seconds(seconds, self.now))
