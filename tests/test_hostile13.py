@@ -45,6 +45,8 @@ from supi3.sdk.pins import PinTransport
 from supi3.sdk.transports import ModelTransport, SpidevTransport
 from supi3.top import Supi3Chip
 
+pytest_plugins = ["pytester"]
+
 # ---------------------------------------------------------------------------------------------------------------
 # The firmware bench (supi3.sdk.bench)
 # ---------------------------------------------------------------------------------------------------------------
@@ -461,3 +463,85 @@ def test_board_runs_past_the_bus_time_maximum_are_refused_not_run_for_ever(digit
     with pytest.raises(ArgumentError, match=r"(seconds|cycles) .* past 1048576 s \(A26"):
         run()
     assert board.cycles == 0
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# The pytest plugin (supi3.sdk.pytest_plugin)
+# ---------------------------------------------------------------------------------------------------------------
+
+MARKERS_TEST = """
+import pytest
+
+pytestmark = pytest.mark.supi3(cycle_time_s=300e-6)
+
+
+@pytest.mark.supi3(bit_rate=2_000_000, strict=True)
+class TestAtTwoMegabit:
+    @pytest.mark.supi3(strict=False)
+    def test_the_class_and_module_markers_still_count(self, supi3_bench):
+        assert supi3_bench.config.bit_rate == 2_000_000
+        assert supi3_bench.cycle_time_s == 300e-6
+        assert supi3_bench.registers.violations.strict is False
+
+
+@pytest.mark.supi3(3)
+class TestPositional:
+    @pytest.mark.supi3(strict=False)
+    def test_a_class_marker_s_positional_argument_is_refused(self, supi3_bench):
+        pass
+"""
+
+
+def test_plugin_markers_of_test_class_and_module_add_up(pytester: pytest.Pytester) -> None:
+    """Defect: ``supi3_bench`` read the closest ``supi3`` marker only: a test's ``strict=False`` silently dropped its
+    class's ``bit_rate=2_000_000`` and its module's cycle time (the test ran at 500 kbit/s, back to back); a class
+    marker's positional argument went unchecked. Now the markers add up, the closest keyword winning (UP-46)."""
+    pytester.makepyfile(test_markers=MARKERS_TEST)
+    result = pytester.runpytest("--strict-markers", "-p", "no:cacheprovider")
+    result.assert_outcomes(passed=1, errors=1)
+    result.stdout.fnmatch_lines(["*keyword arguments of Bench only*not (3,)*"])
+
+
+class _Nested(_Io):
+    """A firmware whose ``where`` (setup, isr or loop) runs the bench it runs on."""
+
+    def __init__(self, where: str, call: str) -> None:
+        self.where, self.call = where, call
+        self.bench: Bench | None = None
+        self.refused: list[str] = []
+
+    def _nest(self, where: str) -> None:
+        if where == self.where and self.bench is not None:
+            try:
+                self.bench.run(1) if self.call == "run" else self.bench.run_for(1e-4)
+            except Supi3Error as error:
+                self.refused.append(str(error))
+
+    def setup(self, drv: Supi3Driver) -> None:
+        super().setup(drv)
+        self._nest("setup")
+
+    def isr(self, drv: Supi3Driver) -> None:
+        super().isr(drv)
+        self._nest("isr")
+
+    def loop(self, drv: Supi3Driver) -> None:
+        drv.transport.delay_us(20)
+        self._nest("loop")
+
+
+@pytest.mark.parametrize("call", ["run", "run_for"])
+@pytest.mark.parametrize("where", ["setup", "isr", "loop"])
+def test_bench_run_from_inside_the_firmware_is_refused(where: str, call: str) -> None:
+    """Defect: a firmware's service routine that called ``bench.run(1)`` nested a run in the run: the inner run's
+    hold and resume cut the outer one's (``run(3)`` and the inner ``run(1)`` made 3 cycles in all, FW-19), and a
+    main loop that called ``bench.run_for`` recursed until RecursionError. The bench runs the firmware; the firmware
+    does not run the bench: a :class:`BenchError` naming the call and the firmware's method, and the outer run
+    still runs exactly its cycles."""
+    firmware = _Nested(where, call)
+    bench = Bench(firmware=firmware)
+    firmware.bench = bench
+    bench.run(3)
+    assert bench.cycles == 3
+    assert firmware.refused
+    assert all(f"Bench.{call}() called from the firmware's {where}()" in text for text in firmware.refused)

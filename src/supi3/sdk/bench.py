@@ -647,6 +647,7 @@ class Bench:
         self._irq_level = 1
         self._irq_fell_at: float | None = None
         self._in_isr = False
+        self._in_firmware: str | None = None  # the Firmware method the bench runs now ("setup", "loop"; isr: _in_isr)
         self._set_up = False
         self.served = True
         """FW-14: the last :meth:`run` ended with the firmware's work served (False: the wait for the main loop's
@@ -806,7 +807,11 @@ class Bench:
         if not self._set_up:
             self._set_up = True
             if self.firmware is not None:
-                self.firmware.setup(self.driver)
+                self._in_firmware = "setup"
+                try:
+                    self.firmware.setup(self.driver)
+                finally:
+                    self._in_firmware = None
             self.set_up_done(self.now)
 
     def set_up_done(self, at: float) -> None:
@@ -839,10 +844,12 @@ class Bench:
         Raises
         ------
         BenchError
-            If the firmware's main loop runs :data:`IDLE_LOOPS_LIMIT` times without clocking a byte or waiting.
+            If the firmware's main loop runs :data:`IDLE_LOOPS_LIMIT` times without clocking a byte or waiting; if
+            called from the firmware's own code (:meth:`_outside_firmware`), nothing runs.
         ArgumentError
             ``cycles`` not an integer from 0, or more than fit before the bus time's maximum (A26); nothing runs.
         """
+        self._outside_firmware("run")
         target = self.cycles + check_run_cycles(cycles, self.now, self.config.bit_rate)
         self.served = False  # until the run ends served (FW-14)
         began = self.now
@@ -852,6 +859,15 @@ class Bench:
             self.served = self._serve(self.last_end(began))
         finally:
             self.resume()
+
+    def _outside_firmware(self, call: str) -> None:
+        """Refuse ``call`` (:meth:`run`, :meth:`run_for`) from inside the firmware's set-up, service routine or main
+        loop pass, which the bench itself runs: nested, the inner run's hold and resume broke the outer one's count
+        of cycles (FW-19), and a main loop that ran the bench recursed without end."""
+        inside = "isr" if self._in_isr else self._in_firmware
+        if inside is not None:
+            raise BenchError(f"Bench.{call}() called from the firmware's {inside}(), which the bench is running: the "
+                             "test runs the bench, the firmware waits with drv.transport.delay_us() (FW-1, FW-19)")
 
     def hold_after(self, cycles: int) -> None:
         """MCU-55, FW-19: the master starts no cycle once :attr:`cycles` has reached ``cycles`` (a cycle under way
@@ -917,7 +933,11 @@ class Bench:
         """One pass of the main loop; the passes in a row before it and with it that clocked no byte and waited for
         nothing (FW-5)."""
         before = (self.now, self.bytes_clocked)
-        loop(self.driver)
+        self._in_firmware = "loop"
+        try:
+            loop(self.driver)
+        finally:
+            self._in_firmware = None
         if (self.now, self.bytes_clocked) != before:
             return 0
         if idle_loops + 1 < IDLE_LOOPS_LIMIT:
@@ -970,7 +990,10 @@ class Bench:
 
         Raises
         ------
+        BenchError
+            Called from the firmware's own code (:meth:`_outside_firmware`); nothing runs.
         ArgumentError
             ``seconds`` not a finite number >= 0, or past the bus time's maximum (A26); nothing runs.
         """
+        self._outside_firmware("run_for")
         self._run_to(math.inf, self.now + check_run_seconds(seconds, self.now))
