@@ -105,7 +105,8 @@ def test_history_bench_clock_never_goes_back_and_run_n_runs_n_cycles(
 ) -> None:  # fmt: skip
     """Over any history of runs, timed runs, bus-time steps, master outputs, ring faults (bit flips, dead lines,
     truncations), fault clearing, Alarm Stops and firmware writes: the clock and the ring's never go back,
-    ``run(n)`` finishes exactly ``n`` master cycles (MCU-55, FW-19), ``run_for(s)`` moves the clock at least ``s``,
+    ``run(n)`` finishes exactly ``n`` master cycles (MCU-55, FW-19), ``run_for(s)`` moves the clock at least ``s``
+    and finishes a cycle if ``s`` is 2 ms or more (a run's hold has ended),
     cycles start in order, and the master goes on once the faults are cleared (not stuck)."""
     bench = Bench(firmware=None if firmware is None else firmware(), bit_rate=bit_rate, cycle_time_s=cycle_time,
                   others=[PlainDevice(0x02, 1) for _ in range(others)], strict=False)  # fmt: skip
@@ -119,9 +120,10 @@ def test_history_bench_clock_never_goes_back_and_run_n_runs_n_cycles(
         if action == "run":
             bench.run(value % 5)
             assert bench.cycles == cycles + value % 5
-        elif action == "run_for":
-            bench.run_for(value % 1000 * 1e-6)
-            assert bench.now >= now + value % 1000 * 1e-6
+        elif action == "run_for":  # up to 4 ms: at least one whole cycle from 2 ms on (the master is not held)
+            bench.run_for(value % 4000 * 1e-6)
+            assert bench.now >= now + value % 4000 * 1e-6
+            assert bench.cycles > cycles or value % 4000 < 2000
         elif action == "out" and bench.master.config and bench.master.entry(1).data_bytes == 2:
             bench.master.set_outputs(1, put_u16(value))
         elif action == "flip":
@@ -164,16 +166,19 @@ _REFUSED: dict[str, Callable[[Supi3Driver], object]] = {
 
 
 @settings(max_examples=80, deadline=None)
-@given(steps=DRIVER_STEPS, bit_rate=st.sampled_from([500_000, 2_000_000]), gap=st.sampled_from([0.0, 3.0]))
+@given(steps=DRIVER_STEPS, bit_rate=st.sampled_from([500_000, 2_000_000]), gap=st.sampled_from([0.0, 3.0]),
+       mode=st.sampled_from(list(Mode)))  # fmt: skip
 def test_history_driver_on_the_bench_leaves_the_chip_waiting_for_a_command(steps: list[tuple[str, int]],
-                                                                           bit_rate: int, gap: float) -> None:
+                                                                           bit_rate: int, gap: float,
+                                                                           mode: Mode) -> None:  # fmt: skip
     """Over any history of driver calls on the bench (register and block accesses, interrupt service, polls of the
     I/O window, SAS_INIT and a new initialization), calls the driver refuses, rule violations the strict chip raises
     (a data access in the latch phase) and bench runs between: after each call the chip waits for a command byte
-    (C/D = 0, 3.4.3), the driver is initialized and reads back the ID it last wrote (FW-16: nothing half sent)."""
-    bench = Bench(bit_rate=bit_rate, frame_gap_us=gap)
+    (C/D = 0, 3.4.3), the driver is initialized and reads back the ID it last wrote (FW-16: nothing half sent), in
+    either interface type."""
+    bench = Bench(bit_rate=bit_rate, frame_gap_us=gap, mode=mode)
     drv = bench.driver
-    drv.initialize(Mode.MOTOROLA)
+    drv.initialize(mode)
     drv.configure(0x83, 0x01)
     drv.irq_enable(Irq.VALID)
     bench.run(3)
@@ -195,7 +200,7 @@ def test_history_driver_on_the_bench_leaves_the_chip_waiting_for_a_command(steps
                 drv.poll_io_window(1 + value % 4)
             elif action == "sas":
                 drv.sas_init()
-                drv.initialize(Mode.MOTOROLA)
+                drv.initialize(mode)
             elif action == "run":
                 bench.run(value % 3)
             elif action == "run_for":
@@ -205,7 +210,8 @@ def test_history_driver_on_the_bench_leaves_the_chip_waiting_for_a_command(steps
                     _REFUSED[action](drv)
         except TransportError:
             raise
-        except (DriverError, Supi3Error):  # a poll that timed out, a data access in the latch phase
+        except (DriverError, Supi3Error):  # a poll that timed out, a data access in the latch phase, no exchange in
+            # Intel mode
             pass
         assert bench.transport.read_cd() == 0
         assert drv.initialized
@@ -545,3 +551,39 @@ def test_bench_run_from_inside_the_firmware_is_refused(where: str, call: str) ->
     assert bench.cycles == 3
     assert firmware.refused
     assert all(f"Bench.{call}() called from the firmware's {where}()" in text for text in firmware.refused)
+
+
+def test_cli_firmware_build_names_a_define_with_a_line_break(source: Path, tmp_path: Path,
+                                                             capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+    """Defect: ``supi3 firmware build -D 'A=1<newline>#error x'`` ran the compiler, whose -Werror refused the macro
+    ("the firmware does not build"); now the -D option is named before any work, one line, exit status 2."""
+    from supi3 import cli
+
+    assert cli.main(["firmware", "build", str(source), "-o", str(tmp_path / "fw.elf"), "-D", "A=1\n#error x"]) == 2
+    err = capsys.readouterr().err
+    assert "-D must be NAME or NAME=VALUE with a C identifier NAME and a one-line VALUE" in err
+    assert not (tmp_path / "fw.elf").exists()
+
+
+def test_run_firmware_refuses_a_firmware_that_is_no_path(digital_io: Path) -> None:
+    """Defect: ``run_firmware(FirmwareImage.load(...))`` (the ``Board`` takes an image) ran the whole power-up, then
+    raised ``Path(image)``'s TypeError building the report; now an ArgumentError naming ``firmware`` first."""
+    from supi3.mcu.core import FirmwareImage
+    from supi3.mcu.session import run_firmware
+
+    with pytest.raises(ArgumentError, match=r"firmware must be a path of an ELF file \(str or os.PathLike\), not "):
+        run_firmware(FirmwareImage.load(digital_io))  # type: ignore[arg-type]
+
+
+def test_fw_board_inputs_refuse_more_than_the_terminals(digital_io: Path) -> None:
+    """Defect: ``board.fw_board.inputs = 5 bytes`` wrote the first four and dropped the fifth without a word (the
+    firmware's ``inputs[FW_DATA_BYTES]`` holds 4); now an ArgumentError, the terminals unchanged."""
+    from supi3.mcu.board import Board
+
+    board = Board(digital_io)
+    fw_board = board.fw_board
+    assert fw_board is not None
+    fw_board.inputs = b"\x12\x34"
+    with pytest.raises(ArgumentError, match=r"inputs must be at most 4 bytes"):
+        fw_board.inputs = b"\x01\x02\x03\x04\x05"
+    assert fw_board.inputs == b"\x12\x34\x00\x00"

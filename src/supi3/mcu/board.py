@@ -237,7 +237,11 @@ class FwBoard:
 
     @inputs.setter
     def inputs(self, data: bytes) -> None:
-        self.core.write_bytes(self.address + self.INPUTS, check_bytes("inputs", data).ljust(4, b"\0")[:4])
+        """At most 4 bytes, the rest 0 (5 bytes lost the fifth silently: ArgumentError)."""
+        data = check_bytes("inputs", data)
+        if len(data) > self.OUTPUTS - self.INPUTS:
+            raise fail("inputs", "at most 4 bytes (fw_board_t's inputs[FW_DATA_BYTES], examples/fw_board.h)", data)
+        self.core.write_bytes(self.address + self.INPUTS, data.ljust(4, b"\0"))
 
     @property
     def outputs(self) -> bytes:
