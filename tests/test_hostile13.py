@@ -28,7 +28,7 @@ from supi3.interbus.device import PlainDevice
 from supi3.interbus.ring import BitFlip, DeadLine, Truncate
 from supi3.mcu import build as mcu_build
 from supi3.model.chip import Supi3
-from supi3.regmap import ID, IN0, OUT0, REGISTER_MAP, SET
+from supi3.regmap import ID, IN0, REGISTER_MAP, SET
 from supi3.regmap.core import AccessDirection, RegisterMapError, Reset
 from supi3.sdk.bench import Bench, Firmware, default_config
 from supi3.sdk.driver import (
@@ -41,6 +41,7 @@ from supi3.sdk.driver import (
     TransportError,
     put_u16,
 )
+from supi3.sdk.examples.digital import DigitalIo
 from supi3.sdk.pins import PinTransport
 from supi3.sdk.transports import ModelTransport, SpidevTransport
 from supi3.top import Supi3Chip
@@ -71,21 +72,8 @@ def test_bench_last_end_refuses_what_is_no_bus_time(began: object) -> None:
         bench.last_end(began)  # type: ignore[arg-type]
 
 
-class _Io(Firmware):
-    """One word, the VALID interrupt; the service routine answers the master's word with it."""
-
-    def setup(self, drv: Supi3Driver) -> None:
-        drv.initialize(Mode.MOTOROLA)
-        drv.configure(0x83, 0x01)
-        drv.irq_enable(Irq.VALID)
-
-    def isr(self, drv: Supi3Driver) -> None:
-        if drv.irq_service() & Irq.VALID:
-            drv.write(IN0, drv.read(OUT0))
-
-
-class _Loop(_Io):
-    """As :class:`_Io`, with a main loop that waits."""
+class _Loop(DigitalIo):
+    """The digital I/O example with a main loop that waits."""
 
     def loop(self, drv: Supi3Driver) -> None:
         drv.transport.delay_us(20)
@@ -97,7 +85,7 @@ BENCH_STEPS = st.lists(st.tuples(st.sampled_from(["run", "run_for", "out", "flip
 
 
 @settings(max_examples=60, deadline=None)
-@given(steps=BENCH_STEPS, firmware=st.sampled_from([None, _Io, _Loop]), others=st.integers(0, 2),
+@given(steps=BENCH_STEPS, firmware=st.sampled_from([None, DigitalIo, _Loop]), others=st.integers(0, 2),
        cycle_time=st.sampled_from([None, 300e-6]), bit_rate=st.sampled_from([500_000, 2_000_000]))  # fmt: skip
 def test_history_bench_clock_never_goes_back_and_run_n_runs_n_cycles(
     steps: list[tuple[str, int]], firmware: type[Firmware] | None, others: int, cycle_time: float | None,
@@ -508,10 +496,11 @@ def test_plugin_markers_of_test_class_and_module_add_up(pytester: pytest.Pyteste
     result.stdout.fnmatch_lines(["*keyword arguments of Bench only*not (3,)*"])
 
 
-class _Nested(_Io):
+class _Nested(DigitalIo):
     """A firmware whose ``where`` (setup, isr or loop) runs the bench it runs on."""
 
     def __init__(self, where: str, call: str) -> None:
+        super().__init__()
         self.where, self.call = where, call
         self.bench: Bench | None = None
         self.refused: list[str] = []
