@@ -30,7 +30,7 @@ from supi3.mcu import build as mcu_build
 from supi3.model.chip import Supi3
 from supi3.regmap import ID, IN0, REGISTER_MAP, SET
 from supi3.regmap.core import AccessDirection, RegisterMapError, Reset
-from supi3.sdk.bench import Bench, Firmware, default_config
+from supi3.sdk.bench import START_WAIT_S, Bench, Firmware, MasterStart, ServeWait, default_config
 from supi3.sdk.driver import (
     DriverArgumentError,
     DriverError,
@@ -576,3 +576,22 @@ def test_fw_board_inputs_refuse_more_than_the_terminals(digital_io: Path) -> Non
     with pytest.raises(ArgumentError, match=r"inputs must be at most 4 bytes"):
         fw_board.inputs = b"\x01\x02\x03\x04\x05"
     assert fw_board.inputs == b"\x12\x34\x00\x00"
+
+
+def test_bench_timing_rules_refuse_what_is_no_bus_time() -> None:
+    """Defect: ``MasterStart.due(nan)`` and ``ServeWait.over(nan)`` answered False (a master that never starts, a
+    wait that never ends), ``CycleTiming.at('3')`` raised TypeError and ``at(-1)`` gave a time before the cycle."""
+    start, wait = MasterStart(), ServeWait(500_000)
+    wait.begin(1e-3)
+    with pytest.raises(ArgumentError, match=r"now must be a number >= 0.0, not nan"):
+        start.due(math.nan)
+    with pytest.raises(ArgumentError, match=r"now must be a number >= 0.0, not nan"):
+        wait.over(math.nan)
+    assert start.due(START_WAIT_S) and not wait.over(0.0) and wait.over(math.inf)
+    bench = Bench()
+    bench.run(1)
+    timing = bench.timeline[0]
+    for bit in ("3", -1, 1.0):
+        with pytest.raises(ArgumentError, match=r"bit must be an integer >= 0"):
+            timing.at(bit)  # type: ignore[arg-type]
+    assert timing.at(0) > timing.start

@@ -127,7 +127,15 @@ class MasterStart:
         return True
 
     def due(self, now: float) -> bool:
-        """Whether the master starts at bus time ``now`` (at or after :attr:`at`)."""
+        """Whether the master starts at bus time ``now`` (at or after :attr:`at`).
+
+        Raises
+        ------
+        ArgumentError
+            ``now`` not a number >= 0 (NaN was never due: the master never started).
+        """
+        if not (type(now) is float and now >= 0.0):  # the board asks every status telegram: one test when valid
+            now = check_real("now", now, 0.0, finite=False)
         return now >= self.at
 
     def start_s(self, bit_rate: int) -> float:
@@ -231,7 +239,15 @@ class ServeWait:
 
     def over(self, now: float) -> bool:
         """Whether the wait has reached its bound at bus time ``now`` (to half a status telegram: the pin-level line
-        idles in whole telegrams, whose float sum may fall an ulp short)."""
+        idles in whole telegrams, whose float sum may fall an ulp short).
+
+        Raises
+        ------
+        ArgumentError
+            ``now`` not a number >= 0 (NaN was never over: the wait never ended).
+        """
+        if not (type(now) is float and now >= 0.0):
+            now = check_real("now", now, 0.0, finite=False)
         return now >= self.until - self._half_s
 
     def end(self) -> None:
@@ -368,7 +384,15 @@ class CycleTiming(NamedTuple):
     bit_s: float
 
     def at(self, bit: int) -> float:
-        """The mid-bit sample of bit period ``bit`` (0 = the cycle's first): when the chip decides on it (A1)."""
+        """The mid-bit sample of bit period ``bit`` (0 = the cycle's first): when the chip decides on it (A1).
+
+        Raises
+        ------
+        ArgumentError
+            ``bit`` not an integer >= 0.
+        """
+        if type(bit) is not int or bit < 0:
+            bit = check_int("bit", bit, 0)
         return self.start + bit_offset(bit, self.bit_s)
 
     @property
