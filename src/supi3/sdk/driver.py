@@ -698,7 +698,9 @@ class Supi3Driver(_DriverApi):
                     kind, argument, s_r = call.send(answer)
                     if kind == _XFER:
                         try:
-                            answer = received_byte(transport.xfer(int(argument), s_r))
+                            answer = transport.xfer(int(argument), s_r)
+                            if type(answer) is not int or not 0 <= answer <= 0xFF:  # every frame: one test
+                                answer = received_byte(answer)
                         except (OSError, TransportError) as error:
                             core.initialized = False
                             raise _transport_error(error) from error
@@ -922,20 +924,27 @@ def pin_level(name: str, level: object) -> int | None:
                          "not wired)")  # fmt: skip
 
 
+_PIN_READS: Final[dict[int, str]] = {_CD: "read_cd", _IRQ: "read_irq", _IO: "read_io"}
+"""The transport's read of each pin the driver reads (:func:`pin_level` names it)."""
+
+
 def _pin(transport: Transport, kind: int, level: int) -> int | bool | None:
     if kind == _CD:
-        return pin_level("read_cd", transport.read_cd())
-    if kind == _IRQ:
-        return pin_level("read_irq", transport.read_irq())
-    if kind == _IO:
-        return pin_level("read_io", transport.read_io())
-    return transport.set_sas_init(level)
+        value = transport.read_cd()
+    elif kind == _IRQ:
+        value = transport.read_irq()
+    elif kind == _IO:
+        value = transport.read_io()  # a polling firmware's every poll: the check below in one test when valid
+    else:
+        return transport.set_sas_init(level)
+    if value is None or (type(value) is int and 0 <= value <= 1):
+        return value
+    return pin_level(_PIN_READS[kind], value)
 
 
 async def _async_pin(transport: AsyncTransport, kind: int, level: int) -> int | bool | None:
     if kind == _SAS:
         return await transport.set_sas_init(level)
-    name, read = {_CD: ("read_cd", transport.read_cd), _IRQ: ("read_irq", transport.read_irq),
-                  _IO: ("read_io", transport.read_io)}[kind]  # fmt: skip
-    return pin_level(name, await read())
+    read = {_CD: transport.read_cd, _IRQ: transport.read_irq, _IO: transport.read_io}[kind]
+    return pin_level(_PIN_READS[kind], await read())
 
