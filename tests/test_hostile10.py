@@ -528,7 +528,7 @@ class CountingSpidevModule:
 
 
 @pytest.mark.parametrize(("args", "options", "message"), [
-    ((0, 0), {"speed_hz": 0}, r"speed_hz must be an integer >= 1"),
+    ((0, 0), {"speed_hz": 0}, r"speed_hz must be an integer from 1"),
     ((0, 0), {"speed_hz": 1.5e6}, r"speed_hz must be an integer"),
     ((-1, 0), {}, r"bus must be an integer >= 0"),
     ((0, "0"), {}, r"device must be an integer >= 0"),

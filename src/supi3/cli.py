@@ -666,8 +666,9 @@ def cmd_firmware_build(args: argparse.Namespace) -> None:
     defines = {}
     for text in args.defines:
         name, _, value = text.partition("=")
-        if not MACRO_NAME.fullmatch(name):
-            raise CommandLineError(f"-D must be NAME or NAME=VALUE with a C identifier NAME, not {_shown(text)}")
+        if not MACRO_NAME.fullmatch(name) or any(c in value for c in "\r\n\0"):  # a line break ends the macro
+            raise CommandLineError(f"-D must be NAME or NAME=VALUE with a C identifier NAME and a one-line VALUE, "
+                                   f"not {_shown(text)}")
         defines[name] = value if _ else "1"
     try:
         print(build(args.sources, out, cpu=args.cpu, defines=defines))

@@ -81,6 +81,8 @@ from supi3.sdk.bench import (
     MainLoopPasses,
     MasterStart,
     ServeWait,
+    check_run_cycles,
+    check_run_seconds,
     default_config,
     discovery_master,
     serve_wait_s,
@@ -248,7 +250,11 @@ class FwBoard:
 
     @inputs.setter
     def inputs(self, data: bytes) -> None:
-        self.core.write_bytes(self.address + self.INPUTS, check_bytes("inputs", data).ljust(4, b"\0")[:4])
+        """At most 4 bytes, the rest 0 (5 bytes lost the fifth silently: ArgumentError)."""
+        data = check_bytes("inputs", data)
+        if len(data) > self.OUTPUTS - self.INPUTS:
+            raise fail("inputs", "at most 4 bytes (fw_board_t's inputs[FW_DATA_BYTES], examples/fw_board.h)", data)
+        self.core.write_bytes(self.address + self.INPUTS, data.ljust(4, b"\0"))
 
     @property
     def outputs(self) -> bytes:
@@ -922,10 +928,10 @@ class Board:
             The firmware touched a peripheral whose clock is off or which RCC_APB2RSTR holds in reset (MCU-7,
             MCU-29).
         """
-        count = check_int("cycles", cycles, 0)
         # MCU-76: a cycle a run_for left under way (transaction level) ends first, then the run's own cycles start,
         # as at pin level, whose run_for runs it whole
-        target = self.cycles + count + (self._bench is not None and self._bench.under_way)
+        target = (self.cycles + check_run_cycles(cycles, self.now, self.config.bit_rate)  # A26
+                  + (self._bench is not None and self._bench.under_way))
         self._passes.end()
         self._serve_end = None
         self.served = False  # until the run ends served (MCU-30)
@@ -949,7 +955,7 @@ class Board:
         cycles that start before the end run whole, then the line idles up to the end, to the nearest status
         telegram; a cycle that runs past the end ends the call there, and the rest of a cycle time's idle is left
         to the next call; the firmware's handler of the last cycle is not waited for (as at transaction level)."""
-        seconds = check_real("seconds", seconds, 0.0)
+        seconds = check_run_seconds(seconds, self.now)  # A26
         ring = self._ring
         if ring is not None:
             end_s = ring.now + seconds

@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Final
 
 from supi3 import sdk
-from supi3.checks import fail
+from supi3.checks import check_bool, fail
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.mcu.core import check_cpu
 
@@ -45,6 +45,8 @@ FLAGS: Final[tuple[str, ...]] = ("-target", "thumb-freestanding-eabi", "-ffreest
 """Flags of every firmware build besides ``-mcpu`` and the paths: the SDK's strict C99 flags, no library."""
 MACRO_NAME: Final[re.Pattern[str]] = re.compile(r"[A-Za-z_][A-Za-z0-9_]*", re.ASCII)
 """A macro name of ``defines``: a C identifier."""
+_DEFINES: Final[str] = "a mapping of C identifiers to one-line str values"
+"""What ``defines`` must be (its error's words)."""
 SOURCE_SUFFIXES: Final[tuple[str, ...]] = (".c", ".S", ".h")
 """Suffixes ``output`` may not have: the ELF would replace a source (``-o a.c a.c``; MCU-48)."""
 
@@ -79,7 +81,15 @@ def toolchain_missing() -> str | None:
 def build_command(sources: Sequence[str | Path], output: str | Path, *, cpu: str = "cortex_m3",
                   defines: Mapping[str, str] | None = None, include_dirs: Iterable[str | Path] = (),
                   compiler_rt: bool = False, port: bool = True) -> list[str]:  # fmt: skip
-    """The command line :func:`build` runs (see the module's docstring)."""
+    """The command line :func:`build` runs (see the module's docstring).
+
+    Raises
+    ------
+    ArgumentError
+        ``cpu`` not one of the board's; ``sources`` not existing .c or .S files; ``output`` a folder, in a folder
+        that does not exist, a source or a .c, .S or .h file (MCU-48); ``defines`` not a mapping of C identifiers to
+        one-line str values; ``include_dirs`` not existing folders; ``compiler_rt`` or ``port`` not a bool.
+    """
     check_cpu(cpu)
     if isinstance(sources, str | bytes) or not isinstance(sources, Sequence) or not sources \
             or not all(isinstance(s, str | PathLike) for s in sources):  # fmt: skip
@@ -88,16 +98,29 @@ def build_command(sources: Sequence[str | Path], output: str | Path, *, cpu: str
     for path in paths:
         if not path.is_file() or path.suffix not in (".c", ".S"):
             raise ArgumentError("sources", path, f"sources must be paths of existing .c or .S files, not {str(path)!r}")
-    if not isinstance(output, str | PathLike) or Path(output).suffix in SOURCE_SUFFIXES \
+    # the compiler cannot write into a folder that does not exist, nor over a folder: refused here, not blamed on the
+    # firmware ("does not build")
+    if not isinstance(output, str | PathLike) or Path(output).suffix in SOURCE_SUFFIXES or Path(output).is_dir() \
+            or not Path(output).parent.is_dir() \
             or any(Path(output).resolve() == path.resolve() for path in paths):  # fmt: skip
-        raise fail("output", "a path of the ELF file to write, neither one of the sources nor a .c, .S or .h file "
-                   "(MCU-48)", output)
+        raise fail("output", "a path of the ELF file to write, in an existing folder, neither a folder, one of the "
+                   "sources nor a .c, .S or .h file (MCU-48)", output)
+    if defines is not None and not isinstance(defines, Mapping):
+        raise fail("defines", _DEFINES, defines)
     for name, value in (defines or {}).items():
-        if not isinstance(name, str) or not MACRO_NAME.fullmatch(name) or not isinstance(value, str):
-            raise fail("defines", "a mapping of C identifiers to str values", {name: value})
+        # a newline ends the macro (the compiler's -Werror refuses it only after a run)
+        if not isinstance(name, str) or not MACRO_NAME.fullmatch(name) or not isinstance(value, str) \
+                or any(c in value for c in "\r\n\0"):  # fmt: skip
+            raise fail("defines", _DEFINES, {name: value})
     if isinstance(include_dirs, str | bytes) or not isinstance(include_dirs, Iterable):
-        raise fail("include_dirs", "an iterable of folder paths", include_dirs)
-    includes = (sdk.include_dir(), sdk.SDK_DIR / "examples", BOARD_DIR, *(Path(d) for d in include_dirs))
+        raise fail("include_dirs", "an iterable of existing folder paths", include_dirs)
+    folders = list(include_dirs)
+    for folder in folders:  # the compiler ignores a -I folder that does not exist
+        if not isinstance(folder, str | PathLike) or not Path(folder).is_dir():
+            raise fail("include_dirs", "an iterable of existing folder paths", folder)
+    check_bool("compiler_rt", compiler_rt)
+    check_bool("port", port)
+    includes = (sdk.include_dir(), sdk.SDK_DIR / "examples", BOARD_DIR, *(Path(d) for d in folders))
     macros = [f"-D{name}={value}" for name, value in sorted((defines or {}).items())]
     library = (BOARD_DIR / "startup.c", BOARD_DIR / "board.c", *sdk.sources()) if port else ()
     return [sys.executable, "-m", "ziglang", "cc", f"-mcpu={cpu}", *FLAGS, *(["-lcompiler_rt"] if compiler_rt else []),
@@ -119,6 +142,8 @@ def build(sources: str | Path | Sequence[str | Path], output: str | Path, *, cpu
     ------
     BuildError
         If ziglang is missing or the sources do not compile under :data:`FLAGS`.
+    ArgumentError
+        Bad arguments (:func:`build_command`), before the compiler runs.
     """
     missing = toolchain_missing()
     if missing is not None:

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from os import PathLike
 from pathlib import Path
 from typing import Final
 
@@ -199,11 +200,14 @@ def run_firmware(firmware: str | Path, *, cpu: str = "cortex_m3", cpu_hz: float 
     (:meth:`Board.write_vcd`), also when the run stopped; ``mode``: the board's wiring
     for the interface type the firmware initializes (``Board``'s ``mode``, MCU-18).
 
-    Bad arguments raise :class:`~supi3.errors.Supi3Error` subclasses (``out_data`` or ``in_data`` of the wrong length
+    Bad arguments raise :class:`~supi3.errors.Supi3Error` subclasses (``firmware`` not a path: an
+    :class:`~supi3.errors.ArgumentError` before anything runs; ``out_data`` or ``in_data`` of the wrong length
     after the power-up, MCU-49: :class:`~supi3.errors.ArgumentError`, no report, no VCD); what the firmware does wrong
     is in the report.
     ``OSError`` if the VCD file cannot be written.
     """
+    if not isinstance(firmware, str | PathLike):  # the report names the file (a FirmwareImage raised TypeError there)
+        raise fail("firmware", "a path of an ELF file (str or os.PathLike)", firmware)
     fidelity = check_choice("fidelity", fidelity, FIDELITIES)
     if vcd is not None and fidelity != "pin":
         raise fail("vcd", "None at transaction level (a VCD holds pins: fidelity='pin')", vcd)

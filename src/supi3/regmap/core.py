@@ -31,6 +31,20 @@ def integer(what: str, value: object) -> int:
     return int(value)
 
 
+def _byte(what: str, value: object) -> int:
+    """``value`` as a register byte (0 to 255) of ``what`` (a field or layout name)."""
+    byte = integer(what, value)
+    if not 0 <= byte <= BYTE_MASK:
+        raise RegisterMapError(f"{what}: {byte!r} is not a byte")
+    return byte
+
+
+def _member(what: str, value: object, kind: type[StrEnum]) -> None:
+    """Refuse ``value`` unless it is one of ``kind``'s members (or its string value, which equals it)."""
+    if not any(type(value) in (str, type(member)) and value == member for member in kind):
+        raise RegisterMapError(f"{what} must be one of {', '.join(kind)}, not {value!r:.40}")
+
+
 class AccessDirection(StrEnum):
     """Direction of the data access that follows a command byte, seen from the microprocessor (3.4.4)."""
 
@@ -176,8 +190,14 @@ class Field:
         return ((1 << self.width) - 1) << self.lsb
 
     def extract(self, byte: int) -> int:
-        """Return the field's value (shifted down) from a register byte."""
-        return (byte & self.mask) >> self.lsb
+        """Return the field's value (shifted down) from a register byte.
+
+        Raises
+        ------
+        RegisterMapError
+            If ``byte`` is not a byte (0 to 255).
+        """
+        return (_byte(self.name, byte) & self.mask) >> self.lsb
 
     def insert(self, byte: int, value: int) -> int:
         """Return ``byte`` with the field replaced by ``value``.
@@ -187,6 +207,7 @@ class Field:
         RegisterMapError
             If ``value`` does not fit in the field.
         """
+        byte = _byte(self.name, byte)
         value = integer(f"field {self.name}", value)
         if not 0 <= value < 1 << self.width:
             raise RegisterMapError(f"field {self.name}: {value!r} does not fit in {self.width} bits")
@@ -269,9 +290,7 @@ class ByteLayout:
 
     def decode(self, byte: int) -> dict[str, int]:
         """Split a byte into the values of its base fields."""
-        byte = integer(self.name, byte)
-        if not 0 <= byte <= BYTE_MASK:
-            raise RegisterMapError(f"{self.name}: {byte!r} is not a byte")
+        byte = _byte(self.name, byte)
         return {f.name: f.extract(byte) for f in self.base_fields}
 
 
@@ -366,8 +385,10 @@ class RegisterMap:
         Raises
         ------
         RegisterMapError
-            If ``address`` is outside 0..15.
+            If ``direction`` is not one of :class:`AccessDirection`, or ``address`` is outside 0..15.
         """
+        if type(direction) is not AccessDirection:  # the model's accesses: one test
+            _member("direction", direction, AccessDirection)
         try:
             return self._by_key[(address, direction)]
         except KeyError:
@@ -383,5 +404,13 @@ class RegisterMap:
         raise RegisterMapError(f"no register {name!r}; registers: {[r.name for r in self.registers]}")
 
     def cleared_by(self, reset: Reset) -> tuple[Register, ...]:
-        """The registers that ``reset`` sets back to their reset value (3.4.7)."""
+        """The registers that ``reset`` sets back to their reset value (3.4.7).
+
+        Raises
+        ------
+        RegisterMapError
+            If ``reset`` is not one of :class:`Reset`.
+        """
+        if type(reset) is not Reset:
+            _member("reset", reset, Reset)
         return tuple(r for r in self.registers if reset in r.cleared_by)

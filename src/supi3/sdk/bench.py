@@ -55,6 +55,8 @@ __all__ = [
     "MainLoopPasses",
     "MasterStart",
     "ServeWait",
+    "check_run_cycles",
+    "check_run_seconds",
     "default_config",
     "discovery_master",
     "resume_s",
@@ -125,7 +127,15 @@ class MasterStart:
         return True
 
     def due(self, now: float) -> bool:
-        """Whether the master starts at bus time ``now`` (at or after :attr:`at`)."""
+        """Whether the master starts at bus time ``now`` (at or after :attr:`at`).
+
+        Raises
+        ------
+        ArgumentError
+            ``now`` not a number >= 0 (NaN was never due: the master never started).
+        """
+        if not (type(now) is float and now >= 0.0):  # the board asks every status telegram: one test when valid
+            now = check_real("now", now, 0.0, finite=False)
         return now >= self.at
 
     def start_s(self, bit_rate: int) -> float:
@@ -229,7 +239,15 @@ class ServeWait:
 
     def over(self, now: float) -> bool:
         """Whether the wait has reached its bound at bus time ``now`` (to half a status telegram: the pin-level line
-        idles in whole telegrams, whose float sum may fall an ulp short)."""
+        idles in whole telegrams, whose float sum may fall an ulp short).
+
+        Raises
+        ------
+        ArgumentError
+            ``now`` not a number >= 0 (NaN was never over: the wait never ended).
+        """
+        if not (type(now) is float and now >= 0.0):
+            now = check_real("now", now, 0.0, finite=False)
         return now >= self.until - self._half_s
 
     def end(self) -> None:
@@ -248,6 +266,38 @@ def resume_s(since: float, scheduled: float, now: float, bit_rate: int) -> float
         ``scheduled`` not a number >= 0 (infinity: no schedule), or :func:`telegram_end_s`'s arguments.
     """
     return max(check_real("scheduled", scheduled, 0.0, finite=False), telegram_end_s(since, now, bit_rate))
+
+
+def check_run_cycles(cycles: object, now: float, bit_rate: int) -> int:
+    """A26: ``cycles``, the master cycles of a run from bus time ``now`` at ``bit_rate``, the one check of the firmware
+    bench's :meth:`Bench.run` and the emulated board's run: an integer from 0, no more than fit before the bus
+    time's maximum (no cycle is shorter than the shortest of a one-device ring; a count too large for a float,
+    2**53 and more, is refused as that many).
+
+    Raises
+    ------
+    ArgumentError
+        ``cycles`` not an integer from 0, or more than fit before :data:`~supi3.interbus.wire.MAX_BUS_TIME_S`.
+    """
+    count = check_int("cycles", cycles, 0)
+    shortest = wire.cycle_bits(0, 1) / wire.check_bit_rate(bit_rate)
+    wire.check_bus_time("cycles", cycles, now, min(count, 2**53) * shortest)
+    return count
+
+
+def check_run_seconds(seconds: object, now: float) -> float:
+    """A26: ``seconds``, the bus time a timed run from ``now`` lasts, the one check of the firmware bench's
+    :meth:`Bench.run_for` and the emulated board's: a finite number >= 0 that does not take bus time past its
+    maximum (1e30 s ran for ever).
+
+    Raises
+    ------
+    ArgumentError
+        ``seconds`` not a finite number >= 0, or past :data:`~supi3.interbus.wire.MAX_BUS_TIME_S` from ``now``.
+    """
+    value = check_real("seconds", seconds, 0.0)
+    wire.check_bus_time("seconds", seconds, now, value)
+    return value
 
 
 def serve_wait_s(bit_rate: int) -> float:
@@ -334,7 +384,15 @@ class CycleTiming(NamedTuple):
     bit_s: float
 
     def at(self, bit: int) -> float:
-        """The mid-bit sample of bit period ``bit`` (0 = the cycle's first): when the chip decides on it (A1)."""
+        """The mid-bit sample of bit period ``bit`` (0 = the cycle's first): when the chip decides on it (A1).
+
+        Raises
+        ------
+        ArgumentError
+            ``bit`` not an integer >= 0.
+        """
+        if type(bit) is not int or bit < 0:
+            bit = check_int("bit", bit, 0)
         return self.start + bit_offset(bit, self.bit_s)
 
     @property
@@ -621,6 +679,7 @@ class Bench:
         self._irq_level = 1
         self._irq_fell_at: float | None = None
         self._in_isr = False
+        self._in_firmware: str | None = None  # the Firmware method the bench runs now ("setup", "loop"; isr: _in_isr)
         self._set_up = False
         self.served = True
         """FW-14: the last :meth:`run` ended with the firmware's work served (False: the wait for the main loop's
@@ -780,7 +839,11 @@ class Bench:
         if not self._set_up:
             self._set_up = True
             if self.firmware is not None:
-                self.firmware.setup(self.driver)
+                self._in_firmware = "setup"
+                try:
+                    self.firmware.setup(self.driver)
+                finally:
+                    self._in_firmware = None
             self.set_up_done(self.now)
 
     def set_up_done(self, at: float) -> None:
@@ -814,16 +877,14 @@ class Bench:
         Raises
         ------
         BenchError
-            If the firmware's main loop runs :data:`IDLE_LOOPS_LIMIT` times without clocking a byte or waiting.
+            If the firmware's main loop runs :data:`IDLE_LOOPS_LIMIT` times without clocking a byte or waiting; if
+            called from the firmware's own code (:meth:`_outside_firmware`), nothing runs.
         ArgumentError
             ``cycles`` not an integer from 0, or more than fit before the bus time's maximum (A26); nothing runs.
         """
-        count = check_int("cycles", cycles, 0)
-        # A26: no cycle is shorter than the shortest of a one-device ring; more than fit before the maximum are refused
-        # (2**53 of them pass it: a count too large for a float is refused as that many)
-        shortest = wire.cycle_bits(0, 1) / self.config.bit_rate
-        wire.check_bus_time("cycles", cycles, self.now, min(count, 2**53) * shortest)
-        target = self.cycles + self.under_way + count  # a cycle a run_for left under way ends first (MCU-76)
+        self._outside_firmware("run")
+        # a cycle a run_for left under way ends first (MCU-76)
+        target = self.cycles + self.under_way + check_run_cycles(cycles, self.now, self.config.bit_rate)
         self.served = False  # until the run ends served (FW-14)
         began = self.now
         self.hold_after(target)
@@ -840,6 +901,15 @@ class Bench:
         ``run_for`` runs the cycles it starts whole, MCU-22)."""
         return bool(self.timeline) and self.timeline[-1].end > self.now
 
+    def _outside_firmware(self, call: str) -> None:
+        """Refuse ``call`` (:meth:`run`, :meth:`run_for`) from inside the firmware's set-up, service routine or main
+        loop pass, which the bench itself runs: nested, the inner run's hold and resume broke the outer one's count
+        of cycles (FW-19), and a main loop that ran the bench recursed without end."""
+        inside = "isr" if self._in_isr else self._in_firmware
+        if inside is not None:
+            raise BenchError(f"Bench.{call}() called from the firmware's {inside}(), which the bench is running: the "
+                             "test runs the bench, the firmware waits with drv.transport.delay_us() (FW-1, FW-19)")
+
     def hold_after(self, cycles: int) -> None:
         """MCU-55, FW-19: the master starts no cycle once :attr:`cycles` has reached ``cycles`` (a cycle under way
         ends), until :meth:`resume`: :meth:`run` and the emulated board's run hold it for their wait.
@@ -853,7 +923,14 @@ class Bench:
 
     def last_end(self, began: float) -> float:
         """MCU-55, FW-19: the bus time the last cycle of a run begun at ``began`` ended (``began`` if none has ended
-        since; :meth:`run` and the board's run count their wait from here)."""
+        since; :meth:`run` and the board's run count their wait from here).
+
+        Raises
+        ------
+        ArgumentError
+            ``began`` not a finite number >= 0.
+        """
+        began = check_real("began", began, 0.0)
         if self._held is not None:
             return max(began, self._held[1])
         return max(began, self.timeline[-1].end) if self.timeline and self.timeline[-1].end <= self.now else began
@@ -897,7 +974,11 @@ class Bench:
         """One pass of the main loop; the passes in a row before it and with it that clocked no byte and waited for
         nothing (FW-5)."""
         before = (self.now, self.bytes_clocked)
-        loop(self.driver)
+        self._in_firmware = "loop"
+        try:
+            loop(self.driver)
+        finally:
+            self._in_firmware = None
         if (self.now, self.bytes_clocked) != before:
             return 0
         if idle_loops + 1 < IDLE_LOOPS_LIMIT:
@@ -946,5 +1027,14 @@ class Bench:
     def run_for(self, seconds: float) -> None:
         """Run until the clock has moved on by ``seconds``, the master going on (a cycle under way at the end stays
         under way, as the emulated board's ``run_for`` at transaction level; FW-19: before, the bench ran on to the
-        end of a cycle); unlike :meth:`run`, the end does not wait for the main loop's pass (FW-14)."""
-        self._run_to(math.inf, self.now + check_real("seconds", seconds, 0.0))
+        end of a cycle); unlike :meth:`run`, the end does not wait for the main loop's pass (FW-14).
+
+        Raises
+        ------
+        BenchError
+            Called from the firmware's own code (:meth:`_outside_firmware`); nothing runs.
+        ArgumentError
+            ``seconds`` not a finite number >= 0, or past the bus time's maximum (A26); nothing runs.
+        """
+        self._outside_firmware("run_for")
+        self._run_to(math.inf, self.now + check_run_seconds(seconds, self.now))

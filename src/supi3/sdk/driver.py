@@ -15,8 +15,9 @@ Every call is written once, as a generator of bus operations (sans-I/O): it yiel
 from __future__ import annotations
 
 import contextlib
+import numbers
 from abc import ABC, abstractmethod
-from collections.abc import Awaitable, Callable, Generator
+from collections.abc import Callable, Generator
 from dataclasses import dataclass
 from enum import IntEnum, IntFlag
 from typing import Any, Final, Protocol, TypeVar
@@ -72,8 +73,10 @@ __all__ = [
     "get_u32",
     "optical_length_cm",
     "optical_length_code",
+    "pin_level",
     "put_u16",
     "put_u32",
+    "received_byte",
 ]
 
 _T = TypeVar("_T")
@@ -296,8 +299,15 @@ class Transport(ABC):
         first. Intel: LSB first, S/R set to ``s_r`` before /SS falls (``True``: the µP sends; Table 3-9, UP-9)."""
 
     def delay_us(self, us: float) -> None:
-        """Wait ``us`` microseconds (frame gap, SAS_INIT pulse); the default does not wait."""
-        del us
+        """Wait ``us`` microseconds (frame gap, SAS_INIT pulse); the default does not wait, but refuses what a
+        transport that waits refuses (a test on the bare model runs on the bench too).
+
+        Raises
+        ------
+        ArgumentError
+            ``us`` not a finite number >= 0.
+        """
+        check_real("us", us, 0.0)
 
     def read_cd(self) -> int | None:
         """The C/D pin (MFP2), 0 = command expected; ``None``: not wired."""
@@ -689,6 +699,8 @@ class Supi3Driver(_DriverApi):
                     if kind == _XFER:
                         try:
                             answer = transport.xfer(int(argument), s_r)
+                            if type(answer) is not int or not 0 <= answer <= 0xFF:  # every frame: one test
+                                answer = received_byte(answer)
                         except (OSError, TransportError) as error:
                             core.initialized = False
                             raise _transport_error(error) from error
@@ -803,7 +815,7 @@ class AsyncSupi3Driver(_DriverApi):
                 kind, argument, s_r = call.send(answer)
                 if kind == _XFER:
                     try:
-                        answer = await transport.xfer(int(argument), s_r)
+                        answer = received_byte(await transport.xfer(int(argument), s_r))
                     except (OSError, TransportError) as error:
                         self._core.initialized = False
                         raise _transport_error(error) from error
@@ -879,20 +891,60 @@ def _transport_error(error: BaseException) -> TransportError:
     return TransportError(f"transport failed: {error}; chip state unknown: pulse SAS_INIT and initialize again")
 
 
+def received_byte(rx: object) -> int:
+    """FW-26: ``rx``, what a transport's ``xfer`` returned, as the byte the frame read (FFh when the chip drove
+    none); the driver's check of every frame's answer.
+
+    Raises
+    ------
+    TransportError
+        ``rx`` not an integer from 0 to 255 (a bool is no byte): the driver forgets its initialization, as for any
+        transport failure.
+    """
+    if type(rx) is int and 0 <= rx <= 0xFF:  # every frame: the common case in one test
+        return rx
+    if isinstance(rx, numbers.Integral) and not isinstance(rx, bool) and 0 <= int(rx) <= 0xFF:
+        return int(rx)
+    raise TransportError(f"Transport.xfer returned {describe(rx)}, not a byte 0 to 255 (FW-26: FFh when the chip "
+                         "drives none); chip state unknown: pulse SAS_INIT and initialize again")  # fmt: skip
+
+
+def pin_level(name: str, level: object) -> int | None:
+    """``level``, what the transport's pin read ``name`` (``read_cd``, ``read_irq``, ``read_io``) returned, as 0, 1
+    or ``None`` (not wired); a bool or a numpy integer 0 or 1 passes (a GPIO library's value).
+
+    Raises
+    ------
+    TransportError
+        ``level`` anything else ('0', 2, 0.5): no pin reads it.
+    """
+    if level is None or (isinstance(level, numbers.Integral) and level in (0, 1)):
+        return None if level is None else int(level)
+    raise TransportError(f"Transport.{name} returned {describe(level)}, not 0, 1 or None (the pin's level; None: "
+                         "not wired)")  # fmt: skip
+
+
+_PIN_READS: Final[dict[int, str]] = {_CD: "read_cd", _IRQ: "read_irq", _IO: "read_io"}
+"""The transport's read of each pin the driver reads (:func:`pin_level` names it)."""
+
+
 def _pin(transport: Transport, kind: int, level: int) -> int | bool | None:
     if kind == _CD:
-        return transport.read_cd()
-    if kind == _IRQ:
-        return transport.read_irq()
-    if kind == _IO:
-        return transport.read_io()
-    return transport.set_sas_init(level)
+        value = transport.read_cd()
+    elif kind == _IRQ:
+        value = transport.read_irq()
+    elif kind == _IO:
+        value = transport.read_io()  # a polling firmware's every poll: the check below in one test when valid
+    else:
+        return transport.set_sas_init(level)
+    if value is None or (type(value) is int and 0 <= value <= 1):
+        return value
+    return pin_level(_PIN_READS[kind], value)
 
 
 async def _async_pin(transport: AsyncTransport, kind: int, level: int) -> int | bool | None:
-    calls: dict[int, Callable[[], Awaitable[int | bool | None]]] = {
-        _CD: transport.read_cd, _IRQ: transport.read_irq, _IO: transport.read_io,
-        _SAS: lambda: transport.set_sas_init(level),
-    }  # fmt: skip
-    return await calls[kind]()
+    if kind == _SAS:
+        return await transport.set_sas_init(level)
+    read = {_CD: transport.read_cd, _IRQ: transport.read_irq, _IO: transport.read_io}[kind]
+    return pin_level(_PIN_READS[kind], await read())
 

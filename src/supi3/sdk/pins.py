@@ -14,7 +14,7 @@ import contextlib
 import math
 from typing import Final
 
-from supi3.checks import check_real, describe
+from supi3.checks import check_int, check_real, describe
 from supi3.model.pins import RESET_STRETCH_CLOCKS
 from supi3.sdk.driver import UNDRIVEN_BYTE, DriverArgumentError, Mode, Transport
 from supi3.spi.master import MasterTiming, SoftMaster
@@ -88,8 +88,14 @@ class PinTransport(Transport):
         return self.master.io
 
     def set_sas_init(self, level: int) -> bool:
-        """SAS_INIT (MFP0): ``1`` pulses it for the shortest time Table 3-7 allows; ``0`` (its end) does nothing."""
-        if level:
+        """SAS_INIT (MFP0): ``1`` pulses it for the shortest time Table 3-7 allows; ``0`` (its end) does nothing.
+
+        Raises
+        ------
+        ArgumentError
+            ``level`` not 0 or 1 (nothing is pulsed).
+        """
+        if check_int("level", level, 0, 1):
             self.master.pulse_sas_init()
         return True
 

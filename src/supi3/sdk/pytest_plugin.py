@@ -11,7 +11,8 @@
 
 - ``supi3_bench``: a :class:`supi3.sdk.bench.Bench` made from the ``supi3`` marker's keyword arguments (any
   argument of ``Bench``: ``config``, ``firmware``, ``mode``, ``bit_rate``, ``others``, ``sclk_hz``,
-  ``frame_gap_us``, ``cycle_time_s``, ``strict``); without the marker, the defaults.
+  ``frame_gap_us``, ``cycle_time_s``, ``strict``); without the marker, the defaults. Markers of the test, its class
+  and its module add up, the closest one's keyword winning (UP-46).
 - ``supi3_ring``, ``supi3_master``: that bench's ring and INTERBUS master.
 
 A firmware object keeps its state (a C firmware its statics and ``fw_board_t``), so the marker's ``firmware`` serves
@@ -44,15 +45,20 @@ def pytest_configure(config: pytest.Config) -> None:
 @pytest.fixture
 def supi3_bench(request: pytest.FixtureRequest) -> Bench:
     """A firmware bench (master, ring, chip and firmware on one clock), configured by the ``supi3`` marker."""
-    marker = request.node.get_closest_marker(MARKER)
-    if marker is None:
+    # UP-46: every supi3 marker that reaches the test (its own, its class's, its module's), the closest one's
+    # keyword winning; the closest marker alone dropped a class's bit_rate under a test's strict=False
+    markers = list(request.node.iter_markers(MARKER))
+    if not markers:
         return Bench()
-    unknown = sorted(set(marker.kwargs) - set(inspect.signature(Bench).parameters))
-    if marker.args or unknown:
-        shown = repr(marker.args) if marker.args else ", ".join(unknown)
-        raise pytest.UsageError(f"@pytest.mark.{MARKER} takes keyword arguments of Bench only "
-                                f"({', '.join(inspect.signature(Bench).parameters)}), not {shown}")
-    bench = Bench(**marker.kwargs)  # its own errors first (a firmware class, say)
+    options: dict[str, object] = {}
+    for marker in reversed(markers):  # the farthest first: the closest marker's keywords overwrite
+        unknown = sorted(set(marker.kwargs) - set(inspect.signature(Bench).parameters))
+        if marker.args or unknown:
+            shown = repr(marker.args) if marker.args else ", ".join(unknown)
+            raise pytest.UsageError(f"@pytest.mark.{MARKER} takes keyword arguments of Bench only "
+                                    f"({', '.join(inspect.signature(Bench).parameters)}), not {shown}")
+        options.update(marker.kwargs)
+    bench = Bench(**options)  # type: ignore[arg-type]  # its own errors first (a firmware class, say)
     firmware = bench.firmware
     if firmware is not None:
         ran = request.config.stash.setdefault(_FIRMWARE_TESTS, {})

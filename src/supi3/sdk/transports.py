@@ -16,15 +16,21 @@ import contextlib
 import importlib
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import Any, Final
 
-from supi3.checks import check_int, describe
+from supi3 import timing
+from supi3.checks import check_int, check_real, describe
 from supi3.model.chip import Supi3
 from supi3.model.registers import RegisterFile
-from supi3.sdk.driver import UNDRIVEN_BYTE, DirectAccess, DriverArgumentError, Mode, Transport
+from supi3.sdk.driver import UNDRIVEN_BYTE, DirectAccess, DriverArgumentError, Mode, Transport, pin_level
 from supi3.spi.upif import Phase, UpInterface
+from supi3.tables import BIT_RATES
 
-__all__ = ["ModelTransport", "SpidevTransport"]
+__all__ = ["MAX_SPEED_HZ", "ModelTransport", "SpidevTransport"]
+
+MAX_SPEED_HZ: Final[int] = max(int(1 / timing.limit("3-7", "t0", rate) * (1 + 1e-9)) for rate in BIT_RATES)
+"""The fastest SCLK of :class:`SpidevTransport`: Table 3-7's shortest t0 (167 ns at 2 Mbit/s), 5 988 023 Hz; a
+faster clock the chip cannot follow at any bit rate (:func:`supi3.timing.upif_byte_s` refuses it as well)."""
 
 
 class ModelTransport(Transport):
@@ -123,7 +129,8 @@ class SpidevTransport(Transport):
     mode:
         Motorola: SPI mode 3, MSB first (UP-5). Intel: LSB first; then ``set_s_r`` is required.
     speed_hz:
-        SCLK; at most 1.5 MHz at 500 kbit/s and 6 MHz at 2 Mbit/s (Table 3-7, t0).
+        SCLK; at most 1.5 MHz at 500 kbit/s and 6 MHz at 2 Mbit/s (Table 3-7, t0 >= 667 ns and 167 ns): more than
+        :data:`MAX_SPEED_HZ` is refused.
     read_cd, read_irq, read_io, set_sas_init, set_s_r:
         The board's GPIOs as callables (``None``: not wired): C/D, /IRQ and I/O levels, SAS_INIT and S/R drive.
     spidev_module:
@@ -147,7 +154,7 @@ class SpidevTransport(Transport):
             if pin is not None and not callable(pin):
                 raise DriverArgumentError(name, pin, f"{name} must be a callable or None, not {describe(pin)}")
         bus, device = check_int("bus", bus, 0), check_int("device", device, 0)
-        speed_hz = check_int("speed_hz", speed_hz, 1)
+        speed_hz = check_int("speed_hz", speed_hz, 1, MAX_SPEED_HZ, "Table 3-7: t0 >= 167 ns at 2 Mbit/s")
         module = importlib.import_module("spidev") if spidev_module is None else spidev_module
         self.spi = module.SpiDev()
         self.spi.open(bus, device)  # every argument checked first: a refused transport leaves no device open
@@ -159,30 +166,50 @@ class SpidevTransport(Transport):
         self._s_r = set_s_r
 
     def xfer(self, tx: int, s_r: bool) -> int:
-        """One ``spidev.xfer([tx])``, S/R set first in Intel mode."""
+        """One ``spidev.xfer([tx])``, S/R set first in Intel mode; the driver checks the answer.
+
+        Raises
+        ------
+        ArgumentError
+            ``tx`` not a byte.
+        """
+        tx = check_int("tx", tx, 0, 0xFF, "one byte per frame, UP-7")
         if self._s_r is not None:
             self._s_r(int(s_r))
         [rx] = self.spi.xfer([tx])
         return int(rx)
 
     def delay_us(self, us: float) -> None:
-        """Sleep (``time.sleep``; the frame gap and the SAS_INIT pulse are far above its resolution's needs)."""
-        time.sleep(us * 1e-6)
+        """Sleep (``time.sleep``; the frame gap and the SAS_INIT pulse are far above its resolution's needs).
+
+        Raises
+        ------
+        ArgumentError
+            ``us`` not a finite number >= 0.
+        """
+        time.sleep(check_real("us", us, 0.0) * 1e-6)
 
     def read_cd(self) -> int | None:
-        """The C/D GPIO, if wired."""
-        return None if self._pins[0] is None else int(self._pins[0]())
+        """The C/D GPIO, if wired (:class:`~supi3.sdk.driver.TransportError` if it reads no level)."""
+        return None if self._pins[0] is None else pin_level("read_cd", self._pins[0]())
 
     def read_irq(self) -> int | None:
-        """The /IRQ GPIO, if wired."""
-        return None if self._pins[1] is None else int(self._pins[1]())
+        """The /IRQ GPIO, if wired (:class:`~supi3.sdk.driver.TransportError` if it reads no level)."""
+        return None if self._pins[1] is None else pin_level("read_irq", self._pins[1]())
 
     def read_io(self) -> int | None:
-        """The I/O GPIO, if wired."""
-        return None if self._pins[2] is None else int(self._pins[2]())
+        """The I/O GPIO, if wired (:class:`~supi3.sdk.driver.TransportError` if it reads no level)."""
+        return None if self._pins[2] is None else pin_level("read_io", self._pins[2]())
 
     def set_sas_init(self, level: int) -> bool:
-        """Drive the SAS_INIT GPIO, if wired."""
+        """Drive the SAS_INIT GPIO, if wired.
+
+        Raises
+        ------
+        ArgumentError
+            ``level`` not 0 or 1.
+        """
+        level = check_int("level", level, 0, 1)
         if self._sas is None:
             return False
         self._sas(level)
