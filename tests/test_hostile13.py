@@ -597,3 +597,23 @@ def test_bench_timing_rules_refuse_what_is_no_bus_time() -> None:
         with pytest.raises(ArgumentError, match=r"bit must be an integer >= 0"):
             timing.at(bit)  # type: ignore[arg-type]
     assert timing.at(0) > timing.start
+
+
+@pytest.mark.parametrize("fidelity", ["transaction", "pin"])
+def test_a_bit_rate_beside_a_config_of_another_rate_is_refused_not_ignored(digital_io: Path, fidelity: str) -> None:
+    """Defect (found by this round, fixed by the lead): ``Bench(config=<2 Mbit/s>, bit_rate=500_000)`` and the same on
+    ``Board`` ran at the config's rate and dropped ``bit_rate`` in silence. The config's CLK_CONF straps the rate
+    (Table 1-7): a second, different rate is refused by name; the same rate, or either alone, is taken."""
+    from supi3.mcu.board import Board
+
+    fast = default_config(2_000_000)
+    with pytest.raises(DriverArgumentError, match=r"bit_rate 500000 is not the config's 2000000 bit/s"):
+        Bench(config=fast, bit_rate=500_000)
+    with pytest.raises(DriverArgumentError, match=r"bit_rate 500000 is not the config's 2000000 bit/s"):
+        Board(digital_io, config=fast, bit_rate=500_000, fidelity=fidelity)
+    assert Bench(config=fast, bit_rate=2_000_000).config.bit_rate == 2_000_000
+    assert Bench(config=fast).config.bit_rate == 2_000_000
+    assert Bench(bit_rate=2_000_000).config.bit_rate == 2_000_000
+    assert Bench().config.bit_rate == 500_000
+    assert Board(digital_io, config=fast, fidelity=fidelity).config.bit_rate == 2_000_000
+    assert Board(digital_io, fidelity=fidelity).config.bit_rate == 500_000

@@ -81,9 +81,9 @@ from supi3.sdk.bench import (
     MainLoopPasses,
     MasterStart,
     ServeWait,
+    bench_config,
     check_run_cycles,
     check_run_seconds,
-    default_config,
     discovery_master,
     serve_wait_s,
 )
@@ -341,7 +341,7 @@ class Board:
     """
 
     def __init__(self, firmware: str | Path | FirmwareImage, *, cpu: str = "cortex_m3", cpu_hz: float = 48e6,
-                 config: DeviceConfig | None = None, bit_rate: int = 500_000,
+                 config: DeviceConfig | None = None, bit_rate: int | None = None,
                  others: Sequence[Device | PinChip | PinBranch] = (),
                  cycle_time_s: float | None = None, strict: bool = True, pedantic: bool = False,
                  fidelity: str = "transaction", record: bool = False, mode: Mode = Mode.MOTOROLA,
@@ -446,11 +446,11 @@ class Board:
         else:
             self._serve_point = None
 
-    def _pin_setup(self, config: DeviceConfig | None, bit_rate: int, others: Sequence[Device | PinChip | PinBranch],
-                   cycle_time_s: float | None, strict: bool, pedantic: bool, record: bool,
-                   stat_err_filter: int) -> None:  # fmt: skip
+    def _pin_setup(self, config: DeviceConfig | None, bit_rate: int | None,
+                   others: Sequence[Device | PinChip | PinBranch], cycle_time_s: float | None, strict: bool,
+                   pedantic: bool, record: bool, stat_err_filter: int) -> None:  # fmt: skip
         """The pin-level chip, its ring and master (MCU-14 to MCU-17)."""
-        self.config = default_config(bit_rate) if config is None else check_instance("config", config, DeviceConfig)
+        self.config = bench_config(config, bit_rate)
         if isinstance(others, str | bytes) or not isinstance(others, Sequence) \
                 or not all(isinstance(other, PinChip | PinBranch) for other in others):  # fmt: skip
             raise fail("others", "pin-level chips at pin level (Supi3Pins or Supi3Chip objects, PinBranch trees: "

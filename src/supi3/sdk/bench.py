@@ -55,6 +55,7 @@ __all__ = [
     "MainLoopPasses",
     "MasterStart",
     "ServeWait",
+    "bench_config",
     "check_run_cycles",
     "check_run_seconds",
     "default_config",
@@ -428,6 +429,19 @@ def default_config(bit_rate: int = 500_000) -> DeviceConfig:
     return decode(*DEFAULT_STRAPS, clk_conf=tables.clk_conf_for(wire.check_bit_rate(bit_rate)))
 
 
+def bench_config(config: DeviceConfig | None, bit_rate: int | None) -> DeviceConfig:
+    """The chip's straps of a bench or board: ``config``, else :func:`default_config` at ``bit_rate`` (500 kbit/s if
+    ``None``). A ``bit_rate`` given beside a ``config`` must be the config's: its CLK_CONF straps the rate (Table
+    1-7), and a second rate would be ignored in silence."""
+    if config is None:
+        return default_config(500_000 if bit_rate is None else bit_rate)
+    check_instance("config", config, DeviceConfig)
+    if bit_rate is not None and bit_rate != config.bit_rate:
+        raise DriverArgumentError("bit_rate", bit_rate, f"bit_rate {bit_rate!r} is not the config's {config.bit_rate} "
+                                  "bit/s (its CLK_CONF straps the rate, Table 1-7): give one of them")  # fmt: skip
+    return config
+
+
 class Firmware:
     """The firmware under test, as the bench calls it. Subclass and override what the firmware has.
 
@@ -580,7 +594,8 @@ class Bench:
     mode:
         The interface type the firmware uses (Table 3-8); tells the bench the Intel bit order, nothing more.
     bit_rate:
-        INTERBUS bit rate when ``config`` is not given.
+        INTERBUS bit rate when ``config`` is not given (500 kbit/s if neither is); given beside ``config``, it must
+        be the config's (:func:`bench_config`).
     others:
         Further devices in the ring, behind the chip (ring positions 2, 3, ...).
     sclk_hz:
@@ -625,7 +640,7 @@ class Bench:
         *,
         firmware: Firmware | None = None,
         mode: Mode = Mode.MOTOROLA,
-        bit_rate: int = 500_000,
+        bit_rate: int | None = None,
         others: Sequence[Device] = (),
         sclk_hz: float | None = None,
         frame_gap_us: float = 0.0,
@@ -635,7 +650,7 @@ class Bench:
         pin_read_s: float = PIN_READ_S,
         pedantic: bool = False,
     ) -> None:
-        self.config = default_config(bit_rate) if config is None else check_instance("config", config, DeviceConfig)
+        self.config = bench_config(config, bit_rate)
         if firmware is not None and not isinstance(firmware, Firmware):
             raise DriverArgumentError("firmware", firmware, f"firmware must be a supi3.sdk.bench.Firmware, not "
                                       f"{describe(firmware)}")  # fmt: skip
