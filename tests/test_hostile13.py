@@ -617,3 +617,25 @@ def test_a_bit_rate_beside_a_config_of_another_rate_is_refused_not_ignored(digit
     assert Bench().config.bit_rate == 500_000
     assert Board(digital_io, config=fast, fidelity=fidelity).config.bit_rate == 2_000_000
     assert Board(digital_io, fidelity=fidelity).config.bit_rate == 500_000
+
+
+@pytest.mark.parametrize(("name", "make"), [
+    ("frame_gap_us", lambda bench: Supi3Driver(bench.transport, frame_gap_us=2.0**32)),
+    ("max_polls", lambda bench: bench.driver.poll_io_window(2**32)),
+])  # fmt: skip
+def test_driver_ranges_are_the_c_drivers(name: str, make: Callable[[Bench], object]) -> None:
+    """Defect (found by this round, fixed by the lead): the Python driver took any ``frame_gap_us`` and ``max_polls``
+    where the C driver's are ``uint32_t`` (``supi3.h``): one API shape, one range; past it is refused by name,
+    nothing sent."""
+    bench = Bench()
+    with pytest.raises(DriverArgumentError, match=rf"{name} must be .*4294967295"):
+        make(bench)
+
+
+def test_register_map_render_to_a_directory_is_refused_by_name(tmp_path: Path) -> None:
+    """Defect (found by this round, fixed by the lead): ``render('md', out=<a directory>)`` rendered, then failed with
+    Python's ``IsADirectoryError``; it is a ``RegisterMapError`` naming ``out`` before the render."""
+    from supi3.regmap.export import render
+
+    with pytest.raises(RegisterMapError, match=r"format 'md' writes a file: out .* is a directory"):
+        render("md", out=tmp_path)

@@ -587,6 +587,8 @@ def render(fmt: str, out: Path | None = None) -> str:
         return str(to_html(out))
     if fmt not in _TEXT_FORMATS:
         raise RegisterMapError(f"unknown register map format {fmt!r}; choose one of {', '.join(FORMATS)}")
+    if out is not None and out.is_dir():  # else the write fails with Python's IsADirectoryError after the render
+        raise RegisterMapError(f"format {fmt!r} writes a file: out {str(out)!r:.80} is a directory")
     text = _TEXT_FORMATS[fmt]()
     if out is not None:
         out.parent.mkdir(parents=True, exist_ok=True)

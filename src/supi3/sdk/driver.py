@@ -51,6 +51,7 @@ __all__ = [
     "BLOCK_MIN_BYTES",
     "ERROR_CODES",
     "IRQ_SERVICE_MAX_READS",
+    "UINT32_MAX",
     "UNDRIVEN_BYTE",
     "AsyncSupi3Driver",
     "AsyncTransport",
@@ -94,6 +95,9 @@ UNDRIVEN_BYTE: Final[int] = 0xFF
 """What :meth:`Transport.xfer` returns for a frame in which the chip drives no data (before its initialization, a
 disabled interface, an Intel send frame; 3.4.1, 3.4.3, UP-25): the data line's pull-up, as on the emulated board
 (MCU-6, FW-26)."""
+
+UINT32_MAX: Final[int] = 0xFFFF_FFFF
+"""The largest ``frame_gap_us`` and ``max_polls``: the C driver's ``uint32_t`` (``supi3.h``), one range for both."""
 
 
 class ErrorCode(IntEnum):
@@ -455,7 +459,8 @@ class _Core:
     """The driver's state and its calls as operation generators; shared by the sync and async drivers."""
 
     def __init__(self, frame_gap_us: float) -> None:
-        self.frame_gap_us = _checked(check_real, "frame_gap_us", frame_gap_us, 0.0)
+        # the C driver's supi3_config_t.frame_gap_us and max_polls are uint32_t: one API shape, one range
+        self.frame_gap_us = _checked(check_real, "frame_gap_us", frame_gap_us, 0.0, UINT32_MAX)
         self.initialized = False
         self.mode = Mode.MOTOROLA
         self.set_value: int | None = None
@@ -612,7 +617,7 @@ class _Core:
         return Irq(events)
 
     def poll_io_window(self, max_polls: object) -> _Call[Irq]:
-        polls = _checked(check_int, "max_polls", max_polls, 1, None, "polls of the I/O access bit")
+        polls = _checked(check_int, "max_polls", max_polls, 1, UINT32_MAX, "polls of the I/O access bit")
         self._ready()
         return self._poll(polls)
 
