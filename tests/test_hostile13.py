@@ -639,3 +639,13 @@ def test_register_map_render_to_a_directory_is_refused_by_name(tmp_path: Path) -
 
     with pytest.raises(RegisterMapError, match=r"format 'md' writes a file: out .* is a directory"):
         render("md", out=tmp_path)
+
+
+def test_pin_transport_delay_past_the_bus_time_maximum_is_refused_by_name() -> None:
+    """Defect (found by this round, fixed by the lead): ``PinTransport.delay_us(1e30)`` failed in numpy (a clock
+    count past int64); a delay past the bus time's maximum (A26) is refused by name, no clock run."""
+    transport = PinTransport(Supi3Chip(default_config()), Mode.MOTOROLA)
+    cycle = transport.port.cycle
+    with pytest.raises(ArgumentError, match=r"us must be a finite number from 0"):
+        transport.delay_us(1e30)
+    assert transport.port.cycle == cycle

@@ -15,6 +15,7 @@ import math
 from typing import Final
 
 from supi3.checks import check_int, check_real, describe
+from supi3.interbus import wire
 from supi3.model.pins import RESET_STRETCH_CLOCKS
 from supi3.sdk.driver import UNDRIVEN_BYTE, DriverArgumentError, Mode, Transport
 from supi3.spi.master import MasterTiming, SoftMaster
@@ -71,8 +72,8 @@ class PinTransport(Transport):
         return UNDRIVEN_BYTE if rx is None else rx
 
     def delay_us(self, us: float) -> None:
-        """Hold the pins for ``us`` microseconds (rounded up to whole clocks)."""
-        us = check_real("us", us, 0.0)
+        """Hold the pins for ``us`` microseconds (rounded up to whole clocks), at most the bus time's maximum (A26)."""
+        us = check_real("us", us, 0.0, wire.MAX_BUS_TIME_S * 1e6)
         self.master.run(math.ceil(us * 1e-6 * self.port.clock_hz))
 
     def read_cd(self) -> int:
