@@ -599,12 +599,16 @@ class Board:
                 self._irq_fell = cycles if low_at is None else math.ceil(low_at * self._cpu_hz - NOISE_CYCLES)
             self.exti.edge(0, PIN_IRQ, level)
             request = True
-        if request and self.exti.requesting(0):
-            self._pend()
+        if request:
+            self._request()
 
     def _request(self) -> None:
-        if self.exti.requesting(0):
-            self._pend()
+        """If EXTI0 requests its interrupt: pend it unless it is active or pending, and stop the run for it (the
+        core's lists asked first: inside the handler no question to EXTI, MCU-79)."""
+        core = self.core
+        if _EXTI0 not in core.active and _EXTI0 not in core.pending and self.exti.requesting(0):
+            core.pend(_EXTI0)
+            core.stop_request = True
 
     def _exti_read(self, offset: int, size: int) -> int:
         """The firmware reads EXTI: at transaction level the bus runs up to the access first, so PR holds every edge
@@ -626,19 +630,12 @@ class Board:
         if self.native_frames is not None:  # MCU-66: the mirror valid again for GPIOA's reads after it
             self._refresh()
 
-    def _pend(self) -> None:
-        """EXTI0 requests its interrupt: pend it unless it is active or pending, and stop the run for it."""
-        core = self.core
-        if _EXTI0 not in core.active and _EXTI0 not in core.pending:
-            core.pend(_EXTI0)
-            core.stop_request = True
-
     def _entered(self, number: int) -> None:
         if number == _EXTI0:
             self._passes.handler()  # MCU-30: a pass serves the edge only if it begins after the handler
             self.interrupts += 1
             if self._irq_fell is not None:
-                self.irq_latency_s = max(self.irq_latency_s, self._seconds(self.core.cycles - self._irq_fell))
+                self.irq_latency_s = max(self.irq_latency_s, (self.core.cycles - self._irq_fell) / self._cpu_hz)
                 self._irq_fell = None
 
     # -- the main loop's passes (MCU-30) --------------------------------------------------------------------------
@@ -963,33 +960,34 @@ class Board:
         self._set_budget(max_instructions)
         self._sync(core.cycles)
         self._follow_irq(core.cycles)  # the chip may have changed between runs (the host's calls)
-        systick, exti = core.systick, self.exti
+        systick = core.systick
         while True:
             tick = systick.due()
-            if exti.requesting(0):
-                self._pend()
+            self._request()
             if done():
                 return
-            deadline = self._bus_deadline()
+            entry = core.next_entry()  # once a step: for the deadline and the step's entry (MCU-79)
+            deadline = self._bus_deadline(entry)
             for bound in (tick, end, self._serve_end):
                 if bound is not None:
                     deadline = min(deadline, bound)
-            self._step(deadline)
+            self._step(deadline, entry)
             self._sync(core.cycles)
 
-    def _bus_deadline(self) -> int:
+    def _bus_deadline(self, entry: int | None) -> int:
         """The core cycle the run loop stops the core at for the bus: the next bus event that may change /IRQ or
         /ModAck (MCU-31); while EXTI0 is active or about to be entered at the step's start, :func:`serve_wait_s`
         after it (MCU-44: an edge of /IRQ then only sets EXTI's pending bit, and the firmware's next access, or the
         next stop, at the latest the handler's return, runs the bus up to it; MCU-55: a handler that makes no access
         for that long, spinning, still lets the bus run on, and a run's wait ends at its bound); none while the
-        master holds at a run's end (MCU-55: no bus event comes)."""
+        master holds at a run's end (MCU-55: no bus event comes). ``entry``: the core's next entry
+        (:meth:`CortexM.next_entry`)."""
         core, bench = self.core, self._bench
         assert bench is not None  # transaction level
         at = bench.next_change_s()
         if at == math.inf:
             return MAX_DEADLINE
-        if _EXTI0 in core.active or (_EXTI0 in core.pending and core.next_entry() == _EXTI0):
+        if entry == _EXTI0 or _EXTI0 in core.active:
             at += self._wait_s
         return math.ceil(at * core.cpu_hz - NOISE_CYCLES)
 
@@ -997,8 +995,9 @@ class Board:
         self._budget = check_int("max_instructions", max_instructions, 1)
         self._limit = self.core.instructions + self._budget
 
-    def _step(self, deadline: int) -> None:
-        """One run of the core up to ``deadline`` (at least one block), within the instruction budget."""
+    def _step(self, deadline: int, entry: int | None) -> None:
+        """One run of the core up to ``deadline`` (at least one block), within the instruction budget, entering
+        ``entry`` first (:meth:`CortexM.next_entry`, asked with nothing run since)."""
         core = self.core
         cycles = core.cycles
         if not core.sleeping:  # a sleeping core runs no instruction (MCU-4)
@@ -1008,7 +1007,7 @@ class Board:
                                                        "(an endless loop?)"))  # fmt: skip
             deadline = min(deadline, cycles + left)  # within the budget: an instruction costs a cycle at least (MCU-1)
         try:
-            state = core.step(max(deadline, cycles + 1))
+            state = core._step_entering(max(deadline, cycles + 1), entry)
         except InterfaceViolationError as error:
             self._place(error)
             raise
@@ -1108,12 +1107,12 @@ class Board:
                 finally:
                     self._held = None
                 wake = ring.core_cycle(reached - 1) if held else (end if stop == clock else tick)
-                self._step(max(core.cycles, wake if wake is not None else end))
+                self._step(max(core.cycles, wake if wake is not None else end), core.next_entry())
                 for edge in held:
                     self._pin_edge(*edge)
                 continue
             deadline = min(end, core.cycles + interval, end if tick is None else tick)
-            self._step(deadline)
+            self._step(deadline, core.next_entry())
             ring.sync(min(clock, ring.clock_of(core.cycles)))
 
 

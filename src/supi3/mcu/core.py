@@ -1188,7 +1188,7 @@ class CortexM:
         if not pending:  # the run loop's common case (MCU-31)
             return None
         if len(pending) == 1:  # the next common one: EXTI0 alone
-            best = next(iter(pending))
+            (best,) = pending  # no call (MCU-79)
             if best >= EXTERNAL and best not in self.enabled:
                 return None
         else:
@@ -1203,7 +1203,10 @@ class CortexM:
         with CONTROL.SPSEL = 1), aligned to 8 bytes (B1.5.7), LR = EXC_RETURN, CONTROL.SPSEL = 0 (the handler runs
         on the main stack), IPSR = ``number``, PC = its vector; costs :attr:`Cpu.entry_cycles`. Returns the
         frame's address."""
-        _exception_number(number)
+        return self._enter(_exception_number(number))
+
+    def _enter(self, number: int) -> int:
+        """:meth:`enter` of a checked exception number."""
         handler_mode = bool(self.active)
         if self._native_exceptions:  # MCU-71: the same traffic in one call
             failed = self._native_enter(self._handle, self._state_ref, number, handler_mode, self.vtor + 4 * number)
@@ -1280,13 +1283,14 @@ class CortexM:
             nesting = f"{len(self.active)} active exception(s)"
             reason = f"EXC_RETURN {exc_return:08X}h does not match the nesting of {nesting}: INVPC UsageFault (B1.5.8)"
             raise FirmwareFaultError(self.report(Stop.FAULT, reason))
-        returning = self.active.pop()
-        chained = self._takeable()
-        if chained is not None:
-            sp = self._read(arm.UC_ARM_REG_PSP if exc_return == EXC_RETURN_THREAD_PSP else arm.UC_ARM_REG_SP)
-            self._take(chained, exc_return, sp, self.cpu.tail_chain_cycles)
-            return
-        self.active.append(returning)  # until the frame is back: a fault report shows the handler still active
+        if self.pending:  # else nothing to chain (MCU-79: the run loop's common return, no question asked)
+            returning = self.active.pop()
+            chained = self._takeable()
+            if chained is not None:
+                sp = self._read(arm.UC_ARM_REG_PSP if exc_return == EXC_RETURN_THREAD_PSP else arm.UC_ARM_REG_SP)
+                self._take(chained, exc_return, sp, self.cpu.tail_chain_cycles)
+                return
+            self.active.append(returning)  # until the frame is back: a fault report shows the handler still active
         if self._native_exceptions:  # MCU-70: the same traffic in one call
             if self._native_return(self._handle, self._state_ref, exc_return):
                 self._unstacking_error(int(self._state.frame))
@@ -1363,10 +1367,14 @@ class CortexM:
 
         A pending exception that may preempt (B1.5.4) is entered first; a sleeping core (WFI, or ``b .`` in thread
         mode: MCU-4) only lets the time pass."""
+        return self._step_entering(deadline, self._takeable())
+
+    def _step_entering(self, deadline: int, number: int | None) -> str:
+        """:meth:`step` with its entry decided: ``number`` is :meth:`next_entry`'s answer with nothing run or
+        written since (the board's run loop asks once a step, for its deadline and the entry, MCU-79)."""
         self.deadline = deadline
-        number = self._takeable()
         if number is not None:
-            self.enter(number)
+            self._enter(number)
         state = self._state
         if self.sleeping:
             state.cycles = max(state.cycles, deadline)
