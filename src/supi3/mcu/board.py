@@ -32,6 +32,7 @@ from supi3.interbus.master import Master
 from supi3.mcu.core import (
     EXTERNAL,
     MAX_DEADLINE,
+    UNASKED,
     CortexM,
     FirmwareImage,
     FirmwareStoppedError,
@@ -420,6 +421,7 @@ class Board:
         self._irq_fell: int | None = None
         self._mod_ack_until = 0
         self._limit = self._budget = 0
+        self._entry: int | None = UNASKED  # the run loop's answer to CortexM.next_entry for the next step (MCU-79)
         pins = (PIN_IRQ, PIN_CD, PIN_IO)
         self.native_frames = NativeFrames(self, held, PIN_SS, pins, NOISE_CYCLES, _EXTI0) if native else None
         """MCU-51: the native per-frame fast path (``native_frames=True`` at transaction level on the Motorola
@@ -966,28 +968,28 @@ class Board:
             self._request()
             if done():
                 return
-            entry = core.next_entry()  # once a step: for the deadline and the step's entry (MCU-79)
-            deadline = self._bus_deadline(entry)
+            self._entry = core.next_entry()  # once a step: for the deadline and the step's entry (MCU-79)
+            deadline = self._bus_deadline()
             for bound in (tick, end, self._serve_end):
                 if bound is not None:
                     deadline = min(deadline, bound)
-            self._step(deadline, entry)
+            self._step(deadline)
             self._sync(core.cycles)
 
-    def _bus_deadline(self, entry: int | None) -> int:
+    def _bus_deadline(self) -> int:
         """The core cycle the run loop stops the core at for the bus: the next bus event that may change /IRQ or
         /ModAck (MCU-31); while EXTI0 is active or about to be entered at the step's start, :func:`serve_wait_s`
         after it (MCU-44: an edge of /IRQ then only sets EXTI's pending bit, and the firmware's next access, or the
         next stop, at the latest the handler's return, runs the bus up to it; MCU-55: a handler that makes no access
         for that long, spinning, still lets the bus run on, and a run's wait ends at its bound); none while the
-        master holds at a run's end (MCU-55: no bus event comes). ``entry``: the core's next entry
-        (:meth:`CortexM.next_entry`)."""
+        master holds at a run's end (MCU-55: no bus event comes). The core's next entry: the run loop's answer of
+        the step (MCU-79)."""
         core, bench = self.core, self._bench
         assert bench is not None  # transaction level
         at = bench.next_change_s()
         if at == math.inf:
             return MAX_DEADLINE
-        if entry == _EXTI0 or _EXTI0 in core.active:
+        if self._entry == _EXTI0 or _EXTI0 in core.active:
             at += self._wait_s
         return math.ceil(at * core.cpu_hz - NOISE_CYCLES)
 
@@ -995,10 +997,11 @@ class Board:
         self._budget = check_int("max_instructions", max_instructions, 1)
         self._limit = self.core.instructions + self._budget
 
-    def _step(self, deadline: int, entry: int | None) -> None:
-        """One run of the core up to ``deadline`` (at least one block), within the instruction budget, entering
-        ``entry`` first (:meth:`CortexM.next_entry`, asked with nothing run since)."""
+    def _step(self, deadline: int) -> None:
+        """One run of the core up to ``deadline`` (at least one block), within the instruction budget; the exception
+        it enters first: the run loop's answer handed in :attr:`_entry` (taken once, MCU-79), else the core asks."""
         core = self.core
+        entry, self._entry = self._entry, UNASKED
         cycles = core.cycles
         if not core.sleeping:  # a sleeping core runs no instruction (MCU-4)
             left = self._limit - core.instructions
@@ -1006,8 +1009,9 @@ class Board:
                 raise FirmwareStoppedError(core.report(Stop.BUDGET, f"instruction budget of {self._budget} used up "
                                                        "(an endless loop?)"))  # fmt: skip
             deadline = min(deadline, cycles + left)  # within the budget: an instruction costs a cycle at least (MCU-1)
+        core._handed = entry  # UNASKED: the step asks
         try:
-            state = core._step_entering(max(deadline, cycles + 1), entry)
+            state = core.step(max(deadline, cycles + 1))
         except InterfaceViolationError as error:
             self._place(error)
             raise
@@ -1107,12 +1111,12 @@ class Board:
                 finally:
                     self._held = None
                 wake = ring.core_cycle(reached - 1) if held else (end if stop == clock else tick)
-                self._step(max(core.cycles, wake if wake is not None else end), core.next_entry())
+                self._step(max(core.cycles, wake if wake is not None else end))
                 for edge in held:
                     self._pin_edge(*edge)
                 continue
             deadline = min(end, core.cycles + interval, end if tick is None else tick)
-            self._step(deadline, core.next_entry())
+            self._step(deadline)
             ring.sync(min(clock, ring.clock_of(core.cycles)))
 
 

@@ -622,6 +622,9 @@ def block_cost(code: bytes) -> tuple[int, int]:
 ReadFn = Callable[[int, int], int]
 WriteFn = Callable[[int, int, int], None]
 _FOREVER: Final[int] = (1 << 64) - 1
+UNASKED: Final[int] = -1
+""":attr:`CortexM._handed` when no caller has handed the next step its entry: the step asks (an exception number is at
+least 2, MCU-79)."""
 MAX_DEADLINE: Final[int] = (1 << 63) - 1
 """The latest cycle a run may end at (MCU-28): the native hook's clock is 64-bit and a run passes its deadline by a
 block, an exception entry or a sleep; half its range (6000 years at 48 MHz) leaves it room never to wrap."""
@@ -829,6 +832,9 @@ class CortexM:
         self.sleeping = False
         self.active: list[int] = []  # active exceptions, outermost first
         self.pending: set[int] = set()
+        self._handed: int | None = UNASKED
+        """The board's run loop's :meth:`next_entry` answer for the next :meth:`step`, asked with nothing run or
+        written since (it asks once a step, for its deadline and the entry, MCU-79); the step takes it once."""
         self.enabled: set[int] = set()  # external interrupts enabled in the NVIC (exception numbers)
         self.priorities: dict[int, int] = {}
         self.stop_request = False
@@ -1367,12 +1373,10 @@ class CortexM:
 
         A pending exception that may preempt (B1.5.4) is entered first; a sleeping core (WFI, or ``b .`` in thread
         mode: MCU-4) only lets the time pass."""
-        return self._step_entering(deadline, self._takeable())
-
-    def _step_entering(self, deadline: int, number: int | None) -> str:
-        """:meth:`step` with its entry decided: ``number`` is :meth:`next_entry`'s answer with nothing run or
-        written since (the board's run loop asks once a step, for its deadline and the entry, MCU-79)."""
+        number, self._handed = self._handed, UNASKED  # taken once (MCU-79)
         self.deadline = deadline
+        if number == UNASKED:
+            number = self._takeable()
         if number is not None:
             self._enter(number)
         state = self._state

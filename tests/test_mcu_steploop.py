@@ -1,0 +1,168 @@
+"""The run loop's step with less Python (MCU-79) against the loop that asks every question where it did before.
+
+MCU-79: the board's run loop asks the core once a step which exception it enters next (``CortexM.next_entry``) and
+hands the answer to the deadline and to the step (``Board._entry``, ``CortexM._handed``) instead of asking in
+both; an exception
+return asks for a tail-chain only with an exception pending; the board asks EXTI whether EXTI0 requests only once
+the core's lists say a request would pend it. The reference board asks the core in its deadline and at the step's start
+(as ``CortexM.step`` does), asks EXTI first, and its core's exception returns always ask for a tail-chain (a pending set
+that is never empty to ``bool``). Over the example firmwares on the board and the hand-written exception programs,
+the state after every step is the same: registers, CONTROL, both stack pointers, RAM, cycles, instructions, active
+and pending exceptions, interrupts, latency, bus time, process data and violations.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+from supi3.mcu import build as mcu_build
+from supi3.mcu.board import _EXTI0, NOISE_CYCLES, Board
+from supi3.mcu.core import CPUS, MAX_DEADLINE, UNASKED, CortexM, FirmwareError
+from supi3.sdk import native
+from test_mcu_nativeexc import SCENARIOS
+
+pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
+
+PROGRAMS = Path(__file__).parent / "mcu"
+
+
+class _AlwaysAsked(set[int]):
+    """A pending set that is true to ``bool`` even empty: the exception return asks for a tail-chain every time (the
+    path before MCU-79; ``_takeable`` of an empty set still answers ``None``)."""
+
+    def __bool__(self) -> bool:
+        return True
+
+
+class AskingBoard(Board):
+    """The run loop before MCU-79: the deadline and the step each ask the core for its entry, EXTI is asked
+    first."""
+
+    def _bus_deadline(self) -> int:
+        core = self.core
+        at = self.bench.next_change_s()
+        if at == math.inf:
+            return MAX_DEADLINE
+        if _EXTI0 in core.active or (_EXTI0 in core.pending and core.next_entry() == _EXTI0):
+            at += self._wait_s
+        return math.ceil(at * core.cpu_hz - NOISE_CYCLES)
+
+    def _step(self, deadline: int) -> None:
+        self._entry = UNASKED
+        super()._step(deadline)
+
+    def _request(self) -> None:
+        core = self.core
+        if self.exti.requesting(0) and _EXTI0 not in core.active and _EXTI0 not in core.pending:
+            core.pend(_EXTI0)
+            core.stop_request = True
+
+
+def _core_state(core: CortexM) -> tuple[object, ...]:
+    return (core.registers(), core.reg("control"), core.reg("msp"), core.reg("psp"), core.read_bytes(*core.ram),
+            core.cycles, core.instructions, list(core.active), sorted(core.pending))  # fmt: skip
+
+
+def _board_steps(elf: Path, cpu: str, bit_rate: int, lean: bool) -> list[tuple[object, ...]]:
+    """Power-up and twelve data cycles with process data both ways; the board's state after every step."""
+    board = (Board if lean else AskingBoard)(elf, cpu=cpu, bit_rate=bit_rate, strict=False)
+    if not lean:
+        board.core.pending = _AlwaysAsked()
+    steps: list[tuple[object, ...]] = []
+    step = board._step
+
+    def recorded(deadline: int) -> None:
+        try:
+            step(deadline)
+        finally:
+            master, fw_board = board.bench.master, board.fw_board
+            steps.append((_core_state(board.core), board.bench.now, board.interrupts, board.irq_latency_s,
+                          None if master.config is None else master.inputs(1),
+                          None if fw_board is None else fw_board.outputs,
+                          [(v.time_s, v.pc, str(v.error)) for v in board.violations]))  # fmt: skip
+
+    board._step = recorded  # type: ignore[method-assign]
+    board.run(3)
+    master = board.bench.master
+    master.set_outputs(1, bytes(range(0x12, 0x12 + master.entry(1).data_bytes)))
+    if board.fw_board is not None:
+        board.fw_board.inputs = bytes(range(0x56, 0x56 + len(board.fw_board.inputs)))
+    board.run(12)
+    assert board.interrupts >= 10  # the EXTI0 handler's entries and returns are exercised
+    return steps
+
+
+BOARD_CASES = [("digital_io", "cortex_m3", 2_000_000, {"BOARD_SPI_BR": "3u"}),
+               ("digital_io", "cortex_m0", 500_000, {}), ("irq_dispatch", "cortex_m3", 500_000, {}),
+               ("pcmd_alarm", "cortex_m3", 500_000, {}), ("analog_io", "cortex_m0", 500_000, {})]  # fmt: skip
+
+
+@pytest.mark.parametrize(("example", "cpu", "bit_rate", "defines"), BOARD_CASES)
+def test_the_lean_step_is_the_asking_step_on_the_example_firmwares(
+    tmp_path: Path, example: str, cpu: str, bit_rate: int, defines: dict[str, str]
+) -> None:
+    """MCU-79: each example firmware on the board (issue #13's case first) gives after every step of the run loop
+    the same registers, RAM, cycles, instructions, exceptions, bus time, interrupts, latency, process data and
+    violations as the loop that asks every question where it did before."""
+    elf = mcu_build.build(native.example(example), tmp_path / f"{example}.elf", cpu=cpu, defines=defines)
+    lean, asking = (_board_steps(elf, cpu, bit_rate, flag) for flag in (True, False))
+    assert len(lean) == len(asking)
+    for number, (one, other) in enumerate(zip(lean, asking, strict=True)):
+        assert one == other, f"step {number}"
+
+
+def test_the_handed_entry_is_the_core_s_answer_at_the_step(tmp_path: Path) -> None:
+    """MCU-79's invariant in issue #13's case: the entry the loop hands the step is what the core answers at the
+    step's start, and EXTI0 is entered from it (the case's re-entries after a return)."""
+    elf = mcu_build.build(native.example("digital_io"), tmp_path / "br3.elf", defines={"BOARD_SPI_BR": "3u"})
+    board = Board(elf, bit_rate=2_000_000, strict=False)
+    core = board.core
+    handed: list[int | None] = []
+    step = core.step
+
+    def checked(deadline: int) -> str:
+        number = core._handed
+        assert number == core.next_entry()
+        handed.append(number)
+        return step(deadline)
+
+    core.step = checked  # type: ignore[method-assign]
+    board.run(8)
+    assert handed.count(_EXTI0) >= 5
+
+
+def _both(elf: Path, cpu: str, scenario: Callable[[CortexM], object]) -> list[tuple[object, list[int], object]]:
+    """``scenario`` on a new core and on one whose returns always ask for a tail-chain."""
+    results: list[tuple[object, list[int], object]] = []
+    for lean in (True, False):
+        core = CortexM(elf, cpu=cpu)
+        if not lean:
+            core.pending = _AlwaysAsked()
+        entries: list[int] = []
+        core.entered = entries.append
+        try:
+            outcome: object = scenario(core)
+        except FirmwareError as error:
+            outcome = (str(error), error.report)
+        results.append((outcome, entries, _core_state(core)))
+    return results
+
+
+@pytest.fixture(scope="module")
+def exceptions_elf(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """exceptions.S (Thumb-1: one ELF for both cores), once per module."""
+    return mcu_build.build(PROGRAMS / "exceptions.S", tmp_path_factory.mktemp("steploop") / "exceptions.elf",
+                           cpu="cortex_m0", port=False)  # fmt: skip
+
+
+@pytest.mark.parametrize("cpu", sorted(CPUS))
+@pytest.mark.parametrize("name", list(SCENARIOS))
+def test_a_return_asks_for_a_chain_only_with_an_exception_pending(exceptions_elf: Path, cpu: str, name: str) -> None:
+    """MCU-79 over the hand-written exception programs (nesting, both stacks, a tail-chain, the faults): the same
+    outcome, entries and state as a core whose every return asks for a tail-chain."""
+    lean, asking = _both(exceptions_elf, cpu, SCENARIOS[name])
+    assert lean == asking
