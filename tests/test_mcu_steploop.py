@@ -23,7 +23,7 @@ from supi3.mcu import build as mcu_build
 from supi3.mcu.board import _EXTI0, NOISE_CYCLES, Board
 from supi3.mcu.core import CPUS, MAX_DEADLINE, UNASKED, CortexM, FirmwareError
 from supi3.sdk import native
-from test_mcu_nativeexc import SCENARIOS
+from test_mcu_nativeexc import BOARD_CASES, SCENARIOS, _state
 
 pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
 
@@ -62,11 +62,6 @@ class AskingBoard(Board):
             core.stop_request = True
 
 
-def _core_state(core: CortexM) -> tuple[object, ...]:
-    return (core.registers(), core.reg("control"), core.reg("msp"), core.reg("psp"), core.read_bytes(*core.ram),
-            core.cycles, core.instructions, list(core.active), sorted(core.pending))  # fmt: skip
-
-
 def _board_steps(elf: Path, cpu: str, bit_rate: int, lean: bool) -> list[tuple[object, ...]]:
     """Power-up and twelve data cycles with process data both ways; the board's state after every step."""
     board = (Board if lean else AskingBoard)(elf, cpu=cpu, bit_rate=bit_rate, strict=False)
@@ -80,7 +75,7 @@ def _board_steps(elf: Path, cpu: str, bit_rate: int, lean: bool) -> list[tuple[o
             step(deadline)
         finally:
             master, fw_board = board.bench.master, board.fw_board
-            steps.append((_core_state(board.core), board.bench.now, board.interrupts, board.irq_latency_s,
+            steps.append((_state(board.core), board.bench.now, board.interrupts, board.irq_latency_s,
                           None if master.config is None else master.inputs(1),
                           None if fw_board is None else fw_board.outputs,
                           [(v.time_s, v.pc, str(v.error)) for v in board.violations]))  # fmt: skip
@@ -94,11 +89,6 @@ def _board_steps(elf: Path, cpu: str, bit_rate: int, lean: bool) -> list[tuple[o
     board.run(12)
     assert board.interrupts >= 10  # the EXTI0 handler's entries and returns are exercised
     return steps
-
-
-BOARD_CASES = [("digital_io", "cortex_m3", 2_000_000, {"BOARD_SPI_BR": "3u"}),
-               ("digital_io", "cortex_m0", 500_000, {}), ("irq_dispatch", "cortex_m3", 500_000, {}),
-               ("pcmd_alarm", "cortex_m3", 500_000, {}), ("analog_io", "cortex_m0", 500_000, {})]  # fmt: skip
 
 
 @pytest.mark.parametrize(("example", "cpu", "bit_rate", "defines"), BOARD_CASES)
@@ -135,21 +125,19 @@ def test_the_handed_entry_is_the_core_s_answer_at_the_step(tmp_path: Path) -> No
     assert handed.count(_EXTI0) >= 5
 
 
-def _both(elf: Path, cpu: str, scenario: Callable[[CortexM], object]) -> list[tuple[object, list[int], object]]:
-    """``scenario`` on a new core and on one whose returns always ask for a tail-chain."""
-    results: list[tuple[object, list[int], object]] = []
-    for lean in (True, False):
-        core = CortexM(elf, cpu=cpu)
-        if not lean:
-            core.pending = _AlwaysAsked()
-        entries: list[int] = []
-        core.entered = entries.append
-        try:
-            outcome: object = scenario(core)
-        except FirmwareError as error:
-            outcome = (str(error), error.report)
-        results.append((outcome, entries, _core_state(core)))
-    return results
+def _scenario(elf: Path, cpu: str, scenario: Callable[[CortexM], object], asking: bool) -> tuple[object, ...]:
+    """``scenario`` on a new core (``asking``: its returns always ask for a tail-chain): its outcome (a fault
+    report as its text and report), the exceptions it entered, the core's state after."""
+    core = CortexM(elf, cpu=cpu)
+    if asking:
+        core.pending = _AlwaysAsked()
+    entries: list[int] = []
+    core.entered = entries.append
+    try:
+        outcome: object = scenario(core)
+    except FirmwareError as error:
+        outcome = (str(error), error.report)
+    return outcome, entries, _state(core)
 
 
 @pytest.fixture(scope="module")
@@ -164,5 +152,5 @@ def exceptions_elf(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def test_a_return_asks_for_a_chain_only_with_an_exception_pending(exceptions_elf: Path, cpu: str, name: str) -> None:
     """MCU-79 over the hand-written exception programs (nesting, both stacks, a tail-chain, the faults): the same
     outcome, entries and state as a core whose every return asks for a tail-chain."""
-    lean, asking = _both(exceptions_elf, cpu, SCENARIOS[name])
+    lean, asking = (_scenario(exceptions_elf, cpu, SCENARIOS[name], flag) for flag in (False, True))
     assert lean == asking
