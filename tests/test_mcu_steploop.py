@@ -21,9 +21,9 @@ import pytest
 
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import _EXTI0, NOISE_CYCLES, Board
-from supi3.mcu.core import CPUS, MAX_DEADLINE, UNASKED, CortexM, FirmwareError
+from supi3.mcu.core import CPUS, MAX_DEADLINE, UNASKED, CortexM
 from supi3.sdk import native
-from test_mcu_nativeexc import BOARD_CASES, SCENARIOS, _state
+from test_mcu_nativeexc import BOARD_CASES, SCENARIOS, _both, _state
 
 pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
 
@@ -63,7 +63,8 @@ class AskingBoard(Board):
 
 
 def _board_steps(elf: Path, cpu: str, bit_rate: int, lean: bool) -> list[tuple[object, ...]]:
-    """Power-up and twelve data cycles with process data both ways; the board's state after every step."""
+    """Power-up and a history of runs of one to five data cycles with new process data both ways after each; the
+    board's state after every step."""
     board = (Board if lean else AskingBoard)(elf, cpu=cpu, bit_rate=bit_rate, strict=False)
     if not lean:
         board.core.pending = _AlwaysAsked()
@@ -81,12 +82,12 @@ def _board_steps(elf: Path, cpu: str, bit_rate: int, lean: bool) -> list[tuple[o
                           [(v.time_s, v.pc, str(v.error)) for v in board.violations]))  # fmt: skip
 
     board._step = recorded  # type: ignore[method-assign]
-    board.run(3)
-    master = board.bench.master
-    master.set_outputs(1, bytes(range(0x12, 0x12 + master.entry(1).data_bytes)))
-    if board.fw_board is not None:
-        board.fw_board.inputs = bytes(range(0x56, 0x56 + len(board.fw_board.inputs)))
-    board.run(12)
+    for cycles, data in ((3, 0x21), (1, 0x43), (4, 0x65), (2, 0x87), (5, 0xA9)):  # new process data each run
+        board.run(cycles)
+        size = board.bench.master.entry(1).data_bytes
+        board.bench.master.set_outputs(1, bytes((data + k) & 0xFF for k in range(size)))
+        if board.fw_board is not None:
+            board.fw_board.inputs = bytes((data ^ 0xFF) - k for k in range(len(board.fw_board.inputs)))
     assert board.interrupts >= 10  # the EXTI0 handler's entries and returns are exercised
     return steps
 
@@ -125,19 +126,14 @@ def test_the_handed_entry_is_the_core_s_answer_at_the_step(tmp_path: Path) -> No
     assert handed.count(_EXTI0) >= 5
 
 
-def _scenario(elf: Path, cpu: str, scenario: Callable[[CortexM], object], asking: bool) -> tuple[object, ...]:
-    """``scenario`` on a new core (``asking``: its returns always ask for a tail-chain): its outcome (a fault
-    report as its text and report), the exceptions it entered, the core's state after."""
-    core = CortexM(elf, cpu=cpu)
-    if asking:
+def _asking(scenario: Callable[[CortexM], object]) -> Callable[[CortexM], object]:
+    """``scenario`` on a core whose returns always ask for a tail-chain."""
+
+    def run(core: CortexM) -> object:
         core.pending = _AlwaysAsked()
-    entries: list[int] = []
-    core.entered = entries.append
-    try:
-        outcome: object = scenario(core)
-    except FirmwareError as error:
-        outcome = (str(error), error.report)
-    return outcome, entries, _state(core)
+        return scenario(core)
+
+    return run
 
 
 @pytest.fixture(scope="module")
@@ -150,7 +146,8 @@ def exceptions_elf(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.mark.parametrize("cpu", sorted(CPUS))
 @pytest.mark.parametrize("name", list(SCENARIOS))
 def test_a_return_asks_for_a_chain_only_with_an_exception_pending(exceptions_elf: Path, cpu: str, name: str) -> None:
-    """MCU-79 over the hand-written exception programs (nesting, both stacks, a tail-chain, the faults): the same
-    outcome, entries and state as a core whose every return asks for a tail-chain."""
-    lean, asking = (_scenario(exceptions_elf, cpu, SCENARIOS[name], flag) for flag in (False, True))
-    assert lean == asking
+    """MCU-79 over the hand-written exception programs (nesting, both stacks, a tail-chain, the faults), with the
+    native and the Python traffic (MCU-70, MCU-71): the same outcome, entries and state as a core whose every
+    return asks for a tail-chain."""
+    scenario = SCENARIOS[name]
+    assert _both(exceptions_elf, cpu, scenario) == _both(exceptions_elf, cpu, _asking(scenario))
