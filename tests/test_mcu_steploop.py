@@ -21,7 +21,7 @@ import pytest
 
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import _EXTI0, NOISE_CYCLES, Board
-from supi3.mcu.core import CPUS, MAX_DEADLINE, UNASKED, CortexM
+from supi3.mcu.core import CPUS, MAX_DEADLINE, PENDSV, UNASKED, CortexM
 from supi3.sdk import native
 from test_mcu_nativeexc import BOARD_CASES, SCENARIOS, _both, _state
 
@@ -151,3 +151,17 @@ def test_a_return_asks_for_a_chain_only_with_an_exception_pending(exceptions_elf
     return asks for a tail-chain."""
     scenario = SCENARIOS[name]
     assert _both(exceptions_elf, cpu, scenario) == _both(exceptions_elf, cpu, _asking(scenario))
+
+
+def test_a_host_s_step_after_a_run_asks_for_its_entry(tmp_path: Path) -> None:
+    """MCU-79: the answer the run loop handed is taken by its step alone (in issue #13's case the last one of a run
+    is EXTI0); the host's own step after the run asks, and enters the PendSV exception the host pended."""
+    elf = mcu_build.build(native.example("digital_io"), tmp_path / "br3.elf", defines={"BOARD_SPI_BR": "3u"})
+    board = Board(elf, bit_rate=2_000_000, strict=False)
+    board.run(3)
+    core = board.core
+    assert board.served and not core.active and not core.pending
+    core.pend(PENDSV)
+    core.step(core.cycles + 1)
+    assert core.active == [PENDSV]
+    assert board.interrupts == 2  # power-up's EXTI0 entries only
