@@ -32,6 +32,7 @@ from supi3.interbus.master import Master
 from supi3.mcu.core import (
     EXTERNAL,
     MAX_DEADLINE,
+    UNASKED,
     CortexM,
     FirmwareImage,
     FirmwareStoppedError,
@@ -426,6 +427,7 @@ class Board:
         self._irq_fell: int | None = None
         self._mod_ack_until = 0
         self._limit = self._budget = 0
+        self._entry: int | None = UNASKED  # the run loop's answer to CortexM.next_entry for the next step (MCU-79)
         pins = (PIN_IRQ, PIN_CD, PIN_IO)
         self.native_frames = NativeFrames(self, held, PIN_SS, pins, NOISE_CYCLES, _EXTI0) if native else None
         """MCU-51: the native per-frame fast path (``native_frames=True`` at transaction level on the Motorola
@@ -605,12 +607,16 @@ class Board:
                 self._irq_fell = cycles if low_at is None else math.ceil(low_at * self._cpu_hz - NOISE_CYCLES)
             self.exti.edge(0, PIN_IRQ, level)
             request = True
-        if request and self.exti.requesting(0):
-            self._pend()
+        if request:
+            self._request()
 
     def _request(self) -> None:
-        if self.exti.requesting(0):
-            self._pend()
+        """If EXTI0 requests its interrupt: pend it unless it is active or pending, and stop the run for it (the
+        core's lists asked first: inside the handler no question to EXTI, MCU-79)."""
+        core = self.core
+        if _EXTI0 not in core.active and _EXTI0 not in core.pending and self.exti.requesting(0):
+            core.pend(_EXTI0)
+            core.stop_request = True
 
     def _exti_read(self, offset: int, size: int) -> int:
         """The firmware reads EXTI: at transaction level the bus runs up to the access first, so PR holds every edge
@@ -632,19 +638,12 @@ class Board:
         if self.native_frames is not None:  # MCU-66: the mirror valid again for GPIOA's reads after it
             self._refresh()
 
-    def _pend(self) -> None:
-        """EXTI0 requests its interrupt: pend it unless it is active or pending, and stop the run for it."""
-        core = self.core
-        if _EXTI0 not in core.active and _EXTI0 not in core.pending:
-            core.pend(_EXTI0)
-            core.stop_request = True
-
     def _entered(self, number: int) -> None:
         if number == _EXTI0:
             self._passes.handler()  # MCU-30: a pass serves the edge only if it begins after the handler
             self.interrupts += 1
             if self._irq_fell is not None:
-                self.irq_latency_s = max(self.irq_latency_s, self._seconds(self.core.cycles - self._irq_fell))
+                self.irq_latency_s = max(self.irq_latency_s, (self.core.cycles - self._irq_fell) / self._cpu_hz)
                 self._irq_fell = None
 
     # -- the main loop's passes (MCU-30) --------------------------------------------------------------------------
@@ -969,13 +968,13 @@ class Board:
         self._set_budget(max_instructions)
         self._sync(core.cycles)
         self._follow_irq(core.cycles)  # the chip may have changed between runs (the host's calls)
-        systick, exti = core.systick, self.exti
+        systick = core.systick
         while True:
             tick = systick.due()
-            if exti.requesting(0):
-                self._pend()
+            self._request()
             if done():
                 return
+            self._entry = core.next_entry()  # once a step: for the deadline and the step's entry (MCU-79)
             deadline = self._bus_deadline()
             for bound in (tick, end, self._serve_end):
                 if bound is not None:
@@ -989,13 +988,14 @@ class Board:
         after it (MCU-44: an edge of /IRQ then only sets EXTI's pending bit, and the firmware's next access, or the
         next stop, at the latest the handler's return, runs the bus up to it; MCU-55: a handler that makes no access
         for that long, spinning, still lets the bus run on, and a run's wait ends at its bound); none while the
-        master holds at a run's end (MCU-55: no bus event comes)."""
+        master holds at a run's end (MCU-55: no bus event comes). The core's next entry: the run loop's answer of
+        the step (MCU-79)."""
         core, bench = self.core, self._bench
         assert bench is not None  # transaction level
         at = bench.next_change_s()
         if at == math.inf:
             return MAX_DEADLINE
-        if _EXTI0 in core.active or (_EXTI0 in core.pending and core.next_entry() == _EXTI0):
+        if self._entry == _EXTI0 or _EXTI0 in core.active:
             at += self._wait_s
         return math.ceil(at * core.cpu_hz - NOISE_CYCLES)
 
@@ -1004,8 +1004,10 @@ class Board:
         self._limit = self.core.instructions + self._budget
 
     def _step(self, deadline: int) -> None:
-        """One run of the core up to ``deadline`` (at least one block), within the instruction budget."""
+        """One run of the core up to ``deadline`` (at least one block), within the instruction budget; the exception
+        it enters first: the run loop's answer handed in :attr:`_entry` (taken once, MCU-79), else the core asks."""
         core = self.core
+        entry, self._entry = self._entry, UNASKED
         cycles = core.cycles
         if not core.sleeping:  # a sleeping core runs no instruction (MCU-4)
             left = self._limit - core.instructions
@@ -1013,6 +1015,7 @@ class Board:
                 raise FirmwareStoppedError(core.report(Stop.BUDGET, f"instruction budget of {self._budget} used up "
                                                        "(an endless loop?)"))  # fmt: skip
             deadline = min(deadline, cycles + left)  # within the budget: an instruction costs a cycle at least (MCU-1)
+        core._handed = entry  # UNASKED: the step asks
         try:
             state = core.step(max(deadline, cycles + 1))
         except InterfaceViolationError as error:

@@ -622,6 +622,9 @@ def block_cost(code: bytes) -> tuple[int, int]:
 ReadFn = Callable[[int, int], int]
 WriteFn = Callable[[int, int, int], None]
 _FOREVER: Final[int] = (1 << 64) - 1
+UNASKED: Final[int] = -1
+""":attr:`CortexM._handed` when no caller has handed the next step its entry: the step asks (an exception number is at
+least 2, MCU-79)."""
 MAX_DEADLINE: Final[int] = (1 << 63) - 1
 """The latest cycle a run may end at (MCU-28): the native hook's clock is 64-bit and a run passes its deadline by a
 block, an exception entry or a sleep; half its range (6000 years at 48 MHz) leaves it room never to wrap."""
@@ -829,6 +832,9 @@ class CortexM:
         self.sleeping = False
         self.active: list[int] = []  # active exceptions, outermost first
         self.pending: set[int] = set()
+        self._handed: int | None = UNASKED
+        """The board's run loop's :meth:`next_entry` answer for the next :meth:`step`, asked with nothing run or
+        written since (it asks once a step, for its deadline and the entry, MCU-79); the step takes it once."""
         self.enabled: set[int] = set()  # external interrupts enabled in the NVIC (exception numbers)
         self.priorities: dict[int, int] = {}
         self.stop_request = False
@@ -1188,7 +1194,7 @@ class CortexM:
         if not pending:  # the run loop's common case (MCU-31)
             return None
         if len(pending) == 1:  # the next common one: EXTI0 alone
-            best = next(iter(pending))
+            (best,) = pending  # no call (MCU-79)
             if best >= EXTERNAL and best not in self.enabled:
                 return None
         else:
@@ -1203,7 +1209,10 @@ class CortexM:
         with CONTROL.SPSEL = 1), aligned to 8 bytes (B1.5.7), LR = EXC_RETURN, CONTROL.SPSEL = 0 (the handler runs
         on the main stack), IPSR = ``number``, PC = its vector; costs :attr:`Cpu.entry_cycles`. Returns the
         frame's address."""
-        _exception_number(number)
+        return self._enter(_exception_number(number))
+
+    def _enter(self, number: int) -> int:
+        """:meth:`enter` of a checked exception number."""
         handler_mode = bool(self.active)
         if self._native_exceptions:  # MCU-71: the same traffic in one call
             failed = self._native_enter(self._handle, self._state_ref, number, handler_mode, self.vtor + 4 * number)
@@ -1280,13 +1289,14 @@ class CortexM:
             nesting = f"{len(self.active)} active exception(s)"
             reason = f"EXC_RETURN {exc_return:08X}h does not match the nesting of {nesting}: INVPC UsageFault (B1.5.8)"
             raise FirmwareFaultError(self.report(Stop.FAULT, reason))
-        returning = self.active.pop()
-        chained = self._takeable()
-        if chained is not None:
-            sp = self._read(arm.UC_ARM_REG_PSP if exc_return == EXC_RETURN_THREAD_PSP else arm.UC_ARM_REG_SP)
-            self._take(chained, exc_return, sp, self.cpu.tail_chain_cycles)
-            return
-        self.active.append(returning)  # until the frame is back: a fault report shows the handler still active
+        if self.pending:  # else nothing to chain (MCU-79: the run loop's common return, no question asked)
+            returning = self.active.pop()
+            chained = self._takeable()
+            if chained is not None:
+                sp = self._read(arm.UC_ARM_REG_PSP if exc_return == EXC_RETURN_THREAD_PSP else arm.UC_ARM_REG_SP)
+                self._take(chained, exc_return, sp, self.cpu.tail_chain_cycles)
+                return
+            self.active.append(returning)  # until the frame is back: a fault report shows the handler still active
         if self._native_exceptions:  # MCU-70: the same traffic in one call
             if self._native_return(self._handle, self._state_ref, exc_return):
                 self._unstacking_error(int(self._state.frame))
@@ -1363,10 +1373,12 @@ class CortexM:
 
         A pending exception that may preempt (B1.5.4) is entered first; a sleeping core (WFI, or ``b .`` in thread
         mode: MCU-4) only lets the time pass."""
+        number, self._handed = self._handed, UNASKED  # taken once (MCU-79)
         self.deadline = deadline
-        number = self._takeable()
+        if number == UNASKED:
+            number = self._takeable()
         if number is not None:
-            self.enter(number)
+            self._enter(number)
         state = self._state
         if self.sleeping:
             state.cycles = max(state.cycles, deadline)
