@@ -155,6 +155,8 @@ if len(_IRQ_ADDRESSES) != 1:  # RegisterFile.irq_n follows the one event registe
     raise NativeHookError(f"the register map has {len(_IRQ_ADDRESSES)} read-clear registers, MCU-67 knows one")
 IRQ_ADDRESS: Final[int] = _IRQ_ADDRESSES[0]
 """MCU-67: the address of the read-clear register /IRQ follows (IRQ_EVT, 3.4.14), whose reads hook.c takes."""
+_MOTOROLA: Final[Mode] = Mode.MOTOROLA
+"""MCU-78: the wiring the native frames run in (an enum member's class attribute is a slow look-up)."""
 
 
 def _access(name: str | None, side_effects: frozenset[str]) -> int:
@@ -170,6 +172,10 @@ FAST_WRITES: Final[tuple[int, ...]] = tuple(_access(name, _EVENT_REGISTERS | _re
                                             for name in _registers._WRITE_NAMES)  # fmt: skip
 """Per address, a write data frame a native frame may take (0, 1, 2 as :data:`FAST_READS`): never SET or ID (they
 configure the chip, 3.4.3), nor an address without a register (pedantic mode may report it: left to Python)."""
+if any(fast and name in _registers._READ_NAMES
+       for fast, name in zip(FAST_WRITES, _registers._WRITE_NAMES, strict=True)):  # fmt: skip
+    # MCU-78: then a native write changes Frames.values, which the values' memo of NativeFrames.refresh does not know
+    raise NativeHookError("a register a native frame writes is readable: MCU-78's values memo knows none")
 
 _STATE_FIELDS: Final[tuple[str, ...]] = (
     "pending", "odr", "synced", "phase", "command", "last_rx", "frame_open", "frame_fall", "frame_driven", "transfer",
@@ -277,6 +283,7 @@ class NativeFrames:
         self._read_values = operator.itemgetter(*reads)  # the fast-readable registers' values, in address order
         self._values = struct.Struct("<" + "".join("B" if name in reads else "x" for name in read_names))
         self._values_at = Frames.values.offset
+        self._packed: tuple[int, ...] | None = None  # MCU-78: the values last packed into Frames.values
         self._bench = board.bench  # the transaction-level bench, set once at the board's construction
         self._due_key: tuple[int, float | None, float] | None = None  # the bench's next events, as last mirrored
         self._due = (0, _NEVER, _NEVER)
@@ -311,6 +318,7 @@ class NativeFrames:
         gpio._levels = frames.gpio_levels
         board.exti.pr = exti_pr  # MCU-68: the handler's writes of PR (before the bus runs on: its edges come after)
         if cleared:  # MCU-67: the register file's own read-clear, each read at the latest one's time (no bus event)
+            self._packed = None  # MCU-78: the native reads changed Frames.values
             board._sync(cleared_at - 1)
             read = board.registers.cpu_read
             for _ in range(cleared):
@@ -379,7 +387,7 @@ class NativeFrames:
         code = self._code
         frame = board._frame
         core = board.core
-        valid = (protocol.mode is Mode.MOTOROLA and not registers.pedantic and bench.low_at is None
+        valid = (protocol.mode is _MOTOROLA and not registers._pedantic and bench.low_at is None
                  and board._irq_level == registers.irq_n and bench.chip.mod_ack_until == board._mod_ack_until
                  and phase and (phase != _PHASE_DATA or code != _NO_COMMAND)
                  and (not board.exti.requesting(0) or self._exti0 in core.active
@@ -402,8 +410,10 @@ class NativeFrames:
                   and rcc.apb2enr & SPI1EN and not rcc.apb2rstr & SPI1EN and cr1 & CR1_SPE and cr1 & CR1_MSTR
                   and not cr1 & (CR1_DFF | CR1_LSBFIRST) and cr1 & (CR1_CPOL | CR1_CPHA) == CR1_CPOL | CR1_CPHA
                   and not period / self._hz < board._shortest_period_s)  # fmt: skip
-        values = registers._values
-        self._values.pack_into(frames, self._values_at, *self._read_values(values))
+        values = self._read_values(registers._values)
+        if values != self._packed:  # MCU-78: only Python's changes and the native reads' clears change them
+            self._packed = values
+            self._values.pack_into(frames, self._values_at, *values)
         events = bench._events  # only popped from the end until the next cycle's start makes a new list
         key = (len(events), events[-1][0] if events else None, bench._next_start)
         if key != self._due_key:
@@ -411,9 +421,9 @@ class NativeFrames:
             self._due = self._thresholds(events, bench._next_start)
         due, latch_at, io_at = self._due
         _MIRROR.pack_into(
-            frames, _MIRROR_AT, 1, due, int(registers.latch_phase), latch_at,
+            frames, _MIRROR_AT, 1, due, int(registers._latch_phase), latch_at,
             int(bool(rcc.apb2enr & IOPAEN) and not rcc.apb2rstr & IOPAEN), gpio._output_mask(), gpio.pulled_up,
-            gpio._levels, int(bool(spi_ok)), period, SR_MODF if spi.modf else 0, int(registers.io_access), io_at,
+            gpio._levels, int(bool(spi_ok)), period, SR_MODF if spi.modf else 0, int(registers._io_access), io_at,
             int(exti.triggers(0, self._irq_pin, 1)), 0, gpio.odr, 0, phase, code, protocol.last_rx,
             int(frame is not None), 0 if frame is None else frame.fall,
             0 if frame is None or frame.driven is None else frame.driven, *transfer, board._ss_rise, board._cd_before,
