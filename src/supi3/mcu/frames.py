@@ -182,10 +182,13 @@ _STATE_FIELDS: Final[tuple[str, ...]] = (
     "transfer_seen", "transfer_start", "transfer_period", "ss_rise", "cd_before", "irq_level", "written", "cleared",
     "cleared_at", "exti_pr", "dr_writes", "rx_last", "shift_received", "shift_start", "shift_end")  # fmt: skip
 """The fields of :class:`~supi3.mcu.hook.Frames` the native frames change, in their order there."""
+_CONFIG_FIELDS: Final[tuple[str, ...]] = (
+    "gpio_ok", "gpio_mask", "gpio_pulled_up", "spi_ok", "period", "sr_modf", "exti_rise")
+"""MCU-78: the fields :meth:`NativeFrames.refresh` writes only when the peripherals' configuration they are computed
+from changed (:meth:`NativeFrames._configuration`), in their order there."""
 _MIRROR_FIELDS: Final[tuple[str, ...]] = (
-    "valid", "due", "latch", "latch_at", "gpio_ok", "gpio_mask", "gpio_pulled_up", "gpio_levels", "spi_ok", "period",
-    "sr_modf", "io", "io_at", "exti_rise", *_STATE_FIELDS[:-3])  # fmt: skip
-"""The fields :meth:`NativeFrames.refresh` writes, in their order there."""
+    "valid", "due", "latch", "latch_at", "gpio_levels", "io", "io_at", *_STATE_FIELDS[:-3])  # fmt: skip
+"""The fields :meth:`NativeFrames.refresh` writes at each call, in their order there."""
 
 
 def _packed(names: tuple[str, ...]) -> tuple[struct.Struct, int]:
@@ -204,6 +207,7 @@ def _packed(names: tuple[str, ...]) -> tuple[struct.Struct, int]:
 
 _STATE, _STATE_AT = _packed(_STATE_FIELDS)
 _MIRROR, _MIRROR_AT = _packed(_MIRROR_FIELDS)
+_CONFIG, _CONFIG_AT = _packed(_CONFIG_FIELDS)
 
 
 def first_due(next_at: float, cpu_hz: float, noise: float) -> int:
@@ -284,6 +288,7 @@ class NativeFrames:
         self._values = struct.Struct("<" + "".join("B" if name in reads else "x" for name in read_names))
         self._values_at = Frames.values.offset
         self._packed: tuple[int, ...] | None = None  # MCU-78: the values last packed into Frames.values
+        self._configured: tuple[object, ...] | None = None  # MCU-78: what the configuration fields were made of
         self._bench = board.bench  # the transaction-level bench, set once at the board's construction
         self._due_key: tuple[int, float | None, float] | None = None  # the bench's next events, as last mirrored
         self._due = (0, _NEVER, _NEVER)
@@ -405,11 +410,12 @@ class NativeFrames:
             frames.valid = 0
             return
         gpio, spi, rcc, exti = board.gpio, board.spi, board.rcc, board.exti
-        cr1, period = spi.cr1, spi.period
-        spi_ok = (spi.holder is self._spi_held and spi.offer is self._spi_held  # hook.c holds and offers as they would
-                  and rcc.apb2enr & SPI1EN and not rcc.apb2rstr & SPI1EN and cr1 & CR1_SPE and cr1 & CR1_MSTR
-                  and not cr1 & (CR1_DFF | CR1_LSBFIRST) and cr1 & (CR1_CPOL | CR1_CPHA) == CR1_CPOL | CR1_CPHA
-                  and not period / self._hz < board._shortest_period_s)  # fmt: skip
+        cr = gpio.cr
+        configured = (rcc.apb2enr, rcc.apb2rstr, spi.cr1, spi.modf, spi.holder, spi.offer, cr[0], cr[1],
+                      gpio.pulled_up, exti.exticr1, exti.rtsr)  # fmt: skip
+        if configured != self._configured:  # MCU-78: everything the configuration fields are computed from
+            self._configured = configured
+            self._configuration()
         values = self._read_values(registers._values)
         if values != self._packed:  # MCU-78: only Python's changes and the native reads' clears change them
             self._packed = values
@@ -421,10 +427,23 @@ class NativeFrames:
             self._due = self._thresholds(events, bench._next_start)
         due, latch_at, io_at = self._due
         _MIRROR.pack_into(
-            frames, _MIRROR_AT, 1, due, int(registers._latch_phase), latch_at,
-            int(bool(rcc.apb2enr & IOPAEN) and not rcc.apb2rstr & IOPAEN), gpio._output_mask(), gpio.pulled_up,
-            gpio._levels, int(bool(spi_ok)), period, SR_MODF if spi.modf else 0, int(registers._io_access), io_at,
-            int(exti.triggers(0, self._irq_pin, 1)), 0, gpio.odr, 0, phase, code, protocol.last_rx,
+            frames, _MIRROR_AT, 1, due, int(registers._latch_phase), latch_at, gpio._levels,
+            int(registers._io_access), io_at, 0, gpio.odr, 0, phase, code, protocol.last_rx,
             int(frame is not None), 0 if frame is None else frame.fall,
             0 if frame is None or frame.driven is None else frame.driven, *transfer, board._ss_rise, board._cd_before,
             board._irq_level, 0, 0, 0, exti.pr, 0, 0)  # fmt: skip
+
+    def _configuration(self) -> None:
+        """MCU-78: the fields the peripherals' configuration decides (GPIOA's clock and output pins, SPI1's mode and
+        SCLK period, MODF, EXTI's trigger on /IRQ's rise), when what :meth:`refresh` computes them from changed."""
+        board = self._board
+        gpio, spi, rcc = board.gpio, board.spi, board.rcc
+        cr1, period = spi.cr1, spi.period
+        spi_ok = (spi.holder is self._spi_held and spi.offer is self._spi_held  # hook.c holds and offers as they would
+                  and rcc.apb2enr & SPI1EN and not rcc.apb2rstr & SPI1EN and cr1 & CR1_SPE and cr1 & CR1_MSTR
+                  and not cr1 & (CR1_DFF | CR1_LSBFIRST) and cr1 & (CR1_CPOL | CR1_CPHA) == CR1_CPOL | CR1_CPHA
+                  and not period / self._hz < board._shortest_period_s)  # fmt: skip
+        _CONFIG.pack_into(
+            self._frames, _CONFIG_AT, int(bool(rcc.apb2enr & IOPAEN) and not rcc.apb2rstr & IOPAEN),
+            gpio._output_mask(), gpio.pulled_up, int(bool(spi_ok)), period, SR_MODF if spi.modf else 0,
+            int(board.exti.triggers(0, self._irq_pin, 1)))
