@@ -25,6 +25,7 @@ from supi3.errors import Supi3Error
 from supi3.interbus.errors import InterbusError
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import NOISE_CYCLES, Board
+from supi3.mcu.core import HeldRegister
 from supi3.mcu.frames import _MEMO_SIZE, FAST_READS, FAST_WRITES, _FirstDue, first_due
 from supi3.mcu.stm32 import CR1_BR, CR1_BR_SHIFT, IOPAEN, SPI1EN
 from supi3.sdk import native
@@ -272,21 +273,24 @@ def _reconfigure(board: Board, change: str, step: int) -> None:
         gpio.write(0x0, 4, gpio.cr[0] & ~(0xF << 16) | 0x4 << 16)
     elif change == "pull-up":  # an input pin without a use: its level is the pull-up's
         gpio.pulled_up ^= 1 << 10
-    elif change == "modf" and step == 1:
-        spi.modf = True
+    elif change == "gpioa mode high" and step == 1:  # PA10, an input without a use, a push-pull output (ODR: 0)
+        gpio.write(0x4, 4, gpio.cr[1] & ~(0xF << 8) | 0x1 << 8)
     elif change == "exti port" and step in (1, 2):  # EXTI0 on PB0 for a run (with a pull-up changed, so the mirror's
-        exti.exticr1 ^= 1  # configuration is made while it is), then on PA0 (/IRQ) again
-        gpio.pulled_up ^= 1 << 10
+        exti.exticr1 ^= 1  # configuration is made while it is), then on PA0 (/IRQ) again, nothing else changed
+        gpio.pulled_up ^= (step == 1) << 10
     elif change == "rising trigger" and step in (1, 2):  # EXTI0's rising trigger off for a run, then on again
         exti.rtsr ^= 1
-        gpio.pulled_up ^= 1 << 10
+        gpio.pulled_up ^= (step == 1) << 10
+    elif change == "modf" and step == 1:
+        spi.modf = True
     elif change == "pcmd":  # the master's processor command: PCMD, which the firmware reads natively, changed
         board.registers.processor_command(step)
 
 
 @pytest.mark.parametrize(("case", "bit_rate", "change"), [
     ("dio_br3", 2_000_000, "spi1 period"), ("dio_br3", 2_000_000, "spi1 reset"), ("dio_br3", 2_000_000, "spi1 clock"),
-    ("dio_br3", 2_000_000, "gpioa reset"), ("dio_br3", 2_000_000, "gpioa mode"), ("dio_br3", 2_000_000, "pull-up"),
+    ("dio_br3", 2_000_000, "gpioa reset"), ("dio_br3", 2_000_000, "gpioa mode"),
+    ("dio_br3", 2_000_000, "gpioa mode high"), ("dio_br3", 2_000_000, "pull-up"),
     ("dio_br3", 2_000_000, "modf"), ("pin_watch_rise", 500_000, "exti port"),
     ("pin_watch_rise", 500_000, "rising trigger"), ("due_cross", 2_000_000, "pcmd")])  # fmt: skip
 def test_the_mirror_follows_the_host_s_changes_between_runs(elves: dict[str, Path], case: str, bit_rate: int,
@@ -310,9 +314,18 @@ def test_the_mirror_follows_the_host_s_changes_between_runs(elves: dict[str, Pat
                 errors.append(None)
         assert errors[0] == errors[1], step
         assert snapshot(boards[0]) == snapshot(boards[1]), step
+        assert _held_sr(boards[0]) == _held_sr(boards[1]), step
         if errors[0] is not None:
             break
     assert boards[0].core.frames.taken > 0
+
+
+def _held_sr(board: Board) -> tuple[int, ...] | None:
+    """SPI1's SR as the core answers its reads natively (MCU-25: held, and after the hold), ``None`` if not held."""
+    held = board.spi.holder
+    assert isinstance(held, HeldRegister)
+    native = held.native
+    return (native.value, native.after if native.has_after else -1) if native.held else None
 
 
 def test_the_fast_sets_follow_the_register_map() -> None:
