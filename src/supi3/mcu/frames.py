@@ -19,7 +19,8 @@ on to the held register's read (MCU-25) and Python:
   ``Board._sync`` would run one, by the same float expression), /IRQ and /ModAck followed, nothing else pending.
 
 Python hands the native side its tables once (:meth:`NativeFrames.__init__`), mirrors the state those conditions read
-after each of its accesses of GPIOA, SPI1 or EXTI (:meth:`NativeFrames.refresh`: ``valid``), and at each entry into
+after each of its accesses of GPIOA, SPI1 or EXTI (:meth:`NativeFrames.refresh`: ``valid``; the peripherals'
+configuration and the register values only when what they are made of changed, MCU-78), and at each entry into
 Python (:attr:`supi3.mcu.core.CortexM.entry`: a peripheral's callback, a watched address, the end of a run) takes the
 mirror's validity back and sets what the native frames changed, as its net effect, in the Python objects
 (:meth:`NativeFrames.catch_up`): the protocol's phase, command and last byte, the written registers, the board's
