@@ -14,6 +14,8 @@ while /SS is low, strict and pedantic boards.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -102,6 +104,15 @@ def _seen(board: Board) -> tuple[int, ...]:
     return tuple(int.from_bytes(data[at:at + 4], "little") for at in range(0, len(data), 4))
 
 
+def _error(run: Callable[[], object]) -> tuple[type[Supi3Error], str] | None:
+    """The error ``run`` raised (its type and text), ``None`` if none."""
+    try:
+        run()
+    except Supi3Error as error:
+        return type(error), str(error)
+    return None
+
+
 def side_by_side(elf: Path, bit_rate: int, steps: int, *, strict: bool = False, pedantic: bool = False,
                  cycles: int = 1) -> tuple[Board, Board]:  # fmt: skip
     """A board with the native frames and one without, run ``steps`` times ``cycles`` master cycles, compared after
@@ -111,14 +122,7 @@ def side_by_side(elf: Path, bit_rate: int, steps: int, *, strict: bool = False, 
               Board(elf, bit_rate=bit_rate, strict=strict, pedantic=pedantic, native_frames=False))  # fmt: skip
     assert boards[0].native_frames is not None and boards[1].native_frames is None
     for step in range(steps):
-        errors: list[tuple[type[Supi3Error], str] | None] = []
-        for board in boards:
-            try:
-                board.run(cycles)
-            except Supi3Error as error:
-                errors.append((type(error), str(error)))
-            else:
-                errors.append(None)
+        errors = [_error(partial(board.run, cycles)) for board in boards]
         assert errors[0] == errors[1], step
         assert snapshot(boards[0]) == snapshot(boards[1]), step
         if errors[0] is not None:
@@ -310,15 +314,9 @@ def test_the_mirror_follows_the_host_s_changes_between_runs(elves: dict[str, Pat
     for board in boards:  # past the firmware's set-up
         board.run(2)
     for step in range(12):
-        errors: list[tuple[type[Supi3Error], str] | None] = []
         for board in boards:
             _reconfigure(board, change, step)
-            try:
-                board.run_for(15e-6)
-            except Supi3Error as error:
-                errors.append((type(error), str(error)))
-            else:
-                errors.append(None)
+        errors = [_error(partial(board.run_for, 15e-6)) for board in boards]
         assert errors[0] == errors[1], step
         assert snapshot(boards[0]) == snapshot(boards[1]), step
         assert _held_sr(boards[0]) == _held_sr(boards[1]), step
