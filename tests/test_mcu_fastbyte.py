@@ -14,6 +14,8 @@ while /SS is low, strict and pedantic boards.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -25,7 +27,9 @@ from supi3.errors import Supi3Error
 from supi3.interbus.errors import InterbusError
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import NOISE_CYCLES, Board
+from supi3.mcu.core import HeldRegister
 from supi3.mcu.frames import _MEMO_SIZE, FAST_READS, FAST_WRITES, _FirstDue, first_due
+from supi3.mcu.stm32 import CR1_BR, CR1_BR_SHIFT, IOPAEN, SPI1EN
 from supi3.sdk import native
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning:unicorn")
@@ -100,6 +104,15 @@ def _seen(board: Board) -> tuple[int, ...]:
     return tuple(int.from_bytes(data[at:at + 4], "little") for at in range(0, len(data), 4))
 
 
+def _error(run: Callable[[], object]) -> tuple[type[Supi3Error], str] | None:
+    """The error ``run`` raised (its type and text), ``None`` if none."""
+    try:
+        run()
+    except Supi3Error as error:
+        return type(error), str(error)
+    return None
+
+
 def side_by_side(elf: Path, bit_rate: int, steps: int, *, strict: bool = False, pedantic: bool = False,
                  cycles: int = 1) -> tuple[Board, Board]:  # fmt: skip
     """A board with the native frames and one without, run ``steps`` times ``cycles`` master cycles, compared after
@@ -109,14 +122,7 @@ def side_by_side(elf: Path, bit_rate: int, steps: int, *, strict: bool = False, 
               Board(elf, bit_rate=bit_rate, strict=strict, pedantic=pedantic, native_frames=False))  # fmt: skip
     assert boards[0].native_frames is not None and boards[1].native_frames is None
     for step in range(steps):
-        errors: list[tuple[type[Supi3Error], str] | None] = []
-        for board in boards:
-            try:
-                board.run(cycles)
-            except Supi3Error as error:
-                errors.append((type(error), str(error)))
-            else:
-                errors.append(None)
+        errors = [_error(partial(board.run, cycles)) for board in boards]
         assert errors[0] == errors[1], step
         assert snapshot(boards[0]) == snapshot(boards[1]), step
         if errors[0] is not None:
@@ -254,6 +260,77 @@ def test_the_native_frames_leave_the_rest_to_python(elves: dict[str, Path], case
     fast, _ = side_by_side(elves[case], bit_rate, 5, strict=strict, pedantic=pedantic)
     if pedantic:
         assert fast.core.frames.taken == 0
+
+
+def _reconfigure(board: Board, change: str, step: int) -> None:
+    """The host's change of ``change`` before run ``step`` (MCU-78's cases), on the model's own state."""
+    gpio, rcc, spi, exti = board.gpio, board.rcc, board.spi, board.exti
+    if change == "spi1 period" and step == 1:  # SCLK 1.5 MHz instead of 3 MHz
+        spi.cr1 = spi.cr1 & ~CR1_BR | 4 << CR1_BR_SHIFT
+    elif change == "spi1 reset" and step == 1:
+        rcc.apb2rstr |= SPI1EN
+    elif change == "spi1 clock" and step == 1:
+        rcc.apb2enr &= ~SPI1EN
+    elif change == "gpioa reset" and step == 1:
+        rcc.apb2rstr |= IOPAEN
+    elif change == "gpioa mode" and step == 1:  # /SS (PA4) a floating input: the pull-up holds it high
+        gpio.write(0x0, 4, gpio.cr[0] & ~(0xF << 16) | 0x4 << 16)
+    elif change == "pull-up":  # an input pin without a use: its level is the pull-up's
+        gpio.pulled_up ^= 1 << 10
+    elif change == "gpioa mode high" and step == 1:  # PA10, an input without a use, a push-pull output driving 1
+        # (pin_watch.c's IDR reads see it)
+        gpio.write(0x10, 4, 1 << 10)
+        gpio.write(0x4, 4, gpio.cr[1] & ~(0xF << 8) | 0x1 << 8)
+    elif change == "exti port" and step == 1:  # EXTI0 on PB0 while the mirror is made (with a pull-up changed: its
+        exti.exticr1 ^= 1  # configuration made again), then on PA0 (/IRQ) again, nothing else changed
+        gpio.pulled_up ^= 1 << 10
+        if board.native_frames is not None:
+            board.native_frames.refresh()
+        exti.exticr1 ^= 1
+    elif change == "rising trigger" and step in (1, 2):  # EXTI0's rising trigger off for a run, then on again
+        exti.rtsr ^= 1
+        gpio.pulled_up ^= (step == 1) << 10
+    elif change == "modf" and step == 1:
+        spi.modf = True
+    elif change == "pcmd":  # the master's processor command: PCMD, which the firmware reads natively, changed
+        board.registers.processor_command(step)
+
+
+@pytest.mark.parametrize(("case", "bit_rate", "change"), [
+    ("dio_br3", 2_000_000, "spi1 period"), ("dio_br3", 2_000_000, "spi1 reset"), ("dio_br3", 2_000_000, "spi1 clock"),
+    ("dio_br3", 2_000_000, "gpioa reset"), ("dio_br3", 2_000_000, "gpioa mode"),
+    ("pin_watch", 2_000_000, "gpioa mode high"), ("dio_br3", 2_000_000, "pull-up"),
+    ("dio_br3", 2_000_000, "modf"), ("pin_watch_rise", 500_000, "exti port"),
+    ("pin_watch_rise", 500_000, "rising trigger"), ("due_cross", 2_000_000, "pcmd")])  # fmt: skip
+def test_the_mirror_follows_the_host_s_changes_between_runs(elves: dict[str, Path], case: str, bit_rate: int,
+                                                             change: str) -> None:  # fmt: skip
+    """MCU-78: the mirror's configuration fields are made again when anything they are computed from changed, and
+    the register values packed again when they changed: the host changes SPI1's SCLK period, resets SPI1 or GPIOA,
+    turns SPI1's clock off, makes /SS an input, changes a pull-up, sets MODF, moves EXTI0 to port B and back, turns
+    its rising trigger off and on, or writes PCMD between runs of 15 µs; the boards with and without the native
+    frames agree after each (the same error at the same step, if one comes), SPI1's held SR too."""
+    boards = (Board(elves[case], bit_rate=bit_rate, strict=False),
+              Board(elves[case], bit_rate=bit_rate, strict=False, native_frames=False))  # fmt: skip
+    for board in boards:  # past the firmware's set-up
+        board.run(2)
+    for step in range(12):
+        for board in boards:
+            _reconfigure(board, change, step)
+        errors = [_error(partial(board.run_for, 15e-6)) for board in boards]
+        assert errors[0] == errors[1], step
+        assert snapshot(boards[0]) == snapshot(boards[1]), step
+        assert _held_sr(boards[0]) == _held_sr(boards[1]), step
+        if errors[0] is not None:
+            break
+    assert boards[0].core.frames.taken > 0
+
+
+def _held_sr(board: Board) -> tuple[int, ...] | None:
+    """SPI1's SR as the core answers its reads natively (MCU-25: held, and after the hold), ``None`` if not held."""
+    held = board.spi.holder
+    assert isinstance(held, HeldRegister)
+    native = held.native
+    return (native.value, native.after if native.has_after else -1) if native.held else None
 
 
 def test_the_fast_sets_follow_the_register_map() -> None:

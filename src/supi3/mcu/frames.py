@@ -19,7 +19,8 @@ on to the held register's read (MCU-25) and Python:
   ``Board._sync`` would run one, by the same float expression), /IRQ and /ModAck followed, nothing else pending.
 
 Python hands the native side its tables once (:meth:`NativeFrames.__init__`), mirrors the state those conditions read
-after each of its accesses of GPIOA, SPI1 or EXTI (:meth:`NativeFrames.refresh`: ``valid``), and at each entry into
+after each of its accesses of GPIOA, SPI1 or EXTI (:meth:`NativeFrames.refresh`: ``valid``; the peripherals'
+configuration and the register values only when what they are made of changed, MCU-78), and at each entry into
 Python (:attr:`supi3.mcu.core.CortexM.entry`: a peripheral's callback, a watched address, the end of a run) takes the
 mirror's validity back and sets what the native frames changed, as its net effect, in the Python objects
 (:meth:`NativeFrames.catch_up`): the protocol's phase, command and last byte, the written registers, the board's
@@ -155,6 +156,8 @@ if len(_IRQ_ADDRESSES) != 1:  # RegisterFile.irq_n follows the one event registe
     raise NativeHookError(f"the register map has {len(_IRQ_ADDRESSES)} read-clear registers, MCU-67 knows one")
 IRQ_ADDRESS: Final[int] = _IRQ_ADDRESSES[0]
 """MCU-67: the address of the read-clear register /IRQ follows (IRQ_EVT, 3.4.14), whose reads hook.c takes."""
+_MOTOROLA: Final[Mode] = Mode.MOTOROLA
+"""MCU-78: the wiring the native frames run in (an enum member's class attribute is a slow look-up)."""
 
 
 def _access(name: str | None, side_effects: frozenset[str]) -> int:
@@ -170,16 +173,23 @@ FAST_WRITES: Final[tuple[int, ...]] = tuple(_access(name, _EVENT_REGISTERS | _re
                                             for name in _registers._WRITE_NAMES)  # fmt: skip
 """Per address, a write data frame a native frame may take (0, 1, 2 as :data:`FAST_READS`): never SET or ID (they
 configure the chip, 3.4.3), nor an address without a register (pedantic mode may report it: left to Python)."""
+if any(fast and name in _registers._READ_NAMES
+       for fast, name in zip(FAST_WRITES, _registers._WRITE_NAMES, strict=True)):  # fmt: skip
+    # MCU-78: then a native write changes Frames.values, which the values' memo of NativeFrames.refresh does not know
+    raise NativeHookError("a register a native frame writes is readable: MCU-78's values memo knows none")
 
 _STATE_FIELDS: Final[tuple[str, ...]] = (
     "pending", "odr", "synced", "phase", "command", "last_rx", "frame_open", "frame_fall", "frame_driven", "transfer",
     "transfer_seen", "transfer_start", "transfer_period", "ss_rise", "cd_before", "irq_level", "written", "cleared",
     "cleared_at", "exti_pr", "dr_writes", "rx_last", "shift_received", "shift_start", "shift_end")  # fmt: skip
 """The fields of :class:`~supi3.mcu.hook.Frames` the native frames change, in their order there."""
+_CONFIG_FIELDS: Final[tuple[str, ...]] = (
+    "gpio_ok", "gpio_mask", "gpio_pulled_up", "spi_ok", "period", "sr_modf", "exti_rise")
+"""MCU-78: the fields :meth:`NativeFrames.refresh` writes only when the peripherals' configuration they are computed
+from changed (:meth:`NativeFrames._configuration`), in their order there."""
 _MIRROR_FIELDS: Final[tuple[str, ...]] = (
-    "valid", "due", "latch", "latch_at", "gpio_ok", "gpio_mask", "gpio_pulled_up", "gpio_levels", "spi_ok", "period",
-    "sr_modf", "io", "io_at", "exti_rise", *_STATE_FIELDS[:-3])  # fmt: skip
-"""The fields :meth:`NativeFrames.refresh` writes, in their order there."""
+    "valid", "due", "latch", "latch_at", "gpio_levels", "io", "io_at", *_STATE_FIELDS[:-3])  # fmt: skip
+"""The fields :meth:`NativeFrames.refresh` writes at each call, in their order there."""
 
 
 def _packed(names: tuple[str, ...]) -> tuple[struct.Struct, int]:
@@ -198,6 +208,7 @@ def _packed(names: tuple[str, ...]) -> tuple[struct.Struct, int]:
 
 _STATE, _STATE_AT = _packed(_STATE_FIELDS)
 _MIRROR, _MIRROR_AT = _packed(_MIRROR_FIELDS)
+_CONFIG, _CONFIG_AT = _packed(_CONFIG_FIELDS)
 
 
 def first_due(next_at: float, cpu_hz: float, noise: float) -> int:
@@ -277,6 +288,8 @@ class NativeFrames:
         self._read_values = operator.itemgetter(*reads)  # the fast-readable registers' values, in address order
         self._values = struct.Struct("<" + "".join("B" if name in reads else "x" for name in read_names))
         self._values_at = Frames.values.offset
+        self._packed: tuple[int, ...] | None = None  # MCU-78: the values last packed into Frames.values
+        self._configured: tuple[object, ...] | None = None  # MCU-78: what the configuration fields were made of
         self._bench = board.bench  # the transaction-level bench, set once at the board's construction
         self._due_key: tuple[int, float | None, float] | None = None  # the bench's next events, as last mirrored
         self._due = (0, _NEVER, _NEVER)
@@ -311,6 +324,7 @@ class NativeFrames:
         gpio._levels = frames.gpio_levels
         board.exti.pr = exti_pr  # MCU-68: the handler's writes of PR (before the bus runs on: its edges come after)
         if cleared:  # MCU-67: the register file's own read-clear, each read at the latest one's time (no bus event)
+            self._packed = None  # MCU-78: the native reads changed Frames.values
             board._sync(cleared_at - 1)
             read = board.registers.cpu_read
             for _ in range(cleared):
@@ -379,7 +393,7 @@ class NativeFrames:
         code = self._code
         frame = board._frame
         core = board.core
-        valid = (protocol.mode is Mode.MOTOROLA and not registers.pedantic and bench.low_at is None
+        valid = (protocol.mode is _MOTOROLA and not registers._pedantic and bench.low_at is None
                  and board._irq_level == registers.irq_n and bench.chip.mod_ack_until == board._mod_ack_until
                  and phase and (phase != _PHASE_DATA or code != _NO_COMMAND)
                  and (not board.exti.requesting(0) or self._exti0 in core.active
@@ -397,13 +411,16 @@ class NativeFrames:
             frames.valid = 0
             return
         gpio, spi, rcc, exti = board.gpio, board.spi, board.rcc, board.exti
-        cr1, period = spi.cr1, spi.period
-        spi_ok = (spi.holder is self._spi_held and spi.offer is self._spi_held  # hook.c holds and offers as they would
-                  and rcc.apb2enr & SPI1EN and not rcc.apb2rstr & SPI1EN and cr1 & CR1_SPE and cr1 & CR1_MSTR
-                  and not cr1 & (CR1_DFF | CR1_LSBFIRST) and cr1 & (CR1_CPOL | CR1_CPHA) == CR1_CPOL | CR1_CPHA
-                  and not period / self._hz < board._shortest_period_s)  # fmt: skip
-        values = registers._values
-        self._values.pack_into(frames, self._values_at, *self._read_values(values))
+        cr = gpio.cr
+        configured = (rcc.apb2enr, rcc.apb2rstr, spi.cr1, spi.modf, spi.holder, spi.offer, cr[0], cr[1],
+                      gpio.pulled_up, exti.exticr1, exti.rtsr)  # fmt: skip
+        if configured != self._configured:  # MCU-78: everything the configuration fields are computed from
+            self._configured = configured
+            self._configuration()
+        values = self._read_values(registers._values)
+        if values != self._packed:  # MCU-78: only Python's changes and the native reads' clears change them
+            self._packed = values
+            self._values.pack_into(frames, self._values_at, *values)
         events = bench._events  # only popped from the end until the next cycle's start makes a new list
         key = (len(events), events[-1][0] if events else None, bench._next_start)
         if key != self._due_key:
@@ -411,10 +428,23 @@ class NativeFrames:
             self._due = self._thresholds(events, bench._next_start)
         due, latch_at, io_at = self._due
         _MIRROR.pack_into(
-            frames, _MIRROR_AT, 1, due, int(registers.latch_phase), latch_at,
-            int(bool(rcc.apb2enr & IOPAEN) and not rcc.apb2rstr & IOPAEN), gpio._output_mask(), gpio.pulled_up,
-            gpio._levels, int(bool(spi_ok)), period, SR_MODF if spi.modf else 0, int(registers.io_access), io_at,
-            int(exti.triggers(0, self._irq_pin, 1)), 0, gpio.odr, 0, phase, code, protocol.last_rx,
+            frames, _MIRROR_AT, 1, due, int(registers._latch_phase), latch_at, gpio._levels,
+            int(registers._io_access), io_at, 0, gpio.odr, 0, phase, code, protocol.last_rx,
             int(frame is not None), 0 if frame is None else frame.fall,
             0 if frame is None or frame.driven is None else frame.driven, *transfer, board._ss_rise, board._cd_before,
             board._irq_level, 0, 0, 0, exti.pr, 0, 0)  # fmt: skip
+
+    def _configuration(self) -> None:
+        """MCU-78: the fields the peripherals' configuration decides (GPIOA's clock and output pins, SPI1's mode and
+        SCLK period, MODF, EXTI's trigger on /IRQ's rise), when what :meth:`refresh` computes them from changed."""
+        board = self._board
+        gpio, spi, rcc = board.gpio, board.spi, board.rcc
+        cr1, period = spi.cr1, spi.period
+        spi_ok = (spi.holder is self._spi_held and spi.offer is self._spi_held  # hook.c holds and offers as they would
+                  and rcc.apb2enr & SPI1EN and not rcc.apb2rstr & SPI1EN and cr1 & CR1_SPE and cr1 & CR1_MSTR
+                  and not cr1 & (CR1_DFF | CR1_LSBFIRST) and cr1 & (CR1_CPOL | CR1_CPHA) == CR1_CPOL | CR1_CPHA
+                  and not period / self._hz < board._shortest_period_s)  # fmt: skip
+        _CONFIG.pack_into(
+            self._frames, _CONFIG_AT, int(bool(rcc.apb2enr & IOPAEN) and not rcc.apb2rstr & IOPAEN),
+            gpio._output_mask(), gpio.pulled_up, int(bool(spi_ok)), period, SR_MODF if spi.modf else 0,
+            int(board.exti.triggers(0, self._irq_pin, 1)))

@@ -398,19 +398,21 @@ typedef struct {
     uint64_t irq_clear;   /* the bits a read of it clears */
     uint64_t io_bit;      /* the live I/O access bit a read of it joins */
     uint64_t exti_pr_offset; /* MCU-68: EXTI_PR's offset */
+    /* MCU-78: the peripherals' configuration, refreshed by Python when what it is computed from changed */
+    uint64_t gpio_ok;    /* GPIOA's clock on, not held in reset */
+    uint64_t gpio_mask, gpio_pulled_up;
+    uint64_t spi_ok;     /* SPI1 clocked, enabled master, 8 bits, mode 3, MSB first, SCLK period >= t0 */
+    uint64_t period;     /* SCLK period in core cycles */
+    uint64_t sr_modf;    /* SPI1's MODF flag in SR */
+    uint64_t exti_rise;  /* MCU-67: a rise of /IRQ sets EXTI's pending bit (Exti.triggers) */
     /* refreshed by Python after each of its writes of GPIOA or SPI1 */
     uint64_t valid;      /* the fast path may run: Python's objects are as mirrored here */
     uint64_t due;        /* the first core cycle whose bus synchronisation would run a bus event */
     uint64_t latch;      /* the latch phase (3.4.14) */
     uint64_t latch_at;   /* the first core cycle whose synchronisation runs the latch phase's start (MCU-52) */
-    uint64_t gpio_ok;    /* GPIOA's clock on, not held in reset */
-    uint64_t gpio_mask, gpio_pulled_up, gpio_levels;
-    uint64_t spi_ok;     /* SPI1 clocked, enabled master, 8 bits, mode 3, MSB first, SCLK period >= t0 */
-    uint64_t period;     /* SCLK period in core cycles */
-    uint64_t sr_modf;    /* SPI1's MODF flag in SR */
+    uint64_t gpio_levels;
     uint64_t io;         /* MCU-66: the chip's I/O access bit */
     uint64_t io_at;      /* the first core cycle whose synchronisation sets it (the bench's `io` event) */
-    uint64_t exti_rise;  /* MCU-67: a rise of /IRQ sets EXTI's pending bit (Exti.triggers) */
     /* the state the fast path runs on: refreshed by Python, changed here, read back by Python's catch-up */
     uint64_t pending;    /* a frame's effect not yet in the Python objects */
     uint64_t odr;
@@ -738,11 +740,11 @@ const uint32_t supi3_frames_layout[] = {
     AT(supi3_frames, sr_bsy), AT(supi3_frames, sr_rxne), AT(supi3_frames, spi_dr), AT(supi3_frames, spi_sr),
     AT(supi3_frames, least_t6max), AT(supi3_frames, irq_pin), AT(supi3_frames, cd_pin), AT(supi3_frames, io_pin),
     AT(supi3_frames, irq_address), AT(supi3_frames, irq_clear), AT(supi3_frames, io_bit),
-    AT(supi3_frames, exti_pr_offset),
-    AT(supi3_frames, valid), AT(supi3_frames, due), AT(supi3_frames, latch), AT(supi3_frames, latch_at),
-    AT(supi3_frames, gpio_ok), AT(supi3_frames, gpio_mask), AT(supi3_frames, gpio_pulled_up),
-    AT(supi3_frames, gpio_levels), AT(supi3_frames, spi_ok), AT(supi3_frames, period), AT(supi3_frames, sr_modf),
-    AT(supi3_frames, io), AT(supi3_frames, io_at), AT(supi3_frames, exti_rise), AT(supi3_frames, pending), AT(supi3_frames, odr), AT(supi3_frames, synced), AT(supi3_frames, phase),
+    AT(supi3_frames, exti_pr_offset), AT(supi3_frames, gpio_ok), AT(supi3_frames, gpio_mask),
+    AT(supi3_frames, gpio_pulled_up), AT(supi3_frames, spi_ok), AT(supi3_frames, period), AT(supi3_frames, sr_modf),
+    AT(supi3_frames, exti_rise), AT(supi3_frames, valid), AT(supi3_frames, due), AT(supi3_frames, latch),
+    AT(supi3_frames, latch_at), AT(supi3_frames, gpio_levels), AT(supi3_frames, io), AT(supi3_frames, io_at),
+    AT(supi3_frames, pending), AT(supi3_frames, odr), AT(supi3_frames, synced), AT(supi3_frames, phase),
     AT(supi3_frames, command), AT(supi3_frames, last_rx), AT(supi3_frames, frame_open),
     AT(supi3_frames, frame_fall), AT(supi3_frames, frame_driven), AT(supi3_frames, transfer),
     AT(supi3_frames, transfer_seen), AT(supi3_frames, transfer_start), AT(supi3_frames, transfer_period),
