@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from supi3 import tables
@@ -220,11 +220,16 @@ def _running_ring(pin_level: bool, locate: bool) -> tuple[Ring | PinRing, Master
     registers.cpu_write(ID.address, 0x01)
     master = Master(ring, locate=locate, max_devices=4)
     assert master.start().ok
+    ring.idle(GAP_BITS / ring.bit_rate)  # the pin level's chips take the ID cycle's end as the line goes idle
     registers.cpu_write(IN0.address, 0xA5)  # after the start: its reset clears the IN data (3.4.7)
     return ring, master, chips[1], chips
 
 
-def _master_cycle(ring: Ring | PinRing, master: Master, chips: list[Supi3], out: int) -> object:
+_Seen = tuple[Cycle, bool, list[tuple[ErrorKind, int | None, str]], list[bytes] | None, bytes, bytes, int]
+"""A master cycle's kind, verdict and diagnostics, the master's IN data, and the OUT data each chip latched."""
+
+
+def _master_cycle(ring: Ring | PinRing, master: Master, chips: list[Supi3], out: int) -> _Seen:
     """OUT data ``out`` to every device the table holds, a gap, the master's next cycle, a gap: what the master and
     the chips show afterwards (each chip's latched OUT data, the µP chip's OUT0)."""
     if master.config is not None:
@@ -260,17 +265,56 @@ def test_extreg_written_while_the_bus_runs_fails_alike_at_both_fidelities(locate
         history += [_master_cycle(ring, master, chips, 0x33) for _ in range(2)]
         seen.append(history)
     assert seen[0] == seen[1] == seen[2]
-    valid = (Cycle.DATA, True, [], [b"\x00", b"\xa5", b"\x00"], b"\x11", b"\x11", 0x11)
+    valid: _Seen = (Cycle.DATA, True, [], [b"\x00", b"\xa5", b"\x00"], b"\x11", b"\x11", 0x11)
     assert seen[0][0] == valid
     failed = 0
     for cycle, ok, diagnostics, *shown in seen[0][1:5]:  # without location an ID cycle after each failure (A21)
-        assert shown == list(valid[3:]) and ok is (cycle is Cycle.ID)
+        assert shown == [*valid[3:]] and ok is (cycle is Cycle.ID)
         if cycle is Cycle.DATA:
             [(kind, location, _)] = diagnostics
             assert kind is ErrorKind.LOOPBACK and location is None
             failed += 1
     assert failed == (4 if locate else 2)
     assert seen[0][5:] == [(Cycle.DATA, True, [], valid[3], b"\x33", b"\x33", 0x33)] * 2
+
+
+EXTREG_OPS = st.lists(st.one_of(
+    st.tuples(st.sampled_from(["ext", "chain"]), st.integers(0, 1)),
+    st.tuples(st.just("cycle"), st.integers(0, 255)),
+    st.tuples(st.just("reset"), st.just(0)),
+), min_size=1, max_size=8)  # fmt: skip
+
+
+@settings(max_examples=8, deadline=None)
+@given(EXTREG_OPS)
+@example([("ext", 1), ("cycle", 0x5A), ("chain", 1), ("cycle", 0x3C), ("chain", 0), ("reset", 0), ("cycle", 0x11),
+          ("ext", 0), ("cycle", 0x22)])
+def test_the_master_sees_the_same_at_both_fidelities_as_extreg_and_from_exr_change(ops: list[tuple[str, int]]) -> None:
+    """RX-13 over histories: SET with ExtReg = 1 (one byte) written or cleared while the bus runs, a chain of that
+    length attached to FromExR or taken off (nothing on FromExR: grounded), master cycles (OUT data and the chain's
+    inputs of the step) and Alarm Stops: after every master cycle its kind, verdict, diagnostics and IN data and the
+    chips' latched OUT data are the same at both fidelities. (The chain's registers are not compared: the pin level
+    clocks the chain lazily, up to where the chip needs its answer, RX-10.)"""
+    seen = []
+    for pin_level in (False, True):
+        ring, master, chip, chips = _running_ring(pin_level, locate=True)
+        registers = chip.registers
+        assert registers is not None
+        chain = FakeChain(1)
+        history: list[_Seen] = []
+        for kind, value in ops:
+            if kind == "ext":
+                registers.cpu_write(SET.address, extreg_set(1) if value else 0x82)
+            elif kind == "chain":
+                chip.attach_expansion(chain if value else None)
+            elif kind == "reset":
+                master.alarm_stop()
+                ring.idle(GAP_BITS / ring.bit_rate)
+            else:
+                chain.inputs = bytes([value ^ 0xFF])
+                history.append(_master_cycle(ring, master, chips, value))
+        seen.append(history)
+    assert seen[0] == seen[1]
 
 
 @pytest.mark.parametrize("bit_rate", tables.BIT_RATES)
