@@ -43,7 +43,7 @@ from dataclasses import dataclass, field
 from enum import Enum
 from itertools import accumulate
 from operator import attrgetter, sub
-from typing import ClassVar, Final, NamedTuple, Protocol, TypeGuard, runtime_checkable
+from typing import ClassVar, Final, NamedTuple, Protocol, cast, runtime_checkable
 
 from supi3.checks import check_bool, check_bytes, check_instance, check_int, check_real, fail
 from supi3.config import DeviceConfig, Interface
@@ -585,14 +585,9 @@ _Opens = list[tuple[int, _Opening]]
 """The devices of a run whose data path can open, with their indices in the run (RX-13)."""
 
 
-def _can_open(device: Device) -> TypeGuard[_Opening]:
-    """The device's data path can open: its ``sends_constant`` is set (RX-13)."""
-    return getattr(device, "sends_constant", False) is True
-
-
 def _opens(run: list[Device]) -> _Opens:
-    """The devices of ``run`` whose data path can open (RX-13), with their indices."""
-    return [(k, device) for k, device in enumerate(run) if _can_open(device)]
+    """The devices of ``run`` whose data path can open (their ``sends_constant`` set, RX-13), with their indices."""
+    return cast(_Opens, [(k, device) for k, device in enumerate(run) if getattr(device, "sends_constant", False)])
 
 
 def _levels(opens: _Opens) -> list[tuple[int, int]]:
@@ -1539,8 +1534,12 @@ class Ring:
             registers, attention = kernel.load(run, now)
         else:
             registers, attention = self._load_groups(run, groups, now)
-        levels = _levels(opens) if opens else None  # RX-13: a chip sending a constant line
-        received, returned, _ = _shift_open(registers, data, levels) if levels else self._shift(registers, data)
+        for _, device in opens:  # RX-13: a chip sending a constant line (no call while none does)
+            if device.constant_output is not None:
+                received, returned, _ = _shift_open(registers, data, _levels(opens))
+                break
+        else:
+            received, returned, _ = self._shift(registers, data)
         n = len(run)
         self._pending = Transfer(Cycle.DATA, data, n, returned, _FLAGS[attention, False], None,
                                  [_new_tuple(_Run, (run, received, True, False, groups, kernel))], n, [], False,

@@ -266,7 +266,8 @@ class Supi3:
         "_serial_pins", "_shown", "_stat_due", "_stat_err", "_stat_filter", "_watch_line", "attention",
         "bus_active", "config", "constant_output",
         "due", "following", "in_word", "io_access", "led_inputs", "line_interrupt", "line_silent", "mfp_in",
-        "mod_ack_until", "pf", "registers", "resreg_until", "revision", "serial_device", "spi_sequences", "te",
+        "mod_ack_until", "pf", "registers", "resreg_until", "revision", "sends_constant", "serial_device",
+        "spi_sequences", "te",
         "watchdog_code", "wd",
     )  # fmt: skip
 
@@ -303,6 +304,10 @@ class Supi3:
         self._frame_bytes = -1  # µP modes: the data bytes the last data-cycle load gave (M15)
         self._shown: tuple[bytes | None, int] = (None, 0)  # (OUT bytes, MFP levels) last driven
         self._init_serial()
+        self.sends_constant = self.registers is not None and self.config.variant is not Variant.LS
+        """RX-13: the chip's data path can open, so that a data cycle's :attr:`constant_output` may be a level: a
+        SUPI 3 OPC in an Init-µP mode (the chips with the expansion interface, RX-1). Fixed by the configuration:
+        the ring reads it when it plans its devices."""
         self._chain: ExternalRegisters | None = None
         self._exr_driver: ExpansionDriver | None = None
         self._optical_driven = False  # pin level: the optical block makes every transition (_optical_drive, OPT-26)
@@ -656,13 +661,6 @@ class Supi3:
     def expansion(self) -> bool:
         """SET selects the external data registers (ExtReg = 1, 3.4.11): data cycles go through the expansion."""
         return self.registers is not None and not self.registers.internal_data_path
-
-    @property
-    def sends_constant(self) -> bool:
-        """RX-13: the chip's data path can open, so that a data cycle's :attr:`constant_output` is a level: a SUPI 3
-        OPC in an Init-µP mode (the chips with the expansion interface, RX-1). Fixed by the configuration: the ring
-        reads it when it plans its devices."""
-        return self.registers is not None and self.config.variant is not Variant.LS
 
     @property
     def expansion_chain(self) -> ExternalRegisters | None:
