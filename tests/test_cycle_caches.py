@@ -29,7 +29,7 @@ from supi3.interbus import wire
 from supi3.interbus.device import PlainDevice
 from supi3.interbus.link import DataKernel, Device
 from supi3.interbus.master import Master
-from supi3.interbus.ring import Ring, _Groups
+from supi3.interbus.ring import Ring, _Groups, _Opens
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
 from supi3.model.registers import RegisterArgumentError, RegisterFile, event_mask
@@ -153,6 +153,9 @@ def test_the_bench_s_cycle_offsets_agree_with_each_cycle_s_timing(ops: list[Op])
 
 # -- the ring's run layout (A28) ---------------------------------------------------------------------------------
 
+EXTREG_SET = 0x49
+"""SET with ExtReg = 1 and one byte (3.4.11, the board case of RX-12): with nothing on FromExR the chip sends a
+constant line (RX-13)."""
 BINARY = next(decode(r.c, r.mfp) for r in tables.MODE_ROWS if decode(r.c, r.mfp).mfp_mode.kind is MfpKind.BINARY_IO)
 
 
@@ -169,6 +172,10 @@ class _EveryCycle(Ring):
             -> tuple[list[bytes], bool, _Groups | None, DataKernel | None]:  # fmt: skip
         self._layout = ([], [], None)
         return super()._load_run(cycle, run, now)
+
+    def _opened(self, run: list[Device]) -> list[tuple[int, int]]:
+        self._open_run = ([], [])
+        return super()._opened(run)
 
 
 def _made(kind: int, k: int) -> Device:
@@ -211,6 +218,10 @@ def _ring_step(ring: Ring, master: Master, op: tuple[str, int, int]) -> object:
                 ring.power_up(k + 1)
         elif kind == "stop":
             master.alarm_stop()
+        elif kind == "ext":  # RX-13: SET with ExtReg = 1 (1 byte, nothing on FromExR) or 82h, written while it runs
+            registers = getattr(devices[k], "registers", None)
+            if registers is not None:
+                registers.cpu_write(SET.address, EXTREG_SET if value % 2 else 0x82)
         else:
             result = master.cycle()
             return result.cycle, result.ok, [d.kind for d in result.diagnostics], master._in
@@ -220,18 +231,22 @@ def _ring_step(ring: Ring, master: Master, op: tuple[str, int, int]) -> object:
 
 
 RING_OPS = st.lists(st.tuples(
-    st.sampled_from(["cycle"] * 6 + ["swap", "swap", "turn", "cut", "flip", "repair", "power", "stop"]),
+    st.sampled_from(["cycle"] * 6 + ["swap", "swap", "turn", "cut", "flip", "repair", "power", "stop", "ext"]),
     st.integers(0, 7), st.integers(0, 200)), max_size=40)  # fmt: skip
 
 
 @settings(derandomize=True, max_examples=40, deadline=None)
 @given(st.lists(st.integers(0, 3), min_size=1, max_size=5), RING_OPS)
+@example([0, 0, 0], [("flip", 0, 5000), ("cycle", 0, 0), ("swap", 2, 1), ("ext", 2, 1), *[("cycle", 0, 0)] * 3,
+                     ("flip", 0, 5000), ("cycle", 0, 0), ("cycle", 0, 0)])  # RX-13: bits past the frame, a chip opened
 def test_the_rings_run_layout_agrees_with_one_worked_out_every_cycle(kinds: list[int],
                                                                    ops: list[tuple[str, int, int]]) -> None:
     """Two rings of the same devices (binary-I/O and µP-mode chips, plain devices, devices without a kernel), one
     keeping its run layout (A28: the groups and the one kernel of the last run, keyed on the run's devices), one
     working it out at every data cycle, take the same history of master cycles, devices swapped in place in the ring's
-    list (of the same class or another), the list turned round, cuts, bit errors, repairs, power-ups and Alarm Stops:
+    list (of the same class or another), the list turned round, cuts, bit errors, repairs, power-ups, Alarm Stops and
+    SET with ExtReg = 1 and nothing on FromExR written and cleared (RX-13: the run's chips whose data path can open,
+    kept for the last run):
     after every step both show the same outcome, IN data and device states."""
     _side_by_side((Ring, _EveryCycle), kinds, ops, _ring_step)
 
@@ -262,8 +277,8 @@ class _General(Ring):
 class _Replanned(Ring):
     """A ring that takes the plain path with its plan worked out anew at every data cycle (the plan emptied first)."""
 
-    def _plain_plan(self) -> tuple[list[Device], _Groups, DataKernel | None, int]:
-        self._plan = ([], [], None, 0)
+    def _plain_plan(self) -> tuple[list[Device], _Groups, DataKernel | None, int, _Opens]:
+        self._plan = ([], [], None, 0, [])
         return super()._plain_plan()
 
 
@@ -279,15 +294,19 @@ def _plain_step(ring: Ring, master: Master, op: tuple[str, int, int]) -> object:
 @settings(derandomize=True, max_examples=40, deadline=None)
 @given(st.lists(st.integers(0, 3), min_size=1, max_size=5),
        st.lists(st.tuples(st.sampled_from(["cycle"] * 6 + ["swap", "swap", "turn", "cut", "flip", "repair", "power",
-                                                          "stop", "record"]),
+                                                          "stop", "ext", "record"]),
                           st.integers(0, 7), st.integers(0, 200)), max_size=40))  # fmt: skip
 @example([2, 0], [("cycle", 0, 0), ("swap", 0, 2), ("cycle", 0, 0), ("turn", 0, 0), ("cycle", 0, 0)])
+@example([0, 1, 2, 1], [("cycle", 0, 0), ("ext", 1, 1), *[("cycle", 0, 0)] * 4, ("flip", 2, 40), ("cycle", 0, 0),
+                        ("ext", 3, 1), ("record", 0, 0), ("cycle", 0, 0), ("cycle", 0, 0), ("record", 0, 0),
+                        ("cycle", 0, 0), ("ext", 1, 0), ("ext", 3, 0), *[("cycle", 0, 0)] * 4])  # RX-13
 def test_the_plain_rings_path_agrees_with_the_general_one_over_any_history(kinds: list[int],
                                                                          ops: list[tuple[str, int, int]]) -> None:
     """A29: three rings of the same devices (binary-I/O and µP-mode chips, plain devices, devices without a kernel),
     one taking the plain ring's path with its plan kept (keyed on the ring's devices), one planning anew every cycle,
     one through the general path only, take the same history of master cycles, devices swapped in place in the
-    ring's list, the list turned round, cuts, bit errors, repairs, power-ups (chips waking up), Alarm Stops and the
+    ring's list, the list turned round, cuts, bit errors, repairs, power-ups (chips waking up), Alarm Stops, SET with
+    ExtReg = 1 and nothing on FromExR written and cleared (RX-13: a chip sending a constant line) and the
     trace switched on and off: after every step all three show the same outcome, IN data, trace, device states and
     bus time."""
     _side_by_side((Ring, _Replanned, _General), kinds, ops, _plain_step)

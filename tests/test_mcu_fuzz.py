@@ -443,10 +443,10 @@ RUNNING_RECONFIGURATIONS: Final[list[list[Step]]] = [
     [(Op.EXCHANGE, 12, 0x55, 0)],  # ID alone: the table's ID code is checked in ID cycles only
     [(Op.EXCHANGE, 13, 0x82, 0)],  # SET alone: 1 byte
     [(Op.BLOCK, 2, 2, 0x5A), (Op.CONFIG, 0x85, 0xBB, 0)],  # MCU-63's script with ExtReg = 0: 2 words, ID BBh
+    [(Op.CONFIG, 0x49, 0x03, 0)],  # SET with ExtReg = 1, 1 byte, nothing on FromExR: LOOPBACK after it (RX-13)
 ]
-"""Bodies served after the VALID interrupt that write SET or ID while the bus runs (MCU-64). ExtReg = 0: with
-ExtReg = 1 and nothing on FromExR the data cycles after the rediscovery differ by RX-11 (the pin-level chip sends
-FromExR's level, the transaction level zeros for its own bytes; a recorded limit, RX-12)."""
+"""Bodies served after the VALID interrupt that write SET or ID while the bus runs (MCU-64); with ExtReg = 1 and
+nothing on FromExR every data cycle after the rediscovery fails with LOOPBACK at both fidelities (RX-11, RX-13)."""
 
 
 @pytest.mark.parametrize("body", RUNNING_RECONFIGURATIONS)

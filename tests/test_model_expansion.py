@@ -11,7 +11,7 @@ from supi3.errors import ArgumentError
 from supi3.expansion import PULSE_T0, chain_to_line, line_to_chain
 from supi3.interbus import wire
 from supi3.interbus.master import Master
-from supi3.interbus.ring import Ring
+from supi3.interbus.ring import ErrorKind, Ring
 from supi3.model.blocks.expansion import overrun_gap_clocks
 from supi3.model.chip import RESREG_PULSE_CLOCKS, ChipArgumentError, ChipError, Supi3, clocks
 from supi3.model.registers import SetRegisterError
@@ -86,9 +86,10 @@ def test_every_length_moves_data_both_ways(length: int, bit_rate: int) -> None:
 
 
 def test_internal_data_registers_are_out_of_the_data_path() -> None:
-    """RX-2: with ExtReg = 1 neither IN bytes nor OUT bytes of the register file move; a grounded FromExR (no
-    chain) sends 0 bits."""
+    """RX-2: with ExtReg = 1 neither IN bytes nor OUT bytes of the register file move: the chain's bytes are sent
+    (a grounded FromExR, no chain, sends 0 bits for the whole frame: RX-13, test_detach_grounds_from_exr)."""
     chip = up_chip(1)
+    chip.attach_expansion(FakeChain(1))
     assert chip.registers is not None and chip.expansion
     registers = chip.registers
     with registers.pedantic_paused():
@@ -96,7 +97,7 @@ def test_internal_data_registers_are_out_of_the_data_path() -> None:
     _, master = started(chip)
     master.set_outputs(1, b"\x99")
     assert master.data_cycle().ok
-    assert master.inputs(1) == b"\x00"
+    assert master.inputs(1) == b"\x00"  # the chain's, not IN0's
     assert registers.value("OUT0") == 0 and registers.value(OUT0.name) == 0
     assert chip.events["VALID"] == 1
 
@@ -148,14 +149,18 @@ def test_chain_of_another_length_is_named() -> None:
         master.data_cycle()
 
 
-def test_detach_sends_zeros() -> None:
+def test_detach_grounds_from_exr() -> None:
+    """RX-13: with the chain taken off FromExR is grounded: the chip sends 0 bits for the whole frame, the loopback
+    word included, as at pin level (test_model_expansion_pins): the data cycle fails, nothing is latched."""
     chip = up_chip(1)
     chain = FakeChain(1, inputs=b"\xff")
     chip.attach_expansion(chain)
     chip.attach_expansion(None)
     assert chip.expansion_chain is None
     _, master = started(chip)
-    assert master.data_cycle().ok and master.inputs(1) == b"\x00"
+    result = master.data_cycle()
+    assert not result.ok and result.diagnostics[0].kind is ErrorKind.LOOPBACK
+    assert master.inputs(1) == b"\x00" and chip.constant_output == 0 and chip.events["VALID"] == 0
 
 
 def test_interbus_reset_clears_the_chain_and_pulses_resreg_4_t0() -> None:

@@ -6,11 +6,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from supi3 import tables
-from supi3.config import decode
+from supi3.config import MfpKind, decode
 from supi3.errors import ArgumentError
 from supi3.expansion import LAIND_AFTER_LAOUD_T0, PULSE_T0, chain_to_line, clock_high, line_to_chain
 from supi3.interbus import wire
@@ -23,7 +23,7 @@ from supi3.model.pinring import PinRing
 from supi3.model.pins import RESET_STRETCH_CLOCKS, Supi3Pins
 from supi3.peripherals.sre import Sre1
 from supi3.pinout import CORE_IDLE
-from supi3.regmap import ID, SET, encode_command
+from supi3.regmap import ID, IN0, SET, encode_command
 from supi3.spi.master import SoftMaster
 from supi3.spi.upif import Mode
 from supi3.top import UP_REST, ChipPort, Supi3Chip
@@ -164,24 +164,157 @@ def test_without_extreg_the_pins_stay_idle() -> None:
     assert chain.calls == []
 
 
-def test_nothing_on_from_exr_breaks_the_ring_at_pin_level() -> None:
-    """RX-2, RX-11: with ExtReg = 1 and FromExR held (grounded or high) every data bit the chip sends is that level,
-    the loopback word included: the master sees a loopback error. With FromExR wired to ToExR (the chain of the
-    data length) it works (test_every_length_at_pin_level). RX-12, the limit: the transaction level, whose ring
-    shifts whole registers, sends zeros for the chip's own byte only and the cycle passes."""
+def test_nothing_on_from_exr_breaks_the_ring_at_both_fidelities() -> None:
+    """RX-2, RX-11, RX-13: with ExtReg = 1 and FromExR held (grounded or high) every data bit the chip sends is that
+    level, the loopback word included: the master sees a loopback error, at transaction level (FromExR grounded) as
+    at pin level. With FromExR wired to ToExR (the chain of the data length) it works
+    (test_every_length_at_pin_level)."""
+    seen = []
     for level in (0, 1):
         pins = up_pins(1)
         ring, master = pin_master(pins)
         ring.set_input(1, "from_exr", level)
-        ring.idle(GAP_BITS / ring.bit_rate)
-        for _ in range(2):  # every cycle, the master's table kept (the diagnostic ID cycle finds the ring whole)
-            result = master.data_cycle()
-            assert not result.ok and result.diagnostics[0].kind is ErrorKind.LOOPBACK
+        seen.append(_failing_cycles(ring, master))
     chip = up_chip(1)
-    master = Master(Ring([chip]))
+    ring_tl = Ring([chip])
+    seen.append(_failing_cycles(ring_tl, Master(ring_tl, locate=False, max_devices=4)))
+    assert seen[0] == seen[1] == seen[2]
+
+
+def _failing_cycles(ring: Ring | PinRing, master: Master) -> list[object]:
+    """Two data cycles after the master's start (the table kept: the diagnostic ID cycle finds the ring whole), each
+    a loopback error; the IN data the master keeps."""
+    if isinstance(ring, Ring):
+        assert master.start().ok
+    seen: list[object] = []
+    for _ in range(2):
+        ring.idle(GAP_BITS / ring.bit_rate)
+        result = master.data_cycle()
+        assert not result.ok and result.diagnostics[0].kind is ErrorKind.LOOPBACK
+        seen.append(([(d.kind, d.location, d.detail) for d in result.diagnostics], master.inputs(1)))
+    return seen
+
+
+UP_STRAPS = ("10011", "1110")
+"""The Init-µP mode of :func:`up_pins` and :func:`~test_model_expansion.up_chip` (RB, Table 2-4)."""
+BINARY = next(decode(r.c, r.mfp) for r in tables.MODE_ROWS if decode(r.c, r.mfp).mfp_mode.kind is MfpKind.BINARY_IO)
+
+
+def _running_ring(pin_level: bool, locate: bool) -> tuple[Ring | PinRing, Master, Supi3, list[Supi3]]:
+    """A binary-I/O chip, a µP-mode chip (SET 82h: one internal byte; not strict, so that SET may be written while
+    the bus runs, UP-20) and a binary-I/O chip, its master started: the ring, the master, the µP chip and all three
+    chips."""
+    config = decode(*UP_STRAPS, clk_conf=tables.clk_conf_for(500_000))
+    ring: Ring | PinRing
+    if pin_level:
+        devices = [Supi3Pins(BINARY), Supi3Pins(config, Supi3(config, strict=False)), Supi3Pins(BINARY)]
+        chips = [device.chip for device in devices]
+        ring = PinRing(devices)
+        ring.idle(2 * RESET_STRETCH_CLOCKS / tables.CLOCK_HZ)
+    else:
+        chips = [Supi3(BINARY), Supi3(config, strict=False), Supi3(BINARY)]
+        ring = Ring(chips)
+    registers = chips[1].registers
+    assert registers is not None
+    registers.cpu_write(SET.address, 0x82)
+    registers.cpu_write(ID.address, 0x01)
+    master = Master(ring, locate=locate, max_devices=4)
     assert master.start().ok
-    result = master.data_cycle()
-    assert result.ok and master.inputs(1) == b"\x00"  # RX-12: not the pin level's loopback error
+    ring.idle(GAP_BITS / ring.bit_rate)  # the pin level's chips take the ID cycle's end as the line goes idle
+    registers.cpu_write(IN0.address, 0xA5)  # after the start: its reset clears the IN data (3.4.7)
+    return ring, master, chips[1], chips
+
+
+_Seen = tuple[Cycle, bool, list[tuple[ErrorKind, int | None, str]], list[bytes] | None, bytes, bytes, int]
+"""A master cycle's kind, verdict and diagnostics, the master's IN data, and the OUT data each chip latched."""
+
+
+def _master_cycle(ring: Ring | PinRing, master: Master, chips: list[Supi3], out: int) -> _Seen:
+    """OUT data ``out`` to every device the table holds, a gap, the master's next cycle, a gap: what the master and
+    the chips show afterwards (each chip's latched OUT data, the µP chip's OUT0)."""
+    if master.config is not None:
+        for entry in master.config:
+            master.set_outputs(entry.ring_position, bytes([out]) * entry.data_bytes)
+    ring.idle(GAP_BITS / ring.bit_rate)
+    result = master.cycle()
+    ring.idle(GAP_BITS / ring.bit_rate)  # the pin level's chips take the latch telegrams as the line goes idle
+    registers = chips[1].registers
+    assert registers is not None
+    inputs = None if master.config is None else [master.inputs(e.ring_position) for e in master.config]
+    return (result.cycle, result.ok, [(d.kind, d.location, d.detail) for d in result.diagnostics], inputs,
+            chips[0]._out, chips[2]._out, registers.value("OUT0"))  # fmt: skip
+
+
+@pytest.mark.parametrize("locate", [True, False])
+def test_extreg_written_while_the_bus_runs_fails_alike_at_both_fidelities(locate: bool) -> None:
+    """RX-13: SET with ExtReg = 1 (one byte, as before) written while the bus runs, nothing on FromExR: every data
+    cycle fails with a loopback error at both fidelities, the master's IN data and every chip's latched OUT data
+    unchanged ("a corrupted or invalid INTERBUS cycle never changes latched data or outputs"), not located at both
+    (the diagnostic ID cycle passes: ID cycles do not go through the expansion); with ExtReg cleared the cycles pass
+    again."""
+    seen = []
+    for pin_level, record in ((False, False), (False, True), (True, False)):  # record: every line checked (slow path)
+        ring, master, chip, chips = _running_ring(pin_level, locate)
+        ring.record = record
+        registers = chip.registers
+        assert registers is not None
+        history = [_master_cycle(ring, master, chips, 0x11)]
+        registers.cpu_write(SET.address, extreg_set(1))
+        history += [_master_cycle(ring, master, chips, 0x22) for _ in range(4)]
+        registers.cpu_write(SET.address, 0x82)
+        history += [_master_cycle(ring, master, chips, 0x33) for _ in range(2)]
+        seen.append(history)
+    assert seen[0] == seen[1] == seen[2]
+    valid: _Seen = (Cycle.DATA, True, [], [b"\x00", b"\xa5", b"\x00"], b"\x11", b"\x11", 0x11)
+    assert seen[0][0] == valid
+    failed = 0
+    for cycle, ok, diagnostics, *shown in seen[0][1:5]:  # without location an ID cycle after each failure (A21)
+        assert shown == [*valid[3:]] and ok is (cycle is Cycle.ID)
+        if cycle is Cycle.DATA:
+            [(kind, location, _)] = diagnostics
+            assert kind is ErrorKind.LOOPBACK and location is None
+            failed += 1
+    assert failed == (4 if locate else 2)
+    assert seen[0][5:] == [(Cycle.DATA, True, [], valid[3], b"\x33", b"\x33", 0x33)] * 2
+
+
+EXTREG_OPS = st.lists(st.one_of(
+    st.tuples(st.sampled_from(["ext", "chain"]), st.integers(0, 1)),
+    st.tuples(st.just("cycle"), st.integers(0, 255)),
+    st.tuples(st.just("reset"), st.just(0)),
+), min_size=1, max_size=8)  # fmt: skip
+
+
+@settings(max_examples=8, deadline=None)
+@given(EXTREG_OPS)
+@example([("ext", 1), ("cycle", 0x5A), ("chain", 1), ("cycle", 0x3C), ("chain", 0), ("reset", 0), ("cycle", 0x11),
+          ("ext", 0), ("cycle", 0x22)])
+def test_the_master_sees_the_same_at_both_fidelities_as_extreg_and_from_exr_change(ops: list[tuple[str, int]]) -> None:
+    """RX-13 over histories: SET with ExtReg = 1 (one byte) written or cleared while the bus runs, a chain of that
+    length attached to FromExR or taken off (nothing on FromExR: grounded), master cycles (OUT data and the chain's
+    inputs of the step) and Alarm Stops: after every master cycle its kind, verdict, diagnostics and IN data and the
+    chips' latched OUT data are the same at both fidelities. (The chain's registers are not compared: the pin level
+    clocks the chain lazily, up to where the chip needs its answer, RX-10.)"""
+    seen = []
+    for pin_level in (False, True):
+        ring, master, chip, chips = _running_ring(pin_level, locate=True)
+        registers = chip.registers
+        assert registers is not None
+        chain = FakeChain(1)
+        history: list[_Seen] = []
+        for kind, value in ops:
+            if kind == "ext":
+                registers.cpu_write(SET.address, extreg_set(1) if value else 0x82)
+            elif kind == "chain":
+                chip.attach_expansion(chain if value else None)
+            elif kind == "reset":
+                master.alarm_stop()
+                ring.idle(GAP_BITS / ring.bit_rate)
+            else:
+                chain.inputs = bytes([value ^ 0xFF])
+                history.append(_master_cycle(ring, master, chips, value))
+        seen.append(history)
+    assert seen[0] == seen[1]
 
 
 @pytest.mark.parametrize("bit_rate", tables.BIT_RATES)

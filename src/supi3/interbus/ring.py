@@ -14,6 +14,10 @@ In a data cycle a run of consecutive devices of one class whose class offers a `
 (:class:`~supi3.interbus.link.DataKernel`, e.g. the SUPI 3 model) is loaded and latched by one kernel call
 rather than by two method calls per device (docs/interbus.md, "Ring kernel").
 
+A device whose data path is open sends a constant line (RX-13: a SUPI 3 OPC with ExtReg = 1 and nothing on FromExR,
+docs/assumptions/expansion.md): what leaves it is that level for the whole data sequence, with its own CRC, whatever
+entered it (:func:`_shift_open`).
+
 Lines are numbered like the devices: line *k* (1..N) enters ring position *k*, line N + 1 is the return line
 into the master.
 
@@ -39,7 +43,7 @@ from dataclasses import dataclass, field
 from enum import Enum
 from itertools import accumulate
 from operator import attrgetter, sub
-from typing import ClassVar, Final, NamedTuple, Protocol, runtime_checkable
+from typing import ClassVar, Final, NamedTuple, Protocol, cast, runtime_checkable
 
 from supi3.checks import check_bool, check_bytes, check_instance, check_int, check_real, fail
 from supi3.config import DeviceConfig, Interface
@@ -569,6 +573,45 @@ def return_repeaters(devices: Iterable[object]) -> int:
     return sum(map(_return_repeater, devices))
 
 
+class _Opening(Device, Protocol):
+    """A device whose data path can open (its ``sends_constant`` set, the SUPI 3 model's
+    :attr:`~supi3.model.chip.Supi3.sends_constant`): after a data-cycle load, the level it sends for the whole data
+    sequence, ``None`` when the frame shifts through its register (RX-13)."""
+
+    constant_output: int | None
+
+
+_Opens = list[tuple[int, _Opening]]
+"""The devices of a run whose data path can open, with their indices in the run (RX-13)."""
+
+
+def _opens(run: list[Device]) -> _Opens:
+    """The devices of ``run`` whose data path can open (their ``sends_constant`` set, RX-13), with their indices."""
+    return cast(_Opens, [(k, device) for k, device in enumerate(run) if getattr(device, "sends_constant", False)])
+
+
+def _levels(opens: _Opens) -> list[tuple[int, int]]:
+    """After a data cycle's loads: (index, level) of each device of ``opens`` that sends a constant line this cycle
+    (its ``constant_output`` not ``None``, RX-13)."""
+    return [(k, level) for k, device in opens if (level := device.constant_output) is not None]
+
+
+def _shift_open(registers: list[bytes], stream: bytes, levels: list[tuple[int, int]]) -> tuple[list[bytes], bytes, int]:
+    """:func:`_shift` through registers of which those at the indices of ``levels`` send a constant line (RX-13): each
+    of them takes in its bytes as any register, and what leaves it is its level in every bit of the stream's length
+    (CRC and CNTR follow as on any line: a sender's CRC is over what it sends)."""
+    received: list[bytes] = []
+    size = len(stream)
+    start = 0
+    for k, level in levels:
+        part, _, _ = _shift(registers[start : k + 1], stream)
+        received += part
+        stream = (b"\xff" if level else b"\x00") * size
+        start = k + 1
+    part, stream, _ = _shift(registers[start:], stream)
+    return received + part, stream, sum(map(len, registers))
+
+
 def _shift(registers: list[bytes], stream: bytes) -> tuple[list[bytes], bytes, int]:
     """Shift ``stream`` through consecutive registers: what each register holds afterwards, what leaves the
     last one, and the registers' total width. A register emits its contents, then what entered it; the stream
@@ -817,9 +860,12 @@ class Ring:
         """M22: bus time the master's idle status telegrams began (the end of its last cycle or reset)."""
         self._loops: tuple[list[Device], list[int]] = ([], [0])
         """The data path whose LBD-MR devices :meth:`_loops_before` counted last, the counts before each position."""
-        self._plan: tuple[list[Device], _Groups, DataKernel | None, int] = ([], [], None, 0)
+        self._plan: tuple[list[Device], _Groups, DataKernel | None, int, _Opens] = ([], [], None, 0, [])
         """A29: the plain ring's data-cycle plan (:meth:`_plain_plan`): a copy of :attr:`devices` as last planned, their
-        groups for the data kernels, the kernel of a ring of one class and the ring's return repeaters."""
+        groups for the data kernels, the kernel of a ring of one class, the ring's return repeaters and the devices
+        whose data path can open (RX-13)."""
+        self._open_run: tuple[list[Device], _Opens] = ([], [])
+        """RX-13: the general path's last data-cycle run and its devices whose data path can open (:meth:`_opened`)."""
         _tell_following(self._tree)
         self._sync()
 
@@ -1266,6 +1312,15 @@ class Ring:
             return registers, attention, groups, single
         return *self._load_groups(run, groups, now), groups, None
 
+    def _opened(self, run: list[Device]) -> list[tuple[int, int]]:
+        """RX-13: after a data cycle's loads of ``run``, (index, level) of each of its devices that sends a constant
+        line; the devices whose data path can open are kept for the last run (keyed on its devices, as A28's
+        layout)."""
+        if run != self._open_run[0]:
+            self._open_run = (list(run), _opens(run))
+        opens = self._open_run[1]
+        return _levels(opens) if opens else []
+
     @staticmethod
     def _load_groups(run: list[Device], groups: _Groups, now: float) -> tuple[list[bytes], bool]:
         """A data cycle's loads of ``run`` by its ``groups`` (through each group's kernel, if it has one) at bus time
@@ -1400,7 +1455,9 @@ class Ring:
                 run = devices if index == 0 and stop == last else devices[index:stop]  # devices: a copy already
                 registers, wants, groups, kernel = self._load_run(cycle, run, now)
                 attention = attention or wants
-                received, stream, width = self._shift(registers, stream)
+                levels = self._opened(run) if cycle is Cycle.DATA else None
+                received, stream, width = _shift_open(registers, stream, levels) if levels \
+                    else self._shift(registers, stream)
                 runs.append(_Run(run, received, not error, False, groups, kernel))
                 shifted += width
                 crc = None
@@ -1419,7 +1476,9 @@ class Ring:
             register = device.load(cycle, now)
             attention, error = wire.decode_cntr(cntr) or (True, True)
             attention = attention or device.attention
-            received, stream, width = _shift([register], line.stream)
+            levels = _levels(_opens([device])) if cycle is Cycle.DATA else None
+            received, stream, width = _shift_open([register], line.stream, levels) if levels \
+                else _shift([register], line.stream)
             runs.append(_Run([device], received, not (local or flags_in is None or flags_in.error), local))
             shifted += width
             crc = None
@@ -1470,19 +1529,24 @@ class Ring:
         (:meth:`_plain_plan`)."""
         if self.trace:  # record was on before (the general path empties it every cycle)
             self.trace = []
-        run, groups, kernel, repeaters = self._plain_plan()
+        run, groups, kernel, repeaters, opens = self._plain_plan()
         if kernel is not None:
             registers, attention = kernel.load(run, now)
         else:
             registers, attention = self._load_groups(run, groups, now)
-        received, returned, _ = self._shift(registers, data)
+        for _, device in opens:  # RX-13: a chip sending a constant line (no call while none does)
+            if device.constant_output is not None:
+                received, returned, _ = _shift_open(registers, data, _levels(opens))
+                break
+        else:
+            received, returned, _ = self._shift(registers, data)
         n = len(run)
         self._pending = Transfer(Cycle.DATA, data, n, returned, _FLAGS[attention, False], None,
                                  [_new_tuple(_Run, (run, received, True, False, groups, kernel))], n, [], False,
                                  repeaters)  # fmt: skip
         return self._pending
 
-    def _plain_plan(self) -> tuple[list[Device], _Groups, DataKernel | None, int]:
+    def _plain_plan(self) -> tuple[list[Device], _Groups, DataKernel | None, int, _Opens]:
         """A29: the plain ring's plan, worked out again only when :attr:`devices` holds other devices than last time
         (compared element by element, by identity first: the list edited in place is seen, as A28's layout)."""
         plan = self._plan
@@ -1494,7 +1558,7 @@ class Ring:
             run = list(devices)
             groups = _group(run)
             plan = self._plan = (run, groups, groups[0][2] if len(groups) == 1 else None,
-                                 self._loops_before(len(run)))  # fmt: skip
+                                 self._loops_before(len(run)), _opens(run))  # fmt: skip
         return plan
 
     def finish(self, transfer: Transfer, latch: bool) -> None:

@@ -264,9 +264,10 @@ class Supi3:
         "_frame_bytes", "_in_map", "_loaded", "_mau_events", "_mau_told", "_now", "_optical", "_optical_driven",
         "_optical_held", "_optical_until", "_out", "_out_map", "_path", "_send_alarm", "_send_optical",
         "_serial_pins", "_shown", "_stat_due", "_stat_err", "_stat_filter", "_watch_line", "attention",
-        "bus_active", "config",
+        "bus_active", "config", "constant_output",
         "due", "following", "in_word", "io_access", "led_inputs", "line_interrupt", "line_silent", "mfp_in",
-        "mod_ack_until", "pf", "registers", "resreg_until", "revision", "serial_device", "spi_sequences", "te",
+        "mod_ack_until", "pf", "registers", "resreg_until", "revision", "sends_constant", "serial_device",
+        "spi_sequences", "te",
         "watchdog_code", "wd",
     )  # fmt: skip
 
@@ -303,6 +304,10 @@ class Supi3:
         self._frame_bytes = -1  # µP modes: the data bytes the last data-cycle load gave (M15)
         self._shown: tuple[bytes | None, int] = (None, 0)  # (OUT bytes, MFP levels) last driven
         self._init_serial()
+        self.sends_constant = self.registers is not None and self.config.variant is not Variant.LS
+        """RX-13: the chip's data path can open, so that a data cycle's :attr:`constant_output` may be a level: a
+        SUPI 3 OPC in an Init-µP mode (the chips with the expansion interface, RX-1). Fixed by the configuration:
+        the ring reads it when it plans its devices."""
         self._chain: ExternalRegisters | None = None
         self._exr_driver: ExpansionDriver | None = None
         self._optical_driven = False  # pin level: the optical block makes every transition (_optical_drive, OPT-26)
@@ -365,6 +370,10 @@ class Supi3:
         self.io_access = False
         self._send_alarm = False
         self._exr_free = 0
+        self.constant_output: int | None = None
+        """RX-13: after a data-cycle load, the level the chip sends for every data bit of the frame in place of what
+        shifts through it (ExtReg = 1 with nothing on FromExR: 0, the grounded pin), ``None`` when the frame shifts
+        through its register (the ring reads it for the chips whose :attr:`sends_constant` is set)."""
         self.line_silent = False
         """The incoming line fell silent (idle time-out) and was not heard since: RC off, /ResReg low (DG-4)."""
         self.line_interrupt = False
@@ -664,7 +673,8 @@ class Supi3:
         They are used while SET has ExtReg = 1 (RX-2): at transaction level a data cycle sends
         ``chain.chain()`` and its latch calls ``shift_cycle``, ``take_outputs`` and ``load_inputs``; at pin level
         (:class:`supi3.model.pins.Supi3Pins`) the chain is clocked at every change of the expansion pins. Without
-        a chain a data cycle with ExtReg = 1 sends 0 bits (FromExR grounded).
+        a chain a data cycle with ExtReg = 1 sends 0 bits (FromExR grounded): for the whole frame, not only the
+        chip's own bytes (:attr:`constant_output`, RX-13).
 
         Raises
         ------
@@ -689,7 +699,8 @@ class Supi3:
 
     def _expansion_load(self, clk: int) -> bytes:
         """A data cycle with ExtReg = 1 begins at ``clk``: what it sends (transaction level: the chain's contents,
-        RX-2), after the overrun check of RX-4; zeros at pin level, where FromExR is shifted bit by bit."""
+        RX-2), after the overrun check of RX-4, or zeros without a chain (and :attr:`constant_output` 0, RX-13);
+        zeros at pin level, where FromExR is shifted bit by bit."""
         length = self.data_bytes()
         if self._exr_driver is not None:
             return bytes(length)
@@ -697,6 +708,9 @@ class Supi3:
             self._count("EXPANSION_OVERRUN")
         chain = self._chain
         if chain is None:
+            # RX-13: FromExR grounded, nothing between ToExR and FromExR: every data bit the chip sends is 0, the
+            # bits of the devices before it and the loopback word too (the ring sends the constant line)
+            self.constant_output = 0
             return bytes(length)
         if chain.length != length:
             raise ChipError(f"the external registers must be as long as SET's data length at transaction level "
@@ -1155,6 +1169,7 @@ class Supi3:
             return wire.word_bytes(self.id_register())
         if self.registers is not None:
             _, expansion, size = self._data_path()
+            self.constant_output = None  # RX-13: the frame shifts through, unless the open expansion says otherwise
             if expansion:
                 data = self._expansion_load(clk)
             elif size:
