@@ -265,6 +265,54 @@ def test_the_native_frames_leave_the_rest_to_python(elves: dict[str, Path], case
         assert fast.core.frames.taken == 0
 
 
+def test_an_edge_past_a_bus_event_runs_the_bus_then_natively(elves: dict[str, Path]) -> None:
+    """MCU-84: issue #13's case (the handler's /SS edges past the cycle's start or end): hook.c has Python run the bus
+    up to such an edge, then takes the edge itself; the same run as through Python after every step, nearly every
+    GPIOA write of the steady state native (what reaches Python: the data registers' latch-phase frames)."""
+    fast, slow = side_by_side(elves["dio_br3"], 2_000_000, 14, cycles=4)
+    assert fast.native_frames is not None and fast.native_frames.bus_dues > 14 * 4 // 2
+    assert slow.native_frames is None
+
+
+def _failing_bus(board: Board, at: float) -> None:
+    """The board's bus refuses to run to ``at`` or past it (an :class:`InterbusError`, as the bench's own refusals)."""
+    advance = board._advance
+
+    def refused(until: float) -> bool:
+        if until >= at:
+            raise InterbusError("test", until, "the bus refused the time")
+        return advance(until)
+
+    board._advance = refused
+
+
+def test_a_bus_that_fails_at_an_edge_fails_alike(elves: dict[str, Path]) -> None:
+    """MCU-84: the bus run for an /SS edge fails (a bus event's error): the run raises it and the board is left as
+    Python's write leaves it (GPIOA's register written, the edge unseen), with the native frames as without."""
+    probe = Board(elves["dio_br3"], bit_rate=2_000_000, strict=False)
+    assert probe.native_frames is not None
+    native = probe.native_frames
+    calls: list[tuple[int, float]] = []
+    advance = probe._advance
+
+    def noted(until: float) -> bool:
+        calls.append((native.bus_dues, probe.bench._next_at))
+        return advance(until)
+
+    probe._advance = noted
+    probe.run(12)
+    at = next(next_at for (before, _), (dues, next_at) in zip(calls, calls[1:], strict=False)
+              if dues > before and next_at > 60e-6)  # an event the bus ran for an edge, after the set-up
+    boards = (Board(elves["dio_br3"], bit_rate=2_000_000, strict=False),
+              Board(elves["dio_br3"], bit_rate=2_000_000, strict=False, native_frames=False))  # fmt: skip
+    for board in boards:
+        _failing_bus(board, at)
+    errors = [_error(partial(board.run, 12)) for board in boards]
+    assert errors[0] == errors[1] and errors[0] is not None and "refused" in errors[0][1]
+    assert snapshot(boards[0]) == snapshot(boards[1])
+    assert boards[0].native_frames is not None and boards[0].native_frames.bus_dues > 0
+
+
 def _checked_backtraces(core: CortexM) -> Counter[str]:
     """MCU-83: ``core``'s backtraces each compared with a fresh unwinding of the same state; counts of the calls
     (``calls``), the unwindings they made (``unwound``) and the call stacks seen per PC (``stacks``)."""

@@ -39,7 +39,7 @@ from typing import TYPE_CHECKING, Final, Protocol
 
 from supi3.interbus import wire
 from supi3.mcu.core import HeldRegister
-from supi3.mcu.hook import Frames, NativeHookError
+from supi3.mcu.hook import BUS_DUE, Frames, NativeHookError
 from supi3.mcu.stm32 import (
     CR1_CPHA,
     CR1_CPOL,
@@ -230,6 +230,10 @@ def first_due(next_at: float, cpu_hz: float, noise: float) -> int:
     return cycles
 
 
+def _unseen(pin: int, level: int) -> None:
+    """MCU-84: a GPIOA output change nobody sees (the write a failed bus run left behind)."""
+
+
 class _FirstDue(dict[float, int]):
     """:func:`first_due` by a bench time, each computed once (MCU-65: the thresholds' own Python call only when a
     time is new); emptied when it grows past :data:`_MEMO_SIZE`."""
@@ -298,10 +302,36 @@ class NativeFrames:
         self._exti0 = exti0
         self._command: object = None
         self._code = _NO_COMMAND
+        self.bus_dues = 0
+        """MCU-84: the /SS edges whose bus event hook.c had Python run (:meth:`_bus_due`; a count for tests)."""
+        self._bus_due_callback = BUS_DUE(self._bus_due)  # kept alive with the frames, which point at it
+        frames.bus_due = self._bus_due_callback
         frames.valid = 0
         frames.pending = 0
         core.entry = self.catch_up
         core.resume = self.refresh
+
+    def _bus_due(self, offset: int, value: int) -> None:
+        """MCU-84: hook.c's /SS edge (GPIOA's BSRR or BRR written with ``value``) has a bus event due at or before
+        it: an entry into Python (:meth:`catch_up`), the bus run up to the edge and /IRQ followed, as
+        ``Board._on_output`` does before the edge, and the mirror made again; hook.c then takes the edge if it is
+        still plain, else calls Python's write, which finds the bus run. A failure stops the run as Python's write
+        would (:meth:`CortexM.fail`), with the register written: that write's state at its failure."""
+        self.catch_up()
+        self.bus_dues += 1
+        board = self._board
+        try:
+            board._now()
+        except BaseException as error:  # handed to the run loop, raised there (CortexM's own callbacks do the same)
+            board.core.fail(error)
+            gpio = board.gpio
+            output, gpio.on_output = gpio.on_output, _unseen
+            try:  # the levels set without the board seeing the edge: Gpio.write's state when the edge failed
+                gpio.write(offset, 4, value)
+            finally:
+                gpio.on_output = output
+            return
+        self.refresh()
 
     def catch_up(self) -> None:
         """An entry into Python (:attr:`CortexM.entry`): the mirror is no longer valid (Python may change what it
