@@ -17,6 +17,7 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Callable
 from functools import partial
+from itertools import pairwise
 from pathlib import Path
 from typing import Any
 
@@ -301,7 +302,7 @@ def test_a_bus_that_fails_at_an_edge_fails_alike(elves: dict[str, Path]) -> None
 
     probe._advance = noted
     probe.run(12)
-    at = next(next_at for (before, _), (dues, next_at) in zip(calls, calls[1:], strict=False)
+    at = next(next_at for (before, _), (dues, next_at) in pairwise(calls)
               if dues > before and next_at > 60e-6)  # an event the bus ran for an edge, after the set-up
     boards = (Board(elves["dio_br3"], bit_rate=2_000_000, strict=False),
               Board(elves["dio_br3"], bit_rate=2_000_000, strict=False, native_frames=False))  # fmt: skip

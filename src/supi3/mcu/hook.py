@@ -33,9 +33,9 @@ from typing import Final
 from supi3.errors import Supi3Error
 from supi3.sdk.native import default_cache_dir
 
-__all__ = ["BUS_DUE", "DESCRIBE", "FLAGS", "MMIO_READ", "MMIO_WRITE", "SOURCE", "Block", "Frames", "Held", "NativeHookError",
-           "Port", "Prefix", "State", "cached_path", "check_layout", "check_whole", "layout", "library",
-           "native_layout"]
+__all__ = ["BUS_DUE", "DESCRIBE", "FLAGS", "MMIO_READ", "MMIO_WRITE", "SOURCE", "Block", "Frames", "Held",
+           "NativeHookError", "Port", "Prefix", "State", "cached_path", "check_layout", "check_whole", "layout",
+           "library", "native_layout"]
 
 SOURCE: Final[Path] = Path(__file__).with_name("hook.c")
 FLAGS: Final[tuple[str, ...]] = ("-shared", "-fPIC", "-O2", "-target", "native", "-mcpu=baseline", "-nostdlib",
@@ -141,7 +141,8 @@ MMIO_WRITE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, cty
 
 
 BUS_DUE: Final = ctypes.CFUNCTYPE(None, ctypes.c_uint64, ctypes.c_uint64)
-"""MCU-84: hook.c's ``bus_due_fn``, :meth:`supi3.mcu.frames.NativeFrames._bus_due` (GPIOA's offset and value written)."""
+"""MCU-84: hook.c's ``bus_due_fn``, :meth:`supi3.mcu.frames.NativeFrames._bus_due` (GPIOA's offset and value
+written)."""
 
 
 class Prefix(ctypes.Structure):
