@@ -16,7 +16,10 @@ on to the held register's read (MCU-25) and Python:
   the latch phase), in Motorola mode, with a register file that is not pedantic, at transaction level;
 - with every Table 3-7 check of the board passing (t8, t1, t2, t0, SPI mode 3, MSB first), by the board's thresholds
   in core cycles, and no bus event due up to the edge (:func:`first_due`: the first core cycle whose
-  ``Board._sync`` would run one, by the same float expression), /IRQ and /ModAck followed, nothing else pending.
+  ``Board._sync`` would run one, by the same float expression), /IRQ and /ModAck followed, nothing else pending;
+- MCU-84: an /SS edge with a bus event due at or before it has Python run the bus up to the edge and mirror the model
+  again (:meth:`NativeFrames._bus_due`, what ``Board._on_output`` does before the edge), then hook.c takes the edge
+  if it is plain by the new mirror.
 
 Python hands the native side its tables once (:meth:`NativeFrames.__init__`), mirrors the state those conditions read
 after each of its accesses of GPIOA, SPI1 or EXTI (:meth:`NativeFrames.refresh`: ``valid``; the peripherals'
