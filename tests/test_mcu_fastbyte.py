@@ -14,8 +14,10 @@ while /SS is low, strict and pedantic boards.
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Callable
 from functools import partial
+from itertools import pairwise
 from pathlib import Path
 from typing import Any
 
@@ -27,7 +29,7 @@ from supi3.errors import Supi3Error
 from supi3.interbus.errors import InterbusError
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import NOISE_CYCLES, Board
-from supi3.mcu.core import HeldRegister
+from supi3.mcu.core import BACKTRACE_DEPTH, CortexM, Frame, HeldRegister
 from supi3.mcu.frames import _MEMO_SIZE, FAST_READS, FAST_WRITES, _FirstDue, first_due
 from supi3.mcu.stm32 import CR1_BR, CR1_BR_SHIFT, IOPAEN, SPI1EN
 from supi3.sdk import native
@@ -58,6 +60,7 @@ def elves(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
         "gpio_reset": mcu_build.build(MCU / "gpio_reset.c", folder / "gpio_reset.elf"),
         "due_cross": mcu_build.build(MCU / "due_cross.c", folder / "due_cross.elf", defines=BR3),
         "pin_watch": mcu_build.build(MCU / "pin_watch.c", folder / "pin_watch.elf", defines=BR3),
+        "call_paths": mcu_build.build(MCU / "call_paths.c", folder / "call_paths.elf"),
         "pin_watch_rise": mcu_build.build(MCU / "pin_watch.c", folder / "pin_watch_rise.elf",
                                           defines={**BR3, "RISING": "1u"}),
     }
@@ -80,7 +83,8 @@ def snapshot(board: Board) -> dict[str, Any]:
         "core": (core.instructions, core.cycles, core.registers(), core._state.handed, board.interrupts,
                  board.irq_latency_s),
         "bus": (board.bench.now, board.cycles, _master_inputs(board)),
-        "violations": [(v.time_s, v.pc, v.error.rule, str(v.error)) for v in board.violations],
+        "violations": [(v.time_s, v.pc, v.function, v.error.rule, str(v.error), v.backtrace)
+                       for v in board.violations],
         "protocol": (protocol.mode, protocol.phase, protocol.command, protocol.last_rx, protocol._frame),
         "registers": (dict(registers._values), registers.latch_phase, registers.io_access, registers.irq_n),
         "chip": (board.bench.chip._stat_err, board.bench.chip._stat_due),
@@ -105,11 +109,11 @@ def _seen(board: Board) -> tuple[int, ...]:
 
 
 def _error(run: Callable[[], object]) -> tuple[type[Supi3Error], str] | None:
-    """The error ``run`` raised (its type and text), ``None`` if none."""
+    """The error ``run`` raised (its type, text and notes), ``None`` if none."""
     try:
         run()
-    except Supi3Error as error:
-        return type(error), str(error)
+    except Supi3Error as error:  # with its notes: a strict board's note of where the firmware was (MCU-83)
+        return type(error), "\n".join([str(error), *getattr(error, "__notes__", ())])
     return None
 
 
@@ -260,6 +264,107 @@ def test_the_native_frames_leave_the_rest_to_python(elves: dict[str, Path], case
     fast, _ = side_by_side(elves[case], bit_rate, 5, strict=strict, pedantic=pedantic)
     if pedantic:
         assert fast.core.frames.taken == 0
+
+
+@pytest.mark.parametrize("strict", [False, True])
+def test_an_edge_past_a_bus_event_runs_the_bus_then_natively(elves: dict[str, Path], strict: bool) -> None:
+    """MCU-84: issue #13's case (the handler's /SS edges past the cycle's start or end): hook.c has Python run the bus
+    up to such an edge, then takes the edge itself; the same run as through Python after every step, nearly every
+    GPIOA write of the steady state native (what reaches Python: the data registers' latch-phase frames, each a
+    violation: a strict board raises the first at the end of its action, with the same note of where the firmware
+    was)."""
+    fast, slow = side_by_side(elves["dio_br3"], 2_000_000, 14, strict=strict, cycles=4)
+    assert fast.native_frames is not None and fast.native_frames.bus_dues > (0 if strict else 14 * 4 // 2)
+    assert slow.native_frames is None
+    assert fast.violations and {v.error.rule for v in fast.violations} == {"3.4.14"}
+    assert len(fast.violations) == 1 if strict else len(fast.violations) > 10  # strict: raised at the first
+
+
+def _failing_bus(board: Board, at: float) -> None:
+    """The board's bus refuses to run to ``at`` or past it (an :class:`InterbusError`, as the bench's own refusals)."""
+    advance = board._advance
+
+    def refused(until: float) -> bool:
+        if until >= at:
+            raise InterbusError("test", until, "the bus refused the time")
+        return advance(until)
+
+    board._advance = refused
+
+
+def test_a_bus_that_fails_at_an_edge_fails_alike(elves: dict[str, Path]) -> None:
+    """MCU-84: the bus run for an /SS edge fails (a bus event's error): the run raises it and the board is left as
+    Python's write leaves it (GPIOA's register written, the edge unseen), with the native frames as without."""
+    probe = Board(elves["dio_br3"], bit_rate=2_000_000, strict=False)
+    assert probe.native_frames is not None
+    native = probe.native_frames
+    calls: list[tuple[int, float]] = []
+    advance = probe._advance
+
+    def noted(until: float) -> bool:
+        calls.append((native.bus_dues, probe.bench._next_at))
+        return advance(until)
+
+    probe._advance = noted
+    probe.run(12)
+    at = next(next_at for (before, _), (dues, next_at) in pairwise(calls)
+              if dues > before and next_at > 60e-6)  # an event the bus ran for an edge, after the set-up
+    boards = (Board(elves["dio_br3"], bit_rate=2_000_000, strict=False),
+              Board(elves["dio_br3"], bit_rate=2_000_000, strict=False, native_frames=False))  # fmt: skip
+    for board in boards:
+        _failing_bus(board, at)
+    errors = [_error(partial(board.run, 12)) for board in boards]
+    assert errors[0] == errors[1] and errors[0] is not None and "refused" in errors[0][1]
+    assert snapshot(boards[0]) == snapshot(boards[1])
+    assert boards[0].native_frames is not None and boards[0].native_frames.bus_dues > 0
+
+
+def _checked_backtraces(core: CortexM) -> Counter[str]:
+    """MCU-83: ``core``'s backtraces each compared with a fresh unwinding of the same state; counts of the calls
+    (``calls``), the unwindings they made (``unwound``) and the call stacks seen per PC (``stacks``)."""
+    counts: Counter[str] = Counter()
+    kept = core.backtrace
+    seen: dict[int, set[tuple[Frame, ...]]] = {}
+
+    def unwind(pc: int, registers: list[int], depth: int) -> Any:
+        counts["unwound"] += 1
+        return CortexM._unwind(core, pc, registers, depth)
+
+    def backtrace(depth: int = BACKTRACE_DEPTH) -> tuple[Frame, ...]:
+        frames = kept(depth)
+        fresh, _, _ = CortexM._unwind(core, core.pc, core._unwind_reads.read(), depth)
+        assert frames == fresh
+        counts["calls"] += 1
+        stacks = seen.setdefault(core.pc, set())
+        counts["stacks"] += frames not in stacks
+        stacks.add(frames)
+        return frames
+
+    core._unwind = unwind  # type: ignore[method-assign]
+    core.backtrace = backtrace  # type: ignore[method-assign]
+    return counts
+
+
+@pytest.mark.parametrize(("case", "bit_rate", "strict", "cycles"), [
+    ("call_paths", 500_000, False, 2), ("edges", 500_000, False, 40), ("edges_br3", 2_000_000, False, 40),
+    ("dio_br3", 2_000_000, False, 60), ("edges_br3", 2_000_000, True, 40)])  # fmt: skip
+def test_a_kept_call_stack_is_the_unwinding_s(elves: dict[str, Path], case: str, bit_rate: int, strict: bool,
+                                              cycles: int) -> None:  # fmt: skip
+    """MCU-83: each violation's backtrace (the record's and a strict board's note) is what a fresh unwinding of the
+    core's state gives, with the native frames and without; call_paths.c breaks a rule at one PC from call stacks
+    that differ only in a stack word, or only in SP and LR (the old frames still in memory), frame_edges.c at the
+    same PCs from different callers (``frame()`` from ``access()`` and from the rounds): a kept call stack is offered
+    where it does not hold, and most records take a kept one."""
+    for native_frames in (True, False):
+        board = Board(elves[case], bit_rate=bit_rate, strict=strict, native_frames=native_frames)
+        counts = _checked_backtraces(board.core)
+        error = _error(partial(board.run, cycles))
+        assert (error is not None) == strict
+        if strict:
+            assert counts["calls"] >= 1 and error is not None and "called from" in error[1]
+            continue
+        assert counts["calls"] == len(board.violations) and counts["unwound"] < counts["calls"] / 2
+        assert counts["stacks"] > len({v.pc for v in board.violations})  # a PC reached from two call stacks
 
 
 def _reconfigure(board: Board, change: str, step: int) -> None:

@@ -124,6 +124,13 @@ SYST_MAX: Final[int] = 0xFF_FFFF
 """SysTick is a 24-bit down counter (B3.3.1)."""
 BACKTRACE_DEPTH: Final[int] = 16
 """Frames :meth:`CortexM.backtrace` unwinds at most."""
+BACKTRACE_MEMO: Final[int] = 64
+"""MCU-83: the PCs (with a depth) whose call stacks :meth:`CortexM.backtrace` keeps, :data:`BACKTRACE_STACKS` each
+(the memo is emptied when a new one would pass it: a firmware's violations come from a few places)."""
+BACKTRACE_STACKS: Final[int] = 8
+"""MCU-83: the call stacks kept per PC, the latest (a PC is reached from a few callers)."""
+_STACK_BYTES: Final[int] = 1024
+"""MCU-83: the widest span of stack words a kept call stack compares in one read (a wider unwinding is not kept)."""
 BLOCK_CACHE_SLOTS: Final[int] = 1 << 13
 PREFIX_SLOTS: Final[int] = 1 << 10
 """MCU-51: the slots of the native memo of :meth:`CortexM.cycles_now`'s prefix costs (a power of two; a PC whose slot
@@ -642,6 +649,36 @@ def _native(function: Any, *arguments: Any) -> Any:
     return function
 
 
+@dataclass(frozen=True, slots=True)
+class _Unwound:
+    """MCU-83: a call stack :meth:`CortexM.backtrace` unwound, with everything its unwinding read: the core's
+    registers (number, value) and the stack words (from ``low``, picked by ``layout``)."""
+
+    frames: tuple[Frame, ...]
+    registers: tuple[tuple[int, int], ...]
+    low: int
+    layout: struct.Struct
+    words: tuple[int, ...]
+
+    @classmethod
+    def of(cls, frames: tuple[Frame, ...], used: dict[int, int], words: dict[int, int]) -> _Unwound | None:
+        """The record of an unwinding that read ``used`` and ``words``; ``None`` if its words span more than one
+        read takes."""
+        addresses = sorted(words)
+        low = addresses[0] if addresses else 0
+        layout = "<"
+        at = low
+        for address in addresses:
+            if address < at:  # words that overlap (no unwinding reads them): not kept
+                return None
+            layout += f"{address - at}xI" if address > at else "I"
+            at = address + 4
+        packed = struct.Struct(layout)
+        if packed.size > _STACK_BYTES:
+            return None
+        return cls(frames, tuple(used.items()), low, packed, tuple(words[address] for address in addresses))
+
+
 class _Batch:
     """Core registers read or written in one call to unicorn's C library (``uc_reg_read_batch``,
     ``uc_reg_write_batch``; MCU-19: 32-bit values in 64-bit slots)."""
@@ -779,6 +816,8 @@ class CortexM:
         self._unstack = _Batch(self._handle, _UNSTACK_WRITES)
         self._resume = _Batch(self._handle, _RESUME_WRITES)
         self._unwind_reads = _Batch(self._handle, _UNWIND_READS)
+        self._stack_buffer = ctypes.create_string_buffer(_STACK_BYTES)  # MCU-83: a kept call stack's words
+        self._backtraces: dict[tuple[int, int], list[_Unwound]] = {}
         self._callbacks: list[object] = []  # the ctypes callbacks unicorn holds: kept alive with the core
         self.flash = flash
         self.ram = ram
@@ -1502,31 +1541,96 @@ class CortexM:
     def backtrace(self, depth: int = BACKTRACE_DEPTH) -> tuple[Frame, ...]:
         """The call stack now, innermost first: the PC's function and line, then each caller's return address
         with the line of its call, unwound with the ELF's call frame information (``.debug_frame``) up to
-        ``depth`` frames, a frame without that information, or an exception entry (LR = EXC_RETURN)."""
+        ``depth`` frames, a frame without that information, or an exception entry (LR = EXC_RETURN).
+
+        MCU-83: a call stack already unwound at this PC and depth is taken again when every register and stack word
+        its unwinding read holds the same value now (the unwinding is a function of those and the ELF alone): one
+        register read and one memory read in place of the unwinding's."""
         check_int("depth", depth, 1)
-        image = self.image
         pc = self.pc
+        registers = self._unwind_reads.read()  # R0..R12, 13 SP, 14 LR
+        key = (pc, depth)
+        kept = self._backtraces.get(key)
+        if kept is not None:
+            for unwound in kept:
+                if all(registers[reg] == value for reg, value in unwound.registers) \
+                        and self._stack_words(unwound.low, unwound.layout) == unwound.words:  # fmt: skip
+                    return unwound.frames
+        frames, used, words = self._unwind(pc, registers, depth)
+        if words is not None:
+            record = _Unwound.of(frames, used, words)
+            if record is not None and self._stack_words(record.low, record.layout) == record.words:
+                if kept is None:
+                    if len(self._backtraces) >= BACKTRACE_MEMO:
+                        self._backtraces.clear()
+                    kept = self._backtraces[key] = []
+                elif len(kept) >= BACKTRACE_STACKS:
+                    del kept[0]
+                kept.append(record)
+        return frames
+
+    def _unwind(self, pc: int, registers: list[int], depth: int
+                ) -> tuple[tuple[Frame, ...], dict[int, int], dict[int, int] | None]:  # fmt: skip
+        """:meth:`backtrace`'s unwinding from ``pc`` and the core's ``registers`` (R0..R12, SP, LR): the frames, and
+        what decided them (MCU-83): the registers of ``registers`` it used and the stack words it used (address:
+        value; ``None`` if a word it read is outside RAM and flash or unmapped: not to be kept). A restored register
+        the unwinding never uses (a callee-saved R4 holding the caller's data) decides nothing."""
+        image = self.image
         frames = [Frame(pc, image.function_at(pc), image.line_at(pc))]
-        regs = dict(enumerate(self._unwind_reads.read()))  # R0..R12, 13 SP, 14 LR
+        regs = dict(enumerate(registers))
+        used: dict[int, int] = {}
+        words: dict[int, int] | None = {}
+        restored: dict[int, int | None] = {}  # a register's stack word, None for the CFA (SP); absent: `registers`
+
+        def value(reg: int) -> int:
+            if words is not None:
+                where = restored.get(reg, -1)
+                if where == -1:
+                    used[reg] = regs[reg]
+                elif where is not None:
+                    words[where] = regs[reg]
+            return regs[reg]
+
         while len(frames) < depth:
             rule = image.frame_rule(pc)
             if rule is None or rule[0] not in regs:
                 break
-            cfa = regs[rule[0]] + rule[1]
+            cfa = value(rule[0]) + rule[1]
             try:
                 saved = {reg: int(struct.unpack("<I", self._peek(cfa + offset, 4))[0])
                          for reg, offset in rule[2].items()}  # fmt: skip
             except ArgumentError:
+                words = None
                 break
+            for reg, offset in rule[2].items():
+                restored[reg] = cfa + offset
+                if words is not None and not (self._in(self.ram, cfa + offset) or self._in(self.flash, cfa + offset)):
+                    words = None  # a word read elsewhere (a peripheral's): every unwinding reads it again
             regs |= saved
             regs[13] = cfa
-            back = regs[14] & ~1
-            if regs[14] >= EXC_RETURN_HANDLER or not self.flash[0] <= back < self.flash[0] + self.flash[1] \
+            restored[13] = None
+            lr = value(14)
+            back = lr & ~1
+            if lr >= EXC_RETURN_HANDLER or not self.flash[0] <= back < self.flash[0] + self.flash[1] \
                     or (back == pc and not saved):  # fmt: skip
                 break
             pc = back
             frames.append(Frame(pc, image.function_at(pc - 1), image.line_at(pc - 1)))  # the call's line
-        return tuple(frames)
+        return tuple(frames), used, words
+
+    @staticmethod
+    def _in(memory: tuple[int, int], address: int) -> bool:
+        """Whether the word at ``address`` lies in ``memory`` (base, size)."""
+        return memory[0] <= address and address + 4 <= memory[0] + memory[1]
+
+    def _stack_words(self, low: int, layout: struct.Struct) -> tuple[int, ...] | None:
+        """MCU-83: the words ``layout`` picks from memory at ``low`` on, in one read; ``None`` if unmapped."""
+        buffer = self._stack_buffer
+        if not layout.size:
+            return ()
+        if _LIB.uc_mem_read(self._handle, low, buffer, layout.size) != ucc.UC_ERR_OK:
+            return None
+        return layout.unpack_from(buffer)
 
     # -- system control space: SysTick, NVIC, SCB (B3.2 to B3.4) -----------------------------------------------
 

@@ -16,7 +16,10 @@ on to the held register's read (MCU-25) and Python:
   the latch phase), in Motorola mode, with a register file that is not pedantic, at transaction level;
 - with every Table 3-7 check of the board passing (t8, t1, t2, t0, SPI mode 3, MSB first), by the board's thresholds
   in core cycles, and no bus event due up to the edge (:func:`first_due`: the first core cycle whose
-  ``Board._sync`` would run one, by the same float expression), /IRQ and /ModAck followed, nothing else pending.
+  ``Board._sync`` would run one, by the same float expression), /IRQ and /ModAck followed, nothing else pending;
+- MCU-84: an /SS edge with a bus event due at or before it has Python run the bus up to the edge and mirror the model
+  again (:meth:`NativeFrames._bus_due`, what ``Board._on_output`` does before the edge), then hook.c takes the edge
+  if it is plain by the new mirror.
 
 Python hands the native side its tables once (:meth:`NativeFrames.__init__`), mirrors the state those conditions read
 after each of its accesses of GPIOA, SPI1 or EXTI (:meth:`NativeFrames.refresh`: ``valid``; the peripherals'
@@ -39,7 +42,7 @@ from typing import TYPE_CHECKING, Final, Protocol
 
 from supi3.interbus import wire
 from supi3.mcu.core import HeldRegister
-from supi3.mcu.hook import Frames, NativeHookError
+from supi3.mcu.hook import BUS_DUE, Frames, NativeHookError
 from supi3.mcu.stm32 import (
     CR1_CPHA,
     CR1_CPOL,
@@ -117,6 +120,8 @@ class FrameBoard(Protocol):
     exti: Exti
 
     def _sync(self, cycles: int) -> None: ...
+
+    def _now(self) -> int: ...
 
     @property
     def bench(self) -> FrameBench: ...
@@ -230,6 +235,10 @@ def first_due(next_at: float, cpu_hz: float, noise: float) -> int:
     return cycles
 
 
+def _unseen(pin: int, level: int) -> None:
+    """MCU-84: a GPIOA output change nobody sees (the write a failed bus run left behind)."""
+
+
 class _FirstDue(dict[float, int]):
     """:func:`first_due` by a bench time, each computed once (MCU-65: the thresholds' own Python call only when a
     time is new); emptied when it grows past :data:`_MEMO_SIZE`."""
@@ -298,10 +307,36 @@ class NativeFrames:
         self._exti0 = exti0
         self._command: object = None
         self._code = _NO_COMMAND
+        self.bus_dues = 0
+        """MCU-84: the /SS edges whose bus event hook.c had Python run (:meth:`_bus_due`; a count for tests)."""
+        self._bus_due_callback = BUS_DUE(self._bus_due)  # kept alive with the frames, which point at it
+        frames.bus_due = self._bus_due_callback
         frames.valid = 0
         frames.pending = 0
         core.entry = self.catch_up
         core.resume = self.refresh
+
+    def _bus_due(self, offset: int, value: int) -> None:
+        """MCU-84: hook.c's /SS edge (GPIOA's BSRR or BRR written with ``value``) has a bus event due at or before
+        it: an entry into Python (:meth:`catch_up`), the bus run up to the edge and /IRQ followed, as
+        ``Board._on_output`` does before the edge, and the mirror made again; hook.c then takes the edge if it is
+        still plain, else calls Python's write, which finds the bus run. A failure stops the run as Python's write
+        would (:meth:`CortexM.fail`), with the register written: that write's state at its failure."""
+        self.catch_up()
+        self.bus_dues += 1
+        board = self._board
+        try:
+            board._now()
+        except BaseException as error:  # handed to the run loop, raised there (CortexM's own callbacks do the same)
+            board.core.fail(error)
+            gpio = board.gpio
+            output, gpio.on_output = gpio.on_output, _unseen
+            try:  # the levels set without the board seeing the edge: Gpio.write's state when the edge failed
+                gpio.write(offset, 4, value)
+            finally:
+                gpio.on_output = output
+            return
+        self.refresh()
 
     def catch_up(self) -> None:
         """An entry into Python (:attr:`CortexM.entry`): the mirror is no longer valid (Python may change what it

@@ -375,6 +375,7 @@ int supi3_run(void *uc, supi3_state *s) {
  * write (`slow`). What the frames changed is noted here (`pending`) and set in the Python objects, as its net effect,
  * at the next entry into Python (supi3.mcu.frames.NativeFrames.catch_up). */
 typedef void (*mmio_write_fn)(void *uc, uint64_t offset, unsigned size, uint64_t value, void *data);
+typedef void (*bus_due_fn)(uint64_t offset, uint64_t value); /* MCU-84: supi3.mcu.frames.NativeFrames._bus_due */
 
 /* The cost in cycles of a block's instructions before the PC of an access (CortexM.cycles_now's memo, MCU-1). */
 typedef struct {
@@ -388,6 +389,7 @@ typedef struct {
     supi3_held *spi;        /* SPI1's held register (MCU-25, MCU-26) */
     supi3_prefix *prefixes; /* CortexM.cycles_now's prefix costs, filled by Python */
     uint64_t prefix_mask;   /* slots - 1 (a power of two) */
+    bus_due_fn bus_due;     /* MCU-84: Python runs the bus up to an /SS edge and mirrors the model again; 0: none */
     /* set up once from Python's tables (supi3.spi.upif, supi3.model.registers, the board's Table 3-7 limits) */
     int64_t least_t1, least_t2, least_t8; /* core cycles */
     uint64_t ss_pin, cd_command, cd_data, phase_command, phase_data;
@@ -615,6 +617,40 @@ static int exti_write(supi3_frames *f, uint64_t offset, uint64_t value) {
     return 1;
 }
 
+/* GPIOA's BSRR (0x10) or BRR (0x14) written with `value`: a write that changes no pin, or an /SS edge of a plain frame
+ * (frame_fall, frame_rise), taken here (1), else left to Python (0). MCU-84: an edge with a bus event due at or before
+ * it (`due`) has Python run the bus up to the edge and mirror the model again (`bus_due`, what Board._on_output does
+ * before the edge), then is taken here if the new mirror is valid and the edge plain before the next bus event (the
+ * same write once more, `may_sync` = 0: Python's write takes it otherwise). */
+static int gpio_write(supi3_frames *f, uint64_t offset, uint64_t value, int may_sync) {
+    supi3_state *s = f->state;
+    uint64_t now = 0;
+    uint64_t odr = offset == 0x10 ? ((f->odr & ~(value >> 16)) | value) & 0xFFFF : f->odr & ~value & 0xFFFF;
+    uint64_t levels = (odr & f->gpio_mask) | (f->gpio_pulled_up & ~f->gpio_mask);
+    uint64_t changed = levels ^ f->gpio_levels;
+    int taken = changed == 0;
+    if (changed == (uint64_t)1 << f->ss_pin && frames_now(f, &now)) {
+        if (now >= f->due) {
+            if (!may_sync || f->bus_due == 0) {
+                return 0;
+            }
+            f->bus_due(offset, value);
+            return f->valid && !s->stop_request && f->gpio_ok && gpio_write(f, offset, value, 0);
+        }
+        taken = levels >> f->ss_pin & 1 ? frame_rise(f, now) : frame_fall(f, now);
+        if (taken) {
+            f->synced = now + 1;
+            s->handed = now;
+        }
+    }
+    if (taken) {
+        f->odr = odr;
+        f->gpio_levels = levels;
+        f->pending = 1;
+    }
+    return taken;
+}
+
 /* The write callback (uc_cb_mmio_write_t) of GPIOA, SPI1 and EXTI: a frame's edge or byte, or EXTI's PR write, taken
  * here, or Python's write. */
 void supi3_port_write(void *uc, uint64_t offset, unsigned size, uint64_t value, void *data) {
@@ -636,25 +672,9 @@ void supi3_port_write(void *uc, uint64_t offset, unsigned size, uint64_t value, 
                 s->handed = now;
                 return;
             }
-        } else if (f->gpio_ok && (offset == 0x10 || offset == 0x14)) {
-            uint64_t odr = offset == 0x10 ? ((f->odr & ~(value >> 16)) | value) & 0xFFFF : f->odr & ~value & 0xFFFF;
-            uint64_t levels = (odr & f->gpio_mask) | (f->gpio_pulled_up & ~f->gpio_mask);
-            uint64_t changed = levels ^ f->gpio_levels;
-            int taken = changed == 0;
-            if (changed == (uint64_t)1 << f->ss_pin && frames_now(f, &now) && now < f->due) {
-                taken = levels >> f->ss_pin & 1 ? frame_rise(f, now) : frame_fall(f, now);
-                if (taken) {
-                    f->synced = now + 1;
-                    s->handed = now;
-                }
-            }
-            if (taken) {
-                f->odr = odr;
-                f->gpio_levels = levels;
-                f->pending = 1;
-                f->taken += 1;
-                return;
-            }
+        } else if (f->gpio_ok && (offset == 0x10 || offset == 0x14) && gpio_write(f, offset, value, 1)) {
+            f->taken += 1;
+            return;
         }
     }
     p->slow(uc, offset, size, value, 0);
@@ -733,8 +753,8 @@ const uint32_t supi3_held_layout[] = {
 const uint32_t supi3_prefix_layout[] = {
     4, sizeof(supi3_prefix), AT(supi3_prefix, address), AT(supi3_prefix, pc), AT(supi3_prefix, cycles)};
 const uint32_t supi3_frames_layout[] = {
-    78, sizeof(supi3_frames), AT(supi3_frames, state), AT(supi3_frames, spi), AT(supi3_frames, prefixes),
-    AT(supi3_frames, prefix_mask), AT(supi3_frames, least_t1), AT(supi3_frames, least_t2),
+    79, sizeof(supi3_frames), AT(supi3_frames, state), AT(supi3_frames, spi), AT(supi3_frames, prefixes),
+    AT(supi3_frames, prefix_mask), AT(supi3_frames, bus_due), AT(supi3_frames, least_t1), AT(supi3_frames, least_t2),
     AT(supi3_frames, least_t8), AT(supi3_frames, ss_pin), AT(supi3_frames, cd_command), AT(supi3_frames, cd_data),
     AT(supi3_frames, phase_command), AT(supi3_frames, phase_data), AT(supi3_frames, sr_txe),
     AT(supi3_frames, sr_bsy), AT(supi3_frames, sr_rxne), AT(supi3_frames, spi_dr), AT(supi3_frames, spi_sr),

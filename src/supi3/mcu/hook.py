@@ -33,9 +33,9 @@ from typing import Final
 from supi3.errors import Supi3Error
 from supi3.sdk.native import default_cache_dir
 
-__all__ = ["DESCRIBE", "FLAGS", "MMIO_READ", "MMIO_WRITE", "SOURCE", "Block", "Frames", "Held", "NativeHookError",
-           "Port", "Prefix", "State", "cached_path", "check_layout", "check_whole", "layout", "library",
-           "native_layout"]
+__all__ = ["BUS_DUE", "DESCRIBE", "FLAGS", "MMIO_READ", "MMIO_WRITE", "SOURCE", "Block", "Frames", "Held",
+           "NativeHookError", "Port", "Prefix", "State", "cached_path", "check_layout", "check_whole", "layout",
+           "library", "native_layout"]
 
 SOURCE: Final[Path] = Path(__file__).with_name("hook.c")
 FLAGS: Final[tuple[str, ...]] = ("-shared", "-fPIC", "-O2", "-target", "native", "-mcpu=baseline", "-nostdlib",
@@ -140,6 +140,11 @@ MMIO_WRITE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, cty
 """unicorn.h's uc_cb_mmio_write_t: a peripheral's write (``handle, offset, size, value, user data``)."""
 
 
+BUS_DUE: Final = ctypes.CFUNCTYPE(None, ctypes.c_uint64, ctypes.c_uint64)
+"""MCU-84: hook.c's ``bus_due_fn``, :meth:`supi3.mcu.frames.NativeFrames._bus_due` (GPIOA's offset and value
+written)."""
+
+
 class Prefix(ctypes.Structure):
     """The cost in cycles of a block's instructions before an access's PC (``supi3_prefix``: the memo of
     :meth:`supi3.mcu.core.CortexM.cycles_now`, MCU-51); address 0: an empty slot."""
@@ -157,6 +162,7 @@ class Frames(ctypes.Structure):
         ("spi", ctypes.POINTER(Held)),
         ("prefixes", ctypes.POINTER(Prefix)),
         ("prefix_mask", ctypes.c_uint64),
+        ("bus_due", BUS_DUE),
         ("least_t1", ctypes.c_int64),
         ("least_t2", ctypes.c_int64),
         ("least_t8", ctypes.c_int64),
