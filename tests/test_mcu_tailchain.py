@@ -94,20 +94,24 @@ def _board(elf: Path, cpu: str, bit_rate: int, **options: object) -> Board:
     return board
 
 
-def _hold(board: Board, microseconds: int) -> None:
+def _hold(board: Board, microseconds: int, *, clear_late: bool = False) -> None:
+    """late_irq's wait in the handler and whether it writes PR again after it."""
     core = board.core
     core.write_bytes(core.image.address("hold_us"), struct.pack("<I", microseconds))
+    core.write_bytes(core.image.address("clear_late"), struct.pack("<I", clear_late))
 
 
+@pytest.mark.parametrize("clear_late", [False, True])
 @pytest.mark.parametrize("fidelity", ["transaction", "pin"])
 @pytest.mark.parametrize("cpu", sorted(CPUS))
-def test_an_irq_fall_inside_the_handler_is_tail_chained_at_its_return(late_irq: dict[str, Path], cpu: str,
-                                                                      fidelity: str) -> None:  # fmt: skip
+def test_an_irq_fall_inside_the_handler_is_tail_chained_at_its_return(
+        late_irq: dict[str, Path], cpu: str, fidelity: str, clear_late: bool) -> None:  # fmt: skip
     """A wait longer than the master cycle: every entry after the first is tail-chained, the handler's first
     instruction 6 (Cortex-M3) or 16 (Cortex-M0) cycles after the return began, on the same frame (the stack pointer
     the handler starts with is the first entry's), the fall inside the handler before the return; the latency
-    reported is the longest fall to first instruction. Without the wait no fall comes inside a handler: nothing
-    chains."""
+    reported is the longest fall to first instruction. With ``clear_late`` the handler clears PR after the wait: the
+    line is low at the return, but the NVIC latched its rise while active (a pulse), so it chains as well. Without the
+    wait no fall comes inside a handler: nothing chains."""
     board = _board(late_irq[cpu], cpu, 500_000, fidelity=fidelity)
     core = board.core
     assert core.cpu.tail_chain_cycles == CHAIN_CYCLES[cpu]
@@ -115,7 +119,7 @@ def test_an_irq_fall_inside_the_handler_is_tail_chained_at_its_return(late_irq: 
     board.run(3)
     assert len(history.entries) == 3 and all(entry.returned is None for entry in history.entries)
     _check(history, board)
-    _hold(board, 300)
+    _hold(board, 300, clear_late=clear_late)
     history = _watched(board)
     stacks: list[int] = []
     entered = core.entered
@@ -134,18 +138,18 @@ def test_an_irq_fall_inside_the_handler_is_tail_chained_at_its_return(late_irq: 
 
 
 @settings(max_examples=12, deadline=None, phases=(Phase.explicit, Phase.reuse, Phase.generate))
-@example(cpu="cortex_m3", bit_rate=500_000, runs=[(300, 3), (0, 2)])  # chains, then entries from thread mode again
+@example(cpu="cortex_m3", bit_rate=500_000, runs=[(300, 3, False), (0, 2, False), (300, 3, True)])  # chains, plain
 @given(cpu=st.sampled_from(sorted(CPUS)), bit_rate=st.sampled_from([500_000, 2_000_000]),
-       runs=st.lists(st.tuples(st.integers(0, 500), st.integers(1, 3)), min_size=1, max_size=4))
+       runs=st.lists(st.tuples(st.integers(0, 500), st.integers(1, 3), st.booleans()), min_size=1, max_size=4))
 def test_every_exti0_entry_is_where_the_architecture_puts_it(late_irq: dict[str, Path], cpu: str, bit_rate: int,
-                                                             runs: list[tuple[int, int]]) -> None:  # fmt: skip
-    """A history of runs with random waits in the handler: every EXTI0 entry is tail-chained iff its /IRQ fall came
-    before the return began, thread-mode entries only after a fall that came later, and the latency is the longest
-    fall to first instruction (:func:`_check`)."""
+                                                             runs: list[tuple[int, int, bool]]) -> None:  # fmt: skip
+    """A history of runs with random waits in the handler, PR cleared again after it or not: every EXTI0 entry is
+    tail-chained iff its /IRQ fall came before the return began, thread-mode entries only after a fall that came
+    later, and the latency is the longest fall to first instruction (:func:`_check`)."""
     board = _board(late_irq[cpu], cpu, bit_rate)
     history = _watched(board)
-    for hold, cycles in runs:
-        _hold(board, hold)
+    for hold, cycles, clear_late in runs:
+        _hold(board, hold, clear_late=clear_late)
         board.run(cycles)
     _check(history, board)
 
@@ -178,14 +182,38 @@ def test_a_line_held_through_the_handler_chains_at_every_return(late_irq: dict[s
             assert returns and not chained
 
 
+@pytest.mark.parametrize("cpu", sorted(CPUS))
+def test_a_line_held_until_the_handler_s_late_pr_write_pends_nothing(late_irq: dict[str, Path], cpu: str) -> None:
+    """The level case the NVIC does not pend: board.c's PR write at the handler's start dropped (the test drops EXTI's
+    PR writes from ``EXTI0_IRQHandler``), late_irq's write after the wait kept: EXTI0's line stays asserted from
+    before the entry until that write, with no rising edge (the /IRQ rise at the IRQ_EVT read sets no PR bit), so
+    nothing pends while the handler runs and the line is low at the return: no tail-chain, each entry from thread
+    mode after its own fall."""
+    board = _board(late_irq[cpu], cpu, 500_000, native_frames=False)
+    core, exti = board.core, board.exti
+    write = exti.write
+
+    def dropping(offset: int, size: int, value: int) -> None:
+        if offset != EXTI_PR or core.image.function_at(core.pc) != "EXTI0_IRQHandler":
+            write(offset, size, value)
+
+    exti.write = dropping  # type: ignore[method-assign]
+    _hold(board, 0, clear_late=True)
+    history = _watched(board)
+    board.run(4)
+    _check(history, board)
+    assert len(history.entries) == 4 and all(entry.returned is None for entry in history.entries)
+    assert len([event for event in history.events if isinstance(event, int)]) == 4
+
+
 def _outcome(elf: Path, cpu: str, *, native_exceptions: bool = True, **options: object) -> tuple[object, ...]:
     """Four runs with waits in the handler that chain and that do not: the history and what the run shows."""
     board = Board(elf, cpu=cpu, bit_rate=500_000, strict=False, **options)  # type: ignore[arg-type]
     board.core.native_exceptions = native_exceptions
     board.run(1)
     history = _watched(board)
-    for hold in (300, 0, 450, 120):
-        _hold(board, hold)
+    for hold, clear_late in ((300, False), (0, False), (450, True), (120, False)):
+        _hold(board, hold, clear_late=clear_late)
         board.run(3)
     core = board.core
     return (history.events, core.cycles, core.instructions, core.registers(), core.read_bytes(*core.ram),
@@ -209,7 +237,8 @@ def _check(history: History, board: Board) -> None:
     """The architecture's rule over a history: EXTI0 is tail-chained at its return iff its /IRQ fall (timed at its
     bus event, MCU-44) came at or before the return's first cycle, and then starts 6 (Cortex-M3) or 16 (Cortex-M0)
     cycles after it; an entry from thread mode follows a fall after the last return began; the latency reported is
-    the longest fall to first instruction."""
+    the longest fall to first instruction; a fall not yet served at the end has its handler running or pending (none
+    is lost: late_irq clears PR before /IRQ can fall again)."""
     chain = board.core.cpu.tail_chain_cycles
     last: int | None = None  # the first cycle of the last return that unstacked
     for event in history.events:
@@ -222,3 +251,5 @@ def _check(history: History, board: Board) -> None:
             assert event.fell is None or last is None or event.fell > last, (event, last)
     latencies = [(entry.cycles - entry.fell) / board.core.cpu_hz for entry in history.entries if entry.fell is not None]
     assert board.irq_latency_s == max([history.latency_s, *latencies])
+    core = board.core  # no fall lost: one not yet served has its handler running or pending
+    assert board._irq_fell is None or EXTI0 in core.active or EXTI0 in core.pending
