@@ -3,9 +3,9 @@
 Issue #13's case (``bench_mcu.py``'s: ``digital_io`` on the Cortex-M3 at 2 Mbit/s, SPI1 at 3 MHz, non-strict) or the
 500 kbit/s one, ``--cycles`` master cycles after power-up (``bench_mcu._board``). ``--calls`` (default): cProfile's
 call counts, each function's count and its count per step of the run loop (``Board._step``), the most called first
-(MCU-79). ``--chain``: how many EXTI0 entries follow at once an exception return whose /IRQ fall came before the
-return began, that is entries the core would tail-chain (MCU-80). Both counts are deterministic. Run from the
-repository root:
+(MCU-79). ``--chain``: how many EXTI0 entries are tail-chained at a return (MCU-81), how many follow at once an
+exception return whose /IRQ fall came before the return began, that is entries the core would tail-chain (MCU-80's
+finding, before MCU-81), and the /IRQ latency reported. Both counts are deterministic. Run from the repository root:
 
     python bench/bench_steps.py [--rate 2000000|500000] [--cycles N] [--calls [--top N] | --chain]
 """
@@ -43,22 +43,32 @@ def calls(board: Board, cycles: int, top: int) -> None:
 
 
 def chain(board: Board, cycles: int) -> None:
-    """Print how many EXTI0 entries follow at once a return whose /IRQ fall came before the return began."""
+    """Print how EXTI0 is entered: tail-chained at a return (MCU-81), at once after a return whose /IRQ fall came
+    before the return began (the entries the core would tail-chain: MCU-80's finding), or otherwise; and the
+    longest /IRQ latency the run reports."""
     core = board.core
     returned: list[tuple[int, int] | None] = [None]  # the last return's first and last cycle, back to thread mode
+    in_return = [False]
     exception_return, entered = core.exception_return, core.entered
-    counts = {"tail-chain": 0, "other": 0}
+    counts = {"tail-chained": 0, "re-entered": 0, "other": 0}
     early: list[int] = []
 
     def on_return(exc_return: int) -> None:
         start = core.cycles
-        exception_return(exc_return)
+        in_return[0] = True
+        try:
+            exception_return(exc_return)
+        finally:
+            in_return[0] = False
         returned[0] = None if core.active else (start, core.cycles)
 
     def on_entered(number: int) -> None:
         fell, last = board._irq_fell, returned[0]
-        if last is not None and fell is not None and fell <= last[0] and core.cycles - core.cpu.entry_cycles == last[1]:
-            counts["tail-chain"] += 1
+        if in_return[0]:
+            counts["tail-chained"] += 1
+        elif last is not None and fell is not None and fell <= last[0] and \
+                core.cycles - core.cpu.entry_cycles == last[1]:  # fmt: skip
+            counts["re-entered"] += 1
             early.append(last[0] - fell)
         else:
             counts["other"] += 1
@@ -68,9 +78,9 @@ def chain(board: Board, cycles: int) -> None:
     core.exception_return = on_return  # type: ignore[method-assign]
     core.entered = on_entered
     board.run(cycles)
-    print(f"EXTI0 entries right after a return with /IRQ fallen before it: {counts['tail-chain']} of "
-          f"{sum(counts.values())}; the fall {min(early, default=0)} to {max(early, default=0)} cycles before the "
-          "return")  # fmt: skip
+    print(f"EXTI0 entries: {counts['tail-chained']} tail-chained at a return, {counts['re-entered']} right after a "
+          f"return with /IRQ fallen before it (the fall {min(early, default=0)} to {max(early, default=0)} cycles "
+          f"before the return), {counts['other']} other; /IRQ latency {board.irq_latency_s * 1e6:.3f} us")
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -415,6 +415,7 @@ class Board:
             held = core.mmio(SPI1_BASE, PERIPHERAL_SIZE, self.spi.read, self.spi.write)
         self.spi.holder = self.spi.offer = held  # SR held (MCU-25), DR's read after its byte (MCU-26)
         core.entered = self._entered
+        core.returning = self._returning
         self.fw_board = FwBoard(core) if "fw_board" in core.image.symbols else None
         self.interrupts = 0
         self.irq_latency_s = 0.0
@@ -611,12 +612,34 @@ class Board:
             self._request()
 
     def _request(self) -> None:
-        """If EXTI0 requests its interrupt: pend it unless it is active or pending, and stop the run for it (the
-        core's lists asked first: inside the handler no question to EXTI, MCU-79)."""
-        core = self.core
-        if _EXTI0 not in core.active and _EXTI0 not in core.pending and self.exti.requesting(0):
+        """The NVIC's look at EXTI0's line (PR AND IMR) after a change: pend EXTI0 if the line is asserted while it
+        is not active, and stop the run for it; while it is active, pend it only if the line rose since the last
+        look (MCU-81: the Cortex-M3 NVIC pends at a rising edge even while active; a line held from before the entry
+        pends nothing), without a stop, since the interrupt waits for the handler's return, which stops the run
+        anyway (MCU-44, MCU-70). The core's lists asked first: inside the handler no question to EXTI (MCU-79)."""
+        core, exti = self.core, self.exti
+        rose, exti.rose = exti.rose, 0
+        if _EXTI0 in core.pending:
+            return
+        if _EXTI0 in core.active:
+            if rose & 1:
+                core.pend(_EXTI0)
+        elif exti.requesting(0):
             core.pend(_EXTI0)
             core.stop_request = True
+
+    def _returning(self, number: int) -> None:
+        """:attr:`CortexM.returning`: the bus run up to the return's first cycle (an /IRQ fall inside the handler
+        that no access has seen yet pends EXTI0 now, MCU-44's bound), then, for EXTI0's own return, the NVIC samples
+        its line: asserted, EXTI0 is pending again, and the return tail-chains into it (MCU-81, MCU-20)."""
+        core = self.core
+        ring = self._ring
+        if ring is None:
+            self._sync(core.cycles)
+        else:
+            ring.sync_to_core(core.cycles)
+        if number == _EXTI0 and self.exti.requesting(0):
+            core.pend(_EXTI0)
 
     def _exti_read(self, offset: int, size: int) -> int:
         """The firmware reads EXTI: at transaction level the bus runs up to the access first, so PR holds every edge

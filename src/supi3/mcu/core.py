@@ -880,6 +880,9 @@ class CortexM:
         self.error: BaseException | None = None
         self.entered: Callable[[int], None] = _nothing
         """Called with the exception number after each exception entry (the board measures latency)."""
+        self.returning: Callable[[int], None] = _nothing
+        """Called with the returning exception's number at each exception return, before the tail-chain is decided
+        (MCU-81: the board runs the bus up to the return and lets the NVIC sample EXTI0's line)."""
         self._costs: dict[tuple[int, int], tuple[int, int]] = {}  # the cost of a block's first instructions
         self._running = False
         self._held: list[hook.Held] = []  # the peripherals' held registers (MCU-25)
@@ -1328,6 +1331,7 @@ class CortexM:
             nesting = f"{len(self.active)} active exception(s)"
             reason = f"EXC_RETURN {exc_return:08X}h does not match the nesting of {nesting}: INVPC UsageFault (B1.5.8)"
             raise FirmwareFaultError(self.report(Stop.FAULT, reason))
+        self.returning(self.active[-1])  # MCU-81: what is pending at the return's first cycle
         if self.pending:  # else nothing to chain (MCU-79: the run loop's common return, no question asked)
             returning = self.active.pop()
             chained = self._takeable()

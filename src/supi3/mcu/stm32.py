@@ -237,6 +237,10 @@ class Gpio:
 class Exti:
     """AFIO's EXTICR1 and the EXTI controller for lines 0..3 (RM0008 9.4.3, 10.3): an edge on a selected pin sets
     PR if its trigger is enabled; a line's interrupt request is PR AND IMR, held until PR is cleared by writing 1.
+
+    :attr:`rose` notes the lines whose request went from low to high (an edge, a SWIER write or an IMR write), for
+    the NVIC, which pends an interrupt at a rising edge of its line even while it is active (MCU-81); the board
+    takes and clears it after each change.
     """
 
     def __init__(self, rcc: Rcc) -> None:
@@ -247,6 +251,7 @@ class Exti:
         self.rtsr = 0
         self.ftsr = 0
         self.pr = 0
+        self.rose = 0
         rcc.on_reset.append(self._reset)
 
     def _reset(self, apb2rstr: int) -> None:
@@ -258,7 +263,9 @@ class Exti:
     def edge(self, port: int, pin: int, level: int) -> None:
         """Pin ``pin`` of port ``port`` (0 = A) went to ``level``."""
         if self.triggers(port, pin, level):
-            self.pr |= 1 << pin
+            bit = 1 << pin
+            self.rose |= bit & self.imr & ~self.pr
+            self.pr |= bit
 
     def triggers(self, port: int, pin: int, level: int) -> bool:
         """Whether pin ``pin`` of port ``port`` going to ``level`` sets its line's pending bit: the line selects that
@@ -293,6 +300,7 @@ class Exti:
         """IMR, EMR, RTSR, FTSR, SWIER (sets PR), PR (write 1 to clear)."""
         del size
         if offset == 0x0:
+            self.rose |= value & ~self.imr & self.pr
             self.imr = value
         elif offset == 0x4:
             self.emr = value
@@ -301,6 +309,7 @@ class Exti:
         elif offset == 0xC:
             self.ftsr = value
         elif offset == 0x10:
+            self.rose |= value & self.imr & ~self.pr
             self.pr |= value & self.imr
         elif offset == EXTI_PR:
             self.pr &= ~value
