@@ -12,9 +12,11 @@ the machine is shared), each after power-up:
   the bench's events, no byte.
 
 Printed: each run's simulated / CPU time and the bench side's share of ``host2M``'s CPU time (the fastest runs).
-Run from the repository root::
+``--opcodes``: in place of CPU time, each case's Python calls and opcodes a master cycle (``sys.settrace``, over
+``--cycles`` cycles: deterministic, the machine's load does not move them) and the functions that run the most
+opcodes. Run from the repository root::
 
-    python bench/bench_split.py [--cycles N] [--rounds R]
+    python bench/bench_split.py [--cycles N] [--rounds R] [--opcodes]
 """
 
 from __future__ import annotations
@@ -22,7 +24,11 @@ from __future__ import annotations
 import argparse
 import gc
 import os
+import sys
 import time
+from collections import Counter
+from types import FrameType
+from typing import Any
 
 from supi3.sdk import native
 from supi3.sdk.bench import Bench, Firmware
@@ -65,16 +71,54 @@ def run(firmware: Firmware, cycles: int) -> tuple[float, float, int]:
     return time.process_time() - cpu, bench.now - start, bench.interrupts - interrupts
 
 
+def count(firmware: Firmware, cycles: int) -> tuple[Counter[str], Counter[str]]:
+    """Python calls and opcodes by function (``file:name``, the file from ``supi3/`` on) of ``cycles`` master cycles
+    after power-up."""
+    bench = Bench(firmware=firmware, bit_rate=BIT_RATE)
+    if isinstance(firmware, QuietIsr):
+        firmware.bench = bench
+    bench.run(POWER_UP)
+    calls: Counter[str] = Counter()
+    opcodes: Counter[str] = Counter()
+
+    def trace(frame: FrameType, event: str, _: Any) -> Any:
+        where = f"{frame.f_code.co_filename.rpartition('/src/')[2]}:{frame.f_code.co_name}"
+        if event == "call":
+            calls[where] += 1
+            frame.f_trace_opcodes = True
+        elif event == "opcode":
+            opcodes[where] += 1
+        return trace
+
+    sys.settrace(trace)
+    try:
+        bench.run(cycles)
+    finally:
+        sys.settrace(None)
+    return calls, opcodes
+
+
 def main(argv: list[str] | None = None) -> None:
     """Measure and print."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cycles", type=int, default=2000, help="master cycles measured after power-up")
     parser.add_argument("--rounds", type=int, default=3, help="runs of each case, interleaved")
+    parser.add_argument("--opcodes", action="store_true", help="count Python calls and opcodes a cycle in place of "
+                        "CPU time (sys.settrace: slow, try --cycles 100)")  # fmt: skip
     args = parser.parse_args(argv)
     if args.cycles < 1 or args.rounds < 1:
         parser.error("--cycles and --rounds must be at least 1")
-    print(f"reproduce: python bench/bench_split.py --cycles {args.cycles} --rounds {args.rounds}")
+    print(f"reproduce: python bench/bench_split.py --cycles {args.cycles} --rounds {args.rounds}"
+          + " --opcodes" * args.opcodes)  # fmt: skip
     host = native.CFirmware(native.example("digital_io"))
+    if args.opcodes:
+        for case, firmware in (("host2M", host), ("bench side", QuietIsr())):
+            calls, opcodes = count(firmware, args.cycles)
+            print(f"{case}: {calls.total() / args.cycles:.1f} Python calls and {opcodes.total() / args.cycles:.0f} "
+                  "opcodes a master cycle; the most opcodes a cycle:")  # fmt: skip
+            for where, n in opcodes.most_common(12):
+                print(f"  {n / args.cycles:7.1f} opcodes, {calls[where] / args.cycles:5.1f} calls  {where}")
+        return
     results: dict[str, list[tuple[float, float, int]]] = {"host2M": [], "bench side": []}
     for _ in range(args.rounds):
         results["host2M"].append(run(host, args.cycles))
