@@ -58,12 +58,18 @@ class QuietIsr(DigitalIo):
             bench.advance(bench.now + STEP_S)
 
 
-def run(firmware: Firmware, cycles: int) -> tuple[float, float, int]:
-    """CPU seconds, simulated seconds and service routines of ``cycles`` master cycles after power-up."""
+def powered(firmware: Firmware) -> Bench:
+    """The bench of a case at 2 Mbit/s back to back, with ``firmware``, after power-up."""
     bench = Bench(firmware=firmware, bit_rate=BIT_RATE)
     if isinstance(firmware, QuietIsr):
         firmware.bench = bench
     bench.run(POWER_UP)
+    return bench
+
+
+def run(firmware: Firmware, cycles: int) -> tuple[float, float, int]:
+    """CPU seconds, simulated seconds and service routines of ``cycles`` master cycles after power-up."""
+    bench = powered(firmware)
     start, interrupts = bench.now, bench.interrupts
     gc.collect()
     cpu = time.process_time()
@@ -74,10 +80,7 @@ def run(firmware: Firmware, cycles: int) -> tuple[float, float, int]:
 def count(firmware: Firmware, cycles: int) -> tuple[Counter[str], Counter[str]]:
     """Python calls and opcodes by function (``file:name``, the file from ``supi3/`` on) of ``cycles`` master cycles
     after power-up."""
-    bench = Bench(firmware=firmware, bit_rate=BIT_RATE)
-    if isinstance(firmware, QuietIsr):
-        firmware.bench = bench
-    bench.run(POWER_UP)
+    bench = powered(firmware)
     calls: Counter[str] = Counter()
     opcodes: Counter[str] = Counter()
 
