@@ -14,7 +14,8 @@ the machine is shared), each after power-up:
 Printed: each run's simulated / CPU time and the bench side's share of ``host2M``'s CPU time (the fastest runs).
 ``--opcodes``: in place of CPU time, each case's Python calls and opcodes a master cycle (``sys.settrace``, over
 ``--cycles`` cycles: deterministic, the machine's load does not move them) and the functions that run the most
-opcodes. Run from the repository root::
+opcodes; also for issue #13's case (``bench_side.py``'s ``issue13``: the binary on the emulated board), whose emulated
+core's native work the count does not see. Run from the repository root::
 
     python bench/bench_split.py [--cycles N] [--rounds R] [--opcodes]
 """
@@ -25,11 +26,16 @@ import argparse
 import gc
 import os
 import sys
+import tempfile
 import time
 from collections import Counter
+from collections.abc import Callable
+from pathlib import Path
 from types import FrameType
 from typing import Any
 
+from supi3.mcu.board import Board
+from supi3.mcu.build import build
 from supi3.sdk import native
 from supi3.sdk.bench import Bench, Firmware
 from supi3.sdk.driver import Supi3Driver
@@ -77,10 +83,23 @@ def run(firmware: Firmware, cycles: int) -> tuple[float, float, int]:
     return time.process_time() - cpu, bench.now - start, bench.interrupts - interrupts
 
 
-def count(firmware: Firmware, cycles: int) -> tuple[Counter[str], Counter[str]]:
-    """Python calls and opcodes by function (``file:name``, the file from ``supi3/`` on) of ``cycles`` master cycles
-    after power-up."""
-    bench = powered(firmware)
+def board(folder: Path) -> Board:
+    """Issue #13's case (``bench_side.py``'s ``issue13``): ``digital_io.c`` built in ``folder`` for the emulated
+    Cortex-M3, SPI1 at 3 MHz, on the board after power-up, its DWARF tables read."""
+    elf = build(native.example("digital_io"), folder / "dio_2M.elf", defines={"BOARD_SPI_BR": "3u"})
+    emulated = Board(elf, bit_rate=BIT_RATE, strict=False)
+    emulated.run(POWER_UP)
+    emulated.bench.master.set_outputs(1, b"\x12\x34")
+    terminals = emulated.fw_board
+    assert terminals is not None  # the example's image has its fw_board
+    terminals.inputs = b"\xab\xcd"
+    _ = emulated.core.image.line_at(0)
+    return emulated
+
+
+def count(run_cycles: Callable[[int], object], cycles: int) -> tuple[Counter[str], Counter[str]]:
+    """Python calls and opcodes by function (``file:name``, the file from ``supi3/`` on) of ``run_cycles(cycles)``:
+    a powered bench's or board's ``run``."""
     calls: Counter[str] = Counter()
     opcodes: Counter[str] = Counter()
 
@@ -95,7 +114,7 @@ def count(firmware: Firmware, cycles: int) -> tuple[Counter[str], Counter[str]]:
 
     sys.settrace(trace)
     try:
-        bench.run(cycles)
+        run_cycles(cycles)
     finally:
         sys.settrace(None)
     return calls, opcodes
@@ -115,12 +134,19 @@ def main(argv: list[str] | None = None) -> None:
           + " --opcodes" * args.opcodes)  # fmt: skip
     host = native.CFirmware(native.example("digital_io"))
     if args.opcodes:
-        for case, firmware in (("host2M", host), ("bench side", QuietIsr())):
-            calls, opcodes = count(firmware, args.cycles)
+        with tempfile.TemporaryDirectory() as folder:
+            runs = [("host2M", powered(host).run), ("bench side", powered(QuietIsr()).run),
+                    ("issue13 (the emulated core's own work not counted)", board(Path(folder)).run)]  # fmt: skip
+            counts = [(case, *count(run_cycles, args.cycles)) for case, run_cycles in runs]
+        for case, calls, opcodes in counts:
             print(f"{case}: {calls.total() / args.cycles:.1f} Python calls and {opcodes.total() / args.cycles:.0f} "
                   "opcodes a master cycle; the most opcodes a cycle:")  # fmt: skip
             for where, n in opcodes.most_common(12):
                 print(f"  {n / args.cycles:7.1f} opcodes, {calls[where] / args.cycles:5.1f} calls  {where}")
+            files: Counter[str] = Counter()
+            for where, n in opcodes.items():
+                files[where.rpartition(":")[0]] += n
+            print("  by file: " + ", ".join(f"{name} {n / args.cycles:.0f}" for name, n in files.most_common(8)))
         return
     results: dict[str, list[tuple[float, float, int]]] = {"host2M": [], "bench side": []}
     for _ in range(args.rounds):
@@ -129,8 +155,8 @@ def main(argv: list[str] | None = None) -> None:
     load = ", ".join(f"{value:.1f}" for value in os.getloadavg())
     print(f"load {load} (1, 5, 15 min) on {os.cpu_count()} CPUs; {args.cycles} cycles, fastest of {args.rounds}")
     fastest = {}
-    for case, runs in results.items():
-        cpu, simulated, interrupts = min(runs)
+    for case, measured in results.items():
+        cpu, simulated, interrupts = min(measured)
         fastest[case] = cpu
         print(f"{case:10}: {simulated / cpu:.3f}x real time ({cpu * 1e3:.1f} ms CPU for {simulated * 1e3:.2f} ms, "
               f"{interrupts} service routines)")  # fmt: skip

@@ -43,7 +43,7 @@ def test_the_bench_side_runs_the_host_builds_cycles_without_a_byte() -> None:
     assert quiet == host and len(host) == 23
     assert [bench.results[-1] for bench in benches] == [benches[0].results[-1]] * 2
     assert [bench.interrupts - n for bench, n in zip(benches, before, strict=True)] == [20, 20]  # one a cycle
-    calls, opcodes = split.count(split.QuietIsr(), 5)
+    calls, opcodes = split.count(split.powered(split.QuietIsr()).run, 5)
     assert not any("upif.py" in where or "transports.py" in where for where in calls)  # no byte clocked
     assert calls["supi3/model/chip.py:latch_at"] == 5  # one latch of the chip a master cycle
     assert opcodes.total() > calls.total() > 0
