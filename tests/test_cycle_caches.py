@@ -29,7 +29,7 @@ from supi3.interbus import wire
 from supi3.interbus.device import PlainDevice
 from supi3.interbus.link import DataKernel, Device
 from supi3.interbus.master import Master
-from supi3.interbus.ring import Ring, _Groups, _Opens
+from supi3.interbus.ring import Ring, Transfer, _Groups
 from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3
 from supi3.model.registers import RegisterArgumentError, RegisterFile, event_mask
@@ -277,9 +277,9 @@ class _General(Ring):
 class _Replanned(Ring):
     """A ring that takes the plain path with its plan worked out anew at every data cycle (the plan emptied first)."""
 
-    def _plain_plan(self) -> tuple[list[Device], _Groups, DataKernel | None, int, _Opens]:
+    def _plain(self, data: bytes, now: float) -> Transfer:
         self._plan = ([], [], None, 0, [])
-        return super()._plain_plan()
+        return super()._plain(data, now)
 
 
 def _plain_step(ring: Ring, master: Master, op: tuple[str, int, int]) -> object:

@@ -491,6 +491,9 @@ _FLAGS: Final = {(a, e): wire.CntrFlags(a, e) for a in (False, True) for e in (F
 """The CNTR flags by (attention, error): immutable, so one object each serves every cycle."""
 
 
+_DATA: Final = Cycle.DATA
+_INF: Final = math.inf
+"""A31: the plain data cycle's tests (:meth:`Ring.transfer`, :meth:`Ring.finish`) without an attribute lookup each."""
 _new_tuple: Final = tuple.__new__
 """A named tuple made from all its fields in order, as its class's own ``__new__`` does, without that Python call
 (A29: a :class:`_Run` a data cycle)."""
@@ -1386,7 +1389,7 @@ class Ring:
         now = self.now
         if not now <= wire.MAX_BUS_TIME_S:  # NaN too: the condition of check_bus_time, which raises
             wire.check_bus_time("cycle", cycle, now)
-        if (self._PLAIN and cycle is Cycle.DATA and close_after is None and type(now) is float and now >= 0.0
+        if (self._PLAIN and cycle is _DATA and close_after is None and type(now) is float and now >= 0.0
                 and not (self._branches or self._faults or self._unanswered or self._wakes or self._late
                          or self.record)):  # fmt: skip
             return self._plain(data, now)
@@ -1529,7 +1532,8 @@ class Ring:
         (:meth:`_plain_plan`)."""
         if self.trace:  # record was on before (the general path empties it every cycle)
             self.trace = []
-        run, groups, kernel, repeaters, opens = self._plain_plan()
+        plan = self._plan  # A29's plan, worked out again only when the ring's devices differ (A31: no call else)
+        run, groups, kernel, repeaters, opens = plan if self.devices == plan[0] else self._plain_plan()
         if kernel is not None:
             registers, attention = kernel.load(run, now)
         else:
@@ -1541,7 +1545,7 @@ class Ring:
         else:
             received, returned, _ = self._shift(registers, data)
         n = len(run)
-        self._pending = Transfer(Cycle.DATA, data, n, returned, _FLAGS[attention, False], None,
+        self._pending = Transfer(_DATA, data, n, returned, _FLAGS[attention, False], None,
                                  [_new_tuple(_Run, (run, received, True, False, groups, kernel))], n, [], False,
                                  repeaters)  # fmt: skip
         return self._pending
@@ -1583,7 +1587,7 @@ class Ring:
         start = self.now
         end = start + bits / self.bit_rate
         cycle = transfer.cycle
-        kernels = cycle is Cycle.DATA and type(end) is float and 0.0 <= end < math.inf
+        kernels = cycle is _DATA and type(end) is float and 0.0 <= end < _INF
         if transfer.branches:  # before the latch telegrams, as a BK's closure at its frame's end (BK-50)
             frame = wire.frame_bits(len(transfer.sent))
             for terminal, traffic, count in transfer.branches:

@@ -1167,13 +1167,15 @@ class Supi3:
             self._expire(clk)
         if cycle is Cycle.ID:
             return wire.word_bytes(self.id_register())
-        if self.registers is not None:
-            _, expansion, size = self._data_path()
+        registers = self.registers
+        if registers is not None:
+            path = self._path  # _data_path's cache, read without the call while it is current (M34)
+            _, expansion, size = path if path[0] == registers.configurations else self._data_path()
             self.constant_output = None  # RX-13: the frame shifts through, unless the open expansion says otherwise
             if expansion:
                 data = self._expansion_load(clk)
             elif size:
-                data = self.registers.in_bytes()
+                data = registers.in_bytes()
             else:
                 data = b""
             self._frame_bytes = len(data)
@@ -1200,7 +1202,12 @@ class Supi3:
         if type(clk) is not int or clk < 0:
             clk = _clock(clk)
         # µP modes: the data path and length once (SET does not change within a latch)
-        path = self._data_path() if cycle is _DATA and self._fixed_bytes is None else None
+        registers = self.registers
+        path = None
+        if cycle is _DATA and registers is not None:  # µP modes (the only ones whose _fixed_bytes is None)
+            path = self._path  # _data_path's cache, read without the call while it is current (M34)
+            if path[0] != registers.configurations:
+                path = self._data_path()
         length = _WORD_BYTES if cycle is not _DATA else self._fixed_bytes if path is None else path[2]
         if type(received) is not bytes or len(received) != length:
             if cycle is _DATA and type(received) is bytes and len(received) == self._frame_bytes:
@@ -1218,14 +1225,13 @@ class Supi3:
             self._expire(clk)
         if self._optical_until != _NEVER or self._optical_held:  # optical block: held in reset, no latch (OPT-20)
             return
-        events = self._events
-        if cycle is Cycle.DATA:
+        if cycle is _DATA:
             self.bus_active = True
             if self.watchdog_code is not None:
                 timeout = WATCHDOG_CLOCKS[self.watchdog_code]
                 self._deadline = None if timeout is None else time_base_end(clk + 1, timeout)
                 self._reschedule()
-            if self.registers is None:
+            if registers is None:
                 self._out = received
                 self._fast_valid += 1
                 if self.spi_sequences is not None:
@@ -1235,11 +1241,12 @@ class Supi3:
             if path[1]:  # the expansion
                 self._expansion_end(clk, received)
             elif received:
-                self.registers.latch(received)
-            self.registers.set_bus_running(True)
+                registers.latch(received)
+            registers.set_bus_running(True)
             self._fast_valid += 1  # M33: VALID, PCP_RX and PCP_TX counted at once (Supi3.events merges them)
-            self.registers.raise_events(_VALID_EVENTS)
+            registers.raise_events(_VALID_EVENTS)
             return
+        events = self._events
         command = wire.decode_command_word(wire.word_from_bytes(received))
         if command.watchdog_code is not None:
             self.watchdog_code = command.watchdog_code

@@ -518,7 +518,7 @@ class BenchTransport(ModelTransport):
         bench = self.bench
         if bench._next_at <= bench.now:  # a bus event due now (else advance(now) would only compare)
             bench.advance(bench.now)
-        driven = super().xfer(tx, s_r)
+        driven = ModelTransport.xfer(self, tx, s_r)  # FW-28: not super(), which makes an object a byte
         bench.bytes_clocked += 1
         if not bench._irq_level:  # FW-18: a byte may release /IRQ (a read of IRQ_EVT), never pull it low
             bench.irq_edge()
@@ -527,7 +527,7 @@ class BenchTransport(ModelTransport):
     def _during_frame(self) -> None:
         bench = self.bench
         until = bench.now + bench.byte_s
-        if until < bench._next_at and until <= wire.MAX_BUS_TIME_S:  # advance's own shortcut: no bus event due
+        if until < bench._next_at and until <= _LAST_TIME:  # advance's own test (FW-28: its constant)
             bench.now = until
         else:
             bench.advance(until)
@@ -545,7 +545,7 @@ class BenchTransport(ModelTransport):
     def read_irq(self) -> int:
         """/IRQ, read in :attr:`Bench.pin_read_s` (FW-9)."""
         self.bench.advance(self.bench.now + self.bench.pin_read_s)
-        return super().read_irq()
+        return ModelTransport.read_irq(self)  # FW-28: a pin read or two a master cycle
 
     def read_io(self) -> int | None:
         """The I/O access bit, read in :attr:`Bench.pin_read_s`; ``None`` if the bench leaves the pin unwired

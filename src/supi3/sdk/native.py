@@ -247,7 +247,7 @@ class NativeLibrary:
             protocol = firmware._protocol
             phase = protocol.phase if protocol is not None else None
             try:
-                rx[0] = firmware._xfer_to(tx, bool(s_r))
+                rx[0] = firmware._xfer_to(tx, s_r != 0)  # FW-28: the C int as a bool without a builtin call
             except BaseException as error:
                 return firmware._fail(error, firmware._describe_byte(tx, phase))
             return 0
