@@ -791,7 +791,7 @@ _RINGS: Final[weakref.WeakValueDictionary[int, Ring]] = weakref.WeakValueDiction
 is its device's while the entry lives; the entry goes with the ring."""
 
 
-def _claim(ring: Ring, devices: list[Device]) -> None:
+def _claim(ring: Ring, devices: Sequence[object]) -> None:
     """RX-14: ``ring`` takes ``devices``, none of which another live ring holds: one device object is one device in
     one place, and two rings (two benches) running it would mix its state (its registers, clock and loads) in
     silence. A ring no longer reachable but not yet collected (a reference cycle) is collected first, once.

@@ -297,7 +297,7 @@ def check_cycle_time(cycle_time_s: object) -> float:
     ArgumentError
         ``cycle_time_s`` not a finite number from 0 to :data:`~supi3.interbus.wire.MAX_BUS_TIME_S`.
     """
-    return check_real("cycle_time_s", cycle_time_s, 0.0, wire.MAX_BUS_TIME_S, "A26: the bus time's maximum")
+    return check_real("cycle_time_s", cycle_time_s, 0.0, wire.MAX_BUS_TIME_S, limit="A26: the bus time's maximum")
 
 
 def check_run_seconds(seconds: object, now: float) -> float:
