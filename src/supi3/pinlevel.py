@@ -185,7 +185,7 @@ def recent_events(model: object) -> list[str]:
     Raises
     ------
     PinSpecError
-        ``recent_events()`` returned no sequence of lines (None, a number, one str: UP-47; a str was printed a
+        ``recent_events()`` returned no sequence of lines (None, a number, one str: UP-48; a str was printed a
         character a line, a number raised TypeError inside the mismatch report).
     """
     method = getattr(model, "recent_events", None)

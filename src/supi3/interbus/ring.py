@@ -787,12 +787,12 @@ def check_finish(transfer: object, pending: Transfer | None, latch: object) -> b
 
 
 _RINGS: Final[weakref.WeakValueDictionary[int, Ring]] = weakref.WeakValueDictionary()
-"""RX-14: ``id`` of each device a live :class:`Ring` holds -> that ring. The ring keeps its devices alive, so an ``id``
+"""UP-47: ``id`` of each device a live :class:`Ring` holds -> that ring. The ring keeps its devices alive, so an ``id``
 is its device's while the entry lives; the entry goes with the ring."""
 
 
 def _claim(ring: Ring, devices: Sequence[object]) -> None:
-    """RX-14: ``ring`` takes ``devices``, none of which another live ring holds: one device object is one device in
+    """UP-47: ``ring`` takes ``devices``, none of which another live ring holds: one device object is one device in
     one place, and two rings (two benches) running it would mix its state (its registers, clock and loads) in
     silence. A ring no longer reachable but not yet collected (a reference cycle) is collected first, once.
 
@@ -808,7 +808,7 @@ def _claim(ring: Ring, devices: Sequence[object]) -> None:
                 raise InterbusArgumentError(f"device at ring position {k}", device, f"device at ring position {k} "
                                             f"({type(device).__name__}) is in another live Ring already: one device "
                                             "object is one device in one ring (two rings would mix its state); "
-                                            "make a new device for this ring", "RX-14")  # fmt: skip
+                                            "make a new device for this ring", "UP-47")  # fmt: skip
     for device in devices:
         _RINGS[id(device)] = ring
 

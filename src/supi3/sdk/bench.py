@@ -946,12 +946,19 @@ class Bench:
         """MCU-55, FW-19: the master starts no cycle once :attr:`cycles` has reached ``cycles`` (a cycle under way
         ends), until :meth:`resume`: :meth:`run` and the emulated board's run hold it for their wait.
 
+        A hold the master is stopped at (a test's ``hold_after`` and a :meth:`run_for` that reached it) is resumed
+        first when ``cycles`` is above :attr:`cycles` (FW-30: the next run found the master's start at infinity and
+        set the clock there).
+
         Raises
         ------
         ArgumentError
             ``cycles`` not an integer from 0.
         """
-        self._hold = check_int("cycles", cycles, 0)
+        count = check_int("cycles", cycles, 0)
+        if self._held is not None and count > self.cycles:
+            self.resume()
+        self._hold = count
 
     def last_end(self, began: float) -> float:
         """MCU-55, FW-19: the bus time the last cycle of a run begun at ``began`` ended (``began`` if none has ended
