@@ -190,6 +190,17 @@ def test_bench_run_after_a_test_held_timed_run_runs_its_cycles() -> None:
     assert bench.now < 0.01
 
 
+def test_bench_last_end_of_a_run_begun_in_the_future_is_refused() -> None:
+    """Defect: ``Bench.last_end(1e300)`` answered 1e300: the end of a run's last cycle after the clock, from which the
+    run's wait (the board's too) would count. A run begins at or before the clock (UP-48)."""
+    bench = Bench()
+    bench.run(1)
+    with pytest.raises(ArgumentError, match=r"began must be a bus time up to the bench's clock"):
+        bench.last_end(bench.now + 1.0)
+    assert bench.last_end(bench.now) == bench.now
+    assert bench.last_end(0.0) == bench.timeline[-1].end
+
+
 BENCH_CALLS = st.lists(st.tuples(st.sampled_from(["run", "run_for", "hold", "resume", "advance", "bad_run",
                                                   "bad_run_for", "bad_hold", "bad_advance", "bad_last_end"]),
                                  st.integers(0, 0xFFFF)), min_size=1, max_size=25)  # fmt: skip
@@ -199,7 +210,7 @@ _BAD: dict[str, Callable[[Bench, int], object]] = {
     "bad_run_for": lambda bench, value: bench.run_for((-1e-3, math.nan, 1e30, "1")[value % 4]),  # type: ignore[arg-type]
     "bad_hold": lambda bench, value: bench.hold_after((-1, 2.0, None)[value % 3]),  # type: ignore[arg-type]
     "bad_advance": lambda bench, value: bench.advance((math.nan, math.inf, 2e6, "0")[value % 4]),  # type: ignore[arg-type]
-    "bad_last_end": lambda bench, value: bench.last_end((-1.0, math.nan)[value % 2]),
+    "bad_last_end": lambda bench, value: bench.last_end((-1.0, math.nan, bench.now + 1e-3)[value % 3]),
 }
 
 

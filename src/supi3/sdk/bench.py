@@ -967,9 +967,12 @@ class Bench:
         Raises
         ------
         ArgumentError
-            ``began`` not a finite number >= 0.
+            ``began`` not a finite number >= 0, or after :attr:`now` (UP-48: a run does not begin in the future; the
+            answer was that future time, from which a wait would count).
         """
         began = check_real("began", began, 0.0)
+        if began > self.now:
+            raise fail("began", f"a bus time up to the bench's clock, {self.now!r} s (a run begun by now)", began)
         if self._held is not None:
             return max(began, self._held[1])
         return max(began, self.timeline[-1].end) if self.timeline and self.timeline[-1].end <= self.now else began
