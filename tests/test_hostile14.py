@@ -458,3 +458,11 @@ def test_spidev_answer_that_is_no_byte_is_a_transport_error(answer: object) -> N
     finally:
         _FakeSpidev.answer = [0x00]
     assert not drv.initialized
+
+
+@pytest.mark.parametrize("level", [np.True_, np.False_])
+def test_spidev_pin_read_as_numpy_bool_is_a_level(level: object) -> None:
+    """Defect: a GPIO callable that reads its level from a numpy array gives ``np.True_``; ``pin_level`` (whose
+    docstring lets a bool and a numpy integer pass) refused it as "np.True_ (bool), not 0, 1 or None"."""
+    transport = SpidevTransport(0, 0, spidev_module=_FakeSpidev, read_cd=lambda: level)  # type: ignore[arg-type,return-value]
+    assert transport.read_cd() == int(bool(level))
