@@ -34,8 +34,9 @@ from supi3.mcu.pins import chip_clock, released
 from supi3.mcu.stm32 import Exti, Rcc, Spi
 from supi3.model.chip import Supi3
 from supi3.pinlevel import PinSpecError, recent_events
-from supi3.sdk.bench import Bench, bench_config, default_config
+from supi3.sdk.bench import Bench, BenchError, bench_config, default_config
 from supi3.sdk.driver import Mode, Supi3Driver, TransportError
+from supi3.sdk.examples.digital import DigitalIo
 from supi3.sdk.transports import SpidevTransport
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -199,6 +200,40 @@ def test_bench_last_end_of_a_run_begun_in_the_future_is_refused() -> None:
         bench.last_end(bench.now + 1.0)
     assert bench.last_end(bench.now) == bench.now
     assert bench.last_end(0.0) == bench.timeline[-1].end
+
+
+class _Resumes(DigitalIo):
+    """The digital I/O example whose service routine also controls the bench (``call``: resume or hold it)."""
+
+    def __init__(self, call: str) -> None:
+        super().__init__()
+        self.call = call
+        self.bench: Bench | None = None
+
+    def isr(self, drv: Supi3Driver) -> None:
+        super().isr(drv)
+        assert self.bench is not None
+        if self.call == "resume":
+            self.bench.resume()
+        else:
+            self.bench.hold_after(0)
+
+
+@pytest.mark.parametrize("call", ["resume", "hold_after"])
+def test_bench_hold_and_resume_from_the_firmware_are_refused(call: str) -> None:
+    """Defect: a service routine that called ``bench.resume()`` dropped the run's hold: ``run(2)`` ran 3 cycles and
+    ended not served, in silence (``run`` and ``run_for`` were already refused from inside the firmware, FW-19). Now a
+    :class:`BenchError` as for them (UP-48), and the run that raised leaves the master resumed."""
+    firmware = _Resumes(call)
+    bench = Bench(firmware=firmware)
+    firmware.bench = bench
+    with pytest.raises(BenchError, match=rf"Bench.{call}\(\) called from the firmware's isr\(\)"):
+        bench.run(3)
+    firmware.call, firmware.bench = call, None
+    firmware.isr = DigitalIo.isr.__get__(firmware)  # type: ignore[method-assign]
+    cycles, under_way = bench.cycles, bench.under_way
+    bench.run(2)
+    assert bench.cycles == cycles + under_way + 2
 
 
 BENCH_CALLS = st.lists(st.tuples(st.sampled_from(["run", "run_for", "hold", "resume", "advance", "bad_run",

@@ -934,9 +934,10 @@ class Bench:
         return bool(self.timeline) and self.timeline[-1].end > self.now
 
     def _outside_firmware(self, call: str) -> None:
-        """Refuse ``call`` (:meth:`run`, :meth:`run_for`) from inside the firmware's set-up, service routine or main
-        loop pass, which the bench itself runs: nested, the inner run's hold and resume broke the outer one's count
-        of cycles (FW-19), and a main loop that ran the bench recursed without end."""
+        """Refuse ``call`` (:meth:`run`, :meth:`run_for`, :meth:`hold_after`, :meth:`resume`) from inside the
+        firmware's set-up, service routine or main loop pass, which the bench itself runs: nested, the inner run's hold
+        and resume broke the outer one's count of cycles (FW-19), and a main loop that ran the bench recursed without
+        end."""
         inside = "isr" if self._in_isr else self._in_firmware
         if inside is not None:
             raise BenchError(f"Bench.{call}() called from the firmware's {inside}(), which the bench is running: the "
@@ -954,7 +955,10 @@ class Bench:
         ------
         ArgumentError
             ``cycles`` not an integer from 0.
+        BenchError
+            Called from the firmware's own code (:meth:`_outside_firmware`), as :meth:`resume`.
         """
+        self._outside_firmware("hold_after")
         count = check_int("cycles", cycles, 0)
         if self._held is not None and count > self.cycles:
             self.resume()
@@ -979,7 +983,15 @@ class Bench:
 
     def resume(self) -> None:
         """MCU-55, FW-19: the run ended: the master goes on, its next cycle at the end of the status telegram the
-        line idles in now, or on the cycle time's schedule if later (:func:`resume_s`)."""
+        line idles in now, or on the cycle time's schedule if later (:func:`resume_s`).
+
+        Raises
+        ------
+        BenchError
+            Called from the firmware's own code (:meth:`_outside_firmware`; UP-48: a service routine's ``resume()``
+            dropped the run's hold, and ``run(2)`` ran 3 cycles); nothing changes.
+        """
+        self._outside_firmware("resume")
         self._hold = math.inf
         held, self._held = self._held, None
         if held is not None:
