@@ -29,7 +29,6 @@ from supi3.interbus.device import PlainDevice
 from supi3.interbus.errors import InterbusArgumentError, InterbusError
 from supi3.interbus.master import Master
 from supi3.interbus.ring import Ring
-from supi3.mcu import build as mcu_build
 from supi3.mcu.pins import chip_clock, released
 from supi3.mcu.stm32 import Exti, Rcc, Spi
 from supi3.model.chip import Supi3
@@ -38,6 +37,7 @@ from supi3.sdk.bench import Bench, BenchError, bench_config, default_config
 from supi3.sdk.driver import Mode, Supi3Driver, TransportError
 from supi3.sdk.examples.digital import DigitalIo
 from supi3.sdk.transports import SpidevTransport
+from support import digital_io_elf
 
 # ---------------------------------------------------------------------------------------------------------------
 # The ring's devices (supi3.interbus.ring)
@@ -309,12 +309,7 @@ def test_history_bench_refused_calls_change_nothing_and_a_resumed_run_runs_its_c
 
 @pytest.fixture(scope="module")
 def digital_io(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    missing = mcu_build.toolchain_missing()
-    if missing is not None:
-        pytest.skip(missing)
-    from supi3.sdk import native
-
-    return mcu_build.build(native.example("digital_io"), tmp_path_factory.mktemp("hostile14") / "digital_io.elf")
+    return digital_io_elf(tmp_path_factory.mktemp("hostile14"))
 
 
 def test_board_pin_level_cycle_time_past_the_maximum_is_refused(digital_io: Path) -> None:
