@@ -722,6 +722,17 @@ def optical_script(config: DeviceConfig, ops: list[OpticalOp]) -> tuple[CoreScri
     return script, ends
 
 
+def digital_io_elf(folder: Path) -> Path:
+    """The digital 16/16 example built for the Cortex-M3 in ``folder``; skips the test when the toolchain is missing
+    (the firmware-in-the-loop tests' common fixture body)."""
+    from supi3.mcu import build as mcu_build
+
+    missing = mcu_build.toolchain_missing()
+    if missing is not None:
+        pytest.skip(missing)
+    return mcu_build.build(native.example("digital_io"), folder / "digital_io.elf")
+
+
 def digital_io_elves(folder: Path) -> dict[str, Path]:
     """The digital 16/16 example built for each core at the board port's SPI1 clock (keys: the CPUs), and for the
     Cortex-M3 with SPI1 at 3 MHz (key ``"br3"``: issue #13's bench case). Imported here on use: the emulated board's

@@ -30,10 +30,11 @@ from __future__ import annotations
 
 import numbers
 from collections import deque
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Final, Protocol, runtime_checkable
 
+from supi3.checks import describe
 from supi3.errors import Supi3Error
 
 SYNC_STAGES: Final = 2
@@ -180,9 +181,21 @@ def recent_events(model: object) -> list[str]:
     """The model's recent bus events, oldest first, or an empty list when it keeps none.
 
     A model opts in by defining ``recent_events() -> Sequence[str]``.
+
+    Raises
+    ------
+    PinSpecError
+        ``recent_events()`` returned no sequence of lines (None, a number, one str: UP-48; a str was printed a
+        character a line, a number raised TypeError inside the mismatch report).
     """
     method = getattr(model, "recent_events", None)
-    return [str(event) for event in method()] if callable(method) else []
+    if not callable(method):
+        return []
+    events = method()
+    if isinstance(events, str | bytes) or not isinstance(events, Iterable):
+        raise PinSpecError(f"{type(model).__name__}.recent_events() must return a sequence of str (the model's recent "
+                           f"bus events, oldest first), not {describe(events)}")  # fmt: skip
+    return [str(event) for event in events]
 
 
 def compared_signals(outputs: Sequence[Pin]) -> list[tuple[str, int, str | None]]:

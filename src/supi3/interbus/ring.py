@@ -37,7 +37,10 @@ send the counter telegram to the BK (2.2.2, ``wire.counter_telegram``).
 
 from __future__ import annotations
 
+import gc
 import math
+import numbers
+import weakref
 from collections.abc import Collection, Iterable, Sequence
 from dataclasses import dataclass, field
 from enum import Enum
@@ -45,7 +48,7 @@ from itertools import accumulate
 from operator import attrgetter, sub
 from typing import ClassVar, Final, NamedTuple, Protocol, cast, runtime_checkable
 
-from supi3.checks import check_bool, check_bytes, check_instance, check_int, check_real, fail
+from supi3.checks import check_bool, check_bytes, check_instance, check_int, check_real, describe, fail
 from supi3.config import DeviceConfig, Interface
 from supi3.interbus import wire
 from supi3.interbus.errors import InterbusArgumentError, InterbusError, TelegramError
@@ -595,8 +598,26 @@ def _opens(run: list[Device]) -> _Opens:
 
 def _levels(opens: _Opens) -> list[tuple[int, int]]:
     """After a data cycle's loads: (index, level) of each device of ``opens`` that sends a constant line this cycle
-    (its ``constant_output`` not ``None``, RX-13)."""
-    return [(k, level) for k, device in opens if (level := device.constant_output) is not None]
+    (its ``constant_output`` not ``None``, RX-13).
+
+    Raises
+    ------
+    InterbusError
+        A ``constant_output`` that is not 0, 1 or ``None`` (RX-14: a user's model said 5 or 'x', once taken as 1).
+    """
+    levels = [(k, level) for k, device in opens if (level := device.constant_output) is not None]
+    for k, level in levels:
+        if type(level) is not int or not 0 <= level <= 1:
+            _check_level(next(device for j, device in opens if j == k), level)
+    return levels
+
+
+def _check_level(device: Device, level: object) -> None:
+    """RX-14: ``level``, ``device``'s ``constant_output`` after a data cycle's load, must be a level (0 or 1; a bool
+    or a numpy integer passes): a model's 5 or 'x' was sent as 1 in silence."""
+    if not (isinstance(level, numbers.Integral) and level in (0, 1)):
+        raise InterbusError("RX-13", level, f"{type(device).__name__}.constant_output must be 0 or 1 after a data "
+                            f"cycle's load (None while the frame shifts through), not {describe(level)}")
 
 
 def _shift_open(registers: list[bytes], stream: bytes, levels: list[tuple[int, int]]) -> tuple[list[bytes], bytes, int]:
@@ -768,6 +789,33 @@ def check_finish(transfer: object, pending: Transfer | None, latch: object) -> b
     return latch if latch is True or latch is False else check_bool("latch", latch)
 
 
+_RINGS: Final[weakref.WeakValueDictionary[int, Ring]] = weakref.WeakValueDictionary()
+"""UP-47: ``id`` of each device a live :class:`Ring` holds -> that ring. The ring keeps its devices alive, so an ``id``
+is its device's while the entry lives; the entry goes with the ring."""
+
+
+def _claim(ring: Ring, devices: Sequence[object]) -> None:
+    """UP-47: ``ring`` takes ``devices``, none of which another live ring holds: one device object is one device in
+    one place, and two rings (two benches) running it would mix its state (its registers, clock and loads) in
+    silence. A ring no longer reachable but not yet collected (a reference cycle) is collected first, once.
+
+    Raises
+    ------
+    InterbusArgumentError
+        A device another live ring holds (nothing is taken).
+    """
+    if any(id(device) in _RINGS for device in devices):
+        gc.collect()  # only here: a dropped ring in a reference cycle (a bench) still holds its devices
+        for k, device in enumerate(devices, 1):
+            if id(device) in _RINGS:
+                raise InterbusArgumentError(f"device at ring position {k}", device, f"device at ring position {k} "
+                                            f"({type(device).__name__}) is in another live Ring already: one device "
+                                            "object is one device in one ring (two rings would mix its state); "
+                                            "make a new device for this ring", "UP-47")  # fmt: skip
+    for device in devices:
+        _RINGS[id(device)] = ring
+
+
 class Ring:
     """A master's ring of devices, at transaction level (docs/interbus.md, "Ring").
 
@@ -814,6 +862,7 @@ class Ring:
         if len({id(d) for d in every}) != len(every):
             raise InterbusArgumentError("devices", devices, "devices must be distinct objects (one device is one "
                                         "place in the ring), not the same object twice", "Tree")  # fmt: skip
+        _claim(self, every)
         self._tree: list[Device | Branch] = list(devices)
         self._branches = _branches(self._tree)
         self._terminals = {id(branch.terminal) for branch in self._branches}

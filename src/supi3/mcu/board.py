@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Final, TypeVar, cast
 
 from supi3 import timing
-from supi3.checks import check_bool, check_bytes, check_choice, check_instance, check_int, check_real, fail
+from supi3.checks import check_bool, check_bytes, check_choice, check_instance, check_int, fail
 from supi3.config import DeviceConfig
 from supi3.errors import Supi3Error
 from supi3.interbus import wire
@@ -83,6 +83,7 @@ from supi3.sdk.bench import (
     MasterStart,
     ServeWait,
     bench_config,
+    check_cycle_time,
     check_run_cycles,
     check_run_seconds,
     discovery_master,
@@ -458,7 +459,7 @@ class Board:
                 or not all(isinstance(other, PinChip | PinBranch) for other in others):  # fmt: skip
             raise fail("others", "pin-level chips at pin level (Supi3Pins or Supi3Chip objects, PinBranch trees: "
                        "MCU-23)", others)  # fmt: skip
-        self._cycle_time_s = None if cycle_time_s is None else check_real("cycle_time_s", cycle_time_s, 0.0)
+        self._cycle_time_s = None if cycle_time_s is None else check_cycle_time(cycle_time_s)
         self.chip = chip = Supi3Chip(self.config, strict=check_bool("strict", strict),
                                      pedantic=check_bool("pedantic", pedantic), stat_err_filter=stat_err_filter)
         if chip.upif is None or chip.chip.registers is None:
@@ -952,8 +953,10 @@ class Board:
         """
         # MCU-76: a cycle a run_for left under way (transaction level) ends first, then the run's own cycles start,
         # as at pin level, whose run_for runs it whole
-        target = (self.cycles + check_run_cycles(cycles, self.now, self.config.bit_rate)  # A26
+        cycle_time_s = self._cycle_time_s if self._bench is None else self._bench.cycle_time_s
+        target = (self.cycles + check_run_cycles(cycles, self.now, self.config.bit_rate, cycle_time_s)  # A26
                   + (self._bench is not None and self._bench.under_way))
+        check_int("max_instructions", max_instructions, 1)  # UP-48: refused before `served` and the hold change
         self._passes.end()
         self._serve_end = None
         self.served = False  # until the run ends served (MCU-30)

@@ -29,7 +29,7 @@ from typing import Final
 import numpy as np
 import numpy.typing as npt
 
-from supi3.checks import check_bits, check_bool, check_trace, fail
+from supi3.checks import check_bits, check_bool, check_choice, check_int, check_real, check_trace, fail
 from supi3.interbus import wire
 from supi3.mcu.core import Frame
 from supi3.mcu.stm32 import CR1_CPHA, CR1_CPOL, CR1_LSBFIRST
@@ -100,14 +100,36 @@ def ss_high_byte(tx: int) -> InterfaceViolationError:
 def chip_clock(cycles: int, cpu_hz: float) -> int:
     """The chip clocks run when a core of ``cpu_hz`` is at cycle ``cycles``: those that began at or before it (a read
     then sees the outputs of the clock running; a write acts from the next clock, MCU-15); a pin the board drives
-    from core cycle ``cycles`` changes at the chip's pins in this clock."""
+    from core cycle ``cycles`` changes at the chip's pins in this clock.
+
+    Raises
+    ------
+    ArgumentError
+        ``cycles`` not an integer from 0, or ``cpu_hz`` not a finite number above 0 (UP-48: 0 divided by zero, a
+        negative cycle gave clock 0, before the first).
+    """
+    if type(cycles) is not int or cycles < 0 or type(cpu_hz) is not float or not 0.0 < cpu_hz < math.inf:
+        check_int("cycles", cycles, 0)
+        if check_real("cpu_hz", cpu_hz, 0.0) == 0.0:
+            raise fail("cpu_hz", "a core clock above 0 Hz", cpu_hz)
     return math.floor(cycles * CLOCK_HZ / cpu_hz + 1e-9) + 1
 
 
 def released(word: int, bits: int, sampled: int, lsb_first: bool) -> int:
     """What SPI1 receives of ``word`` (``bits`` bits, as its data register holds them) when the chip drives MISO for
     the first ``sampled`` sampling edges only and releases it then (/SS rose, MCU-74): those bits of ``word``, and
-    MISO's pull-up (:data:`MISO_PULL_UP`, MCU-6) for the rest, as :meth:`LockstepRing.spi_byte` samples the pins."""
+    MISO's pull-up (:data:`MISO_PULL_UP`, MCU-6) for the rest, as :meth:`LockstepRing.spi_byte` samples the pins.
+
+    Raises
+    ------
+    ArgumentError
+        ``bits`` not 8 or 16 (DFF), ``word`` not of ``bits`` bits, ``sampled`` not 0 to ``bits``, ``lsb_first`` not a
+        bool (UP-48: 9 sampled edges of 8 raised a negative shift count, or gave -256 LSB first).
+    """
+    bits = check_choice("bits", bits, (8, 16))
+    check_bits("word", word, bits, "SPI1's data register (RM0008 25.3.3)")
+    check_int("sampled", sampled, 0, bits, "the transfer's sampling edges")
+    check_bool("lsb_first", lsb_first)
     late = (1 << bits) - (1 << sampled) if lsb_first else (1 << (bits - sampled)) - 1  # the bits sampled after
     return word | late  # MISO_PULL_UP: they read 1
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Final, Protocol
 
+from supi3.checks import check_int, fail
 from supi3.errors import Supi3Error
 
 __all__ = [
@@ -269,7 +270,19 @@ class Exti:
 
     def triggers(self, port: int, pin: int, level: int) -> bool:
         """Whether pin ``pin`` of port ``port`` going to ``level`` sets its line's pending bit: the line selects that
-        port (EXTICR1) and the edge's trigger is enabled (RTSR, FTSR)."""
+        port (EXTICR1) and the edge's trigger is enabled (RTSR, FTSR).
+
+        Raises
+        ------
+        ArgumentError
+            ``port`` not 0 to 6 (GPIOA to GPIOG, RM0008 9.4.3), ``pin`` not 0 to 15, ``level`` not 0 or 1 (UP-48:
+            pin -1 raised a negative shift count, level 2 counted as a rising edge).
+        """
+        if type(pin) is not int or not 0 <= pin <= 15 or type(port) is not int or not 0 <= port <= 6 \
+                or level not in (0, 1):  # fmt: skip
+            check_int("port", port, 0, 6, "GPIOA to GPIOG, RM0008 9.4.3")
+            check_int("pin", pin, 0, 15, "a port's 16 pins")
+            check_int("level", level, 0, 1)
         if pin >= 4 or (self.exticr1 >> (4 * pin)) & 0xF != port:
             return False
         return bool((self.rtsr if level else self.ftsr) >> pin & 1)
@@ -540,9 +553,19 @@ class Spi:
     def replace_received(self, word: int) -> None:
         """The other end changed the word the shifting transfer receives (the chip released MISO before its end,
         MCU-74): the transfer ends with ``word``, and SR's hold and DR's offered read (MCU-25, MCU-26) are made
-        again for it. The offered read starts at the transfer's end, so none can have been taken yet."""
+        again for it. The offered read starts at the transfer's end, so none can have been taken yet.
+
+        Raises
+        ------
+        ArgumentError
+            ``word`` not an integer of 16 bits at most, or no transaction-level transfer shifting (UP-48: an
+            ``assert``, gone under ``python -O``).
+        """
+        check_int("word", word, 0, 0xFFFF, "SPI1's data register, 8 or 16 bits")
         shifting = self.shifting
-        assert shifting is not None and type(shifting[0]) is int, "a transaction-level transfer must be shifting"
+        if shifting is None or type(shifting[0]) is not int:
+            raise fail("Spi.replace_received's transfer", "a transaction-level transfer shifting (SPI1 has none: "
+                       "nothing to replace)", shifting)  # fmt: skip
         self.shifting = (word, shifting[1], shifting[2])
         if self._holding:
             self.holder.release()

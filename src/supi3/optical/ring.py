@@ -265,8 +265,9 @@ class OpticalRing:
         if len(rates) != 1:
             raise fail("chips", "chips of one bit rate", sorted(rates))
         self.links: list[FibreLink | None] = list(links)
+        seed = check_int("seed", seed)  # before the ring takes the chips (UP-47: a refused ring takes none)
         self.ring = Ring(list(chips), bit_rate=rates.pop(), record=check_bool("record", record))
-        self._random = random.Random(check_int("seed", seed))
+        self._random = random.Random(seed)
         self.reports: list[MauReport] = []
         self.history: list[list[PathSample]] = [[] for _ in self.links]
         self._data_cycles = 0

@@ -56,6 +56,7 @@ __all__ = [
     "MasterStart",
     "ServeWait",
     "bench_config",
+    "check_cycle_time",
     "check_run_cycles",
     "check_run_seconds",
     "default_config",
@@ -269,11 +270,11 @@ def resume_s(since: float, scheduled: float, now: float, bit_rate: int) -> float
     return max(check_real("scheduled", scheduled, 0.0, finite=False), telegram_end_s(since, now, bit_rate))
 
 
-def check_run_cycles(cycles: object, now: float, bit_rate: int) -> int:
+def check_run_cycles(cycles: object, now: float, bit_rate: int, cycle_time_s: float | None = None) -> int:
     """A26: ``cycles``, the master cycles of a run from bus time ``now`` at ``bit_rate``, the one check of the firmware
     bench's :meth:`Bench.run` and the emulated board's run: an integer from 0, no more than fit before the bus
-    time's maximum (no cycle is shorter than the shortest of a one-device ring; a count too large for a float,
-    2**53 and more, is refused as that many).
+    time's maximum (no cycle is shorter than the shortest of a one-device ring, nor, on a ``cycle_time_s``
+    schedule, than the cycle time: UP-48; a count too large for a float, 2**53 and more, is refused as that many).
 
     Raises
     ------
@@ -281,9 +282,22 @@ def check_run_cycles(cycles: object, now: float, bit_rate: int) -> int:
         ``cycles`` not an integer from 0, or more than fit before :data:`~supi3.interbus.wire.MAX_BUS_TIME_S`.
     """
     count = check_int("cycles", cycles, 0)
-    shortest = wire.cycle_bits(0, 1) / wire.check_bit_rate(bit_rate)
+    shortest = max(wire.cycle_bits(0, 1) / wire.check_bit_rate(bit_rate), cycle_time_s or 0.0)
     wire.check_bus_time("cycles", cycles, now, min(count, 2**53) * shortest)
     return count
+
+
+def check_cycle_time(cycle_time_s: object) -> float:
+    """UP-48: a master's ``cycle_time_s`` on the firmware bench and the emulated board: a finite number of seconds from
+    0 to the bus time's maximum (A26; 1e30 was taken, and the second cycle's start then raised inside the ring with
+    the bench's clock already past the maximum).
+
+    Raises
+    ------
+    ArgumentError
+        ``cycle_time_s`` not a finite number from 0 to :data:`~supi3.interbus.wire.MAX_BUS_TIME_S`.
+    """
+    return check_real("cycle_time_s", cycle_time_s, 0.0, wire.MAX_BUS_TIME_S, limit="A26: the bus time's maximum")
 
 
 def check_run_seconds(seconds: object, now: float) -> float:
@@ -436,6 +450,8 @@ def bench_config(config: DeviceConfig | None, bit_rate: int | None) -> DeviceCon
     if config is None:
         return default_config(500_000 if bit_rate is None else bit_rate)
     check_instance("config", config, DeviceConfig)
+    if bit_rate is not None:
+        wire.check_bit_rate(bit_rate)  # UP-48: 500000.0 or True beside a config as without one (refused by name)
     if bit_rate is not None and bit_rate != config.bit_rate:
         raise DriverArgumentError("bit_rate", bit_rate, f"bit_rate {bit_rate!r} is not the config's {config.bit_rate} "
                                   "bit/s (its CLK_CONF straps the rate, Table 1-7): give one of them")  # fmt: skip
@@ -670,7 +686,7 @@ class Bench:
         self.byte_s = timing.upif_byte_s(self.config.bit_rate, sclk_hz)
         self.io_pin = check_bool("io_pin", io_pin)
         self.pin_read_s = check_real("pin_read_s", pin_read_s, 0.0, 1e-3)
-        self.cycle_time_s = None if cycle_time_s is None else check_real("cycle_time_s", cycle_time_s, 0.0)
+        self.cycle_time_s = None if cycle_time_s is None else check_cycle_time(cycle_time_s)
         self.transport = BenchTransport(self, self.chip)
         self.driver = Supi3Driver(self.transport, frame_gap_us=frame_gap_us)
         self._chips = [d for d in self.ring.devices if isinstance(d, Supi3) and d.registers is not None]
@@ -899,7 +915,8 @@ class Bench:
         """
         self._outside_firmware("run")
         # a cycle a run_for left under way ends first (MCU-76)
-        target = self.cycles + self.under_way + check_run_cycles(cycles, self.now, self.config.bit_rate)
+        target = self.cycles + self.under_way + check_run_cycles(cycles, self.now, self.config.bit_rate,
+                                                                 self.cycle_time_s)  # fmt: skip
         self.served = False  # until the run ends served (FW-14)
         began = self.now
         self.hold_after(target)
@@ -917,9 +934,10 @@ class Bench:
         return bool(self.timeline) and self.timeline[-1].end > self.now
 
     def _outside_firmware(self, call: str) -> None:
-        """Refuse ``call`` (:meth:`run`, :meth:`run_for`) from inside the firmware's set-up, service routine or main
-        loop pass, which the bench itself runs: nested, the inner run's hold and resume broke the outer one's count
-        of cycles (FW-19), and a main loop that ran the bench recursed without end."""
+        """Refuse ``call`` (:meth:`run`, :meth:`run_for`, :meth:`hold_after`, :meth:`resume`) from inside the
+        firmware's set-up, service routine or main loop pass, which the bench itself runs: nested, the inner run's hold
+        and resume broke the outer one's count of cycles (FW-19), and a main loop that ran the bench recursed without
+        end."""
         inside = "isr" if self._in_isr else self._in_firmware
         if inside is not None:
             raise BenchError(f"Bench.{call}() called from the firmware's {inside}(), which the bench is running: the "
@@ -929,12 +947,22 @@ class Bench:
         """MCU-55, FW-19: the master starts no cycle once :attr:`cycles` has reached ``cycles`` (a cycle under way
         ends), until :meth:`resume`: :meth:`run` and the emulated board's run hold it for their wait.
 
+        A hold the master is stopped at (a test's ``hold_after`` and a :meth:`run_for` that reached it) is resumed
+        first when ``cycles`` is above :attr:`cycles` (FW-30: the next run found the master's start at infinity and
+        set the clock there).
+
         Raises
         ------
         ArgumentError
             ``cycles`` not an integer from 0.
+        BenchError
+            Called from the firmware's own code (:meth:`_outside_firmware`), as :meth:`resume`.
         """
-        self._hold = check_int("cycles", cycles, 0)
+        self._outside_firmware("hold_after")
+        count = check_int("cycles", cycles, 0)
+        if self._held is not None and count > self.cycles:
+            self.resume()
+        self._hold = count
 
     def last_end(self, began: float) -> float:
         """MCU-55, FW-19: the bus time the last cycle of a run begun at ``began`` ended (``began`` if none has ended
@@ -943,16 +971,27 @@ class Bench:
         Raises
         ------
         ArgumentError
-            ``began`` not a finite number >= 0.
+            ``began`` not a finite number >= 0, or after :attr:`now` (UP-48: a run does not begin in the future; the
+            answer was that future time, from which a wait would count).
         """
         began = check_real("began", began, 0.0)
+        if began > self.now:
+            raise fail("began", f"a bus time up to the bench's clock, {self.now!r} s (a run begun by now)", began)
         if self._held is not None:
             return max(began, self._held[1])
         return max(began, self.timeline[-1].end) if self.timeline and self.timeline[-1].end <= self.now else began
 
     def resume(self) -> None:
         """MCU-55, FW-19: the run ended: the master goes on, its next cycle at the end of the status telegram the
-        line idles in now, or on the cycle time's schedule if later (:func:`resume_s`)."""
+        line idles in now, or on the cycle time's schedule if later (:func:`resume_s`).
+
+        Raises
+        ------
+        BenchError
+            Called from the firmware's own code (:meth:`_outside_firmware`; UP-48: a service routine's ``resume()``
+            dropped the run's hold, and ``run(2)`` ran 3 cycles); nothing changes.
+        """
+        self._outside_firmware("resume")
         self._hold = math.inf
         held, self._held = self._held, None
         if held is not None:

@@ -22,6 +22,8 @@ from dataclasses import dataclass
 from enum import IntEnum, IntFlag
 from typing import Any, Final, Protocol, TypeVar
 
+import numpy as np
+
 from supi3.checks import check_bool, check_bytes, check_int, check_real, describe
 from supi3.errors import ArgumentError, Supi3Error
 from supi3.optical import length as _length
@@ -923,8 +925,8 @@ def pin_level(name: str, level: object) -> int | None:
     TransportError
         ``level`` anything else ('0', 2, 0.5): no pin reads it.
     """
-    if level is None or (isinstance(level, numbers.Integral) and level in (0, 1)):
-        return None if level is None else int(level)
+    if level is None or (isinstance(level, numbers.Integral | np.bool_) and level in (0, 1)):
+        return None if level is None else int(level)  # UP-48: numpy's bool too (a GPIO read from an array)
     raise TransportError(f"Transport.{name} returned {describe(level)}, not 0, 1 or None (the pin's level; None: "
                          "not wired)")  # fmt: skip
 

@@ -15,14 +15,23 @@ from __future__ import annotations
 import contextlib
 import importlib
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any, Final
 
 from supi3 import timing
 from supi3.checks import check_int, check_real, describe
 from supi3.model.chip import Supi3
 from supi3.model.registers import RegisterFile
-from supi3.sdk.driver import UNDRIVEN_BYTE, DirectAccess, DriverArgumentError, Mode, Transport, pin_level
+from supi3.sdk.driver import (
+    UNDRIVEN_BYTE,
+    DirectAccess,
+    DriverArgumentError,
+    Mode,
+    Transport,
+    TransportError,
+    pin_level,
+    received_byte,
+)
 from supi3.spi.upif import Phase, UpInterface
 from supi3.tables import BIT_RATES
 
@@ -176,8 +185,10 @@ class SpidevTransport(Transport):
         tx = check_int("tx", tx, 0, 0xFF, "one byte per frame, UP-7")
         if self._s_r is not None:
             self._s_r(int(s_r))
-        [rx] = self.spi.xfer([tx])
-        return int(rx)
+        answer = self.spi.xfer([tx])
+        if not isinstance(answer, Sequence) or len(answer) != 1:  # UP-48: a ValueError of the unpacking before
+            raise TransportError(f"spidev's xfer([{tx}]) returned {describe(answer)}, not one byte for the one sent")
+        return received_byte(answer[0])  # UP-48: int(3.5) was 3, int('A') a ValueError
 
     def delay_us(self, us: float) -> None:
         """Sleep (``time.sleep``; the frame gap and the SAS_INIT pulse are far above its resolution's needs).
