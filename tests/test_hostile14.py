@@ -79,6 +79,18 @@ def test_a_device_of_a_dropped_ring_goes_into_a_new_one() -> None:
         Bench(others=[chip_of_bench])
 
 
+def test_a_chip_of_another_bit_rate_is_refused_by_the_ring() -> None:
+    """Defect: a 500 kbit/s bench took ``others=[<a chip strapped for 2 Mbit/s>]`` and its data cycles passed: at
+    transaction level the ring never looked at the chips' CLK_CONF, where the pin level's ring refuses "every device
+    of a ring runs at one bit rate" (Table 1-7). Now the ring refuses it by name (UP-48), at either rate."""
+    with pytest.raises(InterbusArgumentError, match=r"device at ring position 2 is strapped for 2000000 bit/s"):
+        Bench(others=[Supi3(default_config(2_000_000))])
+    with pytest.raises(InterbusArgumentError, match=r"device at ring position 1 is strapped for 500000 bit/s "
+                                                    r"\(CLK_CONF\), not the ring's 2000000"):  # fmt: skip
+        Ring([Supi3(default_config())], bit_rate=2_000_000)
+    assert Ring([Supi3(default_config(2_000_000)), PlainDevice(0x02, 1)], bit_rate=2_000_000).bit_rate == 2_000_000
+
+
 class _Opening(PlainDevice):
     """A user's device model that says its data path opens (RX-13) with a given ``constant_output``."""
 

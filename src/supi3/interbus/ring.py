@@ -859,6 +859,12 @@ class Ring:
         for k, device in enumerate(every, 1):
             if not isinstance(device, Device):
                 raise fail(f"device at ring position {k}", "a Device (load, latch, discard, ...)", device)
+            config = getattr(device, "config", None)
+            if isinstance(config, DeviceConfig) and config.bit_rate != self.bit_rate:  # UP-48, as the pin level's
+                raise InterbusArgumentError(f"device at ring position {k}", device, f"device at ring position {k} "
+                                            f"is strapped for {config.bit_rate} bit/s (CLK_CONF), not the ring's "
+                                            f"{self.bit_rate}: every device of a ring runs at one bit rate",
+                                            "Table 1-7")  # fmt: skip
         if len({id(d) for d in every}) != len(every):
             raise InterbusArgumentError("devices", devices, "devices must be distinct objects (one device is one "
                                         "place in the ring), not the same object twice", "Tree")  # fmt: skip
