@@ -156,7 +156,10 @@ def test_the_bench_s_cycle_offsets_agree_with_each_cycle_s_timing(ops: list[Op])
 EXTREG_SET = 0x49
 """SET with ExtReg = 1 and one byte (3.4.11, the board case of RX-12): with nothing on FromExR the chip sends a
 constant line (RX-13)."""
-BINARY = next(decode(r.c, r.mfp) for r in tables.MODE_ROWS if decode(r.c, r.mfp).mfp_mode.kind is MfpKind.BINARY_IO)
+CLK_2M = tables.clk_conf_for(2_000_000)
+"""The CLK_CONF straps of the chips of the 2 Mbit/s rings (a ring's devices run at its rate, UP-48)."""
+BINARY = next(decode(r.c, r.mfp, clk_conf=CLK_2M) for r in tables.MODE_ROWS
+              if decode(r.c, r.mfp).mfp_mode.kind is MfpKind.BINARY_IO)  # fmt: skip
 
 
 class _NoKernel(PlainDevice):
@@ -185,7 +188,7 @@ def _made(kind: int, k: int) -> Device:
         chip.set_mfp_inputs((k * 0x1357) & 0xFFFF)
         return chip
     if kind == 1:
-        return Supi3(decode(*RB_INIT_UP), strict=False)
+        return Supi3(decode(*RB_INIT_UP, clk_conf=CLK_2M), strict=False)
     return (PlainDevice if kind == 2 else _NoKernel)(0x03, 0b01001)
 
 
@@ -459,7 +462,7 @@ def test_event_mask_names_a_source_that_is_none() -> None:
 def test_a_chips_valid_cycles_count_its_events_and_raise_them() -> None:
     """M32, M33: each valid data cycle a µP-mode chip latches counts VALID, PCP_RX and PCP_TX once each
     (:attr:`Supi3.events`) and sets the enabled ones in IRQ_EVT; an ID cycle counts ID_CYCLE and PCP_TX."""
-    chip = Supi3(decode(*RB_INIT_UP), strict=False)
+    chip = Supi3(decode(*RB_INIT_UP, clk_conf=CLK_2M), strict=False)
     registers = chip.registers
     assert registers is not None
     registers.cpu_write(SET.address, ONE_WORD_IO)

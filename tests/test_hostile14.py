@@ -89,6 +89,12 @@ def test_a_chip_of_another_bit_rate_is_refused_by_the_ring() -> None:
                                                     r"\(CLK_CONF\), not the ring's 2000000"):  # fmt: skip
         Ring([Supi3(default_config())], bit_rate=2_000_000)
     assert Ring([Supi3(default_config(2_000_000)), PlainDevice(0x02, 1)], bit_rate=2_000_000).bit_rate == 2_000_000
+    # No rate given: the straps' (a 2 Mbit/s chip ran a 500 kbit/s ring before), 500 kbit/s with no strapped device.
+    assert Ring([PlainDevice(0x02, 1), Supi3(default_config(2_000_000))]).bit_rate == 2_000_000
+    assert Ring([PlainDevice(0x02, 1)]).bit_rate == 500_000
+    with pytest.raises(InterbusArgumentError, match=r"device at ring position 3 is strapped for 500000 bit/s "
+                                                    r"\(CLK_CONF\), not the ring's 2000000"):  # fmt: skip
+        Ring([PlainDevice(0x02, 1), Supi3(default_config(2_000_000)), Supi3(default_config())])
 
 
 class _Opening(PlainDevice):

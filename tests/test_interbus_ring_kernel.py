@@ -28,8 +28,12 @@ from supi3.interbus.wire import Cycle
 from supi3.model.chip import Supi3, clocks
 from support import fields
 
-BINARY = [decode(r.c, r.mfp) for r in tables.MODE_ROWS if decode(r.c, r.mfp).mfp_mode.kind is MfpKind.BINARY_IO]
-MICRO = [decode(r.c, r.mfp) for r in tables.MODE_ROWS if decode(r.c, r.mfp).mfp_mode.kind is MfpKind.INIT_UP]
+CLK_2M = tables.clk_conf_for(2_000_000)
+"""The rings here run at 2 Mbit/s, so do their chips (UP-48)."""
+BINARY = [decode(r.c, r.mfp, clk_conf=CLK_2M) for r in tables.MODE_ROWS
+          if decode(r.c, r.mfp).mfp_mode.kind is MfpKind.BINARY_IO]  # fmt: skip
+MICRO = [decode(r.c, r.mfp, clk_conf=CLK_2M) for r in tables.MODE_ROWS
+         if decode(r.c, r.mfp).mfp_mode.kind is MfpKind.INIT_UP]  # fmt: skip
 
 
 class NoKernelDevice(PlainDevice):

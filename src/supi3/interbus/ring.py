@@ -826,7 +826,8 @@ class Ring:
         terminal module followed by its branch (a tree, docs/interbus.md "Tree"); :attr:`devices` is then the
         flattened data path, recomputed when a BK switches its branch (do not edit it in a tree).
     bit_rate:
-        500 000 or 2 000 000 bit/s (Table 1-7).
+        500 000 or 2 000 000 bit/s (Table 1-7); ``None``: the rate the devices with pin straps are strapped for
+        (CLK_CONF), 500 000 when none is. A device strapped for another rate than the ring's is refused (UP-48).
     record:
         Keep a :class:`SegmentTrace` of every line of the last cycle in :attr:`trace` (slow; for tests).
 
@@ -848,10 +849,12 @@ class Ring:
     attribute). A break of a return line before it (a :class:`ReturnBreak`, BK-59) brings back nothing: a dead line,
     which the segment search locates."""
 
-    def __init__(self, devices: Sequence[Device | Branch], bit_rate: int = 500_000, record: bool = False) -> None:
+    def __init__(self, devices: Sequence[Device | Branch], bit_rate: int | None = None, record: bool = False
+                 ) -> None:  # fmt: skip
         if isinstance(devices, (str, bytes)) or not isinstance(devices, Sequence):
             raise fail("devices", "a sequence of devices", devices)
-        self.bit_rate = wire.check_bit_rate(bit_rate)
+        if bit_rate is not None:
+            bit_rate = wire.check_bit_rate(bit_rate)
         every = _devices(devices) if all(isinstance(d, (Device, Branch)) for d in devices) else list(devices)
         if not 1 <= len(every) <= wire.MAX_DEVICES:
             raise InterbusArgumentError("devices", devices, f"devices must be 1 to {wire.MAX_DEVICES} devices "
@@ -859,10 +862,14 @@ class Ring:
         for k, device in enumerate(every, 1):
             if not isinstance(device, Device):
                 raise fail(f"device at ring position {k}", "a Device (load, latch, discard, ...)", device)
-            config = getattr(device, "config", None)
-            if isinstance(config, DeviceConfig) and config.bit_rate != self.bit_rate:  # UP-48, as the pin level's
+        # UP-48, as the pin level's ring: every device runs at the ring's rate, its straps' (Table 1-7).
+        strapped = [(k, d, c.bit_rate) for k, d in enumerate(every, 1) if isinstance(c := getattr(d, "config", None),
+                                                                                     DeviceConfig)]  # fmt: skip
+        self.bit_rate = bit_rate if bit_rate is not None else strapped[0][2] if strapped else 500_000
+        for k, device, rate in strapped:
+            if rate != self.bit_rate:
                 raise InterbusArgumentError(f"device at ring position {k}", device, f"device at ring position {k} "
-                                            f"is strapped for {config.bit_rate} bit/s (CLK_CONF), not the ring's "
+                                            f"is strapped for {rate} bit/s (CLK_CONF), not the ring's "
                                             f"{self.bit_rate}: every device of a ring runs at one bit rate",
                                             "Table 1-7")  # fmt: skip
         if len({id(d) for d in every}) != len(every):
