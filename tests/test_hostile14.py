@@ -32,6 +32,8 @@ from supi3.interbus.ring import Ring
 from supi3.mcu.pins import chip_clock, released
 from supi3.mcu.stm32 import Exti, Rcc, Spi
 from supi3.model.chip import Supi3
+from supi3.model.pinring import PinRing
+from supi3.model.pins import Supi3Pins
 from supi3.pinlevel import PinSpecError, recent_events
 from supi3.sdk.bench import Bench, BenchError, bench_config, default_config
 from supi3.sdk.driver import Mode, Supi3Driver, TransportError
@@ -52,11 +54,11 @@ def test_one_device_in_two_live_rings_is_refused_by_name() -> None:
     chip = Supi3(default_config())
     first = Ring([chip])
     assert chip.following is False
-    with pytest.raises(InterbusArgumentError, match=r"device at ring position 1 \(Supi3\) is in another live Ring"):
+    with pytest.raises(InterbusArgumentError, match=r"device at ring position 1 \(Supi3\) is in another live ring"):
         Ring([chip, PlainDevice(0x02, 1)])
     assert chip.following is False  # the refused ring told it nothing
     bench = Bench()
-    with pytest.raises(InterbusArgumentError, match=r"device at ring position 2 \(Supi3\) is in another live Ring"):
+    with pytest.raises(InterbusArgumentError, match=r"device at ring position 2 \(Supi3\) is in another live ring"):
         Bench(others=[bench.chip])
     assert first.devices == [chip]
 
@@ -75,8 +77,22 @@ def test_a_device_of_a_dropped_ring_goes_into_a_new_one() -> None:
     bench = Bench()
     chip_of_bench = bench.chip
     del bench
-    with pytest.raises(InterbusArgumentError, match=r"is in another live Ring"):
+    with pytest.raises(InterbusArgumentError, match=r"is in another live ring"):
         Bench(others=[chip_of_bench])
+
+
+def test_one_chip_in_two_live_pin_level_rings_is_refused_by_name() -> None:
+    """UP-49 (UP-47's limit closed): a ``Supi3Pins`` put into a second live ``PinRing`` was taken in silence, both
+    rings stepping its one core and pins. Now refused by name as at transaction level; the first ring keeps it,
+    and once that ring is dropped the chip goes into a new one."""
+    chip = Supi3Pins(default_config())
+    first = PinRing([chip])
+    with pytest.raises(InterbusArgumentError, match=r"device at ring position 2 \(Supi3Pins\) is in another live "
+                                                    r"ring"):  # fmt: skip
+        PinRing([Supi3Pins(default_config()), chip])
+    assert first.devices == [chip]
+    del first
+    assert PinRing([chip]).devices == [chip]
 
 
 def test_a_chip_of_another_bit_rate_is_refused_by_the_ring() -> None:

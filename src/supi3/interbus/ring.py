@@ -789,15 +789,16 @@ def check_finish(transfer: object, pending: Transfer | None, latch: object) -> b
     return latch if latch is True or latch is False else check_bool("latch", latch)
 
 
-_RINGS: Final[weakref.WeakValueDictionary[int, Ring]] = weakref.WeakValueDictionary()
-"""UP-47: ``id`` of each device a live :class:`Ring` holds -> that ring. The ring keeps its devices alive, so an ``id``
-is its device's while the entry lives; the entry goes with the ring."""
+_RINGS: Final[weakref.WeakValueDictionary[int, object]] = weakref.WeakValueDictionary()
+"""UP-47: ``id`` of each device a live ring (a :class:`Ring`, a pin-level ``PinRing``) holds -> that ring. The ring
+keeps its devices alive, so an ``id`` is its device's while the entry lives; the entry goes with the ring."""
 
 
-def _claim(ring: Ring, devices: Sequence[object]) -> None:
+def claim(ring: object, devices: Sequence[object]) -> None:
     """UP-47: ``ring`` takes ``devices``, none of which another live ring holds: one device object is one device in
     one place, and two rings (two benches) running it would mix its state (its registers, clock and loads) in
-    silence. A ring no longer reachable but not yet collected (a reference cycle) is collected first, once.
+    silence. A ring no longer reachable but not yet collected (a reference cycle) is collected first, once. The
+    pin-level ``PinRing`` claims its chips too (UP-49).
 
     Raises
     ------
@@ -809,7 +810,7 @@ def _claim(ring: Ring, devices: Sequence[object]) -> None:
         for k, device in enumerate(devices, 1):
             if id(device) in _RINGS:
                 raise InterbusArgumentError(f"device at ring position {k}", device, f"device at ring position {k} "
-                                            f"({type(device).__name__}) is in another live Ring already: one device "
+                                            f"({type(device).__name__}) is in another live ring already: one device "
                                             "object is one device in one ring (two rings would mix its state); "
                                             "make a new device for this ring", "UP-47")  # fmt: skip
     for device in devices:
@@ -875,7 +876,7 @@ class Ring:
         if len({id(d) for d in every}) != len(every):
             raise InterbusArgumentError("devices", devices, "devices must be distinct objects (one device is one "
                                         "place in the ring), not the same object twice", "Tree")  # fmt: skip
-        _claim(self, every)
+        claim(self, every)
         self._tree: list[Device | Branch] = list(devices)
         self._branches = _branches(self._tree)
         self._terminals = {id(branch.terminal) for branch in self._branches}

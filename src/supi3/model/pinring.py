@@ -51,6 +51,7 @@ from supi3.interbus.ring import (
     ErrorKind,
     Transfer,
     check_finish,
+    claim,
     return_inputs,
     return_repeaters,
     terminal_positions,
@@ -215,6 +216,7 @@ class PinRing:
         rates = {chip.config.bit_rate for chip in every}
         if len(rates) != 1:
             raise InterbusError("Table 1-7", sorted(rates), "every device of a ring runs at one bit rate")
+        claim(self, every)  # UP-49: one chip object in one live ring, as a transaction-level Ring's (UP-47)
         self.tree: list[PinChip | PinBranch] = list(chips)
         """The ring's items as given (:class:`PinBranch` for a BK with its branch)."""
         self.devices = every
