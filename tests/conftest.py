@@ -4,6 +4,7 @@ text for tables checked against it. Helpers that test modules import live in sup
 from __future__ import annotations
 
 import functools
+import os
 import re
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -51,7 +52,13 @@ def manual_text() -> str:
 
 @pytest.fixture(scope="session")
 def verilator_build(tmp_path_factory: pytest.TempPathFactory) -> VerilatorBuild:
-    """Fresh, numbered build directories for Verilator models (``verilator_build("rtl_core")``).
+    """Build directories for Verilator models (``verilator_build("rtl_core")``), one per name for the whole run.
+
+    Under xdist every worker gets the same directory for a name (under the run's base temporary directory, the parent
+    of the worker's own, which xdist makes ``<basetemp>/popen-gwN``): the builds in it are keyed by the hash of their
+    sources and made under a file lock (:func:`supi3.verif.rtl.build_slot`), so a design is compiled once per run
+    and the other worker waits for it rather than compiling the same Verilog again beside it (tests/README.md,
+    "Run time").
 
     Every test that needs Verilator requests it, directly or through its bench fixture: that marks the test ``rtl``
     (:func:`pytest_collection_modifyitems`), and skips it with the reason when Verilator is not installed.
@@ -59,25 +66,39 @@ def verilator_build(tmp_path_factory: pytest.TempPathFactory) -> VerilatorBuild:
     reason = verilator_missing()
     if reason is not None:
         pytest.skip(reason)
-    return tmp_path_factory.mktemp
+    root = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        root = root.parent
+    root = root / "verilator"
+
+    def build_dir(name: str) -> Path:
+        directory = root / name
+        directory.mkdir(parents=True, exist_ok=True)
+        return directory
+
+    return build_dir
 
 
 @pytest.fixture(scope="session")
 def chip_build(verilator_build: VerilatorBuild) -> Path:
     """The Verilator build of the RTL chip (top ``supi3_chip``) for the SDK's cocotb tests (sim/sdk_rtl.py): one per
-    session for tests/test_sdk_rtl.py and tests/test_sdk_hostile_rtl.py."""
+    run for tests/test_sdk_rtl.py and tests/test_sdk_hostile_rtl.py (shared by the xdist workers, keyed by the
+    Verilog and the options like a :class:`~supi3.verif.Lockstep` build)."""
     from cocotb_tools.runner import get_runner
 
     from supi3.rtl.chip import verilog
-    from supi3.verif.rtl import ensure_toolchain
+    from supi3.verif.rtl import build_slot, ensure_toolchain
 
     ensure_toolchain("verilator")
-    build = verilator_build("sdk_rtl")
-    source = build / f"{SDK_CHIP_TOP}.v"
-    source.write_text(verilog(), encoding="utf-8")
-    get_runner("verilator").build(sources=[source], hdl_toplevel=SDK_CHIP_TOP, build_dir=build,
-                                  build_args=["-Wno-fatal"], timescale=("1ns", "1ps"),
-                                  log_file=build / "build.log")  # fmt: skip
+    source_text = verilog()
+    options = ["-Wno-fatal"]
+    with build_slot(verilator_build("sdk_rtl"), "cocotb-chip", source_text, *options) as (build, ready):
+        if not ready:
+            source = build / f"{SDK_CHIP_TOP}.v"
+            source.write_text(source_text, encoding="utf-8")
+            get_runner("verilator").build(sources=[source], hdl_toplevel=SDK_CHIP_TOP, build_dir=build,
+                                          build_args=options, timescale=("1ns", "1ps"),
+                                          log_file=build / "build.log")  # fmt: skip
     return build
 
 
@@ -117,7 +138,7 @@ def chip_bench(verilator_build: VerilatorBuild) -> Lockstep:
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     """Mark ``rtl`` every test that uses :func:`verilator_build`, and ``slow`` every ``rtl`` test (a Verilator
     build alone takes a minute); skip every ``rtl`` test when Verilator is missing, with the reason, rather than fail
-    in its fixture."""
+    in its fixture. Then run the long modules first (:func:`_long_first`)."""
     reason = verilator_missing()
     for item in items:
         if "verilator_build" in getattr(item, "fixturenames", ()):
@@ -126,3 +147,21 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
             item.add_marker(pytest.mark.slow)
             if reason is not None:
                 item.add_marker(pytest.mark.skip(reason=reason))
+    _long_first(items)
+
+
+def _long_first(items: list[pytest.Item]) -> None:
+    """Order the modules with an ``rtl`` test first, then those with a ``slow`` test, then the rest, each group and
+    each module in collection order (a stable sort by module: a module's tests stay together, so its fixtures are
+    set up once).
+
+    With ``--dist worksteal`` the run ends when the last long test does: started late, a Verilator lockstep or a
+    pin-level sweep of tens of seconds keeps one worker busy while the other has nothing left to take. Started first,
+    the long tests overlap the short ones, which the workers then share to the end (tests/README.md, "Run time").
+    The order is the same in every worker, as xdist requires, and needs no timing file.
+    """
+    rank: dict[Path, int] = {}
+    for item in items:
+        long = 0 if item.get_closest_marker("rtl") else 1 if item.get_closest_marker("slow") else 2
+        rank[item.path] = min(rank.get(item.path, 2), long)
+    items.sort(key=lambda item: rank[item.path])

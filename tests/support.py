@@ -66,7 +66,8 @@ def register_address(address: int | Register) -> int:
 
 
 VerilatorBuild = Callable[[str], Path]
-"""The ``verilator_build`` fixture (tests/conftest.py): a fresh build directory for a name."""
+"""The ``verilator_build`` fixture (tests/conftest.py): the run's build directory for a name, shared by the xdist
+workers."""
 SDK_CHIP_TOP = "supi3_chip"
 """The RTL chip's top for the SDK's cocotb tests (the ``chip_build`` fixture, sim/sdk_rtl.py)."""
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import itertools
 from collections.abc import Iterator
 
@@ -36,7 +37,10 @@ def _all_straps() -> Iterator[Straps]:
         yield Straps(c, mfp, rf, clk, diag, variant)
 
 
+@functools.cache
 def _outcomes() -> tuple[list[tuple[Straps, DeviceConfig]], list[tuple[Straps, ConfigurationError]]]:
+    """Every strap combination decoded: 65,280 decodes, made once by the first test that needs them rather than at
+    collection, which every xdist worker and every run of other tests would pay (tests/README.md, "Run time")."""
     valid: list[tuple[Straps, DeviceConfig]] = []
     invalid: list[tuple[Straps, ConfigurationError]] = []
     for straps in _all_straps():
@@ -47,26 +51,24 @@ def _outcomes() -> tuple[list[tuple[Straps, DeviceConfig]], list[tuple[Straps, C
     return valid, invalid
 
 
-VALID, INVALID = _outcomes()
-
-
 def test_whole_input_space_decodes_or_raises_configuration_error() -> None:
-    # Any other exception would have escaped _outcomes() and failed collection.
-    assert len(VALID) + len(INVALID) == 2 * 32 * 17 * 5 * 4 * 3
+    # Any other exception escapes _outcomes() and fails the test.
+    valid, invalid = _outcomes()
+    assert len(valid) + len(invalid) == 2 * 32 * 17 * 5 * 4 * 3
     # OPC: 77 mode rows x CLK_CONF {01, 11} x RF {open, 10, 11, 00, 01 (OPT-2)} x DIAG_CONF {open, 0, 1};
     # LS: the 54 rows with C4 = 1 x CLK_CONF {01, 11}, RF and DIAG_CONF absent.
-    assert len(VALID) == 77 * 2 * 5 * 3 + 54 * 2
+    assert len(valid) == 77 * 2 * 5 * 3 + 54 * 2
 
 
 def test_every_error_names_pins_value_and_rule() -> None:
-    for _, exc in INVALID:
+    for _, exc in _outcomes()[1]:
         assert exc.pins and exc.value and exc.rule
         assert "Table" in exc.rule or exc.rule.startswith(("1.", "3."))
         assert exc.pins in str(exc) and exc.rule in str(exc)
 
 
 def test_every_valid_configuration_round_trips() -> None:
-    for straps, config in VALID:
+    for straps, config in _outcomes()[0]:
         assert decode_straps(config.straps()) == config
         explicit = config.straps()
         # Open CIp pins read as 1; explicit straps come back unchanged.
@@ -135,7 +137,7 @@ def test_arbitrary_input_only_raises_configuration_error(
     assert decode_straps(config.straps()) == config
 
 
-@given(st.sampled_from([cfg for _, cfg in VALID]))
+@given(st.deferred(lambda: st.sampled_from([cfg for _, cfg in _outcomes()[0]])))
 def test_configuration_to_pins_to_configuration(config: DeviceConfig) -> None:
     assert decode_straps(config.straps()) == config
 

@@ -9,6 +9,9 @@ joins the branch before, within (the cycle lost, BK-54) or after the master's ne
 
 from __future__ import annotations
 
+import functools
+import pickle
+
 import pytest
 
 from supi3 import tables
@@ -65,12 +68,39 @@ Seen = list[tuple[bool, list[ErrorKind], bool]]
 """Per cycle: its success, its error kinds, whether the BK recognised its branch after it."""
 
 
-def after_power_up(ring: Ring | PinRing, position: int, telegrams: int) -> Seen:
-    """The master starts and runs a data cycle; the chip at ``position`` powers up, ``telegrams`` idle status
-    telegrams, two cycles: per cycle its success and error kinds, and whether the BK recognised its branch then."""
+def _start(ring: Ring | PinRing) -> Master:
+    """The part every run of :func:`after_power_up` shares: idle past the wake-up, the master's start and a data
+    cycle."""
     idle(ring, FIRST_IDLE_TELEGRAMS)
     master = Master(ring, locate=False, max_devices=8)
     assert master.start().ok and master.cycle().ok
+    return master
+
+
+@functools.cache
+def _started(kind: BranchKind, m: int, rate: int) -> bytes:
+    """:func:`trees`' pin-level ring after :func:`_start`, pickled with its master."""
+    pin = trees(kind, m, rate)[1]
+    return pickle.dumps((pin, _start(pin)))
+
+
+def _pin_seen(kind: BranchKind, m: int, rate: int, position: int, telegrams: int) -> Seen:
+    """:func:`after_power_up` on :func:`trees`' pin-level ring, from a fresh copy of the ring and its master after
+    :func:`_start`. The models are deterministic and the pickled copy holds their whole state, so the run from it is
+    the run from the ring's first clock (:func:`test_a_started_pin_tree_runs_on_as_a_fresh_one`): the sweep of
+    :func:`_window` starts its pin-level runs from one copy instead of running the same start again for every
+    position and k (tests/README.md, "Run time"). Not the transaction level: its ``Ring`` keys state by ``id()``, and
+    its runs are short."""
+    ring, master = pickle.loads(_started(kind, m, rate))
+    return after_power_up(ring, position, telegrams, master)
+
+
+def after_power_up(ring: Ring | PinRing, position: int, telegrams: int, master: Master | None = None) -> Seen:
+    """The master starts and runs a data cycle (unless its ``master`` has: :func:`_pin_seen`); the chip at
+    ``position`` powers up, ``telegrams`` idle status telegrams, two cycles: per cycle its success and error kinds,
+    and whether the BK recognised its branch then."""
+    if master is None:
+        master = _start(ring)
     power_cycle(ring, position)
     idle(ring, telegrams)
     seen: Seen = []
@@ -104,13 +134,22 @@ def _window(kind: BranchKind, m: int, rate: int, positions: range) -> list[int]:
         first = next(k for k, seen in enumerate(tl_seen) if seen[0][0])
         residual = RESIDUAL.get((rate, kind, m, position))
         for k in range(max(0, first - 1), first + 1):
-            pin = after_power_up(trees(kind, m, rate)[1], position, k)
+            pin = _pin_seen(kind, m, rate, position, k)
             if residual is None:
                 assert pin == tl_seen[k], (position, k, tl_seen[k])
             else:
                 assert pin[0][0] is (k >= residual[1]) and tl_seen[k][0][0] is (k >= residual[0]), (position, k, pin)
         firsts.append(first)
     return firsts
+
+
+def test_a_started_pin_tree_runs_on_as_a_fresh_one() -> None:
+    """The copy :func:`_window` starts its pin-level runs from gives what the same run from the ring's first clock
+    gives: the BK of a 2-device LBD-MR branch (within its window at k = 3, ``RESIDUAL``) and its second branch device
+    (M26), a copy each."""
+    for position, k in ((2, 3), (4, 1)):
+        fresh = after_power_up(trees(BranchKind.LBD_MR, 2, 2_000_000)[1], position, k)
+        assert _pin_seen(BranchKind.LBD_MR, 2, 2_000_000, position, k) == fresh, (position, k)
 
 
 @pytest.mark.parametrize(("kind", "m"), CASES)

@@ -207,7 +207,8 @@ def _chunks(n: int, size: int = 1 << 20) -> Iterator[slice]:
 
 def long_lockstep(bench: Lockstep, config: DeviceConfig, inputs: Columns, directory: Path) -> Columns:
     """Replay ``inputs`` through the batch executable and compare with ``Supi3Pins(config).run``; return the
-    (matching) model outputs."""
+    (matching) model outputs. The RTL replays in its own process while the model runs here, as
+    :meth:`~supi3.verif.Lockstep.run_batch` does (millions of clocks each)."""
     n = len(inputs["do1"])
     layout = bench.layout
     source, sink = directory / "inputs.bin", directory / "outputs.bin"
@@ -215,8 +216,14 @@ def long_lockstep(bench: Lockstep, config: DeviceConfig, inputs: Columns, direct
         for part in _chunks(n):
             block = np.stack([inputs[name][part] for name in CORE_INPUTS], axis=1)
             stream.write(layout.input_words(strap_stimulus(config, block)).astype("<u4").tobytes())
-    subprocess.run([str(bench.batch_executable()), str(source), str(sink), str(n), str(bench.reset_cycles)], check=True)
-    expected = Supi3Pins(config).run(inputs)
+    command = [str(bench.batch_executable()), str(source), str(sink), str(n), str(bench.reset_cycles)]
+    process = subprocess.Popen(command)
+    try:
+        expected = Supi3Pins(config).run(inputs)
+    finally:
+        status = process.wait()
+    if status != 0:
+        raise subprocess.CalledProcessError(status, command)
     words = np.fromfile(sink, dtype="<u4").reshape(n, layout.out_words)
     for part in _chunks(n):
         actual = layout.output_trace(words[part])
