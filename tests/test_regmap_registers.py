@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import pytest
@@ -268,3 +269,10 @@ def test_declaration_errors_are_supi3_errors() -> None:
         Port(1, AccessDirection.WRITE, Access.RC, "t", register)
     with pytest.raises(RegisterMapError, match="exactly one write port"):
         RegisterMap(4, REGISTER_MAP.ports[:-1], COMMAND_BYTE, INIT_BYTE)
+    renamed = [p if p.register is None or p.register.name != "ID"
+               else dataclasses.replace(p, register=dataclasses.replace(p.register, name="SET"))
+               for p in REGISTER_MAP.ports]  # fmt: skip
+    with pytest.raises(RegisterMapError, match="two registers called 'SET'"):
+        RegisterMap(4, tuple(renamed), COMMAND_BYTE, INIT_BYTE)
+    with pytest.raises(RegisterMapError, match=r"no register \['SET'\]"):
+        REGISTER_MAP.register(["SET"])  # type: ignore[arg-type]

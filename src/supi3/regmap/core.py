@@ -354,16 +354,21 @@ class RegisterMap:
     command_byte: ByteLayout
     init_byte: ByteLayout
     _by_key: dict[tuple[int, AccessDirection], Port] = field(init=False, repr=False, compare=False)
+    _by_name: dict[str, Register] = field(init=False, repr=False, compare=False)
+    """Every register once by name, in address order, the write register first where the two differ (the model's
+    optical block looks its registers up every clock: computed once, the map is frozen)."""
 
     def __post_init__(self) -> None:
         by_key = {(p.address, p.direction): p for p in self.ports}
         expected = {(a, d) for a in range(1 << self.address_bits) for d in AccessDirection}
         if len(by_key) != len(self.ports) or set(by_key) != expected:
             raise RegisterMapError("every address needs exactly one write port and one read port")
-        names = [r.name for r in self.registers]
-        if len(set(names)) != len(names):
-            raise RegisterMapError(f"duplicate register names in {names}")
+        by_name: dict[str, Register] = {}
+        for register in (p.register for p in self.ports if p.register is not None):
+            if by_name.setdefault(register.name, register) != register:
+                raise RegisterMapError(f"two registers called {register.name!r}")
         object.__setattr__(self, "_by_key", by_key)
+        object.__setattr__(self, "_by_name", by_name)
 
     @property
     def addresses(self) -> range:
@@ -373,11 +378,7 @@ class RegisterMap:
     @property
     def registers(self) -> tuple[Register, ...]:
         """Every register once, in address order, the write register first where the two differ."""
-        seen: dict[str, Register] = {}
-        for p in self.ports:
-            if p.register is not None:
-                seen.setdefault(p.register.name, p.register)
-        return tuple(seen.values())
+        return tuple(self._by_name.values())
 
     def port(self, address: int, direction: AccessDirection) -> Port:
         """Return what a ``direction`` data access to ``address`` does.
@@ -398,10 +399,10 @@ class RegisterMap:
 
     def register(self, name: str) -> Register:
         """Return the register called ``name`` (e.g. ``"SET"``, ``"IRQ_EVT"``)."""
-        for r in self.registers:
-            if r.name == name:
-                return r
-        raise RegisterMapError(f"no register {name!r}; registers: {[r.name for r in self.registers]}")
+        try:
+            return self._by_name[name]
+        except (KeyError, TypeError):  # TypeError: an unhashable name
+            raise RegisterMapError(f"no register {name!r}; registers: {list(self._by_name)}") from None
 
     def cleared_by(self, reset: Reset) -> tuple[Register, ...]:
         """The registers that ``reset`` sets back to their reset value (3.4.7).
