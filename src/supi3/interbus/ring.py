@@ -864,8 +864,8 @@ class Ring:
             if not isinstance(device, Device):
                 raise fail(f"device at ring position {k}", "a Device (load, latch, discard, ...)", device)
         # UP-48, as the pin level's ring: every device runs at the ring's rate, its straps' (Table 1-7).
-        strapped = [(k, d, c.bit_rate) for k, d in enumerate(every, 1) if isinstance(c := getattr(d, "config", None),
-                                                                                     DeviceConfig)]  # fmt: skip
+        strapped = [(k, device, config.bit_rate) for k, device in enumerate(every, 1)
+                    if isinstance(config := getattr(device, "config", None), DeviceConfig)]  # fmt: skip
         self.bit_rate = bit_rate if bit_rate is not None else strapped[0][2] if strapped else 500_000
         for k, device, rate in strapped:
             if rate != self.bit_rate:
