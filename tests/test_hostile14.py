@@ -81,6 +81,20 @@ def test_a_device_of_a_dropped_ring_goes_into_a_new_one() -> None:
         Bench(others=[chip_of_bench])
 
 
+def test_a_refused_ring_holds_none_of_its_devices() -> None:
+    """UP-47, a call after an error: ``Ring([chip], record="yes")`` was refused after it had claimed the chip, and
+    while the error was kept (a test's ``pytest.raises``, an ``except`` block) the half-made ring held it: the next
+    ``Ring([chip])`` was refused as "in another live ring". Every check now comes before the claim."""
+    chip = Supi3(default_config())
+    with pytest.raises(ArgumentError, match="record must be True or False") as refused:
+        Ring([chip], record="yes")  # type: ignore[arg-type]
+    assert Ring([chip]).devices == [chip] and refused.value is not None
+    pins = Supi3Pins(default_config())
+    with pytest.raises(ArgumentError, match="record") as refused_pins:
+        PinRing([pins], record="yes")  # type: ignore[arg-type]
+    assert PinRing([pins]).devices == [pins] and refused_pins.value is not None
+
+
 def test_one_chip_in_two_live_pin_level_rings_is_refused_by_name() -> None:
     """UP-49 (UP-47's limit closed): a ``Supi3Pins`` put into a second live ``PinRing`` was taken in silence, both
     rings stepping its one core and pins. Now refused by name as at transaction level; the first ring keeps it,

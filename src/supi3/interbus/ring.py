@@ -856,6 +856,7 @@ class Ring:
             raise fail("devices", "a sequence of devices", devices)
         if bit_rate is not None:
             bit_rate = wire.check_bit_rate(bit_rate)
+        record = check_bool("record", record)  # every check before the devices are claimed (a refused ring holds none)
         every = _devices(devices) if all(isinstance(d, (Device, Branch)) for d in devices) else list(devices)
         if not 1 <= len(every) <= wire.MAX_DEVICES:
             raise InterbusArgumentError("devices", devices, f"devices must be 1 to {wire.MAX_DEVICES} devices "
@@ -891,7 +892,7 @@ class Ring:
         self._index: dict[int, int] = {}
         self._detached: dict[int, tuple[Device, float | None]] = {}
         self.devices: list[Device] = [d for d in self._tree if not isinstance(d, Branch)]
-        self.record = check_bool("record", record)
+        self.record = record
         self.trace: list[SegmentTrace] = []
         self.now = 0.0
         self._faults: list[_Active] = []

@@ -352,6 +352,7 @@ class Board:
         self.intel = check_instance("mode", mode, Mode) is Mode.INTEL
         self._s_r = 1  # PB0: S/R, 1 = the µP sends
         check_bool("record", record)
+        native_frames = check_bool("native_frames", native_frames)  # before the ring claims its devices (UP-47)
         self.core = CortexM(firmware, cpu=cpu, cpu_hz=cpu_hz)
         if self.core.cpu_hz > MAX_CPU_HZ:
             raise fail("cpu_hz", f"at most {MAX_CPU_HZ} (the STM32F10x's highest SYSCLK, RM0008 7.2; MCU-50)", cpu_hz)
@@ -401,7 +402,7 @@ class Board:
         self.spi.on_misuse = self._mcu_violation
         core = self.core
         # MCU-51: the native frames at transaction level on the Motorola board, GPIOA's and SPI1's writes through them
-        native = check_bool("native_frames", native_frames) and self._ring is None and not self.intel
+        native = native_frames and self._ring is None and not self.intel
         core.mmio(RCC_BASE, PERIPHERAL_SIZE, self.rcc.read, self.rcc.write)
         if native:
             core.mmio(GPIOA_BASE, PERIPHERAL_SIZE, self._gpio_read, self._gpio_write, port=0)

@@ -216,7 +216,6 @@ class PinRing:
         rates = {chip.config.bit_rate for chip in every}
         if len(rates) != 1:
             raise InterbusError("Table 1-7", sorted(rates), "every device of a ring runs at one bit rate")
-        claim(self, every)  # UP-49: one chip object in one live ring, as a transaction-level Ring's (UP-47)
         self.tree: list[PinChip | PinBranch] = list(chips)
         """The ring's items as given (:class:`PinBranch` for a BK with its branch)."""
         self.devices = every
@@ -254,6 +253,7 @@ class PinRing:
             {"di2": 0, "rbst_ext": 0, "mfp_in": 0, "stat_err_n": 1, "resu_n": 1, "vmon_ok": 1, "from_exr": 0}
             for _ in every
         ]
+        claim(self, every)  # UP-49, as a Ring's (UP-47); last, so that a ring refused on the way holds no chip
 
     @property
     def path_repeaters(self) -> int:

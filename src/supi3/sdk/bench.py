@@ -679,16 +679,17 @@ class Bench:
         self.registers: RegisterFile = self.chip.registers
         if isinstance(others, str | bytes) or not isinstance(others, Sequence):  # Ring names each item's error
             raise fail("others", "a sequence of the devices behind the chip (Device objects)", others)
-        tree = [self.chip, *others]
-        self.ring = Ring(tree, bit_rate=self.config.bit_rate)
-        self._bus = _ClockedBus(self.ring)
-        self.master = discovery_master(self._bus, ring_positions(tree))  # MCU-56, FW-20
         self.byte_s = timing.upif_byte_s(self.config.bit_rate, sclk_hz)
         self.io_pin = check_bool("io_pin", io_pin)
         self.pin_read_s = check_real("pin_read_s", pin_read_s, 0.0, 1e-3)
         self.cycle_time_s = None if cycle_time_s is None else check_cycle_time(cycle_time_s)
         self.transport = BenchTransport(self, self.chip)
         self.driver = Supi3Driver(self.transport, frame_gap_us=frame_gap_us)
+        # the ring last of what may refuse an argument: it claims its devices (UP-47), a refused bench holds none
+        tree = [self.chip, *others]
+        self.ring = Ring(tree, bit_rate=self.config.bit_rate)
+        self._bus = _ClockedBus(self.ring)
+        self.master = discovery_master(self._bus, ring_positions(tree))  # MCU-56, FW-20
         self._chips = [d for d in self.ring.devices if isinstance(d, Supi3) and d.registers is not None]
         self.now = 0.0
         self.cycles = 0
