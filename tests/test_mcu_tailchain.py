@@ -23,6 +23,7 @@ from supi3.mcu import build as mcu_build
 from supi3.mcu.board import Board
 from supi3.mcu.core import CPUS, EXTERNAL
 from supi3.mcu.stm32 import EXTI_PR
+from supi3.sdk import native
 
 pytestmark = pytest.mark.skipif(mcu_build.toolchain_missing() is not None, reason=str(mcu_build.toolchain_missing()))
 
@@ -62,8 +63,11 @@ class History:
 
 
 def _watched(board: Board) -> History:
-    """Note every EXTI0 entry and return of ``board``'s core from now (around the board's own callbacks)."""
+    """Note every EXTI0 entry and return of ``board``'s core from now (around the board's own callbacks; hook.c's
+    tail-chains off, MCU-86: each return reaches them)."""
     core, history = board.core, History(board.irq_latency_s)
+    if board.native_frames is not None:
+        board.native_frames.tail_chains = False
     exception_return, entered = core.exception_return, core.entered
     returning: list[int | None] = [None]
 
@@ -253,3 +257,122 @@ def _check(history: History, board: Board) -> None:
     assert board.irq_latency_s == max([history.latency_s, *latencies])
     core = board.core  # no fall lost: one not yet served has its handler running or pending
     assert board._irq_fell is None or EXTI0 in core.active or EXTI0 in core.pending
+
+
+Run = tuple[int, int, int, bool]
+"""One run of a history: late_irq's wait (µs), ``board.run``'s cycles (0: ``run_for`` instead), ``run_for``'s µs,
+whether the handler clears PR again after its wait."""
+
+
+def _unwatched(elf: Path, cpu: str, bit_rate: int, runs: list[Run], *, primask_at: int | None = None,
+               **options: object) -> tuple[tuple[object, ...], int]:  # fmt: skip
+    """A history of runs on a board nobody watches (MCU-86: hook.c's tail-chains on, unless ``options`` turn them
+    off): everything the run shows, and how many tail-chains hook.c took. ``primask_at``: the run after which PRIMASK
+    is set (the core stopped wherever ``run_for`` ended: inside a handler, EXTI0's next return cannot chain)."""
+    tail_chains = options.pop("tail_chains", True)
+    board = _board(elf, cpu, bit_rate, **options)
+    frames = board.native_frames
+    if frames is not None:
+        frames.tail_chains = bool(tail_chains)
+    for index, (hold, cycles, micros, clear_late) in enumerate(runs):
+        _hold(board, hold, clear_late=clear_late)
+        if cycles:
+            board.run(cycles)
+        else:
+            board.run_for(micros * 1e-6)
+        if index == primask_at:
+            board.core.set_reg("primask", 1)
+    core = board.core
+    return ((core.cycles, core.instructions, core.registers(), core.read_bytes(*core.ram), board.interrupts,
+             board.irq_latency_s, board._irq_fell, board.now, board.bench.cycles, board.master.inputs(1),
+             sorted(core.pending), list(core.active), board.served,
+             [(v.time_s, v.pc, str(v.error)) for v in board.violations]),
+            0 if frames is None else frames.tail_chained)  # fmt: skip
+
+
+def _alike(elf: Path, cpu: str, bit_rate: int, runs: list[Run], primask_at: int | None = None) -> int:
+    """:func:`_unwatched` with hook.c's tail-chains, without them and with every frame in Python: the same run; the
+    number of tail-chains hook.c took."""
+    native, chains = _unwatched(elf, cpu, bit_rate, runs, primask_at=primask_at)
+    assert native == _unwatched(elf, cpu, bit_rate, runs, primask_at=primask_at, tail_chains=False)[0]
+    assert native == _unwatched(elf, cpu, bit_rate, runs, primask_at=primask_at, native_frames=False)[0]
+    return chains
+
+
+@pytest.mark.parametrize("cpu", sorted(CPUS))
+def test_the_native_tail_chain_runs_alike(late_irq: dict[str, Path], cpu: str) -> None:
+    """MCU-86: hook.c takes the returns whose tail-chain only samples EXTI0's line (the mirror valid, no bus event
+    due): runs that chain (a wait longer than the cycle, PR cleared late or not), runs that end inside a handler
+    (``run_for``) and runs on after it show the same as with each return in Python. late_irq's wait makes no access,
+    so most of its returns find the next cycle's event due (Python's); one chain here is hook.c's (issue #13's case
+    below: nearly all)."""
+    runs: list[Run] = [(300, 3, 0, False), (300, 0, 700, True), (300, 0, 450, False), (0, 2, 0, False),
+                       (450, 3, 0, True)]  # fmt: skip
+    assert _alike(late_irq[cpu], cpu, 500_000, runs) >= 1
+
+
+def test_a_return_under_primask_is_python_s(late_irq: dict[str, Path]) -> None:
+    """MCU-86: PRIMASK set inside a handler (by the test, where ``run_for`` ended) masks EXTI0 in thread mode
+    (B1.5.4): its next return does not chain, EXTI0 stays pending, the same with hook.c's tail-chains as without."""
+    runs: list[Run] = [(300, 0, 650, False), (300, 0, 900, False)]
+    chains = _alike(late_irq["cortex_m3"], "cortex_m3", 500_000, runs, primask_at=0)
+    _, native = _unwatched(late_irq["cortex_m3"], "cortex_m3", 500_000, runs[:1])
+    assert chains == native  # none after PRIMASK
+
+
+def test_issue_13_s_case_chains_natively_alike(tmp_path: Path) -> None:
+    """MCU-86 in issue #13's case (bench/bench_mcu.py: digital_io at 2 Mbit/s, SPI1 at f_PCLK / 16): hook.c takes
+    nearly every EXTI0 return (a tail-chain), with the same run as every frame in Python."""
+    elf = mcu_build.build(native.example("digital_io"), tmp_path / "br3.elf", defines={"BOARD_SPI_BR": "3u"})
+    outcomes = []
+    for native_frames in (True, False):
+        board = Board(elf, bit_rate=2_000_000, strict=False, native_frames=native_frames)
+        board.run(3)
+        board.bench.master.set_outputs(1, b"\x12\x34")
+        assert board.fw_board is not None
+        board.fw_board.inputs = b"\xab\xcd"
+        board.run(60)
+        core = board.core
+        outcomes.append((core.cycles, core.instructions, core.registers(), board.interrupts, board.irq_latency_s,
+                         board.now, board.master.inputs(1), board.fw_board.outputs,
+                         [(v.time_s, v.pc, str(v.error)) for v in board.violations]))  # fmt: skip
+        if native_frames:
+            assert board.native_frames is not None and board.native_frames.tail_chained >= 45
+    assert outcomes[0] == outcomes[1]
+
+
+@settings(max_examples=10, deadline=None, phases=(Phase.explicit, Phase.reuse, Phase.generate))
+@given(cpu=st.sampled_from(sorted(CPUS)), bit_rate=st.sampled_from([500_000, 2_000_000]),
+       runs=st.lists(st.tuples(st.integers(0, 500), st.integers(0, 3), st.integers(1, 900), st.booleans()),
+                     min_size=1, max_size=4),
+       primask=st.none() | st.integers(0, 3))  # fmt: skip
+def test_any_history_runs_alike_with_the_native_tail_chain(late_irq: dict[str, Path], cpu: str, bit_rate: int,
+                                                            runs: list[Run], primask: int | None) -> None:  # fmt: skip
+    """MCU-86 over histories: random waits, PR cleared late or not, ``run`` and ``run_for`` (ending anywhere, inside
+    a handler too), PRIMASK set at a run's end: hook.c's tail-chains change nothing a run shows."""
+    _alike(late_irq[cpu], cpu, bit_rate, runs, primask_at=primask)
+
+
+def test_a_line_held_through_the_handler_chains_natively_alike(late_irq: dict[str, Path]) -> None:
+    """MCU-86, the level rule: the handler's PR writes lost (hook.c's own PR write turned off, so that each reaches
+    Python's EXTI, which drops it), EXTI0's line stays asserted with nothing pended while active; hook.c samples it at
+    the return and chains, as Python's return does."""
+    outcomes = []
+    for native_frames in (True, False):
+        board = _board(late_irq["cortex_m3"], "cortex_m3", 500_000, native_frames=native_frames)
+        exti = board.exti
+        write = exti.write
+
+        def dropping(offset: int, size: int, value: int, write: Callable[[int, int, int], None] = write) -> None:
+            if offset != EXTI_PR:
+                write(offset, size, value)
+
+        exti.write = dropping  # type: ignore[method-assign]
+        board.core.frames.exti_pr_offset = 1 << 32  # no offset: every PR write is Python's
+        board.run(2)
+        core = board.core
+        outcomes.append((core.cycles, core.instructions, core.registers(), board.interrupts, board.irq_latency_s,
+                         board.now, list(core.active), sorted(core.pending)))  # fmt: skip
+        if native_frames:
+            assert board.native_frames is not None and board.native_frames.tail_chained >= 5
+    assert outcomes[0] == outcomes[1]

@@ -380,6 +380,7 @@ class Board:
         self._telegram_s = wire.STATUS_TELEGRAM_BITS / bit_rate  # the line idles in whole telegrams (MCU-22, -30)
         self._wait = ServeWait(bit_rate)  # MCU-55: the run's end, at most SERVE_TELEGRAMS after its last cycle
         self._wait_s = serve_wait_s(bit_rate)
+        self._bounds = MAX_DEADLINE  # MCU-86: the step's deadline but the bus's (_run, _step)
         self._limits = {symbol: timing.limit("3-7", symbol, bit_rate) for symbol in ("t0", "t1", "t2", "t8")}
         self._limits["t6max"] = timing.limit("3-7", "t6", bit_rate, maximum=True)
         self._limits["t_SAS_INIT"] = timing.limit("3-7", "t_SAS_INIT", bit_rate)
@@ -670,6 +671,18 @@ class Board:
             if self._irq_fell is not None:
                 self.irq_latency_s = max(self.irq_latency_s, (self.core.cycles - self._irq_fell) / self._cpu_hz)
                 self._irq_fell = None
+
+    def _chained(self, chains: int, latency: int, fell: int | None) -> None:
+        """MCU-86: ``chains`` tail-chains into EXTI0 hook.c took since the last catch-up, each as
+        :meth:`CortexM.exception_return` and :meth:`_entered` take one: EXTI0 no longer pending (and still active),
+        the entries counted (the main loop's passes were reset at the first entry of the chain, and none arrives in
+        a handler); ``latency``: the longest /IRQ latency of their entries in core cycles (-1: none measured),
+        ``fell``: :attr:`_irq_fell` after them."""
+        self.core.pending.discard(_EXTI0)
+        self.interrupts += chains
+        if latency >= 0:
+            self.irq_latency_s = max(self.irq_latency_s, latency / self._cpu_hz)
+        self._irq_fell = fell
 
     # -- the main loop's passes (MCU-30) --------------------------------------------------------------------------
 
@@ -1002,11 +1015,12 @@ class Board:
             if done():
                 return
             self._entry = core.next_entry()  # once a step: for the deadline and the step's entry (MCU-79)
-            deadline = self._bus_deadline()
+            bounds = MAX_DEADLINE
             for bound in (tick, end, self._serve_end):
                 if bound is not None:
-                    deadline = min(deadline, bound)
-            self._step(deadline)
+                    bounds = min(bounds, bound)
+            self._bounds = bounds
+            self._step(min(self._bus_deadline(), bounds))
             self._sync(core.cycles)
 
     def _bus_deadline(self) -> int:
@@ -1026,6 +1040,18 @@ class Board:
             at += self._wait_s
         return math.ceil(at * core.cpu_hz - NOISE_CYCLES)
 
+    def _bus_ran(self) -> None:
+        """MCU-86: the bus ran during a step (hook.c's /SS edge past a bus event, :meth:`NativeFrames._bus_due`)
+        and the run is not at its end: the step's deadline moves to the one the run loop would give a step starting
+        now (:meth:`_bus_deadline` from the bus's next event, the step's other bounds). A stop at the old one would
+        find no bus event due: nothing but the clock (MCU-31, MCU-44); not stopping there lets hook.c's tail-chains
+        go on to the next bus event."""
+        bench = self._bench
+        assert bench is not None  # the native frames run at transaction level
+        if bench.cycles < bench._hold:  # at a run's end, the serve wait begins at the loop's next stop (MCU-30)
+            state = self.core._state
+            state.deadline = max(state.deadline, min(self._bus_deadline(), self._bounds))
+
     def _set_budget(self, max_instructions: int) -> None:
         self._budget = check_int("max_instructions", max_instructions, 1)
         self._limit = self.core.instructions + self._budget
@@ -1042,6 +1068,7 @@ class Board:
                 raise FirmwareStoppedError(core.report(Stop.BUDGET, f"instruction budget of {self._budget} used up "
                                                        "(an endless loop?)"))  # fmt: skip
             deadline = min(deadline, cycles + left)  # within the budget: an instruction costs a cycle at least (MCU-1)
+            self._bounds = min(self._bounds, cycles + left)
         core._handed = entry  # UNASKED: the step asks
         try:
             state = core.step(max(deadline, cycles + 1))

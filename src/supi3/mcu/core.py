@@ -853,7 +853,7 @@ class CortexM:
         self._native_enter = _native(native.supi3_enter, ctypes.c_uint32, ctypes.c_uint32, ctypes.c_uint64)
         self._native_take = _native(native.supi3_take, ctypes.c_uint32, ctypes.c_uint32, ctypes.c_uint64)
         self._native_return = _native(native.supi3_return, ctypes.c_uint32)
-        self._native_run = _native(native.supi3_run)
+        self._native_run = _native(native.supi3_run, ctypes.c_void_p)
         self._native_exceptions = True
         self._prefixes = (hook.Prefix * PREFIX_SLOTS)()  # cycles_now's memo for the native frames (MCU-51)
         self.frames = frames = hook.Frames()
@@ -861,6 +861,9 @@ class CortexM:
         frames.state = ctypes.pointer(state)
         frames.prefixes = self._prefixes
         frames.prefix_mask = PREFIX_SLOTS - 1
+        frames.exception_exit, frames.primask_register = EXCP_EXCEPTION_EXIT, arm.UC_ARM_REG_PRIMASK  # MCU-86
+        frames.irq_fell = frames.chain_latency = -1
+        self._frames_ref = ctypes.byref(frames)
         self.entry: Callable[[], None] | None = None
         """MCU-51: called first at each entry into Python while the core runs (a peripheral's read or write, a watched
         address) and when a run ends: the native frames' catch-up."""
@@ -1432,7 +1435,7 @@ class CortexM:
             resume()
         self._running = True
         try:  # from the PC; unicorn's CPU exception noted in the state (MCU-72: supi3_run, supi3_interrupt)
-            status = self._native_run(self._handle, self._state_ref)
+            status = self._native_run(self._handle, self._state_ref, self._frames_ref)
             if status != ucc.UC_ERR_OK:
                 raise FirmwareFaultError(self._fault(UcError(status)))
         finally:

@@ -91,6 +91,8 @@ class FrameBench(Protocol):
     low_at: float | None
     _events: list[tuple[float, str]]
     _next_start: float
+    cycles: int
+    _hold: float
 
     @property
     def chip(self) -> Supi3: ...
@@ -111,6 +113,7 @@ class FrameBoard(Protocol):
     _ss_rise: int
     _cd_before: int
     _irq_level: int
+    _irq_fell: int | None
     _mod_ack_until: int
     _least_t1: int
     _least_t2: int
@@ -122,6 +125,10 @@ class FrameBoard(Protocol):
     def _sync(self, cycles: int) -> None: ...
 
     def _now(self) -> int: ...
+
+    def _chained(self, chains: int, latency: int, fell: int | None) -> None: ...
+
+    def _bus_ran(self) -> None: ...
 
     @property
     def bench(self) -> FrameBench: ...
@@ -195,6 +202,8 @@ from changed (:meth:`NativeFrames._configuration`), in their order there."""
 _MIRROR_FIELDS: Final[tuple[str, ...]] = (
     "valid", "due", "latch", "latch_at", "gpio_levels", "io", "io_at", *_STATE_FIELDS[:-3])  # fmt: skip
 """The fields :meth:`NativeFrames.refresh` writes at each call, in their order there."""
+_CHAIN_FIELDS: Final[tuple[str, ...]] = ("chain_leave", "chain_pending", "exti_imr", "irq_fell", "chain_vector")
+"""MCU-86: the fields :meth:`NativeFrames.refresh` writes for hook.c's tail-chain, in their order there."""
 
 
 def _packed(names: tuple[str, ...]) -> tuple[struct.Struct, int]:
@@ -206,7 +215,7 @@ def _packed(names: tuple[str, ...]) -> tuple[struct.Struct, int]:
         field = getattr(Frames, name)
         if field.offset != at or field.size != 8:
             raise NativeHookError(f"Frames.{name} is not an 8-byte field at offset {at}")
-        layout += "q" if name == "ss_rise" else "Q"
+        layout += "q" if name in ("ss_rise", "irq_fell") else "Q"
         at += 8
     return struct.Struct(layout), start
 
@@ -214,6 +223,7 @@ def _packed(names: tuple[str, ...]) -> tuple[struct.Struct, int]:
 _STATE, _STATE_AT = _packed(_STATE_FIELDS)
 _MIRROR, _MIRROR_AT = _packed(_MIRROR_FIELDS)
 _CONFIG, _CONFIG_AT = _packed(_CONFIG_FIELDS)
+_CHAIN, _CHAIN_AT = _packed(_CHAIN_FIELDS)
 
 
 def first_due(next_at: float, cpu_hz: float, noise: float) -> int:
@@ -305,6 +315,12 @@ class NativeFrames:
         self._first_due = _FirstDue(self._hz, noise)
         self._written: tuple[str | None, ...] = _registers._WRITE_NAMES
         self._exti0 = exti0
+        frames.chain_number, frames.tail_chain_cycles = exti0, core.cpu.tail_chain_cycles  # MCU-86
+        self.tail_chained = 0
+        """MCU-86: the tail-chains hook.c took (a count for tests and benchmarks)."""
+        self.tail_chains = True
+        """MCU-86: hook.c takes EXTI0's tail-chains at its handler's returns (off: every return goes to Python's
+        ``CortexM.exception_return``, for a test that watches it and ``CortexM.entered``)."""
         self._command: object = None
         self._code = _NO_COMMAND
         self.bus_dues = 0
@@ -337,6 +353,7 @@ class NativeFrames:
                 gpio.on_output = output
             return
         self.refresh()
+        board._bus_ran()
 
     def catch_up(self) -> None:
         """An entry into Python (:attr:`CortexM.entry`): the mirror is no longer valid (Python may change what it
@@ -346,6 +363,8 @@ class NativeFrames:
         if not frames.valid:
             return
         frames.valid = 0
+        if frames.chains:
+            self._chained()
         if not frames.pending:
             return
         state = _STATE.unpack_from(frames, _STATE_AT)
@@ -392,6 +411,15 @@ class NativeFrames:
             spi.shifting = (received, shift_start, shift_end)
             spi.transfers += dr_writes
             spi._holding = True
+
+    def _chained(self) -> None:
+        """MCU-86: hook.c's tail-chains into EXTI0 since the last catch-up, handed to the board
+        (``Board._chained``); the bus synchronisation to their returns is the catch-up's (``synced``)."""
+        frames = self._frames
+        chains, latency, fell = frames.chains, frames.chain_latency, frames.irq_fell
+        frames.chains, frames.chain_latency = 0, -1
+        self.tail_chained += chains
+        self._board._chained(chains, latency, None if fell < 0 else fell)
 
     def _thresholds(self, events: list[tuple[float, str]], next_start: float) -> tuple[int, int, int]:
         """The first core cycle whose synchronisation runs a cycle's start or end, the one that runs the latch
@@ -468,6 +496,13 @@ class NativeFrames:
             int(frame is not None), 0 if frame is None else frame.fall,
             0 if frame is None or frame.driven is None else frame.driven, *transfer, board._ss_rise, board._cd_before,
             board._irq_level, 0, 0, 0, exti.pr, 0, 0)  # fmt: skip
+        exti0, active, pending = self._exti0, core.active, core.pending
+        fell = board._irq_fell
+        _CHAIN.pack_into(
+            frames, _CHAIN_AT, int(len(active) == 1 and active[0] == exti0 and len(pending) == (exti0 in pending)
+                                   and exti0 in core.enabled and core._native_exceptions and bench.cycles < bench._hold
+                                   and self.tail_chains),
+            int(exti0 in pending), exti.imr, -1 if fell is None else fell, core.vtor + 4 * exti0)  # fmt: skip
 
     def _configuration(self) -> None:
         """MCU-78: the fields the peripherals' configuration decides (GPIOA's clock and output pins, SPI1's mode and
