@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import Board
-from supi3.mcu.core import CPUS, EXTERNAL
+from supi3.mcu.core import CPUS, EXTERNAL, idle_loops
 from supi3.mcu.stm32 import EXTI_PR
 from supi3.sdk import native
 
@@ -265,10 +265,11 @@ whether the handler clears PR again after its wait."""
 
 
 def _unwatched(elf: Path, cpu: str, bit_rate: int, runs: list[Run], *, primask_at: int | None = None,
-               **options: object) -> tuple[tuple[object, ...], int]:  # fmt: skip
-    """A history of runs on a board nobody watches (MCU-86: hook.c's tail-chains on, unless ``options`` turn them
-    off): everything the run shows, and how many tail-chains hook.c took. ``primask_at``: the run after which PRIMASK
-    is set (the core stopped wherever ``run_for`` ended: inside a handler, EXTI0's next return cannot chain)."""
+               **options: object) -> tuple[tuple[object, ...], tuple[int, int]]:  # fmt: skip
+    """A history of runs on a board nobody watches (MCU-86: hook.c's returns on, unless ``options`` turn them
+    off): everything the run shows, and how many tail-chains and plain returns hook.c took. ``primask_at``: the run
+    after which PRIMASK is set (the core stopped wherever ``run_for`` ended: inside a handler, EXTI0's next return
+    cannot chain)."""
     tail_chains = options.pop("tail_chains", True)
     board = _board(elf, cpu, bit_rate, **options)
     frames = board.native_frames
@@ -287,12 +288,12 @@ def _unwatched(elf: Path, cpu: str, bit_rate: int, runs: list[Run], *, primask_a
              board.irq_latency_s, board._irq_fell, board.now, board.bench.cycles, board.master.inputs(1),
              sorted(core.pending), list(core.active), board.served,
              [(v.time_s, v.pc, str(v.error)) for v in board.violations]),
-            0 if frames is None else frames.tail_chained)  # fmt: skip
+            (0, 0) if frames is None else (frames.tail_chained, frames.plain_returns))  # fmt: skip
 
 
-def _alike(elf: Path, cpu: str, bit_rate: int, runs: list[Run], primask_at: int | None = None) -> int:
-    """:func:`_unwatched` with hook.c's tail-chains, without them and with every frame in Python: the same run; the
-    number of tail-chains hook.c took."""
+def _alike(elf: Path, cpu: str, bit_rate: int, runs: list[Run], primask_at: int | None = None) -> tuple[int, int]:
+    """:func:`_unwatched` with hook.c's returns, without them and with every frame in Python: the same run; the
+    number of tail-chains and plain returns hook.c took."""
     native, chains = _unwatched(elf, cpu, bit_rate, runs, primask_at=primask_at)
     assert native == _unwatched(elf, cpu, bit_rate, runs, primask_at=primask_at, tail_chains=False)[0]
     assert native == _unwatched(elf, cpu, bit_rate, runs, primask_at=primask_at, native_frames=False)[0]
@@ -304,20 +305,21 @@ def test_the_native_tail_chain_runs_alike(late_irq: dict[str, Path], cpu: str) -
     """MCU-86: hook.c takes the returns whose tail-chain only samples EXTI0's line (the mirror valid, no bus event
     due): runs that chain (a wait longer than the cycle, PR cleared late or not), runs that end inside a handler
     (``run_for``) and runs on after it show the same as with each return in Python. late_irq's wait makes no access,
-    so most of its returns find the next cycle's event due (Python's); one chain here is hook.c's (issue #13's case
-    below: nearly all)."""
+    so most of its chains find the next cycle's event due (Python's); one chain here is hook.c's (issue #13's case
+    below: nearly all), and the returns of the handlers without a wait are plain ones, hook.c's."""
     runs: list[Run] = [(300, 3, 0, False), (300, 0, 700, True), (300, 0, 450, False), (0, 2, 0, False),
                        (450, 3, 0, True)]  # fmt: skip
-    assert _alike(late_irq[cpu], cpu, 500_000, runs) >= 1
+    chains, plain = _alike(late_irq[cpu], cpu, 500_000, runs)
+    assert chains >= 1 and plain >= 3
 
 
 def test_a_return_under_primask_is_python_s(late_irq: dict[str, Path]) -> None:
     """MCU-86: PRIMASK set inside a handler (by the test, where ``run_for`` ended) masks EXTI0 in thread mode
     (B1.5.4): its next return does not chain, EXTI0 stays pending, the same with hook.c's tail-chains as without."""
     runs: list[Run] = [(300, 0, 650, False), (300, 0, 900, False)]
-    chains = _alike(late_irq["cortex_m3"], "cortex_m3", 500_000, runs, primask_at=0)
+    counts = _alike(late_irq["cortex_m3"], "cortex_m3", 500_000, runs, primask_at=0)
     _, native = _unwatched(late_irq["cortex_m3"], "cortex_m3", 500_000, runs[:1])
-    assert chains == native  # none after PRIMASK
+    assert counts == native  # none after PRIMASK
 
 
 def test_issue_13_s_case_chains_natively_alike(tmp_path: Path) -> None:
@@ -375,4 +377,46 @@ def test_a_line_held_through_the_handler_chains_natively_alike(late_irq: dict[st
                          board.now, list(core.active), sorted(core.pending)))  # fmt: skip
         if native_frames:
             assert board.native_frames is not None and board.native_frames.tail_chained >= 5
+    assert outcomes[0] == outcomes[1]
+
+
+def test_a_return_onto_b_dot_is_python_s(late_irq: dict[str, Path]) -> None:
+    """MCU-86 and MCU-4: the frame of a handler that ``run_for`` left running gets a ``b .`` in flash as its return
+    address (the test writes it), so every later EXTI0 handler returns onto that wait, which the run loop takes
+    without running its block; hook.c leaves those returns to Python, and the run is the same with every frame in
+    Python."""
+    outcomes = []
+    for native_frames in (True, False):
+        board = _board(late_irq["cortex_m3"], "cortex_m3", 500_000, native_frames=native_frames)
+        core = board.core
+        _hold(board, 100)
+        board.run_for(400e-6)
+        assert list(core.active) == [EXTI0]
+        idle = idle_loops(core.image, core.flash)[0]
+        core.write_bytes(int(core._state.frame) + 24, struct.pack("<I", idle))  # the stacked return address
+        _hold(board, 0)
+        board.run(6)
+        outcomes.append((core.cycles, core.instructions, core.registers(), board.interrupts, board.irq_latency_s,
+                         board.now, core.sleeping, core.pc))  # fmt: skip
+        if native_frames:
+            assert board.native_frames is not None and board.native_frames.plain_returns == 0
+        assert board.interrupts >= 7 and core.pc == idle
+    assert outcomes[0] == outcomes[1]
+
+
+def test_a_main_loop_after_a_plain_return_stops_at_the_bus_event(tmp_path: Path) -> None:
+    """MCU-86: digital_io with mcu/main_loop.c's fw_loop: the EXTI0 handler only notes the edge and returns, plain, to
+    a main loop that keeps running; hook.c's return gives the step the run loop's deadline for thread mode (the next
+    bus event, not the handler's wait after it), so the next /IRQ fall is taken on time, as with every frame in
+    Python."""
+    elf = mcu_build.build([native.example("digital_io"), MCU / "main_loop.c"], tmp_path / "loop.elf")
+    outcomes = []
+    for native_frames in (True, False):
+        board = Board(elf, bit_rate=500_000, strict=False, native_frames=native_frames)
+        board.run(10)
+        core = board.core
+        outcomes.append((core.cycles, core.instructions, core.registers(), board.interrupts, board.irq_latency_s,
+                         board.now, board.master.inputs(1)))  # fmt: skip
+        if native_frames:
+            assert board.native_frames is not None and board.native_frames.plain_returns >= 5
     assert outcomes[0] == outcomes[1]

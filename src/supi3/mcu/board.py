@@ -672,13 +672,17 @@ class Board:
                 self.irq_latency_s = max(self.irq_latency_s, (self.core.cycles - self._irq_fell) / self._cpu_hz)
                 self._irq_fell = None
 
-    def _chained(self, chains: int, latency: int, fell: int | None) -> None:
-        """MCU-86: ``chains`` tail-chains into EXTI0 hook.c took since the last catch-up, each as
-        :meth:`CortexM.exception_return` and :meth:`_entered` take one: EXTI0 no longer pending (and still active),
-        the entries counted (the main loop's passes were reset at the first entry of the chain, and none arrives in
-        a handler); ``latency``: the longest /IRQ latency of their entries in core cycles (-1: none measured),
-        ``fell``: :attr:`_irq_fell` after them."""
-        self.core.pending.discard(_EXTI0)
+    def _chained(self, chains: int, latency: int, fell: int | None, returned: bool) -> None:
+        """MCU-86: the returns of EXTI0's handler hook.c took since the last catch-up, as
+        :meth:`CortexM.exception_return` and :meth:`_entered` take them: ``chains`` tail-chains (EXTI0 no longer
+        pending, still active, the entries counted; the main loop's passes were reset at the first entry of the
+        chain, and none arrives in a handler), then, ``returned``, a plain return (EXTI0 no longer active);
+        ``latency``: the longest /IRQ latency of their entries in core cycles (-1: none measured), ``fell``:
+        :attr:`_irq_fell` after them."""
+        core = self.core
+        core.pending.discard(_EXTI0)
+        if returned:
+            core.active.pop()
         self.interrupts += chains
         if latency >= 0:
             self.irq_latency_s = max(self.irq_latency_s, latency / self._cpu_hz)
@@ -1031,14 +1035,16 @@ class Board:
         for that long, spinning, still lets the bus run on, and a run's wait ends at its bound); none while the
         master holds at a run's end (MCU-55: no bus event comes). The core's next entry: the run loop's answer of
         the step (MCU-79)."""
-        core, bench = self.core, self._bench
+        bench = self._bench
         assert bench is not None  # transaction level
-        at = bench.next_change_s()
+        handler = self._entry == _EXTI0 or _EXTI0 in self.core.active
+        return self._deadline_of(bench.next_change_s(), self._wait_s if handler else 0.0)
+
+    def _deadline_of(self, at: float, wait_s: float) -> int:
+        """The core cycle the run loop stops at ``wait_s`` after a bus event at ``at`` (never: no bound)."""
         if at == math.inf:
             return MAX_DEADLINE
-        if self._entry == _EXTI0 or _EXTI0 in core.active:
-            at += self._wait_s
-        return math.ceil(at * core.cpu_hz - NOISE_CYCLES)
+        return math.ceil((at + wait_s) * self._cpu_hz - NOISE_CYCLES)
 
     def _bus_ran(self) -> None:
         """MCU-86: the bus ran during a step (hook.c's /SS edge past a bus event, :meth:`NativeFrames._bus_due`)

@@ -59,6 +59,7 @@ __all__ = [
     "EXC_RETURN_HANDLER",
     "EXC_RETURN_THREAD_MSP",
     "EXC_RETURN_THREAD_PSP",
+    "IDLE_LOOP",
     "CortexM",
     "Cpu",
     "FirmwareError",
@@ -117,7 +118,7 @@ SCS_BASE: Final[int] = 0xE000_E000
 SCS_SIZE: Final[int] = 0x1000
 _PAGE: Final[int] = 0x1000
 """The emulator maps memory in 4 KiB pages: a memory's base and size are multiples of it."""
-_IDLE_LOOP: Final[bytes] = b"\xfe\xe7"
+IDLE_LOOP: Final[bytes] = b"\xfe\xe7"
 """``b .``, a branch to itself (B T2 with offset -4: E7FEh), MCU-4."""
 _ADDRESS_SPACE: Final[int] = 1 << 32
 SYST_MAX: Final[int] = 0xFF_FFFF
@@ -581,7 +582,7 @@ def idle_loops(image: FirmwareImage, flash: tuple[int, int]) -> tuple[int, ...]:
     for address, data in image.segments:
         if base <= address < base + size:
             start = address & 1
-            found += [address + k for k in range(start, len(data) - 1, 2) if data[k:k + 2] == _IDLE_LOOP]
+            found += [address + k for k in range(start, len(data) - 1, 2) if data[k:k + 2] == IDLE_LOOP]
     return tuple(found)
 
 
@@ -1492,7 +1493,7 @@ class CortexM:
         idle = self._idle.get(pc)
         if idle is None:
             idle = self._idle[pc] = bool(self.flash[0] <= pc < self.flash[0] + self.flash[1] - 1 and
-                                         self.read_bytes(pc, 2) == _IDLE_LOOP)  # fmt: skip
+                                         self.read_bytes(pc, 2) == IDLE_LOOP)  # fmt: skip
         return idle
 
     def _on_invalid_access(self, handle: int, access: int, address: int, size: int, value: int,

@@ -41,7 +41,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Final, Protocol
 
 from supi3.interbus import wire
-from supi3.mcu.core import HeldRegister
+from supi3.mcu.core import IDLE_LOOP, HeldRegister
 from supi3.mcu.hook import BUS_DUE, Frames, NativeHookError
 from supi3.mcu.stm32 import (
     CR1_CPHA,
@@ -114,6 +114,7 @@ class FrameBoard(Protocol):
     _cd_before: int
     _irq_level: int
     _irq_fell: int | None
+    _bounds: int
     _mod_ack_until: int
     _least_t1: int
     _least_t2: int
@@ -126,7 +127,9 @@ class FrameBoard(Protocol):
 
     def _now(self) -> int: ...
 
-    def _chained(self, chains: int, latency: int, fell: int | None) -> None: ...
+    def _chained(self, chains: int, latency: int, fell: int | None, returned: bool) -> None: ...
+
+    def _deadline_of(self, at: float, wait_s: float) -> int: ...
 
     def _bus_ran(self) -> None: ...
 
@@ -202,8 +205,9 @@ from changed (:meth:`NativeFrames._configuration`), in their order there."""
 _MIRROR_FIELDS: Final[tuple[str, ...]] = (
     "valid", "due", "latch", "latch_at", "gpio_levels", "io", "io_at", *_STATE_FIELDS[:-3])  # fmt: skip
 """The fields :meth:`NativeFrames.refresh` writes at each call, in their order there."""
-_CHAIN_FIELDS: Final[tuple[str, ...]] = ("chain_leave", "chain_pending", "exti_imr", "irq_fell", "chain_vector")
-"""MCU-86: the fields :meth:`NativeFrames.refresh` writes for hook.c's tail-chain, in their order there."""
+_CHAIN_FIELDS: Final[tuple[str, ...]] = (
+    "chain_leave", "chain_pending", "exti_imr", "irq_fell", "chain_vector", "thread_deadline")
+"""MCU-86: the fields :meth:`NativeFrames.refresh` writes for hook.c's returns of EXTI0, in their order there."""
 
 
 def _packed(names: tuple[str, ...]) -> tuple[struct.Struct, int]:
@@ -311,15 +315,18 @@ class NativeFrames:
         self._configured: tuple[object, ...] | None = None  # MCU-78: what the configuration fields were made of
         self._bench = board.bench  # the transaction-level bench, set once at the board's construction
         self._due_key: tuple[int, float | None, float] | None = None  # the bench's next events, as last mirrored
-        self._due = (0, _NEVER, _NEVER)
+        self._due = (0, _NEVER, _NEVER, _NEVER)
         self._first_due = _FirstDue(self._hz, noise)
         self._written: tuple[str | None, ...] = _registers._WRITE_NAMES
         self._exti0 = exti0
         frames.chain_number, frames.tail_chain_cycles = exti0, core.cpu.tail_chain_cycles  # MCU-86
+        frames.return_cycles, frames.idle_loop = core.cpu.return_cycles, int.from_bytes(IDLE_LOOP, "little")
         self.tail_chained = 0
         """MCU-86: the tail-chains hook.c took (a count for tests and benchmarks)."""
+        self.plain_returns = 0
+        """MCU-86: the plain returns of EXTI0's handler hook.c took (a count for tests and benchmarks)."""
         self.tail_chains = True
-        """MCU-86: hook.c takes EXTI0's tail-chains at its handler's returns (off: every return goes to Python's
+        """MCU-86: hook.c takes EXTI0's returns, tail-chains and plain ones (off: every return goes to Python's
         ``CortexM.exception_return``, for a test that watches it and ``CortexM.entered``)."""
         self._command: object = None
         self._code = _NO_COMMAND
@@ -363,7 +370,7 @@ class NativeFrames:
         if not frames.valid:
             return
         frames.valid = 0
-        if frames.chains:
+        if frames.chains or frames.returned:
             self._chained()
         if not frames.pending:
             return
@@ -413,18 +420,22 @@ class NativeFrames:
             spi._holding = True
 
     def _chained(self) -> None:
-        """MCU-86: hook.c's tail-chains into EXTI0 since the last catch-up, handed to the board
-        (``Board._chained``); the bus synchronisation to their returns is the catch-up's (``synced``)."""
+        """MCU-86: hook.c's returns of EXTI0's handler since the last catch-up (tail-chains, then perhaps a plain
+        return), handed to the board (``Board._chained``); the bus synchronisation to them is the catch-up's
+        (``synced``)."""
         frames = self._frames
-        chains, latency, fell = frames.chains, frames.chain_latency, frames.irq_fell
-        frames.chains, frames.chain_latency = 0, -1
+        chains, latency, fell, returned = frames.chains, frames.chain_latency, frames.irq_fell, frames.returned
+        frames.chains = frames.returned = 0
+        frames.chain_latency = -1
         self.tail_chained += chains
-        self._board._chained(chains, latency, None if fell < 0 else fell)
+        self.plain_returns += returned
+        self._board._chained(chains, latency, None if fell < 0 else fell, bool(returned))
 
-    def _thresholds(self, events: list[tuple[float, str]], next_start: float) -> tuple[int, int, int]:
+    def _thresholds(self, events: list[tuple[float, str]], next_start: float) -> tuple[int, int, int, int]:
         """The first core cycle whose synchronisation runs a cycle's start or end, the one that runs the latch
         phase's start and the one that sets the I/O access bit (each :data:`_NEVER` if none comes before): the phases
-        only set the chips' flags (MCU-52, MCU-66)."""
+        only set the chips' flags (MCU-52, MCU-66); and the run loop's deadline for thread mode at that event
+        (MCU-86: ``Board._deadline_of``, the next event ``Board._bus_deadline`` stops at)."""
         due = self._first_due
         latch_at = io_at = _NEVER
         for at, what in reversed(events):  # the next first
@@ -433,9 +444,8 @@ class NativeFrames:
             elif what == _IO:
                 io_at = due[at]
             else:
-                return due[at], latch_at, io_at
-        return due[next_start], latch_at, io_at
-
+                return due[at], latch_at, io_at, self._board._deadline_of(at, 0.0)
+        return due[next_start], latch_at, io_at, self._board._deadline_of(next_start, 0.0)
 
     def refresh(self) -> None:
         """After Python's write of GPIOA or SPI1: mirror the model's state for the native frames, valid if the
@@ -489,7 +499,7 @@ class NativeFrames:
         if key != self._due_key:
             self._due_key = key
             self._due = self._thresholds(events, bench._next_start)
-        due, latch_at, io_at = self._due
+        due, latch_at, io_at, thread = self._due
         _MIRROR.pack_into(
             frames, _MIRROR_AT, 1, due, int(registers._latch_phase), latch_at, gpio._levels,
             int(registers._io_access), io_at, 0, gpio.odr, 0, phase, code, protocol.last_rx,
@@ -497,12 +507,13 @@ class NativeFrames:
             0 if frame is None or frame.driven is None else frame.driven, *transfer, board._ss_rise, board._cd_before,
             board._irq_level, 0, 0, 0, exti.pr, 0, 0)  # fmt: skip
         exti0, active, pending = self._exti0, core.active, core.pending
-        fell = board._irq_fell
-        _CHAIN.pack_into(
-            frames, _CHAIN_AT, int(len(active) == 1 and active[0] == exti0 and len(pending) == (exti0 in pending)
-                                   and exti0 in core.enabled and core._native_exceptions and bench.cycles < bench._hold
-                                   and self.tail_chains),
-            int(exti0 in pending), exti.imr, -1 if fell is None else fell, core.vtor + 4 * exti0)  # fmt: skip
+        if (len(active) == 1 and active[0] == exti0 and len(pending) == (exti0 in pending) and exti0 in core.enabled
+                and core._native_exceptions and bench.cycles < bench._hold and self.tail_chains):  # fmt: skip
+            fell = board._irq_fell
+            _CHAIN.pack_into(frames, _CHAIN_AT, 1, int(exti0 in pending), exti.imr, -1 if fell is None else fell,
+                             core.vtor + 4 * exti0, min(board._bounds, thread))  # fmt: skip
+        else:
+            frames.chain_leave = 0
 
     def _configuration(self) -> None:
         """MCU-78: the fields the peripherals' configuration decides (GPIOA's clock and output pins, SPI1's mode and

@@ -424,14 +424,18 @@ typedef struct {
     uint64_t primask_register; /* unicorn's number of PRIMASK */
     uint64_t chain_number;     /* EXTI0's exception number */
     uint64_t tail_chain_cycles;
+    uint64_t return_cycles;    /* Cpu.return_cycles */
+    uint64_t idle_loop;        /* the halfword of `b .` (MCU-4) */
     /* mirrored by Python with the rest (refresh): */
     uint64_t chain_leave;    /* the return Python would only decide by EXTI0's line (NativeFrames._chain_leave) */
     uint64_t chain_pending;  /* EXTI0 pending (pended again while active, MCU-81) */
     uint64_t exti_imr;       /* EXTI's IMR */
     int64_t irq_fell;        /* Board._irq_fell, -1: none */
     uint64_t chain_vector;   /* VTOR + 4 * chain_number */
-    /* what the tail-chains taken here since the last catch-up did (NativeFrames._chained): */
+    uint64_t thread_deadline; /* the step's deadline once EXTI0 has returned (Board._deadline_of the next bus event, the step's other bounds) */
+    /* what the returns taken here since the last catch-up did (NativeFrames._chained): */
     uint64_t chains;
+    uint64_t returned;       /* a plain return to thread mode (the last: EXTI0 is no longer active) */
     int64_t chain_latency;   /* the longest /IRQ latency of their entries in core cycles, -1: none measured */
     uint8_t values[16];   /* what a read of each address returns (fast reads only) */
     uint8_t written_values[16];
@@ -728,44 +732,62 @@ uint64_t supi3_port_read(void *uc, uint64_t offset, unsigned size, void *data) {
 
 /* MCU-86: the run stopped at an exception return (`pc`: its EXC_RETURN) of EXTI0's handler. Python's return
  * (CortexM.exception_return, Board._returning) would run the bus up to the return, let the NVIC sample EXTI0's line and
- * tail-chain into it if it is pending again; it is taken here, as that path takes it, when that is all it would do:
- * the mirror valid, Python's leave (EXTI0 alone active and at most itself pending, enabled, the run not at its end),
- * no stop asked, no code written, the deadline and the next bus event (`due`: the flag events before it only set the
- * chip's flags, which the catch-up's synchronisation runs, MCU-52) after the return, EXC_RETURN a return to thread mode
- * (the only valid one with one exception active, B1.5.8), PRIMASK clear (a priority is a byte, below thread mode's
- * 256, B1.5.4), EXTI0 pending or its line asserted, and its vector in memory with bit 0 set. The chain's effects on
- * Python's objects (EXTI0 no longer pending, the entry's count and latency) are counted for the catch-up. 1: taken. */
-static int tail_chain(void *uc, supi3_frames *f) {
+ * tail-chain into it if it is pending again, else unstack the frame; it is taken here, as that path takes it, when
+ * that is all it would do: the mirror valid, Python's leave (EXTI0 alone active and at most itself pending, enabled,
+ * the run not at its end), no stop asked, no code written, the deadline and the next bus event (`due`: the flag events
+ * before it only set the chip's flags, which the catch-up's synchronisation runs, MCU-52) after the return, EXC_RETURN
+ * a return to thread mode (the only valid one with one exception active, B1.5.8), and PRIMASK clear (a priority is a
+ * byte, below thread mode's 256, B1.5.4). EXTI0 pending or its line asserted: the tail-chain, if its vector is in
+ * memory with bit 0 set. Else the plain return, if the frame is in memory and the code returned to is not `b .` (a
+ * wait the run loop takes without running it, MCU-4); the step's deadline becomes the run loop's for thread mode. The
+ * effects on Python's objects (EXTI0 no longer pending or active, the entry's count and latency) are counted for the
+ * catch-up. 1: taken. */
+static int exti0_return(void *uc, supi3_frames *f) {
     supi3_state *s = f->state;
     uint32_t exc_return = (uint32_t)s->pc | 1u;
     uint64_t now = s->cycles;
     uint64_t primask = 0;
     uint8_t bytes[4];
     if (!f->valid || !f->chain_leave || s->stop_request || s->code_written || now >= s->deadline || now >= f->due ||
-        (exc_return != s->exc_return_thread_msp && exc_return != s->exc_return_thread_psp) ||
-        !(f->chain_pending || (f->exti_pr & f->exti_imr & 1))) {
+        (exc_return != s->exc_return_thread_msp && exc_return != s->exc_return_thread_psp)) {
         return 0;
     }
     s->reg_read(uc, (int)f->primask_register, &primask);
-    if (primask & 1 || s->mem_read(uc, f->chain_vector, bytes, sizeof bytes) != 0 || !(little_endian(bytes) & 1)) {
+    if (primask & 1) {
         return 0;
     }
-    supi3_take(uc, s, (uint32_t)f->chain_number, exc_return, f->chain_vector);
-    s->cycles = now + f->tail_chain_cycles;
-    if (f->irq_fell >= 0) {
-        int64_t latency = (int64_t)s->cycles - f->irq_fell;
-        f->chain_latency = latency > f->chain_latency ? latency : f->chain_latency;
-        f->irq_fell = -1;
+    if (f->chain_pending || (f->exti_pr & f->exti_imr & 1)) {
+        if (s->mem_read(uc, f->chain_vector, bytes, sizeof bytes) != 0 || !(little_endian(bytes) & 1)) {
+            return 0;
+        }
+        supi3_take(uc, s, (uint32_t)f->chain_number, exc_return, f->chain_vector);
+        s->cycles = now + f->tail_chain_cycles;
+        if (f->irq_fell >= 0) {
+            int64_t latency = (int64_t)s->cycles - f->irq_fell;
+            f->chain_latency = latency > f->chain_latency ? latency : f->chain_latency;
+            f->irq_fell = -1;
+        }
+        f->chain_pending = 0;
+        f->chains += 1;
+    } else {
+        uint32_t sp = core_read(uc, s, exc_return == s->exc_return_thread_psp ? EXC_PSP : EXC_SP);
+        uint8_t code[2];
+        if (s->mem_read(uc, (uint64_t)sp + 24, bytes, sizeof bytes) != 0 ||
+            s->mem_read(uc, little_endian(bytes) & ~1u, code, sizeof code) != 0 ||
+            (code[0] | (uint64_t)code[1] << 8) == f->idle_loop || supi3_return(uc, s, exc_return) != 0) {
+            return 0;
+        }
+        s->cycles = now + f->return_cycles;
+        s->deadline = s->deadline < f->thread_deadline ? s->deadline : f->thread_deadline;
+        f->returned = 1; /* no other return follows in this run: an entry is Python's */
     }
-    f->chain_pending = 0;
-    f->chains += 1;
     f->synced = now + 1;
     f->pending = 1;
     return 1;
 }
 
 /* A run from the PC (its Thumb bit set) until a hook stops it (MCU-72): no interrupt yet, the PC afterwards in `pc`;
- * unicorn's status. An exception return tail_chain takes runs on from the handler's first instruction (MCU-86). */
+ * unicorn's status. An exception return exti0_return takes runs on from the code it returns to (MCU-86). */
 int supi3_run(void *uc, supi3_state *s, supi3_frames *f) {
     int status = 0;
     do {
@@ -775,7 +797,7 @@ int supi3_run(void *uc, supi3_state *s, supi3_frames *f) {
         status = s->emu_start(uc, pc | 1, 0, 0, 0);
         s->pc = 0;
         s->reg_read(uc, s->pc_register, &s->pc);
-    } while (status == 0 && s->interrupt == f->exception_exit && tail_chain(uc, f));
+    } while (status == 0 && s->interrupt == f->exception_exit && exti0_return(uc, f));
     return status;
 }
 
@@ -808,7 +830,7 @@ const uint32_t supi3_held_layout[] = {
 const uint32_t supi3_prefix_layout[] = {
     4, sizeof(supi3_prefix), AT(supi3_prefix, address), AT(supi3_prefix, pc), AT(supi3_prefix, cycles)};
 const uint32_t supi3_frames_layout[] = {
-    90, sizeof(supi3_frames), AT(supi3_frames, state), AT(supi3_frames, spi), AT(supi3_frames, prefixes),
+    94, sizeof(supi3_frames), AT(supi3_frames, state), AT(supi3_frames, spi), AT(supi3_frames, prefixes),
     AT(supi3_frames, prefix_mask), AT(supi3_frames, bus_due), AT(supi3_frames, least_t1), AT(supi3_frames, least_t2),
     AT(supi3_frames, least_t8), AT(supi3_frames, ss_pin), AT(supi3_frames, cd_command), AT(supi3_frames, cd_data),
     AT(supi3_frames, phase_command), AT(supi3_frames, phase_data), AT(supi3_frames, sr_txe),
@@ -828,8 +850,10 @@ const uint32_t supi3_frames_layout[] = {
     AT(supi3_frames, rx_last), AT(supi3_frames, shift_received), AT(supi3_frames, shift_start),
     AT(supi3_frames, shift_end), AT(supi3_frames, taken), AT(supi3_frames, exception_exit),
     AT(supi3_frames, primask_register), AT(supi3_frames, chain_number), AT(supi3_frames, tail_chain_cycles),
+    AT(supi3_frames, return_cycles), AT(supi3_frames, idle_loop),
     AT(supi3_frames, chain_leave), AT(supi3_frames, chain_pending), AT(supi3_frames, exti_imr),
-    AT(supi3_frames, irq_fell), AT(supi3_frames, chain_vector), AT(supi3_frames, chains),
+    AT(supi3_frames, irq_fell), AT(supi3_frames, chain_vector), AT(supi3_frames, thread_deadline),
+    AT(supi3_frames, chains), AT(supi3_frames, returned),
     AT(supi3_frames, chain_latency), AT(supi3_frames, values),
     AT(supi3_frames, written_values), AT(supi3_frames, plain), AT(supi3_frames, address), AT(supi3_frames, rd),
     AT(supi3_frames, wr), AT(supi3_frames, reads_register), AT(supi3_frames, writes_register),
