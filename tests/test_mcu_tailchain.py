@@ -19,6 +19,7 @@ import pytest
 from hypothesis import Phase, example, given, settings
 from hypothesis import strategies as st
 
+from supi3.errors import ArgumentError
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import Board
 from supi3.mcu.core import CPUS, EXTERNAL, idle_loops
@@ -420,3 +421,14 @@ def test_a_main_loop_after_a_plain_return_stops_at_the_bus_event(tmp_path: Path)
         if native_frames:
             assert board.native_frames is not None and board.native_frames.plain_returns >= 5
     assert outcomes[0] == outcomes[1]
+
+
+@pytest.mark.parametrize("value", ["no", 0, None, 1.0])
+def test_tail_chains_takes_a_bool_only(late_irq: dict[str, Path], value: object) -> None:
+    """MCU-86's switch refuses anything but a bool by name (a string would have reached ``int()`` at the next
+    refresh)."""
+    board = Board(late_irq["cortex_m3"], strict=False)
+    assert board.native_frames is not None and board.native_frames.tail_chains
+    with pytest.raises(ArgumentError, match="tail_chains"):
+        board.native_frames.tail_chains = value  # type: ignore[assignment]
+    assert board.native_frames.tail_chains

@@ -40,6 +40,7 @@ import struct
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Final, Protocol
 
+from supi3.checks import check_bool
 from supi3.interbus import wire
 from supi3.mcu.core import IDLE_LOOP, HeldRegister
 from supi3.mcu.hook import BUS_DUE, Frames, NativeHookError
@@ -325,9 +326,7 @@ class NativeFrames:
         """MCU-86: the tail-chains hook.c took (a count for tests and benchmarks)."""
         self.plain_returns = 0
         """MCU-86: the plain returns of EXTI0's handler hook.c took (a count for tests and benchmarks)."""
-        self.tail_chains = True
-        """MCU-86: hook.c takes EXTI0's returns, tail-chains and plain ones (off: every return goes to Python's
-        ``CortexM.exception_return``, for a test that watches it and ``CortexM.entered``)."""
+        self._tail_chains = True
         self._command: object = None
         self._code = _NO_COMMAND
         self.bus_dues = 0
@@ -338,6 +337,17 @@ class NativeFrames:
         frames.pending = 0
         core.entry = self.catch_up
         core.resume = self.refresh
+
+    @property
+    def tail_chains(self) -> bool:
+        """MCU-86: hook.c takes EXTI0's returns, tail-chains and plain ones (the default); ``False``: every return
+        goes to Python's ``CortexM.exception_return``, for a test that watches it and ``CortexM.entered``. The same
+        run either way."""
+        return self._tail_chains
+
+    @tail_chains.setter
+    def tail_chains(self, value: bool) -> None:
+        self._tail_chains = check_bool("tail_chains", value)
 
     def _bus_due(self, offset: int, value: int) -> None:
         """MCU-84: hook.c's /SS edge (GPIOA's BSRR or BRR written with ``value``) has a bus event due at or before
@@ -508,7 +518,7 @@ class NativeFrames:
             board._irq_level, 0, 0, 0, exti.pr, 0, 0)  # fmt: skip
         exti0, active, pending = self._exti0, core.active, core.pending
         if (len(active) == 1 and active[0] == exti0 and len(pending) == (exti0 in pending) and exti0 in core.enabled
-                and core._native_exceptions and bench.cycles < bench._hold and self.tail_chains):  # fmt: skip
+                and core._native_exceptions and bench.cycles < bench._hold and self._tail_chains):  # fmt: skip
             fell = board._irq_fell
             _CHAIN.pack_into(frames, _CHAIN_AT, 1, int(exti0 in pending), exti.imr, -1 if fell is None else fell,
                              core.vtor + 4 * exti0, min(board._bounds, thread))  # fmt: skip
