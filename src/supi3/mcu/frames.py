@@ -229,6 +229,10 @@ _STATE, _STATE_AT = _packed(_STATE_FIELDS)
 _MIRROR, _MIRROR_AT = _packed(_MIRROR_FIELDS)
 _CONFIG, _CONFIG_AT = _packed(_CONFIG_FIELDS)
 _CHAIN, _CHAIN_AT = _packed(_CHAIN_FIELDS)
+_BUS_STATE, _BUS_STATE_AT = _packed(("irq_level", "written", "cleared", "cleared_at", "exti_pr"))
+"""MCU-88: the native state the bus run reads (``NativeFrames._bus_half``)."""
+_BUS_MIRROR, _BUS_MIRROR_AT = _packed(("valid", "due", "latch", "latch_at"))
+"""MCU-88: the mirror's fields before GPIOA's levels that a bus run changes (``NativeFrames._bus_refresh``)."""
 
 
 def first_due(next_at: float, cpu_hz: float, noise: float) -> int:
@@ -351,16 +355,24 @@ class NativeFrames:
 
     def _bus_due(self, offset: int, value: int) -> None:
         """MCU-84: hook.c's /SS edge (GPIOA's BSRR or BRR written with ``value``) has a bus event due at or before
-        it: an entry into Python (:meth:`catch_up`), the bus run up to the edge and /IRQ followed, as
-        ``Board._on_output`` does before the edge, and the mirror made again; hook.c then takes the edge if it is
-        still plain, else calls Python's write, which finds the bus run. A failure stops the run as Python's write
-        would (:meth:`CortexM.fail`), with the register written: that write's state at its failure."""
-        self.catch_up()
+        it: an entry into Python, the bus run up to the edge and /IRQ followed, as ``Board._on_output`` does before
+        the edge, and the mirror made again; hook.c then takes the edge if it is still plain, else calls Python's
+        write, which finds the bus run. A failure stops the run as Python's write would (:meth:`CortexM.fail`), with
+        the register written: that write's state at its failure. MCU-88: only what the bus run reads is caught up
+        first (:meth:`_bus_half`) and only what it changes mirrored after (:meth:`_bus_refresh`); the frames' own
+        state stays hook.c's until the next entry's catch-up."""
+        frames = self._frames
+        frame_pending = False
+        if frames.valid:
+            frames.valid = 0
+            frame_pending = self._bus_half()
         self.bus_dues += 1
         board = self._board
         try:
             board._now()
         except BaseException as error:  # handed to the run loop, raised there (CortexM's own callbacks do the same)
+            if frame_pending:
+                self._frame_half()
             board.core.fail(error)
             gpio = board.gpio
             output, gpio.on_output = gpio.on_output, _unseen
@@ -369,7 +381,10 @@ class NativeFrames:
             finally:
                 gpio.on_output = output
             return
-        self.refresh()
+        if frame_pending:
+            self._bus_refresh()
+        else:
+            self.refresh()
         board._bus_ran()
 
     def catch_up(self) -> None:
@@ -380,19 +395,22 @@ class NativeFrames:
         if not frames.valid:
             return
         frames.valid = 0
+        if self._bus_half():
+            self._frame_half()
+
+    def _bus_half(self) -> bool:
+        """The part of :meth:`catch_up` the bus and /IRQ's bookkeeping read (MCU-88): hook.c's returns of EXTI0
+        (MCU-86), EXTI's PR (MCU-68), the IRQ_EVT reads (MCU-67), /IRQ as followed, the bus synchronised to the
+        latest access, the data registers written; whether the frames' own state (:meth:`_frame_half`) is pending."""
+        frames = self._frames
         if frames.chains or frames.returned:
             self._chained()
         if not frames.pending:
-            return
-        state = _STATE.unpack_from(frames, _STATE_AT)
-        (_, odr, synced, phase, command, last_rx, frame_open, fall, driven, transfer, seen, start, period, ss_rise,
-         cd_before, irq_level, written, cleared, cleared_at, exti_pr, dr_writes, rx_last, received, shift_start,
-         shift_end) = state
-        frames.pending = frames.written = frames.cleared = frames.dr_writes = frames.synced = 0
+            return False
+        irq_level, written, cleared, cleared_at, exti_pr = _BUS_STATE.unpack_from(frames, _BUS_STATE_AT)
+        synced = frames.synced
+        frames.written = frames.cleared = frames.synced = 0
         board = self._board
-        gpio = board.gpio
-        gpio.odr = odr
-        gpio._levels = frames.gpio_levels
         board.exti.pr = exti_pr  # MCU-68: the handler's writes of PR (before the bus runs on: its edges come after)
         if cleared:  # MCU-67: the register file's own read-clear, each read at the latest one's time (no bus event)
             self._packed = None  # MCU-78: the native reads changed Frames.values
@@ -403,18 +421,33 @@ class NativeFrames:
         board._irq_level = irq_level  # /IRQ rose with the clear: the board followed it (no EXTI bit, MCU-67)
         if synced:  # the bus run up to the latest synchronisation: no event but the phases' flags (MCU-52)
             board._sync(synced - 1)
+        if written:
+            values = board.registers._values
+            masked = frames.written_values
+            names = self._written
+            while written:  # each address written, lowest first
+                address = (written & -written).bit_length() - 1
+                values[names[address]] = masked[address]  # FAST_WRITES: a register
+                written &= written - 1
+        return True
+
+    def _frame_half(self) -> None:
+        """The rest of :meth:`catch_up`: GPIOA's outputs, the µP protocol's phase, command and frame, the board's /SS
+        bookkeeping, SPI1's bytes (nothing the bus reads, MCU-88)."""
+        frames = self._frames
+        (_, odr, _, phase, command, last_rx, frame_open, fall, driven, transfer, seen, start, period, ss_rise,
+         cd_before, _, _, _, _, _, dr_writes, rx_last, received, shift_start, shift_end) = _STATE.unpack_from(
+            frames, _STATE_AT)  # fmt: skip
+        frames.pending = frames.dr_writes = 0
+        board = self._board
+        gpio = board.gpio
+        gpio.odr = odr
+        gpio._levels = frames.gpio_levels
         protocol = board.protocol
         protocol.phase = _PHASE_OF[phase]
         if command < _NO_COMMAND:
             protocol.command = _upif._COMMANDS[command]
         protocol.last_rx = last_rx
-        if written:
-            values = board.registers._values
-            masked = frames.written_values
-            names = self._written
-            for address in range(16):
-                if written >> address & 1:
-                    values[names[address]] = masked[address]  # type: ignore[index]  # FAST_WRITES: a register
         board._ss_rise, board._cd_before = ss_rise, cd_before
         if frame_open:
             board._frame = SsFrame(fall, driven, [(seen, 8, start, period)] if transfer else [])
@@ -504,26 +537,61 @@ class NativeFrames:
         if values != self._packed:  # MCU-78: only Python's changes and the native reads' clears change them
             self._packed = values
             self._values.pack_into(frames, self._values_at, *values)
-        events = bench._events  # only popped from the end until the next cycle's start makes a new list
-        key = (len(events), events[-1][0] if events else None, bench._next_start)
-        if key != self._due_key:
-            self._due_key = key
-            self._due = self._thresholds(events, bench._next_start)
-        due, latch_at, io_at, thread = self._due
+        due, latch_at, io_at, thread = self._events_due()
         _MIRROR.pack_into(
             frames, _MIRROR_AT, 1, due, int(registers._latch_phase), latch_at, gpio._levels,
             int(registers._io_access), io_at, 0, gpio.odr, 0, phase, code, protocol.last_rx,
             int(frame is not None), 0 if frame is None else frame.fall,
             0 if frame is None or frame.driven is None else frame.driven, *transfer, board._ss_rise, board._cd_before,
             board._irq_level, 0, 0, 0, exti.pr, 0, 0)  # fmt: skip
+        self._chain_mirror(thread)
+
+    def _events_due(self) -> tuple[int, int, int, int]:
+        """:meth:`_thresholds` of the bench's next events, recomputed only when they changed."""
+        bench = self._bench
+        events = bench._events  # only popped from the end until the next cycle's start makes a new list
+        key = (len(events), events[-1][0] if events else None, bench._next_start)
+        if key != self._due_key:
+            self._due_key = key
+            self._due = self._thresholds(events, bench._next_start)
+        return self._due
+
+    def _chain_mirror(self, thread: int) -> None:
+        """MCU-86: the fields of hook.c's returns of EXTI0: Python's leave and what the returns read (``thread``: the
+        run loop's deadline for thread mode at the bus's next event)."""
+        frames, board, bench = self._frames, self._board, self._bench
+        core = board.core
         exti0, active, pending = self._exti0, core.active, core.pending
         if (len(active) == 1 and active[0] == exti0 and len(pending) == (exti0 in pending) and exti0 in core.enabled
                 and core._native_exceptions and bench.cycles < bench._hold and self._tail_chains):  # fmt: skip
             fell = board._irq_fell
-            _CHAIN.pack_into(frames, _CHAIN_AT, 1, int(exti0 in pending), exti.imr, -1 if fell is None else fell,
+            _CHAIN.pack_into(frames, _CHAIN_AT, 1, int(exti0 in pending), board.exti.imr, -1 if fell is None else fell,
                              core.vtor + 4 * exti0, min(board._bounds, thread))  # fmt: skip
         else:
             frames.chain_leave = 0
+
+    def _bus_refresh(self) -> None:
+        """MCU-88: after :meth:`_bus_half` and the bus run, the mirror's part a bus run changes made again (what
+        :meth:`catch_up` then :meth:`refresh` would make of it; the frames' own state, which the bus does not touch,
+        stays hook.c's, pending): its validity's bus conditions (/IRQ and /ModAck as followed, no fall to time, EXTI0's
+        request settled), the registers' values, the bus's next events, the chip's flags, /IRQ's level, EXTI's PR and
+        the returns' fields. Invalid: the frames' state into the Python objects too (:meth:`_frame_half`)."""
+        frames, board, bench = self._frames, self._board, self._bench
+        registers, core, exti = board.registers, board.core, board.exti
+        if not (bench.low_at is None and board._irq_level == registers.irq_n
+                and bench.chip.mod_ack_until == board._mod_ack_until
+                and (not exti.requesting(0) or self._exti0 in core.active or self._exti0 in core.pending)):  # fmt: skip
+            self._frame_half()
+            return
+        values = self._read_values(registers._values)
+        if values != self._packed:
+            self._packed = values
+            self._values.pack_into(frames, self._values_at, *values)
+        due, latch_at, io_at, thread = self._events_due()
+        _BUS_MIRROR.pack_into(frames, _BUS_MIRROR_AT, 1, due, int(registers._latch_phase), latch_at)
+        frames.io, frames.io_at = int(registers._io_access), io_at
+        frames.irq_level, frames.exti_pr = board._irq_level, exti.pr
+        self._chain_mirror(thread)
 
     def _configuration(self) -> None:
         """MCU-78: the fields the peripherals' configuration decides (GPIOA's clock and output pins, SPI1's mode and
