@@ -573,16 +573,12 @@ class NativeFrames:
     def _bus_refresh(self) -> None:
         """MCU-88: after :meth:`_bus_half` and the bus run, the mirror's part a bus run changes made again (what
         :meth:`catch_up` then :meth:`refresh` would make of it; the frames' own state, which the bus does not touch,
-        stays hook.c's, pending): its validity's bus conditions (/IRQ and /ModAck as followed, no fall to time, EXTI0's
-        request settled), the registers' values, the bus's next events, the chip's flags, /IRQ's level, EXTI's PR and
-        the returns' fields. Invalid: the frames' state into the Python objects too (:meth:`_frame_half`)."""
-        frames, board, bench = self._frames, self._board, self._bench
-        registers, core, exti = board.registers, board.core, board.exti
-        if not (bench.low_at is None and board._irq_level == registers.irq_n
-                and bench.chip.mod_ack_until == board._mod_ack_until
-                and (not exti.requesting(0) or self._exti0 in core.active or self._exti0 in core.pending)):  # fmt: skip
-            self._frame_half()
-            return
+        stays hook.c's, pending): the registers' values, the bus's next events, the chip's flags, /IRQ's level, EXTI's
+        PR and the returns' fields. Still valid: the bus ran an event (``due`` was reached), so the board followed
+        /IRQ and /ModAck after it (no fall left to time) and settled EXTI0's request, the bus conditions of
+        :meth:`refresh`; the others the bus does not change."""
+        frames, board = self._frames, self._board
+        registers, exti = board.registers, board.exti
         values = self._read_values(registers._values)
         if values != self._packed:
             self._packed = values
