@@ -899,6 +899,7 @@ class CortexM:
         self.vtor = 0
         self.systick = SysTick(self)
         self._scs_words: dict[int, int] = {}
+        self._exact_spans: list[tuple[int, int, int]] = []  # first, last address and handle of each exact-PC hook
         self.mmio(SCS_BASE, SCS_SIZE, self._scs_read, self._scs_write)
         self._hook(ucc.UC_HOOK_BLOCK, native.supi3_block_hook, data=ctypes.byref(state))
         self._hook(ucc.UC_HOOK_MEM_WRITE, native.supi3_code_written, flash[0], flash[0] + flash[1] - 1,
@@ -959,12 +960,28 @@ class CortexM:
             self._callbacks.append(native)
             self._check(_LIB.uc_mmio_map(self._handle, base, size, self._port_read, ctypes.byref(native),
                                          self._port_write, ctypes.byref(native)))  # fmt: skip
-        # unicorn updates the PC before a load or store only if a memory hook covers its address: without one, a
-        # peripheral callback sees the PC of the block's first instruction, and the access would be timed there
-        # (MCU-1 places it by the PC). The native hook also notes that PC for cycles_now (MCU-25).
-        self._hook(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, self._exact_pc, base, base + size - 1,
-                   ctypes.byref(self._state))  # fmt: skip
+        self._exact_pc_over(base, base + size - 1)
         return HeldRegister(held)
+
+    def _exact_pc_over(self, first: int, last: int) -> None:
+        """The exact-PC memory hook over the addresses ``first`` to ``last``, merged with those of the ranges next to
+        them: one hook a run of adjacent ranges (MCU-87).
+
+        unicorn updates the PC before a load or store only if a memory hook covers its address: without one, a
+        peripheral callback sees the PC of the block's first instruction, and the access would be timed there (MCU-1
+        places it by the PC). The native hook also notes that PC for cycles_now (MCU-25). Once any memory hook exists,
+        unicorn walks the whole list at every load and store (MCU-87): the board's GPIOA, GPIOB, AFIO and EXTI, next
+        to each other, share one hook; the addresses covered are the same."""
+        kept = []
+        for low, high, handle in self._exact_spans:
+            if high + 1 == first or last + 1 == low:  # next to it (ranges never overlap: uc_mmio_map refuses that)
+                self._check(_LIB.uc_hook_del(self._handle, ctypes.c_size_t(handle)))
+                first, last = min(first, low), max(last, high)
+            else:
+                kept.append((low, high, handle))
+        handle = self._hook(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, self._exact_pc, first, last,
+                            ctypes.byref(self._state))  # fmt: skip
+        self._exact_spans = [*kept, (first, last, handle)]
 
     def watch(self, address: int, callback: Callable[[], None]) -> None:
         """Call ``callback`` each time the instruction at ``address`` is about to run (a code hook on it: the board's
@@ -989,13 +1006,14 @@ class CortexM:
 
         self._hook(ucc.UC_HOOK_CODE, _HOOK_CODE(on_code), address, address)
 
-    def _hook(self, kind: int, callback: Any, begin: int = 1, end: int = 0, data: Any = None) -> None:
+    def _hook(self, kind: int, callback: Any, begin: int = 1, end: int = 0, data: Any = None) -> int:
         """Add a hook with a ctypes callback or a native function (MCU-19, MCU-25) and its user data; ``begin >
-        end``: every address."""
+        end``: every address. Returns unicorn's handle of the hook."""
         self._callbacks.append(callback)
         handle = ctypes.c_size_t()  # uc_hook
         self._check(_LIB.uc_hook_add(self._handle, ctypes.byref(handle), kind, ctypes.cast(callback, ctypes.c_void_p),
                                      data, ctypes.c_uint64(begin), ctypes.c_uint64(end)))  # fmt: skip
+        return handle.value
 
     @staticmethod
     def _check(status: int) -> None:
