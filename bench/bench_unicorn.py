@@ -8,17 +8,17 @@ Three parts, each run from the repository root:
   runs (the instructions MCU-10 and MCU-11 count without running them are not among them), its runs, its memory
   accesses by region and the entries into Python from a peripheral access or a watched address. Counting hooks are
   added to the board's core (and its translations dropped, so they reach every block): deterministic, not timed.
-- ``synthetic``: unicorn alone on a Thumb loop in flash that has issue #13's mix (4 blocks, 14 instructions and 6
-  loads or stores of RAM an iteration; a variant reads a peripheral in place of one RAM load, answered by hook.c's
-  held-register callback without Python), with the hooks added one by one as ``CortexM`` adds them: (a) none but
-  the seven peripheral ranges mapped with ``uc_mmio_map``; (b) the native block hook; (c) the ``UC_HOOK_MEM_READ |
-  UC_HOOK_MEM_WRITE`` hooks of the peripheral ranges (``supi3_exact_pc``, one a run of adjacent ranges, MCU-87);
-  (d) the flash write hook (``supi3_code_written``, MCU-28) and two code hooks at addresses the loop never runs
-  (the idle loops and the serve point, ``CortexM.watch``). Each figure is the fastest of ``--rounds`` interleaved runs, in CPU time. From them:
-  the block hook's cost a block, a RAM access's cost once any memory hook exists (unicorn then sends every guest
-  load and store through its slow path), a peripheral access's cost and the cost of the exact PC at one (unicorn
-  restores the PC from the host return address, ``cpu_restore_state``, when a memory hook covers the address), and
-  what they come to with ``counts``' figures.
+- ``synthetic``: unicorn alone on a Thumb loop in flash that has issue #13's mix (4 blocks, 14 instructions and 6 loads
+  or stores of RAM an iteration; a variant reads a peripheral in place of one RAM load, answered by hook.c's
+  held-register callback without Python), with the hooks added one by one as ``CortexM`` adds them: (a) none but the
+  seven peripheral ranges mapped with ``uc_mmio_map``; (b) the native block hook; (c) the ``UC_HOOK_MEM_READ |
+  UC_HOOK_MEM_WRITE`` hooks of the peripheral ranges (``supi3_exact_pc``, one a run of adjacent ranges, MCU-87); (d) the
+  flash write hook (``supi3_code_written``, MCU-28) and two code hooks at addresses the loop never runs (the idle loops
+  and the serve point, ``CortexM.watch``). Each figure is the fastest of ``--rounds`` interleaved runs, in CPU time.
+  From them: the block hook's cost a block, a RAM access's cost once any memory hook exists (unicorn then sends every
+  guest load and store through its slow path), a peripheral access's cost and the cost of the exact PC at one (unicorn
+  restores the PC from the host return address, ``cpu_restore_state``, when a memory hook covers the address), and what
+  they come to with ``counts``' figures.
 - ``split``: issue #13's case as ``bench_mcu.py`` runs it, its CPU time split into unicorn with hook.c (the native
   runs less the Python they call) and Python, for the board as it is and, to price the memory hooks, for boards
   without the exact-PC hooks or without any memory hook. Those two are not exact (a peripheral access is then timed
