@@ -266,16 +266,21 @@ whether the handler clears PR again after its wait."""
 
 
 def _unwatched(elf: Path, cpu: str, bit_rate: int, runs: list[Run], *, primask_at: int | None = None,
+               tick: tuple[int, int, int] | None = None,
                **options: object) -> tuple[tuple[object, ...], tuple[int, int]]:  # fmt: skip
     """A history of runs on a board nobody watches (MCU-86: hook.c's returns on, unless ``options`` turn them
     off): everything the run shows, and how many tail-chains and plain returns hook.c took. ``primask_at``: the run
     after which PRIMASK is set (the core stopped wherever ``run_for`` ended: inside a handler, EXTI0's next return
-    cannot chain)."""
+    cannot chain). ``tick``: SysTick's reload, EXTI0's and SysTick's priorities, started at the next EXTI0 entry."""
     tail_chains = options.pop("tail_chains", True)
     board = _board(elf, cpu, bit_rate, **options)
     frames = board.native_frames
     if frames is not None:
         frames.tail_chains = bool(tail_chains)
+    core = board.core
+    if tick is not None:
+        for name, value in zip(("tick_reload", "exti0_priority", "tick_priority"), tick, strict=True):
+            core.write_bytes(core.image.address(name), struct.pack("<I", value))
     for index, (hold, cycles, micros, clear_late) in enumerate(runs):
         _hold(board, hold, clear_late=clear_late)
         if cycles:
@@ -292,12 +297,13 @@ def _unwatched(elf: Path, cpu: str, bit_rate: int, runs: list[Run], *, primask_a
             (0, 0) if frames is None else (frames.tail_chained, frames.plain_returns))  # fmt: skip
 
 
-def _alike(elf: Path, cpu: str, bit_rate: int, runs: list[Run], primask_at: int | None = None) -> tuple[int, int]:
+def _alike(elf: Path, cpu: str, bit_rate: int, runs: list[Run], primask_at: int | None = None,
+           tick: tuple[int, int, int] | None = None) -> tuple[int, int]:  # fmt: skip
     """:func:`_unwatched` with hook.c's returns, without them and with every frame in Python: the same run; the
     number of tail-chains and plain returns hook.c took."""
-    native, chains = _unwatched(elf, cpu, bit_rate, runs, primask_at=primask_at)
-    assert native == _unwatched(elf, cpu, bit_rate, runs, primask_at=primask_at, tail_chains=False)[0]
-    assert native == _unwatched(elf, cpu, bit_rate, runs, primask_at=primask_at, native_frames=False)[0]
+    native, chains = _unwatched(elf, cpu, bit_rate, runs, primask_at=primask_at, tick=tick)
+    assert native == _unwatched(elf, cpu, bit_rate, runs, primask_at=primask_at, tick=tick, tail_chains=False)[0]
+    assert native == _unwatched(elf, cpu, bit_rate, runs, primask_at=primask_at, tick=tick, native_frames=False)[0]
     return chains
 
 
@@ -432,3 +438,29 @@ def test_tail_chains_takes_a_bool_only(late_irq: dict[str, Path], value: object)
     with pytest.raises(ArgumentError, match="tail_chains"):
         board.native_frames.tail_chains = value  # type: ignore[assignment]
     assert board.native_frames.tail_chains
+
+
+PRIORITIES = {"tick above": (0x40, 0x00), "tick below": (0x00, 0x40), "equal": (0x00, 0x00)}
+"""EXTI0's and SysTick's priority bytes: SysTick preempts EXTI0's handler, waits for its return (a tail-chain into
+it, or into EXTI0 first), or is pending beside it at the same priority."""
+
+
+@pytest.mark.parametrize("order", sorted(PRIORITIES))
+def test_returns_with_systick_about_run_alike(late_irq: dict[str, Path], order: str) -> None:
+    """MCU-86 with a second exception: SysTick ticking through late_irq's handlers, preempting them or pending at
+    their returns: hook.c leaves those returns to Python (another exception active or pending), takes the others,
+    and the run (the ticks counted in RAM included) is the same as with each return in Python."""
+    runs: list[Run] = [(0, 2, 0, False), (300, 3, 0, False), (120, 0, 700, True), (0, 3, 0, False)]
+    chains, plain = _alike(late_irq["cortex_m3"], "cortex_m3", 500_000, runs, tick=(4_799, *PRIORITIES[order]))
+    assert chains + plain >= 1
+
+
+@settings(max_examples=8, deadline=None, phases=(Phase.explicit, Phase.reuse, Phase.generate))
+@given(cpu=st.sampled_from(sorted(CPUS)), bit_rate=st.sampled_from([500_000, 2_000_000]),
+       runs=st.lists(st.tuples(st.integers(0, 400), st.integers(0, 3), st.integers(1, 700), st.booleans()),
+                     min_size=1, max_size=3),
+       reload=st.integers(600, 30_000), order=st.sampled_from(sorted(PRIORITIES)))  # fmt: skip
+def test_any_history_with_systick_runs_alike(late_irq: dict[str, Path], cpu: str, bit_rate: int, runs: list[Run],
+                                             reload: int, order: str) -> None:  # fmt: skip
+    """MCU-86 over histories with SysTick at a random period and priority order: hook.c's returns change nothing."""
+    _alike(late_irq[cpu], cpu, bit_rate, runs, tick=(reload, *PRIORITIES[order]))
