@@ -30,7 +30,7 @@ from supi3.interbus.errors import InterbusError
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import NOISE_CYCLES, Board
 from supi3.mcu.core import BACKTRACE_DEPTH, CortexM, Frame, HeldRegister
-from supi3.mcu.frames import _MEMO_SIZE, FAST_READS, FAST_WRITES, _FirstDue, first_due
+from supi3.mcu.frames import FAST_READS, FAST_WRITES, first_due
 from supi3.mcu.stm32 import CR1_BR, CR1_BR_SHIFT, IOPAEN, SPI1EN
 from supi3.sdk import native
 
@@ -460,13 +460,3 @@ def test_first_due_is_the_boards_own_threshold(next_at: float, cpu_hz: float) ->
     first = first_due(next_at, cpu_hz, NOISE_CYCLES)
     assert next_at <= (first + NOISE_CYCLES) / cpu_hz
     assert first == 0 or (first - 1 + NOISE_CYCLES) / cpu_hz < next_at
-
-
-def test_the_thresholds_memo_is_first_due_and_stays_small() -> None:
-    """MCU-65: the native frames' memo of :func:`first_due` by bench time gives its value for each time, new or kept,
-    and holds at most ``_MEMO_SIZE`` of them (a pure function of the time: nothing to invalidate)."""
-    memo = _FirstDue(48e6, NOISE_CYCLES)
-    times = [index * 1.3e-5 for index in range(3 * _MEMO_SIZE)]
-    for at in times + times[::-1]:
-        assert memo[at] == first_due(at, 48e6, NOISE_CYCLES)
-        assert len(memo) <= _MEMO_SIZE

@@ -150,8 +150,6 @@ _PHASES: Final[dict[Phase, int]] = {Phase.COMMAND: _PHASE_COMMAND, Phase.DATA: _
 _PHASE_NUMBERS: Final[dict[Phase, int]] = {phase: _PHASES.get(phase, 0) for phase in Phase}
 """Every phase's number (MCU-65: a subscript, not a Python call)."""
 _PHASE_OF: Final[dict[int, Phase]] = {number: phase for phase, number in _PHASES.items()}
-_MEMO_SIZE: Final[int] = 64
-"""MCU-65: the bench times whose :func:`first_due` the native frames keep (a master cycle has a few events)."""
 _NO_COMMAND: Final[int] = 0x100
 """The protocol has no command (hook.c reads the command only in the data phase, which always has one)."""
 _CODES: Final[dict[object, int]] = {}
@@ -258,22 +256,6 @@ def _unseen(pin: int, level: int) -> None:
     """MCU-84: a GPIOA output change nobody sees (the write a failed bus run left behind)."""
 
 
-class _FirstDue(dict[float, int]):
-    """:func:`first_due` by a bench time, each computed once (MCU-65: the thresholds' own Python call only when a
-    time is new); emptied when it grows past :data:`_MEMO_SIZE`."""
-
-    def __init__(self, cpu_hz: float, noise: float) -> None:
-        super().__init__()
-        self._hz = cpu_hz
-        self._noise = noise
-
-    def __missing__(self, at: float) -> int:
-        if len(self) >= _MEMO_SIZE:
-            self.clear()
-        cycles = self[at] = first_due(at, self._hz, self._noise)
-        return cycles
-
-
 class NativeFrames:
     """The native per-frame fast path of a transaction-level board (MCU-51): the tables handed to hook.c, the
     mirror refreshed after Python's writes of GPIOA and SPI1, the catch-up at each entry into Python."""
@@ -321,7 +303,6 @@ class NativeFrames:
         self._bench = board.bench  # the transaction-level bench, set once at the board's construction
         self._due_key: tuple[int, float | None, float] | None = None  # the bench's next events, as last mirrored
         self._due = (0, _NEVER, _NEVER, _NEVER)
-        self._first_due = _FirstDue(self._hz, noise)
         self._written: tuple[str | None, ...] = _registers._WRITE_NAMES
         self._exti0 = exti0
         frames.chain_number, frames.tail_chain_cycles = exti0, core.cpu.tail_chain_cycles  # MCU-86
@@ -479,16 +460,16 @@ class NativeFrames:
         phase's start and the one that sets the I/O access bit (each :data:`_NEVER` if none comes before): the phases
         only set the chips' flags (MCU-52, MCU-66); and the run loop's deadline for thread mode at that event
         (MCU-86: ``Board._deadline_of``, the next event ``Board._bus_deadline`` stops at)."""
-        due = self._first_due
+        hz, noise = self._hz, self._noise
         latch_at = io_at = _NEVER
         for at, what in reversed(events):  # the next first
             if what == _LATCH:
-                latch_at = due[at]
+                latch_at = first_due(at, hz, noise)
             elif what == _IO:
-                io_at = due[at]
+                io_at = first_due(at, hz, noise)
             else:
-                return due[at], latch_at, io_at, self._board._deadline_of(at, 0.0)
-        return due[next_start], latch_at, io_at, self._board._deadline_of(next_start, 0.0)
+                return first_due(at, hz, noise), latch_at, io_at, self._board._deadline_of(at, 0.0)
+        return first_due(next_start, hz, noise), latch_at, io_at, self._board._deadline_of(next_start, 0.0)
 
     def refresh(self) -> None:
         """After Python's write of GPIOA or SPI1: mirror the model's state for the native frames, valid if the
