@@ -328,6 +328,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--rounds", type=int, default=5, help="interleaved rounds (the fastest of each is given)")
     parser.add_argument("--iterations", type=int, default=200_000, help="iterations of the synthetic loop")
     args = parser.parse_args(argv)
+    for name in ("cycles", "rounds", "iterations"):
+        if getattr(args, name) < 1:
+            parser.error(f"--{name} must be at least 1, not {getattr(args, name)}")
     parts = args.parts or PARTS
     if not set(parts) <= set(PARTS):
         parser.error(f"parts: {', '.join(PARTS)}, not {' '.join(parts)}")

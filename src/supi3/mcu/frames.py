@@ -342,11 +342,8 @@ class NativeFrames:
         the register written: that write's state at its failure. MCU-88: only what the bus run reads is caught up
         first (:meth:`_bus_half`) and only what it changes mirrored after (:meth:`_bus_refresh`); the frames' own
         state stays hook.c's until the next entry's catch-up."""
-        frames = self._frames
-        frame_pending = False
-        if frames.valid:
-            frames.valid = 0
-            frame_pending = self._bus_half()
+        self._frames.valid = 0  # hook.c calls with the mirror valid (MCU-84)
+        frame_pending = self._bus_half()
         self.bus_dues += 1
         board = self._board
         try:
@@ -362,10 +359,7 @@ class NativeFrames:
             finally:
                 gpio.on_output = output
             return
-        if frame_pending:
-            self._bus_refresh()
-        else:
-            self.refresh()
+        self._bus_refresh()
         board._bus_ran()
 
     def catch_up(self) -> None:
@@ -514,10 +508,7 @@ class NativeFrames:
         if configured != self._configured:  # MCU-78: everything the configuration fields are computed from
             self._configured = configured
             self._configuration()
-        values = self._read_values(registers._values)
-        if values != self._packed:  # MCU-78: only Python's changes and the native reads' clears change them
-            self._packed = values
-            self._values.pack_into(frames, self._values_at, *values)
+        self._pack_values()
         due, latch_at, io_at, thread = self._events_due()
         _MIRROR.pack_into(
             frames, _MIRROR_AT, 1, due, int(registers._latch_phase), latch_at, gpio._levels,
@@ -526,6 +517,14 @@ class NativeFrames:
             0 if frame is None or frame.driven is None else frame.driven, *transfer, board._ss_rise, board._cd_before,
             board._irq_level, 0, 0, 0, exti.pr, 0, 0)  # fmt: skip
         self._chain_mirror(thread)
+
+    def _pack_values(self) -> None:
+        """The register file's fast-readable values into ``Frames.values`` if they changed (MCU-78: only Python's
+        changes and the native reads' clears change them)."""
+        values = self._read_values(self._board.registers._values)
+        if values != self._packed:
+            self._packed = values
+            self._values.pack_into(self._frames, self._values_at, *values)
 
     def _events_due(self) -> tuple[int, int, int, int]:
         """:meth:`_thresholds` of the bench's next events, recomputed only when they changed."""
@@ -554,20 +553,17 @@ class NativeFrames:
     def _bus_refresh(self) -> None:
         """MCU-88: after :meth:`_bus_half` and the bus run, the mirror's part a bus run changes made again (what
         :meth:`catch_up` then :meth:`refresh` would make of it; the frames' own state, which the bus does not touch,
-        stays hook.c's, pending): the registers' values, the bus's next events, the chip's flags, /IRQ's level, EXTI's
-        PR and the returns' fields. Still valid: the bus ran an event (``due`` was reached), so the board followed
-        /IRQ and /ModAck after it (no fall left to time) and settled EXTI0's request, the bus conditions of
+        stays hook.c's while pending): the registers' values, the bus's next events, the chip's flags, /IRQ's level,
+        EXTI's PR and the returns' fields. Still valid: the bus ran an event (``due`` was reached), so the board
+        followed /IRQ and /ModAck after it (no fall left to time) and settled EXTI0's request, the bus conditions of
         :meth:`refresh`; the others the bus does not change."""
         frames, board = self._frames, self._board
-        registers, exti = board.registers, board.exti
-        values = self._read_values(registers._values)
-        if values != self._packed:
-            self._packed = values
-            self._values.pack_into(frames, self._values_at, *values)
+        registers = board.registers
+        self._pack_values()
         due, latch_at, io_at, thread = self._events_due()
         _BUS_MIRROR.pack_into(frames, _BUS_MIRROR_AT, 1, due, int(registers._latch_phase), latch_at)
         frames.io, frames.io_at = int(registers._io_access), io_at
-        frames.irq_level, frames.exti_pr = board._irq_level, exti.pr
+        frames.irq_level, frames.exti_pr = board._irq_level, board.exti.pr
         self._chain_mirror(thread)
 
     def _configuration(self) -> None:
