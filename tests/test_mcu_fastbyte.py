@@ -27,6 +27,7 @@ from hypothesis import strategies as st
 
 from supi3.errors import Supi3Error
 from supi3.interbus.errors import InterbusError
+from supi3.interbus.master import CycleResult
 from supi3.mcu import build as mcu_build
 from supi3.mcu.board import NOISE_CYCLES, Board
 from supi3.mcu.core import BACKTRACE_DEPTH, CortexM, Frame, HeldRegister
@@ -281,20 +282,23 @@ def test_an_edge_past_a_bus_event_runs_the_bus_then_natively(elves: dict[str, Pa
 
 
 def _failing_bus(board: Board, at: float) -> None:
-    """The board's bus refuses to run to ``at`` or past it (an :class:`InterbusError`, as the bench's own refusals)."""
-    advance = board._advance
+    """The board's master fails to run a cycle starting at ``at`` or later (an :class:`InterbusError`, as the master's
+    own refusals): the bus fails inside a bus event, after the events before it in the same run (MCU-90)."""
+    bench = board.bench
+    cycle = bench.master.cycle
 
-    def refused(until: float) -> bool:
-        if until >= at:
-            raise InterbusError("test", until, "the bus refused the time")
-        return advance(until)
+    def refused() -> CycleResult:
+        if bench.now >= at:
+            raise InterbusError("test", at, "the bus refused the cycle")
+        return cycle()
 
-    board._advance = refused
+    bench.master.cycle = refused  # type: ignore[method-assign]
 
 
 def test_a_bus_that_fails_at_an_edge_fails_alike(elves: dict[str, Path]) -> None:
     """MCU-84: the bus run for an /SS edge fails (a bus event's error): the run raises it and the board is left as
-    Python's write leaves it (GPIOA's register written, the edge unseen), with the native frames as without."""
+    Python's write leaves it (GPIOA's register written, the edge unseen), with the native frames as without. The bus
+    fails at a cycle's start or end, the events that can (MCU-90: the phases only set flags)."""
     probe = Board(elves["dio_br3"], bit_rate=2_000_000, strict=False)
     assert probe.native_frames is not None
     native = probe.native_frames
@@ -302,7 +306,7 @@ def test_a_bus_that_fails_at_an_edge_fails_alike(elves: dict[str, Path]) -> None
     advance = probe._advance
 
     def noted(until: float) -> bool:
-        calls.append((native.bus_dues, probe.bench._next_at))
+        calls.append((native.bus_dues, probe.bench.next_change_s()))
         return advance(until)
 
     probe._advance = noted

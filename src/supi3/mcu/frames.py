@@ -343,7 +343,7 @@ class NativeFrames:
         first (:meth:`_bus_half`) and only what it changes mirrored after (:meth:`_bus_refresh`); the frames' own
         state stays hook.c's until the next entry's catch-up."""
         self._frames.valid = 0  # hook.c calls with the mirror valid (MCU-84)
-        frame_pending = self._bus_half()
+        frame_pending = self._bus_half(False)
         self.bus_dues += 1
         board = self._board
         try:
@@ -373,10 +373,13 @@ class NativeFrames:
         if self._bus_half():
             self._frame_half()
 
-    def _bus_half(self) -> bool:
+    def _bus_half(self, sync: bool = True) -> bool:
         """The part of :meth:`catch_up` the bus and /IRQ's bookkeeping read (MCU-88): hook.c's returns of EXTI0
         (MCU-86), EXTI's PR (MCU-68), the IRQ_EVT reads (MCU-67), /IRQ as followed, the bus synchronised to the
-        latest access, the data registers written; whether the frames' own state (:meth:`_frame_half`) is pending."""
+        latest access, the data registers written; whether the frames' own state (:meth:`_frame_half`) is pending.
+        ``sync=False`` (MCU-90): the caller runs the bus up to now right after, so the runs up to the
+        accesses are left to it: hook.c took them before ``due``, so only the phases' flags could run there, which
+        neither the replayed reads nor the written values depend on."""
         frames = self._frames
         if frames.chains or frames.returned:
             self._chained()
@@ -389,12 +392,13 @@ class NativeFrames:
         board.exti.pr = exti_pr  # MCU-68: the handler's writes of PR (before the bus runs on: its edges come after)
         if cleared:  # MCU-67: the register file's own read-clear, each read at the latest one's time (no bus event)
             self._packed = None  # MCU-78: the native reads changed Frames.values
-            board._sync(cleared_at - 1)
+            if sync:
+                board._sync(cleared_at - 1)
             read = board.registers.cpu_read
             for _ in range(cleared):
                 read(IRQ_ADDRESS)
         board._irq_level = irq_level  # /IRQ rose with the clear: the board followed it (no EXTI bit, MCU-67)
-        if synced:  # the bus run up to the latest synchronisation: no event but the phases' flags (MCU-52)
+        if synced and sync:  # the bus run up to the latest synchronisation: no event but the phases' flags (MCU-52)
             board._sync(synced - 1)
         if written:
             values = board.registers._values
