@@ -126,8 +126,6 @@ class FrameBoard(Protocol):
 
     def _sync(self, cycles: int) -> None: ...
 
-    def _now(self) -> int: ...
-
     def _chained(self, chains: int, latency: int, fell: int | None, returned: bool) -> None: ...
 
     def _deadline_of(self, at: float, wait_s: float) -> int: ...
@@ -334,20 +332,21 @@ class NativeFrames:
     def tail_chains(self, value: bool) -> None:
         self._tail_chains = check_bool("tail_chains", value)
 
-    def _bus_due(self, offset: int, value: int) -> None:
+    def _bus_due(self, offset: int, value: int, now: int) -> None:
         """MCU-84: hook.c's /SS edge (GPIOA's BSRR or BRR written with ``value``) has a bus event due at or before
         it: an entry into Python, the bus run up to the edge and /IRQ followed, as ``Board._on_output`` does before
         the edge, and the mirror made again; hook.c then takes the edge if it is still plain, else calls Python's
         write, which finds the bus run. A failure stops the run as Python's write would (:meth:`CortexM.fail`), with
         the register written: that write's state at its failure. MCU-88: only what the bus run reads is caught up
         first (:meth:`_bus_half`) and only what it changes mirrored after (:meth:`_bus_refresh`); the frames' own
-        state stays hook.c's until the next entry's catch-up."""
+        state stays hook.c's until the next entry's catch-up. ``now``: the edge's core cycle, which hook.c handed out
+        as :meth:`CortexM.cycles_now` would (MCU-90)."""
         self._frames.valid = 0  # hook.c calls with the mirror valid (MCU-84)
         frame_pending = self._bus_half(False)
         self.bus_dues += 1
         board = self._board
         try:
-            board._now()
+            board._sync(now)  # MCU-90: Board._now's run, at the time hook.c handed out as cycles_now does
         except BaseException as error:  # handed to the run loop, raised there (CortexM's own callbacks do the same)
             if frame_pending:
                 self._frame_half()

@@ -363,7 +363,7 @@ void supi3_interrupt(void *uc, uint32_t number, void *data) {
  * write (`slow`). What the frames changed is noted here (`pending`) and set in the Python objects, as its net effect,
  * at the next entry into Python (supi3.mcu.frames.NativeFrames.catch_up). */
 typedef void (*mmio_write_fn)(void *uc, uint64_t offset, unsigned size, uint64_t value, void *data);
-typedef void (*bus_due_fn)(uint64_t offset, uint64_t value); /* MCU-84: supi3.mcu.frames.NativeFrames._bus_due */
+typedef void (*bus_due_fn)(uint64_t offset, uint64_t value, uint64_t now); /* MCU-84: NativeFrames._bus_due */
 
 /* The cost in cycles of a block's instructions before the PC of an access (CortexM.cycles_now's memo, MCU-1). */
 typedef struct {
@@ -640,7 +640,8 @@ static int gpio_write(supi3_frames *f, uint64_t offset, uint64_t value, int may_
             if (!may_sync || f->bus_due == 0) {
                 return 0;
             }
-            f->bus_due(offset, value);
+            s->handed = now; /* MCU-90: the edge's time handed to Python, as CortexM.cycles_now hands it out */
+            f->bus_due(offset, value, now);
             return f->valid && !s->stop_request && f->gpio_ok && gpio_write(f, offset, value, 0);
         }
         taken = levels >> f->ss_pin & 1 ? frame_rise(f, now) : frame_fall(f, now);

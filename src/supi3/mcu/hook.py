@@ -140,9 +140,9 @@ MMIO_WRITE: Final = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_uint64, cty
 """unicorn.h's uc_cb_mmio_write_t: a peripheral's write (``handle, offset, size, value, user data``)."""
 
 
-BUS_DUE: Final = ctypes.CFUNCTYPE(None, ctypes.c_uint64, ctypes.c_uint64)
+BUS_DUE: Final = ctypes.CFUNCTYPE(None, ctypes.c_uint64, ctypes.c_uint64, ctypes.c_uint64)
 """MCU-84: hook.c's ``bus_due_fn``, :meth:`supi3.mcu.frames.NativeFrames._bus_due` (GPIOA's offset and value
-written)."""
+written, the edge's core cycle: MCU-90)."""
 
 
 class Prefix(ctypes.Structure):
