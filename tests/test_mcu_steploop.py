@@ -42,7 +42,8 @@ class AskingBoard(Board):
     """The run loop before MCU-79: the deadline and the step each ask the core for its entry, EXTI is asked
     first."""
 
-    def _bus_deadline(self) -> int:
+    def _bus_deadline(self, at: float) -> int:
+        del at  # worked out here, not taken from the run loop or the native frames (MCU-90)
         core = self.core
         at = self.bench.next_change_s()
         if at == math.inf:

@@ -1008,7 +1008,8 @@ class Board:
         self._run(lambda: self.core.cycles >= end, max_instructions, end)
 
     def _run(self, done: Callable[[], bool], max_instructions: int, end: int | None = None) -> None:
-        core = self.core
+        core, bench = self.core, self._bench
+        assert bench is not None  # transaction level
         self._set_budget(max_instructions)
         self._sync(core.cycles)
         self._follow_irq(core.cycles)  # the chip may have changed between runs (the host's calls)
@@ -1024,21 +1025,20 @@ class Board:
                 if bound is not None:
                     bounds = min(bounds, bound)
             self._bounds = bounds
-            self._step(min(self._bus_deadline(), bounds))
+            self._step(min(self._bus_deadline(bench.next_change_s()), bounds))
             self._sync(core.cycles)
 
-    def _bus_deadline(self) -> int:
+    def _bus_deadline(self, at: float) -> int:
         """The core cycle the run loop stops the core at for the bus: the next bus event that may change /IRQ or
         /ModAck (MCU-31); while EXTI0 is active or about to be entered at the step's start, :func:`serve_wait_s`
         after it (MCU-44: an edge of /IRQ then only sets EXTI's pending bit, and the firmware's next access, or the
         next stop, at the latest the handler's return, runs the bus up to it; MCU-55: a handler that makes no access
         for that long, spinning, still lets the bus run on, and a run's wait ends at its bound); none while the
         master holds at a run's end (MCU-55: no bus event comes). The core's next entry: the run loop's answer of
-        the step (MCU-79)."""
-        bench = self._bench
-        assert bench is not None  # transaction level
+        the step (MCU-79). ``at``: the bus's next event that may change /IRQ or /ModAck
+        (:meth:`_BoardBench.next_change_s`)."""
         handler = self._entry == _EXTI0 or _EXTI0 in self.core.active
-        return self._deadline_of(bench.next_change_s(), self._wait_s if handler else 0.0)
+        return self._deadline_of(at, self._wait_s if handler else 0.0)
 
     def _deadline_of(self, at: float, wait_s: float) -> int:
         """The core cycle the run loop stops at ``wait_s`` after a bus event at ``at`` (never: no bound)."""
@@ -1046,17 +1046,18 @@ class Board:
             return MAX_DEADLINE
         return math.ceil((at + wait_s) * self._cpu_hz - NOISE_CYCLES)
 
-    def _bus_ran(self) -> None:
+    def _bus_ran(self, at: float) -> None:
         """MCU-86: the bus ran during a step (hook.c's /SS edge past a bus event, :meth:`NativeFrames._bus_due`)
         and the run is not at its end: the step's deadline moves to the one the run loop would give a step starting
         now (:meth:`_bus_deadline` from the bus's next event, the step's other bounds). A stop at the old one would
         find no bus event due: nothing but the clock (MCU-31, MCU-44); not stopping there lets hook.c's tail-chains
-        go on to the next bus event."""
+        go on to the next bus event. ``at``: the bus's next event that may change /IRQ or /ModAck, which the native
+        frames' thresholds found (MCU-90)."""
         bench = self._bench
         assert bench is not None  # the native frames run at transaction level
         if bench.cycles < bench._hold:  # at a run's end, the serve wait begins at the loop's next stop (MCU-30)
             state = self.core._state
-            state.deadline = max(state.deadline, min(self._bus_deadline(), self._bounds))
+            state.deadline = max(state.deadline, min(self._bus_deadline(at), self._bounds))
 
     def _set_budget(self, max_instructions: int) -> None:
         self._budget = check_int("max_instructions", max_instructions, 1)

@@ -130,7 +130,7 @@ class FrameBoard(Protocol):
 
     def _deadline_of(self, at: float, wait_s: float) -> int: ...
 
-    def _bus_ran(self) -> None: ...
+    def _bus_ran(self, at: float) -> None: ...
 
     @property
     def bench(self) -> FrameBench: ...
@@ -300,7 +300,7 @@ class NativeFrames:
         self._configured: tuple[object, ...] | None = None  # MCU-78: what the configuration fields were made of
         self._bench = board.bench  # the transaction-level bench, set once at the board's construction
         self._due_key: tuple[int, float | None, float] | None = None  # the bench's next events, as last mirrored
-        self._due = (0, _NEVER, _NEVER, _NEVER)
+        self._due = (0, _NEVER, _NEVER, _NEVER, math.inf)
         self._written: tuple[str | None, ...] = _registers._WRITE_NAMES
         self._exti0 = exti0
         frames.chain_number, frames.tail_chain_cycles = exti0, core.cpu.tail_chain_cycles  # MCU-86
@@ -358,8 +358,7 @@ class NativeFrames:
             finally:
                 gpio.on_output = output
             return
-        self._bus_refresh()
-        board._bus_ran()
+        board._bus_ran(self._bus_refresh())
 
     def catch_up(self) -> None:
         """An entry into Python (:attr:`CortexM.entry`): the mirror is no longer valid (Python may change what it
@@ -452,11 +451,11 @@ class NativeFrames:
         self.plain_returns += returned
         self._board._chained(chains, latency, None if fell < 0 else fell, bool(returned))
 
-    def _thresholds(self, events: list[tuple[float, str]], next_start: float) -> tuple[int, int, int, int]:
+    def _thresholds(self, events: list[tuple[float, str]], next_start: float) -> tuple[int, int, int, int, float]:
         """The first core cycle whose synchronisation runs a cycle's start or end, the one that runs the latch
         phase's start and the one that sets the I/O access bit (each :data:`_NEVER` if none comes before): the phases
-        only set the chips' flags (MCU-52, MCU-66); and the run loop's deadline for thread mode at that event
-        (MCU-86: ``Board._deadline_of``, the next event ``Board._bus_deadline`` stops at)."""
+        only set the chips' flags (MCU-52, MCU-66); the run loop's deadline for thread mode at that event (MCU-86:
+        ``Board._deadline_of``, the next event ``Board._bus_deadline`` stops at) and the event's time (MCU-90)."""
         hz, noise = self._hz, self._noise
         latch_at = io_at = _NEVER
         for at, what in reversed(events):  # the next first
@@ -465,8 +464,9 @@ class NativeFrames:
             elif what == _IO:
                 io_at = first_due(at, hz, noise)
             else:
-                return first_due(at, hz, noise), latch_at, io_at, self._board._deadline_of(at, 0.0)
-        return first_due(next_start, hz, noise), latch_at, io_at, self._board._deadline_of(next_start, 0.0)
+                return first_due(at, hz, noise), latch_at, io_at, self._board._deadline_of(at, 0.0), at
+        return (first_due(next_start, hz, noise), latch_at, io_at, self._board._deadline_of(next_start, 0.0),
+                next_start)
 
     def refresh(self) -> None:
         """After Python's write of GPIOA or SPI1: mirror the model's state for the native frames, valid if the
@@ -512,7 +512,7 @@ class NativeFrames:
             self._configured = configured
             self._configuration()
         self._pack_values()
-        due, latch_at, io_at, thread = self._events_due()
+        due, latch_at, io_at, thread, _ = self._events_due()
         _MIRROR.pack_into(
             frames, _MIRROR_AT, 1, due, int(registers._latch_phase), latch_at, gpio._levels,
             int(registers._io_access), io_at, 0, gpio.odr, 0, phase, code, protocol.last_rx,
@@ -529,7 +529,7 @@ class NativeFrames:
             self._packed = values
             self._values.pack_into(self._frames, self._values_at, *values)
 
-    def _events_due(self) -> tuple[int, int, int, int]:
+    def _events_due(self) -> tuple[int, int, int, int, float]:
         """:meth:`_thresholds` of the bench's next events, recomputed only when they changed."""
         bench = self._bench
         events = bench._events  # only popped from the end until the next cycle's start makes a new list
@@ -553,21 +553,22 @@ class NativeFrames:
         else:
             frames.chain_leave = 0
 
-    def _bus_refresh(self) -> None:
+    def _bus_refresh(self) -> float:
         """MCU-88: after :meth:`_bus_half` and the bus run, the mirror's part a bus run changes made again (what
         :meth:`catch_up` then :meth:`refresh` would make of it; the frames' own state, which the bus does not touch,
         stays hook.c's while pending): the registers' values, the bus's next events, the chip's flags, /IRQ's level,
         EXTI's PR and the returns' fields. Still valid: the bus ran an event (``due`` was reached), so the board
         followed /IRQ and /ModAck after it (no fall left to time) and settled EXTI0's request, the bus conditions of
-        :meth:`refresh`; the others the bus does not change."""
+        :meth:`refresh`; the others the bus does not change. The time of the bus's next start or end (MCU-90)."""
         frames, board = self._frames, self._board
         registers = board.registers
         self._pack_values()
-        due, latch_at, io_at, thread = self._events_due()
+        due, latch_at, io_at, thread, at = self._events_due()
         _BUS_MIRROR.pack_into(frames, _BUS_MIRROR_AT, 1, due, int(registers._latch_phase), latch_at)
         frames.io, frames.io_at = int(registers._io_access), io_at
         frames.irq_level, frames.exti_pr = board._irq_level, board.exti.pr
         self._chain_mirror(thread)
+        return at
 
     def _configuration(self) -> None:
         """MCU-78: the fields the peripherals' configuration decides (GPIOA's clock and output pins, SPI1's mode and
