@@ -141,6 +141,8 @@ _LATCH: Final[str] = "latch"
 """The bench's phase events (``Bench._step_bus``; ``supi3.mcu.board.FLAG_EVENTS``): the I/O access bit set, the latch
 phase begun; they set flags of the chips only."""
 _NEVER: Final[int] = (1 << 63) - 1
+_TOP: Final[float] = wire.MAX_BUS_TIME_S
+"""The latest bus time the bench takes (A26): :func:`first_due`'s bound."""
 _PHASE_COMMAND: Final[int] = 1
 _PHASE_DATA: Final[int] = 2
 _PHASES: Final[dict[Phase, int]] = {Phase.COMMAND: _PHASE_COMMAND, Phase.DATA: _PHASE_DATA}
@@ -236,13 +238,14 @@ def first_due(next_at: float, cpu_hz: float, noise: float) -> int:
     (``Bench.advance((c + noise) / cpu_hz)`` runs the events at or before that time), or past which it would refuse the
     time (:data:`~supi3.interbus.wire.MAX_BUS_TIME_S`); a cycle before it synchronises without a Python effect beyond
     the clock. At most 2^63 - 1."""
-    limit = (1 << 63) - 1
-    at = min(next_at, wire.MAX_BUS_TIME_S)
-    if not at * cpu_hz < limit:
-        return limit
-    top = wire.MAX_BUS_TIME_S
+    top = _TOP
+    at = next_at if next_at < top else top
+    if not at * cpu_hz < _NEVER:
+        return _NEVER
     # the board's rounding (Board._cycles): the answer or one of its neighbours, found by the expression itself
-    cycles = max(0, math.ceil(at * cpu_hz - noise))
+    cycles = math.ceil(at * cpu_hz - noise)
+    if cycles < 0:
+        cycles = 0
     while cycles > 0 and (next_at <= (until := (cycles - 1 + noise) / cpu_hz) or until > top):
         cycles -= 1
     while not (next_at <= (until := (cycles + noise) / cpu_hz) or until > top):
