@@ -97,19 +97,25 @@ def board(folder: Path) -> Board:
     return emulated
 
 
-def count(run_cycles: Callable[[int], object], cycles: int) -> tuple[Counter[str], Counter[str]]:
+def count(run_cycles: Callable[[int], object], cycles: int) -> tuple[Counter[str], Counter[str], int]:
     """Python calls and opcodes by function (``file:name``, the file from ``supi3/`` on) of ``run_cycles(cycles)``:
-    a powered bench's or board's ``run``."""
+    a powered bench's or board's ``run``; and the opcodes run inside the bus run before an /SS edge
+    (``NativeFrames._bus_due``, MCU-84: issue #13's one entry into Python a steady cycle, MCU-91)."""
     calls: Counter[str] = Counter()
     opcodes: Counter[str] = Counter()
+    inside = [0, 0]  # the _bus_due frames on the stack, the opcodes run while one is
 
     def trace(frame: FrameType, event: str, _: Any) -> Any:
         where = f"{frame.f_code.co_filename.rpartition('/src/')[2]}:{frame.f_code.co_name}"
         if event == "call":
             calls[where] += 1
             frame.f_trace_opcodes = True
+            inside[0] += where == _BUS_DUE
         elif event == "opcode":
             opcodes[where] += 1
+            inside[1] += inside[0] > 0
+        elif event == "return":
+            inside[0] -= where == _BUS_DUE
         return trace
 
     sys.settrace(trace)
@@ -117,7 +123,10 @@ def count(run_cycles: Callable[[int], object], cycles: int) -> tuple[Counter[str
         run_cycles(cycles)
     finally:
         sys.settrace(None)
-    return calls, opcodes
+    return calls, opcodes, inside[1]
+
+
+_BUS_DUE = "supi3/mcu/frames.py:_bus_due"
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -138,9 +147,10 @@ def main(argv: list[str] | None = None) -> None:
             runs = [("host2M", powered(host).run), ("bench side", powered(QuietIsr()).run),
                     ("issue13 (the emulated core's own work not counted)", board(Path(folder)).run)]  # fmt: skip
             counts = [(case, *count(run_cycles, args.cycles)) for case, run_cycles in runs]
-        for case, calls, opcodes in counts:
+        for case, calls, opcodes, bus_due in counts:
             print(f"{case}: {calls.total() / args.cycles:.1f} Python calls and {opcodes.total() / args.cycles:.0f} "
-                  "opcodes a master cycle; the most opcodes a cycle:")  # fmt: skip
+                  "opcodes a master cycle" + (f" ({bus_due / args.cycles:.0f} inside the bus run before an /SS "
+                  "edge, NativeFrames._bus_due)" if bus_due else "") + "; the most opcodes a cycle:")  # fmt: skip
             for where, n in opcodes.most_common(12):
                 print(f"  {n / args.cycles:7.1f} opcodes, {calls[where] / args.cycles:5.1f} calls  {where}")
             files: Counter[str] = Counter()

@@ -43,10 +43,19 @@ def test_the_bench_side_runs_the_host_builds_cycles_without_a_byte() -> None:
     assert quiet == host and len(host) == 23
     assert [bench.results[-1] for bench in benches] == [benches[0].results[-1]] * 2
     assert [bench.interrupts - n for bench, n in zip(benches, before, strict=True)] == [20, 20]  # one a cycle
-    calls, opcodes = split.count(split.powered(split.QuietIsr()).run, 5)
+    calls, opcodes, bus_due = split.count(split.powered(split.QuietIsr()).run, 5)
     assert not any("upif.py" in where or "transports.py" in where for where in calls)  # no byte clocked
     assert calls["supi3/model/chip.py:latch_at"] == 5  # one latch of the chip a master cycle
-    assert opcodes.total() > calls.total() > 0
+    assert opcodes.total() > calls.total() > 0 and bus_due == 0  # no emulated board
+
+
+def test_the_opcodes_inside_the_bus_run_before_an_edge_are_counted_on_the_board(tmp_path: Path) -> None:
+    """MCU-91's split: on issue #13's board the bus runs inside ``NativeFrames._bus_due`` at the steady cycles' /SS
+    edges, and the opcodes counted there are those of its calls and theirs: at least its own, fewer than all."""
+    split = _split()
+    calls, opcodes, bus_due = split.count(split.board(tmp_path).run, 8)
+    assert calls[split._BUS_DUE] > 0
+    assert opcodes[split._BUS_DUE] + opcodes["supi3/interbus/master.py:data_cycle"] <= bus_due < opcodes.total()
 
 
 @pytest.mark.parametrize(("argv", "message"), [
