@@ -23,6 +23,7 @@ import json
 import struct
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -99,8 +100,8 @@ def _stopped(board: Board, error: FirmwareError) -> dict[str, Any]:
     report = error.report
     core = board.core
     return {"type": type(error).__name__, "text": str(error), "stop": report.stop.name, "reason": report.reason,
-            "pc": report.pc, "stacked": report.stacked, "fault_status": report.fault_status,
-            "cycles": core.cycles, "instructions": core.instructions, "active": core.active, "core_pc": core.pc}  # fmt: skip
+            "pc": report.pc, "stacked": report.stacked, "fault_status": report.fault_status, "cycles": core.cycles,
+            "instructions": core.instructions, "active": core.active, "core_pc": core.pc}  # fmt: skip
 
 
 def _fault_address(folder: Path, cpu: str, scenario: int) -> dict[str, Any]:
@@ -121,13 +122,10 @@ def _faults_c(folder: Path, scenario: int) -> dict[str, Any]:
     board = Board(elf)
     board.run_for(20e-6)
     board.core.write_bytes(board.core.image.address("scenario"), struct.pack("<I", scenario))
+    runs: dict[int, Callable[[], None]] = {2: lambda: board.run(1000, max_instructions=50_000),
+                                           3: lambda: board.run(10)}  # fmt: skip
     with pytest.raises(FirmwareError) as caught:
-        if scenario == 2:
-            board.run(1000, max_instructions=50_000)
-        elif scenario == 3:
-            board.run(10)
-        else:
-            board.run_for(20e-6)
+        runs.get(scenario, lambda: board.run_for(20e-6))()
     return _stopped(board, caught.value)
 
 
@@ -177,22 +175,20 @@ def cases() -> dict[str, Callable[[Path], Any]]:
     for cpu in CPUS:
         for bit_rate in (2_000_000, 500_000):
             for frames in (True, False):
-                found[f"bench {cpu} {bit_rate} {'native' if frames else 'python'}"] = (
-                    lambda folder, c=cpu, b=bit_rate, f=frames: _bench(folder, c, b, f))
+                found[f"bench {cpu} {bit_rate} {'native' if frames else 'python'}"] = partial(
+                    _bench, cpu=cpu, bit_rate=bit_rate, native_frames=frames)  # fmt: skip
         for scenario in range(1, 6):
-            found[f"fault_address {cpu} {scenario}"] = lambda folder, c=cpu, s=scenario: _fault_address(folder, c, s)
+            found[f"fault_address {cpu} {scenario}"] = partial(_fault_address, cpu=cpu, scenario=scenario)
         for kind in ("FETCH", "LOAD", "STORE"):
             for address in EDGES:
-                found[f"edge {cpu} {kind} {address:08X}"] = (
-                    lambda folder, c=cpu, k=kind, a=address: _edge(folder, c, k, a))
-        found[f"edge {cpu} FETCH RAM"] = lambda folder, c=cpu: _edge(folder, c, "FETCH", 0x2000_0000)
+                found[f"edge {cpu} {kind} {address:08X}"] = partial(_edge, cpu=cpu, kind=kind, address=address)
+        found[f"edge {cpu} FETCH RAM"] = partial(_edge, cpu=cpu, kind="FETCH", address=0x2000_0000)
         for name in ("flash_rewrite", "vtlb_flash"):
             for step in (5, 40, MAX_DEADLINE):
                 for skip in (True, False):
-                    found[f"{name} {cpu} {step} {skip}"] = (
-                        lambda folder, c=cpu, n=name, t=step, k=skip: _flash(folder, c, n, t, k))
+                    found[f"{name} {cpu} {step} {skip}"] = partial(_flash, cpu=cpu, name=name, step=step, skip=skip)
     for scenario in range(1, 5):
-        found[f"faults.c {scenario}"] = lambda folder, s=scenario: _faults_c(folder, s)
+        found[f"faults.c {scenario}"] = partial(_faults_c, scenario=scenario)
     return found
 
 

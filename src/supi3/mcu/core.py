@@ -822,6 +822,7 @@ class CortexM:
         self._callbacks: list[object] = []  # the ctypes callbacks unicorn holds: kept alive with the core
         self.flash = flash
         self.ram = ram
+        self.uc.ctl_set_tlb_mode(ucc.UC_TLB_VIRTUAL)  # MCU-89: the fill (hook.c's supi3_tlb_fill) in place of QEMU's
         for base, size in (flash, ram):
             self.uc.mem_map(base, size)
         for address, data in self.image.segments:
@@ -902,14 +903,23 @@ class CortexM:
         self._exact_spans: list[tuple[int, int, int]] = []  # first, last address and handle of each exact-PC hook
         self.mmio(SCS_BASE, SCS_SIZE, self._scs_read, self._scs_write)
         self._hook(ucc.UC_HOOK_BLOCK, native.supi3_block_hook, data=ctypes.byref(state))
-        self._hook(ucc.UC_HOOK_MEM_WRITE, native.supi3_code_written, flash[0], flash[0] + flash[1] - 1,
-                   ctypes.byref(state))  # MCU-28: a store into flash may change code  # fmt: skip
+        # MCU-89: no memory hook (each one sends every load and store through unicorn's slow path, MCU-87): the
+        # default memory map's permissions in the virtual TLB's fill, which notes a store into flash (MCU-28)
+        self._memory = memory = hook.Memory(ctypes.pointer(state), *flash)
+        memory.never_low[:], memory.never_high[:] = zip(*EXECUTE_NEVER, strict=True)
+        memory.fetch, memory.store = ucc.UC_MEM_FETCH, ucc.UC_MEM_WRITE
+        memory.prot_write, memory.prot_exec, memory.prot_all = ucc.UC_PROT_WRITE, ucc.UC_PROT_EXEC, ucc.UC_PROT_ALL
+        memory.prefetch_abort = EXCP_PREFETCH_ABORT
+        self._hook(ucc.UC_HOOK_TLB_FILL, native.supi3_tlb_fill, data=ctypes.byref(memory))
         on_idle_loop = _HOOK_CODE(self._on_idle_loop)
         for address in idle_loops(self.image, flash):  # MCU-4: the core stops at its first ``b .``
             self._hook(ucc.UC_HOOK_CODE, on_idle_loop, address, address)
         self._hook(ucc.UC_HOOK_INTR, native.supi3_interrupt, data=self._state_ref)  # native (MCU-72)
         self._fault_address: int | None = None  # the address of the last unmapped or protected access (BFAR, MMFAR)
-        self._hook(ucc.UC_HOOK_MEM_INVALID, _HOOK_MEM_INVALID(self._on_invalid_access))
+        on_invalid_access = _HOOK_MEM_INVALID(self._on_invalid_access)
+        self._hook(ucc.UC_HOOK_MEM_UNMAPPED, on_invalid_access)
+        for base, size in (flash, ram):  # MCU-89: not the peripherals', whose protection hooks take every access
+            self._hook(ucc.UC_HOOK_MEM_PROT, on_invalid_access, base, base + size - 1)
         self.reset()
 
     # -- memory ------------------------------------------------------------------------------------------------
@@ -960,6 +970,7 @@ class CortexM:
             self._callbacks.append(native)
             self._check(_LIB.uc_mmio_map(self._handle, base, size, self._port_read, ctypes.byref(native),
                                          self._port_write, ctypes.byref(native)))  # fmt: skip
+        self.uc.mem_protect(base, size, ucc.UC_PROT_NONE)  # MCU-89: each access calls the exact-PC hook
         self._exact_pc_over(base, base + size - 1)
         return HeldRegister(held)
 
@@ -979,7 +990,7 @@ class CortexM:
                 first, last = min(first, low), max(last, high)
             else:
                 kept.append((low, high, handle))
-        handle = self._hook(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, self._exact_pc, first, last,
+        handle = self._hook(ucc.UC_HOOK_MEM_READ_PROT | ucc.UC_HOOK_MEM_WRITE_PROT, self._exact_pc, first, last,
                             ctypes.byref(self._state))  # fmt: skip
         self._exact_spans = [*kept, (first, last, handle)]
 
@@ -1455,10 +1466,14 @@ class CortexM:
         self._running = True
         try:  # from the PC; unicorn's CPU exception noted in the state (MCU-72: supi3_run, supi3_interrupt)
             status = self._native_run(self._handle, self._state_ref, self._frames_ref)
+            if status == ucc.UC_ERR_EXCEPTION and state.interrupt == EXCP_PREFETCH_ABORT:
+                status = ucc.UC_ERR_OK  # MCU-89: the virtual TLB refused the fetch, as QEMU's map did (_after_stop)
             if status != ucc.UC_ERR_OK:
                 raise FirmwareFaultError(self._fault(UcError(status)))
         finally:
             self._running = False
+            if state.code_written:  # MCU-89: flash read-only again in the TLB, so the next store is noted too
+                self.uc.ctl(ucc.UC_CTL_TLB_FLUSH, ucc.UC_CTL_IO_WRITE)
             entry = self.entry
             if entry is not None:  # MCU-51: the native frames' effects into the Python objects
                 entry()
