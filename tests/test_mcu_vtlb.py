@@ -220,6 +220,22 @@ def test_every_case_has_a_recorded_fingerprint(recorded: dict[str, Any]) -> None
     assert sorted(recorded) == sorted(cases())
 
 
+def test_a_peripheral_access_calls_no_python_of_the_core(folder: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The peripherals' protection events go to the exact-PC hook alone: the core's hook of invalid accesses (BFAR,
+    MMFAR) watches the unmapped addresses and the protection of flash and RAM only, so issue #13's case never calls
+    it (over the peripherals it would run at each of their accesses, before the exact-PC hook)."""
+    calls: list[int] = []
+    noted = CortexM._on_invalid_access
+
+    def counted(self: CortexM, *arguments: Any) -> bool:
+        calls.append(arguments[2])
+        return noted(self, *arguments)
+
+    monkeypatch.setattr(CortexM, "_on_invalid_access", counted)
+    fingerprint = _bench(folder, "cortex_m3", 2_000_000, True)
+    assert fingerprint["instructions"] > 50_000 and calls == []
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description="record the fingerprints of tests/test_mcu_vtlb.py's cases")
     parser.add_argument("--record", type=Path, required=True, help="the JSON file to write")
