@@ -13,14 +13,16 @@ Timing (MCU-1): every basic block unicorn enters costs its instructions' cycles 
 instruction, one more per single load or store, one per register of a multiple load or store, two more for a
 branch that ends the block, taken as taken), so the clock is exact at block boundaries; a peripheral access is
 placed inside its block by the program counter (:meth:`CortexM.cycles_now`; unicorn keeps the PC exact at an
-access only under a memory hook, so each peripheral range has an empty one). Emulation only ever stops at a block
+access only under a memory or protection hook: the peripherals are mapped inaccessible, each run of them has a
+protection hook that lets the access go on, MCU-89). Emulation only ever stops at a block
 boundary (a block hook refuses the next block), because unicorn restarts an instruction stopped inside a memory
 callback and a peripheral would see its access twice.
 
 Speed (MCU-19): the peripheral callbacks and the register reads they need go to unicorn's C library through ctypes
-directly; the binding's wrappers around each call cost as much again as the call. The block hook and the empty memory
-hooks are native code (MCU-25, :mod:`supi3.mcu.hook`): a block in flash calls Python only the first time it runs (one
-in RAM each time it runs, MCU-28).
+directly; the binding's wrappers around each call cost as much again as the call. The block hook, the exact-PC hooks
+and the virtual TLB's fill are native code (MCU-25, MCU-89, :mod:`supi3.mcu.hook`): a block in flash calls Python only
+the first time it runs (one in RAM each time it runs, MCU-28). No memory hook is set: any one sends every guest load
+and store through unicorn's slow path (MCU-87); the fill notes the firmware's stores into flash (MCU-28) instead.
 """
 
 from __future__ import annotations
@@ -84,7 +86,8 @@ EXCP_EXCEPTION_EXIT: Final[int] = 8
 EXCP_SWI: Final[int] = 2
 EXCP_PREFETCH_ABORT: Final[int] = 3
 """unicorn's interrupt number for an instruction fetch it cannot make (QEMU's EXCP_PREFETCH_ABORT): from a peripheral
-callback's region, or from some unmapped addresses (0)."""
+callback's region, or from some unmapped addresses (0). MCU-89: a fetch the virtual TLB's fill refuses (Execute Never)
+ends the run with UC_ERR_EXCEPTION, the fill noting this number, and is taken as this interrupt."""
 EXECUTE_NEVER: Final[tuple[tuple[int, int], ...]] = ((0x4000_0000, 0x6000_0000), (0xA000_0000, 0x1_0000_0000))
 """The Execute Never regions of the default memory map (B3.1, Table B3-1: Peripheral, Device, System): a fetch there
 is a MemManage fault (IACCVIOL)."""
@@ -975,14 +978,16 @@ class CortexM:
         return HeldRegister(held)
 
     def _exact_pc_over(self, first: int, last: int) -> None:
-        """The exact-PC memory hook over the addresses ``first`` to ``last``, merged with those of the ranges next to
-        them: one hook a run of adjacent ranges (MCU-87).
+        """The exact-PC hook over the addresses ``first`` to ``last``, merged with those of the ranges next to them:
+        one hook a run of adjacent ranges (MCU-87).
 
-        unicorn updates the PC before a load or store only if a memory hook covers its address: without one, a
-        peripheral callback sees the PC of the block's first instruction, and the access would be timed there (MCU-1
-        places it by the PC). The native hook also notes that PC for cycles_now (MCU-25). Once any memory hook exists,
-        unicorn walks the whole list at every load and store (MCU-87): the board's GPIOA, GPIOB, AFIO and EXTI, next
-        to each other, share one hook; the addresses covered are the same."""
+        unicorn updates the PC before a load or store only if a memory or protection hook covers its address: without
+        one, a peripheral callback sees the PC of the block's first instruction, and the access would be timed there
+        (MCU-1 places it by the PC). The ranges are mapped inaccessible (:meth:`mmio`), so each access raises a
+        protection event, which this native hook takes: it notes the PC for cycles_now (MCU-25) and lets the access go
+        on (MCU-89: a memory hook would send every load and store of RAM and flash through unicorn's slow path too).
+        unicorn walks the whole list at each event: the board's GPIOA, GPIOB, AFIO and EXTI, next to each other,
+        share one hook; the addresses covered are the same."""
         kept = []
         for low, high, handle in self._exact_spans:
             if high + 1 == first or last + 1 == low:  # next to it (ranges never overlap: uc_mmio_map refuses that)
@@ -1531,8 +1536,9 @@ class CortexM:
 
     def _on_invalid_access(self, handle: int, access: int, address: int, size: int, value: int,
                            data: int | None) -> bool:  # fmt: skip
-        """An access to unmapped or protected memory is about to fault: note its address (BFAR, MMFAR); unicorn then
-        stops with the error (``False``: not handled)."""
+        """An access to unmapped memory or against flash's or RAM's protection is about to fault: note its address
+        (BFAR, MMFAR); unicorn then stops with the error (``False``: not handled). Not hooked over the peripherals
+        (MCU-89): their protection events are the exact-PC hook's, which this one would precede at every access."""
         del handle, access, size, value, data
         self._fault_address = address
         return False
