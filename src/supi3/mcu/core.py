@@ -79,6 +79,7 @@ __all__ = [
     "countdown_register",
     "idle_loops",
     "is_poll_loop",
+    "virtual_tlb",
 ]
 
 EXCP_EXCEPTION_EXIT: Final[int] = 8
@@ -645,6 +646,17 @@ _NO_INTERRUPT: Final[int] = 0xFFFF_FFFF
 """The native state's ``interrupt`` after a run in which unicorn raised no CPU exception (MCU-72)."""
 
 
+def virtual_tlb(state: hook.State, flash: tuple[int, int]) -> hook.Memory:
+    """The user data of hook.c's ``supi3_tlb_fill`` (MCU-89): the default memory map's Execute Never regions
+    (:data:`EXECUTE_NEVER`), ``flash`` (base, size: its stores noted in ``state``, MCU-28) and unicorn's numbers."""
+    memory = hook.Memory(ctypes.pointer(state), *flash)
+    memory.never_low[:], memory.never_high[:] = zip(*EXECUTE_NEVER, strict=True)
+    memory.fetch, memory.store = ucc.UC_MEM_FETCH, ucc.UC_MEM_WRITE
+    memory.prot_write, memory.prot_exec, memory.prot_all = ucc.UC_PROT_WRITE, ucc.UC_PROT_EXEC, ucc.UC_PROT_ALL
+    memory.prefetch_abort = EXCP_PREFETCH_ABORT
+    return memory
+
+
 def _native(function: Any, *arguments: Any) -> Any:
     """A function of the native hook library taking unicorn's engine, the core's state and ``arguments`` (ctypes
     types), returning an ``int`` (MCU-70 to MCU-72)."""
@@ -908,12 +920,8 @@ class CortexM:
         self._hook(ucc.UC_HOOK_BLOCK, native.supi3_block_hook, data=ctypes.byref(state))
         # MCU-89: no memory hook (each one sends every load and store through unicorn's slow path, MCU-87): the
         # default memory map's permissions in the virtual TLB's fill, which notes a store into flash (MCU-28)
-        self._memory = memory = hook.Memory(ctypes.pointer(state), *flash)
-        memory.never_low[:], memory.never_high[:] = zip(*EXECUTE_NEVER, strict=True)
-        memory.fetch, memory.store = ucc.UC_MEM_FETCH, ucc.UC_MEM_WRITE
-        memory.prot_write, memory.prot_exec, memory.prot_all = ucc.UC_PROT_WRITE, ucc.UC_PROT_EXEC, ucc.UC_PROT_ALL
-        memory.prefetch_abort = EXCP_PREFETCH_ABORT
-        self._hook(ucc.UC_HOOK_TLB_FILL, native.supi3_tlb_fill, data=ctypes.byref(memory))
+        self._memory = virtual_tlb(state, flash)
+        self._hook(ucc.UC_HOOK_TLB_FILL, native.supi3_tlb_fill, data=ctypes.byref(self._memory))
         on_idle_loop = _HOOK_CODE(self._on_idle_loop)
         for address in idle_loops(self.image, flash):  # MCU-4: the core stops at its first ``b .``
             self._hook(ucc.UC_HOOK_CODE, on_idle_loop, address, address)
