@@ -24,11 +24,16 @@ Three parts, each run from the repository root:
 - ``split``: issue #13's case as ``bench_mcu.py`` runs it, its CPU time split into unicorn with hook.c (the native
   runs less the Python they call) and Python; interleaved rounds, the fastest. Run it on the tree before MCU-89 for
   the memory hooks' figures (the same process cannot hold both).
+- ``run``: issue #13's case once, power-up and ``--cycles`` master cycles, nothing else: for a count of the host's
+  instructions, deterministic where CPU time is not (MCU-89), with another tree's ``src`` on ``PYTHONPATH`` too;
+  the difference between ``--cycles 501`` and ``--cycles 1`` is 500 cycles':
+
+    PYTHONHASHSEED=0 valgrind --tool=callgrind --cache-sim=no --smc-check=all-non-file python bench/bench_unicorn.py run
 
 The machine is shared: its CPU time per run swings by up to 2x with the other sessions' load (the figures of one
 process are comparable with each other, not with another process's). Run from the repository root:
 
-    python bench/bench_unicorn.py [counts|synthetic|split ...] [--cycles N] [--rounds R]
+    python bench/bench_unicorn.py [counts|synthetic|split|run ...] [--cycles N] [--rounds R]
 """
 
 from __future__ import annotations
@@ -65,7 +70,7 @@ PERIPHERALS = ((0xE000_E000, 0x1000), (0x4002_1000, 0x400), (0x4001_0800, 0x400)
 """The board's mapped ranges (SCS, RCC, GPIOA, GPIOB, AFIO, EXTI, SPI1), as ``Board`` maps them."""
 EXACT_PC_RUNS = ((0xE000_E000, 0x1000), (0x4002_1000, 0x400), (0x4001_0000, 0x1000), (SPI1, 0x400))
 """The exact-PC hooks' ranges as ``CortexM`` hooks the board's: adjacent ranges in one (MCU-87)."""
-PARTS = ["counts", "synthetic", "split"]
+PARTS = ["counts", "synthetic", "split", "run"]
 CONFIGURATIONS: dict[str, frozenset[str]] = {
     "(a) no hook": frozenset(),
     "(b) + block hook": frozenset({"block"}),
@@ -310,7 +315,7 @@ def split(elf: Path, cycles: int, rounds: int) -> tuple[float, float, int, int, 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
-    parser.add_argument("parts", nargs="*", help="counts, synthetic, split (default: all three)")
+    parser.add_argument("parts", nargs="*", help="counts, synthetic, split, run (default: the first three)")
     parser.add_argument("--cycles", type=int, default=500, help="master cycles in issue #13's case")
     parser.add_argument("--rounds", type=int, default=5, help="interleaved rounds (the fastest of each is given)")
     parser.add_argument("--iterations", type=int, default=200_000, help="iterations of the synthetic loop")
@@ -318,13 +323,13 @@ def main(argv: list[str] | None = None) -> None:
     for name in ("cycles", "rounds", "iterations"):
         if getattr(args, name) < 1:
             parser.error(f"--{name} must be at least 1, not {getattr(args, name)}")
-    parts = args.parts or PARTS
+    parts = args.parts or PARTS[:3]
     if not set(parts) <= set(PARTS):
         parser.error(f"parts: {', '.join(PARTS)}, not {' '.join(parts)}")
     with tempfile.TemporaryDirectory() as folder:
         elf = issue_elf(Path(folder))
         simulated = None
-        if "counts" in parts or "split" in parts:
+        if {"counts", "split", "run"} & set(parts):
             board = issue_board(elf)
             start = board.bench.now
             board.run(args.cycles)
