@@ -10,25 +10,30 @@ Three parts, each run from the repository root:
   added to the board's core (and its translations dropped, so they reach every block): deterministic, not timed.
 - ``synthetic``: unicorn alone on a Thumb loop in flash that has issue #13's mix (4 blocks, 14 instructions and 6 loads
   or stores of RAM an iteration; a variant reads a peripheral in place of one RAM load, answered by hook.c's
-  held-register callback without Python), with the hooks added one by one as ``CortexM`` adds them: (a) none but the
-  seven peripheral ranges mapped with ``uc_mmio_map``; (b) the native block hook; (c) the ``UC_HOOK_MEM_READ |
-  UC_HOOK_MEM_WRITE`` hooks of the peripheral ranges (``supi3_exact_pc``, one a run of adjacent ranges, MCU-87); (d) the
-  flash write hook (``supi3_code_written``, MCU-28) and two code hooks at addresses the loop never runs (the idle loops
-  and the serve point, ``CortexM.watch``). Each figure is the fastest of ``--rounds`` interleaved runs, in CPU time.
-  From them: the block hook's cost a block, a RAM access's cost once any memory hook exists (unicorn then sends every
-  guest load and store through its slow path), a peripheral access's cost and the cost of the exact PC at one (unicorn
-  restores the PC from the host return address, ``cpu_restore_state``, when a memory hook covers the address), and what
-  they come to with ``counts``' figures.
+  held-register callback without Python), with the hooks added one by one as ``CortexM`` added them before MCU-89:
+  (a) none but the seven peripheral ranges mapped with ``uc_mmio_map``; (b) the native block hook; (c) the
+  ``UC_HOOK_MEM_READ | UC_HOOK_MEM_WRITE`` hooks of the peripheral ranges (``supi3_exact_pc``, one a run of adjacent
+  ranges, MCU-87); (d) a flash write hook (MCU-28's, never called by the loop) and two code hooks at addresses the
+  loop never runs (the idle loops and the serve point, ``CortexM.watch``); and (e) as ``CortexM`` sets them up since
+  MCU-89: the block hook, the exact-PC hooks as protection hooks over the peripheral ranges mapped inaccessible, the
+  virtual TLB's fill (``supi3_tlb_fill``) and the two code hooks. Each figure is the fastest of ``--rounds``
+  interleaved runs, in CPU time. From them: the block hook's cost a block, a RAM access's cost once any memory hook
+  exists (unicorn then sends every guest load and store through its slow path), a peripheral access's cost and the
+  cost of the exact PC at one (unicorn restores the PC from the host return address, ``cpu_restore_state``, when a
+  memory or protection hook covers the address), and what they come to with ``counts``' figures.
 - ``split``: issue #13's case as ``bench_mcu.py`` runs it, its CPU time split into unicorn with hook.c (the native
-  runs less the Python they call) and Python, for the board as it is and, to price the memory hooks, for boards
-  without the exact-PC hooks or without any memory hook. Those two are not exact (a peripheral access is then timed
-  at its block's entry, MCU-1; the run differs slightly: its instructions and violations are printed), they only
-  say what the hooks cost. Interleaved rounds, the fastest of each.
+  runs less the Python they call) and Python; interleaved rounds, the fastest. Run it on the tree before MCU-89 for
+  the memory hooks' figures (the same process cannot hold both).
+- ``run``: issue #13's case once, power-up and ``--cycles`` master cycles, nothing else: for a count of the host's
+  instructions, deterministic where CPU time is not (MCU-89), with another tree's ``src`` on ``PYTHONPATH`` too;
+  the difference between ``--cycles 501`` and ``--cycles 1`` is 500 cycles':
+
+    PYTHONHASHSEED=0 valgrind --tool=callgrind --cache-sim=no --smc-check=all-non-file python bench/bench_unicorn.py run
 
 The machine is shared: its CPU time per run swings by up to 2x with the other sessions' load (the figures of one
 process are comparable with each other, not with another process's). Run from the repository root:
 
-    python bench/bench_unicorn.py [counts|synthetic|split ...] [--cycles N] [--rounds R]
+    python bench/bench_unicorn.py [counts|synthetic|split|run ...] [--cycles N] [--rounds R]
 """
 
 from __future__ import annotations
@@ -39,8 +44,7 @@ import ctypes
 import struct
 import tempfile
 import time
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -66,15 +70,17 @@ PERIPHERALS = ((0xE000_E000, 0x1000), (0x4002_1000, 0x400), (0x4001_0800, 0x400)
 """The board's mapped ranges (SCS, RCC, GPIOA, GPIOB, AFIO, EXTI, SPI1), as ``Board`` maps them."""
 EXACT_PC_RUNS = ((0xE000_E000, 0x1000), (0x4002_1000, 0x400), (0x4001_0000, 0x1000), (SPI1, 0x400))
 """The exact-PC hooks' ranges as ``CortexM`` hooks the board's: adjacent ranges in one (MCU-87)."""
-PARTS = ["counts", "synthetic", "split"]
+PARTS = ["counts", "synthetic", "split", "run"]
 CONFIGURATIONS: dict[str, frozenset[str]] = {
     "(a) no hook": frozenset(),
     "(b) + block hook": frozenset({"block"}),
     "(c) + exact-PC memory hooks": frozenset({"block", "exact"}),
     "(d) + flash and code hooks": frozenset({"block", "exact", "flash"}),
     "(b) + flash and code hooks only": frozenset({"block", "flash"}),
+    "(e) MCU-89: protection hooks, TLB fill": frozenset({"block", "protection"}),
 }
-"""The synthetic loop's hooks: (a) to (d) as ``CortexM`` adds them; the last without the exact-PC hooks."""
+"""The synthetic loop's hooks: (a) to (d) as ``CortexM`` added them before MCU-89, one without the exact-PC hooks,
+(e) as it adds them since."""
 LOOP_INSTRUCTIONS, LOOP_BLOCKS, LOOP_ACCESSES = 14, 4, 6
 
 
@@ -154,6 +160,8 @@ class _Engine:
         library = hook.library()
         self.uc: Any = core_module._UNICORN.Uc(ucc.UC_ARCH_ARM, ucc.UC_MODE_THUMB | ucc.UC_MODE_MCLASS)
         self.uc.ctl_set_cpu_model(arm.UC_CPU_ARM_CORTEX_M3)
+        if "protection" in hooks:
+            self.uc.ctl_set_tlb_mode(ucc.UC_TLB_VIRTUAL)
         self._keep: list[object] = []
         code, costs = _loop(peripheral)
         self.end = FLASH + len(code) - 2
@@ -179,13 +187,22 @@ class _Engine:
                                     ctypes.byref(held), None, None) == 0  # fmt: skip
         if "block" in hooks:
             self._hook(ucc.UC_HOOK_BLOCK, library.supi3_block_hook, 1, 0, ctypes.byref(state))
-        if "exact" in hooks:
+        if "exact" in hooks:  # before MCU-89 (the native hook's answer is not read by a memory hook's caller)
             for base, size in EXACT_PC_RUNS:
                 self._hook(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, library.supi3_exact_pc, base,
                            base + size - 1, ctypes.byref(state))  # fmt: skip
-        if "flash" in hooks:
-            self._hook(ucc.UC_HOOK_MEM_WRITE, library.supi3_code_written, FLASH, FLASH + 64 * 1024 - 1,
-                       ctypes.byref(state))  # fmt: skip
+        if "flash" in hooks:  # before MCU-89: a flash write hook (the loop stores into RAM only: never called)
+            self._hook(ucc.UC_HOOK_MEM_WRITE, _MEM_HOOK(lambda *_: None), FLASH, FLASH + 64 * 1024 - 1, None)
+        if "protection" in hooks:  # as CortexM since MCU-89
+            memory = core_module.virtual_tlb(state, (FLASH, 64 * 1024))
+            self._keep.append(memory)
+            self._hook(ucc.UC_HOOK_TLB_FILL, library.supi3_tlb_fill, 1, 0, ctypes.byref(memory))
+            for base, size in PERIPHERALS:
+                self.uc.mem_protect(base, size, ucc.UC_PROT_NONE)
+            for base, size in EXACT_PC_RUNS:
+                self._hook(ucc.UC_HOOK_MEM_READ_PROT | ucc.UC_HOOK_MEM_WRITE_PROT, library.supi3_exact_pc, base,
+                           base + size - 1, ctypes.byref(state))  # fmt: skip
+        if hooks & {"flash", "protection"}:
             nothing = core_module._HOOK_CODE(lambda *_: None)
             for address in (FLASH + 0x1000, FLASH + 0x1100):
                 self._hook(ucc.UC_HOOK_CODE, nothing, address, address, None)
@@ -261,69 +278,44 @@ _PYTHON_FROM_RUN = ((frames_module.NativeFrames, ("_bus_due", "catch_up")),
 frames' catch-up and bus synchronisation, a block's costing)."""
 
 
-@contextmanager
-def _without(dropped: set[str]) -> Iterator[None]:
-    """Cores built meanwhile lack the exact-PC hooks (``"exact"``) or the flash hook (``"flash"``)."""
-    library = hook.library()
-    added = core_module.CortexM._hook
-    names = {"exact": library.supi3_exact_pc, "flash": library.supi3_code_written}
-
-    def filtered(self: core_module.CortexM, kind: int, callback: Any, begin: int = 1, end: int = 0,
-                 data: Any = None) -> int:  # fmt: skip
-        if any(callback is names[name] for name in dropped):
-            return 0  # no hook: unicorn's uc_hook_del of it (a merge, MCU-87) finds none and does nothing
-        return added(self, kind, callback, begin, end, data)
-
-    core_module.CortexM._hook = filtered  # type: ignore[method-assign]
-    try:
-        yield
-    finally:
-        core_module.CortexM._hook = added  # type: ignore[method-assign]
-
-
-SPLIT_CASES: dict[str, set[str]] = {"as it is": set(), "without the exact-PC hooks (not exact)": {"exact"},
-                                    "without any memory hook (not exact)": {"exact", "flash"}}  # fmt: skip
-
-
-def split(elf: Path, cycles: int, rounds: int) -> dict[str, tuple[float, float, int, int, int]]:
-    """Per case, of the round with the fastest run: its CPU seconds, those of unicorn with hook.c in it, the
-    instructions counted (MCU-1), the violations and the Python calls from unicorn's runs."""
+def split(elf: Path, cycles: int, rounds: int) -> tuple[float, float, int, int, int]:
+    """Of the round with the fastest run: its CPU seconds, those of unicorn with hook.c in it, the instructions counted
+    (MCU-1), the violations and the Python calls from unicorn's runs."""
     for owner, names in _PYTHON_FROM_RUN:
         for name in names:
             setattr(owner, name, _timed_python(getattr(owner, name)))
-    best: dict[str, tuple[float, float, int, int, int]] = {}
+    best: tuple[float, float, int, int, int] | None = None
     for _ in range(rounds):
-        for case, dropped in SPLIT_CASES.items():
-            with _without(dropped):
-                board = issue_board(elf)
-            core = board.core
-            run = core._native_run
+        board = issue_board(elf)
+        core = board.core
+        run = core._native_run
 
-            def timed_run(*arguments: Any, run: Any = run) -> int:
-                _nested["depth"] = 1
-                start = _clock()
-                try:
-                    return int(run(*arguments))
-                finally:
-                    _nested["native"] += _clock() - start
-                    _nested["depth"] = 0
+        def timed_run(*arguments: Any, run: Any = run) -> int:
+            _nested["depth"] = 1
+            start = _clock()
+            try:
+                return int(run(*arguments))
+            finally:
+                _nested["native"] += _clock() - start
+                _nested["depth"] = 0
 
-            core._native_run = timed_run
-            _nested["python"] = _nested["native"] = _nested["calls"] = 0
-            instructions = core.instructions
-            start = time.process_time()
-            board.run(cycles)
-            total = time.process_time() - start
-            row = (total, _nested["native"] - _nested["python"], core.instructions - instructions,
-                   len(board.violations), int(_nested["calls"]))  # fmt: skip
-            if case not in best or row[0] < best[case][0]:
-                best[case] = row
+        core._native_run = timed_run
+        _nested["python"] = _nested["native"] = _nested["calls"] = 0
+        instructions = core.instructions
+        start = time.process_time()
+        board.run(cycles)
+        total = time.process_time() - start
+        row = (total, _nested["native"] - _nested["python"], core.instructions - instructions, len(board.violations),
+               int(_nested["calls"]))  # fmt: skip
+        if best is None or row[0] < best[0]:
+            best = row
+    assert best is not None
     return best
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
-    parser.add_argument("parts", nargs="*", help="counts, synthetic, split (default: all three)")
+    parser.add_argument("parts", nargs="*", help="counts, synthetic, split, run (default: the first three)")
     parser.add_argument("--cycles", type=int, default=500, help="master cycles in issue #13's case")
     parser.add_argument("--rounds", type=int, default=5, help="interleaved rounds (the fastest of each is given)")
     parser.add_argument("--iterations", type=int, default=200_000, help="iterations of the synthetic loop")
@@ -331,13 +323,13 @@ def main(argv: list[str] | None = None) -> None:
     for name in ("cycles", "rounds", "iterations"):
         if getattr(args, name) < 1:
             parser.error(f"--{name} must be at least 1, not {getattr(args, name)}")
-    parts = args.parts or PARTS
+    parts = args.parts or PARTS[:3]
     if not set(parts) <= set(PARTS):
         parser.error(f"parts: {', '.join(PARTS)}, not {' '.join(parts)}")
     with tempfile.TemporaryDirectory() as folder:
         elf = issue_elf(Path(folder))
         simulated = None
-        if "counts" in parts or "split" in parts:
+        if {"counts", "split", "run"} & set(parts):
             board = issue_board(elf)
             start = board.bench.now
             board.run(args.cycles)
@@ -369,14 +361,11 @@ def main(argv: list[str] | None = None) -> None:
                       f"the slow path, {accesses} exact PCs), the block hook's "
                       f"{found['blocks entered'] * units['block hook, a block'] * 1e3:.1f} ms")  # fmt: skip
         if "split" in parts:
-            print("issue #13's case, CPU time split (the fastest round of each):")
-            for case, (total, emulator, instructions, violations, calls) in split(elf, args.cycles,
-                                                                                  args.rounds).items():  # fmt: skip
-                ratio = f", simulated / emulator {simulated / emulator:.2f}x" if simulated else ""
-                print(f"  {case:40s} total {total * 1e3:6.1f} ms, unicorn with hook.c {emulator * 1e3:5.1f} ms"
-                      f"{ratio}; instructions {instructions}, violations {violations}, Python calls from the runs "
-                      f"{calls}")  # fmt: skip
-
+            total, emulator, instructions, violations, calls = split(elf, args.cycles, args.rounds)
+            ratio = f", simulated / emulator {simulated / emulator:.2f}x" if simulated else ""
+            print(f"issue #13's case, CPU time split (the fastest round): total {total * 1e3:6.1f} ms, unicorn with "
+                  f"hook.c {emulator * 1e3:5.1f} ms{ratio}; instructions {instructions}, violations {violations}, "
+                  f"Python calls from the runs {calls}")  # fmt: skip
 
 if __name__ == "__main__":
     main()

@@ -13,14 +13,16 @@ Timing (MCU-1): every basic block unicorn enters costs its instructions' cycles 
 instruction, one more per single load or store, one per register of a multiple load or store, two more for a
 branch that ends the block, taken as taken), so the clock is exact at block boundaries; a peripheral access is
 placed inside its block by the program counter (:meth:`CortexM.cycles_now`; unicorn keeps the PC exact at an
-access only under a memory hook, so each peripheral range has an empty one). Emulation only ever stops at a block
+access only under a memory or protection hook: the peripherals are mapped inaccessible, each run of them has a
+protection hook that lets the access go on, MCU-89). Emulation only ever stops at a block
 boundary (a block hook refuses the next block), because unicorn restarts an instruction stopped inside a memory
 callback and a peripheral would see its access twice.
 
 Speed (MCU-19): the peripheral callbacks and the register reads they need go to unicorn's C library through ctypes
-directly; the binding's wrappers around each call cost as much again as the call. The block hook and the empty memory
-hooks are native code (MCU-25, :mod:`supi3.mcu.hook`): a block in flash calls Python only the first time it runs (one
-in RAM each time it runs, MCU-28).
+directly; the binding's wrappers around each call cost as much again as the call. The block hook, the exact-PC hooks
+and the virtual TLB's fill are native code (MCU-25, MCU-89, :mod:`supi3.mcu.hook`): a block in flash calls Python only
+the first time it runs (one in RAM each time it runs, MCU-28). No memory hook is set: any one sends every guest load
+and store through unicorn's slow path (MCU-87); the fill notes the firmware's stores into flash (MCU-28) instead.
 """
 
 from __future__ import annotations
@@ -77,6 +79,7 @@ __all__ = [
     "countdown_register",
     "idle_loops",
     "is_poll_loop",
+    "virtual_tlb",
 ]
 
 EXCP_EXCEPTION_EXIT: Final[int] = 8
@@ -84,7 +87,8 @@ EXCP_EXCEPTION_EXIT: Final[int] = 8
 EXCP_SWI: Final[int] = 2
 EXCP_PREFETCH_ABORT: Final[int] = 3
 """unicorn's interrupt number for an instruction fetch it cannot make (QEMU's EXCP_PREFETCH_ABORT): from a peripheral
-callback's region, or from some unmapped addresses (0)."""
+callback's region, or from some unmapped addresses (0). MCU-89: a fetch the virtual TLB's fill refuses (Execute Never)
+ends the run with UC_ERR_EXCEPTION, the fill noting this number, and is taken as this interrupt."""
 EXECUTE_NEVER: Final[tuple[tuple[int, int], ...]] = ((0x4000_0000, 0x6000_0000), (0xA000_0000, 0x1_0000_0000))
 """The Execute Never regions of the default memory map (B3.1, Table B3-1: Peripheral, Device, System): a fetch there
 is a MemManage fault (IACCVIOL)."""
@@ -642,6 +646,17 @@ _NO_INTERRUPT: Final[int] = 0xFFFF_FFFF
 """The native state's ``interrupt`` after a run in which unicorn raised no CPU exception (MCU-72)."""
 
 
+def virtual_tlb(state: hook.State, flash: tuple[int, int]) -> hook.Memory:
+    """The user data of hook.c's ``supi3_tlb_fill`` (MCU-89): the default memory map's Execute Never regions
+    (:data:`EXECUTE_NEVER`), ``flash`` (base, size: its stores noted in ``state``, MCU-28) and unicorn's numbers."""
+    memory = hook.Memory(ctypes.pointer(state), *flash)
+    memory.never_low[:], memory.never_high[:] = zip(*EXECUTE_NEVER, strict=True)
+    memory.fetch, memory.store = ucc.UC_MEM_FETCH, ucc.UC_MEM_WRITE
+    memory.prot_write, memory.prot_exec, memory.prot_all = ucc.UC_PROT_WRITE, ucc.UC_PROT_EXEC, ucc.UC_PROT_ALL
+    memory.prefetch_abort = EXCP_PREFETCH_ABORT
+    return memory
+
+
 def _native(function: Any, *arguments: Any) -> Any:
     """A function of the native hook library taking unicorn's engine, the core's state and ``arguments`` (ctypes
     types), returning an ``int`` (MCU-70 to MCU-72)."""
@@ -822,6 +837,7 @@ class CortexM:
         self._callbacks: list[object] = []  # the ctypes callbacks unicorn holds: kept alive with the core
         self.flash = flash
         self.ram = ram
+        self.uc.ctl_set_tlb_mode(ucc.UC_TLB_VIRTUAL)  # MCU-89: the fill (hook.c's supi3_tlb_fill) in place of QEMU's
         for base, size in (flash, ram):
             self.uc.mem_map(base, size)
         for address, data in self.image.segments:
@@ -902,14 +918,19 @@ class CortexM:
         self._exact_spans: list[tuple[int, int, int]] = []  # first, last address and handle of each exact-PC hook
         self.mmio(SCS_BASE, SCS_SIZE, self._scs_read, self._scs_write)
         self._hook(ucc.UC_HOOK_BLOCK, native.supi3_block_hook, data=ctypes.byref(state))
-        self._hook(ucc.UC_HOOK_MEM_WRITE, native.supi3_code_written, flash[0], flash[0] + flash[1] - 1,
-                   ctypes.byref(state))  # MCU-28: a store into flash may change code  # fmt: skip
+        # MCU-89: no memory hook (each one sends every load and store through unicorn's slow path, MCU-87): the
+        # default memory map's permissions in the virtual TLB's fill, which notes a store into flash (MCU-28)
+        self._memory = virtual_tlb(state, flash)
+        self._hook(ucc.UC_HOOK_TLB_FILL, native.supi3_tlb_fill, data=ctypes.byref(self._memory))
         on_idle_loop = _HOOK_CODE(self._on_idle_loop)
         for address in idle_loops(self.image, flash):  # MCU-4: the core stops at its first ``b .``
             self._hook(ucc.UC_HOOK_CODE, on_idle_loop, address, address)
         self._hook(ucc.UC_HOOK_INTR, native.supi3_interrupt, data=self._state_ref)  # native (MCU-72)
         self._fault_address: int | None = None  # the address of the last unmapped or protected access (BFAR, MMFAR)
-        self._hook(ucc.UC_HOOK_MEM_INVALID, _HOOK_MEM_INVALID(self._on_invalid_access))
+        on_invalid_access = _HOOK_MEM_INVALID(self._on_invalid_access)
+        self._hook(ucc.UC_HOOK_MEM_UNMAPPED, on_invalid_access)
+        for base, size in (flash, ram):  # MCU-89: not the peripherals', whose protection hooks take every access
+            self._hook(ucc.UC_HOOK_MEM_PROT, on_invalid_access, base, base + size - 1)
         self.reset()
 
     # -- memory ------------------------------------------------------------------------------------------------
@@ -960,18 +981,21 @@ class CortexM:
             self._callbacks.append(native)
             self._check(_LIB.uc_mmio_map(self._handle, base, size, self._port_read, ctypes.byref(native),
                                          self._port_write, ctypes.byref(native)))  # fmt: skip
+        self.uc.mem_protect(base, size, ucc.UC_PROT_NONE)  # MCU-89: each access calls the exact-PC hook
         self._exact_pc_over(base, base + size - 1)
         return HeldRegister(held)
 
     def _exact_pc_over(self, first: int, last: int) -> None:
-        """The exact-PC memory hook over the addresses ``first`` to ``last``, merged with those of the ranges next to
-        them: one hook a run of adjacent ranges (MCU-87).
+        """The exact-PC hook over the addresses ``first`` to ``last``, merged with those of the ranges next to them:
+        one hook a run of adjacent ranges (MCU-87).
 
-        unicorn updates the PC before a load or store only if a memory hook covers its address: without one, a
-        peripheral callback sees the PC of the block's first instruction, and the access would be timed there (MCU-1
-        places it by the PC). The native hook also notes that PC for cycles_now (MCU-25). Once any memory hook exists,
-        unicorn walks the whole list at every load and store (MCU-87): the board's GPIOA, GPIOB, AFIO and EXTI, next
-        to each other, share one hook; the addresses covered are the same."""
+        unicorn updates the PC before a load or store only if a memory or protection hook covers its address: without
+        one, a peripheral callback sees the PC of the block's first instruction, and the access would be timed there
+        (MCU-1 places it by the PC). The ranges are mapped inaccessible (:meth:`mmio`), so each access raises a
+        protection event, which this native hook takes: it notes the PC for cycles_now (MCU-25) and lets the access go
+        on (MCU-89: a memory hook would send every load and store of RAM and flash through unicorn's slow path too).
+        unicorn walks the whole list at each event: the board's GPIOA, GPIOB, AFIO and EXTI, next to each other,
+        share one hook; the addresses covered are the same."""
         kept = []
         for low, high, handle in self._exact_spans:
             if high + 1 == first or last + 1 == low:  # next to it (ranges never overlap: uc_mmio_map refuses that)
@@ -979,7 +1003,7 @@ class CortexM:
                 first, last = min(first, low), max(last, high)
             else:
                 kept.append((low, high, handle))
-        handle = self._hook(ucc.UC_HOOK_MEM_READ | ucc.UC_HOOK_MEM_WRITE, self._exact_pc, first, last,
+        handle = self._hook(ucc.UC_HOOK_MEM_READ_PROT | ucc.UC_HOOK_MEM_WRITE_PROT, self._exact_pc, first, last,
                             ctypes.byref(self._state))  # fmt: skip
         self._exact_spans = [*kept, (first, last, handle)]
 
@@ -1455,10 +1479,14 @@ class CortexM:
         self._running = True
         try:  # from the PC; unicorn's CPU exception noted in the state (MCU-72: supi3_run, supi3_interrupt)
             status = self._native_run(self._handle, self._state_ref, self._frames_ref)
+            if status == ucc.UC_ERR_EXCEPTION and state.interrupt == EXCP_PREFETCH_ABORT:
+                status = ucc.UC_ERR_OK  # MCU-89: the virtual TLB refused the fetch, as QEMU's map did (_after_stop)
             if status != ucc.UC_ERR_OK:
                 raise FirmwareFaultError(self._fault(UcError(status)))
         finally:
             self._running = False
+            if state.code_written:  # MCU-89: flash read-only again in the TLB, so the next store is noted too
+                self.uc.ctl(ucc.UC_CTL_TLB_FLUSH, ucc.UC_CTL_IO_WRITE)
             entry = self.entry
             if entry is not None:  # MCU-51: the native frames' effects into the Python objects
                 entry()
@@ -1516,8 +1544,9 @@ class CortexM:
 
     def _on_invalid_access(self, handle: int, access: int, address: int, size: int, value: int,
                            data: int | None) -> bool:  # fmt: skip
-        """An access to unmapped or protected memory is about to fault: note its address (BFAR, MMFAR); unicorn then
-        stops with the error (``False``: not handled)."""
+        """An access to unmapped memory or against flash's or RAM's protection is about to fault: note its address
+        (BFAR, MMFAR); unicorn then stops with the error (``False``: not handled). Not hooked over the peripherals
+        (MCU-89): their protection events are the exact-PC hook's, which this one would precede at every access."""
         del handle, access, size, value, data
         self._fault_address = address
         return False

@@ -1,4 +1,4 @@
-/* The emulated core's block hook and empty memory hook in native code (MCU-25; docs/assumptions/mcu.md).
+/* The emulated core's block hook, exact-PC hook and virtual TLB in native code (MCU-25, MCU-89; docs/assumptions/mcu.md).
  *
  * Built for the host on first use by supi3.mcu.hook (the Zig toolchain from PyPI) and loaded with ctypes. It links
  * against nothing: unicorn's functions it calls come as pointers in the shared state, which the Python side
@@ -21,6 +21,7 @@
  * The exception entry's, tail-chain's and return's register and memory traffic, a run's start and the interrupt hook
  * are here too (MCU-70 to MCU-72): CortexM keeps every decision and report and calls them once each.
  */
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -166,9 +167,10 @@ void supi3_block_hook(void *uc, uint64_t address, uint32_t size, void *data) {
     s->cycles += cost->cycles;
 }
 
-/* The memory hook of each peripheral range: its presence makes unicorn keep the PC exact at each access it covers
- * (MCU-1); it notes that PC for the peripheral's callback, which runs next (CortexM.cycles_now). */
-void supi3_exact_pc(void *uc, int type, uint64_t address, int size, int64_t value, void *data) {
+/* The protection hook of each run of adjacent peripheral ranges (uc_cb_eventmem_t; MCU-89: the ranges are mapped
+ * inaccessible, so each load and store of them calls it, and unicorn restores the PC before it, MCU-1): it notes that
+ * PC for the peripheral's callback, which runs next (CortexM.cycles_now), and lets the access go on. */
+bool supi3_exact_pc(void *uc, int type, uint64_t address, int size, int64_t value, void *data) {
     supi3_state *s = (supi3_state *)data;
     (void)type;
     (void)address;
@@ -176,19 +178,57 @@ void supi3_exact_pc(void *uc, int type, uint64_t address, int size, int64_t valu
     (void)value;
     s->access_pc = 0;
     s->reg_read(uc, s->pc_register, &s->access_pc);
+    return true;
 }
 
-/* MCU-28: the memory hook of flash (uc_cb_hookmem_t). A store there may change code whose cost the cache holds: the
- * run stops at the end of the block and CortexM forgets every cost of code before the next. */
-void supi3_code_written(void *uc, int type, uint64_t address, int size, int64_t value, void *data) {
-    supi3_state *s = (supi3_state *)data;
+/* MCU-89: the virtual TLB (uc_tlb_entry, uc_cb_tlbevent_t). Each address is itself; a page is readable, writable and
+ * executable as the default memory map has it (ARMv7-M B3.1, Table B3-1: its Execute Never regions from CortexM);
+ * flash is writable only for a store's fill, which notes the store as MCU-28 needs (CortexM forgets every cost of
+ * code after the run and empties the TLB, so that the next store fills again). A fetch refused ends the run with
+ * unicorn's UC_ERR_EXCEPTION: `prefetch_abort` in `interrupt` says it was this one (QEMU raised it as
+ * EXCP_PREFETCH_ABORT before the virtual TLB). */
+typedef struct {
+    uint64_t paddr;
+    int32_t perms;
+} supi3_tlb_entry;
+
+typedef struct {
+    supi3_state *state;
+    uint64_t flash;
+    uint64_t flash_size;
+    uint64_t never_low[2];  /* the Execute Never regions, [low, high) */
+    uint64_t never_high[2];
+    int32_t fetch;          /* unicorn's UC_MEM_FETCH and UC_MEM_WRITE */
+    int32_t store;
+    int32_t prot_write;     /* unicorn's UC_PROT_WRITE, UC_PROT_EXEC, UC_PROT_ALL */
+    int32_t prot_exec;
+    int32_t prot_all;
+    uint32_t prefetch_abort;
+} supi3_memory;
+
+bool supi3_tlb_fill(void *uc, uint64_t address, int type, supi3_tlb_entry *entry, void *data) {
+    supi3_memory *m = (supi3_memory *)data;
+    supi3_state *s = m->state;
     (void)uc;
-    (void)type;
-    (void)address;
-    (void)size;
-    (void)value;
-    s->code_written = 1;
-    s->stop_request = 1;
+    entry->paddr = address;
+    entry->perms = m->prot_all;
+    for (int k = 0; k < 2; k++) {
+        if (address - m->never_low[k] < m->never_high[k] - m->never_low[k]) {
+            entry->perms &= ~m->prot_exec;
+            if (type == m->fetch) {
+                s->interrupt = m->prefetch_abort;
+            }
+        }
+    }
+    if (address - m->flash < m->flash_size) {
+        if (type == m->store) { /* MCU-28: a store into flash may change code whose cost the cache holds */
+            s->code_written = 1;
+            s->stop_request = 1;
+        } else {
+            entry->perms &= ~m->prot_write;
+        }
+    }
+    return true;
 }
 
 /* A register value a peripheral holds while the read's time is before `until` (MCU-25). */
@@ -860,5 +900,10 @@ const uint32_t supi3_frames_layout[] = {
     AT(supi3_frames, wr), AT(supi3_frames, reads_register), AT(supi3_frames, writes_register),
     AT(supi3_frames, fast_read), AT(supi3_frames, fast_write), AT(supi3_frames, write_mask),
     AT(supi3_frames, alias)};
+const uint32_t supi3_memory_layout[] = {
+    12, sizeof(supi3_memory), AT(supi3_memory, state), AT(supi3_memory, flash), AT(supi3_memory, flash_size),
+    AT(supi3_memory, never_low), AT(supi3_memory, never_high), AT(supi3_memory, fetch), AT(supi3_memory, store),
+    AT(supi3_memory, prot_write), AT(supi3_memory, prot_exec), AT(supi3_memory, prot_all),
+    AT(supi3_memory, prefetch_abort)};
 const uint32_t supi3_port_layout[] = {
     5, sizeof(supi3_port), AT(supi3_port, frames), AT(supi3_port, slow), AT(supi3_port, port), AT(supi3_port, held)};

@@ -2,8 +2,8 @@
 also holds the exception entry's, tail-chain's and return's register and memory traffic, a run's start and the
 interrupt hook (MCU-70 to MCU-72), which :class:`supi3.mcu.core.CortexM` calls with its :class:`State`.
 
-Ref: unicorn.h (uc_cb_hookcode_t, uc_cb_hookmem_t); decisions MCU-1, MCU-10, MCU-11, MCU-25 in
-docs/assumptions/mcu.md. The C source ships with the package; :func:`library` compiles it on first use with
+Ref: unicorn.h (uc_cb_hookcode_t, uc_cb_eventmem_t, uc_cb_tlbevent_t); decisions MCU-1, MCU-10, MCU-11, MCU-25,
+MCU-89 in docs/assumptions/mcu.md. The C source ships with the package; :func:`library` compiles it on first use with
 
     python -m ziglang cc -shared -fPIC -O2 -target native -mcpu=baseline -nostdlib -std=c99 -Wall -Wextra
         -pedantic -Werror hook.c -o <cache>/_supi3_mcu_hook_<hash>.so
@@ -34,8 +34,8 @@ from supi3.errors import Supi3Error
 from supi3.sdk.native import default_cache_dir
 
 __all__ = ["BUS_DUE", "DESCRIBE", "FLAGS", "MMIO_READ", "MMIO_WRITE", "SOURCE", "Block", "Frames", "Held",
-           "NativeHookError", "Port", "Prefix", "State", "cached_path", "check_layout", "check_whole", "layout",
-           "library", "native_layout"]
+           "Memory", "NativeHookError", "Port", "Prefix", "State", "cached_path", "check_layout", "check_whole",
+           "layout", "library", "native_layout"]
 
 SOURCE: Final[Path] = Path(__file__).with_name("hook.c")
 FLAGS: Final[tuple[str, ...]] = ("-shared", "-fPIC", "-O2", "-target", "native", "-mcpu=baseline", "-nostdlib",
@@ -263,10 +263,23 @@ class Port(ctypes.Structure):
                 ("held", ctypes.POINTER(Held)))
 
 
+class Memory(ctypes.Structure):
+    """The user data of :func:`supi3_tlb_fill`, the virtual TLB's fill (``supi3_memory``, MCU-89): the state, flash
+    (base, size: writable only for a store's fill, which notes it, MCU-28), the Execute Never regions (low, high)
+    and unicorn's numbers: the fetch and store access types, the write, execute and all permissions, and the
+    interrupt number a refused fetch notes in :attr:`State.interrupt`."""
+
+    _fields_ = (("state", ctypes.POINTER(State)), ("flash", ctypes.c_uint64), ("flash_size", ctypes.c_uint64),
+                ("never_low", ctypes.c_uint64 * 2), ("never_high", ctypes.c_uint64 * 2), ("fetch", ctypes.c_int32),
+                ("store", ctypes.c_int32), ("prot_write", ctypes.c_int32), ("prot_exec", ctypes.c_int32),
+                ("prot_all", ctypes.c_int32), ("prefetch_abort", ctypes.c_uint32))  # fmt: skip
+
+
 _LOADED: list[ctypes.CDLL] = []
 _LAYOUTS: Final[dict[str, type[ctypes.Structure]]] = {
     "supi3_block_layout": Block, "supi3_state_layout": State, "supi3_held_layout": Held,
-    "supi3_prefix_layout": Prefix, "supi3_frames_layout": Frames, "supi3_port_layout": Port}  # fmt: skip
+    "supi3_prefix_layout": Prefix, "supi3_frames_layout": Frames, "supi3_port_layout": Port,
+    "supi3_memory_layout": Memory}  # fmt: skip
 """hook.c's layout tables and their ctypes mirrors."""
 
 
