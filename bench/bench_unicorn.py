@@ -194,7 +194,7 @@ class _Engine:
         if "flash" in hooks:  # before MCU-89: a flash write hook (the loop stores into RAM only: never called)
             self._hook(ucc.UC_HOOK_MEM_WRITE, _MEM_HOOK(lambda *_: None), FLASH, FLASH + 64 * 1024 - 1, None)
         if "protection" in hooks:  # as CortexM since MCU-89
-            memory = core_module.virtual_tlb(state, (FLASH, 64 * 1024))
+            memory = core_module._virtual_tlb(state, (FLASH, 64 * 1024))
             self._keep.append(memory)
             self._hook(ucc.UC_HOOK_TLB_FILL, library.supi3_tlb_fill, 1, 0, ctypes.byref(memory))
             for base, size in PERIPHERALS:

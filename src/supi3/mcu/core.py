@@ -79,7 +79,6 @@ __all__ = [
     "countdown_register",
     "idle_loops",
     "is_poll_loop",
-    "virtual_tlb",
 ]
 
 EXCP_EXCEPTION_EXIT: Final[int] = 8
@@ -646,7 +645,7 @@ _NO_INTERRUPT: Final[int] = 0xFFFF_FFFF
 """The native state's ``interrupt`` after a run in which unicorn raised no CPU exception (MCU-72)."""
 
 
-def virtual_tlb(state: hook.State, flash: tuple[int, int]) -> hook.Memory:
+def _virtual_tlb(state: hook.State, flash: tuple[int, int]) -> hook.Memory:
     """The user data of hook.c's ``supi3_tlb_fill`` (MCU-89): the default memory map's Execute Never regions
     (:data:`EXECUTE_NEVER`), ``flash`` (base, size: its stores noted in ``state``, MCU-28) and unicorn's numbers."""
     memory = hook.Memory(ctypes.pointer(state), *flash)
@@ -920,7 +919,7 @@ class CortexM:
         self._hook(ucc.UC_HOOK_BLOCK, native.supi3_block_hook, data=ctypes.byref(state))
         # MCU-89: no memory hook (each one sends every load and store through unicorn's slow path, MCU-87): the
         # default memory map's permissions in the virtual TLB's fill, which notes a store into flash (MCU-28)
-        self._memory = virtual_tlb(state, flash)
+        self._memory = _virtual_tlb(state, flash)
         self._hook(ucc.UC_HOOK_TLB_FILL, native.supi3_tlb_fill, data=ctypes.byref(self._memory))
         on_idle_loop = _HOOK_CODE(self._on_idle_loop)
         for address in idle_loops(self.image, flash):  # MCU-4: the core stops at its first ``b .``
