@@ -865,7 +865,9 @@ class CortexM:
         state.exc_return_thread_psp = EXC_RETURN_THREAD_PSP
         state.xpsr_t, state.xpsr_align, state.control_spsel = XPSR_T, XPSR_ALIGN, CONTROL_SPSEL
         state.no_interrupt = _NO_INTERRUPT
-        self._state_ref = ctypes.byref(state)
+        # MCU-92: a pointer, not a byref: the collector sees into a pointer, so a board let go is freed (a byref held
+        # for the core's life hid the state's references back to the core and kept every board alive)
+        self._state_ref = ctypes.pointer(state)
         self._native_enter = _native(native.supi3_enter, ctypes.c_uint32, ctypes.c_uint32, ctypes.c_uint64)
         self._native_take = _native(native.supi3_take, ctypes.c_uint32, ctypes.c_uint32, ctypes.c_uint64)
         self._native_return = _native(native.supi3_return, ctypes.c_uint32)
@@ -879,7 +881,7 @@ class CortexM:
         frames.prefix_mask = PREFIX_SLOTS - 1
         frames.exception_exit, frames.primask_register = EXCP_EXCEPTION_EXIT, arm.UC_ARM_REG_PRIMASK  # MCU-86
         frames.irq_fell = frames.chain_latency = -1
-        self._frames_ref = ctypes.byref(frames)
+        self._frames_ref = ctypes.pointer(frames)
         self.entry: Callable[[], None] | None = None
         """MCU-51: called first at each entry into Python while the core runs (a peripheral's read or write, a watched
         address) and when a run ends: the native frames' catch-up."""
