@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import gc
 import re
+import tracemalloc
 import weakref
 from pathlib import Path
 
@@ -25,7 +26,7 @@ from supi3.mcu.board import Board
 from supi3.mcu.core import CPUS, FirmwareStoppedError, Stop
 from supi3.model.registers import InconsistentDataError, InterfaceViolationError
 from supi3.sdk import native
-from supi3.sdk.bench import Bench
+from supi3.sdk.bench import KEPT, Bench
 from supi3.sdk.examples.history import SETTLE_CYCLES
 from supi3.spi.upif import Mode
 from support import c_firmware
@@ -167,6 +168,24 @@ def test_a_board_let_go_is_freed(digital_io: dict[str, Path], options: dict[str,
     del board
     gc.collect()
     assert gone() is None
+
+
+def test_a_long_run_stays_flat_in_memory(digital_io: dict[str, Path]) -> None:
+    """A firmware test of any length: once the bench keeps its last ``KEPT`` cycles (FW-6), 1,000 more master cycles
+    leave no more memory held (MCU-92's companion: a board let go is freed, a board kept running does not grow)."""
+    board = Board(digital_io["cortex_m3"], bit_rate=500_000)
+    tracemalloc.start()  # before the kept history fills, so that each cycle it drops was traced too
+    try:
+        board.run(KEPT + 100)
+        gc.collect()
+        before = tracemalloc.get_traced_memory()[0]
+        board.run(1000)
+        gc.collect()
+        grown = tracemalloc.get_traced_memory()[0] - before
+    finally:
+        tracemalloc.stop()
+    assert board.cycles >= 2 * KEPT and board.violations == []
+    assert grown < 16 * 1024, f"{grown} bytes more after 1,000 cycles"
 
 
 def test_a_too_fast_sclk_is_caught_with_the_program_counter(tmp_path: Path) -> None:
